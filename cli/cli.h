@@ -1,0 +1,33 @@
+/*
+ * cli.h -- the command-line tool's parts.  The tool uses the public API
+ * only (hausdorff.h); nothing here reaches into src/.
+ */
+#ifndef HD_CLI_H
+#define HD_CLI_H
+
+#include <hausdorff.h>
+#include <stdio.h>
+
+/* Exit codes: the contract scripts rely on. */
+enum { EXIT_OK = 0, EXIT_USAGE = 1, EXIT_BADINPUT = 2, EXIT_FAILURE_ = 3 };
+
+typedef struct cli_args {
+    const char *path_a, *path_b;
+    hd_options_t opt;
+    hd_read_options_t read;
+    int directed;
+    int json;
+    int quiet;
+} cli_args_t;
+
+/* Parse argv.  Returns -1 to go on, or an exit code (after --help,
+ * --version, or a usage error, which it has reported). */
+int cli_parse(int argc, char **argv, cli_args_t *a);
+void cli_usage(FILE *out);
+
+/* JSON output helpers: numbers with 17 significant digits, so that they
+ * read back as the same double; strings escaped. */
+void json_number(FILE *out, double v);
+void json_string(FILE *out, const char *s);
+
+#endif

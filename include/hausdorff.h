@@ -1,0 +1,363 @@
+/*
+ * hausdorff.h -- exact Hausdorff distance between 3D point sets.
+ *
+ * This is the only public header of libhausdorff.  Everything a C user needs
+ * is declared and documented here; nothing else needs to be read.
+ *
+ * A first program:
+ *
+ *     #include <hausdorff.h>
+ *     #include <stdio.h>
+ *
+ *     int main(void) {
+ *         double a[] = { 0,0,0,  1,0,0,  0,1,0 };
+ *         double b[] = { 0,0,0.5,  1,0.25,0 };
+ *         hd_points_t A = hd_points_f64(a, 3), B = hd_points_f64(b, 2);
+ *         hd_options_t opt;
+ *         hd_options_init(&opt);            // algorithm "auto", every core
+ *         hd_symmetric_t r;
+ *         hd_error_t err;
+ *         if (hd_hausdorff(&A, &B, &opt, &r, &err) != HD_OK) {
+ *             fprintf(stderr, "hausdorff: %s\n", err.message);
+ *             return 1;
+ *         }
+ *         printf("H = %.17g, realised by A[%zu] and B[%zu]\n",
+ *                r.distance, r.ab.i, r.ab.j);
+ *         return 0;
+ *     }
+ *
+ * Build with `cc prog.c $(pkg-config --cflags --libs hausdorff)`, or in CMake
+ * with `find_package(hausdorff)` and `target_link_libraries(app hausdorff::hausdorff)`.
+ *
+ * Conventions, as in SQLite and libuv:
+ *  - Every call that can fail returns an int: HD_OK (0) or a negative HD_E*
+ *    code.  hd_strerror() names a code.  Results come back through
+ *    out-pointers.  When a call fails and the caller passed an hd_error_t,
+ *    it holds the code and a sentence with context ("FILE:LINE: reason").
+ *    There is no global error state; the library never aborts or exits.
+ *  - The caller owns what it passes in.  What the library allocates is freed
+ *    with the matching hd_*_free(), which accepts NULL.
+ *  - Exact means bit-identical to brute force in doubles: every algorithm
+ *    evaluates squared distances as dx*dx + dy*dy + dz*dz, left to right,
+ *    without fused multiply-add, compares squared values, and takes one sqrt
+ *    at the end.  Float inputs are widened to double exactly.
+ *  - Ties break by the smallest index: the witness (i, j) of a directed
+ *    distance is the smallest i in A whose nearest-neighbour distance is the
+ *    maximum, and the smallest j in B at that distance from A[i].  So the
+ *    witness is the same at any thread count and for every algorithm.
+ *  - Thread safety: functions are reentrant; a built index is immutable and
+ *    may be queried from many threads at once.  Seeds are explicit.
+ */
+#ifndef HAUSDORFF_H
+#define HAUSDORFF_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define HD_VERSION_MAJOR 0
+#define HD_VERSION_MINOR 1
+#define HD_VERSION_PATCH 0
+#define HD_VERSION_STRING "0.1.0"
+
+#if defined(_WIN32) && defined(HD_SHARED)
+#define HD_EXTERN __declspec(dllexport)
+#elif defined(__GNUC__)
+#define HD_EXTERN __attribute__((visibility("default")))
+#else
+#define HD_EXTERN
+#endif
+
+/* ------------------------------------------------------------------------
+ * Result codes.  One table; hd_strerror() gives the short text of each.
+ * ---------------------------------------------------------------------- */
+#define HD_ERRNO_MAP(XX)                                                    \
+    XX(OK, 0, "success")                                                    \
+    XX(EINVAL, -1, "invalid argument")                                      \
+    XX(ENOMEM, -2, "out of memory")                                         \
+    XX(EEMPTY, -3, "empty point set")                                       \
+    XX(ENONFINITE, -4, "coordinate is NaN or infinite")                     \
+    XX(ERANGE, -5, "coordinate magnitude too large (limit 1e153)")          \
+    XX(EIO, -6, "input/output error")                                       \
+    XX(EFORMAT, -7, "malformed input")                                      \
+    XX(EUNSUPPORTED, -8, "unsupported format or feature")                   \
+    XX(ETHREAD, -9, "could not start a thread")                             \
+    XX(EOVERFLOW, -10, "size overflow")                                     \
+    XX(EALGORITHM, -11, "unknown algorithm")
+
+enum {
+#define HD__ERRNO_ENUM(name, value, text) HD_##name = value,
+    HD_ERRNO_MAP(HD__ERRNO_ENUM)
+#undef HD__ERRNO_ENUM
+    HD__ERRNO_LAST
+};
+
+/* Largest coordinate magnitude accepted.  Beyond it squared differences could
+ * overflow a double (3 * (2e153)^2 < DBL_MAX); such input is refused with
+ * HD_ERANGE, never answered wrongly. */
+#define HD_MAX_COORD 1e153
+
+/* Context of a failure, filled by any call that takes one (it may be NULL).
+ * `message` is a complete sentence such as "cloud.ply:12: expected 3 numbers,
+ * found 2"; `line` (1-based, text input) and `offset` (bytes, binary input)
+ * are -1 when they do not apply. */
+typedef struct hd_error {
+    int code;
+    long long line;
+    long long offset;
+    char message[1024];
+} hd_error_t;
+
+/* The short text of a result code ("empty point set"); never NULL. */
+HD_EXTERN const char *hd_strerror(int code);
+/* The symbolic name of a result code ("HD_EEMPTY"); never NULL. */
+HD_EXTERN const char *hd_err_name(int code);
+/* The library's version, "MAJOR.MINOR.PATCH". */
+HD_EXTERN const char *hd_version(void);
+
+/* ------------------------------------------------------------------------
+ * Point sets: a view over caller memory, never copied by the view itself.
+ * ---------------------------------------------------------------------- */
+typedef enum hd_dtype { HD_FLOAT64 = 0, HD_FLOAT32 = 1 } hd_dtype_t;
+
+/* `count` points, point k's coordinate c (0=x, 1=y, 2=z) at
+ *     (char *)data + k * stride + c * cstride
+ * read as a double or a float.  stride 0 means 3 elements (packed xyz),
+ * cstride 0 means one element (x, y, z adjacent).  Strides may be negative
+ * (numpy views).  The caller keeps the memory alive for the duration of the
+ * call it is passed to (and for the life of an index built on it). */
+typedef struct hd_points {
+    const void *data;
+    size_t count;
+    hd_dtype_t dtype;
+    ptrdiff_t stride;
+    ptrdiff_t cstride;
+} hd_points_t;
+
+/* Views over packed x,y,z triples. */
+HD_EXTERN hd_points_t hd_points_f64(const double *xyz, size_t count);
+HD_EXTERN hd_points_t hd_points_f32(const float *xyz, size_t count);
+
+/* Point k of a view, widened to double (exact for float).  No checks. */
+HD_EXTERN void hd_points_get(const hd_points_t *p, size_t k, double out[3]);
+
+/* ------------------------------------------------------------------------
+ * Options.
+ * ---------------------------------------------------------------------- */
+typedef enum hd_algorithm {
+    HD_ALG_AUTO = 0,   /* the default engine: fastest exact algorithm */
+    HD_ALG_NAIVE,      /* Algorithm 1 (NAIVEHDD) */
+    HD_ALG_EARLYBREAK, /* Algorithm 2 (Taha & Hanbury) */
+    HD_ALG_INC,        /* incremental dual-tree (Nutanong, Jacox & Samet) */
+    HD_ALG_NOHD,       /* Algorithms 3-5 */
+    HD_ALG_OHD,        /* Algorithms 6-7 */
+    HD_ALG_FRAMEWORK,  /* Algorithm 8: NOHD / EARLYBREAK / OHD by overlap */
+    HD_ALG_KDTREE,     /* one exact nearest-neighbour search per point of A */
+    HD__ALG_COUNT
+} hd_algorithm_t;
+
+typedef struct hd_options {
+    hd_algorithm_t algorithm; /* HD_ALG_AUTO */
+    int threads;              /* 0: every core; 1: serial */
+    uint64_t seed;            /* randomisation (EARLYBREAK, OHD sample); 0 */
+    int depth;                /* NOHD octree depth on A; 6 */
+    double lambda;            /* OHD sample fraction of |A|; 0.01 */
+    double theta;             /* framework overlap threshold; 0.33 */
+    int early_break;          /* NOHD early breaking (0 = nNOHD); 1 */
+    int culling;              /* OHD point culling (0 = nOHD); 1 */
+    int exclude_common;       /* EARLYBREAK skips A points found in B; 1 */
+} hd_options_t;
+
+/* Fill `opt` with the defaults shown above. */
+HD_EXTERN void hd_options_init(hd_options_t *opt);
+
+/* Algorithm names: "auto", "naive", "earlybreak", "inc", "nohd", "ohd",
+ * "framework", "kdtree".  hd_algorithm_from_name returns HD_EALGORITHM for
+ * an unknown name.  hd_algorithm_name never returns NULL. */
+HD_EXTERN int hd_algorithm_from_name(const char *name, hd_algorithm_t *out);
+HD_EXTERN const char *hd_algorithm_name(hd_algorithm_t alg);
+
+/* ------------------------------------------------------------------------
+ * Results.
+ * ---------------------------------------------------------------------- */
+/* Counters that let a benchmark explain itself.  Each is a sum over threads. */
+typedef struct hd_stats {
+    uint64_t distance_evals; /* point-to-point squared distances evaluated */
+    uint64_t nodes_visited;  /* tree nodes or buckets visited */
+    uint64_t points_culled;  /* points of A discarded without an NN search */
+} hd_stats_t;
+
+/* A directed distance h(A,B) = max over a in A of min over b in B |a - b|. */
+typedef struct hd_result {
+    double distance;          /* sqrt(distance2) */
+    double distance2;         /* the squared distance, as evaluated */
+    size_t i;                 /* witness: index in A (smallest on ties) */
+    size_t j;                 /* witness: index in B (smallest on ties) */
+    hd_algorithm_t algorithm; /* the algorithm that actually ran */
+    hd_stats_t stats;
+    double seconds;           /* wall-clock time of the computation */
+} hd_result_t;
+
+/* The symmetric distance H(A,B) = max(h(A,B), h(B,A)). */
+typedef struct hd_symmetric {
+    double distance;
+    hd_result_t ab;   /* h(A,B): ab.i indexes A, ab.j indexes B */
+    hd_result_t ba;   /* h(B,A): ba.i indexes B, ba.j indexes A */
+    double alpha;     /* overlap degree of the bounding boxes, see below */
+    int disjoint;     /* 1 when the bounding boxes do not intersect */
+    double seconds;
+} hd_symmetric_t;
+
+/* ------------------------------------------------------------------------
+ * Distances.
+ * ---------------------------------------------------------------------- */
+
+/* h(A,B), the directed Hausdorff distance from A to B.
+ *
+ * A, B: views over caller memory, read only during the call.  Both must be
+ *   non-empty (HD_EEMPTY), finite (HD_ENONFINITE) and within HD_MAX_COORD
+ *   (HD_ERANGE).
+ * opt: NULL for the defaults.  out: receives the distance and the witness.
+ * err: NULL, or receives the context of a failure.
+ * Errors: HD_EINVAL (NULL argument, bad option), HD_EEMPTY, HD_ENONFINITE,
+ *   HD_ERANGE, HD_ENOMEM, HD_ETHREAD.
+ * Thread safety: reentrant; it may start opt->threads threads of its own. */
+HD_EXTERN int hd_directed(const hd_points_t *A, const hd_points_t *B,
+                          const hd_options_t *opt, hd_result_t *out,
+                          hd_error_t *err);
+
+/* H(A,B) with both directions and their witnesses.  With the framework
+ * algorithm each direction is chosen by the overlap; out->ab.algorithm and
+ * out->ba.algorithm say what ran.  Same arguments and errors as
+ * hd_directed. */
+HD_EXTERN int hd_hausdorff(const hd_points_t *A, const hd_points_t *B,
+                           const hd_options_t *opt, hd_symmetric_t *out,
+                           hd_error_t *err);
+
+/* The overlap degree alpha of the bounding boxes of A and B, as the
+ * framework (Algorithm 8) uses it.  The paper leaves alpha undefined; here,
+ * per axis k, r_k = |I_k| / min(|A_k|, |B_k|) where I_k is the intersection
+ * of the two extents (r_k = 1 when that minimum is 0 and the extents meet),
+ * and alpha = r_x * r_y * r_z.  So alpha is 0 when the boxes just touch and
+ * 1 when they coincide (or one box's extent lies within the other's on every
+ * axis).  *disjoint is 1 when the boxes do not intersect (alpha is then 0).
+ * Errors: as hd_directed. */
+HD_EXTERN int hd_overlap(const hd_points_t *A, const hd_points_t *B,
+                         double *alpha, int *disjoint, hd_error_t *err);
+
+/* ------------------------------------------------------------------------
+ * A reusable index of B: build once, query many times.
+ * ---------------------------------------------------------------------- */
+typedef struct hd_index hd_index_t;
+
+/* A rigid (or any affine) transform applied to query points on the fly:
+ *     x' = ((r[0]*x + r[1]*y) + r[2]*z) + t[0]
+ *     y' = ((r[3]*x + r[4]*y) + r[5]*z) + t[1]
+ *     z' = ((r[6]*x + r[7]*y) + r[8]*z) + t[2]
+ * evaluated in double in exactly this order, without fused multiply-add, so a
+ * brute force that applies the same formula agrees to the bit. */
+typedef struct hd_transform {
+    double r[9];
+    double t[3];
+} hd_transform_t;
+
+/* The identity transform. */
+HD_EXTERN void hd_transform_identity(hd_transform_t *T);
+
+/* Build an index of B.
+ *
+ * The index BORROWS B: it may keep a pointer to B's memory, which the caller
+ * must keep alive and unchanged until hd_index_free().  What the index
+ * allocates itself (reordered coordinates, bucket boxes) is at most a few
+ * tens of bytes per point and is freed by hd_index_free().
+ * opt: NULL for defaults; opt->threads is used for the build.
+ * Errors: HD_EINVAL, HD_EEMPTY, HD_ENONFINITE, HD_ERANGE, HD_ENOMEM,
+ *   HD_EOVERFLOW, HD_ETHREAD.
+ * Thread safety: the built index is immutable; any number of threads may
+ * query it at once. */
+HD_EXTERN int hd_index_build(const hd_points_t *B, const hd_options_t *opt,
+                             hd_index_t **out, hd_error_t *err);
+
+/* Free an index.  NULL is accepted. */
+HD_EXTERN void hd_index_free(hd_index_t *idx);
+
+/* Number of points of the indexed set. */
+HD_EXTERN size_t hd_index_count(const hd_index_t *idx);
+
+/* Bytes the index allocated itself (not counting the borrowed points). */
+HD_EXTERN size_t hd_index_memory(const hd_index_t *idx);
+
+/* h(T(A), B) against an index of B; T NULL means the identity.  The witness
+ * indexes A and B in their original order.  A is read during the call only.
+ * Errors: as hd_directed. */
+HD_EXTERN int hd_index_directed(const hd_index_t *idx, const hd_points_t *A,
+                                const hd_transform_t *T,
+                                const hd_options_t *opt, hd_result_t *out,
+                                hd_error_t *err);
+
+/* Per-point nearest neighbours: for each point k of Q (after T, if not
+ * NULL), dist[k] = min over B |T(q_k) - b| and nearest[k] = the smallest
+ * index in B at that distance.  Either output may be NULL; each has
+ * Q->count elements.  Errors: as hd_directed. */
+HD_EXTERN int hd_index_nearest(const hd_index_t *idx, const hd_points_t *Q,
+                               const hd_transform_t *T,
+                               const hd_options_t *opt, double *dist,
+                               size_t *nearest, hd_error_t *err);
+
+/* ------------------------------------------------------------------------
+ * Reading files.
+ * ---------------------------------------------------------------------- */
+
+/* A point cloud read from a file; the library owns it (hd_cloud_free). */
+typedef struct hd_cloud {
+    void *data;        /* count packed xyz triples of dtype */
+    size_t count;
+    hd_dtype_t dtype;
+    char format[16];   /* the format that was read, e.g. "ply" */
+    size_t n_faces;    /* faces seen (mesh formats), 0 otherwise */
+} hd_cloud_t;
+
+typedef enum hd_mesh_mode {
+    HD_MESH_VERTICES = 0, /* the vertex set, as the paper does */
+    HD_MESH_SAMPLE = 1    /* `sample` points uniformly by area, seeded */
+} hd_mesh_mode_t;
+
+typedef struct hd_read_options {
+    const char *format;  /* NULL: by extension, confirmed by magic */
+    hd_dtype_t dtype;    /* storage of the result: HD_FLOAT64 default */
+    hd_mesh_mode_t mesh; /* for formats with faces */
+    size_t sample;       /* points to sample with HD_MESH_SAMPLE */
+    uint64_t seed;       /* sampling seed */
+    int threads;         /* parallel text parsing: 0 = every core */
+} hd_read_options_t;
+
+/* Fill `opt` with the defaults (by extension, double, vertices). */
+HD_EXTERN void hd_read_options_init(hd_read_options_t *opt);
+
+/* Read a point cloud from `path` ("-" reads standard input; then `format`
+ * must be given or the content is sniffed).  opt NULL: defaults.
+ * Errors: HD_EIO (cannot open or read), HD_EFORMAT (malformed: the message
+ *   names the file and the line or byte offset), HD_EUNSUPPORTED, HD_EEMPTY
+ *   (no points), HD_ENONFINITE, HD_ERANGE, HD_ENOMEM, HD_EOVERFLOW.
+ * No reader allocates more than the file can hold. */
+HD_EXTERN int hd_read_file(const char *path, const hd_read_options_t *opt,
+                           hd_cloud_t **out, hd_error_t *err);
+
+/* Free a cloud.  NULL is accepted. */
+HD_EXTERN void hd_cloud_free(hd_cloud_t *cloud);
+
+/* A view over a cloud (valid while the cloud lives). */
+HD_EXTERN hd_points_t hd_cloud_points(const hd_cloud_t *cloud);
+
+/* The formats the reader knows, as a NULL-terminated array of names, each
+ * with a one-line description in hd_format_description(). */
+HD_EXTERN const char *const *hd_formats(void);
+HD_EXTERN const char *hd_format_description(const char *name);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* HAUSDORFF_H */

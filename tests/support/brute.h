@@ -1,0 +1,19 @@
+/*
+ * brute.h -- the reference the tests trust: a plain double loop, written
+ * independently of the library, with the squared distance evaluated as
+ * dx*dx + dy*dy + dz*dz left to right and ties broken by the smallest index.
+ */
+#ifndef HD_TEST_BRUTE_H
+#define HD_TEST_BRUTE_H
+
+#include <stddef.h>
+
+typedef struct brute {
+    double d2;  /* squared directed distance */
+    size_t i, j;
+} brute_t;
+
+brute_t brute_directed(const double *a, size_t na, const double *b, size_t nb);
+double brute_d2(const double *p, const double *q);
+
+#endif

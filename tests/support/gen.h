@@ -1,0 +1,32 @@
+/*
+ * gen.h -- seeded point-set generators shared by tests, benchmarks and
+ * experiments.  All take an explicit seed; none reads the clock.
+ * Every generator fills packed xyz doubles.
+ */
+#ifndef HD_TEST_GEN_H
+#define HD_TEST_GEN_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+typedef struct gen_rng { uint64_t s; } gen_rng_t;
+void gen_seed(gen_rng_t *r, uint64_t seed);
+uint64_t gen_u64(gen_rng_t *r);
+double gen_unit(gen_rng_t *r);          /* [0, 1) */
+double gen_normal(gen_rng_t *r);        /* standard normal */
+
+/* n points ~ N(mean, sigma^2 I). */
+void gen_gauss(gen_rng_t *r, double *xyz, size_t n, const double mean[3], double sigma);
+/* n points uniform in the cube [lo, hi]^3. */
+void gen_cube(gen_rng_t *r, double *xyz, size_t n, double lo, double hi);
+/* Integer lattice points chosen at random in [0, side)^3 (ties galore). */
+void gen_lattice(gen_rng_t *r, double *xyz, size_t n, int side);
+/* n points on a random line segment / plane patch through the origin. */
+void gen_line(gen_rng_t *r, double *xyz, size_t n);
+void gen_plane(gen_rng_t *r, double *xyz, size_t n);
+/* n points on a torus (major radius R, minor radius rr), centred at 0. */
+void gen_torus(gen_rng_t *r, double *xyz, size_t n, double R, double rr);
+/* Scale and shift every coordinate: x -> x * scale + offset. */
+void gen_affine(double *xyz, size_t n, double scale, double offset);
+
+#endif
