@@ -46,5 +46,12 @@ test-asan:
 install: all
 	cmake --install $(BUILD) $(if $(PREFIX),--prefix $(PREFIX))
 
+# The Python module alone, into $(BUILD)/python (docs/python.md); `make`
+# builds it too whenever numpy, setuptools and Python.h are present.
+python:
+	@scripts/deps.sh build extras python
+	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release $(CMAKE_ARGS)
+	cmake --build $(BUILD) -j$(JOBS) --target hausdorff_python
+
 clean:
 	rm -rf $(BUILD) $(ASAN_BUILD)

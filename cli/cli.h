@@ -8,6 +8,8 @@
 #include <hausdorff.h>
 #include <stdio.h>
 
+#include "analysis.h"
+
 /* Exit codes: the contract scripts rely on. */
 enum { EXIT_OK = 0, EXIT_USAGE = 1, EXIT_BADINPUT = 2, EXIT_FAILURE_ = 3 };
 
@@ -18,12 +20,15 @@ typedef struct cli_args {
     int directed;
     int json;
     int quiet;
+    analysis_args_t an; /* analysis options (analysis.h) */
 } cli_args_t;
 
 /* Parse argv.  Returns -1 to go on, or an exit code (after --help,
  * --version, or a usage error, which it has reported). */
 int cli_parse(int argc, char **argv, cli_args_t *a);
 void cli_usage(FILE *out);
+/* The formats the reader knows, one per line (--formats). */
+void cli_formats(FILE *out);
 
 /* JSON output helpers: numbers with 17 significant digits, so that they
  * read back as the same double; strings escaped. */

@@ -8,10 +8,12 @@
  * "hausdorff: " and maps them to exit codes: bad input 2, other failure 3.
  */
 #include "cli.h"
+#include "progress.h"
 
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <unistd.h>
 
 static double now(void) {
     struct timespec ts;
@@ -53,14 +55,26 @@ int main(int argc, char **argv) {
     hd_error_t err;
     hd_cloud_t *ca = NULL, *cb = NULL;
     double t0 = now();
-    if ((rc = hd_read_file(a.path_a, &a.read, &ca, &err)) != HD_OK ||
-        (rc = hd_read_file(a.path_b, &a.read, &cb, &err)) != HD_OK) {
+    /* progress by phase (read A, read B, compute), only for a person */
+    progress_start(!a.quiet && !a.json && isatty(2), 3);
+    progress_phase("reading A: %s", a.path_a);
+    if ((rc = cli_read_points(a.path_a, &a.read, &a.an, 0, &ca, &err)) != HD_OK ||
+        (progress_phase("reading B: %s", a.path_b),
+         rc = cli_read_points(a.path_b, &a.read, &a.an, 1, &cb, &err)) != HD_OK) {
+        progress_stop();
         fprintf(stderr, "hausdorff: %s\n", err.message);
         hd_cloud_free(ca);
         return exit_for(rc);
     }
     double read_seconds = now() - t0;
     hd_points_t A = hd_cloud_points(ca), B = hd_cloud_points(cb);
+    progress_phase("computing (%zu x %zu points)", A.count, B.count);
+    if ((rc = analysis_handle_empty(&a.an, a.path_a, a.path_b, &A, &B, a.directed, a.json)) >= 0) {
+        progress_stop();
+        hd_cloud_free(ca);
+        hd_cloud_free(cb);
+        return rc;
+    }
 
     hd_symmetric_t s;
     memset(&s, 0, sizeof s);
@@ -74,6 +88,11 @@ int main(int argc, char **argv) {
     } else {
         rc = hd_hausdorff(&A, &B, &a.opt, &s, &err);
     }
+    analysis_result_t an;
+    if (rc == HD_OK && (rc = analysis_run(&a.an, &a.opt, &A, &B, &s, a.directed, a.path_a, a.path_b, &an,
+                                          &err)) != HD_OK)
+        analysis_free(&an);
+    progress_stop();
     if (rc != HD_OK) {
         fprintf(stderr, "hausdorff: %s\n", err.message);
         hd_cloud_free(ca);
@@ -124,6 +143,7 @@ int main(int argc, char **argv) {
         fprintf(out, ", \"stats_ba\": ");
         if (a.directed) fputs("null", out);
         else stats_json(out, &s.ba.stats);
+        analysis_json(out, &a.an, &an);
         fprintf(out, "}\n");
     } else {
         fprintf(out, "A: %s (%zu points, %s)\n", a.path_a, A.count, ca->format);
@@ -146,7 +166,9 @@ int main(int argc, char **argv) {
         fprintf(out, "overlap alpha = %.3f%s; algorithm %s\n", s.alpha, s.disjoint ? " (disjoint boxes)" : "",
                 hd_algorithm_name(a.opt.algorithm));
         fprintf(out, "time: %.6f s computing, %.6f s reading\n", s.seconds, read_seconds);
+        analysis_print(out, &a.an, &an);
     }
+    analysis_free(&an);
     hd_cloud_free(ca);
     hd_cloud_free(cb);
     return EXIT_OK;

@@ -29,17 +29,36 @@ void cli_usage(FILE *out) {
 "  --no-early-break   NOHD without early breaking (the paper's nNOHD)\n"
 "  --no-culling       OHD without point culling (the paper's nOHD)\n"
 "  --format NAME      read both files as NAME instead of by extension\n"
+"                     (a file named - is standard input)\n"
+"  --formats          list the file formats and exit\n"
+"  --vertices         read a mesh (ply, obj, off, stl) as its vertices (default)\n"
+"  --sample N         read a mesh as N points drawn uniformly by area on its\n"
+"                     faces, reproducibly for a given --seed\n"
 "  --float32          store coordinates as float (half the memory)\n"
 "  --json             print one JSON object\n"
-"  --quiet            no progress output\n"
-"  --help, --version\n"
+"  --quiet            no progress bar on stderr (there is none when stderr\n"
+"                     is not a terminal, nor with --json)\n"
+"  --help, --version\n");
+    analysis_usage(out);
+    fprintf(out,
 "\n"
 "Examples:\n"
 "  hausdorff scan.ply model.ply\n"
 "  hausdorff --json --algorithm framework a.xyz b.xyz\n"
 "  hausdorff --directed --threads 1 part.ply reference.ply\n"
+"  hausdorff --sample 100000 --seed 7 part.stl scan.las\n"
+"  cat cloud.csv | hausdorff --format xyz - model.ply\n"
+"  hausdorff --percentile 95 --mean --render dev.png scan.ply model.ply\n"
+"  hausdorff --json --percentile 95 seg.nii.gz truth.nii.gz\n"
 "\n"
 "Exit status: 0 success, 1 usage error, 2 bad input, 3 other failure.\n");
+}
+
+void cli_formats(FILE *out) {
+    fprintf(out, "Formats (chosen by extension, confirmed by content; --format NAME overrides):\n");
+    for (const char *const *f = hd_formats(); *f; f++) fprintf(out, "  %-5s %s\n", *f, hd_format_description(*f));
+    fprintf(out, "Extensions: .ply .obj .off .stl; .xyz .txt .csv .pts .asc; .pcd .las .npy.\n"
+                 "LAZ is not read: convert it with 'laszip -i in.laz -o out.las' or 'pdal translate in.laz out.las'.\n");
 }
 
 static int bad(const char *fmt, const char *arg) {
@@ -81,6 +100,7 @@ int cli_parse(int argc, char **argv, cli_args_t *a) {
     memset(a, 0, sizeof *a);
     hd_options_init(&a->opt);
     hd_read_options_init(&a->read);
+    analysis_args_init(&a->an);
     const char *files[2];
     int nfiles = 0, only_files = 0;
     for (int k = 1; k < argc; k++) {
@@ -99,6 +119,11 @@ int cli_parse(int argc, char **argv, cli_args_t *a) {
         if (strcmp(s, "--no-early-break") == 0) { a->opt.early_break = 0; continue; }
         if (strcmp(s, "--no-culling") == 0) { a->opt.culling = 0; continue; }
         if (strcmp(s, "--float32") == 0) { a->read.dtype = HD_FLOAT32; continue; }
+        if (strcmp(s, "--vertices") == 0) { a->read.mesh = HD_MESH_VERTICES; continue; }
+        if (strcmp(s, "--formats") == 0) { cli_formats(stdout); return EXIT_OK; }
+        int an = analysis_parse_option(argc, argv, &k, &a->an);
+        if (an < 0) return EXIT_USAGE;
+        if (an > 0) continue;
         /* options with an argument, as "--opt VALUE" or "--opt=VALUE" */
         const char *eq = strchr(s, '=');
         char name[64];
@@ -107,7 +132,7 @@ int cli_parse(int argc, char **argv, cli_args_t *a) {
         memcpy(name, s, nl);
         name[nl] = '\0';
         static const char *const with_arg[] = {"--algorithm", "--threads", "--seed", "--depth",
-                                               "--lambda", "--theta", "--format", NULL};
+                                               "--lambda", "--theta", "--format", "--sample", NULL};
         int known = 0;
         for (int w = 0; with_arg[w]; w++) known |= strcmp(name, with_arg[w]) == 0;
         if (!known) return bad("unknown option '%s'", s);
@@ -134,8 +159,15 @@ int cli_parse(int argc, char **argv, cli_args_t *a) {
         } else if (strcmp(name, "--format") == 0) {
             if (!hd_format_description(v)) return bad("unknown format '%s' (see --formats)", v);
             a->read.format = v;
+        } else if (strcmp(name, "--sample") == 0) {
+            uint64_t n;
+            if (parse_u64(v, &n) || n == 0 || n > (uint64_t)1 << 40)
+                return bad("--sample needs a whole number of points 1..2^40, not '%s'", v);
+            a->read.mesh = HD_MESH_SAMPLE;
+            a->read.sample = (size_t)n;
         }
     }
+    a->read.seed = a->opt.seed; /* --seed also seeds --sample */
     if (nfiles != 2) {
         fprintf(stderr, "hausdorff: expected two files, A and B\n");
         cli_usage(stderr);

@@ -308,6 +308,107 @@ HD_EXTERN int hd_index_nearest(const hd_index_t *idx, const hd_points_t *Q,
                                size_t *nearest, hd_error_t *err);
 
 /* ------------------------------------------------------------------------
+ * Analysis: where the deviation is.  Per-point nearest-neighbour distances
+ * and what is derived from them (percentile Hausdorff such as HD95, mean
+ * distances, Chamfer distances, histograms).  docs/analysis.md has the
+ * definitions, with the tools each one agrees with.
+ * ---------------------------------------------------------------------- */
+
+/* Per-point nearest neighbours in both directions: for each point k of A,
+ * dist_ab[k] = min over B |a_k - b| and nearest_ab[k] = the smallest index
+ * in B at that distance; dist_ba and nearest_ba likewise for the points of
+ * B against A.  Each output may be NULL (a direction with both outputs NULL
+ * is skipped); dist_ab/nearest_ab hold A->count elements, dist_ba/nearest_ba
+ * B->count.  Exact: bit-identical to a brute force, at any thread count.
+ * Built on the index (one hd_index_build per set, hd_index_nearest in
+ * parallel with opt->threads).  Errors: as hd_directed. */
+HD_EXTERN int hd_distances(const hd_points_t *A, const hd_points_t *B,
+                           const hd_options_t *opt, double *dist_ab,
+                           size_t *nearest_ab, double *dist_ba,
+                           size_t *nearest_ba, hd_error_t *err);
+
+/* Percentiles of n values with numpy's default method ("linear", Hyndman &
+ * Fan's definition 7), bit-identical to numpy.percentile(values, p): for
+ * the sorted values v, pos = (n - 1) * (p / 100), lo = floor(pos),
+ * t = pos - lo, result = v[lo] + (v[lo+1] - v[lo]) * t (computed as
+ * v[lo+1] - (v[lo+1] - v[lo]) * (1 - t) when t >= 0.5, as numpy does); the
+ * maximum when pos >= n - 1.  Found by selection on a copy (values are not
+ * modified), without sorting.  p in [0, 100]; np requests, np results.
+ * Errors: HD_EINVAL (p outside [0, 100], NULL), HD_EEMPTY (n = 0),
+ * HD_ENONFINITE (a NaN value), HD_ENOMEM. */
+HD_EXTERN int hd_percentiles(const double *values, size_t n, const double *p,
+                             size_t np, double *out, hd_error_t *err);
+HD_EXTERN int hd_percentile(const double *values, size_t n, double p,
+                            double *out, hd_error_t *err);
+
+/* Percentile Hausdorff distances, e.g. HD95 with p = 95.  p = 100 gives
+ * the Hausdorff distances themselves. */
+typedef struct hd_percentile {
+    double p;
+    double ab;        /* P-th percentile of the distances of A's points to B */
+    double ba;        /* ... of B's points to A (NaN when not computed) */
+    double symmetric; /* max(ab, ba): MONAI's compute_hausdorff_distance */
+    double pooled;    /* P-th percentile of both directions' distances
+                         together: medpy's hd95 */
+} hd_percentile_t;
+
+/* From per-point distances (hd_distances): d_ab has n_a values; d_ba may be
+ * NULL (then ba, symmetric and pooled are NaN).  Errors: as hd_percentiles. */
+HD_EXTERN int hd_percentile_of(const double *d_ab, size_t n_a,
+                               const double *d_ba, size_t n_b, double p,
+                               hd_percentile_t *out, hd_error_t *err);
+
+/* From the point sets: hd_distances, then hd_percentile_of. */
+HD_EXTERN int hd_hausdorff_percentile(const hd_points_t *A,
+                                      const hd_points_t *B,
+                                      const hd_options_t *opt, double p,
+                                      hd_percentile_t *out, hd_error_t *err);
+
+/* Sums, means and Chamfer distances of per-point distances.  Sums are
+ * compensated (Neumaier), in index order: within about one rounding of the
+ * exact sum, the same at any thread count.  "2" means squared distances
+ * (d * d of each reported distance).  With d_ba NULL every field that needs
+ * B's distances is NaN. */
+typedef struct hd_summary {
+    size_t n_ab, n_ba;          /* numbers of distances */
+    double max_ab, max_ba;      /* h(A,B), h(B,A) */
+    double sum_ab, sum_ba;      /* sum of distances */
+    double sum2_ab, sum2_ba;    /* sum of squared distances */
+    double mean_ab, mean_ba;    /* mean distance of A's points to B, ... */
+    double mean2_ab, mean2_ba;  /* mean squared distance */
+    double mean_symmetric;      /* max(mean_ab, mean_ba): the average
+                                   Hausdorff distance (Taha & Hanbury) */
+    double mean_average;        /* (mean_ab + mean_ba) / 2 */
+    double mean_pooled;         /* (sum_ab + sum_ba) / (n_ab + n_ba): MONAI's
+                                   symmetric average surface distance */
+    double chamfer;             /* mean2_ab + mean2_ba: THE Chamfer distance
+                                   here (squared, mean per set, summed; as
+                                   PyTorch3D's chamfer_distance) */
+    double chamfer_sum2;        /* sum2_ab + sum2_ba (squared, summed) */
+    double chamfer_mean;        /* mean_ab + mean_ba (not squared, mean) */
+    double chamfer_sum;         /* sum_ab + sum_ba (not squared, summed) */
+} hd_summary_t;
+
+/* Errors: HD_EINVAL, HD_EEMPTY (n_a = 0, or d_ba given with n_b = 0),
+ * HD_ENONFINITE (a NaN). */
+HD_EXTERN int hd_summarize(const double *d_ab, size_t n_a, const double *d_ba,
+                           size_t n_b, hd_summary_t *out, hd_error_t *err);
+
+/* numpy.histogram(values, bins, range=(lo, hi)) to the count: bins equal
+ * bins on [lo, hi] (widened to [lo - 0.5, hi + 0.5] when lo == hi), bin k
+ * is [edge k, edge k+1) except the last, which includes hi; values outside
+ * [lo, hi] are not counted.  counts has `bins` elements.
+ * Errors: HD_EINVAL (bins = 0, lo > hi, a bound not finite, NULL),
+ * HD_ERANGE (hi - lo overflows). */
+HD_EXTERN int hd_histogram(const double *values, size_t n, double lo,
+                           double hi, size_t bins, uint64_t *counts,
+                           hd_error_t *err);
+/* Edge k (0..bins) of that histogram, as numpy.linspace(lo, hi, bins + 1)
+ * computes it: k * ((hi - lo) / bins) + lo, and edge `bins` is hi. */
+HD_EXTERN double hd_histogram_edge(double lo, double hi, size_t bins,
+                                   size_t k);
+
+/* ------------------------------------------------------------------------
  * Reading files.
  * ---------------------------------------------------------------------- */
 

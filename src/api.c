@@ -142,14 +142,16 @@ static int prepare(const hd_points_t *A, const hd_points_t *B,
     if (rc) return rc;
     if ((rc = hd__points_check(A, "A", &p->job.box_a, err))) return rc;
     if ((rc = hd__points_check(B, "B", &p->job.box_b, err))) return rc;
+    p->job.na = A->count;
+    p->job.nb = B->count;
+    p->job.opt = opt;
+    /* The auto engine reads the views itself (no packed copies). */
+    if (opt->algorithm == HD_ALG_AUTO) return HD_OK;
     if ((rc = hd__points_f64(A, NULL, &p->owned_a, &p->job.a, err))) return rc;
     if ((rc = hd__points_f64(B, NULL, &p->owned_b, &p->job.b, err))) {
         free(p->owned_a);
         return rc;
     }
-    p->job.na = A->count;
-    p->job.nb = B->count;
-    p->job.opt = opt;
     return HD_OK;
 }
 
@@ -161,7 +163,10 @@ int hd_directed(const hd_points_t *A, const hd_points_t *B,
     prepared_t p;
     int rc = prepare(A, B, opt, &defaults, &p, err);
     if (rc) return rc;
-    rc = hd__run_directed(&p.job, p.job.opt->algorithm, out, err);
+    if (p.job.opt->algorithm == HD_ALG_AUTO)
+        rc = hd__engine_directed(A, B, p.job.opt, out, err);
+    else
+        rc = hd__run_directed(&p.job, p.job.opt->algorithm, out, err);
     free(p.owned_a);
     free(p.owned_b);
     return rc;
@@ -178,8 +183,11 @@ int hd_hausdorff(const hd_points_t *A, const hd_points_t *B,
     if (rc) return rc;
     double t0 = hd__now();
     out->alpha = hd__alpha(&p.job.box_a, &p.job.box_b, &out->disjoint);
-    rc = hd__run_directed(&p.job, p.job.opt->algorithm, &out->ab, err);
-    if (rc == HD_OK) {
+    if (p.job.opt->algorithm == HD_ALG_AUTO)
+        rc = hd__engine_hausdorff(A, B, p.job.opt, out, err);
+    else
+        rc = hd__run_directed(&p.job, p.job.opt->algorithm, &out->ab, err);
+    if (rc == HD_OK && p.job.opt->algorithm != HD_ALG_AUTO) {
         hd__job_t rev = p.job;
         rev.a = p.job.b;
         rev.na = p.job.nb;

@@ -23,6 +23,7 @@
 #include "hausdorff.h"
 
 #include <stdarg.h>
+#include <stdatomic.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -196,6 +197,18 @@ int hd__parallel_for(int threads, size_t n_tasks, hd__task_fn fn, void *ctx);
 /* ---- clocks ------------------------------------------------------------ */
 double hd__now(void); /* seconds, monotonic */
 
+/* ---- selection and percentiles (select.c) ------------------------------ */
+/* Rearrange v[0..n) (no NaN) so that v[k] holds the value of rank k, with
+ * v[i] <= v[k] before it and v[i] >= v[k] after it; expected O(n), worst
+ * O(n log n) (introselect). */
+void hd__select(double *v, size_t n, size_t k);
+/* HD_OK when 0 <= p <= 100, else HD_EINVAL with a message. */
+int hd__percentile_check(double p, hd_error_t *err);
+/* numpy-linear percentiles p[0..np) of v[0..n) (n > 0, no NaN, p checked),
+ * reordering v; out[r] answers p[r]. */
+int hd__percentiles_inplace(double *v, size_t n, const double *p, size_t np,
+                            double *out, hd_error_t *err);
+
 /* ---- algorithms --------------------------------------------------------- */
 /* What every directed algorithm receives: A and B as packed doubles (after
  * any transform), their boxes, the options and the thread count. */
@@ -222,6 +235,14 @@ int hd__nohd(const hd__job_t *job, hd_result_t *out, hd_error_t *err);
 int hd__ohd(const hd__job_t *job, hd_result_t *out, hd_error_t *err);
 int hd__kdtree(const hd__job_t *job, hd_result_t *out, hd_error_t *err);
 int hd__engine(const hd__job_t *job, hd_result_t *out, hd_error_t *err);
+/* The auto engine on validated views, without packed copies (engine.c):
+ * h(A,B), and H(A,B) with each set indexed once for both directions. */
+int hd__engine_directed(const hd_points_t *A, const hd_points_t *B,
+                        const hd_options_t *opt, hd_result_t *out,
+                        hd_error_t *err);
+int hd__engine_hausdorff(const hd_points_t *A, const hd_points_t *B,
+                         const hd_options_t *opt, hd_symmetric_t *out,
+                         hd_error_t *err);
 
 /* Run h(A,B) on a prepared job (fills seconds, distance, algorithm). */
 int hd__run_directed(hd__job_t *job, hd_algorithm_t alg, hd_result_t *out,
@@ -232,5 +253,60 @@ double hd__alpha(const hd__box_t *a, const hd__box_t *b, int *disjoint);
 /* The framework's choice for h(A,B). */
 hd_algorithm_t hd__framework_choice(const hd__box_t *a, const hd__box_t *b,
                                     double theta);
+
+/* ---- shared by the paper's algorithms (earlybreak.c, nohd.c, ohd.c) ---- */
+/* A lower bound on h(A,B)^2 that threads raise together (cmax, MaxLB,
+ * Maxlb).  It holds a non-negative double whose bits, read as an unsigned
+ * integer, order like the values; it only grows, so a stale read is a
+ * smaller, still valid bound.  Pruning against it is strict (<), so it may
+ * start at 0 with no witness: nothing is ever strictly below 0. */
+typedef struct hd__bound {
+    _Atomic uint64_t bits;
+} hd__bound_t;
+HD__INLINE uint64_t hd__bound_bits(double d2) {
+    union { double d; uint64_t u; } v;
+    v.d = d2 > 0 ? d2 : 0.0; /* never -0.0, whose bits would sort last */
+    return v.u;
+}
+HD__INLINE void hd__bound_init(hd__bound_t *b, double d2) {
+    atomic_init(&b->bits, hd__bound_bits(d2));
+}
+HD__INLINE double hd__bound_get(hd__bound_t *b) {
+    union { double d; uint64_t u; } v;
+    v.u = atomic_load_explicit(&b->bits, memory_order_relaxed);
+    return v.d;
+}
+HD__INLINE void hd__bound_raise(hd__bound_t *b, double d2) {
+    uint64_t want = hd__bound_bits(d2);
+    uint64_t cur = atomic_load_explicit(&b->bits, memory_order_relaxed);
+    while (want > cur && !atomic_compare_exchange_weak_explicit(
+                             &b->bits, &cur, want, memory_order_relaxed,
+                             memory_order_relaxed)) {
+    }
+}
+
+/* The inner loop of Algorithms 2 and 5: scan the n packed points for x's
+ * nearest neighbour, giving up ("cut short") when some squared distance d is
+ * below `bound` or equal to `tie`.  Returns 1 with the minimum in *d2 and
+ * the smallest original index at it in *j (idx[k] is point k's original
+ * index; NULL means k), or 0 when cut short.  Whether a scan is cut short
+ * does not depend on the order of the points, so it is decided per block,
+ * and *evals counts every distance evaluated. */
+int hd__scan_break(const double *x, const double *pts, const size_t *idx, size_t n,
+                   double bound, double tie, double *d2, size_t *j, uint64_t *evals);
+
+/* EARLYBREAK's loop (Algorithm 2, lines 4-16) over the points of A listed
+ * in `order` (visited in that order), against B scanned in a random order
+ * drawn from rng; with exclude_common, points of A equal to a point of B
+ * are skipped (counted in stats->points_culled).  On return *best is the
+ * largest exact nearest-neighbour distance among the points that were not
+ * cut short, with the smallest i among those and the smallest j at that
+ * distance.  A point is cut short only when a distance below the shared
+ * bound proves its nn distance smaller than the final value, or equal to a
+ * value already found at a smaller index; so the witness is canonical among
+ * the points not excluded.  OHD uses it for its AHD. */
+int hd__eb_loop(const hd__job_t *job, const size_t *order, size_t n_order,
+                int exclude_common, hd__rng_t *rng, hd__best_t *best,
+                hd_stats_t *stats, hd_error_t *err);
 
 #endif /* HD_INTERNAL_H */

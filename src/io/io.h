@@ -1,11 +1,14 @@
 /*
- * io.h -- what the readers share: the loaded file, the growing cloud, and
- * the error helpers that put the file name and line or byte offset first.
+ * io.h -- what the readers share: the loaded file, the growing cloud, the
+ * triangles of a mesh, the text-chunk machinery, byte-order helpers and the
+ * error helpers that put the file name and line or byte offset first.
  */
 #ifndef HD_IO_H
 #define HD_IO_H
 
 #include "../internal.h"
+
+#include <string.h>
 
 /* A whole input file in memory (mapped when it is a regular file). */
 typedef struct hd__file {
@@ -14,7 +17,7 @@ typedef struct hd__file {
     size_t size;
 } hd__file_t;
 
-/* Points being collected, stored as the caller asked (double or float). */
+/* ---- points being collected, stored as the caller asked ---------------- */
 typedef struct hd__sink {
     void *data;
     size_t count, cap;
@@ -25,19 +28,244 @@ void hd__sink_init(hd__sink_t *s, hd_dtype_t dtype);
 /* Reserve room for n more points; the caller has checked n against the
  * file's size so that no reader allocates more than the file can hold. */
 int hd__sink_reserve(hd__sink_t *s, size_t n);
-/* Append one point after checking it is finite and within HD_MAX_COORD. */
+/* Append one point after checking it (hd__point_valid). */
 int hd__sink_push(hd__sink_t *s, const double p[3]);
+/* Store point k (< cap) without checking; for parallel fills. */
+HD__INLINE void hd__sink_set(hd__sink_t *s, size_t k, const double p[3]) {
+    if (s->dtype == HD_FLOAT32) {
+        float *d = (float *)s->data + 3 * k;
+        d[0] = (float)p[0];
+        d[1] = (float)p[1];
+        d[2] = (float)p[2];
+    } else {
+        double *d = (double *)s->data + 3 * k;
+        d[0] = p[0];
+        d[1] = p[1];
+        d[2] = p[2];
+    }
+}
+/* Append all points of src (same dtype) to s. */
+int hd__sink_append(hd__sink_t *s, const hd__sink_t *src);
 void hd__sink_free(hd__sink_t *s);
 
-/* Check one coordinate triple (finite, in range); returns HD_OK or the code. */
-int hd__point_valid(const double p[3]);
+/* Check one coordinate triple: HD_ENONFINITE, HD_ERANGE (beyond
+ * HD_MAX_COORD, or beyond FLT_MAX when stored as float), or HD_OK. */
+int hd__point_valid(const double p[3], hd_dtype_t dtype);
+/* "coordinate is NaN or infinite" etc., for a code from hd__point_valid. */
+const char *hd__point_problem(int code);
 
-/* Each reader fills `sink` from `f`, reporting errors as
- * "NAME:LINE: what" (text) or "NAME: byte OFFSET: what" (binary). */
-typedef int (*hd__reader_fn)(const hd__file_t *f, const hd_read_options_t *opt,
-                             hd__sink_t *sink, size_t *n_faces, hd_error_t *err);
+/* ---- triangles of a mesh, for --sample ------------------------------- */
+typedef struct hd__tris {
+    uint64_t *v; /* 3 vertex indices (0-based) per triangle */
+    size_t count, cap;
+} hd__tris_t;
 
-int hd__read_xyz(const hd__file_t *f, const hd_read_options_t *opt,
-                 hd__sink_t *sink, size_t *n_faces, hd_error_t *err);
+void hd__tris_init(hd__tris_t *t);
+/* Add a polygon of n >= 3 vertices as a fan of n-2 triangles. */
+int hd__tris_add(hd__tris_t *t, const uint64_t *v, size_t n);
+void hd__tris_free(hd__tris_t *t);
+/* Move all triangles of src to the end of t (src is emptied). */
+int hd__tris_append(hd__tris_t *t, hd__tris_t *src);
+
+/* `n` points uniformly by area on the triangles (vertices: nv packed
+ * doubles), seeded; appended to out.  Every index must be < nv and the
+ * total area positive (the caller reports which). */
+int hd__mesh_sample(const double *xyz, size_t nv, const hd__tris_t *t,
+                    size_t n, uint64_t seed, hd__sink_t *out,
+                    const char *name, hd_error_t *err);
+
+/* ---- one reader call --------------------------------------------------- */
+typedef struct hd__read {
+    const hd__file_t *f;
+    const hd_read_options_t *opt;
+    int threads;       /* resolved thread count for parallel parsing */
+    hd__sink_t *sink;  /* the vertices or points */
+    hd__tris_t *tris;  /* NULL, or collect faces here (for --sample) */
+    size_t n_faces;    /* faces seen (mesh formats) */
+    hd_error_t *err;
+} hd__read_t;
+
+typedef int (*hd__reader_fn)(hd__read_t *r);
+
+int hd__read_xyz(hd__read_t *r);
+int hd__read_ply(hd__read_t *r);
+int hd__read_obj(hd__read_t *r);
+int hd__read_off(hd__read_t *r);
+int hd__read_stl(hd__read_t *r);
+int hd__read_pcd(hd__read_t *r);
+int hd__read_las(hd__read_t *r);
+int hd__read_npy(hd__read_t *r);
+
+/* ---- errors with a place --------------------------------------------------- */
+/* "NAME:LINE: what" with err->line set. */
+int hd__io_err_line(hd__read_t *r, int code, long long line, const char *fmt,
+                    ...) HD__PRINTF(4, 5);
+/* "NAME: byte OFFSET: what" with err->offset set. */
+int hd__io_err_at(hd__read_t *r, int code, long long offset, const char *fmt,
+                  ...) HD__PRINTF(4, 5);
+/* "NAME: what" (no place). */
+int hd__io_err(hd__read_t *r, int code, const char *fmt, ...) HD__PRINTF(3, 4);
+
+/* ---- text ------------------------------------------------------------------ */
+/* The number in [s, end), entirely: 1 and *out (exactly strtod's value), or 0
+ * when the token is not a number. */
+int hd__parse_double(const char *s, const char *end, double *out);
+/* A non-negative decimal integer in [s, end) without sign or exponent; 0 on
+ * failure or overflow of uint64_t. */
+int hd__parse_u64(const char *s, const char *end, uint64_t *out);
+
+HD__INLINE int hd__is_blank(int c) { return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v'; }
+
+/* End of the line starting at p (the '\n', or end). */
+HD__INLINE const char *hd__eol(const char *p, const char *end) {
+    const char *e = (const char *)memchr(p, '\n', (size_t)(end - p));
+    return e ? e : end;
+}
+
+/* The next whitespace-separated token in [*p, eol): sets [*tb, *te) and
+ * advances *p; 0 when the line has no more tokens. */
+HD__INLINE int hd__token(const char **p, const char *eol, const char **tb,
+                         const char **te) {
+    const char *s = *p;
+    while (s < eol && hd__is_blank((unsigned char)*s)) s++;
+    if (s == eol) {
+        *p = s;
+        return 0;
+    }
+    const char *e = s;
+    while (e < eol && !hd__is_blank((unsigned char)*e)) e++;
+    *tb = s;
+    *te = e;
+    *p = e;
+    return 1;
+}
+
+/* Text parsed in parallel: [begin, end) is cut at line ends into chunks;
+ * fn parses one chunk's whole lines into its own points (and triangles),
+ * counting lines; on the first problem it records a code, the 1-based line
+ * within the chunk and a message, and stops.  The chunks are merged in file
+ * order, so points keep their order and the error reported is the first in
+ * the file, with its line number: `first_line` is the number of the line at
+ * `begin`. */
+typedef struct hd__chunk {
+    const char *begin, *end; /* whole lines */
+    int index;               /* 0 for the chunk at `begin` */
+    long long lines;         /* lines in the chunk (set by the framework) */
+    hd__sink_t pts;
+    hd__tris_t tris;
+    uint64_t aux;            /* free for the reader (e.g. faces counted) */
+    int rc;
+    long long err_line;      /* 1-based within the chunk */
+    char msg[256];
+} hd__chunk_t;
+
+typedef void (*hd__chunk_fn)(void *ctx, hd__chunk_t *c);
+
+/* Record a problem in a chunk (message without file or line). */
+void hd__chunk_fail(hd__chunk_t *c, int code, long long line, const char *fmt,
+                    ...) HD__PRINTF(4, 5);
+
+/* Called in file order before a chunk's results are appended, with the
+ * number of points appended before it (to resolve relative references). */
+typedef void (*hd__chunk_fix_fn)(void *ctx, hd__chunk_t *c, size_t points_before);
+
+/* Run fn over [begin, end) and append the results to r->sink (and r->tris
+ * when fn produced triangles).  fix may be NULL.  *aux_total receives the
+ * sum of chunk aux (may be NULL). */
+int hd__text_parallel(hd__read_t *r, const char *begin, const char *end,
+                      long long first_line, hd__chunk_fn fn,
+                      hd__chunk_fix_fn fix, void *ctx, uint64_t *aux_total);
+
+/* Skip n lines from p: returns the start of line n+1 (or end) and sets
+ * *skipped to the number of lines actually skipped. */
+const char *hd__skip_lines(const char *p, const char *end, uint64_t n,
+                           uint64_t *skipped);
+
+/* Skip n content lines (neither blank nor starting with '#') from p: returns
+ * the start of the line after the n-th, or end; *found is the number of
+ * content lines skipped and *lines the number of lines of any kind. */
+const char *hd__skip_content_lines(const char *p, const char *end, uint64_t n,
+                                   uint64_t *found, uint64_t *lines);
+
+/* ---- binary ----------------------------------------------------------- */
+/* LZF (liblzf format) from in[0..in_len) into exactly out_len bytes of out:
+ * 0, or -1 with *bad_at the input offset of the first bad command. */
+int hd__lzf_decompress(const unsigned char *in, size_t in_len, unsigned char *out,
+                       size_t out_len, size_t *bad_at);
+
+HD__INLINE uint16_t hd__ld_u16(const unsigned char *p, int big) {
+    return big ? (uint16_t)(p[0] << 8 | p[1]) : (uint16_t)(p[1] << 8 | p[0]);
+}
+HD__INLINE uint32_t hd__ld_u32(const unsigned char *p, int big) {
+    return big ? (uint32_t)p[0] << 24 | (uint32_t)p[1] << 16 | (uint32_t)p[2] << 8 | p[3]
+               : (uint32_t)p[3] << 24 | (uint32_t)p[2] << 16 | (uint32_t)p[1] << 8 | p[0];
+}
+HD__INLINE uint64_t hd__ld_u64(const unsigned char *p, int big) {
+    uint64_t a = hd__ld_u32(p, big), b = hd__ld_u32(p + 4, big);
+    return big ? a << 32 | b : b << 32 | a;
+}
+
+/* Scalar element types of binary formats. */
+typedef enum hd__type {
+    HD__T_NONE = 0,
+    HD__T_I8, HD__T_U8, HD__T_I16, HD__T_U16, HD__T_I32, HD__T_U32,
+    HD__T_I64, HD__T_U64, HD__T_F32, HD__T_F64
+} hd__type_t;
+
+HD__INLINE size_t hd__type_size(hd__type_t t) {
+    static const unsigned char sz[] = {0, 1, 1, 2, 2, 4, 4, 8, 8, 4, 8};
+    return sz[t];
+}
+
+/* One value of type t at p, widened to double (exactly for every type but
+ * 64-bit integers beyond 2^53, which round to nearest). */
+HD__INLINE double hd__ld_value(const unsigned char *p, hd__type_t t, int big) {
+    switch (t) {
+    case HD__T_I8: return (double)(int8_t)p[0];
+    case HD__T_U8: return (double)p[0];
+    case HD__T_I16: return (double)(int16_t)hd__ld_u16(p, big);
+    case HD__T_U16: return (double)hd__ld_u16(p, big);
+    case HD__T_I32: return (double)(int32_t)hd__ld_u32(p, big);
+    case HD__T_U32: return (double)hd__ld_u32(p, big);
+    case HD__T_I64: return (double)(int64_t)hd__ld_u64(p, big);
+    case HD__T_U64: return (double)hd__ld_u64(p, big);
+    case HD__T_F32: {
+        uint32_t u = hd__ld_u32(p, big);
+        float v;
+        memcpy(&v, &u, sizeof v);
+        return (double)v;
+    }
+    case HD__T_F64: {
+        uint64_t u = hd__ld_u64(p, big);
+        double v;
+        memcpy(&v, &u, sizeof v);
+        return v;
+    }
+    default: return 0.0;
+    }
+}
+
+/* Where the points are in a binary block: point k is in record k / per,
+ * sub * (k % per) bytes into it; coordinate c at byte off[c] of type[c];
+ * big: big-endian; scale/offset (both NULL, or 3 each): c * scale + offset.
+ * file_offset: where the block starts in the file (for messages). */
+typedef struct hd__layout {
+    size_t n, per, stride, sub;
+    size_t off[3];
+    hd__type_t type[3];
+    int big;
+    const double *scale, *offset;
+    size_t file_offset;
+} hd__layout_t;
+
+/* Convert the n points of L from base into r->sink (reserved here, which
+ * must be empty) in parallel, checking each point.  On a bad point the
+ * first one is reported as "NAME: byte OFFSET: ...". */
+int hd__binary_read(hd__read_t *r, const unsigned char *base, const hd__layout_t *L);
+
+/* The common case: one point per record of `stride` bytes, no scaling. */
+int hd__binary_points(hd__read_t *r, const unsigned char *base, size_t n,
+                      size_t stride, const size_t off[3],
+                      const hd__type_t type[3], int big, size_t file_offset);
 
 #endif

@@ -4,14 +4,22 @@
  * A file is loaded whole (mapped read-only when it is a regular file, read
  * in blocks from a pipe or standard input), so every parser sees one byte
  * range and can check every count against the bytes that remain before it
- * allocates anything.  The format comes from --format, else the extension;
- * the parser then confirms it by the file's magic where the format has one.
+ * allocates anything.  The format comes from opt->format, else the
+ * extension, else (standard input, unknown extension) the content.  A format
+ * with a signature (PLY "ply", LAS "LASF", NPY "\x93NUMPY", PCD's header,
+ * binary STL's size) is confirmed by it; when the extension and the content
+ * disagree the message says what the content looks like, so the user can
+ * pass --format.  The library never prints: progress, if any, is the
+ * caller's business (the CLI reports by phases).
+ *
+ * Meshes (PLY, OBJ, OFF, STL) are read as their vertices by default; with
+ * HD_MESH_SAMPLE the reader also collects the faces as triangles and
+ * mesh.c draws the requested number of points on the surface.
  */
 #include "io.h"
 
 #include <errno.h>
 #include <fcntl.h>
-#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -26,71 +34,99 @@ void hd_read_options_init(hd_read_options_t *opt) {
     opt->mesh = HD_MESH_VERTICES;
 }
 
-void hd__sink_init(hd__sink_t *s, hd_dtype_t dtype) {
-    s->data = NULL;
-    s->count = s->cap = 0;
-    s->dtype = dtype;
+/* ---- signatures ------------------------------------------------------------ */
+static int starts(const unsigned char *d, size_t n, const char *s) {
+    size_t k = strlen(s);
+    return n >= k && memcmp(d, s, k) == 0;
 }
 
-int hd__sink_reserve(hd__sink_t *s, size_t n) {
-    if (n <= s->cap - s->count) return HD_OK;
-    size_t want = s->count + n;
-    if (want < s->count) return HD_EOVERFLOW;
-    size_t cap = s->cap ? s->cap : 1024;
-    while (cap < want) cap = cap > SIZE_MAX / 2 ? want : cap * 2;
-    size_t el = s->dtype == HD_FLOAT32 ? 3 * sizeof(float) : 3 * sizeof(double);
-    void *p = hd__realloc_array(s->data, cap, el);
-    if (!p) return HD_ENOMEM;
-    s->data = p;
-    s->cap = cap;
-    return HD_OK;
+static int magic_ply(const unsigned char *d, size_t n) {
+    return starts(d, n, "ply\n") || starts(d, n, "ply\r\n") || starts(d, n, "ply ");
 }
-
-int hd__point_valid(const double p[3]) {
-    for (int c = 0; c < 3; c++) {
-        if (!isfinite(p[c])) return HD_ENONFINITE;
-        if (fabs(p[c]) > HD_MAX_COORD) return HD_ERANGE;
+static int magic_las(const unsigned char *d, size_t n) { return starts(d, n, "LASF"); }
+static int magic_npy(const unsigned char *d, size_t n) { return starts(d, n, "\x93NUMPY"); }
+static int magic_pcd(const unsigned char *d, size_t n) {
+    /* the header opens with comments and VERSION, or FIELDS directly */
+    size_t k = 0;
+    while (k < n) {
+        while (k < n && (d[k] == ' ' || d[k] == '\t' || d[k] == '\r' || d[k] == '\n')) k++;
+        if (k < n && d[k] == '#') {
+            while (k < n && d[k] != '\n') k++;
+            continue;
+        }
+        return starts(d + k, n - k, "VERSION") || starts(d + k, n - k, "FIELDS");
     }
-    return HD_OK;
+    return 0;
 }
-
-int hd__sink_push(hd__sink_t *s, const double p[3]) {
-    int rc = hd__point_valid(p);
-    if (rc) return rc;
-    if (s->count == s->cap && (rc = hd__sink_reserve(s, 1))) return rc;
-    if (s->dtype == HD_FLOAT32) {
-        float *d = (float *)s->data + 3 * s->count;
-        for (int c = 0; c < 3; c++) d[c] = (float)p[c];
-    } else {
-        double *d = (double *)s->data + 3 * s->count;
-        for (int c = 0; c < 3; c++) d[c] = p[c];
+static int magic_off(const unsigned char *d, size_t n) {
+    size_t k = 0;
+    while (k < n && (d[k] == ' ' || d[k] == '\t' || d[k] == '\r' || d[k] == '\n')) k++;
+    static const char *const kw[] = {"OFF", "COFF", "NOFF", "CNOFF", "NCOFF", NULL};
+    for (int j = 0; kw[j]; j++) {
+        size_t l = strlen(kw[j]);
+        if (n - k >= l && memcmp(d + k, kw[j], l) == 0 &&
+            (n - k == l || d[k + l] == ' ' || d[k + l] == '\t' || d[k + l] == '\r' || d[k + l] == '\n'))
+            return 1;
     }
-    s->count++;
-    return HD_OK;
+    return 0;
+}
+static int magic_stl(const unsigned char *d, size_t n) {
+    if (n >= 84) {
+        uint32_t tri = hd__ld_u32(d + 80, 0);
+        if ((uint64_t)84 + (uint64_t)50 * tri == n) return 1;
+    }
+    size_t k = 0;
+    while (k < n && (d[k] == ' ' || d[k] == '\t' || d[k] == '\r' || d[k] == '\n')) k++;
+    if (!starts(d + k, n - k, "solid")) return 0;
+    for (size_t j = k; j + 5 <= n && j < 4096; j++)
+        if (memcmp(d + j, "facet", 5) == 0) return 1;
+    return 0;
+}
+static int magic_obj(const unsigned char *d, size_t n) {
+    /* first line that is not a comment or blank starts with an OBJ keyword */
+    size_t k = 0;
+    while (k < n) {
+        while (k < n && (d[k] == ' ' || d[k] == '\t' || d[k] == '\r' || d[k] == '\n')) k++;
+        if (k < n && d[k] == '#') {
+            while (k < n && d[k] != '\n') k++;
+            continue;
+        }
+        static const char *const kw[] = {"v ", "v\t", "vn ", "vt ", "o ", "g ", "mtllib ", "usemtl ", "s ", NULL};
+        for (int j = 0; kw[j]; j++)
+            if (starts(d + k, n - k, kw[j])) return 1;
+        return 0;
+    }
+    return 0;
 }
 
-void hd__sink_free(hd__sink_t *s) {
-    free(s->data);
-    s->data = NULL;
-    s->count = s->cap = 0;
-}
-
+/* ---- the table --------------------------------------------------------------- */
 typedef struct {
     const char *name;
     const char *extensions; /* space separated */
     const char *description;
     hd__reader_fn read;
+    int (*magic)(const unsigned char *, size_t); /* NULL: no signature to confirm */
+    int faces;                                   /* a mesh format */
 } format_t;
 
 static const format_t formats[] = {
-    {"xyz", "xyz txt csv pts asc", "text: x y z per line, whitespace or comma separated", hd__read_xyz},
+    {"ply", "ply", "Stanford PLY: ascii, binary little/big endian; x y z of any type; faces", hd__read_ply, magic_ply, 1},
+    {"obj", "obj", "Wavefront OBJ: 'v' lines; 'f' lines are the faces", hd__read_obj, NULL, 1},
+    {"off", "off coff noff", "Object File Format: OFF, COFF, NOFF, CNOFF; faces", hd__read_off, magic_off, 1},
+    {"stl", "stl", "STL: ascii or binary triangles (their corners are the vertices)", hd__read_stl, magic_stl, 1},
+    {"xyz", "xyz txt csv pts asc", "text: x y z per line, whitespace or comma separated, extra columns ignored",
+     hd__read_xyz, NULL, 0},
+    {"pcd", "pcd", "Point Cloud Library PCD v0.7: ascii, binary, binary_compressed; x y z of type F/I/U",
+     hd__read_pcd, magic_pcd, 0},
+    {"las", "las", "ASPRS LAS 1.0-1.4, point formats 0-10 (uncompressed; LAZ must be converted)", hd__read_las,
+     magic_las, 0},
+    {"npy", "npy", "NumPy .npy: float32/float64 array of shape (N, 3), either byte order, C or Fortran order",
+     hd__read_npy, magic_npy, 0},
 };
 #define N_FORMATS (sizeof formats / sizeof formats[0])
 
 const char *const *hd_formats(void) {
-    static const char *names[N_FORMATS + 1];
-    for (size_t k = 0; k < N_FORMATS; k++) names[k] = formats[k].name;
-    names[N_FORMATS] = NULL;
+    static const char *const names[] = {"ply", "obj", "off", "stl", "xyz", "pcd", "las", "npy", NULL};
     return names;
 }
 
@@ -106,17 +142,22 @@ static const format_t *by_name(const char *name) {
     return NULL;
 }
 
-static const format_t *by_extension(const char *path) {
+static const char *extension(const char *path) {
     const char *dot = strrchr(path, '.');
     const char *slash = strrchr(path, '/');
     if (!dot || (slash && dot < slash)) return NULL;
-    dot++;
-    size_t len = strlen(dot);
+    return dot + 1;
+}
+
+static const format_t *by_extension(const char *path) {
+    const char *ext = extension(path);
+    if (!ext) return NULL;
+    size_t len = strlen(ext);
     for (size_t k = 0; k < N_FORMATS; k++) {
         const char *e = formats[k].extensions;
         while (*e) {
             size_t n = strcspn(e, " ");
-            if (n == len && strncasecmp(e, dot, n) == 0) return &formats[k];
+            if (n == len && strncasecmp(e, ext, n) == 0) return &formats[k];
             e += n;
             while (*e == ' ') e++;
         }
@@ -124,14 +165,26 @@ static const format_t *by_extension(const char *path) {
     return NULL;
 }
 
-/* Load a whole file.  *map is set when the bytes are a mapping. */
+/* The format the content looks like: signatures first, then OBJ keywords,
+ * then text that starts with a number (xyz). */
+static const format_t *by_content(const hd__file_t *f) {
+    for (size_t k = 0; k < N_FORMATS; k++)
+        if (formats[k].magic && formats[k].magic(f->data, f->size)) return &formats[k];
+    if (magic_obj(f->data, f->size)) return by_name("obj");
+    size_t k = 0;
+    while (k < f->size && (f->data[k] == ' ' || f->data[k] == '\t' || f->data[k] == '\n' || f->data[k] == '\r')) k++;
+    if (k < f->size && (strchr("+-.0123456789", f->data[k]) || f->data[k] == '#')) return by_name("xyz");
+    return NULL;
+}
+
+/* ---- loading ------------------------------------------------------------------ */
 static int load(const char *path, hd__file_t *f, int *mapped, hd_error_t *err) {
     int fd = strcmp(path, "-") == 0 ? 0 : open(path, O_RDONLY);
     if (fd < 0)
         return hd__err(err, HD_EIO, "%s: cannot open: %s", path, strerror(errno));
     struct stat st;
     *mapped = 0;
-    f->name = path;
+    f->name = strcmp(path, "-") == 0 ? "(standard input)" : path;
     f->data = NULL;
     f->size = 0;
     if (fstat(fd, &st) == 0 && S_ISDIR(st.st_mode)) {
@@ -145,11 +198,15 @@ static int load(const char *path, hd__file_t *f, int *mapped, hd_error_t *err) {
             f->data = empty;
             return HD_OK;
         }
+        if ((unsigned long long)st.st_size > SIZE_MAX) {
+            close(fd);
+            return hd__err(err, HD_EOVERFLOW, "%s: too large to map", path);
+        }
         void *p = mmap(NULL, (size_t)st.st_size, PROT_READ, MAP_PRIVATE, fd, 0);
         close(fd);
         if (p == MAP_FAILED)
             return hd__err(err, HD_EIO, "%s: cannot map: %s", path, strerror(errno));
-        madvise(p, (size_t)st.st_size, MADV_SEQUENTIAL);
+        madvise(p, (size_t)st.st_size, MADV_SEQUENTIAL | MADV_WILLNEED);
         f->data = p;
         f->size = (size_t)st.st_size;
         *mapped = 1;
@@ -163,12 +220,11 @@ static int load(const char *path, hd__file_t *f, int *mapped, hd_error_t *err) {
     }
     for (;;) {
         if (size == cap) {
-            if (cap > SIZE_MAX / 2) break;
-            unsigned char *nb = realloc(buf, cap * 2);
+            unsigned char *nb = cap > SIZE_MAX / 2 ? NULL : realloc(buf, cap * 2);
             if (!nb) {
                 free(buf);
                 if (fd) close(fd);
-                return hd__err(err, HD_ENOMEM, "%s: out of memory", path);
+                return hd__err(err, HD_ENOMEM, "%s: out of memory after %zu bytes", path, size);
             }
             buf = nb;
             cap *= 2;
@@ -195,6 +251,38 @@ static void unload(hd__file_t *f, int mapped) {
     else if (f->size) free((void *)f->data);
 }
 
+static int laz_refused(const char *path, hd_error_t *err) {
+    return hd__err(err, HD_EUNSUPPORTED,
+                   "%s: LAZ (compressed LAS) is not supported; convert it to LAS first, e.g. "
+                   "'laszip -i %s -o out.las', 'las2las -i %s -o out.las' (LAStools) or "
+                   "'pdal translate %s out.las' (PDAL)",
+                   path, path, path, path);
+}
+
+/* Run the reader; with sampling, read vertices as doubles and the faces,
+ * then draw the sample into `out`. */
+static int parse(const format_t *fmt, const hd__file_t *f, const hd_read_options_t *opt,
+                 hd__sink_t *out, size_t *n_faces, hd_error_t *err) {
+    int sample = opt->mesh == HD_MESH_SAMPLE;
+    hd__sink_t verts;
+    hd__tris_t tris;
+    hd__sink_init(&verts, sample ? HD_FLOAT64 : opt->dtype);
+    hd__tris_init(&tris);
+    hd__read_t r = {f, opt, hd__thread_count(opt->threads, 1024), &verts, sample ? &tris : NULL, 0, err};
+    int rc = fmt->read(&r);
+    if (rc == HD_OK && verts.count == 0) rc = hd__err(err, HD_EEMPTY, "%s: no points", f->name);
+    if (rc == HD_OK && sample)
+        rc = hd__mesh_sample(verts.data, verts.count, &tris, opt->sample, opt->seed, out, f->name, err);
+    *n_faces = r.n_faces;
+    hd__tris_free(&tris);
+    if (rc == HD_OK && !sample) {
+        *out = verts;
+        return HD_OK;
+    }
+    hd__sink_free(&verts);
+    return rc;
+}
+
 int hd_read_file(const char *path, const hd_read_options_t *opt,
                  hd_cloud_t **out, hd_error_t *err) {
     hd__err_clear(err);
@@ -205,31 +293,63 @@ int hd_read_file(const char *path, const hd_read_options_t *opt,
         hd_read_options_init(&defaults);
         opt = &defaults;
     }
+    if (opt->dtype != HD_FLOAT64 && opt->dtype != HD_FLOAT32)
+        return hd__err(err, HD_EINVAL, "%s: unknown storage type %d", path, (int)opt->dtype);
+    if (opt->mesh != HD_MESH_VERTICES && opt->mesh != HD_MESH_SAMPLE)
+        return hd__err(err, HD_EINVAL, "%s: unknown mesh mode %d", path, (int)opt->mesh);
+    if (opt->mesh == HD_MESH_SAMPLE && opt->sample == 0)
+        return hd__err(err, HD_EINVAL, "%s: sampling needs a positive number of points", path);
     const format_t *fmt = NULL;
+    int from_extension = 0;
     if (opt->format) {
+        if (strcasecmp(opt->format, "laz") == 0) return laz_refused(path, err);
         fmt = by_name(opt->format);
         if (!fmt) return hd__err(err, HD_EUNSUPPORTED, "%s: unknown format '%s'", path, opt->format);
-    } else {
+    } else if (strcmp(path, "-") != 0) {
+        const char *ext = extension(path);
+        if (ext && strcasecmp(ext, "laz") == 0) return laz_refused(path, err);
         fmt = by_extension(path);
-        if (!fmt)
-            return hd__err(err, HD_EUNSUPPORTED,
-                           "%s: cannot tell the format from the extension; use --format", path);
+        from_extension = fmt != NULL;
     }
     hd__file_t f;
     int mapped, rc = load(path, &f, &mapped, err);
     if (rc) return rc;
+    if (!fmt) {
+        fmt = by_content(&f);
+        if (!fmt) {
+            unload(&f, mapped);
+            return hd__err(err, HD_EUNSUPPORTED,
+                           "%s: cannot tell the format from the %s; use --format (see --formats)", f.name,
+                           strcmp(path, "-") == 0 ? "content" : "extension or the content");
+        }
+    } else if (from_extension && fmt->magic && !fmt->magic(f.data, f.size)) {
+        const format_t *seems = by_content(&f);
+        if (seems && seems != fmt && seems->magic) {
+            unload(&f, mapped);
+            return hd__err(err, HD_EFORMAT, "%s: the name says %s but the content is %s; use --format %s",
+                           path, fmt->name, seems->name, seems->name);
+        }
+    }
+    if (opt->mesh == HD_MESH_SAMPLE && !fmt->faces) {
+        unload(&f, mapped);
+        return hd__err(err, HD_EUNSUPPORTED, "%s: %s holds points, not faces; sampling needs a mesh (ply, obj, off, stl)",
+                       f.name, fmt->name);
+    }
     hd__sink_t sink;
     hd__sink_init(&sink, opt->dtype);
     size_t faces = 0;
-    rc = fmt->read(&f, opt, &sink, &faces, err);
+    rc = parse(fmt, &f, opt, &sink, &faces, err);
     unload(&f, mapped);
-    if (rc == HD_OK && sink.count == 0)
-        rc = hd__err(err, HD_EEMPTY, "%s: no points", path);
     hd_cloud_t *c = NULL;
     if (rc == HD_OK && !(c = malloc(sizeof *c))) rc = hd__err(err, HD_ENOMEM, "%s: out of memory", path);
     if (rc) {
         hd__sink_free(&sink);
         return rc;
+    }
+    if (sink.cap > sink.count + sink.count / 8) {
+        /* give back what an over-estimate reserved */
+        void *p = hd__realloc_array(sink.data, sink.count, sink.dtype == HD_FLOAT32 ? 12 : 24);
+        if (p) sink.data = p;
     }
     c->data = sink.data;
     c->count = sink.count;

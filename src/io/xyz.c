@@ -1,72 +1,71 @@
 /*
- * xyz.c -- whitespace- or comma-separated text: x y z per line.
+ * xyz.c -- plain text point lists: XYZ, TXT, CSV, PTS, ASC.
  *
- * Extra columns after z are ignored; a first line that does not start with
- * a number is taken as a header; blank lines and lines starting with '#' are
- * skipped.  Numbers are converted with strtod, which rounds correctly, so
- * the double read is the double the text denotes.
+ * One point per line: the first three numbers are x, y, z; further columns
+ * (intensity, colour, normals) are ignored.  Numbers are separated by
+ * blanks, commas or semicolons.  Blank lines and lines starting with '#' or
+ * '//' are skipped.  The first line may be a header: if it does not start
+ * with a number (a CSV header such as "x,y,z,intensity") it is skipped, and
+ * so is a first line holding a single whole number (the point count of the
+ * Leica PTS format).  Any other line with fewer than three numbers, or a
+ * token among the first three that is not a number, is an error naming the
+ * line.
+ *
+ * The file is cut into chunks of whole lines parsed in parallel
+ * (hd__text_parallel), each number converted exactly as strtod would
+ * (hd__parse_double), so the points and any error are the same at every
+ * thread count.
  */
 #include "io.h"
 
-#include <errno.h>
-#include <stdlib.h>
-#include <string.h>
+static int is_sep(int c) { return c == ' ' || c == '\t' || c == '\r' || c == ',' || c == ';' || c == '\f' || c == '\v'; }
 
-static int is_space(int c) { return c == ' ' || c == '\t' || c == '\r'; }
-
-int hd__read_xyz(const hd__file_t *f, const hd_read_options_t *opt,
-                 hd__sink_t *sink, size_t *n_faces, hd_error_t *err) {
-    (void)opt;
-    (void)n_faces;
-    const char *p = (const char *)f->data, *end = p + f->size;
+static void chunk(void *ctx, hd__chunk_t *c) {
+    (void)ctx;
+    const char *p = c->begin, *end = c->end;
     long long line = 0;
-    char tmp[128];
     while (p < end) {
         line++;
-        const char *eol = memchr(p, '\n', (size_t)(end - p));
-        if (!eol) eol = end;
-        const char *s = p;
-        while (s < eol && is_space((unsigned char)*s)) s++;
-        if (s == eol || *s == '#') {
-            p = eol + 1;
-            continue;
-        }
+        const char *eol = hd__eol(p, end), *q = p;
+        p = eol + (eol < end);
+        while (q < eol && is_sep((unsigned char)*q)) q++;
+        if (q == eol || *q == '#' || (*q == '/' && q + 1 < eol && q[1] == '/')) continue;
+        int first = c->index == 0 && line == 1;
         double v[3];
         int got = 0;
-        const char *q = s;
-        while (got < 3 && q < eol) {
-            while (q < eol && (is_space((unsigned char)*q) || *q == ',' || *q == ';')) q++;
+        while (got < 3) {
+            while (q < eol && is_sep((unsigned char)*q)) q++;
             if (q == eol) break;
-            size_t n = 0;
-            while (q + n < eol && !is_space((unsigned char)q[n]) && q[n] != ',' && q[n] != ';') n++;
-            if (n >= sizeof tmp) n = sizeof tmp - 1;
-            memcpy(tmp, q, n);
-            tmp[n] = '\0';
-            char *e;
-            errno = 0;
-            v[got] = strtod(tmp, &e);
-            if (e == tmp || *e != '\0') {
-                if (line == 1 && got == 0 && sink->count == 0) break; /* header */
-                return hd__err_line(err, HD_EFORMAT, line, "%s:%lld: '%s' is not a number",
-                                    f->name, line, tmp);
+            const char *t = q;
+            while (q < eol && !is_sep((unsigned char)*q)) q++;
+            if (!hd__parse_double(t, q, &v[got])) {
+                if (first && got == 0) break; /* a header line */
+                hd__chunk_fail(c, HD_EFORMAT, line, "'%.*s' is not a number (column %d)",
+                               (int)(q - t > 40 ? 40 : q - t), t, got + 1);
+                return;
             }
             got++;
-            q += n;
         }
-        if (got == 0 && line == 1) {
-            p = eol + 1;
-            continue;
+        if (first && got <= 1) {
+            /* a header: words, or the single point count of PTS */
+            if (got == 0) continue;
+            while (q < eol && is_sep((unsigned char)*q)) q++;
+            double n = v[0];
+            if (q == eol && n >= 0 && n == (double)(uint64_t)n) continue;
         }
-        if (got < 3)
-            return hd__err_line(err, HD_EFORMAT, line, "%s:%lld: expected 3 numbers, found %d",
-                                f->name, line, got);
-        int rc = hd__sink_push(sink, v);
-        if (rc == HD_ENONFINITE)
-            return hd__err_line(err, rc, line, "%s:%lld: coordinate is NaN or infinite", f->name, line);
-        if (rc == HD_ERANGE)
-            return hd__err_line(err, rc, line, "%s:%lld: coordinate beyond 1e153", f->name, line);
-        if (rc) return hd__err_line(err, rc, line, "%s:%lld: %s", f->name, line, hd_strerror(rc));
-        p = eol + 1;
+        if (got < 3) {
+            hd__chunk_fail(c, HD_EFORMAT, line, "expected 3 numbers (x y z), found %d", got);
+            return;
+        }
+        int rc = hd__sink_push(&c->pts, v);
+        if (rc) {
+            hd__chunk_fail(c, rc, line, "%s", hd__point_problem(rc));
+            return;
+        }
     }
-    return HD_OK;
+}
+
+int hd__read_xyz(hd__read_t *r) {
+    const char *s = (const char *)r->f->data;
+    return hd__text_parallel(r, s, s + r->f->size, 1, chunk, NULL, NULL, NULL);
 }

@@ -1,0 +1,555 @@
+/*
+ * analysis.c -- the command line's analysis options: parsing them, running
+ * them after the Hausdorff distance, and reporting them for a person or in
+ * the JSON object.
+ *
+ * Everything is computed by the library from one array of per-point
+ * distances per direction (hd_distances): the percentile figures
+ * (hd_percentile_of: "ab", "ba", "symmetric" = max of the two as MONAI,
+ * "pooled" = both directions together as medpy), the means and Chamfer
+ * distances (hd_summarize) and the histograms (hd_histogram, numpy's bins).
+ * The tool only adds files (writers.c, render.c) and text.  The per-point
+ * distances are computed once, and only when an option needs them, so a
+ * plain run costs exactly what it did before.
+ *
+ * Empty sets: by default an empty file or mask is an error (exit 2) with a
+ * message that names the file and the --empty option.  With --empty
+ * inf|nan|zero every distance figure becomes that value instead, because
+ * users disagree: MONAI returns NaN or inf, medpy raises, some pipelines
+ * count a miss as 0.  JSON has no inf or NaN, so those are written as null
+ * and "empty" says which policy produced them.
+ */
+#include "analysis.h"
+#include "cli.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+/* ---- options -------------------------------------------------------------- */
+
+void analysis_args_init(analysis_args_t *an) {
+    memset(an, 0, sizeof *an);
+    an->percentile = 95.0;
+    an->bins = 20;
+    an->mask_points = MASK_SURFACE;
+    an->empty = EMPTY_ERROR;
+}
+
+void analysis_usage(FILE *out) {
+    fprintf(out,
+"\n"
+"Where the deviation is (per-point nearest-neighbour distances):\n"
+"  --percentile P     percentile Hausdorff, e.g. 95 for HD95: the P-th\n"
+"                     percentile (numpy's linear interpolation) of the\n"
+"                     distances of A's points to B (ab), of B's to A (ba),\n"
+"                     symmetric = max(ab, ba) as MONAI, pooled = both\n"
+"                     directions together as medpy; P = 100 is H(A,B)\n"
+"  --mean             mean distances: A->B, B->A, their max (the average\n"
+"                     Hausdorff distance), their average, and pooled\n"
+"  --chamfer          Chamfer distance = mean squared distance A->B + mean\n"
+"                     squared distance B->A (as PyTorch3D); the JSON also\n"
+"                     has the summed and the unsquared variants\n"
+"  --histogram        histogram of the distances (--bins N, default 20) on\n"
+"                     [0, largest distance] or [0, --max-distance]\n"
+"  --distances OUT    write A's points with distance and nearest index in B\n"
+"                     (.csv: x,y,z,distance,nearest; .ply: also a viridis\n"
+"                     colour; .npy: (N, 5) float64); B's go to OUT_b.EXT\n"
+"  --max-distance D   top of the colour and histogram scale (default: the\n"
+"                     Hausdorff distance)\n"
+"  --render OUT.png   picture of A coloured by distance to B: front, side\n"
+"                     and top views, colour bar, the Hausdorff witness pair\n"
+"                     marked%s\n"
+"  --histogram-png OUT.png  the histogram as a picture%s\n"
+"\n"
+"Medical masks: A or B may be a NIfTI-1/2 mask (.nii, .nii.gz)%s.\n"
+"  Voxels with a nonzero value are foreground; each becomes the world\n"
+"  coordinate of its centre (sform when sform_code > 0, else qform, else\n"
+"  pixdim), in millimetres.  Distances are then in mm.\n"
+"  --mask-points surface|all  surface (default): foreground voxels with at\n"
+"                     least one 6-neighbour in the background or outside the\n"
+"                     image (as medpy and MONAI); all: every foreground voxel\n"
+"  --empty inf|nan|zero  an empty mask or file is an error by default; with\n"
+"                     this option every distance is reported as inf, NaN or\n"
+"                     0 instead (JSON: null for inf and NaN, with \"empty\")\n",
+            render_available() ? "" : " (unavailable: built without libpng)",
+            render_available() ? "" : " (unavailable)",
+            nifti_available() ? "" : " (unavailable: built without libnifti2)");
+}
+
+static int usage_error(const char *fmt, const char *arg) {
+    fprintf(stderr, "hausdorff: ");
+    fprintf(stderr, fmt, arg);
+    fprintf(stderr, "\nTry 'hausdorff --help'.\n");
+    return -1;
+}
+
+static int to_double(const char *s, double *out) {
+    char *e;
+    errno = 0;
+    double v = strtod(s, &e);
+    if (e == s || *e || errno || !isfinite(v)) return -1;
+    *out = v;
+    return 0;
+}
+
+static const char *const value_names[] = {"--percentile", "--bins", "--distances", "--max-distance",
+                                          "--render", "--histogram-png", "--mask-points", "--empty",
+                                          NULL};
+
+int analysis_parse_option(int argc, char **argv, int *k, analysis_args_t *an) {
+    const char *s = argv[*k];
+    if (strcmp(s, "--mean") == 0) return an->mean = 1;
+    if (strcmp(s, "--chamfer") == 0) return an->chamfer = 1;
+    if (strcmp(s, "--histogram") == 0) return an->histogram = 1;
+    const char *eq = strchr(s, '=');
+    size_t nl = eq ? (size_t)(eq - s) : strlen(s);
+    int which = -1;
+    for (int w = 0; value_names[w]; w++)
+        if (strlen(value_names[w]) == nl && strncmp(s, value_names[w], nl) == 0) which = w;
+    if (which < 0) return 0;
+    const char *name = value_names[which];
+    const char *v = eq ? eq + 1 : (*k + 1 < argc ? argv[++*k] : NULL);
+    if (!v) return usage_error("option '%s' needs a value", name);
+    double d;
+    switch (which) {
+    case 0:
+        if (to_double(v, &d) || d < 0 || d > 100)
+            return usage_error("--percentile needs a number in [0, 100], not '%s'", v);
+        an->percentile_on = 1;
+        an->percentile = d;
+        break;
+    case 1:
+        if (to_double(v, &d) || d < 1 || d > 100000 || d != floor(d))
+            return usage_error("--bins needs a whole number 1..100000, not '%s'", v);
+        an->bins = (size_t)d;
+        break;
+    case 2:
+        if (!distances_format_known(v))
+            return usage_error("--distances: cannot tell the format of '%s'; name it .csv, .ply or .npy", v);
+        an->distances_out = v;
+        break;
+    case 3:
+        if (to_double(v, &d) || !(d > 0))
+            return usage_error("--max-distance needs a positive number, not '%s'", v);
+        an->max_distance = d;
+        break;
+    case 4:
+    case 5:
+        if (!render_available())
+            return usage_error("%s is unavailable: this hausdorff was built without libpng "
+                               "(Debian: libpng-dev)", name);
+        if (which == 4) an->render_out = v;
+        else an->histogram_png = v;
+        break;
+    case 6:
+        if (strcmp(v, "surface") == 0) an->mask_points = MASK_SURFACE;
+        else if (strcmp(v, "all") == 0) an->mask_points = MASK_ALL;
+        else return usage_error("--mask-points is surface or all, not '%s'", v);
+        break;
+    case 7:
+        if (strcmp(v, "inf") == 0) an->empty = EMPTY_INF;
+        else if (strcmp(v, "nan") == 0) an->empty = EMPTY_NAN;
+        else if (strcmp(v, "zero") == 0) an->empty = EMPTY_ZERO;
+        else return usage_error("--empty is inf, nan or zero, not '%s'", v);
+        break;
+    }
+    return 1;
+}
+
+int analysis_active(const analysis_args_t *an) {
+    return an->percentile_on || an->mean || an->chamfer || an->histogram || an->distances_out ||
+           an->render_out || an->histogram_png;
+}
+
+/* ---- empty sets ------------------------------------------------------------ */
+
+static int alloc_fail(hd_error_t *err, size_t n) {
+    snprintf(err->message, sizeof err->message, "out of memory for %zu per-point distances", n);
+    return err->code = HD_ENOMEM;
+}
+
+
+static const char *policy_name(empty_policy_t p) {
+    return p == EMPTY_INF ? "inf" : p == EMPTY_NAN ? "nan" : p == EMPTY_ZERO ? "zero" : "error";
+}
+
+static double policy_value(empty_policy_t p) {
+    return p == EMPTY_INF ? INFINITY : p == EMPTY_NAN ? NAN : 0.0;
+}
+
+/* The per-point files of a run with an empty set: the other set's rows get
+ * the policy's distance and nearest index -1; an empty set gets a file with
+ * no rows, so that scripts find the files they asked for. */
+static int write_empty_files(const analysis_args_t *an, const hd_points_t *A,
+                             const hd_points_t *B, int directed, double v,
+                             hd_error_t *err) {
+    size_t n = A->count > B->count ? A->count : B->count;
+    double *d = malloc((n ? n : 1) * sizeof *d);
+    if (!d) return alloc_fail(err, n);
+    for (size_t k = 0; k < n; k++) d[k] = v;
+    int rc = write_distances(an->distances_out, A, d, NULL, 1.0, err);
+    if (rc == HD_OK && !directed) {
+        char path_b[4096];
+        path_with_suffix(an->distances_out, "_b", path_b, sizeof path_b);
+        rc = write_distances(path_b, B, d, NULL, 1.0, err);
+    }
+    free(d);
+    return rc;
+}
+
+int analysis_handle_empty(const analysis_args_t *an, const char *path_a,
+                          const char *path_b, const hd_points_t *A,
+                          const hd_points_t *B, int directed, int json) {
+    size_t n_a = A->count, n_b = B->count;
+    if (n_a && n_b) return -1;
+    double v = policy_value(an->empty);
+    FILE *out = stdout;
+    hd_error_t err;
+    if (an->distances_out && write_empty_files(an, A, B, directed, v, &err) != HD_OK) {
+        fprintf(stderr, "hausdorff: %s\n", err.message);
+        return EXIT_FAILURE_;
+    }
+    if (an->render_out || an->histogram_png)
+        fprintf(stderr, "hausdorff: no picture drawn: %s is empty\n", n_a ? "B" : "A");
+    if (json) {
+        fprintf(out, "{\"hausdorff\": ");
+        json_number(out, v);
+        fprintf(out, ", \"directed_ab\": ");
+        json_number(out, v);
+        fprintf(out, ", \"directed_ba\": ");
+        if (directed) fputs("null", out);
+        else json_number(out, v);
+        fprintf(out, ", \"witness_ab\": null, \"witness_ba\": null");
+        fprintf(out, ", \"empty\": {\"a\": %s, \"b\": %s, \"policy\": \"%s\"}", n_a ? "false" : "true",
+                n_b ? "false" : "true", policy_name(an->empty));
+        fprintf(out, ", \"n_a\": %zu, \"n_b\": %zu, \"file_a\": ", n_a, n_b);
+        json_string(out, path_a);
+        fprintf(out, ", \"file_b\": ");
+        json_string(out, path_b);
+        if (an->percentile_on) {
+            fprintf(out, ", \"percentile\": {\"p\": ");
+            json_number(out, an->percentile);
+            const char *keys[] = {"ab", "ba", "symmetric", "pooled"};
+            for (int k = 0; k < 4; k++) {
+                fprintf(out, ", \"%s\": ", keys[k]);
+                if (directed && k) fputs("null", out);
+                else json_number(out, v);
+            }
+            fputc('}', out);
+        }
+        if (an->mean) {
+            fprintf(out, ", \"mean\": {");
+            const char *keys[] = {"ab", "ba", "symmetric", "average", "pooled"};
+            for (int k = 0; k < 5; k++) {
+                fprintf(out, "%s\"%s\": ", k ? ", " : "", keys[k]);
+                if (directed && k) fputs("null", out);
+                else json_number(out, v);
+            }
+            fputc('}', out);
+        }
+        if (an->chamfer) {
+            fprintf(out, ", \"chamfer\": {\"definition\": \"mean_squared\"");
+            const char *keys[] = {"value", "mean_squared", "sum_squared", "mean", "sum"};
+            for (int k = 0; k < 5; k++) {
+                fprintf(out, ", \"%s\": ", keys[k]);
+                if (directed) fputs("null", out);
+                else json_number(out, v);
+            }
+            fputc('}', out);
+        }
+        fprintf(out, "}\n");
+    } else {
+        fprintf(out, "A: %s (%zu points)\nB: %s (%zu points)\n", path_a, n_a, path_b, n_b);
+        const char *which = !n_a && !n_b ? "A and B are" : !n_a ? "A is" : "B is";
+        fprintf(out, "%s = %g   (%s empty; --empty %s)\n", directed ? "h(A,B)" : "Hausdorff distance H(A,B)",
+                v, which, policy_name(an->empty));
+        if (an->percentile_on) fprintf(out, "percentile %g: %g\n", an->percentile, v);
+        if (an->mean) fprintf(out, "mean distance: %g\n", v);
+        if (an->chamfer) fprintf(out, "Chamfer distance: %g\n", v);
+    }
+    return EXIT_OK;
+}
+
+/* ---- the run ----------------------------------------------------------------- */
+
+static double seconds_now(void) {
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static size_t count_above(const double *d, size_t n, double hi) {
+    size_t c = 0;
+    for (size_t k = 0; k < n; k++) c += d[k] > hi;
+    return c;
+}
+
+int analysis_run(const analysis_args_t *an, const hd_options_t *opt,
+                 const hd_points_t *A, const hd_points_t *B,
+                 const hd_symmetric_t *s, int directed, const char *path_a,
+                 const char *path_b, analysis_result_t *r, hd_error_t *err) {
+    memset(r, 0, sizeof *r);
+    r->active = analysis_active(an);
+    r->directed = directed;
+    r->n_a = A->count;
+    r->n_b = B->count;
+    if (!r->active) return HD_OK;
+    r->d_ab = malloc(A->count * sizeof *r->d_ab);
+    r->j_ab = malloc(A->count * sizeof *r->j_ab);
+    if (!r->d_ab || !r->j_ab) return alloc_fail(err, A->count);
+    if (!directed) {
+        r->d_ba = malloc(B->count * sizeof *r->d_ba);
+        r->j_ba = malloc(B->count * sizeof *r->j_ba);
+        if (!r->d_ba || !r->j_ba) return alloc_fail(err, B->count);
+    }
+    double t0 = seconds_now();
+    int rc = hd_distances(A, B, opt, r->d_ab, r->j_ab, r->d_ba, r->j_ba, err);
+    r->seconds = seconds_now() - t0;
+    if (rc) return rc;
+    size_t n_ba = directed ? 0 : B->count;
+    if ((rc = hd_summarize(r->d_ab, A->count, r->d_ba, n_ba, &r->sum, err))) return rc;
+    if (an->percentile_on &&
+        (rc = hd_percentile_of(r->d_ab, A->count, r->d_ba, n_ba, an->percentile, &r->pct, err)))
+        return rc;
+    double largest = directed || r->sum.max_ab >= r->sum.max_ba ? r->sum.max_ab : r->sum.max_ba;
+    double scale = an->max_distance > 0 ? an->max_distance : largest;
+    if (an->histogram || an->histogram_png) {
+        r->hist_lo = 0.0;
+        r->hist_hi = scale;
+        r->hist_ab = calloc(an->bins, sizeof *r->hist_ab);
+        if (!r->hist_ab) return alloc_fail(err, an->bins);
+        if ((rc = hd_histogram(r->d_ab, A->count, 0.0, scale, an->bins, r->hist_ab, err))) return rc;
+        r->above_ab = count_above(r->d_ab, A->count, hd_histogram_edge(0.0, scale, an->bins, an->bins));
+        if (!directed) {
+            r->hist_ba = calloc(an->bins, sizeof *r->hist_ba);
+            if (!r->hist_ba) return alloc_fail(err, an->bins);
+            if ((rc = hd_histogram(r->d_ba, B->count, 0.0, scale, an->bins, r->hist_ba, err))) return rc;
+            r->above_ba = count_above(r->d_ba, B->count, hd_histogram_edge(0.0, scale, an->bins, an->bins));
+        }
+    }
+    if (an->distances_out) {
+        snprintf(r->dist_path_a, sizeof r->dist_path_a, "%s", an->distances_out);
+        if ((rc = write_distances(r->dist_path_a, A, r->d_ab, r->j_ab, scale, err))) return rc;
+        if (!directed) {
+            path_with_suffix(an->distances_out, "_b", r->dist_path_b, sizeof r->dist_path_b);
+            if ((rc = write_distances(r->dist_path_b, B, r->d_ba, r->j_ba, scale, err))) return rc;
+        }
+    }
+    if (an->render_out) {
+        char title[512];
+        const char *base = strrchr(path_a, '/') ? strrchr(path_a, '/') + 1 : path_a;
+        const char *base_b = strrchr(path_b, '/') ? strrchr(path_b, '/') + 1 : path_b;
+        snprintf(title, sizeof title, "%s (%zu points) coloured by distance to %s", base, A->count, base_b);
+        if ((rc = render_distances(an->render_out, A, B, r->d_ab, scale, s, directed, title, r->markers,
+                                   &r->n_markers, &r->render_w, &r->render_h, err)))
+            return rc;
+    }
+    if (an->histogram_png && (rc = render_histogram(an->histogram_png, r, an, an->bins, err))) return rc;
+    return HD_OK;
+}
+
+void analysis_free(analysis_result_t *r) {
+    free(r->d_ab);
+    free(r->d_ba);
+    free(r->j_ab);
+    free(r->j_ba);
+    free(r->hist_ab);
+    free(r->hist_ba);
+    memset(r, 0, sizeof *r);
+}
+
+/* ---- reports ------------------------------------------------------------------ */
+
+static void json_member(FILE *out, const char *key, double v, int first) {
+    fprintf(out, "%s\"%s\": ", first ? "" : ", ", key);
+    json_number(out, v);
+}
+
+static void json_counts(FILE *out, const uint64_t *c, size_t n) {
+    fputc('[', out);
+    for (size_t k = 0; k < n; k++) fprintf(out, "%s%llu", k ? ", " : "", (unsigned long long)c[k]);
+    fputc(']', out);
+}
+
+static void json_mask(FILE *out, const mask_info_t *m) {
+    if (!m->is_mask) {
+        fputs("null", out);
+        return;
+    }
+    fprintf(out, "{\"nifti\": %d, \"dim\": [%lld, %lld, %lld], \"spacing\": [", m->nifti_version, m->dim[0],
+            m->dim[1], m->dim[2]);
+    for (int c = 0; c < 3; c++) {
+        if (c) fputs(", ", out);
+        json_number(out, m->spacing[c]);
+    }
+    fprintf(out, "], \"transform\": \"%s\", \"to_mm\": ", m->transform);
+    json_number(out, m->to_mm);
+    fprintf(out, ", \"foreground_voxels\": %lld, \"points\": %zu}", m->foreground, m->points);
+}
+
+void analysis_json(FILE *out, const analysis_args_t *an,
+                   const analysis_result_t *r) {
+    if (an->mask[0].is_mask || an->mask[1].is_mask) {
+        fprintf(out, ", \"units\": \"mm\", \"mask_points\": \"%s\", \"masks\": {\"a\": ",
+                an->mask_points == MASK_ALL ? "all" : "surface");
+        json_mask(out, &an->mask[0]);
+        fprintf(out, ", \"b\": ");
+        json_mask(out, &an->mask[1]);
+        fputc('}', out);
+    }
+    if (!r->active) return;
+    fprintf(out, ", \"distances_seconds\": ");
+    json_number(out, r->seconds);
+    if (an->percentile_on) {
+        fprintf(out, ", \"percentile\": {");
+        json_member(out, "p", r->pct.p, 1);
+        json_member(out, "ab", r->pct.ab, 0);
+        json_member(out, "ba", r->pct.ba, 0);
+        json_member(out, "symmetric", r->pct.symmetric, 0);
+        json_member(out, "pooled", r->pct.pooled, 0);
+        fputc('}', out);
+    }
+    if (an->mean) {
+        fprintf(out, ", \"mean\": {");
+        json_member(out, "ab", r->sum.mean_ab, 1);
+        json_member(out, "ba", r->sum.mean_ba, 0);
+        json_member(out, "symmetric", r->sum.mean_symmetric, 0);
+        json_member(out, "average", r->sum.mean_average, 0);
+        json_member(out, "pooled", r->sum.mean_pooled, 0);
+        fputc('}', out);
+    }
+    if (an->chamfer) {
+        fprintf(out, ", \"chamfer\": {\"definition\": \"mean_squared\"");
+        json_member(out, "value", r->directed ? r->sum.mean2_ab : r->sum.chamfer, 0);
+        json_member(out, "mean_squared", r->sum.chamfer, 0);
+        json_member(out, "sum_squared", r->sum.chamfer_sum2, 0);
+        json_member(out, "mean", r->sum.chamfer_mean, 0);
+        json_member(out, "sum", r->sum.chamfer_sum, 0);
+        json_member(out, "mean_squared_ab", r->sum.mean2_ab, 0);
+        json_member(out, "mean_squared_ba", r->sum.mean2_ba, 0);
+        fputc('}', out);
+    }
+    if (r->hist_ab) {
+        fprintf(out, ", \"histogram\": {\"bins\": %zu, \"range\": [", an->bins);
+        json_number(out, hd_histogram_edge(r->hist_lo, r->hist_hi, an->bins, 0));
+        fputs(", ", out);
+        json_number(out, hd_histogram_edge(r->hist_lo, r->hist_hi, an->bins, an->bins));
+        fprintf(out, "], \"ab\": ");
+        json_counts(out, r->hist_ab, an->bins);
+        fprintf(out, ", \"ba\": ");
+        if (r->hist_ba) json_counts(out, r->hist_ba, an->bins);
+        else fputs("null", out);
+        fprintf(out, ", \"above_ab\": %zu, \"above_ba\": ", r->above_ab);
+        if (r->hist_ba) fprintf(out, "%zu", r->above_ba);
+        else fputs("null", out);
+        fputc('}', out);
+    }
+    if (an->distances_out) {
+        fprintf(out, ", \"distances_file\": {\"a\": ");
+        json_string(out, r->dist_path_a);
+        fprintf(out, ", \"b\": ");
+        if (r->directed) fputs("null", out);
+        else json_string(out, r->dist_path_b);
+        fputc('}', out);
+    }
+    if (an->render_out) {
+        fprintf(out, ", \"render\": {\"file\": ");
+        json_string(out, an->render_out);
+        fprintf(out, ", \"width\": %d, \"height\": %d, \"witness_markers\": [", r->render_w, r->render_h);
+        for (int k = 0; k < r->n_markers; k++) {
+            const render_marker_t *m = &r->markers[k];
+            fprintf(out, "%s{\"view\": \"%s\", \"set\": \"%c\", \"index\": %zu, \"x\": %d, \"y\": %d}",
+                    k ? ", " : "", m->view == 0 ? "front" : m->view == 1 ? "side" : "top", m->set, m->index,
+                    m->x, m->y);
+        }
+        fputs("]}", out);
+    }
+    if (an->histogram_png) {
+        fprintf(out, ", \"histogram_png\": ");
+        json_string(out, an->histogram_png);
+    }
+}
+
+static void print_histogram(FILE *out, const analysis_args_t *an,
+                            const analysis_result_t *r) {
+    uint64_t top = 1;
+    for (size_t k = 0; k < an->bins; k++) {
+        if (r->hist_ab[k] > top) top = r->hist_ab[k];
+        if (r->hist_ba && r->hist_ba[k] > top) top = r->hist_ba[k];
+    }
+    fprintf(out, "histogram of distances (%zu bins; bar = share of the largest bin):\n", an->bins);
+    fprintf(out, "  %-25s %10s %-20s%s\n", "bin", "A->B", "", r->hist_ba ? "      B->A" : "");
+    for (size_t k = 0; k < an->bins; k++) {
+        double lo = hd_histogram_edge(r->hist_lo, r->hist_hi, an->bins, k);
+        double hi = hd_histogram_edge(r->hist_lo, r->hist_hi, an->bins, k + 1);
+        char bin[64], bar[21];
+        snprintf(bin, sizeof bin, "[%.4g, %.4g%c", lo, hi, k + 1 == an->bins ? ']' : ')');
+        int len = (int)(20.0 * (double)r->hist_ab[k] / (double)top + 0.5);
+        memset(bar, '#', (size_t)len);
+        bar[len] = '\0';
+        fprintf(out, "  %-25s %10llu %-20s", bin, (unsigned long long)r->hist_ab[k], bar);
+        if (r->hist_ba) {
+            len = (int)(20.0 * (double)r->hist_ba[k] / (double)top + 0.5);
+            memset(bar, '#', (size_t)len);
+            bar[len] = '\0';
+            fprintf(out, " %10llu %s", (unsigned long long)r->hist_ba[k], bar);
+        }
+        fputc('\n', out);
+    }
+    if (r->above_ab || r->above_ba) {
+        fprintf(out, "  beyond the range: %zu (A->B)", r->above_ab);
+        if (r->hist_ba) fprintf(out, ", %zu (B->A)", r->above_ba);
+        fputc('\n', out);
+    }
+}
+
+void analysis_print(FILE *out, const analysis_args_t *an,
+                    const analysis_result_t *r) {
+    const char *unit = an->mask[0].is_mask || an->mask[1].is_mask ? " mm" : "";
+    for (int k = 0; k < 2; k++) {
+        const mask_info_t *m = &an->mask[k];
+        if (!m->is_mask) continue;
+        fprintf(out, "%c: NIfTI-%d mask %lldx%lldx%lld, spacing %g x %g x %g, %s; %lld foreground voxels, "
+                     "%zu %s points\n",
+                k ? 'B' : 'A', m->nifti_version, m->dim[0], m->dim[1], m->dim[2], m->spacing[0], m->spacing[1],
+                m->spacing[2], m->transform, m->foreground, m->points,
+                an->mask_points == MASK_ALL ? "foreground" : "surface");
+    }
+    if (!r->active) return;
+    if (an->percentile_on) {
+        fprintf(out, "percentile P = %g of the per-point distances%s:\n", r->pct.p, unit);
+        fprintf(out, "  A->B %.17g\n", r->pct.ab);
+        if (!r->directed) {
+            fprintf(out, "  B->A %.17g\n", r->pct.ba);
+            fprintf(out, "  symmetric = max (MONAI) %.17g\n", r->pct.symmetric);
+            fprintf(out, "  pooled (medpy)          %.17g\n", r->pct.pooled);
+        }
+    }
+    if (an->mean) {
+        fprintf(out, "mean distance%s: A->B %.17g", unit, r->sum.mean_ab);
+        if (!r->directed)
+            fprintf(out, ", B->A %.17g\n  max (average Hausdorff) %.17g, average %.17g, pooled %.17g",
+                    r->sum.mean_ba, r->sum.mean_symmetric, r->sum.mean_average, r->sum.mean_pooled);
+        fputc('\n', out);
+    }
+    if (an->chamfer) {
+        if (r->directed)
+            fprintf(out, "Chamfer distance, A->B only (mean squared distance): %.17g\n", r->sum.mean2_ab);
+        else
+            fprintf(out, "Chamfer distance (mean squared A->B + mean squared B->A) = %.17g\n"
+                         "  summed squares %.17g; unsquared: mean %.17g, sum %.17g\n",
+                    r->sum.chamfer, r->sum.chamfer_sum2, r->sum.chamfer_mean, r->sum.chamfer_sum);
+    }
+    if (an->histogram) print_histogram(out, an, r);
+    if (an->distances_out) {
+        fprintf(out, "per-point distances written to %s", r->dist_path_a);
+        if (!r->directed) fprintf(out, " and %s", r->dist_path_b);
+        fputc('\n', out);
+    }
+    if (an->render_out) fprintf(out, "picture written to %s (%dx%d)\n", an->render_out, r->render_w, r->render_h);
+    if (an->histogram_png) fprintf(out, "histogram picture written to %s\n", an->histogram_png);
+    fprintf(out, "time: %.6f s for per-point distances\n", r->seconds);
+}

@@ -1,0 +1,149 @@
+/*
+ * analysis.h -- the command line's analysis features: per-point distances
+ * and their statistics (analysis.c), the files they are written to
+ * (writers.c), pictures (render.c, font.c), and NIfTI masks (nifti.c).
+ * options.c and main.c only hook these in; everything else is here.
+ */
+#ifndef HD_CLI_ANALYSIS_H
+#define HD_CLI_ANALYSIS_H
+
+#include <hausdorff.h>
+#include <stdint.h>
+#include <stdio.h>
+
+typedef enum { EMPTY_ERROR = 0, EMPTY_INF, EMPTY_NAN, EMPTY_ZERO } empty_policy_t;
+typedef enum { MASK_SURFACE = 0, MASK_ALL } mask_points_t;
+
+/* What a mask file turned into (filled by cli_read_points). */
+typedef struct mask_info {
+    int is_mask;
+    int nifti_version;         /* 1 or 2 */
+    long long dim[3];          /* voxels per axis */
+    double spacing[3];         /* pixdim, in the file's units */
+    long long foreground;      /* foreground voxels */
+    size_t points;             /* points produced (surface or all) */
+    const char *transform;     /* "sform", "qform" or "pixdim" */
+    double to_mm;              /* unit factor applied (1 for mm) */
+} mask_info_t;
+
+typedef struct analysis_args {
+    int percentile_on;
+    double percentile;
+    int mean, chamfer, histogram;
+    size_t bins;
+    const char *distances_out;
+    double max_distance;       /* colour and histogram scale; 0 = automatic */
+    const char *render_out;
+    const char *histogram_png;
+    mask_points_t mask_points;
+    empty_policy_t empty;
+    mask_info_t mask[2];       /* for A and B */
+} analysis_args_t;
+
+/* ---- options (analysis.c) ---------------------------------------------- */
+void analysis_args_init(analysis_args_t *an);
+/* Look at argv[*k]: 0 when it is not an analysis option; 1 when it was one
+ * (its value consumed, *k advanced past it); -1 after reporting a usage
+ * error on stderr. */
+int analysis_parse_option(int argc, char **argv, int *k, analysis_args_t *an);
+/* The options' part of --help. */
+void analysis_usage(FILE *out);
+
+/* ---- reading (nifti.c) --------------------------------------------------- */
+/* Read a point set: NIfTI masks (.nii, .nii.gz) become the world
+ * coordinates of their surface or foreground voxels; every other file goes
+ * to hd_read_file.  An empty set is an error (HD_EEMPTY) unless --empty
+ * chose a policy; then it is returned as a cloud of 0 points.  `which` is 0
+ * for A and 1 for B. */
+int cli_read_points(const char *path, const hd_read_options_t *ro,
+                    analysis_args_t *an, int which, hd_cloud_t **out,
+                    hd_error_t *err);
+/* 1 when the name ends in .nii or .nii.gz. */
+int nifti_is_mask_path(const char *path);
+/* 1 when the tool was built with the NIfTI library. */
+int nifti_available(void);
+
+/* ---- the run (analysis.c) ---------------------------------------------- */
+/* Where a witness point was drawn in a picture. */
+typedef struct render_marker {
+    int view;                  /* 0 front, 1 side, 2 top */
+    char set;                  /* 'A' or 'B' */
+    size_t index;              /* the point's index in its set */
+    int x, y;                  /* pixel of the marker's centre */
+} render_marker_t;
+
+typedef struct analysis_result {
+    int active;                /* some analysis option was given */
+    int directed;
+    size_t n_a, n_b;
+    double *d_ab, *d_ba;       /* per-point distances (d_ba NULL: directed) */
+    size_t *j_ab, *j_ba;       /* nearest indices */
+    double seconds;            /* per-point distances */
+    hd_percentile_t pct;
+    hd_summary_t sum;
+    double hist_lo, hist_hi;
+    uint64_t *hist_ab, *hist_ba;
+    size_t above_ab, above_ba; /* values beyond the histogram range */
+    char dist_path_a[4096], dist_path_b[4096];
+    int render_w, render_h, n_markers;
+    render_marker_t markers[6];
+} analysis_result_t;
+
+/* Does anything need the per-point distances? */
+int analysis_active(const analysis_args_t *an);
+/* When A or B is empty: report the --empty policy's values (or the error)
+ * and return the exit code; -1 when both sets have points. */
+int analysis_handle_empty(const analysis_args_t *an, const char *path_a,
+                          const char *path_b, const hd_points_t *A,
+                          const hd_points_t *B, int directed, int json);
+/* Compute per-point distances and every figure asked for, write the files
+ * asked for.  Returns HD_OK or a library code with err filled. */
+int analysis_run(const analysis_args_t *an, const hd_options_t *opt,
+                 const hd_points_t *A, const hd_points_t *B,
+                 const hd_symmetric_t *s, int directed, const char *path_a,
+                 const char *path_b, analysis_result_t *r, hd_error_t *err);
+/* The JSON members (each preceded by ", ") and the lines for a person. */
+void analysis_json(FILE *out, const analysis_args_t *an,
+                   const analysis_result_t *r);
+void analysis_print(FILE *out, const analysis_args_t *an,
+                    const analysis_result_t *r);
+void analysis_free(analysis_result_t *r);
+
+/* ---- files (writers.c) ------------------------------------------------- */
+/* The colour of a distance: viridis at d / dmax (clipped to [0, 1]). */
+void colormap_viridis(double t, unsigned char rgb[3]);
+/* Write points with their distance, nearest index (HD_NONE-free: nearest
+ * NULL writes -1) and colour: CSV, PLY or NPY by the path's extension. */
+int write_distances(const char *path, const hd_points_t *P, const double *d,
+                    const size_t *nearest, double dmax, hd_error_t *err);
+/* 1 when the path names a format write_distances knows. */
+int distances_format_known(const char *path);
+/* OUT.ext -> OUT_b.ext */
+void path_with_suffix(const char *path, const char *suffix, char *out,
+                      size_t size);
+
+/* ---- pictures (render.c) ------------------------------------------------- */
+int render_available(void);
+/* The picture of A coloured by its distances to B, three views, colour
+ * bar, the witness pair of the Hausdorff distance marked and labelled. */
+int render_distances(const char *path, const hd_points_t *A,
+                     const hd_points_t *B, const double *d_a, double dmax,
+                     const hd_symmetric_t *s, int directed,
+                     const char *title, render_marker_t markers[6],
+                     int *n_markers, int *width, int *height,
+                     hd_error_t *err);
+/* A bar chart of the histogram(s) with the percentile and mean marked. */
+int render_histogram(const char *path, const analysis_result_t *r,
+                     const analysis_args_t *an, size_t bins,
+                     hd_error_t *err);
+
+/* ---- text (font.c) --------------------------------------------------------- */
+/* Width in font pixels of s at scale 1; the glyphs are 9 pixels high with
+ * the baseline after row 7. */
+int font_width(const char *s);
+/* Draw s with its top-left corner at (x, y), each font pixel scale x scale,
+ * into an RGB image of w x h; pixels outside are clipped. */
+void font_draw(unsigned char *rgb, int w, int h, int x, int y, int scale,
+               const char *s, const unsigned char color[3]);
+
+#endif

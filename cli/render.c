@@ -1,0 +1,504 @@
+/*
+ * render.c -- pictures for a report, drawn in memory and written as PNG
+ * (libpng), so that no display, GPU or plotting library is needed.
+ *
+ * render_distances draws A three times, in orthographic views from +z
+ * ("front"), from +x ("side") and from +y ("top"), all at one scale so that
+ * lengths compare across views.  Each point of A is a small square splat
+ * coloured by its distance to B (viridis, clipped at the scale's top) and
+ * shaded slightly darker with depth; a depth buffer per view keeps the
+ * nearest splat.  Points at a quarter of the colour scale or more are then
+ * drawn again over everything, in increasing order of distance, so that no
+ * deviation hides behind the surface in front of it.  B is drawn in light grey only where no point of A covers
+ * the pixel, which shows where B reaches beyond A.  The witness pair of the
+ * Hausdorff distance (the farthest point and its nearest point in the other
+ * set) is drawn on top in every view: a red dot in a white ring for the
+ * point that realises the distance, an orange one for its nearest point, a
+ * line between them, and labels with their indices.  A colour bar with
+ * ticks and a title line with the distance complete the picture.  The
+ * markers' pixel positions are returned so that a test can look at them.
+ *
+ * render_histogram draws the per-point distance histograms (A->B and B->A
+ * side by side in each bin) with the percentile and the means marked.
+ *
+ * Built without libpng, both refuse with a message that says so.
+ */
+#include "analysis.h"
+#include "cli.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#ifdef HD_HAVE_PNG
+#include <png.h>
+
+int render_available(void) { return 1; }
+
+/* ---- a canvas ---------------------------------------------------------------- */
+
+typedef struct {
+    int w, h;
+    unsigned char *rgb;
+} canvas_t;
+
+static const unsigned char WHITE[3] = {255, 255, 255}, BLACK[3] = {0, 0, 0}, GREY[3] = {205, 205, 205},
+                           FRAME[3] = {170, 170, 170}, DARK[3] = {60, 60, 60}, RED[3] = {255, 0, 0},
+                           ORANGE[3] = {255, 140, 0}, BLUE[3] = {49, 104, 142}, AMBER[3] = {230, 150, 30};
+
+static int canvas_init(canvas_t *c, int w, int h) {
+    c->w = w;
+    c->h = h;
+    c->rgb = malloc((size_t)w * (size_t)h * 3);
+    if (!c->rgb) return -1;
+    memset(c->rgb, 255, (size_t)w * (size_t)h * 3);
+    return 0;
+}
+
+static void put(canvas_t *c, int x, int y, const unsigned char col[3]) {
+    if (x < 0 || y < 0 || x >= c->w || y >= c->h) return;
+    memcpy(c->rgb + 3 * ((size_t)y * (size_t)c->w + (size_t)x), col, 3);
+}
+
+static void fill_rect(canvas_t *c, int x0, int y0, int x1, int y1, const unsigned char col[3]) {
+    for (int y = y0; y < y1; y++)
+        for (int x = x0; x < x1; x++) put(c, x, y, col);
+}
+
+static void frame_rect(canvas_t *c, int x0, int y0, int x1, int y1, const unsigned char col[3]) {
+    for (int x = x0; x < x1; x++) put(c, x, y0, col), put(c, x, y1 - 1, col);
+    for (int y = y0; y < y1; y++) put(c, x0, y, col), put(c, x1 - 1, y, col);
+}
+
+/* Pixels whose centre lies within [r0, r1] of (x, y). */
+static void ring(canvas_t *c, int x, int y, double r0, double r1, const unsigned char col[3]) {
+    int R = (int)ceil(r1);
+    for (int dy = -R; dy <= R; dy++)
+        for (int dx = -R; dx <= R; dx++) {
+            double d = sqrt((double)(dx * dx + dy * dy));
+            if (d >= r0 && d <= r1) put(c, x + dx, y + dy, col);
+        }
+}
+
+static void line(canvas_t *c, int x0, int y0, int x1, int y1, int thick, const unsigned char col[3]) {
+    int n = abs(x1 - x0) > abs(y1 - y0) ? abs(x1 - x0) : abs(y1 - y0);
+    for (int k = 0; k <= n; k++) {
+        double t = n ? (double)k / n : 0.0;
+        int x = (int)lround(x0 + (x1 - x0) * t), y = (int)lround(y0 + (y1 - y0) * t);
+        for (int dy = 0; dy < thick; dy++)
+            for (int dx = 0; dx < thick; dx++) put(c, x + dx - thick / 2, y + dy - thick / 2, col);
+    }
+}
+
+static void text(canvas_t *c, int x, int y, int scale, const char *s, const unsigned char col[3]) {
+    font_draw(c->rgb, c->w, c->h, x, y, scale, s, col);
+}
+
+/* Text with a one-pixel white halo, readable over points. */
+static void label(canvas_t *c, int x, int y, int scale, const char *s, const unsigned char col[3]) {
+    for (int dy = -1; dy <= 1; dy++)
+        for (int dx = -1; dx <= 1; dx++)
+            if (dx || dy) text(c, x + dx, y + dy, scale, s, WHITE);
+    text(c, x, y, scale, s, col);
+}
+
+static int write_png(const char *path, const canvas_t *c, hd_error_t *err) {
+    FILE *f = fopen(path, "wb");
+    if (!f) {
+        snprintf(err->message, sizeof err->message, "%s: cannot write the picture", path);
+        return err->code = HD_EIO;
+    }
+    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, NULL, NULL, NULL);
+    png_infop info = png ? png_create_info_struct(png) : NULL;
+    if (!png || !info || setjmp(png_jmpbuf(png))) {
+        png_destroy_write_struct(&png, &info);
+        fclose(f);
+        snprintf(err->message, sizeof err->message, "%s: libpng could not write the picture", path);
+        return err->code = HD_EIO;
+    }
+    png_init_io(png, f);
+    png_set_IHDR(png, info, (png_uint_32)c->w, (png_uint_32)c->h, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
+                 PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+    png_text meta;
+    memset(&meta, 0, sizeof meta);
+    meta.compression = PNG_TEXT_COMPRESSION_NONE;
+    meta.key = (png_charp) "Software";
+    meta.text = (png_charp) "hausdorff";
+    png_set_text(png, info, &meta, 1);
+    png_write_info(png, info);
+    for (int y = 0; y < c->h; y++) png_write_row(png, c->rgb + 3 * (size_t)y * (size_t)c->w);
+    png_write_end(png, info);
+    png_destroy_write_struct(&png, &info);
+    if (fclose(f) != 0) {
+        snprintf(err->message, sizeof err->message, "%s: write failed", path);
+        return err->code = HD_EIO;
+    }
+    return HD_OK;
+}
+
+static void fmt_num(char *buf, size_t size, double v) { snprintf(buf, size, "%.4g", v); }
+
+/* ---- the three views ------------------------------------------------------------- */
+
+enum { PANEL = 460, GAP = 24, TOP = 92, BOTTOM = 44, BAR_W = 26, BAR_LABELS = 110 };
+
+/* Screen axes and depth of each view: u right, v up, depth towards the eye. */
+static void project(int view, const double p[3], double *u, double *v, double *depth) {
+    if (view == 0) { /* from +z */
+        *u = p[0], *v = p[1], *depth = p[2];
+    } else if (view == 1) { /* from +x */
+        *u = -p[2], *v = p[1], *depth = p[0];
+    } else { /* from +y */
+        *u = p[0], *v = -p[2], *depth = p[1];
+    }
+}
+
+typedef struct {
+    double u0, v0, s;  /* screen = (u - u0) * s + offset, centred */
+    int x0, y0;        /* panel's top-left pixel */
+} view_t;
+
+static void to_pixel(const view_t *vw, int view, const double p[3], int *x, int *y, double *depth) {
+    double u, v, d;
+    project(view, p, &u, &v, &d);
+    *x = vw->x0 + PANEL / 2 + (int)lround((u - vw->u0) * vw->s);
+    *y = vw->y0 + PANEL / 2 - (int)lround((v - vw->v0) * vw->s);
+    if (depth) *depth = d;
+}
+
+static void splat(canvas_t *c, float *zbuf, const view_t *vw, int x, int y, int r, double depth,
+                  const unsigned char col[3]) {
+    for (int dy = -r; dy <= r; dy++)
+        for (int dx = -r; dx <= r; dx++) {
+            int px = x + dx, py = y + dy;
+            if (px < vw->x0 || py < vw->y0 || px >= vw->x0 + PANEL || py >= vw->y0 + PANEL) continue;
+            float *z = &zbuf[(size_t)(py - vw->y0) * PANEL + (size_t)(px - vw->x0)];
+            if ((float)depth <= *z) continue;
+            *z = (float)depth;
+            put(c, px, py, col);
+        }
+}
+
+typedef struct {
+    double d;
+    size_t k;
+} far_t;
+
+static int cmp_far(const void *x, const void *y) {
+    const far_t *a = x, *b = y;
+    if (a->d != b->d) return a->d < b->d ? -1 : 1;
+    return (a->k > b->k) - (a->k < b->k);
+}
+
+static void bounds(const hd_points_t *P, double lo[3], double hi[3]) {
+    for (size_t k = 0; k < P->count; k++) {
+        double q[3];
+        hd_points_get(P, k, q);
+        for (int a = 0; a < 3; a++) {
+            if (q[a] < lo[a]) lo[a] = q[a];
+            if (q[a] > hi[a]) hi[a] = q[a];
+        }
+    }
+}
+
+int render_distances(const char *path, const hd_points_t *A,
+                     const hd_points_t *B, const double *d_a, double dmax,
+                     const hd_symmetric_t *s, int directed,
+                     const char *title, render_marker_t markers[6],
+                     int *n_markers, int *width, int *height,
+                     hd_error_t *err) {
+    canvas_t c;
+    int W = GAP + 3 * (PANEL + GAP) + BAR_W + BAR_LABELS, H = TOP + PANEL + BOTTOM;
+    float *zbuf = malloc((size_t)PANEL * PANEL * sizeof *zbuf);
+    unsigned char *covered = malloc((size_t)PANEL * PANEL);
+    if (!zbuf || !covered || canvas_init(&c, W, H)) {
+        free(zbuf);
+        free(covered);
+        snprintf(err->message, sizeof err->message, "out of memory for the picture");
+        return err->code = HD_ENOMEM;
+    }
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    bounds(A, lo, hi);
+    bounds(B, lo, hi);
+    double extent = 0, centre[3];
+    for (int a = 0; a < 3; a++) {
+        if (hi[a] - lo[a] > extent) extent = hi[a] - lo[a];
+        centre[a] = lo[a] + (hi[a] - lo[a]) / 2;
+    }
+    if (!(extent > 0)) extent = 1;
+    double sc = (PANEL - 40) / extent;
+    double zlo[3], zhi[3]; /* depth range of each view, for shading */
+    {
+        double u, v;
+        project(0, lo, &u, &v, &zlo[0]), project(0, hi, &u, &v, &zhi[0]);
+        project(1, lo, &u, &v, &zlo[1]), project(1, hi, &u, &v, &zhi[1]);
+        project(2, lo, &u, &v, &zlo[2]), project(2, hi, &u, &v, &zhi[2]);
+    }
+    /* points at a quarter of the scale or more: drawn over the surface */
+    size_t n_far = 0;
+    for (size_t k = 0; k < A->count; k++) n_far += dmax > 0 && d_a[k] >= 0.25 * dmax;
+    far_t *far = malloc((n_far ? n_far : 1) * sizeof *far);
+    if (!far) {
+        free(zbuf), free(covered), free(c.rgb);
+        snprintf(err->message, sizeof err->message, "out of memory for the picture");
+        return err->code = HD_ENOMEM;
+    }
+    n_far = 0;
+    for (size_t k = 0; k < A->count; k++)
+        if (dmax > 0 && d_a[k] >= 0.25 * dmax) far[n_far].d = d_a[k], far[n_far++].k = k;
+    qsort(far, n_far, sizeof *far, cmp_far);
+    int r = (int)lround(0.35 * PANEL / sqrt((double)(A->count + 1)));
+    if (r < 1) r = 1;
+    if (r > 4) r = 4;
+
+    /* the witness pair: the point realising H and its nearest point */
+    int from_a = directed || s->ab.distance2 >= s->ba.distance2;
+    const hd_result_t *w = from_a ? &s->ab : &s->ba;
+    double wp[3], wq[3];
+    hd_points_get(from_a ? A : B, w->i, wp);
+    hd_points_get(from_a ? B : A, w->j, wq);
+
+    static const char *const names[3] = {"front (from +z): x right, y up", "side (from +x): -z right, y up",
+                                         "top (from +y): x right, -z up"};
+    *n_markers = 0;
+    for (int view = 0; view < 3; view++) {
+        view_t vw;
+        double u, v, dd;
+        project(view, centre, &u, &v, &dd);
+        vw.u0 = u, vw.v0 = v, vw.s = sc;
+        vw.x0 = GAP + view * (PANEL + GAP);
+        vw.y0 = TOP;
+        for (size_t k = 0; k < (size_t)PANEL * PANEL; k++) zbuf[k] = -INFINITY;
+        for (size_t m = 0; m < A->count + n_far; m++) {
+            /* first every point with the depth test, then the far ones
+             * again, over everything, nearest-to-farthest in distance */
+            size_t k = m < A->count ? m : far[m - A->count].k;
+            double q[3], depth;
+            int x, y;
+            hd_points_get(A, k, q);
+            to_pixel(&vw, view, q, &x, &y, &depth);
+            unsigned char col[3];
+            colormap_viridis(dmax > 0 ? d_a[k] / dmax : 0.0, col);
+            double span = zhi[view] - zlo[view], shade = span > 0 ? 0.72 + 0.28 * (depth - zlo[view]) / span : 1.0;
+            if (shade < 0.72) shade = 0.72; /* the side view's depth runs the other way */
+            if (shade > 1.0) shade = 1.0;
+            for (int ch = 0; ch < 3; ch++) col[ch] = (unsigned char)(col[ch] * shade + 0.5);
+            splat(&c, zbuf, &vw, x, y, r, m < A->count ? depth : INFINITY, col);
+        }
+        for (size_t k = 0; k < (size_t)PANEL * PANEL; k++) covered[k] = zbuf[k] != -INFINITY;
+        for (size_t k = 0; k < B->count; k++) {
+            double q[3];
+            int x, y;
+            hd_points_get(B, k, q);
+            to_pixel(&vw, view, q, &x, &y, NULL);
+            for (int dy = -r; dy <= r; dy++)
+                for (int dx = -r; dx <= r; dx++) {
+                    int px = x + dx, py = y + dy;
+                    if (px < vw.x0 || py < vw.y0 || px >= vw.x0 + PANEL || py >= vw.y0 + PANEL) continue;
+                    if (!covered[(size_t)(py - vw.y0) * PANEL + (size_t)(px - vw.x0)]) put(&c, px, py, GREY);
+                }
+        }
+        frame_rect(&c, vw.x0 - 1, vw.y0 - 1, vw.x0 + PANEL + 1, vw.y0 + PANEL + 1, FRAME);
+        text(&c, vw.x0, vw.y0 + PANEL + 10, 2, names[view], DARK);
+
+        int px, py, qx, qy;
+        to_pixel(&vw, view, wp, &px, &py, NULL);
+        to_pixel(&vw, view, wq, &qx, &qy, NULL);
+        line(&c, px, py, qx, qy, 2, RED);
+        ring(&c, qx, qy, 0, 4.5, ORANGE);
+        ring(&c, qx, qy, 4.5, 7.5, WHITE);
+        ring(&c, px, py, 0, 5.5, RED);
+        ring(&c, px, py, 5.5, 8.5, WHITE);
+        ring(&c, px, py, 8.5, 9.8, RED);
+        char lp[64], lq[64];
+        snprintf(lp, sizeof lp, "%c[%zu]", from_a ? 'A' : 'B', w->i);
+        snprintf(lq, sizeof lq, "%c[%zu]", from_a ? 'B' : 'A', w->j);
+        int side = qx >= px ? -1 : 1; /* labels away from each other */
+        int lpx = side > 0 ? px + 13 : px - 13 - 2 * font_width(lp);
+        int lqx = side > 0 ? qx - 11 - 2 * font_width(lq) : qx + 11;
+        label(&c, lpx, py - 9, 2, lp, RED);
+        label(&c, lqx, qy - 9, 2, lq, ORANGE);
+        markers[(*n_markers)++] = (render_marker_t){view, from_a ? 'A' : 'B', w->i, px, py};
+        markers[(*n_markers)++] = (render_marker_t){view, from_a ? 'B' : 'A', w->j, qx, qy};
+    }
+
+    /* colour bar */
+    int bx = GAP + 3 * (PANEL + GAP), by = TOP;
+    for (int y = 0; y < PANEL; y++) {
+        unsigned char col[3];
+        colormap_viridis(1.0 - (double)y / (PANEL - 1), col);
+        fill_rect(&c, bx, by + y, bx + BAR_W, by + y + 1, col);
+    }
+    frame_rect(&c, bx - 1, by - 1, bx + BAR_W + 1, by + PANEL + 1, DARK);
+    for (int t = 0; t <= 4; t++) {
+        int y = by + (int)lround((PANEL - 1) * (1.0 - t / 4.0));
+        char buf[64];
+        fmt_num(buf, sizeof buf, dmax * t / 4.0);
+        fill_rect(&c, bx + BAR_W, y, bx + BAR_W + 6, y + 1, DARK);
+        text(&c, bx + BAR_W + 9, y - 8, 2, buf, DARK);
+    }
+    text(&c, bx - 4, by - 26, 2, "distance", DARK);
+
+    /* title lines */
+    char line2[512], hv[64];
+    fmt_num(hv, sizeof hv, w->distance);
+    snprintf(line2, sizeof line2, "%s = %s between %c[%zu] (red) and %c[%zu] (orange); grey: %s only",
+             directed ? "h(A,B)" : "H(A,B)", hv, from_a ? 'A' : 'B', w->i, from_a ? 'B' : 'A', w->j,
+             "B");
+    text(&c, GAP, 14, 2, title, BLACK);
+    text(&c, GAP, 42, 2, line2, DARK);
+
+    int rc = write_png(path, &c, err);
+    *width = W;
+    *height = H;
+    free(c.rgb);
+    free(zbuf);
+    free(covered);
+    free(far);
+    return rc;
+}
+
+/* ---- the histogram ----------------------------------------------------------------- */
+
+int render_histogram(const char *path, const analysis_result_t *r,
+                     const analysis_args_t *an, size_t bins,
+                     hd_error_t *err) {
+    enum { HW = 1000, HH = 580, L = 110, R = 30, T = 104, B = 80 };
+    canvas_t c;
+    if (canvas_init(&c, HW, HH)) {
+        snprintf(err->message, sizeof err->message, "out of memory for the picture");
+        return err->code = HD_ENOMEM;
+    }
+    int pw = HW - L - R, ph = HH - T - B;
+    uint64_t top = 1;
+    for (size_t k = 0; k < bins; k++) {
+        if (r->hist_ab[k] > top) top = r->hist_ab[k];
+        if (r->hist_ba && r->hist_ba[k] > top) top = r->hist_ba[k];
+    }
+    double lo = hd_histogram_edge(r->hist_lo, r->hist_hi, bins, 0);
+    double hi = hd_histogram_edge(r->hist_lo, r->hist_hi, bins, bins);
+    int series = r->hist_ba ? 2 : 1;
+    /* A long tail (the usual case: most points agree, a few deviate) would
+     * be invisible on a linear axis; then the counts go on a log axis. */
+    uint64_t least = top;
+    for (size_t k = 0; k < bins; k++) {
+        if (r->hist_ab[k] && r->hist_ab[k] < least) least = r->hist_ab[k];
+        if (r->hist_ba && r->hist_ba[k] && r->hist_ba[k] < least) least = r->hist_ba[k];
+    }
+    int logy = top >= 50 * least;
+    for (size_t k = 0; k < bins; k++) {
+        int x0 = L + (int)((double)pw * k / bins), x1 = L + (int)((double)pw * (k + 1) / bins);
+        int bw = (x1 - x0 - 2) / series;
+        if (bw < 1) bw = 1;
+        for (int sidx = 0; sidx < series; sidx++) {
+            uint64_t n = sidx ? r->hist_ba[k] : r->hist_ab[k];
+            int hgt = (int)lround(logy ? (double)ph * log10(1.0 + (double)n) / log10(1.0 + (double)top)
+                                       : (double)ph * (double)n / (double)top);
+            int bx0 = x0 + 1 + sidx * bw;
+            fill_rect(&c, bx0, T + ph - hgt, bx0 + bw, T + ph, sidx ? AMBER : BLUE);
+        }
+    }
+    /* axes and ticks */
+    fill_rect(&c, L, T + ph, L + pw, T + ph + 2, DARK);
+    fill_rect(&c, L - 2, T, L, T + ph + 2, DARK);
+    for (int t = 0; t <= 5; t++) {
+        char buf[64];
+        int x = L + (int)lround((double)pw * t / 5.0);
+        fmt_num(buf, sizeof buf, lo + (hi - lo) * t / 5.0);
+        fill_rect(&c, x, T + ph + 2, x + 1, T + ph + 8, DARK);
+        int tx = x - font_width(buf);
+        if (tx + 2 * font_width(buf) > HW - 4) tx = HW - 4 - 2 * font_width(buf);
+        text(&c, tx, T + ph + 12, 2, buf, DARK);
+    }
+    for (double v = 0; v <= (double)top;) { /* count ticks: 0..top in fifths, or powers of ten */
+        char buf[64];
+        double f = logy ? log10(1.0 + v) / log10(1.0 + (double)top) : v / (double)top;
+        int y = T + ph - (int)lround((double)ph * f);
+        snprintf(buf, sizeof buf, "%.0f", v);
+        fill_rect(&c, L - 8, y, L - 2, y + 1, DARK);
+        text(&c, L - 12 - 2 * font_width(buf), y - 8, 2, buf, DARK);
+        if (logy) v = v == 0 ? 1 : v * 10;
+        else v += (double)top / 5.0;
+        if (!logy && v > (double)top + 0.5) break;
+    }
+    text(&c, 8, T - 26, 2, logy ? "count (log scale)" : "count", DARK);
+    const char *unit = an->mask[0].is_mask || an->mask[1].is_mask ? " (mm)" : "";
+    char buf[256];
+    snprintf(buf, sizeof buf, "distance to the nearest point of the other set%s", unit);
+    text(&c, L + pw / 2 - font_width(buf), HH - 34, 2, buf, DARK);
+    /* markers: percentile (dashed) and mean (solid) per direction */
+    for (int sidx = 0; sidx < series; sidx++) {
+        const unsigned char *col = sidx ? AMBER : BLUE;
+        double mean = sidx ? r->sum.mean_ba : r->sum.mean_ab;
+        double pct = sidx ? r->pct.ba : r->pct.ab;
+        if (mean >= lo && mean <= hi) {
+            int x = L + (int)lround(pw * (mean - lo) / (hi - lo));
+            fill_rect(&c, x - 1, T, x + 1, T + ph, col);
+        }
+        if (an->percentile_on && pct >= lo && pct <= hi) {
+            int x = L + (int)lround(pw * (pct - lo) / (hi - lo));
+            for (int y = T; y < T + ph; y += 12) fill_rect(&c, x - 1, y, x + 1, y + 6, col);
+        }
+    }
+    /* legend and title */
+    if (r->hist_ba)
+        snprintf(buf, sizeof buf, "distances of A's %zu points to B and of B's %zu points to A", r->n_a, r->n_b);
+    else
+        snprintf(buf, sizeof buf, "distances of A's %zu points to B", r->n_a);
+    text(&c, L, 14, 2, buf, BLACK);
+    int lx = L, ly = 44;
+    fill_rect(&c, lx, ly, lx + 16, ly + 14, BLUE);
+    text(&c, lx + 22, ly - 1, 2, "A->B", DARK);
+    lx += 22 + 2 * font_width("A->B") + 24;
+    if (r->hist_ba) {
+        fill_rect(&c, lx, ly, lx + 16, ly + 14, AMBER);
+        text(&c, lx + 22, ly - 1, 2, "B->A", DARK);
+        lx += 22 + 2 * font_width("B->A") + 24;
+    }
+    fill_rect(&c, lx, ly + 6, lx + 24, ly + 8, DARK);
+    text(&c, lx + 30, ly - 1, 2, "mean", DARK);
+    lx += 30 + 2 * font_width("mean") + 24;
+    if (an->percentile_on) {
+        for (int x = 0; x < 24; x += 8) fill_rect(&c, lx + x, ly + 6, lx + x + 4, ly + 8, DARK);
+        snprintf(buf, sizeof buf, "percentile %g", an->percentile);
+        text(&c, lx + 30, ly - 1, 2, buf, DARK);
+    }
+    if (r->above_ab || r->above_ba) {
+        snprintf(buf, sizeof buf, "beyond %.4g: %zu", hi, r->above_ab + r->above_ba);
+        text(&c, L + pw - 2 * font_width(buf), 44, 2, buf, RED);
+    }
+    int rc = write_png(path, &c, err);
+    free(c.rgb);
+    return rc;
+}
+
+#else
+
+int render_available(void) { return 0; }
+
+static int unavailable(hd_error_t *err) {
+    snprintf(err->message, sizeof err->message,
+             "pictures are unavailable: this hausdorff was built without libpng (Debian: libpng-dev)");
+    return err->code = HD_EUNSUPPORTED;
+}
+
+int render_distances(const char *path, const hd_points_t *A,
+                     const hd_points_t *B, const double *d_a, double dmax,
+                     const hd_symmetric_t *s, int directed,
+                     const char *title, render_marker_t markers[6],
+                     int *n_markers, int *width, int *height,
+                     hd_error_t *err) {
+    (void)path, (void)A, (void)B, (void)d_a, (void)dmax, (void)s, (void)directed, (void)title;
+    (void)markers, (void)width, (void)height;
+    *n_markers = 0;
+    return unavailable(err);
+}
+
+int render_histogram(const char *path, const analysis_result_t *r,
+                     const analysis_args_t *an, size_t bins,
+                     hd_error_t *err) {
+    (void)path, (void)r, (void)an, (void)bins;
+    return unavailable(err);
+}
+
+#endif

@@ -1,0 +1,189 @@
+/*
+ * writers.c -- per-point distances to files: CSV, PLY or NPY by extension,
+ * and the colour map that turns a distance into a colour.
+ *
+ * Every format carries the same columns, one row per point in the input
+ * file's order: x, y, z (the coordinates as read, widened to double), the
+ * distance to the nearest point of the other set, and `nearest`, the
+ * 0-based index of that point (-1 when the other set is empty).
+ *  - CSV: a header line `x,y,z,distance,nearest`, then numbers printed with
+ *    17 significant digits, which read back as the same doubles.
+ *  - PLY: binary_little_endian, `vertex` with double x y z distance, int
+ *    nearest (double when an index exceeds 2^31 - 1) and uchar red green
+ *    blue: the distance's colour, so that any viewer (MeshLab,
+ *    CloudCompare) shows the deviation at once.
+ *  - NPY: a plain (N, 5) float64 array, C order, columns as above; indices
+ *    are exact in a double up to 2^53.
+ * Colours come from viridis (perceptually uniform, readable in grey and by
+ * colour-blind readers): 64 samples of matplotlib's table (CC0, by Nathaniel
+ * Smith and Stefan van der Walt), interpolated linearly, at d / dmax clipped
+ * to [0, 1].
+ */
+#include "analysis.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+
+static const unsigned char viridis[64][3] = {
+    {68, 1, 84}, {70, 7, 90}, {71, 13, 96}, {71, 19, 101},
+    {72, 24, 106}, {72, 29, 111}, {72, 35, 116}, {72, 40, 120},
+    {71, 45, 123}, {70, 50, 126}, {69, 55, 129}, {68, 59, 132},
+    {66, 64, 134}, {64, 69, 136}, {62, 73, 137}, {61, 78, 138},
+    {58, 83, 139}, {56, 88, 140}, {54, 92, 141}, {52, 96, 141},
+    {50, 100, 142}, {49, 104, 142}, {47, 108, 142}, {45, 112, 142},
+    {44, 115, 142}, {42, 119, 142}, {41, 123, 142}, {39, 127, 142},
+    {38, 130, 142}, {36, 134, 142}, {35, 138, 141}, {33, 142, 141},
+    {32, 146, 140}, {31, 150, 139}, {31, 154, 138}, {31, 158, 137},
+    {31, 161, 135}, {33, 165, 133}, {35, 169, 131}, {38, 173, 129},
+    {42, 176, 127}, {47, 180, 124}, {53, 183, 121}, {59, 187, 117},
+    {66, 190, 113}, {74, 193, 109}, {82, 197, 105}, {90, 200, 100},
+    {101, 203, 94}, {110, 206, 88}, {119, 209, 83}, {129, 211, 77},
+    {139, 214, 70}, {149, 216, 64}, {160, 218, 57}, {170, 220, 50},
+    {181, 222, 43}, {192, 223, 37}, {202, 225, 31}, {213, 226, 26},
+    {223, 227, 24}, {234, 229, 26}, {244, 230, 30}, {253, 231, 37},
+};
+
+void colormap_viridis(double t, unsigned char rgb[3]) {
+    if (!(t > 0.0)) t = 0.0; /* NaN too */
+    if (t > 1.0) t = 1.0;
+    double x = t * 63.0;
+    int k = (int)x;
+    if (k > 62) k = 62;
+    double f = x - k;
+    for (int c = 0; c < 3; c++) {
+        double v = viridis[k][c] + (viridis[k + 1][c] - viridis[k][c]) * f;
+        rgb[c] = (unsigned char)(v + 0.5);
+    }
+}
+
+void path_with_suffix(const char *path, const char *suffix, char *out,
+                      size_t size) {
+    const char *dot = strrchr(path, '.'), *slash = strrchr(path, '/');
+    if (!dot || (slash && dot < slash)) dot = path + strlen(path);
+    snprintf(out, size, "%.*s%s%s", (int)(dot - path), path, suffix, dot);
+}
+
+typedef enum { OUT_CSV, OUT_PLY, OUT_NPY, OUT_UNKNOWN } out_format_t;
+
+static out_format_t format_of(const char *path) {
+    const char *dot = strrchr(path, '.');
+    if (!dot) return OUT_UNKNOWN;
+    if (strcasecmp(dot, ".csv") == 0) return OUT_CSV;
+    if (strcasecmp(dot, ".ply") == 0) return OUT_PLY;
+    if (strcasecmp(dot, ".npy") == 0) return OUT_NPY;
+    return OUT_UNKNOWN;
+}
+
+static double nearest_of(const size_t *nearest, size_t k) {
+    return nearest ? (double)nearest[k] : -1.0;
+}
+
+static void put_le(unsigned char *p, const void *v, size_t n) {
+    const unsigned char *s = v;
+    unsigned one = 1;
+    int little = *(const unsigned char *)&one == 1;
+    for (size_t k = 0; k < n; k++) p[k] = little ? s[k] : s[n - 1 - k];
+}
+
+static void write_csv(FILE *f, const hd_points_t *P, const double *d,
+                      const size_t *nearest) {
+    fputs("x,y,z,distance,nearest\n", f);
+    for (size_t k = 0; k < P->count; k++) {
+        double q[3];
+        hd_points_get(P, k, q);
+        if (nearest)
+            fprintf(f, "%.17g,%.17g,%.17g,%.17g,%zu\n", q[0], q[1], q[2], d[k], nearest[k]);
+        else
+            fprintf(f, "%.17g,%.17g,%.17g,%.17g,-1\n", q[0], q[1], q[2], d[k]);
+    }
+}
+
+static void write_ply(FILE *f, const hd_points_t *P, const double *d,
+                      const size_t *nearest, double dmax) {
+    int wide = 0;
+    for (size_t k = 0; nearest && k < P->count; k++) wide |= nearest[k] > 2147483647u;
+    fprintf(f, "ply\nformat binary_little_endian 1.0\n"
+               "comment written by hausdorff %s: distance to the nearest point of the other set\n"
+               "comment colour: viridis, 0 to %.17g\n"
+               "element vertex %zu\n"
+               "property double x\nproperty double y\nproperty double z\n"
+               "property double distance\nproperty %s nearest\n"
+               "property uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n",
+            hd_version(), dmax, P->count, wide ? "double" : "int");
+    unsigned char rec[4 * 8 + 8 + 3];
+    for (size_t k = 0; k < P->count; k++) {
+        double q[4];
+        hd_points_get(P, k, q);
+        q[3] = d[k];
+        size_t o = 0;
+        for (int c = 0; c < 4; c++, o += 8) put_le(rec + o, &q[c], 8);
+        if (wide) {
+            double j = nearest_of(nearest, k);
+            put_le(rec + o, &j, 8);
+            o += 8;
+        } else {
+            int32_t j = nearest ? (int32_t)nearest[k] : -1;
+            put_le(rec + o, &j, 4);
+            o += 4;
+        }
+        colormap_viridis(dmax > 0 ? d[k] / dmax : 0.0, rec + o);
+        o += 3;
+        fwrite(rec, 1, o, f);
+    }
+}
+
+static void write_npy(FILE *f, const hd_points_t *P, const double *d,
+                      const size_t *nearest) {
+    char dict[128];
+    int n = snprintf(dict, sizeof dict, "{'descr': '<f8', 'fortran_order': False, 'shape': (%zu, 5), }",
+                     P->count);
+    /* magic (6) + version (2) + length (2) + dict, padded with spaces and
+     * a newline to a multiple of 64 bytes */
+    size_t total = 10 + (size_t)n + 1, padded = (total + 63) / 64 * 64;
+    unsigned char head[10] = {0x93, 'N', 'U', 'M', 'P', 'Y', 1, 0, 0, 0};
+    uint16_t hl = (uint16_t)(padded - 10);
+    put_le(head + 8, &hl, 2);
+    fwrite(head, 1, 10, f);
+    fwrite(dict, 1, (size_t)n, f);
+    for (size_t k = total; k < padded; k++) fputc(' ', f);
+    fputc('\n', f);
+    unsigned char rec[40];
+    for (size_t k = 0; k < P->count; k++) {
+        double v[5];
+        hd_points_get(P, k, v);
+        v[3] = d[k];
+        v[4] = nearest_of(nearest, k);
+        for (int c = 0; c < 5; c++) put_le(rec + 8 * c, &v[c], 8);
+        fwrite(rec, 1, sizeof rec, f);
+    }
+}
+
+int write_distances(const char *path, const hd_points_t *P, const double *d,
+                    const size_t *nearest, double dmax, hd_error_t *err) {
+    out_format_t fmt = format_of(path);
+    if (fmt == OUT_UNKNOWN) {
+        snprintf(err->message, sizeof err->message,
+                 "%s: cannot tell the output format; name it .csv, .ply or .npy", path);
+        return err->code = HD_EUNSUPPORTED;
+    }
+    FILE *f = fopen(path, "wb");
+    if (!f) {
+        snprintf(err->message, sizeof err->message, "%s: cannot write: %s", path, strerror(errno));
+        return err->code = HD_EIO;
+    }
+    if (fmt == OUT_CSV) write_csv(f, P, d, nearest);
+    else if (fmt == OUT_PLY) write_ply(f, P, d, nearest, dmax);
+    else write_npy(f, P, d, nearest);
+    int bad = ferror(f);
+    if (fclose(f) != 0) bad = 1;
+    if (bad) {
+        snprintf(err->message, sizeof err->message, "%s: write failed: %s", path, strerror(errno));
+        return err->code = HD_EIO;
+    }
+    return HD_OK;
+}
+
+int distances_format_known(const char *path) { return format_of(path) != OUT_UNKNOWN; }

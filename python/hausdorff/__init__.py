@@ -1,0 +1,47 @@
+"""Exact Hausdorff distance between 3D point sets.
+
+Python bindings to libhausdorff: numpy arrays in, distances out, exact to the
+last bit (identical to a brute force in double precision) and with the same
+witness at any thread count.  The computation runs in C with the GIL
+released.
+
+>>> import numpy as np, hausdorff
+>>> a = np.array([[0.0, 0, 0], [1, 0, 0]])
+>>> b = np.array([[0.0, 0, 0], [3, 0, 0]])
+>>> hausdorff.directed(a, b)           # like scipy's directed_hausdorff
+hausdorff.DirectedResult(distance=1.0, i=1, j=0)
+>>> hausdorff.hausdorff(a, b).distance
+2.0
+
+Functions: directed, hausdorff, distances, percentile, read, formats;
+the class Index (build once, query many times, optionally transformed).
+"""
+from ._hausdorff import (
+    DirectedResult,
+    HausdorffResult,
+    Index,
+    PercentileResult,
+    __version__,
+    algorithms,
+    directed,
+    distances,
+    formats,
+    hausdorff,
+    percentile,
+    read,
+)
+
+__all__ = [
+    "DirectedResult",
+    "HausdorffResult",
+    "Index",
+    "PercentileResult",
+    "__version__",
+    "algorithms",
+    "directed",
+    "distances",
+    "formats",
+    "hausdorff",
+    "percentile",
+    "read",
+]

@@ -1,0 +1,979 @@
+/*
+ * _hausdorff.c -- the CPython extension over libhausdorff.
+ *
+ * This file is a thin layer: it turns Python arguments into the library's
+ * views and options, calls the library with the GIL released, and turns
+ * results and error codes back into Python objects.  It computes no distance
+ * itself, so everything the library guarantees (exact to the bit, the
+ * canonical witness, the same answer at any thread count) holds unchanged in
+ * Python.
+ *
+ * Arrays are passed without a copy whenever the layout allows it.  A numpy
+ * array of float32 or float64 in native byte order and of shape (N, 3) is
+ * described to the library by its data pointer and its two byte strides
+ * (hd_points_t.stride and .cstride, negative allowed), so C order, Fortran
+ * order, slices with steps and reversed views are all read in place.  Only
+ * three cases copy: other numeric types (integers, float16, long double) are
+ * converted to float64 as numpy would; non-native byte order is swapped; and
+ * a zero stride (np.broadcast_to) is materialised, because the library
+ * reads a zero stride as "packed".  The array object is held for as long as
+ * the library may read it, and the GIL is released only around library
+ * calls, which touch no Python object.
+ *
+ * An Index keeps its own C-ordered copy of the indexed points: the library's
+ * index borrows the memory it was built on, and a Python caller could
+ * otherwise change or free that array while the index lives.  The copy is
+ * made once and never written again, so queries from many Python threads at
+ * once are safe (the C index is immutable).
+ *
+ * Library result codes map to Python exceptions by kind: bad input (invalid
+ * argument, empty set, NaN or infinite or too large a coordinate, malformed
+ * or unsupported file, unknown algorithm) raises ValueError; out of memory
+ * and size overflow raise MemoryError; input/output errors raise OSError;
+ * anything else (a thread that could not start) raises RuntimeError.  The
+ * message is the library's sentence, which names the set and the point.
+ */
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+#include <structmember.h>
+
+#define NPY_NO_DEPRECATED_API NPY_1_7_API_VERSION
+#include <numpy/arrayobject.h>
+
+#include <math.h>
+#include <string.h>
+
+#include "hausdorff.h"
+
+/* hd_index_nearest writes size_t indices straight into an intp array. */
+_Static_assert(sizeof(size_t) == sizeof(npy_intp), "size_t and npy_intp differ in size");
+
+/* ------------------------------------------------------------------------
+ * Errors.
+ * ---------------------------------------------------------------------- */
+
+static PyObject *raise_hd(int rc, const hd_error_t *err) {
+    PyObject *type;
+    switch (rc) {
+    case HD_EINVAL:
+    case HD_EEMPTY:
+    case HD_ENONFINITE:
+    case HD_ERANGE:
+    case HD_EFORMAT:
+    case HD_EUNSUPPORTED:
+    case HD_EALGORITHM: type = PyExc_ValueError; break;
+    case HD_ENOMEM:
+    case HD_EOVERFLOW: type = PyExc_MemoryError; break;
+    case HD_EIO: type = PyExc_OSError; break;
+    default: type = PyExc_RuntimeError; break;
+    }
+    const char *msg = err && err->message[0] ? err->message : hd_strerror(rc);
+    PyErr_Format(type, "%s (%s)", msg, hd_err_name(rc));
+    return NULL;
+}
+
+/* ------------------------------------------------------------------------
+ * Point sets: numpy arrays described to the library without a copy.
+ * ---------------------------------------------------------------------- */
+
+typedef struct {
+    PyArrayObject *arr; /* keeps the memory alive; NULL when unused */
+    hd_points_t pts;
+} points_arg_t;
+
+static void points_release(points_arg_t *p) {
+    Py_CLEAR(p->arr);
+}
+
+/* Fill *out from any (N, 3) array-like.  `name` is the argument's name in
+ * messages.  Returns 0, or -1 with an exception set. */
+static int points_from_object(PyObject *obj, const char *name, points_arg_t *out) {
+    out->arr = NULL;
+    PyArrayObject *arr = (PyArrayObject *)PyArray_FROM_O(obj);
+    if (!arr) return -1;
+    if (PyArray_NDIM(arr) != 2 || PyArray_DIM(arr, 1) != 3) {
+        PyObject *shape = PyObject_GetAttrString((PyObject *)arr, "shape");
+        if (shape) {
+            PyErr_Format(PyExc_ValueError,
+                         "%s must be an (N, 3) array of points, got shape %R", name, shape);
+            Py_DECREF(shape);
+        }
+        Py_DECREF(arr);
+        return -1;
+    }
+    if (PyArray_DIM(arr, 0) == 0) {
+        PyErr_Format(PyExc_ValueError, "%s is empty: at least one point is needed", name);
+        Py_DECREF(arr);
+        return -1;
+    }
+    int type = PyArray_TYPE(arr);
+    int want = type;
+    if (type != NPY_DOUBLE && type != NPY_FLOAT) {
+        if (!PyArray_ISINTEGER(arr) && !PyArray_ISFLOAT(arr)) {
+            PyErr_Format(PyExc_TypeError,
+                         "%s must hold real numbers (float32 or float64), got dtype %R",
+                         name, (PyObject *)PyArray_DESCR(arr));
+            Py_DECREF(arr);
+            return -1;
+        }
+        want = NPY_DOUBLE;
+    }
+    npy_intp s0 = PyArray_STRIDE(arr, 0), s1 = PyArray_STRIDE(arr, 1);
+    /* The library reads a zero stride as "packed": materialise broadcasts. */
+    int zero_stride = s1 == 0 || (s0 == 0 && PyArray_DIM(arr, 0) > 1);
+    if (want != type || !PyArray_ISNOTSWAPPED(arr) || zero_stride) {
+        PyArrayObject *c = (PyArrayObject *)PyArray_FromArray(
+            arr, PyArray_DescrFromType(want), NPY_ARRAY_CARRAY | NPY_ARRAY_FORCECAST);
+        Py_DECREF(arr);
+        if (!c) return -1;
+        arr = c;
+        s0 = PyArray_STRIDE(arr, 0);
+        s1 = PyArray_STRIDE(arr, 1);
+    }
+    out->arr = arr;
+    out->pts.data = PyArray_DATA(arr);
+    out->pts.count = (size_t)PyArray_DIM(arr, 0);
+    out->pts.dtype = PyArray_TYPE(arr) == NPY_FLOAT ? HD_FLOAT32 : HD_FLOAT64;
+    out->pts.stride = (ptrdiff_t)s0;
+    out->pts.cstride = (ptrdiff_t)s1;
+    return 0;
+}
+
+/* Both sets of a two-set call; on failure neither is held. */
+static int points_pair(PyObject *oa, PyObject *ob, points_arg_t *a, points_arg_t *b) {
+    if (points_from_object(oa, "a", a)) return -1;
+    if (points_from_object(ob, "b", b)) {
+        points_release(a);
+        return -1;
+    }
+    return 0;
+}
+
+/* ------------------------------------------------------------------------
+ * Options.
+ * ---------------------------------------------------------------------- */
+
+/* threads: None or 0 = every core, else a positive count. */
+static int parse_threads(PyObject *obj, int *threads) {
+    if (!obj || obj == Py_None) {
+        *threads = 0;
+        return 0;
+    }
+    if (!PyLong_Check(obj)) {
+        PyErr_Format(PyExc_TypeError, "threads must be None or an int, not %.100s",
+                     Py_TYPE(obj)->tp_name);
+        return -1;
+    }
+    long v = PyLong_AsLong(obj);
+    if (v == -1 && PyErr_Occurred()) return -1;
+    if (v < 0 || v > 1 << 20) {
+        PyErr_Format(PyExc_ValueError,
+                     "threads must be None (every core) or a positive number, not %ld", v);
+        return -1;
+    }
+    *threads = (int)v;
+    return 0;
+}
+
+static int parse_options(const char *algorithm, PyObject *threads, PyObject *seed,
+                         hd_options_t *opt) {
+    hd_options_init(opt);
+    if (algorithm && hd_algorithm_from_name(algorithm, &opt->algorithm) != HD_OK) {
+        char known[256] = "";
+        for (int k = 0; k < HD__ALG_COUNT; k++) {
+            size_t used = strlen(known);
+            snprintf(known + used, sizeof known - used, "%s%s", k ? ", " : "",
+                     hd_algorithm_name((hd_algorithm_t)k));
+        }
+        PyErr_Format(PyExc_ValueError, "unknown algorithm '%s' (known: %s)", algorithm, known);
+        return -1;
+    }
+    if (parse_threads(threads, &opt->threads)) return -1;
+    if (seed && seed != Py_None) {
+        if (!PyLong_Check(seed)) {
+            PyErr_Format(PyExc_TypeError, "seed must be an int, not %.100s",
+                         Py_TYPE(seed)->tp_name);
+            return -1;
+        }
+        unsigned long long s = PyLong_AsUnsignedLongLong(seed);
+        if (s == (unsigned long long)-1 && PyErr_Occurred()) {
+            PyErr_Clear();
+            PyErr_SetString(PyExc_ValueError, "seed must be an integer in [0, 2**64)");
+            return -1;
+        }
+        opt->seed = (uint64_t)s;
+    }
+    return 0;
+}
+
+/* rotation (3x3) and translation (3,), either may be None.  *use is 0 when
+ * both are None (no transform at all). */
+static int parse_transform(PyObject *rotation, PyObject *translation, hd_transform_t *T,
+                           int *use) {
+    hd_transform_identity(T);
+    *use = 0;
+    struct {
+        PyObject *obj;
+        const char *name;
+        double *dst;
+        int n;
+    } parts[2] = {{rotation, "rotation", T->r, 9}, {translation, "translation", T->t, 3}};
+    for (int k = 0; k < 2; k++) {
+        if (!parts[k].obj || parts[k].obj == Py_None) continue;
+        PyArrayObject *a = (PyArrayObject *)PyArray_FROM_OTF(
+            parts[k].obj, NPY_DOUBLE, NPY_ARRAY_CARRAY | NPY_ARRAY_FORCECAST);
+        if (!a) return -1;
+        int ok = parts[k].n == 9
+                     ? PyArray_NDIM(a) == 2 && PyArray_DIM(a, 0) == 3 && PyArray_DIM(a, 1) == 3
+                     : PyArray_NDIM(a) == 1 && PyArray_DIM(a, 0) == 3;
+        if (!ok) {
+            PyErr_Format(PyExc_ValueError, "%s must have shape %s", parts[k].name,
+                         parts[k].n == 9 ? "(3, 3)" : "(3,)");
+            Py_DECREF(a);
+            return -1;
+        }
+        const double *v = PyArray_DATA(a);
+        for (int c = 0; c < parts[k].n; c++) {
+            if (!isfinite(v[c])) {
+                PyErr_Format(PyExc_ValueError, "%s must be finite", parts[k].name);
+                Py_DECREF(a);
+                return -1;
+            }
+            parts[k].dst[c] = v[c];
+        }
+        Py_DECREF(a);
+        *use = 1;
+    }
+    return 0;
+}
+
+/* ------------------------------------------------------------------------
+ * Result types.
+ * ---------------------------------------------------------------------- */
+
+static PyTypeObject DirectedResultType, HausdorffResultType;
+
+static PyStructSequence_Field directed_fields[] = {
+    {"distance", "the directed Hausdorff distance h(A, B)"},
+    {"i", "witness: index in A (smallest on ties)"},
+    {"j", "witness: index in B nearest to A[i] (smallest on ties)"},
+    {"algorithm", "the algorithm that actually ran"},
+    {"seconds", "wall-clock time of the computation"},
+    {"distance_evals", "point-to-point distances evaluated"},
+    {NULL, NULL},
+};
+
+static PyStructSequence_Desc directed_desc = {
+    "hausdorff.DirectedResult",
+    "The directed distance h(A, B) and its witness, a 3-tuple (distance, i, j) "
+    "as scipy.spatial.distance.directed_hausdorff returns; also has the "
+    "attributes algorithm, seconds and distance_evals.",
+    directed_fields,
+    3,
+};
+
+static PyStructSequence_Field hausdorff_fields[] = {
+    {"distance", "the Hausdorff distance H(A, B) = max(h(A, B), h(B, A))"},
+    {"ab", "h(A, B) as a DirectedResult: ab.i indexes A, ab.j indexes B"},
+    {"ba", "h(B, A) as a DirectedResult: ba.i indexes B, ba.j indexes A"},
+    {"alpha", "overlap degree of the bounding boxes (0 apart or touching, 1 full)"},
+    {"disjoint", "True when the bounding boxes do not intersect"},
+    {"seconds", "wall-clock time of both directions"},
+    {NULL, NULL},
+};
+
+static PyStructSequence_Desc hausdorff_desc = {
+    "hausdorff.HausdorffResult",
+    "The symmetric distance H(A, B) with both directions, a 3-tuple "
+    "(distance, ab, ba); also has the attributes alpha, disjoint and seconds.",
+    hausdorff_fields,
+    3,
+};
+
+static PyTypeObject PercentileResultType;
+
+static PyStructSequence_Field percentile_fields[] = {
+    {"p", "the percentile asked for, in [0, 100]"},
+    {"ab", "p-th percentile of the distances of A's points to B"},
+    {"ba", "p-th percentile of the distances of B's points to A"},
+    {"symmetric", "max(ab, ba): MONAI's percentile Hausdorff distance (HD95)"},
+    {"pooled", "p-th percentile of both directions' distances together: medpy's hd95"},
+    {NULL, NULL},
+};
+
+static PyStructSequence_Desc percentile_desc = {
+    "hausdorff.PercentileResult",
+    "Percentile Hausdorff distances: the tuple (p, ab, ba, symmetric, pooled).",
+    percentile_fields,
+    5,
+};
+
+/* A struct sequence of `type` holding v[0..n), whose references it steals;
+ * NULL (with the exception set) when any of them is NULL. */
+static PyObject *struct_of(PyTypeObject *type, PyObject **v, int n) {
+    PyObject *o = PyStructSequence_New(type);
+    int bad = !o;
+    for (int k = 0; k < n; k++) {
+        if (!v[k]) bad = 1;
+        if (o) PyStructSequence_SET_ITEM(o, k, v[k]); /* NULL is fine for dealloc */
+        else Py_XDECREF(v[k]);
+    }
+    if (bad) Py_CLEAR(o);
+    return o;
+}
+
+static PyObject *percentile_result(const hd_percentile_t *r) {
+    PyObject *v[5] = {PyFloat_FromDouble(r->p), PyFloat_FromDouble(r->ab),
+                      PyFloat_FromDouble(r->ba), PyFloat_FromDouble(r->symmetric),
+                      PyFloat_FromDouble(r->pooled)};
+    return struct_of(&PercentileResultType, v, 5);
+}
+
+static PyObject *directed_result(const hd_result_t *r) {
+    PyObject *v[6] = {
+        PyFloat_FromDouble(r->distance),
+        PyLong_FromSize_t(r->i),
+        PyLong_FromSize_t(r->j),
+        PyUnicode_FromString(hd_algorithm_name(r->algorithm)),
+        PyFloat_FromDouble(r->seconds),
+        PyLong_FromUnsignedLongLong(r->stats.distance_evals),
+    };
+    return struct_of(&DirectedResultType, v, 6);
+}
+
+static PyObject *hausdorff_result(const hd_symmetric_t *r) {
+    PyObject *v[6] = {
+        PyFloat_FromDouble(r->distance),
+        directed_result(&r->ab),
+        directed_result(&r->ba),
+        PyFloat_FromDouble(r->alpha),
+        PyBool_FromLong(r->disjoint),
+        PyFloat_FromDouble(r->seconds),
+    };
+    return struct_of(&HausdorffResultType, v, 6);
+}
+
+/* ------------------------------------------------------------------------
+ * Per-point distances: the query set against an index.
+ * ---------------------------------------------------------------------- */
+
+/* (dist, nearest) for every point of A against idx, with the GIL released
+ * around the library call. */
+static PyObject *nearest_arrays(const hd_index_t *idx, const hd_points_t *A,
+                                const hd_transform_t *T, const hd_options_t *opt) {
+    npy_intp n = (npy_intp)A->count;
+    PyArrayObject *dist = (PyArrayObject *)PyArray_SimpleNew(1, &n, NPY_DOUBLE);
+    PyArrayObject *nearest = (PyArrayObject *)PyArray_SimpleNew(1, &n, NPY_INTP);
+    if (!dist || !nearest) {
+        Py_XDECREF(dist);
+        Py_XDECREF(nearest);
+        return NULL;
+    }
+    hd_error_t err;
+    int rc;
+    Py_BEGIN_ALLOW_THREADS
+    rc = hd_index_nearest(idx, A, T, opt, (double *)PyArray_DATA(dist),
+                          (size_t *)PyArray_DATA(nearest), &err);
+    Py_END_ALLOW_THREADS
+    if (rc != HD_OK) {
+        Py_DECREF(dist);
+        Py_DECREF(nearest);
+        return raise_hd(rc, &err);
+    }
+    return Py_BuildValue("(NN)", dist, nearest);
+}
+
+/* ------------------------------------------------------------------------
+ * Module functions.
+ * ---------------------------------------------------------------------- */
+
+PyDoc_STRVAR(directed_doc,
+"directed($module, a, b, *, algorithm='auto', threads=None, seed=0)\n--\n\n"
+"The directed Hausdorff distance h(a, b) = max over p in a of min over q in b\n"
+"of |p - q|, exact to the last bit, with its witness.\n"
+"\n"
+"A drop-in for scipy.spatial.distance.directed_hausdorff(a, b): it returns the\n"
+"tuple (distance, i, j) where |a[i] - b[j]| == distance.  On ties i is the\n"
+"smallest index in a whose nearest distance is the maximum and j the smallest\n"
+"index in b at that distance, for every algorithm and thread count (scipy's\n"
+"witness depends on its random order instead).\n"
+"\n"
+"a, b: (N, 3) and (M, 3) array-likes of float32 or float64 (C or Fortran\n"
+"    order or strided views are read in place; other real dtypes are\n"
+"    converted to float64).\n"
+"algorithm: 'auto' (the fastest exact engine), 'naive', 'earlybreak',\n"
+"    'inc', 'nohd', 'ohd', 'framework' or 'kdtree'.\n"
+"threads: None or 0 for every core, else the number of threads.\n"
+"seed: the seed of the randomised algorithms (earlybreak, ohd).\n"
+"\n"
+"The GIL is released during the computation.  Raises ValueError for a wrong\n"
+"shape, an empty set, NaN or infinite coordinates, or an unknown algorithm.\n"
+"\n"
+">>> import numpy as np, hausdorff\n"
+">>> a = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0]])\n"
+">>> b = np.array([[0.0, 0, 0.5], [1, 0.25, 0]])\n"
+">>> d, i, j = hausdorff.directed(a, b)\n"
+">>> print(round(d, 6), i, j)\n"
+"1.118034 2 0\n"
+">>> hausdorff.directed(a, b).distance == d\n"
+"True\n");
+
+/* The arguments of directed() and hausdorff(): a, b, *, algorithm, threads,
+ * seed.  On success both sets are held (release them). */
+static int distance_args(PyObject *args, PyObject *kw, const char *fmt, hd_options_t *opt,
+                         points_arg_t *a, points_arg_t *b) {
+    static char *kwlist[] = {"a", "b", "algorithm", "threads", "seed", NULL};
+    PyObject *oa, *ob, *threads = Py_None, *seed = NULL;
+    const char *algorithm = "auto";
+    if (!PyArg_ParseTupleAndKeywords(args, kw, fmt, kwlist, &oa, &ob, &algorithm, &threads,
+                                     &seed))
+        return -1;
+    if (parse_options(algorithm, threads, seed, opt)) return -1;
+    return points_pair(oa, ob, a, b);
+}
+
+/* directed() and hausdorff(): one computation, one or both directions. */
+static PyObject *distance_call(PyObject *args, PyObject *kw, int symmetric) {
+    hd_options_t opt;
+    points_arg_t a, b;
+    if (distance_args(args, kw, symmetric ? "OO|$sOO:hausdorff" : "OO|$sOO:directed", &opt,
+                      &a, &b))
+        return NULL;
+    hd_result_t r;
+    hd_symmetric_t h;
+    hd_error_t err;
+    int rc;
+    Py_BEGIN_ALLOW_THREADS
+    rc = symmetric ? hd_hausdorff(&a.pts, &b.pts, &opt, &h, &err)
+                   : hd_directed(&a.pts, &b.pts, &opt, &r, &err);
+    Py_END_ALLOW_THREADS
+    points_release(&a);
+    points_release(&b);
+    if (rc != HD_OK) return raise_hd(rc, &err);
+    return symmetric ? hausdorff_result(&h) : directed_result(&r);
+}
+
+static PyObject *py_directed(PyObject *self, PyObject *args, PyObject *kw) {
+    (void)self;
+    return distance_call(args, kw, 0);
+}
+
+PyDoc_STRVAR(hausdorff_doc,
+"hausdorff($module, a, b, *, algorithm='auto', threads=None, seed=0)\n--\n\n"
+"The Hausdorff distance H(a, b) = max(h(a, b), h(b, a)), exact, with the\n"
+"witnesses of both directions.\n"
+"\n"
+"Returns a HausdorffResult, the tuple (distance, ab, ba): ab is h(a, b) as\n"
+"a DirectedResult (ab.i indexes a, ab.j indexes b) and ba is h(b, a)\n"
+"(ba.i indexes b, ba.j indexes a).  It also carries alpha (the overlap\n"
+"degree of the bounding boxes), disjoint and seconds.  Arguments as for\n"
+"directed().\n"
+"\n"
+">>> import numpy as np, hausdorff\n"
+">>> a = np.array([[0.0, 0, 0], [1, 0, 0]])\n"
+">>> b = np.array([[0.0, 0, 0], [3, 0, 0]])\n"
+">>> d, ab, ba = hausdorff.hausdorff(a, b)\n"
+">>> d, tuple(ab), tuple(ba)\n"
+"(2.0, (1.0, 1, 0), (2.0, 1, 1))\n");
+
+static PyObject *py_hausdorff(PyObject *self, PyObject *args, PyObject *kw) {
+    (void)self;
+    return distance_call(args, kw, 1);
+}
+
+PyDoc_STRVAR(distances_doc,
+"distances($module, a, b, *, threads=None)\n--\n\n"
+"Per-point distances from a to b: for every point a[k], the exact distance\n"
+"to its nearest point in b and that point's index (the smallest on ties).\n"
+"\n"
+"Returns (dist, nearest): a float64 array and an intp array of len(a).\n"
+"dist.max() is h(a, b).  To query b many times, build an Index(b) once.\n"
+"\n"
+">>> import numpy as np, hausdorff\n"
+">>> a = np.array([[0.0, 0, 0], [2, 0, 0]])\n"
+">>> b = np.array([[0.0, 0, 1], [2, 0, 0.5]])\n"
+">>> dist, nearest = hausdorff.distances(a, b)\n"
+">>> dist.tolist(), nearest.tolist()\n"
+"([1.0, 0.5], [0, 1])\n");
+
+static PyObject *py_distances(PyObject *self, PyObject *args, PyObject *kw) {
+    (void)self;
+    static char *kwlist[] = {"a", "b", "threads", NULL};
+    PyObject *oa, *ob, *threads = Py_None;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "OO|$O:distances", kwlist, &oa, &ob,
+                                     &threads))
+        return NULL;
+    hd_options_t opt;
+    if (parse_options(NULL, threads, NULL, &opt)) return NULL;
+    points_arg_t a, b;
+    if (points_pair(oa, ob, &a, &b)) return NULL;
+    npy_intp n = (npy_intp)a.pts.count;
+    PyArrayObject *dist = (PyArrayObject *)PyArray_SimpleNew(1, &n, NPY_DOUBLE);
+    PyArrayObject *nearest = (PyArrayObject *)PyArray_SimpleNew(1, &n, NPY_INTP);
+    PyObject *res = NULL;
+    if (dist && nearest) {
+        hd_error_t err;
+        int rc;
+        Py_BEGIN_ALLOW_THREADS
+        rc = hd_distances(&a.pts, &b.pts, &opt, (double *)PyArray_DATA(dist),
+                          (size_t *)PyArray_DATA(nearest), NULL, NULL, &err);
+        Py_END_ALLOW_THREADS
+        if (rc == HD_OK) res = Py_BuildValue("(OO)", dist, nearest);
+        else raise_hd(rc, &err);
+    }
+    Py_XDECREF(dist);
+    Py_XDECREF(nearest);
+    points_release(&a);
+    points_release(&b);
+    return res;
+}
+
+PyDoc_STRVAR(percentile_doc,
+"percentile($module, a, b, p, *, threads=None)\n--\n\n"
+"Percentile Hausdorff distances, e.g. HD95 with p=95, exact.\n"
+"\n"
+"p is a number in [0, 100] or a sequence of them (the per-point distances\n"
+"are then computed once for all).  For each p the result is a\n"
+"PercentileResult (p, ab, ba, symmetric, pooled): ab is the p-th percentile\n"
+"of the distances of a's points to b, ba of b's points to a, both with\n"
+"numpy's default linear interpolation (bit-identical to numpy.percentile);\n"
+"symmetric = max(ab, ba) is MONAI's HD95; pooled, the percentile of both\n"
+"directions' distances together, is medpy's hd95.  p=100 gives h(a, b),\n"
+"h(b, a) and H(a, b).  A sequence p gives a list of results.\n"
+"\n"
+">>> import numpy as np, hausdorff\n"
+">>> a = np.array([[0.0, 0, 0], [1, 0, 0], [2, 0, 0]])\n"
+">>> b = np.array([[0.0, 0, 1], [1, 0, 0], [2, 0, 0]])\n"
+">>> hausdorff.percentile(a, b, 100).symmetric\n"
+"1.0\n"
+">>> [r.ab for r in hausdorff.percentile(a, b, [0, 50, 75])]\n"
+"[0.0, 0.0, 0.5]\n");
+
+static PyObject *py_percentile(PyObject *self, PyObject *args, PyObject *kw) {
+    (void)self;
+    static char *kwlist[] = {"a", "b", "p", "threads", NULL};
+    PyObject *oa, *ob, *op, *threads = Py_None;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "OOO|$O:percentile", kwlist, &oa, &ob, &op,
+                                     &threads))
+        return NULL;
+    hd_options_t opt;
+    if (parse_options(NULL, threads, NULL, &opt)) return NULL;
+    PyArrayObject *parr = (PyArrayObject *)PyArray_FROM_OTF(
+        op, NPY_DOUBLE, NPY_ARRAY_CARRAY | NPY_ARRAY_FORCECAST);
+    if (!parr) return NULL;
+    if (PyArray_NDIM(parr) > 1) {
+        Py_DECREF(parr);
+        PyErr_SetString(PyExc_ValueError, "p must be a number or a 1-D sequence of numbers");
+        return NULL;
+    }
+    int scalar = PyArray_NDIM(parr) == 0;
+    size_t np_ = (size_t)PyArray_SIZE(parr);
+    const double *p = PyArray_DATA(parr);
+    hd_error_t err;
+    /* Check every p with the library's own rule before the long part. */
+    double one = 0.0, *scratch = PyMem_Malloc((np_ ? np_ : 1) * sizeof(double));
+    if (!scratch) {
+        Py_DECREF(parr);
+        return PyErr_NoMemory();
+    }
+    int rc = hd_percentiles(&one, 1, p, np_, scratch, &err);
+    PyMem_Free(scratch);
+    if (rc != HD_OK) {
+        Py_DECREF(parr);
+        return raise_hd(rc, &err);
+    }
+    points_arg_t a, b;
+    if (points_pair(oa, ob, &a, &b)) {
+        Py_DECREF(parr);
+        return NULL;
+    }
+    size_t na = a.pts.count, nb = b.pts.count;
+    double *d_ab = PyMem_RawMalloc(na * sizeof(double));
+    double *d_ba = PyMem_RawMalloc(nb * sizeof(double));
+    hd_percentile_t *res = PyMem_RawMalloc((np_ ? np_ : 1) * sizeof *res);
+    PyObject *out = NULL;
+    if (!d_ab || !d_ba || !res) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    Py_BEGIN_ALLOW_THREADS
+    rc = hd_distances(&a.pts, &b.pts, &opt, d_ab, NULL, d_ba, NULL, &err);
+    for (size_t k = 0; rc == HD_OK && k < np_; k++)
+        rc = hd_percentile_of(d_ab, na, d_ba, nb, p[k], &res[k], &err);
+    Py_END_ALLOW_THREADS
+    if (rc != HD_OK) {
+        raise_hd(rc, &err);
+        goto done;
+    }
+    if (scalar) {
+        out = percentile_result(&res[0]);
+        goto done;
+    }
+    out = PyList_New((Py_ssize_t)np_);
+    for (size_t k = 0; out && k < np_; k++) {
+        PyObject *r = percentile_result(&res[k]);
+        if (!r) Py_CLEAR(out);
+        else PyList_SET_ITEM(out, (Py_ssize_t)k, r);
+    }
+done:
+    PyMem_RawFree(d_ab);
+    PyMem_RawFree(d_ba);
+    PyMem_RawFree(res);
+    Py_DECREF(parr);
+    points_release(&a);
+    points_release(&b);
+    return out;
+}
+
+/* ------------------------------------------------------------------------
+ * Reading files.
+ * ---------------------------------------------------------------------- */
+
+static void cloud_capsule_free(PyObject *capsule) {
+    hd_cloud_free(PyCapsule_GetPointer(capsule, "hausdorff.cloud"));
+}
+
+PyDoc_STRVAR(read_doc,
+"read($module, path, *, format=None, float32=False)\n--\n\n"
+"Read a point cloud with the library's readers and return it as an (N, 3)\n"
+"array, float64 by default or float32 with float32=True.\n"
+"\n"
+"The format comes from the extension (confirmed by the file's magic) unless\n"
+"format names it (one of hausdorff.formats()).  Mesh formats give their\n"
+"vertices.  The array takes over the memory the reader filled: no copy.\n"
+"Raises OSError when the file cannot be read and ValueError when it is\n"
+"malformed, empty or of an unknown format.\n"
+"\n"
+">>> import hausdorff, os, tempfile\n"
+">>> path = os.path.join(tempfile.mkdtemp(), 'two.xyz')\n"
+">>> with open(path, 'w') as f:\n"
+"...     _ = f.write('0 0 0\\n1 2 3\\n')\n"
+">>> hausdorff.read(path).tolist()\n"
+"[[0.0, 0.0, 0.0], [1.0, 2.0, 3.0]]\n");
+
+static PyObject *py_read(PyObject *self, PyObject *args, PyObject *kw) {
+    (void)self;
+    static char *kwlist[] = {"path", "format", "float32", NULL};
+    PyObject *path = NULL;
+    const char *format = NULL;
+    int float32 = 0;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "O&|$zp:read", kwlist, PyUnicode_FSConverter,
+                                     &path, &format, &float32))
+        return NULL;
+    hd_read_options_t ropt;
+    hd_read_options_init(&ropt);
+    ropt.format = format;
+    ropt.dtype = float32 ? HD_FLOAT32 : HD_FLOAT64;
+    hd_cloud_t *cloud = NULL;
+    hd_error_t err;
+    int rc;
+    const char *cpath = PyBytes_AS_STRING(path);
+    Py_BEGIN_ALLOW_THREADS
+    rc = hd_read_file(cpath, &ropt, &cloud, &err);
+    Py_END_ALLOW_THREADS
+    Py_DECREF(path);
+    if (rc != HD_OK) return raise_hd(rc, &err);
+    npy_intp dims[2] = {(npy_intp)cloud->count, 3};
+    PyObject *capsule = PyCapsule_New(cloud, "hausdorff.cloud", cloud_capsule_free);
+    if (!capsule) {
+        hd_cloud_free(cloud);
+        return NULL;
+    }
+    PyObject *arr = PyArray_SimpleNewFromData(
+        2, dims, cloud->dtype == HD_FLOAT32 ? NPY_FLOAT : NPY_DOUBLE, cloud->data);
+    if (!arr) {
+        Py_DECREF(capsule);
+        return NULL;
+    }
+    if (PyArray_SetBaseObject((PyArrayObject *)arr, capsule) < 0) { /* steals capsule */
+        Py_DECREF(arr);
+        return NULL;
+    }
+    return arr;
+}
+
+PyDoc_STRVAR(formats_doc,
+"formats($module, /)\n--\n\n"
+"The names of the file formats read() knows, with a one-line description\n"
+"of each, as a dict.\n");
+
+static PyObject *py_formats(PyObject *self, PyObject *noargs) {
+    (void)self;
+    (void)noargs;
+    PyObject *d = PyDict_New();
+    if (!d) return NULL;
+    for (const char *const *f = hd_formats(); *f; f++) {
+        const char *desc = hd_format_description(*f);
+        PyObject *v = PyUnicode_FromString(desc ? desc : "");
+        if (!v || PyDict_SetItemString(d, *f, v) < 0) {
+            Py_XDECREF(v);
+            Py_DECREF(d);
+            return NULL;
+        }
+        Py_DECREF(v);
+    }
+    return d;
+}
+
+/* ------------------------------------------------------------------------
+ * Index.
+ * ---------------------------------------------------------------------- */
+
+typedef struct {
+    PyObject_HEAD
+    hd_index_t *idx;
+    PyArrayObject *points; /* the index's own copy of b, never written */
+} IndexObject;
+
+static PyTypeObject IndexType;
+
+PyDoc_STRVAR(index_doc,
+"Index(b, *, threads=None)\n--\n\n"
+"An index of the point set b, built once and queried many times.\n"
+"\n"
+"The index keeps its own copy of b, so changing b afterwards does not\n"
+"affect it; it is immutable, and any number of threads may query it at once.\n"
+"Queries may move the query set by a rigid (or any affine) transform\n"
+"x -> rotation @ x + translation, applied on the fly in double precision in\n"
+"the order the C header documents, without copying the query.\n"
+"\n"
+">>> import numpy as np, hausdorff\n"
+">>> index = hausdorff.Index(np.array([[0.0, 0, 0], [1, 0, 0]]))\n"
+">>> len(index)\n"
+"2\n"
+">>> a = np.array([[0.0, 0, 2], [1, 0, 1]])\n"
+">>> tuple(index.directed(a))\n"
+"(2.0, 0, 0)\n"
+">>> tuple(index.directed(a, translation=[0, 0, -1]))\n"
+"(1.0, 0, 0)\n");
+
+static PyObject *Index_new(PyTypeObject *type, PyObject *args, PyObject *kw) {
+    static char *kwlist[] = {"b", "threads", NULL};
+    PyObject *ob, *threads = Py_None;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "O|$O:Index", kwlist, &ob, &threads))
+        return NULL;
+    hd_options_t opt;
+    if (parse_options(NULL, threads, NULL, &opt)) return NULL;
+    points_arg_t b;
+    if (points_from_object(ob, "b", &b)) return NULL;
+    PyArrayObject *own = (PyArrayObject *)PyArray_NewCopy(b.arr, NPY_CORDER);
+    points_release(&b);
+    if (!own) return NULL;
+    PyArray_CLEARFLAGS(own, NPY_ARRAY_WRITEABLE);
+    IndexObject *self = (IndexObject *)type->tp_alloc(type, 0);
+    if (!self) {
+        Py_DECREF(own);
+        return NULL;
+    }
+    self->points = own;
+    self->idx = NULL;
+    hd_points_t pts = {PyArray_DATA(own), (size_t)PyArray_DIM(own, 0),
+                       PyArray_TYPE(own) == NPY_FLOAT ? HD_FLOAT32 : HD_FLOAT64, 0, 0};
+    hd_error_t err;
+    int rc;
+    Py_BEGIN_ALLOW_THREADS
+    rc = hd_index_build(&pts, &opt, &self->idx, &err);
+    Py_END_ALLOW_THREADS
+    if (rc != HD_OK) {
+        Py_DECREF(self);
+        return raise_hd(rc, &err);
+    }
+    return (PyObject *)self;
+}
+
+static void Index_dealloc(IndexObject *self) {
+    hd_index_free(self->idx);
+    Py_XDECREF(self->points);
+    Py_TYPE(self)->tp_free((PyObject *)self);
+}
+
+static Py_ssize_t Index_len(IndexObject *self) {
+    return (Py_ssize_t)hd_index_count(self->idx);
+}
+
+/* Common argument parsing of the query methods. */
+static int index_query_args(PyObject *args, PyObject *kw, const char *fmt, PyObject **oa,
+                            hd_transform_t *T, int *use_T, hd_options_t *opt,
+                            points_arg_t *a) {
+    static char *kwlist[] = {"a", "rotation", "translation", "threads", NULL};
+    PyObject *rotation = Py_None, *translation = Py_None, *threads = Py_None;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, fmt, kwlist, oa, &rotation, &translation,
+                                     &threads))
+        return -1;
+    if (parse_options(NULL, threads, NULL, opt)) return -1;
+    if (parse_transform(rotation, translation, T, use_T)) return -1;
+    return points_from_object(*oa, "a", a);
+}
+
+PyDoc_STRVAR(index_directed_doc,
+"directed($self, a, *, rotation=None, translation=None, threads=None)\n--\n\n"
+"h(T(a), b), the directed distance from the transformed query to the indexed\n"
+"set, with its witness (i indexes a, j indexes b), as a DirectedResult.\n"
+"T(x) = rotation @ x + translation; either part may be omitted.\n");
+
+static PyObject *Index_directed(IndexObject *self, PyObject *args, PyObject *kw) {
+    PyObject *oa;
+    hd_transform_t T;
+    int use_T;
+    hd_options_t opt;
+    points_arg_t a;
+    if (index_query_args(args, kw, "O|$OOO:directed", &oa, &T, &use_T, &opt, &a))
+        return NULL;
+    hd_result_t r;
+    hd_error_t err;
+    int rc;
+    Py_BEGIN_ALLOW_THREADS
+    rc = hd_index_directed(self->idx, &a.pts, use_T ? &T : NULL, &opt, &r, &err);
+    Py_END_ALLOW_THREADS
+    points_release(&a);
+    if (rc != HD_OK) return raise_hd(rc, &err);
+    return directed_result(&r);
+}
+
+PyDoc_STRVAR(index_distances_doc,
+"distances($self, a, *, rotation=None, translation=None, threads=None)\n--\n\n"
+"Per-point distances from T(a) to the indexed set: (dist, nearest), a\n"
+"float64 and an intp array of len(a); nearest is the smallest index at that\n"
+"distance.  T(x) = rotation @ x + translation; either part may be omitted.\n");
+
+static PyObject *Index_distances(IndexObject *self, PyObject *args, PyObject *kw) {
+    PyObject *oa;
+    hd_transform_t T;
+    int use_T;
+    hd_options_t opt;
+    points_arg_t a;
+    if (index_query_args(args, kw, "O|$OOO:distances", &oa, &T, &use_T, &opt, &a))
+        return NULL;
+    PyObject *res = nearest_arrays(self->idx, &a.pts, use_T ? &T : NULL, &opt);
+    points_release(&a);
+    return res;
+}
+
+static PyObject *Index_get_memory(IndexObject *self, void *closure) {
+    (void)closure;
+    return PyLong_FromSize_t(hd_index_memory(self->idx));
+}
+
+static PyObject *Index_get_points(IndexObject *self, void *closure) {
+    (void)closure;
+    Py_INCREF(self->points);
+    return (PyObject *)self->points;
+}
+
+static PyObject *Index_repr(IndexObject *self) {
+    return PyUnicode_FromFormat("<hausdorff.Index of %zu points, %s>",
+                                hd_index_count(self->idx),
+                                PyArray_TYPE(self->points) == NPY_FLOAT ? "float32" : "float64");
+}
+
+static PyMethodDef Index_methods[] = {
+    {"directed", (PyCFunction)(void (*)(void))Index_directed, METH_VARARGS | METH_KEYWORDS,
+     index_directed_doc},
+    {"distances", (PyCFunction)(void (*)(void))Index_distances, METH_VARARGS | METH_KEYWORDS,
+     index_distances_doc},
+    {NULL, NULL, 0, NULL},
+};
+
+static PyGetSetDef Index_getset[] = {
+    {"memory", (getter)Index_get_memory, NULL,
+     "bytes the index allocated itself (not counting its copy of the points)", NULL},
+    {"points", (getter)Index_get_points, NULL,
+     "the indexed points: the index's own read-only copy of b", NULL},
+    {NULL, NULL, NULL, NULL, NULL},
+};
+
+static PySequenceMethods Index_as_sequence = {
+    .sq_length = (lenfunc)Index_len,
+};
+
+static PyTypeObject IndexType = {
+    PyVarObject_HEAD_INIT(NULL, 0)
+    .tp_name = "hausdorff.Index",
+    .tp_basicsize = sizeof(IndexObject),
+    .tp_dealloc = (destructor)Index_dealloc,
+    .tp_repr = (reprfunc)Index_repr,
+    .tp_as_sequence = &Index_as_sequence,
+    .tp_flags = Py_TPFLAGS_DEFAULT,
+    .tp_doc = index_doc,
+    .tp_methods = Index_methods,
+    .tp_getset = Index_getset,
+    .tp_new = Index_new,
+};
+
+/* ------------------------------------------------------------------------
+ * The module.
+ * ---------------------------------------------------------------------- */
+
+static PyMethodDef module_methods[] = {
+    {"directed", (PyCFunction)(void (*)(void))py_directed, METH_VARARGS | METH_KEYWORDS,
+     directed_doc},
+    {"hausdorff", (PyCFunction)(void (*)(void))py_hausdorff, METH_VARARGS | METH_KEYWORDS,
+     hausdorff_doc},
+    {"distances", (PyCFunction)(void (*)(void))py_distances, METH_VARARGS | METH_KEYWORDS,
+     distances_doc},
+    {"percentile", (PyCFunction)(void (*)(void))py_percentile, METH_VARARGS | METH_KEYWORDS,
+     percentile_doc},
+    {"read", (PyCFunction)(void (*)(void))py_read, METH_VARARGS | METH_KEYWORDS, read_doc},
+    {"formats", py_formats, METH_NOARGS, formats_doc},
+    {NULL, NULL, 0, NULL},
+};
+
+static struct PyModuleDef module_def = {
+    PyModuleDef_HEAD_INIT,
+    "hausdorff._hausdorff",
+    "The C extension behind the hausdorff package (import hausdorff instead).",
+    -1,
+    module_methods,
+    NULL, NULL, NULL, NULL,
+};
+
+PyMODINIT_FUNC PyInit__hausdorff(void) {
+    import_array();
+    struct {
+        PyTypeObject *type;
+        PyStructSequence_Desc *desc; /* NULL: a plain type */
+    } types[] = {
+        {&DirectedResultType, &directed_desc},
+        {&HausdorffResultType, &hausdorff_desc},
+        {&PercentileResultType, &percentile_desc},
+        {&IndexType, NULL},
+    };
+    const size_t n_types = sizeof types / sizeof types[0];
+    for (size_t k = 0; k < n_types; k++) {
+        int rc = types[k].desc ? (types[k].type->tp_name
+                                      ? 0
+                                      : PyStructSequence_InitType2(types[k].type, types[k].desc))
+                               : PyType_Ready(types[k].type);
+        if (rc < 0) return NULL;
+    }
+    PyObject *m = PyModule_Create(&module_def);
+    if (!m) return NULL;
+    for (size_t k = 0; k < n_types; k++) {
+        /* "hausdorff.Index" -> "Index" */
+        const char *name = strrchr(types[k].type->tp_name, '.') + 1;
+        Py_INCREF(types[k].type);
+        if (PyModule_AddObject(m, name, (PyObject *)types[k].type) < 0) {
+            Py_DECREF(types[k].type);
+            goto fail;
+        }
+    }
+    PyObject *algorithms = PyTuple_New(HD__ALG_COUNT);
+    if (!algorithms) goto fail;
+    for (int k = 0; k < HD__ALG_COUNT; k++) {
+        PyObject *name = PyUnicode_FromString(hd_algorithm_name((hd_algorithm_t)k));
+        if (!name) {
+            Py_DECREF(algorithms);
+            goto fail;
+        }
+        PyTuple_SET_ITEM(algorithms, k, name);
+    }
+    if (PyModule_AddObject(m, "algorithms", algorithms) < 0) {
+        Py_DECREF(algorithms);
+        goto fail;
+    }
+    if (PyModule_AddStringConstant(m, "__version__", hd_version()) < 0) goto fail;
+    return m;
+fail:
+    Py_DECREF(m);
+    return NULL;
+}

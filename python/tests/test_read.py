@@ -1,0 +1,73 @@
+"""read(): files through the library's readers into (N, 3) arrays."""
+import doctest
+
+import numpy as np
+import pytest
+
+import hausdorff
+from conftest import brute_directed
+
+
+def test_read_xyz_gives_the_parsed_doubles(tmp_path):
+    pts = np.random.default_rng(131).normal(size=(57, 3))
+    path = tmp_path / "cloud.xyz"
+    np.savetxt(path, pts, fmt="%.17g")
+    got = hausdorff.read(path)                  # os.PathLike accepted
+    assert got.dtype == np.float64 and got.shape == (57, 3)
+    assert np.array_equal(got, pts)
+    assert got.flags.c_contiguous and got.flags.owndata is False
+
+
+def test_read_float32_keeps_floats(tmp_path):
+    pts = np.random.default_rng(132).normal(size=(20, 3)).astype(np.float32)
+    path = tmp_path / "cloud.txt"
+    np.savetxt(path, pts, fmt="%.9g")
+    got = hausdorff.read(str(path), float32=True)
+    assert got.dtype == np.float32 and np.array_equal(got, pts)
+
+
+def test_read_with_an_explicit_format(tmp_path):
+    path = tmp_path / "cloud.data"
+    path.write_text("1 2 3\n4 5 6\n")
+    assert hausdorff.read(path, format="xyz").tolist() == [[1, 2, 3], [4, 5, 6]]
+    assert "xyz" in hausdorff.formats()
+
+
+def test_read_errors_map_to_python_exceptions(tmp_path):
+    with pytest.raises(OSError, match="cannot open"):
+        hausdorff.read(tmp_path / "missing.xyz")
+    empty = tmp_path / "empty.xyz"
+    empty.write_text("")
+    with pytest.raises(ValueError, match="no points"):
+        hausdorff.read(empty)
+    with pytest.raises(ValueError, match="unknown format"):
+        hausdorff.read(empty, format="nonsense")
+
+
+def read_ascii_ply(path):
+    """The vertex block of the bundled ASCII PLY files (x y z doubles)."""
+    with open(path) as f:
+        n = None
+        for line in f:
+            if line.startswith("element vertex"):
+                n = int(line.split()[2])
+            if line.strip() == "end_header":
+                break
+        return np.loadtxt(f, max_rows=n, usecols=(0, 1, 2)).reshape(-1, 3)
+
+
+@pytest.mark.parametrize("name", ["bunny_3511.ply", "cgal_lion_head.ply"])
+def test_read_bundled_models_and_measure_them(data_dir, name):
+    path = data_dir / name
+    if "ply" not in hausdorff.formats():
+        pytest.skip("this library has no PLY reader")
+    pts = hausdorff.read(path)
+    assert np.array_equal(pts, read_ascii_ply(path))
+    other = pts[::2] + 0.001
+    assert tuple(hausdorff.directed(pts, other)) == brute_directed(pts, other)
+
+
+@pytest.mark.parametrize("module", [hausdorff, hausdorff._hausdorff])
+def test_docstring_examples_run(module):
+    failed, attempted = doctest.testmod(module, optionflags=doctest.ELLIPSIS)
+    assert attempted > 0 and failed == 0

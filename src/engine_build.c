@@ -1,0 +1,396 @@
+/*
+ * engine_build.c -- building the engine's index of one point set: points
+ * sorted along a Morton (Z-order) curve, cut into buckets, with exact boxes.
+ *
+ * Why Morton order.  The engine's work is dominated by reading points, and
+ * a set whose points are listed along a space-filling curve has spatially
+ * coherent buckets: consecutive query points are near each other, so a
+ * search can start where the previous one ended, and the boxes of buckets
+ * and of runs of buckets are small.  Sorting costs a few linear passes (a
+ * radix sort), far less than the median splits of a kd-tree, and needs no
+ * copy of the coordinates, only a permutation.
+ *
+ * Keys.  Each point gets a 30-bit Morton key from a 1024^3 grid of cubic
+ * cells laid over the set's box; the key is packed above the point's 32-bit
+ * original index, so sorting the 64-bit words sorts by (key, index) and the
+ * order is a function of the input alone, at any thread count.  The keys
+ * only decide the order: nothing exact depends on them.  A cell holding more
+ * than a bucket of points (a dense cluster, duplicates) is refined: its
+ * points are re-keyed on a grid over their own exact box and sorted again,
+ * recursively, until every run of equal keys fits in a bucket or consists of
+ * identical points.
+ *
+ * Boxes.  Every bucket's box is the exact box of its points, read as the
+ * doubles the distance computations read (after the transform, if any);
+ * every tree node's box is the union of its children's.  Boxes therefore
+ * enclose their points exactly, which is what makes the pruning tests of
+ * the searches exact without an epsilon (see internal.h).
+ *
+ * Memory.  The sort uses two arrays of 8 bytes per point; the result keeps
+ * 4 bytes per point for the permutation and about 6 for the boxes (two
+ * boxes of 48 bytes per bucket of 16 points).
+ */
+#include "index.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+void hd__src_init(hd__src_t *s, const hd_points_t *p, const hd_transform_t *T) {
+    ptrdiff_t el = p->dtype == HD_FLOAT32 ? (ptrdiff_t)sizeof(float) : (ptrdiff_t)sizeof(double);
+    s->base = p->data;
+    s->dtype = p->dtype;
+    s->cs = p->cstride ? p->cstride : el;
+    s->ps = p->stride ? p->stride : 3 * el;
+    s->T = T;
+    s->kind = 2;
+    if (s->cs == el && s->ps == 3 * el) s->kind = p->dtype == HD_FLOAT32 ? 1 : 0;
+}
+
+/* Spread the low 10 bits of v to every third bit. */
+static inline uint64_t spread3(uint32_t v) {
+    uint64_t x = v & 0x3ff;
+    x = (x | x << 16) & 0x30000ffULL;
+    x = (x | x << 8) & 0x300f00fULL;
+    x = (x | x << 4) & 0x30c30c3ULL;
+    x = (x | x << 2) & 0x9249249ULL;
+    return x;
+}
+
+/* The grid of cubic cells over a box: cell = (c - lo) * scale, clamped. */
+typedef struct {
+    double lo[3], scale;
+} grid_t;
+
+static void grid_of(const hd__box_t *b, grid_t *g) {
+    double ext = 0;
+    for (int k = 0; k < 3; k++) {
+        g->lo[k] = b->lo[k];
+        double e = b->hi[k] - b->lo[k];
+        if (e > ext) ext = e;
+    }
+    g->scale = ext > 0 ? 1024.0 / ext : 0.0;
+}
+
+static inline uint64_t grid_key(const grid_t *g, const double p[3]) {
+    uint32_t c[3];
+    for (int k = 0; k < 3; k++) {
+        double v = (p[k] - g->lo[k]) * g->scale;
+        c[k] = v >= 1023.0 ? 1023u : v > 0 ? (uint32_t)v : 0u;
+    }
+    return spread3(c[0]) | spread3(c[1]) << 1 | spread3(c[2]) << 2;
+}
+
+/* ---- parallel LSD radix sort on bits 32..61 ------------------------------- */
+
+#define RADIX_BITS 10
+#define RADIX (1u << RADIX_BITS)
+#define MAX_SORT_THREADS 64
+
+typedef struct {
+    uint64_t *src, *dst;
+    size_t n;
+    int parts, shift;
+    size_t (*hist)[RADIX];
+} radix_ctx;
+
+static void radix_count(void *vctx, size_t part, int worker) {
+    (void)worker;
+    radix_ctx *c = vctx;
+    size_t lo = c->n * part / (size_t)c->parts, hi = c->n * (part + 1) / (size_t)c->parts;
+    size_t *h = c->hist[part];
+    memset(h, 0, RADIX * sizeof *h);
+    for (size_t k = lo; k < hi; k++) h[(c->src[k] >> c->shift) & (RADIX - 1)]++;
+}
+
+static void radix_scatter(void *vctx, size_t part, int worker) {
+    (void)worker;
+    radix_ctx *c = vctx;
+    size_t lo = c->n * part / (size_t)c->parts, hi = c->n * (part + 1) / (size_t)c->parts;
+    size_t *h = c->hist[part]; /* now the write positions */
+    for (size_t k = lo; k < hi; k++) {
+        uint64_t v = c->src[k];
+        c->dst[h[(v >> c->shift) & (RADIX - 1)]++] = v;
+    }
+}
+
+/* Sort a[0..n) by bits 32..61 (stable); the result ends in *a (the buffers
+ * may be swapped). */
+static int radix_sort(uint64_t **a, uint64_t **tmp, size_t n, int threads) {
+    int parts = threads;
+    if (parts > MAX_SORT_THREADS) parts = MAX_SORT_THREADS;
+    if ((size_t)parts > n / 65536 + 1) parts = (int)(n / 65536 + 1);
+    size_t(*hist)[RADIX] = hd__malloc_array((size_t)parts, sizeof *hist);
+    if (!hist) return HD_ENOMEM;
+    radix_ctx c;
+    c.n = n;
+    c.parts = parts;
+    c.hist = hist;
+    for (int pass = 0; pass < 3; pass++) {
+        c.src = *a;
+        c.dst = *tmp;
+        c.shift = 32 + RADIX_BITS * pass;
+        hd__parallel_for(parts, (size_t)parts, radix_count, &c);
+        size_t sum = 0;
+        for (unsigned d = 0; d < RADIX; d++)
+            for (int p = 0; p < parts; p++) {
+                size_t v = hist[p][d];
+                hist[p][d] = sum;
+                sum += v;
+            }
+        hd__parallel_for(parts, (size_t)parts, radix_scatter, &c);
+        uint64_t *s = *a;
+        *a = *tmp;
+        *tmp = s;
+    }
+    free(hist);
+    return HD_OK;
+}
+
+/* ---- keys ------------------------------------------------------------------ */
+
+#define SLICE 16384
+
+typedef struct {
+    const hd__src_t *src;
+    size_t n;
+    grid_t grid;
+    uint64_t *keys;
+    hd__box_t *part_box;
+} key_ctx;
+
+static void box_task(void *vctx, size_t task, int worker) {
+    (void)worker;
+    key_ctx *c = vctx;
+    size_t lo = task * SLICE, hi = lo + SLICE < c->n ? lo + SLICE : c->n;
+    hd__box_t b;
+    double p[3];
+    hd__src_get(c->src, lo, p);
+    for (int k = 0; k < 3; k++) b.lo[k] = b.hi[k] = p[k];
+    for (size_t i = lo + 1; i < hi; i++) {
+        hd__src_get(c->src, i, p);
+        for (int k = 0; k < 3; k++) {
+            b.lo[k] = p[k] < b.lo[k] ? p[k] : b.lo[k];
+            b.hi[k] = p[k] > b.hi[k] ? p[k] : b.hi[k];
+        }
+    }
+    c->part_box[task] = b;
+}
+
+static void key_task(void *vctx, size_t task, int worker) {
+    (void)worker;
+    key_ctx *c = vctx;
+    size_t lo = task * SLICE, hi = lo + SLICE < c->n ? lo + SLICE : c->n;
+    for (size_t i = lo; i < hi; i++) {
+        double p[3];
+        hd__src_get(c->src, i, p);
+        c->keys[i] = grid_key(&c->grid, p) << 32 | (uint64_t)i;
+    }
+}
+
+static void box_merge(hd__box_t *into, const hd__box_t *b) {
+    for (int k = 0; k < 3; k++) {
+        into->lo[k] = b->lo[k] < into->lo[k] ? b->lo[k] : into->lo[k];
+        into->hi[k] = b->hi[k] > into->hi[k] ? b->hi[k] : into->hi[k];
+    }
+}
+
+/* ---- refinement of crowded cells ------------------------------------------- */
+
+static void insertion_sort(uint64_t *a, size_t n) {
+    for (size_t i = 1; i < n; i++) {
+        uint64_t v = a[i];
+        size_t j = i;
+        while (j > 0 && a[j - 1] > v) {
+            a[j] = a[j - 1];
+            j--;
+        }
+        a[j] = v;
+    }
+}
+
+/* Re-key and sort the run a[0..m) (all with equal keys) on a grid over its
+ * own box, then refine its crowded sub-runs.  tmp has room for m words. */
+static int refine(const hd__src_t *src, uint64_t *a, uint64_t *tmp, size_t m, int depth) {
+    hd__box_t b;
+    double p[3];
+    hd__src_get(src, (uint32_t)a[0], p);
+    for (int k = 0; k < 3; k++) b.lo[k] = b.hi[k] = p[k];
+    for (size_t i = 1; i < m; i++) {
+        hd__src_get(src, (uint32_t)a[i], p);
+        for (int k = 0; k < 3; k++) {
+            b.lo[k] = p[k] < b.lo[k] ? p[k] : b.lo[k];
+            b.hi[k] = p[k] > b.hi[k] ? p[k] : b.hi[k];
+        }
+    }
+    grid_t g;
+    grid_of(&b, &g);
+    if (g.scale == 0.0 || depth > 200) return HD_OK; /* identical points */
+    for (size_t i = 0; i < m; i++) {
+        hd__src_get(src, (uint32_t)a[i], p);
+        a[i] = grid_key(&g, p) << 32 | (a[i] & 0xffffffffu);
+    }
+    if (m <= 64) {
+        insertion_sort(a, m);
+    } else {
+        uint64_t *x = a, *y = tmp;
+        int rc = radix_sort(&x, &y, m, 1);
+        if (rc) return rc;
+        if (x != a) memcpy(a, x, m * sizeof *a);
+    }
+    for (size_t s = 0; s < m;) {
+        size_t e = s + 1;
+        while (e < m && a[e] >> 32 == a[s] >> 32) e++;
+        if (e - s > HD__BUCKET) {
+            int rc = refine(src, a + s, tmp + s, e - s, depth + 1);
+            if (rc) return rc;
+        }
+        s = e;
+    }
+    return HD_OK;
+}
+
+/* ---- boxes ------------------------------------------------------------------ */
+
+typedef struct {
+    hd__tree_t *t;
+    int level;
+} boxes_ctx;
+
+#define BOX_TASK 1024 /* buckets (or nodes) per task */
+
+static void bucket_boxes(void *vctx, size_t task, int worker) {
+    (void)worker;
+    boxes_ctx *c = vctx;
+    hd__tree_t *t = c->t;
+    size_t lo = task * BOX_TASK, hi = lo + BOX_TASK < t->nb ? lo + BOX_TASK : t->nb;
+    for (size_t bk = lo; bk < hi; bk++) {
+        size_t s = bk * HD__BUCKET, e = s + HD__BUCKET < t->n ? s + HD__BUCKET : t->n;
+        hd__box_t b;
+        double p[3];
+        /* The points are scattered in memory: ask for the next bucket's
+         * points early so their loads overlap with this bucket's work. */
+        if (t->src.kind != 2) {
+            size_t pe = e + HD__BUCKET < t->n ? e + HD__BUCKET : t->n;
+            ptrdiff_t el = t->src.kind == 0 ? 24 : 12;
+            for (size_t i = e; i < pe; i++) __builtin_prefetch(t->src.base + (ptrdiff_t)t->perm[i] * el);
+        }
+        hd__src_get(&t->src, t->perm[s], p);
+        for (int k = 0; k < 3; k++) b.lo[k] = b.hi[k] = p[k];
+        for (size_t i = s + 1; i < e; i++) {
+            hd__src_get(&t->src, t->perm[i], p);
+            for (int k = 0; k < 3; k++) {
+                b.lo[k] = p[k] < b.lo[k] ? p[k] : b.lo[k];
+                b.hi[k] = p[k] > b.hi[k] ? p[k] : b.hi[k];
+            }
+        }
+        t->boxes[bk] = b;
+    }
+}
+
+static void node_boxes(void *vctx, size_t task, int worker) {
+    (void)worker;
+    boxes_ctx *c = vctx;
+    hd__tree_t *t = c->t;
+    int l = c->level;
+    size_t lo = task * BOX_TASK, hi = lo + BOX_TASK < t->count[l] ? lo + BOX_TASK : t->count[l];
+    for (size_t i = lo; i < hi; i++) {
+        hd__box_t b = t->boxes[t->off[l - 1] + 2 * i];
+        if (2 * i + 1 < t->count[l - 1]) box_merge(&b, &t->boxes[t->off[l - 1] + 2 * i + 1]);
+        t->boxes[t->off[l] + i] = b;
+    }
+}
+
+/* ---- the build ---------------------------------------------------------------- */
+
+void hd__tree_free(hd__tree_t *t) {
+    if (!t) return;
+    free(t->perm);
+    free(t->boxes);
+    t->perm = NULL;
+    t->boxes = NULL;
+}
+
+size_t hd__tree_memory(const hd__tree_t *t) {
+    size_t boxes = t->levels ? t->off[t->levels - 1] + 1 : 0;
+    return t->n * sizeof *t->perm + boxes * sizeof *t->boxes;
+}
+
+int hd__tree_build(hd__tree_t *t, const hd__src_t *src, size_t n, int threads,
+                   hd_error_t *err) {
+    memset(t, 0, sizeof *t);
+    if (n == 0) return hd__err(err, HD_EEMPTY, "empty point set");
+    if (n > UINT32_MAX)
+        return hd__err(err, HD_EOVERFLOW,
+                       "the auto engine indexes at most 4294967295 points per set, not %zu", n);
+    if (threads < 1) threads = 1;
+    t->n = n;
+    t->src = *src;
+    t->nb = (n + HD__BUCKET - 1) / HD__BUCKET;
+    t->count[0] = t->nb;
+    t->off[0] = 0;
+    t->levels = 1;
+    while (t->count[t->levels - 1] > 1) {
+        int l = t->levels++;
+        t->count[l] = (t->count[l - 1] + 1) / 2;
+        t->off[l] = t->off[l - 1] + t->count[l - 1];
+    }
+    size_t n_boxes = t->off[t->levels - 1] + 1;
+
+    key_ctx kc;
+    kc.src = src;
+    kc.n = n;
+    size_t slices = (n + SLICE - 1) / SLICE;
+    uint64_t *keys = hd__malloc_array(n, sizeof *keys);
+    uint64_t *tmp = hd__malloc_array(n, sizeof *tmp);
+    kc.part_box = hd__malloc_array(slices, sizeof *kc.part_box);
+    int rc = HD_OK;
+    if (!keys || !tmp || !kc.part_box) {
+        rc = HD_ENOMEM;
+        goto done;
+    }
+    kc.keys = keys;
+    hd__parallel_for(threads, slices, box_task, &kc);
+    t->box = kc.part_box[0];
+    for (size_t s = 1; s < slices; s++) box_merge(&t->box, &kc.part_box[s]);
+    grid_of(&t->box, &kc.grid);
+    hd__parallel_for(threads, slices, key_task, &kc);
+    if ((rc = radix_sort(&keys, &tmp, n, threads))) goto done;
+    for (size_t s = 0; s < n;) {
+        size_t e = s + 1;
+        while (e < n && keys[e] >> 32 == keys[s] >> 32) e++;
+        if (e - s > HD__BUCKET && (rc = refine(src, keys + s, tmp + s, e - s, 0))) goto done;
+        s = e;
+    }
+    free(tmp);
+    tmp = NULL;
+    t->perm = hd__malloc_array(n, sizeof *t->perm);
+    if (!t->perm) {
+        rc = HD_ENOMEM;
+        goto done;
+    }
+    for (size_t k = 0; k < n; k++) t->perm[k] = (uint32_t)keys[k];
+    free(keys);
+    keys = NULL;
+    t->boxes = hd__malloc_array(n_boxes, sizeof *t->boxes);
+    if (!t->boxes) {
+        rc = HD_ENOMEM;
+        goto done;
+    }
+    boxes_ctx bc;
+    bc.t = t;
+    bc.level = 0;
+    hd__parallel_for(threads, (t->nb + BOX_TASK - 1) / BOX_TASK, bucket_boxes, &bc);
+    for (int l = 1; l < t->levels; l++) {
+        bc.level = l;
+        hd__parallel_for(threads, (t->count[l] + BOX_TASK - 1) / BOX_TASK, node_boxes, &bc);
+    }
+done:
+    free(keys);
+    free(tmp);
+    free(kc.part_box);
+    if (rc != HD_OK) {
+        hd__tree_free(t);
+        return hd__err(err, rc, "cannot allocate the index of %zu points", n);
+    }
+    return HD_OK;
+}

@@ -1,0 +1,102 @@
+/*
+ * number.c -- text to double, correctly rounded, fast in the common case.
+ *
+ * Every text reader turns tokens into doubles here.  The contract is that
+ * the value is exactly the double strtod() returns for the same token, so a
+ * coordinate read from text is the nearest double to the decimal written,
+ * and two files holding the same decimals give bit-identical distances.
+ *
+ * The fast path is Clinger's (1990): when the decimal significand m has at
+ * most 19 digits and m <= 2^53, m is exactly a double; when in addition the
+ * decimal exponent e satisfies |e| <= 22, 10^|e| is exactly a double too
+ * (5^22 < 2^53).  Then m * 10^e or m / 10^e is ONE correctly rounded IEEE
+ * operation on exact operands, which is by definition the correctly rounded
+ * value of the decimal, i.e. what strtod returns.  The build uses
+ * -ffp-contract=off and x86-64/AArch64 evaluate doubles in double precision
+ * (FLT_EVAL_METHOD 0, asserted below), so nothing widens or fuses the one
+ * operation.  A zero significand gives a signed zero, as strtod does.
+ * Everything else (more digits, larger exponents, "inf", "nan", hex floats)
+ * goes to strtod on a NUL-terminated copy of the token, and the token must be
+ * consumed entirely.  The C locale is assumed (the library never calls
+ * setlocale; a program that sets a locale with a decimal comma would make
+ * strtod itself disagree with the files).
+ */
+#include "io.h"
+
+#include <float.h>
+#include <stdlib.h>
+#include <string.h>
+
+#if !defined(FLT_EVAL_METHOD) || FLT_EVAL_METHOD != 0
+#error "the Clinger fast path needs FLT_EVAL_METHOD == 0 (no extended precision)"
+#endif
+
+static const double pow10_exact[23] = {
+    1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1e8,  1e9,  1e10, 1e11,
+    1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
+
+static int slow_path(const char *s, const char *end, double *out) {
+    size_t n = (size_t)(end - s);
+    char local[256];
+    char *buf = n < sizeof local ? local : malloc(n + 1);
+    if (!buf) return 0;
+    memcpy(buf, s, n);
+    buf[n] = '\0';
+    char *e;
+    *out = strtod(buf, &e);
+    int ok = n > 0 && e == buf + n;
+    if (buf != local) free(buf);
+    return ok;
+}
+
+int hd__parse_double(const char *s, const char *end, double *out) {
+    const char *p = s;
+    int neg = 0;
+    if (p < end && (*p == '-' || *p == '+')) neg = *p++ == '-';
+    uint64_t m = 0;
+    int digits = 0, sig = 0, frac = 0;
+    while (p < end && (unsigned)(*p - '0') < 10) {
+        if (m || *p != '0') sig++;
+        m = m * 10 + (uint64_t)(*p - '0'); /* wraps only when sig > 19 */
+        digits++;
+        p++;
+    }
+    if (p < end && *p == '.') {
+        p++;
+        while (p < end && (unsigned)(*p - '0') < 10) {
+            if (m || *p != '0') sig++;
+            m = m * 10 + (uint64_t)(*p - '0');
+            digits++;
+            frac++;
+            p++;
+        }
+    }
+    if (digits == 0) return slow_path(s, end, out);
+    long e10 = -(long)frac;
+    if (p < end && (*p == 'e' || *p == 'E')) {
+        const char *q = p + 1;
+        int eneg = 0;
+        if (q < end && (*q == '-' || *q == '+')) eneg = *q++ == '-';
+        if (q == end || (unsigned)(*q - '0') >= 10) return slow_path(s, end, out);
+        long x = 0;
+        while (q < end && (unsigned)(*q - '0') < 10) {
+            if (x < 100000) x = x * 10 + (*q - '0');
+            q++;
+        }
+        e10 += eneg ? -x : x;
+        p = q;
+    }
+    if (p != end || sig > 19) return slow_path(s, end, out);
+    double v;
+    if (m == 0) {
+        v = 0.0;
+    } else if (m <= (UINT64_C(1) << 53) && e10 >= -22 && e10 <= 22) {
+        v = (double)m;
+        if (e10 < 0) v /= pow10_exact[-e10];
+        else v *= pow10_exact[e10];
+    } else {
+        return slow_path(s, end, out);
+    }
+    *out = neg ? -v : v;
+    return 1;
+}

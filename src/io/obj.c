@@ -1,0 +1,161 @@
+/*
+ * obj.c -- Wavefront OBJ: the vertices ("v" lines) and, for --sample, the
+ * faces ("f" lines).
+ *
+ * Format (Wavefront "Object Files (.obj)", Appendix B1 of the Advanced
+ * Visualizer manual): one statement per line, the keyword first.  "v x y z
+ * [w]" is a geometric vertex (some writers append r g b; only x y z are
+ * kept).  "f v1 v2 v3 ..." is a polygon whose references are "v", "v/vt",
+ * "v//vn" or "v/vt/vn"; v counts from 1 in file order, and a negative v
+ * counts back from the latest vertex (-1 is the vertex just above).  Every
+ * other statement (vt, vn, g, o, s, usemtl, mtllib, l, p, curves) and '#'
+ * comments are ignored, and so is a trailing '\' continuation's tail.
+ *
+ * The file is parsed in parallel chunks of whole lines.  A chunk does not
+ * know how many vertices came before it, so a relative reference is stored
+ * as "chunk-local vertex count + offset" with a flag, and resolved when the
+ * chunks are merged in order (fix_chunk), where the number of earlier
+ * vertices is known.  References are then checked against the final vertex
+ * count; if one is out of range, a serial pass finds the first such line so
+ * the message names it.
+ */
+#include "io.h"
+
+#include <stdlib.h>
+
+#define REL ((uint64_t)1 << 63)
+#define REL_MASK (((uint64_t)1 << 62) - 1)
+#define BAD UINT64_MAX
+
+/* Parse the vertex part of a face reference "v[/vt[/vn]]" in [tb, te):
+ * 1 with *abs (0-based) or *rel (negative offset), 0 when malformed. */
+static int face_ref(const char *tb, const char *te, int64_t *value) {
+    const char *slash = memchr(tb, '/', (size_t)(te - tb));
+    if (slash) te = slash;
+    int neg = tb < te && *tb == '-';
+    uint64_t v;
+    if (!hd__parse_u64(tb + neg, te, &v) || v == 0 || v > REL_MASK) return 0;
+    *value = neg ? -(int64_t)v : (int64_t)v;
+    return 1;
+}
+
+static void chunk(void *ctx, hd__chunk_t *c) {
+    const int *want_faces = ctx;
+    const char *p = c->begin, *end = c->end, *tb, *te;
+    long long line = 0;
+    uint64_t idx[64];
+    while (p < end) {
+        line++;
+        const char *eol = hd__eol(p, end), *q = p;
+        p = eol + (eol < end);
+        if (!hd__token(&q, eol, &tb, &te) || te - tb != 1) continue;
+        if (*tb == 'v') {
+            double v[3];
+            int got = 0;
+            while (got < 3 && hd__token(&q, eol, &tb, &te)) {
+                if (!hd__parse_double(tb, te, &v[got])) {
+                    hd__chunk_fail(c, HD_EFORMAT, line, "vertex: '%.*s' is not a number", (int)(te - tb > 40 ? 40 : te - tb), tb);
+                    return;
+                }
+                got++;
+            }
+            if (got < 3) {
+                hd__chunk_fail(c, HD_EFORMAT, line, "vertex: expected x y z, found %d number%s", got, got == 1 ? "" : "s");
+                return;
+            }
+            int rc = hd__sink_push(&c->pts, v);
+            if (rc) {
+                hd__chunk_fail(c, rc, line, "%s", hd__point_problem(rc));
+                return;
+            }
+        } else if (*tb == 'f') {
+            c->aux++;
+            if (!*want_faces) continue;
+            size_t n = 0, cap = 64;
+            uint64_t *ix = idx;
+            while (hd__token(&q, eol, &tb, &te)) {
+                if (*tb == '\\') break;
+                int64_t v;
+                if (!face_ref(tb, te, &v)) {
+                    hd__chunk_fail(c, HD_EFORMAT, line, "face: '%.*s' is not a vertex reference", (int)(te - tb > 40 ? 40 : te - tb), tb);
+                    if (ix != idx) free(ix);
+                    return;
+                }
+                if (n == cap) {
+                    uint64_t *nx = hd__malloc_array(cap * 2, sizeof *nx);
+                    if (!nx) {
+                        if (ix != idx) free(ix);
+                        hd__chunk_fail(c, HD_ENOMEM, line, "out of memory for a face");
+                        return;
+                    }
+                    memcpy(nx, ix, n * sizeof *nx);
+                    if (ix != idx) free(ix);
+                    ix = nx;
+                    cap *= 2;
+                }
+                ix[n++] = v > 0 ? (uint64_t)(v - 1) : REL | ((uint64_t)((int64_t)c->pts.count + v) & REL_MASK);
+            }
+            int rc = n >= 3 ? hd__tris_add(&c->tris, ix, n) : HD_OK;
+            if (ix != idx) free(ix);
+            if (n < 3) {
+                hd__chunk_fail(c, HD_EFORMAT, line, "face with %zu vertices (at least 3 are needed)", n);
+                return;
+            }
+            if (rc) {
+                hd__chunk_fail(c, rc, line, "out of memory for faces");
+                return;
+            }
+        }
+    }
+}
+
+/* Resolve relative references now that the vertices before the chunk are
+ * known; an unresolvable one becomes BAD (out of range). */
+static void fix_chunk(void *ctx, hd__chunk_t *c, size_t before) {
+    (void)ctx;
+    for (size_t k = 0; k < 3 * c->tris.count; k++) {
+        uint64_t v = c->tris.v[k];
+        if (!(v & REL)) continue;
+        int64_t local = (int64_t)((v & REL_MASK) << 2) >> 2; /* sign-extend 62 bits */
+        int64_t abs_ = (int64_t)before + local;
+        c->tris.v[k] = abs_ < 0 ? BAD : (uint64_t)abs_;
+    }
+}
+
+/* The first face line whose reference is out of range (serial; only run
+ * when one is known to exist). */
+static int report_bad_reference(hd__read_t *r, size_t nv) {
+    const char *p = (const char *)r->f->data, *end = p + r->f->size, *tb, *te;
+    long long line = 0;
+    uint64_t seen = 0;
+    while (p < end) {
+        line++;
+        const char *eol = hd__eol(p, end), *q = p;
+        p = eol + (eol < end);
+        if (!hd__token(&q, eol, &tb, &te) || te - tb != 1) continue;
+        if (*tb == 'v') seen++;
+        if (*tb != 'f') continue;
+        while (hd__token(&q, eol, &tb, &te)) {
+            int64_t v;
+            if (*tb == '\\' || !face_ref(tb, te, &v)) break;
+            int64_t abs_ = v > 0 ? v - 1 : (int64_t)seen + v;
+            if (abs_ < 0 || (uint64_t)abs_ >= nv)
+                return hd__io_err_line(r, HD_EFORMAT, line, "face refers to vertex %lld, but the file has %zu vertices",
+                                       (long long)v, nv);
+        }
+    }
+    return hd__io_err(r, HD_EFORMAT, "a face refers to a vertex that does not exist");
+}
+
+int hd__read_obj(hd__read_t *r) {
+    const char *s = (const char *)r->f->data;
+    int want_faces = r->tris != NULL;
+    uint64_t faces = 0;
+    int rc = hd__text_parallel(r, s, s + r->f->size, 1, chunk, fix_chunk, &want_faces, &faces);
+    if (rc) return rc;
+    r->n_faces = (size_t)faces;
+    if (r->tris)
+        for (size_t k = 0; k < 3 * r->tris->count; k++)
+            if (r->tris->v[k] >= r->sink->count) return report_bad_reference(r, r->sink->count);
+    return HD_OK;
+}

@@ -1,0 +1,127 @@
+/*
+ * stl.c -- STL (stereolithography) triangles, binary and ascii.
+ *
+ * Binary STL: an 80-byte header (arbitrary text, which may itself start
+ * with "solid"), a little-endian uint32 triangle count, then per triangle
+ * 50 bytes: a normal and three corners as little-endian float32 x y z, and a
+ * 2-byte attribute.  Ascii STL: "solid NAME", then per triangle "facet
+ * normal nx ny nz / outer loop / vertex x y z (three times) / endloop /
+ * endfacet", and "endsolid NAME".
+ *
+ * STL has no shared vertices: the points read are the three corners of
+ * every triangle, in file order, duplicates kept (that is how the bundled
+ * wuson_stl.ply was made).  With --sample, triangle t is corners 3t..3t+2.
+ *
+ * Which variant: a file whose size is exactly 84 + 50 * count is binary
+ * (even when its header starts with "solid", as many exporters write);
+ * otherwise a file starting with "solid" is ascii, and anything else is
+ * binary whose size must hold the declared triangles.  Binary corners are
+ * converted in parallel from the mapping; ascii lines in parallel chunks,
+ * every "vertex" line giving a point, and the total must be three per
+ * facet.
+ */
+#include "io.h"
+
+static int word(const char *tb, const char *te, const char *w) {
+    size_t n = strlen(w);
+    return (size_t)(te - tb) == n && memcmp(tb, w, n) == 0;
+}
+
+static void chunk(void *ctx, hd__chunk_t *c) {
+    (void)ctx;
+    const char *p = c->begin, *end = c->end, *tb, *te;
+    long long line = 0;
+    while (p < end) {
+        line++;
+        const char *eol = hd__eol(p, end), *q = p;
+        p = eol + (eol < end);
+        if (!hd__token(&q, eol, &tb, &te)) continue;
+        if (word(tb, te, "vertex")) {
+            double v[3];
+            for (int k = 0; k < 3; k++) {
+                if (!hd__token(&q, eol, &tb, &te)) {
+                    hd__chunk_fail(c, HD_EFORMAT, line, "vertex: expected x y z, found %d number%s", k, k == 1 ? "" : "s");
+                    return;
+                }
+                if (!hd__parse_double(tb, te, &v[k])) {
+                    hd__chunk_fail(c, HD_EFORMAT, line, "vertex: '%.*s' is not a number", (int)(te - tb > 40 ? 40 : te - tb), tb);
+                    return;
+                }
+            }
+            int rc = hd__sink_push(&c->pts, v);
+            if (rc) {
+                hd__chunk_fail(c, rc, line, "%s", hd__point_problem(rc));
+                return;
+            }
+        } else if (word(tb, te, "facet")) {
+            c->aux++;
+        } else if (!word(tb, te, "outer") && !word(tb, te, "endloop") && !word(tb, te, "endfacet") &&
+                   !word(tb, te, "solid") && !word(tb, te, "endsolid")) {
+            hd__chunk_fail(c, HD_EFORMAT, line, "unknown ascii STL keyword '%.*s'", (int)(te - tb > 40 ? 40 : te - tb), tb);
+            return;
+        }
+    }
+}
+
+/* The first facet that does not have exactly three vertices (serial; only
+ * run when the totals disagree). */
+static int report_bad_facet(hd__read_t *r) {
+    const char *p = (const char *)r->f->data, *end = p + r->f->size, *tb, *te;
+    long long line = 0, facet_line = 0;
+    int n = -1;
+    while (p < end) {
+        line++;
+        const char *eol = hd__eol(p, end), *q = p;
+        p = eol + (eol < end);
+        if (!hd__token(&q, eol, &tb, &te)) continue;
+        if (word(tb, te, "vertex")) {
+            if (n < 0) return hd__io_err_line(r, HD_EFORMAT, line, "vertex outside a facet");
+            n++;
+        } else if (word(tb, te, "facet") || word(tb, te, "endsolid")) {
+            if (n >= 0 && n != 3)
+                return hd__io_err_line(r, HD_EFORMAT, facet_line, "facet with %d vertices (a triangle has 3)", n);
+            n = word(tb, te, "facet") ? 0 : -1;
+            facet_line = line;
+        }
+    }
+    if (n >= 0 && n != 3)
+        return hd__io_err_line(r, HD_EFORMAT, facet_line, "facet with %d vertices (a triangle has 3)", n);
+    return hd__io_err(r, HD_EFORMAT, "the vertices are not three per facet");
+}
+
+static int add_triangles(hd__read_t *r, size_t n_tri) {
+    if (!r->tris) return HD_OK;
+    for (size_t t = 0; t < n_tri; t++) {
+        uint64_t v[3] = {3 * (uint64_t)t, 3 * (uint64_t)t + 1, 3 * (uint64_t)t + 2};
+        if (hd__tris_add(r->tris, v, 3)) return hd__io_err(r, HD_ENOMEM, "out of memory for %zu triangles", n_tri);
+    }
+    return HD_OK;
+}
+
+int hd__read_stl(hd__read_t *r) {
+    const unsigned char *d = r->f->data;
+    size_t size = r->f->size, k = 0;
+    while (k < size && (d[k] == ' ' || d[k] == '\t' || d[k] == '\r' || d[k] == '\n')) k++;
+    int solid = size - k >= 5 && memcmp(d + k, "solid", 5) == 0;
+    uint64_t n = size >= 84 ? hd__ld_u32(d + 80, 0) : 0;
+    int exact = size >= 84 && 84 + 50 * n == size;
+    if (solid && !exact) {
+        const char *s = (const char *)d;
+        uint64_t facets = 0;
+        int rc = hd__text_parallel(r, s, s + size, 1, chunk, NULL, NULL, &facets);
+        if (rc) return rc;
+        if (r->sink->count != 3 * facets) return report_bad_facet(r);
+        r->n_faces = (size_t)facets;
+        return add_triangles(r, (size_t)facets);
+    }
+    if (size < 84)
+        return hd__io_err_at(r, HD_EFORMAT, (long long)size, "binary STL needs an 84-byte header, the file has %zu bytes", size);
+    if (n > (size - 84) / 50)
+        return hd__io_err_at(r, HD_EFORMAT, 80, "binary STL declares %llu triangles (%llu bytes), but the file has %zu bytes",
+                             (unsigned long long)n, (unsigned long long)(84 + 50 * n), size);
+    hd__layout_t L = {3 * (size_t)n, 3, 50, 12, {0, 4, 8}, {HD__T_F32, HD__T_F32, HD__T_F32}, 0, NULL, NULL, 96};
+    int rc = hd__binary_read(r, d + 96, &L);
+    if (rc) return rc;
+    r->n_faces = (size_t)n;
+    return add_triangles(r, (size_t)n);
+}

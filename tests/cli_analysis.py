@@ -1,0 +1,274 @@
+"""The command line's analysis options against numpy and a brute force:
+the --percentile JSON contract (numpy's percentile to the bit, MONAI's
+symmetric and medpy's pooled figures), --mean and --chamfer (their stated
+definitions, to a rounding), --histogram (np.histogram's counts), the
+--distances files (CSV, PLY, NPY: read back identically, CSV and PLY also by
+the tool's own reader), the pictures (size, not blank, the witness markers
+where the JSON says), --empty, and usage errors.
+
+usage: cli_analysis.py HAUSDORFF [NAME-FILTER]
+"""
+import json
+import math
+import os
+import struct
+import sys
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from cli_analysis_support import (lattice_clouds, main, nearest, run, run_json, same, test,  # noqa: E402
+                                  write_xyz)
+
+
+def gauss_clouds(seed, na, nb):
+    r = np.random.default_rng(seed)
+    return r.standard_normal((na, 3)), r.standard_normal((nb, 3)) + [0.4, 0, 0]
+
+
+def files(tmp, a, b):
+    pa, pb = os.path.join(tmp, "a.xyz"), os.path.join(tmp, "b.xyz")
+    write_xyz(pa, a)
+    write_xyz(pb, b)
+    return pa, pb
+
+
+def cases():
+    """(name, A, B): ties on lattices, duplicates, Gaussians, unequal sizes."""
+    yield ("lattice", *lattice_clouds(1, 700, 500))
+    yield ("small lattice, duplicates", *lattice_clouds(2, 300, 300, side=3))
+    yield ("gauss", *gauss_clouds(3, 900, 800))
+    yield ("1:100", *gauss_clouds(4, 1500, 15))
+
+
+@test
+def percentile_json_is_numpy_percentile_monai_and_medpy(tmp):
+    for name, a, b in cases():
+        pa, pb = files(tmp, a, b)
+        dab, _ = nearest(a, b)
+        dba, _ = nearest(b, a)
+        for p in (0, 5, 50, 95, 99.5, 100, 37.123456789):
+            r = run_json(["--percentile", repr(p), pa, pb])
+            q = r["percentile"]
+            what = "%s p=%r" % (name, p)
+            same(q["p"], p, what)
+            same(q["ab"], np.percentile(dab, p), what + " ab")
+            same(q["ba"], np.percentile(dba, p), what + " ba")
+            same(q["symmetric"], max(np.percentile(dab, p), np.percentile(dba, p)), what + " symmetric")
+            same(q["pooled"], np.percentile(np.hstack((dab, dba)), p), what + " pooled")
+            if p == 100:
+                same(q["symmetric"], r["hausdorff"], name + " P=100 is H")
+                same(q["ab"], r["directed_ab"], name + " P=100 is h(A,B)")
+
+
+@test
+def directed_percentile_has_only_the_ab_figure(tmp):
+    a, b = lattice_clouds(5, 200, 150)
+    pa, pb = files(tmp, a, b)
+    r = run_json(["--directed", "--percentile", "95", "--mean", pa, pb])
+    same(r["percentile"]["ab"], np.percentile(nearest(a, b)[0], 95))
+    assert r["percentile"]["ba"] is None and r["percentile"]["pooled"] is None
+    assert r["mean"]["ba"] is None
+
+
+@test
+def mean_and_chamfer_follow_their_stated_definitions(tmp):
+    for name, a, b in cases():
+        pa, pb = files(tmp, a, b)
+        dab, _ = nearest(a, b)
+        dba, _ = nearest(b, a)
+        r = run_json(["--mean", "--chamfer", pa, pb])
+        m, c = r["mean"], r["chamfer"]
+        mab, mba = math.fsum(dab) / len(dab), math.fsum(dba) / len(dba)
+        s2ab, s2ba = math.fsum(dab * dab), math.fsum(dba * dba)
+        want = {"mean ab": (m["ab"], mab), "mean ba": (m["ba"], mba),
+                "mean symmetric": (m["symmetric"], max(mab, mba)),
+                "mean average": (m["average"], (mab + mba) / 2),
+                "mean pooled": (m["pooled"], math.fsum(np.hstack((dab, dba))) / (len(dab) + len(dba))),
+                "chamfer": (c["value"], s2ab / len(dab) + s2ba / len(dba)),
+                "chamfer sum of squares": (c["sum_squared"], s2ab + s2ba),
+                "chamfer unsquared": (c["mean"], mab + mba),
+                "chamfer unsquared sum": (c["sum"], math.fsum(dab) + math.fsum(dba))}
+        for what, (got, ref) in want.items():
+            assert abs(got - ref) <= 4e-16 * abs(ref), "%s %s: %r vs %r" % (name, what, got, ref)
+        assert c["definition"] == "mean_squared" and c["value"] == c["mean_squared"]
+
+
+@test
+def histogram_counts_are_numpys(tmp):
+    a, b = lattice_clouds(6, 600, 400)  # many distances exactly on bin edges
+    pa, pb = files(tmp, a, b)
+    dab, _ = nearest(a, b)
+    dba, _ = nearest(b, a)
+    top = max(dab.max(), dba.max())
+    for bins, extra in ((20, []), (7, []), (13, ["--max-distance", "1.5"])):
+        r = run_json(["--histogram", "--bins", str(bins)] + extra + [pa, pb])["histogram"]
+        hi = 1.5 if extra else top
+        assert r["bins"] == bins and r["range"] == [0, hi]
+        assert r["ab"] == np.histogram(dab, bins, range=(0, hi))[0].tolist()
+        assert r["ba"] == np.histogram(dba, bins, range=(0, hi))[0].tolist()
+        assert r["above_ab"] == int((dab > hi).sum()) and r["above_ba"] == int((dba > hi).sum())
+    out, _ = run(["--histogram", "--bins", "5", pa, pb])
+    assert "histogram of distances (5 bins" in out
+
+
+def check_rows(rows, pts, d, j, what):
+    assert rows.shape == (len(pts), 5), what
+    assert np.array_equal(rows[:, :3], pts), what + ": coordinates"
+    assert np.array_equal(rows[:, 3], d), what + ": distances"
+    assert np.array_equal(rows[:, 4], j), what + ": nearest indices"
+
+
+@test
+def distances_csv_has_the_contract_columns_and_reads_back(tmp):
+    a, b = gauss_clouds(7, 500, 400)
+    pa, pb = files(tmp, a, b)
+    out = os.path.join(tmp, "dev.csv")
+    r = run_json(["--distances", out, pa, pb])
+    assert r["distances_file"] == {"a": out, "b": os.path.join(tmp, "dev_b.csv")}
+    with open(out) as f:
+        assert f.readline() == "x,y,z,distance,nearest\n"
+    check_rows(np.loadtxt(out, delimiter=",", skiprows=1), a, *nearest(a, b), "A")
+    check_rows(np.loadtxt(r["distances_file"]["b"], delimiter=",", skiprows=1), b, *nearest(b, a), "B")
+    back = run_json([out, pa])  # the library's reader sees A's points again
+    assert back["n_a"] == len(a) and back["hausdorff"] == 0
+
+
+def read_ply(path):
+    with open(path, "rb") as f:
+        data = f.read()
+    end = data.index(b"end_header\n") + len(b"end_header\n")
+    header = data[:end].decode().splitlines()
+    assert header[1] == "format binary_little_endian 1.0", header
+    types = {"double": "<f8", "int": "<i4", "uchar": "u1"}
+    fields = [(ln.split()[2], types[ln.split()[1]]) for ln in header if ln.startswith("property")]
+    n = int([ln for ln in header if ln.startswith("element vertex")][0].split()[2])
+    return np.frombuffer(data[end:], dtype=np.dtype(fields), count=n)
+
+
+@test
+def distances_ply_carries_distance_nearest_and_viridis_colour(tmp):
+    a, b = lattice_clouds(8, 400, 300)
+    b[0] = a[5]  # one distance 0
+    pa, pb = files(tmp, a, b)
+    out = os.path.join(tmp, "dev.ply")
+    run(["--distances", out, pa, pb])
+    v = read_ply(out)
+    d, j = nearest(a, b)
+    rows = np.column_stack([v["x"], v["y"], v["z"], v["distance"], v["nearest"]])
+    check_rows(rows, a, d, j, "PLY A")
+    rgb = np.column_stack([v["red"], v["green"], v["blue"]])
+    top = max(d.max(), nearest(b, a)[0].max())  # the colour scale is H
+    assert tuple(rgb[np.argmin(d)]) == (68, 1, 84), "viridis at 0"
+    if d.max() == top:
+        assert tuple(rgb[np.argmax(d)]) == (253, 231, 37), "viridis at 1"
+    back = run_json([out, pa])
+    assert back["n_a"] == len(a) and back["hausdorff"] == 0
+    check_rows(np.column_stack([read_ply(os.path.join(tmp, "dev_b.ply"))[k] for k in
+                                ("x", "y", "z", "distance", "nearest")]), b, *nearest(b, a), "PLY B")
+
+
+@test
+def distances_npy_is_an_n_by_5_float64_array(tmp):
+    a, b = gauss_clouds(9, 300, 350)
+    pa, pb = files(tmp, a, b)
+    out = os.path.join(tmp, "dev.npy")
+    run(["--distances", out, pa, pb])
+    m = np.load(out)
+    assert m.dtype == np.float64 and m.shape == (300, 5)
+    check_rows(m, a, *nearest(a, b), "NPY A")
+    check_rows(np.load(os.path.join(tmp, "dev_b.npy")), b, *nearest(b, a), "NPY B")
+
+
+def read_png(path):
+    from PIL import Image
+    with Image.open(path) as im:
+        return np.asarray(im.convert("RGB"))
+
+
+@test
+def render_is_a_picture_with_the_witness_pair_marked(tmp):
+    a, b = gauss_clouds(10, 3000, 2500)
+    b[7] = [6.0, 5.0, -4.0]  # a far point of B: h(B,A) wins, witness B[7]
+    pa, pb = files(tmp, a, b)
+    png = os.path.join(tmp, "r.png")
+    r = run_json(["--render", png, pa, pb])
+    img = read_png(png)
+    rd = r["render"]
+    assert img.shape == (rd["height"], rd["width"], 3)
+    colours = np.unique(img.reshape(-1, 3), axis=0)
+    assert len(colours) > 100, "a picture, not a blank page"
+    assert r["witness_ba"][0] == 7
+    marks = rd["witness_markers"]
+    assert len(marks) == 6 and {m["view"] for m in marks} == {"front", "side", "top"}
+    for m in marks:
+        want = (255, 0, 0) if (m["set"], m["index"]) == ("B", 7) else (255, 140, 0)
+        if m["set"] == "A":
+            assert m["index"] == r["witness_ba"][1]
+        assert tuple(img[m["y"], m["x"]]) == want, (m, img[m["y"], m["x"]])
+    # the points of A carry viridis colours: its darkest end is present
+    assert ((img[..., 0] < 90) & (img[..., 2] > 60) & (img[..., 1] < 60)).any()
+
+
+@test
+def histogram_png_is_a_picture(tmp):
+    a, b = gauss_clouds(11, 800, 700)
+    pa, pb = files(tmp, a, b)
+    png = os.path.join(tmp, "h.png")
+    r = run_json(["--histogram-png", png, "--percentile", "95", pa, pb])
+    assert r["histogram_png"] == png
+    img = read_png(png)
+    assert img.shape[0] > 300 and img.shape[1] > 600
+    assert len(np.unique(img.reshape(-1, 3), axis=0)) > 3
+
+
+@test
+def answers_do_not_depend_on_the_thread_count(tmp):
+    a, b = lattice_clouds(12, 2000, 1800, side=9)
+    pa, pb = files(tmp, a, b)
+    keys = ("percentile", "mean", "chamfer", "histogram", "hausdorff", "witness_ab", "witness_ba")
+    args = ["--percentile", "90", "--mean", "--chamfer", "--histogram", pa, pb]
+    one = run_json(["--threads", "1"] + args)
+    two = run_json(["--threads", "2"] + args)
+    three = run_json(["--threads", "3"] + args)
+    for k in keys:
+        assert one[k] == two[k] == three[k], k
+
+
+@test
+def an_empty_file_is_an_error_unless_empty_chooses_a_value(tmp):
+    a, _ = gauss_clouds(13, 50, 1)
+    pa, pe = os.path.join(tmp, "a.xyz"), os.path.join(tmp, "e.xyz")
+    write_xyz(pa, a)
+    open(pe, "w").close()
+    _, err = run([pa, pe], expect=2)
+    assert "e.xyz" in err and "--empty" in err, err
+    out = os.path.join(tmp, "d.csv")
+    r = run_json(["--empty", "zero", "--mean", "--distances", out, pa, pe])
+    assert r["hausdorff"] == 0 and r["mean"]["pooled"] == 0 and r["empty"]["policy"] == "zero"
+    rows = np.loadtxt(out, delimiter=",", skiprows=1)
+    assert rows.shape == (50, 5) and (rows[:, 3] == 0).all() and (rows[:, 4] == -1).all()
+    with open(os.path.join(tmp, "d_b.csv")) as f:
+        assert f.read() == "x,y,z,distance,nearest\n"
+    r = run_json(["--empty", "nan", pe, pa])
+    assert r["hausdorff"] is None and r["empty"] == {"a": True, "b": False, "policy": "nan"}
+
+
+@test
+def bad_analysis_options_are_usage_errors(tmp):
+    a, b = gauss_clouds(14, 5, 5)
+    pa, pb = files(tmp, a, b)
+    for args, words in ((["--percentile", "101"], "[0, 100]"), (["--percentile", "x"], "percentile"),
+                        (["--distances", "out.txt"], ".csv, .ply or .npy"),
+                        (["--bins", "0"], "--bins"), (["--max-distance", "-1"], "positive"),
+                        (["--mask-points", "edges"], "surface or all"), (["--empty", "none"], "inf, nan or zero"),
+                        (["--percentile"], "needs a value")):
+        _, err = run([pa, pb] + args, expect=1)
+        assert words in err, (args, err)
+    out, _ = run(["--help"])
+    for words in ("--percentile P", "--mask-points surface|all", "--empty inf|nan|zero", "6-neighbour"):
+        assert words in out, words
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,188 @@
+"""Shared helpers of the analysis tests (cli_analysis*.py): a tiny runner,
+the command line, files written byte by byte, and the brute force.
+
+The brute force is numpy with every operation spelled out in the library's
+order: d2 = (dx*dx + dy*dy) + dz*dz elementwise in float64 (numpy does not
+fuse multiply-adds across separate ufunc calls), the minimum and the first
+index attaining it (argmin), one sqrt.  Percentiles and histograms are
+numpy's own (np.percentile, np.histogram), the reference for bit-exactness.
+"""
+import gzip
+import json
+import os
+import struct
+import subprocess
+import sys
+import tempfile
+import traceback
+
+import numpy as np
+
+TESTS = []
+
+
+def test(fn):
+    TESTS.append(fn)
+    return fn
+
+
+def main():
+    """Run every @test (or those whose name contains argv[2])."""
+    only = sys.argv[2] if len(sys.argv) > 2 else ""
+    failed = 0
+    for fn in TESTS:
+        if only not in fn.__name__:
+            continue
+        try:
+            with tempfile.TemporaryDirectory(prefix="hd-analysis-") as tmp:
+                fn(tmp)
+            print("ok   " + fn.__name__)
+        except Exception:  # report every failure, keep going
+            failed += 1
+            print("FAIL " + fn.__name__)
+            traceback.print_exc()
+    print("%d passed, %d failed" % (len(TESTS) - failed, failed))
+    sys.exit(1 if failed else 0)
+
+
+def tool():
+    return sys.argv[1]
+
+
+def run(args, expect=0):
+    """Run the tool; return (stdout, stderr), checking the exit status."""
+    p = subprocess.run([tool()] + [str(a) for a in args], capture_output=True, text=True)
+    if p.returncode != expect:
+        raise AssertionError("exit %d (expected %d) for %s\nstdout: %s\nstderr: %s"
+                             % (p.returncode, expect, args, p.stdout, p.stderr))
+    return p.stdout, p.stderr
+
+
+def run_json(args):
+    out, _ = run(["--json"] + list(args))
+    return json.loads(out)
+
+
+def write_xyz(path, pts):
+    with open(path, "w") as f:
+        for p in pts:
+            f.write("%r %r %r\n" % (float(p[0]), float(p[1]), float(p[2])))
+
+
+def nearest(q, b):
+    """(distance, nearest index) of every point of q to b, brute force."""
+    d = np.empty(len(q))
+    j = np.empty(len(q), dtype=np.int64)
+    for s in range(0, len(q), 256):
+        qq = q[s:s + 256, None, :]
+        dx = qq[..., 0] - b[None, :, 0]
+        dy = qq[..., 1] - b[None, :, 1]
+        dz = qq[..., 2] - b[None, :, 2]
+        d2 = (dx * dx + dy * dy) + dz * dz
+        jj = np.argmin(d2, axis=1)
+        j[s:s + 256] = jj
+        d[s:s + 256] = np.sqrt(d2[np.arange(len(jj)), jj])
+    return d, j
+
+
+def same(a, b, what=""):
+    """Bit-identical doubles (None in JSON stands for NaN/inf)."""
+    fa, fb = float(a), float(b)
+    if fa.hex() != fb.hex() and not (np.isnan(fa) and np.isnan(fb)):
+        raise AssertionError("%s: %r != %r (%s vs %s)" % (what, fa, fb, fa.hex(), fb.hex()))
+
+
+def lattice_clouds(seed, na, nb, side=6):
+    """Clouds on an integer lattice: many equidistant neighbours (ties)."""
+    r = np.random.default_rng(seed)
+    a = r.integers(0, side, size=(na, 3)).astype(np.float64)
+    b = r.integers(0, side, size=(nb, 3)).astype(np.float64) + np.array([0.5, 0, 0])
+    return a, b
+
+
+# ---- NIfTI written byte by byte (nibabel is not needed) -----------------------
+
+DT = {np.dtype(np.uint8): (2, 8), np.dtype(np.int16): (4, 16), np.dtype(np.int32): (8, 32),
+      np.dtype(np.float32): (16, 32), np.dtype(np.float64): (64, 64)}
+
+
+def write_nifti(path, vol, pixdim=(1, 1, 1), sform=None, qform=None, version=1, units=2):
+    """Write vol (x, y, z indexing; i fastest on disk) as NIfTI-1 or -2.
+    sform: 3x4 rows (srow_x, srow_y, srow_z), sform_code 1.  qform: dict with
+    b, c, d, qfac and offset (qform_code 1).  .gz names are gzipped."""
+    vol = np.asarray(vol)
+    code, bitpix = DT[vol.dtype]
+    dims = [3, vol.shape[0], vol.shape[1], vol.shape[2], 1, 1, 1, 1]
+    qfac = qform["qfac"] if qform else 1.0
+    pd = [qfac, pixdim[0], pixdim[1], pixdim[2], 1, 1, 1, 1]
+    qcode, scode = (1 if qform else 0), (1 if sform is not None else 0)
+    qb, qc, qd = (qform["b"], qform["c"], qform["d"]) if qform else (0, 0, 0)
+    qo = qform["offset"] if qform else (0, 0, 0)
+    rows = np.asarray(sform if sform is not None else np.zeros((3, 4)), dtype=np.float64)
+    if version == 1:
+        h = bytearray(348)
+        struct.pack_into("<i", h, 0, 348)
+        struct.pack_into("<8h", h, 40, *dims)
+        struct.pack_into("<hh", h, 70, code, bitpix)
+        struct.pack_into("<8f", h, 76, *pd)
+        struct.pack_into("<f", h, 108, 352.0)
+        struct.pack_into("<B", h, 123, units)
+        struct.pack_into("<hh", h, 252, qcode, scode)
+        struct.pack_into("<6f", h, 256, qb, qc, qd, *qo)
+        for r in range(3):
+            struct.pack_into("<4f", h, 280 + 16 * r, *rows[r])
+        h[344:348] = b"n+1\0"
+        head = bytes(h) + b"\0\0\0\0"
+    else:
+        h = bytearray(540)
+        struct.pack_into("<i", h, 0, 540)
+        h[4:12] = b"n+2\0\r\n\x1a\n"
+        struct.pack_into("<hh", h, 12, code, bitpix)
+        struct.pack_into("<8q", h, 16, *dims)
+        struct.pack_into("<8d", h, 104, *pd)
+        struct.pack_into("<q", h, 168, 544)
+        struct.pack_into("<ii", h, 344, qcode, scode)
+        struct.pack_into("<6d", h, 352, qb, qc, qd, *qo)
+        for r in range(3):
+            struct.pack_into("<4d", h, 400 + 32 * r, *rows[r])
+        struct.pack_into("<i", h, 500, units)
+        head = bytes(h) + b"\0\0\0\0"
+    data = head + np.asarray(vol, dtype=vol.dtype.newbyteorder("<")).tobytes(order="F")
+    if path.endswith(".gz"):
+        with gzip.open(path, "wb") as f:
+            f.write(data)
+    else:
+        with open(path, "wb") as f:
+            f.write(data)
+
+
+def stored(rows, version):
+    """The transform as the file stores it: float32 in NIfTI-1."""
+    rows = np.asarray(rows, dtype=np.float64)
+    return rows.astype(np.float32).astype(np.float64) if version == 1 else rows
+
+
+def world(ijk, m):
+    """World coordinates in the tool's documented order:
+    x = ((m00*i + m01*j) + m02*k) + m03, and so on."""
+    i, j, k = (ijk[:, 0].astype(np.float64), ijk[:, 1].astype(np.float64),
+               ijk[:, 2].astype(np.float64))
+    out = np.empty((len(ijk), 3))
+    for c in range(3):
+        out[:, c] = ((m[c, 0] * i + m[c, 1] * j) + m[c, 2] * k) + m[c, 3]
+    return out
+
+
+def voxels(mask, surface):
+    """Foreground (or surface) voxel indices in storage order (i fastest):
+    surface = foreground with a 6-neighbour in the background or outside."""
+    fg = mask != 0
+    keep = fg.copy()
+    if surface:
+        p = np.pad(fg, 1, constant_values=False)
+        inner = (p[:-2, 1:-1, 1:-1] & p[2:, 1:-1, 1:-1] & p[1:-1, :-2, 1:-1] &
+                 p[1:-1, 2:, 1:-1] & p[1:-1, 1:-1, :-2] & p[1:-1, 1:-1, 2:])
+        keep = fg & ~inner
+    idx = np.argwhere(keep)  # C order: i slowest; reorder to storage order
+    order = np.lexsort((idx[:, 0], idx[:, 1], idx[:, 2]))
+    return idx[order]

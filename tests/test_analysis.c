@@ -1,0 +1,389 @@
+/*
+ * test_analysis.c -- the analysis functions as a specification: per-point
+ * distances agree with the brute force bit for bit (ties, both directions,
+ * float32 views, thread counts), selection and percentiles agree with a full
+ * sort for every rank and every percentile step, P = 100 is the Hausdorff
+ * distance, sums are compensated, histograms put every value in the bin
+ * whose edges enclose it, and bad input is refused with the right code.
+ * Bit-exact agreement with numpy itself is tested in cli_analysis_lib.py.
+ */
+#include "brute.h"
+#include "check.h"
+#include "gen.h"
+#include "internal.h"
+
+#include <math.h>
+#include <stdlib.h>
+
+/* ---- references ----------------------------------------------------------- */
+
+static int cmp_d(const void *x, const void *y) {
+    double a = *(const double *)x, b = *(const double *)y;
+    return (a > b) - (a < b);
+}
+
+/* numpy.percentile(v, p) written from its documentation on a full sort. */
+static double ref_percentile(const double *v, size_t n, double p) {
+    double *s = malloc(n * sizeof *s);
+    memcpy(s, v, n * sizeof *s);
+    qsort(s, n, sizeof *s, cmp_d);
+    double pos = (double)(n - 1) * (p / 100.0), r;
+    if (pos >= (double)(n - 1)) {
+        r = s[n - 1];
+    } else {
+        size_t lo = (size_t)floor(pos);
+        double t = pos - floor(pos), a = s[lo], b = s[lo + 1];
+        r = t >= 0.5 ? b - (b - a) * (1.0 - t) : a + (b - a) * t;
+    }
+    free(s);
+    return r;
+}
+
+/* Distances with ties: lattice points, few distinct values. */
+static double *lattice_values(gen_rng_t *g, size_t n, int side) {
+    double *v = malloc(n * sizeof *v);
+    for (size_t k = 0; k < n; k++) {
+        double x = (double)(gen_u64(g) % (uint64_t)side), y = (double)(gen_u64(g) % (uint64_t)side);
+        v[k] = sqrt(x * x + y * y);
+    }
+    return v;
+}
+
+/* Two clouds for per-point tests, by case number: Gaussians, lattices with
+ * many equidistant neighbours, duplicates, very unequal sizes. */
+static void make_case(gen_rng_t *g, int kind, double **a, size_t *na, double **b, size_t *nb) {
+    *na = 1 + gen_u64(g) % 400;
+    *nb = 1 + gen_u64(g) % 400;
+    if (kind == 3) *nb = 1 + gen_u64(g) % 4;
+    *a = malloc(24 * *na);
+    *b = malloc(24 * *nb);
+    double m0[3] = {0, 0, 0}, m1[3] = {0.7, 0, 0};
+    if (kind == 0 || kind == 3) {
+        gen_gauss(g, *a, *na, m0, 1.0);
+        gen_gauss(g, *b, *nb, m1, 1.0);
+    } else if (kind == 1) {
+        gen_lattice(g, *a, *na, 6);
+        gen_lattice(g, *b, *nb, 6);
+    } else {
+        gen_lattice(g, *a, *na, 3); /* duplicates in both */
+        gen_lattice(g, *b, *nb, 3);
+        gen_affine(*b, *nb, 1.0, 0.5);
+    }
+}
+
+/* ---- per-point distances ---------------------------------------------------- */
+
+TEST(per_point_distances_match_brute_force_in_both_directions) {
+    gen_rng_t g;
+    for (uint64_t seed = 1; seed <= 40; seed++) {
+        int kind = (int)(seed % 4);
+        CONTEXT("seed=%llu kind=%d", (unsigned long long)seed, kind);
+        gen_seed(&g, seed);
+        double *a, *b;
+        size_t na, nb;
+        make_case(&g, kind, &a, &na, &b, &nb);
+        hd_points_t A = hd_points_f64(a, na), B = hd_points_f64(b, nb);
+        hd_options_t o;
+        hd_options_init(&o);
+        o.threads = (int)(seed % 3) + 1;
+        double *dab = malloc(8 * na), *dba = malloc(8 * nb);
+        size_t *jab = malloc(sizeof(size_t) * na), *jba = malloc(sizeof(size_t) * nb);
+        CHECK_RC(hd_distances(&A, &B, &o, dab, jab, dba, jba, NULL), HD_OK);
+        for (size_t i = 0; i < na && !hdt_failed(); i++) {
+            size_t j;
+            double d2 = brute_nearest(a + 3 * i, b, nb, &j);
+            CHECK_BITS(dab[i], sqrt(d2));
+            CHECK_EQ(jab[i], j);
+        }
+        for (size_t i = 0; i < nb && !hdt_failed(); i++) {
+            size_t j;
+            double d2 = brute_nearest(b + 3 * i, a, na, &j);
+            CHECK_BITS(dba[i], sqrt(d2));
+            CHECK_EQ(jba[i], j);
+        }
+        free(a), free(b), free(dab), free(dba), free(jab), free(jba);
+    }
+}
+
+TEST(per_point_distances_of_float32_views_are_exact_for_the_floats) {
+    gen_rng_t g;
+    gen_seed(&g, 77);
+    CONTEXT("seed=77");
+    size_t na = 300, nb = 250;
+    float fa[900], fb[750];
+    double a[900], b[750];
+    for (size_t k = 0; k < 3 * na; k++) a[k] = fa[k] = (float)gen_normal(&g);
+    for (size_t k = 0; k < 3 * nb; k++) b[k] = fb[k] = (float)(gen_normal(&g) + 0.25);
+    hd_points_t A = hd_points_f32(fa, na), B = hd_points_f32(fb, nb);
+    double d[300];
+    size_t j[300];
+    CHECK_RC(hd_distances(&A, &B, NULL, d, j, NULL, NULL, NULL), HD_OK);
+    for (size_t i = 0; i < na; i++) {
+        size_t bj;
+        CHECK_BITS(d[i], sqrt(brute_nearest(a + 3 * i, b, nb, &bj)));
+        CHECK_EQ(j[i], bj);
+    }
+}
+
+TEST(distances_skip_a_direction_whose_outputs_are_null) {
+    double a[] = {0, 0, 0, 3, 0, 0}, b[] = {1, 0, 0};
+    hd_points_t A = hd_points_f64(a, 2), B = hd_points_f64(b, 1);
+    size_t j[1] = {99};
+    CHECK_RC(hd_distances(&A, &B, NULL, NULL, NULL, NULL, j, NULL), HD_OK);
+    CHECK_EQ(j[0], 0); /* B[0] is at 1 from A[0] and 2 from A[1] */
+    double d[2];
+    CHECK_RC(hd_distances(&A, &B, NULL, d, NULL, NULL, NULL, NULL), HD_OK);
+    CHECK_BITS(d[0], 1.0);
+    CHECK_BITS(d[1], 2.0);
+}
+
+TEST(distances_refuse_empty_and_nonfinite_sets_naming_them) {
+    double a[] = {0, 0, 0}, nan_[] = {0, NAN, 0};
+    hd_points_t A = hd_points_f64(a, 1), E = hd_points_f64(a, 0), N = hd_points_f64(nan_, 1);
+    double d[1];
+    hd_error_t e;
+    CHECK_RC(hd_distances(&A, &E, NULL, d, NULL, NULL, NULL, &e), HD_EEMPTY);
+    CHECK(strstr(e.message, "B") != NULL);
+    CHECK_RC(hd_distances(&E, &A, NULL, d, NULL, NULL, NULL, &e), HD_EEMPTY);
+    CHECK(strstr(e.message, "A") != NULL);
+    CHECK_RC(hd_distances(&N, &A, NULL, d, NULL, NULL, NULL, &e), HD_ENONFINITE);
+}
+
+/* ---- selection and percentiles ----------------------------------------------- */
+
+TEST(select_puts_every_rank_in_place_with_ties) {
+    gen_rng_t g;
+    for (uint64_t seed = 1; seed <= 30; seed++) {
+        CONTEXT("seed=%llu", (unsigned long long)seed);
+        gen_seed(&g, seed);
+        size_t n = 1 + gen_u64(&g) % 700;
+        int side = 1 + (int)(seed % 7);
+        double *v = lattice_values(&g, n, side), *s = malloc(n * sizeof *s), *w = malloc(n * sizeof *w);
+        memcpy(s, v, n * sizeof *s);
+        qsort(s, n, sizeof *s, cmp_d);
+        for (size_t k = 0; k < n && !hdt_failed(); k++) {
+            memcpy(w, v, n * sizeof *w);
+            hd__select(w, n, k);
+            CHECK_BITS(w[k], s[k]);
+            for (size_t i = 0; i < k; i++) CHECK(w[i] <= w[k]);
+            for (size_t i = k + 1; i < n; i++) CHECK(w[i] >= w[k]);
+        }
+        free(v), free(s), free(w);
+    }
+}
+
+TEST(select_survives_inputs_that_defeat_median_of_three) {
+    /* Sorted, reversed, organ-pipe and all-equal inputs of 5000 values. */
+    size_t n = 5000;
+    double *v = malloc(n * sizeof *v), *w = malloc(n * sizeof *w), *s = malloc(n * sizeof *s);
+    for (int shape = 0; shape < 4; shape++) {
+        CONTEXT("shape=%d", shape);
+        for (size_t k = 0; k < n; k++) {
+            double x = (double)k;
+            v[k] = shape == 0 ? x : shape == 1 ? -x : shape == 2 ? (k < n / 2 ? x : (double)(n - k)) : 1.0;
+        }
+        memcpy(s, v, n * sizeof *s);
+        qsort(s, n, sizeof *s, cmp_d);
+        for (size_t k = 0; k < n; k += 499) {
+            memcpy(w, v, n * sizeof *w);
+            hd__select(w, n, k);
+            CHECK_BITS(w[k], s[k]);
+        }
+    }
+    free(v), free(w), free(s);
+}
+
+TEST(percentiles_match_a_full_sort_at_every_half_percent_with_ties) {
+    gen_rng_t g;
+    for (uint64_t seed = 1; seed <= 25; seed++) {
+        CONTEXT("seed=%llu", (unsigned long long)seed);
+        gen_seed(&g, seed);
+        size_t n = 1 + gen_u64(&g) % 500;
+        double *v = lattice_values(&g, n, 2 + (int)(seed % 9));
+        double ps[201], got[201];
+        for (int k = 0; k <= 200; k++) ps[k] = 0.5 * k;
+        CHECK_RC(hd_percentiles(v, n, ps, 201, got, NULL), HD_OK);
+        for (int k = 0; k <= 200; k++) CHECK_BITS(got[k], ref_percentile(v, n, ps[k]));
+        for (int k = 0; k < 20; k++) { /* arbitrary p, one at a time */
+            double p = 100.0 * gen_unit(&g), one;
+            CHECK_RC(hd_percentile(v, n, p, &one, NULL), HD_OK);
+            CHECK_BITS(one, ref_percentile(v, n, p));
+        }
+        free(v);
+    }
+}
+
+TEST(percentiles_leave_the_callers_values_untouched) {
+    double v[] = {5, 1, 4, 2, 3}, p95;
+    CHECK_RC(hd_percentile(v, 5, 95, &p95, NULL), HD_OK);
+    CHECK(v[0] == 5 && v[1] == 1 && v[2] == 4 && v[3] == 2 && v[4] == 3);
+    CHECK_BITS(p95, ref_percentile(v, 5, 95));
+}
+
+TEST(percentile_100_is_the_hausdorff_distance_and_0_the_smallest_distance) {
+    gen_rng_t g;
+    for (uint64_t seed = 1; seed <= 12; seed++) {
+        int kind = (int)(seed % 4);
+        CONTEXT("seed=%llu kind=%d", (unsigned long long)seed, kind);
+        gen_seed(&g, seed);
+        double *a, *b;
+        size_t na, nb;
+        make_case(&g, kind, &a, &na, &b, &nb);
+        hd_points_t A = hd_points_f64(a, na), B = hd_points_f64(b, nb);
+        hd_percentile_t p100, p0;
+        hd_symmetric_t s;
+        CHECK_RC(hd_hausdorff_percentile(&A, &B, NULL, 100, &p100, NULL), HD_OK);
+        CHECK_RC(hd_hausdorff_percentile(&A, &B, NULL, 0, &p0, NULL), HD_OK);
+        CHECK_RC(hd_hausdorff(&A, &B, NULL, &s, NULL), HD_OK);
+        CHECK_BITS(p100.ab, s.ab.distance);
+        CHECK_BITS(p100.ba, s.ba.distance);
+        CHECK_BITS(p100.symmetric, s.distance);
+        CHECK_BITS(p100.pooled, s.distance);
+        double mn = INFINITY;
+        for (size_t i = 0; i < na; i++) {
+            double d = sqrt(brute_nearest(a + 3 * i, b, nb, NULL));
+            if (d < mn) mn = d;
+        }
+        CHECK_BITS(p0.ab, mn);
+        free(a), free(b);
+    }
+}
+
+TEST(percentile_hausdorff_has_monai_symmetric_and_medpy_pooled_figures) {
+    gen_rng_t g;
+    for (uint64_t seed = 1; seed <= 20; seed++) {
+        int kind = (int)(seed % 4);
+        CONTEXT("seed=%llu kind=%d", (unsigned long long)seed, kind);
+        gen_seed(&g, seed);
+        double *a, *b;
+        size_t na, nb;
+        make_case(&g, kind, &a, &na, &b, &nb);
+        double *dab = malloc(8 * na), *both = malloc(8 * (na + nb));
+        for (size_t i = 0; i < na; i++) both[i] = dab[i] = sqrt(brute_nearest(a + 3 * i, b, nb, NULL));
+        for (size_t i = 0; i < nb; i++) both[na + i] = sqrt(brute_nearest(b + 3 * i, a, na, NULL));
+        double p = seed % 2 ? 95.0 : 100.0 * gen_unit(&g);
+        hd_points_t A = hd_points_f64(a, na), B = hd_points_f64(b, nb);
+        hd_percentile_t r;
+        CHECK_RC(hd_hausdorff_percentile(&A, &B, NULL, p, &r, NULL), HD_OK);
+        double ab = ref_percentile(dab, na, p), ba = ref_percentile(both + na, nb, p);
+        CHECK_BITS(r.p, p);
+        CHECK_BITS(r.ab, ab);
+        CHECK_BITS(r.ba, ba);
+        CHECK_BITS(r.symmetric, ab > ba ? ab : ba);
+        CHECK_BITS(r.pooled, ref_percentile(both, na + nb, p));
+        hd_percentile_t dir;
+        CHECK_RC(hd_percentile_of(dab, na, NULL, 0, p, &dir, NULL), HD_OK);
+        CHECK_BITS(dir.ab, ab);
+        CHECK(isnan(dir.ba) && isnan(dir.symmetric) && isnan(dir.pooled));
+        free(a), free(b), free(dab), free(both);
+    }
+}
+
+TEST(percentiles_refuse_bad_p_empty_input_and_nan) {
+    double v[] = {1, 2, NAN}, out;
+    hd_error_t e;
+    CHECK_RC(hd_percentile(v, 2, -0.5, &out, &e), HD_EINVAL);
+    CHECK(strstr(e.message, "[0, 100]") != NULL);
+    CHECK_RC(hd_percentile(v, 2, 100.5, &out, NULL), HD_EINVAL);
+    CHECK_RC(hd_percentile(v, 2, NAN, &out, NULL), HD_EINVAL);
+    CHECK_RC(hd_percentile(v, 0, 50, &out, NULL), HD_EEMPTY);
+    CHECK_RC(hd_percentile(v, 3, 50, &out, NULL), HD_ENONFINITE);
+    hd_percentile_t r;
+    CHECK_RC(hd_percentile_of(v, 0, NULL, 0, 50, &r, NULL), HD_EEMPTY);
+    CHECK_RC(hd_percentile_of(v, 2, v, 3, 50, &r, NULL), HD_ENONFINITE);
+}
+
+/* ---- sums, means, Chamfer ---------------------------------------------------- */
+
+TEST(summary_means_and_chamfer_follow_their_definitions) {
+    double ab[] = {0, 1, 2, 3}, ba[] = {4, 0};
+    hd_summary_t s;
+    CHECK_RC(hd_summarize(ab, 4, ba, 2, &s, NULL), HD_OK);
+    CHECK_EQ(s.n_ab, 4);
+    CHECK_EQ(s.n_ba, 2);
+    CHECK_BITS(s.max_ab, 3.0);
+    CHECK_BITS(s.max_ba, 4.0);
+    CHECK_BITS(s.mean_ab, 1.5);
+    CHECK_BITS(s.mean_ba, 2.0);
+    CHECK_BITS(s.mean_symmetric, 2.0);
+    CHECK_BITS(s.mean_average, 1.75);
+    CHECK_BITS(s.mean_pooled, 10.0 / 6.0);
+    CHECK_BITS(s.mean2_ab, 14.0 / 4.0);
+    CHECK_BITS(s.mean2_ba, 8.0);
+    CHECK_BITS(s.chamfer, 3.5 + 8.0);
+    CHECK_BITS(s.chamfer_sum2, 14.0 + 16.0);
+    CHECK_BITS(s.chamfer_mean, 3.5);
+    CHECK_BITS(s.chamfer_sum, 10.0);
+    hd_summary_t d;
+    CHECK_RC(hd_summarize(ab, 4, NULL, 0, &d, NULL), HD_OK);
+    CHECK_BITS(d.mean_ab, 1.5);
+    CHECK(isnan(d.mean_ba) && isnan(d.chamfer) && isnan(d.mean_pooled));
+}
+
+TEST(sums_are_compensated_where_a_plain_loop_loses_everything) {
+    /* 1e16 followed by 10000 ones: a plain left-to-right sum stays at 1e16
+     * (each 1 is below half an ulp), the exact sum is 1e16 + 10000. */
+    size_t n = 10001;
+    double *v = malloc(n * sizeof *v);
+    v[0] = 1e16;
+    for (size_t k = 1; k < n; k++) v[k] = 1.0;
+    hd_summary_t s;
+    CHECK_RC(hd_summarize(v, n, NULL, 0, &s, NULL), HD_OK);
+    CHECK_BITS(s.sum_ab, 1e16 + 10000.0);
+    free(v);
+}
+
+TEST(summary_refuses_empty_and_nan) {
+    double v[] = {1, NAN};
+    hd_summary_t s;
+    CHECK_RC(hd_summarize(v, 0, NULL, 0, &s, NULL), HD_EEMPTY);
+    CHECK_RC(hd_summarize(v, 1, v, 0, &s, NULL), HD_EEMPTY);
+    CHECK_RC(hd_summarize(v, 2, NULL, 0, &s, NULL), HD_ENONFINITE);
+    CHECK_RC(hd_summarize(v, 1, NULL, 0, NULL, NULL), HD_EINVAL);
+}
+
+/* ---- histograms ---------------------------------------------------------- */
+
+TEST(histogram_puts_each_value_in_the_bin_whose_edges_enclose_it) {
+    gen_rng_t g;
+    for (uint64_t seed = 1; seed <= 20; seed++) {
+        CONTEXT("seed=%llu", (unsigned long long)seed);
+        gen_seed(&g, seed);
+        size_t n = 1 + gen_u64(&g) % 2000, bins = 1 + gen_u64(&g) % 37;
+        double *v = lattice_values(&g, n, 5); /* many values on edges */
+        double lo = seed % 3 ? 0.0 : 0.3, hi = seed % 2 ? 5.0 : 0.1 * (double)(gen_u64(&g) % 60);
+        if (hi < lo) hi = lo;
+        uint64_t *c = malloc(bins * sizeof *c), *want = calloc(bins, sizeof *want);
+        CHECK_RC(hd_histogram(v, n, lo, hi, bins, c, NULL), HD_OK);
+        double wlo = hd_histogram_edge(lo, hi, bins, 0), whi = hd_histogram_edge(lo, hi, bins, bins);
+        for (size_t k = 0; k < n; k++) {
+            if (v[k] < wlo || v[k] > whi) continue;
+            size_t b = 0;
+            while (b + 1 < bins && v[k] >= hd_histogram_edge(lo, hi, bins, b + 1)) b++;
+            want[b]++;
+        }
+        for (size_t b = 0; b < bins; b++) CHECK_EQ(c[b], want[b]);
+        free(v), free(c), free(want);
+    }
+}
+
+TEST(histogram_edges_are_linspace_and_the_last_bin_is_closed) {
+    CHECK_BITS(hd_histogram_edge(0, 1, 10, 3), 3 * 0.1 + 0.0);
+    CHECK_BITS(hd_histogram_edge(0, 1, 10, 10), 1.0);
+    CHECK_BITS(hd_histogram_edge(2, 2, 4, 0), 1.5); /* widened like numpy */
+    CHECK_BITS(hd_histogram_edge(2, 2, 4, 4), 2.5);
+    double v[] = {0.0, 0.5, 1.0, 1.5, 2.0};
+    uint64_t c[2];
+    CHECK_RC(hd_histogram(v, 5, 0, 1, 2, c, NULL), HD_OK);
+    CHECK_EQ(c[0], 1); /* 0.0 */
+    CHECK_EQ(c[1], 2); /* 0.5 on the edge goes up; 1.0 closes the last bin */
+}
+
+TEST(histogram_refuses_bad_ranges_and_zero_bins) {
+    double v[] = {1};
+    uint64_t c[1];
+    CHECK_RC(hd_histogram(v, 1, 0, 1, 0, c, NULL), HD_EINVAL);
+    CHECK_RC(hd_histogram(v, 1, 1, 0, 1, c, NULL), HD_EINVAL);
+    CHECK_RC(hd_histogram(v, 1, 0, INFINITY, 1, c, NULL), HD_EINVAL);
+    CHECK_RC(hd_histogram(v, 1, -1e308, 1e308, 1, c, NULL), HD_ERANGE);
+}

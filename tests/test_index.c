@@ -1,0 +1,326 @@
+/*
+ * test_index.c -- the reusable index (hd_index_*) and the "kdtree"
+ * algorithm: every distance, witness and nearest index agrees bit for bit
+ * with the independent brute force, for transformed queries, lattice ties,
+ * duplicates, float32 and strided views, far offsets and tiny scales, at one
+ * and at three threads.
+ */
+#include "brute.h"
+#include "check.h"
+#include "gen.h"
+
+#include <math.h>
+#include <stdlib.h>
+
+/* The expected answers for T(A) against B: the brute force on the
+ * transformed copy (the transform applied by the test's own code). */
+static void check_against_brute(const hd_points_t *A, const double *a, size_t na,
+                                const hd_points_t *B, const double *b, size_t nb,
+                                const hd_transform_t *T, int threads) {
+    double *ta = malloc(24 * na);
+    if (T) brute_transform(T->r, T->t, a, ta, na);
+    else memcpy(ta, a, 24 * na);
+    hd_options_t o;
+    hd_options_init(&o);
+    o.threads = threads;
+    hd_index_t *idx = NULL;
+    CHECK_RC(hd_index_build(B, &o, &idx, NULL), HD_OK);
+    if (!idx) {
+        free(ta);
+        return;
+    }
+    CHECK_EQ(hd_index_count(idx), nb);
+
+    brute_t want = brute_directed(ta, na, b, nb);
+    hd_result_t r;
+    CHECK_RC(hd_index_directed(idx, A, T, &o, &r, NULL), HD_OK);
+    CHECK_BITS(r.distance2, want.d2);
+    CHECK_BITS(r.distance, sqrt(want.d2));
+    CHECK_EQ(r.i, want.i);
+    CHECK_EQ(r.j, want.j);
+
+    double *dist = malloc(8 * na);
+    size_t *near = malloc(sizeof(size_t) * na);
+    CHECK_RC(hd_index_nearest(idx, A, T, &o, dist, near, NULL), HD_OK);
+    for (size_t k = 0; k < na && !hdt_failed(); k++) {
+        size_t j;
+        double d2 = brute_nearest(ta + 3 * k, b, nb, &j);
+        CHECK_BITS(dist[k], sqrt(d2));
+        CHECK_EQ(near[k], j);
+    }
+    free(dist);
+    free(near);
+    hd_index_free(idx);
+    free(ta);
+}
+
+static void check_packed(const double *a, size_t na, const double *b, size_t nb,
+                         const hd_transform_t *T, int threads) {
+    hd_points_t A = hd_points_f64(a, na), B = hd_points_f64(b, nb);
+    check_against_brute(&A, a, na, &B, b, nb, T, threads);
+}
+
+/* A random rotation (from a unit quaternion) and translation. */
+static void random_transform(gen_rng_t *g, hd_transform_t *T, double shift) {
+    double q[4], n = 0;
+    for (int k = 0; k < 4; k++) {
+        q[k] = gen_normal(g);
+        n += q[k] * q[k];
+    }
+    n = sqrt(n);
+    double w = q[0] / n, x = q[1] / n, y = q[2] / n, z = q[3] / n;
+    double r[9] = {1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w),
+                   2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w),
+                   2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)};
+    memcpy(T->r, r, sizeof r);
+    for (int k = 0; k < 3; k++) T->t[k] = shift * gen_normal(g);
+}
+
+TEST(index_matches_brute_force_on_gaussians) {
+    gen_rng_t g;
+    for (uint64_t seed = 1; seed <= 40; seed++) {
+        CONTEXT("seed=%llu", (unsigned long long)seed);
+        gen_seed(&g, seed);
+        size_t na = 1 + gen_u64(&g) % 700, nb = 1 + gen_u64(&g) % 2000;
+        double *a = malloc(24 * na), *b = malloc(24 * nb);
+        double m0[3] = {0, 0, 0}, m1[3] = {0.3 * (double)(seed % 5), 0, 0};
+        gen_gauss(&g, a, na, m0, 1.0);
+        gen_gauss(&g, b, nb, m1, 1.0);
+        check_packed(a, na, b, nb, NULL, seed % 2 ? 1 : 3);
+        free(a);
+        free(b);
+    }
+}
+
+TEST(index_applies_the_documented_transform) {
+    gen_rng_t g;
+    for (uint64_t seed = 100; seed < 120; seed++) {
+        CONTEXT("seed=%llu", (unsigned long long)seed);
+        gen_seed(&g, seed);
+        size_t na = 1 + gen_u64(&g) % 500, nb = 1 + gen_u64(&g) % 1500;
+        double *a = malloc(24 * na), *b = malloc(24 * nb);
+        gen_torus(&g, a, na, 2.0, 0.5);
+        gen_torus(&g, b, nb, 2.0, 0.5);
+        hd_transform_t T;
+        random_transform(&g, &T, 0.5);
+        check_packed(a, na, b, nb, &T, seed % 2 ? 1 : 3);
+        hd_transform_identity(&T);
+        check_packed(a, na, b, nb, &T, 3);
+        free(a);
+        free(b);
+    }
+}
+
+TEST(lattice_ties_give_the_smallest_indices) {
+    gen_rng_t g;
+    for (uint64_t seed = 200; seed < 230; seed++) {
+        CONTEXT("seed=%llu", (unsigned long long)seed);
+        gen_seed(&g, seed);
+        size_t na = 1 + gen_u64(&g) % 400, nb = 1 + gen_u64(&g) % 400;
+        int side = 2 + (int)(gen_u64(&g) % 6);
+        double *a = malloc(24 * na), *b = malloc(24 * nb);
+        gen_lattice(&g, a, na, side + 2);
+        gen_lattice(&g, b, nb, side);
+        check_packed(a, na, b, nb, NULL, seed % 2 ? 1 : 3);
+        free(a);
+        free(b);
+    }
+}
+
+TEST(duplicates_and_identical_sets) {
+    gen_rng_t g;
+    gen_seed(&g, 300);
+    CONTEXT("seed=300");
+    size_t n = 600;
+    double *a = malloc(24 * n), *b = malloc(24 * n);
+    double m[3] = {0, 0, 0};
+    gen_gauss(&g, a, n / 3, m, 1.0);
+    /* Every point three times, in three blocks. */
+    memcpy(a + 3 * (n / 3), a, 24 * (n / 3));
+    memcpy(a + 6 * (n / 3), a, 24 * (n / 3));
+    memcpy(b, a, 24 * n);
+    check_packed(a, n, b, n, NULL, 1);
+    check_packed(a, n, b, n, NULL, 3);
+    /* All points equal. */
+    for (size_t k = 0; k < 3 * n; k++) b[k] = 0.25;
+    check_packed(a, n, b, n, NULL, 3);
+    check_packed(b, n, a, n, NULL, 3);
+    free(a);
+    free(b);
+}
+
+TEST(float32_views_are_widened_exactly) {
+    gen_rng_t g;
+    for (uint64_t seed = 400; seed < 410; seed++) {
+        CONTEXT("seed=%llu", (unsigned long long)seed);
+        gen_seed(&g, seed);
+        size_t na = 1 + gen_u64(&g) % 500, nb = 1 + gen_u64(&g) % 900;
+        double *a = malloc(24 * na), *b = malloc(24 * nb);
+        float *fa = malloc(12 * na), *fb = malloc(12 * nb);
+        double m0[3] = {0, 0, 0}, m1[3] = {0.5, 0, 0};
+        gen_gauss(&g, a, na, m0, 1.0);
+        gen_gauss(&g, b, nb, m1, 1.0);
+        for (size_t k = 0; k < 3 * na; k++) a[k] = (double)(fa[k] = (float)a[k]);
+        for (size_t k = 0; k < 3 * nb; k++) b[k] = (double)(fb[k] = (float)b[k]);
+        hd_points_t A = hd_points_f32(fa, na), B = hd_points_f32(fb, nb);
+        check_against_brute(&A, a, na, &B, b, nb, NULL, seed % 2 ? 1 : 3);
+        free(a);
+        free(b);
+        free(fa);
+        free(fb);
+    }
+}
+
+TEST(strided_views_read_the_right_points) {
+    gen_rng_t g;
+    gen_seed(&g, 500);
+    CONTEXT("seed=500");
+    size_t na = 333, nb = 777;
+    double *a = malloc(24 * na), *b = malloc(24 * nb);
+    double m[3] = {0, 0, 0};
+    gen_gauss(&g, a, na, m, 1.0);
+    gen_gauss(&g, b, nb, m, 1.0);
+    /* B column-major (Fortran order); A reversed with a negative stride
+     * inside records of four doubles. */
+    double *col = malloc(24 * nb), *rec = malloc(32 * na), *arev = malloc(24 * na);
+    for (size_t k = 0; k < nb; k++)
+        for (int c = 0; c < 3; c++) col[c * nb + k] = b[3 * k + c];
+    for (size_t k = 0; k < na; k++) {
+        for (int c = 0; c < 3; c++) rec[4 * k + c] = a[3 * k + c];
+        rec[4 * k + 3] = NAN; /* a field the view must skip */
+    }
+    for (size_t k = 0; k < na; k++) memcpy(arev + 3 * k, a + 3 * (na - 1 - k), 24);
+    hd_points_t B = hd_points_f64(col, nb);
+    B.stride = sizeof(double);
+    B.cstride = (ptrdiff_t)(nb * sizeof(double));
+    hd_points_t A = hd_points_f64(rec + 4 * (na - 1), na);
+    A.stride = -4 * (ptrdiff_t)sizeof(double);
+    check_against_brute(&A, arev, na, &B, b, nb, NULL, 1);
+    check_against_brute(&A, arev, na, &B, b, nb, NULL, 3);
+    free(a);
+    free(b);
+    free(col);
+    free(rec);
+    free(arev);
+}
+
+TEST(far_offsets_and_tiny_scales_stay_exact) {
+    gen_rng_t g;
+    double scales[] = {1.0, 1e-9, 1.0, 1e-9};
+    double offsets[] = {1e9, 0.0, -1e9, 1e9};
+    for (int c = 0; c < 4; c++) {
+        uint64_t seed = 600 + (uint64_t)c;
+        CONTEXT("seed=%llu scale=%g offset=%g", (unsigned long long)seed, scales[c], offsets[c]);
+        gen_seed(&g, seed);
+        size_t na = 700, nb = 900;
+        double *a = malloc(24 * na), *b = malloc(24 * nb);
+        double m0[3] = {0, 0, 0}, m1[3] = {0.2, 0.1, 0};
+        gen_gauss(&g, a, na, m0, 1.0);
+        gen_gauss(&g, b, nb, m1, 1.0);
+        gen_affine(a, na, scales[c], offsets[c]);
+        gen_affine(b, nb, scales[c], offsets[c]);
+        check_packed(a, na, b, nb, NULL, 1);
+        check_packed(a, na, b, nb, NULL, 3);
+        free(a);
+        free(b);
+    }
+}
+
+TEST(kdtree_algorithm_matches_brute_force) {
+    gen_rng_t g;
+    for (uint64_t seed = 700; seed < 760; seed++) {
+        CONTEXT("seed=%llu", (unsigned long long)seed);
+        gen_seed(&g, seed);
+        size_t na = 1 + gen_u64(&g) % 900, nb = 1 + gen_u64(&g) % 900;
+        double *a = malloc(24 * na), *b = malloc(24 * nb);
+        switch (seed % 4) {
+        case 0: {
+            double m0[3] = {0, 0, 0}, m1[3] = {20, 0, 0};
+            gen_gauss(&g, a, na, m0, 1.0);
+            gen_gauss(&g, b, nb, m1, 1.0);
+            break;
+        }
+        case 1:
+            gen_lattice(&g, a, na, 5);
+            gen_lattice(&g, b, nb, 4);
+            break;
+        case 2:
+            gen_plane(&g, a, na);
+            gen_line(&g, b, nb);
+            break;
+        default:
+            gen_cube(&g, a, na, -1, 1);
+            gen_cube(&g, b, nb, 0, 2);
+            gen_affine(a, na, 1e-9, 1e9);
+            gen_affine(b, nb, 1e-9, 1e9);
+        }
+        brute_t want = brute_directed(a, na, b, nb);
+        hd_points_t A = hd_points_f64(a, na), B = hd_points_f64(b, nb);
+        hd_options_t o;
+        hd_options_init(&o);
+        o.algorithm = HD_ALG_KDTREE;
+        o.threads = seed % 2 ? 1 : 3;
+        hd_result_t r;
+        CHECK_RC(hd_directed(&A, &B, &o, &r, NULL), HD_OK);
+        CHECK_BITS(r.distance2, want.d2);
+        CHECK_EQ(r.i, want.i);
+        CHECK_EQ(r.j, want.j);
+        CHECK_EQ(r.algorithm, HD_ALG_KDTREE);
+        CHECK(r.stats.distance_evals >= na);
+        free(a);
+        free(b);
+    }
+}
+
+TEST(index_refuses_bad_input) {
+    double good[6] = {0, 0, 0, 1, 1, 1}, nan_[3] = {0, NAN, 0};
+    hd_points_t G = hd_points_f64(good, 2), E = hd_points_f64(good, 0), N = hd_points_f64(nan_, 1);
+    hd_index_t *idx = (hd_index_t *)&idx;
+    hd_error_t e;
+    CHECK_RC(hd_index_build(&E, NULL, &idx, &e), HD_EEMPTY);
+    CHECK(idx == NULL);
+    CHECK_RC(hd_index_build(&N, NULL, &idx, &e), HD_ENONFINITE);
+    CHECK_RC(hd_index_build(NULL, NULL, &idx, &e), HD_EINVAL);
+    CHECK_RC(hd_index_build(&G, NULL, NULL, &e), HD_EINVAL);
+    hd_options_t o;
+    hd_options_init(&o);
+    o.threads = -1;
+    CHECK_RC(hd_index_build(&G, &o, &idx, &e), HD_EINVAL);
+    CHECK_RC(hd_index_build(&G, NULL, &idx, &e), HD_OK);
+    CHECK(hd_index_memory(idx) > 0);
+    hd_result_t r;
+    CHECK_RC(hd_index_directed(idx, &E, NULL, NULL, &r, &e), HD_EEMPTY);
+    CHECK_RC(hd_index_directed(idx, &N, NULL, NULL, &r, &e), HD_ENONFINITE);
+    CHECK_RC(hd_index_directed(idx, &G, NULL, NULL, NULL, &e), HD_EINVAL);
+    CHECK_RC(hd_index_directed(NULL, &G, NULL, NULL, &r, &e), HD_EINVAL);
+    /* A transform can carry valid points out of range: refused, not wrong. */
+    hd_transform_t T;
+    hd_transform_identity(&T);
+    T.r[0] = 1e300;
+    double far_[3] = {1e10, 0, 0};
+    hd_points_t F = hd_points_f64(far_, 1);
+    CHECK_RC(hd_index_directed(idx, &F, &T, NULL, &r, &e), HD_ERANGE);
+    double dist[1];
+    CHECK_RC(hd_index_nearest(idx, &F, &T, NULL, dist, NULL, &e), HD_ERANGE);
+    CHECK(strstr(e.message, "point 0") != NULL);
+    hd_index_free(idx);
+    hd_index_free(NULL);
+    CHECK_EQ(hd_index_count(NULL), 0);
+}
+
+TEST(nearest_accepts_either_output_alone) {
+    double b[] = {0, 0, 0, 2, 0, 0, 2, 0, 0};
+    double q[] = {1.5, 0, 0, -1, 0, 0};
+    hd_points_t B = hd_points_f64(b, 3), Q = hd_points_f64(q, 2);
+    hd_index_t *idx;
+    CHECK_RC(hd_index_build(&B, NULL, &idx, NULL), HD_OK);
+    double dist[2];
+    size_t near[2];
+    CHECK_RC(hd_index_nearest(idx, &Q, NULL, NULL, dist, NULL, NULL), HD_OK);
+    CHECK_BITS(dist[0], 0.5);
+    CHECK_BITS(dist[1], 1.0);
+    CHECK_RC(hd_index_nearest(idx, &Q, NULL, NULL, NULL, near, NULL), HD_OK);
+    CHECK_EQ(near[0], 1); /* B[1] and B[2] tie: the smaller index */
+    CHECK_EQ(near[1], 0);
+    hd_index_free(idx);
+}
