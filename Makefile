@@ -53,5 +53,29 @@ python:
 	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release $(CMAKE_ARGS)
 	cmake --build $(BUILD) -j$(JOBS) --target hausdorff_python
 
+# libFuzzer targets, one per reader (fuzz/run.sh, docs/formats.md), each run
+# FUZZ_SECONDS from its seed corpus tests/corpus/FORMAT/; FUZZ_FORMATS picks
+# some ("ply las").  Exits non-zero on a finding.
+FUZZ_SECONDS ?= 60
+FUZZ_FORMATS ?=
+fuzz:
+	@scripts/deps.sh fuzz
+	FUZZ_SECONDS=$(FUZZ_SECONDS) FUZZ_BUILD=build-fuzz fuzz/run.sh $(FUZZ_FORMATS)
+
+# The engine benchmark (docs/benchmarks.md, "Engine"; not part of `make test`):
+# installs the peers (nanoflann, PCL, SciPy, Open3D) and matplotlib, times
+# every case and the scale curve up to 100M points per cloud (about 10 GB of
+# memory), then regenerates the table and the plots.  BENCH_ARGS="--quick"
+# for a short run without the scale curve.
+BENCH_ARGS ?= --scale
+bench:
+	@scripts/deps.sh build extras bench plot
+	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release -DHD_BENCH_PEERS=ON $(CMAKE_ARGS)
+	cmake --build $(BUILD) -j$(JOBS) --target hd_bench nanoflann_hd pcl_hd
+	./$(BUILD)/bench/hd_bench --peers $(BUILD)/bench --scripts bench/peers --data data \
+	  --out $(BUILD)/bench/engine.jsonl $(BENCH_ARGS)
+	/usr/bin/python3 bench/report.py $(BUILD)/bench/engine.jsonl --doc docs/benchmarks.md \
+	  --plots docs/img --command "make bench$(if $(filter-out --scale,$(BENCH_ARGS)), BENCH_ARGS=\"$(BENCH_ARGS)\")"
+
 clean:
-	rm -rf $(BUILD) $(ASAN_BUILD)
+	rm -rf $(BUILD) $(ASAN_BUILD) build-fuzz

@@ -5,6 +5,8 @@
  * Pair "overlapping": A and B both ~ N(0, I), drawn with different seeds.
  * Pair "disjoint":    A ~ N(0, I), B ~ N((20, 0, 0), I), so the bounding
  *                     boxes are apart and the framework picks NOHD.
+ * Pair "identical":   B is a copy of A (h = 0: nothing can be pruned
+ *                     strictly); only run when asked for with --pairs.
  * For each algorithm, hd_hausdorff (both directions) is run --runs times and
  * the median wall-clock time of the call is printed, with the counters of
  * the last run summed over both directions.  NAIVEHDD does |A||B| distances
@@ -12,7 +14,7 @@
  * must equal the first algorithm's bit for bit, or the program fails.
  *
  * usage: algos_bench [--n N] [--runs R] [--naive-runs K] [--threads T]
- *                    [--algorithms a,b,...] [--pairs overlapping,disjoint]
+ *                    [--algorithms a,b,...] [--pairs overlapping,disjoint,identical]
  * Defaults: N = 100000, R = 5, K = 1, T = 1, every algorithm, both pairs.
  * Output: one markdown table row per (pair, algorithm).
  */
@@ -59,7 +61,7 @@ int main(int argc, char **argv) {
         else if (!strcmp(argv[k], "--pairs") && v) pairs = v, k++;
         else {
             fprintf(stderr, "usage: %s [--n N] [--runs R] [--naive-runs K] [--threads T] "
-                            "[--algorithms a,b] [--pairs overlapping,disjoint]\n", argv[0]);
+                            "[--algorithms a,b] [--pairs overlapping,disjoint,identical]\n", argv[0]);
             return 2;
         }
     }
@@ -76,17 +78,21 @@ int main(int argc, char **argv) {
     static const hd_algorithm_t order[] = {HD_ALG_NAIVE, HD_ALG_EARLYBREAK, HD_ALG_INC,
                                            HD_ALG_NOHD,  HD_ALG_OHD,        HD_ALG_FRAMEWORK,
                                            HD_ALG_KDTREE, HD_ALG_AUTO};
-    static const char *const pair_names[] = {"overlapping", "disjoint"};
-    printf("| pair | algorithm (ran) | median s | runs | H | distance evals | nodes visited | points culled |\n");
+    static const char *const pair_names[] = {"overlapping", "disjoint", "identical"};
+    printf("| pair | algorithm (ran) | median s | runs | H | distance evals | nodes visited "
+           "| points culled |\n");
     printf("| --- | --- | ---: | ---: | --- | ---: | ---: | ---: |\n");
     int status = 0;
-    for (int p = 0; p < 2; p++) {
-        if (!listed(pairs, pair_names[p])) continue;
+    for (int p = 0; p < 3; p++) {
+        /* "identical" runs only when named. */
+        if (p == 2 ? !pairs || !listed(pairs, pair_names[p]) : !listed(pairs, pair_names[p]))
+            continue;
         gen_rng_t g;
         double m0[3] = {0, 0, 0}, m1[3] = {p ? 20.0 : 0.0, 0, 0};
         gen_seed(&g, 2017 + (uint64_t)p);
         gen_gauss(&g, a, n, m0, 1.0);
-        gen_gauss(&g, b, n, m1, 1.0);
+        if (p == 2) memcpy(b, a, 3 * n * sizeof *b);
+        else gen_gauss(&g, b, n, m1, 1.0);
         hd_points_t A = hd_points_f64(a, n), B = hd_points_f64(b, n);
         double reference = -1.0;
         for (size_t k = 0; k < sizeof order / sizeof order[0]; k++) {
@@ -117,8 +123,9 @@ int main(int argc, char **argv) {
             double med = r_count % 2 ? times[r_count / 2]
                                      : 0.5 * (times[r_count / 2 - 1] + times[r_count / 2]);
             char ran[64];
-            if (s.ab.algorithm == s.ba.algorithm) snprintf(ran, sizeof ran, "%s", hd_algorithm_name(s.ab.algorithm));
-            else snprintf(ran, sizeof ran, "%s/%s", hd_algorithm_name(s.ab.algorithm), hd_algorithm_name(s.ba.algorithm));
+            const char *ra = hd_algorithm_name(s.ab.algorithm), *rb = hd_algorithm_name(s.ba.algorithm);
+            if (s.ab.algorithm == s.ba.algorithm) snprintf(ran, sizeof ran, "%s", ra);
+            else snprintf(ran, sizeof ran, "%s/%s", ra, rb);
             printf("| %s %zuK/%zuK | %s (%s) | %.3f | %d | %.17g | %llu | %llu | %llu |\n",
                    pair_names[p], n / 1000, n / 1000, name, ran, med, r_count, s.distance,
                    (unsigned long long)(s.ab.stats.distance_evals + s.ba.stats.distance_evals),

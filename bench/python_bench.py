@@ -117,10 +117,11 @@ def cases(n, hausdorff):
     yield "large vs small", lambda: (g(7, n), g(8, small))
     yield "small vs large", lambda: (g(9, small), g(10, n))
 
-    def perturbed():
-        a = g(11, n)
-        return a, a + g(12, n, sigma=1e-3)
-    yield "perturbed copy (noise 1e-3 sigma)", perturbed
+    def perturbed(m):
+        a = g(11, m)
+        return a, a + g(12, m, sigma=1e-3)
+    yield "perturbed copy (noise 1e-3 sigma)", lambda: perturbed(n)
+    yield "perturbed copy, a tenth of the size", lambda: perturbed(max(n // 10, 1))
 
     data = ROOT / "data"
 

@@ -180,6 +180,59 @@ static double policy_value(empty_policy_t p) {
     return p == EMPTY_INF ? INFINITY : p == EMPTY_NAN ? NAN : 0.0;
 }
 
+typedef struct {
+    const char *key;
+    double value;
+} member_t;
+
+/* `, "name": {head, "key": value, ...}` with NaN as null. */
+static void json_object(FILE *out, const char *name, const char *head,
+                        const member_t *m, size_t n) {
+    fprintf(out, ", \"%s\": {%s", name, head ? head : "");
+    for (size_t k = 0; k < n; k++) {
+        fprintf(out, "%s\"%s\": ", k || head ? ", " : "", m[k].key);
+        json_number(out, m[k].value);
+    }
+    fputc('}', out);
+}
+
+/* The percentile, mean and Chamfer members asked for, from r->pct and
+ * r->sum. */
+static void json_figures(FILE *out, const analysis_args_t *an,
+                         const analysis_result_t *r) {
+    const hd_percentile_t *p = &r->pct;
+    const hd_summary_t *s = &r->sum;
+    if (an->percentile_on) {
+        member_t m[] = {{"p", p->p}, {"ab", p->ab}, {"ba", p->ba}, {"symmetric", p->symmetric},
+                        {"pooled", p->pooled}};
+        json_object(out, "percentile", NULL, m, sizeof m / sizeof m[0]);
+    }
+    if (an->mean) {
+        member_t m[] = {{"ab", s->mean_ab}, {"ba", s->mean_ba}, {"symmetric", s->mean_symmetric},
+                        {"average", s->mean_average}, {"pooled", s->mean_pooled}};
+        json_object(out, "mean", NULL, m, sizeof m / sizeof m[0]);
+    }
+    if (an->chamfer) {
+        member_t m[] = {{"value", r->directed ? s->mean2_ab : s->chamfer}, {"mean_squared", s->chamfer},
+                        {"sum_squared", s->chamfer_sum2}, {"mean", s->chamfer_mean}, {"sum", s->chamfer_sum},
+                        {"mean_squared_ab", s->mean2_ab}, {"mean_squared_ba", s->mean2_ba}};
+        json_object(out, "chamfer", "\"definition\": \"mean_squared\"", m, sizeof m / sizeof m[0]);
+    }
+}
+
+/* A result whose every figure is the --empty policy's value v (NaN for
+ * what a directed run does not compute). */
+static void empty_result(analysis_result_t *r, const analysis_args_t *an,
+                         double v, int directed) {
+    memset(r, 0, sizeof *r);
+    r->directed = directed;
+    double w = directed ? NAN : v;
+    r->pct = (hd_percentile_t){an->percentile, v, w, w, w};
+    r->sum.mean_ab = r->sum.mean2_ab = v;
+    r->sum.mean_ba = r->sum.mean_symmetric = r->sum.mean_average = r->sum.mean_pooled = w;
+    r->sum.mean2_ba = r->sum.chamfer = r->sum.chamfer_sum2 = r->sum.chamfer_mean = r->sum.chamfer_sum = w;
+}
+
 /* The per-point files of a run with an empty set: the other set's rows get
  * the policy's distance and nearest index -1; an empty set gets a file with
  * no rows, so that scripts find the files they asked for. */
@@ -229,37 +282,9 @@ int analysis_handle_empty(const analysis_args_t *an, const char *path_a,
         json_string(out, path_a);
         fprintf(out, ", \"file_b\": ");
         json_string(out, path_b);
-        if (an->percentile_on) {
-            fprintf(out, ", \"percentile\": {\"p\": ");
-            json_number(out, an->percentile);
-            const char *keys[] = {"ab", "ba", "symmetric", "pooled"};
-            for (int k = 0; k < 4; k++) {
-                fprintf(out, ", \"%s\": ", keys[k]);
-                if (directed && k) fputs("null", out);
-                else json_number(out, v);
-            }
-            fputc('}', out);
-        }
-        if (an->mean) {
-            fprintf(out, ", \"mean\": {");
-            const char *keys[] = {"ab", "ba", "symmetric", "average", "pooled"};
-            for (int k = 0; k < 5; k++) {
-                fprintf(out, "%s\"%s\": ", k ? ", " : "", keys[k]);
-                if (directed && k) fputs("null", out);
-                else json_number(out, v);
-            }
-            fputc('}', out);
-        }
-        if (an->chamfer) {
-            fprintf(out, ", \"chamfer\": {\"definition\": \"mean_squared\"");
-            const char *keys[] = {"value", "mean_squared", "sum_squared", "mean", "sum"};
-            for (int k = 0; k < 5; k++) {
-                fprintf(out, ", \"%s\": ", keys[k]);
-                if (directed) fputs("null", out);
-                else json_number(out, v);
-            }
-            fputc('}', out);
-        }
+        analysis_result_t r;
+        empty_result(&r, an, v, directed);
+        json_figures(out, an, &r);
         fprintf(out, "}\n");
     } else {
         fprintf(out, "A: %s (%zu points)\nB: %s (%zu points)\n", path_a, n_a, path_b, n_b);
@@ -343,7 +368,8 @@ int analysis_run(const analysis_args_t *an, const hd_options_t *opt,
         const char *base = strrchr(path_a, '/') ? strrchr(path_a, '/') + 1 : path_a;
         const char *base_b = strrchr(path_b, '/') ? strrchr(path_b, '/') + 1 : path_b;
         snprintf(title, sizeof title, "%s (%zu points) coloured by distance to %s", base, A->count, base_b);
-        if ((rc = render_distances(an->render_out, A, B, r->d_ab, scale, s, directed, title, r->markers,
+        int mm = an->mask[0].is_mask || an->mask[1].is_mask;
+        if ((rc = render_distances(an->render_out, A, B, r->d_ab, scale, s, directed, mm, title, r->markers,
                                    &r->n_markers, &r->render_w, &r->render_h, err)))
             return rc;
     }
@@ -362,11 +388,6 @@ void analysis_free(analysis_result_t *r) {
 }
 
 /* ---- reports ------------------------------------------------------------------ */
-
-static void json_member(FILE *out, const char *key, double v, int first) {
-    fprintf(out, "%s\"%s\": ", first ? "" : ", ", key);
-    json_number(out, v);
-}
 
 static void json_counts(FILE *out, const uint64_t *c, size_t n) {
     fputc('[', out);
@@ -403,35 +424,7 @@ void analysis_json(FILE *out, const analysis_args_t *an,
     if (!r->active) return;
     fprintf(out, ", \"distances_seconds\": ");
     json_number(out, r->seconds);
-    if (an->percentile_on) {
-        fprintf(out, ", \"percentile\": {");
-        json_member(out, "p", r->pct.p, 1);
-        json_member(out, "ab", r->pct.ab, 0);
-        json_member(out, "ba", r->pct.ba, 0);
-        json_member(out, "symmetric", r->pct.symmetric, 0);
-        json_member(out, "pooled", r->pct.pooled, 0);
-        fputc('}', out);
-    }
-    if (an->mean) {
-        fprintf(out, ", \"mean\": {");
-        json_member(out, "ab", r->sum.mean_ab, 1);
-        json_member(out, "ba", r->sum.mean_ba, 0);
-        json_member(out, "symmetric", r->sum.mean_symmetric, 0);
-        json_member(out, "average", r->sum.mean_average, 0);
-        json_member(out, "pooled", r->sum.mean_pooled, 0);
-        fputc('}', out);
-    }
-    if (an->chamfer) {
-        fprintf(out, ", \"chamfer\": {\"definition\": \"mean_squared\"");
-        json_member(out, "value", r->directed ? r->sum.mean2_ab : r->sum.chamfer, 0);
-        json_member(out, "mean_squared", r->sum.chamfer, 0);
-        json_member(out, "sum_squared", r->sum.chamfer_sum2, 0);
-        json_member(out, "mean", r->sum.chamfer_mean, 0);
-        json_member(out, "sum", r->sum.chamfer_sum, 0);
-        json_member(out, "mean_squared_ab", r->sum.mean2_ab, 0);
-        json_member(out, "mean_squared_ba", r->sum.mean2_ba, 0);
-        fputc('}', out);
-    }
+    json_figures(out, an, r);
     if (r->hist_ab) {
         fprintf(out, ", \"histogram\": {\"bins\": %zu, \"range\": [", an->bins);
         json_number(out, hd_histogram_edge(r->hist_lo, r->hist_hi, an->bins, 0));
@@ -508,7 +501,7 @@ static void print_histogram(FILE *out, const analysis_args_t *an,
 
 void analysis_print(FILE *out, const analysis_args_t *an,
                     const analysis_result_t *r) {
-    const char *unit = an->mask[0].is_mask || an->mask[1].is_mask ? " mm" : "";
+    const char *unit = an->mask[0].is_mask || an->mask[1].is_mask ? " (mm)" : "";
     for (int k = 0; k < 2; k++) {
         const mask_info_t *m = &an->mask[k];
         if (!m->is_mask) continue;

@@ -112,8 +112,9 @@ void analysis_free(analysis_result_t *r);
 /* ---- files (writers.c) ------------------------------------------------- */
 /* The colour of a distance: viridis at d / dmax (clipped to [0, 1]). */
 void colormap_viridis(double t, unsigned char rgb[3]);
-/* Write points with their distance, nearest index (HD_NONE-free: nearest
- * NULL writes -1) and colour: CSV, PLY or NPY by the path's extension. */
+/* Write points with their distance, the index of their nearest point (-1
+ * for every row when nearest is NULL) and, in PLY, the distance's colour
+ * at d / dmax: CSV, PLY or NPY by the path's extension (writers.c). */
 int write_distances(const char *path, const hd_points_t *P, const double *d,
                     const size_t *nearest, double dmax, hd_error_t *err);
 /* 1 when the path names a format write_distances knows. */
@@ -128,7 +129,7 @@ int render_available(void);
  * bar, the witness pair of the Hausdorff distance marked and labelled. */
 int render_distances(const char *path, const hd_points_t *A,
                      const hd_points_t *B, const double *d_a, double dmax,
-                     const hd_symmetric_t *s, int directed,
+                     const hd_symmetric_t *s, int directed, int mm,
                      const char *title, render_marker_t markers[6],
                      int *n_markers, int *width, int *height,
                      hd_error_t *err);

@@ -146,8 +146,12 @@ int main(int argc, char **argv) {
         analysis_json(out, &a.an, &an);
         fprintf(out, "}\n");
     } else {
-        fprintf(out, "A: %s (%zu points, %s)\n", a.path_a, A.count, ca->format);
-        fprintf(out, "B: %s (%zu points, %s)\n", a.path_b, B.count, cb->format);
+        const char *how = a.read.mesh == HD_MESH_SAMPLE ? " sampled from" : ",";
+        fprintf(out, "A: %s (%zu points, %s", a.path_a, A.count, ca->format);
+        if (ca->n_faces) fprintf(out, "%s %zu faces", how, ca->n_faces);
+        fprintf(out, ")\nB: %s (%zu points, %s", a.path_b, B.count, cb->format);
+        if (cb->n_faces) fprintf(out, "%s %zu faces", how, cb->n_faces);
+        fprintf(out, ")\n");
         if (a.directed) {
             fprintf(out, "h(A,B) = %.17g\n", s.ab.distance);
         } else {

@@ -46,6 +46,11 @@ static const unsigned char WHITE[3] = {255, 255, 255}, BLACK[3] = {0, 0, 0}, GRE
                            FRAME[3] = {170, 170, 170}, DARK[3] = {60, 60, 60}, RED[3] = {255, 0, 0},
                            ORANGE[3] = {255, 140, 0}, BLUE[3] = {49, 104, 142}, AMBER[3] = {230, 150, 30};
 
+static int no_memory(hd_error_t *err) {
+    snprintf(err->message, sizeof err->message, "out of memory for the picture");
+    return err->code = HD_ENOMEM;
+}
+
 static int canvas_init(canvas_t *c, int w, int h) {
     c->w = w;
     c->h = h;
@@ -117,6 +122,9 @@ static int write_png(const char *path, const canvas_t *c, hd_error_t *err) {
         return err->code = HD_EIO;
     }
     png_init_io(png, f);
+    /* unfiltered rows: the pictures are mostly flat colour, which deflate
+     * packs well anyway, and any reader decodes them trivially */
+    png_set_filter(png, 0, PNG_FILTER_NONE);
     png_set_IHDR(png, info, (png_uint_32)c->w, (png_uint_32)c->h, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
                  PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
     png_text meta;
@@ -203,20 +211,30 @@ static void bounds(const hd_points_t *P, double lo[3], double hi[3]) {
 
 int render_distances(const char *path, const hd_points_t *A,
                      const hd_points_t *B, const double *d_a, double dmax,
-                     const hd_symmetric_t *s, int directed,
+                     const hd_symmetric_t *s, int directed, int mm,
                      const char *title, render_marker_t markers[6],
                      int *n_markers, int *width, int *height,
                      hd_error_t *err) {
-    canvas_t c;
+    canvas_t c = {0, 0, NULL};
     int W = GAP + 3 * (PANEL + GAP) + BAR_W + BAR_LABELS, H = TOP + PANEL + BOTTOM;
+    /* points at a quarter of the scale or more: drawn over the surface */
+    size_t n_far = 0;
+    int clipped = 0; /* some distance beyond the scale (--max-distance) */
+    for (size_t k = 0; k < A->count; k++) {
+        n_far += dmax > 0 && d_a[k] >= 0.25 * dmax;
+        clipped |= d_a[k] > dmax;
+    }
     float *zbuf = malloc((size_t)PANEL * PANEL * sizeof *zbuf);
     unsigned char *covered = malloc((size_t)PANEL * PANEL);
-    if (!zbuf || !covered || canvas_init(&c, W, H)) {
-        free(zbuf);
-        free(covered);
-        snprintf(err->message, sizeof err->message, "out of memory for the picture");
-        return err->code = HD_ENOMEM;
+    far_t *far = malloc((n_far ? n_far : 1) * sizeof *far);
+    if (!zbuf || !covered || !far || canvas_init(&c, W, H)) {
+        free(zbuf), free(covered), free(far), free(c.rgb);
+        return no_memory(err);
     }
+    n_far = 0;
+    for (size_t k = 0; k < A->count; k++)
+        if (dmax > 0 && d_a[k] >= 0.25 * dmax) far[n_far].d = d_a[k], far[n_far++].k = k;
+    qsort(far, n_far, sizeof *far, cmp_far);
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     bounds(A, lo, hi);
     bounds(B, lo, hi);
@@ -234,19 +252,6 @@ int render_distances(const char *path, const hd_points_t *A,
         project(1, lo, &u, &v, &zlo[1]), project(1, hi, &u, &v, &zhi[1]);
         project(2, lo, &u, &v, &zlo[2]), project(2, hi, &u, &v, &zhi[2]);
     }
-    /* points at a quarter of the scale or more: drawn over the surface */
-    size_t n_far = 0;
-    for (size_t k = 0; k < A->count; k++) n_far += dmax > 0 && d_a[k] >= 0.25 * dmax;
-    far_t *far = malloc((n_far ? n_far : 1) * sizeof *far);
-    if (!far) {
-        free(zbuf), free(covered), free(c.rgb);
-        snprintf(err->message, sizeof err->message, "out of memory for the picture");
-        return err->code = HD_ENOMEM;
-    }
-    n_far = 0;
-    for (size_t k = 0; k < A->count; k++)
-        if (dmax > 0 && d_a[k] >= 0.25 * dmax) far[n_far].d = d_a[k], far[n_far++].k = k;
-    qsort(far, n_far, sizeof *far, cmp_far);
     int r = (int)lround(0.35 * PANEL / sqrt((double)(A->count + 1)));
     if (r < 1) r = 1;
     if (r > 4) r = 4;
@@ -333,11 +338,17 @@ int render_distances(const char *path, const hd_points_t *A,
     for (int t = 0; t <= 4; t++) {
         int y = by + (int)lround((PANEL - 1) * (1.0 - t / 4.0));
         char buf[64];
-        fmt_num(buf, sizeof buf, dmax * t / 4.0);
+        buf[0] = buf[1] = '>'; /* the top colour stands for everything above */
+        buf[1] = '=';
+        int at = t == 4 && clipped ? 2 : 0;
+        fmt_num(buf + at, sizeof buf - (size_t)at, dmax * t / 4.0);
         fill_rect(&c, bx + BAR_W, y, bx + BAR_W + 6, y + 1, DARK);
         text(&c, bx + BAR_W + 9, y - 8, 2, buf, DARK);
     }
-    text(&c, bx - 4, by - 26, 2, "distance", DARK);
+    const char *bar_title = mm ? "distance (mm)" : "distance";
+    int tx = bx - 4;
+    if (tx + 2 * font_width(bar_title) > W - 4) tx = W - 4 - 2 * font_width(bar_title);
+    text(&c, tx, by - 30, 2, bar_title, DARK);
 
     /* title lines */
     char line2[512], hv[64];
@@ -365,10 +376,7 @@ int render_histogram(const char *path, const analysis_result_t *r,
                      hd_error_t *err) {
     enum { HW = 1000, HH = 580, L = 110, R = 30, T = 104, B = 80 };
     canvas_t c;
-    if (canvas_init(&c, HW, HH)) {
-        snprintf(err->message, sizeof err->message, "out of memory for the picture");
-        return err->code = HD_ENOMEM;
-    }
+    if (canvas_init(&c, HW, HH)) return no_memory(err);
     int pw = HW - L - R, ph = HH - T - B;
     uint64_t top = 1;
     for (size_t k = 0; k < bins; k++) {
@@ -416,7 +424,7 @@ int render_histogram(const char *path, const analysis_result_t *r,
         int y = T + ph - (int)lround((double)ph * f);
         snprintf(buf, sizeof buf, "%.0f", v);
         fill_rect(&c, L - 8, y, L - 2, y + 1, DARK);
-        text(&c, L - 12 - 2 * font_width(buf), y - 8, 2, buf, DARK);
+        if (!logy || v > 0) text(&c, L - 12 - 2 * font_width(buf), y - 8, 2, buf, DARK);
         if (logy) v = v == 0 ? 1 : v * 10;
         else v += (double)top / 5.0;
         if (!logy && v > (double)top + 0.5) break;
@@ -484,11 +492,11 @@ static int unavailable(hd_error_t *err) {
 
 int render_distances(const char *path, const hd_points_t *A,
                      const hd_points_t *B, const double *d_a, double dmax,
-                     const hd_symmetric_t *s, int directed,
+                     const hd_symmetric_t *s, int directed, int mm,
                      const char *title, render_marker_t markers[6],
                      int *n_markers, int *width, int *height,
                      hd_error_t *err) {
-    (void)path, (void)A, (void)B, (void)d_a, (void)dmax, (void)s, (void)directed, (void)title;
+    (void)path, (void)A, (void)B, (void)d_a, (void)dmax, (void)s, (void)directed, (void)mm, (void)title;
     (void)markers, (void)width, (void)height;
     *n_markers = 0;
     return unavailable(err);

@@ -320,8 +320,9 @@ HD_EXTERN int hd_index_nearest(const hd_index_t *idx, const hd_points_t *Q,
  * B against A.  Each output may be NULL (a direction with both outputs NULL
  * is skipped); dist_ab/nearest_ab hold A->count elements, dist_ba/nearest_ba
  * B->count.  Exact: bit-identical to a brute force, at any thread count.
- * Built on the index (one hd_index_build per set, hd_index_nearest in
- * parallel with opt->threads).  Errors: as hd_directed. */
+ * One exact kd-tree per set, each searched by the other set's points and
+ * walked in its own leaf order for its own points' queries; parallel with
+ * opt->threads.  Errors: as hd_directed. */
 HD_EXTERN int hd_distances(const hd_points_t *A, const hd_points_t *B,
                            const hd_options_t *opt, double *dist_ab,
                            size_t *nearest_ab, double *dist_ba,
@@ -432,7 +433,7 @@ typedef struct hd_read_options {
     hd_mesh_mode_t mesh; /* for formats with faces */
     size_t sample;       /* points to sample with HD_MESH_SAMPLE */
     uint64_t seed;       /* sampling seed */
-    int threads;         /* parallel text parsing: 0 = every core */
+    int threads;         /* parsing threads (text and binary): 0 = every core */
 } hd_read_options_t;
 
 /* Fill `opt` with the defaults (by extension, double, vertices). */
@@ -442,8 +443,10 @@ HD_EXTERN void hd_read_options_init(hd_read_options_t *opt);
  * must be given or the content is sniffed).  opt NULL: defaults.
  * Errors: HD_EIO (cannot open or read), HD_EFORMAT (malformed: the message
  *   names the file and the line or byte offset), HD_EUNSUPPORTED, HD_EEMPTY
- *   (no points), HD_ENONFINITE, HD_ERANGE, HD_ENOMEM, HD_EOVERFLOW.
- * No reader allocates more than the file can hold. */
+ *   (no points), HD_ENONFINITE, HD_ERANGE, HD_ENOMEM, HD_EOVERFLOW, HD_EINVAL
+ *   (bad options).  On failure *out is NULL.
+ * No reader allocates more than the file can hold, and nothing is printed.
+ * The formats, their variants and their messages: docs/formats.md. */
 HD_EXTERN int hd_read_file(const char *path, const hd_read_options_t *opt,
                            hd_cloud_t **out, hd_error_t *err);
 

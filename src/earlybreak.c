@@ -4,7 +4,7 @@
  *
  * The paper's Algorithm 2, as corrected in Taha and Hanbury's note:
  *   lines 1-3   cmax <- 0; A and B are visited in random orders;
- *   lines 4-16  for each x, scan B keeping cmin, but stop as soon as some
+ *   lines 4-15  for each x, scan B keeping cmin, but stop as soon as some
  *               d(x, y) < cmax: then x cannot raise cmax, and line 9
  *               (cmin <- 0) makes sure the partial minimum of the scan so far
  *               is not offered as if it were x's nearest-neighbour distance.
@@ -21,13 +21,20 @@
  * tie the answer but not win the tie).  A point that completes its scan
  * keeps the smallest index j of B at its minimum, whatever the order of B.
  *
+ * The scan (hd__scan_break, shared with NOHD's Algorithm 5).  Whether a
+ * scan is cut short does not depend on the order in which B is read, so it
+ * evaluates SCAN_BLOCK distances at a time (a loop the compiler vectorises)
+ * and then tests the block: the decision and the minimum are those of the
+ * point-by-point loop; only distance_evals, which counts what was
+ * evaluated, grows by the rest of the last block.
+ *
  * Excluding common points (paper, Section 3.3, Fig. 1).  Taha and Hanbury
  * intersect voxel grids; on general point sets a grid would merge distinct
  * points, so the common points are found exactly: B's points inside A's box
  * go into a hash set keyed by their coordinates' bits (with -0.0 read as
  * 0.0, since hd__d2 puts them at distance 0) and compared with ==, and each
- * point of A inside the box of those points is looked up.  A
- * common point is at distance 0 from B and cannot raise the maximum unless
+ * point of A inside the box of those points is looked up.  A common point
+ * is at distance 0 from B and cannot raise the maximum unless
  * the answer is 0; in that case every point of A is at distance 0 and the
  * witness is A[0] with the first point of B at distance 0 from it, which
  * hd__earlybreak puts back at the end.
@@ -155,7 +162,7 @@ static void eb_task(void *vctx, size_t task, int worker) {
         double tie = best.i < i ? best.d2 : -1.0, cmin;
         size_t cj;
         if (hd__scan_break(x, br, bidx, nb, hd__bound_get(&c->cmax), tie, &cmin, &cj, &evals)) {
-            hd__best_offer(&best, cmin, i, cj); /* line 15 */
+            hd__best_offer(&best, cmin, i, cj); /* line 14 */
             hd__bound_raise(&c->cmax, cmin);
         } /* else line 9: cmin <- 0, the point offers nothing */
     }

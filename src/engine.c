@@ -38,23 +38,23 @@
 #include "index.h"
 
 #include <math.h>
+#include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
 
 /* ---- one direction ------------------------------------------------------------ */
 
 typedef struct {
-    hd__bcache_t cache;   /* gathered buckets of B */
     hd__counts_t counts;
     uint64_t culled;
-    char pad[64];
 } worker_t;
 
 typedef struct {
     const hd__tree_t *ta, *tb;
-    hd__bound_t cmax;
+    hd__bound_t cmax;     /* the largest exact nearest distance so far */
+    pthread_mutex_t lock; /* guards best */
+    hd__best_t best;      /* the maximum so far with its canonical witness */
     int task_level;
-    hd__best_t *part;
     worker_t *w;
 } dir_ctx;
 
@@ -62,11 +62,33 @@ typedef struct {
 typedef struct {
     dir_ctx *c;
     worker_t *w;
-    hd__best_t best;
-    double bc[3];      /* the last point of B that discarded something */
+    hd__best_t snap;   /* a consistent copy of c->best */
+    double bc[3];      /* the last point of B that discarded something, */
+    double bc_err;     /* known within this distance */
     int have_bc;
     size_t hint;       /* bucket of B where the last search ended */
 } walk_t;
+
+static void walk_init(walk_t *s, dir_ctx *c, worker_t *w) {
+    s->c = c;
+    s->w = w;
+    pthread_mutex_lock(&c->lock);
+    s->snap = c->best;
+    pthread_mutex_unlock(&c->lock);
+    s->have_bc = 0;
+    s->hint = HD__NONE;
+}
+
+/* Record an exact nearest distance: into the shared maximum (canonical
+ * witness by hd__best_offer), the shared bound, and this walk's snapshot. */
+static void offer(walk_t *s, double d2, size_t i, size_t j) {
+    dir_ctx *c = s->c;
+    pthread_mutex_lock(&c->lock);
+    hd__best_offer(&c->best, d2, i, j);
+    s->snap = c->best;
+    pthread_mutex_unlock(&c->lock);
+    hd__bound_raise(&c->cmax, d2);
+}
 
 static size_t node_points(const hd__tree_t *t, int level, size_t i) {
     size_t first = (i << level) * HD__BUCKET;
@@ -75,37 +97,233 @@ static size_t node_points(const hd__tree_t *t, int level, size_t i) {
     return last - first;
 }
 
-/* Resolve point a (original index ia): discard it, or find its exact
- * nearest distance and offer it. */
-static void resolve_point(walk_t *s, const double a[3], size_t ia) {
-    dir_ctx *c = s->c;
-    double cmax2 = hd__bound_get(&c->cmax);
-    if (s->have_bc) {
-        s->w->counts.evals++;
-        if (hd__d2(a, s->bc) < cmax2) {
-            s->w->culled++;
-            return;
-        }
+/* The smallest squared distance between two boxes (0 when they meet). */
+HD__INLINE double box_gap2(const hd__box_t *a, const hd__box_t *b) {
+    double d[3];
+    for (int k = 0; k < 3; k++) {
+        double v = 0.0;
+        if (a->lo[k] > b->hi[k]) v = a->lo[k] - b->hi[k];
+        else if (b->lo[k] > a->hi[k]) v = b->lo[k] - a->hi[k];
+        d[k] = v;
     }
-    hd__hit_t hit;
-    hd__tree_nearest(c->tb, &s->w->cache, a, cmax2, s->hint, &hit, &s->w->counts);
-    s->hint = hit.bucket;
-    memcpy(s->bc, hit.p, sizeof s->bc);
-    s->have_bc = 1;
-    if (hit.d2 < cmax2) return;
-    hd__best_offer(&s->best, hit.d2, ia, hit.j);
-    hd__bound_raise(&c->cmax, hit.d2);
+    return d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
 }
 
-static void walk_bucket(walk_t *s, size_t bk) {
+HD__INLINE double centre_gap2(const hd__box_t *a, const hd__box_t *b) {
+    double d = 0;
+    for (int k = 0; k < 3; k++) {
+        double u = (a->lo[k] + a->hi[k]) - (b->lo[k] + b->hi[k]);
+        d += u * u;
+    }
+    return d;
+}
+
+/* Resolve one exact point a (original index ia) by a search: discard it,
+ * or offer its exact nearest distance.  A point of B at squared distance
+ * < cmax^2 discards it (its nearest distance is below the maximum); so does
+ * one at distance <= the maximum found so far when that maximum was
+ * attained at a smaller index (it cannot be the witness). */
+static void resolve_point(walk_t *s, const double a[3], size_t ia) {
+    double cmax2 = hd__bound_get(&s->c->cmax);
+    double tie2 = ia > s->snap.i ? s->snap.d2 : -1.0;
+    hd__hit_t hit;
+    hd__tree_nearest(s->c->tb, a, cmax2, tie2, s->hint, &hit, &s->w->counts);
+    s->hint = hit.bucket;
+    memcpy(s->bc, hit.p, sizeof s->bc);
+    s->bc_err = hit.perr;
+    s->have_bc = 1;
+    if (hit.killed || hit.d2 < cmax2 || hit.d2 <= tie2) return;
+    offer(s, hit.d2, ia, hit.j);
+}
+
+/* Buckets of B a shared walk may read before the points left over get
+ * their own searches. */
+#define BLOCK_LEAVES 8
+
+/* The points of one bucket of A being resolved together, known through
+ * their quantised copy within err. */
+typedef struct {
+    int m;
+    uint32_t alive; /* bit k: point k not yet discarded */
+    double x[HD__BUCKET], y[HD__BUCKET], z[HD__BUCKET];
+    double err;
+    size_t first;   /* position of point 0 in A's order */
+    uint32_t read;  /* bit k: point k's exact coordinates are in a[k] */
+    double a[HD__BUCKET][3];
+    size_t ia[HD__BUCKET];
+} group_t;
+
+/* The exact coordinates of point k of the group (read once). */
+static const double *group_exact(const hd__tree_t *ta, group_t *g, int k) {
+    if (!(g->read >> k & 1u)) {
+        g->ia[k] = ta->perm[g->first + (size_t)k];
+        hd__src_get(&ta->src, g->ia[k], g->a[k]);
+        g->read |= 1u << k;
+    }
+    return g->a[k];
+}
+
+/* Try bucket i of B on the live points of g; a point is discarded when the
+ * approximations prove some point of the bucket strictly within cmax, or
+ * when the pair is too close to call and its exact distance does.
+ * Returns 1 when the bucket was read. */
+static int try_bucket(walk_t *s, group_t *g, size_t i, double cmax2) {
+    const hd__tree_t *tb = s->c->tb;
+    const hd__bucket_t *bb = &tb->bucket[i];
+    double lim = hd__kill_below(cmax2, g->err + bb->err);
+    double reach = hd__may_reach(cmax2, g->err + bb->err);
+    double lb[HD__BUCKET];
+    for (int k = 0; k < HD__BUCKET; k++) lb[k] = hd__box_lb2s(&bb->box, g->x[k], g->y[k], g->z[k]);
+    uint32_t near = 0;
+    for (int k = 0; k < g->m; k++)
+        if ((g->alive >> k & 1u) && lb[k] < cmax2) near |= 1u << k;
+    if (!near) return 0;
+    double x[HD__BUCKET], y[HD__BUCKET], z[HD__BUCKET];
+    int mb = hd__bucket_decode(tb, i, x, y, z);
+    int close_k[HD__BUCKET], close_b[HD__BUCKET], n_close = 0;
+    for (int k = 0; k < g->m; k++) {
+        if (!(near >> k & 1u)) continue;
+        double d[HD__BUCKET];
+        const double ax = g->x[k], ay = g->y[k], az = g->z[k];
+        for (int q = 0; q < HD__BUCKET; q++) d[q] = hd__d2s(ax, ay, az, x[q], y[q], z[q]);
+        s->w->counts.evals += (uint64_t)mb;
+        double mn = hd__min32(d);
+        if (mn > reach) continue;
+        int arg = hd__find(d, mn);
+        if (mn < lim) {
+            g->alive &= ~(1u << k);
+            s->bc[0] = x[arg], s->bc[1] = y[arg], s->bc[2] = z[arg];
+            s->bc_err = bb->err;
+            s->have_bc = 1;
+            s->hint = i;
+            continue;
+        }
+        close_k[n_close] = k;
+        close_b[n_close++] = arg;
+    }
+    if (!n_close) return 1;
+    /* Pairs too close to call from the approximations (ties, or nearly) are
+     * decided exactly; their scattered loads are started together. */
     const hd__tree_t *ta = s->c->ta;
-    size_t first = bk * HD__BUCKET;
-    size_t m = ta->n - first < HD__BUCKET ? ta->n - first : HD__BUCKET;
-    for (size_t k = 0; k < m; k++) {
-        double a[3];
-        size_t ia = ta->perm[first + k];
-        hd__src_get(&ta->src, ia, a);
-        resolve_point(s, a, ia);
+    if (ta->src.kind != 2 && tb->src.kind != 2) {
+        ptrdiff_t ea = ta->src.kind == 0 ? 24 : 12, eb = tb->src.kind == 0 ? 24 : 12;
+        for (int r = 0; r < n_close; r++) {
+            __builtin_prefetch(ta->src.base + (ptrdiff_t)ta->perm[g->first + (size_t)close_k[r]] * ea);
+            __builtin_prefetch(tb->src.base + (ptrdiff_t)tb->perm[i * HD__BUCKET + (size_t)close_b[r]] * eb);
+        }
+    }
+    for (int r = 0; r < n_close; r++) {
+        int k = close_k[r];
+        const double *a = group_exact(ta, g, k);
+        double b[3];
+        hd__src_get(&tb->src, tb->perm[i * HD__BUCKET + (size_t)close_b[r]], b);
+        double e = hd__d2(a, b);
+        s->w->counts.exact++;
+        if (e < cmax2 || (e <= s->snap.d2 && g->ia[k] > s->snap.i)) {
+            g->alive &= ~(1u << k);
+            memcpy(s->bc, b, sizeof s->bc);
+            s->bc_err = 0;
+            s->have_bc = 1;
+            s->hint = i;
+        }
+    }
+    return 1;
+}
+
+/* Resolve the points of A's bucket bk together, from their quantised copy:
+ * try the last useful point of B on each; then the bucket of B where the
+ * last search ended and its neighbours along B's curve (for nearly
+ * identical sets the nearest points sit at nearly the same place on both
+ * curves); then a short walk of B's tree for the whole bucket, nearest
+ * buckets first.  Every point that the approximations prove irrelevant is
+ * discarded; the points left are read exactly and get their own search. */
+static void walk_bucket(walk_t *s, size_t bk) {
+    const hd__tree_t *ta = s->c->ta, *tb = s->c->tb;
+    group_t g;
+    g.m = hd__bucket_decode(ta, bk, g.x, g.y, g.z);
+    g.err = ta->bucket[bk].err;
+    g.first = bk * HD__BUCKET;
+    g.read = 0;
+    double cmax2 = hd__bound_get(&s->c->cmax);
+    g.alive = g.m == 32 ? 0xffffffffu : (1u << g.m) - 1;
+    if (s->have_bc) {
+        double lim = hd__kill_below(cmax2, g.err + s->bc_err);
+        for (int k = 0; k < g.m; k++)
+            if (hd__d2s(g.x[k], g.y[k], g.z[k], s->bc[0], s->bc[1], s->bc[2]) < lim)
+                g.alive &= ~(1u << k);
+        s->w->counts.evals += (uint64_t)g.m;
+    }
+    if (g.alive) {
+        size_t h = s->hint != HD__NONE ? s->hint : (size_t)((double)bk * (double)tb->nb / (double)ta->nb);
+        if (h >= tb->nb) h = tb->nb - 1;
+        try_bucket(s, &g, h, cmax2);
+        if (g.alive && h + 1 < tb->nb) try_bucket(s, &g, h + 1, cmax2);
+        if (g.alive && h > 0) try_bucket(s, &g, h - 1, cmax2);
+    }
+    const hd__box_t *ba = hd__tree_box(ta, 0, bk);
+    struct {
+        int level;
+        size_t i;
+        double gap2;
+    } stack[2 * HD__MAX_LEVELS + 2];
+    int sp = 0, leaves = 0;
+    /* The shared walk pays when cmax is small next to the bucket (nearly
+     * identical sets): then only the few buckets of B overlapping this one
+     * can discard its points, and the walk visits just those.  When cmax is
+     * larger than the bucket, many buckets of B lie within cmax of it and
+     * per-point searches, ordered by each point's own distance, do better. */
+    double diag2 = 0;
+    for (int k = 0; k < 3; k++) diag2 += (ba->hi[k] - ba->lo[k]) * (ba->hi[k] - ba->lo[k]);
+    if (g.alive && diag2 > cmax2) {
+        stack[0].level = tb->levels - 1;
+        stack[0].i = 0;
+        stack[0].gap2 = box_gap2(ba, hd__tree_box(tb, tb->levels - 1, 0));
+        sp = 1;
+    }
+    while (sp > 0 && g.alive && leaves < BLOCK_LEAVES) {
+        sp--;
+        if (stack[sp].gap2 >= cmax2) continue;
+        int l = stack[sp].level;
+        size_t i = stack[sp].i;
+        s->w->counts.nodes++;
+        if (l == 0) {
+            leaves += try_bucket(s, &g, i, cmax2);
+            continue;
+        }
+        size_t c0 = 2 * i, c1 = 2 * i + 1;
+        const hd__box_t *b0 = hd__tree_box(tb, l - 1, c0);
+        double g0 = box_gap2(ba, b0);
+        if (c1 >= tb->count[l - 1]) {
+            if (g0 < cmax2) stack[sp].level = l - 1, stack[sp].i = c0, stack[sp].gap2 = g0, sp++;
+            continue;
+        }
+        const hd__box_t *b1 = hd__tree_box(tb, l - 1, c1);
+        double g1 = box_gap2(ba, b1);
+        /* Nearer child (by gap, then by centre distance) on top. */
+        if (g0 > g1 || (g0 == g1 && centre_gap2(ba, b0) > centre_gap2(ba, b1))) {
+            size_t t = c0;
+            c0 = c1;
+            c1 = t;
+            double u = g0;
+            g0 = g1;
+            g1 = u;
+        }
+        if (g1 < cmax2) stack[sp].level = l - 1, stack[sp].i = c1, stack[sp].gap2 = g1, sp++;
+        if (g0 < cmax2) stack[sp].level = l - 1, stack[sp].i = c0, stack[sp].gap2 = g0, sp++;
+    }
+    s->w->culled += (uint64_t)(g.m - __builtin_popcount(g.alive));
+    if (!g.alive) return;
+    /* The points left are read exactly; start all their loads at once. */
+    if (ta->src.kind != 2) {
+        ptrdiff_t el = ta->src.kind == 0 ? 24 : 12;
+        for (int k = 0; k < g.m; k++)
+            if ((g.alive >> k & 1u) && !(g.read >> k & 1u))
+                __builtin_prefetch(ta->src.base + (ptrdiff_t)ta->perm[g.first + (size_t)k] * el);
+    }
+    for (int k = 0; k < g.m; k++) {
+        if (!(g.alive >> k & 1u)) continue;
+        const double *a = group_exact(ta, &g, k); /* sets g.ia[k] */
+        resolve_point(s, a, g.ia[k]);
     }
 }
 
@@ -113,12 +331,11 @@ static void walk_node(walk_t *s, int level, size_t i) {
     const hd__tree_t *ta = s->c->ta;
     if (s->have_bc) {
         double cmax2 = hd__bound_get(&s->c->cmax);
-        if (hd__box_ub2(hd__tree_box(ta, level, i), s->bc) < cmax2) {
+        if (hd__box_ub2(hd__tree_box(ta, level, i), s->bc) < hd__kill_below(cmax2, s->bc_err)) {
             s->w->culled += node_points(ta, level, i);
             return;
         }
     }
-    s->w->counts.nodes++;
     if (level == 0) {
         walk_bucket(s, i);
         return;
@@ -130,13 +347,8 @@ static void walk_node(walk_t *s, int level, size_t i) {
 static void walk_task(void *vctx, size_t task, int worker) {
     dir_ctx *c = vctx;
     walk_t s;
-    s.c = c;
-    s.w = &c->w[worker];
-    hd__best_init(&s.best);
-    s.have_bc = 0;
-    s.hint = HD__NONE;
+    walk_init(&s, c, &c->w[worker]);
     walk_node(&s, c->task_level, task);
-    c->part[task] = s.best;
 }
 
 /* Prime cmax with the exact nearest distances of a sample of A: points
@@ -145,23 +357,21 @@ static void walk_task(void *vctx, size_t task, int worker) {
 #define PRIME_SPREAD 64
 #define PRIME_BUCKETS 16
 
-static void prime(dir_ctx *c, hd__best_t *best) {
+static void prime(dir_ctx *c) {
     const hd__tree_t *ta = c->ta;
     walk_t s;
-    s.c = c;
-    s.w = &c->w[0];
-    hd__best_init(&s.best);
-    s.have_bc = 0;
-    s.hint = HD__NONE;
+    /* The points discarded here are walked again later: count the work, not
+     * the discards. */
+    worker_t w;
+    memset(&w, 0, sizeof w);
+    walk_init(&s, c, &w);
     size_t step = ta->n / PRIME_SPREAD + 1;
     for (size_t k = step / 2; k < ta->n; k += step) {
         double a[3];
         size_t ia = ta->perm[k];
         hd__src_get(&ta->src, ia, a);
-        s.have_bc = 0;
         resolve_point(&s, a, ia);
     }
-    /* The buckets with the largest box diagonals (a small selection). */
     size_t top[PRIME_BUCKETS];
     double size[PRIME_BUCKETS];
     int nt = 0;
@@ -184,7 +394,9 @@ static void prime(dir_ctx *c, hd__best_t *best) {
         s.have_bc = 0;
         walk_bucket(&s, top[k]);
     }
-    *best = s.best;
+    c->w[0].counts.evals += w.counts.evals;
+    c->w[0].counts.exact += w.counts.exact;
+    c->w[0].counts.nodes += w.counts.nodes;
 }
 
 /* h(A,B) over built indexes of A and B. */
@@ -195,43 +407,36 @@ static int engine_directed(const hd__tree_t *ta, const hd__tree_t *tb, int threa
     c.ta = ta;
     c.tb = tb;
     hd__bound_init(&c.cmax, 0.0);
+    hd__best_init(&c.best);
     /* Tasks are subtrees of about 64 buckets (1024 points). */
     c.task_level = ta->levels - 1 < 6 ? ta->levels - 1 : 6;
     size_t tasks = ta->count[c.task_level];
     if (threads < 1) threads = 1;
-    c.part = hd__malloc_array(tasks, sizeof *c.part);
     c.w = hd__malloc_array((size_t)threads, sizeof *c.w);
-    if (!c.part || !c.w) {
-        free(c.part);
+    if (!c.w) return hd__err(err, HD_ENOMEM, "out of memory");
+    if (pthread_mutex_init(&c.lock, NULL) != 0) {
         free(c.w);
-        return hd__err(err, HD_ENOMEM, "out of memory");
+        return hd__err(err, HD_ETHREAD, "cannot create a mutex");
     }
-    for (int k = 0; k < threads; k++) {
-        hd__bcache_init(&c.w[k].cache);
-        memset(&c.w[k].counts, 0, sizeof c.w[k].counts);
-        c.w[k].culled = 0;
-    }
-    hd__best_t best;
-    prime(&c, &best);
+    memset(c.w, 0, (size_t)threads * sizeof *c.w);
+    prime(&c);
     int rc = hd__parallel_for(threads, tasks, walk_task, &c);
+    pthread_mutex_destroy(&c.lock);
     if (rc != HD_OK) {
-        free(c.part);
         free(c.w);
         return hd__err(err, rc, "%s", hd_strerror(rc));
     }
-    for (size_t t = 0; t < tasks; t++) hd__best_offer(&best, c.part[t].d2, c.part[t].i, c.part[t].j);
     memset(&out->stats, 0, sizeof out->stats);
     for (int k = 0; k < threads; k++) {
         out->stats.distance_evals += c.w[k].counts.evals;
         out->stats.nodes_visited += c.w[k].counts.nodes;
         out->stats.points_culled += c.w[k].culled;
     }
-    out->distance2 = best.d2;
-    out->distance = sqrt(best.d2);
-    out->i = best.i;
-    out->j = best.j;
+    out->distance2 = c.best.d2;
+    out->distance = sqrt(c.best.d2);
+    out->i = c.best.i;
+    out->j = c.best.j;
     out->algorithm = HD_ALG_AUTO;
-    free(c.part);
     free(c.w);
     return HD_OK;
 }

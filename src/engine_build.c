@@ -32,6 +32,7 @@
  */
 #include "index.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -249,42 +250,86 @@ static int refine(const hd__src_t *src, uint64_t *a, uint64_t *tmp, size_t m, in
     return HD_OK;
 }
 
-/* ---- boxes ------------------------------------------------------------------ */
+/* ---- buckets and boxes ------------------------------------------------------ */
 
 typedef struct {
     hd__tree_t *t;
     int level;
 } boxes_ctx;
 
-#define BOX_TASK 1024 /* buckets (or nodes) per task */
+#define BOX_TASK 512 /* buckets (or nodes) per task */
 
-static void bucket_boxes(void *vctx, size_t task, int worker) {
+/* Bucket b: gather its points, take their exact box, quantise each
+ * coordinate to 16 bits over the box, and measure the error of the
+ * dequantised points (hd__bucket_decode) against the exact ones.  The
+ * computed difference fl(x - x~) is within a factor (1 + 2^-53) of the true
+ * one, so err = sqrt(3) * max |fl(x - x~)| * (1 + slack) bounds the true
+ * Euclidean distance between a point and its approximation. */
+static void make_bucket(hd__tree_t *t, size_t b) {
+    size_t s = b * HD__BUCKET;
+    int m = hd__bucket_size(t, b);
+    double p[3][HD__BUCKET];
+    if (t->src.kind != 2 && b + 1 < t->nb) {
+        /* The points are scattered in memory: ask for the next bucket's
+         * points early so their loads overlap with this bucket's work. */
+        ptrdiff_t el = t->src.kind == 0 ? 24 : 12;
+        size_t e = s + HD__BUCKET, pe = e + HD__BUCKET < t->n ? e + HD__BUCKET : t->n;
+        for (size_t i = e; i < pe; i++) __builtin_prefetch(t->src.base + (ptrdiff_t)t->perm[i] * el);
+    }
+    for (int k = 0; k < m; k++) {
+        double v[3];
+        hd__src_get(&t->src, t->perm[s + (size_t)k], v);
+        p[0][k] = v[0], p[1][k] = v[1], p[2][k] = v[2];
+    }
+    /* Pad a short bucket with copies of its first point, so that the loops
+     * below run over whole buckets (and vectorise). */
+    for (int k = m; k < HD__BUCKET; k++) p[0][k] = p[0][0], p[1][k] = p[1][0], p[2][k] = p[2][0];
+    hd__bucket_t *bk = &t->bucket[b];
+    uint16_t *q = t->q + b * 3 * HD__BUCKET;
+    double err = 0;
+    for (int c = 0; c < 3; c++) {
+        const double *v = p[c];
+        /* Four running extremes each: independent chains, no branches. */
+        double l4[4] = {v[0], v[1], v[2], v[3]}, h4[4] = {v[0], v[1], v[2], v[3]};
+        for (int k = 4; k < HD__BUCKET; k += 4)
+            for (int r = 0; r < 4; r++) {
+                l4[r] = v[k + r] < l4[r] ? v[k + r] : l4[r];
+                h4[r] = v[k + r] > h4[r] ? v[k + r] : h4[r];
+            }
+        double lo = l4[0], hi = h4[0];
+        for (int r = 1; r < 4; r++) {
+            lo = l4[r] < lo ? l4[r] : lo;
+            hi = h4[r] > hi ? h4[r] : hi;
+        }
+        bk->box.lo[c] = lo;
+        bk->box.hi[c] = hi;
+        double step = (hi - lo) * (1.0 / 65535.0);
+        double inv = step > 0 ? 1.0 / step : 0.0;
+        int32_t qi[HD__BUCKET];
+        for (int k = 0; k < HD__BUCKET; k++) {
+            double u = (v[k] - lo) * inv + 0.5; /* >= 0.5: v[k] >= lo */
+            qi[k] = (int32_t)(u < 65535.0 ? u : 65535.0);
+        }
+        double e4[4] = {0, 0, 0, 0};
+        for (int k = 0; k < HD__BUCKET; k += 4)
+            for (int r = 0; r < 4; r++) {
+                /* The dequantised value exactly as hd__bucket_decode computes it. */
+                double d = fabs(v[k + r] - (lo + (double)qi[k + r] * step));
+                e4[r] = d > e4[r] ? d : e4[r];
+            }
+        for (int r = 0; r < 4; r++) err = e4[r] > err ? e4[r] : err;
+        for (int k = 0; k < HD__BUCKET; k++) q[c * HD__BUCKET + k] = (uint16_t)qi[k];
+    }
+    /* sqrt(3) rounded up, and slack for the rounding of this product. */
+    bk->err = err * 1.7320508075688776 * (1 + 1e-12);
+}
+
+static void bucket_task(void *vctx, size_t task, int worker) {
     (void)worker;
     boxes_ctx *c = vctx;
     hd__tree_t *t = c->t;
     size_t lo = task * BOX_TASK, hi = lo + BOX_TASK < t->nb ? lo + BOX_TASK : t->nb;
-    for (size_t bk = lo; bk < hi; bk++) {
-        size_t s = bk * HD__BUCKET, e = s + HD__BUCKET < t->n ? s + HD__BUCKET : t->n;
-        hd__box_t b;
-        double p[3];
-        /* The points are scattered in memory: ask for the next bucket's
-         * points early so their loads overlap with this bucket's work. */
-        if (t->src.kind != 2) {
-            size_t pe = e + HD__BUCKET < t->n ? e + HD__BUCKET : t->n;
-            ptrdiff_t el = t->src.kind == 0 ? 24 : 12;
-            for (size_t i = e; i < pe; i++) __builtin_prefetch(t->src.base + (ptrdiff_t)t->perm[i] * el);
-        }
-        hd__src_get(&t->src, t->perm[s], p);
-        for (int k = 0; k < 3; k++) b.lo[k] = b.hi[k] = p[k];
-        for (size_t i = s + 1; i < e; i++) {
-            hd__src_get(&t->src, t->perm[i], p);
-            for (int k = 0; k < 3; k++) {
-                b.lo[k] = p[k] < b.lo[k] ? p[k] : b.lo[k];
-                b.hi[k] = p[k] > b.hi[k] ? p[k] : b.hi[k];
-            }
-        }
-        t->boxes[bk] = b;
-    }
+    for (size_t b = lo; b < hi; b++) make_bucket(t, b);
 }
 
 static void node_boxes(void *vctx, size_t task, int worker) {
@@ -294,9 +339,9 @@ static void node_boxes(void *vctx, size_t task, int worker) {
     int l = c->level;
     size_t lo = task * BOX_TASK, hi = lo + BOX_TASK < t->count[l] ? lo + BOX_TASK : t->count[l];
     for (size_t i = lo; i < hi; i++) {
-        hd__box_t b = t->boxes[t->off[l - 1] + 2 * i];
-        if (2 * i + 1 < t->count[l - 1]) box_merge(&b, &t->boxes[t->off[l - 1] + 2 * i + 1]);
-        t->boxes[t->off[l] + i] = b;
+        hd__box_t b = *hd__tree_box(t, l - 1, 2 * i);
+        if (2 * i + 1 < t->count[l - 1]) box_merge(&b, hd__tree_box(t, l - 1, 2 * i + 1));
+        t->nodes[t->off[l] + i] = b;
     }
 }
 
@@ -305,14 +350,22 @@ static void node_boxes(void *vctx, size_t task, int worker) {
 void hd__tree_free(hd__tree_t *t) {
     if (!t) return;
     free(t->perm);
-    free(t->boxes);
+    free(t->q);
+    free(t->bucket);
+    free(t->nodes);
     t->perm = NULL;
-    t->boxes = NULL;
+    t->q = NULL;
+    t->bucket = NULL;
+    t->nodes = NULL;
+}
+
+static size_t node_count(const hd__tree_t *t) {
+    return t->levels > 1 ? t->off[t->levels - 1] + 1 : 0;
 }
 
 size_t hd__tree_memory(const hd__tree_t *t) {
-    size_t boxes = t->levels ? t->off[t->levels - 1] + 1 : 0;
-    return t->n * sizeof *t->perm + boxes * sizeof *t->boxes;
+    return t->n * sizeof *t->perm + t->nb * (3 * HD__BUCKET * sizeof *t->q + sizeof *t->bucket) +
+           node_count(t) * sizeof *t->nodes;
 }
 
 int hd__tree_build(hd__tree_t *t, const hd__src_t *src, size_t n, int threads,
@@ -332,9 +385,8 @@ int hd__tree_build(hd__tree_t *t, const hd__src_t *src, size_t n, int threads,
     while (t->count[t->levels - 1] > 1) {
         int l = t->levels++;
         t->count[l] = (t->count[l - 1] + 1) / 2;
-        t->off[l] = t->off[l - 1] + t->count[l - 1];
+        t->off[l] = l == 1 ? 0 : t->off[l - 1] + t->count[l - 1];
     }
-    size_t n_boxes = t->off[t->levels - 1] + 1;
 
     key_ctx kc;
     kc.src = src;
@@ -371,15 +423,17 @@ int hd__tree_build(hd__tree_t *t, const hd__src_t *src, size_t n, int threads,
     for (size_t k = 0; k < n; k++) t->perm[k] = (uint32_t)keys[k];
     free(keys);
     keys = NULL;
-    t->boxes = hd__malloc_array(n_boxes, sizeof *t->boxes);
-    if (!t->boxes) {
+    t->q = hd__malloc_array(t->nb, 3 * HD__BUCKET * sizeof *t->q);
+    t->bucket = hd__malloc_array(t->nb, sizeof *t->bucket);
+    t->nodes = hd__malloc_array(node_count(t), sizeof *t->nodes);
+    if (!t->q || !t->bucket || !t->nodes) {
         rc = HD_ENOMEM;
         goto done;
     }
     boxes_ctx bc;
     bc.t = t;
     bc.level = 0;
-    hd__parallel_for(threads, (t->nb + BOX_TASK - 1) / BOX_TASK, bucket_boxes, &bc);
+    hd__parallel_for(threads, (t->nb + BOX_TASK - 1) / BOX_TASK, bucket_task, &bc);
     for (int l = 1; l < t->levels; l++) {
         bc.level = l;
         hd__parallel_for(threads, (t->count[l] + BOX_TASK - 1) / BOX_TASK, node_boxes, &bc);

@@ -1,94 +1,120 @@
 /*
  * engine_search.c -- exact nearest-neighbour search in the engine's index,
- * with early break, a starting bucket, and a cache of gathered buckets.
+ * with early break and a starting bucket, reading exact coordinates only
+ * where the quantised copy cannot decide.
  *
  * The search is the branch-and-bound of OHD (paper, Algorithm 6, line 6:
  * NNDist(x, Octree_B)) over the implicit tree of index.h, visiting the
  * nearer child first, combined with EARLYBREAK's break (Algorithm 2, lines
  * 8-10; PointToPoints, Algorithm 5, lines 4-6): when the caller only needs
- * to know whether some point of B lies strictly within a bound, the search
- * stops at the first such point.
+ * to know whether some point lies strictly within a bound, the search stops
+ * at the first proof of one.
  *
- * Exactness.  Boxes enclose their points exactly, so a node whose computed
- * lower bound hd__box_lb2 is strictly greater than the best squared distance
- * found cannot hold a nearer point, nor one at the same distance; a node
- * whose bound equals the best is still visited, because it may hold a point
- * at the same distance with a smaller original index.  Within a bucket the
- * minimum is taken over the exact hd__d2s values and ties go to the smallest
- * original index.  The result is therefore the exact nearest squared
- * distance and the smallest index attaining it, whatever the visiting order,
- * the starting bucket or the cache contents.
+ * In a bucket, the squared distance c~ from q to every dequantised point is
+ * computed first (a short loop the compiler vectorises; no fused
+ * multiply-add, the build passes -ffp-contract=off).  Then:
+ *  - c~ < hd__kill_below(stop2, err) proves that the exact squared distance
+ *    is < stop2: the search stops (early break) without reading the point;
+ *  - a point with c~ > hd__may_reach(best, err) provably lies farther than
+ *    the best exact distance so far and is skipped;
+ *  - every other point is read exactly (through the permutation) and its
+ *    exact squared distance hd__d2 is compared, the smallest original index
+ *    winning ties.  The point with the smallest c~ is read first, so `best`
+ *    tightens before the others are judged.
+ * Nodes are pruned with the exact lower bound hd__box_lb2 of their exact
+ * boxes, only when it is strictly greater than the best exact distance (a
+ * node at equal distance may hold a tie with a smaller index).
  *
- * Speed.  The index keeps no copy of the coordinates; a bucket's points are
- * gathered through the permutation into a small direct-mapped cache (per
- * thread) as three arrays, and the distance loop over a bucket is a plain
- * loop over those arrays that the compiler vectorises (without fused
- * multiply-add: the build passes -ffp-contract=off).
+ * So the result is the exact nearest squared distance with the smallest
+ * index attaining it, or a proof that some point is strictly within stop2
+ * (or within tie2), whatever the visiting order and the starting bucket.
  */
 #include "index.h"
 
 #include <math.h>
 
-void hd__bcache_init(hd__bcache_t *c) {
-    for (int s = 0; s < HD__CACHE_SLOTS; s++) c->tag[s] = HD__NONE;
-}
+typedef struct {
+    const hd__tree_t *t;
+    const double *q;
+    double stop2, tie2, kill2; /* kill2 = max(stop2, tie2): what a proof needs */
+    hd__hit_t *hit;
+    hd__counts_t *n;
+} search_t;
 
-int hd__bucket_get(const hd__tree_t *t, hd__bcache_t *c, size_t b, const double **x,
-                   const double **y, const double **z) {
-    size_t s = b % HD__CACHE_SLOTS;
-    size_t first = b * HD__BUCKET;
-    size_t m = t->n - first < HD__BUCKET ? t->n - first : HD__BUCKET;
-    if (c->tag[s] != b) {
-        for (size_t k = 0; k < m; k++) {
-            double p[3];
-            hd__src_get(&t->src, t->perm[first + k], p);
-            c->x[s][k] = p[0];
-            c->y[s][k] = p[1];
-            c->z[s][k] = p[2];
-        }
-        c->tag[s] = b;
+/* Read point k of bucket b exactly and offer it; returns 1 when the search
+ * may stop. */
+static inline int exact_point(search_t *s, size_t b, int k) {
+    const hd__tree_t *t = s->t;
+    hd__hit_t *hit = s->hit;
+    size_t j = t->perm[b * HD__BUCKET + (size_t)k];
+    double p[3];
+    hd__src_get(&t->src, j, p);
+    double d = hd__d2(s->q, p);
+    s->n->exact++;
+    if (d < hit->d2 || (d == hit->d2 && j < hit->j)) {
+        hit->d2 = d;
+        hit->j = j;
+        hit->bucket = b;
+        hit->p[0] = p[0], hit->p[1] = p[1], hit->p[2] = p[2];
+        hit->perr = 0.0;
     }
-    *x = c->x[s];
-    *y = c->y[s];
-    *z = c->z[s];
-    return (int)m;
+    return hit->d2 < s->stop2 || hit->d2 <= s->tie2;
 }
 
-/* Scan bucket b: update *hit (smaller distance, or equal distance with a
- * smaller original index). */
-static inline void scan_bucket(const hd__tree_t *t, hd__bcache_t *c, size_t b, const double q[3],
-                               hd__hit_t *hit, hd__counts_t *n) {
-    const double *x, *y, *z;
-    int m = hd__bucket_get(t, c, b, &x, &y, &z);
-    double d[HD__BUCKET];
-    const double qx = q[0], qy = q[1], qz = q[2];
-    for (int k = 0; k < m; k++) d[k] = hd__d2s(qx, qy, qz, x[k], y[k], z[k]);
-    double dmin = INFINITY;
-    for (int k = 0; k < m; k++) dmin = d[k] < dmin ? d[k] : dmin;
-    n->evals += (uint64_t)m;
-    if (dmin > hit->d2) return;
-    const uint32_t *perm = t->perm + b * HD__BUCKET;
+/* Scan bucket b; returns 1 when the search may stop. */
+static int scan_bucket(search_t *s, size_t b) {
+    const hd__tree_t *t = s->t;
+    double x[HD__BUCKET], y[HD__BUCKET], z[HD__BUCKET], c[HD__BUCKET];
+    int m = hd__bucket_decode(t, b, x, y, z);
+    const double qx = s->q[0], qy = s->q[1], qz = s->q[2];
+    for (int k = 0; k < HD__BUCKET; k++) c[k] = hd__d2s(qx, qy, qz, x[k], y[k], z[k]);
+    s->n->evals += (uint64_t)m;
+    int arg = hd__find(c, hd__min32(c));
+    double err = t->bucket[b].err;
+    if (c[arg] < hd__kill_below(s->kill2, err)) {
+        hd__hit_t *hit = s->hit;
+        hit->killed = 1;
+        hit->bucket = b;
+        hit->p[0] = x[arg], hit->p[1] = y[arg], hit->p[2] = z[arg];
+        hit->perr = err;
+        return 1;
+    }
+    if (c[arg] > hd__may_reach(s->hit->d2, err)) return 0;
+    if (exact_point(s, b, arg)) return 1;
+    double reach = hd__may_reach(s->hit->d2, err);
     for (int k = 0; k < m; k++) {
-        if (d[k] == dmin && (dmin < hit->d2 || perm[k] < hit->j)) {
-            hit->d2 = dmin;
-            hit->j = perm[k];
-            hit->bucket = b;
-            hit->p[0] = x[k];
-            hit->p[1] = y[k];
-            hit->p[2] = z[k];
-        }
+        if (k == arg || c[k] > reach) continue;
+        if (exact_point(s, b, k)) return 1;
+        reach = hd__may_reach(s->hit->d2, err);
     }
+    return 0;
 }
 
-void hd__tree_nearest(const hd__tree_t *t, hd__bcache_t *c, const double q[3], double stop2,
+/* Squared distance from q to the centre of box b (a visiting-order hint). */
+static inline double centre2(const hd__box_t *b, const double q[3]) {
+    double d = 0;
+    for (int k = 0; k < 3; k++) {
+        double u = 0.5 * (b->lo[k] + b->hi[k]) - q[k];
+        d += u * u;
+    }
+    return d;
+}
+
+void hd__tree_nearest(const hd__tree_t *t, const double q[3], double stop2, double tie2,
                       size_t hint, hd__hit_t *hit, hd__counts_t *n) {
+    search_t s;
+    s.t = t;
+    s.q = q;
+    s.stop2 = stop2;
+    s.tie2 = tie2;
+    s.kill2 = stop2 > tie2 ? stop2 : tie2;
+    s.hit = hit;
+    s.n = n;
     hit->d2 = INFINITY;
+    hit->killed = 0;
     hit->j = HD__NONE;
     hit->bucket = HD__NONE;
-    if (hint != HD__NONE) {
-        scan_bucket(t, c, hint, q, hit, n);
-        if (hit->d2 < stop2) return;
-    }
+    if (hint != HD__NONE && scan_bucket(&s, hint)) return;
     struct {
         int level;
         size_t i;
@@ -107,10 +133,7 @@ void hd__tree_nearest(const hd__tree_t *t, hd__bcache_t *c, const double q[3], d
         size_t i = stack[sp].i;
         visited++;
         if (l == 0) {
-            if (i != hint) {
-                scan_bucket(t, c, i, q, hit, n);
-                if (hit->d2 < stop2) break;
-            }
+            if (i != hint && scan_bucket(&s, i)) break;
             continue;
         }
         size_t a = 2 * i, b = 2 * i + 1;
@@ -120,14 +143,17 @@ void hd__tree_nearest(const hd__tree_t *t, hd__bcache_t *c, const double q[3], d
             continue;
         }
         double db = hd__box_lb2(hd__tree_box(t, l - 1, b), q);
-        /* Push the farther child first so the nearer one is searched first. */
-        if (da > db) {
-            size_t s = a;
+        /* Push the farther child first so the nearer one is searched first;
+         * when both bounds are equal (typically 0: q lies in both boxes),
+         * the child whose centre is nearer goes first. */
+        if (da > db || (da == db && centre2(hd__tree_box(t, l - 1, a), q) >
+                                        centre2(hd__tree_box(t, l - 1, b), q))) {
+            size_t u = a;
             a = b;
-            b = s;
-            double u = da;
+            b = u;
+            double v = da;
             da = db;
-            db = u;
+            db = v;
         }
         if (db <= hit->d2) stack[sp].level = l - 1, stack[sp].i = b, stack[sp].lb2 = db, sp++;
         if (da <= hit->d2) stack[sp].level = l - 1, stack[sp].i = a, stack[sp].lb2 = da, sp++;

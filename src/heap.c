@@ -3,7 +3,7 @@
  * DPQ), OHD's NNDist (Algorithm 7, the "ascending order" APQ) and INC.
  *
  * The paper re-sorts its queues after every expansion ("Sort DPQ in
- * descending order using the second element", Algorithm 3 line 18;
+ * descending order using the second element", Algorithm 3 line 17;
  * Algorithm 7 line 15); a binary heap gives the same dequeue order in
  * O(log n) per operation.  The invariant is the usual one: no item comes
  * after its parent in the heap's order (`before` below), so the root is the

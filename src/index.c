@@ -2,41 +2,33 @@
  * index.c -- the public reusable index of B (hd_index_*): build once, query
  * many times, with an optional transform of the query points.
  *
- * The index is the exact kd-tree of kdtree.c over a copy of B, so it keeps
- * no pointer into the caller's memory after hd_index_build returns (the
- * header allows borrowing; this version does not need to).  It is immutable
- * once built: queries only read it, so any number of threads may query it at
- * once.
+ * The index is the engine's index of B (engine_build.c): a permutation of
+ * B in Morton order, buckets with exact boxes and a quantised copy, and a
+ * tree of boxes, about 13 bytes per point.  It borrows B's memory (the
+ * header says so) and reads exact coordinates from it when an approximation
+ * cannot decide.  It is immutable once built, so any number of threads may
+ * query it at once.
  *
- * Queries transform each point of A (or Q) with hd__transform_apply, in the
- * documented order, and check that the transformed point is finite and
- * within HD_MAX_COORD, since a transform can carry a valid point out of
- * range.  Work over A is cut into slices run by hd__parallel_for.
+ * hd_index_directed builds a temporary index of T(A) (the transform applied
+ * on the fly, in the documented order) and runs the engine (engine.c): the
+ * result is exactly h(T(A), B) with the canonical witness.
+ * hd_index_nearest runs one exact search (engine_search.c) per query
+ * point, in slices over threads; each slice starts its searches where the
+ * previous one ended.
  *
- * hd_index_directed computes h(T(A), B) as NAIVEHDD (paper, Algorithm 1)
- * does, with EARLYBREAK's observation (Algorithm 2, line 7: break as soon as
- * cmin < cmax) moved into the tree search: the search for a point a stops as
- * soon as it meets a point of B strictly closer than the current maximum
- * cmax, which all threads share through an atomic.  That is exact and keeps
- * the canonical witness at any thread count: cmax never exceeds the final
- * maximum, so a point whose nearest distance equals or exceeds the final
- * maximum never meets a point strictly closer than cmax, and its search
- * always completes with the exact distance and the smallest nearest index;
- * the slices then merge with hd__best_offer (larger distance, then smaller
- * i).
+ * A transform can carry a valid point out of range, so transformed query
+ * points are checked (finite, within HD_MAX_COORD) before anything else.
  */
-#include "kdtree.h"
+#include "index.h"
 
 #include <math.h>
-#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 
 struct hd_index {
-    hd__kd_t kd;
+    hd_points_t view; /* B, borrowed */
+    hd__tree_t tree;
 };
-
-#define INDEX_SLICE 1024
 
 int hd_index_build(const hd_points_t *B, const hd_options_t *opt, hd_index_t **out,
                    hd_error_t *err) {
@@ -50,8 +42,11 @@ int hd_index_build(const hd_points_t *B, const hd_options_t *opt, hd_index_t **o
     if (rc) return rc;
     hd_index_t *idx = calloc(1, sizeof *idx);
     if (!idx) return hd__err(err, HD_ENOMEM, "cannot allocate an index");
+    idx->view = *B;
+    hd__src_t src;
+    hd__src_init(&src, &idx->view, NULL);
     int threads = hd__thread_count(opt ? opt->threads : 0, B->count);
-    rc = hd__kd_build(&idx->kd, B, threads, err);
+    rc = hd__tree_build(&idx->tree, &src, B->count, threads, err);
     if (rc) {
         free(idx);
         return rc;
@@ -62,134 +57,51 @@ int hd_index_build(const hd_points_t *B, const hd_options_t *opt, hd_index_t **o
 
 void hd_index_free(hd_index_t *idx) {
     if (!idx) return;
-    hd__kd_free(&idx->kd);
+    hd__tree_free(&idx->tree);
     free(idx);
 }
 
-size_t hd_index_count(const hd_index_t *idx) { return idx ? idx->kd.n : 0; }
+size_t hd_index_count(const hd_index_t *idx) { return idx ? idx->tree.n : 0; }
 
 size_t hd_index_memory(const hd_index_t *idx) {
-    return idx ? sizeof *idx + hd__kd_memory(&idx->kd) : 0;
+    return idx ? sizeof *idx + hd__tree_memory(&idx->tree) : 0;
 }
 
-/* ---- shared by both queries -------------------------------------------- */
+/* ---- checking transformed queries ------------------------------------------ */
+
+#define SLICE 4096
 
 typedef struct {
-    const hd_index_t *idx;
-    const hd_points_t *q;
-    const hd_transform_t *T;
+    hd__src_t src;
     size_t n;
-    /* directed */
-    _Atomic uint64_t cmax_bits; /* bits of a non-negative double */
-    hd__best_t *part;
+    size_t *bad; /* per slice: first point out of range, or NONE */
     /* nearest */
+    const hd__tree_t *tree;
     double *dist;
     size_t *nearest;
-    /* both */
-    size_t *bad;            /* per slice: first point out of range, or NONE */
-    hd__kdcount_t *count;   /* per worker */
-    int threads;
+    hd__counts_t *counts; /* per worker */
 } query_ctx;
 
-/* Point k of the query, transformed; 0 when the result is not a valid
- * coordinate triple (non-finite or beyond HD_MAX_COORD). */
-static int query_point(const query_ctx *c, size_t k, double p[3]) {
-    if (!c->T) {
-        hd_points_get(c->q, k, p);
-        return 1;
-    }
-    double raw[3];
-    hd_points_get(c->q, k, raw);
-    hd__transform_apply(c->T, raw, p);
-    for (int d = 0; d < 3; d++)
-        if (!(fabs(p[d]) <= HD_MAX_COORD)) return 0;
-    return 1;
-}
-
-static double bits_to_double(uint64_t u) {
-    double d;
-    memcpy(&d, &u, sizeof d);
-    return d;
-}
-
-/* Raise the shared bound to d2 (>= 0): non-negative doubles order as their
- * bit patterns do, so an integer compare-and-swap maximum suffices. */
-static void raise_bound(_Atomic uint64_t *bits, double d2) {
-    uint64_t want;
-    memcpy(&want, &d2, sizeof want);
-    uint64_t cur = atomic_load_explicit(bits, memory_order_relaxed);
-    while (want > cur &&
-           !atomic_compare_exchange_weak_explicit(bits, &cur, want, memory_order_relaxed,
-                                                  memory_order_relaxed)) {
-    }
-}
-
-static void directed_task(void *vctx, size_t task, int worker) {
+static void check_task(void *vctx, size_t task, int worker) {
+    (void)worker;
     query_ctx *c = vctx;
-    size_t lo = task * INDEX_SLICE, hi = lo + INDEX_SLICE;
-    if (hi > c->n) hi = c->n;
-    hd__best_t best;
-    hd__best_init(&best);
-    c->bad[task] = HD__NONE;
-    for (size_t i = lo; i < hi; i++) {
-        double p[3];
-        if (!query_point(c, i, p)) {
-            c->bad[task] = i;
-            break;
-        }
-        double cmax = bits_to_double(atomic_load_explicit(&c->cmax_bits, memory_order_relaxed));
-        size_t j;
-        double d = hd__kd_nearest(&c->idx->kd, p, cmax, &j, &c->count[worker]);
-        if (d < cmax) continue; /* some point of B is strictly closer than cmax */
-        hd__best_offer(&best, d, i, j);
-        raise_bound(&c->cmax_bits, d);
-    }
-    c->part[task] = best;
-}
-
-static void nearest_task(void *vctx, size_t task, int worker) {
-    query_ctx *c = vctx;
-    size_t lo = task * INDEX_SLICE, hi = lo + INDEX_SLICE;
-    if (hi > c->n) hi = c->n;
+    size_t lo = task * SLICE, hi = lo + SLICE < c->n ? lo + SLICE : c->n;
     c->bad[task] = HD__NONE;
     for (size_t k = lo; k < hi; k++) {
         double p[3];
-        if (!query_point(c, k, p)) {
+        hd__src_get(&c->src, k, p);
+        if (!(fabs(p[0]) <= HD_MAX_COORD && fabs(p[1]) <= HD_MAX_COORD &&
+              fabs(p[2]) <= HD_MAX_COORD)) {
             c->bad[task] = k;
-            break;
+            return;
         }
-        size_t j;
-        double d = hd__kd_nearest(&c->idx->kd, p, 0.0, &j, &c->count[worker]);
-        if (c->dist) c->dist[k] = sqrt(d);
-        if (c->nearest) c->nearest[k] = j;
     }
 }
 
-static int run_query(query_ctx *c, const hd_options_t *opt, hd__task_fn fn, hd_error_t *err) {
-    size_t tasks = (c->n + INDEX_SLICE - 1) / INDEX_SLICE;
-    int threads = hd__thread_count(opt ? opt->threads : 0, tasks);
-    c->threads = threads;
-    c->bad = hd__malloc_array(tasks, sizeof *c->bad);
-    c->count = hd__calloc_array((size_t)threads, sizeof *c->count);
-    int rc = HD_OK;
-    if (!c->bad || !c->count || (fn == directed_task && !c->part)) {
-        rc = hd__err(err, HD_ENOMEM, "out of memory");
-    } else {
-        rc = hd__parallel_for(threads, tasks, fn, c);
-        if (rc != HD_OK) hd__err(err, rc, "%s", hd_strerror(rc));
-    }
-    for (size_t t = 0; rc == HD_OK && t < tasks; t++)
-        if (c->bad[t] != HD__NONE)
-            rc = hd__err(err, HD_ERANGE,
-                         "point %zu of the query is NaN, infinite or beyond 1e153 after "
-                         "the transform",
-                         c->bad[t]);
-    return rc;
-}
-
+/* Validate the view and, with a transform, every transformed point. */
 static int query_begin(const hd_index_t *idx, const hd_points_t *q, const char *what,
                        const hd_transform_t *T, const hd_options_t *opt, query_ctx *c,
-                       hd_error_t *err) {
+                       int *threads, hd_error_t *err) {
     memset(c, 0, sizeof *c);
     if (!idx) return hd__err(err, HD_EINVAL, "index is NULL");
     if (opt && opt->threads < 0)
@@ -197,25 +109,27 @@ static int query_begin(const hd_index_t *idx, const hd_points_t *q, const char *
                        opt->threads);
     int rc = hd__points_check(q, what, NULL, err);
     if (rc) return rc;
-    c->idx = idx;
-    c->q = q;
-    c->T = T;
+    hd__src_init(&c->src, q, T);
     c->n = q->count;
-    atomic_init(&c->cmax_bits, 0);
-    return HD_OK;
+    size_t slices = (c->n + SLICE - 1) / SLICE;
+    *threads = hd__thread_count(opt ? opt->threads : 0, slices);
+    if (!T) return HD_OK;
+    c->bad = hd__malloc_array(slices, sizeof *c->bad);
+    if (!c->bad) return hd__err(err, HD_ENOMEM, "out of memory");
+    hd__parallel_for(*threads, slices, check_task, c);
+    for (size_t t = 0; t < slices; t++)
+        if (c->bad[t] != HD__NONE) {
+            rc = hd__err(err, HD_ERANGE,
+                         "point %zu of %s is NaN, infinite or beyond 1e153 after the transform",
+                         c->bad[t], what);
+            break;
+        }
+    free(c->bad);
+    c->bad = NULL;
+    return rc;
 }
 
-static void query_end(query_ctx *c, hd_stats_t *stats) {
-    if (stats && c->count) {
-        for (int w = 0; w < c->threads; w++) {
-            stats->distance_evals += c->count[w].evals;
-            stats->nodes_visited += c->count[w].nodes;
-        }
-    }
-    free(c->bad);
-    free(c->count);
-    free(c->part);
-}
+/* ---- queries ----------------------------------------------------------------- */
 
 int hd_index_directed(const hd_index_t *idx, const hd_points_t *A, const hd_transform_t *T,
                       const hd_options_t *opt, hd_result_t *out, hd_error_t *err) {
@@ -224,35 +138,48 @@ int hd_index_directed(const hd_index_t *idx, const hd_points_t *A, const hd_tran
     memset(out, 0, sizeof *out);
     double t0 = hd__now();
     query_ctx c;
-    int rc = query_begin(idx, A, "A", T, opt, &c, err);
+    int threads = 1;
+    int rc = query_begin(idx, A, "A", T, opt, &c, &threads, err);
     if (rc) return rc;
-    size_t tasks = (c.n + INDEX_SLICE - 1) / INDEX_SLICE;
-    c.part = hd__malloc_array(tasks, sizeof *c.part);
-    rc = run_query(&c, opt, directed_task, err);
-    if (rc == HD_OK) {
-        hd__best_t best;
-        hd__best_init(&best);
-        for (size_t t = 0; t < tasks; t++) hd__best_offer(&best, c.part[t].d2, c.part[t].i, c.part[t].j);
-        out->distance2 = best.d2;
-        out->distance = sqrt(best.d2);
-        out->i = best.i;
-        out->j = best.j;
-        out->algorithm = HD_ALG_KDTREE;
-    }
-    query_end(&c, &out->stats);
+    threads = hd__thread_count(opt ? opt->threads : 0, A->count > idx->tree.n ? A->count : idx->tree.n);
+    hd__tree_t ta;
+    rc = hd__tree_build(&ta, &c.src, A->count, threads, err);
+    if (rc) return rc;
+    rc = hd__engine_trees(&ta, &idx->tree, threads, out, err);
+    hd__tree_free(&ta);
     out->seconds = hd__now() - t0;
     return rc;
+}
+
+static void nearest_task(void *vctx, size_t task, int worker) {
+    query_ctx *c = vctx;
+    size_t lo = task * SLICE, hi = lo + SLICE < c->n ? lo + SLICE : c->n;
+    size_t hint = HD__NONE;
+    for (size_t k = lo; k < hi; k++) {
+        double p[3];
+        hd__src_get(&c->src, k, p);
+        hd__hit_t hit;
+        hd__tree_nearest(c->tree, p, 0.0, -1.0, hint, &hit, &c->counts[worker]);
+        hint = hit.bucket;
+        if (c->dist) c->dist[k] = sqrt(hit.d2);
+        if (c->nearest) c->nearest[k] = hit.j;
+    }
 }
 
 int hd_index_nearest(const hd_index_t *idx, const hd_points_t *Q, const hd_transform_t *T,
                      const hd_options_t *opt, double *dist, size_t *nearest, hd_error_t *err) {
     hd__err_clear(err);
     query_ctx c;
-    int rc = query_begin(idx, Q, "Q", T, opt, &c, err);
+    int threads = 1;
+    int rc = query_begin(idx, Q, "Q", T, opt, &c, &threads, err);
     if (rc) return rc;
+    c.tree = &idx->tree;
     c.dist = dist;
     c.nearest = nearest;
-    rc = run_query(&c, opt, nearest_task, err);
-    query_end(&c, NULL);
-    return rc;
+    c.counts = hd__calloc_array((size_t)threads, sizeof *c.counts);
+    if (!c.counts) return hd__err(err, HD_ENOMEM, "out of memory");
+    rc = hd__parallel_for(threads, (c.n + SLICE - 1) / SLICE, nearest_task, &c);
+    free(c.counts);
+    if (rc != HD_OK) return hd__err(err, rc, "%s", hd_strerror(rc));
+    return HD_OK;
 }

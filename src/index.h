@@ -1,27 +1,38 @@
 /*
  * index.h -- the engine's spatial index of one point set (internal).
  *
- * An index never copies coordinates: it borrows the caller's view and keeps
- * a permutation (4 bytes per point) that lists the points in Morton order,
- * cut into buckets of HD__BUCKET consecutive points, plus the exact bounding
- * box of every bucket and of every node of an implicit binary tree over the
- * buckets (about 6 bytes per point).  Coordinates are read through the
- * permutation ("gathered") and widened to double, with an optional transform
- * applied on the fly in the documented order, so every distance is computed
- * from exactly the doubles the brute force uses.
+ * An index does not copy coordinates exactly: it borrows the caller's view
+ * and keeps
+ *  - a permutation (4 bytes per point) listing the points in Morton order,
+ *    cut into buckets of HD__BUCKET consecutive points;
+ *  - per bucket, the exact bounding box of its points and a 16-bit
+ *    quantised copy of their coordinates relative to that box (6 bytes per
+ *    point), with `err`, a proven upper bound on the Euclidean distance
+ *    between any point and its dequantised approximation;
+ *  - the exact box of every node of an implicit binary tree over the
+ *    buckets.
+ * That is about 13 bytes per point (with HD__BUCKET = 32).  Exact
+ * coordinates are read through the permutation ("gathered") and widened to
+ * double, with an optional transform applied on the fly in the documented
+ * order, so every exact distance uses the doubles the brute force uses.
+ *
+ * The approximations only ever decide what is provably decided: a point p
+ * known within E of its approximation p~ satisfies |q - p| <= |q - p~| + E,
+ * and hd__kill_below / hd__may_reach turn that into thresholds on the
+ * computed squared distance to p~ with every rounding error accounted for.
  *
  * Tree layout: level 0 holds the buckets; node i of level l+1 covers nodes
  * 2i and 2i+1 of level l (the second may not exist); the top level has one
- * node.  Node (l, i) covers buckets [i << l, (i + 1) << l) and points
- * [(i << l) * HD__BUCKET, ...) of the Morton order.
+ * node.  Node (l, i) covers buckets [i << l, (i + 1) << l).
  */
 #ifndef HD_INDEX_H
 #define HD_INDEX_H
 
 #include "internal.h"
 
-/* Points per bucket. */
-#define HD__BUCKET 16
+/* Points per bucket (at most 32: live points are tracked in 32-bit masks). */
+#define HD__BUCKET 32
+_Static_assert(HD__BUCKET % 4 == 0 && HD__BUCKET <= 32, "bucket size");
 /* Most tree levels (2^40 buckets is far beyond 2^32 points). */
 #define HD__MAX_LEVELS 40
 
@@ -61,16 +72,25 @@ HD__INLINE void hd__src_get(const hd__src_t *s, size_t k, double out[3]) {
     else out[0] = p[0], out[1] = p[1], out[2] = p[2];
 }
 
+/* A bucket: the exact box of its points and the error bound of their
+ * quantised copy. */
+typedef struct hd__bucket {
+    hd__box_t box;
+    double err;
+} hd__bucket_t;
+
 typedef struct hd__tree {
     size_t n;                       /* points */
     hd__src_t src;
     uint32_t *perm;                 /* n original indices in Morton order */
+    uint16_t *q;                    /* per bucket: 32 x, then 32 y, then 32 z */
     size_t nb;                      /* buckets: ceil(n / HD__BUCKET) */
+    hd__bucket_t *bucket;           /* nb buckets */
     int levels;                     /* level 0 .. levels-1; top has 1 node */
     size_t count[HD__MAX_LEVELS];   /* nodes per level */
-    size_t off[HD__MAX_LEVELS];     /* first box of each level in boxes[] */
-    hd__box_t *boxes;               /* exact boxes of all nodes */
-    hd__box_t box;                  /* the set's box (= the top node's) */
+    size_t off[HD__MAX_LEVELS];     /* first box of level l >= 1 in nodes[] */
+    hd__box_t *nodes;               /* exact boxes of the nodes of levels >= 1 */
+    hd__box_t box;                  /* the set's box */
 } hd__tree_t;
 
 /* Build the index of n points read from `src` using `threads` threads.
@@ -82,46 +102,112 @@ void hd__tree_free(hd__tree_t *t);
 size_t hd__tree_memory(const hd__tree_t *t);
 
 HD__INLINE const hd__box_t *hd__tree_box(const hd__tree_t *t, int level, size_t i) {
-    return &t->boxes[t->off[level] + i];
+    return level == 0 ? &t->bucket[i].box : &t->nodes[t->off[level] + i];
+}
+
+HD__INLINE int hd__bucket_size(const hd__tree_t *t, size_t b) {
+    size_t first = b * HD__BUCKET;
+    return (int)(t->n - first < HD__BUCKET ? t->n - first : HD__BUCKET);
+}
+
+/* The dequantised (approximate) coordinates of bucket b, in three arrays;
+ * returns the bucket's point count.  Point k of the bucket lies within
+ * t->bucket[b].err of (x[k], y[k], z[k]). */
+HD__INLINE int hd__bucket_decode(const hd__tree_t *t, size_t b, double *x, double *y,
+                                 double *z) {
+    const hd__bucket_t *bk = &t->bucket[b];
+    const uint16_t *q = t->q + b * 3 * HD__BUCKET;
+    const double unit = 1.0 / 65535.0;
+    double sx = (bk->box.hi[0] - bk->box.lo[0]) * unit;
+    double sy = (bk->box.hi[1] - bk->box.lo[1]) * unit;
+    double sz = (bk->box.hi[2] - bk->box.lo[2]) * unit;
+    int m = hd__bucket_size(t, b);
+    for (int k = 0; k < HD__BUCKET; k++) {
+        x[k] = bk->box.lo[0] + (double)q[k] * sx;
+        y[k] = bk->box.lo[1] + (double)q[HD__BUCKET + k] * sy;
+        z[k] = bk->box.lo[2] + (double)q[2 * HD__BUCKET + k] * sz;
+    }
+    return m;
+}
+
+/* The smallest of c[0..HD__BUCKET).  A short bucket is padded with copies
+ * of its point 0 (engine_build.c), whose values equal c[0], so padding never
+ * changes the minimum.  Four running minima keep the loop free of a serial
+ * dependency. */
+HD__INLINE double hd__min32(const double *c) {
+    double m4[4] = {c[0], c[1], c[2], c[3]};
+    for (int k = 4; k < HD__BUCKET; k += 4)
+        for (int r = 0; r < 4; r++) m4[r] = c[k + r] < m4[r] ? c[k + r] : m4[r];
+    double a = m4[0] < m4[1] ? m4[0] : m4[1], b = m4[2] < m4[3] ? m4[2] : m4[3];
+    return a < b ? a : b;
+}
+
+/* The first position of value v in c (v must occur; always a real point). */
+HD__INLINE int hd__find(const double *c, double v) {
+    int k = 0;
+    while (c[k] != v) k++;
+    return k;
+}
+
+/* The computed lower bound hd__box_lb2 without branches (same values: the
+ * gap on each axis is max(lo - p, p - hi, 0), evaluated as in hd__box_lb2). */
+HD__INLINE double hd__box_lb2s(const hd__box_t *b, double x, double y, double z) {
+    double u, v, gx, gy, gz;
+    u = b->lo[0] - x, v = x - b->hi[0], gx = u > v ? u : v, gx = gx > 0 ? gx : 0;
+    u = b->lo[1] - y, v = y - b->hi[1], gy = u > v ? u : v, gy = gy > 0 ? gy : 0;
+    u = b->lo[2] - z, v = z - b->hi[2], gz = u > v ? u : v, gz = gz > 0 ? gz : 0;
+    return gx * gx + gy * gy + gz * gz;
+}
+
+/* ---- proofs from approximations -------------------------------------------- */
+/* Relative slack that covers every rounding in the computed squared
+ * distances (a few units of 2^-53) and in these thresholds, many times over;
+ * and an absolute floor below which squared distances may have underflowed. */
+#define HD__SLACK 1e-12
+#define HD__TINY 1e-280
+
+/* A computed squared distance c~ = hd__d2s(q, p~) < hd__kill_below(lim, E),
+ * where the true point p lies within E of p~ (and q is exact, or E includes
+ * q's own error), proves that the computed hd__d2s(q, p) < lim.  Returns 0
+ * (nothing is proven, c~ >= 0) when lim is too small. */
+HD__INLINE double hd__kill_below(double lim, double E) {
+    if (!(lim > HD__TINY)) return 0.0;
+    double r = __builtin_sqrt(lim) * (1 - HD__SLACK) - E * (1 + HD__SLACK);
+    if (r <= 0) return 0.0;
+    double t = r * r * (1 - HD__SLACK);
+    return t > HD__TINY ? t : 0.0;
+}
+
+/* A computed c~ > hd__may_reach(best, E) proves hd__d2s(q, p) > best. */
+HD__INLINE double hd__may_reach(double best, double E) {
+    double r = __builtin_sqrt(best) * (1 + HD__SLACK) + E * (1 + HD__SLACK);
+    return r * r * (1 + HD__SLACK) + HD__TINY;
 }
 
 /* ---- searching ----------------------------------------------------------- */
 
-/* A small per-thread cache of gathered buckets (structure of arrays), so
- * that the searches of nearby query points read each bucket's scattered
- * coordinates once. */
-#define HD__CACHE_SLOTS 32
-typedef struct hd__bcache {
-    size_t tag[HD__CACHE_SLOTS];
-    double x[HD__CACHE_SLOTS][HD__BUCKET];
-    double y[HD__CACHE_SLOTS][HD__BUCKET];
-    double z[HD__CACHE_SLOTS][HD__BUCKET];
-} hd__bcache_t;
-
-void hd__bcache_init(hd__bcache_t *c);
-
-/* The gathered coordinates of bucket b of t; returns its point count. */
-int hd__bucket_get(const hd__tree_t *t, hd__bcache_t *c, size_t b, const double **x,
-                   const double **y, const double **z);
-
 /* What a nearest-neighbour search found. */
 typedef struct hd__hit {
-    double d2;       /* squared distance */
-    size_t j;        /* original index in the searched set */
-    size_t bucket;   /* bucket holding it (a hint for the next search) */
-    double p[3];     /* its coordinates */
+    double d2;       /* exact squared distance (when exact) */
+    int killed;      /* 1: the search stopped early, proving d2 < stop2 (or
+                      * <= tie2) for the point below; d2 is then meaningless */
+    size_t j;        /* original index in the searched set (exact hits) */
+    size_t bucket;   /* bucket of the point found (a hint for the next search) */
+    double p[3];     /* its coordinates, known within perr */
+    double perr;     /* 0 for exact coordinates, else the bucket's err */
 } hd__hit_t;
 
 typedef struct hd__counts {
-    uint64_t evals, nodes;
+    uint64_t evals, exact, nodes;
 } hd__counts_t;
 
-/* Exact nearest neighbour of q in t: *hit gets the smallest squared distance
- * and the smallest original index attaining it.  Bucket `hint` (or HD__NONE)
- * is searched first.  With stop2 > 0 the search may stop as soon as it has
- * found a point at squared distance < stop2 (strictly); then hit->d2 < stop2
- * and the hit is that point.  A result >= stop2 is always exact. */
-void hd__tree_nearest(const hd__tree_t *t, hd__bcache_t *c, const double q[3], double stop2,
+/* Exact nearest neighbour of the exact point q in t: hit->d2 is the
+ * smallest squared distance and hit->j the smallest original index
+ * attaining it.  Bucket `hint` (or HD__NONE) is searched first.  The search
+ * may stop as soon as it proves that some point lies at squared distance
+ * < stop2, or <= tie2; it then sets hit->killed.  Pass stop2 = 0 and
+ * tie2 = -1 for a full search. */
+void hd__tree_nearest(const hd__tree_t *t, const double q[3], double stop2, double tie2,
                       size_t hint, hd__hit_t *hit, hd__counts_t *n);
 
 /* ---- the engine ---------------------------------------------------------------- */

@@ -295,7 +295,7 @@ HD__INLINE void hd__bound_raise(hd__bound_t *b, double d2) {
 int hd__scan_break(const double *x, const double *pts, const size_t *idx, size_t n,
                    double bound, double tie, double *d2, size_t *j, uint64_t *evals);
 
-/* EARLYBREAK's loop (Algorithm 2, lines 4-16) over the points of A listed
+/* EARLYBREAK's loop (Algorithm 2, lines 4-15) over the points of A listed
  * in `order` (visited in that order), against B scanned in a random order
  * drawn from rng; with exclude_common, points of A equal to a point of B
  * are skipped (counted in stats->points_culled).  On return *best is the

@@ -18,7 +18,8 @@
  * node's tight box (octree.c), so through the monotone-rounding argument of
  * internal.h they bracket the computed hd__d2 of every point of N: MaxLB
  * never exceeds the true answer, and MinUB is never below the nn distance of
- * any point of N.
+ * any point of N.  CubeToPoints evaluates the same values branch-free, a
+ * block of B at a time (see block_bounds), because it is NOHD's hot loop.
  *
  * The paper's tests made exact and tie-safe:
  *  - line 8 (MinUB >= MaxLB: expand) prunes only when MinUB < MaxLB, so a
@@ -26,7 +27,7 @@
  *    dropped; we apply it to leaves too (the printed algorithm scans every
  *    dequeued leaf), and since the queue is decreasing, the first entry
  *    below MaxLB ends the search;
- *  - Algorithm 4 line 6 (ub(y, C) <= MaxLB: Flag <- false) becomes
+ *  - Algorithm 4 line 5 (ub(y, C) <= MaxLB: Flag <- false) becomes
  *    ub(y, C) < MaxLB: then every point of C is strictly nearer to y than the
  *    answer and cannot be the witness;
  *  - Algorithm 5 breaks when d < MaxLB (strictly, as printed) or when d
@@ -53,7 +54,7 @@
  *
  * Counters: distance_evals counts point-to-point hd__d2 (PointToPoints);
  * nodes_visited counts CubeToPoints calls, each of which evaluates up to
- * |B| box bounds.
+ * 2|B| box bounds.
  */
 #include "heap.h"
 #include "octree.h"
@@ -109,7 +110,7 @@ static void block_bounds(const hd__box_t *box, const double *y, size_t n, double
 
 /* Algorithm 4.  Returns the flag; *ub and *lb are set when it is 1.  The
  * flag and both minima do not depend on the order in which B is scanned, so
- * the test of line 6 is made once per block of CTP_BLOCK points, which keeps
+ * the test of line 5 is made once per block of CTP_BLOCK points, which keeps
  * the loop free of unpredictable branches; the answer is the one the
  * point-by-point loop gives. */
 static int cube_to_points(const hd__onode_t *C, const double *b, size_t nb, double maxlb,
@@ -119,7 +120,7 @@ static int cube_to_points(const hd__onode_t *C, const double *b, size_t nb, doub
         size_t n = nb - j0 < CTP_BLOCK ? nb - j0 : CTP_BLOCK;
         double bu, bl;
         block_bounds(&C->box, b + 3 * j0, n, &bu, &bl);
-        if (early_break && bu < maxlb) return 0; /* lines 6-9 */
+        if (early_break && bu < maxlb) return 0; /* lines 5-7 */
         UB = bu < UB ? bu : UB;
         LB = bl < LB ? bl : LB;
     }
@@ -130,7 +131,7 @@ static int cube_to_points(const hd__onode_t *C, const double *b, size_t nb, doub
 
 /* Algorithm 5.  Returns 1 with the exact nn distance of x in *d2 and the
  * smallest index at that distance in *j, or 0 when the scan was cut short
- * (d < MaxLB, lines 4-6, or d equal to a value found at a smaller index of
+ * (d < MaxLB, lines 4-5, or d equal to a value found at a smaller index of
  * A).  nNOHD never cuts short. */
 static int point_to_points(const double *x, const double *b, size_t nb, double maxlb,
                            double tie, int early_break, double *d2, size_t *j,
@@ -157,7 +158,7 @@ static void nohd_task(void *vctx, size_t task, int worker) {
         const hd__onode_t *N = t->node[it.val];
         if (it.key < hd__bound_get(&c->maxlb)) break; /* line 8, strict */
         if (N->kids) {
-            for (int k = 0; k < N->nkids; k++) { /* lines 9-16 */
+            for (int k = 0; k < N->nkids; k++) { /* lines 9-15 */
                 const hd__onode_t *C = &N->kids[k];
                 double ub, lb;
                 visited++;

@@ -59,21 +59,24 @@ static int add_node(build_t *b, hd__onode_t *nd) {
     return HD_OK;
 }
 
-static void tight_box(const double *pts, size_t begin, size_t count, hd__box_t *box) {
-    hd__box_of(pts + 3 * begin, count, box);
-}
-
 static int all_equal(const hd__box_t *b) {
     return b->lo[0] == b->hi[0] && b->lo[1] == b->hi[1] && b->lo[2] == b->hi[2];
 }
 
-/* Fill node `nd` (begin, count, octant, depth already set) and its subtree;
- * cell_lo is the low corner of its cell. */
+static void box_add(hd__box_t *b, const double *p) {
+    for (int k = 0; k < 3; k++) {
+        if (p[k] < b->lo[k]) b->lo[k] = p[k];
+        if (p[k] > b->hi[k]) b->hi[k] = p[k];
+    }
+}
+
+/* Fill node `nd` (begin, count, box, octant and depth already set) and its
+ * subtree; cell_lo is the low corner of its cell.  A child's tight box is
+ * gathered while its points are moved into place. */
 static int build_node(build_t *b, hd__onode_t *nd, const double cell_lo[3]) {
     hd__octree_t *t = b->t;
     int rc = add_node(b, nd);
     if (rc != HD_OK) return rc;
-    tight_box(t->pts, nd->begin, nd->count, &nd->box);
     nd->kids = NULL;
     nd->nkids = 0;
     if (nd->depth > t->depth) t->depth = nd->depth;
@@ -84,23 +87,28 @@ static int build_node(build_t *b, hd__onode_t *nd, const double cell_lo[3]) {
         return HD_OK;
     }
     /* Stable counting sort of the node's points by octant. */
-    size_t cnt[8] = {0}, start[8];
+    size_t cnt[8] = {0}, start[8], pos[8];
     for (size_t p = nd->begin; p < nd->begin + nd->count; p++)
         cnt[hd__octant(nd->mid, t->pts + 3 * p)]++;
     size_t s = nd->begin;
     int nk = 0;
     for (int o = 0; o < 8; o++) {
-        start[o] = s;
+        start[o] = pos[o] = s;
         s += cnt[o];
         nk += cnt[o] != 0;
     }
-    size_t pos[8];
-    memcpy(pos, start, sizeof pos);
+    hd__box_t kbox[8];
     for (size_t p = nd->begin; p < nd->begin + nd->count; p++) {
-        unsigned o = hd__octant(nd->mid, t->pts + 3 * p);
+        const double *x = t->pts + 3 * p;
+        unsigned o = hd__octant(nd->mid, x);
         size_t q = pos[o]++;
+        if (q == start[o]) {
+            for (int k = 0; k < 3; k++) kbox[o].lo[k] = kbox[o].hi[k] = x[k];
+        } else {
+            box_add(&kbox[o], x);
+        }
         b->tmp_idx[q] = t->idx[p];
-        memcpy(b->tmp_pts + 3 * q, t->pts + 3 * p, 3 * sizeof(double));
+        memcpy(b->tmp_pts + 3 * q, x, 3 * sizeof(double));
     }
     memcpy(t->idx + nd->begin, b->tmp_idx + nd->begin, nd->count * sizeof(size_t));
     memcpy(t->pts + 3 * nd->begin, b->tmp_pts + 3 * nd->begin, nd->count * 3 * sizeof(double));
@@ -115,6 +123,7 @@ static int build_node(build_t *b, hd__onode_t *nd, const double cell_lo[3]) {
         hd__onode_t *c = &kids[k++];
         c->begin = start[o];
         c->count = cnt[o];
+        c->box = kbox[o];
         c->octant = (uint8_t)o;
         c->depth = (uint8_t)(nd->depth + 1);
         double lo[3];
@@ -152,6 +161,7 @@ int hd__octree_build(hd__octree_t *t, const double *xyz, size_t n, int max_depth
         }
         t->root = hd__arena_alloc(&t->arena, sizeof *t->root);
         if (t->root) {
+            t->root->box = box;
             t->root->begin = 0;
             t->root->count = n;
             t->root->octant = 0;

@@ -26,25 +26,27 @@
  * "cannot be over AHD".  Whether the cell's diagonal is <= AHD depends on
  * rounding, and a point exactly at AHD could still be the witness, so we
  * keep the paper's choice of candidates (the leaf whose cell contains x,
- * found by hd__octree_locate with the tree's own split values) but cull x
- * only on a proof that some point of B is strictly nearer than the current
- * Maxlb: the leaf's tight-box upper bound hd__box_ub2 < Maxlb, or else the
- * exact hd__d2 to the leaf's first point < Maxlb.  A culled point's nn
+ * found by hd__octree_locate with the tree's own split values; the cells on
+ * the border of the root reach outwards, so points of A outside B's box are
+ * candidates too) but cull x only on a proof that some point of B is
+ * strictly nearer than the current Maxlb: the leaf's tight-box upper bound
+ * hd__box_ub2 < Maxlb, or else the exact hd__d2 to the leaf's first point
+ * < Maxlb.  A culled point's nn
  * distance is then strictly below the answer.  opt->culling = 0 gives the
  * paper's nOHD (Table 2): every point goes through NNDist.
  *
  * Algorithm 7 (NNDist).  An ascending priority queue (APQ) of (N, lb(x, N))
  * starts with the root at 0 (line 3).  An inner node with lb <= Minlb has
  * its children queued when their lb <= Minlb (lines 7-13); a leaf's points
- * are measured (lines 17-22).  Since the queue is ascending, the first entry
+ * are measured (lines 17-23).  Since the queue is ascending, the first entry
  * with lb > Minlb ends the search (the paper pops and discards the rest one
  * by one, which is the same).  The <= keeps every node that may hold a point
  * at exactly Minlb, so the smallest index of B at the nn distance is found.
- * Line 20's early exit, "if d <= Maxlb then APQ <- empty", is exact only for
- * the distance: a point whose nn distance equals Maxlb may still be the
- * witness if its index is smaller.  We exit when d < Maxlb, or when d equals
- * an exact value already found at a smaller index of A; an exited point
- * offers nothing.
+ * The early exit of lines 19-20, "if d <= Maxlb then APQ <- empty", is
+ * exact only for the distance: a point whose nn distance equals Maxlb may
+ * still be the witness if its index is smaller.  We exit when d < Maxlb, or
+ * when d equals an exact value already found at a smaller index of A; an
+ * exited point offers nothing.
  *
  * Threads: A is cut into slices in index order (hd__parallel_for); Maxlb is
  * shared (hd__bound_t, starting at AHD), each slice's witness starts as
@@ -97,10 +99,10 @@ static int nn_dist(const hd__octree_t *t, hd__heap_t *h, const double *x, double
                 if (lb <= minlb) (void)hd__heap_push(h, lb, C->id);
             }
         } else {
-            for (size_t p = N->begin; p < N->begin + N->count; p++) { /* lines 17-22 */
+            for (size_t p = N->begin; p < N->begin + N->count; p++) { /* lines 17-23 */
                 double d = hd__d2(x, t->pts + 3 * p);
                 (*evals)++;
-                if (d < maxlb || d == tie) return 0; /* line 20, tie-safe */
+                if (d < maxlb || d == tie) return 0; /* lines 19-20, tie-safe */
                 size_t jj = t->idx[p];
                 if (d < minlb || (d == minlb && jj < bj)) {
                     minlb = d;

@@ -17,8 +17,19 @@ import sys
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from cli_analysis_support import (lattice_clouds, main, nearest, run, run_json, same, test,  # noqa: E402
-                                  write_xyz)
+from cli_analysis_support import (lattice_clouds, main, nearest, read_png, run, run_json, same,  # noqa: E402
+                                  test, write_xyz)
+
+
+def pictures_built():
+    """False when the tool was built without libpng (HD_CLI_PNG=OFF)."""
+    return os.environ.get("HD_CLI_PNG", "ON").upper() not in ("OFF", "0", "FALSE", "NO")
+
+
+def refuses_pictures(args):
+    """Without libpng, a picture option is a usage error that says why."""
+    _, err = run(args, expect=1)
+    assert "unavailable" in err and "libpng" in err, err
 
 
 def gauss_clouds(seed, na, nb):
@@ -41,12 +52,16 @@ def cases():
     yield ("1:100", *gauss_clouds(4, 1500, 15))
 
 
-@test
-def percentile_json_is_numpy_percentile_monai_and_medpy(tmp):
+def cases_with_files(tmp):
+    """(name, file A, file B, distances A->B, distances B->A) per case."""
     for name, a, b in cases():
         pa, pb = files(tmp, a, b)
-        dab, _ = nearest(a, b)
-        dba, _ = nearest(b, a)
+        yield name, pa, pb, nearest(a, b)[0], nearest(b, a)[0]
+
+
+@test
+def percentile_json_is_numpy_percentile_monai_and_medpy(tmp):
+    for name, pa, pb, dab, dba in cases_with_files(tmp):
         for p in (0, 5, 50, 95, 99.5, 100, 37.123456789):
             r = run_json(["--percentile", repr(p), pa, pb])
             q = r["percentile"]
@@ -73,10 +88,7 @@ def directed_percentile_has_only_the_ab_figure(tmp):
 
 @test
 def mean_and_chamfer_follow_their_stated_definitions(tmp):
-    for name, a, b in cases():
-        pa, pb = files(tmp, a, b)
-        dab, _ = nearest(a, b)
-        dba, _ = nearest(b, a)
+    for name, pa, pb, dab, dba in cases_with_files(tmp):
         r = run_json(["--mean", "--chamfer", pa, pb])
         m, c = r["mean"], r["chamfer"]
         mab, mba = math.fsum(dab) / len(dab), math.fsum(dba) / len(dba)
@@ -180,18 +192,14 @@ def distances_npy_is_an_n_by_5_float64_array(tmp):
     check_rows(np.load(os.path.join(tmp, "dev_b.npy")), b, *nearest(b, a), "NPY B")
 
 
-def read_png(path):
-    from PIL import Image
-    with Image.open(path) as im:
-        return np.asarray(im.convert("RGB"))
-
-
 @test
 def render_is_a_picture_with_the_witness_pair_marked(tmp):
     a, b = gauss_clouds(10, 3000, 2500)
     b[7] = [6.0, 5.0, -4.0]  # a far point of B: h(B,A) wins, witness B[7]
     pa, pb = files(tmp, a, b)
     png = os.path.join(tmp, "r.png")
+    if not pictures_built():
+        return refuses_pictures(["--render", png, pa, pb])
     r = run_json(["--render", png, pa, pb])
     img = read_png(png)
     rd = r["render"]
@@ -215,6 +223,8 @@ def histogram_png_is_a_picture(tmp):
     a, b = gauss_clouds(11, 800, 700)
     pa, pb = files(tmp, a, b)
     png = os.path.join(tmp, "h.png")
+    if not pictures_built():
+        return refuses_pictures(["--histogram-png", png, pa, pb])
     r = run_json(["--histogram-png", png, "--percentile", "95", pa, pb])
     assert r["histogram_png"] == png
     img = read_png(png)

@@ -49,59 +49,79 @@ static double *lattice_values(gen_rng_t *g, size_t n, int side) {
     return v;
 }
 
-/* Two clouds for per-point tests, by case number: Gaussians, lattices with
- * many equidistant neighbours, duplicates, very unequal sizes. */
-static void make_case(gen_rng_t *g, int kind, double **a, size_t *na, double **b, size_t *nb) {
-    *na = 1 + gen_u64(g) % 400;
-    *nb = 1 + gen_u64(g) % 400;
-    if (kind == 3) *nb = 1 + gen_u64(g) % 4;
-    *a = malloc(24 * *na);
-    *b = malloc(24 * *nb);
+/* Two clouds for per-point tests, by seed: Gaussians, lattices with many
+ * equidistant neighbours, duplicates, very unequal sizes (kind = seed % 4).
+ * case_open sets the failure context to the seed and the kind. */
+typedef struct {
+    double *a, *b;
+    size_t na, nb;
+    hd_points_t A, B;
+} case_t;
+
+static void case_open(case_t *c, uint64_t seed) {
+    int kind = (int)(seed % 4);
+    CONTEXT("seed=%llu kind=%d", (unsigned long long)seed, kind);
+    gen_rng_t g;
+    gen_seed(&g, seed);
+    c->na = 1 + gen_u64(&g) % 400;
+    c->nb = 1 + gen_u64(&g) % 400;
+    if (kind == 3) c->nb = 1 + gen_u64(&g) % 4;
+    c->a = malloc(24 * c->na);
+    c->b = malloc(24 * c->nb);
     double m0[3] = {0, 0, 0}, m1[3] = {0.7, 0, 0};
     if (kind == 0 || kind == 3) {
-        gen_gauss(g, *a, *na, m0, 1.0);
-        gen_gauss(g, *b, *nb, m1, 1.0);
+        gen_gauss(&g, c->a, c->na, m0, 1.0);
+        gen_gauss(&g, c->b, c->nb, m1, 1.0);
     } else if (kind == 1) {
-        gen_lattice(g, *a, *na, 6);
-        gen_lattice(g, *b, *nb, 6);
+        gen_lattice(&g, c->a, c->na, 6);
+        gen_lattice(&g, c->b, c->nb, 6);
     } else {
-        gen_lattice(g, *a, *na, 3); /* duplicates in both */
-        gen_lattice(g, *b, *nb, 3);
-        gen_affine(*b, *nb, 1.0, 0.5);
+        gen_lattice(&g, c->a, c->na, 3); /* duplicates in both */
+        gen_lattice(&g, c->b, c->nb, 3);
+        gen_affine(c->b, c->nb, 1.0, 0.5);
     }
+    c->A = hd_points_f64(c->a, c->na);
+    c->B = hd_points_f64(c->b, c->nb);
+}
+
+static void case_close(case_t *c) {
+    free(c->a);
+    free(c->b);
+}
+
+/* Brute-force distances of the points of p (n) to q (m). */
+static double *brute_distances(const double *p, size_t n, const double *q, size_t m) {
+    double *d = malloc(8 * n);
+    for (size_t i = 0; i < n; i++) d[i] = sqrt(brute_nearest(p + 3 * i, q, m, NULL));
+    return d;
 }
 
 /* ---- per-point distances ---------------------------------------------------- */
 
 TEST(per_point_distances_match_brute_force_in_both_directions) {
-    gen_rng_t g;
     for (uint64_t seed = 1; seed <= 40; seed++) {
-        int kind = (int)(seed % 4);
-        CONTEXT("seed=%llu kind=%d", (unsigned long long)seed, kind);
-        gen_seed(&g, seed);
-        double *a, *b;
-        size_t na, nb;
-        make_case(&g, kind, &a, &na, &b, &nb);
-        hd_points_t A = hd_points_f64(a, na), B = hd_points_f64(b, nb);
+        case_t c;
+        case_open(&c, seed);
         hd_options_t o;
         hd_options_init(&o);
         o.threads = (int)(seed % 3) + 1;
-        double *dab = malloc(8 * na), *dba = malloc(8 * nb);
-        size_t *jab = malloc(sizeof(size_t) * na), *jba = malloc(sizeof(size_t) * nb);
-        CHECK_RC(hd_distances(&A, &B, &o, dab, jab, dba, jba, NULL), HD_OK);
-        for (size_t i = 0; i < na && !hdt_failed(); i++) {
+        double *dab = malloc(8 * c.na), *dba = malloc(8 * c.nb);
+        size_t *jab = malloc(sizeof(size_t) * c.na), *jba = malloc(sizeof(size_t) * c.nb);
+        CHECK_RC(hd_distances(&c.A, &c.B, &o, dab, jab, dba, jba, NULL), HD_OK);
+        for (size_t i = 0; i < c.na && !hdt_failed(); i++) {
             size_t j;
-            double d2 = brute_nearest(a + 3 * i, b, nb, &j);
+            double d2 = brute_nearest(c.a + 3 * i, c.b, c.nb, &j);
             CHECK_BITS(dab[i], sqrt(d2));
             CHECK_EQ(jab[i], j);
         }
-        for (size_t i = 0; i < nb && !hdt_failed(); i++) {
+        for (size_t i = 0; i < c.nb && !hdt_failed(); i++) {
             size_t j;
-            double d2 = brute_nearest(b + 3 * i, a, na, &j);
+            double d2 = brute_nearest(c.b + 3 * i, c.a, c.na, &j);
             CHECK_BITS(dba[i], sqrt(d2));
             CHECK_EQ(jba[i], j);
         }
-        free(a), free(b), free(dab), free(dba), free(jab), free(jba);
+        free(dab), free(dba), free(jab), free(jba);
+        case_close(&c);
     }
 }
 
@@ -221,61 +241,52 @@ TEST(percentiles_leave_the_callers_values_untouched) {
 }
 
 TEST(percentile_100_is_the_hausdorff_distance_and_0_the_smallest_distance) {
-    gen_rng_t g;
     for (uint64_t seed = 1; seed <= 12; seed++) {
-        int kind = (int)(seed % 4);
-        CONTEXT("seed=%llu kind=%d", (unsigned long long)seed, kind);
-        gen_seed(&g, seed);
-        double *a, *b;
-        size_t na, nb;
-        make_case(&g, kind, &a, &na, &b, &nb);
-        hd_points_t A = hd_points_f64(a, na), B = hd_points_f64(b, nb);
+        case_t c;
+        case_open(&c, seed);
         hd_percentile_t p100, p0;
         hd_symmetric_t s;
-        CHECK_RC(hd_hausdorff_percentile(&A, &B, NULL, 100, &p100, NULL), HD_OK);
-        CHECK_RC(hd_hausdorff_percentile(&A, &B, NULL, 0, &p0, NULL), HD_OK);
-        CHECK_RC(hd_hausdorff(&A, &B, NULL, &s, NULL), HD_OK);
+        CHECK_RC(hd_hausdorff_percentile(&c.A, &c.B, NULL, 100, &p100, NULL), HD_OK);
+        CHECK_RC(hd_hausdorff_percentile(&c.A, &c.B, NULL, 0, &p0, NULL), HD_OK);
+        CHECK_RC(hd_hausdorff(&c.A, &c.B, NULL, &s, NULL), HD_OK);
         CHECK_BITS(p100.ab, s.ab.distance);
         CHECK_BITS(p100.ba, s.ba.distance);
         CHECK_BITS(p100.symmetric, s.distance);
         CHECK_BITS(p100.pooled, s.distance);
-        double mn = INFINITY;
-        for (size_t i = 0; i < na; i++) {
-            double d = sqrt(brute_nearest(a + 3 * i, b, nb, NULL));
-            if (d < mn) mn = d;
-        }
+        double *d = brute_distances(c.a, c.na, c.b, c.nb), mn = INFINITY;
+        for (size_t i = 0; i < c.na; i++)
+            if (d[i] < mn) mn = d[i];
         CHECK_BITS(p0.ab, mn);
-        free(a), free(b);
+        free(d);
+        case_close(&c);
     }
 }
 
 TEST(percentile_hausdorff_has_monai_symmetric_and_medpy_pooled_figures) {
     gen_rng_t g;
+    gen_seed(&g, 99);
     for (uint64_t seed = 1; seed <= 20; seed++) {
-        int kind = (int)(seed % 4);
-        CONTEXT("seed=%llu kind=%d", (unsigned long long)seed, kind);
-        gen_seed(&g, seed);
-        double *a, *b;
-        size_t na, nb;
-        make_case(&g, kind, &a, &na, &b, &nb);
-        double *dab = malloc(8 * na), *both = malloc(8 * (na + nb));
-        for (size_t i = 0; i < na; i++) both[i] = dab[i] = sqrt(brute_nearest(a + 3 * i, b, nb, NULL));
-        for (size_t i = 0; i < nb; i++) both[na + i] = sqrt(brute_nearest(b + 3 * i, a, na, NULL));
+        case_t c;
+        case_open(&c, seed);
+        double *dab = brute_distances(c.a, c.na, c.b, c.nb), *dba = brute_distances(c.b, c.nb, c.a, c.na);
+        double *both = malloc(8 * (c.na + c.nb));
+        memcpy(both, dab, 8 * c.na);
+        memcpy(both + c.na, dba, 8 * c.nb);
         double p = seed % 2 ? 95.0 : 100.0 * gen_unit(&g);
-        hd_points_t A = hd_points_f64(a, na), B = hd_points_f64(b, nb);
         hd_percentile_t r;
-        CHECK_RC(hd_hausdorff_percentile(&A, &B, NULL, p, &r, NULL), HD_OK);
-        double ab = ref_percentile(dab, na, p), ba = ref_percentile(both + na, nb, p);
+        CHECK_RC(hd_hausdorff_percentile(&c.A, &c.B, NULL, p, &r, NULL), HD_OK);
+        double ab = ref_percentile(dab, c.na, p), ba = ref_percentile(dba, c.nb, p);
         CHECK_BITS(r.p, p);
         CHECK_BITS(r.ab, ab);
         CHECK_BITS(r.ba, ba);
         CHECK_BITS(r.symmetric, ab > ba ? ab : ba);
-        CHECK_BITS(r.pooled, ref_percentile(both, na + nb, p));
+        CHECK_BITS(r.pooled, ref_percentile(both, c.na + c.nb, p));
         hd_percentile_t dir;
-        CHECK_RC(hd_percentile_of(dab, na, NULL, 0, p, &dir, NULL), HD_OK);
+        CHECK_RC(hd_percentile_of(dab, c.na, NULL, 0, p, &dir, NULL), HD_OK);
         CHECK_BITS(dir.ab, ab);
         CHECK(isnan(dir.ba) && isnan(dir.symmetric) && isnan(dir.pooled));
-        free(a), free(b), free(dab), free(both);
+        free(dab), free(dba), free(both);
+        case_close(&c);
     }
 }
 

@@ -84,7 +84,7 @@ TEST(sampling_chooses_faces_in_proportion_to_their_area) {
 }
 
 TEST(the_same_mesh_in_obj_off_ply_and_stl_gives_the_same_samples) {
-    const char *obj = tf_printf("m.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nf 1 2 3\nf 1 3 4\nf 2 5 3\n");
+    const char *obj = tf_printf("m.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nf 1 2 3 # first\nf 1 3 4\nf 2 5 3\n");
     const char *off = tf_printf("m.off", "OFF\n5 3 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n2 0 0\n3 0 1 2\n3 0 2 3\n3 1 4 2\n");
     const char *ply = tf_printf("m.ply", "ply\nformat ascii 1.0\nelement vertex 5\nproperty double x\nproperty double y\n"
                                          "property double z\nelement face 3\nproperty list uchar uint vertex_indices\nend_header\n"

@@ -13,16 +13,19 @@
  * described to the library by its data pointer and its two byte strides
  * (hd_points_t.stride and .cstride, negative allowed), so C order, Fortran
  * order, slices with steps and reversed views are all read in place.  Only
- * three cases copy: other numeric types (integers, float16, long double) are
- * converted to float64 as numpy would; non-native byte order is swapped; and
- * a zero stride (np.broadcast_to) is materialised, because the library
- * reads a zero stride as "packed".  The array object is held for as long as
+ * four cases copy: other numeric types (integers, float16, long double) are
+ * converted to float64 as numpy would; non-native byte order is swapped;
+ * misaligned data (np.frombuffer at an odd offset) is aligned, since the
+ * library may read packed doubles through a double pointer; and a zero
+ * stride (np.broadcast_to) is materialised, because the library reads a zero
+ * stride as "packed".  The array object is held for as long as
  * the library may read it, and the GIL is released only around library
  * calls, which touch no Python object.
  *
  * An Index keeps its own C-ordered copy of the indexed points: the library's
- * index borrows the memory it was built on, and a Python caller could
- * otherwise change or free that array while the index lives.  The copy is
+ * index may borrow the memory it was built on (hausdorff.h allows it), and a
+ * Python caller could otherwise change or free that array while the index
+ * lives.  The copy is
  * made once and never written again, so queries from many Python threads at
  * once are safe (the C index is immutable).
  *
@@ -35,11 +38,11 @@
  */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
-#include <structmember.h>
 
 #define NPY_NO_DEPRECATED_API NPY_1_7_API_VERSION
 #include <numpy/arrayobject.h>
 
+#include <limits.h>
 #include <math.h>
 #include <string.h>
 
@@ -121,7 +124,7 @@ static int points_from_object(PyObject *obj, const char *name, points_arg_t *out
     npy_intp s0 = PyArray_STRIDE(arr, 0), s1 = PyArray_STRIDE(arr, 1);
     /* The library reads a zero stride as "packed": materialise broadcasts. */
     int zero_stride = s1 == 0 || (s0 == 0 && PyArray_DIM(arr, 0) > 1);
-    if (want != type || !PyArray_ISNOTSWAPPED(arr) || zero_stride) {
+    if (want != type || !PyArray_ISNOTSWAPPED(arr) || !PyArray_ISALIGNED(arr) || zero_stride) {
         PyArrayObject *c = (PyArrayObject *)PyArray_FromArray(
             arr, PyArray_DescrFromType(want), NPY_ARRAY_CARRAY | NPY_ARRAY_FORCECAST);
         Py_DECREF(arr);
@@ -166,7 +169,7 @@ static int parse_threads(PyObject *obj, int *threads) {
     }
     long v = PyLong_AsLong(obj);
     if (v == -1 && PyErr_Occurred()) return -1;
-    if (v < 0 || v > 1 << 20) {
+    if (v < 0 || v > INT_MAX) {
         PyErr_Format(PyExc_ValueError,
                      "threads must be None (every core) or a positive number, not %ld", v);
         return -1;
@@ -189,7 +192,7 @@ static int parse_options(const char *algorithm, PyObject *threads, PyObject *see
         return -1;
     }
     if (parse_threads(threads, &opt->threads)) return -1;
-    if (seed && seed != Py_None) {
+    if (seed) {
         if (!PyLong_Check(seed)) {
             PyErr_Format(PyExc_TypeError, "seed must be an int, not %.100s",
                          Py_TYPE(seed)->tp_name);

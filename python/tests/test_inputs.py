@@ -21,6 +21,8 @@ def layouts(x):
         "reversed columns": np.ascontiguousarray(x[:, ::-1])[:, ::-1],
         "list of lists": x.tolist(),
         "big-endian": x.astype(">f8"),
+        "misaligned": np.frombuffer(b"\0" + x.tobytes(), dtype=np.float64,
+                                    offset=1).reshape(-1, 3),
         "read-only": (lambda y: (y.setflags(write=False), y)[1])(x.copy()),
     }
 
@@ -146,5 +148,7 @@ def test_bad_options_are_rejected_clearly():
         hausdorff.directed(a, b, threads=1.5)
     with pytest.raises(ValueError, match="seed"):
         hausdorff.directed(a, b, seed=-1)
+    with pytest.raises(TypeError, match="seed"):
+        hausdorff.directed(a, b, seed=None)    # explicit seeds only
     with pytest.raises(TypeError):
         hausdorff.directed(a, b, 0)          # options are keyword-only

@@ -13,8 +13,9 @@
  * first bad point; the first bad point in the file (the lowest block that
  * has one) is the one reported, so the error does not depend on the thread
  * count.  The common layouts (three float32 or three float64 in the
- * machine's byte order) get a loop without a type switch; every other
- * layout goes through hd__ld_value.
+ * machine's byte order, and LAS's three scaled int32) get a loop without a
+ * type switch; every other layout goes through hd__ld_value, which computes
+ * the same values.
  */
 #include "io.h"
 
@@ -55,8 +56,9 @@ static void convert(void *ctx, size_t task, int worker) {
     hd__sink_t *s = j->r->sink;
     size_t lo = task * BLOCK, hi = lo + BLOCK < L->n ? lo + BLOCK : L->n;
     double lim = s->dtype == HD_FLOAT32 ? (double)FLT_MAX : HD_MAX_COORD;
-    int same = L->type[0] == L->type[1] && L->type[1] == L->type[2] && L->big == host_big() && !L->scale;
-    int f32 = same && L->type[0] == HD__T_F32, f64 = same && L->type[0] == HD__T_F64;
+    int same = L->type[0] == L->type[1] && L->type[1] == L->type[2] && L->big == host_big();
+    int f32 = same && !L->scale && L->type[0] == HD__T_F32, f64 = same && !L->scale && L->type[0] == HD__T_F64;
+    int i32 = same && L->scale && L->type[0] == HD__T_I32; /* LAS */
     j->bad[task] = SIZE_MAX;
     size_t rec_i = lo / L->per, sub_i = lo % L->per;
     for (size_t k = lo; k < hi; k++) {
@@ -78,6 +80,12 @@ static void convert(void *ctx, size_t task, int worker) {
             memcpy(&p[0], rec + L->off[0], 8);
             memcpy(&p[1], rec + L->off[1], 8);
             memcpy(&p[2], rec + L->off[2], 8);
+        } else if (i32) {
+            int32_t v[3];
+            memcpy(&v[0], rec + L->off[0], 4);
+            memcpy(&v[1], rec + L->off[1], 4);
+            memcpy(&v[2], rec + L->off[2], 4);
+            for (int c = 0; c < 3; c++) p[c] = (double)v[c] * L->scale[c] + L->offset[c];
         } else {
             load(L, rec, p);
         }

@@ -74,6 +74,11 @@ int hd__mesh_sample(const double *xyz, size_t nv, const hd__tris_t *t,
                     size_t n, uint64_t seed, hd__sink_t *out,
                     const char *name, hd_error_t *err);
 
+/* hd_read_file on bytes already in memory: `name` names them in messages
+ * and gives the extension; opt must not be NULL.  For the fuzzers. */
+int hd__read_buffer(const void *data, size_t size, const char *name,
+                    const hd_read_options_t *opt, hd_cloud_t **out, hd_error_t *err);
+
 /* ---- one reader call --------------------------------------------------- */
 typedef struct hd__read {
     const hd__file_t *f;
@@ -141,16 +146,17 @@ HD__INLINE int hd__token(const char **p, const char *eol, const char **tb,
 }
 
 /* Text parsed in parallel: [begin, end) is cut at line ends into chunks;
- * fn parses one chunk's whole lines into its own points (and triangles),
- * counting lines; on the first problem it records a code, the 1-based line
- * within the chunk and a message, and stops.  The chunks are merged in file
+ * fn parses one chunk's whole lines into its own points (and triangles)
+ * and sets c->lines to the number of lines it parsed; on the first problem
+ * it records a code, the 1-based line within the chunk and a message, and
+ * stops.  The chunks are merged in file
  * order, so points keep their order and the error reported is the first in
  * the file, with its line number: `first_line` is the number of the line at
  * `begin`. */
 typedef struct hd__chunk {
     const char *begin, *end; /* whole lines */
     int index;               /* 0 for the chunk at `begin` */
-    long long lines;         /* lines in the chunk (set by the framework) */
+    long long lines;         /* lines parsed: set by fn when it finishes */
     hd__sink_t pts;
     hd__tris_t tris;
     uint64_t aux;            /* free for the reader (e.g. faces counted) */

@@ -37,6 +37,7 @@ static int find_key(const char *p, const char *end, const char *key, const char 
         const char *c = skip_ws(q + n + 2, end);
         if (c >= end || *c != ':') continue;
         c = skip_ws(c + 1, end);
+        if (c == end) return 0;
         const char *e = c;
         if (e < end && *e == '(') {
             while (e < end && *e != ')') e++;

@@ -53,26 +53,29 @@ int hd__parse_double(const char *s, const char *end, double *out) {
     const char *p = s;
     int neg = 0;
     if (p < end && (*p == '-' || *p == '+')) neg = *p++ == '-';
+    /* Leading zeros are not significant; the other digits accumulate in m,
+     * which wraps only when there are more than 19 of them (then sig > 19
+     * sends the token to strtod). */
+    const char *z = p;
+    while (p < end && *p == '0') p++;
+    long digits = (long)(p - z), frac = 0, sig;
     uint64_t m = 0;
-    int digits = 0, sig = 0, frac = 0;
-    while (p < end && (unsigned)(*p - '0') < 10) {
-        if (m || *p != '0') sig++;
-        m = m * 10 + (uint64_t)(*p - '0'); /* wraps only when sig > 19 */
-        digits++;
-        p++;
-    }
+    const char *d = p;
+    while (p < end && (unsigned)(*p - '0') < 10) m = m * 10 + (uint64_t)(*p++ - '0');
+    sig = (long)(p - d);
+    digits += sig;
     if (p < end && *p == '.') {
-        p++;
-        while (p < end && (unsigned)(*p - '0') < 10) {
-            if (m || *p != '0') sig++;
-            m = m * 10 + (uint64_t)(*p - '0');
-            digits++;
-            frac++;
-            p++;
-        }
+        const char *f = ++p;
+        if (m == 0)
+            while (p < end && *p == '0') p++;
+        const char *fd = p;
+        while (p < end && (unsigned)(*p - '0') < 10) m = m * 10 + (uint64_t)(*p++ - '0');
+        frac = (long)(p - f);
+        sig += (long)(p - fd);
+        digits += frac;
     }
     if (digits == 0) return slow_path(s, end, out);
-    long e10 = -(long)frac;
+    long e10 = -frac;
     if (p < end && (*p == 'e' || *p == 'E')) {
         const char *q = p + 1;
         int eneg = 0;

@@ -9,7 +9,8 @@
  * "v//vn" or "v/vt/vn"; v counts from 1 in file order, and a negative v
  * counts back from the latest vertex (-1 is the vertex just above).  Every
  * other statement (vt, vn, g, o, s, usemtl, mtllib, l, p, curves) and '#'
- * comments are ignored, and so is a trailing '\' continuation's tail.
+ * comments (also at the end of an "f" line) are ignored; a trailing '\'
+ * continuation ends the face (continued lines are not joined).
  *
  * The file is parsed in parallel chunks of whole lines.  A chunk does not
  * know how many vertices came before it, so a relative reference is stored
@@ -74,7 +75,7 @@ static void chunk(void *ctx, hd__chunk_t *c) {
             size_t n = 0, cap = 64;
             uint64_t *ix = idx;
             while (hd__token(&q, eol, &tb, &te)) {
-                if (*tb == '\\') break;
+                if (*tb == '\\' || *tb == '#') break;
                 int64_t v;
                 if (!face_ref(tb, te, &v)) {
                     hd__chunk_fail(c, HD_EFORMAT, line, "face: '%.*s' is not a vertex reference", (int)(te - tb > 40 ? 40 : te - tb), tb);
@@ -107,6 +108,7 @@ static void chunk(void *ctx, hd__chunk_t *c) {
             }
         }
     }
+    c->lines = line;
 }
 
 /* Resolve relative references now that the vertices before the chunk are
@@ -137,7 +139,7 @@ static int report_bad_reference(hd__read_t *r, size_t nv) {
         if (*tb != 'f') continue;
         while (hd__token(&q, eol, &tb, &te)) {
             int64_t v;
-            if (*tb == '\\' || !face_ref(tb, te, &v)) break;
+            if (*tb == '\\' || *tb == '#' || !face_ref(tb, te, &v)) break;
             int64_t abs_ = v > 0 ? v - 1 : (int64_t)seen + v;
             if (abs_ < 0 || (uint64_t)abs_ >= nv)
                 return hd__io_err_line(r, HD_EFORMAT, line, "face refers to vertex %lld, but the file has %zu vertices",

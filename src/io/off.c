@@ -103,6 +103,7 @@ static void chunk(void *ctx, hd__chunk_t *c) {
         }
         c->aux++;
     }
+    c->lines = line;
 }
 
 /* A token stream over the header lines, skipping comments. */

@@ -196,6 +196,7 @@ static void chunk(void *ctx, hd__chunk_t *c) {
             return;
         }
     }
+    c->lines = line;
 }
 
 /* binary_compressed with fields of different sizes: x, y, z each in their

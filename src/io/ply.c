@@ -400,6 +400,7 @@ static void vertex_chunk(void *ctx, hd__chunk_t *c) {
             }
         }
     }
+    c->lines = line;
 }
 
 static int read_ascii(ply_t *p, int v, const int *xyz, int face_el, int face) {

@@ -202,7 +202,7 @@ static int load(const char *path, hd__file_t *f, int *mapped, hd_error_t *err) {
             close(fd);
             return hd__err(err, HD_EOVERFLOW, "%s: too large to map", path);
         }
-        void *p = mmap(NULL, (size_t)st.st_size, PROT_READ, MAP_PRIVATE, fd, 0);
+        void *p = mmap(NULL, (size_t)st.st_size, PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, 0);
         close(fd);
         if (p == MAP_FAILED)
             return hd__err(err, HD_EIO, "%s: cannot map: %s", path, strerror(errno));
@@ -283,65 +283,58 @@ static int parse(const format_t *fmt, const hd__file_t *f, const hd_read_options
     return rc;
 }
 
-int hd_read_file(const char *path, const hd_read_options_t *opt,
-                 hd_cloud_t **out, hd_error_t *err) {
-    hd__err_clear(err);
-    if (!path || !out) return hd__err(err, HD_EINVAL, "path or result pointer is NULL");
-    *out = NULL;
-    hd_read_options_t defaults;
-    if (!opt) {
-        hd_read_options_init(&defaults);
-        opt = &defaults;
-    }
+static int check_options(const char *path, const hd_read_options_t *opt, hd_error_t *err) {
     if (opt->dtype != HD_FLOAT64 && opt->dtype != HD_FLOAT32)
         return hd__err(err, HD_EINVAL, "%s: unknown storage type %d", path, (int)opt->dtype);
     if (opt->mesh != HD_MESH_VERTICES && opt->mesh != HD_MESH_SAMPLE)
         return hd__err(err, HD_EINVAL, "%s: unknown mesh mode %d", path, (int)opt->mesh);
     if (opt->mesh == HD_MESH_SAMPLE && opt->sample == 0)
         return hd__err(err, HD_EINVAL, "%s: sampling needs a positive number of points", path);
-    const format_t *fmt = NULL;
-    int from_extension = 0;
+    return HD_OK;
+}
+
+/* The format named by the option, else by the extension (NULL when
+ * neither says; *from_extension tells which). */
+static int choose(const char *path, const hd_read_options_t *opt, const format_t **fmt, int *from_extension,
+                  hd_error_t *err) {
+    *fmt = NULL;
+    *from_extension = 0;
     if (opt->format) {
         if (strcasecmp(opt->format, "laz") == 0) return laz_refused(path, err);
-        fmt = by_name(opt->format);
-        if (!fmt) return hd__err(err, HD_EUNSUPPORTED, "%s: unknown format '%s'", path, opt->format);
+        *fmt = by_name(opt->format);
+        if (!*fmt) return hd__err(err, HD_EUNSUPPORTED, "%s: unknown format '%s'", path, opt->format);
     } else if (strcmp(path, "-") != 0) {
         const char *ext = extension(path);
         if (ext && strcasecmp(ext, "laz") == 0) return laz_refused(path, err);
-        fmt = by_extension(path);
-        from_extension = fmt != NULL;
+        *fmt = by_extension(path);
+        *from_extension = *fmt != NULL;
     }
-    hd__file_t f;
-    int mapped, rc = load(path, &f, &mapped, err);
-    if (rc) return rc;
+    return HD_OK;
+}
+
+/* Everything after loading: confirm the format, parse, make the cloud. */
+static int read_loaded(const hd__file_t *f, const format_t *fmt, int from_extension,
+                       const hd_read_options_t *opt, hd_cloud_t **out, hd_error_t *err) {
     if (!fmt) {
-        fmt = by_content(&f);
-        if (!fmt) {
-            unload(&f, mapped);
-            return hd__err(err, HD_EUNSUPPORTED,
-                           "%s: cannot tell the format from the %s; use --format (see --formats)", f.name,
-                           strcmp(path, "-") == 0 ? "content" : "extension or the content");
-        }
-    } else if (from_extension && fmt->magic && !fmt->magic(f.data, f.size)) {
-        const format_t *seems = by_content(&f);
-        if (seems && seems != fmt && seems->magic) {
-            unload(&f, mapped);
-            return hd__err(err, HD_EFORMAT, "%s: the name says %s but the content is %s; use --format %s",
-                           path, fmt->name, seems->name, seems->name);
-        }
+        fmt = by_content(f);
+        if (!fmt)
+            return hd__err(err, HD_EUNSUPPORTED, "%s: cannot tell the format from the %s; use --format (see --formats)",
+                           f->name, from_extension < 0 ? "content" : "extension or the content");
+    } else if (from_extension > 0 && fmt->magic && !fmt->magic(f->data, f->size)) {
+        const format_t *seems = by_content(f);
+        if (seems && seems != fmt && seems->magic)
+            return hd__err(err, HD_EFORMAT, "%s: the name says %s but the content is %s; use --format %s", f->name,
+                           fmt->name, seems->name, seems->name);
     }
-    if (opt->mesh == HD_MESH_SAMPLE && !fmt->faces) {
-        unload(&f, mapped);
+    if (opt->mesh == HD_MESH_SAMPLE && !fmt->faces)
         return hd__err(err, HD_EUNSUPPORTED, "%s: %s holds points, not faces; sampling needs a mesh (ply, obj, off, stl)",
-                       f.name, fmt->name);
-    }
+                       f->name, fmt->name);
     hd__sink_t sink;
     hd__sink_init(&sink, opt->dtype);
     size_t faces = 0;
-    rc = parse(fmt, &f, opt, &sink, &faces, err);
-    unload(&f, mapped);
+    int rc = parse(fmt, f, opt, &sink, &faces, err);
     hd_cloud_t *c = NULL;
-    if (rc == HD_OK && !(c = malloc(sizeof *c))) rc = hd__err(err, HD_ENOMEM, "%s: out of memory", path);
+    if (rc == HD_OK && !(c = malloc(sizeof *c))) rc = hd__err(err, HD_ENOMEM, "%s: out of memory", f->name);
     if (rc) {
         hd__sink_free(&sink);
         return rc;
@@ -358,6 +351,42 @@ int hd_read_file(const char *path, const hd_read_options_t *opt,
     snprintf(c->format, sizeof c->format, "%s", fmt->name);
     *out = c;
     return HD_OK;
+}
+
+int hd_read_file(const char *path, const hd_read_options_t *opt,
+                 hd_cloud_t **out, hd_error_t *err) {
+    hd__err_clear(err);
+    if (!path || !out) return hd__err(err, HD_EINVAL, "path or result pointer is NULL");
+    *out = NULL;
+    hd_read_options_t defaults;
+    if (!opt) {
+        hd_read_options_init(&defaults);
+        opt = &defaults;
+    }
+    const format_t *fmt;
+    int from_extension;
+    int rc = check_options(path, opt, err);
+    if (rc || (rc = choose(path, opt, &fmt, &from_extension, err))) return rc;
+    if (!fmt && strcmp(path, "-") == 0) from_extension = -1;
+    hd__file_t f;
+    int mapped;
+    if ((rc = load(path, &f, &mapped, err))) return rc;
+    rc = read_loaded(&f, fmt, from_extension, opt, out, err);
+    unload(&f, mapped);
+    return rc;
+}
+
+int hd__read_buffer(const void *data, size_t size, const char *name,
+                    const hd_read_options_t *opt, hd_cloud_t **out, hd_error_t *err) {
+    hd__err_clear(err);
+    *out = NULL;
+    const format_t *fmt;
+    int from_extension;
+    int rc = check_options(name, opt, err);
+    if (rc || (rc = choose(name, opt, &fmt, &from_extension, err))) return rc;
+    static const unsigned char empty[1];
+    hd__file_t f = {name, size ? data : empty, size};
+    return read_loaded(&f, fmt, from_extension, opt, out, err);
 }
 
 void hd_cloud_free(hd_cloud_t *cloud) {

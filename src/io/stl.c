@@ -61,6 +61,7 @@ static void chunk(void *ctx, hd__chunk_t *c) {
             return;
         }
     }
+    c->lines = line;
 }
 
 /* The first facet that does not have exactly three vertices (serial; only

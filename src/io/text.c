@@ -9,9 +9,9 @@
  * the first problem records the code, its line within the chunk and a
  * message, then stops.  Afterwards the chunks are visited in file order: the
  * first chunk with a problem gives THE error, whose absolute line is the
- * region's first line plus the lines of all earlier chunks (counted here for
- * chunks that stopped early, so the count never depends on timing), and
- * otherwise the points are appended in order.  The result is therefore the
+ * region's first line plus the lines of all earlier chunks (each chunk
+ * that finished reports its count; the framework counts the newlines of
+ * one that did not say), and otherwise the points are appended in order.  The result is therefore the
  * same, point for point and error for error, at any thread count.
  */
 #include "io.h"
@@ -149,6 +149,7 @@ int hd__text_parallel(hd__read_t *r, const char *begin, const char *end,
         c->begin = p;
         c->end = stop;
         c->index = (int)used;
+        c->lines = -1;
         hd__sink_init(&c->pts, r->sink->dtype);
         hd__tris_init(&c->tris);
         used++;
@@ -157,6 +158,11 @@ int hd__text_parallel(hd__read_t *r, const char *begin, const char *end,
     run_t run = {chunks, fn, ctx};
     int rc = hd__parallel_for(r->threads, used, run_chunk, &run);
     if (rc) hd__io_err(r, rc, "could not parse in parallel: %s", hd_strerror(rc));
+    /* room for every point once, rather than growing while appending */
+    size_t total = 0;
+    for (size_t k = 0; k < used && !chunks[k].rc; k++) total += chunks[k].pts.count;
+    if (rc == HD_OK && (rc = hd__sink_reserve(r->sink, total)))
+        hd__io_err(r, rc, "out of memory for %zu points", total);
     long long line = first_line;
     uint64_t aux = 0;
     for (size_t k = 0; k < used && rc == HD_OK; k++) {
@@ -165,7 +171,7 @@ int hd__text_parallel(hd__read_t *r, const char *begin, const char *end,
             rc = hd__io_err_line(r, c->rc, line + c->err_line - 1, "%s", c->msg);
             break;
         }
-        line += count_lines(c->begin, c->end);
+        line += c->lines >= 0 ? c->lines : count_lines(c->begin, c->end);
         aux += c->aux;
         if (fix) fix(ctx, c, r->sink->count);
         if ((rc = hd__sink_append(r->sink, &c->pts)) ||

@@ -18,6 +18,8 @@
  */
 #include "io.h"
 
+#include <math.h>
+
 static int is_sep(int c) { return c == ' ' || c == '\t' || c == '\r' || c == ',' || c == ';' || c == '\f' || c == '\v'; }
 
 static void chunk(void *ctx, hd__chunk_t *c) {
@@ -51,7 +53,7 @@ static void chunk(void *ctx, hd__chunk_t *c) {
             if (got == 0) continue;
             while (q < eol && is_sep((unsigned char)*q)) q++;
             double n = v[0];
-            if (q == eol && n >= 0 && n == (double)(uint64_t)n) continue;
+            if (q == eol && n >= 0 && n < 0x1p64 && n == floor(n)) continue;
         }
         if (got < 3) {
             hd__chunk_fail(c, HD_EFORMAT, line, "expected 3 numbers (x y z), found %d", got);
@@ -63,6 +65,7 @@ static void chunk(void *ctx, hd__chunk_t *c) {
             return;
         }
     }
+    c->lines = line;
 }
 
 int hd__read_xyz(hd__read_t *r) {

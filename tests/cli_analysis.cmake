@@ -1,0 +1,38 @@
+# cli_analysis.cmake -- the analysis tests written in Python (numpy is the
+# reference for percentiles and histograms, so they need an interpreter that
+# has it: Debian's /usr/bin/python3, installed by scripts/deps.sh python).
+#   cli_analysis        the command line's analysis options
+#   cli_analysis_nifti  NIfTI masks (only when the tool has libnifti2)
+#   cli_analysis_lib    hd_percentiles / hd_histogram against numpy through
+#                       ctypes (not in the sanitizer build: an ASan library
+#                       cannot be loaded into an uninstrumented interpreter)
+set(HD_ANALYSIS_PYTHON "")
+foreach(_hd_cand /usr/bin/python3 python3)
+  if(NOT HD_ANALYSIS_PYTHON)
+    execute_process(COMMAND ${_hd_cand} -c "import numpy, scipy"
+      RESULT_VARIABLE _hd_rc OUTPUT_QUIET ERROR_QUIET)
+    if(_hd_rc EQUAL 0)
+      set(HD_ANALYSIS_PYTHON ${_hd_cand})
+    endif()
+  endif()
+endforeach()
+if(NOT HD_ANALYSIS_PYTHON)
+  message(STATUS "analysis tests in Python: skipped (no python3 with numpy and scipy; "
+                 "scripts/deps.sh python installs them)")
+  return()
+endif()
+
+add_test(NAME cli_analysis
+  COMMAND ${HD_ANALYSIS_PYTHON} ${CMAKE_CURRENT_SOURCE_DIR}/tests/cli_analysis.py $<TARGET_FILE:hausdorff_cli>)
+set_tests_properties(cli_analysis PROPERTIES ENVIRONMENT "HD_CLI_PNG=${HD_CLI_PNG}" TIMEOUT 600)
+if(HD_CLI_NIFTI)
+  add_test(NAME cli_analysis_nifti
+    COMMAND ${HD_ANALYSIS_PYTHON} ${CMAKE_CURRENT_SOURCE_DIR}/tests/cli_analysis_nifti.py
+            $<TARGET_FILE:hausdorff_cli>)
+  set_tests_properties(cli_analysis_nifti PROPERTIES TIMEOUT 600)
+endif()
+if(NOT HD_SANITIZE)
+  add_test(NAME cli_analysis_lib
+    COMMAND ${HD_ANALYSIS_PYTHON} ${CMAKE_CURRENT_SOURCE_DIR}/tests/cli_analysis_lib.py
+            $<TARGET_FILE:hausdorff>)
+endif()

@@ -1,0 +1,215 @@
+"""Command-line tests of reading: exit codes and messages for bad input in
+every format, standard input, --format, --formats, --sample, --version,
+--help, and the progress bar (only on a terminal, never with --quiet or
+--json).  Standard library only (unittest); run as:
+    cli_io.py PATH/TO/hausdorff [ReadingCli.test_NAME ...]
+"""
+import json
+import os
+import pty
+import select
+import struct
+import subprocess
+import sys
+import tempfile
+import time
+import unittest
+
+TESTS = []
+TOOL = None  # the hausdorff executable, from the command line
+HERE = os.path.dirname(os.path.abspath(__file__))
+DATA = os.path.join(os.path.dirname(HERE), "data")
+
+
+def test(fn):
+    TESTS.append(fn)
+    return fn
+
+
+def run(*args, stdin=None):
+    p = subprocess.run([TOOL] + list(args), input=stdin, capture_output=True, timeout=120)
+    return p.returncode, p.stdout.decode(), p.stderr.decode()
+
+
+def write(d, name, data):
+    path = os.path.join(d, name)
+    with open(path, "wb") as f:
+        f.write(data.encode() if isinstance(data, str) else data)
+    return path
+
+
+def expect_bad(path, needle, code=2, args=()):
+    rc, out, err = run(*args, path, os.path.join(DATA, "pinion_gear.ply"))
+    assert rc == code, "%s: exit %d, expected %d (stderr %r)" % (path, rc, code, err)
+    assert err.startswith("hausdorff: "), err
+    assert needle in err, "%r lacks %r" % (err, needle)
+    assert out == "", out
+
+
+PLY_HEAD = "ply\nformat ascii 1.0\nelement vertex {n}\nproperty float x\nproperty float y\nproperty float z\nend_header\n"
+
+
+@test
+def bad_text_input_exits_2_naming_the_file_and_line(d):
+    expect_bad(write(d, "a.xyz", "1 2 3\n4 five 6\n"), "a.xyz:2: 'five' is not a number")
+    expect_bad(write(d, "b.ply", PLY_HEAD.format(n=2) + "1 2 3\n1 nan 3\n"), "b.ply:9: coordinate is NaN or infinite")
+    expect_bad(write(d, "c.ply", PLY_HEAD.format(n=4611686018427387904) + "1 2 3\n"), "c.ply:3: element vertex")
+    expect_bad(write(d, "d.obj", "v 1 2\n"), "d.obj:1: vertex: expected x y z")
+    expect_bad(write(d, "e.off", "OFF\n3 0 0\n1.000 2.000 3.000\n4.000 5.000 6.000\n"), "e.off:5: file ends after 2 of 3 vertices")
+    expect_bad(write(d, "f.stl", "solid s\nfacet normal 0 0 1\nouter loop\nvertex 1 2 x\n"), "f.stl:4:")
+    expect_bad(write(d, "g.pcd", "VERSION .7\nFIELDS x y\nSIZE 4 4\nTYPE F F\nPOINTS 1\nDATA ascii\n1 2\n"),
+               "g.pcd: FIELDS has no 'z'")
+    expect_bad(write(d, "h.csv", "x,y,z\n1,2,1e999\n"), "h.csv:2: coordinate is NaN or infinite")
+
+
+@test
+def bad_binary_input_exits_2_naming_the_file_and_byte_offset(d):
+    head = PLY_HEAD.replace("ascii", "binary_little_endian").format(n=3)
+    expect_bad(write(d, "a.ply", head.encode() + struct.pack("<6f", 1, 2, 3, 4, 5, 6)),
+               "a.ply: byte %d: file ends inside element vertex" % (len(head) + 24))
+    stl = b"binary".ljust(80, b"\0") + struct.pack("<I", 9) + b"\0" * 50
+    expect_bad(write(d, "b.stl", stl), "b.stl: byte 80: binary STL declares 9 triangles")
+    las = b"LASF" + b"\0" * 100
+    expect_bad(write(d, "c.las", las), "c.las: byte 104: file ends inside the LAS header")
+    npy = b"\x93NUMPY\x01\x00" + struct.pack("<H", 60) + b"{'descr': '<f8', 'fortran_order': False, 'shape': (9, 3), }".ljust(59) + b"\n"
+    expect_bad(write(d, "d.npy", npy + struct.pack("<3d", 1, 2, 3)), "d.npy: byte 94: file ends inside the data")
+    expect_bad(write(d, "e.npy", npy.replace(b"(9, 3)", b"(1, 3)") + struct.pack("<3d", 1, float("inf"), 3)),
+               "d.npy" if False else "e.npy: byte 78: point 0: coordinate is NaN or infinite")
+
+
+@test
+def unsupported_and_missing_files_exit_2_with_a_way_out(d):
+    expect_bad(os.path.join(d, "scan.laz"), "laszip -i")
+    expect_bad(os.path.join(d, "missing.ply"), "missing.ply: cannot open")
+    expect_bad(write(d, "blob.bin", b"\x01\x02\x03"), "use --format")
+    expect_bad(write(d, "las.ply", b"LASF" + b"\0" * 300), "the name says ply but the content is las; use --format las")
+    expect_bad(write(d, "x.xyz", "1 2 3\n"), "sampling needs a mesh", args=("--sample", "10"))
+
+
+@test
+def usage_errors_exit_1(d):
+    for args in (["--format", "dxf"], ["--sample", "0"], ["--sample", "-5"], ["--sample"]):
+        rc, out, err = run(*args, "a.ply", "b.ply")
+        assert rc == 1, (args, rc, err)
+        assert "hausdorff: " in err, err
+
+
+@test
+def formats_version_and_help_describe_the_reader(d):
+    rc, out, _ = run("--formats")
+    assert rc == 0
+    for name in ("ply", "obj", "off", "stl", "xyz", "pcd", "las", "npy"):
+        assert ("  %s " % name) in out, (name, out)
+    assert "laszip" in out
+    rc, out, _ = run("--version")
+    assert rc == 0 and out.startswith("hausdorff ") and out.count(".") >= 2, out
+    rc, out, _ = run("--help")
+    assert rc == 0
+    for needle in ("--format", "--formats", "--sample", "--vertices", "--quiet", "Examples", " - ", "Exit status"):
+        assert needle in out, needle
+
+
+@test
+def standard_input_is_read_with_or_without_format(d):
+    text = open(os.path.join(DATA, "derived", "pinion_gear_ascii.pcd")).read()
+    for args in (["--format", "pcd"], []):  # --format applies to both files
+        rc, out, err = run("--json", *args, "-", os.path.join(DATA, "derived", "pinion_gear_binary.pcd"), stdin=text.encode())
+        assert rc == 0, err
+        r = json.loads(out)
+        assert r["hausdorff"] == 0 and r["n_a"] == 650, r
+    rc, out, err = run("--json", "-", os.path.join(DATA, "pinion_gear.ply"), stdin=b"1 2 3\n4 5 6\n")
+    assert rc == 0 and json.loads(out)["n_a"] == 2, err
+
+
+@test
+def human_output_names_files_counts_distance_witness_and_time(d):
+    a, b = os.path.join(DATA, "orig", "lion.off"), os.path.join(DATA, "cgal_lion_head.ply")
+    rc, out, err = run(a, b)
+    assert rc == 0, err
+    assert "A: %s (7529 points" % a in out and "B: %s (8356 points" % b in out, out
+    assert "0.14468150162771326" in out, out
+    assert "witness:" in out and "(" in out and "time:" in out, out
+    assert err == "", err
+
+
+@test
+def sampling_is_reproducible_and_follows_the_seed(d):
+    mesh = os.path.join(DATA, "orig", "WusonOBJ.obj")
+    stl = os.path.join(DATA, "orig", "Wuson.stl")
+    outs = []
+    for seed in ("1", "1", "2"):
+        rc, out, err = run("--json", "--sample", "2000", "--seed", seed, mesh, stl)
+        assert rc == 0, err
+        r = json.loads(out)
+        assert r["n_a"] == 2000 and r["n_b"] == 2000, r
+        outs.append(r["hausdorff"])
+    assert outs[0] == outs[1] and outs[0] != outs[2], outs
+
+
+def run_on_terminal(args, feed_after=None, stdin_data=b""):
+    """Run with stderr on a pseudo-terminal (stdout and stdin on pipes);
+    return (exit code, stdout, what the terminal received)."""
+    master, slave = pty.openpty()
+    p = subprocess.Popen([TOOL] + args, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=slave)
+    os.close(slave)
+    if feed_after:
+        time.sleep(feed_after)
+    p.stdin.write(stdin_data)
+    p.stdin.close()
+    term = b""
+    while True:
+        r, _, _ = select.select([master], [], [], 0.1)
+        if r:
+            try:
+                chunk = os.read(master, 4096)
+            except OSError:
+                break
+            if not chunk:
+                break
+            term += chunk
+        elif p.poll() is not None:
+            break
+    out = p.stdout.read()
+    p.wait()
+    os.close(master)
+    return p.returncode, out.decode(), term.decode(errors="replace")
+
+
+@test
+def progress_bar_appears_on_a_terminal_for_a_slow_phase_only(d):
+    ply = os.path.join(DATA, "derived", "pinion_gear_binary.pcd")
+    data = open(os.path.join(DATA, "derived", "pinion_gear_ascii.pcd"), "rb").read()
+    # standard input that arrives after 1.6 s makes "reading A" a slow phase
+    rc, out, term = run_on_terminal(["--format", "pcd", "-", ply], feed_after=1.6, stdin_data=data)
+    assert rc == 0, term
+    assert "reading A: -" in term and "[" in term and "\033[K" in term, repr(term)
+    assert "reading A" not in out and "Hausdorff distance" in out
+    for quiet in (["--quiet"], ["--json"]):
+        rc, out, term = run_on_terminal(quiet + ["--format", "pcd", "-", ply], feed_after=1.6, stdin_data=data)
+        assert rc == 0 and term == "", (quiet, repr(term))
+    # a fast run draws nothing, and stderr on a pipe never gets the bar
+    rc, out, term = run_on_terminal([ply, ply])
+    assert rc == 0 and term == "", repr(term)
+    p = subprocess.Popen([TOOL, "--format", "pcd", "-", ply], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE)
+    time.sleep(1.6)
+    out, err = p.communicate(data)
+    assert p.returncode == 0 and err == b"", err
+
+
+class ReadingCli(unittest.TestCase):
+    """Each function above becomes one test, run in a fresh temporary directory."""
+
+    def setUp(self):
+        self.tmp = tempfile.TemporaryDirectory(prefix="hd-cli-io-")
+
+    def tearDown(self):
+        self.tmp.cleanup()
+
+
+for _fn in TESTS:
+    setattr(ReadingCli, "test_" + _fn.__name__, lambda self, fn=_fn: fn(self.tmp.name))
+
+if __name__ == "__main__":
+    TOOL = sys.argv.pop(1)
+    unittest.main(verbosity=2)

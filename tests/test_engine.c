@@ -1,0 +1,311 @@
+/*
+ * test_engine.c -- the `auto` engine gives the brute force's answer, bit for
+ * bit, with the brute force's witness, at one thread and at three.
+ *
+ * Thousands of seeded cases cover what makes the engine's shortcuts
+ * delicate: lattice ties (many points at exactly the maximum), duplicates,
+ * nearly identical clouds and translated copies (every nearest distance
+ * within a rounding of the maximum, so the quantised approximations cannot
+ * decide and exact reads must), sizes 1:1000, far offsets (1e9) and tiny
+ * scales (1e-9), float32 and strided views, and sets large enough for many
+ * buckets, tree levels and tasks.
+ */
+#include "brute.h"
+#include "check.h"
+#include "gen.h"
+
+#include <math.h>
+#include <stdlib.h>
+
+/* The kinds of pairs (A, B) the random cases draw from. */
+enum {
+    K_OVERLAP, K_DISJOINT, K_PARTIAL, K_LATTICE, K_DUPLICATES, K_PERTURBED, K_TRANSLATED,
+    K_FAR, K_TINY, K_PLANE_LINE, K_CUBE, K_COUNT
+};
+static const char *const kind_name[K_COUNT] = {
+    "overlap", "disjoint", "partial", "lattice", "duplicates", "perturbed", "translated",
+    "far-offset", "tiny-scale", "plane-line", "cube",
+};
+
+static void make_pair(gen_rng_t *g, int kind, double *a, size_t na, double *b, size_t nb) {
+    double m0[3] = {0, 0, 0}, m1[3] = {0, 0, 0};
+    switch (kind) {
+    case K_OVERLAP:
+        gen_gauss(g, a, na, m0, 1.0);
+        gen_gauss(g, b, nb, m0, 1.0);
+        break;
+    case K_DISJOINT:
+        m1[0] = 20;
+        gen_gauss(g, a, na, m0, 1.0);
+        gen_gauss(g, b, nb, m1, 1.0);
+        break;
+    case K_PARTIAL:
+        m1[1] = 2;
+        gen_gauss(g, a, na, m0, 1.0);
+        gen_gauss(g, b, nb, m1, 1.0);
+        break;
+    case K_LATTICE: {
+        int side = 2 + (int)(gen_u64(g) % 9);
+        gen_lattice(g, a, na, side + (int)(gen_u64(g) % 3));
+        gen_lattice(g, b, nb, side);
+        break;
+    }
+    case K_DUPLICATES:
+        /* Few distinct points, each repeated many times, in both sets. */
+        gen_gauss(g, a, na < 7 ? na : 7, m0, 1.0);
+        for (size_t k = 7; k < na; k++)
+            for (int c = 0; c < 3; c++) a[3 * k + c] = a[3 * (gen_u64(g) % 7) + c];
+        for (size_t k = 0; k < nb; k++)
+            for (int c = 0; c < 3; c++) b[3 * k + c] = a[3 * (gen_u64(g) % (na < 7 ? na : 7)) + c];
+        break;
+    case K_PERTURBED:
+    case K_TRANSLATED: {
+        /* B is a copy of A's points (cycled to nb), moved slightly. */
+        gen_gauss(g, a, na, m0, 1.0);
+        double t[3] = {1e-3 * gen_normal(g), 1e-3 * gen_normal(g), 0};
+        for (size_t k = 0; k < nb; k++)
+            for (int c = 0; c < 3; c++)
+                b[3 * k + c] = a[3 * (k % na) + c] +
+                               (kind == K_PERTURBED ? 1e-3 * gen_normal(g) : t[c]);
+        break;
+    }
+    case K_FAR:
+        gen_gauss(g, a, na, m0, 1.0);
+        gen_gauss(g, b, nb, m0, 1.0);
+        gen_affine(a, na, 1.0, 1e9);
+        gen_affine(b, nb, 1.0, 1e9);
+        break;
+    case K_TINY:
+        gen_gauss(g, a, na, m0, 1.0);
+        m1[2] = 0.5;
+        gen_gauss(g, b, nb, m1, 1.0);
+        gen_affine(a, na, 1e-9, 0.0);
+        gen_affine(b, nb, 1e-9, 0.0);
+        break;
+    case K_PLANE_LINE:
+        gen_plane(g, a, na);
+        gen_line(g, b, nb);
+        break;
+    default:
+        gen_cube(g, a, na, -1, 1);
+        gen_cube(g, b, nb, 0, 2);
+    }
+}
+
+/* Compare one directed result with the brute force. */
+static void check_directed(const hd_result_t *r, const brute_t *want) {
+    CHECK_BITS(r->distance2, want->d2);
+    CHECK_BITS(r->distance, sqrt(want->d2));
+    CHECK_EQ(r->i, want->i);
+    CHECK_EQ(r->j, want->j);
+    CHECK_EQ(r->algorithm, HD_ALG_AUTO);
+}
+
+/* H(A,B) and h(A,B) with the engine against the brute force. */
+static void check_case(const double *a, size_t na, const double *b, size_t nb, int threads) {
+    brute_t ab = brute_directed(a, na, b, nb), ba = brute_directed(b, nb, a, na);
+    hd_points_t A = hd_points_f64(a, na), B = hd_points_f64(b, nb);
+    hd_options_t o;
+    hd_options_init(&o);
+    o.threads = threads;
+    hd_symmetric_t s;
+    CHECK_RC(hd_hausdorff(&A, &B, &o, &s, NULL), HD_OK);
+    check_directed(&s.ab, &ab);
+    check_directed(&s.ba, &ba);
+    CHECK_BITS(s.distance, sqrt(ab.d2 >= ba.d2 ? ab.d2 : ba.d2));
+    hd_result_t r;
+    CHECK_RC(hd_directed(&A, &B, &o, &r, NULL), HD_OK);
+    check_directed(&r, &ab);
+}
+
+TEST(engine_matches_brute_force_on_thousands_of_seeded_cases) {
+    gen_rng_t g;
+    for (uint64_t seed = 1; seed <= 2200 && !hdt_failed(); seed++) {
+        gen_seed(&g, seed);
+        int kind = (int)(seed % K_COUNT);
+        /* Mostly small sets (one to a few buckets), some up to ~40 buckets. */
+        size_t cap = seed % 10 == 0 ? 1300 : 160;
+        size_t na = 1 + gen_u64(&g) % cap, nb = 1 + gen_u64(&g) % cap;
+        int threads = seed % 2 ? 1 : 3;
+        CONTEXT("seed=%llu kind=%s na=%zu nb=%zu threads=%d", (unsigned long long)seed,
+                kind_name[kind], na, nb, threads);
+        double *a = malloc(24 * na), *b = malloc(24 * nb);
+        make_pair(&g, kind, a, na, b, nb);
+        check_case(a, na, b, nb, threads);
+        free(a);
+        free(b);
+    }
+}
+
+TEST(engine_matches_brute_force_on_large_sets) {
+    gen_rng_t g;
+    for (int kind = 0; kind < K_COUNT; kind++) {
+        uint64_t seed = 5000 + (uint64_t)kind;
+        gen_seed(&g, seed);
+        size_t na = 4000 + gen_u64(&g) % 2000, nb = 4000 + gen_u64(&g) % 2000;
+        CONTEXT("seed=%llu kind=%s na=%zu nb=%zu", (unsigned long long)seed, kind_name[kind], na,
+                nb);
+        double *a = malloc(24 * na), *b = malloc(24 * nb);
+        make_pair(&g, kind, a, na, b, nb);
+        check_case(a, na, b, nb, 1);
+        check_case(a, na, b, nb, 3);
+        free(a);
+        free(b);
+    }
+}
+
+TEST(sizes_one_to_a_thousand) {
+    gen_rng_t g;
+    for (int kind = 0; kind < K_COUNT; kind++) {
+        uint64_t seed = 6000 + (uint64_t)kind;
+        gen_seed(&g, seed);
+        size_t small = 3 + gen_u64(&g) % 5, large = 1000 * small;
+        CONTEXT("seed=%llu kind=%s small=%zu large=%zu", (unsigned long long)seed,
+                kind_name[kind], small, large);
+        double *a = malloc(24 * small), *b = malloc(24 * large);
+        make_pair(&g, kind, a, small, b, large);
+        check_case(a, small, b, large, kind % 2 ? 1 : 3);
+        free(a);
+        free(b);
+    }
+}
+
+TEST(same_answer_at_every_thread_count) {
+    gen_rng_t g;
+    gen_seed(&g, 7000);
+    CONTEXT("seed=7000");
+    size_t n = 20000;
+    double *a = malloc(24 * n), *b = malloc(24 * n);
+    make_pair(&g, K_LATTICE, a, n, b, n);
+    hd_points_t A = hd_points_f64(a, n), B = hd_points_f64(b, n);
+    hd_options_t o;
+    hd_options_init(&o);
+    hd_symmetric_t first, s;
+    memset(&first, 0, sizeof first);
+    for (int t = 1; t <= 4; t++) {
+        o.threads = t;
+        CHECK_RC(hd_hausdorff(&A, &B, &o, &s, NULL), HD_OK);
+        if (t == 1) {
+            first = s;
+            continue;
+        }
+        CHECK_BITS(s.distance, first.distance);
+        CHECK_EQ(s.ab.i, first.ab.i);
+        CHECK_EQ(s.ab.j, first.ab.j);
+        CHECK_EQ(s.ba.i, first.ba.i);
+        CHECK_EQ(s.ba.j, first.ba.j);
+    }
+    /* And it is the brute force's. */
+    brute_t ab = brute_directed(a, 3000, b, n);
+    hd_points_t A3 = hd_points_f64(a, 3000);
+    hd_result_t r;
+    o.threads = 3;
+    CHECK_RC(hd_directed(&A3, &B, &o, &r, NULL), HD_OK);
+    check_directed(&r, &ab);
+    free(a);
+    free(b);
+}
+
+TEST(float32_views_are_exact_for_the_float_values) {
+    gen_rng_t g;
+    for (uint64_t seed = 8000; seed < 8060; seed++) {
+        gen_seed(&g, seed);
+        int kind = (int)(seed % K_COUNT);
+        size_t na = 1 + gen_u64(&g) % 900, nb = 1 + gen_u64(&g) % 900;
+        CONTEXT("seed=%llu kind=%s na=%zu nb=%zu", (unsigned long long)seed, kind_name[kind], na,
+                nb);
+        double *a = malloc(24 * na), *b = malloc(24 * nb);
+        float *fa = malloc(12 * na), *fb = malloc(12 * nb);
+        make_pair(&g, kind, a, na, b, nb);
+        for (size_t k = 0; k < 3 * na; k++) a[k] = (double)(fa[k] = (float)a[k]);
+        for (size_t k = 0; k < 3 * nb; k++) b[k] = (double)(fb[k] = (float)b[k]);
+        brute_t ab = brute_directed(a, na, b, nb), ba = brute_directed(b, nb, a, na);
+        hd_points_t A = hd_points_f32(fa, na), B = hd_points_f32(fb, nb);
+        hd_options_t o;
+        hd_options_init(&o);
+        o.threads = seed % 2 ? 1 : 3;
+        hd_symmetric_t s;
+        CHECK_RC(hd_hausdorff(&A, &B, &o, &s, NULL), HD_OK);
+        check_directed(&s.ab, &ab);
+        check_directed(&s.ba, &ba);
+        free(a);
+        free(b);
+        free(fa);
+        free(fb);
+    }
+}
+
+TEST(strided_and_reversed_views_are_read_correctly) {
+    gen_rng_t g;
+    gen_seed(&g, 9000);
+    CONTEXT("seed=9000");
+    size_t na = 2345, nb = 3456;
+    double *a = malloc(24 * na), *b = malloc(24 * nb);
+    make_pair(&g, K_PERTURBED, a, na, b, nb);
+    /* A as a column-major (Fortran) array; B reversed, inside records of
+     * four doubles, through a negative stride. */
+    double *col = malloc(24 * na), *rec = malloc(32 * nb), *brev = malloc(24 * nb);
+    for (size_t k = 0; k < na; k++)
+        for (int c = 0; c < 3; c++) col[c * na + k] = a[3 * k + c];
+    for (size_t k = 0; k < nb; k++) {
+        for (int c = 0; c < 3; c++) rec[4 * k + c] = b[3 * k + c];
+        rec[4 * k + 3] = NAN;
+        memcpy(brev + 3 * k, b + 3 * (nb - 1 - k), 24);
+    }
+    hd_points_t A = hd_points_f64(col, na);
+    A.stride = sizeof(double);
+    A.cstride = (ptrdiff_t)(na * sizeof(double));
+    hd_points_t B = hd_points_f64(rec + 4 * (nb - 1), nb);
+    B.stride = -4 * (ptrdiff_t)sizeof(double);
+    brute_t ab = brute_directed(a, na, brev, nb), ba = brute_directed(brev, nb, a, na);
+    hd_options_t o;
+    hd_options_init(&o);
+    for (int t = 1; t <= 3; t += 2) {
+        o.threads = t;
+        hd_symmetric_t s;
+        CHECK_RC(hd_hausdorff(&A, &B, &o, &s, NULL), HD_OK);
+        check_directed(&s.ab, &ab);
+        check_directed(&s.ba, &ba);
+    }
+    free(a);
+    free(b);
+    free(col);
+    free(rec);
+    free(brev);
+}
+
+TEST(identical_sets_are_at_distance_zero_with_witness_zero) {
+    gen_rng_t g;
+    gen_seed(&g, 9100);
+    CONTEXT("seed=9100");
+    size_t n = 5000;
+    double *a = malloc(24 * n);
+    make_pair(&g, K_OVERLAP, a, n, a, 0);
+    hd_points_t A = hd_points_f64(a, n);
+    hd_symmetric_t s;
+    CHECK_RC(hd_hausdorff(&A, &A, NULL, &s, NULL), HD_OK);
+    CHECK_BITS(s.distance, 0.0);
+    /* Every point is at distance 0 from itself: the witness is A[0], B[0]. */
+    CHECK_EQ(s.ab.i, 0);
+    CHECK_EQ(s.ab.j, 0);
+    free(a);
+}
+
+TEST(statistics_explain_the_work) {
+    gen_rng_t g;
+    gen_seed(&g, 9200);
+    CONTEXT("seed=9200");
+    size_t n = 30000;
+    double *a = malloc(24 * n), *b = malloc(24 * n);
+    make_pair(&g, K_DISJOINT, a, n, b, n);
+    hd_points_t A = hd_points_f64(a, n), B = hd_points_f64(b, n);
+    hd_result_t r;
+    CHECK_RC(hd_directed(&A, &B, NULL, &r, NULL), HD_OK);
+    CHECK_EQ(r.algorithm, HD_ALG_AUTO);
+    CHECK(r.stats.distance_evals > 0);
+    /* Far apart sets: nearly every point is discarded without a search. */
+    CHECK(r.stats.points_culled > n / 2);
+    CHECK(r.stats.points_culled <= n);
+    free(a);
+    free(b);
+}
