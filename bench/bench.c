@@ -381,9 +381,21 @@ static void run_peer(bench_t *B, const pair_t *p, const char *method, int thread
     fprintf(stderr, "  %-18s t=%d %10.4f s  H=%.17g  %s\n", method, threads, med, d, same);
 }
 
+/* The engine's own account of its plan (an internal function of the
+ * library, for benchmarks). */
+int hd__engine_explain(const hd_points_t *A, const hd_points_t *B, const hd_options_t *opt, char *buf,
+                       size_t len, hd_error_t *err);
+
 static void run_pair(bench_t *B, pair_t *p) {
     if (B->only && !strstr(p->name, B->only)) return;
-    fprintf(stderr, "%s: %zu / %zu points\n", p->name, p->na, p->nb);
+    hd_points_t A = hd_points_f64(p->a, p->na), Bp = hd_points_f64(p->b, p->nb);
+    hd_options_t o;
+    hd_options_init(&o);
+    char plan[256] = "?";
+    hd__engine_explain(&A, &Bp, &o, plan, sizeof plan, NULL);
+    fprintf(stderr, "%s: %zu / %zu points; plan: %s\n", p->name, p->na, p->nb, plan);
+    json_pair_head(B, p, "plan", 0);
+    fprintf(B->fp, ", \"plan\": \"%s\"}\n", plan);
     double H = NAN, floor_s[4];
     for (int k = 0; k < B->n_threads; k++) {
         floor_s[k] = floor_pass(p->a, p->na, p->b, p->nb, B->threads[k]);

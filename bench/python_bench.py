@@ -178,12 +178,14 @@ def main():
     lines = [
         f"hausdorff {hausdorff.__version__} ({hausdorff.__file__}), numpy {np.__version__}, "
         f"Python {platform.python_version()}, {os.cpu_count()} cores; "
-        f"median of {args.runs} runs; timeout {args.timeout:g} s.",
+        f"median of {args.runs} runs; timeout {args.timeout:g} s; "
+        f"load average at the start {os.getloadavg()[0]:.2f}.",
         "",
         "| case | \\|A\\| | \\|B\\| | h(A,B) | " + " | ".join(t for _, t in peers) + " |",
         "|---|---:|---:|---:|" + "---:|" * len(peers),
     ]
     print("\n".join(lines), flush=True)
+    ratios = []  # (case, {peer key: peer time / our time, or (">", bound)})
     with tempfile.TemporaryDirectory(prefix="hd-pybench-") as tmp:
         for name, make in cases(args.size, hausdorff):
             if args.only and args.only not in name:
@@ -194,15 +196,23 @@ def main():
             np.save(fb, b)
             ref = None
             cells = []
+            ours = None
+            ratio = {}
             for key, _ in peers:
                 r = measure(args, key, fa, fb)
                 if "timeout" in r:
                     cells.append(f"> {r['timeout']:g} s")
+                    if ours:
+                        ratio[key] = f"> {r['timeout'] / ours:.3g}x"
                     continue
                 if "error" in r:
                     cells.append(f"failed: {r['error'][:60]}")
                     continue
                 t = statistics.median(r["times"])
+                if key == "hausdorff":
+                    ours = t
+                elif ours:
+                    ratio[key] = f"{t / ours:.3g}x"
                 d = r["distance"]
                 if ref is None:
                     ref = d
@@ -217,8 +227,17 @@ def main():
             row = (f"| {name} | {len(a):,} | {len(b):,} | {ref!r} | " + " | ".join(cells) + " |")
             lines.append(row)
             print(row, flush=True)
-    lines += ["", "Command: `/usr/bin/python3 bench/python_bench.py " +
-              " ".join(sys.argv[1:]) + "`"]
+            ratios.append((name, ratio))
+    others = [(k, t) for k, t in peers if k != "hausdorff"]
+    tail = ["", "Time of each peer divided by the time of hausdorff.directed (default threads):", "",
+            "| case | " + " | ".join(t for _, t in others) + " |",
+            "|---|" + "---:|" * len(others)]
+    tail += [f"| {name} | " + " | ".join(r.get(k, "") for k, _ in others) + " |"
+             for name, r in ratios]
+    tail += ["", f"Load average at the end {os.getloadavg()[0]:.2f}. Command: "
+             "`/usr/bin/python3 bench/python_bench.py " + " ".join(sys.argv[1:]) + "`"]
+    print("\n".join(tail))
+    lines += tail
     if args.out:
         pathlib.Path(args.out).write_text("\n".join(lines) + "\n")
 

@@ -140,8 +140,13 @@ static int prepare(const hd_points_t *A, const hd_points_t *B,
     }
     int rc = check_options(opt, err);
     if (rc) return rc;
-    if ((rc = hd__points_check(A, "A", &p->job.box_a, err))) return rc;
-    if ((rc = hd__points_check(B, "B", &p->job.box_b, err))) return rc;
+    if (opt->algorithm == HD_ALG_AUTO) { /* the engine's fast, parallel pass */
+        if ((rc = hd__points_scan(A, "A", opt->threads, &p->job.box_a, err))) return rc;
+        if ((rc = hd__points_scan(B, "B", opt->threads, &p->job.box_b, err))) return rc;
+    } else {
+        if ((rc = hd__points_check(A, "A", &p->job.box_a, err))) return rc;
+        if ((rc = hd__points_check(B, "B", &p->job.box_b, err))) return rc;
+    }
     p->job.na = A->count;
     p->job.nb = B->count;
     p->job.opt = opt;
@@ -164,7 +169,7 @@ int hd_directed(const hd_points_t *A, const hd_points_t *B,
     int rc = prepare(A, B, opt, &defaults, &p, err);
     if (rc) return rc;
     if (p.job.opt->algorithm == HD_ALG_AUTO)
-        rc = hd__engine_directed(A, B, p.job.opt, out, err);
+        rc = hd__engine_directed(A, B, &p.job.box_a, &p.job.box_b, p.job.opt, out, err);
     else
         rc = hd__run_directed(&p.job, p.job.opt->algorithm, out, err);
     free(p.owned_a);
@@ -184,7 +189,7 @@ int hd_hausdorff(const hd_points_t *A, const hd_points_t *B,
     double t0 = hd__now();
     out->alpha = hd__alpha(&p.job.box_a, &p.job.box_b, &out->disjoint);
     if (p.job.opt->algorithm == HD_ALG_AUTO)
-        rc = hd__engine_hausdorff(A, B, p.job.opt, out, err);
+        rc = hd__engine_hausdorff(A, B, &p.job.box_a, &p.job.box_b, p.job.opt, out, err);
     else
         rc = hd__run_directed(&p.job, p.job.opt->algorithm, &out->ab, err);
     if (rc == HD_OK && p.job.opt->algorithm != HD_ALG_AUTO) {

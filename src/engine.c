@@ -39,6 +39,7 @@
 
 #include <math.h>
 #include <pthread.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -51,9 +52,7 @@ typedef struct {
 
 typedef struct {
     const hd__tree_t *ta, *tb;
-    hd__bound_t cmax;     /* the largest exact nearest distance so far */
-    pthread_mutex_t lock; /* guards best */
-    hd__best_t best;      /* the maximum so far with its canonical witness */
+    hd__max_t *m;         /* the maximum so far, shared */
     int task_level;
     worker_t *w;
 } dir_ctx;
@@ -72,22 +71,9 @@ typedef struct {
 static void walk_init(walk_t *s, dir_ctx *c, worker_t *w) {
     s->c = c;
     s->w = w;
-    pthread_mutex_lock(&c->lock);
-    s->snap = c->best;
-    pthread_mutex_unlock(&c->lock);
+    hd__max_snapshot(c->m, &s->snap);
     s->have_bc = 0;
     s->hint = HD__NONE;
-}
-
-/* Record an exact nearest distance: into the shared maximum (canonical
- * witness by hd__best_offer), the shared bound, and this walk's snapshot. */
-static void offer(walk_t *s, double d2, size_t i, size_t j) {
-    dir_ctx *c = s->c;
-    pthread_mutex_lock(&c->lock);
-    hd__best_offer(&c->best, d2, i, j);
-    s->snap = c->best;
-    pthread_mutex_unlock(&c->lock);
-    hd__bound_raise(&c->cmax, d2);
 }
 
 static size_t node_points(const hd__tree_t *t, int level, size_t i) {
@@ -124,7 +110,7 @@ HD__INLINE double centre_gap2(const hd__box_t *a, const hd__box_t *b) {
  * one at distance <= the maximum found so far when that maximum was
  * attained at a smaller index (it cannot be the witness). */
 static void resolve_point(walk_t *s, const double a[3], size_t ia) {
-    double cmax2 = hd__bound_get(&s->c->cmax);
+    double cmax2 = hd__bound_get(&s->c->m->cmax);
     double tie2 = ia > s->snap.i ? s->snap.d2 : -1.0;
     hd__hit_t hit;
     hd__tree_nearest(s->c->tb, a, cmax2, tie2, s->hint, &hit, &s->w->counts);
@@ -133,12 +119,14 @@ static void resolve_point(walk_t *s, const double a[3], size_t ia) {
     s->bc_err = hit.perr;
     s->have_bc = 1;
     if (hit.killed || hit.d2 < cmax2 || hit.d2 <= tie2) return;
-    offer(s, hit.d2, ia, hit.j);
+    hd__max_offer(s->c->m, hit.d2, ia, hit.j, &s->snap);
 }
 
-/* Buckets of B a shared walk may read before the points left over get
- * their own searches. */
+/* The shared walk of a bucket of A visits at most BLOCK_LEAVES buckets of
+ * B, within the subtree of 2^BLOCK_LEVEL buckets around the last useful one,
+ * before the points left over get their own searches. */
 #define BLOCK_LEAVES 8
+#define BLOCK_LEVEL 3
 
 /* The points of one bucket of A being resolved together, known through
  * their quantised copy within err. */
@@ -172,17 +160,17 @@ static int try_bucket(walk_t *s, group_t *g, size_t i, double cmax2) {
     const hd__bucket_t *bb = &tb->bucket[i];
     double lim = hd__kill_below(cmax2, g->err + bb->err);
     double reach = hd__may_reach(cmax2, g->err + bb->err);
-    double lb[HD__BUCKET];
-    for (int k = 0; k < HD__BUCKET; k++) lb[k] = hd__box_lb2s(&bb->box, g->x[k], g->y[k], g->z[k]);
     uint32_t near = 0;
-    for (int k = 0; k < g->m; k++)
-        if ((g->alive >> k & 1u) && lb[k] < cmax2) near |= 1u << k;
+    for (uint32_t left = g->alive; left; left &= left - 1) {
+        int k = __builtin_ctz(left);
+        if (hd__box_lb2s(&bb->box, g->x[k], g->y[k], g->z[k]) < cmax2) near |= 1u << k;
+    }
     if (!near) return 0;
     double x[HD__BUCKET], y[HD__BUCKET], z[HD__BUCKET];
     int mb = hd__bucket_decode(tb, i, x, y, z);
     int close_k[HD__BUCKET], close_b[HD__BUCKET], n_close = 0;
-    for (int k = 0; k < g->m; k++) {
-        if (!(near >> k & 1u)) continue;
+    for (uint32_t left = near; left; left &= left - 1) {
+        int k = __builtin_ctz(left);
         double d[HD__BUCKET];
         const double ax = g->x[k], ay = g->y[k], az = g->z[k];
         for (int q = 0; q < HD__BUCKET; q++) d[q] = hd__d2s(ax, ay, az, x[q], y[q], z[q]);
@@ -219,7 +207,7 @@ static int try_bucket(walk_t *s, group_t *g, size_t i, double cmax2) {
         hd__src_get(&tb->src, tb->perm[i * HD__BUCKET + (size_t)close_b[r]], b);
         double e = hd__d2(a, b);
         s->w->counts.exact++;
-        if (e < cmax2 || (e <= s->snap.d2 && g->ia[k] > s->snap.i)) {
+        if (hd__kills(cmax2, &s->snap, e, g->ia[k])) {
             g->alive &= ~(1u << k);
             memcpy(s->bc, b, sizeof s->bc);
             s->bc_err = 0;
@@ -244,7 +232,7 @@ static void walk_bucket(walk_t *s, size_t bk) {
     g.err = ta->bucket[bk].err;
     g.first = bk * HD__BUCKET;
     g.read = 0;
-    double cmax2 = hd__bound_get(&s->c->cmax);
+    double cmax2 = hd__bound_get(&s->c->m->cmax);
     g.alive = g.m == 32 ? 0xffffffffu : (1u << g.m) - 1;
     if (s->have_bc) {
         double lim = hd__kill_below(cmax2, g.err + s->bc_err);
@@ -275,9 +263,14 @@ static void walk_bucket(walk_t *s, size_t bk) {
     double diag2 = 0;
     for (int k = 0; k < 3; k++) diag2 += (ba->hi[k] - ba->lo[k]) * (ba->hi[k] - ba->lo[k]);
     if (g.alive && diag2 > cmax2) {
-        stack[0].level = tb->levels - 1;
-        stack[0].i = 0;
-        stack[0].gap2 = box_gap2(ba, hd__tree_box(tb, tb->levels - 1, 0));
+        /* The walk covers the subtree of BLOCK_SPAN buckets around the last
+         * useful bucket of B: points that close are close along the curve
+         * too, apart from the curve's jumps, which the searches handle. */
+        int l = BLOCK_LEVEL < tb->levels - 1 ? BLOCK_LEVEL : tb->levels - 1;
+        size_t h = s->hint != HD__NONE ? s->hint : 0;
+        stack[0].level = l;
+        stack[0].i = h >> l;
+        stack[0].gap2 = box_gap2(ba, hd__tree_box(tb, l, h >> l));
         sp = 1;
     }
     while (sp > 0 && g.alive && leaves < BLOCK_LEAVES) {
@@ -287,7 +280,8 @@ static void walk_bucket(walk_t *s, size_t bk) {
         size_t i = stack[sp].i;
         s->w->counts.nodes++;
         if (l == 0) {
-            leaves += try_bucket(s, &g, i, cmax2);
+            try_bucket(s, &g, i, cmax2);
+            leaves++;
             continue;
         }
         size_t c0 = 2 * i, c1 = 2 * i + 1;
@@ -330,7 +324,7 @@ static void walk_bucket(walk_t *s, size_t bk) {
 static void walk_node(walk_t *s, int level, size_t i) {
     const hd__tree_t *ta = s->c->ta;
     if (s->have_bc) {
-        double cmax2 = hd__bound_get(&s->c->cmax);
+        double cmax2 = hd__bound_get(&s->c->m->cmax);
         if (hd__box_ub2(hd__tree_box(ta, level, i), s->bc) < hd__kill_below(cmax2, s->bc_err)) {
             s->w->culled += node_points(ta, level, i);
             return;
@@ -399,45 +393,203 @@ static void prime(dir_ctx *c) {
     c->w[0].counts.nodes += w.counts.nodes;
 }
 
-/* h(A,B) over built indexes of A and B. */
-static int engine_directed(const hd__tree_t *ta, const hd__tree_t *tb, int threads,
-                           hd_result_t *out, hd_error_t *err) {
+/* The tree walk of h(A,B) over built trees, into the shared maximum m. */
+static int tree_directed(const hd__tree_t *ta, const hd__tree_t *tb, hd__max_t *m, int threads,
+                         hd__counts_t *counts, uint64_t *culled, hd_error_t *err) {
     dir_ctx c;
     memset(&c, 0, sizeof c);
     c.ta = ta;
     c.tb = tb;
-    hd__bound_init(&c.cmax, 0.0);
-    hd__best_init(&c.best);
-    /* Tasks are subtrees of about 64 buckets (1024 points). */
+    c.m = m;
+    /* Tasks are subtrees of about 64 buckets. */
     c.task_level = ta->levels - 1 < 6 ? ta->levels - 1 : 6;
     size_t tasks = ta->count[c.task_level];
     if (threads < 1) threads = 1;
-    c.w = hd__malloc_array((size_t)threads, sizeof *c.w);
+    c.w = hd__calloc_array((size_t)threads, sizeof *c.w);
     if (!c.w) return hd__err(err, HD_ENOMEM, "out of memory");
-    if (pthread_mutex_init(&c.lock, NULL) != 0) {
-        free(c.w);
-        return hd__err(err, HD_ETHREAD, "cannot create a mutex");
-    }
-    memset(c.w, 0, (size_t)threads * sizeof *c.w);
     prime(&c);
     int rc = hd__parallel_for(threads, tasks, walk_task, &c);
-    pthread_mutex_destroy(&c.lock);
-    if (rc != HD_OK) {
-        free(c.w);
-        return hd__err(err, rc, "%s", hd_strerror(rc));
-    }
-    memset(&out->stats, 0, sizeof out->stats);
     for (int k = 0; k < threads; k++) {
-        out->stats.distance_evals += c.w[k].counts.evals;
-        out->stats.nodes_visited += c.w[k].counts.nodes;
-        out->stats.points_culled += c.w[k].culled;
+        counts->evals += c.w[k].counts.evals;
+        counts->exact += c.w[k].counts.exact;
+        counts->nodes += c.w[k].counts.nodes;
+        *culled += c.w[k].culled;
     }
-    out->distance2 = c.best.d2;
-    out->distance = sqrt(c.best.d2);
-    out->i = c.best.i;
-    out->j = c.best.j;
-    out->algorithm = HD_ALG_AUTO;
     free(c.w);
+    if (rc != HD_OK) return hd__err(err, rc, "%s", hd_strerror(rc));
+    return HD_OK;
+}
+
+/* ---- the shared maximum ------------------------------------------------------------ */
+
+int hd__max_init(hd__max_t *m) {
+    hd__bound_init(&m->cmax, 0.0);
+    hd__best_init(&m->best);
+    return pthread_mutex_init(&m->lock, NULL) == 0 ? HD_OK : HD_ETHREAD;
+}
+
+void hd__max_destroy(hd__max_t *m) { pthread_mutex_destroy(&m->lock); }
+
+void hd__max_offer(hd__max_t *m, double d2, size_t i, size_t j, hd__best_t *snap) {
+    pthread_mutex_lock(&m->lock);
+    hd__best_offer(&m->best, d2, i, j);
+    if (snap) *snap = m->best;
+    pthread_mutex_unlock(&m->lock);
+    hd__bound_raise(&m->cmax, d2);
+}
+
+void hd__max_snapshot(hd__max_t *m, hd__best_t *snap) {
+    pthread_mutex_lock(&m->lock);
+    *snap = m->best;
+    pthread_mutex_unlock(&m->lock);
+}
+
+/* ---- the plan: grid or trees -------------------------------------------------------- */
+
+/* The grid pass is chosen when its cheap tests (the representative of the
+ * point's cell, the last useful point) discard at least this fraction of a
+ * sample of A, for every direction computed; otherwise both sets get the
+ * bucket trees.  Measured on the benchmark's cases (docs/engine.md). */
+#define GRID_RATE 0.97
+/* Points of A whose exact nearest distances prime cmax before the choice. */
+#define GRID_PRIME 64
+
+typedef struct {
+    hd__src_t src[2]; /* 0: A, 1: B */
+    size_t n[2];
+    hd__box_t box[2];
+    int threads, directions; /* 1: h(A,B) only; 2: both */
+    hd__grid_t grid[2];
+    hd__tree_t tree[2];
+    int have_grid, have_tree, use_tree;
+    hd__max_t max[2];     /* direction d: from set d to set 1 - d */
+    int max_ready;
+    hd__counts_t counts[2];
+    uint64_t culled[2];
+    double rate[2];
+} engine_t;
+
+static void engine_free(engine_t *e) {
+    if (e->have_grid)
+        for (int k = 0; k < 2; k++) hd__grid_free(&e->grid[k]);
+    if (e->have_tree)
+        for (int k = 0; k < 2; k++) hd__tree_free(&e->tree[k]);
+    for (int d = 0; d < e->max_ready; d++) hd__max_destroy(&e->max[d]);
+    e->have_grid = e->have_tree = e->max_ready = 0;
+}
+
+static int engine_init(engine_t *e, const hd_points_t *A, const hd_points_t *B,
+                       const hd__box_t *box_a, const hd__box_t *box_b, const hd_options_t *opt,
+                       int directions, hd_error_t *err) {
+    memset(e, 0, sizeof *e);
+    hd__src_init(&e->src[0], A, NULL);
+    hd__src_init(&e->src[1], B, NULL);
+    e->n[0] = A->count;
+    e->n[1] = B->count;
+    e->box[0] = *box_a;
+    e->box[1] = *box_b;
+    e->directions = directions;
+    e->threads = hd__thread_count(opt->threads, A->count > B->count ? A->count : B->count);
+    for (int d = 0; d < directions; d++) {
+        if (hd__max_init(&e->max[d]) != HD_OK) {
+            engine_free(e);
+            return hd__err(err, HD_ETHREAD, "cannot create a mutex");
+        }
+        e->max_ready = d + 1;
+    }
+    return HD_OK;
+}
+
+/* Build both grids, prime each direction's maximum with the exact nearest
+ * distances of points spread over the query set, and choose. */
+static int engine_plan(engine_t *e, hd_error_t *err) {
+    for (int k = 0; k < 2; k++) {
+        int rc = hd__grid_build(&e->grid[k], &e->src[k], e->n[k], &e->box[k], e->threads, err);
+        if (rc) {
+            if (k) hd__grid_free(&e->grid[0]);
+            return rc;
+        }
+    }
+    e->have_grid = 1;
+    e->use_tree = 0;
+    for (int d = 0; d < e->directions; d++) {
+        const hd__src_t *q = &e->src[d];
+        const hd__grid_t *t = &e->grid[1 - d];
+        size_t nq = e->n[d], np = nq < GRID_PRIME ? nq : GRID_PRIME;
+        for (size_t s = 0; s < np; s++) {
+            size_t i = (2 * s + 1) * nq / (2 * np);
+            double p[3];
+            hd__src_get(q, i, p);
+            hd__hit_t hit;
+            hd__grid_nearest(t, p, 0.0, -1.0, &hit, &e->counts[d]);
+            hd__max_offer(&e->max[d], hit.d2, i, hit.j, NULL);
+        }
+        e->rate[d] = hd__grid_discard_rate(q, nq, t, &e->max[d], &e->counts[d]);
+        if (e->rate[d] < GRID_RATE) e->use_tree = 1;
+    }
+    return HD_OK;
+}
+
+/* force: 0 lets the plan choose, 1 forces the grid, 2 the trees. */
+static int engine_run(engine_t *e, int force, hd_result_t out[2], hd_error_t *err) {
+    int rc = engine_plan(e, err);
+    if (rc) return rc;
+    if (force) e->use_tree = force == 2;
+    if (e->use_tree) {
+        /* The grids give way to the trees (memory stays under 16 bytes per
+         * point); the maxima found so far stay valid.  The trees' Morton
+         * grids have the same cell size, each centred on its own set's
+         * centroid: a copy of a set, translated or perturbed, then
+         * lists its points in nearly the same order as the original, which
+         * the walk's neighbour scans rely on. */
+        double c[2][3], r = 0;
+        for (int s2 = 0; s2 < 2; s2++)
+            for (int k = 0; k < 3; k++) {
+                c[s2][k] = e->grid[s2].centroid[k];
+                double u = c[s2][k] - e->box[s2].lo[k], v = e->box[s2].hi[k] - c[s2][k];
+                r = u > r ? u : r;
+                r = v > r ? v : r;
+            }
+        hd__box_t g[2];
+        for (int s2 = 0; s2 < 2; s2++)
+            for (int k = 0; k < 3; k++) {
+                g[s2].lo[k] = c[s2][k] - r;
+                g[s2].hi[k] = c[s2][k] + r;
+            }
+        for (int k = 0; k < 2; k++) hd__grid_free(&e->grid[k]);
+        e->have_grid = 0;
+        rc = hd__tree_build(&e->tree[0], &e->src[0], e->n[0], &g[0], e->threads, err);
+        if (rc) return rc;
+        rc = hd__tree_build(&e->tree[1], &e->src[1], e->n[1], &g[1], e->threads, err);
+        if (rc) {
+            hd__tree_free(&e->tree[0]);
+            return rc;
+        }
+        e->have_tree = 1;
+    }
+    for (int d = 0; d < e->directions; d++) {
+        double t0 = hd__now();
+        if (e->use_tree)
+            rc = tree_directed(&e->tree[d], &e->tree[1 - d], &e->max[d], e->threads, &e->counts[d],
+                               &e->culled[d], err);
+        else
+            rc = hd__grid_directed(&e->src[d], e->n[d], &e->grid[1 - d], &e->max[d], e->threads,
+                                   &e->counts[d], &e->culled[d], err);
+        if (rc) return rc;
+        hd_result_t *r = &out[d];
+        memset(r, 0, sizeof *r);
+        hd__best_t b;
+        hd__max_snapshot(&e->max[d], &b);
+        r->distance2 = b.d2;
+        r->distance = sqrt(b.d2);
+        r->i = b.i;
+        r->j = b.j;
+        r->algorithm = HD_ALG_AUTO;
+        r->stats.distance_evals = e->counts[d].evals + e->counts[d].exact;
+        r->stats.nodes_visited = e->counts[d].nodes;
+        r->stats.points_culled = e->culled[d];
+        r->seconds = hd__now() - t0;
+    }
     return HD_OK;
 }
 
@@ -445,66 +597,102 @@ static int engine_directed(const hd__tree_t *ta, const hd__tree_t *tb, int threa
 
 int hd__engine_trees(const hd__tree_t *ta, const hd__tree_t *tb, int threads, hd_result_t *out,
                      hd_error_t *err) {
-    return engine_directed(ta, tb, threads, out, err);
+    hd__max_t m;
+    if (hd__max_init(&m) != HD_OK) return hd__err(err, HD_ETHREAD, "cannot create a mutex");
+    hd__counts_t counts = {0, 0, 0};
+    uint64_t culled = 0;
+    int rc = tree_directed(ta, tb, &m, threads, &counts, &culled, err);
+    if (rc == HD_OK) {
+        memset(out, 0, sizeof *out);
+        out->distance2 = m.best.d2;
+        out->distance = sqrt(m.best.d2);
+        out->i = m.best.i;
+        out->j = m.best.j;
+        out->algorithm = HD_ALG_AUTO;
+        out->stats.distance_evals = counts.evals + counts.exact;
+        out->stats.nodes_visited = counts.nodes;
+        out->stats.points_culled = culled;
+    }
+    hd__max_destroy(&m);
+    return rc;
 }
 
-static int build_pair(const hd_points_t *A, const hd_points_t *B, int threads, hd__tree_t *ta,
-                      hd__tree_t *tb, double *build_seconds, hd_error_t *err) {
-    hd__src_t sa, sb;
-    hd__src_init(&sa, A, NULL);
-    hd__src_init(&sb, B, NULL);
+int hd__engine_directed(const hd_points_t *A, const hd_points_t *B, const hd__box_t *box_a,
+                        const hd__box_t *box_b, const hd_options_t *opt, hd_result_t *out,
+                        hd_error_t *err) {
     double t0 = hd__now();
-    int rc = hd__tree_build(ta, &sa, A->count, threads, err);
+    engine_t e;
+    int rc = engine_init(&e, A, B, box_a, box_b, opt, 1, err);
     if (rc) return rc;
-    rc = hd__tree_build(tb, &sb, B->count, threads, err);
-    if (rc) {
-        hd__tree_free(ta);
-        return rc;
-    }
-    *build_seconds = hd__now() - t0;
+    hd_result_t r[2];
+    rc = engine_run(&e, 0, r, err);
+    engine_free(&e);
+    if (rc) return rc;
+    *out = r[0];
+    out->seconds = hd__now() - t0;
     return HD_OK;
 }
 
-int hd__engine_directed(const hd_points_t *A, const hd_points_t *B, const hd_options_t *opt,
-                        hd_result_t *out, hd_error_t *err) {
-    size_t n = A->count > B->count ? A->count : B->count;
-    int threads = hd__thread_count(opt->threads, n);
-    hd__tree_t ta, tb;
-    double tbuild;
+static int engine_symmetric(const hd_points_t *A, const hd_points_t *B, const hd__box_t *box_a,
+                            const hd__box_t *box_b, const hd_options_t *opt, int force,
+                            hd_symmetric_t *out, hd_error_t *err) {
     double t0 = hd__now();
-    int rc = build_pair(A, B, threads, &ta, &tb, &tbuild, err);
+    engine_t e;
+    int rc = engine_init(&e, A, B, box_a, box_b, opt, 2, err);
     if (rc) return rc;
-    rc = engine_directed(&ta, &tb, threads, out, err);
-    hd__tree_free(&ta);
-    hd__tree_free(&tb);
-    out->seconds = hd__now() - t0;
+    hd_result_t r[2];
+    rc = engine_run(&e, force, r, err);
+    engine_free(&e);
+    if (rc) return rc;
+    /* The shared work (grids or trees, the plan) is split between the two
+     * directions' times in proportion to nothing in particular: half each. */
+    double total = hd__now() - t0, walks = r[0].seconds + r[1].seconds;
+    out->ab = r[0];
+    out->ba = r[1];
+    out->ab.seconds = r[0].seconds + (total - walks) / 2;
+    out->ba.seconds = r[1].seconds + (total - walks) / 2;
+    return HD_OK;
+}
+
+int hd__engine_hausdorff(const hd_points_t *A, const hd_points_t *B, const hd__box_t *box_a,
+                         const hd__box_t *box_b, const hd_options_t *opt, hd_symmetric_t *out,
+                         hd_error_t *err) {
+    return engine_symmetric(A, B, box_a, box_b, opt, 0, out, err);
+}
+
+int hd__engine_forced(const hd_points_t *A, const hd_points_t *B, const hd_options_t *opt,
+                      int use_trees, hd_symmetric_t *out, hd_error_t *err) {
+    hd__box_t ba, bb;
+    int rc = hd__points_scan(A, "A", opt->threads, &ba, err);
+    if (rc == HD_OK) rc = hd__points_scan(B, "B", opt->threads, &bb, err);
+    if (rc) return rc;
+    memset(out, 0, sizeof *out);
+    rc = engine_symmetric(A, B, &ba, &bb, opt, use_trees ? 2 : 1, out, err);
+    if (rc == HD_OK)
+        out->distance = out->ab.distance2 >= out->ba.distance2 ? out->ab.distance : out->ba.distance;
     return rc;
 }
 
-int hd__engine_hausdorff(const hd_points_t *A, const hd_points_t *B, const hd_options_t *opt,
-                         hd_symmetric_t *out, hd_error_t *err) {
-    size_t n = A->count > B->count ? A->count : B->count;
-    int threads = hd__thread_count(opt->threads, n);
-    hd__tree_t ta, tb;
-    double tbuild;
-    int rc = build_pair(A, B, threads, &ta, &tb, &tbuild, err);
+int hd__engine_explain(const hd_points_t *A, const hd_points_t *B, const hd_options_t *opt,
+                       char *buf, size_t len, hd_error_t *err) {
+    hd__box_t ba, bb;
+    int rc = hd__points_scan(A, "A", opt->threads, &ba, err);
+    if (rc == HD_OK) rc = hd__points_scan(B, "B", opt->threads, &bb, err);
     if (rc) return rc;
-    double t0 = hd__now();
-    rc = engine_directed(&ta, &tb, threads, &out->ab, err);
-    double t1 = hd__now();
-    if (rc == HD_OK) rc = engine_directed(&tb, &ta, threads, &out->ba, err);
-    double t2 = hd__now();
-    /* Each direction reports its own walk plus half of the shared build. */
-    out->ab.seconds = (t1 - t0) + tbuild / 2;
-    out->ba.seconds = (t2 - t1) + tbuild / 2;
-    hd__tree_free(&ta);
-    hd__tree_free(&tb);
+    engine_t e;
+    rc = engine_init(&e, A, B, &ba, &bb, opt, 2, err);
+    if (rc) return rc;
+    rc = engine_plan(&e, err);
+    if (rc == HD_OK)
+        snprintf(buf, len, "%s (grid discards %.3f / %.3f of a sample)", e.use_tree ? "trees" : "grid",
+                 e.rate[0], e.rate[1]);
+    engine_free(&e);
     return rc;
 }
 
-/* The packed-doubles form used by hd__run_directed (hd_directed with the
- * packed job, e.g. from other modules). */
+/* The packed-doubles form used by hd__run_directed (for callers that hold
+ * a packed job). */
 int hd__engine(const hd__job_t *job, hd_result_t *out, hd_error_t *err) {
     hd_points_t A = hd_points_f64(job->a, job->na), B = hd_points_f64(job->b, job->nb);
-    return hd__engine_directed(&A, &B, job->opt, out, err);
+    return hd__engine_directed(&A, &B, &job->box_a, &job->box_b, job->opt, out, err);
 }

@@ -368,8 +368,8 @@ size_t hd__tree_memory(const hd__tree_t *t) {
            node_count(t) * sizeof *t->nodes;
 }
 
-int hd__tree_build(hd__tree_t *t, const hd__src_t *src, size_t n, int threads,
-                   hd_error_t *err) {
+int hd__tree_build(hd__tree_t *t, const hd__src_t *src, size_t n, const hd__box_t *grid_box,
+                   int threads, hd_error_t *err) {
     memset(t, 0, sizeof *t);
     if (n == 0) return hd__err(err, HD_EEMPTY, "empty point set");
     if (n > UINT32_MAX)
@@ -401,9 +401,13 @@ int hd__tree_build(hd__tree_t *t, const hd__src_t *src, size_t n, int threads,
         goto done;
     }
     kc.keys = keys;
-    hd__parallel_for(threads, slices, box_task, &kc);
-    t->box = kc.part_box[0];
-    for (size_t s = 1; s < slices; s++) box_merge(&t->box, &kc.part_box[s]);
+    if (grid_box) {
+        t->box = *grid_box;
+    } else {
+        hd__parallel_for(threads, slices, box_task, &kc);
+        t->box = kc.part_box[0];
+        for (size_t s = 1; s < slices; s++) box_merge(&t->box, &kc.part_box[s]);
+    }
     grid_of(&t->box, &kc.grid);
     hd__parallel_for(threads, slices, key_task, &kc);
     if ((rc = radix_sort(&keys, &tmp, n, threads))) goto done;

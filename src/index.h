@@ -30,6 +30,8 @@
 
 #include "internal.h"
 
+#include <pthread.h>
+
 /* Points per bucket (at most 32: live points are tracked in 32-bit masks). */
 #define HD__BUCKET 32
 _Static_assert(HD__BUCKET % 4 == 0 && HD__BUCKET <= 32, "bucket size");
@@ -90,14 +92,17 @@ typedef struct hd__tree {
     size_t count[HD__MAX_LEVELS];   /* nodes per level */
     size_t off[HD__MAX_LEVELS];     /* first box of level l >= 1 in nodes[] */
     hd__box_t *nodes;               /* exact boxes of the nodes of levels >= 1 */
-    hd__box_t box;                  /* the set's box */
+    hd__box_t box;                  /* the box the Morton grid covers */
 } hd__tree_t;
 
 /* Build the index of n points read from `src` using `threads` threads.
- * The points must be valid (finite, within HD_MAX_COORD, also after the
- * transform).  n must be at most UINT32_MAX (HD_EOVERFLOW otherwise). */
-int hd__tree_build(hd__tree_t *t, const hd__src_t *src, size_t n, int threads,
-                   hd_error_t *err);
+ * The Morton grid covers grid_box, or the set's own box when it is NULL
+ * (two sets sorted on the same grid line up along the curve, which is what
+ * the walk over nearly identical sets relies on).  The points must be
+ * valid (finite, within HD_MAX_COORD, also after the transform).  n must be
+ * at most UINT32_MAX (HD_EOVERFLOW otherwise). */
+int hd__tree_build(hd__tree_t *t, const hd__src_t *src, size_t n, const hd__box_t *grid_box,
+                   int threads, hd_error_t *err);
 void hd__tree_free(hd__tree_t *t);
 size_t hd__tree_memory(const hd__tree_t *t);
 
@@ -210,7 +215,79 @@ typedef struct hd__counts {
 void hd__tree_nearest(const hd__tree_t *t, const double q[3], double stop2, double tie2,
                       size_t hint, hd__hit_t *hit, hd__counts_t *n);
 
+/* ---- the grid: a cheap index for sparse queries (engine_grid.c) ------------------ */
+
+/* Points grouped by the cell of a uniform grid of 2^bits cubic cells per
+ * axis over the set's box; cells are numbered along the Morton curve, so
+ * the cells below any node of the implicit octree over them are a
+ * contiguous range, and so are their points.  Each cell keeps a
+ * representative, its point with the smallest original index. */
+typedef struct hd__grid {
+    size_t n;
+    hd__src_t src;
+    int bits;             /* cells per axis: 1 << bits (at most 8) */
+    double lo[3], w, inv; /* cell (cx, cy, cz) spans lo + c * w .. lo + (c + 1) * w */
+    double margin;        /* widening of every face that covers all rounding */
+    uint32_t *perm;       /* n original indices grouped by cell */
+    uint32_t *start;      /* 8^bits + 1 offsets into perm */
+    double *rep;          /* per cell x, y, z of its representative; NaN if empty */
+    double centroid[3];   /* mean of the points (approximate; for alignment) */
+} hd__grid_t;
+
+int hd__grid_build(hd__grid_t *g, const hd__src_t *src, size_t n, const hd__box_t *box,
+                   int threads, hd_error_t *err);
+void hd__grid_free(hd__grid_t *g);
+size_t hd__grid_memory(const hd__grid_t *g);
+
+/* Exact nearest neighbour of q in g, with the early stop of hd__tree_nearest
+ * (stop2, tie2).  hit->bucket is unused. */
+void hd__grid_nearest(const hd__grid_t *g, const double q[3], double stop2, double tie2,
+                      hd__hit_t *hit, hd__counts_t *n);
+
+/* ---- the running maximum shared by the threads of one direction --------------- */
+
+/* cmax (the bound all threads raise), and under a lock the maximum so far
+ * with its canonical witness. */
+typedef struct hd__max {
+    hd__bound_t cmax;
+    pthread_mutex_t lock;
+    hd__best_t best;
+} hd__max_t;
+
+int hd__max_init(hd__max_t *m);
+void hd__max_destroy(hd__max_t *m);
+/* Record an exact nearest distance d2 of point i (nearest j); *snap gets a
+ * consistent copy of the maximum so far. */
+void hd__max_offer(hd__max_t *m, double d2, size_t i, size_t j, hd__best_t *snap);
+void hd__max_snapshot(hd__max_t *m, hd__best_t *snap);
+
+/* Whether a point of B at squared distance d2 from point i of A proves that
+ * i is not the witness: its nearest distance is then below the maximum
+ * (d2 < cmax2), or at most a maximum already attained at a smaller index
+ * (snap, a consistent copy of the maximum so far). */
+HD__INLINE int hd__kills(double cmax2, const hd__best_t *snap, double d2, size_t i) {
+    return d2 < cmax2 || (d2 <= snap->d2 && i > snap->i);
+}
+
+/* h(A,B) by the grid: every point of A is tested against the representative
+ * of its cell in B's grid and the last point of B that discarded something,
+ * and searched exactly when neither discards it.  On return m holds the
+ * maximum; counts and culled are added to. */
+int hd__grid_directed(const hd__src_t *a, size_t na, const hd__grid_t *gb, hd__max_t *m,
+                      int threads, hd__counts_t *counts, uint64_t *culled, hd_error_t *err);
+
+/* Prime m with the exact nearest distances of a few points of a sample of
+ * A chosen where the maximum is likely, and return the fraction of the
+ * sample that the cheap tests then discard. */
+double hd__grid_discard_rate(const hd__src_t *a, size_t na, const hd__grid_t *gb, hd__max_t *m,
+                             hd__counts_t *counts);
+
 /* ---- the engine ---------------------------------------------------------------- */
+
+/* H(A,B) by the engine with its choice overridden: the grid pass for both
+ * directions (use_trees 0) or the trees (1).  For tests. */
+int hd__engine_forced(const hd_points_t *A, const hd_points_t *B, const hd_options_t *opt,
+                      int use_trees, hd_symmetric_t *out, hd_error_t *err);
 
 /* h(A,B) over built indexes of A and B (engine.c), with `threads` threads. */
 int hd__engine_trees(const hd__tree_t *ta, const hd__tree_t *tb, int threads,

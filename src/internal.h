@@ -238,11 +238,22 @@ int hd__engine(const hd__job_t *job, hd_result_t *out, hd_error_t *err);
 /* The auto engine on validated views, without packed copies (engine.c):
  * h(A,B), and H(A,B) with each set indexed once for both directions. */
 int hd__engine_directed(const hd_points_t *A, const hd_points_t *B,
+                        const hd__box_t *box_a, const hd__box_t *box_b,
                         const hd_options_t *opt, hd_result_t *out,
                         hd_error_t *err);
 int hd__engine_hausdorff(const hd_points_t *A, const hd_points_t *B,
+                         const hd__box_t *box_a, const hd__box_t *box_b,
                          const hd_options_t *opt, hd_symmetric_t *out,
                          hd_error_t *err);
+/* The engine's plan for H(A,B) as a sentence in buf (for benchmarks). */
+int hd__engine_explain(const hd_points_t *A, const hd_points_t *B,
+                       const hd_options_t *opt, char *buf, size_t len,
+                       hd_error_t *err);
+/* hd__points_check's result, computed with `threads` threads by a fast pass
+ * for packed views (engine_scan.c); any problem is reported by
+ * hd__points_check itself. */
+int hd__points_scan(const hd_points_t *p, const char *what, int threads,
+                    hd__box_t *box, hd_error_t *err);
 
 /* Run h(A,B) on a prepared job (fills seconds, distance, algorithm). */
 int hd__run_directed(hd__job_t *job, hd_algorithm_t alg, hd_result_t *out,

@@ -2,7 +2,10 @@
  * test_engine.c -- the `auto` engine gives the brute force's answer, bit for
  * bit, with the brute force's witness, at one thread and at three.
  *
- * Thousands of seeded cases cover what makes the engine's shortcuts
+ * Every case runs through the public calls (the engine choosing its path)
+ * and through each of the engine's two paths, the grid pass and the bucket
+ * trees, forced.  Thousands of seeded cases cover what makes the engine's
+ * shortcuts
  * delicate: lattice ties (many points at exactly the maximum), duplicates,
  * nearly identical clouds and translated copies (every nearest distance
  * within a rounding of the maximum, so the quantised approximations cannot
@@ -13,6 +16,7 @@
 #include "brute.h"
 #include "check.h"
 #include "gen.h"
+#include "index.h" /* hd__engine_forced: each of the engine's two paths */
 
 #include <math.h>
 #include <stdlib.h>
@@ -116,6 +120,12 @@ static void check_case(const double *a, size_t na, const double *b, size_t nb, i
     hd_result_t r;
     CHECK_RC(hd_directed(&A, &B, &o, &r, NULL), HD_OK);
     check_directed(&r, &ab);
+    /* Whatever the engine's choice, both of its paths are exact. */
+    for (int trees = 0; trees <= 1; trees++) {
+        CHECK_RC(hd__engine_forced(&A, &B, &o, trees, &s, NULL), HD_OK);
+        check_directed(&s.ab, &ab);
+        check_directed(&s.ba, &ba);
+    }
 }
 
 TEST(engine_matches_brute_force_on_thousands_of_seeded_cases) {

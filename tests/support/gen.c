@@ -65,3 +65,74 @@ void gen_torus(gen_rng_t *r, double *xyz, size_t n, double R, double rr) {
 void gen_affine(double *xyz, size_t n, double scale, double offset) {
     for (size_t k = 0; k < 3 * n; k++) xyz[k] = xyz[k] * scale + offset;
 }
+
+/* The gear's outer radius at polar angle phi (see gen.h). */
+static double gear_radius(double phi, int teeth, double rr, double rt) {
+    double u = phi * (double)teeth / 6.283185307179586;
+    u -= floor(u);
+    if (u < 0.45) return rr;
+    if (u < 0.60) return rr + (rt - rr) * (u - 0.45) / 0.15;
+    if (u < 0.85) return rt;
+    return rt - (rt - rr) * (u - 0.85) / 0.15;
+}
+
+/* The teeth are identical, so one tooth's profile is tabulated as a polyline
+ * of GEAR_STEPS segments (cumulative arc length in cum[]); the rim is
+ * sampled by picking a tooth, then an arc length on that polyline (binary
+ * search), then a height.  Faces are sampled by rejection in the tip disc.
+ * The three parts get points in proportion to their areas (the face area is
+ * the polyline polygon's, by the shoelace formula, minus the bore). */
+#define GEAR_STEPS 400
+void gen_gear(gen_rng_t *r, double *xyz, size_t n, int teeth, double rr, double rt,
+              double rb, double thickness) {
+    const double two_pi = 6.283185307179586, pitch = two_pi / (double)teeth;
+    double tx[GEAR_STEPS + 1], ty[GEAR_STEPS + 1], cum[GEAR_STEPS + 1];
+    double twice_area = 0.0;
+    cum[0] = 0.0;
+    for (int k = 0; k <= GEAR_STEPS; k++) {
+        double phi = pitch * (double)k / GEAR_STEPS, rad = gear_radius(phi, teeth, rr, rt);
+        if (k == GEAR_STEPS) rad = gear_radius(0.0, teeth, rr, rt); /* closes the period */
+        tx[k] = rad * cos(phi), ty[k] = rad * sin(phi);
+        if (k > 0) {
+            cum[k] = cum[k - 1] + hypot(tx[k] - tx[k - 1], ty[k] - ty[k - 1]);
+            twice_area += tx[k - 1] * ty[k] - tx[k] * ty[k - 1];
+        }
+    }
+    double perimeter = (double)teeth * cum[GEAR_STEPS];
+    double face = 0.5 * (double)teeth * twice_area - 0.5 * two_pi * rb * rb;
+    double rim = perimeter * thickness, bore = two_pi * rb * thickness;
+    double total = 2.0 * face + rim + bore;
+    for (size_t k = 0; k < n; k++) {
+        double *p = xyz + 3 * k, pick = total * gen_unit(r);
+        if (pick < 2.0 * face) { /* a face: top or bottom */
+            for (;;) {
+                double x = rt * (2.0 * gen_unit(r) - 1.0), y = rt * (2.0 * gen_unit(r) - 1.0);
+                double rho = hypot(x, y), phi = atan2(y, x);
+                if (phi < 0) phi += two_pi;
+                if (rho >= rb && rho <= gear_radius(phi, teeth, rr, rt)) {
+                    p[0] = x, p[1] = y;
+                    break;
+                }
+            }
+            p[2] = (pick < face ? 0.5 : -0.5) * thickness;
+        } else if (pick < 2.0 * face + rim) { /* the rim: a tooth, then arc length */
+            int tooth = (int)((double)teeth * gen_unit(r));
+            double s = cum[GEAR_STEPS] * gen_unit(r);
+            int lo = 0, hi = GEAR_STEPS; /* the segment [lo, lo + 1] holding s */
+            while (hi - lo > 1) {
+                int mid = (lo + hi) / 2;
+                if (cum[mid] <= s) lo = mid;
+                else hi = mid;
+            }
+            double len = cum[lo + 1] - cum[lo], t = len > 0 ? (s - cum[lo]) / len : 0.0;
+            double x = tx[lo] + t * (tx[lo + 1] - tx[lo]), y = ty[lo] + t * (ty[lo + 1] - ty[lo]);
+            double c = cos(pitch * tooth), sn = sin(pitch * tooth);
+            p[0] = c * x - sn * y, p[1] = sn * x + c * y;
+            p[2] = thickness * (gen_unit(r) - 0.5);
+        } else { /* the bore wall */
+            double phi = two_pi * gen_unit(r);
+            p[0] = rb * cos(phi), p[1] = rb * sin(phi);
+            p[2] = thickness * (gen_unit(r) - 0.5);
+        }
+    }
+}

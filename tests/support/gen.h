@@ -28,5 +28,13 @@ void gen_plane(gen_rng_t *r, double *xyz, size_t n);
 void gen_torus(gen_rng_t *r, double *xyz, size_t n, double R, double rr);
 /* Scale and shift every coordinate: x -> x * scale + offset. */
 void gen_affine(double *xyz, size_t n, double scale, double offset);
+/* n points uniform by area on the surface of a spur gear centred at 0, axis
+ * z, z in [-thickness/2, thickness/2]: `teeth` trapezoidal teeth between
+ * root_radius and tip_radius (per tooth: root land 45%, flank 15%, tip land
+ * 25%, flank 15% of the angular pitch, radius linear in angle on the flanks),
+ * a round bore of bore_radius.  The surface is the two faces, the toothed
+ * rim and the bore wall. */
+void gen_gear(gen_rng_t *r, double *xyz, size_t n, int teeth, double root_radius,
+              double tip_radius, double bore_radius, double thickness);
 
 #endif
