@@ -72,10 +72,25 @@ bench:
 	@scripts/deps.sh build extras bench plot
 	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release -DHD_BENCH_PEERS=ON $(CMAKE_ARGS)
 	cmake --build $(BUILD) -j$(JOBS) --target hd_bench nanoflann_hd pcl_hd
-	./$(BUILD)/bench/hd_bench --peers $(BUILD)/bench --scripts bench/peers --data data \
+	$(BUILD)/bench/hd_bench --peers $(BUILD)/bench --scripts bench/peers --data data \
 	  --out $(BUILD)/bench/engine.jsonl $(BENCH_ARGS)
 	/usr/bin/python3 bench/report.py $(BUILD)/bench/engine.jsonl --doc docs/benchmarks.md \
 	  --plots docs/img --command "make bench$(if $(filter-out --scale,$(BENCH_ARGS)), BENCH_ARGS=\"$(BENCH_ARGS)\")"
 
 clean:
 	rm -rf $(BUILD) $(ASAN_BUILD) build-fuzz
+
+# The paper's experiments (Zhang et al., Section 6) rerun with this library's
+# algorithms: writes docs/paper-reproduction.md and docs/img/paper-*.png (not
+# part of `make test`).  QUICK=1 (or EXPERIMENTS_ARGS=--quick) for the quick
+# mode, about a minute; the full mode takes a few minutes.
+EXPERIMENTS_ARGS ?= $(if $(QUICK),--quick)
+experiments:
+	@scripts/deps.sh build extras plot
+	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release $(CMAKE_ARGS)
+	cmake --build $(BUILD) -j$(JOBS) --target experiments
+	$(BUILD)/bench/experiments --data data --out $(BUILD)/bench/experiments.jsonl $(EXPERIMENTS_ARGS)
+	/usr/bin/python3 bench/plot_experiments.py $(BUILD)/bench/experiments.jsonl \
+	  --doc docs/paper-reproduction.md --img docs/img --command "make experiments$(EXPERIMENTS_CMD)"
+EXPERIMENTS_CMD = $(if $(filter file,$(origin EXPERIMENTS_ARGS)),$(if $(QUICK), QUICK=$(QUICK)),$(if \
+  $(strip $(EXPERIMENTS_ARGS)), EXPERIMENTS_ARGS=\"$(strip $(EXPERIMENTS_ARGS))\"))

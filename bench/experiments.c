@@ -4,21 +4,23 @@
  * through the public API (docs/paper-reproduction.md).
  *
  * What is timed: hd_hausdorff(), the symmetric H(A,B) = max(h(A,B), h(B,A))
- * with both directions computed, on one thread, wall clock around the call
- * (so input validation and the packed copy are included).  All the
- * configurations of one pair of sets (algorithms, parameter values) are
- * timed together: each runs once untimed (warm-up; not NAIVEHDD, whose runs
- * are long enough), then the runs go round robin, one of each configuration
- * per round, so that a change of load on the shared machine affects them
- * alike.  The record holds every time, the mean (the paper's statistic) and
- * the median.  The randomised algorithms
- * (EARLYBREAK's shuffles, OHD's AHD sample) get seed = run number, so the
- * mean is over random orders, as the paper's averages of 10 runs are.
+ * with both directions computed, on one thread (so input validation and the
+ * packed copy are included).  The time is the process's CPU time during the
+ * call: on an idle machine that is the wall-clock time of a one-thread call,
+ * and on a shared one it leaves out the time spent waiting for a core
+ * (wall-clock times are recorded too).  All the configurations of one pair
+ * of sets (algorithms, parameter values) are timed together: each runs once
+ * untimed (warm-up; not NAIVEHDD, whose runs are long enough), then the runs
+ * go round robin, one of each configuration per round, so that a change of
+ * load affects them alike.  The record holds every time, the mean (the
+ * paper's statistic) and the median.  The randomised algorithms (EARLYBREAK's
+ * shuffles, OHD's AHD sample) get seed = run number, so the mean is over
+ * random orders, as the paper's averages of 10 runs are.
  *
  * Exactness is checked on the way: every algorithm and every parameter
  * value on one pair of sets must return the same H, h(A,B), h(B,A) and
  * witnesses, bit for bit, as the first one run on that pair; a mismatch
- * stops the program with status 1.  (The libraries' tests compare each
+ * stops the program with status 1.  (The library's tests compare each
  * algorithm with a brute force; this is a second check at the paper's
  * sizes.)
  *
@@ -28,7 +30,8 @@
  *   table2  OHD with and without point culling (nOHD), 15 overlapping
  *           Gaussian pairs of the Table 2 sizes.
  *   fig8    NOHD time against octree depth 1..10, three disjoint pairs.
- *   fig9    OHD time against lambda 1/10..1/1000, three overlapping pairs.
+ *   fig9    OHD time against lambda 1/2..1/1000 (the paper: 1/10..1/1000),
+ *           three overlapping pairs.
  *   fig10   a torus against a translated copy: framework, EARLYBREAK, OHD
  *           at each offset, with alpha.
  *   fig11   a gear against a translated and rotated copy, likewise.
@@ -142,6 +145,7 @@ typedef struct {
     char variant[32];
     char fields[160];
     double t[MAX_RUNS], wall[MAX_RUNS]; /* CPU and wall-clock seconds per run */
+    uint64_t culled[MAX_RUNS];          /* points culled per run (both directions) */
     double mean, median, wall_mean, wall_median;
     hd_symmetric_t s;
 } config_t;
@@ -202,6 +206,7 @@ static void measure_pair(const char *exp, const cloud_t *a, const cloud_t *b, co
         for (int k = 0; k < n; k++) {
             if (r >= c[k].runs) continue;
             run_once(a, b, &c[k], (uint64_t)r, exp, &c[k].s, &c[k].t[r], &c[k].wall[r]);
+            c[k].culled[r] = c[k].s.ab.stats.points_culled + c[k].s.ba.stats.points_culled;
             if (!have_ref) ref = c[k].s, have_ref = 1;
             same_or_die(&c[k].s, &ref, exp, &c[k], &c[0]);
         }
@@ -222,7 +227,8 @@ static void measure_pair(const char *exp, const cloud_t *a, const cloud_t *b, co
 }
 
 /* One JSON line: the configuration's fields, the options, the measurement
- * and the result. */
+ * and the result; the counters are the last run's, and points_culled, which
+ * depends on OHD's random sample, is also given run by run. */
 static void emit(const char *exp, const config_t *c, const cloud_t *a, const cloud_t *b) {
     const hd_symmetric_t *s = &c->s;
     const hd_options_t *o = &c->o;
@@ -244,6 +250,9 @@ static void emit(const char *exp, const config_t *c, const cloud_t *a, const clo
     for (int r = 0; r < c->runs; r++) fprintf(out, "%s%.9g", r ? "," : "", c->t[r]);
     fprintf(out, "],\"wall\":[");
     for (int r = 0; r < c->runs; r++) fprintf(out, "%s%.9g", r ? "," : "", c->wall[r]);
+    fprintf(out, "],\"culled_runs\":[");
+    for (int r = 0; r < c->runs; r++)
+        fprintf(out, "%s%llu", r ? "," : "", (unsigned long long)c->culled[r]);
     fprintf(out, "],\"load\":%.2f}\n", load1());
     fflush(out);
 }
@@ -395,6 +404,15 @@ static cloud_t gear_cloud(size_t n) {
     gen_rng_t g;
     gen_seed(&g, 11);
     gen_gear(&g, c.xyz, n, GEAR_TEETH, GEAR_ROOT, GEAR_TIP, GEAR_BORE, GEAR_THICK);
+    /* Every point must lie in the gear's solid: between the bore and the
+     * tip circle, within the thickness. */
+    for (size_t k = 0; k < n; k++) {
+        const double *p = c.xyz + 3 * k;
+        double rho = hypot(p[0], p[1]);
+        if (rho < GEAR_BORE * (1 - 1e-12) || rho > GEAR_TIP * (1 + 1e-12) ||
+            fabs(p[2]) > 0.5 * GEAR_THICK * (1 + 1e-12))
+            die("gen_gear: point %zu (%g, %g, %g) is outside the gear", k, p[0], p[1], p[2]);
+    }
     return c;
 }
 

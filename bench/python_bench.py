@@ -3,7 +3,7 @@
 peers a Python user would reach for.
 
     /usr/bin/python3 bench/python_bench.py [--size 1000000] [--runs 5]
-        [--timeout 120] [--build build] [--out table.md]
+        [--timeout 120] [--build build] [--out table.md] [--doc docs/benchmarks.md]
 
 Peers: scipy.spatial.distance.directed_hausdorff (EARLYBREAK, serial),
 scipy.spatial.cKDTree (built on B, query(A, workers=-1), then the maximum)
@@ -39,6 +39,7 @@ import numpy as np
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 SLOW_RUN = 20.0  # seconds: a peer slower than this runs once
+BEGIN, END = "<!-- python-results:begin -->", "<!-- python-results:end -->"
 
 
 def import_hausdorff(build):
@@ -166,6 +167,8 @@ def main():
     ap.add_argument("--build", default=str(ROOT / "build"), help="CMake build directory")
     ap.add_argument("--only", help="run only the cases whose name contains this")
     ap.add_argument("--out", help="also write the markdown table to this file")
+    ap.add_argument("--doc", help="replace the table between the python-results markers "
+                                  "of this markdown file (docs/benchmarks.md)")
     ap.add_argument("--worker", help=argparse.SUPPRESS)
     ap.add_argument("--a", help=argparse.SUPPRESS)
     ap.add_argument("--b", help=argparse.SUPPRESS)
@@ -240,6 +243,13 @@ def main():
     lines += tail
     if args.out:
         pathlib.Path(args.out).write_text("\n".join(lines) + "\n")
+    if args.doc:
+        doc = pathlib.Path(args.doc).read_text()
+        if BEGIN not in doc or END not in doc:
+            sys.exit(f"{args.doc}: no {BEGIN} ... {END} markers to replace")
+        table = "\n".join([BEGIN] + lines + [END])
+        doc = doc[:doc.index(BEGIN)] + table + doc[doc.index(END) + len(END):]
+        pathlib.Path(args.doc).write_text(doc)
 
 
 if __name__ == "__main__":

@@ -1,39 +1,42 @@
 /*
- * engine.c -- the `auto` engine: exact h(A,B) and H(A,B) over the Morton
- * bucket indexes of engine_build.c.
+ * engine.c -- the `auto` engine: its plan (grid pass or bucket trees), the
+ * walk over the bucket trees, the shared maximum, and the entry points.
+ * docs/engine.md explains the design; the essay here is its summary.
  *
- * The engine combines three of the paper's ideas with an index that is cheap
- * to build.  Both sets are indexed once (engine_build.c); h(A,B) then walks
- * A's tree in Morton order and searches B's tree:
- *  1. A lower bound cmax is primed from a sample of A whose exact nearest
- *     distances are computed first (the paper's AHD, Algorithm 6, line 1).
- *  2. A whole node of A (a bucket or a run of buckets) is discarded when one
- *     point b of B is proven closer than cmax to every point of the node's
- *     box: hd__box_ub2(box, b) < cmax^2, strictly (the paper's CubeToPoints,
- *     Algorithm 4, lines 5-7, applied to A's nodes).  The b tried is the last
- *     point of B that discarded something, which is usually nearby because
- *     A is walked along its curve.
- *  3. Every remaining point a is first tested against that same b, then
- *     searched in B's tree starting from the bucket where the previous search
- *     ended, stopping as soon as some point of B lies strictly within cmax
- *     (EARLYBREAK, Algorithm 2, lines 8-10).  A search that does not stop is
- *     an exact nearest-neighbour search; its result is a candidate for the
- *     maximum and raises cmax.
- * Threads take subtrees of A from a shared counter and share cmax through
- * an atomic.
+ * The plan.  Both sets get the cheap grid of engine_grid.c.  For each
+ * direction h(A,B), cmax is primed with the exact nearest distances of the
+ * representatives of A's cells lying where B is emptiest (the paper's AHD,
+ * Algorithm 6, line 1), then the grid pass is tried on a sample of A.  When
+ * it is cheap in every direction it runs; otherwise (nearly identical sets,
+ * where the distance is below the points' spacing) both sets get the bucket
+ * trees of engine_build.c and the walk below runs.
+ *
+ * The walk of h(A,B) over the trees combines three of the paper's ideas:
+ *  1. cmax is primed again from points spread along A's curve and from the
+ *     buckets of A with the largest boxes (sparse regions).
+ *  2. A whole node of A is discarded when one point b of B is proven
+ *     strictly within cmax of every point of the node's box (the paper's
+ *     CubeToPoints, Algorithm 4, lines 5-7, applied to A's nodes); b is the
+ *     last point of B that discarded something.
+ *  3. A bucket of A is resolved together from its quantised copy: against
+ *     that b, the buckets of B at the same place along B's curve, a short
+ *     walk of B's tree nearby; each pair the approximations cannot decide is
+ *     decided exactly; the points left get their own search, which stops at
+ *     the first proof of a point within cmax (EARLYBREAK, Algorithm 2, lines
+ *     8-10) or is an exact nearest-neighbour search.
+ * Threads take subtrees of A from a shared counter; they share cmax through
+ * an atomic and the maximum with its witness under a mutex.
  *
  * Exactness and the witness.  cmax is always the exact nearest distance of
  * some point of A, so it never exceeds h(A,B).  A point or node is discarded
- * only on a strict inequality d2(a, b) < cmax^2 (or ub2 < cmax^2, which
- * bounds d2(a, b) from above for every a in the box: internal.h), which
- * proves that its nearest distance is strictly less than h(A,B): it can be
- * neither the maximum nor tied with it.  So every point whose nearest
- * distance equals h(A,B) reaches a search that cannot stop early and gets
- * its exact nearest distance and smallest nearest index (engine_search.c);
- * the per-task maxima merge with hd__best_offer, which keeps the smallest
- * index of A on ties.  The result is the brute force's, bit for bit, at any
- * thread count and in any schedule: timing changes only how much is
- * discarded, never what survives to the end.
+ * only when a point of B is proven (exactly, or through the bounds of
+ * index.h) strictly within cmax of it, or at most at a maximum already
+ * attained at a smaller index of A (hd__kills): it cannot be the witness.
+ * Every other point gets an exact search with the smallest nearest index
+ * (engine_search.c, engine_grid.c), and the maxima merge with
+ * hd__best_offer (larger distance, then smaller index).  The result is the
+ * brute force's, bit for bit, at any thread count and in any schedule:
+ * timing changes only how much is discarded, never what survives.
  */
 #include "index.h"
 
@@ -122,6 +125,11 @@ static void resolve_point(walk_t *s, const double a[3], size_t ia) {
     hd__max_offer(s->c->m, hit.d2, ia, hit.j, &s->snap);
 }
 
+/* Buckets of B tried on each side of the last useful one, along B's curve. */
+#ifndef NEIGHBOURS
+#define NEIGHBOURS 2
+#endif
+
 /* The shared walk of a bucket of A visits at most BLOCK_LEAVES buckets of
  * B, within the subtree of 2^BLOCK_LEVEL buckets around the last useful one,
  * before the points left over get their own searches. */
@@ -155,7 +163,7 @@ static const double *group_exact(const hd__tree_t *ta, group_t *g, int k) {
  * approximations prove some point of the bucket strictly within cmax, or
  * when the pair is too close to call and its exact distance does.
  * Returns 1 when the bucket was read. */
-static int try_bucket(walk_t *s, group_t *g, size_t i, double cmax2) {
+HD__HOT static int try_bucket(walk_t *s, group_t *g, size_t i, double cmax2) {
     const hd__tree_t *tb = s->c->tb;
     const hd__bucket_t *bb = &tb->bucket[i];
     double lim = hd__kill_below(cmax2, g->err + bb->err);
@@ -242,11 +250,19 @@ static void walk_bucket(walk_t *s, size_t bk) {
         s->w->counts.evals += (uint64_t)g.m;
     }
     if (g.alive) {
-        size_t h = s->hint != HD__NONE ? s->hint : (size_t)((double)bk * (double)tb->nb / (double)ta->nb);
-        if (h >= tb->nb) h = tb->nb - 1;
-        try_bucket(s, &g, h, cmax2);
-        if (g.alive && h + 1 < tb->nb) try_bucket(s, &g, h + 1, cmax2);
-        if (g.alive && h > 0) try_bucket(s, &g, h - 1, cmax2);
+        /* Two guesses: the bucket at the same relative position along B's
+         * curve, and the bucket where the last search ended. */
+        size_t guess[2] = {(size_t)((double)bk * (double)tb->nb / (double)ta->nb), s->hint};
+        for (int q = 0; q < 2 && g.alive; q++) {
+            size_t h = guess[q];
+            if (h == HD__NONE || (q == 1 && h + NEIGHBOURS >= guess[0] && h <= guess[0] + NEIGHBOURS)) continue;
+            if (h >= tb->nb) h = tb->nb - 1;
+            try_bucket(s, &g, h, cmax2);
+            for (size_t r = 1; r <= NEIGHBOURS && g.alive; r++) {
+                if (h + r < tb->nb) try_bucket(s, &g, h + r, cmax2);
+                if (g.alive && h >= r) try_bucket(s, &g, h - r, cmax2);
+            }
+        }
     }
     const hd__box_t *ba = hd__tree_box(ta, 0, bk);
     struct {
@@ -373,16 +389,7 @@ static void prime(dir_ctx *c) {
         const hd__box_t *x = hd__tree_box(ta, 0, b);
         double d = 0;
         for (int k = 0; k < 3; k++) d += (x->hi[k] - x->lo[k]) * (x->hi[k] - x->lo[k]);
-        if (nt < PRIME_BUCKETS || d > size[nt - 1]) {
-            int p = nt < PRIME_BUCKETS ? nt++ : PRIME_BUCKETS - 1;
-            while (p > 0 && size[p - 1] < d) {
-                size[p] = size[p - 1];
-                top[p] = top[p - 1];
-                p--;
-            }
-            size[p] = d;
-            top[p] = b;
-        }
+        hd__top_insert(size, top, &nt, PRIME_BUCKETS, d, b);
     }
     for (int k = 0; k < nt; k++) {
         s.have_bc = 0;
@@ -446,13 +453,12 @@ void hd__max_snapshot(hd__max_t *m, hd__best_t *snap) {
 
 /* ---- the plan: grid or trees -------------------------------------------------------- */
 
-/* The grid pass is chosen when its cheap tests (the representative of the
- * point's cell, the last useful point) discard at least this fraction of a
- * sample of A, for every direction computed; otherwise both sets get the
- * bucket trees.  Measured on the benchmark's cases (docs/engine.md). */
-#define GRID_RATE 0.97
-/* Points of A whose exact nearest distances prime cmax before the choice. */
-#define GRID_PRIME 64
+/* The grid pass is chosen when, run over a sample of each query set, it
+ * costs at most GRID_COST distances and nodes per point; otherwise both
+ * sets get the bucket trees.  Measured on the benchmark's cases
+ * (docs/engine.md): where the grid wins it costs 1 to 3 per point, where
+ * the trees win it costs tens to hundreds. */
+#define GRID_COST 8.0
 
 typedef struct {
     hd__src_t src[2]; /* 0: A, 1: B */
@@ -466,7 +472,7 @@ typedef struct {
     int max_ready;
     hd__counts_t counts[2];
     uint64_t culled[2];
-    double rate[2];
+    double cost[2];
 } engine_t;
 
 static void engine_free(engine_t *e) {
@@ -515,17 +521,10 @@ static int engine_plan(engine_t *e, hd_error_t *err) {
     for (int d = 0; d < e->directions; d++) {
         const hd__src_t *q = &e->src[d];
         const hd__grid_t *t = &e->grid[1 - d];
-        size_t nq = e->n[d], np = nq < GRID_PRIME ? nq : GRID_PRIME;
-        for (size_t s = 0; s < np; s++) {
-            size_t i = (2 * s + 1) * nq / (2 * np);
-            double p[3];
-            hd__src_get(q, i, p);
-            hd__hit_t hit;
-            hd__grid_nearest(t, p, 0.0, -1.0, &hit, &e->counts[d]);
-            hd__max_offer(&e->max[d], hit.d2, i, hit.j, NULL);
-        }
-        e->rate[d] = hd__grid_discard_rate(q, nq, t, &e->max[d], &e->counts[d]);
-        if (e->rate[d] < GRID_RATE) e->use_tree = 1;
+        size_t nq = e->n[d];
+        hd__grid_prime(&e->grid[d], t, &e->max[d], &e->counts[d]);
+        e->cost[d] = hd__grid_trial(q, nq, t, &e->max[d], GRID_COST, &e->counts[d]);
+        if (e->cost[d] > GRID_COST) e->use_tree = 1;
     }
     return HD_OK;
 }
@@ -684,8 +683,8 @@ int hd__engine_explain(const hd_points_t *A, const hd_points_t *B, const hd_opti
     if (rc) return rc;
     rc = engine_plan(&e, err);
     if (rc == HD_OK)
-        snprintf(buf, len, "%s (grid discards %.3f / %.3f of a sample)", e.use_tree ? "trees" : "grid",
-                 e.rate[0], e.rate[1]);
+        snprintf(buf, len, "%s (grid trial: %.3g / %.3g distances and nodes per point)",
+                 e.use_tree ? "trees" : "grid", e.cost[0], e.cost[1]);
     engine_free(&e);
     return rc;
 }

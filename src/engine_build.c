@@ -11,12 +11,13 @@
  * copy of the coordinates, only a permutation.
  *
  * Keys.  Each point gets a 30-bit Morton key from a 1024^3 grid of cubic
- * cells laid over the set's box; the key is packed above the point's 32-bit
- * original index, so sorting the 64-bit words sorts by (key, index) and the
- * order is a function of the input alone, at any thread count.  The keys
- * only decide the order: nothing exact depends on them.  A cell holding more
- * than a bucket of points (a dense cluster, duplicates) is refined: its
- * points are re-keyed on a grid over their own exact box and sorted again,
+ * cells laid over the set's box (or over the box the caller gives, so that
+ * two sets can share a cell size and line up); the key is packed above the
+ * point's 32-bit original index, so sorting the 64-bit words sorts by
+ * (key, index) and the order is a function of the input alone, at any
+ * thread count.  The keys only decide the order: nothing exact depends on
+ * them.  A cell holding more than a bucket of points (a dense cluster,
+ * duplicates) is refined: its points are re-keyed on a grid over their own exact box and sorted again,
  * recursively, until every run of equal keys fits in a bucket or consists of
  * identical points.
  *
@@ -26,9 +27,15 @@
  * enclose their points exactly, which is what makes the pruning tests of
  * the searches exact without an epsilon (see internal.h).
  *
+ * Quantised copy.  Each bucket also keeps its points' coordinates as 16-bit
+ * fractions of its box and `err`, a proven bound on the distance between a
+ * point and its dequantised approximation (make_bucket), so that searches
+ * can decide most questions without reading the scattered input.
+ *
  * Memory.  The sort uses two arrays of 8 bytes per point; the result keeps
- * 4 bytes per point for the permutation and about 6 for the boxes (two
- * boxes of 48 bytes per bucket of 16 points).
+ * 4 bytes per point for the permutation, 6 for the quantised copy, 56 per
+ * bucket of 32 for its box and err, and 48 per tree node (about one per
+ * bucket): 13.25 bytes per point.
  */
 #include "index.h"
 

@@ -294,7 +294,7 @@ void hd__grid_nearest(const hd__grid_t *g, const double q[3], double stop2, doub
         }
         /* The non-empty children, nearest first. */
         int nc = 0;
-        uint32_t cp[8];
+        size_t cp[8];
         double cl[8];
         uint32_t span = 1u << (3 * (l - 1));
         for (uint32_t k = 0; k < 8; k++) {
@@ -304,19 +304,12 @@ void hd__grid_nearest(const hd__grid_t *g, const double q[3], double stop2, doub
             node_box(g, l - 1, q8, &b);
             double lb = hd__box_lb2s(&b, q[0], q[1], q[2]);
             if (lb > hit->d2) continue;
-            int at = nc++;
-            while (at > 0 && cl[at - 1] < lb) {
-                cl[at] = cl[at - 1];
-                cp[at] = cp[at - 1];
-                at--;
-            }
-            cl[at] = lb;
-            cp[at] = q8;
+            hd__top_insert(cl, cp, &nc, 8, lb, q8);
         }
         /* cl is in decreasing order: push so the nearest is popped first. */
         for (int k = 0; k < nc; k++) {
             stack[sp].level = l - 1;
-            stack[sp].p = cp[k];
+            stack[sp].p = (uint32_t)cp[k];
             stack[sp].lb2 = cl[k];
             sp++;
         }
@@ -410,19 +403,55 @@ int hd__grid_directed(const hd__src_t *a, size_t na, const hd__grid_t *gb, hd__m
     return HD_OK;
 }
 
-/* Prime m for h(A,B) and measure how much the cheap tests would discard:
- * take a strided sample of A; in each of a few rounds, find the sampled
- * points that neither the representative of their cell nor any point found
- * so far discards, and resolve exactly the ones farthest from their
- * representative (or from B's box when their cell is empty: far-away
- * points are where the maximum lies).  Returns the fraction of the sample
- * discarded by the cheap tests at the end. */
+/* Prime m for h(A,B) from A's own grid: the representatives of A's cells
+ * cover the space A occupies evenly, whatever its density, so the ones
+ * lying where B is emptiest (B's cells there empty, or nearly) are where
+ * the maximum is likely; the PRIME_CELLS of them with the fewest points of
+ * B around get exact nearest-neighbour searches in B. */
+#define PRIME_CELLS 32
+
+void hd__grid_prime(const hd__grid_t *ga, const hd__grid_t *gb, hd__max_t *m,
+                    hd__counts_t *counts) {
+    size_t cells = (size_t)1 << (3 * ga->bits);
+    size_t pick[PRIME_CELLS];
+    double score[PRIME_CELLS];
+    int np = 0;
+    hd__box_t gbox;
+    for (int k = 0; k < 3; k++) {
+        gbox.lo[k] = gb->lo[k];
+        gbox.hi[k] = gb->lo[k] + gb->w * (double)(1u << gb->bits);
+    }
+    for (size_t c = 0; c < cells; c++) {
+        if (ga->start[c] == ga->start[c + 1]) continue;
+        const double *p = ga->rep + 3 * c;
+        uint32_t cb = cell_of(gb, p);
+        uint32_t count = gb->start[cb + 1] - gb->start[cb];
+        /* Higher is emptier: empty cells by their distance to B's box. */
+        double sc = count ? 1.0 / (double)count : 2.0 + hd__box_lb2(&gbox, p);
+        hd__top_insert(score, pick, &np, PRIME_CELLS, sc, c);
+    }
+    for (int k = 0; k < np; k++) {
+        size_t i = ga->perm[ga->start[pick[k]]];
+        hd__hit_t hit;
+        hd__grid_nearest(gb, ga->rep + 3 * (size_t)pick[k], 0.0, -1.0, &hit, counts);
+        hd__max_offer(m, hit.d2, i, hit.j, NULL);
+    }
+}
+
+/* Prime m for h(A,B) and measure what the grid pass costs: take a strided
+ * sample of A; in a few rounds, resolve exactly the sampled points that
+ * neither the representative of their cell nor any point found so far
+ * discards, farthest from their representative (or from B's box when their
+ * cell is empty) first, since far-away points are where the maximum lies;
+ * then run the pass itself over the sample.  Returns the pass's work per
+ * sampled point (distances evaluated plus octree nodes visited), or an
+ * estimate above `limit` as soon as the work passes limit per point. */
 #define RATE_SAMPLE 2048
 #define RATE_ROUNDS 3
 #define RATE_RESOLVE 16
 
-double hd__grid_discard_rate(const hd__src_t *a, size_t na, const hd__grid_t *gb, hd__max_t *m,
-                             hd__counts_t *counts) {
+double hd__grid_trial(const hd__src_t *a, size_t na, const hd__grid_t *gb, hd__max_t *m,
+                      double limit, hd__counts_t *counts) {
     size_t ns = na < RATE_SAMPLE ? na : RATE_SAMPLE;
     double found[RATE_ROUNDS * RATE_RESOLVE][3];
     int nf = 0;
@@ -431,7 +460,6 @@ double hd__grid_discard_rate(const hd__src_t *a, size_t na, const hd__grid_t *gb
         gbox.lo[k] = gb->lo[k];
         gbox.hi[k] = gb->lo[k] + gb->w * (double)(1u << gb->bits);
     }
-    size_t kept = 0;
     for (int round = 0; round <= RATE_ROUNDS; round++) {
         hd__best_t snap;
         hd__max_snapshot(m, &snap);
@@ -440,29 +468,21 @@ double hd__grid_discard_rate(const hd__src_t *a, size_t na, const hd__grid_t *gb
         size_t pick[RATE_RESOLVE];
         double score[RATE_RESOLVE];
         int np = 0;
-        kept = 0;
         for (size_t s = 0; s < ns; s++) {
             size_t i = s * na / ns;
             double p[3];
             hd__src_get(a, i, p);
-            double d = hd__d2(p, gb->rep + 3 * (size_t)cell_of(gb, p));
+            uint32_t cell = cell_of(gb, p);
+            double d = hd__d2(p, gb->rep + 3 * (size_t)cell);
             int gone = hd__kills(cmax2, &snap, d, i);
             for (int f = 0; f < nf && !gone; f++) gone = hd__kills(cmax2, &snap, hd__d2(p, found[f]), i);
             counts->evals += 1 + (uint64_t)nf;
             if (gone) continue;
-            kept++;
-            double sc = d == d ? d : INFINITY;
-            if (sc == INFINITY) sc = 1e300 + hd__box_lb2(&gbox, p); /* empty cell: by distance */
-            if (np < RATE_RESOLVE || sc > score[np - 1]) {
-                int at = np < RATE_RESOLVE ? np++ : RATE_RESOLVE - 1;
-                while (at > 0 && score[at - 1] < sc) {
-                    score[at] = score[at - 1];
-                    pick[at] = pick[at - 1];
-                    at--;
-                }
-                score[at] = sc;
-                pick[at] = i;
-            }
+            /* Sparse cells of B first (empty ones by their distance to B's
+             * box), then the representative's distance. */
+            uint32_t count = gb->start[cell + 1] - gb->start[cell];
+            double sc = count ? d / (double)count : 1e300 + hd__box_lb2(&gbox, p);
+            hd__top_insert(score, pick, &np, RATE_RESOLVE, sc, i);
         }
         if (round == RATE_ROUNDS || np == 0) break;
         for (int k = 0; k < np; k++) {
@@ -474,5 +494,30 @@ double hd__grid_discard_rate(const hd__src_t *a, size_t na, const hd__grid_t *gb
             memcpy(found[nf++], hit.p, sizeof found[0]);
         }
     }
-    return ns ? 1.0 - (double)kept / (double)ns : 1.0;
+    /* The pass over the sample, as hd__grid_directed runs it. */
+    pass_ctx c;
+    c.a = a;
+    c.na = na;
+    c.gb = gb;
+    c.m = m;
+    hd__counts_t n = {0, 0, 0};
+    uint64_t culled = 0;
+    hd__best_t snap;
+    hd__max_snapshot(m, &snap);
+    double bc[3] = {0, 0, 0};
+    int bc_ok = 0;
+    size_t done = 0;
+    for (size_t s = 0; s < ns; s++, done++) {
+        double cmax2 = hd__bound_get(&m->cmax);
+        pass_point(&c, s * na / ns, cmax2, &snap, bc, &bc_ok, &n, &culled, &snap);
+        /* Far too costly already: the answer is clear, stop paying. */
+        if (n.evals + n.exact + n.nodes > (uint64_t)(limit * (double)ns)) {
+            done++;
+            break;
+        }
+    }
+    counts->evals += n.evals;
+    counts->exact += n.exact;
+    counts->nodes += n.nodes;
+    return done ? (double)(n.evals + n.exact + n.nodes) / (double)done : 0.0;
 }

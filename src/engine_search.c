@@ -62,7 +62,7 @@ static inline int exact_point(search_t *s, size_t b, int k) {
 }
 
 /* Scan bucket b; returns 1 when the search may stop. */
-static int scan_bucket(search_t *s, size_t b) {
+HD__HOT static int scan_bucket(search_t *s, size_t b) {
     const hd__tree_t *t = s->t;
     double x[HD__BUCKET], y[HD__BUCKET], z[HD__BUCKET], c[HD__BUCKET];
     int m = hd__bucket_decode(t, b, x, y, z);

@@ -32,6 +32,16 @@
 
 #include <pthread.h>
 
+/* The few hottest loops (distances to a whole bucket) are compiled twice on
+ * x86-64, for AVX2 and for the baseline, and the loader picks the version
+ * the machine runs (GCC's function multi-versioning).  Neither version uses
+ * fused multiply-add: -ffp-contract=off holds for both. */
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+#define HD__HOT __attribute__((target_clones("avx2", "default")))
+#else
+#define HD__HOT
+#endif
+
 /* Points per bucket (at most 32: live points are tracked in 32-bit masks). */
 #define HD__BUCKET 32
 _Static_assert(HD__BUCKET % 4 == 0 && HD__BUCKET <= 32, "bucket size");
@@ -164,6 +174,20 @@ HD__INLINE double hd__box_lb2s(const hd__box_t *b, double x, double y, double z)
     return gx * gx + gy * gy + gz * gz;
 }
 
+/* Keep the k items with the largest scores, in decreasing order of score,
+ * in score[0..*n) and item[0..*n) (*n grows to k). */
+HD__INLINE void hd__top_insert(double *score, size_t *item, int *n, int k, double sc, size_t it) {
+    if (*n == k && !(sc > score[k - 1])) return;
+    int at = *n < k ? (*n)++ : k - 1;
+    while (at > 0 && score[at - 1] < sc) {
+        score[at] = score[at - 1];
+        item[at] = item[at - 1];
+        at--;
+    }
+    score[at] = sc;
+    item[at] = it;
+}
+
 /* ---- proofs from approximations -------------------------------------------- */
 /* Relative slack that covers every rounding in the computed squared
  * distances (a few units of 2^-53) and in these thresholds, many times over;
@@ -276,11 +300,17 @@ HD__INLINE int hd__kills(double cmax2, const hd__best_t *snap, double d2, size_t
 int hd__grid_directed(const hd__src_t *a, size_t na, const hd__grid_t *gb, hd__max_t *m,
                       int threads, hd__counts_t *counts, uint64_t *culled, hd_error_t *err);
 
-/* Prime m with the exact nearest distances of a few points of a sample of
- * A chosen where the maximum is likely, and return the fraction of the
- * sample that the cheap tests then discard. */
-double hd__grid_discard_rate(const hd__src_t *a, size_t na, const hd__grid_t *gb, hd__max_t *m,
-                             hd__counts_t *counts);
+/* Prime m with the exact nearest distances of the representatives of A's
+ * cells (ga) that lie where B is emptiest. */
+void hd__grid_prime(const hd__grid_t *ga, const hd__grid_t *gb, hd__max_t *m,
+                    hd__counts_t *counts);
+
+/* Prime m with the exact nearest distances of points of a sample of A
+ * chosen where the maximum is likely, then run the grid pass over the
+ * sample; returns its work (distances and nodes) per sampled point, or
+ * stops early with some value above `limit`. */
+double hd__grid_trial(const hd__src_t *a, size_t na, const hd__grid_t *gb, hd__max_t *m,
+                      double limit, hd__counts_t *counts);
 
 /* ---- the engine ---------------------------------------------------------------- */
 

@@ -6,8 +6,8 @@
  * exact nearest-neighbour search for every point of A, keep the maximum.  It
  * is NAIVEHDD (paper, Algorithm 1) with line 4's inner loop over B replaced
  * by a tree search, and serves as the peer-equivalent baseline the `auto`
- * engine is measured against.  The same tree backs the public index
- * (hd_index_build) of index.c.
+ * engine is measured against (the engine and the public index use their
+ * own structures, engine_build.c and engine_grid.c).
  *
  * Build.  The points are copied into three coordinate arrays plus an array
  * of original indices, and split recursively at the median of the widest

@@ -22,6 +22,7 @@ typedef struct hd__sink {
     void *data;
     size_t count, cap;
     hd_dtype_t dtype;
+    int fixed; /* a window into another sink's array: never reallocated */
 } hd__sink_t;
 
 void hd__sink_init(hd__sink_t *s, hd_dtype_t dtype);
@@ -115,6 +116,12 @@ int hd__io_err(hd__read_t *r, int code, const char *fmt, ...) HD__PRINTF(3, 4);
 /* The number in [s, end), entirely: 1 and *out (exactly strtod's value), or 0
  * when the token is not a number. */
 int hd__parse_double(const char *s, const char *end, double *out);
+/* The fast path alone: the decimal number at s (sign, digits, point,
+ * exponent), when Clinger's condition holds; returns the end of the number
+ * and sets *out, or NULL (then delimit the token and call
+ * hd__parse_double, which falls back to strtod).  The caller must check
+ * that the number ends where the token ends. */
+const char *hd__scan_double(const char *s, const char *end, double *out);
 /* A non-negative decimal integer in [s, end) without sign or exponent; 0 on
  * failure or overflow of uint64_t. */
 int hd__parse_u64(const char *s, const char *end, uint64_t *out);
@@ -145,19 +152,48 @@ HD__INLINE int hd__token(const char **p, const char *eol, const char **tb,
     return 1;
 }
 
-/* Text parsed in parallel: [begin, end) is cut at line ends into chunks;
- * fn parses one chunk's whole lines into its own points (and triangles)
- * and sets c->lines to the number of lines it parsed; on the first problem
- * it records a code, the 1-based line within the chunk and a message, and
- * stops.  The chunks are merged in file
- * order, so points keep their order and the error reported is the first in
- * the file, with its line number: `first_line` is the number of the line at
- * `begin`. */
+/* The next blank-separated token of [*q, eol) as a double: 1 (and *q past
+ * it), 0 when the line has no more tokens, -1 when the token [*tb, *te) is
+ * not a number.  One pass over the digits in the common case. */
+HD__INLINE int hd__next_double(const char **q, const char *eol, double *v,
+                               const char **tb, const char **te) {
+    const char *s = *q;
+    while (s < eol && hd__is_blank((unsigned char)*s)) s++;
+    if (s == eol) {
+        *q = s;
+        return 0;
+    }
+    const char *e = hd__scan_double(s, eol, v);
+    if (e && (e == eol || hd__is_blank((unsigned char)*e))) {
+        *q = e;
+        return 1;
+    }
+    e = s;
+    while (e < eol && !hd__is_blank((unsigned char)*e)) e++;
+    *tb = s;
+    *te = e;
+    *q = e;
+    return hd__parse_double(s, e, v) ? 1 : -1;
+}
+
+/* Text parsed in parallel.  [begin, end) is cut at line ends into chunks
+ * of about a megabyte.  First every chunk counts its candidate lines (the
+ * lines that may hold a point; job->candidates, or every line), bounded by
+ * bytes / job->min_line, and r->sink reserves the total once; then every
+ * chunk parses its whole lines, writing its points straight into its own
+ * window of that array (c->pts is the window) and its triangles into
+ * c->tris, and sets c->lines to the number of lines it parsed.  On the
+ * first problem a chunk records a code, the 1-based line within the chunk
+ * and a message, and stops.  Finally the chunks are visited in file order:
+ * the first problem is THE error, reported with its absolute line
+ * (`first_line` is the number of the line at `begin`); otherwise each
+ * window is moved down to follow the previous one. */
 typedef struct hd__chunk {
     const char *begin, *end; /* whole lines */
     int index;               /* 0 for the chunk at `begin` */
-    long long lines;         /* lines parsed: set by fn when it finishes */
-    hd__sink_t pts;
+    long long lines;         /* lines parsed: set by the parser when it finishes */
+    size_t room;             /* candidate lines: the window's size */
+    hd__sink_t pts;          /* the window */
     hd__tris_t tris;
     uint64_t aux;            /* free for the reader (e.g. faces counted) */
     int rc;
@@ -165,22 +201,35 @@ typedef struct hd__chunk {
     char msg[256];
 } hd__chunk_t;
 
-typedef void (*hd__chunk_fn)(void *ctx, hd__chunk_t *c);
-
 /* Record a problem in a chunk (message without file or line). */
 void hd__chunk_fail(hd__chunk_t *c, int code, long long line, const char *fmt,
                     ...) HD__PRINTF(4, 5);
 
-/* Called in file order before a chunk's results are appended, with the
- * number of points appended before it (to resolve relative references). */
-typedef void (*hd__chunk_fix_fn)(void *ctx, hd__chunk_t *c, size_t points_before);
+typedef struct hd__text_job {
+    void (*parse)(void *ctx, hd__chunk_t *c);
+    /* Called in file order before a chunk's results are kept, with the
+     * number of points kept before it (to resolve relative references);
+     * may be NULL. */
+    void (*fix)(void *ctx, hd__chunk_t *c, size_t points_before);
+    /* Lines of [begin, end) that may hold a point; NULL: every line. */
+    size_t (*candidates)(void *ctx, const char *begin, const char *end);
+    size_t min_line; /* bytes of the shortest line holding a point, '\n' included */
+    void *ctx;
+} hd__text_job_t;
 
-/* Run fn over [begin, end) and append the results to r->sink (and r->tris
- * when fn produced triangles).  fix may be NULL.  *aux_total receives the
- * sum of chunk aux (may be NULL). */
+/* Candidate counters for hd__text_job_t: none (a pass that reads faces
+ * only) and content lines (neither blank nor starting with '#'). */
+size_t hd__no_candidates(void *ctx, const char *begin, const char *end);
+size_t hd__content_lines(void *ctx, const char *begin, const char *end);
+/* Lines of [p, end) whose first word is `word`. */
+size_t hd__keyword_lines(const char *p, const char *end, const char *word);
+
+/* Run job over [begin, end), appending the points to r->sink and the
+ * triangles to r->tris (when not NULL).  *aux_total receives the sum of the
+ * chunks' aux (may be NULL). */
 int hd__text_parallel(hd__read_t *r, const char *begin, const char *end,
-                      long long first_line, hd__chunk_fn fn,
-                      hd__chunk_fix_fn fix, void *ctx, uint64_t *aux_total);
+                      long long first_line, const hd__text_job_t *job,
+                      uint64_t *aux_total);
 
 /* Skip n lines from p: returns the start of line n+1 (or end) and sets
  * *skipped to the number of lines actually skipped. */

@@ -49,7 +49,7 @@ static int slow_path(const char *s, const char *end, double *out) {
     return ok;
 }
 
-int hd__parse_double(const char *s, const char *end, double *out) {
+const char *hd__scan_double(const char *s, const char *end, double *out) {
     const char *p = s;
     int neg = 0;
     if (p < end && (*p == '-' || *p == '+')) neg = *p++ == '-';
@@ -74,13 +74,13 @@ int hd__parse_double(const char *s, const char *end, double *out) {
         sig += (long)(p - fd);
         digits += frac;
     }
-    if (digits == 0) return slow_path(s, end, out);
+    if (digits == 0 || sig > 19) return NULL;
     long e10 = -frac;
     if (p < end && (*p == 'e' || *p == 'E')) {
         const char *q = p + 1;
         int eneg = 0;
         if (q < end && (*q == '-' || *q == '+')) eneg = *q++ == '-';
-        if (q == end || (unsigned)(*q - '0') >= 10) return slow_path(s, end, out);
+        if (q == end || (unsigned)(*q - '0') >= 10) return NULL;
         long x = 0;
         while (q < end && (unsigned)(*q - '0') < 10) {
             if (x < 100000) x = x * 10 + (*q - '0');
@@ -89,7 +89,6 @@ int hd__parse_double(const char *s, const char *end, double *out) {
         e10 += eneg ? -x : x;
         p = q;
     }
-    if (p != end || sig > 19) return slow_path(s, end, out);
     double v;
     if (m == 0) {
         v = 0.0;
@@ -98,8 +97,13 @@ int hd__parse_double(const char *s, const char *end, double *out) {
         if (e10 < 0) v /= pow10_exact[-e10];
         else v *= pow10_exact[e10];
     } else {
-        return slow_path(s, end, out);
+        return NULL;
     }
     *out = neg ? -v : v;
-    return 1;
+    return p;
+}
+
+int hd__parse_double(const char *s, const char *end, double *out) {
+    if (hd__scan_double(s, end, out) == end) return 1;
+    return slow_path(s, end, out);
 }

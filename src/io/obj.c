@@ -53,8 +53,9 @@ static void chunk(void *ctx, hd__chunk_t *c) {
         if (*tb == 'v') {
             double v[3];
             int got = 0;
-            while (got < 3 && hd__token(&q, eol, &tb, &te)) {
-                if (!hd__parse_double(tb, te, &v[got])) {
+            int k;
+            while (got < 3 && (k = hd__next_double(&q, eol, &v[got], &tb, &te)) != 0) {
+                if (k < 0) {
                     hd__chunk_fail(c, HD_EFORMAT, line, "vertex: '%.*s' is not a number", (int)(te - tb > 40 ? 40 : te - tb), tb);
                     return;
                 }
@@ -111,6 +112,11 @@ static void chunk(void *ctx, hd__chunk_t *c) {
     c->lines = line;
 }
 
+static size_t candidates(void *ctx, const char *p, const char *end) {
+    (void)ctx;
+    return hd__keyword_lines(p, end, "v");
+}
+
 /* Resolve relative references now that the vertices before the chunk are
  * known; an unresolvable one becomes BAD (out of range). */
 static void fix_chunk(void *ctx, hd__chunk_t *c, size_t before) {
@@ -153,7 +159,9 @@ int hd__read_obj(hd__read_t *r) {
     const char *s = (const char *)r->f->data;
     int want_faces = r->tris != NULL;
     uint64_t faces = 0;
-    int rc = hd__text_parallel(r, s, s + r->f->size, 1, chunk, fix_chunk, &want_faces, &faces);
+    /* the shortest vertex line is "v 0 0 0\n" */
+    hd__text_job_t job = {chunk, fix_chunk, candidates, 8, &want_faces};
+    int rc = hd__text_parallel(r, s, s + r->f->size, 1, &job, &faces);
     if (rc) return rc;
     r->n_faces = (size_t)faces;
     if (r->tris)

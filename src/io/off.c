@@ -46,16 +46,20 @@ static void chunk(void *ctx, hd__chunk_t *c) {
         line++;
         const char *eol = hd__eol(p, end), *q = p;
         p = eol + (eol < end);
-        if (!next_token(&q, eol, &tb, &te)) continue; /* blank or comment */
         if (!o->faces) {
             double v[3];
-            int got = 0;
-            do {
-                if (!hd__parse_double(tb, te, &v[got])) {
+            int got = 0, k;
+            const char *s = q;
+            while (s < eol && hd__is_blank((unsigned char)*s)) s++;
+            if (s == eol || *s == '#') continue; /* blank or comment */
+            while (got < 3 && (k = hd__next_double(&q, eol, &v[got], &tb, &te)) != 0) {
+                if (k < 0 && *tb == '#') break; /* a comment after fewer than 3 numbers */
+                if (k < 0) {
                     hd__chunk_fail(c, HD_EFORMAT, line, "'%.*s' is not a number", (int)(te - tb > 40 ? 40 : te - tb), tb);
                     return;
                 }
-            } while (++got < 3 && next_token(&q, eol, &tb, &te));
+                got++;
+            }
             if (got < 3) {
                 hd__chunk_fail(c, HD_EFORMAT, line, "expected a vertex (x y z), found %d number%s", got, got == 1 ? "" : "s");
                 return;
@@ -67,6 +71,7 @@ static void chunk(void *ctx, hd__chunk_t *c) {
             }
             continue;
         }
+        if (!next_token(&q, eol, &tb, &te)) continue; /* blank or comment */
         uint64_t n;
         if (!hd__parse_u64(tb, te, &n)) {
             hd__chunk_fail(c, HD_EFORMAT, line, "face size '%.*s' is not a whole number", (int)(te - tb > 40 ? 40 : te - tb), tb);
@@ -180,7 +185,8 @@ int hd__read_off(hd__read_t *r) {
     int rc = hd__sink_reserve(r->sink, (size_t)nv);
     if (rc) return hd__io_err(r, rc, "cannot allocate %llu vertices", (unsigned long long)nv);
     off_ctx_t o = {0, nv};
-    if ((rc = hd__text_parallel(r, p, stop, line + 1, chunk, NULL, &o, NULL))) return rc;
+    hd__text_job_t job = {chunk, NULL, hd__content_lines, 6, &o};
+    if ((rc = hd__text_parallel(r, p, stop, line + 1, &job, NULL))) return rc;
     line += (long long)lines;
     p = stop;
     left = (size_t)(end - p);
@@ -193,7 +199,8 @@ int hd__read_off(hd__read_t *r) {
                                (unsigned long long)found, (unsigned long long)nf);
     if (r->tris) {
         o.faces = 1;
-        if ((rc = hd__text_parallel(r, p, stop, line + 1, chunk, NULL, &o, NULL))) return rc;
+        job.candidates = hd__no_candidates;
+        if ((rc = hd__text_parallel(r, p, stop, line + 1, &job, NULL))) return rc;
     }
     return HD_OK;
 }

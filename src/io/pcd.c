@@ -264,7 +264,11 @@ int hd__read_pcd(hd__read_t *r) {
         if (rc == HD_OK && (rc = hd__sink_reserve(r->sink, (size_t)p->points)))
             rc = hd__io_err(r, rc, "cannot allocate %llu points", (unsigned long long)p->points);
         if (rc == HD_OK)
-            rc = hd__text_parallel(r, (const char *)data, (const char *)data + left, p->start_line, chunk, NULL, p, NULL);
+        {
+            /* blank lines are skipped; a point line has 2 bytes per value */
+            hd__text_job_t job = {chunk, NULL, hd__content_lines, (size_t)(2 * p->tokens), p};
+            rc = hd__text_parallel(r, (const char *)data, (const char *)data + left, p->start_line, &job, NULL);
+        }
         if (rc == HD_OK && r->sink->count != p->points)
             rc = hd__io_err(r, HD_EFORMAT, "POINTS says %llu, the data holds %zu", (unsigned long long)p->points, r->sink->count);
     } else if (rc == HD_OK && p->data == 1) {

@@ -322,29 +322,26 @@ static void vertex_chunk(void *ctx, hd__chunk_t *c) {
     uint64_t idx[64];
     while (p < end) {
         line++;
-        const char *eol = hd__eol(p, end), *q = p, *tb, *te;
+        const char *eol = hd__eol(p, end), *q = p, *tb = p, *te = p;
         p = eol + (eol < end);
         double v[3] = {0, 0, 0};
         int found = 0;
         for (int j = 0; j < e->n_props; j++) {
             const prop_t *pr = &e->props[j];
-            if (!hd__token(&q, eol, &tb, &te)) {
+            int cc = pr->count_type ? -1 : j == a->xyz[0] ? 0 : j == a->xyz[1] ? 1 : j == a->xyz[2] ? 2 : -1;
+            int got = cc >= 0 ? hd__next_double(&q, eol, &v[cc], &tb, &te) : hd__token(&q, eol, &tb, &te);
+            if (!got) {
                 hd__chunk_fail(c, HD_EFORMAT, line, "element %.*s: expected a value for property %.*s, found end of line",
                                (int)e->len, e->name, (int)pr->len, pr->name);
                 return;
             }
-            if (!pr->count_type) {
-                int cc = j == a->xyz[0] ? 0 : j == a->xyz[1] ? 1 : j == a->xyz[2] ? 2 : -1;
-                if (cc >= 0) {
-                    if (!hd__parse_double(tb, te, &v[cc])) {
-                        hd__chunk_fail(c, HD_EFORMAT, line, "'%.*s' is not a number (property %.*s)",
-                                       (int)(te - tb > 40 ? 40 : te - tb), tb, (int)pr->len, pr->name);
-                        return;
-                    }
-                    found++;
-                }
-                continue;
+            if (got < 0) {
+                hd__chunk_fail(c, HD_EFORMAT, line, "'%.*s' is not a number (property %.*s)", (int)(te - tb > 40 ? 40 : te - tb),
+                               tb, (int)pr->len, pr->name);
+                return;
             }
+            found += cc >= 0;
+            if (!pr->count_type) continue;
             uint64_t cnt;
             if (!hd__parse_u64(tb, te, &cnt)) {
                 hd__chunk_fail(c, HD_EFORMAT, line, "list length '%.*s' is not a whole number",
@@ -443,7 +440,9 @@ static int read_ascii(ply_t *p, int v, const int *xyz, int face_el, int face) {
             int rc = hd__sink_reserve(r->sink, (size_t)e->count);
             if (rc) return hd__io_err(r, rc, "cannot allocate %llu vertices", (unsigned long long)e->count);
         }
-        int rc = hd__text_parallel(r, q, stop, line, vertex_chunk, NULL, &a, NULL);
+        /* every line of the vertex element is a vertex; face lines are none */
+        hd__text_job_t job = {vertex_chunk, NULL, k == v ? NULL : hd__no_candidates, 2 * (size_t)e->n_props, &a};
+        int rc = hd__text_parallel(r, q, stop, line, &job, NULL);
         if (rc) return rc;
         q = stop;
         line += (long long)e->count;

@@ -8,9 +8,13 @@
  * kept only if every coordinate is finite, within HD_MAX_COORD, and (for
  * float storage) within FLT_MAX.  Readers reserve room only for counts they
  * have checked against the bytes left in the file, so the sink never grows
- * beyond what the file can hold.  Arrays of 8 MB and more are 2 MB aligned
- * and advised to use transparent huge pages: writing 240 MB of fresh memory
- * otherwise costs some 60 000 page faults, more than converting the points.
+ * beyond what the file can hold.
+ *
+ * Transparent huge pages (MADV_HUGEPAGE) were tried for large arrays: they
+ * remove most of the page-fault cost of filling fresh memory, but where
+ * memory is fragmented the kernel first compacts it synchronously, which
+ * cost a whole second for 240 MB in one measurement.  So the sink takes
+ * plain memory, whose cost is predictable.
  */
 #include "io.h"
 
@@ -18,15 +22,12 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/mman.h>
-
-#define HUGE_ALIGN ((size_t)2 << 20)
-#define HUGE_FROM ((size_t)8 << 20)
 
 void hd__sink_init(hd__sink_t *s, hd_dtype_t dtype) {
     s->data = NULL;
     s->count = s->cap = 0;
     s->dtype = dtype;
+    s->fixed = 0;
 }
 
 static size_t point_bytes(hd_dtype_t d) {
@@ -35,28 +36,15 @@ static size_t point_bytes(hd_dtype_t d) {
 
 int hd__sink_reserve(hd__sink_t *s, size_t n) {
     if (n <= s->cap - s->count) return HD_OK;
+    if (s->fixed) return HD_EOVERFLOW; /* a window cannot grow */
     size_t want = s->count + n;
     if (want < s->count) return HD_EOVERFLOW;
     size_t cap = s->cap < SIZE_MAX / 2 ? s->cap + s->cap / 2 : want;
     if (cap < want) cap = want;
     if (cap < 256) cap = 256;
     if (hd__mul_overflows(cap, point_bytes(s->dtype))) return HD_EOVERFLOW;
-    size_t bytes = cap * point_bytes(s->dtype);
-    void *p;
-    if (bytes >= HUGE_FROM) {
-        /* large: 2 MB aligned and backed by transparent huge pages where
-         * the kernel offers them on request, so filling it costs a few
-         * hundred page faults instead of one per 4 KB */
-        size_t round = (bytes + HUGE_ALIGN - 1) / HUGE_ALIGN * HUGE_ALIGN;
-        if (posix_memalign(&p, HUGE_ALIGN, round) != 0) return HD_ENOMEM;
-#ifdef MADV_HUGEPAGE
-        madvise(p, round, MADV_HUGEPAGE);
-#endif
-        if (s->count) memcpy(p, s->data, s->count * point_bytes(s->dtype));
-        free(s->data);
-    } else if (!(p = realloc(s->data, bytes))) {
-        return HD_ENOMEM;
-    }
+    void *p = realloc(s->data, cap * point_bytes(s->dtype));
+    if (!p) return HD_ENOMEM;
     s->data = p;
     s->cap = cap;
     return HD_OK;

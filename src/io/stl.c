@@ -39,11 +39,12 @@ static void chunk(void *ctx, hd__chunk_t *c) {
         if (word(tb, te, "vertex")) {
             double v[3];
             for (int k = 0; k < 3; k++) {
-                if (!hd__token(&q, eol, &tb, &te)) {
+                int got = hd__next_double(&q, eol, &v[k], &tb, &te);
+                if (got == 0) {
                     hd__chunk_fail(c, HD_EFORMAT, line, "vertex: expected x y z, found %d number%s", k, k == 1 ? "" : "s");
                     return;
                 }
-                if (!hd__parse_double(tb, te, &v[k])) {
+                if (got < 0) {
                     hd__chunk_fail(c, HD_EFORMAT, line, "vertex: '%.*s' is not a number", (int)(te - tb > 40 ? 40 : te - tb), tb);
                     return;
                 }
@@ -62,6 +63,11 @@ static void chunk(void *ctx, hd__chunk_t *c) {
         }
     }
     c->lines = line;
+}
+
+static size_t candidates(void *ctx, const char *p, const char *end) {
+    (void)ctx;
+    return hd__keyword_lines(p, end, "vertex");
 }
 
 /* The first facet that does not have exactly three vertices (serial; only
@@ -109,7 +115,9 @@ int hd__read_stl(hd__read_t *r) {
     if (solid && !exact) {
         const char *s = (const char *)d;
         uint64_t facets = 0;
-        int rc = hd__text_parallel(r, s, s + size, 1, chunk, NULL, NULL, &facets);
+        /* the shortest vertex line is "vertex 0 0 0\n" */
+        hd__text_job_t job = {chunk, NULL, candidates, 14, NULL};
+        int rc = hd__text_parallel(r, s, s + size, 1, &job, &facets);
         if (rc) return rc;
         if (r->sink->count != 3 * facets) return report_bad_facet(r);
         r->n_faces = (size_t)facets;

@@ -4,15 +4,22 @@
  *
  * A text region is cut into chunks of about a megabyte, each ending just
  * after a newline, so every chunk holds whole lines and no line is split.
- * Chunks are independent tasks for hd__parallel_for: each parses its lines
- * into its own point array (and its own triangles), counts its lines, and on
- * the first problem records the code, its line within the chunk and a
- * message, then stops.  Afterwards the chunks are visited in file order: the
- * first chunk with a problem gives THE error, whose absolute line is the
- * region's first line plus the lines of all earlier chunks (each chunk
- * that finished reports its count; the framework counts the newlines of
- * one that did not say), and otherwise the points are appended in order.  The result is therefore the
- * same, point for point and error for error, at any thread count.
+ * Parsing is three steps.  (1) In parallel, each chunk counts the lines that
+ * may hold a point (a cheap scan, one memchr per line), bounded by its
+ * bytes over the shortest line a point needs, so the bound never exceeds
+ * what the file can hold.  (2) The result array is reserved once for the
+ * total, each chunk gets the window of it that follows the previous
+ * chunks' windows, and the chunks are parsed in parallel, each writing its
+ * points straight into its window: no chunk-local copies, so each point is
+ * written once and the memory is touched once.  A chunk counts its lines
+ * and, on its first problem, records the code, its line within the chunk
+ * and a message, then stops.  (3) The chunks are visited in file order:
+ * the first chunk with a problem gives THE error, whose absolute line is
+ * the region's first line plus the lines of all earlier chunks, and
+ * otherwise each window is moved down to close the gap left by lines that
+ * held no point (comments, a header; usually there is none).  The result is
+ * therefore the same, point for point and error for error, at any thread
+ * count.
  */
 #include "io.h"
 
@@ -110,14 +117,55 @@ void hd__chunk_fail(hd__chunk_t *c, int code, long long line, const char *fmt, .
 
 typedef struct {
     hd__chunk_t *chunks;
-    hd__chunk_fn fn;
-    void *ctx;
+    const hd__text_job_t *job;
 } run_t;
 
-static void run_chunk(void *ctx, size_t task, int worker) {
+static size_t all_lines(void *ctx, const char *p, const char *end) {
+    (void)ctx;
+    uint64_t n;
+    hd__skip_lines(p, end, UINT64_MAX, &n);
+    return (size_t)n;
+}
+
+size_t hd__keyword_lines(const char *p, const char *end, const char *word) {
+    size_t n = 0, len = strlen(word);
+    const char *tb, *te;
+    while (p < end) {
+        const char *eol = hd__eol(p, end), *q = p;
+        n += hd__token(&q, eol, &tb, &te) && (size_t)(te - tb) == len && memcmp(tb, word, len) == 0;
+        p = eol + (eol < end);
+    }
+    return n;
+}
+
+size_t hd__no_candidates(void *ctx, const char *begin, const char *end) {
+    (void)ctx;
+    (void)begin;
+    (void)end;
+    return 0;
+}
+
+size_t hd__content_lines(void *ctx, const char *begin, const char *end) {
+    (void)ctx;
+    uint64_t found, lines;
+    hd__skip_content_lines(begin, end, UINT64_MAX, &found, &lines);
+    return (size_t)found;
+}
+
+static void count_chunk(void *ctx, size_t task, int worker) {
     (void)worker;
     run_t *run = ctx;
-    run->fn(run->ctx, &run->chunks[task]);
+    hd__chunk_t *c = &run->chunks[task];
+    size_t (*count)(void *, const char *, const char *) = run->job->candidates ? run->job->candidates : all_lines;
+    size_t n = count(run->job->ctx, c->begin, c->end);
+    size_t most = ((size_t)(c->end - c->begin) + 1) / (run->job->min_line ? run->job->min_line : 1);
+    c->room = n < most ? n : most;
+}
+
+static void parse_chunk(void *ctx, size_t task, int worker) {
+    (void)worker;
+    run_t *run = ctx;
+    run->job->parse(run->job->ctx, &run->chunks[task]);
 }
 
 static long long count_lines(const char *p, const char *end) {
@@ -129,11 +177,11 @@ static long long count_lines(const char *p, const char *end) {
 #define CHUNK_BYTES ((size_t)1 << 20)
 
 int hd__text_parallel(hd__read_t *r, const char *begin, const char *end,
-                      long long first_line, hd__chunk_fn fn,
-                      hd__chunk_fix_fn fix, void *ctx, uint64_t *aux_total) {
+                      long long first_line, const hd__text_job_t *job,
+                      uint64_t *aux_total) {
     size_t size = (size_t)(end - begin);
     size_t n = size / CHUNK_BYTES + 1;
-    if (n > 4096) n = 4096;
+    if (n > 65536) n = 65536;
     hd__chunk_t *chunks = hd__calloc_array(n, sizeof *chunks);
     if (!chunks) return hd__io_err(r, HD_ENOMEM, "out of memory for %zu text chunks", n);
     size_t used = 0;
@@ -150,19 +198,33 @@ int hd__text_parallel(hd__read_t *r, const char *begin, const char *end,
         c->end = stop;
         c->index = (int)used;
         c->lines = -1;
-        hd__sink_init(&c->pts, r->sink->dtype);
         hd__tris_init(&c->tris);
         used++;
         p = stop;
     }
-    run_t run = {chunks, fn, ctx};
-    int rc = hd__parallel_for(r->threads, used, run_chunk, &run);
-    if (rc) hd__io_err(r, rc, "could not parse in parallel: %s", hd_strerror(rc));
-    /* room for every point once, rather than growing while appending */
+    run_t run = {chunks, job};
+    hd__sink_t *s = r->sink;
+    size_t el = s->dtype == HD_FLOAT32 ? 3 * sizeof(float) : 3 * sizeof(double);
+    /* 1: how many points each chunk may hold; room for all of them at once */
+    int rc = hd__parallel_for(r->threads, used, count_chunk, &run);
     size_t total = 0;
-    for (size_t k = 0; k < used && !chunks[k].rc; k++) total += chunks[k].pts.count;
-    if (rc == HD_OK && (rc = hd__sink_reserve(r->sink, total)))
-        hd__io_err(r, rc, "out of memory for %zu points", total);
+    for (size_t k = 0; k < used; k++) total += chunks[k].room;
+    if (rc == HD_OK && (rc = hd__sink_reserve(s, total)))
+        hd__io_err(r, rc, "cannot allocate %zu points", total);
+    /* 2: every chunk parses into its window of the array */
+    size_t at = s->count;
+    for (size_t k = 0; rc == HD_OK && k < used; k++) {
+        hd__chunk_t *c = &chunks[k];
+        c->pts.data = (char *)s->data + at * el;
+        c->pts.count = 0;
+        c->pts.cap = c->room;
+        c->pts.dtype = s->dtype;
+        c->pts.fixed = 1;
+        at += c->room;
+    }
+    if (rc == HD_OK && (rc = hd__parallel_for(r->threads, used, parse_chunk, &run)))
+        hd__io_err(r, rc, "could not parse in parallel: %s", hd_strerror(rc));
+    /* 3: in file order, the first problem or the windows closed up */
     long long line = first_line;
     uint64_t aux = 0;
     for (size_t k = 0; k < used && rc == HD_OK; k++) {
@@ -173,15 +235,13 @@ int hd__text_parallel(hd__read_t *r, const char *begin, const char *end,
         }
         line += c->lines >= 0 ? c->lines : count_lines(c->begin, c->end);
         aux += c->aux;
-        if (fix) fix(ctx, c, r->sink->count);
-        if ((rc = hd__sink_append(r->sink, &c->pts)) ||
-            (r->tris && (rc = hd__tris_append(r->tris, &c->tris))))
-            hd__io_err(r, rc, "out of memory for the points read");
+        if (job->fix) job->fix(job->ctx, c, s->count);
+        char *dst = (char *)s->data + s->count * el;
+        if (c->pts.count && dst != (char *)c->pts.data) memmove(dst, c->pts.data, c->pts.count * el);
+        s->count += c->pts.count;
+        if (r->tris && (rc = hd__tris_append(r->tris, &c->tris))) hd__io_err(r, rc, "out of memory for the faces read");
     }
-    for (size_t k = 0; k < used; k++) {
-        hd__sink_free(&chunks[k].pts);
-        hd__tris_free(&chunks[k].tris);
-    }
+    for (size_t k = 0; k < used; k++) hd__tris_free(&chunks[k].tris);
     free(chunks);
     if (aux_total) *aux_total = aux;
     return rc;

@@ -20,7 +20,7 @@
 
 #include <math.h>
 
-static int is_sep(int c) { return c == ' ' || c == '\t' || c == '\r' || c == ',' || c == ';' || c == '\f' || c == '\v'; }
+static int is_sep(int c) { return c == ' ' || c == ',' || c == '\t' || c == ';' || c == '\r' || c == '\f' || c == '\v'; }
 
 static void chunk(void *ctx, hd__chunk_t *c) {
     (void)ctx;
@@ -38,7 +38,12 @@ static void chunk(void *ctx, hd__chunk_t *c) {
         while (got < 3) {
             while (q < eol && is_sep((unsigned char)*q)) q++;
             if (q == eol) break;
-            const char *t = q;
+            const char *t = q, *e = hd__scan_double(q, eol, &v[got]);
+            if (e && (e == eol || is_sep((unsigned char)*e))) {
+                q = e; /* the fast path read the whole token */
+                got++;
+                continue;
+            }
             while (q < eol && !is_sep((unsigned char)*q)) q++;
             if (!hd__parse_double(t, q, &v[got])) {
                 if (first && got == 0) break; /* a header line */
@@ -68,7 +73,24 @@ static void chunk(void *ctx, hd__chunk_t *c) {
     c->lines = line;
 }
 
+/* Lines whose first field can start a number (digits, sign, point, or the
+ * inf/nan that strtod accepts and the point check then refuses). */
+static size_t candidates(void *ctx, const char *p, const char *end) {
+    (void)ctx;
+    size_t n = 0;
+    while (p < end) {
+        const char *eol = hd__eol(p, end), *q = p;
+        while (q < eol && is_sep((unsigned char)*q)) q++;
+        unsigned char f = (unsigned char)(q < eol ? *q : 0);
+        n += ((unsigned)f - (unsigned)'0' < 10u) || f == '-' || f == '+' || f == '.' || f == 'i' || f == 'I' || f == 'n' || f == 'N';
+        p = eol + (eol < end);
+    }
+    return n;
+}
+
 int hd__read_xyz(hd__read_t *r) {
     const char *s = (const char *)r->f->data;
-    return hd__text_parallel(r, s, s + r->f->size, 1, chunk, NULL, NULL, NULL);
+    /* the shortest point line is "0 0 0\n" */
+    hd__text_job_t job = {chunk, NULL, candidates, 6, NULL};
+    return hd__text_parallel(r, s, s + r->f->size, 1, &job, NULL);
 }
