@@ -18,6 +18,7 @@
  * Defaults: N = 100000, R = 5, K = 1, T = 1, every algorithm, both pairs.
  * Output: one markdown table row per (pair, algorithm).
  */
+#include "benchutil.h"
 #include "gen.h"
 
 #include <hausdorff.h>
@@ -27,25 +28,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
-
-static double now(void) {
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static int cmp_double(const void *x, const void *y) {
-    double a = *(const double *)x, b = *(const double *)y;
-    return (a > b) - (a < b);
-}
-
-static int listed(const char *list, const char *name) {
-    if (!list) return 1;
-    size_t n = strlen(name);
-    for (const char *p = list; (p = strstr(p, name)) != NULL; p += n)
-        if ((p == list || p[-1] == ',') && (p[n] == ',' || p[n] == '\0')) return 1;
-    return 0;
-}
 
 int main(int argc, char **argv) {
     size_t n = 100000;
@@ -85,7 +67,7 @@ int main(int argc, char **argv) {
     int status = 0;
     for (int p = 0; p < 3; p++) {
         /* "identical" runs only when named. */
-        if (p == 2 ? !pairs || !listed(pairs, pair_names[p]) : !listed(pairs, pair_names[p]))
+        if (p == 2 ? !pairs || !bench_listed(pairs, pair_names[p]) : !bench_listed(pairs, pair_names[p]))
             continue;
         gen_rng_t g;
         double m0[3] = {0, 0, 0}, m1[3] = {p ? 20.0 : 0.0, 0, 0};
@@ -97,7 +79,7 @@ int main(int argc, char **argv) {
         double reference = -1.0;
         for (size_t k = 0; k < sizeof order / sizeof order[0]; k++) {
             const char *name = hd_algorithm_name(order[k]);
-            if (!listed(algs, name)) continue;
+            if (!bench_listed(algs, name)) continue;
             hd_options_t o;
             hd_options_init(&o);
             o.algorithm = order[k];
@@ -106,12 +88,12 @@ int main(int argc, char **argv) {
             hd_symmetric_t s;
             hd_error_t e;
             for (int r = 0; r < r_count; r++) {
-                double t0 = now();
+                double t0 = bench_now();
                 if (hd_hausdorff(&A, &B, &o, &s, &e) != HD_OK) {
                     fprintf(stderr, "algos_bench: %s: %s\n", name, e.message);
                     return 1;
                 }
-                times[r] = now() - t0;
+                times[r] = bench_now() - t0;
                 if (reference < 0) reference = s.distance;
                 if (s.distance != reference) {
                     fprintf(stderr, "algos_bench: %s gave %.17g, expected %.17g\n", name,
@@ -119,9 +101,7 @@ int main(int argc, char **argv) {
                     status = 1;
                 }
             }
-            qsort(times, (size_t)r_count, sizeof *times, cmp_double);
-            double med = r_count % 2 ? times[r_count / 2]
-                                     : 0.5 * (times[r_count / 2 - 1] + times[r_count / 2]);
+            double med = bench_median(times, r_count);
             char ran[64];
             const char *ra = hd_algorithm_name(s.ab.algorithm), *rb = hd_algorithm_name(s.ba.algorithm);
             if (s.ab.algorithm == s.ba.algorithm) snprintf(ran, sizeof ran, "%s", ra);

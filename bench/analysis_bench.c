@@ -13,6 +13,7 @@
  *
  * usage: analysis_bench [N] [RUNS] [THREADS]   (default 1000000 5 0)
  */
+#include "benchutil.h"
 #include "gen.h"
 
 #include <hausdorff.h>
@@ -20,22 +21,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
-
-static double now(void) {
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static int cmp_double(const void *x, const void *y) {
-    double a = *(const double *)x, b = *(const double *)y;
-    return (a > b) - (a < b);
-}
-
-static double median(double *t, int n) {
-    qsort(t, (size_t)n, sizeof *t, cmp_double);
-    return n % 2 ? t[n / 2] : (t[n / 2 - 1] + t[n / 2]) / 2;
-}
 
 static volatile double sink;
 
@@ -80,31 +65,31 @@ int main(int argc, char **argv) {
         double tp[50], ta[50], tk[50], td[50], ts[50];
         hd_symmetric_t sa, sk;
         for (int r = 0; r < runs; r++) {
-            double t0 = now();
+            double t0 = bench_now();
             sink = stream(a, n, b, n);
-            tp[r] = now() - t0;
-            t0 = now();
+            tp[r] = bench_now() - t0;
+            t0 = bench_now();
             if (hd_hausdorff(&A, &B, &auto_o, &sa, &err)) goto fail;
-            ta[r] = now() - t0;
-            t0 = now();
+            ta[r] = bench_now() - t0;
+            t0 = bench_now();
             if (hd_hausdorff(&A, &B, &kd_o, &sk, &err)) goto fail;
-            tk[r] = now() - t0;
-            t0 = now();
+            tk[r] = bench_now() - t0;
+            t0 = bench_now();
             if (hd_distances(&A, &B, &auto_o, dab, jab, dba, jba, &err)) goto fail;
-            td[r] = now() - t0;
-            t0 = now();
+            td[r] = bench_now() - t0;
+            t0 = bench_now();
             hd_percentile_t p;
             hd_summary_t s;
             if (hd_percentile_of(dab, n, dba, n, 95, &p, &err) || hd_summarize(dab, n, dba, n, &s, &err))
                 goto fail;
-            ts[r] = now() - t0;
+            ts[r] = bench_now() - t0;
             if (s.max_ab != sa.ab.distance || s.max_ba != sa.ba.distance || sk.distance != sa.distance) {
                 fprintf(stderr, "%s: per-point maxima differ from the Hausdorff distance\n", cases[c]);
                 return 2;
             }
         }
-        double mp = median(tp, runs), ma = median(ta, runs), mk = median(tk, runs), md = median(td, runs),
-               ms = median(ts, runs);
+        double mp = bench_median(tp, runs), ma = bench_median(ta, runs), mk = bench_median(tk, runs), md = bench_median(td, runs),
+               ms = bench_median(ts, runs);
         printf("| %s | %zu | %.4f s | %.4f s | %.4f s | %.4f s | %.2f | %.2f | %.1f | %.4f s |\n", cases[c], n, mp,
                ma, mk, md, md / ma, md / mk, md / mp, ms);
         fflush(stdout);

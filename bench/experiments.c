@@ -48,6 +48,7 @@
  * usage: experiments [--quick] [--runs N] [--only a,b,...] [--data DIR]
  *                    [--out FILE]
  */
+#include "benchutil.h"
 #include "gen.h"
 
 #include <hausdorff.h>
@@ -63,27 +64,6 @@
 
 static FILE *out;
 static int quick;
-
-static double clock_s(clockid_t id) {
-    struct timespec ts;
-    clock_gettime(id, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-static double now(void) { return clock_s(CLOCK_MONOTONIC); }
-static double cpu_now(void) { return clock_s(CLOCK_PROCESS_CPUTIME_ID); }
-
-static int cmp_double(const void *x, const void *y) {
-    double a = *(const double *)x, b = *(const double *)y;
-    return (a > b) - (a < b);
-}
-
-static int listed(const char *list, const char *name) {
-    if (!list) return 1;
-    size_t n = strlen(name);
-    for (const char *p = list; (p = strstr(p, name)) != NULL; p += n)
-        if ((p == list || p[-1] == ',') && (p[n] == ',' || p[n] == '\0')) return 1;
-    return 0;
-}
 
 static void die(const char *fmt, ...) {
     va_list ap;
@@ -170,17 +150,10 @@ static void run_once(const cloud_t *a, const cloud_t *b, config_t *c, uint64_t s
     hd_options_t o = c->o;
     hd_error_t e;
     o.seed = seed;
-    double w0 = now(), c0 = cpu_now();
+    double w0 = bench_now(), c0 = bench_cpu_now();
     if (hd_hausdorff(&A, &B, &o, s, &e) != HD_OK) die("%s %s: %s", exp, c->variant, e.message);
-    *cpu = cpu_now() - c0;
-    *wall = now() - w0;
-}
-
-static double median_of(const double *v, int n) {
-    double sorted[MAX_RUNS];
-    memcpy(sorted, v, (size_t)n * sizeof(double));
-    qsort(sorted, (size_t)n, sizeof(double), cmp_double);
-    return n % 2 ? sorted[n / 2] : 0.5 * (sorted[n / 2 - 1] + sorted[n / 2]);
+    *cpu = bench_cpu_now() - c0;
+    *wall = bench_now() - w0;
 }
 
 static void emit(const char *exp, const config_t *c, const cloud_t *a, const cloud_t *b);
@@ -215,8 +188,8 @@ static void measure_pair(const char *exp, const cloud_t *a, const cloud_t *b, co
         for (int r = 0; r < c[k].runs; r++) sum += c[k].t[r], wsum += c[k].wall[r];
         c[k].mean = sum / c[k].runs;
         c[k].wall_mean = wsum / c[k].runs;
-        c[k].median = median_of(c[k].t, c[k].runs);
-        c[k].wall_median = median_of(c[k].wall, c[k].runs);
+        c[k].median = bench_median(c[k].t, c[k].runs);
+        c[k].wall_median = bench_median(c[k].wall, c[k].runs);
         emit(exp, &c[k], a, b);
     }
     fprintf(stderr, "%s {%s} |A| %zu, |B| %zu, alpha %.3f; CPU ms:", exp, c[0].fields, a->n, b->n,
@@ -657,7 +630,7 @@ int main(int argc, char **argv) {
     size_t motion_n = 50000;
     out = stdout;
     if (path && !(out = fopen(path, "w"))) die("cannot write %s", path);
-    double t0 = now();
+    double t0 = bench_now();
     fprintf(out, "{\"exp\":\"header\",\"mode\":\"%s\",\"table_runs\":%d,\"curve_runs\":%d,"
                  "\"naive_runs\":%d,\"motion_points\":%zu,\"threads\":1,\"version\":\"%s\","
                  "\"load_start\":%.2f,\"torus\":[%g,%g],\"gear\":[%d,%g,%g,%g,%g],"
@@ -665,16 +638,16 @@ int main(int argc, char **argv) {
             quick ? "quick" : "full", table_runs, curve_runs, naive_runs, motion_n, hd_version(),
             load1(), TORUS_R, TORUS_r, GEAR_TEETH, GEAR_ROOT, GEAR_TIP, GEAR_BORE, GEAR_THICK,
             DISJOINT_SHIFT);
-    if (listed(only, "shapes")) shapes(3000);
-    if (listed(only, "table1")) table1(table_runs);
-    if (listed(only, "table2")) table2(table_runs);
-    if (listed(only, "fig8")) fig8(curve_runs);
-    if (listed(only, "fig9")) fig9(curve_runs);
-    if (listed(only, "fig10")) fig10(curve_runs, motion_n);
-    if (listed(only, "fig11")) fig11(curve_runs, motion_n);
-    if (listed(only, "theta")) theta_gauss(curve_runs, motion_n);
-    if (listed(only, "table3")) table3(data, table_runs, naive_runs);
-    fprintf(out, "{\"exp\":\"footer\",\"seconds\":%.1f,\"load_end\":%.2f}\n", now() - t0, load1());
+    if (bench_listed(only, "shapes")) shapes(3000);
+    if (bench_listed(only, "table1")) table1(table_runs);
+    if (bench_listed(only, "table2")) table2(table_runs);
+    if (bench_listed(only, "fig8")) fig8(curve_runs);
+    if (bench_listed(only, "fig9")) fig9(curve_runs);
+    if (bench_listed(only, "fig10")) fig10(curve_runs, motion_n);
+    if (bench_listed(only, "fig11")) fig11(curve_runs, motion_n);
+    if (bench_listed(only, "theta")) theta_gauss(curve_runs, motion_n);
+    if (bench_listed(only, "table3")) table3(data, table_runs, naive_runs);
+    fprintf(out, "{\"exp\":\"footer\",\"seconds\":%.1f,\"load_end\":%.2f}\n", bench_now() - t0, load1());
     if (out != stdout) fclose(out);
     return 0;
 }

@@ -215,7 +215,7 @@ int hd__text_parallel(hd__read_t *r, const char *begin, const char *end,
     size_t at = s->count;
     for (size_t k = 0; rc == HD_OK && k < used; k++) {
         hd__chunk_t *c = &chunks[k];
-        c->pts.data = (char *)s->data + at * el;
+        c->pts.data = s->data ? (char *)s->data + at * el : NULL; /* NULL when there is no room at all */
         c->pts.count = 0;
         c->pts.cap = c->room;
         c->pts.dtype = s->dtype;
@@ -236,9 +236,11 @@ int hd__text_parallel(hd__read_t *r, const char *begin, const char *end,
         line += c->lines >= 0 ? c->lines : count_lines(c->begin, c->end);
         aux += c->aux;
         if (job->fix) job->fix(job->ctx, c, s->count);
-        char *dst = (char *)s->data + s->count * el;
-        if (c->pts.count && dst != (char *)c->pts.data) memmove(dst, c->pts.data, c->pts.count * el);
-        s->count += c->pts.count;
+        if (c->pts.count) {
+            char *dst = (char *)s->data + s->count * el;
+            if (dst != (char *)c->pts.data) memmove(dst, c->pts.data, c->pts.count * el);
+            s->count += c->pts.count;
+        }
         if (r->tris && (rc = hd__tris_append(r->tris, &c->tris))) hd__io_err(r, rc, "out of memory for the faces read");
     }
     for (size_t k = 0; k < used; k++) hd__tris_free(&chunks[k].tris);
