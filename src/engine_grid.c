@@ -255,10 +255,16 @@ static int scan_cell(gsearch_t *s, uint32_t cell) {
             hit->d2 = d;
             hit->j = j;
             memcpy(hit->p, p, sizeof p);
+            /* A proof is all the caller wants: stop at the first one (a
+             * crowded cell is not read to its end for nothing). */
+            if (hit->d2 < s->stop2 || hit->d2 <= s->tie2) {
+                s->n->exact += k - b + 1;
+                return 1;
+            }
         }
     }
     s->n->exact += e - b;
-    return hit->d2 < s->stop2 || hit->d2 <= s->tie2;
+    return 0;
 }
 
 void hd__grid_nearest(const hd__grid_t *g, const double q[3], double stop2, double tie2,
