@@ -22,38 +22,15 @@
  */
 #include "gen.h"
 
+#include "benchutil.h"
+
 #include <hausdorff.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/resource.h>
 #include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
-
-static double now(void) {
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-/* CPU seconds (user + system) of this process, every thread. */
-static double cpu(void) {
-    struct rusage u;
-    getrusage(RUSAGE_SELF, &u);
-    return (double)u.ru_utime.tv_sec + 1e-6 * (double)u.ru_utime.tv_usec + (double)u.ru_stime.tv_sec +
-           1e-6 * (double)u.ru_stime.tv_usec;
-}
-
-static int cmp_double(const void *a, const void *b) {
-    double x = *(const double *)a, y = *(const double *)b;
-    return x < y ? -1 : x > y;
-}
-
-static double median(double *v, int n) {
-    qsort(v, (size_t)n, sizeof *v, cmp_double);
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 /* ---- writers ------------------------------------------------------------- */
 static void put_u16(FILE *f, unsigned v) { fputc((int)(v & 255), f), fputc((int)(v >> 8), f); }
@@ -238,15 +215,15 @@ int main(int argc, char **argv) {
      * first touch) */
     double touch_t[99];
     for (int k = 0; k < runs; k++) {
-        double t0 = now();
+        double t0 = bench_now();
         unsigned char *m = malloc(n * 3 * sizeof(double));
         memset(m, k + 1, n * 3 * sizeof(double));
-        touch_t[k] = now() - t0;
+        touch_t[k] = bench_now() - t0;
         if (m[n] != (unsigned char)(k + 1)) return 1;
         free(m);
     }
     printf("First touch of a %zu-point double array (%.0f MB): %.3f s (median of %d)\n\n", n, n * 24 / 1e6,
-           median(touch_t, runs), runs);
+           bench_median(touch_t, runs), runs);
     printf("| format | file MB | cat s | read s | read CPU s | read MB/s | Mpoints/s | read / cat |\n"
            "|---|---|---|---|---|---|---|---|\n");
     for (int c = 0; c < n_chosen; c++) {
@@ -263,19 +240,19 @@ int main(int argc, char **argv) {
         if (system(cmd) != 0) return 1;
         size_t count = 0;
         for (int k = 0; k < runs; k++) {
-            double t0 = now();
+            double t0 = bench_now();
             if (system(cmd) != 0) return 1;
-            cat_t[k] = now() - t0;
+            cat_t[k] = bench_now() - t0;
             hd_read_options_t o;
             hd_read_options_init(&o);
             o.threads = threads;
             hd_cloud_t *cl;
             hd_error_t e;
-            double c0 = cpu();
-            t0 = now();
+            double c0 = bench_cpu_now();
+            t0 = bench_now();
             int rc = hd_read_file(path, &o, &cl, &e);
-            read_t[k] = now() - t0;
-            cpu_t[k] = cpu() - c0;
+            read_t[k] = bench_now() - t0;
+            cpu_t[k] = bench_cpu_now() - c0;
             if (rc) {
                 fprintf(stderr, "read_bench: %s\n", e.message);
                 return 1;
@@ -284,7 +261,7 @@ int main(int argc, char **argv) {
             hd_cloud_free(cl);
         }
         unlink(path);
-        double ct = median(cat_t, runs), rt = median(read_t, runs), cp = median(cpu_t, runs);
+        double ct = bench_median(cat_t, runs), rt = bench_median(read_t, runs), cp = bench_median(cpu_t, runs);
         printf("| %s | %.0f | %.3f | %.3f | %.3f | %.0f | %.1f | %.1f |\n", chosen[c], mb, ct, rt, cp, mb / rt,
                (double)count / rt / 1e6, rt / ct);
         fflush(stdout);

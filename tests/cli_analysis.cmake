@@ -6,16 +6,7 @@
 #   cli_analysis_lib    hd_percentiles / hd_histogram against numpy through
 #                       ctypes (not in the sanitizer build: an ASan library
 #                       cannot be loaded into an uninstrumented interpreter)
-set(HD_ANALYSIS_PYTHON "")
-foreach(_hd_cand /usr/bin/python3 python3)
-  if(NOT HD_ANALYSIS_PYTHON)
-    execute_process(COMMAND ${_hd_cand} -c "import numpy, scipy"
-      RESULT_VARIABLE _hd_rc OUTPUT_QUIET ERROR_QUIET)
-    if(_hd_rc EQUAL 0)
-      set(HD_ANALYSIS_PYTHON ${_hd_cand})
-    endif()
-  endif()
-endforeach()
+hd_find_python(HD_ANALYSIS_PYTHON "import numpy, scipy" /usr/bin/python3 python3)
 if(NOT HD_ANALYSIS_PYTHON)
   message(STATUS "analysis tests in Python: skipped (no python3 with numpy and scipy; "
                  "scripts/deps.sh python installs them)")

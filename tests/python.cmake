@@ -29,16 +29,7 @@ if(NOT HD_PYTHON)
   set(_hd_py_candidates ${_hd_path_python3} /usr/bin/python3)
   unset(_hd_path_python3 CACHE)
 endif()
-set(HD_PYTHON_EXE "")
-foreach(_hd_cand ${_hd_py_candidates})
-  if(_hd_cand AND NOT HD_PYTHON_EXE)
-    execute_process(COMMAND ${_hd_cand} -c "${_hd_py_probe}"
-      RESULT_VARIABLE _hd_rc OUTPUT_QUIET ERROR_QUIET)
-    if(_hd_rc EQUAL 0)
-      set(HD_PYTHON_EXE ${_hd_cand})
-    endif()
-  endif()
-endforeach()
+hd_find_python(HD_PYTHON_EXE "${_hd_py_probe}" ${_hd_py_candidates})
 
 if(NOT HD_PYTHON_EXE)
   message(STATUS "Python module: skipped (no interpreter among '${_hd_py_candidates}' has "
