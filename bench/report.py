@@ -80,19 +80,24 @@ def peer_cell(r, auto):
 
 def tables(rows):
     by = OrderedDict()
+    plans = {}
     for r in rows:
         if r["case"] == "scale":
             continue
+        if r["method"] == "plan":
+            plans[key(r)] = r.get("plan", "?").split(" ")[0]
+            continue
         by.setdefault(key(r), {}).setdefault((r["method"], r["threads"]), r)
     out = []
-    threads = sorted({t for k in by for (_, t) in by[k]})
+    threads = sorted({t for k in by for (m, t) in by[k] if m != "floor"})
     for t in threads:
         out.append("")
-        out.append("**%d thread%s.** Times are medians; `(Nx)` is how many times longer the peer "
-                   "took than `auto`; `~` marks a peer that agrees only to float precision "
-                   "(PCL stores float32); **differs** would mark a wrong distance." % (t, "" if t == 1 else "s"))
+        out.append("**%d thread%s.** Times are medians; \"plan\" is the engine's choice (grid pass or "
+                   "bucket trees); `(Nx)` is how many times longer the peer took than `auto`; `~` marks a "
+                   "peer that agrees only to float precision (PCL stores float32); **differs** would mark "
+                   "a wrong distance." % (t, "" if t == 1 else "s"))
         out.append("")
-        head = ["case", "A / B", "auto", "x floor", "evals/pt", "library kdtree"] + PEERS
+        head = ["case", "A / B", "auto", "plan", "x floor", "evals/pt", "library kdtree"] + PEERS
         if t == 1:
             head.append("scipy directed_hausdorff")
         out.append("| " + " | ".join(head) + " |")
@@ -102,7 +107,7 @@ def tables(rows):
             if not auto:
                 continue
             cells = [k[0], "%s / %s" % (fmt_n(k[1]), fmt_n(k[2])), fmt_time(auto["median_s"]),
-                     "%.1f" % auto["floor_ratio"], "%.3g" % auto["evals_per_point"],
+                     plans.get(k, "-"), "%.1f" % auto["floor_ratio"], "%.3g" % auto["evals_per_point"],
                      peer_cell(m.get(("hausdorff kdtree", t)), auto)]
             cells += [peer_cell(m.get((p, t)), auto) for p in PEERS]
             if t == 1:
@@ -115,15 +120,16 @@ def scale_table(rows):
     sc = [r for r in rows if r["case"] == "scale"]
     if not sc:
         return [], sc
-    out = ["", "| points per cloud | dtype | threads | time | ns per point | peak memory | "
-           "input | peak / input | index + work per point |", "|---|---|---|---|---|---|---|---|---|"]
+    out = ["", "| points per cloud | dtype | threads | plan | time | ns per point | peak memory | "
+           "input | peak / input | peak beyond input, per point |",
+           "|---|---|---|---|---|---|---|---|---|---|"]
     for r in sc:
         n2 = 2 * r["n"]
         extra = (r["peak_rss_bytes"] - r["input_bytes"]) / n2
-        out.append("| %s | %s | %d | %s | %.1f | %.2f GB | %.2f GB | %.2f | %.1f B |" % (
-            fmt_n(r["n"]), r["dtype"], r["threads"], fmt_time(r["median_s"]),
-            r["median_s"] / n2 * 1e9, r["peak_rss_bytes"] / 1e9, r["input_bytes"] / 1e9,
-            r["peak_rss_bytes"] / r["input_bytes"], extra))
+        out.append("| %s | %s | %d | %s | %s | %.1f | %.3f GB | %.3f GB | %.2f | %.1f B |" % (
+            fmt_n(r["n"]), r["dtype"], r["threads"], r.get("plan", "?").split(" ")[0],
+            fmt_time(r["median_s"]), r["median_s"] / n2 * 1e9, r["peak_rss_bytes"] / 1e9,
+            r["input_bytes"] / 1e9, r["peak_rss_bytes"] / r["input_bytes"], extra))
     return out, sc
 
 

@@ -7,9 +7,10 @@
  * has a point of B well within the final maximum, and the work is dominated
  * by reading the input.  This file serves that case with one counting sort
  * per set and one streaming pass over A per direction:
- *  - the grid: 2^bits cubic cells per axis over the set's box (about one
- *    cell per two to four points), numbered along the Morton curve; a
- *    counting sort (two passes) groups the points by cell.  Each cell keeps
+ *  - the grid: 2^bits cubic cells per axis over the set's box (at least 16
+ *    points per cell on average, so that the representatives stay in the
+ *    caches), numbered along the Morton curve; a counting sort (two
+ *    passes) groups the points by cell.  Each cell keeps
  *    a representative, its point with the smallest index.  The octree over
  *    the cells is implicit: the node of level L with prefix p covers cells
  *    [p 8^L, (p+1) 8^L), a contiguous range of points;
@@ -31,6 +32,10 @@
  * them; nodes are pruned only when that bound is strictly above the best
  * exact distance.  The search therefore returns the exact nearest distance
  * with the smallest index, as engine_search.c does.
+ *
+ * The plan (engine.c) primes cmax with hd__grid_prime and decides between
+ * this pass and the bucket trees with hd__grid_trial, both here because
+ * they run this file's pass on a sample.
  */
 #include "index.h"
 
