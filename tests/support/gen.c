@@ -6,7 +6,13 @@
 
 #include <math.h>
 
-void gen_seed(gen_rng_t *r, uint64_t seed) { r->s = seed * 0x9e3779b97f4a7c15ULL + 1; }
+/* The seed is hashed into the starting state, not used as a position: with
+ * s = seed * increment, seeds 1 and 2 were the same stream one draw apart, so
+ * clouds made from consecutive seeds were correlated. */
+void gen_seed(gen_rng_t *r, uint64_t seed) {
+    r->s = seed;
+    r->s = gen_u64(r) ^ 0x2545f4914f6cdd1dULL;
+}
 
 uint64_t gen_u64(gen_rng_t *r) {
     uint64_t z = (r->s += 0x9e3779b97f4a7c15ULL);
