@@ -202,6 +202,12 @@ typedef struct hd__chunk {
 } hd__chunk_t;
 
 /* Record a problem in a chunk (message without file or line). */
+/* Read "x y z" from *q..eol into the chunk's points.  On failure it reports
+ * "<prefix>'tok' is not a number" or "<expected>, found N numbers" (or the
+ * point's problem) through hd__chunk_fail and returns 0.  With comment_ends,
+ * a token starting with '#' ends the numbers (OFF allows trailing comments). */
+int hd__chunk_vertex(hd__chunk_t *c, const char **q, const char *eol, long long line,
+                     const char *prefix, const char *expected, int comment_ends);
 void hd__chunk_fail(hd__chunk_t *c, int code, long long line, const char *fmt,
                     ...) HD__PRINTF(4, 5);
 

@@ -51,25 +51,7 @@ static void chunk(void *ctx, hd__chunk_t *c) {
         p = eol + (eol < end);
         if (!hd__token(&q, eol, &tb, &te) || te - tb != 1) continue;
         if (*tb == 'v') {
-            double v[3];
-            int got = 0;
-            int k;
-            while (got < 3 && (k = hd__next_double(&q, eol, &v[got], &tb, &te)) != 0) {
-                if (k < 0) {
-                    hd__chunk_fail(c, HD_EFORMAT, line, "vertex: '%.*s' is not a number", (int)(te - tb > 40 ? 40 : te - tb), tb);
-                    return;
-                }
-                got++;
-            }
-            if (got < 3) {
-                hd__chunk_fail(c, HD_EFORMAT, line, "vertex: expected x y z, found %d number%s", got, got == 1 ? "" : "s");
-                return;
-            }
-            int rc = hd__sink_push(&c->pts, v);
-            if (rc) {
-                hd__chunk_fail(c, rc, line, "%s", hd__point_problem(rc));
-                return;
-            }
+            if (!hd__chunk_vertex(c, &q, eol, line, "vertex: ", "vertex: expected x y z", 0)) return;
         } else if (*tb == 'f') {
             c->aux++;
             if (!*want_faces) continue;

@@ -47,28 +47,10 @@ static void chunk(void *ctx, hd__chunk_t *c) {
         const char *eol = hd__eol(p, end), *q = p;
         p = eol + (eol < end);
         if (!o->faces) {
-            double v[3];
-            int got = 0, k;
             const char *s = q;
             while (s < eol && hd__is_blank((unsigned char)*s)) s++;
             if (s == eol || *s == '#') continue; /* blank or comment */
-            while (got < 3 && (k = hd__next_double(&q, eol, &v[got], &tb, &te)) != 0) {
-                if (k < 0 && *tb == '#') break; /* a comment after fewer than 3 numbers */
-                if (k < 0) {
-                    hd__chunk_fail(c, HD_EFORMAT, line, "'%.*s' is not a number", (int)(te - tb > 40 ? 40 : te - tb), tb);
-                    return;
-                }
-                got++;
-            }
-            if (got < 3) {
-                hd__chunk_fail(c, HD_EFORMAT, line, "expected a vertex (x y z), found %d number%s", got, got == 1 ? "" : "s");
-                return;
-            }
-            int rc = hd__sink_push(&c->pts, v);
-            if (rc) {
-                hd__chunk_fail(c, rc, line, "%s", hd__point_problem(rc));
-                return;
-            }
+            if (!hd__chunk_vertex(c, &q, eol, line, "", "expected a vertex (x y z)", 1)) return;
             continue;
         }
         if (!next_token(&q, eol, &tb, &te)) continue; /* blank or comment */

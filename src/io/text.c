@@ -248,3 +248,29 @@ int hd__text_parallel(hd__read_t *r, const char *begin, const char *end,
     if (aux_total) *aux_total = aux;
     return rc;
 }
+
+int hd__chunk_vertex(hd__chunk_t *c, const char **q, const char *eol, long long line,
+                     const char *prefix, const char *expected, int comment_ends) {
+    double v[3];
+    const char *tb, *te;
+    int got = 0, k;
+    while (got < 3 && (k = hd__next_double(q, eol, &v[got], &tb, &te)) != 0) {
+        if (k < 0 && comment_ends && *tb == '#') break;
+        if (k < 0) {
+            hd__chunk_fail(c, HD_EFORMAT, line, "%s'%.*s' is not a number", prefix,
+                           (int)(te - tb > 40 ? 40 : te - tb), tb);
+            return 0;
+        }
+        got++;
+    }
+    if (got < 3) {
+        hd__chunk_fail(c, HD_EFORMAT, line, "%s, found %d number%s", expected, got, got == 1 ? "" : "s");
+        return 0;
+    }
+    int rc = hd__sink_push(&c->pts, v);
+    if (rc) {
+        hd__chunk_fail(c, rc, line, "%s", hd__point_problem(rc));
+        return 0;
+    }
+    return 1;
+}
