@@ -7,17 +7,13 @@ usage: open3d_hd.py A.bin B.bin THREADS RUNS BUDGET_SECONDS
 Open3D picks its own thread count (OpenMP); THREADS is passed to it through
 OMP_NUM_THREADS by bench.c.  Prints {"distance": D, "times": [...]}.
 """
-import json
 import sys
-import time
 
 import numpy as np
 import open3d as o3d
 
 
-def load(path):
-    return np.fromfile(path, dtype="<f8").reshape(-1, 3)
-
+from peercommon import load, time_runs
 
 def main():
     pa, pb = sys.argv[1], sys.argv[2]
@@ -31,17 +27,7 @@ def main():
         dba = np.asarray(cb.compute_point_cloud_distance(ca)).max()
         return max(float(dab), float(dba))
 
-    times, spent, d = [], 0.0, 0.0
-    for r in range(runs):
-        if r and spent >= budget:
-            break
-        t0 = time.perf_counter()
-        d = once()
-        t = time.perf_counter() - t0
-        times.append(t)
-        spent += t
-    print(json.dumps({"distance": float(d), "times": times}))
-
+    time_runs(once, runs, budget)
 
 if __name__ == "__main__":
     main()

@@ -10,18 +10,13 @@ The point files are raw little-endian float64 x, y, z triples (bench.c).
 Prints {"distance": D, "times": [...]} like the C++ peers (reading the
 files is not timed).
 """
-import json
 import sys
-import time
 
-import numpy as np
 from scipy.spatial import cKDTree
 from scipy.spatial.distance import directed_hausdorff
 
 
-def load(path):
-    return np.fromfile(path, dtype="<f8").reshape(-1, 3)
-
+from peercommon import load, time_runs
 
 def main():
     method, pa, pb = sys.argv[1], sys.argv[2], sys.argv[3]
@@ -37,17 +32,7 @@ def main():
             return max(float(dab), float(dba))
     else:
         sys.exit("unknown method " + method)
-    times, spent, d = [], 0.0, 0.0
-    for r in range(runs):
-        if r and spent >= budget:
-            break
-        t0 = time.perf_counter()
-        d = once()
-        t = time.perf_counter() - t0
-        times.append(t)
-        spent += t
-    print(json.dumps({"distance": float(d), "times": times}))
-
+    time_runs(once, runs, budget)
 
 if __name__ == "__main__":
     main()
