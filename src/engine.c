@@ -468,6 +468,7 @@ typedef struct {
     hd__grid_t grid[2];
     hd__tree_t tree[2];
     int have_grid, have_tree, use_tree;
+    hd__pairs_t pairs;    /* the correspondence path; pairs.resolved[d] */
     hd__max_t max[2];     /* direction d: from set d to set 1 - d */
     int max_ready;
     hd__counts_t counts[2];
@@ -481,6 +482,7 @@ static void engine_free(engine_t *e) {
     if (e->have_tree)
         for (int k = 0; k < 2; k++) hd__tree_free(&e->tree[k]);
     for (int d = 0; d < e->max_ready; d++) hd__max_destroy(&e->max[d]);
+    hd__pairs_free(&e->pairs);
     e->have_grid = e->have_tree = e->max_ready = 0;
 }
 
@@ -507,8 +509,18 @@ static int engine_init(engine_t *e, const hd_points_t *A, const hd_points_t *B,
 }
 
 /* Build both grids, prime each direction's maximum with the exact nearest
- * distances of points spread over the query set, and choose. */
-static int engine_plan(engine_t *e, hd_error_t *err) {
+ * distances of points spread over the query set, try the correspondence
+ * path (unless a path is forced), and choose. */
+static int engine_plan(engine_t *e, int force, hd_error_t *err) {
+    /* Two sets of one size may be a copy and its original in the same
+     * order; the correspondence path often settles that case in one pass,
+     * before any index is built. */
+    if (!force && e->n[0] == e->n[1]) {
+        int rc = hd__pairs_begin(&e->pairs, e->src, e->n[0], e->threads, &e->counts[0], err);
+        if (rc) return rc;
+        if (hd__pairs_resolve(&e->pairs, e->src, NULL, e->max, e->directions, e->counts))
+            return HD_OK;
+    }
     for (int k = 0; k < 2; k++) {
         int rc = hd__grid_build(&e->grid[k], &e->src[k], e->n[k], &e->box[k], e->threads, err);
         if (rc) {
@@ -518,20 +530,30 @@ static int engine_plan(engine_t *e, hd_error_t *err) {
     }
     e->have_grid = 1;
     e->use_tree = 0;
+    for (int d = 0; d < e->directions; d++)
+        if (!e->pairs.resolved[d])
+            hd__grid_prime(&e->grid[d], &e->grid[1 - d], &e->max[d], &e->counts[d]);
+    hd__pairs_resolve(&e->pairs, e->src, e->grid, e->max, e->directions, e->counts);
     for (int d = 0; d < e->directions; d++) {
-        const hd__src_t *q = &e->src[d];
-        const hd__grid_t *t = &e->grid[1 - d];
-        size_t nq = e->n[d];
-        hd__grid_prime(&e->grid[d], t, &e->max[d], &e->counts[d]);
-        e->cost[d] = hd__grid_trial(q, nq, t, &e->max[d], GRID_COST, &e->counts[d]);
+        if (e->pairs.resolved[d]) continue;
+        e->cost[d] = hd__grid_trial(&e->src[d], e->n[d], &e->grid[1 - d], &e->max[d], GRID_COST,
+                                    &e->counts[d]);
         if (e->cost[d] > GRID_COST) e->use_tree = 1;
     }
     return HD_OK;
 }
 
+/* The plan in a word: "pairs" when the correspondence path settled every
+ * direction, else the path the rest runs. */
+static const char *engine_plan_name(const engine_t *e) {
+    int all = 1;
+    for (int d = 0; d < e->directions; d++) all &= e->pairs.resolved[d];
+    return all ? "pairs" : e->use_tree ? "trees" : "grid";
+}
+
 /* force: 0 lets the plan choose, 1 forces the grid, 2 the trees. */
 static int engine_run(engine_t *e, int force, hd_result_t out[2], hd_error_t *err) {
-    int rc = engine_plan(e, err);
+    int rc = engine_plan(e, force, err);
     if (rc) return rc;
     if (force) e->use_tree = force == 2;
     if (e->use_tree) {
@@ -568,7 +590,9 @@ static int engine_run(engine_t *e, int force, hd_result_t out[2], hd_error_t *er
     }
     for (int d = 0; d < e->directions; d++) {
         double t0 = hd__now();
-        if (e->use_tree)
+        if (e->pairs.resolved[d])
+            rc = HD_OK;
+        else if (e->use_tree)
             rc = tree_directed(&e->tree[d], &e->tree[1 - d], &e->max[d], e->threads, &e->counts[d],
                                &e->culled[d], err);
         else
@@ -681,10 +705,13 @@ int hd__engine_explain(const hd_points_t *A, const hd_points_t *B, const hd_opti
     engine_t e;
     rc = engine_init(&e, A, B, &ba, &bb, opt, 2, err);
     if (rc) return rc;
-    rc = engine_plan(&e, err);
+    rc = engine_plan(&e, 0, err);
     if (rc == HD_OK)
-        snprintf(buf, len, "%s (grid trial: %.3g / %.3g distances and nodes per point)",
-                 e.use_tree ? "trees" : "grid", e.cost[0], e.cost[1]);
+        snprintf(buf, len,
+                 "%s (pairs %s, resolved %d / %d; grid trial: %.3g / %.3g distances and nodes per "
+                 "point)",
+                 engine_plan_name(&e), e.pairs.active ? "listed" : "not tried", e.pairs.resolved[0],
+                 e.pairs.resolved[1], e.cost[0], e.cost[1]);
     engine_free(&e);
     return rc;
 }

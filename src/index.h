@@ -319,6 +319,30 @@ double hd__grid_trial(const hd__src_t *a, size_t na, const hd__grid_t *gb, hd__m
 int hd__engine_forced(const hd_points_t *A, const hd_points_t *B, const hd_options_t *opt,
                       int use_trees, hd_symmetric_t *out, hd_error_t *err);
 
+/* The correspondence path (engine_pairs.c), for two sets of n points each
+ * listed in the same order (a copy and its original).  hd__pairs_begin
+ * tests a sample and, when the partners (a_i, b_i) look closer than other
+ * neighbours, lists the pairs with the largest distances (P->active).
+ * hd__pairs_resolve then resolves, for each direction d < directions, the
+ * listed points of set d exactly, in decreasing order of pair distance,
+ * until the rest provably cannot hold the witness (P->resolved[d]; max[d]
+ * then holds h exactly): by scans of the other set while grid is NULL
+ * (and a budget lasts), in grid[1 - d] otherwise.  It returns 1 when every
+ * direction is resolved.  Otherwise max[d] has only been raised. */
+struct hd__pair;
+typedef struct hd__pairs {
+    struct hd__pair *list; /* m pairs in resolution order */
+    size_t m, n, pos[2];
+    uint64_t scanned; /* points read by scans */
+    int active, resolved[2];
+} hd__pairs_t;
+
+int hd__pairs_begin(hd__pairs_t *P, const hd__src_t src[2], size_t n, int threads,
+                    hd__counts_t *counts, hd_error_t *err);
+int hd__pairs_resolve(hd__pairs_t *P, const hd__src_t src[2], const hd__grid_t *grid,
+                      hd__max_t *max, int directions, hd__counts_t *counts);
+void hd__pairs_free(hd__pairs_t *P);
+
 /* h(A,B) over built indexes of A and B (engine.c), with `threads` threads. */
 int hd__engine_trees(const hd__tree_t *ta, const hd__tree_t *tb, int threads,
                      hd_result_t *out, hd_error_t *err);

@@ -319,3 +319,180 @@ TEST(statistics_explain_the_work) {
     free(a);
     free(b);
 }
+
+/* ---- the correspondence path: B a copy of A in the same order ---------------- */
+
+/* How the copy B of A is made. */
+enum {
+    C_NOISE, C_NOISE_TINY, C_EXACT, C_SHIFT, C_LATTICE_HALF, C_DUPLICATES, C_OUTLIERS,
+    C_SWAPPED, C_SCALED, C_FAR, C_SUBNORMAL_SCALE, C_COPY_COUNT
+};
+static const char *const copy_name[C_COPY_COUNT] = {
+    "noise", "tiny-noise", "exact", "shift", "lattice-half-step", "duplicates", "outliers",
+    "swapped", "scaled", "far-offset", "1e-150-scale",
+};
+
+/* A (n points) and B, a copy of A in the same order made by `how`. */
+static void make_copy(gen_rng_t *g, int how, double *a, double *b, size_t n) {
+    double m0[3] = {0, 0, 0};
+    if (how == C_LATTICE_HALF) gen_lattice(g, a, n, 2 + (int)(gen_u64(g) % 20));
+    else gen_gauss(g, a, n, m0, 1.0);
+    if (how == C_DUPLICATES) /* every point repeated a few times */
+        for (size_t k = 0; k < n; k++)
+            if (gen_u64(g) % 3 == 0) memcpy(a + 3 * k, a + 3 * (gen_u64(g) % n), 24);
+    double sigma = how == C_NOISE_TINY ? 1e-12 : 1e-3;
+    for (size_t k = 0; k < 3 * n; k++) {
+        switch (how) {
+        case C_EXACT: b[k] = a[k]; break;
+        /* Moves by exact binary fractions: every pair at the same distance. */
+        case C_SHIFT: b[k] = a[k] + (k % 3 == 0 ? 0x1p-10 : 0.0); break;
+        case C_LATTICE_HALF: b[k] = a[k] + (k % 3 == 1 ? 0.5 : 0.0); break;
+        case C_SCALED: b[k] = a[k] * 1.001; break;
+        default: b[k] = a[k] + sigma * gen_normal(g);
+        }
+    }
+    if (how == C_OUTLIERS)
+        for (int r = 0; r < 3; r++) b[3 * (gen_u64(g) % n) + (size_t)r] += 0.5;
+    if (how == C_SWAPPED) /* a few partners exchanged with other points */
+        for (size_t r = 0; r < 1 + n / 200; r++) {
+            size_t x = gen_u64(g) % n, y = gen_u64(g) % n;
+            double t[3];
+            memcpy(t, b + 3 * x, 24);
+            memcpy(b + 3 * x, b + 3 * y, 24);
+            memcpy(b + 3 * y, t, 24);
+        }
+    if (how == C_FAR) {
+        gen_affine(a, n, 1.0, 1e9);
+        gen_affine(b, n, 1.0, 1e9);
+    }
+    if (how == C_SUBNORMAL_SCALE) {
+        gen_affine(a, n, 1e-150, 0.0);
+        gen_affine(b, n, 1e-150, 0.0);
+    }
+}
+
+/* The engine's plan, in its own words (engine.c). */
+int hd__engine_explain(const hd_points_t *A, const hd_points_t *B, const hd_options_t *opt,
+                       char *buf, size_t len, hd_error_t *err);
+
+/* Whether the engine's account of its plan for (A, B) contains `words`. */
+static int plan_says(const double *a, const double *b, size_t n, const char *words) {
+    hd_points_t A = hd_points_f64(a, n), B = hd_points_f64(b, n);
+    hd_options_t o;
+    hd_options_init(&o);
+    char plan[256] = "";
+    if (hd__engine_explain(&A, &B, &o, plan, sizeof plan, NULL) != HD_OK) return 0;
+    return strstr(plan, words) != NULL;
+}
+
+TEST(same_order_copies_are_exact_in_every_variation) {
+    gen_rng_t g;
+    int settled = 0, cases = 0;
+    for (uint64_t seed = 10000; seed < 10440 && !hdt_failed(); seed++) {
+        gen_seed(&g, seed);
+        int how = (int)(seed % C_COPY_COUNT);
+        size_t n = 1 + gen_u64(&g) % (seed % 8 == 0 ? 6000 : 700);
+        int threads = seed % 2 ? 1 : 3;
+        CONTEXT("seed=%llu copy=%s n=%zu threads=%d", (unsigned long long)seed, copy_name[how], n,
+                threads);
+        double *a = malloc(24 * n), *b = malloc(24 * n);
+        make_copy(&g, how, a, b, n);
+        check_case(a, n, b, n, threads);
+        settled += plan_says(a, b, n, "resolved 1 / 1");
+        cases++;
+        free(a);
+        free(b);
+    }
+    /* The path itself was under test in most cases (not only the fallback). */
+    CONTEXT("settled by the correspondence path: %d of %d", settled, cases);
+    CHECK(settled >= cases / 2);
+}
+
+TEST(same_order_copies_in_float32_are_exact_for_the_float_values) {
+    gen_rng_t g;
+    for (uint64_t seed = 11000; seed < 11044 && !hdt_failed(); seed++) {
+        gen_seed(&g, seed);
+        int how = (int)(seed % C_COPY_COUNT);
+        if (how == C_SUBNORMAL_SCALE) continue; /* not representable in float */
+        size_t n = 1 + gen_u64(&g) % 3000;
+        CONTEXT("seed=%llu copy=%s n=%zu", (unsigned long long)seed, copy_name[how], n);
+        double *a = malloc(24 * n), *b = malloc(24 * n);
+        float *fa = malloc(12 * n), *fb = malloc(12 * n);
+        make_copy(&g, how, a, b, n);
+        for (size_t k = 0; k < 3 * n; k++) {
+            a[k] = (double)(fa[k] = (float)a[k]);
+            b[k] = (double)(fb[k] = (float)b[k]);
+        }
+        brute_t ab = brute_directed(a, n, b, n), ba = brute_directed(b, n, a, n);
+        hd_points_t A = hd_points_f32(fa, n), B = hd_points_f32(fb, n);
+        hd_options_t o;
+        hd_options_init(&o);
+        o.threads = seed % 2 ? 1 : 3;
+        hd_symmetric_t s;
+        CHECK_RC(hd_hausdorff(&A, &B, &o, &s, NULL), HD_OK);
+        check_directed(&s.ab, &ab);
+        check_directed(&s.ba, &ba);
+        free(a);
+        free(b);
+        free(fa);
+        free(fb);
+    }
+}
+
+TEST(a_noisy_copy_is_settled_by_the_correspondence_path) {
+    gen_rng_t g;
+    gen_seed(&g, 12000);
+    CONTEXT("seed=12000");
+    size_t n = 50000;
+    double *a = malloc(24 * n), *b = malloc(24 * n);
+    make_copy(&g, C_NOISE, a, b, n);
+    CHECK(plan_says(a, b, n, "pairs (pairs listed, resolved 1 / 1"));
+    check_case(a, n, b, n, 3);
+    free(a);
+    free(b);
+}
+
+TEST(independent_clouds_and_shuffled_copies_do_not_take_the_correspondence_path) {
+    gen_rng_t g;
+    gen_seed(&g, 12100);
+    CONTEXT("seed=12100");
+    size_t n = 20000;
+    double *a = malloc(24 * n), *b = malloc(24 * n);
+    make_pair(&g, K_OVERLAP, a, n, b, n);
+    CHECK(plan_says(a, b, n, "pairs not tried"));
+    /* A noisy copy listed backwards: the partners are unrelated points. */
+    make_copy(&g, C_NOISE, a, b, n);
+    for (size_t k = 0; k < n / 2; k++) {
+        double t[3];
+        memcpy(t, b + 3 * k, 24);
+        memcpy(b + 3 * k, b + 3 * (n - 1 - k), 24);
+        memcpy(b + 3 * (n - 1 - k), t, 24);
+    }
+    CHECK(plan_says(a, b, n, "pairs not tried"));
+    check_case(a, n, b, n, 1);
+    free(a);
+    free(b);
+}
+
+TEST(a_copy_with_more_exchanged_partners_than_the_list_falls_back_exactly) {
+    gen_rng_t g;
+    gen_seed(&g, 12200);
+    CONTEXT("seed=12200");
+    /* 5% of 60000 partners exchanged: some 3000 pairs far larger than the
+     * answer, more than the path lists, so it must hand over to the grid or
+     * the trees with what it found. */
+    size_t n = 60000;
+    double *a = malloc(24 * n), *b = malloc(24 * n);
+    make_copy(&g, C_NOISE, a, b, n);
+    for (size_t r = 0; r < n / 40; r++) {
+        size_t x = gen_u64(&g) % n, y = gen_u64(&g) % n;
+        double t[3];
+        memcpy(t, b + 3 * x, 24);
+        memcpy(b + 3 * x, b + 3 * y, 24);
+        memcpy(b + 3 * y, t, 24);
+    }
+    CHECK(plan_says(a, b, n, "pairs listed, resolved 0 / 0"));
+    check_case(a, n, b, n, 3);
+    free(a);
+    free(b);
+}
