@@ -185,7 +185,10 @@ static double extent(const double *p, size_t n) {
     return w;
 }
 
-enum { C_OVERLAP, C_DISJOINT, C_PARTIAL, C_BIG_SMALL, C_SMALL_BIG, C_PERTURBED, C_TRANSLATED };
+enum {
+    C_OVERLAP, C_DISJOINT, C_PARTIAL, C_BIG_SMALL, C_SMALL_BIG, C_PERTURBED, C_SHUFFLED,
+    C_TRANSLATED
+};
 
 /* Synthetic case `kind` at size n (translated: fraction `frac` of the box). */
 static void make_case(pair_t *p, int kind, size_t n, double frac) {
@@ -231,6 +234,25 @@ static void make_case(pair_t *p, int kind, size_t n, double frac) {
         gen_seed(&g, spread_seed(3));
         for (size_t k = 0; k < 3 * nb; k++) p->b[k] = p->a[k] + 1e-3 * gen_normal(&g);
         snprintf(p->note, sizeof p->note, "copy + N(0, (1e-3 sigma)^2) noise");
+        break;
+    }
+    case C_SHUFFLED: {
+        /* The perturbed copy listed in a random order: no point of B is at
+         * the position of its partner, so the engine cannot use the
+         * correspondence and must find every partner itself. */
+        snprintf(p->name, sizeof p->name, "perturbed, shuffled");
+        gauss(1, p->a, na, 0);
+        gen_rng_t g;
+        gen_seed(&g, spread_seed(3));
+        for (size_t k = 0; k < 3 * nb; k++) p->b[k] = p->a[k] + 1e-3 * gen_normal(&g);
+        for (size_t k = nb; k > 1; k--) {
+            size_t r = gen_u64(&g) % k;
+            double t[3];
+            memcpy(t, p->b + 3 * (k - 1), 24);
+            memcpy(p->b + 3 * (k - 1), p->b + 3 * r, 24);
+            memcpy(p->b + 3 * r, t, 24);
+        }
+        snprintf(p->note, sizeof p->note, "copy + N(0, (1e-3 sigma)^2) noise, shuffled");
         break;
     }
     default: {
@@ -636,7 +658,7 @@ int main(int argc, char **argv) {
     mkdir(B.tmp, 0700);
 
     /* Synthetic cases at every size. */
-    int kinds[] = {C_OVERLAP, C_DISJOINT, C_PARTIAL, C_BIG_SMALL, C_SMALL_BIG, C_PERTURBED};
+    int kinds[] = {C_OVERLAP, C_DISJOINT, C_PARTIAL, C_BIG_SMALL, C_SMALL_BIG, C_PERTURBED, C_SHUFFLED};
     for (int s = 0; s < B.n_sizes; s++)
         for (size_t k = 0; k < sizeof kinds / sizeof kinds[0]; k++) {
             if ((kinds[k] == C_BIG_SMALL || kinds[k] == C_SMALL_BIG) && B.sizes[s] < 10000) continue;

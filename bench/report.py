@@ -173,7 +173,7 @@ def targets(by, sc):
         elif eb and auto:
             row(">= 100x faster than scipy directed_hausdorff, overlapping 1M/1M (1 thread)",
                 "directed_hausdorff timed out", True)
-    for case, limit in (("overlapping", 20), ("perturbed", 20), ("disjoint", 5)):
+    for case, limit in (("overlapping", 20), ("perturbed", 20), ("perturbed, shuffled", 20), ("disjoint", 5)):
         m = find(case, 1000000)
         if not m:
             continue
