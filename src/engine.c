@@ -57,6 +57,7 @@ typedef struct {
     const hd__tree_t *ta, *tb;
     hd__max_t *m;         /* the maximum so far, shared */
     int task_level;
+    int extra_level;      /* log2 of how many buckets of B a bucket of A spans */
     worker_t *w;
 } dir_ctx;
 
@@ -146,13 +147,14 @@ typedef struct {
     size_t first;   /* position of point 0 in A's order */
     uint32_t read;  /* bit k: point k's exact coordinates are in a[k] */
     double a[HD__BUCKET][3];
-    size_t ia[HD__BUCKET];
+    size_t ia[HD__BUCKET]; /* original indices */
+    double tie2;    /* the maximum so far when a live point may lose a tie
+                     * to its witness (a larger index), else -1 */
 } group_t;
 
 /* The exact coordinates of point k of the group (read once). */
 static const double *group_exact(const hd__tree_t *ta, group_t *g, int k) {
     if (!(g->read >> k & 1u)) {
-        g->ia[k] = ta->perm[g->first + (size_t)k];
         hd__src_get(&ta->src, g->ia[k], g->a[k]);
         g->read |= 1u << k;
     }
@@ -171,7 +173,10 @@ HD__HOT static int try_bucket(walk_t *s, group_t *g, size_t i, double cmax2) {
     uint32_t near = 0;
     for (uint32_t left = g->alive; left; left &= left - 1) {
         int k = __builtin_ctz(left);
-        if (hd__box_lb2s(&bb->box, g->x[k], g->y[k], g->z[k]) < cmax2) near |= 1u << k;
+        double lb = hd__box_lb2s(&bb->box, g->x[k], g->y[k], g->z[k]);
+        /* Within cmax, or at most the maximum for a point that would lose the
+         * tie (with cmax = 0, as for a subset, only exact duplicates count). */
+        if (lb < cmax2 || (lb <= s->snap.d2 && g->ia[k] > s->snap.i)) near |= 1u << k;
     }
     if (!near) return 0;
     double x[HD__BUCKET], y[HD__BUCKET], z[HD__BUCKET];
@@ -242,6 +247,11 @@ static void walk_bucket(walk_t *s, size_t bk) {
     g.read = 0;
     double cmax2 = hd__bound_get(&s->c->m->cmax);
     g.alive = g.m == 32 ? 0xffffffffu : (1u << g.m) - 1;
+    g.tie2 = -1.0;
+    for (int k = 0; k < g.m; k++) {
+        g.ia[k] = ta->perm[g.first + (size_t)k];
+        if (g.ia[k] > s->snap.i) g.tie2 = s->snap.d2;
+    }
     if (s->have_bc) {
         double lim = hd__kill_below(cmax2, g.err + s->bc_err);
         for (int k = 0; k < g.m; k++)
@@ -282,16 +292,20 @@ static void walk_bucket(walk_t *s, size_t bk) {
         /* The walk covers the subtree of BLOCK_SPAN buckets around the last
          * useful bucket of B: points that close are close along the curve
          * too, apart from the curve's jumps, which the searches handle. */
-        int l = BLOCK_LEVEL < tb->levels - 1 ? BLOCK_LEVEL : tb->levels - 1;
+        int l = BLOCK_LEVEL + s->c->extra_level;
+        if (l > tb->levels - 1) l = tb->levels - 1;
         size_t h = s->hint != HD__NONE ? s->hint : 0;
         stack[0].level = l;
         stack[0].i = h >> l;
         stack[0].gap2 = box_gap2(ba, hd__tree_box(tb, l, h >> l));
         sp = 1;
     }
-    while (sp > 0 && g.alive && leaves < BLOCK_LEAVES) {
+    /* A node of B matters when it may hold a point strictly within cmax,
+     * or one at most the maximum for a point that would lose the tie. */
+#define MATTERS(gap2) ((gap2) < cmax2 || (gap2) <= g.tie2)
+    while (sp > 0 && g.alive && leaves < (BLOCK_LEAVES << s->c->extra_level)) {
         sp--;
-        if (stack[sp].gap2 >= cmax2) continue;
+        if (!MATTERS(stack[sp].gap2)) continue;
         int l = stack[sp].level;
         size_t i = stack[sp].i;
         s->w->counts.nodes++;
@@ -304,7 +318,7 @@ static void walk_bucket(walk_t *s, size_t bk) {
         const hd__box_t *b0 = hd__tree_box(tb, l - 1, c0);
         double g0 = box_gap2(ba, b0);
         if (c1 >= tb->count[l - 1]) {
-            if (g0 < cmax2) stack[sp].level = l - 1, stack[sp].i = c0, stack[sp].gap2 = g0, sp++;
+            if (MATTERS(g0)) stack[sp].level = l - 1, stack[sp].i = c0, stack[sp].gap2 = g0, sp++;
             continue;
         }
         const hd__box_t *b1 = hd__tree_box(tb, l - 1, c1);
@@ -318,9 +332,10 @@ static void walk_bucket(walk_t *s, size_t bk) {
             g0 = g1;
             g1 = u;
         }
-        if (g1 < cmax2) stack[sp].level = l - 1, stack[sp].i = c1, stack[sp].gap2 = g1, sp++;
-        if (g0 < cmax2) stack[sp].level = l - 1, stack[sp].i = c0, stack[sp].gap2 = g0, sp++;
+        if (MATTERS(g1)) stack[sp].level = l - 1, stack[sp].i = c1, stack[sp].gap2 = g1, sp++;
+        if (MATTERS(g0)) stack[sp].level = l - 1, stack[sp].i = c0, stack[sp].gap2 = g0, sp++;
     }
+#undef MATTERS
     s->w->culled += (uint64_t)(g.m - __builtin_popcount(g.alive));
     if (!g.alive) return;
     /* The points left are read exactly; start all their loads at once. */
@@ -410,6 +425,9 @@ static int tree_directed(const hd__tree_t *ta, const hd__tree_t *tb, hd__max_t *
     c.m = m;
     /* Tasks are subtrees of about 64 buckets. */
     c.task_level = ta->levels - 1 < 6 ? ta->levels - 1 : 6;
+    /* A bucket of a set much sparser than B spans that many more buckets of
+     * B: its shared walk may visit proportionally more (at most 16 times). */
+    while (c.extra_level < 4 && (ta->nb << (c.extra_level + 1)) <= tb->nb) c.extra_level++;
     size_t tasks = ta->count[c.task_level];
     if (threads < 1) threads = 1;
     c.w = hd__calloc_array((size_t)threads, sizeof *c.w);
@@ -558,12 +576,16 @@ static int engine_run(engine_t *e, int force, hd_result_t out[2], hd_error_t *er
     if (force) e->use_tree = force == 2;
     if (e->use_tree) {
         /* The grids give way to the trees (memory stays under 16 bytes per
-         * point); the maxima found so far stay valid.  The trees' Morton
-         * grids have the same cell size, each centred on its own set's
-         * centroid: a copy of a set, translated or perturbed, then
-         * lists its points in nearly the same order as the original, which
-         * the walk's neighbour scans rely on. */
-        double c[2][3], r = 0;
+         * point); the maxima found so far stay valid.  Both trees' Morton
+         * grids have the same cell size, and the walk's neighbour scans rely
+         * on the two curves lining up.  When B's box is A's box moved (both
+         * corners by the same vector, within 1e-4 of the extent, and by more
+         * than that), B looks like a moved copy: each grid is centred on its
+         * own set's centroid, so that the copy lists its points in nearly
+         * the original's order.  Any other pair (nearly identical sets, a
+         * subset, a part, a different shape) shares one grid over both
+         * boxes, so that equal points get equal keys. */
+        double c[2][3], r = 0, ext = 0, skew = 0, move = 0;
         for (int s2 = 0; s2 < 2; s2++)
             for (int k = 0; k < 3; k++) {
                 c[s2][k] = e->grid[s2].centroid[k];
@@ -571,12 +593,30 @@ static int engine_run(engine_t *e, int force, hd_result_t out[2], hd_error_t *er
                 r = u > r ? u : r;
                 r = v > r ? v : r;
             }
+        for (int k = 0; k < 3; k++) {
+            double x0 = e->box[0].hi[k] - e->box[0].lo[k];
+            double dlo = e->box[1].lo[k] - e->box[0].lo[k], dhi = e->box[1].hi[k] - e->box[0].hi[k];
+            ext = x0 > ext ? x0 : ext;
+            skew = fabs(dlo - dhi) > skew ? fabs(dlo - dhi) : skew;
+            move = fabs(dlo) > move ? fabs(dlo) : move;
+        }
         hd__box_t g[2];
-        for (int s2 = 0; s2 < 2; s2++)
+        if (skew <= 1e-4 * ext && move > 1e-4 * ext) {
+            for (int s2 = 0; s2 < 2; s2++)
+                for (int k = 0; k < 3; k++) {
+                    g[s2].lo[k] = c[s2][k] - r;
+                    g[s2].hi[k] = c[s2][k] + r;
+                }
+        } else {
+            double lo[3], w = 0;
             for (int k = 0; k < 3; k++) {
-                g[s2].lo[k] = c[s2][k] - r;
-                g[s2].hi[k] = c[s2][k] + r;
+                lo[k] = e->box[0].lo[k] < e->box[1].lo[k] ? e->box[0].lo[k] : e->box[1].lo[k];
+                double hi = e->box[0].hi[k] > e->box[1].hi[k] ? e->box[0].hi[k] : e->box[1].hi[k];
+                w = hi - lo[k] > w ? hi - lo[k] : w;
             }
+            for (int s2 = 0; s2 < 2; s2++)
+                for (int k = 0; k < 3; k++) g[s2].lo[k] = lo[k], g[s2].hi[k] = lo[k] + w;
+        }
         for (int k = 0; k < 2; k++) hd__grid_free(&e->grid[k]);
         e->have_grid = 0;
         rc = hd__tree_build(&e->tree[0], &e->src[0], e->n[0], &g[0], e->threads, err);
