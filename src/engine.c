@@ -636,7 +636,7 @@ static int engine_run(engine_t *e, int force, hd_result_t out[2], hd_error_t *er
             rc = tree_directed(&e->tree[d], &e->tree[1 - d], &e->max[d], e->threads, &e->counts[d],
                                &e->culled[d], err);
         else
-            rc = hd__grid_directed(&e->src[d], e->n[d], &e->grid[1 - d], &e->max[d], e->threads,
+            rc = hd__grid_directed(&e->grid[d], &e->grid[1 - d], &e->max[d], e->threads,
                                    &e->counts[d], &e->culled[d], err);
         if (rc) return rc;
         hd_result_t *r = &out[d];

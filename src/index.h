@@ -249,7 +249,7 @@ void hd__tree_nearest(const hd__tree_t *t, const double q[3], double stop2, doub
 typedef struct hd__grid {
     size_t n;
     hd__src_t src;
-    int bits;             /* cells per axis: 1 << bits (at most 8) */
+    int bits;             /* cells per axis: 1 << bits (at most 6) */
     double lo[3], w, inv; /* cell (cx, cy, cz) spans lo + c * w .. lo + (c + 1) * w */
     double margin;        /* widening of every face that covers all rounding */
     uint32_t *perm;       /* n original indices grouped by cell */
@@ -293,12 +293,15 @@ HD__INLINE int hd__kills(double cmax2, const hd__best_t *snap, double d2, size_t
     return d2 < cmax2 || (d2 <= snap->d2 && i > snap->i);
 }
 
-/* h(A,B) by the grid: every point of A is tested against the representative
- * of its cell in B's grid and the last point of B that discarded something,
- * and searched exactly when neither discards it.  On return m holds the
- * maximum; counts and culled are added to. */
-int hd__grid_directed(const hd__src_t *a, size_t na, const hd__grid_t *gb, hd__max_t *m,
-                      int threads, hd__counts_t *counts, uint64_t *culled, hd_error_t *err);
+/* h(A,B) by the grid: A's cells (ga) are visited in Morton order, and a
+ * cell is discarded whole when one point of B is proven strictly within
+ * cmax of its whole box; the points of the other cells are tested against
+ * nearby points of B and searched exactly when none discards them (when
+ * cmax is below a cell's diagonal, all of A's points in input order
+ * instead).  On return m holds the maximum; counts and culled are added
+ * to. */
+int hd__grid_directed(const hd__grid_t *ga, const hd__grid_t *gb, hd__max_t *m, int threads,
+                      hd__counts_t *counts, uint64_t *culled, hd_error_t *err);
 
 /* Prime m with the exact nearest distances of the representatives of A's
  * cells (ga) that lie where B is emptiest. */

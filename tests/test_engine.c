@@ -11,7 +11,10 @@
  * within a rounding of the maximum, so the quantised approximations cannot
  * decide and exact reads must), sizes 1:1000, far offsets (1e9) and tiny
  * scales (1e-9), float32 and strided views, and sets large enough for many
- * buckets, tree levels and tasks.
+ * buckets, tree levels and tasks.  The grid pass also runs alone on
+ * lattices whose points lie on its cells' faces and tie at the maximum,
+ * where it must discard whole cells (and does, exactly, only with the
+ * cells' margin and a strict proof).
  */
 #include "brute.h"
 #include "check.h"
@@ -495,4 +498,161 @@ TEST(a_copy_with_more_exchanged_partners_than_the_list_falls_back_exactly) {
     check_case(a, n, b, n, 3);
     free(a);
     free(b);
+}
+
+/* ---- the grid pass: whole cells discarded ------------------------------------ */
+
+/* The lattice {0, step, 2 step, ..., side - 1 steps}^3 (side^3 points), scaled by
+ * `scale` and moved by `offset`, in an order shuffled by g (so that ties
+ * go to indices other than the first). */
+static double *shuffled_lattice(gen_rng_t *g, int side, int step, double scale, double offset,
+                                size_t *n) {
+    *n = (size_t)side * (size_t)side * (size_t)side;
+    double *p = malloc(24 * *n);
+    size_t k = 0;
+    for (int x = 0; x < side; x++)
+        for (int y = 0; y < side; y++)
+            for (int z = 0; z < side; z++, k++) {
+                p[3 * k] = (double)(x * step) * scale + offset;
+                p[3 * k + 1] = (double)(y * step) * scale + offset;
+                p[3 * k + 2] = (double)(z * step) * scale + offset;
+            }
+    for (size_t i = *n - 1; i > 0; i--) {
+        size_t j = gen_u64(g) % (i + 1);
+        double t[3];
+        memcpy(t, p + 3 * i, 24);
+        memcpy(p + 3 * i, p + 3 * j, 24);
+        memcpy(p + 3 * j, t, 24);
+    }
+    return p;
+}
+
+/* H(A,B) through the grid path forced, and h(A,B) through the grid pass
+ * alone, unprimed (cmax starts at 0, and the pass reads A in input order)
+ * and primed as the engine primes it (the pass walks A's cells), at
+ * `threads` threads: the brute force's answers; returns whether the primed
+ * pass computed fewer distances than A has points (so it discarded some
+ * cells whole, unread). */
+static int grid_discards_whole_cells(const hd_points_t *A, const hd_points_t *B,
+                                     const brute_t *ab, const brute_t *ba, int threads) {
+    hd_options_t o;
+    hd_options_init(&o);
+    o.threads = threads;
+    hd_symmetric_t s;
+    CHECK_RC(hd__engine_forced(A, B, &o, 0, &s, NULL), HD_OK);
+    check_directed(&s.ab, ab);
+    check_directed(&s.ba, ba);
+    hd__src_t src[2];
+    hd__box_t box[2];
+    hd__grid_t grid[2];
+    const hd_points_t *P[2] = {A, B};
+    for (int k = 0; k < 2; k++) {
+        hd__src_init(&src[k], P[k], NULL);
+        CHECK_RC(hd__points_scan(P[k], "set", threads, &box[k], NULL), HD_OK);
+        CHECK_RC(hd__grid_build(&grid[k], &src[k], P[k]->count, &box[k], threads, NULL), HD_OK);
+    }
+    hd__counts_t n = {0, 0, 0};
+    for (int primed = 0; primed <= 1; primed++) {
+        hd__max_t m;
+        CHECK_RC(hd__max_init(&m), HD_OK);
+        hd__counts_t before = {0, 0, 0};
+        if (primed) hd__grid_prime(&grid[0], &grid[1], &m, &before);
+        uint64_t culled = 0;
+        n = before;
+        CHECK_RC(hd__grid_directed(&grid[0], &grid[1], &m, threads, &n, &culled, NULL), HD_OK);
+        CHECK_BITS(m.best.d2, ab->d2);
+        CHECK_EQ(m.best.i, ab->i);
+        CHECK_EQ(m.best.j, ab->j);
+        CHECK_EQ(culled <= A->count, 1);
+        n.evals -= before.evals, n.exact -= before.exact;
+        hd__max_destroy(&m);
+    }
+    for (int k = 0; k < 2; k++) hd__grid_free(&grid[k]);
+    return n.evals + n.exact < A->count;
+}
+
+TEST(whole_cells_are_discarded_exactly_on_lattices_with_ties) {
+    /* A: the integer lattice {0..20}^3; B: a coarser lattice of the same
+     * box.  Lattice points lie on (or within a rounding of) the grid's cell
+     * faces, cells of A lie wholly within the maximum of one point of B,
+     * others straddle it, and many points of A tie at the maximum with
+     * several nearest points of B each.  Each variation moves the whole
+     * picture to where rounding is hardest: tiny scales (squared distances
+     * near and below the smallest normal double), a huge offset with a
+     * small spacing, float32 values and strided views. */
+    static const struct {
+        int coarse;   /* B's spacing in lattice steps */
+        double scale, offset;
+    } v[] = {
+        {10, 1.0, 0.0},   {2, 1.0, 0.0},      {5, 1.0, 0.0},      {10, 1e-150, 0.0},
+        {2, 1e-155, 0.0}, {10, 1e-3, 1e9},    {5, 1e-3, 1e9},     {10, 0.1, -3.0},
+    };
+    gen_rng_t g;
+    int whole = 0;
+    for (size_t k = 0; k < sizeof v / sizeof v[0] && !hdt_failed(); k++) {
+        gen_seed(&g, 13000 + k);
+        CONTEXT("variation %zu: B spacing %d, scale %g, offset %g", k, v[k].coarse, v[k].scale,
+                v[k].offset);
+        size_t na, nb;
+        double *a = shuffled_lattice(&g, 21, 1, v[k].scale, v[k].offset, &na);
+        double *b = shuffled_lattice(&g, 20 / v[k].coarse + 1, v[k].coarse, v[k].scale,
+                                     v[k].offset, &nb);
+        brute_t ab = brute_directed(a, na, b, nb), ba = brute_directed(b, nb, a, na);
+        hd_points_t A = hd_points_f64(a, na), B = hd_points_f64(b, nb);
+        for (int t = 1; t <= 3; t += 2) whole += grid_discards_whole_cells(&A, &B, &ab, &ba, t);
+        check_case(a, na, b, nb, 3);
+        /* The same values as float32 where they are floats, and A as a
+         * column-major array (a strided view). */
+        float *fa = malloc(12 * na), *fb = malloc(12 * nb);
+        for (size_t i = 0; i < 3 * na; i++) a[i] = (double)(fa[i] = (float)a[i]);
+        for (size_t i = 0; i < 3 * nb; i++) b[i] = (double)(fb[i] = (float)b[i]);
+        brute_t fab = brute_directed(a, na, b, nb), fba = brute_directed(b, nb, a, na);
+        hd_points_t FA = hd_points_f32(fa, na), FB = hd_points_f32(fb, nb);
+        whole += grid_discards_whole_cells(&FA, &FB, &fab, &fba, 3);
+        double *col = malloc(24 * na);
+        for (size_t i = 0; i < na; i++)
+            for (int c = 0; c < 3; c++) col[c * na + i] = a[3 * i + c];
+        hd_points_t CA = hd_points_f64(col, na);
+        CA.stride = sizeof(double);
+        CA.cstride = (ptrdiff_t)(na * sizeof(double));
+        hd_points_t DB = hd_points_f64(b, nb);
+        whole += grid_discards_whole_cells(&CA, &DB, &fab, &fba, 1);
+        free(a);
+        free(b);
+        free(fa);
+        free(fb);
+        free(col);
+    }
+    /* Whole cells were discarded (not only points) in most variations. */
+    CONTEXT("runs that discarded whole cells: %d", whole);
+    CHECK(whole >= 8);
+}
+
+TEST(whole_cells_at_the_maximum_keep_the_canonical_witness) {
+    /* Clusters of A whose whole cells sit at the maximum distance from B
+     * (B is a copy of A's cluster centres moved by exactly the same vector
+     * for every cluster, so every cluster holds points at the maximum), in
+     * sets large enough for several tasks per pass; and the same far apart
+     * (every cell of A discarded by the last useful point of B). */
+    gen_rng_t g;
+    for (int far = 0; far <= 1 && !hdt_failed(); far++) {
+        gen_seed(&g, 13100 + (uint64_t)far);
+        size_t clusters = 400, per = 64, na = clusters * per, nb = clusters;
+        double *a = malloc(24 * na), *b = malloc(24 * nb);
+        for (size_t c = 0; c < clusters; c++) {
+            double ctr[3];
+            for (int k = 0; k < 3; k++) ctr[k] = (double)(gen_u64(&g) % 64);
+            for (int k = 0; k < 3; k++) b[3 * c + k] = ctr[k] + (far ? 500.0 : 0.5);
+            /* The cluster: points of a small lattice around the centre. */
+            for (size_t p = 0; p < per; p++)
+                for (int k = 0; k < 3; k++)
+                    a[3 * (p * clusters + c) + k] =
+                        ctr[k] + 0.125 * (double)((p >> (2 * k)) & 3);
+        }
+        CONTEXT("far=%d na=%zu nb=%zu", far, na, nb);
+        check_case(a, na, b, nb, 1);
+        check_case(a, na, b, nb, 3);
+        free(a);
+        free(b);
+    }
 }
