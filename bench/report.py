@@ -92,10 +92,11 @@ def tables(rows):
     threads = sorted({t for k in by for (m, t) in by[k] if m != "floor"})
     for t in threads:
         out.append("")
-        out.append("**%d thread%s.** Times are medians; \"plan\" is the engine's choice (grid pass or "
-                   "bucket trees); `(Nx)` is how many times longer the peer took than `auto`; `~` marks a "
-                   "peer that agrees only to float precision (PCL stores float32); **differs** would mark "
-                   "a wrong distance." % (t, "" if t == 1 else "s"))
+        out.append("**%d thread%s.** Times are medians; \"plan\" is the engine's choice (pairs: the "
+                   "correspondence path; grid: the grid pass; trees: the bucket trees); `(Nx)` is how "
+                   "many times longer the peer took than `auto`; `~` marks a peer that agrees only to "
+                   "float precision (PCL stores float32); **differs** would mark a wrong distance."
+                   % (t, "" if t == 1 else "s"))
         out.append("")
         head = ["case", "A / B", "auto", "plan", "x floor", "evals/pt", "library kdtree"] + PEERS
         if t == 1:
