@@ -227,32 +227,26 @@ static void make_case(pair_t *p, int kind, size_t n, double frac) {
         snprintf(p->note, sizeof p->note, "overlapping Gaussians, |A|/|B| = %s",
                  kind == C_BIG_SMALL ? "100" : "1/100");
         break;
-    case C_PERTURBED: {
-        snprintf(p->name, sizeof p->name, "perturbed");
-        gauss(1, p->a, na, 0);
-        gen_rng_t g;
-        gen_seed(&g, spread_seed(3));
-        for (size_t k = 0; k < 3 * nb; k++) p->b[k] = p->a[k] + 1e-3 * gen_normal(&g);
-        snprintf(p->note, sizeof p->note, "copy + N(0, (1e-3 sigma)^2) noise");
-        break;
-    }
+    case C_PERTURBED:
     case C_SHUFFLED: {
-        /* The perturbed copy listed in a random order: no point of B is at
-         * the position of its partner, so the engine cannot use the
-         * correspondence and must find every partner itself. */
-        snprintf(p->name, sizeof p->name, "perturbed, shuffled");
+        /* Shuffled: the perturbed copy listed in a random order, so that no
+         * point of B is at the position of its partner; the engine cannot
+         * use the correspondence and must find every partner itself. */
+        int shuffled = kind == C_SHUFFLED;
+        snprintf(p->name, sizeof p->name, shuffled ? "perturbed, shuffled" : "perturbed");
         gauss(1, p->a, na, 0);
         gen_rng_t g;
         gen_seed(&g, spread_seed(3));
         for (size_t k = 0; k < 3 * nb; k++) p->b[k] = p->a[k] + 1e-3 * gen_normal(&g);
-        for (size_t k = nb; k > 1; k--) {
+        snprintf(p->note, sizeof p->note, "copy + N(0, (1e-3 sigma)^2) noise%s",
+                 shuffled ? ", shuffled" : "");
+        for (size_t k = nb; shuffled && k > 1; k--) {
             size_t r = gen_u64(&g) % k;
             double t[3];
             memcpy(t, p->b + 3 * (k - 1), 24);
             memcpy(p->b + 3 * (k - 1), p->b + 3 * r, 24);
             memcpy(p->b + 3 * r, t, 24);
         }
-        snprintf(p->note, sizeof p->note, "copy + N(0, (1e-3 sigma)^2) noise, shuffled");
         break;
     }
     default: {

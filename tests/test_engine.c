@@ -219,6 +219,25 @@ TEST(same_answer_at_every_thread_count) {
     free(b);
 }
 
+/* A and B rounded to float, given to the engine as float32 views, against
+ * the brute force on the rounded values (a and b are overwritten with them). */
+static void check_float32(double *a, size_t na, double *b, size_t nb, int threads) {
+    float *fa = malloc(12 * na), *fb = malloc(12 * nb);
+    for (size_t k = 0; k < 3 * na; k++) a[k] = (double)(fa[k] = (float)a[k]);
+    for (size_t k = 0; k < 3 * nb; k++) b[k] = (double)(fb[k] = (float)b[k]);
+    brute_t ab = brute_directed(a, na, b, nb), ba = brute_directed(b, nb, a, na);
+    hd_points_t A = hd_points_f32(fa, na), B = hd_points_f32(fb, nb);
+    hd_options_t o;
+    hd_options_init(&o);
+    o.threads = threads;
+    hd_symmetric_t s;
+    CHECK_RC(hd_hausdorff(&A, &B, &o, &s, NULL), HD_OK);
+    check_directed(&s.ab, &ab);
+    check_directed(&s.ba, &ba);
+    free(fa);
+    free(fb);
+}
+
 TEST(float32_views_are_exact_for_the_float_values) {
     gen_rng_t g;
     for (uint64_t seed = 8000; seed < 8060; seed++) {
@@ -228,23 +247,10 @@ TEST(float32_views_are_exact_for_the_float_values) {
         CONTEXT("seed=%llu kind=%s na=%zu nb=%zu", (unsigned long long)seed, kind_name[kind], na,
                 nb);
         double *a = malloc(24 * na), *b = malloc(24 * nb);
-        float *fa = malloc(12 * na), *fb = malloc(12 * nb);
         make_pair(&g, kind, a, na, b, nb);
-        for (size_t k = 0; k < 3 * na; k++) a[k] = (double)(fa[k] = (float)a[k]);
-        for (size_t k = 0; k < 3 * nb; k++) b[k] = (double)(fb[k] = (float)b[k]);
-        brute_t ab = brute_directed(a, na, b, nb), ba = brute_directed(b, nb, a, na);
-        hd_points_t A = hd_points_f32(fa, na), B = hd_points_f32(fb, nb);
-        hd_options_t o;
-        hd_options_init(&o);
-        o.threads = seed % 2 ? 1 : 3;
-        hd_symmetric_t s;
-        CHECK_RC(hd_hausdorff(&A, &B, &o, &s, NULL), HD_OK);
-        check_directed(&s.ab, &ab);
-        check_directed(&s.ba, &ba);
+        check_float32(a, na, b, nb, seed % 2 ? 1 : 3);
         free(a);
         free(b);
-        free(fa);
-        free(fb);
     }
 }
 
@@ -420,25 +426,10 @@ TEST(same_order_copies_in_float32_are_exact_for_the_float_values) {
         size_t n = 1 + gen_u64(&g) % 3000;
         CONTEXT("seed=%llu copy=%s n=%zu", (unsigned long long)seed, copy_name[how], n);
         double *a = malloc(24 * n), *b = malloc(24 * n);
-        float *fa = malloc(12 * n), *fb = malloc(12 * n);
         make_copy(&g, how, a, b, n);
-        for (size_t k = 0; k < 3 * n; k++) {
-            a[k] = (double)(fa[k] = (float)a[k]);
-            b[k] = (double)(fb[k] = (float)b[k]);
-        }
-        brute_t ab = brute_directed(a, n, b, n), ba = brute_directed(b, n, a, n);
-        hd_points_t A = hd_points_f32(fa, n), B = hd_points_f32(fb, n);
-        hd_options_t o;
-        hd_options_init(&o);
-        o.threads = seed % 2 ? 1 : 3;
-        hd_symmetric_t s;
-        CHECK_RC(hd_hausdorff(&A, &B, &o, &s, NULL), HD_OK);
-        check_directed(&s.ab, &ab);
-        check_directed(&s.ba, &ba);
+        check_float32(a, n, b, n, seed % 2 ? 1 : 3);
         free(a);
         free(b);
-        free(fa);
-        free(fb);
     }
 }
 
