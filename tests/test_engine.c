@@ -341,6 +341,14 @@ static const char *const copy_name[C_COPY_COUNT] = {
     "swapped", "scaled", "far-offset", "1e-150-scale",
 };
 
+/* Exchange points x and y of p. */
+static void swap_points(double *p, size_t x, size_t y) {
+    double t[3];
+    memcpy(t, p + 3 * x, 24);
+    memcpy(p + 3 * x, p + 3 * y, 24);
+    memcpy(p + 3 * y, t, 24);
+}
+
 /* A (n points) and B, a copy of A in the same order made by `how`. */
 static void make_copy(gen_rng_t *g, int how, double *a, double *b, size_t n) {
     double m0[3] = {0, 0, 0};
@@ -364,11 +372,8 @@ static void make_copy(gen_rng_t *g, int how, double *a, double *b, size_t n) {
         for (int r = 0; r < 3; r++) b[3 * (gen_u64(g) % n) + (size_t)r] += 0.5;
     if (how == C_SWAPPED) /* a few partners exchanged with other points */
         for (size_t r = 0; r < 1 + n / 200; r++) {
-            size_t x = gen_u64(g) % n, y = gen_u64(g) % n;
-            double t[3];
-            memcpy(t, b + 3 * x, 24);
-            memcpy(b + 3 * x, b + 3 * y, 24);
-            memcpy(b + 3 * y, t, 24);
+            size_t x = gen_u64(g) % n;
+            swap_points(b, x, gen_u64(g) % n);
         }
     if (how == C_FAR) {
         gen_affine(a, n, 1.0, 1e9);
@@ -456,12 +461,7 @@ TEST(independent_clouds_and_shuffled_copies_do_not_take_the_correspondence_path)
     CHECK(plan_says(a, b, n, "pairs not tried"));
     /* A noisy copy listed backwards: the partners are unrelated points. */
     make_copy(&g, C_NOISE, a, b, n);
-    for (size_t k = 0; k < n / 2; k++) {
-        double t[3];
-        memcpy(t, b + 3 * k, 24);
-        memcpy(b + 3 * k, b + 3 * (n - 1 - k), 24);
-        memcpy(b + 3 * (n - 1 - k), t, 24);
-    }
+    for (size_t k = 0; k < n / 2; k++) swap_points(b, k, n - 1 - k);
     CHECK(plan_says(a, b, n, "pairs not tried"));
     check_case(a, n, b, n, 1);
     free(a);
@@ -479,11 +479,8 @@ TEST(a_copy_with_more_exchanged_partners_than_the_list_falls_back_exactly) {
     double *a = malloc(24 * n), *b = malloc(24 * n);
     make_copy(&g, C_NOISE, a, b, n);
     for (size_t r = 0; r < n / 40; r++) {
-        size_t x = gen_u64(&g) % n, y = gen_u64(&g) % n;
-        double t[3];
-        memcpy(t, b + 3 * x, 24);
-        memcpy(b + 3 * x, b + 3 * y, 24);
-        memcpy(b + 3 * y, t, 24);
+        size_t x = gen_u64(&g) % n;
+        swap_points(b, x, gen_u64(&g) % n);
     }
     CHECK(plan_says(a, b, n, "pairs listed, resolved 0 / 0"));
     check_case(a, n, b, n, 3);
