@@ -6,24 +6,26 @@
  *
  * Per-point distances are exact nearest-neighbour searches: for each point of
  * A the distance to, and the smallest index of, its nearest point in B (and
- * the reverse).  Each set gets one index, the exact kd-tree of kdtree.c
- * (the tree behind the "kdtree" algorithm), and each tree serves twice:
- * as the structure searched by the other set's points, and as the order in
- * which its own points ask.  The order matters more than anything else:
- * points read in file order (or generated at random) send consecutive
- * searches to unrelated parts of the searched tree, and each one misses the
- * caches; a kd-tree stores its points leaf by leaf, so walking it sends
- * neighbouring queries one after the other, and it holds them as packed
- * coordinate arrays with their original indices, so nothing is gathered.
- * On 1M overlapping Gaussian points this takes less than half the time of
- * the same searches in file order (docs/benchmarks.md, "Analysis").  The order changes no
- * answer: hd__kd_nearest returns the exact nearest squared distance and the
- * smallest original index attaining it (kdtree.c), the same doubles a brute
- * force computes, whatever was asked before and on whichever thread.
- * Unlike the Hausdorff distance itself, which may skip every point that
- * cannot be the farthest (the paper's pruning, Algorithms 2-8), a per-point
- * answer needs one complete search per point; no pruning idea of the paper
- * applies.
+ * the reverse).  Unlike the Hausdorff distance itself, which may skip every
+ * point that cannot be the farthest (the paper's pruning, Algorithms 2-8),
+ * a per-point answer needs one complete search per point; no pruning idea
+ * of the paper applies, and what can be saved is the cost around the
+ * searches.  allnearest.c does them: each set gets one structure (its
+ * points sorted along a Morton curve over the union of both boxes, and the
+ * octree of that order with exact boxes), built side by side with the
+ * other set's, and each structure serves twice: searched by the other
+ * set's points, and grouping its own points so that a group of neighbours
+ * shares one traversal of the searched tree.  The order changes no answer:
+ * every answer is the exact nearest squared distance and the smallest
+ * original index attaining it, the same doubles a brute force computes,
+ * whatever was asked before and on whichever thread (see the exactness
+ * argument there).  On 1M + 1M Gaussian points, with one thread, this
+ * takes 0.22 to 0.51 of the time of the exact kd-trees (kdtree.c) it
+ * replaced, which spent 130 memory passes on building alone, and copes
+ * with massively repeated points, which made every kd-tree search visit
+ * every node (docs/benchmarks.md, "Analysis").  The kd-trees
+ * remain for sets beyond HD__AN_MAX_POINTS points, whose indices do not fit
+ * the structure's 32-bit fields.
  *
  * Everything derived is a pure function of those arrays:
  *  - Percentiles use select.c (numpy's "linear" definition, to the bit),
@@ -42,6 +44,7 @@
  *    hi itself) and the same rule for values on an edge (each bin is
  *    half-open [e_k, e_k+1) except the last, which is closed).
  */
+#include "allnearest.h"
 #include "kdtree.h"
 
 #include <math.h>
@@ -76,12 +79,44 @@ static void nearest_task(void *vctx, size_t task, int worker) {
 }
 
 /* Every point of `asking` against `searched`, answers in file order. */
-static int nearest_direction(const hd__kd_t *asking, const hd__kd_t *searched,
-                             int threads, double *dist, size_t *nearest,
-                             hd_error_t *err) {
+static int kd_direction(const hd__kd_t *asking, const hd__kd_t *searched, int threads,
+                        double *dist, size_t *nearest, hd_error_t *err) {
     nearest_ctx c = {asking, searched, dist, nearest};
     int rc = hd__parallel_for(threads, (asking->n + NEAREST_SLICE - 1) / NEAREST_SLICE, nearest_task, &c);
     return rc == HD_OK ? HD_OK : hd__err(err, rc, "%s", hd_strerror(rc));
+}
+
+/* Both directions with the kd-trees (sets beyond HD__AN_MAX_POINTS points). */
+static int kd_distances(const hd_points_t *A, const hd_points_t *B, int threads, int ab, int ba,
+                        double *dist_ab, size_t *nearest_ab, double *dist_ba, size_t *nearest_ba,
+                        hd_error_t *err) {
+    hd__kd_t ta, tb;
+    int rc;
+    if ((rc = hd__kd_build(&ta, A, threads, err))) return rc;
+    if ((rc = hd__kd_build(&tb, B, threads, err))) {
+        hd__kd_free(&ta);
+        return rc;
+    }
+    if (ab) rc = kd_direction(&ta, &tb, threads, dist_ab, nearest_ab, err);
+    if (rc == HD_OK && ba) rc = kd_direction(&tb, &ta, threads, dist_ba, nearest_ba, err);
+    hd__kd_free(&ta);
+    hd__kd_free(&tb);
+    return rc;
+}
+
+typedef struct {
+    const hd_points_t *set[2];
+    const hd__box_t *keybox;
+    int threads; /* for each build */
+    int rc[2];
+    hd_error_t err[2];
+    hd__an_t s[2];
+} build_ctx;
+
+static void build_task(void *vctx, size_t task, int worker) {
+    (void)worker;
+    build_ctx *c = vctx;
+    c->rc[task] = hd__an_build(&c->s[task], c->set[task], c->keybox, c->threads, &c->err[task]);
 }
 
 int hd_distances(const hd_points_t *A, const hd_points_t *B,
@@ -91,21 +126,37 @@ int hd_distances(const hd_points_t *A, const hd_points_t *B,
     if (opt && opt->threads < 0)
         return hd__err(err, HD_EINVAL, "threads must be 0 (every core) or positive, not %d", opt->threads);
     int rc;
-    if ((rc = hd__points_check(A, "A", NULL, err))) return rc;
-    if ((rc = hd__points_check(B, "B", NULL, err))) return rc;
+    hd__box_t box_a, box_b, keybox;
+    size_t most = A && B ? (A->count > B->count ? A->count : B->count) : 1;
+    int threads = hd__thread_count(opt ? opt->threads : 0, most);
+    /* The engine's validation pass: the reference check's verdict and
+     * message, in one parallel pass without a call per point. */
+    if ((rc = hd__points_scan(A, "A", threads, &box_a, err))) return rc;
+    if ((rc = hd__points_scan(B, "B", threads, &box_b, err))) return rc;
     int ab = dist_ab || nearest_ab, ba = dist_ba || nearest_ba;
     if (!ab && !ba) return HD_OK;
-    int threads = hd__thread_count(opt ? opt->threads : 0, A->count > B->count ? A->count : B->count);
-    hd__kd_t ta, tb;
-    if ((rc = hd__kd_build(&ta, A, threads, err))) return rc;
-    if ((rc = hd__kd_build(&tb, B, threads, err))) {
-        hd__kd_free(&ta);
-        return rc;
+    if (A->count > HD__AN_MAX_POINTS || B->count > HD__AN_MAX_POINTS)
+        return kd_distances(A, B, threads, ab, ba, dist_ab, nearest_ab, dist_ba, nearest_ba, err);
+    /* Both sets ordered on one grid, so that a group of queries and the
+     * buckets it searches are neighbours in memory too. */
+    for (int k = 0; k < 3; k++) {
+        keybox.lo[k] = box_a.lo[k] < box_b.lo[k] ? box_a.lo[k] : box_b.lo[k];
+        keybox.hi[k] = box_a.hi[k] > box_b.hi[k] ? box_a.hi[k] : box_b.hi[k];
     }
-    if (ab) rc = nearest_direction(&ta, &tb, threads, dist_ab, nearest_ab, err);
-    if (rc == HD_OK && ba) rc = nearest_direction(&tb, &ta, threads, dist_ba, nearest_ba, err);
-    hd__kd_free(&ta);
-    hd__kd_free(&tb);
+    /* The two structures are built side by side: part of each build is
+     * serial (the octree), so two builds on half the threads each finish
+     * sooner than one after the other on all of them. */
+    build_ctx c = {{A, B}, &keybox, threads < 2 ? 1 : threads / 2, {HD_OK, HD_OK}, {{0}, {0}}, {{0}, {0}}};
+    rc = hd__parallel_for(threads < 2 ? 1 : 2, 2, build_task, &c);
+    for (int k = 0; k < 2 && rc == HD_OK; k++)
+        if (c.rc[k]) {
+            rc = c.rc[k];
+            if (err) *err = c.err[k];
+        }
+    if (rc == HD_OK && ab) rc = hd__an_nearest(&c.s[0], &c.s[1], threads, dist_ab, nearest_ab, err);
+    if (rc == HD_OK && ba) rc = hd__an_nearest(&c.s[1], &c.s[0], threads, dist_ba, nearest_ba, err);
+    hd__an_free(&c.s[0]);
+    hd__an_free(&c.s[1]);
     return rc;
 }
 

@@ -169,6 +169,200 @@ TEST(distances_refuse_empty_and_nonfinite_sets_naming_them) {
     CHECK_RC(hd_distances(&N, &A, NULL, d, NULL, NULL, NULL, &e), HD_ENONFINITE);
 }
 
+/* ---- per-point distances: shapes that stress the search structure ---------------- */
+
+/* hd_distances of the views A and B (whose points, widened to double, are
+ * a and b) against the brute force in both directions, bit for bit and
+ * index for index, with `threads` threads. */
+static void check_against_brute(const hd_points_t *A, const double *a, size_t na,
+                                const hd_points_t *B, const double *b, size_t nb, int threads) {
+    hd_options_t o;
+    hd_options_init(&o);
+    o.threads = threads;
+    double *dab = malloc(8 * na), *dba = malloc(8 * nb);
+    size_t *jab = malloc(sizeof(size_t) * na), *jba = malloc(sizeof(size_t) * nb);
+    CHECK_RC(hd_distances(A, B, &o, dab, jab, dba, jba, NULL), HD_OK);
+    for (size_t i = 0; i < na && !hdt_failed(); i++) {
+        size_t j;
+        double d2 = brute_nearest(a + 3 * i, b, nb, &j);
+        CHECK_BITS(dab[i], sqrt(d2));
+        CHECK_EQ(jab[i], j);
+    }
+    for (size_t i = 0; i < nb && !hdt_failed(); i++) {
+        size_t j;
+        double d2 = brute_nearest(b + 3 * i, a, na, &j);
+        CHECK_BITS(dba[i], sqrt(d2));
+        CHECK_EQ(jba[i], j);
+    }
+    free(dab), free(dba), free(jab), free(jba);
+}
+
+/* Shape `kind` of n points into xyz (seeded by g). */
+enum { SH_GAUSS, SH_LATTICE, SH_DUPLICATES, SH_IDENTICAL, SH_PLANE, SH_LINE, SH_AXIS_PLANE, SH_KINDS };
+static void shape(gen_rng_t *g, int kind, double *xyz, size_t n) {
+    double m0[3] = {0, 0, 0};
+    switch (kind) {
+    case SH_GAUSS: gen_gauss(g, xyz, n, m0, 1.0); break;
+    case SH_LATTICE: gen_lattice(g, xyz, n, 9); break;
+    case SH_DUPLICATES: gen_lattice(g, xyz, n, 2); break;
+    case SH_IDENTICAL:
+        for (size_t k = 0; k < 3 * n; k++) xyz[k] = k % 3 == 0 ? 0.25 : -1.5;
+        break;
+    case SH_PLANE: gen_plane(g, xyz, n); break;
+    case SH_LINE: gen_line(g, xyz, n); break;
+    default: /* zero extent on two axes after rounding, lattice steps on z */
+        gen_lattice(g, xyz, n, 7);
+        for (size_t k = 0; k < n; k++) xyz[3 * k] = 3.0, xyz[3 * k + 1] = -2.0;
+        break;
+    }
+}
+
+TEST(per_point_distances_are_exact_on_shapes_sizes_scales_and_offsets) {
+    /* Every pair of shapes, with sizes from 1 to a few thousand (ratios up
+     * to 1:1000), B shifted from overlapping to far outside A's box, and
+     * the whole scene scaled to 1e-150 or moved to 1e9 with small steps. */
+    static const size_t sizes[][2] = {{1, 1}, {3, 3000}, {3000, 3}, {700, 900}, {2500, 2000}, {64, 65}};
+    static const double shifts[] = {0.0, 0.3, 40.0, 1e4};
+    uint64_t seed = 1000;
+    for (int ka = 0; ka < SH_KINDS; ka++)
+        for (int kb = 0; kb < SH_KINDS; kb++) {
+            seed++;
+            gen_rng_t g;
+            gen_seed(&g, seed);
+            const size_t *sz = sizes[seed % 6];
+            double shift = shifts[seed / 6 % 4];
+            int scale = (int)(seed / 24 % 3); /* 0: as is, 1: 1e-150, 2: 1e9 + 1e-3 steps */
+            int threads = seed % 2 ? 1 : 3;
+            CONTEXT("seed=%llu shapes=%d,%d sizes=%zu,%zu shift=%g scale=%d threads=%d",
+                    (unsigned long long)seed, ka, kb, sz[0], sz[1], shift, scale, threads);
+            double *a = malloc(24 * sz[0]), *b = malloc(24 * sz[1]);
+            shape(&g, ka, a, sz[0]);
+            shape(&g, kb, b, sz[1]);
+            for (size_t k = 0; k < sz[1]; k++) b[3 * k] += shift;
+            if (scale == 1) {
+                gen_affine(a, sz[0], 1e-150, 0.0);
+                gen_affine(b, sz[1], 1e-150, 0.0);
+            } else if (scale == 2) {
+                gen_affine(a, sz[0], 1e-3, 1e9);
+                gen_affine(b, sz[1], 1e-3, 1e9);
+            }
+            hd_points_t A = hd_points_f64(a, sz[0]), B = hd_points_f64(b, sz[1]);
+            check_against_brute(&A, a, sz[0], &B, b, sz[1], threads);
+            free(a), free(b);
+            if (hdt_failed()) return;
+        }
+}
+
+TEST(per_point_distances_are_exact_with_crowds_of_equal_points) {
+    /* Thousands of copies of a few points: buckets and groups of equal
+     * Morton keys far larger than their nominal sizes, ties everywhere. */
+    for (uint64_t seed = 1; seed <= 4; seed++) {
+        CONTEXT("seed=%llu", (unsigned long long)seed);
+        gen_rng_t g;
+        gen_seed(&g, seed);
+        size_t na = 3000, nb = 2000;
+        double *a = malloc(24 * na), *b = malloc(24 * nb);
+        for (size_t k = 0; k < na; k++) {
+            int c = (int)(gen_u64(&g) % 3);
+            a[3 * k] = c, a[3 * k + 1] = 0.5 * c, a[3 * k + 2] = seed == 4 ? 1e-9 * (double)(k % 2) : 0;
+        }
+        for (size_t k = 0; k < nb; k++) {
+            int c = (int)(gen_u64(&g) % 4);
+            b[3 * k] = 0.5 * c, b[3 * k + 1] = 0.25 * c, b[3 * k + 2] = 0;
+        }
+        hd_points_t A = hd_points_f64(a, na), B = hd_points_f64(b, nb);
+        check_against_brute(&A, a, na, &B, b, nb, (int)seed % 3 + 1);
+        free(a), free(b);
+    }
+}
+
+TEST(per_point_distances_are_exact_for_clusters_next_to_far_outliers) {
+    /* A tight cluster and one far point: the cluster falls into one cell of
+     * the grid over the whole box and must be refined (nested clusters
+     * too); the outliers' nearest points are in the clusters. */
+    for (uint64_t seed = 21; seed <= 24; seed++) {
+        CONTEXT("seed=%llu", (unsigned long long)seed);
+        gen_rng_t g;
+        gen_seed(&g, seed);
+        size_t na = 4000, nb = 3000;
+        double *a = malloc(24 * na), *b = malloc(24 * nb);
+        double m0[3] = {0, 0, 0}, m1[3] = {1e-6, 0, 0};
+        gen_gauss(&g, a, na, m0, 1e-5);
+        gen_gauss(&g, b, nb, m1, 1e-5);
+        if (seed >= 23) { /* a cluster within the cluster */
+            gen_affine(a, na / 2, 1e-7, 0.0);
+            gen_affine(b, nb / 3, 1e-7, 0.0);
+        }
+        a[3 * (na - 1)] = 1e6;
+        b[0] = -1e6, b[1] = 5e5;
+        hd_points_t A = hd_points_f64(a, na), B = hd_points_f64(b, nb);
+        check_against_brute(&A, a, na, &B, b, nb, (int)seed % 3 + 1);
+        free(a), free(b);
+    }
+}
+
+TEST(per_point_distances_of_strided_float32_views_match_the_widened_doubles) {
+    /* Points interleaved with other fields (stride 20 bytes, floats), and a
+     * double view with a coordinate stride: the brute force sees the same
+     * values widened to double. */
+    for (uint64_t seed = 11; seed <= 13; seed++) {
+        CONTEXT("seed=%llu", (unsigned long long)seed);
+        gen_rng_t g;
+        gen_seed(&g, seed);
+        size_t na = 1500, nb = 1200;
+        float *fa = malloc(20 * na);
+        double *a = malloc(24 * na), *braw = malloc(48 * nb), *b = malloc(24 * nb);
+        for (size_t k = 0; k < na; k++)
+            for (int c = 0; c < 3; c++) {
+                float v = (float)(seed == 12 ? (double)(gen_u64(&g) % 5) : gen_normal(&g));
+                fa[5 * k + (size_t)c] = v;
+                a[3 * k + (size_t)c] = v;
+            }
+        for (size_t k = 0; k < nb; k++)
+            for (int c = 0; c < 3; c++) {
+                double v = seed == 12 ? (double)(gen_u64(&g) % 5) + 0.5 : gen_normal(&g) + 0.1;
+                braw[6 * k + 2 * (size_t)c] = v;
+                b[3 * k + (size_t)c] = v;
+            }
+        hd_points_t A = {fa, na, HD_FLOAT32, 20, 4};
+        hd_points_t B = {braw, nb, HD_FLOAT64, 48, 16};
+        check_against_brute(&A, a, na, &B, b, nb, (int)seed % 3 + 1);
+        free(fa), free(a), free(braw), free(b);
+    }
+}
+
+TEST(per_point_distances_do_not_depend_on_the_thread_count) {
+    gen_rng_t g;
+    gen_seed(&g, 99);
+    CONTEXT("seed=99");
+    /* Over 65536 points: the sort is split between threads too. */
+    size_t na = 140000, nb = 70000;
+    double *a = malloc(24 * na), *b = malloc(24 * nb);
+    double m0[3] = {0, 0, 0}, m1[3] = {0.5, 0, 0};
+    gen_gauss(&g, a, na, m0, 1.0);
+    gen_gauss(&g, b, nb, m1, 2.0);
+    for (size_t k = 0; k < nb; k += 7) b[3 * k + 2] = 0; /* some points share a plane */
+    hd_points_t A = hd_points_f64(a, na), B = hd_points_f64(b, nb);
+    double *d1 = malloc(8 * na), *d3 = malloc(8 * na);
+    size_t *j1 = malloc(sizeof(size_t) * na), *j3 = malloc(sizeof(size_t) * na);
+    hd_options_t o;
+    hd_options_init(&o);
+    o.threads = 1;
+    CHECK_RC(hd_distances(&A, &B, &o, d1, j1, NULL, NULL, NULL), HD_OK);
+    o.threads = 3;
+    CHECK_RC(hd_distances(&A, &B, &o, d3, j3, NULL, NULL, NULL), HD_OK);
+    for (size_t i = 0; i < na && !hdt_failed(); i++) {
+        CHECK_BITS(d1[i], d3[i]);
+        CHECK_EQ(j1[i], j3[i]);
+    }
+    for (size_t i = 0; i < na && !hdt_failed(); i += 101) {
+        size_t j;
+        CHECK_BITS(d1[i], sqrt(brute_nearest(a + 3 * i, b, nb, &j)));
+        CHECK_EQ(j1[i], j);
+    }
+    free(a), free(b), free(d1), free(d3), free(j1), free(j3);
+}
+
 /* ---- selection and percentiles ----------------------------------------------- */
 
 TEST(select_puts_every_rank_in_place_with_ties) {
