@@ -100,43 +100,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* ---- Morton keys ------------------------------------------------------------- */
-
-/* Spread the low 10 bits of v to every third bit. */
-static inline uint32_t spread10(uint32_t v) {
-    v &= 0x3ffu;
-    v = (v | v << 16) & 0x30000ffu;
-    v = (v | v << 8) & 0x300f00fu;
-    v = (v | v << 4) & 0x30c30c3u;
-    v = (v | v << 2) & 0x9249249u;
-    return v;
-}
-
-/* Cubic cells over keybox, 1024 per axis along its longest side.  The key
- * only orders the points; any value would be correct. */
-typedef struct {
-    double lo[3], scale;
-} keygrid_t;
-
-static void keygrid_of(const hd__box_t *b, keygrid_t *g) {
-    double ext = 0;
-    for (int k = 0; k < 3; k++) {
-        g->lo[k] = b->lo[k];
-        ext = b->hi[k] - b->lo[k] > ext ? b->hi[k] - b->lo[k] : ext;
-    }
-    g->scale = ext > 0 ? 1024.0 / ext : 0.0;
-}
-
-static inline uint32_t morton_key(const keygrid_t *g, const double p[3]) {
-    uint32_t key = 0;
-    for (int k = 0; k < 3; k++) {
-        double v = (p[k] - g->lo[k]) * g->scale;
-        uint32_t c = v >= 1023.0 ? 1023u : v > 0 ? (uint32_t)v : 0u;
-        key |= spread10(c) << k;
-    }
-    return key;
-}
-
 /* ---- building ---------------------------------------------------------------- */
 
 #define DIGIT_BITS 15
@@ -148,7 +111,7 @@ static inline uint32_t morton_key(const keygrid_t *g, const double p[3]) {
 typedef struct {
     hd__an_t *s;
     hd__src_t src;
-    keygrid_t grid;
+    hd__keygrid_t grid;
     size_t n;
     int parts;
     uint64_t *a, *b;           /* key << 32 | index, sorted from a into b and back */
@@ -171,7 +134,7 @@ static void key_task(void *vctx, size_t part, int worker) {
     for (size_t i = lo; i < hi; i++) {
         double p[3];
         hd__src_get(&c->src, i, p);
-        c->a[i] = (uint64_t)morton_key(&c->grid, p) << 32 | (uint64_t)i;
+        c->a[i] = (uint64_t)hd__key30(&c->grid, p) << 32 | (uint64_t)i;
     }
 }
 
@@ -302,8 +265,8 @@ static int refine(hd__an_t *s, uint64_t *keys, size_t lo, size_t hi) {
             box.hi[d] = v[d][i] > box.hi[d] ? v[d][i] : box.hi[d];
         }
     }
-    keygrid_t g;
-    keygrid_of(&box, &g);
+    hd__keygrid_t g;
+    hd__keygrid_init(&g, &box);
     if (g.scale == 0.0) return 0;
     uint64_t *k2 = hd__malloc_array(m, sizeof *k2);
     double *t = hd__malloc_array(m, 3 * sizeof *t);
@@ -312,7 +275,7 @@ static int refine(hd__an_t *s, uint64_t *keys, size_t lo, size_t hi) {
     if (ok) {
         for (size_t i = 0; i < m; i++) {
             double p[3] = {s->x[lo + i], s->y[lo + i], s->z[lo + i]};
-            k2[i] = (uint64_t)morton_key(&g, p) << 32 | (uint64_t)i;
+            k2[i] = (uint64_t)hd__key30(&g, p) << 32 | (uint64_t)i;
             t[3 * i] = p[0], t[3 * i + 1] = p[1], t[3 * i + 2] = p[2];
             ti[i] = s->idx[lo + i];
         }
@@ -384,7 +347,7 @@ static int build_octree(build_ctx *c, size_t cap) {
             s->first[node] = (uint32_t)nb;
             s->count[node] = 0;
             s->leaf[nb] = (uint32_t)node;
-            s->key[nb] = morton_key(&c->grid, p);
+            s->key[nb] = hd__key30(&c->grid, p);
             s->start[nb++] = (uint32_t)lo;
             continue;
         }
@@ -448,7 +411,7 @@ int hd__an_build(hd__an_t *s, const hd_points_t *p, const hd__box_t *keybox, int
     c.s = s;
     c.n = n;
     hd__src_init(&c.src, p, NULL);
-    keygrid_of(keybox, &c.grid);
+    hd__keygrid_init(&c.grid, keybox);
     c.parts = threads > MAX_PARTS ? MAX_PARTS : threads;
     if ((size_t)c.parts > n / 65536 + 1) c.parts = (int)(n / 65536 + 1);
     /* Node arrays grow as the octree is cut (a bucket usually holds a few

@@ -54,40 +54,6 @@ void hd__src_init(hd__src_t *s, const hd_points_t *p, const hd_transform_t *T) {
     if (s->cs == el && s->ps == 3 * el) s->kind = p->dtype == HD_FLOAT32 ? 1 : 0;
 }
 
-/* Spread the low 10 bits of v to every third bit. */
-static inline uint64_t spread3(uint32_t v) {
-    uint64_t x = v & 0x3ff;
-    x = (x | x << 16) & 0x30000ffULL;
-    x = (x | x << 8) & 0x300f00fULL;
-    x = (x | x << 4) & 0x30c30c3ULL;
-    x = (x | x << 2) & 0x9249249ULL;
-    return x;
-}
-
-/* The grid of cubic cells over a box: cell = (c - lo) * scale, clamped. */
-typedef struct {
-    double lo[3], scale;
-} grid_t;
-
-static void grid_of(const hd__box_t *b, grid_t *g) {
-    double ext = 0;
-    for (int k = 0; k < 3; k++) {
-        g->lo[k] = b->lo[k];
-        double e = b->hi[k] - b->lo[k];
-        if (e > ext) ext = e;
-    }
-    g->scale = ext > 0 ? 1024.0 / ext : 0.0;
-}
-
-static inline uint64_t grid_key(const grid_t *g, const double p[3]) {
-    uint32_t c[3];
-    for (int k = 0; k < 3; k++) {
-        double v = (p[k] - g->lo[k]) * g->scale;
-        c[k] = v >= 1023.0 ? 1023u : v > 0 ? (uint32_t)v : 0u;
-    }
-    return spread3(c[0]) | spread3(c[1]) << 1 | spread3(c[2]) << 2;
-}
-
 /* ---- parallel LSD radix sort on bits 32..61 ------------------------------- */
 
 #define RADIX_BITS 10
@@ -161,7 +127,7 @@ static int radix_sort(uint64_t **a, uint64_t **tmp, size_t n, int threads) {
 typedef struct {
     const hd__src_t *src;
     size_t n;
-    grid_t grid;
+    hd__keygrid_t grid;
     uint64_t *keys;
     hd__box_t *part_box;
 } key_ctx;
@@ -191,7 +157,7 @@ static void key_task(void *vctx, size_t task, int worker) {
     for (size_t i = lo; i < hi; i++) {
         double p[3];
         hd__src_get(c->src, i, p);
-        c->keys[i] = grid_key(&c->grid, p) << 32 | (uint64_t)i;
+        c->keys[i] = (uint64_t)hd__key30(&c->grid, p) << 32 | (uint64_t)i;
     }
 }
 
@@ -230,12 +196,12 @@ static int refine(const hd__src_t *src, uint64_t *a, uint64_t *tmp, size_t m, in
             b.hi[k] = p[k] > b.hi[k] ? p[k] : b.hi[k];
         }
     }
-    grid_t g;
-    grid_of(&b, &g);
+    hd__keygrid_t g;
+    hd__keygrid_init(&g, &b);
     if (g.scale == 0.0 || depth > 200) return HD_OK; /* identical points */
     for (size_t i = 0; i < m; i++) {
         hd__src_get(src, (uint32_t)a[i], p);
-        a[i] = grid_key(&g, p) << 32 | (a[i] & 0xffffffffu);
+        a[i] = (uint64_t)hd__key30(&g, p) << 32 | (a[i] & 0xffffffffu);
     }
     if (m <= 64) {
         insertion_sort(a, m);
@@ -415,7 +381,7 @@ int hd__tree_build(hd__tree_t *t, const hd__src_t *src, size_t n, const hd__box_
         t->box = kc.part_box[0];
         for (size_t s = 1; s < slices; s++) box_merge(&t->box, &kc.part_box[s]);
     }
-    grid_of(&t->box, &kc.grid);
+    hd__keygrid_init(&kc.grid, &t->box);
     hd__parallel_for(threads, slices, key_task, &kc);
     if ((rc = radix_sort(&keys, &tmp, n, threads))) goto done;
     for (size_t s = 0; s < n;) {

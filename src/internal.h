@@ -119,6 +119,44 @@ double hd__nn_scan(const double *p, const double *xyz, size_t n, size_t *j,
 size_t hd__first_at(const double *p, const double *xyz, size_t n, double d2,
                     uint64_t *evals);
 
+/* ---- Morton keys -------------------------------------------------------- */
+/* Cubic cells over a box, 1024 per axis along its longest side (cell =
+ * (c - lo) * scale, clamped to the grid), and the 30-bit Morton key of a
+ * point's cell.  Keys only order points along the curve, for locality: any
+ * value would be correct, so no rounding argument is needed here. */
+typedef struct hd__keygrid {
+    double lo[3], scale;
+} hd__keygrid_t;
+
+HD__INLINE void hd__keygrid_init(hd__keygrid_t *g, const hd__box_t *b) {
+    double ext = 0;
+    for (int k = 0; k < 3; k++) {
+        g->lo[k] = b->lo[k];
+        ext = b->hi[k] - b->lo[k] > ext ? b->hi[k] - b->lo[k] : ext;
+    }
+    g->scale = ext > 0 ? 1024.0 / ext : 0.0;
+}
+
+/* The low 10 bits of v spread to every third bit. */
+HD__INLINE uint32_t hd__spread10(uint32_t v) {
+    v &= 0x3ffu;
+    v = (v | v << 16) & 0x30000ffu;
+    v = (v | v << 8) & 0x300f00fu;
+    v = (v | v << 4) & 0x30c30c3u;
+    v = (v | v << 2) & 0x9249249u;
+    return v;
+}
+
+HD__INLINE uint32_t hd__key30(const hd__keygrid_t *g, const double p[3]) {
+    uint32_t key = 0;
+    for (int k = 0; k < 3; k++) {
+        double v = (p[k] - g->lo[k]) * g->scale;
+        uint32_t c = v >= 1023.0 ? 1023u : v > 0 ? (uint32_t)v : 0u;
+        key |= hd__spread10(c) << k;
+    }
+    return key;
+}
+
 /* ---- errors ----------------------------------------------------------- */
 /* Set err (if not NULL) and return code. */
 int hd__err(hd_error_t *err, int code, const char *fmt, ...) HD__PRINTF(3, 4);
