@@ -320,9 +320,12 @@ HD_EXTERN int hd_index_nearest(const hd_index_t *idx, const hd_points_t *Q,
  * B against A.  Each output may be NULL (a direction with both outputs NULL
  * is skipped); dist_ab/nearest_ab hold A->count elements, dist_ba/nearest_ba
  * B->count.  Exact: bit-identical to a brute force, at any thread count.
- * One exact kd-tree per set, each searched by the other set's points and
- * walked in its own leaf order for its own points' queries; parallel with
- * opt->threads.  Errors: as hd_directed. */
+ * Each set is sorted once along a Morton curve into an octree of small
+ * buckets; each structure is searched by the other set's points, a group
+ * of neighbouring queries at a time.  It holds a copy of the coordinates
+ * (about 32 bytes per point per set while searching, up to about 68 while
+ * building), freed before returning.  Parallel with opt->threads; thread
+ * safe for distinct outputs.  Errors: as hd_directed. */
 HD_EXTERN int hd_distances(const hd_points_t *A, const hd_points_t *B,
                            const hd_options_t *opt, double *dist_ab,
                            size_t *nearest_ab, double *dist_ba,
