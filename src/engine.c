@@ -539,6 +539,13 @@ static int engine_plan(engine_t *e, int force, hd_error_t *err) {
         if (hd__pairs_resolve(&e->pairs, e->src, NULL, e->max, e->directions, e->counts))
             return HD_OK;
     }
+    /* The smaller set may be an ordered subset of the larger: its direction
+     * is then 0, settled by one merge walk. */
+    for (int d = 0; d < e->directions && !force; d++)
+        if (e->n[d] < e->n[1 - d])
+            e->pairs.resolved[d] = hd__subset_resolve(&e->src[d], e->n[d], &e->src[1 - d],
+                                                      e->n[1 - d], &e->max[d], &e->counts[d]);
+    if (e->pairs.resolved[0] && (e->directions == 1 || e->pairs.resolved[1])) return HD_OK;
     for (int k = 0; k < 2; k++) {
         int rc = hd__grid_build(&e->grid[k], &e->src[k], e->n[k], &e->box[k], e->threads, err);
         if (rc) {

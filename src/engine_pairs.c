@@ -47,6 +47,16 @@
  * in them.  If the list is used up before the rule stops, the direction is
  * left to the grid pass or the trees, whose maximum has been raised by
  * every exact search made here; nothing is lost but the pass.
+ *
+ * The same idea covers a smaller set that is an ordered subset of the
+ * larger one (every k-th point kept, a point cloud subsampled by a tool
+ * that keeps the order, a mesh simplified by removing vertices): one merge
+ * walk finds each point of the small set, in order, as an exact copy in
+ * the large one.  Then every nearest distance of the small set is 0, so its
+ * directed distance is 0 and its witness is its point 0 with the smallest
+ * index at squared distance 0 from it.  The walk gives up as soon as a point
+ * is not found, after a first window that keeps unrelated sets from paying
+ * more than a few hundred reads.
  */
 #include "index.h"
 
@@ -268,4 +278,57 @@ int hd__pairs_resolve(hd__pairs_t *P, const hd__src_t src[2], const hd__grid_t *
         all &= P->resolved[d];
     }
     return P->active && all;
+}
+
+/* ---- ordered subsets ---------------------------------------------------------- */
+
+/* Points of the small set the first window must find, and how far into the
+ * large set (in multiples of the size ratio) it may look for them. */
+#define SUBSET_WINDOW 64
+#define SUBSET_SLACK 4
+
+static int same_point(const double p[3], const double q[3]) {
+    return p[0] == q[0] && p[1] == q[1] && p[2] == q[2];
+}
+
+int hd__subset_resolve(const hd__src_t *small, size_t ns, const hd__src_t *large, size_t nl,
+                       hd__max_t *max, hd__counts_t *counts) {
+    if (ns == 0 || ns >= nl) return 0;
+    size_t ratio = (nl + ns - 1) / ns;
+    size_t win = SUBSET_WINDOW < ns ? SUBSET_WINDOW : ns;
+    size_t limit = win * ratio * SUBSET_SLACK + SUBSET_WINDOW;
+    size_t i = 0, first = 0;
+    for (size_t j = 0; j < ns; j++) {
+        double p[3], q[3];
+        hd__src_get(small, j, p);
+        for (;; i++) {
+            if (i == nl || (j < win && i >= limit)) {
+                counts->evals += i;
+                return 0;
+            }
+            hd__src_get(large, i, q);
+            if (same_point(p, q)) break;
+        }
+        if (j == 0) first = i;
+        i++;
+    }
+    counts->evals += i;
+    /* Every point of the small set has a copy: h = 0.  The witness is its
+     * point 0 and the smallest index at squared distance 0 from it (an
+     * earlier point than its copy may differ by less than the square root
+     * of the smallest double). */
+    double p[3];
+    hd__src_get(small, 0, p);
+    size_t j0 = first;
+    for (size_t k = 0; k < first; k++) {
+        double q[3];
+        hd__src_get(large, k, q);
+        if (hd__d2(p, q) == 0.0) {
+            j0 = k;
+            break;
+        }
+    }
+    counts->evals += j0;
+    hd__max_offer(max, 0.0, 0, j0, NULL);
+    return 1;
 }

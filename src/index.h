@@ -346,6 +346,13 @@ int hd__pairs_resolve(hd__pairs_t *P, const hd__src_t src[2], const hd__grid_t *
                       hd__max_t *max, int directions, hd__counts_t *counts);
 void hd__pairs_free(hd__pairs_t *P);
 
+/* When the ns points of `small` appear, in order, as exact copies among the
+ * nl > ns points of `large` (an ordered subset), h(small, large) = 0: offer
+ * it to max with its witness and return 1; otherwise return 0 (after
+ * reading at most a short window of `large` when the sets are unrelated). */
+int hd__subset_resolve(const hd__src_t *small, size_t ns, const hd__src_t *large, size_t nl,
+                       hd__max_t *max, hd__counts_t *counts);
+
 /* h(A,B) over built indexes of A and B (engine.c), with `threads` threads. */
 int hd__engine_trees(const hd__tree_t *ta, const hd__tree_t *tb, int threads,
                      hd_result_t *out, hd_error_t *err);

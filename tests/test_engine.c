@@ -390,8 +390,8 @@ int hd__engine_explain(const hd_points_t *A, const hd_points_t *B, const hd_opti
                        char *buf, size_t len, hd_error_t *err);
 
 /* Whether the engine's account of its plan for (A, B) contains `words`. */
-static int plan_says(const double *a, const double *b, size_t n, const char *words) {
-    hd_points_t A = hd_points_f64(a, n), B = hd_points_f64(b, n);
+static int plan_says(const double *a, size_t na, const double *b, size_t nb, const char *words) {
+    hd_points_t A = hd_points_f64(a, na), B = hd_points_f64(b, nb);
     hd_options_t o;
     hd_options_init(&o);
     char plan[256] = "";
@@ -412,7 +412,7 @@ TEST(same_order_copies_are_exact_in_every_variation) {
         double *a = malloc(24 * n), *b = malloc(24 * n);
         make_copy(&g, how, a, b, n);
         check_case(a, n, b, n, threads);
-        settled += plan_says(a, b, n, "resolved 1 / 1");
+        settled += plan_says(a, n, b, n, "resolved 1 / 1");
         cases++;
         free(a);
         free(b);
@@ -445,7 +445,7 @@ TEST(a_noisy_copy_is_settled_by_the_correspondence_path) {
     size_t n = 50000;
     double *a = malloc(24 * n), *b = malloc(24 * n);
     make_copy(&g, C_NOISE, a, b, n);
-    CHECK(plan_says(a, b, n, "pairs (pairs listed, resolved 1 / 1"));
+    CHECK(plan_says(a, n, b, n, "pairs (pairs listed, resolved 1 / 1"));
     check_case(a, n, b, n, 3);
     free(a);
     free(b);
@@ -458,11 +458,11 @@ TEST(independent_clouds_and_shuffled_copies_do_not_take_the_correspondence_path)
     size_t n = 20000;
     double *a = malloc(24 * n), *b = malloc(24 * n);
     make_pair(&g, K_OVERLAP, a, n, b, n);
-    CHECK(plan_says(a, b, n, "pairs not tried"));
+    CHECK(plan_says(a, n, b, n, "pairs not tried"));
     /* A noisy copy listed backwards: the partners are unrelated points. */
     make_copy(&g, C_NOISE, a, b, n);
     for (size_t k = 0; k < n / 2; k++) swap_points(b, k, n - 1 - k);
-    CHECK(plan_says(a, b, n, "pairs not tried"));
+    CHECK(plan_says(a, n, b, n, "pairs not tried"));
     check_case(a, n, b, n, 1);
     free(a);
     free(b);
@@ -482,7 +482,7 @@ TEST(a_copy_with_more_exchanged_partners_than_the_list_falls_back_exactly) {
         size_t x = gen_u64(&g) % n;
         swap_points(b, x, gen_u64(&g) % n);
     }
-    CHECK(plan_says(a, b, n, "pairs listed, resolved 0 / 0"));
+    CHECK(plan_says(a, n, b, n, "pairs listed, resolved 0 / 0"));
     check_case(a, n, b, n, 3);
     free(a);
     free(b);
@@ -643,4 +643,82 @@ TEST(whole_cells_at_the_maximum_keep_the_canonical_witness) {
         free(a);
         free(b);
     }
+}
+
+/* ---- ordered subsets: the smaller set's points, in order, copied from the larger -- */
+
+/* B: every point of A kept with probability 1 / step (at least one), in A's
+ * order; returns its size. */
+static size_t make_subset(gen_rng_t *g, const double *a, size_t na, size_t step, double *b) {
+    size_t nb = 0;
+    for (size_t k = 0; k < na; k++)
+        if (gen_u64(g) % step == 0) memcpy(b + 3 * nb++, a + 3 * k, 24);
+    if (nb == 0) memcpy(b + 3 * nb++, a + 3 * (na / 2), 24);
+    return nb;
+}
+
+TEST(ordered_subsets_are_exact_in_both_directions) {
+    gen_rng_t g;
+    int settled = 0, cases = 0;
+    for (uint64_t seed = 13000; seed < 13240 && !hdt_failed(); seed++) {
+        gen_seed(&g, seed);
+        int kind = (int)(seed % 4); /* gauss, lattice (ties), duplicates, 1e-150 scale */
+        size_t na = 2 + gen_u64(&g) % (seed % 8 == 0 ? 8000 : 900), step = 2 + gen_u64(&g) % 12;
+        CONTEXT("seed=%llu kind=%d na=%zu step=%zu", (unsigned long long)seed, kind, na, step);
+        double *a = malloc(24 * na), *b = malloc(24 * na), m0[3] = {0, 0, 0};
+        if (kind == 1) gen_lattice(&g, a, na, 2 + (int)(gen_u64(&g) % 12));
+        else gen_gauss(&g, a, na, m0, 1.0);
+        if (kind == 2)
+            for (size_t k = 0; k < na; k++)
+                if (gen_u64(&g) % 2) memcpy(a + 3 * k, a + 3 * (gen_u64(&g) % na), 24);
+        if (kind == 3) gen_affine(a, na, 1e-150, 0.0);
+        size_t nb = make_subset(&g, a, na, step, b);
+        if (nb == na) nb--; /* a proper subset */
+        check_case(a, na, b, nb, seed % 2 ? 1 : 3);
+        check_case(b, nb, a, na, seed % 2 ? 3 : 1);
+        settled += plan_says(a, na, b, nb, "resolved 0 / 1");
+        cases++;
+        free(a);
+        free(b);
+    }
+    CONTEXT("settled by the subset walk: %d of %d", settled, cases);
+    CHECK(settled >= cases * 9 / 10);
+}
+
+TEST(ordered_subsets_in_float32_are_exact_for_the_float_values) {
+    gen_rng_t g;
+    for (uint64_t seed = 13500; seed < 13530 && !hdt_failed(); seed++) {
+        gen_seed(&g, seed);
+        size_t na = 2 + gen_u64(&g) % 3000;
+        CONTEXT("seed=%llu na=%zu", (unsigned long long)seed, na);
+        double *a = malloc(24 * na), *b = malloc(24 * na), m0[3] = {0, 0, 0};
+        gen_gauss(&g, a, na, m0, 1.0);
+        size_t nb = make_subset(&g, a, na, 3, b);
+        if (nb == na) nb--;
+        check_float32(a, na, b, nb, seed % 2 ? 1 : 3);
+        free(a);
+        free(b);
+    }
+}
+
+TEST(subsets_out_of_order_or_with_a_stranger_are_left_to_the_other_paths) {
+    gen_rng_t g;
+    gen_seed(&g, 13600);
+    CONTEXT("seed=13600");
+    size_t na = 40000;
+    double *a = malloc(24 * na), *b = malloc(24 * na), m0[3] = {0, 0, 0};
+    gen_gauss(&g, a, na, m0, 1.0);
+    size_t nb = make_subset(&g, a, na, 10, b);
+    CHECK(plan_says(a, na, b, nb, "resolved 0 / 1"));
+    /* The last point no longer a copy: the walk fails at its very end. */
+    b[3 * (nb - 1)] += 1e-3;
+    CHECK(plan_says(a, na, b, nb, "resolved 0 / 0"));
+    check_case(a, na, b, nb, 3);
+    b[3 * (nb - 1)] -= 1e-3;
+    /* Out of order: the walk gives up within its first window. */
+    for (size_t k = 0; k < nb / 2; k++) swap_points(b, k, nb - 1 - k);
+    CHECK(plan_says(a, na, b, nb, "resolved 0 / 0"));
+    check_case(a, na, b, nb, 1);
+    free(a);
+    free(b);
 }
