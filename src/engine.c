@@ -1,9 +1,14 @@
 /*
- * engine.c -- the `auto` engine: its plan (grid pass or bucket trees), the
- * walk over the bucket trees, the shared maximum, and the entry points.
- * docs/engine.md explains the design; the essay here is its summary.
+ * engine.c -- the `auto` engine: its plan (a copy or subset settled by
+ * engine_pairs.c, else the grid pass or the bucket trees), the walk over the
+ * bucket trees, the shared maximum, and the entry points.  docs/engine.md
+ * explains the design; the essay here is its summary.
  *
- * The plan.  Both sets get the cheap grid of engine_grid.c.  For each
+ * The plan.  First the shortcuts of engine_pairs.c, which need no index: two
+ * sets of one size listed in the same order (a copy and its original) are
+ * settled by their pair distances, and a smaller set that is an ordered
+ * subset of the larger has h = 0 in its direction.  For what is left, both
+ * sets get the cheap grid of engine_grid.c.  For each
  * direction h(A,B), cmax is primed with the exact nearest distances of the
  * representatives of A's cells lying where B is emptiest (the paper's AHD,
  * Algorithm 6, line 1), then the grid pass is tried on a sample of A.  When
