@@ -240,6 +240,12 @@ static void scan_nearest(const hd__src_t *src, size_t n, const double q[3], doub
     }
 }
 
+/* The rule: pair e, and every pair after it in the order, cannot hold the
+ * witness of the maximum snap (its nearest distance is at most e->d2). */
+static inline int cannot_be_witness(const pair_t *e, const hd__best_t *snap) {
+    return snap->d2 >= 0 && (e->d2 < snap->d2 || (e->d2 == snap->d2 && e->i > snap->i));
+}
+
 int hd__pairs_resolve(hd__pairs_t *P, const hd__src_t src[2], const hd__grid_t *grid,
                       hd__max_t *max, int directions, hd__counts_t *counts) {
     int all = 1;
@@ -250,7 +256,7 @@ int hd__pairs_resolve(hd__pairs_t *P, const hd__src_t src[2], const hd__grid_t *
         size_t k = P->pos[d];
         for (; k < P->m; k++) {
             const pair_t *e = &P->list[k];
-            if (snap.d2 >= 0 && (e->d2 < snap.d2 || (e->d2 == snap.d2 && e->i > snap.i))) break;
+            if (cannot_be_witness(e, &snap)) break;
             if (!grid && P->scanned >= (uint64_t)PAIR_SCANS * P->n) break; /* grids wanted */
             double q[3];
             hd__src_get(&src[d], e->i, q);
@@ -269,12 +275,7 @@ int hd__pairs_resolve(hd__pairs_t *P, const hd__src_t src[2], const hd__grid_t *
         }
         P->pos[d] = k;
         /* Settled when the rule stopped the walk, or every point was listed. */
-        if (k < P->m) {
-            const pair_t *e = &P->list[k];
-            P->resolved[d] = snap.d2 >= 0 && (e->d2 < snap.d2 || (e->d2 == snap.d2 && e->i > snap.i));
-        } else {
-            P->resolved[d] = P->m == P->n;
-        }
+        P->resolved[d] = k < P->m ? cannot_be_witness(&P->list[k], &snap) : P->m == P->n;
         all &= P->resolved[d];
     }
     return P->active && all;
