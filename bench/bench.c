@@ -8,9 +8,10 @@
  * cloud against its copy translated by 0.1% to 10% of its box, real models)
  * and every size, it
  *  - generates A and B in memory (tests/support/gen.c, fixed seeds) or reads
- *    them with hd_read_file (data/);
+ *    them with hd_read_file (data/, through bench_read_model);
  *  - times one streaming pass over all input coordinates (the
- *    memory-bandwidth floor) at each thread count;
+ *    memory-bandwidth floor, bench_floor_pass in bench/support/benchutil.c)
+ *    at each thread count;
  *  - times hd_hausdorff with the `auto` engine (median of up to 5 runs) and
  *    records distance evaluations per point and the algorithm that ran;
  *  - times the library's own "kdtree" algorithm (the peer-equivalent
@@ -28,6 +29,7 @@
  *
  * Nothing here is a test: numbers are measured, never asserted.
  */
+#include "benchutil.h"
 #include "gen.h"
 
 #include <hausdorff.h>
@@ -40,7 +42,6 @@
 #include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
-#include <time.h>
 #include <unistd.h>
 
 /* The engine's own account of its plan (an internal function of the
@@ -67,78 +68,6 @@ typedef struct {
     FILE *fp;
     char tmp[256];
 } bench_t;
-
-static double now(void) {
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static int cmp_double(const void *a, const void *b) {
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-static double median(double *v, int n) {
-    qsort(v, (size_t)n, sizeof *v, cmp_double);
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
-/* ---- the memory-bandwidth floor ------------------------------------------------- */
-
-typedef struct {
-    const double *p;
-    size_t n;
-    double sum;
-} pass_t;
-
-static void *pass_thread(void *arg) {
-    pass_t *s = arg;
-    double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
-    size_t k = 0;
-    for (; k + 4 <= s->n; k += 4) {
-        s0 += s->p[k];
-        s1 += s->p[k + 1];
-        s2 += s->p[k + 2];
-        s3 += s->p[k + 3];
-    }
-    for (; k < s->n; k++) s0 += s->p[k];
-    s->sum = s0 + s1 + s2 + s3;
-    return NULL;
-}
-
-/* One streaming pass reading every coordinate of A and B once, split over
- * `threads` threads; median of 5. */
-static double floor_pass(const double *a, size_t na, const double *b, size_t nb, int threads) {
-    double t[5], sink = 0;
-    for (int r = 0; r < 5; r++) {
-        pass_t part[2 * 16];
-        pthread_t tid[2 * 16];
-        int np = 0;
-        const double *set[2] = {a, b};
-        size_t len[2] = {3 * na, 3 * nb};
-        double t0 = now();
-        for (int s = 0; s < 2; s++)
-            for (int k = 0; k < threads; k++) {
-                part[np].p = set[s] + len[s] * (size_t)k / (size_t)threads;
-                part[np].n = len[s] * (size_t)(k + 1) / (size_t)threads - len[s] * (size_t)k / (size_t)threads;
-                np++;
-            }
-        /* Each thread takes its share of A then of B. */
-        for (int k = 1; k < threads; k++) pthread_create(&tid[k], NULL, pass_thread, &part[k]);
-        for (int k = 1; k < threads; k++) pthread_create(&tid[threads + k], NULL, pass_thread, &part[threads + k]);
-        pass_thread(&part[0]);
-        pass_thread(&part[threads]);
-        for (int k = 1; k < threads; k++) {
-            pthread_join(tid[k], NULL);
-            pthread_join(tid[threads + k], NULL);
-        }
-        t[r] = now() - t0;
-        for (int k = 0; k < np; k++) sink += part[k].sum;
-    }
-    if (sink == 12345.678) fprintf(stderr, "%g\n", sink); /* keep the sums alive */
-    return median(t, 5);
-}
 
 /* ---- the cases ------------------------------------------------------------------ */
 
@@ -202,23 +131,23 @@ static void make_case(pair_t *p, int kind, size_t n, double frac) {
     p->b = alloc_points(nb);
     switch (kind) {
     case C_OVERLAP:
-        snprintf(p->name, sizeof p->name, "overlapping");
-        gauss(1, p->a, na, 0);
-        gauss(2, p->b, nb, 0);
-        snprintf(p->note, sizeof p->note, "two Gaussians, same mean");
-        break;
     case C_DISJOINT:
-        snprintf(p->name, sizeof p->name, "disjoint");
+    case C_PARTIAL: {
+        /* Two Gaussians, B's mean `shift` sigma from A's along x. */
+        static const struct {
+            const char *name, *note;
+            double shift;
+        } g[] = {
+            [C_OVERLAP] = {"overlapping", "two Gaussians, same mean", 0},
+            [C_DISJOINT] = {"disjoint", "Gaussians 20 sigma apart", 20},
+            [C_PARTIAL] = {"partial", "Gaussians 2 sigma apart", 2},
+        };
+        snprintf(p->name, sizeof p->name, "%s", g[kind].name);
         gauss(1, p->a, na, 0);
-        gauss(2, p->b, nb, 20);
-        snprintf(p->note, sizeof p->note, "Gaussians 20 sigma apart");
+        gauss(2, p->b, nb, g[kind].shift);
+        snprintf(p->note, sizeof p->note, "%s", g[kind].note);
         break;
-    case C_PARTIAL:
-        snprintf(p->name, sizeof p->name, "partial");
-        gauss(1, p->a, na, 0);
-        gauss(2, p->b, nb, 2);
-        snprintf(p->note, sizeof p->note, "Gaussians 2 sigma apart");
-        break;
+    }
     case C_BIG_SMALL:
     case C_SMALL_BIG:
         snprintf(p->name, sizeof p->name, kind == C_BIG_SMALL ? "100:1" : "1:100");
@@ -263,30 +192,6 @@ static void make_case(pair_t *p, int kind, size_t n, double frac) {
     }
 }
 
-/* A real model read with hd_read_file (vertices, or `sample` points drawn
- * on its faces); NULL when it cannot be read. */
-static double *read_model(const char *path, size_t sample, uint64_t seed, size_t *n) {
-    hd_read_options_t ro;
-    hd_read_options_init(&ro);
-    if (sample) {
-        ro.mesh = HD_MESH_SAMPLE;
-        ro.sample = sample;
-        ro.seed = seed;
-    }
-    hd_cloud_t *c;
-    hd_error_t e;
-    if (hd_read_file(path, &ro, &c, &e) != HD_OK) {
-        fprintf(stderr, "bench: %s\n", e.message);
-        return NULL;
-    }
-    double *p = alloc_points(c->count);
-    hd_points_t v = hd_cloud_points(c);
-    for (size_t k = 0; k < c->count; k++) hd_points_get(&v, k, p + 3 * k);
-    *n = c->count;
-    hd_cloud_free(c);
-    return p;
-}
-
 /* Every `step`-th point of p (a decimated copy). */
 static double *decimate(const double *p, size_t n, size_t step, size_t *m) {
     *m = (n + step - 1) / step;
@@ -322,22 +227,20 @@ static int run_library(bench_t *B, const pair_t *p, hd_algorithm_t alg, int thre
     hd_symmetric_t s;
     hd_error_t e;
     for (int r = 0; r < B->runs && (r == 0 || spent < B->budget); r++) {
-        double t0 = now();
+        double t0 = bench_now();
         if (hd_hausdorff(&A, &Bp, &o, &s, &e) != HD_OK) {
             fprintf(stderr, "bench: %s\n", e.message);
             return -1;
         }
-        t[n] = now() - t0;
+        t[n] = bench_now() - t0;
         spent += t[n++];
     }
-    double times[16];
-    memcpy(times, t, sizeof t);
-    double med = median(t, n);
+    double med = bench_median(t, n);
     uint64_t evals = s.ab.stats.distance_evals + s.ba.stats.distance_evals;
     uint64_t culled = s.ab.stats.points_culled + s.ba.stats.points_culled;
     json_pair_head(B, p, alg == HD_ALG_AUTO ? "hausdorff auto" : "hausdorff kdtree", threads);
     fprintf(B->fp, ", \"median_s\": %.6g", med);
-    json_times(B, times, n);
+    json_times(B, t, n);
     fprintf(B->fp,
             ", \"distance\": %.17g, \"evals_per_point\": %.4g, \"culled_fraction\": %.4g, "
             "\"algorithm\": \"%s/%s\", \"floor_s\": %.6g, \"floor_ratio\": %.4g}\n",
@@ -398,12 +301,10 @@ static void run_peer(bench_t *B, const pair_t *p, const char *method, int thread
         fflush(B->fp);
         return;
     }
-    double times[64];
-    memcpy(times, t, sizeof t);
-    double med = median(t, n);
+    double med = bench_median(t, n);
     const char *same = d == H ? "exact" : fabs(d - H) <= tolerance ? "tolerance" : "DIFFERENT";
     fprintf(B->fp, ", \"median_s\": %.6g", med);
-    json_times(B, times, n);
+    json_times(B, t, n);
     fprintf(B->fp, ", \"distance\": %.17g, \"same\": \"%s\"}\n", d, same);
     fflush(B->fp);
     fprintf(stderr, "  %-18s t=%d %10.4f s  H=%.17g  %s\n", method, threads, med, d, same);
@@ -421,7 +322,7 @@ static void run_pair(bench_t *B, pair_t *p) {
     fprintf(B->fp, ", \"plan\": \"%s\"}\n", plan);
     double H = NAN, floor_s[4];
     for (int k = 0; k < B->n_threads; k++) {
-        floor_s[k] = floor_pass(p->a, p->na, p->b, p->nb, B->threads[k]);
+        floor_s[k] = bench_floor_pass(p->a, p->na, p->b, p->nb, B->threads[k]);
         json_pair_head(B, p, "floor", B->threads[k]);
         fprintf(B->fp, ", \"median_s\": %.6g}\n", floor_s[k]);
     }
@@ -532,12 +433,12 @@ static int scale_one(size_t n, int f32, int threads) {
     int runs = n <= 10000000 ? 3 : 1;
     double t[3];
     for (int r = 0; r < runs; r++) {
-        double t0 = now();
+        double t0 = bench_now();
         if (hd_hausdorff(&A, &B, &o, &s, &e) != HD_OK) {
             fprintf(stderr, "bench: %s\n", e.message);
             return 1;
         }
-        t[r] = now() - t0;
+        t[r] = bench_now() - t0;
     }
     getrusage(RUSAGE_SELF, &ru);
     double input = (double)n * 2 * (f32 ? 12 : 24);
@@ -547,7 +448,7 @@ static int scale_one(size_t n, int f32, int threads) {
     printf("{\"case\": \"scale\", \"method\": \"hausdorff auto\", \"n\": %zu, \"dtype\": \"%s\", \"threads\": %d, "
            "\"median_s\": %.6g, \"runs\": %d, \"distance\": %.17g, \"input_bytes\": %.0f, "
            "\"peak_rss_bytes\": %.0f, \"rss_after_input_bytes\": %.0f, \"plan\": \"%s\"}\n",
-           n, f32 ? "float32" : "float64", threads, median(t, runs), runs, s.distance, input,
+           n, f32 ? "float32" : "float64", threads, bench_median(t, runs), runs, s.distance, input,
            (double)ru.ru_maxrss * 1024.0, rss_before, plan);
     free(a);
     free(b);
@@ -685,16 +586,19 @@ int main(int argc, char **argv) {
         memset(&p, 0, sizeof p);
         snprintf(p.name, sizeof p.name, "%s", models[k].name);
         char path[1024];
+        hd_error_t e;
         snprintf(path, sizeof path, "%s/%s", B.data, models[k].a);
-        p.a = read_model(path, models[k].sample, 1, &p.na);
-        if (!p.a) continue;
-        if (models[k].b) {
+        p.a = bench_read_model(path, models[k].sample, 1, 0, &p.na, &e);
+        if (p.a && models[k].b) {
             snprintf(path, sizeof path, "%s/%s", B.data, models[k].b);
-            p.b = read_model(path, models[k].sample, 2, &p.nb);
-            if (!p.b) {
-                free(p.a);
-                continue;
-            }
+            p.b = bench_read_model(path, models[k].sample, 2, 0, &p.nb, &e);
+        }
+        if (!p.a || (models[k].b && !p.b)) {
+            fprintf(stderr, "bench: %s\n", e.message);
+            free_pair(&p);
+            continue;
+        }
+        if (models[k].b) {
             snprintf(p.note, sizeof p.note, "%s%s vs %s", models[k].sample ? "sampled " : "", models[k].a,
                      models[k].b);
         } else {

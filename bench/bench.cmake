@@ -2,10 +2,7 @@
 # "Engine"): bench/hd_bench, and with -DHD_BENCH_PEERS=ON the C++ peer
 # programs it runs (nanoflann, PCL).  Not a test: nothing here is run by
 # ctest.
-add_executable(hd_bench ${CMAKE_CURRENT_LIST_DIR}/bench.c ${CMAKE_CURRENT_LIST_DIR}/../tests/support/gen.c)
-target_include_directories(hd_bench PRIVATE ${CMAKE_CURRENT_LIST_DIR}/../tests/support)
-target_link_libraries(hd_bench PRIVATE hausdorff_static Threads::Threads m)
-set_target_properties(hd_bench PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/bench)
+hd_add_bench(hd_bench ${CMAKE_CURRENT_LIST_DIR}/bench.c)
 
 option(HD_BENCH_PEERS "Build the C++ peer programs of the engine benchmark (nanoflann, PCL)" OFF)
 if(HD_BENCH_PEERS)

@@ -466,23 +466,15 @@ static void shapes(size_t n) {
 
 /* ---- Table 3: models --------------------------------------------------- */
 
+/* The model dir/file (its vertices, or `sample` points drawn on its faces),
+ * read on one thread; the program stops when it cannot be read. */
 static cloud_t load(const char *dir, const char *file, size_t sample, uint64_t seed) {
     char path[1024];
     snprintf(path, sizeof path, "%s/%s", dir, file);
-    hd_read_options_t ro;
-    hd_read_options_init(&ro);
-    ro.threads = 1;
-    if (sample) {
-        ro.mesh = HD_MESH_SAMPLE;
-        ro.sample = sample;
-        ro.seed = seed;
-    }
-    hd_cloud_t *c;
+    cloud_t r;
     hd_error_t e;
-    if (hd_read_file(path, &ro, &c, &e) != HD_OK) die("%s", e.message);
-    cloud_t r = cloud_new(c->count);
-    memcpy(r.xyz, c->data, 3 * c->count * sizeof(double));
-    hd_cloud_free(c);
+    r.xyz = bench_read_model(path, sample, seed, 1, &r.n, &e);
+    if (!r.xyz) die("%s", e.message);
     return r;
 }
 

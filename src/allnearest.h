@@ -59,8 +59,13 @@ size_t hd__an_memory(const hd__an_t *s);
 /* For every point of `asking`, the exact nearest distance to `searched`
  * (sqrt of the smallest hd__d2s) into dist[i] and the smallest original
  * index attaining it into nearest[i], i being the point's original index;
- * either output may be NULL.  Returns HD_OK, HD_ENOMEM or HD_ETHREAD. */
-int hd__an_nearest(const hd__an_t *asking, const hd__an_t *searched, int threads,
-                   double *dist, size_t *nearest, hd_error_t *err);
+ * either output may be NULL.  `partner`, when not NULL, is the view
+ * `searched` was built from, of as many points as `asking`: its point i is
+ * tried first as the answer of asking's point i (a copy and its original
+ * in the same order settle fast); the answers do not depend on it, and
+ * *paired (if not NULL) counts the groups of queries it settled.
+ * Returns HD_OK, HD_ENOMEM or HD_ETHREAD. */
+int hd__an_nearest(const hd__an_t *asking, const hd__an_t *searched, const hd_points_t *partner,
+                   int threads, double *dist, size_t *nearest, size_t *paired, hd_error_t *err);
 
 #endif /* HD_ALLNEAREST_H */

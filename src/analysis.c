@@ -153,8 +153,13 @@ int hd_distances(const hd_points_t *A, const hd_points_t *B,
             rc = c.rc[k];
             if (err) *err = c.err[k];
         }
-    if (rc == HD_OK && ab) rc = hd__an_nearest(&c.s[0], &c.s[1], threads, dist_ab, nearest_ab, err);
-    if (rc == HD_OK && ba) rc = hd__an_nearest(&c.s[1], &c.s[0], threads, dist_ba, nearest_ba, err);
+    /* Sets of one size may be a copy and its original in the same order:
+     * point i of each is then tried first as the other's answer. */
+    int same = A->count == B->count;
+    if (rc == HD_OK && ab)
+        rc = hd__an_nearest(&c.s[0], &c.s[1], same ? B : NULL, threads, dist_ab, nearest_ab, NULL, err);
+    if (rc == HD_OK && ba)
+        rc = hd__an_nearest(&c.s[1], &c.s[0], same ? A : NULL, threads, dist_ba, nearest_ba, NULL, err);
     hd__an_free(&c.s[0]);
     hd__an_free(&c.s[1]);
     return rc;

@@ -240,7 +240,7 @@ int hd__eb_loop(const hd__job_t *job, const size_t *order, size_t n_order,
         rc = hd__parallel_for(job->threads, tasks, eb_task, &c);
     }
     if (rc == HD_OK) {
-        for (size_t t = 0; t < tasks; t++) hd__best_offer(best, c.part[t].d2, c.part[t].i, c.part[t].j);
+        hd__best_merge(best, c.part, tasks);
         for (int w = 0; w < job->threads; w++) {
             stats->distance_evals += c.evals[w];
             stats->points_culled += c.culled[w];
@@ -274,8 +274,6 @@ int hd__earlybreak(const hd__job_t *job, hd_result_t *out, hd_error_t *err) {
         best.i = 0;
         best.j = hd__first_at(job->a, job->b, job->nb, 0.0, &out->stats.distance_evals);
     }
-    out->distance2 = best.d2;
-    out->i = best.i;
-    out->j = best.j;
+    hd__best_store(&best, out);
     return HD_OK;
 }

@@ -283,9 +283,7 @@ int hd__inc(const hd__job_t *job, hd_result_t *out, hd_error_t *err) {
     }
     rc = run(&s);
     if (rc == HD_OK) {
-        out->distance2 = s.best.d2;
-        out->i = s.best.i;
-        out->j = s.best.j;
+        hd__best_store(&s.best, out);
         out->stats.distance_evals = s.evals;
         out->stats.nodes_visited = s.visited;
     } else {

@@ -109,6 +109,19 @@ HD__INLINE void hd__best_offer(hd__best_t *b, double d2, size_t i, size_t j) {
     }
 }
 
+/* Merge the partial results of n tasks into b (in task order; by the tie
+ * rule the result would be the same in any order). */
+HD__INLINE void hd__best_merge(hd__best_t *b, const hd__best_t *part, size_t n) {
+    for (size_t t = 0; t < n; t++) hd__best_offer(b, part[t].d2, part[t].i, part[t].j);
+}
+
+/* Store b's squared distance and witness in a directed result. */
+HD__INLINE void hd__best_store(const hd__best_t *b, hd_result_t *out) {
+    out->distance2 = b->d2;
+    out->i = b->i;
+    out->j = b->j;
+}
+
 /* Exact nearest distance of p to n packed points with the smallest index at
  * that distance (a full scan). */
 double hd__nn_scan(const double *p, const double *xyz, size_t n, size_t *j,

@@ -246,10 +246,8 @@ int hd__nohd(const hd__job_t *job, hd_result_t *out, hd_error_t *err) {
     if (rc == HD_OK) {
         hd__best_t best;
         hd__best_init(&best);
-        for (size_t t = 0; t < c.n_tasks; t++) hd__best_offer(&best, c.part[t].d2, c.part[t].i, c.part[t].j);
-        out->distance2 = best.d2;
-        out->i = best.i;
-        out->j = best.j;
+        hd__best_merge(&best, c.part, c.n_tasks);
+        hd__best_store(&best, out);
         for (int w = 0; w < threads; w++) {
             out->stats.distance_evals += c.evals[w];
             out->stats.nodes_visited += c.visited[w];

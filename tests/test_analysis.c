@@ -10,6 +10,7 @@
 #include "brute.h"
 #include "check.h"
 #include "gen.h"
+#include "allnearest.h"
 #include "internal.h"
 
 #include <math.h>
@@ -297,6 +298,84 @@ TEST(per_point_distances_are_exact_for_clusters_next_to_far_outliers) {
         b[0] = -1e6, b[1] = 5e5;
         hd_points_t A = hd_points_f64(a, na), B = hd_points_f64(b, nb);
         check_against_brute(&A, a, na, &B, b, nb, (int)seed % 3 + 1);
+        free(a), free(b);
+    }
+}
+
+/* How many groups of A's queries the partner path of allnearest.c settled
+ * when A (n points) asks B (n points), B's point i being A's point i's
+ * partner; *groups gets the number of A's groups. */
+static size_t partner_groups(const double *a, const double *b, size_t n, int threads, size_t *groups) {
+    hd_points_t A = hd_points_f64(a, n), B = hd_points_f64(b, n);
+    hd__box_t box;
+    for (int d = 0; d < 3; d++) {
+        box.lo[d] = box.hi[d] = a[d];
+        for (size_t k = 0; k < n; k++) {
+            double u = a[3 * k + (size_t)d], v = b[3 * k + (size_t)d];
+            box.lo[d] = fmin(box.lo[d], fmin(u, v));
+            box.hi[d] = fmax(box.hi[d], fmax(u, v));
+        }
+    }
+    hd__an_t sa, sb;
+    size_t paired = 0;
+    CHECK_RC(hd__an_build(&sa, &A, &box, threads, NULL), HD_OK);
+    CHECK_RC(hd__an_build(&sb, &B, &box, threads, NULL), HD_OK);
+    CHECK_RC(hd__an_nearest(&sa, &sb, &B, threads, NULL, NULL, &paired, NULL), HD_OK);
+    *groups = sa.ng;
+    hd__an_free(&sa);
+    hd__an_free(&sb);
+    return paired;
+}
+
+TEST(same_order_copies_are_exact_and_mostly_settled_by_their_partners) {
+    /* B is A moved a little, point for point: each query's partner is
+     * tried first.  Ties at the partner's distance (exact binary steps,
+     * half lattice steps, repeated points) must still go to the smallest
+     * index, and exchanged partners or outliers must not fool it. */
+    int settled = 0, cases = 0;
+    for (uint64_t seed = 20000; seed < 20000 + 4 * GEN_COPY_KINDS && !hdt_failed(); seed++) {
+        gen_rng_t g;
+        gen_seed(&g, seed);
+        int how = (int)(seed % GEN_COPY_KINDS), threads = seed % 2 ? 1 : 3;
+        size_t n = 1 + gen_u64(&g) % (seed % 4 == 0 ? 6000 : 900);
+        CONTEXT("seed=%llu copy=%s n=%zu threads=%d", (unsigned long long)seed, gen_copy_name[how], n,
+                threads);
+        double *a = malloc(24 * n), *b = malloc(24 * n);
+        gen_copy(&g, how, a, b, n);
+        hd_points_t A = hd_points_f64(a, n), B = hd_points_f64(b, n);
+        check_against_brute(&A, a, n, &B, b, n, threads);
+        size_t groups;
+        settled += partner_groups(a, b, n, threads, &groups) > 0;
+        cases++;
+        free(a), free(b);
+    }
+    /* The partner path itself was under test in most cases. */
+    CONTEXT("cases with groups settled by partners: %d of %d", settled, cases);
+    CHECK(settled >= cases / 2);
+}
+
+TEST(same_size_sets_that_are_not_copies_fall_back_and_stay_exact) {
+    /* Two unrelated clouds of one size, and a copy in reversed order: the
+     * partners are far, the path gives up, and the seeds take over. */
+    for (uint64_t seed = 30; seed < 34 && !hdt_failed(); seed++) {
+        gen_rng_t g;
+        gen_seed(&g, seed);
+        size_t n = 3000;
+        CONTEXT("seed=%llu %s", (unsigned long long)seed, seed % 2 ? "reversed copy" : "unrelated");
+        double *a = malloc(24 * n), *b = malloc(24 * n), m0[3] = {0, 0, 0};
+        if (seed % 2) {
+            gen_copy(&g, GEN_COPY_NOISE, a, b, n);
+            for (size_t k = 0; k < n / 2; k++) gen_swap(b, k, n - 1 - k);
+        } else {
+            gen_gauss(&g, a, n, m0, 1.0);
+            gen_gauss(&g, b, n, m0, 1.0);
+            /* A sparse tail may hold few enough buckets; the rest fail. */
+            size_t groups, paired = partner_groups(a, b, n, 1, &groups);
+            CONTEXT("seed=%llu unrelated: %zu of %zu groups paired", (unsigned long long)seed, paired, groups);
+            CHECK(paired * 10 < groups);
+        }
+        hd_points_t A = hd_points_f64(a, n), B = hd_points_f64(b, n);
+        check_against_brute(&A, a, n, &B, b, n, (int)seed % 3 + 1);
         free(a), free(b);
     }
 }

@@ -331,60 +331,6 @@ TEST(statistics_explain_the_work) {
 
 /* ---- the correspondence path: B a copy of A in the same order ---------------- */
 
-/* How the copy B of A is made. */
-enum {
-    C_NOISE, C_NOISE_TINY, C_EXACT, C_SHIFT, C_LATTICE_HALF, C_DUPLICATES, C_OUTLIERS,
-    C_SWAPPED, C_SCALED, C_FAR, C_SUBNORMAL_SCALE, C_COPY_COUNT
-};
-static const char *const copy_name[C_COPY_COUNT] = {
-    "noise", "tiny-noise", "exact", "shift", "lattice-half-step", "duplicates", "outliers",
-    "swapped", "scaled", "far-offset", "1e-150-scale",
-};
-
-/* Exchange points x and y of p. */
-static void swap_points(double *p, size_t x, size_t y) {
-    double t[3];
-    memcpy(t, p + 3 * x, 24);
-    memcpy(p + 3 * x, p + 3 * y, 24);
-    memcpy(p + 3 * y, t, 24);
-}
-
-/* A (n points) and B, a copy of A in the same order made by `how`. */
-static void make_copy(gen_rng_t *g, int how, double *a, double *b, size_t n) {
-    double m0[3] = {0, 0, 0};
-    if (how == C_LATTICE_HALF) gen_lattice(g, a, n, 2 + (int)(gen_u64(g) % 20));
-    else gen_gauss(g, a, n, m0, 1.0);
-    if (how == C_DUPLICATES) /* every point repeated a few times */
-        for (size_t k = 0; k < n; k++)
-            if (gen_u64(g) % 3 == 0) memcpy(a + 3 * k, a + 3 * (gen_u64(g) % n), 24);
-    double sigma = how == C_NOISE_TINY ? 1e-12 : 1e-3;
-    for (size_t k = 0; k < 3 * n; k++) {
-        switch (how) {
-        case C_EXACT: b[k] = a[k]; break;
-        /* Moves by exact binary fractions: every pair at the same distance. */
-        case C_SHIFT: b[k] = a[k] + (k % 3 == 0 ? 0x1p-10 : 0.0); break;
-        case C_LATTICE_HALF: b[k] = a[k] + (k % 3 == 1 ? 0.5 : 0.0); break;
-        case C_SCALED: b[k] = a[k] * 1.001; break;
-        default: b[k] = a[k] + sigma * gen_normal(g);
-        }
-    }
-    if (how == C_OUTLIERS)
-        for (int r = 0; r < 3; r++) b[3 * (gen_u64(g) % n) + (size_t)r] += 0.5;
-    if (how == C_SWAPPED) /* a few partners exchanged with other points */
-        for (size_t r = 0; r < 1 + n / 200; r++) {
-            size_t x = gen_u64(g) % n;
-            swap_points(b, x, gen_u64(g) % n);
-        }
-    if (how == C_FAR) {
-        gen_affine(a, n, 1.0, 1e9);
-        gen_affine(b, n, 1.0, 1e9);
-    }
-    if (how == C_SUBNORMAL_SCALE) {
-        gen_affine(a, n, 1e-150, 0.0);
-        gen_affine(b, n, 1e-150, 0.0);
-    }
-}
-
 /* The engine's plan, in its own words (engine.c). */
 int hd__engine_explain(const hd_points_t *A, const hd_points_t *B, const hd_options_t *opt,
                        char *buf, size_t len, hd_error_t *err);
@@ -404,13 +350,13 @@ TEST(same_order_copies_are_exact_in_every_variation) {
     int settled = 0, cases = 0;
     for (uint64_t seed = 10000; seed < 10440 && !hdt_failed(); seed++) {
         gen_seed(&g, seed);
-        int how = (int)(seed % C_COPY_COUNT);
+        int how = (int)(seed % GEN_COPY_KINDS);
         size_t n = 1 + gen_u64(&g) % (seed % 8 == 0 ? 6000 : 700);
         int threads = seed % 2 ? 1 : 3;
-        CONTEXT("seed=%llu copy=%s n=%zu threads=%d", (unsigned long long)seed, copy_name[how], n,
+        CONTEXT("seed=%llu copy=%s n=%zu threads=%d", (unsigned long long)seed, gen_copy_name[how], n,
                 threads);
         double *a = malloc(24 * n), *b = malloc(24 * n);
-        make_copy(&g, how, a, b, n);
+        gen_copy(&g, how, a, b, n);
         check_case(a, n, b, n, threads);
         settled += plan_says(a, n, b, n, "resolved 1 / 1");
         cases++;
@@ -426,12 +372,12 @@ TEST(same_order_copies_in_float32_are_exact_for_the_float_values) {
     gen_rng_t g;
     for (uint64_t seed = 11000; seed < 11044 && !hdt_failed(); seed++) {
         gen_seed(&g, seed);
-        int how = (int)(seed % C_COPY_COUNT);
-        if (how == C_SUBNORMAL_SCALE) continue; /* not representable in float */
+        int how = (int)(seed % GEN_COPY_KINDS);
+        if (how == GEN_COPY_SUBNORMAL_SCALE) continue; /* not representable in float */
         size_t n = 1 + gen_u64(&g) % 3000;
-        CONTEXT("seed=%llu copy=%s n=%zu", (unsigned long long)seed, copy_name[how], n);
+        CONTEXT("seed=%llu copy=%s n=%zu", (unsigned long long)seed, gen_copy_name[how], n);
         double *a = malloc(24 * n), *b = malloc(24 * n);
-        make_copy(&g, how, a, b, n);
+        gen_copy(&g, how, a, b, n);
         check_float32(a, n, b, n, seed % 2 ? 1 : 3);
         free(a);
         free(b);
@@ -444,7 +390,7 @@ TEST(a_noisy_copy_is_settled_by_the_correspondence_path) {
     CONTEXT("seed=12000");
     size_t n = 50000;
     double *a = malloc(24 * n), *b = malloc(24 * n);
-    make_copy(&g, C_NOISE, a, b, n);
+    gen_copy(&g, GEN_COPY_NOISE, a, b, n);
     CHECK(plan_says(a, n, b, n, "pairs (pairs listed, resolved 1 / 1"));
     check_case(a, n, b, n, 3);
     free(a);
@@ -460,8 +406,8 @@ TEST(independent_clouds_and_shuffled_copies_do_not_take_the_correspondence_path)
     make_pair(&g, K_OVERLAP, a, n, b, n);
     CHECK(plan_says(a, n, b, n, "pairs not tried"));
     /* A noisy copy listed backwards: the partners are unrelated points. */
-    make_copy(&g, C_NOISE, a, b, n);
-    for (size_t k = 0; k < n / 2; k++) swap_points(b, k, n - 1 - k);
+    gen_copy(&g, GEN_COPY_NOISE, a, b, n);
+    for (size_t k = 0; k < n / 2; k++) gen_swap(b, k, n - 1 - k);
     CHECK(plan_says(a, n, b, n, "pairs not tried"));
     check_case(a, n, b, n, 1);
     free(a);
@@ -477,10 +423,10 @@ TEST(a_copy_with_more_exchanged_partners_than_the_list_falls_back_exactly) {
      * the trees with what it found. */
     size_t n = 60000;
     double *a = malloc(24 * n), *b = malloc(24 * n);
-    make_copy(&g, C_NOISE, a, b, n);
+    gen_copy(&g, GEN_COPY_NOISE, a, b, n);
     for (size_t r = 0; r < n / 40; r++) {
         size_t x = gen_u64(&g) % n;
-        swap_points(b, x, gen_u64(&g) % n);
+        gen_swap(b, x, gen_u64(&g) % n);
     }
     CHECK(plan_says(a, n, b, n, "pairs listed, resolved 0 / 0"));
     check_case(a, n, b, n, 3);
@@ -716,7 +662,7 @@ TEST(subsets_out_of_order_or_with_a_stranger_are_left_to_the_other_paths) {
     check_case(a, na, b, nb, 3);
     b[3 * (nb - 1)] -= 1e-3;
     /* Out of order: the walk gives up within its first window. */
-    for (size_t k = 0; k < nb / 2; k++) swap_points(b, k, nb - 1 - k);
+    for (size_t k = 0; k < nb / 2; k++) gen_swap(b, k, nb - 1 - k);
     CHECK(plan_says(a, na, b, nb, "resolved 0 / 0"));
     check_case(a, na, b, nb, 1);
     free(a);

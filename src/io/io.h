@@ -210,6 +210,13 @@ int hd__chunk_vertex(hd__chunk_t *c, const char **q, const char *eol, long long 
                      const char *prefix, const char *expected, int comment_ends);
 void hd__chunk_fail(hd__chunk_t *c, int code, long long line, const char *fmt,
                     ...) HD__PRINTF(4, 5);
+/* Append the point v to the chunk's window (hd__sink_push): 1, or 0 with the
+ * point's problem recorded through hd__chunk_fail. */
+HD__INLINE int hd__chunk_push(hd__chunk_t *c, long long line, const double v[3]) {
+    int rc = hd__sink_push(&c->pts, v);
+    if (rc) hd__chunk_fail(c, rc, line, "%s", hd__point_problem(rc));
+    return rc == HD_OK;
+}
 
 typedef struct hd__text_job {
     void (*parse)(void *ctx, hd__chunk_t *c);

@@ -190,11 +190,7 @@ static void chunk(void *ctx, hd__chunk_t *c) {
             hd__chunk_fail(c, HD_EFORMAT, line, "more than the %llu values the fields declare", (unsigned long long)p->tokens);
             return;
         }
-        int rc = hd__sink_push(&c->pts, v);
-        if (rc) {
-            hd__chunk_fail(c, rc, line, "%s", hd__point_problem(rc));
-            return;
-        }
+        if (!hd__chunk_push(c, line, v)) return;
     }
     c->lines = line;
 }

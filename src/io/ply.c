@@ -389,13 +389,7 @@ static void vertex_chunk(void *ctx, hd__chunk_t *c) {
                            (int)e->len, e->name, e->n_props, (int)(te - tb > 40 ? 40 : te - tb), tb);
             return;
         }
-        if (found == 3) {
-            int rc = hd__sink_push(&c->pts, v);
-            if (rc) {
-                hd__chunk_fail(c, rc, line, "%s", hd__point_problem(rc));
-                return;
-            }
-        }
+        if (found == 3 && !hd__chunk_push(c, line, v)) return;
     }
     c->lines = line;
 }

@@ -40,6 +40,23 @@ static int starts(const unsigned char *d, size_t n, const char *s) {
     return n >= k && memcmp(d, s, k) == 0;
 }
 
+/* The first byte at or after k that is not a space, tab, CR or newline. */
+static size_t skip_space(const unsigned char *d, size_t n, size_t k) {
+    while (k < n && (d[k] == ' ' || d[k] == '\t' || d[k] == '\r' || d[k] == '\n')) k++;
+    return k;
+}
+
+/* The first byte that is neither white space nor in a '#' comment line: where
+ * the content of a header-less text file (OBJ) or of a PCD header starts. */
+static size_t skip_comments(const unsigned char *d, size_t n) {
+    size_t k = skip_space(d, n, 0);
+    while (k < n && d[k] == '#') {
+        while (k < n && d[k] != '\n') k++;
+        k = skip_space(d, n, k);
+    }
+    return k;
+}
+
 static int magic_ply(const unsigned char *d, size_t n) {
     return starts(d, n, "ply\n") || starts(d, n, "ply\r\n") || starts(d, n, "ply ");
 }
@@ -47,20 +64,11 @@ static int magic_las(const unsigned char *d, size_t n) { return starts(d, n, "LA
 static int magic_npy(const unsigned char *d, size_t n) { return starts(d, n, "\x93NUMPY"); }
 static int magic_pcd(const unsigned char *d, size_t n) {
     /* the header opens with comments and VERSION, or FIELDS directly */
-    size_t k = 0;
-    while (k < n) {
-        while (k < n && (d[k] == ' ' || d[k] == '\t' || d[k] == '\r' || d[k] == '\n')) k++;
-        if (k < n && d[k] == '#') {
-            while (k < n && d[k] != '\n') k++;
-            continue;
-        }
-        return starts(d + k, n - k, "VERSION") || starts(d + k, n - k, "FIELDS");
-    }
-    return 0;
+    size_t k = skip_comments(d, n);
+    return starts(d + k, n - k, "VERSION") || starts(d + k, n - k, "FIELDS");
 }
 static int magic_off(const unsigned char *d, size_t n) {
-    size_t k = 0;
-    while (k < n && (d[k] == ' ' || d[k] == '\t' || d[k] == '\r' || d[k] == '\n')) k++;
+    size_t k = skip_space(d, n, 0);
     static const char *const kw[] = {"OFF", "COFF", "NOFF", "CNOFF", "NCOFF", NULL};
     for (int j = 0; kw[j]; j++) {
         size_t l = strlen(kw[j]);
@@ -75,8 +83,7 @@ static int magic_stl(const unsigned char *d, size_t n) {
         uint32_t tri = hd__ld_u32(d + 80, 0);
         if ((uint64_t)84 + (uint64_t)50 * tri == n) return 1;
     }
-    size_t k = 0;
-    while (k < n && (d[k] == ' ' || d[k] == '\t' || d[k] == '\r' || d[k] == '\n')) k++;
+    size_t k = skip_space(d, n, 0);
     if (!starts(d + k, n - k, "solid")) return 0;
     for (size_t j = k; j + 5 <= n && j < 4096; j++)
         if (memcmp(d + j, "facet", 5) == 0) return 1;
@@ -84,18 +91,10 @@ static int magic_stl(const unsigned char *d, size_t n) {
 }
 static int magic_obj(const unsigned char *d, size_t n) {
     /* first line that is not a comment or blank starts with an OBJ keyword */
-    size_t k = 0;
-    while (k < n) {
-        while (k < n && (d[k] == ' ' || d[k] == '\t' || d[k] == '\r' || d[k] == '\n')) k++;
-        if (k < n && d[k] == '#') {
-            while (k < n && d[k] != '\n') k++;
-            continue;
-        }
-        static const char *const kw[] = {"v ", "v\t", "vn ", "vt ", "o ", "g ", "mtllib ", "usemtl ", "s ", NULL};
-        for (int j = 0; kw[j]; j++)
-            if (starts(d + k, n - k, kw[j])) return 1;
-        return 0;
-    }
+    size_t k = skip_comments(d, n);
+    static const char *const kw[] = {"v ", "v\t", "vn ", "vt ", "o ", "g ", "mtllib ", "usemtl ", "s ", NULL};
+    for (int j = 0; kw[j]; j++)
+        if (starts(d + k, n - k, kw[j])) return 1;
     return 0;
 }
 

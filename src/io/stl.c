@@ -37,23 +37,7 @@ static void chunk(void *ctx, hd__chunk_t *c) {
         p = eol + (eol < end);
         if (!hd__token(&q, eol, &tb, &te)) continue;
         if (word(tb, te, "vertex")) {
-            double v[3];
-            for (int k = 0; k < 3; k++) {
-                int got = hd__next_double(&q, eol, &v[k], &tb, &te);
-                if (got == 0) {
-                    hd__chunk_fail(c, HD_EFORMAT, line, "vertex: expected x y z, found %d number%s", k, k == 1 ? "" : "s");
-                    return;
-                }
-                if (got < 0) {
-                    hd__chunk_fail(c, HD_EFORMAT, line, "vertex: '%.*s' is not a number", (int)(te - tb > 40 ? 40 : te - tb), tb);
-                    return;
-                }
-            }
-            int rc = hd__sink_push(&c->pts, v);
-            if (rc) {
-                hd__chunk_fail(c, rc, line, "%s", hd__point_problem(rc));
-                return;
-            }
+            if (!hd__chunk_vertex(c, &q, eol, line, "vertex: ", "vertex: expected x y z", 0)) return;
         } else if (word(tb, te, "facet")) {
             c->aux++;
         } else if (!word(tb, te, "outer") && !word(tb, te, "endloop") && !word(tb, te, "endfacet") &&

@@ -267,10 +267,5 @@ int hd__chunk_vertex(hd__chunk_t *c, const char **q, const char *eol, long long 
         hd__chunk_fail(c, HD_EFORMAT, line, "%s, found %d number%s", expected, got, got == 1 ? "" : "s");
         return 0;
     }
-    int rc = hd__sink_push(&c->pts, v);
-    if (rc) {
-        hd__chunk_fail(c, rc, line, "%s", hd__point_problem(rc));
-        return 0;
-    }
-    return 1;
+    return hd__chunk_push(c, line, v);
 }

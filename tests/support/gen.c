@@ -4,6 +4,8 @@
  */
 #include "gen.h"
 
+#include <string.h>
+
 #include <math.h>
 
 /* The seed is hashed into the starting state, not used as a position: with
@@ -140,5 +142,52 @@ void gen_gear(gen_rng_t *r, double *xyz, size_t n, int teeth, double rr, double 
             p[0] = rb * cos(phi), p[1] = rb * sin(phi);
             p[2] = thickness * (gen_unit(r) - 0.5);
         }
+    }
+}
+
+const char *const gen_copy_name[GEN_COPY_KINDS] = {
+    "noise", "tiny-noise", "exact", "shift", "lattice-half-step", "duplicates", "outliers",
+    "swapped", "scaled", "far-offset", "1e-150-scale",
+};
+
+void gen_swap(double *xyz, size_t x, size_t y) {
+    double t[3];
+    memcpy(t, xyz + 3 * x, 24);
+    memcpy(xyz + 3 * x, xyz + 3 * y, 24);
+    memcpy(xyz + 3 * y, t, 24);
+}
+
+void gen_copy(gen_rng_t *r, int how, double *a, double *b, size_t n) {
+    double m0[3] = {0, 0, 0};
+    if (how == GEN_COPY_LATTICE_HALF) gen_lattice(r, a, n, 2 + (int)(gen_u64(r) % 20));
+    else gen_gauss(r, a, n, m0, 1.0);
+    if (how == GEN_COPY_DUPLICATES) /* every point repeated a few times */
+        for (size_t k = 0; k < n; k++)
+            if (gen_u64(r) % 3 == 0) memcpy(a + 3 * k, a + 3 * (gen_u64(r) % n), 24);
+    double sigma = how == GEN_COPY_NOISE_TINY ? 1e-12 : 1e-3;
+    for (size_t k = 0; k < 3 * n; k++) {
+        switch (how) {
+        case GEN_COPY_EXACT: b[k] = a[k]; break;
+        /* Moves by exact binary fractions: every pair at the same distance. */
+        case GEN_COPY_SHIFT: b[k] = a[k] + (k % 3 == 0 ? 0x1p-10 : 0.0); break;
+        case GEN_COPY_LATTICE_HALF: b[k] = a[k] + (k % 3 == 1 ? 0.5 : 0.0); break;
+        case GEN_COPY_SCALED: b[k] = a[k] * 1.001; break;
+        default: b[k] = a[k] + sigma * gen_normal(r);
+        }
+    }
+    if (how == GEN_COPY_OUTLIERS)
+        for (int k = 0; k < 3; k++) b[3 * (gen_u64(r) % n) + (size_t)k] += 0.5;
+    if (how == GEN_COPY_SWAPPED) /* a few partners exchanged with other points */
+        for (size_t k = 0; k < 1 + n / 200; k++) {
+            size_t x = gen_u64(r) % n;
+            gen_swap(b, x, gen_u64(r) % n);
+        }
+    if (how == GEN_COPY_FAR) {
+        gen_affine(a, n, 1.0, 1e9);
+        gen_affine(b, n, 1.0, 1e9);
+    }
+    if (how == GEN_COPY_SUBNORMAL_SCALE) {
+        gen_affine(a, n, 1e-150, 0.0);
+        gen_affine(b, n, 1e-150, 0.0);
     }
 }

@@ -37,4 +37,21 @@ void gen_affine(double *xyz, size_t n, double scale, double offset);
 void gen_gear(gen_rng_t *r, double *xyz, size_t n, int teeth, double root_radius,
               double tip_radius, double bore_radius, double thickness);
 
+/* How gen_copy makes B from A: same-order copies of A (n Gaussian points, or
+ * lattice points for LATTICE_HALF) with noise of 1e-3 or 1e-12, exact, moved
+ * by an exact binary step (every pair at one distance), moved by half a
+ * lattice step (ties with the neighbours), with repeated points, with three
+ * outliers, with a few partners exchanged, scaled by 1.001, both moved to
+ * 1e9, both scaled to 1e-150. */
+enum {
+    GEN_COPY_NOISE, GEN_COPY_NOISE_TINY, GEN_COPY_EXACT, GEN_COPY_SHIFT, GEN_COPY_LATTICE_HALF,
+    GEN_COPY_DUPLICATES, GEN_COPY_OUTLIERS, GEN_COPY_SWAPPED, GEN_COPY_SCALED, GEN_COPY_FAR,
+    GEN_COPY_SUBNORMAL_SCALE, GEN_COPY_KINDS
+};
+extern const char *const gen_copy_name[GEN_COPY_KINDS];
+/* A (n points) and B, a copy of A in the same order made by `how`. */
+void gen_copy(gen_rng_t *r, int how, double *a, double *b, size_t n);
+/* Exchange points x and y of xyz. */
+void gen_swap(double *xyz, size_t x, size_t y);
+
 #endif
