@@ -53,10 +53,15 @@
  *    PAIR_CANDIDATES buckets lie within that bound they are the candidates
  *    and no seed is scanned; otherwise the seeds go on from the partners.
  *    The partners are read from the caller's view in its order (a random
- *    access, prefetched a group ahead).  A task stops trying after most of
- *    its first PAIR_TRIAL groups failed, so unrelated sets pay for eight
- *    groups a task.  This is the engine's correspondence bound
- *    (engine_pairs.c) put to per-point use.
+ *    access, prefetched a group ahead).  A group counts as a success when
+ *    at least half of its answers are the partners themselves; a task stops
+ *    trying once most of the groups it tried, PAIR_TRIAL at least, failed,
+ *    so unrelated sets pay for eight groups a task.  (Sets of a few
+ *    repeated points list few candidates for any partner, but the partner
+ *    is seldom the answer there, and reading partners costs a cache miss
+ *    each: on 1M points on 8 lattice sites, trying every group cost 60%
+ *    more time.)  This is the engine's correspondence bound (engine_pairs.c)
+ *    put to per-point use.
  *  - Scans.  A bucket is scanned four points at a time with GCC's vector
  *    extension (each lane evaluates hd__d2s's expression: no fused
  *    multiply-add, -ffp-contract=off), each lane keeping its smallest
@@ -738,7 +743,7 @@ HD__HOT static void query_task(void *vctx, size_t task, int worker) {
     size_t at0 = g0 < g1 ? bucket_at(t, q->key[q->glead[g0]], 0) : 0;
     hd__src_t psrc;
     if (c->partner) hd__src_init(&psrc, c->partner, NULL);
-    size_t tried = 0, paired_groups = 0;
+    size_t tried = 0, kept_groups = 0;
     for (size_t g = g0; g < g1; g++) {
         /* A group of equal keys may hold more than HD__AN_GROUP points:
          * its queries are then taken HD__AN_GROUP at a time. */
@@ -763,12 +768,13 @@ HD__HOT static void query_task(void *vctx, size_t task, int worker) {
              * lie within it, they are the candidates and no seed is
              * scanned.  Otherwise the partners still stand as first
              * answers for the seeds to improve on.  A task drops the path
-             * once it has failed on most of its first PAIR_TRIAL groups;
-             * no answer depends on any of this. */
+             * once most of the groups it tried, PAIR_TRIAL at least, did
+             * not find most answers at the partners; no answer depends on
+             * any of this. */
             double U = 0;
             int paired = 0;
             for (size_t k = 0; k < m; k++) best[k] = INFINITY, bj[k] = UINT32_MAX;
-            if (c->partner && (tried < PAIR_TRIAL || 2 * paired_groups >= tried)) {
+            if (c->partner && (tried < PAIR_TRIAL || 2 * kept_groups >= tried)) {
                 /* The partners are read in the original order, far apart:
                  * ask for the next chunk's while this one is worked on. */
                 for (size_t k = first + m; k < first + 2 * m && k < q->n; k++)
@@ -782,7 +788,7 @@ HD__HOT static void query_task(void *vctx, size_t task, int worker) {
                     U = best[k] > U ? best[k] : U;
                 }
                 paired = candidates(t, &gbox, U, PAIR_CANDIDATES, cd);
-                tried++, paired_groups += (size_t)paired;
+                tried++;
                 cd->paired += (size_t)paired;
             }
             /* Seeds: the searched buckets at each query's place on the
@@ -807,7 +813,7 @@ HD__HOT static void query_task(void *vctx, size_t task, int worker) {
                 U = Ub < U ? Ub : U;
                 candidates(t, &gbox, U, SIZE_MAX, cd);
             }
-            size_t nc = cd->n;
+            size_t nc = cd->n, kept = 0;
             for (size_t k = 0; k < m; k++) {
                 double qx = q->x[first + k], qy = q->y[first + k], qz = q->z[first + k];
                 double b2 = best[k];
@@ -833,7 +839,13 @@ HD__HOT static void query_task(void *vctx, size_t task, int worker) {
                 }
                 c->sd[first + k] = b2;
                 c->sj[first + k] = j;
+                kept += paired && j == q->idx[first + k];
             }
+            /* The path pays when the partners are the answers (a copy),
+             * not merely near enough to list few candidates (a few
+             * buckets of repeated points): it is kept on while at least
+             * half of the groups tried had half of their answers there. */
+            kept_groups += 2 * kept >= m;
         }
     }
 }
