@@ -45,7 +45,7 @@ int main(int argc, char **argv) {
     static const char *const cases[] = {"overlapping", "perturbed 1e-3", "disjoint 20 sigma",
                                         "perturbed 1e-3, shuffled"};
     static const double target[] = {40, 40, 10, 40};
-    printf("| case | N = |A| = |B| | memory pass | H, auto | H, kdtree | per-point distances | "
+    printf("| case | points per set | memory pass | H, auto | H, kdtree | per-point distances | "
            "per-point / auto | per-point / kdtree | per-point / pass | target / pass | percentile + summary |\n");
     printf("|---|---|---|---|---|---|---|---|---|---|---|\n");
     for (int c = 0; c < 4; c++) {
