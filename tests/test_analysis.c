@@ -354,6 +354,32 @@ TEST(same_order_copies_are_exact_and_mostly_settled_by_their_partners) {
     CHECK(settled >= cases / 2);
 }
 
+TEST(same_order_copies_in_strided_and_float32_views_read_the_right_partners) {
+    /* The partners are read from the caller's views: here a float32 view
+     * with a 20-byte stride and a double view with a coordinate stride.  A
+     * read at the wrong place that lands on values nearer than every point
+     * (or on a point tied with the answer, under a smaller index) would
+     * survive every scan; the brute force checks each answer. */
+    for (uint64_t seed = 40; seed < 46 && !hdt_failed(); seed++) {
+        gen_rng_t g;
+        gen_seed(&g, seed);
+        int how = seed % 2 ? GEN_COPY_NOISE : GEN_COPY_LATTICE_HALF;
+        size_t n = 1 + gen_u64(&g) % 5000;
+        CONTEXT("seed=%llu copy=%s n=%zu", (unsigned long long)seed, gen_copy_name[how], n);
+        double *a = malloc(24 * n), *b = malloc(24 * n), *braw = malloc(48 * n);
+        float *fa = malloc(20 * n);
+        gen_copy(&g, how, a, b, n);
+        for (size_t k = 0; k < 3 * n; k++) {
+            fa[5 * (k / 3) + k % 3] = (float)a[k];
+            a[k] = (float)a[k];
+            braw[6 * (k / 3) + 2 * (k % 3)] = b[k];
+        }
+        hd_points_t A = {fa, n, HD_FLOAT32, 20, 4}, B = {braw, n, HD_FLOAT64, 48, 16};
+        check_against_brute(&A, a, n, &B, b, n, (int)seed % 3 + 1);
+        free(a), free(b), free(braw), free(fa);
+    }
+}
+
 TEST(same_size_sets_that_are_not_copies_fall_back_and_stay_exact) {
     /* Two unrelated clouds of one size, and a copy in reversed order: the
      * partners are far, the path gives up, and the seeds take over. */
