@@ -11,10 +11,11 @@
  * node) and then walked from its root once per query.  Here:
  *  - Build.  Each set is sorted once along a Morton curve: 30-bit keys on a
  *    grid of 1024 cells per axis over the union of both sets' boxes (so that
- *    the two orders line up), a stable radix sort of key and index in three
- *    counting passes of 10 bits (1024 destinations a pass stream better
- *    than the 32768 of two 15-bit passes: 3 to 7% faster on 1M points),
- *    then one gather of the coordinates into packed arrays
+ *    the two orders line up), the engine's stable radix sort of key and
+ *    index (hd__radix_sort: three counting passes of 10 bits, whose 1024
+ *    destinations a pass stream better than the 32768 of two 15-bit passes:
+ *    3 to 7% faster on 1M points), then one gather of the coordinates into
+ *    packed arrays
  *    (x[], y[], z[], original indices idx[]).  The sorted keys define an
  *    octree; one pass over them cuts it where a cell holds at most
  *    HD__AN_BUCKET points (the buckets, which are searched) and, coarser,
@@ -122,7 +123,7 @@
  * points are refused with HD_EOVERFLOW (analysis.c then uses the kd-trees).
  */
 #include "allnearest.h"
-#include "index.h" /* hd__src_t, hd__src_get, HD__HOT */
+#include "index.h" /* hd__src_t, hd__src_get, HD__HOT, hd__radix_sort */
 
 #include <math.h>
 #include <stdlib.h>
@@ -130,8 +131,6 @@
 
 /* ---- building ---------------------------------------------------------------- */
 
-#define DIGIT_BITS 11
-#define DIGITS (1u << DIGIT_BITS)
 #define MAX_PARTS 16
 #define GATHER_TASK 16384 /* points per gathering task */
 #define BOX_TASK 1024     /* buckets per box task */
@@ -142,9 +141,7 @@ typedef struct {
     hd__keygrid_t grid;
     size_t n;
     int parts;
-    uint64_t *a, *b;           /* key << 32 | index, sorted from a into b and back */
-    uint32_t *hist[MAX_PARTS]; /* per part: counts of a digit, then write positions */
-    int shift;
+    uint64_t *a, *b; /* key << 32 | index: computed in a, sorted into b */
 } build_ctx;
 
 /* Part p's share of [0, n). */
@@ -159,47 +156,7 @@ static void key_task(void *vctx, size_t part, int worker) {
     build_ctx *c = vctx;
     size_t lo, hi;
     part_range(c, part, &lo, &hi);
-    for (size_t i = lo; i < hi; i++) {
-        double p[3];
-        hd__src_get(&c->src, i, p);
-        c->a[i] = (uint64_t)hd__key30(&c->grid, p) << 32 | (uint64_t)i;
-    }
-}
-
-/* Counts of the digit at c->shift in one part. */
-static void count_task(void *vctx, size_t part, int worker) {
-    (void)worker;
-    build_ctx *c = vctx;
-    size_t lo, hi;
-    part_range(c, part, &lo, &hi);
-    uint32_t *h = c->hist[part];
-    memset(h, 0, DIGITS * sizeof *h);
-    for (size_t i = lo; i < hi; i++) h[(c->a[i] >> c->shift) & (DIGITS - 1)]++;
-}
-
-/* One stable counting pass of one part from a to b on the digit at shift. */
-static void scatter_task(void *vctx, size_t part, int worker) {
-    (void)worker;
-    build_ctx *c = vctx;
-    size_t lo, hi;
-    part_range(c, part, &lo, &hi);
-    uint32_t *pos = c->hist[part];
-    for (size_t i = lo; i < hi; i++) {
-        uint64_t v = c->a[i];
-        c->b[pos[(v >> c->shift) & (DIGITS - 1)]++] = v;
-    }
-}
-
-/* Turn the counts into write positions (parts in order, so the sort is
- * stable and its result does not depend on the part count). */
-static void positions(build_ctx *c) {
-    uint32_t sum = 0;
-    for (size_t d = 0; d < DIGITS; d++)
-        for (int p = 0; p < c->parts; p++) {
-            uint32_t v = c->hist[p][d];
-            c->hist[p][d] = sum;
-            sum += v;
-        }
+    hd__src_keys(&c->src, &c->grid, lo, hi, c->a);
 }
 
 /* Gather the points [task * GATHER_TASK, ...) in sorted order (positions
@@ -426,8 +383,8 @@ size_t hd__an_memory(const hd__an_t *s) {
            s->nn * (sizeof(uint32_t) + sizeof(uint8_t) + 6 * sizeof(double));
 }
 
-int hd__an_build(hd__an_t *s, const hd_points_t *p, const hd__box_t *keybox, int threads,
-                 hd_error_t *err) {
+int hd__an_build(hd__an_t *s, const hd_points_t *p, const hd_transform_t *T, const hd__box_t *keybox,
+                 int threads, hd_error_t *err) {
     memset(s, 0, sizeof *s);
     size_t n = p->count;
     if (n > HD__AN_MAX_POINTS)
@@ -438,7 +395,7 @@ int hd__an_build(hd__an_t *s, const hd_points_t *p, const hd__box_t *keybox, int
     memset(&c, 0, sizeof c);
     c.s = s;
     c.n = n;
-    hd__src_init(&c.src, p, NULL);
+    hd__src_init(&c.src, p, T);
     hd__keygrid_init(&c.grid, keybox);
     c.parts = threads > MAX_PARTS ? MAX_PARTS : threads;
     if ((size_t)c.parts > n / 65536 + 1) c.parts = (int)(n / 65536 + 1);
@@ -458,32 +415,23 @@ int hd__an_build(hd__an_t *s, const hd_points_t *p, const hd__box_t *keybox, int
     s->glead = hd__malloc_array(n + 1, sizeof *s->glead);
     s->first = hd__malloc_array(cap, sizeof *s->first);
     s->count = hd__malloc_array(cap, sizeof *s->count);
-    /* The sort's first buffer is x[]'s memory: it holds no sorted keys
-     * after the last pass (an odd number of passes ends in c.b), and the
-     * gather fills x[] only then.  Fresh memory costs a page fault per
-     * 4 KiB on first touch, a tenth of the build on some machines. */
-    _Static_assert((30 + DIGIT_BITS - 1) / DIGIT_BITS % 2 == 1, "the sort must end in c.b");
+    /* The keys are computed in x[]'s memory, which the gather fills only
+     * after the sort; hd__radix_sort makes three passes, an odd number, so
+     * the sorted keys end in the other buffer.  Fresh memory costs a page
+     * fault per 4 KiB on first touch, a tenth of the build on some
+     * machines. */
     uint64_t *first_buffer = s->x ? (uint64_t *)(void *)s->x : NULL;
     c.a = first_buffer;
     c.b = hd__malloc_array(n, sizeof *c.b);
     int ok = s->x && s->y && s->z && s->idx && s->start && s->key && s->stop && s->leaf && s->gstart &&
              s->glead && s->first && s->count && c.a && c.b;
-    for (int k = 0; k < c.parts && ok; k++)
-        ok = (c.hist[k] = hd__malloc_array(DIGITS, sizeof(uint32_t))) != NULL;
     int rc = HD_OK;
     if (ok) {
         rc = hd__parallel_for(c.parts, (size_t)c.parts, key_task, &c);
-        /* Stable counting passes, low digit first; c.b ends sorted. */
-        for (int pass = 0; pass < (30 + DIGIT_BITS - 1) / DIGIT_BITS && rc == HD_OK; pass++) {
-            c.shift = 32 + DIGIT_BITS * pass;
-            if (pass) {
-                uint64_t *t = c.a;
-                c.a = c.b, c.b = t;
-            }
-            rc = hd__parallel_for(c.parts, (size_t)c.parts, count_task, &c);
-            positions(&c);
-            if (rc == HD_OK) rc = hd__parallel_for(c.parts, (size_t)c.parts, scatter_task, &c);
-        }
+        if (rc == HD_OK) rc = hd__radix_sort(&c.a, &c.b, n, c.parts);
+        /* Now c.a holds the sorted keys and c.b is x[]'s memory. */
+        uint64_t *t = c.a;
+        c.a = c.b, c.b = t;
         if (rc == HD_OK) rc = hd__parallel_for(threads, (n + 4 + GATHER_TASK - 1) / GATHER_TASK, gather_task, &c);
     }
     if (ok && rc == HD_OK) {
@@ -524,7 +472,6 @@ int hd__an_build(hd__an_t *s, const hd_points_t *p, const hd__box_t *keybox, int
             }
         }
     }
-    for (int k = 0; k < c.parts; k++) free(c.hist[k]);
     if (c.a != first_buffer) free(c.a);
     if (c.b != first_buffer) free(c.b);
     if (!ok) {

@@ -48,10 +48,12 @@ typedef struct hd__an {
 #define HD__AN_MAX_POINTS (UINT32_MAX / 2 - 8)
 
 /* Build the structure of a validated view of at most HD__AN_MAX_POINTS,
- * its Morton order taken on a grid over `keybox` (the same box for both
- * sets lines their orders up).  Returns HD_OK, HD_ENOMEM or HD_EOVERFLOW. */
-int hd__an_build(hd__an_t *s, const hd_points_t *p, const hd__box_t *keybox, int threads,
-                 hd_error_t *err);
+ * each point moved by T if T is not NULL (the transformed points must be
+ * finite and in range), its Morton order taken on a grid over `keybox`
+ * (the same box for both sets lines their orders up).  Returns HD_OK,
+ * HD_ENOMEM or HD_EOVERFLOW. */
+int hd__an_build(hd__an_t *s, const hd_points_t *p, const hd_transform_t *T, const hd__box_t *keybox,
+                 int threads, hd_error_t *err);
 void hd__an_free(hd__an_t *s);
 /* Bytes the structure holds. */
 size_t hd__an_memory(const hd__an_t *s);

@@ -116,7 +116,7 @@ typedef struct {
 static void build_task(void *vctx, size_t task, int worker) {
     (void)worker;
     build_ctx *c = vctx;
-    c->rc[task] = hd__an_build(&c->s[task], c->set[task], c->keybox, c->threads, &c->err[task]);
+    c->rc[task] = hd__an_build(&c->s[task], c->set[task], NULL, c->keybox, c->threads, &c->err[task]);
 }
 
 int hd_distances(const hd_points_t *A, const hd_points_t *B,

@@ -87,9 +87,7 @@ static void radix_scatter(void *vctx, size_t part, int worker) {
     }
 }
 
-/* Sort a[0..n) by bits 32..61 (stable); the result ends in *a (the buffers
- * may be swapped). */
-static int radix_sort(uint64_t **a, uint64_t **tmp, size_t n, int threads) {
+int hd__radix_sort(uint64_t **a, uint64_t **tmp, size_t n, int threads) {
     int parts = threads;
     if (parts > MAX_SORT_THREADS) parts = MAX_SORT_THREADS;
     if ((size_t)parts > n / 65536 + 1) parts = (int)(n / 65536 + 1);
@@ -132,33 +130,39 @@ typedef struct {
     hd__box_t *part_box;
 } key_ctx;
 
+void hd__src_box(const hd__src_t *src, size_t lo, size_t hi, hd__box_t *box) {
+    double p[3];
+    hd__src_get(src, lo, p);
+    for (int k = 0; k < 3; k++) box->lo[k] = box->hi[k] = p[k];
+    for (size_t i = lo + 1; i < hi; i++) {
+        hd__src_get(src, i, p);
+        for (int k = 0; k < 3; k++) {
+            box->lo[k] = p[k] < box->lo[k] ? p[k] : box->lo[k];
+            box->hi[k] = p[k] > box->hi[k] ? p[k] : box->hi[k];
+        }
+    }
+}
+
+void hd__src_keys(const hd__src_t *src, const hd__keygrid_t *grid, size_t lo, size_t hi, uint64_t *keys) {
+    for (size_t i = lo; i < hi; i++) {
+        double p[3];
+        hd__src_get(src, i, p);
+        keys[i] = (uint64_t)hd__key30(grid, p) << 32 | (uint64_t)i;
+    }
+}
+
 static void box_task(void *vctx, size_t task, int worker) {
     (void)worker;
     key_ctx *c = vctx;
     size_t lo = task * SLICE, hi = lo + SLICE < c->n ? lo + SLICE : c->n;
-    hd__box_t b;
-    double p[3];
-    hd__src_get(c->src, lo, p);
-    for (int k = 0; k < 3; k++) b.lo[k] = b.hi[k] = p[k];
-    for (size_t i = lo + 1; i < hi; i++) {
-        hd__src_get(c->src, i, p);
-        for (int k = 0; k < 3; k++) {
-            b.lo[k] = p[k] < b.lo[k] ? p[k] : b.lo[k];
-            b.hi[k] = p[k] > b.hi[k] ? p[k] : b.hi[k];
-        }
-    }
-    c->part_box[task] = b;
+    hd__src_box(c->src, lo, hi, &c->part_box[task]);
 }
 
 static void key_task(void *vctx, size_t task, int worker) {
     (void)worker;
     key_ctx *c = vctx;
     size_t lo = task * SLICE, hi = lo + SLICE < c->n ? lo + SLICE : c->n;
-    for (size_t i = lo; i < hi; i++) {
-        double p[3];
-        hd__src_get(c->src, i, p);
-        c->keys[i] = (uint64_t)hd__key30(&c->grid, p) << 32 | (uint64_t)i;
-    }
+    hd__src_keys(c->src, &c->grid, lo, hi, c->keys);
 }
 
 static void box_merge(hd__box_t *into, const hd__box_t *b) {
@@ -207,7 +211,7 @@ static int refine(const hd__src_t *src, uint64_t *a, uint64_t *tmp, size_t m, in
         insertion_sort(a, m);
     } else {
         uint64_t *x = a, *y = tmp;
-        int rc = radix_sort(&x, &y, m, 1);
+        int rc = hd__radix_sort(&x, &y, m, 1);
         if (rc) return rc;
         if (x != a) memcpy(a, x, m * sizeof *a);
     }
@@ -383,7 +387,7 @@ int hd__tree_build(hd__tree_t *t, const hd__src_t *src, size_t n, const hd__box_
     }
     hd__keygrid_init(&kc.grid, &t->box);
     hd__parallel_for(threads, slices, key_task, &kc);
-    if ((rc = radix_sort(&keys, &tmp, n, threads))) goto done;
+    if ((rc = hd__radix_sort(&keys, &tmp, n, threads))) goto done;
     for (size_t s = 0; s < n;) {
         size_t e = s + 1;
         while (e < n && keys[e] >> 32 == keys[s] >> 32) e++;

@@ -230,6 +230,26 @@ typedef struct hd__counts {
     uint64_t evals, exact, nodes;
 } hd__counts_t;
 
+/* hd_index_nearest by the path it would take (path 0), or, for the tests,
+ * by the one-search-per-query path over the index's tree that only sets
+ * beyond allnearest.c's limit take otherwise (path 2). */
+int hd__index_nearest_by(const hd_index_t *idx, const hd_points_t *Q, const hd_transform_t *T,
+                         const hd_options_t *opt, double *dist, size_t *nearest, int path, hd_error_t *err);
+
+/* The box of points [lo, hi) of src (lo < hi), and their Morton keys on
+ * grid above their indices (keys[i] = key << 32 | i), as the builds and
+ * the index's queries sort them. */
+void hd__src_box(const hd__src_t *src, size_t lo, size_t hi, hd__box_t *box);
+void hd__src_keys(const hd__src_t *src, const hd__keygrid_t *grid, size_t lo, size_t hi, uint64_t *keys);
+
+/* Sort a[0..n) of 64-bit words by bits 32..61 (a Morton key above a 32-bit
+ * index), stable, in three counting passes of 10 bits over `threads`
+ * threads.  The result ends in the buffer *tmp pointed to on entry (an odd
+ * number of passes), and the two pointers are exchanged so that *a points
+ * to it; allnearest.c relies on that.  Returns HD_OK, or HD_ENOMEM with
+ * nothing moved. */
+int hd__radix_sort(uint64_t **a, uint64_t **tmp, size_t n, int threads);
+
 /* Exact nearest neighbour of the exact point q in t: hit->d2 is the
  * smallest squared distance and hit->j the smallest original index
  * attaining it.  Bucket `hint` (or HD__NONE) is searched first.  The search

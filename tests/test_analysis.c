@@ -318,8 +318,8 @@ static size_t partner_groups(const double *a, const double *b, size_t n, int thr
     }
     hd__an_t sa, sb;
     size_t paired = 0;
-    CHECK_RC(hd__an_build(&sa, &A, &box, threads, NULL), HD_OK);
-    CHECK_RC(hd__an_build(&sb, &B, &box, threads, NULL), HD_OK);
+    CHECK_RC(hd__an_build(&sa, &A, NULL, &box, threads, NULL), HD_OK);
+    CHECK_RC(hd__an_build(&sb, &B, NULL, &box, threads, NULL), HD_OK);
     CHECK_RC(hd__an_nearest(&sa, &sb, &B, threads, NULL, NULL, &paired, NULL), HD_OK);
     *groups = sa.ng;
     hd__an_free(&sa);

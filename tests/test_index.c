@@ -11,6 +11,12 @@
 
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
+
+/* hd_index_nearest by a chosen path (index.c): 0 as the library picks, 2
+ * one search of the tree per query. */
+int hd__index_nearest_by(const hd_index_t *idx, const hd_points_t *Q, const hd_transform_t *T,
+                         const hd_options_t *opt, double *dist, size_t *nearest, int path, hd_error_t *err);
 
 /* The expected answers for T(A) against B: the brute force on the
  * transformed copy (the transform applied by the test's own code). */
@@ -39,14 +45,22 @@ static void check_against_brute(const hd_points_t *A, const double *a, size_t na
     CHECK_EQ(r.i, want.i);
     CHECK_EQ(r.j, want.j);
 
+    /* Both paths of hd_index_nearest: the groups of allnearest.c, which it
+     * takes, and one search of the tree per query, which it keeps for sets
+     * beyond allnearest.c's limit. */
     double *dist = malloc(8 * na);
     size_t *near = malloc(sizeof(size_t) * na);
-    CHECK_RC(hd_index_nearest(idx, A, T, &o, dist, near, NULL), HD_OK);
-    for (size_t k = 0; k < na && !hdt_failed(); k++) {
-        size_t j;
-        double d2 = brute_nearest(ta + 3 * k, b, nb, &j);
-        CHECK_BITS(dist[k], sqrt(d2));
-        CHECK_EQ(near[k], j);
+    for (int path = 0; path <= 2 && !hdt_failed(); path += 2) {
+        CONTEXT("hd_index_nearest path %d", path);
+        memset(dist, 0, 8 * na);
+        memset(near, 0, sizeof(size_t) * na);
+        CHECK_RC(hd__index_nearest_by(idx, A, T, &o, dist, near, path, NULL), HD_OK);
+        for (size_t k = 0; k < na && !hdt_failed(); k++) {
+            size_t j;
+            double d2 = brute_nearest(ta + 3 * k, b, nb, &j);
+            CHECK_BITS(dist[k], sqrt(d2));
+            CHECK_EQ(near[k], j);
+        }
     }
     free(dist);
     free(near);
@@ -269,6 +283,26 @@ TEST(kdtree_algorithm_matches_brute_force) {
         CHECK(r.stats.distance_evals >= na);
         free(a);
         free(b);
+    }
+}
+
+TEST(nearest_of_a_same_order_copy_is_exact_with_and_without_a_transform) {
+    /* Queries of B's size meet their partners at the same indices
+     * (allnearest.c); after a rotation the partners are far and the path
+     * must give up without changing an answer. */
+    for (uint64_t seed = 50; seed < 50 + 2 * GEN_COPY_KINDS && !hdt_failed(); seed++) {
+        gen_rng_t g;
+        gen_seed(&g, seed);
+        int how = (int)(seed % GEN_COPY_KINDS);
+        size_t n = 1 + gen_u64(&g) % 2500;
+        hd_transform_t T;
+        random_transform(&g, &T, 0.01);
+        int moved = seed / GEN_COPY_KINDS % 2 == 1;
+        CONTEXT("seed=%llu copy=%s n=%zu transform=%d", (unsigned long long)seed, gen_copy_name[how], n, moved);
+        double *a = malloc(24 * n), *b = malloc(24 * n);
+        gen_copy(&g, how, a, b, n);
+        check_packed(a, n, b, n, moved ? &T : NULL, (int)seed % 3 + 1);
+        free(a), free(b);
     }
 }
 
