@@ -8,6 +8,8 @@ Python user would make for the same answer (docs/benchmarks.md, "Analysis").
 For each case and thread count it times, median of --runs runs, the nearest
 distance and nearest index of every point of A in B (one direction):
   - hausdorff.distances(a, b, threads=t) (builds a structure on both sets);
+  - hausdorff.Index(b).distances(a): the index's build and then the query,
+    which builds the same per-point structures (docs/analysis.md);
   - scipy.spatial.cKDTree(b).query(a, k=1, workers=t) (tree construction
     included), the usual answer in Python;
   - Open3D's PointCloud.compute_point_cloud_distance (distances only, every
@@ -64,12 +66,16 @@ def main():
     except ImportError:
         o3d = None
 
-    print("| case | threads | hausdorff.distances | scipy cKDTree | scipy / ours | scipy same | "
-          "Open3D (every core) | Open3D / ours | Open3D same |")
-    print("|---|---|---|---|---|---|---|---|---|")
+    print("| case | threads | hausdorff.distances | Index(b) + .distances(a) | scipy cKDTree | scipy / ours | "
+          "scipy same | Open3D (every core) | Open3D / ours | Open3D same |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
     for name, a, b in cases(args.size):
         for t in args.threads:
             ours, (d, j) = median_time(lambda: hausdorff.distances(a, b, threads=t), args.runs)
+            ix, (di, ji) = median_time(
+                lambda: hausdorff.Index(b, threads=t).distances(a, threads=t), args.runs)
+            if not (np.array_equal(d, di) and np.array_equal(j, ji)):
+                sys.exit("%s: Index.distances differs from distances" % name)
             sp, (ds, js) = median_time(lambda: cKDTree(b).query(a, k=1, workers=t), args.runs)
             same = "=" if np.array_equal(d, ds) and np.array_equal(j, js) else \
                 "distances %s, indices %s" % ("=" if np.array_equal(d, ds) else "differ",
@@ -80,8 +86,8 @@ def main():
                 pb = o3d.geometry.PointCloud(o3d.utility.Vector3dVector(b))
                 to, do = median_time(lambda: np.asarray(pa.compute_point_cloud_distance(pb)), args.runs)
                 o3 = ("%.3f s" % to, "%.1f" % (to / ours), "=" if np.array_equal(d, do) else "differs")
-            print("| %s | %d | %.3f s | %.3f s | %.1f | %s | %s | %s | %s |"
-                  % (name, t, ours, sp, sp / ours, same, *o3), flush=True)
+            print("| %s | %d | %.3f s | %.3f s | %.3f s | %.1f | %s | %s | %s | %s |"
+                  % (name, t, ours, ix, sp, sp / ours, same, *o3), flush=True)
 
 
 if __name__ == "__main__":
