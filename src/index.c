@@ -14,21 +14,23 @@
  * result is exactly h(T(A), B) with the canonical witness.
  * hd_index_nearest does not search the index's tree once per query: that
  * search is made for the engine's early breaking, and a complete one costs
- * about 1.9 us on 1M Gaussian points even from a nearby start, against
- * 0.16 us for the all-nearest-neighbours structures of allnearest.c, which
- * answer neighbouring queries a group at a time.  So it builds those for B
- * and for the transformed queries (about 45 ms and 32 bytes per point each
- * on 1M points, freed before it returns) and runs hd__an_nearest, as
- * hd_distances does for one direction; the answers are the same.  Sets
- * beyond allnearest.c's limit (2^31 - 9 points) use the tree: one exact
- * search (engine_search.c) per query, in slices over threads, each starting
- * in the bucket where the previous one ended.  That start is only good when
+ * about 1.9 us on 1M Gaussian points even from a nearby start.  The
+ * all-nearest-neighbours structures of allnearest.c answer neighbouring
+ * queries a group at a time, for about 0.4 us a query with their
+ * construction.  So it builds those for B and for the transformed queries
+ * (about 45 ms and 32 bytes per point each on 1M points, freed before it
+ * returns) and runs hd__an_nearest, as hd_distances does for one
+ * direction; the answers are the same.  Sets beyond allnearest.c's limit
+ * (2^31 - 9 points), and calls that cannot get the memory for those
+ * structures, use the tree: one exact search (engine_search.c) per query,
+ * in slices over threads, each starting in the bucket where the previous
+ * one ended.  That start is only good when
  * consecutive queries are close, so the queries are first sorted along the
  * Morton curve of the index's grid (their transformed positions; a radix
  * sort of key and index, 16 bytes per query while it runs) and searched in
  * that order, each answer written at the query's own index.  (On 1M random
  * queries in file order the tree took 19.6 s at 1 thread; sorted, 1.9 s;
- * the groups, 0.3 s.)
+ * the groups, 0.35 to 0.45 s.)
  *
  * A transform can carry a valid point out of range, so transformed query
  * points are checked (finite, within HD_MAX_COORD) before anything else.
@@ -275,8 +277,13 @@ int hd__index_nearest_by(const hd_index_t *idx, const hd_points_t *Q, const hd_t
     if (!dist && !nearest) return HD_OK;
     int groups = c.n <= HD__AN_MAX_POINTS && idx->tree.n <= HD__AN_MAX_POINTS;
     if (path == 2 || !groups) return nearest_by_tree(idx, &c, threads, dist, nearest, err);
-    threads = hd__thread_count(opt ? opt->threads : 0, c.n > idx->tree.n ? c.n : idx->tree.n);
-    return nearest_by_groups(idx, Q, T, &c, threads, dist, nearest, err);
+    int gthreads = hd__thread_count(opt ? opt->threads : 0, c.n > idx->tree.n ? c.n : idx->tree.n);
+    rc = nearest_by_groups(idx, Q, T, &c, gthreads, dist, nearest, err);
+    if (rc != HD_ENOMEM) return rc;
+    /* Without memory for the groups' structures (about 32 bytes per point
+     * of each set), the tree answers the same, in more time. */
+    hd__err_clear(err);
+    return nearest_by_tree(idx, &c, threads, dist, nearest, err);
 }
 
 int hd_index_nearest(const hd_index_t *idx, const hd_points_t *Q, const hd_transform_t *T,
