@@ -24,11 +24,11 @@
  * (2^31 - 9 points), and calls that cannot get the memory for those
  * structures, use the tree: one exact search (engine_search.c) per query,
  * in slices over threads, each starting in the bucket where the previous
- * one ended.  That start is only good when
- * consecutive queries are close, so the queries are first sorted along the
- * Morton curve of the index's grid (their transformed positions; a radix
- * sort of key and index, 16 bytes per query while it runs) and searched in
- * that order, each answer written at the query's own index.  (On 1M random
+ * one ended.  That start is only good when consecutive queries are close,
+ * so the queries are first sorted along the Morton curve of the index's
+ * grid (their transformed positions; a radix sort of key and index, 16
+ * bytes per query while it runs) and searched in that order, each answer
+ * written at the query's own index.  (On 1M random
  * queries in file order the tree took 19.6 s at 1 thread; sorted, 1.9 s;
  * the groups, 0.35 to 0.45 s.)
  *
