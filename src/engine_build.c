@@ -130,27 +130,6 @@ typedef struct {
     hd__box_t *part_box;
 } key_ctx;
 
-void hd__src_box(const hd__src_t *src, size_t lo, size_t hi, hd__box_t *box) {
-    double p[3];
-    hd__src_get(src, lo, p);
-    for (int k = 0; k < 3; k++) box->lo[k] = box->hi[k] = p[k];
-    for (size_t i = lo + 1; i < hi; i++) {
-        hd__src_get(src, i, p);
-        for (int k = 0; k < 3; k++) {
-            box->lo[k] = p[k] < box->lo[k] ? p[k] : box->lo[k];
-            box->hi[k] = p[k] > box->hi[k] ? p[k] : box->hi[k];
-        }
-    }
-}
-
-void hd__src_keys(const hd__src_t *src, const hd__keygrid_t *grid, size_t lo, size_t hi, uint64_t *keys) {
-    for (size_t i = lo; i < hi; i++) {
-        double p[3];
-        hd__src_get(src, i, p);
-        keys[i] = (uint64_t)hd__key30(grid, p) << 32 | (uint64_t)i;
-    }
-}
-
 static void box_task(void *vctx, size_t task, int worker) {
     (void)worker;
     key_ctx *c = vctx;
