@@ -139,10 +139,8 @@ int hd_distances(const hd_points_t *A, const hd_points_t *B,
         return kd_distances(A, B, threads, ab, ba, dist_ab, nearest_ab, dist_ba, nearest_ba, err);
     /* Both sets ordered on one grid, so that a group of queries and the
      * buckets it searches are neighbours in memory too. */
-    for (int k = 0; k < 3; k++) {
-        keybox.lo[k] = box_a.lo[k] < box_b.lo[k] ? box_a.lo[k] : box_b.lo[k];
-        keybox.hi[k] = box_a.hi[k] > box_b.hi[k] ? box_a.hi[k] : box_b.hi[k];
-    }
+    keybox = box_a;
+    hd__box_merge(&keybox, &box_b);
     /* The two structures are built side by side: part of each build is
      * serial (the octree), so two builds on half the threads each finish
      * sooner than one after the other on all of them. */

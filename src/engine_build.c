@@ -134,7 +134,18 @@ static void box_task(void *vctx, size_t task, int worker) {
     (void)worker;
     key_ctx *c = vctx;
     size_t lo = task * SLICE, hi = lo + SLICE < c->n ? lo + SLICE : c->n;
-    hd__src_box(c->src, lo, hi, &c->part_box[task]);
+    hd__box_t b;
+    double p[3];
+    hd__src_get(c->src, lo, p);
+    for (int k = 0; k < 3; k++) b.lo[k] = b.hi[k] = p[k];
+    for (size_t i = lo + 1; i < hi; i++) {
+        hd__src_get(c->src, i, p);
+        for (int k = 0; k < 3; k++) {
+            b.lo[k] = p[k] < b.lo[k] ? p[k] : b.lo[k];
+            b.hi[k] = p[k] > b.hi[k] ? p[k] : b.hi[k];
+        }
+    }
+    c->part_box[task] = b;
 }
 
 static void key_task(void *vctx, size_t task, int worker) {
@@ -142,13 +153,6 @@ static void key_task(void *vctx, size_t task, int worker) {
     key_ctx *c = vctx;
     size_t lo = task * SLICE, hi = lo + SLICE < c->n ? lo + SLICE : c->n;
     hd__src_keys(c->src, &c->grid, lo, hi, c->keys);
-}
-
-static void box_merge(hd__box_t *into, const hd__box_t *b) {
-    for (int k = 0; k < 3; k++) {
-        into->lo[k] = b->lo[k] < into->lo[k] ? b->lo[k] : into->lo[k];
-        into->hi[k] = b->hi[k] > into->hi[k] ? b->hi[k] : into->hi[k];
-    }
 }
 
 /* ---- refinement of crowded cells ------------------------------------------- */
@@ -296,7 +300,7 @@ static void node_boxes(void *vctx, size_t task, int worker) {
     size_t lo = task * BOX_TASK, hi = lo + BOX_TASK < t->count[l] ? lo + BOX_TASK : t->count[l];
     for (size_t i = lo; i < hi; i++) {
         hd__box_t b = *hd__tree_box(t, l - 1, 2 * i);
-        if (2 * i + 1 < t->count[l - 1]) box_merge(&b, hd__tree_box(t, l - 1, 2 * i + 1));
+        if (2 * i + 1 < t->count[l - 1]) hd__box_merge(&b, hd__tree_box(t, l - 1, 2 * i + 1));
         t->nodes[t->off[l] + i] = b;
     }
 }
@@ -362,7 +366,7 @@ int hd__tree_build(hd__tree_t *t, const hd__src_t *src, size_t n, const hd__box_
     } else {
         hd__parallel_for(threads, slices, box_task, &kc);
         t->box = kc.part_box[0];
-        for (size_t s = 1; s < slices; s++) box_merge(&t->box, &kc.part_box[s]);
+        for (size_t s = 1; s < slices; s++) hd__box_merge(&t->box, &kc.part_box[s]);
     }
     hd__keygrid_init(&kc.grid, &t->box);
     hd__parallel_for(threads, slices, key_task, &kc);

@@ -16,7 +16,7 @@
  * search is made for the engine's early breaking, and a complete one costs
  * about 1.9 us on 1M Gaussian points even from a nearby start.  The
  * all-nearest-neighbours structures of allnearest.c answer neighbouring
- * queries a group at a time, for about 0.4 us a query with their
+ * queries a group at a time, for about 0.45 us a query with their
  * construction.  So it builds those for B and for the transformed queries
  * (about 45 ms and 32 bytes per point each on 1M points, freed before it
  * returns) and runs hd__an_nearest, as hd_distances does for one
@@ -99,7 +99,8 @@ typedef struct {
     hd__counts_t *counts; /* per worker */
     hd__keygrid_t grid;   /* the index's grid, for the order of the queries */
     uint64_t *order;      /* key << 32 | query, sorted; NULL: file order */
-    hd__box_t *boxes;     /* per slice: the box of the (transformed) queries */
+    hd__box_t *boxes;     /* per slice: the box of the transformed queries */
+    hd__box_t box;        /* the box of the (transformed) queries */
 } query_ctx;
 
 static void check_task(void *vctx, size_t task, int worker) {
@@ -107,6 +108,7 @@ static void check_task(void *vctx, size_t task, int worker) {
     query_ctx *c = vctx;
     size_t lo = task * SLICE, hi = lo + SLICE < c->n ? lo + SLICE : c->n;
     c->bad[task] = HD__NONE;
+    hd__box_t *b = &c->boxes[task];
     for (size_t k = lo; k < hi; k++) {
         double p[3];
         hd__src_get(&c->src, k, p);
@@ -115,10 +117,15 @@ static void check_task(void *vctx, size_t task, int worker) {
             c->bad[task] = k;
             return;
         }
+        for (int d = 0; d < 3; d++) {
+            b->lo[d] = k == lo || p[d] < b->lo[d] ? p[d] : b->lo[d];
+            b->hi[d] = k == lo || p[d] > b->hi[d] ? p[d] : b->hi[d];
+        }
     }
 }
 
-/* Validate the view and, with a transform, every transformed point. */
+/* Validate the view and, with a transform, every transformed point; c->box
+ * gets the box of the points the queries are (transformed, if T is set). */
 static int query_begin(const hd_index_t *idx, const hd_points_t *q, const char *what,
                        const hd_transform_t *T, const hd_options_t *opt, query_ctx *c,
                        int *threads, hd_error_t *err) {
@@ -127,7 +134,7 @@ static int query_begin(const hd_index_t *idx, const hd_points_t *q, const char *
     if (opt && opt->threads < 0)
         return hd__err(err, HD_EINVAL, "threads must be 0 (every core) or positive, not %d",
                        opt->threads);
-    int rc = hd__points_check(q, what, NULL, err);
+    int rc = hd__points_check(q, what, &c->box, err);
     if (rc) return rc;
     hd__src_init(&c->src, q, T);
     c->n = q->count;
@@ -135,17 +142,23 @@ static int query_begin(const hd_index_t *idx, const hd_points_t *q, const char *
     *threads = hd__thread_count(opt ? opt->threads : 0, slices);
     if (!T) return HD_OK;
     c->bad = hd__malloc_array(slices, sizeof *c->bad);
-    if (!c->bad) return hd__err(err, HD_ENOMEM, "out of memory");
-    hd__parallel_for(*threads, slices, check_task, c);
-    for (size_t t = 0; t < slices; t++)
+    c->boxes = hd__malloc_array(slices, sizeof *c->boxes);
+    if (!c->bad || !c->boxes) rc = hd__err(err, HD_ENOMEM, "out of memory");
+    if (rc == HD_OK) hd__parallel_for(*threads, slices, check_task, c);
+    for (size_t t = 0; t < slices && rc == HD_OK; t++)
         if (c->bad[t] != HD__NONE) {
             rc = hd__err(err, HD_ERANGE,
                          "point %zu of %s is NaN, infinite or beyond 1e153 after the transform",
                          c->bad[t], what);
-            break;
         }
+    for (size_t t = 0; t < slices && rc == HD_OK; t++) {
+        if (t == 0) c->box = c->boxes[0];
+        else hd__box_merge(&c->box, &c->boxes[t]);
+    }
     free(c->bad);
+    free(c->boxes);
     c->bad = NULL;
+    c->boxes = NULL;
     return rc;
 }
 
@@ -171,33 +184,15 @@ int hd_index_directed(const hd_index_t *idx, const hd_points_t *A, const hd_tran
     return rc;
 }
 
-/* The box of the (transformed) queries [task * SLICE, ...). */
-static void box_task(void *vctx, size_t task, int worker) {
-    (void)worker;
-    query_ctx *c = vctx;
-    size_t lo = task * SLICE, hi = lo + SLICE < c->n ? lo + SLICE : c->n;
-    hd__src_box(&c->src, lo, hi, &c->boxes[task]);
-}
-
 /* Per-point answers by allnearest.c (see the essay): the structures of B
  * and of T(Q) on a grid over both boxes, then one group of neighbouring
  * queries at a time. */
 static int nearest_by_groups(const hd_index_t *idx, const hd_points_t *Q, const hd_transform_t *T,
                              query_ctx *c, int threads, double *dist, size_t *nearest, hd_error_t *err) {
-    size_t slices = (c->n + SLICE - 1) / SLICE;
-    c->boxes = hd__malloc_array(slices, sizeof *c->boxes);
-    if (!c->boxes) return hd__err(err, HD_ENOMEM, "out of memory");
-    int rc = hd__parallel_for(threads, slices, box_task, c);
     hd__box_t keybox = idx->tree.box;
-    for (size_t t = 0; t < slices && rc == HD_OK; t++)
-        for (int d = 0; d < 3; d++) {
-            keybox.lo[d] = c->boxes[t].lo[d] < keybox.lo[d] ? c->boxes[t].lo[d] : keybox.lo[d];
-            keybox.hi[d] = c->boxes[t].hi[d] > keybox.hi[d] ? c->boxes[t].hi[d] : keybox.hi[d];
-        }
-    free(c->boxes);
-    c->boxes = NULL;
-    if (rc != HD_OK) return hd__err(err, rc, "%s", hd_strerror(rc));
+    hd__box_merge(&keybox, &c->box);
     hd__an_t sb, sq;
+    int rc;
     if ((rc = hd__an_build(&sb, &idx->view, NULL, &keybox, threads, err))) return rc;
     if ((rc = hd__an_build(&sq, Q, T, &keybox, threads, err)) == HD_OK) {
         /* A copy of B in B's order has its partners at the same indices

@@ -236,24 +236,10 @@ typedef struct hd__counts {
 int hd__index_nearest_by(const hd_index_t *idx, const hd_points_t *Q, const hd_transform_t *T,
                          const hd_options_t *opt, double *dist, size_t *nearest, int path, hd_error_t *err);
 
-/* The box of points [lo, hi) of src (lo < hi), and their Morton keys on
- * grid above their indices (keys[i] = key << 32 | i), as the builds and
- * the index's queries sort them.  Inline: as out-of-line calls they made
- * hd_hausdorff 4 to 7% slower on 1M-point Gaussians (measured, not
- * explained). */
-HD__INLINE void hd__src_box(const hd__src_t *src, size_t lo, size_t hi, hd__box_t *box) {
-    double p[3];
-    hd__src_get(src, lo, p);
-    for (int k = 0; k < 3; k++) box->lo[k] = box->hi[k] = p[k];
-    for (size_t i = lo + 1; i < hi; i++) {
-        hd__src_get(src, i, p);
-        for (int k = 0; k < 3; k++) {
-            box->lo[k] = p[k] < box->lo[k] ? p[k] : box->lo[k];
-            box->hi[k] = p[k] > box->hi[k] ? p[k] : box->hi[k];
-        }
-    }
-}
-
+/* The Morton keys on grid of points [lo, hi) of src, above their indices
+ * (keys[i] = key << 32 | i), as the builds and the index's queries sort
+ * them.  Inline: as an out-of-line call it made hd_hausdorff 4 to 7% slower
+ * on 1M-point Gaussians (measured, not explained). */
 HD__INLINE void hd__src_keys(const hd__src_t *src, const hd__keygrid_t *grid, size_t lo, size_t hi,
                              uint64_t *keys) {
     for (size_t i = lo; i < hi; i++) {

@@ -59,6 +59,14 @@ typedef struct hd__box {
     double lo[3], hi[3];
 } hd__box_t;
 
+/* Grow `into` to hold the box b too. */
+HD__INLINE void hd__box_merge(hd__box_t *into, const hd__box_t *b) {
+    for (int k = 0; k < 3; k++) {
+        into->lo[k] = b->lo[k] < into->lo[k] ? b->lo[k] : into->lo[k];
+        into->hi[k] = b->hi[k] > into->hi[k] ? b->hi[k] : into->hi[k];
+    }
+}
+
 /* Smallest computed squared distance from p to any point in the box. */
 HD__INLINE double hd__box_lb2(const hd__box_t *b, const double *p) {
     double d[3];

@@ -198,6 +198,12 @@ static void check_against_brute(const hd_points_t *A, const double *a, size_t na
     free(dab), free(dba), free(jab), free(jba);
 }
 
+/* check_against_brute on packed doubles. */
+static void check_packed(const double *a, size_t na, const double *b, size_t nb, int threads) {
+    hd_points_t A = hd_points_f64(a, na), B = hd_points_f64(b, nb);
+    check_against_brute(&A, a, na, &B, b, nb, threads);
+}
+
 /* Shape `kind` of n points into xyz (seeded by g). */
 enum { SH_GAUSS, SH_LATTICE, SH_DUPLICATES, SH_IDENTICAL, SH_PLANE, SH_LINE, SH_AXIS_PLANE, SH_KINDS };
 static void shape(gen_rng_t *g, int kind, double *xyz, size_t n) {
@@ -247,8 +253,7 @@ TEST(per_point_distances_are_exact_on_shapes_sizes_scales_and_offsets) {
                 gen_affine(a, sz[0], 1e-3, 1e9);
                 gen_affine(b, sz[1], 1e-3, 1e9);
             }
-            hd_points_t A = hd_points_f64(a, sz[0]), B = hd_points_f64(b, sz[1]);
-            check_against_brute(&A, a, sz[0], &B, b, sz[1], threads);
+            check_packed(a, sz[0], b, sz[1], threads);
             free(a), free(b);
             if (hdt_failed()) return;
         }
@@ -271,8 +276,7 @@ TEST(per_point_distances_are_exact_with_crowds_of_equal_points) {
             int c = (int)(gen_u64(&g) % 4);
             b[3 * k] = 0.5 * c, b[3 * k + 1] = 0.25 * c, b[3 * k + 2] = 0;
         }
-        hd_points_t A = hd_points_f64(a, na), B = hd_points_f64(b, nb);
-        check_against_brute(&A, a, na, &B, b, nb, (int)seed % 3 + 1);
+        check_packed(a, na, b, nb, (int)seed % 3 + 1);
         free(a), free(b);
     }
 }
@@ -296,8 +300,7 @@ TEST(per_point_distances_are_exact_for_clusters_next_to_far_outliers) {
         }
         a[3 * (na - 1)] = 1e6;
         b[0] = -1e6, b[1] = 5e5;
-        hd_points_t A = hd_points_f64(a, na), B = hd_points_f64(b, nb);
-        check_against_brute(&A, a, na, &B, b, nb, (int)seed % 3 + 1);
+        check_packed(a, na, b, nb, (int)seed % 3 + 1);
         free(a), free(b);
     }
 }
@@ -342,8 +345,7 @@ TEST(same_order_copies_are_exact_and_mostly_settled_by_their_partners) {
                 threads);
         double *a = malloc(24 * n), *b = malloc(24 * n);
         gen_copy(&g, how, a, b, n);
-        hd_points_t A = hd_points_f64(a, n), B = hd_points_f64(b, n);
-        check_against_brute(&A, a, n, &B, b, n, threads);
+        check_packed(a, n, b, n, threads);
         size_t groups;
         settled += partner_groups(a, b, n, threads, &groups) > 0;
         cases++;
@@ -400,8 +402,7 @@ TEST(same_size_sets_that_are_not_copies_fall_back_and_stay_exact) {
             CONTEXT("seed=%llu unrelated: %zu of %zu groups paired", (unsigned long long)seed, paired, groups);
             CHECK(paired * 10 < groups);
         }
-        hd_points_t A = hd_points_f64(a, n), B = hd_points_f64(b, n);
-        check_against_brute(&A, a, n, &B, b, n, (int)seed % 3 + 1);
+        check_packed(a, n, b, n, (int)seed % 3 + 1);
         free(a), free(b);
     }
 }
