@@ -451,13 +451,7 @@ static double *shuffled_lattice(gen_rng_t *g, int side, int step, double scale, 
                 p[3 * k + 1] = (double)(y * step) * scale + offset;
                 p[3 * k + 2] = (double)(z * step) * scale + offset;
             }
-    for (size_t i = *n - 1; i > 0; i--) {
-        size_t j = gen_u64(g) % (i + 1);
-        double t[3];
-        memcpy(t, p + 3 * i, 24);
-        memcpy(p + 3 * i, p + 3 * j, 24);
-        memcpy(p + 3 * j, t, 24);
-    }
+    for (size_t i = *n - 1; i > 0; i--) gen_swap(p, i, gen_u64(g) % (i + 1));
     return p;
 }
 
