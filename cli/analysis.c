@@ -373,7 +373,7 @@ int analysis_run(const analysis_args_t *an, const hd_options_t *opt,
                                    &r->n_markers, &r->render_w, &r->render_h, err)))
             return rc;
     }
-    if (an->histogram_png && (rc = render_histogram(an->histogram_png, r, an, an->bins, err))) return rc;
+    if (an->histogram_png && (rc = render_histogram(an->histogram_png, r, an, an->bins, r->hist_markers, &r->n_hist_markers, err))) return rc;
     return HD_OK;
 }
 
@@ -463,6 +463,14 @@ void analysis_json(FILE *out, const analysis_args_t *an,
     if (an->histogram_png) {
         fprintf(out, ", \"histogram_png\": ");
         json_string(out, an->histogram_png);
+        fprintf(out, ", \"histogram_markers\": [");
+        for (int k = 0; k < r->n_hist_markers; k++) {
+            const hist_marker_t *m = &r->hist_markers[k];
+            fprintf(out, "%s{\"line\": \"%s\", \"direction\": \"%s\", \"x\": %d, \"y0\": %d, \"y1\": %d, "
+                    "\"rgb\": [%d, %d, %d]}", k ? ", " : "", m->kind == 'm' ? "mean" : "percentile",
+                    m->dir ? "ba" : "ab", m->x, m->y0, m->y1, m->rgb[0], m->rgb[1], m->rgb[2]);
+        }
+        fputc(']', out);
     }
 }
 

@@ -72,6 +72,14 @@ typedef struct render_marker {
     int x, y;                  /* pixel of the marker's centre */
 } render_marker_t;
 
+/* Where a mean or percentile line was drawn on the histogram picture. */
+typedef struct hist_marker {
+    char kind;                 /* 'm' mean (solid), 'p' percentile (dashed) */
+    int dir;                   /* 0 A->B, 1 B->A */
+    int x, y0, y1;             /* its centre column, rows [y0, y1) */
+    unsigned char rgb[3];      /* its colour (the direction's bars') */
+} hist_marker_t;
+
 typedef struct analysis_result {
     int active;                /* some analysis option was given */
     int directed;
@@ -87,6 +95,8 @@ typedef struct analysis_result {
     char dist_path_a[4096], dist_path_b[4096];
     int render_w, render_h, n_markers;
     render_marker_t markers[6];
+    int n_hist_markers;
+    hist_marker_t hist_markers[4];
 } analysis_result_t;
 
 /* Does anything need the per-point distances? */
@@ -133,10 +143,11 @@ int render_distances(const char *path, const hd_points_t *A,
                      const char *title, render_marker_t markers[6],
                      int *n_markers, int *width, int *height,
                      hd_error_t *err);
-/* A bar chart of the histogram(s) with the percentile and mean marked. */
+/* A bar chart of the histogram(s) with the percentile and mean marked;
+ * where those lines were drawn goes into marks (at most 4). */
 int render_histogram(const char *path, const analysis_result_t *r,
                      const analysis_args_t *an, size_t bins,
-                     hd_error_t *err);
+                     hist_marker_t marks[4], int *n_marks, hd_error_t *err);
 
 /* ---- text (font.c) --------------------------------------------------------- */
 /* Width in font pixels of s at scale 1; the glyphs are 9 pixels high with

@@ -373,7 +373,8 @@ int render_distances(const char *path, const hd_points_t *A,
 
 int render_histogram(const char *path, const analysis_result_t *r,
                      const analysis_args_t *an, size_t bins,
-                     hd_error_t *err) {
+                     hist_marker_t marks[4], int *n_marks, hd_error_t *err) {
+    *n_marks = 0;
     enum { HW = 1000, HH = 580, L = 110, R = 30, T = 104, B = 80 };
     canvas_t c;
     if (canvas_init(&c, HW, HH)) return no_memory(err);
@@ -434,18 +435,24 @@ int render_histogram(const char *path, const analysis_result_t *r,
     char buf[256];
     snprintf(buf, sizeof buf, "distance to the nearest point of the other set%s", unit);
     text(&c, L + pw / 2 - font_width(buf), HH - 34, 2, buf, DARK);
-    /* markers: percentile (dashed) and mean (solid) per direction */
+    /* markers: percentile (dashed) and mean (solid) per direction, in the
+     * direction's colour with a dark edge on each side, so that a line stays
+     * visible where it crosses a bar of its own colour (a mean usually lies
+     * in the tallest bar). */
     for (int sidx = 0; sidx < series; sidx++) {
         const unsigned char *col = sidx ? AMBER : BLUE;
-        double mean = sidx ? r->sum.mean_ba : r->sum.mean_ab;
-        double pct = sidx ? r->pct.ba : r->pct.ab;
-        if (mean >= lo && mean <= hi) {
-            int x = L + (int)lround(pw * (mean - lo) / (hi - lo));
-            fill_rect(&c, x - 1, T, x + 1, T + ph, col);
-        }
-        if (an->percentile_on && pct >= lo && pct <= hi) {
-            int x = L + (int)lround(pw * (pct - lo) / (hi - lo));
-            for (int y = T; y < T + ph; y += 12) fill_rect(&c, x - 1, y, x + 1, y + 6, col);
+        double v[2] = {sidx ? r->sum.mean_ba : r->sum.mean_ab, sidx ? r->pct.ba : r->pct.ab};
+        for (int kind = 0; kind < 2; kind++) {
+            if ((kind == 1 && !an->percentile_on) || !(v[kind] >= lo && v[kind] <= hi)) continue;
+            int x = L + (int)lround(pw * (v[kind] - lo) / (hi - lo));
+            int dash = kind ? 6 : ph, period = kind ? 12 : ph;
+            for (int y = T; y < T + ph; y += period) {
+                int y1 = y + dash < T + ph ? y + dash : T + ph;
+                fill_rect(&c, x - 2, y, x + 2, y1, DARK);
+                fill_rect(&c, x - 1, y, x + 1, y1, col);
+            }
+            hist_marker_t *mk = &marks[(*n_marks)++];
+            *mk = (hist_marker_t){kind ? 'p' : 'm', sidx, x, T, T + ph, {col[0], col[1], col[2]}};
         }
     }
     /* legend and title */
@@ -504,8 +511,9 @@ int render_distances(const char *path, const hd_points_t *A,
 
 int render_histogram(const char *path, const analysis_result_t *r,
                      const analysis_args_t *an, size_t bins,
-                     hd_error_t *err) {
-    (void)path, (void)r, (void)an, (void)bins;
+                     hist_marker_t marks[4], int *n_marks, hd_error_t *err) {
+    (void)path, (void)r, (void)an, (void)bins, (void)marks;
+    *n_marks = 0;
     return unavailable(err);
 }
 

@@ -233,6 +233,31 @@ def histogram_png_is_a_picture(tmp):
 
 
 @test
+def histogram_png_marks_means_and_percentiles_visibly_over_the_bars(tmp):
+    a, b = gauss_clouds(11, 800, 700)
+    pa, pb = files(tmp, a, b)
+    png = os.path.join(tmp, "h.png")
+    if not pictures_built():
+        return refuses_pictures(["--histogram-png", png, pa, pb])
+    r = run_json(["--histogram-png", png, "--percentile", "95", pa, pb])
+    img = read_png(png).astype(int)
+    marks = r["histogram_markers"]
+    assert sorted((m["line"], m["direction"]) for m in marks) == [
+        ("mean", "ab"), ("mean", "ba"), ("percentile", "ab"), ("percentile", "ba")], marks
+    for m in marks:
+        x, rgb = m["x"], np.array(m["rgb"])
+        # solid for the mean; dashes of 6 rows every 12 for the percentile
+        rows = range(m["y0"], m["y1"]) if m["line"] == "mean" else range(m["y0"] + 3, m["y1"], 12)
+        for y in rows:
+            others = [o for o in marks if o is not m and abs(o["x"] - x) <= 3]
+            if others:
+                continue  # lines drawn within a few pixels of each other overlap
+            assert (img[y, x] == rgb).all(), (m, y, img[y, x])
+            # a dark edge on both sides, also where the line crosses a bar of its colour
+            assert img[y, x - 2].sum() < 200 and img[y, x + 1].sum() < 200, (m, y, img[y, x - 2])
+
+
+@test
 def answers_do_not_depend_on_the_thread_count(tmp):
     a, b = lattice_clouds(12, 2000, 1800, side=9)
     pa, pb = files(tmp, a, b)
