@@ -218,29 +218,36 @@ def render_is_a_picture_with_the_witness_pair_marked(tmp):
     assert ((img[..., 0] < 90) & (img[..., 2] > 60) & (img[..., 1] < 60)).any()
 
 
-@test
-def histogram_png_is_a_picture(tmp):
+def histogram_picture(tmp):
+    """The JSON and the pixels of --histogram-png with --percentile 95 on two
+    Gaussian clouds; None (after checking the refusal) without libpng."""
     a, b = gauss_clouds(11, 800, 700)
     pa, pb = files(tmp, a, b)
     png = os.path.join(tmp, "h.png")
     if not pictures_built():
-        return refuses_pictures(["--histogram-png", png, pa, pb])
+        refuses_pictures(["--histogram-png", png, pa, pb])
+        return None
     r = run_json(["--histogram-png", png, "--percentile", "95", pa, pb])
     assert r["histogram_png"] == png
-    img = read_png(png)
+    return r, read_png(png).astype(int)
+
+
+@test
+def histogram_png_is_a_picture(tmp):
+    got = histogram_picture(tmp)
+    if got is None:
+        return
+    img = got[1]
     assert img.shape[0] > 300 and img.shape[1] > 600
     assert len(np.unique(img.reshape(-1, 3), axis=0)) > 3
 
 
 @test
 def histogram_png_marks_means_and_percentiles_visibly_over_the_bars(tmp):
-    a, b = gauss_clouds(11, 800, 700)
-    pa, pb = files(tmp, a, b)
-    png = os.path.join(tmp, "h.png")
-    if not pictures_built():
-        return refuses_pictures(["--histogram-png", png, pa, pb])
-    r = run_json(["--histogram-png", png, "--percentile", "95", pa, pb])
-    img = read_png(png).astype(int)
+    got = histogram_picture(tmp)
+    if got is None:
+        return
+    r, img = got
     marks = r["histogram_markers"]
     assert sorted((m["line"], m["direction"]) for m in marks) == [
         ("mean", "ab"), ("mean", "ba"), ("percentile", "ab"), ("percentile", "ba")], marks
