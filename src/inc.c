@@ -179,7 +179,10 @@ static int offer_entry(inc_t *s, ref_t e, const ref_t *cand, size_t n) {
     s->ent[slot].n = m;
     rc = hd__heap_push(&s->queue, U, slot);
     if (rc != HD_OK) {
+        /* The slot goes back unused; its list must not be freed again by
+         * the final sweep over the slots. */
         free(L);
+        s->ent[slot].L = NULL;
         s->free_slot[s->n_free++] = slot;
     }
     return rc;

@@ -249,7 +249,9 @@ int hd__thread_count(int requested, size_t work_items);
 
 /* Run fn(ctx, task, worker) for task in [0, n_tasks) on `threads` threads
  * (the caller's thread is worker 0).  Tasks are handed out in increasing
- * order through an atomic counter.  Returns HD_OK or HD_ETHREAD. */
+ * order through an atomic counter.  Every task has run when it returns,
+ * even when threads or their handles cannot be had (then on fewer
+ * threads): it returns HD_OK. */
 typedef void (*hd__task_fn)(void *ctx, size_t task, int worker);
 int hd__parallel_for(int threads, size_t n_tasks, hd__task_fn fn, void *ctx);
 

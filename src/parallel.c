@@ -10,7 +10,10 @@
  * serve processes on several machines.
  *
  * The caller's thread is worker 0, so threads = 1 runs serially with no
- * thread created at all.
+ * thread created at all.  Every task has run when hd__parallel_for
+ * returns, whatever fails: when the thread handles cannot be allocated or
+ * a thread cannot be started, the threads that exist (at least the
+ * caller's) take all the tasks, and the failure costs only speed.
  */
 #include "internal.h"
 
@@ -72,9 +75,13 @@ int hd__parallel_for(int threads, size_t n_tasks, hd__task_fn fn, void *ctx) {
     pthread_t *tid = hd__malloc_array((size_t)threads, sizeof *tid);
     hd__worker_t *w = hd__malloc_array((size_t)threads, sizeof *w);
     if (!tid || !w) {
+        /* No memory for the thread handles: this thread takes every task,
+         * as when threads cannot be started (below).  Callers rely on every
+         * task having run once this returns. */
         free(tid);
         free(w);
-        return HD_ENOMEM;
+        run_tasks(&pool, 0);
+        return HD_OK;
     }
     int started = 0, rc = HD_OK;
     for (int k = 1; k < threads; k++) {

@@ -1,0 +1,395 @@
+/*
+ * test_oom.c -- running out of memory is an error like any other: every
+ * allocation the library makes, in turn, is made to fail, and the call must
+ * then return HD_ENOMEM with a message (or, where the library has a
+ * fallback, succeed with the exact answer), never crash, hang, leak or
+ * return a wrong number.  This is SQLite's out-of-memory test, on a small
+ * scale.
+ *
+ * How: this executable is linked with -Wl,--wrap=malloc,--wrap=calloc,
+ * --wrap=realloc (tests/oom.cmake), so every allocation of the library's
+ * objects goes through the wrappers below.  An armed countdown lets k
+ * allocations succeed and fails the next one: in one mode every later one
+ * too (memory is gone: a fallback that allocates again fails as well), in
+ * the other only that one (a transient failure: the code must not carry on
+ * with what it did not get, as if it had).  For k = 0, 1, 2, ... each
+ * operation runs until a run completes without reaching the failure; every
+ * run before that must fail cleanly or give the reference answer.  Leaks
+ * on the error paths are caught by LeakSanitizer in the sanitizer build.
+ * Allocations made inside the C library itself (thread stacks, stdio) are
+ * not wrapped.
+ */
+#include "brute.h"
+#include "check.h"
+#include "gen.h"
+
+#include <math.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ---- the failing allocator ------------------------------------------------ */
+
+void *__real_malloc(size_t n);
+void *__real_calloc(size_t n, size_t size);
+void *__real_realloc(void *p, size_t n);
+
+static atomic_long budget = -1; /* allocations left before failing; -1: off */
+static atomic_int reached;      /* a failure was injected since arming */
+static int once;                /* fail only that one allocation, not the later ones */
+
+static int allow(void) {
+    long left = atomic_load(&budget);
+    while (left >= 0) {
+        if (left == 0) {
+            atomic_store(&reached, 1);
+            if (once) atomic_store(&budget, -1);
+            return 0;
+        }
+        if (atomic_compare_exchange_weak(&budget, &left, left - 1)) return 1;
+    }
+    return 1;
+}
+
+void *__wrap_malloc(size_t n) { return allow() ? __real_malloc(n) : NULL; }
+void *__wrap_calloc(size_t n, size_t size) { return allow() ? __real_calloc(n, size) : NULL; }
+void *__wrap_realloc(void *p, size_t n) { return allow() ? __real_realloc(p, n) : NULL; }
+
+static void arm(long k) {
+    atomic_store(&reached, 0);
+    atomic_store(&budget, k);
+}
+
+/* Disarm; returns whether a failure was injected. */
+static int disarm(void) {
+    atomic_store(&budget, -1);
+    return atomic_load(&reached);
+}
+
+/* ---- the driver -------------------------------------------------------------- */
+
+/* One operation: run it (the allocator possibly armed), returning its code;
+ * check the answer of a successful run against the reference. */
+typedef struct op op_t;
+struct op {
+    const char *name;
+    int (*run)(op_t *op, hd_error_t *err);
+    void (*check)(op_t *op); /* after an HD_OK run, allocator disarmed */
+    void *ctx;
+};
+
+/* Fail each allocation of op in turn until it needs no more, in both
+ * modes. */
+static void exhaust_mode(op_t *op);
+
+static void exhaust(op_t *op) {
+    for (once = 0; once <= 1 && !hdt_failed(); once++) exhaust_mode(op);
+    once = 0;
+}
+
+static void exhaust_mode(op_t *op) {
+    long k;
+    for (k = 0; k < 20000 && !hdt_failed(); k++) {
+        CONTEXT("%s, allocation %ld made to fail%s", op->name, k, once ? " (only that one)" : " (and every later one)");
+        hd_error_t err;
+        memset(&err, 0, sizeof err);
+        arm(k);
+        int rc = op->run(op, &err);
+        int injected = disarm();
+        if (rc == HD_OK) {
+            op->check(op);
+            if (!injected) break; /* every allocation succeeded: done */
+            continue;             /* a fallback absorbed the failure */
+        }
+        CHECK(injected);
+        if (rc != HD_ENOMEM)
+            hdt_fail(__FILE__, __LINE__, "returned %s (%s), expected HD_ENOMEM", hd_err_name(rc),
+                     err.message);
+        CHECK_EQ(err.code, HD_ENOMEM);
+        CHECK(err.message[0] != '\0');
+    }
+    CHECK(k > 0);         /* the operation allocates at all */
+    CHECK(k < 20000);     /* and it ended */
+}
+
+/* ---- the operations ------------------------------------------------------------ */
+
+typedef struct {
+    double *a, *b;
+    size_t na, nb;
+    hd_options_t opt;
+    brute_t ab, ba;       /* the reference */
+    double *want_dist[2]; /* the reference per-point answers */
+    size_t *want_near[2];
+    hd_symmetric_t got;
+    double *dist[2];
+    size_t *near[2];
+} pair_ctx;
+
+static void pair_init(pair_ctx *c, size_t na, size_t nb, int threads) {
+    memset(c, 0, sizeof *c);
+    c->na = na, c->nb = nb;
+    c->a = malloc(24 * na);
+    c->b = malloc(24 * nb);
+    hd_options_init(&c->opt);
+    c->opt.threads = threads;
+}
+
+/* The per-point answers of the points q against p. */
+static void nearest_all(const double *q, size_t nq, const double *p, size_t np, double *dist,
+                        size_t *near) {
+    for (size_t k = 0; k < nq; k++) dist[k] = sqrt(brute_nearest(q + 3 * k, p, np, &near[k]));
+}
+
+/* The reference: the brute force on small sets.  On large ones (where it
+ * would take minutes) the library's own answers with nothing failing:
+ * their exactness is test_engine's and test_analysis's subject, the
+ * question here is only whether a failure changes anything. */
+static void pair_reference(pair_ctx *c) {
+    for (int d = 0; d < 2; d++) {
+        size_t n = d ? c->nb : c->na;
+        c->dist[d] = malloc(8 * n);
+        c->near[d] = malloc(sizeof(size_t) * n);
+        c->want_dist[d] = malloc(8 * n);
+        c->want_near[d] = malloc(sizeof(size_t) * n);
+    }
+    if (c->na * c->nb <= 10000000) {
+        c->ab = brute_directed(c->a, c->na, c->b, c->nb);
+        c->ba = brute_directed(c->b, c->nb, c->a, c->na);
+        nearest_all(c->a, c->na, c->b, c->nb, c->want_dist[0], c->want_near[0]);
+        nearest_all(c->b, c->nb, c->a, c->na, c->want_dist[1], c->want_near[1]);
+        return;
+    }
+    hd_points_t A = hd_points_f64(c->a, c->na), B = hd_points_f64(c->b, c->nb);
+    hd_symmetric_t s;
+    CHECK_RC(hd_hausdorff(&A, &B, &c->opt, &s, NULL), HD_OK);
+    c->ab = (brute_t){s.ab.distance2, s.ab.i, s.ab.j};
+    c->ba = (brute_t){s.ba.distance2, s.ba.i, s.ba.j};
+    CHECK_RC(hd_distances(&A, &B, &c->opt, c->want_dist[0], c->want_near[0], c->want_dist[1],
+                          c->want_near[1], NULL),
+             HD_OK);
+}
+
+static void pair_free(pair_ctx *c) {
+    free(c->a);
+    free(c->b);
+    for (int d = 0; d < 2; d++) {
+        free(c->dist[d]), free(c->near[d]);
+        free(c->want_dist[d]), free(c->want_near[d]);
+    }
+}
+
+static int run_hausdorff(op_t *op, hd_error_t *err) {
+    pair_ctx *c = op->ctx;
+    hd_points_t A = hd_points_f64(c->a, c->na), B = hd_points_f64(c->b, c->nb);
+    return hd_hausdorff(&A, &B, &c->opt, &c->got, err);
+}
+
+static void check_hausdorff(op_t *op) {
+    pair_ctx *c = op->ctx;
+    CHECK_BITS(c->got.ab.distance2, c->ab.d2);
+    CHECK_EQ(c->got.ab.i, c->ab.i);
+    CHECK_EQ(c->got.ab.j, c->ab.j);
+    CHECK_BITS(c->got.ba.distance2, c->ba.d2);
+    CHECK_EQ(c->got.ba.i, c->ba.i);
+    CHECK_EQ(c->got.ba.j, c->ba.j);
+}
+
+/* Per-point answers of direction d against the reference. */
+static void check_nearest(const pair_ctx *c, int d) {
+    size_t n = d ? c->nb : c->na;
+    for (size_t k = 0; k < n && !hdt_failed(); k++) {
+        CHECK_BITS(c->dist[d][k], c->want_dist[d][k]);
+        CHECK_EQ(c->near[d][k], c->want_near[d][k]);
+    }
+}
+
+static int run_distances(op_t *op, hd_error_t *err) {
+    pair_ctx *c = op->ctx;
+    hd_points_t A = hd_points_f64(c->a, c->na), B = hd_points_f64(c->b, c->nb);
+    return hd_distances(&A, &B, &c->opt, c->dist[0], c->near[0], c->dist[1], c->near[1], err);
+}
+
+static void check_distances(op_t *op) {
+    pair_ctx *c = op->ctx;
+    check_nearest(c, 0);
+    check_nearest(c, 1);
+}
+
+/* Build an index of B, then h(A,B) and A's per-point answers through it. */
+static int run_index(op_t *op, hd_error_t *err) {
+    pair_ctx *c = op->ctx;
+    hd_points_t A = hd_points_f64(c->a, c->na), B = hd_points_f64(c->b, c->nb);
+    hd_index_t *idx = NULL;
+    int rc = hd_index_build(&B, &c->opt, &idx, err);
+    if (rc != HD_OK) CHECK(idx == NULL);
+    if (rc == HD_OK) rc = hd_index_directed(idx, &A, NULL, &c->opt, &c->got.ab, err);
+    if (rc == HD_OK) rc = hd_index_nearest(idx, &A, NULL, &c->opt, c->dist[0], c->near[0], err);
+    hd_index_free(idx);
+    return rc;
+}
+
+static void check_index(op_t *op) {
+    pair_ctx *c = op->ctx;
+    CHECK_BITS(c->got.ab.distance2, c->ab.d2);
+    CHECK_EQ(c->got.ab.i, c->ab.i);
+    CHECK_EQ(c->got.ab.j, c->ab.j);
+    check_nearest(c, 0);
+}
+
+static void exhaust_pair(const char *name, pair_ctx *c, int (*run)(op_t *, hd_error_t *),
+                         void (*check)(op_t *)) {
+    pair_reference(c);
+    op_t op = {name, run, check, c};
+    exhaust(&op);
+}
+
+/* Overlapping Gaussians (the engine's grid pass). */
+static void gaussians(pair_ctx *c, uint64_t seed) {
+    gen_rng_t g;
+    gen_seed(&g, seed);
+    double m[3] = {0, 0, 0};
+    gen_gauss(&g, c->a, c->na, m, 1.0);
+    m[0] = 0.3;
+    gen_gauss(&g, c->b, c->nb, m, 1.0);
+}
+
+/* ---- the behaviours --------------------------------------------------------------- */
+
+TEST(every_allocation_of_the_auto_engine_can_fail_cleanly) {
+    /* The four plans: the grid pass, the copy in the same order, the same
+     * copy shuffled (bucket trees), an ordered subset; 1 and 2 threads; and
+     * the trees once more on 70000 points, where the sorts run in parallel
+     * parts. */
+    for (int plan = 0; plan < 5 && !hdt_failed(); plan++)
+        for (int threads = 1; threads <= 2 && !hdt_failed(); threads++) {
+            if (plan == 4 && threads == 1) continue;
+            uint64_t seed = 21000 + (uint64_t)plan;
+            char name[128];
+            snprintf(name, sizeof name, "hd_hausdorff auto, seed=%llu plan=%d threads=%d",
+                     (unsigned long long)seed, plan, threads);
+            pair_ctx c;
+            size_t n = plan == 4 ? 70000 : 3000;
+            pair_init(&c, n, plan == 3 ? n / 10 : n, threads);
+            gen_rng_t g;
+            gen_seed(&g, seed);
+            if (plan == 0) {
+                gaussians(&c, seed);
+            } else if (plan == 3) {
+                double m[3] = {0, 0, 0};
+                gen_gauss(&g, c.a, n, m, 1.0);
+                for (size_t k = 0; k < c.nb; k++) memcpy(c.b + 3 * k, c.a + 30 * k, 24);
+            } else {
+                gen_copy(&g, GEN_COPY_NOISE, c.a, c.b, n);
+                for (size_t k = n - 1; plan != 1 && k > 0; k--) gen_swap(c.b, k, gen_u64(&g) % (k + 1));
+            }
+            exhaust_pair(name, &c, run_hausdorff, check_hausdorff);
+            pair_free(&c);
+        }
+}
+
+TEST(every_allocation_of_every_algorithm_can_fail_cleanly) {
+    static const char *const names[] = {"naive", "earlybreak", "inc", "nohd", "ohd", "framework", "kdtree"};
+    for (size_t k = 0; k < sizeof names / sizeof names[0] && !hdt_failed(); k++) {
+        char name[128];
+        snprintf(name, sizeof name, "hd_hausdorff %s, seed=21100 threads=2", names[k]);
+        pair_ctx c;
+        pair_init(&c, 700, 500, 2);
+        gaussians(&c, 21100);
+        CHECK_RC(hd_algorithm_from_name(names[k], &c.opt.algorithm), HD_OK);
+        exhaust_pair(name, &c, run_hausdorff, check_hausdorff);
+        pair_free(&c);
+    }
+}
+
+TEST(every_allocation_of_per_point_distances_can_fail_cleanly) {
+    /* Small sets, and sets large enough for the sorts' parallel parts. */
+    for (int size = 0; size < 2 && !hdt_failed(); size++)
+        for (int threads = 1; threads <= 2 && !hdt_failed(); threads++) {
+            if (size == 1 && threads == 1) continue;
+            char name[128];
+            snprintf(name, sizeof name, "hd_distances, seed=21200 size=%d threads=%d", size, threads);
+            pair_ctx c;
+            pair_init(&c, size ? 70000 : 2500, size ? 66000 : 2000, threads);
+            gaussians(&c, 21200);
+            exhaust_pair(name, &c, run_distances, check_distances);
+            pair_free(&c);
+        }
+}
+
+TEST(every_allocation_of_an_index_and_its_queries_can_fail_cleanly) {
+    /* hd_index_nearest falls back to searching the index's tree when the
+     * per-point structures cannot be had: those runs must still be exact. */
+    pair_ctx c;
+    pair_init(&c, 2000, 2500, 2);
+    gaussians(&c, 21300);
+    exhaust_pair("hd_index_build, _directed, _nearest, seed=21300 threads=2", &c, run_index, check_index);
+    pair_free(&c);
+}
+
+/* ---- readers ------------------------------------------------------------------------ */
+
+typedef struct {
+    const char *path;
+    hd_read_options_t opt;
+    size_t count;     /* the reference */
+    double first[3], last[3];
+    hd_cloud_t *got;
+} read_ctx;
+
+static int run_read(op_t *op, hd_error_t *err) {
+    read_ctx *c = op->ctx;
+    c->got = NULL;
+    int rc = hd_read_file(c->path, &c->opt, &c->got, err);
+    if (rc != HD_OK) CHECK(c->got == NULL);
+    return rc;
+}
+
+static void check_read(op_t *op) {
+    read_ctx *c = op->ctx;
+    hd_points_t p = hd_cloud_points(c->got);
+    CHECK_EQ(p.count, c->count);
+    double v[3];
+    hd_points_get(&p, 0, v);
+    for (int k = 0; k < 3; k++) CHECK_BITS(v[k], c->first[k]);
+    hd_points_get(&p, p.count - 1, v);
+    for (int k = 0; k < 3; k++) CHECK_BITS(v[k], c->last[k]);
+    hd_cloud_free(c->got);
+    c->got = NULL;
+}
+
+TEST(every_allocation_of_every_reader_can_fail_cleanly) {
+    /* One file of each format, and a larger PLY and OFF (several blocks
+     * for the parallel parsers). */
+    static const char *const files[] = {
+        "tests/corpus/ply/ascii.ply",   "tests/corpus/ply/binary_little_endian.ply",
+        "tests/corpus/obj/mesh.obj",    "tests/corpus/off/coff.off",
+        "tests/corpus/stl/ascii.stl",   "tests/corpus/stl/binary.stl",
+        "tests/corpus/xyz/header.csv",  "tests/corpus/xyz/leica.pts",
+        "tests/corpus/pcd/ascii.pcd",   "tests/corpus/pcd/compressed.pcd",
+        "tests/corpus/las/v14_fmt6.las", "tests/corpus/npy/f_be_f4.npy",
+        "data/cgal_lion_head.ply",      "data/orig/lion-head.off",
+    };
+    for (size_t k = 0; k < sizeof files / sizeof files[0] && !hdt_failed(); k++)
+        for (int threads = 1; threads <= 2 && !hdt_failed(); threads++) {
+            char name[512];
+            snprintf(name, sizeof name, "hd_read_file %s, threads=%d", files[k], threads);
+            CONTEXT("%s", name);
+            read_ctx c;
+            memset(&c, 0, sizeof c);
+            c.path = files[k];
+            hd_read_options_init(&c.opt);
+            c.opt.threads = threads;
+            hd_cloud_t *ref = NULL;
+            CHECK_RC(hd_read_file(c.path, &c.opt, &ref, NULL), HD_OK);
+            if (!ref) return;
+            hd_points_t p = hd_cloud_points(ref);
+            c.count = p.count;
+            hd_points_get(&p, 0, c.first);
+            hd_points_get(&p, p.count - 1, c.last);
+            hd_cloud_free(ref);
+            op_t op = {name, run_read, check_read, &c};
+            exhaust(&op);
+        }
+}
