@@ -328,13 +328,45 @@ TEST(every_allocation_of_an_index_and_its_queries_can_fail_cleanly) {
     pair_free(&c);
 }
 
+typedef struct {
+    pair_ctx *pair;
+    hd_percentile_t want, got;
+} pct_ctx;
+
+static int run_percentile(op_t *op, hd_error_t *err) {
+    pct_ctx *c = op->ctx;
+    hd_points_t A = hd_points_f64(c->pair->a, c->pair->na), B = hd_points_f64(c->pair->b, c->pair->nb);
+    return hd_hausdorff_percentile(&A, &B, &c->pair->opt, 95, &c->got, err);
+}
+
+static void check_percentile(op_t *op) {
+    pct_ctx *c = op->ctx;
+    CHECK(memcmp(&c->got, &c->want, sizeof c->got) == 0);
+}
+
+TEST(every_allocation_of_a_percentile_hausdorff_can_fail_cleanly) {
+    /* The distances, then a selection on a copy of them.  The reference is
+     * the same call with nothing failing (test_analysis compares it with
+     * numpy's definition). */
+    pair_ctx p;
+    pair_init(&p, 2500, 2000, 2);
+    gaussians(&p, 21400);
+    pct_ctx c;
+    memset(&c, 0, sizeof c);
+    c.pair = &p;
+    hd_points_t A = hd_points_f64(p.a, p.na), B = hd_points_f64(p.b, p.nb);
+    CHECK_RC(hd_hausdorff_percentile(&A, &B, &p.opt, 95, &c.want, NULL), HD_OK);
+    op_t op = {"hd_hausdorff_percentile 95, seed=21400 threads=2", run_percentile, check_percentile, &c};
+    exhaust(&op);
+    pair_free(&p);
+}
+
 /* ---- readers ------------------------------------------------------------------------ */
 
 typedef struct {
     const char *path;
     hd_read_options_t opt;
-    size_t count;     /* the reference */
-    double first[3], last[3];
+    hd_cloud_t *want; /* read with nothing failing */
     hd_cloud_t *got;
 } read_ctx;
 
@@ -348,15 +380,22 @@ static int run_read(op_t *op, hd_error_t *err) {
 
 static void check_read(op_t *op) {
     read_ctx *c = op->ctx;
-    hd_points_t p = hd_cloud_points(c->got);
-    CHECK_EQ(p.count, c->count);
-    double v[3];
-    hd_points_get(&p, 0, v);
-    for (int k = 0; k < 3; k++) CHECK_BITS(v[k], c->first[k]);
-    hd_points_get(&p, p.count - 1, v);
-    for (int k = 0; k < 3; k++) CHECK_BITS(v[k], c->last[k]);
+    CHECK_EQ(c->got->count, c->want->count);
+    CHECK_EQ(c->got->dtype, c->want->dtype);
+    if (c->got->count == c->want->count && c->got->dtype == c->want->dtype)
+        CHECK(memcmp(c->got->data, c->want->data,
+                     c->got->count * (c->got->dtype == HD_FLOAT32 ? 12 : 24)) == 0);
     hd_cloud_free(c->got);
     c->got = NULL;
+}
+
+/* Read c->path with nothing failing, then with each allocation failing. */
+static void exhaust_read(read_ctx *c, const char *name) {
+    CHECK_RC(hd_read_file(c->path, &c->opt, &c->want, NULL), HD_OK);
+    if (!c->want) return;
+    op_t op = {name, run_read, check_read, c};
+    exhaust(&op);
+    hd_cloud_free(c->want);
 }
 
 TEST(every_allocation_of_every_reader_can_fail_cleanly) {
@@ -381,15 +420,20 @@ TEST(every_allocation_of_every_reader_can_fail_cleanly) {
             c.path = files[k];
             hd_read_options_init(&c.opt);
             c.opt.threads = threads;
-            hd_cloud_t *ref = NULL;
-            CHECK_RC(hd_read_file(c.path, &c.opt, &ref, NULL), HD_OK);
-            if (!ref) return;
-            hd_points_t p = hd_cloud_points(ref);
-            c.count = p.count;
-            hd_points_get(&p, 0, c.first);
-            hd_points_get(&p, p.count - 1, c.last);
-            hd_cloud_free(ref);
-            op_t op = {name, run_read, check_read, &c};
-            exhaust(&op);
+            exhaust_read(&c, name);
         }
+}
+
+TEST(every_allocation_of_sampling_a_mesh_can_fail_cleanly) {
+    /* Points drawn on the faces (a face table, cumulative areas, seeded
+     * draws) rather than the vertices. */
+    read_ctx c;
+    memset(&c, 0, sizeof c);
+    c.path = "data/orig/lion-head.off";
+    hd_read_options_init(&c.opt);
+    c.opt.mesh = HD_MESH_SAMPLE;
+    c.opt.sample = 5000;
+    c.opt.seed = 7;
+    c.opt.threads = 2;
+    exhaust_read(&c, "hd_read_file data/orig/lion-head.off, 5000 points sampled, seed=7");
 }
