@@ -1,3 +1,4 @@
-# test_oom makes the library's allocations fail one at a time: its
-# executable routes malloc, calloc and realloc through wrappers of its own.
-target_link_options(test_oom PRIVATE "LINKER:--wrap=malloc,--wrap=calloc,--wrap=realloc")
+# test_oom makes the library's allocations fail one at a time, and its threads
+# fail to start: its executable routes malloc, calloc, realloc and
+# pthread_create through wrappers of its own.
+target_link_options(test_oom PRIVATE "LINKER:--wrap=malloc,--wrap=calloc,--wrap=realloc,--wrap=pthread_create")

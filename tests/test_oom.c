@@ -17,13 +17,16 @@
  * run before that must fail cleanly or give the reference answer.  Leaks
  * on the error paths are caught by LeakSanitizer in the sanitizer build.
  * Allocations made inside the C library itself (thread stacks, stdio) are
- * not wrapped.
+ * not wrapped.  pthread_create is wrapped too, so that threads that cannot
+ * start are also tested: they may cost speed, never part of an answer.
  */
 #include "brute.h"
 #include "check.h"
 #include "gen.h"
 
+#include <errno.h>
 #include <math.h>
+#include <pthread.h>
 #include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -55,6 +58,16 @@ static int allow(void) {
 void *__wrap_malloc(size_t n) { return allow() ? __real_malloc(n) : NULL; }
 void *__wrap_calloc(size_t n, size_t size) { return allow() ? __real_calloc(n, size) : NULL; }
 void *__wrap_realloc(void *p, size_t n) { return allow() ? __real_realloc(p, n) : NULL; }
+
+/* Threads too: while no_threads is set, no thread can be started. */
+int __real_pthread_create(pthread_t *t, const pthread_attr_t *attr, void *(*fn)(void *), void *arg);
+static atomic_int no_threads, refused;
+
+int __wrap_pthread_create(pthread_t *t, const pthread_attr_t *attr, void *(*fn)(void *), void *arg) {
+    if (!atomic_load(&no_threads)) return __real_pthread_create(t, attr, fn, arg);
+    atomic_fetch_add(&refused, 1);
+    return EAGAIN;
+}
 
 static void arm(long k) {
     atomic_store(&reached, 0);
@@ -359,6 +372,41 @@ TEST(every_allocation_of_a_percentile_hausdorff_can_fail_cleanly) {
     op_t op = {"hd_hausdorff_percentile 95, seed=21400 threads=2", run_percentile, check_percentile, &c};
     exhaust(&op);
     pair_free(&p);
+}
+
+TEST(threads_that_cannot_start_cost_speed_not_answers) {
+    /* At 2 threads with pthread_create failing, the caller's thread does
+     * every task: each plan of the engine, per-point distances and the index
+     * give the reference answers. */
+    for (int plan = 0; plan < 3 && !hdt_failed(); plan++) {
+        uint64_t seed = 21500 + (uint64_t)plan;
+        CONTEXT("seed=%llu plan=%d, no thread can start", (unsigned long long)seed, plan);
+        pair_ctx c;
+        size_t n = 70000;
+        pair_init(&c, n, n, 2);
+        gen_rng_t g;
+        gen_seed(&g, seed);
+        if (plan == 0) {
+            gaussians(&c, seed);
+        } else {
+            gen_copy(&g, GEN_COPY_NOISE, c.a, c.b, n);
+            for (size_t k = n - 1; plan == 2 && k > 0; k--) gen_swap(c.b, k, gen_u64(&g) % (k + 1));
+        }
+        pair_reference(&c);
+        op_t ops[3] = {{"hd_hausdorff", run_hausdorff, check_hausdorff, &c},
+                       {"hd_distances", run_distances, check_distances, &c},
+                       {"hd_index", run_index, check_index, &c}};
+        for (int k = 0; k < 3 && !hdt_failed(); k++) {
+            atomic_store(&refused, 0);
+            atomic_store(&no_threads, 1);
+            int rc = ops[k].run(&ops[k], NULL);
+            atomic_store(&no_threads, 0);
+            CHECK(atomic_load(&refused) > 0); /* it did try to start threads */
+            CHECK_RC(rc, HD_OK);
+            if (rc == HD_OK) ops[k].check(&ops[k]);
+        }
+        pair_free(&c);
+    }
 }
 
 /* ---- readers ------------------------------------------------------------------------ */
