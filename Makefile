@@ -8,7 +8,7 @@ ASAN_BUILD ?= build-asan
 JOBS       ?= 2
 CMAKE_ARGS ?=
 
-.PHONY: all deps configure run test test-release test-asan install bench experiments fuzz python clean
+.PHONY: all deps configure run test test-release test-asan test-tsan install bench experiments fuzz python clean
 
 all: $(BUILD)/hausdorff
 
@@ -53,6 +53,17 @@ python:
 	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release $(CMAKE_ARGS)
 	cmake --build $(BUILD) -j$(JOBS) --target hausdorff_python
 
+# The threaded tests under ThreadSanitizer (clang's: gcc 12's fails to start
+# on this kernel), in build-tsan/; not part of `make test` (a third build).
+TSAN_BUILD ?= build-tsan
+TSAN_TESTS ?= test_index|test_analysis|test_engine|test_algorithms|test_readers|test_io_mesh|test_oom
+test-tsan:
+	@scripts/deps.sh fuzz
+	CC=clang cmake -S . -B $(TSAN_BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+	  -DCMAKE_C_FLAGS=-fsanitize=thread -DCMAKE_EXE_LINKER_FLAGS=-fsanitize=thread $(CMAKE_ARGS)
+	cmake --build $(TSAN_BUILD) -j$(JOBS)
+	cd $(TSAN_BUILD) && TSAN_OPTIONS=halt_on_error=1 ctest --output-on-failure -j$(JOBS) -R '$(TSAN_TESTS)'
+
 # libFuzzer targets, one per reader (fuzz/run.sh, docs/formats.md), each run
 # FUZZ_SECONDS from its seed corpus tests/corpus/FORMAT/; FUZZ_FORMATS picks
 # some ("ply las").  Exits non-zero on a finding.
@@ -78,7 +89,7 @@ bench:
 	  --plots docs/img --command "make bench$(if $(filter-out --scale,$(BENCH_ARGS)), BENCH_ARGS=\"$(BENCH_ARGS)\")"
 
 clean:
-	rm -rf $(BUILD) $(ASAN_BUILD) build-fuzz
+	rm -rf $(BUILD) $(ASAN_BUILD) $(TSAN_BUILD) build-fuzz
 
 # The paper's experiments (Zhang et al., Section 6) rerun with this library's
 # algorithms: writes docs/paper-reproduction.md and docs/img/paper-*.png (not

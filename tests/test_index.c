@@ -10,6 +10,7 @@
 #include "gen.h"
 
 #include <math.h>
+#include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -357,4 +358,84 @@ TEST(nearest_accepts_either_output_alone) {
     CHECK_EQ(near[0], 1); /* B[1] and B[2] tie: the smaller index */
     CHECK_EQ(near[1], 0);
     hd_index_free(idx);
+}
+
+/* One user thread's queries against the shared index: its own set, moved
+ * by its own transform, answered with 2 threads of the library's own. */
+typedef struct {
+    const hd_index_t *idx;
+    double *a;
+    size_t na;
+    hd_transform_t T;
+    int rc[2];
+    hd_result_t r;
+    double *dist;
+    size_t *near;
+} user_t;
+
+static void *user_queries(void *arg) {
+    user_t *u = arg;
+    hd_options_t o;
+    hd_options_init(&o);
+    o.threads = 2;
+    hd_points_t A = hd_points_f64(u->a, u->na);
+    for (int round = 0; round < 3; round++) {
+        u->rc[0] = hd_index_directed(u->idx, &A, &u->T, &o, &u->r, NULL);
+        u->rc[1] = hd_index_nearest(u->idx, &A, &u->T, &o, u->dist, u->near, NULL);
+        if (u->rc[0] || u->rc[1]) break;
+    }
+    return NULL;
+}
+
+TEST(one_index_answers_many_user_threads_at_once) {
+    /* The header's promise: a built index is immutable, and any number of
+     * threads may query it at once. */
+    enum { USERS = 4 };
+    gen_rng_t g;
+    gen_seed(&g, 900);
+    CONTEXT("seed=900 users=%d", USERS);
+    size_t nb = 20000;
+    double *b = malloc(24 * nb);
+    double m[3] = {0, 0, 0};
+    gen_gauss(&g, b, nb, m, 1.0);
+    hd_points_t B = hd_points_f64(b, nb);
+    hd_index_t *idx = NULL;
+    CHECK_RC(hd_index_build(&B, NULL, &idx, NULL), HD_OK);
+    user_t u[USERS];
+    pthread_t t[USERS];
+    int started[USERS] = {0};
+    for (int k = 0; k < USERS; k++) {
+        u[k] = (user_t){.idx = idx, .na = 3000 + 500 * (size_t)k};
+        u[k].a = malloc(24 * u[k].na);
+        u[k].dist = malloc(8 * u[k].na);
+        u[k].near = malloc(sizeof(size_t) * u[k].na);
+        m[0] = 0.2 * k;
+        gen_gauss(&g, u[k].a, u[k].na, m, 1.0);
+        random_transform(&g, &u[k].T, 0.3);
+    }
+    for (int k = 0; k < USERS && idx; k++) started[k] = pthread_create(&t[k], NULL, user_queries, &u[k]) == 0;
+    for (int k = 0; k < USERS; k++)
+        if (started[k]) pthread_join(t[k], NULL);
+    for (int k = 0; k < USERS && idx && !hdt_failed(); k++) {
+        CONTEXT("seed=900 user %d", k);
+        CHECK(started[k]);
+        CHECK_RC(u[k].rc[0], HD_OK);
+        CHECK_RC(u[k].rc[1], HD_OK);
+        double *ta = malloc(24 * u[k].na);
+        brute_transform(u[k].T.r, u[k].T.t, u[k].a, ta, u[k].na);
+        brute_t want = brute_directed(ta, u[k].na, b, nb);
+        CHECK_BITS(u[k].r.distance2, want.d2);
+        CHECK_EQ(u[k].r.i, want.i);
+        CHECK_EQ(u[k].r.j, want.j);
+        for (size_t q = 0; q < u[k].na && !hdt_failed(); q++) {
+            size_t j;
+            double d2 = brute_nearest(ta + 3 * q, b, nb, &j);
+            CHECK_BITS(u[k].dist[q], sqrt(d2));
+            CHECK_EQ(u[k].near[q], j);
+        }
+        free(ta);
+    }
+    for (int k = 0; k < USERS; k++) free(u[k].a), free(u[k].dist), free(u[k].near);
+    hd_index_free(idx);
+    free(b);
 }
