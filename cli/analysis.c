@@ -373,7 +373,9 @@ int analysis_run(const analysis_args_t *an, const hd_options_t *opt,
                                    &r->n_markers, &r->render_w, &r->render_h, err)))
             return rc;
     }
-    if (an->histogram_png && (rc = render_histogram(an->histogram_png, r, an, an->bins, r->hist_markers, &r->n_hist_markers, err))) return rc;
+    if (an->histogram_png && (rc = render_histogram(an->histogram_png, r, an, an->bins, r->hist_markers,
+                                                    &r->n_hist_markers, err)))
+        return rc;
     return HD_OK;
 }
 
