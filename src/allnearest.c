@@ -430,12 +430,12 @@ int hd__an_build(hd__an_t *s, const hd_points_t *p, const hd_transform_t *T, con
              s->glead && s->first && s->count && c.a && c.b;
     int rc = HD_OK;
     if (ok) {
-        rc = hd__parallel_for(c.parts, (size_t)c.parts, key_task, &c);
-        if (rc == HD_OK) rc = hd__radix_sort(&c.a, &c.b, n, c.parts);
+        hd__parallel_for(c.parts, (size_t)c.parts, key_task, &c);
+        rc = hd__radix_sort(&c.a, &c.b, n, c.parts);
         /* Now c.a holds the sorted keys and c.b is x[]'s memory. */
         uint64_t *t = c.a;
         c.a = c.b, c.b = t;
-        if (rc == HD_OK) rc = hd__parallel_for(threads, (n + 4 + GATHER_TASK - 1) / GATHER_TASK, gather_task, &c);
+        if (rc == HD_OK) hd__parallel_for(threads, (n + 4 + GATHER_TASK - 1) / GATHER_TASK, gather_task, &c);
     }
     if (ok && rc == HD_OK) {
         ok = build_octree(&c, cap) == HD_OK;
@@ -459,7 +459,7 @@ int hd__an_build(hd__an_t *s, const hd_points_t *p, const hd_transform_t *T, con
         shrink((void **)&s->glead, s->ng, sizeof *s->glead);
         shrink((void **)&s->first, s->nn, sizeof *s->first);
         shrink((void **)&s->count, s->nn, sizeof *s->count);
-        rc = hd__parallel_for(threads, (s->nb + BOX_TASK - 1) / BOX_TASK, box_task, &c);
+        hd__parallel_for(threads, (s->nb + BOX_TASK - 1) / BOX_TASK, box_task, &c);
         /* Children come after their parent: boxes bottom-up. */
         for (size_t k = s->nn; k-- > 0;) {
             if (!s->count[k]) continue;
@@ -831,9 +831,10 @@ int hd__an_nearest(const hd__an_t *asking, const hd__an_t *searched, const hd_po
         }
         if (!ok) rc = HD_ENOMEM;
     }
-    if (rc == HD_OK) rc = hd__parallel_for(threads, tasks, query_task, &c);
-    if (rc == HD_OK)
-        rc = hd__parallel_for(threads, (asking->n + SCATTER_TASK - 1) / SCATTER_TASK, scatter_answers, &c);
+    if (rc == HD_OK) {
+        hd__parallel_for(threads, tasks, query_task, &c);
+        hd__parallel_for(threads, (asking->n + SCATTER_TASK - 1) / SCATTER_TASK, scatter_answers, &c);
+    }
     if (paired) *paired = 0;
     for (int w = 0; paired && c.cand && w < threads; w++) *paired += c.cand[w].paired;
     for (int w = 0; c.cand && w < threads; w++) {

@@ -79,11 +79,10 @@ static void nearest_task(void *vctx, size_t task, int worker) {
 }
 
 /* Every point of `asking` against `searched`, answers in file order. */
-static int kd_direction(const hd__kd_t *asking, const hd__kd_t *searched, int threads,
-                        double *dist, size_t *nearest, hd_error_t *err) {
+static void kd_direction(const hd__kd_t *asking, const hd__kd_t *searched, int threads,
+                         double *dist, size_t *nearest) {
     nearest_ctx c = {asking, searched, dist, nearest};
-    int rc = hd__parallel_for(threads, (asking->n + NEAREST_SLICE - 1) / NEAREST_SLICE, nearest_task, &c);
-    return rc == HD_OK ? HD_OK : hd__err(err, rc, "%s", hd_strerror(rc));
+    hd__parallel_for(threads, (asking->n + NEAREST_SLICE - 1) / NEAREST_SLICE, nearest_task, &c);
 }
 
 /* Both directions with the kd-trees (sets beyond HD__AN_MAX_POINTS points). */
@@ -97,11 +96,11 @@ static int kd_distances(const hd_points_t *A, const hd_points_t *B, int threads,
         hd__kd_free(&ta);
         return rc;
     }
-    if (ab) rc = kd_direction(&ta, &tb, threads, dist_ab, nearest_ab, err);
-    if (rc == HD_OK && ba) rc = kd_direction(&tb, &ta, threads, dist_ba, nearest_ba, err);
+    if (ab) kd_direction(&ta, &tb, threads, dist_ab, nearest_ab);
+    if (ba) kd_direction(&tb, &ta, threads, dist_ba, nearest_ba);
     hd__kd_free(&ta);
     hd__kd_free(&tb);
-    return rc;
+    return HD_OK;
 }
 
 typedef struct {
@@ -145,7 +144,7 @@ int hd_distances(const hd_points_t *A, const hd_points_t *B,
      * serial (the octree), so two builds on half the threads each finish
      * sooner than one after the other on all of them. */
     build_ctx c = {{A, B}, &keybox, threads < 2 ? 1 : threads / 2, {HD_OK, HD_OK}, {{0}, {0}}, {{0}, {0}}};
-    rc = hd__parallel_for(threads < 2 ? 1 : 2, 2, build_task, &c);
+    hd__parallel_for(threads < 2 ? 1 : 2, 2, build_task, &c);
     for (int k = 0; k < 2 && rc == HD_OK; k++)
         if (c.rc[k]) {
             rc = c.rc[k];

@@ -237,7 +237,7 @@ int hd__eb_loop(const hd__job_t *job, const size_t *order, size_t n_order,
     if (rc == HD_OK) {
         c.table = table.slot ? &table : NULL;
         hd__bound_init(&c.cmax, 0.0); /* line 1: cmax <- 0 */
-        rc = hd__parallel_for(job->threads, tasks, eb_task, &c);
+        hd__parallel_for(job->threads, tasks, eb_task, &c);
     }
     if (rc == HD_OK) {
         hd__best_merge(best, c.part, tasks);

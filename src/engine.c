@@ -438,7 +438,7 @@ static int tree_directed(const hd__tree_t *ta, const hd__tree_t *tb, hd__max_t *
     c.w = hd__calloc_array((size_t)threads, sizeof *c.w);
     if (!c.w) return hd__err(err, HD_ENOMEM, "out of memory");
     prime(&c);
-    int rc = hd__parallel_for(threads, tasks, walk_task, &c);
+    hd__parallel_for(threads, tasks, walk_task, &c);
     for (int k = 0; k < threads; k++) {
         counts->evals += c.w[k].counts.evals;
         counts->exact += c.w[k].counts.exact;
@@ -446,7 +446,6 @@ static int tree_directed(const hd__tree_t *ta, const hd__tree_t *tb, hd__max_t *
         *culled += c.w[k].culled;
     }
     free(c.w);
-    if (rc != HD_OK) return hd__err(err, rc, "%s", hd_strerror(rc));
     return HD_OK;
 }
 

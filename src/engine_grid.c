@@ -623,7 +623,7 @@ int hd__grid_directed(const hd__grid_t *ga, const hd__grid_t *gb, hd__max_t *m, 
         free(c.culled);
         return hd__err(err, HD_ENOMEM, "out of memory");
     }
-    int rc = hd__parallel_for(threads, tasks, pass_task, &c);
+    hd__parallel_for(threads, tasks, pass_task, &c);
     for (int k = 0; k < threads; k++) {
         counts->evals += c.counts[k].evals;
         counts->exact += c.counts[k].exact;
@@ -632,7 +632,6 @@ int hd__grid_directed(const hd__grid_t *ga, const hd__grid_t *gb, hd__max_t *m, 
     }
     free(c.counts);
     free(c.culled);
-    if (rc != HD_OK) return hd__err(err, rc, "%s", hd_strerror(rc));
     return HD_OK;
 }
 

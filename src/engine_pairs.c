@@ -187,12 +187,7 @@ int hd__pairs_begin(hd__pairs_t *P, const hd__src_t src[2], size_t n, int thread
         free(all);
         return hd__err(err, HD_ENOMEM, "out of memory");
     }
-    int rc = hd__parallel_for(threads, tasks, pass_task, &c);
-    if (rc != HD_OK) {
-        free(c.heap);
-        free(all);
-        return hd__err(err, rc, "%s", hd_strerror(rc));
-    }
+    hd__parallel_for(threads, tasks, pass_task, &c);
     counts->evals += n;
     size_t m = 0;
     for (int w = 0; w < threads; w++) {

@@ -238,27 +238,25 @@ static int nearest_by_tree(const hd_index_t *idx, query_ctx *c, int threads, dou
     c->counts = hd__calloc_array((size_t)threads, sizeof *c->counts);
     if (!c->counts) return hd__err(err, HD_ENOMEM, "out of memory");
     size_t slices = (c->n + SLICE - 1) / SLICE;
-    int rc = HD_OK;
     if (c->n > 1 && c->n <= UINT32_MAX) {
         /* Without memory for the order, the file order is still exact. */
         uint64_t *tmp = hd__malloc_array(c->n, sizeof *tmp);
         c->order = tmp ? hd__malloc_array(c->n, sizeof *c->order) : NULL;
         if (c->order) {
             hd__keygrid_init(&c->grid, &idx->tree.box);
-            rc = hd__parallel_for(threads, slices, key_task, c);
-            if (rc == HD_OK && hd__radix_sort(&c->order, &tmp, c->n, threads) != HD_OK) {
+            hd__parallel_for(threads, slices, key_task, c);
+            if (hd__radix_sort(&c->order, &tmp, c->n, threads) != HD_OK) {
                 free(c->order);
                 c->order = NULL;
             }
         }
         free(tmp);
     }
-    if (rc == HD_OK) rc = hd__parallel_for(threads, slices, nearest_task, c);
+    hd__parallel_for(threads, slices, nearest_task, c);
     free(c->order);
     free(c->counts);
     c->order = NULL;
     c->counts = NULL;
-    if (rc != HD_OK) return hd__err(err, rc, "%s", hd_strerror(rc));
     return HD_OK;
 }
 

@@ -249,11 +249,11 @@ int hd__thread_count(int requested, size_t work_items);
 
 /* Run fn(ctx, task, worker) for task in [0, n_tasks) on `threads` threads
  * (the caller's thread is worker 0).  Tasks are handed out in increasing
- * order through an atomic counter.  Every task has run when it returns,
- * even when threads or their handles cannot be had (then on fewer
- * threads): it returns HD_OK. */
+ * order through an atomic counter.  It cannot fail: every task has run when
+ * it returns, even when threads or their handles cannot be had (then on
+ * fewer threads). */
 typedef void (*hd__task_fn)(void *ctx, size_t task, int worker);
-int hd__parallel_for(int threads, size_t n_tasks, hd__task_fn fn, void *ctx);
+void hd__parallel_for(int threads, size_t n_tasks, hd__task_fn fn, void *ctx);
 
 /* ---- clocks ------------------------------------------------------------ */
 double hd__now(void); /* seconds, monotonic */

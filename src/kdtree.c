@@ -230,12 +230,8 @@ int hd__kd_build(hd__kd_t *kd, const hd_points_t *p, int threads, hd_error_t *er
         return hd__err(err, HD_ENOMEM, "cannot allocate a kd-tree of %zu points", n);
     }
     build_top(&c, 0, 0, n, limit);
-    int rc = hd__parallel_for(threads, c.n_tasks, build_task, &c);
+    hd__parallel_for(threads, c.n_tasks, build_task, &c);
     free(c.tasks);
-    if (rc != HD_OK) {
-        hd__kd_free(kd);
-        return hd__err(err, rc, "%s", hd_strerror(rc));
-    }
     return HD_OK;
 }
 
@@ -330,8 +326,7 @@ int hd__kdtree(const hd__job_t *job, hd_result_t *out, hd_error_t *err) {
     if (!c.part || !c.count) {
         rc = hd__err(err, HD_ENOMEM, "out of memory");
     } else {
-        rc = hd__parallel_for(job->threads, tasks, kdalg_task, &c);
-        if (rc != HD_OK) hd__err(err, rc, "%s", hd_strerror(rc));
+        hd__parallel_for(job->threads, tasks, kdalg_task, &c);
     }
     if (rc == HD_OK) {
         hd__best_t best;

@@ -241,7 +241,7 @@ int hd__nohd(const hd__job_t *job, hd_result_t *out, hd_error_t *err) {
     }
     if (rc == HD_OK) {
         hd__bound_init(&c.maxlb, 0.0); /* line 4 */
-        rc = hd__parallel_for(threads, c.n_tasks, nohd_task, &c);
+        hd__parallel_for(threads, c.n_tasks, nohd_task, &c);
     }
     if (rc == HD_OK) {
         hd__best_t best;

@@ -213,7 +213,7 @@ int hd__ohd(const hd__job_t *job, hd_result_t *out, hd_error_t *err) {
     }
     if (rc == HD_OK) {
         hd__bound_init(&c.maxlb, c.ahd.d2); /* line 3: Maxlb <- AHD */
-        rc = hd__parallel_for(threads, tasks, ohd_task, &c);
+        hd__parallel_for(threads, tasks, ohd_task, &c);
     }
     if (rc == HD_OK) {
         hd__best_t best = c.ahd;

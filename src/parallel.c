@@ -60,7 +60,7 @@ static void *worker_main(void *arg) {
     return NULL;
 }
 
-int hd__parallel_for(int threads, size_t n_tasks, hd__task_fn fn, void *ctx) {
+void hd__parallel_for(int threads, size_t n_tasks, hd__task_fn fn, void *ctx) {
     hd__pool_t pool;
     pool.fn = fn;
     pool.ctx = ctx;
@@ -70,7 +70,7 @@ int hd__parallel_for(int threads, size_t n_tasks, hd__task_fn fn, void *ctx) {
     if ((size_t)threads > n_tasks) threads = n_tasks ? (int)n_tasks : 1;
     if (threads == 1) {
         run_tasks(&pool, 0);
-        return HD_OK;
+        return;
     }
     pthread_t *tid = hd__malloc_array((size_t)threads, sizeof *tid);
     hd__worker_t *w = hd__malloc_array((size_t)threads, sizeof *w);
@@ -81,16 +81,13 @@ int hd__parallel_for(int threads, size_t n_tasks, hd__task_fn fn, void *ctx) {
         free(tid);
         free(w);
         run_tasks(&pool, 0);
-        return HD_OK;
+        return;
     }
-    int started = 0, rc = HD_OK;
+    int started = 0;
     for (int k = 1; k < threads; k++) {
         w[k].pool = &pool;
         w[k].worker = k;
-        if (pthread_create(&tid[k], NULL, worker_main, &w[k]) != 0) {
-            rc = HD_ETHREAD;
-            break;
-        }
+        if (pthread_create(&tid[k], NULL, worker_main, &w[k]) != 0) break;
         started = k;
     }
     /* Worker 0 is this thread.  If a thread failed to start, the ones that
@@ -100,8 +97,6 @@ int hd__parallel_for(int threads, size_t n_tasks, hd__task_fn fn, void *ctx) {
     for (int k = 1; k <= started; k++) pthread_join(tid[k], NULL);
     free(tid);
     free(w);
-    (void)rc;
-    return HD_OK;
 }
 
 double hd__now(void) {

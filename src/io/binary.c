@@ -107,7 +107,7 @@ int hd__binary_read(hd__read_t *r, const unsigned char *base, const hd__layout_t
     size_t blocks = (L->n + BLOCK - 1) / BLOCK;
     job_t j = {r, base, L, hd__malloc_array(blocks, sizeof(size_t))};
     if (!j.bad) return hd__io_err(r, HD_ENOMEM, "out of memory");
-    rc = hd__parallel_for(hd__thread_count(r->threads, blocks), blocks, convert, &j);
+    hd__parallel_for(hd__thread_count(r->threads, blocks), blocks, convert, &j);
     for (size_t b = 0; rc == HD_OK && b < blocks; b++) {
         if (j.bad[b] == SIZE_MAX) continue;
         size_t k = j.bad[b];

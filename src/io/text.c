@@ -206,10 +206,11 @@ int hd__text_parallel(hd__read_t *r, const char *begin, const char *end,
     hd__sink_t *s = r->sink;
     size_t el = s->dtype == HD_FLOAT32 ? 3 * sizeof(float) : 3 * sizeof(double);
     /* 1: how many points each chunk may hold; room for all of them at once */
-    int rc = hd__parallel_for(r->threads, used, count_chunk, &run);
+    hd__parallel_for(r->threads, used, count_chunk, &run);
     size_t total = 0;
     for (size_t k = 0; k < used; k++) total += chunks[k].room;
-    if (rc == HD_OK && (rc = hd__sink_reserve(s, total)))
+    int rc = hd__sink_reserve(s, total);
+    if (rc)
         hd__io_err(r, rc, "cannot allocate %zu points", total);
     /* 2: every chunk parses into its window of the array */
     size_t at = s->count;
@@ -222,8 +223,7 @@ int hd__text_parallel(hd__read_t *r, const char *begin, const char *end,
         c->pts.fixed = 1;
         at += c->room;
     }
-    if (rc == HD_OK && (rc = hd__parallel_for(r->threads, used, parse_chunk, &run)))
-        hd__io_err(r, rc, "could not parse in parallel: %s", hd_strerror(rc));
+    if (rc == HD_OK) hd__parallel_for(r->threads, used, parse_chunk, &run);
     /* 3: in file order, the first problem or the windows closed up */
     long long line = first_line;
     uint64_t aux = 0;
