@@ -847,7 +847,6 @@ int hd__an_nearest(const hd__an_t *asking, const hd__an_t *searched, const hd_po
     free(c.cand);
     free(c.sd);
     free(c.sj);
-    if (rc == HD_ENOMEM) return hd__err(err, rc, "cannot allocate the candidate lists");
-    if (rc != HD_OK) return hd__err(err, rc, "%s", hd_strerror(rc));
+    if (rc != HD_OK) return hd__err(err, rc, "cannot allocate the candidate lists");
     return HD_OK;
 }

@@ -66,7 +66,7 @@ size_t hd__an_memory(const hd__an_t *s);
  * tried first as the answer of asking's point i (a copy and its original
  * in the same order settle fast); the answers do not depend on it, and
  * *paired (if not NULL) counts the groups of queries it settled.
- * Returns HD_OK, HD_ENOMEM or HD_ETHREAD. */
+ * Returns HD_OK or HD_ENOMEM (with err filled). */
 int hd__an_nearest(const hd__an_t *asking, const hd__an_t *searched, const hd_points_t *partner,
                    int threads, double *dist, size_t *nearest, size_t *paired, hd_error_t *err);
 
