@@ -22,20 +22,38 @@
  */
 #include "io.h"
 
+#include <assert.h>
 #include <stdlib.h>
 
 #define REL ((uint64_t)1 << 63)
 #define REL_MASK (((uint64_t)1 << 62) - 1)
-#define BAD UINT64_MAX
+/* An index no file can reach: a stored reference at or above it is out of
+ * range whatever the vertex count.  Relative references are clamped to
+ * -FAR, so "chunk-local count + offset" always lies in (-2^61, 2^61), the
+ * range the 62-bit field below represents exactly (a chunk holds fewer than
+ * 2^60 vertices, each needing 8 bytes of text). */
+#define FAR ((int64_t)1 << 60)
+#define BAD ((uint64_t)FAR << 2) /* absolute, never < a vertex count */
 
 /* Parse the vertex part of a face reference "v[/vt[/vn]]" in [tb, te):
- * 1 with *abs (0-based) or *rel (negative offset), 0 when malformed. */
+ * 1 with *value (1-based, or negative: counting back), 0 when malformed.
+ * Magnitudes beyond FAR are clamped to FAR: they are out of range in any
+ * file, and the clamp keeps the arithmetic below from wrapping into range
+ * (a reference of -(2^62 - 1) once landed on a real vertex). */
 static int face_ref(const char *tb, const char *te, int64_t *value) {
     const char *slash = memchr(tb, '/', (size_t)(te - tb));
     if (slash) te = slash;
     int neg = tb < te && *tb == '-';
     uint64_t v;
-    if (!hd__parse_u64(tb + neg, te, &v) || v == 0 || v > REL_MASK) return 0;
+    if (!hd__parse_u64(tb + neg, te, &v)) {
+        /* all digits but beyond uint64_t: out of range, not malformed */
+        const char *d = tb + neg;
+        while (d < te && *d >= '0' && *d <= '9') d++;
+        if (d != te || te == tb + neg) return 0;
+        v = (uint64_t)FAR;
+    }
+    if (v == 0) return 0;
+    if (v > (uint64_t)FAR) v = (uint64_t)FAR;
     *value = neg ? -(int64_t)v : (int64_t)v;
     return 1;
 }
@@ -77,7 +95,10 @@ static void chunk(void *ctx, hd__chunk_t *c) {
                     ix = nx;
                     cap *= 2;
                 }
-                ix[n++] = v > 0 ? (uint64_t)(v - 1) : REL | ((uint64_t)((int64_t)c->pts.count + v) & REL_MASK);
+                assert(c->pts.count < (size_t)FAR);
+                ix[n++] = v >= FAR ? BAD
+                          : v > 0  ? (uint64_t)(v - 1)
+                                   : REL | ((uint64_t)((int64_t)c->pts.count + v) & REL_MASK);
             }
             int rc = n >= 3 ? hd__tris_add(&c->tris, ix, n) : HD_OK;
             if (ix != idx) free(ix);
@@ -107,6 +128,7 @@ static void fix_chunk(void *ctx, hd__chunk_t *c, size_t before) {
         uint64_t v = c->tris.v[k];
         if (!(v & REL)) continue;
         int64_t local = (int64_t)((v & REL_MASK) << 2) >> 2; /* sign-extend 62 bits */
+        assert(local > -2 * FAR && local < 2 * FAR);
         int64_t abs_ = (int64_t)before + local;
         c->tris.v[k] = abs_ < 0 ? BAD : (uint64_t)abs_;
     }
@@ -128,10 +150,12 @@ static int report_bad_reference(hd__read_t *r, size_t nv) {
         while (hd__token(&q, eol, &tb, &te)) {
             int64_t v;
             if (*tb == '\\' || *tb == '#' || !face_ref(tb, te, &v)) break;
+            const char *slash = memchr(tb, '/', (size_t)(te - tb));
+            if (slash) te = slash;
             int64_t abs_ = v > 0 ? v - 1 : (int64_t)seen + v;
             if (abs_ < 0 || (uint64_t)abs_ >= nv)
-                return hd__io_err_line(r, HD_EFORMAT, line, "face refers to vertex %lld, but the file has %zu vertices",
-                                       (long long)v, nv);
+                return hd__io_err_line(r, HD_EFORMAT, line, "face refers to vertex %.*s, but the file has %zu vertices",
+                                       (int)(te - tb > 40 ? 40 : te - tb), tb, nv);
         }
     }
     return hd__io_err(r, HD_EFORMAT, "a face refers to a vertex that does not exist");

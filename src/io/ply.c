@@ -81,6 +81,26 @@ static hd__type_t type_of(const char *s, size_t n) {
     return HD__T_NONE;
 }
 
+/* The largest value an integer type can hold (0 for the float types, which
+ * can be neither a list count nor a vertex index). */
+static uint64_t int_max(hd__type_t t) {
+    switch (t) {
+    case HD__T_I8: return INT8_MAX;
+    case HD__T_U8: return UINT8_MAX;
+    case HD__T_I16: return INT16_MAX;
+    case HD__T_U16: return UINT16_MAX;
+    case HD__T_I32: return INT32_MAX;
+    case HD__T_U32: return UINT32_MAX;
+    default: return 0;
+    }
+}
+
+static const char *type_name(hd__type_t t) {
+    static const char *const names[] = {"none", "char", "uchar", "short", "ushort", "int", "uint",
+                                        "int64", "uint64", "float", "double"};
+    return names[t];
+}
+
 static int prop_index(const elem_t *e, const char *name) {
     for (int k = 0; k < e->n_props; k++)
         if (is(e->props[k].name, e->props[k].len, name)) return k;
@@ -348,9 +368,23 @@ static void vertex_chunk(void *ctx, hd__chunk_t *c) {
                                (int)(te - tb > 40 ? 40 : te - tb), tb);
                 return;
             }
+            /* The count must fit its declared type, and every item needs a
+             * token of at least one byte and a separator: both are checked
+             * before anything is allocated or stored. */
+            if (cnt > int_max(pr->count_type)) {
+                hd__chunk_fail(c, HD_EFORMAT, line, "list %.*s: length %llu does not fit its count type %s",
+                               (int)pr->len, pr->name, (unsigned long long)cnt, type_name(pr->count_type));
+                return;
+            }
+            if (cnt > (uint64_t)(eol - q + 1) / 2) {
+                hd__chunk_fail(c, HD_EFORMAT, line, "list %.*s: %llu values declared, but the line holds at most %llu",
+                               (int)pr->len, pr->name, (unsigned long long)cnt,
+                               (unsigned long long)((eol - q + 1) / 2));
+                return;
+            }
             int keep = j == a->face;
             uint64_t *ix = idx;
-            if (keep && cnt > 64 && !(ix = hd__malloc_array((size_t)(cnt < SIZE_MAX ? cnt : 0), sizeof *ix))) {
+            if (keep && cnt > 64 && !(ix = hd__malloc_array((size_t)cnt, sizeof *ix))) {
                 hd__chunk_fail(c, HD_ENOMEM, line, "out of memory for a face of %llu vertices", (unsigned long long)cnt);
                 return;
             }
@@ -364,6 +398,12 @@ static void vertex_chunk(void *ctx, hd__chunk_t *c) {
                 if (keep && !hd__parse_u64(tb, te, &ix[k])) {
                     hd__chunk_fail(c, HD_EFORMAT, line, "face vertex index '%.*s' is not a whole number",
                                    (int)(te - tb > 40 ? 40 : te - tb), tb);
+                    if (ix != idx) free(ix);
+                    return;
+                }
+                if (keep && ix[k] > int_max(pr->type)) {
+                    hd__chunk_fail(c, HD_EFORMAT, line, "face vertex index %llu does not fit its type %s",
+                                   (unsigned long long)ix[k], type_name(pr->type));
                     if (ix != idx) free(ix);
                     return;
                 }
@@ -473,8 +513,22 @@ int hd__read_ply(hd__read_t *r) {
     if (rc == HD_OK && r->tris && face < 0)
         rc = hd__io_err(r, HD_EFORMAT, "has no faces to sample from (no element 'face' with a "
                                        "'vertex_indices' list)");
+    if (rc == HD_OK && r->tris && int_max(p->el[face_el].props[face].type) == 0)
+        rc = hd__io_err_line(r, HD_EFORMAT, p->el[face_el].line, "face vertex indices are of type %s, not integers",
+                             type_name(p->el[face_el].props[face].type));
     if (rc == HD_OK)
         rc = p->format ? read_binary(p, v, xyz, face_el, face) : read_ascii(p, v, xyz, face_el, face);
+    /* Faces declared before the vertices could not be checked while they
+     * were read (the vertex count was not known yet): check them now,
+     * before anything uses them. */
+    if (rc == HD_OK && r->tris && face_el < v)
+        for (size_t k = 0; k < 3 * r->tris->count; k++)
+            if (r->tris->v[k] >= r->sink->count) {
+                rc = hd__io_err_line(r, HD_EFORMAT, p->el[face_el].line,
+                                     "element face refers to vertex %llu, but the file has %zu vertices",
+                                     (unsigned long long)r->tris->v[k], r->sink->count);
+                break;
+            }
     free(p);
     return rc;
 }

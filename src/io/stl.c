@@ -13,9 +13,14 @@
  * wuson_stl.ply was made).  With --sample, triangle t is corners 3t..3t+2.
  *
  * Which variant: a file whose size is exactly 84 + 50 * count is binary
- * (even when its header starts with "solid", as many exporters write);
- * otherwise a file starting with "solid" is ascii, and anything else is
- * binary whose size must hold the declared triangles.  Binary corners are
+ * (even when its header starts with "solid", as many exporters write).
+ * Otherwise a file starting with "solid" is ascii when its first 4 KiB name
+ * a "facet" or "endsolid" (every ascii STL with content does), and anything
+ * else is binary: a binary header that starts with "solid" is never taken
+ * for an empty ascii file.  A binary file must hold exactly its declared
+ * triangles: fewer bytes is a truncation, more is data the count does not
+ * cover (a wrong count, or two files joined), and both are errors naming
+ * the numbers, never a silent partial read.  Binary corners are
  * converted in parallel from the mapping; ascii lines in parallel chunks,
  * every "vertex" line giving a point, and the total must be three per
  * facet.
@@ -89,6 +94,15 @@ static int add_triangles(hd__read_t *r, size_t n_tri) {
     return HD_OK;
 }
 
+/* Whether the first 4 KiB hold "facet" or "endsolid": an ascii STL with
+ * content, not a binary header that happens to start with "solid". */
+static int text_keyword(const unsigned char *d, size_t size) {
+    size_t n = size < 4096 ? size : 4096;
+    for (size_t j = 0; j + 5 <= n; j++)
+        if (memcmp(d + j, "facet", 5) == 0 || (j + 8 <= n && memcmp(d + j, "endsolid", 8) == 0)) return 1;
+    return 0;
+}
+
 int hd__read_stl(hd__read_t *r) {
     const unsigned char *d = r->f->data;
     size_t size = r->f->size, k = 0;
@@ -96,6 +110,7 @@ int hd__read_stl(hd__read_t *r) {
     int solid = size - k >= 5 && memcmp(d + k, "solid", 5) == 0;
     uint64_t n = size >= 84 ? hd__ld_u32(d + 80, 0) : 0;
     int exact = size >= 84 && 84 + 50 * n == size;
+    if (solid && !exact && size >= 84 && !text_keyword(d, size)) solid = 0;
     if (solid && !exact) {
         const char *s = (const char *)d;
         uint64_t facets = 0;
@@ -112,6 +127,12 @@ int hd__read_stl(hd__read_t *r) {
     if (n > (size - 84) / 50)
         return hd__io_err_at(r, HD_EFORMAT, 80, "binary STL declares %llu triangles (%llu bytes), but the file has %zu bytes",
                              (unsigned long long)n, (unsigned long long)(84 + 50 * n), size);
+    if (84 + 50 * n != size)
+        return hd__io_err_at(r, HD_EFORMAT, (long long)(84 + 50 * n),
+                             "binary STL declares %llu triangles (%llu bytes), but the file has %zu bytes: "
+                             "%llu bytes after the last triangle",
+                             (unsigned long long)n, (unsigned long long)(84 + 50 * n), size,
+                             (unsigned long long)(size - 84 - 50 * n));
     hd__layout_t L = {3 * (size_t)n, 3, 50, 12, {0, 4, 8}, {HD__T_F32, HD__T_F32, HD__T_F32}, 0, NULL, NULL, 96};
     int rc = hd__binary_read(r, d + 96, &L);
     if (rc) return rc;

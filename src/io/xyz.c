@@ -2,8 +2,21 @@
  * xyz.c -- plain text point lists: XYZ, TXT, CSV, PTS, ASC.
  *
  * One point per line: the first three numbers are x, y, z; further columns
- * (intensity, colour, normals) are ignored.  Numbers are separated by
- * blanks, commas or semicolons.  Blank lines and lines starting with '#' or
+ * (intensity, colour, normals) are ignored.  Which characters separate the
+ * numbers is decided once per file, from its first data line (the first
+ * line whose first field can start a number, the same test as the
+ * candidate count below):
+ *  - it holds a ';': the file is in the dialect European spreadsheets
+ *    write, fields separated by ';' (and blanks), and a comma inside a
+ *    field is its decimal separator ("4,25;5,5;6,75" is 4.25 5.5 6.75);
+ *  - otherwise fields are separated by blanks and commas, and a ';' on a
+ *    later line is an error naming that line (the file mixes dialects, and
+ *    any reading of it could be the wrong one).
+ * Reading "1,5;2,5;3,5" as blank/comma/semicolon-separated once gave the
+ * silent wrong answer (1, 5, 2).  A comma-separated file whose numbers use
+ * decimal commas ("1,5,2,5,3,5") cannot be told from six columns and is
+ * read as six columns; docs/formats.md says so.
+ * Blank lines and lines starting with '#' or
  * '//' are skipped.  The first line may be a header: if it does not start
  * with a number (a CSV header such as "x,y,z,intensity") it is skipped, and
  * so is a first line holding a single whole number (the point count of the
@@ -20,32 +33,67 @@
 
 #include <math.h>
 
-static int is_sep(int c) { return c == ' ' || c == ',' || c == '\t' || c == ';' || c == '\r' || c == '\f' || c == '\v'; }
+typedef struct {
+    int semicolon;       /* fields separated by ';', decimal commas */
+    long long data_line; /* the line that decided (for messages) */
+} dialect_t;
+
+static int is_blank_sep(int c) { return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v'; }
+
+/* Any character that may separate fields in either dialect: what the
+ * candidate count and the dialect check skip. */
+static int is_sep(int c) { return is_blank_sep(c) || c == ',' || c == ';'; }
+
+static int is_field_sep(const dialect_t *d, int c) { return is_blank_sep(c) || c == (d->semicolon ? ';' : ','); }
+
+/* A field with a decimal comma, [t, e), as a double: 1 and *v, or 0.  The
+ * comma is replaced by a point in a copy; a field holding a point too, or
+ * two commas, is not a number. */
+static int parse_decimal_comma(const char *t, const char *e, double *v) {
+    char buf[128];
+    size_t n = (size_t)(e - t);
+    if (n >= sizeof buf || memchr(t, '.', n)) return 0;
+    memcpy(buf, t, n);
+    char *comma = memchr(buf, ',', n);
+    if (!comma || memchr(comma + 1, ',', n - (size_t)(comma - buf) - 1)) return 0;
+    *comma = '.';
+    return hd__parse_double(buf, buf + n, v);
+}
 
 static void chunk(void *ctx, hd__chunk_t *c) {
-    (void)ctx;
+    const dialect_t *d = ctx;
     const char *p = c->begin, *end = c->end;
     long long line = 0;
     while (p < end) {
         line++;
-        const char *eol = hd__eol(p, end), *q = p;
+        const char *eol = hd__eol(p, end), *q = p, *ls = p;
         p = eol + (eol < end);
         while (q < eol && is_sep((unsigned char)*q)) q++;
         if (q == eol || *q == '#' || (*q == '/' && q + 1 < eol && q[1] == '/')) continue;
         int first = c->index == 0 && line == 1;
         double v[3];
         int got = 0;
+        /* lines before the deciding one are a header, whatever they hold */
+        if (!d->semicolon && !(c->index == 0 && line < d->data_line)) {
+            const char *semi = memchr(ls, ';', (size_t)(eol - ls));
+            if (semi) {
+                hd__chunk_fail(c, HD_EFORMAT, line,
+                               "a ';' in a file whose first data line (line %lld) has none: mixed separators",
+                               d->data_line);
+                return;
+            }
+        }
         while (got < 3) {
-            while (q < eol && is_sep((unsigned char)*q)) q++;
+            while (q < eol && is_field_sep(d, (unsigned char)*q)) q++;
             if (q == eol) break;
             const char *t = q, *e = hd__scan_double(q, eol, &v[got]);
-            if (e && (e == eol || is_sep((unsigned char)*e))) {
+            if (e && (e == eol || is_field_sep(d, (unsigned char)*e))) {
                 q = e; /* the fast path read the whole token */
                 got++;
                 continue;
             }
-            while (q < eol && !is_sep((unsigned char)*q)) q++;
-            if (!hd__parse_double(t, q, &v[got])) {
+            while (q < eol && !is_field_sep(d, (unsigned char)*q)) q++;
+            if (!hd__parse_double(t, q, &v[got]) && !(d->semicolon && parse_decimal_comma(t, q, &v[got]))) {
                 if (first && got == 0) break; /* a header line */
                 hd__chunk_fail(c, HD_EFORMAT, line, "'%.*s' is not a number (column %d)",
                                (int)(q - t > 40 ? 40 : q - t), t, got + 1);
@@ -56,7 +104,7 @@ static void chunk(void *ctx, hd__chunk_t *c) {
         if (first && got <= 1) {
             /* a header: words, or the single point count of PTS */
             if (got == 0) continue;
-            while (q < eol && is_sep((unsigned char)*q)) q++;
+            while (q < eol && is_field_sep(d, (unsigned char)*q)) q++;
             double n = v[0];
             if (q == eol && n >= 0 && n < 0x1p64 && n == floor(n)) continue;
         }
@@ -69,24 +117,46 @@ static void chunk(void *ctx, hd__chunk_t *c) {
     c->lines = line;
 }
 
-/* Lines whose first field can start a number (digits, sign, point, or the
- * inf/nan that strtod accepts and the point check then refuses). */
+/* Whether the line [p, eol) may hold a point: its first field can start a
+ * number (digits, sign, point, or the inf/nan that strtod accepts and the
+ * point check then refuses). */
+static int candidate(const char *p, const char *eol) {
+    while (p < eol && is_sep((unsigned char)*p)) p++;
+    unsigned char f = (unsigned char)(p < eol ? *p : 0);
+    return ((unsigned)f - (unsigned)'0' < 10u) || f == '-' || f == '+' || f == '.' || f == 'i' || f == 'I' ||
+           f == 'n' || f == 'N';
+}
+
 static size_t candidates(void *ctx, const char *p, const char *end) {
     (void)ctx;
     size_t n = 0;
     while (p < end) {
-        const char *eol = hd__eol(p, end), *q = p;
-        while (q < eol && is_sep((unsigned char)*q)) q++;
-        unsigned char f = (unsigned char)(q < eol ? *q : 0);
-        n += ((unsigned)f - (unsigned)'0' < 10u) || f == '-' || f == '+' || f == '.' || f == 'i' || f == 'I' || f == 'n' || f == 'N';
+        const char *eol = hd__eol(p, end);
+        n += (size_t)candidate(p, eol);
         p = eol + (eol < end);
     }
     return n;
 }
 
+/* The dialect, from the first candidate line (serial; it stops there). */
+static dialect_t dialect_of(const char *p, const char *end) {
+    dialect_t d = {0, 0};
+    for (long long line = 1; p < end; line++) {
+        const char *eol = hd__eol(p, end);
+        if (candidate(p, eol)) {
+            d.semicolon = memchr(p, ';', (size_t)(eol - p)) != NULL;
+            d.data_line = line;
+            break;
+        }
+        p = eol + (eol < end);
+    }
+    return d;
+}
+
 int hd__read_xyz(hd__read_t *r) {
     const char *s = (const char *)r->f->data;
+    dialect_t d = dialect_of(s, s + r->f->size);
     /* the shortest point line is "0 0 0\n" */
-    hd__text_job_t job = {chunk, NULL, candidates, 6, NULL};
+    hd__text_job_t job = {chunk, NULL, candidates, 6, &d};
     return hd__text_parallel(r, s, s + r->f->size, 1, &job, NULL);
 }

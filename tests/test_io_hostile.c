@@ -1,0 +1,212 @@
+/*
+ * test_io_hostile.c -- files made to break the readers (issue "Hostile
+ * files") are refused with a message that names the file and the place, or
+ * read right; never a crash, a write out of bounds or a silent wrong read.
+ * Each behaviour below once failed: a face list whose length its count
+ * type cannot hold overran a 1-byte buffer; an OBJ relative index wrapped
+ * onto a real vertex; a semicolon CSV with decimal commas gave wrong
+ * points; a binary STL whose header starts with "solid" was taken for an
+ * empty ascii file.  The test runs in the release and the ASan builds.
+ */
+#include "check.h"
+#include "files.h"
+
+#include <stdlib.h>
+
+enum { NONE, LINE, OFFSET };
+
+static hd_read_options_t sampling(size_t n) {
+    hd_read_options_t o;
+    hd_read_options_init(&o);
+    o.mesh = HD_MESH_SAMPLE;
+    o.sample = n;
+    return o;
+}
+
+/* Reading `path` with `opt` fails with `code`; the message starts with the
+ * path, contains `needle`, and names the line or byte `at` as `kind` says. */
+static void refused(const char *path, const hd_read_options_t *opt, int code, const char *needle, int kind,
+                    long long at) {
+    hd_cloud_t *c = NULL;
+    hd_error_t e;
+    CONTEXT("%s", path);
+    CHECK_RC(hd_read_file(path, opt, &c, &e), code);
+    CHECK(c == NULL);
+    if (strncmp(e.message, path, strlen(path)) != 0)
+        hdt_fail(__FILE__, __LINE__, "message '%s' does not start with the file name", e.message);
+    if (!strstr(e.message, needle)) hdt_fail(__FILE__, __LINE__, "message '%s' lacks '%s'", e.message, needle);
+    if (kind == LINE) CHECK_EQ(e.line, at);
+    if (kind == OFFSET) CHECK_EQ(e.offset, at);
+}
+
+/* Reading `path` gives exactly the n points xyz (as doubles). */
+static void reads(const char *path, const hd_read_options_t *opt, const double *xyz, size_t n) {
+    hd_cloud_t *c = NULL;
+    hd_error_t e;
+    CONTEXT("%s", path);
+    int rc = hd_read_file(path, opt, &c, &e);
+    if (rc) hdt_fail(__FILE__, __LINE__, "refused: %s", e.message);
+    CHECK_EQ(c->count, n);
+    hd_points_t p = hd_cloud_points(c);
+    for (size_t k = 0; k < 3 * n && k < 3 * c->count; k++) CHECK_BITS(((const double *)p.data)[k], xyz[k]);
+    hd_cloud_free(c);
+}
+
+/* The issue's file: a face element before the vertices, whose uchar list
+ * length is 2^64 - 1, followed by `items` int-sized tokens that do not fit
+ * an int either. */
+static const char *ply_faces_first(const char *name, const char *count, int items) {
+    tf_buf_t b = {0};
+    tf_puts(&b, "ply\nformat ascii 1.0\nelement face 1\nproperty list uchar int vertex_indices\n"
+                "element vertex 3\nproperty float x\nproperty float y\nproperty float z\nend_header\n");
+    tf_puts(&b, count);
+    for (int k = 0; k < items; k++) tf_puts(&b, " 4702111234474983745");
+    tf_puts(&b, "\n0 0 0\n1 0 0\n0 1 0\n");
+    const char *p = tf_write(name, b.data, b.size);
+    tf_free(&b);
+    return p;
+}
+
+TEST(ply_list_length_beyond_its_count_type_is_refused_before_any_item_is_stored) {
+    hd_read_options_t o = sampling(100);
+    refused(ply_faces_first("overflow.ply", "18446744073709551615", 20000), &o, HD_EFORMAT,
+            "length 18446744073709551615 does not fit its count type uchar", LINE, 10);
+}
+
+TEST(ply_face_lists_are_not_parsed_when_only_vertices_are_read) {
+    /* the faces are skipped line by line: nothing of theirs is stored */
+    const double want[] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    reads(ply_faces_first("overflow2.ply", "18446744073709551615", 200), NULL, want, 3);
+}
+
+TEST(ply_list_length_beyond_the_line_is_refused_before_allocating) {
+    hd_read_options_t o = sampling(10);
+    /* 255 fits a uchar, but the line holds 2 items */
+    refused(ply_faces_first("long.ply", "255", 2), &o, HD_EFORMAT, "255 values declared, but the line holds at most",
+            LINE, 10);
+}
+
+TEST(ply_face_index_beyond_its_item_type_is_refused) {
+    hd_read_options_t o = sampling(10);
+    refused(ply_faces_first("item.ply", "3", 3), &o, HD_EFORMAT, "4702111234474983745 does not fit its type int", LINE,
+            10);
+}
+
+TEST(ply_faces_before_vertices_are_checked_against_the_vertex_count) {
+    const char *head = "ply\nformat ascii 1.0\nelement face 1\nproperty list uchar int vertex_indices\n"
+                       "element vertex 3\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
+    hd_read_options_t o = sampling(10);
+    refused(tf_printf("bad.ply", "%s3 0 1 5\n0 0 0\n1 0 0\n0 1 0\n", head), &o, HD_EFORMAT,
+            "refers to vertex 5, but the file has 3 vertices", LINE, 3);
+    hd_cloud_t *c = NULL;
+    hd_error_t e;
+    CHECK_RC(hd_read_file(tf_printf("good.ply", "%s3 0 1 2\n0 0 0\n1 0 0\n0 1 0\n", head), &o, &c, &e), HD_OK);
+    CHECK_EQ(c->count, 10);
+    hd_cloud_free(c);
+    /* binary, the same order */
+    tf_buf_t b = {0};
+    tf_puts(&b, "ply\nformat binary_little_endian 1.0\nelement face 1\nproperty list uchar uint vertex_indices\n"
+                "element vertex 3\nproperty float x\nproperty float y\nproperty float z\nend_header\n");
+    tf_u8(&b, 3);
+    tf_u32(&b, 0, 0);
+    tf_u32(&b, 1, 0);
+    tf_u32(&b, 4000000000u, 0);
+    for (int k = 0; k < 9; k++) tf_f32(&b, k == 3 || k == 7 ? 1.0f : 0.0f, 0);
+    refused(tf_write("bad.ply", b.data, b.size), &o, HD_EFORMAT, "refers to vertex 4000000000", LINE, 3);
+    tf_free(&b);
+}
+
+TEST(ply_face_indices_of_a_float_type_are_refused) {
+    hd_read_options_t o = sampling(10);
+    refused(tf_printf("float.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                                   "property float z\nelement face 1\nproperty list uchar float vertex_indices\n"
+                                   "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"),
+            &o, HD_EFORMAT, "not integers", LINE, 7);
+}
+
+static const char *five_then_face(const char *name, const char *face, int after) {
+    tf_buf_t b = {0};
+    tf_puts(&b, "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nv 0 0 1\n");
+    tf_putf(&b, "f %s\n", face);
+    for (int k = 0; k < after; k++) tf_putf(&b, "v %d 2 2\n", k);
+    const char *p = tf_write(name, b.data, b.size);
+    tf_free(&b);
+    return p;
+}
+
+TEST(obj_relative_index_far_beyond_the_vertices_does_not_wrap_onto_one) {
+    hd_read_options_t o = sampling(10);
+    /* -(2^62 - 1): with 5 vertices before it, its 62-bit field once
+     * wrapped to 6, a real vertex when more vertices follow */
+    refused(five_then_face("wrap.obj", "1 2 -4611686018427387903", 3), &o, HD_EFORMAT,
+            "face refers to vertex -4611686018427387903, but the file has 8 vertices", LINE, 6);
+    refused(five_then_face("wrap2.obj", "1 2 -4611686018427387903/1/1", 0), &o, HD_EFORMAT, "-4611686018427387903,",
+            LINE, 6);
+    refused(five_then_face("wrap3.obj", "1 2 -9223372036854775808", 3), &o, HD_EFORMAT, "refers to vertex", LINE, 6);
+    refused(five_then_face("wrap4.obj", "1 2 99999999999999999999999", 3), &o, HD_EFORMAT, "refers to vertex", LINE, 6);
+    refused(five_then_face("wrap5.obj", "1 2 -6", 0), &o, HD_EFORMAT, "refers to vertex -6", LINE, 6);
+}
+
+TEST(obj_relative_index_in_range_names_the_right_vertex) {
+    hd_read_options_t o = sampling(4);
+    o.seed = 3;
+    hd_cloud_t *c = NULL, *d = NULL;
+    hd_error_t e;
+    CHECK_RC(hd_read_file(five_then_face("rel.obj", "-5 -4 -3", 2), &o, &c, &e), HD_OK);
+    CHECK_RC(hd_read_file(five_then_face("abs.obj", "1 2 3", 2), &o, &d, &e), HD_OK);
+    CHECK_EQ(c->count, d->count);
+    CHECK(memcmp(c->data, d->data, c->count * 3 * sizeof(double)) == 0);
+    hd_cloud_free(c);
+    hd_cloud_free(d);
+}
+
+TEST(csv_with_semicolons_and_decimal_commas_is_read_right) {
+    const double want[] = {1.5, 2.5, 3.5, 4.25, 5.5, 6.75};
+    reads(tf_printf("eu.csv", "1,5;2,5;3,5\n4,25;5,5;6,75\n"), NULL, want, 2);
+    reads(tf_printf("eu2.csv", "x;y;z\n1,5;2,5;3,5;99\n4,25 ; 5,5 ; 6,75\n"), NULL, want, 2);
+    const double plain[] = {1, 2, 3, 4, 5, 6};
+    reads(tf_printf("semi.csv", "1;2;3\n4;5;6\n"), NULL, plain, 2);
+    reads(tf_printf("comma.csv", "x,y,z\n1,2,3\n4,5,6\n"), NULL, plain, 2);
+}
+
+TEST(csv_whose_separators_cannot_be_told_apart_is_refused_with_its_line) {
+    refused(tf_printf("mixed.csv", "1,2,3\n4;5;6\n"), NULL, HD_EFORMAT, "mixed separators", LINE, 2);
+    refused(tf_printf("two.csv", "1,5;2,5;3,5\n1,2,5;3;4\n"), NULL, HD_EFORMAT, "'1,2,5' is not a number", LINE, 2);
+    refused(tf_printf("both.csv", "1;2;3\n1.5,0;2;3\n"), NULL, HD_EFORMAT, "is not a number", LINE, 2);
+}
+
+static const char *solid_binary_stl(const char *name, int triangles, int extra) {
+    tf_buf_t b = {0};
+    char h[80];
+    memset(h, ' ', sizeof h);
+    memcpy(h, "solid part exported by CAD", 26);
+    h[79] = '\n';
+    tf_put(&b, h, 80);
+    tf_u32(&b, (uint32_t)triangles, 0);
+    for (int t = 0; t < triangles; t++) {
+        for (int k = 0; k < 3; k++) tf_f32(&b, k == 2 ? 1.0f : 0.0f, 0);
+        for (int k = 0; k < 9; k++) tf_f32(&b, (float)(t + (k == 3 || k == 7)), 0);
+        tf_u16(&b, 0, 0);
+    }
+    for (int k = 0; k < extra; k++) tf_u8(&b, '\n');
+    const char *p = tf_write(name, b.data, b.size);
+    tf_free(&b);
+    return p;
+}
+
+TEST(stl_binary_whose_header_starts_with_solid_is_read_as_binary) {
+    const double want[] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 1, 2, 1, 1, 1, 2, 1};
+    reads(solid_binary_stl("solid.stl", 2, 0), NULL, want, 6);
+    hd_read_options_t o = sampling(5);
+    hd_cloud_t *c = NULL;
+    hd_error_t e;
+    CHECK_RC(hd_read_file(solid_binary_stl("solid2.stl", 2, 0), &o, &c, &e), HD_OK);
+    CHECK_EQ(c->count, 5);
+    hd_cloud_free(c);
+}
+
+TEST(stl_binary_with_bytes_after_its_triangles_is_refused_naming_both_sizes) {
+    refused(solid_binary_stl("tail.stl", 2, 1), NULL, HD_EFORMAT, "declares 2 triangles (184 bytes), but the file has 185",
+            OFFSET, 184);
+    refused(solid_binary_stl("tail2.stl", 1, 200), NULL, HD_EFORMAT, "200 bytes after the last triangle", OFFSET, 134);
+}
