@@ -16,7 +16,10 @@
  * inside the file; the record length is at least the format's minimum
  * (20 28 26 34 57 63 30 36 38 59 67 bytes for formats 0-10; extra bytes are
  * skipped); count * record length fits between the point offset and the
- * end of the file; scales and offsets are finite.  A compressed (LAZ) file,
+ * end of the file, and the bytes after them are the waveform data or
+ * extended VLRs the header points to, else the count is wrong (an error,
+ * never a silent partial read; a 1.4 legacy count that disagrees with the
+ * 64-bit count is refused too); scales and offsets are finite.  A compressed (LAZ) file,
  * recognised by bit 7 of the format byte as LASzip sets it, is refused with
  * the commands that convert it.  Points are converted in parallel from the
  * mapping (hd__binary_read).
@@ -64,6 +67,9 @@ int hd__read_las(hd__read_t *r) {
                              min_record[fmt]);
     if (minor >= 4 && header >= 375) {
         uint64_t c64 = hd__ld_u64(d + 247, 0);
+        if (c64 != 0 && count != 0 && c64 != count)
+            return hd__io_err_at(r, HD_EFORMAT, 107, "the legacy point count %llu disagrees with the 64-bit count %llu",
+                                 (unsigned long long)count, (unsigned long long)c64);
         if (c64 != 0 || count == 0) count = c64;
     }
     if (offset < header || offset > size)
@@ -73,6 +79,22 @@ int hd__read_las(hd__read_t *r) {
         return hd__io_err_at(r, HD_EFORMAT, (long long)size,
                              "file ends inside the points: %llu of %zu bytes declared, room for %zu",
                              (unsigned long long)count, rec, (size - offset) / rec);
+    /* What follows the points must be accounted for by the header: the
+     * waveform data (1.3) or the extended VLRs (1.4) start there.  Other
+     * bytes mean the count is lower than the data: never a silent partial
+     * read. */
+    size_t end = offset + (size_t)count * rec;
+    if (end < size) {
+        uint64_t wave = minor >= 3 && header >= 235 ? hd__ld_u64(d + 227, 0) : 0;
+        uint64_t evlr = minor >= 4 && header >= 247 ? hd__ld_u64(d + 235, 0) : 0;
+        uint32_t n_evlr = minor >= 4 && header >= 247 ? hd__ld_u32(d + 243, 0) : 0;
+        int explained = (wave >= end && wave < size) || (n_evlr > 0 && evlr >= end && evlr < size);
+        if (!explained)
+            return hd__io_err_at(r, HD_EFORMAT, (long long)end,
+                                 "%zu bytes after the %llu declared points (%zu bytes each), and the header names "
+                                 "nothing that follows them: the point count is wrong",
+                                 size - end, (unsigned long long)count, rec);
+    }
     double scale[3], shift[3];
     for (int c = 0; c < 3; c++) {
         scale[c] = f64_at(d + 131 + 8 * c);

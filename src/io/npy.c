@@ -129,6 +129,12 @@ int hd__read_npy(hd__read_t *r) {
         return hd__io_err_at(r, HD_EFORMAT, (long long)size, "file ends inside the data: shape (%llu, 3) needs %llu bytes, %zu are left",
                              (unsigned long long)n, (unsigned long long)(n <= UINT64_MAX / (3 * el) ? n * 3 * el : UINT64_MAX),
                              size - data);
+    if (n * 3 * el != size - data)
+        return hd__io_err_at(r, HD_EFORMAT, (long long)(data + n * 3 * el),
+                             "shape (%llu, 3) of %s needs %llu bytes of data, but %zu follow the header: "
+                             "the shape or the dtype is wrong",
+                             (unsigned long long)n, type == HD__T_F32 ? "float32" : "float64",
+                             (unsigned long long)(n * 3 * el), size - data);
     hd__layout_t L = {(size_t)n, 1, 3 * el, 0, {0, el, 2 * el}, {type, type, type}, big, NULL, NULL, data};
     if (fortran) {
         L.stride = el;

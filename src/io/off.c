@@ -184,5 +184,12 @@ int hd__read_off(hd__read_t *r) {
         job.candidates = hd__no_candidates;
         if ((rc = hd__text_parallel(r, p, stop, line + 1, &job, NULL))) return rc;
     }
+    /* counts lower than the data: never a silent partial read */
+    uint64_t extra, more;
+    hd__skip_content_lines(stop, end, 1, &extra, &more);
+    if (extra)
+        return hd__io_err_line(r, HD_EFORMAT, line + (long long)lines + (long long)more,
+                               "more data after the %llu vertices and %llu faces the counts declare",
+                               (unsigned long long)nv, (unsigned long long)nf);
     return HD_OK;
 }

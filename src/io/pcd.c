@@ -212,6 +212,15 @@ static int soa_points(hd__read_t *r, pcd_t *p, const unsigned char *buf, size_t 
     return HD_OK;
 }
 
+/* The offset of the first nonzero byte of data[from, left), or left.  PCL
+ * pads binary files with zeros after the data; any other byte there means
+ * the data go on past what POINTS declares. */
+static size_t nonzero_after(const unsigned char *data, size_t from, size_t left) {
+    for (size_t k = from; k < left; k++)
+        if (data[k]) return k;
+    return left;
+}
+
 int hd__read_pcd(hd__read_t *r) {
     pcd_t *p = calloc(1, sizeof *p);
     if (!p) return hd__io_err(r, HD_ENOMEM, "out of memory");
@@ -273,6 +282,13 @@ int hd__read_pcd(hd__read_t *r) {
                                "file ends inside the data: POINTS %llu of %llu bytes need %llu bytes, %zu are left",
                                (unsigned long long)p->points, (unsigned long long)p->rec,
                                (unsigned long long)(p->points <= UINT64_MAX / p->rec ? p->points * p->rec : UINT64_MAX), left);
+        size_t nz;
+        if (rc == HD_OK && (nz = nonzero_after(data, (size_t)(p->points * p->rec), left)) < left)
+            rc = hd__io_err_at(r, HD_EFORMAT, (long long)(p->start + nz),
+                               "%llu bytes after the data: POINTS %llu of %llu bytes make %llu bytes, the file has %zu "
+                               "(only zeros may follow, as PCL pads)",
+                               (unsigned long long)(left - p->points * p->rec), (unsigned long long)p->points,
+                               (unsigned long long)p->rec, (unsigned long long)(p->points * p->rec), left);
         size_t off[3] = {(size_t)p->off[0], (size_t)p->off[1], (size_t)p->off[2]};
         if (rc == HD_OK) rc = hd__binary_points(r, data, (size_t)p->points, (size_t)p->rec, off, type, 0, p->start);
     } else if (rc == HD_OK) {
@@ -284,6 +300,7 @@ int hd__read_pcd(hd__read_t *r) {
             if (csize > left - 8)
                 rc = hd__io_err_at(r, HD_EFORMAT, (long long)p->start, "compressed size %llu, but only %zu bytes follow",
                                    (unsigned long long)csize, left - 8);
+
             else if (usize != want)
                 rc = hd__io_err_at(r, HD_EFORMAT, (long long)p->start + 4,
                                    "uncompressed size %llu, but POINTS %llu of %llu bytes make %llu", (unsigned long long)usize,
@@ -292,6 +309,12 @@ int hd__read_pcd(hd__read_t *r) {
                 rc = hd__io_err_at(r, HD_EFORMAT, (long long)p->start + 4,
                                    "uncompressed size %llu is more than %llu compressed bytes can expand to",
                                    (unsigned long long)usize, (unsigned long long)csize);
+            size_t nz;
+            if (rc == HD_OK && (nz = nonzero_after(data, 8 + (size_t)csize, left)) < left)
+                rc = hd__io_err_at(r, HD_EFORMAT, (long long)(p->start + nz),
+                                   "%llu bytes after the %llu compressed bytes the header declares "
+                                   "(only zeros may follow, as PCL pads)",
+                                   (unsigned long long)(left - 8 - csize), (unsigned long long)csize);
             unsigned char *buf = NULL;
             if (rc == HD_OK && !(buf = malloc(usize ? (size_t)usize : 1))) rc = hd__io_err(r, HD_ENOMEM, "out of memory");
             size_t bad;

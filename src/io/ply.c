@@ -320,6 +320,11 @@ static int read_binary(ply_t *p, int v, const int *xyz, int face_el, int face) {
                               k > v ? r->sink->count : UINT64_MAX)))
             return rc;
     }
+    if (pos != size)
+        return hd__io_err_at(r, HD_EFORMAT, (long long)pos,
+                             "%zu bytes after the last element (%.*s, %llu declared): a count is lower than the data",
+                             size - pos, (int)p->el[p->n_el - 1].len, p->el[p->n_el - 1].name,
+                             (unsigned long long)p->el[p->n_el - 1].count);
     return HD_OK;
 }
 
@@ -434,6 +439,23 @@ static void vertex_chunk(void *ctx, hd__chunk_t *c) {
     c->lines = line;
 }
 
+/* After the last element only blank lines may follow: anything else means
+ * a count lower than the data, and a silent partial read is never made. */
+static int trailing_lines(ply_t *p, const char *q, long long line) {
+    hd__read_t *r = p->r;
+    const char *end = (const char *)r->f->data + r->f->size;
+    for (; q < end; line++) {
+        const char *eol = hd__eol(q, end), *tb, *te, *cur = q;
+        if (hd__token(&cur, eol, &tb, &te))
+            return hd__io_err_line(r, HD_EFORMAT, line, "data after the last element (%.*s, %llu declared): "
+                                   "a count is lower than the data",
+                                   (int)p->el[p->n_el - 1].len, p->el[p->n_el - 1].name,
+                                   (unsigned long long)p->el[p->n_el - 1].count);
+        q = eol + (eol < end);
+    }
+    return HD_OK;
+}
+
 static int read_ascii(ply_t *p, int v, const int *xyz, int face_el, int face) {
     hd__read_t *r = p->r;
     const char *s = (const char *)r->f->data, *end = s + r->f->size;
@@ -481,7 +503,7 @@ static int read_ascii(ply_t *p, int v, const int *xyz, int face_el, int face) {
         q = stop;
         line += (long long)e->count;
     }
-    return HD_OK;
+    return trailing_lines(p, q, line);
 }
 
 int hd__read_ply(hd__read_t *r) {

@@ -20,7 +20,9 @@
  * '//' are skipped.  The first line may be a header: if it does not start
  * with a number (a CSV header such as "x,y,z,intensity") it is skipped, and
  * so is a first line holding a single whole number (the point count of the
- * Leica PTS format).  Any other line with fewer than three numbers, or a
+ * Leica PTS format), which must then equal the number of points read (a
+ * count lower or higher than the data is an error, never a partial read).
+ * Any other line with fewer than three numbers, or a
  * token among the first three that is not a number, is an error naming the
  * line.
  *
@@ -106,7 +108,10 @@ static void chunk(void *ctx, hd__chunk_t *c) {
             if (got == 0) continue;
             while (q < eol && is_field_sep(d, (unsigned char)*q)) q++;
             double n = v[0];
-            if (q == eol && n >= 0 && n < 0x1p64 && n == floor(n)) continue;
+            if (q == eol && n >= 0 && n < 0x1p64 && n == floor(n)) {
+                c->aux = (uint64_t)n + 1; /* the PTS count, checked at the end */
+                continue;
+            }
         }
         if (got < 3) {
             hd__chunk_fail(c, HD_EFORMAT, line, "expected 3 numbers (x y z), found %d", got);
@@ -158,5 +163,10 @@ int hd__read_xyz(hd__read_t *r) {
     dialect_t d = dialect_of(s, s + r->f->size);
     /* the shortest point line is "0 0 0\n" */
     hd__text_job_t job = {chunk, NULL, candidates, 6, &d};
-    return hd__text_parallel(r, s, s + r->f->size, 1, &job, NULL);
+    uint64_t count = 0; /* only the first chunk sets it: the PTS count + 1 */
+    int rc = hd__text_parallel(r, s, s + r->f->size, 1, &job, &count);
+    if (rc == HD_OK && count && count - 1 != r->sink->count)
+        return hd__io_err_line(r, HD_EFORMAT, 1, "the count line says %llu points, the file holds %zu",
+                               (unsigned long long)(count - 1), r->sink->count);
+    return rc;
 }
