@@ -36,6 +36,10 @@ void cli_usage(FILE *out) {
 "  --sample N         read a mesh as N points drawn uniformly by area on its\n"
 "                     faces, reproducibly for a given --seed\n"
 "  --float32          store coordinates as float (half the memory)\n"
+"  --max-stream-size SIZE  most bytes read from an input that is not a\n"
+"                     regular file (standard input, a pipe, a FIFO), with an\n"
+"                     optional K, M or G suffix (default 2G)\n"
+"  --fifo-wait SECONDS  how long a named FIFO's writer is awaited (default 30)\n"
 "  --json             print one JSON object\n"
 "  --quiet            no progress bar on stderr (there is none when stderr\n"
 "                     is not a terminal, nor with --json)\n"
@@ -88,6 +92,22 @@ static int parse_u64(const char *s, uint64_t *out) {
     return 0;
 }
 
+/* A size in bytes with an optional K, M or G suffix (powers of 1024). */
+static int parse_size(const char *s, uint64_t *out) {
+    char *e;
+    errno = 0;
+    if (*s < '0' || *s > '9') return -1;
+    unsigned long long v = strtoull(s, &e, 10);
+    if (e == s || errno) return -1;
+    int shift = 0;
+    if (*e == 'K' || *e == 'k') shift = 10, e++;
+    else if (*e == 'M' || *e == 'm') shift = 20, e++;
+    else if (*e == 'G' || *e == 'g') shift = 30, e++;
+    if (*e || v == 0 || v > (UINT64_MAX >> shift)) return -1;
+    *out = (uint64_t)v << shift;
+    return 0;
+}
+
 static int parse_double(const char *s, double *out) {
     char *e;
     errno = 0;
@@ -133,7 +153,8 @@ int cli_parse(int argc, char **argv, cli_args_t *a) {
         memcpy(name, s, nl);
         name[nl] = '\0';
         static const char *const with_arg[] = {"--algorithm", "--threads", "--seed", "--depth",
-                                               "--lambda", "--theta", "--format", "--sample", NULL};
+                                               "--lambda", "--theta", "--format", "--sample",
+                                               "--max-stream-size", "--fifo-wait", NULL};
         int known = 0;
         for (int w = 0; with_arg[w]; w++) known |= strcmp(name, with_arg[w]) == 0;
         if (!known) return bad("unknown option '%s'", s);
@@ -166,6 +187,12 @@ int cli_parse(int argc, char **argv, cli_args_t *a) {
                 return bad("--sample needs a whole number of points 1..2^40, not '%s'", v);
             a->read.mesh = HD_MESH_SAMPLE;
             a->read.sample = (size_t)n;
+        } else if (strcmp(name, "--max-stream-size") == 0) {
+            if (parse_size(v, &a->read.stream_limit))
+                return bad("--max-stream-size needs a positive size in bytes (K, M or G may follow), not '%s'", v);
+        } else if (strcmp(name, "--fifo-wait") == 0) {
+            if (parse_long(v, 1, 86400, &l)) return bad("--fifo-wait needs a whole number of seconds 1..86400, not '%s'", v);
+            a->read.fifo_wait_ms = (int)l * 1000;
         }
     }
     a->read.seed = a->opt.seed; /* --seed also seeds --sample */

@@ -442,13 +442,25 @@ typedef struct hd_read_options {
     size_t sample;       /* points to sample with HD_MESH_SAMPLE */
     uint64_t seed;       /* sampling seed */
     int threads;         /* parsing threads (text and binary): 0 = every core */
+    uint64_t stream_limit; /* most bytes read from an input that is not a
+                              regular file (stdin, pipe, FIFO, device):
+                              0 = HD_STREAM_LIMIT */
+    int fifo_wait_ms;      /* how long a named FIFO's first writer is
+                              awaited: <= 0 = HD_FIFO_WAIT_MS */
 } hd_read_options_t;
+
+/* The defaults of stream_limit (2 GiB) and fifo_wait_ms (30 s). */
+#define HD_STREAM_LIMIT ((uint64_t)2 << 30)
+#define HD_FIFO_WAIT_MS 30000
 
 /* Fill `opt` with the defaults (by extension, double, vertices). */
 HD_EXTERN void hd_read_options_init(hd_read_options_t *opt);
 
 /* Read a point cloud from `path` ("-" reads standard input; then `format`
  * must be given or the content is sniffed).  opt NULL: defaults.
+ * A regular file is mapped; any other input is read to its end, at most
+ * opt->stream_limit bytes (HD_EFORMAT beyond), and a named FIFO's first
+ * writer is awaited at most opt->fifo_wait_ms (HD_EIO after).
  * Errors: HD_EIO (cannot open or read), HD_EFORMAT (malformed: the message
  *   names the file and the line or byte offset), HD_EUNSUPPORTED, HD_EEMPTY
  *   (no points), HD_ENONFINITE, HD_ERANGE, HD_ENOMEM, HD_EOVERFLOW, HD_EINVAL

@@ -12,6 +12,15 @@
  * pass --format.  The library never prints: progress, if any, is the
  * caller's business (the CLI reports by phases).
  *
+ * Inputs that are not regular files (standard input, pipes, FIFOs,
+ * devices) are read in blocks up to opt->stream_limit bytes (default
+ * HD_STREAM_LIMIT, 2 GiB), so /dev/zero or /dev/urandom is refused with a
+ * message instead of growing until memory runs out.  A named FIFO is opened
+ * without blocking and its first writer is awaited at most
+ * opt->fifo_wait_ms (default HD_FIFO_WAIT_MS, 30 s): a FIFO nobody writes
+ * to is an error, never a hang.  Once a writer has come, the FIFO is read
+ * like a pipe, to its end.
+ *
  * Meshes (PLY, OBJ, OFF, STL) are read as their vertices by default; with
  * HD_MESH_SAMPLE the reader also collects the faces as triangles and
  * mesh.c draws the requested number of points on the surface.
@@ -20,6 +29,7 @@
 
 #include <errno.h>
 #include <fcntl.h>
+#include <poll.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -177,13 +187,89 @@ static const format_t *by_content(const hd__file_t *f) {
 }
 
 /* ---- loading ------------------------------------------------------------------ */
-static int load(const char *path, hd__file_t *f, int *mapped, hd_error_t *err) {
-    int fd = strcmp(path, "-") == 0 ? 0 : open(path, O_RDONLY);
+
+/* Wait until fd (non-blocking) is readable or its writers are gone: 1, or 0
+ * when ms (> 0) pass first, -1 on a poll error (errno). */
+static int wait_readable(int fd, int ms) {
+    struct pollfd p = {fd, POLLIN, 0};
+    for (;;) {
+        int r = poll(&p, 1, ms);
+        if (r < 0 && errno == EINTR) continue;
+        return r < 0 ? -1 : r > 0;
+    }
+}
+
+/* Read fd to its end into a malloc'd buffer of at most `limit` bytes.  With
+ * fifo_ms > 0, fd is a FIFO opened with O_NONBLOCK: its first writer is
+ * awaited at most fifo_ms, then it is read as a pipe. */
+static int read_stream(int fd, const char *path, uint64_t limit, int fifo_ms, hd__file_t *f, hd_error_t *err) {
+    size_t cap = 1 << 16, size = 0;
+    unsigned char *buf = malloc(cap);
+    if (!buf) return hd__err(err, HD_ENOMEM, "%s: out of memory", path);
+    int waiting = fifo_ms > 0;
+    for (;;) {
+        if (size == cap) {
+            if (size >= limit) {
+                free(buf);
+                return hd__err(err, HD_EFORMAT,
+                               "%s: more than %llu bytes from a stream (not a regular file); "
+                               "--max-stream-size raises the limit",
+                               path, (unsigned long long)limit);
+            }
+            size_t want = cap > SIZE_MAX / 2 ? SIZE_MAX : cap * 2;
+            if (want > limit) want = (size_t)limit + 1; /* one byte more tells "too long" */
+            unsigned char *nb = realloc(buf, want);
+            if (!nb) {
+                free(buf);
+                return hd__err(err, HD_ENOMEM, "%s: out of memory after %zu bytes", path, size);
+            }
+            buf = nb;
+            cap = want;
+        }
+        if (fifo_ms > 0) {
+            int w = wait_readable(fd, waiting ? fifo_ms : -1);
+            if (w == 0) {
+                free(buf);
+                return hd__err(err, HD_EIO, "%s: a FIFO that no writer opened within %d ms", path, fifo_ms);
+            }
+        }
+        ssize_t got = read(fd, buf + size, cap - size);
+        if (got < 0 && (errno == EINTR || errno == EAGAIN || errno == EWOULDBLOCK)) continue;
+        if (got < 0) {
+            int e = errno;
+            free(buf);
+            return hd__err(err, HD_EIO, "%s: cannot read: %s", path, strerror(e));
+        }
+        if (got == 0) break;
+        waiting = 0;
+        size += (size_t)got;
+    }
+    if (size > limit) {
+        free(buf);
+        return hd__err(err, HD_EFORMAT,
+                       "%s: more than %llu bytes from a stream (not a regular file); --max-stream-size raises the limit",
+                       path, (unsigned long long)limit);
+    }
+    if (size == 0) {
+        free(buf);
+        static const unsigned char empty[1];
+        f->data = empty;
+    } else {
+        f->data = buf;
+    }
+    f->size = size;
+    return HD_OK;
+}
+
+static int load(const char *path, const hd_read_options_t *opt, hd__file_t *f, int *mapped, hd_error_t *err) {
+    int is_stdin = strcmp(path, "-") == 0;
+    struct stat st;
+    int fifo = !is_stdin && stat(path, &st) == 0 && S_ISFIFO(st.st_mode);
+    int fd = is_stdin ? 0 : open(path, O_RDONLY | (fifo ? O_NONBLOCK : 0));
     if (fd < 0)
         return hd__err(err, HD_EIO, "%s: cannot open: %s", path, strerror(errno));
-    struct stat st;
     *mapped = 0;
-    f->name = strcmp(path, "-") == 0 ? "(standard input)" : path;
+    f->name = is_stdin ? "(standard input)" : path;
     f->data = NULL;
     f->size = 0;
     if (fstat(fd, &st) == 0 && S_ISDIR(st.st_mode)) {
@@ -211,38 +297,11 @@ static int load(const char *path, hd__file_t *f, int *mapped, hd_error_t *err) {
         *mapped = 1;
         return HD_OK;
     }
-    size_t cap = 1 << 16, size = 0;
-    unsigned char *buf = malloc(cap);
-    if (!buf) {
-        if (fd) close(fd);
-        return hd__err(err, HD_ENOMEM, "%s: out of memory", path);
-    }
-    for (;;) {
-        if (size == cap) {
-            unsigned char *nb = cap > SIZE_MAX / 2 ? NULL : realloc(buf, cap * 2);
-            if (!nb) {
-                free(buf);
-                if (fd) close(fd);
-                return hd__err(err, HD_ENOMEM, "%s: out of memory after %zu bytes", path, size);
-            }
-            buf = nb;
-            cap *= 2;
-        }
-        ssize_t got = read(fd, buf + size, cap - size);
-        if (got < 0 && errno == EINTR) continue;
-        if (got < 0) {
-            int e = errno;
-            free(buf);
-            if (fd) close(fd);
-            return hd__err(err, HD_EIO, "%s: cannot read: %s", path, strerror(e));
-        }
-        if (got == 0) break;
-        size += (size_t)got;
-    }
+    uint64_t limit = opt->stream_limit ? opt->stream_limit : HD_STREAM_LIMIT;
+    int wait_ms = opt->fifo_wait_ms > 0 ? opt->fifo_wait_ms : HD_FIFO_WAIT_MS;
+    int rc = read_stream(fd, f->name, limit, fifo ? wait_ms : 0, f, err);
     if (fd) close(fd);
-    f->data = buf;
-    f->size = size;
-    return HD_OK;
+    return rc;
 }
 
 static void unload(hd__file_t *f, int mapped) {
@@ -369,7 +428,7 @@ int hd_read_file(const char *path, const hd_read_options_t *opt,
     if (!fmt && strcmp(path, "-") == 0) from_extension = -1;
     hd__file_t f;
     int mapped;
-    if ((rc = load(path, &f, &mapped, err))) return rc;
+    if ((rc = load(path, opt, &f, &mapped, err))) return rc;
     rc = read_loaded(&f, fmt, from_extension, opt, out, err);
     unload(&f, mapped);
     return rc;
