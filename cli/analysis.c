@@ -18,6 +18,12 @@
  * users disagree: MONAI returns NaN or inf, medpy raises, some pipelines
  * count a miss as 0.  JSON has no inf or NaN, so those are written as null
  * and "empty" says which policy produced them.
+ *
+ * Files (--distances, its _b file, --render, --histogram-png) are written
+ * here but appear only at the end: each goes to a temporary that main
+ * renames into place, all together, once the report has reached standard
+ * output (output.c).  A write that fails returns OUT_EFAIL (exit 3), and
+ * the files written before it are removed with the rest.
  */
 #include "analysis.h"
 #include "cli.h"

@@ -6,8 +6,18 @@
  * seconds), so a benchmark of the tool can tell them apart.  Errors from the
  * library already carry the file and line or byte offset; the tool prefixes
  * "hausdorff: " and maps them to exit codes: bad input 2, other failure 3.
+ *
+ * Output is part of the result (output.c): a run succeeds only when its
+ * report reached standard output and every file it was asked to write is in
+ * place.  So main guards descriptors 0-2 before anything opens a file,
+ * refuses outputs that would overwrite an input before anything is read
+ * (exit 1), lets every file be written to a temporary, and ends a run that
+ * succeeded with out_finish (standard output flushed and closed, checked;
+ * then the files renamed into place, all or none; exit 3 when either
+ * fails) and a run that failed with out_discard (no file appears).
  */
 #include "cli.h"
+#include "output.h"
 #include "progress.h"
 
 #include <stdlib.h>
@@ -21,6 +31,7 @@ static double now(void) {
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
+/* Library codes to exit codes; an output failure (OUT_EFAIL) is 3. */
 static int exit_for(int code) {
     switch (code) {
     case HD_EIO: case HD_EFORMAT: case HD_EUNSUPPORTED: case HD_EEMPTY:
@@ -47,10 +58,30 @@ static void stats_json(FILE *out, const hd_stats_t *s) {
             (unsigned long long)s->points_culled);
 }
 
+/* Stop a run that failed: no file of it appears. */
+static int failed(int code) {
+    out_discard();
+    return code;
+}
+
+/* Refuse an output that would overwrite an input or another output. */
+static int check_outputs(const cli_args_t *a) {
+    char path_b[4096];
+    const char *outs[4] = {a->an.distances_out, NULL, a->an.render_out, a->an.histogram_png};
+    const char *const what[4] = {"--distances", "--distances (B's rows)", "--render", "--histogram-png"};
+    if (a->an.distances_out && !a->directed) {
+        path_with_suffix(a->an.distances_out, "_b", path_b, sizeof path_b);
+        outs[1] = path_b;
+    }
+    return out_check_paths(outs, what, 4, a->path_a, a->path_b);
+}
+
 int main(int argc, char **argv) {
+    out_guard_std();
     cli_args_t a;
     int rc = cli_parse(argc, argv, &a);
-    if (rc >= 0) return rc;
+    if (rc >= 0) return rc == EXIT_OK ? out_finish() : rc; /* --help, --version, --formats printed */
+    if ((rc = check_outputs(&a)) != 0) return rc;
 
     hd_error_t err;
     hd_cloud_t *ca = NULL, *cb = NULL;
@@ -64,7 +95,7 @@ int main(int argc, char **argv) {
         progress_stop();
         fprintf(stderr, "hausdorff: %s\n", err.message);
         hd_cloud_free(ca);
-        return exit_for(rc);
+        return failed(exit_for(rc));
     }
     double read_seconds = now() - t0;
     hd_points_t A = hd_cloud_points(ca), B = hd_cloud_points(cb);
@@ -73,7 +104,7 @@ int main(int argc, char **argv) {
         progress_stop();
         hd_cloud_free(ca);
         hd_cloud_free(cb);
-        return rc;
+        return rc == EXIT_OK ? out_finish() : failed(rc);
     }
 
     hd_symmetric_t s;
@@ -97,7 +128,7 @@ int main(int argc, char **argv) {
         fprintf(stderr, "hausdorff: %s\n", err.message);
         hd_cloud_free(ca);
         hd_cloud_free(cb);
-        return exit_for(rc);
+        return failed(exit_for(rc));
     }
 
     FILE *out = stdout;
@@ -175,5 +206,5 @@ int main(int argc, char **argv) {
     analysis_free(&an);
     hd_cloud_free(ca);
     hd_cloud_free(cb);
-    return EXIT_OK;
+    return out_finish();
 }

@@ -22,10 +22,16 @@
  * side by side in each bin) with the percentile and the means marked.
  *
  * Built without libpng, both refuse with a message that says so.
+ *
+ * A picture is written through output.c (write_png): into a temporary
+ * beside its name, every write checked, renamed into place only when the
+ * whole run succeeds; a failure removes it and the run exits with 3.
  */
 #include "analysis.h"
 #include "cli.h"
+#include "output.h"
 
+#include <errno.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -107,19 +113,37 @@ static void label(canvas_t *c, int x, int y, int scale, const char *s, const uns
     text(c, x, y, scale, s, col);
 }
 
+/* libpng's errors: the errno of the write that failed (libpng's own
+ * write function calls png_error after a short fwrite), kept for the
+ * message, and a jump back to write_png -- never libpng's default
+ * handler, which would print to stderr. */
+typedef struct {
+    int werr;
+} png_failure_t;
+
+static void png_fail(png_structp png, png_const_charp msg) {
+    png_failure_t *pf = png_get_error_ptr(png);
+    (void)msg;
+    if (!pf->werr) pf->werr = errno ? errno : -1; /* -1: reason unknown */
+    png_longjmp(png, 1);
+}
+
+static void png_warn(png_structp png, png_const_charp msg) { (void)png, (void)msg; }
+
+/* Through output.c: a temporary, renamed into place only when the run
+ * succeeds; any failure removes it and is an output failure (exit 3). */
 static int write_png(const char *path, const canvas_t *c, hd_error_t *err) {
-    FILE *f = fopen(path, "wb");
-    if (!f) {
-        snprintf(err->message, sizeof err->message, "%s: cannot write the picture", path);
-        return err->code = HD_EIO;
-    }
-    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, NULL, NULL, NULL);
+    FILE *f = out_open(path, err);
+    if (!f) return err->code;
+    static png_failure_t pf; /* static: untouched by the longjmp */
+    memset(&pf, 0, sizeof pf);
+    errno = 0;
+    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &pf, png_fail, png_warn);
     png_infop info = png ? png_create_info_struct(png) : NULL;
     if (!png || !info || setjmp(png_jmpbuf(png))) {
         png_destroy_write_struct(&png, &info);
-        fclose(f);
-        snprintf(err->message, sizeof err->message, "%s: libpng could not write the picture", path);
-        return err->code = HD_EIO;
+        if (!pf.werr) pf.werr = ENOMEM; /* no struct: libpng could not allocate */
+        return out_close(f, pf.werr, err);
     }
     png_init_io(png, f);
     /* unfiltered rows: the pictures are mostly flat colour, which deflate
@@ -137,11 +161,7 @@ static int write_png(const char *path, const canvas_t *c, hd_error_t *err) {
     for (int y = 0; y < c->h; y++) png_write_row(png, c->rgb + 3 * (size_t)y * (size_t)c->w);
     png_write_end(png, info);
     png_destroy_write_struct(&png, &info);
-    if (fclose(f) != 0) {
-        snprintf(err->message, sizeof err->message, "%s: write failed", path);
-        return err->code = HD_EIO;
-    }
-    return HD_OK;
+    return out_close(f, 0, err);
 }
 
 static void fmt_num(char *buf, size_t size, double v) { snprintf(buf, size, "%.4g", v); }

@@ -18,8 +18,16 @@
  * colour-blind readers): 64 samples of matplotlib's table (CC0, by Nathaniel
  * Smith and Stefan van der Walt), interpolated linearly, at d / dmax clipped
  * to [0, 1].
+ *
+ * A file is written through output.c: into a temporary beside it, renamed
+ * over the name only when the whole run has succeeded.  Each writer stops at
+ * the first write that fails and returns its errno (a full disk is not
+ * worth a million more failing rows); out_close checks the rest (fflush,
+ * ferror, fclose), so a file is either complete or absent, and its loss is
+ * an output failure (exit status 3), never a quiet success.
  */
 #include "analysis.h"
+#include "output.h"
 
 #include <errno.h>
 #include <math.h>
@@ -88,31 +96,38 @@ static void put_le(unsigned char *p, const void *v, size_t n) {
     for (size_t k = 0; k < n; k++) p[k] = little ? s[k] : s[n - 1 - k];
 }
 
-static void write_csv(FILE *f, const hd_points_t *P, const double *d,
-                      const size_t *nearest) {
-    fputs("x,y,z,distance,nearest\n", f);
+/* errno of a failed write; -1 when unknown, never 0 */
+static int write_errno(void) { return errno ? errno : -1; }
+
+static int write_csv(FILE *f, const hd_points_t *P, const double *d,
+                     const size_t *nearest) {
+    if (fputs("x,y,z,distance,nearest\n", f) == EOF) return write_errno();
     for (size_t k = 0; k < P->count; k++) {
         double q[3];
+        int n;
         hd_points_get(P, k, q);
         if (nearest)
-            fprintf(f, "%.17g,%.17g,%.17g,%.17g,%zu\n", q[0], q[1], q[2], d[k], nearest[k]);
+            n = fprintf(f, "%.17g,%.17g,%.17g,%.17g,%zu\n", q[0], q[1], q[2], d[k], nearest[k]);
         else
-            fprintf(f, "%.17g,%.17g,%.17g,%.17g,-1\n", q[0], q[1], q[2], d[k]);
+            n = fprintf(f, "%.17g,%.17g,%.17g,%.17g,-1\n", q[0], q[1], q[2], d[k]);
+        if (n < 0) return write_errno();
     }
+    return 0;
 }
 
-static void write_ply(FILE *f, const hd_points_t *P, const double *d,
-                      const size_t *nearest, double dmax) {
+static int write_ply(FILE *f, const hd_points_t *P, const double *d,
+                     const size_t *nearest, double dmax) {
     int wide = 0;
     for (size_t k = 0; nearest && k < P->count; k++) wide |= nearest[k] > 2147483647u;
-    fprintf(f, "ply\nformat binary_little_endian 1.0\n"
+    if (fprintf(f, "ply\nformat binary_little_endian 1.0\n"
                "comment written by hausdorff %s: distance to the nearest point of the other set\n"
                "comment colour: viridis, 0 to %.17g\n"
                "element vertex %zu\n"
                "property double x\nproperty double y\nproperty double z\n"
                "property double distance\nproperty %s nearest\n"
                "property uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n",
-            hd_version(), dmax, P->count, wide ? "double" : "int");
+                hd_version(), dmax, P->count, wide ? "double" : "int") < 0)
+        return write_errno();
     unsigned char rec[4 * 8 + 8 + 3];
     for (size_t k = 0; k < P->count; k++) {
         double q[4];
@@ -131,12 +146,13 @@ static void write_ply(FILE *f, const hd_points_t *P, const double *d,
         }
         colormap_viridis(dmax > 0 ? d[k] / dmax : 0.0, rec + o);
         o += 3;
-        fwrite(rec, 1, o, f);
+        if (fwrite(rec, 1, o, f) != o) return write_errno();
     }
+    return 0;
 }
 
-static void write_npy(FILE *f, const hd_points_t *P, const double *d,
-                      const size_t *nearest) {
+static int write_npy(FILE *f, const hd_points_t *P, const double *d,
+                     const size_t *nearest) {
     char dict[128];
     int n = snprintf(dict, sizeof dict, "{'descr': '<f8', 'fortran_order': False, 'shape': (%zu, 5), }",
                      P->count);
@@ -146,10 +162,10 @@ static void write_npy(FILE *f, const hd_points_t *P, const double *d,
     unsigned char head[10] = {0x93, 'N', 'U', 'M', 'P', 'Y', 1, 0, 0, 0};
     uint16_t hl = (uint16_t)(padded - 10);
     put_le(head + 8, &hl, 2);
-    fwrite(head, 1, 10, f);
-    fwrite(dict, 1, (size_t)n, f);
-    for (size_t k = total; k < padded; k++) fputc(' ', f);
-    fputc('\n', f);
+    if (fwrite(head, 1, 10, f) != 10 || fwrite(dict, 1, (size_t)n, f) != (size_t)n) return write_errno();
+    for (size_t k = total; k < padded; k++)
+        if (fputc(' ', f) == EOF) return write_errno();
+    if (fputc('\n', f) == EOF) return write_errno();
     unsigned char rec[40];
     for (size_t k = 0; k < P->count; k++) {
         double v[5];
@@ -157,8 +173,9 @@ static void write_npy(FILE *f, const hd_points_t *P, const double *d,
         v[3] = d[k];
         v[4] = nearest_of(nearest, k);
         for (int c = 0; c < 5; c++) put_le(rec + 8 * c, &v[c], 8);
-        fwrite(rec, 1, sizeof rec, f);
+        if (fwrite(rec, 1, sizeof rec, f) != sizeof rec) return write_errno();
     }
+    return 0;
 }
 
 int write_distances(const char *path, const hd_points_t *P, const double *d,
@@ -169,21 +186,13 @@ int write_distances(const char *path, const hd_points_t *P, const double *d,
                  "%s: cannot tell the output format; name it .csv, .ply or .npy", path);
         return err->code = HD_EUNSUPPORTED;
     }
-    FILE *f = fopen(path, "wb");
-    if (!f) {
-        snprintf(err->message, sizeof err->message, "%s: cannot write: %s", path, strerror(errno));
-        return err->code = HD_EIO;
-    }
-    if (fmt == OUT_CSV) write_csv(f, P, d, nearest);
-    else if (fmt == OUT_PLY) write_ply(f, P, d, nearest, dmax);
-    else write_npy(f, P, d, nearest);
-    int bad = ferror(f);
-    if (fclose(f) != 0) bad = 1;
-    if (bad) {
-        snprintf(err->message, sizeof err->message, "%s: write failed: %s", path, strerror(errno));
-        return err->code = HD_EIO;
-    }
-    return HD_OK;
+    FILE *f = out_open(path, err);
+    if (!f) return err->code;
+    errno = 0;
+    int werr = fmt == OUT_CSV ? write_csv(f, P, d, nearest)
+             : fmt == OUT_PLY ? write_ply(f, P, d, nearest, dmax)
+                              : write_npy(f, P, d, nearest);
+    return out_close(f, werr, err);
 }
 
 int distances_format_known(const char *path) { return format_of(path) != OUT_UNKNOWN; }

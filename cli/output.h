@@ -1,0 +1,43 @@
+/*
+ * output.h -- how the tool writes: standard output and every file
+ * (--distances, --render, --histogram-png) go through here, so that no
+ * output is lost without an exit status that says so (output.c).
+ */
+#ifndef HD_CLI_OUTPUT_H
+#define HD_CLI_OUTPUT_H
+
+#include <hausdorff.h>
+#include <stdio.h>
+
+/* The code of an output failure (not a library code): exit status 3. */
+#define OUT_EFAIL (-100)
+
+/* Before anything else: give descriptors 0, 1 and 2 a file (/dev/null)
+ * when they are closed, so that no file the tool opens takes their number,
+ * and remember that standard output was closed (out_finish reports it). */
+void out_guard_std(void);
+
+/* Refuse an output that names input A or B, or another output: the same
+ * literal path, or the same file (st_dev and st_ino).  outs[k] is a path
+ * (NULL: that output is not asked for), what[k] the option that named it.
+ * Returns 0, or 1 (the usage exit status) after a message naming both. */
+int out_check_paths(const char *const *outs, const char *const *what, int n,
+                    const char *path_a, const char *path_b);
+
+/* Begin writing `path`: a new temporary file beside it (or the file itself
+ * when it is a device or a FIFO).  NULL with err filled (OUT_EFAIL). */
+FILE *out_open(const char *path, hd_error_t *err);
+/* Finish a file from out_open: flush, check, close.  werr is the errno of
+ * the first write that failed (0 if none, -1 for an unknown reason).
+ * Returns HD_OK, or OUT_EFAIL
+ * with err filled after removing the temporary. */
+int out_close(FILE *f, int werr, hd_error_t *err);
+
+/* The end of a run that succeeded: flush and close standard output, then
+ * rename every finished file into place, all of them or none.  Returns
+ * the exit status: 0, or 3 after a message ("hausdorff: what: reason"). */
+int out_finish(void);
+/* The end of a run that failed: remove every temporary. */
+void out_discard(void);
+
+#endif
