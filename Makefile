@@ -38,7 +38,7 @@ test-release:
 	cd $(BUILD) && ctest --output-on-failure -j$(JOBS)
 
 test-asan:
-	@scripts/deps.sh build extras test
+	@scripts/deps.sh build extras test fuzz
 	cmake -S . -B $(ASAN_BUILD) -DCMAKE_BUILD_TYPE=Debug -DHD_SANITIZE=ON -DHD_ASAN_BUILD=ON $(CMAKE_ARGS)
 	cmake --build $(ASAN_BUILD) -j$(JOBS)
 	cd $(ASAN_BUILD) && ASAN_OPTIONS=detect_leaks=1 ctest --output-on-failure -j$(JOBS) -LE slow
@@ -64,14 +64,17 @@ test-tsan:
 	cmake --build $(TSAN_BUILD) -j$(JOBS)
 	cd $(TSAN_BUILD) && TSAN_OPTIONS=halt_on_error=1 ctest --output-on-failure -j$(JOBS) -R '$(TSAN_TESTS)'
 
-# libFuzzer targets, one per reader (fuzz/run.sh, docs/formats.md), each run
-# FUZZ_SECONDS from its seed corpus tests/corpus/FORMAT/; FUZZ_FORMATS picks
-# some ("ply las").  Exits non-zero on a finding.
+# libFuzzer targets (fuzz/run.sh, docs/formats.md "Fuzzing"): the readers as
+# points and sampled, NIfTI masks, the argument parser; each run FUZZ_SECONDS
+# from its seeds in tests/corpus/.  FUZZ_TARGETS picks some ("ply ply_sample
+# nifti cli"; FUZZ_FORMATS is its older name).  Exits non-zero on a finding.
+# `make test` runs every target for 3 s (tests/fuzz_smoke.cmake).
 FUZZ_SECONDS ?= 60
 FUZZ_FORMATS ?=
+FUZZ_TARGETS ?= $(FUZZ_FORMATS)
 fuzz:
 	@scripts/deps.sh fuzz
-	FUZZ_SECONDS=$(FUZZ_SECONDS) FUZZ_BUILD=build-fuzz fuzz/run.sh $(FUZZ_FORMATS)
+	FUZZ_SECONDS=$(FUZZ_SECONDS) FUZZ_BUILD=build-fuzz fuzz/run.sh $(FUZZ_TARGETS)
 
 # The engine benchmark (docs/benchmarks.md, "Engine"; not part of `make test`):
 # installs the peers (nanoflann, PCL, SciPy, Open3D) and matplotlib, times

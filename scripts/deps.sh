@@ -9,11 +9,11 @@ for group in "$@"; do
   case "$group" in
     build)  pkgs="$pkgs gcc make cmake pkg-config libc6-dev" ;;
     extras) pkgs="$pkgs libpng-dev libnifti2-dev zlib1g-dev" ;;
-    test)   pkgs="$pkgs python3" ;;
+    test)   pkgs="$pkgs python3 locales" ;;
     python) pkgs="$pkgs python3 python3-dev python3-numpy python3-setuptools python3-pytest python3-scipy" ;;
     bench)  pkgs="$pkgs libnanoflann-dev libpcl-dev python3-scipy python3-numpy python3-open3d g++ libomp-dev" ;;
     plot)   pkgs="$pkgs python3-matplotlib python3-numpy" ;;
-    fuzz)   pkgs="$pkgs clang libclang-rt-14-dev" ;;
+    fuzz)   pkgs="$pkgs clang libclang-rt-14-dev make libnifti2-dev zlib1g-dev" ;;
     *) echo "deps.sh: unknown group $group" >&2; exit 1 ;;
   esac
 done
