@@ -210,3 +210,25 @@ TEST(stl_binary_with_bytes_after_its_triangles_is_refused_naming_both_sizes) {
             OFFSET, 184);
     refused(solid_binary_stl("tail2.stl", 1, 200), NULL, HD_EFORMAT, "200 bytes after the last triangle", OFFSET, 134);
 }
+
+TEST(sampling_a_mesh_near_the_coordinate_limit_draws_points_on_it) {
+    /* areas of 1e200 square to infinity in the plain sum */
+    hd_read_options_t o = sampling(100);
+    hd_cloud_t *c = NULL;
+    hd_error_t e;
+    const char *p = tf_printf("big.obj", "v 0 0 0\nv 1e100 0 0\nv 0 1e100 0\nv 1e150 1e150 1e150\nv -1e150 1e150 0\n"
+                                         "f 1 2 3\nf 1 4 5\n");
+    int rc = hd_read_file(p, &o, &c, &e);
+    if (rc) hdt_fail(__FILE__, __LINE__, "refused: %s", e.message);
+    CHECK_EQ(c->count, 100);
+    const double *x = c->data;
+    for (size_t k = 0; k < 300; k++) CHECK(x[k] >= -1e150 && x[k] <= 1e150);
+    hd_cloud_free(c);
+    /* a mesh of ordinary size samples exactly as before (the plain path) */
+    o.seed = 9;
+    const double *d;
+    CHECK_RC(hd_read_file(tf_printf("small.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"), &o, &c, &e), HD_OK);
+    d = c->data;
+    for (size_t k = 0; k < 100; k++) CHECK(d[3 * k] >= 0 && d[3 * k + 1] >= 0 && d[3 * k] + d[3 * k + 1] <= 1 + 1e-15);
+    hd_cloud_free(c);
+}

@@ -8,8 +8,10 @@
 #include "gen.h"
 #include "io/io.h"
 
+#include <locale.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 static void check_like_strtod(const char *s) {
     double got = 0, want;
@@ -114,4 +116,34 @@ TEST(lzf_corrupt_streams_are_refused_at_the_bad_command) {
     const unsigned char short_output[] = {1, 'a', 'b'};
     CHECK_EQ(hd__lzf_decompress(short_output, sizeof short_output, out, 3, &bad), -1);
     CHECK_EQ(bad, 3);
+}
+
+/* A German locale (decimal comma) compiled into a temporary LOCPATH with
+ * localedef from Debian's locales package: the program's locale must not
+ * change how numbers in files read.  Fails (never skips) when the locale
+ * cannot be made: `make test` installs the package. */
+TEST(parse_double_ignores_the_program_locale_on_its_slow_path) {
+    char dir[] = "/tmp/hd-locale-XXXXXX";
+    CHECK(mkdtemp(dir) != NULL);
+    char cmd[512];
+    snprintf(cmd, sizeof cmd, "localedef -i de_DE -f UTF-8 %s/de_DE.UTF-8 >/dev/null 2>&1", dir);
+    int made = system(cmd);
+    setenv("LOCPATH", dir, 1);
+    const char *set = setlocale(LC_ALL, "de_DE.UTF-8");
+    if (!set) hdt_fail(__FILE__, __LINE__, "cannot make the de_DE.UTF-8 locale (localedef exit %d; install 'locales')", made);
+    /* in this locale strtod itself stops at the '.' */
+    char *e;
+    const char *tok = "1.0000000000000000000000001";
+    (void)strtod(tok, &e);
+    CHECK(*e == '.');
+    double v = 0;
+    CHECK(hd__parse_double(tok, tok + strlen(tok), &v));
+    CHECK_BITS(v, 1.0);
+    const char *big = "123456789012345678901234.5";
+    CHECK(hd__parse_double(big, big + strlen(big), &v));
+    CHECK_BITS(v, 123456789012345678901234.5);
+    setlocale(LC_ALL, "C");
+    unsetenv("LOCPATH");
+    snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
+    CHECK(system(cmd) == 0);
 }

@@ -82,6 +82,22 @@ static double area2(const double *a, const double *b, const double *c) {
     return sqrt(x * x + y * y + z * z);
 }
 
+/* The same area scaled by 2^-s (s even), for meshes whose areas overflow
+ * in area2: coordinates are accepted up to 1e153, so an edge can reach
+ * 2e153 and a cross product component 8e306, whose square is infinite.
+ * Scaling the edges by 2^(-s/2) is exact (a power of two, no underflow at
+ * those magnitudes), so the ratios of the areas, which are all sampling
+ * uses, are those of the unscaled areas up to rounding. */
+static double area2_scaled(const double *a, const double *b, const double *c, int s) {
+    double k = ldexp(1.0, -s / 2);
+    double u[3] = {(b[0] - a[0]) * k, (b[1] - a[1]) * k, (b[2] - a[2]) * k};
+    double v[3] = {(c[0] - a[0]) * k, (c[1] - a[1]) * k, (c[2] - a[2]) * k};
+    double x = u[1] * v[2] - u[2] * v[1];
+    double y = u[2] * v[0] - u[0] * v[2];
+    double z = u[0] * v[1] - u[1] * v[0];
+    return sqrt(x * x + y * y + z * z);
+}
+
 int hd__mesh_sample(const double *xyz, size_t nv, const hd__tris_t *t,
                     size_t n, uint64_t seed, hd__sink_t *out,
                     const char *name, hd_error_t *err) {
@@ -98,6 +114,18 @@ int hd__mesh_sample(const double *xyz, size_t nv, const hd__tris_t *t,
         const uint64_t *f = t->v + 3 * k;
         total += area2(xyz + 3 * f[0], xyz + 3 * f[1], xyz + 3 * f[2]);
         cum[k] = total;
+    }
+    if (!isfinite(total)) {
+        /* Areas too large for double: the same sums at 2^-600 scale.  The
+         * edges (< 2^512 after the subtraction of coordinates below 1e153)
+         * become < 2^212 and their cross products < 2^426: finite.  Only
+         * such meshes take this path, so every other sample is unchanged. */
+        total = 0.0;
+        for (size_t k = 0; k < t->count; k++) {
+            const uint64_t *f = t->v + 3 * k;
+            total += area2_scaled(xyz + 3 * f[0], xyz + 3 * f[1], xyz + 3 * f[2], 600);
+            cum[k] = total;
+        }
     }
     if (!(total > 0) || !isfinite(total)) {
         free(cum);

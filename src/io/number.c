@@ -17,13 +17,15 @@
  * operation.  A zero significand gives a signed zero, as strtod does.
  * Everything else (more digits, larger exponents, "inf", "nan", hex floats)
  * goes to strtod on a NUL-terminated copy of the token, and the token must be
- * consumed entirely.  The C locale is assumed (the library never calls
- * setlocale; a program that sets a locale with a decimal comma would make
- * strtod itself disagree with the files).
+ * consumed entirely.  strtod runs in the C locale whatever the program's
+ * locale is (uselocale switches this thread to it for the call and back),
+ * since files write a decimal point: a program that had set a German
+ * locale once saw numbers of more than 19 digits refused.
  */
 #include "io.h"
 
 #include <float.h>
+#include <locale.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -43,7 +45,14 @@ static int slow_path(const char *s, const char *end, double *out) {
     memcpy(buf, s, n);
     buf[n] = '\0';
     char *e;
+    /* glibc returns its static C locale object here: no allocation */
+    locale_t c = newlocale(LC_ALL_MASK, "C", (locale_t)0);
+    locale_t old = c ? uselocale(c) : (locale_t)0;
     *out = strtod(buf, &e);
+    if (c) {
+        uselocale(old);
+        freelocale(c);
+    }
     int ok = n > 0 && e == buf + n;
     if (buf != local) free(buf);
     return ok;
