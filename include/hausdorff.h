@@ -47,6 +47,10 @@
  *    witness is the same at any thread count and for every algorithm.
  *  - Thread safety: functions are reentrant; a built index is immutable and
  *    may be queried from many threads at once.  Seeds are explicit.
+ *  - Inputs are borrowed and must not change during a call: points are
+ *    checked (finite, within 1e153) once, when the call starts, and a
+ *    coordinate that another thread rewrites afterwards (to NaN, say) makes
+ *    the result meaningless.
  */
 #ifndef HAUSDORFF_H
 #define HAUSDORFF_H
