@@ -3,6 +3,7 @@
 # has it: Debian's /usr/bin/python3, installed by scripts/deps.sh python).
 #   cli_analysis        the command line's analysis options
 #   cli_analysis_nifti  NIfTI masks (only when the tool has libnifti2)
+#   cli_nifti_hostile   NIfTI headers that lie: refused, one line, exit 2
 #   cli_analysis_lib    hd_percentiles / hd_histogram against numpy through
 #                       ctypes (not in the sanitizer build: an ASan library
 #                       cannot be loaded into an uninstrumented interpreter)
@@ -21,6 +22,10 @@ if(HD_CLI_NIFTI)
     COMMAND ${HD_ANALYSIS_PYTHON} ${CMAKE_CURRENT_SOURCE_DIR}/tests/cli_analysis_nifti.py
             $<TARGET_FILE:hausdorff_cli>)
   set_tests_properties(cli_analysis_nifti PROPERTIES TIMEOUT 600)
+  add_test(NAME cli_nifti_hostile
+    COMMAND ${HD_ANALYSIS_PYTHON} ${CMAKE_CURRENT_SOURCE_DIR}/tests/cli_nifti_hostile.py
+            $<TARGET_FILE:hausdorff_cli>)
+  set_tests_properties(cli_nifti_hostile PROPERTIES TIMEOUT 600)
 endif()
 if(NOT HD_SANITIZE)
   add_test(NAME cli_analysis_lib
