@@ -261,7 +261,10 @@ static int run(inc_t *s) {
             }
             hd__best_offer(&s->best, it.key, s->ta.idx[en.e & ~REF_POINT], j);
             if (it.key > s->lb) s->lb = it.key;
-        } else if (!(en.e & REF_POINT) && hd__box_size2(&s->ta.node[en.e]->box) >= biggest) {
+        } else if (!(en.e & REF_POINT) && !(hd__box_size2(&s->ta.node[en.e]->box) < biggest)) {
+            /* written as !(<) so that a NaN box (points changed during the
+             * call, which hausdorff.h forbids) expands e: refining a list of
+             * points alone would queue the same entry again, for ever */
             rc = expand(s, &en);
         } else {
             rc = refine(s, &en);

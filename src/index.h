@@ -157,11 +157,16 @@ HD__INLINE double hd__min32(const double *c) {
     return a < b ? a : b;
 }
 
-/* The first position of value v in c (v must occur; always a real point). */
+/* The first position of value v in c (v occurs, and is a real point) --
+ * unless the caller's points changed during the call (hausdorff.h forbids
+ * it, but a Python thread can do it): a NaN written after validation makes
+ * v NaN, found nowhere, and then position 0 (always a real point) keeps
+ * the search in bounds.  The answer is then meaningless, but nothing is
+ * read out of bounds. */
 HD__INLINE int hd__find(const double *c, double v) {
     int k = 0;
-    while (c[k] != v) k++;
-    return k;
+    while (k < HD__BUCKET && c[k] != v) k++;
+    return k < HD__BUCKET ? k : 0;
 }
 
 /* The computed lower bound hd__box_lb2 without branches (same values: the
