@@ -140,9 +140,9 @@ static void capture_begin(captured_t *c) {
     }
 }
 
-/* Restore fd 2.  The first message libnifti2 wrote (a line with ERROR or
- * WARNING and the indented lines after it) goes to line as one line: its
- * "** " dropped, runs of blanks and control characters made one space,
+/* Restore fd 2.  The first message libnifti2 wrote (a line that starts
+ * with "** " or "++ ", its ERROR and WARNING prefixes, and the indented
+ * lines after it) goes to line as one line: the prefix dropped, runs of blanks and control characters made one space,
  * continuation lines joined with "; ".  "" when it wrote none. */
 static void capture_end(captured_t *c, char *line, size_t size) {
     line[0] = '\0';
@@ -157,11 +157,12 @@ static void capture_end(captured_t *c, char *line, size_t size) {
     while (fgets(buf, sizeof buf, c->tmp)) {
         int indented = buf[0] == ' ' || buf[0] == '\t';
         if (in && !indented) break;
-        if (!in && !strstr(buf, "ERROR") && !strstr(buf, "WARNING") && !strstr(buf, "error")) continue;
+        const char *q = buf + strspn(buf, "\r");
+        if (!in && strncmp(q, "** ", 3) != 0 && strncmp(q, "++ ", 3) != 0) continue;
         if (in && n + 2 < size) line[n++] = ';';
         in = 1;
         const char *p = buf;
-        while (*p == '*' || *p == '-' || *p == ' ' || *p == '\t' || *p == '\r') p++;
+        while (*p == '*' || *p == '+' || *p == '-' || *p == ' ' || *p == '\t' || *p == '\r') p++;
         if (n && n + 1 < size) line[n++] = ' ';
         for (; *p && n + 1 < size; p++) {
             int blank = (unsigned char)*p <= ' ';
