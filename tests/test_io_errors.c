@@ -426,6 +426,30 @@ TEST(pcd_binary_count_lower_than_the_data_is_refused_but_zero_padding_is_read) {
     hd_cloud_free(c);
 }
 
+TEST(pcd_width_times_height_must_be_points) {
+    const char *head = "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH %d\nHEIGHT %d\n"
+                       "POINTS 2\nDATA ascii\n1 2 3\n4 5 6\n";
+    refused(tf_printf("wh.pcd", head, 1, 1), HD_EFORMAT, "WIDTH 1 x HEIGHT 1 is not POINTS 2", NONE, 0);
+    refused(tf_printf("wh.pcd", head, 2, 2), HD_EFORMAT, "WIDTH 2 x HEIGHT 2 is not POINTS 2", NONE, 0);
+    hd_cloud_t *c;
+    hd_error_t e;
+    CHECK_RC(hd_read_file(tf_printf("wh.pcd", head, 2, 0), NULL, &c, &e), HD_OK); /* HEIGHT 0 is 1, as in PCL */
+    CHECK_EQ(c->count, 2);
+    hd_cloud_free(c);
+}
+
+TEST(off_face_of_fewer_than_three_vertices_is_refused_when_sampling) {
+    hd_read_options_t o;
+    hd_read_options_init(&o);
+    o.mesh = HD_MESH_SAMPLE;
+    o.sample = 4;
+    hd_cloud_t *c;
+    hd_error_t e;
+    CHECK_RC(hd_read_file(tf_printf("two.off", "OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n2 0 1 255 0 0\n"), &o, &c, &e),
+             HD_EFORMAT);
+    CHECK(strstr(e.message, "two.off:7: face with 2 vertices (at least 3 are needed)") != NULL);
+}
+
 TEST(las_count_lower_than_the_data_is_refused) {
     tf_buf_t b = las_header(2, 0, 20, 1, 227);
     for (int k = 0; k < 3 * 20; k++) tf_u8(&b, 1);

@@ -59,6 +59,10 @@ static void chunk(void *ctx, hd__chunk_t *c) {
             hd__chunk_fail(c, HD_EFORMAT, line, "face size '%.*s' is not a whole number", (int)(te - tb > 40 ? 40 : te - tb), tb);
             return;
         }
+        if (n < 3) {
+            hd__chunk_fail(c, HD_EFORMAT, line, "face with %llu vertices (at least 3 are needed)", (unsigned long long)n);
+            return;
+        }
         if (n > (uint64_t)(eol - q) / 2 + 1) {
             hd__chunk_fail(c, HD_EFORMAT, line, "face of %llu vertices does not fit on its line", (unsigned long long)n);
             return;

@@ -253,6 +253,14 @@ int hd__read_pcd(hd__read_t *r) {
         p->rec += p->f[k].size * p->f[k].count;
         p->tokens += p->f[k].count;
     }
+    if (rc == HD_OK && p->have_points && p->have_width) {
+        /* PCL refuses "HEIGHT x WIDTH != number of points"; HEIGHT 0 (or
+         * none) it takes as 1, and so do we */
+        uint64_t h = p->have_height && p->height ? p->height : 1;
+        if (p->width > UINT64_MAX / h || p->width * h != p->points)
+            rc = hd__io_err(r, HD_EFORMAT, "WIDTH %llu x HEIGHT %llu is not POINTS %llu",
+                            (unsigned long long)p->width, (unsigned long long)h, (unsigned long long)p->points);
+    }
     if (rc == HD_OK && !p->have_points) {
         if (!p->have_width) rc = hd__io_err(r, HD_EFORMAT, "the header gives neither POINTS nor WIDTH");
         else if (p->have_height && p->height && p->width > UINT64_MAX / p->height)
