@@ -5,6 +5,7 @@ Standard output on /dev/full or closed; --distances, --render and
 --histogram-png into a read-only directory, a missing one, or past a file
 size limit (RLIMIT_FSIZE: a disk that fills half-way, which also stops
 root); a run whose second file (OUT_b.csv) cannot be written leaves neither;
+a run killed by SIGTERM or cut off by SIGPIPE before its end leaves nothing;
 outputs that name an input (by path, ./path, a link, a hard link, standard
 input) are refused with exit 1 and the input is unchanged; a run that
 succeeds leaves complete files with the usual permissions and no temporary.
@@ -13,10 +14,12 @@ Standard library only (unittest); run as:
 """
 import os
 import resource
+import signal
 import stat
 import subprocess
 import sys
 import tempfile
+import time
 import unittest
 
 TESTS = []
@@ -190,6 +193,34 @@ def when_the_second_file_of_a_pair_fails_neither_appears(d):
     assert listing(d) == ["out.csv", "out_b.csv"], listing(d)
     for name in ("out.csv", "out_b.csv"):
         assert read(os.path.join(d, name)) == "old\n", name
+
+
+def temporaries(d):
+    return [n for n in listing(d) if ".tmp." in n]
+
+
+@test
+def a_run_killed_or_cut_off_before_its_end_leaves_no_file(d):
+    # A report of some MB on a pipe that nobody reads: the tool waits in its
+    # final flush with its files still temporaries.  SIGTERM then, or the
+    # reader leaving (SIGPIPE), must remove them.
+    for how in ("SIGTERM", "SIGPIPE"):
+        p = subprocess.Popen([TOOL, "--histogram", "--bins", "100000", "--distances", os.path.join(d, "out.csv"),
+                              SMALL, OTHER], stdout=subprocess.PIPE, stderr=subprocess.DEVNULL)
+        deadline = time.time() + 60
+        while not listing(d) and p.poll() is None and time.time() < deadline:  # a file or its temporary
+            time.sleep(0.02)
+        time.sleep(0.3)  # into the flush
+        assert p.poll() is None, "the tool did not wait for its reader (%s)" % how
+        if how == "SIGTERM":
+            p.send_signal(signal.SIGTERM)
+            p.stdout.close()
+        else:
+            p.stdout.close()
+        rc = p.wait(timeout=60)
+        sig = signal.SIGTERM if how == "SIGTERM" else signal.SIGPIPE
+        assert rc == -sig, (how, rc)
+        assert listing(d) == [], (how, listing(d))
 
 
 @test
