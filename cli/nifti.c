@@ -159,7 +159,7 @@ static void capture_end(captured_t *c, char *line, size_t size) {
         if (in && !indented) break;
         const char *q = buf + strspn(buf, "\r");
         if (!in && strncmp(q, "** ", 3) != 0 && strncmp(q, "++ ", 3) != 0) continue;
-        if (in && n + 2 < size) line[n++] = ';';
+        if (in && n && line[n - 1] != ':' && n + 2 < size) line[n++] = ';';
         in = 1;
         const char *p = buf;
         while (*p == '*' || *p == '+' || *p == '-' || *p == ' ' || *p == '\t' || *p == '\r') p++;
