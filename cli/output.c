@@ -329,9 +329,9 @@ static int commit(hd_error_t *err) {
             goto out;
         }
         if (many > 1 && s->had) {
-            size_t n = strlen(s->tmp); /* < PATH_MAX, and old has 8 more */
-            memcpy(s->old, s->tmp, n);
-            memcpy(s->old + n, ".old", sizeof ".old");
+            size_t len = strlen(s->tmp); /* < PATH_MAX, and old has 8 more */
+            memcpy(s->old, s->tmp, len);
+            memcpy(s->old + len, ".old", sizeof ".old");
             s->live_old = link(s->target, s->old) == 0;
         }
     }
