@@ -31,7 +31,7 @@ READERS := ply obj off stl xyz pcd las npy
 MESHES  := ply obj off stl
 TARGETS := $(READERS:%=fuzz_%) $(MESHES:%=fuzz_%_sample) fuzz_nifti fuzz_cli
 
-LIB_SRC := $(wildcard src/*.c src/io/*.c)
+LIB_SRC := $(wildcard src/*.c src/*/*.c)
 CLI_SRC := $(filter-out cli/main.c,$(wildcard cli/*.c))
 LIB_OBJ := $(LIB_SRC:%.c=$(OUT)/obj/%.o)
 CLI_OBJ := $(CLI_SRC:%.c=$(OUT)/obj/%.o)

@@ -50,11 +50,9 @@ if static_lib:
     depends.append(static_lib)
     link_args.append("-Wl,--exclude-libs,ALL")
 else:
-    lib = sorted(glob.glob(os.path.join(ROOT, "src", "*.c")) +
-                 glob.glob(os.path.join(ROOT, "src", "io", "*.c")))
+    lib = sorted(glob.glob(os.path.join(ROOT, "src", "**", "*.c"), recursive=True))
     sources += [os.path.relpath(p, HERE) for p in lib]
-    depends += glob.glob(os.path.join(ROOT, "src", "*.h")) + \
-        glob.glob(os.path.join(ROOT, "src", "io", "*.h"))
+    depends += glob.glob(os.path.join(ROOT, "src", "**", "*.h"), recursive=True)
 
 extension = Extension(
     "hausdorff._hausdorff",

@@ -1,22 +1,15 @@
 /*
- * api.c -- the public entry points for distances: options, algorithm names,
- * validation, dispatch, and the overlap degree that the framework uses.
+ * api.c -- the public entry points for distances (like Lua's lapi.c: the
+ * boundary, nothing more): options, algorithm names, validation, and the
+ * hand-off to the auto engine (src/engine/) or to the paper's algorithms
+ * through their dispatcher (src/classic/framework.c).
  *
  * Every public call validates its inputs here, once (non-empty, finite,
- * within HD_MAX_COORD), then hands the algorithm a job of packed doubles.
- * The framework (Algorithm 8) lives here too because it is only a choice:
- * disjoint boxes -> NOHD; overlap degree alpha <= theta -> EARLYBREAK;
- * otherwise OHD.
- *
- * The paper never defines alpha beyond "0 when A and B just touch, 1 when
- * they fully overlap".  We define it per axis as the length of the
- * intersection of the two extents over the shorter extent, and alpha as the
- * product over the three axes.  An axis on which the shorter extent has
- * length zero (a flat set, a single point) counts 1 when the extents meet:
- * the flat set lies wholly within the other's extent on that axis, which is
- * full overlap there.  docs/algorithms.md gives the reasoning.
+ * within HD_MAX_COORD, by src/points/), then hands the algorithm either the
+ * views (the engine reads them itself) or a job of packed doubles.
  */
-#include "internal.h"
+#include "classic/classic.h"
+#include "engine/engine.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -55,35 +48,6 @@ int hd_algorithm_from_name(const char *name, hd_algorithm_t *out) {
     return HD_EALGORITHM;
 }
 
-double hd__alpha(const hd__box_t *a, const hd__box_t *b, int *disjoint) {
-    double alpha = 1.0;
-    int apart = 0;
-    for (int k = 0; k < 3; k++) {
-        double lo = a->lo[k] > b->lo[k] ? a->lo[k] : b->lo[k];
-        double hi = a->hi[k] < b->hi[k] ? a->hi[k] : b->hi[k];
-        if (lo > hi) {
-            apart = 1;
-            continue;
-        }
-        double la = a->hi[k] - a->lo[k], lb = b->hi[k] - b->lo[k];
-        double shorter = la < lb ? la : lb;
-        double r = shorter > 0 ? (hi - lo) / shorter : 1.0;
-        if (r > 1.0) r = 1.0;
-        alpha *= r;
-    }
-    if (disjoint) *disjoint = apart;
-    return apart ? 0.0 : alpha;
-}
-
-hd_algorithm_t hd__framework_choice(const hd__box_t *a, const hd__box_t *b,
-                                    double theta) {
-    int disjoint;
-    double alpha = hd__alpha(a, b, &disjoint);
-    if (disjoint) return HD_ALG_NOHD;
-    if (alpha <= theta) return HD_ALG_EARLYBREAK;
-    return HD_ALG_OHD;
-}
-
 static int check_options(const hd_options_t *o, hd_error_t *err) {
     if ((int)o->algorithm < 0 || o->algorithm >= HD__ALG_COUNT)
         return hd__err(err, HD_EALGORITHM, "unknown algorithm %d", (int)o->algorithm);
@@ -95,33 +59,6 @@ static int check_options(const hd_options_t *o, hd_error_t *err) {
         return hd__err(err, HD_EINVAL, "lambda must be in (0, 1], not %g", o->lambda);
     if (!(o->theta >= 0.0 && o->theta <= 1.0))
         return hd__err(err, HD_EINVAL, "theta must be in [0, 1], not %g", o->theta);
-    return HD_OK;
-}
-
-/* Run one direction on a prepared job with algorithm `alg`. */
-int hd__run_directed(hd__job_t *job, hd_algorithm_t alg, hd_result_t *out,
-                     hd_error_t *err) {
-    memset(out, 0, sizeof *out);
-    if (alg == HD_ALG_FRAMEWORK)
-        alg = hd__framework_choice(&job->box_a, &job->box_b, job->opt->theta);
-    hd__directed_fn fn = NULL;
-    switch (alg) {
-    case HD_ALG_AUTO: fn = hd__engine; break;
-    case HD_ALG_NAIVE: fn = hd__naive; break;
-    case HD_ALG_EARLYBREAK: fn = hd__earlybreak; break;
-    case HD_ALG_INC: fn = hd__inc; break;
-    case HD_ALG_NOHD: fn = hd__nohd; break;
-    case HD_ALG_OHD: fn = hd__ohd; break;
-    case HD_ALG_KDTREE: fn = hd__kdtree; break;
-    default: return hd__err(err, HD_EALGORITHM, "unknown algorithm");
-    }
-    job->threads = hd__thread_count(job->opt->threads, job->na);
-    double t0 = hd__now();
-    int rc = fn(job, out, err);
-    out->seconds = hd__now() - t0;
-    if (rc != HD_OK) return rc;
-    if (out->algorithm == HD_ALG_AUTO && alg != HD_ALG_AUTO) out->algorithm = alg;
-    out->distance = sqrt(out->distance2);
     return HD_OK;
 }
 

@@ -35,8 +35,8 @@
  * A transform can carry a valid point out of range, so transformed query
  * points are checked (finite, within HD_MAX_COORD) before anything else.
  */
-#include "index.h"
-#include "allnearest.h"
+#include "engine/engine.h"
+#include "nearest/nearest.h"
 
 #include <math.h>
 #include <stdlib.h>

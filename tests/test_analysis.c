@@ -10,8 +10,8 @@
 #include "brute.h"
 #include "check.h"
 #include "gen.h"
-#include "allnearest.h"
-#include "internal.h"
+#include "nearest/nearest.h"
+#include "classic/classic.h"
 
 #include <math.h>
 #include <stdlib.h>

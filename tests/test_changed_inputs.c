@@ -10,7 +10,8 @@
  */
 #include "check.h"
 #include "gen.h"
-#include "index.h"
+#include "classic/classic.h"
+#include "engine/engine.h"
 
 #include <math.h>
 #include <stdlib.h>

@@ -19,7 +19,7 @@
 #include "brute.h"
 #include "check.h"
 #include "gen.h"
-#include "index.h" /* hd__engine_forced: each of the engine's two paths */
+#include "engine/engine.h"
 
 #include <math.h>
 #include <stdlib.h>

@@ -6,7 +6,7 @@
  */
 #include "check.h"
 #include "gen.h"
-#include "heap.h"
+#include "base/base.h"
 
 #include <math.h>
 #include <stdlib.h>

@@ -10,7 +10,7 @@
 #include "brute.h"
 #include "check.h"
 #include "gen.h"
-#include "octree.h"
+#include "classic/classic.h"
 
 #include <math.h>
 #include <stdlib.h>

@@ -6,7 +6,7 @@
 #ifndef HD_IO_H
 #define HD_IO_H
 
-#include "../internal.h"
+#include "points/points.h"
 
 #include <string.h>
 
@@ -45,8 +45,6 @@ HD__INLINE void hd__sink_set(hd__sink_t *s, size_t k, const double p[3]) {
         d[2] = p[2];
     }
 }
-/* Append all points of src (same dtype) to s. */
-int hd__sink_append(hd__sink_t *s, const hd__sink_t *src);
 void hd__sink_free(hd__sink_t *s);
 
 /* Check one coordinate triple: HD_ENONFINITE, HD_ERANGE (beyond

@@ -75,16 +75,6 @@ int hd__sink_push(hd__sink_t *s, const double p[3]) {
     return HD_OK;
 }
 
-int hd__sink_append(hd__sink_t *s, const hd__sink_t *src) {
-    if (!src->count) return HD_OK;
-    int rc = hd__sink_reserve(s, src->count);
-    if (rc) return rc;
-    size_t el = point_bytes(s->dtype);
-    memcpy((char *)s->data + s->count * el, src->data, src->count * el);
-    s->count += src->count;
-    return HD_OK;
-}
-
 void hd__sink_free(hd__sink_t *s) {
     free(s->data);
     s->data = NULL;

@@ -1,0 +1,173 @@
+/*
+ * base.h -- the foundation every layer stands on (src/base/): result codes
+ * and messages, checked allocation and arenas, seeded randomness, the
+ * thread pool, clocks, selection and percentiles, and the binary heap.
+ * Nothing here knows about points; everything above may use it.
+ */
+#ifndef HD_BASE_H
+#define HD_BASE_H
+
+#include "hausdorff.h"
+
+#include <stdarg.h>
+#include <stdatomic.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#define HD__NONE ((size_t)-1)
+
+#if defined(__GNUC__)
+#define HD__INLINE static inline __attribute__((always_inline))
+#define HD__PRINTF(f, a) __attribute__((format(printf, f, a)))
+#else
+#define HD__INLINE static inline
+#define HD__PRINTF(f, a)
+#endif
+
+/* The few hottest loops (distances to a whole bucket) are compiled twice on
+ * x86-64, for AVX2 and for the baseline, and the loader picks the version
+ * the machine runs (GCC's function multi-versioning).  Neither version uses
+ * fused multiply-add: -ffp-contract=off holds for both. */
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+#define HD__HOT __attribute__((target_clones("avx2", "default")))
+#else
+#define HD__HOT
+#endif
+
+/* ---- errors ----------------------------------------------------------- */
+/* Set err (if not NULL) and return code. */
+int hd__err(hd_error_t *err, int code, const char *fmt, ...) HD__PRINTF(3, 4);
+int hd__verr(hd_error_t *err, int code, const char *fmt, va_list ap);
+void hd__err_clear(hd_error_t *err);
+
+/* ---- memory ------------------------------------------------------------ */
+/* malloc(n * size) with the product checked; NULL on overflow or failure. */
+void *hd__malloc_array(size_t n, size_t size);
+void *hd__calloc_array(size_t n, size_t size);
+void *hd__realloc_array(void *p, size_t n, size_t size);
+/* 1 when a*b overflows size_t. */
+HD__INLINE int hd__mul_overflows(size_t a, size_t b) {
+    return b != 0 && a > SIZE_MAX / b;
+}
+
+/* A bump allocator: nodes come from large blocks, freed all at once. */
+typedef struct hd__arena {
+    struct hd__arena_block *head;
+    size_t block_size;
+    size_t total;
+} hd__arena_t;
+void hd__arena_init(hd__arena_t *a, size_t block_size);
+void *hd__arena_alloc(hd__arena_t *a, size_t size); /* 16-byte aligned */
+void hd__arena_free(hd__arena_t *a);
+
+/* ---- randomness (explicit seeds only) ------------------------------------ */
+typedef struct hd__rng {
+    uint64_t s[4];
+} hd__rng_t;
+void hd__rng_seed(hd__rng_t *r, uint64_t seed);
+uint64_t hd__rng_next(hd__rng_t *r);
+/* Uniform integer in [0, n), n > 0, without modulo bias. */
+uint64_t hd__rng_below(hd__rng_t *r, uint64_t n);
+/* Uniform double in [0, 1). */
+double hd__rng_unit(hd__rng_t *r);
+/* A random permutation of 0..n-1 (Fisher-Yates). */
+void hd__rng_permute(hd__rng_t *r, size_t *perm, size_t n);
+
+/* ---- threads ------------------------------------------------------------ */
+/* Number of threads to use for `requested` (0 = every core) and n items. */
+int hd__thread_count(int requested, size_t work_items);
+
+/* Run fn(ctx, task, worker) for task in [0, n_tasks) on `threads` threads
+ * (the caller's thread is worker 0).  Tasks are handed out in increasing
+ * order through an atomic counter.  It cannot fail: every task has run when
+ * it returns, even when threads or their handles cannot be had (then on
+ * fewer threads). */
+typedef void (*hd__task_fn)(void *ctx, size_t task, int worker);
+void hd__parallel_for(int threads, size_t n_tasks, hd__task_fn fn, void *ctx);
+
+/* ---- clocks ------------------------------------------------------------ */
+double hd__now(void); /* seconds, monotonic */
+
+/* ---- selection and percentiles (select.c) ------------------------------ */
+/* Rearrange v[0..n) (no NaN) so that v[k] holds the value of rank k, with
+ * v[i] <= v[k] before it and v[i] >= v[k] after it; expected O(n), worst
+ * O(n log n) (introselect). */
+void hd__select(double *v, size_t n, size_t k);
+/* HD_OK when 0 <= p <= 100, else HD_EINVAL with a message. */
+int hd__percentile_check(double p, hd_error_t *err);
+/* numpy-linear percentiles p[0..np) of v[0..n) (n > 0, no NaN, p checked),
+ * reordering v; out[r] answers p[r]. */
+int hd__percentiles_inplace(double *v, size_t n, const double *p, size_t np,
+                            double *out, hd_error_t *err);
+
+/* ---- a bound that only grows, shared by threads ------------------------- */
+/* A lower bound on h(A,B)^2 that threads raise together (the engine's
+ * cmax, and MaxLB / Maxlb of the paper's algorithms).  It holds a non-negative double whose bits, read as an unsigned
+ * integer, order like the values; it only grows, so a stale read is a
+ * smaller, still valid bound.  Pruning against it is strict (<), so it may
+ * start at 0 with no witness: nothing is ever strictly below 0. */
+typedef struct hd__bound {
+    _Atomic uint64_t bits;
+} hd__bound_t;
+HD__INLINE uint64_t hd__bound_bits(double d2) {
+    union { double d; uint64_t u; } v;
+    v.d = d2 > 0 ? d2 : 0.0; /* never -0.0, whose bits would sort last */
+    return v.u;
+}
+HD__INLINE void hd__bound_init(hd__bound_t *b, double d2) {
+    atomic_init(&b->bits, hd__bound_bits(d2));
+}
+HD__INLINE double hd__bound_get(hd__bound_t *b) {
+    union { double d; uint64_t u; } v;
+    v.u = atomic_load_explicit(&b->bits, memory_order_relaxed);
+    return v.d;
+}
+HD__INLINE void hd__bound_raise(hd__bound_t *b, double d2) {
+    uint64_t want = hd__bound_bits(d2);
+    uint64_t cur = atomic_load_explicit(&b->bits, memory_order_relaxed);
+    while (want > cur && !atomic_compare_exchange_weak_explicit(
+                             &b->bits, &cur, want, memory_order_relaxed,
+                             memory_order_relaxed)) {
+    }
+}
+
+/* ---- the binary heap (heap.c) ------------------------------------------- */
+/* a binary heap of (key, payload) pairs, usable as a max-queue
+ * (NOHD's decreasing priority queue, INC's queue of A entries) or as a
+ * min-queue (OHD's ascending queue in NNDist).
+ *
+ * The order is total and deterministic: a larger key comes first in a
+ * max-heap, a smaller key first in a min-heap, and equal keys come out by
+ * increasing payload in both.  Payloads are small integers chosen by the
+ * caller (node ids, entry slots), so two runs on the same input pop entries
+ * in the same order and report the same counters.
+ */
+typedef struct hd__heap_item {
+    double key;
+    uint64_t val;
+} hd__heap_item_t;
+
+typedef struct hd__heap {
+    hd__heap_item_t *a;
+    size_t n, cap;
+    int max_first; /* 1: largest key first; 0: smallest key first */
+} hd__heap_t;
+
+/* An empty heap; nothing is allocated until the first push or reserve. */
+void hd__heap_init(hd__heap_t *h, int max_first);
+/* Make room for `cap` items, so that the next pushes up to that size cannot
+ * fail.  Returns HD_OK or HD_ENOMEM. */
+int hd__heap_reserve(hd__heap_t *h, size_t cap);
+/* Insert an item, growing the storage when needed: HD_OK or HD_ENOMEM. */
+int hd__heap_push(hd__heap_t *h, double key, uint64_t val);
+/* Remove and return the first item; the heap must not be empty. */
+hd__heap_item_t hd__heap_pop(hd__heap_t *h);
+/* The first item without removing it (NULL when empty). */
+const hd__heap_item_t *hd__heap_top(const hd__heap_t *h);
+/* Forget every item, keeping the storage. */
+void hd__heap_clear(hd__heap_t *h);
+void hd__heap_free(hd__heap_t *h);
+
+static inline size_t hd__heap_size(const hd__heap_t *h) { return h->n; }
+
+#endif /* HD_BASE_H */

@@ -1,0 +1,339 @@
+/*
+ * engine_build.c -- building the engine's index of one point set: points
+ * sorted along a Morton (Z-order) curve, cut into buckets, with exact boxes.
+ *
+ * Why Morton order.  The engine's work is dominated by reading points, and
+ * a set whose points are listed along a space-filling curve has spatially
+ * coherent buckets: consecutive query points are near each other, so a
+ * search can start where the previous one ended, and the boxes of buckets
+ * and of runs of buckets are small.  Sorting costs a few linear passes (a
+ * radix sort), far less than the median splits of a kd-tree, and needs no
+ * copy of the coordinates, only a permutation.
+ *
+ * Keys.  Each point gets a 30-bit Morton key from a 1024^3 grid of cubic
+ * cells laid over the set's box (or over the box the caller gives, so that
+ * two sets can share a cell size and line up); the key is packed above the
+ * point's 32-bit original index, so sorting the 64-bit words sorts by
+ * (key, index) and the order is a function of the input alone, at any
+ * thread count.  The keys only decide the order: nothing exact depends on
+ * them.  A cell holding more than a bucket of points (a dense cluster,
+ * duplicates) is refined: its points are re-keyed on a grid over their own exact box and sorted again,
+ * recursively, until every run of equal keys fits in a bucket or consists of
+ * identical points.
+ *
+ * Boxes.  Every bucket's box is the exact box of its points, read as the
+ * doubles the distance computations read (after the transform, if any);
+ * every tree node's box is the union of its children's.  Boxes therefore
+ * enclose their points exactly, which is what makes the pruning tests of
+ * the searches exact without an epsilon (see internal.h).
+ *
+ * Quantised copy.  Each bucket also keeps its points' coordinates as 16-bit
+ * fractions of its box and `err`, a proven bound on the distance between a
+ * point and its dequantised approximation (make_bucket), so that searches
+ * can decide most questions without reading the scattered input.
+ *
+ * Memory.  The sort uses two arrays of 8 bytes per point; the result keeps
+ * 4 bytes per point for the permutation, 6 for the quantised copy, 56 per
+ * bucket of 32 for its box and err, and 48 per tree node (about one per
+ * bucket): 13.25 bytes per point.
+ */
+#include "engine/engine.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ---- keys ------------------------------------------------------------------ */
+
+#define SLICE 16384
+
+typedef struct {
+    const hd__src_t *src;
+    size_t n;
+    hd__keygrid_t grid;
+    uint64_t *keys;
+    hd__box_t *part_box;
+} key_ctx;
+
+static void box_task(void *vctx, size_t task, int worker) {
+    (void)worker;
+    key_ctx *c = vctx;
+    size_t lo = task * SLICE, hi = lo + SLICE < c->n ? lo + SLICE : c->n;
+    hd__box_t b;
+    double p[3];
+    hd__src_get(c->src, lo, p);
+    for (int k = 0; k < 3; k++) b.lo[k] = b.hi[k] = p[k];
+    for (size_t i = lo + 1; i < hi; i++) {
+        hd__src_get(c->src, i, p);
+        for (int k = 0; k < 3; k++) {
+            b.lo[k] = p[k] < b.lo[k] ? p[k] : b.lo[k];
+            b.hi[k] = p[k] > b.hi[k] ? p[k] : b.hi[k];
+        }
+    }
+    c->part_box[task] = b;
+}
+
+static void key_task(void *vctx, size_t task, int worker) {
+    (void)worker;
+    key_ctx *c = vctx;
+    size_t lo = task * SLICE, hi = lo + SLICE < c->n ? lo + SLICE : c->n;
+    hd__src_keys(c->src, &c->grid, lo, hi, c->keys);
+}
+
+/* ---- refinement of crowded cells ------------------------------------------- */
+
+static void insertion_sort(uint64_t *a, size_t n) {
+    for (size_t i = 1; i < n; i++) {
+        uint64_t v = a[i];
+        size_t j = i;
+        while (j > 0 && a[j - 1] > v) {
+            a[j] = a[j - 1];
+            j--;
+        }
+        a[j] = v;
+    }
+}
+
+/* Re-key and sort the run a[0..m) (all with equal keys) on a grid over its
+ * own box, then refine its crowded sub-runs.  tmp has room for m words. */
+static int refine(const hd__src_t *src, uint64_t *a, uint64_t *tmp, size_t m, int depth) {
+    hd__box_t b;
+    double p[3];
+    hd__src_get(src, (uint32_t)a[0], p);
+    for (int k = 0; k < 3; k++) b.lo[k] = b.hi[k] = p[k];
+    for (size_t i = 1; i < m; i++) {
+        hd__src_get(src, (uint32_t)a[i], p);
+        for (int k = 0; k < 3; k++) {
+            b.lo[k] = p[k] < b.lo[k] ? p[k] : b.lo[k];
+            b.hi[k] = p[k] > b.hi[k] ? p[k] : b.hi[k];
+        }
+    }
+    hd__keygrid_t g;
+    hd__keygrid_init(&g, &b);
+    if (g.scale == 0.0 || depth > 200) return HD_OK; /* identical points */
+    for (size_t i = 0; i < m; i++) {
+        hd__src_get(src, (uint32_t)a[i], p);
+        a[i] = (uint64_t)hd__key30(&g, p) << 32 | (a[i] & 0xffffffffu);
+    }
+    if (m <= 64) {
+        insertion_sort(a, m);
+    } else {
+        uint64_t *x = a, *y = tmp;
+        int rc = hd__radix_sort(&x, &y, m, 1);
+        if (rc) return rc;
+        if (x != a) memcpy(a, x, m * sizeof *a);
+    }
+    for (size_t s = 0; s < m;) {
+        size_t e = s + 1;
+        while (e < m && a[e] >> 32 == a[s] >> 32) e++;
+        if (e - s > HD__BUCKET) {
+            int rc = refine(src, a + s, tmp + s, e - s, depth + 1);
+            if (rc) return rc;
+        }
+        s = e;
+    }
+    return HD_OK;
+}
+
+/* ---- buckets and boxes ------------------------------------------------------ */
+
+typedef struct {
+    hd__tree_t *t;
+    int level;
+} boxes_ctx;
+
+#define BOX_TASK 512 /* buckets (or nodes) per task */
+
+/* Bucket b: gather its points, take their exact box, quantise each
+ * coordinate to 16 bits over the box, and measure the error of the
+ * dequantised points (hd__bucket_decode) against the exact ones.  The
+ * computed difference fl(x - x~) is within a factor (1 + 2^-53) of the true
+ * one, so err = sqrt(3) * max |fl(x - x~)| * (1 + slack) bounds the true
+ * Euclidean distance between a point and its approximation. */
+static void make_bucket(hd__tree_t *t, size_t b) {
+    size_t s = b * HD__BUCKET;
+    int m = hd__bucket_size(t, b);
+    double p[3][HD__BUCKET];
+    if (t->src.kind != 2 && b + 1 < t->nb) {
+        /* The points are scattered in memory: ask for the next bucket's
+         * points early so their loads overlap with this bucket's work. */
+        ptrdiff_t el = t->src.kind == 0 ? 24 : 12;
+        size_t e = s + HD__BUCKET, pe = e + HD__BUCKET < t->n ? e + HD__BUCKET : t->n;
+        for (size_t i = e; i < pe; i++) __builtin_prefetch(t->src.base + (ptrdiff_t)t->perm[i] * el);
+    }
+    for (int k = 0; k < m; k++) {
+        double v[3];
+        hd__src_get(&t->src, t->perm[s + (size_t)k], v);
+        p[0][k] = v[0], p[1][k] = v[1], p[2][k] = v[2];
+    }
+    /* Pad a short bucket with copies of its first point, so that the loops
+     * below run over whole buckets (and vectorise). */
+    for (int k = m; k < HD__BUCKET; k++) p[0][k] = p[0][0], p[1][k] = p[1][0], p[2][k] = p[2][0];
+    hd__bucket_t *bk = &t->bucket[b];
+    uint16_t *q = t->q + b * 3 * HD__BUCKET;
+    double err = 0;
+    for (int c = 0; c < 3; c++) {
+        const double *v = p[c];
+        /* Four running extremes each: independent chains, no branches. */
+        double l4[4] = {v[0], v[1], v[2], v[3]}, h4[4] = {v[0], v[1], v[2], v[3]};
+        for (int k = 4; k < HD__BUCKET; k += 4)
+            for (int r = 0; r < 4; r++) {
+                l4[r] = v[k + r] < l4[r] ? v[k + r] : l4[r];
+                h4[r] = v[k + r] > h4[r] ? v[k + r] : h4[r];
+            }
+        double lo = l4[0], hi = h4[0];
+        for (int r = 1; r < 4; r++) {
+            lo = l4[r] < lo ? l4[r] : lo;
+            hi = h4[r] > hi ? h4[r] : hi;
+        }
+        bk->box.lo[c] = lo;
+        bk->box.hi[c] = hi;
+        double step = (hi - lo) * (1.0 / 65535.0);
+        double inv = step > 0 ? 1.0 / step : 0.0;
+        int32_t qi[HD__BUCKET];
+        for (int k = 0; k < HD__BUCKET; k++) {
+            double u = (v[k] - lo) * inv + 0.5; /* >= 0.5: v[k] >= lo */
+            qi[k] = (int32_t)(u < 65535.0 ? u : 65535.0);
+        }
+        double e4[4] = {0, 0, 0, 0};
+        for (int k = 0; k < HD__BUCKET; k += 4)
+            for (int r = 0; r < 4; r++) {
+                /* The dequantised value exactly as hd__bucket_decode computes it. */
+                double d = fabs(v[k + r] - (lo + (double)qi[k + r] * step));
+                e4[r] = d > e4[r] ? d : e4[r];
+            }
+        for (int r = 0; r < 4; r++) err = e4[r] > err ? e4[r] : err;
+        for (int k = 0; k < HD__BUCKET; k++) q[c * HD__BUCKET + k] = (uint16_t)qi[k];
+    }
+    /* sqrt(3) rounded up, and slack for the rounding of this product. */
+    bk->err = err * 1.7320508075688776 * (1 + 1e-12);
+}
+
+static void bucket_task(void *vctx, size_t task, int worker) {
+    (void)worker;
+    boxes_ctx *c = vctx;
+    hd__tree_t *t = c->t;
+    size_t lo = task * BOX_TASK, hi = lo + BOX_TASK < t->nb ? lo + BOX_TASK : t->nb;
+    for (size_t b = lo; b < hi; b++) make_bucket(t, b);
+}
+
+static void node_boxes(void *vctx, size_t task, int worker) {
+    (void)worker;
+    boxes_ctx *c = vctx;
+    hd__tree_t *t = c->t;
+    int l = c->level;
+    size_t lo = task * BOX_TASK, hi = lo + BOX_TASK < t->count[l] ? lo + BOX_TASK : t->count[l];
+    for (size_t i = lo; i < hi; i++) {
+        hd__box_t b = *hd__tree_box(t, l - 1, 2 * i);
+        if (2 * i + 1 < t->count[l - 1]) hd__box_merge(&b, hd__tree_box(t, l - 1, 2 * i + 1));
+        t->nodes[t->off[l] + i] = b;
+    }
+}
+
+/* ---- the build ---------------------------------------------------------------- */
+
+void hd__tree_free(hd__tree_t *t) {
+    if (!t) return;
+    free(t->perm);
+    free(t->q);
+    free(t->bucket);
+    free(t->nodes);
+    t->perm = NULL;
+    t->q = NULL;
+    t->bucket = NULL;
+    t->nodes = NULL;
+}
+
+static size_t node_count(const hd__tree_t *t) {
+    return t->levels > 1 ? t->off[t->levels - 1] + 1 : 0;
+}
+
+size_t hd__tree_memory(const hd__tree_t *t) {
+    return t->n * sizeof *t->perm + t->nb * (3 * HD__BUCKET * sizeof *t->q + sizeof *t->bucket) +
+           node_count(t) * sizeof *t->nodes;
+}
+
+int hd__tree_build(hd__tree_t *t, const hd__src_t *src, size_t n, const hd__box_t *grid_box,
+                   int threads, hd_error_t *err) {
+    memset(t, 0, sizeof *t);
+    if (n == 0) return hd__err(err, HD_EEMPTY, "empty point set");
+    if (n > UINT32_MAX)
+        return hd__err(err, HD_EOVERFLOW,
+                       "the auto engine indexes at most 4294967295 points per set, not %zu", n);
+    if (threads < 1) threads = 1;
+    t->n = n;
+    t->src = *src;
+    t->nb = (n + HD__BUCKET - 1) / HD__BUCKET;
+    t->count[0] = t->nb;
+    t->off[0] = 0;
+    t->levels = 1;
+    while (t->count[t->levels - 1] > 1) {
+        int l = t->levels++;
+        t->count[l] = (t->count[l - 1] + 1) / 2;
+        t->off[l] = l == 1 ? 0 : t->off[l - 1] + t->count[l - 1];
+    }
+
+    key_ctx kc;
+    kc.src = src;
+    kc.n = n;
+    size_t slices = (n + SLICE - 1) / SLICE;
+    uint64_t *keys = hd__malloc_array(n, sizeof *keys);
+    uint64_t *tmp = hd__malloc_array(n, sizeof *tmp);
+    kc.part_box = hd__malloc_array(slices, sizeof *kc.part_box);
+    int rc = HD_OK;
+    if (!keys || !tmp || !kc.part_box) {
+        rc = HD_ENOMEM;
+        goto done;
+    }
+    kc.keys = keys;
+    if (grid_box) {
+        t->box = *grid_box;
+    } else {
+        hd__parallel_for(threads, slices, box_task, &kc);
+        t->box = kc.part_box[0];
+        for (size_t s = 1; s < slices; s++) hd__box_merge(&t->box, &kc.part_box[s]);
+    }
+    hd__keygrid_init(&kc.grid, &t->box);
+    hd__parallel_for(threads, slices, key_task, &kc);
+    if ((rc = hd__radix_sort(&keys, &tmp, n, threads))) goto done;
+    for (size_t s = 0; s < n;) {
+        size_t e = s + 1;
+        while (e < n && keys[e] >> 32 == keys[s] >> 32) e++;
+        if (e - s > HD__BUCKET && (rc = refine(src, keys + s, tmp + s, e - s, 0))) goto done;
+        s = e;
+    }
+    free(tmp);
+    tmp = NULL;
+    t->perm = hd__malloc_array(n, sizeof *t->perm);
+    if (!t->perm) {
+        rc = HD_ENOMEM;
+        goto done;
+    }
+    for (size_t k = 0; k < n; k++) t->perm[k] = (uint32_t)keys[k];
+    free(keys);
+    keys = NULL;
+    t->q = hd__malloc_array(t->nb, 3 * HD__BUCKET * sizeof *t->q);
+    t->bucket = hd__malloc_array(t->nb, sizeof *t->bucket);
+    t->nodes = hd__malloc_array(node_count(t), sizeof *t->nodes);
+    if (!t->q || !t->bucket || !t->nodes) {
+        rc = HD_ENOMEM;
+        goto done;
+    }
+    boxes_ctx bc;
+    bc.t = t;
+    bc.level = 0;
+    hd__parallel_for(threads, (t->nb + BOX_TASK - 1) / BOX_TASK, bucket_task, &bc);
+    for (int l = 1; l < t->levels; l++) {
+        bc.level = l;
+        hd__parallel_for(threads, (t->count[l] + BOX_TASK - 1) / BOX_TASK, node_boxes, &bc);
+    }
+done:
+    free(keys);
+    free(tmp);
+    free(kc.part_box);
+    if (rc != HD_OK) {
+        hd__tree_free(t);
+        return hd__err(err, rc, "cannot allocate the index of %zu points", n);
+    }
+    return HD_OK;
+}

@@ -1,0 +1,742 @@
+/*
+ * engine.c -- the `auto` engine: its plan (a copy or subset settled by
+ * engine_pairs.c, else the grid pass or the bucket trees), the walk over the
+ * bucket trees, the shared maximum, and the entry points.  docs/engine.md
+ * explains the design; the essay here is its summary.
+ *
+ * The plan.  First the shortcuts of engine_pairs.c, which need no index: two
+ * sets of one size listed in the same order (a copy and its original) are
+ * settled by their pair distances, and a smaller set that is an ordered
+ * subset of the larger has h = 0 in its direction.  For what is left, both
+ * sets get the cheap grid of engine_grid.c.  For each
+ * direction h(A,B), cmax is primed with the exact nearest distances of the
+ * representatives of A's cells lying where B is emptiest (the paper's AHD,
+ * Algorithm 6, line 1), then the grid pass is tried on a sample of A.  When
+ * it is cheap in every direction it runs; otherwise (nearly identical sets,
+ * where the distance is below the points' spacing) both sets get the bucket
+ * trees of engine_build.c and the walk below runs.
+ *
+ * The walk of h(A,B) over the trees combines three of the paper's ideas:
+ *  1. cmax is primed again from points spread along A's curve and from the
+ *     buckets of A with the largest boxes (sparse regions).
+ *  2. A whole node of A is discarded when one point b of B is proven
+ *     strictly within cmax of every point of the node's box (the paper's
+ *     CubeToPoints, Algorithm 4, lines 5-7, applied to A's nodes); b is the
+ *     last point of B that discarded something.
+ *  3. A bucket of A is resolved together from its quantised copy: against
+ *     that b, the buckets of B at the same place along B's curve, a short
+ *     walk of B's tree nearby; each pair the approximations cannot decide is
+ *     decided exactly; the points left get their own search, which stops at
+ *     the first proof of a point within cmax (EARLYBREAK, Algorithm 2, lines
+ *     8-10) or is an exact nearest-neighbour search.
+ * Threads take subtrees of A from a shared counter; they share cmax through
+ * an atomic and the maximum with its witness under a mutex.
+ *
+ * Exactness and the witness.  cmax is always the exact nearest distance of
+ * some point of A, so it never exceeds h(A,B).  A point or node is discarded
+ * only when a point of B is proven (exactly, or through the bounds of
+ * index.h) strictly within cmax of it, or at most at a maximum already
+ * attained at a smaller index of A (hd__kills): it cannot be the witness.
+ * Every other point gets an exact search with the smallest nearest index
+ * (engine_search.c, engine_grid.c), and the maxima merge with
+ * hd__best_offer (larger distance, then smaller index).  The result is the
+ * brute force's, bit for bit, at any thread count and in any schedule:
+ * timing changes only how much is discarded, never what survives.
+ */
+#include "engine/engine.h"
+
+#include <math.h>
+#include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ---- one direction ------------------------------------------------------------ */
+
+typedef struct {
+    hd__counts_t counts;
+    uint64_t culled;
+} worker_t;
+
+typedef struct {
+    const hd__tree_t *ta, *tb;
+    hd__max_t *m;         /* the maximum so far, shared */
+    int task_level;
+    int extra_level;      /* log2 of how many buckets of B a bucket of A spans */
+    worker_t *w;
+} dir_ctx;
+
+/* The state of one task's walk. */
+typedef struct {
+    dir_ctx *c;
+    worker_t *w;
+    hd__best_t snap;   /* a consistent copy of c->best */
+    double bc[3];      /* the last point of B that discarded something, */
+    double bc_err;     /* known within this distance */
+    int have_bc;
+    size_t hint;       /* bucket of B where the last search ended */
+} walk_t;
+
+static void walk_init(walk_t *s, dir_ctx *c, worker_t *w) {
+    s->c = c;
+    s->w = w;
+    hd__max_snapshot(c->m, &s->snap);
+    s->have_bc = 0;
+    s->hint = HD__NONE;
+}
+
+static size_t node_points(const hd__tree_t *t, int level, size_t i) {
+    size_t first = (i << level) * HD__BUCKET;
+    size_t last = ((i + 1) << level) * HD__BUCKET;
+    if (last > t->n) last = t->n;
+    return last - first;
+}
+
+/* The smallest squared distance between two boxes (0 when they meet). */
+HD__INLINE double box_gap2(const hd__box_t *a, const hd__box_t *b) {
+    double d[3];
+    for (int k = 0; k < 3; k++) {
+        double v = 0.0;
+        if (a->lo[k] > b->hi[k]) v = a->lo[k] - b->hi[k];
+        else if (b->lo[k] > a->hi[k]) v = b->lo[k] - a->hi[k];
+        d[k] = v;
+    }
+    return d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+}
+
+HD__INLINE double centre_gap2(const hd__box_t *a, const hd__box_t *b) {
+    double d = 0;
+    for (int k = 0; k < 3; k++) {
+        double u = (a->lo[k] + a->hi[k]) - (b->lo[k] + b->hi[k]);
+        d += u * u;
+    }
+    return d;
+}
+
+/* Resolve one exact point a (original index ia) by a search: discard it,
+ * or offer its exact nearest distance.  A point of B at squared distance
+ * < cmax^2 discards it (its nearest distance is below the maximum); so does
+ * one at distance <= the maximum found so far when that maximum was
+ * attained at a smaller index (it cannot be the witness). */
+static void resolve_point(walk_t *s, const double a[3], size_t ia) {
+    double cmax2 = hd__bound_get(&s->c->m->cmax);
+    double tie2 = ia > s->snap.i ? s->snap.d2 : -1.0;
+    hd__hit_t hit;
+    hd__tree_nearest(s->c->tb, a, cmax2, tie2, s->hint, &hit, &s->w->counts);
+    s->hint = hit.bucket;
+    memcpy(s->bc, hit.p, sizeof s->bc);
+    s->bc_err = hit.perr;
+    s->have_bc = 1;
+    if (hit.killed || hit.d2 < cmax2 || hit.d2 <= tie2) return;
+    hd__max_offer(s->c->m, hit.d2, ia, hit.j, &s->snap);
+}
+
+/* Buckets of B tried on each side of the last useful one, along B's curve. */
+#define NEIGHBOURS 2
+
+/* The shared walk of a bucket of A visits at most BLOCK_LEAVES buckets of
+ * B, within the subtree of 2^BLOCK_LEVEL buckets around the last useful one,
+ * before the points left over get their own searches. */
+#define BLOCK_LEAVES 8
+#define BLOCK_LEVEL 3
+
+/* The points of one bucket of A being resolved together, known through
+ * their quantised copy within err. */
+typedef struct {
+    int m;
+    uint32_t alive; /* bit k: point k not yet discarded */
+    double x[HD__BUCKET], y[HD__BUCKET], z[HD__BUCKET];
+    double err;
+    size_t first;   /* position of point 0 in A's order */
+    uint32_t read;  /* bit k: point k's exact coordinates are in a[k] */
+    double a[HD__BUCKET][3];
+    size_t ia[HD__BUCKET]; /* original indices */
+    double tie2;    /* the maximum so far when a live point may lose a tie
+                     * to its witness (a larger index), else -1 */
+} group_t;
+
+/* The exact coordinates of point k of the group (read once). */
+static const double *group_exact(const hd__tree_t *ta, group_t *g, int k) {
+    if (!(g->read >> k & 1u)) {
+        hd__src_get(&ta->src, g->ia[k], g->a[k]);
+        g->read |= 1u << k;
+    }
+    return g->a[k];
+}
+
+/* Try bucket i of B on the live points of g; a point is discarded when the
+ * approximations prove some point of the bucket strictly within cmax, or
+ * when the pair is too close to call and its exact distance does.
+ * Returns 1 when the bucket was read. */
+HD__HOT static int try_bucket(walk_t *s, group_t *g, size_t i, double cmax2) {
+    const hd__tree_t *tb = s->c->tb;
+    const hd__bucket_t *bb = &tb->bucket[i];
+    double lim = hd__kill_below(cmax2, g->err + bb->err);
+    double reach = hd__may_reach(cmax2, g->err + bb->err);
+    uint32_t near = 0;
+    for (uint32_t left = g->alive; left; left &= left - 1) {
+        int k = __builtin_ctz(left);
+        double lb = hd__box_lb2s(&bb->box, g->x[k], g->y[k], g->z[k]);
+        /* Within cmax, or at most the maximum for a point that would lose the
+         * tie (with cmax = 0, as for a subset, only exact duplicates count). */
+        if (lb < cmax2 || (lb <= s->snap.d2 && g->ia[k] > s->snap.i)) near |= 1u << k;
+    }
+    if (!near) return 0;
+    double x[HD__BUCKET], y[HD__BUCKET], z[HD__BUCKET];
+    int mb = hd__bucket_decode(tb, i, x, y, z);
+    int close_k[HD__BUCKET], close_b[HD__BUCKET], n_close = 0;
+    for (uint32_t left = near; left; left &= left - 1) {
+        int k = __builtin_ctz(left);
+        double d[HD__BUCKET];
+        const double ax = g->x[k], ay = g->y[k], az = g->z[k];
+        for (int q = 0; q < HD__BUCKET; q++) d[q] = hd__d2s(ax, ay, az, x[q], y[q], z[q]);
+        s->w->counts.evals += (uint64_t)mb;
+        double mn = hd__min32(d);
+        if (mn > reach) continue;
+        int arg = hd__find(d, mn);
+        if (mn < lim) {
+            g->alive &= ~(1u << k);
+            s->bc[0] = x[arg], s->bc[1] = y[arg], s->bc[2] = z[arg];
+            s->bc_err = bb->err;
+            s->have_bc = 1;
+            s->hint = i;
+            continue;
+        }
+        close_k[n_close] = k;
+        close_b[n_close++] = arg;
+    }
+    if (!n_close) return 1;
+    /* Pairs too close to call from the approximations (ties, or nearly) are
+     * decided exactly; their scattered loads are started together. */
+    const hd__tree_t *ta = s->c->ta;
+    if (ta->src.kind != 2 && tb->src.kind != 2) {
+        ptrdiff_t ea = ta->src.kind == 0 ? 24 : 12, eb = tb->src.kind == 0 ? 24 : 12;
+        for (int r = 0; r < n_close; r++) {
+            __builtin_prefetch(ta->src.base + (ptrdiff_t)ta->perm[g->first + (size_t)close_k[r]] * ea);
+            __builtin_prefetch(tb->src.base + (ptrdiff_t)tb->perm[i * HD__BUCKET + (size_t)close_b[r]] * eb);
+        }
+    }
+    for (int r = 0; r < n_close; r++) {
+        int k = close_k[r];
+        const double *a = group_exact(ta, g, k);
+        double b[3];
+        hd__src_get(&tb->src, tb->perm[i * HD__BUCKET + (size_t)close_b[r]], b);
+        double e = hd__d2(a, b);
+        s->w->counts.exact++;
+        if (hd__kills(cmax2, &s->snap, e, g->ia[k])) {
+            g->alive &= ~(1u << k);
+            memcpy(s->bc, b, sizeof s->bc);
+            s->bc_err = 0;
+            s->have_bc = 1;
+            s->hint = i;
+        }
+    }
+    return 1;
+}
+
+/* Resolve the points of A's bucket bk together, from their quantised copy:
+ * try the last useful point of B on each; then the bucket of B where the
+ * last search ended and its neighbours along B's curve (for nearly
+ * identical sets the nearest points sit at nearly the same place on both
+ * curves); then a short walk of B's tree for the whole bucket, nearest
+ * buckets first.  Every point that the approximations prove irrelevant is
+ * discarded; the points left are read exactly and get their own search. */
+static void walk_bucket(walk_t *s, size_t bk) {
+    const hd__tree_t *ta = s->c->ta, *tb = s->c->tb;
+    group_t g;
+    g.m = hd__bucket_decode(ta, bk, g.x, g.y, g.z);
+    g.err = ta->bucket[bk].err;
+    g.first = bk * HD__BUCKET;
+    g.read = 0;
+    double cmax2 = hd__bound_get(&s->c->m->cmax);
+    g.alive = g.m == 32 ? 0xffffffffu : (1u << g.m) - 1;
+    g.tie2 = -1.0;
+    for (int k = 0; k < g.m; k++) {
+        g.ia[k] = ta->perm[g.first + (size_t)k];
+        if (g.ia[k] > s->snap.i) g.tie2 = s->snap.d2;
+    }
+    if (s->have_bc) {
+        double lim = hd__kill_below(cmax2, g.err + s->bc_err);
+        for (int k = 0; k < g.m; k++)
+            if (hd__d2s(g.x[k], g.y[k], g.z[k], s->bc[0], s->bc[1], s->bc[2]) < lim)
+                g.alive &= ~(1u << k);
+        s->w->counts.evals += (uint64_t)g.m;
+    }
+    if (g.alive) {
+        /* Two guesses: the bucket at the same relative position along B's
+         * curve, and the bucket where the last search ended. */
+        size_t guess[2] = {(size_t)((double)bk * (double)tb->nb / (double)ta->nb), s->hint};
+        for (int q = 0; q < 2 && g.alive; q++) {
+            size_t h = guess[q];
+            if (h == HD__NONE || (q == 1 && h + NEIGHBOURS >= guess[0] && h <= guess[0] + NEIGHBOURS)) continue;
+            if (h >= tb->nb) h = tb->nb - 1;
+            try_bucket(s, &g, h, cmax2);
+            for (size_t r = 1; r <= NEIGHBOURS && g.alive; r++) {
+                if (h + r < tb->nb) try_bucket(s, &g, h + r, cmax2);
+                if (g.alive && h >= r) try_bucket(s, &g, h - r, cmax2);
+            }
+        }
+    }
+    const hd__box_t *ba = hd__tree_box(ta, 0, bk);
+    struct {
+        int level;
+        size_t i;
+        double gap2;
+    } stack[2 * HD__MAX_LEVELS + 2];
+    int sp = 0, leaves = 0;
+    /* The shared walk pays when cmax is small next to the bucket (nearly
+     * identical sets): then only the few buckets of B overlapping this one
+     * can discard its points, and the walk visits just those.  When cmax is
+     * larger than the bucket, many buckets of B lie within cmax of it and
+     * per-point searches, ordered by each point's own distance, do better. */
+    double diag2 = 0;
+    for (int k = 0; k < 3; k++) diag2 += (ba->hi[k] - ba->lo[k]) * (ba->hi[k] - ba->lo[k]);
+    if (g.alive && diag2 > cmax2) {
+        /* The walk covers the subtree of BLOCK_SPAN buckets around the last
+         * useful bucket of B: points that close are close along the curve
+         * too, apart from the curve's jumps, which the searches handle. */
+        int l = BLOCK_LEVEL + s->c->extra_level;
+        if (l > tb->levels - 1) l = tb->levels - 1;
+        size_t h = s->hint != HD__NONE ? s->hint : 0;
+        stack[0].level = l;
+        stack[0].i = h >> l;
+        stack[0].gap2 = box_gap2(ba, hd__tree_box(tb, l, h >> l));
+        sp = 1;
+    }
+    /* A node of B matters when it may hold a point strictly within cmax,
+     * or one at most the maximum for a point that would lose the tie. */
+#define MATTERS(gap2) ((gap2) < cmax2 || (gap2) <= g.tie2)
+    while (sp > 0 && g.alive && leaves < (BLOCK_LEAVES << s->c->extra_level)) {
+        sp--;
+        if (!MATTERS(stack[sp].gap2)) continue;
+        int l = stack[sp].level;
+        size_t i = stack[sp].i;
+        s->w->counts.nodes++;
+        if (l == 0) {
+            try_bucket(s, &g, i, cmax2);
+            leaves++;
+            continue;
+        }
+        size_t c0 = 2 * i, c1 = 2 * i + 1;
+        const hd__box_t *b0 = hd__tree_box(tb, l - 1, c0);
+        double g0 = box_gap2(ba, b0);
+        if (c1 >= tb->count[l - 1]) {
+            if (MATTERS(g0)) stack[sp].level = l - 1, stack[sp].i = c0, stack[sp].gap2 = g0, sp++;
+            continue;
+        }
+        const hd__box_t *b1 = hd__tree_box(tb, l - 1, c1);
+        double g1 = box_gap2(ba, b1);
+        /* Nearer child (by gap, then by centre distance) on top. */
+        if (g0 > g1 || (g0 == g1 && centre_gap2(ba, b0) > centre_gap2(ba, b1))) {
+            size_t t = c0;
+            c0 = c1;
+            c1 = t;
+            double u = g0;
+            g0 = g1;
+            g1 = u;
+        }
+        if (MATTERS(g1)) stack[sp].level = l - 1, stack[sp].i = c1, stack[sp].gap2 = g1, sp++;
+        if (MATTERS(g0)) stack[sp].level = l - 1, stack[sp].i = c0, stack[sp].gap2 = g0, sp++;
+    }
+#undef MATTERS
+    s->w->culled += (uint64_t)(g.m - __builtin_popcount(g.alive));
+    if (!g.alive) return;
+    /* The points left are read exactly; start all their loads at once. */
+    if (ta->src.kind != 2) {
+        ptrdiff_t el = ta->src.kind == 0 ? 24 : 12;
+        for (int k = 0; k < g.m; k++)
+            if ((g.alive >> k & 1u) && !(g.read >> k & 1u))
+                __builtin_prefetch(ta->src.base + (ptrdiff_t)ta->perm[g.first + (size_t)k] * el);
+    }
+    for (int k = 0; k < g.m; k++) {
+        if (!(g.alive >> k & 1u)) continue;
+        const double *a = group_exact(ta, &g, k); /* sets g.ia[k] */
+        resolve_point(s, a, g.ia[k]);
+    }
+}
+
+static void walk_node(walk_t *s, int level, size_t i) {
+    const hd__tree_t *ta = s->c->ta;
+    if (s->have_bc) {
+        double cmax2 = hd__bound_get(&s->c->m->cmax);
+        if (hd__box_ub2(hd__tree_box(ta, level, i), s->bc) < hd__kill_below(cmax2, s->bc_err)) {
+            s->w->culled += node_points(ta, level, i);
+            return;
+        }
+    }
+    if (level == 0) {
+        walk_bucket(s, i);
+        return;
+    }
+    walk_node(s, level - 1, 2 * i);
+    if (2 * i + 1 < ta->count[level - 1]) walk_node(s, level - 1, 2 * i + 1);
+}
+
+static void walk_task(void *vctx, size_t task, int worker) {
+    dir_ctx *c = vctx;
+    walk_t s;
+    walk_init(&s, c, &c->w[worker]);
+    walk_node(&s, c->task_level, task);
+}
+
+/* Prime cmax with the exact nearest distances of a sample of A: points
+ * evenly spread along A's curve, and every point of the buckets of A with
+ * the largest boxes (sparse regions, where the maximum tends to be). */
+#define PRIME_SPREAD 64
+#define PRIME_BUCKETS 16
+
+static void prime(dir_ctx *c) {
+    const hd__tree_t *ta = c->ta;
+    walk_t s;
+    /* The points discarded here are walked again later: count the work, not
+     * the discards. */
+    worker_t w;
+    memset(&w, 0, sizeof w);
+    walk_init(&s, c, &w);
+    size_t step = ta->n / PRIME_SPREAD + 1;
+    for (size_t k = step / 2; k < ta->n; k += step) {
+        double a[3];
+        size_t ia = ta->perm[k];
+        hd__src_get(&ta->src, ia, a);
+        resolve_point(&s, a, ia);
+    }
+    size_t top[PRIME_BUCKETS];
+    double size[PRIME_BUCKETS];
+    int nt = 0;
+    for (size_t b = 0; b < ta->nb; b++) {
+        const hd__box_t *x = hd__tree_box(ta, 0, b);
+        double d = 0;
+        for (int k = 0; k < 3; k++) d += (x->hi[k] - x->lo[k]) * (x->hi[k] - x->lo[k]);
+        hd__top_insert(size, top, &nt, PRIME_BUCKETS, d, b);
+    }
+    for (int k = 0; k < nt; k++) {
+        s.have_bc = 0;
+        walk_bucket(&s, top[k]);
+    }
+    c->w[0].counts.evals += w.counts.evals;
+    c->w[0].counts.exact += w.counts.exact;
+    c->w[0].counts.nodes += w.counts.nodes;
+}
+
+/* The tree walk of h(A,B) over built trees, into the shared maximum m. */
+static int tree_directed(const hd__tree_t *ta, const hd__tree_t *tb, hd__max_t *m, int threads,
+                         hd__counts_t *counts, uint64_t *culled, hd_error_t *err) {
+    dir_ctx c;
+    memset(&c, 0, sizeof c);
+    c.ta = ta;
+    c.tb = tb;
+    c.m = m;
+    /* Tasks are subtrees of about 64 buckets. */
+    c.task_level = ta->levels - 1 < 6 ? ta->levels - 1 : 6;
+    /* A bucket of a set much sparser than B spans that many more buckets of
+     * B: its shared walk may visit proportionally more (at most 16 times). */
+    while (c.extra_level < 4 && (ta->nb << (c.extra_level + 1)) <= tb->nb) c.extra_level++;
+    size_t tasks = ta->count[c.task_level];
+    if (threads < 1) threads = 1;
+    c.w = hd__calloc_array((size_t)threads, sizeof *c.w);
+    if (!c.w) return hd__err(err, HD_ENOMEM, "out of memory");
+    prime(&c);
+    hd__parallel_for(threads, tasks, walk_task, &c);
+    for (int k = 0; k < threads; k++) {
+        counts->evals += c.w[k].counts.evals;
+        counts->exact += c.w[k].counts.exact;
+        counts->nodes += c.w[k].counts.nodes;
+        *culled += c.w[k].culled;
+    }
+    free(c.w);
+    return HD_OK;
+}
+
+/* ---- the plan: grid or trees -------------------------------------------------------- */
+
+/* The grid pass is chosen when, run over a sample of each query set, it
+ * costs at most GRID_COST distances and nodes per point; otherwise both
+ * sets get the bucket trees.  Measured on the benchmark's cases
+ * (docs/engine.md): where the grid wins it costs 1 to 3 per point, where
+ * the trees win it costs tens to hundreds. */
+#define GRID_COST 8.0
+
+typedef struct {
+    hd__src_t src[2]; /* 0: A, 1: B */
+    size_t n[2];
+    hd__box_t box[2];
+    int threads, directions; /* 1: h(A,B) only; 2: both */
+    hd__grid_t grid[2];
+    hd__tree_t tree[2];
+    int have_grid, have_tree, use_tree;
+    hd__pairs_t pairs;    /* the correspondence path; pairs.resolved[d] */
+    hd__max_t max[2];     /* direction d: from set d to set 1 - d */
+    int max_ready;
+    hd__counts_t counts[2];
+    uint64_t culled[2];
+    double cost[2];
+} engine_t;
+
+static void engine_free(engine_t *e) {
+    if (e->have_grid)
+        for (int k = 0; k < 2; k++) hd__grid_free(&e->grid[k]);
+    if (e->have_tree)
+        for (int k = 0; k < 2; k++) hd__tree_free(&e->tree[k]);
+    for (int d = 0; d < e->max_ready; d++) hd__max_destroy(&e->max[d]);
+    hd__pairs_free(&e->pairs);
+    e->have_grid = e->have_tree = e->max_ready = 0;
+}
+
+static int engine_init(engine_t *e, const hd_points_t *A, const hd_points_t *B,
+                       const hd__box_t *box_a, const hd__box_t *box_b, const hd_options_t *opt,
+                       int directions, hd_error_t *err) {
+    memset(e, 0, sizeof *e);
+    hd__src_init(&e->src[0], A, NULL);
+    hd__src_init(&e->src[1], B, NULL);
+    e->n[0] = A->count;
+    e->n[1] = B->count;
+    e->box[0] = *box_a;
+    e->box[1] = *box_b;
+    e->directions = directions;
+    e->threads = hd__thread_count(opt->threads, A->count > B->count ? A->count : B->count);
+    for (int d = 0; d < directions; d++) {
+        if (hd__max_init(&e->max[d]) != HD_OK) {
+            engine_free(e);
+            return hd__err(err, HD_ETHREAD, "cannot create a mutex");
+        }
+        e->max_ready = d + 1;
+    }
+    return HD_OK;
+}
+
+/* Build both grids, prime each direction's maximum with the exact nearest
+ * distances of points spread over the query set, try the correspondence
+ * path (unless a path is forced), and choose. */
+static int engine_plan(engine_t *e, int force, hd_error_t *err) {
+    /* Two sets of one size may be a copy and its original in the same
+     * order; the correspondence path often settles that case in one pass,
+     * before any index is built. */
+    if (!force && e->n[0] == e->n[1]) {
+        int rc = hd__pairs_begin(&e->pairs, e->src, e->n[0], e->threads, &e->counts[0], err);
+        if (rc) return rc;
+        if (hd__pairs_resolve(&e->pairs, e->src, NULL, e->max, e->directions, e->counts))
+            return HD_OK;
+    }
+    /* The smaller set may be an ordered subset of the larger: its direction
+     * is then 0, settled by one merge walk. */
+    for (int d = 0; d < e->directions && !force; d++)
+        if (e->n[d] < e->n[1 - d])
+            e->pairs.resolved[d] = hd__subset_resolve(&e->src[d], e->n[d], &e->src[1 - d],
+                                                      e->n[1 - d], &e->max[d], &e->counts[d]);
+    if (e->pairs.resolved[0] && (e->directions == 1 || e->pairs.resolved[1])) return HD_OK;
+    for (int k = 0; k < 2; k++) {
+        int rc = hd__grid_build(&e->grid[k], &e->src[k], e->n[k], &e->box[k], e->threads, err);
+        if (rc) {
+            if (k) hd__grid_free(&e->grid[0]);
+            return rc;
+        }
+    }
+    e->have_grid = 1;
+    e->use_tree = 0;
+    for (int d = 0; d < e->directions; d++)
+        if (!e->pairs.resolved[d])
+            hd__grid_prime(&e->grid[d], &e->grid[1 - d], &e->max[d], &e->counts[d]);
+    hd__pairs_resolve(&e->pairs, e->src, e->grid, e->max, e->directions, e->counts);
+    for (int d = 0; d < e->directions; d++) {
+        if (e->pairs.resolved[d]) continue;
+        e->cost[d] = hd__grid_trial(&e->src[d], e->n[d], &e->grid[1 - d], &e->max[d], GRID_COST,
+                                    &e->counts[d]);
+        if (e->cost[d] > GRID_COST) e->use_tree = 1;
+    }
+    return HD_OK;
+}
+
+/* The plan in a word: "pairs" when the correspondence path settled every
+ * direction, else the path the rest runs. */
+static const char *engine_plan_name(const engine_t *e) {
+    int all = 1;
+    for (int d = 0; d < e->directions; d++) all &= e->pairs.resolved[d];
+    return all ? "pairs" : e->use_tree ? "trees" : "grid";
+}
+
+/* force: 0 lets the plan choose, 1 forces the grid, 2 the trees. */
+static int engine_run(engine_t *e, int force, hd_result_t out[2], hd_error_t *err) {
+    int rc = engine_plan(e, force, err);
+    if (rc) return rc;
+    if (force) e->use_tree = force == 2;
+    if (e->use_tree) {
+        /* The grids give way to the trees (memory stays under 16 bytes per
+         * point); the maxima found so far stay valid.  Both trees' Morton
+         * grids have the same cell size, and the walk's neighbour scans rely
+         * on the two curves lining up.  When B's box is A's box moved (both
+         * corners by the same vector, within 1e-4 of the extent, and by more
+         * than that), B looks like a moved copy: each grid is centred on its
+         * own set's centroid, so that the copy lists its points in nearly
+         * the original's order.  Any other pair (nearly identical sets, a
+         * subset, a part, a different shape) shares one grid over both
+         * boxes, so that equal points get equal keys. */
+        double c[2][3], r = 0, ext = 0, skew = 0, move = 0;
+        for (int s2 = 0; s2 < 2; s2++)
+            for (int k = 0; k < 3; k++) {
+                c[s2][k] = e->grid[s2].centroid[k];
+                double u = c[s2][k] - e->box[s2].lo[k], v = e->box[s2].hi[k] - c[s2][k];
+                r = u > r ? u : r;
+                r = v > r ? v : r;
+            }
+        for (int k = 0; k < 3; k++) {
+            double x0 = e->box[0].hi[k] - e->box[0].lo[k];
+            double dlo = e->box[1].lo[k] - e->box[0].lo[k], dhi = e->box[1].hi[k] - e->box[0].hi[k];
+            ext = x0 > ext ? x0 : ext;
+            skew = fabs(dlo - dhi) > skew ? fabs(dlo - dhi) : skew;
+            move = fabs(dlo) > move ? fabs(dlo) : move;
+        }
+        hd__box_t g[2];
+        if (skew <= 1e-4 * ext && move > 1e-4 * ext) {
+            for (int s2 = 0; s2 < 2; s2++)
+                for (int k = 0; k < 3; k++) {
+                    g[s2].lo[k] = c[s2][k] - r;
+                    g[s2].hi[k] = c[s2][k] + r;
+                }
+        } else {
+            double lo[3], w = 0;
+            for (int k = 0; k < 3; k++) {
+                lo[k] = e->box[0].lo[k] < e->box[1].lo[k] ? e->box[0].lo[k] : e->box[1].lo[k];
+                double hi = e->box[0].hi[k] > e->box[1].hi[k] ? e->box[0].hi[k] : e->box[1].hi[k];
+                w = hi - lo[k] > w ? hi - lo[k] : w;
+            }
+            for (int s2 = 0; s2 < 2; s2++)
+                for (int k = 0; k < 3; k++) g[s2].lo[k] = lo[k], g[s2].hi[k] = lo[k] + w;
+        }
+        for (int k = 0; k < 2; k++) hd__grid_free(&e->grid[k]);
+        e->have_grid = 0;
+        rc = hd__tree_build(&e->tree[0], &e->src[0], e->n[0], &g[0], e->threads, err);
+        if (rc) return rc;
+        rc = hd__tree_build(&e->tree[1], &e->src[1], e->n[1], &g[1], e->threads, err);
+        if (rc) {
+            hd__tree_free(&e->tree[0]);
+            return rc;
+        }
+        e->have_tree = 1;
+    }
+    for (int d = 0; d < e->directions; d++) {
+        double t0 = hd__now();
+        if (e->pairs.resolved[d])
+            rc = HD_OK;
+        else if (e->use_tree)
+            rc = tree_directed(&e->tree[d], &e->tree[1 - d], &e->max[d], e->threads, &e->counts[d],
+                               &e->culled[d], err);
+        else
+            rc = hd__grid_directed(&e->grid[d], &e->grid[1 - d], &e->max[d], e->threads,
+                                   &e->counts[d], &e->culled[d], err);
+        if (rc) return rc;
+        hd_result_t *r = &out[d];
+        memset(r, 0, sizeof *r);
+        hd__best_t b;
+        hd__max_snapshot(&e->max[d], &b);
+        r->distance2 = b.d2;
+        r->distance = sqrt(b.d2);
+        r->i = b.i;
+        r->j = b.j;
+        r->algorithm = HD_ALG_AUTO;
+        r->stats.distance_evals = e->counts[d].evals + e->counts[d].exact;
+        r->stats.nodes_visited = e->counts[d].nodes;
+        r->stats.points_culled = e->culled[d];
+        r->seconds = hd__now() - t0;
+    }
+    return HD_OK;
+}
+
+/* ---- entry points ---------------------------------------------------------------- */
+
+int hd__engine_trees(const hd__tree_t *ta, const hd__tree_t *tb, int threads, hd_result_t *out,
+                     hd_error_t *err) {
+    hd__max_t m;
+    if (hd__max_init(&m) != HD_OK) return hd__err(err, HD_ETHREAD, "cannot create a mutex");
+    hd__counts_t counts = {0, 0, 0};
+    uint64_t culled = 0;
+    int rc = tree_directed(ta, tb, &m, threads, &counts, &culled, err);
+    if (rc == HD_OK) {
+        memset(out, 0, sizeof *out);
+        out->distance2 = m.best.d2;
+        out->distance = sqrt(m.best.d2);
+        out->i = m.best.i;
+        out->j = m.best.j;
+        out->algorithm = HD_ALG_AUTO;
+        out->stats.distance_evals = counts.evals + counts.exact;
+        out->stats.nodes_visited = counts.nodes;
+        out->stats.points_culled = culled;
+    }
+    hd__max_destroy(&m);
+    return rc;
+}
+
+int hd__engine_directed(const hd_points_t *A, const hd_points_t *B, const hd__box_t *box_a,
+                        const hd__box_t *box_b, const hd_options_t *opt, hd_result_t *out,
+                        hd_error_t *err) {
+    double t0 = hd__now();
+    engine_t e;
+    int rc = engine_init(&e, A, B, box_a, box_b, opt, 1, err);
+    if (rc) return rc;
+    hd_result_t r[2];
+    rc = engine_run(&e, 0, r, err);
+    engine_free(&e);
+    if (rc) return rc;
+    *out = r[0];
+    out->seconds = hd__now() - t0;
+    return HD_OK;
+}
+
+static int engine_symmetric(const hd_points_t *A, const hd_points_t *B, const hd__box_t *box_a,
+                            const hd__box_t *box_b, const hd_options_t *opt, int force,
+                            hd_symmetric_t *out, hd_error_t *err) {
+    double t0 = hd__now();
+    engine_t e;
+    int rc = engine_init(&e, A, B, box_a, box_b, opt, 2, err);
+    if (rc) return rc;
+    hd_result_t r[2];
+    rc = engine_run(&e, force, r, err);
+    engine_free(&e);
+    if (rc) return rc;
+    /* The shared work (grids or trees, the plan) is split between the two
+     * directions' times in proportion to nothing in particular: half each. */
+    double total = hd__now() - t0, walks = r[0].seconds + r[1].seconds;
+    out->ab = r[0];
+    out->ba = r[1];
+    out->ab.seconds = r[0].seconds + (total - walks) / 2;
+    out->ba.seconds = r[1].seconds + (total - walks) / 2;
+    return HD_OK;
+}
+
+int hd__engine_hausdorff(const hd_points_t *A, const hd_points_t *B, const hd__box_t *box_a,
+                         const hd__box_t *box_b, const hd_options_t *opt, hd_symmetric_t *out,
+                         hd_error_t *err) {
+    return engine_symmetric(A, B, box_a, box_b, opt, 0, out, err);
+}
+
+int hd__engine_forced(const hd_points_t *A, const hd_points_t *B, const hd_options_t *opt,
+                      int use_trees, hd_symmetric_t *out, hd_error_t *err) {
+    hd__box_t ba, bb;
+    int rc = hd__points_scan(A, "A", opt->threads, &ba, err);
+    if (rc == HD_OK) rc = hd__points_scan(B, "B", opt->threads, &bb, err);
+    if (rc) return rc;
+    memset(out, 0, sizeof *out);
+    rc = engine_symmetric(A, B, &ba, &bb, opt, use_trees ? 2 : 1, out, err);
+    if (rc == HD_OK)
+        out->distance = out->ab.distance2 >= out->ba.distance2 ? out->ab.distance : out->ba.distance;
+    return rc;
+}
+
+int hd__engine_explain(const hd_points_t *A, const hd_points_t *B, const hd_options_t *opt,
+                       char *buf, size_t len, hd_error_t *err) {
+    hd__box_t ba, bb;
+    int rc = hd__points_scan(A, "A", opt->threads, &ba, err);
+    if (rc == HD_OK) rc = hd__points_scan(B, "B", opt->threads, &bb, err);
+    if (rc) return rc;
+    engine_t e;
+    rc = engine_init(&e, A, B, &ba, &bb, opt, 2, err);
+    if (rc) return rc;
+    rc = engine_plan(&e, 0, err);
+    if (rc == HD_OK)
+        snprintf(buf, len,
+                 "%s (pairs %s, resolved %d / %d; grid trial: %.3g / %.3g distances and nodes per "
+                 "point)",
+                 engine_plan_name(&e), e.pairs.active ? "listed" : "not tried", e.pairs.resolved[0],
+                 e.pairs.resolved[1], e.cost[0], e.cost[1]);
+    engine_free(&e);
+    return rc;
+}

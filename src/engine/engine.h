@@ -1,0 +1,331 @@
+/*
+ * engine.h -- the auto engine (layer src/engine/): its spatial index of one
+ * point set, the searches, the grid, the partner pairs and the plan.
+ *
+ * An index does not copy coordinates exactly: it borrows the caller's view
+ * and keeps
+ *  - a permutation (4 bytes per point) listing the points in Morton order,
+ *    cut into buckets of HD__BUCKET consecutive points;
+ *  - per bucket, the exact bounding box of its points and a 16-bit
+ *    quantised copy of their coordinates relative to that box (6 bytes per
+ *    point), with `err`, a proven upper bound on the Euclidean distance
+ *    between any point and its dequantised approximation;
+ *  - the exact box of every node of an implicit binary tree over the
+ *    buckets.
+ * That is about 13 bytes per point (with HD__BUCKET = 32).  Exact
+ * coordinates are read through the permutation ("gathered") and widened to
+ * double, with an optional transform applied on the fly in the documented
+ * order, so every exact distance uses the doubles the brute force uses.
+ *
+ * The approximations only ever decide what is provably decided: a point p
+ * known within E of its approximation p~ satisfies |q - p| <= |q - p~| + E,
+ * and hd__kill_below / hd__may_reach turn that into thresholds on the
+ * computed squared distance to p~ with every rounding error accounted for.
+ *
+ * Tree layout: level 0 holds the buckets; node i of level l+1 covers nodes
+ * 2i and 2i+1 of level l (the second may not exist); the top level has one
+ * node.  Node (l, i) covers buckets [i << l, (i + 1) << l).
+ */
+#ifndef HD_ENGINE_H
+#define HD_ENGINE_H
+
+#include "points/points.h"
+
+#include <pthread.h>
+
+/* Points per bucket (at most 32: live points are tracked in 32-bit masks). */
+#define HD__BUCKET 32
+_Static_assert(HD__BUCKET % 4 == 0 && HD__BUCKET <= 32, "bucket size");
+/* Most tree levels (2^40 buckets is far beyond 2^32 points). */
+#define HD__MAX_LEVELS 40
+
+/* A bucket: the exact box of its points and the error bound of their
+ * quantised copy. */
+typedef struct hd__bucket {
+    hd__box_t box;
+    double err;
+} hd__bucket_t;
+
+typedef struct hd__tree {
+    size_t n;                       /* points */
+    hd__src_t src;
+    uint32_t *perm;                 /* n original indices in Morton order */
+    uint16_t *q;                    /* per bucket: 32 x, then 32 y, then 32 z */
+    size_t nb;                      /* buckets: ceil(n / HD__BUCKET) */
+    hd__bucket_t *bucket;           /* nb buckets */
+    int levels;                     /* level 0 .. levels-1; top has 1 node */
+    size_t count[HD__MAX_LEVELS];   /* nodes per level */
+    size_t off[HD__MAX_LEVELS];     /* first box of level l >= 1 in nodes[] */
+    hd__box_t *nodes;               /* exact boxes of the nodes of levels >= 1 */
+    hd__box_t box;                  /* the box the Morton grid covers */
+} hd__tree_t;
+
+/* Build the index of n points read from `src` using `threads` threads.
+ * The Morton grid covers grid_box, or the set's own box when it is NULL
+ * (two sets sorted on the same grid line up along the curve, which is what
+ * the walk over nearly identical sets relies on).  The points must be
+ * valid (finite, within HD_MAX_COORD, also after the transform).  n must be
+ * at most UINT32_MAX (HD_EOVERFLOW otherwise). */
+int hd__tree_build(hd__tree_t *t, const hd__src_t *src, size_t n, const hd__box_t *grid_box,
+                   int threads, hd_error_t *err);
+void hd__tree_free(hd__tree_t *t);
+size_t hd__tree_memory(const hd__tree_t *t);
+
+HD__INLINE const hd__box_t *hd__tree_box(const hd__tree_t *t, int level, size_t i) {
+    return level == 0 ? &t->bucket[i].box : &t->nodes[t->off[level] + i];
+}
+
+HD__INLINE int hd__bucket_size(const hd__tree_t *t, size_t b) {
+    size_t first = b * HD__BUCKET;
+    return (int)(t->n - first < HD__BUCKET ? t->n - first : HD__BUCKET);
+}
+
+/* The dequantised (approximate) coordinates of bucket b, in three arrays;
+ * returns the bucket's point count.  Point k of the bucket lies within
+ * t->bucket[b].err of (x[k], y[k], z[k]). */
+HD__INLINE int hd__bucket_decode(const hd__tree_t *t, size_t b, double *x, double *y,
+                                 double *z) {
+    const hd__bucket_t *bk = &t->bucket[b];
+    const uint16_t *q = t->q + b * 3 * HD__BUCKET;
+    const double unit = 1.0 / 65535.0;
+    double sx = (bk->box.hi[0] - bk->box.lo[0]) * unit;
+    double sy = (bk->box.hi[1] - bk->box.lo[1]) * unit;
+    double sz = (bk->box.hi[2] - bk->box.lo[2]) * unit;
+    int m = hd__bucket_size(t, b);
+    for (int k = 0; k < HD__BUCKET; k++) {
+        x[k] = bk->box.lo[0] + (double)q[k] * sx;
+        y[k] = bk->box.lo[1] + (double)q[HD__BUCKET + k] * sy;
+        z[k] = bk->box.lo[2] + (double)q[2 * HD__BUCKET + k] * sz;
+    }
+    return m;
+}
+
+/* The smallest of c[0..HD__BUCKET).  A short bucket is padded with copies
+ * of its point 0 (engine_build.c), whose values equal c[0], so padding never
+ * changes the minimum.  Four running minima keep the loop free of a serial
+ * dependency. */
+HD__INLINE double hd__min32(const double *c) {
+    double m4[4] = {c[0], c[1], c[2], c[3]};
+    for (int k = 4; k < HD__BUCKET; k += 4)
+        for (int r = 0; r < 4; r++) m4[r] = c[k + r] < m4[r] ? c[k + r] : m4[r];
+    double a = m4[0] < m4[1] ? m4[0] : m4[1], b = m4[2] < m4[3] ? m4[2] : m4[3];
+    return a < b ? a : b;
+}
+
+/* The first position of value v in c (v occurs, and is a real point) --
+ * unless the caller's points changed during the call (hausdorff.h forbids
+ * it, but a Python thread can do it): a NaN written after validation makes
+ * v NaN, found nowhere, and then position 0 (always a real point) keeps
+ * the search in bounds.  The answer is then meaningless, but nothing is
+ * read out of bounds. */
+HD__INLINE int hd__find(const double *c, double v) {
+    int k = 0;
+    while (k < HD__BUCKET && c[k] != v) k++;
+    return k < HD__BUCKET ? k : 0;
+}
+
+/* Keep the k items with the largest scores, in decreasing order of score,
+ * in score[0..*n) and item[0..*n) (*n grows to k). */
+HD__INLINE void hd__top_insert(double *score, size_t *item, int *n, int k, double sc, size_t it) {
+    if (*n == k && !(sc > score[k - 1])) return;
+    int at = *n < k ? (*n)++ : k - 1;
+    while (at > 0 && score[at - 1] < sc) {
+        score[at] = score[at - 1];
+        item[at] = item[at - 1];
+        at--;
+    }
+    score[at] = sc;
+    item[at] = it;
+}
+
+/* ---- proofs from approximations -------------------------------------------- */
+/* Relative slack that covers every rounding in the computed squared
+ * distances (a few units of 2^-53) and in these thresholds, many times over;
+ * and an absolute floor below which squared distances may have underflowed. */
+#define HD__SLACK 1e-12
+#define HD__TINY 1e-280
+
+/* A computed squared distance c~ = hd__d2s(q, p~) < hd__kill_below(lim, E),
+ * where the true point p lies within E of p~ (and q is exact, or E includes
+ * q's own error), proves that the computed hd__d2s(q, p) < lim.  Returns 0
+ * (nothing is proven, c~ >= 0) when lim is too small. */
+HD__INLINE double hd__kill_below(double lim, double E) {
+    if (!(lim > HD__TINY)) return 0.0;
+    double r = __builtin_sqrt(lim) * (1 - HD__SLACK) - E * (1 + HD__SLACK);
+    if (r <= 0) return 0.0;
+    double t = r * r * (1 - HD__SLACK);
+    return t > HD__TINY ? t : 0.0;
+}
+
+/* A computed c~ > hd__may_reach(best, E) proves hd__d2s(q, p) > best. */
+HD__INLINE double hd__may_reach(double best, double E) {
+    double r = __builtin_sqrt(best) * (1 + HD__SLACK) + E * (1 + HD__SLACK);
+    return r * r * (1 + HD__SLACK) + HD__TINY;
+}
+
+/* ---- searching ----------------------------------------------------------- */
+
+/* What a nearest-neighbour search found. */
+typedef struct hd__hit {
+    double d2;       /* exact squared distance (when exact) */
+    int killed;      /* 1: the search stopped early, proving d2 < stop2 (or
+                      * <= tie2) for the point below; d2 is then meaningless */
+    size_t j;        /* original index in the searched set (exact hits) */
+    size_t bucket;   /* bucket of the point found (a hint for the next search) */
+    double p[3];     /* its coordinates, known within perr */
+    double perr;     /* 0 for exact coordinates, else the bucket's err */
+} hd__hit_t;
+
+typedef struct hd__counts {
+    uint64_t evals, exact, nodes;
+} hd__counts_t;
+
+/* hd_index_nearest by the path it would take (path 0), or, for the tests,
+ * by the one-search-per-query path over the index's tree that only sets
+ * beyond allnearest.c's limit take otherwise (path 2). */
+int hd__index_nearest_by(const hd_index_t *idx, const hd_points_t *Q, const hd_transform_t *T,
+                         const hd_options_t *opt, double *dist, size_t *nearest, int path, hd_error_t *err);
+
+/* Exact nearest neighbour of the exact point q in t: hit->d2 is the
+ * smallest squared distance and hit->j the smallest original index
+ * attaining it.  Bucket `hint` (or HD__NONE) is searched first.  The search
+ * may stop as soon as it proves that some point lies at squared distance
+ * < stop2, or <= tie2; it then sets hit->killed.  Pass stop2 = 0 and
+ * tie2 = -1 for a full search. */
+void hd__tree_nearest(const hd__tree_t *t, const double q[3], double stop2, double tie2,
+                      size_t hint, hd__hit_t *hit, hd__counts_t *n);
+
+/* ---- the grid: a cheap index for sparse queries (engine_grid.c) ------------------ */
+
+/* Points grouped by the cell of a uniform grid of 2^bits cubic cells per
+ * axis over the set's box; cells are numbered along the Morton curve, so
+ * the cells below any node of the implicit octree over them are a
+ * contiguous range, and so are their points.  Each cell keeps a
+ * representative, its point with the smallest original index. */
+typedef struct hd__grid {
+    size_t n;
+    hd__src_t src;
+    int bits;             /* cells per axis: 1 << bits (at most 6) */
+    double lo[3], w, inv; /* cell (cx, cy, cz) spans lo + c * w .. lo + (c + 1) * w */
+    double margin;        /* widening of every face that covers all rounding */
+    uint32_t *perm;       /* n original indices grouped by cell */
+    uint32_t *start;      /* 8^bits + 1 offsets into perm */
+    double *rep;          /* per cell x, y, z of its representative; NaN if empty */
+    double centroid[3];   /* mean of the points (approximate; for alignment) */
+} hd__grid_t;
+
+int hd__grid_build(hd__grid_t *g, const hd__src_t *src, size_t n, const hd__box_t *box,
+                   int threads, hd_error_t *err);
+void hd__grid_free(hd__grid_t *g);
+
+/* Exact nearest neighbour of q in g, with the early stop of hd__tree_nearest
+ * (stop2, tie2).  hit->bucket is unused. */
+void hd__grid_nearest(const hd__grid_t *g, const double q[3], double stop2, double tie2,
+                      hd__hit_t *hit, hd__counts_t *n);
+
+/* ---- the running maximum shared by the threads of one direction --------------- */
+
+/* cmax (the bound all threads raise), and under a lock the maximum so far
+ * with its canonical witness. */
+typedef struct hd__max {
+    hd__bound_t cmax;
+    pthread_mutex_t lock;
+    hd__best_t best;
+} hd__max_t;
+
+int hd__max_init(hd__max_t *m);
+void hd__max_destroy(hd__max_t *m);
+/* Record an exact nearest distance d2 of point i (nearest j); *snap gets a
+ * consistent copy of the maximum so far. */
+void hd__max_offer(hd__max_t *m, double d2, size_t i, size_t j, hd__best_t *snap);
+void hd__max_snapshot(hd__max_t *m, hd__best_t *snap);
+
+/* Whether a point of B at squared distance d2 from point i of A proves that
+ * i is not the witness: its nearest distance is then below the maximum
+ * (d2 < cmax2), or at most a maximum already attained at a smaller index
+ * (snap, a consistent copy of the maximum so far). */
+HD__INLINE int hd__kills(double cmax2, const hd__best_t *snap, double d2, size_t i) {
+    return d2 < cmax2 || (d2 <= snap->d2 && i > snap->i);
+}
+
+/* h(A,B) by the grid: A's cells (ga) are visited in Morton order, and a
+ * cell is discarded whole when one point of B is proven strictly within
+ * cmax of its whole box; the points of the other cells are tested against
+ * nearby points of B and searched exactly when none discards them (when
+ * cmax is below a cell's diagonal, all of A's points in input order
+ * instead).  On return m holds the maximum; counts and culled are added
+ * to. */
+int hd__grid_directed(const hd__grid_t *ga, const hd__grid_t *gb, hd__max_t *m, int threads,
+                      hd__counts_t *counts, uint64_t *culled, hd_error_t *err);
+
+/* Prime m with the exact nearest distances of the representatives of A's
+ * cells (ga) that lie where B is emptiest. */
+void hd__grid_prime(const hd__grid_t *ga, const hd__grid_t *gb, hd__max_t *m,
+                    hd__counts_t *counts);
+
+/* Prime m with the exact nearest distances of points of a sample of A
+ * chosen where the maximum is likely, then run the grid pass over the
+ * sample; returns its work (distances and nodes) per sampled point, or
+ * stops early with some value above `limit`. */
+double hd__grid_trial(const hd__src_t *a, size_t na, const hd__grid_t *gb, hd__max_t *m,
+                      double limit, hd__counts_t *counts);
+
+/* ---- the engine ---------------------------------------------------------------- */
+
+/* H(A,B) by the engine with its choice overridden: the grid pass for both
+ * directions (use_trees 0) or the trees (1).  For tests. */
+int hd__engine_forced(const hd_points_t *A, const hd_points_t *B, const hd_options_t *opt,
+                      int use_trees, hd_symmetric_t *out, hd_error_t *err);
+
+/* The correspondence path (engine_pairs.c), for two sets of n points each
+ * listed in the same order (a copy and its original).  hd__pairs_begin
+ * tests a sample and, when the partners (a_i, b_i) look closer than other
+ * neighbours, lists the pairs with the largest distances (P->active).
+ * hd__pairs_resolve then resolves, for each direction d < directions, the
+ * listed points of set d exactly, in decreasing order of pair distance,
+ * until the rest provably cannot hold the witness (P->resolved[d]; max[d]
+ * then holds h exactly): by scans of the other set while grid is NULL
+ * (and a budget lasts), in grid[1 - d] otherwise.  It returns 1 when every
+ * direction is resolved.  Otherwise max[d] has only been raised. */
+struct hd__pair;
+typedef struct hd__pairs {
+    struct hd__pair *list; /* m pairs in resolution order */
+    size_t m, n, pos[2];
+    uint64_t scanned; /* points read by scans */
+    int active, resolved[2];
+} hd__pairs_t;
+
+int hd__pairs_begin(hd__pairs_t *P, const hd__src_t src[2], size_t n, int threads,
+                    hd__counts_t *counts, hd_error_t *err);
+int hd__pairs_resolve(hd__pairs_t *P, const hd__src_t src[2], const hd__grid_t *grid,
+                      hd__max_t *max, int directions, hd__counts_t *counts);
+void hd__pairs_free(hd__pairs_t *P);
+
+/* When the ns points of `small` appear, in order, as exact copies among the
+ * nl > ns points of `large` (an ordered subset), h(small, large) = 0: offer
+ * it to max with its witness and return 1; otherwise return 0 (after
+ * reading at most a short window of `large` when the sets are unrelated). */
+int hd__subset_resolve(const hd__src_t *small, size_t ns, const hd__src_t *large, size_t nl,
+                       hd__max_t *max, hd__counts_t *counts);
+
+/* h(A,B) over built indexes of A and B (engine.c), with `threads` threads. */
+int hd__engine_trees(const hd__tree_t *ta, const hd__tree_t *tb, int threads,
+                     hd_result_t *out, hd_error_t *err);
+
+/* ---- entry points for the layers above (engine.c) ------------------------------ */
+/* The auto engine on validated views, without packed copies (engine.c):
+ * h(A,B), and H(A,B) with each set indexed once for both directions. */
+int hd__engine_directed(const hd_points_t *A, const hd_points_t *B,
+                        const hd__box_t *box_a, const hd__box_t *box_b,
+                        const hd_options_t *opt, hd_result_t *out,
+                        hd_error_t *err);
+int hd__engine_hausdorff(const hd_points_t *A, const hd_points_t *B,
+                         const hd__box_t *box_a, const hd__box_t *box_b,
+                         const hd_options_t *opt, hd_symmetric_t *out,
+                         hd_error_t *err);
+/* The engine's plan for H(A,B) as a sentence in buf (for benchmarks). */
+int hd__engine_explain(const hd_points_t *A, const hd_points_t *B,
+                       const hd_options_t *opt, char *buf, size_t len,
+                       hd_error_t *err);
+
+#endif /* HD_ENGINE_H */

@@ -1,0 +1,846 @@
+/*
+ * allnearest.c -- exact all-nearest-neighbours: for every point of one set,
+ * the nearest point of the other, with the smallest index among ties.  This
+ * is what hd_distances computes (analysis.c), in both directions.
+ *
+ * A per-point answer needs one complete search per point: no point may be
+ * skipped, as the Hausdorff distance's pruning skips the points that cannot
+ * be the farthest.  What can be saved is everything around the searches.
+ * The exact kd-tree (kdtree.c) that served here before spent 130 memory
+ * passes on building two trees of a million points (a median selection per
+ * node) and then walked from its root once per query.  Here:
+ *  - Build.  Each set is sorted once along a Morton curve: 30-bit keys on a
+ *    grid of 1024 cells per axis over the union of both sets' boxes (so that
+ *    the two orders line up), the engine's stable radix sort of key and
+ *    index (hd__radix_sort: three counting passes of 10 bits, whose 1024
+ *    destinations a pass stream better than the 32768 of two 15-bit passes:
+ *    3 to 7% faster on 1M points), then one gather of the coordinates into
+ *    packed arrays
+ *    (x[], y[], z[], original indices idx[]).  The sorted keys define an
+ *    octree; one pass over them cuts it where a cell holds at most
+ *    HD__AN_BUCKET points (the buckets, which are searched) and, coarser,
+ *    HD__AN_GROUP points (the groups, in which a set's own points ask).
+ *    Octree cells are cubes, so buckets and groups are compact even where
+ *    the density changes by orders of magnitude (a Gaussian's core and its
+ *    tails), which buckets of a fixed number of consecutive points are not:
+ *    those straddle the curve's jumps, and their boxes overlap.  Cells with
+ *    a single non-empty child are not stored, so every inner node has two
+ *    children or more.  A cell of more than HD__AN_BUCKET points whose keys
+ *    are all equal (a dense cluster in a set with far outliers, whose grid
+ *    is too coarse for it) is sorted again on a grid over its own box
+ *    (refine), up to MAX_REFINE times nested; a bucket whose points are all
+ *    copies of one point is scanned as that one point (the sorts are
+ *    stable, so its first copy has the smallest index), which keeps
+ *    duplicates from costing a scan each.  Every node gets the exact box of
+ *    its points.  The two sets are built side by side (analysis.c).
+ *  - Search, a group at a time.  Every query first scans its seeds: the two
+ *    searched buckets at its own bucket's place on the curve (the orders
+ *    line up, so that is usually close), and the bucket reached from the
+ *    root by always taking the child nearest to the group's box (which is
+ *    close even when the group is far from the searched set, or the curve
+ *    says little).  U, the largest seed distance of the group, lowered to
+ *    the upper bounds of the nodes on that path, bounds every answer of the
+ *    group.  One traversal of the searched octree then lists every bucket
+ *    within U of the group's box: the candidates.  Each query computes its
+ *    own bound to every candidate (one vectorised loop), lists without
+ *    branches those within its best seed distance, and scans them, each
+ *    tested again against the best distance found so far.
+ *  - Partners.  Two sets of one size are often a copy and its original in
+ *    the same order (a deformed or denoised mesh, a registered scan).  Then
+ *    the searched point with a query's own original index, its partner, is
+ *    usually its answer or next to it.  Each query of a group starts with
+ *    its partner's distance (an actual point's, so the largest over the
+ *    group bounds every answer, as U does), and when at most
+ *    PAIR_CANDIDATES buckets lie within that bound they are the candidates
+ *    and no seed is scanned; otherwise the seeds go on from the partners.
+ *    The partners are read from the caller's view in its order (a random
+ *    access, prefetched a group ahead).  A group counts as a success when
+ *    at least half of its answers are the partners themselves; a task stops
+ *    trying once most of the groups it tried, PAIR_TRIAL at least, failed,
+ *    so unrelated sets pay for eight groups a task.  (Sets of a few
+ *    repeated points list few candidates for any partner, but the partner
+ *    is seldom the answer there, and reading partners costs a cache miss
+ *    each: on 1M points on 8 lattice sites, trying every group cost 60%
+ *    more time.)  This is the engine's correspondence bound (engine_pairs.c)
+ *    put to per-point use.
+ *  - Scans.  A bucket is scanned four points at a time with GCC's vector
+ *    extension (each lane evaluates hd__d2s's expression: no fused
+ *    multiply-add, -ffp-contract=off), each lane keeping its smallest
+ *    distance and the smallest index at it; the scan starts at the group of
+ *    four holding the bucket's first point and ends past its last, so it
+ *    may read a few points of the neighbouring buckets (and the four copies
+ *    of the last point stored after the end), all of them points of the
+ *    set.  The lanes' minimum and the smallest index at it are then picked
+ *    without a branch per lane: those branches mispredicted, and cost 12%
+ *    of the time on overlapping clouds.  This file is compiled with
+ *    -fno-trapping-math (CMakeLists.txt):
+ *    without it GCC does not vectorise the bound loop, and no value
+ *    changes.
+ *
+ * Exactness.  Nothing depends on the Morton order, which only decides
+ * locality: every decision compares an exact squared distance or a bound
+ * computed from exact boxes.  Every box (buckets, nodes, groups) is the min
+ * and max of the stored doubles of its points.  IEEE rounding is monotone
+ * (internal.h): for q in box Q and p in box B, the computed |fl(q - p)| on
+ * each axis is at least the computed gap fl(B.lo - Q.hi) (or
+ * fl(Q.lo - B.hi)) and at most the computed span max(fl(Q.hi - B.lo),
+ * fl(B.hi - Q.lo)), and squaring and the left-to-right sum keep both
+ * inequalities.  So node_lb2(Q, B) never exceeds, and node_ub2(Q, B) is
+ * never below, the computed hd__d2s of any pair; the same holds for a
+ * single query (hd__box_lb2s's expression).
+ *  - U is a distance to an actual point (a seed or a partner) or a node's
+ *    upper bound (every node holds a point), so each query of the group
+ *    has a point within U, and its answer is at most U.
+ *  - A node or candidate is dropped only when its bound is strictly above U
+ *    or above the query's best distance so far (which is an actual point's
+ *    distance): none of its points can be the nearest, nor tie with it.  A
+ *    bound equal to the best is not enough: the candidate may hold a point
+ *    at the same distance with a smaller original index.
+ *  - A point replaces the best on a smaller squared distance, or on an
+ *    equal one with a smaller original index; reading a point twice (seed
+ *    and candidate, overlapping scans) or reading extra points of the set
+ *    changes neither, and neither does reading only the first of a
+ *    bucket's copies of one point (same distance, smallest index).
+ * So each answer is the exact minimum and the smallest index attaining it,
+ * whatever the grouping, the order of the candidates or the number of
+ * threads; the radix sort is stable with parts in order, so even the
+ * structure is the same at any thread count.  The work is split by groups,
+ * and every answer is written to the query's original index.
+ *
+ * Answers are written in the asking set's order, squared, into a buffer
+ * (12 bytes per point), and a last parallel pass takes their square roots
+ * to the caller's arrays at the original indices: one tight loop of
+ * scattered stores overlaps its cache misses, which the same stores
+ * between searches did not (5 to 7% of the time on 1M points).
+ *
+ * Memory: about 32 bytes per point and set (28 for the coordinates and
+ * indices, the rest for buckets, groups and nodes with their boxes; 1M
+ * Gaussian points make 53K buckets, 29K groups and 61K nodes), 12 bytes
+ * per asking point for the answers in its order, and, per thread, 64
+ * bytes per searched bucket for the candidates.  While a set is built it
+ * holds up to about 60 bytes per point: 8 of sort keys beside the
+ * coordinates (the sort's other buffer is x[]'s memory) and 24 of
+ * per-bucket arrays sized for the worst case (one point per bucket), given
+ * back once the octree is cut; the node arrays grow as needed.  The
+ * measured times are in docs/benchmarks.md, "Analysis".  Sets of more than HD__AN_MAX_POINTS
+ * points are refused with HD_EOVERFLOW (analysis.c then uses the kd-trees).
+ */
+#include "nearest/nearest.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ---- building ---------------------------------------------------------------- */
+
+#define MAX_PARTS 16
+#define GATHER_TASK 16384 /* points per gathering task */
+#define BOX_TASK 1024     /* buckets per box task */
+
+typedef struct {
+    hd__an_t *s;
+    hd__src_t src;
+    hd__keygrid_t grid;
+    size_t n;
+    int parts;
+    uint64_t *a, *b; /* key << 32 | index: computed in a, sorted into b */
+} build_ctx;
+
+/* Part p's share of [0, n). */
+static void part_range(const build_ctx *c, size_t part, size_t *lo, size_t *hi) {
+    *lo = c->n * part / (size_t)c->parts;
+    *hi = c->n * (part + 1) / (size_t)c->parts;
+}
+
+/* Keys of one part. */
+static void key_task(void *vctx, size_t part, int worker) {
+    (void)worker;
+    build_ctx *c = vctx;
+    size_t lo, hi;
+    part_range(c, part, &lo, &hi);
+    hd__src_keys(&c->src, &c->grid, lo, hi, c->a);
+}
+
+/* Gather the points [task * GATHER_TASK, ...) in sorted order (positions
+ * n .. n + 3 repeat the last point, so that scans may read whole groups of
+ * four). */
+static void gather_task(void *vctx, size_t task, int worker) {
+    (void)worker;
+    build_ctx *c = vctx;
+    hd__an_t *s = c->s;
+    size_t lo = task * GATHER_TASK, hi = lo + GATHER_TASK < s->n + 4 ? lo + GATHER_TASK : s->n + 4;
+    for (size_t at = lo; at < hi; at++) {
+        if (at + 16 < s->n && c->src.kind != 2)
+            __builtin_prefetch(c->src.base + (ptrdiff_t)(uint32_t)c->b[at + 16] * (c->src.kind ? 12 : 24));
+        uint32_t i = (uint32_t)c->b[at < s->n ? at : s->n - 1];
+        double p[3];
+        hd__src_get(&c->src, i, p);
+        s->x[at] = p[0], s->y[at] = p[1], s->z[at] = p[2];
+        s->idx[at] = i;
+    }
+}
+
+/* The exact box of the points [b, e) into node k's box. */
+static void points_box(hd__an_t *s, size_t b, size_t e, size_t k) {
+    const double *v[3] = {s->x, s->y, s->z};
+    for (int d = 0; d < 3; d++) {
+        double lo = v[d][b], hi = lo;
+        for (size_t i = b + 1; i < e; i++) {
+            lo = v[d][i] < lo ? v[d][i] : lo;
+            hi = v[d][i] > hi ? v[d][i] : hi;
+        }
+        s->lo[d][k] = lo;
+        s->hi[d][k] = hi;
+    }
+}
+
+/* The exact boxes of the leaves of buckets [task * BOX_TASK, ...). */
+static void box_task(void *vctx, size_t task, int worker) {
+    (void)worker;
+    build_ctx *c = vctx;
+    hd__an_t *s = c->s;
+    size_t b0 = task * BOX_TASK, b1 = b0 + BOX_TASK < s->nb ? b0 + BOX_TASK : s->nb;
+    for (size_t b = b0; b < b1; b++) {
+        size_t k = s->leaf[b];
+        points_box(s, s->start[b], s->start[b + 1], k);
+        /* Copies of one point are in index order (the sorts are stable):
+         * the first one answers for all of them. */
+        int same = 1;
+        for (int d = 0; d < 3; d++) same = same && s->lo[d][k] == s->hi[d][k];
+        s->stop[b] = same ? s->start[b] + 1 : s->start[b + 1];
+    }
+}
+
+/* The children of the octree cell [lo, hi) of the sorted keys at `shift`
+ * (the cell's keys agree above it): the ends of its non-empty sub-cells,
+ * in order.  Cells with one sub-cell are split further at once, so every
+ * returned cell has at least two children, unless its keys are all equal
+ * (then it has one, and *shift is below 32). */
+static int split_cell(const uint64_t *keys, size_t lo, size_t hi, int *shift, size_t ends[8]) {
+    for (;;) {
+        int nc = 0;
+        size_t e = lo;
+        while (e < hi) {
+            uint64_t digit = keys[e] >> *shift & 7;
+            while (e < hi && (keys[e] >> *shift & 7) == digit) e++;
+            ends[nc++] = e;
+        }
+        *shift -= 3;
+        if (nc > 1 || *shift < 32) return nc;
+    }
+}
+
+static int cmp_u64(const void *x, const void *y) {
+    uint64_t a = *(const uint64_t *)x, b = *(const uint64_t *)y;
+    return (a > b) - (a < b);
+}
+
+/* A cell of more than HD__AN_BUCKET points whose keys are all equal (the
+ * grid is too coarse there: a dense cluster in a set with far outliers):
+ * sort its points again on a grid over their own box and put the new keys
+ * in keys[lo, hi), so that the octree can split it further.  Returns 0
+ * when the points are all equal (nothing to split) or memory is short
+ * (the cell then stays one large bucket: slower, still exact). */
+static int refine(hd__an_t *s, uint64_t *keys, size_t lo, size_t hi) {
+    size_t m = hi - lo;
+    hd__box_t box;
+    double *v[3] = {s->x, s->y, s->z};
+    for (int d = 0; d < 3; d++) {
+        box.lo[d] = box.hi[d] = v[d][lo];
+        for (size_t i = lo + 1; i < hi; i++) {
+            box.lo[d] = v[d][i] < box.lo[d] ? v[d][i] : box.lo[d];
+            box.hi[d] = v[d][i] > box.hi[d] ? v[d][i] : box.hi[d];
+        }
+    }
+    hd__keygrid_t g;
+    hd__keygrid_init(&g, &box);
+    if (g.scale == 0.0) return 0;
+    uint64_t *k2 = hd__malloc_array(m, sizeof *k2);
+    double *t = hd__malloc_array(m, 3 * sizeof *t);
+    uint32_t *ti = hd__malloc_array(m, sizeof *ti);
+    int ok = k2 && t && ti;
+    if (ok) {
+        for (size_t i = 0; i < m; i++) {
+            double p[3] = {s->x[lo + i], s->y[lo + i], s->z[lo + i]};
+            k2[i] = (uint64_t)hd__key30(&g, p) << 32 | (uint64_t)i;
+            t[3 * i] = p[0], t[3 * i + 1] = p[1], t[3 * i + 2] = p[2];
+            ti[i] = s->idx[lo + i];
+        }
+        qsort(k2, m, sizeof *k2, cmp_u64);
+        for (size_t r = 0; r < m; r++) {
+            size_t i = (uint32_t)k2[r];
+            s->x[lo + r] = t[3 * i], s->y[lo + r] = t[3 * i + 1], s->z[lo + r] = t[3 * i + 2];
+            s->idx[lo + r] = ti[i];
+            keys[lo + r] = (k2[r] >> 32) << 32 | ti[i];
+        }
+    }
+    free(k2);
+    free(t);
+    free(ti);
+    return ok;
+}
+
+/* Nested refinements followed, at most (each one splits its cell). */
+#define MAX_REFINE 6
+
+/* The octree of the sorted keys, cells split until at most HD__AN_BUCKET
+ * points remain (or their points are equal): node 0 is the root, the
+ * children of a node are consecutive nodes, and the leaves are the buckets,
+ * numbered in key order (start[], leaf[], and key[]: the key of each
+ * bucket's first point on the grid of both sets).  The groups are the
+ * largest nodes of at most HD__AN_GROUP points (or leaves): unions of whole
+ * buckets (gstart[], glead[]). */
+static int grow_nodes(hd__an_t *s, size_t *cap, size_t need) {
+    size_t want = *cap + *cap / 2 > need ? *cap + *cap / 2 : need;
+    void *p;
+    if (!(p = hd__realloc_array(s->first, want, sizeof *s->first))) return HD_ENOMEM;
+    s->first = p;
+    if (!(p = hd__realloc_array(s->count, want, sizeof *s->count))) return HD_ENOMEM;
+    s->count = p;
+    *cap = want;
+    return HD_OK;
+}
+
+static int build_octree(build_ctx *c, size_t cap) {
+    hd__an_t *s = c->s;
+    uint64_t *keys = c->b;
+    struct {
+        size_t lo, hi, node;
+        int shift, grouped, refined;
+    } stack[7 * 10 * (MAX_REFINE + 1) + 8];
+    int sp = 1;
+    size_t n = s->n, nb = 0, nn = 1, ng = 0;
+    stack[0].lo = 0, stack[0].hi = n, stack[0].node = 0, stack[0].shift = 27 + 32;
+    stack[0].grouped = 0, stack[0].refined = 0;
+    while (sp > 0) {
+        sp--;
+        size_t lo = stack[sp].lo, hi = stack[sp].hi, node = stack[sp].node;
+        int shift = stack[sp].shift, grouped = stack[sp].grouped, refined = stack[sp].refined;
+        size_t ends[8];
+        int nc = hi - lo <= HD__AN_BUCKET || shift < 32 ? 1 : split_cell(keys, lo, hi, &shift, ends);
+        if (nc == 1 && hi - lo > HD__AN_BUCKET && refined < MAX_REFINE && refine(s, keys, lo, hi)) {
+            /* The new keys differ (the cell's extreme points on its widest
+             * axis get cells 0 and 1023), so the cell now splits. */
+            shift = 27 + 32, refined++;
+            nc = split_cell(keys, lo, hi, &shift, ends);
+        }
+        if (!grouped && (hi - lo <= HD__AN_GROUP || nc == 1)) {
+            s->gstart[ng] = (uint32_t)lo;
+            s->glead[ng++] = (uint32_t)nb;
+            grouped = 1;
+        }
+        if (nc == 1) {
+            double p[3] = {s->x[lo], s->y[lo], s->z[lo]};
+            s->first[node] = (uint32_t)nb;
+            s->count[node] = 0;
+            s->leaf[nb] = (uint32_t)node;
+            s->key[nb] = hd__key30(&c->grid, p);
+            s->start[nb++] = (uint32_t)lo;
+            continue;
+        }
+        if (nn + (size_t)nc > cap && grow_nodes(s, &cap, nn + (size_t)nc)) return HD_ENOMEM;
+        s->first[node] = (uint32_t)nn;
+        s->count[node] = (uint8_t)nc;
+        for (int k = nc - 1; k >= 0; k--) {
+            stack[sp].lo = k ? ends[k - 1] : lo;
+            stack[sp].hi = ends[k];
+            stack[sp].node = nn + (size_t)k;
+            stack[sp].shift = shift;
+            stack[sp].grouped = grouped;
+            stack[sp].refined = refined;
+            sp++;
+        }
+        nn += (size_t)nc;
+    }
+    s->start[nb] = s->gstart[ng] = (uint32_t)n;
+    s->nb = nb, s->ng = ng, s->nn = nn;
+    return HD_OK;
+}
+
+static void shrink(void **p, size_t n, size_t size) {
+    void *q = hd__realloc_array(*p, n, size);
+    if (q) *p = q;
+}
+
+void hd__an_free(hd__an_t *s) {
+    if (!s) return;
+    free(s->x);
+    free(s->y);
+    free(s->z);
+    free(s->idx);
+    free(s->start);
+    free(s->key);
+    free(s->stop);
+    free(s->leaf);
+    free(s->gstart);
+    free(s->glead);
+    free(s->first);
+    free(s->count);
+    for (int d = 0; d < 3; d++) free(s->lo[d]), free(s->hi[d]);
+    memset(s, 0, sizeof *s);
+}
+
+int hd__an_build(hd__an_t *s, const hd_points_t *p, const hd_transform_t *T, const hd__box_t *keybox,
+                 int threads, hd_error_t *err) {
+    memset(s, 0, sizeof *s);
+    size_t n = p->count;
+    if (n > HD__AN_MAX_POINTS)
+        return hd__err(err, HD_EOVERFLOW, "at most %zu points per set, not %zu", (size_t)HD__AN_MAX_POINTS, n);
+    s->n = n;
+    threads = threads < 1 ? 1 : threads;
+    build_ctx c;
+    memset(&c, 0, sizeof c);
+    c.s = s;
+    c.n = n;
+    hd__src_init(&c.src, p, T);
+    hd__keygrid_init(&c.grid, keybox);
+    c.parts = threads > MAX_PARTS ? MAX_PARTS : threads;
+    if ((size_t)c.parts > n / 65536 + 1) c.parts = (int)(n / 65536 + 1);
+    /* Node arrays grow as the octree is cut (a bucket usually holds a few
+     * dozen points; at worst there are fewer than 2n nodes, since every
+     * inner node has two children or more). */
+    size_t cap = n / 8 + 64;
+    s->x = hd__malloc_array(n + 4, sizeof *s->x);
+    s->y = hd__malloc_array(n + 4, sizeof *s->y);
+    s->z = hd__malloc_array(n + 4, sizeof *s->z);
+    s->idx = hd__malloc_array(n + 4, sizeof *s->idx);
+    s->start = hd__malloc_array(n + 1, sizeof *s->start);
+    s->key = hd__malloc_array(n + 1, sizeof *s->key);
+    s->stop = hd__malloc_array(n + 1, sizeof *s->stop);
+    s->leaf = hd__malloc_array(n + 1, sizeof *s->leaf);
+    s->gstart = hd__malloc_array(n + 1, sizeof *s->gstart);
+    s->glead = hd__malloc_array(n + 1, sizeof *s->glead);
+    s->first = hd__malloc_array(cap, sizeof *s->first);
+    s->count = hd__malloc_array(cap, sizeof *s->count);
+    /* The keys are computed in x[]'s memory, which the gather fills only
+     * after the sort; hd__radix_sort makes three passes, an odd number, so
+     * the sorted keys end in the other buffer.  Fresh memory costs a page
+     * fault per 4 KiB on first touch, a tenth of the build on some
+     * machines. */
+    uint64_t *first_buffer = s->x ? (uint64_t *)(void *)s->x : NULL;
+    c.a = first_buffer;
+    c.b = hd__malloc_array(n, sizeof *c.b);
+    int ok = s->x && s->y && s->z && s->idx && s->start && s->key && s->stop && s->leaf && s->gstart &&
+             s->glead && s->first && s->count && c.a && c.b;
+    int rc = HD_OK;
+    if (ok) {
+        hd__parallel_for(c.parts, (size_t)c.parts, key_task, &c);
+        rc = hd__radix_sort(&c.a, &c.b, n, c.parts);
+        /* Now c.a holds the sorted keys and c.b is x[]'s memory. */
+        uint64_t *t = c.a;
+        c.a = c.b, c.b = t;
+        if (rc == HD_OK) hd__parallel_for(threads, (n + 4 + GATHER_TASK - 1) / GATHER_TASK, gather_task, &c);
+    }
+    if (ok && rc == HD_OK) {
+        ok = build_octree(&c, cap) == HD_OK;
+        /* The keys are done with: give them back before the boxes. */
+        free(c.b);
+        c.a = c.b = NULL;
+        for (int d = 0; d < 3 && ok; d++) {
+            s->lo[d] = hd__malloc_array(s->nn, sizeof(double));
+            s->hi[d] = hd__malloc_array(s->nn, sizeof(double));
+            ok = s->lo[d] && s->hi[d];
+        }
+    }
+    if (ok && rc == HD_OK) {
+        /* Give back what the bounds reserved (keeping a block if the
+         * system cannot shrink it). */
+        shrink((void **)&s->start, s->nb + 1, sizeof *s->start);
+        shrink((void **)&s->leaf, s->nb, sizeof *s->leaf);
+        shrink((void **)&s->key, s->nb, sizeof *s->key);
+        shrink((void **)&s->stop, s->nb, sizeof *s->stop);
+        shrink((void **)&s->gstart, s->ng + 1, sizeof *s->gstart);
+        shrink((void **)&s->glead, s->ng, sizeof *s->glead);
+        shrink((void **)&s->first, s->nn, sizeof *s->first);
+        shrink((void **)&s->count, s->nn, sizeof *s->count);
+        hd__parallel_for(threads, (s->nb + BOX_TASK - 1) / BOX_TASK, box_task, &c);
+        /* Children come after their parent: boxes bottom-up. */
+        for (size_t k = s->nn; k-- > 0;) {
+            if (!s->count[k]) continue;
+            size_t f = s->first[k], e = f + s->count[k];
+            for (int d = 0; d < 3; d++) {
+                double lo = s->lo[d][f], hi = s->hi[d][f];
+                for (size_t i = f + 1; i < e; i++) {
+                    lo = s->lo[d][i] < lo ? s->lo[d][i] : lo;
+                    hi = s->hi[d][i] > hi ? s->hi[d][i] : hi;
+                }
+                s->lo[d][k] = lo;
+                s->hi[d][k] = hi;
+            }
+        }
+    }
+    if (c.a != first_buffer) free(c.a);
+    if (c.b != first_buffer) free(c.b);
+    if (!ok) {
+        hd__an_free(s);
+        return hd__err(err, HD_ENOMEM, "cannot allocate the search structure of %zu points", n);
+    }
+    if (rc != HD_OK) {
+        hd__an_free(s);
+        return hd__err(err, rc, "%s", hd_strerror(rc));
+    }
+    return HD_OK;
+}
+
+/* ---- searching --------------------------------------------------------------- */
+
+/* Candidate buckets of one group, their boxes in structure of arrays. */
+typedef struct {
+    size_t n;
+    uint32_t *bucket, *keep;
+    double *lo[3], *hi[3];
+    double *lb2;   /* per query: the bound of each candidate */
+    size_t paired; /* groups this worker settled by the partner path */
+} cands_t;
+
+/* The smallest computed squared distance between a point of box q and a
+ * point of node k's box (see the essay). */
+HD__INLINE double node_lb2(const hd__box_t *q, const hd__an_t *t, size_t k) {
+    double g[3];
+    for (int d = 0; d < 3; d++) {
+        double u = t->lo[d][k] - q->hi[d], v = q->lo[d] - t->hi[d][k];
+        g[d] = u > v ? u : v;
+        g[d] = g[d] > 0 ? g[d] : 0;
+    }
+    return g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
+}
+
+/* The largest computed squared distance between a point of box q and a
+ * point of node k's box (see the essay). */
+HD__INLINE double node_ub2(const hd__box_t *q, const hd__an_t *t, size_t k) {
+    double g[3];
+    for (int d = 0; d < 3; d++) {
+        double u = q->hi[d] - t->lo[d][k], v = t->hi[d][k] - q->lo[d];
+        g[d] = u > v ? u : v;
+    }
+    return g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
+}
+
+/* The bucket reached from the root by always taking the child whose box
+ * is nearest to the box q; *U is lowered to the upper bounds of the nodes
+ * on the way (each holds a point, so every query in q has a point within
+ * them).  When the group is far from t, or the curve's order says little
+ * (refined cells), this is a better first bucket than the seeds. */
+static size_t nearest_leaf(const hd__an_t *t, const hd__box_t *q, double *U) {
+    for (size_t k = 0;;) {
+        double u = node_ub2(q, t, k);
+        *U = u < *U ? u : *U;
+        if (!t->count[k]) return t->first[k];
+        size_t f = t->first[k], near = f;
+        double best = INFINITY;
+        for (size_t i = f; i < f + t->count[k]; i++) {
+            double lb = node_lb2(q, t, i);
+            if (lb < best) best = lb, near = i;
+        }
+        k = near;
+    }
+}
+
+/* List in c every bucket of t whose box is within U of the box q (box
+ * bound <= U), U bounding the answer of every query in q: the buckets left
+ * out hold no point that any of them could have as its nearest.  Returns 0,
+ * with the list unfinished, as soon as it would hold more than `limit`. */
+static int candidates(const hd__an_t *t, const hd__box_t *q, double U, size_t limit, cands_t *c) {
+    uint32_t stack[8 * 11 + 8];
+    double slb[8 * 11 + 8];
+    int sp = 0;
+    size_t m = 0;
+    stack[sp] = 0, slb[sp] = node_lb2(q, t, 0), sp++;
+    while (sp > 0) {
+        sp--;
+        if (slb[sp] > U) continue;
+        size_t k = stack[sp];
+        if (!t->count[k]) {
+            if (m == limit) return 0;
+            c->bucket[m] = t->first[k];
+            for (int d = 0; d < 3; d++) c->lo[d][m] = t->lo[d][k], c->hi[d][m] = t->hi[d][k];
+            m++;
+            continue;
+        }
+        size_t f = t->first[k];
+        int nc = t->count[k];
+        double lb[8];
+        for (int i = 0; i < nc; i++) lb[i] = node_lb2(q, t, f + (size_t)i);
+        for (int i = nc - 1; i >= 0; i--)
+            if (lb[i] <= U) stack[sp] = (uint32_t)(f + (size_t)i), slb[sp] = lb[i], sp++;
+    }
+    c->n = m;
+    return 1;
+}
+
+/* The bound hd__box_lb2s of every candidate for the query (qx, qy, qz)
+ * into c->lb2 (branch-free, so that it vectorises). */
+HD__INLINE void candidate_bounds(cands_t *c, size_t nc, double qx, double qy, double qz) {
+    const double *restrict lx = c->lo[0], *restrict ly = c->lo[1], *restrict lz = c->lo[2];
+    const double *restrict hx = c->hi[0], *restrict hy = c->hi[1], *restrict hz = c->hi[2];
+    double *restrict out = c->lb2;
+    for (size_t r = 0; r < nc; r++) {
+        double u, v, gx, gy, gz;
+        u = lx[r] - qx, v = qx - hx[r], gx = u > v ? u : v, gx = gx > 0 ? gx : 0;
+        u = ly[r] - qy, v = qy - hy[r], gy = u > v ? u : v, gy = gy > 0 ? gy : 0;
+        u = lz[r] - qz, v = qz - hz[r], gz = u > v ? u : v, gz = gz > 0 ? gz : 0;
+        out[r] = gx * gx + gy * gy + gz * gz;
+    }
+}
+
+/* One query against one bucket: the squared distances four lanes at a time
+ * (GCC's vector extension; each lane evaluates the expression of hd__d2s),
+ * their minimum, and the smallest original index at the minimum. */
+typedef double v4d __attribute__((vector_size(32)));
+typedef int64_t v4l __attribute__((vector_size(32)));
+typedef uint32_t v4u __attribute__((vector_size(16)));
+
+/* The distances of (vx, vy, vz) to the four points from position k. */
+#define D4(t, k, vx, vy, vz, out)                                         \
+    do {                                                                  \
+        v4d x_, y_, z_;                                                   \
+        __builtin_memcpy(&x_, (t)->x + (k), sizeof x_);                   \
+        __builtin_memcpy(&y_, (t)->y + (k), sizeof y_);                   \
+        __builtin_memcpy(&z_, (t)->z + (k), sizeof z_);                   \
+        x_ = (vx)-x_, y_ = (vy)-y_, z_ = (vz)-z_;                         \
+        (out) = x_ * x_ + y_ * y_ + z_ * z_;                              \
+    } while (0)
+
+HD__INLINE void scan_bucket(const hd__an_t *t, size_t b, double qx, double qy, double qz,
+                            double *best, uint32_t *bj) {
+    /* From the group of four that holds the first point to the one that
+     * holds the last: the points read before and after the bucket are
+     * points of the set too, so reading them changes no answer.  Each lane
+     * keeps its smallest distance and the smallest index at it. */
+    size_t k0 = t->start[b] & ~(size_t)3, e = t->stop[b];
+    v4d vx = {qx, qx, qx, qx}, vy = {qy, qy, qy, qy}, vz = {qz, qz, qz, qz}, mv, d;
+    v4u iu;
+    D4(t, k0, vx, vy, vz, mv);
+    __builtin_memcpy(&iu, t->idx + k0, sizeof iu);
+    v4l jv = __builtin_convertvector(iu, v4l);
+    for (size_t k = k0 + 4; k < e; k += 4) {
+        D4(t, k, vx, vy, vz, d);
+        __builtin_memcpy(&iu, t->idx + k, sizeof iu);
+        v4l jl = __builtin_convertvector(iu, v4l);
+        v4l take = (d < mv) | ((d == mv) & (jl < jv));
+        mv = (v4d)(((v4l)d & take) | ((v4l)mv & ~take));
+        jv = (jl & take) | (jv & ~take);
+    }
+    double m = mv[0] < mv[1] ? mv[0] : mv[1], m2 = mv[2] < mv[3] ? mv[2] : mv[3];
+    m = m < m2 ? m : m2;
+    if (m > *best) return;
+    /* The smallest index among the lanes at m, without a branch per lane
+     * (those mispredict: they cost more than the scan). */
+    v4d mm = {m, m, m, m};
+    v4l at = mv == mm, none = {INT64_MAX, INT64_MAX, INT64_MAX, INT64_MAX};
+    v4l jm = (jv & at) | (none & ~at);
+    int64_t j01 = jm[0] < jm[1] ? jm[0] : jm[1], j23 = jm[2] < jm[3] ? jm[2] : jm[3];
+    uint32_t j = (uint32_t)(j01 < j23 ? j01 : j23);
+    if (m < *best || j < *bj) {
+        *best = m;
+        *bj = j;
+    }
+}
+
+/* The last bucket of t whose first key is at most `key` (or bucket 0),
+ * searching up from bucket `from`, the answer for a smaller key (the keys
+ * grow: a few steps usually do; doubling steps then bisection). */
+static size_t bucket_at(const hd__an_t *t, uint32_t key, size_t from) {
+    size_t lo = from, step = 1;
+    while (lo + step < t->nb && t->key[lo + step] <= key) lo += step, step *= 2;
+    size_t hi = lo + step < t->nb ? lo + step : t->nb; /* the answer is in [lo, hi) */
+    while (hi - lo > 1) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (t->key[mid] <= key) lo = mid;
+        else hi = mid;
+    }
+    return lo;
+}
+
+#define GROUPS_PER_TASK 128 /* groups of queries per task */
+#define SEEDS 2             /* buckets scanned first for each query */
+
+#define PAIR_CANDIDATES 32 /* most candidates of a group for the partner path */
+#define PAIR_TRIAL 8        /* groups of a task tried before the partner path may be dropped */
+
+typedef struct {
+    const hd__an_t *q, *t;
+    const hd_points_t *partner; /* t's view: query i's partner is its point i (or NULL) */
+    double *dist;
+    size_t *nearest;
+    cands_t *cand; /* per worker: room for every bucket of t */
+    double *sd;    /* answers in q's order: squared distances */
+    uint32_t *sj;  /* and nearest original indices */
+} query_ctx;
+
+#define SCATTER_TASK 65536 /* answers per scattering task */
+
+/* The answers [task * SCATTER_TASK, ...) in q's order to the caller's
+ * arrays, at their original indices. */
+static void scatter_answers(void *vctx, size_t task, int worker) {
+    (void)worker;
+    query_ctx *c = vctx;
+    const uint32_t *idx = c->q->idx;
+    size_t lo = task * SCATTER_TASK, hi = lo + SCATTER_TASK < c->q->n ? lo + SCATTER_TASK : c->q->n;
+    if (c->dist)
+        for (size_t k = lo; k < hi; k++) c->dist[idx[k]] = sqrt(c->sd[k]);
+    if (c->nearest)
+        for (size_t k = lo; k < hi; k++) c->nearest[idx[k]] = c->sj[k];
+}
+
+HD__HOT static void query_task(void *vctx, size_t task, int worker) {
+    query_ctx *c = vctx;
+    const hd__an_t *q = c->q, *t = c->t;
+    cands_t *cd = &c->cand[worker];
+    size_t g0 = task * GROUPS_PER_TASK, g1 = g0 + GROUPS_PER_TASK < q->ng ? g0 + GROUPS_PER_TASK : q->ng;
+    double best[HD__AN_GROUP];
+    uint32_t bj[HD__AN_GROUP];
+    size_t seed[HD__AN_GROUP];
+    size_t at0 = g0 < g1 ? bucket_at(t, q->key[q->glead[g0]], 0) : 0;
+    hd__src_t psrc;
+    if (c->partner) hd__src_init(&psrc, c->partner, NULL);
+    size_t tried = 0, kept_groups = 0;
+    for (size_t g = g0; g < g1; g++) {
+        /* A group of equal keys may hold more than HD__AN_GROUP points:
+         * its queries are then taken HD__AN_GROUP at a time. */
+        size_t h = q->glead[g], s0 = at0;
+        at0 = bucket_at(t, q->key[h], at0);
+        for (size_t first = q->gstart[g]; first < q->gstart[g + 1]; first += HD__AN_GROUP) {
+            size_t m = q->gstart[g + 1] - first < HD__AN_GROUP ? q->gstart[g + 1] - first : HD__AN_GROUP;
+            hd__box_t gbox;
+            const double *v[3] = {q->x, q->y, q->z};
+            for (int d = 0; d < 3; d++) {
+                gbox.lo[d] = gbox.hi[d] = v[d][first];
+                for (size_t k = first + 1; k < first + m; k++) {
+                    gbox.lo[d] = v[d][k] < gbox.lo[d] ? v[d][k] : gbox.lo[d];
+                    gbox.hi[d] = v[d][k] > gbox.hi[d] ? v[d][k] : gbox.hi[d];
+                }
+            }
+            /* The partner path: when the sets are a copy and its
+             * original in the same order, each query's partner (the
+             * searched point of its own original index) is usually at or
+             * next to its answer.  Its distance is a real point's, so the
+             * largest over the group bounds every answer; if few buckets
+             * lie within it, they are the candidates and no seed is
+             * scanned.  Otherwise the partners still stand as first
+             * answers for the seeds to improve on.  A task drops the path
+             * once most of the groups it tried, PAIR_TRIAL at least, did
+             * not find most answers at the partners; no answer depends on
+             * any of this. */
+            double U = 0;
+            int paired = 0;
+            for (size_t k = 0; k < m; k++) best[k] = INFINITY, bj[k] = UINT32_MAX;
+            if (c->partner && (tried < PAIR_TRIAL || 2 * kept_groups >= tried)) {
+                /* The partners are read in the original order, far apart:
+                 * ask for the next chunk's while this one is worked on. */
+                for (size_t k = first + m; k < first + 2 * m && k < q->n; k++)
+                    __builtin_prefetch(psrc.base + (ptrdiff_t)q->idx[k] * psrc.ps);
+                for (size_t k = 0; k < m; k++) {
+                    double p[3];
+                    uint32_t i = q->idx[first + k];
+                    hd__src_get(&psrc, i, p);
+                    best[k] = hd__d2s(q->x[first + k], q->y[first + k], q->z[first + k], p[0], p[1], p[2]);
+                    bj[k] = i;
+                    U = best[k] > U ? best[k] : U;
+                }
+                paired = candidates(t, &gbox, U, PAIR_CANDIDATES, cd);
+                tried++;
+                cd->paired += (size_t)paired;
+            }
+            /* Seeds: the searched buckets at each query's place on the
+             * curve (its bucket's), and the bucket nearest to the group's
+             * box, give every query a real point; U, the largest of these
+             * distances, bounds every answer of the group. */
+            size_t near = SIZE_MAX;
+            if (!paired) {
+                double Ub = INFINITY;
+                near = nearest_leaf(t, &gbox, &Ub);
+                U = 0;
+                for (size_t k = 0; k < m; k++) {
+                    while (q->start[h + 1] <= first + k) h++;
+                    if (k == 0 || q->start[h] == first + k) s0 = bucket_at(t, q->key[h], s0);
+                    seed[k] = s0;
+                    double qx = q->x[first + k], qy = q->y[first + k], qz = q->z[first + k];
+                    for (size_t b = s0; b < s0 + SEEDS && b < t->nb; b++)
+                        scan_bucket(t, b, qx, qy, qz, &best[k], &bj[k]);
+                    if (near < s0 || near >= s0 + SEEDS) scan_bucket(t, near, qx, qy, qz, &best[k], &bj[k]);
+                    U = best[k] > U ? best[k] : U;
+                }
+                U = Ub < U ? Ub : U;
+                candidates(t, &gbox, U, SIZE_MAX, cd);
+            }
+            size_t nc = cd->n, kept = 0;
+            for (size_t k = 0; k < m; k++) {
+                double qx = q->x[first + k], qy = q->y[first + k], qz = q->z[first + k];
+                double b2 = best[k];
+                uint32_t j = bj[k];
+                /* Every candidate's bound for this query, then the scans it
+                 * cannot skip: those within the seed's distance and U (the
+                 * answer is within both), listed without branches, each
+                 * tested again against the best found so far (the seeds are
+                 * done already). */
+                candidate_bounds(cd, nc, qx, qy, qz);
+                double lim = b2 < U ? b2 : U;
+                size_t ns = 0;
+                for (size_t r = 0; r < nc; r++) {
+                    cd->keep[ns] = (uint32_t)r;
+                    ns += cd->lb2[r] <= lim;
+                }
+                for (size_t r = 0; r < ns; r++) {
+                    size_t at = cd->keep[r], b = cd->bucket[at];
+                    lim = b2 < U ? b2 : U;
+                    if (cd->lb2[at] > lim) continue;
+                    if (!paired && ((b >= seed[k] && b < seed[k] + SEEDS) || b == near)) continue;
+                    scan_bucket(t, b, qx, qy, qz, &b2, &j);
+                }
+                c->sd[first + k] = b2;
+                c->sj[first + k] = j;
+                kept += paired && j == q->idx[first + k];
+            }
+            /* The path pays when the partners are the answers (a copy),
+             * not merely near enough to list few candidates (a few
+             * buckets of repeated points): it is kept on while at least
+             * half of the groups tried had half of their answers there. */
+            kept_groups += 2 * kept >= m;
+        }
+    }
+}
+
+int hd__an_nearest(const hd__an_t *asking, const hd__an_t *searched, const hd_points_t *partner,
+                   int threads, double *dist, size_t *nearest, size_t *paired, hd_error_t *err) {
+    size_t tasks = (asking->ng + GROUPS_PER_TASK - 1) / GROUPS_PER_TASK;
+    threads = hd__thread_count(threads, tasks);
+    query_ctx c = {asking, searched, partner && partner->count == asking->n ? partner : NULL, dist, nearest, NULL,
+                   NULL, NULL};
+    c.cand = hd__calloc_array((size_t)threads, sizeof *c.cand);
+    c.sd = hd__malloc_array(asking->n, sizeof *c.sd);
+    c.sj = hd__malloc_array(asking->n, sizeof *c.sj);
+    int rc = c.cand && c.sd && c.sj ? HD_OK : HD_ENOMEM;
+    size_t nb = searched->nb;
+    for (int w = 0; w < threads && rc == HD_OK; w++) {
+        cands_t *cd = &c.cand[w];
+        cd->bucket = hd__malloc_array(nb, sizeof *cd->bucket);
+        cd->keep = hd__malloc_array(nb, sizeof *cd->keep);
+        cd->lb2 = hd__malloc_array(nb, sizeof *cd->lb2);
+        int ok = cd->bucket && cd->keep && cd->lb2;
+        for (int d = 0; d < 3; d++) {
+            cd->lo[d] = hd__malloc_array(nb, sizeof(double));
+            cd->hi[d] = hd__malloc_array(nb, sizeof(double));
+            ok = ok && cd->lo[d] && cd->hi[d];
+        }
+        if (!ok) rc = HD_ENOMEM;
+    }
+    if (rc == HD_OK) {
+        hd__parallel_for(threads, tasks, query_task, &c);
+        hd__parallel_for(threads, (asking->n + SCATTER_TASK - 1) / SCATTER_TASK, scatter_answers, &c);
+    }
+    if (paired) *paired = 0;
+    for (int w = 0; paired && c.cand && w < threads; w++) *paired += c.cand[w].paired;
+    for (int w = 0; c.cand && w < threads; w++) {
+        cands_t *cd = &c.cand[w];
+        free(cd->bucket);
+        free(cd->keep);
+        free(cd->lb2);
+        for (int d = 0; d < 3; d++) free(cd->lo[d]), free(cd->hi[d]);
+    }
+    free(c.cand);
+    free(c.sd);
+    free(c.sj);
+    if (rc != HD_OK) return hd__err(err, rc, "cannot allocate the candidate lists");
+    return HD_OK;
+}

@@ -1,0 +1,71 @@
+/*
+ * allnearest.h -- exact all-nearest-neighbours between two point sets
+ * (internal): for every point of one set, its nearest point in the other,
+ * as hd_distances needs them.  See allnearest.c for the design and the
+ * exactness argument.
+ *
+ * One structure per set serves both directions: it is searched by the
+ * other set's points, and it groups its own points as queries.  It holds a
+ * structure-of-arrays copy of the points in Morton order (x[], y[], z[],
+ * original indices idx[]) and the octree the Morton keys define, cut where
+ * a cell holds at most HD__AN_BUCKET points (the buckets, searched) and,
+ * coarser, HD__AN_GROUP points (the groups, asking), with the exact box of
+ * every node.
+ */
+#ifndef HD_ALLNEAREST_H
+#define HD_ALLNEAREST_H
+
+#include "points/points.h"
+
+/* Points per bucket and per group, at most (unless their keys are equal);
+ * measured on 1M-point clouds, 32 to 128 per bucket and 64 to 256 per
+ * group are within noise of each other. */
+#define HD__AN_BUCKET 64
+#define HD__AN_GROUP 128
+
+_Static_assert(HD__AN_BUCKET <= HD__AN_GROUP, "a group is a union of whole buckets");
+
+typedef struct hd__an {
+    size_t n;
+    double *x, *y, *z;     /* n + 4 coordinates in Morton order (the last repeated) */
+    uint32_t *idx;         /* original index of each */
+    size_t nb;             /* buckets (the octree's leaves), in key order */
+    uint32_t *start;       /* nb + 1: bucket b is points [start[b], start[b+1]) */
+    uint32_t *key;         /* nb: Morton key of each bucket's first point */
+    uint32_t *stop;        /* nb: where a scan of the bucket may stop (start + 1 for
+                            * copies of one point, else the next start) */
+    uint32_t *leaf;        /* nb: the node of each bucket */
+    size_t ng;             /* groups of queries, in key order */
+    uint32_t *gstart;      /* ng + 1: group g is points [gstart[g], gstart[g+1]) */
+    uint32_t *glead;       /* ng: the first bucket of each group */
+    size_t nn;             /* octree nodes; node 0 is the root */
+    uint32_t *first;       /* first child (children are consecutive), or bucket of a leaf */
+    uint8_t *count;        /* children, 0 for a leaf */
+    double *lo[3], *hi[3]; /* exact box of each node */
+} hd__an_t;
+
+/* Most points per set (node and point numbers fit 32 bits with room). */
+#define HD__AN_MAX_POINTS (UINT32_MAX / 2 - 8)
+
+/* Build the structure of a validated view of at most HD__AN_MAX_POINTS,
+ * each point moved by T if T is not NULL (the transformed points must be
+ * finite and in range), its Morton order taken on a grid over `keybox`
+ * (the same box for both sets lines their orders up).  Returns HD_OK,
+ * HD_ENOMEM or HD_EOVERFLOW. */
+int hd__an_build(hd__an_t *s, const hd_points_t *p, const hd_transform_t *T, const hd__box_t *keybox,
+                 int threads, hd_error_t *err);
+void hd__an_free(hd__an_t *s);
+
+/* For every point of `asking`, the exact nearest distance to `searched`
+ * (sqrt of the smallest hd__d2s) into dist[i] and the smallest original
+ * index attaining it into nearest[i], i being the point's original index;
+ * either output may be NULL.  `partner`, when not NULL, is the view
+ * `searched` was built from, of as many points as `asking`: its point i is
+ * tried first as the answer of asking's point i (a copy and its original
+ * in the same order settle fast); the answers do not depend on it, and
+ * *paired (if not NULL) counts the groups of queries it settled.
+ * Returns HD_OK or HD_ENOMEM (with err filled). */
+int hd__an_nearest(const hd__an_t *asking, const hd__an_t *searched, const hd_points_t *partner,
+                   int threads, double *dist, size_t *nearest, size_t *paired, hd_error_t *err);
+
+#endif /* HD_ALLNEAREST_H */

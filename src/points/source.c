@@ -1,0 +1,99 @@
+/*
+ * source.c -- where a set's coordinates come from, and the radix sort that
+ * orders points by Morton key.
+ *
+ * A source (hd__src_t) reads point k of a caller's view as three doubles,
+ * widening floats exactly and applying the optional transform in the
+ * documented order; the kind (packed doubles, packed floats, any strides)
+ * lets the hot loops skip the general path.  The view is borrowed: nothing
+ * is copied.
+ *
+ * The radix sort is least-significant-digit first on bits 32..61 of 64-bit
+ * words (a 30-bit Morton key above a 32-bit point index): three stable
+ * counting passes of 10 bits, each counted and scattered in parallel parts
+ * whose offsets come from a prefix sum in part order, so the result is the
+ * same at any thread count.  Stability makes equal keys keep increasing
+ * index order, which is what makes every order built on it a function of
+ * the input alone.  The engine's builds, the index's queries and the
+ * all-nearest structures all sort with it.
+ */
+#include "points/points.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+void hd__src_init(hd__src_t *s, const hd_points_t *p, const hd_transform_t *T) {
+    ptrdiff_t el = p->dtype == HD_FLOAT32 ? (ptrdiff_t)sizeof(float) : (ptrdiff_t)sizeof(double);
+    s->base = p->data;
+    s->dtype = p->dtype;
+    s->cs = p->cstride ? p->cstride : el;
+    s->ps = p->stride ? p->stride : 3 * el;
+    s->T = T;
+    s->kind = 2;
+    if (s->cs == el && s->ps == 3 * el) s->kind = p->dtype == HD_FLOAT32 ? 1 : 0;
+}
+
+/* ---- parallel LSD radix sort on bits 32..61 ------------------------------- */
+
+#define RADIX_BITS 10
+#define RADIX (1u << RADIX_BITS)
+#define MAX_SORT_THREADS 64
+
+typedef struct {
+    uint64_t *src, *dst;
+    size_t n;
+    int parts, shift;
+    size_t (*hist)[RADIX];
+} radix_ctx;
+
+static void radix_count(void *vctx, size_t part, int worker) {
+    (void)worker;
+    radix_ctx *c = vctx;
+    size_t lo = c->n * part / (size_t)c->parts, hi = c->n * (part + 1) / (size_t)c->parts;
+    size_t *h = c->hist[part];
+    memset(h, 0, RADIX * sizeof *h);
+    for (size_t k = lo; k < hi; k++) h[(c->src[k] >> c->shift) & (RADIX - 1)]++;
+}
+
+static void radix_scatter(void *vctx, size_t part, int worker) {
+    (void)worker;
+    radix_ctx *c = vctx;
+    size_t lo = c->n * part / (size_t)c->parts, hi = c->n * (part + 1) / (size_t)c->parts;
+    size_t *h = c->hist[part]; /* now the write positions */
+    for (size_t k = lo; k < hi; k++) {
+        uint64_t v = c->src[k];
+        c->dst[h[(v >> c->shift) & (RADIX - 1)]++] = v;
+    }
+}
+
+int hd__radix_sort(uint64_t **a, uint64_t **tmp, size_t n, int threads) {
+    int parts = threads;
+    if (parts > MAX_SORT_THREADS) parts = MAX_SORT_THREADS;
+    if ((size_t)parts > n / 65536 + 1) parts = (int)(n / 65536 + 1);
+    size_t(*hist)[RADIX] = hd__malloc_array((size_t)parts, sizeof *hist);
+    if (!hist) return HD_ENOMEM;
+    radix_ctx c;
+    c.n = n;
+    c.parts = parts;
+    c.hist = hist;
+    for (int pass = 0; pass < 3; pass++) {
+        c.src = *a;
+        c.dst = *tmp;
+        c.shift = 32 + RADIX_BITS * pass;
+        hd__parallel_for(parts, (size_t)parts, radix_count, &c);
+        size_t sum = 0;
+        for (unsigned d = 0; d < RADIX; d++)
+            for (int p = 0; p < parts; p++) {
+                size_t v = hist[p][d];
+                hist[p][d] = sum;
+                sum += v;
+            }
+        hd__parallel_for(parts, (size_t)parts, radix_scatter, &c);
+        uint64_t *s = *a;
+        *a = *tmp;
+        *tmp = s;
+    }
+    free(hist);
+    return HD_OK;
+}
+
