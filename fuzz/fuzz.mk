@@ -23,7 +23,9 @@ OUT     ?= build-fuzz
 CC      := $(or $(FUZZ_CC),clang)
 SAN     := -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
 NIFTI_INC ?= /usr/include/nifti
-CFLAGS  := -g -O1 -std=c11 -Wall -Wextra -ffp-contract=off -fno-math-errno \
+# the exactness flags from the one file CMake and setup.py read too
+EXACT   := $(shell sed -n '/^-/p' cmake/exactness-flags.txt)
+CFLAGS  := -g -O1 -std=c11 -Wall -Wextra $(EXACT) \
            -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE -Iinclude -Isrc $(SAN)
 LIBS    := -lm -lpthread
 

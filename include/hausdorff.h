@@ -96,7 +96,10 @@ enum {
 #define HD__ERRNO_ENUM(name, value, text) HD_##name = value,
     HD_ERRNO_MAP(HD__ERRNO_ENUM)
 #undef HD__ERRNO_ENUM
-    HD__ERRNO_LAST
+    /* The table's explicit end: the most negative code (codes run from 0
+     * down to it without gaps).  An enumerator after the table would be
+     * HD_EALGORITHM + 1, i.e. equal to HD_EOVERFLOW. */
+    HD__ERRNO_MIN = HD_EALGORITHM
 };
 
 /* Largest coordinate magnitude accepted.  Beyond it squared differences could

@@ -39,6 +39,12 @@ def version():
     return m.group(1) if m else "0"
 
 
+def exactness_flags():
+    """The flags exactness depends on, from the file CMake reads too."""
+    with open(os.path.join(ROOT, "cmake", "exactness-flags.txt"), encoding="utf-8") as f:
+        return [w for line in f if not line.startswith("#") for w in line.split()]
+
+
 static_lib = os.environ.get("HAUSDORFF_STATIC_LIB")
 sources = [os.path.join("hausdorff", "_hausdorff.c")]
 extra_objects = []
@@ -59,8 +65,7 @@ extension = Extension(
     sources=sources,
     include_dirs=[INCLUDE, os.path.join(ROOT, "src"), numpy.get_include()],
     define_macros=[("_POSIX_C_SOURCE", "200809L"), ("_DEFAULT_SOURCE", None)],
-    extra_compile_args=["-std=c11", "-O2", "-ffp-contract=off", "-fno-math-errno",
-                        "-fvisibility=hidden", "-Wall", "-Wextra"],
+    extra_compile_args=["-std=c11", "-O2"] + exactness_flags() + ["-fvisibility=hidden", "-Wall", "-Wextra"],
     extra_objects=extra_objects,
     extra_link_args=link_args,
     libraries=["m"],

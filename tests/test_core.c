@@ -20,6 +20,12 @@ TEST(every_result_code_has_a_text_and_a_name) {
     CHECK(strcmp(hd_strerror(12345), "unknown error") == 0);
 }
 
+TEST(result_codes_run_without_gaps_from_ok_down_to_the_tables_end) {
+    for (int c = HD_OK; c >= HD__ERRNO_MIN; c--) CHECK(strcmp(hd_strerror(c), "unknown error") != 0);
+    CHECK(strcmp(hd_strerror(HD__ERRNO_MIN - 1), "unknown error") == 0);
+    CHECK_EQ(HD__ERRNO_MIN, HD_EALGORITHM);
+}
+
 TEST(algorithm_names_round_trip) {
     for (int k = 0; k < HD__ALG_COUNT; k++) {
         hd_algorithm_t a;
