@@ -471,24 +471,18 @@ static int read_ascii(ply_t *p, int v, const int *xyz, int face_el, int face) {
             return hd__io_err_line(r, HD_EFORMAT, e->line,
                                    "element %.*s: %llu declared, but the file can hold at most %llu",
                                    (int)e->len, e->name, (unsigned long long)e->count, (unsigned long long)room);
-        int want_faces = k == face_el && face >= 0 && r->tris;
-        if (k != v && !want_faces) {
-            uint64_t got;
-            const char *nq = hd__skip_lines(q, end, e->count, &got);
-            if (got < e->count)
-                return hd__io_err_line(r, HD_EFORMAT, line + (long long)got,
-                                       "file ends inside element %.*s: %llu declared, %llu found",
-                                       (int)e->len, e->name, (unsigned long long)e->count, (unsigned long long)got);
-            q = nq;
-            line += (long long)e->count;
-            continue;
-        }
         uint64_t got;
         const char *stop = hd__skip_lines(q, end, e->count, &got);
         if (got < e->count)
             return hd__io_err_line(r, HD_EFORMAT, line + (long long)got,
                                    "file ends inside element %.*s: %llu declared, %llu found",
                                    (int)e->len, e->name, (unsigned long long)e->count, (unsigned long long)got);
+        int want_faces = k == face_el && face >= 0 && r->tris;
+        if (k != v && !want_faces) { /* neither vertices nor wanted faces: skipped */
+            q = stop;
+            line += (long long)e->count;
+            continue;
+        }
         ascii_ctx_t a = {e, {-1, -1, -1}, -1, k > v ? r->sink->count : UINT64_MAX};
         if (k == v) memcpy(a.xyz, xyz, sizeof a.xyz);
         else a.face = face;
