@@ -2,7 +2,7 @@
  * index.c -- the public reusable index of B (hd_index_*): build once, query
  * many times, with an optional transform of the query points.
  *
- * The index is the engine's index of B (engine_build.c): a permutation of
+ * The index is the engine's index of B (engine/build.c): a permutation of
  * B in Morton order, buckets with exact boxes and a quantised copy, and a
  * tree of boxes, about 13 bytes per point.  It borrows B's memory (the
  * header says so) and reads exact coordinates from it when an approximation
@@ -10,7 +10,7 @@
  * query it at once.
  *
  * hd_index_directed builds a temporary index of T(A) (the transform applied
- * on the fly, in the documented order) and runs the engine (engine.c): the
+ * on the fly, in the documented order) and runs the engine (engine/engine.c): the
  * result is exactly h(T(A), B) with the canonical witness.
  * hd_index_nearest does not search the index's tree once per query: that
  * search is made for the engine's early breaking, and a complete one costs
@@ -22,7 +22,7 @@
  * returns) and runs hd__an_nearest, as hd_distances does for one
  * direction; the answers are the same.  Sets beyond allnearest.c's limit
  * (2^31 - 9 points), and calls that cannot get the memory for those
- * structures, use the tree: one exact search (engine_search.c) per query,
+ * structures, use the tree: one exact search (engine/search.c) per query,
  * in slices over threads, each starting in the bucket where the previous
  * one ended.  That start is only good when consecutive queries are close,
  * so the queries are first sorted along the Morton curve of the index's

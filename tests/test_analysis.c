@@ -305,7 +305,7 @@ TEST(per_point_distances_are_exact_for_clusters_next_to_far_outliers) {
     }
 }
 
-/* How many groups of A's queries the partner path of allnearest.c settled
+/* How many groups of A's queries the partner path of src/nearest/allnearest.c settled
  * when A (n points) asks B (n points), B's point i being A's point i's
  * partner; *groups gets the number of A's groups. */
 static size_t partner_groups(const double *a, const double *b, size_t n, int threads, size_t *groups) {

@@ -1,5 +1,5 @@
 /*
- * test_heap.c -- the priority queue of NOHD, OHD and INC (src/heap.c): it
+ * test_heap.c -- the priority queue of NOHD, OHD and INC (src/base/heap.c): it
  * pops in key order (largest first as a max-queue, smallest first as a
  * min-queue), breaks ties by the smaller payload, and agrees with a plain
  * reference under any mix of pushes and pops.

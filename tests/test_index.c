@@ -46,7 +46,7 @@ static void check_against_brute(const hd_points_t *A, const double *a, size_t na
     CHECK_EQ(r.i, want.i);
     CHECK_EQ(r.j, want.j);
 
-    /* Both paths of hd_index_nearest: the groups of allnearest.c, which it
+    /* Both paths of hd_index_nearest: the groups of src/nearest/allnearest.c, which it
      * takes, and one search of the tree per query, which it keeps for sets
      * beyond allnearest.c's limit. */
     double *dist = malloc(8 * na);

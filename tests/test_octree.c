@@ -1,5 +1,5 @@
 /*
- * test_octree.c -- the octree (src/octree.c) and the box bounds every
+ * test_octree.c -- the octree (src/classic/octree.c) and the box bounds every
  * pruning rule relies on: a computed lower bound never exceeds, and a
  * computed upper bound is never below, the computed squared distance to any
  * point the box holds, at ordinary, huge (1e150) and tiny (1e-150) scales;

@@ -28,7 +28,7 @@
  *    between MBRs become hd__box_box_lb2 / hd__box_box_ub2 (octree.h), and
  *    between a point and a box hd__box_lb2 / hd__box_ub2, all evaluated in
  *    hd__d2's operation order, so they bracket the computed distances
- *    exactly (internal.h); between two points the bound is hd__d2 itself.
+ *    exactly (points/points.h); between two points the bound is hd__d2 itself.
  *  - Expand or refine: e is expanded when it is a node at least as large
  *    (squared diagonal of its box) as the largest node of L; otherwise every
  *    node of L is refined.  A point e always refines.

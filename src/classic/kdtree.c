@@ -7,7 +7,7 @@
  * is NAIVEHDD (paper, Algorithm 1) with line 4's inner loop over B replaced
  * by a tree search, and serves as the peer-equivalent baseline the `auto`
  * engine is measured against (the engine and the public index use their
- * own structures, engine_build.c and engine_grid.c).
+ * own structures, engine/build.c and engine/grid.c).
  *
  * Build.  The points are copied into three coordinate arrays plus an array
  * of original indices, and split recursively at the median of the widest
@@ -21,7 +21,7 @@
  *
  * Exactness.  Each node's box is the exact box of its points (min and max of
  * the stored doubles), so the computed lower bound hd__box_lb2 never exceeds
- * the computed hd__d2s to a point inside (internal.h).  A node is skipped
+ * the computed hd__d2s to a point inside (points/points.h).  A node is skipped
  * only when its lower bound is strictly greater than the best distance so
  * far; a node whose bound equals it is still visited, because it may hold a
  * point at the same distance with a smaller original index.  Within a leaf a

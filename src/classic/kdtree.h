@@ -7,7 +7,7 @@
  * flat array in preorder: a node's left child is the next node, its right
  * child is node `right`.  Every node's box is the exact bounding box of the
  * points below it, so hd__box_lb2 of a node never exceeds the computed
- * squared distance to any of its points (see the essay in internal.h).
+ * squared distance to any of its points (see the essay in points/points.h).
  */
 #ifndef HD_KDTREE_H
 #define HD_KDTREE_H

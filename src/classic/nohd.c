@@ -16,7 +16,7 @@
  *
  * Bounds.  lb(y, N) and ub(y, N) are hd__box_lb2 and hd__box_ub2 on the
  * node's tight box (octree.c), so through the monotone-rounding argument of
- * internal.h they bracket the computed hd__d2 of every point of N: MaxLB
+ * points/points.h they bracket the computed hd__d2 of every point of N: MaxLB
  * never exceeds the true answer, and MinUB is never below the nn distance of
  * any point of N.  CubeToPoints evaluates the same values branch-free, a
  * block of B at a time (see block_bounds), because it is NOHD's hot loop.

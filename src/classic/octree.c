@@ -13,7 +13,7 @@
  * The bounds the algorithms prune with are never taken from the cells: each
  * node carries the tight bounding box of its own points, made of their
  * coordinates.  A box that encloses its points exactly gives, through the
- * monotone-rounding argument in internal.h, a computed lower bound no larger
+ * monotone-rounding argument in points/points.h, a computed lower bound no larger
  * and an upper bound no smaller than the computed hd__d2 to each of them.
  * (A cell's faces are rounded sums and need not enclose the points they
  * were meant to: that is why they only steer the descent.)

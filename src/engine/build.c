@@ -1,5 +1,5 @@
 /*
- * engine_build.c -- building the engine's index of one point set: points
+ * build.c -- building the engine's index of one point set: points
  * sorted along a Morton (Z-order) curve, cut into buckets, with exact boxes.
  *
  * Why Morton order.  The engine's work is dominated by reading points, and
@@ -25,7 +25,7 @@
  * doubles the distance computations read (after the transform, if any);
  * every tree node's box is the union of its children's.  Boxes therefore
  * enclose their points exactly, which is what makes the pruning tests of
- * the searches exact without an epsilon (see internal.h).
+ * the searches exact without an epsilon (see points/points.h).
  *
  * Quantised copy.  Each bucket also keeps its points' coordinates as 16-bit
  * fractions of its box and `err`, a proven bound on the distance between a

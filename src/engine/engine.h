@@ -101,7 +101,7 @@ HD__INLINE int hd__bucket_decode(const hd__tree_t *t, size_t b, double *x, doubl
 }
 
 /* The smallest of c[0..HD__BUCKET).  A short bucket is padded with copies
- * of its point 0 (engine_build.c), whose values equal c[0], so padding never
+ * of its point 0 (build.c), whose values equal c[0], so padding never
  * changes the minimum.  Four running minima keep the loop free of a serial
  * dependency. */
 HD__INLINE double hd__min32(const double *c) {
@@ -182,7 +182,7 @@ typedef struct hd__counts {
 
 /* hd_index_nearest by the path it would take (path 0), or, for the tests,
  * by the one-search-per-query path over the index's tree that only sets
- * beyond allnearest.c's limit take otherwise (path 2). */
+ * beyond nearest/allnearest.c's limit take otherwise (path 2). */
 int hd__index_nearest_by(const hd_index_t *idx, const hd_points_t *Q, const hd_transform_t *T,
                          const hd_options_t *opt, double *dist, size_t *nearest, int path, hd_error_t *err);
 
@@ -195,7 +195,7 @@ int hd__index_nearest_by(const hd_index_t *idx, const hd_points_t *Q, const hd_t
 void hd__tree_nearest(const hd__tree_t *t, const double q[3], double stop2, double tie2,
                       size_t hint, hd__hit_t *hit, hd__counts_t *n);
 
-/* ---- the grid: a cheap index for sparse queries (engine_grid.c) ------------------ */
+/* ---- the grid: a cheap index for sparse queries (grid.c) --------------------- */
 
 /* Points grouped by the cell of a uniform grid of 2^bits cubic cells per
  * axis over the set's box; cells are numbered along the Morton curve, so
@@ -277,7 +277,7 @@ double hd__grid_trial(const hd__src_t *a, size_t na, const hd__grid_t *gb, hd__m
 int hd__engine_forced(const hd_points_t *A, const hd_points_t *B, const hd_options_t *opt,
                       int use_trees, hd_symmetric_t *out, hd_error_t *err);
 
-/* The correspondence path (engine_pairs.c), for two sets of n points each
+/* The correspondence path (pairs.c), for two sets of n points each
  * listed in the same order (a copy and its original).  hd__pairs_begin
  * tests a sample and, when the partners (a_i, b_i) look closer than other
  * neighbours, lists the pairs with the largest distances (P->active).

@@ -1,5 +1,5 @@
 /*
- * engine_grid.c -- the engine's cheap index (a uniform grid in Morton order
+ * grid.c -- the engine's cheap index (a uniform grid in Morton order
  * with an implicit octree over it) and the directed pass that uses it.
  *
  * When the two sets are far apart, or overlap with a Hausdorff distance
@@ -37,7 +37,7 @@
  * nominal boxes widened by `margin`, which covers every rounding in
  * assigning a point to its cell and in computing the faces (derived at
  * grid_geometry): each box encloses its points exactly.  Then, by the
- * monotonicity argument of internal.h, hd__box_lb2s never exceeds, and
+ * monotonicity argument of points/points.h, hd__box_lb2s never exceeds, and
  * hd__box_ub2(box, b) is never below, the computed hd__d2(a, b) of any
  * point a in the box: |fl(a - b)| <= max(|fl(lo - b)|, |fl(hi - b)|) on each
  * axis when lo <= a <= hi, and squaring and adding in the same order are
@@ -48,7 +48,7 @@
  * points of B (hd__kills: strictly below cmax, or a tie that cannot be the
  * witness).  Searches prune a node only when its lower bound is strictly
  * above the best exact distance, so they return the exact nearest distance
- * with the smallest index, as engine_search.c does.  Nothing here depends
+ * with the smallest index, as search.c does.  Nothing here depends
  * on the order in which threads take the cells.
  *
  * The plan (engine.c) primes cmax with hd__grid_prime and decides between

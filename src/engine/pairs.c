@@ -1,5 +1,5 @@
 /*
- * engine_pairs.c -- the engine's correspondence path: two sets of the same
+ * pairs.c -- the engine's correspondence path: two sets of the same
  * size listed in the same order.
  *
  * Users very often compare a set with a copy of itself that has been moved,

@@ -1,10 +1,10 @@
 /*
- * engine_search.c -- exact nearest-neighbour search in the engine's index,
+ * search.c -- exact nearest-neighbour search in the engine's index,
  * with early break and a starting bucket, reading exact coordinates only
  * where the quantised copy cannot decide.
  *
  * The search is the branch-and-bound of OHD (paper, Algorithm 6, line 6:
- * NNDist(x, Octree_B)) over the implicit tree of index.h, visiting the
+ * NNDist(x, Octree_B)) over the implicit tree of engine.h, visiting the
  * nearer child first, combined with EARLYBREAK's break (Algorithm 2, lines
  * 8-10; PointToPoints, Algorithm 5, lines 4-6): when the caller only needs
  * to know whether some point lies strictly within a bound, the search stops

@@ -1,12 +1,12 @@
 /*
  * allnearest.c -- exact all-nearest-neighbours: for every point of one set,
  * the nearest point of the other, with the smallest index among ties.  This
- * is what hd_distances computes (analysis.c), in both directions.
+ * is what hd_distances computes (stats.c), in both directions.
  *
  * A per-point answer needs one complete search per point: no point may be
  * skipped, as the Hausdorff distance's pruning skips the points that cannot
  * be the farthest.  What can be saved is everything around the searches.
- * The exact kd-tree (kdtree.c) that served here before spent 130 memory
+ * The exact kd-tree (classic/kdtree.c) that served here before spent 130 memory
  * passes on building two trees of a million points (a median selection per
  * node) and then walked from its root once per query.  Here:
  *  - Build.  Each set is sorted once along a Morton curve: 30-bit keys on a
@@ -32,7 +32,7 @@
  *    copies of one point is scanned as that one point (the sorts are
  *    stable, so its first copy has the smallest index), which keeps
  *    duplicates from costing a scan each.  Every node gets the exact box of
- *    its points.  The two sets are built side by side (analysis.c).
+ *    its points.  The two sets are built side by side (stats.c).
  *  - Search, a group at a time.  Every query first scans its seeds: the two
  *    searched buckets at its own bucket's place on the curve (the orders
  *    line up, so that is usually close), and the bucket reached from the
@@ -61,7 +61,7 @@
  *    repeated points list few candidates for any partner, but the partner
  *    is seldom the answer there, and reading partners costs a cache miss
  *    each: on 1M points on 8 lattice sites, trying every group cost 60%
- *    more time.)  This is the engine's correspondence bound (engine_pairs.c)
+ *    more time.)  This is the engine's correspondence bound (engine/pairs.c)
  *    put to per-point use.
  *  - Scans.  A bucket is scanned four points at a time with GCC's vector
  *    extension (each lane evaluates hd__d2s's expression: no fused
@@ -81,7 +81,7 @@
  * locality: every decision compares an exact squared distance or a bound
  * computed from exact boxes.  Every box (buckets, nodes, groups) is the min
  * and max of the stored doubles of its points.  IEEE rounding is monotone
- * (internal.h): for q in box Q and p in box B, the computed |fl(q - p)| on
+ * (points/points.h): for q in box Q and p in box B, the computed |fl(q - p)| on
  * each axis is at least the computed gap fl(B.lo - Q.hi) (or
  * fl(Q.lo - B.hi)) and at most the computed span max(fl(Q.hi - B.lo),
  * fl(B.hi - Q.lo)), and squaring and the left-to-right sum keep both
@@ -123,7 +123,7 @@
  * per-bucket arrays sized for the worst case (one point per bucket), given
  * back once the octree is cut; the node arrays grow as needed.  The
  * measured times are in docs/benchmarks.md, "Analysis".  Sets of more than HD__AN_MAX_POINTS
- * points are refused with HD_EOVERFLOW (analysis.c then uses the kd-trees).
+ * points are refused with HD_EOVERFLOW (stats.c then uses the kd-trees).
  */
 #include "nearest/nearest.h"
 

@@ -1,6 +1,6 @@
 /*
- * allnearest.h -- exact all-nearest-neighbours between two point sets
- * (internal): for every point of one set, its nearest point in the other,
+ * nearest.h -- exact all-nearest-neighbours between two point sets
+ * (layer src/nearest/): for every point of one set, its nearest point in the other,
  * as hd_distances needs them.  See allnearest.c for the design and the
  * exactness argument.
  *

@@ -188,7 +188,7 @@ HD__INLINE void hd__transform_apply(const hd_transform_t *T, const double *p,
 }
 
 /* hd__points_check's result, computed with `threads` threads by a fast pass
- * for packed views (engine_scan.c); any problem is reported by
+ * for packed views (scan.c); any problem is reported by
  * hd__points_check itself. */
 int hd__points_scan(const hd_points_t *p, const char *what, int threads,
                     hd__box_t *box, hd_error_t *err);
@@ -248,7 +248,7 @@ HD__INLINE void hd__src_keys(const hd__src_t *src, const hd__keygrid_t *grid, si
  * index), stable, in three counting passes of 10 bits over `threads`
  * threads.  The result ends in the buffer *tmp pointed to on entry (an odd
  * number of passes), and the two pointers are exchanged so that *a points
- * to it; allnearest.c relies on that.  Returns HD_OK, or HD_ENOMEM with
+ * to it; nearest/allnearest.c relies on that.  Returns HD_OK, or HD_ENOMEM with
  * nothing moved. */
 int hd__radix_sort(uint64_t **a, uint64_t **tmp, size_t n, int threads);
 
