@@ -1,47 +1,36 @@
 /*
- * engine.c -- the `auto` engine: its plan (a copy or subset settled by
- * engine_pairs.c, else the grid pass or the bucket trees), the walk over the
- * bucket trees, the shared maximum, and the entry points.  docs/engine.md
- * explains the design; the essay here is its summary.
+ * engine.c -- the `auto` engine's plan, its walk over the bucket trees, and
+ * its entry points for the layers above (hd__engine_directed,
+ * hd__engine_hausdorff, hd__engine_trees for the public index, and
+ * hd__engine_forced / hd__engine_explain for tests and benchmarks).  The
+ * design, why each piece is there and what it was measured to save, is told
+ * once, in docs/engine.md; the pieces live beside this file: the
+ * correspondence path in pairs.c, the grid and its pass in grid.c, the
+ * trees in build.c, their search in search.c, the running maximum the
+ * threads share in max.c.
  *
- * The plan.  First the shortcuts of engine_pairs.c, which need no index: two
- * sets of one size listed in the same order (a copy and its original) are
- * settled by their pair distances, and a smaller set that is an ordered
- * subset of the larger has h = 0 in its direction.  For what is left, both
- * sets get the cheap grid of engine_grid.c.  For each
- * direction h(A,B), cmax is primed with the exact nearest distances of the
- * representatives of A's cells lying where B is emptiest (the paper's AHD,
- * Algorithm 6, line 1), then the grid pass is tried on a sample of A.  When
- * it is cheap in every direction it runs; otherwise (nearly identical sets,
- * where the distance is below the points' spacing) both sets get the bucket
- * trees of engine_build.c and the walk below runs.
+ * The plan (engine_plan, engine_run) tries, in order: pairs.c's shortcuts,
+ * then for each open direction the grid pass when its trial on a sample
+ * is cheap in every direction (GRID_COST), else the bucket trees and the
+ * walk below.  A direction settled by one path is not run again, and every
+ * maximum found carries over to the next path.  The plan decides only
+ * speed, never the answer.
  *
- * The walk of h(A,B) over the trees combines three of the paper's ideas:
- *  1. cmax is primed again from points spread along A's curve and from the
- *     buckets of A with the largest boxes (sparse regions).
- *  2. A whole node of A is discarded when one point b of B is proven
- *     strictly within cmax of every point of the node's box (the paper's
- *     CubeToPoints, Algorithm 4, lines 5-7, applied to A's nodes); b is the
- *     last point of B that discarded something.
- *  3. A bucket of A is resolved together from its quantised copy: against
- *     that b, the buckets of B at the same place along B's curve, a short
- *     walk of B's tree nearby; each pair the approximations cannot decide is
- *     decided exactly; the points left get their own search, which stops at
- *     the first proof of a point within cmax (EARLYBREAK, Algorithm 2, lines
- *     8-10) or is an exact nearest-neighbour search.
- * Threads take subtrees of A from a shared counter; they share cmax through
- * an atomic and the maximum with its witness under a mutex.
- *
- * Exactness and the witness.  cmax is always the exact nearest distance of
- * some point of A, so it never exceeds h(A,B).  A point or node is discarded
- * only when a point of B is proven (exactly, or through the bounds of
- * index.h) strictly within cmax of it, or at most at a maximum already
- * attained at a smaller index of A (hd__kills): it cannot be the witness.
- * Every other point gets an exact search with the smallest nearest index
- * (engine_search.c, engine_grid.c), and the maxima merge with
- * hd__best_offer (larger distance, then smaller index).  The result is the
- * brute force's, bit for bit, at any thread count and in any schedule:
- * timing changes only how much is discarded, never what survives.
+ * What the code relies on:
+ *  - cmax (the shared hd__bound_t) is always the exact nearest squared
+ *    distance of some point of A, so it never exceeds h(A,B)^2.
+ *  - A point or node of A is discarded only when a point b of B is proven,
+ *    exactly or through the bounds of engine.h (hd__kill_below,
+ *    hd__may_reach, exact boxes), strictly within cmax of it, or at most at
+ *    a maximum already attained at a smaller index of A (hd__kills): it
+ *    cannot be the witness.
+ *  - Every other point gets an exact search that returns the smallest
+ *    nearest index (search.c, grid.c), and the maxima merge in max.c by
+ *    hd__best_offer (larger distance, then smaller index).
+ *  - Threads take subtrees of A from a shared counter; timing changes only
+ *    how much is discarded, never what survives, so the result and the
+ *    witness are the brute force's, bit for bit, at any thread count and in
+ *    any schedule.
  */
 #include "engine/engine.h"
 
@@ -451,9 +440,9 @@ static int tree_directed(const hd__tree_t *ta, const hd__tree_t *tb, hd__max_t *
 
 /* The grid pass is chosen when, run over a sample of each query set, it
  * costs at most GRID_COST distances and nodes per point; otherwise both
- * sets get the bucket trees.  Measured on the benchmark's cases
- * (docs/engine.md): where the grid wins it costs 1 to 3 per point, where
- * the trees win it costs tens to hundreds. */
+ * sets get the bucket trees.  The threshold only has to separate two
+ * populations that lie far apart: the costs measured on the benchmark's
+ * cases on each side of it are in docs/engine.md, "Step 2: the plan". */
 #define GRID_COST 8.0
 
 typedef struct {
