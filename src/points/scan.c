@@ -1,11 +1,14 @@
 /*
- * engine_scan.c -- validating a view and taking its box in one fast pass,
- * for the `auto` engine.
+ * scan.c -- validating a view and taking its box in one fast pass: the
+ * same answer as hd__points_check, for any caller that validates large
+ * views (the entry points of the `auto` engine and of per-point distances
+ * use it).  It lives in points/ beside the reference so that every layer
+ * above may call it.
  *
  * hd__points_check (points.c) reads every point through hd_points_get and
  * tests each coordinate in turn; it is the reference, and its messages are
- * the library's.  The engine's inputs are often hundreds of millions of
- * points, where that pass alone costs more than the rest of the work, so
+ * the library's.  Inputs are often hundreds of millions of points, where
+ * that pass alone can cost more than the rest of the work, so
  * hd__points_scan does the same checks with loops specialised for packed
  * double and float arrays, without branches in the loop body, over
  * `threads` threads.  Whenever it finds anything wrong (or the view is not
