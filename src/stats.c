@@ -1,6 +1,8 @@
 /*
- * analysis.c -- where the deviation is: per-point nearest-neighbour
- * distances in both directions, and the figures people derive from them
+ * stats.c -- where the deviation is (the public entry points of
+ * hd_distances and the figures; the file was src/analysis.c, and the
+ * tool's own cli/analysis.c only parses and prints): per-point
+ * nearest-neighbour distances in both directions, and the figures people derive from them
  * (percentile Hausdorff distances such as HD95, mean or "average Hausdorff"
  * distances, Chamfer distances, histograms).
  *
@@ -10,7 +12,7 @@
  * point that cannot be the farthest (the paper's pruning, Algorithms 2-8),
  * a per-point answer needs one complete search per point; no pruning idea
  * of the paper applies, and what can be saved is the cost around the
- * searches.  allnearest.c does them: each set gets one structure (its
+ * searches.  nearest/allnearest.c does them: each set gets one structure (its
  * points sorted along a Morton curve over the union of both boxes, and the
  * octree of that order with exact boxes), built side by side with the
  * other set's, and each structure serves twice: searched by the other
@@ -19,16 +21,16 @@
  * every answer is the exact nearest squared distance and the smallest
  * original index attaining it, the same doubles a brute force computes,
  * whatever was asked before and on whichever thread (see the exactness
- * argument there).  On 1M + 1M Gaussian points, with one thread, this
- * takes 0.22 to 0.51 of the time of the exact kd-trees (kdtree.c) it
- * replaced, which spent 130 memory passes on building alone, and copes
- * with massively repeated points, which made every kd-tree search visit
- * every node (docs/benchmarks.md, "Analysis").  The kd-trees
+ * argument there).  It replaced the exact kd-trees (classic/kdtree.c),
+ * whose median splits cost far more to build, and copes with massively
+ * repeated points, which made every kd-tree search visit every node (a
+ * kd-tree prunes only on strictly larger bounds); the times are in
+ * docs/benchmarks.md, "Analysis".  The kd-trees
  * remain for sets beyond HD__AN_MAX_POINTS points, whose indices do not fit
  * the structure's 32-bit fields.
  *
  * Everything derived is a pure function of those arrays:
- *  - Percentiles use select.c (numpy's "linear" definition, to the bit),
+ *  - Percentiles use base/select.c (numpy's "linear" definition, to the bit),
  *    on a copy, without a full sort.  "symmetric" is the larger of the two
  *    directed percentiles, as MONAI's compute_hausdorff_distance(percentile=)
  *    defines HD95; "pooled" is the percentile of both directions' distances
