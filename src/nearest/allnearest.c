@@ -6,15 +6,15 @@
  * A per-point answer needs one complete search per point: no point may be
  * skipped, as the Hausdorff distance's pruning skips the points that cannot
  * be the farthest.  What can be saved is everything around the searches.
- * The exact kd-tree (classic/kdtree.c) that served here before spent 130 memory
- * passes on building two trees of a million points (a median selection per
- * node) and then walked from its root once per query.  Here:
+ * The exact kd-tree (classic/kdtree.c) that served here before paid for a
+ * median selection per node to build, and then walked from its root once
+ * per query.  Here:
  *  - Build.  Each set is sorted once along a Morton curve: 30-bit keys on a
  *    grid of 1024 cells per axis over the union of both sets' boxes (so that
  *    the two orders line up), the engine's stable radix sort of key and
  *    index (hd__radix_sort: three counting passes of 10 bits, whose 1024
- *    destinations a pass stream better than the 32768 of two 15-bit passes:
- *    3 to 7% faster on 1M points), then one gather of the coordinates into
+ *    destinations a pass stream better than the 32768 of two 15-bit
+ *    passes), then one gather of the coordinates into
  *    packed arrays
  *    (x[], y[], z[], original indices idx[]).  The sorted keys define an
  *    octree; one pass over them cuts it where a cell holds at most
@@ -60,8 +60,7 @@
  *    so unrelated sets pay for eight groups a task.  (Sets of a few
  *    repeated points list few candidates for any partner, but the partner
  *    is seldom the answer there, and reading partners costs a cache miss
- *    each: on 1M points on 8 lattice sites, trying every group cost 60%
- *    more time.)  This is the engine's correspondence bound (engine/pairs.c)
+ *    each, so trying every group would cost more than it saves.)  This is the engine's correspondence bound (engine/pairs.c)
  *    put to per-point use.
  *  - Scans.  A bucket is scanned four points at a time with GCC's vector
  *    extension (each lane evaluates hd__d2s's expression: no fused
@@ -71,8 +70,7 @@
  *    may read a few points of the neighbouring buckets (and the four copies
  *    of the last point stored after the end), all of them points of the
  *    set.  The lanes' minimum and the smallest index at it are then picked
- *    without a branch per lane: those branches mispredicted, and cost 12%
- *    of the time on overlapping clouds.  This file is compiled with
+ *    without a branch per lane: those branches mispredicted.  This file is compiled with
  *    -fno-trapping-math (CMakeLists.txt):
  *    without it GCC does not vectorise the bound loop, and no value
  *    changes.
@@ -111,18 +109,19 @@
  * (12 bytes per point), and a last parallel pass takes their square roots
  * to the caller's arrays at the original indices: one tight loop of
  * scattered stores overlaps its cache misses, which the same stores
- * between searches did not (5 to 7% of the time on 1M points).
+ * between searches did not.
  *
  * Memory: about 32 bytes per point and set (28 for the coordinates and
- * indices, the rest for buckets, groups and nodes with their boxes; 1M
- * Gaussian points make 53K buckets, 29K groups and 61K nodes), 12 bytes
+ * indices, the rest for buckets, groups and nodes with their boxes, of
+ * which there are far fewer than points), 12 bytes
  * per asking point for the answers in its order, and, per thread, 64
  * bytes per searched bucket for the candidates.  While a set is built it
  * holds up to about 60 bytes per point: 8 of sort keys beside the
  * coordinates (the sort's other buffer is x[]'s memory) and 24 of
  * per-bucket arrays sized for the worst case (one point per bucket), given
- * back once the octree is cut; the node arrays grow as needed.  The
- * measured times are in docs/benchmarks.md, "Analysis".  Sets of more than HD__AN_MAX_POINTS
+ * back once the octree is cut; the node arrays grow as needed.  What each
+ * of these choices was measured to save, and the times, are in
+ * docs/benchmarks.md, "Analysis".  Sets of more than HD__AN_MAX_POINTS
  * points are refused with HD_EOVERFLOW (stats.c then uses the kd-trees).
  */
 #include "nearest/nearest.h"

@@ -18,8 +18,8 @@
 #include "points/points.h"
 
 /* Points per bucket and per group, at most (unless their keys are equal);
- * measured on 1M-point clouds, 32 to 128 per bucket and 64 to 256 per
- * group are within noise of each other. */
+ * the sizes around these were within noise of each other
+ * (docs/benchmarks.md, "Analysis", "Earlier measurements"). */
 #define HD__AN_BUCKET 64
 #define HD__AN_GROUP 128
 
