@@ -13,14 +13,13 @@
  * on the fly, in the documented order) and runs the engine (engine/engine.c): the
  * result is exactly h(T(A), B) with the canonical witness.
  * hd_index_nearest does not search the index's tree once per query: that
- * search is made for the engine's early breaking, and a complete one costs
- * about 1.9 us on 1M Gaussian points even from a nearby start.  The
- * all-nearest-neighbours structures of allnearest.c answer neighbouring
- * queries a group at a time, for about 0.45 us a query with their
- * construction.  So it builds those for B and for the transformed queries
- * (about 45 ms and 32 bytes per point each on 1M points, freed before it
- * returns) and runs hd__an_nearest, as hd_distances does for one
- * direction; the answers are the same.  Sets beyond allnearest.c's limit
+ * search is made for the engine's early breaking, and a complete one per
+ * query costs several times more, even from a nearby start, than the
+ * all-nearest-neighbours structures of nearest/allnearest.c, which answer
+ * neighbouring queries a group at a time, their construction included.
+ * So it builds those for B and for the transformed queries (32 bytes per
+ * point each, freed before it returns) and runs hd__an_nearest, as
+ * hd_distances does for one direction; the answers are the same.  Sets beyond that file's limit
  * (2^31 - 9 points), and calls that cannot get the memory for those
  * structures, use the tree: one exact search (engine/search.c) per query,
  * in slices over threads, each starting in the bucket where the previous
@@ -28,9 +27,9 @@
  * so the queries are first sorted along the Morton curve of the index's
  * grid (their transformed positions; a radix sort of key and index, 16
  * bytes per query while it runs) and searched in that order, each answer
- * written at the query's own index.  (On 1M random
- * queries in file order the tree took 19.6 s at 1 thread; sorted, 1.9 s;
- * the groups, 0.35 to 0.45 s.)
+ * written at the query's own index.  (The times of the three ways, tree
+ * in file order, tree in Morton order and groups, are in docs/analysis.md
+ * and docs/benchmarks.md.)
  *
  * A transform can carry a valid point out of range, so transformed query
  * points are checked (finite, within HD_MAX_COORD) before anything else.
@@ -184,7 +183,7 @@ int hd_index_directed(const hd_index_t *idx, const hd_points_t *A, const hd_tran
     return rc;
 }
 
-/* Per-point answers by allnearest.c (see the essay): the structures of B
+/* Per-point answers by nearest/allnearest.c (see the essay): the structures of B
  * and of T(Q) on a grid over both boxes, then one group of neighbouring
  * queries at a time. */
 static int nearest_by_groups(const hd_index_t *idx, const hd_points_t *Q, const hd_transform_t *T,
