@@ -105,17 +105,16 @@ static inline uint32_t cell_of(const hd__grid_t *g, const double p[3]) {
 
 /* Points per cell, at least, on average (a cell costs 28 bytes).  Fewer
  * cells make the counting sort cheaper, but a cell must stay small next to
- * the distance for whole cells to be discarded: with 64 (2^12 cells for
- * 10^6 points) the two builds took 2 ms less on the 1M/1M Gaussians, but
- * the copy translated by 3% of its box, where no cell can be discarded
- * whole and each surviving point's search scans a crowded cell, took
- * 400 ms instead of 50. */
+ * the distance for whole cells to be discarded: where none can be (a copy
+ * translated by about a cell), each surviving point's search scans a
+ * crowded cell.  The measurements behind 16 are in docs/engine.md, "Step
+ * 1: the grid". */
 #define GRID_POINTS_PER_CELL 16
 
 /* At most 2^6 cells per axis (2^18 cells, a 1 MB count table per part):
  * beyond that the counting sort's table and its 2^21 write positions miss
- * the caches on every point.  On two clouds of 10^8 points (2 threads) the
- * cap took the engine from 5.6 s to 3.2 s. */
+ * the caches on every point (measured at 10^8 points: docs/engine.md,
+ * "Step 1: the grid"). */
 #define GRID_MAX_BITS 6
 
 /* The grid over a box: cubic cells of side w, a little more than the

@@ -12,9 +12,9 @@
  *
  * Transparent huge pages (MADV_HUGEPAGE) were tried for large arrays: they
  * remove most of the page-fault cost of filling fresh memory, but where
- * memory is fragmented the kernel first compacts it synchronously, which
- * cost a whole second for 240 MB in one measurement.  So the sink takes
- * plain memory, whose cost is predictable.
+ * memory is fragmented the kernel first compacts it synchronously, a stall
+ * far longer than the faults saved (docs/benchmarks.md, "Reading").  So
+ * the sink takes plain memory, whose cost is predictable.
  */
 #include "io.h"
 

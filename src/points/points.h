@@ -232,8 +232,8 @@ HD__INLINE void hd__src_get(const hd__src_t *s, size_t k, double out[3]) {
 
 /* The Morton keys on grid of points [lo, hi) of src, above their indices
  * (keys[i] = key << 32 | i), as the builds and the index's queries sort
- * them.  Inline: as an out-of-line call it made hd_hausdorff 4 to 7% slower
- * on 1M-point Gaussians (measured, not explained). */
+ * them.  Inline: an out-of-line call made hd_hausdorff measurably slower
+ * (docs/benchmarks.md, "Measurements once quoted in the source"). */
 HD__INLINE void hd__src_keys(const hd__src_t *src, const hd__keygrid_t *grid, size_t lo, size_t hi,
                              uint64_t *keys) {
     for (size_t i = lo; i < hi; i++) {
