@@ -1,6 +1,8 @@
 /*
  * heap.c -- the priority queues of NOHD (Algorithm 3, the "descending order"
  * DPQ), OHD's NNDist (Algorithm 7, the "ascending order" APQ) and INC.
+ * It lives in base/ because it knows nothing about points: a key and a
+ * payload per item; the paper's algorithms in classic/ use it.
  *
  * The paper re-sorts its queues after every expansion ("Sort DPQ in
  * descending order using the second element", Algorithm 3 line 17;

@@ -7,7 +7,9 @@
  * is NAIVEHDD (paper, Algorithm 1) with line 4's inner loop over B replaced
  * by a tree search, and serves as the peer-equivalent baseline the `auto`
  * engine is measured against (the engine and the public index use their
- * own structures, engine/build.c and engine/grid.c).
+ * own structures, engine/build.c and engine/grid.c).  Its trees also serve
+ * per-point distances (stats.c) for sets beyond the limit of the
+ * all-nearest structures (nearest/allnearest.c).
  *
  * Build.  The points are copied into three coordinate arrays plus an array
  * of original indices, and split recursively at the median of the widest
