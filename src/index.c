@@ -195,7 +195,7 @@ static int nearest_by_groups(const hd_index_t *idx, const hd_points_t *Q, const 
     if ((rc = hd__an_build(&sb, &idx->view, NULL, &keybox, threads, err))) return rc;
     if ((rc = hd__an_build(&sq, Q, T, &keybox, threads, err)) == HD_OK) {
         /* A copy of B in B's order has its partners at the same indices
-         * (allnearest.c, "Partners"). */
+         * (nearest/allnearest.c, "Partners"). */
         const hd_points_t *partner = Q->count == idx->view.count ? &idx->view : NULL;
         rc = hd__an_nearest(&sq, &sb, partner, threads, dist, nearest, NULL, err);
         hd__an_free(&sq);

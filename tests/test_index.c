@@ -48,7 +48,7 @@ static void check_against_brute(const hd_points_t *A, const double *a, size_t na
 
     /* Both paths of hd_index_nearest: the groups of src/nearest/allnearest.c, which it
      * takes, and one search of the tree per query, which it keeps for sets
-     * beyond allnearest.c's limit. */
+     * beyond that file's limit. */
     double *dist = malloc(8 * na);
     size_t *near = malloc(sizeof(size_t) * na);
     for (int path = 0; path <= 2 && !hdt_failed(); path += 2) {
@@ -289,7 +289,7 @@ TEST(kdtree_algorithm_matches_brute_force) {
 
 TEST(nearest_of_a_same_order_copy_is_exact_with_and_without_a_transform) {
     /* Queries of B's size meet their partners at the same indices
-     * (allnearest.c); after a rotation the partners are far and the path
+     * (src/nearest/allnearest.c); after a rotation the partners are far and the path
      * must give up without changing an answer. */
     for (uint64_t seed = 50; seed < 50 + 2 * GEN_COPY_KINDS && !hdt_failed(); seed++) {
         gen_rng_t g;
