@@ -32,7 +32,10 @@
  * and docs/benchmarks.md.)
  *
  * A transform can carry a valid point out of range, so transformed query
- * points are checked (finite, within HD_MAX_COORD) before anything else.
+ * points are checked (finite, within HD_MAX_COORD) before anything else,
+ * once each: HD_ENONFINITE for a NaN or an infinity, HD_ERANGE beyond
+ * HD_MAX_COORD, as for untransformed points.  Packed views must be aligned
+ * to their element (check_aligned).
  */
 #include "engine/engine.h"
 #include "nearest/nearest.h"
@@ -46,6 +49,23 @@ struct hd_index {
     hd__tree_t tree;
 };
 
+/* A packed view is read through double or float pointers (hd__src_get's
+ * packed kinds, and the packed loops of the builds), which C allows only at
+ * addresses aligned to the element; a misaligned one is refused here, as
+ * hausdorff.h says.  Views with other strides are read with memcpy and may
+ * lie at any address. */
+static int check_aligned(const hd_points_t *p, const char *what, hd_error_t *err) {
+    hd__src_t s;
+    hd__src_init(&s, p, NULL);
+    ptrdiff_t el = p->dtype == HD_FLOAT32 ? (ptrdiff_t)sizeof(float) : (ptrdiff_t)sizeof(double);
+    if (s.cs == el && s.ps == 3 * el && (uintptr_t)p->data % (uintptr_t)el != 0)
+        return hd__err(err, HD_EINVAL,
+                       "point set %s: packed %s data must be aligned to %d bytes (its address is not a "
+                       "multiple of %d)",
+                       what, p->dtype == HD_FLOAT32 ? "float" : "double", (int)el, (int)el);
+    return HD_OK;
+}
+
 int hd_index_build(const hd_points_t *B, const hd_options_t *opt, hd_index_t **out,
                    hd_error_t *err) {
     hd__err_clear(err);
@@ -55,6 +75,7 @@ int hd_index_build(const hd_points_t *B, const hd_options_t *opt, hd_index_t **o
         return hd__err(err, HD_EINVAL, "threads must be 0 (every core) or positive, not %d",
                        opt->threads);
     int rc = hd__points_check(B, "B", NULL, err);
+    if (rc == HD_OK) rc = check_aligned(B, "B", err);
     if (rc) return rc;
     hd_index_t *idx = calloc(1, sizeof *idx);
     if (!idx) return hd__err(err, HD_ENOMEM, "cannot allocate an index");
@@ -134,6 +155,7 @@ static int query_begin(const hd_index_t *idx, const hd_points_t *q, const char *
         return hd__err(err, HD_EINVAL, "threads must be 0 (every core) or positive, not %d",
                        opt->threads);
     int rc = hd__points_check(q, what, &c->box, err);
+    if (rc == HD_OK) rc = check_aligned(q, what, err);
     if (rc) return rc;
     hd__src_init(&c->src, q, T);
     c->n = q->count;
@@ -146,8 +168,14 @@ static int query_begin(const hd_index_t *idx, const hd_points_t *q, const char *
     if (rc == HD_OK) hd__parallel_for(*threads, slices, check_task, c);
     for (size_t t = 0; t < slices && rc == HD_OK; t++)
         if (c->bad[t] != HD__NONE) {
-            rc = hd__err(err, HD_ERANGE,
-                         "point %zu of %s is NaN, infinite or beyond 1e153 after the transform",
+            /* The first such point, read again to say what is wrong, with
+             * the codes hd__points_check gives untransformed points. */
+            double p[3];
+            hd__src_get(&c->src, c->bad[t], p);
+            int finite = isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]);
+            rc = hd__err(err, finite ? HD_ERANGE : HD_ENONFINITE,
+                         finite ? "point %zu of %s is beyond 1e153 after the transform"
+                                : "point %zu of %s is NaN or infinite after the transform",
                          c->bad[t], what);
         }
     for (size_t t = 0; t < slices && rc == HD_OK; t++) {
@@ -260,7 +288,8 @@ static int nearest_by_tree(const hd_index_t *idx, query_ctx *c, int threads, dou
 }
 
 int hd__index_nearest_by(const hd_index_t *idx, const hd_points_t *Q, const hd_transform_t *T,
-                         const hd_options_t *opt, double *dist, size_t *nearest, int path, hd_error_t *err) {
+                         const hd_options_t *opt, double *dist, size_t *nearest, hd__nearest_path_t path,
+                         hd_error_t *err) {
     hd__err_clear(err);
     query_ctx c;
     int threads = 1;
@@ -268,7 +297,7 @@ int hd__index_nearest_by(const hd_index_t *idx, const hd_points_t *Q, const hd_t
     if (rc) return rc;
     if (!dist && !nearest) return HD_OK;
     int groups = c.n <= HD__AN_MAX_POINTS && idx->tree.n <= HD__AN_MAX_POINTS;
-    if (path == 2 || !groups) return nearest_by_tree(idx, &c, threads, dist, nearest, err);
+    if (path == HD__NEAREST_TREE || !groups) return nearest_by_tree(idx, &c, threads, dist, nearest, err);
     int gthreads = hd__thread_count(opt ? opt->threads : 0, c.n > idx->tree.n ? c.n : idx->tree.n);
     rc = nearest_by_groups(idx, Q, T, &c, gthreads, dist, nearest, err);
     if (rc != HD_ENOMEM) return rc;
@@ -280,5 +309,5 @@ int hd__index_nearest_by(const hd_index_t *idx, const hd_points_t *Q, const hd_t
 
 int hd_index_nearest(const hd_index_t *idx, const hd_points_t *Q, const hd_transform_t *T,
                      const hd_options_t *opt, double *dist, size_t *nearest, hd_error_t *err) {
-    return hd__index_nearest_by(idx, Q, T, opt, dist, nearest, 0, err);
+    return hd__index_nearest_by(idx, Q, T, opt, dist, nearest, HD__NEAREST_AUTO, err);
 }

@@ -7,17 +7,13 @@
  */
 #include "brute.h"
 #include "check.h"
+#include "engine/engine.h" /* hd__index_nearest_by and its paths */
 #include "gen.h"
 
 #include <math.h>
 #include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
-
-/* hd_index_nearest by a chosen path (index.c): 0 as the library picks, 2
- * one search of the tree per query. */
-int hd__index_nearest_by(const hd_index_t *idx, const hd_points_t *Q, const hd_transform_t *T,
-                         const hd_options_t *opt, double *dist, size_t *nearest, int path, hd_error_t *err);
 
 /* The expected answers for T(A) against B: the brute force on the
  * transformed copy (the transform applied by the test's own code). */
@@ -51,8 +47,10 @@ static void check_against_brute(const hd_points_t *A, const double *a, size_t na
      * beyond that file's limit. */
     double *dist = malloc(8 * na);
     size_t *near = malloc(sizeof(size_t) * na);
-    for (int path = 0; path <= 2 && !hdt_failed(); path += 2) {
-        CONTEXT("hd_index_nearest path %d", path);
+    static const hd__nearest_path_t paths[] = {HD__NEAREST_AUTO, HD__NEAREST_TREE};
+    for (int k = 0; k < 2 && !hdt_failed(); k++) {
+        hd__nearest_path_t path = paths[k];
+        CONTEXT("hd_index_nearest path %s", path == HD__NEAREST_TREE ? "tree" : "auto");
         memset(dist, 0, 8 * na);
         memset(near, 0, sizeof(size_t) * na);
         CHECK_RC(hd__index_nearest_by(idx, A, T, &o, dist, near, path, NULL), HD_OK);
@@ -331,7 +329,7 @@ TEST(index_refuses_bad_input) {
     /* A transform can carry valid points out of range: refused, not wrong. */
     hd_transform_t T;
     hd_transform_identity(&T);
-    T.r[0] = 1e300;
+    T.r[0] = 1e145; /* 1e155: finite, beyond HD_MAX_COORD */
     double far_[3] = {1e10, 0, 0};
     hd_points_t F = hd_points_f64(far_, 1);
     CHECK_RC(hd_index_directed(idx, &F, &T, NULL, &r, &e), HD_ERANGE);
@@ -341,6 +339,120 @@ TEST(index_refuses_bad_input) {
     hd_index_free(idx);
     hd_index_free(NULL);
     CHECK_EQ(hd_index_count(NULL), 0);
+}
+
+TEST(a_transform_that_makes_a_nan_or_an_infinity_is_refused_as_nonfinite) {
+    /* hausdorff.h promises HD_ENONFINITE for NaN and infinities and
+     * HD_ERANGE beyond HD_MAX_COORD; a transform can produce either from
+     * valid points, so the codes must be the same after it.  The bad point
+     * is the last of 10000 (the third slice of 4096 checked in parallel):
+     * the message names it. */
+    size_t n = 10000;
+    double *q = malloc(24 * n), b[6] = {0, 0, 0, 1, 1, 1};
+    for (size_t k = 0; k < 3 * n; k++) q[k] = k % 3 ? (double)(k % 7) : 0.0;
+    q[3 * (n - 1)] = 1e10; /* x = 0 but here */
+    hd_points_t Q = hd_points_f64(q, n), B = hd_points_f64(b, 2);
+    hd_index_t *idx = NULL;
+    CHECK_RC(hd_index_build(&B, NULL, &idx, NULL), HD_OK);
+    struct {
+        const char *what;
+        double r0, t0;
+        int code;
+    } cases[] = {
+        {"r[0] = NaN", NAN, 0.0, HD_ENONFINITE},       /* every point NaN */
+        {"t[0] = +inf", 1.0, INFINITY, HD_ENONFINITE}, /* every point infinite */
+        {"r[0] = 1e300", 1e300, 0.0, HD_ENONFINITE},   /* 1e310 overflows, 0 stays 0 */
+        {"r[0] = 1e150", 1e150, 0.0, HD_ERANGE},       /* 1e160: finite, beyond */
+        {"r[0] = 1e140", 1e140, 0.0, HD_OK},           /* 1e150: within */
+    };
+    for (size_t c = 0; c < sizeof cases / sizeof cases[0] && idx; c++) {
+        hd_transform_t T;
+        hd_transform_identity(&T);
+        T.r[0] = cases[c].r0;
+        T.t[0] = cases[c].t0;
+        int last_only = c >= 2; /* only the last point goes wrong */
+        for (int threads = 1; threads <= 2; threads++) {
+            CONTEXT("%s, threads %d", cases[c].what, threads);
+            hd_options_t o;
+            hd_options_init(&o);
+            o.threads = threads;
+            hd_error_t e;
+            hd_result_t r;
+            CHECK_RC(hd_index_directed(idx, &Q, &T, &o, &r, &e), cases[c].code);
+            if (cases[c].code != HD_OK)
+                CHECK(strstr(e.message, last_only ? "point 9999 of A" : "point 0 of A") != NULL);
+            double *dist = malloc(8 * n);
+            for (int k = 0; k < 2; k++) {
+                hd__nearest_path_t path = k ? HD__NEAREST_TREE : HD__NEAREST_AUTO;
+                CHECK_RC(hd__index_nearest_by(idx, &Q, &T, &o, dist, NULL, path, &e), cases[c].code);
+                if (cases[c].code != HD_OK)
+                    CHECK(strstr(e.message, last_only ? "point 9999 of Q" : "point 0 of Q") != NULL);
+            }
+            free(dist);
+        }
+    }
+    hd_index_free(idx);
+    free(q);
+}
+
+TEST(packed_views_must_be_aligned_and_strided_views_need_not_be) {
+    /* Packed doubles one byte off their alignment: the library would read
+     * them through double pointers (undefined behaviour, caught by the
+     * sanitizers), so every hd_index_* call refuses them with HD_EINVAL.
+     * The same bytes described with a stride that is not packed are read
+     * with memcpy and answered exactly. */
+    enum { N = 300 };
+    static double store[3 * N + 8];
+    double a[3 * N], b[3 * N];
+    gen_rng_t g;
+    gen_seed(&g, 4242);
+    double m0[3] = {0, 0, 0};
+    gen_gauss(&g, a, N, m0, 1.0);
+    gen_gauss(&g, b, N, m0, 1.0);
+    char *odd = (char *)store + 1;
+    memcpy(odd, a, sizeof a);
+    hd_points_t A = hd_points_f64(a, N), B = hd_points_f64(b, N);
+    hd_points_t M = hd_points_f64((const double *)(const void *)odd, N);
+    hd_error_t e;
+    hd_index_t *idx = (hd_index_t *)&idx;
+    CHECK_RC(hd_index_build(&M, NULL, &idx, &e), HD_EINVAL);
+    CHECK(idx == NULL);
+    CHECK(strstr(e.message, "aligned to 8 bytes") != NULL);
+    float af[3 * N];
+    for (size_t k = 0; k < 3 * N; k++) af[k] = (float)a[k];
+    memcpy((char *)store + 2, af, sizeof af);
+    hd_points_t Mf = hd_points_f32((const float *)(const void *)((char *)store + 2), N);
+    CHECK_RC(hd_index_build(&Mf, NULL, &idx, &e), HD_EINVAL);
+    CHECK(strstr(e.message, "aligned to 4 bytes") != NULL);
+    memcpy(odd, a, sizeof a);
+    M.stride = 24; /* explicit packed strides are packed too */
+    CHECK_RC(hd_index_build(&M, NULL, &idx, &e), HD_EINVAL);
+    M.stride = 0;
+    CHECK_RC(hd_index_build(&B, NULL, &idx, &e), HD_OK);
+    if (!idx) return;
+    hd_result_t r;
+    double dist[N];
+    CHECK_RC(hd_index_directed(idx, &M, NULL, NULL, &r, &e), HD_EINVAL);
+    CHECK_RC(hd_index_nearest(idx, &M, NULL, NULL, dist, NULL, &e), HD_EINVAL);
+    CHECK(strstr(e.message, "point set Q") != NULL);
+    /* Strided (here: Fortran-like, x of every point first) at an odd
+     * address: accepted, exact. */
+    double *soa = malloc(sizeof a + 1);
+    char *s1 = (char *)soa + 1;
+    for (size_t k = 0; k < N; k++)
+        for (int c = 0; c < 3; c++) memcpy(s1 + 8 * (c * N + k), &a[3 * k + c], 8);
+    hd_points_t S = {s1, N, HD_FLOAT64, 8, 8 * N};
+    hd_result_t want;
+    CHECK_RC(hd_index_directed(idx, &A, NULL, NULL, &want, NULL), HD_OK);
+    CHECK_RC(hd_index_directed(idx, &S, NULL, NULL, &r, &e), HD_OK);
+    CHECK_BITS(r.distance2, want.distance2);
+    CHECK_EQ(r.i, want.i);
+    CHECK_EQ(r.j, want.j);
+    hd_index_free(idx);
+    idx = NULL;
+    CHECK_RC(hd_index_build(&S, NULL, &idx, &e), HD_OK);
+    hd_index_free(idx);
+    free(soa);
 }
 
 TEST(nearest_accepts_either_output_alone) {

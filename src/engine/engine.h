@@ -180,11 +180,20 @@ typedef struct hd__counts {
     uint64_t evals, exact, nodes;
 } hd__counts_t;
 
-/* hd_index_nearest by the path it would take (path 0), or, for the tests,
- * by the one-search-per-query path over the index's tree that only sets
- * beyond nearest/allnearest.c's limit take otherwise (path 2). */
+/* How hd__index_nearest_by answers (index.c). */
+typedef enum hd__nearest_path {
+    /* As hd_index_nearest: the groups of nearest/allnearest.c, or the tree
+     * for sets beyond that file's limit or without memory for the groups. */
+    HD__NEAREST_AUTO = 0,
+    /* For the tests: one search of the index's tree per query, the path
+     * that only those sets take otherwise. */
+    HD__NEAREST_TREE = 1
+} hd__nearest_path_t;
+
+/* hd_index_nearest by the given path. */
 int hd__index_nearest_by(const hd_index_t *idx, const hd_points_t *Q, const hd_transform_t *T,
-                         const hd_options_t *opt, double *dist, size_t *nearest, int path, hd_error_t *err);
+                         const hd_options_t *opt, double *dist, size_t *nearest,
+                         hd__nearest_path_t path, hd_error_t *err);
 
 /* Exact nearest neighbour of the exact point q in t: hit->d2 is the
  * smallest squared distance and hit->j the smallest original index
