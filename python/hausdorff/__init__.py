@@ -13,35 +13,46 @@ hausdorff.DirectedResult(distance=1.0, i=1, j=0)
 >>> hausdorff.hausdorff(a, b).distance
 2.0
 
-Functions: directed, hausdorff, distances, percentile, read, formats;
+Functions: directed (a drop-in for scipy's directed_hausdorff), hausdorff,
+distances, percentile, summary, mean, chamfer, read, formats;
 the class Index (build once, query many times, optionally transformed).
 """
 from ._hausdorff import (
     DirectedResult,
     HausdorffResult,
     Index,
+    MeanResult,
     PercentileResult,
+    Summary,
     __version__,
     algorithms,
+    chamfer,
     directed,
     distances,
     formats,
     hausdorff,
+    mean,
     percentile,
     read,
+    summary,
 )
 
 __all__ = [
     "DirectedResult",
     "HausdorffResult",
     "Index",
+    "MeanResult",
     "PercentileResult",
+    "Summary",
     "__version__",
     "algorithms",
+    "chamfer",
     "directed",
     "distances",
     "formats",
     "hausdorff",
+    "mean",
     "percentile",
     "read",
+    "summary",
 ]

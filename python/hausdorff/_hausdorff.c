@@ -82,30 +82,93 @@ static PyObject *raise_hd(int rc, const hd_error_t *err) {
 typedef struct {
     PyArrayObject *arr; /* keeps the memory alive; NULL when unused */
     hd_points_t pts;
+    int dims;           /* the caller's columns: 2 or 3 (0 for an empty `[]`) */
 } points_arg_t;
 
 static void points_release(points_arg_t *p) {
     Py_CLEAR(p->arr);
 }
 
-/* Fill *out from any (N, 3) array-like.  `name` is the argument's name in
- * messages.  Returns 0, or -1 with an exception set. */
-static int points_from_object(PyObject *obj, const char *name, points_arg_t *out) {
-    out->arr = NULL;
-    PyArrayObject *arr = (PyArrayObject *)PyArray_FROM_O(obj);
-    if (!arr) return -1;
-    if (PyArray_NDIM(arr) != 2 || PyArray_DIM(arr, 1) != 3) {
+/* What a distance function returns for an empty set (the CLI's --empty,
+ * plus MONAI's rule).  EMPTY_NONE: the function has no such option. */
+typedef enum { EMPTY_NONE = -1, EMPTY_ERROR, EMPTY_INF, EMPTY_NAN, EMPTY_ZERO, EMPTY_MONAI } empty_t;
+
+static const char *const empty_names[] = {"error", "inf", "nan", "zero", "monai", NULL};
+
+static int parse_empty(const char *name, empty_t *out) {
+    *out = EMPTY_ERROR;
+    if (!name) return 0;
+    for (int k = 0; empty_names[k]; k++)
+        if (strcmp(name, empty_names[k]) == 0) {
+            *out = (empty_t)k;
+            return 0;
+        }
+    PyErr_Format(PyExc_ValueError,
+                 "empty must be 'error', 'inf', 'nan', 'zero' or 'monai', not '%s'", name);
+    return -1;
+}
+
+/* The value every figure takes when a set is empty: inf, NaN or 0, or as
+ * MONAI: inf when one set is empty, NaN when both are. */
+static double empty_value(empty_t policy, size_t na, size_t nb) {
+    switch (policy) {
+    case EMPTY_INF: return INFINITY;
+    case EMPTY_ZERO: return 0.0;
+    case EMPTY_MONAI: return na == 0 && nb == 0 ? NAN : INFINITY;
+    default: return NAN;
+    }
+}
+
+/* An (N, 2) array as the (N, 3) array of the points (x, y, 0), of dtype
+ * `want` (float32 or float64), C-ordered.  The z difference of two such
+ * points is 0, so every squared distance is dx*dx + dy*dy + 0, the same
+ * double as dx*dx + dy*dy: nothing is rounded on the way. */
+static PyArrayObject *lift_plane(PyArrayObject *arr, int want) {
+    PyArrayObject *src = (PyArrayObject *)PyArray_FromArray(
+        arr, PyArray_DescrFromType(want),
+        NPY_ARRAY_ALIGNED | NPY_ARRAY_NOTSWAPPED | NPY_ARRAY_FORCECAST);
+    if (!src) return NULL;
+    npy_intp dims[2] = {PyArray_DIM(src, 0), 3};
+    PyArrayObject *out = (PyArrayObject *)PyArray_ZEROS(2, dims, want, 0);
+    if (!out) {
+        Py_DECREF(src);
+        return NULL;
+    }
+    const char *s = PyArray_BYTES(src);
+    npy_intp s0 = PyArray_STRIDE(src, 0), s1 = PyArray_STRIDE(src, 1);
+    for (npy_intp k = 0; k < dims[0]; k++) {
+        const char *row = s + k * s0;
+        if (want == NPY_DOUBLE) {
+            double *d = (double *)PyArray_DATA(out) + 3 * k;
+            memcpy(&d[0], row, sizeof(double));
+            memcpy(&d[1], row + s1, sizeof(double));
+        } else {
+            float *f = (float *)PyArray_DATA(out) + 3 * k;
+            memcpy(&f[0], row, sizeof(float));
+            memcpy(&f[1], row + s1, sizeof(float));
+        }
+    }
+    Py_DECREF(src);
+    return out;
+}
+
+/* Fill *out from an array of points, whose reference it takes (released on
+ * failure).  `name` is the argument's name in messages.  An empty set is an
+ * error unless a policy other than "error" is given; it is then returned
+ * with count 0.  Returns 0, or -1 with an exception set. */
+static int points_prepare(PyArrayObject *arr, const char *name, empty_t empty,
+                          points_arg_t *out) {
+    memset(out, 0, sizeof *out);
+    int nd = PyArray_NDIM(arr);
+    int cols = nd == 2 ? (int)PyArray_DIM(arr, 1) : 0;
+    if (!(nd == 1 && PyArray_SIZE(arr) == 0) && !(nd == 2 && (cols == 2 || cols == 3))) {
         PyObject *shape = PyObject_GetAttrString((PyObject *)arr, "shape");
         if (shape) {
             PyErr_Format(PyExc_ValueError,
-                         "%s must be an (N, 3) array of points, got shape %R", name, shape);
+                         "%s must be an (N, 3) or (N, 2) array of points, got shape %R", name,
+                         shape);
             Py_DECREF(shape);
         }
-        Py_DECREF(arr);
-        return -1;
-    }
-    if (PyArray_DIM(arr, 0) == 0) {
-        PyErr_Format(PyExc_ValueError, "%s is empty: at least one point is needed", name);
         Py_DECREF(arr);
         return -1;
     }
@@ -121,10 +184,33 @@ static int points_from_object(PyObject *obj, const char *name, points_arg_t *out
         }
         want = NPY_DOUBLE;
     }
+    out->dims = cols;
+    if (nd == 1 || PyArray_DIM(arr, 0) == 0) {
+        if (empty == EMPTY_NONE || empty == EMPTY_ERROR) {
+            PyErr_Format(PyExc_ValueError, "%s is empty: at least one point is needed%s", name,
+                         empty == EMPTY_ERROR
+                             ? " (empty='inf', 'nan', 'zero' or 'monai' gives a value instead)"
+                             : "");
+            Py_DECREF(arr);
+            return -1;
+        }
+        out->arr = arr;
+        out->pts.dtype = HD_FLOAT64;
+        return 0; /* count 0 */
+    }
     npy_intp s0 = PyArray_STRIDE(arr, 0), s1 = PyArray_STRIDE(arr, 1);
+    if (cols == 2) {
+        PyArrayObject *c = lift_plane(arr, want);
+        Py_DECREF(arr);
+        if (!c) return -1;
+        arr = c;
+        s0 = PyArray_STRIDE(arr, 0);
+        s1 = PyArray_STRIDE(arr, 1);
+    }
     /* The library reads a zero stride as "packed": materialise broadcasts. */
     int zero_stride = s1 == 0 || (s0 == 0 && PyArray_DIM(arr, 0) > 1);
-    if (want != type || !PyArray_ISNOTSWAPPED(arr) || !PyArray_ISALIGNED(arr) || zero_stride) {
+    if (want != PyArray_TYPE(arr) || !PyArray_ISNOTSWAPPED(arr) || !PyArray_ISALIGNED(arr) ||
+        zero_stride) {
         PyArrayObject *c = (PyArrayObject *)PyArray_FromArray(
             arr, PyArray_DescrFromType(want), NPY_ARRAY_CARRAY | NPY_ARRAY_FORCECAST);
         Py_DECREF(arr);
@@ -142,10 +228,41 @@ static int points_from_object(PyObject *obj, const char *name, points_arg_t *out
     return 0;
 }
 
-/* Both sets of a two-set call; on failure neither is held. */
-static int points_pair(PyObject *oa, PyObject *ob, points_arg_t *a, points_arg_t *b) {
-    if (points_from_object(oa, "a", a)) return -1;
-    if (points_from_object(ob, "b", b)) {
+/* One set from any array-like. */
+static int points_from_object(PyObject *obj, const char *name, empty_t empty,
+                              points_arg_t *out) {
+    memset(out, 0, sizeof *out);
+    PyArrayObject *arr = (PyArrayObject *)PyArray_FROM_O(obj);
+    if (!arr) return -1;
+    return points_prepare(arr, name, empty, out);
+}
+
+/* Both sets of a two-set call, which must have the same number of columns
+ * (scipy's rule, and its words); on failure neither is held. */
+static int points_pair(PyObject *oa, PyObject *ob, empty_t empty, points_arg_t *a,
+                       points_arg_t *b) {
+    memset(a, 0, sizeof *a);
+    memset(b, 0, sizeof *b);
+    PyArrayObject *xa = (PyArrayObject *)PyArray_FROM_O(oa);
+    if (!xa) return -1;
+    PyArrayObject *xb = (PyArrayObject *)PyArray_FROM_O(ob);
+    if (!xb) {
+        Py_DECREF(xa);
+        return -1;
+    }
+    if (PyArray_NDIM(xa) == 2 && PyArray_NDIM(xb) == 2 && PyArray_DIM(xa, 1) != PyArray_DIM(xb, 1)) {
+        PyErr_Format(PyExc_ValueError,
+                     "a and b need to have the same number of columns, got %zd and %zd",
+                     (Py_ssize_t)PyArray_DIM(xa, 1), (Py_ssize_t)PyArray_DIM(xb, 1));
+        Py_DECREF(xa);
+        Py_DECREF(xb);
+        return -1;
+    }
+    if (points_prepare(xa, "a", empty, a)) {
+        Py_DECREF(xb);
+        return -1;
+    }
+    if (points_prepare(xb, "b", empty, b)) {
         points_release(a);
         return -1;
     }
@@ -156,22 +273,31 @@ static int points_pair(PyObject *oa, PyObject *ob, points_arg_t *a, points_arg_t
  * Options.
  * ---------------------------------------------------------------------- */
 
+/* Any integer: an int, a numpy integer, anything with __index__.  A new
+ * reference, or NULL with a TypeError naming the option. */
+static PyObject *as_integer(PyObject *obj, const char *name, const char *what) {
+    PyObject *v = PyNumber_Index(obj);
+    if (!v && PyErr_ExceptionMatches(PyExc_TypeError)) {
+        PyErr_Clear();
+        PyErr_Format(PyExc_TypeError, "%s must be %s, not %.100s", name, what,
+                     Py_TYPE(obj)->tp_name);
+    }
+    return v;
+}
+
 /* threads: None or 0 = every core, else a positive count. */
 static int parse_threads(PyObject *obj, int *threads) {
-    if (!obj || obj == Py_None) {
-        *threads = 0;
-        return 0;
-    }
-    if (!PyLong_Check(obj)) {
-        PyErr_Format(PyExc_TypeError, "threads must be None or an int, not %.100s",
-                     Py_TYPE(obj)->tp_name);
-        return -1;
-    }
-    long v = PyLong_AsLong(obj);
+    *threads = 0;
+    if (!obj || obj == Py_None) return 0;
+    PyObject *i = as_integer(obj, "threads", "None or an integer");
+    if (!i) return -1;
+    int overflow;
+    long v = PyLong_AsLongAndOverflow(i, &overflow);
+    Py_DECREF(i);
     if (v == -1 && PyErr_Occurred()) return -1;
-    if (v < 0 || v > INT_MAX) {
+    if (overflow || v < 0 || v > INT_MAX) {
         PyErr_Format(PyExc_ValueError,
-                     "threads must be None (every core) or a positive number, not %ld", v);
+                     "threads must be None (every core) or a positive number, not %R", obj);
         return -1;
     }
     *threads = (int)v;
@@ -192,13 +318,11 @@ static int parse_options(const char *algorithm, PyObject *threads, PyObject *see
         return -1;
     }
     if (parse_threads(threads, &opt->threads)) return -1;
-    if (seed) {
-        if (!PyLong_Check(seed)) {
-            PyErr_Format(PyExc_TypeError, "seed must be an int, not %.100s",
-                         Py_TYPE(seed)->tp_name);
-            return -1;
-        }
-        unsigned long long s = PyLong_AsUnsignedLongLong(seed);
+    if (seed && seed != Py_None) { /* None, as scipy's: the default seed */
+        PyObject *i = as_integer(seed, "seed", "an integer or None");
+        if (!i) return -1;
+        unsigned long long s = PyLong_AsUnsignedLongLong(i);
+        Py_DECREF(i);
         if (s == (unsigned long long)-1 && PyErr_Occurred()) {
             PyErr_Clear();
             PyErr_SetString(PyExc_ValueError, "seed must be an integer in [0, 2**64)");
@@ -356,6 +480,95 @@ static PyObject *hausdorff_result(const hd_symmetric_t *r) {
     return struct_of(&HausdorffResultType, v, 6);
 }
 
+/* The results of a call with an empty set: every distance is the policy's
+ * value v, and there is no witness (None), algorithm or box overlap. */
+static PyObject *directed_empty(double v) {
+    Py_INCREF(Py_None);
+    Py_INCREF(Py_None);
+    Py_INCREF(Py_None);
+    PyObject *f[6] = {PyFloat_FromDouble(v), Py_None, Py_None, Py_None,
+                      PyFloat_FromDouble(0.0), PyLong_FromLong(0)};
+    return struct_of(&DirectedResultType, f, 6);
+}
+
+static PyObject *hausdorff_empty(double v) {
+    Py_INCREF(Py_None);
+    PyObject *f[6] = {PyFloat_FromDouble(v), directed_empty(v), directed_empty(v),
+                      PyFloat_FromDouble(NAN), Py_None, PyFloat_FromDouble(0.0)};
+    return struct_of(&HausdorffResultType, f, 6);
+}
+
+/* Sums, means and Chamfer distances: hd_summary_t field for field. */
+static PyTypeObject SummaryType, MeanResultType;
+
+static PyStructSequence_Field summary_fields[] = {
+    {"n_ab", "number of distances from A's points to B (len(a))"},
+    {"n_ba", "number of distances from B's points to A (len(b); 0 when directed)"},
+    {"max_ab", "h(A, B), the largest distance of A's points to B"},
+    {"max_ba", "h(B, A)"},
+    {"sum_ab", "sum of the distances of A's points to B (compensated)"},
+    {"sum_ba", "sum of the distances of B's points to A"},
+    {"sum2_ab", "sum of the squared distances of A's points to B"},
+    {"sum2_ba", "sum of the squared distances of B's points to A"},
+    {"mean_ab", "mean distance of A's points to B"},
+    {"mean_ba", "mean distance of B's points to A"},
+    {"mean2_ab", "mean squared distance of A's points to B"},
+    {"mean2_ba", "mean squared distance of B's points to A"},
+    {"mean_symmetric", "max(mean_ab, mean_ba): the average Hausdorff distance"},
+    {"mean_average", "(mean_ab + mean_ba) / 2"},
+    {"mean_pooled", "(sum_ab + sum_ba) / (n_ab + n_ba): MONAI's symmetric average surface distance"},
+    {"chamfer", "mean2_ab + mean2_ba: the Chamfer distance (as PyTorch3D)"},
+    {"chamfer_sum2", "sum2_ab + sum2_ba"},
+    {"chamfer_mean", "mean_ab + mean_ba"},
+    {"chamfer_sum", "sum_ab + sum_ba"},
+    {NULL, NULL},
+};
+
+static PyStructSequence_Desc summary_desc = {
+    "hausdorff.Summary",
+    "Sums, means and Chamfer distances of the per-point distances, the same "
+    "doubles as the command line's --mean and --chamfer (the fields of the C "
+    "library's hd_summary_t).  Fields of B's direction are NaN when directed.",
+    summary_fields,
+    19,
+};
+
+static PyStructSequence_Field mean_fields[] = {
+    {"ab", "mean distance of A's points to B"},
+    {"ba", "mean distance of B's points to A"},
+    {"symmetric", "max(ab, ba): the average Hausdorff distance"},
+    {"average", "(ab + ba) / 2"},
+    {"pooled", "mean of both directions' distances together (MONAI's symmetric ASD)"},
+    {NULL, NULL},
+};
+
+static PyStructSequence_Desc mean_desc = {
+    "hausdorff.MeanResult",
+    "Mean distances, the tuple (ab, ba, symmetric, average, pooled): the "
+    "command line's --mean.",
+    mean_fields,
+    5,
+};
+
+static PyObject *summary_result(const hd_summary_t *s) {
+    const double d[17] = {s->max_ab, s->max_ba, s->sum_ab, s->sum_ba, s->sum2_ab, s->sum2_ba,
+                          s->mean_ab, s->mean_ba, s->mean2_ab, s->mean2_ba, s->mean_symmetric,
+                          s->mean_average, s->mean_pooled, s->chamfer, s->chamfer_sum2,
+                          s->chamfer_mean, s->chamfer_sum};
+    PyObject *v[19];
+    v[0] = PyLong_FromSize_t(s->n_ab);
+    v[1] = PyLong_FromSize_t(s->n_ba);
+    for (int k = 0; k < 17; k++) v[2 + k] = PyFloat_FromDouble(d[k]);
+    return struct_of(&SummaryType, v, 19);
+}
+
+static PyObject *mean_result(const hd_summary_t *s) {
+    PyObject *v[5] = {PyFloat_FromDouble(s->mean_ab), PyFloat_FromDouble(s->mean_ba),
+                      PyFloat_FromDouble(s->mean_symmetric), PyFloat_FromDouble(s->mean_average),
+                      PyFloat_FromDouble(s->mean_pooled)};
+    return struct_of(&MeanResultType, v, 5);
+}
+
 /* ------------------------------------------------------------------------
  * Per-point distances: the query set against an index.
  * ---------------------------------------------------------------------- */
@@ -391,23 +604,30 @@ static PyObject *nearest_arrays(const hd_index_t *idx, const hd_points_t *A,
  * ---------------------------------------------------------------------- */
 
 PyDoc_STRVAR(directed_doc,
-"directed($module, a, b, *, algorithm='auto', threads=None, seed=0)\n--\n\n"
+"directed($module, a, b, seed=0, *, algorithm='auto', threads=None, empty='error')\n--\n\n"
 "The directed Hausdorff distance h(a, b) = max over p in a of min over q in b\n"
 "of |p - q|, exact to the last bit, with its witness.\n"
 "\n"
-"A drop-in for scipy.spatial.distance.directed_hausdorff(a, b): it returns the\n"
-"tuple (distance, i, j) where |a[i] - b[j]| == distance.  On ties i is the\n"
+"A drop-in for scipy.spatial.distance.directed_hausdorff(u, v, seed=0): the\n"
+"same calls (seed positional or keyword, None included; scipy's names u= and\n"
+"v= for a and b) return the tuple (distance, i, j) where\n"
+"|a[i] - b[j]| == distance, the same double as scipy's.  On ties i is the\n"
 "smallest index in a whose nearest distance is the maximum and j the smallest\n"
 "index in b at that distance, for every algorithm and thread count (scipy's\n"
 "witness depends on its random order instead).\n"
 "\n"
-"a, b: (N, 3) and (M, 3) array-likes of float32 or float64 (C or Fortran\n"
-"    order or strided views are read in place; other real dtypes are\n"
-"    converted to float64).\n"
+"a, b: (N, 3) or (N, 2) array-likes of real numbers, both with the same\n"
+"    number of columns; a point (x, y) is (x, y, 0), which changes no\n"
+"    distance.  float32 and float64 (N, 3) arrays are read in place (C or\n"
+"    Fortran order or strided views); other dtypes are converted to float64.\n"
+"seed: the seed of the randomised algorithms (earlybreak, ohd); it never\n"
+"    changes the answer.  None is the default seed.\n"
 "algorithm: 'auto' (the fastest exact engine), 'naive', 'earlybreak',\n"
 "    'inc', 'nohd', 'ohd', 'framework' or 'kdtree'.\n"
 "threads: None or 0 for every core, else the number of threads.\n"
-"seed: the seed of the randomised algorithms (earlybreak, ohd).\n"
+"empty: what an empty set gives: 'error' (ValueError), 'inf', 'nan',\n"
+"    'zero', or 'monai' (inf when one set is empty, NaN when both are); the\n"
+"    witness is then (None, None).\n"
 "\n"
 "The GIL is released during the computation.  Raises ValueError for a wrong\n"
 "shape, an empty set, NaN or infinite coordinates, or an unknown algorithm.\n"
@@ -419,29 +639,75 @@ PyDoc_STRVAR(directed_doc,
 ">>> print(round(d, 6), i, j)\n"
 "1.118034 2 0\n"
 ">>> hausdorff.directed(a, b).distance == d\n"
-"True\n");
+"True\n"
+">>> hausdorff.directed(u=[(0, 0), (3, 4)], v=[(0, 0)], seed=1)\n"
+"hausdorff.DirectedResult(distance=5.0, i=1, j=0)\n"
+">>> hausdorff.directed(a, np.empty((0, 3)), empty='inf').distance\n"
+"inf\n");
 
-/* The arguments of directed() and hausdorff(): a, b, *, algorithm, threads,
- * seed.  On success both sets are held (release them). */
-static int distance_args(PyObject *args, PyObject *kw, const char *fmt, hd_options_t *opt,
-                         points_arg_t *a, points_arg_t *b) {
-    static char *kwlist[] = {"a", "b", "algorithm", "threads", "seed", NULL};
-    PyObject *oa, *ob, *threads = Py_None, *seed = NULL;
-    const char *algorithm = "auto";
-    if (!PyArg_ParseTupleAndKeywords(args, kw, fmt, kwlist, &oa, &ob, &algorithm, &threads,
-                                     &seed))
-        return -1;
-    if (parse_options(algorithm, threads, seed, opt)) return -1;
-    return points_pair(oa, ob, a, b);
+/* scipy's names u and v for a and b: *out is kw with them renamed (a new
+ * reference; NULL when kw is NULL).  Giving both names is a TypeError. */
+static int scipy_names(PyObject *kw, PyObject **out) {
+    *out = NULL;
+    if (!kw) return 0;
+    static const char *const alias[2][2] = {{"u", "a"}, {"v", "b"}};
+    PyObject *copy = NULL;
+    for (int k = 0; k < 2; k++) {
+        PyObject *val = PyDict_GetItemString(kw, alias[k][0]);
+        if (!val) continue;
+        if (PyDict_GetItemString(kw, alias[k][1])) {
+            PyErr_Format(PyExc_TypeError,
+                         "directed() got both '%s' and '%s' (scipy's name for it)",
+                         alias[k][1], alias[k][0]);
+            Py_XDECREF(copy);
+            return -1;
+        }
+        if (!copy && !(copy = PyDict_Copy(kw))) return -1;
+        if (PyDict_SetItemString(copy, alias[k][1], val) < 0 ||
+            PyDict_DelItemString(copy, alias[k][0]) < 0) {
+            Py_DECREF(copy);
+            return -1;
+        }
+    }
+    if (!copy) {
+        Py_INCREF(kw);
+        copy = kw;
+    }
+    *out = copy;
+    return 0;
 }
 
 /* directed() and hausdorff(): one computation, one or both directions. */
 static PyObject *distance_call(PyObject *args, PyObject *kw, int symmetric) {
+    static char *kw_directed[] = {"a", "b", "seed", "algorithm", "threads", "empty", NULL};
+    static char *kw_hausdorff[] = {"a", "b", "algorithm", "threads", "seed", "empty", NULL};
+    PyObject *oa, *ob, *threads = Py_None, *seed = NULL;
+    const char *algorithm = "auto", *empty_name = NULL;
+    int ok;
+    if (symmetric) {
+        ok = PyArg_ParseTupleAndKeywords(args, kw, "OO|$sOOs:hausdorff", kw_hausdorff, &oa, &ob,
+                                         &algorithm, &threads, &seed, &empty_name);
+    } else {
+        PyObject *kw2;
+        if (scipy_names(kw, &kw2)) return NULL;
+        ok = PyArg_ParseTupleAndKeywords(args, kw2, "OO|O$sOs:directed", kw_directed, &oa, &ob,
+                                         &seed, &algorithm, &threads, &empty_name);
+        Py_XDECREF(kw2);
+    }
+    if (!ok) return NULL;
     hd_options_t opt;
-    points_arg_t a, b;
-    if (distance_args(args, kw, symmetric ? "OO|$sOO:hausdorff" : "OO|$sOO:directed", &opt,
-                      &a, &b))
+    empty_t empty;
+    if (parse_options(algorithm, threads, seed, &opt) || parse_empty(empty_name, &empty))
         return NULL;
+    points_arg_t a, b;
+    if (points_pair(oa, ob, empty, &a, &b)) return NULL;
+    size_t na = a.pts.count, nb = b.pts.count;
+    if (!na || !nb) {
+        points_release(&a);
+        points_release(&b);
+        double v = empty_value(empty, na, nb);
+        return symmetric ? hausdorff_empty(v) : directed_empty(v);
+    }
     hd_result_t r;
     hd_symmetric_t h;
     hd_error_t err;
@@ -462,7 +728,7 @@ static PyObject *py_directed(PyObject *self, PyObject *args, PyObject *kw) {
 }
 
 PyDoc_STRVAR(hausdorff_doc,
-"hausdorff($module, a, b, *, algorithm='auto', threads=None, seed=0)\n--\n\n"
+"hausdorff($module, a, b, *, algorithm='auto', threads=None, seed=0, empty='error')\n--\n\n"
 "The Hausdorff distance H(a, b) = max(h(a, b), h(b, a)), exact, with the\n"
 "witnesses of both directions.\n"
 "\n"
@@ -470,7 +736,8 @@ PyDoc_STRVAR(hausdorff_doc,
 "a DirectedResult (ab.i indexes a, ab.j indexes b) and ba is h(b, a)\n"
 "(ba.i indexes b, ba.j indexes a).  It also carries alpha (the overlap\n"
 "degree of the bounding boxes), disjoint and seconds.  Arguments as for\n"
-"directed().\n"
+"directed(); with an empty set and an empty policy, both directions are\n"
+"the policy's value, alpha is NaN and disjoint None.\n"
 "\n"
 ">>> import numpy as np, hausdorff\n"
 ">>> a = np.array([[0.0, 0, 0], [1, 0, 0]])\n"
@@ -485,12 +752,15 @@ static PyObject *py_hausdorff(PyObject *self, PyObject *args, PyObject *kw) {
 }
 
 PyDoc_STRVAR(distances_doc,
-"distances($module, a, b, *, threads=None)\n--\n\n"
+"distances($module, a, b, *, threads=None, empty='error')\n--\n\n"
 "Per-point distances from a to b: for every point a[k], the exact distance\n"
 "to its nearest point in b and that point's index (the smallest on ties).\n"
 "\n"
-"Returns (dist, nearest): a float64 array and an intp array of len(a).\n"
+"Returns (dist, nearest): a float64 and an intp array of len(a).\n"
 "dist.max() is h(a, b).  To query b many times, build an Index(b) once.\n"
+"With an empty b and an empty policy (see directed()), every distance is\n"
+"the policy's value and every nearest index -1, as the command line's\n"
+"--distances files; an empty a gives two empty arrays.\n"
 "\n"
 ">>> import numpy as np, hausdorff\n"
 ">>> a = np.array([[0.0, 0, 0], [2, 0, 0]])\n"
@@ -501,20 +771,30 @@ PyDoc_STRVAR(distances_doc,
 
 static PyObject *py_distances(PyObject *self, PyObject *args, PyObject *kw) {
     (void)self;
-    static char *kwlist[] = {"a", "b", "threads", NULL};
+    static char *kwlist[] = {"a", "b", "threads", "empty", NULL};
     PyObject *oa, *ob, *threads = Py_None;
-    if (!PyArg_ParseTupleAndKeywords(args, kw, "OO|$O:distances", kwlist, &oa, &ob,
-                                     &threads))
+    const char *empty_name = NULL;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "OO|$Os:distances", kwlist, &oa, &ob,
+                                     &threads, &empty_name))
         return NULL;
     hd_options_t opt;
-    if (parse_options(NULL, threads, NULL, &opt)) return NULL;
+    empty_t empty;
+    if (parse_options(NULL, threads, NULL, &opt) || parse_empty(empty_name, &empty))
+        return NULL;
     points_arg_t a, b;
-    if (points_pair(oa, ob, &a, &b)) return NULL;
+    if (points_pair(oa, ob, empty, &a, &b)) return NULL;
     npy_intp n = (npy_intp)a.pts.count;
     PyArrayObject *dist = (PyArrayObject *)PyArray_SimpleNew(1, &n, NPY_DOUBLE);
     PyArrayObject *nearest = (PyArrayObject *)PyArray_SimpleNew(1, &n, NPY_INTP);
     PyObject *res = NULL;
-    if (dist && nearest) {
+    if (dist && nearest && (!a.pts.count || !b.pts.count)) {
+        double v = empty_value(empty, a.pts.count, b.pts.count);
+        for (npy_intp k = 0; k < n; k++) {
+            ((double *)PyArray_DATA(dist))[k] = v;
+            ((npy_intp *)PyArray_DATA(nearest))[k] = -1;
+        }
+        res = Py_BuildValue("(OO)", dist, nearest);
+    } else if (dist && nearest) {
         hd_error_t err;
         int rc;
         Py_BEGIN_ALLOW_THREADS
@@ -531,8 +811,32 @@ static PyObject *py_distances(PyObject *self, PyObject *args, PyObject *kw) {
     return res;
 }
 
+/* The per-point distances of both directions (only a's when directed), as
+ * the command line computes them for its analysis options: d_ab and d_ba
+ * are PyMem_Raw blocks the caller frees.  The sets must not be empty. */
+static int both_distances(const points_arg_t *a, const points_arg_t *b, int directed,
+                          const hd_options_t *opt, double **d_ab, double **d_ba) {
+    size_t na = a->pts.count, nb = b->pts.count;
+    *d_ab = PyMem_RawMalloc(na * sizeof(double));
+    *d_ba = directed ? NULL : PyMem_RawMalloc(nb * sizeof(double));
+    if (!*d_ab || (!directed && !*d_ba)) {
+        PyErr_NoMemory();
+        return -1;
+    }
+    hd_error_t err;
+    int rc;
+    Py_BEGIN_ALLOW_THREADS
+    rc = hd_distances(&a->pts, &b->pts, opt, *d_ab, NULL, *d_ba, NULL, &err);
+    Py_END_ALLOW_THREADS
+    if (rc != HD_OK) {
+        raise_hd(rc, &err);
+        return -1;
+    }
+    return 0;
+}
+
 PyDoc_STRVAR(percentile_doc,
-"percentile($module, a, b, p, *, threads=None)\n--\n\n"
+"percentile($module, a, b, p, *, threads=None, empty='error')\n--\n\n"
 "Percentile Hausdorff distances, e.g. HD95 with p=95, exact.\n"
 "\n"
 "p is a number in [0, 100] or a sequence of them (the per-point distances\n"
@@ -542,7 +846,9 @@ PyDoc_STRVAR(percentile_doc,
 "numpy's default linear interpolation (bit-identical to numpy.percentile);\n"
 "symmetric = max(ab, ba) is MONAI's HD95; pooled, the percentile of both\n"
 "directions' distances together, is medpy's hd95.  p=100 gives h(a, b),\n"
-"h(b, a) and H(a, b).  A sequence p gives a list of results.\n"
+"h(b, a) and H(a, b).  A sequence p gives a list of results.  The same\n"
+"doubles as the command line's --percentile.  With an empty set and an\n"
+"empty policy (see directed()), all four figures are the policy's value.\n"
 "\n"
 ">>> import numpy as np, hausdorff\n"
 ">>> a = np.array([[0.0, 0, 0], [1, 0, 0], [2, 0, 0]])\n"
@@ -554,13 +860,16 @@ PyDoc_STRVAR(percentile_doc,
 
 static PyObject *py_percentile(PyObject *self, PyObject *args, PyObject *kw) {
     (void)self;
-    static char *kwlist[] = {"a", "b", "p", "threads", NULL};
+    static char *kwlist[] = {"a", "b", "p", "threads", "empty", NULL};
     PyObject *oa, *ob, *op, *threads = Py_None;
-    if (!PyArg_ParseTupleAndKeywords(args, kw, "OOO|$O:percentile", kwlist, &oa, &ob, &op,
-                                     &threads))
+    const char *empty_name = NULL;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "OOO|$Os:percentile", kwlist, &oa, &ob, &op,
+                                     &threads, &empty_name))
         return NULL;
     hd_options_t opt;
-    if (parse_options(NULL, threads, NULL, &opt)) return NULL;
+    empty_t empty;
+    if (parse_options(NULL, threads, NULL, &opt) || parse_empty(empty_name, &empty))
+        return NULL;
     PyArrayObject *parr = (PyArrayObject *)PyArray_FROM_OTF(
         op, NPY_DOUBLE, NPY_ARRAY_CARRAY | NPY_ARRAY_FORCECAST);
     if (!parr) return NULL;
@@ -586,27 +895,31 @@ static PyObject *py_percentile(PyObject *self, PyObject *args, PyObject *kw) {
         return raise_hd(rc, &err);
     }
     points_arg_t a, b;
-    if (points_pair(oa, ob, &a, &b)) {
+    if (points_pair(oa, ob, empty, &a, &b)) {
         Py_DECREF(parr);
         return NULL;
     }
     size_t na = a.pts.count, nb = b.pts.count;
-    double *d_ab = PyMem_RawMalloc(na * sizeof(double));
-    double *d_ba = PyMem_RawMalloc(nb * sizeof(double));
+    double *d_ab = NULL, *d_ba = NULL;
     hd_percentile_t *res = PyMem_RawMalloc((np_ ? np_ : 1) * sizeof *res);
     PyObject *out = NULL;
-    if (!d_ab || !d_ba || !res) {
+    if (!res) {
         PyErr_NoMemory();
         goto done;
     }
-    Py_BEGIN_ALLOW_THREADS
-    rc = hd_distances(&a.pts, &b.pts, &opt, d_ab, NULL, d_ba, NULL, &err);
-    for (size_t k = 0; rc == HD_OK && k < np_; k++)
-        rc = hd_percentile_of(d_ab, na, d_ba, nb, p[k], &res[k], &err);
-    Py_END_ALLOW_THREADS
-    if (rc != HD_OK) {
-        raise_hd(rc, &err);
-        goto done;
+    if (!na || !nb) {
+        double v = empty_value(empty, na, nb);
+        for (size_t k = 0; k < np_; k++) res[k] = (hd_percentile_t){p[k], v, v, v, v};
+    } else {
+        if (both_distances(&a, &b, 0, &opt, &d_ab, &d_ba)) goto done;
+        Py_BEGIN_ALLOW_THREADS
+        for (size_t k = 0; rc == HD_OK && k < np_; k++)
+            rc = hd_percentile_of(d_ab, na, d_ba, nb, p[k], &res[k], &err);
+        Py_END_ALLOW_THREADS
+        if (rc != HD_OK) {
+            raise_hd(rc, &err);
+            goto done;
+        }
     }
     if (scalar) {
         out = percentile_result(&res[0]);
@@ -626,6 +939,118 @@ done:
     points_release(&a);
     points_release(&b);
     return out;
+}
+
+/* summary(), mean() and chamfer(): hd_distances, then hd_summarize, as the
+ * command line's --mean and --chamfer.  With an empty set every figure is
+ * the policy's value (NaN for B's direction when directed), as the command
+ * line's --empty reports them. */
+enum { WANT_SUMMARY, WANT_MEAN, WANT_CHAMFER };
+
+static PyObject *summary_call(PyObject *args, PyObject *kw, int want) {
+    static char *kw_summary[] = {"a", "b", "directed", "threads", "empty", NULL};
+    static char *kw_other[] = {"a", "b", "threads", "empty", NULL};
+    PyObject *oa, *ob, *threads = Py_None;
+    const char *empty_name = NULL;
+    int directed = 0, ok;
+    if (want == WANT_SUMMARY)
+        ok = PyArg_ParseTupleAndKeywords(args, kw, "OO|$pOs:summary", kw_summary, &oa, &ob,
+                                         &directed, &threads, &empty_name);
+    else
+        ok = PyArg_ParseTupleAndKeywords(args, kw,
+                                         want == WANT_MEAN ? "OO|$Os:mean" : "OO|$Os:chamfer",
+                                         kw_other, &oa, &ob, &threads, &empty_name);
+    if (!ok) return NULL;
+    hd_options_t opt;
+    empty_t empty;
+    if (parse_options(NULL, threads, NULL, &opt) || parse_empty(empty_name, &empty))
+        return NULL;
+    points_arg_t a, b;
+    if (points_pair(oa, ob, empty, &a, &b)) return NULL;
+    size_t na = a.pts.count, nb = b.pts.count;
+    hd_summary_t s;
+    PyObject *out = NULL;
+    double *d_ab = NULL, *d_ba = NULL;
+    if (!na || !nb) {
+        double v = empty_value(empty, na, nb), w = directed ? NAN : v;
+        s = (hd_summary_t){na, directed ? 0 : nb, v, w, v, w, v, w, v, w, v, w,
+                           w, w, w, w, w, w, w};
+    } else {
+        if (both_distances(&a, &b, directed, &opt, &d_ab, &d_ba)) goto done;
+        hd_error_t err;
+        int rc = hd_summarize(d_ab, na, d_ba, directed ? 0 : nb, &s, &err);
+        if (rc != HD_OK) {
+            raise_hd(rc, &err);
+            goto done;
+        }
+    }
+    out = want == WANT_SUMMARY ? summary_result(&s)
+          : want == WANT_MEAN  ? mean_result(&s)
+                               : PyFloat_FromDouble(s.chamfer);
+done:
+    PyMem_RawFree(d_ab);
+    PyMem_RawFree(d_ba);
+    points_release(&a);
+    points_release(&b);
+    return out;
+}
+
+PyDoc_STRVAR(summary_doc,
+"summary($module, a, b, *, directed=False, threads=None, empty='error')\n--\n\n"
+"Every sum, mean and Chamfer distance of the per-point distances, as a\n"
+"Summary: the same doubles as the command line's --mean and --chamfer (the\n"
+"C library's hd_summarize).  Sums are compensated (Neumaier) in index\n"
+"order, so they are the same at any thread count.  directed=True computes\n"
+"only a's distances to b (B's fields are NaN and n_ba is 0), as the command\n"
+"line's --directed; its Chamfer figure is then mean2_ab.  With an empty set\n"
+"and an empty policy (see directed()), every figure is the policy's value.\n"
+"\n"
+">>> import numpy as np, hausdorff\n"
+">>> a = np.array([[0.0, 0, 0], [2, 0, 0]])\n"
+">>> b = np.array([[0.0, 0, 1]])\n"
+">>> s = hausdorff.summary(a, b)\n"
+">>> s.mean_ab, s.mean_ba, s.chamfer, s.n_ab, s.n_ba\n"
+"(1.618033988749895, 1.0, 4.0, 2, 1)\n");
+
+static PyObject *py_summary(PyObject *self, PyObject *args, PyObject *kw) {
+    (void)self;
+    return summary_call(args, kw, WANT_SUMMARY);
+}
+
+PyDoc_STRVAR(mean_doc,
+"mean($module, a, b, *, threads=None, empty='error')\n--\n\n"
+"Mean distances, the command line's --mean: a MeanResult (ab, ba,\n"
+"symmetric, average, pooled) where ab is the mean distance of a's points to\n"
+"b, ba of b's points to a, symmetric = max(ab, ba) (the average Hausdorff\n"
+"distance), average = (ab + ba) / 2 and pooled the mean of all the\n"
+"distances of both directions together (MONAI's symmetric average surface\n"
+"distance).  Empty sets as for directed().\n"
+"\n"
+">>> import numpy as np, hausdorff\n"
+">>> a = np.array([[0.0, 0, 0], [2, 0, 0]])\n"
+">>> b = np.array([[0.0, 0, 1]])\n"
+">>> tuple(hausdorff.mean(a, b))[:2]\n"
+"(1.618033988749895, 1.0)\n");
+
+static PyObject *py_mean(PyObject *self, PyObject *args, PyObject *kw) {
+    (void)self;
+    return summary_call(args, kw, WANT_MEAN);
+}
+
+PyDoc_STRVAR(chamfer_doc,
+"chamfer($module, a, b, *, threads=None, empty='error')\n--\n\n"
+"The Chamfer distance, the command line's --chamfer: the mean squared\n"
+"distance of a's points to b plus the mean squared distance of b's points\n"
+"to a (as PyTorch3D's chamfer_distance).  summary() has the summed and the\n"
+"unsquared variants.  Empty sets as for directed().\n"
+"\n"
+">>> import hausdorff\n"
+">>> hausdorff.chamfer([[0.0, 0, 0], [2, 0, 0]], [[0.0, 0, 1]])\n"
+"4.0\n");
+
+static PyObject *py_chamfer(PyObject *self, PyObject *args, PyObject *kw) {
+    (void)self;
+    return summary_call(args, kw, WANT_CHAMFER);
 }
 
 /* ------------------------------------------------------------------------
@@ -726,6 +1151,7 @@ typedef struct {
     PyObject_HEAD
     hd_index_t *idx;
     PyArrayObject *points; /* the index's own copy of b, never written */
+    int dims;              /* b's columns: queries must have as many */
 } IndexObject;
 
 static PyTypeObject IndexType;
@@ -739,6 +1165,8 @@ PyDoc_STRVAR(index_doc,
 "Queries may move the query set by a rigid (or any affine) transform\n"
 "x -> rotation @ x + translation, applied on the fly in double precision in\n"
 "the order the C header documents, without copying the query.\n"
+"An (N, 2) b is indexed as the points (x, y, 0) (index.points has their\n"
+"three columns), and its queries must then be (N, 2) too.\n"
 "\n"
 ">>> import numpy as np, hausdorff\n"
 ">>> index = hausdorff.Index(np.array([[0.0, 0, 0], [1, 0, 0]]))\n"
@@ -758,8 +1186,11 @@ static PyObject *Index_new(PyTypeObject *type, PyObject *args, PyObject *kw) {
     hd_options_t opt;
     if (parse_options(NULL, threads, NULL, &opt)) return NULL;
     points_arg_t b;
-    if (points_from_object(ob, "b", &b)) return NULL;
-    PyArrayObject *own = (PyArrayObject *)PyArray_NewCopy(b.arr, NPY_CORDER);
+    if (points_from_object(ob, "b", EMPTY_NONE, &b)) return NULL;
+    int dims = b.dims;
+    /* (N, 2) points were lifted into an array of our own already. */
+    PyArrayObject *own = dims == 2 ? b.arr : (PyArrayObject *)PyArray_NewCopy(b.arr, NPY_CORDER);
+    if (dims == 2) b.arr = NULL;
     points_release(&b);
     if (!own) return NULL;
     PyArray_CLEARFLAGS(own, NPY_ARRAY_WRITEABLE);
@@ -769,6 +1200,7 @@ static PyObject *Index_new(PyTypeObject *type, PyObject *args, PyObject *kw) {
         return NULL;
     }
     self->points = own;
+    self->dims = dims;
     self->idx = NULL;
     hd_points_t pts = {PyArray_DATA(own), (size_t)PyArray_DIM(own, 0),
                        PyArray_TYPE(own) == NPY_FLOAT ? HD_FLOAT32 : HD_FLOAT64, 0, 0};
@@ -795,9 +1227,9 @@ static Py_ssize_t Index_len(IndexObject *self) {
 }
 
 /* Common argument parsing of the query methods. */
-static int index_query_args(PyObject *args, PyObject *kw, const char *fmt, PyObject **oa,
-                            hd_transform_t *T, int *use_T, hd_options_t *opt,
-                            points_arg_t *a) {
+static int index_query_args(const IndexObject *self, PyObject *args, PyObject *kw,
+                            const char *fmt, PyObject **oa, hd_transform_t *T, int *use_T,
+                            hd_options_t *opt, points_arg_t *a) {
     static char *kwlist[] = {"a", "rotation", "translation", "threads", NULL};
     PyObject *rotation = Py_None, *translation = Py_None, *threads = Py_None;
     if (!PyArg_ParseTupleAndKeywords(args, kw, fmt, kwlist, oa, &rotation, &translation,
@@ -805,7 +1237,15 @@ static int index_query_args(PyObject *args, PyObject *kw, const char *fmt, PyObj
         return -1;
     if (parse_options(NULL, threads, NULL, opt)) return -1;
     if (parse_transform(rotation, translation, T, use_T)) return -1;
-    return points_from_object(*oa, "a", a);
+    if (points_from_object(*oa, "a", EMPTY_NONE, a)) return -1;
+    if (a->dims != self->dims) {
+        PyErr_Format(PyExc_ValueError,
+                     "a and the indexed points need to have the same number of columns, "
+                     "got %d and %d", a->dims, self->dims);
+        points_release(a);
+        return -1;
+    }
+    return 0;
 }
 
 PyDoc_STRVAR(index_directed_doc,
@@ -820,7 +1260,7 @@ static PyObject *Index_directed(IndexObject *self, PyObject *args, PyObject *kw)
     int use_T;
     hd_options_t opt;
     points_arg_t a;
-    if (index_query_args(args, kw, "O|$OOO:directed", &oa, &T, &use_T, &opt, &a))
+    if (index_query_args(self, args, kw, "O|$OOO:directed", &oa, &T, &use_T, &opt, &a))
         return NULL;
     hd_result_t r;
     hd_error_t err;
@@ -845,7 +1285,7 @@ static PyObject *Index_distances(IndexObject *self, PyObject *args, PyObject *kw
     int use_T;
     hd_options_t opt;
     points_arg_t a;
-    if (index_query_args(args, kw, "O|$OOO:distances", &oa, &T, &use_T, &opt, &a))
+    if (index_query_args(self, args, kw, "O|$OOO:distances", &oa, &T, &use_T, &opt, &a))
         return NULL;
     PyObject *res = nearest_arrays(self->idx, &a.pts, use_T ? &T : NULL, &opt);
     points_release(&a);
@@ -916,6 +1356,11 @@ static PyMethodDef module_methods[] = {
      distances_doc},
     {"percentile", (PyCFunction)(void (*)(void))py_percentile, METH_VARARGS | METH_KEYWORDS,
      percentile_doc},
+    {"summary", (PyCFunction)(void (*)(void))py_summary, METH_VARARGS | METH_KEYWORDS,
+     summary_doc},
+    {"mean", (PyCFunction)(void (*)(void))py_mean, METH_VARARGS | METH_KEYWORDS, mean_doc},
+    {"chamfer", (PyCFunction)(void (*)(void))py_chamfer, METH_VARARGS | METH_KEYWORDS,
+     chamfer_doc},
     {"read", (PyCFunction)(void (*)(void))py_read, METH_VARARGS | METH_KEYWORDS, read_doc},
     {"formats", py_formats, METH_NOARGS, formats_doc},
     {NULL, NULL, 0, NULL},
@@ -939,6 +1384,8 @@ PyMODINIT_FUNC PyInit__hausdorff(void) {
         {&DirectedResultType, &directed_desc},
         {&HausdorffResultType, &hausdorff_desc},
         {&PercentileResultType, &percentile_desc},
+        {&SummaryType, &summary_desc},
+        {&MeanResultType, &mean_desc},
         {&IndexType, NULL},
     };
     const size_t n_types = sizeof types / sizeof types[0];

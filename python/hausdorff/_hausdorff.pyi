@@ -1,13 +1,17 @@
 """Type stubs of the hausdorff C extension (see the docstrings for details)."""
 import os
-from typing import Dict, List, Optional, Sequence, Tuple, Union, overload
+from typing import Dict, List, Literal, Optional, Sequence, Tuple, Union, overload
 
 import numpy as np
 import numpy.typing as npt
 
-# Any (N, 3) array-like of real numbers; float32 and float64 arrays are read
-# in place (C or Fortran order, strided or reversed views).
+# Any (N, 3) or (N, 2) array-like of real numbers (a point (x, y) is
+# (x, y, 0)); float32 and float64 (N, 3) arrays are read in place (C or
+# Fortran order, strided or reversed views).
 Points = npt.ArrayLike
+# What an empty set gives: an error, inf, NaN, 0, or as MONAI (inf when one
+# set is empty, NaN when both are).
+Empty = Literal["error", "inf", "nan", "zero", "monai"]
 Matrix3 = npt.ArrayLike  # (3, 3)
 Vector3 = npt.ArrayLike  # (3,)
 
@@ -15,15 +19,17 @@ __version__: str
 algorithms: Tuple[str, ...]
 
 class DirectedResult(Tuple[float, int, int]):
-    """h(A, B) and its witness: the tuple (distance, i, j)."""
+    """h(A, B) and its witness: the tuple (distance, i, j), as scipy's
+    directed_hausdorff returns.  i and j are None (and algorithm None) when a
+    set was empty and an empty policy gave the distance."""
     @property
     def distance(self) -> float: ...
     @property
-    def i(self) -> int: ...
+    def i(self) -> Optional[int]: ...
     @property
-    def j(self) -> int: ...
+    def j(self) -> Optional[int]: ...
     @property
-    def algorithm(self) -> str: ...
+    def algorithm(self) -> Optional[str]: ...
     @property
     def seconds(self) -> float: ...
     @property
@@ -40,7 +46,7 @@ class HausdorffResult(Tuple[float, DirectedResult, DirectedResult]):
     @property
     def alpha(self) -> float: ...
     @property
-    def disjoint(self) -> bool: ...
+    def disjoint(self) -> Optional[bool]: ...
     @property
     def seconds(self) -> float: ...
 
@@ -57,13 +63,69 @@ class PercentileResult(Tuple[float, float, float, float, float]):
     @property
     def pooled(self) -> float: ...
 
+class MeanResult(Tuple[float, float, float, float, float]):
+    """Mean distances: the tuple (ab, ba, symmetric, average, pooled)."""
+    @property
+    def ab(self) -> float: ...
+    @property
+    def ba(self) -> float: ...
+    @property
+    def symmetric(self) -> float: ...
+    @property
+    def average(self) -> float: ...
+    @property
+    def pooled(self) -> float: ...
+
+class Summary(Tuple[Union[int, float], ...]):
+    """Sums, means and Chamfer distances of the per-point distances."""
+    @property
+    def n_ab(self) -> int: ...
+    @property
+    def n_ba(self) -> int: ...
+    @property
+    def max_ab(self) -> float: ...
+    @property
+    def max_ba(self) -> float: ...
+    @property
+    def sum_ab(self) -> float: ...
+    @property
+    def sum_ba(self) -> float: ...
+    @property
+    def sum2_ab(self) -> float: ...
+    @property
+    def sum2_ba(self) -> float: ...
+    @property
+    def mean_ab(self) -> float: ...
+    @property
+    def mean_ba(self) -> float: ...
+    @property
+    def mean2_ab(self) -> float: ...
+    @property
+    def mean2_ba(self) -> float: ...
+    @property
+    def mean_symmetric(self) -> float: ...
+    @property
+    def mean_average(self) -> float: ...
+    @property
+    def mean_pooled(self) -> float: ...
+    @property
+    def chamfer(self) -> float: ...
+    @property
+    def chamfer_sum2(self) -> float: ...
+    @property
+    def chamfer_mean(self) -> float: ...
+    @property
+    def chamfer_sum(self) -> float: ...
+
+# Integers may be ints, numpy integers or anything with __index__.
 def directed(
     a: Points,
     b: Points,
+    seed: Optional[int] = 0,
     *,
     algorithm: str = "auto",
     threads: Optional[int] = None,
-    seed: int = 0,
+    empty: Empty = "error",
 ) -> DirectedResult: ...
 def hausdorff(
     a: Points,
@@ -71,20 +133,32 @@ def hausdorff(
     *,
     algorithm: str = "auto",
     threads: Optional[int] = None,
-    seed: int = 0,
+    seed: Optional[int] = 0,
+    empty: Empty = "error",
 ) -> HausdorffResult: ...
 def distances(
-    a: Points, b: Points, *, threads: Optional[int] = None
+    a: Points, b: Points, *, threads: Optional[int] = None, empty: Empty = "error"
 ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.intp]]: ...
 @overload
 def percentile(
-    a: Points, b: Points, p: float, *, threads: Optional[int] = None
+    a: Points, b: Points, p: float, *, threads: Optional[int] = None,
+    empty: Empty = "error"
 ) -> PercentileResult: ...
 @overload
 def percentile(
     a: Points, b: Points, p: Union[Sequence[float], npt.NDArray[np.floating]], *,
-    threads: Optional[int] = None
+    threads: Optional[int] = None, empty: Empty = "error"
 ) -> List[PercentileResult]: ...
+def summary(
+    a: Points, b: Points, *, directed: bool = False, threads: Optional[int] = None,
+    empty: Empty = "error"
+) -> Summary: ...
+def mean(
+    a: Points, b: Points, *, threads: Optional[int] = None, empty: Empty = "error"
+) -> MeanResult: ...
+def chamfer(
+    a: Points, b: Points, *, threads: Optional[int] = None, empty: Empty = "error"
+) -> float: ...
 def read(
     path: Union[str, bytes, os.PathLike[str], os.PathLike[bytes]],
     *,

@@ -93,11 +93,12 @@ def test_float_arrays_are_not_copied_whatever_their_layout():
     assert peak >= size
 
 
-@pytest.mark.parametrize("shape", [(10, 2), (10, 4), (3,), (2, 3, 1), (3, 10)])
+@pytest.mark.parametrize("shape", [(10, 1), (10, 4), (3,), (2, 3, 1), (3, 10)])
 def test_wrong_shapes_are_value_errors(shape):
-    with pytest.raises(ValueError, match=r"must be an \(N, 3\) array"):
-        hausdorff.directed(np.zeros(shape), gauss(111, 5))
-    with pytest.raises(ValueError, match=r"b must be an \(N, 3\) array"):
+    with pytest.raises(ValueError, match=r"a must be an \(N, 3\) or \(N, 2\) array"):
+        hausdorff.directed(np.zeros(shape), np.zeros(shape))
+    with pytest.raises(ValueError, match=r"b must be an \(N, 3\) or \(N, 2\) array|"
+                                         r"need to have the same number of columns"):
         hausdorff.hausdorff(gauss(111, 5), np.zeros(shape))
 
 
@@ -149,6 +150,10 @@ def test_bad_options_are_rejected_clearly():
     with pytest.raises(ValueError, match="seed"):
         hausdorff.directed(a, b, seed=-1)
     with pytest.raises(TypeError, match="seed"):
-        hausdorff.directed(a, b, seed=None)    # explicit seeds only
+        hausdorff.directed(a, b, seed="1")
+    with pytest.raises(ValueError, match="empty must be"):
+        hausdorff.directed(a, b, empty="skip")
     with pytest.raises(TypeError):
-        hausdorff.directed(a, b, 0)          # options are keyword-only
+        hausdorff.directed(a, b, 0, "naive")   # after seed, keyword-only (as scipy's)
+    with pytest.raises(TypeError):
+        hausdorff.hausdorff(a, b, 0)           # hausdorff() options are keyword-only

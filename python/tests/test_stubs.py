@@ -37,7 +37,7 @@ def test_every_public_name_is_in_the_stubs():
 
 
 @pytest.mark.parametrize("name", ["directed", "hausdorff", "distances", "percentile",
-                                  "read", "formats"])
+                                  "summary", "mean", "chamfer", "read", "formats"])
 def test_function_signatures_match(name):
     defs = [n for n in stub_tree().body if isinstance(n, ast.FunctionDef) and n.name == name]
     assert defs
@@ -47,7 +47,8 @@ def test_function_signatures_match(name):
 
 def test_index_and_result_classes_match():
     classes = {n.name: n for n in stub_tree().body if isinstance(n, ast.ClassDef)}
-    for cname in ("Index", "DirectedResult", "HausdorffResult", "PercentileResult"):
+    for cname in ("Index", "DirectedResult", "HausdorffResult", "PercentileResult",
+                  "MeanResult", "Summary"):
         runtime = getattr(hausdorff, cname)
         for item in classes[cname].body:
             if not isinstance(item, ast.FunctionDef) or item.name.startswith("__"):
