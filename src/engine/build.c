@@ -154,10 +154,10 @@ static void make_bucket(hd__tree_t *t, size_t b) {
     size_t s = b * HD__BUCKET;
     int m = hd__bucket_size(t, b);
     double p[3][HD__BUCKET];
-    if (t->src.kind != 2 && b + 1 < t->nb) {
+    if (t->src.kind != HD__SRC_ANY && b + 1 < t->nb) {
         /* The points are scattered in memory: ask for the next bucket's
          * points early so their loads overlap with this bucket's work. */
-        ptrdiff_t el = t->src.kind == 0 ? 24 : 12;
+        ptrdiff_t el = t->src.kind == HD__SRC_F64 ? 24 : 12;
         size_t e = s + HD__BUCKET, pe = e + HD__BUCKET < t->n ? e + HD__BUCKET : t->n;
         for (size_t i = e; i < pe; i++) __builtin_prefetch(t->src.base + (ptrdiff_t)t->perm[i] * el);
     }

@@ -198,8 +198,8 @@ HD__HOT static int try_bucket(walk_t *s, group_t *g, size_t i, double cmax2) {
     /* Pairs too close to call from the approximations (ties, or nearly) are
      * decided exactly; their scattered loads are started together. */
     const hd__tree_t *ta = s->c->ta;
-    if (ta->src.kind != 2 && tb->src.kind != 2) {
-        ptrdiff_t ea = ta->src.kind == 0 ? 24 : 12, eb = tb->src.kind == 0 ? 24 : 12;
+    if (ta->src.kind != HD__SRC_ANY && tb->src.kind != HD__SRC_ANY) {
+        ptrdiff_t ea = ta->src.kind == HD__SRC_F64 ? 24 : 12, eb = tb->src.kind == HD__SRC_F64 ? 24 : 12;
         for (int r = 0; r < n_close; r++) {
             __builtin_prefetch(ta->src.base + (ptrdiff_t)ta->perm[g->first + (size_t)close_k[r]] * ea);
             __builtin_prefetch(tb->src.base + (ptrdiff_t)tb->perm[i * HD__BUCKET + (size_t)close_b[r]] * eb);
@@ -331,8 +331,8 @@ static void walk_bucket(walk_t *s, size_t bk) {
     s->w->culled += (uint64_t)(g.m - __builtin_popcount(g.alive));
     if (!g.alive) return;
     /* The points left are read exactly; start all their loads at once. */
-    if (ta->src.kind != 2) {
-        ptrdiff_t el = ta->src.kind == 0 ? 24 : 12;
+    if (ta->src.kind != HD__SRC_ANY) {
+        ptrdiff_t el = ta->src.kind == HD__SRC_F64 ? 24 : 12;
         for (int k = 0; k < g.m; k++)
             if ((g.alive >> k & 1u) && !(g.read >> k & 1u))
                 __builtin_prefetch(ta->src.base + (ptrdiff_t)ta->perm[g.first + (size_t)k] * el);

@@ -166,14 +166,14 @@ typedef struct {
     double sum[MAX_PARTS][3];   /* per part: sums of the coordinates */
 } build_ctx;
 
-/* Point k of a packed double (kind 0) or float (kind 1) array, or of any
- * source (kind 2); a constant kind lets the compiler specialise the loops
- * below for the packed layouts. */
-HD__INLINE void src_point(const hd__src_t *s, int kind, size_t k, double p[3]) {
-    if (kind == 0) {
+/* Point k of a packed double (HD__SRC_F64) or float (HD__SRC_F32) array,
+ * or of any source (HD__SRC_ANY); a constant kind lets the compiler
+ * specialise the loops below for the packed layouts. */
+HD__INLINE void src_point(const hd__src_t *s, hd__src_kind_t kind, size_t k, double p[3]) {
+    if (kind == HD__SRC_F64) {
         const double *q = (const double *)(const void *)s->base + 3 * k;
         p[0] = q[0], p[1] = q[1], p[2] = q[2];
-    } else if (kind == 1) {
+    } else if (kind == HD__SRC_F32) {
         const float *q = (const float *)(const void *)s->base + 3 * k;
         p[0] = q[0], p[1] = q[1], p[2] = q[2];
     } else {
@@ -205,7 +205,8 @@ HD__INLINE uint32_t geom_cell(geom_t q, const double p[3]) {
 
 /* The first pass over points [lo, hi): each point's cell (kept when
  * c->cell is set), the counts per cell and the sums of the coordinates. */
-HD__INLINE void count_range(build_ctx *c, size_t part, size_t lo, size_t hi, int kind, int keep) {
+HD__INLINE void count_range(build_ctx *c, size_t part, size_t lo, size_t hi, hd__src_kind_t kind,
+                            int keep) {
     const hd__src_t src = c->g->src;
     const geom_t q = geom_of(c->g);
     uint32_t *h = c->count[part];
@@ -227,7 +228,8 @@ HD__INLINE void count_range(build_ctx *c, size_t part, size_t lo, size_t hi, int
 
 /* The second pass: each point to its place, in input order within a cell,
  * its cell read from c->cell or computed again. */
-HD__INLINE void scatter_range(build_ctx *c, size_t part, size_t lo, size_t hi, int kind, int kept) {
+HD__INLINE void scatter_range(build_ctx *c, size_t part, size_t lo, size_t hi, hd__src_kind_t kind,
+                              int kept) {
     const hd__src_t src = c->g->src;
     const geom_t q = geom_of(c->g);
     uint32_t *perm = c->g->perm, *pos = c->count[part];
@@ -250,23 +252,23 @@ static void count_task(void *vctx, size_t part, int worker) {
     (void)worker;
     build_ctx *c = vctx;
     size_t lo = c->n * part / (size_t)c->parts, hi = c->n * (part + 1) / (size_t)c->parts;
-    int kind = c->g->src.T ? 2 : c->g->src.kind;
-    if (kind == 0 && c->cell) count_range(c, part, lo, hi, 0, 1);
-    else if (kind == 0) count_range(c, part, lo, hi, 0, 0);
-    else if (kind == 1 && c->cell) count_range(c, part, lo, hi, 1, 1);
-    else if (kind == 1) count_range(c, part, lo, hi, 1, 0);
-    else count_range(c, part, lo, hi, 2, c->cell != NULL);
+    hd__src_kind_t kind = c->g->src.T ? HD__SRC_ANY : c->g->src.kind;
+    if (kind == HD__SRC_F64 && c->cell) count_range(c, part, lo, hi, HD__SRC_F64, 1);
+    else if (kind == HD__SRC_F64) count_range(c, part, lo, hi, HD__SRC_F64, 0);
+    else if (kind == HD__SRC_F32 && c->cell) count_range(c, part, lo, hi, HD__SRC_F32, 1);
+    else if (kind == HD__SRC_F32) count_range(c, part, lo, hi, HD__SRC_F32, 0);
+    else count_range(c, part, lo, hi, HD__SRC_ANY, c->cell != NULL);
 }
 
 static void scatter_task(void *vctx, size_t part, int worker) {
     (void)worker;
     build_ctx *c = vctx;
     size_t lo = c->n * part / (size_t)c->parts, hi = c->n * (part + 1) / (size_t)c->parts;
-    int kind = c->g->src.T ? 2 : c->g->src.kind;
-    if (c->cell) scatter_range(c, part, lo, hi, 2, 1);
-    else if (kind == 0) scatter_range(c, part, lo, hi, 0, 0);
-    else if (kind == 1) scatter_range(c, part, lo, hi, 1, 0);
-    else scatter_range(c, part, lo, hi, 2, 0);
+    hd__src_kind_t kind = c->g->src.T ? HD__SRC_ANY : c->g->src.kind;
+    if (c->cell) scatter_range(c, part, lo, hi, HD__SRC_ANY, 1);
+    else if (kind == HD__SRC_F64) scatter_range(c, part, lo, hi, HD__SRC_F64, 0);
+    else if (kind == HD__SRC_F32) scatter_range(c, part, lo, hi, HD__SRC_F32, 0);
+    else scatter_range(c, part, lo, hi, HD__SRC_ANY, 0);
 }
 
 /* The representatives: each cell's first point, which has the smallest

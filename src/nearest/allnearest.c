@@ -169,8 +169,8 @@ static void gather_task(void *vctx, size_t task, int worker) {
     hd__an_t *s = c->s;
     size_t lo = task * GATHER_TASK, hi = lo + GATHER_TASK < s->n + 4 ? lo + GATHER_TASK : s->n + 4;
     for (size_t at = lo; at < hi; at++) {
-        if (at + 16 < s->n && c->src.kind != 2)
-            __builtin_prefetch(c->src.base + (ptrdiff_t)(uint32_t)c->b[at + 16] * (c->src.kind ? 12 : 24));
+        if (at + 16 < s->n && c->src.kind != HD__SRC_ANY)
+            __builtin_prefetch(c->src.base + (ptrdiff_t)(uint32_t)c->b[at + 16] * (c->src.kind == HD__SRC_F64 ? 24 : 12));
         uint32_t i = (uint32_t)c->b[at < s->n ? at : s->n - 1];
         double p[3];
         hd__src_get(&c->src, i, p);

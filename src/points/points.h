@@ -194,11 +194,19 @@ int hd__points_scan(const hd_points_t *p, const char *what, int threads,
                     hd__box_t *box, hd_error_t *err);
 
 /* ---- sources: where the coordinates of a set come from (source.c) ---------- */
+/* How a source's points lie in memory.  The hot loops test the kind to
+ * skip the general path; the values are fixed (0, 1, 2). */
+typedef enum hd__src_kind {
+    HD__SRC_F64 = 0, /* packed doubles: point k at base + 24 k */
+    HD__SRC_F32 = 1, /* packed floats: point k at base + 12 k */
+    HD__SRC_ANY = 2  /* any element type and strides (ps, cs) */
+} hd__src_kind_t;
+
 /* Where the coordinates of a set come from. */
 typedef struct hd__src {
     const char *base;
     ptrdiff_t ps, cs;           /* point and coordinate strides in bytes */
-    int kind;                   /* 0: packed double, 1: packed float, 2: any */
+    hd__src_kind_t kind;        /* the layout: packed double, packed float or any */
     hd_dtype_t dtype;
     const hd_transform_t *T;    /* applied to every point read, or NULL */
 } hd__src_t;
@@ -208,10 +216,10 @@ void hd__src_init(hd__src_t *s, const hd_points_t *p, const hd_transform_t *T);
 /* Point k of the source (original numbering), transformed if T is set. */
 HD__INLINE void hd__src_get(const hd__src_t *s, size_t k, double out[3]) {
     double p[3];
-    if (s->kind == 0) {
+    if (s->kind == HD__SRC_F64) {
         const double *q = (const double *)(const void *)(s->base + (ptrdiff_t)k * 24);
         p[0] = q[0], p[1] = q[1], p[2] = q[2];
-    } else if (s->kind == 1) {
+    } else if (s->kind == HD__SRC_F32) {
         const float *q = (const float *)(const void *)(s->base + (ptrdiff_t)k * 12);
         p[0] = q[0], p[1] = q[1], p[2] = q[2];
     } else {

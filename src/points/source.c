@@ -29,8 +29,8 @@ void hd__src_init(hd__src_t *s, const hd_points_t *p, const hd_transform_t *T) {
     s->cs = p->cstride ? p->cstride : el;
     s->ps = p->stride ? p->stride : 3 * el;
     s->T = T;
-    s->kind = 2;
-    if (s->cs == el && s->ps == 3 * el) s->kind = p->dtype == HD_FLOAT32 ? 1 : 0;
+    s->kind = HD__SRC_ANY;
+    if (s->cs == el && s->ps == 3 * el) s->kind = p->dtype == HD_FLOAT32 ? HD__SRC_F32 : HD__SRC_F64;
 }
 
 /* ---- parallel LSD radix sort on bits 32..61 ------------------------------- */
