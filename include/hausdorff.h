@@ -67,9 +67,21 @@ extern "C" {
 #define HD_VERSION_PATCH 0
 #define HD_VERSION_STRING "0.1.0"
 
-#if defined(_WIN32) && defined(HD_SHARED)
+/* HD_EXTERN marks the public functions, as libuv's UV_EXTERN does.  The
+ * library's own build defines HD_BUILDING (CMakeLists.txt): the functions
+ * are exported, everything else stays hidden (-fvisibility=hidden).  A
+ * program that links the DLL on Windows defines HD_SHARED, which imports
+ * them; any other use (static library, or a shared one on ELF or Mach-O)
+ * needs neither. */
+#if defined(_WIN32) || defined(__CYGWIN__)
+#if defined(HD_BUILDING)
 #define HD_EXTERN __declspec(dllexport)
-#elif defined(__GNUC__)
+#elif defined(HD_SHARED)
+#define HD_EXTERN __declspec(dllimport)
+#else
+#define HD_EXTERN
+#endif
+#elif defined(HD_BUILDING) && defined(__GNUC__)
 #define HD_EXTERN __attribute__((visibility("default")))
 #else
 #define HD_EXTERN
@@ -132,10 +144,26 @@ typedef enum hd_dtype { HD_FLOAT64 = 0, HD_FLOAT32 = 1 } hd_dtype_t;
 
 /* `count` points, point k's coordinate c (0=x, 1=y, 2=z) at
  *     (char *)data + k * stride + c * cstride
- * read as a double or a float.  stride 0 means 3 elements (packed xyz),
- * cstride 0 means one element (x, y, z adjacent).  Strides may be negative
- * (numpy views).  The caller keeps the memory alive for the duration of the
- * call it is passed to (and for the life of an index built on it). */
+ * read as a double or a float.  Strides may be negative (numpy views).  The
+ * caller keeps the memory alive for the duration of the call it is passed
+ * to (and for the life of an index built on it).
+ *
+ * Zero strides are defaults, not broadcasts: stride 0 means 3 elements
+ * (packed xyz) and cstride 0 means one element (x, y, z adjacent), so
+ * {data, count, dtype, 0, 0} is a packed array.  A broadcast view (one
+ * point repeated, numpy's broadcast_to) cannot be described: stride 0
+ * would read count consecutive points.  For a Hausdorff distance pass the
+ * point once (count 1): repeating it changes neither the distance nor the
+ * witness, whose index is that of its first copy, 0.  Where repetition
+ * counts (per-point distances, percentiles, means), repeat it in memory.
+ *
+ * Alignment: a packed view (stride 0 or 3 elements, cstride 0 or one
+ * element) is read through double or float pointers, so `data` must be
+ * aligned to the element, 8 bytes for doubles and 4 for floats, as every C
+ * array of double or float is.  hd_index_build, hd_index_directed and
+ * hd_index_nearest refuse a misaligned packed view with HD_EINVAL; no other
+ * call may be passed one (copy it first).  A view with any other strides
+ * is read byte by byte and may lie at any address. */
 typedef struct hd_points {
     const void *data;
     size_t count;
@@ -227,7 +255,12 @@ typedef struct hd_symmetric {
  * A, B: views over caller memory, read only during the call.  Both must be
  *   non-empty (HD_EEMPTY), finite (HD_ENONFINITE) and within HD_MAX_COORD
  *   (HD_ERANGE).
- * opt: NULL for the defaults.  out: receives the distance and the witness.
+ * opt: NULL for the defaults.  Every field is checked (HD_EALGORITHM for
+ *   an unknown algorithm, HD_EINVAL for threads < 0, depth outside 1..21,
+ *   lambda outside (0, 1], theta outside [0, 1]); `algorithm` and `threads`
+ *   are used, and each other field only by the algorithms its comment in
+ *   hd_options_t names (none by HD_ALG_AUTO).
+ * out: receives the distance and the witness.
  * err: NULL, or receives the context of a failure.
  * Errors: HD_EINVAL (NULL argument, bad option), HD_EEMPTY, HD_ENONFINITE,
  *   HD_ERANGE, HD_ENOMEM, HD_ETHREAD.
@@ -238,8 +271,8 @@ HD_EXTERN int hd_directed(const hd_points_t *A, const hd_points_t *B,
 
 /* H(A,B) with both directions and their witnesses.  With the framework
  * algorithm each direction is chosen by the overlap; out->ab.algorithm and
- * out->ba.algorithm say what ran.  Same arguments and errors as
- * hd_directed. */
+ * out->ba.algorithm say what ran.  Same arguments (the same option
+ * fields) and errors as hd_directed. */
 HD_EXTERN int hd_hausdorff(const hd_points_t *A, const hd_points_t *B,
                            const hd_options_t *opt, hd_symmetric_t *out,
                            hd_error_t *err);
@@ -251,7 +284,7 @@ HD_EXTERN int hd_hausdorff(const hd_points_t *A, const hd_points_t *B,
  * and alpha = r_x * r_y * r_z.  So alpha is 0 when the boxes just touch and
  * 1 when they coincide (or one box's extent lies within the other's on every
  * axis).  *disjoint is 1 when the boxes do not intersect (alpha is then 0).
- * Errors: as hd_directed. */
+ * No options.  Errors: as hd_directed. */
 HD_EXTERN int hd_overlap(const hd_points_t *A, const hd_points_t *B,
                          double *alpha, int *disjoint, hd_error_t *err);
 
@@ -280,7 +313,8 @@ HD_EXTERN void hd_transform_identity(hd_transform_t *T);
  * must keep alive and unchanged until hd_index_free().  What the index
  * allocates itself (reordered coordinates, bucket boxes) is at most a few
  * tens of bytes per point and is freed by hd_index_free().
- * opt: NULL for defaults; opt->threads is used for the build.
+ * opt: NULL for defaults; only opt->threads is read (for the build; < 0 is
+ *   HD_EINVAL): `algorithm` and the other fields are ignored.
  * Errors: HD_EINVAL, HD_EEMPTY, HD_ENONFINITE, HD_ERANGE, HD_ENOMEM,
  *   HD_EOVERFLOW, HD_ETHREAD.
  * Thread safety: the built index is immutable; any number of threads may
@@ -299,7 +333,11 @@ HD_EXTERN size_t hd_index_memory(const hd_index_t *idx);
 
 /* h(T(A), B) against an index of B; T NULL means the identity.  The witness
  * indexes A and B in their original order.  A is read during the call only.
- * Errors: as hd_directed. */
+ * opt: NULL for defaults; only opt->threads is read: the index always runs
+ * the default engine's search (out->algorithm is HD_ALG_AUTO), so
+ * `algorithm` and the other fields are ignored.
+ * Errors: as hd_directed; a point that T makes NaN or infinite is
+ * HD_ENONFINITE, one it carries beyond HD_MAX_COORD is HD_ERANGE. */
 HD_EXTERN int hd_index_directed(const hd_index_t *idx, const hd_points_t *A,
                                 const hd_transform_t *T,
                                 const hd_options_t *opt, hd_result_t *out,
@@ -313,7 +351,9 @@ HD_EXTERN int hd_index_directed(const hd_index_t *idx, const hd_points_t *A,
  * the call (about 32 bytes per point of each, freed before returning; on
  * 1M points about 45 ms each): the index's own tree is made for the
  * Hausdorff distance's early breaking, and one complete search of it per
- * point costs several times more.  Errors: as hd_directed. */
+ * point costs several times more.  opt: as hd_index_directed (only
+ * opt->threads is read; `algorithm` is ignored).  Errors: as
+ * hd_index_directed. */
 HD_EXTERN int hd_index_nearest(const hd_index_t *idx, const hd_points_t *Q,
                                const hd_transform_t *T,
                                const hd_options_t *opt, double *dist,
@@ -336,8 +376,10 @@ HD_EXTERN int hd_index_nearest(const hd_index_t *idx, const hd_points_t *Q,
  * buckets; each structure is searched by the other set's points, a group
  * of neighbouring queries at a time.  It holds a copy of the coordinates
  * (about 32 bytes per point per set while searching, up to about 60 while
- * building), freed before returning.  Parallel with opt->threads; thread
- * safe for distinct outputs.  Errors: as hd_directed. */
+ * building), freed before returning.  opt: NULL for defaults; only
+ * opt->threads is read (the method above is the only one: `algorithm` and
+ * the other fields are ignored).  Thread safe for distinct outputs.
+ * Errors: as hd_directed. */
 HD_EXTERN int hd_distances(const hd_points_t *A, const hd_points_t *B,
                            const hd_options_t *opt, double *dist_ab,
                            size_t *nearest_ab, double *dist_ba,
@@ -374,7 +416,8 @@ HD_EXTERN int hd_percentile_of(const double *d_ab, size_t n_a,
                                const double *d_ba, size_t n_b, double p,
                                hd_percentile_t *out, hd_error_t *err);
 
-/* From the point sets: hd_distances, then hd_percentile_of. */
+/* From the point sets: hd_distances (so only opt->threads is read), then
+ * hd_percentile_of. */
 HD_EXTERN int hd_hausdorff_percentile(const hd_points_t *A,
                                       const hd_points_t *B,
                                       const hd_options_t *opt, double p,
