@@ -80,3 +80,25 @@ def data_dir():
     if not DATA_DIR.is_dir():
         pytest.skip(f"no data directory at {DATA_DIR}")
     return DATA_DIR
+
+
+def pytest_configure(config):
+    # scipy's test module (run by test_scipy_suite.py) uses its own marker.
+    config.addinivalue_line("markers", "xslow: scipy's very slow tests")
+
+
+def pytest_collection_modifyitems(config, items):
+    """test_scipy_suite.py: strict expected failures and skips, each with its
+    reason, from the module's EXPECTED_FAILURES and SKIPPED."""
+    for item in items:
+        module = getattr(item, "module", None)
+        expected = getattr(module, "EXPECTED_FAILURES", None)
+        if expected is None:
+            continue
+        key = item.nodeid.split("::", 1)[1]
+        module.collected.add(key)
+        if key in expected:
+            raises, reason = expected[key]
+            item.add_marker(pytest.mark.xfail(raises=raises, reason=reason, strict=True))
+        if key in module.SKIPPED:
+            item.add_marker(pytest.mark.skip(reason=module.SKIPPED[key]))
