@@ -124,8 +124,9 @@ static void check_case(const double *a, size_t na, const double *b, size_t nb, i
     CHECK_RC(hd_directed(&A, &B, &o, &r, NULL), HD_OK);
     check_directed(&r, &ab);
     /* Whatever the engine's choice, both of its paths are exact. */
-    for (int trees = 0; trees <= 1; trees++) {
-        CHECK_RC(hd__engine_forced(&A, &B, &o, trees, &s, NULL), HD_OK);
+    static const hd__engine_force_t paths[] = {HD__ENGINE_FORCE_GRID, HD__ENGINE_FORCE_TREES};
+    for (int k = 0; k < 2; k++) {
+        CHECK_RC(hd__engine_forced(&A, &B, &o, paths[k], &s, NULL), HD_OK);
         check_directed(&s.ab, &ab);
         check_directed(&s.ba, &ba);
     }
@@ -467,7 +468,7 @@ static int grid_discards_whole_cells(const hd_points_t *A, const hd_points_t *B,
     hd_options_init(&o);
     o.threads = threads;
     hd_symmetric_t s;
-    CHECK_RC(hd__engine_forced(A, B, &o, 0, &s, NULL), HD_OK);
+    CHECK_RC(hd__engine_forced(A, B, &o, HD__ENGINE_FORCE_GRID, &s, NULL), HD_OK);
     check_directed(&s.ab, ab);
     check_directed(&s.ba, ba);
     hd__src_t src[2];

@@ -496,11 +496,11 @@ static int engine_init(engine_t *e, const hd_points_t *A, const hd_points_t *B,
 /* Build both grids, prime each direction's maximum with the exact nearest
  * distances of points spread over the query set, try the correspondence
  * path (unless a path is forced), and choose. */
-static int engine_plan(engine_t *e, int force, hd_error_t *err) {
+static int engine_plan(engine_t *e, hd__engine_force_t force, hd_error_t *err) {
     /* Two sets of one size may be a copy and its original in the same
      * order; the correspondence path often settles that case in one pass,
      * before any index is built. */
-    if (!force && e->n[0] == e->n[1]) {
+    if (force == HD__ENGINE_PLANNED && e->n[0] == e->n[1]) {
         int rc = hd__pairs_begin(&e->pairs, e->src, e->n[0], e->threads, &e->counts[0], err);
         if (rc) return rc;
         if (hd__pairs_resolve(&e->pairs, e->src, NULL, e->max, e->directions, e->counts))
@@ -508,7 +508,7 @@ static int engine_plan(engine_t *e, int force, hd_error_t *err) {
     }
     /* The smaller set may be an ordered subset of the larger: its direction
      * is then 0, settled by one merge walk. */
-    for (int d = 0; d < e->directions && !force; d++)
+    for (int d = 0; d < e->directions && force == HD__ENGINE_PLANNED; d++)
         if (e->n[d] < e->n[1 - d])
             e->pairs.resolved[d] = hd__subset_resolve(&e->src[d], e->n[d], &e->src[1 - d],
                                                       e->n[1 - d], &e->max[d], &e->counts[d]);
@@ -543,11 +543,11 @@ static const char *engine_plan_name(const engine_t *e) {
     return all ? "pairs" : e->use_tree ? "trees" : "grid";
 }
 
-/* force: 0 lets the plan choose, 1 forces the grid, 2 the trees. */
-static int engine_run(engine_t *e, int force, hd_result_t out[2], hd_error_t *err) {
+/* force: the plan's choice, or the grid or the trees forced. */
+static int engine_run(engine_t *e, hd__engine_force_t force, hd_result_t out[2], hd_error_t *err) {
     int rc = engine_plan(e, force, err);
     if (rc) return rc;
-    if (force) e->use_tree = force == 2;
+    if (force != HD__ENGINE_PLANNED) e->use_tree = force == HD__ENGINE_FORCE_TREES;
     if (e->use_tree) {
         /* The grids give way to the trees (memory stays under 16 bytes per
          * point); the maxima found so far stay valid.  Both trees' Morton
@@ -662,7 +662,7 @@ int hd__engine_directed(const hd_points_t *A, const hd_points_t *B, const hd__bo
     int rc = engine_init(&e, A, B, box_a, box_b, opt, 1, err);
     if (rc) return rc;
     hd_result_t r[2];
-    rc = engine_run(&e, 0, r, err);
+    rc = engine_run(&e, HD__ENGINE_PLANNED, r, err);
     engine_free(&e);
     if (rc) return rc;
     *out = r[0];
@@ -671,8 +671,8 @@ int hd__engine_directed(const hd_points_t *A, const hd_points_t *B, const hd__bo
 }
 
 static int engine_symmetric(const hd_points_t *A, const hd_points_t *B, const hd__box_t *box_a,
-                            const hd__box_t *box_b, const hd_options_t *opt, int force,
-                            hd_symmetric_t *out, hd_error_t *err) {
+                            const hd__box_t *box_b, const hd_options_t *opt,
+                            hd__engine_force_t force, hd_symmetric_t *out, hd_error_t *err) {
     double t0 = hd__now();
     engine_t e;
     int rc = engine_init(&e, A, B, box_a, box_b, opt, 2, err);
@@ -694,17 +694,17 @@ static int engine_symmetric(const hd_points_t *A, const hd_points_t *B, const hd
 int hd__engine_hausdorff(const hd_points_t *A, const hd_points_t *B, const hd__box_t *box_a,
                          const hd__box_t *box_b, const hd_options_t *opt, hd_symmetric_t *out,
                          hd_error_t *err) {
-    return engine_symmetric(A, B, box_a, box_b, opt, 0, out, err);
+    return engine_symmetric(A, B, box_a, box_b, opt, HD__ENGINE_PLANNED, out, err);
 }
 
 int hd__engine_forced(const hd_points_t *A, const hd_points_t *B, const hd_options_t *opt,
-                      int use_trees, hd_symmetric_t *out, hd_error_t *err) {
+                      hd__engine_force_t force, hd_symmetric_t *out, hd_error_t *err) {
     hd__box_t ba, bb;
     int rc = hd__points_scan(A, "A", opt->threads, &ba, err);
     if (rc == HD_OK) rc = hd__points_scan(B, "B", opt->threads, &bb, err);
     if (rc) return rc;
     memset(out, 0, sizeof *out);
-    rc = engine_symmetric(A, B, &ba, &bb, opt, use_trees ? 2 : 1, out, err);
+    rc = engine_symmetric(A, B, &ba, &bb, opt, force, out, err);
     if (rc == HD_OK)
         out->distance = out->ab.distance2 >= out->ba.distance2 ? out->ab.distance : out->ba.distance;
     return rc;
@@ -719,7 +719,7 @@ int hd__engine_explain(const hd_points_t *A, const hd_points_t *B, const hd_opti
     engine_t e;
     rc = engine_init(&e, A, B, &ba, &bb, opt, 2, err);
     if (rc) return rc;
-    rc = engine_plan(&e, 0, err);
+    rc = engine_plan(&e, HD__ENGINE_PLANNED, err);
     if (rc == HD_OK)
         snprintf(buf, len,
                  "%s (pairs %s, resolved %d / %d; grid trial: %.3g / %.3g distances and nodes per "

@@ -281,10 +281,22 @@ double hd__grid_trial(const hd__src_t *a, size_t na, const hd__grid_t *gb, hd__m
 
 /* ---- the engine ---------------------------------------------------------------- */
 
-/* H(A,B) by the engine with its choice overridden: the grid pass for both
- * directions (use_trees 0) or the trees (1).  For tests. */
+/* What the engine runs (engine.c): its plan's choice, or one path forced. */
+typedef enum hd__engine_force {
+    /* The plan chooses: the shortcuts of pairs.c (a copy in the same order,
+     * an ordered subset), else the grid pass or the trees by the grid trial. */
+    HD__ENGINE_PLANNED = 0,
+    /* No shortcut: the grid pass for every direction. */
+    HD__ENGINE_FORCE_GRID = 1,
+    /* No shortcut: the bucket trees for every direction. */
+    HD__ENGINE_FORCE_TREES = 2
+} hd__engine_force_t;
+
+/* H(A,B) by the engine with its choice overridden by `force`
+ * (HD__ENGINE_FORCE_GRID or HD__ENGINE_FORCE_TREES; HD__ENGINE_PLANNED
+ * lets the plan choose).  For tests. */
 int hd__engine_forced(const hd_points_t *A, const hd_points_t *B, const hd_options_t *opt,
-                      int use_trees, hd_symmetric_t *out, hd_error_t *err);
+                      hd__engine_force_t force, hd_symmetric_t *out, hd_error_t *err);
 
 /* The correspondence path (pairs.c), for two sets of n points each
  * listed in the same order (a copy and its original).  hd__pairs_begin
