@@ -101,9 +101,25 @@ static int to_double(const char *s, double *out) {
     return 0;
 }
 
-static const char *const value_names[] = {"--percentile", "--bins", "--distances", "--max-distance",
-                                          "--render", "--histogram-png", "--mask-points", "--empty",
-                                          NULL};
+/* The options that take a value, by their place in value_names. */
+typedef enum {
+    OPT_PERCENTILE,
+    OPT_BINS,
+    OPT_DISTANCES,
+    OPT_MAX_DISTANCE,
+    OPT_RENDER,
+    OPT_HISTOGRAM_PNG,
+    OPT_MASK_POINTS,
+    OPT_EMPTY,
+    OPT_COUNT
+} value_option_t;
+
+static const char *const value_names[OPT_COUNT + 1] = {
+    [OPT_PERCENTILE] = "--percentile",   [OPT_BINS] = "--bins",
+    [OPT_DISTANCES] = "--distances",     [OPT_MAX_DISTANCE] = "--max-distance",
+    [OPT_RENDER] = "--render",           [OPT_HISTOGRAM_PNG] = "--histogram-png",
+    [OPT_MASK_POINTS] = "--mask-points", [OPT_EMPTY] = "--empty",
+    [OPT_COUNT] = NULL};
 
 int analysis_parse_option(int argc, char **argv, int *k, analysis_args_t *an) {
     const char *s = argv[*k];
@@ -121,41 +137,41 @@ int analysis_parse_option(int argc, char **argv, int *k, analysis_args_t *an) {
     if (!v) return usage_error("option '%s' needs a value", name);
     double d;
     switch (which) {
-    case 0:
+    case OPT_PERCENTILE:
         if (to_double(v, &d) || d < 0 || d > 100)
             return usage_error("--percentile needs a number in [0, 100], not '%s'", v);
         an->percentile_on = 1;
         an->percentile = d;
         break;
-    case 1:
+    case OPT_BINS:
         if (to_double(v, &d) || d < 1 || d > 100000 || d != floor(d))
             return usage_error("--bins needs a whole number 1..100000, not '%s'", v);
         an->bins = (size_t)d;
         break;
-    case 2:
+    case OPT_DISTANCES:
         if (!distances_format_known(v))
             return usage_error("--distances: cannot tell the format of '%s'; name it .csv, .ply or .npy", v);
         an->distances_out = v;
         break;
-    case 3:
+    case OPT_MAX_DISTANCE:
         if (to_double(v, &d) || !(d > 0))
             return usage_error("--max-distance needs a positive number, not '%s'", v);
         an->max_distance = d;
         break;
-    case 4:
-    case 5:
+    case OPT_RENDER:
+    case OPT_HISTOGRAM_PNG:
         if (!render_available())
             return usage_error("%s is unavailable: this hausdorff was built without libpng "
                                "(Debian: libpng-dev)", name);
-        if (which == 4) an->render_out = v;
+        if (which == OPT_RENDER) an->render_out = v;
         else an->histogram_png = v;
         break;
-    case 6:
+    case OPT_MASK_POINTS:
         if (strcmp(v, "surface") == 0) an->mask_points = MASK_SURFACE;
         else if (strcmp(v, "all") == 0) an->mask_points = MASK_ALL;
         else return usage_error("--mask-points is surface or all, not '%s'", v);
         break;
-    case 7:
+    case OPT_EMPTY:
         if (strcmp(v, "inf") == 0) an->empty = EMPTY_INF;
         else if (strcmp(v, "nan") == 0) an->empty = EMPTY_NAN;
         else if (strcmp(v, "zero") == 0) an->empty = EMPTY_ZERO;
