@@ -61,9 +61,20 @@ def exercise(a, b, af32, path):
     index.directed(a, rotation=np.eye(3), translation=[1, 2, 3])
     index.distances(af32)
     hausdorff.read(path)
-    for bad in (np.zeros((0, 3)), np.full((2, 3), np.nan), np.zeros((2, 2))):
+    hausdorff.directed(u=a[:, :2], v=b[:, :2], seed=np.int64(3))
+    hausdorff.summary(a, b)
+    hausdorff.mean(a, b, threads=np.int32(2))
+    hausdorff.chamfer(a, b)
+    e = b[:0]
+    hausdorff.hausdorff(a, e, empty="monai")
+    hausdorff.percentile(e, b, [50, 95], empty="inf")
+    hausdorff.distances(a, e, empty="zero")
+    hausdorff.summary(e, e, empty="nan")
+    for bad in (np.zeros((0, 3)), np.full((2, 3), np.nan), np.zeros((2, 2)), np.zeros((2, 4))):
         with pytest.raises(ValueError):
             hausdorff.directed(bad, b)
+    with pytest.raises(TypeError):
+        hausdorff.directed(u=a, a=a, v=b)
     with pytest.raises(OSError):
         hausdorff.read(path + ".missing")
 
