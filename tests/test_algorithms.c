@@ -432,10 +432,20 @@ TEST(framework_picks_nohd_earlybreak_or_ohd_by_overlap) {
 
 TEST(counters_are_within_the_work_they_count) {
     /* Point-to-point evaluations never exceed what NAIVEHDD does (plus
-     * OHD's sample and one check per culled point, and EARLYBREAK's search
-     * for the first witness); the tree algorithms report the nodes they
-     * visit.  (INC may evaluate a pair again when it refines a list that
-     * already holds points, so it has no such ceiling.) */
+     * EARLYBREAK's search for the first witness); the tree algorithms
+     * report the nodes they visit.  (INC may evaluate a pair again when it
+     * refines a list that already holds points, so it has no such
+     * ceiling.)  OHD's ceiling is its measured work: its sample and culling
+     * make it evaluate 27736 distances over these 100 cases (at one thread
+     * and seed 0), 3.2% of the 867401 pairs; 2|A||B| per case, the bound
+     * this test had, could not fail.  The ceiling, 1.5 times the measured
+     * count, guards the early exit of Algorithm 7 (without it: 118361) and
+     * the sample's size (lambda 0.05 instead of 0.01: 43265).  Culling
+     * saves little on sets this small (nOHD: 30449, under the ceiling);
+     * ohd_culls_points_only_when_culling_is_on guards it.  A change that
+     * makes OHD cheaper may lower the ceiling. */
+    const uint64_t ohd_ceiling = 41600;
+    uint64_t ohd_evals = 0;
     for (uint64_t seed = 40001; seed <= 40100 && !hdt_failed(); seed++) {
         pair_t c;
         make_pair(seed, &c);
@@ -449,11 +459,15 @@ TEST(counters_are_within_the_work_they_count) {
             CONTEXT("case seed=%llu shape=%s alg=%s", (unsigned long long)seed, c.shape,
                     hd_algorithm_name(o.algorithm));
             hd_result_t r = run_one(c.a, c.na, c.b, c.nb, &o);
-            uint64_t extra = algs[k] == HD_ALG_OHD ? full + c.na : algs[k] == HD_ALG_EARLYBREAK ? c.nb : 0;
-            if (algs[k] != HD_ALG_INC) CHECK(r.stats.distance_evals <= full + extra);
+            uint64_t extra = algs[k] == HD_ALG_EARLYBREAK ? c.nb : 0;
+            if (algs[k] == HD_ALG_OHD) ohd_evals += r.stats.distance_evals;
+            else if (algs[k] != HD_ALG_INC) CHECK(r.stats.distance_evals <= full + extra);
             if (algs[k] == HD_ALG_INC || algs[k] == HD_ALG_OHD) CHECK(r.stats.nodes_visited > 0);
             if (algs[k] == HD_ALG_NOHD && c.na > 1) CHECK(r.stats.nodes_visited > 0);
         }
         free_pair(&c);
     }
+    CONTEXT("OHD evaluated %llu distances over the 100 cases (measured: 27736)",
+            (unsigned long long)ohd_evals);
+    CHECK(ohd_evals <= ohd_ceiling);
 }
