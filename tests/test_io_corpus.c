@@ -5,7 +5,12 @@
  * for meshes, sampled, and the reader's contract holds: a valid seed reads,
  * a failure leaves no cloud and a message that names the file, a success
  * holds finite points within range.  So `make test` replays what the
- * fuzzers found, under the sanitizers, without clang.
+ * fuzzers found, under the sanitizers, without clang.  Each regress-* file
+ * also has its expected outcome in `regress` below (points read, or the
+ * code it is refused with, as points and sampled): a reader that starts
+ * accepting what it refused, refusing what it read, or reading a different
+ * number of points fails here, and a new regress-* file without a row
+ * fails until it has one.
  */
 #include "check.h"
 
@@ -13,6 +18,41 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
+
+/* The outcome of each regress-* file: read with `points` points (code
+ * HD_OK) or refused with `code`, as points; and the same when sampled (8
+ * points of float; meshes only, the first four formats of the test). */
+typedef struct {
+    const char *path;
+    int code;
+    size_t points;
+    int sampled_code;
+    size_t sampled_points;
+    int seen;
+} outcome_t;
+
+static outcome_t regress[] = {
+    {"tests/corpus/ply/regress-empty-window", HD_EFORMAT, 0, HD_EFORMAT, 0, 0},
+    {"tests/corpus/ply/regress-face-first-list-count-2e64", HD_OK, 3, HD_EFORMAT, 0, 0},
+    {"tests/corpus/obj/regress-empty-window", HD_EEMPTY, 0, HD_EEMPTY, 0, 0},
+    {"tests/corpus/obj/regress-relative-index-2e62", HD_OK, 8, HD_EFORMAT, 0, 0},
+    {"tests/corpus/off/regress-empty-window", HD_EFORMAT, 0, HD_EFORMAT, 0, 0},
+    {"tests/corpus/stl/regress-binary-solid-header", HD_OK, 6, HD_OK, 8, 0},
+    {"tests/corpus/stl/regress-empty-window", HD_EFORMAT, 0, HD_EFORMAT, 0, 0},
+    {"tests/corpus/xyz/regress-decimal-comma.csv", HD_OK, 2, 0, 0, 0},
+    {"tests/corpus/xyz/regress-empty-window", HD_EEMPTY, 0, 0, 0, 0},
+    {"tests/corpus/xyz/regress-pts-count-2e64", HD_EFORMAT, 0, 0, 0, 0},
+    {"tests/corpus/pcd/regress-empty-window", HD_EFORMAT, 0, 0, 0, 0},
+    {"tests/corpus/npy/regress-empty-shape", HD_EFORMAT, 0, 0, 0, 0},
+};
+#define N_REGRESS (sizeof regress / sizeof regress[0])
+
+static outcome_t *expected(const char *path) {
+    for (size_t k = 0; k < N_REGRESS; k++)
+        if (strcmp(regress[k].path, path) == 0) return &regress[k];
+    return NULL;
+}
 
 static void read_one(const char *path, const char *format, int sample) {
     hd_read_options_t o;
@@ -28,6 +68,17 @@ static void read_one(const char *path, const char *format, int sample) {
     int rc = hd_read_file(path, &o, &c, &e);
     int seed = strstr(path, "/regress-") == NULL;
     CONTEXT("%s as %s%s", path, format, sample ? ", sampled" : "");
+    if (!seed) {
+        outcome_t *want = expected(path);
+        if (!want) {
+            hdt_fail(__FILE__, __LINE__, "%s has no expected outcome: add a row to `regress`", path);
+        } else {
+            want->seen = 1;
+            CHECK_RC(rc, sample ? want->sampled_code : want->code);
+            size_t points = rc == HD_OK && c ? c->count : 0;
+            CHECK_EQ(points, sample ? want->sampled_points : want->points);
+        }
+    }
     if (rc != HD_OK) {
         CHECK(c == NULL);
         CHECK_EQ(e.code, rc);
@@ -68,4 +119,8 @@ TEST(every_corpus_file_reads_or_is_refused_by_the_contract) {
         closedir(d);
     }
     CHECK(files >= 24);
+    for (size_t k = 0; k < N_REGRESS; k++) {
+        CONTEXT("%s", regress[k].path);
+        CHECK(regress[k].seen); /* a row whose file is gone */
+    }
 }
