@@ -378,9 +378,14 @@ static int read_loaded(const hd__file_t *f, const format_t *fmt, int from_extens
         if (!fmt)
             return hd__err(err, HD_EUNSUPPORTED, "%s: cannot tell the format from the %s; use --format (see --formats)",
                            f->name, from_extension < 0 ? "content" : "extension or the content");
-    } else if (from_extension > 0 && fmt->magic && !fmt->magic(f->data, f->size)) {
+    } else if (from_extension > 0 && !(fmt->magic && fmt->magic(f->data, f->size))) {
+        /* The content must confirm the extension.  A format with a
+         * signature that is missing is refused when the content has another
+         * format's signature; a format without one (OBJ, text) is refused
+         * when the content looks like any other format, so an OFF or a PLY
+         * named .xyz is never read as a list of numbers. */
         const format_t *seems = by_content(f);
-        if (seems && seems != fmt && seems->magic)
+        if (seems && seems != fmt && (seems->magic || !fmt->magic))
             return hd__err(err, HD_EFORMAT, "%s: the name says %s but the content is %s; use --format %s", f->name,
                            fmt->name, seems->name, seems->name);
     }

@@ -16,6 +16,11 @@
  * silent wrong answer (1, 5, 2).  A comma-separated file whose numbers use
  * decimal commas ("1,5,2,5,3,5") cannot be told from six columns and is
  * read as six columns; docs/formats.md says so.
+ * When the first point row holds whole numbers only, every point row must
+ * have as many fields as it: that is the pattern of a mesh without its
+ * keyword (an OFF named .xyz: a counts row "8356 16674 0", vertex rows of 3
+ * fields, face rows "3 i j k" of 4), which was once read as points, faces
+ * included, and answered.  Other files may have ragged extra columns.
  * Blank lines and lines starting with '#' or
  * '//' are skipped.  The first line may be a header: if it does not start
  * with a number (a CSV header such as "x,y,z,intensity") it is skipped, and
@@ -38,6 +43,9 @@
 typedef struct {
     int semicolon;       /* fields separated by ';', decimal commas */
     long long data_line; /* the line that decided (for messages) */
+    int fields;          /* fields of the first point row */
+    long long fields_line; /* that row's line */
+    int first_int;       /* that row holds whole numbers only */
 } dialect_t;
 
 static int is_blank_sep(int c) { return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v'; }
@@ -60,6 +68,18 @@ static int parse_decimal_comma(const char *t, const char *e, double *v) {
     if (!comma || memchr(comma + 1, ',', n - (size_t)(comma - buf) - 1)) return 0;
     *comma = '.';
     return hd__parse_double(buf, buf + n, v);
+}
+
+/* Fields in [q, eol): maximal runs of characters that separate nothing. */
+static int count_fields(const dialect_t *d, const char *q, const char *eol) {
+    int n = 0;
+    while (q < eol) {
+        while (q < eol && is_field_sep(d, (unsigned char)*q)) q++;
+        if (q == eol) break;
+        n++;
+        while (q < eol && !is_field_sep(d, (unsigned char)*q)) q++;
+    }
+    return n;
 }
 
 static void chunk(void *ctx, hd__chunk_t *c) {
@@ -117,6 +137,14 @@ static void chunk(void *ctx, hd__chunk_t *c) {
             hd__chunk_fail(c, HD_EFORMAT, line, "expected 3 numbers (x y z), found %d", got);
             return;
         }
+        int fields = d->first_int ? 3 + count_fields(d, q, eol) : d->fields;
+        if (fields != d->fields) {
+            hd__chunk_fail(c, HD_EFORMAT, line,
+                           "%d fields where the first row (line %lld), whole numbers only, has %d: a count "
+                           "line and rows of indices, not a list of points (a mesh without its keyword?)",
+                           fields, d->fields_line, d->fields);
+            return;
+        }
         if (!hd__chunk_push(c, line, v)) return;
     }
     c->lines = line;
@@ -144,14 +172,27 @@ static size_t candidates(void *ctx, const char *p, const char *end) {
 }
 
 /* The dialect, from the first candidate line (serial; it stops there). */
+/* The dialect and the number of fields, from the first point row: the
+ * first candidate line, or the next one when the first line is a PTS count
+ * (a single field).  Serial; it stops there. */
 static dialect_t dialect_of(const char *p, const char *end) {
-    dialect_t d = {0, 0};
+    dialect_t d = {0, 0, 0, 0, 0};
     for (long long line = 1; p < end; line++) {
         const char *eol = hd__eol(p, end);
         if (candidate(p, eol)) {
-            d.semicolon = memchr(p, ';', (size_t)(eol - p)) != NULL;
-            d.data_line = line;
-            break;
+            const char *q = p;
+            while (q < eol && is_sep((unsigned char)*q)) q++;
+            while (q < eol && !is_sep((unsigned char)*q)) q++;
+            while (q < eol && is_sep((unsigned char)*q)) q++;
+            if (!(line == 1 && q == eol)) { /* not a PTS count line */
+                d.semicolon = memchr(p, ';', (size_t)(eol - p)) != NULL;
+                d.data_line = d.fields_line = line;
+                d.fields = count_fields(&d, p, eol);
+                d.first_int = 1;
+                for (const char *t = p; t < eol && d.first_int; t++)
+                    d.first_int = (*t >= '0' && *t <= '9') || *t == '-' || *t == '+' || is_field_sep(&d, (unsigned char)*t);
+                break;
+            }
         }
         p = eol + (eol < end);
     }
