@@ -15,6 +15,9 @@ enum { EXIT_OK = 0, EXIT_USAGE = 1, EXIT_BADINPUT = 2, EXIT_FAILURE_ = 3 };
 
 typedef struct cli_args {
     const char *path_a, *path_b;
+    /* the format of each file when its path was written FORMAT:PATH
+     * ("xyz:-", "ply:scan.dat"), else NULL: --format, extension, content */
+    const char *format_a, *format_b;
     hd_options_t opt;
     hd_read_options_t read;
     int directed;

@@ -88,10 +88,13 @@ int main(int argc, char **argv) {
     double t0 = now();
     /* progress by phase (read A, read B, compute), only for a person */
     progress_start(!a.quiet && !a.json && isatty(2), 3);
+    hd_read_options_t read_a = a.read, read_b = a.read; /* FORMAT:PATH wins over --format */
+    if (a.format_a) read_a.format = a.format_a;
+    if (a.format_b) read_b.format = a.format_b;
     progress_phase("reading A: %s", a.path_a);
-    if ((rc = cli_read_points(a.path_a, &a.read, &a.an, 0, &ca, &err)) != HD_OK ||
+    if ((rc = cli_read_points(a.path_a, &read_a, &a.an, 0, &ca, &err)) != HD_OK ||
         (progress_phase("reading B: %s", a.path_b),
-         rc = cli_read_points(a.path_b, &a.read, &a.an, 1, &cb, &err)) != HD_OK) {
+         rc = cli_read_points(a.path_b, &read_b, &a.an, 1, &cb, &err)) != HD_OK) {
         progress_stop();
         fprintf(stderr, "hausdorff: %s\n", err.message);
         hd_cloud_free(ca);

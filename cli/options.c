@@ -8,6 +8,7 @@
 #include <errno.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 void cli_usage(FILE *out) {
     fprintf(out,
@@ -30,7 +31,9 @@ void cli_usage(FILE *out) {
 "  --no-culling       OHD without point culling (the paper's nOHD)\n"
 "  --format NAME      read both files as NAME instead of by extension\n"
 "                     (a file named - is standard input: its format is\n"
-"                     --format's, else told from its content)\n"
+"                     --format's, else told from its content); one file's\n"
+"                     format: FORMAT:PATH, e.g. xyz:- or ply:scan.dat\n"
+"                     (./ply:x for a file whose name holds a colon)\n"
 "  --formats          list the file formats and exit\n"
 "  --vertices         read a mesh (ply, obj, off, stl) as its vertices (default)\n"
 "  --sample N         read a mesh as N points drawn uniformly by area on its\n"
@@ -52,7 +55,7 @@ void cli_usage(FILE *out) {
 "  hausdorff --json --algorithm framework a.xyz b.xyz\n"
 "  hausdorff --directed --threads 1 part.ply reference.ply\n"
 "  hausdorff --sample 100000 --seed 7 part.stl scan.las\n"
-"  cat cloud.csv | hausdorff - model.ply\n"
+"  cat cloud.csv | hausdorff xyz:- model.ply\n"
 "  hausdorff --percentile 95 --mean --render dev.png scan.ply model.ply\n"
 "  hausdorff --json --percentile 95 seg.nii.gz truth.nii.gz\n"
 "\n"
@@ -115,6 +118,22 @@ static int parse_double(const char *s, double *out) {
     if (e == s || *e || errno) return -1;
     *out = v;
     return 0;
+}
+
+/* A path written FORMAT:PATH, FORMAT a reader's name in any case ("xyz:-",
+ * "PLY:scan.dat"): *format is the reader's name and the path follows the
+ * colon.  Anything else is a path as it stands, *format NULL ("./ply:x"
+ * names a file whose name holds a colon). */
+static const char *split_format(const char *s, const char **format) {
+    *format = NULL;
+    const char *colon = strchr(s, ':');
+    if (!colon || colon == s) return s;
+    for (const char *const *f = hd_formats(); *f; f++)
+        if (strlen(*f) == (size_t)(colon - s) && strncasecmp(*f, s, (size_t)(colon - s)) == 0) {
+            *format = *f;
+            return colon + 1;
+        }
+    return s;
 }
 
 int cli_parse(int argc, char **argv, cli_args_t *a) {
@@ -201,7 +220,7 @@ int cli_parse(int argc, char **argv, cli_args_t *a) {
         cli_usage(stderr);
         return EXIT_USAGE;
     }
-    a->path_a = files[0];
-    a->path_b = files[1];
+    a->path_a = split_format(files[0], &a->format_a);
+    a->path_b = split_format(files[1], &a->format_b);
     return -1;
 }

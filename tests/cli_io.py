@@ -202,6 +202,40 @@ def progress_bar_appears_on_a_terminal_for_a_slow_phase_only(d):
     assert p.returncode == 0 and err == b"", err
 
 
+@test
+def a_format_per_file_is_written_format_colon_path(d):
+    csv = "x,y,z\n0,0,0\n1,1,1\n"
+    pts = write(d, "p.dat", "0 0 0\n1 1 1\n")
+    # xyz:- reads standard input as text while B keeps its own format
+    rc, out, err = run("--json", "xyz:-", os.path.join(DATA, "pinion_gear.ply"), stdin=csv.encode())
+    assert rc == 0, err
+    # an unknown extension made readable by its prefix
+    rc, out, err = run("--json", "xyz:" + pts, "xyz:" + pts)
+    assert rc == 0 and '"hausdorff": 0' in out, (rc, out, err)
+    # a prefix that names no format is part of the path
+    rc, out, err = run("nosuch:" + pts, pts)
+    assert rc == 2 and "nosuch:" in err and "cannot open" in err, err
+    # FORMAT: wins over --format for its file only
+    ply = os.path.join(DATA, "pinion_gear.ply")
+    rc, out, err = run("--format", "ply", "xyz:" + pts, ply)
+    assert rc == 0, err
+
+
+@test
+def a_file_whose_name_holds_a_colon_is_named_with_a_directory(d):
+    write(d, "ply:x", "0 0 0\n1 1 1\n")
+    p = subprocess.run([os.path.abspath(TOOL), "--format", "xyz", "./ply:x", "./ply:x"], cwd=d,
+                       capture_output=True, timeout=120)
+    assert p.returncode == 0, p.stderr
+
+
+@test
+def a_csv_with_a_header_on_standard_input_is_read_without_format(d):
+    rc, out, err = run("--json", "-", os.path.join(DATA, "pinion_gear.ply"), stdin=b"x,y,z\r\n0,0,0\n1,1,1\n")
+    assert rc == 0, err
+    assert '"n_a": 2' in out, out
+
+
 class ReadingCli(unittest.TestCase):
     """Each function above becomes one test, run in a fresh temporary directory."""
 

@@ -183,6 +183,16 @@ static const format_t *by_content(const hd__file_t *f) {
     size_t k = 0;
     while (k < f->size && (f->data[k] == ' ' || f->data[k] == '\t' || f->data[k] == '\n' || f->data[k] == '\r')) k++;
     if (k < f->size && (strchr("+-.0123456789", f->data[k]) || f->data[k] == '#')) return by_name("xyz");
+    /* a header line of printable text ("x,y,z") over a line that starts
+     * with a number: a CSV with its header */
+    size_t e = k;
+    while (e < f->size && f->data[e] >= 0x20 && f->data[e] < 0x7f) e++;
+    if (e > k && e + 1 < f->size && f->data[e] == '\r') e++;
+    if (e > k && e < f->size && f->data[e] == '\n') {
+        size_t n = e + 1;
+        while (n < f->size && (f->data[n] == ' ' || f->data[n] == '\t' || f->data[n] == '\r')) n++;
+        if (n < f->size && strchr("+-.0123456789", f->data[n])) return by_name("xyz");
+    }
     return NULL;
 }
 
