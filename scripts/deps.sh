@@ -1,19 +1,28 @@
 #!/bin/sh
 # Install the Debian packages a make target needs, when they are missing.
 # usage: scripts/deps.sh GROUP...   (groups: build test python bench plot fuzz extras)
-# Runs apt-get only as root and only for packages not yet installed; as
-# another user it prints the command to run instead.
+# Runs apt-get only as root and only for packages not yet installed, without
+# recommends (the minimal set); as another user it prints the same command,
+# to run as root, instead.  Each package is named once.
 set -e
 pkgs=""
+add() {
+  for p in "$@"; do
+    case " $pkgs " in *" $p "*) ;; *) pkgs="$pkgs $p" ;; esac
+  done
+}
 for group in "$@"; do
   case "$group" in
-    build)  pkgs="$pkgs gcc make cmake pkg-config libc6-dev" ;;
-    extras) pkgs="$pkgs libpng-dev libnifti2-dev zlib1g-dev" ;;
-    test)   pkgs="$pkgs python3 locales" ;;
-    python) pkgs="$pkgs python3 python3-dev python3-numpy python3-setuptools python3-pytest python3-scipy" ;;
-    bench)  pkgs="$pkgs libnanoflann-dev libpcl-dev python3-scipy python3-numpy python3-open3d g++ libomp-dev" ;;
-    plot)   pkgs="$pkgs python3-matplotlib python3-numpy" ;;
-    fuzz)   pkgs="$pkgs clang libclang-rt-14-dev make libnifti2-dev zlib1g-dev" ;;
+    build)  add gcc make cmake pkg-config libc6-dev ;;
+    extras) add libpng-dev libnifti2-dev zlib1g-dev ;;
+    test)   add python3 locales ;;
+    # python3-venv and python3-wheel: README's `pip install --no-build-isolation
+    # ./python` in a venv (tests/python_venv.sh).
+    python) add python3 python3-dev python3-numpy python3-setuptools python3-pytest python3-scipy \
+                python3-venv python3-wheel ;;
+    bench)  add libnanoflann-dev libpcl-dev python3-scipy python3-numpy python3-open3d g++ libomp-dev ;;
+    plot)   add python3-matplotlib python3-numpy ;;
+    fuzz)   add clang libclang-rt-14-dev make libnifti2-dev zlib1g-dev ;;
     *) echo "deps.sh: unknown group $group" >&2; exit 1 ;;
   esac
 done
@@ -24,7 +33,8 @@ done
 [ -z "$missing" ] && exit 0
 if [ "$(id -u)" != 0 ]; then
   echo "Missing Debian packages:$missing" >&2
-  echo "Install them with: sudo apt-get install$missing" >&2
+  echo "Install them as root (then run make again):" >&2
+  echo "  su -c 'apt-get update && apt-get install -y --no-install-recommends$missing'" >&2
   exit 1
 fi
 echo "Installing Debian packages:$missing"
