@@ -8,7 +8,11 @@ ASAN_BUILD ?= build-asan
 JOBS       ?= 2
 CMAKE_ARGS ?=
 
-.PHONY: all deps configure run test test-release test-asan test-tsan install bench experiments fuzz python clean
+.PHONY: all deps configure cli run test test-release test-asan test-tsan install bench experiments fuzz python clean
+
+# Quiet: no "make[1]: Entering/Leaving directory" pair around each step of
+# every cmake --build (the sub-makes read MAKEFLAGS); errors still print.
+MAKEFLAGS += --no-print-directory
 
 all: $(BUILD)/hausdorff
 
@@ -24,8 +28,13 @@ $(BUILD)/hausdorff: $(BUILD)/CMakeCache.txt FORCE
 
 FORCE:
 
+# The command-line tool alone (`make` builds everything: tests, benchmarks,
+# the Python module).
+cli: $(BUILD)/CMakeCache.txt
+	cmake --build $(BUILD) -j$(JOBS) --target hausdorff_cli
+
 # The main job: the exact Hausdorff distance between two bundled models.
-run: all
+run: cli
 	./$(BUILD)/hausdorff data/cgal_lion.ply data/cgal_lion_head.ply
 	./$(BUILD)/hausdorff data/wuson_obj.ply data/wuson_stl.ply
 
@@ -43,8 +52,29 @@ test-asan:
 	cmake --build $(ASAN_BUILD) -j$(JOBS)
 	cd $(ASAN_BUILD) && ASAN_OPTIONS=detect_leaks=1 ctest --output-on-failure -j$(JOBS)
 
-install: all
+# Installs the library, header, tool, man page, pkg-config file and CMake
+# package (PREFIX=/some/where for another prefix than the configured one,
+# /usr/local by default; DESTDIR=/stage to stage).  Into /usr or /usr/local as
+# root it runs ldconfig, so that programs find libhausdorff.so.0; otherwise it
+# says what to set.  Builds only what it installs.
+install: $(BUILD)/CMakeCache.txt
+	cmake --build $(BUILD) -j$(JOBS) --target hausdorff hausdorff_static hausdorff_cli
 	cmake --install $(BUILD) $(if $(PREFIX),--prefix $(PREFIX))
+	@prefix='$(PREFIX)'; cache='$(BUILD)/CMakeCache.txt'; \
+	[ -n "$$prefix" ] || prefix=$$(sed -n 's/^CMAKE_INSTALL_PREFIX:[A-Z]*=//p' "$$cache"); \
+	prefix=$${prefix%/}; libdir=$$(sed -n 's/^CMAKE_INSTALL_LIBDIR:[A-Z]*=//p' "$$cache"); \
+	case "$$libdir" in /*) ;; *) libdir="$$prefix/$$libdir" ;; esac; \
+	if [ -n "$$DESTDIR" ]; then \
+	  echo "Staged under $$DESTDIR for the prefix $$prefix (run ldconfig once it is in place)"; \
+	elif [ "$$prefix" = /usr ] || [ "$$prefix" = /usr/local ]; then \
+	  if [ "$$(id -u)" = 0 ]; then echo "ldconfig"; ldconfig; \
+	  else echo "Now run ldconfig as root (su -c ldconfig), so that programs find libhausdorff.so.0"; fi; \
+	else \
+	  echo "Installed into $$prefix, which pkg-config, CMake and the dynamic linker do not search by themselves:"; \
+	  echo "  export PKG_CONFIG_PATH=$$libdir/pkgconfig   # then: cc prog.c \$$(pkg-config --cflags --libs hausdorff)"; \
+	  echo "  cmake -DCMAKE_PREFIX_PATH=$$prefix ...   # for find_package(hausdorff)"; \
+	  echo "  export LD_LIBRARY_PATH=$$libdir   # to run what links libhausdorff.so, or link with -Wl,-rpath,$$libdir"; \
+	fi
 
 # The Python module alone, into $(BUILD)/python (docs/python.md); `make`
 # builds it too whenever numpy, setuptools and Python.h are present.
