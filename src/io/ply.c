@@ -49,8 +49,8 @@ typedef struct {
     size_t len;
     uint64_t count;
     long long line;
-    prop_t props[MAX_PROPS];
-    int n_props;
+    prop_t *props; /* n_props of them, grown as they are declared */
+    int n_props, cap_props;
     int has_list;
     size_t fixed; /* bytes of scalars and list counts per instance */
 } elem_t;
@@ -164,7 +164,15 @@ static int header(ply_t *p) {
             elem_t *e = &p->el[p->n_el - 1];
             if (e->n_props == MAX_PROPS)
                 return hd__io_err_line(r, HD_EUNSUPPORTED, line, "more than %d properties", MAX_PROPS);
+            if (e->n_props == e->cap_props) {
+                int cap = e->cap_props ? 2 * e->cap_props : 8;
+                prop_t *np = hd__realloc_array(e->props, (size_t)cap, sizeof *np);
+                if (!np) return hd__io_err(r, HD_ENOMEM, "out of memory for the header");
+                e->props = np;
+                e->cap_props = cap;
+            }
             prop_t *pr = &e->props[e->n_props];
+            memset(pr, 0, sizeof *pr);
             const char *nb, *ne;
             if (!hd__token(&cur, eol, &tb, &te))
                 return hd__io_err_line(r, HD_EFORMAT, line, "'property' needs a type and a name");
@@ -545,6 +553,7 @@ int hd__read_ply(hd__read_t *r) {
                                      (unsigned long long)r->tris->v[k], r->sink->count);
                 break;
             }
+    for (int k = 0; k < p->n_el; k++) free(p->el[k].props);
     free(p);
     return rc;
 }
