@@ -33,8 +33,14 @@ void cli_usage(FILE *out);
 /* The formats the reader knows, one per line (--formats). */
 void cli_formats(FILE *out);
 
-/* JSON output helpers: numbers with 17 significant digits, so that they
- * read back as the same double; strings escaped. */
+/* A double as the shortest text that reads back as the same double
+ * ("0.1", "5.9296880000000001" only when needed; numtext.c). */
+enum { NUM_TEXT = 32 };
+const char *num_text(double v, char buf[NUM_TEXT]);
+void num_print(FILE *out, double v);
+
+/* JSON output helpers: numbers as num_text prints them (null when not
+ * finite); strings escaped. */
 void json_number(FILE *out, double v);
 void json_string(FILE *out, const char *s);
 

@@ -1,14 +1,14 @@
 /*
- * json.c -- the few JSON writers the tool needs.  Doubles are printed with
- * 17 significant digits ("%.17g"), which is enough for every double to read
- * back as itself; non-finite values, which JSON cannot hold, become null.
+ * json.c -- the few JSON writers the tool needs.  Doubles are printed as
+ * the shortest text that reads back as the same double (num_text);
+ * non-finite values, which JSON cannot hold, become null.
  */
 #include "cli.h"
 
 #include <math.h>
 
 void json_number(FILE *out, double v) {
-    if (isfinite(v)) fprintf(out, "%.17g", v);
+    if (isfinite(v)) num_print(out, v);
     else fputs("null", out);
 }
 

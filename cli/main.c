@@ -17,6 +17,8 @@
  * fails) and a run that failed with out_discard (no file appears).
  */
 #include "cli.h"
+
+#include <math.h>
 #include "output.h"
 #include "progress.h"
 
@@ -49,7 +51,8 @@ static void witness_json(FILE *out, const hd_result_t *r) {
 static void print_point(FILE *out, const hd_points_t *p, size_t k) {
     double q[3];
     hd_points_get(p, k, q);
-    fprintf(out, "(%.17g, %.17g, %.17g)", q[0], q[1], q[2]);
+    char x[NUM_TEXT], y[NUM_TEXT], z[NUM_TEXT];
+    fprintf(out, "(%s, %s, %s)", num_text(q[0], x), num_text(q[1], y), num_text(q[2], z));
 }
 
 static void stats_json(FILE *out, const hd_stats_t *s) {
@@ -168,10 +171,11 @@ int main(int argc, char **argv) {
         json_string(out, a.path_a);
         fprintf(out, ", \"file_b\": ");
         json_string(out, a.path_b);
+        /* times are measurements: to the microsecond, then shortest */
         fprintf(out, ", \"seconds\": ");
-        json_number(out, s.seconds);
+        json_number(out, round(s.seconds * 1e6) / 1e6);
         fprintf(out, ", \"read_seconds\": ");
-        json_number(out, read_seconds);
+        json_number(out, round(read_seconds * 1e6) / 1e6);
         fprintf(out, ", \"stats_ab\": ");
         stats_json(out, &s.ab.stats);
         fprintf(out, ", \"stats_ba\": ");
@@ -187,11 +191,13 @@ int main(int argc, char **argv) {
         if (cb->n_faces) fprintf(out, "%s %zu faces", how, cb->n_faces);
         fprintf(out, ")\n");
         if (a.directed) {
-            fprintf(out, "h(A,B) = %.17g\n", s.ab.distance);
+            char d[NUM_TEXT];
+            fprintf(out, "h(A,B) = %s\n", num_text(s.ab.distance, d));
         } else {
-            fprintf(out, "Hausdorff distance H(A,B) = %.17g\n", s.distance);
-            fprintf(out, "  h(A,B) = %.17g   [%s]\n", s.ab.distance, hd_algorithm_name(s.ab.algorithm));
-            fprintf(out, "  h(B,A) = %.17g   [%s]\n", s.ba.distance, hd_algorithm_name(s.ba.algorithm));
+            char d[NUM_TEXT];
+            fprintf(out, "Hausdorff distance H(A,B) = %s\n", num_text(s.distance, d));
+            fprintf(out, "  h(A,B) = %s   [%s]\n", num_text(s.ab.distance, d), hd_algorithm_name(s.ab.algorithm));
+            fprintf(out, "  h(B,A) = %s   [%s]\n", num_text(s.ba.distance, d), hd_algorithm_name(s.ba.algorithm));
         }
         const hd_result_t *w = (a.directed || s.ab.distance2 >= s.ba.distance2) ? &s.ab : &s.ba;
         int from_a = w == &s.ab;

@@ -27,6 +27,7 @@
  * an output failure (exit status 3), never a quiet success.
  */
 #include "analysis.h"
+#include "cli.h"
 #include "output.h"
 
 #include <errno.h>
@@ -104,12 +105,15 @@ static int write_csv(FILE *f, const hd_points_t *P, const double *d,
     if (fputs("x,y,z,distance,nearest\n", f) == EOF) return write_errno();
     for (size_t k = 0; k < P->count; k++) {
         double q[3];
+        char t[4][NUM_TEXT];
         int n;
         hd_points_get(P, k, q);
         if (nearest)
-            n = fprintf(f, "%.17g,%.17g,%.17g,%.17g,%zu\n", q[0], q[1], q[2], d[k], nearest[k]);
+            n = fprintf(f, "%s,%s,%s,%s,%zu\n", num_text(q[0], t[0]), num_text(q[1], t[1]), num_text(q[2], t[2]),
+                        num_text(d[k], t[3]), nearest[k]);
         else
-            n = fprintf(f, "%.17g,%.17g,%.17g,%.17g,-1\n", q[0], q[1], q[2], d[k]);
+            n = fprintf(f, "%s,%s,%s,%s,-1\n", num_text(q[0], t[0]), num_text(q[1], t[1]), num_text(q[2], t[2]),
+                        num_text(d[k], t[3]));
         if (n < 0) return write_errno();
     }
     return 0;
@@ -119,14 +123,15 @@ static int write_ply(FILE *f, const hd_points_t *P, const double *d,
                      const size_t *nearest, double dmax) {
     int wide = 0;
     for (size_t k = 0; nearest && k < P->count; k++) wide |= nearest[k] > 2147483647u;
+    char dm[NUM_TEXT];
     if (fprintf(f, "ply\nformat binary_little_endian 1.0\n"
                "comment written by hausdorff %s: distance to the nearest point of the other set\n"
-               "comment colour: viridis, 0 to %.17g\n"
+               "comment colour: viridis, 0 to %s\n"
                "element vertex %zu\n"
                "property double x\nproperty double y\nproperty double z\n"
                "property double distance\nproperty %s nearest\n"
                "property uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n",
-                hd_version(), dmax, P->count, wide ? "double" : "int") < 0)
+                hd_version(), num_text(dmax, dm), P->count, wide ? "double" : "int") < 0)
         return write_errno();
     unsigned char rec[4 * 8 + 8 + 3];
     for (size_t k = 0; k < P->count; k++) {

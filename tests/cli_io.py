@@ -6,6 +6,7 @@ every format, standard input, --format, --formats, --sample, --version,
 """
 import json
 import os
+import re
 import pty
 import select
 import struct
@@ -234,6 +235,46 @@ def a_csv_with_a_header_on_standard_input_is_read_without_format(d):
     rc, out, err = run("--json", "-", os.path.join(DATA, "pinion_gear.ply"), stdin=b"x,y,z\r\n0,0,0\n1,1,1\n")
     assert rc == 0, err
     assert '"n_a": 2' in out, out
+
+
+def significant_digits(tok):
+    """Digits of a decimal token that carry value ("0.0708876" -> 6)."""
+    m = tok.lower().lstrip("+-").split("e")[0].replace(".", "")
+    m = m.lstrip("0").rstrip("0")
+    return max(len(m), 1)
+
+
+def assert_shortest(tok):
+    v = float(tok)
+    assert float(tok) == v
+    want = significant_digits(repr(v))  # Python's repr is the shortest round trip
+    assert significant_digits(tok) == want, "%s has more digits than %r" % (tok, v)
+
+
+NUMBER = re.compile(r"(?<![\w.])-?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?(?![\w.])")
+
+
+@test
+def every_number_printed_is_the_shortest_that_reads_back(d):
+    a, b = os.path.join(DATA, "cgal_lion.ply"), os.path.join(DATA, "cgal_lion_head.ply")
+    out_csv = os.path.join(d, "dist.csv")
+    rc, out, err = run("--json", "--distances", out_csv, a, b)
+    assert rc == 0, err
+    toks = NUMBER.findall(out)
+    assert len(toks) > 10, out
+    for t in toks:
+        assert_shortest(t)
+    assert '"seconds": ' in out
+    rc, text, err = run(a, b)
+    assert rc == 0, err
+    assert "(0.0708876, -0.102745, 0.223258)" in text, text  # once 0.070887599999999995, ...
+    for t in NUMBER.findall(text):
+        assert_shortest(t)
+    with open(out_csv) as f:
+        rows = f.read().split("\n")[1:200]
+    for row in rows:
+        for t in row.split(",")[:4] if row else []:
+            assert_shortest(t)
 
 
 class ReadingCli(unittest.TestCase):
