@@ -160,10 +160,9 @@ typedef enum hd_dtype { HD_FLOAT64 = 0, HD_FLOAT32 = 1 } hd_dtype_t;
  * Alignment: a packed view (stride 0 or 3 elements, cstride 0 or one
  * element) is read through double or float pointers, so `data` must be
  * aligned to the element, 8 bytes for doubles and 4 for floats, as every C
- * array of double or float is.  hd_index_build, hd_index_directed and
- * hd_index_nearest refuse a misaligned packed view with HD_EINVAL; no other
- * call may be passed one (copy it first).  A view with any other strides
- * is read byte by byte and may lie at any address. */
+ * array of double or float is.  Every call that takes points refuses a
+ * misaligned packed view with HD_EINVAL (copy it first).  A view with any
+ * other strides is read byte by byte and may lie at any address. */
 typedef struct hd_points {
     const void *data;
     size_t count;

@@ -35,7 +35,7 @@
  * points are checked (finite, within HD_MAX_COORD) before anything else,
  * once each: HD_ENONFINITE for a NaN or an infinity, HD_ERANGE beyond
  * HD_MAX_COORD, as for untransformed points.  Packed views must be aligned
- * to their element (check_aligned).
+ * to their element (hd__points_check refuses them otherwise).
  */
 #include "engine/engine.h"
 #include "nearest/nearest.h"
@@ -51,21 +51,9 @@ struct hd_index {
 
 /* A packed view is read through double or float pointers (hd__src_get's
  * packed kinds, and the packed loops of the builds), which C allows only at
- * addresses aligned to the element; a misaligned one is refused here, as
- * hausdorff.h says.  Views with other strides are read with memcpy and may
- * lie at any address. */
-static int check_aligned(const hd_points_t *p, const char *what, hd_error_t *err) {
-    hd__src_t s;
-    hd__src_init(&s, p, NULL);
-    ptrdiff_t el = p->dtype == HD_FLOAT32 ? (ptrdiff_t)sizeof(float) : (ptrdiff_t)sizeof(double);
-    if (s.cs == el && s.ps == 3 * el && (uintptr_t)p->data % (uintptr_t)el != 0)
-        return hd__err(err, HD_EINVAL,
-                       "point set %s: packed %s data must be aligned to %d bytes (its address is not a "
-                       "multiple of %d)",
-                       what, p->dtype == HD_FLOAT32 ? "float" : "double", (int)el, (int)el);
-    return HD_OK;
-}
-
+ * addresses aligned to the element; hd__points_check refuses a misaligned
+ * one, as hausdorff.h says.  Views with other strides are read with memcpy
+ * and may lie at any address. */
 int hd_index_build(const hd_points_t *B, const hd_options_t *opt, hd_index_t **out,
                    hd_error_t *err) {
     hd__err_clear(err);
@@ -75,7 +63,6 @@ int hd_index_build(const hd_points_t *B, const hd_options_t *opt, hd_index_t **o
         return hd__err(err, HD_EINVAL, "threads must be 0 (every core) or positive, not %d",
                        opt->threads);
     int rc = hd__points_check(B, "B", NULL, err);
-    if (rc == HD_OK) rc = check_aligned(B, "B", err);
     if (rc) return rc;
     hd_index_t *idx = calloc(1, sizeof *idx);
     if (!idx) return hd__err(err, HD_ENOMEM, "cannot allocate an index");
@@ -155,7 +142,6 @@ static int query_begin(const hd_index_t *idx, const hd_points_t *q, const char *
         return hd__err(err, HD_EINVAL, "threads must be 0 (every core) or positive, not %d",
                        opt->threads);
     int rc = hd__points_check(q, what, &c->box, err);
-    if (rc == HD_OK) rc = check_aligned(q, what, err);
     if (rc) return rc;
     hd__src_init(&c->src, q, T);
     c->n = q->count;

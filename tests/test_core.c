@@ -194,3 +194,42 @@ TEST(alpha_is_zero_when_touching_and_one_when_coinciding) {
     CHECK_RC(hd_overlap(&A, &F, &alpha, &disjoint, NULL), HD_OK);
     CHECK(alpha == 1.0 && !disjoint);
 }
+
+TEST(every_call_refuses_a_misaligned_packed_view_and_reads_a_strided_one_anywhere) {
+    size_t n = 50;
+    unsigned char *raw = malloc(24 * n + 8);
+    double *a = malloc(24 * n);
+    gen_rng_t r;
+    gen_seed(&r, 5);
+    gen_cube(&r, a, n, 0, 1);
+    memcpy(raw + 1, a, 24 * n);
+    hd_points_t bad = hd_points_f64(NULL, n), good = hd_points_f64(a, n);
+    bad.data = raw + 1; /* packed doubles one byte off */
+    hd_result_t res;
+    hd_symmetric_t sym;
+    hd_error_t e;
+    hd_options_t o;
+    hd_options_init(&o);
+    for (int alg = 0; alg < HD__ALG_COUNT; alg++) {
+        o.algorithm = (hd_algorithm_t)alg;
+        CONTEXT("algorithm %s", hd_algorithm_name(o.algorithm));
+        CHECK_RC(hd_directed(&bad, &good, &o, &res, &e), HD_EINVAL);
+        CHECK(strstr(e.message, "must be aligned to 8 bytes") != NULL);
+        CHECK_RC(hd_hausdorff(&good, &bad, &o, &sym, &e), HD_EINVAL);
+    }
+    double *d = malloc(n * sizeof *d);
+    CHECK_RC(hd_distances(&bad, &good, NULL, d, NULL, NULL, NULL, &e), HD_EINVAL);
+    /* the same points 32 bytes apart at an odd address: read anywhere */
+    unsigned char *raw2 = malloc(32 * n + 8);
+    for (size_t k = 0; k < n; k++) memcpy(raw2 + 1 + 32 * k, a + 3 * k, 24);
+    hd_points_t strided = hd_points_f64(NULL, n);
+    strided.data = raw2 + 1;
+    strided.stride = 32;
+    hd_options_init(&o);
+    CHECK_RC(hd_directed(&strided, &good, &o, &res, &e), HD_OK);
+    CHECK_BITS(res.distance, 0.0);
+    free(raw2);
+    free(d);
+    free(a);
+    free(raw);
+}

@@ -65,6 +65,18 @@ void hd__box_of(const double *xyz, size_t n, hd__box_t *out) {
     }
 }
 
+int hd__points_aligned(const hd_points_t *p, const char *what, hd_error_t *err) {
+    hd__src_t s;
+    hd__src_init(&s, p, NULL);
+    size_t el = p->dtype == HD_FLOAT32 ? sizeof(float) : sizeof(double);
+    if (s.kind != HD__SRC_ANY && (uintptr_t)p->data % el != 0)
+        return hd__err(err, HD_EINVAL,
+                       "point set %s: packed %s data must be aligned to %zu bytes (its address is not a "
+                       "multiple of %zu)",
+                       what, p->dtype == HD_FLOAT32 ? "float" : "double", el, el);
+    return HD_OK;
+}
+
 int hd__points_check(const hd_points_t *p, const char *what, hd__box_t *box,
                      hd_error_t *err) {
     if (!p) return hd__err(err, HD_EINVAL, "point set %s is NULL", what);
@@ -72,6 +84,8 @@ int hd__points_check(const hd_points_t *p, const char *what, hd__box_t *box,
     if (!p->data) return hd__err(err, HD_EINVAL, "point set %s has no data", what);
     if (p->dtype != HD_FLOAT64 && p->dtype != HD_FLOAT32)
         return hd__err(err, HD_EINVAL, "point set %s has an unknown element type", what);
+    int rc = hd__points_aligned(p, what, err);
+    if (rc) return rc;
     hd__box_t b;
     for (size_t k = 0; k < p->count; k++) {
         double q[3];

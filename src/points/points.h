@@ -169,6 +169,10 @@ HD__INLINE uint32_t hd__key30(const hd__keygrid_t *g, const double p[3]) {
 /* ---- point sets --------------------------------------------------------- */
 /* Validate a view (non-empty, finite, |c| <= HD_MAX_COORD) and compute its
  * box in the same pass.  `what` names the set in messages ("A", "B"). */
+/* HD_OK, or HD_EINVAL when a packed view (read through double or float
+ * pointers) is not aligned to its element; views with other strides are
+ * read byte by byte and may lie anywhere.  hd__points_check calls it. */
+int hd__points_aligned(const hd_points_t *p, const char *what, hd_error_t *err);
 int hd__points_check(const hd_points_t *p, const char *what, hd__box_t *box,
                      hd_error_t *err);
 

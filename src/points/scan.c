@@ -68,7 +68,8 @@ int hd__points_scan(const hd_points_t *p, const char *what, int threads, hd__box
         return hd__points_check(p, what, box, err);
     hd__src_t s;
     hd__src_init(&s, p, NULL);
-    if (s.kind == HD__SRC_ANY) return hd__points_check(p, what, box, err);
+    if (s.kind == HD__SRC_ANY || hd__points_aligned(p, what, NULL) != HD_OK)
+        return hd__points_check(p, what, box, err); /* which reports a misaligned view */
     scan_ctx c;
     c.p = p;
     c.n = p->count;
