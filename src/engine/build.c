@@ -39,6 +39,7 @@
  */
 #include "engine/engine.h"
 
+#include <assert.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -207,6 +208,24 @@ static void make_bucket(hd__tree_t *t, size_t b) {
     }
     /* sqrt(3) rounded up, and slack for the rounding of this product. */
     bk->err = err * 1.7320508075688776 * (1 + 1e-12);
+#ifndef NDEBUG
+    /* What the searches' proofs rest on, for valid (finite) points: the box
+     * encloses the bucket's points exactly, and each coordinate lies within
+     * err / sqrt(3) of its dequantised copy (hd__bucket_decode), so each
+     * point within err of it. */
+    double x[HD__BUCKET], y[HD__BUCKET], z[HD__BUCKET];
+    hd__bucket_decode(t, b, x, y, z);
+    int finite = 1;
+    for (int k = 0; k < m; k++)
+        finite &= isfinite(p[0][k]) && isfinite(p[1][k]) && isfinite(p[2][k]);
+    for (int k = 0; k < m && finite; k++) {
+        const double a[3] = {x[k], y[k], z[k]};
+        for (int c = 0; c < 3; c++) {
+            assert(p[c][k] >= bk->box.lo[c] && p[c][k] <= bk->box.hi[c]);
+            assert(fabs(p[c][k] - a[c]) * 1.7320508075688776 <= bk->err);
+        }
+    }
+#endif
 }
 
 static void bucket_task(void *vctx, size_t task, int worker) {
@@ -309,7 +328,10 @@ int hd__tree_build(hd__tree_t *t, const hd__src_t *src, size_t n, const hd__box_
         rc = HD_ENOMEM;
         goto done;
     }
-    for (size_t k = 0; k < n; k++) t->perm[k] = (uint32_t)keys[k];
+    for (size_t k = 0; k < n; k++) {
+        t->perm[k] = (uint32_t)keys[k];
+        assert(t->perm[k] < n);
+    }
     free(keys);
     keys = NULL;
     t->q = hd__malloc_array(t->nb, 3 * HD__BUCKET * sizeof *t->q);

@@ -34,6 +34,7 @@
  */
 #include "engine/engine.h"
 
+#include <assert.h>
 #include <math.h>
 #include <pthread.h>
 #include <stdio.h>
@@ -183,7 +184,17 @@ HD__HOT static int try_bucket(walk_t *s, group_t *g, size_t i, double cmax2) {
         double mn = hd__min32(d);
         if (mn > reach) continue;
         int arg = hd__find(d, mn);
+        assert(arg < mb); /* the padding repeats point 0, so a real point comes first */
         if (mn < lim) {
+#ifndef NDEBUG
+            /* The proof from both approximations: the two points, read
+             * exactly, lie strictly within cmax (NaN only if the caller's
+             * points broke the contract). */
+            double ea[3], eb[3];
+            hd__src_get(&s->c->ta->src, g->ia[k], ea);
+            hd__src_get(&tb->src, tb->perm[i * HD__BUCKET + (size_t)arg], eb);
+            assert(!(hd__d2(ea, eb) >= cmax2));
+#endif
             g->alive &= ~(1u << k);
             s->bc[0] = x[arg], s->bc[1] = y[arg], s->bc[2] = z[arg];
             s->bc_err = bb->err;
@@ -242,6 +253,7 @@ static void walk_bucket(walk_t *s, size_t bk) {
     g.tie2 = -1.0;
     for (int k = 0; k < g.m; k++) {
         g.ia[k] = ta->perm[g.first + (size_t)k];
+        assert(g.ia[k] < ta->n);
         if (g.ia[k] > s->snap.i) g.tie2 = s->snap.d2;
     }
     if (s->have_bc) {

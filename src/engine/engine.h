@@ -31,6 +31,7 @@
 
 #include "points/points.h"
 
+#include <assert.h>
 #include <pthread.h>
 
 /* Points per bucket (at most 32: live points are tracked in 32-bit masks). */
@@ -76,6 +77,7 @@ HD__INLINE const hd__box_t *hd__tree_box(const hd__tree_t *t, int level, size_t 
 }
 
 HD__INLINE int hd__bucket_size(const hd__tree_t *t, size_t b) {
+    assert(b < t->nb); /* so the size is 1 .. HD__BUCKET */
     size_t first = b * HD__BUCKET;
     return (int)(t->n - first < HD__BUCKET ? t->n - first : HD__BUCKET);
 }
@@ -97,6 +99,13 @@ HD__INLINE int hd__bucket_decode(const hd__tree_t *t, size_t b, double *x, doubl
         y[k] = bk->box.lo[1] + (double)q[HD__BUCKET + k] * sy;
         z[k] = bk->box.lo[2] + (double)q[2 * HD__BUCKET + k] * sz;
     }
+#ifndef NDEBUG
+    /* A short bucket is padded with copies of its point 0 (hd__min32 and
+     * hd__find rely on it: padding never comes before a real point). */
+    for (int k = m; k < HD__BUCKET; k++)
+        assert(q[k] == q[0] && q[HD__BUCKET + k] == q[HD__BUCKET] &&
+               q[2 * HD__BUCKET + k] == q[2 * HD__BUCKET]);
+#endif
     return m;
 }
 
@@ -121,6 +130,7 @@ HD__INLINE double hd__min32(const double *c) {
 HD__INLINE int hd__find(const double *c, double v) {
     int k = 0;
     while (k < HD__BUCKET && c[k] != v) k++;
+    assert(k < HD__BUCKET || __builtin_isnan(v)); /* c[k] == v unless v is NaN */
     return k < HD__BUCKET ? k : 0;
 }
 
@@ -154,13 +164,17 @@ HD__INLINE double hd__kill_below(double lim, double E) {
     double r = __builtin_sqrt(lim) * (1 - HD__SLACK) - E * (1 + HD__SLACK);
     if (r <= 0) return 0.0;
     double t = r * r * (1 - HD__SLACK);
+    /* With an error bound E >= 0, the threshold never exceeds lim. */
+    assert(!(E >= 0) || !(t > lim));
     return t > HD__TINY ? t : 0.0;
 }
 
 /* A computed c~ > hd__may_reach(best, E) proves hd__d2s(q, p) > best. */
 HD__INLINE double hd__may_reach(double best, double E) {
     double r = __builtin_sqrt(best) * (1 + HD__SLACK) + E * (1 + HD__SLACK);
-    return r * r * (1 + HD__SLACK) + HD__TINY;
+    double t = r * r * (1 + HD__SLACK) + HD__TINY;
+    assert(!(E >= 0) || !(t < best)); /* with E >= 0, a point beyond it is beyond best */
+    return t;
 }
 
 /* ---- searching ----------------------------------------------------------- */

@@ -57,6 +57,7 @@
  */
 #include "engine/engine.h"
 
+#include <assert.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -170,6 +171,8 @@ typedef struct {
  * or of any source (HD__SRC_ANY); a constant kind lets the compiler
  * specialise the loops below for the packed layouts. */
 HD__INLINE void src_point(const hd__src_t *s, hd__src_kind_t kind, size_t k, double p[3]) {
+    /* The packed paths read the layout directly and apply no transform. */
+    assert(kind == HD__SRC_ANY || (kind == s->kind && !s->T));
     if (kind == HD__SRC_F64) {
         const double *q = (const double *)(const void *)s->base + 3 * k;
         p[0] = q[0], p[1] = q[1], p[2] = q[2];
@@ -341,6 +344,7 @@ int hd__grid_build(hd__grid_t *g, const hd__src_t *src, size_t n, const hd__box_
             }
         }
         g->start[cells] = sum;
+        assert(sum == n); /* every point counted in exactly one cell */
         hd__parallel_for(c.parts, (size_t)c.parts, scatter_task, &c);
         hd__parallel_for(c.parts, (size_t)c.parts, rep_task, &c);
     }
@@ -505,6 +509,21 @@ static inline int cell_killed(const hd__box_t *box, const double *b, double cmax
     return hd__box_ub2(box, b) < cmax2;
 }
 
+#ifndef NDEBUG
+/* What discarding a cell whole claims: each of its points (perm[s..e) of
+ * g), read exactly, lies strictly within cmax2 of b (NaN only when the
+ * caller's points broke the contract). */
+static int cell_within(const hd__grid_t *g, uint32_t s, uint32_t e, const double *b,
+                       double cmax2) {
+    for (uint32_t k = s; k < e; k++) {
+        double a[3];
+        hd__src_get(&g->src, g->perm[k], a);
+        if (hd__d2(a, b) >= cmax2) return 0;
+    }
+    return 1;
+}
+#endif
+
 /* Points read this far ahead in a cell are prefetched. */
 #define PREFETCH 16
 
@@ -554,12 +573,14 @@ static void pass_task(void *vctx, size_t task, int worker) {
          * point of B that discarded something. */
         const double *rep = gb->rep + 3 * (size_t)cell_of(gb, mid);
         if (cell_killed(&box, rep, cmax2, n)) {
+            assert(cell_within(ga, s, e, rep, cmax2));
             memcpy(bc, rep, sizeof bc);
             bc_ok = 1;
             *culled += e - s;
             continue;
         }
         if (bc_ok && cell_killed(&box, bc, cmax2, n)) {
+            assert(cell_within(ga, s, e, bc, cmax2));
             *culled += e - s;
             continue;
         }
@@ -572,6 +593,7 @@ static void pass_task(void *vctx, size_t task, int worker) {
         if (e - s >= CELL_SEARCH_MIN && r > 0.5 * ga->w) {
             hd__grid_nearest(gb, mid, r * r, -1.0, &hit, n);
             if (cell_killed(&box, hit.p, cmax2, n)) {
+                assert(cell_within(ga, s, e, hit.p, cmax2));
                 memcpy(bc, hit.p, sizeof bc);
                 bc_ok = 1;
                 *culled += e - s;

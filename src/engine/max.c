@@ -11,6 +11,8 @@
  */
 #include "engine/engine.h"
 
+#include <assert.h>
+
 int hd__max_init(hd__max_t *m) {
     hd__bound_init(&m->cmax, 0.0);
     hd__best_init(&m->best);
@@ -20,6 +22,8 @@ int hd__max_init(hd__max_t *m) {
 void hd__max_destroy(hd__max_t *m) { pthread_mutex_destroy(&m->lock); }
 
 void hd__max_offer(hd__max_t *m, double d2, size_t i, size_t j, hd__best_t *snap) {
+    /* A squared distance of a real point (-1 would read as "nothing yet"). */
+    assert(!(d2 < 0) && i != HD__NONE);
     pthread_mutex_lock(&m->lock);
     hd__best_offer(&m->best, d2, i, j);
     if (snap) *snap = m->best;

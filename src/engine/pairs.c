@@ -60,6 +60,7 @@
  */
 #include "engine/engine.h"
 
+#include <assert.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -251,6 +252,9 @@ int hd__pairs_resolve(hd__pairs_t *P, const hd__src_t src[2], const hd__grid_t *
         size_t k = P->pos[d];
         for (; k < P->m; k++) {
             const pair_t *e = &P->list[k];
+            /* The rule covers the pairs after e only if they come in order. */
+            assert(k == 0 || !pair_before(e, &P->list[k - 1]));
+            assert(e->i < P->n);
             if (cannot_be_witness(e, &snap)) break;
             if (!grid && P->scanned >= (uint64_t)PAIR_SCANS * P->n) break; /* grids wanted */
             double q[3];
@@ -266,6 +270,8 @@ int hd__pairs_resolve(hd__pairs_t *P, const hd__src_t src[2], const hd__grid_t *
                 P->scanned += counts[d].exact - before;
             }
             if (hit.d2 < cmax2 || hit.d2 <= tie2) continue; /* not the witness */
+            /* A full search: the nearest distance is at most the pair's. */
+            assert(!(hit.d2 > e->d2));
             hd__max_offer(&max[d], hit.d2, e->i, hit.j, &snap);
         }
         P->pos[d] = k;
@@ -325,6 +331,12 @@ int hd__subset_resolve(const hd__src_t *small, size_t ns, const hd__src_t *large
         }
     }
     counts->evals += j0;
+#ifndef NDEBUG
+    /* The witness: point 0 of the small set is at squared distance 0 from j0. */
+    double w[3];
+    hd__src_get(large, j0, w);
+    assert(hd__d2(p, w) == 0.0);
+#endif
     hd__max_offer(max, 0.0, 0, j0, NULL);
     return 1;
 }

@@ -31,6 +31,7 @@
  */
 #include "engine/engine.h"
 
+#include <assert.h>
 #include <math.h>
 
 typedef struct {
@@ -46,7 +47,9 @@ typedef struct {
 static inline int exact_point(search_t *s, size_t b, int k) {
     const hd__tree_t *t = s->t;
     hd__hit_t *hit = s->hit;
+    assert(k < hd__bucket_size(t, b));
     size_t j = t->perm[b * HD__BUCKET + (size_t)k];
+    assert(j < t->n);
     double p[3];
     hd__src_get(&t->src, j, p);
     double d = hd__d2(s->q, p);
@@ -70,8 +73,16 @@ HD__HOT static int scan_bucket(search_t *s, size_t b) {
     for (int k = 0; k < HD__BUCKET; k++) c[k] = hd__d2s(qx, qy, qz, x[k], y[k], z[k]);
     s->n->evals += (uint64_t)m;
     int arg = hd__find(c, hd__min32(c));
+    assert(arg < m); /* the padding repeats point 0, so a real point comes first */
     double err = t->bucket[b].err;
     if (c[arg] < hd__kill_below(s->kill2, err)) {
+#ifndef NDEBUG
+        /* The early break's proof: the point, read exactly, lies strictly
+         * within kill2 (NaN only if the caller broke the contract). */
+        double e[3];
+        hd__src_get(&t->src, t->perm[b * HD__BUCKET + (size_t)arg], e);
+        assert(!(hd__d2(s->q, e) >= s->kill2));
+#endif
         hd__hit_t *hit = s->hit;
         hit->killed = 1;
         hit->bucket = b;
@@ -131,6 +142,7 @@ void hd__tree_nearest(const hd__tree_t *t, const double q[3], double stop2, doub
         if (stack[sp].lb2 > hit->d2) continue;
         int l = stack[sp].level;
         size_t i = stack[sp].i;
+        assert(l >= 0 && l < t->levels && i < t->count[l]);
         visited++;
         if (l == 0) {
             if (i != hint && scan_bucket(&s, i)) break;
