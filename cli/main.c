@@ -139,8 +139,11 @@ int main(int argc, char **argv) {
 
     FILE *out = stdout;
     if (a.json) {
+        /* with --directed H(A,B) is not computed: null, like directed_ba
+         * (it once held h(A,B), which a script could take for H) */
         fprintf(out, "{\"hausdorff\": ");
-        json_number(out, s.distance);
+        if (a.directed) fputs("null", out);
+        else json_number(out, s.distance);
         fprintf(out, ", \"directed_ab\": ");
         json_number(out, s.ab.distance);
         fprintf(out, ", \"directed_ba\": ");

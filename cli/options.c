@@ -65,7 +65,11 @@ void cli_usage(FILE *out) {
 void cli_formats(FILE *out) {
     fprintf(out, "Formats (chosen by extension, confirmed by content; --format NAME overrides):\n");
     for (const char *const *f = hd_formats(); *f; f++) fprintf(out, "  %-5s %s\n", *f, hd_format_description(*f));
-    fprintf(out, "Extensions: .ply .obj .off .stl; .xyz .txt .csv .pts .asc; .pcd .las .npy.\n"
+    fprintf(out, "  nifti NIfTI-1/2 segmentation masks (.nii, .nii.gz): the surface or every foreground voxel,\n"
+                 "        in millimetres (read by the tool, %s)\n",
+            nifti_available() ? "available" : "unavailable: built without libnifti2");
+    fprintf(out, "Extensions: .ply .obj .off .stl; .xyz .txt .csv .pts .asc; .pcd .las .npy; .nii .nii.gz.\n"
+                 "One file's format: FORMAT:PATH (xyz:-, ply:scan.dat).\n"
                  "LAZ is not read: convert it with 'laszip -i in.laz -o out.las' or 'pdal translate in.laz out.las'.\n");
 }
 
@@ -216,8 +220,10 @@ int cli_parse(int argc, char **argv, cli_args_t *a) {
     }
     a->read.seed = a->opt.seed; /* --seed also seeds --sample */
     if (nfiles != 2) {
-        fprintf(stderr, "hausdorff: expected two files, A and B\n");
-        cli_usage(stderr);
+        /* one line and a pointer, not the whole help */
+        fprintf(stderr, "hausdorff: expected two files, A and B, not %d\n"
+                        "usage: hausdorff [options] A B   (hausdorff --help lists the options)\n",
+                nfiles);
         return EXIT_USAGE;
     }
     a->path_a = split_format(files[0], &a->format_a);

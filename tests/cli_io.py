@@ -277,6 +277,19 @@ def every_number_printed_is_the_shortest_that_reads_back(d):
             assert_shortest(t)
 
 
+@test
+def small_surprises_of_a_first_hour_are_gone(d):
+    rc, out, err = run("--formats")
+    assert rc == 0 and "nifti" in out and ".nii.gz" in out, out
+    rc, out, err = run(os.path.join(DATA, "pinion_gear.ply"))
+    assert rc == 1 and "expected two files" in err and len(err.splitlines()) <= 3, err
+    p = os.path.join(DATA, "pinion_gear.ply")
+    rc, out, err = run("--json", "--directed", p, p)
+    assert rc == 0, err
+    r = json.loads(out)
+    assert r["hausdorff"] is None and r["directed_ab"] == 0 and r["directed_ba"] is None, r
+
+
 class ReadingCli(unittest.TestCase):
     """Each function above becomes one test, run in a fresh temporary directory."""
 

@@ -123,7 +123,7 @@ static const format_t formats[] = {
     {"obj", "obj", "Wavefront OBJ: 'v' lines; 'f' lines are the faces", hd__read_obj, NULL, 1},
     {"off", "off coff noff", "Object File Format: OFF, COFF, NOFF, CNOFF; faces", hd__read_off, magic_off, 1},
     {"stl", "stl", "STL: ascii or binary triangles (their corners are the vertices)", hd__read_stl, magic_stl, 1},
-    {"xyz", "xyz txt csv pts asc", "text: x y z per line, whitespace or comma separated, extra columns ignored",
+    {"xyz", "xyz txt csv pts asc", "text: x y z per line, separated by blanks and commas, or by semicolons with decimal commas; extra columns ignored",
      hd__read_xyz, NULL, 0},
     {"pcd", "pcd", "Point Cloud Library PCD v0.7: ascii, binary, binary_compressed; x y z of type F/I/U",
      hd__read_pcd, magic_pcd, 0},
