@@ -22,6 +22,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 int LLVMFuzzerInitialize(int *argc, char ***argv);
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
@@ -37,9 +38,15 @@ int LLVMFuzzerInitialize(int *argc, char ***argv) {
     return 0;
 }
 
-static int given(char **argv, int argc, const char *s) {
-    for (int k = 1; k < argc; k++)
-        if (argv[k] == s) return 1;
+/* s is an argument, or the path after a "FORMAT:" prefix of one (then
+ * `format` is that reader's name). */
+static int given(char **argv, int argc, const char *s, const char *format) {
+    for (int k = 1; k < argc; k++) {
+        if (argv[k] == s && !format) return 1;
+        if (format && s == argv[k] + strlen(format) + 1 && strncasecmp(argv[k], format, strlen(format)) == 0 &&
+            argv[k][strlen(format)] == ':')
+            return 1;
+    }
     return 0;
 }
 
@@ -72,7 +79,11 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
         const hd_options_t *o = &a.opt;
         const hd_read_options_t *r = &a.read;
         const analysis_args_t *an = &a.an;
-        if (!a.path_a || !a.path_b || !given(argv, argc, a.path_a) || !given(argv, argc, a.path_b)) abort();
+        if (!a.path_a || !a.path_b || !given(argv, argc, a.path_a, a.format_a) ||
+            !given(argv, argc, a.path_b, a.format_b))
+            abort();
+        if ((a.format_a && !hd_format_description(a.format_a)) || (a.format_b && !hd_format_description(a.format_b)))
+            abort();
         if (o->threads < 0 || o->threads > 1024 || o->depth < 1 || o->depth > 21) abort();
         if (!(o->lambda > 0 && o->lambda <= 1) || !(o->theta >= 0 && o->theta <= 1)) abort();
         hd_algorithm_t alg;
