@@ -311,11 +311,13 @@ int analysis_handle_empty(const analysis_args_t *an, const char *path_a,
     } else {
         fprintf(out, "A: %s (%zu points)\nB: %s (%zu points)\n", path_a, n_a, path_b, n_b);
         const char *which = !n_a && !n_b ? "A and B are" : !n_a ? "A is" : "B is";
-        fprintf(out, "%s = %g   (%s empty; --empty %s)\n", directed ? "h(A,B)" : "Hausdorff distance H(A,B)",
-                v, which, policy_name(an->empty));
-        if (an->percentile_on) fprintf(out, "percentile %g: %g\n", an->percentile, v);
-        if (an->mean) fprintf(out, "mean distance: %g\n", v);
-        if (an->chamfer) fprintf(out, "Chamfer distance: %g\n", v);
+        char t[NUM_TEXT], pt[NUM_TEXT];
+        num_text(v, t);
+        fprintf(out, "%s = %s   (%s empty; --empty %s)\n", directed ? "h(A,B)" : "Hausdorff distance H(A,B)", t,
+                which, policy_name(an->empty));
+        if (an->percentile_on) fprintf(out, "percentile %s: %s\n", num_text(an->percentile, pt), t);
+        if (an->mean) fprintf(out, "mean distance: %s\n", t);
+        if (an->chamfer) fprintf(out, "Chamfer distance: %s\n", t);
     }
     return EXIT_OK;
 }
@@ -544,29 +546,32 @@ void analysis_print(FILE *out, const analysis_args_t *an,
                 an->mask_points == MASK_ALL ? "foreground" : "surface");
     }
     if (!r->active) return;
+    char t[4][NUM_TEXT]; /* shortest text of each figure (numtext.c) */
     if (an->percentile_on) {
-        fprintf(out, "percentile P = %g of the per-point distances%s:\n", r->pct.p, unit);
-        fprintf(out, "  A->B %.17g\n", r->pct.ab);
+        fprintf(out, "percentile P = %s of the per-point distances%s:\n", num_text(r->pct.p, t[1]), unit);
+        fprintf(out, "  A->B %s\n", num_text(r->pct.ab, t[0]));
         if (!r->directed) {
-            fprintf(out, "  B->A %.17g\n", r->pct.ba);
-            fprintf(out, "  symmetric = max (MONAI) %.17g\n", r->pct.symmetric);
-            fprintf(out, "  pooled (medpy)          %.17g\n", r->pct.pooled);
+            fprintf(out, "  B->A %s\n", num_text(r->pct.ba, t[0]));
+            fprintf(out, "  symmetric = max (MONAI) %s\n", num_text(r->pct.symmetric, t[0]));
+            fprintf(out, "  pooled (medpy)          %s\n", num_text(r->pct.pooled, t[0]));
         }
     }
     if (an->mean) {
-        fprintf(out, "mean distance%s: A->B %.17g", unit, r->sum.mean_ab);
+        fprintf(out, "mean distance%s: A->B %s", unit, num_text(r->sum.mean_ab, t[0]));
         if (!r->directed)
-            fprintf(out, ", B->A %.17g\n  max (average Hausdorff) %.17g, average %.17g, pooled %.17g",
-                    r->sum.mean_ba, r->sum.mean_symmetric, r->sum.mean_average, r->sum.mean_pooled);
+            fprintf(out, ", B->A %s\n  max (average Hausdorff) %s, average %s, pooled %s",
+                    num_text(r->sum.mean_ba, t[0]), num_text(r->sum.mean_symmetric, t[1]), num_text(r->sum.mean_average, t[2]),
+                    num_text(r->sum.mean_pooled, t[3]));
         fputc('\n', out);
     }
     if (an->chamfer) {
         if (r->directed)
-            fprintf(out, "Chamfer distance, A->B only (mean squared distance): %.17g\n", r->sum.mean2_ab);
+            fprintf(out, "Chamfer distance, A->B only (mean squared distance): %s\n", num_text(r->sum.mean2_ab, t[0]));
         else
-            fprintf(out, "Chamfer distance (mean squared A->B + mean squared B->A) = %.17g\n"
-                         "  summed squares %.17g; unsquared: mean %.17g, sum %.17g\n",
-                    r->sum.chamfer, r->sum.chamfer_sum2, r->sum.chamfer_mean, r->sum.chamfer_sum);
+            fprintf(out, "Chamfer distance (mean squared A->B + mean squared B->A) = %s\n"
+                         "  summed squares %s; unsquared: mean %s, sum %s\n",
+                    num_text(r->sum.chamfer, t[0]), num_text(r->sum.chamfer_sum2, t[1]),
+                    num_text(r->sum.chamfer_mean, t[2]), num_text(r->sum.chamfer_sum, t[3]));
     }
     if (an->histogram) print_histogram(out, an, r);
     if (an->distances_out) {

@@ -258,16 +258,17 @@ NUMBER = re.compile(r"(?<![\w.])-?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?(?![\w.
 def every_number_printed_is_the_shortest_that_reads_back(d):
     a, b = os.path.join(DATA, "cgal_lion.ply"), os.path.join(DATA, "cgal_lion_head.ply")
     out_csv = os.path.join(d, "dist.csv")
-    rc, out, err = run("--json", "--distances", out_csv, a, b)
+    rc, out, err = run("--json", "--percentile", "95", "--mean", "--chamfer", "--distances", out_csv, a, b)
     assert rc == 0, err
     toks = NUMBER.findall(out)
     assert len(toks) > 10, out
     for t in toks:
         assert_shortest(t)
     assert '"seconds": ' in out
-    rc, text, err = run(a, b)
+    rc, text, err = run("--percentile", "95", "--mean", "--chamfer", a, b)
     assert rc == 0, err
     assert "(0.0708876, -0.102745, 0.223258)" in text, text  # once 0.070887599999999995, ...
+    assert "pooled (medpy)" in text and "Chamfer distance" in text, text
     for t in NUMBER.findall(text):
         assert_shortest(t)
     with open(out_csv) as f:
