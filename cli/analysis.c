@@ -77,9 +77,10 @@ void analysis_usage(FILE *out) {
 "  --mask-points surface|all  surface (default): foreground voxels with at\n"
 "                     least one 6-neighbour in the background or outside the\n"
 "                     image (as medpy and MONAI); all: every foreground voxel\n"
-"  --empty inf|nan|zero  an empty mask or file is an error by default; with\n"
-"                     this option every distance is reported as inf, NaN or\n"
-"                     0 instead (JSON: null for inf and NaN, with \"empty\")\n",
+"  --empty inf|nan|zero|monai  an empty mask or file is an error by default;\n"
+"                     with this option every distance is reported as inf, NaN\n"
+"                     or 0 instead; monai: inf when one set is empty, NaN when\n"
+"                     both are, as MONAI (JSON: null for inf and NaN, with \"empty\")\n",
             render_available() ? "" : " (unavailable: built without libpng)",
             render_available() ? "" : " (unavailable)",
             nifti_available() ? "" : " (unavailable: built without libnifti2)");
@@ -175,7 +176,8 @@ int analysis_parse_option(int argc, char **argv, int *k, analysis_args_t *an) {
         if (strcmp(v, "inf") == 0) an->empty = EMPTY_INF;
         else if (strcmp(v, "nan") == 0) an->empty = EMPTY_NAN;
         else if (strcmp(v, "zero") == 0) an->empty = EMPTY_ZERO;
-        else return usage_error("--empty is inf, nan or zero, not '%s'", v);
+        else if (strcmp(v, "monai") == 0) an->empty = EMPTY_MONAI;
+        else return usage_error("--empty is inf, nan, zero or monai, not '%s'", v);
         break;
     }
     return 1;
@@ -195,10 +197,12 @@ static int alloc_fail(hd_error_t *err, size_t n) {
 
 
 static const char *policy_name(empty_policy_t p) {
-    return p == EMPTY_INF ? "inf" : p == EMPTY_NAN ? "nan" : p == EMPTY_ZERO ? "zero" : "error";
+    return p == EMPTY_INF ? "inf" : p == EMPTY_NAN ? "nan" : p == EMPTY_ZERO ? "zero" : p == EMPTY_MONAI ? "monai" : "error";
 }
 
-static double policy_value(empty_policy_t p) {
+/* The value every figure takes when A (n_a points) or B (n_b) is empty. */
+static double policy_value(empty_policy_t p, size_t n_a, size_t n_b) {
+    if (p == EMPTY_MONAI) return n_a || n_b ? INFINITY : NAN; /* MONAI: inf for one, NaN for both */
     return p == EMPTY_INF ? INFINITY : p == EMPTY_NAN ? NAN : 0.0;
 }
 
@@ -280,7 +284,7 @@ int analysis_handle_empty(const analysis_args_t *an, const char *path_a,
                           const hd_points_t *B, int directed, int json) {
     size_t n_a = A->count, n_b = B->count;
     if (n_a && n_b) return -1;
-    double v = policy_value(an->empty);
+    double v = policy_value(an->empty, n_a, n_b);
     FILE *out = stdout;
     hd_error_t err;
     if (an->distances_out && write_empty_files(an, A, B, directed, v, &err) != HD_OK) {

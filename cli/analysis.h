@@ -11,7 +11,9 @@
 #include <stdint.h>
 #include <stdio.h>
 
-typedef enum { EMPTY_ERROR = 0, EMPTY_INF, EMPTY_NAN, EMPTY_ZERO } empty_policy_t;
+/* --empty: an error, or every figure inf, NaN or 0; MONAI's convention is
+ * inf when one set is empty and NaN when both are. */
+typedef enum { EMPTY_ERROR = 0, EMPTY_INF, EMPTY_NAN, EMPTY_ZERO, EMPTY_MONAI } empty_policy_t;
 typedef enum { MASK_SURFACE = 0, MASK_ALL } mask_points_t;
 
 /* What a mask file turned into (filled by cli_read_points). */

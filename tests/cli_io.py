@@ -291,6 +291,21 @@ def small_surprises_of_a_first_hour_are_gone(d):
     assert r["hausdorff"] is None and r["directed_ab"] == 0 and r["directed_ba"] is None, r
 
 
+@test
+def empty_monai_is_inf_for_one_empty_set_and_nan_for_two(d):
+    empty = write(d, "empty.xyz", "")
+    full = write(d, "full.xyz", "0 0 0\n1 1 1\n")
+    rc, out, err = run("--empty", "monai", "--mean", empty, full)
+    assert rc == 0 and "H(A,B) = inf" in out and "mean distance: inf" in out, (out, err)
+    rc, out, err = run("--empty", "monai", full, empty)
+    assert rc == 0 and "H(A,B) = inf" in out, (out, err)
+    rc, out, err = run("--empty", "monai", empty, empty)
+    assert rc == 0 and "H(A,B) = nan" in out, (out, err)
+    rc, out, err = run("--json", "--empty", "monai", empty, empty)
+    r = json.loads(out)
+    assert r["hausdorff"] is None and r["empty"]["policy"] == "monai", r
+
+
 class ReadingCli(unittest.TestCase):
     """Each function above becomes one test, run in a fresh temporary directory."""
 
