@@ -678,7 +678,7 @@ int cli_read_points(const char *path, const hd_read_options_t *ro,
     if (an->empty == EMPTY_ERROR) {
         size_t len = strlen(err->message);
         snprintf(err->message + len, sizeof err->message - len,
-                 " (an empty set has no distance; --empty inf|nan|zero reports one)");
+                 " (an empty set has no distance; --empty inf|nan|zero|monai reports one)");
         return rc;
     }
     if (!(*out = new_cloud(0, ro->dtype, "empty"))) return fail(err, HD_ENOMEM, path, "out of memory");

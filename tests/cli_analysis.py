@@ -303,12 +303,12 @@ def bad_analysis_options_are_usage_errors(tmp):
     for args, words in ((["--percentile", "101"], "[0, 100]"), (["--percentile", "x"], "percentile"),
                         (["--distances", "out.txt"], ".csv, .ply or .npy"),
                         (["--bins", "0"], "--bins"), (["--max-distance", "-1"], "positive"),
-                        (["--mask-points", "edges"], "surface or all"), (["--empty", "none"], "inf, nan or zero"),
+                        (["--mask-points", "edges"], "surface or all"), (["--empty", "none"], "inf, nan, zero or monai"),
                         (["--percentile"], "needs a value")):
         _, err = run([pa, pb] + args, expect=1)
         assert words in err, (args, err)
     out, _ = run(["--help"])
-    for words in ("--percentile P", "--mask-points surface|all", "--empty inf|nan|zero", "6-neighbour"):
+    for words in ("--percentile P", "--mask-points surface|all", "--empty inf|nan|zero|monai", "6-neighbour"):
         assert words in out, words
 
 
