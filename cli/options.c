@@ -4,11 +4,11 @@
  * line on stderr saying what was wrong.
  */
 #include "cli.h"
+#include "tiles.h"
 
 #include <errno.h>
 #include <stdlib.h>
 #include <string.h>
-#include <strings.h>
 
 void cli_usage(FILE *out) {
     fprintf(out,
@@ -124,22 +124,6 @@ static int parse_double(const char *s, double *out) {
     return 0;
 }
 
-/* A path written FORMAT:PATH, FORMAT a reader's name in any case ("xyz:-",
- * "PLY:scan.dat"): *format is the reader's name and the path follows the
- * colon.  Anything else is a path as it stands, *format NULL ("./ply:x"
- * names a file whose name holds a colon). */
-static const char *split_format(const char *s, const char **format) {
-    *format = NULL;
-    const char *colon = strchr(s, ':');
-    if (!colon || colon == s) return s;
-    for (const char *const *f = hd_formats(); *f; f++)
-        if (strlen(*f) == (size_t)(colon - s) && strncasecmp(*f, s, (size_t)(colon - s)) == 0) {
-            *format = *f;
-            return colon + 1;
-        }
-    return s;
-}
-
 int cli_parse(int argc, char **argv, cli_args_t *a) {
     memset(a, 0, sizeof *a);
     hd_options_init(&a->opt);
@@ -226,7 +210,7 @@ int cli_parse(int argc, char **argv, cli_args_t *a) {
                 nfiles);
         return EXIT_USAGE;
     }
-    a->path_a = split_format(files[0], &a->format_a);
-    a->path_b = split_format(files[1], &a->format_b);
+    a->path_a = tiles_split_format(files[0], &a->format_a);
+    a->path_b = tiles_split_format(files[1], &a->format_b);
     return -1;
 }

@@ -139,14 +139,13 @@ static int clash(const char *out, const char *other, int input) {
 }
 
 int out_check_paths(const char *const *outs, const char *const *what, int n,
-                    const char *path_a, const char *path_b) {
+                    const char *const *inputs, const char *side, size_t n_inputs) {
     for (int k = 0; k < n; k++) {
         if (!outs[k]) continue;
-        const char *in[2] = {path_a, path_b};
-        for (int w = 0; w < 2; w++)
-            if (clash(outs[k], in[w], 1)) {
+        for (size_t w = 0; w < n_inputs; w++)
+            if (clash(outs[k], inputs[w], 1)) {
                 fprintf(stderr, "hausdorff: %s %s would overwrite input %c (%s); name another file\n", what[k],
-                        outs[k], "AB"[w], is_stdin(in[w], 1) ? "standard input" : in[w]);
+                        outs[k], side[w], is_stdin(inputs[w], 1) ? "standard input" : inputs[w]);
                 return EXIT_USAGE;
             }
         for (int j = 0; j < k; j++)
