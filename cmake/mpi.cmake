@@ -18,6 +18,17 @@ if(HD_WITH_MPI AND MPI_C_FOUND)
   target_include_directories(hausdorff_mpi PUBLIC
     $<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include>)
   target_link_libraries(hausdorff_mpi PUBLIC hausdorff_static MPI::MPI_C m)
+  # The tool: cli/mpi/main.c over the tool's shared objects (report, tiles,
+  # options) and the MPI library.
+  add_executable(hausdorff_mpi_cli ${CMAKE_CURRENT_SOURCE_DIR}/cli/mpi/main.c)
+  set_target_properties(hausdorff_mpi_cli PROPERTIES OUTPUT_NAME hausdorff-mpi
+    RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR})
+  target_include_directories(hausdorff_mpi_cli PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/cli)
+  target_link_libraries(hausdorff_mpi_cli PRIVATE hd_cli_objects hausdorff_mpi)
+  install(TARGETS hausdorff_mpi hausdorff_mpi_cli
+    ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
+    RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+  install(FILES ${CMAKE_CURRENT_SOURCE_DIR}/include/hausdorff_mpi.h DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 else()
   message(STATUS "hausdorff: MPI not found: no hausdorff_mpi, hausdorff-mpi (Debian: libopenmpi-dev openmpi-bin)")
 endif()

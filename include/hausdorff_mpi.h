@@ -139,6 +139,15 @@ int hd_mpi_directed(MPI_Comm comm, const hd_mpi_part_t *a, size_t na,
                     const hd_options_t *opt, hd_result_t *out,
                     hd_mpi_stats_t *stats, hd_error_t *err);
 
+/* The overlap degree alpha and *disjoint of the bounding boxes of all of A
+ * and all of B, as hd_overlap() gives them on the union (hausdorff.h);
+ * with hd_mpi_directed it makes what hd_hausdorff's result holds besides
+ * the distances.  Collective; arguments and errors as hd_mpi_hausdorff
+ * (no options). */
+int hd_mpi_overlap(MPI_Comm comm, const hd_mpi_part_t *a, size_t na,
+                   const hd_mpi_part_t *b, size_t nb, double *alpha,
+                   int *disjoint, hd_error_t *err);
+
 #ifdef __cplusplus
 }
 #endif

@@ -254,6 +254,10 @@ static void check_equal(int which, int how, uint64_t seed) {
         rc = hd_mpi_directed(MPI_COMM_WORLD, pa, na, pb, nb, &opt, &d, NULL, &err);
         CHECK(rc == HD_OK);
         CHECK(SAME_BITS(d.distance2, ref.ab.distance2) && d.i == ref.ab.i && d.j == ref.ab.j);
+        double alpha = -1;
+        int disjoint = -1;
+        CHECK(hd_mpi_overlap(MPI_COMM_WORLD, pa, na, pb, nb, &alpha, &disjoint, &err) == HD_OK);
+        CHECK(SAME_BITS(alpha, ref.alpha) && disjoint == ref.disjoint);
     }
     free(s.a);
     free(s.b);

@@ -843,8 +843,13 @@ static int check_local(ctx_t *c, const hd_options_t *opt, input_t *in, const voi
     return HD_OK;
 }
 
+enum { MODE_DIRECTED = 0, MODE_BOTH = 1, MODE_OVERLAP = 2 };
+typedef struct { double *alpha; int *disjoint; } overlap_t;
+
+/* `both` is a MODE_*: res is an hd_result_t, an hd_symmetric_t or an
+ * overlap_t. */
 static int run(ctx_t *c, const hd_options_t *opt, input_t *in, int both, void *res, hd_mpi_stats_t *st) {
-    hd_symmetric_t *out = both ? res : NULL;
+    hd_symmetric_t *out = both == MODE_BOTH ? res : NULL;
     int K = c->K;
     double t0 = hd__now();
     node_t *tree = NULL;
@@ -867,6 +872,10 @@ static int run(ctx_t *c, const hd_options_t *opt, input_t *in, int both, void *r
     for (int s = 0; s < 2; s++)
         for (int k = 0; k < 3; k++) corners[s][k] = gb[6 * s + k], corners[s][3 + k] = -gb[6 * s + 3 + k];
     hd_points_t ca = hd_points_f64(corners[0], 2), cb = hd_points_f64(corners[1], 2);
+    if (both == MODE_OVERLAP) {
+        overlap_t *o = res;
+        return hd_overlap(&ca, &cb, o->alpha, o->disjoint, &c->e);
+    }
     memset(res, 0, both ? sizeof(hd_symmetric_t) : sizeof(hd_result_t));
     if (both && (rc = hd_overlap(&ca, &cb, &out->alpha, &out->disjoint, &c->e)) != HD_OK) return rc;
 
@@ -999,10 +1008,17 @@ static int call(MPI_Comm comm, const hd_mpi_part_t *a, size_t na, const hd_mpi_p
 
 int hd_mpi_hausdorff(MPI_Comm comm, const hd_mpi_part_t *a, size_t na, const hd_mpi_part_t *b, size_t nb,
                      const hd_options_t *opt, hd_symmetric_t *out, hd_mpi_stats_t *stats, hd_error_t *err) {
-    return call(comm, a, na, b, nb, opt, 1, out, stats, err);
+    return call(comm, a, na, b, nb, opt, MODE_BOTH, out, stats, err);
 }
 
 int hd_mpi_directed(MPI_Comm comm, const hd_mpi_part_t *a, size_t na, const hd_mpi_part_t *b, size_t nb,
                     const hd_options_t *opt, hd_result_t *out, hd_mpi_stats_t *stats, hd_error_t *err) {
-    return call(comm, a, na, b, nb, opt, 0, out, stats, err);
+    return call(comm, a, na, b, nb, opt, MODE_DIRECTED, out, stats, err);
+}
+
+int hd_mpi_overlap(MPI_Comm comm, const hd_mpi_part_t *a, size_t na, const hd_mpi_part_t *b, size_t nb,
+                   double *alpha, int *disjoint, hd_error_t *err) {
+    overlap_t o = {alpha, disjoint};
+    if (!alpha || !disjoint) o.alpha = NULL; /* refused by check_local, on every rank */
+    return call(comm, a, na, b, nb, NULL, MODE_OVERLAP, o.alpha ? &o : NULL, NULL, err);
 }
