@@ -97,10 +97,14 @@ typedef struct hd_mpi_stats {
                                    counted as points */
     double seconds_max;         /* the slowest rank's time in the call */
     double seconds_mean;
+    double search_seconds_max;  /* the most a rank spent in the per-point
+                                   searches (its own points and the
+                                   queries it answered) */
     uint64_t peak_bytes_max;    /* most bytes a rank held in the buffers of
                                    this call (not counting hd_distances'
                                    own, about 32-60 a point) */
     double seconds;             /* this rank: time in the call */
+    double search_seconds;      /* this rank: time in the searches */
     uint64_t local_points;      /* this rank: points after the partition */
     uint64_t peak_bytes;        /* this rank: peak of the buffers above */
 } hd_mpi_stats_t;

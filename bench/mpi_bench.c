@@ -1,0 +1,194 @@
+/*
+ * mpi_bench.c -- the exchange figures of hd_mpi_hausdorff (docs/scale-out.md):
+ *     mpirun -n K build/bench/mpi_bench [--points N] [--per-rank] [--cases LIST]
+ *                                       [--layout random|tiles] [--threads T]
+ *                                       [--check]
+ * For each case, every rank generates its share of A and B (N points per
+ * side in total, or per rank with --per-rank: weak scaling), and one call
+ * of hd_mpi_hausdorff is timed; rank 0 prints one line per case with the
+ * figures the targets of issue 14 name: bytes moved per input point (the
+ * partition's and the forwarding's), the fraction of points forwarded,
+ * the imbalance (largest rank's points, and its points plus answered
+ * queries, over the mean), the peak of the call's own buffers per local
+ * point, the growth of the peak RSS per local point, and times (the
+ * slowest rank's total and search).  --check compares with hd_hausdorff on
+ * rank 0 (all points gathered; small N only).
+ *
+ * Cases:
+ *  - uniform: A and B independent, uniform in a cube.
+ *  - lidar: two epochs of a 1 km x 1 km LiDAR-like scene: terrain (a smooth
+ *    height field), a city quarter four times denser with box buildings
+ *    (roofs and walls), a lake with no points at all; epoch B is another
+ *    sampling of the same scene, one building demolished and one new.
+ *  - copy: B is A with noise of 1 cm on a 1 km scene (a re-registered
+ *    scan), same point order.
+ * Layouts: "random" (each rank's points spread over the whole scene: every
+ * point may move) or "tiles" (rank r generates the strip r of K in x, as a
+ * rank reading its share of tile files does: most points stay).
+ */
+#include <hausdorff_mpi.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/resource.h>
+
+#include "gen.h"
+
+static int rank_, K_;
+
+/* ---- the scenes ---------------------------------------------------------- */
+
+static double terrain(double x, double y) {
+    return 20 * sin(x / 170.0) * cos(y / 130.0) + 5 * sin(x / 37.0 + y / 53.0);
+}
+
+static int in_lake(double x, double y) { return (x - 780) * (x - 780) + (y - 300) * (y - 300) < 200.0 * 200.0; }
+
+static int in_city(double x, double y) { return x < 400 && y > 500; }
+
+/* Building height at (x, y) in the given epoch, 0 outside: 20 m squares
+ * on a 30 m grid in the city; building (3, 3) demolished in epoch 1, and
+ * one new in the park at (600, 700) in epoch 1. */
+static double building(double x, double y, int epoch) {
+    if (epoch == 1 && fabs(x - 600) < 10 && fabs(y - 700) < 10) return 15;
+    if (!in_city(x, y)) return 0;
+    int i = (int)(x / 30), j = (int)((y - 500) / 30);
+    double u = x - 30 * i, v = (y - 500) - 30 * j;
+    if (u < 5 || u > 25 || v < 5 || v > 25) return 0;
+    if (epoch == 1 && i == 3 && j == 3) return 0;
+    return 10 + (double)((i * 7 + j * 13) % 5) * 6;
+}
+
+/* n points of the scene in x in [xlo, xhi). */
+static void lidar(gen_rng_t *g, double *p, size_t n, double xlo, double xhi, int epoch) {
+    for (size_t k = 0; k < n;) {
+        double x = xlo + (xhi - xlo) * gen_unit(g), y = 1000 * gen_unit(g);
+        if (in_lake(x, y)) continue;                            /* water: no returns */
+        if (!in_city(x, y) && gen_unit(g) >= 0.25) continue;   /* the city is 4x denser */
+        double h = building(x, y, epoch), z = terrain(x, y) + 0.05 * gen_normal(g);
+        if (h > 0) {
+            if (gen_unit(g) < 0.8) z += h; /* roof */
+            else z += h * gen_unit(g);     /* wall-ish returns */
+        }
+        p[3 * k] = x, p[3 * k + 1] = y, p[3 * k + 2] = z;
+        k++;
+    }
+}
+
+static void make(const char *which, int tiles, uint64_t seed, double *a, double *b, size_t n) {
+    gen_rng_t g;
+    gen_seed(&g, seed * 1000003 + (uint64_t)rank_);
+    double xlo = tiles ? 1000.0 * rank_ / K_ : 0, xhi = tiles ? 1000.0 * (rank_ + 1) / K_ : 1000;
+    if (strcmp(which, "uniform") == 0) {
+        for (size_t k = 0; k < n; k++) {
+            a[3 * k] = xlo + (xhi - xlo) * gen_unit(&g), a[3 * k + 1] = 1000 * gen_unit(&g),
+            a[3 * k + 2] = 1000 * gen_unit(&g);
+            b[3 * k] = xlo + (xhi - xlo) * gen_unit(&g), b[3 * k + 1] = 1000 * gen_unit(&g),
+            b[3 * k + 2] = 1000 * gen_unit(&g);
+        }
+    } else if (strcmp(which, "lidar") == 0) {
+        lidar(&g, a, n, xlo, xhi, 0);
+        lidar(&g, b, n, xlo, xhi, 1);
+    } else { /* copy */
+        lidar(&g, a, n, xlo, xhi, 0);
+        for (size_t k = 0; k < 3 * n; k++) b[k] = a[k] + 0.01 * gen_normal(&g);
+    }
+}
+
+static double maxrss(void) {
+    struct rusage ru;
+    return getrusage(RUSAGE_SELF, &ru) == 0 ? 1024.0 * (double)ru.ru_maxrss : 0;
+}
+
+int main(int argc, char **argv) {
+    MPI_Init(&argc, &argv);
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
+    MPI_Comm_size(MPI_COMM_WORLD, &K_);
+    size_t N = 1000000;
+    int per_rank = 0, tiles = 0, threads = 1, check = 0;
+    const char *cases = "uniform,lidar,copy";
+    for (int k = 1; k < argc; k++) {
+        if (!strcmp(argv[k], "--points") && k + 1 < argc) N = (size_t)atof(argv[++k]);
+        else if (!strcmp(argv[k], "--per-rank")) per_rank = 1;
+        else if (!strcmp(argv[k], "--cases") && k + 1 < argc) cases = argv[++k];
+        else if (!strcmp(argv[k], "--layout") && k + 1 < argc) tiles = !strcmp(argv[++k], "tiles");
+        else if (!strcmp(argv[k], "--threads") && k + 1 < argc) threads = atoi(argv[++k]);
+        else if (!strcmp(argv[k], "--check")) check = 1;
+        else {
+            if (rank_ == 0) fprintf(stderr, "mpi_bench: unknown argument %s\n", argv[k]);
+            MPI_Finalize();
+            return 1;
+        }
+    }
+    size_t n = per_rank ? N : N / (size_t)K_ + ((size_t)rank_ < N % (size_t)K_);
+    size_t offset = per_rank ? n * (size_t)rank_ : N / (size_t)K_ * (size_t)rank_ +
+                                                       ((size_t)rank_ < N % (size_t)K_ ? (size_t)rank_ : N % (size_t)K_);
+    double *a = malloc(3 * n * sizeof(double) + 8), *b = malloc(3 * n * sizeof(double) + 8);
+    if (!a || !b) {
+        fprintf(stderr, "mpi_bench: out of memory\n");
+        MPI_Abort(MPI_COMM_WORLD, 1);
+    }
+    if (rank_ == 0)
+        printf("# mpi_bench: %d ranks, %zu points per side%s, layout %s, %d thread(s) per rank\n"
+               "# case     points  B/pt(part) B/pt(fwd) fwd%%    imbal work-imbal buf B/pt rss B/pt "
+               "time(s) search(s) search ns/pt\n",
+               K_, N, per_rank ? " per rank" : "", tiles ? "tiles" : "random", threads);
+    char list[256];
+    snprintf(list, sizeof list, "%s", cases);
+    for (char *c = strtok(list, ","); c; c = strtok(NULL, ",")) {
+        make(c, tiles, 7, a, b, n);
+        hd_mpi_part_t pa = {hd_points_f64(a, n), offset}, pb = {hd_points_f64(b, n), offset};
+        hd_options_t opt;
+        hd_options_init(&opt);
+        opt.threads = threads;
+        hd_symmetric_t r;
+        hd_mpi_stats_t st;
+        hd_error_t err;
+        double rss0 = maxrss();
+        MPI_Barrier(MPI_COMM_WORLD);
+        int rc = hd_mpi_hausdorff(MPI_COMM_WORLD, &pa, 1, &pb, 1, &opt, &r, &st, &err);
+        if (rc != HD_OK) {
+            if (rank_ == 0) fprintf(stderr, "mpi_bench: %s\n", err.message);
+            MPI_Abort(MPI_COMM_WORLD, 1);
+        }
+        double grow = (maxrss() - rss0) / (double)(st.local_points ? st.local_points : 1), most = 0;
+        MPI_Reduce(&grow, &most, 1, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD);
+        uint64_t tot = st.points;
+        if (rank_ == 0)
+            printf("%-8s %9llu %9.2f %9.3f %7.3f %6.3f %8.3f %10.1f %10.1f %8.3f %8.3f %8.1f\n", c,
+                   (unsigned long long)tot, (double)st.bytes_partition / (double)tot,
+                   (double)st.bytes_forwarding / (double)tot, 100.0 * (double)st.forwarded_points / (double)tot,
+                   st.imbalance, st.work_imbalance, (double)st.peak_bytes_max / ((double)tot / K_), most,
+                   st.seconds_max, st.search_seconds_max, 1e9 * st.search_seconds_max / ((double)tot / K_));
+        if (check) { /* gather everything on rank 0 and compare */
+            double *all[2] = {NULL, NULL};
+            int cnt = (int)(3 * n), *cnts = malloc((size_t)K_ * sizeof(int)), *disp = malloc((size_t)K_ * sizeof(int));
+            MPI_Gather(&cnt, 1, MPI_INT, cnts, 1, MPI_INT, 0, MPI_COMM_WORLD);
+            int total = 0;
+            for (int q = 0; rank_ == 0 && q < K_; q++) disp[q] = total, total += cnts[q];
+            for (int s = 0; s < 2; s++) {
+                if (rank_ == 0) all[s] = malloc((size_t)total * sizeof(double));
+                MPI_Gatherv(s ? b : a, cnt, MPI_DOUBLE, all[s], cnts, disp, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+            }
+            if (rank_ == 0) {
+                hd_points_t A = hd_points_f64(all[0], (size_t)total / 3), B = hd_points_f64(all[1], (size_t)total / 3);
+                hd_symmetric_t ref;
+                hd_hausdorff(&A, &B, NULL, &ref, &err);
+                int same = ref.distance == r.distance && ref.ab.i == r.ab.i && ref.ab.j == r.ab.j &&
+                           ref.ba.i == r.ba.i && ref.ba.j == r.ba.j;
+                printf("#   check: %s (H = %.17g)\n", same ? "identical to hd_hausdorff" : "DIFFERS", r.distance);
+            }
+            free(all[0]);
+            free(all[1]);
+            free(cnts);
+            free(disp);
+        }
+        fflush(stdout);
+    }
+    free(a);
+    free(b);
+    MPI_Finalize();
+    return 0;
+}
