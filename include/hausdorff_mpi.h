@@ -90,6 +90,9 @@ typedef struct hd_mpi_stats {
                                    their answers (16 each) */
     uint64_t forwarded;         /* (point, rank) queries forwarded */
     uint64_t forwarded_points;  /* points forwarded to one rank or more */
+    uint64_t shell_points;      /* points searched one by one, in both
+                                   directions (the shells: the others are
+                                   settled by the engine's pruned pass) */
     int rounds;                 /* forwarding rounds (one per direction) */
     uint64_t points_max;        /* most points (A and B) a rank computed on */
     double imbalance;           /* points_max over the mean per rank */

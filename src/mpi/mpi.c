@@ -85,7 +85,8 @@ typedef struct ctx {
     hd_error_t e;
     size_t cur, peak;          /* bytes of this call's buffers */
     uint64_t bytes_part, bytes_fwd, forwarded, forwarded_points, answered;
-    double search;             /* seconds in hd_distances (local and answers) */
+    double search;             /* seconds in the engine and hd_distances */
+    uint64_t shell;            /* points searched one by one (the shells) */
     int rounds;
     MPI_Datatype rec_type, ans_type, q_type, far_type, sample_type, node_type;
     MPI_Op far_op;
@@ -306,13 +307,116 @@ typedef struct {
     const double *Q;         /* local points searched */
     const uint64_t *gQ;
     size_t nQ;
-    const size_t *nearest;   /* local nearest in Q of each P (NULL if nQ = 0) */
     int qside;               /* 0: Q is A, 1: Q is B */
 } dir_t;
 
+/* 1 when every finite face of region r is farther from p than u2 allows
+ * (computed fl(gap^2) > u2): then no point of another region is within u2
+ * of p, nor at u2 (see the essay, step 4). */
+static int faces_clear(const hd__box_t *r, const double *p, double u2) {
+    for (int a = 0; a < 3; a++) {
+        if (isfinite(r->lo[a])) {
+            double g = p[a] - r->lo[a];
+            if (!(g * g > u2)) return 0;
+        }
+        if (isfinite(r->hi[a])) {
+            double g = r->hi[a] - p[a];
+            if (!(g * g > u2)) return 0;
+        }
+    }
+    return 1;
+}
+
+/* The engine's pass over one direction.  hd_directed(P, Q) on the local
+ * sets gives h2, the largest u(a)^2 of the rank, with its witness: so
+ * u(a)^2 <= h2 for every local a, and a point whose faces are clear of h2
+ * is confirmed without a search of its own (the interior).  The interior's
+ * exact maximum is the engine's own answer when the engine's witness is
+ * interior (it is then the smallest index at h2), else one more engine
+ * call on the interior alone.  The other points (the shell) get per-point
+ * searches (hd_distances).  The engine prunes the points that cannot be the
+ * farthest, which per-point searches cannot: on two epochs of one scene it
+ * is tens of times faster (docs/scale-out.md), and the shell is the points
+ * within h of the region's faces. */
+typedef struct {
+    const double *xyz;       /* the shell's points (P itself when all are) */
+    const uint64_t *g;
+    size_t n;
+    size_t *nearest;         /* each one's nearest in Q (NULL if Q is empty) */
+    double *own_xyz;         /* what was allocated for a proper subset */
+    uint64_t *own_g;
+    far_t inner;             /* exact over the interior; d2 = -1 if none */
+} shell_t;
+
+static void shell_free(ctx_t *c, shell_t *sh) {
+    cfree(c, sh->own_xyz, sh->n, 3 * sizeof(double));
+    cfree(c, sh->own_g, sh->n, sizeof(uint64_t));
+    cfree(c, sh->nearest, sh->n, sizeof(size_t));
+}
+
+static int shell_of(ctx_t *c, const dir_t *d, const hd__box_t *mine, shell_t *sh) {
+    memset(sh, 0, sizeof *sh);
+    sh->inner = (far_t){-1.0, UINT64_MAX, UINT64_MAX};
+    sh->xyz = d->P;
+    sh->g = d->gP;
+    sh->n = d->nP;
+    if (d->nP == 0 || d->nQ == 0) return HD_OK;
+    hd_points_t Pv = hd_points_f64(d->P, d->nP), Qv = hd_points_f64(d->Q, d->nQ);
+    hd_options_t o;
+    hd_options_init(&o);
+    o.threads = c->threads;
+    hd_result_t e;
+    int rc = hd_directed(&Pv, &Qv, &o, &e, &c->e);
+    if (rc != HD_OK) return rc;
+    unsigned char *in = cmalloc(c, d->nP, 1);
+    if (!in) return nomem(c, "the interior", d->nP);
+    size_t nI = 0;
+    for (size_t k = 0; k < d->nP; k++) nI += in[k] = (unsigned char)faces_clear(mine, d->P + 3 * k, e.distance2);
+    size_t nS = d->nP - nI;
+    if (nI && in[e.i]) {
+        sh->inner = (far_t){e.distance2, d->gP[e.i], d->gQ[e.j]};
+    } else if (nI) {
+        double *ixyz = cmalloc(c, nI, 3 * sizeof(double));
+        size_t *idx = cmalloc(c, nI, sizeof(size_t));
+        if (!ixyz || !idx) rc = nomem(c, "the interior", nI);
+        for (size_t k = 0, t = 0; k < d->nP && rc == HD_OK; k++)
+            if (in[k]) {
+                memcpy(ixyz + 3 * t, d->P + 3 * k, 3 * sizeof(double));
+                idx[t++] = k;
+            }
+        hd_points_t Iv = hd_points_f64(ixyz, nI);
+        if (rc == HD_OK && (rc = hd_directed(&Iv, &Qv, &o, &e, &c->e)) == HD_OK)
+            sh->inner = (far_t){e.distance2, d->gP[idx[e.i]], d->gQ[e.j]};
+        cfree(c, ixyz, nI, 3 * sizeof(double));
+        cfree(c, idx, nI, sizeof(size_t));
+    }
+    if (rc == HD_OK && nS && nI) { /* a proper subset: copied */
+        sh->n = nS;
+        sh->own_xyz = cmalloc(c, nS, 3 * sizeof(double));
+        sh->own_g = cmalloc(c, nS, sizeof(uint64_t));
+        if (!sh->own_xyz || !sh->own_g) rc = nomem(c, "the shell", nS);
+        for (size_t k = 0, t = 0; k < d->nP && rc == HD_OK; k++)
+            if (!in[k]) {
+                memcpy(sh->own_xyz + 3 * t, d->P + 3 * k, 3 * sizeof(double));
+                sh->own_g[t++] = d->gP[k];
+            }
+        sh->xyz = sh->own_xyz;
+        sh->g = sh->own_g;
+    }
+    sh->n = nS;
+    cfree(c, in, d->nP, 1);
+    if (rc == HD_OK && nS) {
+        sh->nearest = cmalloc(c, nS, sizeof(size_t));
+        if (!sh->nearest) return nomem(c, "nearest neighbours", nS);
+        hd_points_t Sv = hd_points_f64(sh->xyz, nS);
+        rc = hd_distances(&Sv, &Qv, &o, NULL, sh->nearest, NULL, NULL, &c->e);
+    }
+    return rc;
+}
+
 typedef struct { size_t k; int dest; int pad; } pair_t;
 
-static int pack_queries(ctx_t *c, const dir_t *d, const pair_t *pairs, size_t np, int *scount, int *sdispl,
+static int pack_queries(ctx_t *c, const double *P, const pair_t *pairs, size_t np, int *scount, int *sdispl,
                         double **send, size_t **order) {
     for (int r = 0; r < c->K; r++) scount[r] = 0;
     for (size_t t = 0; t < np; t++) scount[pairs[t].dest]++;
@@ -329,7 +433,7 @@ static int pack_queries(ctx_t *c, const dir_t *d, const pair_t *pairs, size_t np
     memcpy(fill, sdispl, (size_t)c->K * sizeof(int));
     for (size_t t = 0; t < np; t++) {
         size_t at = (size_t)fill[pairs[t].dest]++;
-        memcpy(*send + 3 * at, d->P + 3 * pairs[t].k, 3 * sizeof(double));
+        memcpy(*send + 3 * at, P + 3 * pairs[t].k, 3 * sizeof(double));
         (*order)[at] = pairs[t].k;
     }
     cfree(c, fill, (size_t)c->K, sizeof(int));
@@ -360,7 +464,15 @@ static int answer(ctx_t *c, const dir_t *d, const double *q, size_t m, ans_t *an
 static int direction(ctx_t *c, const dir_t *d, const node_t *tree, const hd__box_t *region,
                      const held_t *held, far_t *result) {
     int K = c->K, rc = HD_OK;
-    size_t nP = d->nP, np = 0, cap = 0;
+    const hd__box_t *mine = &region[c->rank];
+    shell_t sh;
+    double t0 = hd__now();
+    rc = shell_of(c, d, mine, &sh);
+    c->search += hd__now() - t0;
+    c->shell += sh.n;
+    size_t nP = sh.n, np = 0, cap = 0;
+    const double *P = sh.xyz;
+    const uint64_t *gP = sh.g;
     double *u2 = cmalloc(c, nP, sizeof(double));
     uint64_t *jj = cmalloc(c, nP, sizeof(uint64_t));
     unsigned char *exact = cmalloc(c, nP, 1);
@@ -371,34 +483,22 @@ static int direction(ctx_t *c, const dir_t *d, const node_t *tree, const hd__box
     double *sendq = NULL, *recvq = NULL;
     size_t *order = NULL, m = 0;
     ans_t *ans = NULL, *back = NULL;
-    if (!u2 || !jj || !exact || !nbox || !list || !cnt) rc = nomem(c, "per-point bounds", nP);
-    const hd__box_t *mine = &region[c->rank];
-    far_t Lmine = {-1.0, UINT64_MAX, UINT64_MAX}, Lall;
+    if (rc == HD_OK && (!u2 || !jj || !exact || !nbox || !list || !cnt)) rc = nomem(c, "per-point bounds", nP);
+    far_t Lmine = sh.inner, Lall;
     if (rc == HD_OK) {
         for (size_t k = 0; k < nP; k++) {
-            const double *p = d->P + 3 * k;
+            const double *p = P + 3 * k;
             if (d->nQ == 0) {
                 u2[k] = INFINITY;
                 jj[k] = UINT64_MAX;
                 exact[k] = 0;
                 continue;
             }
-            u2[k] = hd__d2(p, d->Q + 3 * d->nearest[k]);
-            jj[k] = d->gQ[d->nearest[k]];
-            int ok = 1;
-            for (int a = 0; a < 3 && ok; a++) {
-                if (isfinite(mine->lo[a])) {
-                    double g = p[a] - mine->lo[a];
-                    ok = g * g > u2[k];
-                }
-                if (ok && isfinite(mine->hi[a])) {
-                    double g = mine->hi[a] - p[a];
-                    ok = g * g > u2[k];
-                }
-            }
-            exact[k] = (unsigned char)ok;
-            far_t f = {u2[k], d->gP[k], jj[k]};
-            if (ok && far_better(&f, &Lmine)) Lmine = f;
+            u2[k] = hd__d2(p, d->Q + 3 * sh.nearest[k]);
+            jj[k] = d->gQ[sh.nearest[k]];
+            exact[k] = (unsigned char)faces_clear(mine, p, u2[k]);
+            far_t f = {u2[k], gP[k], jj[k]};
+            if (exact[k] && far_better(&f, &Lmine)) Lmine = f;
         }
         if (K > 1) node_boxes(tree, 0, held, d->qside, nbox);
     }
@@ -410,8 +510,8 @@ static int direction(ctx_t *c, const dir_t *d, const node_t *tree, const hd__box
     uint64_t iL = Lall.i;
     /* The points to forward, as (point, rank) pairs. */
     for (size_t k = 0; k < nP && rc == HD_OK; k++) {
-        if (exact[k] || u2[k] < L || (u2[k] == L && d->gP[k] > iL)) continue;
-        const double *p = d->P + 3 * k;
+        if (exact[k] || u2[k] < L || (u2[k] == L && gP[k] > iL)) continue;
+        const double *p = P + 3 * k;
         double bound = u2[k];
         if (d->nQ == 0)
             for (int r = 0; r < K; r++)
@@ -443,7 +543,7 @@ static int direction(ctx_t *c, const dir_t *d, const node_t *tree, const hd__box
     }
     int *scount = cnt, *sdispl = cnt + K, *rcount = cnt + 2 * K, *rdispl = cnt + 3 * K;
     if (rc == HD_OK && np > INT_MAX) rc = hd__err(&c->e, HD_EOVERFLOW, "%zu forwarded queries exceed MPI's int counts", np);
-    if (rc == HD_OK) rc = pack_queries(c, d, pairs, np, scount, sdispl, &sendq, &order);
+    if (rc == HD_OK) rc = pack_queries(c, P, pairs, np, scount, sdispl, &sendq, &order);
     if ((rc = agree(c, rc)) != HD_OK) goto done;
     MPI_GO(c, rc, MPI_Alltoall(scount, 1, MPI_INT, rcount, 1, MPI_INT, c->comm));
     for (int r = 0; r < K; r++) {
@@ -478,10 +578,10 @@ static int direction(ctx_t *c, const dir_t *d, const node_t *tree, const hd__box
     }
     /* Every point that could win is now exact; the others cannot win (a
      * point at L with a larger index than i_L loses to i_L). */
-    far_t best = {-1.0, UINT64_MAX, UINT64_MAX};
+    far_t best = sh.inner;
     for (size_t k = 0; k < nP; k++) {
-        if (u2[k] < L || (u2[k] == L && d->gP[k] > iL)) continue;
-        far_t f = {u2[k], d->gP[k], jj[k]};
+        if (u2[k] < L || (u2[k] == L && gP[k] > iL)) continue;
+        far_t f = {u2[k], gP[k], jj[k]};
         if (far_better(&f, &best)) best = f;
     }
     MPI_GO(c, rc, MPI_Allreduce(&best, result, 1, c->far_type, c->far_op, c->comm));
@@ -498,6 +598,7 @@ done:
     cfree(c, recvq, m, 3 * sizeof(double));
     cfree(c, ans, m, sizeof(ans_t));
     cfree(c, back, np, sizeof(ans_t));
+    shell_free(c, &sh);
     return rc;
 }
 
@@ -509,6 +610,16 @@ typedef struct {
     uint64_t n[2];            /* local points of A, B (input) */
     hd__box_t box[2];         /* local boxes (input) */
 } input_t;
+
+/* Point k of a view: packed doubles directly, anything else through
+ * hd_points_get (the exchange reads every point twice). */
+static inline void get_point(const hd_points_t *p, size_t k, double out[3]) {
+    if (p->dtype == HD_FLOAT64 && (p->stride == 0 || p->stride == 3 * (ptrdiff_t)sizeof(double)) &&
+        (p->cstride == 0 || p->cstride == (ptrdiff_t)sizeof(double)))
+        memcpy(out, (const double *)p->data + 3 * k, 3 * sizeof(double));
+    else
+        hd_points_get(p, k, out);
+}
 
 /* Part k of side s in increasing offset order (parts do not share
  * indices, so this is increasing global index order). */
@@ -605,7 +716,7 @@ static int partition(ctx_t *c, const input_t *in, uint64_t N, node_t *tree) {
         cursor_t cu = {0, 0, 0};
         cursor_seek(in, at, &cu);
         const hd_mpi_part_t *p = &in->parts[cu.side][cu.part];
-        hd_points_get(&p->points, cu.k, mine[t].x);
+        get_point(&p->points, cu.k, mine[t].x);
         mine[t].g = p->offset + cu.k;
         mine[t].side = (uint64_t)cu.side;
     }
@@ -705,7 +816,7 @@ static int exchange(ctx_t *c, const input_t *in, const node_t *tree, local_t *lo
             for (size_t p = 0; p < in->nparts[s]; p++)
                 for (size_t k = 0; k < order[s][p]->points.count; k++) {
                     double x[3];
-                    hd_points_get(&order[s][p]->points, k, x);
+                    get_point(&order[s][p]->points, k, x);
                     int r = rank_of(tree, K, x, (uint64_t)s, order[s][p]->offset + k);
                     dest[t++] = r;
                     fill[2 * r + s]++;
@@ -735,7 +846,7 @@ static int exchange(ctx_t *c, const input_t *in, const node_t *tree, local_t *lo
             for (size_t p = 0; p < in->nparts[s]; p++)
                 for (size_t k = 0; k < order[s][p]->points.count; k++) {
                     rec_t *r = &send[fill[2 * dest[t++] + s]++];
-                    hd_points_get(&order[s][p]->points, k, r->x);
+                    get_point(&order[s][p]->points, k, r->x);
                     r->g = order[s][p]->offset + k;
                 }
     }
@@ -752,7 +863,7 @@ static int exchange(ctx_t *c, const input_t *in, const node_t *tree, local_t *lo
         else {
             rdispl[r] = (int)m;
             rcount[r] = (int)here;
-            m += here;
+            if (r != c->rank) m += here; /* its own stay in the send buffer */
             loc->n[0] += (size_t)rcn[2 * r];
             loc->n[1] += (size_t)rcn[2 * r + 1];
         }
@@ -763,9 +874,13 @@ static int exchange(ctx_t *c, const input_t *in, const node_t *tree, local_t *lo
         if (!recv) rc = nomem(c, "points received", m);
     }
     if ((rc = agree(c, rc)) != HD_OK) goto done;
+    /* What stays on this rank is merged from the send buffer, not copied
+     * through MPI. */
+    int me = c->rank, keep_s = scount[me], keep_r = rcount[me];
+    scount[me] = rcount[me] = 0;
     MPI_GO(c, rc, MPI_Alltoallv(send, scount, sdispl, c->rec_type, recv, rcount, rdispl, c->rec_type, c->comm));
-    cfree(c, send, scap, sizeof(rec_t));
-    send = NULL;
+    scount[me] = keep_s;
+    rcount[me] = keep_r;
     runs = cmalloc(c, (size_t)K, sizeof(run_t));
     heap = cmalloc(c, (size_t)K, sizeof(int));
     for (int s = 0; s < 2; s++) {
@@ -776,7 +891,7 @@ static int exchange(ctx_t *c, const input_t *in, const node_t *tree, local_t *lo
     if (!runs || !heap) rc = nomem(c, "the merge", (size_t)K);
     for (int s = 0; s < 2 && rc == HD_OK; s++) {
         for (int r = 0; r < K; r++) {
-            const rec_t *b = recv + rdispl[r] + (s ? rcn[2 * r] : 0);
+            const rec_t *b = (r == me ? send + sdispl[r] : recv + rdispl[r]) + (s ? rcn[2 * r] : 0);
             runs[r] = (run_t){b, b + rcn[2 * r + s]};
         }
         merge_runs(runs, K, heap, loc->xyz[s], loc->g[s]);
@@ -860,7 +975,6 @@ static int run(ctx_t *c, const hd_options_t *opt, input_t *in, int both, void *r
     hd__box_t *region = NULL;
     held_t *held = NULL;
     local_t loc = {{NULL, NULL}, {NULL, NULL}, {0, 0}};
-    size_t *near[2] = {NULL, NULL};
     int rc = check_local(c, opt, in, res);
     if ((rc = agree(c, rc)) != HD_OK) return rc;
     if ((rc = check_ranges(c, in)) != HD_OK) return rc;
@@ -904,25 +1018,9 @@ static int run(ctx_t *c, const hd_options_t *opt, input_t *in, int both, void *r
     }
     MPI_GO(c, rc, MPI_Allgather(&h, (int)sizeof h, MPI_BYTE, held, (int)sizeof h, MPI_BYTE, c->comm));
 
-    /* Local nearest neighbours, both directions at once. */
-    for (int s = 0; s < (both ? 2 : 1); s++) {
-        near[s] = cmalloc(c, loc.n[s], sizeof(size_t));
-        if (!near[s]) rc = nomem(c, "nearest neighbours", loc.n[s]);
-    }
-    if (rc == HD_OK && loc.n[0] && loc.n[1]) {
-        hd_points_t A = hd_points_f64(loc.xyz[0], loc.n[0]), B = hd_points_f64(loc.xyz[1], loc.n[1]);
-        hd_options_t o;
-        hd_options_init(&o);
-        o.threads = c->threads;
-        double t = hd__now();
-        rc = hd_distances(&A, &B, &o, NULL, near[0], NULL, both ? near[1] : NULL, &c->e);
-        c->search += hd__now() - t;
-    }
-    if ((rc = agree(c, rc)) != HD_OK) goto done;
     far_t f[2];
     for (int s = 0; s < (both ? 2 : 1); s++) {
-        dir_t d = {loc.xyz[s], loc.g[s], loc.n[s], loc.xyz[1 - s], loc.g[1 - s], loc.n[1 - s],
-                   loc.n[1 - s] ? near[s] : NULL, 1 - s};
+        dir_t d = {loc.xyz[s], loc.g[s], loc.n[s], loc.xyz[1 - s], loc.g[1 - s], loc.n[1 - s], 1 - s};
         if ((rc = direction(c, &d, tree, region, held, &f[s])) != HD_OK) goto done;
     }
     hd_result_t *r[2] = {both ? &out->ab : res, both ? &out->ba : NULL};
@@ -945,7 +1043,7 @@ static int run(ctx_t *c, const hd_options_t *opt, input_t *in, int both, void *r
     }
     if (st) {
         uint64_t pts = loc.n[0] + loc.n[1], work = pts + c->answered;
-        uint64_t sums[6] = {c->bytes_part, c->bytes_fwd, c->forwarded, c->forwarded_points, work, 0}, gs[6];
+        uint64_t sums[6] = {c->bytes_part, c->bytes_fwd, c->forwarded, c->forwarded_points, work, c->shell}, gs[6];
         uint64_t maxes[3] = {pts, work, c->peak}, gm[3];
         MPI_GO(c, rc, MPI_Allreduce(sums, gs, 6, MPI_UINT64_T, MPI_SUM, c->comm));
         MPI_GO(c, rc, MPI_Allreduce(maxes, gm, 3, MPI_UINT64_T, MPI_MAX, c->comm));
@@ -956,6 +1054,7 @@ static int run(ctx_t *c, const hd_options_t *opt, input_t *in, int both, void *r
         st->bytes_forwarding = gs[1];
         st->forwarded = gs[2];
         st->forwarded_points = gs[3];
+        st->shell_points = gs[5];
         st->rounds = c->rounds;
         st->points_max = gm[0];
         st->imbalance = (double)gm[0] * K / (double)st->points;
@@ -971,7 +1070,6 @@ static int run(ctx_t *c, const hd_options_t *opt, input_t *in, int both, void *r
     }
 done:
     for (int s = 0; s < 2; s++) {
-        cfree(c, near[s], loc.n[s], sizeof(size_t));
         cfree(c, loc.xyz[s], loc.n[s], 3 * sizeof(double));
         cfree(c, loc.g[s], loc.n[s], sizeof(uint64_t));
     }
