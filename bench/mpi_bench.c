@@ -10,8 +10,12 @@
  * partition's and the forwarding's), the fraction of points forwarded,
  * the imbalance (largest rank's points, and its points plus answered
  * queries, over the mean), the peak of the call's own buffers per local
- * point, the growth of the peak RSS per local point, and times (the
- * slowest rank's total and search).  --check compares with hd_hausdorff on
+ * point, the growth of the peak RSS per local point (meaningful for the
+ * first case of a run only: later ones reuse freed memory), times (the
+ * slowest rank's total and search, wall clock), the largest CPU time of a
+ * rank per local point (the per-point cost for the model: with more ranks
+ * than cores it includes MPI's busy waiting), and the share of points
+ * searched one by one (the shells).  --check compares with hd_hausdorff on
  * rank 0 (all points gathered; small N only).
  *
  * Cases:
@@ -33,6 +37,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/resource.h>
+#include <time.h>
 
 #include "gen.h"
 
@@ -97,6 +102,12 @@ static void make(const char *which, int tiles, uint64_t seed, double *a, double 
     }
 }
 
+static double cpu_now(void) {
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
 static double maxrss(void) {
     struct rusage ru;
     return getrusage(RUSAGE_SELF, &ru) == 0 ? 1024.0 * (double)ru.ru_maxrss : 0;
@@ -133,7 +144,7 @@ int main(int argc, char **argv) {
     if (rank_ == 0)
         printf("# mpi_bench: %d ranks, %zu points per side%s, layout %s, %d thread(s) per rank\n"
                "# case     points  B/pt(part) B/pt(fwd) fwd%%    imbal work-imbal buf B/pt rss B/pt "
-               "time(s) search(s) search ns/pt\n",
+               "time(s) search(s) search ns/pt cpu ns/pt shell%% searchcpu ns/pt\n",
                K_, N, per_rank ? " per rank" : "", tiles ? "tiles" : "random", threads);
     char list[256];
     snprintf(list, sizeof list, "%s", cases);
@@ -148,7 +159,10 @@ int main(int argc, char **argv) {
         hd_error_t err;
         double rss0 = maxrss();
         MPI_Barrier(MPI_COMM_WORLD);
+        double cpu0 = cpu_now();
         int rc = hd_mpi_hausdorff(MPI_COMM_WORLD, &pa, 1, &pb, 1, &opt, &r, &st, &err);
+        double cpu = (cpu_now() - cpu0) / (double)(st.local_points ? st.local_points : 1), cpumax = 0;
+        MPI_Reduce(&cpu, &cpumax, 1, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD);
         if (rc != HD_OK) {
             if (rank_ == 0) fprintf(stderr, "mpi_bench: %s\n", err.message);
             MPI_Abort(MPI_COMM_WORLD, 1);
@@ -157,11 +171,13 @@ int main(int argc, char **argv) {
         MPI_Reduce(&grow, &most, 1, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD);
         uint64_t tot = st.points;
         if (rank_ == 0)
-            printf("%-8s %9llu %9.2f %9.3f %7.3f %6.3f %8.3f %10.1f %10.1f %8.3f %8.3f %8.1f\n", c,
+            printf("%-8s %9llu %9.2f %9.3f %7.3f %6.3f %8.3f %10.1f %10.1f %8.3f %8.3f %8.1f %8.1f %7.3f %8.1f\n", c,
                    (unsigned long long)tot, (double)st.bytes_partition / (double)tot,
                    (double)st.bytes_forwarding / (double)tot, 100.0 * (double)st.forwarded_points / (double)tot,
                    st.imbalance, st.work_imbalance, (double)st.peak_bytes_max / ((double)tot / K_), most,
-                   st.seconds_max, st.search_seconds_max, 1e9 * st.search_seconds_max / ((double)tot / K_));
+                   st.seconds_max, st.search_seconds_max, 1e9 * st.search_seconds_max / ((double)tot / K_),
+                   1e9 * cpumax, 100.0 * (double)st.shell_points / (double)tot,
+                   1e9 * st.search_cpu_max / ((double)tot / K_));
         if (check) { /* gather everything on rank 0 and compare */
             double *all[2] = {NULL, NULL};
             int cnt = (int)(3 * n), *cnts = malloc((size_t)K_ * sizeof(int)), *disp = malloc((size_t)K_ * sizeof(int));

@@ -103,6 +103,9 @@ typedef struct hd_mpi_stats {
     double search_seconds_max;  /* the most a rank spent in the per-point
                                    searches (its own points and the
                                    queries it answered) */
+    double search_cpu_max;      /* the same in CPU seconds of the calling
+                                   thread: with opt->threads = 1 the
+                                   searches' own cost, whatever the load */
     uint64_t peak_bytes_max;    /* most bytes a rank held in the buffers of
                                    this call (not counting hd_distances'
                                    own, about 32-60 a point) */

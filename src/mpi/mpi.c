@@ -24,18 +24,30 @@
  *     index order, so each rank receives K sorted runs per set and merges
  *     them: local order is global index order, and a local "smallest index
  *     on ties" is the global one.
- *  3. hd_distances (the single-machine engine's exact all-nearest search)
- *     gives, for each local a, its nearest local b (smallest index on ties);
- *     u(a)^2 = hd__d2(a, b) is the exact minimum over local B, an upper
- *     bound on the minimum over all of B.
+ *  3. The single-machine engine on each rank's part: hd_directed(local A,
+ *     local B) gives h2, the rank's largest u(a)^2, where u(a)^2 is the
+ *     exact minimum over local B (an upper bound on the minimum over all
+ *     of B).  Every a whose region faces are clear of h2 (step 4's test
+ *     with h2 >= u(a)^2) is settled without a search of its own, and the
+ *     largest of those is the engine's answer (or one more engine call on
+ *     them alone when the engine's witness is not among them).  The rest,
+ *     the shell within h of the faces, get per-point searches
+ *     (hd_distances: the nearest local b, smallest index on ties).  The
+ *     engine prunes the points that cannot be the farthest, which
+ *     per-point searches cannot: on two epochs of one scene that is tens
+ *     of times less work.
  *  4. a is *confirmed* when every finite face of its region is strictly
  *     farther than u(a): a point b beyond the face at s on axis k has
  *     |fl(a_k - b_k)| >= |fl(a_k - s)| (rounding is monotone), and the
  *     squared sum keeps that order (points/points.h), so hd__d2(a, b) >=
  *     fl(gap^2) > u(a)^2: no other rank holds a point as near, nor one that
- *     ties.  L, the largest confirmed u^2 over all ranks (one allreduce), is
- *     a lower bound on h(A,B)^2: a point with u(a)^2 < L cannot be the
- *     witness and is never forwarded.
+ *     ties.  L, the largest confirmed u^2 over all ranks with the smallest
+ *     index i_L of a confirmed point at L (one allreduce), bounds h(A,B)^2
+ *     from below: a point with u(a)^2 < L, or u(a)^2 = L and an index above
+ *     i_L, cannot be the witness and is never forwarded.  (Skipping every
+ *     u(a)^2 <= L would lose ties: a point at exactly L with a smaller
+ *     index is the witness, and its smallest-index nearest point may lie on
+ *     another rank; tests/mpi_api.c's checkerboard fails that way.)
  *  5. Every other a with u(a)^2 >= L is sent to each rank whose box of B
  *     points lies within u(a) (hd__box_lb2 <= u^2: a computed lower bound
  *     no larger than the computed distance to any point inside, so every
@@ -68,6 +80,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/mman.h>
+#include <time.h>
 
 #define SAMPLES_PER_RANK 1024
 
@@ -87,11 +100,20 @@ typedef struct ctx {
     size_t cur, peak;          /* bytes of this call's buffers */
     uint64_t bytes_part, bytes_fwd, forwarded, forwarded_points, answered;
     double search;             /* seconds in the engine and hd_distances */
+    double search_cpu;         /* the calling thread's CPU seconds there */
     uint64_t shell;            /* points searched one by one (the shells) */
     int rounds;
     MPI_Datatype rec_type, ans_type, q_type, far_type, sample_type, node_type;
     MPI_Op far_op;
 } ctx_t;
+
+/* CPU seconds of the calling thread (the searches' own cost with one
+ * thread, whatever else the machine runs). */
+static double thread_cpu(void) {
+    struct timespec ts;
+    if (clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts) != 0) return 0;
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
 
 /* ---- memory: every buffer counted, so the peak can be reported ---------- */
 
@@ -481,9 +503,10 @@ static int direction(ctx_t *c, const dir_t *d, const node_t *tree, const hd__box
     int K = c->K, rc = HD_OK;
     const hd__box_t *mine = &region[c->rank];
     shell_t sh;
-    double t0 = hd__now();
+    double t0 = hd__now(), u0 = thread_cpu();
     rc = shell_of(c, d, mine, &sh);
     c->search += hd__now() - t0;
+    c->search_cpu += thread_cpu() - u0;
     c->shell += sh.n;
     size_t nP = sh.n, np = 0, cap = 0;
     const double *P = sh.xyz;
@@ -575,9 +598,10 @@ static int direction(ctx_t *c, const dir_t *d, const node_t *tree, const hd__box
     }
     if ((rc = agree(c, rc)) != HD_OK) goto done;
     MPI_GO(c, rc, MPI_Alltoallv(sendq, scount, sdispl, c->q_type, recvq, rcount, rdispl, c->q_type, c->comm));
-    double t = hd__now();
+    double t = hd__now(), u = thread_cpu();
     rc = answer(c, d, recvq, m, ans);
     c->search += hd__now() - t;
+    c->search_cpu += thread_cpu() - u;
     c->answered += m;
     if ((rc = agree(c, rc)) != HD_OK) goto done;
     MPI_GO(c, rc, MPI_Alltoallv(ans, rcount, rdispl, c->ans_type, back, scount, sdispl, c->ans_type, c->comm));
@@ -1047,8 +1071,8 @@ static int run(ctx_t *c, const hd_options_t *opt, input_t *in, int both, void *r
         r[s]->algorithm = HD_ALG_AUTO;
     }
     /* Figures. */
-    double secs = hd__now() - t0, tmax = secs, tsum = secs, mine[2] = {secs, c->search}, most[2];
-    MPI_GO(c, rc, MPI_Allreduce(mine, most, 2, MPI_DOUBLE, MPI_MAX, c->comm));
+    double secs = hd__now() - t0, tmax = secs, tsum = secs, mine[3] = {secs, c->search, c->search_cpu}, most[3];
+    MPI_GO(c, rc, MPI_Allreduce(mine, most, 3, MPI_DOUBLE, MPI_MAX, c->comm));
     tmax = most[0];
     MPI_GO(c, rc, MPI_Allreduce(&secs, &tsum, 1, MPI_DOUBLE, MPI_SUM, c->comm));
     for (int s = 0; s < (both ? 2 : 1); s++) r[s]->seconds = tmax;
@@ -1078,6 +1102,7 @@ static int run(ctx_t *c, const hd_options_t *opt, input_t *in, int both, void *r
         st->seconds_mean = tsum / K;
         st->search_seconds_max = most[1];
         st->search_seconds = c->search;
+        st->search_cpu_max = most[2];
         st->peak_bytes_max = gm[2];
         st->seconds = secs;
         st->local_points = pts;
