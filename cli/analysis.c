@@ -94,7 +94,8 @@ void analysis_usage(FILE *out) {
 "  --empty inf|nan|zero|monai  an empty mask or file is an error by default;\n"
 "                     with this option every distance is reported as inf, NaN\n"
 "                     or 0 instead; monai: inf when one set is empty, NaN when\n"
-"                     both are, as MONAI (JSON: null for inf and NaN, with \"empty\")\n",
+"                     both are, as MONAI (JSON: null for inf and NaN, and an\n"
+"                     \"empty\" member)\n",
             render_available() ? "" : " (unavailable: built without libpng)",
             render_available() ? "" : " (unavailable)",
             nifti_available() ? "" : " (unavailable: built without libnifti2)");
@@ -514,8 +515,8 @@ void analysis_json(FILE *out, const analysis_args_t *an,
         fputc('}', out);
     }
     if (!r->active) return;
-    fprintf(out, ", \"distances_seconds\": ");
-    json_number(out, r->seconds);
+    fprintf(out, ", \"distances_seconds\": "); /* to the microsecond, as "seconds" */
+    json_number(out, round(r->seconds * 1e6) / 1e6);
     json_figures(out, an, r);
     if (r->hist_ab) {
         fprintf(out, ", \"histogram\": {\"bins\": %zu, \"range\": [", an->bins);

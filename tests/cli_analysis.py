@@ -361,6 +361,8 @@ def bad_analysis_options_are_usage_errors(tmp):
     out, _ = run(["--help"])
     for words in ("--percentile P", "--mask-points surface|all", "--empty inf|nan|zero|monai", "6-neighbour"):
         assert words in out, words
+    long = [line for line in out.splitlines() if len(line) > 79]
+    assert not long, long  # fits an 80-column terminal
 
 
 if __name__ == "__main__":
