@@ -69,6 +69,7 @@
  */
 #include "analysis.h"
 
+#include <assert.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -527,11 +528,11 @@ typedef struct {
     int used[3];        /* the axes of the neighbourhood */
     int rank;           /* how many */
     int n;              /* offsets */
-    int d[26][3];
-    ptrdiff_t step[26]; /* the offset as a voxel index difference */
+    ptrdiff_t step[26]; /* each offset as a voxel index difference */
 } neighbourhood_t;
 
 static void neighbourhood(neighbourhood_t *nb, const long long n[3], int mask_dims, int connectivity) {
+    assert(connectivity >= 1 && connectivity <= 3 && (mask_dims == 0 || mask_dims == 2 || mask_dims == 3));
     memset(nb, 0, sizeof *nb);
     for (int a = 0; a < 3; a++) {
         /* auto: the axes of more than one voxel (a single slice is a 2-D
@@ -547,7 +548,7 @@ static void neighbourhood(neighbourhood_t *nb, const long long n[3], int mask_di
                 if (d[a] && !nb->used[a]) ok = 0;
             }
             if (!ok || nz != order) continue;
-            memcpy(nb->d[nb->n], d, sizeof d);
+            assert(nb->n < 26);
             nb->step[nb->n++] = (ptrdiff_t)d[0] + (ptrdiff_t)d[1] * (ptrdiff_t)n[0] +
                                 (ptrdiff_t)d[2] * (ptrdiff_t)(n[0] * n[1]);
         }
