@@ -305,6 +305,18 @@ def small_surprises_of_a_first_hour_are_gone(d):
 
 
 @test
+def every_option_of_the_help_is_in_the_man_page(d):
+    """A user who reads `man hausdorff` meets every option --help lists
+    (--max-stream-size and --fifo-wait were missing)."""
+    rc, out, err = run("--help")
+    assert rc == 0, err
+    with open(os.path.join(os.path.dirname(HERE), "docs", "hausdorff.1")) as f:
+        man = f.read().replace("\\-", "-")
+    missing = sorted({o for o in re.findall(r"--[a-z][a-z0-9-]*", out) if o not in man})
+    assert not missing, missing
+
+
+@test
 def empty_monai_is_inf_for_one_empty_set_and_nan_for_two(d):
     empty = write(d, "empty.xyz", "")
     full = write(d, "full.xyz", "0 0 0\n1 1 1\n")
