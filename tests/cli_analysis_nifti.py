@@ -278,6 +278,7 @@ def units_come_from_the_header_or_units_and_are_null_when_unknown(tmp):
         out, _ = run(["--percentile", "95", path, path])
         assert ("(mm)" in out) == (want is not None), out
         assert ("unit not given" in out) == (want is None), out
+        assert ("H(A,B) = 0 mm\n" in out) == (want is not None), out  # the distance says its unit
     r = run_json(["--units", "um", path, path])
     assert r["units"] == "um"
 
