@@ -35,6 +35,12 @@ void cli_usage(FILE *out) {
 "                     format: FORMAT:PATH, e.g. xyz:- or ply:scan.dat\n"
 "                     (./ply:x for a file whose name holds a colon)\n"
 "  --formats          list the file formats and exit\n"
+"  A or B as tiles:   a directory (its point files by extension, sorted by\n"
+"                     name in byte order, not recursed) or @LIST (a file of\n"
+"                     paths, one a line, relative to the list's folder; '#'\n"
+"                     comments; a line may be FORMAT:PATH): their points in\n"
+"                     that order; the witness is named by file and index\n"
+"                     (./@x for a file whose name starts with @)\n"
 "  --vertices         read a mesh (ply, obj, off, stl) as its vertices (default)\n"
 "  --sample N         read a mesh as N points drawn uniformly by area on its\n"
 "                     faces, reproducibly for a given --seed\n"
@@ -58,6 +64,7 @@ void cli_usage(FILE *out) {
 "  cat cloud.csv | hausdorff xyz:- model.ply\n"
 "  hausdorff --percentile 95 --mean --render dev.png scan.ply model.ply\n"
 "  hausdorff --json --percentile 95 seg.nii.gz truth.nii.gz\n"
+"  hausdorff --json tiles-2019/ @tiles-2024.txt\n"
 "\n"
 "Exit status: 0 success, 1 usage error, 2 bad input, 3 other failure.\n");
 }
