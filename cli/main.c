@@ -183,9 +183,12 @@ int main(int argc, char **argv) {
     double t0 = now();
     /* progress by phase (read A, read B, compute), only for a person */
     progress_start(!a.quiet && !a.json && isatty(2), 3);
-    progress_phase("reading A: %s", a.path_a);
+    char files[2][32] = {"", ""};
+    for (int w = 0; w < 2; w++)
+        if (side[w].kind != TILES_FILE) snprintf(files[w], sizeof files[w], " (%zu files)", side[w].n);
+    progress_phase("reading A: %s%s", a.path_a, files[0]);
     if ((rc = tiles_read(&side[0], 0, side[0].n, &a.read, &a.an, 0, &ca, &err)) != HD_OK ||
-        (progress_phase("reading B: %s", a.path_b),
+        (progress_phase("reading B: %s%s", a.path_b, files[1]),
          rc = tiles_read(&side[1], 0, side[1].n, &a.read, &a.an, 1, &cb, &err)) != HD_OK) {
         progress_stop();
         fprintf(stderr, "hausdorff: %s\n", err.message);

@@ -241,6 +241,7 @@ def an_empty_directory_or_list_is_an_error_or_follows_the_empty_policy(d):
     expect_error(["@" + lst, full], ["l.txt: the list names no files", "--empty"])
     r = run_json("--empty", "inf", os.path.join(d, "e"), full)
     assert r["hausdorff"] is None and r["empty"]["a"] is True and r["n_a"] == 0, r
+    assert r["witness_ab_files"] is None, r
 
 
 @test
