@@ -36,6 +36,7 @@
 #include "tiles.h"
 #include "cli.h"
 
+#include <assert.h>
 #include <dirent.h>
 #include <errno.h>
 #include <stdarg.h>
@@ -180,8 +181,14 @@ static char *trim(char *line, size_t len) {
     return *line && *line != '#' ? line : NULL;
 }
 
+/* The longest line of a list: a path (PATH_MAX) and some blanks.  Longer
+ * is not a list (a binary file given by mistake), and is refused before
+ * getline grows its buffer to the size of the file. */
+enum { LINE_MAX_ = 4096 + 64 };
+
 static int expand_list(tiles_t *s, const char *list, const char *format, hd_error_t *err) {
     struct stat st;
+    if (!list[0]) return fail(err, HD_EIO, 0, "'@' names no list (write @FILE; ./@x for a file named @x)");
     if (stat(list, &st) == 0 && S_ISDIR(st.st_mode))
         return fail(err, HD_EFORMAT, 0, "%s: is a directory, not a list of files (name a directory without '@')",
                     list);
@@ -196,8 +203,9 @@ static int expand_list(tiles_t *s, const char *list, const char *format, hd_erro
     int rc = HD_OK;
     while (rc == HD_OK && (len = getline(&buf, &bufcap, f)) >= 0) {
         line++;
-        if (memchr(buf, '\0', (size_t)len)) {
-            rc = fail(err, HD_EFORMAT, line, "%s:%ld: a NUL byte (a list is text, one path per line)", list, line);
+        if (memchr(buf, '\0', (size_t)len) || len > LINE_MAX_) {
+            rc = fail(err, HD_EFORMAT, line, "%s:%ld: %s (a list is text, one path per line)", list, line,
+                      len > LINE_MAX_ ? "a line longer than 4096 bytes" : "a NUL byte");
             break;
         }
         char *p = trim(buf, (size_t)len);
@@ -388,6 +396,7 @@ size_t tiles_locate(const tiles_t *s, size_t g, size_t *local) {
 }
 
 void tiles_share(const tiles_t *s, int rank, int parts, size_t *first, size_t *n) {
+    assert(parts >= 1 && rank >= 0 && rank < parts);
     uint64_t total = 0;
     for (size_t k = 0; k < s->n; k++) total += s->t[k].bytes;
     /* bound(r) = floor(r * total / parts), without overflow */

@@ -67,7 +67,8 @@ const char *tiles_split_format(const char *s, const char **format);
  * relative path is taken relative to the list's folder.
  * Errors (err names the list and line, or the directory): HD_EIO (list or
  * directory unreadable; a listed file missing or unreadable), HD_EFORMAT
- * (a listed "-", directory or NIfTI mask; a NUL byte in the list),
+ * (a listed "-", directory or NIfTI mask; a NUL byte or a line longer
+ * than 4096 bytes in the list),
  * HD_ENOMEM.  An empty directory or list is not an error here: n is 0.
  * On failure *out is left empty (tiles_free is still safe). */
 int tiles_expand(const char *arg, const char *format, tiles_t *out,
@@ -107,7 +108,8 @@ size_t tiles_locate(const tiles_t *s, size_t g, size_t *local);
  * starting byte (the sizes of the tiles before, summed) falls in
  * [r * total / parts, (r + 1) * total / parts).  Every tile goes to one
  * part, in order, so the parts' points concatenated in rank order are the
- * side's points in order.  Some parts may get none. */
+ * side's points in order.  Some parts may get none.  parts >= 1 and
+ * 0 <= rank < parts (asserted). */
 void tiles_share(const tiles_t *s, int rank, int parts, size_t *first,
                  size_t *n);
 
