@@ -19,7 +19,8 @@
  *    an error naming LIST:LINE before any point is read.
  *  - One side is one file when it is neither a directory nor @LIST; then
  *    tiles_read is exactly cli_read_points on it (masks, standard input,
- *    the --empty policy), and the cloud it returns is the reader's own.
+ *    the --empty policy; seed + 0), and the cloud it returns is the
+ *    reader's own: the first tile's cloud is never copied.
  *  - Memory.  Tiles are read one at a time and appended to one buffer that
  *    grows by half again when full (realloc: glibc moves large blocks with
  *    mremap, without copying) and is trimmed to the count at the end.  The
@@ -319,13 +320,6 @@ int tiles_read(tiles_t *s, size_t first, size_t n, const hd_read_options_t *ro, 
                hd_cloud_t **out, hd_error_t *err) {
     *out = NULL;
     if (first > s->n || n > s->n - first) return fail(err, HD_EINVAL, 0, "%s: tiles out of range", s->arg);
-    if (s->kind == TILES_FILE && n == 1) { /* the one file, exactly as before tiles */
-        hd_read_options_t r = *ro;
-        if (s->t[0].format) r.format = s->t[0].format;
-        int rc = cli_read_points(s->t[0].path, &r, an, which, out, err);
-        if (rc == HD_OK) s->t[0].count = (*out)->count;
-        return rc;
-    }
     if (n == 0) { /* no tiles: a share of none, or an empty side */
         if (s->n == 0 && an->empty == EMPTY_ERROR) {
             char skipped[512];
