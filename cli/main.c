@@ -10,7 +10,9 @@
  * Output is part of the result (output.c): a run succeeds only when its
  * report reached standard output and every file it was asked to write is in
  * place.  So main guards descriptors 0-2 before anything opens a file,
- * refuses outputs that would overwrite an input before anything is read
+ * expands each side into its files (tiles.c: one file, a directory or a
+ * list, read as one point set whose indices run across the files), then
+ * refuses outputs that would overwrite any input before anything is read
  * (exit 1), lets every file be written to a temporary, and ends a run that
  * succeeded with out_finish (standard output flushed and closed, checked;
  * then the files renamed into place, all or none; exit 3 when either
