@@ -364,6 +364,17 @@ int tiles_read(tiles_t *s, size_t first, size_t n, const hd_read_options_t *ro, 
     return HD_OK;
 }
 
+int tiles_number(tiles_t *s, hd_error_t *err) {
+    size_t at = 0;
+    for (size_t k = 0; k < s->n; k++) {
+        if (s->t[k].count > SIZE_MAX - at)
+            return fail(err, HD_EOVERFLOW, 0, "%s: the side's points would number more than a size_t holds", s->arg);
+        s->t[k].first = at;
+        at += s->t[k].count;
+    }
+    return HD_OK;
+}
+
 void tiles_skipped_text(const tiles_t *s, char *buf, size_t size) {
     enum { SHOWN = 3 };
     size_t len = 0;

@@ -94,6 +94,13 @@ int tiles_read(tiles_t *s, size_t first, size_t n, const hd_read_options_t *ro,
                analysis_args_t *an, int which, hd_cloud_t **out,
                hd_error_t *err);
 
+/* Number the whole side from the tiles' counts: first = the counts of the
+ * tiles before, summed.  For processes that each read a share: once every
+ * tile's count is known everywhere (gathered), tiles_locate works as after
+ * reading the whole side.  HD_EOVERFLOW (err filled) when the sum does not
+ * fit a size_t; else HD_OK. */
+int tiles_number(tiles_t *s, hd_error_t *err);
+
 /* What was skipped, for a person: "skipped 2: notes.md (no point format
  * has this extension), sub (a directory, not recursed)", the first three
  * and how many more; "" when nothing was.  Truncated to size. */

@@ -3,8 +3,8 @@
  * processes (hausdorff-mpi) uses it: tiles_share cuts a side into
  * contiguous ranges that cover every tile once, in order; tiles_read of a
  * range gives exactly that range's points of the whole side, numbered from
- * the range's start; tiles_locate finds the tile of a global index past
- * empty tiles.  The command line's behaviour is tests/cli_tiles.py's.
+ * the range's start; tiles_number numbers the whole side from gathered
+ * counts; tiles_locate finds the tile of a global index past empty tiles.  The command line's behaviour is tests/cli_tiles.py's.
  */
 #include "check.h"
 #include "files.h"
@@ -19,6 +19,7 @@ static tiles_t sized(const uint64_t *bytes, size_t n) {
     tiles_t s;
     memset(&s, 0, sizeof s);
     s.kind = TILES_LIST;
+    s.arg = "@sizes.txt";
     s.n = n;
     s.t = calloc(n ? n : 1, sizeof *s.t);
     for (size_t k = 0; k < n; k++) s.t[k].bytes = bytes[k];
@@ -122,4 +123,23 @@ TEST(reading_a_range_gives_that_range_of_the_whole_side) {
         }
     hd_cloud_free(whole);
     tiles_free(&s);
+}
+
+TEST(number_gives_each_tile_the_counts_before_it_and_refuses_overflow) {
+    const uint64_t bytes[] = {0, 0, 0, 0};
+    tiles_t s = sized(bytes, 4);
+    const size_t count[] = {5, 0, 3, 2};
+    for (int k = 0; k < 4; k++) s.t[k].count = count[k];
+    hd_error_t err;
+    CHECK_RC(tiles_number(&s, &err), HD_OK);
+    CHECK_EQ(s.t[0].first, 0);
+    CHECK_EQ(s.t[1].first, 5);
+    CHECK_EQ(s.t[2].first, 5);
+    CHECK_EQ(s.t[3].first, 8);
+    size_t local;
+    CHECK_EQ(tiles_locate(&s, 9, &local), 3);
+    CHECK_EQ(local, 1);
+    s.t[2].count = SIZE_MAX - 4;
+    CHECK_RC(tiles_number(&s, &err), HD_EOVERFLOW);
+    free(s.t);
 }
