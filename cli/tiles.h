@@ -88,8 +88,9 @@ int tiles_expand(const char *arg, const char *format, tiles_t *out,
  * (an->empty), as for one file; so is a side of no tiles (an empty
  * directory or list), which with a policy is a cloud of 0 points.  A range
  * of no tiles of a side that has some (a process's empty share) is a cloud
- * of 0 points.
- * On failure *out is NULL. */
+ * of 0 points.  `which` is 0 for A and 1 for B (where cli_read_points
+ * describes a mask).  A range beyond the tiles is HD_EINVAL.
+ * *out is the caller's (hd_cloud_free); on failure it is NULL. */
 int tiles_read(tiles_t *s, size_t first, size_t n, const hd_read_options_t *ro,
                analysis_args_t *an, int which, hd_cloud_t **out,
                hd_error_t *err);
