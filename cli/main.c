@@ -10,7 +10,9 @@
  * Output is part of the result (output.c): a run succeeds only when its
  * report reached standard output and every file it was asked to write is in
  * place.  So main guards descriptors 0-2 before anything opens a file,
- * refuses outputs that would overwrite an input before anything is read
+ * expands each side into its files (tiles.c: one file, a directory or a
+ * list, read as one point set whose indices run across the files), then
+ * refuses outputs that would overwrite any input before anything is read
  * (exit 1), lets every file be written to a temporary, and ends a run that
  * succeeded with out_finish (standard output flushed and closed, checked;
  * then the files renamed into place, all or none; exit 3 when either
@@ -92,9 +94,12 @@ int main(int argc, char **argv) {
     double t0 = cli_now();
     /* progress by phase (read A, read B, compute), only for a person */
     progress_start(!a.quiet && !a.json && isatty(2), 3);
-    progress_phase("reading A: %s", a.path_a);
+    char files[2][32] = {"", ""};
+    for (int w = 0; w < 2; w++)
+        if (side[w].kind != TILES_FILE) snprintf(files[w], sizeof files[w], " (%zu files)", side[w].n);
+    progress_phase("reading A: %s%s", a.path_a, files[0]);
     if ((rc = tiles_read(&side[0], 0, side[0].n, &a.read, &a.an, 0, &ca, &err)) != HD_OK ||
-        (progress_phase("reading B: %s", a.path_b),
+        (progress_phase("reading B: %s%s", a.path_b, files[1]),
          rc = tiles_read(&side[1], 0, side[1].n, &a.read, &a.an, 1, &cb, &err)) != HD_OK) {
         progress_stop();
         fprintf(stderr, "hausdorff: %s\n", err.message);

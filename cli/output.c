@@ -39,10 +39,11 @@
  *    and SIGXFSZ is ignored, so that a file beyond `ulimit -f` is a write
  *    that fails with EFBIG (reported, exit 3) rather than a crash.
  *  - Inputs are never overwritten: out_check_paths compares every output
- *    with A and B, and with the other outputs, by literal path and by
- *    identity (st_dev and st_ino, through links; standard input by fstat
- *    when it is a regular file), before anything is read, and refuses with
- *    the usage exit status 1 and a message naming both.
+ *    with every input (each tile of A and B, and a list of tiles), and
+ *    with the other outputs, by literal path and by identity (st_dev and
+ *    st_ino, through links; standard input by fstat when it is a regular
+ *    file), before anything is read, and refuses with the usage exit
+ *    status 1 and a message naming both.
  * A failure prints "hausdorff: WHAT: strerror" and the run exits with 3.
  * Files are not fsync'ed: a rename makes a complete file appear, but a
  * machine that crashes right after may still lose it.

@@ -173,12 +173,17 @@ void report_text(FILE *out, const report_t *r) {
     side_line(out, r, 0);
     side_line(out, r, 1);
     char d[NUM_TEXT];
+    const char *unit = analysis_units(&a->an); /* " mm" after each distance, when known */
+    const char *sp = unit ? " " : "";
+    if (!unit) unit = "";
     if (a->directed) {
-        fprintf(out, "h(A,B) = %s\n", num_text(s->ab.distance, d));
+        fprintf(out, "h(A,B) = %s%s%s\n", num_text(s->ab.distance, d), sp, unit);
     } else {
-        fprintf(out, "Hausdorff distance H(A,B) = %s\n", num_text(s->distance, d));
-        fprintf(out, "  h(A,B) = %s   [%s]\n", num_text(s->ab.distance, d), hd_algorithm_name(s->ab.algorithm));
-        fprintf(out, "  h(B,A) = %s   [%s]\n", num_text(s->ba.distance, d), hd_algorithm_name(s->ba.algorithm));
+        fprintf(out, "Hausdorff distance H(A,B) = %s%s%s\n", num_text(s->distance, d), sp, unit);
+        fprintf(out, "  h(A,B) = %s%s%s   [%s]\n", num_text(s->ab.distance, d), sp, unit,
+                hd_algorithm_name(s->ab.algorithm));
+        fprintf(out, "  h(B,A) = %s%s%s   [%s]\n", num_text(s->ba.distance, d), sp, unit,
+                hd_algorithm_name(s->ba.algorithm));
     }
     int from_a;
     const hd_result_t *w = report_witness(a, s, &from_a);

@@ -19,7 +19,8 @@
  *    an error naming LIST:LINE before any point is read.
  *  - One side is one file when it is neither a directory nor @LIST; then
  *    tiles_read is exactly cli_read_points on it (masks, standard input,
- *    the --empty policy), and the cloud it returns is the reader's own.
+ *    the --empty policy; seed + 0), and the cloud it returns is the
+ *    reader's own: the first tile's cloud is never copied.
  *  - Memory.  Tiles are read one at a time and appended to one buffer that
  *    grows by half again when full (realloc: glibc moves large blocks with
  *    mremap, without copying) and is trimmed to the count at the end.  The
@@ -36,6 +37,7 @@
 #include "tiles.h"
 #include "cli.h"
 
+#include <assert.h>
 #include <dirent.h>
 #include <errno.h>
 #include <stdarg.h>
@@ -58,16 +60,19 @@ static int fail(hd_error_t *err, int code, long line, const char *fmt, ...) {
     return code;
 }
 
-const char *tiles_split_format(const char *s, const char **format) {
-    *format = NULL;
-    const char *colon = strchr(s, ':');
-    if (!colon || colon == s) return s;
+const char *tiles_format_named(const char *s, size_t n) {
+    static const char *const text_aliases[] = {"csv", "txt", "pts", "asc", NULL};
     for (const char *const *f = hd_formats(); *f; f++)
-        if (strlen(*f) == (size_t)(colon - s) && strncasecmp(*f, s, (size_t)(colon - s)) == 0) {
-            *format = *f;
-            return colon + 1;
-        }
-    return s;
+        if (strlen(*f) == n && strncasecmp(*f, s, n) == 0) return *f;
+    for (const char *const *f = text_aliases; *f; f++)
+        if (strlen(*f) == n && strncasecmp(*f, s, n) == 0) return "xyz";
+    return NULL;
+}
+
+const char *tiles_split_format(const char *s, const char **format) {
+    const char *colon = strchr(s, ':');
+    *format = colon && colon != s ? tiles_format_named(s, (size_t)(colon - s)) : NULL;
+    return *format ? colon + 1 : s;
 }
 
 /* dir/name, without doubling a '/' that ends dir; NULL when out of memory */
@@ -180,8 +185,14 @@ static char *trim(char *line, size_t len) {
     return *line && *line != '#' ? line : NULL;
 }
 
+/* The longest line of a list: a path (PATH_MAX) and some blanks.  Longer
+ * is not a list (a binary file given by mistake), and is refused before
+ * getline grows its buffer to the size of the file. */
+enum { LINE_MAX_ = 4096 + 64 };
+
 static int expand_list(tiles_t *s, const char *list, const char *format, hd_error_t *err) {
     struct stat st;
+    if (!list[0]) return fail(err, HD_EIO, 0, "'@' names no list (write @FILE; ./@x for a file named @x)");
     if (stat(list, &st) == 0 && S_ISDIR(st.st_mode))
         return fail(err, HD_EFORMAT, 0, "%s: is a directory, not a list of files (name a directory without '@')",
                     list);
@@ -196,8 +207,9 @@ static int expand_list(tiles_t *s, const char *list, const char *format, hd_erro
     int rc = HD_OK;
     while (rc == HD_OK && (len = getline(&buf, &bufcap, f)) >= 0) {
         line++;
-        if (memchr(buf, '\0', (size_t)len)) {
-            rc = fail(err, HD_EFORMAT, line, "%s:%ld: a NUL byte (a list is text, one path per line)", list, line);
+        if (memchr(buf, '\0', (size_t)len) || len > LINE_MAX_) {
+            rc = fail(err, HD_EFORMAT, line, "%s:%ld: %s (a list is text, one path per line)", list, line,
+                      len > LINE_MAX_ ? "a line longer than 4096 bytes" : "a NUL byte");
             break;
         }
         char *p = trim(buf, (size_t)len);
@@ -311,13 +323,6 @@ int tiles_read(tiles_t *s, size_t first, size_t n, const hd_read_options_t *ro, 
                hd_cloud_t **out, hd_error_t *err) {
     *out = NULL;
     if (first > s->n || n > s->n - first) return fail(err, HD_EINVAL, 0, "%s: tiles out of range", s->arg);
-    if (s->kind == TILES_FILE && n == 1) { /* the one file, exactly as before tiles */
-        hd_read_options_t r = *ro;
-        if (s->t[0].format) r.format = s->t[0].format;
-        int rc = cli_read_points(s->t[0].path, &r, an, which, out, err);
-        if (rc == HD_OK) s->t[0].count = (*out)->count;
-        return rc;
-    }
     if (n == 0) { /* no tiles: a share of none, or an empty side */
         if (s->n == 0 && an->empty == EMPTY_ERROR) {
             char skipped[512];
@@ -362,6 +367,17 @@ int tiles_read(tiles_t *s, size_t first, size_t n, const hd_read_options_t *ro, 
     return HD_OK;
 }
 
+int tiles_number(tiles_t *s, hd_error_t *err) {
+    size_t at = 0;
+    for (size_t k = 0; k < s->n; k++) {
+        if (s->t[k].count > SIZE_MAX - at)
+            return fail(err, HD_EOVERFLOW, 0, "%s: the side's points would number more than a size_t holds", s->arg);
+        s->t[k].first = at;
+        at += s->t[k].count;
+    }
+    return HD_OK;
+}
+
 void tiles_skipped_text(const tiles_t *s, char *buf, size_t size) {
     enum { SHOWN = 3 };
     size_t len = 0;
@@ -388,6 +404,7 @@ size_t tiles_locate(const tiles_t *s, size_t g, size_t *local) {
 }
 
 void tiles_share(const tiles_t *s, int rank, int parts, size_t *first, size_t *n) {
+    assert(parts >= 1 && rank >= 0 && rank < parts);
     uint64_t total = 0;
     for (size_t k = 0; k < s->n; k++) total += s->t[k].bytes;
     /* bound(r) = floor(r * total / parts), without overflow */

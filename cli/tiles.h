@@ -48,8 +48,13 @@ typedef struct tiles {
     tile_skip_t *skipped;
 } tiles_t;
 
-/* The FORMAT of a path written FORMAT:PATH (FORMAT a reader's name in any
- * case: "xyz:-", "PLY:scan.dat") into *format and the path after the
+/* The reader named by the n bytes at s, in any case: a reader's name, or
+ * one of the text extensions the xyz reader has (csv, txt, pts, asc: a user
+ * who names a file .csv types csv:- or --format csv); NULL for neither. */
+const char *tiles_format_named(const char *s, size_t n);
+
+/* The FORMAT of a path written FORMAT:PATH (FORMAT a reader's name or
+ * alias in any case: "xyz:-", "csv:-", "PLY:scan.dat") into *format and the path after the
  * colon; anything else is a path as it stands, *format NULL ("./ply:x"
  * names a file whose name holds a colon).  Used for the command line's two
  * sides and for each line of a list. */
@@ -67,7 +72,8 @@ const char *tiles_split_format(const char *s, const char **format);
  * relative path is taken relative to the list's folder.
  * Errors (err names the list and line, or the directory): HD_EIO (list or
  * directory unreadable; a listed file missing or unreadable), HD_EFORMAT
- * (a listed "-", directory or NIfTI mask; a NUL byte in the list),
+ * (a listed "-", directory or NIfTI mask; a NUL byte or a line longer
+ * than 4096 bytes in the list),
  * HD_ENOMEM.  An empty directory or list is not an error here: n is 0.
  * On failure *out is left empty (tiles_free is still safe). */
 int tiles_expand(const char *arg, const char *format, tiles_t *out,
@@ -87,11 +93,19 @@ int tiles_expand(const char *arg, const char *format, tiles_t *out,
  * (an->empty), as for one file; so is a side of no tiles (an empty
  * directory or list), which with a policy is a cloud of 0 points.  A range
  * of no tiles of a side that has some (a process's empty share) is a cloud
- * of 0 points.
- * On failure *out is NULL. */
+ * of 0 points.  `which` is 0 for A and 1 for B (where cli_read_points
+ * describes a mask).  A range beyond the tiles is HD_EINVAL.
+ * *out is the caller's (hd_cloud_free); on failure it is NULL. */
 int tiles_read(tiles_t *s, size_t first, size_t n, const hd_read_options_t *ro,
                analysis_args_t *an, int which, hd_cloud_t **out,
                hd_error_t *err);
+
+/* Number the whole side from the tiles' counts: first = the counts of the
+ * tiles before, summed.  For processes that each read a share: once every
+ * tile's count is known everywhere (gathered), tiles_locate works as after
+ * reading the whole side.  HD_EOVERFLOW (err filled) when the sum does not
+ * fit a size_t; else HD_OK. */
+int tiles_number(tiles_t *s, hd_error_t *err);
 
 /* What was skipped, for a person: "skipped 2: notes.md (no point format
  * has this extension), sub (a directory, not recursed)", the first three
@@ -107,7 +121,8 @@ size_t tiles_locate(const tiles_t *s, size_t g, size_t *local);
  * starting byte (the sizes of the tiles before, summed) falls in
  * [r * total / parts, (r + 1) * total / parts).  Every tile goes to one
  * part, in order, so the parts' points concatenated in rank order are the
- * side's points in order.  Some parts may get none. */
+ * side's points in order.  Some parts may get none.  parts >= 1 and
+ * 0 <= rank < parts (asserted). */
 void tiles_share(const tiles_t *s, int rank, int parts, size_t *first,
                  size_t *n);
 

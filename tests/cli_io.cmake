@@ -10,6 +10,15 @@
 #               files: their points concatenated in order, bit-identical to
 #               one concatenated file, the witness by file and index, every
 #               bad tile or list line named.
+#   cli_tiles_unit (tests/cli_tiles_unit.c) cli/tiles.c as hausdorff-mpi
+#               uses it: tiles_share, tiles_read of a range, tiles_locate.
+add_executable(cli_tiles_unit tests/cli_tiles_unit.c cli/tiles.c cli/nifti.c ${HD_TEST_SUPPORT})
+target_include_directories(cli_tiles_unit PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/cli
+                           ${CMAKE_CURRENT_SOURCE_DIR}/tests/support)
+target_link_libraries(cli_tiles_unit PRIVATE hausdorff_static)
+set_target_properties(cli_tiles_unit PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/tests)
+add_test(NAME cli_tiles_unit COMMAND cli_tiles_unit WORKING_DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR})
+
 # Standard-library Python only, so any python3 will do.
 find_program(HD_CLI_IO_PYTHON NAMES python3)
 if(NOT HD_CLI_IO_PYTHON)

@@ -173,6 +173,16 @@ def a_list_names_files_not_standard_input_or_directories(d):
 
 
 @test
+def a_list_that_is_not_text_is_refused_at_its_first_bad_line(d):
+    write(os.path.join(d, "a.xyz"), "0 0 0\n")
+    lst = write(os.path.join(d, "bin.txt"), b"a.xyz\n\x93NUMPY\x00\x01\n")
+    expect_error(["@" + lst, os.path.join(d, "a.xyz")], ["bin.txt:2: a NUL byte"])
+    lst = write(os.path.join(d, "long.txt"), "a.xyz\n" + "x" * 5000 + "\n")
+    expect_error(["@" + lst, os.path.join(d, "a.xyz")], ["long.txt:2: a line longer than 4096 bytes"])
+    expect_error(["@", os.path.join(d, "a.xyz")], ["'@' names no list"])
+
+
+@test
 def a_directory_skips_and_reports_other_entries_and_does_not_recurse(d):
     t = os.path.join(d, "t")
     write(os.path.join(t, "a.xyz"), "0 0 0\n")
@@ -241,6 +251,7 @@ def an_empty_directory_or_list_is_an_error_or_follows_the_empty_policy(d):
     expect_error(["@" + lst, full], ["l.txt: the list names no files", "--empty"])
     r = run_json("--empty", "inf", os.path.join(d, "e"), full)
     assert r["hausdorff"] is None and r["empty"]["a"] is True and r["n_a"] == 0, r
+    assert r["witness_ab_files"] is None, r
 
 
 @test

@@ -71,8 +71,8 @@ static void quiet_others(void) {
     if (fd > 2) close(fd);
 }
 
-/* Every tile's first index and count over all ranks (each tile was read by
- * one rank); returns this rank's offset, the first index of its range. */
+/* Every tile's count over all ranks (each tile was read by one rank), then
+ * tiles_number; *offset is the first index of this rank's range. */
 static int number_tiles(tiles_t *t, size_t first, size_t n, size_t *offset, hd_error_t *err) {
     size_t m = t->n ? t->n : 1;
     uint64_t *mine = calloc(m, sizeof *mine), *all = calloc(m, sizeof *all);
@@ -81,14 +81,9 @@ static int number_tiles(tiles_t *t, size_t first, size_t n, size_t *offset, hd_e
     if ((rc = agree(rc, err)) == HD_OK) {
         for (size_t k = first; k < first + n; k++) mine[k] = t->t[k].count;
         MPI_Allreduce(mine, all, (int)m, MPI_UINT64_T, MPI_SUM, MPI_COMM_WORLD);
-        size_t at = 0;
-        *offset = 0;
-        for (size_t k = 0; k < t->n; k++) {
-            if (k == first) *offset = at;
-            t->t[k].first = at;
-            t->t[k].count = (size_t)all[k];
-            at += (size_t)all[k];
-        }
+        for (size_t k = 0; k < t->n; k++) t->t[k].count = (size_t)all[k];
+        rc = tiles_number(t, err); /* the same verdict on every rank */
+        *offset = n && rc == HD_OK ? t->t[first].first : 0;
     }
     free(mine);
     free(all);
