@@ -1,6 +1,6 @@
 # mpi.cmake -- the MPI scale-out's tests (cmake/mpi.cmake builds what they
 # test; without MPI there is nothing to test and nothing is added).
-#  - mpi_api_K: tests/mpi_api.c under `mpirun -n K`: hd_mpi_hausdorff equals
+#  - mpi_api_K: tests/api/mpi_api.c under `mpirun -n K`: hd_mpi_hausdorff equals
 #    hd_hausdorff bit for bit on the adversarial sets and layouts, and a
 #    failure on one rank is agreed by all.  K = 1, 2, 3, 4, 7 here; the
 #    sanitizer build runs K = 3 only.
@@ -17,7 +17,7 @@
 # 12 s.
 if(HD_MPI)
   find_program(HD_MPIEXEC NAMES mpirun mpiexec REQUIRED)
-  add_executable(mpi_api ${CMAKE_CURRENT_SOURCE_DIR}/tests/mpi_api.c ${CMAKE_CURRENT_SOURCE_DIR}/tests/support/gen.c)
+  add_executable(mpi_api ${CMAKE_CURRENT_SOURCE_DIR}/tests/api/mpi_api.c ${CMAKE_CURRENT_SOURCE_DIR}/tests/support/gen.c)
   target_include_directories(mpi_api PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/tests/support)
   target_link_libraries(mpi_api PRIVATE hausdorff_mpi)
   set_target_properties(mpi_api PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/tests)

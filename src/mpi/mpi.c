@@ -47,7 +47,7 @@
  *     i_L, cannot be the witness and is never forwarded.  (Skipping every
  *     u(a)^2 <= L would lose ties: a point at exactly L with a smaller
  *     index is the witness, and its smallest-index nearest point may lie on
- *     another rank; tests/mpi_api.c's checkerboard fails that way.)
+ *     another rank; tests/api/mpi_api.c's checkerboard fails that way.)
  *  5. Every other a with u(a)^2 >= L is sent to each rank whose box of B
  *     points lies within u(a) (hd__box_lb2 <= u^2: a computed lower bound
  *     no larger than the computed distance to any point inside, so every
