@@ -71,6 +71,7 @@
  * the same code and message and none waits for a rank that gave up.
  */
 #include "hausdorff_mpi.h"
+#include "nearest/nearest.h"
 #include "points/points.h"
 
 #include <assert.h>
@@ -347,6 +348,46 @@ typedef struct {
     int qside;               /* 0: Q is A, 1: Q is B */
 } dir_t;
 
+/* The structure of the searched local set for per-point searches (the
+ * nearest layer's, as hd_distances builds it), built on first use and kept
+ * for the direction: the shell and the forwarded queries ask it in turn,
+ * instead of hd_distances building it again for each. */
+typedef struct {
+    hd__an_t s;
+    int built;
+} qtree_t;
+
+/* For each of n packed points, the nearest point of Q (exact, smallest
+ * index on ties, as hd_distances gives it). */
+static int nearest_in_q(ctx_t *c, const dir_t *d, qtree_t *q, const double *pts, size_t n, size_t *near) {
+    if (n == 0) return HD_OK;
+    hd_points_t Sv = hd_points_f64(pts, n), Qv = hd_points_f64(d->Q, d->nQ);
+    int threads = hd__thread_count(c->threads, n > d->nQ ? n : d->nQ), rc;
+    if (n > HD__AN_MAX_POINTS || d->nQ > HD__AN_MAX_POINTS) { /* hd_distances' kd-trees */
+        hd_options_t o;
+        hd_options_init(&o);
+        o.threads = c->threads;
+        return hd_distances(&Sv, &Qv, &o, NULL, near, NULL, NULL, &c->e);
+    }
+    hd__box_t kb;
+    hd__box_of(d->Q, d->nQ, &kb); /* keys only order (clamped): any box is exact */
+    if (!q->built) {
+        rc = hd__an_build(&q->s, &Qv, NULL, &kb, threads, &c->e);
+        q->built = 1; /* freed by qtree_free whatever happened */
+        if (rc != HD_OK) return rc;
+    }
+    hd__an_t asking;
+    rc = hd__an_build(&asking, &Sv, NULL, &kb, threads, &c->e);
+    if (rc == HD_OK) rc = hd__an_nearest(&asking, &q->s, NULL, threads, NULL, near, NULL, &c->e);
+    hd__an_free(&asking);
+    return rc;
+}
+
+static void qtree_free(qtree_t *q) {
+    if (q->built) hd__an_free(&q->s);
+    q->built = 0;
+}
+
 /* 1 when every finite face of region r is farther from p than u2 allows
  * (computed fl(gap^2) > u2): then no point of another region is within u2
  * of p, nor at u2 (see the essay, step 4). */
@@ -391,7 +432,7 @@ static void shell_free(ctx_t *c, shell_t *sh) {
     cfree(c, sh->nearest, sh->n, sizeof(size_t));
 }
 
-static int shell_of(ctx_t *c, const dir_t *d, const hd__box_t *mine, shell_t *sh) {
+static int shell_of(ctx_t *c, const dir_t *d, const hd__box_t *mine, qtree_t *q, shell_t *sh) {
     memset(sh, 0, sizeof *sh);
     sh->inner = (far_t){-1.0, UINT64_MAX, UINT64_MAX};
     sh->xyz = d->P;
@@ -445,8 +486,7 @@ static int shell_of(ctx_t *c, const dir_t *d, const hd__box_t *mine, shell_t *sh
     if (rc == HD_OK && nS) {
         sh->nearest = cmalloc(c, nS, sizeof(size_t));
         if (!sh->nearest) return nomem(c, "nearest neighbours", nS);
-        hd_points_t Sv = hd_points_f64(sh->xyz, nS);
-        rc = hd_distances(&Sv, &Qv, &o, NULL, sh->nearest, NULL, NULL, &c->e);
+        rc = nearest_in_q(c, d, q, sh->xyz, nS, sh->nearest);
     }
     return rc;
 }
@@ -478,7 +518,7 @@ static int pack_queries(ctx_t *c, const double *P, const pair_t *pairs, size_t n
 }
 
 /* Answer m queries against the local Q: exact nearest, smallest index. */
-static int answer(ctx_t *c, const dir_t *d, const double *q, size_t m, ans_t *ans) {
+static int answer(ctx_t *c, const dir_t *d, qtree_t *q, const double *pts, size_t m, ans_t *ans) {
     if (m == 0) return HD_OK;
     if (d->nQ == 0) {
         for (size_t k = 0; k < m; k++) ans[k] = (ans_t){INFINITY, UINT64_MAX};
@@ -486,14 +526,10 @@ static int answer(ctx_t *c, const dir_t *d, const double *q, size_t m, ans_t *an
     }
     size_t *near = cmalloc(c, m, sizeof(size_t));
     if (!near) return nomem(c, "answers", m);
-    hd_points_t Qv = hd_points_f64(q, m), Sv = hd_points_f64(d->Q, d->nQ);
-    hd_options_t o;
-    hd_options_init(&o);
-    o.threads = c->threads;
-    int rc = hd_distances(&Qv, &Sv, &o, NULL, near, NULL, NULL, &c->e);
+    int rc = nearest_in_q(c, d, q, pts, m, near);
     if (rc == HD_OK)
         for (size_t k = 0; k < m; k++)
-            ans[k] = (ans_t){hd__d2(q + 3 * k, d->Q + 3 * near[k]), d->gQ[near[k]]};
+            ans[k] = (ans_t){hd__d2(pts + 3 * k, d->Q + 3 * near[k]), d->gQ[near[k]]};
     cfree(c, near, m, sizeof(size_t));
     return rc;
 }
@@ -503,8 +539,9 @@ static int direction(ctx_t *c, const dir_t *d, const node_t *tree, const hd__box
     int K = c->K, rc = HD_OK;
     const hd__box_t *mine = &region[c->rank];
     shell_t sh;
+    qtree_t q = {{0}, 0};
     double t0 = hd__now(), u0 = thread_cpu();
-    rc = shell_of(c, d, mine, &sh);
+    rc = shell_of(c, d, mine, &q, &sh);
     c->search += hd__now() - t0;
     c->search_cpu += thread_cpu() - u0;
     c->shell += sh.n;
@@ -599,7 +636,7 @@ static int direction(ctx_t *c, const dir_t *d, const node_t *tree, const hd__box
     if ((rc = agree(c, rc)) != HD_OK) goto done;
     MPI_GO(c, rc, MPI_Alltoallv(sendq, scount, sdispl, c->q_type, recvq, rcount, rdispl, c->q_type, c->comm));
     double t = hd__now(), u = thread_cpu();
-    rc = answer(c, d, recvq, m, ans);
+    rc = answer(c, d, &q, recvq, m, ans);
     c->search += hd__now() - t;
     c->search_cpu += thread_cpu() - u;
     c->answered += m;
@@ -638,6 +675,7 @@ done:
     cfree(c, ans, m, sizeof(ans_t));
     cfree(c, back, np, sizeof(ans_t));
     shell_free(c, &sh);
+    qtree_free(&q);
     return rc;
 }
 
