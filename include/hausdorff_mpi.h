@@ -107,8 +107,10 @@ typedef struct hd_mpi_stats {
                                    thread: with opt->threads = 1 the
                                    searches' own cost, whatever the load */
     uint64_t peak_bytes_max;    /* most bytes a rank held in the buffers of
-                                   this call (not counting hd_distances'
-                                   own, about 32-60 a point) */
+                                   this call, not counting the engine's and
+                                   the per-point searches' structures
+                                   (about 32 bytes a point of the local
+                                   set searched, up to 60 while built) */
     double seconds;             /* this rank: time in the call */
     double search_seconds;      /* this rank: time in the searches */
     uint64_t local_points;      /* this rank: points after the partition */

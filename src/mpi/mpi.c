@@ -1,9 +1,10 @@
 /*
  * mpi.c -- the exact Hausdorff distance of point sets spread over the ranks
  * of an MPI communicator (hausdorff_mpi.h).  A layer above the public entry
- * points: it calls the public API (hd_distances, hd_overlap) and the points
- * layer's geometry (points/points.h: the one squared distance, boxes, the
- * validation pass); nothing below includes it.  docs/scale-out.md has the
+ * points: it calls the public API (hd_directed, hd_overlap), the nearest
+ * layer's all-nearest search (nearest/nearest.h, what hd_distances runs)
+ * and the points layer's geometry (points/points.h: the one squared
+ * distance, boxes, the validation pass); nothing below includes it.  docs/scale-out.md has the
  * measurements and the cost model.
  *
  * The algorithm, for h(A,B) (the symmetric distance runs it both ways on one
@@ -31,8 +32,10 @@
  *     with h2 >= u(a)^2) is settled without a search of its own, and the
  *     largest of those is the engine's answer (or one more engine call on
  *     them alone when the engine's witness is not among them).  The rest,
- *     the shell within h of the faces, get per-point searches
- *     (hd_distances: the nearest local b, smallest index on ties).  The
+ *     the shell within h of the faces, get per-point searches (the
+ *     nearest layer's, as hd_distances runs them: the nearest local b,
+ *     smallest index on ties) on one structure of the local B per
+ *     direction, which the forwarded queries of step 5 ask too.  The
  *     engine prunes the points that cannot be the farthest, which
  *     per-point searches cannot: on two epochs of one scene that is tens
  *     of times less work.
