@@ -435,6 +435,84 @@ static void shell_free(ctx_t *c, shell_t *sh) {
     cfree(c, sh->nearest, sh->n, sizeof(size_t));
 }
 
+/* The correspondence pass, for a copy and its original (|A| = |B|, point g
+ * of B the moved point g of A).  After the partition a rank holds most
+ * pairs whole, but not all (a face separates some), so its local sets
+ * differ in size and the engine's correspondence path (docs/engine.md,
+ * step 0.5), which settles a copy at a few ns a point, does not run on
+ * them.  Here P_c, the local points of P whose partner is local too, and
+ * Q_c, those partners, are passed to the engine in the same order (both
+ * are in global index order), so the path runs.  Its answer h_c, with
+ * witness a*, bounds every u(a)^2 of P_c from above (Q_c is part of the
+ * local Q), so the points of P_c whose faces are clear of h_c are settled
+ * (the interior; the points of P without a local partner are shell).  The
+ * interior's exact maximum is h_c at a* when a* is interior and no point
+ * of Q_x, the local Q points whose partner is elsewhere, is nearer to a*
+ * than h_c: then u(a*)^2 = h_c, no interior u exceeds it, and any point
+ * of P_c with u^2 = h_c has u_c^2 = h_c too, so an index no smaller than
+ * a*'s (the engine's tie rule).  The witness's j is the engine's, or the
+ * smallest index of Q_x at exactly h_c.  Otherwise (*done = 0) the caller
+ * runs the engine on the whole local sets.  Tried only when nine tenths
+ * of P have their partner: anything else is not a copy. */
+static int paired_pass(ctx_t *c, const dir_t *d, const hd__box_t *mine, unsigned char *in, size_t *nI,
+                       far_t *inner, int *done) {
+    size_t nP = d->nP, nQ = d->nQ, nc = 0;
+    *done = 0;
+    for (size_t i = 0, j = 0; i < nP && j < nQ;) {
+        if (d->gP[i] == d->gQ[j]) nc++, i++, j++;
+        else if (d->gP[i] < d->gQ[j]) i++;
+        else j++;
+    }
+    if (nc < 64 || nc < nP - nP / 10 || (nc == nP && nc == nQ)) return HD_OK; /* whole sets: the engine's own */
+    size_t nx = nQ - nc;
+    double *pc = cmalloc(c, nc, 3 * sizeof(double)), *qc = cmalloc(c, nc, 3 * sizeof(double));
+    size_t *pidx = cmalloc(c, nc, sizeof(size_t)), *qx = cmalloc(c, nx, sizeof(size_t));
+    int rc = HD_OK;
+    if (!pc || !qc || !pidx || !qx) rc = nomem(c, "the pairs", nc);
+    for (size_t i = 0, j = 0, t = 0, x = 0; rc == HD_OK && j < nQ;) {
+        if (i < nP && d->gP[i] == d->gQ[j]) {
+            memcpy(pc + 3 * t, d->P + 3 * i, 3 * sizeof(double));
+            memcpy(qc + 3 * t, d->Q + 3 * j, 3 * sizeof(double));
+            pidx[t++] = i++;
+            j++;
+        } else if (i < nP && d->gP[i] < d->gQ[j]) {
+            i++;
+        } else {
+            qx[x++] = j++;
+        }
+    }
+    hd_result_t e;
+    if (rc == HD_OK) {
+        hd_points_t Pv = hd_points_f64(pc, nc), Qv = hd_points_f64(qc, nc);
+        hd_options_t o;
+        hd_options_init(&o);
+        o.threads = c->threads;
+        rc = hd_directed(&Pv, &Qv, &o, &e, &c->e);
+    }
+    if (rc == HD_OK) {
+        size_t astar = pidx[e.i];
+        memset(in, 0, nP);
+        *nI = 0;
+        for (size_t t = 0; t < nc; t++) *nI += in[pidx[t]] = (unsigned char)faces_clear(mine, d->P + 3 * pidx[t], e.distance2);
+        double v = INFINITY;
+        uint64_t jv = UINT64_MAX;
+        for (size_t x = 0; x < nx && in[astar]; x++) {
+            double d2 = hd__d2(d->P + 3 * astar, d->Q + 3 * qx[x]);
+            if (d2 < v || (d2 == v && d->gQ[qx[x]] < jv)) v = d2, jv = d->gQ[qx[x]];
+        }
+        uint64_t jc = d->gP[pidx[e.j]]; /* Q_c's point e.j is the partner of P_c's point e.j */
+        if (in[astar] && v >= e.distance2) {
+            *inner = (far_t){e.distance2, d->gP[astar], v == e.distance2 && jv < jc ? jv : jc};
+            *done = 1;
+        }
+    }
+    cfree(c, pc, nc, 3 * sizeof(double));
+    cfree(c, qc, nc, 3 * sizeof(double));
+    cfree(c, pidx, nc, sizeof(size_t));
+    cfree(c, qx, nx, sizeof(size_t));
+    return rc;
+}
+
 static int shell_of(ctx_t *c, const dir_t *d, const hd__box_t *mine, qtree_t *q, shell_t *sh) {
     memset(sh, 0, sizeof *sh);
     sh->inner = (far_t){-1.0, UINT64_MAX, UINT64_MAX};
@@ -447,14 +525,23 @@ static int shell_of(ctx_t *c, const dir_t *d, const hd__box_t *mine, qtree_t *q,
     hd_options_init(&o);
     o.threads = c->threads;
     hd_result_t e;
-    int rc = hd_directed(&Pv, &Qv, &o, &e, &c->e);
-    if (rc != HD_OK) return rc;
     unsigned char *in = cmalloc(c, d->nP, 1);
     if (!in) return nomem(c, "the interior", d->nP);
     size_t nI = 0;
-    for (size_t k = 0; k < d->nP; k++) nI += in[k] = (unsigned char)faces_clear(mine, d->P + 3 * k, e.distance2);
+    int done = 0;
+    int rc = paired_pass(c, d, mine, in, &nI, &sh->inner, &done);
+    if (rc == HD_OK && !done && (rc = hd_directed(&Pv, &Qv, &o, &e, &c->e)) == HD_OK) {
+        nI = 0;
+        for (size_t k = 0; k < d->nP; k++) nI += in[k] = (unsigned char)faces_clear(mine, d->P + 3 * k, e.distance2);
+    }
+    if (rc != HD_OK) {
+        cfree(c, in, d->nP, 1);
+        return rc;
+    }
     size_t nS = d->nP - nI;
-    if (nI && in[e.i]) {
+    if (done) {
+        /* the interior's answer is the paired pass's */
+    } else if (nI && in[e.i]) {
         sh->inner = (far_t){e.distance2, d->gP[e.i], d->gQ[e.j]};
     } else if (nI) {
         double *ixyz = cmalloc(c, nI, 3 * sizeof(double));

@@ -61,10 +61,11 @@ static size_t layout(int how, int side, const double *xyz, size_t n, uint64_t se
         parts[np++] = (hd_mpi_part_t){hd_points_f64(xyz + 3 * lo, hi - lo), lo};
         break;
     }
-    case LAY_CHUNKS:
-        for (size_t lo = 0, c = 0; lo < n; lo += 7, c++)
-            if ((int)(c % (size_t)K) == r && np < cap) {
-                size_t m = n - lo < 7 ? n - lo : 7;
+    case LAY_CHUNKS: {
+        size_t w = n / 7 < cap - 1 ? 7 : n / (cap - 1) + 1; /* chunks of 7, fewer for large sets */
+        for (size_t lo = 0, c = 0; lo < n; lo += w, c++)
+            if ((int)(c % (size_t)K) == r) {
+                size_t m = n - lo < w ? n - lo : w;
                 parts[np++] = (hd_mpi_part_t){hd_points_f64(xyz + 3 * lo, m), lo};
             }
         for (size_t k = 0; k < np / 2; k++) { /* any order: the library sorts */
@@ -73,6 +74,7 @@ static size_t layout(int how, int side, const double *xyz, size_t n, uint64_t se
             parts[np - 1 - k] = t;
         }
         break;
+    }
     case LAY_ALL_ON_0:
         if (r == 0) parts[np++] = (hd_mpi_part_t){hd_points_f64(xyz, n), 0};
         break;
@@ -112,7 +114,7 @@ typedef struct {
 
 enum {
     DS_UNIFORM, DS_LATTICE, DS_LATTICE_HALF, DS_ONE_POINT, DS_PLANE, DS_FAR_B, DS_CORNER_B, DS_DUPLICATES,
-    DS_TINY, DS_HUGE, DS_NOISE, DS_DISJOINT, DS_CHECKER, DS_COUNT
+    DS_TINY, DS_HUGE, DS_NOISE, DS_DISJOINT, DS_CHECKER, DS_STRAY, DS_COUNT
 };
 
 static void make_set(int which, uint64_t seed, set_t *s) {
@@ -121,8 +123,8 @@ static void make_set(int which, uint64_t seed, set_t *s) {
     size_t n = 2000;
     s->na = n;
     s->nb = n;
-    s->a = malloc(3 * 4096 * sizeof(double)); /* the checkerboard has 2048 */
-    s->b = malloc(3 * 4096 * sizeof(double));
+    s->a = malloc(3 * 16000 * sizeof(double)); /* the largest set (DS_STRAY) */
+    s->b = malloc(3 * 16000 * sizeof(double));
     switch (which) {
     case DS_UNIFORM:
         s->name = "uniform A and B";
@@ -204,6 +206,32 @@ static void make_set(int which, uint64_t seed, set_t *s) {
             if (s->b[3 * k] == 8 && s->b[3 * k + 1] == 8 && s->b[3 * k + 2] == 7) gen_swap(s->b, 0, k);
         break;
     }
+    case DS_STRAY: {
+        /* A copy (|A| = |B|, B[g] = A[g] + 1e-3 noise) of a 20^3 lattice
+         * whose every point is in A twice (g and g + 8000), so that the
+         * ranks' correspondence pass runs; but B[c] and B[c + 8000] are
+         * moved 0.3 off A[c] = (2, 2, 2), which makes A[c] the pairs'
+         * farthest point, and B[s], the partner of the far A[s] =
+         * (17, 17, 17), sits 0.1 from A[c]: a point of B whose partner is on
+         * another rank, nearer to the pairs' witness than its pairs.  So
+         * h(A,B) = 0.1 at A[c], not the pairs' 0.3. */
+        s->name = "copy whose farthest pair has a nearer point paired elsewhere";
+        size_t N = 8000, c = 0, f = 0, k = 0;
+        for (int x = 0; x < 20; x++)
+            for (int y = 0; y < 20; y++)
+                for (int z = 0; z < 20; z++, k++) {
+                    s->a[3 * k] = x, s->a[3 * k + 1] = y, s->a[3 * k + 2] = z;
+                    if (x == 2 && y == 2 && z == 2) c = k;
+                    if (x == 17 && y == 17 && z == 17) f = k;
+                }
+        memcpy(s->a + 3 * N, s->a, 3 * N * sizeof(double));
+        s->na = s->nb = 2 * N;
+        for (size_t q = 0; q < 3 * s->na; q++) s->b[q] = s->a[q] + 1e-3 * gen_normal(&g);
+        s->b[3 * c + 1] = 2.3, s->b[3 * c] = 2, s->b[3 * c + 2] = 2;
+        s->b[3 * (c + N) + 1] = 1.7, s->b[3 * (c + N)] = 2, s->b[3 * (c + N) + 2] = 2;
+        s->b[3 * f] = 2.1, s->b[3 * f + 1] = 2, s->b[3 * f + 2] = 2;
+        break;
+    }
     case DS_DISJOINT:
         s->name = "disjoint boxes";
         gen_cube(&g, s->a, n, 0, 1);
@@ -229,6 +257,11 @@ static void check_equal(int which, int how, uint64_t seed) {
     CHECK(rc == HD_OK);
     hd_mpi_part_t pa[400], pb[400];
     size_t na = layout(how, 0, s.a, s.na, seed, pa, 400), nb = layout(how, 1, s.b, s.nb, seed, pb, 400);
+    unsigned long long held[2] = {0, 0}, all[2];
+    for (size_t k = 0; k < na; k++) held[0] += pa[k].points.count;
+    for (size_t k = 0; k < nb; k++) held[1] += pb[k].points.count;
+    MPI_Allreduce(held, all, 2, MPI_UNSIGNED_LONG_LONG, MPI_SUM, MPI_COMM_WORLD);
+    CHECK(all[0] == s.na && all[1] == s.nb); /* the layout gave every point out once */
     hd_mpi_stats_t st;
     rc = hd_mpi_hausdorff(MPI_COMM_WORLD, pa, na, pb, nb, &opt, &got, &st, &err);
     CHECK(rc == HD_OK);
