@@ -38,7 +38,10 @@
  *     direction, which the forwarded queries of step 5 ask too.  The
  *     engine prunes the points that cannot be the farthest, which
  *     per-point searches cannot: on two epochs of one scene that is tens
- *     of times less work.
+ *     of times less work.  For a copy and its original (point g of B the
+ *     moved point g of A) the rank first passes its whole pairs to the
+ *     engine in the same order, so the engine's correspondence path runs
+ *     (paired_pass).
  *  4. a is *confirmed* when every finite face of its region is strictly
  *     farther than u(a): a point b beyond the face at s on axis k has
  *     |fl(a_k - b_k)| >= |fl(a_k - s)| (rounding is monotone), and the
