@@ -17,10 +17,10 @@ MAKEFLAGS += --no-print-directory
 all: $(BUILD)/hausdorff
 
 deps:
-	@scripts/deps.sh build extras
+	@scripts/deps.sh build extras mpi
 
 $(BUILD)/CMakeCache.txt:
-	@scripts/deps.sh build extras
+	@scripts/deps.sh build extras mpi
 	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release $(CMAKE_ARGS)
 
 $(BUILD)/hausdorff: $(BUILD)/CMakeCache.txt FORCE
