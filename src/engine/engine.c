@@ -471,6 +471,7 @@ typedef struct {
     hd__counts_t counts[2];
     uint64_t culled[2];
     double cost[2];
+    hd__reuse_t pool;      /* the grids' and trees' arrays, reused as they are freed */
 } engine_t;
 
 static void engine_free(engine_t *e) {
@@ -480,6 +481,7 @@ static void engine_free(engine_t *e) {
         for (int k = 0; k < 2; k++) hd__tree_free(&e->tree[k]);
     for (int d = 0; d < e->max_ready; d++) hd__max_destroy(&e->max[d]);
     hd__pairs_free(&e->pairs);
+    hd__reuse_free(&e->pool);
     e->have_grid = e->have_tree = e->max_ready = 0;
 }
 
@@ -487,6 +489,7 @@ static int engine_init(engine_t *e, const hd_points_t *A, const hd_points_t *B,
                        const hd__box_t *box_a, const hd__box_t *box_b, const hd_options_t *opt,
                        int directions, hd_error_t *err) {
     memset(e, 0, sizeof *e);
+    hd__reuse_init(&e->pool);
     hd__src_init(&e->src[0], A, NULL);
     hd__src_init(&e->src[1], B, NULL);
     e->n[0] = A->count;
@@ -526,7 +529,8 @@ static int engine_plan(engine_t *e, hd__engine_force_t force, hd_error_t *err) {
                                                       e->n[1 - d], &e->max[d], &e->counts[d]);
     if (e->pairs.resolved[0] && (e->directions == 1 || e->pairs.resolved[1])) return HD_OK;
     for (int k = 0; k < 2; k++) {
-        int rc = hd__grid_build(&e->grid[k], &e->src[k], e->n[k], &e->box[k], e->threads, err);
+        int rc = hd__grid_build(&e->grid[k], &e->src[k], e->n[k], &e->box[k], e->threads, &e->pool,
+                                 err);
         if (rc) {
             if (k) hd__grid_free(&e->grid[0]);
             return rc;
@@ -605,9 +609,9 @@ static int engine_run(engine_t *e, hd__engine_force_t force, hd_result_t out[2],
         }
         for (int k = 0; k < 2; k++) hd__grid_free(&e->grid[k]);
         e->have_grid = 0;
-        rc = hd__tree_build(&e->tree[0], &e->src[0], e->n[0], &g[0], e->threads, err);
+        rc = hd__tree_build(&e->tree[0], &e->src[0], e->n[0], &g[0], e->threads, &e->pool, err);
         if (rc) return rc;
-        rc = hd__tree_build(&e->tree[1], &e->src[1], e->n[1], &g[1], e->threads, err);
+        rc = hd__tree_build(&e->tree[1], &e->src[1], e->n[1], &g[1], e->threads, &e->pool, err);
         if (rc) {
             hd__tree_free(&e->tree[0]);
             return rc;
