@@ -81,6 +81,15 @@ void *hd__reuse_get(hd__reuse_t *pool, size_t n, size_t size);
 void hd__reuse_put(hd__reuse_t *pool, void *p); /* p may be NULL */
 void hd__reuse_free(hd__reuse_t *pool);          /* frees every kept block */
 
+/* Map the pages of the fresh block p[0..bytes) now, in one call, rather
+ * than one page fault per page as it is first written (a fault costs far
+ * more than the write on virtual machines: docs/engine.md, "Threads and
+ * memory").  For arrays about to be written whole; a no-op below
+ * HD__PREFAULT_MIN bytes and where the system has no such call.
+ * hd__reuse_get does it for the fresh blocks it allocates. */
+#define HD__PREFAULT_MIN (1u << 20)
+void hd__prefault(void *p, size_t bytes);
+
 /* ---- randomness (explicit seeds only) ------------------------------------ */
 typedef struct hd__rng {
     uint64_t s[4];
