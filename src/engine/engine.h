@@ -130,10 +130,12 @@ HD__INLINE double hd__min32(const double *c) {
  * the search in bounds.  The answer is then meaningless, but nothing is
  * read out of bounds. */
 HD__INLINE int hd__find(const double *c, double v) {
-    int k = 0;
-    while (k < HD__BUCKET && c[k] != v) k++;
-    assert(k < HD__BUCKET || __builtin_isnan(v)); /* c[k] == v unless v is NaN */
-    return k < HD__BUCKET ? k : 0;
+    /* A mask of the equal values, without an early exit: the loop
+     * vectorises (compare, move mask), where a search loop does not. */
+    uint32_t m = 0;
+    for (int k = 0; k < HD__BUCKET; k++) m |= (uint32_t)(c[k] == v) << k;
+    assert(m != 0 || __builtin_isnan(v)); /* some c[k] == v unless v is NaN */
+    return m ? __builtin_ctz(m) : 0;
 }
 
 /* Keep the k items with the largest scores, in decreasing order of score,
