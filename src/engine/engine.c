@@ -65,6 +65,8 @@ typedef struct {
     double bc_err;     /* known within this distance */
     int have_bc;
     size_t hint;       /* bucket of B where the last search ended */
+    ptrdiff_t drift;   /* where the previous bucket of A found most partners,
+                        * relative to the same place along B's curve */
 } walk_t;
 
 static void walk_init(walk_t *s, dir_ctx *c, worker_t *w) {
@@ -73,6 +75,7 @@ static void walk_init(walk_t *s, dir_ctx *c, worker_t *w) {
     hd__max_snapshot(c->m, &s->snap);
     s->have_bc = 0;
     s->hint = HD__NONE;
+    s->drift = 0;
 }
 
 static size_t node_points(const hd__tree_t *t, int level, size_t i) {
@@ -157,9 +160,10 @@ static const double *group_exact(const hd__tree_t *ta, group_t *g, int k) {
 /* Try bucket i of B on the live points of g; a point is discarded when the
  * approximations prove some point of the bucket strictly within cmax, or
  * when the pair is too close to call and its exact distance does.
- * Returns 1 when the bucket was read. */
+ * Returns how many points it discarded. */
 HD__HOT static int try_bucket(walk_t *s, group_t *g, size_t i, double cmax2) {
     const hd__tree_t *tb = s->c->tb;
+    const uint32_t alive0 = g->alive;
     const hd__bucket_t *bb = &tb->bucket[i];
     double lim = hd__kill_below(cmax2, g->err + bb->err);
     double reach = hd__may_reach(cmax2, g->err + bb->err);
@@ -205,7 +209,7 @@ HD__HOT static int try_bucket(walk_t *s, group_t *g, size_t i, double cmax2) {
         close_k[n_close] = k;
         close_b[n_close++] = arg;
     }
-    if (!n_close) return 1;
+    if (!n_close) return __builtin_popcount(alive0 & ~g->alive);
     /* Pairs too close to call from the approximations (ties, or nearly) are
      * decided exactly; their scattered loads are started together. */
     const hd__tree_t *ta = s->c->ta;
@@ -231,7 +235,7 @@ HD__HOT static int try_bucket(walk_t *s, group_t *g, size_t i, double cmax2) {
             s->hint = i;
         }
     }
-    return 1;
+    return __builtin_popcount(alive0 & ~g->alive);
 }
 
 /* Resolve the points of A's bucket bk together, from their quantised copy:
@@ -265,18 +269,27 @@ static void walk_bucket(walk_t *s, size_t bk) {
     }
     if (g.alive) {
         /* Two guesses: the bucket at the same relative position along B's
-         * curve, and the bucket where the last search ended. */
-        size_t guess[2] = {(size_t)((double)bk * (double)tb->nb / (double)ta->nb), s->hint};
+         * curve moved by the drift that served the previous bucket (two
+         * curves over nearly the same points drift apart slowly, by the
+         * points that crossed a cell face), and the bucket where the last
+         * search ended. */
+        size_t same = (size_t)((double)bk * (double)tb->nb / (double)ta->nb);
+        ptrdiff_t at = (ptrdiff_t)same + s->drift;
+        size_t guess[2] = {at < 0 ? 0 : (size_t)at, s->hint};
+        size_t most = HD__NONE;
+        int most_k = 0;
         for (int q = 0; q < 2 && g.alive; q++) {
             size_t h = guess[q];
             if (h == HD__NONE || (q == 1 && h + NEIGHBOURS >= guess[0] && h <= guess[0] + NEIGHBOURS)) continue;
             if (h >= tb->nb) h = tb->nb - 1;
-            try_bucket(s, &g, h, cmax2);
+            int k = try_bucket(s, &g, h, cmax2);
+            if (k > most_k) most_k = k, most = h;
             for (size_t r = 1; r <= NEIGHBOURS && g.alive; r++) {
-                if (h + r < tb->nb) try_bucket(s, &g, h + r, cmax2);
-                if (g.alive && h >= r) try_bucket(s, &g, h - r, cmax2);
+                if (h + r < tb->nb && (k = try_bucket(s, &g, h + r, cmax2)) > most_k) most_k = k, most = h + r;
+                if (g.alive && h >= r && (k = try_bucket(s, &g, h - r, cmax2)) > most_k) most_k = k, most = h - r;
             }
         }
+        if (most != HD__NONE) s->drift = (ptrdiff_t)most - (ptrdiff_t)same;
     }
     const hd__box_t *ba = hd__tree_box(ta, 0, bk);
     struct {
