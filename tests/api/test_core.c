@@ -6,12 +6,9 @@
 #include "brute.h"
 #include "check.h"
 #include "gen.h"
-#include "base/base.h"
 
 #include <math.h>
-#include <stdint.h>
 #include <stdlib.h>
-#include <string.h>
 
 TEST(every_result_code_has_a_text_and_a_name) {
     int codes[] = {HD_OK, HD_EINVAL, HD_ENOMEM, HD_EEMPTY, HD_ENONFINITE, HD_ERANGE, HD_EIO,
@@ -27,36 +24,6 @@ TEST(result_codes_run_without_gaps_from_ok_down_to_the_tables_end) {
     for (int c = HD_OK; c >= HD__ERRNO_MIN; c--) CHECK(strcmp(hd_strerror(c), "unknown error") != 0);
     CHECK(strcmp(hd_strerror(HD__ERRNO_MIN - 1), "unknown error") == 0);
     CHECK_EQ(HD__ERRNO_MIN, HD_EALGORITHM);
-}
-
-TEST(a_reuse_set_hands_a_returned_block_to_a_request_it_fits) {
-    hd__reuse_t r;
-    hd__reuse_init(&r);
-    unsigned char *a = hd__reuse_get(&r, 1 << 20, 4);
-    CHECK(a != NULL);
-    memset(a, 1, (size_t)4 << 20);
-    hd__reuse_put(&r, a);
-    /* Larger than the block, or under a third of it: fresh memory. */
-    unsigned char *big = hd__reuse_get(&r, (1 << 20) + 1, 4), *tiny = hd__reuse_get(&r, 1 << 18, 4);
-    CHECK(big != a && tiny != a);
-    /* A request it fits gets it back, once. */
-    unsigned char *b = hd__reuse_get(&r, 3 << 18, 4), *c = hd__reuse_get(&r, 3 << 18, 4);
-    CHECK(b == a && c != a);
-    CHECK_EQ(b[0], 1);
-    hd__reuse_put(&r, big);
-    hd__reuse_put(&r, tiny);
-    hd__reuse_put(&r, b);
-    hd__reuse_put(&r, c);
-    hd__reuse_put(&r, NULL);
-    CHECK_EQ(r.n, 4);
-    hd__reuse_free(&r);
-    CHECK_EQ(r.n, 0);
-    /* Without a set, blocks are plain allocations (ASan checks the frees). */
-    void *p = hd__reuse_get(NULL, 1 << 20, 8), *q = hd__reuse_get(NULL, 3, 8);
-    CHECK(p != NULL && q != NULL);
-    hd__reuse_put(NULL, p);
-    hd__reuse_put(NULL, q);
-    CHECK(hd__reuse_get(&r, SIZE_MAX / 2, 4) == NULL);
 }
 
 TEST(algorithm_names_round_trip) {
