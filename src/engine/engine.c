@@ -124,8 +124,11 @@ static void resolve_point(walk_t *s, const double a[3], size_t ia) {
     hd__max_offer(s->c->m, hit.d2, ia, hit.j, &s->snap);
 }
 
-/* Buckets of B tried on each side of the last useful one, along B's curve. */
-#define NEIGHBOURS 2
+/* Buckets of B tried on each side of the guess along B's curve, while
+ * points are left: a point still alive after them gets a search of its
+ * own, which on nearly identical sets costs as much as a dozen more tries
+ * (docs/engine.md). */
+#define NEIGHBOURS 8
 
 /* The shared walk of a bucket of A visits at most BLOCK_LEAVES buckets of
  * B, within the subtree of 2^BLOCK_LEVEL buckets around the last useful one,
