@@ -4,18 +4,19 @@
  * line on stderr saying what was wrong.
  */
 #include "cli.h"
+#include "tiles.h"
 
 #include <errno.h>
 #include <stdlib.h>
 #include <string.h>
-#include <strings.h>
 
 void cli_usage(FILE *out) {
     fprintf(out,
 "usage: hausdorff [options] A B\n"
 "\n"
 "Exact Hausdorff distance between the point sets in files A and B:\n"
-"H(A,B) = max(h(A,B), h(B,A)), h(A,B) = max over a in A of min over b in B |a-b|.\n"
+"H(A,B) = max(h(A,B), h(B,A)),\n"
+"h(A,B) = max over a in A of min over b in B of |a-b|.\n"
 "Distances are bit-identical to a brute force in double precision.\n"
 "\n"
 "Options:\n"
@@ -35,6 +36,12 @@ void cli_usage(FILE *out) {
 "                     format: FORMAT:PATH, e.g. xyz:- or ply:scan.dat\n"
 "                     (./ply:x for a file whose name holds a colon)\n"
 "  --formats          list the file formats and exit\n"
+"  A or B as tiles:   a directory (its point files by extension, sorted by\n"
+"                     name in byte order, not recursed) or @LIST (a file of\n"
+"                     paths, one a line, relative to the list's folder; '#'\n"
+"                     comments; a line may be FORMAT:PATH): their points in\n"
+"                     that order; the witness is named by file and index\n"
+"                     (./@x for a file whose name starts with @)\n"
 "  --vertices         read a mesh (ply, obj, off, stl) as its vertices (default)\n"
 "  --sample N         read a mesh as N points drawn uniformly by area on its\n"
 "                     faces, reproducibly for a given --seed\n"
@@ -58,6 +65,7 @@ void cli_usage(FILE *out) {
 "  cat cloud.csv | hausdorff xyz:- model.ply\n"
 "  hausdorff --percentile 95 --mean --render dev.png scan.ply model.ply\n"
 "  hausdorff --json --percentile 95 seg.nii.gz truth.nii.gz\n"
+"  hausdorff --json tiles-2019/ @tiles-2024.txt\n"
 "\n"
 "Exit status: 0 success, 1 usage error, 2 bad input, 3 other failure.\n");
 }
@@ -69,6 +77,7 @@ void cli_formats(FILE *out) {
                  "        in millimetres (read by the tool, %s)\n",
             nifti_available() ? "available" : "unavailable: built without libnifti2");
     fprintf(out, "Extensions: .ply .obj .off .stl; .xyz .txt .csv .pts .asc; .pcd .las .npy; .nii .nii.gz.\n"
+                 "csv, txt, pts and asc name the xyz reader too (--format csv, csv:-).\n"
                  "One file's format: FORMAT:PATH (xyz:-, ply:scan.dat).\n"
                  "LAZ is not read: convert it with 'laszip -i in.laz -o out.las' or 'pdal translate in.laz out.las'.\n");
 }
@@ -122,22 +131,6 @@ static int parse_double(const char *s, double *out) {
     if (e == s || *e || errno) return -1;
     *out = v;
     return 0;
-}
-
-/* A path written FORMAT:PATH, FORMAT a reader's name in any case ("xyz:-",
- * "PLY:scan.dat"): *format is the reader's name and the path follows the
- * colon.  Anything else is a path as it stands, *format NULL ("./ply:x"
- * names a file whose name holds a colon). */
-static const char *split_format(const char *s, const char **format) {
-    *format = NULL;
-    const char *colon = strchr(s, ':');
-    if (!colon || colon == s) return s;
-    for (const char *const *f = hd_formats(); *f; f++)
-        if (strlen(*f) == (size_t)(colon - s) && strncasecmp(*f, s, (size_t)(colon - s)) == 0) {
-            *format = *f;
-            return colon + 1;
-        }
-    return s;
 }
 
 int cli_parse(int argc, char **argv, cli_args_t *a) {
@@ -202,8 +195,8 @@ int cli_parse(int argc, char **argv, cli_args_t *a) {
             if (parse_double(v, &a->opt.theta) || !(a->opt.theta >= 0 && a->opt.theta <= 1))
                 return bad("--theta needs a number in [0, 1], not '%s'", v);
         } else if (strcmp(name, "--format") == 0) {
-            if (!hd_format_description(v)) return bad("unknown format '%s' (see --formats)", v);
-            a->read.format = v;
+            if (!(a->read.format = tiles_format_named(v, strlen(v))))
+                return bad("unknown format '%s' (see --formats)", v);
         } else if (strcmp(name, "--sample") == 0) {
             uint64_t n;
             if (parse_u64(v, &n) || n == 0 || n > (uint64_t)1 << 40)
@@ -226,7 +219,7 @@ int cli_parse(int argc, char **argv, cli_args_t *a) {
                 nfiles);
         return EXIT_USAGE;
     }
-    a->path_a = split_format(files[0], &a->format_a);
-    a->path_b = split_format(files[1], &a->format_b);
+    a->path_a = tiles_split_format(files[0], &a->format_a);
+    a->path_b = tiles_split_format(files[1], &a->format_b);
     return -1;
 }

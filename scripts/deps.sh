@@ -15,7 +15,8 @@ for group in "$@"; do
   case "$group" in
     build)  add gcc make cmake pkg-config libc6-dev ;;
     extras) add libpng-dev libnifti2-dev zlib1g-dev ;;
-    test)   add python3 locales ;;
+    # python3-nibabel: tests/cli_nifti_reference.py writes MONAI's and medpy's test masks with it.
+    test)   add python3 locales python3-nibabel ;;
     # python3-venv and python3-wheel: README's `pip install --no-build-isolation
     # ./python` in a venv (tests/python_venv.sh).
     python) add python3 python3-dev python3-numpy python3-setuptools python3-pytest python3-scipy \
