@@ -13,8 +13,8 @@
 # cannot even be suppressed by library name.  The library's own buffers are
 # checked instead by an assert (src/mpi/mpi.c: the call's count of bytes
 # held is 0 when it returns), and AddressSanitizer and UBSan stay on.  The
-# times (Release, 2 cores): mpi_api 1 s, 3.5 s, 4.5 s, 3.5 s, 13 s; mpi_cli_3
-# 12 s.
+# times (Release, 2 shared cores): mpi_api 1, 3, 2.5-4.5, 3.5 and 6-13 s;
+# mpi_cli_3 10-22 s; sanitizers: mpi_api_3 14 s, mpi_cli_3 21 s.
 if(HD_MPI)
   find_program(HD_MPIEXEC NAMES mpirun mpiexec REQUIRED)
   add_executable(mpi_api ${CMAKE_CURRENT_SOURCE_DIR}/tests/api/mpi_api.c ${CMAKE_CURRENT_SOURCE_DIR}/tests/support/gen.c)
