@@ -102,9 +102,9 @@ void analysis_usage(FILE *out) {
 }
 
 static int usage_error(const char *fmt, const char *arg) {
-    fprintf(stderr, "hausdorff: ");
+    fprintf(stderr, "%s: ", cli_prog());
     fprintf(stderr, fmt, arg);
-    fprintf(stderr, "\nTry 'hausdorff --help'.\n");
+    fprintf(stderr, "\nTry '%s --help'.\n", cli_prog());
     return -1;
 }
 
@@ -337,11 +337,11 @@ int analysis_handle_empty(const analysis_args_t *an, const char *path_a,
     FILE *out = stdout;
     hd_error_t err;
     if (an->distances_out && write_empty_files(an, A, B, directed, v, &err) != HD_OK) {
-        fprintf(stderr, "hausdorff: %s\n", err.message);
+        fprintf(stderr, "%s: %s\n", cli_prog(), err.message);
         return EXIT_FAILURE_;
     }
     if (an->render_out || an->histogram_png)
-        fprintf(stderr, "hausdorff: no picture drawn: %s is empty\n", n_a ? "B" : "A");
+        fprintf(stderr, "%s: no picture drawn: %s is empty\n", cli_prog(), n_a ? "B" : "A");
     if (json) {
         fprintf(out, "{\"hausdorff\": ");
         json_number(out, v);

@@ -30,6 +30,9 @@ typedef struct cli_args {
  * --version, or a usage error, which it has reported). */
 int cli_parse(int argc, char **argv, cli_args_t *a);
 void cli_usage(FILE *out);
+/* The program's name for messages ("hausdorff", "hausdorff-mpi"), from
+ * argv[0] once cli_parse has run. */
+const char *cli_prog(void);
 /* The formats the reader knows, one per line (--formats). */
 void cli_formats(FILE *out);
 

@@ -54,7 +54,7 @@ static int check_outputs(const cli_args_t *a, const tiles_t side[2]) {
     if (!in || !which) {
         free(in);
         free(which);
-        fprintf(stderr, "hausdorff: out of memory\n");
+        fprintf(stderr, "%s: out of memory\n", cli_prog());
         return EXIT_FAILURE_;
     }
     for (int w = 0; w < 2; w++) {
@@ -80,7 +80,7 @@ int main(int argc, char **argv) {
     memset(side, 0, sizeof side);
     if ((rc = tiles_expand(a.path_a, a.format_a, &side[0], &err)) != HD_OK ||
         (rc = tiles_expand(a.path_b, a.format_b, &side[1], &err)) != HD_OK) {
-        fprintf(stderr, "hausdorff: %s\n", err.message);
+        fprintf(stderr, "%s: %s\n", cli_prog(), err.message);
         tiles_free(&side[0]);
         return cli_exit_for(rc);
     }
@@ -102,7 +102,7 @@ int main(int argc, char **argv) {
         (progress_phase("reading B: %s%s", a.path_b, files[1]),
          rc = tiles_read(&side[1], 0, side[1].n, &a.read, &a.an, 1, &cb, &err)) != HD_OK) {
         progress_stop();
-        fprintf(stderr, "hausdorff: %s\n", err.message);
+        fprintf(stderr, "%s: %s\n", cli_prog(), err.message);
         hd_cloud_free(ca);
         tiles_free(&side[0]);
         tiles_free(&side[1]);
@@ -138,7 +138,7 @@ int main(int argc, char **argv) {
         analysis_free(&an);
     progress_stop();
     if (rc != HD_OK) {
-        fprintf(stderr, "hausdorff: %s\n", err.message);
+        fprintf(stderr, "%s: %s\n", cli_prog(), err.message);
         hd_cloud_free(ca);
         hd_cloud_free(cb);
         tiles_free(&side[0]);

@@ -10,9 +10,15 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* The program's name in messages: the last part of argv[0] as cli_parse
+ * saw it ("hausdorff", "hausdorff-mpi"); "hausdorff" before that. */
+static const char *prog_name = "hausdorff";
+
+const char *cli_prog(void) { return prog_name; }
+
 void cli_usage(FILE *out) {
+    fprintf(out, "usage: %s [options] A B\n", prog_name);
     fprintf(out,
-"usage: hausdorff [options] A B\n"
 "\n"
 "Exact Hausdorff distance between the point sets in files A and B:\n"
 "H(A,B) = max(h(A,B), h(B,A)),\n"
@@ -83,9 +89,9 @@ void cli_formats(FILE *out) {
 }
 
 static int bad(const char *fmt, const char *arg) {
-    fprintf(stderr, "hausdorff: ");
+    fprintf(stderr, "%s: ", cli_prog());
     fprintf(stderr, fmt, arg);
-    fprintf(stderr, "\nTry 'hausdorff --help'.\n");
+    fprintf(stderr, "\nTry '%s --help'.\n", cli_prog());
     return EXIT_USAGE;
 }
 
@@ -135,6 +141,10 @@ static int parse_double(const char *s, double *out) {
 
 int cli_parse(int argc, char **argv, cli_args_t *a) {
     memset(a, 0, sizeof *a);
+    if (argc > 0 && argv[0] && argv[0][0]) {
+        const char *slash = strrchr(argv[0], '/');
+        prog_name = slash && slash[1] ? slash + 1 : argv[0];
+    }
     hd_options_init(&a->opt);
     hd_read_options_init(&a->read);
     analysis_args_init(&a->an);
@@ -149,7 +159,7 @@ int cli_parse(int argc, char **argv, cli_args_t *a) {
         }
         if (strcmp(s, "--") == 0) { only_files = 1; continue; }
         if (strcmp(s, "--help") == 0 || strcmp(s, "-h") == 0) { cli_usage(stdout); return EXIT_OK; }
-        if (strcmp(s, "--version") == 0) { printf("hausdorff %s\n", hd_version()); return EXIT_OK; }
+        if (strcmp(s, "--version") == 0) { printf("%s %s\n", prog_name, hd_version()); return EXIT_OK; }
         if (strcmp(s, "--directed") == 0) { a->directed = 1; continue; }
         if (strcmp(s, "--json") == 0) { a->json = 1; continue; }
         if (strcmp(s, "--quiet") == 0 || strcmp(s, "-q") == 0) { a->quiet = 1; continue; }
@@ -214,9 +224,9 @@ int cli_parse(int argc, char **argv, cli_args_t *a) {
     a->read.seed = a->opt.seed; /* --seed also seeds --sample */
     if (nfiles != 2) {
         /* one line and a pointer, not the whole help */
-        fprintf(stderr, "hausdorff: expected two files, A and B, not %d\n"
-                        "usage: hausdorff [options] A B   (hausdorff --help lists the options)\n",
-                nfiles);
+        fprintf(stderr, "%s: expected two files, A and B, not %d\n"
+                        "usage: %s [options] A B   (%s --help lists the options)\n", cli_prog(),
+                nfiles, cli_prog(), cli_prog());
         return EXIT_USAGE;
     }
     a->path_a = tiles_split_format(files[0], &a->format_a);

@@ -145,13 +145,13 @@ int out_check_paths(const char *const *outs, const char *const *what, int n,
         if (!outs[k]) continue;
         for (size_t w = 0; w < n_inputs; w++)
             if (clash(outs[k], inputs[w], 1)) {
-                fprintf(stderr, "hausdorff: %s %s would overwrite input %c (%s); name another file\n", what[k],
+                fprintf(stderr, "%s: %s %s would overwrite input %c (%s); name another file\n", cli_prog(), what[k],
                         outs[k], side[w], is_stdin(inputs[w], 1) ? "standard input" : inputs[w]);
                 return EXIT_USAGE;
             }
         for (int j = 0; j < k; j++)
             if (outs[j] && clash(outs[k], outs[j], 0)) {
-                fprintf(stderr, "hausdorff: %s %s and %s %s are the same file; name another file\n", what[j],
+                fprintf(stderr, "%s: %s %s and %s %s are the same file; name another file\n", cli_prog(), what[j],
                         outs[j], what[k], outs[k]);
                 return EXIT_USAGE;
             }
@@ -366,12 +366,12 @@ int out_finish(void) {
     if (fclose(stdout) != 0 && !e) e = errno ? errno : -1;
     if (e) {
         out_discard();
-        fprintf(stderr, "hausdorff: standard output: %s\n", reason(e));
+        fprintf(stderr, "%s: standard output: %s\n", cli_prog(), reason(e));
         return EXIT_FAILURE_;
     }
     hd_error_t err;
     if (commit(&err) != HD_OK) {
-        fprintf(stderr, "hausdorff: %s\n", err.message);
+        fprintf(stderr, "%s: %s\n", cli_prog(), err.message);
         return EXIT_FAILURE_;
     }
     return EXIT_OK;
