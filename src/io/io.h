@@ -100,6 +100,20 @@ int hd__read_pcd(hd__read_t *r);
 int hd__read_las(hd__read_t *r);
 int hd__read_npy(hd__read_t *r);
 
+/* A LAS header as las.c checked it: version minor, header size, offset to
+ * the points, point format (compression bit cleared), record length, point
+ * count (the 64-bit one in 1.4), VLR count, scale and offset per axis
+ * (finite).  The points start at `offset`. */
+typedef struct hd__las_header {
+    unsigned minor, fmt;
+    size_t header, offset, rec;
+    uint64_t count;
+    uint32_t n_vlr;
+    double scale[3], shift[3];
+} hd__las_header_t;
+/* The points of a LAZ (LASzip-compressed) file: laz.c. */
+int hd__read_laz(hd__read_t *r, const hd__las_header_t *h);
+
 /* ---- errors with a place --------------------------------------------------- */
 /* "NAME:LINE: what" with err->line set. */
 int hd__io_err_line(hd__read_t *r, int code, long long line, const char *fmt,
