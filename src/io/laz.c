@@ -91,92 +91,6 @@ typedef struct {
     char (*msg)[200];
 } laz_t;
 
-/* ---- small state shared by both schemes --------------------------------- */
-typedef struct {
-    int32_t v[5];
-    int high;
-} median5_t;
-
-static void median5_init(median5_t *m) {
-    memset(m->v, 0, sizeof m->v);
-    m->high = 1;
-}
-/* LASzip's streaming median: v[2] approximates the median of the last
- * five values; the update rule is part of the format. */
-static void median5_add(median5_t *m, int32_t x) {
-    int32_t *v = m->v;
-    if (m->high) {
-        if (x < v[2]) {
-            v[4] = v[3];
-            v[3] = v[2];
-            if (x < v[0]) {
-                v[2] = v[1];
-                v[1] = v[0];
-                v[0] = x;
-            } else if (x < v[1]) {
-                v[2] = v[1];
-                v[1] = x;
-            } else {
-                v[2] = x;
-            }
-        } else {
-            if (x < v[3]) {
-                v[4] = v[3];
-                v[3] = x;
-            } else {
-                v[4] = x;
-            }
-            m->high = 0;
-        }
-    } else {
-        if (v[2] < x) {
-            v[0] = v[1];
-            v[1] = v[2];
-            if (v[4] < x) {
-                v[2] = v[3];
-                v[3] = v[4];
-                v[4] = x;
-            } else if (v[3] < x) {
-                v[2] = v[3];
-                v[3] = x;
-            } else {
-                v[2] = x;
-            }
-        } else {
-            if (v[1] < x) {
-                v[0] = v[1];
-                v[1] = x;
-            } else {
-                v[0] = x;
-            }
-            m->high = 1;
-        }
-    }
-}
-
-/* number_return_map (POINT10): the return context m of return r of n. */
-static const unsigned char rmap10[8][8] = {
-    {15, 14, 13, 12, 11, 10, 9, 8}, {14, 0, 1, 3, 6, 10, 10, 9},   {13, 1, 2, 4, 7, 11, 11, 10},
-    {12, 3, 4, 5, 8, 12, 12, 11},   {11, 6, 7, 8, 9, 13, 13, 12},  {10, 10, 11, 12, 13, 14, 14, 13},
-    {9, 10, 11, 12, 13, 14, 15, 14}, {8, 9, 10, 11, 12, 13, 14, 15}};
-/* number_return_map_6ctx (POINT14). */
-static const unsigned char rmap14[16][16] = {
-    {0, 1, 2, 3, 4, 5, 3, 4, 4, 5, 5, 5, 5, 5, 5, 5}, {1, 0, 1, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3},
-    {2, 1, 2, 4, 4, 4, 4, 4, 4, 4, 4, 3, 3, 3, 3, 3}, {3, 3, 4, 5, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4},
-    {4, 3, 4, 4, 5, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4}, {5, 3, 4, 4, 4, 5, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4},
-    {3, 3, 4, 4, 4, 4, 5, 4, 4, 4, 4, 4, 4, 4, 4, 4}, {4, 3, 4, 4, 4, 4, 4, 5, 4, 4, 4, 4, 4, 4, 4, 4},
-    {4, 3, 4, 4, 4, 4, 4, 4, 5, 4, 4, 4, 4, 4, 4, 4}, {5, 3, 4, 4, 4, 4, 4, 4, 4, 5, 4, 4, 4, 4, 4, 4},
-    {5, 3, 4, 4, 4, 4, 4, 4, 4, 4, 5, 4, 4, 4, 4, 4}, {5, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5, 4, 4, 4},
-    {5, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5, 5, 4, 4}, {5, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5, 5, 4},
-    {5, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5, 5}, {5, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5}};
-/* number_return_level: |n - r| (POINT10), capped at 7 (POINT14). */
-static unsigned rlevel(unsigned n, unsigned r) {
-    unsigned l = n > r ? n - r : r - n;
-    return l > 7 ? 7 : l;
-}
-/* the context of dy from dx's k, and of z from the mean k */
-static unsigned kctx(unsigned k, unsigned cap) { return k < cap ? (k & ~1u) : cap; }
-
 /* ---- one chunk's work ------------------------------------------------------ */
 typedef struct {
     laz_t *z;
@@ -223,7 +137,7 @@ typedef struct {
     hd__symmodel_t changed, scan[2];
     hd__symmodel_t *bitbyte[256], *cls[256], *user[256];
     hd__intcoder_t intensity, psid, dx, dy, dz;
-    median5_t mx[16], my[16];
+    hd__median5_t mx[16], my[16];
     uint16_t last_int[16];
     int32_t last_h[8];
     unsigned char last[20];
@@ -346,7 +260,7 @@ static int p10_read(p10_t *p, hd__dec_t *d) {
         }
         r = L[14] & 7;
         n = (L[14] >> 3) & 7;
-        unsigned m = rmap10[n][r];
+        unsigned m = hd__laz_rmap10[n][r];
         if (changed & 16) {
             p->last_int[m] = (uint16_t)hd__ic_decode(&p->intensity, d, p->last_int[m], m < 3 ? m : 3);
         }
@@ -374,13 +288,13 @@ static int p10_read(p10_t *p, hd__dec_t *d) {
         r = L[14] & 7;
         n = (L[14] >> 3) & 7;
     }
-    unsigned m = rmap10[n][r], l = rlevel(n, r);
+    unsigned m = hd__laz_rmap10[n][r], l = hd__laz_level(n, r);
     int32_t dx = hd__ic_decode(&p->dx, d, p->mx[m].v[2], n == 1);
-    median5_add(&p->mx[m], dx);
-    int32_t dy = hd__ic_decode(&p->dy, d, p->my[m].v[2], (n == 1) + kctx(p->dx.k, 20));
-    median5_add(&p->my[m], dy);
+    hd__median5_add(&p->mx[m], dx);
+    int32_t dy = hd__ic_decode(&p->dy, d, p->my[m].v[2], (n == 1) + hd__laz_kctx(p->dx.k, 20));
+    hd__median5_add(&p->my[m], dy);
     int32_t X = (int32_t)((uint32_t)i32_at(L) + (uint32_t)dx), Y = (int32_t)((uint32_t)i32_at(L + 4) + (uint32_t)dy);
-    int32_t Z = hd__ic_decode(&p->dz, d, p->last_h[l], (n == 1) + kctx((p->dx.k + p->dy.k) / 2, 18));
+    int32_t Z = hd__ic_decode(&p->dz, d, p->last_h[l], (n == 1) + hd__laz_kctx((p->dx.k + p->dy.k) / 2, 18));
     p->last_h[l] = Z;
     for (int b = 0; b < 4; b++) {
         L[b] = (unsigned char)((uint32_t)X >> (8 * b));
@@ -501,8 +415,8 @@ static void pointwise_chunk(job_t *j, const unsigned char *b, size_t nb, size_t 
     }
     /* initial state from the raw first point */
     for (int i = 0; i < 16; i++) {
-        median5_init(&w->p.mx[i]);
-        median5_init(&w->p.my[i]);
+        hd__median5_init(&w->p.mx[i]);
+        hd__median5_init(&w->p.my[i]);
     }
     memcpy(w->p.last, b, 20);
     w->p.last[12] = w->p.last[13] = 0; /* intensity starts at 0 */
@@ -548,7 +462,7 @@ typedef struct {
     hd__symmodel_t changed[8], scanner, rn_same;
     hd__symmodel_t *nret[16], *rnum[16];
     hd__intcoder_t dx, dy, dz;
-    median5_t mx[12], my[12];
+    hd__median5_t mx[12], my[12];
     int32_t last_z[8];
     int32_t X, Y, Z;
     unsigned r, n, gps_change;
@@ -581,8 +495,8 @@ static int ctx14_start(ctx14_t *c, const ctx14_t *from) {
     rc = rc ? rc : hd__intcoder_new(&c->dz, 32, 20);
     if (rc) return rc;
     for (int i = 0; i < 12; i++) {
-        median5_init(&c->mx[i]);
-        median5_init(&c->my[i]);
+        hd__median5_init(&c->mx[i]);
+        hd__median5_init(&c->my[i]);
     }
     c->X = from->X;
     c->Y = from->Y;
@@ -632,6 +546,7 @@ static void layered_chunk(job_t *j, const unsigned char *b, size_t nb, size_t n)
     hd__dec_t dxy, dz;
     hd__dec_init(&dxy, lxy, nxy);
     hd__dec_init(&dz, lz, nz);
+    dz.over = 0; /* an empty z layer (z constant in the chunk) is never read */
     if (ctx14_start(&cx[cur], &first)) {
         fail(j, HD_ENOMEM, at, "out of memory");
         goto done;
@@ -678,15 +593,15 @@ static void layered_chunk(job_t *j, const unsigned char *b, size_t nb, size_t n)
         }
         c->n = nn;
         c->r = r;
-        unsigned m = rmap14[nn][r], l = rlevel(nn, r), mi = m << 1 | gps;
+        unsigned m = hd__laz_rmap14[nn][r], l = hd__laz_level(nn, r), mi = m << 1 | gps;
         int32_t dx = hd__ic_decode(&c->dx, &dxy, c->mx[mi].v[2], nn == 1);
         c->X = (int32_t)((uint32_t)c->X + (uint32_t)dx);
-        median5_add(&c->mx[mi], dx);
-        int32_t dy = hd__ic_decode(&c->dy, &dxy, c->my[mi].v[2], (nn == 1) + kctx(c->dx.k, 20));
+        hd__median5_add(&c->mx[mi], dx);
+        int32_t dy = hd__ic_decode(&c->dy, &dxy, c->my[mi].v[2], (nn == 1) + hd__laz_kctx(c->dx.k, 20));
         c->Y = (int32_t)((uint32_t)c->Y + (uint32_t)dy);
-        median5_add(&c->my[mi], dy);
+        hd__median5_add(&c->my[mi], dy);
         if (nz) {
-            c->Z = hd__ic_decode(&c->dz, &dz, c->last_z[l], (nn == 1) + kctx((c->dx.k + c->dy.k) / 2, 18));
+            c->Z = hd__ic_decode(&c->dz, &dz, c->last_z[l], (nn == 1) + hd__laz_kctx((c->dx.k + c->dy.k) / 2, 18));
             c->last_z[l] = c->Z;
         }
         c->gps_change = gps;

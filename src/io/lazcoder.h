@@ -183,4 +183,25 @@ HD__INLINE int32_t hd__ic_decode(hd__intcoder_t *ic, hd__dec_t *d, int32_t pred,
     return (int32_t)real;
 }
 
+/* ---- facts shared by the POINT10 and POINT14 schemes -------------------- */
+/* LASzip's streaming median of the last five values: v[2]; the update rule
+ * is part of the format. */
+typedef struct hd__median5 {
+    int32_t v[5];
+    int high;
+} hd__median5_t;
+void hd__median5_init(hd__median5_t *m);
+void hd__median5_add(hd__median5_t *m, int32_t x);
+/* The return context m of return r of n: number_return_map (POINT10, 8x8)
+ * and number_return_map_6ctx (POINT14, 16x16), indexed [n][r]. */
+extern const unsigned char hd__laz_rmap10[8][8];
+extern const unsigned char hd__laz_rmap14[16][16];
+/* The return level l: |n - r|, capped at 7. */
+HD__INLINE unsigned hd__laz_level(unsigned n, unsigned r) {
+    unsigned l = n > r ? n - r : r - n;
+    return l > 7 ? 7 : l;
+}
+/* The context of dy from dx's k (cap 20), of z from the mean k (cap 18). */
+HD__INLINE unsigned hd__laz_kctx(unsigned k, unsigned cap) { return k < cap ? (k & ~1u) : cap; }
+
 #endif
