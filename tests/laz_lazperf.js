@@ -11,7 +11,7 @@
 const fs = require('fs');
 const path = require('path');
 const [modules, file] = process.argv.slice(2);
-const { createLazPerf } = require(path.join(modules, 'laz-perf'));
+const { createLazPerf } = require(path.resolve(modules, 'laz-perf'));
 
 (async () => {
   const lp = await createLazPerf();

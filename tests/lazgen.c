@@ -1,0 +1,70 @@
+/*
+ * lazgen.c -- writes the LAZ files of the laz-perf check (tests/laz_lazperf.py):
+ *
+ *   lazgen DIR
+ *
+ * For each case, DIR/NAME.laz from the tests' LAZ writer
+ * (tests/support/lazwrite.c) and DIR/NAME.txt with its points' integer
+ * coordinates, "X Y Z" per line in file order; then prints the case names,
+ * one per line.  Seeded: the same files on every run.
+ */
+#include "files.h"
+#include "gen.h"
+#include "lazwrite.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+
+static void write_case(const char *dir, const char *name, const lazw_opts_t *o, uint64_t seed, size_t n) {
+    gen_rng_t g;
+    gen_seed(&g, seed);
+    lazw_point_t *p = malloc(n * sizeof *p);
+    if (!p) exit(1);
+    lazw_random(&g, p, n, o->format);
+    tf_buf_t b = {0};
+    lazw_encode(&b, o, p, n);
+    char path[4096];
+    snprintf(path, sizeof path, "%s/%s.laz", dir, name);
+    FILE *f = fopen(path, "wb");
+    if (!f || fwrite(b.data, 1, b.size, f) != b.size || fclose(f)) {
+        perror(path);
+        exit(1);
+    }
+    snprintf(path, sizeof path, "%s/%s.txt", dir, name);
+    f = fopen(path, "w");
+    if (!f) {
+        perror(path);
+        exit(1);
+    }
+    for (size_t k = 0; k < n; k++) fprintf(f, "%d %d %d\n", (int)p[k].x, (int)p[k].y, (int)p[k].z);
+    if (fclose(f)) exit(1);
+    printf("%s\n", name);
+    tf_free(&b);
+    free(p);
+}
+
+int main(int argc, char **argv) {
+    if (argc != 2) {
+        fprintf(stderr, "usage: lazgen DIR\n");
+        return 2;
+    }
+    static const size_t sizes[] = {1, 700, 33, 2000, 1266};
+    for (int fmt = 0; fmt <= 3; fmt++)
+        for (unsigned extra = 0; extra <= 2; extra += 2) {
+            char name[64];
+            snprintf(name, sizeof name, "format%d_extra%u", fmt, extra);
+            lazw_opts_t o = {fmt, extra, 1000, NULL, 0, {0.01, 0.01, 0.01}, {100, 200, 300}};
+            write_case(argv[1], name, &o, 100 + (uint64_t)fmt * 10 + extra, 2500);
+        }
+    for (unsigned extra = 0; extra <= 3; extra += 3) {
+        char name[64];
+        snprintf(name, sizeof name, "format6_extra%u", extra);
+        lazw_opts_t o = {6, extra, 1000, NULL, 0, {0.001, 0.001, 0.001}, {0, 0, 0}};
+        write_case(argv[1], name, &o, 200 + extra, 2500);
+    }
+    lazw_opts_t v = {6, 0, 0, sizes, 5, {0.01, 0.01, 0.01}, {0, 0, 0}};
+    write_case(argv[1], "format6_variable_chunks", &v, 300, 4000);
+    v.format = 1;
+    write_case(argv[1], "format1_variable_chunks", &v, 301, 4000);
+    return 0;
+}
