@@ -7,6 +7,10 @@
  * (tests/support/lazwrite.c) and DIR/NAME.txt with its points' integer
  * coordinates, "X Y Z" per line in file order; then prints the case names,
  * one per line.  Seeded: the same files on every run.
+ *
+ *   lazgen --seeds DIR
+ *
+ * writes the fuzz target's seed files (tests/corpus/laz/, committed).
  */
 #include "files.h"
 #include "gen.h"
@@ -14,8 +18,10 @@
 
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
-static void write_case(const char *dir, const char *name, const lazw_opts_t *o, uint64_t seed, size_t n) {
+static void write_case(const char *dir, const char *name, const lazw_opts_t *o, uint64_t seed, size_t n,
+                       int with_points) {
     gen_rng_t g;
     gen_seed(&g, seed);
     lazw_point_t *p = malloc(n * sizeof *p);
@@ -30,6 +36,11 @@ static void write_case(const char *dir, const char *name, const lazw_opts_t *o, 
         perror(path);
         exit(1);
     }
+    if (!with_points) {
+        tf_free(&b);
+        free(p);
+        return;
+    }
     snprintf(path, sizeof path, "%s/%s.txt", dir, name);
     f = fopen(path, "w");
     if (!f) {
@@ -43,9 +54,26 @@ static void write_case(const char *dir, const char *name, const lazw_opts_t *o, 
     free(p);
 }
 
+/* The fuzz target's seeds (tests/corpus/laz/): small files of each scheme. */
+static int seeds(const char *dir) {
+    static const size_t sizes[] = {9, 1, 20};
+    lazw_opts_t o = {0, 0, 16, NULL, 0, {0.01, 0.01, 0.01}, {-5, 7, 0.5}};
+    write_case(dir, "fmt0_chunks16", &o, 1, 40, 0);
+    o.format = 3, o.extra = 2;
+    write_case(dir, "fmt3_extra2", &o, 2, 30, 0);
+    o.format = 6, o.extra = 0;
+    write_case(dir, "fmt6_channels", &o, 3, 60, 0);
+    o.extra = 1, o.chunk_size = 0, o.chunks = sizes, o.n_chunks = 3;
+    write_case(dir, "fmt6_variable_extra1", &o, 4, 30, 0);
+    o.format = 1, o.extra = 0;
+    write_case(dir, "fmt1_variable", &o, 5, 30, 0);
+    return 0;
+}
+
 int main(int argc, char **argv) {
+    if (argc == 3 && strcmp(argv[1], "--seeds") == 0) return seeds(argv[2]);
     if (argc != 2) {
-        fprintf(stderr, "usage: lazgen DIR\n");
+        fprintf(stderr, "usage: lazgen DIR | lazgen --seeds DIR\n");
         return 2;
     }
     static const size_t sizes[] = {1, 700, 33, 2000, 1266};
@@ -54,17 +82,17 @@ int main(int argc, char **argv) {
             char name[64];
             snprintf(name, sizeof name, "format%d_extra%u", fmt, extra);
             lazw_opts_t o = {fmt, extra, 1000, NULL, 0, {0.01, 0.01, 0.01}, {100, 200, 300}};
-            write_case(argv[1], name, &o, 100 + (uint64_t)fmt * 10 + extra, 2500);
+            write_case(argv[1], name, &o, 100 + (uint64_t)fmt * 10 + extra, 2500, 1);
         }
     for (unsigned extra = 0; extra <= 3; extra += 3) {
         char name[64];
         snprintf(name, sizeof name, "format6_extra%u", extra);
         lazw_opts_t o = {6, extra, 1000, NULL, 0, {0.001, 0.001, 0.001}, {0, 0, 0}};
-        write_case(argv[1], name, &o, 200 + extra, 2500);
+        write_case(argv[1], name, &o, 200 + extra, 2500, 1);
     }
     lazw_opts_t v = {6, 0, 0, sizes, 5, {0.01, 0.01, 0.01}, {0, 0, 0}};
-    write_case(argv[1], "format6_variable_chunks", &v, 300, 4000);
+    write_case(argv[1], "format6_variable_chunks", &v, 300, 4000, 1);
     v.format = 1;
-    write_case(argv[1], "format1_variable_chunks", &v, 301, 4000);
+    write_case(argv[1], "format1_variable_chunks", &v, 301, 4000, 1);
     return 0;
 }

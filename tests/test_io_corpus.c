@@ -99,7 +99,7 @@ static void read_one(const char *path, const char *format, int sample) {
 }
 
 TEST(every_corpus_file_reads_or_is_refused_by_the_contract) {
-    static const char *const formats[] = {"ply", "obj", "off", "stl", "xyz", "pcd", "las", "npy"};
+    static const char *const formats[] = {"ply", "obj", "off", "stl", "xyz", "pcd", "las", "npy", "laz"};
     int files = 0;
     for (size_t f = 0; f < sizeof formats / sizeof formats[0]; f++) {
         char dir[256];

@@ -111,7 +111,10 @@ typedef struct hd__las_header {
     uint32_t n_vlr;
     double scale[3], shift[3];
 } hd__las_header_t;
-/* The points of a LAZ (LASzip-compressed) file: laz.c. */
+/* The points of a LAZ (LASzip-compressed) file: laz.c.  A chunk may not
+ * claim more than HD__LAZ_POINTS_PER_BYTE points per byte of it: the bound
+ * on the allocation a LAZ file can cause. */
+#define HD__LAZ_POINTS_PER_BYTE 4096
 int hd__read_laz(hd__read_t *r, const hd__las_header_t *h);
 
 /* ---- errors with a place --------------------------------------------------- */

@@ -64,7 +64,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-#define HD__LAZ_POINTS_PER_BYTE 4096
 
 enum { IT_BYTE = 0, IT_POINT10 = 6, IT_GPSTIME11 = 7, IT_RGB12 = 8, IT_WAVE13 = 9, IT_POINT14 = 10, IT_RGB14 = 11,
        IT_RGBNIR14 = 12, IT_WAVE14 = 13, IT_BYTE14 = 14 };
