@@ -18,11 +18,14 @@
  * ("%.6f"), except the "xyz17" row, which uses the 17 significant digits
  * that round-trip a double (where the fast path of number.c gives way to
  * strtod).  Binary PCD, LAS, NPY, STL and PLY rows read straight from the
- * mapping.  Timings are wall-clock (CLOCK_MONOTONIC); nothing is asserted.
+ * mapping.  The "laz" and "laz10" rows hold the LAS row's integers
+ * LASzip-compressed (tests/support/lazwrite.c) as point format 6 (layered)
+ * and 0 (pointwise), chunks of 50 000 decoded in parallel.  Timings are wall-clock (CLOCK_MONOTONIC); nothing is asserted.
  */
 #include "gen.h"
 
 #include "benchutil.h"
+#include "lazwrite.h"
 
 #include <hausdorff.h>
 #include <stdio.h>
@@ -162,6 +165,21 @@ static int write_file(const char *fmt, const char *path, const double *p, size_t
             }
             fwrite(rec, 1, 30, f);
         }
+    } else if (!strncmp(fmt, "laz", 3)) {
+        /* the LAS row's integers, LASzip-compressed in chunks of 50 000:
+         * laz = point format 6 (layered), laz10 = format 0 (pointwise) */
+        lazw_point_t *q = malloc(n * sizeof *q);
+        for (size_t k = 0; k < n; k++) {
+            int32_t X[3];
+            for (int d = 0; d < 3; d++) X[d] = (int32_t)(p[3 * k + d] * 1e6);
+            q[k] = (lazw_point_t){X[0], X[1], X[2], 1, 1, 0};
+        }
+        lazw_opts_t o = {strcmp(fmt, "laz10") ? 6 : 0, 0, 50000, NULL, 0, {1e-6, 1e-6, 1e-6}, {0, 0, 0}};
+        tf_buf_t b = {0};
+        lazw_encode(&b, &o, q, n);
+        fwrite(b.data, 1, b.size, f);
+        tf_free(&b);
+        free(q);
     } else if (!strcmp(fmt, "npy")) {
         char h[128];
         int len = snprintf(h, sizeof h, "{'descr': '<f8', 'fortran_order': False, 'shape': (%zu, 3), }", n);
@@ -179,11 +197,12 @@ static int write_file(const char *fmt, const char *path, const double *p, size_t
 }
 
 static const char *const all_formats[] = {"ply_f32", "ply_f64", "ply_ascii", "stl", "obj", "off", "xyz", "xyz17", "csv",
-                                          "pcd_bin", "pcd_z", "pcd_ascii", "las", "npy", NULL};
+                                          "pcd_bin", "pcd_z", "pcd_ascii", "las", "laz", "laz10", "npy", NULL};
 static const char *extension(const char *fmt) {
     if (!strncmp(fmt, "ply", 3)) return "ply";
     if (!strncmp(fmt, "pcd", 3)) return "pcd";
     if (!strcmp(fmt, "xyz17")) return "xyz";
+    if (!strcmp(fmt, "laz10")) return "laz";
     return fmt;
 }
 

@@ -40,9 +40,17 @@ void hd__bitmodel_update(hd__bitmodel_t *m) {
 int hd__symmodel_new(hd__symmodel_t *m, uint32_t n) {
     assert(n >= 2 && n <= 2048);
     m->n = n;
-    m->dist = hd__malloc_array(2 * (size_t)n, sizeof(uint32_t));
+    m->tsize = m->tshift = 0;
+    if (n > 16) {
+        uint32_t bits = 3;
+        while (n > (1u << (bits + 2))) bits++;
+        m->tsize = 1u << bits;
+        m->tshift = HD__DM_SHIFT - bits;
+    }
+    m->dist = hd__malloc_array(2 * (size_t)n + (m->tsize ? m->tsize + 2 : 0), sizeof(uint32_t));
     if (!m->dist) return HD_ENOMEM;
     m->count = m->dist + n;
+    m->table = m->tsize ? m->dist + 2 * n : NULL;
     hd__symmodel_init(m);
     return HD_OK;
 }
@@ -60,10 +68,18 @@ void hd__symmodel_update(hd__symmodel_t *m) {
         m->total = 0;
         for (uint32_t k = 0; k < m->n; k++) m->total += (m->count[k] = (m->count[k] + 1) >> 1);
     }
-    uint32_t scale = 0x80000000u / m->total, sum = 0;
+    uint32_t scale = 0x80000000u / m->total, sum = 0, s = 0;
     for (uint32_t k = 0; k < m->n; k++) {
         m->dist[k] = (scale * sum) >> (31 - HD__DM_SHIFT);
         sum += m->count[k];
+        if (m->table) {
+            uint32_t w = m->dist[k] >> m->tshift;
+            while (s < w) m->table[++s] = k - 1;
+        }
+    }
+    if (m->table) {
+        m->table[0] = 0;
+        while (s <= m->tsize) m->table[++s] = m->n - 1;
     }
     m->cycle = (5 * m->cycle) >> 2;
     uint32_t max = (m->n + 6) << 3;
@@ -73,7 +89,7 @@ void hd__symmodel_update(hd__symmodel_t *m) {
 
 void hd__symmodel_free(hd__symmodel_t *m) {
     free(m->dist);
-    m->dist = m->count = NULL;
+    m->dist = m->count = m->table = NULL;
 }
 
 int hd__intcoder_new(hd__intcoder_t *ic, uint32_t bits, uint32_t contexts) {

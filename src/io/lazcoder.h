@@ -52,6 +52,10 @@ typedef struct hd__symmodel {
     uint32_t n, total, cycle, until;
     uint32_t *dist;  /* n entries: cumulative, scaled to 2^15 */
     uint32_t *count; /* n entries */
+    /* n > 16: table[t] = the last symbol whose dist >> tshift is below t,
+     * for t in [0, tsize + 1] (FastAC's decoder table; a speed-up that
+     * gives the symbol the bisection gives) */
+    uint32_t *table, tshift, tsize;
 } hd__symmodel_t;
 
 void hd__bitmodel_init(hd__bitmodel_t *m);
@@ -105,18 +109,33 @@ HD__INLINE uint32_t hd__dec_bit(hd__dec_t *d, hd__bitmodel_t *m) {
 HD__INLINE uint32_t hd__dec_symbol(hd__dec_t *d, hd__symmodel_t *m) {
     uint32_t y = d->length, x = 0, sym = 0, n = m->n;
     uint32_t len = d->length >> HD__DM_SHIFT;
-    /* the largest sym with dist[sym] * len <= value, by bisection */
-    uint32_t k = n >> 1;
-    do {
-        uint32_t z = len * m->dist[k];
-        if (z > d->value) {
-            n = k;
-            y = z;
-        } else {
-            sym = k;
-            x = z;
+    /* the largest sym with dist[sym] * len <= value, i.e. dist[sym] <=
+     * floor(value / len) */
+    if (m->table) {
+        uint32_t dv = d->value / len, t = dv >> m->tshift;
+        if (t > m->tsize) t = m->tsize; /* only when value >= length: bad input */
+        sym = m->table[t];
+        n = m->table[t + 1] + 1;
+        while (n > sym + 1) {
+            uint32_t k = (sym + n) >> 1;
+            if (m->dist[k] > dv) n = k;
+            else sym = k;
         }
-    } while ((k = (sym + n) >> 1) != sym);
+        x = m->dist[sym] * len;
+        if (sym != m->n - 1) y = m->dist[sym + 1] * len;
+    } else {
+        uint32_t k = n >> 1;
+        do {
+            uint32_t z = len * m->dist[k];
+            if (z > d->value) {
+                n = k;
+                y = z;
+            } else {
+                sym = k;
+                x = z;
+            }
+        } while ((k = (sym + n) >> 1) != sym);
+    }
     d->value -= x;
     d->length = y - x;
     if (d->length < HD__AC_MIN) hd__dec_renorm(d);
