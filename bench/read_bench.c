@@ -174,7 +174,7 @@ static int write_file(const char *fmt, const char *path, const double *p, size_t
             for (int d = 0; d < 3; d++) X[d] = (int32_t)(p[3 * k + d] * 1e6);
             q[k] = (lazw_point_t){X[0], X[1], X[2], 1, 1, 0};
         }
-        lazw_opts_t o = {strcmp(fmt, "laz10") ? 6 : 0, 0, 50000, NULL, 0, {1e-6, 1e-6, 1e-6}, {0, 0, 0}};
+        lazw_opts_t o = {strcmp(fmt, "laz10") ? 6 : 0, 0, 50000, NULL, 0, {1e-6, 1e-6, 1e-6}, {0, 0, 0}, 0};
         tf_buf_t b = {0};
         lazw_encode(&b, &o, q, n);
         fwrite(b.data, 1, b.size, f);

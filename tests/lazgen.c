@@ -57,7 +57,7 @@ static void write_case(const char *dir, const char *name, const lazw_opts_t *o, 
 /* The fuzz target's seeds (tests/corpus/laz/): small files of each scheme. */
 static int seeds(const char *dir) {
     static const size_t sizes[] = {9, 1, 20};
-    lazw_opts_t o = {0, 0, 16, NULL, 0, {0.01, 0.01, 0.01}, {-5, 7, 0.5}};
+    lazw_opts_t o = {0, 0, 16, NULL, 0, {0.01, 0.01, 0.01}, {-5, 7, 0.5}, 0};
     write_case(dir, "fmt0_chunks16", &o, 1, 40, 0);
     o.format = 3, o.extra = 2;
     write_case(dir, "fmt3_extra2", &o, 2, 30, 0);
@@ -67,6 +67,8 @@ static int seeds(const char *dir) {
     write_case(dir, "fmt6_variable_extra1", &o, 4, 30, 0);
     o.format = 1, o.extra = 0;
     write_case(dir, "fmt1_variable", &o, 5, 30, 0);
+    o.format = 3, o.extra = 1, o.v1 = 1;
+    write_case(dir, "fmt3_laszip1_extra1", &o, 6, 30, 0);
     return 0;
 }
 
@@ -81,16 +83,16 @@ int main(int argc, char **argv) {
         for (unsigned extra = 0; extra <= 2; extra += 2) {
             char name[64];
             snprintf(name, sizeof name, "format%d_extra%u", fmt, extra);
-            lazw_opts_t o = {fmt, extra, 1000, NULL, 0, {0.01, 0.01, 0.01}, {100, 200, 300}};
+            lazw_opts_t o = {fmt, extra, 1000, NULL, 0, {0.01, 0.01, 0.01}, {100, 200, 300}, 0};
             write_case(argv[1], name, &o, 100 + (uint64_t)fmt * 10 + extra, 2500, 1);
         }
     for (unsigned extra = 0; extra <= 3; extra += 3) {
         char name[64];
         snprintf(name, sizeof name, "format6_extra%u", extra);
-        lazw_opts_t o = {6, extra, 1000, NULL, 0, {0.001, 0.001, 0.001}, {0, 0, 0}};
+        lazw_opts_t o = {6, extra, 1000, NULL, 0, {0.001, 0.001, 0.001}, {0, 0, 0}, 0};
         write_case(argv[1], name, &o, 200 + extra, 2500, 1);
     }
-    lazw_opts_t v = {6, 0, 0, sizes, 5, {0.01, 0.01, 0.01}, {0, 0, 0}};
+    lazw_opts_t v = {6, 0, 0, sizes, 5, {0.01, 0.01, 0.01}, {0, 0, 0}, 0};
     write_case(argv[1], "format6_variable_chunks", &v, 300, 4000, 1);
     v.format = 1;
     write_case(argv[1], "format1_variable_chunks", &v, 301, 4000, 1);

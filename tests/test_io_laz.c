@@ -16,7 +16,7 @@
 
 #include <stdlib.h>
 
-static const lazw_opts_t plain = {0, 0, 50, NULL, 0, {0.01, 0.01, 0.001}, {1000.5, -20.25, 3}};
+static const lazw_opts_t plain = {0, 0, 50, NULL, 0, {0.01, 0.01, 0.001}, {1000.5, -20.25, 3}, 0};
 
 /* Read the LAZ bytes b with `threads`; HD_OK and the cloud, or the code
  * and the message in e. */
@@ -73,6 +73,24 @@ TEST(pointwise_formats_0_to_3_with_and_without_extra_bytes_read_bit_identically)
                 round_trip(&o, p, n, (int)seed);
                 free(p);
             }
+}
+
+TEST(laszip_1_streams_of_version_1_items_read_bit_identically) {
+    for (int fmt = 0; fmt <= 3; fmt++)
+        for (unsigned extra = 0; extra <= 2; extra += 2) {
+            CONTEXT("format %d, extra %u, seed 31", fmt, extra);
+            gen_rng_t g;
+            gen_seed(&g, 31);
+            size_t n = 1 + (size_t)(gen_u64(&g) % 700);
+            lazw_point_t *p = malloc(n * sizeof *p);
+            lazw_random(&g, p, n, fmt);
+            lazw_opts_t o = plain;
+            o.format = fmt;
+            o.extra = extra;
+            o.v1 = 1;
+            round_trip(&o, p, n, 2);
+            free(p);
+        }
 }
 
 TEST(layered_format_6_with_channels_returns_and_extra_bytes_reads_bit_identically) {
@@ -157,7 +175,7 @@ static void refused(const tf_buf_t *b, int code, const char *needle, long long a
     }
 }
 
-static void sample(tf_buf_t *b, int fmt, size_t n, uint32_t chunk) {
+static void sample_v(tf_buf_t *b, int fmt, size_t n, uint32_t chunk, int v1) {
     gen_rng_t g;
     gen_seed(&g, 5);
     lazw_point_t *p = malloc(n * sizeof *p);
@@ -165,9 +183,11 @@ static void sample(tf_buf_t *b, int fmt, size_t n, uint32_t chunk) {
     lazw_opts_t o = plain;
     o.format = fmt;
     o.chunk_size = chunk;
+    o.v1 = v1;
     lazw_encode(b, &o, p, n);
     free(p);
 }
+static void sample(tf_buf_t *b, int fmt, size_t n, uint32_t chunk) { sample_v(b, fmt, n, chunk, 0); }
 static void put_u32(tf_buf_t *b, size_t at, uint32_t v) {
     for (int i = 0; i < 4; i++) b->data[at + i] = (unsigned char)(v >> (8 * i));
 }
@@ -176,12 +196,13 @@ static void put_u64(tf_buf_t *b, size_t at, uint64_t v) {
 }
 
 TEST(every_truncation_of_a_laz_file_is_refused_or_read_whole_never_partly) {
-    for (int fmt = 0; fmt <= 6; fmt += 6) {
+    for (int variant = 0; variant < 3; variant++) {
+        int fmt = variant == 1 ? 6 : variant ? 1 : 0;
         tf_buf_t b = {0};
-        sample(&b, fmt, 300, 64);
+        sample_v(&b, fmt, 300, 64, variant == 2);
         size_t full = b.size;
         for (size_t cut = 0; cut < full; cut += 1 + cut / 16) {
-            CONTEXT("format %d cut at %zu of %zu", fmt, cut, full);
+            CONTEXT("format %d%s cut at %zu of %zu", fmt, variant == 2 ? " (LASzip 1)" : "", cut, full);
             b.size = cut;
             hd_cloud_t *c = NULL;
             hd_error_t e;
@@ -296,11 +317,11 @@ TEST(unsupported_or_inconsistent_laszip_vlrs_are_refused_naming_the_field) {
     tf_buf_t b = {0};
     sample(&b, 0, 10, 50);
     size_t v = lazw_last.vlr;
-    b.data[v] = 1; /* compressor 1: LASzip 1.x pointwise without chunks */
-    refused(&b, HD_EUNSUPPORTED, "compressor 1", (long long)v);
+    b.data[v] = 4; /* compressor 4: not defined */
+    refused(&b, HD_EUNSUPPORTED, "compressor 4", (long long)v);
     b.data[v] = 2;
-    b.data[v + 34 + 4] = 1; /* POINT10 version 1 */
-    refused(&b, HD_EUNSUPPORTED, "item 1 is type 6 version 1", (long long)v + 34);
+    b.data[v + 34 + 4] = 3; /* POINT10 version 3 */
+    refused(&b, HD_EUNSUPPORTED, "item 1 is type 6 version 3", (long long)v + 34);
     b.data[v + 34 + 4] = 2;
     b.data[v + 34 + 2] = 21; /* POINT10 of 21 bytes */
     refused(&b, HD_EFORMAT, "has size 21, not 20", (long long)v + 36);

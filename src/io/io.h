@@ -102,13 +102,14 @@ int hd__read_npy(hd__read_t *r);
 
 /* A LAS header as las.c checked it: version minor, header size, offset to
  * the points, point format (compression bit cleared), record length, point
- * count (the 64-bit one in 1.4), VLR count, scale and offset per axis
+ * count (the 64-bit one in 1.4), VLR count, extended VLRs, scale and offset per axis
  * (finite).  The points start at `offset`. */
 typedef struct hd__las_header {
     unsigned minor, fmt;
     size_t header, offset, rec;
     uint64_t count;
     uint32_t n_vlr;
+    uint64_t evlr; /* 1.4: where the extended VLRs start (0: none) */
     double scale[3], shift[3];
 } hd__las_header_t;
 /* The points of a LAZ (LASzip-compressed) file: laz.c.  A chunk may not

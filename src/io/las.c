@@ -80,7 +80,8 @@ int hd__read_las(hd__read_t *r) {
                                  "%c %s is not a finite number", "xyz"[c], isfinite(scale[c]) ? "offset" : "scale factor");
     }
     if (fmt_byte & 0x80) {
-        hd__las_header_t h = {minor, fmt, header, offset, rec, count, hd__ld_u32(d + 100, 0), {0}, {0}};
+        uint64_t evlr = minor >= 4 && header >= 247 && hd__ld_u32(d + 243, 0) > 0 ? hd__ld_u64(d + 235, 0) : 0;
+        hd__las_header_t h = {minor, fmt, header, offset, rec, count, hd__ld_u32(d + 100, 0), evlr, {0}, {0}};
         memcpy(h.scale, scale, sizeof scale);
         memcpy(h.shift, shift, sizeof shift);
         return hd__read_laz(r, &h);

@@ -76,7 +76,7 @@ typedef struct {
     hd__read_t *r;
     const unsigned char *d;
     size_t size;
-    int layered;
+    int layered, chunked;
     size_t rec;
     item_t items[32];
     unsigned n_items, n_layers;
@@ -131,98 +131,92 @@ static int put(job_t *j, int32_t X, int32_t Y, int32_t Z) {
 
 static int32_t i32_at(const unsigned char *p) { return (int32_t)hd__ld_u32(p, 0); }
 
-/* ---- POINT10 v2 and the pointwise items ------------------------------------ */
+/* ---- POINT10 and the pointwise items, versions 1 and 2 --------------------- */
+/* Every model of a pointwise chunk, zeroed first so that freeing is always
+ * safe; each item uses the fields of its version. */
 typedef struct {
-    hd__symmodel_t changed, scan[2];
+    /* POINT10 */
+    hd__symmodel_t changed, scan[2]; /* scan: v2 only */
     hd__symmodel_t *bitbyte[256], *cls[256], *user[256];
-    hd__intcoder_t intensity, psid, dx, dy, dz;
-    hd__median5_t mx[16], my[16];
+    hd__intcoder_t intensity, psid, dx, dy, dz, scan1; /* scan1: v1 only */
+    hd__median5_t mx[16], my[16];                     /* v2 */
+    int32_t diff1[2][3];                              /* v1: the last three dx, dy */
+    unsigned incr1;
     uint16_t last_int[16];
     int32_t last_h[8];
     unsigned char last[20];
-} p10_t;
-
-typedef struct {
-    hd__symmodel_t multi, zero;
-    hd__intcoder_t ic;
+    /* GPSTIME11 */
+    hd__symmodel_t gmulti, gzero;
+    hd__intcoder_t gic;
     int64_t t[4];
-    int32_t diff[4];
+    int32_t gdiff[4];
     int extreme[4];
-    unsigned last, next;
-} gps_t;
-
-typedef struct {
-    hd__symmodel_t used, diff[6];
-} rgb_t;
-
-typedef struct {
-    unsigned n;
-    hd__symmodel_t *m; /* n models */
-} bytes_t;
-
-/* Every model of a chunk, zeroed first so that freeing is always safe. */
-typedef struct {
-    p10_t p;
-    gps_t g;
-    rgb_t c;
-    bytes_t b;
-    int has_g, has_c, has_b;
+    unsigned glast, gnext;
+    /* RGB12 */
+    hd__symmodel_t used, cdiff[6]; /* cdiff: v2 */
+    hd__intcoder_t cic;            /* v1 */
+    /* BYTE */
+    unsigned nb;
+    hd__symmodel_t *bm; /* v2: nb models */
+    hd__intcoder_t bic; /* v1: nb contexts */
 } pw_t;
 
 static void pw_free(pw_t *w) {
-    hd__symmodel_free(&w->p.changed);
-    hd__symmodel_free(&w->p.scan[0]);
-    hd__symmodel_free(&w->p.scan[1]);
+    hd__symmodel_t *models[] = {&w->changed, &w->scan[0], &w->scan[1], &w->gmulti, &w->gzero, &w->used};
+    for (size_t i = 0; i < sizeof models / sizeof models[0]; i++) hd__symmodel_free(models[i]);
+    for (int i = 0; i < 6; i++) hd__symmodel_free(&w->cdiff[i]);
     for (int i = 0; i < 256; i++) {
-        hd__symmodel_t **t[3] = {w->p.bitbyte, w->p.cls, w->p.user};
+        hd__symmodel_t **t[3] = {w->bitbyte, w->cls, w->user};
         for (int a = 0; a < 3; a++)
             if (t[a][i]) {
                 hd__symmodel_free(t[a][i]);
                 free(t[a][i]);
             }
     }
-    hd__intcoder_free(&w->p.intensity);
-    hd__intcoder_free(&w->p.psid);
-    hd__intcoder_free(&w->p.dx);
-    hd__intcoder_free(&w->p.dy);
-    hd__intcoder_free(&w->p.dz);
-    hd__symmodel_free(&w->g.multi);
-    hd__symmodel_free(&w->g.zero);
-    hd__intcoder_free(&w->g.ic);
-    hd__symmodel_free(&w->c.used);
-    for (int i = 0; i < 6; i++) hd__symmodel_free(&w->c.diff[i]);
-    if (w->b.m)
-        for (unsigned i = 0; i < w->b.n; i++) hd__symmodel_free(&w->b.m[i]);
-    free(w->b.m);
+    hd__intcoder_t *ics[] = {&w->intensity, &w->psid, &w->dx, &w->dy, &w->dz, &w->scan1, &w->gic, &w->cic, &w->bic};
+    for (size_t i = 0; i < sizeof ics / sizeof ics[0]; i++) hd__intcoder_free(ics[i]);
+    if (w->bm)
+        for (unsigned i = 0; i < w->nb; i++) hd__symmodel_free(&w->bm[i]);
+    free(w->bm);
 }
 
+/* Create the models of every item, in the version the VLR gives it. */
 static int pw_new(pw_t *w, const laz_t *z) {
     memset(w, 0, sizeof *w);
-    int rc = hd__symmodel_new(&w->p.changed, 64);
-    rc = rc ? rc : hd__symmodel_new(&w->p.scan[0], 256);
-    rc = rc ? rc : hd__symmodel_new(&w->p.scan[1], 256);
-    rc = rc ? rc : hd__intcoder_new(&w->p.intensity, 16, 4);
-    rc = rc ? rc : hd__intcoder_new(&w->p.psid, 16, 1);
-    rc = rc ? rc : hd__intcoder_new(&w->p.dx, 32, 2);
-    rc = rc ? rc : hd__intcoder_new(&w->p.dy, 32, 22);
-    rc = rc ? rc : hd__intcoder_new(&w->p.dz, 32, 20);
+    int v2 = z->items[0].version == 2, rc = hd__symmodel_new(&w->changed, 64);
+    if (v2) {
+        rc = rc ? rc : hd__symmodel_new(&w->scan[0], 256);
+        rc = rc ? rc : hd__symmodel_new(&w->scan[1], 256);
+        rc = rc ? rc : hd__intcoder_new(&w->intensity, 16, 4);
+        rc = rc ? rc : hd__intcoder_new(&w->dx, 32, 2);
+        rc = rc ? rc : hd__intcoder_new(&w->dy, 32, 22);
+    } else {
+        rc = rc ? rc : hd__intcoder_new(&w->scan1, 8, 2);
+        rc = rc ? rc : hd__intcoder_new(&w->intensity, 16, 1);
+        rc = rc ? rc : hd__intcoder_new(&w->dx, 32, 1);
+        rc = rc ? rc : hd__intcoder_new(&w->dy, 32, 20);
+    }
+    rc = rc ? rc : hd__intcoder_new(&w->psid, 16, 1);
+    rc = rc ? rc : hd__intcoder_new(&w->dz, 32, 20);
     for (unsigned i = 1; i < z->n_items && rc == HD_OK; i++) {
-        unsigned t = z->items[i].type;
+        unsigned t = z->items[i].type, iv2 = z->items[i].version == 2;
         if (t == IT_GPSTIME11) {
-            w->has_g = 1;
-            rc = hd__symmodel_new(&w->g.multi, 516);
-            rc = rc ? rc : hd__symmodel_new(&w->g.zero, 6);
-            rc = rc ? rc : hd__intcoder_new(&w->g.ic, 32, 9);
+            rc = hd__symmodel_new(&w->gmulti, iv2 ? 516 : 512);
+            rc = rc ? rc : hd__symmodel_new(&w->gzero, iv2 ? 6 : 3);
+            rc = rc ? rc : hd__intcoder_new(&w->gic, 32, iv2 ? 9 : 6);
         } else if (t == IT_RGB12) {
-            w->has_c = 1;
-            rc = hd__symmodel_new(&w->c.used, 128);
-            for (int k = 0; k < 6 && rc == HD_OK; k++) rc = hd__symmodel_new(&w->c.diff[k], 256);
+            rc = hd__symmodel_new(&w->used, iv2 ? 128 : 64);
+            for (int k = 0; k < 6 && rc == HD_OK && iv2; k++) rc = hd__symmodel_new(&w->cdiff[k], 256);
+            if (!iv2 && rc == HD_OK) rc = hd__intcoder_new(&w->cic, 8, 6);
         } else if (t == IT_BYTE) {
-            w->has_b = 1;
-            w->b.m = calloc(z->items[i].size, sizeof *w->b.m);
-            if (!w->b.m) return HD_ENOMEM;
-            w->b.n = z->items[i].size;
-            for (unsigned k = 0; k < w->b.n && rc == HD_OK; k++) rc = hd__symmodel_new(&w->b.m[k], 256);
+            w->nb = z->items[i].size;
+            if (!iv2) {
+                rc = hd__intcoder_new(&w->bic, 8, w->nb);
+                continue;
+            }
+            w->bm = calloc(w->nb, sizeof *w->bm);
+            if (!w->bm) return HD_ENOMEM;
+            for (unsigned k = 0; k < w->nb && rc == HD_OK; k++) rc = hd__symmodel_new(&w->bm[k], 256);
         }
     }
     return rc;
@@ -243,154 +237,228 @@ static hd__symmodel_t *lazy(hd__symmodel_t **slot, uint32_t n) {
     return *slot;
 }
 
-static uint32_t fold8(int32_t v) { return (uint32_t)v & 255u; }
+/* A byte from the model chosen by the byte's last value: 0, or -1 when
+ * the model could not be allocated. */
+static int lazy_byte(hd__symmodel_t **models, unsigned char *byte, hd__dec_t *d) {
+    hd__symmodel_t *m = lazy(&models[*byte], 256);
+    if (!m) return -1;
+    *byte = (unsigned char)hd__dec_symbol(d, m);
+    return 0;
+}
 
-/* One POINT10 v2 record after the first: updates w->p.last.  0, or -1
- * when a lazily created model could not be allocated. */
-static int p10_read(p10_t *p, hd__dec_t *d) {
-    unsigned char *L = p->last;
-    uint32_t changed = hd__dec_symbol(d, &p->changed);
-    unsigned r, n;
-    if (changed) {
-        if (changed & 32) {
-            hd__symmodel_t *m = lazy(&p->bitbyte[L[14]], 256);
-            if (!m) return -1;
-            L[14] = (unsigned char)hd__dec_symbol(d, m);
-        }
-        r = L[14] & 7;
-        n = (L[14] >> 3) & 7;
-        unsigned m = hd__laz_rmap10[n][r];
-        if (changed & 16) {
-            p->last_int[m] = (uint16_t)hd__ic_decode(&p->intensity, d, p->last_int[m], m < 3 ? m : 3);
-        }
-        if (changed & 8) {
-            hd__symmodel_t *mc = lazy(&p->cls[L[15]], 256);
-            if (!mc) return -1;
-            L[15] = (unsigned char)hd__dec_symbol(d, mc);
-        }
-        if (changed & 4) {
-            uint32_t v = hd__dec_symbol(d, &p->scan[(L[14] >> 6) & 1]);
-            L[16] = (unsigned char)fold8((int32_t)(v + L[16]));
-        }
-        if (changed & 2) {
-            hd__symmodel_t *mu = lazy(&p->user[L[17]], 256);
-            if (!mu) return -1;
-            L[17] = (unsigned char)hd__dec_symbol(d, mu);
-        }
-        if (changed & 1) {
-            uint16_t ps = hd__ld_u16(L + 18, 0);
-            ps = (uint16_t)hd__ic_decode(&p->psid, d, ps, 0);
-            L[18] = (unsigned char)ps;
-            L[19] = (unsigned char)(ps >> 8);
-        }
-    } else {
-        r = L[14] & 7;
-        n = (L[14] >> 3) & 7;
-    }
-    unsigned m = hd__laz_rmap10[n][r], l = hd__laz_level(n, r);
-    int32_t dx = hd__ic_decode(&p->dx, d, p->mx[m].v[2], n == 1);
-    hd__median5_add(&p->mx[m], dx);
-    int32_t dy = hd__ic_decode(&p->dy, d, p->my[m].v[2], (n == 1) + hd__laz_kctx(p->dx.k, 20));
-    hd__median5_add(&p->my[m], dy);
-    int32_t X = (int32_t)((uint32_t)i32_at(L) + (uint32_t)dx), Y = (int32_t)((uint32_t)i32_at(L + 4) + (uint32_t)dy);
-    int32_t Z = hd__ic_decode(&p->dz, d, p->last_h[l], (n == 1) + hd__laz_kctx((p->dx.k + p->dy.k) / 2, 18));
-    p->last_h[l] = Z;
+static void set_xyz(unsigned char *L, int32_t X, int32_t Y, int32_t Z) {
     for (int b = 0; b < 4; b++) {
         L[b] = (unsigned char)((uint32_t)X >> (8 * b));
         L[4 + b] = (unsigned char)((uint32_t)Y >> (8 * b));
         L[8 + b] = (unsigned char)((uint32_t)Z >> (8 * b));
     }
+}
+
+static uint16_t ic16(hd__intcoder_t *ic, hd__dec_t *d, uint16_t pred, uint32_t ctx) {
+    return (uint16_t)hd__ic_decode(ic, d, pred, ctx);
+}
+
+/* One POINT10 v2 record after the first: updates w->last.  0, or -1
+ * when a lazily created model could not be allocated. */
+static int p10_read(pw_t *p, hd__dec_t *d) {
+    unsigned char *L = p->last;
+    uint32_t changed = hd__dec_symbol(d, &p->changed);
+    if (changed) {
+        if ((changed & 32) && lazy_byte(p->bitbyte, &L[14], d)) return -1;
+        unsigned m = hd__laz_rmap10[(L[14] >> 3) & 7][L[14] & 7];
+        if (changed & 16) p->last_int[m] = ic16(&p->intensity, d, p->last_int[m], m < 3 ? m : 3);
+        if ((changed & 8) && lazy_byte(p->cls, &L[15], d)) return -1;
+        if (changed & 4) L[16] = (unsigned char)(hd__dec_symbol(d, &p->scan[(L[14] >> 6) & 1]) + L[16]);
+        if ((changed & 2) && lazy_byte(p->user, &L[17], d)) return -1;
+        if (changed & 1) {
+            uint16_t ps = ic16(&p->psid, d, hd__ld_u16(L + 18, 0), 0);
+            L[18] = (unsigned char)ps;
+            L[19] = (unsigned char)(ps >> 8);
+        }
+    }
+    unsigned r = L[14] & 7, n = (L[14] >> 3) & 7;
+    unsigned m = hd__laz_rmap10[n][r], l = hd__laz_level(n, r);
+    int32_t dx = hd__ic_decode(&p->dx, d, p->mx[m].v[2], n == 1);
+    hd__median5_add(&p->mx[m], dx);
+    int32_t dy = hd__ic_decode(&p->dy, d, p->my[m].v[2], (n == 1) + hd__laz_kctx(p->dx.k, 20));
+    hd__median5_add(&p->my[m], dy);
+    int32_t Z = hd__ic_decode(&p->dz, d, p->last_h[l], (n == 1) + hd__laz_kctx((p->dx.k + p->dy.k) / 2, 18));
+    p->last_h[l] = Z;
+    set_xyz(L, (int32_t)((uint32_t)i32_at(L) + (uint32_t)dx), (int32_t)((uint32_t)i32_at(L + 4) + (uint32_t)dy), Z);
     return 0;
 }
 
-/* GPSTIME11 v2: the values only steer which models come next, but they
- * must be followed exactly to stay in step.  A valid stream switches
- * sequence at most once per point; more is an error (returns -1). */
-static int gps_read(gps_t *g, hd__dec_t *d) {
+static int32_t median3(const int32_t v[3]) {
+    if (v[0] < v[1]) return v[1] < v[2] ? v[1] : v[0] < v[2] ? v[2] : v[0];
+    return v[0] < v[2] ? v[0] : v[1] < v[2] ? v[2] : v[1];
+}
+
+/* One POINT10 v1 record: x, y, z first (predicted by the median of the
+ * last three differences; contexts from k), then the changed fields. */
+static int p10v1_read(pw_t *p, hd__dec_t *d) {
+    unsigned char *L = p->last;
+    int32_t dx = hd__ic_decode(&p->dx, d, median3(p->diff1[0]), 0);
+    unsigned k = p->dx.k;
+    int32_t dy = hd__ic_decode(&p->dy, d, median3(p->diff1[1]), k < 19 ? k : 19);
+    k = (k + p->dy.k) / 2;
+    int32_t Z = hd__ic_decode(&p->dz, d, i32_at(L + 8), k < 19 ? k : 19);
+    set_xyz(L, (int32_t)((uint32_t)i32_at(L) + (uint32_t)dx), (int32_t)((uint32_t)i32_at(L + 4) + (uint32_t)dy), Z);
+    uint32_t changed = hd__dec_symbol(d, &p->changed);
+    if (changed) {
+        if (changed & 32) {
+            uint16_t v = ic16(&p->intensity, d, hd__ld_u16(L + 12, 0), 0);
+            L[12] = (unsigned char)v;
+            L[13] = (unsigned char)(v >> 8);
+        }
+        if ((changed & 16) && lazy_byte(p->bitbyte, &L[14], d)) return -1;
+        if ((changed & 8) && lazy_byte(p->cls, &L[15], d)) return -1;
+        if (changed & 4) L[16] = (unsigned char)hd__ic_decode(&p->scan1, d, L[16], k < 3);
+        if ((changed & 2) && lazy_byte(p->user, &L[17], d)) return -1;
+        if (changed & 1) {
+            uint16_t ps = ic16(&p->psid, d, hd__ld_u16(L + 18, 0), 0);
+            L[18] = (unsigned char)ps;
+            L[19] = (unsigned char)(ps >> 8);
+        }
+    }
+    p->diff1[0][p->incr1] = dx;
+    p->diff1[1][p->incr1] = dy;
+    p->incr1 = (p->incr1 + 1) % 3;
+    return 0;
+}
+
+static uint64_t raw64(hd__dec_t *d) {
+    uint64_t lo = hd__dec_raw(d, 16);
+    lo |= (uint64_t)hd__dec_raw(d, 16) << 16;
+    uint64_t hi = hd__dec_raw(d, 16);
+    hi |= (uint64_t)hd__dec_raw(d, 16) << 16;
+    return hi << 32 | lo;
+}
+
+static void gps_add(pw_t *g, unsigned s, int32_t diff) { g->t[s] = (int64_t)((uint64_t)g->t[s] + (uint64_t)(int64_t)diff); }
+static int32_t times(int32_t m, int32_t v) { return (int32_t)((uint32_t)m * (uint32_t)v); }
+
+/* GPSTIME11 v1: one sequence of times. */
+static void gps1_read(pw_t *g, hd__dec_t *d) {
+    int32_t *last = &g->gdiff[0];
+    if (*last == 0) {
+        uint32_t multi = hd__dec_symbol(d, &g->gzero);
+        if (multi == 1) {
+            *last = hd__ic_decode(&g->gic, d, 0, 0);
+            gps_add(g, 0, *last);
+        } else if (multi == 2) {
+            g->t[0] = (int64_t)raw64(d);
+        }
+        return;
+    }
+    uint32_t multi = hd__dec_symbol(d, &g->gmulti);
+    if (multi < 510) {
+        int32_t diff;
+        if (multi == 1) {
+            diff = *last = hd__ic_decode(&g->gic, d, *last, 1);
+            g->extreme[0] = 0;
+        } else if (multi == 0) {
+            diff = hd__ic_decode(&g->gic, d, *last / 4, 2);
+            if (++g->extreme[0] > 3) *last = diff, g->extreme[0] = 0;
+        } else {
+            diff = hd__ic_decode(&g->gic, d, times((int32_t)multi, *last), multi < 10 ? 3 : multi < 50 ? 4 : 5);
+            if (multi == 509 && ++g->extreme[0] > 3) *last = diff, g->extreme[0] = 0;
+        }
+        gps_add(g, 0, diff);
+    } else if (multi == 510) {
+        g->t[0] = (int64_t)raw64(d);
+    }
+}
+
+/* GPSTIME11 v2: four sequences, switched between.  The values only steer
+ * which models come next, but they must be followed exactly to stay in
+ * step.  A valid stream switches sequence at most once per point; more is
+ * an error (returns -1). */
+static int gps_read(pw_t *g, hd__dec_t *d) {
     for (int round = 0; round < 4; round++) {
-        unsigned L = g->last;
-        if (g->diff[L] == 0) {
-            uint32_t multi = hd__dec_symbol(d, &g->zero);
+        unsigned L = g->glast;
+        uint32_t multi;
+        if (g->gdiff[L] == 0) {
+            multi = hd__dec_symbol(d, &g->gzero);
             if (multi == 1) {
-                g->diff[L] = hd__ic_decode(&g->ic, d, 0, 0);
-                g->t[L] = (int64_t)((uint64_t)g->t[L] + (uint64_t)(int64_t)g->diff[L]);
+                g->gdiff[L] = hd__ic_decode(&g->gic, d, 0, 0);
+                gps_add(g, L, g->gdiff[L]);
                 g->extreme[L] = 0;
-            } else if (multi == 2) {
-                g->next = (g->next + 1) & 3;
-                uint32_t hi = (uint32_t)hd__ic_decode(&g->ic, d, (int32_t)((uint64_t)g->t[L] >> 32), 8);
-                uint32_t lo = hd__dec_raw(d, 16);
-                lo |= hd__dec_raw(d, 16) << 16;
-                g->t[g->next] = (int64_t)((uint64_t)hi << 32 | lo);
-                g->last = g->next;
-                g->diff[g->last] = 0;
-                g->extreme[g->last] = 0;
-            } else if (multi > 2) {
-                g->last = (L + multi - 2) & 3;
+                return 0;
+            }
+            if (multi > 2) {
+                g->glast = (L + multi - 2) & 3;
                 continue;
             }
-            return 0;
-        }
-        uint32_t multi = hd__dec_symbol(d, &g->multi);
-        if (multi == 1) {
-            g->t[L] = (int64_t)((uint64_t)g->t[L] + (uint64_t)(int64_t)hd__ic_decode(&g->ic, d, g->diff[L], 1));
-            g->extreme[L] = 0;
-        } else if (multi < 511) { /* 500 - (-10) + 1: unchanged */
-            int32_t diff;
-            if (multi == 0) {
-                diff = hd__ic_decode(&g->ic, d, 0, 7);
-                if (++g->extreme[L] > 3) {
-                    g->diff[L] = diff;
-                    g->extreme[L] = 0;
-                }
-            } else if (multi < 500) {
-                diff = hd__ic_decode(&g->ic, d, (int32_t)(multi * (uint32_t)g->diff[L]), multi < 10 ? 2 : 3);
-            } else if (multi == 500) {
-                diff = hd__ic_decode(&g->ic, d, (int32_t)(500u * (uint32_t)g->diff[L]), 4);
-                if (++g->extreme[L] > 3) {
-                    g->diff[L] = diff;
-                    g->extreme[L] = 0;
-                }
-            } else {
-                int32_t mm = 500 - (int32_t)multi;
-                if (mm > -10) {
-                    diff = hd__ic_decode(&g->ic, d, (int32_t)((uint32_t)mm * (uint32_t)g->diff[L]), 5);
-                } else {
-                    diff = hd__ic_decode(&g->ic, d, (int32_t)((uint32_t)-10 * (uint32_t)g->diff[L]), 6);
-                    if (++g->extreme[L] > 3) {
-                        g->diff[L] = diff;
-                        g->extreme[L] = 0;
-                    }
-                }
+            if (multi == 0) return 0;
+        } else {
+            multi = hd__dec_symbol(d, &g->gmulti);
+            if (multi == 1) {
+                gps_add(g, L, hd__ic_decode(&g->gic, d, g->gdiff[L], 1));
+                g->extreme[L] = 0;
+                return 0;
             }
-            g->t[L] = (int64_t)((uint64_t)g->t[L] + (uint64_t)(int64_t)diff);
-        } else if (multi == 512) { /* code for a full value */
-            g->next = (g->next + 1) & 3;
-            uint32_t hi = (uint32_t)hd__ic_decode(&g->ic, d, (int32_t)((uint64_t)g->t[L] >> 32), 8);
-            uint32_t lo = hd__dec_raw(d, 16);
-            lo |= hd__dec_raw(d, 16) << 16;
-            g->t[g->next] = (int64_t)((uint64_t)hi << 32 | lo);
-            g->last = g->next;
-            g->diff[g->last] = 0;
-            g->extreme[g->last] = 0;
-        } else if (multi > 512) {
-            g->last = (L + multi - 512) & 3;
-            continue;
+            if (multi < 511) { /* 500 - (-10) + 1: unchanged */
+                int32_t diff;
+                int extreme = 0;
+                if (multi == 0) {
+                    diff = hd__ic_decode(&g->gic, d, 0, 7);
+                    extreme = 1;
+                } else if (multi < 500) {
+                    diff = hd__ic_decode(&g->gic, d, times((int32_t)multi, g->gdiff[L]), multi < 10 ? 2 : 3);
+                } else if (multi == 500) {
+                    diff = hd__ic_decode(&g->gic, d, times(500, g->gdiff[L]), 4);
+                    extreme = 1;
+                } else {
+                    int32_t mm = 500 - (int32_t)multi;
+                    extreme = mm <= -10;
+                    diff = hd__ic_decode(&g->gic, d, times(extreme ? -10 : mm, g->gdiff[L]), extreme ? 6 : 5);
+                }
+                if (extreme && ++g->extreme[L] > 3) {
+                    g->gdiff[L] = diff;
+                    g->extreme[L] = 0;
+                }
+                gps_add(g, L, diff);
+                return 0;
+            }
+            if (multi == 511) return 0;
+            if (multi > 512) {
+                g->glast = (L + multi - 512) & 3;
+                continue;
+            }
         }
-        /* multi == 511: unchanged */
+        /* a full value (0diff symbol 2, multi symbol 512): a new sequence */
+        g->gnext = (g->gnext + 1) & 3;
+        uint32_t hi = (uint32_t)hd__ic_decode(&g->gic, d, (int32_t)((uint64_t)g->t[L] >> 32), 8);
+        uint32_t lo = hd__dec_raw(d, 16);
+        lo |= hd__dec_raw(d, 16) << 16;
+        g->t[g->gnext] = (int64_t)((uint64_t)hi << 32 | lo);
+        g->glast = g->gnext;
+        g->gdiff[g->glast] = 0;
+        g->extreme[g->glast] = 0;
         return 0;
     }
     return -1;
 }
 
-static void rgb_read(rgb_t *c, hd__dec_t *d) {
+/* RGB12 v2 and v1, BYTE v2 and v1: their values never steer the stream,
+ * so only their symbols are decoded. */
+static void rgb_read(pw_t *c, hd__dec_t *d, int v2) {
     uint32_t sym = hd__dec_symbol(d, &c->used);
-    if (sym & 1) hd__dec_symbol(d, &c->diff[0]);
-    if (sym & 2) hd__dec_symbol(d, &c->diff[1]);
-    if (sym & 64) {
-        if (sym & 4) hd__dec_symbol(d, &c->diff[2]);
-        if (sym & 16) hd__dec_symbol(d, &c->diff[4]);
-        if (sym & 8) hd__dec_symbol(d, &c->diff[3]);
-        if (sym & 32) hd__dec_symbol(d, &c->diff[5]);
+    if (!v2) {
+        for (unsigned k = 0; k < 6; k++)
+            if (sym & (1u << k)) hd__ic_decode(&c->cic, d, 0, k);
+        return;
+    }
+    static const unsigned char order[6] = {0, 1, 2, 4, 3, 5};
+    for (int i = 0; i < 6; i++) {
+        unsigned k = order[i];
+        if ((sym & (1u << k)) && (k < 2 || (sym & 64))) hd__dec_symbol(d, &c->cdiff[k]);
+    }
+}
+static void bytes_read(pw_t *c, hd__dec_t *d, int v2) {
+    for (unsigned k = 0; k < c->nb; k++) {
+        if (v2) hd__dec_symbol(d, &c->bm[k]);
+        else hd__ic_decode(&c->bic, d, 0, k);
     }
 }
 
@@ -414,38 +482,41 @@ static void pointwise_chunk(job_t *j, const unsigned char *b, size_t nb, size_t 
     }
     /* initial state from the raw first point */
     for (int i = 0; i < 16; i++) {
-        hd__median5_init(&w->p.mx[i]);
-        hd__median5_init(&w->p.my[i]);
+        hd__median5_init(&w->mx[i]);
+        hd__median5_init(&w->my[i]);
     }
-    memcpy(w->p.last, b, 20);
-    w->p.last[12] = w->p.last[13] = 0; /* intensity starts at 0 */
+    memcpy(w->last, b, 20);
+    int v2 = z->items[0].version == 2;
+    if (v2) w->last[12] = w->last[13] = 0; /* v2: intensity starts at 0 */
     size_t off = 20;
     for (unsigned i = 1; i < z->n_items; i++) {
-        if (z->items[i].type == IT_GPSTIME11) w->g.t[0] = (int64_t)hd__ld_u64(b + off, 0);
+        if (z->items[i].type == IT_GPSTIME11) w->t[0] = (int64_t)hd__ld_u64(b + off, 0);
         off += z->items[i].size;
     }
     hd__dec_t d;
     hd__dec_init(&d, b + z->rec, nb - z->rec);
     for (size_t i = 1; i < n; i++) {
-        if (p10_read(&w->p, &d)) {
+        if (v2 ? p10_read(w, &d) : p10v1_read(w, &d)) {
             fail(j, HD_ENOMEM, at, "out of memory");
             goto done;
         }
         for (unsigned t = 1; t < z->n_items; t++) {
-            unsigned ty = z->items[t].type;
+            unsigned ty = z->items[t].type, iv2 = z->items[t].version == 2;
             if (ty == IT_GPSTIME11) {
-                if (gps_read(&w->g, &d)) {
+                if (!iv2) {
+                    gps1_read(w, &d);
+                } else if (gps_read(w, &d)) {
                     fail(j, HD_EFORMAT, at, "point %zu: the GPS time switches sequence more than once", j->k);
                     goto done;
                 }
             } else if (ty == IT_RGB12) {
-                rgb_read(&w->c, &d);
+                rgb_read(w, &d, iv2);
             } else {
-                for (unsigned k = 0; k < w->b.n; k++) hd__dec_symbol(&d, &w->b.m[k]);
+                bytes_read(w, &d, iv2);
             }
         }
         if (d.over > 4) break;
-        if (put(j, i32_at(w->p.last), i32_at(w->p.last + 4), i32_at(w->p.last + 8))) goto done;
+        if (put(j, i32_at(w->last), i32_at(w->last + 4), i32_at(w->last + 8))) goto done;
     }
     if (d.over)
         fail(j, HD_EFORMAT, (long long)(z->start[j->chunk] + nb),
@@ -668,11 +739,11 @@ static int parse_vlr(laz_t *z, const hd__las_header_t *h, uint32_t *chunk_size) 
     z->n_items = hd__ld_u16(v + 32, 0);
     if (coder != 0)
         return hd__io_err_at(r, HD_EUNSUPPORTED, (long long)at + 2, "LASzip coder %u (0, arithmetic, is the one defined)", coder);
-    if (compressor != 2 && compressor != 3)
+    if (compressor < 1 || compressor > 3)
         return hd__io_err_at(r, HD_EUNSUPPORTED, (long long)at,
-                             "LASzip compressor %u (%s); the chunked pointwise (2) and layered (3) compressors are read",
-                             compressor, compressor == 1 ? "pointwise without chunks, from LASzip before 2.0" : "unknown");
+                             "LASzip compressor %u (1 pointwise, 2 pointwise chunked, 3 layered chunked are read)", compressor);
     z->layered = compressor == 3;
+    z->chunked = compressor >= 2;
     if (z->n_items == 0 || z->n_items > 32 || 34 + 6 * (size_t)z->n_items > len)
         return hd__io_err_at(r, HD_EFORMAT, (long long)at + 32, "LASzip VLR lists %u items in %zu bytes", z->n_items, len);
     size_t sum = 0;
@@ -689,7 +760,7 @@ static int parse_vlr(laz_t *z, const hd__las_header_t *h, uint32_t *chunk_size) 
         int ok, first = i == 0;
         if (!z->layered) {
             ok = (first ? it->type == IT_POINT10 : (it->type == IT_GPSTIME11 || it->type == IT_RGB12 || it->type == IT_BYTE)) &&
-                 it->version == 2;
+                 (it->version == 1 || it->version == 2);
         } else {
             ok = (first ? it->type == IT_POINT14
                         : (it->type == IT_RGB14 || it->type == IT_RGBNIR14 || it->type == IT_WAVE14 || it->type == IT_BYTE14)) &&
@@ -700,7 +771,7 @@ static int parse_vlr(laz_t *z, const hd__las_header_t *h, uint32_t *chunk_size) 
             return hd__io_err_at(r, HD_EUNSUPPORTED, where,
                                  "LASzip item %u is type %u version %u; read are %s", i + 1, it->type, it->version,
                                  z->layered ? "POINT14 first, then RGB14, RGBNIR14, WAVEPACKET14, BYTE14 (versions 3, 4)"
-                                            : "POINT10 first, then GPSTIME11, RGB12, BYTE (version 2)");
+                                            : "POINT10 first, then GPSTIME11, RGB12, BYTE (versions 1, 2)");
         if (it->type < 15 && need[it->type] && it->size != need[it->type])
             return hd__io_err_at(r, HD_EFORMAT, where + 2, "LASzip item %u (type %u) has size %u, not %u", i + 1, it->type, it->size,
                                  need[it->type]);
@@ -783,6 +854,24 @@ static int read_table(laz_t *z, const hd__las_header_t *h, uint32_t chunk_size) 
     return rc;
 }
 
+/* LASzip 1.x (compressor 1): no chunk table, one stream from the point
+ * offset to the end of the file or the extended VLRs. */
+static int one_chunk(laz_t *z, const hd__las_header_t *h) {
+    size_t end = h->evlr > h->offset && h->evlr < z->size ? (size_t)h->evlr : z->size;
+    z->n_chunks = 1;
+    z->start = hd__malloc_array(2, sizeof(uint64_t));
+    z->first = hd__malloc_array(2, sizeof(uint64_t));
+    if (!z->start || !z->first) return hd__io_err(z->r, HD_ENOMEM, "out of memory");
+    z->start[0] = h->offset;
+    z->start[1] = end;
+    z->first[0] = 0;
+    z->first[1] = h->count;
+    if (h->count > (uint64_t)(end - h->offset) * HD__LAZ_POINTS_PER_BYTE)
+        return hd__io_err_at(z->r, HD_EFORMAT, 107, "%llu points in %zu bytes of compressed data (at most %d per byte)",
+                             (unsigned long long)h->count, end - h->offset, HD__LAZ_POINTS_PER_BYTE);
+    return HD_OK;
+}
+
 int hd__read_laz(hd__read_t *r, const hd__las_header_t *h) {
     laz_t z;
     memset(&z, 0, sizeof z);
@@ -797,7 +886,8 @@ int hd__read_laz(hd__read_t *r, const hd__las_header_t *h) {
     uint32_t chunk_size = 0;
     int rc = parse_vlr(&z, h, &chunk_size);
     if (rc == HD_OK && h->count == 0) return HD_OK;
-    if (rc == HD_OK) rc = read_table(&z, h, chunk_size);
+    if (rc == HD_OK && z.chunked) rc = read_table(&z, h, chunk_size);
+    if (rc == HD_OK && !z.chunked) rc = one_chunk(&z, h);
     if (rc == HD_OK && r->sink->count != 0) rc = hd__io_err(r, HD_EINVAL, "internal: LAZ points into a non-empty sink");
     if (rc == HD_OK && (rc = hd__sink_reserve(r->sink, (size_t)h->count)) != HD_OK)
         rc = hd__io_err(r, rc, "cannot allocate %llu points: %s", (unsigned long long)h->count, hd_strerror(rc));

@@ -93,7 +93,7 @@ void hd__symmodel_free(hd__symmodel_t *m) {
 }
 
 int hd__intcoder_new(hd__intcoder_t *ic, uint32_t bits, uint32_t contexts) {
-    assert(bits == 16 || bits == 32);
+    assert(bits >= 1 && bits <= 32);
     memset(ic, 0, sizeof *ic);
     ic->bits = bits;
     ic->contexts = contexts;

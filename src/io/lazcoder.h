@@ -169,7 +169,7 @@ typedef struct hd__intcoder {
     hd__symmodel_t corr[33]; /* 1..corr_bits: 2^min(k, 8) symbols */
 } hd__intcoder_t;
 
-/* bits: 16 or 32 (the only sizes LAZ uses); HD_OK or HD_ENOMEM. */
+/* bits: 1 to 32 (LAZ uses 8, 16, 32); HD_OK or HD_ENOMEM. */
 int hd__intcoder_new(hd__intcoder_t *ic, uint32_t bits, uint32_t contexts);
 void hd__intcoder_init(hd__intcoder_t *ic);
 void hd__intcoder_free(hd__intcoder_t *ic);

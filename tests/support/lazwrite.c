@@ -218,6 +218,62 @@ static void chunk10(tf_buf_t *b, const lazw_opts_t *o, const lazw_point_t *p, si
     hd__intcoder_free(&dz);
 }
 
+/* POINT10 v1 (LASzip 1.x): x, y, z predicted by the median of the last
+ * three differences, then the changed-values symbol; the other items v1
+ * (their fields unchanged). */
+static int32_t median3(const int32_t v[3]) {
+    if (v[0] < v[1]) return v[1] < v[2] ? v[1] : v[0] < v[2] ? v[2] : v[0];
+    return v[0] < v[2] ? v[0] : v[1] < v[2] ? v[2] : v[1];
+}
+static void chunk10v1(tf_buf_t *b, const lazw_opts_t *o, const lazw_point_t *p, size_t n) {
+    raw_point(b, o, p);
+    enc_t e;
+    enc_init(&e);
+    hd__symmodel_t changed, bitbyte[256], gzero, rgbused;
+    hd__intcoder_t dx, dy, dz, bic;
+    symnew(&changed, 64);
+    symnew(&gzero, 3);
+    symnew(&rgbused, 64);
+    icnew(&dx, 32, 1);
+    icnew(&dy, 32, 20);
+    icnew(&dz, 32, 20);
+    icnew(&bic, 8, o->extra ? o->extra : 1);
+    char made[256] = {0};
+    int32_t diff[2][3] = {{0}}, X = p[0].x, Y = p[0].y, Z = p[0].z;
+    unsigned incr = 0, byte14 = (unsigned)(p[0].r | p[0].n << 3);
+    for (size_t i = 1; i < n; i++) {
+        int32_t ddx = (int32_t)((uint32_t)p[i].x - (uint32_t)X), ddy = (int32_t)((uint32_t)p[i].y - (uint32_t)Y);
+        ic_encode(&dx, &e, median3(diff[0]), ddx, 0);
+        unsigned k = dx.k;
+        ic_encode(&dy, &e, median3(diff[1]), ddy, k < 19 ? k : 19);
+        k = (k + dy.k) / 2;
+        ic_encode(&dz, &e, Z, p[i].z, k < 19 ? k : 19);
+        unsigned nb = (unsigned)(p[i].r | p[i].n << 3);
+        enc_symbol(&e, &changed, nb != byte14 ? 16 : 0);
+        if (nb != byte14) {
+            if (!made[byte14]) symnew(&bitbyte[byte14], 256), made[byte14] = 1;
+            enc_symbol(&e, &bitbyte[byte14], nb);
+            byte14 = nb;
+        }
+        diff[0][incr] = ddx;
+        diff[1][incr] = ddy;
+        incr = (incr + 1) % 3;
+        X = p[i].x, Y = p[i].y, Z = p[i].z;
+        if (o->format == 1 || o->format == 3) enc_symbol(&e, &gzero, 0);
+        if (o->format >= 2) enc_symbol(&e, &rgbused, 0);
+        for (unsigned q = 0; q < o->extra; q++) ic_encode(&bic, &e, 40 + q, 40 + q, q);
+    }
+    enc_done(&e);
+    tf_put(b, e.out.data, e.out.size);
+    tf_free(&e.out);
+    hd__symmodel_t *ms[] = {&changed, &gzero, &rgbused};
+    for (int i = 0; i < 3; i++) hd__symmodel_free(ms[i]);
+    for (int i = 0; i < 256; i++)
+        if (made[i]) hd__symmodel_free(&bitbyte[i]);
+    hd__intcoder_t *ics[] = {&dx, &dy, &dz, &bic};
+    for (int i = 0; i < 4; i++) hd__intcoder_free(ics[i]);
+}
+
 /* ---- POINT14 v3 layered chunks -------------------------------------------- */
 typedef struct {
     int used;
@@ -368,9 +424,10 @@ void lazw_encode(tf_buf_t *out, const lazw_opts_t *o, const lazw_point_t *p, siz
     tf_u16(out, (unsigned)vlr, 0);
     tf_put(out, desc, 32);
     lazw_last.vlr = out->size - base;
-    tf_u16(out, layered ? 3 : 2, 0);
+    unsigned iv = o->v1 ? 1 : 2;
+    tf_u16(out, layered ? 3 : o->v1 ? 1 : 2, 0);
     tf_u16(out, 0, 0);
-    tf_u8(out, layered ? 3 : 2);
+    tf_u8(out, layered ? 3 : iv);
     tf_u8(out, layered ? 4 : 2);
     tf_u16(out, 0, 0);
     tf_u32(out, 0, 0);
@@ -382,12 +439,18 @@ void lazw_encode(tf_buf_t *out, const lazw_opts_t *o, const lazw_point_t *p, siz
         tf_u16(out, 10, 0), tf_u16(out, 30, 0), tf_u16(out, 3, 0);
         if (o->extra) tf_u16(out, 14, 0), tf_u16(out, o->extra, 0), tf_u16(out, 3, 0);
     } else {
-        tf_u16(out, 6, 0), tf_u16(out, 20, 0), tf_u16(out, 2, 0);
-        if (o->format == 1 || o->format == 3) tf_u16(out, 7, 0), tf_u16(out, 8, 0), tf_u16(out, 2, 0);
-        if (o->format >= 2) tf_u16(out, 8, 0), tf_u16(out, 6, 0), tf_u16(out, 2, 0);
-        if (o->extra) tf_u16(out, 0, 0), tf_u16(out, o->extra, 0), tf_u16(out, 2, 0);
+        tf_u16(out, 6, 0), tf_u16(out, 20, 0), tf_u16(out, iv, 0);
+        if (o->format == 1 || o->format == 3) tf_u16(out, 7, 0), tf_u16(out, 8, 0), tf_u16(out, iv, 0);
+        if (o->format >= 2) tf_u16(out, 8, 0), tf_u16(out, 6, 0), tf_u16(out, iv, 0);
+        if (o->extra) tf_u16(out, 0, 0), tf_u16(out, o->extra, 0), tf_u16(out, iv, 0);
     }
     assert(out->size - base == offset);
+    if (o->v1) { /* LASzip 1.x: one stream, no chunk table */
+        lazw_last.points = lazw_last.chunk[0] = offset;
+        lazw_last.table = 0;
+        if (n) chunk10v1(out, o, p, n);
+        return;
+    }
     /* chunks */
     lazw_last.points = offset;
     size_t table_ptr = out->size;

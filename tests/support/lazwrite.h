@@ -2,7 +2,7 @@
  * lazwrite.h -- a LAZ writer for the tests: the LASzip range encoder and
  * integer compressor over the models of src/io/lazcoder.c, POINT10 v2
  * pointwise chunks (point formats 0-3, with GPSTIME11, RGB12 and BYTE
- * items) and POINT14 v3 layered chunks (format 6, with a BYTE14 item),
+ * items; or their version 1 in LASzip 1.x's single stream) and POINT14 v3 layered chunks (format 6, with a BYTE14 item),
  * fixed or variable chunk sizes, and the compressed chunk table.
  *
  * Only x, y, z, the return number and count, and (layered) the scanner
@@ -35,6 +35,8 @@ typedef struct lazw_opts {
     const size_t *chunks; /* variable chunk sizes (n_chunks of them, sum n) */
     size_t n_chunks;
     double scale[3], offset[3];
+    int v1; /* formats 0-3: LASzip 1.x, items version 1 in one unchunked
+             * stream (compressor 1); chunk sizes are then ignored */
 } lazw_opts_t;
 
 /* The LAZ file of n points into *out (appended). */
