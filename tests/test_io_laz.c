@@ -56,59 +56,48 @@ static void round_trip(const lazw_opts_t *o, const lazw_point_t *p, size_t n, in
     tf_free(&b);
 }
 
+/* A random file of up to max_n points (seeded) in format fmt with `extra`
+ * bytes, random fixed chunk sizes up to max_chunk (LASzip 1: one stream),
+ * read back with `threads`. */
+/* n random points for format fmt from seed (free them). */
+static lazw_point_t *points(uint64_t seed, size_t n, int fmt) {
+    gen_rng_t g;
+    gen_seed(&g, seed);
+    lazw_point_t *p = malloc(n * sizeof *p);
+    lazw_random(&g, p, n, fmt);
+    return p;
+}
+
+/* A random file of up to max_n points (seeded) in format fmt with `extra`
+ * bytes, random fixed chunk sizes up to max_chunk (LASzip 1: one stream),
+ * read back with `threads`. */
+static void random_trip(int fmt, unsigned extra, int v1, uint64_t seed, size_t max_n, uint32_t max_chunk, int threads) {
+    CONTEXT("format %d, extra %u%s, seed %llu", fmt, extra, v1 ? ", LASzip 1" : "", (unsigned long long)seed);
+    size_t n = 1 + (size_t)(seed * 7919 % max_n);
+    lazw_point_t *p = points(seed, n, fmt);
+    lazw_opts_t o = plain;
+    o.format = fmt;
+    o.extra = extra;
+    o.v1 = v1;
+    o.chunk_size = 1 + (uint32_t)(seed * 104729 % max_chunk);
+    round_trip(&o, p, n, threads);
+    free(p);
+}
+
 TEST(pointwise_formats_0_to_3_with_and_without_extra_bytes_read_bit_identically) {
     for (int fmt = 0; fmt <= 3; fmt++)
         for (unsigned extra = 0; extra <= 3; extra += 3)
-            for (uint64_t seed = 1; seed <= 3; seed++) {
-                CONTEXT("format %d, extra %u, seed %llu", fmt, extra, (unsigned long long)seed);
-                gen_rng_t g;
-                gen_seed(&g, seed);
-                size_t n = 1 + (size_t)(gen_u64(&g) % 400);
-                lazw_point_t *p = malloc(n * sizeof *p);
-                lazw_random(&g, p, n, fmt);
-                lazw_opts_t o = plain;
-                o.format = fmt;
-                o.extra = extra;
-                o.chunk_size = 1 + (uint32_t)(gen_u64(&g) % 120);
-                round_trip(&o, p, n, (int)seed);
-                free(p);
-            }
+            for (uint64_t seed = 1; seed <= 3; seed++) random_trip(fmt, extra, 0, seed, 400, 120, (int)seed);
 }
 
 TEST(laszip_1_streams_of_version_1_items_read_bit_identically) {
     for (int fmt = 0; fmt <= 3; fmt++)
-        for (unsigned extra = 0; extra <= 2; extra += 2) {
-            CONTEXT("format %d, extra %u, seed 31", fmt, extra);
-            gen_rng_t g;
-            gen_seed(&g, 31);
-            size_t n = 1 + (size_t)(gen_u64(&g) % 700);
-            lazw_point_t *p = malloc(n * sizeof *p);
-            lazw_random(&g, p, n, fmt);
-            lazw_opts_t o = plain;
-            o.format = fmt;
-            o.extra = extra;
-            o.v1 = 1;
-            round_trip(&o, p, n, 2);
-            free(p);
-        }
+        for (unsigned extra = 0; extra <= 2; extra += 2) random_trip(fmt, extra, 1, 31, 700, 1, 2);
 }
 
 TEST(layered_format_6_with_channels_returns_and_extra_bytes_reads_bit_identically) {
     for (unsigned extra = 0; extra <= 2; extra += 2)
-        for (uint64_t seed = 11; seed <= 14; seed++) {
-            CONTEXT("extra %u, seed %llu", extra, (unsigned long long)seed);
-            gen_rng_t g;
-            gen_seed(&g, seed);
-            size_t n = 1 + (size_t)(gen_u64(&g) % 600);
-            lazw_point_t *p = malloc(n * sizeof *p);
-            lazw_random(&g, p, n, 6);
-            lazw_opts_t o = plain;
-            o.format = 6;
-            o.extra = extra;
-            o.chunk_size = 1 + (uint32_t)(gen_u64(&g) % 200);
-            round_trip(&o, p, n, 2);
-            free(p);
-        }
+        for (uint64_t seed = 11; seed <= 14; seed++) random_trip(6, extra, 0, seed, 600, 200, 2);
 }
 
 TEST(variable_chunk_sizes_as_copc_writes_them_read_bit_identically) {
@@ -176,10 +165,7 @@ static void refused(const tf_buf_t *b, int code, const char *needle, long long a
 }
 
 static void sample_v(tf_buf_t *b, int fmt, size_t n, uint32_t chunk, int v1) {
-    gen_rng_t g;
-    gen_seed(&g, 5);
-    lazw_point_t *p = malloc(n * sizeof *p);
-    lazw_random(&g, p, n, fmt);
+    lazw_point_t *p = points(5, n, fmt);
     lazw_opts_t o = plain;
     o.format = fmt;
     o.chunk_size = chunk;
