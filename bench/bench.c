@@ -44,10 +44,9 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-/* The engine's own account of its plan (an internal function of the
- * library, for benchmarks). */
-int hd__engine_explain(const hd_points_t *A, const hd_points_t *B, const hd_options_t *opt, char *buf,
-                       size_t len, hd_error_t *err);
+/* The engine's own account of its plan (hd__engine_explain, an internal
+ * function of the library, for benchmarks). */
+#include "engine/engine.h"
 
 /* ---- options ----------------------------------------------------------------- */
 
@@ -316,7 +315,7 @@ static void run_pair(bench_t *B, pair_t *p) {
     hd_options_t o;
     hd_options_init(&o);
     char plan[256] = "?";
-    hd__engine_explain(&A, &Bp, &o, plan, sizeof plan, NULL);
+    hd__engine_explain(&A, &Bp, &o, NULL, plan, sizeof plan, NULL);
     fprintf(stderr, "%s: %zu / %zu points; plan: %s\n", p->name, p->na, p->nb, plan);
     json_pair_head(B, p, "plan", 0);
     fprintf(B->fp, ", \"plan\": \"%s\"}\n", plan);
@@ -444,7 +443,7 @@ static int scale_one(size_t n, int f32, int threads) {
     double input = (double)n * 2 * (f32 ? 12 : 24);
     /* The plan, asked after the timed runs and the memory reading. */
     char plan[256] = "?";
-    hd__engine_explain(&A, &B, &o, plan, sizeof plan, NULL);
+    hd__engine_explain(&A, &B, &o, NULL, plan, sizeof plan, NULL);
     printf("{\"case\": \"scale\", \"method\": \"hausdorff auto\", \"n\": %zu, \"dtype\": \"%s\", \"threads\": %d, "
            "\"median_s\": %.6g, \"runs\": %d, \"distance\": %.17g, \"input_bytes\": %.0f, "
            "\"peak_rss_bytes\": %.0f, \"rss_after_input_bytes\": %.0f, \"plan\": \"%s\"}\n",

@@ -3,6 +3,8 @@
 # programs it runs (nanoflann, PCL).  Not a test: nothing here is run by
 # ctest.
 hd_add_bench(hd_bench ${CMAKE_CURRENT_LIST_DIR}/bench.c)
+# hd_bench prints the engine's plan (hd__engine_explain, src/engine/engine.h).
+target_include_directories(hd_bench PRIVATE ${CMAKE_SOURCE_DIR}/src)
 
 option(HD_BENCH_PEERS "Build the C++ peer programs of the engine benchmark (nanoflann, PCL)" OFF)
 if(HD_BENCH_PEERS)

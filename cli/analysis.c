@@ -41,6 +41,8 @@ void analysis_args_init(analysis_args_t *an) {
     an->percentile = 95.0;
     an->bins = 20;
     an->mask_points = MASK_SURFACE;
+    an->connectivity = 1;
+    an->mask_dims = 0;
     an->empty = EMPTY_ERROR;
 }
 
@@ -67,20 +69,33 @@ void analysis_usage(FILE *out) {
 "                     Hausdorff distance)\n"
 "  --render OUT.png   picture of A coloured by distance to B: front, side\n"
 "                     and top views, colour bar, the Hausdorff witness pair\n"
-"                     marked%s\n"
+"                     marked, the --percentile figure on the bar%s\n"
 "  --histogram-png OUT.png  the histogram as a picture%s\n"
+"                     (pictures are PNG: OUT must end in .png)\n"
+"  --units TEXT       the distances' unit, shown in the report, the JSON and\n"
+"                     the pictures (a label: nothing is scaled); masks whose\n"
+"                     header names mm, um or m are in mm without it\n"
 "\n"
 "Medical masks: A or B may be a NIfTI-1/2 mask (.nii, .nii.gz)%s.\n"
 "  Voxels with a nonzero value are foreground; each becomes the world\n"
 "  coordinate of its centre (sform when sform_code > 0, else qform, else\n"
-"  pixdim), in millimetres.  Distances are then in mm.\n"
-"  --mask-points surface|all  surface (default): foreground voxels with at\n"
-"                     least one 6-neighbour in the background or outside the\n"
-"                     image (as medpy and MONAI); all: every foreground voxel\n"
+"  pixdim), in millimetres (m and um are converted).  Distances are in mm.\n"
+"  --mask-points surface|all  surface (default): the foreground voxels that\n"
+"                     binary erosion removes, outside the image counting as\n"
+"                     background (as medpy and MONAI); all: every foreground\n"
+"                     voxel\n"
+"  --connectivity 1|2|3  the surface's neighbourhood, as medpy's connectivity:\n"
+"                     1 (default) 6-neighbour in 3-D, 4 in 2-D; 2: 18 (8 in\n"
+"                     2-D); 3: 26\n"
+"  --mask-dims auto|2|3  the axes of that neighbourhood: auto (default) those\n"
+"                     of more than one voxel (a single slice is a 2-D mask);\n"
+"                     2: each slice (constant k) on its own, a stack of\n"
+"                     in-plane contours; 3: all three, a one-voxel axis too\n"
 "  --empty inf|nan|zero|monai  an empty mask or file is an error by default;\n"
 "                     with this option every distance is reported as inf, NaN\n"
 "                     or 0 instead; monai: inf when one set is empty, NaN when\n"
-"                     both are, as MONAI (JSON: null for inf and NaN, with \"empty\")\n",
+"                     both are, as MONAI (JSON: null for inf and NaN, and an\n"
+"                     \"empty\" member)\n",
             render_available() ? "" : " (unavailable: built without libpng)",
             render_available() ? "" : " (unavailable)",
             nifti_available() ? "" : " (unavailable: built without libnifti2)");
@@ -112,6 +127,9 @@ typedef enum {
     OPT_HISTOGRAM_PNG,
     OPT_MASK_POINTS,
     OPT_EMPTY,
+    OPT_CONNECTIVITY,
+    OPT_MASK_DIMS,
+    OPT_UNITS,
     OPT_COUNT
 } value_option_t;
 
@@ -120,7 +138,8 @@ static const char *const value_names[OPT_COUNT + 1] = {
     [OPT_DISTANCES] = "--distances",     [OPT_MAX_DISTANCE] = "--max-distance",
     [OPT_RENDER] = "--render",           [OPT_HISTOGRAM_PNG] = "--histogram-png",
     [OPT_MASK_POINTS] = "--mask-points", [OPT_EMPTY] = "--empty",
-    [OPT_COUNT] = NULL};
+    [OPT_CONNECTIVITY] = "--connectivity", [OPT_MASK_DIMS] = "--mask-dims",
+    [OPT_UNITS] = "--units",             [OPT_COUNT] = NULL};
 
 int analysis_parse_option(int argc, char **argv, int *k, analysis_args_t *an) {
     const char *s = argv[*k];
@@ -164,6 +183,11 @@ int analysis_parse_option(int argc, char **argv, int *k, analysis_args_t *an) {
         if (!render_available())
             return usage_error("%s is unavailable: this hausdorff was built without libpng "
                                "(Debian: libpng-dev)", name);
+        if (!render_path_ok(v)) {
+            char m[4200];
+            snprintf(m, sizeof m, "%s %s: pictures are written as PNG only; name the file .png", name, v);
+            return usage_error("%s", m);
+        }
         if (which == OPT_RENDER) an->render_out = v;
         else an->histogram_png = v;
         break;
@@ -179,8 +203,33 @@ int analysis_parse_option(int argc, char **argv, int *k, analysis_args_t *an) {
         else if (strcmp(v, "monai") == 0) an->empty = EMPTY_MONAI;
         else return usage_error("--empty is inf, nan, zero or monai, not '%s'", v);
         break;
+    case OPT_CONNECTIVITY:
+        if (strcmp(v, "1") && strcmp(v, "2") && strcmp(v, "3"))
+            return usage_error("--connectivity is 1, 2 or 3 (faces, and edges, and corners), not '%s'", v);
+        an->connectivity = v[0] - '0';
+        break;
+    case OPT_MASK_DIMS:
+        if (strcmp(v, "auto") == 0) an->mask_dims = 0;
+        else if (strcmp(v, "2") == 0 || strcmp(v, "3") == 0) an->mask_dims = v[0] - '0';
+        else return usage_error("--mask-dims is auto, 2 or 3, not '%s'", v);
+        break;
+    case OPT_UNITS:
+        if (!v[0] || strlen(v) > 16 || strpbrk(v, "\"\\") || strspn(v, " ") == strlen(v))
+            return usage_error("--units needs a short label (1 to 16 characters, no quotes), not '%s'", v);
+        for (const char *c = v; *c; c++)
+            if ((unsigned char)*c < ' ' || (unsigned char)*c > '~')
+                return usage_error("--units needs printable ASCII (the pictures' font has no other), not '%s'", v);
+        an->units = v;
+        break;
     }
     return 1;
+}
+
+const char *analysis_units(const analysis_args_t *an) {
+    if (an->units) return an->units;
+    for (int k = 0; k < 2; k++)
+        if (an->mask[k].is_mask && an->mask[k].unit_known) return "mm";
+    return NULL;
 }
 
 int analysis_active(const analysis_args_t *an) {
@@ -396,9 +445,9 @@ int analysis_run(const analysis_args_t *an, const hd_options_t *opt,
         const char *base = strrchr(path_a, '/') ? strrchr(path_a, '/') + 1 : path_a;
         const char *base_b = strrchr(path_b, '/') ? strrchr(path_b, '/') + 1 : path_b;
         snprintf(title, sizeof title, "%s (%zu points) coloured by distance to %s", base, A->count, base_b);
-        int mm = an->mask[0].is_mask || an->mask[1].is_mask;
-        if ((rc = render_distances(an->render_out, A, B, r->d_ab, scale, s, directed, mm, title, r->markers,
-                                   &r->n_markers, &r->render_w, &r->render_h, err)))
+        render_notes_t notes = {analysis_units(an), an->percentile_on, r->pct};
+        if ((rc = render_distances(an->render_out, A, B, r->d_ab, scale, s, directed, &notes, title, r->markers,
+                                   &r->n_markers, &r->render, &r->render_w, &r->render_h, err)))
             return rc;
     }
     if (an->histogram_png && (rc = render_histogram(an->histogram_png, r, an, an->bins, r->hist_markers,
@@ -438,22 +487,36 @@ static void json_mask(FILE *out, const mask_info_t *m) {
     }
     fprintf(out, "], \"transform\": \"%s\", \"to_mm\": ", m->transform);
     json_number(out, m->to_mm);
-    fprintf(out, ", \"foreground_voxels\": %lld, \"points\": %zu}", m->foreground, m->points);
+    fprintf(out, ", \"unit_known\": %s, \"foreground_voxels\": %lld, \"points\": %zu", m->unit_known ? "true" : "false",
+            m->foreground, m->points);
+    if (m->surface_dims || m->connectivity)
+        fprintf(out, ", \"surface_dims\": %d, \"connectivity\": %d", m->surface_dims, m->connectivity);
+    fputc('}', out);
 }
 
 void analysis_json(FILE *out, const analysis_args_t *an,
                    const analysis_result_t *r) {
-    if (an->mask[0].is_mask || an->mask[1].is_mask) {
-        fprintf(out, ", \"units\": \"mm\", \"mask_points\": \"%s\", \"masks\": {\"a\": ",
-                an->mask_points == MASK_ALL ? "all" : "surface");
+    const char *units = analysis_units(an);
+    int masks = an->mask[0].is_mask || an->mask[1].is_mask;
+    if (units || masks) {
+        fprintf(out, ", \"units\": ");
+        if (units) json_string(out, units);
+        else fputs("null", out);
+    }
+    if (masks) {
+        fprintf(out, ", \"mask_points\": \"%s\", \"connectivity\": %d, \"mask_dims\": ",
+                an->mask_points == MASK_ALL ? "all" : "surface", an->connectivity);
+        if (an->mask_dims) fprintf(out, "%d", an->mask_dims);
+        else fputs("\"auto\"", out);
+        fprintf(out, ", \"masks\": {\"a\": ");
         json_mask(out, &an->mask[0]);
         fprintf(out, ", \"b\": ");
         json_mask(out, &an->mask[1]);
         fputc('}', out);
     }
     if (!r->active) return;
-    fprintf(out, ", \"distances_seconds\": ");
-    json_number(out, r->seconds);
+    fprintf(out, ", \"distances_seconds\": "); /* to the microsecond, as "seconds" */
+    json_number(out, round(r->seconds * 1e6) / 1e6);
     json_figures(out, an, r);
     if (r->hist_ab) {
         fprintf(out, ", \"histogram\": {\"bins\": %zu, \"range\": [", an->bins);
@@ -481,7 +544,19 @@ void analysis_json(FILE *out, const analysis_args_t *an,
     if (an->render_out) {
         fprintf(out, ", \"render\": {\"file\": ");
         json_string(out, an->render_out);
-        fprintf(out, ", \"width\": %d, \"height\": %d, \"witness_markers\": [", r->render_w, r->render_h);
+        fprintf(out, ", \"width\": %d, \"height\": %d, \"bar_title\": ", r->render_w, r->render_h);
+        json_string(out, r->render.bar_title);
+        fprintf(out, ", \"caption\": [");
+        for (int k = 0; k < 3 && r->render.caption[k][0]; k++) {
+            if (k) fputs(", ", out);
+            json_string(out, r->render.caption[k]);
+        }
+        fprintf(out, "], \"percentile_mark\": ");
+        if (r->render.pct_y >= 0)
+            fprintf(out, "{\"y\": %d, \"x0\": %d, \"x1\": %d}", r->render.pct_y, r->render.pct_x0, r->render.pct_x1);
+        else
+            fputs("null", out);
+        fprintf(out, ", \"witness_markers\": [");
         for (int k = 0; k < r->n_markers; k++) {
             const render_marker_t *m = &r->markers[k];
             fprintf(out, "%s{\"view\": \"%s\", \"set\": \"%c\", \"index\": %zu, \"x\": %d, \"y\": %d}",
@@ -539,15 +614,19 @@ static void print_histogram(FILE *out, const analysis_args_t *an,
 
 void analysis_print(FILE *out, const analysis_args_t *an,
                     const analysis_result_t *r) {
-    const char *unit = an->mask[0].is_mask || an->mask[1].is_mask ? " (mm)" : "";
+    char unit[40] = "";
+    if (analysis_units(an)) snprintf(unit, sizeof unit, " (%s)", analysis_units(an));
     for (int k = 0; k < 2; k++) {
         const mask_info_t *m = &an->mask[k];
         if (!m->is_mask) continue;
-        fprintf(out, "%c: NIfTI-%d mask %lldx%lldx%lld, spacing %g x %g x %g, %s; %lld foreground voxels, "
-                     "%zu %s points\n",
+        char how[96] = "";
+        if (an->mask_points == MASK_SURFACE)
+            snprintf(how, sizeof how, " (%d-D, connectivity %d)", m->surface_dims, m->connectivity);
+        fprintf(out, "%c: NIfTI-%d mask %lldx%lldx%lld, spacing %g x %g x %g%s, %s; %lld foreground voxels, "
+                     "%zu %s points%s\n",
                 k ? 'B' : 'A', m->nifti_version, m->dim[0], m->dim[1], m->dim[2], m->spacing[0], m->spacing[1],
-                m->spacing[2], m->transform, m->foreground, m->points,
-                an->mask_points == MASK_ALL ? "foreground" : "surface");
+                m->spacing[2], m->unit_known ? "" : " (unit not given: taken as mm)", m->transform, m->foreground,
+                m->points, an->mask_points == MASK_ALL ? "foreground" : "surface", how);
     }
     if (!r->active) return;
     char t[4][NUM_TEXT]; /* shortest text of each figure (numtext.c) */

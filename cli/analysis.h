@@ -26,6 +26,9 @@ typedef struct mask_info {
     size_t points;             /* points produced (surface or all) */
     const char *transform;     /* "sform", "qform" or "pixdim" */
     double to_mm;              /* unit factor applied (1 for mm) */
+    int unit_known;            /* the header names mm, um or m (now mm) */
+    int surface_dims;          /* axes of the surface's neighbourhood (0: --mask-points all) */
+    int connectivity;          /* its connectivity (1..surface_dims) */
 } mask_info_t;
 
 typedef struct analysis_args {
@@ -38,6 +41,9 @@ typedef struct analysis_args {
     const char *render_out;
     const char *histogram_png;
     mask_points_t mask_points;
+    int connectivity;          /* --connectivity 1|2|3 (default 1: faces) */
+    int mask_dims;             /* --mask-dims: 0 auto, 2 slice by slice, 3 */
+    const char *units;         /* --units TEXT, or NULL */
     empty_policy_t empty;
     mask_info_t mask[2];       /* for A and B */
 } analysis_args_t;
@@ -74,6 +80,20 @@ typedef struct render_marker {
     int x, y;                  /* pixel of the marker's centre */
 } render_marker_t;
 
+/* What the picture says besides the points: the unit (NULL: none) and,
+ * when percentile_on, the percentile figures of the run. */
+typedef struct render_notes {
+    const char *unit;
+    int percentile_on;
+    hd_percentile_t pct;
+} render_notes_t;
+/* What render_distances drew as text and where it marked the percentile
+ * on the colour bar (pct_y < 0: not marked), for the JSON and the tests. */
+typedef struct render_info {
+    char bar_title[64];
+    char caption[3][512];
+    int pct_y, pct_x0, pct_x1;
+} render_info_t;
 /* Where a mean or percentile line was drawn on the histogram picture. */
 typedef struct hist_marker {
     char kind;                 /* 'm' mean (solid), 'p' percentile (dashed) */
@@ -97,10 +117,14 @@ typedef struct analysis_result {
     char dist_path_a[4096], dist_path_b[4096];
     int render_w, render_h, n_markers;
     render_marker_t markers[6];
+    render_info_t render;
     int n_hist_markers;
     hist_marker_t hist_markers[4];
 } analysis_result_t;
 
+/* The unit of the distances: --units, else "mm" when a mask's header
+ * names its unit (converted to mm), else NULL (unknown: no label). */
+const char *analysis_units(const analysis_args_t *an);
 /* Does anything need the per-point distances? */
 int analysis_active(const analysis_args_t *an);
 /* When A or B is empty: report the --empty policy's values (or the error)
@@ -137,13 +161,17 @@ void path_with_suffix(const char *path, const char *suffix, char *out,
 
 /* ---- pictures (render.c) ------------------------------------------------- */
 int render_available(void);
+/* 1 when the path may name a PNG: it ends in .png (any case) or has no
+ * extension (/dev/stdout); another extension (.jpg) would be a lie. */
+int render_path_ok(const char *path);
 /* The picture of A coloured by its distances to B, three views, colour
  * bar, the witness pair of the Hausdorff distance marked and labelled. */
 int render_distances(const char *path, const hd_points_t *A,
                      const hd_points_t *B, const double *d_a, double dmax,
-                     const hd_symmetric_t *s, int directed, int mm,
-                     const char *title, render_marker_t markers[6],
-                     int *n_markers, int *width, int *height,
+                     const hd_symmetric_t *s, int directed,
+                     const render_notes_t *notes, const char *title,
+                     render_marker_t markers[6], int *n_markers,
+                     render_info_t *info, int *width, int *height,
                      hd_error_t *err);
 /* A bar chart of the histogram(s) with the percentile and mean marked;
  * where those lines were drawn goes into marks (at most 4). */

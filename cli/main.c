@@ -193,14 +193,19 @@ int main(int argc, char **argv) {
         fprintf(out, ")\nB: %s (%zu points, %s", a.path_b, B.count, cb->format);
         if (cb->n_faces) fprintf(out, "%s %zu faces", how, cb->n_faces);
         fprintf(out, ")\n");
+        const char *unit = analysis_units(&a.an); /* " mm" after each distance, when known */
+        const char *sp = unit ? " " : "";
+        if (!unit) unit = "";
         if (a.directed) {
             char d[NUM_TEXT];
-            fprintf(out, "h(A,B) = %s\n", num_text(s.ab.distance, d));
+            fprintf(out, "h(A,B) = %s%s%s\n", num_text(s.ab.distance, d), sp, unit);
         } else {
             char d[NUM_TEXT];
-            fprintf(out, "Hausdorff distance H(A,B) = %s\n", num_text(s.distance, d));
-            fprintf(out, "  h(A,B) = %s   [%s]\n", num_text(s.ab.distance, d), hd_algorithm_name(s.ab.algorithm));
-            fprintf(out, "  h(B,A) = %s   [%s]\n", num_text(s.ba.distance, d), hd_algorithm_name(s.ba.algorithm));
+            fprintf(out, "Hausdorff distance H(A,B) = %s%s%s\n", num_text(s.distance, d), sp, unit);
+            fprintf(out, "  h(A,B) = %s%s%s   [%s]\n", num_text(s.ab.distance, d), sp, unit,
+                    hd_algorithm_name(s.ab.algorithm));
+            fprintf(out, "  h(B,A) = %s%s%s   [%s]\n", num_text(s.ba.distance, d), sp, unit,
+                    hd_algorithm_name(s.ba.algorithm));
         }
         const hd_result_t *w = (a.directed || s.ab.distance2 >= s.ba.distance2) ? &s.ab : &s.ba;
         int from_a = w == &s.ab;

@@ -39,14 +39,19 @@
  * sees one line.
  *
  * Which voxels become points (--mask-points):
- *  - surface (default): foreground voxels with, along some axis of more
- *    than one voxel, a face neighbour in the background or outside the
- *    image.  This is the border that medpy (binary erosion with a
- *    connectivity-1 structure, border value 0) and MONAI use for surface
- *    distances, HD and HD95.  An axis of one voxel is not an axis of the
- *    mask: a single slice (nz = 1, or dim[0] = 2) has the in-plane border
- *    medpy finds on the 2-D array, not "every voxel" (its z neighbours lie
- *    outside the image); a mask of one voxel is its own surface.
+ *  - surface (default): the foreground voxels that binary erosion removes,
+ *    the image outside counting as background (border value 0): medpy's
+ *    border (mask ^ binary_erosion(mask, generate_binary_structure(ndim,
+ *    connectivity))), which MONAI uses too with connectivity 1.  The
+ *    neighbourhood (neighbourhood()) has --connectivity 1|2|3 (faces; and
+ *    edges; and corners: 6, 18 or 26 neighbours in 3-D, 4 or 8 in 2-D) over
+ *    the axes --mask-dims chooses: by default the axes of more than one
+ *    voxel, so that a single slice (nz = 1, or dim[0] = 2) has the in-plane
+ *    border medpy finds on the 2-D array, not "every voxel" (its z
+ *    neighbours lie outside the image), and a mask of one voxel is its own
+ *    surface; 2: i and j, each slice of constant k eroded on its own (a
+ *    stack of contours); 3: all three, an axis of one voxel included (what
+ *    medpy gives for the unsqueezed (nx, ny, 1) array).
  *  - all: every foreground voxel.
  * A point is the world coordinate of the voxel's centre (i, j, k):
  *     x = ((m00*i + m01*j) + m02*k) + m03, likewise y and z,
@@ -64,6 +69,7 @@
  */
 #include "analysis.h"
 
+#include <assert.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -512,23 +518,59 @@ static unsigned char *foreground_of(const nifti_image *nim, size_t nvox, long lo
     return fg;
 }
 
-/* A foreground voxel is on the surface when, along some axis of more than
- * one voxel, it lies on the image's edge or next to a background voxel.  An
- * axis of one voxel is not an axis of the mask (a single slice is a 2-D
- * mask, whose surface is its in-plane border); a mask of one voxel is its
- * own surface. */
-static int on_surface(const unsigned char *fg, const long long n[3], long long i, long long j,
-                      long long k) {
-    const long long at[3] = {i, j, k};
-    const size_t stride[3] = {1, (size_t)n[0], (size_t)(n[0] * n[1])};
-    size_t v = (size_t)((k * n[1] + j) * n[0] + i);
-    int axes = 0;
+/* The neighbourhood that defines the surface: scipy's
+ * generate_binary_structure(rank, connectivity) over the axes in use, as
+ * offsets -- every (di, dj, dk) in {-1, 0, 1}^3 that is 0 on the axes not
+ * in use, not all 0, and has at most `connectivity` nonzero entries (a
+ * connectivity above the rank acts as the rank, as scipy's does).  Face
+ * neighbours come first, so that most border voxels stop at the first few. */
+typedef struct {
+    int used[3];        /* the axes of the neighbourhood */
+    int rank;           /* how many */
+    int n;              /* offsets */
+    ptrdiff_t step[26]; /* each offset as a voxel index difference */
+} neighbourhood_t;
+
+static void neighbourhood(neighbourhood_t *nb, const long long n[3], int mask_dims, int connectivity) {
+    assert(connectivity >= 1 && connectivity <= 3 && (mask_dims == 0 || mask_dims == 2 || mask_dims == 3));
+    memset(nb, 0, sizeof *nb);
     for (int a = 0; a < 3; a++) {
-        if (n[a] == 1) continue;
-        axes++;
-        if (at[a] == 0 || at[a] == n[a] - 1 || !fg[v - stride[a]] || !fg[v + stride[a]]) return 1;
+        /* auto: the axes of more than one voxel (a single slice is a 2-D
+         * mask); 2: i and j, each slice k on its own; 3: all three */
+        nb->used[a] = mask_dims == 3 ? 1 : mask_dims == 2 ? a < 2 : n[a] > 1;
+        nb->rank += nb->used[a];
     }
-    return axes == 0;
+    for (int order = 1; order <= 3 && order <= connectivity; order++)
+        for (int o = 0; o < 27; o++) {
+            int d[3] = {o % 3 - 1, o / 3 % 3 - 1, o / 9 - 1}, nz = 0, ok = 1;
+            for (int a = 0; a < 3; a++) {
+                nz += d[a] != 0;
+                if (d[a] && !nb->used[a]) ok = 0;
+            }
+            if (!ok || nz != order) continue;
+            assert(nb->n < 26);
+            nb->step[nb->n++] = (ptrdiff_t)d[0] + (ptrdiff_t)d[1] * (ptrdiff_t)n[0] +
+                                (ptrdiff_t)d[2] * (ptrdiff_t)(n[0] * n[1]);
+        }
+}
+
+/* A foreground voxel is on the surface when binary erosion with the
+ * neighbourhood removes it: some neighbour is background or lies outside
+ * the image (border value 0, as medpy and MONAI erode).  Every
+ * neighbourhood holds the face neighbours along the axes in use, so a voxel
+ * on the image's edge along such an axis is on the surface at once; inside,
+ * every neighbour is within the image.  With no axis in use (a mask of one
+ * voxel, automatically) the voxel is its own surface. */
+static int on_surface(const unsigned char *fg, const long long n[3], const neighbourhood_t *nb,
+                      long long i, long long j, long long k) {
+    if (nb->rank == 0) return 1;
+    const long long at[3] = {i, j, k};
+    for (int a = 0; a < 3; a++)
+        if (nb->used[a] && (at[a] == 0 || at[a] == n[a] - 1)) return 1;
+    size_t v = (size_t)((k * n[1] + j) * n[0] + i);
+    for (int q = 0; q < nb->n; q++)
+        if (!fg[(size_t)((ptrdiff_t)v + nb->step[q])]) return 1;
+    return 0;
 }
 
 /* x = ((m0 i + m1 j) + m2 k) + m3, then the unit. */
@@ -538,8 +580,9 @@ static double world(const nifti_dmat44 *m, int c, double i, double j, double k, 
 }
 
 static int read_mask(const char *path, const hd_read_options_t *ro,
-                     mask_points_t which, mask_info_t *info, hd_cloud_t **out,
+                     const analysis_args_t *an, mask_info_t *info, hd_cloud_t **out,
                      hd_error_t *err) {
+    mask_points_t which = an->mask_points;
     if (access(path, R_OK) != 0) return fail(err, HD_EIO, path, "cannot open the mask");
     header_t h;
     geometry_t g;
@@ -606,6 +649,14 @@ static int read_mask(const char *path, const hd_read_options_t *ro,
     info->foreground = count;
     info->transform = h.sform_code > 0 ? "sform" : h.qform_code > 0 ? "qform" : "pixdim";
     info->to_mm = to_mm;
+    info->unit_known = nim->xyz_units == NIFTI_UNITS_METER || nim->xyz_units == NIFTI_UNITS_MM ||
+                       nim->xyz_units == NIFTI_UNITS_MICRON;
+    neighbourhood_t nb;
+    neighbourhood(&nb, n, an->mask_dims, an->connectivity);
+    if (which == MASK_SURFACE) {
+        info->surface_dims = nb.rank;
+        info->connectivity = an->connectivity < nb.rank ? an->connectivity : nb.rank;
+    }
     /* count the points, then fill exactly that many */
     size_t np = 0;
     for (int pass = 0; pass < 2; pass++) {
@@ -618,7 +669,7 @@ static int read_mask(const char *path, const hd_read_options_t *ro,
             for (long long j = 0; j < n[1]; j++)
                 for (long long i = 0; i < n[0]; i++) {
                     size_t v = (size_t)((k * n[1] + j) * n[0] + i);
-                    if (!fg[v] || (which == MASK_SURFACE && !on_surface(fg, n, i, j, k))) continue;
+                    if (!fg[v] || (which == MASK_SURFACE && !on_surface(fg, n, &nb, i, j, k))) continue;
                     if (pass == 1) {
                         double q[3];
                         for (int c = 0; c < 3; c++) q[c] = world(m, c, (double)i, (double)j, (double)k, to_mm);
@@ -642,9 +693,9 @@ static int read_mask(const char *path, const hd_read_options_t *ro,
 int nifti_available(void) { return 0; }
 
 static int read_mask(const char *path, const hd_read_options_t *ro,
-                     mask_points_t which, mask_info_t *info, hd_cloud_t **out,
+                     const analysis_args_t *an, mask_info_t *info, hd_cloud_t **out,
                      hd_error_t *err) {
-    (void)ro, (void)which, (void)info, (void)out;
+    (void)ro, (void)an, (void)info, (void)out;
     return fail(err, HD_EUNSUPPORTED, path,
                 "NIfTI masks are unavailable: this hausdorff was built without libnifti2 "
                 "(Debian: libnifti2-dev)");
@@ -663,7 +714,7 @@ int cli_read_points(const char *path, const hd_read_options_t *ro,
     }
     int rc;
     if (nifti_is_mask_path(path) && !ro->format) {
-        rc = read_mask(path, ro, an->mask_points, &an->mask[which], out, err);
+        rc = read_mask(path, ro, an, &an->mask[which], out, err);
         if (rc == HD_OK && (*out)->count == 0) {
             hd_cloud_free(*out);
             *out = NULL;

@@ -15,7 +15,8 @@ void cli_usage(FILE *out) {
 "usage: hausdorff [options] A B\n"
 "\n"
 "Exact Hausdorff distance between the point sets in files A and B:\n"
-"H(A,B) = max(h(A,B), h(B,A)), h(A,B) = max over a in A of min over b in B |a-b|.\n"
+"H(A,B) = max(h(A,B), h(B,A)),\n"
+"h(A,B) = max over a in A of min over b in B of |a-b|.\n"
 "Distances are bit-identical to a brute force in double precision.\n"
 "\n"
 "Options:\n"
@@ -68,8 +69,12 @@ void cli_formats(FILE *out) {
     fprintf(out, "  nifti NIfTI-1/2 segmentation masks (.nii, .nii.gz): the surface or every foreground voxel,\n"
                  "        in millimetres (read by the tool, %s)\n",
             nifti_available() ? "available" : "unavailable: built without libnifti2");
-    fprintf(out, "Extensions: .ply .obj .off .stl; .xyz .txt .csv .pts .asc; .pcd .las .laz .npy; .nii .nii.gz.\n"
-                 "One file's format: FORMAT:PATH (xyz:-, ply:scan.dat).\n");
+    fprintf(out, "Extensions: .ply .obj .off .stl; .xyz .txt .csv .pts .asc; .pcd .las .laz .npy; .nii .nii.gz.
+"
+                 "csv, txt, pts and asc name the xyz reader too (--format csv, csv:-).
+"
+                 "One file's format: FORMAT:PATH (xyz:-, ply:scan.dat).
+");
 }
 
 static int bad(const char *fmt, const char *arg) {
@@ -123,20 +128,26 @@ static int parse_double(const char *s, double *out) {
     return 0;
 }
 
-/* A path written FORMAT:PATH, FORMAT a reader's name in any case ("xyz:-",
- * "PLY:scan.dat"): *format is the reader's name and the path follows the
- * colon.  Anything else is a path as it stands, *format NULL ("./ply:x"
- * names a file whose name holds a colon). */
-static const char *split_format(const char *s, const char **format) {
-    *format = NULL;
-    const char *colon = strchr(s, ':');
-    if (!colon || colon == s) return s;
+/* The reader named by the n bytes at s, in any case: a reader's name, or
+ * one of the text extensions the xyz reader has (csv, txt, pts, asc: a user
+ * who names a file .csv types csv:- or --format csv); NULL for neither. */
+static const char *format_named(const char *s, size_t n) {
+    static const char *const text_aliases[] = {"csv", "txt", "pts", "asc", NULL};
     for (const char *const *f = hd_formats(); *f; f++)
-        if (strlen(*f) == (size_t)(colon - s) && strncasecmp(*f, s, (size_t)(colon - s)) == 0) {
-            *format = *f;
-            return colon + 1;
-        }
-    return s;
+        if (strlen(*f) == n && strncasecmp(*f, s, n) == 0) return *f;
+    for (const char *const *f = text_aliases; *f; f++)
+        if (strlen(*f) == n && strncasecmp(*f, s, n) == 0) return "xyz";
+    return NULL;
+}
+
+/* A path written FORMAT:PATH, FORMAT a reader's name or alias in any case
+ * ("xyz:-", "csv:-", "PLY:scan.dat"): *format is the reader's name and the
+ * path follows the colon.  Anything else is a path as it stands, *format
+ * NULL ("./ply:x" names a file whose name holds a colon). */
+static const char *split_format(const char *s, const char **format) {
+    const char *colon = strchr(s, ':');
+    *format = colon && colon != s ? format_named(s, (size_t)(colon - s)) : NULL;
+    return *format ? colon + 1 : s;
 }
 
 int cli_parse(int argc, char **argv, cli_args_t *a) {
@@ -201,8 +212,8 @@ int cli_parse(int argc, char **argv, cli_args_t *a) {
             if (parse_double(v, &a->opt.theta) || !(a->opt.theta >= 0 && a->opt.theta <= 1))
                 return bad("--theta needs a number in [0, 1], not '%s'", v);
         } else if (strcmp(name, "--format") == 0) {
-            if (!hd_format_description(v)) return bad("unknown format '%s' (see --formats)", v);
-            a->read.format = v;
+            if (!(a->read.format = format_named(v, strlen(v))))
+                return bad("unknown format '%s' (see --formats)", v);
         } else if (strcmp(name, "--sample") == 0) {
             uint64_t n;
             if (parse_u64(v, &n) || n == 0 || n > (uint64_t)1 << 40)

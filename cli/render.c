@@ -36,6 +36,14 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <strings.h>
+
+int render_path_ok(const char *path) {
+    const char *base = strrchr(path, '/') ? strrchr(path, '/') + 1 : path;
+    const char *dot = strrchr(base, '.');
+    return !dot || dot == base || strcasecmp(dot, ".png") == 0;
+}
+
 #ifdef HD_HAVE_PNG
 #include <png.h>
 
@@ -231,10 +239,13 @@ static void bounds(const hd_points_t *P, double lo[3], double hi[3]) {
 
 int render_distances(const char *path, const hd_points_t *A,
                      const hd_points_t *B, const double *d_a, double dmax,
-                     const hd_symmetric_t *s, int directed, int mm,
-                     const char *title, render_marker_t markers[6],
-                     int *n_markers, int *width, int *height,
+                     const hd_symmetric_t *s, int directed,
+                     const render_notes_t *notes, const char *title,
+                     render_marker_t markers[6], int *n_markers,
+                     render_info_t *info, int *width, int *height,
                      hd_error_t *err) {
+    memset(info, 0, sizeof *info);
+    info->pct_y = -1;
     canvas_t c = {0, 0, NULL};
     int W = GAP + 3 * (PANEL + GAP) + BAR_W + BAR_LABELS, H = TOP + PANEL + BOTTOM;
     /* points at a quarter of the scale or more: drawn over the surface */
@@ -355,29 +366,68 @@ int render_distances(const char *path, const hd_points_t *A,
         fill_rect(&c, bx, by + y, bx + BAR_W, by + y + 1, col);
     }
     frame_rect(&c, bx - 1, by - 1, bx + BAR_W + 1, by + PANEL + 1, DARK);
+    /* the percentile of the coloured distances (A's to B) on the bar: a
+     * white line with red edges across it and a red tick on each side,
+     * labelled "P95" (or the P asked for) on the right; a tick label it
+     * would cover is left out */
+    int py = -1;
+    char plabel[NUM_TEXT + 1] = "";
+    if (notes->percentile_on && dmax > 0) {
+        double t = notes->pct.ab / dmax;
+        if (t > 1) t = 1;
+        py = by + (int)lround((PANEL - 1) * (1.0 - t));
+        plabel[0] = 'P';
+        num_text(notes->pct.p, plabel + 1);
+    }
     for (int t = 0; t <= 4; t++) {
         int y = by + (int)lround((PANEL - 1) * (1.0 - t / 4.0));
         char buf[64];
-        buf[0] = buf[1] = '>'; /* the top colour stands for everything above */
+        buf[0] = '>'; /* the top colour stands for everything above */
         buf[1] = '=';
         int at = t == 4 && clipped ? 2 : 0;
         fmt_num(buf + at, sizeof buf - (size_t)at, dmax * t / 4.0);
         fill_rect(&c, bx + BAR_W, y, bx + BAR_W + 6, y + 1, DARK);
-        text(&c, bx + BAR_W + 9, y - 8, 2, buf, DARK);
+        if (py < 0 || abs(y - py) >= 22) text(&c, bx + BAR_W + 9, y - 8, 2, buf, DARK);
     }
-    const char *bar_title = mm ? "distance (mm)" : "distance";
+    if (py >= 0) {
+        fill_rect(&c, bx - 8, py - 2, bx + BAR_W + 8, py + 3, RED);
+        fill_rect(&c, bx, py - 1, bx + BAR_W, py + 2, WHITE);
+        label(&c, bx + BAR_W + 11, py - 8, 2, plabel, RED);
+        info->pct_y = py;
+        info->pct_x0 = bx;
+        info->pct_x1 = bx + BAR_W;
+    }
+    if (notes->unit) snprintf(info->bar_title, sizeof info->bar_title, "distance (%.40s)", notes->unit);
+    else snprintf(info->bar_title, sizeof info->bar_title, "distance");
     int tx = bx - 4;
-    if (tx + 2 * font_width(bar_title) > W - 4) tx = W - 4 - 2 * font_width(bar_title);
-    text(&c, tx, by - 30, 2, bar_title, DARK);
+    if (tx + 2 * font_width(info->bar_title) > W - 4) tx = W - 4 - 2 * font_width(info->bar_title);
+    text(&c, tx, by - 30, 2, info->bar_title, DARK);
 
-    /* title lines */
-    char line2[512], hv[64];
+    /* title lines: what is drawn, H and its witnesses, the percentile */
+    char hv[64];
     fmt_num(hv, sizeof hv, w->distance);
-    snprintf(line2, sizeof line2, "%s = %s between %c[%zu] (red) and %c[%zu] (orange); grey: %s only",
-             directed ? "h(A,B)" : "H(A,B)", hv, from_a ? 'A' : 'B', w->i, from_a ? 'B' : 'A', w->j,
-             "B");
-    text(&c, GAP, 14, 2, title, BLACK);
-    text(&c, GAP, 42, 2, line2, DARK);
+    const char *u = notes->unit ? notes->unit : "";
+    snprintf(info->caption[0], sizeof info->caption[0], "%s", title);
+    snprintf(info->caption[1], sizeof info->caption[1],
+             "%s = %s%s%s between %c[%zu] (red) and %c[%zu] (orange); grey: B only",
+             directed ? "h(A,B)" : "H(A,B)", hv, *u ? " " : "", u, from_a ? 'A' : 'B', w->i, from_a ? 'B' : 'A',
+             w->j);
+    if (py >= 0) {
+        char ab[64], sym[64], pooled[64];
+        fmt_num(ab, sizeof ab, notes->pct.ab);
+        fmt_num(sym, sizeof sym, notes->pct.symmetric);
+        fmt_num(pooled, sizeof pooled, notes->pct.pooled);
+        if (directed)
+            snprintf(info->caption[2], sizeof info->caption[2], "%s: A->B %s%s%s (marked on the colour bar)",
+                     plabel, ab, *u ? " " : "", u);
+        else
+            snprintf(info->caption[2], sizeof info->caption[2],
+                     "%s: A->B %s (marked on the colour bar), symmetric (MONAI) %s, pooled (medpy) %s%s%s",
+                     plabel, ab, sym, pooled, *u ? " " : "", u);
+    }
+    text(&c, GAP, 10, 2, info->caption[0], BLACK);
+    text(&c, GAP, 34, 2, info->caption[1], DARK);
+    if (info->caption[2][0]) text(&c, GAP, 58, 2, info->caption[2], DARK);
 
     int rc = write_png(path, &c, err);
     *width = W;
@@ -451,9 +501,10 @@ int render_histogram(const char *path, const analysis_result_t *r,
         if (!logy && v > (double)top + 0.5) break;
     }
     text(&c, 8, T - 26, 2, logy ? "count (log scale)" : "count", DARK);
-    const char *unit = an->mask[0].is_mask || an->mask[1].is_mask ? " (mm)" : "";
+    const char *unit = analysis_units(an);
     char buf[256];
-    snprintf(buf, sizeof buf, "distance to the nearest point of the other set%s", unit);
+    snprintf(buf, sizeof buf, "distance to the nearest point of the other set%s%s%s", unit ? " (" : "",
+             unit ? unit : "", unit ? ")" : "");
     text(&c, L + pw / 2 - font_width(buf), HH - 34, 2, buf, DARK);
     /* markers: percentile (dashed) and mean (solid) per direction, in the
      * direction's colour with a dark edge on each side, so that a line stays
@@ -519,12 +570,15 @@ static int unavailable(hd_error_t *err) {
 
 int render_distances(const char *path, const hd_points_t *A,
                      const hd_points_t *B, const double *d_a, double dmax,
-                     const hd_symmetric_t *s, int directed, int mm,
-                     const char *title, render_marker_t markers[6],
-                     int *n_markers, int *width, int *height,
+                     const hd_symmetric_t *s, int directed,
+                     const render_notes_t *notes, const char *title,
+                     render_marker_t markers[6], int *n_markers,
+                     render_info_t *info, int *width, int *height,
                      hd_error_t *err) {
-    (void)path, (void)A, (void)B, (void)d_a, (void)dmax, (void)s, (void)directed, (void)mm, (void)title;
+    (void)path, (void)A, (void)B, (void)d_a, (void)dmax, (void)s, (void)directed, (void)notes, (void)title;
     (void)markers, (void)width, (void)height;
+    memset(info, 0, sizeof *info);
+    info->pct_y = -1;
     *n_markers = 0;
     return unavailable(err);
 }

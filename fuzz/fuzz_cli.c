@@ -15,7 +15,9 @@
  * accepts: threads 0..1024, depth 1..21, lambda in (0, 1], theta in [0, 1],
  * a known algorithm and format, sampling with 1..2^40 points, the sampling
  * seed equal to --seed, percentile in [0, 100], bins 1..100000, a
- * non-negative --max-distance, known --mask-points and --empty values.
+ * non-negative --max-distance, known --mask-points and --empty values,
+ * --connectivity 1..3, --mask-dims auto, 2 or 3, picture names a PNG may
+ * have, a --units label of 1 to 16 characters.
  */
 #include "cli.h"
 
@@ -38,14 +40,24 @@ int LLVMFuzzerInitialize(int *argc, char ***argv) {
     return 0;
 }
 
+/* 1 when the n bytes at p name the reader `format` in any case: its name,
+ * or for xyz one of the text extensions csv, txt, pts, asc. */
+static int names(const char *p, size_t n, const char *format) {
+    static const char *const text_aliases[] = {"csv", "txt", "pts", "asc", NULL};
+    if (strlen(format) == n && strncasecmp(p, format, n) == 0) return 1;
+    if (strcmp(format, "xyz") != 0) return 0;
+    for (const char *const *f = text_aliases; *f; f++)
+        if (strlen(*f) == n && strncasecmp(p, *f, n) == 0) return 1;
+    return 0;
+}
+
 /* s is an argument, or the path after a "FORMAT:" prefix of one (then
- * `format` is that reader's name). */
+ * `format` is the reader that prefix names). */
 static int given(char **argv, int argc, const char *s, const char *format) {
     for (int k = 1; k < argc; k++) {
         if (argv[k] == s && !format) return 1;
-        if (format && s == argv[k] + strlen(format) + 1 && strncasecmp(argv[k], format, strlen(format)) == 0 &&
-            argv[k][strlen(format)] == ':')
-            return 1;
+        const char *colon = strchr(argv[k], ':');
+        if (format && colon && s == colon + 1 && names(argv[k], (size_t)(colon - argv[k]), format)) return 1;
     }
     return 0;
 }
@@ -100,6 +112,12 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
             an->empty != EMPTY_MONAI)
             abort();
         if (an->distances_out && !distances_format_known(an->distances_out)) abort();
+        if (an->connectivity < 1 || an->connectivity > 3) abort();
+        if (an->mask_dims != 0 && an->mask_dims != 2 && an->mask_dims != 3) abort();
+        if ((an->render_out && !render_path_ok(an->render_out)) ||
+            (an->histogram_png && !render_path_ok(an->histogram_png)))
+            abort();
+        if (an->units && (!an->units[0] || strlen(an->units) > 16)) abort();
     }
     free(buf);
     return 0;

@@ -8,7 +8,8 @@
  * The size of the input picks the options, so that a reproducer replays
  * the same way: odd sizes store float32 (even: float64); bit 1 of the size
  * chooses --mask-points all (else surface); bit 2 --empty zero (else an
- * empty mask is an error).
+ * empty mask is an error); (size >> 3) % 3 + 1 is --connectivity and
+ * (size >> 5) % 3 picks --mask-dims auto, 2 or 3.
  *
  * Besides "no crash, no leak, no undefined behaviour" the target checks the
  * contract of cli_read_points: a failure leaves no cloud and a message that
@@ -66,6 +67,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     memset(&an, 0, sizeof an);
     an.mask_points = size & 2 ? MASK_ALL : MASK_SURFACE;
     an.empty = size & 4 ? EMPTY_ZERO : EMPTY_ERROR;
+    an.connectivity = (int)((size >> 3) % 3) + 1;
+    an.mask_dims = (int[]){0, 2, 3}[(size >> 5) % 3];
     hd_cloud_t *c = (hd_cloud_t *)&an; /* must become NULL on failure */
     hd_error_t e;
     int rc = cli_read_points(path, &ro, &an, 0, &c, &e);

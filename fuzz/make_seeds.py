@@ -9,7 +9,7 @@ only rerun to change them):
                        fuzz_FORMAT_sample targets (and the vertex ones)
   regress-*            the hostile files of issue 17, one per reader fault
 
-Files not named regress-* are valid: tests/test_io_corpus.c reads every file
+Files not named regress-* are valid: tests/api/test_io_corpus.c reads every file
 of the reader directories and requires those to read.
 """
 import gzip

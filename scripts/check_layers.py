@@ -11,7 +11,9 @@ src/ is built in layers, each a folder, each offering one header:
 A file may include the standard library, "hausdorff.h", headers of its own
 folder (bare names, "io.h"), and headers of lower layers by their path from
 src/ ("points/points.h").  cli/ sees the public header and its own headers
-only; tests/ and bench/ may include anything.  An argument names another
+only; so do tests/api/, whose tests use the public header and tests/support/
+alone (the build does not give them src/ either); tests/internal/ and bench/
+may include anything.  An argument names another
 tree to check (tests/layers_check.py uses it to see the check fail).  Every violation is printed
 as FILE:LINE: what, and the exit status is 1 when there is one.
 """
@@ -68,10 +70,18 @@ def check_cli(rel, lines, bad):
             bad.append(f"{rel}:{n}: cli/ uses the public API only, not \"{m.group(1)}\"")
 
 
+def check_api_tests(rel, lines, bad):
+    for n, line in enumerate(lines, 1):
+        m = INCLUDE.match(line)
+        if m and m.group(1) != "hausdorff.h" and not os.path.exists(os.path.join(ROOT, "tests", "support", m.group(1))):
+            bad.append(f"{rel}:{n}: tests/api/ uses the public header and tests/support/ only, "
+                       f"not \"{m.group(1)}\" (a white-box test goes in tests/internal/)")
+
+
 def main():
     bad = []
     count = 0
-    for top, check in (("src", check_src), ("cli", check_cli)):
+    for top, check in (("src", check_src), ("cli", check_cli), ("tests/api", check_api_tests)):
         for d, _, files in os.walk(os.path.join(ROOT, top)):
             for f in sorted(files):
                 if not f.endswith((".c", ".h")):

@@ -265,6 +265,57 @@ def histogram_png_marks_means_and_percentiles_visibly_over_the_bars(tmp):
 
 
 @test
+def render_marks_the_percentile_on_the_colour_bar_and_says_the_unit(tmp):
+    """Issue 18: the picture showed neither HD95 when it was asked for nor a
+    unit.  With --percentile 95 the A->B figure (A's distances are the
+    colours) is a white line with red edges across the colour bar, labelled
+    P95, and the caption gives all three figures; --units names the unit of
+    the bar and the caption; without either, neither appears."""
+    a, b = gauss_clouds(15, 1500, 1400)
+    pa, pb = files(tmp, a, b)
+    png = os.path.join(tmp, "p.png")
+    if not pictures_built():
+        return refuses_pictures(["--render", png, "--percentile", "95", pa, pb])
+    r = run_json(["--render", png, "--percentile", "95", "--units", "mm", pa, pb])
+    rd, p = r["render"], r["percentile"]
+    assert r["units"] == "mm" and rd["bar_title"] == "distance (mm)", rd["bar_title"]
+    assert rd["caption"][2].startswith("P95: A->B %.4g " % p["ab"]), rd["caption"]
+    assert ("symmetric (MONAI) %.4g" % p["symmetric"]) in rd["caption"][2] and rd["caption"][2].endswith(" mm")
+    assert " mm between " in rd["caption"][1], rd["caption"]
+    mark = rd["percentile_mark"]
+    img = read_png(png)
+    # the bar runs from the top (the scale's top, H here) down to 0 over 460 rows
+    top = mark["y"] - round(459 * (1 - p["ab"] / r["hausdorff"]))
+    assert abs(top - 92) <= 1, (mark, top)
+    assert tuple(img[mark["y"], (mark["x0"] + mark["x1"]) // 2]) == (255, 255, 255)
+    assert tuple(img[mark["y"] - 2, mark["x0"] + 3]) == (255, 0, 0)
+    assert tuple(img[mark["y"], mark["x0"] - 5]) == (255, 0, 0)
+    plain = run_json(["--render", png, pa, pb])
+    assert plain["render"]["percentile_mark"] is None and len(plain["render"]["caption"]) == 2
+    assert plain["render"]["bar_title"] == "distance" and "units" not in plain
+    img2 = read_png(png)
+    assert tuple(img2[mark["y"], (mark["x0"] + mark["x1"]) // 2]) != (255, 255, 255)
+
+
+@test
+def pictures_refuse_a_name_that_is_not_png(tmp):
+    """Issue 18: --render x.jpg wrote a PNG under a .jpg name.  Another
+    extension is a usage error (nothing written); .png in any case and a
+    name without an extension (/dev/stdout) are fine."""
+    a, b = gauss_clouds(16, 50, 40)
+    pa, pb = files(tmp, a, b)
+    for opt in ("--render", "--histogram-png"):
+        for name in ("x.jpg", "x.jpeg", "x.png.gif", "x.tif"):
+            _, err = run([opt, os.path.join(tmp, name), pa, pb], expect=1)
+            if pictures_built():
+                assert "PNG only" in err and name in err, err
+            assert not os.path.exists(os.path.join(tmp, name))
+    if pictures_built():
+        run(["--render", os.path.join(tmp, "x.PNG"), "--histogram-png", os.path.join(tmp, "noext"), pa, pb])
+        assert read_png(os.path.join(tmp, "x.PNG")).shape[2] == 3 and read_png(os.path.join(tmp, "noext")).size
+
+
+@test
 def answers_do_not_depend_on_the_thread_count(tmp):
     a, b = lattice_clouds(12, 2000, 1800, side=9)
     pa, pb = files(tmp, a, b)
@@ -303,13 +354,15 @@ def bad_analysis_options_are_usage_errors(tmp):
     for args, words in ((["--percentile", "101"], "[0, 100]"), (["--percentile", "x"], "percentile"),
                         (["--distances", "out.txt"], ".csv, .ply or .npy"),
                         (["--bins", "0"], "--bins"), (["--max-distance", "-1"], "positive"),
-                        (["--mask-points", "edges"], "surface or all"), (["--empty", "none"], "inf, nan, zero or monai"),
+                        (["--mask-points", "edges"], "surface or all"), (["--units", ""], "--units"), (["--empty", "none"], "inf, nan, zero or monai"),
                         (["--percentile"], "needs a value")):
         _, err = run([pa, pb] + args, expect=1)
         assert words in err, (args, err)
     out, _ = run(["--help"])
     for words in ("--percentile P", "--mask-points surface|all", "--empty inf|nan|zero|monai", "6-neighbour"):
         assert words in out, words
+    long = [line for line in out.splitlines() if len(line) > 79]
+    assert not long, long  # fits an 80-column terminal
 
 
 if __name__ == "__main__":

@@ -170,5 +170,118 @@ def a_file_that_is_not_nifti_is_bad_input(tmp):
     assert "bad.nii" in err, err
 
 
+def erosion_border(m, connectivity=1):
+    """medpy's border of the array as given: m ^ binary_erosion(m,
+    generate_binary_structure(m.ndim, connectivity)), border value 0."""
+    from scipy import ndimage
+    m = m.astype(bool)
+    return m ^ ndimage.binary_erosion(m, structure=ndimage.generate_binary_structure(m.ndim, connectivity))
+
+
+def surface_rows(tmp, path, args):
+    """The voxel indices of the points the tool made of a mask (pixdim 1,
+    no transform: the coordinates are the indices), in storage order."""
+    csv = os.path.join(tmp, "rows.csv")
+    run(args + ["--distances", csv, path, path])
+    return np.loadtxt(csv, delimiter=",", skiprows=1, ndmin=2)[:, :3].astype(int)
+
+
+def storage_order(mask):
+    ijk = np.argwhere(mask)
+    return ijk[np.lexsort((ijk[:, 0], ijk[:, 1], ijk[:, 2]))]
+
+
+@test
+def mask_dims_2_erodes_each_slice_on_its_own(tmp):
+    """--mask-dims 2: each slice of constant k is a 2-D mask; the surface is
+    the union of their in-plane borders (a stack of contours, as RT
+    structures are drawn), with the in-plane connectivity asked for."""
+    m = blob(14, (16, 14, 7), (8, 7, 3), (6, 5, 4))
+    path = os.path.join(tmp, "m.nii")
+    write_nifti(path, m)
+    for c in (1, 2):
+        want = np.zeros(m.shape, bool)
+        for k in range(m.shape[2]):
+            want[:, :, k] = erosion_border(m[:, :, k], c)
+        got = surface_rows(tmp, path, ["--mask-dims", "2", "--connectivity", str(c)])
+        assert np.array_equal(got, storage_order(want)), (c, len(got), int(want.sum()))
+        assert len(got) != len(voxels(m, True))  # not the 3-D surface
+        r = run_json(["--mask-dims", "2", "--connectivity", str(c), path, path])
+        assert r["mask_dims"] == 2 and r["masks"]["a"]["surface_dims"] == 2 and r["masks"]["a"]["connectivity"] == c
+
+
+@test
+def mask_dims_3_keeps_an_axis_of_one_voxel_as_medpy_on_the_unsqueezed_array(tmp):
+    """--mask-dims 3 on a single slice: all three axes, the empty z
+    neighbours outside the image included -- every foreground voxel, what
+    medpy answers for the (nx, ny, 1) array; auto gives the in-plane border."""
+    m = blob(15, (20, 18, 1), (10, 9, 0), (8, 7, 1))
+    path = os.path.join(tmp, "s.nii")
+    write_nifti(path, m)
+    assert np.array_equal(surface_rows(tmp, path, ["--mask-dims", "3"]), storage_order(erosion_border(m)))
+    assert len(surface_rows(tmp, path, ["--mask-dims", "3"])) == int(m.sum())
+    flat = np.zeros(m.shape, bool)
+    flat[:, :, 0] = erosion_border(m[:, :, 0])
+    assert np.array_equal(surface_rows(tmp, path, []), storage_order(flat))
+    assert np.array_equal(surface_rows(tmp, path, ["--mask-dims", "auto"]), storage_order(flat))
+
+
+@test
+def connectivity_2_and_3_give_scipys_border_and_exact_distances(tmp):
+    """--connectivity 2 and 3 on 3-D masks with a rotated sform: the points
+    are scipy's border for that structure, the distances the brute force's
+    to the bit."""
+    ma = blob(16, (14, 13, 10), (7, 6, 5), (5, 5, 3))
+    mb = blob(17, (14, 13, 10), (6, 7, 5), (5, 4, 3))
+    m = np.zeros((3, 4))
+    m[:, :3] = rotation(0.2, -0.4, 0.9) * [0.8, 1.1, 1.7]
+    m[:, 3] = [3.5, -2.25, 11.0]
+    ms = stored(m, 1)
+    pa, pb = os.path.join(tmp, "a.nii.gz"), os.path.join(tmp, "b.nii.gz")
+    write_nifti(pa, ma, sform=m)
+    write_nifti(pb, mb, sform=m)
+    for c in (2, 3):
+        A = world(storage_order(erosion_border(ma, c)), ms)
+        B = world(storage_order(erosion_border(mb, c)), ms)
+        dab, _ = nearest(A, B)
+        dba, _ = nearest(B, A)
+        r = run_json(["--connectivity", str(c), "--percentile", "95", pa, pb])
+        assert (r["n_a"], r["n_b"]) == (len(A), len(B)), (c, r["n_a"], len(A))
+        same(r["hausdorff"], max(dab.max(), dba.max()), "H, connectivity %d" % c)
+        same(r["percentile"]["pooled"], np.percentile(np.hstack((dab, dba)), 95), "HD95, connectivity %d" % c)
+
+
+@test
+def mask_options_are_checked_and_listed_in_help(tmp):
+    path = os.path.join(tmp, "m.nii")
+    write_nifti(path, blob(18, (6, 6, 6), (3, 3, 3), (2, 2, 2)))
+    for args, words in ((["--connectivity", "4"], "1, 2 or 3"), (["--connectivity", "0"], "1, 2 or 3"),
+                        (["--mask-dims", "1"], "auto, 2 or 3"), (["--mask-dims", "4"], "auto, 2 or 3")):
+        _, err = run(args + [path, path], expect=1)
+        assert words in err, (args, err)
+    out, _ = run(["--help"])
+    for words in ("--connectivity 1|2|3", "--mask-dims auto|2|3", "--units TEXT"):
+        assert words in out, words
+
+
+@test
+def units_come_from_the_header_or_units_and_are_null_when_unknown(tmp):
+    """The header's xyzt_units: mm, um and m are reported in mm; unknown (0)
+    gives no unit (null), and a line that says it was taken as mm; --units
+    labels any input."""
+    m = blob(19, (6, 6, 6), (3, 3, 3), (2, 2, 2))
+    for code, want in ((2, "mm"), (3, "mm"), (1, "mm"), (0, None)):
+        path = os.path.join(tmp, "u%d.nii" % code)
+        write_nifti(path, m, units=code)
+        r = run_json(["--percentile", "95", path, path])
+        assert r["units"] == want and r["masks"]["a"]["unit_known"] == (want is not None), (code, r["units"])
+        out, _ = run(["--percentile", "95", path, path])
+        assert ("(mm)" in out) == (want is not None), out
+        assert ("unit not given" in out) == (want is None), out
+        assert ("H(A,B) = 0 mm\n" in out) == (want is not None), out  # the distance says its unit
+    r = run_json(["--units", "um", path, path])
+    assert r["units"] == "um"
+
+
 if __name__ == "__main__":
     main()

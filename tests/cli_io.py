@@ -300,6 +300,31 @@ def small_surprises_of_a_first_hour_are_gone(d):
     assert rc == 0, err
     r = json.loads(out)
     assert r["hausdorff"] is None and r["directed_ab"] == 0 and r["directed_ba"] is None, r
+    # timings to the microsecond, the per-point distances' too (were 0.011584724999920581)
+    rc, out, err = run("--json", "--mean", p, p)
+    r = json.loads(out)
+    for key in ("seconds", "read_seconds", "distances_seconds"):
+        assert r[key] == round(r[key], 6), (key, r[key])
+    # the text extensions name the xyz reader, as --format and as FORMAT:PATH (were "unknown format 'csv'"
+    # and "csv:-: cannot open")
+    pts = write(d, "pts.dat", "x,y,z\n0,0,0\n1,1,1\n")
+    for args in (["--format", "csv", pts, pts], ["csv:" + pts, "TXT:" + pts], ["csv:-", "asc:" + pts]):
+        rc, out, err = run("--json", *args, stdin=b"x,y,z\n0,0,0\n1,1,1\n")
+        assert rc == 0 and json.loads(out)["n_a"] == 2, (args, err)
+    rc, out, err = run("--formats")
+    assert "csv, txt, pts and asc" in out, out
+
+
+@test
+def every_option_of_the_help_is_in_the_man_page(d):
+    """A user who reads `man hausdorff` meets every option --help lists
+    (--max-stream-size and --fifo-wait were missing)."""
+    rc, out, err = run("--help")
+    assert rc == 0, err
+    with open(os.path.join(os.path.dirname(HERE), "docs", "hausdorff.1")) as f:
+        man = f.read().replace("\\-", "-")
+    missing = sorted({o for o in re.findall(r"--[a-z][a-z0-9-]*", out) if o not in man})
+    assert not missing, missing
 
 
 @test

@@ -13,6 +13,7 @@ Standard library only (unittest); run as:
     cli_output.py PATH/TO/hausdorff [WritingCli.test_NAME ...]
 """
 import os
+import shutil
 import resource
 import signal
 import stat
@@ -238,9 +239,12 @@ def an_output_naming_an_input_is_refused_and_the_input_is_unchanged(d):
         (["--distances", "hard.csv", "--directed", "a.csv", OTHER], "--distances hard.csv", "input A (a.csv)"),
         (["--distances", "b.csv", SMALL, "b_b.csv"], "b_b.csv", "input B (b_b.csv)"),
     ]
-    if pictures_built():
-        cases.append((["--render", "a.csv", SMALL, "a.csv"], "--render a.csv", "input B (a.csv)"))
-        cases.append((["--histogram-png", "b_b.csv", "b_b.csv", SMALL], "--histogram-png b_b.csv", "input A"))
+    if pictures_built():  # a picture's name ends in .png or has no extension
+        shutil.copyfile(a, os.path.join(d, "apts"))
+        before[os.path.join(d, "apts")] = before[a]
+        os.symlink("b_b.csv", os.path.join(d, "pic.png"))
+        cases.append((["--render", "apts", SMALL, "xyz:apts"], "--render apts", "input B (apts)"))
+        cases.append((["--histogram-png", "pic.png", "b_b.csv", SMALL], "--histogram-png pic.png", "input A"))
     for args, *needles in cases:
         rc, out, err = run(*args, cwd=d)
         expect(rc, err, 1, "would overwrite", *needles)
@@ -250,7 +254,8 @@ def an_output_naming_an_input_is_refused_and_the_input_is_unchanged(d):
     expect(rc, err, 1, "would overwrite input A (standard input)")
     for p, data in before.items():
         assert read(p, "rb") == data, p
-    assert sorted(listing(d)) == ["a.csv", "b_b.csv", "hard.csv", "link.csv"], listing(d)
+    pictures = ["apts", "pic.png"] if pictures_built() else []
+    assert sorted(listing(d)) == sorted(["a.csv", "b_b.csv", "hard.csv", "link.csv"] + pictures), listing(d)
 
 
 @test

@@ -54,6 +54,15 @@ class Layers(unittest.TestCase):
         r = self.run_on({"cli/x.c": '#include "engine/engine.h"\n'})
         self.assertEqual(r.returncode, 1)
 
+    def test_an_api_test_including_an_internal_header_fails(self):
+        r = self.run_on({"tests/api/test_x.c": '#include "engine/engine.h"\n'})
+        self.assertEqual(r.returncode, 1)
+        self.assertIn("tests/api/test_x.c:1", r.stdout)
+
+    def test_an_api_test_including_support_headers_passes(self):
+        r = self.run_on({"tests/support/check.h": "", "tests/api/test_x.c": '#include "hausdorff.h"\n#include "check.h"\n'})
+        self.assertEqual(r.returncode, 0, r.stdout)
+
     def test_the_top_including_any_layer_passes(self):
         r = self.run_on({"src/api.c": '#include "engine/engine.h"\n#include "io/io.h"\n#include "hausdorff.h"\n'})
         self.assertEqual(r.returncode, 0, r.stdout)

@@ -18,7 +18,7 @@
  * (A cell's faces are rounded sums and need not enclose the points they
  * were meant to: that is why they only steer the descent.)
  *
- * Invariants, checked by tests/test_octree.c:
+ * Invariants, checked by tests/internal/test_octree.c:
  *  - the positions [begin, begin + count) of a node are the disjoint union of
  *    its children's, children listed by increasing octant, and idx is a
  *    permutation of 0..n-1; pts holds the points in that order, so a leaf's

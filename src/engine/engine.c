@@ -549,10 +549,10 @@ static int engine_plan(engine_t *e, hd__engine_force_t force, hd_error_t *err) {
 
 /* The plan in a word: "pairs" when the correspondence path settled every
  * direction, else the path the rest runs. */
-static const char *engine_plan_name(const engine_t *e) {
+static hd__plan_path_t engine_plan_path(const engine_t *e) {
     int all = 1;
     for (int d = 0; d < e->directions; d++) all &= e->pairs.resolved[d];
-    return all ? "pairs" : e->use_tree ? "trees" : "grid";
+    return all ? HD__PLAN_PAIRS : e->use_tree ? HD__PLAN_TREES : HD__PLAN_GRID;
 }
 
 /* force: the plan's choice, or the grid or the trees forced. */
@@ -723,7 +723,7 @@ int hd__engine_forced(const hd_points_t *A, const hd_points_t *B, const hd_optio
 }
 
 int hd__engine_explain(const hd_points_t *A, const hd_points_t *B, const hd_options_t *opt,
-                       char *buf, size_t len, hd_error_t *err) {
+                       hd__engine_plan_t *plan, char *buf, size_t len, hd_error_t *err) {
     hd__box_t ba, bb;
     int rc = hd__points_scan(A, "A", opt->threads, &ba, err);
     if (rc == HD_OK) rc = hd__points_scan(B, "B", opt->threads, &bb, err);
@@ -732,12 +732,19 @@ int hd__engine_explain(const hd_points_t *A, const hd_points_t *B, const hd_opti
     rc = engine_init(&e, A, B, &ba, &bb, opt, 2, err);
     if (rc) return rc;
     rc = engine_plan(&e, HD__ENGINE_PLANNED, err);
-    if (rc == HD_OK)
-        snprintf(buf, len,
-                 "%s (pairs %s, resolved %d / %d; grid trial: %.3g / %.3g distances and nodes per "
-                 "point)",
-                 engine_plan_name(&e), e.pairs.active ? "listed" : "not tried", e.pairs.resolved[0],
-                 e.pairs.resolved[1], e.cost[0], e.cost[1]);
+    if (rc == HD_OK) {
+        hd__engine_plan_t p = {engine_plan_path(&e), e.pairs.active != 0,
+                               {e.pairs.resolved[0] != 0, e.pairs.resolved[1] != 0}, {e.cost[0], e.cost[1]}};
+        static const char *const name[] = {[HD__PLAN_PAIRS] = "pairs", [HD__PLAN_GRID] = "grid",
+                                           [HD__PLAN_TREES] = "trees"};
+        if (plan) *plan = p;
+        if (len)
+            snprintf(buf, len,
+                     "%s (pairs %s, resolved %d / %d; grid trial: %.3g / %.3g distances and nodes per "
+                     "point)",
+                     name[p.path], p.pairs_listed ? "listed" : "not tried", p.resolved[0], p.resolved[1],
+                     p.grid_cost[0], p.grid_cost[1]);
+    }
     engine_free(&e);
     return rc;
 }

@@ -358,9 +358,21 @@ int hd__engine_hausdorff(const hd_points_t *A, const hd_points_t *B,
                          const hd__box_t *box_a, const hd__box_t *box_b,
                          const hd_options_t *opt, hd_symmetric_t *out,
                          hd_error_t *err);
-/* The engine's plan for H(A,B) as a sentence in buf (for benchmarks). */
+/* The engine's plan for H(A,B), for tests and benchmarks: which path
+ * answers (the correspondence path settles both directions exactly when
+ * path is HD__PLAN_PAIRS), whether the pairs were listed, which directions
+ * they resolved, and each direction's grid trial cost (distances and nodes
+ * per point).  plan may be NULL; buf (may be NULL when len is 0) gets the
+ * same as one sentence, for people. */
+typedef enum { HD__PLAN_PAIRS = 1, HD__PLAN_GRID, HD__PLAN_TREES } hd__plan_path_t;
+typedef struct {
+    hd__plan_path_t path;
+    int pairs_listed;  /* 1: pairs listed, 0: not tried */
+    int resolved[2];   /* per direction, 0 or 1 */
+    double grid_cost[2];
+} hd__engine_plan_t;
 int hd__engine_explain(const hd_points_t *A, const hd_points_t *B,
-                       const hd_options_t *opt, char *buf, size_t len,
-                       hd_error_t *err);
+                       const hd_options_t *opt, hd__engine_plan_t *plan,
+                       char *buf, size_t len, hd_error_t *err);
 
 #endif /* HD_ENGINE_H */

@@ -150,6 +150,19 @@ HD__INLINE const char *hd__eol(const char *p, const char *end) {
     return e ? e : end;
 }
 
+/* Steps through [*p, end) a line at a time: sets *line to the line's first
+ * byte and *eol to its end (its '\n', or end), moves *p past the '\n', and
+ * returns 1; returns 0, changing nothing, once *p reaches end.  A loop
+ * `for (const char *q, *eol; hd__next_line(&p, end, &q, &eol);)` visits
+ * every line, the last one too when it has no '\n'. */
+HD__INLINE int hd__next_line(const char **p, const char *end, const char **line, const char **eol) {
+    if (*p >= end) return 0;
+    *line = *p;
+    *eol = hd__eol(*p, end);
+    *p = *eol + (*eol < end);
+    return 1;
+}
+
 /* The next whitespace-separated token in [*p, eol): sets [*tb, *te) and
  * advances *p; 0 when the line has no more tokens. */
 HD__INLINE int hd__token(const char **p, const char *eol, const char **tb,

@@ -63,10 +63,8 @@ static void chunk(void *ctx, hd__chunk_t *c) {
     const char *p = c->begin, *end = c->end, *tb, *te;
     long long line = 0;
     uint64_t idx[64];
-    while (p < end) {
+    for (const char *q, *eol; hd__next_line(&p, end, &q, &eol);) {
         line++;
-        const char *eol = hd__eol(p, end), *q = p;
-        p = eol + (eol < end);
         if (!hd__token(&q, eol, &tb, &te) || te - tb != 1) continue;
         if (*tb == 'v') {
             if (!hd__chunk_vertex(c, &q, eol, line, "vertex: ", "vertex: expected x y z", 0)) return;
@@ -140,10 +138,8 @@ static int report_bad_reference(hd__read_t *r, size_t nv) {
     const char *p = (const char *)r->f->data, *end = p + r->f->size, *tb, *te;
     long long line = 0;
     uint64_t seen = 0;
-    while (p < end) {
+    for (const char *q, *eol; hd__next_line(&p, end, &q, &eol);) {
         line++;
-        const char *eol = hd__eol(p, end), *q = p;
-        p = eol + (eol < end);
         if (!hd__token(&q, eol, &tb, &te) || te - tb != 1) continue;
         if (*tb == 'v') seen++;
         if (*tb != 'f') continue;

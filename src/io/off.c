@@ -42,10 +42,8 @@ static void chunk(void *ctx, hd__chunk_t *c) {
     const char *p = c->begin, *end = c->end, *tb, *te;
     long long line = 0;
     uint64_t idx[64];
-    while (p < end) {
+    for (const char *q, *eol; hd__next_line(&p, end, &q, &eol);) {
         line++;
-        const char *eol = hd__eol(p, end), *q = p;
-        p = eol + (eol < end);
         if (!o->faces) {
             const char *s = q;
             while (s < eol && hd__is_blank((unsigned char)*s)) s++;

@@ -353,10 +353,9 @@ static void vertex_chunk(void *ctx, hd__chunk_t *c) {
     const char *p = c->begin, *end = c->end;
     long long line = 0;
     uint64_t idx[64];
-    while (p < end) {
+    for (const char *q, *eol; hd__next_line(&p, end, &q, &eol);) {
         line++;
-        const char *eol = hd__eol(p, end), *q = p, *tb = p, *te = p;
-        p = eol + (eol < end);
+        const char *tb = q, *te = q;
         double v[3] = {0, 0, 0};
         int found = 0;
         for (int j = 0; j < e->n_props; j++) {

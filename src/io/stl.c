@@ -36,10 +36,8 @@ static void chunk(void *ctx, hd__chunk_t *c) {
     (void)ctx;
     const char *p = c->begin, *end = c->end, *tb, *te;
     long long line = 0;
-    while (p < end) {
+    for (const char *q, *eol; hd__next_line(&p, end, &q, &eol);) {
         line++;
-        const char *eol = hd__eol(p, end), *q = p;
-        p = eol + (eol < end);
         if (!hd__token(&q, eol, &tb, &te)) continue;
         if (word(tb, te, "vertex")) {
             if (!hd__chunk_vertex(c, &q, eol, line, "vertex: ", "vertex: expected x y z", 0)) return;
@@ -65,10 +63,8 @@ static int report_bad_facet(hd__read_t *r) {
     const char *p = (const char *)r->f->data, *end = p + r->f->size, *tb, *te;
     long long line = 0, facet_line = 0;
     int n = -1;
-    while (p < end) {
+    for (const char *q, *eol; hd__next_line(&p, end, &q, &eol);) {
         line++;
-        const char *eol = hd__eol(p, end), *q = p;
-        p = eol + (eol < end);
         if (!hd__token(&q, eol, &tb, &te)) continue;
         if (word(tb, te, "vertex")) {
             if (n < 0) return hd__io_err_line(r, HD_EFORMAT, line, "vertex outside a facet");

@@ -130,11 +130,8 @@ static size_t all_lines(void *ctx, const char *p, const char *end) {
 size_t hd__keyword_lines(const char *p, const char *end, const char *word) {
     size_t n = 0, len = strlen(word);
     const char *tb, *te;
-    while (p < end) {
-        const char *eol = hd__eol(p, end), *q = p;
+    for (const char *q, *eol; hd__next_line(&p, end, &q, &eol);)
         n += hd__token(&q, eol, &tb, &te) && (size_t)(te - tb) == len && memcmp(tb, word, len) == 0;
-        p = eol + (eol < end);
-    }
     return n;
 }
 

@@ -86,10 +86,9 @@ static void chunk(void *ctx, hd__chunk_t *c) {
     const dialect_t *d = ctx;
     const char *p = c->begin, *end = c->end;
     long long line = 0;
-    while (p < end) {
+    for (const char *q, *eol; hd__next_line(&p, end, &q, &eol);) {
         line++;
-        const char *eol = hd__eol(p, end), *q = p, *ls = p;
-        p = eol + (eol < end);
+        const char *ls = q;
         while (q < eol && is_sep((unsigned char)*q)) q++;
         if (q == eol || *q == '#' || (*q == '/' && q + 1 < eol && q[1] == '/')) continue;
         int first = c->index == 0 && line == 1;
@@ -163,11 +162,7 @@ static int candidate(const char *p, const char *eol) {
 static size_t candidates(void *ctx, const char *p, const char *end) {
     (void)ctx;
     size_t n = 0;
-    while (p < end) {
-        const char *eol = hd__eol(p, end);
-        n += (size_t)candidate(p, eol);
-        p = eol + (eol < end);
-    }
+    for (const char *q, *eol; hd__next_line(&p, end, &q, &eol);) n += (size_t)candidate(q, eol);
     return n;
 }
 

@@ -332,18 +332,12 @@ TEST(statistics_explain_the_work) {
 
 /* ---- the correspondence path: B a copy of A in the same order ---------------- */
 
-/* The engine's plan, in its own words (engine.c). */
-int hd__engine_explain(const hd_points_t *A, const hd_points_t *B, const hd_options_t *opt,
-                       char *buf, size_t len, hd_error_t *err);
-
-/* The engine's plan for H(A,B) as values: which path answers, whether the
- * correspondence path listed pairs, and which directions it resolved.
- * They are read from hd__engine_explain's sentence, whose shape engine.c
- * fixes ("NAME (pairs listed|not tried, resolved R0 / R1; ..."), field by
- * field and strictly: a sentence of any other shape, or a value out of
- * its range, fails the test (it cannot pass as a plan that merely lacks
- * some words), and every field is compared, not searched for. */
-typedef enum { PLAN_UNREAD = 0, PLAN_PAIRS, PLAN_GRID, PLAN_TREES } plan_path_t;
+/* The engine's plan for H(A,B) as values (hd__engine_explain's
+ * hd__engine_plan_t): which path answers, whether the correspondence path
+ * listed pairs, and which directions it resolved.  Every field is checked
+ * to be in its range, so a plan the engine failed to fill fails the test. */
+typedef enum { PLAN_UNREAD = 0, PLAN_PAIRS = HD__PLAN_PAIRS, PLAN_GRID = HD__PLAN_GRID,
+               PLAN_TREES = HD__PLAN_TREES } plan_path_t;
 typedef struct {
     plan_path_t path;
     int listed;      /* 1: pairs listed, 0: not tried */
@@ -355,30 +349,24 @@ static plan_t plan_of(const double *a, size_t na, const double *b, size_t nb) {
     hd_points_t A = hd_points_f64(a, na), B = hd_points_f64(b, nb);
     hd_options_t o;
     hd_options_init(&o);
-    char plan[256] = "", name[16] = "", pairs[16] = "";
-    int rc = hd__engine_explain(&A, &B, &o, plan, sizeof plan, NULL), r0 = -1, r1 = -1, end = 0;
+    hd__engine_plan_t e;
+    memset(&e, 0xff, sizeof e); /* out of range until the engine writes it */
+    int rc = hd__engine_explain(&A, &B, &o, &e, NULL, 0, NULL);
     CHECK_RC(rc, HD_OK);
     if (rc != HD_OK) return p;
-    if (sscanf(plan, "%15[a-z] (pairs %15[a-z ], resolved %d / %d;%n", name, pairs, &r0, &r1, &end) != 4 ||
-        end == 0 || (r0 != 0 && r0 != 1) || (r1 != 0 && r1 != 1)) {
-        hdt_fail(__FILE__, __LINE__, "the engine's plan is not in the shape this test reads: \"%s\"", plan);
-        return p;
-    }
-    plan_path_t path = strcmp(name, "pairs") == 0   ? PLAN_PAIRS
-                       : strcmp(name, "grid") == 0  ? PLAN_GRID
-                       : strcmp(name, "trees") == 0 ? PLAN_TREES
-                                                    : PLAN_UNREAD;
-    int listed = strcmp(pairs, "listed") == 0 ? 1 : strcmp(pairs, "not tried") == 0 ? 0 : -1;
-    if (path == PLAN_UNREAD || listed < 0) {
-        hdt_fail(__FILE__, __LINE__, "the engine's plan names an unknown path: \"%s\"", plan);
+    if ((e.path != HD__PLAN_PAIRS && e.path != HD__PLAN_GRID && e.path != HD__PLAN_TREES) ||
+        (e.pairs_listed != 0 && e.pairs_listed != 1) || (e.resolved[0] != 0 && e.resolved[0] != 1) ||
+        (e.resolved[1] != 0 && e.resolved[1] != 1)) {
+        hdt_fail(__FILE__, __LINE__, "the engine's plan has a field out of range: path %d, listed %d, "
+                 "resolved %d / %d", (int)e.path, e.pairs_listed, e.resolved[0], e.resolved[1]);
         return p;
     }
     /* The path is "pairs" exactly when both directions were resolved. */
-    CHECK_EQ(path == PLAN_PAIRS, r0 && r1);
-    p.path = path;
-    p.listed = listed;
-    p.resolved[0] = r0;
-    p.resolved[1] = r1;
+    CHECK_EQ(e.path == HD__PLAN_PAIRS, e.resolved[0] && e.resolved[1]);
+    p.path = (plan_path_t)e.path;
+    p.listed = e.pairs_listed;
+    p.resolved[0] = e.resolved[0];
+    p.resolved[1] = e.resolved[1];
     return p;
 }
 
