@@ -19,7 +19,7 @@
  * that round-trip a double (where the fast path of number.c gives way to
  * strtod).  Binary PCD, LAS, NPY, STL and PLY rows read straight from the
  * mapping.  The "laz" and "laz10" rows hold the LAS row's integers
- * LASzip-compressed (tests/support/lazwrite.c) as point format 6 (layered)
+ * LASzip-compressed (tests/internal/lazwrite.c) as point format 6 (layered)
  * and 0 (pointwise), chunks of 50 000 decoded in parallel.  Timings are wall-clock (CLOCK_MONOTONIC); nothing is asserted.
  */
 #include "gen.h"

@@ -4,7 +4,7 @@
  *   lazgen DIR
  *
  * For each case, DIR/NAME.laz from the tests' LAZ writer
- * (tests/support/lazwrite.c) and DIR/NAME.txt with its points' integer
+ * (tests/internal/lazwrite.c) and DIR/NAME.txt with its points' integer
  * coordinates, "X Y Z" per line in file order; then prints the case names,
  * one per line.  Seeded: the same files on every run.
  *

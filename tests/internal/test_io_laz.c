@@ -1,6 +1,6 @@
 /*
  * test_io_laz.c -- the LAZ reader (src/io/laz.c): random point sets written
- * by the tests' LAZ writer (tests/support/lazwrite.c, whose files
+ * by the tests' LAZ writer (tests/internal/lazwrite.c, whose files
  * tests/laz_lazperf.py checks with laz-perf) read back bit-identically in
  * every point format family, chunking and thread count; and damaged files
  * refused with the place of the damage, never a crash, a hang or an
