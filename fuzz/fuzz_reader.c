@@ -62,9 +62,11 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
 #ifdef HD_FUZZ_SAMPLE
     if (c->count != HD_FUZZ_SAMPLE) abort();
 #else
-    /* LAZ: a chunk may hold up to HD__LAZ_POINTS_PER_BYTE points per byte
-     * (a run of identical points costs a tiny fraction of a bit each) */
-    if (c->count > (strcmp(HD_FUZZ_FORMAT, "laz") == 0 ? HD__LAZ_POINTS_PER_BYTE : 1) * size) abort();
+    /* LAZ (named las or laz: the compression bit decides): a chunk may hold
+     * up to HD__LAZ_POINTS_PER_BYTE points per byte (a run of identical
+     * points costs a tiny fraction of a bit each) */
+    int laz = size > 104 && memcmp(data, "LASF", 4) == 0 && (data[104] & 0x80);
+    if (c->count > (laz ? HD__LAZ_POINTS_PER_BYTE : 1) * size) abort();
 #endif
     hd_points_t p = hd_cloud_points(c);
     for (size_t k = 0; k < c->count; k++) {
