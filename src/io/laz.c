@@ -772,6 +772,9 @@ static int parse_vlr(laz_t *z, const hd__las_header_t *h, uint32_t *chunk_size) 
                                  "LASzip item %u is type %u version %u; read are %s", i + 1, it->type, it->version,
                                  z->layered ? "POINT14 first, then RGB14, RGBNIR14, WAVEPACKET14, BYTE14 (versions 3, 4)"
                                             : "POINT10 first, then GPSTIME11, RGB12, BYTE (versions 1, 2)");
+        for (unsigned k = 0; k < i; k++)
+            if (z->items[k].type == it->type)
+                return hd__io_err_at(r, HD_EFORMAT, where, "LASzip item %u repeats item %u's type %u", i + 1, k + 1, it->type);
         if (it->type < 15 && need[it->type] && it->size != need[it->type])
             return hd__io_err_at(r, HD_EFORMAT, where + 2, "LASzip item %u (type %u) has size %u, not %u", i + 1, it->type, it->size,
                                  need[it->type]);

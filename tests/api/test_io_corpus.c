@@ -45,6 +45,7 @@ static outcome_t regress[] = {
     {"tests/corpus/xyz/regress-pts-count-2e64", HD_EFORMAT, 0, 0, 0, 0},
     {"tests/corpus/pcd/regress-empty-window", HD_EFORMAT, 0, 0, 0, 0},
     {"tests/corpus/npy/regress-empty-shape", HD_EFORMAT, 0, 0, 0, 0},
+    {"tests/corpus/las/regress-laz-repeated-items", HD_EFORMAT, 0, 0, 0, 0},
 };
 #define N_REGRESS (sizeof regress / sizeof regress[0])
 

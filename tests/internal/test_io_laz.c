@@ -312,6 +312,26 @@ TEST(unsupported_or_inconsistent_laszip_vlrs_are_refused_naming_the_field) {
     b.data[v + 34 + 2] = 21; /* POINT10 of 21 bytes */
     refused(&b, HD_EFORMAT, "has size 21, not 20", (long long)v + 36);
     b.data[v + 34 + 2] = 20;
+    tf_free(&b);
+    /* two BYTE items (a file with 2 extra bytes whose BYTE item is split
+     * into two of one byte; the VLR and the point offset grow by 6) */
+    tf_buf_t x = {0};
+    lazw_opts_t o = plain;
+    o.extra = 2;
+    lazw_point_t p[10];
+    for (int i = 0; i < 10; i++) p[i] = (lazw_point_t){i, i, i, 1, 1, 0};
+    lazw_encode(&x, &o, p, 10);
+    size_t it = lazw_last.vlr + 34 + 6;
+    tf_put(&x, "123456", 6);
+    memmove(x.data + it + 6, x.data + it, x.size - 6 - it);
+    x.data[it + 2] = 1;
+    x.data[it + 6 + 2] = 1;
+    x.data[lazw_last.vlr + 32] = 3;
+    x.data[lazw_last.vlr - 54 + 20] += 6;
+    put_u32(&x, 96, (uint32_t)lazw_last.points + 6);
+    refused(&x, HD_EFORMAT, "LASzip item 3 repeats item 2's type 0", (long long)it + 6);
+    tf_free(&x);
+    sample(&b, 0, 10, 50);
     b.data[v - 54 + 2] = 'L'; /* no VLR of user "laszip encoded" */
     refused(&b, HD_EFORMAT, "no LASzip VLR", 104);
     tf_free(&b);
