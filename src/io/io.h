@@ -116,6 +116,9 @@ typedef struct hd__las_header {
  * claim more than HD__LAZ_POINTS_PER_BYTE points per byte of it: the bound
  * on the allocation a LAZ file can cause. */
 #define HD__LAZ_POINTS_PER_BYTE 4096
+/* Up to this many points per compressed byte the LAZ reader allocates the
+ * result at once; above, it grows it as points are decoded (laz.c). */
+#define HD__LAZ_EAGER_PER_BYTE 64
 int hd__read_laz(hd__read_t *r, const hd__las_header_t *h);
 
 /* ---- errors with a place --------------------------------------------------- */

@@ -47,7 +47,10 @@
  * points per chunk add up to the header's count, and no chunk claims more
  * points than HD__LAZ_POINTS_PER_BYTE per byte of it (a point costs at
  * least a few thousandths of a bit in the format's most skewed models;
- * the limit is generous for real files, see docs/formats.md); a chunk's
+ * the limit is generous for real files, see docs/formats.md), and above
+ * HD__LAZ_EAGER_PER_BYTE points per byte the result is not allocated up
+ * front but grown while the chunks are decoded in order, so that only
+ * decoded points cost memory; a chunk's
  * layer sizes fit inside it; a stream that reads past its bytes is an
  * error (a valid stream never does: the encoder's last bytes and padding
  * keep the decoder within them).  Chunks are decoded in parallel, each by
@@ -59,6 +62,7 @@
 #include "io.h"
 #include "lazcoder.h"
 
+#include <assert.h>
 #include <float.h>
 #include <math.h>
 #include <stdio.h>
@@ -77,6 +81,7 @@ typedef struct {
     const unsigned char *d;
     size_t size;
     int layered, chunked;
+    int grow; /* decode sequentially, growing the result (see hd__read_laz) */
     size_t rec;
     item_t items[32];
     unsigned n_items, n_layers;
@@ -124,6 +129,12 @@ static int put(job_t *j, int32_t X, int32_t Y, int32_t Z) {
         while (c < 2 && hd__point_valid((double[3]){p[c], 0, 0}, j->s->dtype) == HD_OK) c++;
         return fail(j, code, (long long)z->start[j->chunk], "point %zu (in the chunk starting here): %s (%c = %g)", j->k,
                     hd__point_problem(code), "xyz"[c], p[c]);
+    }
+    if (j->k >= j->s->cap) { /* the sequential path grows the result as points appear */
+        assert(j->z->grow);
+        j->s->count = j->k;
+        int rc = hd__sink_reserve(j->s, 1 << 16);
+        if (rc) return fail(j, rc, (long long)z->start[j->chunk], "cannot allocate %zu points: %s", j->k + 1, hd_strerror(rc));
     }
     hd__sink_set(j->s, j->k++, p);
     return 0;
@@ -892,7 +903,14 @@ int hd__read_laz(hd__read_t *r, const hd__las_header_t *h) {
     if (rc == HD_OK && z.chunked) rc = read_table(&z, h, chunk_size);
     if (rc == HD_OK && !z.chunked) rc = one_chunk(&z, h);
     if (rc == HD_OK && r->sink->count != 0) rc = hd__io_err(r, HD_EINVAL, "internal: LAZ points into a non-empty sink");
-    if (rc == HD_OK && (rc = hd__sink_reserve(r->sink, (size_t)h->count)) != HD_OK)
+    /* Real data holds under a third of a point per byte; a degenerate file
+     * (a repeated point) up to a thousand.  Up to HD__LAZ_EAGER_PER_BYTE the
+     * result is allocated at once and the chunks decoded in parallel; above,
+     * chunks are decoded one after the other and the result grows as points
+     * are decoded, so a file whose claims its bytes do not back fails
+     * before allocating them. */
+    z.grow = rc == HD_OK && h->count > (z.start[z.n_chunks] - z.start[0]) * HD__LAZ_EAGER_PER_BYTE;
+    if (rc == HD_OK && (rc = hd__sink_reserve(r->sink, z.grow ? 0 : (size_t)h->count)) != HD_OK)
         rc = hd__io_err(r, rc, "cannot allocate %llu points: %s", (unsigned long long)h->count, hd_strerror(rc));
     if (rc == HD_OK) {
         z.rc = hd__malloc_array(z.n_chunks, sizeof *z.rc);
@@ -901,7 +919,11 @@ int hd__read_laz(hd__read_t *r, const hd__las_header_t *h) {
         if (!z.rc || !z.at || !z.msg) rc = hd__io_err(r, HD_ENOMEM, "out of memory");
     }
     if (rc == HD_OK) {
-        hd__parallel_for(hd__thread_count(r->threads, z.n_chunks), z.n_chunks, decode_chunk, &z);
+        if (!z.grow) hd__parallel_for(hd__thread_count(r->threads, z.n_chunks), z.n_chunks, decode_chunk, &z);
+        for (size_t c = 0; z.grow && c < z.n_chunks; c++) {
+            decode_chunk(&z, c, 0);
+            if (z.rc[c]) break;
+        }
         for (size_t c = 0; c < z.n_chunks && rc == HD_OK; c++)
             if (z.rc[c]) rc = hd__io_err_at(r, z.rc[c], z.at[c], "chunk %zu of %zu: %s", c + 1, z.n_chunks, z.msg[c]);
         if (rc == HD_OK) r->sink->count = (size_t)h->count;

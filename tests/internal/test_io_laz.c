@@ -261,6 +261,28 @@ TEST(a_huge_point_count_in_a_tiny_chunk_is_refused_before_allocating) {
     tf_free(&b);
 }
 
+TEST(a_chunk_claiming_thousands_of_points_per_byte_fails_as_its_stream_runs_out) {
+    /* a pointwise chunk of 50 real points whose table says 4000 per byte:
+     * the reader takes the sequential path, growing the result as points
+     * are decoded, and stops where the stream runs past the chunk */
+    lazw_point_t *p = points(9, 50, 0);
+    size_t sizes[1] = {50};
+    lazw_opts_t o = plain;
+    o.chunk_size = 0;
+    o.chunks = sizes;
+    o.n_chunks = 1;
+    tf_buf_t b = {0};
+    lazw_encode(&b, &o, p, 50);
+    size_t t = lazw_last.table;
+    uint32_t bytes = (uint32_t)(t - lazw_last.chunk[0]), cnt = bytes * 4000;
+    b.size = t;
+    lazw_table(&b, &cnt, &bytes, 1);
+    put_u32(&b, 107, cnt);
+    refused(&b, HD_EFORMAT, "ran past the chunk's end", (long long)t);
+    tf_free(&b);
+    free(p);
+}
+
 TEST(a_chunk_shortened_in_the_table_makes_its_decoder_run_past_its_end) {
     for (int fmt = 0; fmt <= 6; fmt += 6) {
         CONTEXT("format %d", fmt);
