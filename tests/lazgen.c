@@ -69,6 +69,17 @@ static int seeds(const char *dir) {
     write_case(dir, "fmt1_variable", &o, 5, 30, 0);
     o.format = 3, o.extra = 1, o.v1 = 1;
     write_case(dir, "fmt3_laszip1_extra1", &o, 6, 30, 0);
+    /* one point repeated: over 64 points per byte, the reader's growing path */
+    static lazw_point_t same[40000];
+    for (size_t k = 0; k < 40000; k++) same[k] = (lazw_point_t){1, 2, 3, 1, 1, 0};
+    lazw_opts_t r = {0, 0, 40000, NULL, 0, {0.5, 0.5, 0.5}, {0, 0, 0}, 0};
+    tf_buf_t b = {0};
+    lazw_encode(&b, &r, same, 40000);
+    char path[4096];
+    snprintf(path, sizeof path, "%s/fmt0_repeated_point.laz", dir);
+    FILE *f = fopen(path, "wb");
+    if (!f || fwrite(b.data, 1, b.size, f) != b.size || fclose(f)) return 1;
+    tf_free(&b);
     return 0;
 }
 
