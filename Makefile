@@ -115,9 +115,9 @@ BENCH_ARGS ?= --scale
 bench:
 	@scripts/deps.sh build extras bench plot
 	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release -DHD_BENCH_PEERS=ON $(CMAKE_ARGS)
-	cmake --build $(BUILD) -j$(JOBS) --target hd_bench nanoflann_hd pcl_hd
+	cmake --build $(BUILD) -j$(JOBS) --target hd_bench hausdorff_cli nanoflann_hd pcl_hd
 	$(BUILD)/bench/hd_bench --peers $(BUILD)/bench --scripts bench/peers --data data \
-	  --out $(BUILD)/bench/engine.jsonl $(BENCH_ARGS)
+	  --cli $(BUILD)/hausdorff --out $(BUILD)/bench/engine.jsonl $(BENCH_ARGS)
 	/usr/bin/python3 bench/report.py $(BUILD)/bench/engine.jsonl --doc docs/benchmarks.md \
 	  --plots docs/img --command "make bench$(if $(filter-out --scale,$(BENCH_ARGS)), BENCH_ARGS=\"$(BENCH_ARGS)\")"
 

@@ -350,7 +350,8 @@ int analysis_handle_empty(const analysis_args_t *an, const char *path_a,
         fprintf(out, ", \"directed_ba\": ");
         if (directed) fputs("null", out);
         else json_number(out, v);
-        fprintf(out, ", \"witness_ab\": null, \"witness_ba\": null");
+        fprintf(out, ", \"witness_ab\": null, \"witness_ba\": null, \"witness_ab_files\": null, "
+                     "\"witness_ba_files\": null");
         fprintf(out, ", \"empty\": {\"a\": %s, \"b\": %s, \"policy\": \"%s\"}", n_a ? "false" : "true",
                 n_b ? "false" : "true", policy_name(an->empty));
         fprintf(out, ", \"n_a\": %zu, \"n_b\": %zu, \"file_a\": ", n_a, n_b);
@@ -387,6 +388,17 @@ static size_t count_above(const double *d, size_t n, double hi) {
     size_t c = 0;
     for (size_t k = 0; k < n; k++) c += d[k] > hi;
     return c;
+}
+
+/* The last component of a path, without the '/' that may end a directory's
+ * ("tiles/" -> "tiles"), into buf. */
+static const char *last_name(const char *path, char buf[256]) {
+    size_t n = strlen(path);
+    while (n > 1 && path[n - 1] == '/') n--;
+    size_t k = n;
+    while (k > 0 && path[k - 1] != '/') k--;
+    snprintf(buf, 256, "%.*s", (int)(n - k < 255 ? n - k : 255), path + k);
+    return buf;
 }
 
 int analysis_run(const analysis_args_t *an, const hd_options_t *opt,
@@ -441,10 +453,10 @@ int analysis_run(const analysis_args_t *an, const hd_options_t *opt,
         }
     }
     if (an->render_out) {
-        char title[512];
-        const char *base = strrchr(path_a, '/') ? strrchr(path_a, '/') + 1 : path_a;
-        const char *base_b = strrchr(path_b, '/') ? strrchr(path_b, '/') + 1 : path_b;
-        snprintf(title, sizeof title, "%s (%zu points) coloured by distance to %s", base, A->count, base_b);
+        char title[640];
+        char base[256], base_b[256];
+        snprintf(title, sizeof title, "%s (%zu points) coloured by distance to %s", last_name(path_a, base),
+                 A->count, last_name(path_b, base_b));
         render_notes_t notes = {analysis_units(an), an->percentile_on, r->pct};
         if ((rc = render_distances(an->render_out, A, B, r->d_ab, scale, s, directed, &notes, title, r->markers,
                                    &r->n_markers, &r->render, &r->render_w, &r->render_h, err)))

@@ -66,6 +66,10 @@ void analysis_usage(FILE *out);
 int cli_read_points(const char *path, const hd_read_options_t *ro,
                     analysis_args_t *an, int which, hd_cloud_t **out,
                     hd_error_t *err);
+/* A cloud of `count` points the tool fills itself (uninitialised; 0 points
+ * allowed), freed by hd_cloud_free like the library's; NULL when out of
+ * memory or count * 3 elements overflows. */
+hd_cloud_t *cli_cloud_new(size_t count, hd_dtype_t dtype, const char *format);
 /* 1 when the name ends in .nii or .nii.gz. */
 int nifti_is_mask_path(const char *path);
 /* 1 when the tool was built with the NIfTI library. */

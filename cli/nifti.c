@@ -91,7 +91,7 @@ static int fail(hd_error_t *err, int code, const char *path, const char *what) {
 
 /* A cloud the tool made itself; hd_cloud_free releases it (free() of the
  * data and of the struct, as for the library's own clouds). */
-static hd_cloud_t *new_cloud(size_t count, hd_dtype_t dtype, const char *format) {
+hd_cloud_t *cli_cloud_new(size_t count, hd_dtype_t dtype, const char *format) {
     hd_cloud_t *c = calloc(1, sizeof *c);
     if (!c) return NULL;
     size_t el = dtype == HD_FLOAT32 ? 3 * sizeof(float) : 3 * sizeof(double);
@@ -660,7 +660,7 @@ static int read_mask(const char *path, const hd_read_options_t *ro,
     /* count the points, then fill exactly that many */
     size_t np = 0;
     for (int pass = 0; pass < 2; pass++) {
-        if (pass == 1 && !(*out = new_cloud(np, ro->dtype, which == MASK_ALL ? "nifti:all" : "nifti:surface"))) {
+        if (pass == 1 && !(*out = cli_cloud_new(np, ro->dtype, which == MASK_ALL ? "nifti:all" : "nifti:surface"))) {
             rc = fail(err, HD_ENOMEM, path, "out of memory for the mask's points");
             break;
         }
@@ -732,6 +732,6 @@ int cli_read_points(const char *path, const hd_read_options_t *ro,
                  " (an empty set has no distance; --empty inf|nan|zero|monai reports one)");
         return rc;
     }
-    if (!(*out = new_cloud(0, ro->dtype, "empty"))) return fail(err, HD_ENOMEM, path, "out of memory");
+    if (!(*out = cli_cloud_new(0, ro->dtype, "empty"))) return fail(err, HD_ENOMEM, path, "out of memory");
     return HD_OK;
 }

@@ -4,11 +4,11 @@
  * line on stderr saying what was wrong.
  */
 #include "cli.h"
+#include "tiles.h"
 
 #include <errno.h>
 #include <stdlib.h>
 #include <string.h>
-#include <strings.h>
 
 void cli_usage(FILE *out) {
     fprintf(out,
@@ -36,6 +36,12 @@ void cli_usage(FILE *out) {
 "                     format: FORMAT:PATH, e.g. xyz:- or ply:scan.dat\n"
 "                     (./ply:x for a file whose name holds a colon)\n"
 "  --formats          list the file formats and exit\n"
+"  A or B as tiles:   a directory (its point files by extension, sorted by\n"
+"                     name in byte order, not recursed) or @LIST (a file of\n"
+"                     paths, one a line, relative to the list's folder; '#'\n"
+"                     comments; a line may be FORMAT:PATH): their points in\n"
+"                     that order; the witness is named by file and index\n"
+"                     (./@x for a file whose name starts with @)\n"
 "  --vertices         read a mesh (ply, obj, off, stl) as its vertices (default)\n"
 "  --sample N         read a mesh as N points drawn uniformly by area on its\n"
 "                     faces, reproducibly for a given --seed\n"
@@ -59,6 +65,7 @@ void cli_usage(FILE *out) {
 "  cat cloud.csv | hausdorff xyz:- model.ply\n"
 "  hausdorff --percentile 95 --mean --render dev.png scan.ply model.ply\n"
 "  hausdorff --json --percentile 95 seg.nii.gz truth.nii.gz\n"
+"  hausdorff --json tiles-2019/ @tiles-2024.txt\n"
 "\n"
 "Exit status: 0 success, 1 usage error, 2 bad input, 3 other failure.\n");
 }
@@ -125,28 +132,6 @@ static int parse_double(const char *s, double *out) {
     return 0;
 }
 
-/* The reader named by the n bytes at s, in any case: a reader's name, or
- * one of the text extensions the xyz reader has (csv, txt, pts, asc: a user
- * who names a file .csv types csv:- or --format csv); NULL for neither. */
-static const char *format_named(const char *s, size_t n) {
-    static const char *const text_aliases[] = {"csv", "txt", "pts", "asc", NULL};
-    for (const char *const *f = hd_formats(); *f; f++)
-        if (strlen(*f) == n && strncasecmp(*f, s, n) == 0) return *f;
-    for (const char *const *f = text_aliases; *f; f++)
-        if (strlen(*f) == n && strncasecmp(*f, s, n) == 0) return "xyz";
-    return NULL;
-}
-
-/* A path written FORMAT:PATH, FORMAT a reader's name or alias in any case
- * ("xyz:-", "csv:-", "PLY:scan.dat"): *format is the reader's name and the
- * path follows the colon.  Anything else is a path as it stands, *format
- * NULL ("./ply:x" names a file whose name holds a colon). */
-static const char *split_format(const char *s, const char **format) {
-    const char *colon = strchr(s, ':');
-    *format = colon && colon != s ? format_named(s, (size_t)(colon - s)) : NULL;
-    return *format ? colon + 1 : s;
-}
-
 int cli_parse(int argc, char **argv, cli_args_t *a) {
     memset(a, 0, sizeof *a);
     hd_options_init(&a->opt);
@@ -209,7 +194,7 @@ int cli_parse(int argc, char **argv, cli_args_t *a) {
             if (parse_double(v, &a->opt.theta) || !(a->opt.theta >= 0 && a->opt.theta <= 1))
                 return bad("--theta needs a number in [0, 1], not '%s'", v);
         } else if (strcmp(name, "--format") == 0) {
-            if (!(a->read.format = format_named(v, strlen(v))))
+            if (!(a->read.format = tiles_format_named(v, strlen(v))))
                 return bad("unknown format '%s' (see --formats)", v);
         } else if (strcmp(name, "--sample") == 0) {
             uint64_t n;
@@ -233,7 +218,7 @@ int cli_parse(int argc, char **argv, cli_args_t *a) {
                 nfiles);
         return EXIT_USAGE;
     }
-    a->path_a = split_format(files[0], &a->format_a);
-    a->path_b = split_format(files[1], &a->format_b);
+    a->path_a = tiles_split_format(files[0], &a->format_a);
+    a->path_b = tiles_split_format(files[1], &a->format_b);
     return -1;
 }

@@ -39,10 +39,11 @@
  *    and SIGXFSZ is ignored, so that a file beyond `ulimit -f` is a write
  *    that fails with EFBIG (reported, exit 3) rather than a crash.
  *  - Inputs are never overwritten: out_check_paths compares every output
- *    with A and B, and with the other outputs, by literal path and by
- *    identity (st_dev and st_ino, through links; standard input by fstat
- *    when it is a regular file), before anything is read, and refuses with
- *    the usage exit status 1 and a message naming both.
+ *    with every input (each tile of A and B, and a list of tiles), and
+ *    with the other outputs, by literal path and by identity (st_dev and
+ *    st_ino, through links; standard input by fstat when it is a regular
+ *    file), before anything is read, and refuses with the usage exit
+ *    status 1 and a message naming both.
  * A failure prints "hausdorff: WHAT: strerror" and the run exits with 3.
  * Files are not fsync'ed: a rename makes a complete file appear, but a
  * machine that crashes right after may still lose it.
@@ -139,14 +140,13 @@ static int clash(const char *out, const char *other, int input) {
 }
 
 int out_check_paths(const char *const *outs, const char *const *what, int n,
-                    const char *path_a, const char *path_b) {
+                    const char *const *inputs, const char *side, size_t n_inputs) {
     for (int k = 0; k < n; k++) {
         if (!outs[k]) continue;
-        const char *in[2] = {path_a, path_b};
-        for (int w = 0; w < 2; w++)
-            if (clash(outs[k], in[w], 1)) {
+        for (size_t w = 0; w < n_inputs; w++)
+            if (clash(outs[k], inputs[w], 1)) {
                 fprintf(stderr, "hausdorff: %s %s would overwrite input %c (%s); name another file\n", what[k],
-                        outs[k], "AB"[w], is_stdin(in[w], 1) ? "standard input" : in[w]);
+                        outs[k], side[w], is_stdin(inputs[w], 1) ? "standard input" : inputs[w]);
                 return EXIT_USAGE;
             }
         for (int j = 0; j < k; j++)

@@ -17,12 +17,15 @@
  * and remember that standard output was closed (out_finish reports it). */
 void out_guard_std(void);
 
-/* Refuse an output that names input A or B, or another output: the same
+/* Refuse an output that names an input, or another output: the same
  * literal path, or the same file (st_dev and st_ino).  outs[k] is a path
- * (NULL: that output is not asked for), what[k] the option that named it.
- * Returns 0, or 1 (the usage exit status) after a message naming both. */
+ * (NULL: that output is not asked for), what[k] the option that named it;
+ * inputs[k] is an input file (every tile of a side, and a list of tiles)
+ * and side[k] its side, 'A' or 'B'.  Returns 0, or 1 (the usage exit
+ * status) after a message naming both. */
 int out_check_paths(const char *const *outs, const char *const *what, int n,
-                    const char *path_a, const char *path_b);
+                    const char *const *inputs, const char *side,
+                    size_t n_inputs);
 
 /* Begin writing `path`: a new temporary file beside it (or the file itself
  * when it is a device or a FIFO).  NULL with err filled (OUT_EFAIL). */

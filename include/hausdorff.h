@@ -470,7 +470,10 @@ HD_EXTERN double hd_histogram_edge(double lo, double hi, size_t bins,
  * Reading files.
  * ---------------------------------------------------------------------- */
 
-/* A point cloud read from a file; the library owns it (hd_cloud_free). */
+/* A point cloud read from a file; the library owns it (hd_cloud_free).
+ * Both the struct and `data` come from malloc and hd_cloud_free releases
+ * them with free, so a caller may realloc `data` (to append points, say),
+ * and may build a cloud of its own with malloc for hd_cloud_free to free. */
 typedef struct hd_cloud {
     void *data;        /* count packed xyz triples of dtype */
     size_t count;
@@ -529,6 +532,13 @@ HD_EXTERN hd_points_t hd_cloud_points(const hd_cloud_t *cloud);
  * with a one-line description in hd_format_description(). */
 HD_EXTERN const char *const *hd_formats(void);
 HD_EXTERN const char *hd_format_description(const char *name);
+
+/* The name of the format that `path`'s extension selects, in any case
+ * ("ply" for "scan.PLY", "xyz" for "points.csv"), as hd_read_file chooses
+ * it when no format is given; NULL when the extension names no format the
+ * library reads (no extension, ".laz", ".dat").  The path is not opened, so
+ * hd_read_file may still refuse the content.  Never fails; thread safe. */
+HD_EXTERN const char *hd_format_of_path(const char *path);
 
 #ifdef __cplusplus
 }

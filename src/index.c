@@ -70,7 +70,7 @@ int hd_index_build(const hd_points_t *B, const hd_options_t *opt, hd_index_t **o
     hd__src_t src;
     hd__src_init(&src, &idx->view, NULL);
     int threads = hd__thread_count(opt ? opt->threads : 0, B->count);
-    rc = hd__tree_build(&idx->tree, &src, B->count, NULL, threads, err);
+    rc = hd__tree_build(&idx->tree, &src, B->count, NULL, threads, NULL, err);
     if (rc) {
         free(idx);
         return rc;
@@ -189,7 +189,7 @@ int hd_index_directed(const hd_index_t *idx, const hd_points_t *A, const hd_tran
     if (rc) return rc;
     threads = hd__thread_count(opt ? opt->threads : 0, A->count > idx->tree.n ? A->count : idx->tree.n);
     hd__tree_t ta;
-    rc = hd__tree_build(&ta, &c.src, A->count, &idx->tree.box, threads, err);
+    rc = hd__tree_build(&ta, &c.src, A->count, &idx->tree.box, threads, NULL, err);
     if (rc) return rc;
     rc = hd__engine_trees(&ta, &idx->tree, threads, out, err);
     hd__tree_free(&ta);

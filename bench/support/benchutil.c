@@ -14,6 +14,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <time.h>
 
 static double clock_s(clockid_t id) {
@@ -23,6 +24,12 @@ static double clock_s(clockid_t id) {
 }
 
 double bench_now(void) { return clock_s(CLOCK_MONOTONIC); }
+
+long bench_minor_faults(void) {
+    struct rusage ru;
+    getrusage(RUSAGE_SELF, &ru);
+    return ru.ru_minflt;
+}
 double bench_cpu_now(void) { return clock_s(CLOCK_PROCESS_CPUTIME_ID); }
 
 static int cmp_double(const void *x, const void *y) {

@@ -13,6 +13,9 @@
 
 /* Wall-clock seconds (monotonic) and this process's CPU seconds. */
 double bench_now(void);
+/* Minor page faults of this process so far (getrusage): a first write to a
+ * fresh page of memory takes one. */
+long bench_minor_faults(void);
 double bench_cpu_now(void);
 
 /* Median of n > 0 values (the mean of the middle two when n is even); the

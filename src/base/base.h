@@ -60,6 +60,36 @@ void hd__arena_init(hd__arena_t *a, size_t block_size);
 void *hd__arena_alloc(hd__arena_t *a, size_t size); /* 16-byte aligned */
 void hd__arena_free(hd__arena_t *a);
 
+/* Large blocks kept for reuse within one call.  A block
+ * given back (hd__reuse_put) is kept, and a later request that fits it
+ * (at most three times smaller) gets it again instead of fresh memory:
+ * the first write to a fresh page costs a page fault, far more than the
+ * write itself, and one call of the engine allocates and frees several
+ * arrays of a few bytes per point in turn (docs/engine.md, "Threads and
+ * memory").  Blocks come with a small header, so every block from
+ * hd__reuse_get goes back through hd__reuse_put; with a NULL set they are
+ * plain allocations (hd__reuse_put(NULL, p) frees p).  Not thread safe: one
+ * thread allocates. */
+#define HD__REUSE_KEEP 16
+typedef struct hd__reuse {
+    void *block[HD__REUSE_KEEP];
+    int n;
+} hd__reuse_t;
+void hd__reuse_init(hd__reuse_t *pool);
+/* n * size bytes (checked for overflow), aligned as malloc's; NULL when out of memory. */
+void *hd__reuse_get(hd__reuse_t *pool, size_t n, size_t size);
+void hd__reuse_put(hd__reuse_t *pool, void *p); /* p may be NULL */
+void hd__reuse_free(hd__reuse_t *pool);          /* frees every kept block */
+
+/* Map the pages of the fresh block p[0..bytes) now, in one call, rather
+ * than one page fault per page as it is first written (a fault costs far
+ * more than the write on virtual machines: docs/engine.md, "Threads and
+ * memory").  For arrays about to be written whole; a no-op below
+ * HD__PREFAULT_MIN bytes and where the system has no such call.
+ * hd__reuse_get does it for the fresh blocks it allocates. */
+#define HD__PREFAULT_MIN (1u << 20)
+void hd__prefault(void *p, size_t bytes);
+
 /* ---- randomness (explicit seeds only) ------------------------------------ */
 typedef struct hd__rng {
     uint64_t s[4];

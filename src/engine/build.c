@@ -253,10 +253,10 @@ static void node_boxes(void *vctx, size_t task, int worker) {
 
 void hd__tree_free(hd__tree_t *t) {
     if (!t) return;
-    free(t->perm);
-    free(t->q);
-    free(t->bucket);
-    free(t->nodes);
+    hd__reuse_put(t->pool, t->perm);
+    hd__reuse_put(t->pool, t->q);
+    hd__reuse_put(t->pool, t->bucket);
+    hd__reuse_put(t->pool, t->nodes);
     t->perm = NULL;
     t->q = NULL;
     t->bucket = NULL;
@@ -273,8 +273,9 @@ size_t hd__tree_memory(const hd__tree_t *t) {
 }
 
 int hd__tree_build(hd__tree_t *t, const hd__src_t *src, size_t n, const hd__box_t *grid_box,
-                   int threads, hd_error_t *err) {
+                   int threads, hd__reuse_t *pool, hd_error_t *err) {
     memset(t, 0, sizeof *t);
+    t->pool = pool;
     if (n == 0) return hd__err(err, HD_EEMPTY, "empty point set");
     if (n > UINT32_MAX)
         return hd__err(err, HD_EOVERFLOW,
@@ -296,8 +297,8 @@ int hd__tree_build(hd__tree_t *t, const hd__src_t *src, size_t n, const hd__box_
     kc.src = src;
     kc.n = n;
     size_t slices = (n + SLICE - 1) / SLICE;
-    uint64_t *keys = hd__malloc_array(n, sizeof *keys);
-    uint64_t *tmp = hd__malloc_array(n, sizeof *tmp);
+    uint64_t *keys = hd__reuse_get(pool, n, sizeof *keys);
+    uint64_t *tmp = hd__reuse_get(pool, n, sizeof *tmp);
     kc.part_box = hd__malloc_array(slices, sizeof *kc.part_box);
     int rc = HD_OK;
     if (!keys || !tmp || !kc.part_box) {
@@ -321,9 +322,9 @@ int hd__tree_build(hd__tree_t *t, const hd__src_t *src, size_t n, const hd__box_
         if (e - s > HD__BUCKET && (rc = refine(src, keys + s, tmp + s, e - s, 0))) goto done;
         s = e;
     }
-    free(tmp);
+    hd__reuse_put(pool, tmp);
     tmp = NULL;
-    t->perm = hd__malloc_array(n, sizeof *t->perm);
+    t->perm = hd__reuse_get(pool, n, sizeof *t->perm);
     if (!t->perm) {
         rc = HD_ENOMEM;
         goto done;
@@ -332,11 +333,11 @@ int hd__tree_build(hd__tree_t *t, const hd__src_t *src, size_t n, const hd__box_
         t->perm[k] = (uint32_t)keys[k];
         assert(t->perm[k] < n);
     }
-    free(keys);
+    hd__reuse_put(pool, keys);
     keys = NULL;
-    t->q = hd__malloc_array(t->nb, 3 * HD__BUCKET * sizeof *t->q);
-    t->bucket = hd__malloc_array(t->nb, sizeof *t->bucket);
-    t->nodes = hd__malloc_array(node_count(t), sizeof *t->nodes);
+    t->q = hd__reuse_get(pool, t->nb, 3 * HD__BUCKET * sizeof *t->q);
+    t->bucket = hd__reuse_get(pool, t->nb, sizeof *t->bucket);
+    t->nodes = hd__reuse_get(pool, node_count(t), sizeof *t->nodes);
     if (!t->q || !t->bucket || !t->nodes) {
         rc = HD_ENOMEM;
         goto done;
@@ -350,8 +351,8 @@ int hd__tree_build(hd__tree_t *t, const hd__src_t *src, size_t n, const hd__box_
         hd__parallel_for(threads, (t->count[l] + BOX_TASK - 1) / BOX_TASK, node_boxes, &bc);
     }
 done:
-    free(keys);
-    free(tmp);
+    hd__reuse_put(pool, keys);
+    hd__reuse_put(pool, tmp);
     free(kc.part_box);
     if (rc != HD_OK) {
         hd__tree_free(t);

@@ -65,6 +65,8 @@ typedef struct {
     double bc_err;     /* known within this distance */
     int have_bc;
     size_t hint;       /* bucket of B where the last search ended */
+    ptrdiff_t drift;   /* where the previous bucket of A found most partners,
+                        * relative to the same place along B's curve */
 } walk_t;
 
 static void walk_init(walk_t *s, dir_ctx *c, worker_t *w) {
@@ -73,6 +75,7 @@ static void walk_init(walk_t *s, dir_ctx *c, worker_t *w) {
     hd__max_snapshot(c->m, &s->snap);
     s->have_bc = 0;
     s->hint = HD__NONE;
+    s->drift = 0;
 }
 
 static size_t node_points(const hd__tree_t *t, int level, size_t i) {
@@ -121,8 +124,11 @@ static void resolve_point(walk_t *s, const double a[3], size_t ia) {
     hd__max_offer(s->c->m, hit.d2, ia, hit.j, &s->snap);
 }
 
-/* Buckets of B tried on each side of the last useful one, along B's curve. */
-#define NEIGHBOURS 2
+/* Buckets of B tried on each side of the guess along B's curve, while
+ * points are left: a point still alive after them gets a search of its
+ * own, which on nearly identical sets costs as much as a dozen more tries
+ * (docs/engine.md). */
+#define NEIGHBOURS 8
 
 /* The shared walk of a bucket of A visits at most BLOCK_LEAVES buckets of
  * B, within the subtree of 2^BLOCK_LEVEL buckets around the last useful one,
@@ -157,9 +163,10 @@ static const double *group_exact(const hd__tree_t *ta, group_t *g, int k) {
 /* Try bucket i of B on the live points of g; a point is discarded when the
  * approximations prove some point of the bucket strictly within cmax, or
  * when the pair is too close to call and its exact distance does.
- * Returns 1 when the bucket was read. */
+ * Returns how many points it discarded. */
 HD__HOT static int try_bucket(walk_t *s, group_t *g, size_t i, double cmax2) {
     const hd__tree_t *tb = s->c->tb;
+    const uint32_t alive0 = g->alive;
     const hd__bucket_t *bb = &tb->bucket[i];
     double lim = hd__kill_below(cmax2, g->err + bb->err);
     double reach = hd__may_reach(cmax2, g->err + bb->err);
@@ -205,7 +212,7 @@ HD__HOT static int try_bucket(walk_t *s, group_t *g, size_t i, double cmax2) {
         close_k[n_close] = k;
         close_b[n_close++] = arg;
     }
-    if (!n_close) return 1;
+    if (!n_close) return __builtin_popcount(alive0 & ~g->alive);
     /* Pairs too close to call from the approximations (ties, or nearly) are
      * decided exactly; their scattered loads are started together. */
     const hd__tree_t *ta = s->c->ta;
@@ -231,7 +238,7 @@ HD__HOT static int try_bucket(walk_t *s, group_t *g, size_t i, double cmax2) {
             s->hint = i;
         }
     }
-    return 1;
+    return __builtin_popcount(alive0 & ~g->alive);
 }
 
 /* Resolve the points of A's bucket bk together, from their quantised copy:
@@ -265,18 +272,27 @@ static void walk_bucket(walk_t *s, size_t bk) {
     }
     if (g.alive) {
         /* Two guesses: the bucket at the same relative position along B's
-         * curve, and the bucket where the last search ended. */
-        size_t guess[2] = {(size_t)((double)bk * (double)tb->nb / (double)ta->nb), s->hint};
+         * curve moved by the drift that served the previous bucket (two
+         * curves over nearly the same points drift apart slowly, by the
+         * points that crossed a cell face), and the bucket where the last
+         * search ended. */
+        size_t same = (size_t)((double)bk * (double)tb->nb / (double)ta->nb);
+        ptrdiff_t at = (ptrdiff_t)same + s->drift;
+        size_t guess[2] = {at < 0 ? 0 : (size_t)at, s->hint};
+        size_t most = HD__NONE;
+        int most_k = 0;
         for (int q = 0; q < 2 && g.alive; q++) {
             size_t h = guess[q];
             if (h == HD__NONE || (q == 1 && h + NEIGHBOURS >= guess[0] && h <= guess[0] + NEIGHBOURS)) continue;
             if (h >= tb->nb) h = tb->nb - 1;
-            try_bucket(s, &g, h, cmax2);
+            int k = try_bucket(s, &g, h, cmax2);
+            if (k > most_k) most_k = k, most = h;
             for (size_t r = 1; r <= NEIGHBOURS && g.alive; r++) {
-                if (h + r < tb->nb) try_bucket(s, &g, h + r, cmax2);
-                if (g.alive && h >= r) try_bucket(s, &g, h - r, cmax2);
+                if (h + r < tb->nb && (k = try_bucket(s, &g, h + r, cmax2)) > most_k) most_k = k, most = h + r;
+                if (g.alive && h >= r && (k = try_bucket(s, &g, h - r, cmax2)) > most_k) most_k = k, most = h - r;
             }
         }
+        if (most != HD__NONE) s->drift = (ptrdiff_t)most - (ptrdiff_t)same;
     }
     const hd__box_t *ba = hd__tree_box(ta, 0, bk);
     struct {
@@ -471,6 +487,7 @@ typedef struct {
     hd__counts_t counts[2];
     uint64_t culled[2];
     double cost[2];
+    hd__reuse_t pool;      /* the grids' and trees' arrays, reused as they are freed */
 } engine_t;
 
 static void engine_free(engine_t *e) {
@@ -480,6 +497,7 @@ static void engine_free(engine_t *e) {
         for (int k = 0; k < 2; k++) hd__tree_free(&e->tree[k]);
     for (int d = 0; d < e->max_ready; d++) hd__max_destroy(&e->max[d]);
     hd__pairs_free(&e->pairs);
+    hd__reuse_free(&e->pool);
     e->have_grid = e->have_tree = e->max_ready = 0;
 }
 
@@ -487,6 +505,7 @@ static int engine_init(engine_t *e, const hd_points_t *A, const hd_points_t *B,
                        const hd__box_t *box_a, const hd__box_t *box_b, const hd_options_t *opt,
                        int directions, hd_error_t *err) {
     memset(e, 0, sizeof *e);
+    hd__reuse_init(&e->pool);
     hd__src_init(&e->src[0], A, NULL);
     hd__src_init(&e->src[1], B, NULL);
     e->n[0] = A->count;
@@ -526,7 +545,8 @@ static int engine_plan(engine_t *e, hd__engine_force_t force, hd_error_t *err) {
                                                       e->n[1 - d], &e->max[d], &e->counts[d]);
     if (e->pairs.resolved[0] && (e->directions == 1 || e->pairs.resolved[1])) return HD_OK;
     for (int k = 0; k < 2; k++) {
-        int rc = hd__grid_build(&e->grid[k], &e->src[k], e->n[k], &e->box[k], e->threads, err);
+        int rc = hd__grid_build(&e->grid[k], &e->src[k], e->n[k], &e->box[k], e->threads, &e->pool,
+                                 err);
         if (rc) {
             if (k) hd__grid_free(&e->grid[0]);
             return rc;
@@ -605,9 +625,9 @@ static int engine_run(engine_t *e, hd__engine_force_t force, hd_result_t out[2],
         }
         for (int k = 0; k < 2; k++) hd__grid_free(&e->grid[k]);
         e->have_grid = 0;
-        rc = hd__tree_build(&e->tree[0], &e->src[0], e->n[0], &g[0], e->threads, err);
+        rc = hd__tree_build(&e->tree[0], &e->src[0], e->n[0], &g[0], e->threads, &e->pool, err);
         if (rc) return rc;
-        rc = hd__tree_build(&e->tree[1], &e->src[1], e->n[1], &g[1], e->threads, err);
+        rc = hd__tree_build(&e->tree[1], &e->src[1], e->n[1], &g[1], e->threads, &e->pool, err);
         if (rc) {
             hd__tree_free(&e->tree[0]);
             return rc;

@@ -59,6 +59,7 @@ typedef struct hd__tree {
     size_t off[HD__MAX_LEVELS];     /* first box of level l >= 1 in nodes[] */
     hd__box_t *nodes;               /* exact boxes of the nodes of levels >= 1 */
     hd__box_t box;                  /* the box the Morton grid covers */
+    hd__reuse_t *pool;              /* where the arrays come from and go back to (or NULL) */
 } hd__tree_t;
 
 /* Build the index of n points read from `src` using `threads` threads.
@@ -66,9 +67,10 @@ typedef struct hd__tree {
  * (two sets sorted on the same grid line up along the curve, which is what
  * the walk over nearly identical sets relies on).  The points must be
  * valid (finite, within HD_MAX_COORD, also after the transform).  n must be
- * at most UINT32_MAX (HD_EOVERFLOW otherwise). */
+ * at most UINT32_MAX (HD_EOVERFLOW otherwise).  Its arrays, and the sort's,
+ * come from `pool` (NULL: plain allocations), which must outlive the tree. */
 int hd__tree_build(hd__tree_t *t, const hd__src_t *src, size_t n, const hd__box_t *grid_box,
-                   int threads, hd_error_t *err);
+                   int threads, hd__reuse_t *pool, hd_error_t *err);
 void hd__tree_free(hd__tree_t *t);
 size_t hd__tree_memory(const hd__tree_t *t);
 
@@ -128,10 +130,12 @@ HD__INLINE double hd__min32(const double *c) {
  * the search in bounds.  The answer is then meaningless, but nothing is
  * read out of bounds. */
 HD__INLINE int hd__find(const double *c, double v) {
-    int k = 0;
-    while (k < HD__BUCKET && c[k] != v) k++;
-    assert(k < HD__BUCKET || __builtin_isnan(v)); /* c[k] == v unless v is NaN */
-    return k < HD__BUCKET ? k : 0;
+    /* A mask of the equal values, without an early exit: the loop
+     * vectorises (compare, move mask), where a search loop does not. */
+    uint32_t m = 0;
+    for (int k = 0; k < HD__BUCKET; k++) m |= (uint32_t)(c[k] == v) << k;
+    assert(m != 0 || __builtin_isnan(v)); /* some c[k] == v unless v is NaN */
+    return m ? __builtin_ctz(m) : 0;
 }
 
 /* Keep the k items with the largest scores, in decreasing order of score,
@@ -235,10 +239,12 @@ typedef struct hd__grid {
     uint32_t *start;      /* 8^bits + 1 offsets into perm */
     double *rep;          /* per cell x, y, z of its representative; NaN if empty */
     double centroid[3];   /* mean of the points (approximate; for alignment) */
+    hd__reuse_t *pool;     /* where the arrays come from and go back to (or NULL) */
 } hd__grid_t;
 
+/* The grid's arrays come from `pool` (NULL: plain allocations). */
 int hd__grid_build(hd__grid_t *g, const hd__src_t *src, size_t n, const hd__box_t *box,
-                   int threads, hd_error_t *err);
+                   int threads, hd__reuse_t *pool, hd_error_t *err);
 void hd__grid_free(hd__grid_t *g);
 
 /* Exact nearest neighbour of q in g, with the early stop of hd__tree_nearest

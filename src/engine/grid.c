@@ -291,17 +291,18 @@ static void rep_task(void *vctx, size_t part, int worker) {
 
 void hd__grid_free(hd__grid_t *g) {
     if (!g) return;
-    free(g->perm);
-    free(g->start);
-    free(g->rep);
+    hd__reuse_put(g->pool, g->perm);
+    hd__reuse_put(g->pool, g->start);
+    hd__reuse_put(g->pool, g->rep);
     g->perm = NULL;
     g->start = NULL;
     g->rep = NULL;
 }
 
 int hd__grid_build(hd__grid_t *g, const hd__src_t *src, size_t n, const hd__box_t *box,
-                   int threads, hd_error_t *err) {
+                   int threads, hd__reuse_t *pool, hd_error_t *err) {
     memset(g, 0, sizeof *g);
+    g->pool = pool;
     if (n > UINT32_MAX)
         return hd__err(err, HD_EOVERFLOW,
                        "the auto engine indexes at most 4294967295 points per set, not %zu", n);
@@ -315,14 +316,14 @@ int hd__grid_build(hd__grid_t *g, const hd__src_t *src, size_t n, const hd__box_
     c.n = n;
     c.parts = threads < 1 ? 1 : threads > MAX_PARTS ? MAX_PARTS : threads;
     if ((size_t)c.parts > n / 4096 + 1) c.parts = (int)(n / 4096 + 1);
-    g->perm = hd__malloc_array(n, sizeof *g->perm);
-    g->start = hd__malloc_array(cells + 1, sizeof *g->start);
-    g->rep = hd__malloc_array(cells, 3 * sizeof *g->rep);
+    g->perm = hd__reuse_get(pool, n, sizeof *g->perm);
+    g->start = hd__reuse_get(pool, cells + 1, sizeof *g->start);
+    g->rep = hd__reuse_get(pool, cells, 3 * sizeof *g->rep);
     /* Cell numbers are kept between the passes when they fit in 16 bits;
      * otherwise (more than 4 million points) the second pass computes them
      * again, which costs less than first touching 4 more bytes per point. */
     int keep = cells <= 65536;
-    c.cell = keep ? hd__malloc_array(n, sizeof *c.cell) : NULL;
+    c.cell = keep ? hd__reuse_get(pool, n, sizeof *c.cell) : NULL;
     int ok = g->perm && g->start && g->rep && (c.cell || !keep);
     for (int p = 0; p < c.parts && ok; p++) ok = (c.count[p] = hd__calloc_array(cells, sizeof(uint32_t))) != NULL;
     if (ok) {
@@ -349,7 +350,7 @@ int hd__grid_build(hd__grid_t *g, const hd__src_t *src, size_t n, const hd__box_
         hd__parallel_for(c.parts, (size_t)c.parts, rep_task, &c);
     }
     for (int p = 0; p < c.parts; p++) free(c.count[p]);
-    free(c.cell);
+    hd__reuse_put(pool, c.cell);
     if (!ok) {
         hd__grid_free(g);
         return hd__err(err, HD_ENOMEM, "cannot allocate the grid of %zu points", n);

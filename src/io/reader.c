@@ -176,6 +176,11 @@ static const format_t *by_extension(const char *path) {
     return NULL;
 }
 
+const char *hd_format_of_path(const char *path) {
+    const format_t *f = path ? by_extension(path) : NULL;
+    return f ? f->name : NULL;
+}
+
 /* The format the content looks like: signatures first, then OBJ keywords,
  * then text that starts with a number (xyz). */
 static const format_t *by_content(const hd__file_t *f) {

@@ -419,6 +419,13 @@ int hd__an_build(hd__an_t *s, const hd_points_t *p, const hd_transform_t *T, con
     uint64_t *first_buffer = s->x ? (uint64_t *)(void *)s->x : NULL;
     c.a = first_buffer;
     c.b = hd__malloc_array(n, sizeof *c.b);
+    /* These are written whole (keys, then the gathered coordinates): map
+     * their pages at once rather than a fault per page. */
+    hd__prefault(s->x, (n + 4) * sizeof *s->x);
+    hd__prefault(s->y, (n + 4) * sizeof *s->y);
+    hd__prefault(s->z, (n + 4) * sizeof *s->z);
+    hd__prefault(s->idx, (n + 4) * sizeof *s->idx);
+    hd__prefault(c.b, n * sizeof *c.b);
     int ok = s->x && s->y && s->z && s->idx && s->start && s->key && s->stop && s->leaf && s->gstart &&
              s->glead && s->first && s->count && c.a && c.b;
     int rc = HD_OK;
@@ -810,6 +817,9 @@ int hd__an_nearest(const hd__an_t *asking, const hd__an_t *searched, const hd_po
     c.sd = hd__malloc_array(asking->n, sizeof *c.sd);
     c.sj = hd__malloc_array(asking->n, sizeof *c.sj);
     int rc = c.cand && c.sd && c.sj ? HD_OK : HD_ENOMEM;
+    /* Every answer is written: their pages mapped at once. */
+    hd__prefault(c.sd, asking->n * sizeof *c.sd);
+    hd__prefault(c.sj, asking->n * sizeof *c.sj);
     size_t nb = searched->nb;
     for (int w = 0; w < threads && rc == HD_OK; w++) {
         cands_t *cd = &c.cand[w];

@@ -692,3 +692,21 @@ TEST(every_format_is_listed_with_a_description) {
     CHECK(hd_format_description("laz") != NULL);
     CHECK(hd_format_description("zip") == NULL);
 }
+
+TEST(format_of_path_is_the_format_the_extension_selects) {
+    CHECK(strcmp(hd_format_of_path("scan.PLY"), "ply") == 0);
+    CHECK(strcmp(hd_format_of_path("dir.v2/points.csv"), "xyz") == 0);
+    CHECK(strcmp(hd_format_of_path("m.coff"), "off") == 0);
+    CHECK(strcmp(hd_format_of_path("cloud.npy"), "npy") == 0);
+    CHECK(hd_format_of_path("scan.laz") == NULL);
+    CHECK(hd_format_of_path("dir.ply/README") == NULL);
+    CHECK(hd_format_of_path("mask.nii.gz") == NULL);
+    CHECK(hd_format_of_path("noext") == NULL);
+    CHECK(hd_format_of_path(NULL) == NULL);
+    /* every name it gives is one hd_read_file takes as a format */
+    for (const char *const *f = hd_formats(); *f; f++) {
+        char path[32];
+        snprintf(path, sizeof path, "x.%s", *f);
+        CHECK(strcmp(hd_format_of_path(path), *f) == 0);
+    }
+}

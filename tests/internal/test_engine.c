@@ -508,7 +508,7 @@ static int grid_discards_whole_cells(const hd_points_t *A, const hd_points_t *B,
     for (int k = 0; k < 2; k++) {
         hd__src_init(&src[k], P[k], NULL);
         CHECK_RC(hd__points_scan(P[k], "set", threads, &box[k], NULL), HD_OK);
-        CHECK_RC(hd__grid_build(&grid[k], &src[k], P[k]->count, &box[k], threads, NULL), HD_OK);
+        CHECK_RC(hd__grid_build(&grid[k], &src[k], P[k]->count, &box[k], threads, NULL, NULL), HD_OK);
     }
     hd__counts_t n = {0, 0, 0};
     for (int primed = 0; primed <= 1; primed++) {

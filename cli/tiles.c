@@ -1,0 +1,426 @@
+/*
+ * tiles.c -- one side of the comparison as many files: a directory or a
+ * list (@LIST) of tiles, read as one point set.
+ *
+ * Invariants:
+ *  - Order.  A side's points are its tiles' points concatenated in tile
+ *    order: list order, or the directory's names sorted by strcmp (bytes,
+ *    not the locale, so every machine and every rank of hausdorff-mpi sees
+ *    the same order).  Tile k's points are global indices [first, first +
+ *    count), firsts non-decreasing, so tiles_locate is a binary search and
+ *    the witness, the --distances rows and their nearest indices all name
+ *    the same points whether a side is one file or its tiles.
+ *  - Nothing is guessed.  A directory is not recursed; its entries that are
+ *    not tiles (hidden, directories, other extensions, NIfTI masks, FIFOs
+ *    and devices) are kept in `skipped` with the reason, for the report.
+ *    An entry named like a point file that cannot be stat'ed (a dangling
+ *    link) stays a tile, so reading it fails with its name instead of the
+ *    side silently losing points.  A list's missing or unsuitable file is
+ *    an error naming LIST:LINE before any point is read.
+ *  - One side is one file when it is neither a directory nor @LIST; then
+ *    tiles_read is exactly cli_read_points on it (masks, standard input,
+ *    the --empty policy; seed + 0), and the cloud it returns is the
+ *    reader's own: the first tile's cloud is never copied.
+ *  - Memory.  Tiles are read one at a time and appended to one buffer that
+ *    grows by half again when full (realloc: glibc moves large blocks with
+ *    mremap, without copying) and is trimmed to the count at the end.  The
+ *    first tile's own buffer becomes that buffer.  At the peak the process
+ *    holds the points read so far, the unused growth (at most a third of
+ *    the buffer, untouched pages) and one tile's cloud: never two copies of
+ *    the side.  Counts and byte sizes are checked for overflow before each
+ *    allocation.
+ *  - Seeds.  With --sample, tile k of the side is drawn with seed + k: a
+ *    side of one mesh is drawn exactly as that mesh alone, and tiles do
+ *    not repeat each other's pattern.  k is the tile's place in the whole
+ *    side, so reading a sub-range (another process) draws the same points.
+ */
+#include "tiles.h"
+#include "cli.h"
+
+#include <assert.h>
+#include <dirent.h>
+#include <errno.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <sys/stat.h>
+
+static int fail(hd_error_t *err, int code, long line, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
+static int fail(hd_error_t *err, int code, long line, const char *fmt, ...) {
+    err->code = code;
+    err->line = line > 0 ? line : -1;
+    err->offset = -1;
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(err->message, sizeof err->message, fmt, ap);
+    va_end(ap);
+    return code;
+}
+
+const char *tiles_format_named(const char *s, size_t n) {
+    static const char *const text_aliases[] = {"csv", "txt", "pts", "asc", NULL};
+    for (const char *const *f = hd_formats(); *f; f++)
+        if (strlen(*f) == n && strncasecmp(*f, s, n) == 0) return *f;
+    for (const char *const *f = text_aliases; *f; f++)
+        if (strlen(*f) == n && strncasecmp(*f, s, n) == 0) return "xyz";
+    return NULL;
+}
+
+const char *tiles_split_format(const char *s, const char **format) {
+    const char *colon = strchr(s, ':');
+    *format = colon && colon != s ? tiles_format_named(s, (size_t)(colon - s)) : NULL;
+    return *format ? colon + 1 : s;
+}
+
+/* dir/name, without doubling a '/' that ends dir; NULL when out of memory */
+static char *join(const char *dir, size_t dirlen, const char *name) {
+    size_t nl = strlen(name);
+    int slash = dirlen > 0 && dir[dirlen - 1] != '/';
+    char *p = malloc(dirlen + (size_t)slash + nl + 1);
+    if (!p) return NULL;
+    memcpy(p, dir, dirlen);
+    if (slash) p[dirlen] = '/';
+    memcpy(p + dirlen + (size_t)slash, name, nl + 1);
+    return p;
+}
+
+/* Append a tile (taking `path`); HD_ENOMEM frees it. */
+static int add_tile(tiles_t *s, size_t *cap, char *path, const char *format, long line, uint64_t bytes,
+                    hd_error_t *err) {
+    if (s->n == *cap) {
+        size_t nc = *cap ? *cap * 2 : 16;
+        tile_t *t = nc <= SIZE_MAX / sizeof *t ? realloc(s->t, nc * sizeof *t) : NULL;
+        if (!t) {
+            free(path);
+            return fail(err, HD_ENOMEM, line, "%s: out of memory for the list of tiles", s->arg);
+        }
+        s->t = t;
+        *cap = nc;
+    }
+    s->t[s->n++] = (tile_t){path, format, line, bytes, 0, 0};
+    return HD_OK;
+}
+
+static int by_name(const void *x, const void *y) { return strcmp(*(char *const *)x, *(char *const *)y); }
+
+/* Why a directory entry is not a tile, or NULL when it is one. */
+static const char *not_a_tile(const char *name, const char *path, uint64_t *bytes) {
+    struct stat st;
+    *bytes = 0;
+    if (name[0] == '.') return "hidden";
+    int known = stat(path, &st) == 0;
+    if (known && S_ISDIR(st.st_mode)) return "a directory, not recursed";
+    if (nifti_is_mask_path(name)) return "a NIfTI mask, read alone and not as a tile";
+    if (!hd_format_of_path(name)) return "no point format has this extension";
+    if (known && !S_ISREG(st.st_mode)) return "not a regular file";
+    if (known) *bytes = (uint64_t)st.st_size;
+    return NULL;
+}
+
+static int expand_dir(tiles_t *s, const char *format, hd_error_t *err) {
+    DIR *d = opendir(s->arg);
+    if (!d) return fail(err, HD_EIO, 0, "%s: cannot read the directory: %s", s->arg, strerror(errno));
+    char **names = NULL;
+    size_t n = 0, cap = 0;
+    int rc = HD_OK;
+    struct dirent *e;
+    errno = 0;
+    while ((e = readdir(d)) != NULL) {
+        if (strcmp(e->d_name, ".") == 0 || strcmp(e->d_name, "..") == 0) continue;
+        if (n == cap) {
+            size_t nc = cap ? cap * 2 : 64;
+            char **p = nc <= SIZE_MAX / sizeof *p ? realloc(names, nc * sizeof *p) : NULL;
+            if (!p) break;
+            names = p;
+            cap = nc;
+        }
+        if (!(names[n] = strdup(e->d_name))) break;
+        n++;
+        errno = 0;
+    }
+    if (e) rc = fail(err, HD_ENOMEM, 0, "%s: out of memory for the directory's names", s->arg);
+    else if (errno) rc = fail(err, HD_EIO, 0, "%s: cannot read the directory: %s", s->arg, strerror(errno));
+    closedir(d);
+    if (rc == HD_OK && n) qsort(names, n, sizeof *names, by_name);
+    size_t tcap = 0, scap = 0, dirlen = strlen(s->arg);
+    for (size_t k = 0; k < n && rc == HD_OK; k++) {
+        char *path = join(s->arg, dirlen, names[k]);
+        if (!path) {
+            rc = fail(err, HD_ENOMEM, 0, "%s: out of memory", s->arg);
+            break;
+        }
+        uint64_t bytes;
+        const char *why = not_a_tile(names[k], path, &bytes);
+        if (!why) {
+            rc = add_tile(s, &tcap, path, format, 0, bytes, err);
+            continue;
+        }
+        free(path);
+        if (s->n_skipped == scap) {
+            size_t nc = scap ? scap * 2 : 8;
+            tile_skip_t *p = nc <= SIZE_MAX / sizeof *p ? realloc(s->skipped, nc * sizeof *p) : NULL;
+            if (!p) {
+                rc = fail(err, HD_ENOMEM, 0, "%s: out of memory", s->arg);
+                break;
+            }
+            s->skipped = p;
+            scap = nc;
+        }
+        s->skipped[s->n_skipped++] = (tile_skip_t){names[k], why};
+        names[k] = NULL; /* now the skip's */
+    }
+    for (size_t k = 0; k < n; k++) free(names[k]);
+    free(names);
+    return rc;
+}
+
+/* One line of a list: blanks around it dropped; NULL for a blank or '#' line. */
+static char *trim(char *line, size_t len) {
+    while (len && (line[len - 1] == '\n' || line[len - 1] == '\r' || line[len - 1] == ' ' || line[len - 1] == '\t'))
+        line[--len] = '\0';
+    while (*line == ' ' || *line == '\t') line++;
+    return *line && *line != '#' ? line : NULL;
+}
+
+/* The longest line of a list: a path (PATH_MAX) and some blanks.  Longer
+ * is not a list (a binary file given by mistake), and is refused before
+ * getline grows its buffer to the size of the file. */
+enum { LINE_MAX_ = 4096 + 64 };
+
+static int expand_list(tiles_t *s, const char *list, const char *format, hd_error_t *err) {
+    struct stat st;
+    if (!list[0]) return fail(err, HD_EIO, 0, "'@' names no list (write @FILE; ./@x for a file named @x)");
+    if (stat(list, &st) == 0 && S_ISDIR(st.st_mode))
+        return fail(err, HD_EFORMAT, 0, "%s: is a directory, not a list of files (name a directory without '@')",
+                    list);
+    FILE *f = fopen(list, "r");
+    if (!f) return fail(err, HD_EIO, 0, "%s: cannot open the list: %s", list, strerror(errno));
+    const char *slash = strrchr(list, '/');
+    size_t dirlen = slash ? (size_t)(slash - list) + 1 : 0; /* relative paths: from the list's folder */
+    char *buf = NULL;
+    size_t bufcap = 0, tcap = 0;
+    long line = 0;
+    ssize_t len;
+    int rc = HD_OK;
+    while (rc == HD_OK && (len = getline(&buf, &bufcap, f)) >= 0) {
+        line++;
+        if (memchr(buf, '\0', (size_t)len) || len > LINE_MAX_) {
+            rc = fail(err, HD_EFORMAT, line, "%s:%ld: %s (a list is text, one path per line)", list, line,
+                      len > LINE_MAX_ ? "a line longer than 4096 bytes" : "a NUL byte");
+            break;
+        }
+        char *p = trim(buf, (size_t)len);
+        if (!p) continue;
+        const char *fmt;
+        const char *name = tiles_split_format(p, &fmt);
+        if (!fmt) fmt = format;
+        if (strcmp(name, "-") == 0) {
+            rc = fail(err, HD_EFORMAT, line, "%s:%ld: standard input ('-') cannot be a tile", list, line);
+            break;
+        }
+        char *path = name[0] == '/' ? strdup(name) : join(list, dirlen, name);
+        if (!path) {
+            rc = fail(err, HD_ENOMEM, line, "%s:%ld: out of memory", list, line);
+            break;
+        }
+        if (stat(path, &st) != 0)
+            rc = fail(err, HD_EIO, line, "%s:%ld: %s: cannot open: %s", list, line, path, strerror(errno));
+        else if (S_ISDIR(st.st_mode))
+            rc = fail(err, HD_EFORMAT, line, "%s:%ld: %s is a directory (a list names files, one per line)", list,
+                      line, path);
+        else if (!fmt && nifti_is_mask_path(path))
+            rc = fail(err, HD_EFORMAT, line, "%s:%ld: %s: a NIfTI mask is read alone, not as a tile", list, line,
+                      path);
+        if (rc != HD_OK) {
+            free(path);
+            break;
+        }
+        rc = add_tile(s, &tcap, path, fmt, line, S_ISREG(st.st_mode) ? (uint64_t)st.st_size : 0, err);
+    }
+    if (rc == HD_OK && ferror(f)) rc = fail(err, HD_EIO, 0, "%s: cannot read the list: %s", list, strerror(errno));
+    free(buf);
+    fclose(f);
+    return rc;
+}
+
+int tiles_expand(const char *arg, const char *format, tiles_t *out, hd_error_t *err) {
+    memset(out, 0, sizeof *out);
+    out->arg = arg;
+    struct stat st;
+    int rc;
+    if (arg[0] == '@') {
+        out->kind = TILES_LIST;
+        rc = expand_list(out, arg + 1, format, err);
+    } else if (strcmp(arg, "-") != 0 && stat(arg, &st) == 0 && S_ISDIR(st.st_mode)) {
+        out->kind = TILES_DIR;
+        rc = expand_dir(out, format, err);
+    } else {
+        out->kind = TILES_FILE;
+        size_t cap = 0;
+        char *p = strdup(arg);
+        rc = p ? add_tile(out, &cap, p, format, 0, 0, err) : fail(err, HD_ENOMEM, 0, "%s: out of memory", arg);
+    }
+    if (rc != HD_OK) {
+        tiles_free(out);
+        out->arg = arg;
+    }
+    return rc;
+}
+
+void tiles_free(tiles_t *s) {
+    for (size_t k = 0; k < s->n; k++) free(s->t[k].path);
+    for (size_t k = 0; k < s->n_skipped; k++) free(s->skipped[k].name);
+    free(s->t);
+    free(s->skipped);
+    memset(s, 0, sizeof *s);
+}
+
+/* ---- reading ------------------------------------------------------------------ */
+
+/* Append c's points to *all (c freed either way). */
+static int append(hd_cloud_t *all, size_t *cap, hd_cloud_t *c, const char *path, hd_error_t *err) {
+    size_t el = all->dtype == HD_FLOAT32 ? 3 * sizeof(float) : 3 * sizeof(double);
+    if (c->count > SIZE_MAX / el - all->count) {
+        hd_cloud_free(c);
+        return fail(err, HD_EOVERFLOW, 0, "%s: the side's points would number more than memory can index", path);
+    }
+    size_t need = all->count + c->count;
+    if (need > *cap) {
+        size_t grow = *cap + *cap / 2;
+        size_t nc = grow > need && grow <= SIZE_MAX / el ? grow : need;
+        void *p = realloc(all->data, nc * el);
+        if (!p) {
+            hd_cloud_free(c);
+            return fail(err, HD_ENOMEM, 0, "%s: out of memory for the side's %zu points", path, need);
+        }
+        all->data = p;
+        *cap = nc;
+    }
+    if (c->count) memcpy((char *)all->data + all->count * el, c->data, c->count * el);
+    all->count = need;
+    all->n_faces += c->n_faces;
+    if (strcmp(all->format, c->format) != 0 && strcmp(c->format, "empty") != 0) {
+        if (strcmp(all->format, "empty") == 0) snprintf(all->format, sizeof all->format, "%s", c->format);
+        else snprintf(all->format, sizeof all->format, "mixed");
+    }
+    hd_cloud_free(c);
+    return HD_OK;
+}
+
+/* The error of tile t, with the list line it came from. */
+static int from_list(const tiles_t *s, const tile_t *t, int rc, hd_error_t *err) {
+    if (s->kind == TILES_LIST) {
+        size_t len = strlen(err->message);
+        snprintf(err->message + len, sizeof err->message - len, " (listed at %s:%ld)", s->arg + 1, t->line);
+    }
+    return rc;
+}
+
+int tiles_read(tiles_t *s, size_t first, size_t n, const hd_read_options_t *ro, analysis_args_t *an, int which,
+               hd_cloud_t **out, hd_error_t *err) {
+    *out = NULL;
+    if (first > s->n || n > s->n - first) return fail(err, HD_EINVAL, 0, "%s: tiles out of range", s->arg);
+    if (n == 0) { /* no tiles: a share of none, or an empty side */
+        if (s->n == 0 && an->empty == EMPTY_ERROR) {
+            char skipped[512];
+            tiles_skipped_text(s, skipped, sizeof skipped);
+            return fail(err, HD_EEMPTY, 0,
+                        "%s: %s%s%s (an empty set has no distance; --empty inf|nan|zero|monai reports one)", s->arg,
+                        s->kind == TILES_DIR ? "no point files in the directory" : "the list names no files",
+                        skipped[0] ? "; " : "", skipped);
+        }
+        if (!(*out = cli_cloud_new(0, ro->dtype, "empty"))) return fail(err, HD_ENOMEM, 0, "out of memory");
+        return HD_OK;
+    }
+    hd_cloud_t *all = NULL;
+    size_t cap = 0;
+    for (size_t k = first; k < first + n; k++) {
+        tile_t *t = &s->t[k];
+        hd_read_options_t r = *ro;
+        if (t->format) r.format = t->format;
+        r.seed = ro->seed + (uint64_t)k;
+        hd_cloud_t *c;
+        int rc = cli_read_points(t->path, &r, an, which, &c, err);
+        if (rc != HD_OK) {
+            hd_cloud_free(all);
+            return from_list(s, t, rc, err);
+        }
+        t->first = all ? all->count : 0;
+        t->count = c->count;
+        if (!all) {
+            all = c; /* its buffer becomes the side's */
+            cap = c->count;
+        } else if ((rc = append(all, &cap, c, t->path, err)) != HD_OK) {
+            hd_cloud_free(all);
+            return rc;
+        }
+    }
+    if (cap > all->count && all->count) { /* trim the growth's slack */
+        size_t el = all->dtype == HD_FLOAT32 ? 3 * sizeof(float) : 3 * sizeof(double);
+        void *p = realloc(all->data, all->count * el);
+        if (p) all->data = p;
+    }
+    *out = all;
+    return HD_OK;
+}
+
+int tiles_number(tiles_t *s, hd_error_t *err) {
+    size_t at = 0;
+    for (size_t k = 0; k < s->n; k++) {
+        if (s->t[k].count > SIZE_MAX - at)
+            return fail(err, HD_EOVERFLOW, 0, "%s: the side's points would number more than a size_t holds", s->arg);
+        s->t[k].first = at;
+        at += s->t[k].count;
+    }
+    return HD_OK;
+}
+
+void tiles_skipped_text(const tiles_t *s, char *buf, size_t size) {
+    enum { SHOWN = 3 };
+    size_t len = 0;
+    buf[0] = '\0';
+    if (!s->n_skipped) return;
+    len += (size_t)snprintf(buf, size, "skipped %zu: ", s->n_skipped);
+    for (size_t k = 0; k < s->n_skipped && k < SHOWN && len < size; k++)
+        len += (size_t)snprintf(buf + len, size - len, "%s%s (%s)", k ? ", " : "", s->skipped[k].name,
+                                s->skipped[k].reason);
+    if (s->n_skipped > SHOWN && len < size) snprintf(buf + len, size - len, " and %zu more", s->n_skipped - SHOWN);
+}
+
+size_t tiles_locate(const tiles_t *s, size_t g, size_t *local) {
+    /* the last tile whose first <= g: empty tiles share the next one's
+     * first and come before it, so the tile found holds g */
+    size_t lo = 0, hi = s->n; /* answer in [lo, hi) */
+    while (hi - lo > 1) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (s->t[mid].first <= g) lo = mid;
+        else hi = mid;
+    }
+    *local = g - s->t[lo].first;
+    return lo;
+}
+
+void tiles_share(const tiles_t *s, int rank, int parts, size_t *first, size_t *n) {
+    assert(parts >= 1 && rank >= 0 && rank < parts);
+    uint64_t total = 0;
+    for (size_t k = 0; k < s->n; k++) total += s->t[k].bytes;
+    /* bound(r) = floor(r * total / parts), without overflow */
+    uint64_t q = total / (uint64_t)parts, rem = total % (uint64_t)parts;
+#define BOUND(r) ((uint64_t)(r) * q + (uint64_t)(r) * rem / (uint64_t)parts)
+    uint64_t lo = BOUND(rank), hi = BOUND(rank + 1), at = 0;
+    int last = rank == parts - 1;
+    *first = s->n;
+    *n = 0;
+    for (size_t k = 0; k < s->n; k++) {
+        if (at >= lo && (last || at < hi)) {
+            if (*first == s->n) *first = k;
+            ++*n;
+        }
+        at += s->t[k].bytes;
+    }
+#undef BOUND
+    if (*n == 0) *first = 0;
+}
