@@ -698,7 +698,7 @@ TEST(format_of_path_is_the_format_the_extension_selects) {
     CHECK(strcmp(hd_format_of_path("dir.v2/points.csv"), "xyz") == 0);
     CHECK(strcmp(hd_format_of_path("m.coff"), "off") == 0);
     CHECK(strcmp(hd_format_of_path("cloud.npy"), "npy") == 0);
-    CHECK(hd_format_of_path("scan.laz") == NULL);
+    CHECK(strcmp(hd_format_of_path("scan.laz"), "laz") == 0);
     CHECK(hd_format_of_path("dir.ply/README") == NULL);
     CHECK(hd_format_of_path("mask.nii.gz") == NULL);
     CHECK(hd_format_of_path("noext") == NULL);
