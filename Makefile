@@ -17,10 +17,10 @@ MAKEFLAGS += --no-print-directory
 all: $(BUILD)/hausdorff
 
 deps:
-	@scripts/deps.sh build extras
+	@scripts/deps.sh build extras mpi
 
 $(BUILD)/CMakeCache.txt:
-	@scripts/deps.sh build extras
+	@scripts/deps.sh build extras mpi
 	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release $(CMAKE_ARGS)
 
 $(BUILD)/hausdorff: $(BUILD)/CMakeCache.txt FORCE
@@ -41,13 +41,13 @@ run: cli
 test: test-release test-asan
 
 test-release:
-	@scripts/deps.sh build extras test python
+	@scripts/deps.sh build extras test python mpi
 	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release $(CMAKE_ARGS)
 	cmake --build $(BUILD) -j$(JOBS)
 	cd $(BUILD) && ctest --output-on-failure -j$(JOBS)
 
 test-asan:
-	@scripts/deps.sh build extras test fuzz
+	@scripts/deps.sh build extras test fuzz mpi
 	cmake -S . -B $(ASAN_BUILD) -DCMAKE_BUILD_TYPE=Debug -DHD_SANITIZE=ON -DHD_ASAN_BUILD=ON $(CMAKE_ARGS)
 	cmake --build $(ASAN_BUILD) -j$(JOBS)
 	cd $(ASAN_BUILD) && ASAN_OPTIONS=detect_leaks=1 ctest --output-on-failure -j$(JOBS)

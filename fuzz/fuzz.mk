@@ -33,7 +33,8 @@ READERS := ply obj off stl xyz pcd las npy laz
 MESHES  := ply obj off stl
 TARGETS := $(READERS:%=fuzz_%) $(MESHES:%=fuzz_%_sample) fuzz_nifti fuzz_cli
 
-LIB_SRC := $(wildcard src/*.c src/*/*.c)
+# src/mpi/ is the optional MPI library (cmake/mpi.cmake), not the core
+LIB_SRC := $(filter-out src/mpi/%,$(wildcard src/*.c src/*/*.c))
 CLI_SRC := $(filter-out cli/main.c,$(wildcard cli/*.c))
 LIB_OBJ := $(LIB_SRC:%.c=$(OUT)/obj/%.o)
 CLI_OBJ := $(CLI_SRC:%.c=$(OUT)/obj/%.o)

@@ -56,7 +56,9 @@ if static_lib:
     depends.append(static_lib)
     link_args.append("-Wl,--exclude-libs,ALL")
 else:
-    lib = sorted(glob.glob(os.path.join(ROOT, "src", "**", "*.c"), recursive=True))
+    # src/mpi/ is the optional MPI library (cmake/mpi.cmake), not the core
+    lib = sorted(f for f in glob.glob(os.path.join(ROOT, "src", "**", "*.c"), recursive=True)
+                 if os.sep + "mpi" + os.sep not in os.path.relpath(f, ROOT))
     sources += [os.path.relpath(p, HERE) for p in lib]
     depends += glob.glob(os.path.join(ROOT, "src", "**", "*.h"), recursive=True)
 

@@ -7,6 +7,7 @@ src/ is built in layers, each a folder, each offering one header:
     points   points/points.h   distance, boxes, keys, views, sources, sort
     io, classic, engine, nearest   (siblings: none includes another)
     src/*.c  api.c, index.c, stats.c: the public entry points, over all
+    mpi      (hausdorff_mpi.h) the optional MPI library, over the public API
 
 A file may include the standard library, "hausdorff.h", headers of its own
 folder (bare names, "io.h"), and headers of lower layers by their path from
@@ -24,7 +25,10 @@ import sys
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 if len(sys.argv) > 1:  # another tree (the checker's own test)
     ROOT = os.path.abspath(sys.argv[1])
-LEVEL = {"base": 0, "points": 1, "io": 2, "classic": 2, "engine": 2, "nearest": 2, "": 3}
+LEVEL = {"base": 0, "points": 1, "io": 2, "classic": 2, "engine": 2, "nearest": 2, "": 3, "mpi": 4}
+# The public headers: hausdorff.h anywhere, hausdorff_mpi.h only in the MPI
+# library and the MPI tool (cli/mpi/).
+PUBLIC_MPI = "hausdorff_mpi.h"
 INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"')
 
 
@@ -44,7 +48,7 @@ def check_src(rel, lines, bad):
         if not m:
             continue
         h = m.group(1)
-        if h == "hausdorff.h":
+        if h == "hausdorff.h" or (h == PUBLIC_MPI and own == "mpi"):
             continue
         if "/" not in h:
             if not os.path.exists(os.path.join(ROOT, "src", own, h)):
@@ -66,6 +70,8 @@ def check_src(rel, lines, bad):
 def check_cli(rel, lines, bad):
     for n, line in enumerate(lines, 1):
         m = INCLUDE.match(line)
+        if m and m.group(1) == PUBLIC_MPI and rel.startswith("cli/mpi/"):
+            continue
         if m and m.group(1) != "hausdorff.h" and not os.path.exists(os.path.join(ROOT, "cli", m.group(1))):
             bad.append(f"{rel}:{n}: cli/ uses the public API only, not \"{m.group(1)}\"")
 

@@ -1,6 +1,6 @@
 #!/bin/sh
 # Install the Debian packages a make target needs, when they are missing.
-# usage: scripts/deps.sh GROUP...   (groups: build test python bench plot fuzz extras)
+# usage: scripts/deps.sh GROUP...   (groups: build test python bench plot fuzz extras mpi)
 # Runs apt-get only as root and only for packages not yet installed, without
 # recommends (the minimal set); as another user it prints the same command,
 # to run as root, instead.  Each package is named once.
@@ -25,6 +25,9 @@ for group in "$@"; do
                 python3-venv python3-wheel ;;
     bench)  add libnanoflann-dev libpcl-dev python3-scipy python3-numpy python3-open3d g++ libomp-dev ;;
     plot)   add python3-matplotlib python3-numpy ;;
+    # Open MPI: the optional scale-out library and tool (cmake/mpi.cmake), and
+    # mpirun for their tests (tests/mpi.cmake).
+    mpi)    add libopenmpi-dev openmpi-bin ;;
     fuzz)   add clang libclang-rt-14-dev make libnifti2-dev zlib1g-dev ;;
     *) echo "deps.sh: unknown group $group" >&2; exit 1 ;;
   esac

@@ -1,0 +1,151 @@
+/*
+ * mpi_bench.c -- the exchange figures of hd_mpi_hausdorff (docs/scale-out.md):
+ *     mpirun -n K build/bench/mpi_bench [--points N] [--per-rank] [--cases LIST]
+ *                                       [--layout random|tiles] [--threads T]
+ *                                       [--check]
+ * For each case, every rank generates its share of A and B (N points per
+ * side in total, or per rank with --per-rank: weak scaling), and one call
+ * of hd_mpi_hausdorff is timed; rank 0 prints one line per case with the
+ * figures the targets of issue 14 name: bytes moved per input point (the
+ * partition's and the forwarding's), the fraction of points forwarded,
+ * the imbalance (largest rank's points, and its points plus answered
+ * queries, over the mean), the peak of the call's own buffers per local
+ * point, the growth of the peak RSS per local point (meaningful for the
+ * first case of a run only: later ones reuse freed memory), times (the
+ * slowest rank's total and search, wall clock), the largest CPU time of a
+ * rank per local point (the per-point cost for the model: with more ranks
+ * than cores it includes MPI's busy waiting), and the share of points
+ * searched one by one (the shells).  --check compares with hd_hausdorff on
+ * rank 0 (all points gathered; small N only).
+ *
+ * Cases:
+ *  - uniform: A and B independent, uniform in a cube.
+ *  - lidar: two epochs of a 1 km x 1 km LiDAR-like scene: terrain (a smooth
+ *    height field), a city quarter four times denser with box buildings
+ *    (roofs and walls), a lake with no points at all; epoch B is another
+ *    sampling of the same scene, one building demolished and one new.
+ *  - copy: B is A with noise of 1 cm on a 1 km scene (a re-registered
+ *    scan), same point order.
+ * Layouts: "random" (each rank's points spread over the whole scene: every
+ * point may move) or "tiles" (rank r generates the strip r of K in x, as a
+ * rank reading its share of tile files does: most points stay).
+ */
+#include <hausdorff_mpi.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/resource.h>
+#include <time.h>
+
+#include "scene.h"
+
+static int rank_, K_;
+
+static double cpu_now(void) {
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static double maxrss(void) {
+    struct rusage ru;
+    return getrusage(RUSAGE_SELF, &ru) == 0 ? 1024.0 * (double)ru.ru_maxrss : 0;
+}
+
+int main(int argc, char **argv) {
+    MPI_Init(&argc, &argv);
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
+    MPI_Comm_size(MPI_COMM_WORLD, &K_);
+    size_t N = 1000000;
+    int per_rank = 0, tiles = 0, threads = 1, check = 0;
+    const char *cases = "uniform,lidar,copy";
+    for (int k = 1; k < argc; k++) {
+        if (!strcmp(argv[k], "--points") && k + 1 < argc) N = (size_t)atof(argv[++k]);
+        else if (!strcmp(argv[k], "--per-rank")) per_rank = 1;
+        else if (!strcmp(argv[k], "--cases") && k + 1 < argc) cases = argv[++k];
+        else if (!strcmp(argv[k], "--layout") && k + 1 < argc) tiles = !strcmp(argv[++k], "tiles");
+        else if (!strcmp(argv[k], "--threads") && k + 1 < argc) threads = atoi(argv[++k]);
+        else if (!strcmp(argv[k], "--check")) check = 1;
+        else {
+            if (rank_ == 0) fprintf(stderr, "mpi_bench: unknown argument %s\n", argv[k]);
+            MPI_Finalize();
+            return 1;
+        }
+    }
+    size_t n = per_rank ? N : N / (size_t)K_ + ((size_t)rank_ < N % (size_t)K_);
+    size_t offset = per_rank ? n * (size_t)rank_ : N / (size_t)K_ * (size_t)rank_ +
+                                                       ((size_t)rank_ < N % (size_t)K_ ? (size_t)rank_ : N % (size_t)K_);
+    double *a = malloc(3 * n * sizeof(double) + 8), *b = malloc(3 * n * sizeof(double) + 8);
+    if (!a || !b) {
+        fprintf(stderr, "mpi_bench: out of memory\n");
+        MPI_Abort(MPI_COMM_WORLD, 1);
+    }
+    if (rank_ == 0)
+        printf("# mpi_bench: %d ranks, %zu points per side%s, layout %s, %d thread(s) per rank\n"
+               "# case     points  B/pt(part) B/pt(fwd) fwd%%    imbal work-imbal buf B/pt rss B/pt "
+               "time(s) search(s) search ns/pt cpu ns/pt shell%% searchcpu ns/pt\n",
+               K_, N, per_rank ? " per rank" : "", tiles ? "tiles" : "random", threads);
+    char list[256];
+    snprintf(list, sizeof list, "%s", cases);
+    for (char *c = strtok(list, ","); c; c = strtok(NULL, ",")) {
+        scene_make(c, tiles ? rank_ : 0, tiles ? K_ : 1, 7, (uint64_t)rank_, a, b, n);
+        hd_mpi_part_t pa = {hd_points_f64(a, n), offset}, pb = {hd_points_f64(b, n), offset};
+        hd_options_t opt;
+        hd_options_init(&opt);
+        opt.threads = threads;
+        hd_symmetric_t r;
+        hd_mpi_stats_t st;
+        hd_error_t err;
+        double rss0 = maxrss();
+        MPI_Barrier(MPI_COMM_WORLD);
+        double cpu0 = cpu_now();
+        int rc = hd_mpi_hausdorff(MPI_COMM_WORLD, &pa, 1, &pb, 1, &opt, &r, &st, &err);
+        double cpu = (cpu_now() - cpu0) / (double)(st.local_points ? st.local_points : 1), cpumax = 0;
+        MPI_Reduce(&cpu, &cpumax, 1, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD);
+        if (rc != HD_OK) {
+            if (rank_ == 0) fprintf(stderr, "mpi_bench: %s\n", err.message);
+            MPI_Abort(MPI_COMM_WORLD, 1);
+        }
+        double grow = (maxrss() - rss0) / (double)(st.local_points ? st.local_points : 1), most = 0;
+        MPI_Reduce(&grow, &most, 1, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD);
+        uint64_t tot = st.points;
+        if (rank_ == 0)
+            printf("%-8s %9llu %9.2f %9.3f %7.3f %6.3f %8.3f %10.1f %10.1f %8.3f %8.3f %8.1f %8.1f %7.3f %8.1f\n", c,
+                   (unsigned long long)tot, (double)st.bytes_partition / (double)tot,
+                   (double)st.bytes_forwarding / (double)tot, 100.0 * (double)st.forwarded_points / (double)tot,
+                   st.imbalance, st.work_imbalance, (double)st.peak_bytes_max / ((double)tot / K_), most,
+                   st.seconds_max, st.search_seconds_max, 1e9 * st.search_seconds_max / ((double)tot / K_),
+                   1e9 * cpumax, 100.0 * (double)st.shell_points / (double)tot,
+                   1e9 * st.search_cpu_max / ((double)tot / K_));
+        if (check) { /* gather everything on rank 0 and compare */
+            double *all[2] = {NULL, NULL};
+            int cnt = (int)(3 * n), *cnts = malloc((size_t)K_ * sizeof(int)), *disp = malloc((size_t)K_ * sizeof(int));
+            MPI_Gather(&cnt, 1, MPI_INT, cnts, 1, MPI_INT, 0, MPI_COMM_WORLD);
+            int total = 0;
+            for (int q = 0; rank_ == 0 && q < K_; q++) disp[q] = total, total += cnts[q];
+            for (int s = 0; s < 2; s++) {
+                if (rank_ == 0) all[s] = malloc((size_t)total * sizeof(double));
+                MPI_Gatherv(s ? b : a, cnt, MPI_DOUBLE, all[s], cnts, disp, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+            }
+            if (rank_ == 0) {
+                hd_points_t A = hd_points_f64(all[0], (size_t)total / 3), B = hd_points_f64(all[1], (size_t)total / 3);
+                hd_symmetric_t ref;
+                hd_hausdorff(&A, &B, NULL, &ref, &err);
+                int same = ref.distance == r.distance && ref.ab.i == r.ab.i && ref.ab.j == r.ab.j &&
+                           ref.ba.i == r.ba.i && ref.ba.j == r.ba.j;
+                printf("#   check: %s (H = %.17g)\n", same ? "identical to hd_hausdorff" : "DIFFERS", r.distance);
+            }
+            free(all[0]);
+            free(all[1]);
+            free(cnts);
+            free(disp);
+        }
+        fflush(stdout);
+    }
+    free(a);
+    free(b);
+    MPI_Finalize();
+    return 0;
+}

@@ -1,0 +1,260 @@
+/*
+ * mpi/main.c -- `mpirun -n K hausdorff-mpi [options] A B`: the exact
+ * Hausdorff distance of two sides that no single process needs to hold,
+ * printed as `hausdorff` prints it (report.c), the same numbers and
+ * witnesses to the bit, with the exchange's figures added.
+ *
+ * Each side is one file, a directory or @LIST of tiles (tiles.c).  Each rank
+ * reads its share of each side's tiles (tiles_share: a contiguous range,
+ * balanced by bytes; B's shares are rotated by K/2 ranks, so a side of one
+ * file each puts A and B on different ranks), and numbers its points by the
+ * counts of the tiles before its range (an allreduce of every tile's
+ * count).  Then hd_mpi_hausdorff (or hd_mpi_directed and hd_mpi_overlap)
+ * over MPI_COMM_WORLD.
+ *
+ * Failures: every step that can fail on some ranks only (expanding a side,
+ * reading a tile, the computation) ends with agree(): the ranks learn the
+ * first failing rank's code and message, rank 0 prints it, and every rank
+ * exits with the same status; no rank waits in a collective for one that
+ * gave up.  Only rank 0 writes to standard output and standard error (the
+ * others' are /dev/null), so a message appears once, not K times.  The
+ * per-point outputs (--distances, --percentile, pictures, ...) need every
+ * distance in one place and are refused (exit 1), as is --empty.
+ */
+#include <hausdorff_mpi.h>
+
+#include "cli.h"
+#include "output.h"
+#include "report.h"
+#include "tiles.h"
+
+#include <fcntl.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/resource.h>
+#include <unistd.h>
+
+static int rank_, K_;
+
+/* The first failing rank's code and message, on every rank (HD_OK when no
+ * rank failed). */
+static int agree(int rc, hd_error_t *err) {
+    int mine = rc != HD_OK ? rank_ : K_, first = K_;
+    MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+    if (first == K_) return HD_OK;
+    if (rank_ == first) err->code = rc;
+    MPI_Bcast(err, (int)sizeof *err, MPI_BYTE, first, MPI_COMM_WORLD);
+    return err->code;
+}
+
+/* The same exit status on every rank (rank 0's). */
+static int finish(int status) {
+    MPI_Bcast(&status, 1, MPI_INT, 0, MPI_COMM_WORLD);
+    MPI_Finalize();
+    return status;
+}
+
+static int fail(int rc, const hd_error_t *err) {
+    fprintf(stderr, "hausdorff-mpi: %s\n", err->message);
+    out_discard();
+    return finish(cli_exit_for(rc));
+}
+
+/* Silence every rank but 0: one message, one report. */
+static void quiet_others(void) {
+    if (rank_ == 0) return;
+    int fd = open("/dev/null", O_WRONLY);
+    if (fd < 0) return;
+    dup2(fd, 1);
+    dup2(fd, 2);
+    if (fd > 2) close(fd);
+}
+
+/* Every tile's count over all ranks (each tile was read by one rank), then
+ * tiles_number; *offset is the first index of this rank's range. */
+static int number_tiles(tiles_t *t, size_t first, size_t n, size_t *offset, hd_error_t *err) {
+    size_t m = t->n ? t->n : 1;
+    uint64_t *mine = calloc(m, sizeof *mine), *all = calloc(m, sizeof *all);
+    int rc = mine && all ? HD_OK : HD_ENOMEM;
+    if (rc) snprintf(err->message, sizeof err->message, "out of memory for %zu tiles", t->n);
+    if ((rc = agree(rc, err)) == HD_OK) {
+        for (size_t k = first; k < first + n; k++) mine[k] = t->t[k].count;
+        MPI_Allreduce(mine, all, (int)m, MPI_UINT64_T, MPI_SUM, MPI_COMM_WORLD);
+        for (size_t k = 0; k < t->n; k++) t->t[k].count = (size_t)all[k];
+        rc = tiles_number(t, err); /* the same verdict on every rank */
+        *offset = n && rc == HD_OK ? t->t[first].first : 0;
+    }
+    free(mine);
+    free(all);
+    return rc;
+}
+
+/* A side's format: its ranks' common one, or "mixed". */
+static void side_format(const hd_cloud_t *c, char out[16]) {
+    char mine[16] = {0}, *all = rank_ == 0 ? calloc((size_t)K_, 16) : NULL;
+    if (c->count) memcpy(mine, c->format, 15);
+    MPI_Gather(mine, 16, MPI_CHAR, all, 16, MPI_CHAR, 0, MPI_COMM_WORLD);
+    memset(out, 0, 16);
+    if (!all) return;
+    for (int r = 0; r < K_; r++) {
+        const char *f = all + 16 * r;
+        if (!f[0]) continue;
+        if (!out[0]) memcpy(out, f, 16);
+        else if (strcmp(out, f) != 0) strcpy(out, "mixed");
+    }
+    free(all);
+}
+
+/* Point g of a side, from the rank that holds it, on every rank. */
+static void fetch_point(const hd_mpi_part_t *p, size_t g, double q[3]) {
+    int own = p->points.count && g >= p->offset && g - p->offset < p->points.count, from = K_;
+    int mine = own ? rank_ : K_;
+    MPI_Allreduce(&mine, &from, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+    if (own && from == rank_) hd_points_get(&p->points, g - p->offset, q);
+    MPI_Bcast(q, 3, MPI_DOUBLE, from < K_ ? from : 0, MPI_COMM_WORLD);
+}
+
+/* The exchange figures, gathered to rank 0 and printed there. */
+static void mpi_json(FILE *out, const hd_mpi_stats_t *st, const double *secs, const double *peak,
+                     const double *rss) {
+    fprintf(out, ", \"mpi\": {\"ranks\": %d, \"rounds\": %d", st->ranks, st->rounds);
+    fprintf(out, ", \"bytes_per_point\": ");
+    json_number(out, (double)(st->bytes_partition + st->bytes_forwarding) / (double)st->points);
+    fprintf(out, ", \"bytes_partition\": %llu, \"bytes_forwarding\": %llu",
+            (unsigned long long)st->bytes_partition, (unsigned long long)st->bytes_forwarding);
+    fprintf(out, ", \"forwarded_fraction\": ");
+    json_number(out, (double)st->forwarded_points / (double)st->points);
+    fprintf(out, ", \"forwarded_queries\": %llu", (unsigned long long)st->forwarded);
+    fprintf(out, ", \"imbalance\": ");
+    json_number(out, st->imbalance);
+    fprintf(out, ", \"work_imbalance\": ");
+    json_number(out, st->work_imbalance);
+    const char *keys[3] = {"seconds_per_rank", "buffer_bytes_per_rank", "peak_rss_bytes_per_rank"};
+    const double *vals[3] = {secs, peak, rss};
+    for (int k = 0; k < 3; k++) {
+        fprintf(out, ", \"%s\": [", keys[k]);
+        for (int r = 0; r < K_; r++) {
+            if (r) fputs(", ", out);
+            json_number(out, k == 0 ? round(vals[k][r] * 1e6) / 1e6 : vals[k][r]);
+        }
+        fputc(']', out);
+    }
+    fputc('}', out);
+}
+
+int main(int argc, char **argv) {
+    MPI_Init(&argc, &argv);
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
+    MPI_Comm_size(MPI_COMM_WORLD, &K_);
+    quiet_others();
+    out_guard_std();
+    cli_args_t a;
+    int rc = cli_parse(argc, argv, &a); /* the same verdict on every rank */
+    if (rc >= 0) return finish(rc == EXIT_OK ? out_finish() : rc);
+    if (analysis_active(&a.an) || a.an.empty != EMPTY_ERROR) {
+        fprintf(stderr, "hausdorff-mpi: per-point outputs (--distances, --percentile, --mean, --chamfer, "
+                        "--histogram, --render, ...) and --empty need every distance in one process: use "
+                        "hausdorff\n");
+        return finish(EXIT_USAGE);
+    }
+    hd_error_t err;
+    memset(&err, 0, sizeof err);
+    tiles_t side[2];
+    memset(side, 0, sizeof side);
+    hd_cloud_t *cloud[2] = {NULL, NULL};
+    const char *paths[2] = {a.path_a, a.path_b}, *formats[2] = {a.format_a, a.format_b};
+    rc = HD_OK;
+    for (int w = 0; w < 2 && rc == HD_OK; w++) {
+        rc = tiles_expand(paths[w], formats[w], &side[w], &err);
+        if ((rc = agree(rc, &err)) != HD_OK) break;
+    }
+    /* Each rank reads its share of each side. */
+    double t0 = cli_now();
+    hd_mpi_part_t part[2];
+    size_t first[2] = {0, 0}, n[2] = {0, 0};
+    for (int w = 0; w < 2 && rc == HD_OK; w++) {
+        tiles_share(&side[w], w ? (rank_ + K_ / 2) % K_ : rank_, K_, &first[w], &n[w]);
+        rc = tiles_read(&side[w], first[w], n[w], &a.read, &a.an, w, &cloud[w], &err);
+        if ((rc = agree(rc, &err)) == HD_OK) rc = number_tiles(&side[w], first[w], n[w], &part[w].offset, &err);
+        if (rc == HD_OK) part[w].points = hd_cloud_points(cloud[w]);
+    }
+    double read_local = cli_now() - t0, read_seconds = read_local;
+    hd_symmetric_t s;
+    hd_mpi_stats_t st;
+    memset(&s, 0, sizeof s);
+    memset(&st, 0, sizeof st);
+    if (rc == HD_OK) {
+        MPI_Allreduce(&read_local, &read_seconds, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+        if (a.directed) {
+            rc = hd_mpi_directed(MPI_COMM_WORLD, &part[0], 1, &part[1], 1, &a.opt, &s.ab, &st, &err);
+            if (rc == HD_OK) {
+                s.distance = s.ab.distance;
+                s.seconds = s.ab.seconds;
+                rc = hd_mpi_overlap(MPI_COMM_WORLD, &part[0], 1, &part[1], 1, &s.alpha, &s.disjoint, &err);
+            }
+        } else {
+            rc = hd_mpi_hausdorff(MPI_COMM_WORLD, &part[0], 1, &part[1], 1, &a.opt, &s, &st, &err);
+        }
+    }
+    if (rc != HD_OK) {
+        for (int w = 0; w < 2; w++) {
+            hd_cloud_free(cloud[w]);
+            tiles_free(&side[w]);
+        }
+        return fail(rc, &err);
+    }
+
+    /* Everything the report shows, on rank 0. */
+    report_t r = {&a, &s, side, {(size_t)0, (size_t)0}, {NULL, NULL}, {0, 0}, {0, 0, 0}, {0, 0, 0},
+                  read_seconds};
+    char fmt[2][16];
+    uint64_t counts[4] = {cloud[0]->count, cloud[1]->count, cloud[0]->n_faces, cloud[1]->n_faces}, sums[4];
+    MPI_Allreduce(counts, sums, 4, MPI_UINT64_T, MPI_SUM, MPI_COMM_WORLD);
+    for (int w = 0; w < 2; w++) {
+        side_format(cloud[w], fmt[w]);
+        r.n[w] = (size_t)sums[w];
+        r.faces[w] = (size_t)sums[2 + w];
+        r.format[w] = fmt[w];
+    }
+    int from_a;
+    const hd_result_t *wit = report_witness(&a, &s, &from_a);
+    fetch_point(&part[!from_a], wit->i, r.wp);
+    fetch_point(&part[from_a], wit->j, r.wq);
+    struct rusage ru;
+    double mine[3] = {st.seconds, (double)st.peak_bytes, 0}, *all = rank_ == 0 ? calloc(3 * (size_t)K_, sizeof(double)) : NULL;
+    if (getrusage(RUSAGE_SELF, &ru) == 0) mine[2] = 1024.0 * (double)ru.ru_maxrss;
+    MPI_Gather(mine, 3, MPI_DOUBLE, all, 3, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+    int status = EXIT_OK;
+    if (rank_ == 0) {
+        double *col[3] = {NULL, NULL, NULL};
+        for (int k = 0; k < 3 && all; k++) {
+            col[k] = malloc((size_t)K_ * sizeof(double));
+            for (int q = 0; q < K_ && col[k]; q++) col[k][q] = all[3 * q + k];
+        }
+        FILE *out = stdout;
+        if (!all || !col[0] || !col[1] || !col[2]) {
+            fprintf(stderr, "hausdorff-mpi: out of memory\n");
+            status = EXIT_FAILURE_;
+        } else if (a.json) {
+            report_json(out, &r);
+            mpi_json(out, &st, col[0], col[1], col[2]);
+            fprintf(out, "}\n");
+        } else {
+            report_text(out, &r);
+            char b[NUM_TEXT], f[NUM_TEXT], im[NUM_TEXT];
+            fprintf(out, "mpi: %d ranks, %s bytes moved per point, %s of the points forwarded, imbalance %s\n", K_,
+                    num_text((double)(st.bytes_partition + st.bytes_forwarding) / (double)st.points, b),
+                    num_text((double)st.forwarded_points / (double)st.points, f), num_text(st.imbalance, im));
+        }
+        for (int k = 0; k < 3; k++) free(col[k]);
+        if (status == EXIT_OK) status = out_finish();
+        else out_discard();
+    }
+    free(all);
+    for (int w = 0; w < 2; w++) {
+        hd_cloud_free(cloud[w]);
+        tiles_free(&side[w]);
+    }
+    return finish(status);
+}

@@ -1,0 +1,166 @@
+/*
+ * hausdorff_mpi.h -- the exact Hausdorff distance of point sets spread over
+ * the ranks of an MPI communicator.
+ *
+ * The optional library libhausdorff_mpi (built when CMake finds MPI) adds
+ * one call over libhausdorff: every rank passes the points it holds, each
+ * numbered by its global index, and every rank receives the same result,
+ * bit for bit the one hd_hausdorff() returns on all the points in one
+ * process, witness included.  docs/scale-out.md explains the algorithm and
+ * its costs.
+ *
+ * A first program (run with `mpirun -n 4 ./prog`):
+ *
+ *     #include <hausdorff_mpi.h>
+ *     #include <stdio.h>
+ *
+ *     int main(int argc, char **argv) {
+ *         MPI_Init(&argc, &argv);
+ *         int rank;
+ *         MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+ *         // rank r holds A's points 2r and 2r+1, and B's point r
+ *         double a[6] = { rank, 0, 0,  rank, 1, 0 };
+ *         double b[3] = { rank, 0, 0.5 };
+ *         hd_mpi_part_t A = { hd_points_f64(a, 2), 2 * (size_t)rank };
+ *         hd_mpi_part_t B = { hd_points_f64(b, 1), (size_t)rank };
+ *         hd_symmetric_t r;
+ *         hd_error_t err;
+ *         int rc = hd_mpi_hausdorff(MPI_COMM_WORLD, &A, 1, &B, 1, NULL,
+ *                                   &r, NULL, &err);
+ *         if (rc != HD_OK) {           // the same code on every rank
+ *             if (rank == 0) fprintf(stderr, "%s\n", err.message);
+ *         } else if (rank == 0) {
+ *             printf("H = %.17g, A[%zu] to B[%zu]\n", r.distance,
+ *                    r.ab.i, r.ab.j);
+ *         }
+ *         MPI_Finalize();
+ *         return rc != HD_OK;
+ *     }
+ *
+ * Build with `mpicc prog.c -lhausdorff_mpi -lhausdorff -lm -lpthread`, or in
+ * CMake with the targets hausdorff_mpi and MPI::MPI_C.
+ *
+ * Conventions: those of hausdorff.h (result codes, hd_error_t, ownership,
+ * exactness, the tie rule), and for MPI:
+ *  - Every call here is collective over `comm`: every rank calls it with
+ *    the same options, and every rank returns the same result code, the
+ *    same result and the same message (the first failing rank's, prefixed
+ *    with "rank R: ").  A failure on one rank (a bad point, no memory) never
+ *    leaves the others waiting: the ranks agree on a status before every
+ *    step that could block.
+ *  - The library duplicates `comm` for its own messages (so they never
+ *    match the caller's) and frees the duplicate before returning.  MPI
+ *    must be initialised.  Only the calling thread makes MPI calls; the
+ *    threads the library starts (opt->threads) make none, so
+ *    MPI_THREAD_FUNNELED is the level the standard asks for.
+ *  - Points are read during the call only, and may be laid out in any way
+ *    over the ranks: any rank may hold any points of either set, or none.
+ */
+#ifndef HAUSDORFF_MPI_H
+#define HAUSDORFF_MPI_H
+
+#include <mpi.h>
+
+#include "hausdorff.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* A run of consecutive points of one set held by this rank: its points are
+ * the set's points offset, offset + 1, ..., offset + points.count - 1.  A
+ * rank passes as many parts of each set as it holds (a tile file each, say);
+ * over all ranks the parts of one set must not share an index (HD_EINVAL).
+ * Indices need not cover 0..n-1 without gaps: the witness names them as
+ * given. */
+typedef struct hd_mpi_part {
+    hd_points_t points;
+    size_t offset;
+} hd_mpi_part_t;
+
+/* What the exchange cost, the same on every rank (sums and maxima over the
+ * ranks) except the fields marked "this rank". */
+typedef struct hd_mpi_stats {
+    int ranks;
+    uint64_t points;            /* input points of A and B */
+    uint64_t bytes_partition;   /* bytes sent to other ranks to move the
+                                   points (32 a point moved) and choose the
+                                   regions (the samples) */
+    uint64_t bytes_forwarding;  /* bytes of forwarded queries (24 each) and
+                                   their answers (16 each) */
+    uint64_t forwarded;         /* (point, rank) queries forwarded */
+    uint64_t forwarded_points;  /* points forwarded to one rank or more */
+    uint64_t shell_points;      /* points searched one by one, in both
+                                   directions (the shells: the others are
+                                   settled by the engine's pruned pass) */
+    int rounds;                 /* forwarding rounds (one per direction) */
+    uint64_t points_max;        /* most points (A and B) a rank computed on */
+    double imbalance;           /* points_max over the mean per rank */
+    double work_imbalance;      /* the same with forwarded queries answered
+                                   counted as points */
+    double seconds_max;         /* the slowest rank's time in the call */
+    double seconds_mean;
+    double search_seconds_max;  /* the most a rank spent in the per-point
+                                   searches (its own points and the
+                                   queries it answered) */
+    double search_cpu_max;      /* the same in CPU seconds of the calling
+                                   thread: with opt->threads = 1 the
+                                   searches' own cost, whatever the load */
+    uint64_t peak_bytes_max;    /* most bytes a rank held in the buffers of
+                                   this call, not counting the engine's and
+                                   the per-point searches' structures
+                                   (about 32 bytes a point of the local
+                                   set searched, up to 60 while built) */
+    double seconds;             /* this rank: time in the call */
+    double search_seconds;      /* this rank: time in the searches */
+    uint64_t local_points;      /* this rank: points after the partition */
+    uint64_t peak_bytes;        /* this rank: peak of the buffers above */
+} hd_mpi_stats_t;
+
+/* H(A,B) of the points every rank holds, with both directions and their
+ * witnesses: the result hd_hausdorff() gives on the union of all ranks'
+ * points, to the bit (distances, witnesses in global indices, alpha,
+ * disjoint).  Collective over comm.
+ *
+ * a, na: this rank's parts of A (na may be 0, a is then not read); b, nb
+ *   likewise for B.  Read during the call only.  A part with no points is
+ *   allowed.  Over all ranks each set must have a point (HD_EEMPTY).
+ * opt: NULL for the defaults; opt->threads is the number of threads each
+ *   rank uses (< 0 is HD_EINVAL) and opt->algorithm must be a valid one
+ *   (HD_EALGORITHM), although the default engine's per-point search always
+ *   runs (out->ab.algorithm is HD_ALG_AUTO); other fields are ignored.
+ * out: receives the result on every rank; its stats are zero and its
+ *   seconds are the slowest rank's.
+ * stats: NULL, or receives the exchange figures above.
+ * err: NULL, or receives the context of a failure.
+ * Errors: as hd_hausdorff (HD_EINVAL, HD_EEMPTY, HD_ENONFINITE, HD_ERANGE,
+ *   HD_ENOMEM, HD_ETHREAD), HD_EINVAL too for parts that share an index or
+ *   run past SIZE_MAX, HD_EOVERFLOW for more than 2^31 - 1 records between
+ *   two ranks (MPI's int counts), HD_EIO when an MPI call fails.
+ * Thread safety: as any collective MPI call: one call at a time per
+ *   communicator. */
+int hd_mpi_hausdorff(MPI_Comm comm, const hd_mpi_part_t *a, size_t na,
+                     const hd_mpi_part_t *b, size_t nb,
+                     const hd_options_t *opt, hd_symmetric_t *out,
+                     hd_mpi_stats_t *stats, hd_error_t *err);
+
+/* h(A,B) alone, as hd_directed() gives it: the same arguments and errors
+ * as hd_mpi_hausdorff, half the work. */
+int hd_mpi_directed(MPI_Comm comm, const hd_mpi_part_t *a, size_t na,
+                    const hd_mpi_part_t *b, size_t nb,
+                    const hd_options_t *opt, hd_result_t *out,
+                    hd_mpi_stats_t *stats, hd_error_t *err);
+
+/* The overlap degree alpha and *disjoint of the bounding boxes of all of A
+ * and all of B, as hd_overlap() gives them on the union (hausdorff.h);
+ * with hd_mpi_directed it makes what hd_hausdorff's result holds besides
+ * the distances.  Collective; arguments and errors as hd_mpi_hausdorff
+ * (no options). */
+int hd_mpi_overlap(MPI_Comm comm, const hd_mpi_part_t *a, size_t na,
+                   const hd_mpi_part_t *b, size_t nb, double *alpha,
+                   int *disjoint, hd_error_t *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* HAUSDORFF_MPI_H */

@@ -1,0 +1,384 @@
+/*
+ * mpi_api.c -- hd_mpi_hausdorff (hausdorff_mpi.h) equals hd_hausdorff on
+ * the union of every rank's points, bit for bit, witnesses, alpha and
+ * disjoint included, however the points are spread over the ranks; and a
+ * failure on one rank is the same failure, with the same message, on every
+ * rank.  Run under mpirun with 1, 2, 3, 4 and 7 ranks (tests/mpi.cmake).
+ *
+ * Every rank generates the same sets from the same seed; each layout
+ * (below) gives each rank some runs of them as parts; the reference is
+ * hd_hausdorff on the whole sets, one thread, on every rank.  The cases are
+ * the adversarial ones of issue 14: ties across region boundaries (integer
+ * lattices, a half-step shifted copy), all points in one region (every
+ * point equal; all on one plane), ranks with no points, one side on one
+ * rank, a nearest neighbour two regions away (B far from most of A, and
+ * absent from most regions), duplicates, 1e-9 and 1e9 scales.
+ *
+ * The harness is this file's own (tests/support/check.c has a main of its
+ * own and knows nothing of ranks): a failure prints the rank, the case, the
+ * layout and the seed; the ranks agree on the verdict, and rank 0 prints
+ * "N passed, M failed".
+ */
+#include <hausdorff_mpi.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "gen.h"
+
+static int rank_, K_, failures, checks;
+static char context_[256];
+
+#define CHECK(cond)                                                                     \
+    do {                                                                                \
+        checks++;                                                                       \
+        if (!(cond)) {                                                                  \
+            failures++;                                                                 \
+            fprintf(stderr, "rank %d/%d: %s:%d: CHECK(%s) failed [%s]\n", rank_, K_,     \
+                    __FILE__, __LINE__, #cond, context_);                               \
+        }                                                                               \
+    } while (0)
+
+#define SAME_BITS(x, y) (memcmp(&(x), &(y), sizeof(double)) == 0)
+
+/* ---- layouts: which runs of each set a rank holds ------------------------ */
+
+enum { LAY_BLOCKS, LAY_CHUNKS, LAY_ALL_ON_0, LAY_A_ON_LAST, LAY_HOLES, LAY_COUNT };
+static const char *const lay_name[LAY_COUNT] = {"blocks", "chunks-of-7 round robin, parts reversed",
+                                                "all on rank 0", "A on the last rank, B in blocks",
+                                                "rank 1 empty, random runs"};
+
+/* The parts of a set of n points (packed xyz) that this rank holds. */
+static size_t layout(int how, int side, const double *xyz, size_t n, uint64_t seed, hd_mpi_part_t *parts,
+                     size_t cap) {
+    size_t np = 0;
+    int K = K_, r = rank_;
+    switch (how) {
+    case LAY_BLOCKS: {
+        size_t lo = n * (size_t)r / (size_t)K, hi = n * (size_t)(r + 1) / (size_t)K;
+        parts[np++] = (hd_mpi_part_t){hd_points_f64(xyz + 3 * lo, hi - lo), lo};
+        break;
+    }
+    case LAY_CHUNKS: {
+        size_t w = n / 7 < cap - 1 ? 7 : n / (cap - 1) + 1; /* chunks of 7, fewer for large sets */
+        for (size_t lo = 0, c = 0; lo < n; lo += w, c++)
+            if ((int)(c % (size_t)K) == r) {
+                size_t m = n - lo < w ? n - lo : w;
+                parts[np++] = (hd_mpi_part_t){hd_points_f64(xyz + 3 * lo, m), lo};
+            }
+        for (size_t k = 0; k < np / 2; k++) { /* any order: the library sorts */
+            hd_mpi_part_t t = parts[k];
+            parts[k] = parts[np - 1 - k];
+            parts[np - 1 - k] = t;
+        }
+        break;
+    }
+    case LAY_ALL_ON_0:
+        if (r == 0) parts[np++] = (hd_mpi_part_t){hd_points_f64(xyz, n), 0};
+        break;
+    case LAY_A_ON_LAST:
+        if (side == 0) {
+            if (r == K - 1) parts[np++] = (hd_mpi_part_t){hd_points_f64(xyz, n), 0};
+        } else {
+            return layout(LAY_BLOCKS, side, xyz, n, seed, parts, cap);
+        }
+        break;
+    case LAY_HOLES: { /* runs of random length to random ranks other than 1 */
+        gen_rng_t g;
+        gen_seed(&g, seed * 31 + (uint64_t)side);
+        for (size_t lo = 0; lo < n;) {
+            size_t m = 1 + (size_t)(gen_u64(&g) % 400);
+            if (m > n - lo) m = n - lo;
+            int to = (int)(gen_u64(&g) % (uint64_t)K);
+            if (K > 1 && to == 1) to = 0;
+            if (to == r && np < cap) parts[np++] = (hd_mpi_part_t){hd_points_f64(xyz + 3 * lo, m), lo};
+            lo += m;
+        }
+        break;
+    }
+    }
+    /* an empty part is allowed anywhere */
+    if (np < cap) parts[np++] = (hd_mpi_part_t){hd_points_f64(xyz, 0), 12345};
+    return np;
+}
+
+/* ---- data sets ---------------------------------------------------------- */
+
+typedef struct {
+    const char *name;
+    double *a, *b;
+    size_t na, nb;
+} set_t;
+
+enum {
+    DS_UNIFORM, DS_LATTICE, DS_LATTICE_HALF, DS_ONE_POINT, DS_PLANE, DS_FAR_B, DS_CORNER_B, DS_DUPLICATES,
+    DS_TINY, DS_HUGE, DS_NOISE, DS_DISJOINT, DS_CHECKER, DS_STRAY, DS_COUNT
+};
+
+static void make_set(int which, uint64_t seed, set_t *s) {
+    gen_rng_t g;
+    gen_seed(&g, seed);
+    size_t n = 2000;
+    s->na = n;
+    s->nb = n;
+    s->a = malloc(3 * 16000 * sizeof(double)); /* the largest set (DS_STRAY) */
+    s->b = malloc(3 * 16000 * sizeof(double));
+    switch (which) {
+    case DS_UNIFORM:
+        s->name = "uniform A and B";
+        s->nb = 1500;
+        gen_cube(&g, s->a, n, -1, 1);
+        gen_cube(&g, s->b, s->nb, -1, 1);
+        break;
+    case DS_LATTICE:
+        s->name = "integer lattice (ties across regions)";
+        gen_lattice(&g, s->a, n, 12);
+        gen_lattice(&g, s->b, n, 12);
+        break;
+    case DS_LATTICE_HALF:
+        s->name = "lattice copy shifted half a step (ties with neighbours)";
+        gen_copy(&g, GEN_COPY_LATTICE_HALF, s->a, s->b, n);
+        break;
+    case DS_ONE_POINT:
+        s->name = "every point equal (all in one region)";
+        for (size_t k = 0; k < 3 * n; k++) s->a[k] = 0.25, s->b[k] = 0.25;
+        s->b[0] = 0.5; /* one B point elsewhere: h(B,A) > 0 */
+        break;
+    case DS_PLANE:
+        s->name = "all points on the plane x = 1 (split keys tie on x)";
+        gen_cube(&g, s->a, n, 0, 1);
+        gen_cube(&g, s->b, n, 0, 1);
+        for (size_t k = 0; k < n; k++) s->a[3 * k] = 1, s->b[3 * k] = 1;
+        break;
+    case DS_FAR_B:
+        s->name = "B a small cluster far from A (nearest neighbours regions away)";
+        s->nb = 40;
+        gen_cube(&g, s->a, n, 0, 1);
+        gen_cube(&g, s->b, s->nb, 5, 5.01);
+        break;
+    case DS_CORNER_B:
+        s->name = "B in one corner of A's cube (most regions have no B)";
+        gen_cube(&g, s->a, n, 0, 1);
+        gen_cube(&g, s->b, n, 0, 0.1);
+        break;
+    case DS_DUPLICATES:
+        s->name = "copy with repeated points";
+        gen_copy(&g, GEN_COPY_DUPLICATES, s->a, s->b, n);
+        break;
+    case DS_TINY:
+        s->name = "scale 1e-9";
+        gen_copy(&g, GEN_COPY_NOISE, s->a, s->b, n);
+        gen_affine(s->a, n, 1e-9, 0);
+        gen_affine(s->b, n, 1e-9, 0);
+        break;
+    case DS_HUGE:
+        s->name = "at 1e9 (copy moved far away)";
+        gen_copy(&g, GEN_COPY_FAR, s->a, s->b, n);
+        break;
+    case DS_NOISE:
+        s->name = "perturbed copy";
+        gen_copy(&g, GEN_COPY_NOISE, s->a, s->b, n);
+        break;
+    case DS_CHECKER: {
+        /* Every A point's nearest B points are its lattice neighbours at
+         * distance 1, so h(A,B) = 1 is tied by every A point; the witness
+         * is A[0] = (7, 8, 7) (mid-cube, where the first split falls) and
+         * B[0] = (8, 8, 7), its neighbour across the middle plane: beyond
+         * a region face exactly 1 away: a face at the distance does not
+         * confirm a point. */
+        s->name = "checkerboard lattice (every A point ties, across faces)";
+        size_t na = 0, nb = 0;
+        for (int x = 0; x < 16; x++)
+            for (int y = 0; y < 16; y++)
+                for (int z = 0; z < 16; z++) {
+                    double *to = (x + y + z) % 2 ? s->b + 3 * nb++ : s->a + 3 * na++;
+                    to[0] = x, to[1] = y, to[2] = z;
+                }
+        s->na = na;
+        s->nb = nb;
+        for (size_t k = na - 1; k > 0; k--) gen_swap(s->a, k, (size_t)(gen_u64(&g) % (k + 1)));
+        for (size_t k = nb - 1; k > 0; k--) gen_swap(s->b, k, (size_t)(gen_u64(&g) % (k + 1)));
+        for (size_t k = 0; k < na; k++)
+            if (s->a[3 * k] == 7 && s->a[3 * k + 1] == 8 && s->a[3 * k + 2] == 7) gen_swap(s->a, 0, k);
+        for (size_t k = 0; k < nb; k++) /* its neighbour across the middle, B[0] */
+            if (s->b[3 * k] == 8 && s->b[3 * k + 1] == 8 && s->b[3 * k + 2] == 7) gen_swap(s->b, 0, k);
+        break;
+    }
+    case DS_STRAY: {
+        /* A copy (|A| = |B|, B[g] = A[g] + 1e-3 noise) of a 20^3 lattice
+         * whose every point is in A twice (g and g + 8000), so that the
+         * ranks' correspondence pass runs; but B[c] and B[c + 8000] are
+         * moved 0.3 off A[c] = (2, 2, 2), which makes A[c] the pairs'
+         * farthest point, and B[s], the partner of the far A[s] =
+         * (17, 17, 17), sits 0.1 from A[c]: a point of B whose partner is on
+         * another rank, nearer to the pairs' witness than its pairs.  So
+         * h(A,B) = 0.1 at A[c], not the pairs' 0.3. */
+        s->name = "copy whose farthest pair has a nearer point paired elsewhere";
+        size_t N = 8000, c = 0, f = 0, k = 0;
+        for (int x = 0; x < 20; x++)
+            for (int y = 0; y < 20; y++)
+                for (int z = 0; z < 20; z++, k++) {
+                    s->a[3 * k] = x, s->a[3 * k + 1] = y, s->a[3 * k + 2] = z;
+                    if (x == 2 && y == 2 && z == 2) c = k;
+                    if (x == 17 && y == 17 && z == 17) f = k;
+                }
+        memcpy(s->a + 3 * N, s->a, 3 * N * sizeof(double));
+        s->na = s->nb = 2 * N;
+        for (size_t q = 0; q < 3 * s->na; q++) s->b[q] = s->a[q] + 1e-3 * gen_normal(&g);
+        s->b[3 * c + 1] = 2.3, s->b[3 * c] = 2, s->b[3 * c + 2] = 2;
+        s->b[3 * (c + N) + 1] = 1.7, s->b[3 * (c + N)] = 2, s->b[3 * (c + N) + 2] = 2;
+        s->b[3 * f] = 2.1, s->b[3 * f + 1] = 2, s->b[3 * f + 2] = 2;
+        break;
+    }
+    case DS_DISJOINT:
+        s->name = "disjoint boxes";
+        gen_cube(&g, s->a, n, 0, 1);
+        gen_cube(&g, s->b, n, 2, 3);
+        break;
+    }
+}
+
+/* ---- the checks --------------------------------------------------------- */
+
+static void check_equal(int which, int how, uint64_t seed) {
+    set_t s = {"", NULL, NULL, 0, 0};
+    make_set(which, seed, &s);
+    snprintf(context_, sizeof context_, "set \"%s\", layout \"%s\", seed %llu", s.name, lay_name[how],
+             (unsigned long long)seed);
+    hd_options_t opt;
+    hd_options_init(&opt);
+    opt.threads = 1;
+    hd_points_t A = hd_points_f64(s.a, s.na), B = hd_points_f64(s.b, s.nb);
+    hd_symmetric_t ref, got;
+    hd_error_t err;
+    int rc = hd_hausdorff(&A, &B, &opt, &ref, &err);
+    CHECK(rc == HD_OK);
+    hd_mpi_part_t pa[400], pb[400];
+    size_t na = layout(how, 0, s.a, s.na, seed, pa, 400), nb = layout(how, 1, s.b, s.nb, seed, pb, 400);
+    unsigned long long held[2] = {0, 0}, all[2];
+    for (size_t k = 0; k < na; k++) held[0] += pa[k].points.count;
+    for (size_t k = 0; k < nb; k++) held[1] += pb[k].points.count;
+    MPI_Allreduce(held, all, 2, MPI_UNSIGNED_LONG_LONG, MPI_SUM, MPI_COMM_WORLD);
+    CHECK(all[0] == s.na && all[1] == s.nb); /* the layout gave every point out once */
+    hd_mpi_stats_t st;
+    rc = hd_mpi_hausdorff(MPI_COMM_WORLD, pa, na, pb, nb, &opt, &got, &st, &err);
+    CHECK(rc == HD_OK);
+    if (rc != HD_OK) fprintf(stderr, "rank %d: %s\n", rank_, err.message);
+    CHECK(SAME_BITS(got.distance, ref.distance));
+    CHECK(SAME_BITS(got.ab.distance2, ref.ab.distance2));
+    CHECK(SAME_BITS(got.ba.distance2, ref.ba.distance2));
+    CHECK(SAME_BITS(got.ab.distance, ref.ab.distance));
+    CHECK(got.ab.i == ref.ab.i && got.ab.j == ref.ab.j);
+    CHECK(got.ba.i == ref.ba.i && got.ba.j == ref.ba.j);
+    CHECK(SAME_BITS(got.alpha, ref.alpha));
+    CHECK(got.disjoint == ref.disjoint);
+    CHECK(st.points == s.na + s.nb && st.ranks == K_ && st.rounds == 2);
+    if (got.ab.i != ref.ab.i || got.ab.j != ref.ab.j || got.ba.i != ref.ba.i || got.ba.j != ref.ba.j ||
+        !SAME_BITS(got.distance, ref.distance))
+        fprintf(stderr, "rank %d: got ab %.17g (%zu,%zu) ba %.17g (%zu,%zu); expected ab %.17g (%zu,%zu) ba "
+                        "%.17g (%zu,%zu)\n",
+                rank_, got.ab.distance, got.ab.i, got.ab.j, got.ba.distance, got.ba.i, got.ba.j,
+                ref.ab.distance, ref.ab.i, ref.ab.j, ref.ba.distance, ref.ba.i, ref.ba.j);
+    /* the directed call too, on one layout */
+    if (how == LAY_HOLES) {
+        hd_result_t d;
+        rc = hd_mpi_directed(MPI_COMM_WORLD, pa, na, pb, nb, &opt, &d, NULL, &err);
+        CHECK(rc == HD_OK);
+        CHECK(SAME_BITS(d.distance2, ref.ab.distance2) && d.i == ref.ab.i && d.j == ref.ab.j);
+        double alpha = -1;
+        int disjoint = -1;
+        CHECK(hd_mpi_overlap(MPI_COMM_WORLD, pa, na, pb, nb, &alpha, &disjoint, &err) == HD_OK);
+        CHECK(SAME_BITS(alpha, ref.alpha) && disjoint == ref.disjoint);
+    }
+    free(s.a);
+    free(s.b);
+}
+
+/* The same code and message on every rank. */
+static void check_agreed(int rc, int expected, const hd_error_t *err, const char *must_contain) {
+    CHECK(rc == expected);
+    char msg[1024];
+    memcpy(msg, err->message, sizeof msg);
+    MPI_Bcast(msg, (int)sizeof msg, MPI_CHAR, 0, MPI_COMM_WORLD);
+    CHECK(strcmp(msg, err->message) == 0);
+    CHECK(err->code == expected);
+    CHECK(strstr(err->message, must_contain) != NULL);
+    if (rc != expected || !strstr(err->message, must_contain))
+        fprintf(stderr, "rank %d: %s: %s\n", rank_, hd_err_name(rc), err->message);
+}
+
+static void check_errors(void) {
+    double a[30], b[30];
+    for (int k = 0; k < 30; k++) a[k] = k, b[k] = k + 0.5;
+    int bad = K_ - 1; /* the rank with the bad input */
+    hd_mpi_part_t pa = {hd_points_f64(a, 10), 10 * (size_t)rank_}, pb = {hd_points_f64(b, 10), 10 * (size_t)rank_};
+    hd_error_t err;
+    hd_symmetric_t r;
+
+    snprintf(context_, sizeof context_, "a NaN on rank %d only", bad);
+    double nan_a[30];
+    memcpy(nan_a, a, sizeof a);
+    if (rank_ == bad) nan_a[7] = NAN;
+    hd_mpi_part_t pn = {hd_points_f64(nan_a, 10), 10 * (size_t)rank_};
+    check_agreed(hd_mpi_hausdorff(MPI_COMM_WORLD, &pn, 1, &pb, 1, NULL, &r, NULL, &err), HD_ENONFINITE, &err,
+                 "rank");
+
+    snprintf(context_, sizeof context_, "a coordinate of 1e200 on rank %d only", bad);
+    double big[30];
+    memcpy(big, b, sizeof b);
+    if (rank_ == bad) big[4] = 1e200;
+    hd_mpi_part_t pbig = {hd_points_f64(big, 10), 10 * (size_t)rank_};
+    check_agreed(hd_mpi_hausdorff(MPI_COMM_WORLD, &pa, 1, &pbig, 1, NULL, &r, NULL, &err), HD_ERANGE, &err,
+                 "B (part 0");
+
+    snprintf(context_, sizeof context_, "threads = -1 on rank %d only", bad);
+    hd_options_t opt;
+    hd_options_init(&opt);
+    opt.threads = rank_ == bad ? -1 : 1;
+    check_agreed(hd_mpi_hausdorff(MPI_COMM_WORLD, &pa, 1, &pb, 1, &opt, &r, NULL, &err), HD_EINVAL, &err,
+                 "threads");
+
+    snprintf(context_, sizeof context_, "B's parts share indices across ranks");
+    hd_mpi_part_t same = {hd_points_f64(b, 10), rank_ == bad ? 5 : 10 * (size_t)rank_};
+    if (K_ > 1)
+        check_agreed(hd_mpi_hausdorff(MPI_COMM_WORLD, &pa, 1, &same, 1, NULL, &r, NULL, &err), HD_EINVAL, &err,
+                     "share indices");
+    hd_mpi_part_t twice[2] = {pb, pb};
+    check_agreed(hd_mpi_hausdorff(MPI_COMM_WORLD, &pa, 1, twice, 2, NULL, &r, NULL, &err), HD_EINVAL, &err,
+                 "share indices");
+
+    snprintf(context_, sizeof context_, "B empty on every rank");
+    check_agreed(hd_mpi_hausdorff(MPI_COMM_WORLD, &pa, 1, NULL, 0, NULL, &r, NULL, &err), HD_EEMPTY, &err,
+                 "point set B is empty");
+
+    snprintf(context_, sizeof context_, "result NULL on rank %d only", bad);
+    check_agreed(hd_mpi_hausdorff(MPI_COMM_WORLD, &pa, 1, &pb, 1, NULL, rank_ == bad ? NULL : &r, NULL, &err),
+                 HD_EINVAL, &err, "NULL");
+
+    /* and after all that, a good call still works */
+    snprintf(context_, sizeof context_, "a good call after the failures");
+    CHECK(hd_mpi_hausdorff(MPI_COMM_WORLD, &pa, 1, &pb, 1, NULL, &r, NULL, &err) == HD_OK);
+    CHECK(r.ab.distance2 == 0.75 && r.ab.i == 0 && r.ab.j == 0);
+}
+
+int main(int argc, char **argv) {
+    MPI_Init(&argc, &argv);
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
+    MPI_Comm_size(MPI_COMM_WORLD, &K_);
+    const char *only = argc > 1 ? argv[1] : NULL; /* "errors" or a set number */
+    if (!only || strcmp(only, "errors") == 0) check_errors();
+    for (int which = 0; which < DS_COUNT; which++) {
+        if (only && strcmp(only, "errors") != 0 && atoi(only) != which) continue;
+        if (only && strcmp(only, "errors") == 0) break;
+        for (int how = 0; how < LAY_COUNT; how++) check_equal(which, how, 1000 + (uint64_t)which);
+    }
+    int all[2] = {failures, checks}, sum[2];
+    MPI_Reduce(all, sum, 2, MPI_INT, MPI_SUM, 0, MPI_COMM_WORLD);
+    int any = failures > 0, anyall = 0;
+    MPI_Allreduce(&any, &anyall, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+    if (rank_ == 0) printf("mpi_api on %d ranks: %d checks, %d failed\n", K_, sum[1], sum[0]);
+    MPI_Finalize();
+    return anyall ? 1 : 0;
+}

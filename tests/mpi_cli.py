@@ -1,0 +1,135 @@
+"""hausdorff-mpi on K ranks prints what hausdorff prints, bit for bit:
+the same distances, witnesses (global and as file + index), alpha, counts
+and files, in the JSON and in the report for a person; and bad input on one
+rank is one clear message and the same exit status from every rank, never a
+hang.  Standard library only; run as:
+    mpi_cli.py HAUSDORFF HAUSDORFF_MPI K MPIRUN [MPIRUN ARGS...]
+Random points come from random.Random(SEED); a failure prints the seed.
+"""
+import json
+import os
+import random
+import subprocess
+import sys
+import tempfile
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+DATA = os.path.join(os.path.dirname(HERE), "data")
+SEED = 1414
+SAME_KEYS = ["hausdorff", "directed_ab", "directed_ba", "witness_ab", "witness_ba", "witness_ab_files",
+             "witness_ba_files", "alpha", "disjoint", "n_a", "n_b", "file_a", "file_b", "tiles_a", "tiles_b",
+             "skipped_a", "skipped_b", "requested_algorithm"]
+
+
+def single(tool, *args):
+    p = subprocess.run([tool] + list(args), capture_output=True, timeout=120)
+    return p.returncode, p.stdout.decode(), p.stderr.decode()
+
+
+def ranks(mpirun, k, tool, *args):
+    p = subprocess.run(mpirun + ["-n", str(k), tool] + list(args), capture_output=True, timeout=120)
+    return p.returncode, p.stdout.decode(), p.stderr.decode()
+
+
+def write(path, text):
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    with open(path, "w") as f:
+        f.write(text)
+    return path
+
+
+def xyz(points):
+    return "".join("%r %r %r\n" % p for p in points)
+
+
+def make_tiles(tmp, rng):
+    """A: a directory of 7 tiles of a jittered lattice (ties across tiles
+    and regions, a duplicate point in two tiles, an empty-looking gap);
+    B: @list of 5 tiles of the same lattice shifted half a step in x, one
+    tile far away (a nearest neighbour regions away)."""
+    pts = [(float(x), float(y), float(z)) for x in range(9) for y in range(9) for z in range(6)]
+    rng.shuffle(pts)
+    a = pts[:300] + [pts[0]]
+    for t in range(7):
+        write(os.path.join(tmp, "A", "t%d.xyz" % t), xyz(a[t * 43:(t + 1) * 43]))
+    b = [(x + 0.5, y, z) for (x, y, z) in pts[100:400]]
+    names = []
+    for t in range(4):
+        names.append(write(os.path.join(tmp, "B", "b%d.xyz" % t), xyz(b[t * 75:(t + 1) * 75])))
+    names.append(write(os.path.join(tmp, "B", "far.xyz"), xyz([(40.0, 40.0, 40.0), (40.0, 40.0, 41.0)])))
+    write(os.path.join(tmp, "B", "list.txt"), "".join(os.path.basename(n) + "\n" for n in names))
+    return os.path.join(tmp, "A"), "@" + os.path.join(tmp, "B", "list.txt")
+
+
+def main():
+    hausdorff, tool, k, mpirun = sys.argv[1], sys.argv[2], int(sys.argv[3]), sys.argv[4:]
+    failures = []
+
+    def check(cond, what):
+        if not cond:
+            failures.append(what)
+            print("FAIL (K=%d, seed %d): %s" % (k, SEED, what), file=sys.stderr)
+
+    def same_json(args):
+        rc1, out1, err1 = single(hausdorff, "--json", *args)
+        rc2, out2, err2 = ranks(mpirun, k, tool, "--json", *args)
+        check(rc1 == 0 and rc2 == 0, "%s: exit %d / %d: %s %s" % (args, rc1, rc2, err1, err2))
+        if rc1 or rc2:
+            return
+        j1, j2 = json.loads(out1), json.loads(out2)
+        for key in SAME_KEYS:
+            check(j1.get(key) == j2.get(key), "%s: %s: %r != %r" % (args, key, j1.get(key), j2.get(key)))
+        m = j2.get("mpi", {})
+        check(m.get("ranks") == k and len(m.get("seconds_per_rank", [])) == k, "%s: mpi figures %r" % (args, m))
+
+    def same_text(args):
+        rc1, out1, _ = single(hausdorff, *args)
+        rc2, out2, err2 = ranks(mpirun, k, tool, *args)
+        keep = lambda out: [l for l in out.splitlines() if not l.startswith(("time:", "mpi:"))]
+        check(rc1 == 0 and rc2 == 0 and keep(out1) == keep(out2), "%s: text differs:\n%s\n%s%s" %
+              (args, out1, out2, err2))
+        check(out2.count("mpi: %d ranks" % k) == 1, "%s: no mpi line once: %s" % (args, out2))
+
+    rng = random.Random(SEED)
+    with tempfile.TemporaryDirectory() as tmp:
+        lion, head = os.path.join(DATA, "cgal_lion.ply"), os.path.join(DATA, "cgal_lion_head.ply")
+        same_json([lion, head])
+        same_text([lion, head])
+        A, B = make_tiles(tmp, rng)
+        same_json([A, B])
+        same_json(["--directed", B, A])
+        same_text([A, B])
+        # 1e-9 and 1e9 scales
+        small = [tuple(rng.uniform(0, 1e-9) for _ in range(3)) for _ in range(200)]
+        big = [tuple(1e9 + rng.uniform(0, 1) for _ in range(3)) for _ in range(200)]
+        for name, pts in (("small", small), ("big", big)):
+            for t in range(3):
+                write(os.path.join(tmp, name, "a%d.xyz" % t), xyz(pts[t * 50:(t + 1) * 50]))
+            write(os.path.join(tmp, name + "_b.xyz"), xyz(pts[25:200:3]))
+            same_json([os.path.join(tmp, name), os.path.join(tmp, name + "_b.xyz")])
+
+        # Bad input in the last tile of A, which the last rank reads: one
+        # message naming it, exit 2 from every rank, within the timeout.
+        write(os.path.join(tmp, "bad", "a0.xyz"), xyz(small[:50]))
+        write(os.path.join(tmp, "bad", "a1.xyz"), xyz(small[50:100]))
+        write(os.path.join(tmp, "bad", "a2.xyz"), xyz(small[100:140]) + "1 2 zebra\n")
+        rc, out, err = ranks(mpirun, k, tool, os.path.join(tmp, "bad"), os.path.join(tmp, "small_b.xyz"))
+        lines = [l for l in err.splitlines() if l.startswith("hausdorff-mpi:")]
+        check(rc == 2, "bad tile: exit %d, expected 2: %s" % (rc, err))
+        check(len(lines) == 1 and "a2.xyz:41" in lines[0], "bad tile: one message naming a2.xyz:41: %r" % err)
+        check(out == "", "bad tile: nothing on stdout: %r" % out)
+        rc1, _, err1 = single(hausdorff, os.path.join(tmp, "bad"), os.path.join(tmp, "small_b.xyz"))
+        check(rc1 == 2 and err1.strip().split(": ", 1)[1] in lines[0] if lines else False,
+              "bad tile: hausdorff's message %r within %r" % (err1, lines))
+        # A missing file: every rank fails alike.
+        rc, out, err = ranks(mpirun, k, tool, os.path.join(tmp, "nope.xyz"), lion)
+        check(rc == 2 and err.count("nope.xyz") == 1, "missing file: exit %d, %r" % (rc, err))
+        # Per-point outputs are refused, once.
+        rc, out, err = ranks(mpirun, k, tool, "--percentile", "95", lion, head)
+        check(rc == 1 and err.count("hausdorff-mpi:") == 1, "--percentile: exit %d, %r" % (rc, err))
+    print("mpi_cli on %d ranks: %s" % (k, "%d failed" % len(failures) if failures else "passed"))
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
