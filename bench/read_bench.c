@@ -3,6 +3,7 @@
  * the time `cat` takes to stream the same file to /dev/null.
  *
  *   read_bench [-n POINTS] [-r RUNS] [-d DIR] [-t THREADS] [FORMAT...]
+ *   read_bench [-r RUNS] [-t THREADS] -f FILE...
  *
  * For each format (all by default) it writes POINTS points (10 000 000 by
  * default, seeded uniform in [-100, 100]^3) to DIR (default /tmp), streams
@@ -18,11 +19,16 @@
  * ("%.6f"), except the "xyz17" row, which uses the 17 significant digits
  * that round-trip a double (where the fast path of number.c gives way to
  * strtod).  Binary PCD, LAS, NPY, STL and PLY rows read straight from the
- * mapping.  Timings are wall-clock (CLOCK_MONOTONIC); nothing is asserted.
+ * mapping.  The "laz" and "laz10" rows hold the LAS row's integers
+ * LASzip-compressed (tests/internal/lazwrite.c) as point format 6 (layered)
+ * and 0 (pointwise), chunks of 50 000 decoded in parallel.  With -f the
+ * rows are the given files instead (their base names), read where they
+ * are and kept: real data, e.g. a LAZ file against its LAS counterpart.  Timings are wall-clock (CLOCK_MONOTONIC); nothing is asserted.
  */
 #include "gen.h"
 
 #include "benchutil.h"
+#include "lazwrite.h"
 
 #include <hausdorff.h>
 #include <stdio.h>
@@ -162,6 +168,21 @@ static int write_file(const char *fmt, const char *path, const double *p, size_t
             }
             fwrite(rec, 1, 30, f);
         }
+    } else if (!strncmp(fmt, "laz", 3)) {
+        /* the LAS row's integers, LASzip-compressed in chunks of 50 000:
+         * laz = point format 6 (layered), laz10 = format 0 (pointwise) */
+        lazw_point_t *q = malloc(n * sizeof *q);
+        for (size_t k = 0; k < n; k++) {
+            int32_t X[3];
+            for (int d = 0; d < 3; d++) X[d] = (int32_t)(p[3 * k + d] * 1e6);
+            q[k] = (lazw_point_t){X[0], X[1], X[2], 1, 1, 0};
+        }
+        lazw_opts_t o = {strcmp(fmt, "laz10") ? 6 : 0, 0, 50000, NULL, 0, {1e-6, 1e-6, 1e-6}, {0, 0, 0}, 0};
+        tf_buf_t b = {0};
+        lazw_encode(&b, &o, q, n);
+        fwrite(b.data, 1, b.size, f);
+        tf_free(&b);
+        free(q);
     } else if (!strcmp(fmt, "npy")) {
         char h[128];
         int len = snprintf(h, sizeof h, "{'descr': '<f8', 'fortran_order': False, 'shape': (%zu, 3), }", n);
@@ -179,17 +200,18 @@ static int write_file(const char *fmt, const char *path, const double *p, size_t
 }
 
 static const char *const all_formats[] = {"ply_f32", "ply_f64", "ply_ascii", "stl", "obj", "off", "xyz", "xyz17", "csv",
-                                          "pcd_bin", "pcd_z", "pcd_ascii", "las", "npy", NULL};
+                                          "pcd_bin", "pcd_z", "pcd_ascii", "las", "laz", "laz10", "npy", NULL};
 static const char *extension(const char *fmt) {
     if (!strncmp(fmt, "ply", 3)) return "ply";
     if (!strncmp(fmt, "pcd", 3)) return "pcd";
     if (!strcmp(fmt, "xyz17")) return "xyz";
+    if (!strcmp(fmt, "laz10")) return "laz";
     return fmt;
 }
 
 int main(int argc, char **argv) {
     size_t n = 10000000;
-    int runs = 5, threads = 0;
+    int runs = 5, threads = 0, given = 0;
     const char *dir = "/tmp";
     const char *chosen[32];
     int n_chosen = 0;
@@ -198,14 +220,17 @@ int main(int argc, char **argv) {
         else if (!strcmp(argv[k], "-r") && k + 1 < argc) runs = atoi(argv[++k]);
         else if (!strcmp(argv[k], "-d") && k + 1 < argc) dir = argv[++k];
         else if (!strcmp(argv[k], "-t") && k + 1 < argc) threads = atoi(argv[++k]);
+        else if (!strcmp(argv[k], "-f")) given = 1;
         else if (n_chosen < 32) chosen[n_chosen++] = argv[k];
     }
     if (runs < 1 || runs > 99 || n < 3) {
-        fprintf(stderr, "usage: read_bench [-n POINTS] [-r RUNS] [-d DIR] [-t THREADS] [FORMAT...]\n");
+        fprintf(stderr, "usage: read_bench [-n POINTS] [-r RUNS] [-d DIR] [-t THREADS] [FORMAT...]\n"
+                        "       read_bench [-r RUNS] [-t THREADS] -f FILE...\n");
         return 1;
     }
     if (!n_chosen)
         for (int k = 0; all_formats[k]; k++) chosen[n_chosen++] = all_formats[k];
+    if (given) n = 3; /* nothing to generate */
     double *p = malloc(3 * n * sizeof *p);
     gen_rng_t r;
     gen_seed(&r, 1);
@@ -222,14 +247,16 @@ int main(int argc, char **argv) {
         if (m[n] != (unsigned char)(k + 1)) return 1;
         free(m);
     }
-    printf("First touch of a %zu-point double array (%.0f MB): %.3f s (median of %d)\n\n", n, n * 24 / 1e6,
-           bench_median(touch_t, runs), runs);
-    printf("| format | file MB | cat s | read s | read CPU s | read MB/s | Mpoints/s | read / cat |\n"
-           "|---|---|---|---|---|---|---|---|\n");
+    if (!given)
+        printf("First touch of a %zu-point double array (%.0f MB): %.3f s (median of %d)\n\n", n, n * 24 / 1e6,
+               bench_median(touch_t, runs), runs);
+    printf("| %s | file MB | cat s | read s | read CPU s | read MB/s | Mpoints/s | read / cat |\n"
+           "|---|---|---|---|---|---|---|---|\n", given ? "file" : "format");
     for (int c = 0; c < n_chosen; c++) {
         char path[1024], cmd[1100];
         snprintf(path, sizeof path, "%s/read_bench_%d.%s", dir, (int)getpid(), extension(chosen[c]));
-        if (write_file(chosen[c], path, p, n)) {
+        if (given) snprintf(path, sizeof path, "%s", chosen[c]);
+        else if (write_file(chosen[c], path, p, n)) {
             fprintf(stderr, "read_bench: cannot write %s as %s\n", path, chosen[c]);
             return 1;
         }
@@ -260,9 +287,10 @@ int main(int argc, char **argv) {
             count = cl->count;
             hd_cloud_free(cl);
         }
-        unlink(path);
+        if (!given) unlink(path);
+        const char *slash = strrchr(chosen[c], '/'), *row = given && slash ? slash + 1 : chosen[c];
         double ct = bench_median(cat_t, runs), rt = bench_median(read_t, runs), cp = bench_median(cpu_t, runs);
-        printf("| %s | %.0f | %.3f | %.3f | %.3f | %.0f | %.1f | %.1f |\n", chosen[c], mb, ct, rt, cp, mb / rt,
+        printf("| %s | %.1f | %.3f | %.3f | %.3f | %.0f | %.1f | %.1f |\n", row, mb, ct, rt, cp, mb / rt,
                (double)count / rt / 1e6, rt / ct);
         fflush(stdout);
     }

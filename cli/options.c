@@ -82,10 +82,9 @@ void cli_formats(FILE *out) {
     fprintf(out, "  nifti NIfTI-1/2 segmentation masks (.nii, .nii.gz): the surface or every foreground voxel,\n"
                  "        in millimetres (read by the tool, %s)\n",
             nifti_available() ? "available" : "unavailable: built without libnifti2");
-    fprintf(out, "Extensions: .ply .obj .off .stl; .xyz .txt .csv .pts .asc; .pcd .las .npy; .nii .nii.gz.\n"
+    fprintf(out, "Extensions: .ply .obj .off .stl; .xyz .txt .csv .pts .asc; .pcd .las .laz .npy; .nii .nii.gz.\n"
                  "csv, txt, pts and asc name the xyz reader too (--format csv, csv:-).\n"
-                 "One file's format: FORMAT:PATH (xyz:-, ply:scan.dat).\n"
-                 "LAZ is not read: convert it with 'laszip -i in.laz -o out.las' or 'pdal translate in.laz out.las'.\n");
+                 "One file's format: FORMAT:PATH (xyz:-, ply:scan.dat).\n");
 }
 
 static int bad(const char *fmt, const char *arg) {

@@ -10,7 +10,7 @@
 # into $(OUT)/libcli_fuzz.a (with NIfTI support, without libpng).  Each
 # target is then one small file compiled and linked against them:
 #
-#   fuzz_FORMAT         fuzz/fuzz_reader.c, a reader as points (8 formats)
+#   fuzz_FORMAT         fuzz/fuzz_reader.c, a reader as points (9 formats)
 #   fuzz_FORMAT_sample  fuzz/fuzz_reader.c, a mesh reader's faces (--sample)
 #   fuzz_nifti          fuzz/fuzz_nifti.c, a NIfTI-1/2 mask through libnifti2
 #                       and cli/nifti.c
@@ -29,7 +29,7 @@ CFLAGS  := -g -O1 -std=c11 -Wall -Wextra $(EXACT) \
            -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE -Iinclude -Isrc $(SAN)
 LIBS    := -lm -lpthread
 
-READERS := ply obj off stl xyz pcd las npy
+READERS := ply obj off stl xyz pcd las npy laz
 MESHES  := ply obj off stl
 TARGETS := $(READERS:%=fuzz_%) $(MESHES:%=fuzz_%_sample) fuzz_nifti fuzz_cli
 

@@ -4,10 +4,10 @@
 #
 #   fuzz/run.sh                           every target
 #   FUZZ_SECONDS=300 fuzz/run.sh ply_sample nifti cli
-#   fuzz/run.sh readers | meshes | all    the 8 vertex targets | the 4 sample ones
+#   fuzz/run.sh readers | meshes | all    the 9 vertex targets | the 4 sample ones
 #
 # Targets (docs/formats.md, "Fuzzing"):
-#   ply obj off stl xyz pcd las npy   a reader as points     seeds tests/corpus/FORMAT/
+#   ply obj off stl xyz pcd las npy laz  a reader as points    seeds tests/corpus/FORMAT/
 #   ply_sample ... stl_sample         a mesh's faces sampled seeds tests/corpus/FORMAT/
 #   nifti                             a NIfTI mask           seeds tests/corpus/nifti/
 #   cli                               the argument parser    seeds tests/corpus/cli/
@@ -32,7 +32,7 @@ CC=${FUZZ_CC:-clang}
 SECONDS_EACH=${FUZZ_SECONDS:-60}
 OUT=${FUZZ_BUILD:-build-fuzz}
 JOBS=${FUZZ_JOBS:-2}
-READERS="ply obj off stl xyz pcd las npy"
+READERS="ply obj off stl xyz pcd las npy laz"
 MESHES="ply_sample obj_sample off_sample stl_sample"
 ALL="$READERS $MESHES nifti cli"
 

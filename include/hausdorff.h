@@ -536,7 +536,7 @@ HD_EXTERN const char *hd_format_description(const char *name);
 /* The name of the format that `path`'s extension selects, in any case
  * ("ply" for "scan.PLY", "xyz" for "points.csv"), as hd_read_file chooses
  * it when no format is given; NULL when the extension names no format the
- * library reads (no extension, ".laz", ".dat").  The path is not opened, so
+ * library reads (no extension, ".dat", ".nii").  The path is not opened, so
  * hd_read_file may still refuse the content.  Never fails; thread safe. */
 HD_EXTERN const char *hd_format_of_path(const char *path);
 

@@ -16,7 +16,9 @@ for group in "$@"; do
     build)  add gcc make cmake pkg-config libc6-dev ;;
     extras) add libpng-dev libnifti2-dev zlib1g-dev ;;
     # python3-nibabel: tests/cli_nifti_reference.py writes MONAI's and medpy's test masks with it.
-    test)   add python3 locales python3-nibabel ;;
+    # nodejs and npm: tests/laz_lazperf.py installs laz-perf (npm) to check
+    # the tests' LAZ files with an independent decoder.
+    test)   add python3 locales python3-nibabel nodejs npm ;;
     # python3-venv and python3-wheel: README's `pip install --no-build-isolation
     # ./python` in a venv (tests/python_venv.sh).
     python) add python3 python3-dev python3-numpy python3-setuptools python3-pytest python3-scipy \

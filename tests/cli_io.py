@@ -80,11 +80,22 @@ def bad_binary_input_exits_2_naming_the_file_and_byte_offset(d):
 
 @test
 def unsupported_and_missing_files_exit_2_with_a_way_out(d):
-    expect_bad(os.path.join(d, "scan.laz"), "laszip -i")
+    expect_bad(os.path.join(d, "scan.laz"), "scan.laz: cannot open")
     expect_bad(os.path.join(d, "missing.ply"), "missing.ply: cannot open")
     expect_bad(write(d, "blob.bin", b"\x01\x02\x03"), "use --format")
     expect_bad(write(d, "las.ply", b"LASF" + b"\0" * 300), "the name says ply but the content is las; use --format las")
     expect_bad(write(d, "x.xyz", "1 2 3\n"), "sampling needs a mesh", args=("--sample", "10"))
+
+
+@test
+def laz_files_are_read_by_extension_and_by_format(d):
+    laz = os.path.join(HERE, "corpus", "laz", "fmt6_channels.laz")
+    rc, out, err = run(laz, laz)
+    assert rc == 0 and "(60 points, laz)" in out and "H(A,B) = 0" in out, (rc, out, err)
+    rc, out, err = run("--format", "laz", "-", laz, stdin=open(laz, "rb").read())
+    assert rc == 0 and "H(A,B) = 0" in out, (rc, out, err)
+    bad = open(laz, "rb").read()[:-40]
+    expect_bad(write(d, "cut.laz", bad), "cut.laz: byte ")
 
 
 @test
@@ -99,9 +110,9 @@ def usage_errors_exit_1(d):
 def formats_version_and_help_describe_the_reader(d):
     rc, out, _ = run("--formats")
     assert rc == 0
-    for name in ("ply", "obj", "off", "stl", "xyz", "pcd", "las", "npy"):
+    for name in ("ply", "obj", "off", "stl", "xyz", "pcd", "las", "laz", "npy"):
         assert ("  %s " % name) in out, (name, out)
-    assert "laszip" in out
+    assert ".laz" in out
     rc, out, _ = run("--version")
     assert rc == 0 and out.startswith("hausdorff ") and out.count(".") >= 2, out
     rc, out, _ = run("--help")

@@ -1,10 +1,10 @@
-# fuzz_smoke.cmake -- every libFuzzer target (fuzz/fuzz.mk: the 8 readers as
+# fuzz_smoke.cmake -- every libFuzzer target (fuzz/fuzz.mk: the 9 readers as
 # points, the 4 mesh readers sampled, NIfTI masks, the argument parser) is
 # built with clang and run for FUZZ_SECONDS (3) from its seeds in
 # tests/corpus/, which hold the inputs of every past finding: a reader or
 # parser that regresses fails here.  It builds in the build directory's
 # fuzz-smoke/ and takes about two minutes on the shared 2-core machine (70 s
-# building, 14 x 3 s fuzzing).  Added to the sanitizer build only (make test-asan, which
+# building, 15 x 3 s fuzzing).  Added to the sanitizer build only (make test-asan, which
 # installs clang through scripts/deps.sh fuzz), or anywhere with
 # -DHD_FUZZ_SMOKE=ON.  Without clang the test fails: it never passes without
 # fuzzing.

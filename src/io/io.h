@@ -100,6 +100,27 @@ int hd__read_pcd(hd__read_t *r);
 int hd__read_las(hd__read_t *r);
 int hd__read_npy(hd__read_t *r);
 
+/* A LAS header as las.c checked it: version minor, header size, offset to
+ * the points, point format (compression bit cleared), record length, point
+ * count (the 64-bit one in 1.4), VLR count, extended VLRs, scale and offset per axis
+ * (finite).  The points start at `offset`. */
+typedef struct hd__las_header {
+    unsigned minor, fmt;
+    size_t header, offset, rec;
+    uint64_t count;
+    uint32_t n_vlr;
+    uint64_t evlr; /* 1.4: where the extended VLRs start (0: none) */
+    double scale[3], shift[3];
+} hd__las_header_t;
+/* The points of a LAZ (LASzip-compressed) file: laz.c.  A chunk may not
+ * claim more than HD__LAZ_POINTS_PER_BYTE points per byte of it: the bound
+ * on the allocation a LAZ file can cause. */
+#define HD__LAZ_POINTS_PER_BYTE 4096
+/* Up to this many points per compressed byte the LAZ reader allocates the
+ * result at once; above, it grows it as points are decoded (laz.c). */
+#define HD__LAZ_EAGER_PER_BYTE 64
+int hd__read_laz(hd__read_t *r, const hd__las_header_t *h);
+
 /* ---- errors with a place --------------------------------------------------- */
 /* "NAME:LINE: what" with err->line set. */
 int hd__io_err_line(hd__read_t *r, int code, long long line, const char *fmt,

@@ -20,8 +20,9 @@
  * extended VLRs the header points to, else the count is wrong (an error,
  * never a silent partial read; a 1.4 legacy count that disagrees with the
  * 64-bit count is refused too); scales and offsets are finite.  A compressed (LAZ) file,
- * recognised by bit 7 of the format byte as LASzip sets it, is refused with
- * the commands that convert it.  Points are converted in parallel from the
+ * recognised by bit 7 of the format byte as LASzip sets it, goes to laz.c
+ * once the header is checked (its record length and count describe the
+ * points before compression).  Points are converted in parallel from the
  * mapping (hd__binary_read).
  */
 #include "io.h"
@@ -54,11 +55,6 @@ int hd__read_las(hd__read_t *r) {
     uint64_t count = hd__ld_u32(d + 107, 0);
     if (header < 227 || header > size)
         return hd__io_err_at(r, HD_EFORMAT, 94, "header size %zu (at least 227, at most the file's %zu bytes)", header, size);
-    if (fmt_byte & 0x80)
-        return hd__io_err_at(r, HD_EUNSUPPORTED, 104,
-                             "compressed (LAZ) point data is not supported; convert it to LAS first, e.g. "
-                             "'laszip -i %s -o out.las' or 'pdal translate %s out.las'",
-                             r->f->name, r->f->name);
     unsigned fmt = fmt_byte & 0x3f;
     if (fmt > 10)
         return hd__io_err_at(r, HD_EUNSUPPORTED, 104, "point data format %u (0 to 10 are defined)", fmt);
@@ -75,6 +71,21 @@ int hd__read_las(hd__read_t *r) {
     if (offset < header || offset > size)
         return hd__io_err_at(r, HD_EFORMAT, 96, "offset to point data %zu is outside [header size %zu, file size %zu]", offset,
                              header, size);
+    double scale[3], shift[3];
+    for (int c = 0; c < 3; c++) {
+        scale[c] = f64_at(d + 131 + 8 * c);
+        shift[c] = f64_at(d + 155 + 8 * c);
+        if (!isfinite(scale[c]) || !isfinite(shift[c]))
+            return hd__io_err_at(r, HD_EFORMAT, (long long)(isfinite(scale[c]) ? 155 + 8 * c : 131 + 8 * c),
+                                 "%c %s is not a finite number", "xyz"[c], isfinite(scale[c]) ? "offset" : "scale factor");
+    }
+    if (fmt_byte & 0x80) {
+        uint64_t evlr = minor >= 4 && header >= 247 && hd__ld_u32(d + 243, 0) > 0 ? hd__ld_u64(d + 235, 0) : 0;
+        hd__las_header_t h = {minor, fmt, header, offset, rec, count, hd__ld_u32(d + 100, 0), evlr, {0}, {0}};
+        memcpy(h.scale, scale, sizeof scale);
+        memcpy(h.shift, shift, sizeof shift);
+        return hd__read_laz(r, &h);
+    }
     if (count > (size - offset) / rec)
         return hd__io_err_at(r, HD_EFORMAT, (long long)size,
                              "file ends inside the points: %llu of %zu bytes declared, room for %zu",
@@ -94,14 +105,6 @@ int hd__read_las(hd__read_t *r) {
                                  "%zu bytes after the %llu declared points (%zu bytes each), and the header names "
                                  "nothing that follows them: the point count is wrong",
                                  size - end, (unsigned long long)count, rec);
-    }
-    double scale[3], shift[3];
-    for (int c = 0; c < 3; c++) {
-        scale[c] = f64_at(d + 131 + 8 * c);
-        shift[c] = f64_at(d + 155 + 8 * c);
-        if (!isfinite(scale[c]) || !isfinite(shift[c]))
-            return hd__io_err_at(r, HD_EFORMAT, (long long)(isfinite(scale[c]) ? 155 + 8 * c : 131 + 8 * c),
-                                 "%c %s is not a finite number", "xyz"[c], isfinite(scale[c]) ? "offset" : "scale factor");
     }
     hd__layout_t L = {(size_t)count, 1, rec, 0, {0, 4, 8}, {HD__T_I32, HD__T_I32, HD__T_I32}, 0, scale, shift, offset};
     return hd__binary_read(r, d + offset, &L);

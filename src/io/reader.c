@@ -127,15 +127,17 @@ static const format_t formats[] = {
      hd__read_xyz, NULL, 0},
     {"pcd", "pcd", "Point Cloud Library PCD v0.7: ascii, binary, binary_compressed; x y z of type F/I/U",
      hd__read_pcd, magic_pcd, 0},
-    {"las", "las", "ASPRS LAS 1.0-1.4, point formats 0-10 (uncompressed; LAZ must be converted)", hd__read_las,
-     magic_las, 0},
+    {"las", "las", "ASPRS LAS 1.0-1.4, point formats 0-10 (compressed ones too, as for laz)", hd__read_las, magic_las,
+     0},
+    {"laz", "laz", "LAZ (LASzip-compressed LAS), point formats 0-10: chunked pointwise and layered, COPC included",
+     hd__read_las, magic_las, 0},
     {"npy", "npy", "NumPy .npy: float32/float64 array of shape (N, 3), either byte order, C or Fortran order",
      hd__read_npy, magic_npy, 0},
 };
 #define N_FORMATS (sizeof formats / sizeof formats[0])
 
 const char *const *hd_formats(void) {
-    static const char *const names[] = {"ply", "obj", "off", "stl", "xyz", "pcd", "las", "npy", NULL};
+    static const char *const names[] = {"ply", "obj", "off", "stl", "xyz", "pcd", "las", "laz", "npy", NULL};
     return names;
 }
 
@@ -324,14 +326,6 @@ static void unload(hd__file_t *f, int mapped) {
     else if (f->size) free((void *)f->data);
 }
 
-static int laz_refused(const char *path, hd_error_t *err) {
-    return hd__err(err, HD_EUNSUPPORTED,
-                   "%s: LAZ (compressed LAS) is not supported; convert it to LAS first, e.g. "
-                   "'laszip -i %s -o out.las', 'las2las -i %s -o out.las' (LAStools) or "
-                   "'pdal translate %s out.las' (PDAL)",
-                   path, path, path, path);
-}
-
 /* Run the reader; with sampling, read vertices as doubles and the faces,
  * then draw the sample into `out`. */
 static int parse(const format_t *fmt, const hd__file_t *f, const hd_read_options_t *opt,
@@ -373,12 +367,9 @@ static int choose(const char *path, const hd_read_options_t *opt, const format_t
     *fmt = NULL;
     *from_extension = 0;
     if (opt->format) {
-        if (strcasecmp(opt->format, "laz") == 0) return laz_refused(path, err);
         *fmt = by_name(opt->format);
         if (!*fmt) return hd__err(err, HD_EUNSUPPORTED, "%s: unknown format '%s'", path, opt->format);
     } else if (strcmp(path, "-") != 0) {
-        const char *ext = extension(path);
-        if (ext && strcasecmp(ext, "laz") == 0) return laz_refused(path, err);
         *fmt = by_extension(path);
         *from_extension = *fmt != NULL;
     }

@@ -45,6 +45,7 @@ static outcome_t regress[] = {
     {"tests/corpus/xyz/regress-pts-count-2e64", HD_EFORMAT, 0, 0, 0, 0},
     {"tests/corpus/pcd/regress-empty-window", HD_EFORMAT, 0, 0, 0, 0},
     {"tests/corpus/npy/regress-empty-shape", HD_EFORMAT, 0, 0, 0, 0},
+    {"tests/corpus/las/regress-laz-repeated-items", HD_EFORMAT, 0, 0, 0, 0},
 };
 #define N_REGRESS (sizeof regress / sizeof regress[0])
 
@@ -99,7 +100,7 @@ static void read_one(const char *path, const char *format, int sample) {
 }
 
 TEST(every_corpus_file_reads_or_is_refused_by_the_contract) {
-    static const char *const formats[] = {"ply", "obj", "off", "stl", "xyz", "pcd", "las", "npy"};
+    static const char *const formats[] = {"ply", "obj", "off", "stl", "xyz", "pcd", "las", "npy", "laz"};
     int files = 0;
     for (size_t f = 0; f < sizeof formats / sizeof formats[0]; f++) {
         char dir[256];

@@ -495,6 +495,8 @@ TEST(every_allocation_of_every_reader_can_fail_cleanly) {
         "tests/corpus/xyz/header.csv",  "tests/corpus/xyz/leica.pts",
         "tests/corpus/pcd/ascii.pcd",   "tests/corpus/pcd/compressed.pcd",
         "tests/corpus/las/v14_fmt6.las", "tests/corpus/npy/f_be_f4.npy",
+        "tests/corpus/laz/fmt3_extra2.laz", "tests/corpus/laz/fmt6_channels.laz",
+        "tests/corpus/laz/fmt3_laszip1_extra1.laz", "tests/corpus/laz/fmt0_repeated_point.laz",
         "data/cgal_lion_head.ply",      "data/orig/lion-head.off",
     };
     for (size_t k = 0; k < sizeof files / sizeof files[0] && !hdt_failed(); k++)

@@ -660,11 +660,13 @@ TEST(format_comes_from_the_option_then_the_extension_then_the_content) {
     CHECK(strstr(e.message, "content is las") && strstr(e.message, "--format las"));
 }
 
-TEST(laz_is_refused_with_the_commands_that_convert_it) {
+TEST(laz_files_are_read_and_a_compressed_las_without_its_laszip_vlr_is_refused) {
     hd_cloud_t *c;
     hd_error_t e;
-    CHECK_RC(hd_read_file("no_such.laz", NULL, &c, &e), HD_EUNSUPPORTED);
-    CHECK(strstr(e.message, "laszip") && strstr(e.message, "pdal translate"));
+    CHECK_RC(hd_read_file("no_such.laz", NULL, &c, &e), HD_EIO);
+    CHECK_RC(hd_read_file("tests/corpus/laz/fmt0_chunks16.laz", NULL, &c, &e), HD_OK);
+    CHECK_EQ(c->count, 40);
+    hd_cloud_free(c);
     /* a LAS file whose point format has the LASzip compression bit */
     size_t n = 2;
     double want[6];
@@ -675,8 +677,9 @@ TEST(laz_is_refused_with_the_commands_that_convert_it) {
     fseek(f, 104, SEEK_SET);
     fputc(0x81, f);
     fclose(f);
-    CHECK_RC(hd_read_file(p, NULL, &c, &e), HD_EUNSUPPORTED);
-    CHECK(strstr(e.message, "LAZ") && strstr(e.message, "laszip"));
+    CHECK_RC(hd_read_file(p, NULL, &c, &e), HD_EFORMAT);
+    CHECK(strstr(e.message, "compressed (LAZ)") && strstr(e.message, "no LASzip VLR"));
+    CHECK_EQ(e.offset, 104);
 }
 
 TEST(every_format_is_listed_with_a_description) {
@@ -685,8 +688,9 @@ TEST(every_format_is_listed_with_a_description) {
         CHECK(hd_format_description(*f) != NULL);
         CHECK(strlen(hd_format_description(*f)) > 10);
     }
-    CHECK_EQ(n, 8);
-    CHECK(hd_format_description("laz") == NULL);
+    CHECK_EQ(n, 9);
+    CHECK(hd_format_description("laz") != NULL);
+    CHECK(hd_format_description("zip") == NULL);
 }
 
 TEST(format_of_path_is_the_format_the_extension_selects) {
@@ -694,7 +698,7 @@ TEST(format_of_path_is_the_format_the_extension_selects) {
     CHECK(strcmp(hd_format_of_path("dir.v2/points.csv"), "xyz") == 0);
     CHECK(strcmp(hd_format_of_path("m.coff"), "off") == 0);
     CHECK(strcmp(hd_format_of_path("cloud.npy"), "npy") == 0);
-    CHECK(hd_format_of_path("scan.laz") == NULL);
+    CHECK(strcmp(hd_format_of_path("scan.laz"), "laz") == 0);
     CHECK(hd_format_of_path("dir.ply/README") == NULL);
     CHECK(hd_format_of_path("mask.nii.gz") == NULL);
     CHECK(hd_format_of_path("noext") == NULL);

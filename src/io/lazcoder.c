@@ -1,0 +1,210 @@
+/*
+ * lazcoder.c -- the adaptive models and the integer compressor of LASzip's
+ * range coder (lazcoder.h has the format's facts).  A model's state is a
+ * pure function of the symbols coded with it, so an encoder and a decoder
+ * that code the same symbols hold the same distributions at every step:
+ * that is the whole contract, and the update rules below are the format.
+ *
+ * Symbol model update: the running total grows by the symbols seen since
+ * the last update (the first time: one per symbol, the initial counts);
+ * past 2^15 every count is halved, rounding up, and the total recomputed;
+ * then dist[k] = (floor(2^31 / total) * sum_{j<k} count[j]) >> 16, each
+ * product modulo 2^32 as the format computes it.  Bit model: the same with
+ * 2^13 and p0 = (c0 * floor(2^31 / count)) >> 18.
+ */
+#include "lazcoder.h"
+
+#include <assert.h>
+#include <stdlib.h>
+
+void hd__bitmodel_init(hd__bitmodel_t *m) {
+    m->c0 = 1;
+    m->count = 2;
+    m->p0 = 1u << (HD__BM_SHIFT - 1);
+    m->cycle = m->until = 4;
+}
+
+void hd__bitmodel_update(hd__bitmodel_t *m) {
+    if ((m->count += m->cycle) > HD__BM_MAX) {
+        m->count = (m->count + 1) >> 1;
+        m->c0 = (m->c0 + 1) >> 1;
+        if (m->c0 == m->count) m->count++;
+    }
+    uint32_t scale = 0x80000000u / m->count;
+    m->p0 = (m->c0 * scale) >> (31 - HD__BM_SHIFT);
+    m->cycle = (5 * m->cycle) >> 2;
+    if (m->cycle > 64) m->cycle = 64;
+    m->until = m->cycle;
+}
+
+int hd__symmodel_new(hd__symmodel_t *m, uint32_t n) {
+    assert(n >= 2 && n <= 2048);
+    m->n = n;
+    m->tsize = m->tshift = 0;
+    if (n > 16) {
+        uint32_t bits = 3;
+        while (n > (1u << (bits + 2))) bits++;
+        m->tsize = 1u << bits;
+        m->tshift = HD__DM_SHIFT - bits;
+    }
+    m->dist = hd__malloc_array(2 * (size_t)n + (m->tsize ? m->tsize + 2 : 0), sizeof(uint32_t));
+    if (!m->dist) return HD_ENOMEM;
+    m->count = m->dist + n;
+    m->table = m->tsize ? m->dist + 2 * n : NULL;
+    hd__symmodel_init(m);
+    return HD_OK;
+}
+
+void hd__symmodel_init(hd__symmodel_t *m) {
+    m->total = 0;
+    m->cycle = m->n;
+    for (uint32_t k = 0; k < m->n; k++) m->count[k] = 1;
+    hd__symmodel_update(m);
+    m->until = m->cycle = (m->n + 6) >> 1;
+}
+
+void hd__symmodel_update(hd__symmodel_t *m) {
+    if ((m->total += m->cycle) > HD__DM_MAX) {
+        m->total = 0;
+        for (uint32_t k = 0; k < m->n; k++) m->total += (m->count[k] = (m->count[k] + 1) >> 1);
+    }
+    uint32_t scale = 0x80000000u / m->total, sum = 0, s = 0;
+    for (uint32_t k = 0; k < m->n; k++) {
+        m->dist[k] = (scale * sum) >> (31 - HD__DM_SHIFT);
+        sum += m->count[k];
+        if (m->table) {
+            uint32_t w = m->dist[k] >> m->tshift;
+            while (s < w) m->table[++s] = k - 1;
+        }
+    }
+    if (m->table) {
+        m->table[0] = 0;
+        while (s <= m->tsize) m->table[++s] = m->n - 1;
+    }
+    m->cycle = (5 * m->cycle) >> 2;
+    uint32_t max = (m->n + 6) << 3;
+    if (m->cycle > max) m->cycle = max;
+    m->until = m->cycle;
+}
+
+void hd__symmodel_free(hd__symmodel_t *m) {
+    free(m->dist);
+    m->dist = m->count = m->table = NULL;
+}
+
+int hd__intcoder_new(hd__intcoder_t *ic, uint32_t bits, uint32_t contexts) {
+    assert(bits >= 1 && bits <= 32);
+    memset(ic, 0, sizeof *ic);
+    ic->bits = bits;
+    ic->contexts = contexts;
+    if (bits < 32) {
+        ic->corr_bits = bits;
+        ic->corr_range = 1u << bits;
+        ic->corr_min = -(int32_t)(ic->corr_range / 2);
+        ic->corr_max = ic->corr_min + (int32_t)ic->corr_range - 1;
+    } else {
+        ic->corr_bits = 32;
+        ic->corr_range = 0;
+        ic->corr_min = INT32_MIN;
+        ic->corr_max = INT32_MAX;
+    }
+    ic->mbits = calloc(contexts, sizeof *ic->mbits);
+    if (!ic->mbits) return HD_ENOMEM;
+    for (uint32_t i = 0; i < contexts; i++)
+        if (hd__symmodel_new(&ic->mbits[i], ic->corr_bits + 1)) goto fail;
+    hd__bitmodel_init(&ic->corr0);
+    for (uint32_t i = 1; i <= ic->corr_bits; i++)
+        if (hd__symmodel_new(&ic->corr[i], 1u << (i <= 8 ? i : 8))) goto fail;
+    return HD_OK;
+fail:
+    hd__intcoder_free(ic);
+    return HD_ENOMEM;
+}
+
+void hd__intcoder_init(hd__intcoder_t *ic) {
+    for (uint32_t i = 0; i < ic->contexts; i++) hd__symmodel_init(&ic->mbits[i]);
+    hd__bitmodel_init(&ic->corr0);
+    for (uint32_t i = 1; i <= ic->corr_bits; i++) hd__symmodel_init(&ic->corr[i]);
+    ic->k = 0;
+}
+
+void hd__intcoder_free(hd__intcoder_t *ic) {
+    if (ic->mbits)
+        for (uint32_t i = 0; i < ic->contexts; i++) hd__symmodel_free(&ic->mbits[i]);
+    free(ic->mbits);
+    ic->mbits = NULL;
+    for (uint32_t i = 1; i <= 32; i++) hd__symmodel_free(&ic->corr[i]);
+}
+
+void hd__median5_init(hd__median5_t *m) {
+    memset(m->v, 0, sizeof m->v);
+    m->high = 1;
+}
+/* LASzip's streaming median: v[2] approximates the median of the last
+ * five values; the update rule is part of the format. */
+void hd__median5_add(hd__median5_t *m, int32_t x) {
+    int32_t *v = m->v;
+    if (m->high) {
+        if (x < v[2]) {
+            v[4] = v[3];
+            v[3] = v[2];
+            if (x < v[0]) {
+                v[2] = v[1];
+                v[1] = v[0];
+                v[0] = x;
+            } else if (x < v[1]) {
+                v[2] = v[1];
+                v[1] = x;
+            } else {
+                v[2] = x;
+            }
+        } else {
+            if (x < v[3]) {
+                v[4] = v[3];
+                v[3] = x;
+            } else {
+                v[4] = x;
+            }
+            m->high = 0;
+        }
+    } else {
+        if (v[2] < x) {
+            v[0] = v[1];
+            v[1] = v[2];
+            if (v[4] < x) {
+                v[2] = v[3];
+                v[3] = v[4];
+                v[4] = x;
+            } else if (v[3] < x) {
+                v[2] = v[3];
+                v[3] = x;
+            } else {
+                v[2] = x;
+            }
+        } else {
+            if (v[1] < x) {
+                v[0] = v[1];
+                v[1] = x;
+            } else {
+                v[0] = x;
+            }
+            m->high = 1;
+        }
+    }
+}
+
+/* number_return_map (POINT10): the return context m of return r of n. */
+const unsigned char hd__laz_rmap10[8][8] = {
+    {15, 14, 13, 12, 11, 10, 9, 8}, {14, 0, 1, 3, 6, 10, 10, 9},   {13, 1, 2, 4, 7, 11, 11, 10},
+    {12, 3, 4, 5, 8, 12, 12, 11},   {11, 6, 7, 8, 9, 13, 13, 12},  {10, 10, 11, 12, 13, 14, 14, 13},
+    {9, 10, 11, 12, 13, 14, 15, 14}, {8, 9, 10, 11, 12, 13, 14, 15}};
+/* number_return_map_6ctx (POINT14). */
+const unsigned char hd__laz_rmap14[16][16] = {
+    {0, 1, 2, 3, 4, 5, 3, 4, 4, 5, 5, 5, 5, 5, 5, 5}, {1, 0, 1, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3},
+    {2, 1, 2, 4, 4, 4, 4, 4, 4, 4, 4, 3, 3, 3, 3, 3}, {3, 3, 4, 5, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4},
+    {4, 3, 4, 4, 5, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4}, {5, 3, 4, 4, 4, 5, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4},
+    {3, 3, 4, 4, 4, 4, 5, 4, 4, 4, 4, 4, 4, 4, 4, 4}, {4, 3, 4, 4, 4, 4, 4, 5, 4, 4, 4, 4, 4, 4, 4, 4},
+    {4, 3, 4, 4, 4, 4, 4, 4, 5, 4, 4, 4, 4, 4, 4, 4}, {5, 3, 4, 4, 4, 4, 4, 4, 4, 5, 4, 4, 4, 4, 4, 4},
+    {5, 3, 4, 4, 4, 4, 4, 4, 4, 4, 5, 4, 4, 4, 4, 4}, {5, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5, 4, 4, 4},
+    {5, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5, 5, 4, 4}, {5, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5, 5, 4},
+    {5, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5, 5}, {5, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5}};

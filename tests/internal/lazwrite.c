@@ -1,0 +1,500 @@
+/*
+ * lazwrite.c -- the tests' LAZ writer (lazwrite.h).  The encoder mirrors
+ * the decoder of src/io/lazcoder.h: an interval [base, base + length) of
+ * 32 bits, a byte shifted out whenever length < 2^24, a carry propagated
+ * back through the bytes already written; done() leaves one or two final
+ * bytes and pads with zeros to four, so that a decoder, which reads four
+ * bytes ahead, consumes the stream exactly.
+ */
+#include "lazwrite.h"
+
+#include "io/lazcoder.h"
+
+#include <assert.h>
+#include <stdlib.h>
+#include <string.h>
+
+lazw_layout_t lazw_last;
+
+typedef struct {
+    tf_buf_t out;
+    uint32_t base, length;
+} enc_t;
+
+static void enc_init(enc_t *e) {
+    memset(e, 0, sizeof *e);
+    e->length = 0xFFFFFFFFu;
+}
+static void carry(enc_t *e) {
+    size_t i = e->out.size;
+    while (i > 0 && e->out.data[i - 1] == 0xFF) e->out.data[--i] = 0;
+    assert(i > 0);
+    e->out.data[i - 1]++;
+}
+static void renorm(enc_t *e) {
+    do {
+        tf_u8(&e->out, e->base >> 24);
+        e->base <<= 8;
+    } while ((e->length <<= 8) < HD__AC_MIN);
+}
+static void enc_bit(enc_t *e, hd__bitmodel_t *m, uint32_t sym) {
+    uint32_t x = m->p0 * (e->length >> HD__BM_SHIFT);
+    if (sym == 0) {
+        e->length = x;
+        m->c0++;
+    } else {
+        uint32_t b = e->base;
+        e->base += x;
+        e->length -= x;
+        if (b > e->base) carry(e);
+    }
+    if (e->length < HD__AC_MIN) renorm(e);
+    if (--m->until == 0) hd__bitmodel_update(m);
+}
+static void enc_symbol(enc_t *e, hd__symmodel_t *m, uint32_t sym) {
+    assert(sym < m->n);
+    uint32_t x, b = e->base;
+    if (sym == m->n - 1) {
+        x = m->dist[sym] * (e->length >> HD__DM_SHIFT);
+        e->base += x;
+        e->length -= x;
+    } else {
+        x = m->dist[sym] * (e->length >>= HD__DM_SHIFT);
+        e->base += x;
+        e->length = m->dist[sym + 1] * e->length - x;
+    }
+    if (b > e->base) carry(e);
+    if (e->length < HD__AC_MIN) renorm(e);
+    m->count[sym]++;
+    if (--m->until == 0) hd__symmodel_update(m);
+}
+static void enc_raw(enc_t *e, unsigned bits, uint32_t sym) {
+    if (bits > 19) {
+        enc_raw(e, 16, sym & 0xFFFF);
+        sym >>= 16;
+        bits -= 16;
+    }
+    uint32_t b = e->base;
+    e->base += sym * (e->length >>= bits);
+    if (b > e->base) carry(e);
+    if (e->length < HD__AC_MIN) renorm(e);
+}
+static void enc_done(enc_t *e) {
+    uint32_t b = e->base;
+    int another = 1;
+    if (e->length > 2 * HD__AC_MIN) {
+        e->base += HD__AC_MIN;
+        e->length = HD__AC_MIN >> 1;
+    } else {
+        e->base += HD__AC_MIN >> 1;
+        e->length = HD__AC_MIN >> 9;
+        another = 0;
+    }
+    if (b > e->base) carry(e);
+    renorm(e);
+    tf_u8(&e->out, 0);
+    tf_u8(&e->out, 0);
+    if (another) tf_u8(&e->out, 0);
+}
+
+static void ic_encode(hd__intcoder_t *ic, enc_t *e, int32_t pred, int32_t real, uint32_t ctx) {
+    int64_t c = (int32_t)((uint32_t)real - (uint32_t)pred);
+    if (ic->corr_range) {
+        if (c < ic->corr_min) c += ic->corr_range;
+        else if (c > ic->corr_max) c -= ic->corr_range;
+    }
+    int64_t c1 = c <= 0 ? -c : c - 1;
+    uint32_t k = 0;
+    while (c1) {
+        c1 >>= 1;
+        k++;
+    }
+    ic->k = k;
+    enc_symbol(e, &ic->mbits[ctx], k);
+    if (k) {
+        c = c < 0 ? c + (((int64_t)1 << k) - 1) : c - 1;
+        if (k <= 8) {
+            enc_symbol(e, &ic->corr[k], (uint32_t)c);
+        } else {
+            unsigned k1 = k - 8;
+            enc_symbol(e, &ic->corr[k], (uint32_t)(c >> k1));
+            enc_raw(e, k1, (uint32_t)(c & (((int64_t)1 << k1) - 1)));
+        }
+    } else {
+        enc_bit(e, &ic->corr0, (uint32_t)c);
+    }
+}
+
+static void symnew(hd__symmodel_t *m, uint32_t n) {
+    if (hd__symmodel_new(m, n)) abort();
+}
+static void icnew(hd__intcoder_t *ic, uint32_t bits, uint32_t ctx) {
+    if (hd__intcoder_new(ic, bits, ctx)) abort();
+}
+
+/* ---- POINT10 v2 chunks --------------------------------------------------- */
+static size_t rec_size(const lazw_opts_t *o) {
+    static const size_t base[7] = {20, 28, 26, 34, 0, 0, 30};
+    return base[o->format] + o->extra;
+}
+
+static void raw_point(tf_buf_t *b, const lazw_opts_t *o, const lazw_point_t *p) {
+    tf_u32(b, (uint32_t)p->x, 0);
+    tf_u32(b, (uint32_t)p->y, 0);
+    tf_u32(b, (uint32_t)p->z, 0);
+    tf_u16(b, 0, 0); /* intensity */
+    if (o->format < 6) {
+        tf_u8(b, (unsigned)(p->r | p->n << 3));
+        tf_u8(b, 2);             /* classification */
+        tf_u8(b, 0);             /* scan angle */
+        tf_u8(b, 7);             /* user data */
+        tf_u16(b, 11, 0);        /* point source */
+        if (o->format == 1 || o->format == 3) tf_f64(b, 123456.5, 0);
+        if (o->format >= 2) tf_u16(b, 100, 0), tf_u16(b, 200, 0), tf_u16(b, 300, 0);
+    } else {
+        tf_u8(b, (unsigned)(p->r | p->n << 4));
+        tf_u8(b, (unsigned)(p->channel << 4));
+        tf_u8(b, 2);      /* classification */
+        tf_u8(b, 7);      /* user data */
+        tf_u16(b, 0, 0);  /* scan angle */
+        tf_u16(b, 11, 0); /* point source */
+        tf_f64(b, 123456.5, 0);
+    }
+    for (unsigned i = 0; i < o->extra; i++) tf_u8(b, 40 + i);
+}
+
+static void chunk10(tf_buf_t *b, const lazw_opts_t *o, const lazw_point_t *p, size_t n) {
+    raw_point(b, o, p);
+    enc_t e;
+    enc_init(&e);
+    hd__symmodel_t changed, bitbyte[256];
+    hd__intcoder_t dx, dy, dz;
+    symnew(&changed, 64);
+    icnew(&dx, 32, 2);
+    icnew(&dy, 32, 22);
+    icnew(&dz, 32, 20);
+    char made[256] = {0};
+    hd__symmodel_t gzero, rgbused, bytes[8];
+    symnew(&gzero, 6);
+    symnew(&rgbused, 128);
+    for (unsigned i = 0; i < o->extra; i++) symnew(&bytes[i], 256);
+    hd__median5_t mx[16], my[16];
+    for (int i = 0; i < 16; i++) hd__median5_init(&mx[i]), hd__median5_init(&my[i]);
+    int32_t last_h[8] = {0}, X = p[0].x, Y = p[0].y;
+    unsigned byte14 = (unsigned)(p[0].r | p[0].n << 3);
+    for (size_t i = 1; i < n; i++) {
+        unsigned nb = (unsigned)(p[i].r | p[i].n << 3);
+        enc_symbol(&e, &changed, nb != byte14 ? 32 : 0);
+        if (nb != byte14) {
+            if (!made[byte14]) symnew(&bitbyte[byte14], 256), made[byte14] = 1;
+            enc_symbol(&e, &bitbyte[byte14], nb);
+            byte14 = nb;
+        }
+        unsigned r = p[i].r, nn = p[i].n, m = hd__laz_rmap10[nn][r], l = hd__laz_level(nn, r);
+        int32_t ddx = (int32_t)((uint32_t)p[i].x - (uint32_t)X), ddy = (int32_t)((uint32_t)p[i].y - (uint32_t)Y);
+        ic_encode(&dx, &e, mx[m].v[2], ddx, nn == 1);
+        hd__median5_add(&mx[m], ddx);
+        ic_encode(&dy, &e, my[m].v[2], ddy, (nn == 1) + hd__laz_kctx(dx.k, 20));
+        hd__median5_add(&my[m], ddy);
+        ic_encode(&dz, &e, last_h[l], p[i].z, (nn == 1) + hd__laz_kctx((dx.k + dy.k) / 2, 18));
+        last_h[l] = p[i].z;
+        X = p[i].x;
+        Y = p[i].y;
+        if (o->format == 1 || o->format == 3) enc_symbol(&e, &gzero, 0); /* GPS time unchanged */
+        if (o->format >= 2) enc_symbol(&e, &rgbused, 0);                 /* colour unchanged */
+        for (unsigned k = 0; k < o->extra; k++) enc_symbol(&e, &bytes[k], 0);
+    }
+    enc_done(&e);
+    tf_put(b, e.out.data, e.out.size);
+    tf_free(&e.out);
+    hd__symmodel_free(&changed);
+    hd__symmodel_free(&gzero);
+    hd__symmodel_free(&rgbused);
+    for (unsigned i = 0; i < o->extra; i++) hd__symmodel_free(&bytes[i]);
+    for (int i = 0; i < 256; i++)
+        if (made[i]) hd__symmodel_free(&bitbyte[i]);
+    hd__intcoder_free(&dx);
+    hd__intcoder_free(&dy);
+    hd__intcoder_free(&dz);
+}
+
+/* POINT10 v1 (LASzip 1.x): x, y, z predicted by the median of the last
+ * three differences, then the changed-values symbol; the other items v1
+ * (their fields unchanged). */
+static int32_t median3(const int32_t v[3]) {
+    if (v[0] < v[1]) return v[1] < v[2] ? v[1] : v[0] < v[2] ? v[2] : v[0];
+    return v[0] < v[2] ? v[0] : v[1] < v[2] ? v[2] : v[1];
+}
+static void chunk10v1(tf_buf_t *b, const lazw_opts_t *o, const lazw_point_t *p, size_t n) {
+    raw_point(b, o, p);
+    enc_t e;
+    enc_init(&e);
+    hd__symmodel_t changed, bitbyte[256], gzero, rgbused;
+    hd__intcoder_t dx, dy, dz, bic;
+    symnew(&changed, 64);
+    symnew(&gzero, 3);
+    symnew(&rgbused, 64);
+    icnew(&dx, 32, 1);
+    icnew(&dy, 32, 20);
+    icnew(&dz, 32, 20);
+    icnew(&bic, 8, o->extra ? o->extra : 1);
+    char made[256] = {0};
+    int32_t diff[2][3] = {{0}}, X = p[0].x, Y = p[0].y, Z = p[0].z;
+    unsigned incr = 0, byte14 = (unsigned)(p[0].r | p[0].n << 3);
+    for (size_t i = 1; i < n; i++) {
+        int32_t ddx = (int32_t)((uint32_t)p[i].x - (uint32_t)X), ddy = (int32_t)((uint32_t)p[i].y - (uint32_t)Y);
+        ic_encode(&dx, &e, median3(diff[0]), ddx, 0);
+        unsigned k = dx.k;
+        ic_encode(&dy, &e, median3(diff[1]), ddy, k < 19 ? k : 19);
+        k = (k + dy.k) / 2;
+        ic_encode(&dz, &e, Z, p[i].z, k < 19 ? k : 19);
+        unsigned nb = (unsigned)(p[i].r | p[i].n << 3);
+        enc_symbol(&e, &changed, nb != byte14 ? 16 : 0);
+        if (nb != byte14) {
+            if (!made[byte14]) symnew(&bitbyte[byte14], 256), made[byte14] = 1;
+            enc_symbol(&e, &bitbyte[byte14], nb);
+            byte14 = nb;
+        }
+        diff[0][incr] = ddx;
+        diff[1][incr] = ddy;
+        incr = (incr + 1) % 3;
+        X = p[i].x, Y = p[i].y, Z = p[i].z;
+        if (o->format == 1 || o->format == 3) enc_symbol(&e, &gzero, 0);
+        if (o->format >= 2) enc_symbol(&e, &rgbused, 0);
+        for (unsigned q = 0; q < o->extra; q++) ic_encode(&bic, &e, 40 + q, 40 + q, q);
+    }
+    enc_done(&e);
+    tf_put(b, e.out.data, e.out.size);
+    tf_free(&e.out);
+    hd__symmodel_t *ms[] = {&changed, &gzero, &rgbused};
+    for (int i = 0; i < 3; i++) hd__symmodel_free(ms[i]);
+    for (int i = 0; i < 256; i++)
+        if (made[i]) hd__symmodel_free(&bitbyte[i]);
+    hd__intcoder_t *ics[] = {&dx, &dy, &dz, &bic};
+    for (int i = 0; i < 4; i++) hd__intcoder_free(ics[i]);
+}
+
+/* ---- POINT14 v3 layered chunks -------------------------------------------- */
+typedef struct {
+    int used;
+    hd__symmodel_t changed[8], scanner, rn_same, nret[16];
+    char nret_made[16];
+    hd__intcoder_t dx, dy, dz;
+    hd__median5_t mx[12], my[12];
+    int32_t last_z[8], X, Y, Z;
+    unsigned r, n;
+} c14_t;
+
+static void c14_start(c14_t *c, const c14_t *from) {
+    memset(c, 0, sizeof *c);
+    for (int i = 0; i < 8; i++) symnew(&c->changed[i], 128);
+    symnew(&c->scanner, 3);
+    symnew(&c->rn_same, 13);
+    icnew(&c->dx, 32, 2);
+    icnew(&c->dy, 32, 22);
+    icnew(&c->dz, 32, 20);
+    for (int i = 0; i < 12; i++) hd__median5_init(&c->mx[i]), hd__median5_init(&c->my[i]);
+    c->X = from->X, c->Y = from->Y, c->Z = from->Z, c->r = from->r, c->n = from->n;
+    for (int i = 0; i < 8; i++) c->last_z[i] = from->Z;
+    c->used = 1;
+}
+static void c14_free(c14_t *c) {
+    if (!c->used) return;
+    for (int i = 0; i < 8; i++) hd__symmodel_free(&c->changed[i]);
+    hd__symmodel_free(&c->scanner);
+    hd__symmodel_free(&c->rn_same);
+    for (int i = 0; i < 16; i++)
+        if (c->nret_made[i]) hd__symmodel_free(&c->nret[i]);
+    hd__intcoder_free(&c->dx);
+    hd__intcoder_free(&c->dy);
+    hd__intcoder_free(&c->dz);
+}
+
+static void chunk14(tf_buf_t *b, const lazw_opts_t *o, const lazw_point_t *p, size_t n) {
+    raw_point(b, o, p);
+    tf_u32(b, (uint32_t)n, 0);
+    enc_t exy, ez;
+    enc_init(&exy);
+    enc_init(&ez);
+    int zchanges = 0;
+    for (size_t i = 1; i < n; i++) zchanges |= p[i].z != p[0].z;
+    c14_t *cx = calloc(4, sizeof *cx), first = {0};
+    first.X = p[0].x, first.Y = p[0].y, first.Z = p[0].z, first.r = p[0].r, first.n = p[0].n;
+    unsigned cur = p[0].channel;
+    c14_start(&cx[cur], &first);
+    for (size_t i = 1; i < n; i++) {
+        c14_t *c = &cx[cur];
+        unsigned lpr = (c->r == 1) + 2 * (c->r >= c->n); /* the GPS time never changes */
+        unsigned ch = p[i].channel;
+        c14_t *t = ch != cur && cx[ch].used ? &cx[ch] : c;
+        unsigned diff = (p[i].r - t->r) & 15, changed = 0;
+        if (ch != cur) changed |= 64;
+        if (p[i].n != t->n) changed |= 4;
+        changed |= diff == 0 ? 0 : diff == 1 ? 1 : diff == 15 ? 2 : 3;
+        enc_symbol(&exy, &c->changed[lpr], changed);
+        if (ch != cur) {
+            enc_symbol(&exy, &c->scanner, (ch - cur - 1) & 3);
+            if (!cx[ch].used) c14_start(&cx[ch], c);
+            cur = ch;
+            c = &cx[cur];
+        }
+        if (changed & 4) {
+            if (!c->nret_made[c->n]) symnew(&c->nret[c->n], 16), c->nret_made[c->n] = 1;
+            enc_symbol(&exy, &c->nret[c->n], p[i].n);
+        }
+        if ((changed & 3) == 3) enc_symbol(&exy, &c->rn_same, diff - 2);
+        c->n = p[i].n;
+        c->r = p[i].r;
+        unsigned nn = c->n, mi = hd__laz_rmap14[nn][c->r] << 1, l = hd__laz_level(nn, c->r);
+        int32_t ddx = (int32_t)((uint32_t)p[i].x - (uint32_t)c->X), ddy = (int32_t)((uint32_t)p[i].y - (uint32_t)c->Y);
+        ic_encode(&c->dx, &exy, c->mx[mi].v[2], ddx, nn == 1);
+        hd__median5_add(&c->mx[mi], ddx);
+        ic_encode(&c->dy, &exy, c->my[mi].v[2], ddy, (nn == 1) + hd__laz_kctx(c->dx.k, 20));
+        hd__median5_add(&c->my[mi], ddy);
+        c->X = p[i].x;
+        c->Y = p[i].y;
+        if (zchanges) {
+            ic_encode(&c->dz, &ez, c->last_z[l], p[i].z, (nn == 1) + hd__laz_kctx((c->dx.k + c->dy.k) / 2, 18));
+            c->last_z[l] = p[i].z;
+        }
+        c->Z = p[i].z;
+    }
+    enc_done(&exy);
+    if (zchanges) enc_done(&ez);
+    tf_u32(b, (uint32_t)exy.out.size, 0);
+    tf_u32(b, (uint32_t)ez.out.size, 0);
+    for (unsigned i = 2; i < 9 + o->extra; i++) tf_u32(b, 0, 0); /* unchanged layers: empty */
+    tf_put(b, exy.out.data, exy.out.size);
+    tf_put(b, ez.out.data, ez.out.size);
+    tf_free(&exy.out);
+    tf_free(&ez.out);
+    for (int i = 0; i < 4; i++) c14_free(&cx[i]);
+    free(cx);
+}
+
+void lazw_table(tf_buf_t *out, const uint32_t *counts, const uint32_t *bytes, size_t nc) {
+    tf_u32(out, 0, 0);
+    tf_u32(out, (uint32_t)nc, 0);
+    enc_t e;
+    enc_init(&e);
+    hd__intcoder_t ic;
+    icnew(&ic, 32, 2);
+    for (size_t c = 0; c < nc; c++) {
+        if (counts) ic_encode(&ic, &e, c ? (int32_t)counts[c - 1] : 0, (int32_t)counts[c], 0);
+        ic_encode(&ic, &e, c ? (int32_t)bytes[c - 1] : 0, (int32_t)bytes[c], 1);
+    }
+    enc_done(&e);
+    tf_put(out, e.out.data, e.out.size);
+    tf_free(&e.out);
+    hd__intcoder_free(&ic);
+}
+
+/* ---- the file --------------------------------------------------------------- */
+void lazw_encode(tf_buf_t *out, const lazw_opts_t *o, const lazw_point_t *p, size_t n) {
+    int layered = o->format >= 6;
+    size_t header = layered ? 375 : 227, rec = rec_size(o);
+    unsigned n_items = 1 + (o->format == 1 || o->format == 3) + (o->format == 2 || o->format == 3) + (o->extra > 0);
+    if (layered) n_items = 1 + (o->extra > 0);
+    size_t vlr = 34 + 6 * n_items, offset = header + 54 + vlr, base = out->size;
+    /* header */
+    tf_put(out, "LASF", 4);
+    for (int i = 4; i < 24; i++) tf_u8(out, 0);
+    tf_u8(out, 1);
+    tf_u8(out, layered ? 4 : 2);
+    while (out->size - base < 94) tf_u8(out, 0);
+    tf_u16(out, (unsigned)header, 0);
+    tf_u32(out, (uint32_t)offset, 0);
+    tf_u32(out, 1, 0); /* VLRs */
+    tf_u8(out, (unsigned)o->format | 0x80);
+    tf_u16(out, (unsigned)rec, 0);
+    tf_u32(out, layered || n > 0xFFFFFFFFu ? 0 : (uint32_t)n, 0);
+    while (out->size - base < 131) tf_u8(out, 0);
+    for (int c = 0; c < 3; c++) tf_f64(out, o->scale[c], 0);
+    for (int c = 0; c < 3; c++) tf_f64(out, o->offset[c], 0);
+    while (out->size - base < (layered ? 247 : header)) tf_u8(out, 0);
+    if (layered) {
+        tf_u64(out, n, 0);
+        while (out->size - base < header) tf_u8(out, 0);
+    }
+    /* VLR */
+    tf_u16(out, 0, 0);
+    char user[16] = "laszip encoded", desc[32] = "lazwrite (tests)";
+    tf_put(out, user, 16);
+    tf_u16(out, 22204, 0);
+    tf_u16(out, (unsigned)vlr, 0);
+    tf_put(out, desc, 32);
+    lazw_last.vlr = out->size - base;
+    unsigned iv = o->v1 ? 1 : 2;
+    tf_u16(out, layered ? 3 : o->v1 ? 1 : 2, 0);
+    tf_u16(out, 0, 0);
+    tf_u8(out, layered ? 3 : iv);
+    tf_u8(out, layered ? 4 : 2);
+    tf_u16(out, 0, 0);
+    tf_u32(out, 0, 0);
+    tf_u32(out, o->chunk_size ? o->chunk_size : 0xFFFFFFFFu, 0);
+    tf_u64(out, (uint64_t)-1, 0);
+    tf_u64(out, (uint64_t)-1, 0);
+    tf_u16(out, n_items, 0);
+    if (layered) {
+        tf_u16(out, 10, 0), tf_u16(out, 30, 0), tf_u16(out, 3, 0);
+        if (o->extra) tf_u16(out, 14, 0), tf_u16(out, o->extra, 0), tf_u16(out, 3, 0);
+    } else {
+        tf_u16(out, 6, 0), tf_u16(out, 20, 0), tf_u16(out, iv, 0);
+        if (o->format == 1 || o->format == 3) tf_u16(out, 7, 0), tf_u16(out, 8, 0), tf_u16(out, iv, 0);
+        if (o->format >= 2) tf_u16(out, 8, 0), tf_u16(out, 6, 0), tf_u16(out, iv, 0);
+        if (o->extra) tf_u16(out, 0, 0), tf_u16(out, o->extra, 0), tf_u16(out, iv, 0);
+    }
+    assert(out->size - base == offset);
+    if (o->v1) { /* LASzip 1.x: one stream, no chunk table */
+        lazw_last.points = lazw_last.chunk[0] = offset;
+        lazw_last.table = 0;
+        if (n) chunk10v1(out, o, p, n);
+        return;
+    }
+    /* chunks */
+    lazw_last.points = offset;
+    size_t table_ptr = out->size;
+    tf_u64(out, 0, 0);
+    size_t nc = o->chunk_size ? (n + o->chunk_size - 1) / o->chunk_size : o->n_chunks;
+    uint32_t *cnt = calloc(nc + 1, sizeof *cnt), *bytes = calloc(nc + 1, sizeof *bytes);
+    size_t done = 0;
+    for (size_t c = 0; c < nc; c++) {
+        size_t k = o->chunk_size ? (n - done < o->chunk_size ? n - done : o->chunk_size) : o->chunks[c];
+        size_t at = out->size;
+        if (c < 64) lazw_last.chunk[c] = at - base;
+        if (layered) chunk14(out, o, p + done, k);
+        else chunk10(out, o, p + done, k);
+        cnt[c] = (uint32_t)k;
+        bytes[c] = (uint32_t)(out->size - at);
+        done += k;
+    }
+    assert(done == n);
+    /* the chunk table */
+    uint64_t tab = out->size - base;
+    lazw_last.table = (size_t)tab;
+    for (int i = 0; i < 8; i++) out->data[table_ptr + i] = (unsigned char)(tab >> (8 * i));
+    lazw_table(out, o->chunk_size ? NULL : cnt, bytes, nc);
+    free(cnt);
+    free(bytes);
+}
+
+void lazw_random(gen_rng_t *g, lazw_point_t *p, size_t n, int format) {
+    int32_t x = (int32_t)gen_u64(g), y = (int32_t)gen_u64(g), z = (int32_t)(gen_u64(g) % 100000);
+    unsigned maxn = format >= 6 ? 15 : 7, ch = 0;
+    for (size_t i = 0; i < n; i++) {
+        uint64_t u = gen_u64(g);
+        /* mostly small steps, sometimes any 32-bit jump (k up to 32) */
+        switch (u % 8) {
+        case 0: x = (int32_t)gen_u64(g), y = (int32_t)gen_u64(g), z = (int32_t)gen_u64(g); break;
+        case 1: break; /* a repeated point */
+        default:
+            x = (int32_t)((uint32_t)x + (uint32_t)(gen_u64(g) % 2001) - 1000u);
+            y = (int32_t)((uint32_t)y + (uint32_t)(gen_u64(g) % 201) - 100u);
+            z = (int32_t)((uint32_t)z + (uint32_t)(gen_u64(g) % 21) - 10u);
+        }
+        unsigned nn = (unsigned)(u >> 8) % 4 ? 1 + (unsigned)(u >> 16) % 4 : (unsigned)(u >> 16) % (maxn + 1);
+        unsigned r = (unsigned)(u >> 24) % 8 ? 1 + (unsigned)(u >> 28) % (nn ? nn : 1) : (unsigned)(u >> 32) % (maxn + 1);
+        if (format >= 6 && (u >> 40) % 16 == 0) ch = (unsigned)(u >> 44) % 4;
+        p[i] = (lazw_point_t){x, y, z, (unsigned char)r, (unsigned char)nn, (unsigned char)ch};
+    }
+}

@@ -1,0 +1,62 @@
+/*
+ * lazwrite.h -- a LAZ writer for the tests: the LASzip range encoder and
+ * integer compressor over the models of src/io/lazcoder.c, POINT10 v2
+ * pointwise chunks (point formats 0-3, with GPSTIME11, RGB12 and BYTE
+ * items; or their version 1 in LASzip 1.x's single stream) and POINT14 v3 layered chunks (format 6, with a BYTE14 item),
+ * fixed or variable chunk sizes, and the compressed chunk table.
+ *
+ * Only x, y, z, the return number and count, and (layered) the scanner
+ * channel vary; every other field keeps its first value (so their changed
+ * bits stay 0 and their layers are empty), which is what the reader must
+ * walk past.  Its files are checked against laz-perf
+ * (tests/laz_lazperf.py), so it is an independent witness of the format
+ * only for what it shares with the reader: the models, which laz-perf
+ * checks.
+ */
+#ifndef HD_TEST_LAZWRITE_H
+#define HD_TEST_LAZWRITE_H
+
+#include "files.h"
+#include "gen.h"
+
+#include <stddef.h>
+#include <stdint.h>
+
+typedef struct lazw_point {
+    int32_t x, y, z;
+    unsigned char r, n;   /* return number and count: 0-7 (format 0-3), 0-15 (6) */
+    unsigned char channel; /* scanner channel 0-3 (format 6) */
+} lazw_point_t;
+
+typedef struct lazw_opts {
+    int format;           /* 0, 1, 2, 3 (pointwise) or 6 (layered) */
+    unsigned extra;       /* extra bytes per point (0-8) */
+    uint32_t chunk_size;  /* points per chunk; 0: variable, sizes in chunks[] */
+    const size_t *chunks; /* variable chunk sizes (n_chunks of them, sum n) */
+    size_t n_chunks;
+    double scale[3], offset[3];
+    int v1; /* formats 0-3: LASzip 1.x, items version 1 in one unchunked
+             * stream (compressor 1); chunk sizes are then ignored */
+} lazw_opts_t;
+
+/* The LAZ file of n points into *out (appended). */
+void lazw_encode(tf_buf_t *out, const lazw_opts_t *o, const lazw_point_t *p, size_t n);
+
+/* A chunk table (version, count, the compressed entries) appended to out:
+ * per chunk its point count (counts NULL: fixed chunk size) and bytes. */
+void lazw_table(tf_buf_t *out, const uint32_t *counts, const uint32_t *bytes, size_t nc);
+
+/* n random points for `format`: random walks with small steps, repeats
+ * and arbitrary 32-bit jumps; returns of 1..n mostly, any 0..7 (0..15)
+ * sometimes; scanner channels switching now and then (format 6). */
+void lazw_random(gen_rng_t *g, lazw_point_t *p, size_t n, int format);
+
+/* Byte offsets of the parts of the last file lazw_encode wrote (for
+ * hostile tests that damage one of them). */
+typedef struct lazw_layout {
+    size_t vlr, points, table; /* the LASzip VLR's data, the point data, the chunk table */
+    size_t chunk[64];          /* the first 64 chunks' starts */
+} lazw_layout_t;
+extern lazw_layout_t lazw_last;
+
+#endif

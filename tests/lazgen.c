@@ -1,0 +1,111 @@
+/*
+ * lazgen.c -- writes the LAZ files of the laz-perf check (tests/laz_lazperf.py):
+ *
+ *   lazgen DIR
+ *
+ * For each case, DIR/NAME.laz from the tests' LAZ writer
+ * (tests/internal/lazwrite.c) and DIR/NAME.txt with its points' integer
+ * coordinates, "X Y Z" per line in file order; then prints the case names,
+ * one per line.  Seeded: the same files on every run.
+ *
+ *   lazgen --seeds DIR
+ *
+ * writes the fuzz target's seed files (tests/corpus/laz/, committed).
+ */
+#include "files.h"
+#include "gen.h"
+#include "lazwrite.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static void write_case(const char *dir, const char *name, const lazw_opts_t *o, uint64_t seed, size_t n,
+                       int with_points) {
+    gen_rng_t g;
+    gen_seed(&g, seed);
+    lazw_point_t *p = malloc(n * sizeof *p);
+    if (!p) exit(1);
+    lazw_random(&g, p, n, o->format);
+    tf_buf_t b = {0};
+    lazw_encode(&b, o, p, n);
+    char path[4096];
+    snprintf(path, sizeof path, "%s/%s.laz", dir, name);
+    FILE *f = fopen(path, "wb");
+    if (!f || fwrite(b.data, 1, b.size, f) != b.size || fclose(f)) {
+        perror(path);
+        exit(1);
+    }
+    if (!with_points) {
+        tf_free(&b);
+        free(p);
+        return;
+    }
+    snprintf(path, sizeof path, "%s/%s.txt", dir, name);
+    f = fopen(path, "w");
+    if (!f) {
+        perror(path);
+        exit(1);
+    }
+    for (size_t k = 0; k < n; k++) fprintf(f, "%d %d %d\n", (int)p[k].x, (int)p[k].y, (int)p[k].z);
+    if (fclose(f)) exit(1);
+    printf("%s\n", name);
+    tf_free(&b);
+    free(p);
+}
+
+/* The fuzz target's seeds (tests/corpus/laz/): small files of each scheme. */
+static int seeds(const char *dir) {
+    static const size_t sizes[] = {9, 1, 20};
+    lazw_opts_t o = {0, 0, 16, NULL, 0, {0.01, 0.01, 0.01}, {-5, 7, 0.5}, 0};
+    write_case(dir, "fmt0_chunks16", &o, 1, 40, 0);
+    o.format = 3, o.extra = 2;
+    write_case(dir, "fmt3_extra2", &o, 2, 30, 0);
+    o.format = 6, o.extra = 0;
+    write_case(dir, "fmt6_channels", &o, 3, 60, 0);
+    o.extra = 1, o.chunk_size = 0, o.chunks = sizes, o.n_chunks = 3;
+    write_case(dir, "fmt6_variable_extra1", &o, 4, 30, 0);
+    o.format = 1, o.extra = 0;
+    write_case(dir, "fmt1_variable", &o, 5, 30, 0);
+    o.format = 3, o.extra = 1, o.v1 = 1;
+    write_case(dir, "fmt3_laszip1_extra1", &o, 6, 30, 0);
+    /* one point repeated: over 64 points per byte, the reader's growing path */
+    static lazw_point_t same[40000];
+    for (size_t k = 0; k < 40000; k++) same[k] = (lazw_point_t){1, 2, 3, 1, 1, 0};
+    lazw_opts_t r = {0, 0, 40000, NULL, 0, {0.5, 0.5, 0.5}, {0, 0, 0}, 0};
+    tf_buf_t b = {0};
+    lazw_encode(&b, &r, same, 40000);
+    char path[4096];
+    snprintf(path, sizeof path, "%s/fmt0_repeated_point.laz", dir);
+    FILE *f = fopen(path, "wb");
+    if (!f || fwrite(b.data, 1, b.size, f) != b.size || fclose(f)) return 1;
+    tf_free(&b);
+    return 0;
+}
+
+int main(int argc, char **argv) {
+    if (argc == 3 && strcmp(argv[1], "--seeds") == 0) return seeds(argv[2]);
+    if (argc != 2) {
+        fprintf(stderr, "usage: lazgen DIR | lazgen --seeds DIR\n");
+        return 2;
+    }
+    static const size_t sizes[] = {1, 700, 33, 2000, 1266};
+    for (int fmt = 0; fmt <= 3; fmt++)
+        for (unsigned extra = 0; extra <= 2; extra += 2) {
+            char name[64];
+            snprintf(name, sizeof name, "format%d_extra%u", fmt, extra);
+            lazw_opts_t o = {fmt, extra, 1000, NULL, 0, {0.01, 0.01, 0.01}, {100, 200, 300}, 0};
+            write_case(argv[1], name, &o, 100 + (uint64_t)fmt * 10 + extra, 2500, 1);
+        }
+    for (unsigned extra = 0; extra <= 3; extra += 3) {
+        char name[64];
+        snprintf(name, sizeof name, "format6_extra%u", extra);
+        lazw_opts_t o = {6, extra, 1000, NULL, 0, {0.001, 0.001, 0.001}, {0, 0, 0}, 0};
+        write_case(argv[1], name, &o, 200 + extra, 2500, 1);
+    }
+    lazw_opts_t v = {6, 0, 0, sizes, 5, {0.01, 0.01, 0.01}, {0, 0, 0}, 0};
+    write_case(argv[1], "format6_variable_chunks", &v, 300, 4000, 1);
+    v.format = 1;
+    write_case(argv[1], "format1_variable_chunks", &v, 301, 4000, 1);
+    return 0;
+}
