@@ -34,6 +34,13 @@ for group in "$@"; do
 done
 missing=""
 for p in $pkgs; do
+  # node and npm may come from elsewhere than Debian (NodeSource's nodejs
+  # bundles npm and conflicts with Debian's npm package): a command on the
+  # PATH is enough.
+  case "$p" in
+    nodejs) command -v node >/dev/null 2>&1 && continue ;;
+    npm)    command -v npm >/dev/null 2>&1 && continue ;;
+  esac
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"
 done
 [ -z "$missing" ] && exit 0
