@@ -634,10 +634,11 @@ void analysis_print(FILE *out, const analysis_args_t *an,
         char how[96] = "";
         if (an->mask_points == MASK_SURFACE)
             snprintf(how, sizeof how, " (%d-D, connectivity %d)", m->surface_dims, m->connectivity);
-        fprintf(out, "%c: NIfTI-%d mask %lldx%lldx%lld, spacing %g x %g x %g%s, %s; %lld foreground voxels, "
+        char sp[3][NUM_TEXT];
+        fprintf(out, "%c: NIfTI-%d mask %lldx%lldx%lld, spacing %s x %s x %s%s, %s; %lld foreground voxels, "
                      "%zu %s points%s\n",
-                k ? 'B' : 'A', m->nifti_version, m->dim[0], m->dim[1], m->dim[2], m->spacing[0], m->spacing[1],
-                m->spacing[2], m->unit_known ? "" : " (unit not given: taken as mm)", m->transform, m->foreground,
+                k ? 'B' : 'A', m->nifti_version, m->dim[0], m->dim[1], m->dim[2], num_text(m->spacing[0], sp[0]),
+                num_text(m->spacing[1], sp[1]), num_text(m->spacing[2], sp[2]), m->unit_known ? "" : " (unit not given: taken as mm)", m->transform, m->foreground,
                 m->points, an->mask_points == MASK_ALL ? "foreground" : "surface", how);
     }
     if (!r->active) return;
@@ -676,5 +677,5 @@ void analysis_print(FILE *out, const analysis_args_t *an,
     }
     if (an->render_out) fprintf(out, "picture written to %s (%dx%d)\n", an->render_out, r->render_w, r->render_h);
     if (an->histogram_png) fprintf(out, "histogram picture written to %s\n", an->histogram_png);
-    fprintf(out, "time: %.6f s for per-point distances\n", r->seconds);
+    fprintf(out, "time: %s s for per-point distances\n", num_text(round(r->seconds * 1e6) / 1e6, t[0]));
 }

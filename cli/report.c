@@ -195,7 +195,10 @@ void report_text(FILE *out, const report_t *r) {
     print_point(out, r->wq);
     where_text(out, TQ, w->j);
     fprintf(out, "\n");
-    fprintf(out, "overlap alpha = %.3f%s; algorithm %s\n", s->alpha, s->disjoint ? " (disjoint boxes)" : "",
-            hd_algorithm_name(a->opt.algorithm));
-    fprintf(out, "time: %.6f s computing, %.6f s reading\n", s->seconds, r->read_seconds);
+    char al[NUM_TEXT], tc[NUM_TEXT], tr[NUM_TEXT];
+    fprintf(out, "overlap alpha = %s%s; algorithm %s\n", num_text(s->alpha, al),
+            s->disjoint ? " (disjoint boxes)" : "", hd_algorithm_name(a->opt.algorithm));
+    /* times are measurements: to the microsecond, then shortest (as in the JSON) */
+    fprintf(out, "time: %s s computing, %s s reading\n", num_text(round(s->seconds * 1e6) / 1e6, tc),
+            num_text(round(r->read_seconds * 1e6) / 1e6, tr));
 }

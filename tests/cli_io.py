@@ -260,6 +260,8 @@ def assert_shortest(tok):
     assert float(tok) == v
     want = significant_digits(repr(v))  # Python's repr is the shortest round trip
     assert significant_digits(tok) == want, "%s has more digits than %r" % (tok, v)
+    mant = tok.lower().split("e")[0]
+    assert not ("." in mant and mant.endswith("0")), "%s has trailing zeros (%r)" % (tok, v)  # once "1.000"
 
 
 NUMBER = re.compile(r"(?<![\w.])-?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?(?![\w.])")
