@@ -52,6 +52,9 @@ void cli_usage(FILE *out) {
 "  --sample N         read a mesh as N points drawn uniformly by area on its\n"
 "                     faces, reproducibly for a given --seed\n"
 "  --float32          store coordinates as float (half the memory)\n"
+"  --decimal-comma    text files write 1,5 for 1.5: commas are decimal points\n"
+"                     and fields are separated by ';' or blanks (without it\n"
+"                     a decimal comma is refused with its line)\n"
 "  --max-stream-size SIZE  most bytes read from an input that is not a\n"
 "                     regular file (standard input, a pipe, a FIFO), with an\n"
 "                     optional K, M or G suffix (default 2G)\n"
@@ -165,6 +168,7 @@ int cli_parse(int argc, char **argv, cli_args_t *a) {
         if (strcmp(s, "--no-early-break") == 0) { a->opt.early_break = 0; continue; }
         if (strcmp(s, "--no-culling") == 0) { a->opt.culling = 0; continue; }
         if (strcmp(s, "--float32") == 0) { a->read.dtype = HD_FLOAT32; continue; }
+        if (strcmp(s, "--decimal-comma") == 0) { a->read.decimal_comma = 1; continue; }
         if (strcmp(s, "--vertices") == 0) { a->read.mesh = HD_MESH_VERTICES; continue; }
         if (strcmp(s, "--formats") == 0) { cli_formats(stdout); return EXIT_OK; }
         int an = analysis_parse_option(argc, argv, &k, &a->an);

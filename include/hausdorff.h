@@ -499,6 +499,13 @@ typedef struct hd_read_options {
                               0 = HD_STREAM_LIMIT */
     int fifo_wait_ms;      /* how long a named FIFO's first writer is
                               awaited: <= 0 = HD_FIFO_WAIT_MS */
+    int decimal_comma;     /* text (xyz/csv) only.  0 (default): a number
+                              written with a decimal comma ("1,5;2,5;3,5")
+                              is refused with its line, since "1,500" is
+                              1.5 in one locale and 1500 in another.
+                              1: commas are decimal separators and fields
+                              are separated by ';' or blanks, as European
+                              spreadsheets write. */
 } hd_read_options_t;
 
 /* The defaults of stream_limit (2 GiB) and fifo_wait_ms (30 s). */

@@ -64,6 +64,18 @@ def bad_text_input_exits_2_naming_the_file_and_line(d):
 
 
 @test
+def decimal_comma_csv_is_refused_unless_decimal_comma_is_given(d):
+    eu = write(d, "german.csv", "1,5;2,5;3,5\n4,25;5,5;6,75\n")
+    o = write(d, "o.xyz", "0 0 0\n")
+    expect_bad(eu, "german.csv:1: '1,5' has a decimal comma (column 1)")
+    rc, out, err = run("--decimal-comma", "--json", eu, o)
+    assert rc == 0, (rc, out, err)
+    r = json.loads(out)
+    # the farthest point of A from the origin is (4.25, 5.5, 6.75)
+    assert r["directed_ab"] == (4.25 ** 2 + 5.5 ** 2 + 6.75 ** 2) ** 0.5, r
+
+
+@test
 def bad_binary_input_exits_2_naming_the_file_and_byte_offset(d):
     head = PLY_HEAD.replace("ascii", "binary_little_endian").format(n=3)
     expect_bad(write(d, "a.ply", head.encode() + struct.pack("<6f", 1, 2, 3, 4, 5, 6)),

@@ -1062,13 +1062,16 @@ static void cloud_capsule_free(PyObject *capsule) {
 }
 
 PyDoc_STRVAR(read_doc,
-"read($module, path, *, format=None, float32=False)\n--\n\n"
+"read($module, path, *, format=None, float32=False, decimal_comma=False)\n--\n\n"
 "Read a point cloud with the library's readers and return it as an (N, 3)\n"
 "array, float64 by default or float32 with float32=True.\n"
 "\n"
 "The format comes from the extension (confirmed by the file's magic) unless\n"
 "format names it (one of hausdorff.formats()).  Mesh formats give their\n"
-"vertices.  The array takes over the memory the reader filled: no copy.\n"
+"vertices.  Text files whose numbers have decimal commas (1,5;2,5;3,5) are\n"
+"refused unless decimal_comma=True, which reads commas as decimal points\n"
+"and ';' or blanks as separators.\n"
+"The array takes over the memory the reader filled: no copy.\n"
 "Raises OSError when the file cannot be read and ValueError when it is\n"
 "malformed, empty or of an unknown format.\n"
 "\n"
@@ -1081,16 +1084,17 @@ PyDoc_STRVAR(read_doc,
 
 static PyObject *py_read(PyObject *self, PyObject *args, PyObject *kw) {
     (void)self;
-    static char *kwlist[] = {"path", "format", "float32", NULL};
+    static char *kwlist[] = {"path", "format", "float32", "decimal_comma", NULL};
     PyObject *path = NULL;
     const char *format = NULL;
-    int float32 = 0;
-    if (!PyArg_ParseTupleAndKeywords(args, kw, "O&|$zp:read", kwlist, PyUnicode_FSConverter,
-                                     &path, &format, &float32))
+    int float32 = 0, decimal_comma = 0;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "O&|$zpp:read", kwlist, PyUnicode_FSConverter,
+                                     &path, &format, &float32, &decimal_comma))
         return NULL;
     hd_read_options_t ropt;
     hd_read_options_init(&ropt);
     ropt.format = format;
+    ropt.decimal_comma = decimal_comma;
     ropt.dtype = float32 ? HD_FLOAT32 : HD_FLOAT64;
     hd_cloud_t *cloud = NULL;
     hd_error_t err;

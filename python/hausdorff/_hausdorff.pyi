@@ -164,6 +164,7 @@ def read(
     *,
     format: Optional[str] = None,
     float32: bool = False,
+    decimal_comma: bool = False,
 ) -> npt.NDArray[np.floating]: ...
 def formats() -> Dict[str, str]: ...
 

@@ -33,6 +33,15 @@ def test_read_with_an_explicit_format(tmp_path):
     assert "xyz" in hausdorff.formats()
 
 
+def test_read_decimal_commas_need_decimal_comma_true(tmp_path):
+    path = tmp_path / "excel.csv"
+    path.write_text("x;y;z\n1,5;2,5;3,5\n4,25;5,5;6,75\n")
+    with pytest.raises(ValueError, match=r"excel.csv:2: '1,5' has a decimal comma.*decimal_comma=True"):
+        hausdorff.read(path)
+    got = hausdorff.read(path, decimal_comma=True)
+    assert got.tolist() == [[1.5, 2.5, 3.5], [4.25, 5.5, 6.75]]
+
+
 def test_read_errors_map_to_python_exceptions(tmp_path):
     with pytest.raises(OSError, match="cannot open"):
         hausdorff.read(tmp_path / "missing.xyz")

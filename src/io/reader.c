@@ -123,7 +123,7 @@ static const format_t formats[] = {
     {"obj", "obj", "Wavefront OBJ: 'v' lines; 'f' lines are the faces", hd__read_obj, NULL, 1},
     {"off", "off coff noff", "Object File Format: OFF, COFF, NOFF, CNOFF; faces", hd__read_off, magic_off, 1},
     {"stl", "stl", "STL: ascii or binary triangles (their corners are the vertices)", hd__read_stl, magic_stl, 1},
-    {"xyz", "xyz txt csv pts asc", "text: x y z per line, separated by blanks and commas, or by semicolons with decimal commas; extra columns ignored",
+    {"xyz", "xyz txt csv pts asc", "text: x y z per line, separated by blanks and commas (or semicolons); decimal commas with the decimal-comma option; extra columns ignored",
      hd__read_xyz, NULL, 0},
     {"pcd", "pcd", "Point Cloud Library PCD v0.7: ascii, binary, binary_compressed; x y z of type F/I/U",
      hd__read_pcd, magic_pcd, 0},
@@ -357,6 +357,8 @@ static int check_options(const char *path, const hd_read_options_t *opt, hd_erro
         return hd__err(err, HD_EINVAL, "%s: unknown mesh mode %d", path, (int)opt->mesh);
     if (opt->mesh == HD_MESH_SAMPLE && opt->sample == 0)
         return hd__err(err, HD_EINVAL, "%s: sampling needs a positive number of points", path);
+    if (opt->decimal_comma != 0 && opt->decimal_comma != 1)
+        return hd__err(err, HD_EINVAL, "%s: decimal_comma must be 0 or 1, not %d", path, opt->decimal_comma);
     return HD_OK;
 }
 

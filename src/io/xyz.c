@@ -3,15 +3,19 @@
  *
  * One point per line: the first three numbers are x, y, z; further columns
  * (intensity, colour, normals) are ignored.  Which characters separate the
- * numbers is decided once per file, from its first data line (the first
- * line whose first field can start a number, the same test as the
- * candidate count below):
- *  - it holds a ';': the file is in the dialect European spreadsheets
- *    write, fields separated by ';' (and blanks), and a comma inside a
- *    field is its decimal separator ("4,25;5,5;6,75" is 4.25 5.5 6.75);
- *  - otherwise fields are separated by blanks and commas, and a ';' on a
- *    later line is an error naming that line (the file mixes dialects, and
- *    any reading of it could be the wrong one).
+ * numbers is decided once per file:
+ *  - with the decimal_comma option, commas are decimal separators and
+ *    fields are separated by ';' and blanks: the dialect European
+ *    spreadsheets write ("4,25;5,5;6,75" is 4.25 5.5 6.75);
+ *  - otherwise the first data line (the first line whose first field can
+ *    start a number, the same test as the candidate count below) decides:
+ *    if it holds a ';', fields are separated by ';' and blanks, and a
+ *    field holding a comma is refused with its line, since "1,500" is 1.5
+ *    written in one locale and 1500 in another and only the user knows
+ *    which (the message names the option); if it holds none, fields are
+ *    separated by blanks and commas, and a ';' on a later line is refused
+ *    naming that line (the file mixes dialects, and any reading of it could
+ *    be the wrong one).
  * Reading "1,5;2,5;3,5" as blank/comma/semicolon-separated once gave the
  * silent wrong answer (1, 5, 2).  A comma-separated file whose numbers use
  * decimal commas ("1,5,2,5,3,5") cannot be told from six columns and is
@@ -41,7 +45,8 @@
 #include <math.h>
 
 typedef struct {
-    int semicolon;       /* fields separated by ';', decimal commas */
+    int semicolon;       /* fields separated by ';' and blanks, not ',' */
+    int decimal_comma;   /* the option: a comma in a field is its decimal point */
     long long data_line; /* the line that decided (for messages) */
     int fields;          /* fields of the first point row */
     long long fields_line; /* that row's line */
@@ -120,6 +125,14 @@ static void chunk(void *ctx, hd__chunk_t *c) {
                                (int)(q - t > 40 ? 40 : q - t), t, got + 1);
                 return;
             }
+            if (d->semicolon && !d->decimal_comma && memchr(t, ',', (size_t)(q - t))) {
+                hd__chunk_fail(c, HD_EFORMAT, line,
+                               "'%.*s' has a decimal comma (column %d): 1,500 is 1.5 in one locale and 1500 in "
+                               "another; to read commas as decimal points, give the decimal_comma read option "
+                               "(--decimal-comma in the tool, decimal_comma=True in Python)",
+                               (int)(q - t > 40 ? 40 : q - t), t, got + 1);
+                return;
+            }
             got++;
         }
         if (first && got <= 1) {
@@ -170,8 +183,8 @@ static size_t candidates(void *ctx, const char *p, const char *end) {
 /* The dialect and the number of fields, from the first point row: the
  * first candidate line, or the next one when the first line is a PTS count
  * (a single field).  Serial; it stops there. */
-static dialect_t dialect_of(const char *p, const char *end) {
-    dialect_t d = {0, 0, 0, 0, 0};
+static dialect_t dialect_of(const char *p, const char *end, int decimal_comma) {
+    dialect_t d = {decimal_comma, decimal_comma, 0, 0, 0, 0};
     for (long long line = 1; p < end; line++) {
         const char *eol = hd__eol(p, end);
         if (candidate(p, eol)) {
@@ -180,7 +193,7 @@ static dialect_t dialect_of(const char *p, const char *end) {
             while (q < eol && !is_sep((unsigned char)*q)) q++;
             while (q < eol && is_sep((unsigned char)*q)) q++;
             if (!(line == 1 && q == eol)) { /* not a PTS count line */
-                d.semicolon = memchr(p, ';', (size_t)(eol - p)) != NULL;
+                d.semicolon = decimal_comma || memchr(p, ';', (size_t)(eol - p)) != NULL;
                 d.data_line = d.fields_line = line;
                 d.fields = count_fields(&d, p, eol);
                 d.first_int = 1;
@@ -196,7 +209,7 @@ static dialect_t dialect_of(const char *p, const char *end) {
 
 int hd__read_xyz(hd__read_t *r) {
     const char *s = (const char *)r->f->data;
-    dialect_t d = dialect_of(s, s + r->f->size);
+    dialect_t d = dialect_of(s, s + r->f->size, r->opt->decimal_comma);
     /* the shortest point line is "0 0 0\n" */
     hd__text_job_t job = {chunk, NULL, candidates, 6, &d};
     uint64_t count = 0; /* only the first chunk sets it: the PTS count + 1 */

@@ -163,18 +163,43 @@ TEST(obj_relative_index_in_range_names_the_right_vertex) {
     hd_cloud_free(d);
 }
 
-TEST(csv_with_semicolons_and_decimal_commas_is_read_right) {
+TEST(csv_with_decimal_commas_is_refused_without_the_option_naming_line_and_option) {
+    /* "1,5" is 1.5 in a German spreadsheet and 1500 with an English
+     * thousands separator: only the user can say which */
+    refused(tf_printf("eu.csv", "1,5;2,5;3,5\n4,25;5,5;6,75\n"), NULL, HD_EFORMAT,
+            "'1,5' has a decimal comma (column 1)", LINE, 1);
+    refused(tf_printf("eu2.csv", "x;y;z;i\n1;2;3;99\n4 ; 5,5 ; 6;0\n"), NULL, HD_EFORMAT,
+            "'5,5' has a decimal comma (column 2)", LINE, 3);
+    refused(tf_printf("eu3.csv", "1,500;2,000;3,000\n"), NULL, HD_EFORMAT, "decimal_comma", LINE, 1);
+}
+
+TEST(csv_with_decimal_commas_is_read_right_with_the_option) {
+    hd_read_options_t o;
+    hd_read_options_init(&o);
+    o.decimal_comma = 1;
     const double want[] = {1.5, 2.5, 3.5, 4.25, 5.5, 6.75};
-    reads(tf_printf("eu.csv", "1,5;2,5;3,5\n4,25;5,5;6,75\n"), NULL, want, 2);
-    reads(tf_printf("eu2.csv", "x;y;z;i\n1,5;2,5;3,5;99\n4,25 ; 5,5 ; 6,75;0\n"), NULL, want, 2);
+    reads(tf_printf("eu.csv", "1,5;2,5;3,5\n4,25;5,5;6,75\n"), &o, want, 2);
+    reads(tf_printf("eu2.csv", "x;y;z;i\n1,5;2,5;3,5;99\n4,25 ; 5,5 ; 6,75;0\n"), &o, want, 2);
+    reads(tf_printf("eu3.txt", "1,5 2,5 3,5\n4,25\t5,5 6,75\n"), &o, want, 2);
     const double plain[] = {1, 2, 3, 4, 5, 6};
-    reads(tf_printf("semi.csv", "1;2;3\n4;5;6\n"), NULL, plain, 2);
+    reads(tf_printf("eu4.csv", "1;2;3\n4;5;6\n"), &o, plain, 2);
+    /* with the option a comma never separates fields */
+    refused(tf_printf("commas.csv", "1;2;3\n1,5,2,5,3,5\n"), &o, HD_EFORMAT, "is not a number", LINE, 2);
+    o.decimal_comma = 2;
+    refused(tf_printf("eu5.csv", "1;2;3\n"), &o, HD_EINVAL, "decimal_comma must be 0 or 1", NONE, 0);
+}
+
+TEST(csv_with_semicolons_or_commas_and_decimal_points_is_read_by_default) {
+    const double want[] = {1.5, 2.5, 3.5, 4.25, 5.5, 6.75};
+    reads(tf_printf("semi.csv", "1.5;2.5;3.5\n4.25 ; 5.5 ; 6.75\n"), NULL, want, 2);
+    const double plain[] = {1, 2, 3, 4, 5, 6};
+    reads(tf_printf("semi2.csv", "1;2;3\n4;5;6\n"), NULL, plain, 2);
     reads(tf_printf("comma.csv", "x,y,z\n1,2,3\n4,5,6\n"), NULL, plain, 2);
 }
 
 TEST(csv_whose_separators_cannot_be_told_apart_is_refused_with_its_line) {
     refused(tf_printf("mixed.csv", "1,2,3\n4;5;6\n"), NULL, HD_EFORMAT, "mixed separators", LINE, 2);
-    refused(tf_printf("two.csv", "1,5;2,5;3,5\n1,2,5;3;4\n"), NULL, HD_EFORMAT, "'1,2,5' is not a number", LINE, 2);
+    refused(tf_printf("two.csv", "1;2;3\n1,2,5;3;4\n"), NULL, HD_EFORMAT, "'1,2,5' is not a number", LINE, 2);
     refused(tf_printf("both.csv", "1;2;3\n1.5,0;2;3\n"), NULL, HD_EFORMAT, "is not a number", LINE, 2);
 }
 
