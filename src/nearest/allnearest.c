@@ -176,6 +176,7 @@ static void gather_task(void *vctx, size_t task, int worker) {
         hd__src_get(&c->src, i, p);
         s->x[at] = p[0], s->y[at] = p[1], s->z[at] = p[2];
         s->idx[at] = i;
+        if (at < s->n) s->key32[at] = (uint32_t)(c->b[at] >> 32);
     }
 }
 
@@ -367,6 +368,7 @@ void hd__an_free(hd__an_t *s) {
     free(s->y);
     free(s->z);
     free(s->idx);
+    free(s->key32);
     free(s->start);
     free(s->key);
     free(s->stop);
@@ -403,6 +405,7 @@ int hd__an_build(hd__an_t *s, const hd_points_t *p, const hd_transform_t *T, con
     s->y = hd__malloc_array(n + 4, sizeof *s->y);
     s->z = hd__malloc_array(n + 4, sizeof *s->z);
     s->idx = hd__malloc_array(n + 4, sizeof *s->idx);
+    s->key32 = hd__malloc_array(n + 1, sizeof *s->key32);
     s->start = hd__malloc_array(n + 1, sizeof *s->start);
     s->key = hd__malloc_array(n + 1, sizeof *s->key);
     s->stop = hd__malloc_array(n + 1, sizeof *s->stop);
@@ -425,8 +428,9 @@ int hd__an_build(hd__an_t *s, const hd_points_t *p, const hd_transform_t *T, con
     hd__prefault(s->y, (n + 4) * sizeof *s->y);
     hd__prefault(s->z, (n + 4) * sizeof *s->z);
     hd__prefault(s->idx, (n + 4) * sizeof *s->idx);
+    hd__prefault(s->key32, n * sizeof *s->key32);
     hd__prefault(c.b, n * sizeof *c.b);
-    int ok = s->x && s->y && s->z && s->idx && s->start && s->key && s->stop && s->leaf && s->gstart &&
+    int ok = s->x && s->y && s->z && s->idx && s->key32 && s->start && s->key && s->stop && s->leaf && s->gstart &&
              s->glead && s->first && s->count && c.a && c.b;
     int rc = HD_OK;
     if (ok) {
@@ -496,7 +500,7 @@ typedef struct {
     uint32_t *bucket, *keep;
     double *lo[3], *hi[3];
     double *lb2;   /* per query: the bound of each candidate */
-    size_t paired; /* groups this worker settled by the partner path */
+    hd__an_counts_t counts; /* what this worker's groups and queries took */
 } cands_t;
 
 /* The smallest computed squared distance between a point of box q and a
@@ -607,13 +611,12 @@ typedef uint32_t v4u __attribute__((vector_size(16)));
         (out) = x_ * x_ + y_ * y_ + z_ * z_;                              \
     } while (0)
 
-HD__INLINE void scan_bucket(const hd__an_t *t, size_t b, double qx, double qy, double qz,
-                            double *best, uint32_t *bj) {
-    /* From the group of four that holds the first point to the one that
-     * holds the last: the points read before and after the bucket are
-     * points of the set too, so reading them changes no answer.  Each lane
-     * keeps its smallest distance and the smallest index at it. */
-    size_t k0 = t->start[b] & ~(size_t)3, e = t->stop[b];
+/* The points [k0, e) of t, k0 a multiple of four, e at most n + 1 (the
+ * last group of four read may run past e, into the copies of the last
+ * point stored after the end): each lane keeps its smallest distance and
+ * the smallest index at it. */
+HD__INLINE void scan_span(const hd__an_t *t, size_t k0, size_t e, double qx, double qy, double qz,
+                          double *best, uint32_t *bj) {
     v4d vx = {qx, qx, qx, qx}, vy = {qy, qy, qy, qy}, vz = {qz, qz, qz, qz}, mv, d;
     v4u iu;
     D4(t, k0, vx, vy, vz, mv);
@@ -643,6 +646,14 @@ HD__INLINE void scan_bucket(const hd__an_t *t, size_t b, double qx, double qy, d
     }
 }
 
+/* One bucket: from the group of four that holds its first point to the
+ * one that holds its last.  The points read before and after the bucket
+ * are points of the set too, so reading them changes no answer. */
+HD__INLINE void scan_bucket(const hd__an_t *t, size_t b, double qx, double qy, double qz,
+                            double *best, uint32_t *bj) {
+    scan_span(t, t->start[b] & ~(size_t)3, t->stop[b], qx, qy, qz, best, bj);
+}
+
 /* The last bucket of t whose first key is at most `key` (or bucket 0),
  * searching up from bucket `from`, the answer for a smaller key (the keys
  * grow: a few steps usually do; doubling steps then bisection). */
@@ -663,6 +674,36 @@ static size_t bucket_at(const hd__an_t *t, uint32_t key, size_t from) {
 
 #define PAIR_CANDIDATES 32 /* most candidates of a group for the partner path */
 #define PAIR_TRIAL 8        /* groups of a task tried before the partner path may be dropped */
+#define WINDOW 12           /* points of t scanned around a query's rank (a multiple of 4) */
+
+/* The rest of one query's search, on the candidate list cd (the buckets
+ * within U of a box holding the query, U at least its answer): every
+ * candidate's bound for it, then the scans it cannot skip, those within
+ * its best so far and U, listed without branches and each tested again
+ * against the best found so far.  The buckets [s0, s1) and `near` were
+ * scanned already. */
+HD__INLINE void finish_query(const hd__an_t *t, cands_t *cd, double qx, double qy, double qz, double U,
+                             size_t s0, size_t s1, size_t near, double *best, uint32_t *bj) {
+    size_t nc = cd->n;
+    double b2 = *best;
+    uint32_t j = *bj;
+    candidate_bounds(cd, nc, qx, qy, qz);
+    double lim = b2 < U ? b2 : U;
+    size_t ns = 0;
+    for (size_t r = 0; r < nc; r++) {
+        cd->keep[ns] = (uint32_t)r;
+        ns += cd->lb2[r] <= lim;
+    }
+    for (size_t r = 0; r < ns; r++) {
+        size_t at = cd->keep[r], b = cd->bucket[at];
+        lim = b2 < U ? b2 : U;
+        if (cd->lb2[at] > lim) continue;
+        if ((b >= s0 && b < s1) || b == near) continue;
+        scan_bucket(t, b, qx, qy, qz, &b2, &j);
+    }
+    *best = b2;
+    *bj = j;
+}
 
 typedef struct {
     const hd__an_t *q, *t;
@@ -700,7 +741,7 @@ HD__HOT static void query_task(void *vctx, size_t task, int worker) {
     size_t at0 = g0 < g1 ? bucket_at(t, q->key[q->glead[g0]], 0) : 0;
     hd__src_t psrc;
     if (c->partner) hd__src_init(&psrc, c->partner, NULL);
-    size_t tried = 0, kept_groups = 0;
+    size_t tried = 0, kept_groups = 0, wtried = 0, wkept = 0;
     for (size_t g = g0; g < g1; g++) {
         /* A group of equal keys may hold more than HD__AN_GROUP points:
          * its queries are then taken HD__AN_GROUP at a time. */
@@ -729,7 +770,7 @@ HD__HOT static void query_task(void *vctx, size_t task, int worker) {
              * not find most answers at the partners; no answer depends on
              * any of this. */
             double U = 0;
-            int paired = 0;
+            int paired = 0, windowed = 0, seeded = 0;
             for (size_t k = 0; k < m; k++) best[k] = INFINITY, bj[k] = UINT32_MAX;
             if (c->partner && (tried < PAIR_TRIAL || 2 * kept_groups >= tried)) {
                 /* The partners are read in the original order, far apart:
@@ -746,69 +787,137 @@ HD__HOT static void query_task(void *vctx, size_t task, int worker) {
                 }
                 paired = candidates(t, &gbox, U, PAIR_CANDIDATES, cd);
                 tried++;
-                cd->paired += (size_t)paired;
-            }
-            /* Seeds: the searched buckets at each query's place on the
-             * curve (its bucket's), and the bucket nearest to the group's
-             * box, give every query a real point; U, the largest of these
-             * distances, bounds every answer of the group. */
-            size_t near = SIZE_MAX;
-            if (!paired) {
-                double Ub = INFINITY;
-                near = nearest_leaf(t, &gbox, &Ub);
-                U = 0;
+                cd->counts.paired += (size_t)paired;
+            } else if (wtried < PAIR_TRIAL || 2 * wkept >= wtried) {
+                /* The window path: a near-copy in another order (or two
+                 * sets sampled alike) puts each query's answer at about
+                 * its own place on t's curve, the two orders being taken
+                 * on one grid: p, the first point of t whose key is not
+                 * below the query's (found from its seed bucket's start,
+                 * the queries' keys growing).  The WINDOW points of t around
+                 * it are real points, so each query's best among them
+                 * bounds its answer.  A few queries whose answer lies
+                 * across a jump of the curve get a far worse best than
+                 * the others; U, the largest best of the rest, bounds
+                 * their answers and lists few candidates, and those few
+                 * (best above U) are searched on their own afterwards.
+                 * The cut between them: 16 times (in squares) the
+                 * geometric mean of the group's bests, from their
+                 * exponents.  Dropped by a task, as the partners are,
+                 * when most groups tried fail (more than an eighth of
+                 * the queries apart, or too many candidates); no answer
+                 * depends on any of this. */
+                /* Each query's place on t's curve: the searched bucket
+                 * at its own bucket's key. */
                 for (size_t k = 0; k < m; k++) {
                     while (q->start[h + 1] <= first + k) h++;
                     if (k == 0 || q->start[h] == first + k) s0 = bucket_at(t, q->key[h], s0);
                     seed[k] = s0;
+                }
+                seeded = 1;
+                int64_t esum = 0;
+                for (size_t k = 0, p = 0, b = 0; k < m; k++) {
+                    uint32_t kq = q->key32[first + k];
+                    b = bucket_at(t, kq, b > seed[k] ? b : seed[k]);
+                    p = p > t->start[b] ? p : t->start[b];
+                    while (p < t->start[b + 1] && t->key32[p] < kq) p++;
+                    size_t k0 = p & ~(size_t)3;
+                    k0 = k0 >= WINDOW / 2 ? k0 - WINDOW / 2 : 0;
+                    size_t e = k0 + WINDOW < t->n ? k0 + WINDOW : t->n;
+                    scan_span(t, k0, e, q->x[first + k], q->y[first + k], q->z[first + k], &best[k], &bj[k]);
+                    uint64_t u;
+                    __builtin_memcpy(&u, &best[k], sizeof u);
+                    esum += (int64_t)(u >> 52);
+                }
+                int64_t ecut = esum / (int64_t)m + 4;
+                uint64_t ucut = (uint64_t)(ecut < 2047 ? ecut : 2047) << 52;
+                double cut;
+                __builtin_memcpy(&cut, &ucut, sizeof cut);
+                size_t apart = 0;
+                for (size_t k = 0; k < m; k++) {
+                    int far = best[k] > cut;
+                    apart += (size_t)far;
+                    U = !far && best[k] > U ? best[k] : U;
+                }
+                if (8 * apart <= m) paired = candidates(t, &gbox, U, PAIR_CANDIDATES, cd);
+                windowed = paired;
+                wtried++;
+                wkept += (size_t)paired;
+                cd->counts.windowed += (size_t)paired;
+            }
+            /* Seeds: the searched buckets at each query's place on the
+             * curve, and the bucket nearest to the group's box, give every
+             * query a real point; U, the largest of these distances,
+             * bounds every answer of the group. */
+            size_t near = SIZE_MAX;
+            if (!paired) {
+                if (!seeded) {
+                    /* Each query's place on t's curve: the searched bucket
+                     * at its own bucket's key. */
+                    for (size_t k = 0; k < m; k++) {
+                        while (q->start[h + 1] <= first + k) h++;
+                        if (k == 0 || q->start[h] == first + k) s0 = bucket_at(t, q->key[h], s0);
+                        seed[k] = s0;
+                    }
+                }
+                double Ub = INFINITY;
+                near = nearest_leaf(t, &gbox, &Ub);
+                U = 0;
+                for (size_t k = 0; k < m; k++) {
                     double qx = q->x[first + k], qy = q->y[first + k], qz = q->z[first + k];
-                    for (size_t b = s0; b < s0 + SEEDS && b < t->nb; b++)
+                    for (size_t b = seed[k]; b < seed[k] + SEEDS && b < t->nb; b++)
                         scan_bucket(t, b, qx, qy, qz, &best[k], &bj[k]);
-                    if (near < s0 || near >= s0 + SEEDS) scan_bucket(t, near, qx, qy, qz, &best[k], &bj[k]);
+                    if (near < seed[k] || near >= seed[k] + SEEDS) scan_bucket(t, near, qx, qy, qz, &best[k], &bj[k]);
                     U = best[k] > U ? best[k] : U;
                 }
                 U = Ub < U ? Ub : U;
                 candidates(t, &gbox, U, SIZE_MAX, cd);
             }
-            size_t nc = cd->n, kept = 0;
+            size_t kept = 0, napart = 0;
+            uint32_t apart[HD__AN_GROUP];
             for (size_t k = 0; k < m; k++) {
                 double qx = q->x[first + k], qy = q->y[first + k], qz = q->z[first + k];
-                double b2 = best[k];
-                uint32_t j = bj[k];
-                /* Every candidate's bound for this query, then the scans it
-                 * cannot skip: those within the seed's distance and U (the
-                 * answer is within both), listed without branches, each
-                 * tested again against the best found so far (the seeds are
-                 * done already). */
-                candidate_bounds(cd, nc, qx, qy, qz);
-                double lim = b2 < U ? b2 : U;
-                size_t ns = 0;
-                for (size_t r = 0; r < nc; r++) {
-                    cd->keep[ns] = (uint32_t)r;
-                    ns += cd->lb2[r] <= lim;
-                }
-                for (size_t r = 0; r < ns; r++) {
-                    size_t at = cd->keep[r], b = cd->bucket[at];
-                    lim = b2 < U ? b2 : U;
-                    if (cd->lb2[at] > lim) continue;
-                    if (!paired && ((b >= seed[k] && b < seed[k] + SEEDS) || b == near)) continue;
-                    scan_bucket(t, b, qx, qy, qz, &b2, &j);
-                }
-                c->sd[first + k] = b2;
-                c->sj[first + k] = j;
-                kept += paired && j == q->idx[first + k];
+                if (windowed && best[k] > U) {
+                    /* Set apart: its seed buckets usually bring it within
+                     * U, and then the list holds its answer; if not, its
+                     * answer may lie outside the list: later. */
+                    for (size_t b = seed[k]; b < seed[k] + SEEDS && b < t->nb; b++)
+                        scan_bucket(t, b, qx, qy, qz, &best[k], &bj[k]);
+                    if (best[k] > U) {
+                        apart[napart++] = (uint32_t)k;
+                        cd->counts.apart++;
+                        continue;
+                    }
+                    finish_query(t, cd, qx, qy, qz, U, seed[k], seed[k] + SEEDS, SIZE_MAX, &best[k], &bj[k]);
+                } else if (paired) finish_query(t, cd, qx, qy, qz, U, 0, 0, SIZE_MAX, &best[k], &bj[k]);
+                else finish_query(t, cd, qx, qy, qz, U, seed[k], seed[k] + SEEDS, near, &best[k], &bj[k]);
+                c->sd[first + k] = best[k];
+                c->sj[first + k] = bj[k];
+                kept += paired && !windowed && bj[k] == q->idx[first + k];
+            }
+            /* The queries set apart: each one's own candidates, the
+             * buckets within its best so far (a real point's distance, so
+             * at least its answer) of the query itself. */
+            for (size_t r = 0; r < napart; r++) {
+                size_t k = apart[r];
+                double qx = q->x[first + k], qy = q->y[first + k], qz = q->z[first + k];
+                hd__box_t pb = {{qx, qy, qz}, {qx, qy, qz}};
+                candidates(t, &pb, best[k], SIZE_MAX, cd);
+                finish_query(t, cd, qx, qy, qz, best[k], 0, 0, SIZE_MAX, &best[k], &bj[k]);
+                c->sd[first + k] = best[k];
+                c->sj[first + k] = bj[k];
             }
             /* The path pays when the partners are the answers (a copy),
              * not merely near enough to list few candidates (a few
              * buckets of repeated points): it is kept on while at least
              * half of the groups tried had half of their answers there. */
-            kept_groups += 2 * kept >= m;
+            kept_groups += !windowed && 2 * kept >= m;
         }
     }
 }
 
 int hd__an_nearest(const hd__an_t *asking, const hd__an_t *searched, const hd_points_t *partner,
-                   int threads, double *dist, size_t *nearest, size_t *paired, hd_error_t *err) {
+                   int threads, double *dist, size_t *nearest, hd__an_counts_t *counts, hd_error_t *err) {
     size_t tasks = (asking->ng + GROUPS_PER_TASK - 1) / GROUPS_PER_TASK;
     threads = hd__thread_count(threads, tasks);
     query_ctx c = {asking, searched, partner && partner->count == asking->n ? partner : NULL, dist, nearest, NULL,
@@ -838,8 +947,12 @@ int hd__an_nearest(const hd__an_t *asking, const hd__an_t *searched, const hd_po
         hd__parallel_for(threads, tasks, query_task, &c);
         hd__parallel_for(threads, (asking->n + SCATTER_TASK - 1) / SCATTER_TASK, scatter_answers, &c);
     }
-    if (paired) *paired = 0;
-    for (int w = 0; paired && c.cand && w < threads; w++) *paired += c.cand[w].paired;
+    if (counts) memset(counts, 0, sizeof *counts);
+    for (int w = 0; counts && c.cand && w < threads; w++) {
+        counts->paired += c.cand[w].counts.paired;
+        counts->windowed += c.cand[w].counts.windowed;
+        counts->apart += c.cand[w].counts.apart;
+    }
     for (int w = 0; c.cand && w < threads; w++) {
         cands_t *cd = &c.cand[w];
         free(cd->bucket);

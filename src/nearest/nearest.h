@@ -29,6 +29,8 @@ typedef struct hd__an {
     size_t n;
     double *x, *y, *z;     /* n + 4 coordinates in Morton order (the last repeated) */
     uint32_t *idx;         /* original index of each */
+    uint32_t *key32;       /* n: Morton key of each on the grid of both sets (the
+                            * key before any refinement: equal in a refined cell) */
     size_t nb;             /* buckets (the octree's leaves), in key order */
     uint32_t *start;       /* nb + 1: bucket b is points [start[b], start[b+1]) */
     uint32_t *key;         /* nb: Morton key of each bucket's first point */
@@ -56,16 +58,25 @@ int hd__an_build(hd__an_t *s, const hd_points_t *p, const hd_transform_t *T, con
                  int threads, hd_error_t *err);
 void hd__an_free(hd__an_t *s);
 
+/* What the searches of one hd__an_nearest took (for tests: no answer
+ * depends on it). */
+typedef struct hd__an_counts {
+    size_t paired;   /* groups of queries settled by the partners */
+    size_t windowed; /* groups settled by the window on the other curve */
+    size_t apart;    /* queries of those searched on their own */
+} hd__an_counts_t;
+
 /* For every point of `asking`, the exact nearest distance to `searched`
  * (sqrt of the smallest hd__d2s) into dist[i] and the smallest original
  * index attaining it into nearest[i], i being the point's original index;
  * either output may be NULL.  `partner`, when not NULL, is the view
  * `searched` was built from, of as many points as `asking`: its point i is
  * tried first as the answer of asking's point i (a copy and its original
- * in the same order settle fast); the answers do not depend on it, and
- * *paired (if not NULL) counts the groups of queries it settled.
- * Returns HD_OK or HD_ENOMEM (with err filled). */
+ * in the same order settle fast); the answers do not depend on it, nor on
+ * the window (the points of `searched` at each query's place on its
+ * curve, tried when the partners are not).  *counts (if not NULL) says
+ * what the searches took.  Returns HD_OK or HD_ENOMEM (with err filled). */
 int hd__an_nearest(const hd__an_t *asking, const hd__an_t *searched, const hd_points_t *partner,
-                   int threads, double *dist, size_t *nearest, size_t *paired, hd_error_t *err);
+                   int threads, double *dist, size_t *nearest, hd__an_counts_t *counts, hd_error_t *err);
 
 #endif /* HD_ALLNEAREST_H */

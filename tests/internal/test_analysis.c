@@ -320,14 +320,14 @@ static size_t partner_groups(const double *a, const double *b, size_t n, int thr
         }
     }
     hd__an_t sa, sb;
-    size_t paired = 0;
+    hd__an_counts_t counts = {0, 0, 0};
     CHECK_RC(hd__an_build(&sa, &A, NULL, &box, threads, NULL), HD_OK);
     CHECK_RC(hd__an_build(&sb, &B, NULL, &box, threads, NULL), HD_OK);
-    CHECK_RC(hd__an_nearest(&sa, &sb, &B, threads, NULL, NULL, &paired, NULL), HD_OK);
+    CHECK_RC(hd__an_nearest(&sa, &sb, &B, threads, NULL, NULL, &counts, NULL), HD_OK);
     *groups = sa.ng;
     hd__an_free(&sa);
     hd__an_free(&sb);
-    return paired;
+    return counts.paired;
 }
 
 TEST(same_order_copies_are_exact_and_mostly_settled_by_their_partners) {
