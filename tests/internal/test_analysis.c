@@ -356,6 +356,101 @@ TEST(same_order_copies_are_exact_and_mostly_settled_by_their_partners) {
     CHECK(settled >= cases / 2);
 }
 
+/* A asks B (n points each) without partners, on the grid over both
+ * boxes as hd_distances builds them: each answer against the brute force,
+ * bit for bit and index for index; *counts gets what the searches took. */
+static void check_window(const double *a, const double *b, size_t n, int threads, hd__an_counts_t *counts) {
+    hd_points_t A = hd_points_f64(a, n), B = hd_points_f64(b, n);
+    hd__box_t box;
+    for (int d = 0; d < 3; d++) {
+        box.lo[d] = box.hi[d] = a[d];
+        for (size_t k = 0; k < n; k++) {
+            double u = a[3 * k + (size_t)d], v = b[3 * k + (size_t)d];
+            box.lo[d] = fmin(box.lo[d], fmin(u, v));
+            box.hi[d] = fmax(box.hi[d], fmax(u, v));
+        }
+    }
+    hd__an_t sa, sb;
+    double *d = malloc(8 * n);
+    size_t *j = malloc(sizeof(size_t) * n);
+    CHECK_RC(hd__an_build(&sa, &A, NULL, &box, threads, NULL), HD_OK);
+    CHECK_RC(hd__an_build(&sb, &B, NULL, &box, threads, NULL), HD_OK);
+    CHECK_RC(hd__an_nearest(&sa, &sb, NULL, threads, d, j, counts, NULL), HD_OK);
+    for (size_t i = 0; i < n && !hdt_failed(); i++) {
+        size_t jb;
+        double d2 = brute_nearest(a + 3 * i, b, n, &jb);
+        CONTEXT("query %zu", i);
+        CHECK_BITS(d[i], sqrt(d2));
+        CHECK_EQ(j[i], jb);
+    }
+    hd__an_free(&sa);
+    hd__an_free(&sb);
+    free(d), free(j);
+}
+
+TEST(shuffled_copies_are_exact_and_mostly_settled_by_the_window) {
+    /* B is a copy of A (every kind gen_copy makes: noise, exact, binary
+     * and half-lattice steps with ties, repeated points, outliers, far
+     * away at 1e9, scaled to 1e-150, and here also to 1e-9) in a random
+     * order, so no partner helps: each query's first answer comes from
+     * the points at its own key on B's curve.  Ties must still go to the
+     * smallest index, the queries set apart (their answers across a jump
+     * of the curve) must still find theirs. */
+    int windowed = 0, apart = 0, cases = 0;
+    for (uint64_t seed = 31000; seed < 31000 + 4 * GEN_COPY_KINDS && !hdt_failed(); seed++) {
+        gen_rng_t g;
+        gen_seed(&g, seed);
+        int how = (int)(seed % GEN_COPY_KINDS), threads = seed % 2 ? 1 : 3;
+        size_t n = 1 + gen_u64(&g) % (seed % 4 == 0 ? 9000 : 1500);
+        int tiny = seed % 3 == 0;
+        CONTEXT("seed=%llu copy=%s n=%zu threads=%d scale=%s", (unsigned long long)seed, gen_copy_name[how], n,
+                threads, tiny ? "1e-9" : "1");
+        double *a = malloc(24 * n), *b = malloc(24 * n);
+        gen_copy(&g, how, a, b, n);
+        for (size_t k = n; k > 1; k--) gen_swap(b, k - 1, gen_u64(&g) % k);
+        if (tiny) gen_affine(a, n, 1e-9, 0.0), gen_affine(b, n, 1e-9, 0.0);
+        hd__an_counts_t c = {0, 0, 0};
+        check_window(a, b, n, threads, &c);
+        check_window(b, a, n, threads, &c);
+        check_packed(a, n, b, n, threads);
+        windowed += c.windowed > 0;
+        apart += c.apart > 0;
+        cases++;
+        free(a), free(b);
+    }
+    /* Both routes of the window path were under test. */
+    CONTEXT("cases with groups settled by the window: %d of %d, with queries set apart: %d", windowed, cases,
+            apart);
+    CHECK(windowed >= cases / 2);
+    CHECK(apart >= 4);
+}
+
+TEST(the_window_gives_up_on_disjoint_sets_and_stays_exact) {
+    /* Two Gaussians 20 sigma apart, and a lattice against a plane far
+     * away: the points at a query's key on the other curve are far from
+     * its answer, so the groups fall back to the seeds; every answer
+     * exact, ties on the lattice to the smallest index. */
+    for (uint64_t seed = 32000; seed < 32004 && !hdt_failed(); seed++) {
+        gen_rng_t g;
+        gen_seed(&g, seed);
+        size_t n = 2000 + gen_u64(&g) % 3000;
+        CONTEXT("seed=%llu n=%zu", (unsigned long long)seed, n);
+        double *a = malloc(24 * n), *b = malloc(24 * n), m0[3] = {0, 0, 0}, m1[3] = {20, 0, 0};
+        if (seed % 2) {
+            gen_gauss(&g, a, n, m0, 1.0);
+            gen_gauss(&g, b, n, m1, 1.0);
+        } else {
+            gen_lattice(&g, a, n, 9);
+            gen_plane(&g, b, n);
+            gen_affine(b, n, 1.0, 50.0);
+        }
+        hd__an_counts_t c = {0, 0, 0};
+        check_window(a, b, n, (int)seed % 3 + 1, &c);
+        check_window(b, a, n, (int)seed % 3 + 1, &c);
+        free(a), free(b);
+    }
+}
+
 TEST(same_order_copies_in_strided_and_float32_views_read_the_right_partners) {
     /* The partners are read from the caller's views: here a float32 view
      * with a 20-byte stride and a double view with a coordinate stride.  A
