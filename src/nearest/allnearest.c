@@ -863,10 +863,22 @@ HD__HOT static void query_task(void *vctx, size_t task, int worker) {
                 double Ub = INFINITY;
                 near = nearest_leaf(t, &gbox, &Ub);
                 U = 0;
+                /* A seed bucket whose box is farther from the group's
+                 * than Ub holds no answer of the group and is not listed
+                 * (U <= Ub below): it is not scanned either (disjoint sets,
+                 * where the curve's seeds are far and the nearest leaf is
+                 * near). */
+                size_t last = SIZE_MAX;
+                int useful[SEEDS] = {0};
                 for (size_t k = 0; k < m; k++) {
                     double qx = q->x[first + k], qy = q->y[first + k], qz = q->z[first + k];
-                    for (size_t b = seed[k]; b < seed[k] + SEEDS && b < t->nb; b++)
-                        scan_bucket(t, b, qx, qy, qz, &best[k], &bj[k]);
+                    if (seed[k] != last) {
+                        last = seed[k];
+                        for (size_t b = last; b < last + SEEDS; b++)
+                            useful[b - last] = b < t->nb && node_lb2(&gbox, t, t->leaf[b]) <= Ub;
+                    }
+                    for (size_t b = seed[k]; b < seed[k] + SEEDS; b++)
+                        if (useful[b - seed[k]]) scan_bucket(t, b, qx, qy, qz, &best[k], &bj[k]);
                     if (near < seed[k] || near >= seed[k] + SEEDS) scan_bucket(t, near, qx, qy, qz, &best[k], &bj[k]);
                     U = best[k] > U ? best[k] : U;
                 }
