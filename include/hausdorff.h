@@ -347,7 +347,7 @@ HD_EXTERN int hd_index_directed(const hd_index_t *idx, const hd_points_t *A,
  * index in B at that distance.  Either output may be NULL; each has
  * Q->count elements.  Exact, at any thread count.  The answers come from
  * the per-point structures hd_distances uses, built for B and T(Q) during
- * the call (about 32 bytes per point of each, freed before returning; on
+ * the call (about 36 bytes per point of each, freed before returning; on
  * 1M points about 45 ms each): the index's own tree is made for the
  * Hausdorff distance's early breaking, and one complete search of it per
  * point costs several times more.  opt: as hd_index_directed (only
@@ -374,7 +374,7 @@ HD_EXTERN int hd_index_nearest(const hd_index_t *idx, const hd_points_t *Q,
  * Each set is sorted once along a Morton curve into an octree of small
  * buckets; each structure is searched by the other set's points, a group
  * of neighbouring queries at a time.  It holds a copy of the coordinates
- * (about 32 bytes per point per set while searching, up to about 60 while
+ * (about 36 bytes per point per set while searching, up to about 60 while
  * building), freed before returning.  opt: NULL for defaults; only
  * opt->threads is read (the method above is the only one: `algorithm` and
  * the other fields are ignored).  Thread safe for distinct outputs.

@@ -17,7 +17,7 @@
  * query costs several times more, even from a nearby start, than the
  * all-nearest-neighbours structures of nearest/allnearest.c, which answer
  * neighbouring queries a group at a time, their construction included.
- * So it builds those for B and for the transformed queries (32 bytes per
+ * So it builds those for B and for the transformed queries (36 bytes per
  * point each, freed before it returns) and runs hd__an_nearest, as
  * hd_distances does for one direction; the answers are the same.  Sets beyond that file's limit
  * (2^31 - 9 points), and calls that cannot get the memory for those
@@ -287,7 +287,7 @@ int hd__index_nearest_by(const hd_index_t *idx, const hd_points_t *Q, const hd_t
     int gthreads = hd__thread_count(opt ? opt->threads : 0, c.n > idx->tree.n ? c.n : idx->tree.n);
     rc = nearest_by_groups(idx, Q, T, &c, gthreads, dist, nearest, err);
     if (rc != HD_ENOMEM) return rc;
-    /* Without memory for the groups' structures (about 32 bytes per point
+    /* Without memory for the groups' structures (about 36 bytes per point
      * of each set), the tree answers the same, in more time. */
     hd__err_clear(err);
     return nearest_by_tree(idx, &c, threads, dist, nearest, err);

@@ -62,6 +62,25 @@
  *    is seldom the answer there, and reading partners costs a cache miss
  *    each, so trying every group would cost more than it saves.)  This is the engine's correspondence bound (engine/pairs.c)
  *    put to per-point use.
+ *  - Window.  When the partners do not help (a copy in another order, or
+ *    two sets sampled alike), the two Morton orders still line up: a
+ *    query's answer is usually within a few places of the query's own key
+ *    on the searched set's curve.  Each set keeps the key of every point
+ *    (key32[], 4 bytes a point); a query finds the first searched point
+ *    whose key is not below its own (from the searched bucket at its
+ *    bucket's key, moving forward as the keys grow) and scans the WINDOW
+ *    points around it.  Most queries then hold their answer or a point
+ *    as near, and the largest of their bests lists few candidates.  The
+ *    few whose answer lies across a jump of the curve have far worse
+ *    bests, and one of them would set a bound for the whole group: they
+ *    are set apart (best above 16 times, in squares, the geometric mean of
+ *    the group's bests, read from the exponents), U is the largest best of
+ *    the others, and each query set apart scans its two seed buckets,
+ *    then either falls within U (and uses the group's list) or lists its
+ *    own candidates around its own point.  A group fails when more than
+ *    an eighth of its queries are set apart or more than PAIR_CANDIDATES
+ *    buckets are listed; a task drops the path as it drops the partners.
+ *    How often each route runs is in docs/benchmarks.md, "Issue 15".
  *  - Scans.  A bucket is scanned four points at a time with GCC's vector
  *    extension (each lane evaluates hd__d2s's expression: no fused
  *    multiply-add, -ffp-contract=off), each lane keeping its smallest
@@ -86,9 +105,18 @@
  * inequalities.  So node_lb2(Q, B) never exceeds, and node_ub2(Q, B) is
  * never below, the computed hd__d2s of any pair; the same holds for a
  * single query (hd__box_lb2s's expression).
- *  - U is a distance to an actual point (a seed or a partner) or a node's
- *    upper bound (every node holds a point), so each query of the group
- *    has a point within U, and its answer is at most U.
+ *  - U is a distance to an actual point (a seed, a partner or a point of
+ *    a window) or a node's upper bound (every node holds a point), so each
+ *    query of the group has a point within U, and its answer is at most
+ *    U; on the window path U is the largest best of the queries not set
+ *    apart, so it bounds their answers only, and a query set apart uses
+ *    the group's list only once its best is at most U, else lists its own
+ *    candidates within its best (an actual point's distance, so at least
+ *    its answer) of its own point.
+ *  - A seed bucket is scanned only when node_lb2 from the group's box to
+ *    its box is at most Ub, the nearest leaf's bound; U <= Ub, so a seed
+ *    left unscanned is not listed either (the list holds the buckets with
+ *    node_lb2 <= U, the same computed value), and no query needs it.
  *  - A node or candidate is dropped only when its bound is strictly above U
  *    or above the query's best distance so far (which is an actual point's
  *    distance): none of its points can be the nearest, nor tie with it.  A
@@ -111,8 +139,8 @@
  * scattered stores overlaps its cache misses, which the same stores
  * between searches did not.
  *
- * Memory: about 32 bytes per point and set (28 for the coordinates and
- * indices, the rest for buckets, groups and nodes with their boxes, of
+ * Memory: about 36 bytes per point and set (28 for the coordinates and
+ * indices, 4 for the keys, the rest for buckets, groups and nodes with their boxes, of
  * which there are far fewer than points), 12 bytes
  * per asking point for the answers in its order, and, per thread, 64
  * bytes per searched bucket for the candidates.  While a set is built it
@@ -674,7 +702,7 @@ static size_t bucket_at(const hd__an_t *t, uint32_t key, size_t from) {
 
 #define PAIR_CANDIDATES 32 /* most candidates of a group for the partner path */
 #define PAIR_TRIAL 8        /* groups of a task tried before the partner path may be dropped */
-#define WINDOW 12           /* points of t scanned around a query's rank (a multiple of 4) */
+#define WINDOW 8            /* points of t scanned around a query's key (a multiple of 8) */
 
 /* The rest of one query's search, on the candidate list cd (the buckets
  * within U of a box holding the query, U at least its answer): every
