@@ -87,7 +87,16 @@ typedef struct hd__read {
     hd__tris_t *tris;  /* NULL, or collect faces here (for --sample) */
     size_t n_faces;    /* faces seen (mesh formats) */
     hd_error_t *err;
+    int count_only;    /* hd_read_count: hd__binary_read stores L->n in
+                          total and returns HD__COUNTED; text parsers
+                          refuse (HD_EUNSUPPORTED) */
+    uint64_t total;
+    int ranged;        /* hd__binary_read applied opt's range */
 } hd__read_t;
+
+/* Returned by hd__binary_read in count_only mode; readers pass any nonzero
+ * code up, and reader.c turns it into HD_OK.  Never leaves the library. */
+#define HD__COUNTED 1
 
 typedef int (*hd__reader_fn)(hd__read_t *r);
 
