@@ -77,6 +77,9 @@ int hd__mesh_sample(const double *xyz, size_t nv, const hd__tris_t *t,
  * and gives the extension; opt must not be NULL.  For the fuzzers. */
 int hd__read_buffer(const void *data, size_t size, const char *name,
                     const hd_read_options_t *opt, hd_cloud_t **out, hd_error_t *err);
+/* hd_read_count on bytes in memory (for the fuzzers). */
+int hd__count_buffer(const void *data, size_t size, const char *name,
+                     const hd_read_options_t *opt, uint64_t *total, hd_error_t *err);
 
 /* ---- one reader call --------------------------------------------------- */
 typedef struct hd__read {

@@ -509,8 +509,8 @@ int hd_read_count(const char *path, const hd_read_options_t *opt,
     return read_path(path, opt, &unused, count, err);
 }
 
-int hd__read_buffer(const void *data, size_t size, const char *name,
-                    const hd_read_options_t *opt, hd_cloud_t **out, hd_error_t *err) {
+static int read_buffer(const void *data, size_t size, const char *name, const hd_read_options_t *opt,
+                       hd_cloud_t **out, uint64_t *total, hd_error_t *err) {
     hd__err_clear(err);
     *out = NULL;
     const format_t *fmt;
@@ -519,7 +519,19 @@ int hd__read_buffer(const void *data, size_t size, const char *name,
     if (rc || (rc = choose(name, opt, &fmt, &from_extension, err))) return rc;
     static const unsigned char empty[1];
     hd__file_t f = {name, size ? data : empty, size};
-    return read_loaded(&f, fmt, from_extension, opt, out, NULL, err);
+    return read_loaded(&f, fmt, from_extension, opt, out, total, err);
+}
+
+int hd__read_buffer(const void *data, size_t size, const char *name,
+                    const hd_read_options_t *opt, hd_cloud_t **out, hd_error_t *err) {
+    return read_buffer(data, size, name, opt, out, NULL, err);
+}
+
+int hd__count_buffer(const void *data, size_t size, const char *name,
+                     const hd_read_options_t *opt, uint64_t *total, hd_error_t *err) {
+    hd_cloud_t *unused = NULL;
+    *total = 0;
+    return read_buffer(data, size, name, opt, &unused, total, err);
 }
 
 void hd_cloud_free(hd_cloud_t *cloud) {

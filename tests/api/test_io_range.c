@@ -30,9 +30,7 @@ static const char *ply_binary(const char *name, size_t n) {
         tf_u8(&b, 7);
         tf_f32(&b, (float)coord(k, 2), 0);
     }
-    const char *p = tf_write(name, b.data, b.size);
-    tf_free(&b);
-    return p;
+    return tf_finish(&b, name);
 }
 
 static const char *npy_f8(const char *name, size_t n) {
@@ -47,9 +45,7 @@ static const char *npy_f8(const char *name, size_t n) {
     tf_u8(&b, '\n');
     for (size_t k = 0; k < n; k++)
         for (int c = 0; c < 3; c++) tf_f64(&b, coord(k, c), 0);
-    const char *p = tf_write(name, b.data, b.size);
-    tf_free(&b);
-    return p;
+    return tf_finish(&b, name);
 }
 
 /* Binary STL of t triangles: 3t points, three to a 50-byte record. */
@@ -65,17 +61,13 @@ static const char *stl_binary(const char *name, size_t t) {
             for (int c = 0; c < 3; c++) tf_f32(&b, (float)coord(3 * k + v, c), 0);
         tf_u16(&b, 0, 0);
     }
-    const char *p = tf_write(name, b.data, b.size);
-    tf_free(&b);
-    return p;
+    return tf_finish(&b, name);
 }
 
 static const char *xyz_text(const char *name, size_t n) {
     tf_buf_t b = {0};
     for (size_t k = 0; k < n; k++) tf_putf(&b, "%.17g %.17g %.17g\n", coord(k, 0), coord(k, 1), coord(k, 2));
-    const char *p = tf_write(name, b.data, b.size);
-    tf_free(&b);
-    return p;
+    return tf_finish(&b, name);
 }
 
 static hd_cloud_t *read_range(const char *path, uint64_t first, uint64_t count, int *rc, hd_error_t *e) {
