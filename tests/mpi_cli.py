@@ -173,6 +173,16 @@ def main():
         # A missing file: every rank fails alike.
         rc, out, err = ranks(mpirun, k, tool, os.path.join(tmp, "nope.xyz"), lion)
         check(rc == 2 and err.count("nope.xyz") == 1, "missing file: exit %d, %r" % (rc, err))
+        # --empty: an empty side gets the policy's answer, as hausdorff gives it.
+        empty = write(os.path.join(tmp, "empty.xyz"), "# no points\n")
+        for args in (["--empty", "inf", empty, lion], ["--empty", "zero", "--directed", lion, empty],
+                     ["--empty", "monai", empty, empty]):
+            for fmt in (["--json"], []):
+                rc1, out1, err1 = single(hausdorff, *fmt, *args)
+                rc2, out2, err2 = ranks(mpirun, k, tool, *fmt, *args)
+                check(rc1 == 0 and rc2 == 0 and out1 == out2, "%s: %d %d\n%s\n%s%s" % (fmt + args, rc1, rc2, out1, out2, err2))
+        rc, out, err = ranks(mpirun, k, tool, empty, lion)
+        check(rc == 2 and err.count("hausdorff-mpi:") == 1 and "--empty" in err, "empty without --empty: %d %r" % (rc, err))
         # Per-point outputs are refused, once.
         rc, out, err = ranks(mpirun, k, tool, "--percentile", "95", lion, head)
         check(rc == 1 and err.count("hausdorff-mpi:") == 1, "--percentile: exit %d, %r" % (rc, err))

@@ -19,7 +19,9 @@
  * gave up.  Only rank 0 writes to standard output and standard error (the
  * others' are /dev/null), so a message appears once, not K times.  The
  * per-point outputs (--distances, --percentile, pictures, ...) need every
- * distance in one place and are refused (exit 1), as is --empty.
+ * distance in one place and are refused (exit 1).  Under --empty a side
+ * whose ranks read no point at all gets the policy's answer, printed by
+ * rank 0 with the single-process code (analysis_handle_empty).
  */
 #include <hausdorff_mpi.h>
 
@@ -194,10 +196,9 @@ int main(int argc, char **argv) {
     cli_args_t a;
     int rc = cli_parse(argc, argv, &a); /* the same verdict on every rank */
     if (rc >= 0) return finish(rc == EXIT_OK ? out_finish() : rc);
-    if (analysis_active(&a.an) || a.an.empty != EMPTY_ERROR) {
+    if (analysis_active(&a.an)) {
         fprintf(stderr, "hausdorff-mpi: per-point outputs (--distances, --percentile, --mean, --chamfer, "
-                        "--histogram, --render, ...) and --empty need every distance in one process: use "
-                        "hausdorff\n");
+                        "--histogram, --render, ...) need every distance in one process: use hausdorff\n");
         return finish(EXIT_USAGE);
     }
     hd_error_t err;
@@ -229,6 +230,23 @@ int main(int argc, char **argv) {
         if (rc == HD_OK) part[w].points = hd_cloud_points(cloud[w]);
     }
     double read_local = cli_now() - t0, read_seconds = read_local;
+    if (rc == HD_OK) { /* an empty side (only under --empty: else reading refused it) */
+        uint64_t mine[2] = {cloud[0]->count, cloud[1]->count}, all[2];
+        MPI_Allreduce(mine, all, 2, MPI_UINT64_T, MPI_SUM, MPI_COMM_WORLD);
+        if (!all[0] || !all[1]) {
+            /* the policy's answer, printed as hausdorff prints it: the
+             * views carry the counts only (no per-point output is asked) */
+            hd_points_t A = hd_points_f64(NULL, (size_t)all[0]), B = hd_points_f64(NULL, (size_t)all[1]);
+            int status = rank_ == 0 ? analysis_handle_empty(&a.an, a.path_a, a.path_b, &A, &B, a.directed, a.json)
+                                    : EXIT_OK;
+            if (rank_ == 0) status = status == EXIT_OK ? out_finish() : (out_discard(), status);
+            for (int w = 0; w < 2; w++) {
+                hd_cloud_free(cloud[w]);
+                tiles_free(&side[w]);
+            }
+            return finish(status);
+        }
+    }
     hd_symmetric_t s;
     hd_mpi_stats_t st;
     memset(&s, 0, sizeof s);
