@@ -204,7 +204,6 @@ static void gather_task(void *vctx, size_t task, int worker) {
         hd__src_get(&c->src, i, p);
         s->x[at] = p[0], s->y[at] = p[1], s->z[at] = p[2];
         s->idx[at] = i;
-        if (at < s->n) s->key32[at] = (uint32_t)(c->b[at] >> 32);
     }
 }
 
@@ -433,7 +432,6 @@ int hd__an_build(hd__an_t *s, const hd_points_t *p, const hd_transform_t *T, con
     s->y = hd__malloc_array(n + 4, sizeof *s->y);
     s->z = hd__malloc_array(n + 4, sizeof *s->z);
     s->idx = hd__malloc_array(n + 4, sizeof *s->idx);
-    s->key32 = hd__malloc_array(n + 1, sizeof *s->key32);
     s->start = hd__malloc_array(n + 1, sizeof *s->start);
     s->key = hd__malloc_array(n + 1, sizeof *s->key);
     s->stop = hd__malloc_array(n + 1, sizeof *s->stop);
@@ -456,9 +454,8 @@ int hd__an_build(hd__an_t *s, const hd_points_t *p, const hd_transform_t *T, con
     hd__prefault(s->y, (n + 4) * sizeof *s->y);
     hd__prefault(s->z, (n + 4) * sizeof *s->z);
     hd__prefault(s->idx, (n + 4) * sizeof *s->idx);
-    hd__prefault(s->key32, n * sizeof *s->key32);
     hd__prefault(c.b, n * sizeof *c.b);
-    int ok = s->x && s->y && s->z && s->idx && s->key32 && s->start && s->key && s->stop && s->leaf && s->gstart &&
+    int ok = s->x && s->y && s->z && s->idx && s->start && s->key && s->stop && s->leaf && s->gstart &&
              s->glead && s->first && s->count && c.a && c.b;
     int rc = HD_OK;
     if (ok) {
@@ -471,8 +468,18 @@ int hd__an_build(hd__an_t *s, const hd_points_t *p, const hd_transform_t *T, con
     }
     if (ok && rc == HD_OK) {
         ok = build_octree(&c, cap) == HD_OK;
-        /* The keys are done with: give them back before the boxes. */
-        free(c.b);
+        /* The keys' upper halves are kept (key32[]), moved down in their
+         * own memory, which is touched already (a fresh array costs a page
+         * fault per 4 KiB); the rest is given back before the boxes.  In
+         * a refined cell they are the keys on the cell's own grid: the
+         * window there is a guess like any other. */
+        unsigned char *k32 = (unsigned char *)c.b;
+        for (size_t i = 0; k32 && i < n; i++) {
+            uint32_t k = (uint32_t)(c.b[i] >> 32);
+            memcpy(k32 + 4 * i, &k, sizeof k); /* bytes of keys read already */
+        }
+        s->key32 = (uint32_t *)(void *)c.b;
+        shrink((void **)&s->key32, n ? n : 1, sizeof *s->key32);
         c.a = c.b = NULL;
         for (int d = 0; d < 3 && ok; d++) {
             s->lo[d] = hd__malloc_array(s->nn, sizeof(double));
