@@ -128,7 +128,9 @@ static void resolve_point(walk_t *s, const double a[3], size_t ia) {
  * points are left: a point still alive after them gets a search of its
  * own, which on nearly identical sets costs as much as a dozen more tries
  * (docs/engine.md). */
+#ifndef NEIGHBOURS
 #define NEIGHBOURS 8
+#endif
 
 /* The shared walk of a bucket of A visits at most BLOCK_LEAVES buckets of
  * B, within the subtree of 2^BLOCK_LEVEL buckets around the last useful one,
@@ -239,6 +241,64 @@ HD__HOT static int try_bucket(walk_t *s, group_t *g, size_t i, double cmax2) {
         }
     }
     return __builtin_popcount(alive0 & ~g->alive);
+}
+
+/* The buckets of B that may hold points of B's Morton cell `key`: those
+ * points lie along B's curve between the last bucket whose first key is
+ * below `key` and the last one whose first key equals it.  Writes at most
+ * two buckets (in a cell crowded enough to span more, the first two) and
+ * returns how many. */
+static int key_buckets(const hd__tree_t *t, uint32_t key, size_t out[2]) {
+    size_t lo = 0, hi = t->nb; /* the first bucket whose first key is >= key */
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (t->fkey[mid] < key) lo = mid + 1;
+        else hi = mid;
+    }
+    int n = 0;
+    if (lo > 0) out[n++] = lo - 1;
+    if (lo < t->nb && t->fkey[lo] == key) out[n++] = lo;
+    return n;
+}
+
+/* Before the points left in a group get searches of their own: a point
+ * whose partner lies across a jump of B's curve is not near its own
+ * position along it, but it is in one of the few cells of B's Morton grid
+ * that its ball of radius cmax meets.  Each of those cells is found along
+ * B's curve by its key (a binary search over the buckets' first keys) and
+ * its buckets are tried like any other (try_bucket's proofs).  Only speed
+ * depends on which buckets are tried. */
+static void try_cells(walk_t *s, group_t *g, double cmax2) {
+    const hd__tree_t *tb = s->c->tb;
+    const hd__keygrid_t *grid = &tb->grid;
+    if (grid->scale == 0.0) return;
+    double r = sqrt(cmax2 > g->tie2 ? cmax2 : g->tie2);
+    for (uint32_t left = g->alive; left; left &= left - 1) {
+        int k = __builtin_ctz(left);
+        if (!(g->alive >> k & 1u)) continue; /* discarded by a bucket tried for another point */
+        const double p[3] = {g->x[k], g->y[k], g->z[k]};
+        uint32_t c[3][2];
+        for (int d = 0; d < 3; d++) {
+            c[d][0] = hd__key_cell(grid, d, p[d] - r);
+            c[d][1] = hd__key_cell(grid, d, p[d] + r);
+        }
+        size_t tried[16];
+        int nt = 0;
+        for (int corner = 0; corner < 8 && (g->alive >> k & 1u); corner++) {
+            uint32_t x = c[0][corner & 1], y = c[1][corner >> 1 & 1], z = c[2][corner >> 2];
+            if ((corner & 1 && x == c[0][0]) || (corner & 2 && y == c[1][0]) || (corner & 4 && z == c[2][0]))
+                continue; /* the same cell as a corner already taken */
+            size_t bk[2];
+            int m = key_buckets(tb, hd__spread10(x) | hd__spread10(y) << 1 | hd__spread10(z) << 2, bk);
+            for (int q = 0; q < m && (g->alive >> k & 1u); q++) {
+                int seen = 0;
+                for (int t = 0; t < nt; t++) seen |= tried[t] == bk[q];
+                if (seen) continue;
+                tried[nt++] = bk[q];
+                try_bucket(s, g, bk[q], cmax2);
+            }
+        }
+    }
 }
 
 /* Resolve the points of A's bucket bk together, from their quantised copy:
@@ -356,6 +416,7 @@ static void walk_bucket(walk_t *s, size_t bk) {
         if (MATTERS(g0)) stack[sp].level = l - 1, stack[sp].i = c0, stack[sp].gap2 = g0, sp++;
     }
 #undef MATTERS
+    if (g.alive) try_cells(s, &g, cmax2);
     s->w->culled += (uint64_t)(g.m - __builtin_popcount(g.alive));
     if (!g.alive) return;
     /* The points left are read exactly; start all their loads at once. */
