@@ -67,6 +67,8 @@ typedef struct {
     size_t hint;       /* bucket of B where the last search ended */
     ptrdiff_t drift;   /* where the previous bucket of A found most partners,
                         * relative to the same place along B's curve */
+    ptrdiff_t pdrift;  /* the same for the last partner found, in points */
+    int track;         /* whether try_bucket's partners update pdrift */
 } walk_t;
 
 static void walk_init(walk_t *s, dir_ctx *c, worker_t *w) {
@@ -76,6 +78,8 @@ static void walk_init(walk_t *s, dir_ctx *c, worker_t *w) {
     s->have_bc = 0;
     s->hint = HD__NONE;
     s->drift = 0;
+    s->pdrift = 0;
+    s->track = 0;
 }
 
 static size_t node_points(const hd__tree_t *t, int level, size_t i) {
@@ -128,9 +132,7 @@ static void resolve_point(walk_t *s, const double a[3], size_t ia) {
  * points are left: a point still alive after them gets a search of its
  * own, which on nearly identical sets costs as much as a dozen more tries
  * (docs/engine.md). */
-#ifndef NEIGHBOURS
 #define NEIGHBOURS 8
-#endif
 
 /* The shared walk of a bucket of A visits at most BLOCK_LEAVES buckets of
  * B, within the subtree of 2^BLOCK_LEVEL buckets around the last useful one,
@@ -160,6 +162,82 @@ static const double *group_exact(const hd__tree_t *ta, group_t *g, int k) {
         g->read |= 1u << k;
     }
     return g->a[k];
+}
+
+/* The position along B's curve at the same relative place as position p
+ * along A's. */
+static size_t same_place(const walk_t *s, size_t p) {
+    const hd__tree_t *ta = s->c->ta, *tb = s->c->tb;
+    if (ta->n == tb->n) return p;
+    return (size_t)((double)p * (double)tb->n / (double)ta->n);
+}
+
+/* Points of B tried on each point of A around its partner's expected
+ * position (its own position moved by the last partner's offset). */
+#define WINDOW 4 /* one vector of four (hd__v4d) */
+
+/* Each live point of g against the WINDOW points of B around its own
+ * place along B's curve moved by the offset of the last partner found
+ * (pdrift): two curves over nearly the same points drift apart slowly, so
+ * the partner of a point is most often within a few positions of where the
+ * previous point's partner suggests.  A point is discarded on the proof of
+ * try_bucket (hd__kill_below with both points' errors; the error of B's
+ * side is the largest of the buckets decoded, which only lowers the
+ * threshold).  Ties at the maximum are left to the buckets. */
+HD__HOT static void try_window(walk_t *s, group_t *g, double cmax2) {
+    const hd__tree_t *ta = s->c->ta, *tb = s->c->tb;
+    size_t nb_pts = tb->nb * HD__BUCKET; /* positions, padding included */
+    ptrdiff_t lo = (ptrdiff_t)same_place(s, g->first) + s->pdrift - WINDOW / 2;
+    ptrdiff_t hi = (ptrdiff_t)same_place(s, g->first + (size_t)g->m) + s->pdrift + WINDOW / 2;
+    if (lo < 0) lo = 0;
+    if (hi > (ptrdiff_t)nb_pts) hi = (ptrdiff_t)nb_pts;
+    if (hi - lo < WINDOW) return;
+    size_t b0 = (size_t)lo / HD__BUCKET, b1 = ((size_t)hi - 1) / HD__BUCKET;
+    if (b1 - b0 > 2) return; /* sizes far apart: the window spans too much */
+    double x[3 * HD__BUCKET], y[3 * HD__BUCKET], z[3 * HD__BUCKET];
+    double eb = 0;
+    for (size_t b = b0; b <= b1; b++) {
+        size_t o = (b - b0) * HD__BUCKET;
+        hd__bucket_decode(tb, b, x + o, y + o, z + o);
+        eb = tb->bucket[b].err > eb ? tb->bucket[b].err : eb;
+    }
+    double lim = hd__kill_below(cmax2, g->err + eb);
+    /* Window starts relative to the decoded points: point k's place along
+     * B's curve, moved by pdrift, less half the window, clamped. */
+    const ptrdiff_t base = (ptrdiff_t)(b0 * HD__BUCKET);
+    const ptrdiff_t top = (ptrdiff_t)((b1 + 1 - b0) * HD__BUCKET) - WINDOW;
+    const int same_size = ta->n == tb->n;
+    ptrdiff_t pd = s->pdrift, last = -1;
+    s->w->counts.evals += (uint64_t)WINDOW * (uint64_t)__builtin_popcount(g->alive);
+    for (uint32_t left = g->alive; left; left &= left - 1) {
+        int k = __builtin_ctz(left);
+        size_t pa = g->first + (size_t)k;
+        ptrdiff_t place = (ptrdiff_t)(same_size ? pa : same_place(s, pa));
+        ptrdiff_t w = place + pd - WINDOW / 2 - base;
+        w = w < 0 ? 0 : w > top ? top : w;
+        /* hd__d2s of a against the window's four points, in one vector
+         * (GCC's scalar code for the same loop was twice the
+         * instructions): the same operations in the same order, so the
+         * same values. */
+        hd__v4d bx, by, bz;
+        __builtin_memcpy(&bx, x + w, sizeof bx);
+        __builtin_memcpy(&by, y + w, sizeof by);
+        __builtin_memcpy(&bz, z + w, sizeof bz);
+        hd__v4d dx = g->x[k] - bx, dy = g->y[k] - by, dz = g->z[k] - bz;
+        hd__v4d d = dx * dx + dy * dy + dz * dz;
+        hd__v4l in = d < lim;
+        if (!(in[0] | in[1] | in[2] | in[3])) continue;
+        int arg = in[0] ? 0 : in[1] ? 1 : in[2] ? 2 : 3;
+        g->alive &= ~(1u << k);
+        last = w + arg;
+        pd = base + last - place;
+    }
+    if (last < 0) return;
+    s->pdrift = pd;
+    s->bc[0] = x[last], s->bc[1] = y[last], s->bc[2] = z[last];
+    s->bc_err = eb;
+    s->have_bc = 1;
+    s->hint = (size_t)(base + last) / HD__BUCKET;
 }
 
 /* Try bucket i of B on the live points of g; a point is discarded when the
@@ -209,6 +287,8 @@ HD__HOT static int try_bucket(walk_t *s, group_t *g, size_t i, double cmax2) {
             s->bc_err = bb->err;
             s->have_bc = 1;
             s->hint = i;
+            if (s->track)
+                s->pdrift = (ptrdiff_t)(i * HD__BUCKET + (size_t)arg) - (ptrdiff_t)same_place(s, g->first + (size_t)k);
             continue;
         }
         close_k[n_close] = k;
@@ -302,12 +382,16 @@ static void try_cells(walk_t *s, group_t *g, double cmax2) {
 }
 
 /* Resolve the points of A's bucket bk together, from their quantised copy:
- * try the last useful point of B on each; then the bucket of B where the
- * last search ended and its neighbours along B's curve (for nearly
- * identical sets the nearest points sit at nearly the same place on both
- * curves); then a short walk of B's tree for the whole bucket, nearest
- * buckets first.  Every point that the approximations prove irrelevant is
- * discarded; the points left are read exactly and get their own search. */
+ * try the last useful point of B on each; then each point against the few
+ * points of B around its expected place along B's curve (try_window); then
+ * the bucket of B at the same relative place moved by the drift, and the
+ * one where the last search ended, with their neighbours along B's curve
+ * (for nearly identical sets the nearest points sit at nearly the same
+ * place on both curves); then a short walk of B's tree for the whole
+ * bucket, nearest buckets first; then, for each point left, the buckets of
+ * the cells of B around it found by their keys (try_cells).  Every point
+ * that the approximations prove irrelevant is discarded; the points left
+ * are read exactly and get their own search. */
 static void walk_bucket(walk_t *s, size_t bk) {
     const hd__tree_t *ta = s->c->ta, *tb = s->c->tb;
     group_t g;
@@ -330,6 +414,7 @@ static void walk_bucket(walk_t *s, size_t bk) {
                 g.alive &= ~(1u << k);
         s->w->counts.evals += (uint64_t)g.m;
     }
+    if (g.alive) try_window(s, &g, cmax2);
     if (g.alive) {
         /* Two guesses: the bucket at the same relative position along B's
          * curve moved by the drift that served the previous bucket (two
@@ -345,7 +430,9 @@ static void walk_bucket(walk_t *s, size_t bk) {
             size_t h = guess[q];
             if (h == HD__NONE || (q == 1 && h + NEIGHBOURS >= guess[0] && h <= guess[0] + NEIGHBOURS)) continue;
             if (h >= tb->nb) h = tb->nb - 1;
+            s->track = q == 0;
             int k = try_bucket(s, &g, h, cmax2);
+            s->track = 0;
             if (k > most_k) most_k = k, most = h;
             for (size_t r = 1; r <= NEIGHBOURS && g.alive; r++) {
                 if (h + r < tb->nb && (k = try_bucket(s, &g, h + r, cmax2)) > most_k) most_k = k, most = h + r;
