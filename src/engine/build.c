@@ -151,7 +151,7 @@ typedef struct {
  * computed difference fl(x - x~) is within a factor (1 + 2^-53) of the true
  * one, so err = sqrt(3) * max |fl(x - x~)| * (1 + slack) bounds the true
  * Euclidean distance between a point and its approximation. */
-static void make_bucket(hd__tree_t *t, size_t b) {
+HD__HOT static void make_bucket(hd__tree_t *t, size_t b) {
     size_t s = b * HD__BUCKET;
     int m = hd__bucket_size(t, b);
     double p[3][HD__BUCKET];

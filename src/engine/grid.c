@@ -236,7 +236,7 @@ HD__INLINE void scatter_range(build_ctx *c, size_t part, size_t lo, size_t hi, h
 }
 
 /* Each pass, specialised for the packed layouts and for kept cells. */
-static void count_task(void *vctx, size_t part, int worker) {
+HD__HOT static void count_task(void *vctx, size_t part, int worker) {
     (void)worker;
     build_ctx *c = vctx;
     size_t lo = c->n * part / (size_t)c->parts, hi = c->n * (part + 1) / (size_t)c->parts;
