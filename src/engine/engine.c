@@ -69,6 +69,8 @@ typedef struct {
                         * relative to the same place along B's curve */
     ptrdiff_t pdrift;  /* the same for the last partner found, in points */
     int track;         /* whether try_bucket's partners update pdrift */
+    int window_miss;   /* consecutive buckets of A the window settled nothing in */
+    unsigned window_tick;
 } walk_t;
 
 static void walk_init(walk_t *s, dir_ctx *c, worker_t *w) {
@@ -80,6 +82,8 @@ static void walk_init(walk_t *s, dir_ctx *c, worker_t *w) {
     s->drift = 0;
     s->pdrift = 0;
     s->track = 0;
+    s->window_miss = 0;
+    s->window_tick = 0;
 }
 
 static size_t node_points(const hd__tree_t *t, int level, size_t i) {
@@ -175,20 +179,25 @@ static size_t same_place(const walk_t *s, size_t p) {
 /* Points of B tried on each point of A around its partner's expected
  * position (its own position moved by the last partner's offset). */
 #define WINDOW 4 /* one vector of four (hd__v4d) */
+#define REACH (2 * WINDOW) /* how far the window may move to either side */
+#define WINDOW_REST 8
+#define WINDOW_MISSES 4
 
 /* Each live point of g against the WINDOW points of B around its own
  * place along B's curve moved by the offset of the last partner found
  * (pdrift): two curves over nearly the same points drift apart slowly, so
  * the partner of a point is most often within a few positions of where the
- * previous point's partner suggests.  A point is discarded on the proof of
+ * previous point's partner suggests; when none of the four is close
+ * enough, the four on each side, then the next four (REACH), are tried.
+ * A point is discarded on the proof of
  * try_bucket (hd__kill_below with both points' errors; the error of B's
  * side is the largest of the buckets decoded, which only lowers the
  * threshold).  Ties at the maximum are left to the buckets. */
 HD__HOT static void try_window(walk_t *s, group_t *g, double cmax2) {
     const hd__tree_t *ta = s->c->ta, *tb = s->c->tb;
     size_t nb_pts = tb->nb * HD__BUCKET; /* positions, padding included */
-    ptrdiff_t lo = (ptrdiff_t)same_place(s, g->first) + s->pdrift - WINDOW / 2;
-    ptrdiff_t hi = (ptrdiff_t)same_place(s, g->first + (size_t)g->m) + s->pdrift + WINDOW / 2;
+    ptrdiff_t lo = (ptrdiff_t)same_place(s, g->first) + s->pdrift - WINDOW / 2 - REACH;
+    ptrdiff_t hi = (ptrdiff_t)same_place(s, g->first + (size_t)g->m) + s->pdrift + WINDOW / 2 + REACH;
     if (lo < 0) lo = 0;
     if (hi > (ptrdiff_t)nb_pts) hi = (ptrdiff_t)nb_pts;
     if (hi - lo < WINDOW) return;
@@ -226,6 +235,25 @@ HD__HOT static void try_window(walk_t *s, group_t *g, double cmax2) {
         hd__v4d dx = g->x[k] - bx, dy = g->y[k] - by, dz = g->z[k] - bz;
         hd__v4d d = dx * dx + dy * dy + dz * dz;
         hd__v4l in = d < lim;
+        if (!(in[0] | in[1] | in[2] | in[3])) {
+            /* Not within the first four: the four on each side, then the
+             * next four on each side (REACH). */
+            static const int8_t shift[4] = {-WINDOW, WINDOW, -2 * WINDOW, 2 * WINDOW};
+            int hit = 0;
+            for (int t = 0; t < 4 && !hit; t++) {
+                ptrdiff_t v = w + shift[t];
+                v = v < 0 ? 0 : v > top ? top : v;
+                __builtin_memcpy(&bx, x + v, sizeof bx);
+                __builtin_memcpy(&by, y + v, sizeof by);
+                __builtin_memcpy(&bz, z + v, sizeof bz);
+                dx = g->x[k] - bx, dy = g->y[k] - by, dz = g->z[k] - bz;
+                d = dx * dx + dy * dy + dz * dz;
+                in = d < lim;
+                s->w->counts.evals += WINDOW;
+                if (in[0] | in[1] | in[2] | in[3]) hit = 1, w = v;
+            }
+            if (!hit) continue;
+        }
         if (!(in[0] | in[1] | in[2] | in[3])) continue;
         int arg = in[0] ? 0 : in[1] ? 1 : in[2] ? 2 : 3;
         g->alive &= ~(1u << k);
@@ -414,7 +442,15 @@ static void walk_bucket(walk_t *s, size_t bk) {
                 g.alive &= ~(1u << k);
         s->w->counts.evals += (uint64_t)g.m;
     }
-    if (g.alive) try_window(s, &g, cmax2);
+    /* Where the window settles nothing WINDOW_MISSES times in a row (a
+     * translated copy, whose partners all lie at the maximum distance, too
+     * close to call from the approximations), it is tried only on every
+     * WINDOW_REST-th bucket of A until it settles something again. */
+    if (g.alive && (s->window_miss < WINDOW_MISSES || ++s->window_tick % WINDOW_REST == 0)) {
+        uint32_t before = g.alive;
+        try_window(s, &g, cmax2);
+        s->window_miss = g.alive == before ? s->window_miss + 1 : 0;
+    }
     if (g.alive) {
         /* Two guesses: the bucket at the same relative position along B's
          * curve moved by the drift that served the previous bucket (two
