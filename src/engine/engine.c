@@ -189,10 +189,11 @@ static size_t same_place(const walk_t *s, size_t p) {
  * the partner of a point is most often within a few positions of where the
  * previous point's partner suggests; when none of the four is close
  * enough, the four on each side, then the next four (REACH), are tried.
- * A point is discarded on the proof of
- * try_bucket (hd__kill_below with both points' errors; the error of B's
- * side is the largest of the buckets decoded, which only lowers the
- * threshold).  Ties at the maximum are left to the buckets. */
+ * A point is discarded on the proof of try_bucket (hd__kill_below with
+ * both points' errors; the error of B's side is the largest of the
+ * buckets decoded, which only lowers the threshold, since hd__kill_below
+ * decreases as the error grows).  Ties at the maximum are left to the
+ * buckets. */
 HD__HOT static void try_window(walk_t *s, group_t *g, double cmax2) {
     const hd__tree_t *ta = s->c->ta, *tb = s->c->tb;
     size_t nb_pts = tb->nb * HD__BUCKET; /* positions, padding included */
@@ -254,10 +255,22 @@ HD__HOT static void try_window(walk_t *s, group_t *g, double cmax2) {
             }
             if (!hit) continue;
         }
-        if (!(in[0] | in[1] | in[2] | in[3])) continue;
         int arg = in[0] ? 0 : in[1] ? 1 : in[2] ? 2 : 3;
-        g->alive &= ~(1u << k);
         last = w + arg;
+#ifndef NDEBUG
+        {
+            /* The proof from both approximations: the two points, read
+             * exactly, lie strictly within cmax (a position in the last
+             * bucket's padding holds a copy of that bucket's point 0). */
+            size_t at = (size_t)(base + last);
+            if (at >= tb->n) at = at / HD__BUCKET * HD__BUCKET;
+            double ea[3], eb3[3];
+            hd__src_get(&ta->src, g->ia[k], ea);
+            hd__src_get(&tb->src, tb->perm[at], eb3);
+            assert(!(hd__d2(ea, eb3) >= cmax2));
+        }
+#endif
+        g->alive &= ~(1u << k);
         pd = base + last - place;
     }
     if (last < 0) return;
