@@ -15,7 +15,11 @@
  * slowest rank's total and search, wall clock), the largest CPU time of a
  * rank per local point (the per-point cost for the model: with more ranks
  * than cores it includes MPI's busy waiting), and the share of points
- * searched one by one (the shells).  --check compares with hd_hausdorff on
+ * searched one by one (the shells), and the peak RSS of the call over the
+ * RSS before it per local point ("hwm": VmHWM reset through
+ * /proc/self/clear_refs before the call, so everything the call touched
+ * counts, the engine's and MPI's memory too; run one case per process for
+ * it, since later cases reuse memory freed by earlier ones).  --check compares with hd_hausdorff on
  * rank 0 (all points gathered; small N only).
  *
  * Cases:
@@ -47,6 +51,29 @@ static double cpu_now(void) {
     struct timespec ts;
     clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* Resident kilobytes from /proc/self/status ("VmRSS:" or "VmHWM:"), 0 where missing. */
+static double status_kb(const char *key) {
+    FILE *f = fopen("/proc/self/status", "r");
+    char line[256];
+    double v = 0;
+    size_t n = strlen(key);
+    while (f && fgets(line, sizeof line, f))
+        if (!strncmp(line, key, n)) v = atof(line + n);
+    if (f) fclose(f);
+    return 1024.0 * v;
+}
+
+/* Reset the peak RSS to the current RSS (Linux >= 4.0: clear_refs 5), so
+ * that VmHWM after the call is the call's own peak: everything it touched,
+ * the engine's and MPI's memory included. */
+static void hwm_reset(void) {
+    FILE *f = fopen("/proc/self/clear_refs", "w");
+    if (f) {
+        fputs("5", f);
+        fclose(f);
+    }
 }
 
 static double maxrss(void) {
@@ -85,7 +112,7 @@ int main(int argc, char **argv) {
     if (rank_ == 0)
         printf("# mpi_bench: %d ranks, %zu points per side%s, layout %s, %d thread(s) per rank\n"
                "# case     points  B/pt(part) B/pt(fwd) fwd%%    imbal work-imbal buf B/pt rss B/pt "
-               "time(s) search(s) search ns/pt cpu ns/pt shell%% searchcpu ns/pt\n",
+               "time(s) search(s) search ns/pt cpu ns/pt shell%% searchcpu ns/pt hwm B/pt\n",
                K_, N, per_rank ? " per rank" : "", tiles ? "tiles" : "random", threads);
     char list[256];
     snprintf(list, sizeof list, "%s", cases);
@@ -99,6 +126,8 @@ int main(int argc, char **argv) {
         hd_mpi_stats_t st;
         hd_error_t err;
         double rss0 = maxrss();
+        hwm_reset();
+        double cur0 = status_kb("VmRSS:");
         MPI_Barrier(MPI_COMM_WORLD);
         double cpu0 = cpu_now();
         int rc = hd_mpi_hausdorff(MPI_COMM_WORLD, &pa, 1, &pb, 1, &opt, &r, &st, &err);
@@ -110,15 +139,17 @@ int main(int argc, char **argv) {
         }
         double grow = (maxrss() - rss0) / (double)(st.local_points ? st.local_points : 1), most = 0;
         MPI_Reduce(&grow, &most, 1, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD);
+        double hwm = (status_kb("VmHWM:") - cur0) / (double)(st.local_points ? st.local_points : 1), hwmax = 0;
+        MPI_Reduce(&hwm, &hwmax, 1, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD);
         uint64_t tot = st.points;
         if (rank_ == 0)
-            printf("%-8s %9llu %9.2f %9.3f %7.3f %6.3f %8.3f %10.1f %10.1f %8.3f %8.3f %8.1f %8.1f %7.3f %8.1f\n", c,
+            printf("%-8s %9llu %9.2f %9.3f %7.3f %6.3f %8.3f %10.1f %10.1f %8.3f %8.3f %8.1f %8.1f %7.3f %8.1f %8.1f\n", c,
                    (unsigned long long)tot, (double)st.bytes_partition / (double)tot,
                    (double)st.bytes_forwarding / (double)tot, 100.0 * (double)st.forwarded_points / (double)tot,
                    st.imbalance, st.work_imbalance, (double)st.peak_bytes_max / ((double)tot / K_), most,
                    st.seconds_max, st.search_seconds_max, 1e9 * st.search_seconds_max / ((double)tot / K_),
                    1e9 * cpumax, 100.0 * (double)st.shell_points / (double)tot,
-                   1e9 * st.search_cpu_max / ((double)tot / K_));
+                   1e9 * st.search_cpu_max / ((double)tot / K_), hwmax);
         if (check) { /* gather everything on rank 0 and compare */
             double *all[2] = {NULL, NULL};
             int cnt = (int)(3 * n), *cnts = malloc((size_t)K_ * sizeof(int)), *disp = malloc((size_t)K_ * sizeof(int));
