@@ -15,7 +15,9 @@
  * slowest rank's total and search, wall clock), the largest CPU time of a
  * rank per local point (the per-point cost for the model: with more ranks
  * than cores it includes MPI's busy waiting), and the share of points
- * searched one by one (the shells), and the peak RSS of the call over the
+ * searched one by one (the shells), the most CPU time of a rank's calling
+ * thread per local point outside the searches and MPI calls ("othercpu":
+ * the bookkeeping, c_rest of docs/scale-out.md's model), and the peak RSS of the call over the
  * RSS before it per local point ("hwm": VmHWM reset through
  * /proc/self/clear_refs before the call, so everything the call touched
  * counts, the engine's and MPI's memory too; run one case per process for
@@ -112,7 +114,7 @@ int main(int argc, char **argv) {
     if (rank_ == 0)
         printf("# mpi_bench: %d ranks, %zu points per side%s, layout %s, %d thread(s) per rank\n"
                "# case     points  B/pt(part) B/pt(fwd) fwd%%    imbal work-imbal buf B/pt rss B/pt "
-               "time(s) search(s) search ns/pt cpu ns/pt shell%% searchcpu ns/pt hwm B/pt\n",
+               "time(s) search(s) search ns/pt cpu ns/pt shell%% searchcpu ns/pt hwm B/pt othercpu ns/pt\n",
                K_, N, per_rank ? " per rank" : "", tiles ? "tiles" : "random", threads);
     char list[256];
     snprintf(list, sizeof list, "%s", cases);
@@ -143,13 +145,13 @@ int main(int argc, char **argv) {
         MPI_Reduce(&hwm, &hwmax, 1, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD);
         uint64_t tot = st.points;
         if (rank_ == 0)
-            printf("%-8s %9llu %9.2f %9.3f %7.3f %6.3f %8.3f %10.1f %10.1f %8.3f %8.3f %8.1f %8.1f %7.3f %8.1f %8.1f\n", c,
+            printf("%-8s %9llu %9.2f %9.3f %7.3f %6.3f %8.3f %10.1f %10.1f %8.3f %8.3f %8.1f %8.1f %7.3f %8.1f %8.1f %8.1f\n", c,
                    (unsigned long long)tot, (double)st.bytes_partition / (double)tot,
                    (double)st.bytes_forwarding / (double)tot, 100.0 * (double)st.forwarded_points / (double)tot,
                    st.imbalance, st.work_imbalance, (double)st.peak_bytes_max / ((double)tot / K_), most,
                    st.seconds_max, st.search_seconds_max, 1e9 * st.search_seconds_max / ((double)tot / K_),
                    1e9 * cpumax, 100.0 * (double)st.shell_points / (double)tot,
-                   1e9 * st.search_cpu_max / ((double)tot / K_), hwmax);
+                   1e9 * st.search_cpu_max / ((double)tot / K_), hwmax, 1e9 * st.other_cpu_max / ((double)tot / K_));
         if (check) { /* gather everything on rank 0 and compare */
             double *all[2] = {NULL, NULL};
             int cnt = (int)(3 * n), *cnts = malloc((size_t)K_ * sizeof(int)), *disp = malloc((size_t)K_ * sizeof(int));

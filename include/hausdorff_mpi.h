@@ -111,6 +111,10 @@ typedef struct hd_mpi_stats {
     double search_cpu_max;      /* the same in CPU seconds of the calling
                                    thread: with opt->threads = 1 the
                                    searches' own cost, whatever the load */
+    double other_cpu_max;       /* the most CPU seconds of a rank's calling
+                                   thread outside the searches and the MPI
+                                   calls: validation, sampling, packing,
+                                   merging, boxes (the bookkeeping) */
     uint64_t peak_bytes_max;    /* most bytes a rank held at once for this
                                    call: its buffers, the per-point
                                    searches' structures (up to 60 bytes a
@@ -120,6 +124,7 @@ typedef struct hd_mpi_stats {
                                    nor MPI's own buffers */
     double seconds;             /* this rank: time in the call */
     double search_seconds;      /* this rank: time in the searches */
+    double other_cpu;           /* this rank: the bookkeeping's CPU seconds */
     uint64_t local_points;      /* this rank: points after the partition */
     uint64_t peak_bytes;        /* this rank: peak of the buffers above */
 } hd_mpi_stats_t;

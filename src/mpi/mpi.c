@@ -121,6 +121,7 @@ typedef struct ctx {
     uint64_t bytes_part, bytes_fwd, forwarded, forwarded_points, answered;
     double search;             /* seconds in the engine and hd_distances */
     double search_cpu;         /* the calling thread's CPU seconds there */
+    double mpi_cpu;            /* ... and in MPI calls */
     uint64_t shell;            /* points searched one by one (the shells) */
     uint64_t interior_passes;  /* second engine calls on an interior */
     int rounds;
@@ -204,16 +205,24 @@ static int mpi_failed(ctx_t *c, const char *call, int code) {
     return hd__err(&c->e, HD_EIO, "%s failed: %s", call, len ? text : "unknown MPI error");
 }
 
+/* Every MPI call is timed (thread CPU): what is left of the call's CPU
+ * besides them and the searches is its bookkeeping (stats->other_cpu). */
+#define MPI_TIMED(c, call) (mpi_t0_ = thread_cpu(), mpi_rc_ = (call), (c)->mpi_cpu += thread_cpu() - mpi_t0_, mpi_rc_)
+
 #define MPI_TRY(c, call)                                                  \
     do {                                                                  \
-        int mpi_rc_ = (call);                                             \
+        double mpi_t0_;                                                   \
+        int mpi_rc_;                                                      \
+        mpi_rc_ = MPI_TIMED(c, call);                                     \
         if (mpi_rc_ != MPI_SUCCESS) return mpi_failed(c, #call, mpi_rc_); \
     } while (0)
 
 /* The same in a function that frees its buffers at `done`. */
 #define MPI_GO(c, rc, call)                          \
     do {                                             \
-        int mpi_rc_ = (call);                        \
+        double mpi_t0_;                              \
+        int mpi_rc_;                                 \
+        mpi_rc_ = MPI_TIMED(c, call);                \
         if (mpi_rc_ != MPI_SUCCESS) {                \
             rc = mpi_failed(c, #call, mpi_rc_);      \
             goto done;                               \
@@ -226,7 +235,9 @@ static int mpi_failed(ctx_t *c, const char *call, int code) {
  * every collective that a failed rank would not reach. */
 static int agree(ctx_t *c, int rc) {
     int mine = rc != HD_OK ? c->rank : c->K, first = c->K;
-    if (MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, c->comm) != MPI_SUCCESS)
+    double mpi_t0_;
+    int mpi_rc_;
+    if (MPI_TIMED(c, MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, c->comm)) != MPI_SUCCESS)
         return rc != HD_OK ? rc : hd__err(&c->e, HD_EIO, "MPI_Allreduce failed while agreeing on a status");
     if (first == c->K) return HD_OK;
     hd_error_t e = c->e;
@@ -234,7 +245,7 @@ static int agree(ctx_t *c, int rc) {
         e.code = rc;
         snprintf(e.message, sizeof e.message, "rank %d: %.1000s", first, c->e.message);
     }
-    if (MPI_Bcast(&e, (int)sizeof e, MPI_BYTE, first, c->comm) != MPI_SUCCESS)
+    if (MPI_TIMED(c, MPI_Bcast(&e, (int)sizeof e, MPI_BYTE, first, c->comm)) != MPI_SUCCESS)
         return hd__err(&c->e, HD_EIO, "MPI_Bcast failed while agreeing on a status");
     c->e = e;
     return e.code;
@@ -920,6 +931,28 @@ static int direction(ctx_t *c, const dir_t *d, const node_t *tree, const hd__box
         }
         if (K > 1) node_boxes(tree, 0, held, d->qside, nbox);
     }
+    /* What the searches and the forwarding held, freed before the
+     * interior's engine call (and on failure). */
+#define DIRECTION_FREE()                               \
+    do {                                               \
+        cfree(c, u2, nP, sizeof(double));              \
+        cfree(c, jj, nP, sizeof(uint64_t));            \
+        cfree(c, exact, nP, 1);                        \
+        cfree(c, nbox, K > 1 ? (size_t)K - 1 : 1, sizeof(hd__box_t)); \
+        cfree(c, list, (size_t)K, sizeof(int));        \
+        cfree(c, cnt, 4 * (size_t)K, sizeof(int));     \
+        cfree(c, pairs, cap, sizeof(pair_t));          \
+        cfree(c, sendq, np, 3 * sizeof(double));       \
+        cfree(c, order, np, sizeof(size_t));           \
+        cfree(c, recvq, m, 3 * sizeof(double));        \
+        cfree(c, ans, m, sizeof(ans_t));               \
+        cfree(c, back, np, sizeof(ans_t));             \
+        u2 = NULL, jj = NULL, exact = NULL, nbox = NULL, list = NULL, cnt = NULL, pairs = NULL; \
+        sendq = NULL, order = NULL, recvq = NULL, ans = NULL, back = NULL; \
+        cfree(c, sh.nearest, sh.n, sizeof(size_t));    \
+        sh.nearest = NULL;                             \
+        qtree_free(c, &q);                             \
+    } while (0)
     if ((rc = agree(c, rc)) != HD_OK) goto done;
     /* L and the smallest index i_L of a confirmed point at L: a point
      * with u2 < L, or u2 = L and a larger index, cannot be the witness. */
@@ -1008,6 +1041,7 @@ static int direction(ctx_t *c, const dir_t *d, const node_t *tree, const hd__box
      * over all ranks: every interior point is below (h2, a*) (u <= h2,
      * and a* is the smallest index at h2), so it cannot beat what (h2, a*)
      * does not. */
+    DIRECTION_FREE();
     far_t G;
     MPI_GO(c, rc, MPI_Allreduce(&best, &G, 1, c->far_type, c->far_op, c->comm));
     if (sh.lazy && far_better(&sh.h, &G)) {
@@ -1022,21 +1056,10 @@ static int direction(ctx_t *c, const dir_t *d, const node_t *tree, const hd__box
     if ((rc = agree(c, rc)) != HD_OK) goto done;
     MPI_GO(c, rc, MPI_Allreduce(&best, result, 1, c->far_type, c->far_op, c->comm));
 done:
-    cfree(c, u2, nP, sizeof(double));
-    cfree(c, jj, nP, sizeof(uint64_t));
-    cfree(c, exact, nP, 1);
-    cfree(c, nbox, K > 1 ? (size_t)K - 1 : 1, sizeof(hd__box_t));
-    cfree(c, list, (size_t)K, sizeof(int));
-    cfree(c, cnt, 4 * (size_t)K, sizeof(int));
-    cfree(c, pairs, cap, sizeof(pair_t));
-    cfree(c, sendq, np, 3 * sizeof(double));
-    cfree(c, order, np, sizeof(size_t));
-    cfree(c, recvq, m, 3 * sizeof(double));
-    cfree(c, ans, m, sizeof(ans_t));
-    cfree(c, back, np, sizeof(ans_t));
+    DIRECTION_FREE();
     shell_free(c, &sh);
-    qtree_free(c, &q);
     return rc;
+#undef DIRECTION_FREE
 }
 
 /* ---- the partition and the exchange -------------------------------------- */
@@ -1156,7 +1179,10 @@ static int check_ranges(ctx_t *c, const input_t *in, ranges_t *rg) {
                 if (p->points.count)
                     mine[t++] = (range_t){p->offset, p->offset + (p->points.count - 1), s, c->rank};
             }
-        int e = MPI_Allgatherv(mine, n * (int)sizeof(range_t), MPI_BYTE, rg->all, counts, displ, MPI_BYTE, c->comm);
+        double mpi_t0_;
+        int mpi_rc_,
+            e = MPI_TIMED(c, MPI_Allgatherv(mine, n * (int)sizeof(range_t), MPI_BYTE, rg->all, counts, displ,
+                                            MPI_BYTE, c->comm));
         if (e != MPI_SUCCESS) rc = mpi_failed(c, "MPI_Allgatherv", e);
     }
     cfree(c, mine, (size_t)n, sizeof(range_t));
@@ -1242,7 +1268,9 @@ static int partition(ctx_t *c, const input_t *in, uint64_t N, node_t *tree) {
         if (!all) rc = nomem(c, "samples", total);
     }
     if ((rc = agree(c, rc)) == HD_OK) {
-        int e = MPI_Gatherv(mine, n, c->sample_type, all, counts, counts + K, c->sample_type, 0, c->comm);
+        double mpi_t0_;
+        int mpi_rc_,
+            e = MPI_TIMED(c, MPI_Gatherv(mine, n, c->sample_type, all, counts, counts + K, c->sample_type, 0, c->comm));
         if (e != MPI_SUCCESS) rc = mpi_failed(c, "MPI_Gatherv", e);
         c->bytes_part += c->rank ? (uint64_t)ns * sizeof(sample_t) : 0;
         if (rc == HD_OK && c->rank == 0) {
@@ -1676,7 +1704,7 @@ typedef struct { double *alpha; int *disjoint; } overlap_t;
 static int run(ctx_t *c, const hd_options_t *opt, input_t *in, int both, void *res, hd_mpi_stats_t *st) {
     hd_symmetric_t *out = both == MODE_BOTH ? res : NULL;
     int K = c->K;
-    double t0 = hd__now();
+    double t0 = hd__now(), cpu0 = thread_cpu();
     node_t *tree = NULL;
     hd__box_t *region = NULL;
     held_t *held = NULL;
@@ -1749,8 +1777,9 @@ static int run(ctx_t *c, const hd_options_t *opt, input_t *in, int both, void *r
         r[s]->algorithm = HD_ALG_AUTO;
     }
     /* Figures. */
-    double secs = hd__now() - t0, tmax = secs, tsum = secs, mine[3] = {secs, c->search, c->search_cpu}, most[3];
-    MPI_GO(c, rc, MPI_Allreduce(mine, most, 3, MPI_DOUBLE, MPI_MAX, c->comm));
+    double other = thread_cpu() - cpu0 - c->search_cpu - c->mpi_cpu;
+    double secs = hd__now() - t0, tmax = secs, tsum = secs, mine[4] = {secs, c->search, c->search_cpu, other}, most[4];
+    MPI_GO(c, rc, MPI_Allreduce(mine, most, 4, MPI_DOUBLE, MPI_MAX, c->comm));
     tmax = most[0];
     MPI_GO(c, rc, MPI_Allreduce(&secs, &tsum, 1, MPI_DOUBLE, MPI_SUM, c->comm));
     for (int s = 0; s < (both ? 2 : 1); s++) r[s]->seconds = tmax;
@@ -1781,6 +1810,8 @@ static int run(ctx_t *c, const hd_options_t *opt, input_t *in, int both, void *r
         st->search_seconds_max = most[1];
         st->search_seconds = c->search;
         st->search_cpu_max = most[2];
+        st->other_cpu_max = most[3];
+        st->other_cpu = other;
         st->peak_bytes_max = gm[2];
         st->seconds = secs;
         st->local_points = pts;
