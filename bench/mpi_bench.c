@@ -2,7 +2,7 @@
  * mpi_bench.c -- the exchange figures of hd_mpi_hausdorff (docs/scale-out.md):
  *     mpirun -n K build/bench/mpi_bench [--points N] [--per-rank] [--cases LIST]
  *                                       [--layout random|tiles] [--threads T]
- *                                       [--check]
+ *                                       [--check] [--repeat R]
  * For each case, every rank generates its share of A and B (N points per
  * side in total, or per rank with --per-rank: weak scaling), and one call
  * of hd_mpi_hausdorff is timed; rank 0 prints one line per case with the
@@ -21,7 +21,10 @@
  * RSS before it per local point ("hwm": VmHWM reset through
  * /proc/self/clear_refs before the call, so everything the call touched
  * counts, the engine's and MPI's memory too; run one case per process for
- * it, since later cases reuse memory freed by earlier ones).  --check compares with hd_hausdorff on
+ * it, since later cases reuse memory freed by earlier ones).  --repeat R
+ * calls R times per case (the repeats' lines are marked "+": memory the
+ * first call freed is reused, so they show the costs without first
+ * touches of fresh pages).  --check compares with hd_hausdorff on
  * rank 0 (all points gathered; small N only).
  *
  * Cases:
@@ -88,7 +91,7 @@ int main(int argc, char **argv) {
     MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
     MPI_Comm_size(MPI_COMM_WORLD, &K_);
     size_t N = 1000000;
-    int per_rank = 0, tiles = 0, threads = 1, check = 0;
+    int per_rank = 0, tiles = 0, threads = 1, check = 0, repeat = 1;
     const char *cases = "uniform,lidar,copy";
     for (int k = 1; k < argc; k++) {
         if (!strcmp(argv[k], "--points") && k + 1 < argc) N = (size_t)atof(argv[++k]);
@@ -97,6 +100,7 @@ int main(int argc, char **argv) {
         else if (!strcmp(argv[k], "--layout") && k + 1 < argc) tiles = !strcmp(argv[++k], "tiles");
         else if (!strcmp(argv[k], "--threads") && k + 1 < argc) threads = atoi(argv[++k]);
         else if (!strcmp(argv[k], "--check")) check = 1;
+        else if (!strcmp(argv[k], "--repeat") && k + 1 < argc) repeat = atoi(argv[++k]);
         else {
             if (rank_ == 0) fprintf(stderr, "mpi_bench: unknown argument %s\n", argv[k]);
             MPI_Finalize();
@@ -118,7 +122,8 @@ int main(int argc, char **argv) {
                K_, N, per_rank ? " per rank" : "", tiles ? "tiles" : "random", threads);
     char list[256];
     snprintf(list, sizeof list, "%s", cases);
-    for (char *c = strtok(list, ","); c; c = strtok(NULL, ",")) {
+    for (char *c = strtok(list, ","); c; c = strtok(NULL, ","))
+      for (int rep = 0; rep < (repeat > 0 ? repeat : 1); rep++) {
         scene_make(c, tiles ? rank_ : 0, tiles ? K_ : 1, 7, (uint64_t)rank_, a, b, n);
         hd_mpi_part_t pa = {hd_points_f64(a, n), offset}, pb = {hd_points_f64(b, n), offset};
         hd_options_t opt;
@@ -145,7 +150,7 @@ int main(int argc, char **argv) {
         MPI_Reduce(&hwm, &hwmax, 1, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD);
         uint64_t tot = st.points;
         if (rank_ == 0)
-            printf("%-8s %9llu %9.2f %9.3f %7.3f %6.3f %8.3f %10.1f %10.1f %8.3f %8.3f %8.1f %8.1f %7.3f %8.1f %8.1f %8.1f\n", c,
+            printf("%-8s%s %9llu %9.2f %9.3f %7.3f %6.3f %8.3f %10.1f %10.1f %8.3f %8.3f %8.1f %8.1f %7.3f %8.1f %8.1f %8.1f\n", c, rep ? "+" : "",
                    (unsigned long long)tot, (double)st.bytes_partition / (double)tot,
                    (double)st.bytes_forwarding / (double)tot, 100.0 * (double)st.forwarded_points / (double)tot,
                    st.imbalance, st.work_imbalance, (double)st.peak_bytes_max / ((double)tot / K_), most,

@@ -427,8 +427,9 @@ static int faces_clear(const hd__box_t *r, const double *p, double u2) {
  * within h of the region's faces, and queries from beyond the faces), so
  * the first is built over a slab: the points of Q within a margin M of a
  * finite face.  An answer from the slab is the answer from all of Q when
- * every point left out is provably farther (slab_proves); the others ask
- * a slab twice as wide as they need, then all of Q.
+ * every point left out is provably farther (slab_proves); the others,
+ * when a few, are compared with every point of Q, else ask a slab twice as
+ * wide as they need, then all of Q.
  *
  * Proof.  A point b of Q left out has fl(|b_k - s|) > M for every finite
  * face s (on axis k) of the region, which holds b.  For a lo face s and any
@@ -573,6 +574,12 @@ static int slab_search(ctx_t *c, const slab_t *sl, const double *pts, const size
     return rc;
 }
 
+/* At most this many points the slab did not prove are searched by brute
+ * force (a handful, on a copy: points whose partner is on another rank)
+ * rather than in a wider slab, which costs as much as a few hundred
+ * thousand distances to build. */
+#define BRUTE_MAX 16
+
 /* For each of n packed points, the nearest point of Q (exact, smallest
  * index on ties, as hd_distances gives it). */
 static int nearest_in_q(ctx_t *c, const dir_t *d, const hd__box_t *r, qtree_t *q, const double *pts, size_t n,
@@ -594,6 +601,20 @@ static int nearest_in_q(ctx_t *c, const dir_t *d, const hd__box_t *r, qtree_t *q
     for (int level = 0; level < 3 && m > 0 && rc == HD_OK; level++) {
         slab_t *sl = level == 2 ? &q->full : &q->sub;
         double M = level == 2 ? INFINITY : q->M0;
+        if (level == 1 && m <= BRUTE_MAX) { /* a few: every point of Q, in index order */
+            for (size_t t = 0; t < m; t++) {
+                const double *x = pts + 3 * list[t];
+                double best = INFINITY;
+                size_t at = SIZE_MAX;
+                for (size_t j = 0; j < d->nQ; j++) {
+                    double d2 = hd__d2(x, d->Q + 3 * j);
+                    if (d2 < best) best = d2, at = j;
+                }
+                near[list[t]] = at;
+            }
+            m = 0;
+            break;
+        }
         if (level == 1) { /* twice what the unproven need, if finite */
             double need = q->sub.M;
             for (size_t t = 0; t < m; t++) {
