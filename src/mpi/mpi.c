@@ -156,7 +156,10 @@ static void *cmalloc(ctx_t *c, size_t n, size_t size) {
         else madvise(p, bytes, MADV_HUGEPAGE); /* advice: failure changes nothing */
     } else
 #endif
+    {
         p = malloc(bytes ? bytes : 1);
+        hd__prefault(p, bytes); /* one call, not a fault a page (a no-op below 1 MiB) */
+    }
     if (p) {
         c->cur += bytes;
         if (c->cur > c->peak) c->peak = c->cur;
