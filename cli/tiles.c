@@ -319,6 +319,53 @@ static int from_list(const tiles_t *s, const tile_t *t, int rc, hd_error_t *err)
     return rc;
 }
 
+/* Read tile k (points [from, from + take) of it when take > 0) and append
+ * it to *all (NULL at first: the first tile's buffer becomes the side's).
+ * Fills the tile's count and first when it is read whole; a partial read
+ * leaves them (tiles_read_points numbers from the header counts).  On
+ * failure *all is freed and NULL. */
+static int read_tile(tiles_t *s, size_t k, const hd_read_options_t *ro, analysis_args_t *an, int which, uint64_t from,
+                    uint64_t take, hd_cloud_t **all, size_t *cap, hd_error_t *err) {
+    tile_t *t = &s->t[k];
+    hd_read_options_t r = *ro;
+    if (t->format) r.format = t->format;
+    r.seed = ro->seed + (uint64_t)k;
+    r.range_first = from;
+    r.range_count = take;
+    hd_cloud_t *c;
+    int rc = cli_read_points(t->path, &r, an, which, &c, err);
+    if (rc != HD_OK) {
+        hd_cloud_free(*all);
+        *all = NULL;
+        return from_list(s, t, rc, err);
+    }
+    if (!take) {
+        t->first = *all ? (*all)->count : 0;
+        t->count = c->count;
+    } else if (from) {
+        c->n_faces = 0; /* a tile's faces count once: in the piece that starts it */
+    }
+    if (!*all) {
+        *all = c; /* its buffer becomes the side's */
+        *cap = c->count;
+    } else if ((rc = append(*all, cap, c, t->path, err)) != HD_OK) {
+        hd_cloud_free(*all);
+        *all = NULL;
+        return rc;
+    }
+    return HD_OK;
+}
+
+/* The side's cloud without the growth's slack. */
+static hd_cloud_t *trimmed(hd_cloud_t *all) {
+    size_t el = all->dtype == HD_FLOAT32 ? 3 * sizeof(float) : 3 * sizeof(double);
+    if (all->count) {
+        void *p = realloc(all->data, all->count * el);
+        if (p) all->data = p;
+    }
+    return all;
+}
+
 int tiles_read(tiles_t *s, size_t first, size_t n, const hd_read_options_t *ro, analysis_args_t *an, int which,
                hd_cloud_t **out, hd_error_t *err) {
     *out = NULL;
@@ -338,32 +385,43 @@ int tiles_read(tiles_t *s, size_t first, size_t n, const hd_read_options_t *ro, 
     hd_cloud_t *all = NULL;
     size_t cap = 0;
     for (size_t k = first; k < first + n; k++) {
-        tile_t *t = &s->t[k];
+        int rc = read_tile(s, k, ro, an, which, 0, 0, &all, &cap, err);
+        if (rc != HD_OK) return rc;
+    }
+    *out = trimmed(all);
+    return HD_OK;
+}
+
+int tiles_count(const tiles_t *s, int rank, int parts, const hd_read_options_t *ro, uint64_t *counts) {
+    assert(parts >= 1 && rank >= 0 && rank < parts);
+    for (size_t k = 0; k < s->n; k++) {
+        counts[k] = 0;
+        if (k % (size_t)parts != (size_t)rank) continue;
         hd_read_options_t r = *ro;
-        if (t->format) r.format = t->format;
-        r.seed = ro->seed + (uint64_t)k;
-        hd_cloud_t *c;
-        int rc = cli_read_points(t->path, &r, an, which, &c, err);
-        if (rc != HD_OK) {
-            hd_cloud_free(all);
-            return from_list(s, t, rc, err);
-        }
-        t->first = all ? all->count : 0;
-        t->count = c->count;
-        if (!all) {
-            all = c; /* its buffer becomes the side's */
-            cap = c->count;
-        } else if ((rc = append(all, &cap, c, t->path, err)) != HD_OK) {
-            hd_cloud_free(all);
-            return rc;
-        }
+        if (s->t[k].format) r.format = s->t[k].format;
+        uint64_t c;
+        hd_error_t e;
+        if (hd_read_count(s->t[k].path, &r, &c, &e) == HD_OK && c < UINT64_MAX) counts[k] = c + 1;
     }
-    if (cap > all->count && all->count) { /* trim the growth's slack */
-        size_t el = all->dtype == HD_FLOAT32 ? 3 * sizeof(float) : 3 * sizeof(double);
-        void *p = realloc(all->data, all->count * el);
-        if (p) all->data = p;
+    return HD_OK;
+}
+
+int tiles_read_points(tiles_t *s, uint64_t g, uint64_t m, const hd_read_options_t *ro, analysis_args_t *an,
+                      int which, hd_cloud_t **out, hd_error_t *err) {
+    *out = NULL;
+    hd_cloud_t *all = NULL;
+    size_t cap = 0;
+    for (size_t k = 0; k < s->n && m; k++) {
+        tile_t *t = &s->t[k];
+        if (g >= (uint64_t)t->first + t->count) continue; /* before the range */
+        uint64_t from = g - t->first, take = t->count - from < m ? t->count - from : m;
+        int rc = read_tile(s, k, ro, an, which, from, take, &all, &cap, err);
+        if (rc != HD_OK) return rc;
+        g += take;
+        m -= take;
     }
-    *out = all;
+    if (!all && !(all = cli_cloud_new(0, ro->dtype, "empty"))) return fail(err, HD_ENOMEM, 0, "out of memory");
+    *out = trimmed(all);
     return HD_OK;
 }
 

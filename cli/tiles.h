@@ -100,6 +100,22 @@ int tiles_read(tiles_t *s, size_t first, size_t n, const hd_read_options_t *ro,
                analysis_args_t *an, int which, hd_cloud_t **out,
                hd_error_t *err);
 
+/* Split by points, for processes that share a side of few big files.
+ * tiles_count: for the tiles k with k % parts == rank, counts[k] = the
+ * tile's point count + 1 from its header (hd_read_count), 0 when the header
+ * does not say (text, sampled meshes, ...) or the tile cannot be opened
+ * (reading it reports that); the other entries are 0, so a sum over the
+ * processes gives every tile's.  counts has s->n entries.  Never fails.
+ * tiles_read_points: the side's points [g, g + m), once every tile's count
+ * and first are set (tiles_number): the tiles that meet the range, each
+ * read in part (hd_read_options_t.range_first/range_count) and appended.
+ * Errors as tiles_read; m = 0 is a cloud of 0 points. */
+int tiles_count(const tiles_t *s, int rank, int parts,
+                const hd_read_options_t *ro, uint64_t *counts);
+int tiles_read_points(tiles_t *s, uint64_t g, uint64_t m,
+                      const hd_read_options_t *ro, analysis_args_t *an,
+                      int which, hd_cloud_t **out, hd_error_t *err);
+
 /* Number the whole side from the tiles' counts: first = the counts of the
  * tiles before, summed.  For processes that each read a share: once every
  * tile's count is known everywhere (gathered), tiles_locate works as after

@@ -20,6 +20,9 @@
  * vertices never more points than the input has bytes (no reader may
  * allocate more than the file can hold; a LAZ
  * chunk up to HD__LAZ_POINTS_PER_BYTE points per byte), sampled exactly the sample size.
+ * After a success two more reads check the range contract: where the
+ * header count answers it equals the count read, and a range read of the
+ * middle third gives exactly that slice of the whole read, bit for bit.
  */
 #include "io/io.h"
 
@@ -75,6 +78,18 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
         for (int d = 0; d < 3; d++)
             if (!isfinite(q[d]) || fabs(q[d]) > HD_MAX_COORD) abort();
     }
+    uint64_t total;
+    rc = hd__count_buffer(data, size, NAME, &o, &total, &e);
+    if (rc == HD_OK ? total != c->count : rc != HD_EUNSUPPORTED) abort();
+    o.range_first = c->count / 3;
+    o.range_count = c->count - c->count / 3 - c->count / 3;
+    hd_cloud_t *part = NULL;
+    rc = hd__read_buffer(data, size, NAME, &o, &part, &e);
+    size_t el = c->dtype == HD_FLOAT32 ? 3 * sizeof(float) : 3 * sizeof(double);
+    if (rc != HD_OK || part->count != o.range_count ||
+        memcmp(part->data, (const char *)c->data + o.range_first * el, part->count * el) != 0)
+        abort();
+    hd_cloud_free(part);
     hd_cloud_free(c);
     return 0;
 }

@@ -506,6 +506,17 @@ typedef struct hd_read_options {
                               1: commas are decimal separators and fields
                               are separated by ';' or blanks, as European
                               spreadsheets write. */
+    uint64_t range_first;  /* with range_count > 0: only the points
+                              [range_first, range_first + range_count) of
+                              what the whole read gives, numbered from 0
+                              (HD_ERANGE when the file has fewer).  LAS,
+                              LAZ (only the chunks that meet the range are
+                              decoded), NPY and the fixed-size records of
+                              binary PLY, PCD and STL touch only the range's
+                              bytes, so processes can split one file; other
+                              formats are read whole, then cut.  A bad point
+                              outside the range is not seen. */
+    uint64_t range_count;  /* 0 (default): the whole file */
 } hd_read_options_t;
 
 /* The defaults of stream_limit (2 GiB) and fifo_wait_ms (30 s). */
@@ -528,6 +539,18 @@ HD_EXTERN void hd_read_options_init(hd_read_options_t *opt);
  * The formats, their variants and their messages: docs/formats.md. */
 HD_EXTERN int hd_read_file(const char *path, const hd_read_options_t *opt,
                            hd_cloud_t **out, hd_error_t *err);
+
+/* The number of points hd_read_file(path, opt) would give, from the
+ * file's header alone: for LAS, LAZ, NPY and binary PLY, PCD and STL (the
+ * formats whose range reads touch only the range; see range_first), once
+ * the header and the file's size are checked.  For a program that splits
+ * one file between processes.  opt NULL: defaults; its range is ignored.
+ * Errors: those of hd_read_file for the header, and HD_EUNSUPPORTED for
+ * every other format or variant (text, OBJ, OFF, ascii PLY/PCD/STL, PLY
+ * vertices with list properties), standard input and mesh sampling, whose
+ * count needs the whole file read.  *count is 0 on failure.  Thread safe. */
+HD_EXTERN int hd_read_count(const char *path, const hd_read_options_t *opt,
+                            uint64_t *count, hd_error_t *err);
 
 /* Free a cloud.  NULL is accepted. */
 HD_EXTERN void hd_cloud_free(hd_cloud_t *cloud);

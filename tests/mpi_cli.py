@@ -7,8 +7,10 @@ hang.  Standard library only; run as:
 Random points come from random.Random(SEED); a failure prints the seed.
 """
 import json
+import math
 import os
 import random
+import struct
 import subprocess
 import sys
 import tempfile
@@ -61,6 +63,24 @@ def make_tiles(tmp, rng):
     return os.path.join(tmp, "A"), "@" + os.path.join(tmp, "B", "list.txt")
 
 
+def write_ply_binary(path, points):
+    """Binary little-endian PLY of doubles with an extra uchar per vertex."""
+    head = ("ply\nformat binary_little_endian 1.0\nelement vertex %d\nproperty double x\nproperty double y\n"
+            "property uchar i\nproperty double z\nend_header\n" % len(points)).encode()
+    with open(path, "wb") as f:
+        f.write(head + b"".join(struct.pack("<ddBd", x, y, 7, z) for (x, y, z) in points))
+    return path, len(head)
+
+
+def write_npy(path, points):
+    d = "{'descr': '<f8', 'fortran_order': False, 'shape': (%d, 3), }" % len(points)
+    d += " " * ((64 - (10 + len(d) + 1) % 64) % 64) + "\n"
+    with open(path, "wb") as f:
+        f.write(b"\x93NUMPY\x01\x00" + struct.pack("<H", len(d)) + d.encode())
+        f.write(b"".join(struct.pack("<3d", *p) for p in points))
+    return path
+
+
 def main():
     hausdorff, tool, k, mpirun = sys.argv[1], sys.argv[2], int(sys.argv[3]), sys.argv[4:]
     failures = []
@@ -108,6 +128,35 @@ def main():
             write(os.path.join(tmp, name + "_b.xyz"), xyz(pts[25:200:3]))
             same_json([os.path.join(tmp, name), os.path.join(tmp, name + "_b.xyz")])
 
+        # One big binary file a side: every rank reads a range of it
+        # (hd_read_count, range reads), and the answer is the same.
+        pa = [tuple(rng.gauss(0, 1) for _ in range(3)) for _ in range(3001)]
+        pb = [tuple(c + rng.gauss(0, 1e-3) for c in p) for p in pa[::2]] + [(0.5, 0.5, 9.0)]
+        os.makedirs(os.path.join(tmp, "one"))
+        ply, head_len = write_ply_binary(os.path.join(tmp, "one", "a.ply"), pa)
+        npy = write_npy(os.path.join(tmp, "one", "b.npy"), pb)
+        same_json([ply, npy])
+        same_json(["--directed", npy, ply])
+        rc, out, err = ranks(mpirun, k, tool, "--json", ply, npy)
+        check(rc == 0 and json.loads(out)["mpi"]["read_by_points"] == [True, True],
+              "one file a side is read by points: %r %r" % (out[-300:], err))
+        laz = os.path.join(HERE, "corpus", "laz", "fmt0_chunks16.laz")
+        same_json([laz, os.path.join(HERE, "corpus", "laz", "fmt1_variable.laz")])
+        rc, out, err = ranks(mpirun, k, tool, "--json", A, npy)
+        check(rc == 0 and json.loads(out)["mpi"]["read_by_points"] == [False, True],
+              "text tiles are shared by tiles: %r %r" % (out[-300:], err))
+        # A NaN in the last third of the one file, which the last rank's
+        # range holds: the message hausdorff gives, byte offset included.
+        bad = list(pa)
+        bad[2900] = (1.0, math.nan, 2.0)
+        badply, _ = write_ply_binary(os.path.join(tmp, "one", "bad.ply"), bad)
+        rc, out, err = ranks(mpirun, k, tool, badply, npy)
+        rc1, _, err1 = single(hausdorff, badply, npy)
+        lines = [l for l in err.splitlines() if l.startswith("hausdorff-mpi:")]
+        want = "byte %d: point 2900:" % (head_len + 2900 * 25 + 8)
+        check(rc == 2 and rc1 == 2 and len(lines) == 1 and want in lines[0] and want in err1,
+              "NaN in a split file: exit %d/%d, %r, %r, want %r" % (rc, rc1, err, err1, want))
+
         # Bad input in the last tile of A, which the last rank reads: one
         # message naming it, exit 2 from every rank, within the timeout.
         write(os.path.join(tmp, "bad", "a0.xyz"), xyz(small[:50]))
@@ -124,6 +173,16 @@ def main():
         # A missing file: every rank fails alike.
         rc, out, err = ranks(mpirun, k, tool, os.path.join(tmp, "nope.xyz"), lion)
         check(rc == 2 and err.count("nope.xyz") == 1, "missing file: exit %d, %r" % (rc, err))
+        # --empty: an empty side gets the policy's answer, as hausdorff gives it.
+        empty = write(os.path.join(tmp, "empty.xyz"), "# no points\n")
+        for args in (["--empty", "inf", empty, lion], ["--empty", "zero", "--directed", lion, empty],
+                     ["--empty", "monai", empty, empty]):
+            for fmt in (["--json"], []):
+                rc1, out1, err1 = single(hausdorff, *fmt, *args)
+                rc2, out2, err2 = ranks(mpirun, k, tool, *fmt, *args)
+                check(rc1 == 0 and rc2 == 0 and out1 == out2, "%s: %d %d\n%s\n%s%s" % (fmt + args, rc1, rc2, out1, out2, err2))
+        rc, out, err = ranks(mpirun, k, tool, empty, lion)
+        check(rc == 2 and err.count("hausdorff-mpi:") == 1 and "--empty" in err, "empty without --empty: %d %r" % (rc, err))
         # Per-point outputs are refused, once.
         rc, out, err = ranks(mpirun, k, tool, "--percentile", "95", lion, head)
         check(rc == 1 and err.count("hausdorff-mpi:") == 1, "--percentile: exit %d, %r" % (rc, err))

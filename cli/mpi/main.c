@@ -19,7 +19,9 @@
  * gave up.  Only rank 0 writes to standard output and standard error (the
  * others' are /dev/null), so a message appears once, not K times.  The
  * per-point outputs (--distances, --percentile, pictures, ...) need every
- * distance in one place and are refused (exit 1), as is --empty.
+ * distance in one place and are refused (exit 1).  Under --empty a side
+ * whose ranks read no point at all gets the policy's answer, printed by
+ * rank 0 with the single-process code (analysis_handle_empty).
  */
 #include <hausdorff_mpi.h>
 
@@ -90,6 +92,47 @@ static int number_tiles(tiles_t *t, size_t first, size_t n, size_t *offset, hd_e
     return rc;
 }
 
+/* Read this rank's share of a side by points rather than by tiles, when
+ * every tile's header gives its count (LAS, LAZ, NPY, binary PLY/PCD/STL):
+ * the side's N points are cut into K equal ranges, and part `share` reads
+ * [N share / K, N (share + 1) / K), parts of at most two tiles and the
+ * whole of those between.  One big file is then read by every rank, each
+ * touching only its range's bytes (or, in a LAZ, decoding only the chunks
+ * that meet it).  *split is 0 when some tile's count is unknown or zero
+ * (an empty tile has to be reported as the whole read reports it): the
+ * caller shares by tiles then. */
+static int read_split(tiles_t *t, int share, const cli_args_t *a, analysis_args_t *an, int which, int *split,
+                      hd_cloud_t **out, size_t *offset, hd_error_t *err) {
+    *split = 0;
+    size_t m = t->n ? t->n : 1;
+    uint64_t *mine = calloc(m, sizeof *mine), *all = calloc(m, sizeof *all);
+    int rc = mine && all ? HD_OK : HD_ENOMEM;
+    if (rc) snprintf(err->message, sizeof err->message, "out of memory for %zu tiles", t->n);
+    if ((rc = agree(rc, err)) == HD_OK && t->n) {
+        tiles_count(t, rank_, K_, &a->read, mine);
+        MPI_Allreduce(mine, all, (int)m, MPI_UINT64_T, MPI_SUM, MPI_COMM_WORLD);
+        int known = 1;
+        for (size_t k = 0; k < t->n; k++) known &= all[k] > 1;
+        if (known) {
+            for (size_t k = 0; k < t->n; k++) t->t[k].count = (size_t)(all[k] - 1);
+            rc = tiles_number(t, err); /* the same verdict on every rank */
+        }
+        if (known && rc == HD_OK) {
+            uint64_t n = (uint64_t)t->t[t->n - 1].first + t->t[t->n - 1].count;
+            uint64_t q = n / (uint64_t)K_, rem = n % (uint64_t)K_;
+#define BOUND(r) ((uint64_t)(r) * q + (uint64_t)(r) * rem / (uint64_t)K_)
+            uint64_t lo = BOUND(share), hi = BOUND(share + 1);
+#undef BOUND
+            *split = 1;
+            *offset = (size_t)lo;
+            rc = tiles_read_points(t, lo, hi - lo, &a->read, an, which, out, err);
+        }
+    }
+    free(mine);
+    free(all);
+    return rc;
+}
+
 /* A side's format: its ranks' common one, or "mixed". */
 static void side_format(const hd_cloud_t *c, char out[16]) {
     char mine[16] = {0}, *all = rank_ == 0 ? calloc((size_t)K_, 16) : NULL;
@@ -117,8 +160,9 @@ static void fetch_point(const hd_mpi_part_t *p, size_t g, double q[3]) {
 
 /* The exchange figures, gathered to rank 0 and printed there. */
 static void mpi_json(FILE *out, const hd_mpi_stats_t *st, const double *secs, const double *peak,
-                     const double *rss) {
+                     const double *rss, const int split[2]) {
     fprintf(out, ", \"mpi\": {\"ranks\": %d, \"rounds\": %d", st->ranks, st->rounds);
+    fprintf(out, ", \"read_by_points\": [%s, %s]", split[0] ? "true" : "false", split[1] ? "true" : "false");
     fprintf(out, ", \"bytes_per_point\": ");
     json_number(out, (double)(st->bytes_partition + st->bytes_forwarding) / (double)st->points);
     fprintf(out, ", \"bytes_partition\": %llu, \"bytes_forwarding\": %llu",
@@ -152,10 +196,9 @@ int main(int argc, char **argv) {
     cli_args_t a;
     int rc = cli_parse(argc, argv, &a); /* the same verdict on every rank */
     if (rc >= 0) return finish(rc == EXIT_OK ? out_finish() : rc);
-    if (analysis_active(&a.an) || a.an.empty != EMPTY_ERROR) {
+    if (analysis_active(&a.an)) {
         fprintf(stderr, "hausdorff-mpi: per-point outputs (--distances, --percentile, --mean, --chamfer, "
-                        "--histogram, --render, ...) and --empty need every distance in one process: use "
-                        "hausdorff\n");
+                        "--histogram, --render, ...) need every distance in one process: use hausdorff\n");
         return finish(EXIT_USAGE);
     }
     hd_error_t err;
@@ -173,13 +216,37 @@ int main(int argc, char **argv) {
     double t0 = cli_now();
     hd_mpi_part_t part[2];
     size_t first[2] = {0, 0}, n[2] = {0, 0};
+    int split[2] = {0, 0};
     for (int w = 0; w < 2 && rc == HD_OK; w++) {
-        tiles_share(&side[w], w ? (rank_ + K_ / 2) % K_ : rank_, K_, &first[w], &n[w]);
+        int share = w ? (rank_ + K_ / 2) % K_ : rank_;
+        rc = read_split(&side[w], share, &a, &a.an, w, &split[w], &cloud[w], &part[w].offset, &err);
+        if ((rc = agree(rc, &err)) != HD_OK || split[w]) {
+            if (rc == HD_OK) part[w].points = hd_cloud_points(cloud[w]);
+            continue;
+        }
+        tiles_share(&side[w], share, K_, &first[w], &n[w]);
         rc = tiles_read(&side[w], first[w], n[w], &a.read, &a.an, w, &cloud[w], &err);
         if ((rc = agree(rc, &err)) == HD_OK) rc = number_tiles(&side[w], first[w], n[w], &part[w].offset, &err);
         if (rc == HD_OK) part[w].points = hd_cloud_points(cloud[w]);
     }
     double read_local = cli_now() - t0, read_seconds = read_local;
+    if (rc == HD_OK) { /* an empty side (only under --empty: else reading refused it) */
+        uint64_t mine[2] = {cloud[0]->count, cloud[1]->count}, all[2];
+        MPI_Allreduce(mine, all, 2, MPI_UINT64_T, MPI_SUM, MPI_COMM_WORLD);
+        if (!all[0] || !all[1]) {
+            /* the policy's answer, printed as hausdorff prints it: the
+             * views carry the counts only (no per-point output is asked) */
+            hd_points_t A = hd_points_f64(NULL, (size_t)all[0]), B = hd_points_f64(NULL, (size_t)all[1]);
+            int status = rank_ == 0 ? analysis_handle_empty(&a.an, a.path_a, a.path_b, &A, &B, a.directed, a.json)
+                                    : EXIT_OK;
+            if (rank_ == 0) status = status == EXIT_OK ? out_finish() : (out_discard(), status);
+            for (int w = 0; w < 2; w++) {
+                hd_cloud_free(cloud[w]);
+                tiles_free(&side[w]);
+            }
+            return finish(status);
+        }
+    }
     hd_symmetric_t s;
     hd_mpi_stats_t st;
     memset(&s, 0, sizeof s);
@@ -238,7 +305,7 @@ int main(int argc, char **argv) {
             status = EXIT_FAILURE_;
         } else if (a.json) {
             report_json(out, &r);
-            mpi_json(out, &st, col[0], col[1], col[2]);
+            mpi_json(out, &st, col[0], col[1], col[2], split);
             fprintf(out, "}\n");
         } else {
             report_text(out, &r);

@@ -14,7 +14,7 @@ hausdorff.DirectedResult(distance=1.0, i=1, j=0)
 2.0
 
 Functions: directed (a drop-in for scipy's directed_hausdorff), hausdorff,
-distances, percentile, summary, mean, chamfer, read, formats;
+distances, percentile, summary, mean, chamfer, read, count, formats;
 the class Index (build once, query many times, optionally transformed).
 """
 from ._hausdorff import (
@@ -27,6 +27,7 @@ from ._hausdorff import (
     __version__,
     algorithms,
     chamfer,
+    count,
     directed,
     distances,
     formats,
@@ -47,6 +48,7 @@ __all__ = [
     "__version__",
     "algorithms",
     "chamfer",
+    "count",
     "directed",
     "distances",
     "formats",

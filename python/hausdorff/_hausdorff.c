@@ -1062,7 +1062,8 @@ static void cloud_capsule_free(PyObject *capsule) {
 }
 
 PyDoc_STRVAR(read_doc,
-"read($module, path, *, format=None, float32=False, decimal_comma=False)\n--\n\n"
+"read($module, path, *, format=None, float32=False, decimal_comma=False,\n"
+"     start=0, count=None)\n--\n\n"
 "Read a point cloud with the library's readers and return it as an (N, 3)\n"
 "array, float64 by default or float32 with float32=True.\n"
 "\n"
@@ -1071,6 +1072,10 @@ PyDoc_STRVAR(read_doc,
 "vertices.  Text files whose numbers have decimal commas (1,5;2,5;3,5) are\n"
 "refused unless decimal_comma=True, which reads commas as decimal points\n"
 "and ';' or blanks as separators.\n"
+"start and count read points [start, start + count) only (count None: to\n"
+"the end); LAS, LAZ, NPY and binary PLY/PCD/STL then touch only those\n"
+"records, so processes can share one big file (hausdorff.count gives its\n"
+"size from the header).  A range past the end raises ValueError.\n"
 "The array takes over the memory the reader filled: no copy.\n"
 "Raises OSError when the file cannot be read and ValueError when it is\n"
 "malformed, empty or of an unknown format.\n"
@@ -1084,17 +1089,58 @@ PyDoc_STRVAR(read_doc,
 
 static PyObject *py_read(PyObject *self, PyObject *args, PyObject *kw) {
     (void)self;
-    static char *kwlist[] = {"path", "format", "float32", "decimal_comma", NULL};
-    PyObject *path = NULL;
+    static char *kwlist[] = {"path", "format", "float32", "decimal_comma", "start", "count", NULL};
+    PyObject *path = NULL, *count_obj = Py_None;
     const char *format = NULL;
     int float32 = 0, decimal_comma = 0;
-    if (!PyArg_ParseTupleAndKeywords(args, kw, "O&|$zpp:read", kwlist, PyUnicode_FSConverter,
-                                     &path, &format, &float32, &decimal_comma))
+    unsigned long long start = 0, count = 0;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "O&|$zppKO:read", kwlist, PyUnicode_FSConverter,
+                                     &path, &format, &float32, &decimal_comma, &start, &count_obj))
         return NULL;
+    if (count_obj != Py_None) {
+        count = PyLong_AsUnsignedLongLong(count_obj);
+        if (PyErr_Occurred() || count == 0) {
+            PyErr_Clear();
+            Py_DECREF(path);
+            PyErr_SetString(PyExc_ValueError, "read: count must be a positive integer or None");
+            return NULL;
+        }
+    }
     hd_read_options_t ropt;
     hd_read_options_init(&ropt);
     ropt.format = format;
     ropt.decimal_comma = decimal_comma;
+    if (start || count_obj != Py_None) {
+        hd_error_t cerr;
+        uint64_t total = 0;
+        if (count_obj == Py_None) { /* to the end: the header's count, else a whole read's */
+            int crc;
+            Py_BEGIN_ALLOW_THREADS
+            crc = hd_read_count(PyBytes_AS_STRING(path), &ropt, &total, &cerr);
+            Py_END_ALLOW_THREADS
+            if (crc == HD_EUNSUPPORTED) {
+                hd_cloud_t *whole = NULL;
+                Py_BEGIN_ALLOW_THREADS
+                crc = hd_read_file(PyBytes_AS_STRING(path), &ropt, &whole, &cerr);
+                Py_END_ALLOW_THREADS
+                if (whole) total = whole->count;
+                hd_cloud_free(whole);
+            }
+            if (crc != HD_OK) {
+                Py_DECREF(path);
+                return raise_hd(crc, &cerr);
+            }
+            if (start >= total) {
+                Py_DECREF(path);
+                PyErr_Format(PyExc_ValueError, "%s: start %llu is not below the file's %llu points",
+                             PyBytes_AS_STRING(path), start, (unsigned long long)total);
+                return NULL;
+            }
+            count = total - start;
+        }
+        ropt.range_first = start;
+        ropt.range_count = count;
+    }
     ropt.dtype = float32 ? HD_FLOAT32 : HD_FLOAT64;
     hd_cloud_t *cloud = NULL;
     hd_error_t err;
@@ -1122,6 +1168,35 @@ static PyObject *py_read(PyObject *self, PyObject *args, PyObject *kw) {
         return NULL;
     }
     return arr;
+}
+
+PyDoc_STRVAR(count_doc,
+"count($module, path, *, format=None)\n--\n\n"
+"The number of points read(path) would give, from the file's header alone,\n"
+"for LAS, LAZ, NPY and binary PLY, PCD and STL.  Raises ValueError for the\n"
+"other formats (their count needs the whole file read) and as read() does\n"
+"for a bad header.\n");
+
+static PyObject *py_count(PyObject *self, PyObject *args, PyObject *kw) {
+    (void)self;
+    static char *kwlist[] = {"path", "format", NULL};
+    PyObject *path = NULL;
+    const char *format = NULL;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "O&|$z:count", kwlist, PyUnicode_FSConverter, &path, &format))
+        return NULL;
+    hd_read_options_t ropt;
+    hd_read_options_init(&ropt);
+    ropt.format = format;
+    uint64_t n = 0;
+    hd_error_t err;
+    int rc;
+    const char *cpath = PyBytes_AS_STRING(path);
+    Py_BEGIN_ALLOW_THREADS
+    rc = hd_read_count(cpath, &ropt, &n, &err);
+    Py_END_ALLOW_THREADS
+    Py_DECREF(path);
+    if (rc != HD_OK) return raise_hd(rc, &err);
+    return PyLong_FromUnsignedLongLong((unsigned long long)n);
 }
 
 PyDoc_STRVAR(formats_doc,
@@ -1367,6 +1442,7 @@ static PyMethodDef module_methods[] = {
      chamfer_doc},
     {"read", (PyCFunction)(void (*)(void))py_read, METH_VARARGS | METH_KEYWORDS, read_doc},
     {"formats", py_formats, METH_NOARGS, formats_doc},
+    {"count", (PyCFunction)(void (*)(void))py_count, METH_VARARGS | METH_KEYWORDS, count_doc},
     {NULL, NULL, 0, NULL},
 };
 

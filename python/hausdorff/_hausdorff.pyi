@@ -165,7 +165,14 @@ def read(
     format: Optional[str] = None,
     float32: bool = False,
     decimal_comma: bool = False,
+    start: int = 0,
+    count: Optional[int] = None,
 ) -> npt.NDArray[np.floating]: ...
+def count(
+    path: Union[str, bytes, os.PathLike[str], os.PathLike[bytes]],
+    *,
+    format: Optional[str] = None,
+) -> int: ...
 def formats() -> Dict[str, str]: ...
 
 class Index:

@@ -42,6 +42,29 @@ def test_read_decimal_commas_need_decimal_comma_true(tmp_path):
     assert got.tolist() == [[1.5, 2.5, 3.5], [4.25, 5.5, 6.75]]
 
 
+def test_read_a_range_and_count_from_the_header(tmp_path):
+    pts = np.random.default_rng(133).normal(size=(1000, 3))
+    path = tmp_path / "big.npy"
+    np.save(path, pts)
+    assert hausdorff.count(path) == 1000
+    assert np.array_equal(hausdorff.read(path, start=250, count=500), pts[250:750])
+    assert np.array_equal(hausdorff.read(path, start=990), pts[990:])
+    parts = [hausdorff.read(path, start=s, count=250) for s in range(0, 1000, 250)]
+    assert np.array_equal(np.concatenate(parts), pts)
+    with pytest.raises(ValueError, match=r"points \[999, 1001\) asked of a file of 1000 points"):
+        hausdorff.read(path, start=999, count=2)
+    with pytest.raises(ValueError, match="start 1000 is not below"):
+        hausdorff.read(path, start=1000)
+    with pytest.raises(ValueError, match="positive"):
+        hausdorff.read(path, count=0)
+    text = tmp_path / "t.xyz"
+    np.savetxt(text, pts[:10], fmt="%.17g")
+    assert np.array_equal(hausdorff.read(text, start=3, count=4), pts[3:7])   # read whole, then cut
+    assert np.array_equal(hausdorff.read(text, start=8), pts[8:10])
+    with pytest.raises(ValueError, match="needs reading"):
+        hausdorff.count(text)
+
+
 def test_read_errors_map_to_python_exceptions(tmp_path):
     with pytest.raises(OSError, match="cannot open"):
         hausdorff.read(tmp_path / "missing.xyz")

@@ -12,7 +12,12 @@
  * mapping into the sink, checking every point.  Each block remembers its
  * first bad point; the first bad point in the file (the lowest block that
  * has one) is the one reported, so the error does not depend on the thread
- * count.  The common layouts (three float32 or three float64 in the
+ * count.  A reader call may ask for a range of the points
+ * (hd_read_options_t.range_first/range_count): then only those records are
+ * converted (and only their pages of the mapping touched), numbered from the
+ * range's start in the sink but from the file's start in messages; or it
+ * may ask for the count alone (hd_read_count), answered here from L->n
+ * once the reader has checked its header and sizes.  The common layouts (three float32 or three float64 in the
  * machine's byte order, and LAS's three scaled int32) get a loop without a
  * type switch; every other layout goes through hd__ld_value, which computes
  * the same values.
@@ -29,7 +34,8 @@ typedef struct {
     hd__read_t *r;
     const unsigned char *base;
     const hd__layout_t *L;
-    size_t *bad; /* per block: first bad point, or SIZE_MAX */
+    size_t first, n; /* the points converted: [first, first + n) of L's */
+    size_t *bad;     /* per block: first bad point (from first), or SIZE_MAX */
 } job_t;
 
 static int host_big(void) {
@@ -54,13 +60,13 @@ static void convert(void *ctx, size_t task, int worker) {
     job_t *j = ctx;
     const hd__layout_t *L = j->L;
     hd__sink_t *s = j->r->sink;
-    size_t lo = task * BLOCK, hi = lo + BLOCK < L->n ? lo + BLOCK : L->n;
+    size_t lo = task * BLOCK, hi = lo + BLOCK < j->n ? lo + BLOCK : j->n;
     double lim = s->dtype == HD_FLOAT32 ? (double)FLT_MAX : HD_MAX_COORD;
     int same = L->type[0] == L->type[1] && L->type[1] == L->type[2] && L->big == host_big();
     int f32 = same && !L->scale && L->type[0] == HD__T_F32, f64 = same && !L->scale && L->type[0] == HD__T_F64;
     int i32 = same && L->scale && L->type[0] == HD__T_I32; /* LAS */
     j->bad[task] = SIZE_MAX;
-    size_t rec_i = lo / L->per, sub_i = lo % L->per;
+    size_t rec_i = (j->first + lo) / L->per, sub_i = (j->first + lo) % L->per;
     for (size_t k = lo; k < hi; k++) {
         const unsigned char *rec = j->base + rec_i * L->stride + sub_i * L->sub;
         if (++sub_i == L->per) {
@@ -101,16 +107,34 @@ static void convert(void *ctx, size_t task, int worker) {
 int hd__binary_read(hd__read_t *r, const unsigned char *base, const hd__layout_t *L) {
     hd__sink_t *s = r->sink;
     if (s->count != 0) return hd__io_err(r, HD_EINVAL, "internal: binary points into a non-empty sink");
-    if (L->n == 0) return HD_OK;
-    int rc = hd__sink_reserve(s, L->n);
-    if (rc) return hd__io_err(r, rc, "cannot allocate %zu points: %s", L->n, hd_strerror(rc));
-    size_t blocks = (L->n + BLOCK - 1) / BLOCK;
-    job_t j = {r, base, L, hd__malloc_array(blocks, sizeof(size_t))};
+    if (r->count_only) { /* hd_read_count: the header's figure, nothing read */
+        r->total = L->n;
+        return HD__COUNTED;
+    }
+    /* A range of the points (hd_read_options_t.range_*): only its records
+     * are touched.  With mesh sampling the range is of the sampled points,
+     * which reader.c slices after sampling. */
+    size_t first = 0, n = L->n;
+    const hd_read_options_t *o = r->opt;
+    if (o->range_count && o->mesh == HD_MESH_VERTICES) {
+        if (o->range_first > L->n || o->range_count > L->n - o->range_first)
+            return hd__io_err(r, HD_ERANGE, "points [%llu, %llu) asked of a file of %zu points",
+                              (unsigned long long)o->range_first,
+                              (unsigned long long)(o->range_first + o->range_count), L->n);
+        first = (size_t)o->range_first;
+        n = (size_t)o->range_count;
+        r->ranged = 1;
+    }
+    if (n == 0) return HD_OK;
+    int rc = hd__sink_reserve(s, n);
+    if (rc) return hd__io_err(r, rc, "cannot allocate %zu points: %s", n, hd_strerror(rc));
+    size_t blocks = (n + BLOCK - 1) / BLOCK;
+    job_t j = {r, base, L, first, n, hd__malloc_array(blocks, sizeof(size_t))};
     if (!j.bad) return hd__io_err(r, HD_ENOMEM, "out of memory");
     hd__parallel_for(hd__thread_count(r->threads, blocks), blocks, convert, &j);
     for (size_t b = 0; rc == HD_OK && b < blocks; b++) {
         if (j.bad[b] == SIZE_MAX) continue;
-        size_t k = j.bad[b];
+        size_t k = first + j.bad[b];
         const unsigned char *rec = record(L, base, k);
         double p[3];
         load(L, rec, p);
@@ -120,7 +144,7 @@ int hd__binary_read(hd__read_t *r, const unsigned char *base, const hd__layout_t
                            "point %zu: %s (%c = %g)", k, hd__point_problem(code), "xyz"[c], p[c]);
     }
     free(j.bad);
-    if (rc == HD_OK) s->count = L->n;
+    if (rc == HD_OK) s->count = n;
     return rc;
 }
 

@@ -77,6 +77,9 @@ int hd__mesh_sample(const double *xyz, size_t nv, const hd__tris_t *t,
  * and gives the extension; opt must not be NULL.  For the fuzzers. */
 int hd__read_buffer(const void *data, size_t size, const char *name,
                     const hd_read_options_t *opt, hd_cloud_t **out, hd_error_t *err);
+/* hd_read_count on bytes in memory (for the fuzzers). */
+int hd__count_buffer(const void *data, size_t size, const char *name,
+                     const hd_read_options_t *opt, uint64_t *total, hd_error_t *err);
 
 /* ---- one reader call --------------------------------------------------- */
 typedef struct hd__read {
@@ -87,7 +90,16 @@ typedef struct hd__read {
     hd__tris_t *tris;  /* NULL, or collect faces here (for --sample) */
     size_t n_faces;    /* faces seen (mesh formats) */
     hd_error_t *err;
+    int count_only;    /* hd_read_count: hd__binary_read stores L->n in
+                          total and returns HD__COUNTED; text parsers
+                          refuse (HD_EUNSUPPORTED) */
+    uint64_t total;
+    int ranged;        /* hd__binary_read applied opt's range */
 } hd__read_t;
+
+/* Returned by hd__binary_read in count_only mode; readers pass any nonzero
+ * code up, and reader.c turns it into HD_OK.  Never leaves the library. */
+#define HD__COUNTED 1
 
 typedef int (*hd__reader_fn)(hd__read_t *r);
 

@@ -88,6 +88,8 @@ typedef struct {
     size_t n_chunks;
     uint64_t *start; /* n_chunks + 1 byte offsets */
     uint64_t *first; /* n_chunks + 1 cumulative point counts */
+    uint64_t lo, hi; /* the points kept: [lo, hi) of the file's (a range
+                        read keeps part; chunks outside it are not decoded) */
     double scale[3], shift[3];
     /* per chunk: the first problem */
     int *rc;
@@ -122,6 +124,10 @@ static int fail(job_t *j, int code, long long at, const char *fmt, ...) {
 /* Store point k from integer coordinates; 0 or the point's problem. */
 static int put(job_t *j, int32_t X, int32_t Y, int32_t Z) {
     const laz_t *z = j->z;
+    if (j->k < z->lo || j->k >= z->hi) { /* outside a range read: decoded, not kept */
+        j->k++;
+        return 0;
+    }
     double p[3] = {(double)X * z->scale[0] + z->shift[0], (double)Y * z->scale[1] + z->shift[1],
                    (double)Z * z->scale[2] + z->shift[2]};
     if (!(fabs(p[0]) <= j->lim && fabs(p[1]) <= j->lim && fabs(p[2]) <= j->lim)) {
@@ -130,13 +136,15 @@ static int put(job_t *j, int32_t X, int32_t Y, int32_t Z) {
         return fail(j, code, (long long)z->start[j->chunk], "point %zu (in the chunk starting here): %s (%c = %g)", j->k,
                     hd__point_problem(code), "xyz"[c], p[c]);
     }
-    if (j->k >= j->s->cap) { /* the sequential path grows the result as points appear */
+    size_t at = j->k - (size_t)z->lo;
+    if (at >= j->s->cap) { /* the sequential path grows the result as points appear */
         assert(j->z->grow);
-        j->s->count = j->k;
+        j->s->count = at;
         int rc = hd__sink_reserve(j->s, 1 << 16);
-        if (rc) return fail(j, rc, (long long)z->start[j->chunk], "cannot allocate %zu points: %s", j->k + 1, hd_strerror(rc));
+        if (rc) return fail(j, rc, (long long)z->start[j->chunk], "cannot allocate %zu points: %s", at + 1, hd_strerror(rc));
     }
-    hd__sink_set(j->s, j->k++, p);
+    hd__sink_set(j->s, at, p);
+    j->k++;
     return 0;
 }
 
@@ -701,6 +709,10 @@ done:
 static void decode_chunk(void *ctx, size_t task, int worker) {
     (void)worker;
     laz_t *z = ctx;
+    if (z->first[task + 1] <= z->lo || z->first[task] >= z->hi) { /* outside a range read */
+        z->rc[task] = 0;
+        return;
+    }
     job_t j = {z, task, z->r->sink, z->r->sink->dtype == HD_FLOAT32 ? (double)FLT_MAX : HD_MAX_COORD,
                (size_t)z->first[task], 0, -1, ""};
     const unsigned char *b = z->d + z->start[task];
@@ -899,10 +911,30 @@ int hd__read_laz(hd__read_t *r, const hd__las_header_t *h) {
     }
     uint32_t chunk_size = 0;
     int rc = parse_vlr(&z, h, &chunk_size);
-    if (rc == HD_OK && h->count == 0) return HD_OK;
+    if (rc == HD_OK && h->count == 0) {
+        r->total = 0;
+        return r->count_only ? HD__COUNTED : HD_OK;
+    }
     if (rc == HD_OK && z.chunked) rc = read_table(&z, h, chunk_size);
     if (rc == HD_OK && !z.chunked) rc = one_chunk(&z, h);
     if (rc == HD_OK && r->sink->count != 0) rc = hd__io_err(r, HD_EINVAL, "internal: LAZ points into a non-empty sink");
+    if (rc == HD_OK && r->count_only) { /* hd_read_count: the chunk table is checked */
+        r->total = h->count;
+        rc = HD__COUNTED;
+    }
+    /* A range read keeps [lo, hi) and decodes only the chunks that meet it. */
+    z.lo = 0;
+    z.hi = h->count;
+    const hd_read_options_t *o = r->opt;
+    if (rc == HD_OK && o->range_count && o->mesh == HD_MESH_VERTICES) {
+        if (o->range_first > h->count || o->range_count > h->count - o->range_first)
+            rc = hd__io_err(r, HD_ERANGE, "points [%llu, %llu) asked of a file of %llu points",
+                            (unsigned long long)o->range_first, (unsigned long long)(o->range_first + o->range_count),
+                            (unsigned long long)h->count);
+        z.lo = o->range_first;
+        z.hi = o->range_first + o->range_count;
+        r->ranged = 1;
+    }
     /* Real data holds under a third of a point per byte; a degenerate file
      * (a repeated point) up to a thousand.  Up to HD__LAZ_EAGER_PER_BYTE the
      * result is allocated at once and the chunks decoded in parallel; above,
@@ -910,7 +942,7 @@ int hd__read_laz(hd__read_t *r, const hd__las_header_t *h) {
      * are decoded, so a file whose claims its bytes do not back fails
      * before allocating them. */
     z.grow = rc == HD_OK && h->count > (z.start[z.n_chunks] - z.start[0]) * HD__LAZ_EAGER_PER_BYTE;
-    if (rc == HD_OK && (rc = hd__sink_reserve(r->sink, z.grow ? 0 : (size_t)h->count)) != HD_OK)
+    if (rc == HD_OK && (rc = hd__sink_reserve(r->sink, z.grow ? 0 : (size_t)(z.hi - z.lo))) != HD_OK)
         rc = hd__io_err(r, rc, "cannot allocate %llu points: %s", (unsigned long long)h->count, hd_strerror(rc));
     if (rc == HD_OK) {
         z.rc = hd__malloc_array(z.n_chunks, sizeof *z.rc);
@@ -926,7 +958,7 @@ int hd__read_laz(hd__read_t *r, const hd__las_header_t *h) {
         }
         for (size_t c = 0; c < z.n_chunks && rc == HD_OK; c++)
             if (z.rc[c]) rc = hd__io_err_at(r, z.rc[c], z.at[c], "chunk %zu of %zu: %s", c + 1, z.n_chunks, z.msg[c]);
-        if (rc == HD_OK) r->sink->count = (size_t)h->count;
+        if (rc == HD_OK) r->sink->count = (size_t)(z.hi - z.lo);
     }
     free(z.start);
     free(z.first);

@@ -37,7 +37,8 @@ void hd__bitmodel_update(hd__bitmodel_t *m) {
     m->until = m->cycle;
 }
 
-int hd__symmodel_new(hd__symmodel_t *m, uint32_t n) {
+/* Allocate a model of n symbols, not initialised (ready = 0). */
+static int symmodel_alloc(hd__symmodel_t *m, uint32_t n) {
     assert(n >= 2 && n <= 2048);
     m->n = n;
     m->tsize = m->tshift = 0;
@@ -51,11 +52,18 @@ int hd__symmodel_new(hd__symmodel_t *m, uint32_t n) {
     if (!m->dist) return HD_ENOMEM;
     m->count = m->dist + n;
     m->table = m->tsize ? m->dist + 2 * n : NULL;
-    hd__symmodel_init(m);
+    m->ready = 0;
     return HD_OK;
 }
 
+int hd__symmodel_new(hd__symmodel_t *m, uint32_t n) {
+    int rc = symmodel_alloc(m, n);
+    if (rc == HD_OK) hd__symmodel_init(m);
+    return rc;
+}
+
 void hd__symmodel_init(hd__symmodel_t *m) {
+    m->ready = 1;
     m->total = 0;
     m->cycle = m->n;
     for (uint32_t k = 0; k < m->n; k++) m->count[k] = 1;
@@ -111,10 +119,10 @@ int hd__intcoder_new(hd__intcoder_t *ic, uint32_t bits, uint32_t contexts) {
     ic->mbits = calloc(contexts, sizeof *ic->mbits);
     if (!ic->mbits) return HD_ENOMEM;
     for (uint32_t i = 0; i < contexts; i++)
-        if (hd__symmodel_new(&ic->mbits[i], ic->corr_bits + 1)) goto fail;
+        if (symmodel_alloc(&ic->mbits[i], ic->corr_bits + 1)) goto fail;
     hd__bitmodel_init(&ic->corr0);
     for (uint32_t i = 1; i <= ic->corr_bits; i++)
-        if (hd__symmodel_new(&ic->corr[i], 1u << (i <= 8 ? i : 8))) goto fail;
+        if (symmodel_alloc(&ic->corr[i], 1u << (i <= 8 ? i : 8))) goto fail;
     return HD_OK;
 fail:
     hd__intcoder_free(ic);
@@ -122,9 +130,9 @@ fail:
 }
 
 void hd__intcoder_init(hd__intcoder_t *ic) {
-    for (uint32_t i = 0; i < ic->contexts; i++) hd__symmodel_init(&ic->mbits[i]);
+    for (uint32_t i = 0; i < ic->contexts; i++) ic->mbits[i].ready = 0;
     hd__bitmodel_init(&ic->corr0);
-    for (uint32_t i = 1; i <= ic->corr_bits; i++) hd__symmodel_init(&ic->corr[i]);
+    for (uint32_t i = 1; i <= ic->corr_bits; i++) ic->corr[i].ready = 0;
     ic->k = 0;
 }
 

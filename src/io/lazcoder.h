@@ -56,6 +56,10 @@ typedef struct hd__symmodel {
      * for t in [0, tsize + 1] (FastAC's decoder table; a speed-up that
      * gives the symbol the bisection gives) */
     uint32_t *table, tshift, tsize;
+    int ready; /* initialised (an integer coder's models are initialised
+                  at their first use: most of its 2^k corrector models are
+                  never used, and initialising one costs a pass over its
+                  symbols, which dominated small chunks) */
 } hd__symmodel_t;
 
 void hd__bitmodel_init(hd__bitmodel_t *m);
@@ -174,16 +178,22 @@ int hd__intcoder_new(hd__intcoder_t *ic, uint32_t bits, uint32_t contexts);
 void hd__intcoder_init(hd__intcoder_t *ic);
 void hd__intcoder_free(hd__intcoder_t *ic);
 
+/* The model m, initialised at its first use. */
+HD__INLINE hd__symmodel_t *hd__ic_model(hd__symmodel_t *m) {
+    if (!m->ready) hd__symmodel_init(m);
+    return m;
+}
+
 HD__INLINE int32_t hd__ic_decode(hd__intcoder_t *ic, hd__dec_t *d, int32_t pred, uint32_t ctx) {
-    uint32_t k = ic->k = hd__dec_symbol(d, &ic->mbits[ctx]);
+    uint32_t k = ic->k = hd__dec_symbol(d, hd__ic_model(&ic->mbits[ctx]));
     int64_t c;
     if (k) {
         uint32_t v;
         if (k <= 8) {
-            v = hd__dec_symbol(d, &ic->corr[k]);
+            v = hd__dec_symbol(d, hd__ic_model(&ic->corr[k]));
         } else {
             unsigned k1 = k - 8;
-            v = hd__dec_symbol(d, &ic->corr[k]);
+            v = hd__dec_symbol(d, hd__ic_model(&ic->corr[k]));
             v = v << k1 | hd__dec_raw(d, k1);
         }
         c = (int64_t)v >= ((int64_t)1 << (k - 1)) ? (int64_t)v + 1 : (int64_t)v - (((int64_t)1 << k) - 1);

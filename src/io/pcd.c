@@ -337,7 +337,9 @@ int hd__read_pcd(hd__read_t *r) {
                     /* offsets into the decompressed buffer; errors name the compressed block */
                     hd__read_t rr = *r;
                     rc = hd__binary_points(&rr, buf, n, (size_t)sx, off, type, 0, 0);
-                    if (rc && r->err) {
+                    r->ranged = rr.ranged;
+                    r->total = rr.total;
+                    if (rc && rc != HD__COUNTED && r->err) {
                         char msg[sizeof r->err->message];
                         memcpy(msg, r->err->message, sizeof msg);
                         hd__io_err_at(r, rc, (long long)p->start + 8, "in the compressed data: %s",

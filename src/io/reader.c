@@ -27,6 +27,7 @@
  */
 #include "io.h"
 
+#include <assert.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <poll.h>
@@ -328,20 +329,50 @@ static void unload(hd__file_t *f, int mapped) {
 
 /* Run the reader; with sampling, read vertices as doubles and the faces,
  * then draw the sample into `out`. */
+/* Keep points [first, first + n) of a sink read whole (a range read of a
+ * format or mode whose reader cannot skip: text, variable-size PLY
+ * vertices, sampled meshes). */
+static int slice(hd__sink_t *s, const hd_read_options_t *opt, const char *name, hd_error_t *err) {
+    if (opt->range_first > s->count || opt->range_count > s->count - opt->range_first)
+        return hd__err(err, HD_ERANGE, "%s: points [%llu, %llu) asked of a file of %zu points", name,
+                       (unsigned long long)opt->range_first,
+                       (unsigned long long)(opt->range_first + opt->range_count), s->count);
+    size_t el = s->dtype == HD_FLOAT32 ? 3 * sizeof(float) : 3 * sizeof(double);
+    memmove(s->data, (char *)s->data + (size_t)opt->range_first * el, (size_t)opt->range_count * el);
+    s->count = (size_t)opt->range_count;
+    return HD_OK;
+}
+
+/* Read with fmt; *total (when not NULL) asks for the count alone
+ * (hd_read_count). */
 static int parse(const format_t *fmt, const hd__file_t *f, const hd_read_options_t *opt,
-                 hd__sink_t *out, size_t *n_faces, hd_error_t *err) {
+                 hd__sink_t *out, size_t *n_faces, uint64_t *total, hd_error_t *err) {
     int sample = opt->mesh == HD_MESH_SAMPLE;
     hd__sink_t verts;
     hd__tris_t tris;
     hd__sink_init(&verts, sample ? HD_FLOAT64 : opt->dtype);
     hd__tris_init(&tris);
-    hd__read_t r = {f, opt, hd__thread_count(opt->threads, 1024), &verts, sample ? &tris : NULL, 0, err};
+    hd__read_t r = {f, opt, hd__thread_count(opt->threads, 1024), &verts, sample ? &tris : NULL, 0, err,
+                    total != NULL, 0, 0};
     int rc = fmt->read(&r);
+    if (total) { /* only hd__binary_read and the LAZ reader answer a count */
+        hd__tris_free(&tris);
+        hd__sink_free(&verts);
+        if (rc == HD__COUNTED) {
+            *total = r.total;
+            return HD_OK;
+        }
+        return rc ? rc
+                  : hd__err(err, HD_EUNSUPPORTED, "%s: the point count of this %s variant needs reading it whole",
+                            f->name, fmt->name);
+    }
+    assert(rc != HD__COUNTED);
     if (rc == HD_OK && verts.count == 0) rc = hd__err(err, HD_EEMPTY, "%s: no points", f->name);
     if (rc == HD_OK && sample)
         rc = hd__mesh_sample(verts.data, verts.count, &tris, opt->sample, opt->seed, out, f->name, err);
     *n_faces = r.n_faces;
     hd__tris_free(&tris);
+    if (rc == HD_OK && opt->range_count && !r.ranged) rc = slice(sample ? out : &verts, opt, f->name, err);
     if (rc == HD_OK && !sample) {
         *out = verts;
         return HD_OK;
@@ -357,6 +388,11 @@ static int check_options(const char *path, const hd_read_options_t *opt, hd_erro
         return hd__err(err, HD_EINVAL, "%s: unknown mesh mode %d", path, (int)opt->mesh);
     if (opt->mesh == HD_MESH_SAMPLE && opt->sample == 0)
         return hd__err(err, HD_EINVAL, "%s: sampling needs a positive number of points", path);
+    if (opt->range_first && !opt->range_count)
+        return hd__err(err, HD_EINVAL, "%s: range_first %llu without range_count", path,
+                       (unsigned long long)opt->range_first);
+    if (opt->range_count > UINT64_MAX - opt->range_first)
+        return hd__err(err, HD_EINVAL, "%s: the range's end overflows", path);
     if (opt->decimal_comma != 0 && opt->decimal_comma != 1)
         return hd__err(err, HD_EINVAL, "%s: decimal_comma must be 0 or 1, not %d", path, opt->decimal_comma);
     return HD_OK;
@@ -380,7 +416,7 @@ static int choose(const char *path, const hd_read_options_t *opt, const format_t
 
 /* Everything after loading: confirm the format, parse, make the cloud. */
 static int read_loaded(const hd__file_t *f, const format_t *fmt, int from_extension,
-                       const hd_read_options_t *opt, hd_cloud_t **out, hd_error_t *err) {
+                       const hd_read_options_t *opt, hd_cloud_t **out, uint64_t *total, hd_error_t *err) {
     if (!fmt) {
         fmt = by_content(f);
         if (!fmt)
@@ -403,7 +439,16 @@ static int read_loaded(const hd__file_t *f, const format_t *fmt, int from_extens
     hd__sink_t sink;
     hd__sink_init(&sink, opt->dtype);
     size_t faces = 0;
-    int rc = parse(fmt, f, opt, &sink, &faces, err);
+    if (total) {
+        static const char *const counted[] = {"ply", "pcd", "stl", "las", "laz", "npy"};
+        int known = 0;
+        for (size_t k = 0; k < sizeof counted / sizeof counted[0]; k++) known |= strcmp(fmt->name, counted[k]) == 0;
+        if (!known || opt->mesh == HD_MESH_SAMPLE)
+            return hd__err(err, HD_EUNSUPPORTED, "%s: the point count of %s needs reading it whole", f->name,
+                           opt->mesh == HD_MESH_SAMPLE ? "a sampled mesh" : fmt->name);
+        return parse(fmt, f, opt, &sink, &faces, total, err);
+    }
+    int rc = parse(fmt, f, opt, &sink, &faces, NULL, err);
     hd_cloud_t *c = NULL;
     if (rc == HD_OK && !(c = malloc(sizeof *c))) rc = hd__err(err, HD_ENOMEM, "%s: out of memory", f->name);
     if (rc) {
@@ -424,11 +469,9 @@ static int read_loaded(const hd__file_t *f, const format_t *fmt, int from_extens
     return HD_OK;
 }
 
-int hd_read_file(const char *path, const hd_read_options_t *opt,
-                 hd_cloud_t **out, hd_error_t *err) {
-    hd__err_clear(err);
-    if (!path || !out) return hd__err(err, HD_EINVAL, "path or result pointer is NULL");
-    *out = NULL;
+/* hd_read_file, or hd_read_count when total is not NULL. */
+static int read_path(const char *path, const hd_read_options_t *opt, hd_cloud_t **out, uint64_t *total,
+                     hd_error_t *err) {
     hd_read_options_t defaults;
     if (!opt) {
         hd_read_options_init(&defaults);
@@ -442,13 +485,32 @@ int hd_read_file(const char *path, const hd_read_options_t *opt,
     hd__file_t f;
     int mapped;
     if ((rc = load(path, opt, &f, &mapped, err))) return rc;
-    rc = read_loaded(&f, fmt, from_extension, opt, out, err);
+    rc = read_loaded(&f, fmt, from_extension, opt, out, total, err);
     unload(&f, mapped);
     return rc;
 }
 
-int hd__read_buffer(const void *data, size_t size, const char *name,
-                    const hd_read_options_t *opt, hd_cloud_t **out, hd_error_t *err) {
+int hd_read_file(const char *path, const hd_read_options_t *opt,
+                 hd_cloud_t **out, hd_error_t *err) {
+    hd__err_clear(err);
+    if (!path || !out) return hd__err(err, HD_EINVAL, "path or result pointer is NULL");
+    *out = NULL;
+    return read_path(path, opt, out, NULL, err);
+}
+
+int hd_read_count(const char *path, const hd_read_options_t *opt,
+                  uint64_t *count, hd_error_t *err) {
+    hd__err_clear(err);
+    if (!path || !count) return hd__err(err, HD_EINVAL, "path or result pointer is NULL");
+    *count = 0;
+    if (strcmp(path, "-") == 0)
+        return hd__err(err, HD_EUNSUPPORTED, "-: the point count of standard input needs reading it whole");
+    hd_cloud_t *unused = NULL;
+    return read_path(path, opt, &unused, count, err);
+}
+
+static int read_buffer(const void *data, size_t size, const char *name, const hd_read_options_t *opt,
+                       hd_cloud_t **out, uint64_t *total, hd_error_t *err) {
     hd__err_clear(err);
     *out = NULL;
     const format_t *fmt;
@@ -457,7 +519,19 @@ int hd__read_buffer(const void *data, size_t size, const char *name,
     if (rc || (rc = choose(name, opt, &fmt, &from_extension, err))) return rc;
     static const unsigned char empty[1];
     hd__file_t f = {name, size ? data : empty, size};
-    return read_loaded(&f, fmt, from_extension, opt, out, err);
+    return read_loaded(&f, fmt, from_extension, opt, out, total, err);
+}
+
+int hd__read_buffer(const void *data, size_t size, const char *name,
+                    const hd_read_options_t *opt, hd_cloud_t **out, hd_error_t *err) {
+    return read_buffer(data, size, name, opt, out, NULL, err);
+}
+
+int hd__count_buffer(const void *data, size_t size, const char *name,
+                     const hd_read_options_t *opt, uint64_t *total, hd_error_t *err) {
+    hd_cloud_t *unused = NULL;
+    *total = 0;
+    return read_buffer(data, size, name, opt, &unused, total, err);
 }
 
 void hd_cloud_free(hd_cloud_t *cloud) {

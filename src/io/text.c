@@ -176,6 +176,8 @@ static long long count_lines(const char *p, const char *end) {
 int hd__text_parallel(hd__read_t *r, const char *begin, const char *end,
                       long long first_line, const hd__text_job_t *job,
                       uint64_t *aux_total) {
+    if (r->count_only) /* hd_read_count: a text's count is its lines' */
+        return hd__io_err(r, HD_EUNSUPPORTED, "the point count of a text variant needs reading it whole");
     size_t size = (size_t)(end - begin);
     size_t n = size / CHUNK_BYTES + 1;
     if (n > 65536) n = 65536;

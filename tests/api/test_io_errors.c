@@ -242,9 +242,7 @@ static const char *pcd(const char *name, const char *fields, const char *size, c
                 "VIEWPOINT 0 0 0 1 0 0 0\nPOINTS %s\nDATA %s\n",
             fields, size, type, points, points, data);
     tf_put(&b, body, n);
-    const char *p = tf_write(name, b.data, b.size);
-    tf_free(&b);
-    return p;
+    return tf_finish(&b, name);
 }
 
 TEST(pcd_bad_headers_and_data_are_refused_with_their_place) {
@@ -353,9 +351,7 @@ static const char *npy(const char *name, const char *dict, const void *body, siz
     tf_puts(&b, dict);
     tf_puts(&b, "\n");
     tf_put(&b, body, n);
-    const char *p = tf_write(name, b.data, b.size);
-    tf_free(&b);
-    return p;
+    return tf_finish(&b, name);
 }
 
 TEST(npy_unsupported_arrays_and_truncated_data_are_refused_with_their_offset) {

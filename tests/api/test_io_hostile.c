@@ -65,9 +65,7 @@ static const char *ply_faces_first(const char *name, const char *count, int item
     tf_puts(&b, count);
     for (int k = 0; k < items; k++) tf_puts(&b, " 4702111234474983745");
     tf_puts(&b, "\n0 0 0\n1 0 0\n0 1 0\n");
-    const char *p = tf_write(name, b.data, b.size);
-    tf_free(&b);
-    return p;
+    return tf_finish(&b, name);
 }
 
 TEST(ply_list_length_beyond_its_count_type_is_refused_before_any_item_is_stored) {
@@ -132,9 +130,7 @@ static const char *five_then_face(const char *name, const char *face, int after)
     tf_puts(&b, "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nv 0 0 1\n");
     tf_putf(&b, "f %s\n", face);
     for (int k = 0; k < after; k++) tf_putf(&b, "v %d 2 2\n", k);
-    const char *p = tf_write(name, b.data, b.size);
-    tf_free(&b);
-    return p;
+    return tf_finish(&b, name);
 }
 
 TEST(obj_relative_index_far_beyond_the_vertices_does_not_wrap_onto_one) {
@@ -217,9 +213,7 @@ static const char *solid_binary_stl(const char *name, int triangles, int extra) 
         tf_u16(&b, 0, 0);
     }
     for (int k = 0; k < extra; k++) tf_u8(&b, '\n');
-    const char *p = tf_write(name, b.data, b.size);
-    tf_free(&b);
-    return p;
+    return tf_finish(&b, name);
 }
 
 TEST(stl_binary_whose_header_starts_with_solid_is_read_as_binary) {

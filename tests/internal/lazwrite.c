@@ -110,14 +110,14 @@ static void ic_encode(hd__intcoder_t *ic, enc_t *e, int32_t pred, int32_t real, 
         k++;
     }
     ic->k = k;
-    enc_symbol(e, &ic->mbits[ctx], k);
+    enc_symbol(e, hd__ic_model(&ic->mbits[ctx]), k);
     if (k) {
         c = c < 0 ? c + (((int64_t)1 << k) - 1) : c - 1;
         if (k <= 8) {
-            enc_symbol(e, &ic->corr[k], (uint32_t)c);
+            enc_symbol(e, hd__ic_model(&ic->corr[k]), (uint32_t)c);
         } else {
             unsigned k1 = k - 8;
-            enc_symbol(e, &ic->corr[k], (uint32_t)(c >> k1));
+            enc_symbol(e, hd__ic_model(&ic->corr[k]), (uint32_t)(c >> k1));
             enc_raw(e, k1, (uint32_t)(c & (((int64_t)1 << k1) - 1)));
         }
     } else {

@@ -116,3 +116,9 @@ void tf_free(tf_buf_t *b) {
     b->data = NULL;
     b->size = b->cap = 0;
 }
+
+const char *tf_finish(tf_buf_t *b, const char *name) {
+    const char *p = tf_write(name, b->data, b->size);
+    tf_free(b);
+    return p;
+}

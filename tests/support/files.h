@@ -33,5 +33,7 @@ void tf_u64(tf_buf_t *b, uint64_t v, int big);
 void tf_f32(tf_buf_t *b, float v, int big);
 void tf_f64(tf_buf_t *b, double v, int big);
 void tf_free(tf_buf_t *b);
+/* Write the buffer to NAME, free it, and return the path (as tf_write). */
+const char *tf_finish(tf_buf_t *b, const char *name);
 
 #endif
