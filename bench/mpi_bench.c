@@ -2,7 +2,7 @@
  * mpi_bench.c -- the exchange figures of hd_mpi_hausdorff (docs/scale-out.md):
  *     mpirun -n K build/bench/mpi_bench [--points N] [--per-rank] [--cases LIST]
  *                                       [--layout random|tiles] [--threads T]
- *                                       [--check]
+ *                                       [--check] [--repeat R]
  * For each case, every rank generates its share of A and B (N points per
  * side in total, or per rank with --per-rank: weak scaling), and one call
  * of hd_mpi_hausdorff is timed; rank 0 prints one line per case with the
@@ -15,7 +15,16 @@
  * slowest rank's total and search, wall clock), the largest CPU time of a
  * rank per local point (the per-point cost for the model: with more ranks
  * than cores it includes MPI's busy waiting), and the share of points
- * searched one by one (the shells).  --check compares with hd_hausdorff on
+ * searched one by one (the shells), the most CPU time of a rank's calling
+ * thread per local point outside the searches and MPI calls ("othercpu":
+ * the bookkeeping, c_rest of docs/scale-out.md's model), and the peak RSS of the call over the
+ * RSS before it per local point ("hwm": VmHWM reset through
+ * /proc/self/clear_refs before the call, so everything the call touched
+ * counts, the engine's and MPI's memory too; run one case per process for
+ * it, since later cases reuse memory freed by earlier ones).  --repeat R
+ * calls R times per case (the repeats' lines are marked "+": memory the
+ * first call freed is reused, so they show the costs without first
+ * touches of fresh pages).  --check compares with hd_hausdorff on
  * rank 0 (all points gathered; small N only).
  *
  * Cases:
@@ -49,6 +58,29 @@ static double cpu_now(void) {
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
+/* Resident kilobytes from /proc/self/status ("VmRSS:" or "VmHWM:"), 0 where missing. */
+static double status_kb(const char *key) {
+    FILE *f = fopen("/proc/self/status", "r");
+    char line[256];
+    double v = 0;
+    size_t n = strlen(key);
+    while (f && fgets(line, sizeof line, f))
+        if (!strncmp(line, key, n)) v = atof(line + n);
+    if (f) fclose(f);
+    return 1024.0 * v;
+}
+
+/* Reset the peak RSS to the current RSS (Linux >= 4.0: clear_refs 5), so
+ * that VmHWM after the call is the call's own peak: everything it touched,
+ * the engine's and MPI's memory included. */
+static void hwm_reset(void) {
+    FILE *f = fopen("/proc/self/clear_refs", "w");
+    if (f) {
+        fputs("5", f);
+        fclose(f);
+    }
+}
+
 static double maxrss(void) {
     struct rusage ru;
     return getrusage(RUSAGE_SELF, &ru) == 0 ? 1024.0 * (double)ru.ru_maxrss : 0;
@@ -59,7 +91,7 @@ int main(int argc, char **argv) {
     MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
     MPI_Comm_size(MPI_COMM_WORLD, &K_);
     size_t N = 1000000;
-    int per_rank = 0, tiles = 0, threads = 1, check = 0;
+    int per_rank = 0, tiles = 0, threads = 1, check = 0, repeat = 1;
     const char *cases = "uniform,lidar,copy";
     for (int k = 1; k < argc; k++) {
         if (!strcmp(argv[k], "--points") && k + 1 < argc) N = (size_t)atof(argv[++k]);
@@ -68,6 +100,7 @@ int main(int argc, char **argv) {
         else if (!strcmp(argv[k], "--layout") && k + 1 < argc) tiles = !strcmp(argv[++k], "tiles");
         else if (!strcmp(argv[k], "--threads") && k + 1 < argc) threads = atoi(argv[++k]);
         else if (!strcmp(argv[k], "--check")) check = 1;
+        else if (!strcmp(argv[k], "--repeat") && k + 1 < argc) repeat = atoi(argv[++k]);
         else {
             if (rank_ == 0) fprintf(stderr, "mpi_bench: unknown argument %s\n", argv[k]);
             MPI_Finalize();
@@ -85,11 +118,12 @@ int main(int argc, char **argv) {
     if (rank_ == 0)
         printf("# mpi_bench: %d ranks, %zu points per side%s, layout %s, %d thread(s) per rank\n"
                "# case     points  B/pt(part) B/pt(fwd) fwd%%    imbal work-imbal buf B/pt rss B/pt "
-               "time(s) search(s) search ns/pt cpu ns/pt shell%% searchcpu ns/pt\n",
+               "time(s) search(s) search ns/pt cpu ns/pt shell%% searchcpu ns/pt hwm B/pt othercpu ns/pt\n",
                K_, N, per_rank ? " per rank" : "", tiles ? "tiles" : "random", threads);
     char list[256];
     snprintf(list, sizeof list, "%s", cases);
-    for (char *c = strtok(list, ","); c; c = strtok(NULL, ",")) {
+    for (char *c = strtok(list, ","); c; c = strtok(NULL, ","))
+      for (int rep = 0; rep < (repeat > 0 ? repeat : 1); rep++) {
         scene_make(c, tiles ? rank_ : 0, tiles ? K_ : 1, 7, (uint64_t)rank_, a, b, n);
         hd_mpi_part_t pa = {hd_points_f64(a, n), offset}, pb = {hd_points_f64(b, n), offset};
         hd_options_t opt;
@@ -99,6 +133,8 @@ int main(int argc, char **argv) {
         hd_mpi_stats_t st;
         hd_error_t err;
         double rss0 = maxrss();
+        hwm_reset();
+        double cur0 = status_kb("VmRSS:");
         MPI_Barrier(MPI_COMM_WORLD);
         double cpu0 = cpu_now();
         int rc = hd_mpi_hausdorff(MPI_COMM_WORLD, &pa, 1, &pb, 1, &opt, &r, &st, &err);
@@ -110,15 +146,17 @@ int main(int argc, char **argv) {
         }
         double grow = (maxrss() - rss0) / (double)(st.local_points ? st.local_points : 1), most = 0;
         MPI_Reduce(&grow, &most, 1, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD);
+        double hwm = (status_kb("VmHWM:") - cur0) / (double)(st.local_points ? st.local_points : 1), hwmax = 0;
+        MPI_Reduce(&hwm, &hwmax, 1, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD);
         uint64_t tot = st.points;
         if (rank_ == 0)
-            printf("%-8s %9llu %9.2f %9.3f %7.3f %6.3f %8.3f %10.1f %10.1f %8.3f %8.3f %8.1f %8.1f %7.3f %8.1f\n", c,
+            printf("%-8s%s %9llu %9.2f %9.3f %7.3f %6.3f %8.3f %10.1f %10.1f %8.3f %8.3f %8.1f %8.1f %7.3f %8.1f %8.1f %8.1f\n", c, rep ? "+" : "",
                    (unsigned long long)tot, (double)st.bytes_partition / (double)tot,
                    (double)st.bytes_forwarding / (double)tot, 100.0 * (double)st.forwarded_points / (double)tot,
                    st.imbalance, st.work_imbalance, (double)st.peak_bytes_max / ((double)tot / K_), most,
                    st.seconds_max, st.search_seconds_max, 1e9 * st.search_seconds_max / ((double)tot / K_),
                    1e9 * cpumax, 100.0 * (double)st.shell_points / (double)tot,
-                   1e9 * st.search_cpu_max / ((double)tot / K_));
+                   1e9 * st.search_cpu_max / ((double)tot / K_), hwmax, 1e9 * st.other_cpu_max / ((double)tot / K_));
         if (check) { /* gather everything on rank 0 and compare */
             double *all[2] = {NULL, NULL};
             int cnt = (int)(3 * n), *cnts = malloc((size_t)K_ * sizeof(int)), *disp = malloc((size_t)K_ * sizeof(int));

@@ -55,6 +55,10 @@
  *    MPI_THREAD_FUNNELED is the level the standard asks for.
  *  - Points are read during the call only, and may be laid out in any way
  *    over the ranks: any rank may hold any points of either set, or none.
+ *  - Memory: the call holds about 36 bytes per point it ends up with while
+ *    the points move and 32 after (coordinates and indices), plus the
+ *    engine's and the searches' structures (docs/scale-out.md); on one
+ *    rank it runs on the caller's points without a copy.
  */
 #ifndef HAUSDORFF_MPI_H
 #define HAUSDORFF_MPI_H
@@ -84,7 +88,7 @@ typedef struct hd_mpi_stats {
     int ranks;
     uint64_t points;            /* input points of A and B */
     uint64_t bytes_partition;   /* bytes sent to other ranks to move the
-                                   points (32 a point moved) and choose the
+                                   points (28 a point moved) and choose the
                                    regions (the samples) */
     uint64_t bytes_forwarding;  /* bytes of forwarded queries (24 each) and
                                    their answers (16 each) */
@@ -93,7 +97,8 @@ typedef struct hd_mpi_stats {
     uint64_t shell_points;      /* points searched one by one, in both
                                    directions (the shells: the others are
                                    settled by the engine's pruned pass) */
-    int rounds;                 /* forwarding rounds (one per direction) */
+    int rounds;                 /* forwarding rounds (one per direction;
+                                   0 on one rank, where none is needed) */
     uint64_t points_max;        /* most points (A and B) a rank computed on */
     double imbalance;           /* points_max over the mean per rank */
     double work_imbalance;      /* the same with forwarded queries answered
@@ -106,13 +111,20 @@ typedef struct hd_mpi_stats {
     double search_cpu_max;      /* the same in CPU seconds of the calling
                                    thread: with opt->threads = 1 the
                                    searches' own cost, whatever the load */
-    uint64_t peak_bytes_max;    /* most bytes a rank held in the buffers of
-                                   this call, not counting the engine's and
-                                   the per-point searches' structures
-                                   (about 32 bytes a point of the local
-                                   set searched, up to 60 while built) */
+    double other_cpu_max;       /* the most CPU seconds of a rank's calling
+                                   thread outside the searches and the MPI
+                                   calls: validation, sampling, packing,
+                                   merging, boxes (the bookkeeping) */
+    uint64_t peak_bytes_max;    /* most bytes a rank held at once for this
+                                   call: its buffers, the per-point
+                                   searches' structures (up to 60 bytes a
+                                   point while built), and the engine's,
+                                   charged at its documented bound of 16
+                                   bytes a point; not the caller's input,
+                                   nor MPI's own buffers */
     double seconds;             /* this rank: time in the call */
     double search_seconds;      /* this rank: time in the searches */
+    double other_cpu;           /* this rank: the bookkeeping's CPU seconds */
     uint64_t local_points;      /* this rank: points after the partition */
     uint64_t peak_bytes;        /* this rank: peak of the buffers above */
 } hd_mpi_stats_t;
@@ -135,7 +147,8 @@ typedef struct hd_mpi_stats {
  * err: NULL, or receives the context of a failure.
  * Errors: as hd_hausdorff (HD_EINVAL, HD_EEMPTY, HD_ENONFINITE, HD_ERANGE,
  *   HD_ENOMEM, HD_ETHREAD), HD_EINVAL too for parts that share an index or
- *   run past SIZE_MAX, HD_EOVERFLOW for more than 2^31 - 1 records between
+ *   run past SIZE_MAX, HD_ERANGE for more than 2^32 - 1 points of a set on
+ *   one rank (checked before any point is read), HD_EOVERFLOW for more than 2^31 - 1 records between
  *   two ranks (MPI's int counts), HD_EIO when an MPI call fails.
  * Thread safety: as any collective MPI call: one call at a time per
  *   communicator. */

@@ -151,7 +151,7 @@ typedef struct {
  * computed difference fl(x - x~) is within a factor (1 + 2^-53) of the true
  * one, so err = sqrt(3) * max |fl(x - x~)| * (1 + slack) bounds the true
  * Euclidean distance between a point and its approximation. */
-static void make_bucket(hd__tree_t *t, size_t b) {
+HD__HOT static void make_bucket(hd__tree_t *t, size_t b) {
     size_t s = b * HD__BUCKET;
     int m = hd__bucket_size(t, b);
     double p[3][HD__BUCKET];
@@ -257,6 +257,8 @@ void hd__tree_free(hd__tree_t *t) {
     hd__reuse_put(t->pool, t->q);
     hd__reuse_put(t->pool, t->bucket);
     hd__reuse_put(t->pool, t->nodes);
+    hd__reuse_put(t->pool, t->fkey);
+    t->fkey = NULL;
     t->perm = NULL;
     t->q = NULL;
     t->bucket = NULL;
@@ -268,7 +270,8 @@ static size_t node_count(const hd__tree_t *t) {
 }
 
 size_t hd__tree_memory(const hd__tree_t *t) {
-    return t->n * sizeof *t->perm + t->nb * (3 * HD__BUCKET * sizeof *t->q + sizeof *t->bucket) +
+    return t->n * sizeof *t->perm +
+           t->nb * (3 * HD__BUCKET * sizeof *t->q + sizeof *t->bucket + sizeof *t->fkey) +
            node_count(t) * sizeof *t->nodes;
 }
 
@@ -314,12 +317,20 @@ int hd__tree_build(hd__tree_t *t, const hd__src_t *src, size_t n, const hd__box_
         for (size_t s = 1; s < slices; s++) hd__box_merge(&t->box, &kc.part_box[s]);
     }
     hd__keygrid_init(&kc.grid, &t->box);
+    t->grid = kc.grid;
     hd__parallel_for(threads, slices, key_task, &kc);
     if ((rc = hd__radix_sort(&keys, &tmp, n, threads))) goto done;
     for (size_t s = 0; s < n;) {
         size_t e = s + 1;
         while (e < n && keys[e] >> 32 == keys[s] >> 32) e++;
-        if (e - s > HD__BUCKET && (rc = refine(src, keys + s, tmp + s, e - s, 0))) goto done;
+        if (e - s > HD__BUCKET) {
+            /* Refining re-keys the run on its own grid; the run's key on
+             * the set's grid is put back afterwards, so that the keys kept
+             * (t->fkey) are all on one grid and never decrease. */
+            uint64_t top = keys[s] >> 32 << 32;
+            if ((rc = refine(src, keys + s, tmp + s, e - s, 0))) goto done;
+            for (size_t i = s; i < e; i++) keys[i] = top | (keys[i] & 0xffffffffu);
+        }
         s = e;
     }
     hd__reuse_put(pool, tmp);
@@ -333,6 +344,12 @@ int hd__tree_build(hd__tree_t *t, const hd__src_t *src, size_t n, const hd__box_
         t->perm[k] = (uint32_t)keys[k];
         assert(t->perm[k] < n);
     }
+    t->fkey = hd__reuse_get(pool, t->nb, sizeof *t->fkey);
+    if (!t->fkey) {
+        rc = HD_ENOMEM;
+        goto done;
+    }
+    for (size_t b = 0; b < t->nb; b++) t->fkey[b] = (uint32_t)(keys[b * HD__BUCKET] >> 32);
     hd__reuse_put(pool, keys);
     keys = NULL;
     t->q = hd__reuse_get(pool, t->nb, 3 * HD__BUCKET * sizeof *t->q);

@@ -67,6 +67,10 @@ typedef struct {
     size_t hint;       /* bucket of B where the last search ended */
     ptrdiff_t drift;   /* where the previous bucket of A found most partners,
                         * relative to the same place along B's curve */
+    ptrdiff_t pdrift;  /* the same for the last partner found, in points */
+    int track;         /* whether try_bucket's partners update pdrift */
+    int window_miss;   /* consecutive buckets of A the window settled nothing in */
+    unsigned window_tick;
 } walk_t;
 
 static void walk_init(walk_t *s, dir_ctx *c, worker_t *w) {
@@ -76,6 +80,10 @@ static void walk_init(walk_t *s, dir_ctx *c, worker_t *w) {
     s->have_bc = 0;
     s->hint = HD__NONE;
     s->drift = 0;
+    s->pdrift = 0;
+    s->track = 0;
+    s->window_miss = 0;
+    s->window_tick = 0;
 }
 
 static size_t node_points(const hd__tree_t *t, int level, size_t i) {
@@ -160,6 +168,119 @@ static const double *group_exact(const hd__tree_t *ta, group_t *g, int k) {
     return g->a[k];
 }
 
+/* The position along B's curve at the same relative place as position p
+ * along A's. */
+static size_t same_place(const walk_t *s, size_t p) {
+    const hd__tree_t *ta = s->c->ta, *tb = s->c->tb;
+    if (ta->n == tb->n) return p;
+    return (size_t)((double)p * (double)tb->n / (double)ta->n);
+}
+
+/* Points of B tried on each point of A around its partner's expected
+ * position (its own position moved by the last partner's offset). */
+#define WINDOW 4 /* one vector of four (hd__v4d) */
+#define REACH (2 * WINDOW) /* how far the window may move to either side */
+#define WINDOW_REST 8
+#define WINDOW_MISSES 4
+
+/* Each live point of g against the WINDOW points of B around its own
+ * place along B's curve moved by the offset of the last partner found
+ * (pdrift): two curves over nearly the same points drift apart slowly, so
+ * the partner of a point is most often within a few positions of where the
+ * previous point's partner suggests; when none of the four is close
+ * enough, the four on each side, then the next four (REACH), are tried.
+ * A point is discarded on the proof of try_bucket (hd__kill_below with
+ * both points' errors; the error of B's side is the largest of the
+ * buckets decoded, which only lowers the threshold, since hd__kill_below
+ * decreases as the error grows).  Ties at the maximum are left to the
+ * buckets. */
+HD__HOT static void try_window(walk_t *s, group_t *g, double cmax2) {
+    const hd__tree_t *ta = s->c->ta, *tb = s->c->tb;
+    size_t nb_pts = tb->nb * HD__BUCKET; /* positions, padding included */
+    ptrdiff_t lo = (ptrdiff_t)same_place(s, g->first) + s->pdrift - WINDOW / 2 - REACH;
+    ptrdiff_t hi = (ptrdiff_t)same_place(s, g->first + (size_t)g->m) + s->pdrift + WINDOW / 2 + REACH;
+    if (lo < 0) lo = 0;
+    if (hi > (ptrdiff_t)nb_pts) hi = (ptrdiff_t)nb_pts;
+    if (hi - lo < WINDOW) return;
+    size_t b0 = (size_t)lo / HD__BUCKET, b1 = ((size_t)hi - 1) / HD__BUCKET;
+    if (b1 - b0 > 2) return; /* sizes far apart: the window spans too much */
+    double x[3 * HD__BUCKET], y[3 * HD__BUCKET], z[3 * HD__BUCKET];
+    double eb = 0;
+    for (size_t b = b0; b <= b1; b++) {
+        size_t o = (b - b0) * HD__BUCKET;
+        hd__bucket_decode(tb, b, x + o, y + o, z + o);
+        eb = tb->bucket[b].err > eb ? tb->bucket[b].err : eb;
+    }
+    double lim = hd__kill_below(cmax2, g->err + eb);
+    /* Window starts relative to the decoded points: point k's place along
+     * B's curve, moved by pdrift, less half the window, clamped. */
+    const ptrdiff_t base = (ptrdiff_t)(b0 * HD__BUCKET);
+    const ptrdiff_t top = (ptrdiff_t)((b1 + 1 - b0) * HD__BUCKET) - WINDOW;
+    const int same_size = ta->n == tb->n;
+    ptrdiff_t pd = s->pdrift, last = -1;
+    s->w->counts.evals += (uint64_t)WINDOW * (uint64_t)__builtin_popcount(g->alive);
+    for (uint32_t left = g->alive; left; left &= left - 1) {
+        int k = __builtin_ctz(left);
+        size_t pa = g->first + (size_t)k;
+        ptrdiff_t place = (ptrdiff_t)(same_size ? pa : same_place(s, pa));
+        ptrdiff_t w = place + pd - WINDOW / 2 - base;
+        w = w < 0 ? 0 : w > top ? top : w;
+        /* hd__d2s of a against the window's four points, in one vector
+         * (GCC's scalar code for the same loop was twice the
+         * instructions): the same operations in the same order, so the
+         * same values. */
+        hd__v4d bx, by, bz;
+        __builtin_memcpy(&bx, x + w, sizeof bx);
+        __builtin_memcpy(&by, y + w, sizeof by);
+        __builtin_memcpy(&bz, z + w, sizeof bz);
+        hd__v4d dx = g->x[k] - bx, dy = g->y[k] - by, dz = g->z[k] - bz;
+        hd__v4d d = dx * dx + dy * dy + dz * dz;
+        hd__v4l in = d < lim;
+        if (!(in[0] | in[1] | in[2] | in[3])) {
+            /* Not within the first four: the four on each side, then the
+             * next four on each side (REACH). */
+            static const int8_t shift[4] = {-WINDOW, WINDOW, -2 * WINDOW, 2 * WINDOW};
+            int hit = 0;
+            for (int t = 0; t < 4 && !hit; t++) {
+                ptrdiff_t v = w + shift[t];
+                v = v < 0 ? 0 : v > top ? top : v;
+                __builtin_memcpy(&bx, x + v, sizeof bx);
+                __builtin_memcpy(&by, y + v, sizeof by);
+                __builtin_memcpy(&bz, z + v, sizeof bz);
+                dx = g->x[k] - bx, dy = g->y[k] - by, dz = g->z[k] - bz;
+                d = dx * dx + dy * dy + dz * dz;
+                in = d < lim;
+                s->w->counts.evals += WINDOW;
+                if (in[0] | in[1] | in[2] | in[3]) hit = 1, w = v;
+            }
+            if (!hit) continue;
+        }
+        int arg = in[0] ? 0 : in[1] ? 1 : in[2] ? 2 : 3;
+        last = w + arg;
+#ifndef NDEBUG
+        {
+            /* The proof from both approximations: the two points, read
+             * exactly, lie strictly within cmax (a position in the last
+             * bucket's padding holds a copy of that bucket's point 0). */
+            size_t at = (size_t)(base + last);
+            if (at >= tb->n) at = at / HD__BUCKET * HD__BUCKET;
+            double ea[3], eb3[3];
+            hd__src_get(&ta->src, g->ia[k], ea);
+            hd__src_get(&tb->src, tb->perm[at], eb3);
+            assert(!(hd__d2(ea, eb3) >= cmax2));
+        }
+#endif
+        g->alive &= ~(1u << k);
+        pd = base + last - place;
+    }
+    if (last < 0) return;
+    s->pdrift = pd;
+    s->bc[0] = x[last], s->bc[1] = y[last], s->bc[2] = z[last];
+    s->bc_err = eb;
+    s->have_bc = 1;
+    s->hint = (size_t)(base + last) / HD__BUCKET;
+}
+
 /* Try bucket i of B on the live points of g; a point is discarded when the
  * approximations prove some point of the bucket strictly within cmax, or
  * when the pair is too close to call and its exact distance does.
@@ -207,6 +328,8 @@ HD__HOT static int try_bucket(walk_t *s, group_t *g, size_t i, double cmax2) {
             s->bc_err = bb->err;
             s->have_bc = 1;
             s->hint = i;
+            if (s->track)
+                s->pdrift = (ptrdiff_t)(i * HD__BUCKET + (size_t)arg) - (ptrdiff_t)same_place(s, g->first + (size_t)k);
             continue;
         }
         close_k[n_close] = k;
@@ -241,13 +364,75 @@ HD__HOT static int try_bucket(walk_t *s, group_t *g, size_t i, double cmax2) {
     return __builtin_popcount(alive0 & ~g->alive);
 }
 
+/* The buckets of B that may hold points of B's Morton cell `key`: those
+ * points lie along B's curve between the last bucket whose first key is
+ * below `key` and the last one whose first key equals it.  Writes at most
+ * two buckets (in a cell crowded enough to span more, the first two) and
+ * returns how many. */
+static int key_buckets(const hd__tree_t *t, uint32_t key, size_t out[2]) {
+    size_t lo = 0, hi = t->nb; /* the first bucket whose first key is >= key */
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (t->fkey[mid] < key) lo = mid + 1;
+        else hi = mid;
+    }
+    int n = 0;
+    if (lo > 0) out[n++] = lo - 1;
+    if (lo < t->nb && t->fkey[lo] == key) out[n++] = lo;
+    return n;
+}
+
+/* Before the points left in a group get searches of their own: a point
+ * whose partner lies across a jump of B's curve is not near its own
+ * position along it, but it is in one of the few cells of B's Morton grid
+ * that its ball of radius cmax meets.  Each of those cells is found along
+ * B's curve by its key (a binary search over the buckets' first keys) and
+ * its buckets are tried like any other (try_bucket's proofs).  Only speed
+ * depends on which buckets are tried. */
+static void try_cells(walk_t *s, group_t *g, double cmax2) {
+    const hd__tree_t *tb = s->c->tb;
+    const hd__keygrid_t *grid = &tb->grid;
+    if (grid->scale == 0.0) return;
+    double r = sqrt(cmax2 > g->tie2 ? cmax2 : g->tie2);
+    for (uint32_t left = g->alive; left; left &= left - 1) {
+        int k = __builtin_ctz(left);
+        if (!(g->alive >> k & 1u)) continue; /* discarded by a bucket tried for another point */
+        const double p[3] = {g->x[k], g->y[k], g->z[k]};
+        uint32_t c[3][2];
+        for (int d = 0; d < 3; d++) {
+            c[d][0] = hd__key_cell(grid, d, p[d] - r);
+            c[d][1] = hd__key_cell(grid, d, p[d] + r);
+        }
+        size_t tried[16];
+        int nt = 0;
+        for (int corner = 0; corner < 8 && (g->alive >> k & 1u); corner++) {
+            uint32_t x = c[0][corner & 1], y = c[1][corner >> 1 & 1], z = c[2][corner >> 2];
+            if ((corner & 1 && x == c[0][0]) || (corner & 2 && y == c[1][0]) || (corner & 4 && z == c[2][0]))
+                continue; /* the same cell as a corner already taken */
+            size_t bk[2];
+            int m = key_buckets(tb, hd__spread10(x) | hd__spread10(y) << 1 | hd__spread10(z) << 2, bk);
+            for (int q = 0; q < m && (g->alive >> k & 1u); q++) {
+                int seen = 0;
+                for (int t = 0; t < nt; t++) seen |= tried[t] == bk[q];
+                if (seen) continue;
+                tried[nt++] = bk[q];
+                try_bucket(s, g, bk[q], cmax2);
+            }
+        }
+    }
+}
+
 /* Resolve the points of A's bucket bk together, from their quantised copy:
- * try the last useful point of B on each; then the bucket of B where the
- * last search ended and its neighbours along B's curve (for nearly
- * identical sets the nearest points sit at nearly the same place on both
- * curves); then a short walk of B's tree for the whole bucket, nearest
- * buckets first.  Every point that the approximations prove irrelevant is
- * discarded; the points left are read exactly and get their own search. */
+ * try the last useful point of B on each; then each point against the few
+ * points of B around its expected place along B's curve (try_window); then
+ * the bucket of B at the same relative place moved by the drift, and the
+ * one where the last search ended, with their neighbours along B's curve
+ * (for nearly identical sets the nearest points sit at nearly the same
+ * place on both curves); then a short walk of B's tree for the whole
+ * bucket, nearest buckets first; then, for each point left, the buckets of
+ * the cells of B around it found by their keys (try_cells).  Every point
+ * that the approximations prove irrelevant is discarded; the points left
+ * are read exactly and get their own search. */
 static void walk_bucket(walk_t *s, size_t bk) {
     const hd__tree_t *ta = s->c->ta, *tb = s->c->tb;
     group_t g;
@@ -270,6 +455,15 @@ static void walk_bucket(walk_t *s, size_t bk) {
                 g.alive &= ~(1u << k);
         s->w->counts.evals += (uint64_t)g.m;
     }
+    /* Where the window settles nothing WINDOW_MISSES times in a row (a
+     * translated copy, whose partners all lie at the maximum distance, too
+     * close to call from the approximations), it is tried only on every
+     * WINDOW_REST-th bucket of A until it settles something again. */
+    if (g.alive && (s->window_miss < WINDOW_MISSES || ++s->window_tick % WINDOW_REST == 0)) {
+        uint32_t before = g.alive;
+        try_window(s, &g, cmax2);
+        s->window_miss = g.alive == before ? s->window_miss + 1 : 0;
+    }
     if (g.alive) {
         /* Two guesses: the bucket at the same relative position along B's
          * curve moved by the drift that served the previous bucket (two
@@ -285,7 +479,9 @@ static void walk_bucket(walk_t *s, size_t bk) {
             size_t h = guess[q];
             if (h == HD__NONE || (q == 1 && h + NEIGHBOURS >= guess[0] && h <= guess[0] + NEIGHBOURS)) continue;
             if (h >= tb->nb) h = tb->nb - 1;
+            s->track = q == 0;
             int k = try_bucket(s, &g, h, cmax2);
+            s->track = 0;
             if (k > most_k) most_k = k, most = h;
             for (size_t r = 1; r <= NEIGHBOURS && g.alive; r++) {
                 if (h + r < tb->nb && (k = try_bucket(s, &g, h + r, cmax2)) > most_k) most_k = k, most = h + r;
@@ -356,6 +552,7 @@ static void walk_bucket(walk_t *s, size_t bk) {
         if (MATTERS(g0)) stack[sp].level = l - 1, stack[sp].i = c0, stack[sp].gap2 = g0, sp++;
     }
 #undef MATTERS
+    if (g.alive) try_cells(s, &g, cmax2);
     s->w->culled += (uint64_t)(g.m - __builtin_popcount(g.alive));
     if (!g.alive) return;
     /* The points left are read exactly; start all their loads at once. */

@@ -64,22 +64,7 @@
 
 /* ---- geometry ------------------------------------------------------------------- */
 
-/* Spread the 8 bits of v to every third bit (Morton interleaving), from a
- * table: three table reads per point instead of some thirty operations. */
-#define S1(v) ((((v)&1u) | ((v)&2u) << 2 | ((v)&4u) << 4 | ((v)&8u) << 6))
-#define S2(v) (S1(v) | S1((v) >> 4) << 12)
-#define ROW(b) S2(b), S2(b + 1), S2(b + 2), S2(b + 3), S2(b + 4), S2(b + 5), S2(b + 6), S2(b + 7)
-static const uint32_t spread_table[256] = {
-    ROW(0),   ROW(8),   ROW(16),  ROW(24),  ROW(32),  ROW(40),  ROW(48),  ROW(56),
-    ROW(64),  ROW(72),  ROW(80),  ROW(88),  ROW(96),  ROW(104), ROW(112), ROW(120),
-    ROW(128), ROW(136), ROW(144), ROW(152), ROW(160), ROW(168), ROW(176), ROW(184),
-    ROW(192), ROW(200), ROW(208), ROW(216), ROW(224), ROW(232), ROW(240), ROW(248),
-};
-#undef ROW
-#undef S2
-#undef S1
-
-static inline uint32_t spread8(uint32_t v) { return spread_table[v & 0xff]; }
+static inline uint32_t spread8(uint32_t v) { return hd__spread_table[v & 0xff]; }
 
 static inline uint32_t compact8(uint32_t x) {
     x &= 0x249249u;
@@ -202,8 +187,8 @@ HD__INLINE uint32_t geom_cell(geom_t q, const double p[3]) {
         t[k] = t[k] < q.top ? t[k] : q.top;
         t[k] = t[k] > 0 ? t[k] : 0;
     }
-    return spread_table[(int32_t)t[0]] | spread_table[(int32_t)t[1]] << 1 |
-           spread_table[(int32_t)t[2]] << 2;
+    return hd__spread_table[(int32_t)t[0]] | hd__spread_table[(int32_t)t[1]] << 1 |
+           hd__spread_table[(int32_t)t[2]] << 2;
 }
 
 /* The first pass over points [lo, hi): each point's cell (kept when
@@ -251,7 +236,7 @@ HD__INLINE void scatter_range(build_ctx *c, size_t part, size_t lo, size_t hi, h
 }
 
 /* Each pass, specialised for the packed layouts and for kept cells. */
-static void count_task(void *vctx, size_t part, int worker) {
+HD__HOT static void count_task(void *vctx, size_t part, int worker) {
     (void)worker;
     build_ctx *c = vctx;
     size_t lo = c->n * part / (size_t)c->parts, hi = c->n * (part + 1) / (size_t)c->parts;

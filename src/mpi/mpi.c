@@ -20,23 +20,36 @@
  *     broadcast; each rank's region is a box (faces at split coordinates,
  *     infinite outside), and every point of another region lies on or
  *     beyond one of its faces.
- *  2. One MPI_Alltoallv moves each point (x, y, z, global index: 32 bytes)
- *     to the rank of its region.  Senders send their parts in increasing
- *     index order, so each rank receives K sorted runs per set and merges
- *     them: local order is global index order, and a local "smallest index
- *     on ties" is the global one.
+ *  2. MPI_Alltoallv moves each point to the rank of its region as its
+ *     coordinates and a 4-byte number, its rank among the sender's points
+ *     of its set in index order (28 bytes; every rank knows every rank's
+ *     index runs, so the receiver turns it back into the global index).
+ *     Each source's run is received straight into its slot of the local
+ *     arrays, in rounds of at most an eighth of a rank's points, so the
+ *     points are never held twice.  Senders walk their parts in increasing
+ *     index order, so each run is sorted; when the runs follow each other
+ *     in index order (each rank's parts above the previous rank's) the
+ *     local arrays are in global order as received, else they are merged
+ *     in place (a permutation, 4 bytes a point): local order is global
+ *     index order, and a local "smallest index on ties" is the global one.
+ *     On one rank none of this happens: the engine runs on the caller's
+ *     points as they are (one part a set) or packed once (several).
  *  3. The single-machine engine on each rank's part: hd_directed(local A,
  *     local B) gives h2, the rank's largest u(a)^2, where u(a)^2 is the
  *     exact minimum over local B (an upper bound on the minimum over all
  *     of B).  Every a whose region faces are clear of h2 (step 4's test
- *     with h2 >= u(a)^2) is settled without a search of its own, and the
- *     largest of those is the engine's answer (or one more engine call on
- *     them alone when the engine's witness is not among them).  The rest,
- *     the shell within h of the faces, get per-point searches (the
- *     nearest layer's, as hd_distances runs them: the nearest local b,
- *     smallest index on ties) on one structure of the local B per
- *     direction, which the forwarded queries of step 5 ask too.  The
- *     engine prunes the points that cannot be the farthest, which
+ *     with h2 >= u(a)^2) is settled without a search of its own (the
+ *     interior).  When the engine's witness is interior, it is the
+ *     interior's maximum; else the interior's maximum is computed (one
+ *     more engine call on it) only on a rank where the engine's answer
+ *     beats the best over all ranks found without it (step 6): every
+ *     interior point is below that answer.  The rest, the shell within h
+ *     of the faces, get per-point searches (the nearest layer's, as
+ *     hd_distances runs them: the nearest local b, smallest index on
+ *     ties) on a structure of the slab of local B within about 2h of the
+ *     faces, which the forwarded queries of step 5 ask too; an answer the
+ *     slab cannot prove (see slab_t) asks a wider slab, then all of B.
+ *     The engine prunes the points that cannot be the farthest, which
  *     per-point searches cannot: on two epochs of one scene that is tens
  *     of times less work.  For a copy and its original (point g of B the
  *     moved point g of A) the rank first passes its whole pairs to the
@@ -67,9 +80,10 @@
  *     and the asker keeps the smaller pair: the exact global answer.  One
  *     round: the bound is final before anything is sent.
  *  6. Each rank's farthest exact point (largest d2, smallest index on ties)
- *     is max-reduced; the result is the pair hd_hausdorff gives on the
- *     union, bit for bit, since every value compared is an hd__d2 of the
- *     same doubles.
+ *     is max-reduced; then the ranks of step 3 whose engine answer beats
+ *     that add their interior's maximum, and it is reduced again.  The
+ *     result is the pair hd_hausdorff gives on the union, bit for bit,
+ *     since every value compared is an hd__d2 of the same doubles.
  *
  * Failures: any local failure (a bad point, memory) is agreed on before the
  * next collective that could block (agree(): an allreduce of the first
@@ -91,7 +105,6 @@
 
 #define SAMPLES_PER_RANK 1024
 
-typedef struct { double x[3]; uint64_t g; } rec_t;               /* a moved point */
 typedef struct { double d2; uint64_t g; } ans_t;                 /* an answer */
 typedef struct { double d2; uint64_t i, j; } far_t;              /* a witness */
 typedef struct { double x[3]; uint64_t g, side; } sample_t;
@@ -108,9 +121,11 @@ typedef struct ctx {
     uint64_t bytes_part, bytes_fwd, forwarded, forwarded_points, answered;
     double search;             /* seconds in the engine and hd_distances */
     double search_cpu;         /* the calling thread's CPU seconds there */
+    double mpi_cpu;            /* ... and in MPI calls */
     uint64_t shell;            /* points searched one by one (the shells) */
+    uint64_t interior_passes;  /* second engine calls on an interior */
     int rounds;
-    MPI_Datatype rec_type, ans_type, q_type, far_type, sample_type, node_type;
+    MPI_Datatype ans_type, q_type, far_type, sample_type, node_type;
     MPI_Op far_op;
 } ctx_t;
 
@@ -141,7 +156,10 @@ static void *cmalloc(ctx_t *c, size_t n, size_t size) {
         else madvise(p, bytes, MADV_HUGEPAGE); /* advice: failure changes nothing */
     } else
 #endif
+    {
         p = malloc(bytes ? bytes : 1);
+        hd__prefault(p, bytes); /* one call, not a fault a page (a no-op below 1 MiB) */
+    }
     if (p) {
         c->cur += bytes;
         if (c->cur > c->peak) c->peak = c->cur;
@@ -153,6 +171,29 @@ static void cfree(ctx_t *c, void *p, size_t n, size_t size) {
     if (!p) return;
     c->cur -= n * size;
     free(p);
+}
+
+/* Memory this layer does not allocate itself but the call holds: counted
+ * in the peak while held. */
+static void charge(ctx_t *c, size_t bytes) {
+    c->cur += bytes;
+    if (c->cur > c->peak) c->peak = c->cur;
+}
+
+/* The engine's own memory, which this layer cannot see: docs/engine.md
+ * bounds it by 16 bytes a point of each set (its two trees while sorted;
+ * the grids take less), which is charged for the call's duration. */
+#define ENGINE_BYTES 16
+
+static int engine_directed(ctx_t *c, const hd_points_t *P, const hd_points_t *Q, hd_result_t *e) {
+    hd_options_t o;
+    hd_options_init(&o);
+    o.threads = c->threads;
+    size_t bytes = ENGINE_BYTES * (P->count + Q->count);
+    charge(c, bytes);
+    int rc = hd_directed(P, Q, &o, e, &c->e);
+    c->cur -= bytes;
+    return rc;
 }
 
 static int nomem(ctx_t *c, const char *what, size_t n) {
@@ -167,16 +208,24 @@ static int mpi_failed(ctx_t *c, const char *call, int code) {
     return hd__err(&c->e, HD_EIO, "%s failed: %s", call, len ? text : "unknown MPI error");
 }
 
+/* Every MPI call is timed (thread CPU): what is left of the call's CPU
+ * besides them and the searches is its bookkeeping (stats->other_cpu). */
+#define MPI_TIMED(c, call) (mpi_t0_ = thread_cpu(), mpi_rc_ = (call), (c)->mpi_cpu += thread_cpu() - mpi_t0_, mpi_rc_)
+
 #define MPI_TRY(c, call)                                                  \
     do {                                                                  \
-        int mpi_rc_ = (call);                                             \
+        double mpi_t0_;                                                   \
+        int mpi_rc_;                                                      \
+        mpi_rc_ = MPI_TIMED(c, call);                                     \
         if (mpi_rc_ != MPI_SUCCESS) return mpi_failed(c, #call, mpi_rc_); \
     } while (0)
 
 /* The same in a function that frees its buffers at `done`. */
 #define MPI_GO(c, rc, call)                          \
     do {                                             \
-        int mpi_rc_ = (call);                        \
+        double mpi_t0_;                              \
+        int mpi_rc_;                                 \
+        mpi_rc_ = MPI_TIMED(c, call);                \
         if (mpi_rc_ != MPI_SUCCESS) {                \
             rc = mpi_failed(c, #call, mpi_rc_);      \
             goto done;                               \
@@ -189,7 +238,9 @@ static int mpi_failed(ctx_t *c, const char *call, int code) {
  * every collective that a failed rank would not reach. */
 static int agree(ctx_t *c, int rc) {
     int mine = rc != HD_OK ? c->rank : c->K, first = c->K;
-    if (MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, c->comm) != MPI_SUCCESS)
+    double mpi_t0_;
+    int mpi_rc_;
+    if (MPI_TIMED(c, MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, c->comm)) != MPI_SUCCESS)
         return rc != HD_OK ? rc : hd__err(&c->e, HD_EIO, "MPI_Allreduce failed while agreeing on a status");
     if (first == c->K) return HD_OK;
     hd_error_t e = c->e;
@@ -197,7 +248,7 @@ static int agree(ctx_t *c, int rc) {
         e.code = rc;
         snprintf(e.message, sizeof e.message, "rank %d: %.1000s", first, c->e.message);
     }
-    if (MPI_Bcast(&e, (int)sizeof e, MPI_BYTE, first, c->comm) != MPI_SUCCESS)
+    if (MPI_TIMED(c, MPI_Bcast(&e, (int)sizeof e, MPI_BYTE, first, c->comm)) != MPI_SUCCESS)
         return hd__err(&c->e, HD_EIO, "MPI_Bcast failed while agreeing on a status");
     c->e = e;
     return e.code;
@@ -345,54 +396,15 @@ static void far_reduce(void *in, void *inout, int *len, MPI_Datatype *type) {
 /* ---- one direction: h(P, Q) over the partition -------------------------- */
 
 typedef struct {
-    const double *P;         /* local points asking, packed xyz */
-    const uint64_t *gP;
+    double *P;               /* local points asking, packed xyz (reordered
+                                and restored by split/unsplit) */
+    uint64_t *gP;
     size_t nP;
-    const double *Q;         /* local points searched */
-    const uint64_t *gQ;
+    double *Q;               /* local points searched */
+    uint64_t *gQ;
     size_t nQ;
     int qside;               /* 0: Q is A, 1: Q is B */
 } dir_t;
-
-/* The structure of the searched local set for per-point searches (the
- * nearest layer's, as hd_distances builds it), built on first use and kept
- * for the direction: the shell and the forwarded queries ask it in turn,
- * instead of hd_distances building it again for each. */
-typedef struct {
-    hd__an_t s;
-    int built;
-} qtree_t;
-
-/* For each of n packed points, the nearest point of Q (exact, smallest
- * index on ties, as hd_distances gives it). */
-static int nearest_in_q(ctx_t *c, const dir_t *d, qtree_t *q, const double *pts, size_t n, size_t *near) {
-    if (n == 0) return HD_OK;
-    hd_points_t Sv = hd_points_f64(pts, n), Qv = hd_points_f64(d->Q, d->nQ);
-    int threads = hd__thread_count(c->threads, n > d->nQ ? n : d->nQ), rc;
-    if (n > HD__AN_MAX_POINTS || d->nQ > HD__AN_MAX_POINTS) { /* hd_distances' kd-trees */
-        hd_options_t o;
-        hd_options_init(&o);
-        o.threads = c->threads;
-        return hd_distances(&Sv, &Qv, &o, NULL, near, NULL, NULL, &c->e);
-    }
-    hd__box_t kb;
-    hd__box_of(d->Q, d->nQ, &kb); /* keys only order (clamped): any box is exact */
-    if (!q->built) {
-        rc = hd__an_build(&q->s, &Qv, NULL, &kb, threads, &c->e);
-        q->built = 1; /* freed by qtree_free whatever happened */
-        if (rc != HD_OK) return rc;
-    }
-    hd__an_t asking;
-    rc = hd__an_build(&asking, &Sv, NULL, &kb, threads, &c->e);
-    if (rc == HD_OK) rc = hd__an_nearest(&asking, &q->s, NULL, threads, NULL, near, NULL, &c->e);
-    hd__an_free(&asking);
-    return rc;
-}
-
-static void qtree_free(qtree_t *q) {
-    if (q->built) hd__an_free(&q->s);
-    q->built = 0;
-}
 
 /* 1 when every finite face of region r is farther from p than u2 allows
  * (computed fl(gap^2) > u2): then no point of another region is within u2
@@ -409,6 +421,228 @@ static int faces_clear(const hd__box_t *r, const double *p, double u2) {
         }
     }
     return 1;
+}
+
+/* The structures of the searched local set Q for per-point searches (the
+ * nearest layer's, as hd_distances builds them), built on first use and
+ * kept for the direction: the shell and the forwarded queries ask them in
+ * turn.  Only the points that ask need them, and those are few (the shell,
+ * within h of the region's faces, and queries from beyond the faces), so
+ * the first is built over a slab: the points of Q within a margin M of a
+ * finite face.  An answer from the slab is the answer from all of Q when
+ * every point left out is provably farther (slab_proves); the others,
+ * when a few, are compared with every point of Q, else ask a slab twice as
+ * wide as they need, then all of Q.
+ *
+ * Proof.  A point b of Q left out has fl(|b_k - s|) > M for every finite
+ * face s (on axis k) of the region, which holds b.  For a lo face s and any
+ * x, b_k - x_k = (b_k - s) + (s - x_k) > M + o with o = s - x_k; for a hi
+ * face x_k - b_k = (x_k - s) + (s - b_k) > M + o with o = x_k - s.  So
+ * |x_k - b_k| > lb = M + max over faces of o, and hd__d2(x, b) >= fl(fl(x_k
+ * - b_k)^2) > lb^2 (1 - 4 eps) when lb^2 is normal: rounding is monotone.
+ * lb is computed with a relative slack of 1e-12 and the test asks
+ * d2 < lb^2 (1 - 1e-9), far beyond the few ulps involved; below 1e-140 no
+ * proof is tried. */
+typedef struct {
+    hd__an_t s;
+    int built;
+    size_t n, bytes;
+    uint32_t *map;           /* the slab's points in Q (NULL: all of Q) */
+    double M;                /* its margin (infinite: all of Q) */
+    hd__box_t kb;            /* the key box its askers use too */
+} slab_t;
+
+typedef struct {
+    slab_t sub, full;
+    double M0;               /* the first slab's margin (set by shell_of) */
+} qtree_t;
+
+/* The nearest layer's bound on a structure being built (hausdorff.h,
+ * hd_distances: up to about 60 bytes a point), charged while it is. */
+#define AN_BUILD_BYTES 60
+
+static size_t an_bytes(const hd__an_t *s) {
+    return (s->n + 4) * (3 * sizeof(double) + 0) + s->n * sizeof(uint32_t) + (s->nb + 1) * 4 * sizeof(uint32_t) +
+           (s->ng + 1) * 2 * sizeof(uint32_t) + s->nn * (sizeof(uint32_t) + 1 + 6 * sizeof(double));
+}
+
+static int an_build(ctx_t *c, hd__an_t *s, const hd_points_t *v, const hd__box_t *kb, int threads, size_t *bytes) {
+    size_t b = AN_BUILD_BYTES * v->count;
+    charge(c, b);
+    int rc = hd__an_build(s, v, NULL, kb, threads, &c->e);
+    c->cur -= b;
+    *bytes = rc == HD_OK ? an_bytes(s) : 0;
+    charge(c, *bytes);
+    return rc;
+}
+
+static void slab_free(ctx_t *c, slab_t *sl) {
+    if (sl->built) {
+        hd__an_free(&sl->s);
+        c->cur -= sl->bytes;
+    }
+    cfree(c, sl->map, sl->n, sizeof(uint32_t));
+    memset(sl, 0, sizeof *sl);
+}
+
+static void qtree_free(ctx_t *c, qtree_t *q) {
+    slab_free(c, &q->sub);
+    slab_free(c, &q->full);
+}
+
+/* The lower bound lb of the proof above for x, minus its slack. */
+static double slab_lb(const hd__box_t *r, double M, const double *x) {
+    double o = -INFINITY;
+    for (int a = 0; a < 3; a++) {
+        if (isfinite(r->lo[a]) && r->lo[a] - x[a] > o) o = r->lo[a] - x[a];
+        if (isfinite(r->hi[a]) && x[a] - r->hi[a] > o) o = x[a] - r->hi[a];
+    }
+    if (!isfinite(o)) return 0; /* no finite face: every point is in the slab */
+    return (M + o) - 1e-12 * (M + fabs(o));
+}
+
+static int slab_proves(const hd__box_t *r, double M, const double *x, double d2) {
+    double lb = slab_lb(r, M, x);
+    return lb > 1e-140 && d2 < lb * lb * (1 - 1e-9);
+}
+
+/* The distance from b to the nearest finite face of r, as computed. */
+static double face_gap(const hd__box_t *r, const double *b) {
+    double g = INFINITY;
+    for (int a = 0; a < 3; a++) {
+        if (isfinite(r->lo[a]) && fabs(b[a] - r->lo[a]) < g) g = fabs(b[a] - r->lo[a]);
+        if (isfinite(r->hi[a]) && fabs(r->hi[a] - b[a]) < g) g = fabs(r->hi[a] - b[a]);
+    }
+    return g;
+}
+
+/* Build the slab of margin M (infinite: all of Q). */
+static int slab_build(ctx_t *c, const dir_t *d, const hd__box_t *r, double M, slab_t *sl) {
+    memset(sl, 0, sizeof *sl);
+    sl->M = M;
+    double *xyz = NULL;
+    int rc = HD_OK;
+    size_t n = d->nQ;
+    if (isfinite(M)) {
+        n = 0;
+        for (size_t j = 0; j < d->nQ; j++) n += face_gap(r, d->Q + 3 * j) <= M;
+        sl->map = cmalloc(c, n, sizeof(uint32_t));
+        xyz = cmalloc(c, n, 3 * sizeof(double));
+        sl->n = n;
+        if (!sl->map || !xyz) rc = nomem(c, "the searched slab", n);
+        for (size_t j = 0, t = 0; j < d->nQ && rc == HD_OK; j++)
+            if (face_gap(r, d->Q + 3 * j) <= M) {
+                memcpy(xyz + 3 * t, d->Q + 3 * j, 3 * sizeof(double));
+                sl->map[t++] = (uint32_t)j;
+            }
+    }
+    sl->n = n;
+    hd_points_t v = hd_points_f64(xyz ? xyz : d->Q, n);
+    if (rc == HD_OK && n > 0) {
+        hd__box_of(xyz ? xyz : d->Q, n, &sl->kb); /* keys only order (clamped): any box is exact */
+        rc = an_build(c, &sl->s, &v, &sl->kb, hd__thread_count(c->threads, n), &sl->bytes);
+        sl->built = 1; /* freed by slab_free whatever happened */
+    }
+    cfree(c, xyz, n, 3 * sizeof(double));
+    return rc;
+}
+
+/* near[k] for the points pts[k], k in list[0..m), searched in a built slab:
+ * Q's index of the nearest (smallest index on ties) within the slab, or
+ * SIZE_MAX when the slab is empty. */
+static int slab_search(ctx_t *c, const slab_t *sl, const double *pts, const size_t *list, size_t m, size_t *near) {
+    if (m == 0) return HD_OK;
+    if (sl->n == 0) {
+        for (size_t t = 0; t < m; t++) near[list[t]] = SIZE_MAX;
+        return HD_OK;
+    }
+    double *xyz = cmalloc(c, m, 3 * sizeof(double));
+    size_t *got = cmalloc(c, m, sizeof(size_t));
+    int rc = HD_OK;
+    if (!xyz || !got) rc = nomem(c, "the searches", m);
+    for (size_t t = 0; t < m && rc == HD_OK; t++) memcpy(xyz + 3 * t, pts + 3 * list[t], 3 * sizeof(double));
+    hd__an_t asking;
+    size_t ab = 0;
+    int threads = hd__thread_count(c->threads, m > sl->n ? m : sl->n);
+    hd_points_t Sv = hd_points_f64(xyz, m);
+    if (rc == HD_OK && (rc = an_build(c, &asking, &Sv, &sl->kb, threads, &ab)) == HD_OK)
+        rc = hd__an_nearest(&asking, &sl->s, NULL, threads, NULL, got, NULL, &c->e);
+    if (ab) {
+        hd__an_free(&asking);
+        c->cur -= ab;
+    }
+    for (size_t t = 0; t < m && rc == HD_OK; t++) near[list[t]] = sl->map ? sl->map[got[t]] : got[t];
+    cfree(c, xyz, m, 3 * sizeof(double));
+    cfree(c, got, m, sizeof(size_t));
+    return rc;
+}
+
+/* At most this many points the slab did not prove are searched by brute
+ * force (a handful, on a copy: points whose partner is on another rank)
+ * rather than in a wider slab, which costs as much as a few hundred
+ * thousand distances to build. */
+#define BRUTE_MAX 16
+
+/* For each of n packed points, the nearest point of Q (exact, smallest
+ * index on ties, as hd_distances gives it). */
+static int nearest_in_q(ctx_t *c, const dir_t *d, const hd__box_t *r, qtree_t *q, const double *pts, size_t n,
+                        size_t *near) {
+    if (n == 0) return HD_OK;
+    if (n > HD__AN_MAX_POINTS || d->nQ > HD__AN_MAX_POINTS) { /* hd_distances' kd-trees */
+        hd_points_t Sv = hd_points_f64(pts, n), Qv = hd_points_f64(d->Q, d->nQ);
+        hd_options_t o;
+        hd_options_init(&o);
+        o.threads = c->threads;
+        return hd_distances(&Sv, &Qv, &o, NULL, near, NULL, NULL, &c->e);
+    }
+    size_t *list = cmalloc(c, n, sizeof(size_t));
+    if (!list) return nomem(c, "the searches", n);
+    int rc = HD_OK;
+    size_t m = n;
+    for (size_t k = 0; k < n; k++) list[k] = k;
+    /* the slab, a wider one for what it did not prove, then all of Q */
+    for (int level = 0; level < 3 && m > 0 && rc == HD_OK; level++) {
+        slab_t *sl = level == 2 ? &q->full : &q->sub;
+        double M = level == 2 ? INFINITY : q->M0;
+        if (level == 1 && m <= BRUTE_MAX) { /* a few: every point of Q, in index order */
+            for (size_t t = 0; t < m; t++) {
+                const double *x = pts + 3 * list[t];
+                double best = INFINITY;
+                size_t at = SIZE_MAX;
+                for (size_t j = 0; j < d->nQ; j++) {
+                    double d2 = hd__d2(x, d->Q + 3 * j);
+                    if (d2 < best) best = d2, at = j;
+                }
+                near[list[t]] = at;
+            }
+            m = 0;
+            break;
+        }
+        if (level == 1) { /* twice what the unproven need, if finite */
+            double need = q->sub.M;
+            for (size_t t = 0; t < m; t++) {
+                size_t j = near[list[t]];
+                double u = j == SIZE_MAX ? INFINITY : sqrt(hd__d2(pts + 3 * list[t], d->Q + 3 * j));
+                double o = q->sub.M - slab_lb(r, q->sub.M, pts + 3 * list[t]); /* -(max o), about */
+                if (u + o > need) need = u + o;
+            }
+            M = 2 * need;
+            if (!isfinite(M) || M <= q->sub.M) continue;
+            slab_free(c, &q->sub);
+        }
+        if (!sl->built && (rc = slab_build(c, d, r, M, sl)) != HD_OK) break;
+        if ((rc = slab_search(c, sl, pts, list, m, near)) != HD_OK) break;
+        if (level == 2) break;
+        size_t keep = 0;
+        for (size_t t = 0; t < m; t++) {
+            size_t k = list[t], j = near[k];
+            if (j == SIZE_MAX || !slab_proves(r, sl->M, pts + 3 * k, hd__d2(pts + 3 * k, d->Q + 3 * j)))
+                list[keep++] = k;
+        }
+        m = keep;
+    }
+    cfree(c, list, n, sizeof(size_t));
+    return rc;
 }
 
 /* The engine's pass over one direction.  hd_directed(P, Q) on the local
@@ -429,13 +663,50 @@ typedef struct {
     size_t *nearest;         /* each one's nearest in Q (NULL if Q is empty) */
     double *own_xyz;         /* what was allocated for a proper subset */
     uint64_t *own_g;
-    far_t inner;             /* exact over the interior; d2 = -1 if none */
+    far_t inner;             /* exact over the interior; d2 = -1 if none
+                                or not known (lazy) */
+    int lazy;                /* the interior's maximum was not computed */
+    far_t h;                 /* then: the engine's answer, whose witness
+                                is in the shell and bounds the interior */
 } shell_t;
 
 static void shell_free(ctx_t *c, shell_t *sh) {
     cfree(c, sh->own_xyz, sh->n, 3 * sizeof(double));
     cfree(c, sh->own_g, sh->n, sizeof(uint64_t));
     cfree(c, sh->nearest, sh->n, sizeof(size_t));
+}
+
+/* Stable partition in place: the points k with keep[k] to the front, in
+ * order, the others to aside (in order; NULL: the caller has them
+ * already).  unsplit puts everything back. */
+static void split(double *xyz, uint64_t *g, size_t n, const unsigned char *keep, double *axyz, uint64_t *ag) {
+    size_t t = 0, a = 0;
+    for (size_t k = 0; k < n; k++) {
+        if (keep[k]) {
+            if (t != k) memcpy(xyz + 3 * t, xyz + 3 * k, 3 * sizeof(double)), g[t] = g[k];
+            t++;
+        } else if (axyz) {
+            memcpy(axyz + 3 * a, xyz + 3 * k, 3 * sizeof(double));
+            ag[a++] = g[k];
+        }
+    }
+}
+
+static void unsplit(double *xyz, uint64_t *g, size_t n, const unsigned char *keep, const double *axyz,
+                    const uint64_t *ag) {
+    size_t t = 0, a = 0;
+    for (size_t k = 0; k < n; k++) t += keep[k] != 0;
+    a = n - t;
+    for (size_t k = n; k-- > 0;) {
+        if (keep[k]) {
+            --t;
+            if (t != k) memcpy(xyz + 3 * k, xyz + 3 * t, 3 * sizeof(double)), g[k] = g[t];
+        } else {
+            --a;
+            memcpy(xyz + 3 * k, axyz + 3 * a, 3 * sizeof(double));
+            g[k] = ag[a];
+        }
+    }
 }
 
 /* The correspondence pass, for a copy and its original (|A| = |B|, point g
@@ -467,52 +738,74 @@ static int paired_pass(ctx_t *c, const dir_t *d, const hd__box_t *mine, unsigned
         else j++;
     }
     if (nc < 64 || nc < nP - nP / 10 || (nc == nP && nc == nQ)) return HD_OK; /* whole sets: the engine's own */
-    size_t nx = nQ - nc;
-    double *pc = cmalloc(c, nc, 3 * sizeof(double)), *qc = cmalloc(c, nc, 3 * sizeof(double));
-    size_t *pidx = cmalloc(c, nc, sizeof(size_t)), *qx = cmalloc(c, nx, sizeof(size_t));
+    /* The pairs to the front of P and Q, in order; the others aside. */
+    size_t nx = nQ - nc, ny = nP - nc;
+    unsigned char *inq = cmalloc(c, nQ, 1);
+    double *qx = cmalloc(c, nx, 3 * sizeof(double)), *py = cmalloc(c, ny, 3 * sizeof(double));
+    uint64_t *gx = cmalloc(c, nx, sizeof(uint64_t)), *gy = cmalloc(c, ny, sizeof(uint64_t));
     int rc = HD_OK;
-    if (!pc || !qc || !pidx || !qx) rc = nomem(c, "the pairs", nc);
-    for (size_t i = 0, j = 0, t = 0, x = 0; rc == HD_OK && j < nQ;) {
-        if (i < nP && d->gP[i] == d->gQ[j]) {
-            memcpy(pc + 3 * t, d->P + 3 * i, 3 * sizeof(double));
-            memcpy(qc + 3 * t, d->Q + 3 * j, 3 * sizeof(double));
-            pidx[t++] = i++;
-            j++;
-        } else if (i < nP && d->gP[i] < d->gQ[j]) {
-            i++;
-        } else {
-            qx[x++] = j++;
-        }
+    if (!inq || !qx || !py || !gx || !gy) {
+        rc = nomem(c, "the pairs", nc);
+        goto done;
     }
+    memset(in, 0, nP);
+    memset(inq, 0, nQ);
+    for (size_t i = 0, j = 0; i < nP && j < nQ;) {
+        if (d->gP[i] == d->gQ[j]) in[i++] = inq[j++] = 1;
+        else if (d->gP[i] < d->gQ[j]) i++;
+        else j++;
+    }
+    split(d->P, d->gP, nP, in, py, gy);
+    split(d->Q, d->gQ, nQ, inq, qx, gx);
     hd_result_t e;
+    hd_points_t Pv = hd_points_f64(d->P, nc), Qv = hd_points_f64(d->Q, nc);
+    rc = engine_directed(c, &Pv, &Qv, &e);
+    uint64_t gi = rc == HD_OK ? d->gP[e.i] : 0, jc = rc == HD_OK ? d->gP[e.j] : 0; /* Q_c's e.j: P_c's e.j's partner */
+    unsplit(d->P, d->gP, nP, in, py, gy);
+    unsplit(d->Q, d->gQ, nQ, inq, qx, gx);
     if (rc == HD_OK) {
-        hd_points_t Pv = hd_points_f64(pc, nc), Qv = hd_points_f64(qc, nc);
-        hd_options_t o;
-        hd_options_init(&o);
-        o.threads = c->threads;
-        rc = hd_directed(&Pv, &Qv, &o, &e, &c->e);
-    }
-    if (rc == HD_OK) {
-        size_t astar = pidx[e.i];
-        memset(in, 0, nP);
+        size_t astar = 0;
+        for (size_t i = 0, t = 0; i < nP; i++)
+            if (in[i] && t++ == e.i) astar = i;
+        assert(d->gP[astar] == gi);
         *nI = 0;
-        for (size_t t = 0; t < nc; t++) *nI += in[pidx[t]] = (unsigned char)faces_clear(mine, d->P + 3 * pidx[t], e.distance2);
+        for (size_t i = 0; i < nP; i++)
+            *nI += in[i] = (unsigned char)(in[i] && faces_clear(mine, d->P + 3 * i, e.distance2));
         double v = INFINITY;
         uint64_t jv = UINT64_MAX;
         for (size_t x = 0; x < nx && in[astar]; x++) {
-            double d2 = hd__d2(d->P + 3 * astar, d->Q + 3 * qx[x]);
-            if (d2 < v || (d2 == v && d->gQ[qx[x]] < jv)) v = d2, jv = d->gQ[qx[x]];
+            double d2 = hd__d2(d->P + 3 * astar, qx + 3 * x);
+            if (d2 < v || (d2 == v && gx[x] < jv)) v = d2, jv = gx[x];
         }
-        uint64_t jc = d->gP[pidx[e.j]]; /* Q_c's point e.j is the partner of P_c's point e.j */
         if (in[astar] && v >= e.distance2) {
-            *inner = (far_t){e.distance2, d->gP[astar], v == e.distance2 && jv < jc ? jv : jc};
+            *inner = (far_t){e.distance2, gi, v == e.distance2 && jv < jc ? jv : jc};
             *done = 1;
         }
     }
-    cfree(c, pc, nc, 3 * sizeof(double));
-    cfree(c, qc, nc, 3 * sizeof(double));
-    cfree(c, pidx, nc, sizeof(size_t));
-    cfree(c, qx, nx, sizeof(size_t));
+done:
+    cfree(c, inq, nQ, 1);
+    cfree(c, qx, nx, 3 * sizeof(double));
+    cfree(c, py, ny, 3 * sizeof(double));
+    cfree(c, gx, nx, sizeof(uint64_t));
+    cfree(c, gy, ny, sizeof(uint64_t));
+    return rc;
+}
+
+/* The exact maximum over the interior, the points whose faces are clear
+ * of h2 (their local u is global): the engine on a copy of them. */
+static int interior_max(ctx_t *c, const dir_t *d, const hd__box_t *mine, const shell_t *sh, double h2, far_t *out) {
+    unsigned char *in = cmalloc(c, d->nP, 1);
+    if (!in) return nomem(c, "the interior", d->nP);
+    size_t nI = 0;
+    for (size_t k = 0; k < d->nP; k++) nI += in[k] = (unsigned char)faces_clear(mine, d->P + 3 * k, h2);
+    assert(nI + sh->n == d->nP && sh->own_xyz);
+    split(d->P, d->gP, d->nP, in, NULL, NULL); /* the shell's copy is the aside */
+    hd_points_t Iv = hd_points_f64(d->P, nI), Qv = hd_points_f64(d->Q, d->nQ);
+    hd_result_t e;
+    int rc = engine_directed(c, &Iv, &Qv, &e);
+    if (rc == HD_OK) *out = (far_t){e.distance2, d->gP[e.i], d->gQ[e.j]};
+    unsplit(d->P, d->gP, d->nP, in, sh->own_xyz, sh->own_g);
+    cfree(c, in, d->nP, 1);
     return rc;
 }
 
@@ -524,16 +817,13 @@ static int shell_of(ctx_t *c, const dir_t *d, const hd__box_t *mine, qtree_t *q,
     sh->n = d->nP;
     if (d->nP == 0 || d->nQ == 0) return HD_OK;
     hd_points_t Pv = hd_points_f64(d->P, d->nP), Qv = hd_points_f64(d->Q, d->nQ);
-    hd_options_t o;
-    hd_options_init(&o);
-    o.threads = c->threads;
     hd_result_t e;
     unsigned char *in = cmalloc(c, d->nP, 1);
     if (!in) return nomem(c, "the interior", d->nP);
     size_t nI = 0;
     int done = 0;
     int rc = paired_pass(c, d, mine, in, &nI, &sh->inner, &done);
-    if (rc == HD_OK && !done && (rc = hd_directed(&Pv, &Qv, &o, &e, &c->e)) == HD_OK) {
+    if (rc == HD_OK && !done && (rc = engine_directed(c, &Pv, &Qv, &e)) == HD_OK) {
         nI = 0;
         for (size_t k = 0; k < d->nP; k++) nI += in[k] = (unsigned char)faces_clear(mine, d->P + 3 * k, e.distance2);
     }
@@ -542,24 +832,17 @@ static int shell_of(ctx_t *c, const dir_t *d, const hd__box_t *mine, qtree_t *q,
         return rc;
     }
     size_t nS = d->nP - nI;
+    /* The shell's points have u <= sqrt(h2) (those of the paired pass's
+     * interior, h_c) and lie within it of a face, so their nearest points
+     * lie within about 2 sqrt(h2) of one: the slab's margin. */
+    q->M0 = 2.5 * sqrt(done ? sh->inner.d2 : e.distance2);
     if (done) {
         /* the interior's answer is the paired pass's */
     } else if (nI && in[e.i]) {
         sh->inner = (far_t){e.distance2, d->gP[e.i], d->gQ[e.j]};
     } else if (nI) {
-        double *ixyz = cmalloc(c, nI, 3 * sizeof(double));
-        size_t *idx = cmalloc(c, nI, sizeof(size_t));
-        if (!ixyz || !idx) rc = nomem(c, "the interior", nI);
-        for (size_t k = 0, t = 0; k < d->nP && rc == HD_OK; k++)
-            if (in[k]) {
-                memcpy(ixyz + 3 * t, d->P + 3 * k, 3 * sizeof(double));
-                idx[t++] = k;
-            }
-        hd_points_t Iv = hd_points_f64(ixyz, nI);
-        if (rc == HD_OK && (rc = hd_directed(&Iv, &Qv, &o, &e, &c->e)) == HD_OK)
-            sh->inner = (far_t){e.distance2, d->gP[idx[e.i]], d->gQ[e.j]};
-        cfree(c, ixyz, nI, 3 * sizeof(double));
-        cfree(c, idx, nI, sizeof(size_t));
+        sh->lazy = 1; /* interior_max, only if it can matter */
+        sh->h = (far_t){e.distance2, d->gP[e.i], d->gQ[e.j]};
     }
     if (rc == HD_OK && nS && nI) { /* a proper subset: copied */
         sh->n = nS;
@@ -579,7 +862,7 @@ static int shell_of(ctx_t *c, const dir_t *d, const hd__box_t *mine, qtree_t *q,
     if (rc == HD_OK && nS) {
         sh->nearest = cmalloc(c, nS, sizeof(size_t));
         if (!sh->nearest) return nomem(c, "nearest neighbours", nS);
-        rc = nearest_in_q(c, d, q, sh->xyz, nS, sh->nearest);
+        rc = nearest_in_q(c, d, mine, q, sh->xyz, nS, sh->nearest);
     }
     return rc;
 }
@@ -611,7 +894,8 @@ static int pack_queries(ctx_t *c, const double *P, const pair_t *pairs, size_t n
 }
 
 /* Answer m queries against the local Q: exact nearest, smallest index. */
-static int answer(ctx_t *c, const dir_t *d, qtree_t *q, const double *pts, size_t m, ans_t *ans) {
+static int answer(ctx_t *c, const dir_t *d, const hd__box_t *mine, qtree_t *q, const double *pts, size_t m,
+                  ans_t *ans) {
     if (m == 0) return HD_OK;
     if (d->nQ == 0) {
         for (size_t k = 0; k < m; k++) ans[k] = (ans_t){INFINITY, UINT64_MAX};
@@ -619,7 +903,7 @@ static int answer(ctx_t *c, const dir_t *d, qtree_t *q, const double *pts, size_
     }
     size_t *near = cmalloc(c, m, sizeof(size_t));
     if (!near) return nomem(c, "answers", m);
-    int rc = nearest_in_q(c, d, q, pts, m, near);
+    int rc = nearest_in_q(c, d, mine, q, pts, m, near);
     if (rc == HD_OK)
         for (size_t k = 0; k < m; k++)
             ans[k] = (ans_t){hd__d2(pts + 3 * k, d->Q + 3 * near[k]), d->gQ[near[k]]};
@@ -632,7 +916,8 @@ static int direction(ctx_t *c, const dir_t *d, const node_t *tree, const hd__box
     int K = c->K, rc = HD_OK;
     const hd__box_t *mine = &region[c->rank];
     shell_t sh;
-    qtree_t q = {{0}, 0};
+    qtree_t q;
+    memset(&q, 0, sizeof q);
     double t0 = hd__now(), u0 = thread_cpu();
     rc = shell_of(c, d, mine, &q, &sh);
     c->search += hd__now() - t0;
@@ -670,6 +955,28 @@ static int direction(ctx_t *c, const dir_t *d, const node_t *tree, const hd__box
         }
         if (K > 1) node_boxes(tree, 0, held, d->qside, nbox);
     }
+    /* What the searches and the forwarding held, freed before the
+     * interior's engine call (and on failure). */
+#define DIRECTION_FREE()                               \
+    do {                                               \
+        cfree(c, u2, nP, sizeof(double));              \
+        cfree(c, jj, nP, sizeof(uint64_t));            \
+        cfree(c, exact, nP, 1);                        \
+        cfree(c, nbox, K > 1 ? (size_t)K - 1 : 1, sizeof(hd__box_t)); \
+        cfree(c, list, (size_t)K, sizeof(int));        \
+        cfree(c, cnt, 4 * (size_t)K, sizeof(int));     \
+        cfree(c, pairs, cap, sizeof(pair_t));          \
+        cfree(c, sendq, np, 3 * sizeof(double));       \
+        cfree(c, order, np, sizeof(size_t));           \
+        cfree(c, recvq, m, 3 * sizeof(double));        \
+        cfree(c, ans, m, sizeof(ans_t));               \
+        cfree(c, back, np, sizeof(ans_t));             \
+        u2 = NULL, jj = NULL, exact = NULL, nbox = NULL, list = NULL, cnt = NULL, pairs = NULL; \
+        sendq = NULL, order = NULL, recvq = NULL, ans = NULL, back = NULL; \
+        cfree(c, sh.nearest, sh.n, sizeof(size_t));    \
+        sh.nearest = NULL;                             \
+        qtree_free(c, &q);                             \
+    } while (0)
     if ((rc = agree(c, rc)) != HD_OK) goto done;
     /* L and the smallest index i_L of a confirmed point at L: a point
      * with u2 < L, or u2 = L and a larger index, cannot be the witness. */
@@ -729,7 +1036,7 @@ static int direction(ctx_t *c, const dir_t *d, const node_t *tree, const hd__box
     if ((rc = agree(c, rc)) != HD_OK) goto done;
     MPI_GO(c, rc, MPI_Alltoallv(sendq, scount, sdispl, c->q_type, recvq, rcount, rdispl, c->q_type, c->comm));
     double t = hd__now(), u = thread_cpu();
-    rc = answer(c, d, &q, recvq, m, ans);
+    rc = answer(c, d, mine, &q, recvq, m, ans);
     c->search += hd__now() - t;
     c->search_cpu += thread_cpu() - u;
     c->answered += m;
@@ -753,23 +1060,30 @@ static int direction(ctx_t *c, const dir_t *d, const node_t *tree, const hd__box
         far_t f = {u2[k], gP[k], jj[k]};
         if (far_better(&f, &best)) best = f;
     }
+    /* The interior's maximum, when not known, is needed only where the
+     * engine's answer (h2, a*), a* in the shell, beats the best known
+     * over all ranks: every interior point is below (h2, a*) (u <= h2,
+     * and a* is the smallest index at h2), so it cannot beat what (h2, a*)
+     * does not. */
+    DIRECTION_FREE();
+    far_t G;
+    MPI_GO(c, rc, MPI_Allreduce(&best, &G, 1, c->far_type, c->far_op, c->comm));
+    if (sh.lazy && far_better(&sh.h, &G)) {
+        far_t I = {-1.0, UINT64_MAX, UINT64_MAX};
+        double t1 = hd__now(), u1 = thread_cpu();
+        rc = interior_max(c, d, mine, &sh, sh.h.d2, &I);
+        c->search += hd__now() - t1;
+        c->search_cpu += thread_cpu() - u1;
+        c->interior_passes++;
+        if (far_better(&I, &best)) best = I;
+    }
+    if ((rc = agree(c, rc)) != HD_OK) goto done;
     MPI_GO(c, rc, MPI_Allreduce(&best, result, 1, c->far_type, c->far_op, c->comm));
 done:
-    cfree(c, u2, nP, sizeof(double));
-    cfree(c, jj, nP, sizeof(uint64_t));
-    cfree(c, exact, nP, 1);
-    cfree(c, nbox, K > 1 ? (size_t)K - 1 : 1, sizeof(hd__box_t));
-    cfree(c, list, (size_t)K, sizeof(int));
-    cfree(c, cnt, 4 * (size_t)K, sizeof(int));
-    cfree(c, pairs, cap, sizeof(pair_t));
-    cfree(c, sendq, np, 3 * sizeof(double));
-    cfree(c, order, np, sizeof(size_t));
-    cfree(c, recvq, m, 3 * sizeof(double));
-    cfree(c, ans, m, sizeof(ans_t));
-    cfree(c, back, np, sizeof(ans_t));
+    DIRECTION_FREE();
     shell_free(c, &sh);
-    qtree_free(&q);
     return rc;
+#undef DIRECTION_FREE
 }
 
 /* ---- the partition and the exchange -------------------------------------- */
@@ -806,24 +1120,81 @@ static int by_range(const void *x, const void *y) {
     return p->lo < q->lo ? -1 : p->lo > q->lo;
 }
 
-/* Over all ranks, no two parts of one set share an index. */
-static int check_ranges(ctx_t *c, const input_t *in) {
-    int n = 0, rc = HD_OK;
+static int by_owner(const void *x, const void *y) {
+    const range_t *p = x, *q = y;
+    if (p->side != q->side) return p->side - q->side;
+    if (p->rank != q->rank) return p->rank - q->rank;
+    return p->lo < q->lo ? -1 : p->lo > q->lo;
+}
+
+/* Every rank's nonempty parts (all-gathered by check_ranges), sorted by
+ * (side, rank, first index): side s, rank r's are all[seg[s (K + 1) + r]]
+ * up to all[seg[s (K + 1) + r + 1]], and first[i] is the number of part
+ * i's first point among its rank's points of its side in index order.  So
+ * point number m of rank r's side s names a global index (ranges_globals),
+ * which lets the exchange send 4-byte numbers instead of 8-byte indices. */
+typedef struct {
+    int K;
+    range_t *all;
+    size_t total;
+    size_t *seg;
+    uint64_t *first;
+} ranges_t;
+
+static void ranges_free(ctx_t *c, ranges_t *rg) {
+    cfree(c, rg->all, rg->total, sizeof(range_t));
+    if (rg->seg) cfree(c, rg->seg, 2 * ((size_t)rg->K + 1), sizeof(size_t));
+    cfree(c, rg->first, rg->total, sizeof(uint64_t));
+    rg->all = NULL, rg->seg = NULL, rg->first = NULL;
+}
+
+/* g[k] = the global index of point number num[k] of rank r's side s, for
+ * num[] increasing. */
+static void ranges_globals(const ranges_t *rg, int s, int r, const uint32_t *num, size_t n, uint64_t *g) {
+    size_t i = rg->seg[(size_t)s * ((size_t)rg->K + 1) + (size_t)r];
+    for (size_t k = 0; k < n; k++) {
+        while (num[k] - rg->first[i] > rg->all[i].hi - rg->all[i].lo) i++;
+        assert(i < rg->seg[(size_t)s * ((size_t)rg->K + 1) + (size_t)r + 1] && num[k] >= rg->first[i]);
+        g[k] = rg->all[i].lo + (num[k] - rg->first[i]);
+    }
+}
+
+/* The global index of point number m (any) of rank r's side s. */
+static uint64_t ranges_global(const ranges_t *rg, int s, int r, uint64_t m) {
+    size_t lo = rg->seg[(size_t)s * ((size_t)rg->K + 1) + (size_t)r],
+           hi = rg->seg[(size_t)s * ((size_t)rg->K + 1) + (size_t)r + 1] - 1;
+    while (lo < hi) { /* the last part whose first number is <= m */
+        size_t mid = lo + (hi - lo + 1) / 2;
+        if (rg->first[mid] <= m) lo = mid;
+        else hi = mid - 1;
+    }
+    return rg->all[lo].lo + (m - rg->first[lo]);
+}
+
+/* Over all ranks, no two parts of one set share an index; rg receives
+ * every rank's parts. */
+static int check_ranges(ctx_t *c, const input_t *in, ranges_t *rg) {
+    int n = 0, rc = HD_OK, K = c->K;
     for (int s = 0; s < 2; s++)
         for (size_t k = 0; k < in->nparts[s]; k++) n += in->parts[s][k].points.count > 0;
-    int *counts = cmalloc(c, 2 * (size_t)c->K, sizeof(int));
-    if (!counts) rc = nomem(c, "index ranges", (size_t)c->K);
-    if ((rc = agree(c, rc)) != HD_OK) return rc;
-    MPI_TRY(c, MPI_Allgather(&n, 1, MPI_INT, counts, 1, MPI_INT, c->comm));
+    int *counts = cmalloc(c, 2 * (size_t)K, sizeof(int));
+    rg->K = K;
+    rg->seg = cmalloc(c, 2 * ((size_t)K + 1), sizeof(size_t));
+    if (!counts || !rg->seg) rc = nomem(c, "index ranges", (size_t)K);
+    if ((rc = agree(c, rc)) != HD_OK) goto done;
+    MPI_GO(c, rc, MPI_Allgather(&n, 1, MPI_INT, counts, 1, MPI_INT, c->comm));
     size_t total = 0;
-    int *displ = counts + c->K;
-    for (int r = 0; r < c->K; r++) {
+    int *displ = counts + K;
+    for (int r = 0; r < K; r++) {
         displ[r] = (int)(total * sizeof(range_t));
         total += (size_t)counts[r];
         counts[r] *= (int)sizeof(range_t);
     }
-    range_t *mine = cmalloc(c, (size_t)n, sizeof(range_t)), *all = cmalloc(c, total, sizeof(range_t));
-    if (!mine || !all || total * sizeof(range_t) > INT_MAX) rc = nomem(c, "index ranges", total);
+    range_t *mine = cmalloc(c, (size_t)n, sizeof(range_t));
+    rg->all = cmalloc(c, total, sizeof(range_t));
+    rg->first = cmalloc(c, total, sizeof(uint64_t));
+    rg->total = total;
+    if (!mine || !rg->all || !rg->first || total * sizeof(range_t) > INT_MAX) rc = nomem(c, "index ranges", total);
     if ((rc = agree(c, rc)) == HD_OK) {
         int t = 0;
         for (int s = 0; s < 2; s++)
@@ -832,10 +1203,15 @@ static int check_ranges(ctx_t *c, const input_t *in) {
                 if (p->points.count)
                     mine[t++] = (range_t){p->offset, p->offset + (p->points.count - 1), s, c->rank};
             }
-        int e = MPI_Allgatherv(mine, n * (int)sizeof(range_t), MPI_BYTE, all, counts, displ, MPI_BYTE, c->comm);
+        double mpi_t0_;
+        int mpi_rc_,
+            e = MPI_TIMED(c, MPI_Allgatherv(mine, n * (int)sizeof(range_t), MPI_BYTE, rg->all, counts, displ,
+                                            MPI_BYTE, c->comm));
         if (e != MPI_SUCCESS) rc = mpi_failed(c, "MPI_Allgatherv", e);
     }
+    cfree(c, mine, (size_t)n, sizeof(range_t));
     if (rc == HD_OK) {
+        range_t *all = rg->all;
         qsort(all, total, sizeof(range_t), by_range);
         for (size_t k = 1; k < total; k++)
             if (all[k].side == all[k - 1].side && all[k].lo <= all[k - 1].hi) {
@@ -847,9 +1223,21 @@ static int check_ranges(ctx_t *c, const input_t *in) {
                 break;
             }
     }
-    cfree(c, counts, 2 * (size_t)c->K, sizeof(int));
-    cfree(c, mine, (size_t)n, sizeof(range_t));
-    cfree(c, all, total, sizeof(range_t));
+    if (rc == HD_OK) {
+        qsort(rg->all, total, sizeof(range_t), by_owner);
+        size_t k = 0;
+        for (int s = 0; s < 2; s++)
+            for (int r = 0; r <= K; r++) {
+                while (k < total && (rg->all[k].side < s || (rg->all[k].side == s && rg->all[k].rank < r))) k++;
+                rg->seg[(size_t)s * ((size_t)K + 1) + (size_t)r] = k;
+            }
+        for (size_t i = 0; i < total; i++) {
+            int same = i > 0 && rg->all[i].side == rg->all[i - 1].side && rg->all[i].rank == rg->all[i - 1].rank;
+            rg->first[i] = same ? rg->first[i - 1] + (rg->all[i - 1].hi - rg->all[i - 1].lo + 1) : 0;
+        }
+    }
+done:
+    cfree(c, counts, 2 * (size_t)K, sizeof(int));
     return rc;
 }
 
@@ -904,7 +1292,9 @@ static int partition(ctx_t *c, const input_t *in, uint64_t N, node_t *tree) {
         if (!all) rc = nomem(c, "samples", total);
     }
     if ((rc = agree(c, rc)) == HD_OK) {
-        int e = MPI_Gatherv(mine, n, c->sample_type, all, counts, counts + K, c->sample_type, 0, c->comm);
+        double mpi_t0_;
+        int mpi_rc_,
+            e = MPI_TIMED(c, MPI_Gatherv(mine, n, c->sample_type, all, counts, counts + K, c->sample_type, 0, c->comm));
         if (e != MPI_SUCCESS) rc = mpi_failed(c, "MPI_Gatherv", e);
         c->bytes_part += c->rank ? (uint64_t)ns * sizeof(sample_t) : 0;
         if (rc == HD_OK && c->rank == 0) {
@@ -921,15 +1311,16 @@ done:
     return rc;
 }
 
-/* Merge K runs of records sorted by index into packed xyz and indices. */
-typedef struct { const rec_t *at, *end; } run_t;
+/* Merge order of K runs of g[] sorted by index: perm[o] is the position of
+ * the o-th smallest index (the runs are [at, end) ranges of positions). */
+typedef struct { size_t at, end; } run_t;
 
-static void merge_runs(run_t *runs, int K, int *heap, double *xyz, uint64_t *g) {
+static void merge_order(const uint64_t *g, run_t *runs, int K, int *heap, uint32_t *perm) {
     int n = 0;
     for (int r = 0; r < K; r++) {
         if (runs[r].at == runs[r].end) continue;
         int k = n++; /* sift up */
-        while (k > 0 && runs[heap[(k - 1) / 2]].at->g > runs[r].at->g) {
+        while (k > 0 && g[runs[heap[(k - 1) / 2]].at] > g[runs[r].at]) {
             heap[k] = heap[(k - 1) / 2];
             k = (k - 1) / 2;
         }
@@ -938,21 +1329,44 @@ static void merge_runs(run_t *runs, int K, int *heap, double *xyz, uint64_t *g) 
     size_t out = 0;
     while (n > 0) {
         run_t *top = &runs[heap[0]];
-        memcpy(xyz + 3 * out, top->at->x, 3 * sizeof(double));
-        g[out++] = top->at->g;
+        perm[out++] = (uint32_t)top->at;
         int r = heap[0];
         if (++top->at == top->end) r = heap[--n];
-        /* sift down r from the root */
-        int k = 0;
+        int k = 0; /* sift r down from the root */
         for (;;) {
             int ch = 2 * k + 1;
             if (ch >= n) break;
-            if (ch + 1 < n && runs[heap[ch + 1]].at->g < runs[heap[ch]].at->g) ch++;
-            if (runs[heap[ch]].at->g >= runs[r].at->g) break;
+            if (ch + 1 < n && g[runs[heap[ch + 1]].at] < g[runs[heap[ch]].at]) ch++;
+            if (g[runs[heap[ch]].at] >= g[runs[r].at]) break;
             heap[k] = heap[ch];
             k = ch;
         }
         if (n > 0) heap[k] = r;
+    }
+}
+
+/* xyz[o], g[o] = old xyz[perm[o]], g[perm[o]] for every o, in place: each
+ * cycle of the permutation is followed once, and perm[o] = o marks o
+ * done (perm is destroyed). */
+static void permute(double *xyz, uint64_t *g, uint32_t *perm, size_t n) {
+    for (size_t i = 0; i < n; i++) {
+        if (perm[i] == i) continue;
+        double t[3];
+        memcpy(t, xyz + 3 * i, sizeof t);
+        uint64_t tg = g[i];
+        size_t j = i;
+        for (;;) {
+            size_t k = perm[j];
+            perm[j] = (uint32_t)j;
+            if (k == i) {
+                memcpy(xyz + 3 * j, t, sizeof t);
+                g[j] = tg;
+                break;
+            }
+            memcpy(xyz + 3 * j, xyz + 3 * k, sizeof t);
+            g[j] = g[k];
+            j = k;
+        }
     }
 }
 
@@ -962,23 +1376,80 @@ typedef struct {
     size_t n[2];
 } local_t;
 
-/* Move every point to the rank of its region (one MPI_Alltoallv). */
-static int exchange(ctx_t *c, const input_t *in, const node_t *tree, local_t *loc) {
-    int K = c->K, rc = HD_OK;
-    size_t nloc = (size_t)(in->n[0] + in->n[1]), scap = nloc, rcap = 0;
-    int *cnt = cmalloc(c, 8 * (size_t)K, sizeof(int)); /* per rank: s[2] r[2] scount sdispl rcount rdispl */
-    size_t *fill = cmalloc(c, 2 * (size_t)K, sizeof(size_t));
-    int *dest = cmalloc(c, nloc, sizeof(int));
+/* Where point t of the local input goes: one byte a point up to 256 ranks,
+ * two up to 65536. */
+static inline int dest_get(const void *d, int w, size_t t) {
+    return w == 1 ? ((const uint8_t *)d)[t] : w == 2 ? ((const uint16_t *)d)[t] : (int)((const uint32_t *)d)[t];
+}
+
+static inline void dest_set(void *d, int w, size_t t, int r) {
+    if (w == 1) ((uint8_t *)d)[t] = (uint8_t)r;
+    else if (w == 2) ((uint16_t *)d)[t] = (uint16_t)r;
+    else ((uint32_t *)d)[t] = (uint32_t)r;
+}
+
+/* A position in the local input: side, part (in offset order), point in
+ * it, point t overall, and the point's local number in its side. */
+typedef struct { int s; size_t p, k, t; uint64_t num[2]; } walk_t;
+
+static int walk_next(const input_t *in, const hd_mpi_part_t **order[2], walk_t *w) {
+    while (w->s < 2) {
+        if (w->p < in->nparts[w->s] && w->k < order[w->s][w->p]->points.count) return 1;
+        if (w->p < in->nparts[w->s]) w->p++, w->k = 0;
+        else w->s++, w->p = 0, w->k = 0;
+    }
+    return 0;
+}
+
+static void walk_step(walk_t *w) {
+    w->k++;
+    w->t++;
+    w->num[w->s]++;
+}
+
+/* Points sent per round by a rank: an eighth of its points (at least 64K),
+ * so the send buffer is at most 28/8 = 3.5 bytes a point (the minimum
+ * also makes the tests' larger sets take several rounds). */
+#define ROUND_SHARE 8
+#define ROUND_MIN 4096
+
+/* Move every point to the rank of its region.  Each point goes as its
+ * coordinates and a 4-byte number: its rank among the sender's points of
+ * its set in index order (ranges_t turns it back into the global index).
+ * Each source's run is received straight into its slot of the local
+ * arrays, in rounds of at most an eighth of the sender's points, so no
+ * copy of all the points is ever held twice; a rank's own points are
+ * copied from the input into their slot.  Runs are in index order, since
+ * senders walk their parts in offset order; when the runs follow each
+ * other in index order too (each rank's parts lie above the previous
+ * rank's) the local arrays are in global order as received, else they are
+ * merged in place (a permutation from a K-way merge, 4 bytes a point). */
+static int exchange(ctx_t *c, const input_t *in, const ranges_t *rg, const node_t *tree, local_t *loc) {
+    int K = c->K, me = c->rank, rc = HD_OK, w = K <= 256 ? 1 : K <= 65536 ? 2 : 4;
+    size_t nloc = (size_t)(in->n[0] + in->n[1]), C = nloc / ROUND_SHARE, sendcap = 0;
+    if (C < ROUND_MIN) C = ROUND_MIN;
+    /* ints per rank: totals sent tot[2] and received rtot[2]; this round's
+     * per[2] and rper[2]; where each (rank, side) block of the send buffer
+     * starts, sdisp[2], and a cursor in it, sfill[2]; one side's counts and
+     * displacements for MPI: sc sd rcn rd */
+    int *cnt = cmalloc(c, 16 * (size_t)K, sizeof(int));
+    size_t *base = cmalloc(c, 4 * (size_t)K, sizeof(size_t)); /* base[s K + r], then got[s K + r] */
+    void *dest = cmalloc(c, nloc, (size_t)w);
     const hd_mpi_part_t **order[2] = {NULL, NULL};
-    rec_t *send = NULL, *recv = NULL;
+    uint32_t *off[2] = {NULL, NULL};
+    double *sx = NULL;
+    uint32_t *so = NULL;
+    uint32_t *perm = NULL;
+    size_t permn = 0;
     run_t *runs = NULL;
     int *heap = NULL;
     for (int s = 0; s < 2; s++) order[s] = cmalloc(c, in->nparts[s], sizeof *order[s]);
-    if (!cnt || !fill || !dest || !order[0] || !order[1]) rc = nomem(c, "the exchange", nloc);
-    int *sc = cnt, *rcn = cnt + 2 * K, *scount = cnt + 4 * K, *sdispl = cnt + 5 * K, *rcount = cnt + 6 * K,
-        *rdispl = cnt + 7 * K;
+    if (!cnt || !base || !dest || !order[0] || !order[1]) rc = nomem(c, "the exchange", nloc);
+    int *tot = cnt, *rtot = cnt + 2 * K, *per = cnt + 4 * K, *rper = cnt + 6 * K, *sdisp = cnt + 8 * K,
+        *sfill = cnt + 10 * K, *sc = cnt + 12 * K, *sd = cnt + 13 * K, *rcn = cnt + 14 * K, *rd = cnt + 15 * K;
+    size_t *got = base + 2 * K, own = 0;
     if (rc == HD_OK) {
-        memset(fill, 0, 2 * (size_t)K * sizeof(size_t));
+        memset(tot, 0, 2 * (size_t)K * sizeof(int));
         size_t t = 0;
         for (int s = 0; s < 2; s++) {
             for (size_t p = 0; p < in->nparts[s]; p++) order[s][p] = &in->parts[s][p];
@@ -988,92 +1459,152 @@ static int exchange(ctx_t *c, const input_t *in, const node_t *tree, local_t *lo
                     double x[3];
                     get_point(&order[s][p]->points, k, x);
                     int r = rank_of(tree, K, x, (uint64_t)s, order[s][p]->offset + k);
-                    dest[t++] = r;
-                    fill[2 * r + s]++;
+                    dest_set(dest, w, t++, r);
+                    if (tot[2 * r + s] == INT_MAX) rc = HD_EOVERFLOW;
+                    else tot[2 * r + s]++;
                 }
         }
-        size_t total = 0;
-        for (int r = 0; r < K && rc == HD_OK; r++) {
-            if (fill[2 * r] > INT_MAX || fill[2 * r + 1] > INT_MAX || total > INT_MAX ||
-                fill[2 * r] + fill[2 * r + 1] > (size_t)INT_MAX - total)
-                rc = hd__err(&c->e, HD_EOVERFLOW, "more than 2^31 - 1 points to send from rank %d", c->rank);
-            else {
-                sc[2 * r] = (int)fill[2 * r];
-                sc[2 * r + 1] = (int)fill[2 * r + 1];
-                sdispl[r] = (int)total;
-                scount[r] = sc[2 * r] + sc[2 * r + 1];
-                size_t a0 = total;
-                total += fill[2 * r] + fill[2 * r + 1];
-                fill[2 * r + 1] = a0 + fill[2 * r]; /* where B's records start */
-                fill[2 * r] = a0;
-                if (r != c->rank) c->bytes_part += (uint64_t)scount[r] * sizeof(rec_t);
-            }
-        }
-        send = cmalloc(c, scap, sizeof(rec_t));
-        if (rc == HD_OK && !send) rc = nomem(c, "points to send", nloc);
-        t = 0;
-        for (int s = 0; s < 2 && rc == HD_OK; s++)
-            for (size_t p = 0; p < in->nparts[s]; p++)
-                for (size_t k = 0; k < order[s][p]->points.count; k++) {
-                    rec_t *r = &send[fill[2 * dest[t++] + s]++];
-                    get_point(&order[s][p]->points, k, r->x);
-                    r->g = order[s][p]->offset + k;
-                }
+        if (rc != HD_OK)
+            rc = hd__err(&c->e, HD_EOVERFLOW, "more than 2^31 - 1 points of a set to send from rank %d to one rank",
+                         c->rank);
+        own = (size_t)tot[2 * me] + (size_t)tot[2 * me + 1];
+        sendcap = nloc - own < C ? nloc - own : C;
+        for (int r = 0; r < K; r++)
+            if (r != me) c->bytes_part += ((uint64_t)tot[2 * r] + (uint64_t)tot[2 * r + 1]) * (3 * sizeof(double) + 4);
     }
-    cfree(c, dest, nloc, sizeof(int));
-    dest = NULL;
     if ((rc = agree(c, rc)) != HD_OK) goto done;
-    MPI_GO(c, rc, MPI_Alltoall(sc, 2, MPI_INT, rcn, 2, MPI_INT, c->comm));
-    size_t m = 0;
-    loc->n[0] = loc->n[1] = 0;
-    for (int r = 0; r < K && rc == HD_OK; r++) {
-        size_t here = (size_t)rcn[2 * r] + (size_t)rcn[2 * r + 1];
-        if (m > INT_MAX || here > (size_t)INT_MAX - m)
-            rc = hd__err(&c->e, HD_EOVERFLOW, "more than 2^31 - 1 points to receive on rank %d", c->rank);
-        else {
-            rdispl[r] = (int)m;
-            rcount[r] = (int)here;
-            if (r != c->rank) m += here; /* its own stay in the send buffer */
-            loc->n[0] += (size_t)rcn[2 * r];
-            loc->n[1] += (size_t)rcn[2 * r + 1];
+    MPI_GO(c, rc, MPI_Alltoall(tot, 2, MPI_INT, rtot, 2, MPI_INT, c->comm));
+    for (int s = 0; s < 2 && rc == HD_OK; s++) {
+        size_t m = 0;
+        for (int r = 0; r < K; r++) {
+            base[s * K + r] = m;
+            got[s * K + r] = 0;
+            m += (size_t)rtot[2 * r + s];
         }
+        loc->n[s] = m;
+        if (m > INT_MAX) {
+            rc = hd__err(&c->e, HD_EOVERFLOW, "more than 2^31 - 1 points of %s to receive on rank %d",
+                         s ? "B" : "A", c->rank);
+            loc->n[0] = loc->n[1] = 0;
+        }
+    }
+    for (int s = 0; s < 2 && rc == HD_OK; s++) {
+        loc->xyz[s] = cmalloc(c, loc->n[s], 3 * sizeof(double));
+        off[s] = cmalloc(c, loc->n[s], sizeof(uint32_t));
+        if (!loc->xyz[s] || !off[s]) rc = nomem(c, "the local points", loc->n[s]);
     }
     if (rc == HD_OK) {
-        rcap = m;
-        recv = cmalloc(c, m, sizeof(rec_t));
-        if (!recv) rc = nomem(c, "points received", m);
+        sx = cmalloc(c, sendcap, 3 * sizeof(double));
+        so = cmalloc(c, sendcap, sizeof(uint32_t));
+        if (!sx || !so) rc = nomem(c, "points to send", sendcap);
     }
     if ((rc = agree(c, rc)) != HD_OK) goto done;
-    /* What stays on this rank is merged from the send buffer, not copied
-     * through MPI. */
-    int me = c->rank, keep_s = scount[me], keep_r = rcount[me];
-    scount[me] = rcount[me] = 0;
-    MPI_GO(c, rc, MPI_Alltoallv(send, scount, sdispl, c->rec_type, recv, rcount, rdispl, c->rec_type, c->comm));
-    scount[me] = keep_s;
-    rcount[me] = keep_r;
-    runs = cmalloc(c, (size_t)K, sizeof(run_t));
-    heap = cmalloc(c, (size_t)K, sizeof(int));
-    for (int s = 0; s < 2; s++) {
-        loc->xyz[s] = cmalloc(c, loc->n[s], 3 * sizeof(double));
-        loc->g[s] = cmalloc(c, loc->n[s], sizeof(uint64_t));
-        if (!loc->xyz[s] || !loc->g[s]) rc = nomem(c, "the local points", loc->n[s]);
-    }
-    if (!runs || !heap) rc = nomem(c, "the merge", (size_t)K);
-    for (int s = 0; s < 2 && rc == HD_OK; s++) {
-        for (int r = 0; r < K; r++) {
-            const rec_t *b = (r == me ? send + sdispl[r] : recv + rdispl[r]) + (s ? rcn[2 * r] : 0);
-            runs[r] = (run_t){b, b + rcn[2 * r + s]};
+    uint64_t mine = (nloc - own + C - 1) / C, rounds = 0;
+    MPI_GO(c, rc, MPI_Allreduce(&mine, &rounds, 1, MPI_UINT64_T, MPI_MAX, c->comm));
+    if (rounds == 0) rounds = 1; /* a round copies the own points too */
+    walk_t at = {0, 0, 0, 0, {0, 0}};
+    size_t ownat[2] = {base[me], base[K + me]};
+    for (uint64_t round = 0; round < rounds; round++) {
+        /* The window: from `at` up to the C-th point for another rank. */
+        memset(per, 0, 2 * (size_t)K * sizeof(int));
+        walk_t end = at;
+        size_t out = 0;
+        while (walk_next(in, order, &end)) {
+            int r = dest_get(dest, w, end.t);
+            if (r != me) {
+                if (out == C) break;
+                per[2 * r + end.s]++, out++;
+            }
+            walk_step(&end);
         }
-        merge_runs(runs, K, heap, loc->xyz[s], loc->g[s]);
+        int pos = 0; /* the send buffer: A's blocks by rank, then B's */
+        for (int s = 0; s < 2; s++)
+            for (int r = 0; r < K; r++) {
+                sdisp[2 * r + s] = sfill[2 * r + s] = pos;
+                pos += per[2 * r + s];
+            }
+        while (at.t < end.t && walk_next(in, order, &at)) {
+            int r = dest_get(dest, w, at.t), s = at.s;
+            size_t to;
+            double *x;
+            if (r == me) {
+                to = ownat[s]++;
+                x = loc->xyz[s] + 3 * to;
+                off[s][to] = (uint32_t)at.num[s];
+            } else {
+                to = (size_t)sfill[2 * r + s]++;
+                x = sx + 3 * to;
+                so[to] = (uint32_t)at.num[s];
+            }
+            get_point(&order[s][at.p]->points, at.k, x);
+            walk_step(&at);
+        }
+        MPI_GO(c, rc, MPI_Alltoall(per, 2, MPI_INT, rper, 2, MPI_INT, c->comm));
+        for (int s = 0; s < 2; s++) {
+            for (int r = 0; r < K; r++) {
+                sc[r] = per[2 * r + s];
+                sd[r] = sdisp[2 * r + s];
+                rcn[r] = rper[2 * r + s];
+                rd[r] = (int)(base[s * K + r] + got[s * K + r]);
+                got[s * K + r] += (size_t)rcn[r];
+            }
+            MPI_GO(c, rc, MPI_Alltoallv(sx, sc, sd, c->q_type, loc->xyz[s], rcn, rd, c->q_type, c->comm));
+            MPI_GO(c, rc, MPI_Alltoallv(so, sc, sd, MPI_UINT32_T, off[s], rcn, rd, MPI_UINT32_T, c->comm));
+        }
+    }
+    cfree(c, sx, sendcap, 3 * sizeof(double));
+    cfree(c, so, sendcap, sizeof(uint32_t));
+    cfree(c, dest, nloc, (size_t)w);
+    sx = NULL, so = NULL, dest = NULL;
+    assert(ownat[0] == base[me] + (size_t)rtot[2 * me] && ownat[1] == base[K + me] + (size_t)rtot[2 * me + 1]);
+    /* Numbers back to global indices, and global order. */
+    for (int s = 0; s < 2 && rc == HD_OK; s++) {
+        loc->g[s] = cmalloc(c, loc->n[s], sizeof(uint64_t));
+        if (!loc->g[s]) {
+            rc = nomem(c, "the local indices", loc->n[s]);
+            break;
+        }
+        int sorted = 1;
+        uint64_t last = 0;
+        for (int r = 0; r < K; r++) {
+            size_t lo = base[s * K + r], hi = lo + (size_t)rtot[2 * r + s];
+            ranges_globals(rg, s, r, off[s] + lo, hi - lo, loc->g[s] + lo);
+            if (hi > lo) {
+                if (lo > 0 && loc->g[s][lo] < last) sorted = 0;
+                last = loc->g[s][hi - 1];
+            }
+        }
+        cfree(c, off[s], loc->n[s], sizeof(uint32_t));
+        off[s] = NULL;
+        if (sorted) continue;
+        permn = loc->n[s];
+        perm = cmalloc(c, permn, sizeof(uint32_t));
+        runs = cmalloc(c, (size_t)K, sizeof(run_t));
+        heap = cmalloc(c, (size_t)K, sizeof(int));
+        if (!perm || !runs || !heap) {
+            rc = nomem(c, "the merge", loc->n[s]);
+            break;
+        }
+        for (int r = 0; r < K; r++) runs[r] = (run_t){base[s * K + r], base[s * K + r] + (size_t)rtot[2 * r + s]};
+        merge_order(loc->g[s], runs, K, heap, perm);
+        permute(loc->xyz[s], loc->g[s], perm, loc->n[s]);
+        cfree(c, perm, permn, sizeof(uint32_t));
+        cfree(c, runs, (size_t)K, sizeof(run_t));
+        cfree(c, heap, (size_t)K, sizeof(int));
+        perm = NULL, runs = NULL, heap = NULL;
     }
     rc = agree(c, rc);
 done:
-    cfree(c, cnt, 8 * (size_t)K, sizeof(int));
-    cfree(c, fill, 2 * (size_t)K, sizeof(size_t));
-    cfree(c, dest, nloc, sizeof(int));
-    for (int s = 0; s < 2; s++) cfree(c, order[s], in->nparts[s], sizeof *order[s]);
-    cfree(c, send, scap, sizeof(rec_t));
-    cfree(c, recv, rcap, sizeof(rec_t));
+    cfree(c, cnt, 16 * (size_t)K, sizeof(int));
+    cfree(c, base, 4 * (size_t)K, sizeof(size_t));
+    cfree(c, dest, nloc, (size_t)w);
+    for (int s = 0; s < 2; s++) {
+        cfree(c, order[s], in->nparts[s], sizeof *order[s]);
+        cfree(c, off[s], loc->n[s], sizeof(uint32_t));
+    }
+    cfree(c, sx, sendcap, 3 * sizeof(double));
+    cfree(c, so, sendcap, sizeof(uint32_t));
+    cfree(c, perm, permn, sizeof(uint32_t));
     cfree(c, runs, (size_t)K, sizeof(run_t));
     cfree(c, heap, (size_t)K, sizeof(int));
     return rc;
@@ -1082,20 +1613,19 @@ done:
 /* ---- the call ------------------------------------------------------------ */
 
 static int types_create(ctx_t *c) {
-    MPI_TRY(c, MPI_Type_contiguous((int)sizeof(rec_t), MPI_BYTE, &c->rec_type));
     MPI_TRY(c, MPI_Type_contiguous((int)sizeof(ans_t), MPI_BYTE, &c->ans_type));
     MPI_TRY(c, MPI_Type_contiguous(3, MPI_DOUBLE, &c->q_type));
     MPI_TRY(c, MPI_Type_contiguous((int)sizeof(far_t), MPI_BYTE, &c->far_type));
     MPI_TRY(c, MPI_Type_contiguous((int)sizeof(sample_t), MPI_BYTE, &c->sample_type));
     MPI_TRY(c, MPI_Type_contiguous((int)sizeof(node_t), MPI_BYTE, &c->node_type));
-    MPI_Datatype *all[] = {&c->rec_type, &c->ans_type, &c->q_type, &c->far_type, &c->sample_type, &c->node_type};
+    MPI_Datatype *all[] = {&c->ans_type, &c->q_type, &c->far_type, &c->sample_type, &c->node_type};
     for (size_t k = 0; k < sizeof all / sizeof *all; k++) MPI_TRY(c, MPI_Type_commit(all[k]));
     MPI_TRY(c, MPI_Op_create(far_reduce, 1, &c->far_op));
     return HD_OK;
 }
 
 static void types_free(ctx_t *c) {
-    MPI_Datatype *all[] = {&c->rec_type, &c->ans_type, &c->q_type, &c->far_type, &c->sample_type, &c->node_type};
+    MPI_Datatype *all[] = {&c->ans_type, &c->q_type, &c->far_type, &c->sample_type, &c->node_type};
     for (size_t k = 0; k < sizeof all / sizeof *all; k++)
         if (*all[k] != MPI_DATATYPE_NULL) MPI_Type_free(all[k]);
     if (c->far_op != MPI_OP_NULL) MPI_Op_free(&c->far_op);
@@ -1114,6 +1644,17 @@ static int check_local(ctx_t *c, const hd_options_t *opt, input_t *in, const voi
         in->n[s] = 0;
         for (int k = 0; k < 3; k++) in->box[s].lo[k] = INFINITY, in->box[s].hi[k] = -INFINITY;
         if (in->nparts[s] && !in->parts[s]) return hd__err(&c->e, HD_EINVAL, "the parts of %s are NULL", name);
+        /* The exchange numbers a rank's points of a set in 4 bytes (and
+         * the engine takes at most 2^32 - 1 a set): refused before a
+         * point is read. */
+        uint64_t held = 0;
+        for (size_t p = 0; p < in->nparts[s]; p++) {
+            size_t n = in->parts[s][p].points.count;
+            if (n > UINT32_MAX - held)
+                return hd__err(&c->e, HD_ERANGE, "%s: more than 2^32 - 1 points on one rank (%zu parts so far)",
+                               name, p + 1);
+            held += n;
+        }
         for (size_t p = 0; p < in->nparts[s]; p++) {
             const hd_mpi_part_t *part = &in->parts[s][p];
             if (part->points.count == 0) continue;
@@ -1132,6 +1673,53 @@ static int check_local(ctx_t *c, const hd_options_t *opt, input_t *in, const voi
     return HD_OK;
 }
 
+/* K = 1: no partition, no exchange and no copy: the engine runs on the
+ * caller's points, a view of any layout, when each set is one part (else
+ * the parts are packed into one array in index order, 24 bytes a point),
+ * and its local indices become global ones (ranges_global).  Local order
+ * is index order, so the engine's smallest index on ties is the global
+ * one. */
+static int single(ctx_t *c, const input_t *in, const ranges_t *rg, int both, far_t *f) {
+    hd_points_t v[2];
+    double *own[2] = {NULL, NULL};
+    const hd_mpi_part_t **order[2] = {NULL, NULL};
+    int rc = HD_OK;
+    for (int s = 0; s < 2 && rc == HD_OK; s++) {
+        size_t nonempty = 0, last = 0;
+        for (size_t p = 0; p < in->nparts[s]; p++)
+            if (in->parts[s][p].points.count) nonempty++, last = p;
+        if (nonempty == 1) {
+            v[s] = in->parts[s][last].points;
+            continue;
+        }
+        own[s] = cmalloc(c, in->n[s], 3 * sizeof(double));
+        order[s] = cmalloc(c, in->nparts[s], sizeof *order[s]);
+        if (!own[s] || !order[s]) {
+            rc = nomem(c, "the parts", in->n[s]);
+            break;
+        }
+        for (size_t p = 0; p < in->nparts[s]; p++) order[s][p] = &in->parts[s][p];
+        qsort(order[s], in->nparts[s], sizeof *order[s], by_offset);
+        size_t t = 0;
+        for (size_t p = 0; p < in->nparts[s]; p++)
+            for (size_t k = 0; k < order[s][p]->points.count; k++) get_point(&order[s][p]->points, k, own[s] + 3 * t++);
+        v[s] = hd_points_f64(own[s], in->n[s]);
+    }
+    double t0 = hd__now(), u0 = thread_cpu();
+    for (int s = 0; s < (both ? 2 : 1) && rc == HD_OK; s++) {
+        hd_result_t e;
+        if ((rc = engine_directed(c, &v[s], &v[1 - s], &e)) == HD_OK)
+            f[s] = (far_t){e.distance2, ranges_global(rg, s, 0, e.i), ranges_global(rg, 1 - s, 0, e.j)};
+    }
+    c->search += hd__now() - t0;
+    c->search_cpu += thread_cpu() - u0;
+    for (int s = 0; s < 2; s++) {
+        cfree(c, own[s], in->n[s], 3 * sizeof(double));
+        cfree(c, order[s], in->nparts[s], sizeof *order[s]);
+    }
+    return rc;
+}
+
 enum { MODE_DIRECTED = 0, MODE_BOTH = 1, MODE_OVERLAP = 2 };
 typedef struct { double *alpha; int *disjoint; } overlap_t;
 
@@ -1140,17 +1728,21 @@ typedef struct { double *alpha; int *disjoint; } overlap_t;
 static int run(ctx_t *c, const hd_options_t *opt, input_t *in, int both, void *res, hd_mpi_stats_t *st) {
     hd_symmetric_t *out = both == MODE_BOTH ? res : NULL;
     int K = c->K;
-    double t0 = hd__now();
+    double t0 = hd__now(), cpu0 = thread_cpu();
     node_t *tree = NULL;
     hd__box_t *region = NULL;
     held_t *held = NULL;
     local_t loc = {{NULL, NULL}, {NULL, NULL}, {0, 0}};
+    ranges_t rg = {K, NULL, 0, NULL, NULL};
     int rc = check_local(c, opt, in, res);
     if ((rc = agree(c, rc)) != HD_OK) return rc;
-    if ((rc = check_ranges(c, in)) != HD_OK) return rc;
+    if ((rc = check_ranges(c, in, &rg)) != HD_OK) goto done;
     uint64_t n[2] = {in->n[0], in->n[1]}, N[2];
     MPI_GO(c, rc, MPI_Allreduce(n, N, 2, MPI_UINT64_T, MPI_SUM, c->comm));
-    if (N[0] == 0 || N[1] == 0) return hd__err(&c->e, HD_EEMPTY, "point set %s is empty", N[0] ? "B" : "A");
+    if (N[0] == 0 || N[1] == 0) {
+        rc = hd__err(&c->e, HD_EEMPTY, "point set %s is empty", N[0] ? "B" : "A");
+        goto done;
+    }
     /* Global boxes (hi negated: one MIN), and alpha as hd_overlap gives it. */
     double bx[12], gb[12];
     for (int s = 0; s < 2; s++)
@@ -1162,36 +1754,43 @@ static int run(ctx_t *c, const hd_options_t *opt, input_t *in, int both, void *r
     hd_points_t ca = hd_points_f64(corners[0], 2), cb = hd_points_f64(corners[1], 2);
     if (both == MODE_OVERLAP) {
         overlap_t *o = res;
-        return hd_overlap(&ca, &cb, o->alpha, o->disjoint, &c->e);
+        rc = hd_overlap(&ca, &cb, o->alpha, o->disjoint, &c->e);
+        goto done;
     }
     memset(res, 0, both ? sizeof(hd_symmetric_t) : sizeof(hd_result_t));
-    if (both && (rc = hd_overlap(&ca, &cb, &out->alpha, &out->disjoint, &c->e)) != HD_OK) return rc;
-
-    tree = cmalloc(c, K > 1 ? (size_t)K - 1 : 1, sizeof(node_t));
-    region = cmalloc(c, (size_t)K, sizeof(hd__box_t));
-    held = cmalloc(c, (size_t)K, sizeof(held_t));
-    if (!tree || !region || !held) rc = nomem(c, "the partition", (size_t)K);
-    if ((rc = agree(c, rc)) != HD_OK) goto done;
-    if ((rc = partition(c, in, N[0] + N[1], tree)) != HD_OK) goto done;
-    hd__box_t all = {{-INFINITY, -INFINITY, -INFINITY}, {INFINITY, INFINITY, INFINITY}};
-    if (K > 1) regions(tree, 0, all, region);
-    else region[0] = all;
-    if ((rc = exchange(c, in, tree, &loc)) != HD_OK) goto done;
-
-    /* What every rank holds now. */
-    held_t h;
-    for (int s = 0; s < 2; s++) {
-        h.n[s] = loc.n[s];
-        if (loc.n[s]) hd__box_of(loc.xyz[s], loc.n[s], &h.box[s]);
-        else
-            for (int k = 0; k < 3; k++) h.box[s].lo[k] = INFINITY, h.box[s].hi[k] = -INFINITY;
-    }
-    MPI_GO(c, rc, MPI_Allgather(&h, (int)sizeof h, MPI_BYTE, held, (int)sizeof h, MPI_BYTE, c->comm));
+    if (both && (rc = hd_overlap(&ca, &cb, &out->alpha, &out->disjoint, &c->e)) != HD_OK) goto done;
 
     far_t f[2];
-    for (int s = 0; s < (both ? 2 : 1); s++) {
-        dir_t d = {loc.xyz[s], loc.g[s], loc.n[s], loc.xyz[1 - s], loc.g[1 - s], loc.n[1 - s], 1 - s};
-        if ((rc = direction(c, &d, tree, region, held, &f[s])) != HD_OK) goto done;
+    uint64_t pts;
+    if (K == 1) {
+        if ((rc = single(c, in, &rg, both, f)) != HD_OK) goto done;
+        pts = in->n[0] + in->n[1];
+    } else {
+        tree = cmalloc(c, (size_t)K - 1, sizeof(node_t));
+        region = cmalloc(c, (size_t)K, sizeof(hd__box_t));
+        held = cmalloc(c, (size_t)K, sizeof(held_t));
+        if (!tree || !region || !held) rc = nomem(c, "the partition", (size_t)K);
+        if ((rc = agree(c, rc)) != HD_OK) goto done;
+        if ((rc = partition(c, in, N[0] + N[1], tree)) != HD_OK) goto done;
+        hd__box_t all = {{-INFINITY, -INFINITY, -INFINITY}, {INFINITY, INFINITY, INFINITY}};
+        regions(tree, 0, all, region);
+        if ((rc = exchange(c, in, &rg, tree, &loc)) != HD_OK) goto done;
+        ranges_free(c, &rg);
+
+        /* What every rank holds now. */
+        held_t h;
+        for (int s = 0; s < 2; s++) {
+            h.n[s] = loc.n[s];
+            if (loc.n[s]) hd__box_of(loc.xyz[s], loc.n[s], &h.box[s]);
+            else
+                for (int k = 0; k < 3; k++) h.box[s].lo[k] = INFINITY, h.box[s].hi[k] = -INFINITY;
+        }
+        MPI_GO(c, rc, MPI_Allgather(&h, (int)sizeof h, MPI_BYTE, held, (int)sizeof h, MPI_BYTE, c->comm));
+        for (int s = 0; s < (both ? 2 : 1); s++) {
+            dir_t d = {loc.xyz[s], loc.g[s], loc.n[s], loc.xyz[1 - s], loc.g[1 - s], loc.n[1 - s], 1 - s};
+            if ((rc = direction(c, &d, tree, region, held, &f[s])) != HD_OK) goto done;
+        }
+        pts = loc.n[0] + loc.n[1];
     }
     hd_result_t *r[2] = {both ? &out->ab : res, both ? &out->ba : NULL};
     for (int s = 0; s < (both ? 2 : 1); s++) {
@@ -1202,8 +1801,9 @@ static int run(ctx_t *c, const hd_options_t *opt, input_t *in, int both, void *r
         r[s]->algorithm = HD_ALG_AUTO;
     }
     /* Figures. */
-    double secs = hd__now() - t0, tmax = secs, tsum = secs, mine[3] = {secs, c->search, c->search_cpu}, most[3];
-    MPI_GO(c, rc, MPI_Allreduce(mine, most, 3, MPI_DOUBLE, MPI_MAX, c->comm));
+    double other = thread_cpu() - cpu0 - c->search_cpu - c->mpi_cpu;
+    double secs = hd__now() - t0, tmax = secs, tsum = secs, mine[4] = {secs, c->search, c->search_cpu, other}, most[4];
+    MPI_GO(c, rc, MPI_Allreduce(mine, most, 4, MPI_DOUBLE, MPI_MAX, c->comm));
     tmax = most[0];
     MPI_GO(c, rc, MPI_Allreduce(&secs, &tsum, 1, MPI_DOUBLE, MPI_SUM, c->comm));
     for (int s = 0; s < (both ? 2 : 1); s++) r[s]->seconds = tmax;
@@ -1212,7 +1812,7 @@ static int run(ctx_t *c, const hd_options_t *opt, input_t *in, int both, void *r
         out->seconds = tmax;
     }
     if (st) {
-        uint64_t pts = loc.n[0] + loc.n[1], work = pts + c->answered;
+        uint64_t work = pts + c->answered;
         uint64_t sums[6] = {c->bytes_part, c->bytes_fwd, c->forwarded, c->forwarded_points, work, c->shell}, gs[6];
         uint64_t maxes[3] = {pts, work, c->peak}, gm[3];
         MPI_GO(c, rc, MPI_Allreduce(sums, gs, 6, MPI_UINT64_T, MPI_SUM, c->comm));
@@ -1234,6 +1834,8 @@ static int run(ctx_t *c, const hd_options_t *opt, input_t *in, int both, void *r
         st->search_seconds_max = most[1];
         st->search_seconds = c->search;
         st->search_cpu_max = most[2];
+        st->other_cpu_max = most[3];
+        st->other_cpu = other;
         st->peak_bytes_max = gm[2];
         st->seconds = secs;
         st->local_points = pts;
@@ -1244,9 +1846,10 @@ done:
         cfree(c, loc.xyz[s], loc.n[s], 3 * sizeof(double));
         cfree(c, loc.g[s], loc.n[s], sizeof(uint64_t));
     }
-    cfree(c, tree, K > 1 ? (size_t)K - 1 : 1, sizeof(node_t));
+    cfree(c, tree, (size_t)K - 1, sizeof(node_t));
     cfree(c, region, (size_t)K, sizeof(hd__box_t));
     cfree(c, held, (size_t)K, sizeof(held_t));
+    ranges_free(c, &rg);
     return rc;
 }
 
@@ -1255,7 +1858,7 @@ static int call(MPI_Comm comm, const hd_mpi_part_t *a, size_t na, const hd_mpi_p
     hd__err_clear(err);
     ctx_t c;
     memset(&c, 0, sizeof c);
-    c.rec_type = c.ans_type = c.q_type = c.far_type = c.sample_type = c.node_type = MPI_DATATYPE_NULL;
+    c.ans_type = c.q_type = c.far_type = c.sample_type = c.node_type = MPI_DATATYPE_NULL;
     c.far_op = MPI_OP_NULL;
     c.comm = MPI_COMM_NULL;
     hd__err_clear(&c.e);

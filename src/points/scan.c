@@ -33,7 +33,7 @@ typedef struct {
     int *bad; /* per slice: 1 when something is wrong */
 } scan_ctx;
 
-static void scan_task(void *vctx, size_t task, int worker) {
+HD__HOT static void scan_task(void *vctx, size_t task, int worker) {
     (void)worker;
     scan_ctx *c = vctx;
     size_t lo = task * SCAN_SLICE, hi = lo + SCAN_SLICE < c->n ? lo + SCAN_SLICE : c->n;

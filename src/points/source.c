@@ -22,6 +22,19 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* Entry v: bit i of v moved to bit 3i. */
+#define S1(v) ((((v)&1u) | ((v)&2u) << 2 | ((v)&4u) << 4 | ((v)&8u) << 6))
+#define S3(v) (S1(v) | S1((v) >> 4) << 12 | S1((v) >> 8) << 24)
+#define R8(b) S3(b), S3(b + 1), S3(b + 2), S3(b + 3), S3(b + 4), S3(b + 5), S3(b + 6), S3(b + 7)
+#define R64(b) R8(b), R8(b + 8), R8(b + 16), R8(b + 24), R8(b + 32), R8(b + 40), R8(b + 48), R8(b + 56)
+#define R256(b) R64(b), R64(b + 64), R64(b + 128), R64(b + 192)
+const uint32_t hd__spread_table[1024] = {R256(0u), R256(256u), R256(512u), R256(768u)};
+#undef R256
+#undef R64
+#undef R8
+#undef S3
+#undef S1
+
 void hd__src_init(hd__src_t *s, const hd_points_t *p, const hd_transform_t *T) {
     ptrdiff_t el = p->dtype == HD_FLOAT32 ? (ptrdiff_t)sizeof(float) : (ptrdiff_t)sizeof(double);
     s->base = p->data;
