@@ -305,11 +305,9 @@ TEST(per_point_distances_are_exact_for_clusters_next_to_far_outliers) {
     }
 }
 
-/* How many groups of A's queries the partner path of src/nearest/allnearest.c settled
- * when A (n points) asks B (n points), B's point i being A's point i's
- * partner; *groups gets the number of A's groups. */
-static size_t partner_groups(const double *a, const double *b, size_t n, int threads, size_t *groups) {
-    hd_points_t A = hd_points_f64(a, n), B = hd_points_f64(b, n);
+/* The box of the n points of a and the n points of b: the grid both
+ * structures are sorted on, as hd_distances takes it. */
+static hd__box_t union_box(const double *a, const double *b, size_t n) {
     hd__box_t box;
     for (int d = 0; d < 3; d++) {
         box.lo[d] = box.hi[d] = a[d];
@@ -319,6 +317,15 @@ static size_t partner_groups(const double *a, const double *b, size_t n, int thr
             box.hi[d] = fmax(box.hi[d], fmax(u, v));
         }
     }
+    return box;
+}
+
+/* How many groups of A's queries the partner path of src/nearest/allnearest.c settled
+ * when A (n points) asks B (n points), B's point i being A's point i's
+ * partner; *groups gets the number of A's groups. */
+static size_t partner_groups(const double *a, const double *b, size_t n, int threads, size_t *groups) {
+    hd_points_t A = hd_points_f64(a, n), B = hd_points_f64(b, n);
+    hd__box_t box = union_box(a, b, n);
     hd__an_t sa, sb;
     hd__an_counts_t counts = {0, 0, 0};
     CHECK_RC(hd__an_build(&sa, &A, NULL, &box, threads, NULL), HD_OK);
@@ -361,15 +368,7 @@ TEST(same_order_copies_are_exact_and_mostly_settled_by_their_partners) {
  * bit for bit and index for index; *counts gets what the searches took. */
 static void check_window(const double *a, const double *b, size_t n, int threads, hd__an_counts_t *counts) {
     hd_points_t A = hd_points_f64(a, n), B = hd_points_f64(b, n);
-    hd__box_t box;
-    for (int d = 0; d < 3; d++) {
-        box.lo[d] = box.hi[d] = a[d];
-        for (size_t k = 0; k < n; k++) {
-            double u = a[3 * k + (size_t)d], v = b[3 * k + (size_t)d];
-            box.lo[d] = fmin(box.lo[d], fmin(u, v));
-            box.hi[d] = fmax(box.hi[d], fmax(u, v));
-        }
-    }
+    hd__box_t box = union_box(a, b, n);
     hd__an_t sa, sb;
     double *d = malloc(8 * n);
     size_t *j = malloc(sizeof(size_t) * n);
