@@ -67,9 +67,78 @@ void hd__prefault(void *p, size_t bytes) {
 #define REUSE_HEADER 64
 #define REUSE_SMALL 65536
 
+/* A block's header, the REUSE_HEADER bytes before the array: its capacity,
+ * and for a block mapped by huge_map the mapping to unmap (else NULL). */
+typedef struct {
+    size_t cap;
+    void *map;
+    size_t map_len;
+} reuse_head_t;
+
+static reuse_head_t *reuse_head(const void *p) { return (reuse_head_t *)((unsigned char *)p - REUSE_HEADER); }
+
+/* Blocks of at least HUGE_MIN bytes are mapped by huge_map: the array
+ * starts on a HUGE_ALIGN boundary, its header sits at the end of the page
+ * before it, and the pages that hold only the array are marked for
+ * transparent huge pages (MADV_HUGEPAGE; the kernel's default mode here is
+ * "madvise") before they are mapped: a 2 MiB page costs one fault instead
+ * of 512 (docs/benchmarks.md, "Issue 15, item 2").  The mapping ends at
+ * the array's last small page, so a partly used last 2 MiB stays in small
+ * pages and the block costs no more memory than the array (plus a page).
+ * Where the system has no such call, or mmap fails, the block comes from
+ * malloc as below. */
+#define HUGE_ALIGN ((size_t)2 << 20)
+#define HUGE_MIN (HUGE_ALIGN / 9 * 8)
+
+static void *huge_map(size_t bytes) {
+#if defined(MADV_HUGEPAGE) && defined(MAP_ANONYMOUS)
+    long page = sysconf(_SC_PAGESIZE);
+    if (page < 4096 || (size_t)page > HUGE_ALIGN || bytes < HUGE_MIN || bytes > SIZE_MAX / 4) return NULL;
+    size_t pg = (size_t)page, used = (bytes + pg - 1) & ~(pg - 1);
+    size_t whole = (bytes + HUGE_ALIGN - 1) & ~(HUGE_ALIGN - 1);
+    if (whole - bytes <= bytes / 8) used = whole;
+    size_t len = pg + used + HUGE_ALIGN;
+    unsigned char *m = mmap(NULL, len, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    if (m == MAP_FAILED) return NULL;
+    unsigned char *a = (unsigned char *)(((uintptr_t)m + pg + HUGE_ALIGN - 1) & ~(uintptr_t)(HUGE_ALIGN - 1));
+    unsigned char *lo = a - pg, *hi = a + used; /* kept: the header's page and the array's pages */
+    if (lo > m) munmap(m, (size_t)(lo - m));
+    if (m + len > hi) munmap(hi, (size_t)(m + len - hi));
+    /* The huge part is mapped by writing one byte per 2 MiB, not by
+     * MADV_POPULATE_WRITE, which made the first call slower here.  When the
+     * kernel gave small pages instead (THP off, or no free 2 MiB block),
+     * the last page of the last 2 MiB is still absent, and the whole block
+     * is prefaulted as any other; the small pages after the huge part are
+     * prefaulted in any case. */
+    size_t huge = used & ~(HUGE_ALIGN - 1);
+    if (huge && madvise(a, huge, MADV_HUGEPAGE) == 0) {
+        for (size_t o = 0; o < huge; o += HUGE_ALIGN) a[o] = 0;
+        unsigned char in[HUGE_ALIGN / 4096];
+        size_t last = HUGE_ALIGN / pg - 1;
+        if (mincore(a + huge - HUGE_ALIGN, HUGE_ALIGN, in) != 0 || !(in[last] & 1)) huge = 0;
+    } else {
+        huge = 0;
+    }
+    if (huge < bytes) hd__prefault(a + huge, bytes - huge);
+    reuse_head_t *h = reuse_head(a);
+    h->map = lo;
+    h->map_len = (size_t)(hi - lo);
+    return a;
+#else
+    (void)bytes;
+    return NULL;
+#endif
+}
+
+static void reuse_release(void *p) {
+    reuse_head_t *h = reuse_head(p);
+    if (h->map) munmap(h->map, h->map_len);
+    else free(h);
+}
+
 void hd__reuse_init(hd__reuse_t *pool) { pool->n = 0; }
 
-static size_t reuse_cap(const void *p) { return *(const size_t *)((const unsigned char *)p - REUSE_HEADER); }
+static size_t reuse_cap(const void *p) { return reuse_head(p)->cap; }
 
 void *hd__reuse_get(hd__reuse_t *pool, size_t n, size_t size) {
     if (hd__mul_overflows(n, size) || n * size > SIZE_MAX - REUSE_HEADER) return NULL;
@@ -86,11 +155,16 @@ void *hd__reuse_get(hd__reuse_t *pool, size_t n, size_t size) {
             return p;
         }
     }
-    unsigned char *b = malloc(REUSE_HEADER + bytes);
-    if (!b) return NULL;
-    hd__prefault(b, REUSE_HEADER + bytes);
-    *(size_t *)b = bytes;
-    return b + REUSE_HEADER;
+    unsigned char *p = huge_map(bytes);
+    if (!p) {
+        unsigned char *b = malloc(REUSE_HEADER + bytes);
+        if (!b) return NULL;
+        hd__prefault(b, REUSE_HEADER + bytes);
+        p = b + REUSE_HEADER;
+        reuse_head(p)->map = NULL;
+    }
+    reuse_head(p)->cap = bytes;
+    return p;
 }
 
 void hd__reuse_put(hd__reuse_t *pool, void *p) {
@@ -99,11 +173,11 @@ void hd__reuse_put(hd__reuse_t *pool, void *p) {
         pool->block[pool->n++] = p;
         return;
     }
-    free((unsigned char *)p - REUSE_HEADER);
+    reuse_release(p);
 }
 
 void hd__reuse_free(hd__reuse_t *pool) {
-    for (int k = 0; k < pool->n; k++) free((unsigned char *)pool->block[k] - REUSE_HEADER);
+    for (int k = 0; k < pool->n; k++) reuse_release(pool->block[k]);
     pool->n = 0;
 }
 
