@@ -71,9 +71,13 @@ void hd__arena_free(hd__arena_t *a);
  * plain allocations (hd__reuse_put(NULL, p) frees p).  Not thread safe: one
  * thread allocates. */
 #define HD__REUSE_KEEP 16
+#define HD__REUSE_CHUNKS 4
 typedef struct hd__reuse {
     void *block[HD__REUSE_KEEP];
     int n;
+    void *chunk[HD__REUSE_CHUNKS]; /* 2 MiB blocks that middle-sized arrays are cut from */
+    int n_chunks;
+    size_t chunk_used; /* bytes cut from the last chunk */
 } hd__reuse_t;
 void hd__reuse_init(hd__reuse_t *pool);
 /* n * size bytes (checked for overflow), aligned as malloc's; NULL when out of memory. */

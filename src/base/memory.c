@@ -73,6 +73,7 @@ typedef struct {
     size_t cap;
     void *map;
     size_t map_len;
+    int cut; /* cut from one of the pool's chunks: freed with the pool */
 } reuse_head_t;
 
 static reuse_head_t *reuse_head(const void *p) { return (reuse_head_t *)((unsigned char *)p - REUSE_HEADER); }
@@ -90,7 +91,7 @@ static reuse_head_t *reuse_head(const void *p) { return (reuse_head_t *)((unsign
 #define HUGE_ALIGN ((size_t)2 << 20)
 #define HUGE_MIN (HUGE_ALIGN / 9 * 8)
 
-static void *huge_map(size_t bytes) {
+static void *huge_map(size_t bytes, int prefault) {
 #if defined(MADV_HUGEPAGE) && defined(MAP_ANONYMOUS)
     long page = sysconf(_SC_PAGESIZE);
     if (page < 4096 || (size_t)page > HUGE_ALIGN || bytes < HUGE_MIN || bytes > SIZE_MAX / 4) return NULL;
@@ -119,24 +120,54 @@ static void *huge_map(size_t bytes) {
     } else {
         huge = 0;
     }
-    if (huge < bytes) hd__prefault(a + huge, bytes - huge);
+    if (huge < bytes && prefault) hd__prefault(a + huge, bytes - huge);
     reuse_head_t *h = reuse_head(a);
+    h->cut = 0;
     h->map = lo;
     h->map_len = (size_t)(hi - lo);
     return a;
 #else
-    (void)bytes;
+    (void)bytes, (void)prefault;
     return NULL;
 #endif
 }
 
 static void reuse_release(void *p) {
     reuse_head_t *h = reuse_head(p);
+    if (h->cut) return;
     if (h->map) munmap(h->map, h->map_len);
     else free(h);
 }
 
-void hd__reuse_init(hd__reuse_t *pool) { pool->n = 0; }
+/* Middle-sized blocks (REUSE_SMALL up to HUGE_MIN bytes: a grid's cell
+ * tables, the counting sorts' counts) are cut one after another from 2 MiB
+ * chunks of the pool, mapped as huge pages by huge_map: one fault for the
+ * lot instead of one per 4 KiB page.  They go back to the pool's list like
+ * any block, and their memory is unmapped with the pool.  NULL when the
+ * pool has no chunk left or none can be mapped (the caller then uses
+ * malloc). */
+static void *chunk_get(hd__reuse_t *pool, size_t bytes) {
+    size_t need = REUSE_HEADER + ((bytes + REUSE_HEADER - 1) & ~(size_t)(REUSE_HEADER - 1));
+    if (!pool->n_chunks || HUGE_ALIGN - pool->chunk_used < need) {
+        if (pool->n_chunks == HD__REUSE_CHUNKS) return NULL;
+        /* Not prefaulted when the kernel gives small pages: only the
+         * pieces cut from it are touched, each on first write. */
+        void *c = huge_map(HUGE_ALIGN, 0);
+        if (!c) return NULL;
+        pool->chunk[pool->n_chunks++] = c;
+        pool->chunk_used = 0;
+    }
+    unsigned char *p = (unsigned char *)pool->chunk[pool->n_chunks - 1] + pool->chunk_used + REUSE_HEADER;
+    pool->chunk_used += need;
+    reuse_head(p)->cut = 1;
+    return p;
+}
+
+void hd__reuse_init(hd__reuse_t *pool) {
+    pool->n = 0;
+    pool->n_chunks = 0;
+    pool->chunk_used = 0;
+}
 
 static size_t reuse_cap(const void *p) { return reuse_head(p)->cap; }
 
@@ -155,13 +186,16 @@ void *hd__reuse_get(hd__reuse_t *pool, size_t n, size_t size) {
             return p;
         }
     }
-    unsigned char *p = huge_map(bytes);
+    unsigned char *p = NULL;
+    if (pool && bytes >= REUSE_SMALL && bytes < HUGE_MIN) p = chunk_get(pool, bytes);
+    if (!p) p = huge_map(bytes, 1);
     if (!p) {
         unsigned char *b = malloc(REUSE_HEADER + bytes);
         if (!b) return NULL;
         hd__prefault(b, REUSE_HEADER + bytes);
         p = b + REUSE_HEADER;
         reuse_head(p)->map = NULL;
+        reuse_head(p)->cut = 0;
     }
     reuse_head(p)->cap = bytes;
     return p;
@@ -178,7 +212,8 @@ void hd__reuse_put(hd__reuse_t *pool, void *p) {
 
 void hd__reuse_free(hd__reuse_t *pool) {
     for (int k = 0; k < pool->n; k++) reuse_release(pool->block[k]);
-    pool->n = 0;
+    for (int k = 0; k < pool->n_chunks; k++) reuse_release(pool->chunk[k]);
+    hd__reuse_init(pool);
 }
 
 void hd__arena_init(hd__arena_t *a, size_t block_size) {

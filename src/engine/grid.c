@@ -310,7 +310,10 @@ int hd__grid_build(hd__grid_t *g, const hd__src_t *src, size_t n, const hd__box_
     int keep = cells <= 65536;
     c.cell = keep ? hd__reuse_get(pool, n, sizeof *c.cell) : NULL;
     int ok = g->perm && g->start && g->rep && (c.cell || !keep);
-    for (int p = 0; p < c.parts && ok; p++) ok = (c.count[p] = hd__calloc_array(cells, sizeof(uint32_t))) != NULL;
+    for (int p = 0; p < c.parts && ok; p++) {
+        ok = (c.count[p] = hd__reuse_get(pool, cells, sizeof(uint32_t))) != NULL;
+        if (ok) memset(c.count[p], 0, cells * sizeof(uint32_t));
+    }
     if (ok) {
         hd__parallel_for(c.parts, (size_t)c.parts, count_task, &c);
         for (int k = 0; k < 3; k++) {
@@ -334,7 +337,7 @@ int hd__grid_build(hd__grid_t *g, const hd__src_t *src, size_t n, const hd__box_
         hd__parallel_for(c.parts, (size_t)c.parts, scatter_task, &c);
         hd__parallel_for(c.parts, (size_t)c.parts, rep_task, &c);
     }
-    for (int p = 0; p < c.parts; p++) free(c.count[p]);
+    for (int p = c.parts - 1; p >= 0; p--) hd__reuse_put(pool, c.count[p]);
     hd__reuse_put(pool, c.cell);
     if (!ok) {
         hd__grid_free(g);
