@@ -54,3 +54,40 @@ TEST(a_prefaulted_block_is_written_and_freed_as_any_other) {
     free(p);
 }
 
+
+/* Blocks of about 2 MiB and more are mapped on their own (in huge pages
+ * where the kernel gives them), middle-sized ones are cut from the set's
+ * 2 MiB chunks, and more of them than the chunks hold come from malloc:
+ * every block is writable whole and overlaps no other, whichever way it was
+ * made (ASan checks the frees of the malloc'd ones). */
+TEST(blocks_mapped_whole_or_cut_from_chunks_never_overlap) {
+    enum { MID = 100, BIG = 3 };
+    size_t mid_bytes = 100000, big_bytes[BIG] = {(size_t)2 << 20, ((size_t)5 << 20) + 1, 1900000};
+    unsigned char *mid[MID], *big[BIG];
+    hd__reuse_t r;
+    hd__reuse_init(&r);
+    for (int k = 0; k < BIG; k++) {
+        big[k] = hd__reuse_get(&r, big_bytes[k], 1);
+        CHECK(big[k] != NULL);
+        memset(big[k], 200 + k, big_bytes[k]);
+    }
+    for (int k = 0; k < MID; k++) {
+        mid[k] = hd__reuse_get(&r, mid_bytes, 1);
+        CHECK(mid[k] != NULL);
+        CHECK((uintptr_t)mid[k] % 16 == 0);
+        memset(mid[k], k, mid_bytes);
+    }
+    CHECK(r.n_chunks >= 1 && r.n_chunks <= HD__REUSE_CHUNKS);
+    for (int k = 0; k < MID; k++) CHECK(mid[k][0] == k && mid[k][mid_bytes - 1] == k);
+    for (int k = 0; k < BIG; k++) CHECK(big[k][0] == 200 + k && big[k][big_bytes[k] - 1] == 200 + k);
+    /* Given back (the set keeps 16, the rest are released), then reused. */
+    for (int k = 0; k < MID; k++) hd__reuse_put(&r, mid[k]);
+    for (int k = 0; k < BIG; k++) hd__reuse_put(&r, big[k]);
+    unsigned char *again = hd__reuse_get(&r, mid_bytes, 1);
+    CHECK(again != NULL);
+    memset(again, 9, mid_bytes);
+    hd__reuse_put(&r, again);
+    hd__reuse_free(&r);
+    CHECK_EQ(r.n, 0);
+    CHECK_EQ(r.n_chunks, 0);
+}
