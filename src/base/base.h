@@ -68,8 +68,10 @@ void hd__arena_free(hd__arena_t *a);
  * arrays of a few bytes per point in turn (docs/engine.md, "Threads and
  * memory").  Blocks come with a small header, so every block from
  * hd__reuse_get goes back through hd__reuse_put; with a NULL set they are
- * plain allocations (hd__reuse_put(NULL, p) frees p).  Not thread safe: one
- * thread allocates. */
+ * plain allocations (hd__reuse_put(NULL, p) frees p).  Fresh blocks of a
+ * set are mapped in 2 MiB huge pages where the kernel gives them (blocks
+ * from 64 KiB up to about 2 MiB are cut from 2 MiB chunks that the set
+ * unmaps in hd__reuse_free).  Not thread safe: one thread allocates. */
 #define HD__REUSE_KEEP 16
 #define HD__REUSE_CHUNKS 4
 typedef struct hd__reuse {

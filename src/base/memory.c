@@ -18,6 +18,13 @@
  * hd__prefault asks the kernel to map a fresh block's pages in one call
  * (madvise MADV_POPULATE_WRITE) instead of one page fault per page on first
  * write; only for arrays that are written whole, since it maps every page.
+ *
+ * Fresh blocks of the reuse set are mapped in transparent huge pages where
+ * the kernel gives them: large blocks each on their own (huge_map), middle-
+ * sized ones cut from the set's 2 MiB chunks (chunk_get).  A block's pages
+ * are then 2 MiB, one fault each instead of 512.  Every block, however it
+ * was made, starts REUSE_HEADER bytes after its header and is released by
+ * reuse_release, which knows from the header how.
  */
 #include "base/base.h"
 
