@@ -29,9 +29,13 @@
  *     points are never held twice.  Senders walk their parts in increasing
  *     index order, so each run is sorted; when the runs follow each other
  *     in index order (each rank's parts above the previous rank's) the
- *     local arrays are in global order as received, else they are merged
- *     in place (a permutation, 4 bytes a point): local order is global
- *     index order, and a local "smallest index on ties" is the global one.
+ *     local arrays are in global order as received and keep the numbers
+ *     (gidx_t: 28 bytes a point, the index computed where one is needed),
+ *     else the numbers become 8-byte indices and the arrays are merged in
+ *     place (a permutation, 4 bytes a point): local order is global index
+ *     order, and a local "smallest index on ties" is the global one.  The
+ *     arrays are never reordered afterwards (the engine's passes on a
+ *     subset move coordinates only), so a position's index is fixed.
  *     On one rank none of this happens: the engine runs on the caller's
  *     points as they are (one part a set) or packed once (several).
  *  3. The single-machine engine on each rank's part: hd_directed(local A,
@@ -1163,7 +1167,8 @@ static int by_owner(const void *x, const void *y) {
  * up to all[seg[s (K + 1) + r + 1]], and first[i] is the number of part
  * i's first point among its rank's points of its side in index order.  So
  * point number m of rank r's side s names a global index (ranges_globals),
- * which lets the exchange send 4-byte numbers instead of 8-byte indices. */
+ * which lets the exchange send 4-byte numbers instead of 8-byte indices,
+ * and the local arrays keep them (gidx_t): held for the whole call. */
 struct ranges {
     int K;
     range_t *all;
@@ -1467,8 +1472,10 @@ static void walk_step(walk_t *w) {
  * copied from the input into their slot.  Runs are in index order, since
  * senders walk their parts in offset order; when the runs follow each
  * other in index order too (each rank's parts lie above the previous
- * rank's) the local arrays are in global order as received, else they are
- * merged in place (a permutation from a K-way merge, 4 bytes a point). */
+ * rank's) the local arrays are in global order as received and the
+ * numbers stay (loc->num, loc->start: gidx_t), else they become indices
+ * (loc->g) and the arrays are merged in place (a permutation from a K-way
+ * merge, 4 bytes a point). */
 static int exchange(ctx_t *c, const input_t *in, const ranges_t *rg, const node_t *tree, local_t *loc) {
     int K = c->K, me = c->rank, rc = HD_OK, w = K <= 256 ? 1 : K <= 65536 ? 2 : 4;
     size_t nloc = (size_t)(in->n[0] + in->n[1]), C = nloc / ROUND_SHARE, sendcap = 0;
