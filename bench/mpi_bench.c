@@ -21,7 +21,10 @@
  * RSS before it per local point ("hwm": VmHWM reset through
  * /proc/self/clear_refs before the call, so everything the call touched
  * counts, the engine's and MPI's memory too; run one case per process for
- * it, since later cases reuse memory freed by earlier ones).  --repeat R
+ * it, since later cases reuse memory freed by earlier ones), and "own":
+ * the largest of a rank's peak over its own local points (the "buf"
+ * column divides the largest peak by the mean, so it includes the
+ * imbalance).  --repeat R
  * calls R times per case (the repeats' lines are marked "+": memory the
  * first call freed is reused, so they show the costs without first
  * touches of fresh pages).  --check compares with hd_hausdorff on
@@ -118,7 +121,7 @@ int main(int argc, char **argv) {
     if (rank_ == 0)
         printf("# mpi_bench: %d ranks, %zu points per side%s, layout %s, %d thread(s) per rank\n"
                "# case     points  B/pt(part) B/pt(fwd) fwd%%    imbal work-imbal buf B/pt rss B/pt "
-               "time(s) search(s) search ns/pt cpu ns/pt shell%% searchcpu ns/pt hwm B/pt othercpu ns/pt\n",
+               "time(s) search(s) search ns/pt cpu ns/pt shell%% searchcpu ns/pt hwm B/pt othercpu ns/pt own B/pt\n",
                K_, N, per_rank ? " per rank" : "", tiles ? "tiles" : "random", threads);
     char list[256];
     snprintf(list, sizeof list, "%s", cases);
@@ -148,15 +151,17 @@ int main(int argc, char **argv) {
         MPI_Reduce(&grow, &most, 1, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD);
         double hwm = (status_kb("VmHWM:") - cur0) / (double)(st.local_points ? st.local_points : 1), hwmax = 0;
         MPI_Reduce(&hwm, &hwmax, 1, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD);
+        double own = (double)st.peak_bytes / (double)(st.local_points ? st.local_points : 1), ownmax = 0;
+        MPI_Reduce(&own, &ownmax, 1, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD);
         uint64_t tot = st.points;
         if (rank_ == 0)
-            printf("%-8s%s %9llu %9.2f %9.3f %7.3f %6.3f %8.3f %10.1f %10.1f %8.3f %8.3f %8.1f %8.1f %7.3f %8.1f %8.1f %8.1f\n", c, rep ? "+" : "",
+            printf("%-8s%s %9llu %9.2f %9.3f %7.3f %6.3f %8.3f %10.1f %10.1f %8.3f %8.3f %8.1f %8.1f %7.3f %8.1f %8.1f %8.1f %8.1f\n", c, rep ? "+" : "",
                    (unsigned long long)tot, (double)st.bytes_partition / (double)tot,
                    (double)st.bytes_forwarding / (double)tot, 100.0 * (double)st.forwarded_points / (double)tot,
                    st.imbalance, st.work_imbalance, (double)st.peak_bytes_max / ((double)tot / K_), most,
                    st.seconds_max, st.search_seconds_max, 1e9 * st.search_seconds_max / ((double)tot / K_),
                    1e9 * cpumax, 100.0 * (double)st.shell_points / (double)tot,
-                   1e9 * st.search_cpu_max / ((double)tot / K_), hwmax, 1e9 * st.other_cpu_max / ((double)tot / K_));
+                   1e9 * st.search_cpu_max / ((double)tot / K_), hwmax, 1e9 * st.other_cpu_max / ((double)tot / K_), ownmax);
         if (check) { /* gather everything on rank 0 and compare */
             double *all[2] = {NULL, NULL};
             int cnt = (int)(3 * n), *cnts = malloc((size_t)K_ * sizeof(int)), *disp = malloc((size_t)K_ * sizeof(int));

@@ -29,9 +29,13 @@
  *     points are never held twice.  Senders walk their parts in increasing
  *     index order, so each run is sorted; when the runs follow each other
  *     in index order (each rank's parts above the previous rank's) the
- *     local arrays are in global order as received, else they are merged
- *     in place (a permutation, 4 bytes a point): local order is global
- *     index order, and a local "smallest index on ties" is the global one.
+ *     local arrays are in global order as received and keep the numbers
+ *     (gidx_t: 28 bytes a point, the index computed where one is needed),
+ *     else the numbers become 8-byte indices and the arrays are merged in
+ *     place (a permutation, 4 bytes a point): local order is global index
+ *     order, and a local "smallest index on ties" is the global one.  The
+ *     arrays are never reordered afterwards (the engine's passes on a
+ *     subset move coordinates only), so a position's index is fixed.
  *     On one rank none of this happens: the engine runs on the caller's
  *     points as they are (one part a set) or packed once (several).
  *  3. The single-machine engine on each rank's part: hd_directed(local A,
@@ -395,13 +399,34 @@ static void far_reduce(void *in, void *inout, int *len, MPI_Datatype *type) {
 
 /* ---- one direction: h(P, Q) over the partition -------------------------- */
 
+/* The global indices of a local set, by position (local order is global
+ * index order).  Not stored as 8-byte indices: each point keeps the 4-byte
+ * number it came with (its rank among its sender's points of the set, in
+ * index order), and since the senders' runs lie in the local array one
+ * after the other, a position names its sender (start[]) and the sender's
+ * index runs (ranges_t) turn the number into the index (gidx).  Where the
+ * runs had to be merged (the senders' index ranges interleave), positions
+ * no longer name senders and the indices are stored (g).  The arrays are
+ * never reordered after the exchange (split/unsplit move coordinates
+ * only), so position k's index is fixed for the call. */
+typedef struct ranges ranges_t;
+typedef struct {
+    const uint64_t *g;       /* each position's index (runs merged), or NULL */
+    const uint32_t *num;     /* else each position's number at its sender */
+    const size_t *start;     /* K + 1: where each sender's run starts */
+    const ranges_t *rg;
+    int side, K;
+} gidx_t;
+
+static uint64_t gidx(const gidx_t *x, size_t k);
+
 typedef struct {
     double *P;               /* local points asking, packed xyz (reordered
                                 and restored by split/unsplit) */
-    uint64_t *gP;
+    const gidx_t *gP;        /* their global indices, by position */
     size_t nP;
     double *Q;               /* local points searched */
-    uint64_t *gQ;
+    const gidx_t *gQ;
     size_t nQ;
     int qside;               /* 0: Q is A, 1: Q is B */
 } dir_t;
@@ -658,11 +683,10 @@ static int nearest_in_q(ctx_t *c, const dir_t *d, const hd__box_t *r, qtree_t *q
  * within h of the region's faces. */
 typedef struct {
     const double *xyz;       /* the shell's points (P itself when all are) */
-    const uint64_t *g;
     size_t n;
     size_t *nearest;         /* each one's nearest in Q (NULL if Q is empty) */
     double *own_xyz;         /* what was allocated for a proper subset */
-    uint64_t *own_g;
+    uint32_t *own_pos;       /* ... with each one's position in P */
     far_t inner;             /* exact over the interior; d2 = -1 if none
                                 or not known (lazy) */
     int lazy;                /* the interior's maximum was not computed */
@@ -672,39 +696,45 @@ typedef struct {
 
 static void shell_free(ctx_t *c, shell_t *sh) {
     cfree(c, sh->own_xyz, sh->n, 3 * sizeof(double));
-    cfree(c, sh->own_g, sh->n, sizeof(uint64_t));
+    cfree(c, sh->own_pos, sh->n, sizeof(uint32_t));
     cfree(c, sh->nearest, sh->n, sizeof(size_t));
 }
 
-/* Stable partition in place: the points k with keep[k] to the front, in
- * order, the others to aside (in order; NULL: the caller has them
- * already).  unsplit puts everything back. */
-static void split(double *xyz, uint64_t *g, size_t n, const unsigned char *keep, double *axyz, uint64_t *ag) {
+/* Stable partition in place of the coordinates (the indices stay by
+ * position): the points k with keep[k] to the front, in order, the others
+ * to aside (in order; NULL: the caller has them already).  unsplit puts
+ * everything back. */
+static void split(double *xyz, size_t n, const unsigned char *keep, double *axyz) {
     size_t t = 0, a = 0;
     for (size_t k = 0; k < n; k++) {
         if (keep[k]) {
-            if (t != k) memcpy(xyz + 3 * t, xyz + 3 * k, 3 * sizeof(double)), g[t] = g[k];
+            if (t != k) memcpy(xyz + 3 * t, xyz + 3 * k, 3 * sizeof(double));
             t++;
         } else if (axyz) {
-            memcpy(axyz + 3 * a, xyz + 3 * k, 3 * sizeof(double));
-            ag[a++] = g[k];
+            memcpy(axyz + 3 * a++, xyz + 3 * k, 3 * sizeof(double));
         }
     }
 }
 
-static void unsplit(double *xyz, uint64_t *g, size_t n, const unsigned char *keep, const double *axyz,
-                    const uint64_t *ag) {
+/* The position of the m-th point k (from 0) with keep[k]. */
+static size_t kept_at(const unsigned char *keep, size_t n, size_t m) {
+    for (size_t k = 0, t = 0; k < n; k++)
+        if (keep[k] && t++ == m) return k;
+    assert(0);
+    return 0;
+}
+
+static void unsplit(double *xyz, size_t n, const unsigned char *keep, const double *axyz) {
     size_t t = 0, a = 0;
     for (size_t k = 0; k < n; k++) t += keep[k] != 0;
     a = n - t;
     for (size_t k = n; k-- > 0;) {
         if (keep[k]) {
             --t;
-            if (t != k) memcpy(xyz + 3 * k, xyz + 3 * t, 3 * sizeof(double)), g[k] = g[t];
+            if (t != k) memcpy(xyz + 3 * k, xyz + 3 * t, 3 * sizeof(double));
         } else {
             --a;
             memcpy(xyz + 3 * k, axyz + 3 * a, 3 * sizeof(double));
-            g[k] = ag[a];
         }
     }
 }
@@ -728,55 +758,59 @@ static void unsplit(double *xyz, uint64_t *g, size_t n, const unsigned char *kee
  * smallest index of Q_x at exactly h_c.  Otherwise (*done = 0) the caller
  * runs the engine on the whole local sets.  Tried only when nine tenths
  * of P have their partner: anything else is not a copy. */
-static int paired_pass(ctx_t *c, const dir_t *d, const hd__box_t *mine, unsigned char *in, size_t *nI,
+static int paired_pass(ctx_t *c, const dir_t *d, const hd__box_t *mine, unsigned char **inp, size_t *nI,
                        far_t *inner, int *done) {
     size_t nP = d->nP, nQ = d->nQ, nc = 0;
     *done = 0;
+    *inp = NULL;
     for (size_t i = 0, j = 0; i < nP && j < nQ;) {
-        if (d->gP[i] == d->gQ[j]) nc++, i++, j++;
-        else if (d->gP[i] < d->gQ[j]) i++;
+        uint64_t gi = gidx(d->gP, i), gj = gidx(d->gQ, j);
+        if (gi == gj) nc++, i++, j++;
+        else if (gi < gj) i++;
         else j++;
     }
     if (nc < 64 || nc < nP - nP / 10 || (nc == nP && nc == nQ)) return HD_OK; /* whole sets: the engine's own */
     /* The pairs to the front of P and Q, in order; the others aside. */
     size_t nx = nQ - nc, ny = nP - nc;
-    unsigned char *inq = cmalloc(c, nQ, 1);
+    unsigned char *in = *inp = cmalloc(c, nP, 1), *inq = cmalloc(c, nQ, 1);
     double *qx = cmalloc(c, nx, 3 * sizeof(double)), *py = cmalloc(c, ny, 3 * sizeof(double));
-    uint64_t *gx = cmalloc(c, nx, sizeof(uint64_t)), *gy = cmalloc(c, ny, sizeof(uint64_t));
     int rc = HD_OK;
-    if (!inq || !qx || !py || !gx || !gy) {
+    if (!in || !inq || !qx || !py) {
         rc = nomem(c, "the pairs", nc);
         goto done;
     }
     memset(in, 0, nP);
     memset(inq, 0, nQ);
     for (size_t i = 0, j = 0; i < nP && j < nQ;) {
-        if (d->gP[i] == d->gQ[j]) in[i++] = inq[j++] = 1;
-        else if (d->gP[i] < d->gQ[j]) i++;
+        uint64_t gi = gidx(d->gP, i), gj = gidx(d->gQ, j);
+        if (gi == gj) in[i++] = inq[j++] = 1;
+        else if (gi < gj) i++;
         else j++;
     }
-    split(d->P, d->gP, nP, in, py, gy);
-    split(d->Q, d->gQ, nQ, inq, qx, gx);
+    split(d->P, nP, in, py);
+    split(d->Q, nQ, inq, qx);
     hd_result_t e;
     hd_points_t Pv = hd_points_f64(d->P, nc), Qv = hd_points_f64(d->Q, nc);
     rc = engine_directed(c, &Pv, &Qv, &e);
-    uint64_t gi = rc == HD_OK ? d->gP[e.i] : 0, jc = rc == HD_OK ? d->gP[e.j] : 0; /* Q_c's e.j: P_c's e.j's partner */
-    unsplit(d->P, d->gP, nP, in, py, gy);
-    unsplit(d->Q, d->gQ, nQ, inq, qx, gx);
+    unsplit(d->P, nP, in, py);
+    unsplit(d->Q, nQ, inq, qx);
     if (rc == HD_OK) {
-        size_t astar = 0;
-        for (size_t i = 0, t = 0; i < nP; i++)
-            if (in[i] && t++ == e.i) astar = i;
-        assert(d->gP[astar] == gi);
+        /* a*, and Q_c's e.j: P_c's e.j's partner (the same index) */
+        size_t astar = kept_at(in, nP, e.i);
+        uint64_t gi = gidx(d->gP, astar), jc = gidx(d->gP, kept_at(in, nP, e.j));
         *nI = 0;
         for (size_t i = 0; i < nP; i++)
             *nI += in[i] = (unsigned char)(in[i] && faces_clear(mine, d->P + 3 * i, e.distance2));
+        /* The nearest point of Q_x to a* (position order is index order:
+         * the first at the minimum is the smallest index). */
         double v = INFINITY;
-        uint64_t jv = UINT64_MAX;
-        for (size_t x = 0; x < nx && in[astar]; x++) {
-            double d2 = hd__d2(d->P + 3 * astar, qx + 3 * x);
-            if (d2 < v || (d2 == v && gx[x] < jv)) v = d2, jv = gx[x];
+        size_t jx = SIZE_MAX;
+        for (size_t j = 0; j < nQ && in[astar]; j++) {
+            if (inq[j]) continue;
+            double d2 = hd__d2(d->P + 3 * astar, d->Q + 3 * j);
+            if (d2 < v) v = d2, jx = j;
         }
+        uint64_t jv = jx == SIZE_MAX ? UINT64_MAX : gidx(d->gQ, jx);
         if (in[astar] && v >= e.distance2) {
             *inner = (far_t){e.distance2, gi, v == e.distance2 && jv < jc ? jv : jc};
             *done = 1;
@@ -786,8 +820,6 @@ done:
     cfree(c, inq, nQ, 1);
     cfree(c, qx, nx, 3 * sizeof(double));
     cfree(c, py, ny, 3 * sizeof(double));
-    cfree(c, gx, nx, sizeof(uint64_t));
-    cfree(c, gy, ny, sizeof(uint64_t));
     return rc;
 }
 
@@ -799,33 +831,38 @@ static int interior_max(ctx_t *c, const dir_t *d, const hd__box_t *mine, const s
     size_t nI = 0;
     for (size_t k = 0; k < d->nP; k++) nI += in[k] = (unsigned char)faces_clear(mine, d->P + 3 * k, h2);
     assert(nI + sh->n == d->nP && sh->own_xyz);
-    split(d->P, d->gP, d->nP, in, NULL, NULL); /* the shell's copy is the aside */
+    split(d->P, d->nP, in, NULL); /* the shell's copy is the aside */
     hd_points_t Iv = hd_points_f64(d->P, nI), Qv = hd_points_f64(d->Q, d->nQ);
     hd_result_t e;
     int rc = engine_directed(c, &Iv, &Qv, &e);
-    if (rc == HD_OK) *out = (far_t){e.distance2, d->gP[e.i], d->gQ[e.j]};
-    unsplit(d->P, d->gP, d->nP, in, sh->own_xyz, sh->own_g);
+    unsplit(d->P, d->nP, in, sh->own_xyz);
+    if (rc == HD_OK) *out = (far_t){e.distance2, gidx(d->gP, kept_at(in, d->nP, e.i)), gidx(d->gQ, e.j)};
     cfree(c, in, d->nP, 1);
     return rc;
+}
+
+/* The global index of the shell's point k. */
+static uint64_t shell_g(const dir_t *d, const shell_t *sh, size_t k) {
+    return gidx(d->gP, sh->own_pos ? sh->own_pos[k] : k);
 }
 
 static int shell_of(ctx_t *c, const dir_t *d, const hd__box_t *mine, qtree_t *q, shell_t *sh) {
     memset(sh, 0, sizeof *sh);
     sh->inner = (far_t){-1.0, UINT64_MAX, UINT64_MAX};
     sh->xyz = d->P;
-    sh->g = d->gP;
     sh->n = d->nP;
     if (d->nP == 0 || d->nQ == 0) return HD_OK;
     hd_points_t Pv = hd_points_f64(d->P, d->nP), Qv = hd_points_f64(d->Q, d->nQ);
     hd_result_t e;
-    unsigned char *in = cmalloc(c, d->nP, 1);
-    if (!in) return nomem(c, "the interior", d->nP);
+    unsigned char *in = NULL; /* allocated after the engine's pass, the peak */
     size_t nI = 0;
     int done = 0;
-    int rc = paired_pass(c, d, mine, in, &nI, &sh->inner, &done);
+    int rc = paired_pass(c, d, mine, &in, &nI, &sh->inner, &done);
     if (rc == HD_OK && !done && (rc = engine_directed(c, &Pv, &Qv, &e)) == HD_OK) {
+        if (!in && !(in = cmalloc(c, d->nP, 1))) rc = nomem(c, "the interior", d->nP);
         nI = 0;
-        for (size_t k = 0; k < d->nP; k++) nI += in[k] = (unsigned char)faces_clear(mine, d->P + 3 * k, e.distance2);
+        for (size_t k = 0; k < d->nP && rc == HD_OK; k++)
+            nI += in[k] = (unsigned char)faces_clear(mine, d->P + 3 * k, e.distance2);
     }
     if (rc != HD_OK) {
         cfree(c, in, d->nP, 1);
@@ -839,23 +876,22 @@ static int shell_of(ctx_t *c, const dir_t *d, const hd__box_t *mine, qtree_t *q,
     if (done) {
         /* the interior's answer is the paired pass's */
     } else if (nI && in[e.i]) {
-        sh->inner = (far_t){e.distance2, d->gP[e.i], d->gQ[e.j]};
+        sh->inner = (far_t){e.distance2, gidx(d->gP, e.i), gidx(d->gQ, e.j)};
     } else if (nI) {
         sh->lazy = 1; /* interior_max, only if it can matter */
-        sh->h = (far_t){e.distance2, d->gP[e.i], d->gQ[e.j]};
+        sh->h = (far_t){e.distance2, gidx(d->gP, e.i), gidx(d->gQ, e.j)};
     }
     if (rc == HD_OK && nS && nI) { /* a proper subset: copied */
         sh->n = nS;
         sh->own_xyz = cmalloc(c, nS, 3 * sizeof(double));
-        sh->own_g = cmalloc(c, nS, sizeof(uint64_t));
-        if (!sh->own_xyz || !sh->own_g) rc = nomem(c, "the shell", nS);
+        sh->own_pos = cmalloc(c, nS, sizeof(uint32_t));
+        if (!sh->own_xyz || !sh->own_pos) rc = nomem(c, "the shell", nS);
         for (size_t k = 0, t = 0; k < d->nP && rc == HD_OK; k++)
             if (!in[k]) {
                 memcpy(sh->own_xyz + 3 * t, d->P + 3 * k, 3 * sizeof(double));
-                sh->own_g[t++] = d->gP[k];
+                sh->own_pos[t++] = (uint32_t)k;
             }
         sh->xyz = sh->own_xyz;
-        sh->g = sh->own_g;
     }
     sh->n = nS;
     cfree(c, in, d->nP, 1);
@@ -906,7 +942,7 @@ static int answer(ctx_t *c, const dir_t *d, const hd__box_t *mine, qtree_t *q, c
     int rc = nearest_in_q(c, d, mine, q, pts, m, near);
     if (rc == HD_OK)
         for (size_t k = 0; k < m; k++)
-            ans[k] = (ans_t){hd__d2(pts + 3 * k, d->Q + 3 * near[k]), d->gQ[near[k]]};
+            ans[k] = (ans_t){hd__d2(pts + 3 * k, d->Q + 3 * near[k]), gidx(d->gQ, near[k])};
     cfree(c, near, m, sizeof(size_t));
     return rc;
 }
@@ -925,7 +961,6 @@ static int direction(ctx_t *c, const dir_t *d, const node_t *tree, const hd__box
     c->shell += sh.n;
     size_t nP = sh.n, np = 0, cap = 0;
     const double *P = sh.xyz;
-    const uint64_t *gP = sh.g;
     double *u2 = cmalloc(c, nP, sizeof(double));
     uint64_t *jj = cmalloc(c, nP, sizeof(uint64_t));
     unsigned char *exact = cmalloc(c, nP, 1);
@@ -948,9 +983,9 @@ static int direction(ctx_t *c, const dir_t *d, const node_t *tree, const hd__box
                 continue;
             }
             u2[k] = hd__d2(p, d->Q + 3 * sh.nearest[k]);
-            jj[k] = d->gQ[sh.nearest[k]];
+            jj[k] = gidx(d->gQ, sh.nearest[k]);
             exact[k] = (unsigned char)faces_clear(mine, p, u2[k]);
-            far_t f = {u2[k], gP[k], jj[k]};
+            far_t f = {u2[k], shell_g(d, &sh, k), jj[k]};
             if (exact[k] && far_better(&f, &Lmine)) Lmine = f;
         }
         if (K > 1) node_boxes(tree, 0, held, d->qside, nbox);
@@ -985,7 +1020,7 @@ static int direction(ctx_t *c, const dir_t *d, const node_t *tree, const hd__box
     uint64_t iL = Lall.i;
     /* The points to forward, as (point, rank) pairs. */
     for (size_t k = 0; k < nP && rc == HD_OK; k++) {
-        if (exact[k] || u2[k] < L || (u2[k] == L && gP[k] > iL)) continue;
+        if (exact[k] || u2[k] < L || (u2[k] == L && shell_g(d, &sh, k) > iL)) continue;
         const double *p = P + 3 * k;
         double bound = u2[k];
         if (d->nQ == 0)
@@ -1056,8 +1091,8 @@ static int direction(ctx_t *c, const dir_t *d, const node_t *tree, const hd__box
      * point at L with a larger index than i_L loses to i_L). */
     far_t best = sh.inner;
     for (size_t k = 0; k < nP; k++) {
-        if (u2[k] < L || (u2[k] == L && gP[k] > iL)) continue;
-        far_t f = {u2[k], gP[k], jj[k]};
+        if (u2[k] < L || (u2[k] == L && shell_g(d, &sh, k) > iL)) continue;
+        far_t f = {u2[k], shell_g(d, &sh, k), jj[k]};
         if (far_better(&f, &best)) best = f;
     }
     /* The interior's maximum, when not known, is needed only where the
@@ -1132,14 +1167,15 @@ static int by_owner(const void *x, const void *y) {
  * up to all[seg[s (K + 1) + r + 1]], and first[i] is the number of part
  * i's first point among its rank's points of its side in index order.  So
  * point number m of rank r's side s names a global index (ranges_globals),
- * which lets the exchange send 4-byte numbers instead of 8-byte indices. */
-typedef struct {
+ * which lets the exchange send 4-byte numbers instead of 8-byte indices,
+ * and the local arrays keep them (gidx_t): held for the whole call. */
+struct ranges {
     int K;
     range_t *all;
     size_t total;
     size_t *seg;
     uint64_t *first;
-} ranges_t;
+};
 
 static void ranges_free(ctx_t *c, ranges_t *rg) {
     cfree(c, rg->all, rg->total, sizeof(range_t));
@@ -1169,6 +1205,18 @@ static uint64_t ranges_global(const ranges_t *rg, int s, int r, uint64_t m) {
         else hi = mid - 1;
     }
     return rg->all[lo].lo + (m - rg->first[lo]);
+}
+
+static uint64_t gidx(const gidx_t *x, size_t k) {
+    if (x->g) return x->g[k];
+    int lo = 0, hi = x->K - 1;
+    while (lo < hi) { /* the last sender whose run starts at or before k */
+        int mid = lo + (hi - lo + 1) / 2;
+        if (x->start[mid] <= k) lo = mid;
+        else hi = mid - 1;
+    }
+    assert(k >= x->start[lo] && k < x->start[lo + 1]);
+    return ranges_global(x->rg, x->side, lo, x->num[k]);
 }
 
 /* Over all ranks, no two parts of one set share an index; rg receives
@@ -1372,7 +1420,9 @@ static void permute(double *xyz, uint64_t *g, uint32_t *perm, size_t n) {
 
 typedef struct {
     double *xyz[2];
-    uint64_t *g[2];
+    uint64_t *g[2];          /* the indices, where the runs were merged */
+    uint32_t *num[2];        /* else the senders' numbers (gidx_t) */
+    size_t *start[2];        /* K + 1 a side: each sender's run */
     size_t n[2];
 } local_t;
 
@@ -1422,8 +1472,10 @@ static void walk_step(walk_t *w) {
  * copied from the input into their slot.  Runs are in index order, since
  * senders walk their parts in offset order; when the runs follow each
  * other in index order too (each rank's parts lie above the previous
- * rank's) the local arrays are in global order as received, else they are
- * merged in place (a permutation from a K-way merge, 4 bytes a point). */
+ * rank's) the local arrays are in global order as received and the
+ * numbers stay (loc->num, loc->start: gidx_t), else they become indices
+ * (loc->g) and the arrays are merged in place (a permutation from a K-way
+ * merge, 4 bytes a point). */
 static int exchange(ctx_t *c, const input_t *in, const ranges_t *rg, const node_t *tree, local_t *loc) {
     int K = c->K, me = c->rank, rc = HD_OK, w = K <= 256 ? 1 : K <= 65536 ? 2 : 4;
     size_t nloc = (size_t)(in->n[0] + in->n[1]), C = nloc / ROUND_SHARE, sendcap = 0;
@@ -1557,26 +1609,43 @@ static int exchange(ctx_t *c, const input_t *in, const ranges_t *rg, const node_
     cfree(c, dest, nloc, (size_t)w);
     sx = NULL, so = NULL, dest = NULL;
     assert(ownat[0] == base[me] + (size_t)rtot[2 * me] && ownat[1] == base[K + me] + (size_t)rtot[2 * me + 1]);
-    /* Numbers back to global indices, and global order. */
+    /* The runs in index order as received (each rank's parts above the
+     * previous rank's): the numbers stay and name the indices (gidx_t,
+     * 4 bytes a point).  Else the numbers become indices (8 bytes) and
+     * the runs are merged into index order. */
     for (int s = 0; s < 2 && rc == HD_OK; s++) {
-        loc->g[s] = cmalloc(c, loc->n[s], sizeof(uint64_t));
-        if (!loc->g[s]) {
-            rc = nomem(c, "the local indices", loc->n[s]);
+        loc->start[s] = cmalloc(c, (size_t)K + 1, sizeof(size_t));
+        if (!loc->start[s]) {
+            rc = nomem(c, "the local indices", (size_t)K);
             break;
         }
         int sorted = 1;
         uint64_t last = 0;
         for (int r = 0; r < K; r++) {
             size_t lo = base[s * K + r], hi = lo + (size_t)rtot[2 * r + s];
-            ranges_globals(rg, s, r, off[s] + lo, hi - lo, loc->g[s] + lo);
+            loc->start[s][r] = lo;
             if (hi > lo) {
-                if (lo > 0 && loc->g[s][lo] < last) sorted = 0;
-                last = loc->g[s][hi - 1];
+                if (lo > 0 && ranges_global(rg, s, r, off[s][lo]) < last) sorted = 0;
+                last = ranges_global(rg, s, r, off[s][hi - 1]);
             }
+        }
+        loc->start[s][K] = loc->n[s];
+        if (sorted) {
+            loc->num[s] = off[s];
+            off[s] = NULL;
+            continue;
+        }
+        loc->g[s] = cmalloc(c, loc->n[s], sizeof(uint64_t));
+        if (!loc->g[s]) {
+            rc = nomem(c, "the local indices", loc->n[s]);
+            break;
+        }
+        for (int r = 0; r < K; r++) {
+            size_t lo = base[s * K + r], hi = lo + (size_t)rtot[2 * r + s];
+            ranges_globals(rg, s, r, off[s] + lo, hi - lo, loc->g[s] + lo);
         }
         cfree(c, off[s], loc->n[s], sizeof(uint32_t));
         off[s] = NULL;
-        if (sorted) continue;
         permn = loc->n[s];
         perm = cmalloc(c, permn, sizeof(uint32_t));
         runs = cmalloc(c, (size_t)K, sizeof(run_t));
@@ -1732,7 +1801,7 @@ static int run(ctx_t *c, const hd_options_t *opt, input_t *in, int both, void *r
     node_t *tree = NULL;
     hd__box_t *region = NULL;
     held_t *held = NULL;
-    local_t loc = {{NULL, NULL}, {NULL, NULL}, {0, 0}};
+    local_t loc = {{NULL, NULL}, {NULL, NULL}, {NULL, NULL}, {NULL, NULL}, {0, 0}};
     ranges_t rg = {K, NULL, 0, NULL, NULL};
     int rc = check_local(c, opt, in, res);
     if ((rc = agree(c, rc)) != HD_OK) return rc;
@@ -1775,7 +1844,6 @@ static int run(ctx_t *c, const hd_options_t *opt, input_t *in, int both, void *r
         hd__box_t all = {{-INFINITY, -INFINITY, -INFINITY}, {INFINITY, INFINITY, INFINITY}};
         regions(tree, 0, all, region);
         if ((rc = exchange(c, in, &rg, tree, &loc)) != HD_OK) goto done;
-        ranges_free(c, &rg);
 
         /* What every rank holds now. */
         held_t h;
@@ -1787,7 +1855,9 @@ static int run(ctx_t *c, const hd_options_t *opt, input_t *in, int both, void *r
         }
         MPI_GO(c, rc, MPI_Allgather(&h, (int)sizeof h, MPI_BYTE, held, (int)sizeof h, MPI_BYTE, c->comm));
         for (int s = 0; s < (both ? 2 : 1); s++) {
-            dir_t d = {loc.xyz[s], loc.g[s], loc.n[s], loc.xyz[1 - s], loc.g[1 - s], loc.n[1 - s], 1 - s};
+            gidx_t gi[2];
+            for (int t = 0; t < 2; t++) gi[t] = (gidx_t){loc.g[t], loc.num[t], loc.start[t], &rg, t, K};
+            dir_t d = {loc.xyz[s], &gi[s], loc.n[s], loc.xyz[1 - s], &gi[1 - s], loc.n[1 - s], 1 - s};
             if ((rc = direction(c, &d, tree, region, held, &f[s])) != HD_OK) goto done;
         }
         pts = loc.n[0] + loc.n[1];
@@ -1845,6 +1915,8 @@ done:
     for (int s = 0; s < 2; s++) {
         cfree(c, loc.xyz[s], loc.n[s], 3 * sizeof(double));
         cfree(c, loc.g[s], loc.n[s], sizeof(uint64_t));
+        cfree(c, loc.num[s], loc.n[s], sizeof(uint32_t));
+        if (loc.start[s]) cfree(c, loc.start[s], (size_t)K + 1, sizeof(size_t));
     }
     cfree(c, tree, (size_t)K - 1, sizeof(node_t));
     cfree(c, region, (size_t)K, sizeof(hd__box_t));
