@@ -356,10 +356,10 @@ static int read_tile(tiles_t *s, size_t k, const hd_read_options_t *ro, analysis
     return HD_OK;
 }
 
-/* The side's cloud without the growth's slack. */
-static hd_cloud_t *trimmed(hd_cloud_t *all) {
+/* The side's cloud without the growth's slack (cap points allocated). */
+static hd_cloud_t *trimmed(hd_cloud_t *all, size_t cap) {
     size_t el = all->dtype == HD_FLOAT32 ? 3 * sizeof(float) : 3 * sizeof(double);
-    if (all->count) {
+    if (cap > all->count && all->count) {
         void *p = realloc(all->data, all->count * el);
         if (p) all->data = p;
     }
@@ -388,7 +388,7 @@ int tiles_read(tiles_t *s, size_t first, size_t n, const hd_read_options_t *ro, 
         int rc = read_tile(s, k, ro, an, which, 0, 0, &all, &cap, err);
         if (rc != HD_OK) return rc;
     }
-    *out = trimmed(all);
+    *out = trimmed(all, cap);
     return HD_OK;
 }
 
@@ -421,7 +421,7 @@ int tiles_read_points(tiles_t *s, uint64_t g, uint64_t m, const hd_read_options_
         m -= take;
     }
     if (!all && !(all = cli_cloud_new(0, ro->dtype, "empty"))) return fail(err, HD_ENOMEM, 0, "out of memory");
-    *out = trimmed(all);
+    *out = trimmed(all, cap);
     return HD_OK;
 }
 
@@ -461,14 +461,17 @@ size_t tiles_locate(const tiles_t *s, size_t g, size_t *local) {
     return lo;
 }
 
+uint64_t tiles_bound(uint64_t total, int r, int parts) {
+    assert(parts >= 1 && r >= 0 && r <= parts);
+    uint64_t q = total / (uint64_t)parts, rem = total % (uint64_t)parts; /* rem * r < parts^2: no overflow */
+    return (uint64_t)r * q + (uint64_t)r * rem / (uint64_t)parts;
+}
+
 void tiles_share(const tiles_t *s, int rank, int parts, size_t *first, size_t *n) {
     assert(parts >= 1 && rank >= 0 && rank < parts);
     uint64_t total = 0;
     for (size_t k = 0; k < s->n; k++) total += s->t[k].bytes;
-    /* bound(r) = floor(r * total / parts), without overflow */
-    uint64_t q = total / (uint64_t)parts, rem = total % (uint64_t)parts;
-#define BOUND(r) ((uint64_t)(r) * q + (uint64_t)(r) * rem / (uint64_t)parts)
-    uint64_t lo = BOUND(rank), hi = BOUND(rank + 1), at = 0;
+    uint64_t lo = tiles_bound(total, rank, parts), hi = tiles_bound(total, rank + 1, parts), at = 0;
     int last = rank == parts - 1;
     *first = s->n;
     *n = 0;
@@ -479,6 +482,5 @@ void tiles_share(const tiles_t *s, int rank, int parts, size_t *first, size_t *n
         }
         at += s->t[k].bytes;
     }
-#undef BOUND
     if (*n == 0) *first = 0;
 }

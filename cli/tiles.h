@@ -139,6 +139,10 @@ size_t tiles_locate(const tiles_t *s, size_t g, size_t *local);
  * part, in order, so the parts' points concatenated in rank order are the
  * side's points in order.  Some parts may get none.  parts >= 1 and
  * 0 <= rank < parts (asserted). */
+/* floor(r * total / parts) without overflow (0 <= r <= parts): where part r
+ * of `parts` equal shares of `total` starts. */
+uint64_t tiles_bound(uint64_t total, int r, int parts);
+
 void tiles_share(const tiles_t *s, int rank, int parts, size_t *first,
                  size_t *n);
 

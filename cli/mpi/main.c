@@ -119,10 +119,7 @@ static int read_split(tiles_t *t, int share, const cli_args_t *a, analysis_args_
         }
         if (known && rc == HD_OK) {
             uint64_t n = (uint64_t)t->t[t->n - 1].first + t->t[t->n - 1].count;
-            uint64_t q = n / (uint64_t)K_, rem = n % (uint64_t)K_;
-#define BOUND(r) ((uint64_t)(r) * q + (uint64_t)(r) * rem / (uint64_t)K_)
-            uint64_t lo = BOUND(share), hi = BOUND(share + 1);
-#undef BOUND
+            uint64_t lo = tiles_bound(n, share, K_), hi = tiles_bound(n, share + 1, K_);
             *split = 1;
             *offset = (size_t)lo;
             rc = tiles_read_points(t, lo, hi - lo, &a->read, an, which, out, err);

@@ -1110,45 +1110,38 @@ static PyObject *py_read(PyObject *self, PyObject *args, PyObject *kw) {
     hd_read_options_init(&ropt);
     ropt.format = format;
     ropt.decimal_comma = decimal_comma;
-    if (start || count_obj != Py_None) {
-        hd_error_t cerr;
-        uint64_t total = 0;
-        if (count_obj == Py_None) { /* to the end: the header's count, else a whole read's */
-            int crc;
-            Py_BEGIN_ALLOW_THREADS
-            crc = hd_read_count(PyBytes_AS_STRING(path), &ropt, &total, &cerr);
-            Py_END_ALLOW_THREADS
-            if (crc == HD_EUNSUPPORTED) {
-                hd_cloud_t *whole = NULL;
-                Py_BEGIN_ALLOW_THREADS
-                crc = hd_read_file(PyBytes_AS_STRING(path), &ropt, &whole, &cerr);
-                Py_END_ALLOW_THREADS
-                if (whole) total = whole->count;
-                hd_cloud_free(whole);
-            }
-            if (crc != HD_OK) {
-                Py_DECREF(path);
-                return raise_hd(crc, &cerr);
-            }
-            if (start >= total) {
-                Py_DECREF(path);
-                PyErr_Format(PyExc_ValueError, "%s: start %llu is not below the file's %llu points",
-                             PyBytes_AS_STRING(path), start, (unsigned long long)total);
-                return NULL;
-            }
-            count = total - start;
-        }
-        ropt.range_first = start;
-        ropt.range_count = count;
-    }
     ropt.dtype = float32 ? HD_FLOAT32 : HD_FLOAT64;
+    const char *cpath = PyBytes_AS_STRING(path);
     hd_cloud_t *cloud = NULL;
     hd_error_t err;
-    int rc;
-    const char *cpath = PyBytes_AS_STRING(path);
-    Py_BEGIN_ALLOW_THREADS
-    rc = hd_read_file(cpath, &ropt, &cloud, &err);
-    Py_END_ALLOW_THREADS
+    int rc = HD_OK;
+    uint64_t total = 0;
+    if (start && count_obj == Py_None) {
+        /* to the end: the header's count, else a whole read, cut below */
+        Py_BEGIN_ALLOW_THREADS
+        rc = hd_read_count(cpath, &ropt, &total, &err);
+        if (rc == HD_EUNSUPPORTED && (rc = hd_read_file(cpath, &ropt, &cloud, &err)) == HD_OK) total = cloud->count;
+        Py_END_ALLOW_THREADS
+        if (rc == HD_OK && start >= total) {
+            PyErr_Format(PyExc_ValueError, "%s: start %llu is not below the file's %llu points", cpath, start,
+                         (unsigned long long)total);
+            hd_cloud_free(cloud);
+            Py_DECREF(path);
+            return NULL;
+        }
+        count = total - start;
+    }
+    if (rc == HD_OK && cloud) { /* read whole: keep [start, total) */
+        size_t el = cloud->dtype == HD_FLOAT32 ? 3 * sizeof(float) : 3 * sizeof(double);
+        memmove(cloud->data, (char *)cloud->data + (size_t)start * el, (size_t)count * el);
+        cloud->count = (size_t)count;
+    } else if (rc == HD_OK) {
+        ropt.range_first = start;
+        ropt.range_count = count; /* 0 with start 0: the whole file */
+        Py_BEGIN_ALLOW_THREADS
+        rc = hd_read_file(cpath, &ropt, &cloud, &err);
+        Py_END_ALLOW_THREADS
+    }
     Py_DECREF(path);
     if (rc != HD_OK) return raise_hd(rc, &err);
     npy_intp dims[2] = {(npy_intp)cloud->count, 3};

@@ -911,10 +911,7 @@ int hd__read_laz(hd__read_t *r, const hd__las_header_t *h) {
     }
     uint32_t chunk_size = 0;
     int rc = parse_vlr(&z, h, &chunk_size);
-    if (rc == HD_OK && h->count == 0) {
-        r->total = 0;
-        return r->count_only ? HD__COUNTED : HD_OK;
-    }
+    if (rc == HD_OK && h->count == 0) return r->count_only ? HD__COUNTED : HD_OK; /* total stays 0 */
     if (rc == HD_OK && z.chunked) rc = read_table(&z, h, chunk_size);
     if (rc == HD_OK && !z.chunked) rc = one_chunk(&z, h);
     if (rc == HD_OK && r->sink->count != 0) rc = hd__io_err(r, HD_EINVAL, "internal: LAZ points into a non-empty sink");

@@ -117,23 +117,25 @@ typedef struct {
     hd__reader_fn read;
     int (*magic)(const unsigned char *, size_t); /* NULL: no signature to confirm */
     int faces;                                   /* a mesh format */
+    int counted; /* its header gives the point count (hd_read_count); its
+                    ascii variants, if any, refuse in hd__text_parallel */
 } format_t;
 
 static const format_t formats[] = {
-    {"ply", "ply", "Stanford PLY: ascii, binary little/big endian; x y z of any type; faces", hd__read_ply, magic_ply, 1},
-    {"obj", "obj", "Wavefront OBJ: 'v' lines; 'f' lines are the faces", hd__read_obj, NULL, 1},
-    {"off", "off coff noff", "Object File Format: OFF, COFF, NOFF, CNOFF; faces", hd__read_off, magic_off, 1},
-    {"stl", "stl", "STL: ascii or binary triangles (their corners are the vertices)", hd__read_stl, magic_stl, 1},
+    {"ply", "ply", "Stanford PLY: ascii, binary little/big endian; x y z of any type; faces", hd__read_ply, magic_ply, 1, 1},
+    {"obj", "obj", "Wavefront OBJ: 'v' lines; 'f' lines are the faces", hd__read_obj, NULL, 1, 0},
+    {"off", "off coff noff", "Object File Format: OFF, COFF, NOFF, CNOFF; faces", hd__read_off, magic_off, 1, 0},
+    {"stl", "stl", "STL: ascii or binary triangles (their corners are the vertices)", hd__read_stl, magic_stl, 1, 1},
     {"xyz", "xyz txt csv pts asc", "text: x y z per line, separated by blanks and commas (or semicolons); decimal commas with the decimal-comma option; extra columns ignored",
-     hd__read_xyz, NULL, 0},
+     hd__read_xyz, NULL, 0, 0},
     {"pcd", "pcd", "Point Cloud Library PCD v0.7: ascii, binary, binary_compressed; x y z of type F/I/U",
-     hd__read_pcd, magic_pcd, 0},
+     hd__read_pcd, magic_pcd, 0, 1},
     {"las", "las", "ASPRS LAS 1.0-1.4, point formats 0-10 (compressed ones too, as for laz)", hd__read_las, magic_las,
-     0},
+     0, 1},
     {"laz", "laz", "LAZ (LASzip-compressed LAS), point formats 0-10: chunked pointwise and layered, COPC included",
-     hd__read_las, magic_las, 0},
+     hd__read_las, magic_las, 0, 1},
     {"npy", "npy", "NumPy .npy: float32/float64 array of shape (N, 3), either byte order, C or Fortran order",
-     hd__read_npy, magic_npy, 0},
+     hd__read_npy, magic_npy, 0, 1},
 };
 #define N_FORMATS (sizeof formats / sizeof formats[0])
 
@@ -440,10 +442,7 @@ static int read_loaded(const hd__file_t *f, const format_t *fmt, int from_extens
     hd__sink_init(&sink, opt->dtype);
     size_t faces = 0;
     if (total) {
-        static const char *const counted[] = {"ply", "pcd", "stl", "las", "laz", "npy"};
-        int known = 0;
-        for (size_t k = 0; k < sizeof counted / sizeof counted[0]; k++) known |= strcmp(fmt->name, counted[k]) == 0;
-        if (!known || opt->mesh == HD_MESH_SAMPLE)
+        if (!fmt->counted || opt->mesh == HD_MESH_SAMPLE)
             return hd__err(err, HD_EUNSUPPORTED, "%s: the point count of %s needs reading it whole", f->name,
                            opt->mesh == HD_MESH_SAMPLE ? "a sampled mesh" : fmt->name);
         return parse(fmt, f, opt, &sink, &faces, total, err);
