@@ -389,9 +389,9 @@ static int distances(ctx_t *c, const hd_options_t *opt, input_t *in, void *arg, 
     spread_t *sp = &cs.sp;
     an_t an[2];
     memset(an, 0, sizeof an);
-    uint64_t pts = in->n[0] + in->n[1];
     int rc = hd__mpi_begin(c, opt, in, o, &cs.rg, cs.N, NULL);
     if (rc != HD_OK) goto done;
+    uint64_t pts = in->n[0] + in->n[1];
     /* A direction runs when some rank asks for it. */
     int asks[2] = {o->dist[0] || o->nearest[0], o->dist[1] || o->nearest[1]}, want[2];
     MPI_GO(c, rc, MPI_Allreduce(asks, want, 2, MPI_INT, MPI_MAX, c->comm));
