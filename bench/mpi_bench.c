@@ -37,7 +37,7 @@
  * slowest rank's search CPU and process CPU per local point, and, in the
  * same run, single-process hd_distances on all the points gathered on rank
  * 0 (one thread, its CPU per point, the faster of two calls; the other
- * ranks sleep meanwhile) with
+ * ranks sleep meanwhile; both write into outputs touched before) with
  * the ratio of the two (the slowest rank's search and bookkeeping CPU,
  * MPI's own calls left out as their busy waiting depends on the load, per
  * mean local point, over the single process's CPU per point) and whether the answers are identical (they must
@@ -141,6 +141,10 @@ static void bench_distances(const char *c, const double *a, const double *b, siz
     opt.threads = threads;
     double *d[2] = {malloc(n * sizeof(double) + 8), malloc(n * sizeof(double) + 8)};
     size_t *j[2] = {malloc(n * sizeof(size_t) + 8), malloc(n * sizeof(size_t) + 8)};
+    for (int s = 0; s < 2; s++) { /* touched, as the single process's are when it runs again */
+        memset(d[s], 0, n * sizeof(double));
+        memset(j[s], 0, n * sizeof(size_t));
+    }
     hd_mpi_stats_t st;
     hd_error_t err;
     MPI_Barrier(MPI_COMM_WORLD);
