@@ -55,42 +55,52 @@ static const char *not_built(const analysis_args_t *an) {
     return NULL;
 }
 
-/* --distances: every rank's per-point distances (hd_mpi_distances) written
- * to OUT (and OUT_b unless --directed) by all ranks (writer.c), the colour
- * scale as hausdorff's (--max-distance, else the Hausdorff distance); r
- * receives what the report says of them. */
-static int write_distances_mpi(const cli_args_t *a, const hd_mpi_part_t part[2], const uint64_t total[2],
-                               const hd_symmetric_t *s, analysis_result_t *r, hd_error_t *err) {
+/* The per-point distances of this rank's points (hd_mpi_distances, both
+ * directions unless --directed) into r->d_ab, j_ab, d_ba, j_ba (this
+ * rank's points only, in its parts' order; analysis_free frees them), with
+ * what the report says of them: r->n_a, n_b are the sides' totals, and
+ * r->seconds the slowest rank's time.  Collective. */
+static int distances_mpi(const cli_args_t *a, const hd_mpi_part_t part[2], const uint64_t total[2],
+                         analysis_result_t *r, hd_error_t *err) {
     size_t n[2] = {part[0].points.count, part[1].points.count};
-    double *d[2] = {NULL, NULL};
-    size_t *j[2] = {NULL, NULL};
-    int sides = a->directed ? 1 : 2, rc = HD_OK;
-    for (int w = 0; w < sides; w++) {
-        d[w] = malloc((n[w] ? n[w] : 1) * sizeof(double));
-        j[w] = malloc((n[w] ? n[w] : 1) * sizeof(size_t));
-        if (!d[w] || !j[w]) {
+    r->active = 1;
+    r->directed = a->directed;
+    r->n_a = (size_t)total[0];
+    r->n_b = (size_t)total[1];
+    double **d[2] = {&r->d_ab, &r->d_ba};
+    size_t **j[2] = {&r->j_ab, &r->j_ba};
+    int rc = HD_OK;
+    for (int w = 0; w < (a->directed ? 1 : 2); w++) {
+        *d[w] = malloc((n[w] ? n[w] : 1) * sizeof(double));
+        *j[w] = malloc((n[w] ? n[w] : 1) * sizeof(size_t));
+        if (!*d[w] || !*j[w]) {
             snprintf(err->message, sizeof err->message, "out of memory for %zu per-point distances", n[w]);
             rc = err->code = HD_ENOMEM;
         }
     }
     hd_mpi_stats_t st;
     if ((rc = agree(rc, err)) == HD_OK)
-        rc = hd_mpi_distances(MPI_COMM_WORLD, &part[0], 1, &part[1], 1, &a->opt, d[0], j[0], d[1], j[1], &st, err);
-    r->active = 1;
-    r->directed = a->directed;
-    r->n_a = (size_t)total[0];
-    r->n_b = (size_t)total[1];
+        rc = hd_mpi_distances(MPI_COMM_WORLD, &part[0], 1, &part[1], 1, &a->opt, r->d_ab, r->j_ab, r->d_ba,
+                              r->j_ba, &st, err);
     r->seconds = rc == HD_OK ? st.seconds_max : 0;
+    return rc;
+}
+
+/* --distances: r's per-rank distances written to OUT (and OUT_b unless
+ * --directed) by all ranks (writer.c), the colour scale as hausdorff's
+ * (--max-distance, else the Hausdorff distance).  Collective. */
+static int distances_files_mpi(const cli_args_t *a, const hd_mpi_part_t part[2], const uint64_t total[2],
+                               const hd_symmetric_t *s, analysis_result_t *r, hd_error_t *err) {
     double scale = a->an.max_distance > 0 ? a->an.max_distance : s->distance;
     snprintf(r->dist_path_a, sizeof r->dist_path_a, "%s", a->an.distances_out);
     if (!a->directed) path_with_suffix(a->an.distances_out, "_b", r->dist_path_b, sizeof r->dist_path_b);
     const char *path[2] = {r->dist_path_a, r->dist_path_b};
-    for (int w = 0; w < sides && rc == HD_OK; w++)
-        rc = mpi_write_distances(path[w], &part[w].points, part[w].offset, d[w], j[w], (size_t)total[w], scale, err);
-    for (int w = 0; w < 2; w++) {
-        free(d[w]);
-        free(j[w]);
-    }
+    const double *d[2] = {r->d_ab, r->d_ba};
+    const size_t *j[2] = {r->j_ab, r->j_ba};
+    int rc = HD_OK;
+    for (int w = 0; w < (a->directed ? 1 : 2) && rc == HD_OK; w++)
+        rc = mpi_write_distances(path[w], &part[w].points, part[w].offset, d[w], j[w], (size_t)total[w], scale,
+                                 err);
     return rc;
 }
 
@@ -328,9 +338,11 @@ int main(int argc, char **argv) {
     if (rc == HD_OK && a.an.distances_out) {
         uint64_t mine[2] = {part[0].points.count, part[1].points.count}, total[2];
         MPI_Allreduce(mine, total, 2, MPI_UINT64_T, MPI_SUM, MPI_COMM_WORLD);
-        rc = write_distances_mpi(&a, part, total, &s, &an, &err);
+        if ((rc = distances_mpi(&a, part, total, &an, &err)) == HD_OK)
+            rc = distances_files_mpi(&a, part, total, &s, &an, &err);
     }
     if (rc != HD_OK) {
+        analysis_free(&an);
         for (int w = 0; w < 2; w++) {
             hd_cloud_free(cloud[w]);
             tiles_free(&side[w]);
@@ -387,6 +399,7 @@ int main(int argc, char **argv) {
         else out_discard();
     }
     free(all);
+    analysis_free(&an);
     for (int w = 0; w < 2; w++) {
         hd_cloud_free(cloud[w]);
         tiles_free(&side[w]);
