@@ -62,11 +62,16 @@ typedef struct {
     size_t *nearest[2];
 } outs_t;
 
-/* One local set's structure, charged while held. */
+/* One local set's structure, charged while held, and where each point
+ * (by local position) is in it: the structure keeps exact copies of the
+ * coordinates in its own order, so once it exists the local array of
+ * coordinates is freed and point k is read from it (an_point). */
 typedef struct {
     hd__an_t s;
     size_t bytes;
     int built;
+    uint32_t *pos;           /* n: local position -> position in s */
+    size_t n;
 } an_t;
 
 static void an_free(ctx_t *c, an_t *t) {
@@ -74,8 +79,18 @@ static void an_free(ctx_t *c, an_t *t) {
         hd__an_free(&t->s);
         c->cur -= t->bytes;
     }
+    hd__mpi_free(c, t->pos, t->n, sizeof(uint32_t));
     memset(t, 0, sizeof *t);
 }
+
+static inline void an_point(const an_t *t, size_t k, double out[3]) {
+    uint32_t at = t->pos[k];
+    out[0] = t->s.x[at], out[1] = t->s.y[at], out[2] = t->s.z[at];
+}
+
+/* The structure of local set xyz (n points), then its inverse order; the
+ * coordinates are the caller's to free. */
+static int an_of_set(ctx_t *c, const double *xyz, size_t n, const hd__box_t *kb, an_t *t);
 
 static int an_of(ctx_t *c, const double *xyz, size_t n, const hd__box_t *kb, an_t *t) {
     memset(t, 0, sizeof *t);
@@ -87,6 +102,15 @@ static int an_of(ctx_t *c, const double *xyz, size_t n, const hd__box_t *kb, an_
     int rc = hd__mpi_an_build(c, &t->s, &v, kb, hd__thread_count(c->threads, n), &t->bytes);
     t->built = 1; /* freed by an_free whatever happened */
     return rc;
+}
+
+static int an_of_set(ctx_t *c, const double *xyz, size_t n, const hd__box_t *kb, an_t *t) {
+    int rc = an_of(c, xyz, n, kb, t);
+    if (rc != HD_OK || n == 0) return rc;
+    if (!(t->pos = hd__mpi_alloc(c, n, sizeof(uint32_t)))) return hd__mpi_nomem(c, "the structures", n);
+    t->n = n;
+    for (size_t at = 0; at < n; at++) t->pos[t->s.idx[at]] = (uint32_t)at;
+    return HD_OK;
 }
 
 /* Side s's parts in offset order (the order the exchange walks them) and,
@@ -304,7 +328,6 @@ done:
 typedef struct {
     const an_t *searched;
     const hd__box_t *kb;
-    const double *Q;
     size_t nQ;
     const gidx_t *gQ;
 } answer_t;
@@ -322,8 +345,11 @@ static int answer(ctx_t *c, void *arg, const double *pts, size_t m, ans_t *ans) 
     if (rc == HD_OK)
         rc = hd__an_nearest(&asked.s, &a->searched->s, NULL, hd__thread_count(c->threads, m), NULL, near, NULL,
                             &c->e);
-    for (size_t k = 0; k < m && rc == HD_OK; k++)
-        ans[k] = (ans_t){hd__d2(pts + 3 * k, a->Q + 3 * near[k]), hd__mpi_gidx(a->gQ, near[k])};
+    for (size_t k = 0; k < m && rc == HD_OK; k++) {
+        double q[3];
+        an_point(a->searched, near[k], q);
+        ans[k] = (ans_t){hd__d2(pts + 3 * k, q), hd__mpi_gidx(a->gQ, near[k])};
+    }
     if (near) an_free(c, &asked);
     hd__mpi_free(c, near, m, sizeof(size_t));
     return rc;
@@ -336,8 +362,7 @@ static int direction(ctx_t *c, const spread_t *sp, const ranges_t *rg, const inp
                      const an_t *asking, const an_t *searched, const hd__box_t *kb, outs_t *o) {
     int K = c->K, rc = HD_OK, qs = 1 - s;
     const local_t *loc = &sp->loc;
-    const double *P = loc->xyz[s], *Q = loc->xyz[qs];
-    size_t nP = loc->n[s], nQ = loc->n[qs];
+    size_t nP = loc->n[s], nQ = loc->n[qs], nf = 0;
     const hd__box_t *mine = &sp->region[c->rank];
     double *u2 = hd__mpi_alloc(c, nP, sizeof(double));
     uint64_t *jj = hd__mpi_alloc(c, nP, sizeof(uint64_t));
@@ -352,27 +377,51 @@ static int direction(ctx_t *c, const spread_t *sp, const ranges_t *rg, const inp
         rc = hd__an_nearest(&asking->s, &searched->s, NULL, hd__thread_count(c->threads, nP), NULL, near, NULL,
                             &c->e);
     for (size_t k = 0; k < nP && rc == HD_OK; k++) {
-        u2[k] = nQ ? hd__d2(P + 3 * k, Q + 3 * near[k]) : INFINITY;
+        double p[3], q[3];
+        an_point(asking, k, p);
+        if (nQ) an_point(searched, near[k], q);
+        u2[k] = nQ ? hd__d2(p, q) : INFINITY;
         jj[k] = nQ ? hd__mpi_gidx(&sp->gi[qs], near[k]) : UINT64_MAX;
     }
     hd__mpi_free(c, near, nP, sizeof(size_t));
     c->search += hd__now() - t0;
     c->search_cpu += hd__mpi_cpu() - u0;
-    /* 2. The points whose faces are not clear ask the candidate ranks. */
+    /* 2. The points whose faces are not clear ask the candidate ranks; the
+     * forwarded ones are packed (few), with their answers so far. */
     if (rc == HD_OK) hd__mpi_node_boxes(sp->tree, 0, sp->held, qs, nbox);
     for (size_t k = 0; k < nP && rc == HD_OK; k++) {
-        if (hd__mpi_faces_clear(mine, P + 3 * k, u2[k])) continue;
+        double p[3];
+        an_point(asking, k, p);
+        if (hd__mpi_faces_clear(mine, p, u2[k])) continue;
         c->shell++;
-        int n = hd__mpi_asked(sp->tree, nbox, sp->held, K, qs, nQ == 0, P + 3 * k, u2[k], c->rank, list);
+        int n = hd__mpi_asked(sp->tree, nbox, sp->held, K, qs, nQ == 0, p, u2[k], c->rank, list);
         if (n == 0) continue; /* no other rank holds a point as near */
         c->forwarded_points++;
-        rc = hd__mpi_pairs_add(c, &pr, k, list, n);
+        rc = hd__mpi_pairs_add(c, &pr, nf++, list, n);
+    }
+    double *fx = hd__mpi_alloc(c, nf, 3 * sizeof(double)), *fu = hd__mpi_alloc(c, nf, sizeof(double));
+    uint64_t *fj = hd__mpi_alloc(c, nf, sizeof(uint64_t));
+    size_t *fk = hd__mpi_alloc(c, nf, sizeof(size_t));
+    if (rc == HD_OK && (!fx || !fu || !fj || !fk)) rc = hd__mpi_nomem(c, "forwarded queries", nf);
+    for (size_t k = 0, f = 0; k < nP && f < nf && rc == HD_OK; k++) { /* the same points, in order */
+        double p[3];
+        an_point(asking, k, p);
+        if (hd__mpi_faces_clear(mine, p, u2[k]) ||
+            hd__mpi_asked(sp->tree, nbox, sp->held, K, qs, nQ == 0, p, u2[k], c->rank, list) == 0)
+            continue;
+        memcpy(fx + 3 * f, p, sizeof p);
+        fu[f] = u2[k], fj[f] = jj[k], fk[f++] = k;
     }
     hd__mpi_free(c, nbox, (size_t)K - 1, sizeof(hd__box_t));
     hd__mpi_free(c, list, (size_t)K, sizeof(int));
-    answer_t an = {searched, kb, Q, nQ, &sp->gi[qs]};
-    rc = hd__mpi_round(c, rc, P, &pr, answer, &an, u2, jj);
+    answer_t an = {searched, kb, nQ, &sp->gi[qs]};
+    rc = hd__mpi_round(c, rc, fx, &pr, answer, &an, fu, fj);
+    for (size_t f = 0; f < nf && rc == HD_OK; f++) u2[fk[f]] = fu[f], jj[fk[f]] = fj[f];
     hd__mpi_pairs_free(c, &pr);
+    hd__mpi_free(c, fx, nf, 3 * sizeof(double));
+    hd__mpi_free(c, fu, nf, sizeof(double));
+    hd__mpi_free(c, fj, nf, sizeof(uint64_t));
+    hd__mpi_free(c, fk, nf, sizeof(size_t));
     /* 3. Back to the points' ranks. */
     if (rc == HD_OK) rc = give_back(c, sp, rg, in, s, &u2, &jj, o);
     hd__mpi_free(c, u2, nP, sizeof(double));
@@ -405,7 +454,11 @@ static int distances(ctx_t *c, const hd_options_t *opt, input_t *in, void *arg, 
         hd__box_t kb = sp->held[c->rank].box[0];
         hd__box_merge(&kb, &sp->held[c->rank].box[1]);
         double t1 = hd__now(), u1 = hd__mpi_cpu();
-        for (int s = 0; s < 2 && rc == HD_OK; s++) rc = an_of(c, sp->loc.xyz[s], sp->loc.n[s], &kb, &an[s]);
+        for (int s = 0; s < 2 && rc == HD_OK; s++) { /* the coordinates move into the structures */
+            rc = an_of_set(c, sp->loc.xyz[s], sp->loc.n[s], &kb, &an[s]);
+            hd__mpi_free(c, sp->loc.xyz[s], sp->loc.n[s], 3 * sizeof(double));
+            sp->loc.xyz[s] = NULL;
+        }
         c->search += hd__now() - t1;
         c->search_cpu += hd__mpi_cpu() - u1;
         if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
