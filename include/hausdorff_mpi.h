@@ -192,13 +192,13 @@ int hd_mpi_directed(MPI_Comm comm, const hd_mpi_part_t *a, size_t na,
  *   forwarded* the queries sent to other ranks (no lower bound prunes
  *   them: every point needs its answer); rounds one per direction.
  * err: NULL, or receives the context of a failure.
- * Memory, per point a rank holds after the partition: 28 bytes (the local
- *   arrays), about 28 bytes a point of each set for the nearest layer's
- *   structures (60 while one is built), and 24 bytes a point of the
- *   direction being computed (16 after its local pass); 16 bytes a point
- *   of the rank's own input while the answers come back (32 while they are
- *   sent when the ranks' index runs interleave).  Measured peak: 75 to 78
- *   bytes a point a rank holds (docs/scale-out.md).  On one rank,
+ * Memory, per point a rank holds after the partition: 4 bytes (its
+ *   number), about 37 bytes a point of each set for the nearest layer's
+ *   structures, which hold the coordinates (60 while one is built), and
+ *   24 bytes a point of the direction being computed (16 after its local
+ *   pass); 16 bytes a point of the rank's own input while the answers come
+ *   back (32 while they are sent when the ranks' index runs interleave).
+ *   Measured peak: 64 bytes a point a rank holds (docs/scale-out.md).  On one rank,
  *   hd_distances on the caller's points (charged at its 60 bytes a point),
  *   without a copy when a set has one nonempty part (else its parts are
  *   packed, 24 bytes a point), into the outputs themselves when the parts

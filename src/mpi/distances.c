@@ -41,15 +41,20 @@
  *  on the parts packed in index order), and its positions become global
  *  indices.
  *
- * Memory (K > 1), per local point: the local arrays (28 bytes), the two
- * structures (about 28 bytes a point of each set, 60 while one is built),
- * and per point of the direction being computed u2, the index and, during
- * the local pass, the local position (24 bytes, then 16); a rank's own
- * points of that direction take 16 bytes more while the answers come back
- * (before they are written to the caller's outputs).  When the runs were
- * merged, the answers are reordered by sender into a buffer of 16 bytes a
- * point first.  The queries and their answers are 40 bytes each, few.
- * Measured peak: 75 to 78 bytes a local point (docs/scale-out.md).
+ * Memory (K > 1), per local point.  The coordinates are held once: a
+ * structure keeps exact copies in its own order, so each local array of
+ * coordinates is freed once its structure exists, and point k is read from
+ * the structure through the inverse of its order (an_t.pos, 4 bytes).  So:
+ * the exchange's 4-byte numbers, the two structures (about 33 bytes a
+ * point of each set, 60 while one is built) with their inverse orders, and
+ * per point of the direction being computed u2, the index and, during the
+ * local pass, the local position (24 bytes, then 16); a rank's own points
+ * of that direction take 16 bytes more while the answers come back (before
+ * they are written to the caller's outputs).  When the runs were merged,
+ * the answers are reordered by sender into a buffer of 16 bytes a point
+ * first.  The forwarded points are packed with their answers so far (48
+ * bytes each, few), and their queries and answers are 40 bytes each.
+ * Measured peak: 64 bytes a local point (docs/scale-out.md).
  */
 #include "mpi_int.h"
 
