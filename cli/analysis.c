@@ -328,6 +328,10 @@ static int write_empty_files(const analysis_args_t *an, const hd_points_t *A,
     return rc;
 }
 
+double analysis_empty_value(const analysis_args_t *an, size_t n_a, size_t n_b) {
+    return policy_value(an->empty, n_a, n_b);
+}
+
 int analysis_handle_empty(const analysis_args_t *an, const char *path_a,
                           const char *path_b, const hd_points_t *A,
                           const hd_points_t *B, int directed, int json) {

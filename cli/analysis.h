@@ -131,6 +131,8 @@ typedef struct analysis_result {
 const char *analysis_units(const analysis_args_t *an);
 /* Does anything need the per-point distances? */
 int analysis_active(const analysis_args_t *an);
+/* The --empty policy's value for sides of n_a and n_b points (one 0). */
+double analysis_empty_value(const analysis_args_t *an, size_t n_a, size_t n_b);
 /* When A or B is empty: report the --empty policy's values (or the error)
  * and return the exit code; -1 when both sets have points. */
 int analysis_handle_empty(const analysis_args_t *an, const char *path_a,

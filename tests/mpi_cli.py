@@ -215,6 +215,10 @@ def main():
             same_files([lion, head], ext, False)
             same_files(["--directed", B, A], ext, True)
         same_files([ply, npy], "ply", False)
+        # --empty: the rows at the policy's value, nearest -1; an empty side's file has no rows
+        same_files(["--empty", "inf", empty, lion], "csv", False)
+        same_files(["--empty", "zero", "--directed", lion, empty], "ply", True)
+        same_files(["--empty", "monai", empty, empty], "npy", False)
         same_files(["--max-distance", "0.25", A, B], "ply", False)
         # A file that cannot be written (B's rows' name is a directory),
         # after A's was: one message, exit 3 from every rank, no file.

@@ -17,11 +17,14 @@
  * first failing rank's code and message, rank 0 prints it, and every rank
  * exits with the same status; no rank waits in a collective for one that
  * gave up.  Only rank 0 writes to standard output and standard error (the
- * others' are /dev/null), so a message appears once, not K times.  The
- * per-point outputs (--distances, --percentile, pictures, ...) need every
- * distance in one place and are refused (exit 1).  Under --empty a side
- * whose ranks read no point at all gets the policy's answer, printed by
- * rank 0 with the single-process code (analysis_handle_empty).
+ * others' are /dev/null), so a message appears once, not K times.
+ * --distances: hd_mpi_distances gives each rank its points' distances, and
+ * every rank writes its rows of the files (writer.c), byte for byte
+ * hausdorff's.  The other per-point outputs (--percentile, --mean,
+ * --chamfer, --histogram, pictures) are refused (exit 1: not_built).
+ * Under --empty a side whose ranks read no point at all gets the policy's
+ * answer, printed by rank 0 with the single-process code
+ * (analysis_handle_empty), and --distances files with the policy's value.
  */
 #include <hausdorff_mpi.h>
 
@@ -293,21 +296,40 @@ int main(int argc, char **argv) {
     if (rc == HD_OK) { /* an empty side (only under --empty: else reading refused it) */
         uint64_t mine[2] = {cloud[0]->count, cloud[1]->count}, all[2];
         MPI_Allreduce(mine, all, 2, MPI_UINT64_T, MPI_SUM, MPI_COMM_WORLD);
-        if ((!all[0] || !all[1]) && a.an.distances_out) {
-            fprintf(stderr, "hausdorff-mpi: --distances with an empty side is not built across ranks: use "
-                            "hausdorff\n");
-            for (int w = 0; w < 2; w++) {
-                hd_cloud_free(cloud[w]);
-                tiles_free(&side[w]);
-            }
-            return finish(EXIT_USAGE);
-        }
         if (!all[0] || !all[1]) {
+            /* --distances: the files hausdorff writes, every row at the
+             * policy's value with nearest index -1 (a side with no point
+             * gets a file with no rows) */
+            int status = EXIT_OK;
+            if (a.an.distances_out) {
+                double v = analysis_empty_value(&a.an, (size_t)all[0], (size_t)all[1]);
+                size_t most = part[0].points.count > part[1].points.count ? part[0].points.count
+                                                                          : part[1].points.count;
+                double *d = malloc((most ? most : 1) * sizeof *d);
+                char path_b[4096];
+                path_with_suffix(a.an.distances_out, "_b", path_b, sizeof path_b);
+                const char *path[2] = {a.an.distances_out, path_b};
+                rc = d ? HD_OK : HD_ENOMEM;
+                if (!d) snprintf(err.message, sizeof err.message, "out of memory for %zu per-point distances", most);
+                for (size_t k = 0; k < most && d; k++) d[k] = v;
+                for (int w = 0; w < (a.directed ? 1 : 2) && (rc = agree(rc, &err)) == HD_OK; w++)
+                    rc = mpi_write_distances(path[w], &part[w].points, part[w].offset, d, NULL, (size_t)all[w], 1.0,
+                                             &err);
+                free(d);
+                if (rc != HD_OK) {
+                    for (int w = 0; w < 2; w++) {
+                        hd_cloud_free(cloud[w]);
+                        tiles_free(&side[w]);
+                    }
+                    return fail(rc, &err);
+                }
+            }
             /* the policy's answer, printed as hausdorff prints it: the
-             * views carry the counts only (no per-point output is asked) */
+             * views carry the counts only (the files are written) */
+            analysis_args_t printed = a.an;
+            printed.distances_out = NULL;
             hd_points_t A = hd_points_f64(NULL, (size_t)all[0]), B = hd_points_f64(NULL, (size_t)all[1]);
-            int status = rank_ == 0 ? analysis_handle_empty(&a.an, a.path_a, a.path_b, &A, &B, a.directed, a.json)
-                                    : EXIT_OK;
+            if (rank_ == 0) status = analysis_handle_empty(&printed, a.path_a, a.path_b, &A, &B, a.directed, a.json);
             if (rank_ == 0) status = status == EXIT_OK ? out_finish() : (out_discard(), status);
             for (int w = 0; w < 2; w++) {
                 hd_cloud_free(cloud[w]);
