@@ -1,11 +1,12 @@
 # mpi.cmake -- the MPI scale-out's tests (cmake/mpi.cmake builds what they
 # test; without MPI there is nothing to test and nothing is added).
 #  - mpi_api_K: tests/api/mpi_api.c under `mpirun -n K`: hd_mpi_hausdorff equals
-#    hd_hausdorff bit for bit on the adversarial sets and layouts, and a
-#    failure on one rank is agreed by all.  K = 1, 2, 3, 4, 7 here; the
+#    hd_hausdorff, and hd_mpi_distances hd_distances, bit for bit on the
+#    adversarial sets and layouts, and a failure on one rank is agreed by all.  K = 1, 2, 3, 4, 7 here; the
 #    sanitizer build runs K = 3 only.
 #  - mpi_cli_3: tests/mpi_cli.py, hausdorff-mpi on 3 ranks against
-#    hausdorff (JSON and text, tiles, scales, a bad tile on one rank).
+#    hausdorff (JSON and text, tiles, scales, a bad tile on one rank, the
+#    --distances files byte for byte and their failures).
 # Ranks are oversubscribed on purpose (2 cores, up to 7 ranks) and CI runs
 # as root: hence --oversubscribe and --allow-run-as-root.  Under the
 # sanitizers LeakSanitizer is off for these tests: Open MPI does not free
@@ -14,7 +15,7 @@
 # checked instead by an assert (src/mpi/mpi.c: the call's count of bytes
 # held is 0 when it returns), and AddressSanitizer and UBSan stay on.  The
 # times (Release, 2 shared cores): mpi_api 1, 3, 2.5-4.5, 3.5 and 6-13 s;
-# mpi_cli_3 10-22 s; sanitizers: mpi_api_3 14 s, mpi_cli_3 21 s.
+# mpi_cli_3 30-50 s; sanitizers: mpi_api_3 14-25 s, mpi_cli_3 40-100 s.
 if(HD_MPI)
   find_program(HD_MPIEXEC NAMES mpirun mpiexec REQUIRED)
   add_executable(mpi_api ${CMAKE_CURRENT_SOURCE_DIR}/tests/api/mpi_api.c ${CMAKE_CURRENT_SOURCE_DIR}/tests/support/gen.c)
