@@ -4,7 +4,7 @@
  * even, whatever the order.
  *
  * The references are Python's math.fsum, computed when the cases were
- * generated (tests/api/gen_sums.py writes sums_cases.h: each case is a seed
+ * generated (tests/gen_sums.py writes tests/support/sums_cases.h: each case is a seed
  * and the parameters of a generator that this file and the script share,
  * and the expected bits), so the test needs no Python and cannot drift
  * from its reference: the generator builds each double from integer bits
