@@ -1,0 +1,158 @@
+/*
+ * context.c -- what every step of an MPI call shares (mpi_int.h's ctx_t):
+ * the count of the bytes it holds, the CPU it spends in MPI, the agreement
+ * on a status, and the MPI types and the witness reduction.
+ *
+ * Invariants.
+ *  - Every buffer of a call is allocated by hd__mpi_alloc and freed by
+ *    hd__mpi_free with the same count and size, and memory the layer does
+ *    not allocate but the call holds (the engine's structures at their
+ *    documented bound, the nearest layer's while built) is charged with
+ *    hd__mpi_charge for as long as it is held.  So c->cur is the bytes held
+ *    now, c->peak the most held at once (hd_mpi_stats_t.peak_bytes), and
+ *    c->cur is 0 when the call returns (mpi.c asserts it, on every path).
+ *  - hd__mpi_agree is the only place where ranks learn of each other's
+ *    failures: an allreduce of the first failing rank, then that rank's
+ *    code and message broadcast.  Every collective a failed rank would not
+ *    reach is preceded by it, so no rank waits for one that gave up, and
+ *    every rank returns the same code and message.
+ *  - Every MPI call's thread CPU is added to c->mpi_cpu (MPI_TIMED), so the
+ *    bookkeeping's CPU (stats->other_cpu) is what remains of the call's
+ *    besides the MPI calls and the searches.
+ */
+#include "mpi_int.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <sys/mman.h>
+#include <time.h>
+
+/* CPU seconds of the calling thread (the searches' own cost with one
+ * thread, whatever else the machine runs). */
+double hd__mpi_cpu(void) {
+    struct timespec ts;
+    if (clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts) != 0) return 0;
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* ---- memory: every buffer counted, so the peak can be reported ---------- */
+
+/* Large buffers ask for transparent huge pages: each is written once,
+ * right after it is allocated, and first touches of 4 KiB pages (a fault
+ * each) were a quarter of the time outside the searches on the machine of
+ * docs/scale-out.md.  Where madvise or THP is missing this is plain
+ * memory. */
+#define HUGE_BYTES ((size_t)4 << 20)
+
+void *hd__mpi_alloc(ctx_t *c, size_t n, size_t size) {
+    if (size && n > SIZE_MAX / size) return NULL;
+    size_t bytes = n * size;
+    void *p = NULL;
+#ifdef MADV_HUGEPAGE
+    if (bytes >= HUGE_BYTES) {
+        if (posix_memalign(&p, (size_t)2 << 20, bytes) != 0) p = NULL;
+        else madvise(p, bytes, MADV_HUGEPAGE); /* advice: failure changes nothing */
+    } else
+#endif
+    {
+        p = malloc(bytes ? bytes : 1);
+        hd__prefault(p, bytes); /* one call, not a fault a page (a no-op below 1 MiB) */
+    }
+    if (p) {
+        c->cur += bytes;
+        if (c->cur > c->peak) c->peak = c->cur;
+    }
+    return p;
+}
+
+void hd__mpi_free(ctx_t *c, void *p, size_t n, size_t size) {
+    if (!p) return;
+    c->cur -= n * size;
+    free(p);
+}
+
+/* Memory this layer does not allocate itself but the call holds: counted
+ * in the peak while held. */
+void hd__mpi_charge(ctx_t *c, size_t bytes) {
+    c->cur += bytes;
+    if (c->cur > c->peak) c->peak = c->cur;
+}
+
+/* The engine's own memory, which this layer cannot see: docs/engine.md
+ * bounds it by 16 bytes a point of each set (its two trees while sorted;
+ * the grids take less), which is charged for the call's duration. */
+#define ENGINE_BYTES 16
+
+int hd__mpi_engine(ctx_t *c, const hd_points_t *P, const hd_points_t *Q, hd_result_t *e) {
+    hd_options_t o;
+    hd_options_init(&o);
+    o.threads = c->threads;
+    size_t bytes = ENGINE_BYTES * (P->count + Q->count);
+    hd__mpi_charge(c, bytes);
+    int rc = hd_directed(P, Q, &o, e, &c->e);
+    c->cur -= bytes;
+    return rc;
+}
+
+int hd__mpi_nomem(ctx_t *c, const char *what, size_t n) {
+    return hd__err(&c->e, HD_ENOMEM, "out of memory for %s (%zu items)", what, n);
+}
+
+int hd__mpi_failed(ctx_t *c, const char *call, int code) {
+    char text[MPI_MAX_ERROR_STRING];
+    int len = 0;
+    if (MPI_Error_string(code, text, &len) != MPI_SUCCESS) len = 0;
+    text[len] = '\0';
+    return hd__err(&c->e, HD_EIO, "%s failed: %s", call, len ? text : "unknown MPI error");
+}
+
+/* Every rank passes its local status; all return the first failing rank's
+ * code with its message ("rank R: ..."), or HD_OK when none failed.  The
+ * only place where ranks learn of each other's failures, called before
+ * every collective that a failed rank would not reach. */
+int hd__mpi_agree(ctx_t *c, int rc) {
+    int mine = rc != HD_OK ? c->rank : c->K, first = c->K;
+    double mpi_t0_;
+    int mpi_rc_;
+    if (MPI_TIMED(c, MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, c->comm)) != MPI_SUCCESS)
+        return rc != HD_OK ? rc : hd__err(&c->e, HD_EIO, "MPI_Allreduce failed while agreeing on a status");
+    if (first == c->K) return HD_OK;
+    hd_error_t e = c->e;
+    if (c->rank == first) {
+        e.code = rc;
+        snprintf(e.message, sizeof e.message, "rank %d: %.1000s", first, c->e.message);
+    }
+    if (MPI_TIMED(c, MPI_Bcast(&e, (int)sizeof e, MPI_BYTE, first, c->comm)) != MPI_SUCCESS)
+        return hd__err(&c->e, HD_EIO, "MPI_Bcast failed while agreeing on a status");
+    c->e = e;
+    return e.code;
+}
+
+/* ---- the witness reduction ---------------------------------------------- */
+
+static void far_reduce(void *in, void *inout, int *len, MPI_Datatype *type) {
+    (void)type;
+    const far_t *x = in;
+    far_t *y = inout;
+    for (int k = 0; k < *len; k++)
+        if (hd__mpi_far_better(&x[k], &y[k])) y[k] = x[k];
+}
+
+int hd__mpi_types_create(ctx_t *c) {
+    MPI_TRY(c, MPI_Type_contiguous((int)sizeof(ans_t), MPI_BYTE, &c->ans_type));
+    MPI_TRY(c, MPI_Type_contiguous(3, MPI_DOUBLE, &c->q_type));
+    MPI_TRY(c, MPI_Type_contiguous((int)sizeof(far_t), MPI_BYTE, &c->far_type));
+    MPI_TRY(c, MPI_Type_contiguous((int)sizeof(sample_t), MPI_BYTE, &c->sample_type));
+    MPI_TRY(c, MPI_Type_contiguous((int)sizeof(node_t), MPI_BYTE, &c->node_type));
+    MPI_Datatype *all[] = {&c->ans_type, &c->q_type, &c->far_type, &c->sample_type, &c->node_type};
+    for (size_t k = 0; k < sizeof all / sizeof *all; k++) MPI_TRY(c, MPI_Type_commit(all[k]));
+    MPI_TRY(c, MPI_Op_create(far_reduce, 1, &c->far_op));
+    return HD_OK;
+}
+
+void hd__mpi_types_free(ctx_t *c) {
+    MPI_Datatype *all[] = {&c->ans_type, &c->q_type, &c->far_type, &c->sample_type, &c->node_type};
+    for (size_t k = 0; k < sizeof all / sizeof *all; k++)
+        if (*all[k] != MPI_DATATYPE_NULL) MPI_Type_free(all[k]);
+    if (c->far_op != MPI_OP_NULL) MPI_Op_free(&c->far_op);
+}

@@ -1,0 +1,338 @@
+/*
+ * exchange.c -- moving every point to the rank of its region (step 2 of
+ * mpi.c's essay) with MPI_Alltoallv in rounds.
+ *
+ * Invariants.
+ *  - A point travels as its coordinates and its 4-byte number (28 bytes);
+ *    the receiver knows every sender's index runs (ranges.c), so the
+ *    number names the global index.
+ *  - Senders walk their parts in increasing offset order, so each
+ *    sender's run at the receiver is in increasing index order; the run of
+ *    source r is received at base + got, straight into its slot of the
+ *    local arrays (no second copy of the points), and a rank's own points
+ *    are copied from the input into their slot in the same walk.
+ *  - A round sends at most C = max(n / 8, 4096) points of a rank, so the
+ *    send buffer is at most 3.5 bytes a point; every rank runs the same
+ *    number of rounds (the allreduced maximum), each three collectives.
+ *  - After the rounds, local order is global index order: as received when
+ *    the runs follow each other in index order (the numbers stay: gidx_t),
+ *    else after a K-way merge applied in place (the numbers become 8-byte
+ *    indices).  Nothing reorders the local arrays' indices afterwards.
+ */
+#include "mpi_int.h"
+
+#include <assert.h>
+#include <limits.h>
+#include <stdlib.h>
+
+/* Merge order of K runs of g[] sorted by index: perm[o] is the position of
+ * the o-th smallest index (the runs are [at, end) ranges of positions). */
+typedef struct { size_t at, end; } run_t;
+
+static void merge_order(const uint64_t *g, run_t *runs, int K, int *heap, uint32_t *perm) {
+    int n = 0;
+    for (int r = 0; r < K; r++) {
+        if (runs[r].at == runs[r].end) continue;
+        int k = n++; /* sift up */
+        while (k > 0 && g[runs[heap[(k - 1) / 2]].at] > g[runs[r].at]) {
+            heap[k] = heap[(k - 1) / 2];
+            k = (k - 1) / 2;
+        }
+        heap[k] = r;
+    }
+    size_t out = 0;
+    while (n > 0) {
+        run_t *top = &runs[heap[0]];
+        perm[out++] = (uint32_t)top->at;
+        int r = heap[0];
+        if (++top->at == top->end) r = heap[--n];
+        int k = 0; /* sift r down from the root */
+        for (;;) {
+            int ch = 2 * k + 1;
+            if (ch >= n) break;
+            if (ch + 1 < n && g[runs[heap[ch + 1]].at] < g[runs[heap[ch]].at]) ch++;
+            if (g[runs[heap[ch]].at] >= g[runs[r].at]) break;
+            heap[k] = heap[ch];
+            k = ch;
+        }
+        if (n > 0) heap[k] = r;
+    }
+}
+
+/* xyz[o], g[o] = old xyz[perm[o]], g[perm[o]] for every o, in place: each
+ * cycle of the permutation is followed once, and perm[o] = o marks o
+ * done (perm is destroyed). */
+static void permute(double *xyz, uint64_t *g, uint32_t *perm, size_t n) {
+    for (size_t i = 0; i < n; i++) {
+        if (perm[i] == i) continue;
+        double t[3];
+        memcpy(t, xyz + 3 * i, sizeof t);
+        uint64_t tg = g[i];
+        size_t j = i;
+        for (;;) {
+            size_t k = perm[j];
+            perm[j] = (uint32_t)j;
+            if (k == i) {
+                memcpy(xyz + 3 * j, t, sizeof t);
+                g[j] = tg;
+                break;
+            }
+            memcpy(xyz + 3 * j, xyz + 3 * k, sizeof t);
+            g[j] = g[k];
+            j = k;
+        }
+    }
+}
+
+/* Where point t of the local input goes: one byte a point up to 256 ranks,
+ * two up to 65536. */
+static inline int dest_get(const void *d, int w, size_t t) {
+    return w == 1 ? ((const uint8_t *)d)[t] : w == 2 ? ((const uint16_t *)d)[t] : (int)((const uint32_t *)d)[t];
+}
+
+static inline void dest_set(void *d, int w, size_t t, int r) {
+    if (w == 1) ((uint8_t *)d)[t] = (uint8_t)r;
+    else if (w == 2) ((uint16_t *)d)[t] = (uint16_t)r;
+    else ((uint32_t *)d)[t] = (uint32_t)r;
+}
+
+/* A position in the local input: side, part (in offset order), point in
+ * it, point t overall, and the point's local number in its side. */
+typedef struct { int s; size_t p, k, t; uint64_t num[2]; } walk_t;
+
+static int walk_next(const input_t *in, const hd_mpi_part_t **order[2], walk_t *w) {
+    while (w->s < 2) {
+        if (w->p < in->nparts[w->s] && w->k < order[w->s][w->p]->points.count) return 1;
+        if (w->p < in->nparts[w->s]) w->p++, w->k = 0;
+        else w->s++, w->p = 0, w->k = 0;
+    }
+    return 0;
+}
+
+static void walk_step(walk_t *w) {
+    w->k++;
+    w->t++;
+    w->num[w->s]++;
+}
+
+/* Points sent per round by a rank: an eighth of its points (at least 64K),
+ * so the send buffer is at most 28/8 = 3.5 bytes a point (the minimum
+ * also makes the tests' larger sets take several rounds). */
+#define ROUND_SHARE 8
+#define ROUND_MIN 4096
+
+/* Move every point to the rank of its region.  Each point goes as its
+ * coordinates and a 4-byte number: its rank among the sender's points of
+ * its set in index order (ranges_t turns it back into the global index).
+ * Each source's run is received straight into its slot of the local
+ * arrays, in rounds of at most an eighth of the sender's points, so no
+ * copy of all the points is ever held twice; a rank's own points are
+ * copied from the input into their slot.  Runs are in index order, since
+ * senders walk their parts in offset order; when the runs follow each
+ * other in index order too (each rank's parts lie above the previous
+ * rank's) the local arrays are in global order as received and the
+ * numbers stay (loc->num, loc->start: gidx_t), else they become indices
+ * (loc->g) and the arrays are merged in place (a permutation from a K-way
+ * merge, 4 bytes a point). */
+int hd__mpi_exchange(ctx_t *c, const input_t *in, const ranges_t *rg, const node_t *tree, local_t *loc) {
+    int K = c->K, me = c->rank, rc = HD_OK, w = K <= 256 ? 1 : K <= 65536 ? 2 : 4;
+    size_t nloc = (size_t)(in->n[0] + in->n[1]), C = nloc / ROUND_SHARE, sendcap = 0;
+    if (C < ROUND_MIN) C = ROUND_MIN;
+    /* ints per rank: totals sent tot[2] and received rtot[2]; this round's
+     * per[2] and rper[2]; where each (rank, side) block of the send buffer
+     * starts, sdisp[2], and a cursor in it, sfill[2]; one side's counts and
+     * displacements for MPI: sc sd rcn rd */
+    int *cnt = hd__mpi_alloc(c, 16 * (size_t)K, sizeof(int));
+    size_t *base = hd__mpi_alloc(c, 4 * (size_t)K, sizeof(size_t)); /* base[s K + r], then got[s K + r] */
+    void *dest = hd__mpi_alloc(c, nloc, (size_t)w);
+    const hd_mpi_part_t **order[2] = {NULL, NULL};
+    uint32_t *off[2] = {NULL, NULL};
+    double *sx = NULL;
+    uint32_t *so = NULL;
+    uint32_t *perm = NULL;
+    size_t permn = 0;
+    run_t *runs = NULL;
+    int *heap = NULL;
+    for (int s = 0; s < 2; s++) order[s] = hd__mpi_alloc(c, in->nparts[s], sizeof *order[s]);
+    if (!cnt || !base || !dest || !order[0] || !order[1]) rc = hd__mpi_nomem(c, "the exchange", nloc);
+    int *tot = cnt, *rtot = cnt + 2 * K, *per = cnt + 4 * K, *rper = cnt + 6 * K, *sdisp = cnt + 8 * K,
+        *sfill = cnt + 10 * K, *sc = cnt + 12 * K, *sd = cnt + 13 * K, *rcn = cnt + 14 * K, *rd = cnt + 15 * K;
+    size_t *got = base + 2 * K, own = 0;
+    if (rc == HD_OK) {
+        memset(tot, 0, 2 * (size_t)K * sizeof(int));
+        size_t t = 0;
+        for (int s = 0; s < 2; s++) {
+            for (size_t p = 0; p < in->nparts[s]; p++) order[s][p] = &in->parts[s][p];
+            qsort(order[s], in->nparts[s], sizeof *order[s], hd__mpi_by_offset);
+            for (size_t p = 0; p < in->nparts[s]; p++)
+                for (size_t k = 0; k < order[s][p]->points.count; k++) {
+                    double x[3];
+                    hd__mpi_get_point(&order[s][p]->points, k, x);
+                    int r = hd__mpi_rank_of(tree, K, x, (uint64_t)s, order[s][p]->offset + k);
+                    dest_set(dest, w, t++, r);
+                    if (tot[2 * r + s] == INT_MAX) rc = HD_EOVERFLOW;
+                    else tot[2 * r + s]++;
+                }
+        }
+        if (rc != HD_OK)
+            rc = hd__err(&c->e, HD_EOVERFLOW, "more than 2^31 - 1 points of a set to send from rank %d to one rank",
+                         c->rank);
+        own = (size_t)tot[2 * me] + (size_t)tot[2 * me + 1];
+        sendcap = nloc - own < C ? nloc - own : C;
+        for (int r = 0; r < K; r++)
+            if (r != me) c->bytes_part += ((uint64_t)tot[2 * r] + (uint64_t)tot[2 * r + 1]) * (3 * sizeof(double) + 4);
+    }
+    if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
+    MPI_GO(c, rc, MPI_Alltoall(tot, 2, MPI_INT, rtot, 2, MPI_INT, c->comm));
+    for (int s = 0; s < 2 && rc == HD_OK; s++) {
+        size_t m = 0;
+        for (int r = 0; r < K; r++) {
+            base[s * K + r] = m;
+            got[s * K + r] = 0;
+            m += (size_t)rtot[2 * r + s];
+        }
+        loc->n[s] = m;
+        if (m > INT_MAX) {
+            rc = hd__err(&c->e, HD_EOVERFLOW, "more than 2^31 - 1 points of %s to receive on rank %d",
+                         s ? "B" : "A", c->rank);
+            loc->n[0] = loc->n[1] = 0;
+        }
+    }
+    for (int s = 0; s < 2 && rc == HD_OK; s++) {
+        loc->xyz[s] = hd__mpi_alloc(c, loc->n[s], 3 * sizeof(double));
+        off[s] = hd__mpi_alloc(c, loc->n[s], sizeof(uint32_t));
+        if (!loc->xyz[s] || !off[s]) rc = hd__mpi_nomem(c, "the local points", loc->n[s]);
+    }
+    if (rc == HD_OK) {
+        sx = hd__mpi_alloc(c, sendcap, 3 * sizeof(double));
+        so = hd__mpi_alloc(c, sendcap, sizeof(uint32_t));
+        if (!sx || !so) rc = hd__mpi_nomem(c, "points to send", sendcap);
+    }
+    if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
+    uint64_t mine = (nloc - own + C - 1) / C, rounds = 0;
+    MPI_GO(c, rc, MPI_Allreduce(&mine, &rounds, 1, MPI_UINT64_T, MPI_MAX, c->comm));
+    if (rounds == 0) rounds = 1; /* a round copies the own points too */
+    walk_t at = {0, 0, 0, 0, {0, 0}};
+    size_t ownat[2] = {base[me], base[K + me]};
+    for (uint64_t round = 0; round < rounds; round++) {
+        /* The window: from `at` up to the C-th point for another rank. */
+        memset(per, 0, 2 * (size_t)K * sizeof(int));
+        walk_t end = at;
+        size_t out = 0;
+        while (walk_next(in, order, &end)) {
+            int r = dest_get(dest, w, end.t);
+            if (r != me) {
+                if (out == C) break;
+                per[2 * r + end.s]++, out++;
+            }
+            walk_step(&end);
+        }
+        int pos = 0; /* the send buffer: A's blocks by rank, then B's */
+        for (int s = 0; s < 2; s++)
+            for (int r = 0; r < K; r++) {
+                sdisp[2 * r + s] = sfill[2 * r + s] = pos;
+                pos += per[2 * r + s];
+            }
+        while (at.t < end.t && walk_next(in, order, &at)) {
+            int r = dest_get(dest, w, at.t), s = at.s;
+            size_t to;
+            double *x;
+            if (r == me) {
+                to = ownat[s]++;
+                x = loc->xyz[s] + 3 * to;
+                off[s][to] = (uint32_t)at.num[s];
+            } else {
+                to = (size_t)sfill[2 * r + s]++;
+                x = sx + 3 * to;
+                so[to] = (uint32_t)at.num[s];
+            }
+            hd__mpi_get_point(&order[s][at.p]->points, at.k, x);
+            walk_step(&at);
+        }
+        MPI_GO(c, rc, MPI_Alltoall(per, 2, MPI_INT, rper, 2, MPI_INT, c->comm));
+        for (int s = 0; s < 2; s++) {
+            for (int r = 0; r < K; r++) {
+                sc[r] = per[2 * r + s];
+                sd[r] = sdisp[2 * r + s];
+                rcn[r] = rper[2 * r + s];
+                rd[r] = (int)(base[s * K + r] + got[s * K + r]);
+                got[s * K + r] += (size_t)rcn[r];
+            }
+            MPI_GO(c, rc, MPI_Alltoallv(sx, sc, sd, c->q_type, loc->xyz[s], rcn, rd, c->q_type, c->comm));
+            MPI_GO(c, rc, MPI_Alltoallv(so, sc, sd, MPI_UINT32_T, off[s], rcn, rd, MPI_UINT32_T, c->comm));
+        }
+    }
+    hd__mpi_free(c, sx, sendcap, 3 * sizeof(double));
+    hd__mpi_free(c, so, sendcap, sizeof(uint32_t));
+    hd__mpi_free(c, dest, nloc, (size_t)w);
+    sx = NULL, so = NULL, dest = NULL;
+    assert(ownat[0] == base[me] + (size_t)rtot[2 * me] && ownat[1] == base[K + me] + (size_t)rtot[2 * me + 1]);
+    /* The runs in index order as received (each rank's parts above the
+     * previous rank's): the numbers stay and name the indices (gidx_t,
+     * 4 bytes a point).  Else the numbers become indices (8 bytes) and
+     * the runs are merged into index order. */
+    for (int s = 0; s < 2 && rc == HD_OK; s++) {
+        loc->start[s] = hd__mpi_alloc(c, (size_t)K + 1, sizeof(size_t));
+        if (!loc->start[s]) {
+            rc = hd__mpi_nomem(c, "the local indices", (size_t)K);
+            break;
+        }
+        int sorted = 1;
+        uint64_t last = 0;
+        for (int r = 0; r < K; r++) {
+            size_t lo = base[s * K + r], hi = lo + (size_t)rtot[2 * r + s];
+            loc->start[s][r] = lo;
+            if (hi > lo) {
+                if (lo > 0 && hd__mpi_ranges_global(rg, s, r, off[s][lo]) < last) sorted = 0;
+                last = hd__mpi_ranges_global(rg, s, r, off[s][hi - 1]);
+            }
+        }
+        loc->start[s][K] = loc->n[s];
+        if (sorted) {
+            loc->num[s] = off[s];
+            off[s] = NULL;
+            continue;
+        }
+        loc->g[s] = hd__mpi_alloc(c, loc->n[s], sizeof(uint64_t));
+        if (!loc->g[s]) {
+            rc = hd__mpi_nomem(c, "the local indices", loc->n[s]);
+            break;
+        }
+        for (int r = 0; r < K; r++) {
+            size_t lo = base[s * K + r], hi = lo + (size_t)rtot[2 * r + s];
+            hd__mpi_ranges_globals(rg, s, r, off[s] + lo, hi - lo, loc->g[s] + lo);
+        }
+        hd__mpi_free(c, off[s], loc->n[s], sizeof(uint32_t));
+        off[s] = NULL;
+        permn = loc->n[s];
+        perm = hd__mpi_alloc(c, permn, sizeof(uint32_t));
+        runs = hd__mpi_alloc(c, (size_t)K, sizeof(run_t));
+        heap = hd__mpi_alloc(c, (size_t)K, sizeof(int));
+        if (!perm || !runs || !heap) {
+            rc = hd__mpi_nomem(c, "the merge", loc->n[s]);
+            break;
+        }
+        for (int r = 0; r < K; r++) runs[r] = (run_t){base[s * K + r], base[s * K + r] + (size_t)rtot[2 * r + s]};
+        merge_order(loc->g[s], runs, K, heap, perm);
+        permute(loc->xyz[s], loc->g[s], perm, loc->n[s]);
+        hd__mpi_free(c, perm, permn, sizeof(uint32_t));
+        hd__mpi_free(c, runs, (size_t)K, sizeof(run_t));
+        hd__mpi_free(c, heap, (size_t)K, sizeof(int));
+        perm = NULL, runs = NULL, heap = NULL;
+    }
+    rc = hd__mpi_agree(c, rc);
+done:
+    hd__mpi_free(c, cnt, 16 * (size_t)K, sizeof(int));
+    hd__mpi_free(c, base, 4 * (size_t)K, sizeof(size_t));
+    hd__mpi_free(c, dest, nloc, (size_t)w);
+    for (int s = 0; s < 2; s++) {
+        hd__mpi_free(c, order[s], in->nparts[s], sizeof *order[s]);
+        hd__mpi_free(c, off[s], loc->n[s], sizeof(uint32_t));
+    }
+    hd__mpi_free(c, sx, sendcap, 3 * sizeof(double));
+    hd__mpi_free(c, so, sendcap, sizeof(uint32_t));
+    hd__mpi_free(c, perm, permn, sizeof(uint32_t));
+    hd__mpi_free(c, runs, (size_t)K, sizeof(run_t));
+    hd__mpi_free(c, heap, (size_t)K, sizeof(int));
+    return rc;
+}

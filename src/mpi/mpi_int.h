@@ -1,0 +1,326 @@
+/*
+ * mpi_int.h -- what the files of the MPI library (src/mpi/) share: the
+ * call's context (context.c), the RCB tree (rcb.c), the index runs
+ * (ranges.c), the exchange (exchange.c), the per-point searches on slabs
+ * (slab.c), the engine's pass and its shell (shell.c), the forwarding and
+ * the reduction of one direction (forward.c), and the entry points
+ * (mpi.c, whose essay has the algorithm).  Internal: names hd__mpi_*, and
+ * nothing outside src/mpi/ includes it.
+ *
+ * Conventions of every function here: a ctx_t carries the call's
+ * communicator, its error (c->e, what hd__mpi_agree() broadcasts) and its
+ * count of bytes held (every buffer through hd__mpi_alloc/hd__mpi_free, so
+ * the peak is known and the call can assert that it freed everything); a
+ * function that can fail returns an HD_* code with c->e set, and collective
+ * functions agree on a status before every collective a failed rank would
+ * not reach.
+ */
+#ifndef HD_MPI_INT_H
+#define HD_MPI_INT_H
+
+#include "hausdorff_mpi.h"
+#include "nearest/nearest.h"
+#include "points/points.h"
+
+#include <math.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <string.h>
+
+/* ---- the call's context (context.c) -------------------------------------- */
+
+typedef struct { double d2; uint64_t g; } ans_t;                 /* an answer */
+typedef struct { double d2; uint64_t i, j; } far_t;              /* a witness */
+typedef struct { double x[3]; uint64_t g, side; } sample_t;
+/* An RCB node: left/right >= 0 are nodes, < 0 are ranks -(r + 1). */
+typedef struct { double s; uint64_t side, g; int axis, left, right, pad; } node_t;
+/* What each rank holds after the partition. */
+typedef struct { hd__box_t box[2]; uint64_t n[2]; } held_t;
+
+typedef struct ctx {
+    MPI_Comm comm;
+    int rank, K, threads;
+    hd_error_t e;
+    size_t cur, peak;          /* bytes of this call's buffers */
+    uint64_t bytes_part, bytes_fwd, forwarded, forwarded_points, answered;
+    uint64_t bytes_back;       /* per-point answers sent back (distances.c) */
+    double search;             /* seconds in the engine and hd_distances */
+    double search_cpu;         /* the calling thread's CPU seconds there */
+    double mpi_cpu;            /* ... and in MPI calls */
+    uint64_t shell;            /* points searched one by one (the shells) */
+    uint64_t interior_passes;  /* second engine calls on an interior */
+    int rounds;
+    MPI_Datatype ans_type, q_type, far_type, sample_type, node_type;
+    MPI_Op far_op;
+} ctx_t;
+
+
+double hd__mpi_cpu(void);
+void *hd__mpi_alloc(ctx_t *c, size_t n, size_t size);
+void hd__mpi_free(ctx_t *c, void *p, size_t n, size_t size);
+void hd__mpi_charge(ctx_t *c, size_t bytes);
+int hd__mpi_engine(ctx_t *c, const hd_points_t *P, const hd_points_t *Q, hd_result_t *e);
+int hd__mpi_nomem(ctx_t *c, const char *what, size_t n);
+int hd__mpi_failed(ctx_t *c, const char *call, int code);
+int hd__mpi_agree(ctx_t *c, int rc);
+int hd__mpi_types_create(ctx_t *c);
+void hd__mpi_types_free(ctx_t *c);
+
+/* The witness order: larger d2 first, then the smaller index i. */
+static inline int hd__mpi_far_better(const far_t *x, const far_t *y) {
+    return x->d2 > y->d2 || (x->d2 == y->d2 && x->i < y->i);
+}
+
+/* Every MPI call is timed (thread CPU): what is left of the call's CPU
+ * besides them and the searches is its bookkeeping (stats->other_cpu). */
+#define MPI_TIMED(c, call) (mpi_t0_ = hd__mpi_cpu(), mpi_rc_ = (call), (c)->mpi_cpu += hd__mpi_cpu() - mpi_t0_, mpi_rc_)
+
+#define MPI_TRY(c, call)                                                      \
+    do {                                                                      \
+        double mpi_t0_;                                                       \
+        int mpi_rc_;                                                          \
+        mpi_rc_ = MPI_TIMED(c, call);                                         \
+        if (mpi_rc_ != MPI_SUCCESS) return hd__mpi_failed(c, #call, mpi_rc_); \
+    } while (0)
+
+/* The same in a function that frees its buffers at `done`. */
+#define MPI_GO(c, rc, call)                         \
+    do {                                            \
+        double mpi_t0_;                             \
+        int mpi_rc_;                                \
+        mpi_rc_ = MPI_TIMED(c, call);               \
+        if (mpi_rc_ != MPI_SUCCESS) {               \
+            rc = hd__mpi_failed(c, #call, mpi_rc_); \
+            goto done;                              \
+        }                                           \
+    } while (0)
+
+/* ---- the input and its index runs (ranges.c) ----------------------------- */
+
+typedef struct {
+    const hd_mpi_part_t *parts[2];
+    size_t nparts[2];
+    uint64_t n[2];            /* local points of A, B (input) */
+    hd__box_t box[2];         /* local boxes (input) */
+} input_t;
+
+/* Point k of a view: packed doubles directly, anything else through
+ * hd_points_get (the exchange reads every point twice). */
+static inline void hd__mpi_get_point(const hd_points_t *p, size_t k, double out[3]) {
+    if (p->dtype == HD_FLOAT64 && (p->stride == 0 || p->stride == 3 * (ptrdiff_t)sizeof(double)) &&
+        (p->cstride == 0 || p->cstride == (ptrdiff_t)sizeof(double)))
+        memcpy(out, (const double *)p->data + 3 * k, 3 * sizeof(double));
+    else
+        hd_points_get(p, k, out);
+}
+
+typedef struct { uint64_t lo, hi; int side, rank; } range_t;
+
+/* Every rank's nonempty parts (all-gathered by check_ranges), sorted by
+ * (side, rank, first index): side s, rank r's are all[seg[s (K + 1) + r]]
+ * up to all[seg[s (K + 1) + r + 1]], and first[i] is the number of part
+ * i's first point among its rank's points of its side in index order.  So
+ * point number m of rank r's side s names a global index (ranges_globals),
+ * which lets the exchange send 4-byte numbers instead of 8-byte indices,
+ * and the local arrays keep them (gidx_t): held for the whole call. */
+struct ranges {
+    int K;
+    range_t *all;
+    size_t total;
+    size_t *seg;
+    uint64_t *first;
+};
+
+/* The global indices of a local set, by position (local order is global
+ * index order).  Not stored as 8-byte indices: each point keeps the 4-byte
+ * number it came with (its rank among its sender's points of the set, in
+ * index order), and since the senders' runs lie in the local array one
+ * after the other, a position names its sender (start[]) and the sender's
+ * index runs (ranges_t) turn the number into the index (gidx).  Where the
+ * runs had to be merged (the senders' index ranges interleave), positions
+ * no longer name senders and the indices are stored (g).  The arrays are
+ * never reordered after the exchange (split/unsplit move coordinates
+ * only), so position k's index is fixed for the call. */
+typedef struct ranges ranges_t;
+typedef struct {
+    const uint64_t *g;       /* each position's index (runs merged), or NULL */
+    const uint32_t *num;     /* else each position's number at its sender */
+    const size_t *start;     /* K + 1: where each sender's run starts */
+    const ranges_t *rg;
+    int side, K;
+} gidx_t;
+
+uint64_t hd__mpi_gidx(const gidx_t *x, size_t k);
+
+typedef struct {
+    double *P;               /* local points asking, packed xyz (reordered
+                                and restored by split/unsplit) */
+    const gidx_t *gP;        /* their global indices, by position */
+    size_t nP;
+    double *Q;               /* local points searched */
+    const gidx_t *gQ;
+    size_t nQ;
+    int qside;               /* 0: Q is A, 1: Q is B */
+} dir_t;
+
+int hd__mpi_by_offset(const void *x, const void *y);
+int hd__mpi_by_range(const void *x, const void *y); /* range_t by (side, lo) */
+void hd__mpi_ranges_free(ctx_t *c, ranges_t *rg);
+void hd__mpi_ranges_globals(const ranges_t *rg, int s, int r, const uint32_t *num, size_t n, uint64_t *g);
+uint64_t hd__mpi_ranges_global(const ranges_t *rg, int s, int r, uint64_t m);
+int hd__mpi_check_ranges(ctx_t *c, const input_t *in, ranges_t *rg);
+int hd__mpi_check_local(ctx_t *c, const hd_options_t *opt, input_t *in, const void *out);
+
+/* ---- the partition (rcb.c) and the exchange (exchange.c) ----------------- */
+
+int hd__mpi_rank_of(const node_t *t, int K, const double *x, uint64_t side, uint64_t g);
+void hd__mpi_regions(const node_t *t, int node, hd__box_t box, hd__box_t *out);
+hd__box_t hd__mpi_node_boxes(const node_t *t, int node, const held_t *held, int side, hd__box_t *out);
+void hd__mpi_candidates(const node_t *t, const hd__box_t *nbox, const held_t *held, int side, int node,
+                        const double *p, double u2, int me, int *list, int *n);
+int hd__mpi_partition(ctx_t *c, const input_t *in, uint64_t N, node_t *tree);
+/* The ranks other than `me` that p must ask (into list; their number is
+ * returned): those whose box of `side` may hold a point within u2 of p,
+ * ties included; when this rank holds no point of `side` (none_here), u2
+ * is first lowered to the nearest farthest corner of the nonempty boxes,
+ * which bounds the distance to the nearest point from above. */
+int hd__mpi_asked(const node_t *t, const hd__box_t *nbox, const held_t *held, int K, int side, int none_here,
+                  const double *p, double u2, int me, int *list);
+
+typedef struct {
+    double *xyz[2];
+    uint64_t *g[2];          /* the indices, where the runs were merged */
+    uint32_t *num[2];        /* else the senders' numbers (gidx_t) */
+    size_t *start[2];        /* K + 1 a side: each sender's run */
+    size_t n[2];
+} local_t;
+
+int hd__mpi_exchange(ctx_t *c, const input_t *in, const ranges_t *rg, const node_t *tree, local_t *loc);
+
+/* ---- the per-point searches (slab.c) ------------------------------------- */
+
+/* 1 when every finite face of region r is farther from p than u2 allows
+ * (computed fl(gap^2) > u2): then no point of another region is within u2
+ * of p, nor at u2 (see mpi.c's essay, step 4). */
+static inline int hd__mpi_faces_clear(const hd__box_t *r, const double *p, double u2) {
+    for (int a = 0; a < 3; a++) {
+        if (isfinite(r->lo[a])) {
+            double g = p[a] - r->lo[a];
+            if (!(g * g > u2)) return 0;
+        }
+        if (isfinite(r->hi[a])) {
+            double g = r->hi[a] - p[a];
+            if (!(g * g > u2)) return 0;
+        }
+    }
+    return 1;
+}
+
+/* The slabs of the searched local set Q (slab.c has the proof). */
+typedef struct {
+    hd__an_t s;
+    int built;
+    size_t n, bytes;
+    uint32_t *map;           /* the slab's points in Q (NULL: all of Q) */
+    double M;                /* its margin (infinite: all of Q) */
+    hd__box_t kb;            /* the key box its askers use too */
+} slab_t;
+
+typedef struct {
+    slab_t sub, full;
+    double M0;               /* the first slab's margin (set by shell_of) */
+} qtree_t;
+
+void hd__mpi_qtree_free(ctx_t *c, qtree_t *q);
+/* The nearest layer's structure of v, charged (60 bytes a point while
+ * built, then what it holds: *bytes, to subtract when it is freed). */
+int hd__mpi_an_build(ctx_t *c, hd__an_t *s, const hd_points_t *v, const hd__box_t *kb, int threads, size_t *bytes);
+int hd__mpi_nearest_in_q(ctx_t *c, const dir_t *d, const hd__box_t *r, qtree_t *q, const double *pts, size_t n,
+                         size_t *near);
+
+/* ---- the engine's pass and its shell (shell.c) --------------------------- */
+
+/* What the engine's pass leaves for per-point searches (shell.c's essay). */
+typedef struct {
+    const double *xyz;       /* the shell's points (P itself when all are) */
+    size_t n;
+    size_t *nearest;         /* each one's nearest in Q (NULL if Q is empty) */
+    double *own_xyz;         /* what was allocated for a proper subset */
+    uint32_t *own_pos;       /* ... with each one's position in P */
+    far_t inner;             /* exact over the interior; d2 = -1 if none
+                                or not known (lazy) */
+    int lazy;                /* the interior's maximum was not computed */
+    far_t h;                 /* then: the engine's answer, whose witness
+                                is in the shell and bounds the interior */
+} shell_t;
+
+void hd__mpi_shell_free(ctx_t *c, shell_t *sh);
+int hd__mpi_interior_max(ctx_t *c, const dir_t *d, const hd__box_t *mine, const shell_t *sh, double h2, far_t *out);
+uint64_t hd__mpi_shell_g(const dir_t *d, const shell_t *sh, size_t k);
+int hd__mpi_shell_of(ctx_t *c, const dir_t *d, const hd__box_t *mine, qtree_t *q, shell_t *sh);
+
+/* ---- one direction over the partition (forward.c) ------------------------ */
+
+/* Forwarded queries: point k of the asking set to rank dest. */
+typedef struct { size_t k; int dest; int pad; } pair_t;
+typedef struct { pair_t *p; size_t n, cap; } pairs_t;
+int hd__mpi_pairs_add(ctx_t *c, pairs_t *pr, size_t k, const int *list, int n);
+void hd__mpi_pairs_free(ctx_t *c, pairs_t *pr);
+
+/* Answers m queries pts against this rank's local set: exact (d2,
+ * smallest global index), or (infinity, UINT64_MAX) when it holds none. */
+typedef int (*hd__mpi_answer_t)(ctx_t *c, void *arg, const double *pts, size_t m, ans_t *ans);
+
+/* One round of forwarding (collective; rc is the caller's status, agreed
+ * first): each pair (k, r) sends point k of P to rank r, every rank
+ * answers what it receives with fn, and each answer replaces (u2[k],
+ * jj[k]) when smaller (d2 first, then the index). */
+int hd__mpi_round(ctx_t *c, int rc, const double *P, const pairs_t *pr, hd__mpi_answer_t fn, void *arg,
+                  double *u2, uint64_t *jj);
+
+int hd__mpi_direction(ctx_t *c, const dir_t *d, const node_t *tree, const hd__box_t *region, const held_t *held,
+                      far_t *result);
+
+/* ---- the course of a call (mpi.c) ---------------------------------------- */
+
+/* What the ranks hold after the partition (K > 1). */
+typedef struct {
+    node_t *tree;            /* K - 1 nodes */
+    hd__box_t *region;       /* K: every rank's region */
+    held_t *held;            /* K: every rank's count and box a set */
+    local_t loc;             /* this rank's points */
+    gidx_t gi[2];            /* their global indices */
+} spread_t;
+
+/* K = 1: each set as one view (the caller's, or packed in index order). */
+typedef struct {
+    hd_points_t v[2];
+    double *own[2];
+    const hd_mpi_part_t **order[2];
+} views_t;
+
+/* What a call's body holds from its start to its end. */
+typedef struct {
+    ranges_t rg;
+    spread_t sp;             /* K > 1 */
+    uint64_t N[2];           /* points of A and B over all ranks */
+    double t0, cpu0;         /* the body's start (wall, thread CPU) */
+} course_t;
+
+void hd__mpi_course_init(ctx_t *c, course_t *cs);
+void hd__mpi_course_free(ctx_t *c, course_t *cs);
+int hd__mpi_figures(ctx_t *c, const course_t *cs, uint64_t pts, hd_mpi_stats_t *st, double *tmax);
+
+/* A call's body, run by hd__mpi_call inside its context. */
+typedef int (*hd__mpi_body_t)(ctx_t *c, const hd_options_t *opt, input_t *in, void *arg, hd_mpi_stats_t *st);
+
+int hd__mpi_call(MPI_Comm comm, const hd_mpi_part_t *a, size_t na, const hd_mpi_part_t *b, size_t nb,
+                 const hd_options_t *opt, hd__mpi_body_t body, void *arg, hd_mpi_stats_t *st, hd_error_t *err);
+int hd__mpi_begin(ctx_t *c, const hd_options_t *opt, input_t *in, const void *res, ranges_t *rg, uint64_t N[2],
+                  double corners[2][6]);
+int hd__mpi_spread(ctx_t *c, const input_t *in, const ranges_t *rg, const uint64_t N[2], spread_t *sp);
+void hd__mpi_spread_free(ctx_t *c, spread_t *sp);
+int hd__mpi_views(ctx_t *c, const input_t *in, views_t *vw);
+void hd__mpi_views_free(ctx_t *c, const input_t *in, views_t *vw);
+
+#endif /* HD_MPI_INT_H */

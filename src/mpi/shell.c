@@ -1,0 +1,234 @@
+/*
+ * shell.c -- the engine's pass over one direction of a rank's local sets
+ * (step 3 of mpi.c's essay).
+ *
+ * The engine's pass over one direction.  hd_directed(P, Q) on the local
+ * sets gives h2, the largest u(a)^2 of the rank, with its witness: so
+ * u(a)^2 <= h2 for every local a, and a point whose faces are clear of h2
+ * is confirmed without a search of its own (the interior).  The interior's
+ * exact maximum is the engine's own answer when the engine's witness is
+ * interior (it is then the smallest index at h2), else one more engine
+ * call on the interior alone.  The other points (the shell) get per-point
+ * searches (hd_distances).  The engine prunes the points that cannot be the
+ * farthest, which per-point searches cannot: on two epochs of one scene it
+ * is tens of times faster (docs/scale-out.md), and the shell is the points
+ * within h of the region's faces.
+ *
+ * Invariants: the local arrays' coordinates are moved (split) and put back
+ * (unsplit) around each engine call on a subset, so every position holds
+ * its own point again when a function here returns, and its index (gidx)
+ * never changes.
+ */
+#include "mpi_int.h"
+
+#include <assert.h>
+#include <stdlib.h>
+
+void hd__mpi_shell_free(ctx_t *c, shell_t *sh) {
+    hd__mpi_free(c, sh->own_xyz, sh->n, 3 * sizeof(double));
+    hd__mpi_free(c, sh->own_pos, sh->n, sizeof(uint32_t));
+    hd__mpi_free(c, sh->nearest, sh->n, sizeof(size_t));
+}
+
+/* Stable partition in place of the coordinates (the indices stay by
+ * position): the points k with keep[k] to the front, in order, the others
+ * to aside (in order; NULL: the caller has them already).  unsplit puts
+ * everything back. */
+static void split(double *xyz, size_t n, const unsigned char *keep, double *axyz) {
+    size_t t = 0, a = 0;
+    for (size_t k = 0; k < n; k++) {
+        if (keep[k]) {
+            if (t != k) memcpy(xyz + 3 * t, xyz + 3 * k, 3 * sizeof(double));
+            t++;
+        } else if (axyz) {
+            memcpy(axyz + 3 * a++, xyz + 3 * k, 3 * sizeof(double));
+        }
+    }
+}
+
+/* The position of the m-th point k (from 0) with keep[k]. */
+static size_t kept_at(const unsigned char *keep, size_t n, size_t m) {
+    for (size_t k = 0, t = 0; k < n; k++)
+        if (keep[k] && t++ == m) return k;
+    assert(0);
+    return 0;
+}
+
+static void unsplit(double *xyz, size_t n, const unsigned char *keep, const double *axyz) {
+    size_t t = 0, a = 0;
+    for (size_t k = 0; k < n; k++) t += keep[k] != 0;
+    a = n - t;
+    for (size_t k = n; k-- > 0;) {
+        if (keep[k]) {
+            --t;
+            if (t != k) memcpy(xyz + 3 * k, xyz + 3 * t, 3 * sizeof(double));
+        } else {
+            --a;
+            memcpy(xyz + 3 * k, axyz + 3 * a, 3 * sizeof(double));
+        }
+    }
+}
+
+/* The correspondence pass, for a copy and its original (|A| = |B|, point g
+ * of B the moved point g of A).  After the partition a rank holds most
+ * pairs whole, but not all (a face separates some), so its local sets
+ * differ in size and the engine's correspondence path (docs/engine.md,
+ * step 0.5), which settles a copy at a few ns a point, does not run on
+ * them.  Here P_c, the local points of P whose partner is local too, and
+ * Q_c, those partners, are passed to the engine in the same order (both
+ * are in global index order), so the path runs.  Its answer h_c, with
+ * witness a*, bounds every u(a)^2 of P_c from above (Q_c is part of the
+ * local Q), so the points of P_c whose faces are clear of h_c are settled
+ * (the interior; the points of P without a local partner are shell).  The
+ * interior's exact maximum is h_c at a* when a* is interior and no point
+ * of Q_x, the local Q points whose partner is elsewhere, is nearer to a*
+ * than h_c: then u(a*)^2 = h_c, no interior u exceeds it, and any point
+ * of P_c with u^2 = h_c has u_c^2 = h_c too, so an index no smaller than
+ * a*'s (the engine's tie rule).  The witness's j is the engine's, or the
+ * smallest index of Q_x at exactly h_c.  Otherwise (*done = 0) the caller
+ * runs the engine on the whole local sets.  Tried only when nine tenths
+ * of P have their partner: anything else is not a copy. */
+static int paired_pass(ctx_t *c, const dir_t *d, const hd__box_t *mine, unsigned char **inp, size_t *nI,
+                       far_t *inner, int *done) {
+    size_t nP = d->nP, nQ = d->nQ, nc = 0;
+    *done = 0;
+    *inp = NULL;
+    for (size_t i = 0, j = 0; i < nP && j < nQ;) {
+        uint64_t gi = hd__mpi_gidx(d->gP, i), gj = hd__mpi_gidx(d->gQ, j);
+        if (gi == gj) nc++, i++, j++;
+        else if (gi < gj) i++;
+        else j++;
+    }
+    if (nc < 64 || nc < nP - nP / 10 || (nc == nP && nc == nQ)) return HD_OK; /* whole sets: the engine's own */
+    /* The pairs to the front of P and Q, in order; the others aside. */
+    size_t nx = nQ - nc, ny = nP - nc;
+    unsigned char *in = *inp = hd__mpi_alloc(c, nP, 1), *inq = hd__mpi_alloc(c, nQ, 1);
+    double *qx = hd__mpi_alloc(c, nx, 3 * sizeof(double)), *py = hd__mpi_alloc(c, ny, 3 * sizeof(double));
+    int rc = HD_OK;
+    if (!in || !inq || !qx || !py) {
+        rc = hd__mpi_nomem(c, "the pairs", nc);
+        goto done;
+    }
+    memset(in, 0, nP);
+    memset(inq, 0, nQ);
+    for (size_t i = 0, j = 0; i < nP && j < nQ;) {
+        uint64_t gi = hd__mpi_gidx(d->gP, i), gj = hd__mpi_gidx(d->gQ, j);
+        if (gi == gj) in[i++] = inq[j++] = 1;
+        else if (gi < gj) i++;
+        else j++;
+    }
+    split(d->P, nP, in, py);
+    split(d->Q, nQ, inq, qx);
+    hd_result_t e;
+    hd_points_t Pv = hd_points_f64(d->P, nc), Qv = hd_points_f64(d->Q, nc);
+    rc = hd__mpi_engine(c, &Pv, &Qv, &e);
+    unsplit(d->P, nP, in, py);
+    unsplit(d->Q, nQ, inq, qx);
+    if (rc == HD_OK) {
+        /* a*, and Q_c's e.j: P_c's e.j's partner (the same index) */
+        size_t astar = kept_at(in, nP, e.i);
+        uint64_t gi = hd__mpi_gidx(d->gP, astar), jc = hd__mpi_gidx(d->gP, kept_at(in, nP, e.j));
+        *nI = 0;
+        for (size_t i = 0; i < nP; i++)
+            *nI += in[i] = (unsigned char)(in[i] && hd__mpi_faces_clear(mine, d->P + 3 * i, e.distance2));
+        /* The nearest point of Q_x to a* (position order is index order:
+         * the first at the minimum is the smallest index). */
+        double v = INFINITY;
+        size_t jx = SIZE_MAX;
+        for (size_t j = 0; j < nQ && in[astar]; j++) {
+            if (inq[j]) continue;
+            double d2 = hd__d2(d->P + 3 * astar, d->Q + 3 * j);
+            if (d2 < v) v = d2, jx = j;
+        }
+        uint64_t jv = jx == SIZE_MAX ? UINT64_MAX : hd__mpi_gidx(d->gQ, jx);
+        if (in[astar] && v >= e.distance2) {
+            *inner = (far_t){e.distance2, gi, v == e.distance2 && jv < jc ? jv : jc};
+            *done = 1;
+        }
+    }
+done:
+    hd__mpi_free(c, inq, nQ, 1);
+    hd__mpi_free(c, qx, nx, 3 * sizeof(double));
+    hd__mpi_free(c, py, ny, 3 * sizeof(double));
+    return rc;
+}
+
+/* The exact maximum over the interior, the points whose faces are clear
+ * of h2 (their local u is global): the engine on a copy of them. */
+int hd__mpi_interior_max(ctx_t *c, const dir_t *d, const hd__box_t *mine, const shell_t *sh, double h2, far_t *out) {
+    unsigned char *in = hd__mpi_alloc(c, d->nP, 1);
+    if (!in) return hd__mpi_nomem(c, "the interior", d->nP);
+    size_t nI = 0;
+    for (size_t k = 0; k < d->nP; k++) nI += in[k] = (unsigned char)hd__mpi_faces_clear(mine, d->P + 3 * k, h2);
+    assert(nI + sh->n == d->nP && sh->own_xyz);
+    split(d->P, d->nP, in, NULL); /* the shell's copy is the aside */
+    hd_points_t Iv = hd_points_f64(d->P, nI), Qv = hd_points_f64(d->Q, d->nQ);
+    hd_result_t e;
+    int rc = hd__mpi_engine(c, &Iv, &Qv, &e);
+    unsplit(d->P, d->nP, in, sh->own_xyz);
+    if (rc == HD_OK) *out = (far_t){e.distance2, hd__mpi_gidx(d->gP, kept_at(in, d->nP, e.i)), hd__mpi_gidx(d->gQ, e.j)};
+    hd__mpi_free(c, in, d->nP, 1);
+    return rc;
+}
+
+/* The global index of the shell's point k. */
+uint64_t hd__mpi_shell_g(const dir_t *d, const shell_t *sh, size_t k) {
+    return hd__mpi_gidx(d->gP, sh->own_pos ? sh->own_pos[k] : k);
+}
+
+int hd__mpi_shell_of(ctx_t *c, const dir_t *d, const hd__box_t *mine, qtree_t *q, shell_t *sh) {
+    memset(sh, 0, sizeof *sh);
+    sh->inner = (far_t){-1.0, UINT64_MAX, UINT64_MAX};
+    sh->xyz = d->P;
+    sh->n = d->nP;
+    if (d->nP == 0 || d->nQ == 0) return HD_OK;
+    hd_points_t Pv = hd_points_f64(d->P, d->nP), Qv = hd_points_f64(d->Q, d->nQ);
+    hd_result_t e;
+    unsigned char *in = NULL; /* allocated after the engine's pass, the peak */
+    size_t nI = 0;
+    int done = 0;
+    int rc = paired_pass(c, d, mine, &in, &nI, &sh->inner, &done);
+    if (rc == HD_OK && !done && (rc = hd__mpi_engine(c, &Pv, &Qv, &e)) == HD_OK) {
+        if (!in && !(in = hd__mpi_alloc(c, d->nP, 1))) rc = hd__mpi_nomem(c, "the interior", d->nP);
+        nI = 0;
+        for (size_t k = 0; k < d->nP && rc == HD_OK; k++)
+            nI += in[k] = (unsigned char)hd__mpi_faces_clear(mine, d->P + 3 * k, e.distance2);
+    }
+    if (rc != HD_OK) {
+        hd__mpi_free(c, in, d->nP, 1);
+        return rc;
+    }
+    size_t nS = d->nP - nI;
+    /* The shell's points have u <= sqrt(h2) (those of the paired pass's
+     * interior, h_c) and lie within it of a face, so their nearest points
+     * lie within about 2 sqrt(h2) of one: the slab's margin. */
+    q->M0 = 2.5 * sqrt(done ? sh->inner.d2 : e.distance2);
+    if (done) {
+        /* the interior's answer is the paired pass's */
+    } else if (nI && in[e.i]) {
+        sh->inner = (far_t){e.distance2, hd__mpi_gidx(d->gP, e.i), hd__mpi_gidx(d->gQ, e.j)};
+    } else if (nI) {
+        sh->lazy = 1; /* interior_max, only if it can matter */
+        sh->h = (far_t){e.distance2, hd__mpi_gidx(d->gP, e.i), hd__mpi_gidx(d->gQ, e.j)};
+    }
+    if (rc == HD_OK && nS && nI) { /* a proper subset: copied */
+        sh->n = nS;
+        sh->own_xyz = hd__mpi_alloc(c, nS, 3 * sizeof(double));
+        sh->own_pos = hd__mpi_alloc(c, nS, sizeof(uint32_t));
+        if (!sh->own_xyz || !sh->own_pos) rc = hd__mpi_nomem(c, "the shell", nS);
+        for (size_t k = 0, t = 0; k < d->nP && rc == HD_OK; k++)
+            if (!in[k]) {
+                memcpy(sh->own_xyz + 3 * t, d->P + 3 * k, 3 * sizeof(double));
+                sh->own_pos[t++] = (uint32_t)k;
+            }
+        sh->xyz = sh->own_xyz;
+    }
+    sh->n = nS;
+    hd__mpi_free(c, in, d->nP, 1);
+    if (rc == HD_OK && nS) {
+        sh->nearest = hd__mpi_alloc(c, nS, sizeof(size_t));
+        if (!sh->nearest) return hd__mpi_nomem(c, "nearest neighbours", nS);
+        rc = hd__mpi_nearest_in_q(c, d, mine, q, sh->xyz, nS, sh->nearest);
+    }
+    return rc;
+}
