@@ -172,9 +172,7 @@ static int check_values(const double *d, size_t n, const char *what,
                         hd_error_t *err) {
     if (!d) return hd__err(err, HD_EINVAL, "distances %s are NULL", what);
     if (n == 0) return hd__err(err, HD_EEMPTY, "distances %s are empty", what);
-    for (size_t i = 0; i < n; i++)
-        if (isnan(d[i])) return hd__err(err, HD_ENONFINITE, "distance %zu of %s is NaN", i, what);
-    return HD_OK;
+    return hd__nan_check(d, n, 0, what, err);
 }
 
 int hd_percentile_of(const double *d_ab, size_t n_a, const double *d_ba,
@@ -228,28 +226,6 @@ int hd_hausdorff_percentile(const hd_points_t *A, const hd_points_t *B,
 
 /* ---- means and Chamfer distances ------------------------------------------ */
 
-/* The maximum of d[0..n) (n > 0) and the exact sums of d[k] and of the
- * rounded d[k] * d[k], one pass; the additions are counted a block at a
- * time (base.h), so the loop keeps its counter in a register. */
-static double max_and_sums(const double *d, size_t n, hd__xsum_t *sum, hd__xsum_t *sum2) {
-    enum { BLOCK = HD__XSUM_PENDING_MAX / 2 };
-    double m = d[0];
-    hd__xsum_init(sum);
-    hd__xsum_init(sum2);
-    for (size_t k0 = 0; k0 < n; k0 += BLOCK) {
-        size_t k1 = n - k0 < BLOCK ? n : k0 + BLOCK;
-        for (size_t k = k0; k < k1; k++) {
-            double x = d[k];
-            m = x > m ? x : m;
-            hd__xsum_add_uncounted(sum, x);
-            hd__xsum_add_uncounted(sum2, x * x);
-        }
-        hd__xsum_count(sum, (int64_t)(k1 - k0));
-        hd__xsum_count(sum2, (int64_t)(k1 - k0));
-    }
-    return m;
-}
-
 int hd_summarize(const double *d_ab, size_t n_a, const double *d_ba,
                  size_t n_b, hd_summary_t *out, hd_error_t *err) {
     hd__err_clear(err);
@@ -259,8 +235,9 @@ int hd_summarize(const double *d_ab, size_t n_a, const double *d_ba,
     if (!d_ba) n_b = 0;
     if (d_ba && (rc = check_values(d_ba, n_b, "B to A", err))) return rc;
     hd__xsum_t s[4];
-    double max_ab = max_and_sums(d_ab, n_a, &s[0], &s[1]), max_ba = NAN;
-    if (n_b) max_ba = max_and_sums(d_ba, n_b, &s[2], &s[3]);
+    for (int k = 0; k < 4; k++) hd__xsum_init(&s[k]);
+    double max_ab = hd__xsum_values(&s[0], &s[1], d_ab, n_a, -INFINITY), max_ba = NAN;
+    if (n_b) max_ba = hd__xsum_values(&s[2], &s[3], d_ba, n_b, -INFINITY);
     hd__summary_derive(out, n_a, max_ab, hd__xsum_round(&s[0]), hd__xsum_round(&s[1]), n_b, max_ba,
                        n_b ? hd__xsum_round(&s[2]) : NAN, n_b ? hd__xsum_round(&s[3]) : NAN);
     return HD_OK;

@@ -146,6 +146,11 @@ void hd__percentile_ranks(size_t n, double p, size_t *lo, size_t *hi, double *t)
 /* numpy's _lerp: a + (b - a) * t, or b - (b - a) * (1 - t) when t >= 0.5. */
 double hd__lerp(double a, double b, double t);
 
+/* HD_ENONFINITE naming the first NaN of d[0..n) as "distance first + k of
+ * <what>", else HD_OK: the per-point figures' check (hd_summarize,
+ * hd_percentile_of and the MPI library's, which pass their offset). */
+int hd__nan_check(const double *d, size_t n, size_t first, const char *what, hd_error_t *err);
+
 /* ---- exact sums (xsum.c) -------------------------------------------------- */
 /* An exact accumulator of doubles: the sum of any number of finite doubles
  * held without rounding, as a fixed-point number in int64 limbs of 32-bit
@@ -218,6 +223,13 @@ HD__INLINE void hd__xsum_add(hd__xsum_t *s, double x) {
     hd__xsum_add_uncounted(s, x);
     hd__xsum_count(s, 1);
 }
+
+/* sum += d[k] and sum2 += d[k] * d[k] (rounded) for k in [0, n), one
+ * pass, counted a block at a time (the loop keeps its counter in a
+ * register); returns the largest of m and the d[k], the first of equal
+ * ones (a strict > from m on: the same fold, split anywhere, gives the
+ * same bits). */
+double hd__xsum_values(hd__xsum_t *sum, hd__xsum_t *sum2, const double *d, size_t n, double m);
 
 /* ---- the summary's derived figures (xsum.c) ------------------------------- */
 /* Fill every field of out from the counts, maxima and exactly rounded sums

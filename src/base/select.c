@@ -113,6 +113,12 @@ void hd__percentile_ranks(size_t n, double p, size_t *lo, size_t *hi, double *t)
     }
 }
 
+int hd__nan_check(const double *d, size_t n, size_t first, const char *what, hd_error_t *err) {
+    for (size_t i = 0; i < n; i++)
+        if (isnan(d[i])) return hd__err(err, HD_ENONFINITE, "distance %zu of %s is NaN", first + i, what);
+    return HD_OK;
+}
+
 int hd__percentile_check(double p, hd_error_t *err) {
     if (!(p >= 0.0 && p <= 100.0))
         return hd__err(err, HD_EINVAL, "percentile must be in [0, 100], not %g", p);

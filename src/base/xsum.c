@@ -133,6 +133,22 @@ double hd__xsum_round(const hd__xsum_t *s) {
     return sign * ldexp((double)m, h - 52 - 1074);
 }
 
+double hd__xsum_values(hd__xsum_t *sum, hd__xsum_t *sum2, const double *d, size_t n, double m) {
+    enum { BLOCK = HD__XSUM_PENDING_MAX / 2 };
+    for (size_t k0 = 0; k0 < n; k0 += BLOCK) {
+        size_t k1 = n - k0 < BLOCK ? n : k0 + BLOCK;
+        for (size_t k = k0; k < k1; k++) {
+            double x = d[k];
+            m = x > m ? x : m;
+            hd__xsum_add_uncounted(sum, x);
+            hd__xsum_add_uncounted(sum2, x * x);
+        }
+        hd__xsum_count(sum, (int64_t)(k1 - k0));
+        hd__xsum_count(sum2, (int64_t)(k1 - k0));
+    }
+    return m;
+}
+
 void hd__summary_derive(hd_summary_t *out, size_t n_a, double max_ab, double sum_ab, double sum2_ab,
                         size_t n_b, double max_ba, double sum_ba, double sum2_ba) {
     out->n_ab = n_a;
