@@ -215,6 +215,14 @@ static void check_errors(void) {
     snprintf(want, sizeof want, "distance %zu of A to B is NaN", (size_t)(K_ - 1) * n + 40);
     check_agreed(hd_mpi_summarize(MPI_COMM_WORLD, v, n, NULL, 0, &s, &err), HD_ENONFINITE, &err, want);
     check_agreed(hd_mpi_percentile_of(MPI_COMM_WORLD, v, n, v, n, 95, &p, &err), HD_ENONFINITE, &err, want);
+    /* A's NaN on the last rank wins over B's on rank 0, as in the single
+     * process, which checks A's distances first */
+    double *u = malloc(n * sizeof *u);
+    for (size_t k = 0; k < n; k++) u[k] = (double)k;
+    if (rank_ == 0) u[3] = NAN;
+    check_agreed(hd_mpi_summarize(MPI_COMM_WORLD, v, n, u, n, &s, &err), HD_ENONFINITE, &err, want);
+    check_agreed(hd_mpi_percentile_of(MPI_COMM_WORLD, v, n, u, n, 5, &p, &err), HD_ENONFINITE, &err, want);
+    free(u);
     /* B's NaN is found after A's checks pass */
     if (rank_ == K_ - 1) v[40] = 40;
     double *w = malloc(n * sizeof *w);
