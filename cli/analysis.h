@@ -142,6 +142,25 @@ int analysis_run(const analysis_args_t *an, const hd_options_t *opt,
                  const hd_points_t *A, const hd_points_t *B,
                  const hd_symmetric_t *s, int directed, const char *path_a,
                  const char *path_b, analysis_result_t *r, hd_error_t *err);
+/* The figures of the per-point distances d_ab (n_a values) and d_ba (n_b;
+ * ignored when r->directed) into r->sum, r->pct (--percentile) and the
+ * histograms (--histogram, --histogram-png; r->n_a and r->n_b, the
+ * distances of all of A and B, give the values above the range), by ops:
+ * the library's functions here, hausdorff-mpi's over the ranks (each rank
+ * passing its own distances).  r->directed is set by the caller. */
+typedef struct analysis_ops {
+    int (*summarize)(const double *d_ab, size_t n_a, const double *d_ba, size_t n_b, hd_summary_t *out,
+                     hd_error_t *err);
+    int (*percentile_of)(const double *d_ab, size_t n_a, const double *d_ba, size_t n_b, double p,
+                         hd_percentile_t *out, hd_error_t *err);
+    int (*histogram)(const double *values, size_t n, double lo, double hi, size_t bins, uint64_t *counts,
+                     hd_error_t *err);
+} analysis_ops_t;
+int analysis_figures(const analysis_args_t *an, const analysis_ops_t *ops, const double *d_ab, size_t n_a,
+                     const double *d_ba, size_t n_b, analysis_result_t *r, hd_error_t *err);
+/* The colour and histogram scale: --max-distance, else the largest
+ * distance (r->sum). */
+double analysis_scale(const analysis_args_t *an, const analysis_result_t *r);
 /* The JSON members (each preceded by ", ") and the lines for a person. */
 void analysis_json(FILE *out, const analysis_args_t *an,
                    const analysis_result_t *r);
