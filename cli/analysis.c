@@ -420,12 +420,12 @@ int analysis_figures(const analysis_args_t *an, const analysis_ops_t *ops, const
     double scale = analysis_scale(an, r);
     r->hist_lo = 0.0;
     r->hist_hi = scale;
-    r->hist_ab = calloc(an->bins, sizeof *r->hist_ab);
+    if (!r->hist_ab) r->hist_ab = calloc(an->bins, sizeof *r->hist_ab); /* or the caller's */
     if (!r->hist_ab) return alloc_fail(err, an->bins);
     if ((rc = ops->histogram(d_ab, n_a, 0.0, scale, an->bins, r->hist_ab, err))) return rc;
     r->above_ab = beyond(r->hist_ab, an->bins, r->n_a);
     if (!r->directed) {
-        r->hist_ba = calloc(an->bins, sizeof *r->hist_ba);
+        if (!r->hist_ba) r->hist_ba = calloc(an->bins, sizeof *r->hist_ba);
         if (!r->hist_ba) return alloc_fail(err, an->bins);
         if ((rc = ops->histogram(d_ba, n_b, 0.0, scale, an->bins, r->hist_ba, err))) return rc;
         r->above_ba = beyond(r->hist_ba, an->bins, r->n_b);

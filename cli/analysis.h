@@ -147,7 +147,9 @@ int analysis_run(const analysis_args_t *an, const hd_options_t *opt,
  * histograms (--histogram, --histogram-png; r->n_a and r->n_b, the
  * distances of all of A and B, give the values above the range), by ops:
  * the library's functions here, hausdorff-mpi's over the ranks (each rank
- * passing its own distances).  r->directed is set by the caller. */
+ * passing its own distances).  r->directed is set by the caller; r's
+ * histograms may be allocated by it (`bins` counts each), else they are
+ * allocated here. */
 typedef struct analysis_ops {
     int (*summarize)(const double *d_ab, size_t n_a, const double *d_ba, size_t n_b, hd_summary_t *out,
                      hd_error_t *err);
