@@ -180,6 +180,28 @@ int write_distances(const char *path, const hd_points_t *P, const double *d,
                     const size_t *nearest, double dmax, hd_error_t *err);
 /* 1 when the path names a format write_distances knows. */
 int distances_format_known(const char *path);
+/* The pieces of a distances file, for a writer that places the rows
+ * itself (hausdorff-mpi: each rank writes its rows at its offset): the
+ * header, then one row a point, each row's bytes depending on that row
+ * alone (PLY: given the colour scale dmax and `wide`, nearest indices as
+ * doubles because one exceeds 2^31 - 1 somewhere in the file). */
+enum { DIST_CSV, DIST_PLY, DIST_NPY, DIST_UNKNOWN };
+enum { DIST_HEAD_MAX = 1024, DIST_ROW_MAX = 160 }; /* a CSV row: 4 numbers of NUM_TEXT and an index */
+typedef struct dist_layout {
+    int format;                /* DIST_* */
+    size_t count;              /* rows in the file */
+    double dmax;
+    int wide;
+} dist_layout_t;
+/* The layout of a file of `count` rows by the path's extension; an unknown
+ * one is HD_EUNSUPPORTED with err filled. */
+int distances_layout(const char *path, size_t count, double dmax, int wide, dist_layout_t *f, hd_error_t *err);
+/* 1 when an index of nearest[0..n) needs the wide PLY column. */
+int distances_wide(const size_t *nearest, size_t n);
+/* The header's bytes, and one row's (nearest NULL: -1). */
+size_t distances_header(const dist_layout_t *f, char buf[DIST_HEAD_MAX]);
+size_t distances_row(const dist_layout_t *f, const double q[3], double d, const size_t *nearest,
+                     unsigned char buf[DIST_ROW_MAX]);
 /* OUT.ext -> OUT_b.ext */
 void path_with_suffix(const char *path, const char *suffix, char *out,
                       size_t size);

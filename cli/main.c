@@ -37,36 +37,6 @@ static int failed(int code) {
     return code;
 }
 
-/* Refuse an output that would overwrite an input (any tile, or a list of
- * them) or another output. */
-static int check_outputs(const cli_args_t *a, const tiles_t side[2]) {
-    char path_b[4096];
-    const char *outs[4] = {a->an.distances_out, NULL, a->an.render_out, a->an.histogram_png};
-    const char *const what[4] = {"--distances", "--distances (B's rows)", "--render", "--histogram-png"};
-    if (a->an.distances_out && !a->directed) {
-        path_with_suffix(a->an.distances_out, "_b", path_b, sizeof path_b);
-        outs[1] = path_b;
-    }
-    if (!outs[0] && !outs[2] && !outs[3]) return 0;
-    size_t n = side[0].n + side[1].n + 2, m = 0;
-    const char **in = malloc(n * sizeof *in);
-    char *which = malloc(n);
-    if (!in || !which) {
-        free(in);
-        free(which);
-        fprintf(stderr, "%s: out of memory\n", cli_prog());
-        return EXIT_FAILURE_;
-    }
-    for (int w = 0; w < 2; w++) {
-        if (side[w].kind == TILES_LIST) in[m] = side[w].arg + 1, which[m++] = "AB"[w];
-        for (size_t k = 0; k < side[w].n; k++) in[m] = side[w].t[k].path, which[m++] = "AB"[w];
-    }
-    int rc = out_check_paths(outs, what, 4, in, which, m);
-    free(in);
-    free(which);
-    return rc;
-}
-
 int main(int argc, char **argv) {
     out_guard_std();
     cli_args_t a;
@@ -84,7 +54,7 @@ int main(int argc, char **argv) {
         tiles_free(&side[0]);
         return cli_exit_for(rc);
     }
-    if ((rc = check_outputs(&a, side)) != 0) {
+    if ((rc = out_check_outputs(&a, side)) != 0) {
         tiles_free(&side[0]);
         tiles_free(&side[1]);
         return rc;

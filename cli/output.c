@@ -50,6 +50,7 @@
  */
 #include "output.h"
 #include "cli.h"
+#include "tiles.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -157,6 +158,36 @@ int out_check_paths(const char *const *outs, const char *const *what, int n,
             }
     }
     return 0;
+}
+
+/* Refuse an output that would overwrite an input (any tile, or a list of
+ * them) or another output. */
+int out_check_outputs(const cli_args_t *a, const tiles_t *side) {
+    char path_b[4096];
+    const char *outs[4] = {a->an.distances_out, NULL, a->an.render_out, a->an.histogram_png};
+    const char *const what[4] = {"--distances", "--distances (B's rows)", "--render", "--histogram-png"};
+    if (a->an.distances_out && !a->directed) {
+        path_with_suffix(a->an.distances_out, "_b", path_b, sizeof path_b);
+        outs[1] = path_b;
+    }
+    if (!outs[0] && !outs[2] && !outs[3]) return 0;
+    size_t n = side[0].n + side[1].n + 2, m = 0;
+    const char **in = malloc(n * sizeof *in);
+    char *which = malloc(n);
+    if (!in || !which) {
+        free(in);
+        free(which);
+        fprintf(stderr, "%s: out of memory\n", cli_prog());
+        return EXIT_FAILURE_;
+    }
+    for (int w = 0; w < 2; w++) {
+        if (side[w].kind == TILES_LIST) in[m] = side[w].arg + 1, which[m++] = "AB"[w];
+        for (size_t k = 0; k < side[w].n; k++) in[m] = side[w].t[k].path, which[m++] = "AB"[w];
+    }
+    int rc = out_check_paths(outs, what, 4, in, which, m);
+    free(in);
+    free(which);
+    return rc;
 }
 
 /* ---- temporaries -------------------------------------------------------------- */
@@ -269,6 +300,12 @@ FILE *out_open(const char *path, hd_error_t *err) {
         return NULL;
     }
     return s->f;
+}
+
+const char *out_file_path(FILE *f) {
+    for (int k = 0; k < n_staged; k++)
+        if (S[k].f == f) return S[k].direct ? S[k].target : S[k].tmp;
+    return NULL;
 }
 
 int out_close(FILE *f, int werr, hd_error_t *err) {

@@ -27,9 +27,24 @@ int out_check_paths(const char *const *outs, const char *const *what, int n,
                     const char *const *inputs, const char *side,
                     size_t n_inputs);
 
+/* The tool's outputs (--distances and its _b file, --render,
+ * --histogram-png) checked with out_check_paths against every input (each
+ * tile of either side, and a list of them) and each other: 0, or the exit
+ * status after a message.  hausdorff and hausdorff-mpi (rank 0) run it
+ * before reading. */
+struct cli_args;
+struct tiles;
+int out_check_outputs(const struct cli_args *a, const struct tiles *side);
+
 /* Begin writing `path`: a new temporary file beside it (or the file itself
  * when it is a device or a FIFO).  NULL with err filled (OUT_EFAIL). */
 FILE *out_open(const char *path, hd_error_t *err);
+/* The file an open FILE from out_open writes: its temporary (or the target
+ * itself when written in place), for a writer that writes it by name
+ * after out_close (hausdorff-mpi's ranks, through MPI-IO); it is renamed
+ * by out_finish or removed by out_discard as any other.  NULL when f is
+ * not open. */
+const char *out_file_path(FILE *f);
 /* Finish a file from out_open: flush, check, close.  werr is the errno of
  * the first write that failed (0 if none, -1 for an unknown reason).
  * Returns HD_OK, or OUT_EFAIL

@@ -75,20 +75,16 @@ void path_with_suffix(const char *path, const char *suffix, char *out,
     snprintf(out, size, "%.*s%s%s", (int)(dot - path), path, suffix, dot);
 }
 
-typedef enum { OUT_CSV, OUT_PLY, OUT_NPY, OUT_UNKNOWN } out_format_t;
-
-static out_format_t format_of(const char *path) {
+static int format_of(const char *path) {
     const char *dot = strrchr(path, '.');
-    if (!dot) return OUT_UNKNOWN;
-    if (strcasecmp(dot, ".csv") == 0) return OUT_CSV;
-    if (strcasecmp(dot, ".ply") == 0) return OUT_PLY;
-    if (strcasecmp(dot, ".npy") == 0) return OUT_NPY;
-    return OUT_UNKNOWN;
+    if (!dot) return DIST_UNKNOWN;
+    if (strcasecmp(dot, ".csv") == 0) return DIST_CSV;
+    if (strcasecmp(dot, ".ply") == 0) return DIST_PLY;
+    if (strcasecmp(dot, ".npy") == 0) return DIST_NPY;
+    return DIST_UNKNOWN;
 }
 
-static double nearest_of(const size_t *nearest, size_t k) {
-    return nearest ? (double)nearest[k] : -1.0;
-}
+_Static_assert(DIST_ROW_MAX >= 4 * NUM_TEXT + 32, "a CSV row fits");
 
 static void put_le(unsigned char *p, const void *v, size_t n) {
     const unsigned char *s = v;
@@ -97,107 +93,108 @@ static void put_le(unsigned char *p, const void *v, size_t n) {
     for (size_t k = 0; k < n; k++) p[k] = little ? s[k] : s[n - 1 - k];
 }
 
+int distances_layout(const char *path, size_t count, double dmax, int wide, dist_layout_t *f, hd_error_t *err) {
+    f->format = format_of(path);
+    f->count = count;
+    f->dmax = dmax;
+    f->wide = wide;
+    if (f->format != DIST_UNKNOWN) return HD_OK;
+    snprintf(err->message, sizeof err->message, "%s: cannot tell the output format; name it .csv, .ply or .npy",
+             path);
+    return err->code = HD_EUNSUPPORTED;
+}
+
+int distances_wide(const size_t *nearest, size_t n) {
+    int wide = 0;
+    for (size_t k = 0; nearest && k < n; k++) wide |= nearest[k] > 2147483647u;
+    return wide;
+}
+
+size_t distances_header(const dist_layout_t *f, char buf[DIST_HEAD_MAX]) {
+    int n = 0;
+    if (f->format == DIST_CSV) {
+        n = snprintf(buf, DIST_HEAD_MAX, "x,y,z,distance,nearest\n");
+    } else if (f->format == DIST_PLY) {
+        char dm[NUM_TEXT];
+        n = snprintf(buf, DIST_HEAD_MAX, "ply\nformat binary_little_endian 1.0\n"
+                     "comment written by hausdorff %s: distance to the nearest point of the other set\n"
+                     "comment colour: viridis, 0 to %s\n"
+                     "element vertex %zu\n"
+                     "property double x\nproperty double y\nproperty double z\n"
+                     "property double distance\nproperty %s nearest\n"
+                     "property uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n",
+                     hd_version(), num_text(f->dmax, dm), f->count, f->wide ? "double" : "int");
+    } else {
+        char dict[128];
+        int m = snprintf(dict, sizeof dict, "{'descr': '<f8', 'fortran_order': False, 'shape': (%zu, 5), }",
+                         f->count);
+        /* magic (6) + version (2) + length (2) + dict, padded with spaces
+         * and a newline to a multiple of 64 bytes */
+        size_t total = 10 + (size_t)m + 1, padded = (total + 63) / 64 * 64;
+        unsigned char head[10] = {0x93, 'N', 'U', 'M', 'P', 'Y', 1, 0, 0, 0};
+        uint16_t hl = (uint16_t)(padded - 10);
+        put_le(head + 8, &hl, 2);
+        memcpy(buf, head, 10);
+        memcpy(buf + 10, dict, (size_t)m);
+        memset(buf + 10 + m, ' ', padded - total);
+        buf[padded - 1] = '\n';
+        n = (int)padded;
+    }
+    return n < 0 ? 0 : (size_t)n;
+}
+
+size_t distances_row(const dist_layout_t *f, const double q[3], double d, const size_t *nearest,
+                     unsigned char buf[DIST_ROW_MAX]) {
+    if (f->format == DIST_CSV) {
+        char t[4][NUM_TEXT];
+        int n;
+        if (nearest)
+            n = snprintf((char *)buf, DIST_ROW_MAX, "%s,%s,%s,%s,%zu\n", num_text(q[0], t[0]), num_text(q[1], t[1]),
+                         num_text(q[2], t[2]), num_text(d, t[3]), *nearest);
+        else
+            n = snprintf((char *)buf, DIST_ROW_MAX, "%s,%s,%s,%s,-1\n", num_text(q[0], t[0]), num_text(q[1], t[1]),
+                         num_text(q[2], t[2]), num_text(d, t[3]));
+        return n < 0 ? 0 : (size_t)n;
+    }
+    double v[5] = {q[0], q[1], q[2], d, nearest ? (double)*nearest : -1.0};
+    size_t o = 0;
+    for (int c = 0; c < 4; c++, o += 8) put_le(buf + o, &v[c], 8);
+    if (f->format == DIST_NPY || f->wide) {
+        put_le(buf + o, &v[4], 8);
+        o += 8;
+    } else {
+        int32_t j = nearest ? (int32_t)*nearest : -1;
+        put_le(buf + o, &j, 4);
+        o += 4;
+    }
+    if (f->format == DIST_PLY) {
+        colormap_viridis(f->dmax > 0 ? d / f->dmax : 0.0, buf + o);
+        o += 3;
+    }
+    return o;
+}
+
 /* errno of a failed write; -1 when unknown, never 0 */
 static int write_errno(void) { return errno ? errno : -1; }
 
-static int write_csv(FILE *f, const hd_points_t *P, const double *d,
-                     const size_t *nearest) {
-    if (fputs("x,y,z,distance,nearest\n", f) == EOF) return write_errno();
-    for (size_t k = 0; k < P->count; k++) {
-        double q[3];
-        char t[4][NUM_TEXT];
-        int n;
-        hd_points_get(P, k, q);
-        if (nearest)
-            n = fprintf(f, "%s,%s,%s,%s,%zu\n", num_text(q[0], t[0]), num_text(q[1], t[1]), num_text(q[2], t[2]),
-                        num_text(d[k], t[3]), nearest[k]);
-        else
-            n = fprintf(f, "%s,%s,%s,%s,-1\n", num_text(q[0], t[0]), num_text(q[1], t[1]), num_text(q[2], t[2]),
-                        num_text(d[k], t[3]));
-        if (n < 0) return write_errno();
-    }
-    return 0;
-}
-
-static int write_ply(FILE *f, const hd_points_t *P, const double *d,
-                     const size_t *nearest, double dmax) {
-    int wide = 0;
-    for (size_t k = 0; nearest && k < P->count; k++) wide |= nearest[k] > 2147483647u;
-    char dm[NUM_TEXT];
-    if (fprintf(f, "ply\nformat binary_little_endian 1.0\n"
-               "comment written by hausdorff %s: distance to the nearest point of the other set\n"
-               "comment colour: viridis, 0 to %s\n"
-               "element vertex %zu\n"
-               "property double x\nproperty double y\nproperty double z\n"
-               "property double distance\nproperty %s nearest\n"
-               "property uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n",
-                hd_version(), num_text(dmax, dm), P->count, wide ? "double" : "int") < 0)
-        return write_errno();
-    unsigned char rec[4 * 8 + 8 + 3];
-    for (size_t k = 0; k < P->count; k++) {
-        double q[4];
-        hd_points_get(P, k, q);
-        q[3] = d[k];
-        size_t o = 0;
-        for (int c = 0; c < 4; c++, o += 8) put_le(rec + o, &q[c], 8);
-        if (wide) {
-            double j = nearest_of(nearest, k);
-            put_le(rec + o, &j, 8);
-            o += 8;
-        } else {
-            int32_t j = nearest ? (int32_t)nearest[k] : -1;
-            put_le(rec + o, &j, 4);
-            o += 4;
-        }
-        colormap_viridis(dmax > 0 ? d[k] / dmax : 0.0, rec + o);
-        o += 3;
-        if (fwrite(rec, 1, o, f) != o) return write_errno();
-    }
-    return 0;
-}
-
-static int write_npy(FILE *f, const hd_points_t *P, const double *d,
-                     const size_t *nearest) {
-    char dict[128];
-    int n = snprintf(dict, sizeof dict, "{'descr': '<f8', 'fortran_order': False, 'shape': (%zu, 5), }",
-                     P->count);
-    /* magic (6) + version (2) + length (2) + dict, padded with spaces and
-     * a newline to a multiple of 64 bytes */
-    size_t total = 10 + (size_t)n + 1, padded = (total + 63) / 64 * 64;
-    unsigned char head[10] = {0x93, 'N', 'U', 'M', 'P', 'Y', 1, 0, 0, 0};
-    uint16_t hl = (uint16_t)(padded - 10);
-    put_le(head + 8, &hl, 2);
-    if (fwrite(head, 1, 10, f) != 10 || fwrite(dict, 1, (size_t)n, f) != (size_t)n) return write_errno();
-    for (size_t k = total; k < padded; k++)
-        if (fputc(' ', f) == EOF) return write_errno();
-    if (fputc('\n', f) == EOF) return write_errno();
-    unsigned char rec[40];
-    for (size_t k = 0; k < P->count; k++) {
-        double v[5];
-        hd_points_get(P, k, v);
-        v[3] = d[k];
-        v[4] = nearest_of(nearest, k);
-        for (int c = 0; c < 5; c++) put_le(rec + 8 * c, &v[c], 8);
-        if (fwrite(rec, 1, sizeof rec, f) != sizeof rec) return write_errno();
-    }
-    return 0;
-}
-
 int write_distances(const char *path, const hd_points_t *P, const double *d,
                     const size_t *nearest, double dmax, hd_error_t *err) {
-    out_format_t fmt = format_of(path);
-    if (fmt == OUT_UNKNOWN) {
-        snprintf(err->message, sizeof err->message,
-                 "%s: cannot tell the output format; name it .csv, .ply or .npy", path);
-        return err->code = HD_EUNSUPPORTED;
-    }
+    dist_layout_t lay;
+    if (distances_layout(path, P->count, dmax, distances_wide(nearest, P->count), &lay, err)) return err->code;
     FILE *f = out_open(path, err);
     if (!f) return err->code;
     errno = 0;
-    int werr = fmt == OUT_CSV ? write_csv(f, P, d, nearest)
-             : fmt == OUT_PLY ? write_ply(f, P, d, nearest, dmax)
-                              : write_npy(f, P, d, nearest);
+    char head[DIST_HEAD_MAX];
+    size_t n = distances_header(&lay, head);
+    int werr = fwrite(head, 1, n, f) != n ? write_errno() : 0;
+    unsigned char row[DIST_ROW_MAX];
+    for (size_t k = 0; k < P->count && !werr; k++) {
+        double q[3];
+        hd_points_get(P, k, q);
+        n = distances_row(&lay, q, d[k], nearest ? &nearest[k] : NULL, row);
+        if (fwrite(row, 1, n, f) != n) werr = write_errno();
+    }
     return out_close(f, werr, err);
 }
 
-int distances_format_known(const char *path) { return format_of(path) != OUT_UNKNOWN; }
+int distances_format_known(const char *path) { return format_of(path) != DIST_UNKNOWN; }

@@ -183,9 +183,51 @@ def main():
                 check(rc1 == 0 and rc2 == 0 and out1 == out2, "%s: %d %d\n%s\n%s%s" % (fmt + args, rc1, rc2, out1, out2, err2))
         rc, out, err = ranks(mpirun, k, tool, empty, lion)
         check(rc == 2 and err.count("hausdorff-mpi:") == 1 and "--empty" in err, "empty without --empty: %d %r" % (rc, err))
-        # Per-point outputs are refused, once.
+        # Per-point outputs not built across ranks are refused, once.
         rc, out, err = ranks(mpirun, k, tool, "--percentile", "95", lion, head)
         check(rc == 1 and err.count("hausdorff-mpi:") == 1, "--percentile: exit %d, %r" % (rc, err))
+
+        # --distances: the files hausdorff writes, byte for byte, in each
+        # format: the tiles with ties (B's shares rotated, so the ranks'
+        # rows are not in rank order), a bundled model, --directed (no
+        # _b file), one binary file a side read by points.
+        def same_files(args, ext, directed):
+            d = tempfile.mkdtemp(dir=tmp)
+            s_out, m_out = os.path.join(d, "s." + ext), os.path.join(d, "m." + ext)
+            rc1, out1, err1 = single(hausdorff, "--distances", s_out, *args)
+            rc2, out2, err2 = ranks(mpirun, k, tool, "--distances", m_out, *args)
+            what = "--distances %s %s" % (ext, args)
+            check(rc1 == 0 and rc2 == 0, "%s: exit %d / %d: %s %s" % (what, rc1, rc2, err1, err2))
+            for suffix in ([""] if directed else ["", "_b"]):
+                f1, f2 = os.path.join(d, "s%s.%s" % (suffix, ext)), os.path.join(d, "m%s.%s" % (suffix, ext))
+                same = os.path.exists(f1) and os.path.exists(f2) and open(f1, "rb").read() == open(f2, "rb").read()
+                check(same, "%s: %s differs from hausdorff's" % (what, f2))
+            check(not directed or not os.path.exists(os.path.join(d, "m_b." + ext)), "%s: a _b file" % what)
+            check(sorted(os.listdir(d)) == sorted(["s." + ext, "m." + ext] +
+                                                   ([] if directed else ["s_b." + ext, "m_b." + ext])),
+                  "%s: files left: %r" % (what, os.listdir(d)))
+            keep = lambda out: [l.replace("m.", "s.").replace("m_b.", "s_b.") for l in out.splitlines()
+                                if not l.startswith(("time:", "mpi:"))]
+            check(keep(out1) == keep(out2), "%s: report differs:\n%s\n%s" % (what, out1, out2))
+
+        for ext in ("csv", "ply", "npy"):
+            same_files([A, B], ext, False)
+            same_files([lion, head], ext, False)
+            same_files(["--directed", B, A], ext, True)
+        same_files([ply, npy], "ply", False)
+        same_files(["--max-distance", "0.25", A, B], "ply", False)
+        # A file that cannot be written (B's rows' name is a directory),
+        # after A's was: one message, exit 3 from every rank, no file.
+        d = tempfile.mkdtemp(dir=tmp)
+        os.makedirs(os.path.join(d, "x_b.csv"))
+        rc, out, err = ranks(mpirun, k, tool, "--distances", os.path.join(d, "x.csv"), lion, head)
+        lines = [l for l in err.splitlines() if l.startswith("hausdorff-mpi:")]
+        check(rc == 3 and len(lines) == 1 and "x_b.csv: cannot write" in lines[0] and out == "",
+              "unwritable --distances: exit %d, %r" % (rc, err))
+        check(os.listdir(d) == ["x_b.csv"], "unwritable --distances left %r" % os.listdir(d))
+        rc, out, err = ranks(mpirun, k, tool, "--distances", os.path.join(tmp, "nodir", "x.npy"), lion, head)
+        check(rc == 3 and err.count("hausdorff-mpi:") == 1 and "cannot write" in err,
+              "--distances in no directory: exit %d, %r" % (rc, err))
     print("mpi_cli on %d ranks: %s" % (k, "%d failed" % len(failures) if failures else "passed"))
     return 1 if failures else 0
 

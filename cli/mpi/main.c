@@ -25,7 +25,9 @@
  */
 #include <hausdorff_mpi.h>
 
+#include "analysis.h"
 #include "cli.h"
+#include "mpi_cli.h"
 #include "output.h"
 #include "report.h"
 #include "tiles.h"
@@ -39,15 +41,57 @@
 
 static int rank_, K_;
 
-/* The first failing rank's code and message, on every rank (HD_OK when no
- * rank failed). */
-static int agree(int rc, hd_error_t *err) {
-    int mine = rc != HD_OK ? rank_ : K_, first = K_;
-    MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
-    if (first == K_) return HD_OK;
-    if (rank_ == first) err->code = rc;
-    MPI_Bcast(err, (int)sizeof *err, MPI_BYTE, first, MPI_COMM_WORLD);
-    return err->code;
+static int agree(int rc, hd_error_t *err) { return mpi_agree(rc, err); }
+
+/* The per-point option that hausdorff-mpi does not compute yet, or NULL:
+ * --distances is built (hd_mpi_distances, writer.c). */
+static const char *not_built(const analysis_args_t *an) {
+    if (an->percentile_on) return "--percentile";
+    if (an->mean) return "--mean";
+    if (an->chamfer) return "--chamfer";
+    if (an->histogram) return "--histogram";
+    if (an->render_out) return "--render";
+    if (an->histogram_png) return "--histogram-png";
+    return NULL;
+}
+
+/* --distances: every rank's per-point distances (hd_mpi_distances) written
+ * to OUT (and OUT_b unless --directed) by all ranks (writer.c), the colour
+ * scale as hausdorff's (--max-distance, else the Hausdorff distance); r
+ * receives what the report says of them. */
+static int write_distances_mpi(const cli_args_t *a, const hd_mpi_part_t part[2], const uint64_t total[2],
+                               const hd_symmetric_t *s, analysis_result_t *r, hd_error_t *err) {
+    size_t n[2] = {part[0].points.count, part[1].points.count};
+    double *d[2] = {NULL, NULL};
+    size_t *j[2] = {NULL, NULL};
+    int sides = a->directed ? 1 : 2, rc = HD_OK;
+    for (int w = 0; w < sides; w++) {
+        d[w] = malloc((n[w] ? n[w] : 1) * sizeof(double));
+        j[w] = malloc((n[w] ? n[w] : 1) * sizeof(size_t));
+        if (!d[w] || !j[w]) {
+            snprintf(err->message, sizeof err->message, "out of memory for %zu per-point distances", n[w]);
+            rc = err->code = HD_ENOMEM;
+        }
+    }
+    hd_mpi_stats_t st;
+    if ((rc = agree(rc, err)) == HD_OK)
+        rc = hd_mpi_distances(MPI_COMM_WORLD, &part[0], 1, &part[1], 1, &a->opt, d[0], j[0], d[1], j[1], &st, err);
+    r->active = 1;
+    r->directed = a->directed;
+    r->n_a = (size_t)total[0];
+    r->n_b = (size_t)total[1];
+    r->seconds = rc == HD_OK ? st.seconds_max : 0;
+    double scale = a->an.max_distance > 0 ? a->an.max_distance : s->distance;
+    snprintf(r->dist_path_a, sizeof r->dist_path_a, "%s", a->an.distances_out);
+    if (!a->directed) path_with_suffix(a->an.distances_out, "_b", r->dist_path_b, sizeof r->dist_path_b);
+    const char *path[2] = {r->dist_path_a, r->dist_path_b};
+    for (int w = 0; w < sides && rc == HD_OK; w++)
+        rc = mpi_write_distances(path[w], &part[w].points, part[w].offset, d[w], j[w], (size_t)total[w], scale, err);
+    for (int w = 0; w < 2; w++) {
+        free(d[w]);
+        free(j[w]);
+    }
+    return rc;
 }
 
 /* The same exit status on every rank (rank 0's). */
@@ -193,9 +237,10 @@ int main(int argc, char **argv) {
     cli_args_t a;
     int rc = cli_parse(argc, argv, &a); /* the same verdict on every rank */
     if (rc >= 0) return finish(rc == EXIT_OK ? out_finish() : rc);
-    if (analysis_active(&a.an)) {
-        fprintf(stderr, "hausdorff-mpi: per-point outputs (--distances, --percentile, --mean, --chamfer, "
-                        "--histogram, --render, ...) need every distance in one process: use hausdorff\n");
+    const char *refused = not_built(&a.an);
+    if (refused) {
+        fprintf(stderr, "hausdorff-mpi: %s is not built across ranks yet (per-point outputs: --distances only): "
+                        "use hausdorff\n", refused);
         return finish(EXIT_USAGE);
     }
     hd_error_t err;
@@ -208,6 +253,14 @@ int main(int argc, char **argv) {
     for (int w = 0; w < 2 && rc == HD_OK; w++) {
         rc = tiles_expand(paths[w], formats[w], &side[w], &err);
         if ((rc = agree(rc, &err)) != HD_OK) break;
+    }
+    if (rc == HD_OK) { /* no output may overwrite an input: rank 0 checks */
+        int bad = rank_ == 0 ? out_check_outputs(&a, side) : 0;
+        MPI_Bcast(&bad, 1, MPI_INT, 0, MPI_COMM_WORLD);
+        if (bad) {
+            for (int w = 0; w < 2; w++) tiles_free(&side[w]);
+            return finish(bad);
+        }
     }
     /* Each rank reads its share of each side. */
     double t0 = cli_now();
@@ -230,6 +283,15 @@ int main(int argc, char **argv) {
     if (rc == HD_OK) { /* an empty side (only under --empty: else reading refused it) */
         uint64_t mine[2] = {cloud[0]->count, cloud[1]->count}, all[2];
         MPI_Allreduce(mine, all, 2, MPI_UINT64_T, MPI_SUM, MPI_COMM_WORLD);
+        if ((!all[0] || !all[1]) && a.an.distances_out) {
+            fprintf(stderr, "hausdorff-mpi: --distances with an empty side is not built across ranks: use "
+                            "hausdorff\n");
+            for (int w = 0; w < 2; w++) {
+                hd_cloud_free(cloud[w]);
+                tiles_free(&side[w]);
+            }
+            return finish(EXIT_USAGE);
+        }
         if (!all[0] || !all[1]) {
             /* the policy's answer, printed as hausdorff prints it: the
              * views carry the counts only (no per-point output is asked) */
@@ -260,6 +322,13 @@ int main(int argc, char **argv) {
         } else {
             rc = hd_mpi_hausdorff(MPI_COMM_WORLD, &part[0], 1, &part[1], 1, &a.opt, &s, &st, &err);
         }
+    }
+    analysis_result_t an;
+    memset(&an, 0, sizeof an);
+    if (rc == HD_OK && a.an.distances_out) {
+        uint64_t mine[2] = {part[0].points.count, part[1].points.count}, total[2];
+        MPI_Allreduce(mine, total, 2, MPI_UINT64_T, MPI_SUM, MPI_COMM_WORLD);
+        rc = write_distances_mpi(&a, part, total, &s, &an, &err);
     }
     if (rc != HD_OK) {
         for (int w = 0; w < 2; w++) {
@@ -302,10 +371,12 @@ int main(int argc, char **argv) {
             status = EXIT_FAILURE_;
         } else if (a.json) {
             report_json(out, &r);
+            if (an.active) analysis_json(out, &a.an, &an);
             mpi_json(out, &st, col[0], col[1], col[2], split);
             fprintf(out, "}\n");
         } else {
             report_text(out, &r);
+            if (an.active) analysis_print(out, &a.an, &an);
             char b[NUM_TEXT], f[NUM_TEXT], im[NUM_TEXT];
             fprintf(out, "mpi: %d ranks, %s bytes moved per point, %s of the points forwarded, imbalance %s\n", K_,
                     num_text((double)(st.bytes_partition + st.bytes_forwarding) / (double)st.points, b),

@@ -1,0 +1,21 @@
+/*
+ * mpi_cli.h -- what hausdorff-mpi's files share (cli/mpi/).
+ */
+#ifndef HD_MPI_CLI_H
+#define HD_MPI_CLI_H
+
+#include <hausdorff.h>
+
+/* The first failing rank's code and message, on every rank (HD_OK when no
+ * rank failed).  Collective over MPI_COMM_WORLD. */
+int mpi_agree(int rc, hd_error_t *err);
+
+/* Write a --distances file (writer.c): this rank's rows P, d, nearest
+ * (nearest NULL: -1), the side's points first, first + 1, ...; total is
+ * the file's rows over all ranks, dmax the PLY colour scale.  Collective;
+ * HD_OK, or the same OUT_EFAIL (HD_EUNSUPPORTED, HD_ENOMEM) and message on
+ * every rank.  The file is renamed into place by rank 0's out_finish. */
+int mpi_write_distances(const char *path, const hd_points_t *P, size_t first, const double *d,
+                        const size_t *nearest, size_t total, double dmax, hd_error_t *err);
+
+#endif

@@ -1,0 +1,165 @@
+/*
+ * mpi/writer.c -- hausdorff-mpi's --distances files, written by every rank
+ * at once, byte for byte the file `hausdorff --distances` writes
+ * (writers.c's header and rows, output.c's temporary and rename).
+ *
+ * Each rank holds one run of a side's points, consecutive global indices
+ * from `first` (mpi/main.c reads the shares that way; B's are rotated, so
+ * not in rank order), so the file is the header, then the ranks' rows in
+ * the order of their first indices.  Every rank counts its rows' bytes; an
+ * allgather of (first, count, bytes) gives each its offset (the header's
+ * length plus the bytes of every run before its own); then all write with
+ * MPI_File_write_at_all, rank 0 the header in a first round, then the rows
+ * in rounds of at most CHUNK bytes a rank (an allreduce says whether any
+ * rank has more), into the temporary rank 0 created with out_open.  A PLY's colour scale and
+ * the width of its index column are the same on every rank (the scale is
+ * given; the width is an allreduce).  A CSV row's length depends on its
+ * numbers, so its bytes are counted in a first pass (formatting, without
+ * keeping the text); binary rows have one length.
+ *
+ * Failures: rank 0's out_open (an unwritable directory), the MPI-IO open,
+ * a write or the close, on any rank, are agreed (mpi_agree): every rank
+ * returns the same OUT_EFAIL and message ("PATH: cannot write: reason"),
+ * and the caller's out_discard removes the temporary; every rank keeps
+ * calling the collective writes until all are done, so no rank waits.
+ * The file appears under its name only at rank 0's out_finish.
+ */
+#include <hausdorff_mpi.h>
+
+#include "analysis.h"
+#include "cli.h"
+#include "mpi_cli.h"
+#include "output.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+/* Bytes a rank writes per round. */
+#define CHUNK ((size_t)1 << 20)
+
+int mpi_agree(int rc, hd_error_t *err) {
+    int rank, K;
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+    MPI_Comm_size(MPI_COMM_WORLD, &K);
+    int mine = rc != HD_OK ? rank : K, first = K;
+    MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+    if (first == K) return HD_OK;
+    if (rank == first) err->code = rc;
+    MPI_Bcast(err, (int)sizeof *err, MPI_BYTE, first, MPI_COMM_WORLD);
+    return err->code;
+}
+
+static int io_failed(const char *path, int code, hd_error_t *err) {
+    char text[MPI_MAX_ERROR_STRING];
+    int len = 0;
+    if (MPI_Error_string(code, text, &len) != MPI_SUCCESS) len = 0;
+    text[len] = '\0';
+    snprintf(err->message, sizeof err->message, "%.800s: cannot write: %s", path, len ? text : "MPI-IO error");
+    return err->code = OUT_EFAIL;
+}
+
+/* Rows [*k, n) into buf, as many as fit in CHUNK bytes; *k advances. */
+static size_t fill(const dist_layout_t *lay, const hd_points_t *P, const double *d, const size_t *nearest,
+                   size_t *k, unsigned char *buf) {
+    size_t at = 0;
+    for (; *k < P->count && at + DIST_ROW_MAX <= CHUNK; ++*k) {
+        double q[3];
+        hd_points_get(P, *k, q);
+        at += distances_row(lay, q, d[*k], nearest ? &nearest[*k] : NULL, buf + at);
+    }
+    return at;
+}
+
+/* Where this rank's rows start: after the header and every rank's rows of
+ * smaller indices (B's shares are not in rank order). */
+static int row_offset(uint64_t first, uint64_t count, uint64_t bytes, uint64_t head, uint64_t *off,
+                      hd_error_t *err) {
+    int K;
+    MPI_Comm_size(MPI_COMM_WORLD, &K);
+    uint64_t mine[3] = {first, count, bytes}, *all = malloc(3 * (size_t)K * sizeof *all);
+    int rc = HD_OK;
+    if (!all) {
+        snprintf(err->message, sizeof err->message, "out of memory for %d ranks' rows", K);
+        rc = err->code = HD_ENOMEM;
+    }
+    if ((rc = mpi_agree(rc, err)) != HD_OK) {
+        free(all);
+        return rc;
+    }
+    MPI_Allgather(mine, 3, MPI_UINT64_T, all, 3, MPI_UINT64_T, MPI_COMM_WORLD);
+    *off = head;
+    for (int r = 0; r < K; r++)
+        if (all[3 * r + 1] && all[3 * r] < first) *off += all[3 * r + 2];
+    free(all);
+    return HD_OK;
+}
+
+int mpi_write_distances(const char *path, const hd_points_t *P, size_t first, const double *d,
+                        const size_t *nearest, size_t total, double dmax, hd_error_t *err) {
+    int rank;
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+    int wide = distances_wide(nearest, P->count), any = 0;
+    MPI_Allreduce(&wide, &any, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+    dist_layout_t lay;
+    int rc = distances_layout(path, total, dmax, any, &lay, err); /* the same verdict on every rank */
+    if (rc != HD_OK) return rc;
+    char tmp[4096] = "";
+    if (rank == 0) {
+        FILE *f = out_open(path, err);
+        if (!f) {
+            rc = err->code;
+        } else {
+            snprintf(tmp, sizeof tmp, "%s", out_file_path(f));
+            rc = out_close(f, 0, err); /* empty: the ranks write it by name */
+        }
+    }
+    unsigned char *buf = malloc(CHUNK);
+    if (rc == HD_OK && !buf) {
+        snprintf(err->message, sizeof err->message, "out of memory for writing %s", path);
+        rc = err->code = HD_ENOMEM;
+    }
+    if ((rc = mpi_agree(rc, err)) != HD_OK) {
+        free(buf);
+        return rc;
+    }
+    MPI_Bcast(tmp, (int)sizeof tmp, MPI_CHAR, 0, MPI_COMM_WORLD);
+    /* This rank's bytes (text rows: a first pass), then its offset. */
+    size_t head = distances_header(&lay, (char *)buf), k = 0;
+    uint64_t bytes = 0, off = 0;
+    if (lay.format == DIST_CSV) {
+        while (k < P->count) bytes += fill(&lay, P, d, nearest, &k, buf);
+    } else {
+        unsigned char row[DIST_ROW_MAX];
+        bytes = (uint64_t)P->count * distances_row(&lay, (const double[3]){0, 0, 0}, 0, nearest, row);
+    }
+    if ((rc = row_offset(first, P->count, bytes, head, &off, err)) != HD_OK) {
+        free(buf);
+        return rc;
+    }
+    MPI_File fh;
+    int e = MPI_File_open(MPI_COMM_WORLD, tmp, MPI_MODE_WRONLY, MPI_INFO_NULL, &fh);
+    if (e != MPI_SUCCESS) rc = io_failed(path, e, err);
+    if ((rc = mpi_agree(rc, err)) != HD_OK) {
+        free(buf);
+        return rc;
+    }
+    /* The first round: rank 0 writes the header at 0; then the rows. */
+    MPI_Status st;
+    head = rank == 0 ? distances_header(&lay, (char *)buf) : 0;
+    e = MPI_File_write_at_all(fh, 0, buf, (int)head, MPI_BYTE, &st);
+    if (e != MPI_SUCCESS) rc = io_failed(path, e, err);
+    k = 0;
+    for (;;) {
+        int more = k < P->count, anyone = 0;
+        MPI_Allreduce(&more, &anyone, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+        if (!anyone) break;
+        size_t n = more ? fill(&lay, P, d, nearest, &k, buf) : 0;
+        e = MPI_File_write_at_all(fh, (MPI_Offset)off, buf, (int)n, MPI_BYTE, &st);
+        if (e != MPI_SUCCESS && rc == HD_OK) rc = io_failed(path, e, err);
+        off += n;
+    }
+    e = MPI_File_close(&fh);
+    if (e != MPI_SUCCESS && rc == HD_OK) rc = io_failed(path, e, err);
+    free(buf);
+    return mpi_agree(rc, err);
+}
