@@ -43,24 +43,23 @@ static int rank_, K_;
 
 static int agree(int rc, hd_error_t *err) { return mpi_agree(rc, err); }
 
-/* The per-point option that hausdorff-mpi does not compute yet, or NULL:
- * --distances is built (hd_mpi_distances, writer.c). */
+/* The per-point option that hausdorff-mpi does not compute, or NULL:
+ * --distances (hd_mpi_distances, writer.c) and the figures (figures.c) are
+ * built; --render would need the z-buffers of every rank merged
+ * (docs/scale-out.md, "What is not built"). */
 static const char *not_built(const analysis_args_t *an) {
-    if (an->percentile_on) return "--percentile";
-    if (an->mean) return "--mean";
-    if (an->chamfer) return "--chamfer";
-    if (an->histogram) return "--histogram";
     if (an->render_out) return "--render";
-    if (an->histogram_png) return "--histogram-png";
     return NULL;
 }
 
-/* --distances: every rank's per-point distances (hd_mpi_distances) written
- * to OUT (and OUT_b unless --directed) by all ranks (writer.c), the colour
- * scale as hausdorff's (--max-distance, else the Hausdorff distance); r
- * receives what the report says of them. */
-static int write_distances_mpi(const cli_args_t *a, const hd_mpi_part_t part[2], const uint64_t total[2],
-                               const hd_symmetric_t *s, analysis_result_t *r, hd_error_t *err) {
+/* The per-point options: every rank's per-point distances
+ * (hd_mpi_distances), the figures over the ranks (figures.c: --percentile,
+ * --mean, --chamfer, --histogram, --histogram-png), and --distances
+ * written to OUT (and OUT_b unless --directed) by all ranks (writer.c), the
+ * colour scale as hausdorff's (--max-distance, else the Hausdorff
+ * distance); r receives what the report says of them. */
+static int per_point_mpi(const cli_args_t *a, const hd_mpi_part_t part[2], const uint64_t total[2],
+                         analysis_result_t *r, hd_error_t *err) {
     size_t n[2] = {part[0].points.count, part[1].points.count};
     double *d[2] = {NULL, NULL};
     size_t *j[2] = {NULL, NULL};
@@ -81,9 +80,11 @@ static int write_distances_mpi(const cli_args_t *a, const hd_mpi_part_t part[2],
     r->n_a = (size_t)total[0];
     r->n_b = (size_t)total[1];
     r->seconds = rc == HD_OK ? st.seconds_max : 0;
-    double scale = a->an.max_distance > 0 ? a->an.max_distance : s->distance;
-    snprintf(r->dist_path_a, sizeof r->dist_path_a, "%s", a->an.distances_out);
-    if (!a->directed) path_with_suffix(a->an.distances_out, "_b", r->dist_path_b, sizeof r->dist_path_b);
+    if (rc == HD_OK) rc = mpi_figures(&a->an, d[0], n[0], d[1], n[1], r, err);
+    if (!a->an.distances_out) sides = 0;
+    double scale = analysis_scale(&a->an, r); /* hausdorff's: --max-distance, else the largest distance */
+    if (sides) snprintf(r->dist_path_a, sizeof r->dist_path_a, "%s", a->an.distances_out);
+    if (sides == 2) path_with_suffix(a->an.distances_out, "_b", r->dist_path_b, sizeof r->dist_path_b);
     const char *path[2] = {r->dist_path_a, r->dist_path_b};
     for (int w = 0; w < sides && rc == HD_OK; w++)
         rc = mpi_write_distances(path[w], &part[w].points, part[w].offset, d[w], j[w], (size_t)total[w], scale, err);
@@ -325,12 +326,13 @@ int main(int argc, char **argv) {
     }
     analysis_result_t an;
     memset(&an, 0, sizeof an);
-    if (rc == HD_OK && a.an.distances_out) {
+    if (rc == HD_OK && analysis_active(&a.an)) {
         uint64_t mine[2] = {part[0].points.count, part[1].points.count}, total[2];
         MPI_Allreduce(mine, total, 2, MPI_UINT64_T, MPI_SUM, MPI_COMM_WORLD);
-        rc = write_distances_mpi(&a, part, total, &s, &an, &err);
+        rc = per_point_mpi(&a, part, total, &an, &err);
     }
     if (rc != HD_OK) {
+        analysis_free(&an);
         for (int w = 0; w < 2; w++) {
             hd_cloud_free(cloud[w]);
             tiles_free(&side[w]);
@@ -387,6 +389,7 @@ int main(int argc, char **argv) {
         else out_discard();
     }
     free(all);
+    analysis_free(&an);
     for (int w = 0; w < 2; w++) {
         hd_cloud_free(cloud[w]);
         tiles_free(&side[w]);
