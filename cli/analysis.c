@@ -433,6 +433,12 @@ int analysis_figures(const analysis_args_t *an, const analysis_ops_t *ops, const
     return HD_OK;
 }
 
+void analysis_render_title(const char *path_a, size_t n_a, const char *path_b, char *title, size_t size) {
+    char base[256], base_b[256];
+    snprintf(title, size, "%s (%zu points) coloured by distance to %s", last_name(path_a, base), n_a,
+             last_name(path_b, base_b));
+}
+
 int analysis_run(const analysis_args_t *an, const hd_options_t *opt,
                  const hd_points_t *A, const hd_points_t *B,
                  const hd_symmetric_t *s, int directed, const char *path_a,
@@ -468,9 +474,7 @@ int analysis_run(const analysis_args_t *an, const hd_options_t *opt,
     }
     if (an->render_out) {
         char title[640];
-        char base[256], base_b[256];
-        snprintf(title, sizeof title, "%s (%zu points) coloured by distance to %s", last_name(path_a, base),
-                 A->count, last_name(path_b, base_b));
+        analysis_render_title(path_a, A->count, path_b, title, sizeof title);
         render_notes_t notes = {analysis_units(an), an->percentile_on, r->pct};
         if ((rc = render_distances(an->render_out, A, B, r->d_ab, scale, s, directed, &notes, title, r->markers,
                                    &r->n_markers, &r->render, &r->render_w, &r->render_h, err)))

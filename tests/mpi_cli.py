@@ -183,9 +183,6 @@ def main():
                 check(rc1 == 0 and rc2 == 0 and out1 == out2, "%s: %d %d\n%s\n%s%s" % (fmt + args, rc1, rc2, out1, out2, err2))
         rc, out, err = ranks(mpirun, k, tool, empty, lion)
         check(rc == 2 and err.count("hausdorff-mpi:") == 1 and "--empty" in err, "empty without --empty: %d %r" % (rc, err))
-        # --render is not built across ranks: refused, once, saying so.
-        rc, out, err = ranks(mpirun, k, tool, "--render", os.path.join(tmp, "r.png"), lion, head)
-        check(rc == 1 and err.count("hausdorff-mpi:") == 1 and "--render" in err, "--render: exit %d, %r" % (rc, err))
 
         # The figures (--percentile, --mean, --chamfer, --histogram): the
         # JSON and the text hausdorff prints, every member and line but the
@@ -226,6 +223,24 @@ def main():
             j1, j2 = json.loads(out1), json.loads(out2)
             check(j1["histogram_markers"] == j2["histogram_markers"] and j2["histogram_png"] == m_png,
                   "--histogram-png: markers %r != %r" % (j1["histogram_markers"], j2["histogram_markers"]))
+        # --render: hausdorff's picture byte for byte (the ranks' layers
+        # merged on rank 0), and the same JSON member (markers, captions)
+        def same_picture(args):
+            d = tempfile.mkdtemp(dir=tmp)
+            s_png, m_png = os.path.join(d, "s.png"), os.path.join(d, "m.png")
+            rc1, out1, err1 = single(hausdorff, "--json", "--render", s_png, *args)
+            rc2, out2, err2 = ranks(mpirun, k, tool, "--json", "--render", m_png, *args)
+            same = rc1 == 0 and rc2 == 0 and os.path.exists(m_png) and open(s_png, "rb").read() == open(m_png, "rb").read()
+            check(same, "--render %s: exit %d / %d, the pictures differ: %s %s" % (args, rc1, rc2, err1, err2))
+            if rc1 == 0 and rc2 == 0:
+                r1, r2 = json.loads(out1)["render"], json.loads(out2)["render"]
+                r2["file"] = r1["file"]
+                check(r1 == r2, "--render %s: %r != %r" % (args, r1, r2))
+
+        same_picture([A, B])
+        same_picture(["--percentile", "95", "--max-distance", "0.01", "--units", "mm", lion, head])
+        same_picture(["--directed", head, lion])
+        same_picture([ply, npy])
         # --empty with a per-point figure: the policy's values
         for args in (["--empty", "inf", "--mean", "--percentile", "95", empty, lion],
                      ["--empty", "nan", "--chamfer", "--directed", lion, empty]):

@@ -18,8 +18,10 @@
  * exits with the same status; no rank waits in a collective for one that
  * gave up.  Only rank 0 writes to standard output and standard error (the
  * others' are /dev/null), so a message appears once, not K times.  The
- * per-point outputs (--distances, --percentile, pictures, ...) need every
- * distance in one place and are refused (exit 1).  Under --empty a side
+ * per-point outputs are hausdorff's, computed where the points are: every
+ * rank's per-point distances (hd_mpi_distances), the figures over the
+ * ranks and the pictures from merged layers (figures.c), the --distances
+ * files written by every rank at its offset (writer.c).  Under --empty a side
  * whose ranks read no point at all gets the policy's answer, printed by
  * rank 0 with the single-process code (analysis_handle_empty).
  */
@@ -43,14 +45,7 @@ static int rank_, K_;
 
 static int agree(int rc, hd_error_t *err) { return mpi_agree(rc, err); }
 
-/* The per-point option that hausdorff-mpi does not compute, or NULL:
- * --distances (hd_mpi_distances, writer.c) and the figures (figures.c) are
- * built; --render would need the z-buffers of every rank merged
- * (docs/scale-out.md, "What is not built"). */
-static const char *not_built(const analysis_args_t *an) {
-    if (an->render_out) return "--render";
-    return NULL;
-}
+static void fetch_point(const hd_mpi_part_t *p, size_t g, double q[3]);
 
 /* The per-point options: every rank's per-point distances
  * (hd_mpi_distances), the figures over the ranks (figures.c: --percentile,
@@ -59,7 +54,7 @@ static const char *not_built(const analysis_args_t *an) {
  * colour scale as hausdorff's (--max-distance, else the Hausdorff
  * distance); r receives what the report says of them. */
 static int per_point_mpi(const cli_args_t *a, const hd_mpi_part_t part[2], const uint64_t total[2],
-                         analysis_result_t *r, hd_error_t *err) {
+                         const hd_symmetric_t *s, analysis_result_t *r, hd_error_t *err) {
     size_t n[2] = {part[0].points.count, part[1].points.count};
     double *d[2] = {NULL, NULL};
     size_t *j[2] = {NULL, NULL};
@@ -88,6 +83,14 @@ static int per_point_mpi(const cli_args_t *a, const hd_mpi_part_t part[2], const
     const char *path[2] = {r->dist_path_a, r->dist_path_b};
     for (int w = 0; w < sides && rc == HD_OK; w++)
         rc = mpi_write_distances(path[w], &part[w].points, part[w].offset, d[w], j[w], (size_t)total[w], scale, err);
+    if (rc == HD_OK && a->an.render_out) { /* the witness pair's points, from the ranks that hold them */
+        int from_a;
+        const hd_result_t *wit = report_witness(a, s, &from_a);
+        double wp[3], wq[3];
+        fetch_point(&part[!from_a], wit->i, wp);
+        fetch_point(&part[from_a], wit->j, wq);
+        rc = mpi_render(&a->an, part, d[0], wp, wq, s, a->path_a, a->path_b, r, err);
+    }
     for (int w = 0; w < 2; w++) {
         free(d[w]);
         free(j[w]);
@@ -238,12 +241,6 @@ int main(int argc, char **argv) {
     cli_args_t a;
     int rc = cli_parse(argc, argv, &a); /* the same verdict on every rank */
     if (rc >= 0) return finish(rc == EXIT_OK ? out_finish() : rc);
-    const char *refused = not_built(&a.an);
-    if (refused) {
-        fprintf(stderr, "hausdorff-mpi: %s is not built across ranks yet (per-point outputs: --distances only): "
-                        "use hausdorff\n", refused);
-        return finish(EXIT_USAGE);
-    }
     hd_error_t err;
     memset(&err, 0, sizeof err);
     tiles_t side[2];
@@ -329,7 +326,7 @@ int main(int argc, char **argv) {
     if (rc == HD_OK && analysis_active(&a.an)) {
         uint64_t mine[2] = {part[0].points.count, part[1].points.count}, total[2];
         MPI_Allreduce(mine, total, 2, MPI_UINT64_T, MPI_SUM, MPI_COMM_WORLD);
-        rc = per_point_mpi(&a, part, total, &an, &err);
+        rc = per_point_mpi(&a, part, total, &s, &an, &err);
     }
     if (rc != HD_OK) {
         analysis_free(&an);

@@ -29,4 +29,16 @@ struct analysis_result;
 int mpi_figures(const struct analysis_args *an, const double *d_ab, size_t n_a, const double *d_ba, size_t n_b,
                 struct analysis_result *r, hd_error_t *err);
 
+/* --render across the ranks (figures.c): each rank draws its points of A
+ * (d_a, its distances) and B into per-pixel layers (render_splat), the
+ * layers are merged on rank 0 (MPI_Reduce with the merges as operations),
+ * which draws hausdorff's picture from them (render_compose); wp and wq are
+ * the witness pair's points, r the figures (r->pct for the bar).  Fills
+ * r's render fields on rank 0.  Collective. */
+struct hd_mpi_part;
+struct hd_symmetric;
+int mpi_render(const struct analysis_args *an, const struct hd_mpi_part part[2], const double *d_a,
+               const double wp[3], const double wq[3], const struct hd_symmetric *s, const char *path_a,
+               const char *path_b, struct analysis_result *r, hd_error_t *err);
+
 #endif
