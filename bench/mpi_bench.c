@@ -2,7 +2,7 @@
  * mpi_bench.c -- the exchange figures of hd_mpi_hausdorff (docs/scale-out.md):
  *     mpirun -n K build/bench/mpi_bench [--points N] [--per-rank] [--cases LIST]
  *                                       [--layout random|tiles] [--threads T]
- *                                       [--check] [--repeat R]
+ *                                       [--check] [--repeat R] [--distances]
  * For each case, every rank generates its share of A and B (N points per
  * side in total, or per rank with --per-rank: weak scaling), and one call
  * of hd_mpi_hausdorff is timed; rank 0 prints one line per case with the
@@ -30,6 +30,19 @@
  * touches of fresh pages).  --check compares with hd_hausdorff on
  * rank 0 (all points gathered; small N only).
  *
+ * --distances times hd_mpi_distances (both directions, every point's nearest
+ * neighbour) instead, and prints per case: bytes moved per input point by
+ * the partition, the forwarding and the answers' return, the share of
+ * points forwarded, the largest rank's peak over its own local points, the
+ * slowest rank's search CPU and process CPU per local point, and, in the
+ * same run, single-process hd_distances on all the points gathered on rank
+ * 0 (one thread, its CPU per point, the faster of two calls; the other
+ * ranks sleep meanwhile; both write into outputs touched before) with
+ * the ratio of the two (the slowest rank's search and bookkeeping CPU,
+ * MPI's own calls left out as their busy waiting depends on the load, per
+ * mean local point, over the single process's CPU per point) and whether the answers are identical (they must
+ * be: every distance's bits and nearest index, both directions).
+ *
  * Cases:
  *  - uniform: A and B independent, uniform in a cube.
  *  - lidar: two epochs of a 1 km x 1 km LiDAR-like scene: terrain (a smooth
@@ -50,6 +63,7 @@
 #include <string.h>
 #include <sys/resource.h>
 #include <time.h>
+#include <unistd.h>
 
 #include "scene.h"
 
@@ -84,6 +98,109 @@ static void hwm_reset(void) {
     }
 }
 
+static double thread_cpu_now(void) {
+    struct timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* Rank 0 works alone while the others sleep (no busy waiting in MPI on a
+ * shared machine). */
+static void wait_for_rank0(void) {
+    MPI_Request req;
+    MPI_Ibarrier(MPI_COMM_WORLD, &req);
+    int done = 0;
+    while (!done) {
+        MPI_Test(&req, &done, MPI_STATUS_IGNORE);
+        if (!done && rank_ != 0) usleep(1000);
+    }
+}
+
+/* Gather a side's n points (or values, w doubles each) of every rank in
+ * rank order (= index order here) on rank 0; NULL elsewhere. */
+static double *gather(const double *v, size_t n, int w, size_t *total) {
+    int cnt = (int)(w * n), *cnts = malloc((size_t)K_ * sizeof(int)), *disp = malloc((size_t)K_ * sizeof(int));
+    MPI_Gather(&cnt, 1, MPI_INT, cnts, 1, MPI_INT, 0, MPI_COMM_WORLD);
+    int t = 0;
+    for (int q = 0; rank_ == 0 && q < K_; q++) disp[q] = t, t += cnts[q];
+    double *all = rank_ == 0 ? malloc((size_t)t * sizeof(double) + 8) : NULL;
+    MPI_Gatherv(v, cnt, MPI_DOUBLE, all, cnts, disp, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+    free(cnts);
+    free(disp);
+    *total = (size_t)t / (size_t)w;
+    return all;
+}
+
+/* One case of --distances: hd_mpi_distances timed, then hd_distances on
+ * rank 0 on everything, compared. */
+static void bench_distances(const char *c, const double *a, const double *b, size_t n, size_t offset,
+                            int threads) {
+    hd_mpi_part_t pa = {hd_points_f64(a, n), offset}, pb = {hd_points_f64(b, n), offset};
+    hd_options_t opt;
+    hd_options_init(&opt);
+    opt.threads = threads;
+    double *d[2] = {malloc(n * sizeof(double) + 8), malloc(n * sizeof(double) + 8)};
+    size_t *j[2] = {malloc(n * sizeof(size_t) + 8), malloc(n * sizeof(size_t) + 8)};
+    for (int s = 0; s < 2; s++) { /* touched, as the single process's are when it runs again */
+        memset(d[s], 0, n * sizeof(double));
+        memset(j[s], 0, n * sizeof(size_t));
+    }
+    hd_mpi_stats_t st;
+    hd_error_t err;
+    MPI_Barrier(MPI_COMM_WORLD);
+    double cpu0 = cpu_now();
+    int rc = hd_mpi_distances(MPI_COMM_WORLD, &pa, 1, &pb, 1, &opt, d[0], j[0], d[1], j[1], &st, &err);
+    double cpu = (cpu_now() - cpu0) / (double)(st.local_points ? st.local_points : 1), cpumax = 0;
+    MPI_Reduce(&cpu, &cpumax, 1, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD);
+    if (rc != HD_OK) {
+        if (rank_ == 0) fprintf(stderr, "mpi_bench: %s\n", err.message);
+        MPI_Abort(MPI_COMM_WORLD, 1);
+    }
+    double own = (double)st.peak_bytes / (double)(st.local_points ? st.local_points : 1), ownmax = 0;
+    MPI_Reduce(&own, &ownmax, 1, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD);
+    /* the single process on the same points, in the same run */
+    size_t na, nb, m;
+    double *A = gather(a, n, 3, &na), *B = gather(b, n, 3, &nb), *gd[2], *gj[2];
+    for (int s = 0; s < 2; s++) {
+        gd[s] = gather(d[s], n, 1, &m);
+        double *jj = malloc(n * sizeof(double) + 8);
+        for (size_t k = 0; k < n; k++) jj[k] = (double)j[s][k];
+        gj[s] = gather(jj, n, 1, &m);
+        free(jj);
+    }
+    double single = 0;
+    int same = 1;
+    if (rank_ == 0) {
+        hd_points_t Av = hd_points_f64(A, na), Bv = hd_points_f64(B, nb);
+        double *rd[2] = {malloc(na * sizeof(double)), malloc(nb * sizeof(double))};
+        size_t *rj[2] = {malloc(na * sizeof(size_t)), malloc(nb * sizeof(size_t))};
+        hd_options_t o1;
+        hd_options_init(&o1);
+        o1.threads = threads;
+        for (int rep = 0; rep < 2; rep++) { /* the faster of two: the first touches fresh memory */
+            double t0 = thread_cpu_now();
+            hd_distances(&Av, &Bv, &o1, rd[0], rj[0], rd[1], rj[1], &err);
+            double t = (thread_cpu_now() - t0) / (double)(na + nb);
+            single = rep == 0 || t < single ? t : single;
+        }
+        for (int s = 0; s < 2; s++)
+            for (size_t k = 0; k < (s ? nb : na); k++)
+                same &= memcmp(&rd[s][k], &gd[s][k], sizeof(double)) == 0 && (double)rj[s][k] == gj[s][k];
+        for (int s = 0; s < 2; s++) free(rd[s]), free(rj[s]);
+    }
+    wait_for_rank0();
+    uint64_t tot = st.points;
+    if (rank_ == 0)
+        printf("%-8s %9llu %9.2f %9.3f %9.2f %7.3f %8.1f %8.1f %8.1f %8.1f %8.1f %7.2f %s\n", c,
+               (unsigned long long)tot, (double)st.bytes_partition / (double)tot,
+               (double)st.bytes_forwarding / (double)tot, (double)st.bytes_returned / (double)tot,
+               100.0 * (double)st.forwarded_points / (double)tot, ownmax, 1e9 * st.search_cpu_max / ((double)tot / K_),
+               1e9 * st.other_cpu_max / ((double)tot / K_), 1e9 * cpumax, 1e9 * single,
+               (st.search_cpu_max + st.other_cpu_max) / ((double)tot / K_) / single, same ? "identical" : "DIFFERS");
+    free(A), free(B);
+    for (int s = 0; s < 2; s++) free(d[s]), free(j[s]), free(gd[s]), free(gj[s]);
+}
+
 static double maxrss(void) {
     struct rusage ru;
     return getrusage(RUSAGE_SELF, &ru) == 0 ? 1024.0 * (double)ru.ru_maxrss : 0;
@@ -94,7 +211,7 @@ int main(int argc, char **argv) {
     MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
     MPI_Comm_size(MPI_COMM_WORLD, &K_);
     size_t N = 1000000;
-    int per_rank = 0, tiles = 0, threads = 1, check = 0, repeat = 1;
+    int per_rank = 0, tiles = 0, threads = 1, check = 0, repeat = 1, dist = 0;
     const char *cases = "uniform,lidar,copy";
     for (int k = 1; k < argc; k++) {
         if (!strcmp(argv[k], "--points") && k + 1 < argc) N = (size_t)atof(argv[++k]);
@@ -104,6 +221,7 @@ int main(int argc, char **argv) {
         else if (!strcmp(argv[k], "--threads") && k + 1 < argc) threads = atoi(argv[++k]);
         else if (!strcmp(argv[k], "--check")) check = 1;
         else if (!strcmp(argv[k], "--repeat") && k + 1 < argc) repeat = atoi(argv[++k]);
+        else if (!strcmp(argv[k], "--distances")) dist = 1;
         else {
             if (rank_ == 0) fprintf(stderr, "mpi_bench: unknown argument %s\n", argv[k]);
             MPI_Finalize();
@@ -118,7 +236,11 @@ int main(int argc, char **argv) {
         fprintf(stderr, "mpi_bench: out of memory\n");
         MPI_Abort(MPI_COMM_WORLD, 1);
     }
-    if (rank_ == 0)
+    if (rank_ == 0 && dist)
+        printf("# mpi_bench --distances: %d ranks, %zu points per side%s, layout %s, %d thread(s) per rank\n"
+               "# case     points  B/pt(part) B/pt(fwd) B/pt(ret) fwd%% own B/pt searchcpu ns/pt othercpu ns/pt "
+               "cpu ns/pt single ns/pt ratio answers\n", K_, N, per_rank ? " per rank" : "", tiles ? "tiles" : "random", threads);
+    else if (rank_ == 0)
         printf("# mpi_bench: %d ranks, %zu points per side%s, layout %s, %d thread(s) per rank\n"
                "# case     points  B/pt(part) B/pt(fwd) fwd%%    imbal work-imbal buf B/pt rss B/pt "
                "time(s) search(s) search ns/pt cpu ns/pt shell%% searchcpu ns/pt hwm B/pt othercpu ns/pt own B/pt\n",
@@ -128,6 +250,10 @@ int main(int argc, char **argv) {
     for (char *c = strtok(list, ","); c; c = strtok(NULL, ","))
       for (int rep = 0; rep < (repeat > 0 ? repeat : 1); rep++) {
         scene_make(c, tiles ? rank_ : 0, tiles ? K_ : 1, 7, (uint64_t)rank_, a, b, n);
+        if (dist) {
+            bench_distances(c, a, b, n, offset, threads);
+            continue;
+        }
         hd_mpi_part_t pa = {hd_points_f64(a, n), offset}, pb = {hd_points_f64(b, n), offset};
         hd_options_t opt;
         hd_options_init(&opt);

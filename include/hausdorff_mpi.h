@@ -3,11 +3,13 @@
  * the ranks of an MPI communicator.
  *
  * The optional library libhausdorff_mpi (built when CMake finds MPI) adds
- * one call over libhausdorff: every rank passes the points it holds, each
+ * calls over libhausdorff: every rank passes the points it holds, each
  * numbered by its global index, and every rank receives the same result,
  * bit for bit the one hd_hausdorff() returns on all the points in one
- * process, witness included.  docs/scale-out.md explains the algorithm and
- * its costs.
+ * process, witness included (hd_mpi_hausdorff); or each rank receives, for
+ * its own points, what hd_distances() returns for them on all the points
+ * (hd_mpi_distances).  docs/scale-out.md explains the algorithm and its
+ * costs.
  *
  * A first program (run with `mpirun -n 4 ./prog`):
  *
@@ -58,7 +60,9 @@
  *  - Memory: the call holds about 36 bytes per point it ends up with while
  *    the points move and 32 after (coordinates and indices), plus the
  *    engine's and the searches' structures (docs/scale-out.md); on one
- *    rank it runs on the caller's points without a copy.
+ *    rank it runs on the caller's points without a copy.  hd_mpi_distances
+ *    holds more (its entry says how much): every point needs its own
+ *    search.
  */
 #ifndef HAUSDORFF_MPI_H
 #define HAUSDORFF_MPI_H
@@ -189,13 +193,15 @@ int hd_mpi_directed(MPI_Comm comm, const hd_mpi_part_t *a, size_t na,
  *   them: every point needs its answer); rounds one per direction.
  * err: NULL, or receives the context of a failure.
  * Memory, per point a rank holds after the partition: 28 bytes (the local
- *   arrays), about 36 bytes a point of each set for the nearest layer's
- *   structures (60 while one is built), and 16 bytes a point of the
- *   direction being computed; 16 bytes a point of the rank's own input
- *   while the answers come back (32 while they are sent when the ranks'
- *   index runs interleave).  On one rank, hd_distances on the caller's
- *   points (its 36 to 60 bytes a point), with no copy when each set is one
- *   part given in index order.
+ *   arrays), about 28 bytes a point of each set for the nearest layer's
+ *   structures (60 while one is built), and 24 bytes a point of the
+ *   direction being computed (16 after its local pass); 16 bytes a point
+ *   of the rank's own input while the answers come back (32 while they are
+ *   sent when the ranks' index runs interleave).  Measured peak: 75 to 78
+ *   bytes a point a rank holds (docs/scale-out.md).  On one rank,
+ *   hd_distances on the caller's points (charged at its 60 bytes a point),
+ *   with no copy when each set is one part, or its nonempty parts are
+ *   given in index order.
  * Errors: as hd_mpi_hausdorff (HD_EEMPTY when a set has no point on any
  *   rank), HD_EOVERFLOW for more than 2^31 - 1 points of a set on one rank
  *   (MPI's int counts).

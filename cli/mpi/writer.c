@@ -54,7 +54,7 @@ static int io_failed(const char *path, int code, hd_error_t *err) {
     int len = 0;
     if (MPI_Error_string(code, text, &len) != MPI_SUCCESS) len = 0;
     text[len] = '\0';
-    snprintf(err->message, sizeof err->message, "%.800s: cannot write: %s", path, len ? text : "MPI-IO error");
+    snprintf(err->message, sizeof err->message, "%.700s: cannot write: %s", path, len ? text : "MPI-IO error");
     return err->code = OUT_EFAIL;
 }
 

@@ -42,13 +42,14 @@
  *  indices.
  *
  * Memory (K > 1), per local point: the local arrays (28 bytes), the two
- * structures (about 36 bytes a point of each set, 60 while one is built),
- * and per point of the direction being computed u2 and j (16 bytes); a
- * rank's own points of that direction take 16 bytes more while the answers
- * come back (before they are written to the caller's outputs).  When the
- * runs were merged, the answers are reordered by sender into a buffer of
- * 16 bytes a point first.  The queries and their answers are 40 bytes each,
- * few.
+ * structures (about 28 bytes a point of each set, 60 while one is built),
+ * and per point of the direction being computed u2, the index and, during
+ * the local pass, the local position (24 bytes, then 16); a rank's own
+ * points of that direction take 16 bytes more while the answers come back
+ * (before they are written to the caller's outputs).  When the runs were
+ * merged, the answers are reordered by sender into a buffer of 16 bytes a
+ * point first.  The queries and their answers are 40 bytes each, few.
+ * Measured peak: 75 to 78 bytes a local point (docs/scale-out.md).
  */
 #include "mpi_int.h"
 
@@ -389,9 +390,9 @@ static int distances(ctx_t *c, const hd_options_t *opt, input_t *in, void *arg, 
     spread_t *sp = &cs.sp;
     an_t an[2];
     memset(an, 0, sizeof an);
-    uint64_t pts = in->n[0] + in->n[1];
     int rc = hd__mpi_begin(c, opt, in, o, &cs.rg, cs.N, NULL);
     if (rc != HD_OK) goto done;
+    uint64_t pts = in->n[0] + in->n[1];
     /* A direction runs when some rank asks for it. */
     int asks[2] = {o->dist[0] || o->nearest[0], o->dist[1] || o->nearest[1]}, want[2];
     MPI_GO(c, rc, MPI_Allreduce(asks, want, 2, MPI_INT, MPI_MAX, c->comm));
