@@ -90,17 +90,24 @@ def main():
             failures.append(what)
             print("FAIL (K=%d, seed %d): %s" % (k, SEED, what), file=sys.stderr)
 
-    def same_json(args):
+    def same_json(args, keys=SAME_KEYS):
+        """The members `keys` equal (None: every member but the times, the
+        engine's counters and "mpi"); None if a run failed, else both."""
         rc1, out1, err1 = single(hausdorff, "--json", *args)
         rc2, out2, err2 = ranks(mpirun, k, tool, "--json", *args)
         check(rc1 == 0 and rc2 == 0, "%s: exit %d / %d: %s %s" % (args, rc1, rc2, err1, err2))
         if rc1 or rc2:
-            return
+            return None
         j1, j2 = json.loads(out1), json.loads(out2)
-        for key in SAME_KEYS:
+        if keys is None:
+            keys = [key for key in j1 if key not in ("seconds", "read_seconds", "distances_seconds", "stats_ab",
+                                                     "stats_ba")]
+            check(sorted(j2) == sorted(list(j1) + ["mpi"]), "%s: members %r, %r" % (args, sorted(j1), sorted(j2)))
+        for key in keys:
             check(j1.get(key) == j2.get(key), "%s: %s: %r != %r" % (args, key, j1.get(key), j2.get(key)))
         m = j2.get("mpi", {})
         check(m.get("ranks") == k and len(m.get("seconds_per_rank", [])) == k, "%s: mpi figures %r" % (args, m))
+        return j1, j2
 
     def same_text(args):
         rc1, out1, _ = single(hausdorff, *args)
@@ -189,17 +196,7 @@ def main():
         # times, the engine's counters (the ranks run other searches) and
         # the mpi figures.
         def same_all(args):
-            rc1, out1, err1 = single(hausdorff, "--json", *args)
-            rc2, out2, err2 = ranks(mpirun, k, tool, "--json", *args)
-            check(rc1 == 0 and rc2 == 0, "%s: exit %d / %d: %s %s" % (args, rc1, rc2, err1, err2))
-            if rc1 or rc2:
-                return
-            j1, j2 = json.loads(out1), json.loads(out2)
-            skip = ("seconds", "read_seconds", "distances_seconds", "stats_ab", "stats_ba")
-            for key in j1:
-                if key not in skip:
-                    check(j1[key] == j2.get(key), "%s: %s: %r != %r" % (args, key, j1[key], j2.get(key)))
-            check(sorted(j2) == sorted(list(j1) + ["mpi"]), "%s: members %r, %r" % (args, sorted(j1), sorted(j2)))
+            same_json(args, None)
             same_text(args)
 
         figures = ["--percentile", "95", "--mean", "--chamfer", "--histogram"]

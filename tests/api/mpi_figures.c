@@ -15,9 +15,9 @@
  * values, and the exact sum's hard cases (values whose Neumaier sum was off
  * by an ulp).  Percentiles 0, 50, 95, 100 and two between ranks.
  *
- * The harness is mpi_api.c's kind (tests/support/check.c knows nothing of
- * ranks): a failure prints the rank, the case and the seed; rank 0 prints
- * "N checks, M failed", and the exit status is agreed.
+ * The harness is tests/support/mpicheck.h (tests/support/check.c knows
+ * nothing of ranks): a failure prints the rank, the case and the seed; rank
+ * 0 prints "N checks, M failed", and the exit status is agreed.
  */
 #include <hausdorff_mpi.h>
 
@@ -28,21 +28,7 @@
 #include <string.h>
 
 #include "gen.h"
-
-static int rank_, K_, failures, checks;
-static char context_[256];
-
-#define CHECK(cond)                                                                     \
-    do {                                                                                \
-        checks++;                                                                       \
-        if (!(cond)) {                                                                  \
-            failures++;                                                                 \
-            fprintf(stderr, "rank %d/%d: %s:%d: CHECK(%s) failed [%s]\n", rank_, K_,     \
-                    __FILE__, __LINE__, #cond, context_);                               \
-        }                                                                               \
-    } while (0)
-
-#define SAME_BITS(x, y) (memcmp(&(x), &(y), sizeof(double)) == 0)
+#include "mpicheck.h"
 
 /* ---- arrays ------------------------------------------------------------------ */
 
@@ -176,20 +162,6 @@ static void check_figures(int wa, int wb, int how, int directed, uint64_t seed) 
 
 /* ---- failures ----------------------------------------------------------------------- */
 
-static void check_agreed(int rc, int expected, const hd_error_t *err, const char *must_contain) {
-    CHECK(rc == expected);
-    CHECK(strstr(err->message, must_contain) != NULL);
-    if (rc != expected || !strstr(err->message, must_contain))
-        fprintf(stderr, "rank %d: got %s \"%s\", expected %s with \"%s\"\n", rank_, hd_err_name(rc), err->message,
-                hd_err_name(expected), must_contain);
-    /* the same message on every rank */
-    char mine[sizeof err->message], r0[sizeof err->message];
-    memcpy(mine, err->message, sizeof mine);
-    memcpy(r0, mine, sizeof r0);
-    MPI_Bcast(r0, (int)sizeof r0, MPI_CHAR, 0, MPI_COMM_WORLD);
-    CHECK(strcmp(mine, r0) == 0);
-}
-
 static void check_good_call_after(void) {
     double v[3] = {1, 2, 3 + rank_};
     hd_summary_t s;
@@ -268,11 +240,5 @@ int main(int argc, char **argv) {
             check_figures(wa, (wa + how) % AR_COUNT, how, 0, seed);
             if (how == LAY_HOLES) check_figures(wa, 0, how, 1, seed);
         }
-    int all[2] = {failures, checks}, sum[2];
-    MPI_Reduce(all, sum, 2, MPI_INT, MPI_SUM, 0, MPI_COMM_WORLD);
-    int any = failures > 0, anyall = 0;
-    MPI_Allreduce(&any, &anyall, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
-    if (rank_ == 0) printf("mpi_figures on %d ranks: %d checks, %d failed\n", K_, sum[1], sum[0]);
-    MPI_Finalize();
-    return anyall ? 1 : 0;
+    return mpicheck_finish("mpi_figures");
 }
