@@ -30,7 +30,11 @@
  * keep the reductions small (2 KB a figure): with 16-bit digits (four
  * rounds of 512 KB) tests/api/mpi_figures.c took 22 s on 7 oversubscribed
  * ranks instead of 4, and a local pass costs less than a large reduction
- * across many ranks.  After eight rounds the prefix is the whole key of rank k, and the last bin's count
+ * across many ranks.  After two rounds (the sign, the exponent and 4 bits
+ * of the significand) few values still match the prefix as a rule: when at
+ * most an eighth of a rank's do, their keys are copied once and the later
+ * rounds count only those (compact(); the smallest key above the prefix's
+ * range is kept for rank k + 1).  After eight rounds the prefix is the whole key of rank k, and the last bin's count
  * says whether rank k + 1 holds the same key; if not, it is the smallest
  * key above it (one MPI_Allreduce of minima).  The three selections (A->B,
  * B->A, both pooled) share their rounds.  hd__lerp, the single process's
@@ -158,10 +162,93 @@ typedef struct {
     uint64_t same;    /* values with the whole key of rank k, after the last round */
 } sel_t;
 
+/* A selection's local values: the directions' arrays, or (after
+ * COMPACT_AFTER rounds, when few of them still match the prefix) the keys
+ * that do, copied once, with the smallest key above the prefix's range
+ * (`beyond`), which the last step needs. */
+#define COMPACT_AFTER 2
+typedef struct {
+    uint64_t *keys;   /* NULL: scan the arrays */
+    size_t n;
+    uint64_t beyond;
+} cand_t;
+
+/* Count the local values of selection sel whose key starts with its
+ * prefix into h, by their digit at `shift`. */
+static void count_digits(const dists_t *v, const sel_t *sel, const cand_t *cd, int round, int shift, uint64_t *h) {
+    if (cd->keys) {
+        for (size_t i = 0; i < cd->n; i++)
+            if (cd->keys[i] >> (shift + DIGIT) == sel->prefix) h[(cd->keys[i] >> shift) & (BINS - 1)]++;
+        return;
+    }
+    for (int d = 0; d < 2; d++) {
+        if (!(sel->dirs >> d & 1)) continue;
+        const double *x = v->d[d];
+        size_t n = v->n[d];
+        if (round == 0) {
+            for (size_t i = 0; i < n; i++) h[key_of(x[i]) >> shift]++;
+        } else {
+            for (size_t i = 0; i < n; i++) {
+                uint64_t kk = key_of(x[i]);
+                if (kk >> (shift + DIGIT) == sel->prefix) h[(kk >> shift) & (BINS - 1)]++;
+            }
+        }
+    }
+}
+
+/* After COMPACT_AFTER rounds: the keys still matching the prefix, when
+ * they are at most an eighth of the local values (a local choice: without
+ * memory the arrays are scanned, with the same counts). */
+static void compact(ctx_t *c, const dists_t *v, const sel_t *sel, cand_t *cd) {
+    int shift = 64 - DIGIT * COMPACT_AFTER;
+    size_t all = 0, m = 0;
+    uint64_t beyond = UINT64_MAX;
+    for (int d = 0; d < 2; d++) {
+        if (!(sel->dirs >> d & 1)) continue;
+        all += v->n[d];
+        for (size_t i = 0; i < v->n[d]; i++) {
+            uint64_t kk = key_of(v->d[d][i]), top = kk >> shift;
+            m += top == sel->prefix;
+            if (top > sel->prefix && kk < beyond) beyond = kk;
+        }
+    }
+    if (m > all / 8 || !(cd->keys = hd__mpi_alloc(c, m ? m : 1, sizeof *cd->keys))) return;
+    cd->n = 0;
+    cd->beyond = beyond;
+    for (int d = 0; d < 2; d++) {
+        if (!(sel->dirs >> d & 1)) continue;
+        for (size_t i = 0; i < v->n[d]; i++) {
+            uint64_t kk = key_of(v->d[d][i]);
+            if (kk >> shift == sel->prefix) cd->keys[cd->n++] = kk;
+        }
+    }
+    assert(cd->n == m);
+}
+
+/* The smallest local key above k. */
+static uint64_t key_above(const dists_t *v, const sel_t *sel, const cand_t *cd, uint64_t k) {
+    uint64_t above = UINT64_MAX;
+    if (cd->keys) {
+        above = cd->beyond;
+        for (size_t i = 0; i < cd->n; i++)
+            if (cd->keys[i] > k && cd->keys[i] < above) above = cd->keys[i];
+        return above;
+    }
+    for (int d = 0; d < 2; d++) {
+        if (!(sel->dirs >> d & 1)) continue;
+        for (size_t i = 0; i < v->n[d]; i++) {
+            uint64_t kk = key_of(v->d[d][i]);
+            if (kk > k && kk < above) above = kk;
+        }
+    }
+    return above;
+}
+
 /* Ranks k of every selection in sel[0..ns), and of k + 1 in *next
  * (next[s] = the key of rank k + 1). */
 static int select_ranks(ctx_t *c, const dists_t *v, sel_t *sel, int ns, uint64_t *key, uint64_t *next) {
     size_t words = (size_t)ns * BINS;
+    cand_t cd[3] = {{NULL, 0, 0}, {NULL, 0, 0}, {NULL, 0, 0}};
     uint64_t *hist = hd__mpi_alloc(c, words, sizeof *hist);
     int rc = hist ? HD_OK : hd__mpi_nomem(c, "the selection's histograms", words);
     if ((rc = hd__mpi_agree(c, rc))) return rc;
@@ -169,20 +256,8 @@ static int select_ranks(ctx_t *c, const dists_t *v, sel_t *sel, int ns, uint64_t
         int shift = 64 - DIGIT * (round + 1);
         memset(hist, 0, words * sizeof *hist);
         for (int s = 0; s < ns; s++) {
-            uint64_t *h = hist + (size_t)s * BINS;
-            for (int d = 0; d < 2; d++) {
-                if (!(sel[s].dirs >> d & 1)) continue;
-                const double *x = v->d[d];
-                size_t n = v->n[d];
-                if (round == 0) {
-                    for (size_t i = 0; i < n; i++) h[key_of(x[i]) >> shift]++;
-                } else {
-                    for (size_t i = 0; i < n; i++) {
-                        uint64_t kk = key_of(x[i]);
-                        if (kk >> (shift + DIGIT) == sel[s].prefix) h[(kk >> shift) & (BINS - 1)]++;
-                    }
-                }
-            }
+            if (round == COMPACT_AFTER) compact(c, v, &sel[s], &cd[s]);
+            count_digits(v, &sel[s], &cd[s], round, shift, hist + (size_t)s * BINS);
         }
         int e = MPI_Allreduce(MPI_IN_PLACE, hist, (int)words, MPI_UINT64_T, MPI_SUM, c->comm);
         if (e != MPI_SUCCESS) {
@@ -199,20 +274,14 @@ static int select_ranks(ctx_t *c, const dists_t *v, sel_t *sel, int ns, uint64_t
         }
     }
     hd__mpi_free(c, hist, words, sizeof *hist);
-    if (rc) return rc;
     /* rank k + 1: the same key, or the smallest key above it */
-    uint64_t above[3];
+    uint64_t above[3] = {UINT64_MAX, UINT64_MAX, UINT64_MAX};
     for (int s = 0; s < ns; s++) {
         key[s] = sel[s].prefix;
-        above[s] = UINT64_MAX;
-        for (int d = 0; d < 2; d++) {
-            if (!(sel[s].dirs >> d & 1)) continue;
-            for (size_t i = 0; i < v->n[d]; i++) {
-                uint64_t kk = key_of(v->d[d][i]);
-                if (kk > key[s] && kk < above[s]) above[s] = kk;
-            }
-        }
+        if (rc == HD_OK) above[s] = key_above(v, &sel[s], &cd[s], key[s]);
+        hd__mpi_free(c, cd[s].keys, cd[s].n ? cd[s].n : 1, sizeof *cd[s].keys);
     }
+    if (rc) return rc;
     MPI_TRY(c, MPI_Allreduce(MPI_IN_PLACE, above, ns, MPI_UINT64_T, MPI_MIN, c->comm));
     for (int s = 0; s < ns; s++) next[s] = sel[s].k + 1 < sel[s].same ? key[s] : above[s];
     return HD_OK;
