@@ -4,8 +4,13 @@
 #    hd_hausdorff bit for bit on the adversarial sets and layouts, and a
 #    failure on one rank is agreed by all.  K = 1, 2, 3, 4, 7 here; the
 #    sanitizer build runs K = 3 only.
+#  - mpi_figures_K: tests/api/mpi_figures.c under `mpirun -n K`:
+#    hd_mpi_summarize, hd_mpi_percentile_of and hd_mpi_histogram equal the
+#    single-process functions bit for bit however the values are spread,
+#    and failures are agreed.  The same K as mpi_api.
 #  - mpi_cli_3: tests/mpi_cli.py, hausdorff-mpi on 3 ranks against
-#    hausdorff (JSON and text, tiles, scales, a bad tile on one rank).
+#    hausdorff (JSON and text, tiles, scales, a bad tile on one rank, the
+#    per-point files, figures and pictures).
 # Ranks are oversubscribed on purpose (2 cores, up to 7 ranks) and CI runs
 # as root: hence --oversubscribe and --allow-run-as-root.  Under the
 # sanitizers LeakSanitizer is off for these tests: Open MPI does not free
@@ -14,7 +19,10 @@
 # checked instead by an assert (src/mpi/mpi.c: the call's count of bytes
 # held is 0 when it returns), and AddressSanitizer and UBSan stay on.  The
 # times (Release, 2 shared cores): mpi_api 1, 3, 2.5-4.5, 3.5 and 6-13 s;
-# mpi_cli_3 10-22 s; sanitizers: mpi_api_3 14 s, mpi_cli_3 21 s.
+# mpi_cli_3 10-22 s; sanitizers: mpi_api_3 14 s, mpi_cli_3 21 s.  With
+# the per-point outputs (load average 7-8, 2026-11-23): mpi_figures 1, 1.5,
+# 4.4, 3.4 and 5.8 s; mpi_cli_3 90-100 s; sanitizers: mpi_figures_3 8 s,
+# mpi_cli_3 156 s.
 if(HD_MPI)
   find_program(HD_MPIEXEC NAMES mpirun mpiexec REQUIRED)
   add_executable(mpi_api ${CMAKE_CURRENT_SOURCE_DIR}/tests/api/mpi_api.c ${CMAKE_CURRENT_SOURCE_DIR}/tests/support/gen.c)
