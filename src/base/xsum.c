@@ -13,16 +13,21 @@
  * How: every finite double is m 2^(p - 1074) with an integer m < 2^53 and
  * 0 <= p <= 2045 (p = biased exponent - 1, 0 for subnormals), so every sum
  * of them is an integer multiple of 2^-1074: a fixed-point number.  It is
- * held in HD__XSUM_LIMBS int64 limbs of 32-bit chunks (limb k weighs
- * 2^(32 k - 1074)); an addition splits m << (p mod 32) into three chunks of
- * at most 32 bits and adds (or subtracts) them to three limbs, without a
- * carry: each limb has 31 bits of headroom, and `pending` counts the
+ * held in HD__XSUM_LIMBS int64 limbs of 32-bit digits (limb k weighs
+ * 2^(32 k - 1074)); an addition splits m << (p mod 32) (at most 84 bits)
+ * into its low 32 bits and the rest (< 2^52) and adds (or subtracts) them
+ * to two neighbouring limbs, without a carry (Neal's "small
+ * superaccumulator" does the same with other sizes): `pending` counts the
  * additions since the limbs were last normalised, which happens before any
- * limb can overflow (HD__XSUM_PENDING_MAX = 2^30 additions of less than
- * 2^32 each stay below 2^62).  Normalising carries each limb's excess into
- * the next (the division by 2^32 is exact: v - (v mod 2^32)); the top limb
- * keeps the sign, and the 70 limbs reach 2^1166, so the sum of 2^64
- * doubles (< 2^1088) never reaches it.
+ * limb can overflow (HD__XSUM_PENDING_MAX = 2^10 additions of less than
+ * 2^52 each stay below 2^62).  A loop counts its additions a block of 512
+ * at a time (hd__xsum_add_uncounted, hd__xsum_count), so the counter stays
+ * in a register.  Normalising carries each limb's excess into the next
+ * (the division by 2^32 is exact: v - (v mod 2^32)), every 512 additions:
+ * 70 limbs, a fraction of an operation per addition.  The top limb keeps
+ * the sign, and the 70 limbs reach 2^1166, so the sum of 2^64 doubles
+ * (< 2^1088) never reaches it.  Cost: about 1-2 ns a value more than
+ * Neumaier's summation (docs/benchmarks.md, "Exact sums").
  *
  * Rounding: the normalised limbs are a two's complement number; a negative
  * one is negated limb by limb and normalised again, so the magnitude is a
