@@ -230,14 +230,18 @@ int hd_summarize(const double *d_ab, size_t n_a, const double *d_ba,
                  size_t n_b, hd_summary_t *out, hd_error_t *err) {
     hd__err_clear(err);
     if (!out) return hd__err(err, HD_EINVAL, "result pointer is NULL");
-    int rc;
-    if ((rc = check_values(d_ab, n_a, "A to B", err))) return rc;
-    if (!d_ba) n_b = 0;
-    if (d_ba && (rc = check_values(d_ba, n_b, "B to A", err))) return rc;
+    /* check_values' checks in its order, the NaN check only when the sum
+     * counted a NaN (one pass over the values instead of two) */
+    if (!d_ab) return hd__err(err, HD_EINVAL, "distances A to B are NULL");
+    if (n_a == 0) return hd__err(err, HD_EEMPTY, "distances A to B are empty");
     hd__xsum_t s[4];
     for (int k = 0; k < 4; k++) hd__xsum_init(&s[k]);
     double max_ab = hd__xsum_values(&s[0], &s[1], d_ab, n_a, -INFINITY), max_ba = NAN;
+    if (s[0].nan) return hd__nan_check(d_ab, n_a, 0, "A to B", err);
+    if (!d_ba) n_b = 0;
+    if (d_ba && n_b == 0) return hd__err(err, HD_EEMPTY, "distances B to A are empty");
     if (n_b) max_ba = hd__xsum_values(&s[2], &s[3], d_ba, n_b, -INFINITY);
+    if (s[2].nan) return hd__nan_check(d_ba, n_b, 0, "B to A", err);
     hd__summary_derive(out, n_a, max_ab, hd__xsum_round(&s[0]), hd__xsum_round(&s[1]), n_b, max_ba,
                        n_b ? hd__xsum_round(&s[2]) : NAN, n_b ? hd__xsum_round(&s[3]) : NAN);
     return HD_OK;
