@@ -31,7 +31,7 @@
  * rank 0 (all points gathered; small N only).
  *
  * --distances times hd_mpi_distances (both directions, every point's nearest
- * neighbour) instead, and prints per case: bytes moved per input point by
+ * neighbour; the faster of two calls) instead, and prints per case: bytes moved per input point by
  * the partition, the forwarding and the answers' return, the share of
  * points forwarded, the largest rank's peak over its own local points, the
  * slowest rank's search CPU and process CPU per local point, and, in the
@@ -145,16 +145,23 @@ static void bench_distances(const char *c, const double *a, const double *b, siz
         memset(d[s], 0, n * sizeof(double));
         memset(j[s], 0, n * sizeof(size_t));
     }
-    hd_mpi_stats_t st;
+    hd_mpi_stats_t st, one;
     hd_error_t err;
-    MPI_Barrier(MPI_COMM_WORLD);
-    double cpu0 = cpu_now();
-    int rc = hd_mpi_distances(MPI_COMM_WORLD, &pa, 1, &pb, 1, &opt, d[0], j[0], d[1], j[1], &st, &err);
-    double cpu = (cpu_now() - cpu0) / (double)(st.local_points ? st.local_points : 1), cpumax = 0;
-    MPI_Reduce(&cpu, &cpumax, 1, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD);
-    if (rc != HD_OK) {
-        if (rank_ == 0) fprintf(stderr, "mpi_bench: %s\n", err.message);
-        MPI_Abort(MPI_COMM_WORLD, 1);
+    double cpumax = 0;
+    for (int rep = 0; rep < 2; rep++) { /* the faster of two, as the single process's below */
+        MPI_Barrier(MPI_COMM_WORLD);
+        double cpu0 = cpu_now();
+        int rc = hd_mpi_distances(MPI_COMM_WORLD, &pa, 1, &pb, 1, &opt, d[0], j[0], d[1], j[1], &one, &err);
+        double cpu = (cpu_now() - cpu0) / (double)(one.local_points ? one.local_points : 1), most = 0;
+        MPI_Reduce(&cpu, &most, 1, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD);
+        if (rc != HD_OK) {
+            if (rank_ == 0) fprintf(stderr, "mpi_bench: %s\n", err.message);
+            MPI_Abort(MPI_COMM_WORLD, 1);
+        }
+        if (rep == 0 || one.search_cpu_max + one.other_cpu_max < st.search_cpu_max + st.other_cpu_max) {
+            st = one; /* the same choice on every rank: the figures are maxima over the ranks */
+            cpumax = most;
+        }
     }
     double own = (double)st.peak_bytes / (double)(st.local_points ? st.local_points : 1), ownmax = 0;
     MPI_Reduce(&own, &ownmax, 1, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD);

@@ -47,55 +47,65 @@ static int agree(int rc, hd_error_t *err) { return mpi_agree(rc, err); }
 
 static void fetch_point(const hd_mpi_part_t *p, size_t g, double q[3]);
 
-/* The per-point options: every rank's per-point distances
- * (hd_mpi_distances), the figures over the ranks (figures.c: --percentile,
- * --mean, --chamfer, --histogram, --histogram-png), and --distances
- * written to OUT (and OUT_b unless --directed) by all ranks (writer.c), the
- * colour scale as hausdorff's (--max-distance, else the Hausdorff
- * distance); r receives what the report says of them. */
-static int per_point_mpi(const cli_args_t *a, const hd_mpi_part_t part[2], const uint64_t total[2],
-                         const hd_symmetric_t *s, analysis_result_t *r, hd_error_t *err) {
+/* The per-point distances of this rank's points (hd_mpi_distances, both
+ * directions unless --directed) into r->d_ab, j_ab, d_ba, j_ba (this
+ * rank's points only, in its parts' order; analysis_free frees them), with
+ * what the report says of them: r->n_a, n_b are the sides' totals, and
+ * r->seconds the slowest rank's time.  Collective. */
+static int distances_mpi(const cli_args_t *a, const hd_mpi_part_t part[2], const uint64_t total[2],
+                         analysis_result_t *r, hd_error_t *err) {
     size_t n[2] = {part[0].points.count, part[1].points.count};
-    double *d[2] = {NULL, NULL};
-    size_t *j[2] = {NULL, NULL};
-    int sides = a->directed ? 1 : 2, rc = HD_OK;
-    for (int w = 0; w < sides; w++) {
-        d[w] = malloc((n[w] ? n[w] : 1) * sizeof(double));
-        j[w] = malloc((n[w] ? n[w] : 1) * sizeof(size_t));
-        if (!d[w] || !j[w]) {
+    r->active = 1;
+    r->directed = a->directed;
+    r->n_a = (size_t)total[0];
+    r->n_b = (size_t)total[1];
+    double **d[2] = {&r->d_ab, &r->d_ba};
+    size_t **j[2] = {&r->j_ab, &r->j_ba};
+    int rc = HD_OK;
+    for (int w = 0; w < (a->directed ? 1 : 2); w++) {
+        *d[w] = malloc((n[w] ? n[w] : 1) * sizeof(double));
+        *j[w] = malloc((n[w] ? n[w] : 1) * sizeof(size_t));
+        if (!*d[w] || !*j[w]) {
             snprintf(err->message, sizeof err->message, "out of memory for %zu per-point distances", n[w]);
             rc = err->code = HD_ENOMEM;
         }
     }
     hd_mpi_stats_t st;
     if ((rc = agree(rc, err)) == HD_OK)
-        rc = hd_mpi_distances(MPI_COMM_WORLD, &part[0], 1, &part[1], 1, &a->opt, d[0], j[0], d[1], j[1], &st, err);
-    r->active = 1;
-    r->directed = a->directed;
-    r->n_a = (size_t)total[0];
-    r->n_b = (size_t)total[1];
+        rc = hd_mpi_distances(MPI_COMM_WORLD, &part[0], 1, &part[1], 1, &a->opt, r->d_ab, r->j_ab, r->d_ba,
+                              r->j_ba, &st, err);
     r->seconds = rc == HD_OK ? st.seconds_max : 0;
-    if (rc == HD_OK) rc = mpi_figures(&a->an, d[0], n[0], d[1], n[1], r, err);
-    if (!a->an.distances_out) sides = 0;
-    double scale = analysis_scale(&a->an, r); /* hausdorff's: --max-distance, else the largest distance */
-    if (sides) snprintf(r->dist_path_a, sizeof r->dist_path_a, "%s", a->an.distances_out);
-    if (sides == 2) path_with_suffix(a->an.distances_out, "_b", r->dist_path_b, sizeof r->dist_path_b);
-    const char *path[2] = {r->dist_path_a, r->dist_path_b};
-    for (int w = 0; w < sides && rc == HD_OK; w++)
-        rc = mpi_write_distances(path[w], &part[w].points, part[w].offset, d[w], j[w], (size_t)total[w], scale, err);
-    if (rc == HD_OK && a->an.render_out) { /* the witness pair's points, from the ranks that hold them */
-        int from_a;
-        const hd_result_t *wit = report_witness(a, s, &from_a);
-        double wp[3], wq[3];
-        fetch_point(&part[!from_a], wit->i, wp);
-        fetch_point(&part[from_a], wit->j, wq);
-        rc = mpi_render(&a->an, part, d[0], wp, wq, s, a->path_a, a->path_b, r, err);
-    }
-    for (int w = 0; w < 2; w++) {
-        free(d[w]);
-        free(j[w]);
-    }
     return rc;
+}
+
+/* --distances: r's per-rank distances written to OUT (and OUT_b unless
+ * --directed) by all ranks (writer.c), the colour scale as hausdorff's
+ * (--max-distance, else the Hausdorff distance).  Collective. */
+static int distances_files_mpi(const cli_args_t *a, const hd_mpi_part_t part[2], const uint64_t total[2],
+                               const hd_symmetric_t *s, analysis_result_t *r, hd_error_t *err) {
+    double scale = a->an.max_distance > 0 ? a->an.max_distance : s->distance;
+    snprintf(r->dist_path_a, sizeof r->dist_path_a, "%s", a->an.distances_out);
+    if (!a->directed) path_with_suffix(a->an.distances_out, "_b", r->dist_path_b, sizeof r->dist_path_b);
+    const char *path[2] = {r->dist_path_a, r->dist_path_b};
+    const double *d[2] = {r->d_ab, r->d_ba};
+    const size_t *j[2] = {r->j_ab, r->j_ba};
+    int rc = HD_OK;
+    for (int w = 0; w < (a->directed ? 1 : 2) && rc == HD_OK; w++)
+        rc = mpi_write_distances(path[w], &part[w].points, part[w].offset, d[w], j[w], (size_t)total[w], scale,
+                                 err);
+    return rc;
+}
+
+/* --render: the witness pair's points from the ranks that hold them, then
+ * the picture from every rank's layers (figures.c).  Collective. */
+static int render_mpi(const cli_args_t *a, const hd_mpi_part_t part[2], const hd_symmetric_t *s,
+                      analysis_result_t *r, hd_error_t *err) {
+    int from_a;
+    const hd_result_t *wit = report_witness(a, s, &from_a);
+    double wp[3], wq[3];
+    fetch_point(&part[!from_a], wit->i, wp);
+    fetch_point(&part[from_a], wit->j, wq);
+    return mpi_render(&a->an, part, r->d_ab, wp, wq, s, a->path_a, a->path_b, r, err);
 }
 
 /* The same exit status on every rank (rank 0's). */
@@ -326,7 +336,11 @@ int main(int argc, char **argv) {
     if (rc == HD_OK && analysis_active(&a.an)) {
         uint64_t mine[2] = {part[0].points.count, part[1].points.count}, total[2];
         MPI_Allreduce(mine, total, 2, MPI_UINT64_T, MPI_SUM, MPI_COMM_WORLD);
-        rc = per_point_mpi(&a, part, total, &s, &an, &err);
+        /* as analysis_run: the distances, the figures, the files, the pictures */
+        if ((rc = distances_mpi(&a, part, total, &an, &err)) == HD_OK)
+            rc = mpi_figures(&a.an, an.d_ab, part[0].points.count, an.d_ba, part[1].points.count, &an, &err);
+        if (rc == HD_OK && a.an.distances_out) rc = distances_files_mpi(&a, part, total, &s, &an, &err);
+        if (rc == HD_OK && a.an.render_out) rc = render_mpi(&a, part, &s, &an, &err);
     }
     if (rc != HD_OK) {
         analysis_free(&an);

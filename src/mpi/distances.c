@@ -141,7 +141,6 @@ static int single(ctx_t *c, const input_t *in, const ranges_t *rg, const int wan
         if (direct) continue;
         if (o->dist[s] && !(td[s] = hd__mpi_alloc(c, in->n[s], sizeof(double))))
             rc = hd__mpi_nomem(c, "the distances", in->n[s]);
-        /* the indices are needed in any case: wanted means some output */
         if (rc == HD_OK && o->nearest[s] && !(tn[s] = hd__mpi_alloc(c, in->n[s], sizeof(size_t))))
             rc = hd__mpi_nomem(c, "the distances", in->n[s]);
     }

@@ -349,6 +349,17 @@ static void check_distances(int which, int how, uint64_t seed) {
         for (size_t k = 0; k < mb; k++) d_ba[k] = ed_ba[k];
         CHECK(same_answers(d_ba, n_ba, ed_ba, en_ba, mb, "B to A alone"));
     }
+    /* a direction runs when any rank asks for it: rank 0 does not ask for
+     * B's answers, the others get theirs */
+    if (how == LAY_BLOCKS) {
+        memset(n_ba, 0, (s.nb + 1) * sizeof(size_t));
+        int r0 = rank_ == 0;
+        CHECK(hd_mpi_distances(MPI_COMM_WORLD, pa, na, pb, nb, &opt, d_ab, n_ab, r0 ? NULL : d_ba, r0 ? NULL : n_ba,
+                               &st, &err) == HD_OK);
+        CHECK(st.rounds == (K_ > 1 ? 2 : 0));
+        CHECK(same_answers(d_ab, n_ab, ed_ab, en_ab, ma, "A to B, B to A asked by some ranks"));
+        if (!r0) CHECK(same_answers(d_ba, n_ba, ed_ba, en_ba, mb, "B to A asked by some ranks"));
+    }
     free(rd_ab), free(rd_ba), free(rn_ab), free(rn_ba);
     free(ed_ab), free(ed_ba), free(en_ab), free(en_ba);
     free(d_ab), free(d_ba), free(n_ab), free(n_ba);
