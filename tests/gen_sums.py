@@ -16,7 +16,12 @@ The search for the Neumaier case: the first seed whose Neumaier sum (the
 summation hd_summarize used before) differs from math.fsum.
 
 usage: python3 tests/gen_sums.py > tests/support/sums_cases.h
+       python3 tests/gen_sums.py --check tests/support/sums_cases.h
+(--check: exit 1 unless the file is what this script writes: the CTest
+entry sums_cases_current, so that the generator and the table cannot drift
+apart.)
 """
+import sys
 import math
 import struct
 from fractions import Fraction
@@ -135,8 +140,15 @@ def main():
         out.append('    {"%s", %d, %d, %d, %d, %d, 0x%016xULL, 0x%016xULL, 0x%016xULL},'
                    % (name, seed, n, emin, emax, mode, bits(s), bits(s2), bits(nm)))
     out.append("};")
-    print("\n".join(out))
+    text = "\n".join(out) + "\n"
+    if len(sys.argv) == 3 and sys.argv[1] == "--check":
+        with open(sys.argv[2]) as f:
+            same = f.read() == text
+        print("%s is %s" % (sys.argv[2], "current" if same else "NOT what tests/gen_sums.py writes: regenerate it"))
+        return 0 if same else 1
+    sys.stdout.write(text)
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())
