@@ -185,7 +185,7 @@ int hd_mpi_directed(MPI_Comm comm, const hd_mpi_part_t *a, size_t na,
  *   points, then part 1's, ...; dist_ba, nearest_ba likewise for B.  A
  *   direction is computed when any rank passes an output for it; a rank's
  *   NULL outputs are not written (a rank with no points of a set passes
- *   NULL or anything).  Written only when the call returns HD_OK.
+ *   NULL or anything).  Undefined when the call fails.
  * stats: NULL, or the figures of hd_mpi_stats_t: bytes_returned counts the
  *   answers sent back to the points' ranks; shell_points the points whose
  *   region faces were not clear of their local nearest distance;
@@ -200,8 +200,9 @@ int hd_mpi_directed(MPI_Comm comm, const hd_mpi_part_t *a, size_t na,
  *   sent when the ranks' index runs interleave).  Measured peak: 75 to 78
  *   bytes a point a rank holds (docs/scale-out.md).  On one rank,
  *   hd_distances on the caller's points (charged at its 60 bytes a point),
- *   with no copy when each set is one part, or its nonempty parts are
- *   given in index order.
+ *   without a copy when a set has one nonempty part (else its parts are
+ *   packed, 24 bytes a point), into the outputs themselves when the parts
+ *   are given in index order (else through a copy, 16 bytes a point).
  * Errors: as hd_mpi_hausdorff (HD_EEMPTY when a set has no point on any
  *   rank), HD_EOVERFLOW for more than 2^31 - 1 points of a set on one rank
  *   (MPI's int counts).
