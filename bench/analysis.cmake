@@ -2,3 +2,5 @@
 # distance alone (auto engine and the kd-tree baseline) and the memory pass,
 # for docs/benchmarks.md, "Analysis".  Built with the project; not a test.
 hd_add_bench(analysis_bench ${CMAKE_CURRENT_LIST_DIR}/analysis_bench.c)
+# summarize_bench: hd_summarize's exact sums per value, against a plain loop.
+hd_add_bench(summarize_bench ${CMAKE_CURRENT_LIST_DIR}/summarize_bench.c)

@@ -388,12 +388,6 @@ static double seconds_now(void) {
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-static size_t count_above(const double *d, size_t n, double hi) {
-    size_t c = 0;
-    for (size_t k = 0; k < n; k++) c += d[k] > hi;
-    return c;
-}
-
 /* The last component of a path, without the '/' that may end a directory's
  * ("tiles/" -> "tiles"), into buf. */
 static const char *last_name(const char *path, char buf[256]) {
@@ -403,6 +397,50 @@ static const char *last_name(const char *path, char buf[256]) {
     while (k > 0 && path[k - 1] != '/') k--;
     snprintf(buf, 256, "%.*s", (int)(n - k < 255 ? n - k : 255), path + k);
     return buf;
+}
+
+/* Values beyond the histogram's range: the distances are never negative
+ * nor NaN (a NaN was refused by the summary), so every value not counted
+ * lies above it. */
+static size_t beyond(const uint64_t *counts, size_t bins, size_t n) {
+    uint64_t in = 0;
+    for (size_t k = 0; k < bins; k++) in += counts[k];
+    return n - (size_t)in;
+}
+
+double analysis_scale(const analysis_args_t *an, const analysis_result_t *r) {
+    double largest = r->directed || r->sum.max_ab >= r->sum.max_ba ? r->sum.max_ab : r->sum.max_ba;
+    return an->max_distance > 0 ? an->max_distance : largest;
+}
+
+int analysis_figures(const analysis_args_t *an, const analysis_ops_t *ops, const double *d_ab, size_t n_a,
+                     const double *d_ba, size_t n_b, analysis_result_t *r, hd_error_t *err) {
+    int rc;
+    if ((rc = ops->summarize(d_ab, n_a, r->directed ? NULL : d_ba, n_b, &r->sum, err))) return rc;
+    if (an->percentile_on &&
+        (rc = ops->percentile_of(d_ab, n_a, r->directed ? NULL : d_ba, n_b, an->percentile, &r->pct, err)))
+        return rc;
+    if (!an->histogram && !an->histogram_png) return HD_OK;
+    double scale = analysis_scale(an, r);
+    r->hist_lo = 0.0;
+    r->hist_hi = scale;
+    if (!r->hist_ab) r->hist_ab = calloc(an->bins, sizeof *r->hist_ab); /* or the caller's */
+    if (!r->hist_ab) return alloc_fail(err, an->bins);
+    if ((rc = ops->histogram(d_ab, n_a, 0.0, scale, an->bins, r->hist_ab, err))) return rc;
+    r->above_ab = beyond(r->hist_ab, an->bins, r->n_a);
+    if (!r->directed) {
+        if (!r->hist_ba) r->hist_ba = calloc(an->bins, sizeof *r->hist_ba);
+        if (!r->hist_ba) return alloc_fail(err, an->bins);
+        if ((rc = ops->histogram(d_ba, n_b, 0.0, scale, an->bins, r->hist_ba, err))) return rc;
+        r->above_ba = beyond(r->hist_ba, an->bins, r->n_b);
+    }
+    return HD_OK;
+}
+
+void analysis_render_title(const char *path_a, size_t n_a, const char *path_b, char *title, size_t size) {
+    char base[256], base_b[256];
+    snprintf(title, size, "%s (%zu points) coloured by distance to %s", last_name(path_a, base), n_a,
+             last_name(path_b, base_b));
 }
 
 int analysis_run(const analysis_args_t *an, const hd_options_t *opt,
@@ -427,27 +465,9 @@ int analysis_run(const analysis_args_t *an, const hd_options_t *opt,
     int rc = hd_distances(A, B, opt, r->d_ab, r->j_ab, r->d_ba, r->j_ba, err);
     r->seconds = seconds_now() - t0;
     if (rc) return rc;
-    size_t n_ba = directed ? 0 : B->count;
-    if ((rc = hd_summarize(r->d_ab, A->count, r->d_ba, n_ba, &r->sum, err))) return rc;
-    if (an->percentile_on &&
-        (rc = hd_percentile_of(r->d_ab, A->count, r->d_ba, n_ba, an->percentile, &r->pct, err)))
-        return rc;
-    double largest = directed || r->sum.max_ab >= r->sum.max_ba ? r->sum.max_ab : r->sum.max_ba;
-    double scale = an->max_distance > 0 ? an->max_distance : largest;
-    if (an->histogram || an->histogram_png) {
-        r->hist_lo = 0.0;
-        r->hist_hi = scale;
-        r->hist_ab = calloc(an->bins, sizeof *r->hist_ab);
-        if (!r->hist_ab) return alloc_fail(err, an->bins);
-        if ((rc = hd_histogram(r->d_ab, A->count, 0.0, scale, an->bins, r->hist_ab, err))) return rc;
-        r->above_ab = count_above(r->d_ab, A->count, hd_histogram_edge(0.0, scale, an->bins, an->bins));
-        if (!directed) {
-            r->hist_ba = calloc(an->bins, sizeof *r->hist_ba);
-            if (!r->hist_ba) return alloc_fail(err, an->bins);
-            if ((rc = hd_histogram(r->d_ba, B->count, 0.0, scale, an->bins, r->hist_ba, err))) return rc;
-            r->above_ba = count_above(r->d_ba, B->count, hd_histogram_edge(0.0, scale, an->bins, an->bins));
-        }
-    }
+    static const analysis_ops_t here = {hd_summarize, hd_percentile_of, hd_histogram};
+    if ((rc = analysis_figures(an, &here, r->d_ab, A->count, r->d_ba, directed ? 0 : B->count, r, err))) return rc;
+    double scale = analysis_scale(an, r);
     if (an->distances_out) {
         snprintf(r->dist_path_a, sizeof r->dist_path_a, "%s", an->distances_out);
         if ((rc = write_distances(r->dist_path_a, A, r->d_ab, r->j_ab, scale, err))) return rc;
@@ -458,9 +478,7 @@ int analysis_run(const analysis_args_t *an, const hd_options_t *opt,
     }
     if (an->render_out) {
         char title[640];
-        char base[256], base_b[256];
-        snprintf(title, sizeof title, "%s (%zu points) coloured by distance to %s", last_name(path_a, base),
-                 A->count, last_name(path_b, base_b));
+        analysis_render_title(path_a, A->count, path_b, title, sizeof title);
         render_notes_t notes = {analysis_units(an), an->percentile_on, r->pct};
         if ((rc = render_distances(an->render_out, A, B, r->d_ab, scale, s, directed, &notes, title, r->markers,
                                    &r->n_markers, &r->render, &r->render_w, &r->render_h, err)))

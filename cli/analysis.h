@@ -144,6 +144,30 @@ int analysis_run(const analysis_args_t *an, const hd_options_t *opt,
                  const hd_points_t *A, const hd_points_t *B,
                  const hd_symmetric_t *s, int directed, const char *path_a,
                  const char *path_b, analysis_result_t *r, hd_error_t *err);
+/* The figures of the per-point distances d_ab (n_a values) and d_ba (n_b;
+ * ignored when r->directed) into r->sum, r->pct (--percentile) and the
+ * histograms (--histogram, --histogram-png; r->n_a and r->n_b, the
+ * distances of all of A and B, give the values above the range), by ops:
+ * the library's functions here, hausdorff-mpi's over the ranks (each rank
+ * passing its own distances).  r->directed is set by the caller; r's
+ * histograms may be allocated by it (`bins` counts each), else they are
+ * allocated here. */
+typedef struct analysis_ops {
+    int (*summarize)(const double *d_ab, size_t n_a, const double *d_ba, size_t n_b, hd_summary_t *out,
+                     hd_error_t *err);
+    int (*percentile_of)(const double *d_ab, size_t n_a, const double *d_ba, size_t n_b, double p,
+                         hd_percentile_t *out, hd_error_t *err);
+    int (*histogram)(const double *values, size_t n, double lo, double hi, size_t bins, uint64_t *counts,
+                     hd_error_t *err);
+} analysis_ops_t;
+int analysis_figures(const analysis_args_t *an, const analysis_ops_t *ops, const double *d_ab, size_t n_a,
+                     const double *d_ba, size_t n_b, analysis_result_t *r, hd_error_t *err);
+/* The picture's title line: "A's name (N points) coloured by distance to
+ * B's name". */
+void analysis_render_title(const char *path_a, size_t n_a, const char *path_b, char *title, size_t size);
+/* The colour and histogram scale: --max-distance, else the largest
+ * distance (r->sum). */
+double analysis_scale(const analysis_args_t *an, const analysis_result_t *r);
 /* The JSON members (each preceded by ", ") and the lines for a person. */
 void analysis_json(FILE *out, const analysis_args_t *an,
                    const analysis_result_t *r);
@@ -201,6 +225,55 @@ int render_distances(const char *path, const hd_points_t *A,
                      render_marker_t markers[6], int *n_markers,
                      render_info_t *info, int *width, int *height,
                      hd_error_t *err);
+/* render_distances in two halves, for hausdorff-mpi, whose ranks each
+ * hold some of the points: render_splat draws points into per-pixel
+ * layers (3 views of RENDER_PANEL x RENDER_PANEL), which merge pixel by
+ * pixel in any order (render_near_merge, render_far_merge, and the OR of
+ * b), and render_compose draws the picture from the merged layers.  The
+ * scene is what every rank must agree on first: the bounds of all of A and
+ * B, A's count (the splat size), the colour scale and whether a distance
+ * lies beyond it. */
+enum { RENDER_PANEL = 460 };
+typedef struct render_scene {
+    double lo[3], hi[3];
+    size_t n_a;
+    double dmax;
+    int clipped;
+} render_scene_t;
+/* A pixel's nearest splat of A (the largest float depth, then the smallest
+ * index; none: k = UINT64_MAX, depth -inf) and its colour (0xRRGGBB). */
+typedef struct render_px {
+    uint64_t k;
+    float depth;
+    uint32_t rgb;
+} render_px_t;
+/* The splat drawn over the surface there: of the points at a quarter of
+ * the scale or more, the smallest (distance, index) (none: k = UINT64_MAX). */
+typedef struct render_far {
+    double d;
+    uint64_t k;
+    uint32_t rgb, pad;
+} render_far_t;
+typedef struct render_layers {
+    size_t n;                  /* 3 * RENDER_PANEL^2 pixels */
+    render_px_t *near;
+    render_far_t *far;
+    unsigned char *b;          /* 1 where a point of B is */
+} render_layers_t;
+void render_scene_bounds(render_scene_t *sc, const hd_points_t *A, const hd_points_t *B);
+int render_layers_init(render_layers_t *L); /* -1: out of memory */
+void render_layers_free(render_layers_t *L);
+void render_near_merge(render_px_t *dst, const render_px_t *src, size_t n);
+void render_far_merge(render_far_t *dst, const render_far_t *src, size_t n);
+/* A's points (their indices first, first + 1, ...) with their distances,
+ * and B's, into L. */
+void render_splat(const render_scene_t *sc, const hd_points_t *A, size_t first, const double *d_a,
+                  const hd_points_t *B, render_layers_t *L);
+/* The picture from the layers; wp and wq are the witness pair's points. */
+int render_compose(const char *path, const render_scene_t *sc, const render_layers_t *L, const double wp[3],
+                   const double wq[3], const hd_symmetric_t *s, int directed, const render_notes_t *notes,
+                   const char *title, render_marker_t markers[6], int *n_markers, render_info_t *info, int *width,
+                   int *height, hd_error_t *err);
 /* A bar chart of the histogram(s) with the percentile and mean marked;
  * where those lines were drawn goes into marks (at most 4). */
 int render_histogram(const char *path, const analysis_result_t *r,

@@ -176,7 +176,7 @@ static void fmt_num(char *buf, size_t size, double v) { snprintf(buf, size, "%.4
 
 /* ---- the three views ------------------------------------------------------------- */
 
-enum { PANEL = 460, GAP = 24, TOP = 92, BOTTOM = 44, BAR_W = 26, BAR_LABELS = 110 };
+enum { PANEL = RENDER_PANEL, GAP = 24, TOP = 92, BOTTOM = 44, BAR_W = 26, BAR_LABELS = 110 };
 
 /* Screen axes and depth of each view: u right, v up, depth towards the eye. */
 static void project(int view, const double p[3], double *u, double *v, double *depth) {
@@ -202,30 +202,6 @@ static void to_pixel(const view_t *vw, int view, const double p[3], int *x, int 
     if (depth) *depth = d;
 }
 
-static void splat(canvas_t *c, float *zbuf, const view_t *vw, int x, int y, int r, double depth,
-                  const unsigned char col[3]) {
-    for (int dy = -r; dy <= r; dy++)
-        for (int dx = -r; dx <= r; dx++) {
-            int px = x + dx, py = y + dy;
-            if (px < vw->x0 || py < vw->y0 || px >= vw->x0 + PANEL || py >= vw->y0 + PANEL) continue;
-            float *z = &zbuf[(size_t)(py - vw->y0) * PANEL + (size_t)(px - vw->x0)];
-            if ((float)depth <= *z) continue;
-            *z = (float)depth;
-            put(c, px, py, col);
-        }
-}
-
-typedef struct {
-    double d;
-    size_t k;
-} far_t;
-
-static int cmp_far(const void *x, const void *y) {
-    const far_t *a = x, *b = y;
-    if (a->d != b->d) return a->d < b->d ? -1 : 1;
-    return (a->k > b->k) - (a->k < b->k);
-}
-
 static void bounds(const hd_points_t *P, double lo[3], double hi[3]) {
     for (size_t k = 0; k < P->count; k++) {
         double q[3];
@@ -237,103 +213,172 @@ static void bounds(const hd_points_t *P, double lo[3], double hi[3]) {
     }
 }
 
-int render_distances(const char *path, const hd_points_t *A,
-                     const hd_points_t *B, const double *d_a, double dmax,
-                     const hd_symmetric_t *s, int directed,
-                     const render_notes_t *notes, const char *title,
-                     render_marker_t markers[6], int *n_markers,
-                     render_info_t *info, int *width, int *height,
-                     hd_error_t *err) {
+void render_scene_bounds(render_scene_t *sc, const hd_points_t *A, const hd_points_t *B) {
+    for (int a = 0; a < 3; a++) sc->lo[a] = INFINITY, sc->hi[a] = -INFINITY;
+    bounds(A, sc->lo, sc->hi);
+    bounds(B, sc->lo, sc->hi);
+}
+
+/* ---- the layers: what the points leave in each pixel ------------------------------ */
+
+int render_layers_init(render_layers_t *L) {
+    L->n = 3 * (size_t)PANEL * PANEL;
+    L->near = malloc(L->n * sizeof *L->near);
+    L->far = malloc(L->n * sizeof *L->far);
+    L->b = calloc(L->n, 1);
+    if (!L->near || !L->far || !L->b) {
+        render_layers_free(L);
+        return -1;
+    }
+    for (size_t k = 0; k < L->n; k++) {
+        L->near[k] = (render_px_t){UINT64_MAX, -INFINITY, 0};
+        L->far[k] = (render_far_t){INFINITY, UINT64_MAX, 0, 0};
+    }
+    return 0;
+}
+
+void render_layers_free(render_layers_t *L) {
+    free(L->near);
+    free(L->far);
+    free(L->b);
+    L->near = NULL, L->far = NULL, L->b = NULL;
+}
+
+/* The nearest splat: the larger depth, then the smaller index (the first
+ * drawn of equal depths, points being drawn in index order). */
+static int near_better(const render_px_t *x, const render_px_t *y) {
+    return x->depth > y->depth || (x->depth == y->depth && x->k < y->k);
+}
+
+/* The far splat drawn over the surface: the first in order of (distance,
+ * index); later ones fail the depth test against its infinite depth. */
+static int far_better(const render_far_t *x, const render_far_t *y) {
+    return x->d < y->d || (x->d == y->d && x->k < y->k);
+}
+
+void render_near_merge(render_px_t *dst, const render_px_t *src, size_t n) {
+    for (size_t k = 0; k < n; k++)
+        if (near_better(&src[k], &dst[k])) dst[k] = src[k];
+}
+
+void render_far_merge(render_far_t *dst, const render_far_t *src, size_t n) {
+    for (size_t k = 0; k < n; k++)
+        if (far_better(&src[k], &dst[k])) dst[k] = src[k];
+}
+
+/* Where the views are, on the scene's bounds. */
+typedef struct {
+    view_t vw[3];
+    double zlo[3], zhi[3]; /* depth range of each view, for shading */
+    int r;                 /* splat radius */
+} geometry_t;
+
+static void geometry(const render_scene_t *sc, geometry_t *g) {
+    double extent = 0, centre[3];
+    for (int a = 0; a < 3; a++) {
+        if (sc->hi[a] - sc->lo[a] > extent) extent = sc->hi[a] - sc->lo[a];
+        centre[a] = sc->lo[a] + (sc->hi[a] - sc->lo[a]) / 2;
+    }
+    if (!(extent > 0)) extent = 1;
+    double s = (PANEL - 40) / extent, u, v, dd;
+    for (int view = 0; view < 3; view++) {
+        project(view, sc->lo, &u, &v, &g->zlo[view]);
+        project(view, sc->hi, &u, &v, &g->zhi[view]);
+        project(view, centre, &u, &v, &dd);
+        g->vw[view] = (view_t){u, v, s, GAP + view * (PANEL + GAP), TOP};
+    }
+    g->r = (int)lround(0.35 * PANEL / sqrt((double)(sc->n_a + 1)));
+    if (g->r < 1) g->r = 1;
+    if (g->r > 4) g->r = 4;
+}
+
+void render_splat(const render_scene_t *sc, const hd_points_t *A, size_t first, const double *d_a,
+                  const hd_points_t *B, render_layers_t *L) {
+    geometry_t g;
+    geometry(sc, &g);
+    double dmax = sc->dmax;
+    for (int view = 0; view < 3; view++) {
+        const view_t *vw = &g.vw[view];
+        size_t base = (size_t)view * PANEL * PANEL;
+        for (size_t k = 0; k < A->count; k++) {
+            double q[3], depth;
+            int x, y;
+            hd_points_get(A, k, q);
+            to_pixel(vw, view, q, &x, &y, &depth);
+            unsigned char col[3];
+            colormap_viridis(dmax > 0 ? d_a[k] / dmax : 0.0, col);
+            double span = g.zhi[view] - g.zlo[view], shade = span > 0 ? 0.72 + 0.28 * (depth - g.zlo[view]) / span : 1.0;
+            if (shade < 0.72) shade = 0.72; /* the side view's depth runs the other way */
+            if (shade > 1.0) shade = 1.0;
+            for (int ch = 0; ch < 3; ch++) col[ch] = (unsigned char)(col[ch] * shade + 0.5);
+            uint32_t rgb = (uint32_t)col[0] << 16 | (uint32_t)col[1] << 8 | col[2];
+            render_px_t me = {first + k, (float)depth, rgb};
+            render_far_t fm = {d_a[k], first + k, rgb, 0};
+            int is_far = dmax > 0 && d_a[k] >= 0.25 * dmax;
+            for (int dy = -g.r; dy <= g.r; dy++)
+                for (int dx = -g.r; dx <= g.r; dx++) {
+                    int px = x + dx, py = y + dy;
+                    if (px < vw->x0 || py < vw->y0 || px >= vw->x0 + PANEL || py >= vw->y0 + PANEL) continue;
+                    size_t at = base + (size_t)(py - vw->y0) * PANEL + (size_t)(px - vw->x0);
+                    if (near_better(&me, &L->near[at])) L->near[at] = me;
+                    if (is_far && far_better(&fm, &L->far[at])) L->far[at] = fm;
+                }
+        }
+        for (size_t k = 0; k < B->count; k++) {
+            double q[3];
+            int x, y;
+            hd_points_get(B, k, q);
+            to_pixel(vw, view, q, &x, &y, NULL);
+            for (int dy = -g.r; dy <= g.r; dy++)
+                for (int dx = -g.r; dx <= g.r; dx++) {
+                    int px = x + dx, py = y + dy;
+                    if (px < vw->x0 || py < vw->y0 || px >= vw->x0 + PANEL || py >= vw->y0 + PANEL) continue;
+                    L->b[base + (size_t)(py - vw->y0) * PANEL + (size_t)(px - vw->x0)] = 1;
+                }
+        }
+    }
+}
+
+static void unpack(uint32_t rgb, unsigned char col[3]) {
+    col[0] = (unsigned char)(rgb >> 16), col[1] = (unsigned char)(rgb >> 8), col[2] = (unsigned char)rgb;
+}
+
+int render_compose(const char *path, const render_scene_t *sc, const render_layers_t *L, const double wp[3],
+                   const double wq[3], const hd_symmetric_t *s, int directed, const render_notes_t *notes,
+                   const char *title, render_marker_t markers[6], int *n_markers, render_info_t *info, int *width,
+                   int *height, hd_error_t *err) {
     memset(info, 0, sizeof *info);
     info->pct_y = -1;
     canvas_t c = {0, 0, NULL};
     int W = GAP + 3 * (PANEL + GAP) + BAR_W + BAR_LABELS, H = TOP + PANEL + BOTTOM;
-    /* points at a quarter of the scale or more: drawn over the surface */
-    size_t n_far = 0;
-    int clipped = 0; /* some distance beyond the scale (--max-distance) */
-    for (size_t k = 0; k < A->count; k++) {
-        n_far += dmax > 0 && d_a[k] >= 0.25 * dmax;
-        clipped |= d_a[k] > dmax;
-    }
-    float *zbuf = malloc((size_t)PANEL * PANEL * sizeof *zbuf);
-    unsigned char *covered = malloc((size_t)PANEL * PANEL);
-    far_t *far = malloc((n_far ? n_far : 1) * sizeof *far);
-    if (!zbuf || !covered || !far || canvas_init(&c, W, H)) {
-        free(zbuf), free(covered), free(far), free(c.rgb);
-        return no_memory(err);
-    }
-    n_far = 0;
-    for (size_t k = 0; k < A->count; k++)
-        if (dmax > 0 && d_a[k] >= 0.25 * dmax) far[n_far].d = d_a[k], far[n_far++].k = k;
-    qsort(far, n_far, sizeof *far, cmp_far);
-    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    bounds(A, lo, hi);
-    bounds(B, lo, hi);
-    double extent = 0, centre[3];
-    for (int a = 0; a < 3; a++) {
-        if (hi[a] - lo[a] > extent) extent = hi[a] - lo[a];
-        centre[a] = lo[a] + (hi[a] - lo[a]) / 2;
-    }
-    if (!(extent > 0)) extent = 1;
-    double sc = (PANEL - 40) / extent;
-    double zlo[3], zhi[3]; /* depth range of each view, for shading */
-    {
-        double u, v;
-        project(0, lo, &u, &v, &zlo[0]), project(0, hi, &u, &v, &zhi[0]);
-        project(1, lo, &u, &v, &zlo[1]), project(1, hi, &u, &v, &zhi[1]);
-        project(2, lo, &u, &v, &zlo[2]), project(2, hi, &u, &v, &zhi[2]);
-    }
-    int r = (int)lround(0.35 * PANEL / sqrt((double)(A->count + 1)));
-    if (r < 1) r = 1;
-    if (r > 4) r = 4;
-
+    if (canvas_init(&c, W, H)) return no_memory(err);
+    double dmax = sc->dmax;
+    int clipped = sc->clipped; /* some distance beyond the scale (--max-distance) */
+    geometry_t g;
+    geometry(sc, &g);
     /* the witness pair: the point realising H and its nearest point */
     int from_a = directed || s->ab.distance2 >= s->ba.distance2;
     const hd_result_t *w = from_a ? &s->ab : &s->ba;
-    double wp[3], wq[3];
-    hd_points_get(from_a ? A : B, w->i, wp);
-    hd_points_get(from_a ? B : A, w->j, wq);
 
     static const char *const names[3] = {"front (from +z): x right, y up", "side (from +x): -z right, y up",
                                          "top (from +y): x right, -z up"};
     *n_markers = 0;
     for (int view = 0; view < 3; view++) {
-        view_t vw;
-        double u, v, dd;
-        project(view, centre, &u, &v, &dd);
-        vw.u0 = u, vw.v0 = v, vw.s = sc;
-        vw.x0 = GAP + view * (PANEL + GAP);
-        vw.y0 = TOP;
-        for (size_t k = 0; k < (size_t)PANEL * PANEL; k++) zbuf[k] = -INFINITY;
-        for (size_t m = 0; m < A->count + n_far; m++) {
-            /* first every point with the depth test, then the far ones
-             * again, over everything, nearest-to-farthest in distance */
-            size_t k = m < A->count ? m : far[m - A->count].k;
-            double q[3], depth;
-            int x, y;
-            hd_points_get(A, k, q);
-            to_pixel(&vw, view, q, &x, &y, &depth);
-            unsigned char col[3];
-            colormap_viridis(dmax > 0 ? d_a[k] / dmax : 0.0, col);
-            double span = zhi[view] - zlo[view], shade = span > 0 ? 0.72 + 0.28 * (depth - zlo[view]) / span : 1.0;
-            if (shade < 0.72) shade = 0.72; /* the side view's depth runs the other way */
-            if (shade > 1.0) shade = 1.0;
-            for (int ch = 0; ch < 3; ch++) col[ch] = (unsigned char)(col[ch] * shade + 0.5);
-            splat(&c, zbuf, &vw, x, y, r, m < A->count ? depth : INFINITY, col);
-        }
-        for (size_t k = 0; k < (size_t)PANEL * PANEL; k++) covered[k] = zbuf[k] != -INFINITY;
-        for (size_t k = 0; k < B->count; k++) {
-            double q[3];
-            int x, y;
-            hd_points_get(B, k, q);
-            to_pixel(&vw, view, q, &x, &y, NULL);
-            for (int dy = -r; dy <= r; dy++)
-                for (int dx = -r; dx <= r; dx++) {
-                    int px = x + dx, py = y + dy;
-                    if (px < vw.x0 || py < vw.y0 || px >= vw.x0 + PANEL || py >= vw.y0 + PANEL) continue;
-                    if (!covered[(size_t)(py - vw.y0) * PANEL + (size_t)(px - vw.x0)]) put(&c, px, py, GREY);
-                }
-        }
+        const view_t vw = g.vw[view];
+        size_t base = (size_t)view * PANEL * PANEL;
+        /* every point with the depth test, then the far ones over the
+         * surface (unless it lies at an infinite depth itself), then B in
+         * grey where no point of A is */
+        for (int py = vw.y0; py < vw.y0 + PANEL; py++)
+            for (int px = vw.x0; px < vw.x0 + PANEL; px++) {
+                size_t at = base + (size_t)(py - vw.y0) * PANEL + (size_t)(px - vw.x0);
+                const render_px_t *n = &L->near[at];
+                const render_far_t *f = &L->far[at];
+                unsigned char col[3];
+                if (f->k != UINT64_MAX && n->depth != INFINITY) unpack(f->rgb, col), put(&c, px, py, col);
+                else if (n->depth != -INFINITY) unpack(n->rgb, col), put(&c, px, py, col);
+                else if (f->k == UINT64_MAX && L->b[at]) put(&c, px, py, GREY);
+            }
         frame_rect(&c, vw.x0 - 1, vw.y0 - 1, vw.x0 + PANEL + 1, vw.y0 + PANEL + 1, FRAME);
         text(&c, vw.x0, vw.y0 + PANEL + 10, 2, names[view], DARK);
 
@@ -433,9 +478,38 @@ int render_distances(const char *path, const hd_points_t *A,
     *width = W;
     *height = H;
     free(c.rgb);
-    free(zbuf);
-    free(covered);
-    free(far);
+    return rc;
+}
+
+int render_distances(const char *path, const hd_points_t *A,
+                     const hd_points_t *B, const double *d_a, double dmax,
+                     const hd_symmetric_t *s, int directed,
+                     const render_notes_t *notes, const char *title,
+                     render_marker_t markers[6], int *n_markers,
+                     render_info_t *info, int *width, int *height,
+                     hd_error_t *err) {
+    render_scene_t sc;
+    render_scene_bounds(&sc, A, B);
+    sc.n_a = A->count;
+    sc.dmax = dmax;
+    sc.clipped = 0;
+    for (size_t k = 0; k < A->count; k++) sc.clipped |= d_a[k] > dmax;
+    render_layers_t L;
+    if (render_layers_init(&L)) {
+        memset(info, 0, sizeof *info);
+        info->pct_y = -1;
+        *n_markers = 0;
+        return no_memory(err);
+    }
+    render_splat(&sc, A, 0, d_a, B, &L);
+    int from_a = directed || s->ab.distance2 >= s->ba.distance2;
+    const hd_result_t *w = from_a ? &s->ab : &s->ba;
+    double wp[3], wq[3];
+    hd_points_get(from_a ? A : B, w->i, wp);
+    hd_points_get(from_a ? B : A, w->j, wq);
+    int rc = render_compose(path, &sc, &L, wp, wq, s, directed, notes, title, markers, n_markers, info, width,
+                            height, err);
+    render_layers_free(&L);
     return rc;
 }
 
@@ -588,6 +662,35 @@ int render_histogram(const char *path, const analysis_result_t *r,
                      hist_marker_t marks[4], int *n_marks, hd_error_t *err) {
     (void)path, (void)r, (void)an, (void)bins, (void)marks;
     *n_marks = 0;
+    return unavailable(err);
+}
+
+/* The halves of render_distances: never called without libpng (the
+ * options are refused first); here so that the tools link. */
+void render_scene_bounds(render_scene_t *sc, const hd_points_t *A, const hd_points_t *B) {
+    (void)A, (void)B;
+    memset(sc, 0, sizeof *sc);
+}
+int render_layers_init(render_layers_t *L) {
+    memset(L, 0, sizeof *L);
+    return -1;
+}
+void render_layers_free(render_layers_t *L) { (void)L; }
+void render_near_merge(render_px_t *dst, const render_px_t *src, size_t n) { (void)dst, (void)src, (void)n; }
+void render_far_merge(render_far_t *dst, const render_far_t *src, size_t n) { (void)dst, (void)src, (void)n; }
+void render_splat(const render_scene_t *sc, const hd_points_t *A, size_t first, const double *d_a,
+                  const hd_points_t *B, render_layers_t *L) {
+    (void)sc, (void)A, (void)first, (void)d_a, (void)B, (void)L;
+}
+int render_compose(const char *path, const render_scene_t *sc, const render_layers_t *L, const double wp[3],
+                   const double wq[3], const hd_symmetric_t *s, int directed, const render_notes_t *notes,
+                   const char *title, render_marker_t markers[6], int *n_markers, render_info_t *info, int *width,
+                   int *height, hd_error_t *err) {
+    (void)path, (void)sc, (void)L, (void)wp, (void)wq, (void)s, (void)directed, (void)notes, (void)title;
+    (void)markers, (void)width, (void)height;
+    memset(info, 0, sizeof *info);
+    info->pct_y = -1;
+    *n_markers = 0;
     return unavailable(err);
 }
 

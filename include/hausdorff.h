@@ -423,8 +423,11 @@ HD_EXTERN int hd_hausdorff_percentile(const hd_points_t *A,
                                       hd_percentile_t *out, hd_error_t *err);
 
 /* Sums, means and Chamfer distances of per-point distances.  Sums are
- * compensated (Neumaier), in index order: within about one rounding of the
- * exact sum, the same at any thread count.  "2" means squared distances
+ * correctly rounded: the exact sum of the doubles rounded once to nearest
+ * even (Python's math.fsum), so they do not depend on the order of the
+ * values (the same at any thread count, and from hausdorff_mpi.h's
+ * hd_mpi_summarize for any split over ranks).  Means and Chamfer figures
+ * are computed from the rounded sums.  "2" means squared distances
  * (d * d of each reported distance).  With d_ba NULL every field that needs
  * B's distances is NaN. */
 typedef struct hd_summary {

@@ -223,6 +223,51 @@ int hd_mpi_overlap(MPI_Comm comm, const hd_mpi_part_t *a, size_t na,
                    const hd_mpi_part_t *b, size_t nb, double *alpha,
                    int *disjoint, hd_error_t *err);
 
+/* ---- figures of per-point distances spread over the ranks ----------------
+ * Each rank passes its part of the per-point distances (hd_mpi_distances'
+ * output, or any split: a rank may pass none), and every rank receives the
+ * single-process function's result on the concatenation of every rank's
+ * values in rank order, to the bit, without any value moving between
+ * ranks.  Collective over comm; every rank returns the same code, the same
+ * result and the same message (the first failing rank's).  The checks are
+ * made in the single-process function's order, so the code is the one it
+ * would return; a NaN's message names its global index. */
+
+/* hd_summarize on the concatenation: d_ab holds this rank's n_a distances
+ * of A's points to B (NULL allowed when n_a = 0), d_ba its n_b of B's to A.
+ * B's distances are absent (their fields NaN, as hd_summarize with d_ba
+ * NULL) when every rank passes d_ba = NULL; otherwise a rank's NULL d_ba is
+ * none of them.  The sums are exact and rounded once (hausdorff.h), hence
+ * the same for any split: each rank's exact accumulators are added over
+ * the ranks (one MPI_Allreduce of 4 x 74 int64) and rounded once.
+ * Errors: as hd_summarize (HD_EINVAL, HD_EEMPTY when a set's distances
+ * are empty over all ranks, HD_ENONFINITE), HD_ENOMEM, HD_EIO. */
+int hd_mpi_summarize(MPI_Comm comm, const double *d_ab, size_t n_a,
+                     const double *d_ba, size_t n_b, hd_summary_t *out,
+                     hd_error_t *err);
+
+/* hd_percentile_of on the concatenation (numpy's linear percentile p of
+ * A->B, B->A, their maximum, and both pooled), with d_ab, n_a, d_ba, n_b as
+ * hd_mpi_summarize.  The ranks' values needed are found by an exact
+ * distributed radix selection over the doubles' bits: eight rounds of an
+ * MPI_Allreduce of 256 counts for each of the (up to) three figures, and
+ * eight passes over the local values; one more of three minima.  The one difference from hd_percentile_of: when the result is a
+ * zero, it is +0.0 (the single-process selection may return -0.0 when the
+ * values hold both zeros; distances never do).
+ * Errors: as hd_percentile_of (HD_EINVAL for p outside [0, 100] too),
+ * HD_ENOMEM, HD_EIO. */
+int hd_mpi_percentile_of(MPI_Comm comm, const double *d_ab, size_t n_a,
+                         const double *d_ba, size_t n_b, double p,
+                         hd_percentile_t *out, hd_error_t *err);
+
+/* hd_histogram's counts of this rank's n values, summed over the ranks
+ * into counts (`bins` elements on every rank); lo, hi and bins must be the
+ * same on every rank.  Errors: as hd_histogram, HD_EOVERFLOW for more
+ * than INT_MAX bins, HD_EIO. */
+int hd_mpi_histogram(MPI_Comm comm, const double *values, size_t n,
+                     double lo, double hi, size_t bins, uint64_t *counts,
+                     hd_error_t *err);
+
 #ifdef __cplusplus
 }
 #endif

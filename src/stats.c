@@ -36,11 +36,13 @@
  *    defines HD95; "pooled" is the percentile of both directions' distances
  *    together, as medpy's hd95 defines it.  P = 100 gives h(A,B), h(B,A) and
  *    H(A,B) exactly (the maximum is a rank like any other).
- *  - Sums use Neumaier's compensated summation in index order, so the
- *    result is within about one rounding of the exact sum of the doubles and
- *    does not depend on the thread count.  Squared terms are d * d of the
- *    reported distance d = sqrt(d2), which may differ from the evaluated d2
- *    in the last bit; the sum's rounding is of the same size.
+ *  - Sums are exact, rounded once to nearest even (base/xsum.c): the
+ *    correctly rounded sum of the doubles, as Python's math.fsum gives it,
+ *    whatever their order, so the MPI library's distributed summary
+ *    (src/mpi/figures.c) is the same to the bit.  Squared terms are d * d
+ *    of the reported distance d = sqrt(d2), which may differ from the
+ *    evaluated d2 in the last bit.  The derived figures (means, Chamfer
+ *    distances) are computed from the rounded sums by hd__summary_derive.
  *  - Histograms reproduce numpy.histogram(values, bins, range=(lo, hi)) to
  *    the count: the same edges (numpy.linspace: k * step + lo, the last edge
  *    hi itself) and the same rule for values on an edge (each bin is
@@ -170,9 +172,7 @@ static int check_values(const double *d, size_t n, const char *what,
                         hd_error_t *err) {
     if (!d) return hd__err(err, HD_EINVAL, "distances %s are NULL", what);
     if (n == 0) return hd__err(err, HD_EEMPTY, "distances %s are empty", what);
-    for (size_t i = 0; i < n; i++)
-        if (isnan(d[i])) return hd__err(err, HD_ENONFINITE, "distance %zu of %s is NaN", i, what);
-    return HD_OK;
+    return hd__nan_check(d, n, 0, what, err);
 }
 
 int hd_percentile_of(const double *d_ab, size_t n_a, const double *d_ba,
@@ -226,57 +226,24 @@ int hd_hausdorff_percentile(const hd_points_t *A, const hd_points_t *B,
 
 /* ---- means and Chamfer distances ------------------------------------------ */
 
-/* Neumaier's compensated sum of d[k] (squares: d[k] * d[k]) in index order. */
-static double neumaier(const double *d, size_t n, int square) {
-    double s = 0.0, c = 0.0;
-    for (size_t k = 0; k < n; k++) {
-        double x = square ? d[k] * d[k] : d[k];
-        double t = s + x;
-        if (fabs(s) >= fabs(x)) c += (s - t) + x;
-        else c += (x - t) + s;
-        s = t;
-    }
-    return s + c;
-}
-
-static double max_of(const double *d, size_t n) {
-    double m = d[0];
-    for (size_t k = 1; k < n; k++)
-        if (d[k] > m) m = d[k];
-    return m;
-}
-
 int hd_summarize(const double *d_ab, size_t n_a, const double *d_ba,
                  size_t n_b, hd_summary_t *out, hd_error_t *err) {
     hd__err_clear(err);
     if (!out) return hd__err(err, HD_EINVAL, "result pointer is NULL");
-    int rc;
-    if ((rc = check_values(d_ab, n_a, "A to B", err))) return rc;
+    /* check_values' checks in its order, the NaN check only when the sum
+     * counted a NaN (one pass over the values instead of two) */
+    if (!d_ab) return hd__err(err, HD_EINVAL, "distances A to B are NULL");
+    if (n_a == 0) return hd__err(err, HD_EEMPTY, "distances A to B are empty");
+    hd__xsum_t s[4];
+    for (int k = 0; k < 4; k++) hd__xsum_init(&s[k]);
+    double max_ab = hd__xsum_values(&s[0], &s[1], d_ab, n_a, -INFINITY), max_ba = NAN;
+    if (s[0].nan) return hd__nan_check(d_ab, n_a, 0, "A to B", err);
     if (!d_ba) n_b = 0;
-    if (d_ba && (rc = check_values(d_ba, n_b, "B to A", err))) return rc;
-    out->n_ab = n_a;
-    out->n_ba = n_b;
-    out->max_ab = max_of(d_ab, n_a);
-    out->sum_ab = neumaier(d_ab, n_a, 0);
-    out->sum2_ab = neumaier(d_ab, n_a, 1);
-    out->mean_ab = out->sum_ab / (double)n_a;
-    out->mean2_ab = out->sum2_ab / (double)n_a;
-    out->max_ba = out->sum_ba = out->sum2_ba = out->mean_ba = out->mean2_ba = NAN;
-    out->mean_symmetric = out->mean_average = out->mean_pooled = NAN;
-    out->chamfer = out->chamfer_sum2 = out->chamfer_mean = out->chamfer_sum = NAN;
-    if (n_b == 0) return HD_OK;
-    out->max_ba = max_of(d_ba, n_b);
-    out->sum_ba = neumaier(d_ba, n_b, 0);
-    out->sum2_ba = neumaier(d_ba, n_b, 1);
-    out->mean_ba = out->sum_ba / (double)n_b;
-    out->mean2_ba = out->sum2_ba / (double)n_b;
-    out->mean_symmetric = out->mean_ab >= out->mean_ba ? out->mean_ab : out->mean_ba;
-    out->mean_average = (out->mean_ab + out->mean_ba) / 2.0;
-    out->mean_pooled = (out->sum_ab + out->sum_ba) / ((double)n_a + (double)n_b);
-    out->chamfer = out->mean2_ab + out->mean2_ba;
-    out->chamfer_sum2 = out->sum2_ab + out->sum2_ba;
-    out->chamfer_mean = out->mean_ab + out->mean_ba;
-    out->chamfer_sum = out->sum_ab + out->sum_ba;
+    if (d_ba && n_b == 0) return hd__err(err, HD_EEMPTY, "distances B to A are empty");
+    if (n_b) max_ba = hd__xsum_values(&s[2], &s[3], d_ba, n_b, -INFINITY);
+    if (s[2].nan) return hd__nan_check(d_ba, n_b, 0, "B to A", err);
+    hd__summary_derive(out, n_a, max_ab, hd__xsum_round(&s[0]), hd__xsum_round(&s[1]), n_b, max_ba,
+                       n_b ? hd__xsum_round(&s[2]) : NAN, n_b ? hd__xsum_round(&s[3]) : NAN);
     return HD_OK;
 }
 

@@ -4,9 +4,14 @@
 #    hd_hausdorff, and hd_mpi_distances hd_distances, bit for bit on the
 #    adversarial sets and layouts, and a failure on one rank is agreed by all.  K = 1, 2, 3, 4, 7 here; the
 #    sanitizer build runs K = 3 only.
+#  - mpi_figures_K: tests/api/mpi_figures.c under `mpirun -n K`:
+#    hd_mpi_summarize, hd_mpi_percentile_of and hd_mpi_histogram equal the
+#    single-process functions bit for bit however the values are spread,
+#    and failures are agreed.  The same K as mpi_api.
 #  - mpi_cli_3: tests/mpi_cli.py, hausdorff-mpi on 3 ranks against
 #    hausdorff (JSON and text, tiles, scales, a bad tile on one rank, the
-#    --distances files byte for byte and their failures).
+#    --distances files byte for byte and their failures, the figures and
+#    the pictures).
 # Ranks are oversubscribed on purpose (2 cores, up to 7 ranks) and CI runs
 # as root: hence --oversubscribe and --allow-run-as-root.  Under the
 # sanitizers LeakSanitizer is off for these tests: Open MPI does not free
@@ -15,13 +20,20 @@
 # checked instead by an assert (src/mpi/mpi.c: the call's count of bytes
 # held is 0 when it returns), and AddressSanitizer and UBSan stay on.  The
 # times (Release, 2 shared cores): mpi_api 1, 3, 2.5-4.5, 3.5 and 6-13 s;
-# mpi_cli_3 30-50 s; sanitizers: mpi_api_3 14-25 s, mpi_cli_3 40-100 s.
+# mpi_figures 1, 1.5, 4.4, 3.4 and 5.8 s; mpi_cli_3 90-110 s (load 7-8);
+# sanitizers: mpi_api_3 14-25 s, mpi_figures_3 8 s, mpi_cli_3 100-160 s.
 if(HD_MPI)
   find_program(HD_MPIEXEC NAMES mpirun mpiexec REQUIRED)
   add_executable(mpi_api ${CMAKE_CURRENT_SOURCE_DIR}/tests/api/mpi_api.c ${CMAKE_CURRENT_SOURCE_DIR}/tests/support/gen.c)
   target_include_directories(mpi_api PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/tests/support)
   target_link_libraries(mpi_api PRIVATE hausdorff_mpi)
   set_target_properties(mpi_api PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/tests)
+  # mpi_figures_K: tests/api/mpi_figures.c, hd_mpi_summarize,
+  # hd_mpi_percentile_of and hd_mpi_histogram against the single process.
+  add_executable(mpi_figures ${CMAKE_CURRENT_SOURCE_DIR}/tests/api/mpi_figures.c ${CMAKE_CURRENT_SOURCE_DIR}/tests/support/gen.c)
+  target_include_directories(mpi_figures PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/tests/support)
+  target_link_libraries(mpi_figures PRIVATE hausdorff_mpi)
+  set_target_properties(mpi_figures PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/tests)
   set(HD_MPIRUN ${HD_MPIEXEC} --oversubscribe --allow-run-as-root)
   set(HD_MPI_ENV "OMPI_ALLOW_RUN_AS_ROOT=1" "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1")
   if(HD_SANITIZE)
@@ -33,6 +45,8 @@ if(HD_MPI)
   foreach(k ${HD_MPI_RANKS})
     add_test(NAME mpi_api_${k} COMMAND ${HD_MPIRUN} -n ${k} $<TARGET_FILE:mpi_api>)
     set_tests_properties(mpi_api_${k} PROPERTIES TIMEOUT 300 ENVIRONMENT "${HD_MPI_ENV}" PROCESSORS 2)
+    add_test(NAME mpi_figures_${k} COMMAND ${HD_MPIRUN} -n ${k} $<TARGET_FILE:mpi_figures>)
+    set_tests_properties(mpi_figures_${k} PROPERTIES TIMEOUT 300 ENVIRONMENT "${HD_MPI_ENV}" PROCESSORS 2)
   endforeach()
   find_program(HD_MPI_PYTHON NAMES python3 REQUIRED)
   add_test(NAME mpi_cli_3 COMMAND ${HD_MPI_PYTHON} ${CMAKE_CURRENT_SOURCE_DIR}/tests/mpi_cli.py

@@ -90,17 +90,24 @@ def main():
             failures.append(what)
             print("FAIL (K=%d, seed %d): %s" % (k, SEED, what), file=sys.stderr)
 
-    def same_json(args):
+    def same_json(args, keys=SAME_KEYS):
+        """The members `keys` equal (None: every member but the times, the
+        engine's counters and "mpi"); None if a run failed, else both."""
         rc1, out1, err1 = single(hausdorff, "--json", *args)
         rc2, out2, err2 = ranks(mpirun, k, tool, "--json", *args)
         check(rc1 == 0 and rc2 == 0, "%s: exit %d / %d: %s %s" % (args, rc1, rc2, err1, err2))
         if rc1 or rc2:
-            return
+            return None
         j1, j2 = json.loads(out1), json.loads(out2)
-        for key in SAME_KEYS:
+        if keys is None:
+            keys = [key for key in j1 if key not in ("seconds", "read_seconds", "distances_seconds", "stats_ab",
+                                                     "stats_ba")]
+            check(sorted(j2) == sorted(list(j1) + ["mpi"]), "%s: members %r, %r" % (args, sorted(j1), sorted(j2)))
+        for key in keys:
             check(j1.get(key) == j2.get(key), "%s: %s: %r != %r" % (args, key, j1.get(key), j2.get(key)))
         m = j2.get("mpi", {})
         check(m.get("ranks") == k and len(m.get("seconds_per_rank", [])) == k, "%s: mpi figures %r" % (args, m))
+        return j1, j2
 
     def same_text(args):
         rc1, out1, _ = single(hausdorff, *args)
@@ -183,9 +190,62 @@ def main():
                 check(rc1 == 0 and rc2 == 0 and out1 == out2, "%s: %d %d\n%s\n%s%s" % (fmt + args, rc1, rc2, out1, out2, err2))
         rc, out, err = ranks(mpirun, k, tool, empty, lion)
         check(rc == 2 and err.count("hausdorff-mpi:") == 1 and "--empty" in err, "empty without --empty: %d %r" % (rc, err))
-        # Per-point outputs not built across ranks are refused, once.
-        rc, out, err = ranks(mpirun, k, tool, "--percentile", "95", lion, head)
-        check(rc == 1 and err.count("hausdorff-mpi:") == 1, "--percentile: exit %d, %r" % (rc, err))
+
+        # The figures (--percentile, --mean, --chamfer, --histogram): the
+        # JSON and the text hausdorff prints, every member and line but the
+        # times, the engine's counters (the ranks run other searches) and
+        # the mpi figures.
+        def same_all(args):
+            same_json(args, None)
+            same_text(args)
+
+        figures = ["--percentile", "95", "--mean", "--chamfer", "--histogram"]
+        same_all(figures + [A, B])
+        same_all(figures + [lion, head])
+        same_all(figures + ["--directed", B, A])
+        same_all(figures + [ply, npy])
+        for p in ("0", "50", "100", "99.9"):
+            same_all(["--percentile", p, A, B])
+        same_all(["--histogram", "--bins", "7", "--max-distance", "0.25", "--units", "mm", lion, head])
+        # the histogram picture, byte for byte, with its markers
+        d = tempfile.mkdtemp(dir=tmp)
+        s_png, m_png = os.path.join(d, "s.png"), os.path.join(d, "m.png")
+        rc1, out1, err1 = single(hausdorff, "--json", "--percentile", "90", "--mean", "--histogram-png", s_png, A, B)
+        rc2, out2, err2 = ranks(mpirun, k, tool, "--json", "--percentile", "90", "--mean", "--histogram-png", m_png,
+                                A, B)
+        check(rc1 == 0 and rc2 == 0 and os.path.exists(m_png) and
+              open(s_png, "rb").read() == open(m_png, "rb").read(),
+              "--histogram-png: exit %d / %d, the pictures differ: %s %s" % (rc1, rc2, err1, err2))
+        if rc1 == 0 and rc2 == 0:
+            j1, j2 = json.loads(out1), json.loads(out2)
+            check(j1["histogram_markers"] == j2["histogram_markers"] and j2["histogram_png"] == m_png,
+                  "--histogram-png: markers %r != %r" % (j1["histogram_markers"], j2["histogram_markers"]))
+        # --render: hausdorff's picture byte for byte (the ranks' layers
+        # merged on rank 0), and the same JSON member (markers, captions)
+        def same_picture(args):
+            d = tempfile.mkdtemp(dir=tmp)
+            s_png, m_png = os.path.join(d, "s.png"), os.path.join(d, "m.png")
+            rc1, out1, err1 = single(hausdorff, "--json", "--render", s_png, *args)
+            rc2, out2, err2 = ranks(mpirun, k, tool, "--json", "--render", m_png, *args)
+            same = rc1 == 0 and rc2 == 0 and os.path.exists(m_png) and open(s_png, "rb").read() == open(m_png, "rb").read()
+            check(same, "--render %s: exit %d / %d, the pictures differ: %s %s" % (args, rc1, rc2, err1, err2))
+            if rc1 == 0 and rc2 == 0:
+                r1, r2 = json.loads(out1)["render"], json.loads(out2)["render"]
+                r2["file"] = r1["file"]
+                check(r1 == r2, "--render %s: %r != %r" % (args, r1, r2))
+
+        same_picture([A, B])
+        same_picture(["--percentile", "95", "--max-distance", "0.01", "--units", "mm", lion, head])
+        same_picture(["--directed", head, lion])
+        same_picture([ply, npy])
+        # --empty with a per-point figure: the policy's values
+        for args in (["--empty", "inf", "--mean", "--percentile", "95", empty, lion],
+                     ["--empty", "nan", "--chamfer", "--directed", lion, empty]):
+            for fmt in (["--json"], []):
+                rc1, out1, err1 = single(hausdorff, *fmt, *args)
+                rc2, out2, err2 = ranks(mpirun, k, tool, *fmt, *args)
+                check(rc1 == 0 and rc2 == 0 and out1 == out2, "%s: %d %d\n%s\n%s%s" % (fmt + args, rc1, rc2, out1,
+                                                                                    out2, err2))
 
         # --distances: the files hausdorff writes, byte for byte, in each
         # format: the tiles with ties (B's shares rotated, so the ranks'

@@ -17,14 +17,14 @@
  * first failing rank's code and message, rank 0 prints it, and every rank
  * exits with the same status; no rank waits in a collective for one that
  * gave up.  Only rank 0 writes to standard output and standard error (the
- * others' are /dev/null), so a message appears once, not K times.
- * --distances: hd_mpi_distances gives each rank its points' distances, and
- * every rank writes its rows of the files (writer.c), byte for byte
- * hausdorff's.  The other per-point outputs (--percentile, --mean,
- * --chamfer, --histogram, pictures) are refused (exit 1: not_built).
- * Under --empty a side whose ranks read no point at all gets the policy's
- * answer, printed by rank 0 with the single-process code
- * (analysis_handle_empty), and --distances files with the policy's value.
+ * others' are /dev/null), so a message appears once, not K times.  The
+ * per-point outputs are hausdorff's, computed where the points are: every
+ * rank's per-point distances (hd_mpi_distances), the figures over the
+ * ranks and the pictures from merged layers (figures.c), the --distances
+ * files written by every rank at its offset (writer.c).  Under --empty a side
+ * whose ranks read no point at all gets the policy's answer, printed by
+ * rank 0 with the single-process code (analysis_handle_empty), and
+ * --distances files with the policy's value.
  */
 #include <hausdorff_mpi.h>
 
@@ -46,17 +46,7 @@ static int rank_, K_;
 
 static int agree(int rc, hd_error_t *err) { return mpi_agree(rc, err); }
 
-/* The per-point option that hausdorff-mpi does not compute yet, or NULL:
- * --distances is built (hd_mpi_distances, writer.c). */
-static const char *not_built(const analysis_args_t *an) {
-    if (an->percentile_on) return "--percentile";
-    if (an->mean) return "--mean";
-    if (an->chamfer) return "--chamfer";
-    if (an->histogram) return "--histogram";
-    if (an->render_out) return "--render";
-    if (an->histogram_png) return "--histogram-png";
-    return NULL;
-}
+static void fetch_point(const hd_mpi_part_t *p, size_t g, double q[3]);
 
 /* The per-point distances of this rank's points (hd_mpi_distances, both
  * directions unless --directed) into r->d_ab, j_ab, d_ba, j_ba (this
@@ -105,6 +95,18 @@ static int distances_files_mpi(const cli_args_t *a, const hd_mpi_part_t part[2],
         rc = mpi_write_distances(path[w], &part[w].points, part[w].offset, d[w], j[w], (size_t)total[w], scale,
                                  err);
     return rc;
+}
+
+/* --render: the witness pair's points from the ranks that hold them, then
+ * the picture from every rank's layers (figures.c).  Collective. */
+static int render_mpi(const cli_args_t *a, const hd_mpi_part_t part[2], const hd_symmetric_t *s,
+                      analysis_result_t *r, hd_error_t *err) {
+    int from_a;
+    const hd_result_t *wit = report_witness(a, s, &from_a);
+    double wp[3], wq[3];
+    fetch_point(&part[!from_a], wit->i, wp);
+    fetch_point(&part[from_a], wit->j, wq);
+    return mpi_render(&a->an, part, r->d_ab, wp, wq, s, a->path_a, a->path_b, r, err);
 }
 
 /* The same exit status on every rank (rank 0's). */
@@ -250,12 +252,6 @@ int main(int argc, char **argv) {
     cli_args_t a;
     int rc = cli_parse(argc, argv, &a); /* the same verdict on every rank */
     if (rc >= 0) return finish(rc == EXIT_OK ? out_finish() : rc);
-    const char *refused = not_built(&a.an);
-    if (refused) {
-        fprintf(stderr, "hausdorff-mpi: %s is not built across ranks yet (per-point outputs: --distances only): "
-                        "use hausdorff\n", refused);
-        return finish(EXIT_USAGE);
-    }
     hd_error_t err;
     memset(&err, 0, sizeof err);
     tiles_t side[2];
@@ -357,11 +353,14 @@ int main(int argc, char **argv) {
     }
     analysis_result_t an;
     memset(&an, 0, sizeof an);
-    if (rc == HD_OK && a.an.distances_out) {
+    if (rc == HD_OK && analysis_active(&a.an)) {
         uint64_t mine[2] = {part[0].points.count, part[1].points.count}, total[2];
         MPI_Allreduce(mine, total, 2, MPI_UINT64_T, MPI_SUM, MPI_COMM_WORLD);
+        /* as analysis_run: the distances, the figures, the files, the pictures */
         if ((rc = distances_mpi(&a, part, total, &an, &err)) == HD_OK)
-            rc = distances_files_mpi(&a, part, total, &s, &an, &err);
+            rc = mpi_figures(&a.an, an.d_ab, part[0].points.count, an.d_ba, part[1].points.count, &an, &err);
+        if (rc == HD_OK && a.an.distances_out) rc = distances_files_mpi(&a, part, total, &s, &an, &err);
+        if (rc == HD_OK && a.an.render_out) rc = render_mpi(&a, part, &s, &an, &err);
     }
     if (rc != HD_OK) {
         analysis_free(&an);

@@ -506,7 +506,7 @@ static PyStructSequence_Field summary_fields[] = {
     {"n_ba", "number of distances from B's points to A (len(b); 0 when directed)"},
     {"max_ab", "h(A, B), the largest distance of A's points to B"},
     {"max_ba", "h(B, A)"},
-    {"sum_ab", "sum of the distances of A's points to B (compensated)"},
+    {"sum_ab", "sum of the distances of A's points to B (correctly rounded)"},
     {"sum_ba", "sum of the distances of B's points to A"},
     {"sum2_ab", "sum of the squared distances of A's points to B"},
     {"sum2_ba", "sum of the squared distances of B's points to A"},
@@ -999,8 +999,8 @@ PyDoc_STRVAR(summary_doc,
 "summary($module, a, b, *, directed=False, threads=None, empty='error')\n--\n\n"
 "Every sum, mean and Chamfer distance of the per-point distances, as a\n"
 "Summary: the same doubles as the command line's --mean and --chamfer (the\n"
-"C library's hd_summarize).  Sums are compensated (Neumaier) in index\n"
-"order, so they are the same at any thread count.  directed=True computes\n"
+"C library's hd_summarize).  Sums are correctly rounded (math.fsum's\n"
+"result, whatever the order), so the same at any thread count.  directed=True computes\n"
 "only a's distances to b (B's fields are NaN and n_ba is 0), as the command\n"
 "line's --directed; its Chamfer figure is then mean2_ab.  With an empty set\n"
 "and an empty policy (see directed()), every figure is the policy's value.\n"

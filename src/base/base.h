@@ -136,6 +136,110 @@ int hd__percentile_check(double p, hd_error_t *err);
 int hd__percentiles_inplace(double *v, size_t n, const double *p, size_t np,
                             double *out, hd_error_t *err);
 
+/* The ranks and weight of numpy's linear percentile p (checked) of n > 0
+ * sorted values v: the result is hd__lerp(v[*lo], v[*hi], *t), where
+ * *hi = *lo + 1, or *hi = *lo = n - 1 when pos = (n - 1) * (p / 100)
+ * reaches the last value.  One definition for every caller (the selection
+ * here, the MPI library's distributed one). */
+double hd__percentile_pos(size_t n, double p);
+void hd__percentile_ranks(size_t n, double p, size_t *lo, size_t *hi, double *t);
+/* numpy's _lerp: a + (b - a) * t, or b - (b - a) * (1 - t) when t >= 0.5. */
+double hd__lerp(double a, double b, double t);
+
+/* HD_ENONFINITE naming the first NaN of d[0..n) as "distance first + k of
+ * <what>", else HD_OK: the per-point figures' check (hd_summarize,
+ * hd_percentile_of and the MPI library's, which pass their offset). */
+int hd__nan_check(const double *d, size_t n, size_t first, const char *what, hd_error_t *err);
+
+/* ---- exact sums (xsum.c) -------------------------------------------------- */
+/* An exact accumulator of doubles: the sum of any number of finite doubles
+ * held without rounding, as a fixed-point number in int64 limbs of 32-bit
+ * digits; hd__xsum_round rounds it once, to nearest even.  The result does
+ * not depend on the order of the additions, nor on how they were split
+ * between accumulators that were merged.  Limb k weighs 2^(32 k - 1074):
+ * limb 0's lowest bit is the smallest subnormal, and the HD__XSUM_LIMBS
+ * limbs reach 2^(32 * 70 - 1074) = 2^1166, far above any sum of 2^64
+ * doubles (< 2^1088).  Between normalisations a limb holds more than its
+ * 32-bit digit (each addition adds less than 2^52 to a limb's magnitude):
+ * `pending` counts the additions since the last normalisation (which
+ * leaves every limb but the top one in [0, 2^32), the top one signed, and
+ * pending = 1), so |limb| < pending 2^52, and the limbs are normalised
+ * before pending exceeds HD__XSUM_PENDING_MAX = 2^10.  Infinities and NaN
+ * are counted apart.  The struct is HD__XSUM_WORDS int64 values and nothing
+ * else, so it can be sent as bytes or as int64s; the limb-wise sum of up to
+ * 2^30 normalised accumulators (their pending and special counts added
+ * too) is their merge, normalised when it is used. */
+#define HD__XSUM_LIMBS 70
+#define HD__XSUM_WORDS (HD__XSUM_LIMBS + 4)
+#define HD__XSUM_PENDING_MAX 1024
+typedef struct hd__xsum {
+    int64_t limb[HD__XSUM_LIMBS];
+    int64_t pending; /* |limb[k]| < pending * 2^52 (k below the top) */
+    int64_t pinf, ninf, nan; /* how many +inf, -inf and NaN were added */
+} hd__xsum_t;
+void hd__xsum_init(hd__xsum_t *s);
+/* Carry every limb into [0, 2^32) (the top one keeps the sign); pending = 1. */
+void hd__xsum_normalize(hd__xsum_t *s);
+void hd__xsum_add_special(hd__xsum_t *s, double x);
+/* dst += src (src unchanged). */
+void hd__xsum_merge(hd__xsum_t *dst, const hd__xsum_t *src);
+/* The exact sum rounded once to nearest even: subnormal results are exact
+ * or rounded as any other, |sum| >= 2^1024 - 2^970 gives +-inf; +inf and
+ * -inf together, or a NaN, give NaN.  An exact zero is +0.0 (as a loop
+ * starting from 0.0 gives).  s is unchanged. */
+double hd__xsum_round(const hd__xsum_t *s);
+/* s += x without counting it in pending: the caller counts its additions
+ * with hd__xsum_count, at most HD__XSUM_PENDING_MAX / 2 between two calls
+ * (a loop keeps its counter in a register so).  x = m 2^(e - 1075) with the
+ * 53-bit significand m of a finite double (e its biased exponent, 1 for
+ * subnormals): m << ((e - 1) mod 32) is split into its low 32 bits, added
+ * to limb (e - 1) / 32, and the rest (< 2^52), added to the next limb. */
+HD__INLINE void hd__xsum_add_uncounted(hd__xsum_t *s, double x) {
+    union { double d; uint64_t u; } v;
+    v.d = x;
+    uint64_t m = v.u & (((uint64_t)1 << 52) - 1);
+    unsigned e = (unsigned)(v.u >> 52) & 0x7ff;
+    if (e == 0x7ff) {
+        hd__xsum_add_special(s, x);
+        return;
+    }
+    if (e) m |= (uint64_t)1 << 52;
+    else e = 1;
+    unsigned p = e - 1, w = p >> 5, sh = p & 31;
+    int64_t c0 = (int64_t)((m << sh) & 0xffffffffu);
+    int64_t c1 = (int64_t)(m >> (32 - sh));
+    int64_t neg = -(int64_t)(v.u >> 63); /* 0 or -1: negate by (c ^ neg) - neg */
+    s->limb[w] += (c0 ^ neg) - neg;
+    s->limb[w + 1] += (c1 ^ neg) - neg;
+}
+/* Count `added` uncounted additions (<= HD__XSUM_PENDING_MAX / 2),
+ * normalising first when the bound would be passed. */
+HD__INLINE void hd__xsum_count(hd__xsum_t *s, int64_t added) {
+    s->pending += added;
+    if (s->pending > HD__XSUM_PENDING_MAX / 2) hd__xsum_normalize(s);
+}
+/* s += x. */
+HD__INLINE void hd__xsum_add(hd__xsum_t *s, double x) {
+    hd__xsum_add_uncounted(s, x);
+    hd__xsum_count(s, 1);
+}
+
+/* sum += d[k] and sum2 += d[k] * d[k] (rounded) for k in [0, n), one
+ * pass, counted a block at a time (the loop keeps its counter in a
+ * register); returns the largest of m and the d[k], the first of equal
+ * ones (a strict > from m on: the same fold, split anywhere, gives the
+ * same bits). */
+double hd__xsum_values(hd__xsum_t *sum, hd__xsum_t *sum2, const double *d, size_t n, double m);
+
+/* ---- the summary's derived figures (xsum.c) ------------------------------- */
+/* Fill every field of out from the counts, maxima and exactly rounded sums
+ * (sum_ab, sum2_ab: of d and of d * d over A's n_a distances; likewise for
+ * B, n_b = 0 when B's are absent: its fields are then NaN).  The one place
+ * where hd_summarize's means and Chamfer figures are defined, for
+ * hd_summarize and the MPI library's distributed version. */
+void hd__summary_derive(hd_summary_t *out, size_t n_a, double max_ab, double sum_ab, double sum2_ab,
+                        size_t n_b, double max_ba, double sum_ba, double sum2_ba);
+
 /* ---- a bound that only grows, shared by threads ------------------------- */
 /* A lower bound on h(A,B)^2 that threads raise together (the engine's
  * cmax, and MaxLB / Maxlb of the paper's algorithms).  It holds a non-negative double whose bits, read as an unsigned

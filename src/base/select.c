@@ -88,10 +88,35 @@ void hd__select(double *v, size_t n, size_t k) {
 }
 
 /* numpy's _lerp, including its correction for t >= 0.5. */
-static double lerp(double a, double b, double t) {
+double hd__lerp(double a, double b, double t) {
     double d = b - a;
     if (t >= 0.5) return b - d * (1.0 - t);
     return a + d * t;
+}
+
+double hd__percentile_pos(size_t n, double p) {
+    double q = p / 100.0;
+    return (double)(n - 1) * q;
+}
+
+void hd__percentile_ranks(size_t n, double p, size_t *lo, size_t *hi, double *t) {
+    double pos = hd__percentile_pos(n, p);
+    if (pos >= (double)(n - 1)) {
+        /* numpy takes the last element twice, weight pos - (-1) */
+        *lo = *hi = n - 1;
+        *t = pos + 1.0;
+    } else {
+        double f = floor(pos);
+        *lo = (size_t)f;
+        *hi = *lo + 1;
+        *t = pos - f;
+    }
+}
+
+int hd__nan_check(const double *d, size_t n, size_t first, const char *what, hd_error_t *err) {
+    for (size_t i = 0; i < n; i++)
+        if (isnan(d[i])) return hd__err(err, HD_ENONFINITE, "distance %zu of %s is NaN", first + i, what);
+    return HD_OK;
 }
 
 int hd__percentile_check(double p, hd_error_t *err) {
@@ -119,32 +144,24 @@ int hd__percentiles_inplace(double *v, size_t n, const double *p, size_t np,
     request_t *req = hd__malloc_array(np, sizeof *req);
     if (!req) return hd__err(err, HD_ENOMEM, "out of memory for %zu percentiles", np);
     for (size_t r = 0; r < np; r++) {
-        double q = p[r] / 100.0;
-        req[r].pos = (double)(n - 1) * q;
+        req[r].pos = hd__percentile_pos(n, p[r]);
         req[r].slot = r;
     }
     qsort(req, np, sizeof *req, cmp_request);
     size_t base = 0;
     for (size_t r = 0; r < np; r++) {
-        double pos = req[r].pos, a, b, t;
-        if (pos >= (double)(n - 1)) {
-            /* numpy takes the last element twice, weight pos - (-1) */
-            hd__select(v + base, n - base, n - 1 - base);
-            base = n - 1;
-            a = b = v[n - 1];
-            t = pos + 1.0;
-        } else {
-            double f = floor(pos);
-            size_t k = (size_t)f;
-            hd__select(v + base, n - base, k - base);
-            base = k;
-            a = v[k];
+        size_t k, k1;
+        double t;
+        hd__percentile_ranks(n, p[req[r].slot], &k, &k1, &t);
+        hd__select(v + base, n - base, k - base);
+        base = k;
+        double a = v[k], b = a;
+        if (k1 > k) { /* the smallest of the values above rank k */
             b = v[k + 1];
             for (size_t i = k + 2; i < n; i++)
                 if (v[i] < b) b = v[i];
-            t = pos - f;
         }
-        out[req[r].slot] = lerp(a, b, t);
+        out[req[r].slot] = hd__lerp(a, b, t);
     }
     free(req);
     return HD_OK;

@@ -27,21 +27,7 @@
 #include <string.h>
 
 #include "gen.h"
-
-static int rank_, K_, failures, checks;
-static char context_[256];
-
-#define CHECK(cond)                                                                     \
-    do {                                                                                \
-        checks++;                                                                       \
-        if (!(cond)) {                                                                  \
-            failures++;                                                                 \
-            fprintf(stderr, "rank %d/%d: %s:%d: CHECK(%s) failed [%s]\n", rank_, K_,     \
-                    __FILE__, __LINE__, #cond, context_);                               \
-        }                                                                               \
-    } while (0)
-
-#define SAME_BITS(x, y) (memcmp(&(x), &(y), sizeof(double)) == 0)
+#include "mpicheck.h"
 
 /* ---- layouts: which runs of each set a rank holds ------------------------ */
 
@@ -381,19 +367,6 @@ static void check_distances(int which, int how, uint64_t seed) {
     free(s.b);
 }
 
-/* The same code and message on every rank. */
-static void check_agreed(int rc, int expected, const hd_error_t *err, const char *must_contain) {
-    CHECK(rc == expected);
-    char msg[1024];
-    memcpy(msg, err->message, sizeof msg);
-    MPI_Bcast(msg, (int)sizeof msg, MPI_CHAR, 0, MPI_COMM_WORLD);
-    CHECK(strcmp(msg, err->message) == 0);
-    CHECK(err->code == expected);
-    CHECK(strstr(err->message, must_contain) != NULL);
-    if (rc != expected || !strstr(err->message, must_contain))
-        fprintf(stderr, "rank %d: %s: %s\n", rank_, hd_err_name(rc), err->message);
-}
-
 static void check_errors(void) {
     double a[30], b[30];
     for (int k = 0; k < 30; k++) a[k] = k, b[k] = k + 0.5;
@@ -523,11 +496,5 @@ int main(int argc, char **argv) {
         for (int how = 0; how < LAY_COUNT; how++) check_equal(which, how, 1000 + (uint64_t)which);
         for (int how = 0; how < LAY_COUNT; how++) check_distances(which, how, 1000 + (uint64_t)which);
     }
-    int all[2] = {failures, checks}, sum[2];
-    MPI_Reduce(all, sum, 2, MPI_INT, MPI_SUM, 0, MPI_COMM_WORLD);
-    int any = failures > 0, anyall = 0;
-    MPI_Allreduce(&any, &anyall, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
-    if (rank_ == 0) printf("mpi_api on %d ranks: %d checks, %d failed\n", K_, sum[1], sum[0]);
-    MPI_Finalize();
-    return anyall ? 1 : 0;
+    return mpicheck_finish("mpi_api");
 }

@@ -3,7 +3,7 @@
  * distances agree with the brute force bit for bit (ties, both directions,
  * float32 views, thread counts), selection and percentiles agree with a full
  * sort for every rank and every percentile step, P = 100 is the Hausdorff
- * distance, sums are compensated, histograms put every value in the bin
+ * distance, sums are exact, histograms put every value in the bin
  * whose edges enclose it, and bad input is refused with the right code.
  * Bit-exact agreement with numpy itself is tested in cli_analysis_lib.py.
  */
@@ -725,7 +725,7 @@ TEST(summary_means_and_chamfer_follow_their_definitions) {
     CHECK(isnan(d.mean_ba) && isnan(d.chamfer) && isnan(d.mean_pooled));
 }
 
-TEST(sums_are_compensated_where_a_plain_loop_loses_everything) {
+TEST(sums_are_exact_where_a_plain_loop_loses_everything) {
     /* 1e16 followed by 10000 ones: a plain left-to-right sum stays at 1e16
      * (each 1 is below half an ulp), the exact sum is 1e16 + 10000. */
     size_t n = 10001;
