@@ -94,6 +94,19 @@ int hd__mpi_engine(ctx_t *c, const hd_points_t *P, const hd_points_t *Q, hd_resu
     return rc;
 }
 
+/* Both directions in one call: the engine builds each set's structures
+ * once for both (hd_directed builds both sets' too), charged as above. */
+int hd__mpi_engine_sym(ctx_t *c, const hd_points_t *P, const hd_points_t *Q, hd_symmetric_t *s) {
+    hd_options_t o;
+    hd_options_init(&o);
+    o.threads = c->threads;
+    size_t bytes = ENGINE_BYTES * (P->count + Q->count);
+    hd__mpi_charge(c, bytes);
+    int rc = hd_hausdorff(P, Q, &o, s, &c->e);
+    c->cur -= bytes;
+    return rc;
+}
+
 int hd__mpi_nomem(ctx_t *c, const char *what, size_t n) {
     return hd__err(&c->e, HD_ENOMEM, "out of memory for %s (%zu items)", what, n);
 }

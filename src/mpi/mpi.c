@@ -219,10 +219,24 @@ static int run(ctx_t *c, const hd_options_t *opt, input_t *in, int both, void *r
                 for (int k = 0; k < 3; k++) h.box[s].lo[k] = INFINITY, h.box[s].hi[k] = -INFINITY;
         }
         MPI_GO(c, rc, MPI_Allgather(&h, (int)sizeof h, MPI_BYTE, held, (int)sizeof h, MPI_BYTE, c->comm));
+        gidx_t gi[2];
+        for (int t = 0; t < 2; t++) gi[t] = (gidx_t){loc.g[t], loc.num[t], loc.start[t], &rg, t, K};
+        /* Both directions: the engine once for both (each of its calls
+         * builds both sets' structures); its failure is agreed on by the
+         * first direction. */
+        pre_t pre[2];
+        memset(pre, 0, sizeof pre);
+        int pre_rc = HD_OK;
+        if (both) {
+            const gidx_t *gp[2] = {&gi[0], &gi[1]};
+            double t1 = hd__now(), u1 = hd__mpi_cpu();
+            pre_rc = hd__mpi_engine_both(c, loc.xyz, gp, loc.n, pre);
+            c->search += hd__now() - t1;
+            c->search_cpu += hd__mpi_cpu() - u1;
+        }
+        if ((rc = hd__mpi_agree(c, pre_rc)) != HD_OK) goto done;
         for (int s = 0; s < (both ? 2 : 1); s++) {
-            gidx_t gi[2];
-            for (int t = 0; t < 2; t++) gi[t] = (gidx_t){loc.g[t], loc.num[t], loc.start[t], &rg, t, K};
-            dir_t d = {loc.xyz[s], &gi[s], loc.n[s], loc.xyz[1 - s], &gi[1 - s], loc.n[1 - s], 1 - s};
+            dir_t d = {loc.xyz[s], &gi[s], loc.n[s], loc.xyz[1 - s], &gi[1 - s], loc.n[1 - s], 1 - s, &pre[s]};
             if ((rc = hd__mpi_direction(c, &d, tree, region, held, &f[s])) != HD_OK) goto done;
         }
         pts = loc.n[0] + loc.n[1];

@@ -86,6 +86,31 @@ uint64_t hd__mpi_gidx(const gidx_t *x, size_t k) {
     return hd__mpi_ranges_global(x->rg, x->side, lo, x->num[k]);
 }
 
+void hd__mpi_gcur_init(gcur_t *cu, const gidx_t *x) {
+    cu->x = x;
+    cu->r = -1;
+    cu->i = cu->end = 0;
+}
+
+uint64_t hd__mpi_gcur_at(gcur_t *cu, size_t k) {
+    const gidx_t *x = cu->x;
+    if (x->g) return x->g[k];
+    const ranges_t *rg = x->rg;
+    if (cu->r < 0 || k >= x->start[cu->r + 1]) { /* the next sender with points */
+        int r = cu->r < 0 ? 0 : cu->r;
+        while (k >= x->start[r + 1]) r++;
+        size_t seg = (size_t)x->side * ((size_t)rg->K + 1) + (size_t)r;
+        cu->r = r;
+        cu->i = rg->seg[seg];
+        cu->end = rg->seg[seg + 1];
+    }
+    assert(k >= x->start[cu->r]);
+    uint64_t m = x->num[k]; /* increasing within the sender's run */
+    while (m - rg->first[cu->i] > rg->all[cu->i].hi - rg->all[cu->i].lo) cu->i++;
+    assert(cu->i < cu->end && m >= rg->first[cu->i]);
+    return rg->all[cu->i].lo + (m - rg->first[cu->i]);
+}
+
 /* Over all ranks, no two parts of one set share an index; rg receives
  * every rank's parts. */
 int hd__mpi_check_ranges(ctx_t *c, const input_t *in, ranges_t *rg) {

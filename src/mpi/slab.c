@@ -151,10 +151,13 @@ static int slab_search(ctx_t *c, const slab_t *sl, const double *pts, const size
 }
 
 /* At most this many points the slab did not prove are searched by brute
- * force (a handful, on a copy: points whose partner is on another rank)
- * rather than in a wider slab, which costs as much as a few hundred
- * thousand distances to build. */
-#define BRUTE_MAX 16
+ * force (on a copy: points whose partner is on another rank) rather than
+ * in a wider slab.  Brute force costs one distance per point of Q and
+ * point asking (about 1.5 ns); the wider slab two passes over Q measuring
+ * face gaps (about 3 ns a point each) and a structure over the few points
+ * in it: so up to 4 points brute force is the cheaper (at 16 it cost a
+ * copy 15 ns per local point at 2M points a rank; docs/scale-out.md). */
+#define BRUTE_MAX 4
 
 /* For each of n packed points, the nearest point of Q (exact, smallest
  * index on ties, as hd_distances gives it). */

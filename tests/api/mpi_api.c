@@ -407,6 +407,48 @@ static void check_single_rank_copies_nothing(void) {
     free(bf);
 }
 
+/* Views of any layout travel as packed doubles do: here floats in records
+ * of four (x, y, z and a weight: a stride of 16 bytes, read point by point
+ * rather than in place), A's in blocks by rank and B's in reverse rank
+ * order, large enough for several exchange rounds.  Coordinates are
+ * integers, exact in floats, so the reference is hd_hausdorff on doubles. */
+static void check_strided_views_over_ranks(void) {
+    uint64_t seed = 91;
+    gen_rng_t g;
+    gen_seed(&g, seed);
+    size_t n = 24000;
+    double *a = malloc(3 * n * sizeof(double)), *b = malloc(3 * n * sizeof(double));
+    float *af = malloc(4 * n * sizeof(float)), *bf = malloc(4 * n * sizeof(float));
+    for (size_t k = 0; k < 3 * n; k++) {
+        a[k] = (double)((int)(gen_u64(&g) % 101) - 50);
+        b[k] = (double)((int)(gen_u64(&g) % 101) - 50);
+    }
+    for (size_t k = 0; k < n; k++)
+        for (int c = 0; c < 4; c++) {
+            af[4 * k + c] = c < 3 ? (float)a[3 * k + c] : 1.0f;
+            bf[4 * k + c] = c < 3 ? (float)b[3 * k + c] : 1.0f;
+        }
+    snprintf(context_, sizeof context_, "strided float views over %d ranks, seed %llu", K_,
+             (unsigned long long)seed);
+    hd_points_t A = hd_points_f64(a, n), B = hd_points_f64(b, n);
+    hd_symmetric_t ref, got;
+    hd_error_t err;
+    CHECK(hd_hausdorff(&A, &B, NULL, &ref, &err) == HD_OK);
+    size_t a0 = n * (size_t)rank_ / (size_t)K_, a1 = n * ((size_t)rank_ + 1) / (size_t)K_;
+    size_t rb = (size_t)(K_ - 1 - rank_), b0 = n * rb / (size_t)K_, b1 = n * (rb + 1) / (size_t)K_;
+    hd_points_t va = {af + 4 * a0, a1 - a0, HD_FLOAT32, 4 * sizeof(float), sizeof(float)};
+    hd_points_t vb = {bf + 4 * b0, b1 - b0, HD_FLOAT32, 4 * sizeof(float), sizeof(float)};
+    hd_mpi_part_t pa = {va, a0}, pb = {vb, b0};
+    CHECK(hd_mpi_hausdorff(MPI_COMM_WORLD, &pa, 1, &pb, 1, NULL, &got, NULL, &err) == HD_OK);
+    CHECK(SAME_BITS(got.distance, ref.distance) && SAME_BITS(got.ab.distance2, ref.ab.distance2) &&
+          SAME_BITS(got.ba.distance2, ref.ba.distance2));
+    CHECK(got.ab.i == ref.ab.i && got.ab.j == ref.ab.j && got.ba.i == ref.ba.i && got.ba.j == ref.ba.j);
+    free(a);
+    free(b);
+    free(af);
+    free(bf);
+}
+
 int main(int argc, char **argv) {
     MPI_Init(&argc, &argv);
     MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
@@ -414,6 +456,7 @@ int main(int argc, char **argv) {
     const char *only = argc > 1 ? argv[1] : NULL; /* "errors" or a set number */
     if (!only || strcmp(only, "errors") == 0) check_errors();
     if (!only) check_single_rank_copies_nothing();
+    if (!only) check_strided_views_over_ranks();
     for (int which = 0; which < DS_COUNT; which++) {
         if (only && strcmp(only, "errors") != 0 && atoi(only) != which) continue;
         if (only && strcmp(only, "errors") == 0) break;
