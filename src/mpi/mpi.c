@@ -226,19 +226,22 @@ static int run(ctx_t *c, const hd_options_t *opt, input_t *in, int both, void *r
          * first direction. */
         pre_t pre[2];
         memset(pre, 0, sizeof pre);
+        unsigned char *mask[2] = {NULL, NULL};
         int pre_rc = HD_OK;
         if (both) {
             const gidx_t *gp[2] = {&gi[0], &gi[1]};
             double t1 = hd__now(), u1 = hd__mpi_cpu();
-            pre_rc = hd__mpi_engine_both(c, loc.xyz, gp, loc.n, pre);
+            pre_rc = hd__mpi_engine_both(c, loc.xyz, gp, loc.n, pre, mask);
             c->search += hd__now() - t1;
             c->search_cpu += hd__mpi_cpu() - u1;
         }
-        if ((rc = hd__mpi_agree(c, pre_rc)) != HD_OK) goto done;
-        for (int s = 0; s < (both ? 2 : 1); s++) {
+        rc = hd__mpi_agree(c, pre_rc);
+        for (int s = 0; s < (both ? 2 : 1) && rc == HD_OK; s++) {
             dir_t d = {loc.xyz[s], &gi[s], loc.n[s], loc.xyz[1 - s], &gi[1 - s], loc.n[1 - s], 1 - s, &pre[s]};
-            if ((rc = hd__mpi_direction(c, &d, tree, region, held, &f[s])) != HD_OK) goto done;
+            rc = hd__mpi_direction(c, &d, tree, region, held, &f[s]);
         }
+        for (int s = 0; s < 2; s++) hd__mpi_free(c, mask[s], loc.n[s], 1);
+        if (rc != HD_OK) goto done;
         pts = loc.n[0] + loc.n[1];
     }
     hd_result_t *r[2] = {both ? &out->ab : res, both ? &out->ba : NULL};

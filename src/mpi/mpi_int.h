@@ -160,16 +160,28 @@ uint64_t hd__mpi_gidx(const gidx_t *x, size_t k);
 
 /* A walk over a local set's global indices at nondecreasing positions:
  * the sender and its index run advance with the position instead of being
- * searched for each point (hd__mpi_gidx's two binary searches), so a pass
- * over every point costs a few ns a point. */
+ * searched for each point (hd__mpi_gidx's two binary searches), and a
+ * position in the current run costs a subtraction and a comparison. */
 typedef struct {
     const gidx_t *x;
     int r;                   /* the sender whose run holds the position */
     size_t i, end;           /* its current index run in rg, and its end */
+    size_t kend;             /* the sender's run ends before this position */
+    uint64_t first, span, lo; /* the index run: numbers first .. first +
+                                 span name indices lo .. lo + span */
 } gcur_t;
 
 void hd__mpi_gcur_init(gcur_t *cu, const gidx_t *x);
-uint64_t hd__mpi_gcur_at(gcur_t *cu, size_t k);
+uint64_t hd__mpi_gcur_next(gcur_t *cu, size_t k);
+
+static inline uint64_t hd__mpi_gcur_at(gcur_t *cu, size_t k) {
+    if (cu->x->g) return cu->x->g[k];
+    if (k < cu->kend) {
+        uint64_t d = cu->x->num[k] - cu->first;
+        if (d <= cu->span) return cu->lo + d;
+    }
+    return hd__mpi_gcur_next(cu, k);
+}
 
 typedef struct {
     double *P;               /* local points asking, packed xyz (reordered
@@ -272,9 +284,13 @@ typedef struct pre {
     int have;                /* 0: the direction runs the engine itself */
     int paired;              /* the answer is on the pairs (P_c, Q_c) */
     hd_result_t e;           /* positions in P and Q, or in P_c and Q_c */
+    const unsigned char *inp, *inq; /* paired: the pairs' masks of P, Q */
 } pre_t;
 
-int hd__mpi_engine_both(ctx_t *c, double *xyz[2], const gidx_t *g[2], const size_t n[2], pre_t pre[2]);
+/* mask[s]: NULL, or the pairs' mask of side s (n[s] bytes) when paired,
+ * which the caller frees (hd__mpi_free) after both directions. */
+int hd__mpi_engine_both(ctx_t *c, double *xyz[2], const gidx_t *g[2], const size_t n[2], pre_t pre[2],
+                        unsigned char *mask[2]);
 void hd__mpi_shell_free(ctx_t *c, shell_t *sh);
 int hd__mpi_interior_max(ctx_t *c, const dir_t *d, const hd__box_t *mine, const shell_t *sh, double h2, far_t *out);
 uint64_t hd__mpi_shell_g(const dir_t *d, const shell_t *sh, size_t k);

@@ -69,25 +69,6 @@ static void unsplit(double *xyz, size_t n, const unsigned char *keep, const doub
     }
 }
 
-/* The correspondence pass, for a copy and its original (|A| = |B|, point g
- * of B the moved point g of A).  After the partition a rank holds most
- * pairs whole, but not all (a face separates some), so its local sets
- * differ in size and the engine's correspondence path (docs/engine.md,
- * step 0.5), which settles a copy at a few ns a point, does not run on
- * them.  Here P_c, the local points of P whose partner is local too, and
- * Q_c, those partners, are passed to the engine in the same order (both
- * are in global index order), so the path runs.  Its answer h_c, with
- * witness a*, bounds every u(a)^2 of P_c from above (Q_c is part of the
- * local Q), so the points of P_c whose faces are clear of h_c are settled
- * (the interior; the points of P without a local partner are shell).  The
- * interior's exact maximum is h_c at a* when a* is interior and no point
- * of Q_x, the local Q points whose partner is elsewhere, is nearer to a*
- * than h_c: then u(a*)^2 = h_c, no interior u exceeds it, and any point
- * of P_c with u^2 = h_c has u_c^2 = h_c too, so an index no smaller than
- * a*'s (the engine's tie rule).  The witness's j is the engine's, or the
- * smallest index of Q_x at exactly h_c.  Otherwise (*done = 0) the caller
- * runs the engine on the whole local sets.  Tried only when nine tenths
- * of P have their partner: anything else is not a copy. */
 /* Marks the pairs: inp[i] = inq[j] = 1 when point i of P and point j of Q
  * have the same global index (the masks zeroed by the caller; both NULL:
  * count only), and returns their number.  One merge walk over both index
@@ -149,8 +130,10 @@ static int pairs_engine(ctx_t *c, double *P, size_t nP, double *Q, size_t nQ, co
     return rc;
 }
 
-int hd__mpi_engine_both(ctx_t *c, double *xyz[2], const gidx_t *g[2], const size_t n[2], pre_t pre[2]) {
+int hd__mpi_engine_both(ctx_t *c, double *xyz[2], const gidx_t *g[2], const size_t n[2], pre_t pre[2],
+                        unsigned char *mask[2]) {
     memset(pre, 0, 2 * sizeof *pre);
+    mask[0] = mask[1] = NULL;
     if (n[0] == 0 || n[1] == 0) return HD_OK; /* shell_of has nothing to ask the engine */
     size_t nc = mark_pairs(g[0], n[0], g[1], n[1], NULL, NULL);
     int paired = is_paired(nc, n[0], n[1]);
@@ -162,19 +145,18 @@ int hd__mpi_engine_both(ctx_t *c, double *xyz[2], const gidx_t *g[2], const size
         hd_symmetric_t s;
         if ((rc = hd__mpi_engine_sym(c, &Av, &Bv, &s)) == HD_OK) e[0] = s.ab, e[1] = s.ba;
     } else {
-        unsigned char *in0 = hd__mpi_alloc(c, n[0], 1), *in1 = hd__mpi_alloc(c, n[1], 1);
-        if (!in0 || !in1) rc = hd__mpi_nomem(c, "the pairs", nc);
+        mask[0] = hd__mpi_alloc(c, n[0], 1);
+        mask[1] = hd__mpi_alloc(c, n[1], 1);
+        if (!mask[0] || !mask[1]) rc = hd__mpi_nomem(c, "the pairs", nc);
         if (rc == HD_OK) {
-            memset(in0, 0, n[0]);
-            memset(in1, 0, n[1]);
-            mark_pairs(g[0], n[0], g[1], n[1], in0, in1);
-            rc = pairs_engine(c, xyz[0], n[0], xyz[1], n[1], in0, in1, nc, 1, e);
+            memset(mask[0], 0, n[0]);
+            memset(mask[1], 0, n[1]);
+            mark_pairs(g[0], n[0], g[1], n[1], mask[0], mask[1]);
+            rc = pairs_engine(c, xyz[0], n[0], xyz[1], n[1], mask[0], mask[1], nc, 1, e);
         }
-        hd__mpi_free(c, in0, n[0], 1);
-        hd__mpi_free(c, in1, n[1], 1);
     }
     if (rc == HD_OK)
-        for (int s = 0; s < 2; s++) pre[s] = (pre_t){1, paired, e[s]};
+        for (int s = 0; s < 2; s++) pre[s] = (pre_t){1, paired, e[s], mask[s], mask[1 - s]};
     return rc;
 }
 
@@ -211,9 +193,14 @@ static int paired_pass(ctx_t *c, const dir_t *d, const hd__box_t *mine, unsigned
         rc = hd__mpi_nomem(c, "the pairs", nP);
         goto done;
     }
-    memset(in, 0, nP);
-    memset(inq, 0, nQ);
-    nc = mark_pairs(d->gP, nP, d->gQ, nQ, in, inq);
+    if (pre) { /* the masks of hd__mpi_engine_both */
+        memcpy(in, pre->inp, nP);
+        memcpy(inq, pre->inq, nQ);
+    } else {
+        memset(in, 0, nP);
+        memset(inq, 0, nQ);
+        nc = mark_pairs(d->gP, nP, d->gQ, nQ, in, inq);
+    }
     hd_result_t e[2];
     if (pre) e[0] = pre->e;
     else rc = pairs_engine(c, d->P, nP, d->Q, nQ, in, inq, nc, 0, e);

@@ -114,7 +114,7 @@ typedef struct {
 
 enum {
     DS_UNIFORM, DS_LATTICE, DS_LATTICE_HALF, DS_ONE_POINT, DS_PLANE, DS_FAR_B, DS_CORNER_B, DS_DUPLICATES,
-    DS_TINY, DS_HUGE, DS_NOISE, DS_DISJOINT, DS_CHECKER, DS_STRAY, DS_COUNT
+    DS_TINY, DS_HUGE, DS_NOISE, DS_DISJOINT, DS_CHECKER, DS_STRAY, DS_DEEP, DS_COUNT
 };
 
 static void make_set(int which, uint64_t seed, set_t *s) {
@@ -230,6 +230,23 @@ static void make_set(int which, uint64_t seed, set_t *s) {
         s->b[3 * c + 1] = 2.3, s->b[3 * c] = 2, s->b[3 * c + 2] = 2;
         s->b[3 * (c + N) + 1] = 1.7, s->b[3 * (c + N)] = 2, s->b[3 * (c + N) + 2] = 2;
         s->b[3 * f] = 2.1, s->b[3 * f + 1] = 2, s->b[3 * f + 2] = 2;
+        break;
+    }
+    case DS_DEEP: {
+        /* A and B sampled on the strip [0, 4] x [0, 1] of the plane z = 0
+         * (the first cut falls near x = 2), with A[0] = (1.5, 0.5, 5) above
+         * it and B[0] = (5.5, 0.5, 5) beside that, 4 away: nearer than the
+         * plane (5), in another region and deep inside it.  A[0] is
+         * forwarded, and the answering rank's slab (the strip's points near
+         * its face) gives the plane; only the comparison with every point
+         * of its B finds B[0] (and likewise B[0]'s query finds A[0]). */
+        s->name = "forwarded query whose nearest lies deep in another region";
+        for (size_t k = 0; k < n; k++) {
+            s->a[3 * k] = 4 * gen_unit(&g), s->a[3 * k + 1] = gen_unit(&g), s->a[3 * k + 2] = 0;
+            s->b[3 * k] = 4 * gen_unit(&g), s->b[3 * k + 1] = gen_unit(&g), s->b[3 * k + 2] = 0;
+        }
+        s->a[0] = 1.5, s->a[1] = 0.5, s->a[2] = 5;
+        s->b[0] = 5.5, s->b[1] = 0.5, s->b[2] = 5;
         break;
     }
     case DS_DISJOINT:
