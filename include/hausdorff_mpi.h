@@ -92,6 +92,9 @@ typedef struct hd_mpi_stats {
                                    regions (the samples) */
     uint64_t bytes_forwarding;  /* bytes of forwarded queries (24 each) and
                                    their answers (16 each) */
+    uint64_t bytes_returned;    /* hd_mpi_distances: bytes of per-point
+                                   answers sent back to the rank that
+                                   holds the point (16 each); 0 otherwise */
     uint64_t forwarded;         /* (point, rank) queries forwarded */
     uint64_t forwarded_points;  /* points forwarded to one rank or more */
     uint64_t shell_points;      /* points searched one by one, in both
@@ -163,6 +166,46 @@ int hd_mpi_directed(MPI_Comm comm, const hd_mpi_part_t *a, size_t na,
                     const hd_mpi_part_t *b, size_t nb,
                     const hd_options_t *opt, hd_result_t *out,
                     hd_mpi_stats_t *stats, hd_error_t *err);
+
+/* Per-point nearest neighbours over the ranks, as hd_distances() gives
+ * them on the union of all ranks' points, to the bit: for each point a_k
+ * of A that this rank passes, dist_ab[k] = min over all of B (every rank's
+ * points) of |a_k - b| and nearest_ab[k] = the smallest global index of B
+ * at that distance; dist_ba and nearest_ba likewise for this rank's points
+ * of B against all of A.  Collective over comm.
+ *
+ * a, na, b, nb, opt: as hd_mpi_hausdorff (only opt->threads is read
+ *   besides the checks).
+ * dist_ab, nearest_ab: NULL, or arrays of this rank's points of A (the sum
+ *   of its parts' counts), filled in the order of its parts: part 0's
+ *   points, then part 1's, ...; dist_ba, nearest_ba likewise for B.  A
+ *   direction is computed when any rank passes an output for it; a rank's
+ *   NULL outputs are not written (a rank with no points of a set passes
+ *   NULL or anything).  Written only when the call returns HD_OK.
+ * stats: NULL, or the figures of hd_mpi_stats_t: bytes_returned counts the
+ *   answers sent back to the points' ranks; shell_points the points whose
+ *   region faces were not clear of their local nearest distance;
+ *   forwarded* the queries sent to other ranks (no lower bound prunes
+ *   them: every point needs its answer); rounds one per direction.
+ * err: NULL, or receives the context of a failure.
+ * Memory, per point a rank holds after the partition: 28 bytes (the local
+ *   arrays), about 36 bytes a point of each set for the nearest layer's
+ *   structures (60 while one is built), and 16 bytes a point of the
+ *   direction being computed; 16 bytes a point of the rank's own input
+ *   while the answers come back (32 while they are sent when the ranks'
+ *   index runs interleave).  On one rank, hd_distances on the caller's
+ *   points (its 36 to 60 bytes a point), with no copy when each set is one
+ *   part given in index order.
+ * Errors: as hd_mpi_hausdorff (HD_EEMPTY when a set has no point on any
+ *   rank), HD_EOVERFLOW for more than 2^31 - 1 points of a set on one rank
+ *   (MPI's int counts).
+ * Thread safety: as hd_mpi_hausdorff. */
+int hd_mpi_distances(MPI_Comm comm, const hd_mpi_part_t *a, size_t na,
+                     const hd_mpi_part_t *b, size_t nb,
+                     const hd_options_t *opt, double *dist_ab,
+                     size_t *nearest_ab, double *dist_ba,
+                     size_t *nearest_ba, hd_mpi_stats_t *stats,
+                     hd_error_t *err);
 
 /* The overlap degree alpha and *disjoint of the bounding boxes of all of A
  * and all of B, as hd_overlap() gives them on the union (hausdorff.h);

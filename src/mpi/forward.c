@@ -23,8 +23,6 @@
 #include <limits.h>
 #include <stdlib.h>
 
-typedef struct { size_t k; int dest; int pad; } pair_t;
-
 static int pack_queries(ctx_t *c, const double *P, const pair_t *pairs, size_t np, int *scount, int *sdispl,
                         double **send, size_t **order) {
     for (int r = 0; r < c->K; r++) scount[r] = 0;
@@ -49,9 +47,90 @@ static int pack_queries(ctx_t *c, const double *P, const pair_t *pairs, size_t n
     return HD_OK;
 }
 
+void hd__mpi_pairs_free(ctx_t *c, pairs_t *pr) {
+    hd__mpi_free(c, pr->p, pr->cap, sizeof(pair_t));
+    memset(pr, 0, sizeof *pr);
+}
+
+int hd__mpi_pairs_add(ctx_t *c, pairs_t *pr, size_t k, const int *list, int n) {
+    if (pr->n + (size_t)n > pr->cap) {
+        size_t ncap = pr->cap ? 2 * pr->cap : 1024;
+        while (ncap < pr->n + (size_t)n) ncap *= 2;
+        pair_t *grown = hd__mpi_alloc(c, ncap, sizeof(pair_t));
+        if (!grown) return hd__mpi_nomem(c, "forwarded queries", ncap);
+        if (pr->n) memcpy(grown, pr->p, pr->n * sizeof(pair_t));
+        hd__mpi_free(c, pr->p, pr->cap, sizeof(pair_t));
+        pr->p = grown;
+        pr->cap = ncap;
+    }
+    for (int t = 0; t < n; t++) pr->p[pr->n++] = (pair_t){k, list[t], 0};
+    return HD_OK;
+}
+
+int hd__mpi_round(ctx_t *c, int rc, const double *P, const pairs_t *pr, hd__mpi_answer_t fn, void *arg,
+                  double *u2, uint64_t *jj) {
+    int K = c->K;
+    size_t np = pr->n, m = 0, *order = NULL;
+    int *cnt = hd__mpi_alloc(c, 4 * (size_t)K, sizeof(int)); /* scount sdispl rcount rdispl */
+    double *sendq = NULL, *recvq = NULL;
+    ans_t *ans = NULL, *back = NULL;
+    if (rc == HD_OK && !cnt) rc = hd__mpi_nomem(c, "forwarded queries", np);
+    int *scount = cnt, *sdispl = cnt + K, *rcount = cnt + 2 * K, *rdispl = cnt + 3 * K;
+    if (rc == HD_OK && np > INT_MAX) rc = hd__err(&c->e, HD_EOVERFLOW, "%zu forwarded queries exceed MPI's int counts", np);
+    if (rc == HD_OK) rc = pack_queries(c, P, pr->p, np, scount, sdispl, &sendq, &order);
+    if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
+    MPI_GO(c, rc, MPI_Alltoall(scount, 1, MPI_INT, rcount, 1, MPI_INT, c->comm));
+    for (int r = 0; r < K; r++) {
+        if (m > INT_MAX) break;
+        rdispl[r] = (int)m;
+        m += (size_t)rcount[r];
+    }
+    if (m > INT_MAX) rc = hd__err(&c->e, HD_EOVERFLOW, "%zu queries received exceed MPI's int counts", m);
+    if (rc == HD_OK) {
+        recvq = hd__mpi_alloc(c, m, 3 * sizeof(double));
+        ans = hd__mpi_alloc(c, m, sizeof(ans_t));
+        back = hd__mpi_alloc(c, np, sizeof(ans_t));
+        if (!recvq || !ans || !back) rc = hd__mpi_nomem(c, "forwarded queries", m);
+    }
+    if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
+    MPI_GO(c, rc, MPI_Alltoallv(sendq, scount, sdispl, c->q_type, recvq, rcount, rdispl, c->q_type, c->comm));
+    double t = hd__now(), u = hd__mpi_cpu();
+    rc = fn(c, arg, recvq, m, ans);
+    c->search += hd__now() - t;
+    c->search_cpu += hd__mpi_cpu() - u;
+    c->answered += m;
+    if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
+    MPI_GO(c, rc, MPI_Alltoallv(ans, rcount, rdispl, c->ans_type, back, scount, sdispl, c->ans_type, c->comm));
+    c->rounds++;
+    c->forwarded += np;
+    c->bytes_fwd += (uint64_t)np * (3 * sizeof(double) + sizeof(ans_t));
+    for (size_t t = 0; t < np; t++) {
+        size_t k = order[t];
+        if (back[t].d2 < u2[k] || (back[t].d2 == u2[k] && back[t].g < jj[k])) {
+            u2[k] = back[t].d2;
+            jj[k] = back[t].g;
+        }
+    }
+done:
+    hd__mpi_free(c, cnt, 4 * (size_t)K, sizeof(int));
+    hd__mpi_free(c, sendq, np, 3 * sizeof(double));
+    hd__mpi_free(c, order, np, sizeof(size_t));
+    hd__mpi_free(c, recvq, m, 3 * sizeof(double));
+    hd__mpi_free(c, ans, m, sizeof(ans_t));
+    hd__mpi_free(c, back, np, sizeof(ans_t));
+    return rc;
+}
+
 /* Answer m queries against the local Q: exact nearest, smallest index. */
-static int answer(ctx_t *c, const dir_t *d, const hd__box_t *mine, qtree_t *q, const double *pts, size_t m,
-                  ans_t *ans) {
+typedef struct {
+    const dir_t *d;
+    const hd__box_t *mine;
+    qtree_t *q;
+} answer_t;
+
+static int answer(ctx_t *c, void *arg, const double *pts, size_t m, ans_t *ans) {
+    const answer_t *a = arg;
+    const dir_t *d = a->d;
     if (m == 0) return HD_OK;
     if (d->nQ == 0) {
         for (size_t k = 0; k < m; k++) ans[k] = (ans_t){INFINITY, UINT64_MAX};
@@ -59,7 +138,7 @@ static int answer(ctx_t *c, const dir_t *d, const hd__box_t *mine, qtree_t *q, c
     }
     size_t *near = hd__mpi_alloc(c, m, sizeof(size_t));
     if (!near) return hd__mpi_nomem(c, "answers", m);
-    int rc = hd__mpi_nearest_in_q(c, d, mine, q, pts, m, near);
+    int rc = hd__mpi_nearest_in_q(c, d, a->mine, a->q, pts, m, near);
     if (rc == HD_OK)
         for (size_t k = 0; k < m; k++)
             ans[k] = (ans_t){hd__d2(pts + 3 * k, d->Q + 3 * near[k]), hd__mpi_gidx(d->gQ, near[k])};
@@ -79,19 +158,15 @@ int hd__mpi_direction(ctx_t *c, const dir_t *d, const node_t *tree, const hd__bo
     c->search += hd__now() - t0;
     c->search_cpu += hd__mpi_cpu() - u0;
     c->shell += sh.n;
-    size_t nP = sh.n, np = 0, cap = 0;
+    size_t nP = sh.n;
     const double *P = sh.xyz;
     double *u2 = hd__mpi_alloc(c, nP, sizeof(double));
     uint64_t *jj = hd__mpi_alloc(c, nP, sizeof(uint64_t));
     unsigned char *exact = hd__mpi_alloc(c, nP, 1);
     hd__box_t *nbox = hd__mpi_alloc(c, K > 1 ? (size_t)K - 1 : 1, sizeof(hd__box_t));
     int *list = hd__mpi_alloc(c, (size_t)K, sizeof(int));
-    pair_t *pairs = NULL;
-    int *cnt = hd__mpi_alloc(c, 4 * (size_t)K, sizeof(int)); /* scount sdispl rcount rdispl */
-    double *sendq = NULL, *recvq = NULL;
-    size_t *order = NULL, m = 0;
-    ans_t *ans = NULL, *back = NULL;
-    if (rc == HD_OK && (!u2 || !jj || !exact || !nbox || !list || !cnt)) rc = hd__mpi_nomem(c, "per-point bounds", nP);
+    pairs_t pr = {NULL, 0, 0};
+    if (rc == HD_OK && (!u2 || !jj || !exact || !nbox || !list)) rc = hd__mpi_nomem(c, "per-point bounds", nP);
     far_t Lmine = sh.inner, Lall;
     if (rc == HD_OK) {
         for (size_t k = 0; k < nP; k++) {
@@ -112,25 +187,18 @@ int hd__mpi_direction(ctx_t *c, const dir_t *d, const node_t *tree, const hd__bo
     }
     /* What the searches and the forwarding held, freed before the
      * interior's engine call (and on failure). */
-#define DIRECTION_FREE()                               \
-    do {                                               \
-        hd__mpi_free(c, u2, nP, sizeof(double));              \
-        hd__mpi_free(c, jj, nP, sizeof(uint64_t));            \
-        hd__mpi_free(c, exact, nP, 1);                        \
-        hd__mpi_free(c, nbox, K > 1 ? (size_t)K - 1 : 1, sizeof(hd__box_t)); \
-        hd__mpi_free(c, list, (size_t)K, sizeof(int));        \
-        hd__mpi_free(c, cnt, 4 * (size_t)K, sizeof(int));     \
-        hd__mpi_free(c, pairs, cap, sizeof(pair_t));          \
-        hd__mpi_free(c, sendq, np, 3 * sizeof(double));       \
-        hd__mpi_free(c, order, np, sizeof(size_t));           \
-        hd__mpi_free(c, recvq, m, 3 * sizeof(double));        \
-        hd__mpi_free(c, ans, m, sizeof(ans_t));               \
-        hd__mpi_free(c, back, np, sizeof(ans_t));             \
-        u2 = NULL, jj = NULL, exact = NULL, nbox = NULL, list = NULL, cnt = NULL, pairs = NULL; \
-        sendq = NULL, order = NULL, recvq = NULL, ans = NULL, back = NULL; \
-        hd__mpi_free(c, sh.nearest, sh.n, sizeof(size_t));    \
-        sh.nearest = NULL;                             \
-        hd__mpi_qtree_free(c, &q);                             \
+#define DIRECTION_FREE()                                                         \
+    do {                                                                         \
+        hd__mpi_free(c, u2, nP, sizeof(double));                                 \
+        hd__mpi_free(c, jj, nP, sizeof(uint64_t));                               \
+        hd__mpi_free(c, exact, nP, 1);                                           \
+        hd__mpi_free(c, nbox, K > 1 ? (size_t)K - 1 : 1, sizeof(hd__box_t));     \
+        hd__mpi_free(c, list, (size_t)K, sizeof(int));                           \
+        hd__mpi_pairs_free(c, &pr);                                              \
+        u2 = NULL, jj = NULL, exact = NULL, nbox = NULL, list = NULL;            \
+        hd__mpi_free(c, sh.nearest, sh.n, sizeof(size_t));                       \
+        sh.nearest = NULL;                                                       \
+        hd__mpi_qtree_free(c, &q);                                               \
     } while (0)
     if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
     /* L and the smallest index i_L of a confirmed point at L: a point
@@ -141,72 +209,16 @@ int hd__mpi_direction(ctx_t *c, const dir_t *d, const node_t *tree, const hd__bo
     /* The points to forward, as (point, rank) pairs. */
     for (size_t k = 0; k < nP && rc == HD_OK; k++) {
         if (exact[k] || u2[k] < L || (u2[k] == L && hd__mpi_shell_g(d, &sh, k) > iL)) continue;
-        const double *p = P + 3 * k;
-        double bound = u2[k];
-        if (d->nQ == 0)
-            for (int r = 0; r < K; r++)
-                if (held[r].n[d->qside]) {
-                    double ub = hd__box_ub2(&held[r].box[d->qside], p);
-                    if (ub < bound) bound = ub;
-                }
-        int n = 0;
-        if (K > 1) hd__mpi_candidates(tree, nbox, held, d->qside, 0, p, bound, c->rank, list, &n);
+        int n = hd__mpi_asked(tree, nbox, held, K, d->qside, d->nQ == 0, P + 3 * k, u2[k], c->rank, list);
         if (n == 0) {
             exact[k] = 1; /* no other rank holds a point as near */
             continue;
         }
         c->forwarded_points++;
-        if (np + (size_t)n > cap) {
-            size_t ncap = cap ? 2 * cap : 1024;
-            while (ncap < np + (size_t)n) ncap *= 2;
-            pair_t *grown = hd__mpi_alloc(c, ncap, sizeof(pair_t));
-            if (!grown) {
-                rc = hd__mpi_nomem(c, "forwarded queries", ncap);
-                break;
-            }
-            if (np) memcpy(grown, pairs, np * sizeof(pair_t));
-            hd__mpi_free(c, pairs, cap, sizeof(pair_t));
-            pairs = grown;
-            cap = ncap;
-        }
-        for (int t = 0; t < n; t++) pairs[np++] = (pair_t){k, list[t], 0};
+        rc = hd__mpi_pairs_add(c, &pr, k, list, n);
     }
-    int *scount = cnt, *sdispl = cnt + K, *rcount = cnt + 2 * K, *rdispl = cnt + 3 * K;
-    if (rc == HD_OK && np > INT_MAX) rc = hd__err(&c->e, HD_EOVERFLOW, "%zu forwarded queries exceed MPI's int counts", np);
-    if (rc == HD_OK) rc = pack_queries(c, P, pairs, np, scount, sdispl, &sendq, &order);
-    if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
-    MPI_GO(c, rc, MPI_Alltoall(scount, 1, MPI_INT, rcount, 1, MPI_INT, c->comm));
-    for (int r = 0; r < K; r++) {
-        if (m > INT_MAX) break;
-        rdispl[r] = (int)m;
-        m += (size_t)rcount[r];
-    }
-    if (m > INT_MAX) rc = hd__err(&c->e, HD_EOVERFLOW, "%zu queries received exceed MPI's int counts", m);
-    if (rc == HD_OK) {
-        recvq = hd__mpi_alloc(c, m, 3 * sizeof(double));
-        ans = hd__mpi_alloc(c, m, sizeof(ans_t));
-        back = hd__mpi_alloc(c, np, sizeof(ans_t));
-        if (!recvq || !ans || !back) rc = hd__mpi_nomem(c, "forwarded queries", m);
-    }
-    if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
-    MPI_GO(c, rc, MPI_Alltoallv(sendq, scount, sdispl, c->q_type, recvq, rcount, rdispl, c->q_type, c->comm));
-    double t = hd__now(), u = hd__mpi_cpu();
-    rc = answer(c, d, mine, &q, recvq, m, ans);
-    c->search += hd__now() - t;
-    c->search_cpu += hd__mpi_cpu() - u;
-    c->answered += m;
-    if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
-    MPI_GO(c, rc, MPI_Alltoallv(ans, rcount, rdispl, c->ans_type, back, scount, sdispl, c->ans_type, c->comm));
-    c->rounds++;
-    c->forwarded += np;
-    c->bytes_fwd += (uint64_t)np * (3 * sizeof(double) + sizeof(ans_t));
-    for (size_t t = 0; t < np; t++) {
-        size_t k = order[t];
-        if (back[t].d2 < u2[k] || (back[t].d2 == u2[k] && back[t].g < jj[k])) {
-            u2[k] = back[t].d2;
-            jj[k] = back[t].g;
-        }
-    }
+    answer_t an = {d, mine, &q};
+    if ((rc = hd__mpi_round(c, rc, P, &pr, answer, &an, u2, jj)) != HD_OK) goto done;
     /* Every point that could win is now exact; the others cannot win (a
      * point at L with a larger index than i_L loses to i_L). */
     far_t best = sh.inner;

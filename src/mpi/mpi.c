@@ -107,84 +107,196 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* K = 1: no partition, no exchange and no copy: the engine runs on the
- * caller's points, a view of any layout, when each set is one part (else
- * the parts are packed into one array in index order, 24 bytes a point),
- * and its local indices become global ones (ranges_global).  Local order
- * is index order, so the engine's smallest index on ties is the global
- * one. */
-static int single(ctx_t *c, const input_t *in, const ranges_t *rg, int both, far_t *f) {
-    hd_points_t v[2];
-    double *own[2] = {NULL, NULL};
-    const hd_mpi_part_t **order[2] = {NULL, NULL};
-    int rc = HD_OK;
-    for (int s = 0; s < 2 && rc == HD_OK; s++) {
+/* K = 1: no partition, no exchange and no copy: a set given as one part
+ * (or one nonempty part) is the caller's view, of any layout; else its
+ * parts are packed into one array in index order (24 bytes a point).  Its
+ * local indices become global ones (ranges_global): local order is index
+ * order, so a smallest index on ties is the global one. */
+int hd__mpi_views(ctx_t *c, const input_t *in, views_t *vw) {
+    memset(vw, 0, sizeof *vw);
+    for (int s = 0; s < 2; s++) {
         size_t nonempty = 0, last = 0;
         for (size_t p = 0; p < in->nparts[s]; p++)
             if (in->parts[s][p].points.count) nonempty++, last = p;
         if (nonempty == 1) {
-            v[s] = in->parts[s][last].points;
+            vw->v[s] = in->parts[s][last].points;
             continue;
         }
-        own[s] = hd__mpi_alloc(c, in->n[s], 3 * sizeof(double));
-        order[s] = hd__mpi_alloc(c, in->nparts[s], sizeof *order[s]);
-        if (!own[s] || !order[s]) {
-            rc = hd__mpi_nomem(c, "the parts", in->n[s]);
-            break;
-        }
-        for (size_t p = 0; p < in->nparts[s]; p++) order[s][p] = &in->parts[s][p];
-        qsort(order[s], in->nparts[s], sizeof *order[s], hd__mpi_by_offset);
+        vw->own[s] = hd__mpi_alloc(c, in->n[s], 3 * sizeof(double));
+        vw->order[s] = hd__mpi_alloc(c, in->nparts[s], sizeof *vw->order[s]);
+        if (!vw->own[s] || !vw->order[s]) return hd__mpi_nomem(c, "the parts", in->n[s]);
+        const hd_mpi_part_t **order = vw->order[s];
+        for (size_t p = 0; p < in->nparts[s]; p++) order[p] = &in->parts[s][p];
+        qsort(order, in->nparts[s], sizeof *order, hd__mpi_by_offset);
         size_t t = 0;
         for (size_t p = 0; p < in->nparts[s]; p++)
-            for (size_t k = 0; k < order[s][p]->points.count; k++) hd__mpi_get_point(&order[s][p]->points, k, own[s] + 3 * t++);
-        v[s] = hd_points_f64(own[s], in->n[s]);
+            for (size_t k = 0; k < order[p]->points.count; k++)
+                hd__mpi_get_point(&order[p]->points, k, vw->own[s] + 3 * t++);
+        vw->v[s] = hd_points_f64(vw->own[s], in->n[s]);
     }
+    return HD_OK;
+}
+
+void hd__mpi_views_free(ctx_t *c, const input_t *in, views_t *vw) {
+    for (int s = 0; s < 2; s++) {
+        hd__mpi_free(c, vw->own[s], in->n[s], 3 * sizeof(double));
+        hd__mpi_free(c, vw->order[s], in->nparts[s], sizeof *vw->order[s]);
+        vw->own[s] = NULL, vw->order[s] = NULL;
+    }
+}
+
+/* K = 1: the engine on the views. */
+static int single(ctx_t *c, const input_t *in, const ranges_t *rg, int both, far_t *f) {
+    views_t vw;
+    int rc = hd__mpi_views(c, in, &vw);
     double t0 = hd__now(), u0 = hd__mpi_cpu();
     for (int s = 0; s < (both ? 2 : 1) && rc == HD_OK; s++) {
         hd_result_t e;
-        if ((rc = hd__mpi_engine(c, &v[s], &v[1 - s], &e)) == HD_OK)
+        if ((rc = hd__mpi_engine(c, &vw.v[s], &vw.v[1 - s], &e)) == HD_OK)
             f[s] = (far_t){e.distance2, hd__mpi_ranges_global(rg, s, 0, e.i), hd__mpi_ranges_global(rg, 1 - s, 0, e.j)};
     }
     c->search += hd__now() - t0;
     c->search_cpu += hd__mpi_cpu() - u0;
-    for (int s = 0; s < 2; s++) {
-        hd__mpi_free(c, own[s], in->n[s], 3 * sizeof(double));
-        hd__mpi_free(c, order[s], in->nparts[s], sizeof *order[s]);
-    }
+    hd__mpi_views_free(c, in, &vw);
     return rc;
+}
+
+/* The start of every call: the local checks (agreed), the index runs, the
+ * global counts N (an empty set is HD_EEMPTY) and, when box is not NULL,
+ * the global boxes of A and B as hd_overlap's corner pairs. */
+int hd__mpi_begin(ctx_t *c, const hd_options_t *opt, input_t *in, const void *res, ranges_t *rg, uint64_t N[2],
+                  double corners[2][6]) {
+    int rc = hd__mpi_check_local(c, opt, in, res);
+    if ((rc = hd__mpi_agree(c, rc)) != HD_OK) return rc;
+    if ((rc = hd__mpi_check_ranges(c, in, rg)) != HD_OK) return rc;
+    uint64_t n[2] = {in->n[0], in->n[1]};
+    MPI_TRY(c, MPI_Allreduce(n, N, 2, MPI_UINT64_T, MPI_SUM, c->comm));
+    if (N[0] == 0 || N[1] == 0) return hd__err(&c->e, HD_EEMPTY, "point set %s is empty", N[0] ? "B" : "A");
+    if (!corners) return HD_OK;
+    /* Global boxes (hi negated: one MIN). */
+    double bx[12], gb[12];
+    for (int s = 0; s < 2; s++)
+        for (int k = 0; k < 3; k++) bx[6 * s + k] = in->box[s].lo[k], bx[6 * s + 3 + k] = -in->box[s].hi[k];
+    MPI_TRY(c, MPI_Allreduce(bx, gb, 12, MPI_DOUBLE, MPI_MIN, c->comm));
+    for (int s = 0; s < 2; s++)
+        for (int k = 0; k < 3; k++) corners[s][k] = gb[6 * s + k], corners[s][3 + k] = -gb[6 * s + 3 + k];
+    return HD_OK;
+}
+
+/* K > 1: the partition, the exchange and what every rank holds. */
+int hd__mpi_spread(ctx_t *c, const input_t *in, const ranges_t *rg, const uint64_t N[2], spread_t *sp) {
+    int K = c->K, rc = HD_OK;
+    sp->tree = hd__mpi_alloc(c, (size_t)K - 1, sizeof(node_t));
+    sp->region = hd__mpi_alloc(c, (size_t)K, sizeof(hd__box_t));
+    sp->held = hd__mpi_alloc(c, (size_t)K, sizeof(held_t));
+    if (!sp->tree || !sp->region || !sp->held) rc = hd__mpi_nomem(c, "the partition", (size_t)K);
+    if ((rc = hd__mpi_agree(c, rc)) != HD_OK) return rc;
+    if ((rc = hd__mpi_partition(c, in, N[0] + N[1], sp->tree)) != HD_OK) return rc;
+    hd__box_t all = {{-INFINITY, -INFINITY, -INFINITY}, {INFINITY, INFINITY, INFINITY}};
+    hd__mpi_regions(sp->tree, 0, all, sp->region);
+    if ((rc = hd__mpi_exchange(c, in, rg, sp->tree, &sp->loc)) != HD_OK) return rc;
+    held_t h;
+    for (int s = 0; s < 2; s++) {
+        h.n[s] = sp->loc.n[s];
+        if (sp->loc.n[s]) hd__box_of(sp->loc.xyz[s], sp->loc.n[s], &h.box[s]);
+        else
+            for (int k = 0; k < 3; k++) h.box[s].lo[k] = INFINITY, h.box[s].hi[k] = -INFINITY;
+    }
+    MPI_TRY(c, MPI_Allgather(&h, (int)sizeof h, MPI_BYTE, sp->held, (int)sizeof h, MPI_BYTE, c->comm));
+    for (int t = 0; t < 2; t++)
+        sp->gi[t] = (gidx_t){sp->loc.g[t], sp->loc.num[t], sp->loc.start[t], rg, t, K};
+    return HD_OK;
+}
+
+void hd__mpi_spread_free(ctx_t *c, spread_t *sp) {
+    int K = c->K;
+    for (int s = 0; s < 2; s++) {
+        hd__mpi_free(c, sp->loc.xyz[s], sp->loc.n[s], 3 * sizeof(double));
+        hd__mpi_free(c, sp->loc.g[s], sp->loc.n[s], sizeof(uint64_t));
+        hd__mpi_free(c, sp->loc.num[s], sp->loc.n[s], sizeof(uint32_t));
+        if (sp->loc.start[s]) hd__mpi_free(c, sp->loc.start[s], (size_t)K + 1, sizeof(size_t));
+    }
+    hd__mpi_free(c, sp->tree, (size_t)K - 1, sizeof(node_t));
+    hd__mpi_free(c, sp->region, (size_t)K, sizeof(hd__box_t));
+    hd__mpi_free(c, sp->held, (size_t)K, sizeof(held_t));
+    memset(sp, 0, sizeof *sp);
+}
+
+/* The figures every call reports (collective): pts is this rank's points
+ * after the partition; *tmax receives the slowest rank's seconds. */
+int hd__mpi_figures(ctx_t *c, const course_t *cs, uint64_t pts, hd_mpi_stats_t *st, double *tmax) {
+    int K = c->K;
+    const uint64_t *N = cs->N;
+    double t0 = cs->t0, cpu0 = cs->cpu0;
+    double other = hd__mpi_cpu() - cpu0 - c->search_cpu - c->mpi_cpu;
+    double secs = hd__now() - t0, tsum = secs, mine[4] = {secs, c->search, c->search_cpu, other}, most[4];
+    MPI_TRY(c, MPI_Allreduce(mine, most, 4, MPI_DOUBLE, MPI_MAX, c->comm));
+    *tmax = most[0];
+    MPI_TRY(c, MPI_Allreduce(&secs, &tsum, 1, MPI_DOUBLE, MPI_SUM, c->comm));
+    if (!st) return HD_OK;
+    uint64_t work = pts + c->answered;
+    uint64_t sums[7] = {c->bytes_part, c->bytes_fwd, c->forwarded, c->forwarded_points, work, c->shell,
+                        c->bytes_back},
+             gs[7];
+    uint64_t maxes[3] = {pts, work, c->peak}, gm[3];
+    MPI_TRY(c, MPI_Allreduce(sums, gs, 7, MPI_UINT64_T, MPI_SUM, c->comm));
+    MPI_TRY(c, MPI_Allreduce(maxes, gm, 3, MPI_UINT64_T, MPI_MAX, c->comm));
+    memset(st, 0, sizeof *st);
+    st->ranks = K;
+    st->points = N[0] + N[1];
+    st->bytes_partition = gs[0];
+    st->bytes_forwarding = gs[1];
+    st->bytes_returned = gs[6];
+    st->forwarded = gs[2];
+    st->forwarded_points = gs[3];
+    st->shell_points = gs[5];
+    st->rounds = c->rounds;
+    st->points_max = gm[0];
+    st->imbalance = (double)gm[0] * K / (double)st->points;
+    st->work_imbalance = (double)gm[1] * K / (double)gs[4];
+    st->seconds_max = most[0];
+    st->seconds_mean = tsum / K;
+    st->search_seconds_max = most[1];
+    st->search_seconds = c->search;
+    st->search_cpu_max = most[2];
+    st->other_cpu_max = most[3];
+    st->other_cpu = other;
+    st->peak_bytes_max = gm[2];
+    st->seconds = secs;
+    st->local_points = pts;
+    st->peak_bytes = c->peak;
+    return HD_OK;
+}
+
+void hd__mpi_course_init(ctx_t *c, course_t *cs) {
+    memset(cs, 0, sizeof *cs);
+    cs->rg.K = c->K;
+    cs->t0 = hd__now();
+    cs->cpu0 = hd__mpi_cpu();
+}
+
+void hd__mpi_course_free(ctx_t *c, course_t *cs) {
+    hd__mpi_spread_free(c, &cs->sp);
+    hd__mpi_ranges_free(c, &cs->rg);
 }
 
 enum { MODE_DIRECTED = 0, MODE_BOTH = 1, MODE_OVERLAP = 2 };
 typedef struct { double *alpha; int *disjoint; } overlap_t;
+typedef struct { int mode; void *res; } what_t;
 
-/* `both` is a MODE_*: res is an hd_result_t, an hd_symmetric_t or an
- * overlap_t. */
-static int run(ctx_t *c, const hd_options_t *opt, input_t *in, int both, void *res, hd_mpi_stats_t *st) {
+/* The Hausdorff distance's course.  what->mode is a MODE_*: what->res is
+ * an hd_result_t, an hd_symmetric_t or an overlap_t. */
+static int run(ctx_t *c, const hd_options_t *opt, input_t *in, void *arg, hd_mpi_stats_t *st) {
+    const what_t *what = arg;
+    int both = what->mode;
+    void *res = what->res;
     hd_symmetric_t *out = both == MODE_BOTH ? res : NULL;
     int K = c->K;
-    double t0 = hd__now(), cpu0 = hd__mpi_cpu();
-    node_t *tree = NULL;
-    hd__box_t *region = NULL;
-    held_t *held = NULL;
-    local_t loc = {{NULL, NULL}, {NULL, NULL}, {NULL, NULL}, {NULL, NULL}, {0, 0}};
-    ranges_t rg = {K, NULL, 0, NULL, NULL};
-    int rc = hd__mpi_check_local(c, opt, in, res);
-    if ((rc = hd__mpi_agree(c, rc)) != HD_OK) return rc;
-    if ((rc = hd__mpi_check_ranges(c, in, &rg)) != HD_OK) goto done;
-    uint64_t n[2] = {in->n[0], in->n[1]}, N[2];
-    MPI_GO(c, rc, MPI_Allreduce(n, N, 2, MPI_UINT64_T, MPI_SUM, c->comm));
-    if (N[0] == 0 || N[1] == 0) {
-        rc = hd__err(&c->e, HD_EEMPTY, "point set %s is empty", N[0] ? "B" : "A");
-        goto done;
-    }
-    /* Global boxes (hi negated: one MIN), and alpha as hd_overlap gives it. */
-    double bx[12], gb[12];
-    for (int s = 0; s < 2; s++)
-        for (int k = 0; k < 3; k++) bx[6 * s + k] = in->box[s].lo[k], bx[6 * s + 3 + k] = -in->box[s].hi[k];
-    MPI_GO(c, rc, MPI_Allreduce(bx, gb, 12, MPI_DOUBLE, MPI_MIN, c->comm));
+    course_t cs;
+    hd__mpi_course_init(c, &cs);
     double corners[2][6];
-    for (int s = 0; s < 2; s++)
-        for (int k = 0; k < 3; k++) corners[s][k] = gb[6 * s + k], corners[s][3 + k] = -gb[6 * s + 3 + k];
+    int rc = hd__mpi_begin(c, opt, in, res, &cs.rg, cs.N, corners);
+    if (rc != HD_OK) goto done;
     hd_points_t ca = hd_points_f64(corners[0], 2), cb = hd_points_f64(corners[1], 2);
     if (both == MODE_OVERLAP) {
         overlap_t *o = res;
@@ -197,52 +309,35 @@ static int run(ctx_t *c, const hd_options_t *opt, input_t *in, int both, void *r
     far_t f[2];
     uint64_t pts;
     if (K == 1) {
-        if ((rc = single(c, in, &rg, both, f)) != HD_OK) goto done;
+        if ((rc = single(c, in, &cs.rg, both, f)) != HD_OK) goto done;
         pts = in->n[0] + in->n[1];
     } else {
-        tree = hd__mpi_alloc(c, (size_t)K - 1, sizeof(node_t));
-        region = hd__mpi_alloc(c, (size_t)K, sizeof(hd__box_t));
-        held = hd__mpi_alloc(c, (size_t)K, sizeof(held_t));
-        if (!tree || !region || !held) rc = hd__mpi_nomem(c, "the partition", (size_t)K);
-        if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
-        if ((rc = hd__mpi_partition(c, in, N[0] + N[1], tree)) != HD_OK) goto done;
-        hd__box_t all = {{-INFINITY, -INFINITY, -INFINITY}, {INFINITY, INFINITY, INFINITY}};
-        hd__mpi_regions(tree, 0, all, region);
-        if ((rc = hd__mpi_exchange(c, in, &rg, tree, &loc)) != HD_OK) goto done;
-
-        /* What every rank holds now. */
-        held_t h;
-        for (int s = 0; s < 2; s++) {
-            h.n[s] = loc.n[s];
-            if (loc.n[s]) hd__box_of(loc.xyz[s], loc.n[s], &h.box[s]);
-            else
-                for (int k = 0; k < 3; k++) h.box[s].lo[k] = INFINITY, h.box[s].hi[k] = -INFINITY;
-        }
-        MPI_GO(c, rc, MPI_Allgather(&h, (int)sizeof h, MPI_BYTE, held, (int)sizeof h, MPI_BYTE, c->comm));
-        gidx_t gi[2];
-        for (int t = 0; t < 2; t++) gi[t] = (gidx_t){loc.g[t], loc.num[t], loc.start[t], &rg, t, K};
+        spread_t *sp = &cs.sp;
+        if ((rc = hd__mpi_spread(c, in, &cs.rg, cs.N, sp)) != HD_OK) goto done;
+        local_t *loc = &sp->loc;
         /* Both directions: the engine once for both (each of its calls
-         * builds both sets' structures); its failure is agreed on by the
-         * first direction. */
+         * builds both sets' structures); its failure is agreed on before
+         * the first direction. */
         pre_t pre[2];
         memset(pre, 0, sizeof pre);
         unsigned char *mask[2] = {NULL, NULL};
         int pre_rc = HD_OK;
         if (both) {
-            const gidx_t *gp[2] = {&gi[0], &gi[1]};
+            const gidx_t *gp[2] = {&sp->gi[0], &sp->gi[1]};
             double t1 = hd__now(), u1 = hd__mpi_cpu();
-            pre_rc = hd__mpi_engine_both(c, loc.xyz, gp, loc.n, pre, mask);
+            pre_rc = hd__mpi_engine_both(c, loc->xyz, gp, loc->n, pre, mask);
             c->search += hd__now() - t1;
             c->search_cpu += hd__mpi_cpu() - u1;
         }
         rc = hd__mpi_agree(c, pre_rc);
         for (int s = 0; s < (both ? 2 : 1) && rc == HD_OK; s++) {
-            dir_t d = {loc.xyz[s], &gi[s], loc.n[s], loc.xyz[1 - s], &gi[1 - s], loc.n[1 - s], 1 - s, &pre[s]};
-            rc = hd__mpi_direction(c, &d, tree, region, held, &f[s]);
+            dir_t d = {loc->xyz[s], &sp->gi[s], loc->n[s], loc->xyz[1 - s], &sp->gi[1 - s], loc->n[1 - s], 1 - s,
+                       &pre[s]};
+            rc = hd__mpi_direction(c, &d, sp->tree, sp->region, sp->held, &f[s]);
         }
-        for (int s = 0; s < 2; s++) hd__mpi_free(c, mask[s], loc.n[s], 1);
+        for (int s = 0; s < 2; s++) hd__mpi_free(c, mask[s], loc->n[s], 1);
         if (rc != HD_OK) goto done;
-        pts = loc.n[0] + loc.n[1];
+        pts = loc->n[0] + loc->n[1];
     }
     hd_result_t *r[2] = {both ? &out->ab : res, both ? &out->ba : NULL};
     for (int s = 0; s < (both ? 2 : 1); s++) {
@@ -252,63 +347,20 @@ static int run(ctx_t *c, const hd_options_t *opt, input_t *in, int both, void *r
         r[s]->j = (size_t)f[s].j;
         r[s]->algorithm = HD_ALG_AUTO;
     }
-    /* Figures. */
-    double other = hd__mpi_cpu() - cpu0 - c->search_cpu - c->mpi_cpu;
-    double secs = hd__now() - t0, tmax = secs, tsum = secs, mine[4] = {secs, c->search, c->search_cpu, other}, most[4];
-    MPI_GO(c, rc, MPI_Allreduce(mine, most, 4, MPI_DOUBLE, MPI_MAX, c->comm));
-    tmax = most[0];
-    MPI_GO(c, rc, MPI_Allreduce(&secs, &tsum, 1, MPI_DOUBLE, MPI_SUM, c->comm));
+    double tmax;
+    if ((rc = hd__mpi_figures(c, &cs, pts, st, &tmax)) != HD_OK) goto done;
     for (int s = 0; s < (both ? 2 : 1); s++) r[s]->seconds = tmax;
     if (both) {
         out->distance = out->ab.distance2 >= out->ba.distance2 ? out->ab.distance : out->ba.distance;
         out->seconds = tmax;
     }
-    if (st) {
-        uint64_t work = pts + c->answered;
-        uint64_t sums[6] = {c->bytes_part, c->bytes_fwd, c->forwarded, c->forwarded_points, work, c->shell}, gs[6];
-        uint64_t maxes[3] = {pts, work, c->peak}, gm[3];
-        MPI_GO(c, rc, MPI_Allreduce(sums, gs, 6, MPI_UINT64_T, MPI_SUM, c->comm));
-        MPI_GO(c, rc, MPI_Allreduce(maxes, gm, 3, MPI_UINT64_T, MPI_MAX, c->comm));
-        memset(st, 0, sizeof *st);
-        st->ranks = K;
-        st->points = N[0] + N[1];
-        st->bytes_partition = gs[0];
-        st->bytes_forwarding = gs[1];
-        st->forwarded = gs[2];
-        st->forwarded_points = gs[3];
-        st->shell_points = gs[5];
-        st->rounds = c->rounds;
-        st->points_max = gm[0];
-        st->imbalance = (double)gm[0] * K / (double)st->points;
-        st->work_imbalance = (double)gm[1] * K / (double)gs[4];
-        st->seconds_max = tmax;
-        st->seconds_mean = tsum / K;
-        st->search_seconds_max = most[1];
-        st->search_seconds = c->search;
-        st->search_cpu_max = most[2];
-        st->other_cpu_max = most[3];
-        st->other_cpu = other;
-        st->peak_bytes_max = gm[2];
-        st->seconds = secs;
-        st->local_points = pts;
-        st->peak_bytes = c->peak;
-    }
 done:
-    for (int s = 0; s < 2; s++) {
-        hd__mpi_free(c, loc.xyz[s], loc.n[s], 3 * sizeof(double));
-        hd__mpi_free(c, loc.g[s], loc.n[s], sizeof(uint64_t));
-        hd__mpi_free(c, loc.num[s], loc.n[s], sizeof(uint32_t));
-        if (loc.start[s]) hd__mpi_free(c, loc.start[s], (size_t)K + 1, sizeof(size_t));
-    }
-    hd__mpi_free(c, tree, (size_t)K - 1, sizeof(node_t));
-    hd__mpi_free(c, region, (size_t)K, sizeof(hd__box_t));
-    hd__mpi_free(c, held, (size_t)K, sizeof(held_t));
-    hd__mpi_ranges_free(c, &rg);
+    hd__mpi_course_free(c, &cs);
     return rc;
 }
 
-static int call(MPI_Comm comm, const hd_mpi_part_t *a, size_t na, const hd_mpi_part_t *b, size_t nb,
-                const hd_options_t *opt, int both, void *out, hd_mpi_stats_t *st, hd_error_t *err) {
+int hd__mpi_call(MPI_Comm comm, const hd_mpi_part_t *a, size_t na, const hd_mpi_part_t *b, size_t nb,
+                 const hd_options_t *opt, hd__mpi_body_t body, void *arg, hd_mpi_stats_t *st, hd_error_t *err) {
     hd__err_clear(err);
     ctx_t c;
     memset(&c, 0, sizeof c);
@@ -332,7 +384,7 @@ static int call(MPI_Comm comm, const hd_mpi_part_t *a, size_t na, const hd_mpi_p
         rc = hd__mpi_types_create(&c);
         if ((rc = hd__mpi_agree(&c, rc)) == HD_OK) {
             input_t in = {{a, b}, {na, nb}, {0, 0}, {{{0}, {0}}, {{0}, {0}}}};
-            rc = run(&c, opt, &in, both, out, st);
+            rc = body(&c, opt, &in, arg, st);
         }
         /* Every buffer of the call was freed, on every path (the
          * sanitizer build checks this instead of LeakSanitizer, which
@@ -347,17 +399,20 @@ static int call(MPI_Comm comm, const hd_mpi_part_t *a, size_t na, const hd_mpi_p
 
 int hd_mpi_hausdorff(MPI_Comm comm, const hd_mpi_part_t *a, size_t na, const hd_mpi_part_t *b, size_t nb,
                      const hd_options_t *opt, hd_symmetric_t *out, hd_mpi_stats_t *stats, hd_error_t *err) {
-    return call(comm, a, na, b, nb, opt, MODE_BOTH, out, stats, err);
+    what_t w = {MODE_BOTH, out};
+    return hd__mpi_call(comm, a, na, b, nb, opt, run, &w, stats, err);
 }
 
 int hd_mpi_directed(MPI_Comm comm, const hd_mpi_part_t *a, size_t na, const hd_mpi_part_t *b, size_t nb,
                     const hd_options_t *opt, hd_result_t *out, hd_mpi_stats_t *stats, hd_error_t *err) {
-    return call(comm, a, na, b, nb, opt, MODE_DIRECTED, out, stats, err);
+    what_t w = {MODE_DIRECTED, out};
+    return hd__mpi_call(comm, a, na, b, nb, opt, run, &w, stats, err);
 }
 
 int hd_mpi_overlap(MPI_Comm comm, const hd_mpi_part_t *a, size_t na, const hd_mpi_part_t *b, size_t nb,
                    double *alpha, int *disjoint, hd_error_t *err) {
     overlap_t o = {alpha, disjoint};
     if (!alpha || !disjoint) o.alpha = NULL; /* refused by check_local, on every rank */
-    return call(comm, a, na, b, nb, NULL, MODE_OVERLAP, o.alpha ? &o : NULL, NULL, err);
+    what_t w = {MODE_OVERLAP, o.alpha ? &o : NULL};
+    return hd__mpi_call(comm, a, na, b, nb, NULL, run, &w, NULL, err);
 }

@@ -43,6 +43,7 @@ typedef struct ctx {
     hd_error_t e;
     size_t cur, peak;          /* bytes of this call's buffers */
     uint64_t bytes_part, bytes_fwd, forwarded, forwarded_points, answered;
+    uint64_t bytes_back;       /* per-point answers sent back (distances.c) */
     double search;             /* seconds in the engine and hd_distances */
     double search_cpu;         /* the calling thread's CPU seconds there */
     double mpi_cpu;            /* ... and in MPI calls */
@@ -197,6 +198,7 @@ typedef struct {
 } dir_t;
 
 int hd__mpi_by_offset(const void *x, const void *y);
+int hd__mpi_by_range(const void *x, const void *y); /* range_t by (side, lo) */
 void hd__mpi_ranges_free(ctx_t *c, ranges_t *rg);
 void hd__mpi_ranges_globals(const ranges_t *rg, int s, int r, const uint32_t *num, size_t n, uint64_t *g);
 uint64_t hd__mpi_ranges_global(const ranges_t *rg, int s, int r, uint64_t m);
@@ -211,6 +213,13 @@ hd__box_t hd__mpi_node_boxes(const node_t *t, int node, const held_t *held, int 
 void hd__mpi_candidates(const node_t *t, const hd__box_t *nbox, const held_t *held, int side, int node,
                         const double *p, double u2, int me, int *list, int *n);
 int hd__mpi_partition(ctx_t *c, const input_t *in, uint64_t N, node_t *tree);
+/* The ranks other than `me` that p must ask (into list; their number is
+ * returned): those whose box of `side` may hold a point within u2 of p,
+ * ties included; when this rank holds no point of `side` (none_here), u2
+ * is first lowered to the nearest farthest corner of the nonempty boxes,
+ * which bounds the distance to the nearest point from above. */
+int hd__mpi_asked(const node_t *t, const hd__box_t *nbox, const held_t *held, int K, int side, int none_here,
+                  const double *p, double u2, int me, int *list);
 
 typedef struct {
     double *xyz[2];
@@ -257,6 +266,9 @@ typedef struct {
 } qtree_t;
 
 void hd__mpi_qtree_free(ctx_t *c, qtree_t *q);
+/* The nearest layer's structure of v, charged (60 bytes a point while
+ * built, then what it holds: *bytes, to subtract when it is freed). */
+int hd__mpi_an_build(ctx_t *c, hd__an_t *s, const hd_points_t *v, const hd__box_t *kb, int threads, size_t *bytes);
 int hd__mpi_nearest_in_q(ctx_t *c, const dir_t *d, const hd__box_t *r, qtree_t *q, const double *pts, size_t n,
                          size_t *near);
 
@@ -298,7 +310,66 @@ int hd__mpi_shell_of(ctx_t *c, const dir_t *d, const hd__box_t *mine, qtree_t *q
 
 /* ---- one direction over the partition (forward.c) ------------------------ */
 
+/* Forwarded queries: point k of the asking set to rank dest. */
+typedef struct { size_t k; int dest; int pad; } pair_t;
+typedef struct { pair_t *p; size_t n, cap; } pairs_t;
+int hd__mpi_pairs_add(ctx_t *c, pairs_t *pr, size_t k, const int *list, int n);
+void hd__mpi_pairs_free(ctx_t *c, pairs_t *pr);
+
+/* Answers m queries pts against this rank's local set: exact (d2,
+ * smallest global index), or (infinity, UINT64_MAX) when it holds none. */
+typedef int (*hd__mpi_answer_t)(ctx_t *c, void *arg, const double *pts, size_t m, ans_t *ans);
+
+/* One round of forwarding (collective; rc is the caller's status, agreed
+ * first): each pair (k, r) sends point k of P to rank r, every rank
+ * answers what it receives with fn, and each answer replaces (u2[k],
+ * jj[k]) when smaller (d2 first, then the index). */
+int hd__mpi_round(ctx_t *c, int rc, const double *P, const pairs_t *pr, hd__mpi_answer_t fn, void *arg,
+                  double *u2, uint64_t *jj);
+
 int hd__mpi_direction(ctx_t *c, const dir_t *d, const node_t *tree, const hd__box_t *region, const held_t *held,
                       far_t *result);
+
+/* ---- the course of a call (mpi.c) ---------------------------------------- */
+
+/* What the ranks hold after the partition (K > 1). */
+typedef struct {
+    node_t *tree;            /* K - 1 nodes */
+    hd__box_t *region;       /* K: every rank's region */
+    held_t *held;            /* K: every rank's count and box a set */
+    local_t loc;             /* this rank's points */
+    gidx_t gi[2];            /* their global indices */
+} spread_t;
+
+/* K = 1: each set as one view (the caller's, or packed in index order). */
+typedef struct {
+    hd_points_t v[2];
+    double *own[2];
+    const hd_mpi_part_t **order[2];
+} views_t;
+
+/* What a call's body holds from its start to its end. */
+typedef struct {
+    ranges_t rg;
+    spread_t sp;             /* K > 1 */
+    uint64_t N[2];           /* points of A and B over all ranks */
+    double t0, cpu0;         /* the body's start (wall, thread CPU) */
+} course_t;
+
+void hd__mpi_course_init(ctx_t *c, course_t *cs);
+void hd__mpi_course_free(ctx_t *c, course_t *cs);
+int hd__mpi_figures(ctx_t *c, const course_t *cs, uint64_t pts, hd_mpi_stats_t *st, double *tmax);
+
+/* A call's body, run by hd__mpi_call inside its context. */
+typedef int (*hd__mpi_body_t)(ctx_t *c, const hd_options_t *opt, input_t *in, void *arg, hd_mpi_stats_t *st);
+
+int hd__mpi_call(MPI_Comm comm, const hd_mpi_part_t *a, size_t na, const hd_mpi_part_t *b, size_t nb,
+                 const hd_options_t *opt, hd__mpi_body_t body, void *arg, hd_mpi_stats_t *st, hd_error_t *err);
+int hd__mpi_begin(ctx_t *c, const hd_options_t *opt, input_t *in, const void *res, ranges_t *rg, uint64_t N[2],
+                  double corners[2][6]);
+int hd__mpi_spread(ctx_t *c, const input_t *in, const ranges_t *rg, const uint64_t N[2], spread_t *sp);
+void hd__mpi_spread_free(ctx_t *c, spread_t *sp);
+int hd__mpi_views(ctx_t *c, const input_t *in, views_t *vw);
+void hd__mpi_views_free(ctx_t *c, const input_t *in, views_t *vw);
 
 #endif /* HD_MPI_INT_H */

@@ -32,7 +32,7 @@ int hd__mpi_by_offset(const void *x, const void *y) {
     return p->offset < q->offset ? -1 : p->offset > q->offset;
 }
 
-static int by_range(const void *x, const void *y) {
+int hd__mpi_by_range(const void *x, const void *y) {
     const range_t *p = x, *q = y;
     if (p->side != q->side) return p->side - q->side;
     return p->lo < q->lo ? -1 : p->lo > q->lo;
@@ -158,7 +158,7 @@ int hd__mpi_check_ranges(ctx_t *c, const input_t *in, ranges_t *rg) {
     hd__mpi_free(c, mine, (size_t)n, sizeof(range_t));
     if (rc == HD_OK) {
         range_t *all = rg->all;
-        qsort(all, total, sizeof(range_t), by_range);
+        qsort(all, total, sizeof(range_t), hd__mpi_by_range);
         for (size_t k = 1; k < total; k++)
             if (all[k].side == all[k - 1].side && all[k].lo <= all[k - 1].hi) {
                 rc = hd__err(&c->e, HD_EINVAL,

@@ -168,6 +168,20 @@ static void cursor_seek(const input_t *in, uint64_t t, cursor_t *cu) {
         }
 }
 
+int hd__mpi_asked(const node_t *t, const hd__box_t *nbox, const held_t *held, int K, int side, int none_here,
+                  const double *p, double u2, int me, int *list) {
+    double bound = u2;
+    if (none_here)
+        for (int r = 0; r < K; r++)
+            if (held[r].n[side]) {
+                double ub = hd__box_ub2(&held[r].box[side], p);
+                if (ub < bound) bound = ub;
+            }
+    int n = 0;
+    if (K > 1) hd__mpi_candidates(t, nbox, held, side, 0, p, bound, me, list, &n);
+    return n;
+}
+
 /* Rank 0 builds the RCB tree from everyone's samples; all get it. */
 int hd__mpi_partition(ctx_t *c, const input_t *in, uint64_t N, node_t *tree) {
     int rc = HD_OK, K = c->K;

@@ -39,7 +39,7 @@ static size_t an_bytes(const hd__an_t *s) {
            (s->ng + 1) * 2 * sizeof(uint32_t) + s->nn * (sizeof(uint32_t) + 1 + 6 * sizeof(double));
 }
 
-static int an_build(ctx_t *c, hd__an_t *s, const hd_points_t *v, const hd__box_t *kb, int threads, size_t *bytes) {
+int hd__mpi_an_build(ctx_t *c, hd__an_t *s, const hd_points_t *v, const hd__box_t *kb, int threads, size_t *bytes) {
     size_t b = AN_BUILD_BYTES * v->count;
     hd__mpi_charge(c, b);
     int rc = hd__an_build(s, v, NULL, kb, threads, &c->e);
@@ -113,7 +113,7 @@ static int slab_build(ctx_t *c, const dir_t *d, const hd__box_t *r, double M, sl
     hd_points_t v = hd_points_f64(xyz ? xyz : d->Q, n);
     if (rc == HD_OK && n > 0) {
         hd__box_of(xyz ? xyz : d->Q, n, &sl->kb); /* keys only order (clamped): any box is exact */
-        rc = an_build(c, &sl->s, &v, &sl->kb, hd__thread_count(c->threads, n), &sl->bytes);
+        rc = hd__mpi_an_build(c, &sl->s, &v, &sl->kb, hd__thread_count(c->threads, n), &sl->bytes);
         sl->built = 1; /* freed by slab_free whatever happened */
     }
     hd__mpi_free(c, xyz, n, 3 * sizeof(double));
@@ -138,7 +138,7 @@ static int slab_search(ctx_t *c, const slab_t *sl, const double *pts, const size
     size_t ab = 0;
     int threads = hd__thread_count(c->threads, m > sl->n ? m : sl->n);
     hd_points_t Sv = hd_points_f64(xyz, m);
-    if (rc == HD_OK && (rc = an_build(c, &asking, &Sv, &sl->kb, threads, &ab)) == HD_OK)
+    if (rc == HD_OK && (rc = hd__mpi_an_build(c, &asking, &Sv, &sl->kb, threads, &ab)) == HD_OK)
         rc = hd__an_nearest(&asking, &sl->s, NULL, threads, NULL, got, NULL, &c->e);
     if (ab) {
         hd__an_free(&asking);

@@ -259,14 +259,19 @@ static void make_set(int which, uint64_t seed, set_t *s) {
 
 /* ---- the checks --------------------------------------------------------- */
 
+/* A case: the set, the context printed on failure, one thread. */
+static void open_case(const char *call, int which, int how, uint64_t seed, set_t *s, hd_options_t *opt) {
+    make_set(which, seed, s);
+    snprintf(context_, sizeof context_, "%s: set \"%s\", layout \"%s\", seed %llu", call, s->name, lay_name[how],
+             (unsigned long long)seed);
+    hd_options_init(opt);
+    opt->threads = 1;
+}
+
 static void check_equal(int which, int how, uint64_t seed) {
     set_t s = {"", NULL, NULL, 0, 0};
-    make_set(which, seed, &s);
-    snprintf(context_, sizeof context_, "set \"%s\", layout \"%s\", seed %llu", s.name, lay_name[how],
-             (unsigned long long)seed);
     hd_options_t opt;
-    hd_options_init(&opt);
-    opt.threads = 1;
+    open_case("hausdorff", which, how, seed, &s, &opt);
     hd_points_t A = hd_points_f64(s.a, s.na), B = hd_points_f64(s.b, s.nb);
     hd_symmetric_t ref, got;
     hd_error_t err;
@@ -309,6 +314,75 @@ static void check_equal(int which, int how, uint64_t seed) {
         CHECK(hd_mpi_overlap(MPI_COMM_WORLD, pa, na, pb, nb, &alpha, &disjoint, &err) == HD_OK);
         CHECK(SAME_BITS(alpha, ref.alpha) && disjoint == ref.disjoint);
     }
+    free(s.a);
+    free(s.b);
+}
+
+/* hd_mpi_distances gives every rank, for its own points in the order of
+ * its parts, what hd_distances gives on the whole sets: the distances to
+ * the bit and the smallest nearest index, both directions; and each
+ * direction alone (the other's outputs NULL on every rank). */
+static size_t gather_expected(const hd_mpi_part_t *parts, size_t np, const double *ref_d, const size_t *ref_n,
+                              double *d, size_t *n) {
+    size_t t = 0;
+    for (size_t p = 0; p < np; p++)
+        for (size_t k = 0; k < parts[p].points.count; k++, t++) {
+            d[t] = ref_d[parts[p].offset + k];
+            n[t] = ref_n[parts[p].offset + k];
+        }
+    return t;
+}
+
+static int same_answers(const double *d, const size_t *n, const double *ed, const size_t *en, size_t m,
+                        const char *what) {
+    for (size_t k = 0; k < m; k++)
+        if (memcmp(&d[k], &ed[k], sizeof(double)) != 0 || n[k] != en[k]) {
+            fprintf(stderr, "rank %d: %s: point %zu of %zu: got %.17g [%zu], expected %.17g [%zu]\n", rank_, what, k,
+                    m, d[k], n[k], ed[k], en[k]);
+            return 0;
+        }
+    return 1;
+}
+
+static void check_distances(int which, int how, uint64_t seed) {
+    set_t s = {"", NULL, NULL, 0, 0};
+    hd_options_t opt;
+    open_case("distances", which, how, seed, &s, &opt);
+    hd_points_t A = hd_points_f64(s.a, s.na), B = hd_points_f64(s.b, s.nb);
+    double *rd_ab = malloc(s.na * sizeof(double)), *rd_ba = malloc(s.nb * sizeof(double));
+    size_t *rn_ab = malloc(s.na * sizeof(size_t)), *rn_ba = malloc(s.nb * sizeof(size_t));
+    hd_error_t err;
+    CHECK(hd_distances(&A, &B, &opt, rd_ab, rn_ab, rd_ba, rn_ba, &err) == HD_OK);
+    hd_mpi_part_t pa[400], pb[400];
+    size_t na = layout(how, 0, s.a, s.na, seed, pa, 400), nb = layout(how, 1, s.b, s.nb, seed, pb, 400);
+    /* this rank's expected answers, and room for the call's */
+    double *ed_ab = malloc((s.na + 1) * sizeof(double)), *ed_ba = malloc((s.nb + 1) * sizeof(double));
+    size_t *en_ab = malloc((s.na + 1) * sizeof(size_t)), *en_ba = malloc((s.nb + 1) * sizeof(size_t));
+    double *d_ab = malloc((s.na + 1) * sizeof(double)), *d_ba = malloc((s.nb + 1) * sizeof(double));
+    size_t *n_ab = malloc((s.na + 1) * sizeof(size_t)), *n_ba = malloc((s.nb + 1) * sizeof(size_t));
+    size_t ma = gather_expected(pa, na, rd_ab, rn_ab, ed_ab, en_ab), mb = gather_expected(pb, nb, rd_ba, rn_ba, ed_ba, en_ba);
+    hd_mpi_stats_t st;
+    int rc = hd_mpi_distances(MPI_COMM_WORLD, pa, na, pb, nb, &opt, d_ab, n_ab, d_ba, n_ba, &st, &err);
+    CHECK(rc == HD_OK);
+    if (rc != HD_OK) fprintf(stderr, "rank %d: %s\n", rank_, err.message);
+    CHECK(same_answers(d_ab, n_ab, ed_ab, en_ab, ma, "A to B"));
+    CHECK(same_answers(d_ba, n_ba, ed_ba, en_ba, mb, "B to A"));
+    CHECK(st.points == s.na + s.nb && st.ranks == K_ && st.rounds == (K_ > 1 ? 2 : 0));
+    /* one direction at a time, on two layouts: the other's outputs NULL */
+    if (how == LAY_HOLES || how == LAY_CHUNKS) {
+        memset(d_ab, 0, (s.na + 1) * sizeof(double));
+        memset(n_ba, 0, (s.nb + 1) * sizeof(size_t));
+        CHECK(hd_mpi_distances(MPI_COMM_WORLD, pa, na, pb, nb, &opt, d_ab, NULL, NULL, NULL, &st, &err) == HD_OK);
+        CHECK(st.rounds == (K_ > 1 ? 1 : 0));
+        for (size_t k = 0; k < ma; k++) n_ab[k] = en_ab[k];
+        CHECK(same_answers(d_ab, n_ab, ed_ab, en_ab, ma, "A to B alone"));
+        CHECK(hd_mpi_distances(MPI_COMM_WORLD, pa, na, pb, nb, &opt, NULL, NULL, NULL, n_ba, &st, &err) == HD_OK);
+        for (size_t k = 0; k < mb; k++) d_ba[k] = ed_ba[k];
+        CHECK(same_answers(d_ba, n_ba, ed_ba, en_ba, mb, "B to A alone"));
+    }
+    free(rd_ab), free(rd_ba), free(rn_ab), free(rn_ba);
+    free(ed_ab), free(ed_ba), free(en_ab), free(en_ba);
+    free(d_ab), free(d_ba), free(n_ab), free(n_ba);
     free(s.a);
     free(s.b);
 }
@@ -383,10 +457,28 @@ static void check_errors(void) {
                                   NULL, &err),
                  HD_ERANGE, &err, "more than 2^32 - 1 points");
 
+    /* hd_mpi_distances agrees on failures the same way */
+    double dd[10];
+    size_t nn[10];
+    snprintf(context_, sizeof context_, "distances: a NaN on rank %d only", bad);
+    check_agreed(hd_mpi_distances(MPI_COMM_WORLD, &pn, 1, &pb, 1, NULL, dd, nn, NULL, NULL, NULL, &err),
+                 HD_ENONFINITE, &err, "rank");
+    snprintf(context_, sizeof context_, "distances: B empty on every rank");
+    check_agreed(hd_mpi_distances(MPI_COMM_WORLD, &pa, 1, NULL, 0, NULL, dd, nn, NULL, NULL, NULL, &err), HD_EEMPTY,
+                 &err, "point set B is empty");
+    snprintf(context_, sizeof context_, "distances: threads = -1 on rank %d only", bad);
+    check_agreed(hd_mpi_distances(MPI_COMM_WORLD, &pa, 1, &pb, 1, &opt, dd, nn, NULL, NULL, NULL, &err), HD_EINVAL,
+                 &err, "threads");
+
     /* and after all that, a good call still works */
     snprintf(context_, sizeof context_, "a good call after the failures");
     CHECK(hd_mpi_hausdorff(MPI_COMM_WORLD, &pa, 1, &pb, 1, NULL, &r, NULL, &err) == HD_OK);
     CHECK(r.ab.distance2 == 0.75 && r.ab.i == 0 && r.ab.j == 0);
+    /* every rank holds the same ten points of each set: A's point k is
+     * nearest to B's point k of every rank, and rank 0's has the smallest
+     * index */
+    CHECK(hd_mpi_distances(MPI_COMM_WORLD, &pa, 1, &pb, 1, NULL, dd, nn, NULL, NULL, NULL, &err) == HD_OK);
+    for (size_t k = 0; k < 10; k++) CHECK(dd[k] == sqrt(0.75) && nn[k] == k);
 }
 
 /* On one rank the call copies no point: a set given as one part, of any
@@ -478,6 +570,7 @@ int main(int argc, char **argv) {
         if (only && strcmp(only, "errors") != 0 && atoi(only) != which) continue;
         if (only && strcmp(only, "errors") == 0) break;
         for (int how = 0; how < LAY_COUNT; how++) check_equal(which, how, 1000 + (uint64_t)which);
+        for (int how = 0; how < LAY_COUNT; how++) check_distances(which, how, 1000 + (uint64_t)which);
     }
     int all[2] = {failures, checks}, sum[2];
     MPI_Reduce(all, sum, 2, MPI_INT, MPI_SUM, 0, MPI_COMM_WORLD);

@@ -1,0 +1,429 @@
+/*
+ * distances.c -- per-point nearest neighbours over the ranks
+ * (hd_mpi_distances): for every point a of A, on the rank that holds it,
+ * the distance to its nearest point of all of B and that point's smallest
+ * global index; likewise for B against A.  Bit for bit what hd_distances
+ * gives on the union of all ranks' points.
+ *
+ * The course, on the partition of the Hausdorff distance (mpi.c's essay,
+ * steps 1 and 2: the same RCB regions, the same exchange):
+ *  1. Local pass.  Each rank builds the nearest layer's structures (what
+ *     hd_distances builds) of its local A and B, and every local point a of
+ *     P gets u(a)^2, the exact minimum of hd__d2 over local Q, and j(a), the
+ *     smallest local position at it (hd__an_nearest: smallest position on
+ *     ties; local order is global index order, so the smallest global
+ *     index of local Q at u(a)).
+ *  2. Forwarding.  a is exact when its region's faces are clear of u(a)^2
+ *     (hd__mpi_faces_clear, the proof of mpi.c's step 4: every point of
+ *     another region is farther than u(a), none ties), or when no other
+ *     rank's box of Q has hd__box_lb2 <= u(a)^2 (a computed lower bound of
+ *     every distance to a point inside: every rank that may hold a point
+ *     at u(a) or nearer, ties included, is a candidate).  A rank with no
+ *     local Q bounds u(a) by the smallest hd__box_ub2 over the nonempty
+ *     boxes (at least the distance to every point inside one of them, so
+ *     the nearest point is within it).  No lower bound L prunes here: every
+ *     point needs its exact answer.  The other points go, in one round, to
+ *     each candidate rank, which answers with its exact (d2, smallest
+ *     global index) from its structure of local Q; the asker keeps the
+ *     smaller pair (d2 first, then the index): the exact global answer,
+ *     since every value compared is an hd__d2 of the same doubles.
+ *  3. Return.  The answers go back to the ranks that hold the points, by
+ *     the reverse of the exchange: a sender's points arrived in its walk
+ *     order (parts by offset, then points), and the local arrays keep that
+ *     order within each sender (in runs when received in index order; when
+ *     the runs were merged, in the merge's index order, which keeps each
+ *     sender's points in their order), so this rank returns each sender's
+ *     answers in position order, and the sender walks its parts again in
+ *     the same order, routing each point through the RCB tree as the
+ *     exchange did, and takes the next answer of that point's rank.
+ *     dist = sqrt(d2), computed once, as hd_distances computes it.
+ *  On one rank nothing moves: hd_distances runs on the caller's views (or
+ *  on the parts packed in index order), and its positions become global
+ *  indices.
+ *
+ * Memory (K > 1), per local point: the local arrays (28 bytes), the two
+ * structures (about 36 bytes a point of each set, 60 while one is built),
+ * and per point of the direction being computed u2 and j (16 bytes); a
+ * rank's own points of that direction take 16 bytes more while the answers
+ * come back (before they are written to the caller's outputs).  When the
+ * runs were merged, the answers are reordered by sender into a buffer of
+ * 16 bytes a point first.  The queries and their answers are 40 bytes each,
+ * few.
+ */
+#include "mpi_int.h"
+
+#include <assert.h>
+#include <limits.h>
+#include <stdlib.h>
+
+typedef struct {
+    double *dist[2];
+    size_t *nearest[2];
+} outs_t;
+
+/* One local set's structure, charged while held. */
+typedef struct {
+    hd__an_t s;
+    size_t bytes;
+    int built;
+} an_t;
+
+static void an_free(ctx_t *c, an_t *t) {
+    if (t->built) {
+        hd__an_free(&t->s);
+        c->cur -= t->bytes;
+    }
+    memset(t, 0, sizeof *t);
+}
+
+static int an_of(ctx_t *c, const double *xyz, size_t n, const hd__box_t *kb, an_t *t) {
+    memset(t, 0, sizeof *t);
+    if (n == 0) return HD_OK;
+    if (n > HD__AN_MAX_POINTS)
+        return hd__err(&c->e, HD_ERANGE, "%zu points on one rank: the per-point search takes at most %zu", n,
+                       (size_t)HD__AN_MAX_POINTS);
+    hd_points_t v = hd_points_f64(xyz, n);
+    int rc = hd__mpi_an_build(c, &t->s, &v, kb, hd__thread_count(c->threads, n), &t->bytes);
+    t->built = 1; /* freed by an_free whatever happened */
+    return rc;
+}
+
+/* Side s's parts in offset order (the order the exchange walks them) and,
+ * for each, where its first point goes in the outputs (part order as
+ * given: part 0's points, then part 1's, ...). */
+static int walk_order(ctx_t *c, const input_t *in, int s, const hd_mpi_part_t ***order, size_t **base) {
+    size_t np = in->nparts[s];
+    *order = hd__mpi_alloc(c, np, sizeof **order);
+    *base = hd__mpi_alloc(c, np, sizeof **base);
+    size_t *given = hd__mpi_alloc(c, np, sizeof *given);
+    if (!*order || !*base || !given) {
+        hd__mpi_free(c, given, np, sizeof *given);
+        return hd__mpi_nomem(c, "the parts", np);
+    }
+    for (size_t p = 0, at = 0; p < np; p++) {
+        given[p] = at;
+        at += in->parts[s][p].points.count;
+        (*order)[p] = &in->parts[s][p];
+    }
+    qsort(*order, np, sizeof **order, hd__mpi_by_offset);
+    for (size_t p = 0; p < np; p++) (*base)[p] = given[(size_t)((*order)[p] - in->parts[s])];
+    hd__mpi_free(c, given, np, sizeof *given);
+    return HD_OK;
+}
+
+static void walk_order_free(ctx_t *c, const input_t *in, int s, const hd_mpi_part_t **order, size_t *base) {
+    hd__mpi_free(c, order, in->nparts[s], sizeof *order);
+    hd__mpi_free(c, base, in->nparts[s], sizeof *base);
+}
+
+/* ---- one rank ------------------------------------------------------------ */
+
+/* hd_distances on the views; its positions (index order) become global
+ * indices, and the answers go to the outputs in part order (directly when
+ * the nonempty parts are given in offset order, else through a copy). */
+static int single(ctx_t *c, const input_t *in, const ranges_t *rg, const int want[2], outs_t *o) {
+    views_t vw;
+    double *td[2] = {NULL, NULL};
+    size_t *tn[2] = {NULL, NULL};
+    const hd_mpi_part_t **order[2] = {NULL, NULL};
+    size_t *base[2] = {NULL, NULL};
+    int rc = hd__mpi_views(c, in, &vw);
+    for (int s = 0; s < 2 && rc == HD_OK; s++) {
+        if (!want[s] || (rc = walk_order(c, in, s, &order[s], &base[s])) != HD_OK) continue;
+        int direct = 1;
+        for (size_t p = 0, at = 0; p < in->nparts[s]; p++) {
+            direct &= base[s][p] == at;
+            at += order[s][p]->points.count;
+        }
+        td[s] = o->dist[s];
+        tn[s] = o->nearest[s];
+        if (direct) continue;
+        if (o->dist[s] && !(td[s] = hd__mpi_alloc(c, in->n[s], sizeof(double))))
+            rc = hd__mpi_nomem(c, "the distances", in->n[s]);
+        /* the indices are needed in any case: wanted means some output */
+        if (rc == HD_OK && o->nearest[s] && !(tn[s] = hd__mpi_alloc(c, in->n[s], sizeof(size_t))))
+            rc = hd__mpi_nomem(c, "the distances", in->n[s]);
+    }
+    if (rc == HD_OK) {
+        /* hd_distances' bound: 60 bytes a point of each set while built */
+        size_t bytes = 60 * (size_t)(in->n[0] + in->n[1]);
+        hd_options_t opt;
+        hd_options_init(&opt);
+        opt.threads = c->threads;
+        hd__mpi_charge(c, bytes);
+        double t0 = hd__now(), u0 = hd__mpi_cpu();
+        rc = hd_distances(&vw.v[0], &vw.v[1], &opt, td[0], tn[0], td[1], tn[1], &c->e);
+        c->search += hd__now() - t0;
+        c->search_cpu += hd__mpi_cpu() - u0;
+        c->cur -= bytes;
+    }
+    for (int s = 0; s < 2 && rc == HD_OK; s++) {
+        if (!want[s]) continue;
+        if (tn[s])
+            for (size_t k = 0; k < in->n[s]; k++) tn[s][k] = (size_t)hd__mpi_ranges_global(rg, 1 - s, 0, tn[s][k]);
+        if (td[s] == o->dist[s] && tn[s] == o->nearest[s]) continue;
+        for (size_t p = 0, t = 0; p < in->nparts[s]; p++)
+            for (size_t k = 0; k < order[s][p]->points.count; k++, t++) {
+                if (o->dist[s]) o->dist[s][base[s][p] + k] = td[s][t];
+                if (o->nearest[s]) o->nearest[s][base[s][p] + k] = tn[s][t];
+            }
+    }
+    for (int s = 0; s < 2; s++) {
+        if (td[s] != o->dist[s]) hd__mpi_free(c, td[s], in->n[s], sizeof(double));
+        if (tn[s] != o->nearest[s]) hd__mpi_free(c, tn[s], in->n[s], sizeof(size_t));
+        if (order[s]) walk_order_free(c, in, s, order[s], base[s]);
+    }
+    hd__mpi_views_free(c, in, &vw);
+    return rc;
+}
+
+/* ---- the return ---------------------------------------------------------- */
+
+/* The rank whose parts hold index g of side s (rg sorted by (side, lo)). */
+static int owner_of(const range_t *by, size_t n, uint64_t g) {
+    size_t lo = 0, hi = n - 1;
+    while (lo < hi) { /* the last run starting at or below g */
+        size_t mid = lo + (hi - lo + 1) / 2;
+        if (by[mid].lo <= g) lo = mid;
+        else hi = mid - 1;
+    }
+    assert(by[lo].lo <= g && g <= by[lo].hi);
+    return by[lo].rank;
+}
+
+/* The answers (d2, index) of side s's local points go back to the ranks
+ * that hold them (step 3 of the essay), which write them to their outputs.
+ * d2 is made the distance in place; d2 and j are freed here. */
+static int give_back(ctx_t *c, const spread_t *sp, const ranges_t *rg, const input_t *in, int s, double **d2p,
+                     uint64_t **jp, outs_t *o) {
+    int K = c->K, rc = HD_OK;
+    const local_t *loc = &sp->loc;
+    size_t n = loc->n[s], own = (size_t)in->n[s], m = 0;
+    double *d2 = *d2p, *sd = d2, *rd = NULL;
+    uint64_t *j = *jp, *sj = j, *rj = NULL;
+    int packed = 0; /* sd, sj are buffers of their own (else d2, j) */
+    int *cnt = hd__mpi_alloc(c, 5 * (size_t)K, sizeof(int)); /* scount sdispl rcount rdispl cursor */
+    range_t *by = NULL;
+    size_t nby = 0;
+    const hd_mpi_part_t **order = NULL;
+    size_t *base = NULL;
+    if (!cnt) rc = hd__mpi_nomem(c, "the answers", (size_t)K);
+    int *scount = cnt, *sdispl = cnt + K, *rcount = cnt + 2 * K, *rdispl = cnt + 3 * K, *cur = cnt + 4 * K;
+    for (size_t k = 0; k < n && rc == HD_OK; k++) d2[k] = sqrt(d2[k]); /* one sqrt, as hd_distances */
+    if (rc == HD_OK && !loc->g[s]) {
+        /* Runs as received: sender r's points are positions [start[r], start[r + 1]). */
+        for (int r = 0; r < K; r++) {
+            sdispl[r] = (int)loc->start[s][r];
+            scount[r] = (int)(loc->start[s][r + 1] - loc->start[s][r]);
+        }
+    } else if (rc == HD_OK) {
+        /* Merged: each position's sender is the owner of its index; its
+         * points are in index order, the order it sent them in. */
+        size_t lo = rg->seg[(size_t)s * ((size_t)K + 1)], hi = rg->seg[(size_t)s * ((size_t)K + 1) + (size_t)K];
+        nby = hi - lo;
+        by = hd__mpi_alloc(c, nby, sizeof(range_t));
+        sd = hd__mpi_alloc(c, n, sizeof(double));
+        sj = hd__mpi_alloc(c, n, sizeof(uint64_t));
+        packed = 1;
+        if (!by || !sd || !sj) rc = hd__mpi_nomem(c, "the answers", n);
+        if (rc == HD_OK) {
+            memcpy(by, rg->all + lo, nby * sizeof(range_t));
+            qsort(by, nby, sizeof(range_t), hd__mpi_by_range);
+            memset(scount, 0, (size_t)K * sizeof(int));
+            for (size_t k = 0; k < n; k++) scount[owner_of(by, nby, loc->g[s][k])]++;
+            for (int r = 0, at = 0; r < K; r++) sdispl[r] = cur[r] = at, at += scount[r];
+            for (size_t k = 0; k < n; k++) {
+                int r = owner_of(by, nby, loc->g[s][k]);
+                sd[cur[r]] = d2[k];
+                sj[cur[r]++] = j[k];
+            }
+            hd__mpi_free(c, d2, n, sizeof(double));
+            hd__mpi_free(c, j, n, sizeof(uint64_t));
+            *d2p = NULL, *jp = NULL, d2 = NULL, j = NULL;
+        }
+    }
+    if (rc == HD_OK && own > INT_MAX)
+        rc = hd__err(&c->e, HD_EOVERFLOW, "%zu points of %s on rank %d exceed MPI's int counts", own, s ? "B" : "A",
+                     c->rank);
+    if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
+    MPI_GO(c, rc, MPI_Alltoall(scount, 1, MPI_INT, rcount, 1, MPI_INT, c->comm));
+    for (int r = 0; r < K; r++) {
+        rdispl[r] = (int)m;
+        m += (size_t)rcount[r];
+        if (r != c->rank) c->bytes_back += (uint64_t)scount[r] * (sizeof(double) + sizeof(uint64_t));
+    }
+    assert(m == own);
+    rd = hd__mpi_alloc(c, m, sizeof(double));
+    rj = hd__mpi_alloc(c, m, sizeof(uint64_t));
+    if (!rd || !rj) rc = hd__mpi_nomem(c, "the answers", m);
+    if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
+    MPI_GO(c, rc, MPI_Alltoallv(sd, scount, sdispl, MPI_DOUBLE, rd, rcount, rdispl, MPI_DOUBLE, c->comm));
+    MPI_GO(c, rc, MPI_Alltoallv(sj, scount, sdispl, MPI_UINT64_T, rj, rcount, rdispl, MPI_UINT64_T, c->comm));
+    /* What was sent is not needed any more. */
+    if (packed) {
+        hd__mpi_free(c, sd, n, sizeof(double));
+        hd__mpi_free(c, sj, n, sizeof(uint64_t));
+        packed = 0;
+    }
+    hd__mpi_free(c, *d2p, n, sizeof(double));
+    hd__mpi_free(c, *jp, n, sizeof(uint64_t));
+    *d2p = NULL, *jp = NULL;
+    /* The walk of the exchange again: each point's rank, and that rank's
+     * next answer. */
+    if ((rc = walk_order(c, in, s, &order, &base)) == HD_OK) {
+        memcpy(cur, rdispl, (size_t)K * sizeof(int));
+        for (size_t p = 0; p < in->nparts[s]; p++) {
+            const hd_mpi_part_t *part = order[p];
+            for (size_t k = 0; k < part->points.count; k++) {
+                double x[3];
+                hd__mpi_get_point(&part->points, k, x);
+                int r = hd__mpi_rank_of(sp->tree, K, x, (uint64_t)s, part->offset + k);
+                size_t at = (size_t)cur[r]++, slot = base[p] + k;
+                if (o->dist[s]) o->dist[s][slot] = rd[at];
+                if (o->nearest[s]) o->nearest[s][slot] = (size_t)rj[at];
+            }
+        }
+        for (int r = 0; r < K; r++) assert(cur[r] == rdispl[r] + rcount[r]);
+    }
+done:
+    if (packed) {
+        hd__mpi_free(c, sd, n, sizeof(double));
+        hd__mpi_free(c, sj, n, sizeof(uint64_t));
+    }
+    hd__mpi_free(c, rd, m, sizeof(double));
+    hd__mpi_free(c, rj, m, sizeof(uint64_t));
+    hd__mpi_free(c, by, nby, sizeof(range_t));
+    hd__mpi_free(c, cnt, 5 * (size_t)K, sizeof(int));
+    if (order) walk_order_free(c, in, s, order, base);
+    return rc;
+}
+
+/* ---- one direction ------------------------------------------------------- */
+
+/* Answers from the structure of local Q (forwarded queries). */
+typedef struct {
+    const an_t *searched;
+    const hd__box_t *kb;
+    const double *Q;
+    size_t nQ;
+    const gidx_t *gQ;
+} answer_t;
+
+static int answer(ctx_t *c, void *arg, const double *pts, size_t m, ans_t *ans) {
+    const answer_t *a = arg;
+    if (m == 0) return HD_OK;
+    if (a->nQ == 0) {
+        for (size_t k = 0; k < m; k++) ans[k] = (ans_t){INFINITY, UINT64_MAX};
+        return HD_OK;
+    }
+    size_t *near = hd__mpi_alloc(c, m, sizeof(size_t));
+    an_t asked;
+    int rc = near ? an_of(c, pts, m, a->kb, &asked) : hd__mpi_nomem(c, "answers", m);
+    if (rc == HD_OK)
+        rc = hd__an_nearest(&asked.s, &a->searched->s, NULL, hd__thread_count(c->threads, m), NULL, near, NULL,
+                            &c->e);
+    for (size_t k = 0; k < m && rc == HD_OK; k++)
+        ans[k] = (ans_t){hd__d2(pts + 3 * k, a->Q + 3 * near[k]), hd__mpi_gidx(a->gQ, near[k])};
+    if (near) an_free(c, &asked);
+    hd__mpi_free(c, near, m, sizeof(size_t));
+    return rc;
+}
+
+/* The exact answers of side s's local points against all of the other
+ * side (steps 1 and 2), then returned (step 3).  `asking` and `searched`
+ * are the structures of local P and local Q on the key box kb. */
+static int direction(ctx_t *c, const spread_t *sp, const ranges_t *rg, const input_t *in, int s,
+                     const an_t *asking, const an_t *searched, const hd__box_t *kb, outs_t *o) {
+    int K = c->K, rc = HD_OK, qs = 1 - s;
+    const local_t *loc = &sp->loc;
+    const double *P = loc->xyz[s], *Q = loc->xyz[qs];
+    size_t nP = loc->n[s], nQ = loc->n[qs];
+    const hd__box_t *mine = &sp->region[c->rank];
+    double *u2 = hd__mpi_alloc(c, nP, sizeof(double));
+    uint64_t *jj = hd__mpi_alloc(c, nP, sizeof(uint64_t));
+    size_t *near = hd__mpi_alloc(c, nP, sizeof(size_t));
+    hd__box_t *nbox = hd__mpi_alloc(c, (size_t)K - 1, sizeof(hd__box_t));
+    int *list = hd__mpi_alloc(c, (size_t)K, sizeof(int));
+    pairs_t pr = {NULL, 0, 0};
+    if (!u2 || !jj || !near || !nbox || !list) rc = hd__mpi_nomem(c, "the distances", nP);
+    /* 1. The local pass. */
+    double t0 = hd__now(), u0 = hd__mpi_cpu();
+    if (rc == HD_OK && nP && nQ)
+        rc = hd__an_nearest(&asking->s, &searched->s, NULL, hd__thread_count(c->threads, nP), NULL, near, NULL,
+                            &c->e);
+    for (size_t k = 0; k < nP && rc == HD_OK; k++) {
+        u2[k] = nQ ? hd__d2(P + 3 * k, Q + 3 * near[k]) : INFINITY;
+        jj[k] = nQ ? hd__mpi_gidx(&sp->gi[qs], near[k]) : UINT64_MAX;
+    }
+    hd__mpi_free(c, near, nP, sizeof(size_t));
+    c->search += hd__now() - t0;
+    c->search_cpu += hd__mpi_cpu() - u0;
+    /* 2. The points whose faces are not clear ask the candidate ranks. */
+    if (rc == HD_OK) hd__mpi_node_boxes(sp->tree, 0, sp->held, qs, nbox);
+    for (size_t k = 0; k < nP && rc == HD_OK; k++) {
+        if (hd__mpi_faces_clear(mine, P + 3 * k, u2[k])) continue;
+        c->shell++;
+        int n = hd__mpi_asked(sp->tree, nbox, sp->held, K, qs, nQ == 0, P + 3 * k, u2[k], c->rank, list);
+        if (n == 0) continue; /* no other rank holds a point as near */
+        c->forwarded_points++;
+        rc = hd__mpi_pairs_add(c, &pr, k, list, n);
+    }
+    hd__mpi_free(c, nbox, (size_t)K - 1, sizeof(hd__box_t));
+    hd__mpi_free(c, list, (size_t)K, sizeof(int));
+    answer_t an = {searched, kb, Q, nQ, &sp->gi[qs]};
+    rc = hd__mpi_round(c, rc, P, &pr, answer, &an, u2, jj);
+    hd__mpi_pairs_free(c, &pr);
+    /* 3. Back to the points' ranks. */
+    if (rc == HD_OK) rc = give_back(c, sp, rg, in, s, &u2, &jj, o);
+    hd__mpi_free(c, u2, nP, sizeof(double));
+    hd__mpi_free(c, jj, nP, sizeof(uint64_t));
+    return rc;
+}
+
+/* ---- the call ------------------------------------------------------------ */
+
+static int distances(ctx_t *c, const hd_options_t *opt, input_t *in, void *arg, hd_mpi_stats_t *st) {
+    outs_t *o = arg;
+    course_t cs;
+    hd__mpi_course_init(c, &cs);
+    spread_t *sp = &cs.sp;
+    an_t an[2];
+    memset(an, 0, sizeof an);
+    uint64_t pts = in->n[0] + in->n[1];
+    int rc = hd__mpi_begin(c, opt, in, o, &cs.rg, cs.N, NULL);
+    if (rc != HD_OK) goto done;
+    /* A direction runs when some rank asks for it. */
+    int asks[2] = {o->dist[0] || o->nearest[0], o->dist[1] || o->nearest[1]}, want[2];
+    MPI_GO(c, rc, MPI_Allreduce(asks, want, 2, MPI_INT, MPI_MAX, c->comm));
+    if (c->K == 1) {
+        if ((rc = single(c, in, &cs.rg, want, o)) != HD_OK) goto done;
+    } else if (want[0] || want[1]) {
+        if ((rc = hd__mpi_spread(c, in, &cs.rg, cs.N, sp)) != HD_OK) goto done;
+        pts = sp->loc.n[0] + sp->loc.n[1];
+        /* Both structures on one key box: the queries' groups and the
+         * buckets they search are neighbours in memory (as hd_distances). */
+        hd__box_t kb = sp->held[c->rank].box[0];
+        hd__box_merge(&kb, &sp->held[c->rank].box[1]);
+        double t1 = hd__now(), u1 = hd__mpi_cpu();
+        for (int s = 0; s < 2 && rc == HD_OK; s++) rc = an_of(c, sp->loc.xyz[s], sp->loc.n[s], &kb, &an[s]);
+        c->search += hd__now() - t1;
+        c->search_cpu += hd__mpi_cpu() - u1;
+        if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
+        for (int s = 0; s < 2; s++)
+            if (want[s] && (rc = direction(c, sp, &cs.rg, in, s, &an[s], &an[1 - s], &kb, o)) != HD_OK) goto done;
+    }
+    double tmax;
+    rc = hd__mpi_figures(c, &cs, pts, st, &tmax);
+done:
+    an_free(c, &an[0]);
+    an_free(c, &an[1]);
+    hd__mpi_course_free(c, &cs);
+    return rc;
+}
+
+int hd_mpi_distances(MPI_Comm comm, const hd_mpi_part_t *a, size_t na, const hd_mpi_part_t *b, size_t nb,
+                     const hd_options_t *opt, double *dist_ab, size_t *nearest_ab, double *dist_ba,
+                     size_t *nearest_ba, hd_mpi_stats_t *stats, hd_error_t *err) {
+    outs_t o = {{dist_ab, dist_ba}, {nearest_ab, nearest_ba}};
+    return hd__mpi_call(comm, a, na, b, nb, opt, distances, &o, stats, err);
+}
