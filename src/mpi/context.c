@@ -21,6 +21,7 @@
  *    besides the MPI calls and the searches.
  */
 #include "mpi_int.h"
+#include "engine/engine.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -90,6 +91,25 @@ int hd__mpi_engine(ctx_t *c, const hd_points_t *P, const hd_points_t *Q, hd_resu
     size_t bytes = ENGINE_BYTES * (P->count + Q->count);
     hd__mpi_charge(c, bytes);
     int rc = hd_directed(P, Q, &o, e, &c->e);
+    c->cur -= bytes;
+    return rc;
+}
+
+/* h(P, Q) where only an answer beating (floor2, floor_i) matters
+ * (hd__engine_directed_above: the points that cannot beat it are pruned
+ * as soon as one point of Q shows it), on packed views of validated local
+ * points; charged as above. */
+int hd__mpi_engine_above(ctx_t *c, const hd_points_t *P, const hd_points_t *Q, double floor2, size_t floor_i,
+                         hd_result_t *e) {
+    hd_options_t o;
+    hd_options_init(&o);
+    o.threads = c->threads;
+    hd__box_t bp, bq;
+    hd__box_of(P->data, P->count, &bp);
+    hd__box_of(Q->data, Q->count, &bq);
+    size_t bytes = ENGINE_BYTES * (P->count + Q->count);
+    hd__mpi_charge(c, bytes);
+    int rc = hd__engine_directed_above(P, Q, &bp, &bq, &o, floor2, floor_i, e, &c->e);
     c->cur -= bytes;
     return rc;
 }

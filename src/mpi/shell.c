@@ -232,19 +232,33 @@ done:
 }
 
 /* The exact maximum over the interior, the points whose faces are clear
- * of h2 (their local u is global): the engine on a copy of them. */
-int hd__mpi_interior_max(ctx_t *c, const dir_t *d, const hd__box_t *mine, const shell_t *sh, double h2, far_t *out) {
+ * of h2 (their local u is global), where it beats G, the best over every
+ * rank without it (else *out has d2 = -1: it cannot change the result).
+ * The engine runs on a compacted copy of them with its maximum starting at
+ * G: as (G.d2, p*), p* the number of interior points whose global index is
+ * below G's, since the copy's positions are in global index order, so a
+ * point beats the floor exactly when it beats G (G's point is not
+ * interior: the interior's maximum is what G was computed without).  The
+ * points that cannot are pruned as soon as one point of Q shows it, which
+ * is most of them. */
+int hd__mpi_interior_max(ctx_t *c, const dir_t *d, const hd__box_t *mine, const shell_t *sh, double h2,
+                         const far_t *G, far_t *out) {
+    *out = (far_t){-1.0, UINT64_MAX, UINT64_MAX};
     unsigned char *in = hd__mpi_alloc(c, d->nP, 1);
     if (!in) return hd__mpi_nomem(c, "the interior", d->nP);
-    size_t nI = 0;
+    size_t nI = 0, below = 0;
     for (size_t k = 0; k < d->nP; k++) nI += in[k] = (unsigned char)hd__mpi_faces_clear(mine, d->P + 3 * k, h2);
     assert(nI + sh->n == d->nP && sh->own_xyz);
+    gcur_t cu;
+    hd__mpi_gcur_init(&cu, d->gP);
+    for (size_t k = 0; k < d->nP && hd__mpi_gcur_at(&cu, k) < G->i; k++) below += in[k];
     split(d->P, d->nP, in, NULL); /* the shell's copy is the aside */
     hd_points_t Iv = hd_points_f64(d->P, nI), Qv = hd_points_f64(d->Q, d->nQ);
     hd_result_t e;
-    int rc = hd__mpi_engine(c, &Iv, &Qv, &e);
+    int rc = G->d2 >= 0 ? hd__mpi_engine_above(c, &Iv, &Qv, G->d2, below, &e) : hd__mpi_engine(c, &Iv, &Qv, &e);
     unsplit(d->P, d->nP, in, sh->own_xyz);
-    if (rc == HD_OK) *out = (far_t){e.distance2, hd__mpi_gidx(d->gP, kept_at(in, d->nP, e.i)), hd__mpi_gidx(d->gQ, e.j)};
+    if (rc == HD_OK && (G->d2 < 0 || e.distance2 > G->d2 || (e.distance2 == G->d2 && e.i < below)))
+        *out = (far_t){e.distance2, hd__mpi_gidx(d->gP, kept_at(in, d->nP, e.i)), hd__mpi_gidx(d->gQ, e.j)};
     hd__mpi_free(c, in, d->nP, 1);
     return rc;
 }

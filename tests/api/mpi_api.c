@@ -114,7 +114,7 @@ typedef struct {
 
 enum {
     DS_UNIFORM, DS_LATTICE, DS_LATTICE_HALF, DS_ONE_POINT, DS_PLANE, DS_FAR_B, DS_CORNER_B, DS_DUPLICATES,
-    DS_TINY, DS_HUGE, DS_NOISE, DS_DISJOINT, DS_CHECKER, DS_STRAY, DS_DEEP, DS_COUNT
+    DS_TINY, DS_HUGE, DS_NOISE, DS_DISJOINT, DS_CHECKER, DS_STRAY, DS_DEEP, DS_SMALL_LATTICE, DS_COUNT
 };
 
 static void make_set(int which, uint64_t seed, set_t *s) {
@@ -249,6 +249,15 @@ static void make_set(int which, uint64_t seed, set_t *s) {
         s->b[0] = 5.5, s->b[1] = 0.5, s->b[2] = 5;
         break;
     }
+    case DS_SMALL_LATTICE:
+        /* Run over many seeds: every distance is the root of a small
+         * integer, so most points tie with many others, across faces, in
+         * the interior and in the shell, in both directions. */
+        s->name = "small lattice, ties everywhere";
+        s->na = s->nb = 400;
+        gen_lattice(&g, s->a, s->na, 7);
+        gen_lattice(&g, s->b, s->nb, 7);
+        break;
     case DS_DISJOINT:
         s->name = "disjoint boxes";
         gen_cube(&g, s->a, n, 0, 1);
@@ -570,6 +579,8 @@ int main(int argc, char **argv) {
         if (only && strcmp(only, "errors") != 0 && atoi(only) != which) continue;
         if (only && strcmp(only, "errors") == 0) break;
         for (int how = 0; how < LAY_COUNT; how++) check_equal(which, how, 1000 + (uint64_t)which);
+        for (uint64_t seed = 1; which == DS_SMALL_LATTICE && seed < 60; seed++)
+            check_equal(which, (int)(seed % LAY_COUNT), 5000 + seed);
         for (int how = 0; how < LAY_COUNT; how++) check_distances(which, how, 1000 + (uint64_t)which);
     }
     int all[2] = {failures, checks}, sum[2];
