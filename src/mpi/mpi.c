@@ -48,12 +48,15 @@
  *  3. The single-machine engine on each rank's part: hd_directed(local A,
  *     local B) gives h2, the rank's largest u(a)^2, where u(a)^2 is the
  *     exact minimum over local B (an upper bound on the minimum over all
- *     of B).  Every a whose region faces are clear of h2 (step 4's test
+ *     of B); the symmetric call runs hd_hausdorff once for both
+ *     directions (each engine call builds both sets' structures).  Every
+ *     a whose region faces are clear of h2 (step 4's test
  *     with h2 >= u(a)^2) is settled without a search of its own (the
  *     interior).  When the engine's witness is interior, it is the
  *     interior's maximum; else the interior's maximum is computed (one
- *     more engine call on it) only on a rank where the engine's answer
- *     beats the best over all ranks found without it (step 6): every
+ *     more engine call on it, its maximum starting at G, so what cannot
+ *     beat G is pruned at once) only on a rank where the engine's answer
+ *     beats G, the best over all ranks found without it (step 6): every
  *     interior point is below that answer.  The rest, the shell within h
  *     of the faces, get per-point searches (the nearest layer's, as
  *     hd_distances runs them: the nearest local b, smallest index on
