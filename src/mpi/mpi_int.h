@@ -209,7 +209,26 @@ int hd__mpi_check_local(ctx_t *c, const hd_options_t *opt, input_t *in, const vo
 
 /* ---- the partition (rcb.c) and the exchange (exchange.c) ----------------- */
 
-int hd__mpi_rank_of(const node_t *t, int K, const double *x, uint64_t side, uint64_t g);
+/* Whether a point (coordinates x, set side, global index g) goes to the
+ * left of a node: its key (coordinate, set, index) below the split's. */
+static inline int hd__mpi_goes_left(const node_t *nd, const double *x, uint64_t side, uint64_t g) {
+    double v = x[nd->axis];
+    if (v != nd->s) return v < nd->s;
+    if (side != nd->side) return side < nd->side;
+    return g < nd->g;
+}
+
+/* The rank whose region holds the point (a walk down the tree; inline,
+ * since the exchange asks it for every point). */
+static inline int hd__mpi_rank_of(const node_t *t, int K, const double *x, uint64_t side, uint64_t g) {
+    if (K == 1) return 0;
+    int k = 0;
+    for (;;) {
+        int next = hd__mpi_goes_left(&t[k], x, side, g) ? t[k].left : t[k].right;
+        if (next < 0) return -next - 1;
+        k = next;
+    }
+}
 void hd__mpi_regions(const node_t *t, int node, hd__box_t box, hd__box_t *out);
 hd__box_t hd__mpi_node_boxes(const node_t *t, int node, const held_t *held, int side, hd__box_t *out);
 void hd__mpi_candidates(const node_t *t, const hd__box_t *nbox, const held_t *held, int side, int node,

@@ -135,9 +135,20 @@ int hd__mpi_engine_both(ctx_t *c, double *xyz[2], const gidx_t *g[2], const size
     memset(pre, 0, 2 * sizeof *pre);
     mask[0] = mask[1] = NULL;
     if (n[0] == 0 || n[1] == 0) return HD_OK; /* shell_of has nothing to ask the engine */
-    size_t nc = mark_pairs(g[0], n[0], g[1], n[1], NULL, NULL);
+    /* The masks are marked in the walk that counts the pairs (2 bytes a
+     * point while the local arrays alone are held: below the engine's
+     * peak), and freed at once when the sets are not a copy. */
+    mask[0] = hd__mpi_alloc(c, n[0], 1);
+    mask[1] = hd__mpi_alloc(c, n[1], 1);
+    if (!mask[0] || !mask[1]) return hd__mpi_nomem(c, "the pairs", n[0]);
+    memset(mask[0], 0, n[0]);
+    memset(mask[1], 0, n[1]);
+    size_t nc = mark_pairs(g[0], n[0], g[1], n[1], mask[0], mask[1]);
     int paired = is_paired(nc, n[0], n[1]);
-    if (paired != is_paired(nc, n[1], n[0])) return HD_OK; /* each direction on its own */
+    if (!paired || paired != is_paired(nc, n[1], n[0])) {
+        for (int s = 0; s < 2; s++) hd__mpi_free(c, mask[s], n[s], 1), mask[s] = NULL;
+        if (paired) return HD_OK; /* each direction on its own */
+    }
     hd_result_t e[2];
     int rc = HD_OK;
     if (!paired) {
@@ -145,15 +156,7 @@ int hd__mpi_engine_both(ctx_t *c, double *xyz[2], const gidx_t *g[2], const size
         hd_symmetric_t s;
         if ((rc = hd__mpi_engine_sym(c, &Av, &Bv, &s)) == HD_OK) e[0] = s.ab, e[1] = s.ba;
     } else {
-        mask[0] = hd__mpi_alloc(c, n[0], 1);
-        mask[1] = hd__mpi_alloc(c, n[1], 1);
-        if (!mask[0] || !mask[1]) rc = hd__mpi_nomem(c, "the pairs", nc);
-        if (rc == HD_OK) {
-            memset(mask[0], 0, n[0]);
-            memset(mask[1], 0, n[1]);
-            mark_pairs(g[0], n[0], g[1], n[1], mask[0], mask[1]);
-            rc = pairs_engine(c, xyz[0], n[0], xyz[1], n[1], mask[0], mask[1], nc, 1, e);
-        }
+        rc = pairs_engine(c, xyz[0], n[0], xyz[1], n[1], mask[0], mask[1], nc, 1, e);
     }
     if (rc == HD_OK)
         for (int s = 0; s < 2; s++) pre[s] = (pre_t){1, paired, e[s], mask[s], mask[1 - s]};

@@ -154,10 +154,11 @@ static int slab_search(ctx_t *c, const slab_t *sl, const double *pts, const size
  * every point of Q (on a copy: points whose partner is on another rank)
  * rather than searched in a wider slab.  One pass over Q serves them all,
  * and a point of Q is mostly passed over after one coordinate's gap
- * (about 1 ns for each point asking, against 1.5 for a distance); the
- * wider slab costs two passes over Q measuring face gaps (about 3 ns a
- * point each) and a structure over the points in it. */
-#define BRUTE_MAX 8
+ * (about 6 instructions for each point asking, against 15 for a
+ * distance); the wider slab costs two passes over Q measuring face gaps
+ * (about 15 instructions a point each) and a structure over the points
+ * in it: past 4 askers it is the cheaper (callgrind, docs/scale-out.md). */
+#define BRUTE_MAX 4
 
 /* For each of n packed points, the nearest point of Q (exact, smallest
  * index on ties, as hd_distances gives it). */
