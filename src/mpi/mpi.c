@@ -328,7 +328,7 @@ static int run(ctx_t *c, const hd_options_t *opt, input_t *in, void *arg, hd_mpi
         if (both) {
             const gidx_t *gp[2] = {&sp->gi[0], &sp->gi[1]};
             double t1 = hd__now(), u1 = hd__mpi_cpu();
-            pre_rc = hd__mpi_engine_both(c, loc->xyz, gp, loc->n, pre, mask);
+            pre_rc = hd__mpi_engine_both(c, loc->xyz, gp, loc->n, sp->held[c->rank].box, pre, mask);
             c->search += hd__now() - t1;
             c->search_cpu += hd__mpi_cpu() - u1;
         }

@@ -60,7 +60,10 @@ void *hd__mpi_alloc(ctx_t *c, size_t n, size_t size);
 void hd__mpi_free(ctx_t *c, void *p, size_t n, size_t size);
 void hd__mpi_charge(ctx_t *c, size_t bytes);
 int hd__mpi_engine(ctx_t *c, const hd_points_t *P, const hd_points_t *Q, hd_result_t *e);
-int hd__mpi_engine_sym(ctx_t *c, const hd_points_t *P, const hd_points_t *Q, hd_symmetric_t *s);
+int hd__mpi_engine_local(ctx_t *c, const hd_points_t *P, const hd_points_t *Q, const hd__box_t *bp,
+                         const hd__box_t *bq, hd_result_t *e);
+int hd__mpi_engine_sym(ctx_t *c, const hd_points_t *P, const hd_points_t *Q, const hd__box_t *bp,
+                       const hd__box_t *bq, hd_symmetric_t *s);
 int hd__mpi_engine_above(ctx_t *c, const hd_points_t *P, const hd_points_t *Q, double floor2, size_t floor_i,
                          hd_result_t *e);
 int hd__mpi_nomem(ctx_t *c, const char *what, size_t n);
@@ -322,8 +325,8 @@ typedef struct pre {
 
 /* mask[s]: NULL, or the pairs' mask of side s (n[s] bytes) when paired,
  * which the caller frees (hd__mpi_free) after both directions. */
-int hd__mpi_engine_both(ctx_t *c, double *xyz[2], const gidx_t *g[2], const size_t n[2], pre_t pre[2],
-                        unsigned char *mask[2]);
+int hd__mpi_engine_both(ctx_t *c, double *xyz[2], const gidx_t *g[2], const size_t n[2], const hd__box_t box[2],
+                        pre_t pre[2], unsigned char *mask[2]);
 void hd__mpi_shell_free(ctx_t *c, shell_t *sh);
 int hd__mpi_interior_max(ctx_t *c, const dir_t *d, const hd__box_t *mine, const shell_t *sh, double h2,
                          const far_t *G, far_t *out);

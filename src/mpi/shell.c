@@ -108,9 +108,11 @@ static int is_paired(size_t nc, size_t nP, size_t nQ) {
 
 /* The engine on the pairs of P and Q (masks inp, inq), moved to the front
  * of both arrays and put back after: *e's positions are in P_c and Q_c.
- * sym: both directions (e[0] P to Q, e[1] Q to P), else e[0] only. */
+ * sym: both directions (e[0] P to Q, e[1] Q to P), else e[0] only.  box:
+ * NULL, or the boxes of all of P and Q, which hold the pairs (the engine
+ * needs a box that holds its points, not the smallest). */
 static int pairs_engine(ctx_t *c, double *P, size_t nP, double *Q, size_t nQ, const unsigned char *inp,
-                        const unsigned char *inq, size_t nc, int sym, hd_result_t e[2]) {
+                        const unsigned char *inq, size_t nc, int sym, const hd__box_t *box, hd_result_t e[2]) {
     size_t nx = nQ - nc, ny = nP - nc;
     double *qx = hd__mpi_alloc(c, nx, 3 * sizeof(double)), *py = hd__mpi_alloc(c, ny, 3 * sizeof(double));
     int rc = HD_OK;
@@ -120,8 +122,9 @@ static int pairs_engine(ctx_t *c, double *P, size_t nP, double *Q, size_t nQ, co
         split(Q, nQ, inq, qx);
         hd_points_t Pv = hd_points_f64(P, nc), Qv = hd_points_f64(Q, nc);
         hd_symmetric_t s;
-        if (sym && (rc = hd__mpi_engine_sym(c, &Pv, &Qv, &s)) == HD_OK) e[0] = s.ab, e[1] = s.ba;
-        if (!sym) rc = hd__mpi_engine(c, &Pv, &Qv, &e[0]);
+        if (sym && (rc = hd__mpi_engine_sym(c, &Pv, &Qv, box ? &box[0] : NULL, box ? &box[1] : NULL, &s)) == HD_OK)
+            e[0] = s.ab, e[1] = s.ba;
+        if (!sym) rc = hd__mpi_engine_local(c, &Pv, &Qv, NULL, NULL, &e[0]);
         unsplit(P, nP, inp, py);
         unsplit(Q, nQ, inq, qx);
     }
@@ -130,8 +133,8 @@ static int pairs_engine(ctx_t *c, double *P, size_t nP, double *Q, size_t nQ, co
     return rc;
 }
 
-int hd__mpi_engine_both(ctx_t *c, double *xyz[2], const gidx_t *g[2], const size_t n[2], pre_t pre[2],
-                        unsigned char *mask[2]) {
+int hd__mpi_engine_both(ctx_t *c, double *xyz[2], const gidx_t *g[2], const size_t n[2], const hd__box_t box[2],
+                        pre_t pre[2], unsigned char *mask[2]) {
     memset(pre, 0, 2 * sizeof *pre);
     mask[0] = mask[1] = NULL;
     if (n[0] == 0 || n[1] == 0) return HD_OK; /* shell_of has nothing to ask the engine */
@@ -154,9 +157,9 @@ int hd__mpi_engine_both(ctx_t *c, double *xyz[2], const gidx_t *g[2], const size
     if (!paired) {
         hd_points_t Av = hd_points_f64(xyz[0], n[0]), Bv = hd_points_f64(xyz[1], n[1]);
         hd_symmetric_t s;
-        if ((rc = hd__mpi_engine_sym(c, &Av, &Bv, &s)) == HD_OK) e[0] = s.ab, e[1] = s.ba;
+        if ((rc = hd__mpi_engine_sym(c, &Av, &Bv, &box[0], &box[1], &s)) == HD_OK) e[0] = s.ab, e[1] = s.ba;
     } else {
-        rc = pairs_engine(c, xyz[0], n[0], xyz[1], n[1], mask[0], mask[1], nc, 1, e);
+        rc = pairs_engine(c, xyz[0], n[0], xyz[1], n[1], mask[0], mask[1], nc, 1, box, e);
     }
     if (rc == HD_OK)
         for (int s = 0; s < 2; s++) pre[s] = (pre_t){1, paired, e[s], mask[s], mask[1 - s]};
@@ -206,7 +209,7 @@ static int paired_pass(ctx_t *c, const dir_t *d, const hd__box_t *mine, unsigned
     }
     hd_result_t e[2];
     if (pre) e[0] = pre->e;
-    else rc = pairs_engine(c, d->P, nP, d->Q, nQ, in, inq, nc, 0, e);
+    else rc = pairs_engine(c, d->P, nP, d->Q, nQ, in, inq, nc, 0, NULL, e);
     if (rc == HD_OK) {
         /* a*, and Q_c's e.j: P_c's e.j's partner (the same index) */
         size_t astar = kept_at(in, nP, e[0].i);
@@ -258,7 +261,7 @@ int hd__mpi_interior_max(ctx_t *c, const dir_t *d, const hd__box_t *mine, const 
     split(d->P, d->nP, in, NULL); /* the shell's copy is the aside */
     hd_points_t Iv = hd_points_f64(d->P, nI), Qv = hd_points_f64(d->Q, d->nQ);
     hd_result_t e;
-    int rc = G->d2 >= 0 ? hd__mpi_engine_above(c, &Iv, &Qv, G->d2, below, &e) : hd__mpi_engine(c, &Iv, &Qv, &e);
+    int rc = G->d2 >= 0 ? hd__mpi_engine_above(c, &Iv, &Qv, G->d2, below, &e) : hd__mpi_engine_local(c, &Iv, &Qv, NULL, NULL, &e);
     unsplit(d->P, d->nP, in, sh->own_xyz);
     if (rc == HD_OK && (G->d2 < 0 || e.distance2 > G->d2 || (e.distance2 == G->d2 && e.i < below)))
         *out = (far_t){e.distance2, hd__mpi_gidx(d->gP, kept_at(in, d->nP, e.i)), hd__mpi_gidx(d->gQ, e.j)};
@@ -285,7 +288,7 @@ int hd__mpi_shell_of(ctx_t *c, const dir_t *d, const hd__box_t *mine, qtree_t *q
     int rc = paired_pass(c, d, mine, &in, &nI, &sh->inner, &done);
     const pre_t *pre = d->pre && d->pre->have && !d->pre->paired ? d->pre : NULL;
     if (rc == HD_OK && !done && pre) e = pre->e;
-    if (rc == HD_OK && !done && (pre || (rc = hd__mpi_engine(c, &Pv, &Qv, &e)) == HD_OK)) {
+    if (rc == HD_OK && !done && (pre || (rc = hd__mpi_engine_local(c, &Pv, &Qv, NULL, NULL, &e)) == HD_OK)) {
         if (!in && !(in = hd__mpi_alloc(c, d->nP, 1))) rc = hd__mpi_nomem(c, "the interior", d->nP);
         nI = 0;
         for (size_t k = 0; k < d->nP && rc == HD_OK; k++)
