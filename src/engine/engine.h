@@ -388,6 +388,21 @@ int hd__engine_hausdorff(const hd_points_t *A, const hd_points_t *B,
                          const hd__box_t *box_a, const hd__box_t *box_b,
                          const hd_options_t *opt, hd_symmetric_t *out,
                          hd_error_t *err);
+/* h(A,B) where only an answer above a floor matters: the maximum starts
+ * at (floor2, floor_i) as if point floor_i of A had that squared nearest
+ * distance, so every point that cannot beat it (u^2 < floor2, or u^2 =
+ * floor2 and an index above floor_i) is pruned as soon as one point of B
+ * shows it.  out is the exact h(A,B) with its witness when that beats the
+ * floor (a larger distance, or the same at an index below floor_i); else
+ * out->distance2 = floor2 and out->i = floor_i, which the caller reads as
+ * "nothing above" (out->j is then HD__NONE, or a real nearest point of a
+ * point floor_i at exactly floor2).  For the MPI library's second pass
+ * over a rank's interior, which matters only where it beats the best of
+ * every rank. */
+int hd__engine_directed_above(const hd_points_t *A, const hd_points_t *B,
+                              const hd__box_t *box_a, const hd__box_t *box_b,
+                              const hd_options_t *opt, double floor2, size_t floor_i,
+                              hd_result_t *out, hd_error_t *err);
 /* The engine's plan for H(A,B), for tests and benchmarks: which path
  * answers (the correspondence path settles both directions exactly when
  * path is HD__PLAN_PAIRS), whether the pairs were listed, which directions

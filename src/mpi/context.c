@@ -21,6 +21,7 @@
  *    besides the MPI calls and the searches.
  */
 #include "mpi_int.h"
+#include "engine/engine.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -90,6 +91,66 @@ int hd__mpi_engine(ctx_t *c, const hd_points_t *P, const hd_points_t *Q, hd_resu
     size_t bytes = ENGINE_BYTES * (P->count + Q->count);
     hd__mpi_charge(c, bytes);
     int rc = hd_directed(P, Q, &o, e, &c->e);
+    c->cur -= bytes;
+    return rc;
+}
+
+/* The engine on local arrays (packed doubles, validated before the
+ * exchange): its internal entry, given the sets' boxes (NULL: computed
+ * here), instead of hd_directed, which would validate every point again
+ * (a pass over both sets, about 50 instructions a point). */
+static void boxes(const hd_points_t *P, const hd_points_t *Q, const hd__box_t *bp, const hd__box_t *bq,
+                  hd__box_t out[2]) {
+    if (bp) out[0] = *bp;
+    else hd__box_of(P->data, P->count, &out[0]);
+    if (bq) out[1] = *bq;
+    else hd__box_of(Q->data, Q->count, &out[1]);
+}
+
+int hd__mpi_engine_local(ctx_t *c, const hd_points_t *P, const hd_points_t *Q, const hd__box_t *bp,
+                         const hd__box_t *bq, hd_result_t *e) {
+    hd_options_t o;
+    hd_options_init(&o);
+    o.threads = c->threads;
+    hd__box_t b[2];
+    boxes(P, Q, bp, bq, b);
+    size_t bytes = ENGINE_BYTES * (P->count + Q->count);
+    hd__mpi_charge(c, bytes);
+    int rc = hd__engine_directed(P, Q, &b[0], &b[1], &o, e, &c->e);
+    c->cur -= bytes;
+    return rc;
+}
+
+/* h(P, Q) where only an answer beating (floor2, floor_i) matters
+ * (hd__engine_directed_above: the points that cannot beat it are pruned
+ * as soon as one point of Q shows it), on packed views of validated local
+ * points; charged as above. */
+int hd__mpi_engine_above(ctx_t *c, const hd_points_t *P, const hd_points_t *Q, double floor2, size_t floor_i,
+                         hd_result_t *e) {
+    hd_options_t o;
+    hd_options_init(&o);
+    o.threads = c->threads;
+    hd__box_t b[2];
+    boxes(P, Q, NULL, NULL, b);
+    size_t bytes = ENGINE_BYTES * (P->count + Q->count);
+    hd__mpi_charge(c, bytes);
+    int rc = hd__engine_directed_above(P, Q, &b[0], &b[1], &o, floor2, floor_i, e, &c->e);
+    c->cur -= bytes;
+    return rc;
+}
+
+/* Both directions in one call: the engine builds each set's structures
+ * once for both (hd_directed builds both sets' too), charged as above. */
+int hd__mpi_engine_sym(ctx_t *c, const hd_points_t *P, const hd_points_t *Q, const hd__box_t *bp,
+                       const hd__box_t *bq, hd_symmetric_t *s) {
+    hd_options_t o;
+    hd_options_init(&o);
+    o.threads = c->threads;
+    hd__box_t b[2];
+    boxes(P, Q, bp, bq, b);
+    size_t bytes = ENGINE_BYTES * (P->count + Q->count);
+    hd__mpi_charge(c, bytes);
+    int rc = hd__engine_hausdorff(P, Q, &b[0], &b[1], &o, s, &c->e);
     c->cur -= bytes;
     return rc;
 }

@@ -96,23 +96,25 @@ static inline void dest_set(void *d, int w, size_t t, int r) {
     else ((uint32_t *)d)[t] = (uint32_t)r;
 }
 
-/* A position in the local input: side, part (in offset order), point in
- * it, point t overall, and the point's local number in its side. */
-typedef struct { int s; size_t p, k, t; uint64_t num[2]; } walk_t;
+/* A cursor over the local input in walking order (sides A then B, parts
+ * in offset order): side s, part p, point k in it, and the next local
+ * number of each side.  The passes run a tight loop over each part's
+ * points, not a step function a point. */
+typedef struct { int s; size_t p, k; uint64_t num[2]; } walk_t;
 
-static int walk_next(const input_t *in, const hd_mpi_part_t **order[2], walk_t *w) {
+/* The points left in the cursor's part, after moving past finished parts
+ * (0 at the end of the input). */
+static size_t walk_avail(const input_t *in, const hd_mpi_part_t **order[2], walk_t *w) {
     while (w->s < 2) {
-        if (w->p < in->nparts[w->s] && w->k < order[w->s][w->p]->points.count) return 1;
-        if (w->p < in->nparts[w->s]) w->p++, w->k = 0;
-        else w->s++, w->p = 0, w->k = 0;
+        if (w->p < in->nparts[w->s]) {
+            size_t n = order[w->s][w->p]->points.count;
+            if (w->k < n) return n - w->k;
+            w->p++, w->k = 0;
+        } else {
+            w->s++, w->p = 0, w->k = 0;
+        }
     }
     return 0;
-}
-
-static void walk_step(walk_t *w) {
-    w->k++;
-    w->t++;
-    w->num[w->s]++;
 }
 
 /* Points sent per round by a rank: an eighth of its points (at least 64K),
@@ -158,22 +160,42 @@ int hd__mpi_exchange(ctx_t *c, const input_t *in, const ranges_t *rg, const node
     int *tot = cnt, *rtot = cnt + 2 * K, *per = cnt + 4 * K, *rper = cnt + 6 * K, *sdisp = cnt + 8 * K,
         *sfill = cnt + 10 * K, *sc = cnt + 12 * K, *sd = cnt + 13 * K, *rcn = cnt + 14 * K, *rd = cnt + 15 * K;
     size_t *got = base + 2 * K, own = 0;
+    /* The rounds: round q walks the input positions [tb[q], tb[q + 1]),
+     * up to the (q + 1) C-th point for another rank (the last to the end),
+     * and sends rcnt[q 2K + 2 r + s] points of side s to rank r. */
+    size_t maxr = nloc / C + 2, nr = 1;
+    size_t *tb = hd__mpi_alloc(c, maxr + 1, sizeof(size_t));
+    int *rcnt = hd__mpi_alloc(c, maxr * 2 * (size_t)K, sizeof(int));
+    if (rc == HD_OK && (!tb || !rcnt)) rc = hd__mpi_nomem(c, "the exchange's rounds", maxr);
     if (rc == HD_OK) {
         memset(tot, 0, 2 * (size_t)K * sizeof(int));
-        size_t t = 0;
+        memset(rcnt, 0, maxr * 2 * (size_t)K * sizeof(int));
+        size_t t = 0, out = 0, q = 0;
+        tb[0] = 0;
         for (int s = 0; s < 2; s++) {
             for (size_t p = 0; p < in->nparts[s]; p++) order[s][p] = &in->parts[s][p];
             qsort(order[s], in->nparts[s], sizeof *order[s], hd__mpi_by_offset);
-            for (size_t p = 0; p < in->nparts[s]; p++)
-                for (size_t k = 0; k < order[s][p]->points.count; k++) {
-                    double x[3];
-                    hd__mpi_get_point(&order[s][p]->points, k, x);
-                    int r = hd__mpi_rank_of(tree, K, x, (uint64_t)s, order[s][p]->offset + k);
-                    dest_set(dest, w, t++, r);
+            for (size_t p = 0; p < in->nparts[s]; p++) {
+                const hd_points_t *v = &order[s][p]->points;
+                const double *px = hd__mpi_packed(v);
+                uint64_t g0 = order[s][p]->offset;
+                for (size_t k = 0; k < v->count; k++, t++) {
+                    double xb[3];
+                    const double *x = px ? px + 3 * k : (hd_points_get(v, k, xb), xb);
+                    int r = hd__mpi_rank_of(tree, K, x, (uint64_t)s, g0 + k);
+                    dest_set(dest, w, t, r);
                     if (tot[2 * r + s] == INT_MAX) rc = HD_EOVERFLOW;
                     else tot[2 * r + s]++;
+                    if (r == me) continue;
+                    if (out == (q + 1) * C) tb[++q] = t;
+                    assert(q < maxr);
+                    rcnt[q * 2 * (size_t)K + 2 * (size_t)r + (size_t)s]++;
+                    out++;
                 }
+            }
         }
+        nr = q + 1;
+        tb[nr] = nloc;
         if (rc != HD_OK)
             rc = hd__err(&c->e, HD_EOVERFLOW, "more than 2^31 - 1 points of a set to send from rank %d to one rank",
                          c->rank);
@@ -209,45 +231,46 @@ int hd__mpi_exchange(ctx_t *c, const input_t *in, const ranges_t *rg, const node
         if (!sx || !so) rc = hd__mpi_nomem(c, "points to send", sendcap);
     }
     if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
-    uint64_t mine = (nloc - own + C - 1) / C, rounds = 0;
+    uint64_t mine = nr, rounds = 0;
     MPI_GO(c, rc, MPI_Allreduce(&mine, &rounds, 1, MPI_UINT64_T, MPI_MAX, c->comm));
-    if (rounds == 0) rounds = 1; /* a round copies the own points too */
-    walk_t at = {0, 0, 0, 0, {0, 0}};
+    walk_t at = {0, 0, 0, {0, 0}};
     size_t ownat[2] = {base[me], base[K + me]};
     for (uint64_t round = 0; round < rounds; round++) {
-        /* The window: from `at` up to the C-th point for another rank. */
-        memset(per, 0, 2 * (size_t)K * sizeof(int));
-        walk_t end = at;
-        size_t out = 0;
-        while (walk_next(in, order, &end)) {
-            int r = dest_get(dest, w, end.t);
-            if (r != me) {
-                if (out == C) break;
-                per[2 * r + end.s]++, out++;
-            }
-            walk_step(&end);
-        }
+        if (round < nr) memcpy(per, rcnt + round * 2 * (size_t)K, 2 * (size_t)K * sizeof(int));
+        else memset(per, 0, 2 * (size_t)K * sizeof(int));
         int pos = 0; /* the send buffer: A's blocks by rank, then B's */
         for (int s = 0; s < 2; s++)
             for (int r = 0; r < K; r++) {
                 sdisp[2 * r + s] = sfill[2 * r + s] = pos;
                 pos += per[2 * r + s];
             }
-        while (at.t < end.t && walk_next(in, order, &at)) {
-            int r = dest_get(dest, w, at.t), s = at.s;
-            size_t to;
-            double *x;
-            if (r == me) {
-                to = ownat[s]++;
-                x = loc->xyz[s] + 3 * to;
-                off[s][to] = (uint32_t)at.num[s];
-            } else {
-                to = (size_t)sfill[2 * r + s]++;
-                x = sx + 3 * to;
-                so[to] = (uint32_t)at.num[s];
+        /* Pack the round's positions, a part's run at a time. */
+        for (size_t t = round < nr ? tb[round] : nloc, t1 = round < nr ? tb[round + 1] : nloc; t < t1;) {
+            size_t avail = walk_avail(in, order, &at), m = t1 - t < avail ? t1 - t : avail;
+            assert(avail > 0);
+            int s = at.s;
+            const hd_points_t *v = &order[s][at.p]->points;
+            const double *px = hd__mpi_packed(v);
+            uint32_t num = (uint32_t)at.num[s];
+            double *lx = loc->xyz[s];
+            uint32_t *lo = off[s];
+            for (size_t i = 0; i < m; i++, t++, num++) {
+                int r = dest_get(dest, w, t);
+                double *x;
+                if (r == me) {
+                    size_t to = ownat[s]++;
+                    x = lx + 3 * to;
+                    lo[to] = num;
+                } else {
+                    size_t to = (size_t)sfill[2 * r + s]++;
+                    x = sx + 3 * to;
+                    so[to] = num;
+                }
+                if (px) memcpy(x, px + 3 * (at.k + i), 3 * sizeof(double));
+                else hd_points_get(v, at.k + i, x);
             }
-            hd__mpi_get_point(&order[s][at.p]->points, at.k, x);
-            walk_step(&at);
+            at.k += m;
+            at.num[s] += m;
         }
         MPI_GO(c, rc, MPI_Alltoall(per, 2, MPI_INT, rper, 2, MPI_INT, c->comm));
         for (int s = 0; s < 2; s++) {
@@ -322,6 +345,8 @@ int hd__mpi_exchange(ctx_t *c, const input_t *in, const ranges_t *rg, const node
     }
     rc = hd__mpi_agree(c, rc);
 done:
+    hd__mpi_free(c, tb, maxr + 1, sizeof(size_t));
+    hd__mpi_free(c, rcnt, maxr * 2 * (size_t)K, sizeof(int));
     hd__mpi_free(c, cnt, 16 * (size_t)K, sizeof(int));
     hd__mpi_free(c, base, 4 * (size_t)K, sizeof(size_t));
     hd__mpi_free(c, dest, nloc, (size_t)w);

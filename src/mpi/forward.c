@@ -238,7 +238,7 @@ int hd__mpi_direction(ctx_t *c, const dir_t *d, const node_t *tree, const hd__bo
     if (sh.lazy && hd__mpi_far_better(&sh.h, &G)) {
         far_t I = {-1.0, UINT64_MAX, UINT64_MAX};
         double t1 = hd__now(), u1 = hd__mpi_cpu();
-        rc = hd__mpi_interior_max(c, d, mine, &sh, sh.h.d2, &I);
+        rc = hd__mpi_interior_max(c, d, mine, &sh, sh.h.d2, &G, &I);
         c->search += hd__now() - t1;
         c->search_cpu += hd__mpi_cpu() - u1;
         c->interior_passes++;

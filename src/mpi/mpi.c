@@ -48,12 +48,15 @@
  *  3. The single-machine engine on each rank's part: hd_directed(local A,
  *     local B) gives h2, the rank's largest u(a)^2, where u(a)^2 is the
  *     exact minimum over local B (an upper bound on the minimum over all
- *     of B).  Every a whose region faces are clear of h2 (step 4's test
+ *     of B); the symmetric call runs hd_hausdorff once for both
+ *     directions (each engine call builds both sets' structures).  Every
+ *     a whose region faces are clear of h2 (step 4's test
  *     with h2 >= u(a)^2) is settled without a search of its own (the
  *     interior).  When the engine's witness is interior, it is the
  *     interior's maximum; else the interior's maximum is computed (one
- *     more engine call on it) only on a rank where the engine's answer
- *     beats the best over all ranks found without it (step 6): every
+ *     more engine call on it, its maximum starting at G, so what cannot
+ *     beat G is pruned at once) only on a rank where the engine's answer
+ *     beats G, the best over all ranks found without it (step 6): every
  *     interior point is below that answer.  The rest, the shell within h
  *     of the faces, get per-point searches (the nearest layer's, as
  *     hd_distances runs them: the nearest local b, smallest index on
@@ -315,10 +318,28 @@ static int run(ctx_t *c, const hd_options_t *opt, input_t *in, void *arg, hd_mpi
         spread_t *sp = &cs.sp;
         if ((rc = hd__mpi_spread(c, in, &cs.rg, cs.N, sp)) != HD_OK) goto done;
         local_t *loc = &sp->loc;
-        for (int s = 0; s < (both ? 2 : 1); s++) {
-            dir_t d = {loc->xyz[s], &sp->gi[s], loc->n[s], loc->xyz[1 - s], &sp->gi[1 - s], loc->n[1 - s], 1 - s};
-            if ((rc = hd__mpi_direction(c, &d, sp->tree, sp->region, sp->held, &f[s])) != HD_OK) goto done;
+        /* Both directions: the engine once for both (each of its calls
+         * builds both sets' structures); its failure is agreed on before
+         * the first direction. */
+        pre_t pre[2];
+        memset(pre, 0, sizeof pre);
+        unsigned char *mask[2] = {NULL, NULL};
+        int pre_rc = HD_OK;
+        if (both) {
+            const gidx_t *gp[2] = {&sp->gi[0], &sp->gi[1]};
+            double t1 = hd__now(), u1 = hd__mpi_cpu();
+            pre_rc = hd__mpi_engine_both(c, loc->xyz, gp, loc->n, sp->held[c->rank].box, pre, mask);
+            c->search += hd__now() - t1;
+            c->search_cpu += hd__mpi_cpu() - u1;
         }
+        rc = hd__mpi_agree(c, pre_rc);
+        for (int s = 0; s < (both ? 2 : 1) && rc == HD_OK; s++) {
+            dir_t d = {loc->xyz[s], &sp->gi[s], loc->n[s], loc->xyz[1 - s], &sp->gi[1 - s], loc->n[1 - s], 1 - s,
+                       &pre[s]};
+            rc = hd__mpi_direction(c, &d, sp->tree, sp->region, sp->held, &f[s]);
+        }
+        for (int s = 0; s < 2; s++) hd__mpi_free(c, mask[s], loc->n[s], 1);
+        if (rc != HD_OK) goto done;
         pts = loc->n[0] + loc->n[1];
     }
     hd_result_t *r[2] = {both ? &out->ab : res, both ? &out->ba : NULL};

@@ -60,6 +60,12 @@ void *hd__mpi_alloc(ctx_t *c, size_t n, size_t size);
 void hd__mpi_free(ctx_t *c, void *p, size_t n, size_t size);
 void hd__mpi_charge(ctx_t *c, size_t bytes);
 int hd__mpi_engine(ctx_t *c, const hd_points_t *P, const hd_points_t *Q, hd_result_t *e);
+int hd__mpi_engine_local(ctx_t *c, const hd_points_t *P, const hd_points_t *Q, const hd__box_t *bp,
+                         const hd__box_t *bq, hd_result_t *e);
+int hd__mpi_engine_sym(ctx_t *c, const hd_points_t *P, const hd_points_t *Q, const hd__box_t *bp,
+                       const hd__box_t *bq, hd_symmetric_t *s);
+int hd__mpi_engine_above(ctx_t *c, const hd_points_t *P, const hd_points_t *Q, double floor2, size_t floor_i,
+                         hd_result_t *e);
 int hd__mpi_nomem(ctx_t *c, const char *what, size_t n);
 int hd__mpi_failed(ctx_t *c, const char *call, int code);
 int hd__mpi_agree(ctx_t *c, int rc);
@@ -104,14 +110,20 @@ typedef struct {
     hd__box_t box[2];         /* local boxes (input) */
 } input_t;
 
-/* Point k of a view: packed doubles directly, anything else through
- * hd_points_get (the exchange reads every point twice). */
-static inline void hd__mpi_get_point(const hd_points_t *p, size_t k, double out[3]) {
+/* A view of packed doubles (the common layout) as its array, read in
+ * place; NULL for any other layout, read through hd_points_get. */
+static inline const double *hd__mpi_packed(const hd_points_t *p) {
     if (p->dtype == HD_FLOAT64 && (p->stride == 0 || p->stride == 3 * (ptrdiff_t)sizeof(double)) &&
         (p->cstride == 0 || p->cstride == (ptrdiff_t)sizeof(double)))
-        memcpy(out, (const double *)p->data + 3 * k, 3 * sizeof(double));
-    else
-        hd_points_get(p, k, out);
+        return p->data;
+    return NULL;
+}
+
+/* Point k of a view. */
+static inline void hd__mpi_get_point(const hd_points_t *p, size_t k, double out[3]) {
+    const double *x = hd__mpi_packed(p);
+    if (x) memcpy(out, x + 3 * k, 3 * sizeof(double));
+    else hd_points_get(p, k, out);
 }
 
 typedef struct { uint64_t lo, hi; int side, rank; } range_t;
@@ -152,6 +164,31 @@ typedef struct {
 
 uint64_t hd__mpi_gidx(const gidx_t *x, size_t k);
 
+/* A walk over a local set's global indices at nondecreasing positions:
+ * the sender and its index run advance with the position instead of being
+ * searched for each point (hd__mpi_gidx's two binary searches), and a
+ * position in the current run costs a subtraction and a comparison. */
+typedef struct {
+    const gidx_t *x;
+    int r;                   /* the sender whose run holds the position */
+    size_t i, end;           /* its current index run in rg, and its end */
+    size_t kend;             /* the sender's run ends before this position */
+    uint64_t first, span, lo; /* the index run: numbers first .. first +
+                                 span name indices lo .. lo + span */
+} gcur_t;
+
+void hd__mpi_gcur_init(gcur_t *cu, const gidx_t *x);
+uint64_t hd__mpi_gcur_next(gcur_t *cu, size_t k);
+
+static inline uint64_t hd__mpi_gcur_at(gcur_t *cu, size_t k) {
+    if (cu->x->g) return cu->x->g[k];
+    if (k < cu->kend) {
+        uint64_t d = cu->x->num[k] - cu->first;
+        if (d <= cu->span) return cu->lo + d;
+    }
+    return hd__mpi_gcur_next(cu, k);
+}
+
 typedef struct {
     double *P;               /* local points asking, packed xyz (reordered
                                 and restored by split/unsplit) */
@@ -161,6 +198,8 @@ typedef struct {
     const gidx_t *gQ;
     size_t nQ;
     int qside;               /* 0: Q is A, 1: Q is B */
+    const struct pre *pre;   /* the engine's answer, when computed for both
+                                directions at once (NULL: not) */
 } dir_t;
 
 int hd__mpi_by_offset(const void *x, const void *y);
@@ -173,7 +212,26 @@ int hd__mpi_check_local(ctx_t *c, const hd_options_t *opt, input_t *in, const vo
 
 /* ---- the partition (rcb.c) and the exchange (exchange.c) ----------------- */
 
-int hd__mpi_rank_of(const node_t *t, int K, const double *x, uint64_t side, uint64_t g);
+/* Whether a point (coordinates x, set side, global index g) goes to the
+ * left of a node: its key (coordinate, set, index) below the split's. */
+static inline int hd__mpi_goes_left(const node_t *nd, const double *x, uint64_t side, uint64_t g) {
+    double v = x[nd->axis];
+    if (v != nd->s) return v < nd->s;
+    if (side != nd->side) return side < nd->side;
+    return g < nd->g;
+}
+
+/* The rank whose region holds the point (a walk down the tree; inline,
+ * since the exchange asks it for every point). */
+static inline int hd__mpi_rank_of(const node_t *t, int K, const double *x, uint64_t side, uint64_t g) {
+    if (K == 1) return 0;
+    int k = 0;
+    for (;;) {
+        int next = hd__mpi_goes_left(&t[k], x, side, g) ? t[k].left : t[k].right;
+        if (next < 0) return -next - 1;
+        k = next;
+    }
+}
 void hd__mpi_regions(const node_t *t, int node, hd__box_t box, hd__box_t *out);
 hd__box_t hd__mpi_node_boxes(const node_t *t, int node, const held_t *held, int side, hd__box_t *out);
 void hd__mpi_candidates(const node_t *t, const hd__box_t *nbox, const held_t *held, int side, int node,
@@ -254,8 +312,24 @@ typedef struct {
                                 is in the shell and bounds the interior */
 } shell_t;
 
+/* The engine's answer for a direction, computed before it runs: the
+ * symmetric call runs the engine once for both directions
+ * (hd__mpi_engine_both), since each of its calls builds both sets'
+ * structures. */
+typedef struct pre {
+    int have;                /* 0: the direction runs the engine itself */
+    int paired;              /* the answer is on the pairs (P_c, Q_c) */
+    hd_result_t e;           /* positions in P and Q, or in P_c and Q_c */
+    const unsigned char *inp, *inq; /* paired: the pairs' masks of P, Q */
+} pre_t;
+
+/* mask[s]: NULL, or the pairs' mask of side s (n[s] bytes) when paired,
+ * which the caller frees (hd__mpi_free) after both directions. */
+int hd__mpi_engine_both(ctx_t *c, double *xyz[2], const gidx_t *g[2], const size_t n[2], const hd__box_t box[2],
+                        pre_t pre[2], unsigned char *mask[2]);
 void hd__mpi_shell_free(ctx_t *c, shell_t *sh);
-int hd__mpi_interior_max(ctx_t *c, const dir_t *d, const hd__box_t *mine, const shell_t *sh, double h2, far_t *out);
+int hd__mpi_interior_max(ctx_t *c, const dir_t *d, const hd__box_t *mine, const shell_t *sh, double h2,
+                         const far_t *G, far_t *out);
 uint64_t hd__mpi_shell_g(const dir_t *d, const shell_t *sh, size_t k);
 int hd__mpi_shell_of(ctx_t *c, const dir_t *d, const hd__box_t *mine, qtree_t *q, shell_t *sh);
 

@@ -20,6 +20,7 @@
 #include "mpi_int.h"
 
 #include <assert.h>
+#include <string.h>
 #include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -84,6 +85,36 @@ uint64_t hd__mpi_gidx(const gidx_t *x, size_t k) {
     }
     assert(k >= x->start[lo] && k < x->start[lo + 1]);
     return hd__mpi_ranges_global(x->rg, x->side, lo, x->num[k]);
+}
+
+void hd__mpi_gcur_init(gcur_t *cu, const gidx_t *x) {
+    memset(cu, 0, sizeof *cu);
+    cu->x = x;
+    cu->r = -1;
+}
+
+/* The slow path of hd__mpi_gcur_at: the next sender, or the next index
+ * run of the same sender (numbers increase within a sender's run). */
+uint64_t hd__mpi_gcur_next(gcur_t *cu, size_t k) {
+    const gidx_t *x = cu->x;
+    const ranges_t *rg = x->rg;
+    if (cu->r < 0 || k >= x->start[cu->r + 1]) {
+        int r = cu->r < 0 ? 0 : cu->r;
+        while (k >= x->start[r + 1]) r++;
+        size_t seg = (size_t)x->side * ((size_t)rg->K + 1) + (size_t)r;
+        cu->r = r;
+        cu->kend = x->start[r + 1];
+        cu->i = rg->seg[seg];
+        cu->end = rg->seg[seg + 1];
+    }
+    assert(k >= x->start[cu->r]);
+    uint64_t m = x->num[k];
+    while (m - rg->first[cu->i] > rg->all[cu->i].hi - rg->all[cu->i].lo) cu->i++;
+    assert(cu->i < cu->end && m >= rg->first[cu->i]);
+    cu->first = rg->first[cu->i];
+    cu->span = rg->all[cu->i].hi - rg->all[cu->i].lo;
+    cu->lo = rg->all[cu->i].lo;
+    return cu->lo + (m - cu->first);
 }
 
 /* Over all ranks, no two parts of one set share an index; rg receives

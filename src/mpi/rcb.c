@@ -7,7 +7,7 @@
  *  - Keys are (coordinate on the node's axis, set, global index): distinct
  *    for distinct points, since (set, index) names one point.  So a node
  *    divides its samples exactly at floor(k/2)/k even when they share a
- *    coordinate (a lattice, a roof, every point equal), and goes_left,
+ *    coordinate (a lattice, a roof, every point equal), and hd__mpi_goes_left,
  *    which every rank applies to every point, orders points as
  *    select_nth ordered the samples: a point goes left when its key is
  *    smaller than the split sample's.
@@ -39,23 +39,6 @@ static int key_less(const double *x, uint64_t side, uint64_t g, int axis,
 
 static int sample_less(const sample_t *p, const sample_t *q, int axis) {
     return key_less(p->x, p->side, p->g, axis, q->x, q->side, q->g);
-}
-
-static int goes_left(const node_t *nd, const double *x, uint64_t side, uint64_t g) {
-    double v = x[nd->axis];
-    if (v != nd->s) return v < nd->s;
-    if (side != nd->side) return side < nd->side;
-    return g < nd->g;
-}
-
-int hd__mpi_rank_of(const node_t *t, int K, const double *x, uint64_t side, uint64_t g) {
-    if (K == 1) return 0;
-    int k = 0;
-    for (;;) {
-        int next = goes_left(&t[k], x, side, g) ? t[k].left : t[k].right;
-        if (next < 0) return -next - 1;
-        k = next;
-    }
 }
 
 static void swap_samples(sample_t *a, sample_t *b) {

@@ -69,6 +69,103 @@ static void unsplit(double *xyz, size_t n, const unsigned char *keep, const doub
     }
 }
 
+/* Marks the pairs: inp[i] = inq[j] = 1 when point i of P and point j of Q
+ * have the same global index (the masks zeroed by the caller; both NULL:
+ * count only), and returns their number.  One merge walk over both index
+ * orders. */
+static size_t mark_pairs(const gidx_t *gP, size_t nP, const gidx_t *gQ, size_t nQ, unsigned char *inp,
+                         unsigned char *inq) {
+    if (nP == 0 || nQ == 0) return 0;
+    gcur_t cp, cq;
+    hd__mpi_gcur_init(&cp, gP);
+    hd__mpi_gcur_init(&cq, gQ);
+    size_t i = 0, j = 0, nc = 0;
+    uint64_t gi = hd__mpi_gcur_at(&cp, 0), gj = hd__mpi_gcur_at(&cq, 0);
+    for (;;) {
+        if (gi == gj) {
+            if (inp) inp[i] = inq[j] = 1;
+            nc++;
+            if (++i == nP || ++j == nQ) break;
+            gi = hd__mpi_gcur_at(&cp, i);
+            gj = hd__mpi_gcur_at(&cq, j);
+        } else if (gi < gj) {
+            if (++i == nP) break;
+            gi = hd__mpi_gcur_at(&cp, i);
+        } else {
+            if (++j == nQ) break;
+            gj = hd__mpi_gcur_at(&cq, j);
+        }
+    }
+    return nc;
+}
+
+/* The correspondence pass is tried when nine tenths of P have their
+ * partner (anything else is not a copy), and not on whole sets in one
+ * order, which the engine's own path takes. */
+static int is_paired(size_t nc, size_t nP, size_t nQ) {
+    return !(nc < 64 || nc < nP - nP / 10 || (nc == nP && nc == nQ));
+}
+
+/* The engine on the pairs of P and Q (masks inp, inq), moved to the front
+ * of both arrays and put back after: *e's positions are in P_c and Q_c.
+ * sym: both directions (e[0] P to Q, e[1] Q to P), else e[0] only.  box:
+ * NULL, or the boxes of all of P and Q, which hold the pairs (the engine
+ * needs a box that holds its points, not the smallest). */
+static int pairs_engine(ctx_t *c, double *P, size_t nP, double *Q, size_t nQ, const unsigned char *inp,
+                        const unsigned char *inq, size_t nc, int sym, const hd__box_t *box, hd_result_t e[2]) {
+    size_t nx = nQ - nc, ny = nP - nc;
+    double *qx = hd__mpi_alloc(c, nx, 3 * sizeof(double)), *py = hd__mpi_alloc(c, ny, 3 * sizeof(double));
+    int rc = HD_OK;
+    if (!qx || !py) rc = hd__mpi_nomem(c, "the pairs", nc);
+    if (rc == HD_OK) {
+        split(P, nP, inp, py);
+        split(Q, nQ, inq, qx);
+        hd_points_t Pv = hd_points_f64(P, nc), Qv = hd_points_f64(Q, nc);
+        hd_symmetric_t s;
+        if (sym && (rc = hd__mpi_engine_sym(c, &Pv, &Qv, box ? &box[0] : NULL, box ? &box[1] : NULL, &s)) == HD_OK)
+            e[0] = s.ab, e[1] = s.ba;
+        if (!sym) rc = hd__mpi_engine_local(c, &Pv, &Qv, NULL, NULL, &e[0]);
+        unsplit(P, nP, inp, py);
+        unsplit(Q, nQ, inq, qx);
+    }
+    hd__mpi_free(c, qx, nx, 3 * sizeof(double));
+    hd__mpi_free(c, py, ny, 3 * sizeof(double));
+    return rc;
+}
+
+int hd__mpi_engine_both(ctx_t *c, double *xyz[2], const gidx_t *g[2], const size_t n[2], const hd__box_t box[2],
+                        pre_t pre[2], unsigned char *mask[2]) {
+    memset(pre, 0, 2 * sizeof *pre);
+    mask[0] = mask[1] = NULL;
+    if (n[0] == 0 || n[1] == 0) return HD_OK; /* shell_of has nothing to ask the engine */
+    /* The masks are marked in the walk that counts the pairs (2 bytes a
+     * point while the local arrays alone are held: below the engine's
+     * peak), and freed at once when the sets are not a copy. */
+    mask[0] = hd__mpi_alloc(c, n[0], 1);
+    mask[1] = hd__mpi_alloc(c, n[1], 1);
+    if (!mask[0] || !mask[1]) return hd__mpi_nomem(c, "the pairs", n[0]);
+    memset(mask[0], 0, n[0]);
+    memset(mask[1], 0, n[1]);
+    size_t nc = mark_pairs(g[0], n[0], g[1], n[1], mask[0], mask[1]);
+    int paired = is_paired(nc, n[0], n[1]);
+    if (!paired || paired != is_paired(nc, n[1], n[0])) {
+        for (int s = 0; s < 2; s++) hd__mpi_free(c, mask[s], n[s], 1), mask[s] = NULL;
+        if (paired) return HD_OK; /* each direction on its own */
+    }
+    hd_result_t e[2];
+    int rc = HD_OK;
+    if (!paired) {
+        hd_points_t Av = hd_points_f64(xyz[0], n[0]), Bv = hd_points_f64(xyz[1], n[1]);
+        hd_symmetric_t s;
+        if ((rc = hd__mpi_engine_sym(c, &Av, &Bv, &box[0], &box[1], &s)) == HD_OK) e[0] = s.ab, e[1] = s.ba;
+    } else {
+        rc = pairs_engine(c, xyz[0], n[0], xyz[1], n[1], mask[0], mask[1], nc, 1, box, e);
+    }
+    if (rc == HD_OK)
+        for (int s = 0; s < 2; s++) pre[s] = (pre_t){1, paired, e[s], mask[s], mask[1 - s]};
+    return rc;
+}
+
 /* The correspondence pass, for a copy and its original (|A| = |B|, point g
  * of B the moved point g of A).  After the partition a rank holds most
  * pairs whole, but not all (a face separates some), so its local sets
@@ -76,7 +173,8 @@ static void unsplit(double *xyz, size_t n, const unsigned char *keep, const doub
  * step 0.5), which settles a copy at a few ns a point, does not run on
  * them.  Here P_c, the local points of P whose partner is local too, and
  * Q_c, those partners, are passed to the engine in the same order (both
- * are in global index order), so the path runs.  Its answer h_c, with
+ * are in global index order), so the path runs (or ran already for both
+ * directions: d->pre).  Its answer h_c, with
  * witness a*, bounds every u(a)^2 of P_c from above (Q_c is part of the
  * local Q), so the points of P_c whose faces are clear of h_c are settled
  * (the interior; the points of P without a local partner are shell).  The
@@ -86,51 +184,39 @@ static void unsplit(double *xyz, size_t n, const unsigned char *keep, const doub
  * of P_c with u^2 = h_c has u_c^2 = h_c too, so an index no smaller than
  * a*'s (the engine's tie rule).  The witness's j is the engine's, or the
  * smallest index of Q_x at exactly h_c.  Otherwise (*done = 0) the caller
- * runs the engine on the whole local sets.  Tried only when nine tenths
- * of P have their partner: anything else is not a copy. */
+ * runs the engine on the whole local sets (or takes d->pre's answer). */
 static int paired_pass(ctx_t *c, const dir_t *d, const hd__box_t *mine, unsigned char **inp, size_t *nI,
                        far_t *inner, int *done) {
-    size_t nP = d->nP, nQ = d->nQ, nc = 0;
+    size_t nP = d->nP, nQ = d->nQ, nc;
+    const pre_t *pre = d->pre && d->pre->have ? d->pre : NULL;
     *done = 0;
     *inp = NULL;
-    for (size_t i = 0, j = 0; i < nP && j < nQ;) {
-        uint64_t gi = hd__mpi_gidx(d->gP, i), gj = hd__mpi_gidx(d->gQ, j);
-        if (gi == gj) nc++, i++, j++;
-        else if (gi < gj) i++;
-        else j++;
-    }
-    if (nc < 64 || nc < nP - nP / 10 || (nc == nP && nc == nQ)) return HD_OK; /* whole sets: the engine's own */
-    /* The pairs to the front of P and Q, in order; the others aside. */
-    size_t nx = nQ - nc, ny = nP - nc;
+    if (pre && !pre->paired) return HD_OK;
+    if (!pre && !is_paired(nc = mark_pairs(d->gP, nP, d->gQ, nQ, NULL, NULL), nP, nQ)) return HD_OK;
     unsigned char *in = *inp = hd__mpi_alloc(c, nP, 1), *inq = hd__mpi_alloc(c, nQ, 1);
-    double *qx = hd__mpi_alloc(c, nx, 3 * sizeof(double)), *py = hd__mpi_alloc(c, ny, 3 * sizeof(double));
     int rc = HD_OK;
-    if (!in || !inq || !qx || !py) {
-        rc = hd__mpi_nomem(c, "the pairs", nc);
+    if (!in || !inq) {
+        rc = hd__mpi_nomem(c, "the pairs", nP);
         goto done;
     }
-    memset(in, 0, nP);
-    memset(inq, 0, nQ);
-    for (size_t i = 0, j = 0; i < nP && j < nQ;) {
-        uint64_t gi = hd__mpi_gidx(d->gP, i), gj = hd__mpi_gidx(d->gQ, j);
-        if (gi == gj) in[i++] = inq[j++] = 1;
-        else if (gi < gj) i++;
-        else j++;
+    if (pre) { /* the masks of hd__mpi_engine_both */
+        memcpy(in, pre->inp, nP);
+        memcpy(inq, pre->inq, nQ);
+    } else {
+        memset(in, 0, nP);
+        memset(inq, 0, nQ);
+        nc = mark_pairs(d->gP, nP, d->gQ, nQ, in, inq);
     }
-    split(d->P, nP, in, py);
-    split(d->Q, nQ, inq, qx);
-    hd_result_t e;
-    hd_points_t Pv = hd_points_f64(d->P, nc), Qv = hd_points_f64(d->Q, nc);
-    rc = hd__mpi_engine(c, &Pv, &Qv, &e);
-    unsplit(d->P, nP, in, py);
-    unsplit(d->Q, nQ, inq, qx);
+    hd_result_t e[2];
+    if (pre) e[0] = pre->e;
+    else rc = pairs_engine(c, d->P, nP, d->Q, nQ, in, inq, nc, 0, NULL, e);
     if (rc == HD_OK) {
         /* a*, and Q_c's e.j: P_c's e.j's partner (the same index) */
-        size_t astar = kept_at(in, nP, e.i);
-        uint64_t gi = hd__mpi_gidx(d->gP, astar), jc = hd__mpi_gidx(d->gP, kept_at(in, nP, e.j));
+        size_t astar = kept_at(in, nP, e[0].i);
+        uint64_t gi = hd__mpi_gidx(d->gP, astar), jc = hd__mpi_gidx(d->gP, kept_at(in, nP, e[0].j));
         *nI = 0;
         for (size_t i = 0; i < nP; i++)
-            *nI += in[i] = (unsigned char)(in[i] && hd__mpi_faces_clear(mine, d->P + 3 * i, e.distance2));
+            *nI += in[i] = (unsigned char)(in[i] && hd__mpi_faces_clear(mine, d->P + 3 * i, e[0].distance2));
         /* The nearest point of Q_x to a* (position order is index order:
          * the first at the minimum is the smallest index). */
         double v = INFINITY;
@@ -141,32 +227,44 @@ static int paired_pass(ctx_t *c, const dir_t *d, const hd__box_t *mine, unsigned
             if (d2 < v) v = d2, jx = j;
         }
         uint64_t jv = jx == SIZE_MAX ? UINT64_MAX : hd__mpi_gidx(d->gQ, jx);
-        if (in[astar] && v >= e.distance2) {
-            *inner = (far_t){e.distance2, gi, v == e.distance2 && jv < jc ? jv : jc};
+        if (in[astar] && v >= e[0].distance2) {
+            *inner = (far_t){e[0].distance2, gi, v == e[0].distance2 && jv < jc ? jv : jc};
             *done = 1;
         }
     }
 done:
     hd__mpi_free(c, inq, nQ, 1);
-    hd__mpi_free(c, qx, nx, 3 * sizeof(double));
-    hd__mpi_free(c, py, ny, 3 * sizeof(double));
     return rc;
 }
 
 /* The exact maximum over the interior, the points whose faces are clear
- * of h2 (their local u is global): the engine on a copy of them. */
-int hd__mpi_interior_max(ctx_t *c, const dir_t *d, const hd__box_t *mine, const shell_t *sh, double h2, far_t *out) {
+ * of h2 (their local u is global), where it beats G, the best over every
+ * rank without it (else *out has d2 = -1: it cannot change the result).
+ * The engine runs on a compacted copy of them with its maximum starting at
+ * G: as (G.d2, p*), p* the number of interior points whose global index is
+ * below G's, since the copy's positions are in global index order, so a
+ * point beats the floor exactly when it beats G (G's point is not
+ * interior: the interior's maximum is what G was computed without).  The
+ * points that cannot are pruned as soon as one point of Q shows it, which
+ * is most of them. */
+int hd__mpi_interior_max(ctx_t *c, const dir_t *d, const hd__box_t *mine, const shell_t *sh, double h2,
+                         const far_t *G, far_t *out) {
+    *out = (far_t){-1.0, UINT64_MAX, UINT64_MAX};
     unsigned char *in = hd__mpi_alloc(c, d->nP, 1);
     if (!in) return hd__mpi_nomem(c, "the interior", d->nP);
-    size_t nI = 0;
+    size_t nI = 0, below = 0;
     for (size_t k = 0; k < d->nP; k++) nI += in[k] = (unsigned char)hd__mpi_faces_clear(mine, d->P + 3 * k, h2);
     assert(nI + sh->n == d->nP && sh->own_xyz);
+    gcur_t cu;
+    hd__mpi_gcur_init(&cu, d->gP);
+    for (size_t k = 0; k < d->nP && hd__mpi_gcur_at(&cu, k) < G->i; k++) below += in[k];
     split(d->P, d->nP, in, NULL); /* the shell's copy is the aside */
     hd_points_t Iv = hd_points_f64(d->P, nI), Qv = hd_points_f64(d->Q, d->nQ);
     hd_result_t e;
-    int rc = hd__mpi_engine(c, &Iv, &Qv, &e);
+    int rc = G->d2 >= 0 ? hd__mpi_engine_above(c, &Iv, &Qv, G->d2, below, &e) : hd__mpi_engine_local(c, &Iv, &Qv, NULL, NULL, &e);
     unsplit(d->P, d->nP, in, sh->own_xyz);
-    if (rc == HD_OK) *out = (far_t){e.distance2, hd__mpi_gidx(d->gP, kept_at(in, d->nP, e.i)), hd__mpi_gidx(d->gQ, e.j)};
+    if (rc == HD_OK && (G->d2 < 0 || e.distance2 > G->d2 || (e.distance2 == G->d2 && e.i < below)))
+        *out = (far_t){e.distance2, hd__mpi_gidx(d->gP, kept_at(in, d->nP, e.i)), hd__mpi_gidx(d->gQ, e.j)};
     hd__mpi_free(c, in, d->nP, 1);
     return rc;
 }
@@ -188,7 +286,9 @@ int hd__mpi_shell_of(ctx_t *c, const dir_t *d, const hd__box_t *mine, qtree_t *q
     size_t nI = 0;
     int done = 0;
     int rc = paired_pass(c, d, mine, &in, &nI, &sh->inner, &done);
-    if (rc == HD_OK && !done && (rc = hd__mpi_engine(c, &Pv, &Qv, &e)) == HD_OK) {
+    const pre_t *pre = d->pre && d->pre->have && !d->pre->paired ? d->pre : NULL;
+    if (rc == HD_OK && !done && pre) e = pre->e;
+    if (rc == HD_OK && !done && (pre || (rc = hd__mpi_engine_local(c, &Pv, &Qv, NULL, NULL, &e)) == HD_OK)) {
         if (!in && !(in = hd__mpi_alloc(c, d->nP, 1))) rc = hd__mpi_nomem(c, "the interior", d->nP);
         nI = 0;
         for (size_t k = 0; k < d->nP && rc == HD_OK; k++)

@@ -150,11 +150,15 @@ static int slab_search(ctx_t *c, const slab_t *sl, const double *pts, const size
     return rc;
 }
 
-/* At most this many points the slab did not prove are searched by brute
- * force (a handful, on a copy: points whose partner is on another rank)
- * rather than in a wider slab, which costs as much as a few hundred
- * thousand distances to build. */
-#define BRUTE_MAX 16
+/* At most this many points the slab did not prove are compared with
+ * every point of Q (on a copy: points whose partner is on another rank)
+ * rather than searched in a wider slab.  One pass over Q serves them all,
+ * and a point of Q is mostly passed over after one coordinate's gap
+ * (about 6 instructions for each point asking, against 15 for a
+ * distance); the wider slab costs two passes over Q measuring face gaps
+ * (about 15 instructions a point each) and a structure over the points
+ * in it: past 4 askers it is the cheaper (callgrind, docs/scale-out.md). */
+#define BRUTE_MAX 4
 
 /* For each of n packed points, the nearest point of Q (exact, smallest
  * index on ties, as hd_distances gives it). */
@@ -177,17 +181,29 @@ int hd__mpi_nearest_in_q(ctx_t *c, const dir_t *d, const hd__box_t *r, qtree_t *
     for (int level = 0; level < 3 && m > 0 && rc == HD_OK; level++) {
         slab_t *sl = level == 2 ? &q->full : &q->sub;
         double M = level == 2 ? INFINITY : q->M0;
-        if (level == 1 && m <= BRUTE_MAX) { /* a few: every point of Q, in index order */
+        if (level == 1 && m <= BRUTE_MAX) { /* a few: every point of Q, in one pass */
+            /* Each starts from the slab's answer (an upper bound), and a
+             * point b of Q whose x gap alone exceeds it is passed over:
+             * hd__d2(x, b) >= fl(dx * dx) (the sum only adds non-negative
+             * terms, and rounding is monotone), so b is farther, not tied. */
+            double best[BRUTE_MAX];
+            size_t at[BRUTE_MAX];
             for (size_t t = 0; t < m; t++) {
-                const double *x = pts + 3 * list[t];
-                double best = INFINITY;
-                size_t at = SIZE_MAX;
-                for (size_t j = 0; j < d->nQ; j++) {
-                    double d2 = hd__d2(x, d->Q + 3 * j);
-                    if (d2 < best) best = d2, at = j;
-                }
-                near[list[t]] = at;
+                size_t j = near[list[t]];
+                at[t] = j;
+                best[t] = j == SIZE_MAX ? INFINITY : hd__d2(pts + 3 * list[t], d->Q + 3 * j);
             }
+            for (size_t j = 0; j < d->nQ; j++) {
+                const double *b = d->Q + 3 * j;
+                for (size_t t = 0; t < m; t++) {
+                    const double *x = pts + 3 * list[t];
+                    double dx = x[0] - b[0];
+                    if (dx * dx > best[t]) continue;
+                    double d2 = hd__d2(x, b);
+                    if (d2 < best[t] || (d2 == best[t] && j < at[t])) best[t] = d2, at[t] = j;
+                }
+            }
+            for (size_t t = 0; t < m; t++) near[list[t]] = at[t];
             m = 0;
             break;
         }

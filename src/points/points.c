@@ -58,9 +58,9 @@ void hd__box_of(const double *xyz, size_t n, hd__box_t *out) {
     for (int c = 0; c < 3; c++) out->lo[c] = out->hi[c] = xyz[c];
     for (size_t k = 1; k < n; k++) {
         const double *q = xyz + 3 * k;
-        for (int c = 0; c < 3; c++) {
-            if (q[c] < out->lo[c]) out->lo[c] = q[c];
-            if (q[c] > out->hi[c]) out->hi[c] = q[c];
+        for (int c = 0; c < 3; c++) { /* selects, not branches: the compiler's min and max */
+            out->lo[c] = q[c] < out->lo[c] ? q[c] : out->lo[c];
+            out->hi[c] = q[c] > out->hi[c] ? q[c] : out->hi[c];
         }
     }
 }

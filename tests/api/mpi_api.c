@@ -100,7 +100,7 @@ typedef struct {
 
 enum {
     DS_UNIFORM, DS_LATTICE, DS_LATTICE_HALF, DS_ONE_POINT, DS_PLANE, DS_FAR_B, DS_CORNER_B, DS_DUPLICATES,
-    DS_TINY, DS_HUGE, DS_NOISE, DS_DISJOINT, DS_CHECKER, DS_STRAY, DS_COUNT
+    DS_TINY, DS_HUGE, DS_NOISE, DS_DISJOINT, DS_CHECKER, DS_STRAY, DS_DEEP, DS_SMALL_LATTICE, DS_COUNT
 };
 
 static void make_set(int which, uint64_t seed, set_t *s) {
@@ -218,6 +218,32 @@ static void make_set(int which, uint64_t seed, set_t *s) {
         s->b[3 * f] = 2.1, s->b[3 * f + 1] = 2, s->b[3 * f + 2] = 2;
         break;
     }
+    case DS_DEEP: {
+        /* A and B sampled on the strip [0, 4] x [0, 1] of the plane z = 0
+         * (the first cut falls near x = 2), with A[0] = (1.5, 0.5, 5) above
+         * it and B[0] = (5.5, 0.5, 5) beside that, 4 away: nearer than the
+         * plane (5), in another region and deep inside it.  A[0] is
+         * forwarded, and the answering rank's slab (the strip's points near
+         * its face) gives the plane; only the comparison with every point
+         * of its B finds B[0] (and likewise B[0]'s query finds A[0]). */
+        s->name = "forwarded query whose nearest lies deep in another region";
+        for (size_t k = 0; k < n; k++) {
+            s->a[3 * k] = 4 * gen_unit(&g), s->a[3 * k + 1] = gen_unit(&g), s->a[3 * k + 2] = 0;
+            s->b[3 * k] = 4 * gen_unit(&g), s->b[3 * k + 1] = gen_unit(&g), s->b[3 * k + 2] = 0;
+        }
+        s->a[0] = 1.5, s->a[1] = 0.5, s->a[2] = 5;
+        s->b[0] = 5.5, s->b[1] = 0.5, s->b[2] = 5;
+        break;
+    }
+    case DS_SMALL_LATTICE:
+        /* Run over many seeds: every distance is the root of a small
+         * integer, so most points tie with many others, across faces, in
+         * the interior and in the shell, in both directions. */
+        s->name = "small lattice, ties everywhere";
+        s->na = s->nb = 400;
+        gen_lattice(&g, s->a, s->na, 7);
+        gen_lattice(&g, s->b, s->nb, 7);
+        break;
     case DS_DISJOINT:
         s->name = "disjoint boxes";
         gen_cube(&g, s->a, n, 0, 1);
@@ -483,6 +509,48 @@ static void check_single_rank_copies_nothing(void) {
     free(bf);
 }
 
+/* Views of any layout travel as packed doubles do: here floats in records
+ * of four (x, y, z and a weight: a stride of 16 bytes, read point by point
+ * rather than in place), A's in blocks by rank and B's in reverse rank
+ * order, large enough for several exchange rounds.  Coordinates are
+ * integers, exact in floats, so the reference is hd_hausdorff on doubles. */
+static void check_strided_views_over_ranks(void) {
+    uint64_t seed = 91;
+    gen_rng_t g;
+    gen_seed(&g, seed);
+    size_t n = 24000;
+    double *a = malloc(3 * n * sizeof(double)), *b = malloc(3 * n * sizeof(double));
+    float *af = malloc(4 * n * sizeof(float)), *bf = malloc(4 * n * sizeof(float));
+    for (size_t k = 0; k < 3 * n; k++) {
+        a[k] = (double)((int)(gen_u64(&g) % 101) - 50);
+        b[k] = (double)((int)(gen_u64(&g) % 101) - 50);
+    }
+    for (size_t k = 0; k < n; k++)
+        for (int c = 0; c < 4; c++) {
+            af[4 * k + c] = c < 3 ? (float)a[3 * k + c] : 1.0f;
+            bf[4 * k + c] = c < 3 ? (float)b[3 * k + c] : 1.0f;
+        }
+    snprintf(context_, sizeof context_, "strided float views over %d ranks, seed %llu", K_,
+             (unsigned long long)seed);
+    hd_points_t A = hd_points_f64(a, n), B = hd_points_f64(b, n);
+    hd_symmetric_t ref, got;
+    hd_error_t err;
+    CHECK(hd_hausdorff(&A, &B, NULL, &ref, &err) == HD_OK);
+    size_t a0 = n * (size_t)rank_ / (size_t)K_, a1 = n * ((size_t)rank_ + 1) / (size_t)K_;
+    size_t rb = (size_t)(K_ - 1 - rank_), b0 = n * rb / (size_t)K_, b1 = n * (rb + 1) / (size_t)K_;
+    hd_points_t va = {af + 4 * a0, a1 - a0, HD_FLOAT32, 4 * sizeof(float), sizeof(float)};
+    hd_points_t vb = {bf + 4 * b0, b1 - b0, HD_FLOAT32, 4 * sizeof(float), sizeof(float)};
+    hd_mpi_part_t pa = {va, a0}, pb = {vb, b0};
+    CHECK(hd_mpi_hausdorff(MPI_COMM_WORLD, &pa, 1, &pb, 1, NULL, &got, NULL, &err) == HD_OK);
+    CHECK(SAME_BITS(got.distance, ref.distance) && SAME_BITS(got.ab.distance2, ref.ab.distance2) &&
+          SAME_BITS(got.ba.distance2, ref.ba.distance2));
+    CHECK(got.ab.i == ref.ab.i && got.ab.j == ref.ab.j && got.ba.i == ref.ba.i && got.ba.j == ref.ba.j);
+    free(a);
+    free(b);
+    free(af);
+    free(bf);
+}
+
 int main(int argc, char **argv) {
     MPI_Init(&argc, &argv);
     MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
@@ -490,10 +558,13 @@ int main(int argc, char **argv) {
     const char *only = argc > 1 ? argv[1] : NULL; /* "errors" or a set number */
     if (!only || strcmp(only, "errors") == 0) check_errors();
     if (!only) check_single_rank_copies_nothing();
+    if (!only) check_strided_views_over_ranks();
     for (int which = 0; which < DS_COUNT; which++) {
         if (only && strcmp(only, "errors") != 0 && atoi(only) != which) continue;
         if (only && strcmp(only, "errors") == 0) break;
         for (int how = 0; how < LAY_COUNT; how++) check_equal(which, how, 1000 + (uint64_t)which);
+        for (uint64_t seed = 1; which == DS_SMALL_LATTICE && seed < 60; seed++)
+            check_equal(which, (int)(seed % LAY_COUNT), 5000 + seed);
         for (int how = 0; how < LAY_COUNT; how++) check_distances(which, how, 1000 + (uint64_t)which);
     }
     return mpicheck_finish("mpi_api");
