@@ -886,17 +886,7 @@ int hd__engine_trees(const hd__tree_t *ta, const hd__tree_t *tb, int threads, hd
 int hd__engine_directed(const hd_points_t *A, const hd_points_t *B, const hd__box_t *box_a,
                         const hd__box_t *box_b, const hd_options_t *opt, hd_result_t *out,
                         hd_error_t *err) {
-    double t0 = hd__now();
-    engine_t e;
-    int rc = engine_init(&e, A, B, box_a, box_b, opt, 1, err);
-    if (rc) return rc;
-    hd_result_t r[2];
-    rc = engine_run(&e, HD__ENGINE_PLANNED, r, err);
-    engine_free(&e);
-    if (rc) return rc;
-    *out = r[0];
-    out->seconds = hd__now() - t0;
-    return HD_OK;
+    return hd__engine_directed_above(A, B, box_a, box_b, opt, -1.0, 0, out, err);
 }
 
 int hd__engine_directed_above(const hd_points_t *A, const hd_points_t *B,
@@ -909,8 +899,10 @@ int hd__engine_directed_above(const hd_points_t *A, const hd_points_t *B,
     if (rc) return rc;
     /* A virtual point at the floor: every path only offers real points to
      * the maximum and prunes against it, so what survives is what beats it. */
-    hd__best_offer(&e.max[0].best, floor2, floor_i, HD__NONE);
-    hd__bound_raise(&e.max[0].cmax, floor2);
+    if (floor2 >= 0) {
+        hd__best_offer(&e.max[0].best, floor2, floor_i, HD__NONE);
+        hd__bound_raise(&e.max[0].cmax, floor2);
+    }
     hd_result_t r[2];
     rc = engine_run(&e, HD__ENGINE_PLANNED, r, err);
     engine_free(&e);

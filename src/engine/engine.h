@@ -396,7 +396,8 @@ int hd__engine_hausdorff(const hd_points_t *A, const hd_points_t *B,
  * floor (a larger distance, or the same at an index below floor_i); else
  * out->distance2 = floor2 and out->i = floor_i, which the caller reads as
  * "nothing above" (out->j is then HD__NONE, or a real nearest point of a
- * point floor_i at exactly floor2).  For the MPI library's second pass
+ * point floor_i at exactly floor2).  floor2 < 0: no floor (what
+ * hd__engine_directed runs).  For the MPI library's second pass
  * over a rank's interior, which matters only where it beats the best of
  * every rank. */
 int hd__engine_directed_above(const hd_points_t *A, const hd_points_t *B,

@@ -84,75 +84,58 @@ void hd__mpi_charge(ctx_t *c, size_t bytes) {
  * the grids take less), which is charged for the call's duration. */
 #define ENGINE_BYTES 16
 
-int hd__mpi_engine(ctx_t *c, const hd_points_t *P, const hd_points_t *Q, hd_result_t *e) {
+/* Every engine call of the library: charged at the engine's bound while
+ * it runs.  On the local arrays (packed doubles, validated before the
+ * exchange) it takes the engine's internal entries with the sets' boxes
+ * (bp, bq; NULL: computed here), since hd_directed would validate every
+ * point again (a pass over both sets, about 50 instructions a point); on
+ * the caller's views (one rank: any layout) the public hd_directed.  s:
+ * both directions at once (hd__engine_hausdorff), else h(P, Q) into e,
+ * from a floor when floor2 >= 0 (hd__engine_directed_above). */
+enum { VIEWS, LOCAL };
+static int engine_call(ctx_t *c, int where, const hd_points_t *P, const hd_points_t *Q, const hd__box_t *bp,
+                       const hd__box_t *bq, double floor2, size_t floor_i, hd_result_t *e, hd_symmetric_t *s) {
     hd_options_t o;
     hd_options_init(&o);
     o.threads = c->threads;
+    hd__box_t b[2];
+    if (where == LOCAL) {
+        if (bp) b[0] = *bp;
+        else hd__box_of(P->data, P->count, &b[0]);
+        if (bq) b[1] = *bq;
+        else hd__box_of(Q->data, Q->count, &b[1]);
+    }
     size_t bytes = ENGINE_BYTES * (P->count + Q->count);
     hd__mpi_charge(c, bytes);
-    int rc = hd_directed(P, Q, &o, e, &c->e);
+    int rc = where == VIEWS ? hd_directed(P, Q, &o, e, &c->e)
+             : s            ? hd__engine_hausdorff(P, Q, &b[0], &b[1], &o, s, &c->e)
+                            : hd__engine_directed_above(P, Q, &b[0], &b[1], &o, floor2, floor_i, e, &c->e);
     c->cur -= bytes;
     return rc;
 }
 
-/* The engine on local arrays (packed doubles, validated before the
- * exchange): its internal entry, given the sets' boxes (NULL: computed
- * here), instead of hd_directed, which would validate every point again
- * (a pass over both sets, about 50 instructions a point). */
-static void boxes(const hd_points_t *P, const hd_points_t *Q, const hd__box_t *bp, const hd__box_t *bq,
-                  hd__box_t out[2]) {
-    if (bp) out[0] = *bp;
-    else hd__box_of(P->data, P->count, &out[0]);
-    if (bq) out[1] = *bq;
-    else hd__box_of(Q->data, Q->count, &out[1]);
+int hd__mpi_engine(ctx_t *c, const hd_points_t *P, const hd_points_t *Q, hd_result_t *e) {
+    return engine_call(c, VIEWS, P, Q, NULL, NULL, -1.0, 0, e, NULL);
 }
 
 int hd__mpi_engine_local(ctx_t *c, const hd_points_t *P, const hd_points_t *Q, const hd__box_t *bp,
                          const hd__box_t *bq, hd_result_t *e) {
-    hd_options_t o;
-    hd_options_init(&o);
-    o.threads = c->threads;
-    hd__box_t b[2];
-    boxes(P, Q, bp, bq, b);
-    size_t bytes = ENGINE_BYTES * (P->count + Q->count);
-    hd__mpi_charge(c, bytes);
-    int rc = hd__engine_directed(P, Q, &b[0], &b[1], &o, e, &c->e);
-    c->cur -= bytes;
-    return rc;
+    return engine_call(c, LOCAL, P, Q, bp, bq, -1.0, 0, e, NULL);
 }
 
-/* h(P, Q) where only an answer beating (floor2, floor_i) matters
- * (hd__engine_directed_above: the points that cannot beat it are pruned
- * as soon as one point of Q shows it), on packed views of validated local
- * points; charged as above. */
+/* h(P, Q) where only an answer beating (floor2, floor_i) matters: the
+ * points that cannot beat it are pruned as soon as one point of Q shows
+ * it. */
 int hd__mpi_engine_above(ctx_t *c, const hd_points_t *P, const hd_points_t *Q, double floor2, size_t floor_i,
                          hd_result_t *e) {
-    hd_options_t o;
-    hd_options_init(&o);
-    o.threads = c->threads;
-    hd__box_t b[2];
-    boxes(P, Q, NULL, NULL, b);
-    size_t bytes = ENGINE_BYTES * (P->count + Q->count);
-    hd__mpi_charge(c, bytes);
-    int rc = hd__engine_directed_above(P, Q, &b[0], &b[1], &o, floor2, floor_i, e, &c->e);
-    c->cur -= bytes;
-    return rc;
+    return engine_call(c, LOCAL, P, Q, NULL, NULL, floor2, floor_i, e, NULL);
 }
 
 /* Both directions in one call: the engine builds each set's structures
- * once for both (hd_directed builds both sets' too), charged as above. */
+ * once for both (hd_directed builds both sets' too). */
 int hd__mpi_engine_sym(ctx_t *c, const hd_points_t *P, const hd_points_t *Q, const hd__box_t *bp,
                        const hd__box_t *bq, hd_symmetric_t *s) {
-    hd_options_t o;
-    hd_options_init(&o);
-    o.threads = c->threads;
-    hd__box_t b[2];
-    boxes(P, Q, bp, bq, b);
-    size_t bytes = ENGINE_BYTES * (P->count + Q->count);
-    hd__mpi_charge(c, bytes);
-    int rc = hd__engine_hausdorff(P, Q, &b[0], &b[1], &o, s, &c->e);
-    c->cur -= bytes;
-    return rc;
+    return engine_call(c, LOCAL, P, Q, bp, bq, -1.0, 0, NULL, s);
 }
 
 int hd__mpi_nomem(ctx_t *c, const char *what, size_t n) {
