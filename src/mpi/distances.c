@@ -80,10 +80,7 @@ typedef struct {
 } an_t;
 
 static void an_free(ctx_t *c, an_t *t) {
-    if (t->built) {
-        hd__an_free(&t->s);
-        c->cur -= t->bytes;
-    }
+    if (t->built) hd__mpi_an_release(c, &t->s, t->bytes);
     hd__mpi_free(c, t->pos, t->n, sizeof(uint32_t));
     memset(t, 0, sizeof *t);
 }

@@ -293,6 +293,8 @@ void hd__mpi_qtree_free(ctx_t *c, qtree_t *q);
 /* The nearest layer's structure of v, charged (60 bytes a point while
  * built, then what it holds: *bytes, to subtract when it is freed). */
 int hd__mpi_an_build(ctx_t *c, hd__an_t *s, const hd_points_t *v, const hd__box_t *kb, int threads, size_t *bytes);
+/* Frees a structure hd__mpi_an_build made and takes its bytes off the count. */
+void hd__mpi_an_release(ctx_t *c, hd__an_t *s, size_t bytes);
 int hd__mpi_nearest_in_q(ctx_t *c, const dir_t *d, const hd__box_t *r, qtree_t *q, const double *pts, size_t n,
                          size_t *near);
 

@@ -193,19 +193,21 @@ static int paired_pass(ctx_t *c, const dir_t *d, const hd__box_t *mine, unsigned
     *inp = NULL;
     if (pre && !pre->paired) return HD_OK;
     if (!pre && !is_paired(nc = mark_pairs(d->gP, nP, d->gQ, nQ, NULL, NULL), nP, nQ)) return HD_OK;
-    unsigned char *in = *inp = hd__mpi_alloc(c, nP, 1), *inq = hd__mpi_alloc(c, nQ, 1);
+    /* P's mask is made the interior's below, so it is this pass's own; Q's
+     * is only read, hd__mpi_engine_both's when it marked them */
+    unsigned char *in = *inp = hd__mpi_alloc(c, nP, 1), *ownq = pre ? NULL : hd__mpi_alloc(c, nQ, 1);
+    const unsigned char *inq = pre ? pre->inq : ownq;
     int rc = HD_OK;
     if (!in || !inq) {
         rc = hd__mpi_nomem(c, "the pairs", nP);
         goto done;
     }
-    if (pre) { /* the masks of hd__mpi_engine_both */
+    if (pre) {
         memcpy(in, pre->inp, nP);
-        memcpy(inq, pre->inq, nQ);
     } else {
         memset(in, 0, nP);
-        memset(inq, 0, nQ);
-        nc = mark_pairs(d->gP, nP, d->gQ, nQ, in, inq);
+        memset(ownq, 0, nQ);
+        nc = mark_pairs(d->gP, nP, d->gQ, nQ, in, ownq);
     }
     hd_result_t e[2];
     if (pre) e[0] = pre->e;
@@ -233,7 +235,7 @@ static int paired_pass(ctx_t *c, const dir_t *d, const hd__box_t *mine, unsigned
         }
     }
 done:
-    hd__mpi_free(c, inq, nQ, 1);
+    hd__mpi_free(c, ownq, nQ, 1);
     return rc;
 }
 

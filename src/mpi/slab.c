@@ -49,11 +49,13 @@ int hd__mpi_an_build(ctx_t *c, hd__an_t *s, const hd_points_t *v, const hd__box_
     return rc;
 }
 
+void hd__mpi_an_release(ctx_t *c, hd__an_t *s, size_t bytes) {
+    hd__an_free(s);
+    c->cur -= bytes;
+}
+
 static void slab_free(ctx_t *c, slab_t *sl) {
-    if (sl->built) {
-        hd__an_free(&sl->s);
-        c->cur -= sl->bytes;
-    }
+    if (sl->built) hd__mpi_an_release(c, &sl->s, sl->bytes);
     hd__mpi_free(c, sl->map, sl->n, sizeof(uint32_t));
     memset(sl, 0, sizeof *sl);
 }
@@ -140,10 +142,7 @@ static int slab_search(ctx_t *c, const slab_t *sl, const double *pts, const size
     hd_points_t Sv = hd_points_f64(xyz, m);
     if (rc == HD_OK && (rc = hd__mpi_an_build(c, &asking, &Sv, &sl->kb, threads, &ab)) == HD_OK)
         rc = hd__an_nearest(&asking, &sl->s, NULL, threads, NULL, got, NULL, &c->e);
-    if (ab) {
-        hd__an_free(&asking);
-        c->cur -= ab;
-    }
+    if (ab) hd__mpi_an_release(c, &asking, ab);
     for (size_t t = 0; t < m && rc == HD_OK; t++) near[list[t]] = sl->map ? sl->map[got[t]] : got[t];
     hd__mpi_free(c, xyz, m, 3 * sizeof(double));
     hd__mpi_free(c, got, m, sizeof(size_t));
@@ -153,11 +152,10 @@ static int slab_search(ctx_t *c, const slab_t *sl, const double *pts, const size
 /* At most this many points the slab did not prove are compared with
  * every point of Q (on a copy: points whose partner is on another rank)
  * rather than searched in a wider slab.  One pass over Q serves them all,
- * and a point of Q is mostly passed over after one coordinate's gap
- * (about 6 instructions for each point asking, against 15 for a
- * distance); the wider slab costs two passes over Q measuring face gaps
- * (about 15 instructions a point each) and a structure over the points
- * in it: past 4 askers it is the cheaper (callgrind, docs/scale-out.md). */
+ * and a point of Q is mostly passed over after one coordinate's gap; the
+ * wider slab costs two passes over Q measuring face gaps and a structure
+ * over the points in it.  Measured (callgrind, the copy at K = 2, 400K
+ * points a rank): 160M instructions with 4, 176M with 0 or 1. */
 #define BRUTE_MAX 4
 
 /* For each of n packed points, the nearest point of Q (exact, smallest
