@@ -106,8 +106,40 @@ def main():
         for key in keys:
             check(j1.get(key) == j2.get(key), "%s: %s: %r != %r" % (args, key, j1.get(key), j2.get(key)))
         m = j2.get("mpi", {})
-        check(m.get("ranks") == k and len(m.get("seconds_per_rank", [])) == k, "%s: mpi figures %r" % (args, m))
+        check(m.get("ranks") == k and len(m.get("peak_rss_bytes_per_rank", [])) == k, "%s: mpi figures %r" % (args, m))
+        points = j1["n_a"] + j1["n_b"]
+        check_call_figures(args, m, points, returned=False)
+        per_point = "distances_seconds" in j1
+        check(("distances" in m) == per_point, "%s: a \"distances\" member in mpi only with per-point outputs: %r"
+              % (args, sorted(m)))
+        if per_point and "distances" in m:
+            check_call_figures(args, m["distances"], points, returned=True)
         return j1, j2
+
+    def check_call_figures(args, f, points, returned):
+        """One call's exchange figures (the Hausdorff distance's, or the
+        per-point distances' with the answers returned to their ranks) agree
+        with each other and with the run: K entries a rank, bytes moved that
+        add up (28 a moved point, 40 a forwarded query, 16 a returned answer),
+        nothing moved on one rank."""
+        what = "%s: %s figures %r" % (args, "distances'" if returned else "the distance's", f)
+        keys = ("rounds", "bytes_per_point", "bytes_partition", "bytes_forwarding", "bytes_returned",
+                "forwarded_fraction", "forwarded_queries", "shell_points", "imbalance", "work_imbalance",
+                "seconds_per_rank", "buffer_bytes_per_rank")
+        if not all(key in f for key in keys):
+            check(False, what + ": members missing")
+            return
+        moved = f["bytes_partition"] + f["bytes_forwarding"] + f["bytes_returned"]
+        check(len(f["seconds_per_rank"]) == k and len(f["buffer_bytes_per_rank"]) == k, what + ": per rank")
+        check(f["bytes_per_point"] == moved / points, what + ": bytes_per_point")
+        check(f["bytes_forwarding"] == 40 * f["forwarded_queries"], what + ": 40 bytes a forwarded query")
+        check(f["forwarded_fraction"] * points <= f["forwarded_queries"] + 1e-9, what + ": forwarded points")
+        check(f["bytes_returned"] % 16 == 0 and f["bytes_returned"] <= 16 * points, what + ": returned answers")
+        check(f["imbalance"] >= 1 and f["work_imbalance"] >= 1, what + ": imbalance at least 1")
+        if k == 1:
+            check(moved == 0 and f["rounds"] == 0, what + ": one rank moves nothing")
+        else:
+            check(f["bytes_partition"] > 0 and (returned or f["bytes_returned"] == 0), what + ": bytes moved")
 
     def same_text(args):
         rc1, out1, _ = single(hausdorff, *args)

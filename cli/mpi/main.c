@@ -52,9 +52,10 @@ static void fetch_point(const hd_mpi_part_t *p, size_t g, double q[3]);
  * directions unless --directed) into r->d_ab, j_ab, d_ba, j_ba (this
  * rank's points only, in its parts' order; analysis_free frees them), with
  * what the report says of them: r->n_a, n_b are the sides' totals, and
- * r->seconds the slowest rank's time.  Collective. */
+ * r->seconds the slowest rank's time; the call's exchange figures in *st
+ * (zeroed when it is not reached).  Collective. */
 static int distances_mpi(const cli_args_t *a, const hd_mpi_part_t part[2], const uint64_t total[2],
-                         analysis_result_t *r, hd_error_t *err) {
+                         analysis_result_t *r, hd_mpi_stats_t *st, hd_error_t *err) {
     size_t n[2] = {part[0].points.count, part[1].points.count};
     r->active = 1;
     r->directed = a->directed;
@@ -71,11 +72,11 @@ static int distances_mpi(const cli_args_t *a, const hd_mpi_part_t part[2], const
             rc = err->code = HD_ENOMEM;
         }
     }
-    hd_mpi_stats_t st;
+    memset(st, 0, sizeof *st);
     if ((rc = agree(rc, err)) == HD_OK)
         rc = hd_mpi_distances(MPI_COMM_WORLD, &part[0], 1, &part[1], 1, &a->opt, r->d_ab, r->j_ab, r->d_ba,
-                              r->j_ba, &st, err);
-    r->seconds = rc == HD_OK ? st.seconds_max : 0;
+                              r->j_ba, st, err);
+    r->seconds = rc == HD_OK ? st->seconds_max : 0;
     return rc;
 }
 
@@ -214,31 +215,55 @@ static void fetch_point(const hd_mpi_part_t *p, size_t g, double q[3]) {
     MPI_Bcast(q, 3, MPI_DOUBLE, from < K_ ? from : 0, MPI_COMM_WORLD);
 }
 
-/* The exchange figures, gathered to rank 0 and printed there. */
-static void mpi_json(FILE *out, const hd_mpi_stats_t *st, const double *secs, const double *peak,
-                     const double *rss, const int split[2]) {
-    fprintf(out, ", \"mpi\": {\"ranks\": %d, \"rounds\": %d", st->ranks, st->rounds);
-    fprintf(out, ", \"read_by_points\": [%s, %s]", split[0] ? "true" : "false", split[1] ? "true" : "false");
-    fprintf(out, ", \"bytes_per_point\": ");
-    json_number(out, (double)(st->bytes_partition + st->bytes_forwarding) / (double)st->points);
-    fprintf(out, ", \"bytes_partition\": %llu, \"bytes_forwarding\": %llu",
-            (unsigned long long)st->bytes_partition, (unsigned long long)st->bytes_forwarding);
+/* One call's exchange figures as JSON members (after an opening brace):
+ * the totals of *st and, per rank, the columns secs and peak (gathered to
+ * rank 0). */
+static void call_json(FILE *out, const hd_mpi_stats_t *st, const double *secs, const double *peak) {
+    fprintf(out, "\"rounds\": %d, \"bytes_per_point\": ", st->rounds);
+    json_number(out, (double)(st->bytes_partition + st->bytes_forwarding + st->bytes_returned) / (double)st->points);
+    fprintf(out, ", \"bytes_partition\": %llu, \"bytes_forwarding\": %llu, \"bytes_returned\": %llu",
+            (unsigned long long)st->bytes_partition, (unsigned long long)st->bytes_forwarding,
+            (unsigned long long)st->bytes_returned);
     fprintf(out, ", \"forwarded_fraction\": ");
     json_number(out, (double)st->forwarded_points / (double)st->points);
-    fprintf(out, ", \"forwarded_queries\": %llu", (unsigned long long)st->forwarded);
+    fprintf(out, ", \"forwarded_queries\": %llu, \"shell_points\": %llu", (unsigned long long)st->forwarded,
+            (unsigned long long)st->shell_points);
     fprintf(out, ", \"imbalance\": ");
     json_number(out, st->imbalance);
     fprintf(out, ", \"work_imbalance\": ");
     json_number(out, st->work_imbalance);
-    const char *keys[3] = {"seconds_per_rank", "buffer_bytes_per_rank", "peak_rss_bytes_per_rank"};
-    const double *vals[3] = {secs, peak, rss};
-    for (int k = 0; k < 3; k++) {
+    const char *keys[2] = {"seconds_per_rank", "buffer_bytes_per_rank"};
+    const double *vals[2] = {secs, peak};
+    for (int k = 0; k < 2; k++) {
         fprintf(out, ", \"%s\": [", keys[k]);
         for (int r = 0; r < K_; r++) {
             if (r) fputs(", ", out);
             json_number(out, k == 0 ? round(vals[k][r] * 1e6) / 1e6 : vals[k][r]);
         }
         fputc(']', out);
+    }
+}
+
+/* The member "mpi": the distance call's figures (call_json), the peak RSS
+ * of each rank, and, when the per-point distances were computed (dst not
+ * NULL), their call's figures as the member "distances".  col[] holds the
+ * per-rank columns gathered by main: the distance call's seconds and
+ * peak, the peak RSS, the distances call's seconds and peak. */
+static void mpi_json(FILE *out, const hd_mpi_stats_t *st, const hd_mpi_stats_t *dst, double *const col[5],
+                     const int split[2]) {
+    fprintf(out, ", \"mpi\": {\"ranks\": %d", st->ranks);
+    fprintf(out, ", \"read_by_points\": [%s, %s], ", split[0] ? "true" : "false", split[1] ? "true" : "false");
+    call_json(out, st, col[0], col[1]);
+    fprintf(out, ", \"peak_rss_bytes_per_rank\": [");
+    for (int r = 0; r < K_; r++) {
+        if (r) fputs(", ", out);
+        json_number(out, col[2][r]);
+    }
+    fputc(']', out);
+    if (dst) {
+        fprintf(out, ", \"distances\": {");
+        call_json(out, dst, col[3], col[4]);
+        fputc('}', out);
     }
     fputc('}', out);
 }
@@ -352,12 +377,14 @@ int main(int argc, char **argv) {
         }
     }
     analysis_result_t an;
+    hd_mpi_stats_t dst; /* the per-point distances' call, when made */
     memset(&an, 0, sizeof an);
+    memset(&dst, 0, sizeof dst);
     if (rc == HD_OK && analysis_active(&a.an)) {
         uint64_t mine[2] = {part[0].points.count, part[1].points.count}, total[2];
         MPI_Allreduce(mine, total, 2, MPI_UINT64_T, MPI_SUM, MPI_COMM_WORLD);
         /* as analysis_run: the distances, the figures, the files, the pictures */
-        if ((rc = distances_mpi(&a, part, total, &an, &err)) == HD_OK)
+        if ((rc = distances_mpi(&a, part, total, &an, &dst, &err)) == HD_OK)
             rc = mpi_figures(&a.an, an.d_ab, part[0].points.count, an.d_ba, part[1].points.count, &an, &err);
         if (rc == HD_OK && a.an.distances_out) rc = distances_files_mpi(&a, part, total, &s, &an, &err);
         if (rc == HD_OK && a.an.render_out) rc = render_mpi(&a, part, &s, &an, &err);
@@ -388,24 +415,27 @@ int main(int argc, char **argv) {
     fetch_point(&part[!from_a], wit->i, r.wp);
     fetch_point(&part[from_a], wit->j, r.wq);
     struct rusage ru;
-    double mine[3] = {st.seconds, (double)st.peak_bytes, 0}, *all = rank_ == 0 ? calloc(3 * (size_t)K_, sizeof(double)) : NULL;
+    enum { COLS = 5 }; /* per rank: seconds, peak; RSS; the distances call's seconds, peak */
+    double mine[COLS] = {st.seconds, (double)st.peak_bytes, 0, dst.seconds, (double)dst.peak_bytes};
+    double *all = rank_ == 0 ? calloc(COLS * (size_t)K_, sizeof(double)) : NULL;
     if (getrusage(RUSAGE_SELF, &ru) == 0) mine[2] = 1024.0 * (double)ru.ru_maxrss;
-    MPI_Gather(mine, 3, MPI_DOUBLE, all, 3, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+    MPI_Gather(mine, COLS, MPI_DOUBLE, all, COLS, MPI_DOUBLE, 0, MPI_COMM_WORLD);
     int status = EXIT_OK;
     if (rank_ == 0) {
-        double *col[3] = {NULL, NULL, NULL};
-        for (int k = 0; k < 3 && all; k++) {
-            col[k] = malloc((size_t)K_ * sizeof(double));
-            for (int q = 0; q < K_ && col[k]; q++) col[k][q] = all[3 * q + k];
+        double *col[COLS] = {NULL};
+        int ok = all != NULL;
+        for (int k = 0; k < COLS && ok; k++) {
+            ok = (col[k] = malloc((size_t)K_ * sizeof(double))) != NULL;
+            for (int q = 0; q < K_ && ok; q++) col[k][q] = all[COLS * q + k];
         }
         FILE *out = stdout;
-        if (!all || !col[0] || !col[1] || !col[2]) {
+        if (!ok) {
             fprintf(stderr, "hausdorff-mpi: out of memory\n");
             status = EXIT_FAILURE_;
         } else if (a.json) {
             report_json(out, &r);
             if (an.active) analysis_json(out, &a.an, &an);
-            mpi_json(out, &st, col[0], col[1], col[2], split);
+            mpi_json(out, &st, an.active ? &dst : NULL, col, split);
             fprintf(out, "}\n");
         } else {
             report_text(out, &r);
@@ -414,8 +444,13 @@ int main(int argc, char **argv) {
             fprintf(out, "mpi: %d ranks, %s bytes moved per point, %s of the points forwarded, imbalance %s\n", K_,
                     num_text((double)(st.bytes_partition + st.bytes_forwarding) / (double)st.points, b),
                     num_text((double)st.forwarded_points / (double)st.points, f), num_text(st.imbalance, im));
+            if (an.active)
+                fprintf(out, "mpi: per-point distances: %s bytes moved per point, %s of the points forwarded\n",
+                        num_text((double)(dst.bytes_partition + dst.bytes_forwarding + dst.bytes_returned) /
+                                     (double)dst.points, b),
+                        num_text((double)dst.forwarded_points / (double)dst.points, f));
         }
-        for (int k = 0; k < 3; k++) free(col[k]);
+        for (int k = 0; k < COLS; k++) free(col[k]);
         if (status == EXIT_OK) status = out_finish();
         else out_discard();
     }
