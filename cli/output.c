@@ -308,6 +308,12 @@ const char *out_file_path(FILE *f) {
     return NULL;
 }
 
+int out_is_direct(FILE *f) {
+    for (int k = 0; k < n_staged; k++)
+        if (S[k].f == f) return S[k].direct;
+    return 0;
+}
+
 int out_close(FILE *f, int werr, hd_error_t *err) {
     staged_t *s = NULL;
     for (int k = 0; k < n_staged; k++)

@@ -45,6 +45,9 @@ FILE *out_open(const char *path, hd_error_t *err);
  * by out_finish or removed by out_discard as any other.  NULL when f is
  * not open. */
 const char *out_file_path(FILE *f);
+/* 1 when f from out_open writes its target in place (a device or a FIFO:
+ * no temporary, no offsets to seek to), else 0. */
+int out_is_direct(FILE *f);
 /* Finish a file from out_open: flush, check, close.  werr is the errno of
  * the first write that failed (0 if none, -1 for an unknown reason).
  * Returns HD_OK, or OUT_EFAIL

@@ -14,6 +14,7 @@ import struct
 import subprocess
 import sys
 import tempfile
+import threading
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 DATA = os.path.join(os.path.dirname(HERE), "data")
@@ -312,6 +313,30 @@ def main():
         same_files(["--empty", "zero", "--directed", lion, empty], "ply", True)
         same_files(["--empty", "monai", empty, empty], "npy", False)
         same_files(["--max-distance", "0.25", A, B], "ply", False)
+
+        # A FIFO (not a regular file: no offsets to write at) gets the bytes
+        # hausdorff writes, through rank 0, in order.
+        def same_through_fifo(args, ext):
+            d = tempfile.mkdtemp(dir=tmp)
+            s_out, fifo = os.path.join(d, "s." + ext), os.path.join(d, "fifo." + ext)
+            os.mkfifo(fifo)
+            got = []
+            reader = threading.Thread(target=lambda: got.append(open(fifo, "rb").read()))
+            reader.start()
+            rc1, _, err1 = single(hausdorff, "--directed", "--distances", s_out, *args)
+            rc2, _, err2 = ranks(mpirun, k, tool, "--directed", "--distances", fifo, *args)
+            if reader.is_alive():  # the run failed before opening the FIFO: release the reader
+                open(fifo, "wb").close()
+            reader.join()
+            what = "--distances into a FIFO (%s) %s" % (ext, args)
+            check(rc1 == 0 and rc2 == 0, "%s: exit %d / %d: %s %s" % (what, rc1, rc2, err1, err2))
+            check(rc1 == 0 and got and got[0] == open(s_out, "rb").read(),
+                  "%s: %d bytes read, hausdorff wrote %d" % (what, len(got[0]) if got else -1,
+                                                             os.path.getsize(s_out) if rc1 == 0 else -1))
+
+        same_through_fifo([A, B], "csv")
+        same_through_fifo([lion, head], "npy")
+        same_through_fifo(["--empty", "zero", lion, empty], "ply")
         # A file that cannot be written (B's rows' name is a directory),
         # after A's was: one message, exit 3 from every rank, no file.
         d = tempfile.mkdtemp(dir=tmp)

@@ -17,6 +17,15 @@
  * numbers, so its bytes are counted in a first pass (formatting, without
  * keeping the text); binary rows have one length.
  *
+ * A target that is not a regular file (a FIFO, a device: out_open writes
+ * it in place) cannot be written at offsets, and MPI-IO's writes at
+ * offsets into a pipe are lost without an error: there rank 0 writes the
+ * file through its stream, the header and then every rank's rows in the
+ * order of their first indices, each other rank sending its rows in
+ * messages of at most CHUNK bytes and an empty one to end (stream_rows).
+ * Rank 0 receives every message even after a write failed, so no sender
+ * waits; the failure is agreed after the last.
+ *
  * Failures: rank 0's out_open (an unwritable directory), the MPI-IO open,
  * a write or the close, on any rank, are agreed (mpi_agree): every rank
  * returns the same OUT_EFAIL and message ("PATH: cannot write: reason"),
@@ -31,6 +40,7 @@
 #include "mpi_cli.h"
 #include "output.h"
 
+#include <errno.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -94,6 +104,69 @@ static int row_offset(uint64_t first, uint64_t count, uint64_t bytes, uint64_t h
     return HD_OK;
 }
 
+/* The rows of every rank through rank 0's stream f (see the essay),
+ * ranks in the order of their first indices; rank 0 writes the header
+ * first.  Collective; rank 0 closes f. */
+static int stream_rows(FILE *f, const dist_layout_t *lay, const hd_points_t *P, const double *d,
+                       const size_t *nearest, uint64_t first, unsigned char *buf, hd_error_t *err) {
+    enum { TAG = 7311 };
+    int rank, K;
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+    MPI_Comm_size(MPI_COMM_WORLD, &K);
+    uint64_t mine[2] = {first, P->count}, *all = malloc(2 * (size_t)K * sizeof *all);
+    int *order = malloc((size_t)K * sizeof *order), rc = HD_OK;
+    if (!all || !order) {
+        snprintf(err->message, sizeof err->message, "out of memory for %d ranks' rows", K);
+        rc = err->code = HD_ENOMEM;
+    }
+    if ((rc = mpi_agree(rc, err)) != HD_OK) {
+        free(all);
+        free(order);
+        if (rank == 0) (void)out_close(f, 0, err);
+        return rc;
+    }
+    MPI_Allgather(mine, 2, MPI_UINT64_T, all, 2, MPI_UINT64_T, MPI_COMM_WORLD);
+    int n = 0; /* the ranks with rows, by first index (insertion: K is small) */
+    for (int r = 0; r < K; r++) {
+        if (!all[2 * r + 1]) continue;
+        int at = n++;
+        while (at > 0 && all[2 * order[at - 1]] > all[2 * r]) order[at] = order[at - 1], at--;
+        order[at] = r;
+    }
+    size_t k = 0;
+    if (rank == 0) {
+        int werr = 0;
+        size_t head = distances_header(lay, (char *)buf);
+        if (fwrite(buf, 1, head, f) != head) werr = errno ? errno : -1;
+        for (int q = 0; q < n; q++) {
+            for (;;) {
+                size_t len = 0;
+                if (order[q] == 0) {
+                    len = fill(lay, P, d, nearest, &k, buf);
+                } else {
+                    MPI_Status st;
+                    int got = 0;
+                    MPI_Recv(buf, (int)CHUNK, MPI_BYTE, order[q], TAG, MPI_COMM_WORLD, &st);
+                    MPI_Get_count(&st, MPI_BYTE, &got);
+                    len = (size_t)got;
+                }
+                if (!len) break;
+                if (!werr && fwrite(buf, 1, len, f) != len) werr = errno ? errno : -1;
+            }
+        }
+        rc = out_close(f, werr, err);
+    } else if (P->count) {
+        size_t len;
+        do {
+            len = fill(lay, P, d, nearest, &k, buf);
+            MPI_Send(buf, (int)len, MPI_BYTE, 0, TAG, MPI_COMM_WORLD);
+        } while (len);
+    }
+    free(all);
+    free(order);
+    return mpi_agree(rc, err);
+}
+
 int mpi_write_distances(const char *path, const hd_points_t *P, size_t first, const double *d,
                         const size_t *nearest, size_t total, double dmax, hd_error_t *err) {
     int rank;
@@ -104,11 +177,13 @@ int mpi_write_distances(const char *path, const hd_points_t *P, size_t first, co
     int rc = distances_layout(path, total, dmax, any, &lay, err); /* the same verdict on every rank */
     if (rc != HD_OK) return rc;
     char tmp[4096] = "";
+    FILE *f = NULL; /* rank 0's, kept open when the target is written in place */
+    int direct = 0;
     if (rank == 0) {
-        FILE *f = out_open(path, err);
+        f = out_open(path, err);
         if (!f) {
             rc = err->code;
-        } else {
+        } else if (!(direct = out_is_direct(f))) {
             snprintf(tmp, sizeof tmp, "%s", out_file_path(f));
             rc = out_close(f, 0, err); /* empty: the ranks write it by name */
         }
@@ -119,6 +194,12 @@ int mpi_write_distances(const char *path, const hd_points_t *P, size_t first, co
         rc = err->code = HD_ENOMEM;
     }
     if ((rc = mpi_agree(rc, err)) != HD_OK) {
+        free(buf);
+        return rc;
+    }
+    MPI_Bcast(&direct, 1, MPI_INT, 0, MPI_COMM_WORLD);
+    if (direct) {
+        rc = stream_rows(f, &lay, P, d, nearest, first, buf, err);
         free(buf);
         return rc;
     }
