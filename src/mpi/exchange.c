@@ -152,7 +152,8 @@ int hd__mpi_exchange(ctx_t *c, const input_t *in, const ranges_t *rg, const node
     double *sx = NULL;
     uint32_t *so = NULL;
     uint32_t *perm = NULL;
-    size_t permn = 0;
+    size_t permn = 0, gn = 0;
+    uint64_t *g = NULL;      /* the indices of merged runs */
     run_t *runs = NULL;
     int *heap = NULL;
     for (int s = 0; s < 2; s++) order[s] = hd__mpi_alloc(c, in->nparts[s], sizeof *order[s]);
@@ -291,9 +292,10 @@ int hd__mpi_exchange(ctx_t *c, const input_t *in, const ranges_t *rg, const node
     sx = NULL, so = NULL, dest = NULL;
     assert(ownat[0] == base[me] + (size_t)rtot[2 * me] && ownat[1] == base[K + me] + (size_t)rtot[2 * me + 1]);
     /* The runs in index order as received (each rank's parts above the
-     * previous rank's): the numbers stay and name the indices (gidx_t,
-     * 4 bytes a point).  Else the numbers become indices (8 bytes) and
-     * the runs are merged into index order. */
+     * previous rank's): the numbers name the indices in place.  Else the
+     * numbers become indices (8 bytes) and the runs are merged into index
+     * order.  Either way the indices are then encoded (gidx_t) and the
+     * numbers or indices freed. */
     for (int s = 0; s < 2 && rc == HD_OK; s++) {
         loc->start[s] = hd__mpi_alloc(c, (size_t)K + 1, sizeof(size_t));
         if (!loc->start[s]) {
@@ -312,18 +314,32 @@ int hd__mpi_exchange(ctx_t *c, const input_t *in, const ranges_t *rg, const node
         }
         loc->start[s][K] = loc->n[s];
         if (sorted) {
-            loc->num[s] = off[s];
+            if ((rc = hd__mpi_gidx_init(c, &loc->gi[s], rg, s, loc->n[s])) != HD_OK) break;
+            size_t run = 0;
+            for (int r = 0; r < K; r++) {
+                size_t i = rg->seg[(size_t)s * ((size_t)K + 1) + (size_t)r];
+                for (size_t k = loc->start[s][r], m; k < loc->start[s][r + 1]; k += m) {
+                    uint64_t gb[256];
+                    m = loc->start[s][r + 1] - k < 256 ? loc->start[s][r + 1] - k : 256;
+                    hd__mpi_ranges_globals(rg, s, r, &i, off[s] + k, m, gb);
+                    for (size_t t = 0; t < m; t++) hd__mpi_gidx_put(&loc->gi[s], &run, k + t, gb[t]);
+                }
+            }
+            hd__mpi_free(c, off[s], loc->n[s], sizeof(uint32_t));
             off[s] = NULL;
             continue;
         }
-        loc->g[s] = hd__mpi_alloc(c, loc->n[s], sizeof(uint64_t));
-        if (!loc->g[s]) {
+        loc->merged[s] = 1;
+        g = hd__mpi_alloc(c, loc->n[s], sizeof(uint64_t));
+        if (!g) {
             rc = hd__mpi_nomem(c, "the local indices", loc->n[s]);
             break;
         }
+        gn = loc->n[s];
         for (int r = 0; r < K; r++) {
-            size_t lo = base[s * K + r], hi = lo + (size_t)rtot[2 * r + s];
-            hd__mpi_ranges_globals(rg, s, r, off[s] + lo, hi - lo, loc->g[s] + lo);
+            size_t lo = base[s * K + r], hi = lo + (size_t)rtot[2 * r + s],
+                   i = rg->seg[(size_t)s * ((size_t)K + 1) + (size_t)r];
+            hd__mpi_ranges_globals(rg, s, r, &i, off[s] + lo, hi - lo, g + lo);
         }
         hd__mpi_free(c, off[s], loc->n[s], sizeof(uint32_t));
         off[s] = NULL;
@@ -336,12 +352,17 @@ int hd__mpi_exchange(ctx_t *c, const input_t *in, const ranges_t *rg, const node
             break;
         }
         for (int r = 0; r < K; r++) runs[r] = (run_t){base[s * K + r], base[s * K + r] + (size_t)rtot[2 * r + s]};
-        merge_order(loc->g[s], runs, K, heap, perm);
-        permute(loc->xyz[s], loc->g[s], perm, loc->n[s]);
+        merge_order(g, runs, K, heap, perm);
+        permute(loc->xyz[s], g, perm, loc->n[s]);
         hd__mpi_free(c, perm, permn, sizeof(uint32_t));
         hd__mpi_free(c, runs, (size_t)K, sizeof(run_t));
         hd__mpi_free(c, heap, (size_t)K, sizeof(int));
         perm = NULL, runs = NULL, heap = NULL;
+        if ((rc = hd__mpi_gidx_init(c, &loc->gi[s], rg, s, loc->n[s])) != HD_OK) break;
+        size_t run = 0;
+        for (size_t k = 0; k < loc->n[s]; k++) hd__mpi_gidx_put(&loc->gi[s], &run, k, g[k]);
+        hd__mpi_free(c, g, gn, sizeof(uint64_t));
+        g = NULL;
     }
     rc = hd__mpi_agree(c, rc);
 done:
@@ -359,5 +380,6 @@ done:
     hd__mpi_free(c, perm, permn, sizeof(uint32_t));
     hd__mpi_free(c, runs, (size_t)K, sizeof(run_t));
     hd__mpi_free(c, heap, (size_t)K, sizeof(int));
+    hd__mpi_free(c, g, gn, sizeof(uint64_t));
     return rc;
 }

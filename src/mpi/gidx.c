@@ -1,0 +1,174 @@
+/*
+ * gidx.c -- the global indices of a local set, Elias-Fano coded over the
+ * side's dense ordinals (mpi_int.h's gidx_t), with random access and a
+ * sequential cursor.
+ *
+ * Invariants.
+ *  - Ordinals.  The side's index runs over all ranks, by first index
+ *    (ranges_t.bylo), with the number of indices below each (ranges_t.ord),
+ *    map every global index g of the side to its ordinal, the number of the
+ *    side's indices below g: ord[i] + (g - lo) for g in run i.  The map is
+ *    strictly increasing, so a local set (in global index order, without
+ *    repeats) has strictly increasing ordinals o_0 < .. < o_{n-1} < U, U
+ *    the side's points over all ranks.
+ *  - The code.  l = the largest l <= 63 with n 2^l <= U (0 when n = 0 or
+ *    U <= n).  low holds o_k mod 2^l at bits k l .. k l + l - 1; high has
+ *    bit (o_k >> l) + k set for every k and no other: since o_k >> l is
+ *    nondecreasing, these are n distinct increasing positions below
+ *    n + ((U - 1) >> l) + 1, and the k-th 1 (from 0) is at (o_k >> l) + k,
+ *    so o_k = ((select1(k) - k) << l) | low_k.  samp[t] is the position of
+ *    the 1 of k = 64 t: select1(k) scans from samp[k / 64] for the
+ *    (k mod 64)-th 1 after it, at most the 63 ones and the zeros between
+ *    (at most (U >> l) / n + ... <= about 2 words on average: the zeros
+ *    are at most U >> l <= 2n).
+ *  - Memory: ceil(n l / 64) + ceil(bits / 64) + ceil(n / 64) words, all in
+ *    one allocation through the call's allocator, so counted in the peak.
+ *  - The cursor holds the word of the last decoded position's 1 with the
+ *    1s after it, so the next position's 1 is the lowest bit left (or in a
+ *    following word), and the run of the last ordinal: within it an index
+ *    is lo + (o - first).  Anything else is the slow path here: steps
+ *    forward over the next 1s for short jumps, a select for long ones or
+ *    backwards, and the runs searched forward from the current one, or
+ *    from the start when the ordinal went back.
+ */
+#include "mpi_int.h"
+
+#include <assert.h>
+
+/* The position of the r-th 1 (from 0) of w, which has more than r. */
+static inline unsigned select64(uint64_t w, unsigned r) {
+    unsigned s = 0;
+    for (;;) {
+        unsigned c = (unsigned)__builtin_popcountll(w & 0xff);
+        if (r < c) break;
+        r -= c;
+        w >>= 8;
+        s += 8;
+    }
+    while (r--) w &= w - 1;
+    return s + (unsigned)__builtin_ctzll(w);
+}
+
+/* From word *wi whose 1s still to count are *w: the position of the
+ * left-th 1 (from 0) among them and after; *wi and *w become its word and
+ * that word's 1s after it. */
+static inline uint64_t ones_from(const uint64_t *high, size_t *wi, uint64_t *w, uint64_t left) {
+    uint64_t v = *w;
+    size_t i = *wi;
+    for (;;) {
+        unsigned c = (unsigned)__builtin_popcountll(v);
+        if (left < c) break;
+        left -= c;
+        v = high[++i];
+    }
+    unsigned b = select64(v, (unsigned)left);
+    *wi = i;
+    *w = b == 63 ? 0 : v & (~UINT64_C(0) << (b + 1));
+    return ((uint64_t)i << 6) | b;
+}
+
+/* The k-th 1 of high, through the sample before it. */
+static inline uint64_t select1(const gidx_t *x, size_t k, size_t *wi, uint64_t *w) {
+    uint64_t at = x->samp[k >> 6];
+    *wi = (size_t)(at >> 6);
+    *w = x->high[*wi] & (~UINT64_C(0) << (at & 63));
+    return ones_from(x->high, wi, w, k & 63);
+}
+
+/* The run of ordinal o: the last whose first ordinal is <= o. */
+static size_t run_of(const gidx_t *x, uint64_t o) {
+    size_t lo = 0, hi = x->nrun - 1;
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo + 1) / 2;
+        if (x->rord[mid] <= o) lo = mid;
+        else hi = mid - 1;
+    }
+    return lo;
+}
+
+int hd__mpi_gidx_init(ctx_t *c, gidx_t *x, const ranges_t *rg, int side, size_t n) {
+    memset(x, 0, sizeof *x);
+    size_t a = rg->seg[(size_t)side * ((size_t)rg->K + 1)], b = rg->seg[(size_t)side * ((size_t)rg->K + 1) + (size_t)rg->K];
+    x->run = rg->bylo + a;
+    x->rord = rg->ord + a;
+    x->nrun = b - a;
+    x->n = n;
+    uint64_t U = x->nrun ? x->rord[x->nrun - 1] + (x->run[x->nrun - 1].hi - x->run[x->nrun - 1].lo) + 1 : 0;
+    assert(n <= U);
+    int l = 0;
+    while (n && l < 63 && (U >> (l + 1)) >= n) l++;
+    x->l = l;
+    /* n <= 2^32 and l <= 63: no product below overflows 64 bits */
+    uint64_t lw = ((uint64_t)n * (uint64_t)l + 63) / 64, hbits = n ? n + ((U - 1) >> l) + 1 : 0,
+             hw = (hbits + 63) / 64, sw = ((uint64_t)n + 63) / 64, words = lw + hw + sw;
+    if (words > SIZE_MAX / sizeof(uint64_t) || !(x->w = hd__mpi_alloc(c, (size_t)words, sizeof(uint64_t))))
+        return hd__mpi_nomem(c, "the local indices", n);
+    x->words = (size_t)words;
+    memset(x->w, 0, (size_t)words * sizeof(uint64_t));
+    x->low = x->w;
+    x->high = x->w + lw;
+    x->samp = x->w + lw + hw;
+    return HD_OK;
+}
+
+void hd__mpi_gidx_put(gidx_t *x, size_t *run, size_t k, uint64_t g) {
+    while (g > x->run[*run].hi) ++*run;
+    assert(*run < x->nrun && g >= x->run[*run].lo);
+    uint64_t o = x->rord[*run] + (g - x->run[*run].lo), h = (o >> x->l) + k;
+    uint64_t *low = x->w, *high = x->w + (x->high - x->low), *samp = x->w + (x->samp - x->low);
+    if (x->l) {
+        uint64_t v = o & ((UINT64_C(1) << x->l) - 1), bit = (uint64_t)k * (uint64_t)x->l;
+        unsigned s = (unsigned)(bit & 63);
+        low[bit >> 6] |= v << s;
+        if (s + (unsigned)x->l > 64) low[(bit >> 6) + 1] |= v >> (64 - s);
+    }
+    high[h >> 6] |= UINT64_C(1) << (h & 63);
+    if ((k & 63) == 0) samp[k >> 6] = h;
+}
+
+void hd__mpi_gidx_free(ctx_t *c, gidx_t *x) {
+    hd__mpi_free(c, x->w, x->words, sizeof(uint64_t));
+    x->w = NULL;
+    x->words = 0;
+}
+
+uint64_t hd__mpi_gidx(const gidx_t *x, size_t k) {
+    assert(k < x->n);
+    size_t wi;
+    uint64_t w, o = ((select1(x, k, &wi, &w) - k) << x->l) | hd__mpi_gidx_low(x, k);
+    size_t r = run_of(x, o);
+    return x->run[r].lo + (o - x->rord[r]);
+}
+
+void hd__mpi_gcur_init(gcur_t *cu, const gidx_t *x) {
+    memset(cu, 0, sizeof *cu);
+    cu->x = x;
+    cu->k = SIZE_MAX;
+    cu->run = SIZE_MAX;
+}
+
+/* Jumps of at most this many positions step over the 1s between. */
+#define GCUR_STEP 256
+
+uint64_t hd__mpi_gcur_next(gcur_t *cu, size_t k) {
+    const gidx_t *x = cu->x;
+    assert(k < x->n);
+    if (k == cu->k) return cu->g;
+    uint64_t at;
+    if (cu->k != SIZE_MAX && k > cu->k && k - cu->k <= GCUR_STEP)
+        at = ones_from(x->high, &cu->wi, &cu->w, k - cu->k - 1);
+    else
+        at = select1(x, k, &cu->wi, &cu->w);
+    uint64_t o = ((at - k) << x->l) | hd__mpi_gidx_low(x, k);
+    if (cu->run == SIZE_MAX || o < cu->first) {
+        cu->run = run_of(x, o);
+    } else {
+        while (o - x->rord[cu->run] > x->run[cu->run].hi - x->run[cu->run].lo) cu->run++;
+    }
+    assert(cu->run < x->nrun);
+    cu->first = x->rord[cu->run];
+    cu->span = x->run[cu->run].hi - x->run[cu->run].lo;
+    cu->lo = x->run[cu->run].lo;
+    cu->k = k;
+    return cu->g = cu->lo + (o - cu->first);
+}
