@@ -332,10 +332,12 @@ static int answer(ctx_t *c, void *arg, const double *pts, size_t m, ans_t *ans) 
     if (rc == HD_OK)
         rc = hd__an_nearest(&asked.s, &a->searched->s, NULL, hd__thread_count(c->threads, m), NULL, near, NULL,
                             &c->e);
+    gcur_t cq;
+    hd__mpi_gcur_init(&cq, a->gQ);
     for (size_t k = 0; k < m && rc == HD_OK; k++) {
         double q[3];
         an_point(a->searched, near[k], q);
-        ans[k] = (ans_t){hd__d2(pts + 3 * k, q), hd__mpi_gidx(a->gQ, near[k])};
+        ans[k] = (ans_t){hd__d2(pts + 3 * k, q), hd__mpi_gcur_at(&cq, near[k])};
     }
     if (near) an_free(c, &asked);
     hd__mpi_free(c, near, m, sizeof(size_t));
@@ -363,12 +365,15 @@ static int direction(ctx_t *c, const spread_t *sp, const input_t *in, int s,
     if (rc == HD_OK && nP && nQ)
         rc = hd__an_nearest(&asking->s, &searched->s, NULL, hd__thread_count(c->threads, nP), NULL, near, NULL,
                             &c->e);
+    gcur_t cq; /* near[] goes anywhere, but mostly forward in small steps
+                  where index order follows space */
+    hd__mpi_gcur_init(&cq, &sp->loc.gi[qs]);
     for (size_t k = 0; k < nP && rc == HD_OK; k++) {
         double p[3], q[3];
         an_point(asking, k, p);
         if (nQ) an_point(searched, near[k], q);
         u2[k] = nQ ? hd__d2(p, q) : INFINITY;
-        jj[k] = nQ ? hd__mpi_gidx(&sp->loc.gi[qs], near[k]) : UINT64_MAX;
+        jj[k] = nQ ? hd__mpi_gcur_at(&cq, near[k]) : UINT64_MAX;
     }
     hd__mpi_free(c, near, nP, sizeof(size_t));
     c->search += hd__now() - t0;

@@ -18,18 +18,21 @@
  *    n + ((U - 1) >> l) + 1, and the k-th 1 (from 0) is at (o_k >> l) + k,
  *    so o_k = ((select1(k) - k) << l) | low_k.  samp[t] is the position of
  *    the 1 of k = 64 t: select1(k) scans from samp[k / 64] for the
- *    (k mod 64)-th 1 after it, at most the 63 ones and the zeros between
- *    (at most (U >> l) / n + ... <= about 2 words on average: the zeros
- *    are at most U >> l <= 2n).
+ *    (k mod 64)-th 1 after it, over at most 63 ones and the zeros between
+ *    (U >> l < 2n zeros in all: about 2 words on average).
  *  - Memory: ceil(n l / 64) + ceil(bits / 64) + ceil(n / 64) words, all in
- *    one allocation through the call's allocator, so counted in the peak.
+ *    one allocation through the call's allocator, so counted in the peak:
+ *    n l + n + (U >> l) + n bits, less than l + 4 bits a point with
+ *    l <= log2(U / n) (l + 2 + 2^f bits, U / n = 2^(l + f), 0 <= f < 1;
+ *    this l is the best: l + 1 costs 1 - 2^(f - 1) >= 0 bits more).
  *  - The cursor holds the word of the last decoded position's 1 with the
  *    1s after it, so the next position's 1 is the lowest bit left (or in a
  *    following word), and the run of the last ordinal: within it an index
  *    is lo + (o - first).  Anything else is the slow path here: steps
- *    forward over the next 1s for short jumps, a select for long ones or
- *    backwards, and the runs searched forward from the current one, or
- *    from the start when the ordinal went back.
+ *    forward over the next 1s for jumps of at most GCUR_STEP positions, a
+ *    select for longer ones or backwards; the ordinal's run is the current
+ *    one, the next, or else searched (binary).  So any order of positions
+ *    is correct, and nondecreasing ones cost a few operations each.
  */
 #include "mpi_int.h"
 
@@ -160,11 +163,13 @@ uint64_t hd__mpi_gcur_next(gcur_t *cu, size_t k) {
     else
         at = select1(x, k, &cu->wi, &cu->w);
     uint64_t o = ((at - k) << x->l) | hd__mpi_gidx_low(x, k);
-    if (cu->run == SIZE_MAX || o < cu->first) {
-        cu->run = run_of(x, o);
-    } else {
-        while (o - x->rord[cu->run] > x->run[cu->run].hi - x->run[cu->run].lo) cu->run++;
-    }
+    size_t r = cu->run;
+    if (r == SIZE_MAX || o < cu->first || o - cu->first > cu->span) /* not the current run, */
+        r = r != SIZE_MAX && o >= cu->first && r + 1 < x->nrun && o >= x->rord[r + 1] &&
+                    o - x->rord[r + 1] <= x->run[r + 1].hi - x->run[r + 1].lo
+                ? r + 1 /* the next, */
+                : run_of(x, o); /* or any */
+    cu->run = r;
     assert(cu->run < x->nrun);
     cu->first = x->rord[cu->run];
     cu->span = x->run[cu->run].hi - x->run[cu->run].lo;

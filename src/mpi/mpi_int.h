@@ -378,7 +378,7 @@ int hd__mpi_engine_both(ctx_t *c, double *xyz[2], const gidx_t *g[2], const size
 void hd__mpi_shell_free(ctx_t *c, shell_t *sh);
 int hd__mpi_interior_max(ctx_t *c, const dir_t *d, const hd__box_t *mine, const shell_t *sh, double h2,
                          const far_t *G, far_t *out);
-uint64_t hd__mpi_shell_g(const dir_t *d, const shell_t *sh, size_t k);
+uint64_t hd__mpi_shell_g(gcur_t *cu, const shell_t *sh, size_t k);
 int hd__mpi_shell_of(ctx_t *c, const dir_t *d, const hd__box_t *mine, qtree_t *q, shell_t *sh);
 
 /* ---- one direction over the partition (forward.c) ------------------------ */
