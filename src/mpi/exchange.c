@@ -315,16 +315,9 @@ int hd__mpi_exchange(ctx_t *c, const input_t *in, const ranges_t *rg, const node
         loc->start[s][K] = loc->n[s];
         if (sorted) {
             if ((rc = hd__mpi_gidx_init(c, &loc->gi[s], rg, s, loc->n[s])) != HD_OK) break;
-            size_t run = 0;
-            for (int r = 0; r < K; r++) {
-                size_t i = rg->seg[(size_t)s * ((size_t)K + 1) + (size_t)r];
-                for (size_t k = loc->start[s][r], m; k < loc->start[s][r + 1]; k += m) {
-                    uint64_t gb[256];
-                    m = loc->start[s][r + 1] - k < 256 ? loc->start[s][r + 1] - k : 256;
-                    hd__mpi_ranges_globals(rg, s, r, &i, off[s] + k, m, gb);
-                    for (size_t t = 0; t < m; t++) hd__mpi_gidx_put(&loc->gi[s], &run, k + t, gb[t]);
-                }
-            }
+            for (int r = 0; r < K; r++)
+                hd__mpi_gidx_put_numbers(&loc->gi[s], rg, r, loc->start[s][r], off[s] + loc->start[s][r],
+                                         loc->start[s][r + 1] - loc->start[s][r]);
             hd__mpi_free(c, off[s], loc->n[s], sizeof(uint32_t));
             off[s] = NULL;
             continue;
@@ -359,8 +352,7 @@ int hd__mpi_exchange(ctx_t *c, const input_t *in, const ranges_t *rg, const node
         hd__mpi_free(c, heap, (size_t)K, sizeof(int));
         perm = NULL, runs = NULL, heap = NULL;
         if ((rc = hd__mpi_gidx_init(c, &loc->gi[s], rg, s, loc->n[s])) != HD_OK) break;
-        size_t run = 0;
-        for (size_t k = 0; k < loc->n[s]; k++) hd__mpi_gidx_put(&loc->gi[s], &run, k, g[k]);
+        hd__mpi_gidx_put_indices(&loc->gi[s], 0, g, loc->n[s]);
         hd__mpi_free(c, g, gn, sizeof(uint64_t));
         g = NULL;
     }

@@ -96,6 +96,7 @@ int hd__mpi_gidx_init(ctx_t *c, gidx_t *x, const ranges_t *rg, int side, size_t 
     x->rord = rg->ord + a;
     x->nrun = b - a;
     x->n = n;
+    x->side = side;
     uint64_t U = x->nrun ? x->rord[x->nrun - 1] + (x->run[x->nrun - 1].hi - x->run[x->nrun - 1].lo) + 1 : 0;
     assert(n <= U);
     int l = 0;
@@ -114,19 +115,92 @@ int hd__mpi_gidx_init(ctx_t *c, gidx_t *x, const ranges_t *rg, int side, size_t 
     return HD_OK;
 }
 
-void hd__mpi_gidx_put(gidx_t *x, size_t *run, size_t k, uint64_t g) {
-    while (g > x->run[*run].hi) ++*run;
-    assert(*run < x->nrun && g >= x->run[*run].lo);
-    uint64_t o = x->rord[*run] + (g - x->run[*run].lo), h = (o >> x->l) + k;
-    uint64_t *low = x->w, *high = x->w + (x->high - x->low), *samp = x->w + (x->samp - x->low);
-    if (x->l) {
-        uint64_t v = o & ((UINT64_C(1) << x->l) - 1), bit = (uint64_t)k * (uint64_t)x->l;
-        unsigned s = (unsigned)(bit & 63);
-        low[bit >> 6] |= v << s;
-        if (s + (unsigned)x->l > 64) low[(bit >> 6) + 1] |= v >> (64 - s);
+/* The run holding index g (one of the side's). */
+static size_t run_at(const gidx_t *x, uint64_t g) {
+    size_t lo = 0, hi = x->nrun - 1;
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo + 1) / 2;
+        if (x->run[mid].lo <= g) lo = mid;
+        else hi = mid - 1;
     }
-    high[h >> 6] |= UINT64_C(1) << (h & 63);
-    if ((k & 63) == 0) samp[k >> 6] = h;
+    assert(g >= x->run[lo].lo && g <= x->run[lo].hi);
+    return lo;
+}
+
+/* The ordinals of consecutive positions gathered in registers, a word of
+ * low bits and a word of high bits at a time, OR-ed into the code when
+ * full (the words at either end may be shared with other calls' runs). */
+typedef struct {
+    uint64_t *low, *high, *samp;
+    int l;
+    uint64_t lbit, lacc;     /* the next low bit, and its word's bits so far */
+    size_t hw;               /* the high word being filled, */
+    uint64_t hacc;           /* and its bits so far */
+} seq_t;
+
+static void seq_begin(seq_t *q, gidx_t *x, size_t k) {
+    q->low = x->w, q->high = x->w + (x->high - x->low), q->samp = x->w + (x->samp - x->low);
+    q->l = x->l;
+    q->lbit = (uint64_t)k * (uint64_t)x->l, q->lacc = 0;
+    q->hw = SIZE_MAX, q->hacc = 0;
+}
+
+static inline void seq_put(seq_t *q, size_t k, uint64_t o) {
+    uint64_t h = (o >> q->l) + k;
+    if ((size_t)(h >> 6) != q->hw) {
+        if (q->hw != SIZE_MAX) q->high[q->hw] |= q->hacc;
+        q->hw = (size_t)(h >> 6), q->hacc = 0;
+    }
+    q->hacc |= UINT64_C(1) << (h & 63);
+    if ((k & 63) == 0) q->samp[k >> 6] = h;
+    if (q->l) {
+        uint64_t v = o & ((UINT64_C(1) << q->l) - 1);
+        unsigned s = (unsigned)(q->lbit & 63);
+        q->lacc |= v << s;
+        if (s + (unsigned)q->l >= 64) {
+            q->low[q->lbit >> 6] |= q->lacc;
+            q->lacc = s + (unsigned)q->l > 64 ? v >> (64 - s) : 0;
+        }
+        q->lbit += (uint64_t)q->l;
+    }
+}
+
+static void seq_end(seq_t *q) {
+    if (q->hw != SIZE_MAX) q->high[q->hw] |= q->hacc;
+    if (q->l && (q->lbit & 63)) q->low[q->lbit >> 6] |= q->lacc;
+}
+
+void hd__mpi_gidx_put_numbers(gidx_t *x, const ranges_t *rg, int r, size_t k, const uint32_t *num, size_t n) {
+    if (n == 0) return;
+    seq_t q;
+    seq_begin(&q, x, k);
+    size_t i = rg->seg[(size_t)x->side * ((size_t)rg->K + 1) + (size_t)r];
+    /* rank r's run i: numbers first .. first + span, ordinals from ob */
+    uint64_t first = UINT64_MAX, span = 0, ob = 0; /* m - first > span: no run yet */
+    for (size_t t = 0; t < n; t++) {
+        uint64_t m = num[t];
+        if (m - first > span) {
+            while (m - rg->first[i] > rg->all[i].hi - rg->all[i].lo) i++;
+            assert(i < rg->seg[(size_t)x->side * ((size_t)rg->K + 1) + (size_t)r + 1] && m >= rg->first[i]);
+            first = rg->first[i], span = rg->all[i].hi - rg->all[i].lo;
+            ob = x->rord[run_at(x, rg->all[i].lo)];
+        }
+        seq_put(&q, k + t, ob + (m - first));
+    }
+    seq_end(&q);
+}
+
+void hd__mpi_gidx_put_indices(gidx_t *x, size_t k, const uint64_t *g, size_t n) {
+    if (n == 0) return;
+    seq_t q;
+    seq_begin(&q, x, k);
+    size_t i = run_at(x, g[0]);
+    for (size_t t = 0; t < n; t++) {
+        while (g[t] > x->run[i].hi) i++;
+        assert(i < x->nrun && g[t] >= x->run[i].lo);
+        seq_put(&q, k + t, x->rord[i] + (g[t] - x->run[i].lo));
+    }
+    seq_end(&q);
 }
 
 void hd__mpi_gidx_free(ctx_t *c, gidx_t *x) {

@@ -173,12 +173,16 @@ typedef struct {
     const range_t *run;      /* the side's runs by first index */
     const uint64_t *rord;    /* each one's first ordinal */
     size_t nrun;
+    int side;
 } gidx_t;
 
 int hd__mpi_gidx_init(ctx_t *c, gidx_t *x, const ranges_t *rg, int side, size_t n);
-/* Position k's index is g: called for k = 0, 1, .., n - 1 in turn, with g
- * increasing (*run starts at 0: the run of the last g). */
-void hd__mpi_gidx_put(gidx_t *x, size_t *run, size_t k, uint64_t g);
+/* Positions k .. k + n - 1's indices are g[0 .. n - 1] (increasing, and
+ * above those of the positions before k), or the indices of numbers
+ * num[0 .. n - 1] at their sender r (increasing: a run received in index
+ * order).  The code is written once, from calls covering 0 .. x->n - 1. */
+void hd__mpi_gidx_put_indices(gidx_t *x, size_t k, const uint64_t *g, size_t n);
+void hd__mpi_gidx_put_numbers(gidx_t *x, const ranges_t *rg, int r, size_t k, const uint32_t *num, size_t n);
 void hd__mpi_gidx_free(ctx_t *c, gidx_t *x);
 /* Position k's index, at any k (a select from the sample before it and a
  * binary search of the runs). */

@@ -66,8 +66,8 @@ static void check_side(scene_t *sc, int s, gen_rng_t *rng) {
     size_t before = sc->c.cur;
     gidx_t x;
     CHECK_RC(hd__mpi_gidx_init(&sc->c, &x, &sc->rg, s, n), HD_OK);
-    size_t run = 0;
-    for (size_t k = 0; k < n; k++) hd__mpi_gidx_put(&x, &run, k, g[k]);
+    for (size_t k = 0, m; k < n; k += m) /* in pieces of any length, as the exchange's runs */
+        hd__mpi_gidx_put_indices(&x, k, g + k, m = 1 + (size_t)(gen_u64(rng) % (n - k)));
     /* charged while held, and small: n l low bits, n ones and U >> l < 2n
      * zeros, a sample word per 64 points (l = floor(log2(U / n)), U the
      * side's indices), and at most a word of rounding in each part */
