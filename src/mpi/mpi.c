@@ -36,13 +36,17 @@
  *     points are never held twice.  Senders walk their parts in increasing
  *     index order, so each run is sorted; when the runs follow each other
  *     in index order (each rank's parts above the previous rank's) the
- *     local arrays are in global order as received and keep the numbers
- *     (gidx_t: 28 bytes a point, the index computed where one is needed),
- *     else the numbers become 8-byte indices and the arrays are merged in
- *     place (a permutation, 4 bytes a point): local order is global index
- *     order, and a local "smallest index on ties" is the global one.  The
- *     arrays are never reordered afterwards (the engine's passes on a
- *     subset move coordinates only), so a position's index is fixed.
+ *     local arrays are in global order as received, else the numbers
+ *     become 8-byte indices and the arrays are merged in place (a
+ *     permutation, 4 bytes a point): local order is global index order,
+ *     and a local "smallest index on ties" is the global one.  The indices
+ *     are then held Elias-Fano coded over the set's dense ordinals (gidx_t:
+ *     3 + log2(N_side / n) bits a point or so, under 1 byte at K <= 16;
+ *     the numbers and indices are freed), so a point costs 24 bytes and a
+ *     fraction through the engine's pass, and an index is decoded where
+ *     one is needed (by a cursor in the per-point loops).  The arrays are
+ *     never reordered afterwards (the engine's passes on a subset move
+ *     coordinates only), so a position's index is fixed.
  *     On one rank none of this happens: the engine runs on the caller's
  *     points as they are (one part a set) or packed once (several).
  *  3. The single-machine engine on each rank's part: hd_directed(local A,

@@ -1,11 +1,12 @@
 /*
  * mpi_int.h -- what the files of the MPI library (src/mpi/) share: the
  * call's context (context.c), the RCB tree (rcb.c), the index runs
- * (ranges.c), the local sets' indices (gidx.c), the exchange (exchange.c), the per-point searches on slabs
- * (slab.c), the engine's pass and its shell (shell.c), the forwarding and
- * the reduction of one direction (forward.c), and the entry points
- * (mpi.c, whose essay has the algorithm).  Internal: names hd__mpi_*, and
- * nothing outside src/mpi/ includes it.
+ * (ranges.c), the local sets' indices (gidx.c), the exchange
+ * (exchange.c), the per-point searches on slabs (slab.c), the engine's
+ * pass and its shell (shell.c), the forwarding and the reduction of one
+ * direction (forward.c), and the entry points (mpi.c, whose essay has the
+ * algorithm).  Internal: names hd__mpi_*, and nothing outside src/mpi/
+ * includes it but its white-box test (tests/internal/mpi_gidx.c).
  *
  * Conventions of every function here: a ctx_t carries the call's
  * communicator, its error (c->e, what hd__mpi_agree() broadcasts) and its
@@ -155,13 +156,14 @@ struct ranges {
  * n points among the side's U indices and l = floor(log2(U / n)), the low
  * l bits of each ordinal in a packed array, and the high part h of the
  * k-th ordinal as bit h + k of a bit array of n + (U - 1 >> l) + 1 bits
- * (one 1 a point, at most U >> l zeros), with the position of every 64th
- * 1 (samp): 2 + l bits a point and one word per 64 points, about
- * 3 + log2(U / n) bits, not 4 or 8 bytes.  The exchange encodes them once
- * (from its 4-byte numbers, or from the 8-byte indices of merged runs,
- * both freed then), and they are never reordered afterwards (split and
- * unsplit move coordinates only), so position k's index is fixed for the
- * call.  An index is the ordinal's run's first index plus the ordinal's
+ * (one 1 a point, U >> l < 2n zeros), with the position of every 64th 1
+ * (samp): l + 1 + 2^f bits a point (U / n = 2^(l + f), 0 <= f < 1) and
+ * a word per 64 points, less than 4 + log2(U / n) bits in all, not 4 or 8
+ * bytes (0.5 B/pt at U / n = 2, 0.625 at 4, 0.875 at 16: K ranks holding
+ * equal shares; docs/scale-out.md).  The exchange encodes them once (from its 4-byte
+ * numbers, or from the 8-byte indices of merged runs, both freed then),
+ * and they are never reordered afterwards (split and unsplit move
+ * coordinates only), so position k's index is fixed for the call.  An index is the ordinal's run's first index plus the ordinal's
  * offset in it (run, rord: the side's runs of ranges_t by first index). */
 typedef struct ranges ranges_t;
 typedef struct {
