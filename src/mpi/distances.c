@@ -365,16 +365,24 @@ static int direction(ctx_t *c, const spread_t *sp, const input_t *in, int s,
     if (rc == HD_OK && nP && nQ)
         rc = hd__an_nearest(&asking->s, &searched->s, NULL, hd__thread_count(c->threads, nP), NULL, near, NULL,
                             &c->e);
-    gcur_t cq; /* near[] goes anywhere, but mostly forward in small steps
-                  where index order follows space */
-    hd__mpi_gcur_init(&cq, &sp->loc.gi[qs]);
+    /* near[] goes anywhere in Q: Q's indices are decoded in order first
+     * (8 bytes a point of Q for the loop, below the peak of the
+     * structures' build), not one by one at random */
+    uint64_t *gq = rc == HD_OK && nQ ? hd__mpi_alloc(c, nQ, sizeof(uint64_t)) : NULL;
+    if (rc == HD_OK && nQ && !gq) rc = hd__mpi_nomem(c, "the distances", nQ);
+    if (gq) {
+        gcur_t cq;
+        hd__mpi_gcur_init(&cq, &sp->loc.gi[qs]);
+        for (size_t j = 0; j < nQ; j++) gq[j] = hd__mpi_gcur_at(&cq, j);
+    }
     for (size_t k = 0; k < nP && rc == HD_OK; k++) {
         double p[3], q[3];
         an_point(asking, k, p);
         if (nQ) an_point(searched, near[k], q);
         u2[k] = nQ ? hd__d2(p, q) : INFINITY;
-        jj[k] = nQ ? hd__mpi_gcur_at(&cq, near[k]) : UINT64_MAX;
+        jj[k] = nQ ? gq[near[k]] : UINT64_MAX;
     }
+    hd__mpi_free(c, gq, nQ, sizeof(uint64_t));
     hd__mpi_free(c, near, nP, sizeof(size_t));
     c->search += hd__now() - t0;
     c->search_cpu += hd__mpi_cpu() - u0;

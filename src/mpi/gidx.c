@@ -38,18 +38,32 @@
 
 #include <assert.h>
 
-/* The position of the r-th 1 (from 0) of w, which has more than r. */
+/* Bit counts without the CPU's instruction (the library is built for any
+ * x86-64, where __builtin_popcountll is a call): each byte's count, and
+ * the sum of all. */
+static inline uint64_t byte_counts(uint64_t w) {
+    w = w - ((w >> 1) & UINT64_C(0x5555555555555555));
+    w = (w & UINT64_C(0x3333333333333333)) + ((w >> 2) & UINT64_C(0x3333333333333333));
+    return (w + (w >> 4)) & UINT64_C(0x0F0F0F0F0F0F0F0F);
+}
+
+static inline unsigned ones(uint64_t w) {
+    return (unsigned)((byte_counts(w) * UINT64_C(0x0101010101010101)) >> 56);
+}
+
+/* The position of the r-th 1 (from 0) of w, which has more than r: the
+ * byte holding it from the bytes' running counts (byte i of sums is the
+ * count of bytes 0 .. i, at most 64, so the bytewise subtraction below
+ * never borrows across bytes: its high bit is set where sums <= r), then
+ * the bit in that byte. */
 static inline unsigned select64(uint64_t w, unsigned r) {
-    unsigned s = 0;
-    for (;;) {
-        unsigned c = (unsigned)__builtin_popcountll(w & 0xff);
-        if (r < c) break;
-        r -= c;
-        w >>= 8;
-        s += 8;
-    }
-    while (r--) w &= w - 1;
-    return s + (unsigned)__builtin_ctzll(w);
+    const uint64_t L8 = UINT64_C(0x0101010101010101), H8 = UINT64_C(0x8080808080808080);
+    uint64_t sums = byte_counts(w) * L8;
+    unsigned place = ones(((((uint64_t)r * L8) | H8) - sums) & H8) * 8;
+    unsigned left = r - (unsigned)(((sums << 8) >> place) & 0xFF);
+    uint64_t v = (w >> place) & 0xFF;
+    while (left--) v &= v - 1;
+    return place + (unsigned)__builtin_ctzll(v);
 }
 
 /* From word *wi whose 1s still to count are *w: the position of the
@@ -59,7 +73,7 @@ static inline uint64_t ones_from(const uint64_t *high, size_t *wi, uint64_t *w, 
     uint64_t v = *w;
     size_t i = *wi;
     for (;;) {
-        unsigned c = (unsigned)__builtin_popcountll(v);
+        unsigned c = ones(v);
         if (left < c) break;
         left -= c;
         v = high[++i];
@@ -224,8 +238,9 @@ void hd__mpi_gcur_init(gcur_t *cu, const gidx_t *x) {
     cu->run = SIZE_MAX;
 }
 
-/* Jumps of at most this many positions step over the 1s between. */
-#define GCUR_STEP 256
+/* Jumps of at most this many positions step over the 1s between (a word
+ * or two at the densest: about what a select from the sample costs). */
+#define GCUR_STEP 48
 
 uint64_t hd__mpi_gcur_next(gcur_t *cu, size_t k) {
     const gidx_t *x = cu->x;
