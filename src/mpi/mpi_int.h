@@ -202,9 +202,9 @@ static inline uint64_t hd__mpi_gidx_low(const gidx_t *x, size_t k) {
 }
 
 /* A walk over a local set's global indices at nondecreasing positions:
- * the next position's 1 is the next set bit of the current word of the
- * high bits, and its run the current one (a subtraction and a
- * comparison); anything else (a jump, a new word, a new run) is
+ * the next position's 1 is the next set bit of the high bits (in the
+ * current word or a following one), and its run the current one (a
+ * subtraction and a comparison); anything else (a jump, a new run) is
  * hd__mpi_gcur_next's.  Positions may also go back (then as
  * hd__mpi_gidx). */
 typedef struct {
@@ -223,11 +223,15 @@ uint64_t hd__mpi_gcur_next(gcur_t *cu, size_t k);
 
 static inline uint64_t hd__mpi_gcur_at(gcur_t *cu, size_t k) {
     if (k == cu->k) return cu->g;
-    if (k == cu->k + 1 && cu->w) {
-        uint64_t h = (((uint64_t)cu->wi << 6) | (uint64_t)__builtin_ctzll(cu->w)) - k;
+    if (k == cu->k + 1 && cu->run != SIZE_MAX) { /* k < n: a 1 follows */
+        size_t wi = cu->wi;
+        uint64_t w = cu->w;
+        while (!w) w = cu->x->high[++wi];
+        uint64_t h = (((uint64_t)wi << 6) | (uint64_t)__builtin_ctzll(w)) - k;
         uint64_t d = ((h << cu->x->l) | hd__mpi_gidx_low(cu->x, k)) - cu->first;
         if (d <= cu->span) {
-            cu->w &= cu->w - 1;
+            cu->wi = wi;
+            cu->w = w & (w - 1);
             cu->k = k;
             return cu->g = cu->lo + d;
         }
