@@ -45,16 +45,19 @@
  * structure keeps exact copies in its own order, so each local array of
  * coordinates is freed once its structure exists, and point k is read from
  * the structure through the inverse of its order (an_t.pos, 4 bytes).  So:
- * the exchange's 4-byte numbers, the two structures (about 33 bytes a
- * point of each set, 60 while one is built) with their inverse orders, and
- * per point of the direction being computed u2, the index and, during the
- * local pass, the local position (24 bytes, then 16); a rank's own points
+ * the encoded indices (gidx_t, under a byte), the two structures (about 33
+ * bytes a point of each set, 60 while one is built) with their inverse
+ * orders, and per point of the direction being computed u2, the index and,
+ * during the local pass, the local position (24 bytes, then 16), with the
+ * other side's indices decoded in order for that pass (8 bytes a point of
+ * it: the nearest points fall anywhere in it, and a decode at random costs
+ * several times one in order); a rank's own points
  * of that direction take 16 bytes more while the answers come back (before
  * they are written to the caller's outputs).  When the runs were merged,
  * the answers are reordered by sender into a buffer of 16 bytes a point
  * first.  The forwarded points are packed with their answers so far (48
  * bytes each, few), and their queries and answers are 40 bytes each.
- * Measured peak: 64 bytes a local point (docs/scale-out.md).
+ * Measured peak: 61 bytes a local point (docs/scale-out.md).
  */
 #include "mpi_int.h"
 

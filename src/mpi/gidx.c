@@ -12,7 +12,7 @@
  *    repeats) has strictly increasing ordinals o_0 < .. < o_{n-1} < U, U
  *    the side's points over all ranks.
  *  - The code.  l = the largest l <= 63 with n 2^l <= U (0 when n = 0 or
- *    U <= n).  low holds o_k mod 2^l at bits k l .. k l + l - 1; high has
+ *    U < 2n).  low holds o_k mod 2^l at bits k l .. k l + l - 1; high has
  *    bit (o_k >> l) + k set for every k and no other: since o_k >> l is
  *    nondecreasing, these are n distinct increasing positions below
  *    n + ((U - 1) >> l) + 1, and the k-th 1 (from 0) is at (o_k >> l) + k,
@@ -20,6 +20,12 @@
  *    the 1 of k = 64 t: select1(k) scans from samp[k / 64] for the
  *    (k mod 64)-th 1 after it, over at most 63 ones and the zeros between
  *    (U >> l < 2n zeros in all: about 2 words on average).
+ *  - Writing.  The words start zeroed, and the code of consecutive
+ *    positions (a piece: a sender's run received in a round, or the merged
+ *    indices) is gathered in registers and OR-ed into them a word at a
+ *    time: a piece's bits are a function of its positions and ordinals
+ *    alone, and the words at its ends may hold a neighbouring piece's
+ *    bits, so pieces may be written in any order, each once.
  *  - Memory: ceil(n l / 64) + ceil(bits / 64) + ceil(n / 64) words, all in
  *    one allocation through the call's allocator, so counted in the peak:
  *    n l + n + (U >> l) + n bits, less than l + 4 bits a point with
