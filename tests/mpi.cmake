@@ -8,6 +8,8 @@
 #    hd_mpi_summarize, hd_mpi_percentile_of and hd_mpi_histogram equal the
 #    single-process functions bit for bit however the values are spread,
 #    and failures are agreed.  The same K as mpi_api.
+#  - mpi_gidx: tests/internal/mpi_gidx.c, the encoded global indices of
+#    the local sets (src/mpi/gidx.c) read back by position and by cursor.
 #  - mpi_cli_3: tests/mpi_cli.py, hausdorff-mpi on 3 ranks against
 #    hausdorff (JSON and text, tiles, scales, a bad tile on one rank, the
 #    --distances files byte for byte and their failures, the figures and
@@ -48,6 +50,13 @@ if(HD_MPI)
     add_test(NAME mpi_figures_${k} COMMAND ${HD_MPIRUN} -n ${k} $<TARGET_FILE:mpi_figures>)
     set_tests_properties(mpi_figures_${k} PROPERTIES TIMEOUT 300 ENVIRONMENT "${HD_MPI_ENV}" PROCESSORS 2)
   endforeach()
+  # mpi_gidx: tests/internal/mpi_gidx.c, the local sets' encoded global
+  # indices (src/mpi/gidx.c), white-box and without mpirun (no MPI call).
+  add_executable(mpi_gidx ${CMAKE_CURRENT_SOURCE_DIR}/tests/internal/mpi_gidx.c ${HD_TEST_SUPPORT})
+  target_include_directories(mpi_gidx PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/tests/support ${CMAKE_CURRENT_SOURCE_DIR}/src)
+  target_link_libraries(mpi_gidx PRIVATE hausdorff_mpi)
+  set_target_properties(mpi_gidx PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/tests)
+  add_test(NAME mpi_gidx COMMAND mpi_gidx)
   find_program(HD_MPI_PYTHON NAMES python3 REQUIRED)
   add_test(NAME mpi_cli_3 COMMAND ${HD_MPI_PYTHON} ${CMAKE_CURRENT_SOURCE_DIR}/tests/mpi_cli.py
            $<TARGET_FILE:hausdorff_cli> $<TARGET_FILE:hausdorff_mpi_cli> 3 ${HD_MPIRUN})

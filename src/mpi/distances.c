@@ -45,16 +45,19 @@
  * structure keeps exact copies in its own order, so each local array of
  * coordinates is freed once its structure exists, and point k is read from
  * the structure through the inverse of its order (an_t.pos, 4 bytes).  So:
- * the exchange's 4-byte numbers, the two structures (about 33 bytes a
- * point of each set, 60 while one is built) with their inverse orders, and
- * per point of the direction being computed u2, the index and, during the
- * local pass, the local position (24 bytes, then 16); a rank's own points
+ * the encoded indices (gidx_t, under a byte), the two structures (about 33
+ * bytes a point of each set, 60 while one is built) with their inverse
+ * orders, and per point of the direction being computed u2, the index and,
+ * during the local pass, the local position (24 bytes, then 16), with the
+ * other side's indices decoded in order for that pass (8 bytes a point of
+ * it: the nearest points fall anywhere in it, and a decode at random costs
+ * several times one in order); a rank's own points
  * of that direction take 16 bytes more while the answers come back (before
  * they are written to the caller's outputs).  When the runs were merged,
  * the answers are reordered by sender into a buffer of 16 bytes a point
  * first.  The forwarded points are packed with their answers so far (48
  * bytes each, few), and their queries and answers are 40 bytes each.
- * Measured peak: 64 bytes a local point (docs/scale-out.md).
+ * Measured peak: 61 bytes a local point (docs/scale-out.md).
  */
 #include "mpi_int.h"
 
@@ -205,22 +208,10 @@ static int single(ctx_t *c, const input_t *in, const ranges_t *rg, const int wan
 
 /* ---- the return ---------------------------------------------------------- */
 
-/* The rank whose parts hold index g of side s (rg sorted by (side, lo)). */
-static int owner_of(const range_t *by, size_t n, uint64_t g) {
-    size_t lo = 0, hi = n - 1;
-    while (lo < hi) { /* the last run starting at or below g */
-        size_t mid = lo + (hi - lo + 1) / 2;
-        if (by[mid].lo <= g) lo = mid;
-        else hi = mid - 1;
-    }
-    assert(by[lo].lo <= g && g <= by[lo].hi);
-    return by[lo].rank;
-}
-
 /* The answers (d2, index) of side s's local points go back to the ranks
  * that hold them (step 3 of the essay), which write them to their outputs.
  * d2 is made the distance in place; d2 and j are freed here. */
-static int give_back(ctx_t *c, const spread_t *sp, const ranges_t *rg, const input_t *in, int s, double **d2p,
+static int give_back(ctx_t *c, const spread_t *sp, const input_t *in, int s, double **d2p,
                      uint64_t **jp, outs_t *o) {
     int K = c->K, rc = HD_OK;
     const local_t *loc = &sp->loc;
@@ -229,37 +220,35 @@ static int give_back(ctx_t *c, const spread_t *sp, const ranges_t *rg, const inp
     uint64_t *j = *jp, *sj = j, *rj = NULL;
     int packed = 0; /* sd, sj are buffers of their own (else d2, j) */
     int *cnt = hd__mpi_alloc(c, 5 * (size_t)K, sizeof(int)); /* scount sdispl rcount rdispl cursor */
-    range_t *by = NULL;
-    size_t nby = 0;
     const hd_mpi_part_t **order = NULL;
     size_t *base = NULL;
     if (!cnt) rc = hd__mpi_nomem(c, "the answers", (size_t)K);
     int *scount = cnt, *sdispl = cnt + K, *rcount = cnt + 2 * K, *rdispl = cnt + 3 * K, *cur = cnt + 4 * K;
     for (size_t k = 0; k < n && rc == HD_OK; k++) d2[k] = sqrt(d2[k]); /* one sqrt, as hd_distances */
-    if (rc == HD_OK && !loc->g[s]) {
+    if (rc == HD_OK && !loc->merged[s]) {
         /* Runs as received: sender r's points are positions [start[r], start[r + 1]). */
         for (int r = 0; r < K; r++) {
             sdispl[r] = (int)loc->start[s][r];
             scount[r] = (int)(loc->start[s][r + 1] - loc->start[s][r]);
         }
     } else if (rc == HD_OK) {
-        /* Merged: each position's sender is the owner of its index; its
-         * points are in index order, the order it sent them in. */
-        size_t lo = rg->seg[(size_t)s * ((size_t)K + 1)], hi = rg->seg[(size_t)s * ((size_t)K + 1) + (size_t)K];
-        nby = hi - lo;
-        by = hd__mpi_alloc(c, nby, sizeof(range_t));
+        /* Merged: each position's sender is the owner of its index (the
+         * rank of its run); its points are in index order, the order it
+         * sent them in. */
         sd = hd__mpi_alloc(c, n, sizeof(double));
         sj = hd__mpi_alloc(c, n, sizeof(uint64_t));
         packed = 1;
-        if (!by || !sd || !sj) rc = hd__mpi_nomem(c, "the answers", n);
+        if (!sd || !sj) rc = hd__mpi_nomem(c, "the answers", n);
         if (rc == HD_OK) {
-            memcpy(by, rg->all + lo, nby * sizeof(range_t));
-            qsort(by, nby, sizeof(range_t), hd__mpi_by_range);
+            gcur_t cu;
             memset(scount, 0, (size_t)K * sizeof(int));
-            for (size_t k = 0; k < n; k++) scount[owner_of(by, nby, loc->g[s][k])]++;
+            hd__mpi_gcur_init(&cu, &loc->gi[s]);
+            for (size_t k = 0; k < n; k++) hd__mpi_gcur_at(&cu, k), scount[hd__mpi_gcur_rank(&cu)]++;
             for (int r = 0, at = 0; r < K; r++) sdispl[r] = cur[r] = at, at += scount[r];
+            hd__mpi_gcur_init(&cu, &loc->gi[s]);
             for (size_t k = 0; k < n; k++) {
-                int r = owner_of(by, nby, loc->g[s][k]);
+                hd__mpi_gcur_at(&cu, k);
+                int r = hd__mpi_gcur_rank(&cu);
                 sd[cur[r]] = d2[k];
                 sj[cur[r]++] = j[k];
             }
@@ -318,7 +307,6 @@ done:
     }
     hd__mpi_free(c, rd, m, sizeof(double));
     hd__mpi_free(c, rj, m, sizeof(uint64_t));
-    hd__mpi_free(c, by, nby, sizeof(range_t));
     hd__mpi_free(c, cnt, 5 * (size_t)K, sizeof(int));
     if (order) walk_order_free(c, in, s, order, base);
     return rc;
@@ -347,10 +335,12 @@ static int answer(ctx_t *c, void *arg, const double *pts, size_t m, ans_t *ans) 
     if (rc == HD_OK)
         rc = hd__an_nearest(&asked.s, &a->searched->s, NULL, hd__thread_count(c->threads, m), NULL, near, NULL,
                             &c->e);
+    gcur_t cq;
+    hd__mpi_gcur_init(&cq, a->gQ);
     for (size_t k = 0; k < m && rc == HD_OK; k++) {
         double q[3];
         an_point(a->searched, near[k], q);
-        ans[k] = (ans_t){hd__d2(pts + 3 * k, q), hd__mpi_gidx(a->gQ, near[k])};
+        ans[k] = (ans_t){hd__d2(pts + 3 * k, q), hd__mpi_gcur_at(&cq, near[k])};
     }
     if (near) an_free(c, &asked);
     hd__mpi_free(c, near, m, sizeof(size_t));
@@ -360,7 +350,7 @@ static int answer(ctx_t *c, void *arg, const double *pts, size_t m, ans_t *ans) 
 /* The exact answers of side s's local points against all of the other
  * side (steps 1 and 2), then returned (step 3).  `asking` and `searched`
  * are the structures of local P and local Q on the key box kb. */
-static int direction(ctx_t *c, const spread_t *sp, const ranges_t *rg, const input_t *in, int s,
+static int direction(ctx_t *c, const spread_t *sp, const input_t *in, int s,
                      const an_t *asking, const an_t *searched, const hd__box_t *kb, outs_t *o) {
     int K = c->K, rc = HD_OK, qs = 1 - s;
     const local_t *loc = &sp->loc;
@@ -378,13 +368,24 @@ static int direction(ctx_t *c, const spread_t *sp, const ranges_t *rg, const inp
     if (rc == HD_OK && nP && nQ)
         rc = hd__an_nearest(&asking->s, &searched->s, NULL, hd__thread_count(c->threads, nP), NULL, near, NULL,
                             &c->e);
+    /* near[] goes anywhere in Q: Q's indices are decoded in order first
+     * (8 bytes a point of Q for the loop, below the peak of the
+     * structures' build), not one by one at random */
+    uint64_t *gq = rc == HD_OK && nQ ? hd__mpi_alloc(c, nQ, sizeof(uint64_t)) : NULL;
+    if (rc == HD_OK && nQ && !gq) rc = hd__mpi_nomem(c, "the distances", nQ);
+    if (gq) {
+        gcur_t cq;
+        hd__mpi_gcur_init(&cq, &sp->loc.gi[qs]);
+        for (size_t j = 0; j < nQ; j++) gq[j] = hd__mpi_gcur_at(&cq, j);
+    }
     for (size_t k = 0; k < nP && rc == HD_OK; k++) {
         double p[3], q[3];
         an_point(asking, k, p);
         if (nQ) an_point(searched, near[k], q);
         u2[k] = nQ ? hd__d2(p, q) : INFINITY;
-        jj[k] = nQ ? hd__mpi_gidx(&sp->gi[qs], near[k]) : UINT64_MAX;
+        jj[k] = nQ ? gq[near[k]] : UINT64_MAX;
     }
+    hd__mpi_free(c, gq, nQ, sizeof(uint64_t));
     hd__mpi_free(c, near, nP, sizeof(size_t));
     c->search += hd__now() - t0;
     c->search_cpu += hd__mpi_cpu() - u0;
@@ -416,7 +417,7 @@ static int direction(ctx_t *c, const spread_t *sp, const ranges_t *rg, const inp
     }
     hd__mpi_free(c, nbox, (size_t)K - 1, sizeof(hd__box_t));
     hd__mpi_free(c, list, (size_t)K, sizeof(int));
-    answer_t an = {searched, kb, nQ, &sp->gi[qs]};
+    answer_t an = {searched, kb, nQ, &sp->loc.gi[qs]};
     rc = hd__mpi_round(c, rc, fx, &pr, answer, &an, fu, fj);
     for (size_t f = 0; f < nf && rc == HD_OK; f++) u2[fk[f]] = fu[f], jj[fk[f]] = fj[f];
     hd__mpi_pairs_free(c, &pr);
@@ -425,7 +426,7 @@ static int direction(ctx_t *c, const spread_t *sp, const ranges_t *rg, const inp
     hd__mpi_free(c, fj, nf, sizeof(uint64_t));
     hd__mpi_free(c, fk, nf, sizeof(size_t));
     /* 3. Back to the points' ranks. */
-    if (rc == HD_OK) rc = give_back(c, sp, rg, in, s, &u2, &jj, o);
+    if (rc == HD_OK) rc = give_back(c, sp, in, s, &u2, &jj, o);
     hd__mpi_free(c, u2, nP, sizeof(double));
     hd__mpi_free(c, jj, nP, sizeof(uint64_t));
     return rc;
@@ -465,7 +466,7 @@ static int distances(ctx_t *c, const hd_options_t *opt, input_t *in, void *arg, 
         c->search_cpu += hd__mpi_cpu() - u1;
         if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
         for (int s = 0; s < 2; s++)
-            if (want[s] && (rc = direction(c, sp, &cs.rg, in, s, &an[s], &an[1 - s], &kb, o)) != HD_OK) goto done;
+            if (want[s] && (rc = direction(c, sp, in, s, &an[s], &an[1 - s], &kb, o)) != HD_OK) goto done;
     }
     double tmax;
     rc = hd__mpi_figures(c, &cs, pts, st, &tmax);

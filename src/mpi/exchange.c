@@ -15,9 +15,13 @@
  *    send buffer is at most 3.5 bytes a point; every rank runs the same
  *    number of rounds (the allreduced maximum), each three collectives.
  *  - After the rounds, local order is global index order: as received when
- *    the runs follow each other in index order (the numbers stay: gidx_t),
- *    else after a K-way merge applied in place (the numbers become 8-byte
- *    indices).  Nothing reorders the local arrays' indices afterwards.
+ *    the runs follow each other in index order, else after a K-way merge
+ *    applied in place (the numbers become 8-byte indices first).  The
+ *    indices are then held encoded (gidx_t, gidx.c): each round's numbers
+ *    are encoded as they arrive (still in the cache), as if the runs were
+ *    in order, and encoded again from the merged indices when they were
+ *    not; the numbers and indices are freed before the call goes on.
+ *    Nothing reorders the local arrays' indices afterwards.
  */
 #include "mpi_int.h"
 
@@ -132,10 +136,10 @@ static size_t walk_avail(const input_t *in, const hd_mpi_part_t **order[2], walk
  * copied from the input into their slot.  Runs are in index order, since
  * senders walk their parts in offset order; when the runs follow each
  * other in index order too (each rank's parts lie above the previous
- * rank's) the local arrays are in global order as received and the
- * numbers stay (loc->num, loc->start: gidx_t), else they become indices
- * (loc->g) and the arrays are merged in place (a permutation from a K-way
- * merge, 4 bytes a point). */
+ * rank's) the local arrays are in global order as received (loc->start:
+ * each sender's run), else the numbers become indices and the arrays are
+ * merged in place (a permutation from a K-way merge, 4 bytes a point;
+ * loc->merged).  Either way loc->gi holds the indices encoded. */
 int hd__mpi_exchange(ctx_t *c, const input_t *in, const ranges_t *rg, const node_t *tree, local_t *loc) {
     int K = c->K, me = c->rank, rc = HD_OK, w = K <= 256 ? 1 : K <= 65536 ? 2 : 4;
     size_t nloc = (size_t)(in->n[0] + in->n[1]), C = nloc / ROUND_SHARE, sendcap = 0;
@@ -152,7 +156,8 @@ int hd__mpi_exchange(ctx_t *c, const input_t *in, const ranges_t *rg, const node
     double *sx = NULL;
     uint32_t *so = NULL;
     uint32_t *perm = NULL;
-    size_t permn = 0;
+    size_t permn = 0, gn = 0;
+    uint64_t *g = NULL;      /* the indices of merged runs */
     run_t *runs = NULL;
     int *heap = NULL;
     for (int s = 0; s < 2; s++) order[s] = hd__mpi_alloc(c, in->nparts[s], sizeof *order[s]);
@@ -224,6 +229,7 @@ int hd__mpi_exchange(ctx_t *c, const input_t *in, const ranges_t *rg, const node
         loc->xyz[s] = hd__mpi_alloc(c, loc->n[s], 3 * sizeof(double));
         off[s] = hd__mpi_alloc(c, loc->n[s], sizeof(uint32_t));
         if (!loc->xyz[s] || !off[s]) rc = hd__mpi_nomem(c, "the local points", loc->n[s]);
+        else rc = hd__mpi_gidx_init(c, &loc->gi[s], rg, s, loc->n[s]);
     }
     if (rc == HD_OK) {
         sx = hd__mpi_alloc(c, sendcap, 3 * sizeof(double));
@@ -244,6 +250,7 @@ int hd__mpi_exchange(ctx_t *c, const input_t *in, const ranges_t *rg, const node
                 sdisp[2 * r + s] = sfill[2 * r + s] = pos;
                 pos += per[2 * r + s];
             }
+        size_t own0[2] = {ownat[0], ownat[1]};
         /* Pack the round's positions, a part's run at a time. */
         for (size_t t = round < nr ? tb[round] : nloc, t1 = round < nr ? tb[round + 1] : nloc; t < t1;) {
             size_t avail = walk_avail(in, order, &at), m = t1 - t < avail ? t1 - t : avail;
@@ -272,6 +279,10 @@ int hd__mpi_exchange(ctx_t *c, const input_t *in, const ranges_t *rg, const node
             at.k += m;
             at.num[s] += m;
         }
+        /* The numbers are encoded while in the cache, as if the runs were
+         * in index order (else encoded again below). */
+        for (int s = 0; s < 2; s++)
+            hd__mpi_gidx_put_numbers(&loc->gi[s], rg, me, own0[s], off[s] + own0[s], ownat[s] - own0[s]);
         MPI_GO(c, rc, MPI_Alltoall(per, 2, MPI_INT, rper, 2, MPI_INT, c->comm));
         for (int s = 0; s < 2; s++) {
             for (int r = 0; r < K; r++) {
@@ -283,6 +294,8 @@ int hd__mpi_exchange(ctx_t *c, const input_t *in, const ranges_t *rg, const node
             }
             MPI_GO(c, rc, MPI_Alltoallv(sx, sc, sd, c->q_type, loc->xyz[s], rcn, rd, c->q_type, c->comm));
             MPI_GO(c, rc, MPI_Alltoallv(so, sc, sd, MPI_UINT32_T, off[s], rcn, rd, MPI_UINT32_T, c->comm));
+            for (int r = 0; r < K; r++)
+                if (r != me) hd__mpi_gidx_put_numbers(&loc->gi[s], rg, r, (size_t)rd[r], off[s] + rd[r], (size_t)rcn[r]);
         }
     }
     hd__mpi_free(c, sx, sendcap, 3 * sizeof(double));
@@ -291,9 +304,9 @@ int hd__mpi_exchange(ctx_t *c, const input_t *in, const ranges_t *rg, const node
     sx = NULL, so = NULL, dest = NULL;
     assert(ownat[0] == base[me] + (size_t)rtot[2 * me] && ownat[1] == base[K + me] + (size_t)rtot[2 * me + 1]);
     /* The runs in index order as received (each rank's parts above the
-     * previous rank's): the numbers stay and name the indices (gidx_t,
-     * 4 bytes a point).  Else the numbers become indices (8 bytes) and
-     * the runs are merged into index order. */
+     * previous rank's): the numbers were encoded as received, and are
+     * freed.  Else the numbers become indices (8 bytes), the runs are
+     * merged into index order, and the indices are encoded afresh. */
     for (int s = 0; s < 2 && rc == HD_OK; s++) {
         loc->start[s] = hd__mpi_alloc(c, (size_t)K + 1, sizeof(size_t));
         if (!loc->start[s]) {
@@ -312,18 +325,21 @@ int hd__mpi_exchange(ctx_t *c, const input_t *in, const ranges_t *rg, const node
         }
         loc->start[s][K] = loc->n[s];
         if (sorted) {
-            loc->num[s] = off[s];
+            hd__mpi_free(c, off[s], loc->n[s], sizeof(uint32_t));
             off[s] = NULL;
             continue;
         }
-        loc->g[s] = hd__mpi_alloc(c, loc->n[s], sizeof(uint64_t));
-        if (!loc->g[s]) {
+        loc->merged[s] = 1;
+        g = hd__mpi_alloc(c, loc->n[s], sizeof(uint64_t));
+        if (!g) {
             rc = hd__mpi_nomem(c, "the local indices", loc->n[s]);
             break;
         }
+        gn = loc->n[s];
         for (int r = 0; r < K; r++) {
-            size_t lo = base[s * K + r], hi = lo + (size_t)rtot[2 * r + s];
-            hd__mpi_ranges_globals(rg, s, r, off[s] + lo, hi - lo, loc->g[s] + lo);
+            size_t lo = base[s * K + r], hi = lo + (size_t)rtot[2 * r + s],
+                   i = rg->seg[(size_t)s * ((size_t)K + 1) + (size_t)r];
+            hd__mpi_ranges_globals(rg, s, r, &i, off[s] + lo, hi - lo, g + lo);
         }
         hd__mpi_free(c, off[s], loc->n[s], sizeof(uint32_t));
         off[s] = NULL;
@@ -336,12 +352,16 @@ int hd__mpi_exchange(ctx_t *c, const input_t *in, const ranges_t *rg, const node
             break;
         }
         for (int r = 0; r < K; r++) runs[r] = (run_t){base[s * K + r], base[s * K + r] + (size_t)rtot[2 * r + s]};
-        merge_order(loc->g[s], runs, K, heap, perm);
-        permute(loc->xyz[s], loc->g[s], perm, loc->n[s]);
+        merge_order(g, runs, K, heap, perm);
+        permute(loc->xyz[s], g, perm, loc->n[s]);
         hd__mpi_free(c, perm, permn, sizeof(uint32_t));
         hd__mpi_free(c, runs, (size_t)K, sizeof(run_t));
         hd__mpi_free(c, heap, (size_t)K, sizeof(int));
         perm = NULL, runs = NULL, heap = NULL;
+        memset(loc->gi[s].w, 0, loc->gi[s].words * sizeof(uint64_t));
+        hd__mpi_gidx_put_indices(&loc->gi[s], 0, g, loc->n[s]);
+        hd__mpi_free(c, g, gn, sizeof(uint64_t));
+        g = NULL;
     }
     rc = hd__mpi_agree(c, rc);
 done:
@@ -359,5 +379,6 @@ done:
     hd__mpi_free(c, perm, permn, sizeof(uint32_t));
     hd__mpi_free(c, runs, (size_t)K, sizeof(run_t));
     hd__mpi_free(c, heap, (size_t)K, sizeof(int));
+    hd__mpi_free(c, g, gn, sizeof(uint64_t));
     return rc;
 }

@@ -139,9 +139,11 @@ static int answer(ctx_t *c, void *arg, const double *pts, size_t m, ans_t *ans) 
     size_t *near = hd__mpi_alloc(c, m, sizeof(size_t));
     if (!near) return hd__mpi_nomem(c, "answers", m);
     int rc = hd__mpi_nearest_in_q(c, d, a->mine, a->q, pts, m, near);
+    gcur_t cq;
+    hd__mpi_gcur_init(&cq, d->gQ);
     if (rc == HD_OK)
         for (size_t k = 0; k < m; k++)
-            ans[k] = (ans_t){hd__d2(pts + 3 * k, d->Q + 3 * near[k]), hd__mpi_gidx(d->gQ, near[k])};
+            ans[k] = (ans_t){hd__d2(pts + 3 * k, d->Q + 3 * near[k]), hd__mpi_gcur_at(&cq, near[k])};
     hd__mpi_free(c, near, m, sizeof(size_t));
     return rc;
 }
@@ -168,7 +170,10 @@ int hd__mpi_direction(ctx_t *c, const dir_t *d, const node_t *tree, const hd__bo
     pairs_t pr = {NULL, 0, 0};
     if (rc == HD_OK && (!u2 || !jj || !exact || !nbox || !list)) rc = hd__mpi_nomem(c, "per-point bounds", nP);
     far_t Lmine = sh.inner, Lall;
+    gcur_t cp, cq; /* P's indices (the shell's, in order) and Q's */
     if (rc == HD_OK) {
+        hd__mpi_gcur_init(&cp, d->gP);
+        hd__mpi_gcur_init(&cq, d->gQ);
         for (size_t k = 0; k < nP; k++) {
             const double *p = P + 3 * k;
             if (d->nQ == 0) {
@@ -178,9 +183,9 @@ int hd__mpi_direction(ctx_t *c, const dir_t *d, const node_t *tree, const hd__bo
                 continue;
             }
             u2[k] = hd__d2(p, d->Q + 3 * sh.nearest[k]);
-            jj[k] = hd__mpi_gidx(d->gQ, sh.nearest[k]);
+            jj[k] = hd__mpi_gcur_at(&cq, sh.nearest[k]);
             exact[k] = (unsigned char)hd__mpi_faces_clear(mine, p, u2[k]);
-            far_t f = {u2[k], hd__mpi_shell_g(d, &sh, k), jj[k]};
+            far_t f = {u2[k], hd__mpi_shell_g(&cp, &sh, k), jj[k]};
             if (exact[k] && hd__mpi_far_better(&f, &Lmine)) Lmine = f;
         }
         if (K > 1) hd__mpi_node_boxes(tree, 0, held, d->qside, nbox);
@@ -207,8 +212,9 @@ int hd__mpi_direction(ctx_t *c, const dir_t *d, const node_t *tree, const hd__bo
     double L = Lall.d2;
     uint64_t iL = Lall.i;
     /* The points to forward, as (point, rank) pairs. */
+    hd__mpi_gcur_init(&cp, d->gP);
     for (size_t k = 0; k < nP && rc == HD_OK; k++) {
-        if (exact[k] || u2[k] < L || (u2[k] == L && hd__mpi_shell_g(d, &sh, k) > iL)) continue;
+        if (exact[k] || u2[k] < L || (u2[k] == L && hd__mpi_shell_g(&cp, &sh, k) > iL)) continue;
         int n = hd__mpi_asked(tree, nbox, held, K, d->qside, d->nQ == 0, P + 3 * k, u2[k], c->rank, list);
         if (n == 0) {
             exact[k] = 1; /* no other rank holds a point as near */
@@ -222,9 +228,10 @@ int hd__mpi_direction(ctx_t *c, const dir_t *d, const node_t *tree, const hd__bo
     /* Every point that could win is now exact; the others cannot win (a
      * point at L with a larger index than i_L loses to i_L). */
     far_t best = sh.inner;
+    hd__mpi_gcur_init(&cp, d->gP);
     for (size_t k = 0; k < nP; k++) {
-        if (u2[k] < L || (u2[k] == L && hd__mpi_shell_g(d, &sh, k) > iL)) continue;
-        far_t f = {u2[k], hd__mpi_shell_g(d, &sh, k), jj[k]};
+        if (u2[k] < L || (u2[k] == L && hd__mpi_shell_g(&cp, &sh, k) > iL)) continue;
+        far_t f = {u2[k], hd__mpi_shell_g(&cp, &sh, k), jj[k]};
         if (hd__mpi_far_better(&f, &best)) best = f;
     }
     /* The interior's maximum, when not known, is needed only where the

@@ -36,13 +36,17 @@
  *     points are never held twice.  Senders walk their parts in increasing
  *     index order, so each run is sorted; when the runs follow each other
  *     in index order (each rank's parts above the previous rank's) the
- *     local arrays are in global order as received and keep the numbers
- *     (gidx_t: 28 bytes a point, the index computed where one is needed),
- *     else the numbers become 8-byte indices and the arrays are merged in
- *     place (a permutation, 4 bytes a point): local order is global index
- *     order, and a local "smallest index on ties" is the global one.  The
- *     arrays are never reordered afterwards (the engine's passes on a
- *     subset move coordinates only), so a position's index is fixed.
+ *     local arrays are in global order as received, else the numbers
+ *     become 8-byte indices and the arrays are merged in place (a
+ *     permutation, 4 bytes a point): local order is global index order,
+ *     and a local "smallest index on ties" is the global one.  The indices
+ *     are then held Elias-Fano coded over the set's dense ordinals (gidx_t:
+ *     3 + log2(N_side / n) bits a point or so, under 1 byte at K <= 16;
+ *     the numbers and indices are freed), so a point costs 24 bytes and a
+ *     fraction through the engine's pass, and an index is decoded where
+ *     one is needed (by a cursor in the per-point loops).  The arrays are
+ *     never reordered afterwards (the engine's passes on a subset move
+ *     coordinates only), so a position's index is fixed.
  *     On one rank none of this happens: the engine runs on the caller's
  *     points as they are (one part a set) or packed once (several).
  *  3. The single-machine engine on each rank's part: hd_directed(local A,
@@ -206,8 +210,6 @@ int hd__mpi_spread(ctx_t *c, const input_t *in, const ranges_t *rg, const uint64
             for (int k = 0; k < 3; k++) h.box[s].lo[k] = INFINITY, h.box[s].hi[k] = -INFINITY;
     }
     MPI_TRY(c, MPI_Allgather(&h, (int)sizeof h, MPI_BYTE, sp->held, (int)sizeof h, MPI_BYTE, c->comm));
-    for (int t = 0; t < 2; t++)
-        sp->gi[t] = (gidx_t){sp->loc.g[t], sp->loc.num[t], sp->loc.start[t], rg, t, K};
     return HD_OK;
 }
 
@@ -215,8 +217,7 @@ void hd__mpi_spread_free(ctx_t *c, spread_t *sp) {
     int K = c->K;
     for (int s = 0; s < 2; s++) {
         hd__mpi_free(c, sp->loc.xyz[s], sp->loc.n[s], 3 * sizeof(double));
-        hd__mpi_free(c, sp->loc.g[s], sp->loc.n[s], sizeof(uint64_t));
-        hd__mpi_free(c, sp->loc.num[s], sp->loc.n[s], sizeof(uint32_t));
+        hd__mpi_gidx_free(c, &sp->loc.gi[s]);
         if (sp->loc.start[s]) hd__mpi_free(c, sp->loc.start[s], (size_t)K + 1, sizeof(size_t));
     }
     hd__mpi_free(c, sp->tree, (size_t)K - 1, sizeof(node_t));
@@ -326,7 +327,7 @@ static int run(ctx_t *c, const hd_options_t *opt, input_t *in, void *arg, hd_mpi
         unsigned char *mask[2] = {NULL, NULL};
         int pre_rc = HD_OK;
         if (both) {
-            const gidx_t *gp[2] = {&sp->gi[0], &sp->gi[1]};
+            const gidx_t *gp[2] = {&sp->loc.gi[0], &sp->loc.gi[1]};
             double t1 = hd__now(), u1 = hd__mpi_cpu();
             pre_rc = hd__mpi_engine_both(c, loc->xyz, gp, loc->n, sp->held[c->rank].box, pre, mask);
             c->search += hd__now() - t1;
@@ -334,7 +335,7 @@ static int run(ctx_t *c, const hd_options_t *opt, input_t *in, void *arg, hd_mpi
         }
         rc = hd__mpi_agree(c, pre_rc);
         for (int s = 0; s < (both ? 2 : 1) && rc == HD_OK; s++) {
-            dir_t d = {loc->xyz[s], &sp->gi[s], loc->n[s], loc->xyz[1 - s], &sp->gi[1 - s], loc->n[1 - s], 1 - s,
+            dir_t d = {loc->xyz[s], &sp->loc.gi[s], loc->n[s], loc->xyz[1 - s], &sp->loc.gi[1 - s], loc->n[1 - s], 1 - s,
                        &pre[s]};
             rc = hd__mpi_direction(c, &d, sp->tree, sp->region, sp->held, &f[s]);
         }

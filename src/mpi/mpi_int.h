@@ -1,11 +1,12 @@
 /*
  * mpi_int.h -- what the files of the MPI library (src/mpi/) share: the
  * call's context (context.c), the RCB tree (rcb.c), the index runs
- * (ranges.c), the exchange (exchange.c), the per-point searches on slabs
- * (slab.c), the engine's pass and its shell (shell.c), the forwarding and
- * the reduction of one direction (forward.c), and the entry points
- * (mpi.c, whose essay has the algorithm).  Internal: names hd__mpi_*, and
- * nothing outside src/mpi/ includes it.
+ * (ranges.c), the local sets' indices (gidx.c), the exchange
+ * (exchange.c), the per-point searches on slabs (slab.c), the engine's
+ * pass and its shell (shell.c), the forwarding and the reduction of one
+ * direction (forward.c), and the entry points (mpi.c, whose essay has the
+ * algorithm).  Internal: names hd__mpi_*, and nothing outside src/mpi/
+ * includes it but its white-box test (tests/internal/mpi_gidx.c).
  *
  * Conventions of every function here: a ctx_t carries the call's
  * communicator, its error (c->e, what hd__mpi_agree() broadcasts) and its
@@ -133,60 +134,114 @@ typedef struct { uint64_t lo, hi; int side, rank; } range_t;
  * up to all[seg[s (K + 1) + r + 1]], and first[i] is the number of part
  * i's first point among its rank's points of its side in index order.  So
  * point number m of rank r's side s names a global index (ranges_globals),
- * which lets the exchange send 4-byte numbers instead of 8-byte indices,
- * and the local arrays keep them (gidx_t): held for the whole call. */
+ * which lets the exchange send 4-byte numbers instead of 8-byte indices.
+ * The same runs sorted by (side, first index) are bylo (side s's at the
+ * same positions seg[s (K + 1)] .. seg[s (K + 1) + K] as in all), and
+ * ord[i] is the number of side indices below bylo[i].lo over all ranks:
+ * index g of run i is the side's ordinal ord[i] + (g - lo), dense in
+ * 0 .. N_side - 1 (what gidx_t encodes). */
 struct ranges {
     int K;
     range_t *all;
     size_t total;
     size_t *seg;
     uint64_t *first;
+    range_t *bylo;
+    uint64_t *ord;
 };
 
-/* The global indices of a local set, by position (local order is global
- * index order).  Not stored as 8-byte indices: each point keeps the 4-byte
- * number it came with (its rank among its sender's points of the set, in
- * index order), and since the senders' runs lie in the local array one
- * after the other, a position names its sender (start[]) and the sender's
- * index runs (ranges_t) turn the number into the index (gidx).  Where the
- * runs had to be merged (the senders' index ranges interleave), positions
- * no longer name senders and the indices are stored (g).  The arrays are
- * never reordered after the exchange (split/unsplit move coordinates
- * only), so position k's index is fixed for the call. */
+/* The global indices of a local set, by position (gidx.c).  Local order is
+ * global index order, so the ordinals (ranges_t.ord) of a local set
+ * increase with the position, and they are held Elias-Fano coded: with
+ * n points among the side's U indices and l = floor(log2(U / n)), the low
+ * l bits of each ordinal in a packed array, and the high part h of the
+ * k-th ordinal as bit h + k of a bit array of n + (U - 1 >> l) + 1 bits
+ * (one 1 a point, U >> l < 2n zeros), with the position of every 64th 1
+ * (samp): l + 1 + 2^f bits a point (U / n = 2^(l + f), 0 <= f < 1) and
+ * a word per 64 points, less than 4 + log2(U / n) bits in all, not 4 or 8
+ * bytes (0.5 B/pt at U / n = 2, 0.625 at 4, 0.875 at 16: K ranks holding
+ * equal shares; docs/scale-out.md).  The exchange encodes them once (from its 4-byte
+ * numbers, or from the 8-byte indices of merged runs, both freed then),
+ * and they are never reordered afterwards (split and unsplit move
+ * coordinates only), so position k's index is fixed for the call.  An index is the ordinal's run's first index plus the ordinal's
+ * offset in it (run, rord: the side's runs of ranges_t by first index). */
 typedef struct ranges ranges_t;
 typedef struct {
-    const uint64_t *g;       /* each position's index (runs merged), or NULL */
-    const uint32_t *num;     /* else each position's number at its sender */
-    const size_t *start;     /* K + 1: where each sender's run starts */
-    const ranges_t *rg;
-    int side, K;
+    uint64_t *w;             /* one allocation: low, high, samp */
+    size_t words;            /* its words (charged) */
+    const uint64_t *low, *high, *samp;
+    size_t n;                /* positions */
+    int l;                   /* low bits an ordinal */
+    const range_t *run;      /* the side's runs by first index */
+    const uint64_t *rord;    /* each one's first ordinal */
+    size_t nrun;
+    int side;
 } gidx_t;
 
+int hd__mpi_gidx_init(ctx_t *c, gidx_t *x, const ranges_t *rg, int side, size_t n);
+/* Positions k .. k + n - 1's indices are g[0 .. n - 1] (increasing, and
+ * above those of the positions before k), or the indices of numbers
+ * num[0 .. n - 1] at their sender r (increasing: a run received in index
+ * order).  The code is written once, from calls covering 0 .. x->n - 1. */
+void hd__mpi_gidx_put_indices(gidx_t *x, size_t k, const uint64_t *g, size_t n);
+void hd__mpi_gidx_put_numbers(gidx_t *x, const ranges_t *rg, int r, size_t k, const uint32_t *num, size_t n);
+void hd__mpi_gidx_free(ctx_t *c, gidx_t *x);
+/* Position k's index, at any k (a select from the sample before it and a
+ * binary search of the runs). */
 uint64_t hd__mpi_gidx(const gidx_t *x, size_t k);
 
+/* The low l bits of position k's ordinal. */
+static inline uint64_t hd__mpi_gidx_low(const gidx_t *x, size_t k) {
+    if (x->l == 0) return 0;
+    uint64_t bit = (uint64_t)k * (uint64_t)x->l;
+    size_t w = (size_t)(bit >> 6);
+    unsigned o = (unsigned)(bit & 63);
+    uint64_t v = x->low[w] >> o;
+    if (o + (unsigned)x->l > 64) v |= x->low[w + 1] << (64 - o);
+    return v & ((UINT64_C(1) << x->l) - 1);
+}
+
 /* A walk over a local set's global indices at nondecreasing positions:
- * the sender and its index run advance with the position instead of being
- * searched for each point (hd__mpi_gidx's two binary searches), and a
- * position in the current run costs a subtraction and a comparison. */
+ * the next position's 1 is the next set bit of the high bits (in the
+ * current word or a following one), and its run the current one (a
+ * subtraction and a comparison); anything else (a jump, a new run) is
+ * hd__mpi_gcur_next's.  Positions may also go back (then as
+ * hd__mpi_gidx). */
 typedef struct {
     const gidx_t *x;
-    int r;                   /* the sender whose run holds the position */
-    size_t i, end;           /* its current index run in rg, and its end */
-    size_t kend;             /* the sender's run ends before this position */
-    uint64_t first, span, lo; /* the index run: numbers first .. first +
-                                 span name indices lo .. lo + span */
+    size_t k;                /* the last position decoded (SIZE_MAX: none) */
+    size_t wi;               /* the word of the high bits holding its 1 */
+    uint64_t w;              /* that word's 1s after it */
+    size_t run;              /* the run of its ordinal (SIZE_MAX: none) */
+    uint64_t first, span, lo; /* that run: ordinals first .. first + span
+                                 name indices lo .. lo + span */
+    uint64_t g;              /* its index */
 } gcur_t;
 
 void hd__mpi_gcur_init(gcur_t *cu, const gidx_t *x);
 uint64_t hd__mpi_gcur_next(gcur_t *cu, size_t k);
 
 static inline uint64_t hd__mpi_gcur_at(gcur_t *cu, size_t k) {
-    if (cu->x->g) return cu->x->g[k];
-    if (k < cu->kend) {
-        uint64_t d = cu->x->num[k] - cu->first;
-        if (d <= cu->span) return cu->lo + d;
+    if (k == cu->k) return cu->g;
+    if (k == cu->k + 1 && cu->run != SIZE_MAX) { /* k < n: a 1 follows */
+        size_t wi = cu->wi;
+        uint64_t w = cu->w;
+        while (!w) w = cu->x->high[++wi];
+        uint64_t h = (((uint64_t)wi << 6) | (uint64_t)__builtin_ctzll(w)) - k;
+        uint64_t d = ((h << cu->x->l) | hd__mpi_gidx_low(cu->x, k)) - cu->first;
+        if (d <= cu->span) {
+            cu->wi = wi;
+            cu->w = w & (w - 1);
+            cu->k = k;
+            return cu->g = cu->lo + d;
+        }
     }
     return hd__mpi_gcur_next(cu, k);
+}
+
+/* The rank whose parts hold the cursor's last index. */
+static inline int hd__mpi_gcur_rank(const gcur_t *cu) {
+    return cu->x->run[cu->run].rank;
 }
 
 typedef struct {
@@ -205,7 +260,8 @@ typedef struct {
 int hd__mpi_by_offset(const void *x, const void *y);
 int hd__mpi_by_range(const void *x, const void *y); /* range_t by (side, lo) */
 void hd__mpi_ranges_free(ctx_t *c, ranges_t *rg);
-void hd__mpi_ranges_globals(const ranges_t *rg, int s, int r, const uint32_t *num, size_t n, uint64_t *g);
+int hd__mpi_ranges_index(ctx_t *c, ranges_t *rg);
+void hd__mpi_ranges_globals(const ranges_t *rg, int s, int r, size_t *i, const uint32_t *num, size_t n, uint64_t *g);
 uint64_t hd__mpi_ranges_global(const ranges_t *rg, int s, int r, uint64_t m);
 int hd__mpi_check_ranges(ctx_t *c, const input_t *in, ranges_t *rg);
 int hd__mpi_check_local(ctx_t *c, const hd_options_t *opt, input_t *in, const void *out);
@@ -247,9 +303,9 @@ int hd__mpi_asked(const node_t *t, const hd__box_t *nbox, const held_t *held, in
 
 typedef struct {
     double *xyz[2];
-    uint64_t *g[2];          /* the indices, where the runs were merged */
-    uint32_t *num[2];        /* else the senders' numbers (gidx_t) */
-    size_t *start[2];        /* K + 1 a side: each sender's run */
+    gidx_t gi[2];            /* their global indices */
+    int merged[2];           /* the senders' runs were merged, */
+    size_t *start[2];        /* else K + 1 a side: each sender's run */
     size_t n[2];
 } local_t;
 
@@ -332,7 +388,7 @@ int hd__mpi_engine_both(ctx_t *c, double *xyz[2], const gidx_t *g[2], const size
 void hd__mpi_shell_free(ctx_t *c, shell_t *sh);
 int hd__mpi_interior_max(ctx_t *c, const dir_t *d, const hd__box_t *mine, const shell_t *sh, double h2,
                          const far_t *G, far_t *out);
-uint64_t hd__mpi_shell_g(const dir_t *d, const shell_t *sh, size_t k);
+uint64_t hd__mpi_shell_g(gcur_t *cu, const shell_t *sh, size_t k);
 int hd__mpi_shell_of(ctx_t *c, const dir_t *d, const hd__box_t *mine, qtree_t *q, shell_t *sh);
 
 /* ---- one direction over the partition (forward.c) ------------------------ */
@@ -365,7 +421,6 @@ typedef struct {
     hd__box_t *region;       /* K: every rank's region */
     held_t *held;            /* K: every rank's count and box a set */
     local_t loc;             /* this rank's points */
-    gidx_t gi[2];            /* their global indices */
 } spread_t;
 
 /* K = 1: each set as one view (the caller's, or packed in index order). */

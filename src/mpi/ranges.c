@@ -1,6 +1,6 @@
 /*
  * ranges.c -- the validation of a call's input and the index runs that name
- * every point (mpi_int.h's ranges_t and gidx_t).
+ * every point (mpi_int.h's ranges_t).
  *
  * Invariants.
  *  - hd__mpi_check_local refuses, before a point is read, more than
@@ -13,9 +13,10 @@
  *    global index names one point over all ranks.  Sorted by (set, rank,
  *    first index), the runs turn a point's number (its rank among its
  *    sender's points of the set in index order) into its global index:
- *    number m lies in the last run whose first number is <= m.
- *  - gidx: a local position's global index, stored (runs merged) or
- *    computed from its sender (the run it lies in) and its number.
+ *    number m lies in the last run whose first number is <= m.  Sorted by
+ *    (set, first index), with the count of the set's indices below each
+ *    (ord), they number a set's indices densely (the ordinals gidx.c
+ *    encodes).
  */
 #include "mpi_int.h"
 
@@ -49,18 +50,23 @@ void hd__mpi_ranges_free(ctx_t *c, ranges_t *rg) {
     hd__mpi_free(c, rg->all, rg->total, sizeof(range_t));
     if (rg->seg) hd__mpi_free(c, rg->seg, 2 * ((size_t)rg->K + 1), sizeof(size_t));
     hd__mpi_free(c, rg->first, rg->total, sizeof(uint64_t));
-    rg->all = NULL, rg->seg = NULL, rg->first = NULL;
+    hd__mpi_free(c, rg->bylo, rg->total, sizeof(range_t));
+    hd__mpi_free(c, rg->ord, rg->total, sizeof(uint64_t));
+    rg->all = NULL, rg->seg = NULL, rg->first = NULL, rg->bylo = NULL, rg->ord = NULL;
 }
 
 /* g[k] = the global index of point number num[k] of rank r's side s, for
- * num[] increasing. */
-void hd__mpi_ranges_globals(const ranges_t *rg, int s, int r, const uint32_t *num, size_t n, uint64_t *g) {
-    size_t i = rg->seg[(size_t)s * ((size_t)rg->K + 1) + (size_t)r];
+ * num[] increasing; *i is a run of rank r's side s at or before num[0]'s
+ * (its first: rg->seg[s (K + 1) + r]), and becomes num[n - 1]'s. */
+void hd__mpi_ranges_globals(const ranges_t *rg, int s, int r, size_t *i, const uint32_t *num, size_t n, uint64_t *g) {
+    size_t at = *i;
+    (void)s, (void)r; /* the asserts' */
     for (size_t k = 0; k < n; k++) {
-        while (num[k] - rg->first[i] > rg->all[i].hi - rg->all[i].lo) i++;
-        assert(i < rg->seg[(size_t)s * ((size_t)rg->K + 1) + (size_t)r + 1] && num[k] >= rg->first[i]);
-        g[k] = rg->all[i].lo + (num[k] - rg->first[i]);
+        while (num[k] - rg->first[at] > rg->all[at].hi - rg->all[at].lo) at++;
+        assert(at < rg->seg[(size_t)s * ((size_t)rg->K + 1) + (size_t)r + 1] && num[k] >= rg->first[at]);
+        g[k] = rg->all[at].lo + (num[k] - rg->first[at]);
     }
+    *i = at;
 }
 
 /* The global index of point number m (any) of rank r's side s. */
@@ -75,46 +81,38 @@ uint64_t hd__mpi_ranges_global(const ranges_t *rg, int s, int r, uint64_t m) {
     return rg->all[lo].lo + (m - rg->first[lo]);
 }
 
-uint64_t hd__mpi_gidx(const gidx_t *x, size_t k) {
-    if (x->g) return x->g[k];
-    int lo = 0, hi = x->K - 1;
-    while (lo < hi) { /* the last sender whose run starts at or before k */
-        int mid = lo + (hi - lo + 1) / 2;
-        if (x->start[mid] <= k) lo = mid;
-        else hi = mid - 1;
+/* The runs' orders (mpi_int.h's ranges_t): rg->all (any order, rg->total
+ * runs of rg->K ranks, no two of a side sharing an index) sorted by owner
+ * with seg and first, and bylo with ord.  Local (check_ranges runs it on
+ * every rank after the all-gather); fails only for memory. */
+int hd__mpi_ranges_index(ctx_t *c, ranges_t *rg) {
+    int K = rg->K;
+    size_t total = rg->total;
+    if (!rg->seg && !(rg->seg = hd__mpi_alloc(c, 2 * ((size_t)K + 1), sizeof(size_t))))
+        return hd__mpi_nomem(c, "index ranges", (size_t)K);
+    if (!rg->first && !(rg->first = hd__mpi_alloc(c, total, sizeof(uint64_t))))
+        return hd__mpi_nomem(c, "index ranges", total);
+    rg->bylo = hd__mpi_alloc(c, total, sizeof(range_t));
+    rg->ord = hd__mpi_alloc(c, total, sizeof(uint64_t));
+    if (!rg->bylo || !rg->ord) return hd__mpi_nomem(c, "index ranges", total);
+    memcpy(rg->bylo, rg->all, total * sizeof(range_t));
+    qsort(rg->bylo, total, sizeof(range_t), hd__mpi_by_range);
+    for (size_t i = 0; i < total; i++) {
+        int same = i > 0 && rg->bylo[i].side == rg->bylo[i - 1].side;
+        rg->ord[i] = same ? rg->ord[i - 1] + (rg->bylo[i - 1].hi - rg->bylo[i - 1].lo + 1) : 0;
     }
-    assert(k >= x->start[lo] && k < x->start[lo + 1]);
-    return hd__mpi_ranges_global(x->rg, x->side, lo, x->num[k]);
-}
-
-void hd__mpi_gcur_init(gcur_t *cu, const gidx_t *x) {
-    memset(cu, 0, sizeof *cu);
-    cu->x = x;
-    cu->r = -1;
-}
-
-/* The slow path of hd__mpi_gcur_at: the next sender, or the next index
- * run of the same sender (numbers increase within a sender's run). */
-uint64_t hd__mpi_gcur_next(gcur_t *cu, size_t k) {
-    const gidx_t *x = cu->x;
-    const ranges_t *rg = x->rg;
-    if (cu->r < 0 || k >= x->start[cu->r + 1]) {
-        int r = cu->r < 0 ? 0 : cu->r;
-        while (k >= x->start[r + 1]) r++;
-        size_t seg = (size_t)x->side * ((size_t)rg->K + 1) + (size_t)r;
-        cu->r = r;
-        cu->kend = x->start[r + 1];
-        cu->i = rg->seg[seg];
-        cu->end = rg->seg[seg + 1];
+    qsort(rg->all, total, sizeof(range_t), by_owner);
+    size_t k = 0;
+    for (int s = 0; s < 2; s++)
+        for (int r = 0; r <= K; r++) {
+            while (k < total && (rg->all[k].side < s || (rg->all[k].side == s && rg->all[k].rank < r))) k++;
+            rg->seg[(size_t)s * ((size_t)K + 1) + (size_t)r] = k;
+        }
+    for (size_t i = 0; i < total; i++) {
+        int same = i > 0 && rg->all[i].side == rg->all[i - 1].side && rg->all[i].rank == rg->all[i - 1].rank;
+        rg->first[i] = same ? rg->first[i - 1] + (rg->all[i - 1].hi - rg->all[i - 1].lo + 1) : 0;
     }
-    assert(k >= x->start[cu->r]);
-    uint64_t m = x->num[k];
-    while (m - rg->first[cu->i] > rg->all[cu->i].hi - rg->all[cu->i].lo) cu->i++;
-    assert(cu->i < cu->end && m >= rg->first[cu->i]);
-    cu->first = rg->first[cu->i];
-    cu->span = rg->all[cu->i].hi - rg->all[cu->i].lo;
-    cu->lo = rg->all[cu->i].lo;
-    return cu->lo + (m - cu->first);
+    return HD_OK;
 }
 
 /* Over all ranks, no two parts of one set share an index; rg receives
@@ -169,19 +167,8 @@ int hd__mpi_check_ranges(ctx_t *c, const input_t *in, ranges_t *rg) {
                 break;
             }
     }
-    if (rc == HD_OK) {
-        qsort(rg->all, total, sizeof(range_t), by_owner);
-        size_t k = 0;
-        for (int s = 0; s < 2; s++)
-            for (int r = 0; r <= K; r++) {
-                while (k < total && (rg->all[k].side < s || (rg->all[k].side == s && rg->all[k].rank < r))) k++;
-                rg->seg[(size_t)s * ((size_t)K + 1) + (size_t)r] = k;
-            }
-        for (size_t i = 0; i < total; i++) {
-            int same = i > 0 && rg->all[i].side == rg->all[i - 1].side && rg->all[i].rank == rg->all[i - 1].rank;
-            rg->first[i] = same ? rg->first[i - 1] + (rg->all[i - 1].hi - rg->all[i - 1].lo + 1) : 0;
-        }
-    }
+    if (rc == HD_OK) rc = hd__mpi_ranges_index(c, rg);
+    rc = hd__mpi_agree(c, rc); /* a refusal is every rank's; a failed allocation one's */
 done:
     hd__mpi_free(c, counts, 2 * (size_t)K, sizeof(int));
     return rc;

@@ -271,9 +271,10 @@ int hd__mpi_interior_max(ctx_t *c, const dir_t *d, const hd__box_t *mine, const 
     return rc;
 }
 
-/* The global index of the shell's point k. */
-uint64_t hd__mpi_shell_g(const dir_t *d, const shell_t *sh, size_t k) {
-    return hd__mpi_gidx(d->gP, sh->own_pos ? sh->own_pos[k] : k);
+/* The global index of the shell's point k, through a cursor on P's
+ * indices (the shell's points are in P's order). */
+uint64_t hd__mpi_shell_g(gcur_t *cu, const shell_t *sh, size_t k) {
+    return hd__mpi_gcur_at(cu, sh->own_pos ? sh->own_pos[k] : k);
 }
 
 int hd__mpi_shell_of(ctx_t *c, const dir_t *d, const hd__box_t *mine, qtree_t *q, shell_t *sh) {

@@ -1,0 +1,187 @@
+/*
+ * mpi_gidx.c -- the local sets' global indices of the MPI library
+ * (src/mpi/gidx.c, mpi_int.h's gidx_t): a set of indices of a side,
+ * encoded in increasing order over the side's index runs, gives back every
+ * index by position (hd__mpi_gidx) and through a cursor (hd__mpi_gcur_at)
+ * walked in order, with jumps, and backwards, with the rank whose run holds
+ * it; in less than 4 + log2(U / n) bits a point and a few words, charged to
+ * the call while held.  No MPI call is made (the context only counts
+ * bytes), so this runs without mpirun; built with the MPI library
+ * (tests/mpi.cmake).
+ */
+#include "check.h"
+#include "gen.h"
+#include "mpi/mpi_int.h"
+
+#include <stdlib.h>
+
+/* A scene: both sides' runs of K ranks and, for each side, a local set. */
+typedef struct {
+    ctx_t c;
+    ranges_t rg;
+    uint64_t *g[2];           /* the local sets' indices, increasing */
+    int *owner[2];            /* the rank of each one's run */
+    size_t n[2];
+} scene_t;
+
+static void scene_free(scene_t *sc) {
+    hd__mpi_ranges_free(&sc->c, &sc->rg);
+    for (int s = 0; s < 2; s++) {
+        free(sc->g[s]);
+        free(sc->owner[s]);
+    }
+    CHECK_EQ(sc->c.cur, 0); /* every byte given back */
+}
+
+/* The runs (lo, hi, side, rank) as ranges_t, and each side's local set:
+ * every index of a run with probability keep (1: all of them). */
+static void scene_make(scene_t *sc, int K, const range_t *runs, size_t nruns, double keep, gen_rng_t *rng) {
+    memset(sc, 0, sizeof *sc);
+    sc->rg.K = K;
+    sc->rg.total = nruns;
+    sc->rg.all = hd__mpi_alloc(&sc->c, nruns, sizeof(range_t));
+    memcpy(sc->rg.all, runs, nruns * sizeof(range_t));
+    CHECK_RC(hd__mpi_ranges_index(&sc->c, &sc->rg), HD_OK);
+    for (int s = 0; s < 2; s++) {
+        size_t a = sc->rg.seg[(size_t)s * ((size_t)K + 1)], b = sc->rg.seg[(size_t)s * ((size_t)K + 1) + (size_t)K],
+               cap = 0;
+        for (size_t i = a; i < b; i++) cap += (size_t)(sc->rg.bylo[i].hi - sc->rg.bylo[i].lo + 1);
+        sc->g[s] = malloc((cap ? cap : 1) * sizeof(uint64_t));
+        sc->owner[s] = malloc((cap ? cap : 1) * sizeof(int));
+        for (size_t i = a; i < b; i++) /* by first index: the set comes out increasing */
+            for (uint64_t g = sc->rg.bylo[i].lo;; g++) {
+                if (keep >= 1 || gen_unit(rng) < keep) {
+                    sc->g[s][sc->n[s]] = g;
+                    sc->owner[s][sc->n[s]++] = sc->rg.bylo[i].rank;
+                }
+                if (g == sc->rg.bylo[i].hi) break;
+            }
+    }
+}
+
+/* Side s's set encoded, then read back every way. */
+static void check_side(scene_t *sc, int s, gen_rng_t *rng) {
+    size_t n = sc->n[s];
+    const uint64_t *g = sc->g[s];
+    size_t before = sc->c.cur;
+    gidx_t x;
+    CHECK_RC(hd__mpi_gidx_init(&sc->c, &x, &sc->rg, s, n), HD_OK);
+    for (size_t k = 0, m; k < n; k += m) /* in pieces of any length, as the exchange's runs */
+        hd__mpi_gidx_put_indices(&x, k, g + k, m = 1 + (size_t)(gen_u64(rng) % (n - k)));
+    /* charged while held, and small: n l low bits, n ones and U >> l < 2n
+     * zeros, a sample word per 64 points (l = floor(log2(U / n)), U the
+     * side's indices), and at most a word of rounding in each part */
+    CHECK_EQ(sc->c.cur - before, x.words * sizeof(uint64_t));
+    uint64_t U = 0;
+    for (size_t i = 0; i < x.nrun; i++) U += x.run[i].hi - x.run[i].lo + 1;
+    int l = 0;
+    while (n && (U >> (l + 1)) >= n) l++;
+    CHECK_EQ(x.l, l);
+    CHECK((uint64_t)x.words * 64 <= (uint64_t)n * (uint64_t)(l + 4) + 3 * 64);
+    /* every position at random access */
+    for (size_t k = 0; k < n && !hdt_failed(); k++) CHECK_EQ(hd__mpi_gidx(&x, k), g[k]);
+    /* the cursor in order, each position twice (the second from the
+     * cursor's memory), with its run's rank */
+    gcur_t cu;
+    hd__mpi_gcur_init(&cu, &x);
+    for (size_t k = 0; k < n && !hdt_failed(); k++) {
+        CHECK_EQ(hd__mpi_gcur_at(&cu, k), g[k]);
+        CHECK_EQ(hd__mpi_gcur_at(&cu, k), g[k]);
+        CHECK_EQ(hd__mpi_gcur_rank(&cu), sc->owner[s][k]);
+    }
+    /* forward jumps, short (stepped) and long (selected) */
+    hd__mpi_gcur_init(&cu, &x);
+    for (size_t k = n ? gen_u64(rng) % n : 0; k < n && !hdt_failed();) {
+        CHECK_EQ(hd__mpi_gcur_at(&cu, k), g[k]);
+        CHECK_EQ(hd__mpi_gcur_rank(&cu), sc->owner[s][k]);
+        uint64_t r = gen_u64(rng) % 4;
+        k += r == 0 ? 1 : r == 1 ? gen_u64(rng) % 70 : r == 2 ? 250 + gen_u64(rng) % 10 : gen_u64(rng) % 5000;
+    }
+    /* anywhere, backwards included */
+    hd__mpi_gcur_init(&cu, &x);
+    for (int t = 0; t < 2000 && n && !hdt_failed(); t++) {
+        size_t k = (size_t)(gen_u64(rng) % n);
+        CHECK_EQ(hd__mpi_gcur_at(&cu, k), g[k]);
+        CHECK_EQ(hd__mpi_gcur_rank(&cu), sc->owner[s][k]);
+    }
+    hd__mpi_gidx_free(&sc->c, &x);
+    CHECK_EQ(sc->c.cur, before);
+}
+
+static void check_scene(int K, const range_t *runs, size_t nruns, double keep, uint64_t seed) {
+    gen_rng_t rng;
+    gen_seed(&rng, seed);
+    scene_t sc;
+    scene_make(&sc, K, runs, nruns, keep, &rng);
+    for (int s = 0; s < 2 && !hdt_failed(); s++) {
+        CONTEXT("seed=%llu K=%d runs=%zu keep=%g side=%d n=%zu", (unsigned long long)seed, K, nruns, keep, s,
+                sc.n[s]);
+        check_side(&sc, s, &rng);
+    }
+    scene_free(&sc);
+}
+
+TEST(an_empty_set_holds_nothing_and_frees_cleanly) {
+    range_t runs[] = {{0, 999, 0, 0}, {5, 5, 1, 1}};
+    check_scene(2, runs, 2, 0.0, 1);
+}
+
+TEST(one_point_among_many_is_found) {
+    gen_rng_t rng;
+    gen_seed(&rng, 2);
+    range_t runs[] = {{100, 100099, 0, 0}, {0, 0, 1, 0}};
+    scene_t sc;
+    scene_make(&sc, 1, runs, 2, 0.0, &rng);
+    sc.g[0][0] = 77777, sc.owner[0][0] = 0, sc.n[0] = 1; /* one point of A */
+    CONTEXT("one point of A at 77777 of 100 .. 100099");
+    check_side(&sc, 0, &rng);
+    sc.g[0][0] = 100099; /* the last index of all */
+    check_side(&sc, 0, &rng);
+    sc.g[1][0] = 0, sc.owner[1][0] = 0, sc.n[1] = 1; /* B's only index */
+    check_side(&sc, 1, &rng);
+    scene_free(&sc);
+}
+
+TEST(all_points_of_a_side_on_one_rank_take_no_low_bits) {
+    range_t runs[] = {{0, 9999, 0, 0}, {10000, 20000, 0, 1}, {30000, 30000, 0, 0}, {0, 4095, 1, 1}};
+    check_scene(2, runs, 4, 1.0, 3); /* every index of both sides: l = 0 */
+}
+
+TEST(sparse_huge_offsets_near_two_to_the_63_and_the_top) {
+    uint64_t top = UINT64_MAX - 1; /* the largest index a part may hold */
+    range_t runs[] = {
+        {(UINT64_C(1) << 63) - 1000, (UINT64_C(1) << 63) + 1000, 0, 2}, /* across 2^63 */
+        {(UINT64_C(1) << 63) + 5000, (UINT64_C(1) << 63) + 5000, 0, 0}, /* a gap, one index */
+        {UINT64_C(1) << 40, (UINT64_C(1) << 40) + 3000, 0, 1},
+        {top - 2000, top, 0, 1},
+        {0, 63, 0, 0},
+        {(UINT64_C(1) << 62), (UINT64_C(1) << 62) + 9000, 1, 0},
+        {top - 10, top, 1, 2},
+    };
+    for (uint64_t seed = 10; seed < 16; seed++) {
+        double keep = seed == 10 ? 1.0 : 1.0 / (double)(1u << (seed - 10) * 2);
+        check_scene(3, runs, sizeof runs / sizeof *runs, keep, seed);
+    }
+}
+
+/* Random runs: K ranks, runs of random lengths and gaps (gaps up to 2^50),
+ * owned by random ranks, kept at a random density. */
+TEST(random_runs_and_densities_read_back_exactly) {
+    for (uint64_t seed = 100; seed < 160 && !hdt_failed(); seed++) {
+        gen_rng_t rng;
+        gen_seed(&rng, seed);
+        int K = 1 + (int)(gen_u64(&rng) % 9);
+        size_t nruns = 1 + gen_u64(&rng) % 40, maxlen = 1 + gen_u64(&rng) % 3000;
+        range_t *runs = malloc(nruns * sizeof *runs);
+        uint64_t at[2] = {gen_u64(&rng) % 2 ? 0 : gen_u64(&rng) >> 2, gen_u64(&rng) >> 3};
+        for (size_t i = 0; i < nruns; i++) {
+            int s = (int)(gen_u64(&rng) % 2);
+            uint64_t len = 1 + gen_u64(&rng) % maxlen, gap = gen_u64(&rng) % 3 ? gen_u64(&rng) % 5 : gen_u64(&rng) >> 14;
+            runs[i] = (range_t){at[s], at[s] + len - 1, s, (int)(gen_u64(&rng) % (uint64_t)K)};
+            at[s] += len + gap;
+        }
+        double keep = gen_u64(&rng) % 4 == 0 ? 1.0 : gen_unit(&rng) * gen_unit(&rng);
+        check_scene(K, runs, nruns, keep, seed);
+        free(runs);
+    }
+}
