@@ -89,6 +89,7 @@ typedef struct {
     void *map;
     size_t map_len;
     int cut; /* cut from one of the pool's chunks: freed with the pool */
+    size_t huge; /* the array's first bytes mapped in 2 MiB pages (huge_map) */
 } reuse_head_t;
 
 static reuse_head_t *reuse_head(const void *p) { return (reuse_head_t *)((unsigned char *)p - REUSE_HEADER); }
@@ -140,6 +141,7 @@ static void *huge_map(size_t bytes, int prefault) {
     h->cut = 0;
     h->map = lo;
     h->map_len = (size_t)(hi - lo);
+    h->huge = huge;
     return a;
 #else
     (void)bytes, (void)prefault;
@@ -283,8 +285,15 @@ void hd__reuse_shrink(hd__reuse_t *pool, void *p, size_t bytes) {
     long page = sysconf(_SC_PAGESIZE);
     if (!h->map || bytes > h->cap || page <= 0) return;
     uintptr_t pg = (uintptr_t)page, lo = (uintptr_t)h->map, end = lo + h->map_len;
-    uintptr_t keep = ((uintptr_t)p + bytes + pg - 1) & ~(pg - 1);
+    /* A 2 MiB page is never cut: unmapping part of it splits it into small
+     * pages, and each of those then costs a fault (of the hypervisor, on
+     * this virtual machine) when next touched, which made the trees' build
+     * slower (docs/benchmarks.md, "The engine's memory peak").  So the pages
+     * kept end at a 2 MiB boundary within the huge part. */
+    size_t round = bytes < h->huge ? HUGE_ALIGN : (size_t)pg;
+    uintptr_t keep = ((uintptr_t)p + bytes + round - 1) & ~(uintptr_t)(round - 1);
     h->cap = bytes;
+    if (h->huge > keep - (uintptr_t)p) h->huge = keep - (uintptr_t)p;
     if (keep >= end) return;
     munmap((void *)keep, end - keep);
     h->map_len = keep - lo;

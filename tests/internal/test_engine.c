@@ -722,9 +722,10 @@ TEST(subsets_out_of_order_or_with_a_stranger_are_left_to_the_other_paths) {
  * set's sort alone, the smaller's sort beside the larger's permutation and
  * boxes, or the two finished trees at 13.4), plus at most two 2 MiB chunks
  * that arrays under about 1.9 MB are cut from; for sets of one size, the
- * finished trees' 13.4 bytes a point and a chunk (before the sorts were set
- * apart from the trees, 22 bytes a point).  hd__engine_peak_bytes reports
- * it once, then 0.  Uniform clouds, equal and 10:1 either way. */
+ * finished trees' 13.4 bytes a point with their blocks' last 2 MiB pages
+ * kept whole: at most 14 bytes a point and a chunk (before the sorts were
+ * set apart from the trees, 22).  hd__engine_peak_bytes reports it once, then 0.  Uniform clouds,
+ * equal and 10:1 either way. */
 TEST(the_tree_path_holds_at_most_16_bytes_a_point_and_reports_it) {
     static const size_t sizes[3][2] = {{300000, 300000}, {300000, 30000}, {30000, 300000}};
     for (int c = 0; c < 3; c++) {
