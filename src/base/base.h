@@ -98,9 +98,9 @@ void hd__reuse_trim(hd__reuse_t *pool);
  * one is mapped. */
 void *hd__reuse_take(hd__reuse_t *pool, size_t n, size_t size);
 /* Block p of the set (or of none: NULL) keeps only its first `bytes`
- * (at most what it was asked for): the whole pages after them go back to
- * the system.  A no-op for blocks that are not mapped on their own (cut
- * from a chunk, or malloc'ed). */
+ * (at most what it was asked for): the pages after them go back to the
+ * system, but a 2 MiB page only whole.  A no-op for blocks that are not
+ * mapped on their own (cut from a chunk, or malloc'ed). */
 void hd__reuse_shrink(hd__reuse_t *pool, void *p, size_t bytes);
 
 /* Map the pages of the fresh block p[0..bytes) now, in one call, rather

@@ -38,7 +38,8 @@
  * per tree node (about one per bucket): 13.375 bytes per point, in two
  * blocks.  The permutation, the first keys and the boxes (7.4 bytes per
  * point) are written into the sort buffer the sort leaves spare, whose
- * pages past them go back to the system (hd__reuse_shrink); the quantised
+ * pages past them go back to the system (hd__reuse_shrink; 2 MiB pages
+ * only whole, so up to 2 MiB a block stays); the quantised
  * copy takes a kept sort buffer when one fits, shrunk the same way.  The
  * engine builds its two trees in two halves (hd__tree_build_pair): both
  * sorts first, the larger set's first, each leaving only its 7.4 bytes per

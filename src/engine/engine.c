@@ -790,9 +790,8 @@ static int engine_run(engine_t *e, hd__engine_force_t force, hd_result_t out[2],
     if (e->use_tree) {
         /* The grids give way to the trees (memory stays under 16 bytes per
          * point of both sets: hd__tree_build_pair); the maxima found so far
-         * stay valid.  Both trees' Morton
-         * grids have the same cell size, and the walk's neighbour scans rely
-         * on the two curves lining up.  When B's box is A's box moved (both
+         * stay valid.  Both trees' Morton grids have the same cell size, and
+         * the walk's neighbour scans rely on the two curves lining up.  When B's box is A's box moved (both
          * corners by the same vector, within 1e-4 of the extent, and by more
          * than that), B looks like a moved copy: each grid is centred on its
          * own set's centroid, so that the copy lists its points in nearly
