@@ -80,12 +80,28 @@ typedef struct hd__reuse {
     void *chunk[HD__REUSE_CHUNKS]; /* 2 MiB blocks that middle-sized arrays are cut from */
     int n_chunks;
     size_t chunk_used; /* bytes cut from the last chunk */
+    int cut_out;       /* blocks cut from the chunks and in use (not kept) */
+    size_t held;       /* bytes the set holds from the system: its blocks in use or kept, its chunks */
+    size_t peak;       /* the most it held at once since hd__reuse_init (kept by hd__reuse_free) */
 } hd__reuse_t;
 void hd__reuse_init(hd__reuse_t *pool);
 /* n * size bytes (checked for overflow), aligned as malloc's; NULL when out of memory. */
 void *hd__reuse_get(hd__reuse_t *pool, size_t n, size_t size);
 void hd__reuse_put(hd__reuse_t *pool, void *p); /* p may be NULL */
 void hd__reuse_free(hd__reuse_t *pool);          /* frees every kept block */
+/* Give the kept blocks back to the system (and the chunks, when no block
+ * cut from them is in use): for a caller whose next requests cannot reuse
+ * them, or could only by holding them through a larger peak.  NULL: no-op. */
+void hd__reuse_trim(hd__reuse_t *pool);
+/* hd__reuse_get, but the set first gives back every kept block that this
+ * request does not get: no block it cannot reuse is held while a fresh
+ * one is mapped. */
+void *hd__reuse_take(hd__reuse_t *pool, size_t n, size_t size);
+/* Block p of the set (or of none: NULL) keeps only its first `bytes`
+ * (at most what it was asked for): the pages after them go back to the
+ * system, but a 2 MiB page only whole.  A no-op for blocks that are not
+ * mapped on their own (cut from a chunk, or malloc'ed). */
+void hd__reuse_shrink(hd__reuse_t *pool, void *p, size_t bytes);
 
 /* Map the pages of the fresh block p[0..bytes) now, in one call, rather
  * than one page fault per page as it is first written (a fault costs far

@@ -15,6 +15,14 @@
  * already touched are written again instead of fresh ones.  Requests below
  * REUSE_SMALL bytes are not worth keeping and are freed at once.
  *
+ * What a set holds from the system (its blocks in use or kept, its chunks)
+ * is counted in `held`, and its most in `peak`, which is the engine's
+ * memory high-water mark (hd__engine_peak_bytes).  A caller that knows the
+ * kept blocks will not serve it gives them back (hd__reuse_trim,
+ * hd__reuse_take), and one that uses only the start of a block gives back
+ * the pages after it (hd__reuse_shrink): that, not reuse, is what bounds
+ * the engine's peak (docs/engine.md, "Threads and memory").
+ *
  * hd__prefault asks the kernel to map a fresh block's pages in one call
  * (madvise MADV_POPULATE_WRITE) instead of one page fault per page on first
  * write; only for arrays that are written whole, since it maps every page.
@@ -81,6 +89,7 @@ typedef struct {
     void *map;
     size_t map_len;
     int cut; /* cut from one of the pool's chunks: freed with the pool */
+    size_t huge; /* the array's first bytes mapped in 2 MiB pages (huge_map) */
 } reuse_head_t;
 
 static reuse_head_t *reuse_head(const void *p) { return (reuse_head_t *)((unsigned char *)p - REUSE_HEADER); }
@@ -132,6 +141,7 @@ static void *huge_map(size_t bytes, int prefault) {
     h->cut = 0;
     h->map = lo;
     h->map_len = (size_t)(hi - lo);
+    h->huge = huge;
     return a;
 #else
     (void)bytes, (void)prefault;
@@ -139,9 +149,24 @@ static void *huge_map(size_t bytes, int prefault) {
 #endif
 }
 
-static void reuse_release(void *p) {
+/* The bytes a block takes from the system: its mapping, or its malloc'ed
+ * header and array.  A block cut from a chunk takes nothing of its own:
+ * the chunk is counted once, as it is mapped. */
+static size_t reuse_span(const void *p) {
+    const reuse_head_t *h = reuse_head(p);
+    return h->cut ? 0 : h->map ? h->map_len : REUSE_HEADER + h->cap;
+}
+
+static void reuse_held(hd__reuse_t *pool, size_t more) {
+    if (!pool) return;
+    pool->held += more;
+    if (pool->held > pool->peak) pool->peak = pool->held;
+}
+
+static void reuse_release(hd__reuse_t *pool, void *p) {
     reuse_head_t *h = reuse_head(p);
     if (h->cut) return;
+    if (pool) pool->held -= reuse_span(p);
     if (h->map) munmap(h->map, h->map_len);
     else free(h);
 }
@@ -162,10 +187,12 @@ static void *chunk_get(hd__reuse_t *pool, size_t bytes) {
         void *c = huge_map(HUGE_ALIGN, 0);
         if (!c) return NULL;
         pool->chunk[pool->n_chunks++] = c;
+        reuse_held(pool, reuse_span(c));
         pool->chunk_used = 0;
     }
     unsigned char *p = (unsigned char *)pool->chunk[pool->n_chunks - 1] + pool->chunk_used + REUSE_HEADER;
     pool->chunk_used += need;
+    pool->cut_out++;
     reuse_head(p)->cut = 1;
     return p;
 }
@@ -174,22 +201,32 @@ void hd__reuse_init(hd__reuse_t *pool) {
     pool->n = 0;
     pool->n_chunks = 0;
     pool->chunk_used = 0;
+    pool->cut_out = 0;
+    pool->held = 0;
+    pool->peak = 0;
 }
 
 static size_t reuse_cap(const void *p) { return reuse_head(p)->cap; }
+
+/* The kept block that a request of `bytes` gets (best fit), or -1. */
+static int reuse_best(const hd__reuse_t *pool, size_t bytes) {
+    int best = -1;
+    for (int k = 0; pool && bytes >= REUSE_SMALL && k < pool->n; k++) {
+        size_t cap = reuse_cap(pool->block[k]);
+        if (cap >= bytes && cap / 3 <= bytes && (best < 0 || cap < reuse_cap(pool->block[best]))) best = k;
+    }
+    return best;
+}
 
 void *hd__reuse_get(hd__reuse_t *pool, size_t n, size_t size) {
     if (hd__mul_overflows(n, size) || n * size > SIZE_MAX - REUSE_HEADER) return NULL;
     size_t bytes = n * size;
     if (pool && bytes >= REUSE_SMALL) {
-        int best = -1;
-        for (int k = 0; k < pool->n; k++) {
-            size_t cap = reuse_cap(pool->block[k]);
-            if (cap >= bytes && cap / 3 <= bytes && (best < 0 || cap < reuse_cap(pool->block[best]))) best = k;
-        }
+        int best = reuse_best(pool, bytes);
         if (best >= 0) {
             void *p = pool->block[best];
             pool->block[best] = pool->block[--pool->n];
+            pool->cut_out += reuse_head(p)->cut;
             return p;
         }
     }
@@ -205,22 +242,70 @@ void *hd__reuse_get(hd__reuse_t *pool, size_t n, size_t size) {
         reuse_head(p)->cut = 0;
     }
     reuse_head(p)->cap = bytes;
+    reuse_held(pool, reuse_span(p));
     return p;
 }
 
 void hd__reuse_put(hd__reuse_t *pool, void *p) {
     if (!p) return;
+    if (pool) pool->cut_out -= reuse_head(p)->cut;
     if (pool && pool->n < HD__REUSE_KEEP && reuse_cap(p) >= REUSE_SMALL) {
         pool->block[pool->n++] = p;
         return;
     }
-    reuse_release(p);
+    reuse_release(pool, p);
+}
+
+void hd__reuse_trim(hd__reuse_t *pool) {
+    if (!pool) return;
+    int kept = 0;
+    for (int k = 0; k < pool->n; k++) {
+        if (reuse_head(pool->block[k])->cut && pool->cut_out) pool->block[kept++] = pool->block[k];
+        else reuse_release(pool, pool->block[k]);
+    }
+    pool->n = kept;
+    if (pool->cut_out) return;
+    for (int k = 0; k < pool->n_chunks; k++) reuse_release(pool, pool->chunk[k]);
+    pool->n_chunks = 0;
+    pool->chunk_used = 0;
+}
+
+void *hd__reuse_take(hd__reuse_t *pool, size_t n, size_t size) {
+    if (!pool || hd__mul_overflows(n, size)) return hd__reuse_get(pool, n, size);
+    int best = reuse_best(pool, n * size);
+    void *keep = best >= 0 ? pool->block[best] : NULL;
+    if (keep) pool->block[best] = pool->block[--pool->n];
+    hd__reuse_trim(pool);
+    if (keep) pool->block[pool->n++] = keep; /* the one kept block left */
+    return hd__reuse_get(pool, n, size);
+}
+
+void hd__reuse_shrink(hd__reuse_t *pool, void *p, size_t bytes) {
+    reuse_head_t *h = reuse_head(p);
+    long page = sysconf(_SC_PAGESIZE);
+    if (!h->map || bytes > h->cap || page <= 0) return;
+    uintptr_t pg = (uintptr_t)page, lo = (uintptr_t)h->map, end = lo + h->map_len;
+    /* A 2 MiB page is never cut: unmapping part of it splits it into small
+     * pages, and each of those then costs a fault (of the hypervisor, on
+     * this virtual machine) when next touched, which made the trees' build
+     * slower (docs/benchmarks.md, "The engine's memory peak").  So the pages
+     * kept end at a 2 MiB boundary within the huge part. */
+    size_t round = bytes < h->huge ? HUGE_ALIGN : (size_t)pg;
+    uintptr_t keep = ((uintptr_t)p + bytes + round - 1) & ~(uintptr_t)(round - 1);
+    h->cap = bytes;
+    if (h->huge > keep - (uintptr_t)p) h->huge = keep - (uintptr_t)p;
+    if (keep >= end) return;
+    munmap((void *)keep, end - keep);
+    h->map_len = keep - lo;
+    if (pool) pool->held -= end - keep;
 }
 
 void hd__reuse_free(hd__reuse_t *pool) {
-    for (int k = 0; k < pool->n; k++) reuse_release(pool->block[k]);
-    for (int k = 0; k < pool->n_chunks; k++) reuse_release(pool->chunk[k]);
+    for (int k = 0; k < pool->n; k++) reuse_release(pool, pool->block[k]);
+    for (int k = 0; k < pool->n_chunks; k++) reuse_release(pool, pool->chunk[k]);
+    size_t peak = pool->peak;
     hd__reuse_init(pool);
+    pool->peak = peak; /* what the call held at most, for its caller */
 }
 
 void hd__arena_init(hd__arena_t *a, size_t block_size) {

@@ -34,8 +34,20 @@
  *
  * Memory.  The sort uses two arrays of 8 bytes per point; the result keeps
  * 4 bytes per point for the permutation, 6 for the quantised copy, 56 per
- * bucket of 32 for its box and err, and 48 per tree node (about one per
- * bucket): 13.25 bytes per point.
+ * bucket of 32 for its box and err, 4 per bucket for its first key, and 48
+ * per tree node (about one per bucket): 13.375 bytes per point, in two
+ * blocks.  The permutation, the first keys and the boxes (7.4 bytes per
+ * point) are written into the sort buffer the sort leaves spare, whose
+ * pages past them go back to the system (hd__reuse_shrink; 2 MiB pages
+ * only whole, so up to 2 MiB a block stays); the quantised
+ * copy takes a kept sort buffer when one fits, shrunk the same way.  The
+ * engine builds its two trees in two halves (hd__tree_build_pair): both
+ * sorts first, the larger set's first, each leaving only its 7.4 bytes per
+ * point, then both quantised copies and boxes.  So at no time are more
+ * than max(16 n0, 7.4 n0 + 16 n1, 13.375 (n0 + n1)) bytes held (n0 the
+ * larger set), at most 16 bytes per point of both sets, plus pages lost to
+ * rounding and the pool's chunks; on sets of one size, the finished trees'
+ * 13.375.
  */
 #include "engine/engine.h"
 
@@ -251,22 +263,30 @@ static void node_boxes(void *vctx, size_t task, int worker) {
 
 /* ---- the build ---------------------------------------------------------------- */
 
+/* A tree's arrays live in two blocks: perm, then fkey, bucket and nodes
+ * (written into the buffer the sort left spare, offsets rounded up to 64
+ * bytes), and q alone. */
+#define ALIGN64(x) (((x) + 63) & ~(size_t)63)
+
+static size_t node_count(const hd__tree_t *t) {
+    return t->levels > 1 ? t->off[t->levels - 1] + 1 : 0;
+}
+
+static size_t fkey_at(const hd__tree_t *t) { return ALIGN64(t->n * sizeof *t->perm); }
+static size_t bucket_at(const hd__tree_t *t) { return ALIGN64(fkey_at(t) + t->nb * sizeof *t->fkey); }
+static size_t nodes_at(const hd__tree_t *t) { return ALIGN64(bucket_at(t) + t->nb * sizeof *t->bucket); }
+static size_t perm_bytes(const hd__tree_t *t) { return nodes_at(t) + node_count(t) * sizeof *t->nodes; }
+static size_t q_bytes(const hd__tree_t *t) { return t->nb * 3 * HD__BUCKET * sizeof *t->q; }
+
 void hd__tree_free(hd__tree_t *t) {
     if (!t) return;
-    hd__reuse_put(t->pool, t->perm);
+    hd__reuse_put(t->pool, t->perm); /* and fkey, bucket, nodes */
     hd__reuse_put(t->pool, t->q);
-    hd__reuse_put(t->pool, t->bucket);
-    hd__reuse_put(t->pool, t->nodes);
-    hd__reuse_put(t->pool, t->fkey);
     t->fkey = NULL;
     t->perm = NULL;
     t->q = NULL;
     t->bucket = NULL;
     t->nodes = NULL;
-}
-
-static size_t node_count(const hd__tree_t *t) {
-    return t->levels > 1 ? t->off[t->levels - 1] + 1 : 0;
 }
 
 size_t hd__tree_memory(const hd__tree_t *t) {
@@ -275,8 +295,16 @@ size_t hd__tree_memory(const hd__tree_t *t) {
            node_count(t) * sizeof *t->nodes;
 }
 
-int hd__tree_build(hd__tree_t *t, const hd__src_t *src, size_t n, const hd__box_t *grid_box,
-                   int threads, hd__reuse_t *pool, hd_error_t *err) {
+/* The first half of a build: the keys, their sort, and from them perm and
+ * fkey.  The sort's two buffers are the largest arrays of the build; the
+ * permutation is written into the one the sort left spare, which then keeps
+ * only perm, fkey and room for the boxes (hd__reuse_shrink; 7.4 of its 8
+ * bytes a point), and the other goes back to the pool.  The first request
+ * takes the block the previous sort kept, if it fits, and gives back any
+ * other (hd__reuse_take): nothing the build cannot use is held through
+ * it. */
+static int tree_sort(hd__tree_t *t, const hd__src_t *src, size_t n, const hd__box_t *grid_box,
+                     int threads, hd__reuse_t *pool, hd_error_t *err) {
     memset(t, 0, sizeof *t);
     t->pool = pool;
     if (n == 0) return hd__err(err, HD_EEMPTY, "empty point set");
@@ -300,8 +328,11 @@ int hd__tree_build(hd__tree_t *t, const hd__src_t *src, size_t n, const hd__box_
     kc.src = src;
     kc.n = n;
     size_t slices = (n + SLICE - 1) / SLICE;
-    uint64_t *keys = hd__reuse_get(pool, n, sizeof *keys);
-    uint64_t *tmp = hd__reuse_get(pool, n, sizeof *tmp);
+    /* n <= UINT32_MAX: none of these sizes overflows. */
+    size_t words = perm_bytes(t) / sizeof(uint64_t) + 1;
+    if (words < n) words = n;
+    uint64_t *keys = hd__reuse_take(pool, words, sizeof *keys);
+    uint64_t *tmp = hd__reuse_get(pool, words, sizeof *tmp);
     kc.part_box = hd__malloc_array(slices, sizeof *kc.part_box);
     int rc = HD_OK;
     if (!keys || !tmp || !kc.part_box) {
@@ -333,40 +364,18 @@ int hd__tree_build(hd__tree_t *t, const hd__src_t *src, size_t n, const hd__box_
         }
         s = e;
     }
-    hd__reuse_put(pool, tmp);
+    /* tmp is spare now: perm and fkey go there, read from the sorted keys. */
+    t->perm = (uint32_t *)tmp;
+    t->fkey = (uint32_t *)((unsigned char *)tmp + fkey_at(t));
+    t->bucket = (hd__bucket_t *)((unsigned char *)tmp + bucket_at(t));
+    t->nodes = (hd__box_t *)((unsigned char *)tmp + nodes_at(t));
     tmp = NULL;
-    t->perm = hd__reuse_get(pool, n, sizeof *t->perm);
-    if (!t->perm) {
-        rc = HD_ENOMEM;
-        goto done;
-    }
     for (size_t k = 0; k < n; k++) {
         t->perm[k] = (uint32_t)keys[k];
         assert(t->perm[k] < n);
     }
-    t->fkey = hd__reuse_get(pool, t->nb, sizeof *t->fkey);
-    if (!t->fkey) {
-        rc = HD_ENOMEM;
-        goto done;
-    }
     for (size_t b = 0; b < t->nb; b++) t->fkey[b] = (uint32_t)(keys[b * HD__BUCKET] >> 32);
-    hd__reuse_put(pool, keys);
-    keys = NULL;
-    t->q = hd__reuse_get(pool, t->nb, 3 * HD__BUCKET * sizeof *t->q);
-    t->bucket = hd__reuse_get(pool, t->nb, sizeof *t->bucket);
-    t->nodes = hd__reuse_get(pool, node_count(t), sizeof *t->nodes);
-    if (!t->q || !t->bucket || !t->nodes) {
-        rc = HD_ENOMEM;
-        goto done;
-    }
-    boxes_ctx bc;
-    bc.t = t;
-    bc.level = 0;
-    hd__parallel_for(threads, (t->nb + BOX_TASK - 1) / BOX_TASK, bucket_task, &bc);
-    for (int l = 1; l < t->levels; l++) {
-        bc.level = l;
-        hd__parallel_for(threads, (t->count[l] + BOX_TASK - 1) / BOX_TASK, node_boxes, &bc);
-    }
+    hd__reuse_shrink(pool, t->perm, perm_bytes(t));
 done:
     hd__reuse_put(pool, keys);
     hd__reuse_put(pool, tmp);
@@ -376,4 +385,47 @@ done:
         return hd__err(err, rc, "cannot allocate the index of %zu points", n);
     }
     return HD_OK;
+}
+
+/* The second half: the quantised copy and the boxes, from perm.  q takes
+ * the block kept from a sort when one fits (given back beyond q's size),
+ * and any other kept block is given back (hd__reuse_take). */
+static int tree_finish(hd__tree_t *t, int threads, hd_error_t *err) {
+    hd__reuse_t *pool = t->pool;
+    if (threads < 1) threads = 1;
+    t->q = hd__reuse_take(pool, q_bytes(t), 1);
+    if (!t->q) {
+        hd__tree_free(t);
+        return hd__err(err, HD_ENOMEM, "cannot allocate the index of %zu points", t->n);
+    }
+    hd__reuse_shrink(pool, t->q, q_bytes(t));
+    boxes_ctx bc;
+    bc.t = t;
+    bc.level = 0;
+    hd__parallel_for(threads, (t->nb + BOX_TASK - 1) / BOX_TASK, bucket_task, &bc);
+    for (int l = 1; l < t->levels; l++) {
+        bc.level = l;
+        hd__parallel_for(threads, (t->count[l] + BOX_TASK - 1) / BOX_TASK, node_boxes, &bc);
+    }
+    return HD_OK;
+}
+
+int hd__tree_build(hd__tree_t *t, const hd__src_t *src, size_t n, const hd__box_t *grid_box,
+                   int threads, hd__reuse_t *pool, hd_error_t *err) {
+    int rc = tree_sort(t, src, n, grid_box, threads, pool, err);
+    return rc ? rc : tree_finish(t, threads, err);
+}
+
+int hd__tree_build_pair(hd__tree_t t[2], const hd__src_t src[2], const size_t n[2],
+                        const hd__box_t grid_box[2], int threads, hd__reuse_t *pool, hd_error_t *err) {
+    memset(t, 0, 2 * sizeof *t);
+    hd__reuse_trim(pool);
+    const int order[2] = {n[1] > n[0], n[1] <= n[0]}; /* the larger set first */
+    int rc = HD_OK;
+    for (int j = 0; j < 2 && rc == HD_OK; j++)
+        rc = tree_sort(&t[order[j]], &src[order[j]], n[order[j]], &grid_box[order[j]], threads, pool, err);
+    for (int j = 0; j < 2 && rc == HD_OK; j++) rc = tree_finish(&t[order[j]], threads, err);
+    if (rc)
+        for (int k = 0; k < 2; k++) hd__tree_free(&t[k]);
+    return rc;
 }

@@ -687,6 +687,15 @@ typedef struct {
     hd__reuse_t pool;      /* the grids' and trees' arrays, reused as they are freed */
 } engine_t;
 
+/* The pool's peak of this thread's last call (hd__engine_peak_bytes). */
+static _Thread_local size_t last_peak;
+
+size_t hd__engine_peak_bytes(void) {
+    size_t p = last_peak;
+    last_peak = 0;
+    return p;
+}
+
 static void engine_free(engine_t *e) {
     if (e->have_grid)
         for (int k = 0; k < 2; k++) hd__grid_free(&e->grid[k]);
@@ -695,6 +704,7 @@ static void engine_free(engine_t *e) {
     for (int d = 0; d < e->max_ready; d++) hd__max_destroy(&e->max[d]);
     hd__pairs_free(&e->pairs);
     hd__reuse_free(&e->pool);
+    last_peak = e->pool.peak;
     e->have_grid = e->have_tree = e->max_ready = 0;
 }
 
@@ -779,9 +789,9 @@ static int engine_run(engine_t *e, hd__engine_force_t force, hd_result_t out[2],
     if (force != HD__ENGINE_PLANNED) e->use_tree = force == HD__ENGINE_FORCE_TREES;
     if (e->use_tree) {
         /* The grids give way to the trees (memory stays under 16 bytes per
-         * point); the maxima found so far stay valid.  Both trees' Morton
-         * grids have the same cell size, and the walk's neighbour scans rely
-         * on the two curves lining up.  When B's box is A's box moved (both
+         * point of both sets: hd__tree_build_pair); the maxima found so far
+         * stay valid.  Both trees' Morton grids have the same cell size, and
+         * the walk's neighbour scans rely on the two curves lining up.  When B's box is A's box moved (both
          * corners by the same vector, within 1e-4 of the extent, and by more
          * than that), B looks like a moved copy: each grid is centred on its
          * own set's centroid, so that the copy lists its points in nearly
@@ -822,13 +832,8 @@ static int engine_run(engine_t *e, hd__engine_force_t force, hd_result_t out[2],
         }
         for (int k = 0; k < 2; k++) hd__grid_free(&e->grid[k]);
         e->have_grid = 0;
-        rc = hd__tree_build(&e->tree[0], &e->src[0], e->n[0], &g[0], e->threads, &e->pool, err);
+        rc = hd__tree_build_pair(e->tree, e->src, e->n, g, e->threads, &e->pool, err);
         if (rc) return rc;
-        rc = hd__tree_build(&e->tree[1], &e->src[1], e->n[1], &g[1], e->threads, &e->pool, err);
-        if (rc) {
-            hd__tree_free(&e->tree[0]);
-            return rc;
-        }
         e->have_tree = 1;
     }
     for (int d = 0; d < e->directions; d++) {

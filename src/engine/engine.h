@@ -74,6 +74,15 @@ typedef struct hd__tree {
  * come from `pool` (NULL: plain allocations), which must outlive the tree. */
 int hd__tree_build(hd__tree_t *t, const hd__src_t *src, size_t n, const hd__box_t *grid_box,
                    int threads, hd__reuse_t *pool, hd_error_t *err);
+/* Both trees of a call at once, from `pool` (kept blocks are given back
+ * first), in the order that holds the least memory at once: both sorts
+ * (the larger set first), each leaving only its perm, fkey and room for
+ * its boxes, then both quantised copies and boxes.  The pool then holds at
+ * most max(16 n0, 7.4 n0 + 16 n1, 13.4 (n0 + n1)) bytes, plus pages lost
+ * to rounding, with n0 the larger set (docs/engine.md, "Threads and
+ * memory"). */
+int hd__tree_build_pair(hd__tree_t t[2], const hd__src_t src[2], const size_t n[2],
+                        const hd__box_t grid_box[2], int threads, hd__reuse_t *pool, hd_error_t *err);
 void hd__tree_free(hd__tree_t *t);
 size_t hd__tree_memory(const hd__tree_t *t);
 
@@ -404,6 +413,14 @@ int hd__engine_directed_above(const hd_points_t *A, const hd_points_t *B,
                               const hd__box_t *box_a, const hd__box_t *box_b,
                               const hd_options_t *opt, double floor2, size_t floor_i,
                               hd_result_t *out, hd_error_t *err);
+/* The most memory the engine's last call on this thread held at once, in
+ * bytes, and 0 after that until its next call (reading it forgets it): its
+ * pool's high-water mark (hd__reuse_t.peak: every array proportional to a
+ * set, mapped and touched), which excludes only arrays of O(threads +
+ * n / 16384) bytes (the plan's pairs, the threads' counts).  0 for a call
+ * settled before any index.  For the layers that account for memory
+ * (the MPI library's peak). */
+size_t hd__engine_peak_bytes(void);
 /* The engine's plan for H(A,B), for tests and benchmarks: which path
  * answers (the correspondence path settles both directions exactly when
  * path is HD__PLAN_PAIRS), whether the pairs were listed, which directions

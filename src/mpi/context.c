@@ -79,13 +79,11 @@ void hd__mpi_charge(ctx_t *c, size_t bytes) {
     if (c->cur > c->peak) c->peak = c->cur;
 }
 
-/* The engine's own memory, which this layer cannot see: docs/engine.md
- * bounds it by 16 bytes a point of each set (its two trees while sorted;
- * the grids take less), which is charged for the call's duration. */
-#define ENGINE_BYTES 16
-
-/* Every engine call of the library: charged at the engine's bound while
- * it runs.  On the local arrays (packed doubles, validated before the
+/* Every engine call of the library: charged, once it returns, at the
+ * most memory the engine held during it (hd__engine_peak_bytes, its
+ * pool's high-water mark: at most 16 bytes a point of both sets and less
+ * on every path, docs/engine.md "Threads and memory"), on top of what this
+ * layer held meanwhile.  On the local arrays (packed doubles, validated before the
  * exchange) it takes the engine's internal entries with the sets' boxes
  * (bp, bq; NULL: computed here), since hd_directed would validate every
  * point again (a pass over both sets, about 50 instructions a point); on
@@ -105,11 +103,12 @@ static int engine_call(ctx_t *c, int where, const hd_points_t *P, const hd_point
         if (bq) b[1] = *bq;
         else hd__box_of(Q->data, Q->count, &b[1]);
     }
-    size_t bytes = ENGINE_BYTES * (P->count + Q->count);
-    hd__mpi_charge(c, bytes);
+    (void)hd__engine_peak_bytes(); /* forget any earlier call's */
     int rc = where == VIEWS ? hd_directed(P, Q, &o, e, &c->e)
              : s            ? hd__engine_hausdorff(P, Q, &b[0], &b[1], &o, s, &c->e)
                             : hd__engine_directed_above(P, Q, &b[0], &b[1], &o, floor2, floor_i, e, &c->e);
+    size_t bytes = hd__engine_peak_bytes();
+    hd__mpi_charge(c, bytes);
     c->cur -= bytes;
     return rc;
 }

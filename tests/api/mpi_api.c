@@ -476,7 +476,7 @@ static void check_errors(void) {
 
 /* On one rank the call copies no point: a set given as one part, of any
  * layout (floats here), goes to the engine as it is, so the call's own
- * peak is the engine's (charged at 16 bytes a point) and a few small
+ * peak is the engine's (charged at its measured peak) and a few small
  * tables; a copy would be 24 bytes a point more, as it was before. */
 static void check_single_rank_copies_nothing(void) {
     if (K_ != 1) return;

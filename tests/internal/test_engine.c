@@ -716,3 +716,43 @@ TEST(subsets_out_of_order_or_with_a_stranger_are_left_to_the_other_paths) {
     free(a);
     free(b);
 }
+
+/* The engine's memory on the tree path: its pool holds at most 16 bytes a
+ * point of both sets (docs/engine.md, "Threads and memory": the larger
+ * set's sort alone, the smaller's sort beside the larger's permutation and
+ * boxes, or the two finished trees at 13.4), plus at most two 2 MiB chunks
+ * that arrays under about 1.9 MB are cut from; for sets of one size, the
+ * finished trees' 13.4 bytes a point with their blocks' last 2 MiB pages
+ * kept whole: at most 14 bytes a point and a chunk (before the sorts were
+ * set apart from the trees, 22).  hd__engine_peak_bytes reports it once, then 0.  Uniform clouds,
+ * equal and 10:1 either way. */
+TEST(the_tree_path_holds_at_most_16_bytes_a_point_and_reports_it) {
+    static const size_t sizes[3][2] = {{300000, 300000}, {300000, 30000}, {30000, 300000}};
+    for (int c = 0; c < 3; c++) {
+        uint64_t seed = 8100 + (uint64_t)c;
+        gen_rng_t g;
+        gen_seed(&g, seed);
+        size_t na = sizes[c][0], nb = sizes[c][1];
+        CONTEXT("seed=%llu na=%zu nb=%zu", (unsigned long long)seed, na, nb);
+        double *a = malloc(24 * na), *b = malloc(24 * nb);
+        gen_cube(&g, a, na, 0, 1);
+        gen_cube(&g, b, nb, 0, 1);
+        hd_points_t A = hd_points_f64(a, na), B = hd_points_f64(b, nb);
+        hd_options_t o;
+        hd_options_init(&o);
+        o.threads = 2;
+        hd_symmetric_t s;
+        CHECK_RC(hd__engine_forced(&A, &B, &o, HD__ENGINE_FORCE_TREES, &s, NULL), HD_OK);
+        size_t peak = hd__engine_peak_bytes();
+        /* At least both trees' permutations and quantised copies. */
+        CHECK(peak >= 10 * (na + nb));
+        size_t chunk = ((size_t)2 << 20) + 4096;
+        CHECK(peak <= 16 * (na + nb) + 2 * chunk);
+        if (na == nb) CHECK(peak <= 14 * (na + nb) + chunk);
+        if (peak > 16 * (na + nb) + 2 * chunk || (na == nb && peak > 14 * (na + nb) + chunk))
+            fprintf(stderr, "peak %.2f bytes a point\n", (double)peak / (double)(na + nb));
+        CHECK(hd__engine_peak_bytes() == 0);
+        free(a);
+        free(b);
+    }
+}

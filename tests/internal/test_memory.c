@@ -91,3 +91,41 @@ TEST(blocks_mapped_whole_or_cut_from_chunks_never_overlap) {
     CHECK_EQ(r.n, 0);
     CHECK_EQ(r.n_chunks, 0);
 }
+
+/* What a set holds from the system (held, and its most, peak) follows its
+ * blocks: a block shrunk gives back the pages after its new size (whole
+ * 2 MiB pages only, where it has them) and stays writable up to it; blocks given back stay held until the set is trimmed;
+ * a trim gives the chunks back too once no block cut from them is in use;
+ * the peak survives hd__reuse_free. */
+TEST(a_set_counts_what_it_holds_and_gives_back_shrunk_tails_and_trimmed_blocks) {
+    hd__reuse_t r;
+    hd__reuse_init(&r);
+    size_t big = (size_t)8 << 20, small = (size_t)1 << 20, mid = 100000;
+    unsigned char *a = hd__reuse_get(&r, big, 1);
+    CHECK(a != NULL);
+    memset(a, 3, big);
+    CHECK(r.held >= big && r.peak == r.held);
+    size_t before = r.held;
+    hd__reuse_shrink(&r, a, small);
+    /* Mapped on its own: the pages past `small` go back, those in 2 MiB
+     * pages (where the kernel gave them) up to the next 2 MiB boundary. */
+    CHECK(r.held + (big - ((size_t)2 << 20)) <= before && r.held >= small);
+    memset(a, 4, small);
+    CHECK_EQ(a[small - 1], 4);
+    unsigned char *m = hd__reuse_get(&r, mid, 1); /* cut from a chunk */
+    CHECK(m != NULL && r.n_chunks == 1);
+    memset(m, 5, mid);
+    hd__reuse_put(&r, a);
+    size_t kept = r.held;
+    CHECK(kept >= small + ((size_t)2 << 20) && r.n == 1);
+    hd__reuse_trim(&r); /* m is in use: its chunk stays */
+    CHECK(r.n == 0 && r.n_chunks == 1 && r.held < kept && r.held >= ((size_t)2 << 20));
+    CHECK_EQ(m[mid - 1], 5);
+    hd__reuse_put(&r, m);
+    hd__reuse_trim(&r);
+    CHECK(r.n == 0 && r.n_chunks == 0 && r.held == 0);
+    CHECK(r.peak >= big);
+    size_t peak = r.peak;
+    hd__reuse_free(&r);
+    CHECK(r.held == 0 && r.peak == peak);
+}
