@@ -274,8 +274,14 @@ void *hd__reuse_take(hd__reuse_t *pool, size_t n, size_t size) {
     if (!pool || hd__mul_overflows(n, size)) return hd__reuse_get(pool, n, size);
     int best = reuse_best(pool, n * size);
     void *keep = best >= 0 ? pool->block[best] : NULL;
+    /* The block that will serve counts as in use while the others go: a
+     * block cut from a chunk keeps its chunk mapped (trim unmaps chunks
+     * only when nothing cut from them is in use). */
+    int cut = keep ? reuse_head(keep)->cut : 0;
     if (keep) pool->block[best] = pool->block[--pool->n];
+    pool->cut_out += cut;
     hd__reuse_trim(pool);
+    pool->cut_out -= cut;
     if (keep) pool->block[pool->n++] = keep; /* the one kept block left */
     return hd__reuse_get(pool, n, size);
 }

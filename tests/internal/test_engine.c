@@ -756,3 +756,40 @@ TEST(the_tree_path_holds_at_most_16_bytes_a_point_and_reports_it) {
         free(b);
     }
 }
+
+/* The trees' build hands blocks between the two sets' sorts, permutations
+ * and quantised copies (build.c, hd__tree_build_pair; src/base/memory.c's
+ * reuse set): at 265928 + 232739 points a kept block cut from a chunk once
+ * lost its chunk under it (a crash).  Set sizes around the pool's
+ * thresholds, and random ones, at one thread and two: the trees' answer
+ * equals the grids' (both exact, computed independently) and the peak
+ * stays within its bound. */
+TEST(the_trees_build_for_any_pair_of_set_sizes) {
+    static const size_t fixed[][2] = {{265928, 232739}, {232739, 265928}, {65536, 65537}, {2731, 87381},
+                                      {131072, 4096},   {174763, 174762}, {1, 300000},   {300000, 1}};
+    enum { N_FIXED = sizeof fixed / sizeof fixed[0], N_RANDOM = 8 };
+    for (int c = 0; c < N_FIXED + N_RANDOM; c++) {
+        uint64_t seed = 8300 + (uint64_t)c;
+        gen_rng_t g;
+        gen_seed(&g, seed);
+        size_t na = c < N_FIXED ? fixed[c][0] : 1 + gen_u64(&g) % 400000;
+        size_t nb = c < N_FIXED ? fixed[c][1] : 1 + gen_u64(&g) % 400000;
+        CONTEXT("seed=%llu na=%zu nb=%zu", (unsigned long long)seed, na, nb);
+        double *a = malloc(24 * na), *b = malloc(24 * nb);
+        gen_cube(&g, a, na, 0, 1);
+        gen_cube(&g, b, nb, 0, 1);
+        hd_points_t A = hd_points_f64(a, na), B = hd_points_f64(b, nb);
+        hd_options_t o;
+        hd_options_init(&o);
+        o.threads = 1 + c % 2;
+        hd_symmetric_t t, r;
+        CHECK_RC(hd__engine_forced(&A, &B, &o, HD__ENGINE_FORCE_TREES, &t, NULL), HD_OK);
+        size_t peak = hd__engine_peak_bytes();
+        CHECK(peak <= 16 * (na + nb) + 2 * (((size_t)2 << 20) + 4096));
+        CHECK_RC(hd__engine_forced(&A, &B, &o, HD__ENGINE_FORCE_GRID, &r, NULL), HD_OK);
+        CHECK(t.ab.distance == r.ab.distance && t.ab.i == r.ab.i && t.ab.j == r.ab.j);
+        CHECK(t.ba.distance == r.ba.distance && t.ba.i == r.ba.i && t.ba.j == r.ba.j);
+        free(a);
+        free(b);
+    }
+}

@@ -97,6 +97,27 @@ TEST(blocks_mapped_whole_or_cut_from_chunks_never_overlap) {
  * 2 MiB pages only, where it has them) and stays writable up to it; blocks given back stay held until the set is trimmed;
  * a trim gives the chunks back too once no block cut from them is in use;
  * the peak survives hd__reuse_free. */
+/* hd__reuse_take trims every kept block but the one that serves the
+ * request; when that one was cut from a chunk, the chunk must stay mapped
+ * (it once was unmapped under it: a crash in the engine's build). */
+TEST(taking_a_kept_block_cut_from_a_chunk_keeps_its_chunk) {
+    hd__reuse_t r;
+    hd__reuse_init(&r);
+    size_t mid = 200000;
+    unsigned char *m = hd__reuse_get(&r, mid, 1); /* cut from a chunk */
+    CHECK(m != NULL && r.n_chunks == 1);
+    memset(m, 6, mid);
+    hd__reuse_put(&r, m); /* kept, nothing cut is in use */
+    CHECK(r.n == 1 && r.cut_out == 0);
+    unsigned char *t = hd__reuse_take(&r, mid - 1000, 1); /* served by m */
+    CHECK(t == m && r.n_chunks == 1 && r.cut_out == 1);
+    memset(t, 7, mid - 1000); /* mapped: ASan or a fault says otherwise */
+    CHECK_EQ(t[mid - 1001], 7);
+    hd__reuse_put(&r, t);
+    hd__reuse_free(&r);
+    CHECK(r.held == 0);
+}
+
 TEST(a_set_counts_what_it_holds_and_gives_back_shrunk_tails_and_trimmed_blocks) {
     hd__reuse_t r;
     hd__reuse_init(&r);
