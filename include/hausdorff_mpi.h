@@ -57,9 +57,10 @@
  *    MPI_THREAD_FUNNELED is the level the standard asks for.
  *  - Points are read during the call only, and may be laid out in any way
  *    over the ranks: any rank may hold any points of either set, or none.
- *  - Memory: the call holds about 36 bytes per point it ends up with while
- *    the points move and 32 after (coordinates and indices), plus the
- *    engine's and the searches' structures (docs/scale-out.md); on one
+ *  - Memory: the call holds about 33 bytes per point it ends up with while
+ *    the points move and 25 after (coordinates, and their global indices
+ *    in under a byte), plus the engine's structures (about 14.5 bytes a
+ *    point) and the searches' (docs/scale-out.md); on one
  *    rank it runs on the caller's points without a copy.  hd_mpi_distances
  *    holds more (its entry says how much): every point needs its own
  *    search.
@@ -126,9 +127,11 @@ typedef struct hd_mpi_stats {
                                    call: its buffers, the per-point
                                    searches' structures (up to 60 bytes a
                                    point while built), and the engine's,
-                                   charged at its documented bound of 16
-                                   bytes a point; not the caller's input,
-                                   nor MPI's own buffers */
+                                   charged at what the engine held at
+                                   most during each of its calls (about
+                                   14.5 bytes a point of uniform sets,
+                                   never above 16 plus 4 MiB); not the
+                                   caller's input, nor MPI's own buffers */
     double seconds;             /* this rank: time in the call */
     double search_seconds;      /* this rank: time in the searches */
     double other_cpu;           /* this rank: the bookkeeping's CPU seconds */
@@ -192,13 +195,13 @@ int hd_mpi_directed(MPI_Comm comm, const hd_mpi_part_t *a, size_t na,
  *   forwarded* the queries sent to other ranks (no lower bound prunes
  *   them: every point needs its answer); rounds one per direction.
  * err: NULL, or receives the context of a failure.
- * Memory, per point a rank holds after the partition: 4 bytes (its
- *   number), about 37 bytes a point of each set for the nearest layer's
+ * Memory, per point a rank holds after the partition: under a byte (its
+ *   coded index), about 37 bytes a point of each set for the nearest layer's
  *   structures, which hold the coordinates (60 while one is built), and
  *   24 bytes a point of the direction being computed (16 after its local
  *   pass); 16 bytes a point of the rank's own input while the answers come
  *   back (32 while they are sent when the ranks' index runs interleave).
- *   Measured peak: 64 bytes a point a rank holds (docs/scale-out.md).  On one rank,
+ *   Measured peak: 61 bytes a point a rank holds (docs/scale-out.md).  On one rank,
  *   hd_distances on the caller's points (charged at its 60 bytes a point),
  *   without a copy when a set has one nonempty part (else its parts are
  *   packed, 24 bytes a point), into the outputs themselves when the parts
