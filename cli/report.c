@@ -97,9 +97,9 @@ static void print_point(FILE *out, const double *q) {
 }
 
 static void stats_json(FILE *out, const hd_stats_t *s) {
-    fprintf(out, "{\"distance_evals\": %llu, \"nodes_visited\": %llu, \"points_culled\": %llu}",
+    fprintf(out, "{\"distance_evals\": %llu, \"nodes_visited\": %llu, \"points_culled\": %llu, \"peak_bytes\": %llu}",
             (unsigned long long)s->distance_evals, (unsigned long long)s->nodes_visited,
-            (unsigned long long)s->points_culled);
+            (unsigned long long)s->points_culled, (unsigned long long)s->peak_bytes);
 }
 
 

@@ -222,6 +222,13 @@ typedef struct hd_stats {
     uint64_t distance_evals; /* point-to-point squared distances evaluated */
     uint64_t nodes_visited;  /* tree nodes or buckets visited */
     uint64_t points_culled;  /* points of A discarded without an NN search */
+    uint64_t peak_bytes;     /* the most bytes the default engine's
+                                structures held at once during the call
+                                (its high-water mark, measured; for
+                                hd_hausdorff the call's, in both
+                                directions' stats); 0 for the other
+                                algorithms and the index, which do not
+                                measure it */
 } hd_stats_t;
 
 /* A directed distance h(A,B) = max over a in A of min over b in B |a - b|. */

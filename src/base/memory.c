@@ -17,7 +17,7 @@
  *
  * What a set holds from the system (its blocks in use or kept, its chunks)
  * is counted in `held`, and its most in `peak`, which is the engine's
- * memory high-water mark (hd__engine_peak_bytes).  A caller that knows the
+ * memory high-water mark (its results' stats.peak_bytes).  A caller that knows the
  * kept blocks will not serve it gives them back (hd__reuse_trim,
  * hd__reuse_take), and one that uses only the start of a block gives back
  * the pages after it (hd__reuse_shrink): that, not reuse, is what bounds

@@ -687,15 +687,6 @@ typedef struct {
     hd__reuse_t pool;      /* the grids' and trees' arrays, reused as they are freed */
 } engine_t;
 
-/* The pool's peak of this thread's last call (hd__engine_peak_bytes). */
-static _Thread_local size_t last_peak;
-
-size_t hd__engine_peak_bytes(void) {
-    size_t p = last_peak;
-    last_peak = 0;
-    return p;
-}
-
 static void engine_free(engine_t *e) {
     if (e->have_grid)
         for (int k = 0; k < 2; k++) hd__grid_free(&e->grid[k]);
@@ -703,8 +694,7 @@ static void engine_free(engine_t *e) {
         for (int k = 0; k < 2; k++) hd__tree_free(&e->tree[k]);
     for (int d = 0; d < e->max_ready; d++) hd__max_destroy(&e->max[d]);
     hd__pairs_free(&e->pairs);
-    hd__reuse_free(&e->pool);
-    last_peak = e->pool.peak;
+    hd__reuse_free(&e->pool); /* keeps pool.peak, the call's high-water mark */
     e->have_grid = e->have_tree = e->max_ready = 0;
 }
 
@@ -913,6 +903,7 @@ int hd__engine_directed_above(const hd_points_t *A, const hd_points_t *B,
     engine_free(&e);
     if (rc) return rc;
     *out = r[0];
+    out->stats.peak_bytes = e.pool.peak;
     out->seconds = hd__now() - t0;
     return HD_OK;
 }
@@ -933,6 +924,7 @@ static int engine_symmetric(const hd_points_t *A, const hd_points_t *B, const hd
     double total = hd__now() - t0, walks = r[0].seconds + r[1].seconds;
     out->ab = r[0];
     out->ba = r[1];
+    out->ab.stats.peak_bytes = out->ba.stats.peak_bytes = e.pool.peak; /* one call, one peak */
     out->ab.seconds = r[0].seconds + (total - walks) / 2;
     out->ba.seconds = r[1].seconds + (total - walks) / 2;
     return HD_OK;

@@ -80,7 +80,7 @@ void hd__mpi_charge(ctx_t *c, size_t bytes) {
 }
 
 /* Every engine call of the library: charged, once it returns, at the
- * most memory the engine held during it (hd__engine_peak_bytes, its
+ * most memory the engine held during it (its results' stats.peak_bytes, its
  * pool's high-water mark: at most 16 bytes a point of both sets and less
  * on every path, docs/engine.md "Threads and memory"), on top of what this
  * layer held meanwhile.  On the local arrays (packed doubles, validated before the
@@ -103,11 +103,10 @@ static int engine_call(ctx_t *c, int where, const hd_points_t *P, const hd_point
         if (bq) b[1] = *bq;
         else hd__box_of(Q->data, Q->count, &b[1]);
     }
-    (void)hd__engine_peak_bytes(); /* forget any earlier call's */
     int rc = where == VIEWS ? hd_directed(P, Q, &o, e, &c->e)
              : s            ? hd__engine_hausdorff(P, Q, &b[0], &b[1], &o, s, &c->e)
                             : hd__engine_directed_above(P, Q, &b[0], &b[1], &o, floor2, floor_i, e, &c->e);
-    size_t bytes = hd__engine_peak_bytes();
+    size_t bytes = rc != HD_OK ? 0 : s ? (size_t)s->ab.stats.peak_bytes : (size_t)e->stats.peak_bytes;
     hd__mpi_charge(c, bytes);
     c->cur -= bytes;
     return rc;

@@ -233,3 +233,37 @@ TEST(every_call_refuses_a_misaligned_packed_view_and_reads_a_strided_one_anywher
     free(a);
     free(raw);
 }
+
+/* The default engine reports in its results how much memory it held at
+ * once (stats.peak_bytes: measured, the same in both directions of one
+ * call); the paper's algorithms do not measure it and report 0.  On
+ * 200K + 200K uniform points the engine holds its trees: more than their
+ * permutations (4 bytes a point) and within its 16 bytes a point plus two
+ * 2 MiB chunks (docs/engine.md, "Threads and memory"). */
+TEST(the_engine_reports_its_peak_memory_and_the_other_algorithms_zero) {
+    uint64_t seed = 9100;
+    CONTEXT("seed=%llu", (unsigned long long)seed);
+    gen_rng_t g;
+    gen_seed(&g, seed);
+    size_t n = 200000;
+    double *a = malloc(24 * n), *b = malloc(24 * n);
+    gen_cube(&g, a, n, 0, 1);
+    gen_cube(&g, b, n, 0, 1);
+    hd_points_t A = hd_points_f64(a, n), B = hd_points_f64(b, n);
+    hd_options_t o;
+    hd_options_init(&o);
+    o.threads = 2;
+    hd_symmetric_t s;
+    CHECK_RC(hd_hausdorff(&A, &B, &o, &s, NULL), HD_OK);
+    CHECK_EQ(s.ab.stats.peak_bytes, s.ba.stats.peak_bytes);
+    CHECK(s.ab.stats.peak_bytes > 4 * 2 * n);
+    CHECK(s.ab.stats.peak_bytes <= 16 * 2 * n + 2 * (((uint64_t)2 << 20) + 4096));
+    hd_result_t r;
+    CHECK_RC(hd_directed(&A, &B, &o, &r, NULL), HD_OK);
+    CHECK(r.stats.peak_bytes > 4 * n && r.stats.peak_bytes <= 16 * 2 * n + 2 * (((uint64_t)2 << 20) + 4096));
+    o.algorithm = HD_ALG_NOHD;
+    CHECK_RC(hd_directed(&A, &B, &o, &r, NULL), HD_OK);
+    CHECK_EQ(r.stats.peak_bytes, 0);
+    free(a);
+    free(b);
+}
