@@ -246,10 +246,9 @@ TEST(the_engine_reports_its_peak_memory_and_the_other_algorithms_zero) {
     gen_rng_t g;
     gen_seed(&g, seed);
     size_t n = 200000;
-    double *a = malloc(24 * n), *b = malloc(24 * n);
-    gen_cube(&g, a, n, 0, 1);
-    gen_cube(&g, b, n, 0, 1);
-    hd_points_t A = hd_points_f64(a, n), B = hd_points_f64(b, n);
+    double *a, *b;
+    hd_points_t A, B;
+    gen_cube_pair(&g, n, n, &a, &b, &A, &B);
     hd_options_t o;
     hd_options_init(&o);
     o.threads = 2;

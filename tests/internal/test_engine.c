@@ -727,21 +727,30 @@ TEST(subsets_out_of_order_or_with_a_stranger_are_left_to_the_other_paths) {
  * set apart from the trees, 22).  The results' stats.peak_bytes report it, the same in both directions.  Uniform clouds,
  * equal and 10:1 either way. */
 TEST(the_tree_path_holds_at_most_16_bytes_a_point_and_reports_it) {
-    static const size_t sizes[3][2] = {{300000, 300000}, {300000, 30000}, {30000, 300000}};
-    for (int c = 0; c < 3; c++) {
+    /* Equal and 10:1 either way; then sizes around the reuse set's
+     * thresholds, and random ones (the build hands blocks between the two
+     * sets' sorts, permutations and quantised copies: at 265928 + 232739
+     * points a kept block cut from a chunk once lost its chunk under it, a
+     * crash), at one thread and two.  The trees' answer equals the grids'
+     * (both exact, computed independently). */
+    static const size_t fixed[][2] = {{300000, 300000}, {300000, 30000}, {30000, 300000}, {265928, 232739},
+                                      {232739, 265928}, {65536, 65537},   {2731, 87381},   {131072, 4096},
+                                      {174763, 174762}, {1, 300000},      {300000, 1}};
+    enum { N_FIXED = sizeof fixed / sizeof fixed[0], N_RANDOM = 8 };
+    for (int c = 0; c < N_FIXED + N_RANDOM; c++) {
         uint64_t seed = 8100 + (uint64_t)c;
         gen_rng_t g;
         gen_seed(&g, seed);
-        size_t na = sizes[c][0], nb = sizes[c][1];
+        size_t na = c < N_FIXED ? fixed[c][0] : 1 + gen_u64(&g) % 400000;
+        size_t nb = c < N_FIXED ? fixed[c][1] : 1 + gen_u64(&g) % 400000;
         CONTEXT("seed=%llu na=%zu nb=%zu", (unsigned long long)seed, na, nb);
-        double *a = malloc(24 * na), *b = malloc(24 * nb);
-        gen_cube(&g, a, na, 0, 1);
-        gen_cube(&g, b, nb, 0, 1);
-        hd_points_t A = hd_points_f64(a, na), B = hd_points_f64(b, nb);
+        double *a, *b;
+        hd_points_t A, B;
+        gen_cube_pair(&g, na, nb, &a, &b, &A, &B);
         hd_options_t o;
         hd_options_init(&o);
-        o.threads = 2;
-        hd_symmetric_t s;
+        o.threads = c < 3 ? 2 : 1 + c % 2;
+        hd_symmetric_t s, r;
         CHECK_RC(hd__engine_forced(&A, &B, &o, HD__ENGINE_FORCE_TREES, &s, NULL), HD_OK);
         size_t peak = (size_t)s.ab.stats.peak_bytes;
         CHECK_EQ(s.ba.stats.peak_bytes, s.ab.stats.peak_bytes);
@@ -752,43 +761,9 @@ TEST(the_tree_path_holds_at_most_16_bytes_a_point_and_reports_it) {
         if (na == nb) CHECK(peak <= 14 * (na + nb) + chunk);
         if (peak > 16 * (na + nb) + 2 * chunk || (na == nb && peak > 14 * (na + nb) + chunk))
             fprintf(stderr, "peak %.2f bytes a point\n", (double)peak / (double)(na + nb));
-        free(a);
-        free(b);
-    }
-}
-
-/* The trees' build hands blocks between the two sets' sorts, permutations
- * and quantised copies (build.c, hd__tree_build_pair; src/base/memory.c's
- * reuse set): at 265928 + 232739 points a kept block cut from a chunk once
- * lost its chunk under it (a crash).  Set sizes around the pool's
- * thresholds, and random ones, at one thread and two: the trees' answer
- * equals the grids' (both exact, computed independently) and the peak
- * stays within its bound. */
-TEST(the_trees_build_for_any_pair_of_set_sizes) {
-    static const size_t fixed[][2] = {{265928, 232739}, {232739, 265928}, {65536, 65537}, {2731, 87381},
-                                      {131072, 4096},   {174763, 174762}, {1, 300000},   {300000, 1}};
-    enum { N_FIXED = sizeof fixed / sizeof fixed[0], N_RANDOM = 8 };
-    for (int c = 0; c < N_FIXED + N_RANDOM; c++) {
-        uint64_t seed = 8300 + (uint64_t)c;
-        gen_rng_t g;
-        gen_seed(&g, seed);
-        size_t na = c < N_FIXED ? fixed[c][0] : 1 + gen_u64(&g) % 400000;
-        size_t nb = c < N_FIXED ? fixed[c][1] : 1 + gen_u64(&g) % 400000;
-        CONTEXT("seed=%llu na=%zu nb=%zu", (unsigned long long)seed, na, nb);
-        double *a = malloc(24 * na), *b = malloc(24 * nb);
-        gen_cube(&g, a, na, 0, 1);
-        gen_cube(&g, b, nb, 0, 1);
-        hd_points_t A = hd_points_f64(a, na), B = hd_points_f64(b, nb);
-        hd_options_t o;
-        hd_options_init(&o);
-        o.threads = 1 + c % 2;
-        hd_symmetric_t t, r;
-        CHECK_RC(hd__engine_forced(&A, &B, &o, HD__ENGINE_FORCE_TREES, &t, NULL), HD_OK);
-        size_t peak = (size_t)t.ab.stats.peak_bytes;
-        CHECK(peak <= 16 * (na + nb) + 2 * (((size_t)2 << 20) + 4096));
         CHECK_RC(hd__engine_forced(&A, &B, &o, HD__ENGINE_FORCE_GRID, &r, NULL), HD_OK);
-        CHECK(t.ab.distance == r.ab.distance && t.ab.i == r.ab.i && t.ab.j == r.ab.j);
-        CHECK(t.ba.distance == r.ba.distance && t.ba.i == r.ba.i && t.ba.j == r.ba.j);
+        CHECK(s.ab.distance == r.ab.distance && s.ab.i == r.ab.i && s.ab.j == r.ab.j);
+        CHECK(s.ba.distance == r.ba.distance && s.ba.i == r.ba.i && s.ba.j == r.ba.j);
         free(a);
         free(b);
     }

@@ -4,9 +4,10 @@
  */
 #include "gen.h"
 
-#include <string.h>
-
 #include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
 
 /* The seed is hashed into the starting state, not used as a position: with
  * s = seed * increment, seeds 1 and 2 were the same stream one draw apart, so
@@ -38,6 +39,19 @@ void gen_gauss(gen_rng_t *r, double *xyz, size_t n, const double mean[3], double
 
 void gen_cube(gen_rng_t *r, double *xyz, size_t n, double lo, double hi) {
     for (size_t k = 0; k < 3 * n; k++) xyz[k] = lo + (hi - lo) * gen_unit(r);
+}
+
+void gen_cube_pair(gen_rng_t *r, size_t na, size_t nb, double **a, double **b, hd_points_t *A, hd_points_t *B) {
+    *a = malloc(24 * (na ? na : 1));
+    *b = malloc(24 * (nb ? nb : 1));
+    if (!*a || !*b) {
+        fprintf(stderr, "gen_cube_pair: out of memory for %zu + %zu points\n", na, nb);
+        abort();
+    }
+    gen_cube(r, *a, na, 0, 1);
+    gen_cube(r, *b, nb, 0, 1);
+    *A = hd_points_f64(*a, na);
+    *B = hd_points_f64(*b, nb);
 }
 
 void gen_lattice(gen_rng_t *r, double *xyz, size_t n, int side) {

@@ -6,6 +6,8 @@
 #ifndef HD_TEST_GEN_H
 #define HD_TEST_GEN_H
 
+#include <hausdorff.h>
+
 #include <stddef.h>
 #include <stdint.h>
 
@@ -19,6 +21,10 @@ double gen_normal(gen_rng_t *r);        /* standard normal */
 void gen_gauss(gen_rng_t *r, double *xyz, size_t n, const double mean[3], double sigma);
 /* n points uniform in the cube [lo, hi]^3. */
 void gen_cube(gen_rng_t *r, double *xyz, size_t n, double lo, double hi);
+/* Two new arrays of na and nb points uniform in the unit cube (A's first),
+ * with their views; the caller frees *a and *b.  Aborts the test program
+ * when out of memory. */
+void gen_cube_pair(gen_rng_t *r, size_t na, size_t nb, double **a, double **b, hd_points_t *A, hd_points_t *B);
 /* Integer lattice points chosen at random in [0, side)^3 (ties galore). */
 void gen_lattice(gen_rng_t *r, double *xyz, size_t n, int side);
 /* n points on a random line segment / plane patch through the origin. */
