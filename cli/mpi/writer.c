@@ -80,23 +80,36 @@ static size_t fill(const dist_layout_t *lay, const hd_points_t *P, const double 
     return at;
 }
 
+/* Every rank's rows: (first index, count, bytes) a rank, all-gathered
+ * into *all (3 K values; the caller frees it).  Collective; a failure to
+ * allocate is agreed. */
+static int rows_of_ranks(uint64_t first, uint64_t count, uint64_t bytes, uint64_t **all, hd_error_t *err) {
+    int K;
+    MPI_Comm_size(MPI_COMM_WORLD, &K);
+    uint64_t mine[3] = {first, count, bytes};
+    int rc = HD_OK;
+    if (!(*all = malloc(3 * (size_t)K * sizeof **all))) {
+        snprintf(err->message, sizeof err->message, "out of memory for %d ranks' rows", K);
+        rc = err->code = HD_ENOMEM;
+    }
+    if ((rc = mpi_agree(rc, err)) != HD_OK) {
+        free(*all);
+        *all = NULL;
+        return rc;
+    }
+    MPI_Allgather(mine, 3, MPI_UINT64_T, *all, 3, MPI_UINT64_T, MPI_COMM_WORLD);
+    return HD_OK;
+}
+
 /* Where this rank's rows start: after the header and every rank's rows of
  * smaller indices (B's shares are not in rank order). */
 static int row_offset(uint64_t first, uint64_t count, uint64_t bytes, uint64_t head, uint64_t *off,
                       hd_error_t *err) {
     int K;
     MPI_Comm_size(MPI_COMM_WORLD, &K);
-    uint64_t mine[3] = {first, count, bytes}, *all = malloc(3 * (size_t)K * sizeof *all);
-    int rc = HD_OK;
-    if (!all) {
-        snprintf(err->message, sizeof err->message, "out of memory for %d ranks' rows", K);
-        rc = err->code = HD_ENOMEM;
-    }
-    if ((rc = mpi_agree(rc, err)) != HD_OK) {
-        free(all);
-        return rc;
-    }
-    MPI_Allgather(mine, 3, MPI_UINT64_T, all, 3, MPI_UINT64_T, MPI_COMM_WORLD);
+    uint64_t *all;
+    int rc = rows_of_ranks(first, count, bytes, &all, err);
+    if (rc != HD_OK) return rc;
     *off = head;
     for (int r = 0; r < K; r++)
         if (all[3 * r + 1] && all[3 * r] < first) *off += all[3 * r + 2];
@@ -113,24 +126,23 @@ static int stream_rows(FILE *f, const dist_layout_t *lay, const hd_points_t *P, 
     int rank, K;
     MPI_Comm_rank(MPI_COMM_WORLD, &rank);
     MPI_Comm_size(MPI_COMM_WORLD, &K);
-    uint64_t mine[2] = {first, P->count}, *all = malloc(2 * (size_t)K * sizeof *all);
+    uint64_t *all = NULL;
     int *order = malloc((size_t)K * sizeof *order), rc = HD_OK;
-    if (!all || !order) {
+    if (!order) {
         snprintf(err->message, sizeof err->message, "out of memory for %d ranks' rows", K);
         rc = err->code = HD_ENOMEM;
     }
-    if ((rc = mpi_agree(rc, err)) != HD_OK) {
-        free(all);
+    if ((rc = mpi_agree(rc, err)) == HD_OK) rc = rows_of_ranks(first, P->count, 0, &all, err);
+    if (rc != HD_OK) {
         free(order);
         if (rank == 0) (void)out_close(f, 0, err);
         return rc;
     }
-    MPI_Allgather(mine, 2, MPI_UINT64_T, all, 2, MPI_UINT64_T, MPI_COMM_WORLD);
     int n = 0; /* the ranks with rows, by first index (insertion: K is small) */
     for (int r = 0; r < K; r++) {
-        if (!all[2 * r + 1]) continue;
+        if (!all[3 * r + 1]) continue;
         int at = n++;
-        while (at > 0 && all[2 * order[at - 1]] > all[2 * r]) order[at] = order[at - 1], at--;
+        while (at > 0 && all[3 * order[at - 1]] > all[3 * r]) order[at] = order[at - 1], at--;
         order[at] = r;
     }
     size_t k = 0;

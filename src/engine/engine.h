@@ -387,6 +387,14 @@ int hd__engine_trees(const hd__tree_t *ta, const hd__tree_t *tb, int threads,
                      hd_result_t *out, hd_error_t *err);
 
 /* ---- entry points for the layers above (engine.c) ------------------------------ */
+/* Each entry that runs the engine (hd__engine_directed,
+ * hd__engine_hausdorff, hd__engine_directed_above, hd__engine_forced)
+ * reports in its results' stats.peak_bytes the most memory the call held
+ * at once: its pool's high-water mark (hd__reuse_t.peak: every array
+ * proportional to a set, mapped and touched), which excludes only arrays
+ * of O(threads + n / 16384) bytes (the plan's pairs, the threads' counts);
+ * 0 for a call settled before any index.  The layers that account for
+ * memory (the MPI library's peak) read it there. */
 /* The auto engine on validated views, without packed copies (engine.c):
  * h(A,B), and H(A,B) with each set indexed once for both directions. */
 int hd__engine_directed(const hd_points_t *A, const hd_points_t *B,
@@ -413,13 +421,6 @@ int hd__engine_directed_above(const hd_points_t *A, const hd_points_t *B,
                               const hd__box_t *box_a, const hd__box_t *box_b,
                               const hd_options_t *opt, double floor2, size_t floor_i,
                               hd_result_t *out, hd_error_t *err);
-/* Every entry above that runs the engine (not hd__engine_trees) reports
- * in its results' stats.peak_bytes the most memory the call held at once:
- * its pool's high-water mark (hd__reuse_t.peak: every array proportional
- * to a set, mapped and touched), which excludes only arrays of O(threads +
- * n / 16384) bytes (the plan's pairs, the threads' counts); 0 for a call
- * settled before any index.  The layers that account for memory (the MPI
- * library's peak) read it there. */
 /* The engine's plan for H(A,B), for tests and benchmarks: which path
  * answers (the correspondence path settles both directions exactly when
  * path is HD__PLAN_PAIRS), whether the pairs were listed, which directions

@@ -358,7 +358,7 @@ int hd__mpi_exchange(ctx_t *c, const input_t *in, const ranges_t *rg, const node
         hd__mpi_free(c, runs, (size_t)K, sizeof(run_t));
         hd__mpi_free(c, heap, (size_t)K, sizeof(int));
         perm = NULL, runs = NULL, heap = NULL;
-        memset(loc->gi[s].w, 0, loc->gi[s].words * sizeof(uint64_t));
+        hd__mpi_gidx_clear(&loc->gi[s]);
         hd__mpi_gidx_put_indices(&loc->gi[s], 0, g, loc->n[s]);
         hd__mpi_free(c, g, gn, sizeof(uint64_t));
         g = NULL;

@@ -128,7 +128,7 @@ int hd__mpi_gidx_init(ctx_t *c, gidx_t *x, const ranges_t *rg, int side, size_t 
     if (words > SIZE_MAX / sizeof(uint64_t) || !(x->w = hd__mpi_alloc(c, (size_t)words, sizeof(uint64_t))))
         return hd__mpi_nomem(c, "the local indices", n);
     x->words = (size_t)words;
-    memset(x->w, 0, (size_t)words * sizeof(uint64_t));
+    hd__mpi_gidx_clear(x);
     x->low = x->w;
     x->high = x->w + lw;
     x->samp = x->w + lw + hw;
@@ -200,8 +200,7 @@ void hd__mpi_gidx_put_numbers(gidx_t *x, const ranges_t *rg, int r, size_t k, co
     for (size_t t = 0; t < n; t++) {
         uint64_t m = num[t];
         if (m - first > span) {
-            while (m - rg->first[i] > rg->all[i].hi - rg->all[i].lo) i++;
-            assert(i < rg->seg[(size_t)x->side * ((size_t)rg->K + 1) + (size_t)r + 1] && m >= rg->first[i]);
+            hd__mpi_ranges_seek(rg, x->side, r, &i, m);
             first = rg->first[i], span = rg->all[i].hi - rg->all[i].lo;
             ob = x->rord[run_at(x, rg->all[i].lo)];
         }
@@ -221,6 +220,10 @@ void hd__mpi_gidx_put_indices(gidx_t *x, size_t k, const uint64_t *g, size_t n) 
         seq_put(&q, k + t, x->rord[i] + (g[t] - x->run[i].lo));
     }
     seq_end(&q);
+}
+
+void hd__mpi_gidx_clear(gidx_t *x) {
+    if (x->words) memset(x->w, 0, x->words * sizeof(uint64_t));
 }
 
 void hd__mpi_gidx_free(ctx_t *c, gidx_t *x) {

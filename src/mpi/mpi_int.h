@@ -23,6 +23,7 @@
 #include "nearest/nearest.h"
 #include "points/points.h"
 
+#include <assert.h>
 #include <math.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -185,6 +186,8 @@ int hd__mpi_gidx_init(ctx_t *c, gidx_t *x, const ranges_t *rg, int side, size_t 
  * order).  The code is written once, from calls covering 0 .. x->n - 1. */
 void hd__mpi_gidx_put_indices(gidx_t *x, size_t k, const uint64_t *g, size_t n);
 void hd__mpi_gidx_put_numbers(gidx_t *x, const ranges_t *rg, int r, size_t k, const uint32_t *num, size_t n);
+/* The code emptied (every word zero), to be written again. */
+void hd__mpi_gidx_clear(gidx_t *x);
 void hd__mpi_gidx_free(ctx_t *c, gidx_t *x);
 /* Position k's index, at any k (a select from the sample before it and a
  * binary search of the runs). */
@@ -263,6 +266,13 @@ void hd__mpi_ranges_free(ctx_t *c, ranges_t *rg);
 int hd__mpi_ranges_index(ctx_t *c, ranges_t *rg);
 void hd__mpi_ranges_globals(const ranges_t *rg, int s, int r, size_t *i, const uint32_t *num, size_t n, uint64_t *g);
 uint64_t hd__mpi_ranges_global(const ranges_t *rg, int s, int r, uint64_t m);
+/* *i, a run of rank r's side s at or before number m's (numbers only grow
+ * along a walk), becomes the run holding number m. */
+static inline void hd__mpi_ranges_seek(const ranges_t *rg, int s, int r, size_t *i, uint64_t m) {
+    while (m - rg->first[*i] > rg->all[*i].hi - rg->all[*i].lo) ++*i;
+    assert(*i < rg->seg[(size_t)s * ((size_t)rg->K + 1) + (size_t)r + 1] && m >= rg->first[*i]);
+    (void)s, (void)r; /* the assert's */
+}
 int hd__mpi_check_ranges(ctx_t *c, const input_t *in, ranges_t *rg);
 int hd__mpi_check_local(ctx_t *c, const hd_options_t *opt, input_t *in, const void *out);
 

@@ -59,14 +59,10 @@ void hd__mpi_ranges_free(ctx_t *c, ranges_t *rg) {
  * num[] increasing; *i is a run of rank r's side s at or before num[0]'s
  * (its first: rg->seg[s (K + 1) + r]), and becomes num[n - 1]'s. */
 void hd__mpi_ranges_globals(const ranges_t *rg, int s, int r, size_t *i, const uint32_t *num, size_t n, uint64_t *g) {
-    size_t at = *i;
-    (void)s, (void)r; /* the asserts' */
     for (size_t k = 0; k < n; k++) {
-        while (num[k] - rg->first[at] > rg->all[at].hi - rg->all[at].lo) at++;
-        assert(at < rg->seg[(size_t)s * ((size_t)rg->K + 1) + (size_t)r + 1] && num[k] >= rg->first[at]);
-        g[k] = rg->all[at].lo + (num[k] - rg->first[at]);
+        hd__mpi_ranges_seek(rg, s, r, i, num[k]);
+        g[k] = rg->all[*i].lo + (num[k] - rg->first[*i]);
     }
-    *i = at;
 }
 
 /* The global index of point number m (any) of rank r's side s. */
