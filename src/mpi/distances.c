@@ -104,7 +104,7 @@ static int an_of(ctx_t *c, const double *xyz, size_t n, const hd__box_t *kb, an_
         return hd__err(&c->e, HD_ERANGE, "%zu points on one rank: the per-point search takes at most %zu", n,
                        (size_t)HD__AN_MAX_POINTS);
     hd_points_t v = hd_points_f64(xyz, n);
-    int rc = hd__mpi_an_build(c, &t->s, &v, kb, hd__thread_count(c->threads, n), &t->bytes);
+    int rc = hd__mpi_an_build(c, &t->s, &v, NULL, NULL, 0, kb, hd__thread_count(c->threads, n), &t->bytes);
     t->built = 1; /* freed by an_free whatever happened */
     return rc;
 }
@@ -333,8 +333,7 @@ static int answer(ctx_t *c, void *arg, const double *pts, size_t m, ans_t *ans) 
     an_t asked;
     int rc = near ? an_of(c, pts, m, a->kb, &asked) : hd__mpi_nomem(c, "answers", m);
     if (rc == HD_OK)
-        rc = hd__an_nearest(&asked.s, &a->searched->s, NULL, hd__thread_count(c->threads, m), NULL, near, NULL,
-                            &c->e);
+        rc = hd__mpi_an_nearest(c, &asked.s, &a->searched->s, hd__thread_count(c->threads, m), near);
     gcur_t cq;
     hd__mpi_gcur_init(&cq, a->gQ);
     for (size_t k = 0; k < m && rc == HD_OK; k++) {
@@ -366,8 +365,7 @@ static int direction(ctx_t *c, const spread_t *sp, const input_t *in, int s,
     /* 1. The local pass. */
     double t0 = hd__now(), u0 = hd__mpi_cpu();
     if (rc == HD_OK && nP && nQ)
-        rc = hd__an_nearest(&asking->s, &searched->s, NULL, hd__thread_count(c->threads, nP), NULL, near, NULL,
-                            &c->e);
+        rc = hd__mpi_an_nearest(c, &asking->s, &searched->s, hd__thread_count(c->threads, nP), near);
     /* near[] goes anywhere in Q: Q's indices are decoded in order first
      * (8 bytes a point of Q for the loop, below the peak of the
      * structures' build), not one by one at random */
@@ -418,7 +416,7 @@ static int direction(ctx_t *c, const spread_t *sp, const input_t *in, int s,
     hd__mpi_free(c, nbox, (size_t)K - 1, sizeof(hd__box_t));
     hd__mpi_free(c, list, (size_t)K, sizeof(int));
     answer_t an = {searched, kb, nQ, &sp->loc.gi[qs]};
-    rc = hd__mpi_round(c, rc, fx, &pr, answer, &an, fu, fj);
+    rc = hd__mpi_round(c, rc, fx, NULL, &pr, answer, &an, fu, fj);
     for (size_t f = 0; f < nf && rc == HD_OK; f++) u2[fk[f]] = fu[f], jj[fk[f]] = fj[f];
     hd__mpi_pairs_free(c, &pr);
     hd__mpi_free(c, fx, nf, 3 * sizeof(double));

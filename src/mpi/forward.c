@@ -23,8 +23,8 @@
 #include <limits.h>
 #include <stdlib.h>
 
-static int pack_queries(ctx_t *c, const double *P, const pair_t *pairs, size_t np, int *scount, int *sdispl,
-                        double **send, size_t **order) {
+static int pack_queries(ctx_t *c, const double *P, const uint32_t *pos, const pair_t *pairs, size_t np,
+                        int *scount, int *sdispl, double **send, size_t **order) {
     for (int r = 0; r < c->K; r++) scount[r] = 0;
     for (size_t t = 0; t < np; t++) scount[pairs[t].dest]++;
     size_t total = 0;
@@ -40,7 +40,8 @@ static int pack_queries(ctx_t *c, const double *P, const pair_t *pairs, size_t n
     memcpy(fill, sdispl, (size_t)c->K * sizeof(int));
     for (size_t t = 0; t < np; t++) {
         size_t at = (size_t)fill[pairs[t].dest]++;
-        memcpy(*send + 3 * at, P + 3 * pairs[t].k, 3 * sizeof(double));
+        size_t k = pairs[t].k;
+        memcpy(*send + 3 * at, P + 3 * (pos ? pos[k] : k), 3 * sizeof(double));
         (*order)[at] = pairs[t].k;
     }
     hd__mpi_free(c, fill, (size_t)c->K, sizeof(int));
@@ -67,8 +68,8 @@ int hd__mpi_pairs_add(ctx_t *c, pairs_t *pr, size_t k, const int *list, int n) {
     return HD_OK;
 }
 
-int hd__mpi_round(ctx_t *c, int rc, const double *P, const pairs_t *pr, hd__mpi_answer_t fn, void *arg,
-                  double *u2, uint64_t *jj) {
+int hd__mpi_round(ctx_t *c, int rc, const double *P, const uint32_t *pos, const pairs_t *pr,
+                  hd__mpi_answer_t fn, void *arg, double *u2, uint64_t *jj) {
     int K = c->K;
     size_t np = pr->n, m = 0, *order = NULL;
     int *cnt = hd__mpi_alloc(c, 4 * (size_t)K, sizeof(int)); /* scount sdispl rcount rdispl */
@@ -77,7 +78,7 @@ int hd__mpi_round(ctx_t *c, int rc, const double *P, const pairs_t *pr, hd__mpi_
     if (rc == HD_OK && !cnt) rc = hd__mpi_nomem(c, "forwarded queries", np);
     int *scount = cnt, *sdispl = cnt + K, *rcount = cnt + 2 * K, *rdispl = cnt + 3 * K;
     if (rc == HD_OK && np > INT_MAX) rc = hd__err(&c->e, HD_EOVERFLOW, "%zu forwarded queries exceed MPI's int counts", np);
-    if (rc == HD_OK) rc = pack_queries(c, P, pr->p, np, scount, sdispl, &sendq, &order);
+    if (rc == HD_OK) rc = pack_queries(c, P, pos, pr->p, np, scount, sdispl, &sendq, &order);
     if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
     MPI_GO(c, rc, MPI_Alltoall(scount, 1, MPI_INT, rcount, 1, MPI_INT, c->comm));
     for (int r = 0; r < K; r++) {
@@ -138,7 +139,7 @@ static int answer(ctx_t *c, void *arg, const double *pts, size_t m, ans_t *ans) 
     }
     size_t *near = hd__mpi_alloc(c, m, sizeof(size_t));
     if (!near) return hd__mpi_nomem(c, "answers", m);
-    int rc = hd__mpi_nearest_in_q(c, d, a->mine, a->q, pts, m, near);
+    int rc = hd__mpi_nearest_in_q(c, d, a->mine, a->q, pts, NULL, m, near);
     gcur_t cq;
     hd__mpi_gcur_init(&cq, d->gQ);
     if (rc == HD_OK)
@@ -161,7 +162,6 @@ int hd__mpi_direction(ctx_t *c, const dir_t *d, const node_t *tree, const hd__bo
     c->search_cpu += hd__mpi_cpu() - u0;
     c->shell += sh.n;
     size_t nP = sh.n;
-    const double *P = sh.xyz;
     double *u2 = hd__mpi_alloc(c, nP, sizeof(double));
     uint64_t *jj = hd__mpi_alloc(c, nP, sizeof(uint64_t));
     unsigned char *exact = hd__mpi_alloc(c, nP, 1);
@@ -175,7 +175,7 @@ int hd__mpi_direction(ctx_t *c, const dir_t *d, const node_t *tree, const hd__bo
         hd__mpi_gcur_init(&cp, d->gP);
         hd__mpi_gcur_init(&cq, d->gQ);
         for (size_t k = 0; k < nP; k++) {
-            const double *p = P + 3 * k;
+            const double *p = hd__mpi_shell_pt(d, &sh, k);
             if (d->nQ == 0) {
                 u2[k] = INFINITY;
                 jj[k] = UINT64_MAX;
@@ -215,7 +215,8 @@ int hd__mpi_direction(ctx_t *c, const dir_t *d, const node_t *tree, const hd__bo
     hd__mpi_gcur_init(&cp, d->gP);
     for (size_t k = 0; k < nP && rc == HD_OK; k++) {
         if (exact[k] || u2[k] < L || (u2[k] == L && hd__mpi_shell_g(&cp, &sh, k) > iL)) continue;
-        int n = hd__mpi_asked(tree, nbox, held, K, d->qside, d->nQ == 0, P + 3 * k, u2[k], c->rank, list);
+        int n = hd__mpi_asked(tree, nbox, held, K, d->qside, d->nQ == 0, hd__mpi_shell_pt(d, &sh, k), u2[k],
+                                c->rank, list);
         if (n == 0) {
             exact[k] = 1; /* no other rank holds a point as near */
             continue;
@@ -224,7 +225,7 @@ int hd__mpi_direction(ctx_t *c, const dir_t *d, const node_t *tree, const hd__bo
         rc = hd__mpi_pairs_add(c, &pr, k, list, n);
     }
     answer_t an = {d, mine, &q};
-    if ((rc = hd__mpi_round(c, rc, P, &pr, answer, &an, u2, jj)) != HD_OK) goto done;
+    if ((rc = hd__mpi_round(c, rc, d->P, sh.own_pos, &pr, answer, &an, u2, jj)) != HD_OK) goto done;
     /* Every point that could win is now exact; the others cannot win (a
      * point at L with a larger index than i_L loses to i_L). */
     far_t best = sh.inner;

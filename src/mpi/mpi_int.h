@@ -344,8 +344,7 @@ static inline int hd__mpi_faces_clear(const hd__box_t *r, const double *p, doubl
 typedef struct {
     hd__an_t s;
     int built;
-    size_t n, bytes;
-    uint32_t *map;           /* the slab's points in Q (NULL: all of Q) */
+    size_t n, bytes;         /* its points (named by their positions in Q) */
     double M;                /* its margin (infinite: all of Q) */
     hd__box_t kb;            /* the key box its askers use too */
 } slab_t;
@@ -356,29 +355,41 @@ typedef struct {
 } qtree_t;
 
 void hd__mpi_qtree_free(ctx_t *c, qtree_t *q);
-/* The nearest layer's structure of v, charged (60 bytes a point while
- * built, then what it holds: *bytes, to subtract when it is freed). */
-int hd__mpi_an_build(ctx_t *c, hd__an_t *s, const hd_points_t *v, const hd__box_t *kb, int threads, size_t *bytes);
+/* The nearest layer's structure of v (sel NULL), or of v's m points
+ * sel[0..m) named by names[] or their positions in v (hd__an_build_sel),
+ * charged at its build's measured peak while built, then at what it
+ * holds (*bytes, to subtract when it is freed). */
+int hd__mpi_an_build(ctx_t *c, hd__an_t *s, const hd_points_t *v, const uint32_t *sel, const uint32_t *names,
+                     size_t m, const hd__box_t *kb, int threads, size_t *bytes);
+/* hd__an_nearest(asking, searched) into near (no distances, no partners),
+ * its own arrays charged while it runs. */
+int hd__mpi_an_nearest(ctx_t *c, const hd__an_t *asking, const hd__an_t *searched, int threads, size_t *near);
 /* Frees a structure hd__mpi_an_build made and takes its bytes off the count. */
 void hd__mpi_an_release(ctx_t *c, hd__an_t *s, size_t bytes);
-int hd__mpi_nearest_in_q(ctx_t *c, const dir_t *d, const hd__box_t *r, qtree_t *q, const double *pts, size_t n,
-                         size_t *near);
+/* For each of n points, point k at pts + 3 pos[k] (pos NULL: pts + 3 k),
+ * its nearest point of Q into near[k] (exact, smallest index on ties, as
+ * hd_distances gives it), from q's slabs (slab.c), built as needed. */
+int hd__mpi_nearest_in_q(ctx_t *c, const dir_t *d, const hd__box_t *r, qtree_t *q, const double *pts,
+                         const uint32_t *pos, size_t n, size_t *near);
 
 /* ---- the engine's pass and its shell (shell.c) --------------------------- */
 
 /* What the engine's pass leaves for per-point searches (shell.c's essay). */
 typedef struct {
-    const double *xyz;       /* the shell's points (P itself when all are) */
-    size_t n;
+    size_t n;                /* the shell's points, read in P (hd__mpi_shell_pt) */
     size_t *nearest;         /* each one's nearest in Q (NULL if Q is empty) */
-    double *own_xyz;         /* what was allocated for a proper subset */
-    uint32_t *own_pos;       /* ... with each one's position in P */
+    uint32_t *own_pos;       /* each one's position in P (NULL: all of P) */
     far_t inner;             /* exact over the interior; d2 = -1 if none
                                 or not known (lazy) */
     int lazy;                /* the interior's maximum was not computed */
     far_t h;                 /* then: the engine's answer, whose witness
                                 is in the shell and bounds the interior */
 } shell_t;
+
+/* The shell's point k: its coordinates are P's, not a copy. */
+static inline const double *hd__mpi_shell_pt(const dir_t *d, const shell_t *sh, size_t k) {
+    return d->P + 3 * (sh->own_pos ? sh->own_pos[k] : k);
+}
 
 /* The engine's answer for a direction, computed before it runs: the
  * symmetric call runs the engine once for both directions
@@ -414,11 +425,12 @@ void hd__mpi_pairs_free(ctx_t *c, pairs_t *pr);
 typedef int (*hd__mpi_answer_t)(ctx_t *c, void *arg, const double *pts, size_t m, ans_t *ans);
 
 /* One round of forwarding (collective; rc is the caller's status, agreed
- * first): each pair (k, r) sends point k of P to rank r, every rank
- * answers what it receives with fn, and each answer replaces (u2[k],
- * jj[k]) when smaller (d2 first, then the index). */
-int hd__mpi_round(ctx_t *c, int rc, const double *P, const pairs_t *pr, hd__mpi_answer_t fn, void *arg,
-                  double *u2, uint64_t *jj);
+ * first): each pair (k, r) sends point k of P (at P + 3 pos[k], pos NULL:
+ * P + 3 k) to rank r, every rank answers what it receives with fn, and
+ * each answer replaces (u2[k], jj[k]) when smaller (d2 first, then the
+ * index). */
+int hd__mpi_round(ctx_t *c, int rc, const double *P, const uint32_t *pos, const pairs_t *pr,
+                  hd__mpi_answer_t fn, void *arg, double *u2, uint64_t *jj);
 
 int hd__mpi_direction(ctx_t *c, const dir_t *d, const node_t *tree, const hd__box_t *region, const held_t *held,
                       far_t *result);

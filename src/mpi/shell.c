@@ -25,22 +25,20 @@
 #include <stdlib.h>
 
 void hd__mpi_shell_free(ctx_t *c, shell_t *sh) {
-    hd__mpi_free(c, sh->own_xyz, sh->n, 3 * sizeof(double));
     hd__mpi_free(c, sh->own_pos, sh->n, sizeof(uint32_t));
     hd__mpi_free(c, sh->nearest, sh->n, sizeof(size_t));
 }
 
 /* Stable partition in place of the coordinates (the indices stay by
  * position): the points k with keep[k] to the front, in order, the others
- * to aside (in order; NULL: the caller has them already).  unsplit puts
- * everything back. */
+ * to aside, in order.  unsplit puts everything back. */
 static void split(double *xyz, size_t n, const unsigned char *keep, double *axyz) {
     size_t t = 0, a = 0;
     for (size_t k = 0; k < n; k++) {
         if (keep[k]) {
             if (t != k) memcpy(xyz + 3 * t, xyz + 3 * k, 3 * sizeof(double));
             t++;
-        } else if (axyz) {
+        } else {
             memcpy(axyz + 3 * a++, xyz + 3 * k, 3 * sizeof(double));
         }
     }
@@ -253,18 +251,25 @@ int hd__mpi_interior_max(ctx_t *c, const dir_t *d, const hd__box_t *mine, const 
                          const far_t *G, far_t *out) {
     *out = (far_t){-1.0, UINT64_MAX, UINT64_MAX};
     unsigned char *in = hd__mpi_alloc(c, d->nP, 1);
-    if (!in) return hd__mpi_nomem(c, "the interior", d->nP);
+    /* the shell's points are moved aside here, not copied while searched */
+    double *aside = hd__mpi_alloc(c, sh->n, 3 * sizeof(double));
+    if (!in || !aside) {
+        hd__mpi_free(c, in, d->nP, 1);
+        hd__mpi_free(c, aside, sh->n, 3 * sizeof(double));
+        return hd__mpi_nomem(c, "the interior", d->nP);
+    }
     size_t nI = 0, below = 0;
     for (size_t k = 0; k < d->nP; k++) nI += in[k] = (unsigned char)hd__mpi_faces_clear(mine, d->P + 3 * k, h2);
-    assert(nI + sh->n == d->nP && sh->own_xyz);
+    assert(nI + sh->n == d->nP && sh->own_pos);
     gcur_t cu;
     hd__mpi_gcur_init(&cu, d->gP);
     for (size_t k = 0; k < d->nP && hd__mpi_gcur_at(&cu, k) < G->i; k++) below += in[k];
-    split(d->P, d->nP, in, NULL); /* the shell's copy is the aside */
+    split(d->P, d->nP, in, aside);
     hd_points_t Iv = hd_points_f64(d->P, nI), Qv = hd_points_f64(d->Q, d->nQ);
     hd_result_t e;
     int rc = G->d2 >= 0 ? hd__mpi_engine_above(c, &Iv, &Qv, G->d2, below, &e) : hd__mpi_engine_local(c, &Iv, &Qv, NULL, NULL, &e);
-    unsplit(d->P, d->nP, in, sh->own_xyz);
+    unsplit(d->P, d->nP, in, aside);
+    hd__mpi_free(c, aside, sh->n, 3 * sizeof(double));
     if (rc == HD_OK && (G->d2 < 0 || e.distance2 > G->d2 || (e.distance2 == G->d2 && e.i < below)))
         *out = (far_t){e.distance2, hd__mpi_gidx(d->gP, kept_at(in, d->nP, e.i)), hd__mpi_gidx(d->gQ, e.j)};
     hd__mpi_free(c, in, d->nP, 1);
@@ -280,7 +285,6 @@ uint64_t hd__mpi_shell_g(gcur_t *cu, const shell_t *sh, size_t k) {
 int hd__mpi_shell_of(ctx_t *c, const dir_t *d, const hd__box_t *mine, qtree_t *q, shell_t *sh) {
     memset(sh, 0, sizeof *sh);
     sh->inner = (far_t){-1.0, UINT64_MAX, UINT64_MAX};
-    sh->xyz = d->P;
     sh->n = d->nP;
     if (d->nP == 0 || d->nQ == 0) return HD_OK;
     hd_points_t Pv = hd_points_f64(d->P, d->nP), Qv = hd_points_f64(d->Q, d->nQ);
@@ -302,10 +306,17 @@ int hd__mpi_shell_of(ctx_t *c, const dir_t *d, const hd__box_t *mine, qtree_t *q
         return rc;
     }
     size_t nS = d->nP - nI;
-    /* The shell's points have u <= sqrt(h2) (those of the paired pass's
-     * interior, h_c) and lie within it of a face, so their nearest points
-     * lie within about 2 sqrt(h2) of one: the slab's margin. */
-    q->M0 = 2.5 * sqrt(done ? sh->inner.d2 : e.distance2);
+    /* The shell's points have u <= h = sqrt(h2) (those of the paired
+     * pass's interior, h_c) and lie within h of a face, so their nearest
+     * points lie within 2h of one.  Most are far nearer: their u is a
+     * point spacing, h the largest u of the rank (over water, at an
+     * outlier).  The first slab's margin is 1.5 h, which proves every
+     * point with u below half of h; the others ask a slab as wide as they
+     * need (slab.c), never wider than the 2h that would hold them all.
+     * (At 2.5 h the slab held up to half of Q on lidar at K = 16 and was
+     * the rank's memory peak; at 1.25 h, uniform sets at K = 2 needed the
+     * second slab: docs/scale-out.md.) */
+    q->M0 = 1.5 * sqrt(done ? sh->inner.d2 : e.distance2);
     if (done) {
         /* the interior's answer is the paired pass's */
     } else if (nI && in[e.i]) {
@@ -314,24 +325,18 @@ int hd__mpi_shell_of(ctx_t *c, const dir_t *d, const hd__box_t *mine, qtree_t *q
         sh->lazy = 1; /* interior_max, only if it can matter */
         sh->h = (far_t){e.distance2, hd__mpi_gidx(d->gP, e.i), hd__mpi_gidx(d->gQ, e.j)};
     }
-    if (rc == HD_OK && nS && nI) { /* a proper subset: copied */
+    if (rc == HD_OK && nS && nI) { /* a proper subset: its positions */
         sh->n = nS;
-        sh->own_xyz = hd__mpi_alloc(c, nS, 3 * sizeof(double));
-        sh->own_pos = hd__mpi_alloc(c, nS, sizeof(uint32_t));
-        if (!sh->own_xyz || !sh->own_pos) rc = hd__mpi_nomem(c, "the shell", nS);
+        if (!(sh->own_pos = hd__mpi_alloc(c, nS, sizeof(uint32_t)))) rc = hd__mpi_nomem(c, "the shell", nS);
         for (size_t k = 0, t = 0; k < d->nP && rc == HD_OK; k++)
-            if (!in[k]) {
-                memcpy(sh->own_xyz + 3 * t, d->P + 3 * k, 3 * sizeof(double));
-                sh->own_pos[t++] = (uint32_t)k;
-            }
-        sh->xyz = sh->own_xyz;
+            if (!in[k]) sh->own_pos[t++] = (uint32_t)k;
     }
     sh->n = nS;
     hd__mpi_free(c, in, d->nP, 1);
     if (rc == HD_OK && nS) {
         sh->nearest = hd__mpi_alloc(c, nS, sizeof(size_t));
         if (!sh->nearest) return hd__mpi_nomem(c, "nearest neighbours", nS);
-        rc = hd__mpi_nearest_in_q(c, d, mine, q, sh->xyz, nS, sh->nearest);
+        rc = hd__mpi_nearest_in_q(c, d, mine, q, d->P, sh->own_pos, nS, sh->nearest);
     }
     return rc;
 }

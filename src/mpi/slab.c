@@ -12,8 +12,12 @@
  * the first is built over a slab: the points of Q within a margin M of a
  * finite face.  An answer from the slab is the answer from all of Q when
  * every point left out is provably farther (slab_proves); the others,
- * when a few, are compared with every point of Q, else ask a slab twice as
- * wide as they need, then all of Q.
+ * when a few, are compared with every point of Q, else ask a slab as wide
+ * as they need and an eighth more (it replaces the first), then all of Q.
+ * The structures hold no copy of the points but their own: a slab's is
+ * built over Q's positions and answers with them, an asking one over the
+ * askers' positions and writes each answer at its asker
+ * (hd__an_build_sel).
  *
  * Proof.  A point b of Q left out has fl(|b_k - s|) > M for every finite
  * face s (on axis k) of the region, which holds b.  For a lo face s and any
@@ -30,22 +34,27 @@
 #include <assert.h>
 #include <stdlib.h>
 
-/* The nearest layer's bound on a structure being built (hausdorff.h,
- * hd_distances: up to about 60 bytes a point), charged while it is. */
-#define AN_BUILD_BYTES 60
-
-static size_t an_bytes(const hd__an_t *s) {
-    return (s->n + 4) * (3 * sizeof(double) + 0) + s->n * sizeof(uint32_t) + (s->nb + 1) * 4 * sizeof(uint32_t) +
-           (s->ng + 1) * 2 * sizeof(uint32_t) + s->nn * (sizeof(uint32_t) + 1 + 6 * sizeof(double));
+/* A structure is charged, once built, at the most its build held (the
+ * build's own account: what it allocated, hd__an_t.peak) on top of what
+ * this layer held meanwhile, then at what it keeps. */
+int hd__mpi_an_build(ctx_t *c, hd__an_t *s, const hd_points_t *v, const uint32_t *sel, const uint32_t *names,
+                     size_t m, const hd__box_t *kb, int threads, size_t *bytes) {
+    int rc = sel ? hd__an_build_sel(s, v, sel, names, m, kb, threads, &c->e)
+                 : hd__an_build(s, v, NULL, kb, threads, &c->e);
+    *bytes = 0;
+    if (rc != HD_OK) return rc;
+    hd__mpi_charge(c, s->peak);
+    c->cur -= s->peak;
+    *bytes = hd__an_bytes(s);
+    hd__mpi_charge(c, *bytes);
+    return rc;
 }
 
-int hd__mpi_an_build(ctx_t *c, hd__an_t *s, const hd_points_t *v, const hd__box_t *kb, int threads, size_t *bytes) {
-    size_t b = AN_BUILD_BYTES * v->count;
+int hd__mpi_an_nearest(ctx_t *c, const hd__an_t *asking, const hd__an_t *searched, int threads, size_t *near) {
+    size_t b = hd__an_nearest_bytes(asking, searched, threads);
     hd__mpi_charge(c, b);
-    int rc = hd__an_build(s, v, NULL, kb, threads, &c->e);
+    int rc = hd__an_nearest(asking, searched, NULL, threads, NULL, near, NULL, &c->e);
     c->cur -= b;
-    *bytes = rc == HD_OK ? an_bytes(s) : 0;
-    hd__mpi_charge(c, *bytes);
     return rc;
 }
 
@@ -56,7 +65,6 @@ void hd__mpi_an_release(ctx_t *c, hd__an_t *s, size_t bytes) {
 
 static void slab_free(ctx_t *c, slab_t *sl) {
     if (sl->built) hd__mpi_an_release(c, &sl->s, sl->bytes);
-    hd__mpi_free(c, sl->map, sl->n, sizeof(uint32_t));
     memset(sl, 0, sizeof *sl);
 }
 
@@ -81,71 +89,92 @@ static int slab_proves(const hd__box_t *r, double M, const double *x, double d2)
     return lb > 1e-140 && d2 < lb * lb * (1 - 1e-9);
 }
 
-/* The distance from b to the nearest finite face of r, as computed. */
-static double face_gap(const hd__box_t *r, const double *b) {
-    double g = INFINITY;
+/* The finite faces of a region: axis and place of each. */
+typedef struct {
+    int n, axis[6];
+    double at[6];
+} faces_t;
+
+static void faces_of(const hd__box_t *r, faces_t *f) {
+    f->n = 0;
     for (int a = 0; a < 3; a++) {
-        if (isfinite(r->lo[a]) && fabs(b[a] - r->lo[a]) < g) g = fabs(b[a] - r->lo[a]);
-        if (isfinite(r->hi[a]) && fabs(r->hi[a] - b[a]) < g) g = fabs(r->hi[a] - b[a]);
+        if (isfinite(r->lo[a])) f->axis[f->n] = a, f->at[f->n++] = r->lo[a];
+        if (isfinite(r->hi[a])) f->axis[f->n] = a, f->at[f->n++] = r->hi[a];
     }
-    return g;
 }
 
-/* Build the slab of margin M (infinite: all of Q). */
+/* Whether b is within M of a finite face (the computed |b_k - s| <= M:
+ * the proof's test, for a lo face or a hi face alike). */
+static int near_face(const faces_t *f, const double *b, double M) {
+    for (int k = 0; k < f->n; k++)
+        if (fabs(b[f->axis[k]] - f->at[k]) <= M) return 1;
+    return 0;
+}
+
+/* Build the slab of margin M (infinite: all of Q).  Its structure names
+ * its points by their positions in Q (hd__an_build_sel): no copy of them
+ * is made, and its answers need no map back. */
 static int slab_build(ctx_t *c, const dir_t *d, const hd__box_t *r, double M, slab_t *sl) {
     memset(sl, 0, sizeof *sl);
     sl->M = M;
-    double *xyz = NULL;
+    uint32_t *sel = NULL;
     int rc = HD_OK;
     size_t n = d->nQ;
+    hd_points_t v = hd_points_f64(d->Q, d->nQ);
     if (isfinite(M)) {
         n = 0;
-        for (size_t j = 0; j < d->nQ; j++) n += face_gap(r, d->Q + 3 * j) <= M;
-        sl->map = hd__mpi_alloc(c, n, sizeof(uint32_t));
-        xyz = hd__mpi_alloc(c, n, 3 * sizeof(double));
-        sl->n = n;
-        if (!sl->map || !xyz) rc = hd__mpi_nomem(c, "the searched slab", n);
+        faces_t f;
+        faces_of(r, &f);
+        for (size_t j = 0; j < d->nQ; j++) n += (size_t)near_face(&f, d->Q + 3 * j, M);
+        if (n > 0 && !(sel = hd__mpi_alloc(c, n, sizeof(uint32_t)))) rc = hd__mpi_nomem(c, "the searched slab", n);
         for (size_t j = 0, t = 0; j < d->nQ && rc == HD_OK; j++)
-            if (face_gap(r, d->Q + 3 * j) <= M) {
-                memcpy(xyz + 3 * t, d->Q + 3 * j, 3 * sizeof(double));
-                sl->map[t++] = (uint32_t)j;
+            if (near_face(&f, d->Q + 3 * j, M)) sel[t++] = (uint32_t)j;
+        /* the slab's box (keys only order, clamped: any box is exact) */
+        for (int a = 0; a < 3 && rc == HD_OK && n > 0; a++) {
+            double lo = d->Q[3 * (size_t)sel[0] + (size_t)a], hi = lo;
+            for (size_t t = 1; t < n; t++) {
+                double v = d->Q[3 * (size_t)sel[t] + (size_t)a];
+                lo = v < lo ? v : lo;
+                hi = v > hi ? v : hi;
             }
+            sl->kb.lo[a] = lo, sl->kb.hi[a] = hi;
+        }
+    } else if (n > 0) {
+        hd__box_of(d->Q, n, &sl->kb);
     }
     sl->n = n;
-    hd_points_t v = hd_points_f64(xyz ? xyz : d->Q, n);
     if (rc == HD_OK && n > 0) {
-        hd__box_of(xyz ? xyz : d->Q, n, &sl->kb); /* keys only order (clamped): any box is exact */
-        rc = hd__mpi_an_build(c, &sl->s, &v, &sl->kb, hd__thread_count(c->threads, n), &sl->bytes);
+        rc = hd__mpi_an_build(c, &sl->s, &v, sel, NULL, n, &sl->kb, hd__thread_count(c->threads, n), &sl->bytes);
         sl->built = 1; /* freed by slab_free whatever happened */
     }
-    hd__mpi_free(c, xyz, n, 3 * sizeof(double));
+    hd__mpi_free(c, sel, n, sizeof(uint32_t));
     return rc;
 }
 
-/* near[k] for the points pts[k], k in list[0..m), searched in a built slab:
- * Q's index of the nearest (smallest index on ties) within the slab, or
- * SIZE_MAX when the slab is empty. */
-static int slab_search(ctx_t *c, const slab_t *sl, const double *pts, const size_t *list, size_t m, size_t *near) {
+/* near[k] for the points k in list[0..m) (increasing), point k at pts +
+ * 3 pos[k] (pos NULL: pts + 3 k), searched in a built slab: Q's index of
+ * the nearest (smallest index on ties) within the slab, or SIZE_MAX when
+ * the slab is empty.  The asking structure names each point k (names[] or
+ * sel[], hd__an_build_sel), so the answers land in near[k] directly. */
+static int slab_search(ctx_t *c, const slab_t *sl, const double *pts, const uint32_t *pos, const uint32_t *list,
+                       size_t m, size_t *near) {
     if (m == 0) return HD_OK;
     if (sl->n == 0) {
         for (size_t t = 0; t < m; t++) near[list[t]] = SIZE_MAX;
         return HD_OK;
     }
-    double *xyz = hd__mpi_alloc(c, m, 3 * sizeof(double));
-    size_t *got = hd__mpi_alloc(c, m, sizeof(size_t));
-    int rc = HD_OK;
-    if (!xyz || !got) rc = hd__mpi_nomem(c, "the searches", m);
-    for (size_t t = 0; t < m && rc == HD_OK; t++) memcpy(xyz + 3 * t, pts + 3 * list[t], 3 * sizeof(double));
+    uint32_t *sel = NULL;
+    if (pos && !(sel = hd__mpi_alloc(c, m, sizeof(uint32_t)))) return hd__mpi_nomem(c, "the searches", m);
+    for (size_t t = 0; sel && t < m; t++) sel[t] = pos[list[t]];
+    const uint32_t *from = sel ? sel : list;
     hd__an_t asking;
     size_t ab = 0;
     int threads = hd__thread_count(c->threads, m > sl->n ? m : sl->n);
-    hd_points_t Sv = hd_points_f64(xyz, m);
-    if (rc == HD_OK && (rc = hd__mpi_an_build(c, &asking, &Sv, &sl->kb, threads, &ab)) == HD_OK)
-        rc = hd__an_nearest(&asking, &sl->s, NULL, threads, NULL, got, NULL, &c->e);
+    hd_points_t Sv = hd_points_f64(pts, (size_t)from[m - 1] + 1); /* from[] increases */
+    int rc = hd__mpi_an_build(c, &asking, &Sv, from, sel ? list : NULL, m, &sl->kb, threads, &ab);
+    hd__mpi_free(c, sel, m, sizeof(uint32_t));
+    if (rc == HD_OK) rc = hd__mpi_an_nearest(c, &asking, &sl->s, threads, near);
     if (ab) hd__mpi_an_release(c, &asking, ab);
-    for (size_t t = 0; t < m && rc == HD_OK; t++) near[list[t]] = sl->map ? sl->map[got[t]] : got[t];
-    hd__mpi_free(c, xyz, m, 3 * sizeof(double));
-    hd__mpi_free(c, got, m, sizeof(size_t));
     return rc;
 }
 
@@ -158,23 +187,27 @@ static int slab_search(ctx_t *c, const slab_t *sl, const double *pts, const size
  * points a rank): 160M instructions with 4, 176M with 0 or 1. */
 #define BRUTE_MAX 4
 
-/* For each of n packed points, the nearest point of Q (exact, smallest
- * index on ties, as hd_distances gives it). */
-int hd__mpi_nearest_in_q(ctx_t *c, const dir_t *d, const hd__box_t *r, qtree_t *q, const double *pts, size_t n,
-                        size_t *near) {
+int hd__mpi_nearest_in_q(ctx_t *c, const dir_t *d, const hd__box_t *r, qtree_t *q, const double *pts,
+                         const uint32_t *pos, size_t n, size_t *near) {
+#define X(k) (pts + 3 * (pos ? pos[k] : (k)))
     if (n == 0) return HD_OK;
     if (n > HD__AN_MAX_POINTS || d->nQ > HD__AN_MAX_POINTS) { /* hd_distances' kd-trees */
-        hd_points_t Sv = hd_points_f64(pts, n), Qv = hd_points_f64(d->Q, d->nQ);
+        double *own = pos ? hd__mpi_alloc(c, n, 3 * sizeof(double)) : NULL;
+        if (pos && !own) return hd__mpi_nomem(c, "the searches", n);
+        for (size_t k = 0; own && k < n; k++) memcpy(own + 3 * k, X(k), 3 * sizeof(double));
+        hd_points_t Sv = hd_points_f64(own ? own : pts, n), Qv = hd_points_f64(d->Q, d->nQ);
         hd_options_t o;
         hd_options_init(&o);
         o.threads = c->threads;
-        return hd_distances(&Sv, &Qv, &o, NULL, near, NULL, NULL, &c->e);
+        int rc = hd_distances(&Sv, &Qv, &o, NULL, near, NULL, NULL, &c->e);
+        hd__mpi_free(c, own, n, 3 * sizeof(double));
+        return rc;
     }
-    size_t *list = hd__mpi_alloc(c, n, sizeof(size_t));
+    uint32_t *list = hd__mpi_alloc(c, n, sizeof(uint32_t));
     if (!list) return hd__mpi_nomem(c, "the searches", n);
     int rc = HD_OK;
     size_t m = n;
-    for (size_t k = 0; k < n; k++) list[k] = k;
+    for (size_t k = 0; k < n; k++) list[k] = (uint32_t)k;
     /* the slab, a wider one for what it did not prove, then all of Q */
     for (int level = 0; level < 3 && m > 0 && rc == HD_OK; level++) {
         slab_t *sl = level == 2 ? &q->full : &q->sub;
@@ -189,12 +222,12 @@ int hd__mpi_nearest_in_q(ctx_t *c, const dir_t *d, const hd__box_t *r, qtree_t *
             for (size_t t = 0; t < m; t++) {
                 size_t j = near[list[t]];
                 at[t] = j;
-                best[t] = j == SIZE_MAX ? INFINITY : hd__d2(pts + 3 * list[t], d->Q + 3 * j);
+                best[t] = j == SIZE_MAX ? INFINITY : hd__d2(X(list[t]), d->Q + 3 * j);
             }
             for (size_t j = 0; j < d->nQ; j++) {
                 const double *b = d->Q + 3 * j;
                 for (size_t t = 0; t < m; t++) {
-                    const double *x = pts + 3 * list[t];
+                    const double *x = X(list[t]);
                     double dx = x[0] - b[0];
                     if (dx * dx > best[t]) continue;
                     double d2 = hd__d2(x, b);
@@ -205,29 +238,30 @@ int hd__mpi_nearest_in_q(ctx_t *c, const dir_t *d, const hd__box_t *r, qtree_t *
             m = 0;
             break;
         }
-        if (level == 1) { /* twice what the unproven need, if finite */
+        if (level == 1) { /* what the unproven need, and an eighth more, if finite */
             double need = q->sub.M;
             for (size_t t = 0; t < m; t++) {
                 size_t j = near[list[t]];
-                double u = j == SIZE_MAX ? INFINITY : sqrt(hd__d2(pts + 3 * list[t], d->Q + 3 * j));
-                double o = q->sub.M - slab_lb(r, q->sub.M, pts + 3 * list[t]); /* -(max o), about */
+                double u = j == SIZE_MAX ? INFINITY : sqrt(hd__d2(X(list[t]), d->Q + 3 * j));
+                double o = q->sub.M - slab_lb(r, q->sub.M, X(list[t])); /* -(max o), about */
                 if (u + o > need) need = u + o;
             }
-            M = 2 * need;
+            M = 1.125 * need;
             if (!isfinite(M) || M <= q->sub.M) continue;
             slab_free(c, &q->sub);
         }
         if (!sl->built && (rc = slab_build(c, d, r, M, sl)) != HD_OK) break;
-        if ((rc = slab_search(c, sl, pts, list, m, near)) != HD_OK) break;
+        if ((rc = slab_search(c, sl, pts, pos, list, m, near)) != HD_OK) break;
         if (level == 2) break;
         size_t keep = 0;
         for (size_t t = 0; t < m; t++) {
             size_t k = list[t], j = near[k];
-            if (j == SIZE_MAX || !slab_proves(r, sl->M, pts + 3 * k, hd__d2(pts + 3 * k, d->Q + 3 * j)))
+            if (j == SIZE_MAX || !slab_proves(r, sl->M, X(k), hd__d2(X(k), d->Q + 3 * j)))
                 list[keep++] = k;
         }
         m = keep;
     }
-    hd__mpi_free(c, list, n, sizeof(size_t));
+    hd__mpi_free(c, list, n, sizeof(uint32_t));
     return rc;
+#undef X
 }

@@ -32,7 +32,15 @@
  *    copies of one point is scanned as that one point (the sorts are
  *    stable, so its first copy has the smallest index), which keeps
  *    duplicates from costing a scan each.  Every node gets the exact box of
- *    its points.  The two sets are built side by side (stats.c).
+ *    its points.  The two sets are built side by side (stats.c).  A
+ *    structure may hold a selection of a set's points, read through the
+ *    selection and named as its caller says (hd__an_build_sel: the MPI
+ *    layer's slabs, with no copy of the points); the names increase along
+ *    the selection, so a stable sort's first copy of a point still has the
+ *    smallest name.  The node and bucket arrays grow as the octree is cut
+ *    (they were sized for the worst case, n + 1 buckets, and mostly never
+ *    touched), and the build keeps an account of every byte it allocates:
+ *    its peak (hd__an_t.peak) is what the MPI layer charges.
  *  - Search, a group at a time.  Every query first scans its seeds: the two
  *    searched buckets at its own bucket's place on the curve (the orders
  *    line up, so that is usually close), and the bucket reached from the
@@ -154,6 +162,7 @@
  */
 #include "nearest/nearest.h"
 
+#include <assert.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -170,8 +179,18 @@ typedef struct {
     hd__keygrid_t grid;
     size_t n;
     int parts;
-    uint64_t *a, *b; /* key << 32 | index: computed in a, sorted into b */
+    uint64_t *a, *b;     /* key << 32 | index: computed in a, sorted into b */
+    const uint32_t *sel; /* point i is the source's point sel[i] (NULL: i) */
+    const uint32_t *names; /* and is named names[i] (NULL: its number in the source) */
+    size_t bcap, ncap;   /* room in the per-bucket (and per-group) and per-node arrays */
+    size_t held, peak;   /* bytes allocated now and at most (hd__an_t.peak) */
 } build_ctx;
+
+/* The build's account of what it holds (hd__an_t.peak). */
+static void held_add(build_ctx *c, size_t bytes) {
+    c->held += bytes;
+    if (c->held > c->peak) c->peak = c->held;
+}
 
 /* Part p's share of [0, n). */
 static void part_range(const build_ctx *c, size_t part, size_t *lo, size_t *hi) {
@@ -185,7 +204,15 @@ static void key_task(void *vctx, size_t part, int worker) {
     build_ctx *c = vctx;
     size_t lo, hi;
     part_range(c, part, &lo, &hi);
-    hd__src_keys(&c->src, &c->grid, lo, hi, c->a);
+    if (!c->sel) {
+        hd__src_keys(&c->src, &c->grid, lo, hi, c->a);
+        return;
+    }
+    for (size_t i = lo; i < hi; i++) {
+        double p[3];
+        hd__src_get(&c->src, c->sel[i], p);
+        c->a[i] = (uint64_t)hd__key30(&c->grid, p) << 32 | (uint64_t)i;
+    }
 }
 
 /* Gather the points [task * GATHER_TASK, ...) in sorted order (positions
@@ -196,6 +223,20 @@ static void gather_task(void *vctx, size_t task, int worker) {
     build_ctx *c = vctx;
     hd__an_t *s = c->s;
     size_t lo = task * GATHER_TASK, hi = lo + GATHER_TASK < s->n + 4 ? lo + GATHER_TASK : s->n + 4;
+    const uint32_t *sel = c->sel, *names = c->names;
+    if (sel) { /* a selection (hd__an_build_sel): its own loop, the other is hot */
+        for (size_t at = lo; at < hi; at++) {
+            if (at + 16 < s->n && c->src.kind != HD__SRC_ANY)
+                __builtin_prefetch(c->src.base + (ptrdiff_t)sel[(uint32_t)c->b[at + 16]] *
+                                                     (c->src.kind == HD__SRC_F64 ? 24 : 12));
+            uint32_t i = (uint32_t)c->b[at < s->n ? at : s->n - 1];
+            double p[3];
+            hd__src_get(&c->src, sel[i], p);
+            s->x[at] = p[0], s->y[at] = p[1], s->z[at] = p[2];
+            s->idx[at] = names ? names[i] : sel[i];
+        }
+        return;
+    }
     for (size_t at = lo; at < hi; at++) {
         if (at + 16 < s->n && c->src.kind != HD__SRC_ANY)
             __builtin_prefetch(c->src.base + (ptrdiff_t)(uint32_t)c->b[at + 16] * (c->src.kind == HD__SRC_F64 ? 24 : 12));
@@ -268,7 +309,7 @@ static int cmp_u64(const void *x, const void *y) {
  * in keys[lo, hi), so that the octree can split it further.  Returns 0
  * when the points are all equal (nothing to split) or memory is short
  * (the cell then stays one large bucket: slower, still exact). */
-static int refine(hd__an_t *s, uint64_t *keys, size_t lo, size_t hi) {
+static int refine(build_ctx *c, hd__an_t *s, uint64_t *keys, size_t lo, size_t hi) {
     size_t m = hi - lo;
     hd__box_t box;
     double *v[3] = {s->x, s->y, s->z};
@@ -286,6 +327,9 @@ static int refine(hd__an_t *s, uint64_t *keys, size_t lo, size_t hi) {
     double *t = hd__malloc_array(m, 3 * sizeof *t);
     uint32_t *ti = hd__malloc_array(m, sizeof *ti);
     int ok = k2 && t && ti;
+    size_t temp = m * (sizeof *k2 + 3 * sizeof *t + sizeof *ti); /* m < n: no overflow */
+    held_add(c, temp);
+    c->held -= temp;
     if (ok) {
         for (size_t i = 0; i < m; i++) {
             double p[3] = {s->x[lo + i], s->y[lo + i], s->z[lo + i]};
@@ -310,6 +354,44 @@ static int refine(hd__an_t *s, uint64_t *keys, size_t lo, size_t hi) {
 /* Nested refinements followed, at most (each one splits its cell). */
 #define MAX_REFINE 6
 
+/* Array *p of `cap` elements of `size` bytes made `want` long, in the
+ * build's account (both blocks at once, as a copying realloc holds them). */
+static int grow(build_ctx *c, void **p, size_t cap, size_t want, size_t size) {
+    void *q = hd__realloc_array(*p, want, size);
+    if (!q) return HD_ENOMEM;
+    *p = q;
+    held_add(c, want * size); /* want * size: checked by hd__realloc_array */
+    c->held -= cap * size;
+    return HD_OK;
+}
+
+/* Half as much room again, or `need` if more. */
+static size_t grown(size_t cap, size_t need) {
+    return cap + cap / 2 > need ? cap + cap / 2 : need;
+}
+
+static int grow_nodes(build_ctx *c, size_t *cap, size_t need) {
+    hd__an_t *s = c->s;
+    size_t want = grown(*cap, need);
+    if (grow(c, (void **)&s->first, *cap, want, sizeof *s->first) ||
+        grow(c, (void **)&s->count, *cap, want, sizeof *s->count))
+        return HD_ENOMEM;
+    *cap = want;
+    return HD_OK;
+}
+
+/* The per-bucket and per-group arrays (a group holds a bucket or more, so
+ * there are never more groups than buckets) with room for `need`. */
+static int grow_buckets(build_ctx *c, size_t need) {
+    hd__an_t *s = c->s;
+    size_t want = grown(c->bcap, need), cap = c->bcap;
+    uint32_t **a[6] = {&s->start, &s->key, &s->stop, &s->leaf, &s->gstart, &s->glead};
+    for (int k = 0; k < 6; k++)
+        if (grow(c, (void **)a[k], cap, want, sizeof(uint32_t))) return HD_ENOMEM;
+    c->bcap = want;
+    return HD_OK;
+}
+
 /* The octree of the sorted keys, cells split until at most HD__AN_BUCKET
  * points remain (or their points are equal): node 0 is the root, the
  * children of a node are consecutive nodes, and the leaves are the buckets,
@@ -317,18 +399,7 @@ static int refine(hd__an_t *s, uint64_t *keys, size_t lo, size_t hi) {
  * bucket's first point on the grid of both sets).  The groups are the
  * largest nodes of at most HD__AN_GROUP points (or leaves): unions of whole
  * buckets (gstart[], glead[]). */
-static int grow_nodes(hd__an_t *s, size_t *cap, size_t need) {
-    size_t want = *cap + *cap / 2 > need ? *cap + *cap / 2 : need;
-    void *p;
-    if (!(p = hd__realloc_array(s->first, want, sizeof *s->first))) return HD_ENOMEM;
-    s->first = p;
-    if (!(p = hd__realloc_array(s->count, want, sizeof *s->count))) return HD_ENOMEM;
-    s->count = p;
-    *cap = want;
-    return HD_OK;
-}
-
-static int build_octree(build_ctx *c, size_t cap) {
+static int build_octree(build_ctx *c) {
     hd__an_t *s = c->s;
     uint64_t *keys = c->b;
     struct {
@@ -343,9 +414,11 @@ static int build_octree(build_ctx *c, size_t cap) {
         sp--;
         size_t lo = stack[sp].lo, hi = stack[sp].hi, node = stack[sp].node;
         int shift = stack[sp].shift, grouped = stack[sp].grouped, refined = stack[sp].refined;
+        /* Room for a leaf at nb, a group at ng <= nb, and start[nb + 1]. */
+        if (nb + 2 > c->bcap && grow_buckets(c, nb + 2)) return HD_ENOMEM;
         size_t ends[8];
         int nc = hi - lo <= HD__AN_BUCKET || shift < 32 ? 1 : split_cell(keys, lo, hi, &shift, ends);
-        if (nc == 1 && hi - lo > HD__AN_BUCKET && refined < MAX_REFINE && refine(s, keys, lo, hi)) {
+        if (nc == 1 && hi - lo > HD__AN_BUCKET && refined < MAX_REFINE && refine(c, s, keys, lo, hi)) {
             /* The new keys differ (the cell's extreme points on its widest
              * axis get cells 0 and 1023), so the cell now splits. */
             shift = 27 + 32, refined++;
@@ -365,7 +438,7 @@ static int build_octree(build_ctx *c, size_t cap) {
             s->start[nb++] = (uint32_t)lo;
             continue;
         }
-        if (nn + (size_t)nc > cap && grow_nodes(s, &cap, nn + (size_t)nc)) return HD_ENOMEM;
+        if (nn + (size_t)nc > c->ncap && grow_nodes(c, &c->ncap, nn + (size_t)nc)) return HD_ENOMEM;
         s->first[node] = (uint32_t)nn;
         s->count[node] = (uint8_t)nc;
         for (int k = nc - 1; k >= 0; k--) {
@@ -408,10 +481,11 @@ void hd__an_free(hd__an_t *s) {
     memset(s, 0, sizeof *s);
 }
 
-int hd__an_build(hd__an_t *s, const hd_points_t *p, const hd_transform_t *T, const hd__box_t *keybox,
-                 int threads, hd_error_t *err) {
+/* The structure of the points p[sel[i]], i < n (sel NULL: p's first n),
+ * each named names[i] (names NULL: by its number in p). */
+static int build(hd__an_t *s, const hd_points_t *p, const uint32_t *sel, const uint32_t *names, size_t n,
+                 const hd_transform_t *T, const hd__box_t *keybox, int threads, hd_error_t *err) {
     memset(s, 0, sizeof *s);
-    size_t n = p->count;
     if (n > HD__AN_MAX_POINTS)
         return hd__err(err, HD_EOVERFLOW, "at most %zu points per set, not %zu", (size_t)HD__AN_MAX_POINTS, n);
     s->n = n;
@@ -420,26 +494,33 @@ int hd__an_build(hd__an_t *s, const hd_points_t *p, const hd_transform_t *T, con
     memset(&c, 0, sizeof c);
     c.s = s;
     c.n = n;
+    c.sel = sel;
+    c.names = names;
+#ifndef NDEBUG
+    for (size_t t = 1; t < n && (sel || names); t++) /* names increase (the essay) */
+        assert(names ? names[t - 1] < names[t] : sel[t - 1] < sel[t]);
+#endif
     hd__src_init(&c.src, p, T);
     hd__keygrid_init(&c.grid, keybox);
     c.parts = threads > MAX_PARTS ? MAX_PARTS : threads;
     if ((size_t)c.parts > n / 65536 + 1) c.parts = (int)(n / 65536 + 1);
-    /* Node arrays grow as the octree is cut (a bucket usually holds a few
-     * dozen points; at worst there are fewer than 2n nodes, since every
-     * inner node has two children or more). */
-    size_t cap = n / 8 + 64;
+    /* Node and bucket arrays grow as the octree is cut (a bucket usually
+     * holds a few dozen points; at worst there are fewer than 2n nodes,
+     * since every inner node has two children or more). */
+    c.ncap = n / 8 + 64;
+    c.bcap = n / 16 + 64;
     s->x = hd__malloc_array(n + 4, sizeof *s->x);
     s->y = hd__malloc_array(n + 4, sizeof *s->y);
     s->z = hd__malloc_array(n + 4, sizeof *s->z);
     s->idx = hd__malloc_array(n + 4, sizeof *s->idx);
-    s->start = hd__malloc_array(n + 1, sizeof *s->start);
-    s->key = hd__malloc_array(n + 1, sizeof *s->key);
-    s->stop = hd__malloc_array(n + 1, sizeof *s->stop);
-    s->leaf = hd__malloc_array(n + 1, sizeof *s->leaf);
-    s->gstart = hd__malloc_array(n + 1, sizeof *s->gstart);
-    s->glead = hd__malloc_array(n + 1, sizeof *s->glead);
-    s->first = hd__malloc_array(cap, sizeof *s->first);
-    s->count = hd__malloc_array(cap, sizeof *s->count);
+    s->start = hd__malloc_array(c.bcap, sizeof *s->start);
+    s->key = hd__malloc_array(c.bcap, sizeof *s->key);
+    s->stop = hd__malloc_array(c.bcap, sizeof *s->stop);
+    s->leaf = hd__malloc_array(c.bcap, sizeof *s->leaf);
+    s->gstart = hd__malloc_array(c.bcap, sizeof *s->gstart);
+    s->glead = hd__malloc_array(c.bcap, sizeof *s->glead);
+    s->first = hd__malloc_array(c.ncap, sizeof *s->first);
+    s->count = hd__malloc_array(c.ncap, sizeof *s->count);
     /* The keys are computed in x[]'s memory, which the gather fills only
      * after the sort; hd__radix_sort makes three passes, an odd number, so
      * the sorted keys end in the other buffer.  Fresh memory costs a page
@@ -457,6 +538,9 @@ int hd__an_build(hd__an_t *s, const hd_points_t *p, const hd_transform_t *T, con
     hd__prefault(c.b, n * sizeof *c.b);
     int ok = s->x && s->y && s->z && s->idx && s->start && s->key && s->stop && s->leaf && s->gstart &&
              s->glead && s->first && s->count && c.a && c.b;
+    /* Every count is below 2^31 and every size a few bytes: no overflow. */
+    held_add(&c, (n + 4) * (3 * sizeof(double) + sizeof(uint32_t)) + 6 * c.bcap * sizeof(uint32_t) +
+                     c.ncap * (sizeof *s->first + sizeof *s->count) + n * sizeof *c.b);
     int rc = HD_OK;
     if (ok) {
         hd__parallel_for(c.parts, (size_t)c.parts, key_task, &c);
@@ -467,7 +551,7 @@ int hd__an_build(hd__an_t *s, const hd_points_t *p, const hd_transform_t *T, con
         if (rc == HD_OK) hd__parallel_for(threads, (n + 4 + GATHER_TASK - 1) / GATHER_TASK, gather_task, &c);
     }
     if (ok && rc == HD_OK) {
-        ok = build_octree(&c, cap) == HD_OK;
+        ok = build_octree(&c) == HD_OK;
         /* The keys' upper halves are kept (key32[]), moved down in their
          * own memory, which is touched already (a fresh array costs a page
          * fault per 4 KiB); the rest is given back before the boxes.  In
@@ -480,7 +564,23 @@ int hd__an_build(hd__an_t *s, const hd_points_t *p, const hd_transform_t *T, con
         }
         s->key32 = (uint32_t *)(void *)c.b;
         shrink((void **)&s->key32, n ? n : 1, sizeof *s->key32);
+        c.held -= n * (sizeof *c.b - sizeof *s->key32);
         c.a = c.b = NULL;
+        /* Give back what the bounds reserved (keeping a block if the
+         * system cannot shrink it) before the boxes are allocated. */
+        if (ok) {
+            shrink((void **)&s->start, s->nb + 1, sizeof *s->start);
+            shrink((void **)&s->leaf, s->nb, sizeof *s->leaf);
+            shrink((void **)&s->key, s->nb, sizeof *s->key);
+            shrink((void **)&s->stop, s->nb, sizeof *s->stop);
+            shrink((void **)&s->gstart, s->ng + 1, sizeof *s->gstart);
+            shrink((void **)&s->glead, s->ng, sizeof *s->glead);
+            shrink((void **)&s->first, s->nn, sizeof *s->first);
+            shrink((void **)&s->count, s->nn, sizeof *s->count);
+            c.held -= 6 * c.bcap * sizeof(uint32_t) + (c.ncap - s->nn) * (sizeof *s->first + sizeof *s->count);
+            c.held += (4 * s->nb + 2 * s->ng + 2) * sizeof(uint32_t);
+            held_add(&c, 6 * s->nn * sizeof(double));
+        }
         for (int d = 0; d < 3 && ok; d++) {
             s->lo[d] = hd__malloc_array(s->nn, sizeof(double));
             s->hi[d] = hd__malloc_array(s->nn, sizeof(double));
@@ -488,16 +588,6 @@ int hd__an_build(hd__an_t *s, const hd_points_t *p, const hd_transform_t *T, con
         }
     }
     if (ok && rc == HD_OK) {
-        /* Give back what the bounds reserved (keeping a block if the
-         * system cannot shrink it). */
-        shrink((void **)&s->start, s->nb + 1, sizeof *s->start);
-        shrink((void **)&s->leaf, s->nb, sizeof *s->leaf);
-        shrink((void **)&s->key, s->nb, sizeof *s->key);
-        shrink((void **)&s->stop, s->nb, sizeof *s->stop);
-        shrink((void **)&s->gstart, s->ng + 1, sizeof *s->gstart);
-        shrink((void **)&s->glead, s->ng, sizeof *s->glead);
-        shrink((void **)&s->first, s->nn, sizeof *s->first);
-        shrink((void **)&s->count, s->nn, sizeof *s->count);
         hd__parallel_for(threads, (s->nb + BOX_TASK - 1) / BOX_TASK, box_task, &c);
         /* Children come after their parent: boxes bottom-up. */
         for (size_t k = s->nn; k-- > 0;) {
@@ -524,7 +614,26 @@ int hd__an_build(hd__an_t *s, const hd_points_t *p, const hd_transform_t *T, con
         hd__an_free(s);
         return hd__err(err, rc, "%s", hd_strerror(rc));
     }
+    assert(c.held == hd__an_bytes(s));
+    s->peak = c.peak;
     return HD_OK;
+}
+
+int hd__an_build(hd__an_t *s, const hd_points_t *p, const hd_transform_t *T, const hd__box_t *keybox,
+                 int threads, hd_error_t *err) {
+    return build(s, p, NULL, NULL, p->count, T, keybox, threads, err);
+}
+
+int hd__an_build_sel(hd__an_t *s, const hd_points_t *p, const uint32_t *sel, const uint32_t *names, size_t m,
+                     const hd__box_t *keybox, int threads, hd_error_t *err) {
+    return build(s, p, sel, names, m, NULL, keybox, threads, err);
+}
+
+size_t hd__an_bytes(const hd__an_t *s) {
+    size_t n = s->n;
+    return (n + 4) * (3 * sizeof(double) + sizeof(uint32_t)) + n * sizeof(uint32_t) +
+           s->nb * 4 * sizeof(uint32_t) + s->ng * 2 * sizeof(uint32_t) + 2 * sizeof(uint32_t) +
+           s->nn * (sizeof *s->first + sizeof *s->count + 6 * sizeof(double));
 }
 
 /* ---- searching --------------------------------------------------------------- */
@@ -963,10 +1072,21 @@ HD__HOT static void query_task(void *vctx, size_t task, int worker) {
     }
 }
 
+/* The workers hd__an_nearest runs. */
+static int query_threads(const hd__an_t *asking, int threads) {
+    return hd__thread_count(threads, (asking->ng + GROUPS_PER_TASK - 1) / GROUPS_PER_TASK);
+}
+
+size_t hd__an_nearest_bytes(const hd__an_t *asking, const hd__an_t *searched, int threads) {
+    size_t w = (size_t)query_threads(asking, threads);
+    return w * (sizeof(cands_t) + searched->nb * (2 * sizeof(uint32_t) + 7 * sizeof(double))) +
+           asking->n * (sizeof(double) + sizeof(uint32_t));
+}
+
 int hd__an_nearest(const hd__an_t *asking, const hd__an_t *searched, const hd_points_t *partner,
                    int threads, double *dist, size_t *nearest, hd__an_counts_t *counts, hd_error_t *err) {
     size_t tasks = (asking->ng + GROUPS_PER_TASK - 1) / GROUPS_PER_TASK;
-    threads = hd__thread_count(threads, tasks);
+    threads = query_threads(asking, threads);
     query_ctx c = {asking, searched, partner && partner->count == asking->n ? partner : NULL, dist, nearest, NULL,
                    NULL, NULL};
     c.cand = hd__calloc_array((size_t)threads, sizeof *c.cand);

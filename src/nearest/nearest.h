@@ -44,6 +44,7 @@ typedef struct hd__an {
     uint32_t *first;       /* first child (children are consecutive), or bucket of a leaf */
     uint8_t *count;        /* children, 0 for a leaf */
     double *lo[3], *hi[3]; /* exact box of each node */
+    size_t peak;           /* the most bytes the build held at once */
 } hd__an_t;
 
 /* Most points per set (node and point numbers fit 32 bits with room). */
@@ -57,6 +58,25 @@ typedef struct hd__an {
 int hd__an_build(hd__an_t *s, const hd_points_t *p, const hd_transform_t *T, const hd__box_t *keybox,
                  int threads, hd_error_t *err);
 void hd__an_free(hd__an_t *s);
+
+/* The structure of the m points p[sel[0]], ..., p[sel[m - 1]] (each
+ * below p->count, m at most HD__AN_MAX_POINTS), point t named names[t], or
+ * sel[t] when names is NULL, the names increasing with t (asserted): the
+ * tie rule needs it.  idx[] holds the names, so searched, the
+ * structure answers with names (the smallest name among ties), and
+ * asking, its answers are written at their names (arrays that long).
+ * No copy of the points is made beyond the structure's own.  Returns as
+ * hd__an_build. */
+int hd__an_build_sel(hd__an_t *s, const hd_points_t *p, const uint32_t *sel, const uint32_t *names, size_t m,
+                     const hd__box_t *keybox, int threads, hd_error_t *err);
+
+/* The bytes a built structure holds (its build held at most s->peak). */
+size_t hd__an_bytes(const hd__an_t *s);
+
+/* The most bytes hd__an_nearest allocates for its own use with these
+ * structures and threads (the candidate lists of every worker, a list
+ * the length of searched's buckets, and two answers per asking point). */
+size_t hd__an_nearest_bytes(const hd__an_t *asking, const hd__an_t *searched, int threads);
 
 /* What the searches of one hd__an_nearest took (for tests: no answer
  * depends on it). */

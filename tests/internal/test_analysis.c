@@ -424,6 +424,76 @@ TEST(shuffled_copies_are_exact_and_mostly_settled_by_the_window) {
     CHECK(apart >= 4);
 }
 
+TEST(a_structure_over_selected_points_answers_with_their_names) {
+    /* hd__an_build_sel, as the MPI layer's slabs use it: B's structure
+     * holds a random subset of B named by B's numbers, A's a subset of A
+     * named by their ranks in it.  Each answer is the brute force's over
+     * the subset (smallest B number on ties: copies with ties, lattices,
+     * repeated points), written at the asking point's name; the build's
+     * account of its peak covers what it keeps. */
+    for (uint64_t seed = 41000; seed < 41000 + 3 * GEN_COPY_KINDS && !hdt_failed(); seed++) {
+        gen_rng_t g;
+        gen_seed(&g, seed);
+        int how = (int)(seed % GEN_COPY_KINDS), threads = seed % 2 ? 1 : 3;
+        size_t n = 2 + gen_u64(&g) % (seed % 4 == 0 ? 7000 : 1200);
+        CONTEXT("seed=%llu copy=%s n=%zu threads=%d", (unsigned long long)seed, gen_copy_name[how], n, threads);
+        double *a = malloc(24 * n), *b = malloc(24 * n), *bs = malloc(24 * n);
+        uint32_t *sa = malloc(4 * n), *sb = malloc(4 * n), *names = malloc(4 * n);
+        size_t *got = malloc(sizeof(size_t) * n);
+        gen_copy(&g, how, a, b, n);
+        size_t ma = 0, mb = 0, keep = 1 + gen_u64(&g) % 4; /* about keep in 5 */
+        for (size_t k = 0; k < n; k++) {
+            if (gen_u64(&g) % 5 < keep) sa[ma] = (uint32_t)k, names[ma] = (uint32_t)ma, ma++;
+            if (gen_u64(&g) % 5 < keep) memcpy(bs + 3 * mb, b + 3 * k, 24), sb[mb++] = (uint32_t)k;
+        }
+        if (mb == 0) memcpy(bs, b, 24), sb[mb++] = 0;
+        hd_points_t A = hd_points_f64(a, n), B = hd_points_f64(b, n);
+        hd__box_t box = union_box(a, b, n);
+        hd__an_t qa, qb;
+        CHECK_RC(hd__an_build_sel(&qb, &B, sb, NULL, mb, &box, threads, NULL), HD_OK);
+        CHECK_RC(hd__an_build_sel(&qa, &A, sa, names, ma, &box, threads, NULL), HD_OK);
+        CHECK(qb.peak >= hd__an_bytes(&qb) && qa.peak >= hd__an_bytes(&qa));
+        for (size_t t = 0; t < n; t++) got[t] = SIZE_MAX;
+        if (ma) CHECK_RC(hd__an_nearest(&qa, &qb, NULL, threads, NULL, got, NULL, NULL), HD_OK);
+        for (size_t t = 0; t < ma && !hdt_failed(); t++) {
+            size_t jb;
+            brute_nearest(a + 3 * sa[t], bs, mb, &jb);
+            CONTEXT("query %zu (point %u of A)", t, sa[t]);
+            CHECK_EQ(got[t], (size_t)sb[jb]);
+        }
+        for (size_t t = ma; t < n && !hdt_failed(); t++) CHECK_EQ(got[t], SIZE_MAX);
+        hd__an_free(&qa);
+        hd__an_free(&qb);
+        free(a), free(b), free(bs), free(sa), free(sb), free(names), free(got);
+    }
+}
+
+TEST(a_structure_build_holds_at_most_39_bytes_a_point) {
+    /* The build's account (hd__an_t.peak, which the MPI layer charges):
+     * coordinates and indices (28 B), the sort's keys (8 B), the node and
+     * bucket arrays grown as the octree is cut (about 2 B).  Sized for the
+     * worst case (n + 1 buckets) the bucket arrays alone were 24 B more. */
+    const size_t sizes[] = {1000, 200000, 1000000};
+    for (size_t k = 0; k < 3 && !hdt_failed(); k++) {
+        size_t n = sizes[k];
+        uint64_t seed = 52000 + k;
+        CONTEXT("seed=%llu n=%zu", (unsigned long long)seed, n);
+        gen_rng_t g;
+        gen_seed(&g, seed);
+        double *a = malloc(24 * n);
+        gen_cube(&g, a, n, -1.0, 1.0);
+        hd_points_t A = hd_points_f64(a, n);
+        hd__box_t box = union_box(a, a, n);
+        hd__an_t s;
+        CHECK_RC(hd__an_build(&s, &A, NULL, &box, 2, NULL), HD_OK);
+        CONTEXT("seed=%llu n=%zu peak=%zu kept=%zu", (unsigned long long)seed, n, s.peak, hd__an_bytes(&s));
+        CHECK(s.peak >= hd__an_bytes(&s));
+        CHECK(s.peak <= 39 * n + 4096);
+        hd__an_free(&s);
+        free(a);
+    }
+}
+
 TEST(the_window_gives_up_on_disjoint_sets_and_stays_exact) {
     /* Two Gaussians 20 sigma apart, and a lattice against a plane far
      * away: the points at a query's key on the other curve are far from
