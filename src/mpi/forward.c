@@ -139,12 +139,52 @@ static int answer(ctx_t *c, void *arg, const double *pts, size_t m, ans_t *ans) 
     }
     size_t *near = hd__mpi_alloc(c, m, sizeof(size_t));
     if (!near) return hd__mpi_nomem(c, "answers", m);
-    int rc = hd__mpi_nearest_in_q(c, d, a->mine, a->q, pts, NULL, m, near);
+    int rc = hd__mpi_nearest_in_q(c, d, a->mine, a->q, pts, NULL, m, near, NULL);
     gcur_t cq;
     hd__mpi_gcur_init(&cq, d->gQ);
     if (rc == HD_OK)
         for (size_t k = 0; k < m; k++)
             ans[k] = (ans_t){hd__d2(pts + 3 * k, d->Q + 3 * near[k]), hd__mpi_gcur_at(&cq, near[k])};
+    hd__mpi_free(c, near, m, sizeof(size_t));
+    return rc;
+}
+
+/* The shell's points the first slab answered without proof
+ * (sh->unproven) and that can still win (not below L, nor at L with an
+ * index above i_L): the answer each has now, the slab's or a smaller one
+ * from another rank, is its nearest when the slab's proof holds for it
+ * (every point of Q outside the slab is then farther; inside, the slab's
+ * answer was the nearest); the others ask all of Q (hd__mpi_nearest_in_q
+ * again), and the smaller answer is kept (d2 first, then the index). */
+static int resolve(ctx_t *c, const dir_t *d, const hd__box_t *mine, qtree_t *q, const shell_t *sh, double *u2,
+                   uint64_t *jj, double L, uint64_t iL) {
+    gcur_t cp;
+    size_t m = 0;
+    hd__mpi_gcur_init(&cp, d->gP);
+    for (size_t k = 0; k < sh->n; k++) {
+        if (!sh->unproven[k] || u2[k] < L || (u2[k] == L && hd__mpi_shell_g(&cp, sh, k) > iL)) continue;
+        m += !hd__mpi_slab_proves(mine, q->M0, hd__mpi_shell_pt(d, sh, k), u2[k]);
+    }
+    if (m == 0) return HD_OK;
+    uint32_t *pos = hd__mpi_alloc(c, m, sizeof(uint32_t)), *ks = hd__mpi_alloc(c, m, sizeof(uint32_t));
+    size_t *near = hd__mpi_alloc(c, m, sizeof(size_t));
+    int rc = pos && ks && near ? HD_OK : hd__mpi_nomem(c, "the searches", m);
+    hd__mpi_gcur_init(&cp, d->gP);
+    for (size_t k = 0, t = 0; k < sh->n && rc == HD_OK; k++) {
+        if (!sh->unproven[k] || u2[k] < L || (u2[k] == L && hd__mpi_shell_g(&cp, sh, k) > iL)) continue;
+        if (hd__mpi_slab_proves(mine, q->M0, hd__mpi_shell_pt(d, sh, k), u2[k])) continue;
+        ks[t] = (uint32_t)k;
+        pos[t++] = sh->own_pos ? sh->own_pos[k] : (uint32_t)k;
+    }
+    if (rc == HD_OK) rc = hd__mpi_nearest_in_q(c, d, mine, q, d->P, pos, m, near, NULL);
+    for (size_t t = 0; t < m && rc == HD_OK; t++) {
+        size_t k = ks[t];
+        double d2 = hd__d2(hd__mpi_shell_pt(d, sh, k), d->Q + 3 * near[t]);
+        uint64_t g = hd__mpi_gidx(d->gQ, near[t]);
+        if (d2 < u2[k] || (d2 == u2[k] && g < jj[k])) u2[k] = d2, jj[k] = g;
+    }
+    hd__mpi_free(c, pos, m, sizeof(uint32_t));
+    hd__mpi_free(c, ks, m, sizeof(uint32_t));
     hd__mpi_free(c, near, m, sizeof(size_t));
     return rc;
 }
@@ -184,7 +224,8 @@ int hd__mpi_direction(ctx_t *c, const dir_t *d, const node_t *tree, const hd__bo
             }
             u2[k] = hd__d2(p, d->Q + 3 * sh.nearest[k]);
             jj[k] = hd__mpi_gcur_at(&cq, sh.nearest[k]);
-            exact[k] = (unsigned char)hd__mpi_faces_clear(mine, p, u2[k]);
+            /* an answer the first slab did not prove is not exact yet (resolve) */
+            exact[k] = (unsigned char)(!sh.unproven[k] && hd__mpi_faces_clear(mine, p, u2[k]));
             far_t f = {u2[k], hd__mpi_shell_g(&cp, &sh, k), jj[k]};
             if (exact[k] && hd__mpi_far_better(&f, &Lmine)) Lmine = f;
         }
@@ -202,7 +243,8 @@ int hd__mpi_direction(ctx_t *c, const dir_t *d, const node_t *tree, const hd__bo
         hd__mpi_pairs_free(c, &pr);                                              \
         u2 = NULL, jj = NULL, exact = NULL, nbox = NULL, list = NULL;            \
         hd__mpi_free(c, sh.nearest, sh.n, sizeof(size_t));                       \
-        sh.nearest = NULL;                                                       \
+        hd__mpi_free(c, sh.unproven, sh.n, 1);                                   \
+        sh.nearest = NULL, sh.unproven = NULL;                                   \
         hd__mpi_qtree_free(c, &q);                                               \
     } while (0)
     if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
@@ -218,7 +260,7 @@ int hd__mpi_direction(ctx_t *c, const dir_t *d, const node_t *tree, const hd__bo
         int n = hd__mpi_asked(tree, nbox, held, K, d->qside, d->nQ == 0, hd__mpi_shell_pt(d, &sh, k), u2[k],
                                 c->rank, list);
         if (n == 0) {
-            exact[k] = 1; /* no other rank holds a point as near */
+            exact[k] = !(sh.unproven && sh.unproven[k]); /* no other rank holds a point as near */
             continue;
         }
         c->forwarded_points++;
@@ -226,6 +268,8 @@ int hd__mpi_direction(ctx_t *c, const dir_t *d, const node_t *tree, const hd__bo
     }
     answer_t an = {d, mine, &q};
     if ((rc = hd__mpi_round(c, rc, d->P, sh.own_pos, &pr, answer, &an, u2, jj)) != HD_OK) goto done;
+    /* local: a failure goes on to the agreement below, as the interior's */
+    if (nP && d->nQ) rc = resolve(c, d, mine, &q, &sh, u2, jj, L, iL);
     /* Every point that could win is now exact; the others cannot win (a
      * point at L with a larger index than i_L loses to i_L). */
     far_t best = sh.inner;
@@ -243,7 +287,7 @@ int hd__mpi_direction(ctx_t *c, const dir_t *d, const node_t *tree, const hd__bo
     DIRECTION_FREE();
     far_t G;
     MPI_GO(c, rc, MPI_Allreduce(&best, &G, 1, c->far_type, c->far_op, c->comm));
-    if (sh.lazy && hd__mpi_far_better(&sh.h, &G)) {
+    if (rc == HD_OK && sh.lazy && hd__mpi_far_better(&sh.h, &G)) {
         far_t I = {-1.0, UINT64_MAX, UINT64_MAX};
         double t1 = hd__now(), u1 = hd__mpi_cpu();
         rc = hd__mpi_interior_max(c, d, mine, &sh, sh.h.d2, &G, &I);

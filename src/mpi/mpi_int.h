@@ -368,9 +368,17 @@ int hd__mpi_an_nearest(ctx_t *c, const hd__an_t *asking, const hd__an_t *searche
 void hd__mpi_an_release(ctx_t *c, hd__an_t *s, size_t bytes);
 /* For each of n points, point k at pts + 3 pos[k] (pos NULL: pts + 3 k),
  * its nearest point of Q into near[k] (exact, smallest index on ties, as
- * hd_distances gives it), from q's slabs (slab.c), built as needed. */
+ * hd_distances gives it), from q's slabs (slab.c), built as needed.  With
+ * `unproven` (n flags, zeroed by the caller), a point the first slab
+ * answers but does not prove is left with that answer (a point of Q, so
+ * an upper bound of its nearest distance) and flagged, for the caller to
+ * prove by a smaller answer from elsewhere (hd__mpi_slab_proves with the
+ * first slab's margin, q->M0) or to ask again without `unproven`. */
 int hd__mpi_nearest_in_q(ctx_t *c, const dir_t *d, const hd__box_t *r, qtree_t *q, const double *pts,
-                         const uint32_t *pos, size_t n, size_t *near);
+                         const uint32_t *pos, size_t n, size_t *near, unsigned char *unproven);
+/* Whether every point of Q farther than M from all of r's finite faces is
+ * farther from x than sqrt(d2) (slab.c's proof). */
+int hd__mpi_slab_proves(const hd__box_t *r, double M, const double *x, double d2);
 
 /* ---- the engine's pass and its shell (shell.c) --------------------------- */
 
@@ -379,6 +387,8 @@ typedef struct {
     size_t n;                /* the shell's points, read in P (hd__mpi_shell_pt) */
     size_t *nearest;         /* each one's nearest in Q (NULL if Q is empty) */
     uint32_t *own_pos;       /* each one's position in P (NULL: all of P) */
+    unsigned char *unproven; /* each one's: nearest[] only a point of the first slab
+                                (hd__mpi_nearest_in_q), or NULL */
     far_t inner;             /* exact over the interior; d2 = -1 if none
                                 or not known (lazy) */
     int lazy;                /* the interior's maximum was not computed */

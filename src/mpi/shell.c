@@ -26,6 +26,7 @@
 
 void hd__mpi_shell_free(ctx_t *c, shell_t *sh) {
     hd__mpi_free(c, sh->own_pos, sh->n, sizeof(uint32_t));
+    hd__mpi_free(c, sh->unproven, sh->n, 1);
     hd__mpi_free(c, sh->nearest, sh->n, sizeof(size_t));
 }
 
@@ -335,8 +336,10 @@ int hd__mpi_shell_of(ctx_t *c, const dir_t *d, const hd__box_t *mine, qtree_t *q
     hd__mpi_free(c, in, d->nP, 1);
     if (rc == HD_OK && nS) {
         sh->nearest = hd__mpi_alloc(c, nS, sizeof(size_t));
-        if (!sh->nearest) return hd__mpi_nomem(c, "nearest neighbours", nS);
-        rc = hd__mpi_nearest_in_q(c, d, mine, q, d->P, sh->own_pos, nS, sh->nearest);
+        sh->unproven = hd__mpi_alloc(c, nS, 1);
+        if (!sh->nearest || !sh->unproven) return hd__mpi_nomem(c, "nearest neighbours", nS);
+        memset(sh->unproven, 0, nS);
+        rc = hd__mpi_nearest_in_q(c, d, mine, q, d->P, sh->own_pos, nS, sh->nearest, sh->unproven);
     }
     return rc;
 }

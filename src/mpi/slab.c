@@ -89,6 +89,10 @@ static int slab_proves(const hd__box_t *r, double M, const double *x, double d2)
     return lb > 1e-140 && d2 < lb * lb * (1 - 1e-9);
 }
 
+int hd__mpi_slab_proves(const hd__box_t *r, double M, const double *x, double d2) {
+    return slab_proves(r, M, x, d2);
+}
+
 /* The finite faces of a region: axis and place of each. */
 typedef struct {
     int n, axis[6];
@@ -188,7 +192,7 @@ static int slab_search(ctx_t *c, const slab_t *sl, const double *pts, const uint
 #define BRUTE_MAX 4
 
 int hd__mpi_nearest_in_q(ctx_t *c, const dir_t *d, const hd__box_t *r, qtree_t *q, const double *pts,
-                         const uint32_t *pos, size_t n, size_t *near) {
+                         const uint32_t *pos, size_t n, size_t *near, unsigned char *unproven) {
 #define X(k) (pts + 3 * (pos ? pos[k] : (k)))
     if (n == 0) return HD_OK;
     if (n > HD__AN_MAX_POINTS || d->nQ > HD__AN_MAX_POINTS) { /* hd_distances' kd-trees */
@@ -256,8 +260,9 @@ int hd__mpi_nearest_in_q(ctx_t *c, const dir_t *d, const hd__box_t *r, qtree_t *
         size_t keep = 0;
         for (size_t t = 0; t < m; t++) {
             size_t k = list[t], j = near[k];
-            if (j == SIZE_MAX || !slab_proves(r, sl->M, X(k), hd__d2(X(k), d->Q + 3 * j)))
-                list[keep++] = k;
+            if (j != SIZE_MAX && slab_proves(r, sl->M, X(k), hd__d2(X(k), d->Q + 3 * j))) continue;
+            if (unproven && level == 0 && j != SIZE_MAX) unproven[k] = 1; /* the caller's, with an answer */
+            else list[keep++] = k;
         }
         m = keep;
     }
