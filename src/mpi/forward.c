@@ -15,6 +15,12 @@
  *    at L, bounds the result from below: a point below (L, i_L) in the
  *    witness order cannot be the witness and is not forwarded.  A point
  *    at exactly L with a smaller index is forwarded.
+ *  - A shell point whose local answer the first slab did not prove
+ *    (sh.unproven) is never exact before the round: its answer is a point
+ *    of Q, an upper bound u2 of its nearest distance, so the ranks within
+ *    it are a superset of those it needs, and u2 below (L, i_L) still
+ *    means it cannot win.  After the round its answer is proven by the
+ *    slab's test, or searched again in all of the local Q (resolve).
  *  - One round of forwarding a direction: every bound is final before
  *    anything is sent.  Every collective is preceded by hd__mpi_agree.
  */

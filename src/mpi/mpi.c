@@ -64,9 +64,12 @@
  *     interior point is below that answer.  The rest, the shell within h
  *     of the faces, get per-point searches (the nearest layer's, as
  *     hd_distances runs them: the nearest local b, smallest index on
- *     ties) on a structure of the slab of local B within about 2h of the
- *     faces, which the forwarded queries of step 5 ask too; an answer the
- *     slab cannot prove (slab.c) asks a wider slab, then all of B.
+ *     ties) on a structure of the slab of local B within 1.5h of the
+ *     faces, which the forwarded queries of step 5 ask too; a shell
+ *     point's answer the slab cannot prove (slab.c) is an upper bound that
+ *     steps 4 and 5 use as it is, proven after the round by the smallest
+ *     answer or else searched again (forward.c, resolve): a wider slab,
+ *     then all of B.
  *     The engine prunes the points that cannot be the farthest, which
  *     per-point searches cannot: on two epochs of one scene that is tens
  *     of times less work.  For a copy and its original (point g of B the
