@@ -381,8 +381,8 @@ HD_EXTERN int hd_index_nearest(const hd_index_t *idx, const hd_points_t *Q,
  * Each set is sorted once along a Morton curve into an octree of small
  * buckets; each structure is searched by the other set's points, a group
  * of neighbouring queries at a time.  It holds a copy of the coordinates
- * (about 36 bytes per point per set while searching, up to about 60 while
- * building), freed before returning.  opt: NULL for defaults; only
+ * (about 36 bytes per point per set while searching, up to about 39
+ * while building), freed before returning.  opt: NULL for defaults; only
  * opt->threads is read (the method above is the only one: `algorithm` and
  * the other fields are ignored).  Thread safe for distinct outputs.
  * Errors: as hd_directed. */

@@ -125,8 +125,9 @@ typedef struct hd_mpi_stats {
                                    merging, boxes (the bookkeeping) */
     uint64_t peak_bytes_max;    /* most bytes a rank held at once for this
                                    call: its buffers, the per-point
-                                   searches' structures (up to 60 bytes a
-                                   point while built), and the engine's,
+                                   searches' structures (up to about 38
+                                   bytes a point while built, as their
+                                   builds count it), and the engine's,
                                    charged at what the engine held at
                                    most during each of its calls (about
                                    14.5 bytes a point of uniform sets,
@@ -197,7 +198,7 @@ int hd_mpi_directed(MPI_Comm comm, const hd_mpi_part_t *a, size_t na,
  * err: NULL, or receives the context of a failure.
  * Memory, per point a rank holds after the partition: under a byte (its
  *   coded index), about 37 bytes a point of each set for the nearest layer's
- *   structures, which hold the coordinates (60 while one is built), and
+ *   structures, which hold the coordinates (about 38 while one is built), and
  *   24 bytes a point of the direction being computed (16 after its local
  *   pass); 16 bytes a point of the rank's own input while the answers come
  *   back (32 while they are sent when the ranks' index runs interleave).

@@ -152,10 +152,11 @@
  * which there are far fewer than points), 12 bytes
  * per asking point for the answers in its order, and, per thread, 64
  * bytes per searched bucket for the candidates.  While a set is built it
- * holds up to about 60 bytes per point: 8 of sort keys beside the
- * coordinates (the sort's other buffer is x[]'s memory) and 24 of
- * per-bucket arrays sized for the worst case (one point per bucket), given
- * back once the octree is cut; the node arrays grow as needed.  What each
+ * holds up to about 38 bytes per point: 8 of sort keys beside the
+ * coordinates and indices (the sort's other buffer is x[]'s memory), and
+ * the node and per-bucket arrays, which grow as the octree is cut (sized
+ * for the worst case, one point a bucket, they took 24 bytes a point
+ * more); the build's account of it is hd__an_t.peak.  What each
  * of these choices was measured to save, and the times, are in
  * docs/benchmarks.md, "Analysis".  Sets of more than HD__AN_MAX_POINTS
  * points are refused with HD_EOVERFLOW (stats.c then uses the kd-trees).
