@@ -155,30 +155,39 @@ static int answer(ctx_t *c, void *arg, const double *pts, size_t m, ans_t *ans) 
     return rc;
 }
 
+/* Whether the shell's point k, at u2, is below (L, i_L) in the witness
+ * order, so that it cannot be the witness (cu: a cursor on P's indices,
+ * asked in increasing k). */
+static int loses(gcur_t *cu, const shell_t *sh, size_t k, double u2, double L, uint64_t iL) {
+    return u2 < L || (u2 == L && hd__mpi_shell_g(cu, sh, k) > iL);
+}
+
 /* The shell's points the first slab answered without proof
- * (sh->unproven) and that can still win (not below L, nor at L with an
- * index above i_L): the answer each has now, the slab's or a smaller one
- * from another rank, is its nearest when the slab's proof holds for it
- * (every point of Q outside the slab is then farther; inside, the slab's
- * answer was the nearest); the others ask all of Q (hd__mpi_nearest_in_q
- * again), and the smaller answer is kept (d2 first, then the index). */
+ * (sh->unproven) and that can still win: the answer each has now, the
+ * slab's or a smaller one from another rank, is its nearest when the
+ * slab's proof holds for it (every point of Q outside the slab is then
+ * farther; inside, the slab's answer was the nearest); the others ask all
+ * of Q (hd__mpi_nearest_in_q again), and the smaller answer is kept (d2
+ * first, then the index).  The flags of the points settled without a
+ * search are cleared on the way. */
 static int resolve(ctx_t *c, const dir_t *d, const hd__box_t *mine, qtree_t *q, const shell_t *sh, double *u2,
                    uint64_t *jj, double L, uint64_t iL) {
     gcur_t cp;
     size_t m = 0;
     hd__mpi_gcur_init(&cp, d->gP);
     for (size_t k = 0; k < sh->n; k++) {
-        if (!sh->unproven[k] || u2[k] < L || (u2[k] == L && hd__mpi_shell_g(&cp, sh, k) > iL)) continue;
-        m += !hd__mpi_slab_proves(mine, q->M0, hd__mpi_shell_pt(d, sh, k), u2[k]);
+        if (!sh->unproven[k]) continue;
+        int settled = loses(&cp, sh, k, u2[k], L, iL) ||
+                      hd__mpi_slab_proves(mine, q->M0, hd__mpi_shell_pt(d, sh, k), u2[k]);
+        sh->unproven[k] = (unsigned char)!settled;
+        m += !settled;
     }
     if (m == 0) return HD_OK;
     uint32_t *pos = hd__mpi_alloc(c, m, sizeof(uint32_t)), *ks = hd__mpi_alloc(c, m, sizeof(uint32_t));
     size_t *near = hd__mpi_alloc(c, m, sizeof(size_t));
     int rc = pos && ks && near ? HD_OK : hd__mpi_nomem(c, "the searches", m);
-    hd__mpi_gcur_init(&cp, d->gP);
     for (size_t k = 0, t = 0; k < sh->n && rc == HD_OK; k++) {
-        if (!sh->unproven[k] || u2[k] < L || (u2[k] == L && hd__mpi_shell_g(&cp, sh, k) > iL)) continue;
-        if (hd__mpi_slab_proves(mine, q->M0, hd__mpi_shell_pt(d, sh, k), u2[k])) continue;
+        if (!sh->unproven[k]) continue;
         ks[t] = (uint32_t)k;
         pos[t++] = sh->own_pos ? sh->own_pos[k] : (uint32_t)k;
     }
@@ -231,7 +240,7 @@ int hd__mpi_direction(ctx_t *c, const dir_t *d, const node_t *tree, const hd__bo
             u2[k] = hd__d2(p, d->Q + 3 * sh.nearest[k]);
             jj[k] = hd__mpi_gcur_at(&cq, sh.nearest[k]);
             /* an answer the first slab did not prove is not exact yet (resolve) */
-            exact[k] = (unsigned char)(!sh.unproven[k] && hd__mpi_faces_clear(mine, p, u2[k]));
+            exact[k] = (unsigned char)(!(sh.unproven && sh.unproven[k]) && hd__mpi_faces_clear(mine, p, u2[k]));
             far_t f = {u2[k], hd__mpi_shell_g(&cp, &sh, k), jj[k]};
             if (exact[k] && hd__mpi_far_better(&f, &Lmine)) Lmine = f;
         }
@@ -262,7 +271,7 @@ int hd__mpi_direction(ctx_t *c, const dir_t *d, const node_t *tree, const hd__bo
     /* The points to forward, as (point, rank) pairs. */
     hd__mpi_gcur_init(&cp, d->gP);
     for (size_t k = 0; k < nP && rc == HD_OK; k++) {
-        if (exact[k] || u2[k] < L || (u2[k] == L && hd__mpi_shell_g(&cp, &sh, k) > iL)) continue;
+        if (exact[k] || loses(&cp, &sh, k, u2[k], L, iL)) continue;
         int n = hd__mpi_asked(tree, nbox, held, K, d->qside, d->nQ == 0, hd__mpi_shell_pt(d, &sh, k), u2[k],
                                 c->rank, list);
         if (n == 0) {
@@ -281,7 +290,7 @@ int hd__mpi_direction(ctx_t *c, const dir_t *d, const node_t *tree, const hd__bo
     far_t best = sh.inner;
     hd__mpi_gcur_init(&cp, d->gP);
     for (size_t k = 0; k < nP; k++) {
-        if (u2[k] < L || (u2[k] == L && hd__mpi_shell_g(&cp, &sh, k) > iL)) continue;
+        if (loses(&cp, &sh, k, u2[k], L, iL)) continue;
         far_t f = {u2[k], hd__mpi_shell_g(&cp, &sh, k), jj[k]};
         if (hd__mpi_far_better(&f, &best)) best = f;
     }

@@ -312,8 +312,10 @@ int hd__mpi_shell_of(ctx_t *c, const dir_t *d, const hd__box_t *mine, qtree_t *q
      * points lie within 2h of one.  Most are far nearer: their u is a
      * point spacing, h the largest u of the rank (over water, at an
      * outlier).  The first slab's margin is 1.5 h, which proves every
-     * point with u below half of h; the others ask a slab as wide as they
-     * need (slab.c), never wider than the 2h that would hold them all.
+     * point with u below half of h; the others keep the slab's answer
+     * through the forwarding round (forward.c, resolve), and those still
+     * unproven then ask a slab as wide as they need (slab.c), never wider
+     * than the 2h that would hold them all.
      * (At 2.5 h the slab held up to half of Q on lidar at K = 16 and was
      * the rank's memory peak; at 1.25 h, uniform sets at K = 2 needed the
      * second slab: docs/scale-out.md.) */

@@ -11,7 +11,7 @@
  * within h of the region's faces, and queries from beyond the faces), so
  * the first is built over a slab: the points of Q within a margin M of a
  * finite face.  An answer from the slab is the answer from all of Q when
- * every point left out is provably farther (slab_proves); the others,
+ * every point left out is provably farther (hd__mpi_slab_proves); the others,
  * when a few, are compared with every point of Q, else ask a slab as wide
  * as they need and an eighth more (it replaces the first), then all of Q.
  * The structures hold no copy of the points but their own: a slab's is
@@ -84,13 +84,9 @@ static double slab_lb(const hd__box_t *r, double M, const double *x) {
     return (M + o) - 1e-12 * (M + fabs(o));
 }
 
-static int slab_proves(const hd__box_t *r, double M, const double *x, double d2) {
+int hd__mpi_slab_proves(const hd__box_t *r, double M, const double *x, double d2) {
     double lb = slab_lb(r, M, x);
     return lb > 1e-140 && d2 < lb * lb * (1 - 1e-9);
-}
-
-int hd__mpi_slab_proves(const hd__box_t *r, double M, const double *x, double d2) {
-    return slab_proves(r, M, x, d2);
 }
 
 /* The finite faces of a region: axis and place of each. */
@@ -137,9 +133,9 @@ static int slab_build(ctx_t *c, const dir_t *d, const hd__box_t *r, double M, sl
         for (int a = 0; a < 3 && rc == HD_OK && n > 0; a++) {
             double lo = d->Q[3 * (size_t)sel[0] + (size_t)a], hi = lo;
             for (size_t t = 1; t < n; t++) {
-                double v = d->Q[3 * (size_t)sel[t] + (size_t)a];
-                lo = v < lo ? v : lo;
-                hi = v > hi ? v : hi;
+                double x = d->Q[3 * (size_t)sel[t] + (size_t)a];
+                lo = x < lo ? x : lo;
+                hi = x > hi ? x : hi;
             }
             sl->kb.lo[a] = lo, sl->kb.hi[a] = hi;
         }
@@ -260,7 +256,7 @@ int hd__mpi_nearest_in_q(ctx_t *c, const dir_t *d, const hd__box_t *r, qtree_t *
         size_t keep = 0;
         for (size_t t = 0; t < m; t++) {
             size_t k = list[t], j = near[k];
-            if (j != SIZE_MAX && slab_proves(r, sl->M, X(k), hd__d2(X(k), d->Q + 3 * j))) continue;
+            if (j != SIZE_MAX && hd__mpi_slab_proves(r, sl->M, X(k), hd__d2(X(k), d->Q + 3 * j))) continue;
             if (unproven && level == 0 && j != SIZE_MAX) unproven[k] = 1; /* the caller's, with an answer */
             else list[keep++] = k;
         }

@@ -371,13 +371,14 @@ static size_t grown(size_t cap, size_t need) {
     return cap + cap / 2 > need ? cap + cap / 2 : need;
 }
 
-static int grow_nodes(build_ctx *c, size_t *cap, size_t need) {
+/* The node arrays with room for `need`. */
+static int grow_nodes(build_ctx *c, size_t need) {
     hd__an_t *s = c->s;
-    size_t want = grown(*cap, need);
-    if (grow(c, (void **)&s->first, *cap, want, sizeof *s->first) ||
-        grow(c, (void **)&s->count, *cap, want, sizeof *s->count))
+    size_t want = grown(c->ncap, need), cap = c->ncap;
+    if (grow(c, (void **)&s->first, cap, want, sizeof *s->first) ||
+        grow(c, (void **)&s->count, cap, want, sizeof *s->count))
         return HD_ENOMEM;
-    *cap = want;
+    c->ncap = want;
     return HD_OK;
 }
 
@@ -439,7 +440,7 @@ static int build_octree(build_ctx *c) {
             s->start[nb++] = (uint32_t)lo;
             continue;
         }
-        if (nn + (size_t)nc > c->ncap && grow_nodes(c, &c->ncap, nn + (size_t)nc)) return HD_ENOMEM;
+        if (nn + (size_t)nc > c->ncap && grow_nodes(c, nn + (size_t)nc)) return HD_ENOMEM;
         s->first[node] = (uint32_t)nn;
         s->count[node] = (uint8_t)nc;
         for (int k = nc - 1; k >= 0; k--) {
@@ -565,7 +566,6 @@ static int build(hd__an_t *s, const hd_points_t *p, const uint32_t *sel, const u
         }
         s->key32 = (uint32_t *)(void *)c.b;
         shrink((void **)&s->key32, n ? n : 1, sizeof *s->key32);
-        c.held -= n * (sizeof *c.b - sizeof *s->key32);
         c.a = c.b = NULL;
         /* Give back what the bounds reserved (keeping a block if the
          * system cannot shrink it) before the boxes are allocated. */
@@ -578,9 +578,10 @@ static int build(hd__an_t *s, const hd_points_t *p, const uint32_t *sel, const u
             shrink((void **)&s->glead, s->ng, sizeof *s->glead);
             shrink((void **)&s->first, s->nn, sizeof *s->first);
             shrink((void **)&s->count, s->nn, sizeof *s->count);
-            c.held -= 6 * c.bcap * sizeof(uint32_t) + (c.ncap - s->nn) * (sizeof *s->first + sizeof *s->count);
-            c.held += (4 * s->nb + 2 * s->ng + 2) * sizeof(uint32_t);
-            held_add(&c, 6 * s->nn * sizeof(double));
+            /* From here on the structure holds what it keeps, the boxes
+             * allocated next among it. */
+            c.held = 0;
+            held_add(&c, hd__an_bytes(s));
         }
         for (int d = 0; d < 3 && ok; d++) {
             s->lo[d] = hd__malloc_array(s->nn, sizeof(double));
@@ -615,7 +616,6 @@ static int build(hd__an_t *s, const hd_points_t *p, const uint32_t *sel, const u
         hd__an_free(s);
         return hd__err(err, rc, "%s", hd_strerror(rc));
     }
-    assert(c.held == hd__an_bytes(s));
     s->peak = c.peak;
     return HD_OK;
 }
