@@ -94,7 +94,8 @@ typedef struct hd_mpi_stats {
     uint64_t points;            /* input points of A and B */
     uint64_t bytes_partition;   /* bytes sent to other ranks to move the
                                    points (28 a point moved) and choose the
-                                   regions (the samples) */
+                                   regions (the samples, and the counts
+                                   that refine the splits) */
     uint64_t bytes_forwarding;  /* bytes of forwarded queries (24 each) and
                                    their answers (16 each) */
     uint64_t bytes_returned;    /* hd_mpi_distances: bytes of per-point

@@ -24,7 +24,13 @@
  *     (coordinate, set, global index), so points on the split plane are
  *     divided too (a lattice, or every point equal, still balances); a
  *     point goes left when its key is smaller.  The tree (k - 1 nodes) is
- *     broadcast; each rank's region is a box (faces at split coordinates,
+ *     broadcast, and each split is then moved, level by level, to the plane
+ *     of its node's bracket that divides a second, larger sample (up to
+ *     32768 a rank) nearest to floor(k/2)/k, counted exactly by one
+ *     all-reduce a level (rcb.c, refine: 1024 samples a rank leave a region
+ *     up to 13 % above its share, the second ones within 2 %).  Any
+ *     tree is a correct partition; the samples decide only the balance.
+ *     Each rank's region is a box (faces at split coordinates,
  *     infinite outside), and every point of another region lies on or
  *     beyond one of its faces.
  *  2. MPI_Alltoallv moves each point to the rank of its region as its

@@ -25,10 +25,15 @@
  */
 #include "mpi_int.h"
 
+#include <assert.h>
 #include <limits.h>
+#include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 #define SAMPLES_PER_RANK 1024
+#define REFINE_PER_RANK 32768 /* the second samples (refine) */
+#define REFINE_BINS 64
 
 static int key_less(const double *x, uint64_t side, uint64_t g, int axis,
                     const double *y, uint64_t yside, uint64_t yg) {
@@ -68,12 +73,17 @@ static void select_nth(sample_t *s, size_t n, size_t m, int axis) {
     }
 }
 
-/* Node for k ranks r0.. over samples s[0..n); returns its id or -(r0 + 1). */
-static int build(node_t *t, int *next, sample_t *s, size_t n, int r0, int k) {
+/* Node for k ranks r0.. over samples s[0..n); returns its id or -(r0 + 1).
+ * br[2 id], br[2 id + 1]: the coordinates, on the node's axis, of the
+ * samples about three standard deviations of a sample quantile either side
+ * of the split (the range refine() searches; lo > hi: none). */
+static int build(node_t *t, double *br, int *next, sample_t *s, size_t n, int r0, int k) {
     if (k == 1) return -(r0 + 1);
     int id = (*next)++, kl = k / 2;
     node_t nd = {INFINITY, 0, 0, 0, 0, 0, 0}; /* no samples: all go left */
     size_t m = 0;
+    br[2 * id] = INFINITY;
+    br[2 * id + 1] = -INFINITY;
     if (n > 0) {
         double lo[3], hi[3];
         for (int a = 0; a < 3; a++) lo[a] = hi[a] = s[0].x[a];
@@ -90,9 +100,21 @@ static int build(node_t *t, int *next, sample_t *s, size_t n, int r0, int k) {
         nd.s = s[m].x[nd.axis];
         nd.side = s[m].side;
         nd.g = s[m].g;
+        /* Selecting within each side keeps both sides' sets of samples. */
+        size_t w = (size_t)(3.0 * sqrt((double)n)) + 2;
+        br[2 * id] = lo[nd.axis];
+        br[2 * id + 1] = hi[nd.axis];
+        if (m >= w) {
+            select_nth(s, m, m - w, nd.axis);
+            br[2 * id] = s[m - w].x[nd.axis];
+        }
+        if (n - m > w) {
+            select_nth(s + m + 1, n - m - 1, w - 1, nd.axis);
+            br[2 * id + 1] = s[m + w].x[nd.axis];
+        }
     }
-    nd.left = build(t, next, s, m, r0, kl);
-    nd.right = build(t, next, s + m, n - m, r0 + kl, k - kl);
+    nd.left = build(t, br, next, s, m, r0, kl);
+    nd.right = build(t, br, next, s + m, n - m, r0 + kl, k - kl);
     t[id] = nd;
     return id;
 }
@@ -136,21 +158,6 @@ void hd__mpi_candidates(const node_t *t, const hd__box_t *nbox, const held_t *he
     hd__mpi_candidates(t, nbox, held, side, t[node].right, p, u2, me, list, n);
 }
 
-/* Local point t (A's parts in order, then B's) as side, part index. */
-typedef struct { int side; size_t part, k; } cursor_t;
-
-static void cursor_seek(const input_t *in, uint64_t t, cursor_t *cu) {
-    for (int s = 0; s < 2; s++)
-        for (size_t p = 0; p < in->nparts[s]; p++) {
-            size_t n = in->parts[s][p].points.count;
-            if (t < n) {
-                *cu = (cursor_t){s, p, (size_t)t};
-                return;
-            }
-            t -= n;
-        }
-}
-
 int hd__mpi_asked(const node_t *t, const hd__box_t *nbox, const held_t *held, int K, int side, int none_here,
                   const double *p, double u2, int me, int *list) {
     double bound = u2;
@@ -165,28 +172,165 @@ int hd__mpi_asked(const node_t *t, const hd__box_t *nbox, const held_t *held, in
     return n;
 }
 
-/* Rank 0 builds the RCB tree from everyone's samples; all get it. */
+/* ns samples of this rank's nloc points (A's parts in order, then B's:
+ * local point t is the t-th of them), evenly spaced, into out. */
+static void take_samples(const input_t *in, uint64_t nloc, size_t ns, sample_t *out) {
+    int side = 0;
+    size_t part = 0;
+    uint64_t base = 0; /* local number of the part's first point */
+    for (size_t t = 0; t < ns; t++) {
+        uint64_t at = (uint64_t)(((double)t + 0.5) * (double)nloc / (double)ns);
+        if (at >= nloc) at = nloc - 1;
+        /* at grows with t: the part that holds it is this one or a later one */
+        while (part >= in->nparts[side] || at - base >= in->parts[side][part].points.count) {
+            if (part < in->nparts[side]) base += in->parts[side][part++].points.count;
+            else side++, part = 0;
+        }
+        const hd_mpi_part_t *p = &in->parts[side][part];
+        hd__mpi_get_point(&p->points, (size_t)(at - base), out[t].x);
+        out[t].g = p->offset + (at - base);
+        out[t].side = (uint64_t)side;
+    }
+}
+
+/* How many of this rank's nloc points to sample, when the job samples
+ * `rate` of its points: at least one from a rank that has points. */
+static size_t sample_count(uint64_t nloc, double rate) {
+    size_t ns = (size_t)(rate * (double)nloc + 0.5);
+    if (ns > nloc) ns = (size_t)nloc;
+    if (ns == 0 && nloc > 0) ns = 1;
+    return ns;
+}
+
+/* Node id's depth and number of ranks (leaves) below it. */
+static int shape(const node_t *t, int node, int depth, int *dep, int *ranks) {
+    if (node < 0) return 1;
+    dep[node] = depth;
+    ranks[node] = shape(t, t[node].left, depth + 1, dep, ranks) + shape(t, t[node].right, depth + 1, dep, ranks);
+    return ranks[node];
+}
+
+/* Edge j of node id's REFINE_BINS bins over [lo, hi]: nondecreasing in j,
+ * the same double on every rank. */
+static double edge(const double *br, int id, int j) {
+    double lo = br[2 * id], hi = br[2 * id + 1];
+    return j == REFINE_BINS ? hi : lo + (hi - lo) * ((double)j / REFINE_BINS);
+}
+
+/* The second step of the partition.  Rank 0's tree divides the first
+ * samples (1024 a rank) exactly, but a sample quantile is off the true one
+ * by about a standard deviation of 1 / (2 sqrt(samples)) of the node's
+ * points: 1-2 % of a leaf's, and the largest of K regions a few times that
+ * (docs/scale-out.md, "The partition refined").  So each split is moved, level by
+ * level from the root, to the best of REFINE_BINS + 1 planes spread over
+ * its bracket (build) or kept, judged by exact counts of a second, larger
+ * sample (REFINE_PER_RANK a rank, at most a quarter of the points) routed
+ * through the tree as refined so far: one all-reduce of REFINE_BINS + 3
+ * counts a node per level, no gather.  A plane at coordinate e is the key
+ * (e, 0, 0): a point goes left when its coordinate is below e.
+ * Invariants: every rank decides from the same summed counts with the same
+ * arithmetic, so the tree stays identical on all ranks; a split moves only
+ * to a candidate that divides the second sample strictly closer to
+ * floor(k/2)/k than the split it replaces (never worse on what it
+ * measures); any split is a valid partition, so the result never depends
+ * on it, only the balance does. */
+static int refine(ctx_t *c, const input_t *in, uint64_t N, node_t *tree, const double *br) {
+    int rc = HD_OK, K = c->K, nodes = K - 1;
+    uint64_t nloc = in->n[0] + in->n[1];
+    double rate = (double)REFINE_PER_RANK * K / (double)N;
+    if (rate > 0.25) rate = 0.25;
+    if (rate * (double)N <= 2.0 * SAMPLES_PER_RANK * K) return HD_OK; /* no more than the first samples */
+    size_t ns = sample_count(nloc, rate), width = REFINE_BINS + 3;
+    sample_t *r = hd__mpi_alloc(c, ns, sizeof(sample_t));
+    int *dep = hd__mpi_alloc(c, 3 * (size_t)nodes, sizeof(int));
+    int *at = hd__mpi_alloc(c, ns, sizeof(int)); /* each sample's node at the current depth */
+    uint64_t *cnt = hd__mpi_alloc(c, 2 * (size_t)nodes * width, sizeof(uint64_t));
+    double *edges = hd__mpi_alloc(c, (size_t)nodes * (REFINE_BINS + 1), sizeof(double));
+    if (!r || !dep || !at || !cnt || !edges) rc = hd__mpi_nomem(c, "the partition's second samples", ns);
+    if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
+    take_samples(in, nloc, ns, r);
+    int *ranks = dep + nodes, *slot = dep + 2 * (size_t)nodes; /* slot: index among its depth's nodes */
+    shape(tree, 0, 0, dep, ranks);
+    for (size_t q = 0; q < ns; q++) at[q] = 0;
+    for (int depth = 0;; depth++) {
+        int level = 0;
+        for (int id = 0; id < nodes; id++) {
+            slot[id] = dep[id] == depth ? level++ : -1;
+            for (int j = 0; slot[id] >= 0 && j <= REFINE_BINS; j++)
+                edges[(size_t)id * (REFINE_BINS + 1) + (size_t)j] = edge(br, id, j);
+        }
+        if (!level) break;
+        uint64_t *sum = cnt + (size_t)level * width;
+        memset(cnt, 0, (size_t)level * width * sizeof *cnt);
+        for (size_t q = 0; q < ns; q++) {
+            int id = at[q];
+            if (id < 0) continue;
+            assert(slot[id] >= 0);
+            const node_t *nd = &tree[id];
+            uint64_t *h = cnt + (size_t)slot[id] * width;
+            double v = r[q].x[nd->axis];
+            const double *e = edges + (size_t)id * (REFINE_BINS + 1);
+            int lo = 0, hi = REFINE_BINS + 1; /* how many edges are <= v: in [lo, hi] */
+            if (br[2 * id] > br[2 * id + 1] || v < e[0]) hi = 0; /* most are outside the bracket */
+            else if (v >= e[REFINE_BINS]) lo = hi;
+            else
+                while (lo < hi) {
+                    int mid = (lo + hi) / 2;
+                    if (e[mid] <= v) lo = mid + 1;
+                    else hi = mid;
+                }
+            h[lo]++;
+            h[REFINE_BINS + 2] += (uint64_t)hd__mpi_goes_left(nd, r[q].x, r[q].side, r[q].g);
+        }
+        MPI_GO(c, rc, MPI_Allreduce(cnt, sum, (int)((size_t)level * width), MPI_UINT64_T, MPI_SUM, c->comm));
+        c->bytes_part += (uint64_t)level * width * sizeof *cnt; /* what this rank contributed */
+        for (int id = 0; id < nodes; id++) {
+            if (slot[id] < 0 || br[2 * id] > br[2 * id + 1] || tree[id].s == INFINITY) continue;
+            const uint64_t *h = sum + (size_t)slot[id] * width;
+            uint64_t total = 0;
+            for (int t = 0; t <= REFINE_BINS + 1; t++) total += h[t];
+            double want = (double)total * (double)(ranks[id] / 2) / (double)ranks[id];
+            double best = fabs((double)h[REFINE_BINS + 2] - want);
+            uint64_t left = 0;
+            int pick = -1;
+            for (int j = 0; j <= REFINE_BINS; j++) {
+                left += h[j]; /* points below edge j */
+                if (fabs((double)left - want) < best) best = fabs((double)left - want), pick = j;
+            }
+            if (pick >= 0) {
+                tree[id].s = edges[(size_t)id * (REFINE_BINS + 1) + (size_t)pick];
+                tree[id].side = 0;
+                tree[id].g = 0;
+            }
+        }
+        for (size_t q = 0; q < ns; q++)
+            if (at[q] >= 0) {
+                const node_t *nd = &tree[at[q]];
+                at[q] = hd__mpi_goes_left(nd, r[q].x, r[q].side, r[q].g) ? nd->left : nd->right;
+            }
+    }
+done:
+    hd__mpi_free(c, r, ns, sizeof(sample_t));
+    hd__mpi_free(c, dep, 3 * (size_t)nodes, sizeof(int));
+    hd__mpi_free(c, at, ns, sizeof(int));
+    hd__mpi_free(c, cnt, 2 * (size_t)nodes * width, sizeof(uint64_t));
+    hd__mpi_free(c, edges, (size_t)nodes * (REFINE_BINS + 1), sizeof(double));
+    return rc;
+}
+
+/* Rank 0 builds the RCB tree from everyone's samples; all get it, and
+ * refine() then moves its splits by a second sample's exact counts. */
 int hd__mpi_partition(ctx_t *c, const input_t *in, uint64_t N, node_t *tree) {
     int rc = HD_OK, K = c->K;
     uint64_t nloc = in->n[0] + in->n[1];
     uint64_t S = N < (uint64_t)SAMPLES_PER_RANK * (uint64_t)K ? N : (uint64_t)SAMPLES_PER_RANK * (uint64_t)K;
-    size_t ns = (size_t)((double)S * (double)nloc / (double)N);
-    if (ns > nloc) ns = (size_t)nloc;
-    if (ns == 0 && nloc > 0) ns = 1;
+    size_t ns = sample_count(nloc, (double)S / (double)N);
     sample_t *mine = hd__mpi_alloc(c, ns, sizeof(sample_t));
     int *counts = hd__mpi_alloc(c, 2 * (size_t)K, sizeof(int));
-    if (!mine || !counts) rc = hd__mpi_nomem(c, "samples", ns);
+    double *br = hd__mpi_alloc(c, 2 * (size_t)K, sizeof(double));
+    if (!mine || !counts || !br) rc = hd__mpi_nomem(c, "samples", ns);
     if (rc == HD_OK && ns > INT_MAX / 64) rc = hd__err(&c->e, HD_EOVERFLOW, "too many samples");
-    for (size_t t = 0; t < ns && rc == HD_OK; t++) {
-        uint64_t at = (uint64_t)(((double)t + 0.5) * (double)nloc / (double)ns);
-        if (at >= nloc) at = nloc - 1;
-        cursor_t cu = {0, 0, 0};
-        cursor_seek(in, at, &cu);
-        const hd_mpi_part_t *p = &in->parts[cu.side][cu.part];
-        hd__mpi_get_point(&p->points, cu.k, mine[t].x);
-        mine[t].g = p->offset + cu.k;
-        mine[t].side = (uint64_t)cu.side;
-    }
+    if (rc == HD_OK) take_samples(in, nloc, ns, mine);
     if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
     int n = (int)ns;
     MPI_GO(c, rc, MPI_Gather(&n, 1, MPI_INT, counts, 1, MPI_INT, 0, c->comm));
@@ -208,13 +352,16 @@ int hd__mpi_partition(ctx_t *c, const input_t *in, uint64_t N, node_t *tree) {
         c->bytes_part += c->rank ? (uint64_t)ns * sizeof(sample_t) : 0;
         if (rc == HD_OK && c->rank == 0) {
             int next = 0;
-            build(tree, &next, all, total, 0, K);
+            build(tree, br, &next, all, total, 0, K);
         }
     }
     if (c->rank == 0) hd__mpi_free(c, all, total, sizeof(sample_t));
     if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
     if (K > 1) MPI_GO(c, rc, MPI_Bcast(tree, K - 1, c->node_type, 0, c->comm));
+    if (K > 1) MPI_GO(c, rc, MPI_Bcast(br, 2 * (K - 1), MPI_DOUBLE, 0, c->comm));
+    if (K > 1) rc = refine(c, in, N, tree, br);
 done:
+    hd__mpi_free(c, br, 2 * (size_t)K, sizeof(double));
     hd__mpi_free(c, mine, ns, sizeof(sample_t));
     hd__mpi_free(c, counts, 2 * (size_t)K, sizeof(int));
     return rc;

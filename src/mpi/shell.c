@@ -30,42 +30,115 @@ void hd__mpi_shell_free(ctx_t *c, shell_t *sh) {
     hd__mpi_free(c, sh->nearest, sh->n, sizeof(size_t));
 }
 
-/* Stable partition in place of the coordinates (the indices stay by
- * position): the points k with keep[k] to the front, in order, the others
- * to aside, in order.  unsplit puts everything back. */
-static void split(double *xyz, size_t n, const unsigned char *keep, double *axyz) {
-    size_t t = 0, a = 0;
-    for (size_t k = 0; k < n; k++) {
-        if (keep[k]) {
-            if (t != k) memcpy(xyz + 3 * t, xyz + 3 * k, 3 * sizeof(double));
-            t++;
-        } else {
-            memcpy(axyz + 3 * a++, xyz + 3 * k, 3 * sizeof(double));
-        }
-    }
+/* Which positions a split keeps: those with mask[k], or (mask NULL) those
+ * not listed in out[0..nout), which increases (the shell's positions: the
+ * interior is then kept without a byte a point to say so). */
+typedef struct {
+    const unsigned char *mask;
+    const uint32_t *out;
+    size_t nout;
+} keep_t;
+
+/* Partition in place of the coordinates (the indices stay by position):
+ * the kept points to the front, in order; unsplit puts every point back.
+ * Two ways, one result:
+ *  - with an aside (room for the dropped points' coordinates), each kept
+ *    point moves once, forwards, and each dropped one to the aside, in
+ *    order; unsplit walks backwards and moves them back;
+ *  - without one, by swaps, so the dropped points need no room of their own
+ *    while they wait (their order among themselves is scrambled): unsplit
+ *    undoes the same swaps in reverse order, which puts every point back
+ *    where it was, since a swap is its own inverse and the swap of step k
+ *    is between position k and the number t of kept points before k, which
+ *    the reverse walk recovers by counting down.
+ * A swap moves twice the bytes of a move, so the pairs take an aside when
+ * it is small (aside_for: at most a 64th of the points, as the unpaired
+ * points of a copy are; docs/scale-out.md has the instructions both ways
+ * cost), and the interior's pass always swaps: it may be the rank's peak,
+ * and its shell is 3-10 % of the points. */
+HD__INLINE void swap3(double *xyz, size_t i, size_t k) {
+    double t[3];
+    memcpy(t, xyz + 3 * i, sizeof t);
+    memcpy(xyz + 3 * i, xyz + 3 * k, sizeof t);
+    memcpy(xyz + 3 * k, t, sizeof t);
 }
 
-/* The position of the m-th point k (from 0) with keep[k]. */
-static size_t kept_at(const unsigned char *keep, size_t n, size_t m) {
-    for (size_t k = 0, t = 0; k < n; k++)
-        if (keep[k] && t++ == m) return k;
-    assert(0);
+static double *aside_for(ctx_t *c, size_t n, size_t dropped) {
+    return dropped <= n / 64 ? hd__mpi_alloc(c, dropped, 3 * sizeof(double)) : NULL;
+}
+
+/* Whether position k is dropped, walking forwards (o: the next listed
+ * position's rank in out) or backwards (o: one past it). */
+HD__INLINE int dropped(const keep_t *kp, size_t k, size_t *o) {
+    if (kp->mask) return !kp->mask[k];
+    if (*o < kp->nout && kp->out[*o] == k) return ++*o, 1;
     return 0;
 }
 
-static void unsplit(double *xyz, size_t n, const unsigned char *keep, const double *axyz) {
+HD__INLINE int dropped_back(const keep_t *kp, size_t k, size_t *o) {
+    if (kp->mask) return !kp->mask[k];
+    if (*o > 0 && kp->out[*o - 1] == k) return --*o, 1;
+    return 0;
+}
+
+/* split's and unsplit's walks, inlined into one copy for each way (mask
+ * or list, aside or swaps), so that no test of the way is left in a loop:
+ * they run over every local point. */
+HD__INLINE size_t split_walk(double *xyz, size_t n, keep_t kp, double *aside) {
     size_t t = 0, a = 0;
-    for (size_t k = 0; k < n; k++) t += keep[k] != 0;
-    a = n - t;
-    for (size_t k = n; k-- > 0;) {
-        if (keep[k]) {
-            --t;
-            if (t != k) memcpy(xyz + 3 * k, xyz + 3 * t, 3 * sizeof(double));
+    for (size_t k = 0, o = 0; k < n; k++) {
+        if (dropped(&kp, k, &o)) {
+            if (aside) memcpy(aside + 3 * a++, xyz + 3 * k, 3 * sizeof(double));
         } else {
-            --a;
-            memcpy(xyz + 3 * k, axyz + 3 * a, 3 * sizeof(double));
+            if (t != k) {
+                if (aside) memcpy(xyz + 3 * t, xyz + 3 * k, 3 * sizeof(double));
+                else swap3(xyz, t, k);
+            }
+            t++;
         }
     }
+    return t;
+}
+
+HD__INLINE void unsplit_walk(double *xyz, size_t n, keep_t kp, const double *aside) {
+    size_t t = 0;
+    if (kp.mask)
+        for (size_t k = 0; k < n; k++) t += kp.mask[k] != 0;
+    else
+        t = n - kp.nout;
+    size_t a = n - t;
+    for (size_t k = n, o = kp.nout; k-- > 0;) {
+        if (dropped_back(&kp, k, &o)) {
+            if (aside) memcpy(xyz + 3 * k, aside + 3 * --a, 3 * sizeof(double));
+        } else if (--t != k) {
+            if (aside) memcpy(xyz + 3 * k, xyz + 3 * t, 3 * sizeof(double));
+            else swap3(xyz, t, k);
+        }
+    }
+}
+
+static size_t split(double *xyz, size_t n, keep_t kp, double *aside) {
+    if (kp.mask && aside) return split_walk(xyz, n, (keep_t){kp.mask, NULL, 0}, aside);
+    if (kp.mask) return split_walk(xyz, n, (keep_t){kp.mask, NULL, 0}, NULL);
+    if (aside) return split_walk(xyz, n, (keep_t){NULL, kp.out, kp.nout}, aside);
+    return split_walk(xyz, n, (keep_t){NULL, kp.out, kp.nout}, NULL);
+}
+
+static void unsplit(double *xyz, size_t n, keep_t kp, const double *aside) {
+    if (kp.mask && aside) unsplit_walk(xyz, n, (keep_t){kp.mask, NULL, 0}, aside);
+    else if (kp.mask) unsplit_walk(xyz, n, (keep_t){kp.mask, NULL, 0}, NULL);
+    else if (aside) unsplit_walk(xyz, n, (keep_t){NULL, kp.out, kp.nout}, aside);
+    else unsplit_walk(xyz, n, (keep_t){NULL, kp.out, kp.nout}, NULL);
+}
+
+/* The position of the m-th kept point (from 0). */
+static size_t kept_at(keep_t kp, size_t n, size_t m) {
+    for (size_t k = 0, t = 0, o = 0; k < n; k++) {
+        if (dropped(&kp, k, &o)) continue;
+        if (t++ == m) return k;
+    }
+    assert(0);
+    return 0;
 }
 
 /* Marks the pairs: inp[i] = inq[j] = 1 when point i of P and point j of Q
@@ -112,23 +185,19 @@ static int is_paired(size_t nc, size_t nP, size_t nQ) {
  * needs a box that holds its points, not the smallest). */
 static int pairs_engine(ctx_t *c, double *P, size_t nP, double *Q, size_t nQ, const unsigned char *inp,
                         const unsigned char *inq, size_t nc, int sym, const hd__box_t *box, hd_result_t e[2]) {
-    size_t nx = nQ - nc, ny = nP - nc;
-    double *qx = hd__mpi_alloc(c, nx, 3 * sizeof(double)), *py = hd__mpi_alloc(c, ny, 3 * sizeof(double));
+    double *py = aside_for(c, nP, nP - nc), *qx = aside_for(c, nQ, nQ - nc);
+    split(P, nP, (keep_t){inp, NULL, 0}, py);
+    split(Q, nQ, (keep_t){inq, NULL, 0}, qx);
+    hd_points_t Pv = hd_points_f64(P, nc), Qv = hd_points_f64(Q, nc);
+    hd_symmetric_t s;
     int rc = HD_OK;
-    if (!qx || !py) rc = hd__mpi_nomem(c, "the pairs", nc);
-    if (rc == HD_OK) {
-        split(P, nP, inp, py);
-        split(Q, nQ, inq, qx);
-        hd_points_t Pv = hd_points_f64(P, nc), Qv = hd_points_f64(Q, nc);
-        hd_symmetric_t s;
-        if (sym && (rc = hd__mpi_engine_sym(c, &Pv, &Qv, box ? &box[0] : NULL, box ? &box[1] : NULL, &s)) == HD_OK)
-            e[0] = s.ab, e[1] = s.ba;
-        if (!sym) rc = hd__mpi_engine_local(c, &Pv, &Qv, NULL, NULL, &e[0]);
-        unsplit(P, nP, inp, py);
-        unsplit(Q, nQ, inq, qx);
-    }
-    hd__mpi_free(c, qx, nx, 3 * sizeof(double));
-    hd__mpi_free(c, py, ny, 3 * sizeof(double));
+    if (sym && (rc = hd__mpi_engine_sym(c, &Pv, &Qv, box ? &box[0] : NULL, box ? &box[1] : NULL, &s)) == HD_OK)
+        e[0] = s.ab, e[1] = s.ba;
+    if (!sym) rc = hd__mpi_engine_local(c, &Pv, &Qv, NULL, NULL, &e[0]);
+    unsplit(P, nP, (keep_t){inp, NULL, 0}, py);
+    unsplit(Q, nQ, (keep_t){inq, NULL, 0}, qx);
+    hd__mpi_free(c, py, nP - nc, 3 * sizeof(double));
+    hd__mpi_free(c, qx, nQ - nc, 3 * sizeof(double));
     return rc;
 }
 
@@ -213,8 +282,9 @@ static int paired_pass(ctx_t *c, const dir_t *d, const hd__box_t *mine, unsigned
     else rc = pairs_engine(c, d->P, nP, d->Q, nQ, in, inq, nc, 0, NULL, e);
     if (rc == HD_OK) {
         /* a*, and Q_c's e.j: P_c's e.j's partner (the same index) */
-        size_t astar = kept_at(in, nP, e[0].i);
-        uint64_t gi = hd__mpi_gidx(d->gP, astar), jc = hd__mpi_gidx(d->gP, kept_at(in, nP, e[0].j));
+        keep_t kp = {in, NULL, 0};
+        size_t astar = kept_at(kp, nP, e[0].i);
+        uint64_t gi = hd__mpi_gidx(d->gP, astar), jc = hd__mpi_gidx(d->gP, kept_at(kp, nP, e[0].j));
         *nI = 0;
         for (size_t i = 0; i < nP; i++)
             *nI += in[i] = (unsigned char)(in[i] && hd__mpi_faces_clear(mine, d->P + 3 * i, e[0].distance2));
@@ -251,29 +321,26 @@ done:
 int hd__mpi_interior_max(ctx_t *c, const dir_t *d, const hd__box_t *mine, const shell_t *sh, double h2,
                          const far_t *G, far_t *out) {
     *out = (far_t){-1.0, UINT64_MAX, UINT64_MAX};
-    unsigned char *in = hd__mpi_alloc(c, d->nP, 1);
-    /* the shell's points are moved aside here, not copied while searched */
-    double *aside = hd__mpi_alloc(c, sh->n, 3 * sizeof(double));
-    if (!in || !aside) {
-        hd__mpi_free(c, in, d->nP, 1);
-        hd__mpi_free(c, aside, sh->n, 3 * sizeof(double));
-        return hd__mpi_nomem(c, "the interior", d->nP);
-    }
-    size_t nI = 0, below = 0;
-    for (size_t k = 0; k < d->nP; k++) nI += in[k] = (unsigned char)hd__mpi_faces_clear(mine, d->P + 3 * k, h2);
-    assert(nI + sh->n == d->nP && sh->own_pos);
+    /* The interior is what the shell is not (shell_of: the points whose
+     * faces are not clear of the same h2, a proper subset: own_pos). */
+    assert(sh->own_pos && sh->n < d->nP);
+    keep_t in = {NULL, sh->own_pos, sh->n};
+    size_t below = 0;
     gcur_t cu;
     hd__mpi_gcur_init(&cu, d->gP);
-    for (size_t k = 0; k < d->nP && hd__mpi_gcur_at(&cu, k) < G->i; k++) below += in[k];
-    split(d->P, d->nP, in, aside);
+    for (size_t k = 0, o = 0; k < d->nP && hd__mpi_gcur_at(&cu, k) < G->i; k++) below += !dropped(&in, k, &o);
+    size_t nI = split(d->P, d->nP, in, NULL); /* by swaps: this pass may be the peak */
+#ifndef NDEBUG
+    for (size_t k = 0; k < nI; k++) assert(hd__mpi_faces_clear(mine, d->P + 3 * k, h2));
+#else
+    (void)mine, (void)h2;
+#endif
     hd_points_t Iv = hd_points_f64(d->P, nI), Qv = hd_points_f64(d->Q, d->nQ);
     hd_result_t e;
     int rc = G->d2 >= 0 ? hd__mpi_engine_above(c, &Iv, &Qv, G->d2, below, &e) : hd__mpi_engine_local(c, &Iv, &Qv, NULL, NULL, &e);
-    unsplit(d->P, d->nP, in, aside);
-    hd__mpi_free(c, aside, sh->n, 3 * sizeof(double));
+    unsplit(d->P, d->nP, in, NULL);
     if (rc == HD_OK && (G->d2 < 0 || e.distance2 > G->d2 || (e.distance2 == G->d2 && e.i < below)))
         *out = (far_t){e.distance2, hd__mpi_gidx(d->gP, kept_at(in, d->nP, e.i)), hd__mpi_gidx(d->gQ, e.j)};
-    hd__mpi_free(c, in, d->nP, 1);
     return rc;
 }
 

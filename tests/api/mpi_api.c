@@ -100,8 +100,11 @@ typedef struct {
 
 enum {
     DS_UNIFORM, DS_LATTICE, DS_LATTICE_HALF, DS_ONE_POINT, DS_PLANE, DS_FAR_B, DS_CORNER_B, DS_DUPLICATES,
-    DS_TINY, DS_HUGE, DS_NOISE, DS_DISJOINT, DS_CHECKER, DS_STRAY, DS_DEEP, DS_SMALL_LATTICE, DS_COUNT
+    DS_TINY, DS_HUGE, DS_NOISE, DS_DISJOINT, DS_CHECKER, DS_STRAY, DS_DEEP, DS_SMALL_LATTICE, DS_BIG_LATTICE,
+    DS_BIG_UNIFORM, DS_COUNT
 };
+
+#define BIG 40000 /* points a side of the sets large enough for the partition's second samples */
 
 static void make_set(int which, uint64_t seed, set_t *s) {
     gen_rng_t g;
@@ -109,8 +112,8 @@ static void make_set(int which, uint64_t seed, set_t *s) {
     size_t n = 2000;
     s->na = n;
     s->nb = n;
-    s->a = malloc(3 * 16000 * sizeof(double)); /* the largest set (DS_STRAY) */
-    s->b = malloc(3 * 16000 * sizeof(double));
+    s->a = malloc(3 * BIG * sizeof(double)); /* the largest sets (DS_BIG_*) */
+    s->b = malloc(3 * BIG * sizeof(double));
     switch (which) {
     case DS_UNIFORM:
         s->name = "uniform A and B";
@@ -243,6 +246,21 @@ static void make_set(int which, uint64_t seed, set_t *s) {
         s->na = s->nb = 400;
         gen_lattice(&g, s->a, s->na, 7);
         gen_lattice(&g, s->b, s->nb, 7);
+        break;
+    case DS_BIG_LATTICE:
+        /* Enough points (at 7 ranks too) that the partition refines its
+         * splits by its second samples (src/mpi/rcb.c, refine), whose
+         * planes fall between or on the lattice's: ties across them. */
+        s->name = "large integer lattice (refined splits, ties across them)";
+        s->na = s->nb = BIG;
+        gen_lattice(&g, s->a, s->na, 24);
+        gen_lattice(&g, s->b, s->nb, 24);
+        break;
+    case DS_BIG_UNIFORM:
+        s->name = "large uniform A and B (refined splits)";
+        s->na = s->nb = BIG;
+        gen_cube(&g, s->a, s->na, -1, 1);
+        gen_cube(&g, s->b, s->nb, -1, 1);
         break;
     case DS_DISJOINT:
         s->name = "disjoint boxes";
@@ -551,6 +569,29 @@ static void check_strided_views_over_ranks(void) {
     free(bf);
 }
 
+/* The partition gives every rank its share of the points within 2 %:
+ * the first samples (1024 a rank) alone leave the largest region a few
+ * percent above its share, the second samples' exact counts move each
+ * split to within a fraction of one.  Blocks of a uniform set over the
+ * ranks, 80K points in all. */
+static void check_partition_balances(void) {
+    if (K_ < 2) return;
+    uint64_t seed = 1000 + DS_BIG_UNIFORM;
+    set_t s = {"", NULL, NULL, 0, 0};
+    hd_options_t opt;
+    open_case("balance", DS_BIG_UNIFORM, LAY_BLOCKS, seed, &s, &opt);
+    hd_mpi_part_t pa[1], pb[1];
+    size_t na = layout(LAY_BLOCKS, 0, s.a, s.na, seed, pa, 1), nb = layout(LAY_BLOCKS, 1, s.b, s.nb, seed, pb, 1);
+    hd_symmetric_t got;
+    hd_mpi_stats_t st;
+    hd_error_t err;
+    CHECK(hd_mpi_hausdorff(MPI_COMM_WORLD, pa, na, pb, nb, &opt, &got, &st, &err) == HD_OK);
+    CHECK(st.imbalance >= 1.0 && st.imbalance <= 1.02);
+    if (st.imbalance > 1.02) fprintf(stderr, "rank %d: imbalance %.4f\n", rank_, st.imbalance);
+    free(s.a);
+    free(s.b);
+}
+
 int main(int argc, char **argv) {
     MPI_Init(&argc, &argv);
     MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
@@ -559,6 +600,7 @@ int main(int argc, char **argv) {
     if (!only || strcmp(only, "errors") == 0) check_errors();
     if (!only) check_single_rank_copies_nothing();
     if (!only) check_strided_views_over_ranks();
+    if (!only) check_partition_balances();
     for (int which = 0; which < DS_COUNT; which++) {
         if (only && strcmp(only, "errors") != 0 && atoi(only) != which) continue;
         if (only && strcmp(only, "errors") == 0) break;
