@@ -285,7 +285,7 @@ static int refine(ctx_t *c, const input_t *in, uint64_t N, node_t *tree, const d
         MPI_GO(c, rc, MPI_Allreduce(cnt, sum, (int)((size_t)level * width), MPI_UINT64_T, MPI_SUM, c->comm));
         c->bytes_part += (uint64_t)level * width * sizeof *cnt; /* what this rank contributed */
         for (int id = 0; id < nodes; id++) {
-            if (slot[id] < 0 || br[2 * id] > br[2 * id + 1] || tree[id].s == INFINITY) continue;
+            if (slot[id] < 0 || br[2 * id] > br[2 * id + 1]) continue; /* no bracket: no samples (s infinite) */
             const uint64_t *h = sum + (size_t)slot[id] * width;
             uint64_t total = 0;
             for (int t = 0; t <= REFINE_BINS + 1; t++) total += h[t];
