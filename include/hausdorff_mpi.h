@@ -200,10 +200,11 @@ int hd_mpi_directed(MPI_Comm comm, const hd_mpi_part_t *a, size_t na,
  * Memory, per point a rank holds after the partition: under a byte (its
  *   coded index), about 37 bytes a point of each set for the nearest layer's
  *   structures, which hold the coordinates (about 38 while one is built), and
- *   24 bytes a point of the direction being computed (16 after its local
- *   pass); 16 bytes a point of the rank's own input while the answers come
- *   back (32 while they are sent when the ranks' index runs interleave).
- *   Measured peak: 61 bytes a point a rank holds (docs/scale-out.md).  On one rank,
+ *   about 24 bytes a point of the direction being computed during its
+ *   search (16 after it); 8 bytes a point of the rank's own input while the
+ *   answers come back (24 while they are sent when the ranks' index runs
+ *   interleave).  Measured peak: 53-55 bytes a point a rank holds
+ *   (docs/scale-out.md).  On one rank,
  *   hd_distances on the caller's points (charged at its 60 bytes a point),
  *   without a copy when a set has one nonempty part (else its parts are
  *   packed, 24 bytes a point), into the outputs themselves when the parts

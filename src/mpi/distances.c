@@ -12,7 +12,13 @@
  *     P gets u(a)^2, the exact minimum of hd__d2 over local Q, and j(a), the
  *     smallest local position at it (hd__an_nearest: smallest position on
  *     ties; local order is global index order, so the smallest global
- *     index of local Q at u(a)).
+ *     index of local Q at u(a)).  When A and B have one size, a point's
+ *     partner (the other side's point of its global index, as
+ *     hd_distances pairs point i with point i) is tried first when it is
+ *     here (partners: one merge of the two sides' indices), if a sample
+ *     says the partners are near (a copy and its original; not two
+ *     samplings of one scene, where the merge would cost 2 % for nothing).
+ *     No answer depends on them.
  *  2. Forwarding.  a is exact when its region's faces are clear of u(a)^2
  *     (hd__mpi_faces_clear, the proof of mpi.c's step 4: every point of
  *     another region is farther than u(a), none ties), or when no other
@@ -45,19 +51,25 @@
  * structure keeps exact copies in its own order, so each local array of
  * coordinates is freed once its structure exists, and point k is read from
  * the structure through the inverse of its order (an_t.pos, 4 bytes).  So:
- * the encoded indices (gidx_t, under a byte), the two structures (about 33
- * bytes a point of each set, 60 while one is built) with their inverse
- * orders, and per point of the direction being computed u2, the index and,
- * during the local pass, the local position (24 bytes, then 16), with the
- * other side's indices decoded in order for that pass (8 bytes a point of
- * it: the nearest points fall anywhere in it, and a decode at random costs
- * several times one in order); a rank's own points
- * of that direction take 16 bytes more while the answers come back (before
- * they are written to the caller's outputs).  When the runs were merged,
- * the answers are reordered by sender into a buffer of 16 bytes a point
- * first.  The forwarded points are packed with their answers so far (48
- * bytes each, few), and their queries and answers are 40 bytes each.
- * Measured peak: 61 bytes a local point (docs/scale-out.md).
+ * the encoded indices (gidx_t, under a byte), the two structures (about 37
+ * bytes a point of each set, 38 while one is built) with their inverse
+ * orders, held through both directions (each set asks in one and is
+ * searched in the other), and per point of the direction being computed:
+ * during the search the local position of its nearest (8 bytes), the
+ * partners (4, when used; the other side's indices decoded for their
+ * merge are freed before the search) and the search's own answers (12);
+ * after it u2 (8) and the global index, written over the position in the
+ * same 8 bytes, with the other side's indices decoded in order for that
+ * pass (8 bytes a point of it: the nearest points fall anywhere in it,
+ * and a decode at random costs several times one in order).  A rank's own
+ * points of that direction take 8 bytes for the distances while the
+ * answers come back, then 8 for the indices, each receive buffer had once
+ * what it replaces was sent and freed; where the runs were merged, the
+ * answers are first reordered by sender into buffers of 16 bytes a point.
+ * The forwarded points are packed with their answers so far (48 bytes
+ * each, few), and their queries and answers are 40 bytes each.
+ * Measured peak: 53-55 bytes a local point, the search of a direction
+ * (docs/scale-out.md).
  */
 #include "mpi_int.h"
 
@@ -268,21 +280,21 @@ static int give_back(ctx_t *c, const spread_t *sp, const input_t *in, int s, dou
         if (r != c->rank) c->bytes_back += (uint64_t)scount[r] * (sizeof(double) + sizeof(uint64_t));
     }
     assert(m == own);
-    rd = hd__mpi_alloc(c, m, sizeof(double));
-    rj = hd__mpi_alloc(c, m, sizeof(uint64_t));
-    if (!rd || !rj) rc = hd__mpi_nomem(c, "the answers", m);
+    /* The distances, then the indices: what was sent is freed before the
+     * next receive buffer is had (8 bytes a point less at the peak). */
+    if (!(rd = hd__mpi_alloc(c, m, sizeof(double)))) rc = hd__mpi_nomem(c, "the answers", m);
     if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
     MPI_GO(c, rc, MPI_Alltoallv(sd, scount, sdispl, MPI_DOUBLE, rd, rcount, rdispl, MPI_DOUBLE, c->comm));
+    if (sd == *d2p) *d2p = NULL; /* not packed: the caller's array, freed here */
+    hd__mpi_free(c, sd, n, sizeof(double));
+    sd = NULL;
+    if (!(rj = hd__mpi_alloc(c, m, sizeof(uint64_t)))) rc = hd__mpi_nomem(c, "the answers", m);
+    if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
     MPI_GO(c, rc, MPI_Alltoallv(sj, scount, sdispl, MPI_UINT64_T, rj, rcount, rdispl, MPI_UINT64_T, c->comm));
-    /* What was sent is not needed any more. */
-    if (packed) {
-        hd__mpi_free(c, sd, n, sizeof(double));
-        hd__mpi_free(c, sj, n, sizeof(uint64_t));
-        packed = 0;
-    }
-    hd__mpi_free(c, *d2p, n, sizeof(double));
-    hd__mpi_free(c, *jp, n, sizeof(uint64_t));
-    *d2p = NULL, *jp = NULL;
+    if (sj == *jp) *jp = NULL;
+    hd__mpi_free(c, sj, n, sizeof(uint64_t));
+    sj = NULL;
+    packed = 0;
     /* The walk of the exchange again: each point's rank, and that rank's
      * next answer. */
     if ((rc = walk_order(c, in, s, &order, &base)) == HD_OK) {
@@ -314,6 +326,83 @@ done:
 
 /* ---- one direction ------------------------------------------------------- */
 
+_Static_assert(sizeof(size_t) <= sizeof(uint64_t), "a position's slot holds a global index");
+
+/* The n global indices of a local set in local order (8 bytes a point,
+ * charged), or NULL when they cannot be had. */
+static uint64_t *decode(ctx_t *c, const gidx_t *gi, size_t n) {
+    uint64_t *g = hd__mpi_alloc(c, n, sizeof(uint64_t));
+    if (g) hd__mpi_gidx_decode(gi, 0, n, g);
+    return g;
+}
+
+#define PAIR_SAMPLES 64
+#define PAIR_CHUNK 512 /* indices of P decoded at once by the partners' merge */
+
+/* Whether the partners are worth their merge (an index decoded for every
+ * point of both sides, about 2 % of a search on unrelated sets): at least
+ * half of PAIR_SAMPLES points of P, evenly spaced, have their partner
+ * here and within the diagonal of its bucket's box (the scale of its
+ * neighbours' spacing), as a copy's partners are; two independent
+ * samplings of one scene have theirs anywhere.  The samples' indices are
+ * decoded at random (a binary search over Q's), a few thousand decodes. */
+static int partners_near(const spread_t *sp, int s, const an_t *asking, const an_t *searched) {
+    size_t nP = sp->loc.n[s], nQ = sp->loc.n[1 - s], m = nP < PAIR_SAMPLES ? nP : PAIR_SAMPLES, near = 0;
+    const gidx_t *gp = &sp->loc.gi[s], *gq = &sp->loc.gi[1 - s];
+    const hd__an_t *t = &searched->s;
+    for (size_t r = 0; r < m && nQ; r++) {
+        size_t kp = r * nP / m, lo = 0, hi = nQ;
+        uint64_t g = hd__mpi_gidx(gp, kp);
+        while (lo < hi) {
+            size_t mid = lo + (hi - lo) / 2;
+            if (hd__mpi_gidx(gq, mid) < g) lo = mid + 1;
+            else hi = mid;
+        }
+        if (lo == nQ || hd__mpi_gidx(gq, lo) != g) continue;
+        uint32_t at = searched->pos[lo];
+        size_t b0 = 0, b1 = t->nb; /* the bucket holding position at: start[b0] <= at < start[b0 + 1] */
+        while (b1 - b0 > 1) {
+            size_t mid = b0 + (b1 - b0) / 2;
+            if (t->start[mid] <= at) b0 = mid;
+            else b1 = mid;
+        }
+        uint32_t node = t->leaf[b0];
+        double p[3], q[3], diag[3];
+        for (int d = 0; d < 3; d++) diag[d] = t->hi[d][node] - t->lo[d][node];
+        an_point(asking, kp, p);
+        an_point(searched, lo, q);
+        near += hd__d2(p, q) <= hd__d2(diag, (const double[3]){0, 0, 0});
+    }
+    return m > 0 && 2 * near >= m;
+}
+
+/* The partners of side s's local points when the two sides have one size
+ * (hd_distances' partners: point i of one side tried first for point i of
+ * the other, a copy and its original in one order settling fast): for
+ * each point of `asking`, by its position there, the position in
+ * `searched` of the local point of the other side with its global index,
+ * or HD__AN_NO_PARTNER when that point is on another rank.  Both sides'
+ * local orders are their global indices' order, so one merge of the two
+ * finds them (gq: Q's indices in local order).  NULL (no partners) when
+ * the array cannot be had: no answer depends on the partners. */
+static uint32_t *partners(ctx_t *c, const spread_t *sp, int s, const an_t *asking, const an_t *searched,
+                          const uint64_t *gq) {
+    size_t nP = sp->loc.n[s], nQ = sp->loc.n[1 - s];
+    uint32_t *at = nP && nQ ? hd__mpi_alloc(c, nP, sizeof(uint32_t)) : NULL;
+    if (!at) return NULL;
+    for (size_t k = 0; k < nP; k++) at[k] = HD__AN_NO_PARTNER;
+    uint64_t gp[PAIR_CHUNK]; /* P's indices, a chunk at a time */
+    for (size_t k0 = 0, kq = 0; k0 < nP && kq < nQ; k0 += PAIR_CHUNK) {
+        size_t m = nP - k0 < PAIR_CHUNK ? nP - k0 : PAIR_CHUNK;
+        hd__mpi_gidx_decode(&sp->loc.gi[s], k0, m, gp);
+        for (size_t t = 0; t < m && kq < nQ; t++) {
+            while (kq < nQ && gq[kq] < gp[t]) kq++;
+            if (kq < nQ && gq[kq] == gp[t]) at[asking->pos[k0 + t]] = searched->pos[kq];
+        }
+    }
+    return at;
+}
+
 /* Answers from the structure of local Q (forwarded queries). */
 typedef struct {
     const an_t *searched;
@@ -333,7 +422,7 @@ static int answer(ctx_t *c, void *arg, const double *pts, size_t m, ans_t *ans) 
     an_t asked;
     int rc = near ? an_of(c, pts, m, a->kb, &asked) : hd__mpi_nomem(c, "answers", m);
     if (rc == HD_OK)
-        rc = hd__mpi_an_nearest(c, &asked.s, &a->searched->s, hd__thread_count(c->threads, m), near);
+        rc = hd__mpi_an_nearest(c, &asked.s, &a->searched->s, NULL, hd__thread_count(c->threads, m), near);
     gcur_t cq;
     hd__mpi_gcur_init(&cq, a->gQ);
     for (size_t k = 0; k < m && rc == HD_OK; k++) {
@@ -349,42 +438,56 @@ static int answer(ctx_t *c, void *arg, const double *pts, size_t m, ans_t *ans) 
 /* The exact answers of side s's local points against all of the other
  * side (steps 1 and 2), then returned (step 3).  `asking` and `searched`
  * are the structures of local P and local Q on the key box kb. */
-static int direction(ctx_t *c, const spread_t *sp, const input_t *in, int s,
+static int direction(ctx_t *c, const spread_t *sp, const input_t *in, int s, int paired,
                      const an_t *asking, const an_t *searched, const hd__box_t *kb, outs_t *o) {
     int K = c->K, rc = HD_OK, qs = 1 - s;
     const local_t *loc = &sp->loc;
     size_t nP = loc->n[s], nQ = loc->n[qs], nf = 0;
     const hd__box_t *mine = &sp->region[c->rank];
-    double *u2 = hd__mpi_alloc(c, nP, sizeof(double));
-    uint64_t *jj = hd__mpi_alloc(c, nP, sizeof(uint64_t));
-    size_t *near = hd__mpi_alloc(c, nP, sizeof(size_t));
+    double *u2 = NULL;
+    uint64_t *jj = NULL, *gq = NULL;
+    /* near[k], the local position of point k's nearest, becomes jj[k], its
+     * global index, in the same 8 bytes (size_t is at most as wide as
+     * uint64_t: the bytes are moved, never read as the other type). */
+    unsigned char *slot = hd__mpi_alloc(c, nP, sizeof(uint64_t));
+    size_t *near = (size_t *)(void *)slot;
     hd__box_t *nbox = hd__mpi_alloc(c, (size_t)K - 1, sizeof(hd__box_t));
     int *list = hd__mpi_alloc(c, (size_t)K, sizeof(int));
     pairs_t pr = {NULL, 0, 0};
-    if (!u2 || !jj || !near || !nbox || !list) rc = hd__mpi_nomem(c, "the distances", nP);
-    /* 1. The local pass. */
+    if (!slot || !nbox || !list) rc = hd__mpi_nomem(c, "the distances", nP);
+    /* 1. The local pass: the partners first (when the sides have one size
+     * and a sample finds them near), from Q's indices decoded in order. */
     double t0 = hd__now(), u0 = hd__mpi_cpu();
-    if (rc == HD_OK && nP && nQ)
-        rc = hd__mpi_an_nearest(c, &asking->s, &searched->s, hd__thread_count(c->threads, nP), near);
-    /* near[] goes anywhere in Q: Q's indices are decoded in order first
-     * (8 bytes a point of Q for the loop, below the peak of the
-     * structures' build), not one by one at random */
-    uint64_t *gq = rc == HD_OK && nQ ? hd__mpi_alloc(c, nQ, sizeof(uint64_t)) : NULL;
-    if (rc == HD_OK && nQ && !gq) rc = hd__mpi_nomem(c, "the distances", nQ);
-    if (gq) {
-        gcur_t cq;
-        hd__mpi_gcur_init(&cq, &sp->loc.gi[qs]);
-        for (size_t j = 0; j < nQ; j++) gq[j] = hd__mpi_gcur_at(&cq, j);
+    if (rc == HD_OK && nP && nQ) {
+        uint32_t *pair_at = NULL;
+        if (paired && partners_near(sp, s, asking, searched) && (gq = decode(c, &loc->gi[qs], nQ)))
+            pair_at = partners(c, sp, s, asking, searched, gq);
+        hd__mpi_free(c, gq, nQ, sizeof(uint64_t)); /* decoded again below: not held in the search */
+        gq = NULL;
+        rc = hd__mpi_an_nearest(c, &asking->s, &searched->s, pair_at, hd__thread_count(c->threads, nP), near);
+        hd__mpi_free(c, pair_at, nP, sizeof(uint32_t));
     }
-    for (size_t k = 0; k < nP && rc == HD_OK; k++) {
+    /* Then, once the search's arrays are freed, each point's exact squared
+     * distance and global index.  near[] goes anywhere in Q: Q's indices
+     * are decoded in order (8 bytes a point of Q), not one by one at
+     * random.  Backwards, so that near[k] is read before its bytes are
+     * overwritten whatever the width of size_t. */
+    if (rc == HD_OK && nQ && !(gq = decode(c, &loc->gi[qs], nQ))) rc = hd__mpi_nomem(c, "the distances", nQ);
+    if (rc == HD_OK && !(u2 = hd__mpi_alloc(c, nP, sizeof(double)))) rc = hd__mpi_nomem(c, "the distances", nP);
+    for (size_t k = nP; k-- > 0 && rc == HD_OK;) {
         double p[3], q[3];
+        uint64_t g = UINT64_MAX;
         an_point(asking, k, p);
-        if (nQ) an_point(searched, near[k], q);
-        u2[k] = nQ ? hd__d2(p, q) : INFINITY;
-        jj[k] = nQ ? gq[near[k]] : UINT64_MAX;
+        u2[k] = INFINITY;
+        if (nQ) {
+            an_point(searched, near[k], q);
+            u2[k] = hd__d2(p, q);
+            g = gq[near[k]];
+        }
+        memcpy(slot + k * sizeof g, &g, sizeof g);
     }
+    jj = (uint64_t *)(void *)slot;
     hd__mpi_free(c, gq, nQ, sizeof(uint64_t));
-    hd__mpi_free(c, near, nP, sizeof(size_t));
     c->search += hd__now() - t0;
     c->search_cpu += hd__mpi_cpu() - u0;
     /* 2. The points whose faces are not clear ask the candidate ranks; the
@@ -464,7 +567,8 @@ static int distances(ctx_t *c, const hd_options_t *opt, input_t *in, void *arg, 
         c->search_cpu += hd__mpi_cpu() - u1;
         if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
         for (int s = 0; s < 2; s++)
-            if (want[s] && (rc = direction(c, sp, in, s, &an[s], &an[1 - s], &kb, o)) != HD_OK) goto done;
+            if (want[s] && (rc = direction(c, sp, in, s, cs.N[0] == cs.N[1], &an[s], &an[1 - s], &kb, o)) != HD_OK)
+                goto done;
     }
     double tmax;
     rc = hd__mpi_figures(c, &cs, pts, st, &tmax);

@@ -240,6 +240,23 @@ uint64_t hd__mpi_gidx(const gidx_t *x, size_t k) {
     return x->run[r].lo + (o - x->rord[r]);
 }
 
+void hd__mpi_gidx_decode(const gidx_t *x, size_t k, size_t m, uint64_t *g) {
+    if (m == 0) return;
+    assert(k + m <= x->n);
+    size_t wi, r = SIZE_MAX;
+    uint64_t w, at = select1(x, k, &wi, &w);
+    for (size_t t = 0;;) {
+        uint64_t o = ((at - (k + t)) << x->l) | hd__mpi_gidx_low(x, k + t);
+        if (r == SIZE_MAX) r = run_of(x, o);
+        while (r + 1 < x->nrun && o >= x->rord[r + 1]) r++; /* ordinals grow: runs only advance */
+        g[t] = x->run[r].lo + (o - x->rord[r]);
+        if (++t == m) break;
+        while (!w) w = x->high[++wi];
+        at = ((uint64_t)wi << 6) | (uint64_t)__builtin_ctzll(w);
+        w &= w - 1;
+    }
+}
+
 void hd__mpi_gcur_init(gcur_t *cu, const gidx_t *x) {
     memset(cu, 0, sizeof *cu);
     cu->x = x;

@@ -192,6 +192,10 @@ void hd__mpi_gidx_free(ctx_t *c, gidx_t *x);
 /* Position k's index, at any k (a select from the sample before it and a
  * binary search of the runs). */
 uint64_t hd__mpi_gidx(const gidx_t *x, size_t k);
+/* Positions k .. k + m - 1's indices into g[0 .. m - 1]: a select for the
+ * first, then the 1s of the high bits in order and the runs only forward
+ * (a fraction of a cursor's cost a position, when all are wanted). */
+void hd__mpi_gidx_decode(const gidx_t *x, size_t k, size_t m, uint64_t *g);
 
 /* The low l bits of position k's ordinal. */
 static inline uint64_t hd__mpi_gidx_low(const gidx_t *x, size_t k) {
@@ -361,9 +365,11 @@ void hd__mpi_qtree_free(ctx_t *c, qtree_t *q);
  * holds (*bytes, to subtract when it is freed). */
 int hd__mpi_an_build(ctx_t *c, hd__an_t *s, const hd_points_t *v, const uint32_t *sel, const uint32_t *names,
                      size_t m, const hd__box_t *kb, int threads, size_t *bytes);
-/* hd__an_nearest(asking, searched) into near (no distances, no partners),
- * its own arrays charged while it runs. */
-int hd__mpi_an_nearest(ctx_t *c, const hd__an_t *asking, const hd__an_t *searched, int threads, size_t *near);
+/* hd__an_nearest_paired(asking, searched, pair_at) into near (no
+ * distances; pair_at may be NULL: no partners), its own arrays charged
+ * while it runs. */
+int hd__mpi_an_nearest(ctx_t *c, const hd__an_t *asking, const hd__an_t *searched, const uint32_t *pair_at,
+                       int threads, size_t *near);
 /* Frees a structure hd__mpi_an_build made and takes its bytes off the count. */
 void hd__mpi_an_release(ctx_t *c, hd__an_t *s, size_t bytes);
 /* For each of n points, point k at pts + 3 pos[k] (pos NULL: pts + 3 k),

@@ -50,10 +50,11 @@ int hd__mpi_an_build(ctx_t *c, hd__an_t *s, const hd_points_t *v, const uint32_t
     return rc;
 }
 
-int hd__mpi_an_nearest(ctx_t *c, const hd__an_t *asking, const hd__an_t *searched, int threads, size_t *near) {
+int hd__mpi_an_nearest(ctx_t *c, const hd__an_t *asking, const hd__an_t *searched, const uint32_t *pair_at,
+                       int threads, size_t *near) {
     size_t b = hd__an_nearest_bytes(asking, searched, threads);
     hd__mpi_charge(c, b);
-    int rc = hd__an_nearest(asking, searched, NULL, threads, NULL, near, NULL, &c->e);
+    int rc = hd__an_nearest_paired(asking, searched, pair_at, threads, NULL, near, NULL, &c->e);
     c->cur -= b;
     return rc;
 }
@@ -173,7 +174,7 @@ static int slab_search(ctx_t *c, const slab_t *sl, const double *pts, const uint
     hd_points_t Sv = hd_points_f64(pts, (size_t)from[m - 1] + 1); /* from[] increases */
     int rc = hd__mpi_an_build(c, &asking, &Sv, from, sel ? list : NULL, m, &sl->kb, threads, &ab);
     hd__mpi_free(c, sel, m, sizeof(uint32_t));
-    if (rc == HD_OK) rc = hd__mpi_an_nearest(c, &asking, &sl->s, threads, near);
+    if (rc == HD_OK) rc = hd__mpi_an_nearest(c, &asking, &sl->s, NULL, threads, near);
     if (ab) hd__mpi_an_release(c, &asking, ab);
     return rc;
 }

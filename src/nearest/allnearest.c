@@ -62,7 +62,11 @@
  *    PAIR_CANDIDATES buckets lie within that bound they are the candidates
  *    and no seed is scanned; otherwise the seeds go on from the partners.
  *    The partners are read from the caller's view in its order (a random
- *    access, prefetched a group ahead).  A group counts as a success when
+ *    access, prefetched a group ahead), or, given by position
+ *    (hd__an_nearest_paired: the MPI layer's local parts, of different
+ *    sizes, where some partners are on other ranks), from the searched
+ *    structure itself; a query without a partner leaves the group's bound
+ *    infinite, and the group goes on to the seeds.  A group counts as a success when
  *    at least half of its answers are the partners themselves; a task stops
  *    trying once most of the groups it tried, PAIR_TRIAL at least, failed,
  *    so unrelated sets pay for eight groups a task.  (Sets of a few
@@ -853,6 +857,8 @@ HD__INLINE void finish_query(const hd__an_t *t, cands_t *cd, double qx, double q
 typedef struct {
     const hd__an_t *q, *t;
     const hd_points_t *partner; /* t's view: query i's partner is its point i (or NULL) */
+    const uint32_t *pair_at;    /* or per query, in q's order: its partner's position in t
+                                 * (HD__AN_NO_PARTNER: none), or NULL */
     double *dist;
     size_t *nearest;
     cands_t *cand; /* per worker: room for every bucket of t */
@@ -881,7 +887,7 @@ HD__HOT static void query_task(void *vctx, size_t task, int worker) {
     cands_t *cd = &c->cand[worker];
     size_t g0 = task * GROUPS_PER_TASK, g1 = g0 + GROUPS_PER_TASK < q->ng ? g0 + GROUPS_PER_TASK : q->ng;
     double best[HD__AN_GROUP];
-    uint32_t bj[HD__AN_GROUP];
+    uint32_t bj[HD__AN_GROUP], pj[HD__AN_GROUP]; /* pj: the partners' names */
     size_t seed[HD__AN_GROUP];
     size_t at0 = g0 < g1 ? bucket_at(t, q->key[q->glead[g0]], 0) : 0;
     hd__src_t psrc;
@@ -917,18 +923,38 @@ HD__HOT static void query_task(void *vctx, size_t task, int worker) {
             double U = 0;
             int paired = 0, windowed = 0, seeded = 0;
             for (size_t k = 0; k < m; k++) best[k] = INFINITY, bj[k] = UINT32_MAX;
-            if (c->partner && (tried < PAIR_TRIAL || 2 * kept_groups >= tried)) {
-                /* The partners are read in the original order, far apart:
-                 * ask for the next chunk's while this one is worked on. */
-                for (size_t k = first + m; k < first + 2 * m && k < q->n; k++)
-                    __builtin_prefetch(psrc.base + (ptrdiff_t)q->idx[k] * psrc.ps);
-                for (size_t k = 0; k < m; k++) {
-                    double p[3];
-                    uint32_t i = q->idx[first + k];
-                    hd__src_get(&psrc, i, p);
-                    best[k] = hd__d2s(q->x[first + k], q->y[first + k], q->z[first + k], p[0], p[1], p[2]);
-                    bj[k] = i;
-                    U = best[k] > U ? best[k] : U;
+            if ((c->partner || c->pair_at) && (tried < PAIR_TRIAL || 2 * kept_groups >= tried)) {
+                if (c->partner) {
+                    /* The partners are read in the original order, far
+                     * apart: ask for the next chunk's while this one is
+                     * worked on. */
+                    for (size_t k = first + m; k < first + 2 * m && k < q->n; k++)
+                        __builtin_prefetch(psrc.base + (ptrdiff_t)q->idx[k] * psrc.ps);
+                    for (size_t k = 0; k < m; k++) {
+                        double p[3];
+                        uint32_t i = q->idx[first + k];
+                        hd__src_get(&psrc, i, p);
+                        best[k] = hd__d2s(q->x[first + k], q->y[first + k], q->z[first + k], p[0], p[1], p[2]);
+                        pj[k] = bj[k] = i;
+                        U = best[k] > U ? best[k] : U;
+                    }
+                } else {
+                    /* The partners are points of t, near in its order when
+                     * near in space; a query without one has no bound
+                     * (U infinite: the seeds go on from the others). */
+                    for (size_t k = 0; k < m; k++) {
+                        uint32_t at = c->pair_at[first + k];
+                        pj[k] = UINT32_MAX;
+                        if (at == HD__AN_NO_PARTNER) {
+                            U = INFINITY;
+                            continue;
+                        }
+                        assert(at < t->n);
+                        best[k] = hd__d2s(q->x[first + k], q->y[first + k], q->z[first + k], t->x[at], t->y[at],
+                                          t->z[at]);
+                        pj[k] = bj[k] = t->idx[at];
+                        U = best[k] > U ? best[k] : U;
+                    }
                 }
                 paired = candidates(t, &gbox, U, PAIR_CANDIDATES, cd);
                 tried++;
@@ -1050,7 +1076,7 @@ HD__HOT static void query_task(void *vctx, size_t task, int worker) {
                 else finish_query(t, cd, qx, qy, qz, U, seed[k], seed[k] + SEEDS, near, &best[k], &bj[k]);
                 c->sd[first + k] = best[k];
                 c->sj[first + k] = bj[k];
-                kept += paired && !windowed && bj[k] == q->idx[first + k];
+                kept += paired && !windowed && bj[k] == pj[k];
             }
             /* The queries set apart: each one's own candidates, the
              * buckets within its best so far (a real point's distance, so
@@ -1084,12 +1110,16 @@ size_t hd__an_nearest_bytes(const hd__an_t *asking, const hd__an_t *searched, in
            asking->n * (sizeof(double) + sizeof(uint32_t));
 }
 
-int hd__an_nearest(const hd__an_t *asking, const hd__an_t *searched, const hd_points_t *partner,
-                   int threads, double *dist, size_t *nearest, hd__an_counts_t *counts, hd_error_t *err) {
+/* hd__an_nearest with the partners of a view (partner) or at positions
+ * of searched (pair_at), at most one of them. */
+static int nearest_run(const hd__an_t *asking, const hd__an_t *searched, const hd_points_t *partner,
+                       const uint32_t *pair_at, int threads, double *dist, size_t *nearest, hd__an_counts_t *counts,
+                       hd_error_t *err) {
     size_t tasks = (asking->ng + GROUPS_PER_TASK - 1) / GROUPS_PER_TASK;
     threads = query_threads(asking, threads);
-    query_ctx c = {asking, searched, partner && partner->count == asking->n ? partner : NULL, dist, nearest, NULL,
-                   NULL, NULL};
+    assert(!partner || !pair_at);
+    query_ctx c = {asking, searched, partner && partner->count == asking->n ? partner : NULL, pair_at, dist, nearest,
+                   NULL, NULL, NULL};
     c.cand = hd__calloc_array((size_t)threads, sizeof *c.cand);
     c.sd = hd__malloc_array(asking->n, sizeof *c.sd);
     c.sj = hd__malloc_array(asking->n, sizeof *c.sj);
@@ -1133,4 +1163,14 @@ int hd__an_nearest(const hd__an_t *asking, const hd__an_t *searched, const hd_po
     free(c.sj);
     if (rc != HD_OK) return hd__err(err, rc, "cannot allocate the candidate lists");
     return HD_OK;
+}
+
+int hd__an_nearest(const hd__an_t *asking, const hd__an_t *searched, const hd_points_t *partner,
+                   int threads, double *dist, size_t *nearest, hd__an_counts_t *counts, hd_error_t *err) {
+    return nearest_run(asking, searched, partner, NULL, threads, dist, nearest, counts, err);
+}
+
+int hd__an_nearest_paired(const hd__an_t *asking, const hd__an_t *searched, const uint32_t *pair_at, int threads,
+                          double *dist, size_t *nearest, hd__an_counts_t *counts, hd_error_t *err) {
+    return nearest_run(asking, searched, NULL, pair_at, threads, dist, nearest, counts, err);
 }

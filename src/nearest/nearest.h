@@ -99,4 +99,15 @@ typedef struct hd__an_counts {
 int hd__an_nearest(const hd__an_t *asking, const hd__an_t *searched, const hd_points_t *partner,
                    int threads, double *dist, size_t *nearest, hd__an_counts_t *counts, hd_error_t *err);
 
+/* hd__an_nearest with partners given by position: pair_at[k], for the
+ * point at position k of `asking` (its order, not its original index), is
+ * the position in `searched` of the point tried first as its answer, or
+ * HD__AN_NO_PARTNER.  For sets of different sizes whose points still pair
+ * up (the MPI layer's local parts of a copy and its original: a point and
+ * the one of the same global index).  The answers do not depend on
+ * pair_at.  Returns as hd__an_nearest. */
+#define HD__AN_NO_PARTNER UINT32_MAX
+int hd__an_nearest_paired(const hd__an_t *asking, const hd__an_t *searched, const uint32_t *pair_at, int threads,
+                          double *dist, size_t *nearest, hd__an_counts_t *counts, hd_error_t *err);
+
 #endif /* HD_ALLNEAREST_H */

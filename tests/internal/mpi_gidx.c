@@ -2,10 +2,11 @@
  * mpi_gidx.c -- the local sets' global indices of the MPI library
  * (src/mpi/gidx.c, mpi_int.h's gidx_t): a set of indices of a side,
  * encoded in increasing order over the side's index runs, gives back every
- * index by position (hd__mpi_gidx) and through a cursor (hd__mpi_gcur_at)
+ * index by position (hd__mpi_gidx), through a cursor (hd__mpi_gcur_at)
  * walked in order, with jumps, and backwards, with the rank whose run holds
- * it; in less than 4 + log2(U / n) bits a point and a few words, charged to
- * the call while held.  No MPI call is made (the context only counts
+ * it, and in bulk from any position (hd__mpi_gidx_decode); in less than
+ * 4 + log2(U / n) bits a point and a few words, charged to the call while
+ * held.  No MPI call is made (the context only counts
  * bytes), so this runs without mpirun; built with the MPI library
  * (tests/mpi.cmake).
  */
@@ -97,6 +98,17 @@ static void check_side(scene_t *sc, int s, gen_rng_t *rng) {
         uint64_t r = gen_u64(rng) % 4;
         k += r == 0 ? 1 : r == 1 ? gen_u64(rng) % 70 : r == 2 ? 250 + gen_u64(rng) % 10 : gen_u64(rng) % 5000;
     }
+    /* decoded in bulk: the whole set, and stretches of any length from
+     * anywhere (a word's middle, a run's end, the last position) */
+    uint64_t *d = malloc((n + 1) * sizeof *d);
+    hd__mpi_gidx_decode(&x, 0, n, d);
+    for (size_t k = 0; k < n && !hdt_failed(); k++) CHECK_EQ(d[k], g[k]);
+    for (int t = 0; t < 200 && n && !hdt_failed(); t++) {
+        size_t k = (size_t)(gen_u64(rng) % n), m = (size_t)(gen_u64(rng) % (n - k + 1));
+        hd__mpi_gidx_decode(&x, k, m, d);
+        for (size_t i = 0; i < m && !hdt_failed(); i++) CHECK_EQ(d[i], g[k + i]);
+    }
+    free(d);
     /* anywhere, backwards included */
     hd__mpi_gcur_init(&cu, &x);
     for (int t = 0; t < 2000 && n && !hdt_failed(); t++) {

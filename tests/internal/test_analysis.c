@@ -468,6 +468,58 @@ TEST(a_structure_over_selected_points_answers_with_their_names) {
     }
 }
 
+TEST(partners_given_by_position_leave_every_answer_exact) {
+    /* hd__an_nearest_paired, as the MPI layer gives a rank's local parts
+     * of a copy: B keeps a random subset of its points (named by B's
+     * numbers), and each query of A is paired with the position in B's
+     * structure of B's point of its own number when kept, none when not;
+     * every third case gets wrong partners instead (random positions).
+     * Each answer is the brute force's over the subset, bit for bit and
+     * index for index (copies with ties, half-lattice steps, repeated
+     * points, outliers, far away, tiny); the true partners settle groups
+     * in most cases (the path was under test). */
+    int settled = 0, cases = 0;
+    for (uint64_t seed = 43000; seed < 43000 + 4 * GEN_COPY_KINDS && !hdt_failed(); seed++) {
+        gen_rng_t g;
+        gen_seed(&g, seed);
+        int how = (int)(seed % GEN_COPY_KINDS), threads = seed % 2 ? 1 : 3, wrong = seed % 3 == 0;
+        size_t n = 2 + gen_u64(&g) % (seed % 4 == 0 ? 8000 : 1500);
+        CONTEXT("seed=%llu copy=%s n=%zu threads=%d partners=%s", (unsigned long long)seed, gen_copy_name[how], n,
+                threads, wrong ? "wrong" : "true");
+        double *a = malloc(24 * n), *b = malloc(24 * n), *bs = malloc(24 * n), *d = malloc(8 * n);
+        uint32_t *sb = malloc(4 * n), *at = malloc(4 * n), *pos = malloc(4 * n);
+        size_t *j = malloc(sizeof(size_t) * n);
+        gen_copy(&g, how, a, b, n);
+        size_t mb = 0, drop = gen_u64(&g) % 4; /* about drop in 10 of B left out */
+        for (size_t k = 0; k < n; k++)
+            if (gen_u64(&g) % 10 >= drop || k == 0) memcpy(bs + 3 * mb, b + 3 * k, 24), sb[mb++] = (uint32_t)k;
+        hd_points_t A = hd_points_f64(a, n), B = hd_points_f64(b, n);
+        hd__box_t box = union_box(a, b, n);
+        hd__an_t qa, qb;
+        hd__an_counts_t counts = {0, 0, 0};
+        CHECK_RC(hd__an_build(&qa, &A, NULL, &box, threads, NULL), HD_OK);
+        CHECK_RC(hd__an_build_sel(&qb, &B, sb, NULL, mb, &box, threads, NULL), HD_OK);
+        for (size_t k = 0; k < n; k++) pos[k] = HD__AN_NO_PARTNER; /* B's number -> position in qb */
+        for (size_t t = 0; t < mb; t++) pos[qb.idx[t]] = (uint32_t)t;
+        for (size_t t = 0; t < n; t++) at[t] = wrong ? (uint32_t)(gen_u64(&g) % mb) : pos[qa.idx[t]];
+        CHECK_RC(hd__an_nearest_paired(&qa, &qb, at, threads, d, j, &counts, NULL), HD_OK);
+        for (size_t i = 0; i < n && !hdt_failed(); i++) {
+            size_t jb;
+            double d2 = brute_nearest(a + 3 * i, bs, mb, &jb);
+            CONTEXT("query %zu", i);
+            CHECK_BITS(d[i], sqrt(d2));
+            CHECK_EQ(j[i], (size_t)sb[jb]);
+        }
+        settled += !wrong && counts.paired > 0;
+        cases += !wrong;
+        hd__an_free(&qa);
+        hd__an_free(&qb);
+        free(a), free(b), free(bs), free(d), free(sb), free(at), free(pos), free(j);
+    }
+    CONTEXT("cases with groups settled by partners: %d of %d", settled, cases);
+    CHECK(settled >= cases / 2);
+}
+
 TEST(a_structure_build_holds_at_most_39_bytes_a_point) {
     /* The build's account (hd__an_t.peak, which the MPI layer charges):
      * coordinates and indices (28 B), the sort's keys (8 B), the node and
