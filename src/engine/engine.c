@@ -728,7 +728,10 @@ static int engine_plan(engine_t *e, hd__engine_force_t force, hd_error_t *err) {
     /* Two sets of one size may be a copy and its original in the same
      * order; the correspondence path often settles that case in one pass,
      * before any index is built. */
-    if (force == HD__ENGINE_PLANNED && e->n[0] == e->n[1]) {
+    /* (Not with a filter on a maximum: those paths settle a direction
+     * from its pairs' distances, which a filter may have refused.) */
+    int filtered = e->max[0].keep.keep || e->max[1].keep.keep;
+    if (force == HD__ENGINE_PLANNED && e->n[0] == e->n[1] && !filtered) {
         int rc = hd__pairs_begin(&e->pairs, e->src, e->n[0], e->threads, &e->counts[0], err);
         if (rc) return rc;
         if (hd__pairs_resolve(&e->pairs, e->src, NULL, e->max, e->directions, e->counts))
@@ -736,7 +739,7 @@ static int engine_plan(engine_t *e, hd__engine_force_t force, hd_error_t *err) {
     }
     /* The smaller set may be an ordered subset of the larger: its direction
      * is then 0, settled by one merge walk. */
-    for (int d = 0; d < e->directions && force == HD__ENGINE_PLANNED; d++)
+    for (int d = 0; d < e->directions && force == HD__ENGINE_PLANNED && !filtered; d++)
         if (e->n[d] < e->n[1 - d])
             e->pairs.resolved[d] = hd__subset_resolve(&e->src[d], e->n[d], &e->src[1 - d],
                                                       e->n[1 - d], &e->max[d], &e->counts[d]);
@@ -884,14 +887,14 @@ int hd__engine_directed(const hd_points_t *A, const hd_points_t *B, const hd__bo
     return hd__engine_directed_above(A, B, box_a, box_b, opt, -1.0, 0, out, err);
 }
 
-int hd__engine_directed_above(const hd_points_t *A, const hd_points_t *B,
-                              const hd__box_t *box_a, const hd__box_t *box_b,
-                              const hd_options_t *opt, double floor2, size_t floor_i,
-                              hd_result_t *out, hd_error_t *err) {
+static int engine_directed(const hd_points_t *A, const hd_points_t *B, const hd__box_t *box_a,
+                           const hd__box_t *box_b, const hd_options_t *opt, double floor2, size_t floor_i,
+                           const hd__keep_t *keep, hd_result_t *out, hd_error_t *err) {
     double t0 = hd__now();
     engine_t e;
     int rc = engine_init(&e, A, B, box_a, box_b, opt, 1, err);
     if (rc) return rc;
+    if (keep) e.max[0].keep = *keep;
     /* A virtual point at the floor: every path only offers real points to
      * the maximum and prunes against it, so what survives is what beats it. */
     if (floor2 >= 0) {
@@ -908,13 +911,26 @@ int hd__engine_directed_above(const hd_points_t *A, const hd_points_t *B,
     return HD_OK;
 }
 
+int hd__engine_directed_above(const hd_points_t *A, const hd_points_t *B, const hd__box_t *box_a,
+                              const hd__box_t *box_b, const hd_options_t *opt, double floor2, size_t floor_i,
+                              hd_result_t *out, hd_error_t *err) {
+    return engine_directed(A, B, box_a, box_b, opt, floor2, floor_i, NULL, out, err);
+}
+
+int hd__engine_directed_kept(const hd_points_t *A, const hd_points_t *B, const hd__box_t *box_a,
+                             const hd__box_t *box_b, const hd_options_t *opt, const hd__keep_t *keep,
+                             hd_result_t *out, hd_error_t *err) {
+    return engine_directed(A, B, box_a, box_b, opt, -1.0, 0, keep, out, err);
+}
+
 static int engine_symmetric(const hd_points_t *A, const hd_points_t *B, const hd__box_t *box_a,
-                            const hd__box_t *box_b, const hd_options_t *opt,
-                            hd__engine_force_t force, hd_symmetric_t *out, hd_error_t *err) {
+                            const hd__box_t *box_b, const hd_options_t *opt, hd__engine_force_t force,
+                            const hd__keep_t keep[2], hd_symmetric_t *out, hd_error_t *err) {
     double t0 = hd__now();
     engine_t e;
     int rc = engine_init(&e, A, B, box_a, box_b, opt, 2, err);
     if (rc) return rc;
+    for (int d = 0; d < 2 && keep; d++) e.max[d].keep = keep[d];
     hd_result_t r[2];
     rc = engine_run(&e, force, r, err);
     engine_free(&e);
@@ -933,7 +949,13 @@ static int engine_symmetric(const hd_points_t *A, const hd_points_t *B, const hd
 int hd__engine_hausdorff(const hd_points_t *A, const hd_points_t *B, const hd__box_t *box_a,
                          const hd__box_t *box_b, const hd_options_t *opt, hd_symmetric_t *out,
                          hd_error_t *err) {
-    return engine_symmetric(A, B, box_a, box_b, opt, HD__ENGINE_PLANNED, out, err);
+    return engine_symmetric(A, B, box_a, box_b, opt, HD__ENGINE_PLANNED, NULL, out, err);
+}
+
+int hd__engine_hausdorff_kept(const hd_points_t *A, const hd_points_t *B, const hd__box_t *box_a,
+                              const hd__box_t *box_b, const hd_options_t *opt, const hd__keep_t keep[2],
+                              hd_symmetric_t *out, hd_error_t *err) {
+    return engine_symmetric(A, B, box_a, box_b, opt, HD__ENGINE_PLANNED, keep, out, err);
 }
 
 int hd__engine_forced(const hd_points_t *A, const hd_points_t *B, const hd_options_t *opt,
@@ -943,7 +965,7 @@ int hd__engine_forced(const hd_points_t *A, const hd_points_t *B, const hd_optio
     if (rc == HD_OK) rc = hd__points_scan(B, "B", opt->threads, &bb, err);
     if (rc) return rc;
     memset(out, 0, sizeof *out);
-    rc = engine_symmetric(A, B, &ba, &bb, opt, force, out, err);
+    rc = engine_symmetric(A, B, &ba, &bb, opt, force, NULL, out, err);
     if (rc == HD_OK)
         out->distance = out->ab.distance2 >= out->ba.distance2 ? out->ab.distance : out->ba.distance;
     return rc;

@@ -287,18 +287,33 @@ void hd__grid_nearest(const hd__grid_t *g, const double q[3], double stop2, doub
 
 /* ---- the running maximum shared by the threads of one direction --------------- */
 
+/* A filter on a direction's maximum: keep(ctx, i, d2) says whether point
+ * i of A, whose exact squared nearest distance is d2, may be the maximum.
+ * A point it refuses is left out of the maximum and of the bound that
+ * prunes the others, as if it were not in A; every path offers each point
+ * that may beat the maximum (hd__max_offer), so the answer is the maximum
+ * over the points kept, with its smallest index, and every point not
+ * offered has a nearest distance no larger than it.  Called under the
+ * maximum's lock, so it may record what it refuses. */
+typedef struct {
+    int (*keep)(void *ctx, size_t i, double d2); /* NULL: every point */
+    void *ctx;
+} hd__keep_t;
+
 /* cmax (the bound all threads raise), and under a lock the maximum so far
  * with its canonical witness. */
 typedef struct hd__max {
     hd__bound_t cmax;
     pthread_mutex_t lock;
     hd__best_t best;
+    hd__keep_t keep;
 } hd__max_t;
 
 int hd__max_init(hd__max_t *m);
 void hd__max_destroy(hd__max_t *m);
-/* Record an exact nearest distance d2 of point i (nearest j); *snap gets a
- * consistent copy of the maximum so far. */
+/* Record an exact nearest distance d2 of point i (nearest j), unless the
+ * maximum's filter refuses it; *snap gets a consistent copy of the maximum
+ * so far. */
 void hd__max_offer(hd__max_t *m, double d2, size_t i, size_t j, hd__best_t *snap);
 void hd__max_snapshot(hd__max_t *m, hd__best_t *snap);
 
@@ -405,6 +420,22 @@ int hd__engine_hausdorff(const hd_points_t *A, const hd_points_t *B,
                          const hd__box_t *box_a, const hd__box_t *box_b,
                          const hd_options_t *opt, hd_symmetric_t *out,
                          hd_error_t *err);
+/* hd__engine_hausdorff with a filter on each direction's maximum (keep[0]
+ * on h(A,B)'s points of A, keep[1] on h(B,A)'s points of B; see
+ * hd__keep_t): each answer is the maximum over the points kept.  The
+ * correspondence and subset paths, which settle a direction from its
+ * pairs, do not run.  For the MPI library's pass over a rank's local sets,
+ * whose points near a face of the rank's region have a nearest distance
+ * that is only local. */
+int hd__engine_hausdorff_kept(const hd_points_t *A, const hd_points_t *B,
+                              const hd__box_t *box_a, const hd__box_t *box_b,
+                              const hd_options_t *opt, const hd__keep_t keep[2],
+                              hd_symmetric_t *out, hd_error_t *err);
+/* h(A,B) alone, its maximum filtered by *keep (as above). */
+int hd__engine_directed_kept(const hd_points_t *A, const hd_points_t *B,
+                             const hd__box_t *box_a, const hd__box_t *box_b,
+                             const hd_options_t *opt, const hd__keep_t *keep,
+                             hd_result_t *out, hd_error_t *err);
 /* h(A,B) where only an answer above a floor matters: the maximum starts
  * at (floor2, floor_i) as if point floor_i of A had that squared nearest
  * distance, so every point that cannot beat it (u^2 < floor2, or u^2 =

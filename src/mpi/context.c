@@ -89,10 +89,12 @@ void hd__mpi_charge(ctx_t *c, size_t bytes) {
  * point again (a pass over both sets, about 50 instructions a point); on
  * the caller's views (one rank: any layout) the public hd_directed.  s:
  * both directions at once (hd__engine_hausdorff), else h(P, Q) into e,
- * from a floor when floor2 >= 0 (hd__engine_directed_above). */
+ * from a floor when floor2 >= 0 (hd__engine_directed_above); keep: NULL,
+ * or the filter on each direction's maximum (hd__keep_t; s: two). */
 enum { VIEWS, LOCAL };
 static int engine_call(ctx_t *c, int where, const hd_points_t *P, const hd_points_t *Q, const hd__box_t *bp,
-                       const hd__box_t *bq, double floor2, size_t floor_i, hd_result_t *e, hd_symmetric_t *s) {
+                       const hd__box_t *bq, double floor2, size_t floor_i, const hd__keep_t *keep, hd_result_t *e,
+                       hd_symmetric_t *s) {
     hd_options_t o;
     hd_options_init(&o);
     o.threads = c->threads;
@@ -104,7 +106,9 @@ static int engine_call(ctx_t *c, int where, const hd_points_t *P, const hd_point
         else hd__box_of(Q->data, Q->count, &b[1]);
     }
     int rc = where == VIEWS ? hd_directed(P, Q, &o, e, &c->e)
+             : s && keep    ? hd__engine_hausdorff_kept(P, Q, &b[0], &b[1], &o, keep, s, &c->e)
              : s            ? hd__engine_hausdorff(P, Q, &b[0], &b[1], &o, s, &c->e)
+             : keep         ? hd__engine_directed_kept(P, Q, &b[0], &b[1], &o, keep, e, &c->e)
                             : hd__engine_directed_above(P, Q, &b[0], &b[1], &o, floor2, floor_i, e, &c->e);
     size_t bytes = rc != HD_OK ? 0 : s ? (size_t)s->ab.stats.peak_bytes : (size_t)e->stats.peak_bytes;
     hd__mpi_charge(c, bytes);
@@ -113,12 +117,18 @@ static int engine_call(ctx_t *c, int where, const hd_points_t *P, const hd_point
 }
 
 int hd__mpi_engine(ctx_t *c, const hd_points_t *P, const hd_points_t *Q, hd_result_t *e) {
-    return engine_call(c, VIEWS, P, Q, NULL, NULL, -1.0, 0, e, NULL);
+    return engine_call(c, VIEWS, P, Q, NULL, NULL, -1.0, 0, NULL, e, NULL);
 }
 
 int hd__mpi_engine_local(ctx_t *c, const hd_points_t *P, const hd_points_t *Q, const hd__box_t *bp,
                          const hd__box_t *bq, hd_result_t *e) {
-    return engine_call(c, LOCAL, P, Q, bp, bq, -1.0, 0, e, NULL);
+    return engine_call(c, LOCAL, P, Q, bp, bq, -1.0, 0, NULL, e, NULL);
+}
+
+/* h(P, Q) over the points *keep keeps (hd__keep_t). */
+int hd__mpi_engine_kept(ctx_t *c, const hd_points_t *P, const hd_points_t *Q, const hd__keep_t *keep,
+                        hd_result_t *e) {
+    return engine_call(c, LOCAL, P, Q, NULL, NULL, -1.0, 0, keep, e, NULL);
 }
 
 /* h(P, Q) where only an answer beating (floor2, floor_i) matters: the
@@ -126,14 +136,15 @@ int hd__mpi_engine_local(ctx_t *c, const hd_points_t *P, const hd_points_t *Q, c
  * it. */
 int hd__mpi_engine_above(ctx_t *c, const hd_points_t *P, const hd_points_t *Q, double floor2, size_t floor_i,
                          hd_result_t *e) {
-    return engine_call(c, LOCAL, P, Q, NULL, NULL, floor2, floor_i, e, NULL);
+    return engine_call(c, LOCAL, P, Q, NULL, NULL, floor2, floor_i, NULL, e, NULL);
 }
 
 /* Both directions in one call: the engine builds each set's structures
- * once for both (hd_directed builds both sets' too). */
+ * once for both (hd_directed builds both sets' too).  keep: NULL, or a
+ * filter on each direction's maximum (hd__keep_t). */
 int hd__mpi_engine_sym(ctx_t *c, const hd_points_t *P, const hd_points_t *Q, const hd__box_t *bp,
-                       const hd__box_t *bq, hd_symmetric_t *s) {
-    return engine_call(c, LOCAL, P, Q, bp, bq, -1.0, 0, NULL, s);
+                       const hd__box_t *bq, const hd__keep_t keep[2], hd_symmetric_t *s) {
+    return engine_call(c, LOCAL, P, Q, bp, bq, -1.0, 0, keep, NULL, s);
 }
 
 int hd__mpi_nomem(ctx_t *c, const char *what, size_t n) {

@@ -62,7 +62,11 @@
  *     directions (each engine call builds both sets' structures).  Every
  *     a whose region faces are clear of h2 (step 4's test
  *     with h2 >= u(a)^2) is settled without a search of its own (the
- *     interior).  When the engine's witness is interior, it is the
+ *     interior).  The engine's maximum keeps only the points whose faces
+ *     are clear of their own u (a filter on it: shell.c), so its answer is
+ *     the interior's maximum at once; when the filter's list of refused
+ *     points overflows, or it keeps none, the engine runs unfiltered and:
+ *     When the engine's witness is interior, it is the
  *     interior's maximum; else the interior's maximum is computed (one
  *     more engine call on it, its maximum starting at G, so what cannot
  *     beat G is pruned at once) only on a rank where the engine's answer
@@ -338,7 +342,8 @@ static int run(ctx_t *c, const hd_options_t *opt, input_t *in, void *arg, hd_mpi
         if (both) {
             const gidx_t *gp[2] = {&sp->loc.gi[0], &sp->loc.gi[1]};
             double t1 = hd__now(), u1 = hd__mpi_cpu();
-            pre_rc = hd__mpi_engine_both(c, loc->xyz, gp, loc->n, sp->held[c->rank].box, pre, mask);
+            pre_rc = hd__mpi_engine_both(c, loc->xyz, gp, loc->n, sp->held[c->rank].box, &sp->region[c->rank], pre,
+                                         mask);
             c->search += hd__now() - t1;
             c->search_cpu += hd__mpi_cpu() - u1;
         }
@@ -348,7 +353,7 @@ static int run(ctx_t *c, const hd_options_t *opt, input_t *in, void *arg, hd_mpi
                        &pre[s]};
             rc = hd__mpi_direction(c, &d, sp->tree, sp->region, sp->held, &f[s]);
         }
-        for (int s = 0; s < 2; s++) hd__mpi_free(c, mask[s], loc->n[s], 1);
+        for (int s = 0; s < 2; s++) hd__mpi_free(c, mask[s], loc->n[s], 1), hd__mpi_pre_free(c, &pre[s]);
         if (rc != HD_OK) goto done;
         pts = loc->n[0] + loc->n[1];
     }

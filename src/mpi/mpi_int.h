@@ -19,6 +19,7 @@
 #ifndef HD_MPI_INT_H
 #define HD_MPI_INT_H
 
+#include "engine/engine.h"
 #include "hausdorff_mpi.h"
 #include "nearest/nearest.h"
 #include "points/points.h"
@@ -65,9 +66,11 @@ int hd__mpi_engine(ctx_t *c, const hd_points_t *P, const hd_points_t *Q, hd_resu
 int hd__mpi_engine_local(ctx_t *c, const hd_points_t *P, const hd_points_t *Q, const hd__box_t *bp,
                          const hd__box_t *bq, hd_result_t *e);
 int hd__mpi_engine_sym(ctx_t *c, const hd_points_t *P, const hd_points_t *Q, const hd__box_t *bp,
-                       const hd__box_t *bq, hd_symmetric_t *s);
+                       const hd__box_t *bq, const hd__keep_t keep[2], hd_symmetric_t *s);
 int hd__mpi_engine_above(ctx_t *c, const hd_points_t *P, const hd_points_t *Q, double floor2, size_t floor_i,
                          hd_result_t *e);
+int hd__mpi_engine_kept(ctx_t *c, const hd_points_t *P, const hd_points_t *Q, const hd__keep_t *keep,
+                        hd_result_t *e);
 int hd__mpi_nomem(ctx_t *c, const char *what, size_t n);
 int hd__mpi_failed(ctx_t *c, const char *call, int code);
 int hd__mpi_agree(ctx_t *c, int rc);
@@ -411,17 +414,33 @@ static inline const double *hd__mpi_shell_pt(const dir_t *d, const shell_t *sh, 
  * symmetric call runs the engine once for both directions
  * (hd__mpi_engine_both), since each of its calls builds both sets'
  * structures. */
+/* The points of P the engine's maximum refused (shell.c, keep_clear):
+ * those whose region faces are not clear of their own local nearest
+ * distance, which may be only local. */
+typedef struct {
+    const hd__box_t *mine;   /* the rank's region */
+    const double *P;
+    int on;                  /* the engine's answer is over the points kept */
+    double d2;               /* the largest refused u^2 (-1: none) */
+    uint32_t *pos;           /* refused positions in P (repeats possible) */
+    size_t n, cap;
+    int overflow;            /* more than cap were refused: pos is partial */
+} refused_t;
+
 typedef struct pre {
     int have;                /* 0: the direction runs the engine itself */
     int paired;              /* the answer is on the pairs (P_c, Q_c) */
     hd_result_t e;           /* positions in P and Q, or in P_c and Q_c */
     const unsigned char *inp, *inq; /* paired: the pairs' masks of P, Q */
+    refused_t ref;           /* not paired: what e's maximum left out */
 } pre_t;
 
 /* mask[s]: NULL, or the pairs' mask of side s (n[s] bytes) when paired,
- * which the caller frees (hd__mpi_free) after both directions. */
+ * which the caller frees (hd__mpi_free) after both directions, as it
+ * frees pre[s] (hd__mpi_pre_free).  mine: the rank's region. */
 int hd__mpi_engine_both(ctx_t *c, double *xyz[2], const gidx_t *g[2], const size_t n[2], const hd__box_t box[2],
-                        pre_t pre[2], unsigned char *mask[2]);
+                        const hd__box_t *mine, pre_t pre[2], unsigned char *mask[2]);
+void hd__mpi_pre_free(ctx_t *c, pre_t *pre);
 void hd__mpi_shell_free(ctx_t *c, shell_t *sh);
 int hd__mpi_interior_max(ctx_t *c, const dir_t *d, const hd__box_t *mine, const shell_t *sh, double h2,
                          const far_t *G, far_t *out);

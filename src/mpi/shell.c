@@ -8,7 +8,17 @@
  * is confirmed without a search of its own (the interior).  The interior's
  * exact maximum is the engine's own answer when the engine's witness is
  * interior (it is then the smallest index at h2), else one more engine
- * call on the interior alone.  The other points (the shell) get per-point
+ * call on the interior alone.  Unless its list of refused points
+ * overflows, the engine's maximum is filtered instead (keep_clear, in
+ * hd__mpi_engine_both for both directions at once, else here): it keeps
+ * only the points whose faces are clear of their own u, so its answer h_I
+ * is attained by an interior point and bounds every point not refused,
+ * the interior is the points clear of h_I that were not refused, and its
+ * maximum is h_I at once; the rank's largest u (the slabs' scale) is the
+ * larger of h_I and the refused points' largest.  (A refused point's faces
+ * are not clear of its u <= that largest u, so the shell stays within it
+ * of the faces; the interior only grows, by points whose u is at most h_I
+ * and clear.)  The other points (the shell) get per-point
  * searches (hd_distances).  The engine prunes the points that cannot be the
  * farthest, which per-point searches cannot: on two epochs of one scene it
  * is tens of times faster (docs/scale-out.md), and the shell is the points
@@ -191,7 +201,7 @@ static int pairs_engine(ctx_t *c, double *P, size_t nP, double *Q, size_t nQ, co
     hd_points_t Pv = hd_points_f64(P, nc), Qv = hd_points_f64(Q, nc);
     hd_symmetric_t s;
     int rc = HD_OK;
-    if (sym && (rc = hd__mpi_engine_sym(c, &Pv, &Qv, box ? &box[0] : NULL, box ? &box[1] : NULL, &s)) == HD_OK)
+    if (sym && (rc = hd__mpi_engine_sym(c, &Pv, &Qv, box ? &box[0] : NULL, box ? &box[1] : NULL, NULL, &s)) == HD_OK)
         e[0] = s.ab, e[1] = s.ba;
     if (!sym) rc = hd__mpi_engine_local(c, &Pv, &Qv, NULL, NULL, &e[0]);
     unsplit(P, nP, (keep_t){inp, NULL, 0}, py);
@@ -201,8 +211,31 @@ static int pairs_engine(ctx_t *c, double *P, size_t nP, double *Q, size_t nQ, co
     return rc;
 }
 
+/* The engine's filter on a direction's maximum: point i of P counts only
+ * when its region's faces are clear of its own local nearest distance
+ * (then that distance is its global one: mpi.c, step 4); the others are
+ * recorded, with the largest of their distances. */
+static int keep_clear(void *ctx, size_t i, double d2) {
+    refused_t *r = ctx;
+    if (hd__mpi_faces_clear(r->mine, r->P + 3 * i, d2)) return 1;
+    r->d2 = d2 > r->d2 ? d2 : r->d2;
+    if (r->n < r->cap) r->pos[r->n++] = (uint32_t)i;
+    else r->overflow = 1;
+    return 0;
+}
+
+/* Room for the refused points: an engine pass offers a few thousand
+ * points of a million, and refuses those of the shell among them. */
+#define REFUSED_ROOM(n) ((n) / 256 + 256)
+
+void hd__mpi_pre_free(ctx_t *c, pre_t *pre) {
+    hd__mpi_free(c, pre->ref.pos, pre->ref.cap, sizeof(uint32_t));
+    pre->ref.pos = NULL;
+    pre->ref.cap = 0;
+}
+
 int hd__mpi_engine_both(ctx_t *c, double *xyz[2], const gidx_t *g[2], const size_t n[2], const hd__box_t box[2],
-                        pre_t pre[2], unsigned char *mask[2]) {
+                        const hd__box_t *mine, pre_t pre[2], unsigned char *mask[2]) {
     memset(pre, 0, 2 * sizeof *pre);
     mask[0] = mask[1] = NULL;
     if (n[0] == 0 || n[1] == 0) return HD_OK; /* shell_of has nothing to ask the engine */
@@ -221,16 +254,28 @@ int hd__mpi_engine_both(ctx_t *c, double *xyz[2], const gidx_t *g[2], const size
         if (paired) return HD_OK; /* each direction on its own */
     }
     hd_result_t e[2];
+    refused_t ref[2];
+    memset(ref, 0, sizeof ref);
     int rc = HD_OK;
     if (!paired) {
+        /* Each direction's maximum over the points whose faces are clear
+         * of their own distance: the interior's maximum, at once (shell_of) */
+        hd__keep_t keep[2];
+        for (int s = 0; s < 2; s++) {
+            ref[s] = (refused_t){mine, xyz[s], 1, -1.0, NULL, 0, REFUSED_ROOM(n[s]), 0};
+            keep[s] = (hd__keep_t){keep_clear, &ref[s]};
+            if (!(ref[s].pos = hd__mpi_alloc(c, ref[s].cap, sizeof(uint32_t))))
+                rc = hd__mpi_nomem(c, "the shell", n[s]);
+        }
         hd_points_t Av = hd_points_f64(xyz[0], n[0]), Bv = hd_points_f64(xyz[1], n[1]);
         hd_symmetric_t s;
-        if ((rc = hd__mpi_engine_sym(c, &Av, &Bv, &box[0], &box[1], &s)) == HD_OK) e[0] = s.ab, e[1] = s.ba;
+        if (rc == HD_OK && (rc = hd__mpi_engine_sym(c, &Av, &Bv, &box[0], &box[1], keep, &s)) == HD_OK)
+            e[0] = s.ab, e[1] = s.ba;
     } else {
         rc = pairs_engine(c, xyz[0], n[0], xyz[1], n[1], mask[0], mask[1], nc, 1, box, e);
     }
-    if (rc == HD_OK)
-        for (int s = 0; s < 2; s++) pre[s] = (pre_t){1, paired, e[s], mask[s], mask[1 - s]};
+    for (int s = 0; s < 2; s++)
+        pre[s] = rc == HD_OK ? (pre_t){1, paired, e[s], mask[s], mask[1 - s], ref[s]} : (pre_t){.ref = ref[s]};
     return rc;
 }
 
@@ -362,15 +407,36 @@ int hd__mpi_shell_of(ctx_t *c, const dir_t *d, const hd__box_t *mine, qtree_t *q
     int done = 0;
     int rc = paired_pass(c, d, mine, &in, &nI, &sh->inner, &done);
     const pre_t *pre = d->pre && d->pre->have && !d->pre->paired ? d->pre : NULL;
+    /* The engine's answer over the points kept (hd__mpi_engine_both): every
+     * point of P either was refused (its faces not clear of its own u), or
+     * has u no larger than the answer, which a kept point attains.  With
+     * the refused points' list incomplete, or no point kept, the engine
+     * runs again on the whole local sets, without the filter. */
+    const refused_t *ref = pre && pre->ref.on ? &pre->ref : NULL;
+    refused_t own = {mine, d->P, 0, -1.0, NULL, 0, 0, 0}; /* when the engine runs here */
+    if (ref && (ref->overflow || pre->e.i == HD__NONE)) pre = NULL, ref = NULL;
     if (rc == HD_OK && !done && pre) e = pre->e;
-    if (rc == HD_OK && !done && (pre || (rc = hd__mpi_engine_local(c, &Pv, &Qv, NULL, NULL, &e)) == HD_OK)) {
+    if (rc == HD_OK && !done && !pre) {
+        own.cap = REFUSED_ROOM(d->nP);
+        hd__keep_t keep = {keep_clear, &own};
+        if (!(own.pos = hd__mpi_alloc(c, own.cap, sizeof(uint32_t)))) rc = hd__mpi_nomem(c, "the shell", d->nP);
+        if (rc == HD_OK && (rc = hd__mpi_engine_kept(c, &Pv, &Qv, &keep, &e)) == HD_OK && !own.overflow &&
+            e.i != HD__NONE)
+            ref = &own;
+    }
+    if (rc == HD_OK && !done && (pre || ref || (rc = hd__mpi_engine_local(c, &Pv, &Qv, NULL, NULL, &e)) == HD_OK)) {
         if (!in && !(in = hd__mpi_alloc(c, d->nP, 1))) rc = hd__mpi_nomem(c, "the interior", d->nP);
         nI = 0;
         for (size_t k = 0; k < d->nP && rc == HD_OK; k++)
             nI += in[k] = (unsigned char)hd__mpi_faces_clear(mine, d->P + 3 * k, e.distance2);
+        for (size_t r = 0; ref && rc == HD_OK && r < ref->n; r++) { /* refused: shell, whatever their faces */
+            nI -= in[ref->pos[r]];
+            in[ref->pos[r]] = 0;
+        }
     }
     if (rc != HD_OK) {
         hd__mpi_free(c, in, d->nP, 1);
+        hd__mpi_free(c, own.pos, own.cap, sizeof(uint32_t));
         return rc;
     }
     size_t nS = d->nP - nI;
@@ -386,7 +452,11 @@ int hd__mpi_shell_of(ctx_t *c, const dir_t *d, const hd__box_t *mine, qtree_t *q
      * (At 2.5 h the slab held up to half of Q on lidar at K = 16 and was
      * the rank's memory peak; at 1.25 h, uniform sets at K = 2 needed the
      * second slab: docs/scale-out.md.) */
-    q->M0 = 1.5 * sqrt(done ? sh->inner.d2 : e.distance2);
+    /* h: the largest u of the rank, the kept points' or the refused ones' */
+    q->M0 = 1.5 * sqrt(done ? sh->inner.d2 : ref && ref->d2 > e.distance2 ? ref->d2 : e.distance2);
+    /* A kept witness is interior: its faces are clear of its own u. */
+    assert(done || !ref || !nI || in[e.i]);
+    hd__mpi_free(c, own.pos, own.cap, sizeof(uint32_t));
     if (done) {
         /* the interior's answer is the paired pass's */
     } else if (nI && in[e.i]) {

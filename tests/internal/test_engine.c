@@ -151,6 +151,79 @@ TEST(engine_matches_brute_force_on_thousands_of_seeded_cases) {
     }
 }
 
+/* A filter like the MPI library's (a point counts only when the plane
+ * x = cut is farther than its own nearest distance), or one that refuses
+ * every third index above a threshold, or everything. */
+typedef struct {
+    const double *p;
+    double cut, t2;
+    int rule; /* 0: the plane, 1: every third index above t2, 2: none kept */
+} keep_rule_t;
+
+static int keep_by_rule(void *ctx, size_t i, double d2) {
+    const keep_rule_t *r = ctx;
+    if (r->rule == 2) return 0;
+    if (r->rule == 1) return i % 3 != 0 || d2 <= r->t2;
+    double g = r->p[3 * i] - r->cut;
+    return g * g > d2;
+}
+
+/* The brute force's maximum over the points of a the rule keeps (d2 = -1
+ * and no witness when none is). */
+static brute_t brute_kept(const double *a, size_t na, const double *b, size_t nb, keep_rule_t *r) {
+    brute_t best = {-1.0, HD__NONE, HD__NONE};
+    for (size_t i = 0; i < na; i++) {
+        size_t j;
+        double d2 = brute_nearest(a + 3 * i, b, nb, &j);
+        if (keep_by_rule(r, i, d2) && d2 > best.d2) best = (brute_t){d2, i, j};
+    }
+    return best;
+}
+
+TEST(a_filtered_maximum_is_the_maximum_over_the_points_kept) {
+    /* hd__engine_hausdorff_kept, as the MPI library runs it on a rank's
+     * local sets: each direction's answer is the brute force's over the
+     * points its filter keeps (every path of the engine offers each point
+     * that may beat the maximum; the refused ones raise no bound), ties
+     * to the smallest index, at one thread and at three; copies in one
+     * order (whose correspondence path must not run) included. */
+    gen_rng_t g;
+    for (uint64_t seed = 7000; seed < 7000 + 40 * K_COUNT && !hdt_failed(); seed++) {
+        gen_seed(&g, seed);
+        int kind = (int)(seed % K_COUNT), threads = seed % 2 ? 1 : 3, rule = (int)(seed / K_COUNT % 5);
+        rule = rule < 3 ? 0 : rule == 3 ? 1 : 2;
+        size_t cap = seed % 7 == 0 ? 3000 : 300;
+        size_t na = 1 + gen_u64(&g) % cap, nb = seed % 5 == 0 ? na : 1 + gen_u64(&g) % cap;
+        CONTEXT("seed=%llu kind=%s na=%zu nb=%zu threads=%d rule=%d", (unsigned long long)seed, kind_name[kind],
+                na, nb, threads, rule);
+        double *a = malloc(24 * na), *b = malloc(24 * nb);
+        make_pair(&g, kind, a, na, b, nb);
+        if (nb == na && seed % 10 == 0) /* a copy in one order */
+            for (size_t k = 0; k < 3 * na; k++) b[k] = a[k] + (k % 3 == 0 ? 1e-3 : 0);
+        keep_rule_t ra = {a, a[3 * (na / 2)], 0, rule}, rb = {b, b[3 * (nb / 2)], 0, rule};
+        ra.t2 = rb.t2 = brute_directed(a, na, b, nb).d2 / 4;
+        brute_t want_ab = brute_kept(a, na, b, nb, &ra), want_ba = brute_kept(b, nb, a, na, &rb);
+        hd_points_t A = hd_points_f64(a, na), B = hd_points_f64(b, nb);
+        hd__box_t ba, bb;
+        hd__box_of(a, na, &ba);
+        hd__box_of(b, nb, &bb);
+        hd_options_t o;
+        hd_options_init(&o);
+        o.threads = threads;
+        hd__keep_t keep[2] = {{keep_by_rule, &ra}, {keep_by_rule, &rb}};
+        hd_symmetric_t s;
+        CHECK_RC(hd__engine_hausdorff_kept(&A, &B, &ba, &bb, &o, keep, &s, NULL), HD_OK);
+        CHECK_BITS(s.ab.distance2, want_ab.d2);
+        CHECK_EQ(s.ab.i, want_ab.i);
+        CHECK_BITS(s.ba.distance2, want_ba.d2);
+        CHECK_EQ(s.ba.i, want_ba.i);
+        if (want_ab.i != HD__NONE) CHECK_EQ(s.ab.j, want_ab.j);
+        if (want_ba.i != HD__NONE) CHECK_EQ(s.ba.j, want_ba.j);
+        free(a);
+        free(b);
+    }
+}
+
 TEST(engine_matches_brute_force_on_large_sets) {
     gen_rng_t g;
     for (int kind = 0; kind < K_COUNT; kind++) {
