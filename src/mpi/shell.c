@@ -214,10 +214,14 @@ static int pairs_engine(ctx_t *c, double *P, size_t nP, double *Q, size_t nQ, co
 /* The engine's filter on a direction's maximum: point i of P counts only
  * when its region's faces are clear of its own local nearest distance
  * (then that distance is its global one: mpi.c, step 4); the others are
- * recorded, with the largest of their distances. */
+ * recorded, with the largest of their distances.  Once the list is full
+ * the pass's answer is of no use (shell_of runs the engine again without
+ * the filter), and the filter keeps every point, so that the rest of the
+ * pass prunes as an unfiltered one does instead of searching every point
+ * that nothing kept bounds (A far from the local B: every u large). */
 static int keep_clear(void *ctx, size_t i, double d2) {
     refused_t *r = ctx;
-    if (hd__mpi_faces_clear(r->mine, r->P + 3 * i, d2)) return 1;
+    if (r->overflow || hd__mpi_faces_clear(r->mine, r->P + 3 * i, d2)) return 1;
     r->d2 = d2 > r->d2 ? d2 : r->d2;
     if (r->n < r->cap) r->pos[r->n++] = (uint32_t)i;
     else r->overflow = 1;
