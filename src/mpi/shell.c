@@ -181,6 +181,31 @@ static size_t mark_pairs(const gidx_t *gP, size_t nP, const gidx_t *gQ, size_t n
     return nc;
 }
 
+/* Whether the merge walk of mark_pairs is worth it: at least three
+ * quarters of PAIRS_SAMPLE points of P, evenly spaced, have their partner
+ * here (each found by a binary search of Q's indices, decoded at random:
+ * a few thousand decodes against the walk's 45-60 instructions a point).
+ * The correspondence pass wants nine tenths (is_paired), which a sample of
+ * 64 misses by that much only at four standard deviations if it were
+ * random; two unrelated sets of one size have about 1/K of their partners
+ * here (half at K = 2).  A sample that misses a copy only costs that pass,
+ * never an answer. */
+#define PAIRS_SAMPLE 64
+static int pairs_likely(const gidx_t *gP, size_t nP, const gidx_t *gQ, size_t nQ) {
+    size_t m = nP < PAIRS_SAMPLE ? nP : PAIRS_SAMPLE, hits = 0;
+    for (size_t r = 0; r < m && nQ; r++) {
+        uint64_t g = hd__mpi_gidx(gP, r * nP / m);
+        size_t lo = 0, hi = nQ;
+        while (lo < hi) {
+            size_t mid = lo + (hi - lo) / 2;
+            if (hd__mpi_gidx(gQ, mid) < g) lo = mid + 1;
+            else hi = mid;
+        }
+        hits += lo < nQ && hd__mpi_gidx(gQ, lo) == g;
+    }
+    return 4 * hits >= 3 * m;
+}
+
 /* The correspondence pass is tried when nine tenths of P have their
  * partner (anything else is not a copy), and not on whole sets in one
  * order, which the engine's own path takes. */
@@ -245,17 +270,22 @@ int hd__mpi_engine_both(ctx_t *c, double *xyz[2], const gidx_t *g[2], const size
     if (n[0] == 0 || n[1] == 0) return HD_OK; /* shell_of has nothing to ask the engine */
     /* The masks are marked in the walk that counts the pairs (2 bytes a
      * point while the local arrays alone are held: below the engine's
-     * peak), and freed at once when the sets are not a copy. */
-    mask[0] = hd__mpi_alloc(c, n[0], 1);
-    mask[1] = hd__mpi_alloc(c, n[1], 1);
-    if (!mask[0] || !mask[1]) return hd__mpi_nomem(c, "the pairs", n[0]);
-    memset(mask[0], 0, n[0]);
-    memset(mask[1], 0, n[1]);
-    size_t nc = mark_pairs(g[0], n[0], g[1], n[1], mask[0], mask[1]);
-    int paired = is_paired(nc, n[0], n[1]);
-    if (!paired || paired != is_paired(nc, n[1], n[0])) {
-        for (int s = 0; s < 2; s++) hd__mpi_free(c, mask[s], n[s], 1), mask[s] = NULL;
-        if (paired) return HD_OK; /* each direction on its own */
+     * peak), and freed at once when the sets are not a copy; neither is
+     * done when a sample finds few pairs. */
+    int paired = 0;
+    size_t nc = 0;
+    if (pairs_likely(g[0], n[0], g[1], n[1])) {
+        mask[0] = hd__mpi_alloc(c, n[0], 1);
+        mask[1] = hd__mpi_alloc(c, n[1], 1);
+        if (!mask[0] || !mask[1]) return hd__mpi_nomem(c, "the pairs", n[0]);
+        memset(mask[0], 0, n[0]);
+        memset(mask[1], 0, n[1]);
+        nc = mark_pairs(g[0], n[0], g[1], n[1], mask[0], mask[1]);
+        paired = is_paired(nc, n[0], n[1]);
+        if (!paired || paired != is_paired(nc, n[1], n[0])) {
+            for (int s = 0; s < 2; s++) hd__mpi_free(c, mask[s], n[s], 1), mask[s] = NULL;
+            if (paired) return HD_OK; /* each direction on its own */
+        }
     }
     hd_result_t e[2];
     refused_t ref[2];
@@ -309,7 +339,9 @@ static int paired_pass(ctx_t *c, const dir_t *d, const hd__box_t *mine, unsigned
     *done = 0;
     *inp = NULL;
     if (pre && !pre->paired) return HD_OK;
-    if (!pre && !is_paired(nc = mark_pairs(d->gP, nP, d->gQ, nQ, NULL, NULL), nP, nQ)) return HD_OK;
+    if (!pre && (!pairs_likely(d->gP, nP, d->gQ, nQ) ||
+                 !is_paired(nc = mark_pairs(d->gP, nP, d->gQ, nQ, NULL, NULL), nP, nQ)))
+        return HD_OK;
     /* P's mask is made the interior's below, so it is this pass's own; Q's
      * is only read, hd__mpi_engine_both's when it marked them */
     unsigned char *in = *inp = hd__mpi_alloc(c, nP, 1), *ownq = pre ? NULL : hd__mpi_alloc(c, nQ, 1);
