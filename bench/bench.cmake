@@ -5,6 +5,8 @@
 hd_add_bench(hd_bench ${CMAKE_CURRENT_LIST_DIR}/bench.c)
 # hd_bench prints the engine's plan (hd__engine_explain, src/engine/engine.h).
 target_include_directories(hd_bench PRIVATE ${CMAKE_SOURCE_DIR}/src)
+# engine_peak: the engine's memory peak and time, call after call.
+hd_add_bench(engine_peak ${CMAKE_CURRENT_LIST_DIR}/engine_peak.c)
 
 option(HD_BENCH_PEERS "Build the C++ peer programs of the engine benchmark (nanoflann, PCL)" OFF)
 if(HD_BENCH_PEERS)

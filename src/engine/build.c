@@ -43,11 +43,15 @@
  * copy takes a kept sort buffer when one fits, shrunk the same way.  The
  * engine builds its two trees in two halves (hd__tree_build_pair): both
  * sorts first, the larger set's first, each leaving only its 7.4 bytes per
- * point, then both quantised copies and boxes.  So at no time are more
- * than max(16 n0, 7.4 n0 + 16 n1, 13.375 (n0 + n1)) bytes held (n0 the
- * larger set), at most 16 bytes per point of both sets, plus pages lost to
- * rounding and the pool's chunks; on sets of one size, the finished trees'
- * 13.375.
+ * point, then both quantised copies, in one block, and boxes.  That block
+ * is the first sort's key buffer, asked for at max(8 n0, 6 (n0 + n1))
+ * bytes so that it can take both copies: two blocks would each keep a last
+ * 2 MiB page whole (0.6 MB each on 250K points).  So at no time are more
+ * than max(16 n0, 7.4 n0 + max(8 n0, 6 (n0 + n1)) + 8 n1, 13.375 (n0 + n1))
+ * bytes held (n0 the larger set), at most 16 bytes per point of both sets,
+ * plus pages lost to rounding and the pool's chunks; on sets of one size
+ * 13.7.  The second tree's q lies in the first's block (q_borrowed): the
+ * pair is freed together.
  */
 #include "engine/engine.h"
 
@@ -276,12 +280,13 @@ static size_t fkey_at(const hd__tree_t *t) { return ALIGN64(t->n * sizeof *t->pe
 static size_t bucket_at(const hd__tree_t *t) { return ALIGN64(fkey_at(t) + t->nb * sizeof *t->fkey); }
 static size_t nodes_at(const hd__tree_t *t) { return ALIGN64(bucket_at(t) + t->nb * sizeof *t->bucket); }
 static size_t perm_bytes(const hd__tree_t *t) { return nodes_at(t) + node_count(t) * sizeof *t->nodes; }
-static size_t q_bytes(const hd__tree_t *t) { return t->nb * 3 * HD__BUCKET * sizeof *t->q; }
+static size_t q_bytes_of(size_t n) { return (n + HD__BUCKET - 1) / HD__BUCKET * 3 * HD__BUCKET * sizeof(uint16_t); }
+static size_t q_bytes(const hd__tree_t *t) { return q_bytes_of(t->n); }
 
 void hd__tree_free(hd__tree_t *t) {
     if (!t) return;
     hd__reuse_put(t->pool, t->perm); /* and fkey, bucket, nodes */
-    hd__reuse_put(t->pool, t->q);
+    if (!t->q_borrowed) hd__reuse_put(t->pool, t->q);
     t->fkey = NULL;
     t->perm = NULL;
     t->q = NULL;
@@ -302,9 +307,10 @@ size_t hd__tree_memory(const hd__tree_t *t) {
  * bytes a point), and the other goes back to the pool.  The first request
  * takes the block the previous sort kept, if it fits, and gives back any
  * other (hd__reuse_take): nothing the build cannot use is held through
- * it. */
+ * it.  The block that goes back is made at least spare_min bytes (the pair's
+ * quantised copies, which take it last). */
 static int tree_sort(hd__tree_t *t, const hd__src_t *src, size_t n, const hd__box_t *grid_box,
-                     int threads, hd__reuse_t *pool, hd_error_t *err) {
+                     size_t spare_min, int threads, hd__reuse_t *pool, hd_error_t *err) {
     memset(t, 0, sizeof *t);
     t->pool = pool;
     if (n == 0) return hd__err(err, HD_EEMPTY, "empty point set");
@@ -331,8 +337,12 @@ static int tree_sort(hd__tree_t *t, const hd__src_t *src, size_t n, const hd__bo
     /* n <= UINT32_MAX: none of these sizes overflows. */
     size_t words = perm_bytes(t) / sizeof(uint64_t) + 1;
     if (words < n) words = n;
-    uint64_t *keys = hd__reuse_take(pool, words, sizeof *keys);
-    uint64_t *tmp = hd__reuse_get(pool, words, sizeof *tmp);
+    size_t tmp_words = words > spare_min / sizeof(uint64_t) ? words : spare_min / sizeof(uint64_t) + 1;
+    /* The sort's three passes leave the sorted keys in tmp's buffer and
+     * keys' buffer spare: keys' becomes perm's block, and tmp's goes back
+     * to the pool, for the next sort's tmp or the quantised copies. */
+    uint64_t *tmp = hd__reuse_take(pool, tmp_words, sizeof *tmp);
+    uint64_t *keys = hd__reuse_get(pool, words, sizeof *keys);
     kc.part_box = hd__malloc_array(slices, sizeof *kc.part_box);
     int rc = HD_OK;
     if (!keys || !tmp || !kc.part_box) {
@@ -387,18 +397,9 @@ done:
     return HD_OK;
 }
 
-/* The second half: the quantised copy and the boxes, from perm.  q takes
- * the block kept from a sort when one fits (given back beyond q's size),
- * and any other kept block is given back (hd__reuse_take). */
-static int tree_finish(hd__tree_t *t, int threads, hd_error_t *err) {
-    hd__reuse_t *pool = t->pool;
+/* The boxes, from perm and q. */
+static void tree_boxes(hd__tree_t *t, int threads) {
     if (threads < 1) threads = 1;
-    t->q = hd__reuse_take(pool, q_bytes(t), 1);
-    if (!t->q) {
-        hd__tree_free(t);
-        return hd__err(err, HD_ENOMEM, "cannot allocate the index of %zu points", t->n);
-    }
-    hd__reuse_shrink(pool, t->q, q_bytes(t));
     boxes_ctx bc;
     bc.t = t;
     bc.level = 0;
@@ -407,12 +408,26 @@ static int tree_finish(hd__tree_t *t, int threads, hd_error_t *err) {
         bc.level = l;
         hd__parallel_for(threads, (t->count[l] + BOX_TASK - 1) / BOX_TASK, node_boxes, &bc);
     }
+}
+
+/* The second half: the quantised copy and the boxes, from perm.  q takes
+ * the block kept from a sort when one fits (given back beyond q's size),
+ * and any other kept block is given back (hd__reuse_take). */
+static int tree_finish(hd__tree_t *t, int threads, hd_error_t *err) {
+    hd__reuse_t *pool = t->pool;
+    t->q = hd__reuse_take(pool, q_bytes(t), 1);
+    if (!t->q) {
+        hd__tree_free(t);
+        return hd__err(err, HD_ENOMEM, "cannot allocate the index of %zu points", t->n);
+    }
+    hd__reuse_shrink(pool, t->q, q_bytes(t));
+    tree_boxes(t, threads);
     return HD_OK;
 }
 
 int hd__tree_build(hd__tree_t *t, const hd__src_t *src, size_t n, const hd__box_t *grid_box,
                    int threads, hd__reuse_t *pool, hd_error_t *err) {
-    int rc = tree_sort(t, src, n, grid_box, threads, pool, err);
+    int rc = tree_sort(t, src, n, grid_box, 0, threads, pool, err);
     return rc ? rc : tree_finish(t, threads, err);
 }
 
@@ -421,10 +436,28 @@ int hd__tree_build_pair(hd__tree_t t[2], const hd__src_t src[2], const size_t n[
     memset(t, 0, 2 * sizeof *t);
     hd__reuse_trim(pool);
     const int order[2] = {n[1] > n[0], n[1] <= n[0]}; /* the larger set first */
-    int rc = HD_OK;
-    for (int j = 0; j < 2 && rc == HD_OK; j++)
-        rc = tree_sort(&t[order[j]], &src[order[j]], n[order[j]], &grid_box[order[j]], threads, pool, err);
-    for (int j = 0; j < 2 && rc == HD_OK; j++) rc = tree_finish(&t[order[j]], threads, err);
+    hd__tree_t *t0 = &t[order[0]], *t1 = &t[order[1]];
+    /* Both quantised copies share one block, t0's first: the first sort's
+     * key buffer is made large enough for it, so that the block the sorts
+     * leave is the one the copies take (when the second sort could use it:
+     * n1 >= 1.5 (n0 + n1) / 8 / 3, else a fresh one). */
+    size_t q0 = ALIGN64(q_bytes_of(n[order[0]])), q_pair = q0 + q_bytes_of(n[order[1]]);
+    int rc = tree_sort(t0, &src[order[0]], n[order[0]], &grid_box[order[0]], q_pair, threads, pool, err);
+    if (rc == HD_OK)
+        rc = tree_sort(t1, &src[order[1]], n[order[1]], &grid_box[order[1]], 0, threads, pool, err);
+    if (rc == HD_OK) {
+        unsigned char *q = hd__reuse_take(pool, q_pair, 1);
+        if (q) {
+            hd__reuse_shrink(pool, q, q_pair);
+            t0->q = (uint16_t *)q;
+            t1->q = (uint16_t *)(q + q0);
+            t1->q_borrowed = 1;
+            tree_boxes(t0, threads);
+            tree_boxes(t1, threads);
+        } else {
+            rc = hd__err(err, HD_ENOMEM, "cannot allocate the index of %zu + %zu points", n[0], n[1]);
+        }
+    }
     if (rc)
         for (int k = 0; k < 2; k++) hd__tree_free(&t[k]);
     return rc;

@@ -52,6 +52,7 @@ typedef struct hd__tree {
     hd__src_t src;
     uint32_t *perm;                 /* n original indices in Morton order */
     uint16_t *q;                    /* per bucket: 32 x, then 32 y, then 32 z */
+    int q_borrowed;                 /* q lies in the other tree's block (a pair's second tree) */
     size_t nb;                      /* buckets: ceil(n / HD__BUCKET) */
     hd__bucket_t *bucket;           /* nb buckets */
     int levels;                     /* level 0 .. levels-1; top has 1 node */
@@ -77,10 +78,11 @@ int hd__tree_build(hd__tree_t *t, const hd__src_t *src, size_t n, const hd__box_
 /* Both trees of a call at once, from `pool` (kept blocks are given back
  * first), in the order that holds the least memory at once: both sorts
  * (the larger set first), each leaving only its perm, fkey and room for
- * its boxes, then both quantised copies and boxes.  The pool then holds at
- * most max(16 n0, 7.4 n0 + 16 n1, 13.4 (n0 + n1)) bytes, plus pages lost
- * to rounding, with n0 the larger set (docs/engine.md, "Threads and
- * memory"). */
+ * its boxes, then both quantised copies (one block, the second tree's q
+ * borrowed from the first's: free the two together) and boxes.  The pool
+ * then holds at most max(16 n0, 7.4 n0 + max(8 n0, 6 (n0 + n1)) + 8 n1,
+ * 13.4 (n0 + n1)) bytes, plus pages lost to rounding, with n0 the larger
+ * set (docs/engine.md, "Threads and memory"). */
 int hd__tree_build_pair(hd__tree_t t[2], const hd__src_t src[2], const size_t n[2],
                         const hd__box_t grid_box[2], int threads, hd__reuse_t *pool, hd_error_t *err);
 void hd__tree_free(hd__tree_t *t);

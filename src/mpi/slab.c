@@ -157,25 +157,38 @@ static int slab_build(ctx_t *c, const dir_t *d, const hd__box_t *r, double M, sl
  * the nearest (smallest index on ties) within the slab, or SIZE_MAX when
  * the slab is empty.  The asking structure names each point k (names[] or
  * sel[], hd__an_build_sel), so the answers land in near[k] directly. */
+/* The askers of one search, in batches of at most `batch` (consecutive in
+ * list order, whose positions increase): a batch's structure takes about
+ * 36 bytes an asker and its search 16, so a shell that is a large share of
+ * the rank's points (the lidar scene in strips at K = 16: a quarter of a
+ * set) would otherwise raise the call's peak by 50 bytes a point of it.
+ * Every asker's answer is its own exact nearest point, whatever batch it
+ * is in. */
 static int slab_search(ctx_t *c, const slab_t *sl, const double *pts, const uint32_t *pos, const uint32_t *list,
-                       size_t m, size_t *near) {
+                       size_t m, size_t batch, size_t *near) {
     if (m == 0) return HD_OK;
     if (sl->n == 0) {
         for (size_t t = 0; t < m; t++) near[list[t]] = SIZE_MAX;
         return HD_OK;
     }
-    uint32_t *sel = NULL;
-    if (pos && !(sel = hd__mpi_alloc(c, m, sizeof(uint32_t)))) return hd__mpi_nomem(c, "the searches", m);
-    for (size_t t = 0; sel && t < m; t++) sel[t] = pos[list[t]];
-    const uint32_t *from = sel ? sel : list;
-    hd__an_t asking;
-    size_t ab = 0;
-    int threads = hd__thread_count(c->threads, m > sl->n ? m : sl->n);
-    hd_points_t Sv = hd_points_f64(pts, (size_t)from[m - 1] + 1); /* from[] increases */
-    int rc = hd__mpi_an_build(c, &asking, &Sv, from, sel ? list : NULL, m, &sl->kb, threads, &ab);
-    hd__mpi_free(c, sel, m, sizeof(uint32_t));
-    if (rc == HD_OK) rc = hd__mpi_an_nearest(c, &asking, &sl->s, NULL, threads, near);
-    if (ab) hd__mpi_an_release(c, &asking, ab);
+    if (batch < 1) batch = 1;
+    int rc = HD_OK;
+    for (size_t t0 = 0; t0 < m && rc == HD_OK; t0 += batch) {
+        size_t mb = m - t0 < batch ? m - t0 : batch;
+        const uint32_t *lb = list + t0;
+        uint32_t *sel = NULL;
+        if (pos && !(sel = hd__mpi_alloc(c, mb, sizeof(uint32_t)))) return hd__mpi_nomem(c, "the searches", mb);
+        for (size_t t = 0; sel && t < mb; t++) sel[t] = pos[lb[t]];
+        const uint32_t *from = sel ? sel : lb;
+        hd__an_t asking;
+        size_t ab = 0;
+        int threads = hd__thread_count(c->threads, mb > sl->n ? mb : sl->n);
+        hd_points_t Sv = hd_points_f64(pts, (size_t)from[mb - 1] + 1); /* from[] increases */
+        rc = hd__mpi_an_build(c, &asking, &Sv, from, sel ? lb : NULL, mb, &sl->kb, threads, &ab);
+        hd__mpi_free(c, sel, mb, sizeof(uint32_t));
+        if (rc == HD_OK) rc = hd__mpi_an_nearest(c, &asking, &sl->s, NULL, threads, near);
+        if (ab) hd__mpi_an_release(c, &asking, ab);
+    }
     return rc;
 }
 
@@ -208,6 +221,9 @@ int hd__mpi_nearest_in_q(ctx_t *c, const dir_t *d, const hd__box_t *r, qtree_t *
     if (!list) return hd__mpi_nomem(c, "the searches", n);
     int rc = HD_OK;
     size_t m = n;
+    /* Askers a batch: a thirty-second of the rank's points (1.6 bytes a
+     * point of them in the batch's structure and search), at least 4096. */
+    size_t batch = (d->nP + d->nQ) / 32 > 4096 ? (d->nP + d->nQ) / 32 : 4096;
     for (size_t k = 0; k < n; k++) list[k] = (uint32_t)k;
     /* the slab, a wider one for what it did not prove, then all of Q */
     for (int level = 0; level < 3 && m > 0 && rc == HD_OK; level++) {
@@ -252,7 +268,7 @@ int hd__mpi_nearest_in_q(ctx_t *c, const dir_t *d, const hd__box_t *r, qtree_t *
             slab_free(c, &q->sub);
         }
         if (!sl->built && (rc = slab_build(c, d, r, M, sl)) != HD_OK) break;
-        if ((rc = slab_search(c, sl, pts, pos, list, m, near)) != HD_OK) break;
+        if ((rc = slab_search(c, sl, pts, pos, list, m, batch, near)) != HD_OK) break;
         if (level == 2) break;
         size_t keep = 0;
         for (size_t t = 0; t < m; t++) {

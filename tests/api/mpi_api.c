@@ -101,7 +101,7 @@ typedef struct {
 enum {
     DS_UNIFORM, DS_LATTICE, DS_LATTICE_HALF, DS_ONE_POINT, DS_PLANE, DS_FAR_B, DS_CORNER_B, DS_DUPLICATES,
     DS_TINY, DS_HUGE, DS_NOISE, DS_DISJOINT, DS_CHECKER, DS_STRAY, DS_DEEP, DS_SMALL_LATTICE, DS_BIG_LATTICE,
-    DS_BIG_UNIFORM, DS_COUNT
+    DS_BIG_UNIFORM, DS_BIG_SHIFTED, DS_COUNT
 };
 
 #define BIG 40000 /* points a side of the sets large enough for the partition's second samples */
@@ -261,6 +261,15 @@ static void make_set(int which, uint64_t seed, set_t *s) {
         s->na = s->nb = BIG;
         gen_cube(&g, s->a, s->na, -1, 1);
         gen_cube(&g, s->b, s->nb, -1, 1);
+        break;
+    case DS_BIG_SHIFTED:
+        /* h is a third of the cube, larger than a region at K >= 2, so most
+         * points are in the shells: each rank searches them in several
+         * batches (src/mpi/slab.c, slab_search: at least 4096 a batch). */
+        s->name = "large uniform B moved by a third of the cube (shells of most points, in batches)";
+        s->na = s->nb = BIG;
+        gen_cube(&g, s->a, s->na, -1, 1);
+        gen_cube(&g, s->b, s->nb, -1 + 2.0 / 3, 1 + 2.0 / 3);
         break;
     case DS_DISJOINT:
         s->name = "disjoint boxes";
