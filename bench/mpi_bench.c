@@ -3,6 +3,7 @@
  *     mpirun -n K build/bench/mpi_bench [--points N] [--per-rank] [--cases LIST]
  *                                       [--layout random|tiles] [--threads T]
  *                                       [--check] [--repeat R] [--distances]
+ *                                       [--rank-cpu]
  * For each case, every rank generates its share of A and B (N points per
  * side in total, or per rank with --per-rank: weak scaling), and one call
  * of hd_mpi_hausdorff is timed; rank 0 prints one line per case with the
@@ -28,7 +29,10 @@
  * calls R times per case (the repeats' lines are marked "+": memory the
  * first call freed is reused, so they show the costs without first
  * touches of fresh pages).  --check compares with hd_hausdorff on
- * rank 0 (all points gathered; small N only).
+ * rank 0 (all points gathered; small N only).  --rank-cpu prints each
+ * rank's own searchcpu and othercpu per local point and the core it ended
+ * on (with `mpirun --bind-to core` rank r stays on core r: on the machine of
+ * docs/scale-out.md one core ran 1.4 times slower than the other).
  *
  * --distances times hd_mpi_distances (both directions, every point's nearest
  * neighbour; the faster of two calls) instead, and prints per case: bytes moved per input point by
@@ -55,9 +59,11 @@
  * point may move) or "tiles" (rank r generates the strip r of K in x, as a
  * rank reading its share of tile files does: most points stay).
  */
+#define _GNU_SOURCE /* sched_getcpu */
 #include <hausdorff_mpi.h>
 
 #include <math.h>
+#include <sched.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -218,7 +224,7 @@ int main(int argc, char **argv) {
     MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
     MPI_Comm_size(MPI_COMM_WORLD, &K_);
     size_t N = 1000000;
-    int per_rank = 0, tiles = 0, threads = 1, check = 0, repeat = 1, dist = 0;
+    int per_rank = 0, tiles = 0, threads = 1, check = 0, repeat = 1, dist = 0, rank_cpu = 0;
     const char *cases = "uniform,lidar,copy";
     for (int k = 1; k < argc; k++) {
         if (!strcmp(argv[k], "--points") && k + 1 < argc) N = (size_t)atof(argv[++k]);
@@ -229,6 +235,7 @@ int main(int argc, char **argv) {
         else if (!strcmp(argv[k], "--check")) check = 1;
         else if (!strcmp(argv[k], "--repeat") && k + 1 < argc) repeat = atoi(argv[++k]);
         else if (!strcmp(argv[k], "--distances")) dist = 1;
+        else if (!strcmp(argv[k], "--rank-cpu")) rank_cpu = 1;
         else {
             if (rank_ == 0) fprintf(stderr, "mpi_bench: unknown argument %s\n", argv[k]);
             MPI_Finalize();
@@ -295,6 +302,16 @@ int main(int argc, char **argv) {
                    st.seconds_max, st.search_seconds_max, 1e9 * st.search_seconds_max / ((double)tot / K_),
                    1e9 * cpumax, 100.0 * (double)st.shell_points / (double)tot,
                    1e9 * st.search_cpu_max / ((double)tot / K_), hwmax, 1e9 * st.other_cpu_max / ((double)tot / K_), ownmax);
+        if (rank_cpu) { /* each rank's own CPU per local point, and its core */
+            double mine[3] = {1e9 * st.search_cpu / (double)(st.local_points ? st.local_points : 1),
+                              1e9 * st.other_cpu / (double)(st.local_points ? st.local_points : 1), (double)sched_getcpu()};
+            double *all = rank_ == 0 ? malloc((size_t)K_ * sizeof mine) : NULL;
+            MPI_Gather(mine, 3, MPI_DOUBLE, all, 3, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+            for (int q = 0; rank_ == 0 && q < K_; q++)
+                printf("#   rank %d (on cpu %.0f): searchcpu %.1f othercpu %.1f ns a local point\n", q, all[3 * q + 2],
+                       all[3 * q], all[3 * q + 1]);
+            free(all);
+        }
         if (check) { /* gather everything on rank 0 and compare */
             double *all[2] = {NULL, NULL};
             int cnt = (int)(3 * n), *cnts = malloc((size_t)K_ * sizeof(int)), *disp = malloc((size_t)K_ * sizeof(int));

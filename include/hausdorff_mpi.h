@@ -139,6 +139,7 @@ typedef struct hd_mpi_stats {
     double other_cpu;           /* this rank: the bookkeeping's CPU seconds */
     uint64_t local_points;      /* this rank: points after the partition */
     uint64_t peak_bytes;        /* this rank: peak of the buffers above */
+    double search_cpu;          /* this rank: the searches' CPU seconds */
 } hd_mpi_stats_t;
 
 /* H(A,B) of the points every rank holds, with both directions and their

@@ -278,6 +278,7 @@ int hd__mpi_figures(ctx_t *c, const course_t *cs, uint64_t pts, hd_mpi_stats_t *
     st->search_cpu_max = most[2];
     st->other_cpu_max = most[3];
     st->other_cpu = other;
+    st->search_cpu = c->search_cpu;
     st->peak_bytes_max = gm[2];
     st->seconds = secs;
     st->local_points = pts;

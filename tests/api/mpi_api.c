@@ -602,6 +602,30 @@ static void check_partition_balances(void) {
     free(s.b);
 }
 
+/* Each rank's own figures (its points, peak, search and bookkeeping CPU)
+ * are the ones whose maxima over the ranks the call reports. */
+static void check_own_figures_make_the_maxima(void) {
+    uint64_t seed = 1000 + DS_BIG_UNIFORM;
+    set_t s = {"", NULL, NULL, 0, 0};
+    hd_options_t opt;
+    open_case("own figures", DS_BIG_UNIFORM, LAY_CHUNKS, seed, &s, &opt);
+    hd_mpi_part_t pa[64], pb[64];
+    size_t na = layout(LAY_CHUNKS, 0, s.a, s.na, seed, pa, 64), nb = layout(LAY_CHUNKS, 1, s.b, s.nb, seed, pb, 64);
+    hd_symmetric_t got;
+    hd_mpi_stats_t st;
+    hd_error_t err;
+    CHECK(hd_mpi_hausdorff(MPI_COMM_WORLD, pa, na, pb, nb, &opt, &got, &st, &err) == HD_OK);
+    double mine[3] = {st.search_cpu, st.other_cpu, st.search_seconds}, most[3];
+    uint64_t own[2] = {st.local_points, st.peak_bytes}, omost[2];
+    MPI_Allreduce(mine, most, 3, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+    MPI_Allreduce(own, omost, 2, MPI_UINT64_T, MPI_MAX, MPI_COMM_WORLD);
+    CHECK(st.search_cpu >= 0 && st.search_cpu <= st.search_cpu_max);
+    CHECK(most[0] == st.search_cpu_max && most[1] == st.other_cpu_max && most[2] == st.search_seconds_max);
+    CHECK(omost[0] == st.points_max && omost[1] == st.peak_bytes_max);
+    free(s.a);
+    free(s.b);
+}
+
 int main(int argc, char **argv) {
     MPI_Init(&argc, &argv);
     MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
@@ -610,6 +634,7 @@ int main(int argc, char **argv) {
     if (!only || strcmp(only, "errors") == 0) check_errors();
     if (!only) check_single_rank_copies_nothing();
     if (!only) check_strided_views_over_ranks();
+    if (!only) check_own_figures_make_the_maxima();
     if (!only) check_partition_balances();
     for (int which = 0; which < DS_COUNT; which++) {
         if (only && strcmp(only, "errors") != 0 && atoi(only) != which) continue;
