@@ -579,6 +579,21 @@ static void check_strided_views_over_ranks(void) {
     free(bf);
 }
 
+/* One call on the large uniform sets in layout `how`, its figures in *st. */
+static void call_big_uniform(const char *what, int how, hd_mpi_stats_t *st) {
+    uint64_t seed = 1000 + DS_BIG_UNIFORM;
+    set_t s = {"", NULL, NULL, 0, 0};
+    hd_options_t opt;
+    open_case(what, DS_BIG_UNIFORM, how, seed, &s, &opt);
+    hd_mpi_part_t pa[64], pb[64];
+    size_t na = layout(how, 0, s.a, s.na, seed, pa, 64), nb = layout(how, 1, s.b, s.nb, seed, pb, 64);
+    hd_symmetric_t got;
+    hd_error_t err;
+    CHECK(hd_mpi_hausdorff(MPI_COMM_WORLD, pa, na, pb, nb, &opt, &got, st, &err) == HD_OK);
+    free(s.a);
+    free(s.b);
+}
+
 /* The partition gives every rank its share of the points within 2 %:
  * the first samples (1024 a rank) alone leave the largest region a few
  * percent above its share, the second samples' exact counts move each
@@ -586,35 +601,17 @@ static void check_strided_views_over_ranks(void) {
  * ranks, 80K points in all. */
 static void check_partition_balances(void) {
     if (K_ < 2) return;
-    uint64_t seed = 1000 + DS_BIG_UNIFORM;
-    set_t s = {"", NULL, NULL, 0, 0};
-    hd_options_t opt;
-    open_case("balance", DS_BIG_UNIFORM, LAY_BLOCKS, seed, &s, &opt);
-    hd_mpi_part_t pa[1], pb[1];
-    size_t na = layout(LAY_BLOCKS, 0, s.a, s.na, seed, pa, 1), nb = layout(LAY_BLOCKS, 1, s.b, s.nb, seed, pb, 1);
-    hd_symmetric_t got;
     hd_mpi_stats_t st;
-    hd_error_t err;
-    CHECK(hd_mpi_hausdorff(MPI_COMM_WORLD, pa, na, pb, nb, &opt, &got, &st, &err) == HD_OK);
+    call_big_uniform("balance", LAY_BLOCKS, &st);
     CHECK(st.imbalance >= 1.0 && st.imbalance <= 1.02);
     if (st.imbalance > 1.02) fprintf(stderr, "rank %d: imbalance %.4f\n", rank_, st.imbalance);
-    free(s.a);
-    free(s.b);
 }
 
 /* Each rank's own figures (its points, peak, search and bookkeeping CPU)
  * are the ones whose maxima over the ranks the call reports. */
 static void check_own_figures_make_the_maxima(void) {
-    uint64_t seed = 1000 + DS_BIG_UNIFORM;
-    set_t s = {"", NULL, NULL, 0, 0};
-    hd_options_t opt;
-    open_case("own figures", DS_BIG_UNIFORM, LAY_CHUNKS, seed, &s, &opt);
-    hd_mpi_part_t pa[64], pb[64];
-    size_t na = layout(LAY_CHUNKS, 0, s.a, s.na, seed, pa, 64), nb = layout(LAY_CHUNKS, 1, s.b, s.nb, seed, pb, 64);
-    hd_symmetric_t got;
     hd_mpi_stats_t st;
-    hd_error_t err;
-    CHECK(hd_mpi_hausdorff(MPI_COMM_WORLD, pa, na, pb, nb, &opt, &got, &st, &err) == HD_OK);
+    call_big_uniform("own figures", LAY_CHUNKS, &st);
     double mine[3] = {st.search_cpu, st.other_cpu, st.search_seconds}, most[3];
     uint64_t own[2] = {st.local_points, st.peak_bytes}, omost[2];
     MPI_Allreduce(mine, most, 3, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
@@ -622,8 +619,6 @@ static void check_own_figures_make_the_maxima(void) {
     CHECK(st.search_cpu >= 0 && st.search_cpu <= st.search_cpu_max);
     CHECK(most[0] == st.search_cpu_max && most[1] == st.other_cpu_max && most[2] == st.search_seconds_max);
     CHECK(omost[0] == st.points_max && omost[1] == st.peak_bytes_max);
-    free(s.a);
-    free(s.b);
 }
 
 int main(int argc, char **argv) {
