@@ -59,7 +59,9 @@
  * point may move) or "tiles" (rank r generates the strip r of K in x, as a
  * rank reading its share of tile files does: most points stay).
  */
+#ifndef _GNU_SOURCE
 #define _GNU_SOURCE /* sched_getcpu */
+#endif
 #include <hausdorff_mpi.h>
 
 #include <math.h>
