@@ -437,10 +437,13 @@ int hd__tree_build_pair(hd__tree_t t[2], const hd__src_t src[2], const size_t n[
     hd__reuse_trim(pool);
     const int order[2] = {n[1] > n[0], n[1] <= n[0]}; /* the larger set first */
     hd__tree_t *t0 = &t[order[0]], *t1 = &t[order[1]];
-    /* Both quantised copies share one block, t0's first: the first sort's
-     * key buffer is made large enough for it, so that the block the sorts
-     * leave is the one the copies take (when the second sort could use it:
-     * n1 >= 1.5 (n0 + n1) / 8 / 3, else a fresh one). */
+    /* Both quantised copies share one block, t0's first: the buffer the
+     * first sort leaves spare is made large enough for it (q_pair bytes),
+     * the second sort takes it as its own spare buffer when it may (a kept
+     * block serves a request of at least a third of its size: 8 n1 >=
+     * max(8 n0, q_pair) / 3), and the copies take it after that sort; else
+     * the copies get a fresh block.  Either way one block, so one last 2 MiB
+     * page kept whole instead of two. */
     size_t q0 = ALIGN64(q_bytes_of(n[order[0]])), q_pair = q0 + q_bytes_of(n[order[1]]);
     int rc = tree_sort(t0, &src[order[0]], n[order[0]], &grid_box[order[0]], q_pair, threads, pool, err);
     if (rc == HD_OK)
