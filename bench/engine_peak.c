@@ -14,8 +14,9 @@
  *
  * Comparing two builds on this machine (2 virtual cores): run them
  * alternately, one process each, and pin them to one core (taskset -c 1):
- * unpinned, the same process took 33 or 49 ms by the core it landed on
- * (2026-11-29), which hides differences of a few per cent.
+ * while the host slowed one core (an hour on 2026-11-29), the same
+ * unpinned process took 33 or 49 ms by the core it landed on, which hides
+ * differences of a few per cent.
  */
 #include <hausdorff.h>
 

@@ -32,7 +32,8 @@
  * rank 0 (all points gathered; small N only).  --rank-cpu prints each
  * rank's own searchcpu and othercpu per local point and the core it ended
  * on (with `mpirun --bind-to core` rank r stays on core r: on the machine of
- * docs/scale-out.md one core ran 1.4 times slower than the other).
+ * docs/scale-out.md one core ran 1.4 times slower than the other for an
+ * hour on 2026-11-29).
  *
  * --distances times hd_mpi_distances (both directions, every point's nearest
  * neighbour; the faster of two calls) instead, and prints per case: bytes moved per input point by

@@ -44,8 +44,9 @@
  * engine builds its two trees in two halves (hd__tree_build_pair): both
  * sorts first, the larger set's first, each leaving only its 7.4 bytes per
  * point, then both quantised copies, in one block, and boxes.  That block
- * is the first sort's key buffer, asked for at max(8 n0, 6 (n0 + n1))
- * bytes so that it can take both copies: two blocks would each keep a last
+ * is the buffer the first sort's keys end in (its tmp: the radix sort
+ * makes three passes), given back after it and asked for at max(8 n0,
+ * 6 (n0 + n1)) bytes so that it can take both copies: two blocks would each keep a last
  * 2 MiB page whole (0.6 MB each on 250K points).  So at no time are more
  * than max(16 n0, 7.4 n0 + max(8 n0, 6 (n0 + n1)) + 8 n1, 13.375 (n0 + n1))
  * bytes held (n0 the larger set), at most 16 bytes per point of both sets,
@@ -307,10 +308,10 @@ size_t hd__tree_memory(const hd__tree_t *t) {
  * bytes a point), and the other goes back to the pool.  The first request
  * takes the block the previous sort kept, if it fits, and gives back any
  * other (hd__reuse_take): nothing the build cannot use is held through
- * it.  The block that goes back is made at least spare_min bytes (the pair's
+ * it.  The block that goes back is made at least back_min bytes (the pair's
  * quantised copies, which take it last). */
 static int tree_sort(hd__tree_t *t, const hd__src_t *src, size_t n, const hd__box_t *grid_box,
-                     size_t spare_min, int threads, hd__reuse_t *pool, hd_error_t *err) {
+                     size_t back_min, int threads, hd__reuse_t *pool, hd_error_t *err) {
     memset(t, 0, sizeof *t);
     t->pool = pool;
     if (n == 0) return hd__err(err, HD_EEMPTY, "empty point set");
@@ -337,7 +338,7 @@ static int tree_sort(hd__tree_t *t, const hd__src_t *src, size_t n, const hd__bo
     /* n <= UINT32_MAX: none of these sizes overflows. */
     size_t words = perm_bytes(t) / sizeof(uint64_t) + 1;
     if (words < n) words = n;
-    size_t tmp_words = words > spare_min / sizeof(uint64_t) ? words : spare_min / sizeof(uint64_t) + 1;
+    size_t tmp_words = words > back_min / sizeof(uint64_t) ? words : back_min / sizeof(uint64_t) + 1;
     /* The sort's three passes leave the sorted keys in tmp's buffer and
      * keys' buffer spare: keys' becomes perm's block, and tmp's goes back
      * to the pool, for the next sort's tmp or the quantised copies. */
@@ -438,8 +439,8 @@ int hd__tree_build_pair(hd__tree_t t[2], const hd__src_t src[2], const size_t n[
     const int order[2] = {n[1] > n[0], n[1] <= n[0]}; /* the larger set first */
     hd__tree_t *t0 = &t[order[0]], *t1 = &t[order[1]];
     /* Both quantised copies share one block, t0's first: the buffer the
-     * first sort leaves spare is made large enough for it (q_pair bytes),
-     * the second sort takes it as its own spare buffer when it may (a kept
+     * first sort gives back is made large enough for it (q_pair bytes),
+     * the second sort takes it as its own tmp when it may (a kept
      * block serves a request of at least a third of its size: 8 n1 >=
      * max(8 n0, q_pair) / 3), and the copies take it after that sort; else
      * the copies get a fresh block.  Either way one block, so one last 2 MiB

@@ -156,9 +156,9 @@ static int slab_build(ctx_t *c, const dir_t *d, const hd__box_t *r, double M, sl
  * 3 pos[k] (pos NULL: pts + 3 k), searched in a built slab: Q's index of
  * the nearest (smallest index on ties) within the slab, or SIZE_MAX when
  * the slab is empty.  The asking structure names each point k (names[] or
- * sel[], hd__an_build_sel), so the answers land in near[k] directly. */
-/* The askers of one search, in batches of at most `batch` (consecutive in
- * list order, whose positions increase): a batch's structure takes about
+ * sel[], hd__an_build_sel), so the answers land in near[k] directly.
+ * The askers go in batches of at most `batch` (consecutive in list
+ * order, whose positions increase): a batch's structure takes about
  * 36 bytes an asker and its search 16, so a shell that is a large share of
  * the rank's points (the lidar scene in strips at K = 16: a quarter of a
  * set) would otherwise raise the call's peak by 50 bytes a point of it.
