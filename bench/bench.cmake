@@ -7,6 +7,9 @@ hd_add_bench(hd_bench ${CMAKE_CURRENT_LIST_DIR}/bench.c)
 target_include_directories(hd_bench PRIVATE ${CMAKE_SOURCE_DIR}/src)
 # engine_peak: the engine's memory peak and time, call after call.
 hd_add_bench(engine_peak ${CMAKE_CURRENT_LIST_DIR}/engine_peak.c)
+# page_cost: what fresh memory costs a byte, in small, populated and huge
+# pages (docs/scale-out.md, "Memory pages on this machine").
+hd_add_bench(page_cost ${CMAKE_CURRENT_LIST_DIR}/page_cost.c)
 
 option(HD_BENCH_PEERS "Build the C++ peer programs of the engine benchmark (nanoflann, PCL)" OFF)
 if(HD_BENCH_PEERS)

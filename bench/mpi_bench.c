@@ -25,7 +25,10 @@
  * it, since later cases reuse memory freed by earlier ones), and "own":
  * the largest of a rank's peak over its own local points (the "buf"
  * column divides the largest peak by the mean, so it includes the
- * imbalance).  --repeat R
+ * imbalance), then the most kernel CPU of a rank's calling thread per
+ * local point during the call ("sys", part of searchcpu and othercpu:
+ * mostly first touches of fresh pages) and the most page faults a rank's
+ * thread took by a trap ("faults").  --repeat R
  * calls R times per case (the repeats' lines are marked "+": memory the
  * first call freed is reused, so they show the costs without first
  * touches of fresh pages).  --check compares with hd_hausdorff on
@@ -105,6 +108,20 @@ static void hwm_reset(void) {
         fputs("5", f);
         fclose(f);
     }
+}
+
+/* The calling thread's kernel CPU seconds and page faults taken by a trap
+ * (what MADV_POPULATE_WRITE maps is not counted): what first touches of
+ * fresh memory cost, inside "searchcpu" and "othercpu" (docs/scale-out.md,
+ * "Memory pages on this machine"). */
+static void thread_kernel(double *sys, double *faults) {
+    struct rusage ru;
+    if (getrusage(RUSAGE_THREAD, &ru) != 0) {
+        *sys = *faults = 0;
+        return;
+    }
+    *sys = (double)ru.ru_stime.tv_sec + 1e-6 * (double)ru.ru_stime.tv_usec;
+    *faults = (double)ru.ru_minflt + (double)ru.ru_majflt;
 }
 
 static double thread_cpu_now(void) {
@@ -260,7 +277,8 @@ int main(int argc, char **argv) {
     else if (rank_ == 0)
         printf("# mpi_bench: %d ranks, %zu points per side%s, layout %s, %d thread(s) per rank\n"
                "# case     points  B/pt(part) B/pt(fwd) fwd%%    imbal work-imbal buf B/pt rss B/pt "
-               "time(s) search(s) search ns/pt cpu ns/pt shell%% searchcpu ns/pt hwm B/pt othercpu ns/pt own B/pt\n",
+               "time(s) search(s) search ns/pt cpu ns/pt shell%% searchcpu ns/pt hwm B/pt othercpu ns/pt own B/pt "
+               "sys ns/pt faults\n",
                K_, N, per_rank ? " per rank" : "", tiles ? "tiles" : "random", threads);
     char list[256];
     snprintf(list, sizeof list, "%s", cases);
@@ -282,10 +300,14 @@ int main(int argc, char **argv) {
         hwm_reset();
         double cur0 = status_kb("VmRSS:");
         MPI_Barrier(MPI_COMM_WORLD);
-        double cpu0 = cpu_now();
+        double cpu0 = cpu_now(), sys0, flt0, sys1, flt1;
+        thread_kernel(&sys0, &flt0);
         int rc = hd_mpi_hausdorff(MPI_COMM_WORLD, &pa, 1, &pb, 1, &opt, &r, &st, &err);
+        thread_kernel(&sys1, &flt1);
         double cpu = (cpu_now() - cpu0) / (double)(st.local_points ? st.local_points : 1), cpumax = 0;
         MPI_Reduce(&cpu, &cpumax, 1, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD);
+        double kern[2] = {(sys1 - sys0) / (double)(st.local_points ? st.local_points : 1), flt1 - flt0}, kernmax[2];
+        MPI_Reduce(kern, kernmax, 2, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD);
         if (rc != HD_OK) {
             if (rank_ == 0) fprintf(stderr, "mpi_bench: %s\n", err.message);
             MPI_Abort(MPI_COMM_WORLD, 1);
@@ -298,13 +320,14 @@ int main(int argc, char **argv) {
         MPI_Reduce(&own, &ownmax, 1, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD);
         uint64_t tot = st.points;
         if (rank_ == 0)
-            printf("%-8s%s %9llu %9.2f %9.3f %7.3f %6.3f %8.3f %10.1f %10.1f %8.3f %8.3f %8.1f %8.1f %7.3f %8.1f %8.1f %8.1f %8.1f\n", c, rep ? "+" : "",
+            printf("%-8s%s %9llu %9.2f %9.3f %7.3f %6.3f %8.3f %10.1f %10.1f %8.3f %8.3f %8.1f %8.1f %7.3f %8.1f %8.1f %8.1f %8.1f %8.1f %8.0f\n", c, rep ? "+" : "",
                    (unsigned long long)tot, (double)st.bytes_partition / (double)tot,
                    (double)st.bytes_forwarding / (double)tot, 100.0 * (double)st.forwarded_points / (double)tot,
                    st.imbalance, st.work_imbalance, (double)st.peak_bytes_max / ((double)tot / K_), most,
                    st.seconds_max, st.search_seconds_max, 1e9 * st.search_seconds_max / ((double)tot / K_),
                    1e9 * cpumax, 100.0 * (double)st.shell_points / (double)tot,
-                   1e9 * st.search_cpu_max / ((double)tot / K_), hwmax, 1e9 * st.other_cpu_max / ((double)tot / K_), ownmax);
+                   1e9 * st.search_cpu_max / ((double)tot / K_), hwmax, 1e9 * st.other_cpu_max / ((double)tot / K_), ownmax,
+                   1e9 * kernmax[0], kernmax[1]);
         if (rank_cpu) { /* each rank's own CPU per local point, and its core */
             double mine[3] = {1e9 * st.search_cpu / (double)(st.local_points ? st.local_points : 1),
                               1e9 * st.other_cpu / (double)(st.local_points ? st.local_points : 1), (double)sched_getcpu()};

@@ -11,6 +11,8 @@
 #    and failures are agreed.  The same K as mpi_api.
 #  - mpi_gidx: tests/internal/mpi_gidx.c, the encoded global indices of
 #    the local sets (src/mpi/gidx.c) read back by position and by cursor.
+#  - mpi_memory: tests/internal/mpi_memory.c, the call's buffers charged at
+#    what they hold (src/mpi/context.c), scratch ones rounded to huge pages.
 #  - mpi_cli_3: tests/mpi_cli.py, hausdorff-mpi on 3 ranks against
 #    hausdorff (JSON and text, tiles, scales, a bad tile on one rank, the
 #    --distances files byte for byte and their failures, the figures and
@@ -58,6 +60,13 @@ if(HD_MPI)
   target_link_libraries(mpi_gidx PRIVATE hausdorff_mpi)
   set_target_properties(mpi_gidx PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/tests)
   add_test(NAME mpi_gidx COMMAND mpi_gidx)
+  # mpi_memory: tests/internal/mpi_memory.c, how the call's buffers are
+  # charged (src/mpi/context.c), white-box and without mpirun.
+  add_executable(mpi_memory ${CMAKE_CURRENT_SOURCE_DIR}/tests/internal/mpi_memory.c ${HD_TEST_SUPPORT})
+  target_include_directories(mpi_memory PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/tests/support ${CMAKE_CURRENT_SOURCE_DIR}/src)
+  target_link_libraries(mpi_memory PRIVATE hausdorff_mpi)
+  set_target_properties(mpi_memory PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/tests)
+  add_test(NAME mpi_memory COMMAND mpi_memory)
   find_program(HD_MPI_PYTHON NAMES python3 REQUIRED)
   add_test(NAME mpi_cli_3 COMMAND ${HD_MPI_PYTHON} ${CMAKE_CURRENT_SOURCE_DIR}/tests/mpi_cli.py
            $<TARGET_FILE:hausdorff_cli> $<TARGET_FILE:hausdorff_mpi_cli> 3 ${HD_MPIRUN})

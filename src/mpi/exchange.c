@@ -12,8 +12,10 @@
  *    local arrays (no second copy of the points), and a rank's own points
  *    are copied from the input into their slot in the same walk.
  *  - A round sends at most C = max(n / 8, 4096) points of a rank, so the
- *    send buffer is at most 3.5 bytes a point; every rank runs the same
- *    number of rounds (the allreduced maximum), each three collectives.
+ *    send buffer is at most 3.5 bytes a point (3.9 when it is made whole
+ *    huge pages, as the other buffers freed here may be: hd__mpi_scratch);
+ *    every rank runs the same number of rounds (the allreduced maximum),
+ *    each three collectives.
  *  - After the rounds, local order is global index order: as received when
  *    the runs follow each other in index order, else after a K-way merge
  *    applied in place (the numbers become 8-byte indices first).  The
@@ -150,7 +152,7 @@ int hd__mpi_exchange(ctx_t *c, const input_t *in, const ranges_t *rg, const node
      * displacements for MPI: sc sd rcn rd */
     int *cnt = hd__mpi_alloc(c, 16 * (size_t)K, sizeof(int));
     size_t *base = hd__mpi_alloc(c, 4 * (size_t)K, sizeof(size_t)); /* base[s K + r], then got[s K + r] */
-    void *dest = hd__mpi_alloc(c, nloc, (size_t)w);
+    void *dest = hd__mpi_scratch(c, nloc, (size_t)w);
     const hd_mpi_part_t **order[2] = {NULL, NULL};
     uint32_t *off[2] = {NULL, NULL};
     double *sx = NULL;
@@ -227,13 +229,13 @@ int hd__mpi_exchange(ctx_t *c, const input_t *in, const ranges_t *rg, const node
     }
     for (int s = 0; s < 2 && rc == HD_OK; s++) {
         loc->xyz[s] = hd__mpi_alloc(c, loc->n[s], 3 * sizeof(double));
-        off[s] = hd__mpi_alloc(c, loc->n[s], sizeof(uint32_t));
+        off[s] = hd__mpi_scratch(c, loc->n[s], sizeof(uint32_t));
         if (!loc->xyz[s] || !off[s]) rc = hd__mpi_nomem(c, "the local points", loc->n[s]);
         else rc = hd__mpi_gidx_init(c, &loc->gi[s], rg, s, loc->n[s]);
     }
     if (rc == HD_OK) {
-        sx = hd__mpi_alloc(c, sendcap, 3 * sizeof(double));
-        so = hd__mpi_alloc(c, sendcap, sizeof(uint32_t));
+        sx = hd__mpi_scratch(c, sendcap, 3 * sizeof(double));
+        so = hd__mpi_scratch(c, sendcap, sizeof(uint32_t));
         if (!sx || !so) rc = hd__mpi_nomem(c, "points to send", sendcap);
     }
     if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
@@ -298,9 +300,9 @@ int hd__mpi_exchange(ctx_t *c, const input_t *in, const ranges_t *rg, const node
                 if (r != me) hd__mpi_gidx_put_numbers(&loc->gi[s], rg, r, (size_t)rd[r], off[s] + rd[r], (size_t)rcn[r]);
         }
     }
-    hd__mpi_free(c, sx, sendcap, 3 * sizeof(double));
-    hd__mpi_free(c, so, sendcap, sizeof(uint32_t));
-    hd__mpi_free(c, dest, nloc, (size_t)w);
+    hd__mpi_free_scratch(c, sx, sendcap, 3 * sizeof(double));
+    hd__mpi_free_scratch(c, so, sendcap, sizeof(uint32_t));
+    hd__mpi_free_scratch(c, dest, nloc, (size_t)w);
     sx = NULL, so = NULL, dest = NULL;
     assert(ownat[0] == base[me] + (size_t)rtot[2 * me] && ownat[1] == base[K + me] + (size_t)rtot[2 * me + 1]);
     /* The runs in index order as received (each rank's parts above the
@@ -325,7 +327,7 @@ int hd__mpi_exchange(ctx_t *c, const input_t *in, const ranges_t *rg, const node
         }
         loc->start[s][K] = loc->n[s];
         if (sorted) {
-            hd__mpi_free(c, off[s], loc->n[s], sizeof(uint32_t));
+            hd__mpi_free_scratch(c, off[s], loc->n[s], sizeof(uint32_t));
             off[s] = NULL;
             continue;
         }
@@ -341,7 +343,7 @@ int hd__mpi_exchange(ctx_t *c, const input_t *in, const ranges_t *rg, const node
                    i = rg->seg[(size_t)s * ((size_t)K + 1) + (size_t)r];
             hd__mpi_ranges_globals(rg, s, r, &i, off[s] + lo, hi - lo, g + lo);
         }
-        hd__mpi_free(c, off[s], loc->n[s], sizeof(uint32_t));
+        hd__mpi_free_scratch(c, off[s], loc->n[s], sizeof(uint32_t));
         off[s] = NULL;
         permn = loc->n[s];
         perm = hd__mpi_alloc(c, permn, sizeof(uint32_t));
@@ -369,13 +371,13 @@ done:
     hd__mpi_free(c, rcnt, maxr * 2 * (size_t)K, sizeof(int));
     hd__mpi_free(c, cnt, 16 * (size_t)K, sizeof(int));
     hd__mpi_free(c, base, 4 * (size_t)K, sizeof(size_t));
-    hd__mpi_free(c, dest, nloc, (size_t)w);
+    hd__mpi_free_scratch(c, dest, nloc, (size_t)w);
     for (int s = 0; s < 2; s++) {
         hd__mpi_free(c, order[s], in->nparts[s], sizeof *order[s]);
-        hd__mpi_free(c, off[s], loc->n[s], sizeof(uint32_t));
+        hd__mpi_free_scratch(c, off[s], loc->n[s], sizeof(uint32_t));
     }
-    hd__mpi_free(c, sx, sendcap, 3 * sizeof(double));
-    hd__mpi_free(c, so, sendcap, sizeof(uint32_t));
+    hd__mpi_free_scratch(c, sx, sendcap, 3 * sizeof(double));
+    hd__mpi_free_scratch(c, so, sendcap, sizeof(uint32_t));
     hd__mpi_free(c, perm, permn, sizeof(uint32_t));
     hd__mpi_free(c, runs, (size_t)K, sizeof(run_t));
     hd__mpi_free(c, heap, (size_t)K, sizeof(int));

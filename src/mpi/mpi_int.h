@@ -61,6 +61,11 @@ typedef struct ctx {
 double hd__mpi_cpu(void);
 void *hd__mpi_alloc(ctx_t *c, size_t n, size_t size);
 void hd__mpi_free(ctx_t *c, void *p, size_t n, size_t size);
+/* A buffer freed before the engine's pass (the exchange's), which may be
+ * rounded up to whole huge pages and is charged so; freed by
+ * hd__mpi_free_scratch with the same count and size. */
+void *hd__mpi_scratch(ctx_t *c, size_t n, size_t size);
+void hd__mpi_free_scratch(ctx_t *c, void *p, size_t n, size_t size);
 void hd__mpi_charge(ctx_t *c, size_t bytes);
 int hd__mpi_engine(ctx_t *c, const hd_points_t *P, const hd_points_t *Q, hd_result_t *e);
 int hd__mpi_engine_local(ctx_t *c, const hd_points_t *P, const hd_points_t *Q, const hd__box_t *bp,
