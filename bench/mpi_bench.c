@@ -27,8 +27,10 @@
  * column divides the largest peak by the mean, so it includes the
  * imbalance), then the most kernel CPU of a rank's calling thread per
  * local point during the call ("sys", part of searchcpu and othercpu:
- * mostly first touches of fresh pages) and the most page faults a rank's
- * thread took by a trap ("faults").  --repeat R
+ * mostly first touches of fresh pages) and the most pages the kernel
+ * mapped for a rank's thread ("faults": getrusage's minor and major
+ * faults, which count a page mapped in advance by MADV_POPULATE_WRITE as
+ * well as one faulted in by a trap; a 2 MiB page counts once).  --repeat R
  * calls R times per case (the repeats' lines are marked "+": memory the
  * first call freed is reused, so they show the costs without first
  * touches of fresh pages).  --check compares with hd_hausdorff on
@@ -110,10 +112,10 @@ static void hwm_reset(void) {
     }
 }
 
-/* The calling thread's kernel CPU seconds and page faults taken by a trap
- * (what MADV_POPULATE_WRITE maps is not counted): what first touches of
- * fresh memory cost, inside "searchcpu" and "othercpu" (docs/scale-out.md,
- * "Memory pages on this machine"). */
+/* The calling thread's kernel CPU seconds and the pages mapped for it (by a
+ * trap on first touch or in advance by MADV_POPULATE_WRITE, each once):
+ * what first touches of fresh memory cost, inside "searchcpu" and
+ * "othercpu" (docs/scale-out.md, "Memory pages on this machine"). */
 static void thread_kernel(double *sys, double *faults) {
     struct rusage ru;
     if (getrusage(RUSAGE_THREAD, &ru) != 0) {

@@ -41,7 +41,7 @@ double hd__mpi_cpu(void) {
 /* Large buffers ask for transparent huge pages: each is written once,
  * right after it is allocated, and on the machine of docs/scale-out.md a
  * 4 KiB page costs 1.3 (mapped in advance) to 2.6 ns a byte (a fault each)
- * against 0.06 for a 2 MiB page ("Memory pages on this machine").  A
+ * against 0.07 for a 2 MiB page ("Memory pages on this machine").  A
  * buffer of HUGE_BYTES or more starts on a 2 MiB boundary and its whole
  * 2 MiB pages are marked; what is left after them, which the kernel maps
  * in small pages, is mapped in one call (MADV_POPULATE_WRITE), not a
@@ -90,7 +90,7 @@ static void *alloc_span(ctx_t *c, size_t n, size_t size, int scratch) {
 #endif
     {
         p = malloc(bytes ? bytes : 1);
-        hd__prefault(p, bytes); /* one call, not a fault a page (a no-op below 1 MiB) */
+        hd__prefault(p, bytes); /* one call, not a fault a page (a no-op below 64 KiB) */
     }
     if (p) {
         c->cur += span;
