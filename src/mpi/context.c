@@ -44,8 +44,8 @@ double hd__mpi_cpu(void) {
  * against 0.07 for a 2 MiB page ("Memory pages on this machine").  A
  * buffer of HUGE_BYTES or more starts on a 2 MiB boundary and its whole
  * 2 MiB pages are marked; what is left after them, which the kernel maps
- * in small pages, is mapped in one call (MADV_POPULATE_WRITE), not a
- * fault a page.  A short-lived buffer (hd__mpi_scratch: freed before the engine's
+ * in small pages, is mapped in one call (hd__prefault), not a fault a
+ * page.  A short-lived buffer (hd__mpi_scratch: freed before the engine's
  * pass, where the call's peak is) of at least SCRATCH_BYTES is made whole
  * 2 MiB pages when that adds at most an eighth of its size, and is charged
  * at that size; the long-lived ones are never rounded, so the peak is
@@ -79,12 +79,8 @@ static void *alloc_span(ctx_t *c, size_t n, size_t size, int scratch) {
         } else {
             size_t huge = span & ~(HUGE_PAGE - 1);
             madvise(p, huge, MADV_HUGEPAGE); /* advice: failure changes nothing */
-#ifdef MADV_POPULATE_WRITE
-            /* The tail starts on a huge page's boundary: its whole small
-             * pages from there (a last, partly used one on first touch). */
-            if (huge < bytes && (bytes - huge) >> 12)
-                madvise((unsigned char *)p + huge, (bytes - huge) & ~(size_t)4095, MADV_POPULATE_WRITE);
-#endif
+            /* the tail in small pages, from a huge page's boundary */
+            if (huge < bytes) hd__prefault((unsigned char *)p + huge, bytes - huge);
         }
     } else
 #endif
