@@ -39,37 +39,24 @@ static int one(int kind, size_t bytes, double out[3]) {
     unsigned char *m = mmap(NULL, len, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
     if (m == MAP_FAILED) return -1;
     unsigned char *a = (unsigned char *)(((uintptr_t)m + HUGE - 1) & ~(uintptr_t)(HUGE - 1));
-    if (kind == HUGEPG && madvise(a, bytes, MADV_HUGEPAGE) != 0) {
-        munmap(m, len);
-        return -1;
-    }
-    if (kind != HUGEPG && madvise(a, bytes, MADV_NOHUGEPAGE) != 0) {
-        munmap(m, len);
-        return -1;
-    }
+    int ok = madvise(a, bytes, kind == HUGEPG ? MADV_HUGEPAGE : MADV_NOHUGEPAGE) == 0;
     double t0 = bench_now();
 #ifdef MADV_POPULATE_WRITE
-    if (kind == POPULATE && madvise(a, bytes, MADV_POPULATE_WRITE) != 0) {
-        munmap(m, len);
-        return -1;
-    }
+    if (kind == POPULATE) ok = ok && madvise(a, bytes, MADV_POPULATE_WRITE) == 0;
 #else
-    if (kind == POPULATE) {
-        munmap(m, len);
-        return -1;
-    }
+    if (kind == POPULATE) ok = 0;
 #endif
-    for (size_t o = 0; o < bytes; o += 4096) a[o] = 1;
+    for (size_t o = 0; ok && o < bytes; o += 4096) a[o] = 1;
     double t1 = bench_now();
-    memset(a, 2, bytes);
+    if (ok) memset(a, 2, bytes);
     double t2 = bench_now();
-    unsigned char sum = a[bytes / 2];
+    ok = ok && a[bytes / 2] == 2;
     munmap(m, len);
     double t3 = bench_now();
     out[0] = (t1 - t0) * 1e9 / (double)bytes;
     out[1] = (t2 - t1) * 1e9 / (double)bytes;
     out[2] = (t3 - t2) * 1e9 / (double)bytes;
-    return sum == 2 ? 0 : -1;
+    return ok ? 0 : -1;
 }
 
 int main(int argc, char **argv) {

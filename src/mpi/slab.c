@@ -172,12 +172,13 @@ static int slab_search(ctx_t *c, const slab_t *sl, const double *pts, const uint
         return HD_OK;
     }
     if (batch < 1) batch = 1;
+    if (batch > m) batch = m;
+    uint32_t *sel = NULL; /* one batch's positions, when pos names them */
+    if (pos && !(sel = hd__mpi_alloc(c, batch, sizeof(uint32_t)))) return hd__mpi_nomem(c, "the searches", batch);
     int rc = HD_OK;
     for (size_t t0 = 0; t0 < m && rc == HD_OK; t0 += batch) {
         size_t mb = m - t0 < batch ? m - t0 : batch;
         const uint32_t *lb = list + t0;
-        uint32_t *sel = NULL;
-        if (pos && !(sel = hd__mpi_alloc(c, mb, sizeof(uint32_t)))) return hd__mpi_nomem(c, "the searches", mb);
         for (size_t t = 0; sel && t < mb; t++) sel[t] = pos[lb[t]];
         const uint32_t *from = sel ? sel : lb;
         hd__an_t asking;
@@ -185,10 +186,10 @@ static int slab_search(ctx_t *c, const slab_t *sl, const double *pts, const uint
         int threads = hd__thread_count(c->threads, mb > sl->n ? mb : sl->n);
         hd_points_t Sv = hd_points_f64(pts, (size_t)from[mb - 1] + 1); /* from[] increases */
         rc = hd__mpi_an_build(c, &asking, &Sv, from, sel ? lb : NULL, mb, &sl->kb, threads, &ab);
-        hd__mpi_free(c, sel, mb, sizeof(uint32_t));
         if (rc == HD_OK) rc = hd__mpi_an_nearest(c, &asking, &sl->s, NULL, threads, near);
         if (ab) hd__mpi_an_release(c, &asking, ab);
     }
+    hd__mpi_free(c, sel, batch, sizeof(uint32_t));
     return rc;
 }
 
