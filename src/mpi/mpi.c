@@ -63,16 +63,20 @@
  *     a whose region faces are clear of h2 (step 4's test
  *     with h2 >= u(a)^2) is settled without a search of its own (the
  *     interior).  The engine's maximum keeps only the points whose faces
- *     are clear of their own u (a filter on it: shell.c), so its answer is
- *     the interior's maximum at once; when the filter's list of refused
- *     points overflows, or it keeps none, the engine runs unfiltered and:
+ *     are clear of their own u (a filter on it: shell.c), so its answer
+ *     h_I is a kept point's global u, and every point the filter did not
+ *     refuse is interior: kept (exact), or never offered, so below h_I or
+ *     at it with a larger index than the witness (hd__keep_t), which no
+ *     other rank's points can change; the shell is the refused points
+ *     alone.  When the filter's list of refused points overflows, or it
+ *     keeps none, the engine runs unfiltered and:
  *     When the engine's witness is interior, it is the
  *     interior's maximum; else the interior's maximum is computed (one
  *     more engine call on it, its maximum starting at G, so what cannot
  *     beat G is pruned at once) only on a rank where the engine's answer
  *     beats G, the best over all ranks found without it (step 6): every
- *     interior point is below that answer.  The rest, the shell within h
- *     of the faces, get per-point searches (the nearest layer's, as
+ *     interior point is below that answer; the shell is the points within
+ *     h of the faces.  The shell's points get per-point searches (the nearest layer's, as
  *     hd_distances runs them: the nearest local b, smallest index on
  *     ties) on a structure of the slab of local B within 1.5h of the
  *     faces, which the forwarded queries of step 5 ask too; a shell

@@ -12,14 +12,19 @@
  * overflows, the engine's maximum is filtered instead (keep_clear, in
  * hd__mpi_engine_both for both directions at once, else here): it keeps
  * only the points whose faces are clear of their own u, so its answer h_I
- * is attained by an interior point and bounds every point not refused,
- * the interior is the points clear of h_I that were not refused, and its
- * maximum is h_I at once; the rank's largest u (the slabs' scale) is the
- * larger of h_I and the refused points' largest.  (A refused point's faces
- * are not clear of its u <= that largest u, so the shell stays within it
- * of the faces; the interior only grows, by points whose u is at most h_I
- * and clear.)  The other points (the shell) get per-point
- * searches (hd_distances).  The engine prunes the points that cannot be the
+ * is a kept point's u, which is global, and the interior is every point
+ * not refused, with maximum h_I at once: a point not refused was either
+ * kept (exact) or never offered, and then its local u, which bounds its
+ * global one, is below h_I or equal to it at a larger index than the
+ * witness (hd__keep_t), so it cannot be the witness on any rank, whatever
+ * other ranks hold near it.  The shell is the refused points alone (those
+ * the engine could not prune and whose faces are not clear of their u),
+ * none at K = 2 on the uniform and lidar scenes, where the points within
+ * h_I of a face were 3 % (docs/scale-out.md); the rank's largest u (the
+ * slabs' scale) is the larger of h_I and the refused points' largest.
+ * Unfiltered, the shell is the points whose faces are not clear of the
+ * engine's answer, the rank's largest u.  The shell's points get
+ * per-point searches (hd_distances).  The engine prunes the points that cannot be the
  * farthest, which per-point searches cannot: on two epochs of one scene it
  * is tens of times faster (docs/scale-out.md), and the shell is the points
  * within h of the region's faces.
@@ -431,6 +436,36 @@ uint64_t hd__mpi_shell_g(gcur_t *cu, const shell_t *sh, size_t k) {
     return hd__mpi_gcur_at(cu, sh->own_pos ? sh->own_pos[k] : k);
 }
 
+static int by_u32(const void *x, const void *y) {
+    uint32_t a = *(const uint32_t *)x, b = *(const uint32_t *)y;
+    return (a > b) - (a < b);
+}
+
+/* The refused positions, increasing, each once (the engine may offer a
+ * point twice), in an array of exactly their number: *pos NULL when none. */
+static int refused_shell(ctx_t *c, const refused_t *ref, uint32_t **pos, size_t *n) {
+    *pos = NULL;
+    *n = 0;
+    if (ref->n == 0) return HD_OK;
+    uint32_t *p = hd__mpi_alloc(c, ref->n, sizeof *p);
+    if (!p) return hd__mpi_nomem(c, "the shell", ref->n);
+    memcpy(p, ref->pos, ref->n * sizeof *p);
+    qsort(p, ref->n, sizeof *p, by_u32);
+    size_t m = 1;
+    for (size_t r = 1; r < ref->n; r++)
+        if (p[r] != p[m - 1]) p[m++] = p[r];
+    if (m < ref->n) { /* repeats: an array of the distinct ones' size, as freed */
+        uint32_t *q = hd__mpi_alloc(c, m, sizeof *q);
+        if (q) memcpy(q, p, m * sizeof *q);
+        hd__mpi_free(c, p, ref->n, sizeof *p);
+        if (!q) return hd__mpi_nomem(c, "the shell", m);
+        p = q;
+    }
+    *pos = p;
+    *n = m;
+    return HD_OK;
+}
+
 int hd__mpi_shell_of(ctx_t *c, const dir_t *d, const hd__box_t *mine, qtree_t *q, shell_t *sh) {
     memset(sh, 0, sizeof *sh);
     sh->inner = (far_t){-1.0, UINT64_MAX, UINT64_MAX};
@@ -460,18 +495,30 @@ int hd__mpi_shell_of(ctx_t *c, const dir_t *d, const hd__box_t *mine, qtree_t *q
             e.i != HD__NONE)
             ref = &own;
     }
-    if (rc == HD_OK && !done && (pre || ref || (rc = hd__mpi_engine_local(c, &Pv, &Qv, NULL, NULL, &e)) == HD_OK)) {
+    /* The shell's positions, when it is the refused points (below). */
+    uint32_t *refpos = NULL;
+    size_t nref = 0;
+    if (rc == HD_OK && !done && ref) {
+        /* The filter's list is complete, so the shell is the refused
+         * points alone, whatever their faces: every other point is either
+         * kept (its faces clear of its own u: exact) or was never offered,
+         * so its local u, which bounds its global one, is below the
+         * answer h_I or equal to it at a larger index than the witness
+         * (hd__keep_t); and h_I is a kept point's global u, so such a point
+         * cannot be the witness on any rank. */
+        rc = refused_shell(c, ref, &refpos, &nref);
+        nI = d->nP - nref;
+    } else if (rc == HD_OK && !done && (pre || (rc = hd__mpi_engine_local(c, &Pv, &Qv, NULL, NULL, &e)) == HD_OK)) {
+        /* Unfiltered: the engine's answer is the rank's largest u, which
+         * only the points whose faces are clear of it may take as global */
         if (!in && !(in = hd__mpi_alloc(c, d->nP, 1))) rc = hd__mpi_nomem(c, "the interior", d->nP);
         nI = 0;
         for (size_t k = 0; k < d->nP && rc == HD_OK; k++)
             nI += in[k] = (unsigned char)hd__mpi_faces_clear(mine, d->P + 3 * k, e.distance2);
-        for (size_t r = 0; ref && rc == HD_OK && r < ref->n; r++) { /* refused: shell, whatever their faces */
-            nI -= in[ref->pos[r]];
-            in[ref->pos[r]] = 0;
-        }
     }
     if (rc != HD_OK) {
         hd__mpi_free(c, in, d->nP, 1);
+        hd__mpi_free(c, refpos, nref, sizeof(uint32_t));
         hd__mpi_free(c, own.pos, own.cap, sizeof(uint32_t));
         return rc;
     }
@@ -490,18 +537,21 @@ int hd__mpi_shell_of(ctx_t *c, const dir_t *d, const hd__box_t *mine, qtree_t *q
      * second slab: docs/scale-out.md.) */
     /* h: the largest u of the rank, the kept points' or the refused ones' */
     q->M0 = 1.5 * sqrt(done ? sh->inner.d2 : ref && ref->d2 > e.distance2 ? ref->d2 : e.distance2);
-    /* A kept witness is interior: its faces are clear of its own u. */
-    assert(done || !ref || !nI || in[e.i]);
+    /* A kept witness is interior: it was not refused. */
+    assert(done || !ref || !nref || !bsearch(&(uint32_t){(uint32_t)e.i}, refpos, nref, sizeof *refpos, by_u32));
     hd__mpi_free(c, own.pos, own.cap, sizeof(uint32_t));
     if (done) {
         /* the interior's answer is the paired pass's */
-    } else if (nI && in[e.i]) {
+    } else if (ref || (nI && in[e.i])) {
         sh->inner = (far_t){e.distance2, hd__mpi_gidx(d->gP, e.i), hd__mpi_gidx(d->gQ, e.j)};
     } else if (nI) {
         sh->lazy = 1; /* interior_max, only if it can matter */
         sh->h = (far_t){e.distance2, hd__mpi_gidx(d->gP, e.i), hd__mpi_gidx(d->gQ, e.j)};
     }
-    if (rc == HD_OK && nS && nI) { /* a proper subset: its positions */
+    if (rc == HD_OK && ref) { /* the refused points: a proper subset (the witness is kept) */
+        assert(nI > 0);
+        sh->own_pos = refpos;
+    } else if (rc == HD_OK && nS && nI) { /* a proper subset: its positions */
         sh->n = nS;
         if (!(sh->own_pos = hd__mpi_alloc(c, nS, sizeof(uint32_t)))) rc = hd__mpi_nomem(c, "the shell", nS);
         for (size_t k = 0, t = 0; k < d->nP && rc == HD_OK; k++)
