@@ -13,6 +13,9 @@
 #    the local sets (src/mpi/gidx.c) read back by position and by cursor.
 #  - mpi_memory: tests/internal/mpi_memory.c, the call's buffers charged at
 #    what they hold (src/mpi/context.c), scratch ones rounded to huge pages.
+#  - mpi_nearest: tests/internal/mpi_nearest.c, the per-point searches of a
+#    local set (src/mpi/slab.c): a few askers by one pass over it, more by
+#    the slab, both the brute force's answer, ties to the smallest index.
 #  - mpi_cli_3: tests/mpi_cli.py, hausdorff-mpi on 3 ranks against
 #    hausdorff (JSON and text, tiles, scales, a bad tile on one rank, the
 #    --distances files byte for byte and their failures, the figures and
@@ -67,6 +70,13 @@ if(HD_MPI)
   target_link_libraries(mpi_memory PRIVATE hausdorff_mpi)
   set_target_properties(mpi_memory PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/tests)
   add_test(NAME mpi_memory COMMAND mpi_memory)
+  # mpi_nearest: tests/internal/mpi_nearest.c, the per-point searches of a
+  # rank's local set (src/mpi/slab.c), white-box and without mpirun.
+  add_executable(mpi_nearest ${CMAKE_CURRENT_SOURCE_DIR}/tests/internal/mpi_nearest.c ${HD_TEST_SUPPORT})
+  target_include_directories(mpi_nearest PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/tests/support ${CMAKE_CURRENT_SOURCE_DIR}/src)
+  target_link_libraries(mpi_nearest PRIVATE hausdorff_mpi)
+  set_target_properties(mpi_nearest PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/tests)
+  add_test(NAME mpi_nearest COMMAND mpi_nearest)
   find_program(HD_MPI_PYTHON NAMES python3 REQUIRED)
   add_test(NAME mpi_cli_3 COMMAND ${HD_MPI_PYTHON} ${CMAKE_CURRENT_SOURCE_DIR}/tests/mpi_cli.py
            $<TARGET_FILE:hausdorff_cli> $<TARGET_FILE:hausdorff_mpi_cli> 3 ${HD_MPIRUN})

@@ -202,10 +202,92 @@ static int slab_search(ctx_t *c, const slab_t *sl, const double *pts, const uint
  * points a rank): 160M instructions with 4, 176M with 0 or 1. */
 #define BRUTE_MAX 4
 
+/* At most this many askers, while no slab is built, are answered by one
+ * pass over all of Q (scan_q) instead: the engine's filter leaves a shell
+ * of a few points on most ranks (1 to 36 a direction on the uniform and
+ * lidar scenes, 1M a rank, K = 2 and 4), for which the slab's two passes
+ * over Q and its structure were 39 instructions a local point (callgrind,
+ * uniform at K = 2).  A copy's shell (its pairs cut by a face: about 200)
+ * takes the slab. */
+#define SCAN_MAX 16
+
+/* The exact nearest point of Q (smallest index on ties) for each of the
+ * n <= SCAN_MAX askers X(k), in one pass over Q.  Each starts from its
+ * nearest in a strided sample of Q (an upper bound), and a point b of Q
+ * is passed over without a distance when it is provably farther than
+ * every asker's bound:
+ *  - beyond the askers' box on an axis: g = fl(b_a - hi_a) > 0 with
+ *    fl(g g) > MB, the largest bound (or the same below lo_a).  For an
+ *    asker x, x_a <= hi_a, so fl(b_a - x_a) >= g (rounding is monotone),
+ *    hd__d2(x, b) >= fl(fl(b_a - x_a)^2) >= fl(g g) (the squared sum only
+ *    adds non-negative terms), > MB >= x's bound: farther, not tied;
+ *  - for one asker, when fl(dx dx) > its bound (the same argument).
+ * Every other b is compared exactly, the smaller index winning a tie, so
+ * each answer is the nearest with the smallest index. */
+static void scan_q(const dir_t *d, const double *pts, const uint32_t *pos, size_t n, size_t *near) {
+#define X(k) (pts + 3 * (pos ? pos[k] : (k)))
+    double best[SCAN_MAX], lo[3], hi[3];
+    size_t at[SCAN_MAX];
+    assert(n <= SCAN_MAX && d->nQ > 0);
+    for (int a = 0; a < 3; a++) lo[a] = hi[a] = X(0)[a];
+    for (size_t t = 0; t < n; t++) {
+        best[t] = INFINITY, at[t] = SIZE_MAX;
+        for (int a = 0; a < 3; a++) {
+            lo[a] = X(t)[a] < lo[a] ? X(t)[a] : lo[a];
+            hi[a] = X(t)[a] > hi[a] ? X(t)[a] : hi[a];
+        }
+    }
+    /* the sample: the bounds the pass starts from */
+    size_t step = d->nQ / 1024 + 1;
+    for (size_t j = 0; j < d->nQ; j += step)
+        for (size_t t = 0; t < n; t++) {
+            double d2 = hd__d2(X(t), d->Q + 3 * j);
+            if (d2 < best[t]) best[t] = d2, at[t] = j; /* j increases: the first at a tie */
+        }
+    /* the axes, the askers' thinnest first: most points of Q are beyond
+     * the box on it (the shell lies along a face) */
+    int ax[3] = {0, 1, 2};
+    for (int a = 1; a < 3; a++)
+        for (int k = a; k > 0 && hi[ax[k]] - lo[ax[k]] < hi[ax[k - 1]] - lo[ax[k - 1]]; k--) {
+            int t = ax[k];
+            ax[k] = ax[k - 1], ax[k - 1] = t;
+        }
+    for (size_t j0 = 0; j0 < d->nQ; j0 += 4096) {
+        double MB = 0;
+        for (size_t t = 0; t < n; t++) MB = best[t] > MB ? best[t] : MB;
+        size_t j1 = d->nQ - j0 < 4096 ? d->nQ : j0 + 4096;
+        for (size_t j = j0; j < j1; j++) {
+            const double *b = d->Q + 3 * j;
+            /* beyond the box on an axis: g > 0 on one side at most, since
+             * lo <= hi, so the larger of the two gaps is the one */
+            int far = 0;
+            for (int k = 0; k < 3 && !far; k++) {
+                int a = ax[k];
+                double g1 = b[a] - hi[a], g2 = lo[a] - b[a], g = g1 > g2 ? g1 : g2;
+                far = g > 0 && g * g > MB;
+            }
+            if (far) continue;
+            for (size_t t = 0; t < n; t++) {
+                const double *x = X(t);
+                double dx = x[0] - b[0];
+                if (dx * dx > best[t]) continue;
+                double d2 = hd__d2(x, b);
+                if (d2 < best[t] || (d2 == best[t] && j < at[t])) best[t] = d2, at[t] = j;
+            }
+        }
+    }
+    for (size_t t = 0; t < n; t++) near[t] = at[t];
+#undef X
+}
+
 int hd__mpi_nearest_in_q(ctx_t *c, const dir_t *d, const hd__box_t *r, qtree_t *q, const double *pts,
                          const uint32_t *pos, size_t n, size_t *near, unsigned char *unproven) {
-#define X(k) (pts + 3 * (pos ? pos[k] : (k)))
     if (n == 0) return HD_OK;
+    if (n <= SCAN_MAX && !q->sub.built && !q->full.built && d->nQ > 0) {
+        scan_q(d, pts, pos, n, near); /* exact: nothing left unproven */
+        return HD_OK;
+    }
+#define X(k) (pts + 3 * (pos ? pos[k] : (k)))
     if (n > HD__AN_MAX_POINTS || d->nQ > HD__AN_MAX_POINTS) { /* hd_distances' kd-trees */
         double *own = pos ? hd__mpi_alloc(c, n, 3 * sizeof(double)) : NULL;
         if (pos && !own) return hd__mpi_nomem(c, "the searches", n);
