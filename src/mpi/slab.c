@@ -7,10 +7,12 @@
  * The structures of the searched local set Q for per-point searches (the
  * nearest layer's, as hd_distances builds them), built on first use and
  * kept for the direction: the shell and the forwarded queries ask them in
- * turn.  Only the points that ask need them, and those are few (the shell,
- * within h of the region's faces, and queries from beyond the faces), so
- * the first is built over a slab: the points of Q within a margin M of a
- * finite face.  An answer from the slab is the answer from all of Q when
+ * turn.  Only the points that ask need them, and those are few (the
+ * shell: the engine's refused points, or in its unfiltered fallback the
+ * points within h of a face; and queries from beyond the faces).  At most
+ * SCAN_MAX of them, while nothing is built, are answered by one pass over
+ * Q (scan_q) and need no structure; more ask one built over a slab: the
+ * points of Q within a margin M of a finite face.  An answer from the slab is the answer from all of Q when
  * every point left out is provably farther (hd__mpi_slab_proves); the others,
  * when a few, are compared with every point of Q, else ask a slab as wide
  * as they need and an eighth more (it replaces the first), then all of Q.
