@@ -8,6 +8,7 @@
  * so this runs without mpirun; built with the MPI library
  * (tests/mpi.cmake).
  */
+#include "brute.h"
 #include "check.h"
 #include "gen.h"
 #include "mpi/mpi_int.h"
@@ -15,14 +16,11 @@
 #include <math.h>
 #include <stdlib.h>
 
-/* The brute force: the smallest index at the smallest hd__d2. */
+/* The brute force (tests/support/brute.c): the smallest index at the
+ * smallest squared distance. */
 static size_t brute(const double *x, const double *Q, size_t nQ) {
     size_t at = 0;
-    double best = hd__d2(x, Q);
-    for (size_t j = 1; j < nQ; j++) {
-        double d2 = hd__d2(x, Q + 3 * j);
-        if (d2 < best) best = d2, at = j;
-    }
+    brute_nearest(x, Q, nQ, &at);
     return at;
 }
 
