@@ -123,6 +123,53 @@ static size_t walk_avail(const input_t *in, const hd_mpi_part_t **order[2], walk
     return 0;
 }
 
+/* Where one part's run of points goes in a round: each point's
+ * coordinates and number to its slot in the local arrays (lx, lo at
+ * *own, when it stays) or in the send buffer (sx, so at sfill[2 r + s]).
+ * Two ways, one result, chosen by the caller from how often consecutive
+ * points change destination (the first pass counts it):
+ *  - a branch on whether the point stays, for destinations in long runs
+ *    (an input in space's order, as a rank reading its tiles has), where
+ *    it is predicted;
+ *  - tables indexed by it, with no branch, for destinations at random (an
+ *    input in no spatial order: half the points stay at K = 2, and the
+ *    branch was mispredicted as often, by callgrind's branch simulation;
+ *    GCC turned plain ternaries back into the branch).  A rank's own
+ *    block of the send buffer is empty, so its cursor, written back
+ *    unchanged when a point stays, is never used.
+ * Inlined with a constant `branchless`, so each way is its own loop. */
+HD__INLINE void pack_run(const hd_points_t *v, const double *px, size_t k0, size_t m, const void *dest, int w,
+                         size_t t, int me, int s, uint32_t num, double *lx, uint32_t *lo, size_t *own, double *sx,
+                         uint32_t *so, int *sfill, int branchless) {
+    double *const xto[2] = {sx, lx};
+    uint32_t *const oto[2] = {so, lo};
+    size_t cur[2] = {0, *own};
+    for (size_t i = 0; i < m; i++, t++, num++) {
+        int r = dest_get(dest, w, t);
+        double *x;
+        if (branchless) {
+            int mine = r == me;
+            cur[0] = (size_t)sfill[2 * r + s];
+            size_t to = cur[mine];
+            sfill[2 * r + s] = (int)cur[0] + !mine;
+            cur[1] += (size_t)mine;
+            x = xto[mine] + 3 * to;
+            oto[mine][to] = num;
+        } else if (r == me) {
+            size_t to = cur[1]++;
+            x = lx + 3 * to;
+            lo[to] = num;
+        } else {
+            size_t to = (size_t)sfill[2 * r + s]++;
+            x = sx + 3 * to;
+            so[to] = num;
+        }
+        if (px) memcpy(x, px + 3 * (k0 + i), 3 * sizeof(double));
+        else hd_points_get(v, k0 + i, x);
+    }
+    *own = cur[1];
+}
+
 /* Points sent per round by a rank: an eighth of its points (at least 64K),
  * so the send buffer is at most 28/8 = 3.5 bytes a point (the minimum
  * also makes the tests' larger sets take several rounds). */
@@ -166,7 +213,7 @@ int hd__mpi_exchange(ctx_t *c, const input_t *in, const ranges_t *rg, const node
     if (!cnt || !base || !dest || !order[0] || !order[1]) rc = hd__mpi_nomem(c, "the exchange", nloc);
     int *tot = cnt, *rtot = cnt + 2 * K, *per = cnt + 4 * K, *rper = cnt + 6 * K, *sdisp = cnt + 8 * K,
         *sfill = cnt + 10 * K, *sc = cnt + 12 * K, *sd = cnt + 13 * K, *rcn = cnt + 14 * K, *rd = cnt + 15 * K;
-    size_t *got = base + 2 * K, own = 0;
+    size_t *got = base + 2 * K, own = 0, switches = 0; /* points whose destination is not the previous one's */
     /* The rounds: round q walks the input positions [tb[q], tb[q + 1]),
      * up to the (q + 1) C-th point for another rank (the last to the end),
      * and sends rcnt[q 2K + 2 r + s] points of side s to rank r. */
@@ -177,7 +224,8 @@ int hd__mpi_exchange(ctx_t *c, const input_t *in, const ranges_t *rg, const node
     if (rc == HD_OK) {
         memset(tot, 0, 2 * (size_t)K * sizeof(int));
         memset(rcnt, 0, maxr * 2 * (size_t)K * sizeof(int));
-        size_t t = 0, out = 0, q = 0;
+        size_t t = 0, out = 0, q = 0, cut = C; /* cut: where round q ends, (q + 1) C points sent */
+        int prev = -1, *row = rcnt;              /* row: round q's counts */
         tb[0] = 0;
         for (int s = 0; s < 2; s++) {
             for (size_t p = 0; p < in->nparts[s]; p++) order[s][p] = &in->parts[s][p];
@@ -191,13 +239,19 @@ int hd__mpi_exchange(ctx_t *c, const input_t *in, const ranges_t *rg, const node
                     const double *x = px ? px + 3 * k : (hd_points_get(v, k, xb), xb);
                     int r = hd__mpi_rank_of(tree, K, x, (uint64_t)s, g0 + k);
                     dest_set(dest, w, t, r);
+                    switches += (size_t)(r != prev);
+                    prev = r;
                     if (tot[2 * r + s] == INT_MAX) rc = HD_EOVERFLOW;
                     else tot[2 * r + s]++;
-                    if (r == me) continue;
-                    if (out == (q + 1) * C) tb[++q] = t;
-                    assert(q < maxr);
-                    rcnt[q * 2 * (size_t)K + 2 * (size_t)r + (size_t)s]++;
-                    out++;
+                    /* No branch on whether the point stays: in an input
+                     * that is not in space's order it does at random (half
+                     * the points at K = 2), and the branch was mispredicted
+                     * as often (callgrind's branch simulation). */
+                    int other = r != me;
+                    if (out == cut && other) tb[++q] = t, row += 2 * (size_t)K, cut += C;
+                    assert(q < maxr && cut == (q + 1) * C && row == rcnt + q * 2 * (size_t)K);
+                    row[2 * r + s] += other;
+                    out += (size_t)other;
                 }
             }
         }
@@ -242,6 +296,12 @@ int hd__mpi_exchange(ctx_t *c, const input_t *in, const ranges_t *rg, const node
     uint64_t mine = nr, rounds = 0;
     MPI_GO(c, rc, MPI_Allreduce(&mine, &rounds, 1, MPI_UINT64_T, MPI_MAX, c->comm));
     walk_t at = {0, 0, 0, {0, 0}};
+    /* Destinations that change at more than a quarter of the points are
+     * packed without a branch on them (pack_run): at K = 2 a branch
+     * mispredicted at random costs more than the tables' 20 instructions
+     * a point, which cost an input in tiles 1.8 ns a point (alternated
+     * runs, docs/benchmarks.md). */
+    int scattered = switches > nloc / 4;
     size_t ownat[2] = {base[me], base[K + me]};
     for (uint64_t round = 0; round < rounds; round++) {
         if (round < nr) memcpy(per, rcnt + round * 2 * (size_t)K, 2 * (size_t)K * sizeof(int));
@@ -261,23 +321,11 @@ int hd__mpi_exchange(ctx_t *c, const input_t *in, const ranges_t *rg, const node
             const hd_points_t *v = &order[s][at.p]->points;
             const double *px = hd__mpi_packed(v);
             uint32_t num = (uint32_t)at.num[s];
-            double *lx = loc->xyz[s];
-            uint32_t *lo = off[s];
-            for (size_t i = 0; i < m; i++, t++, num++) {
-                int r = dest_get(dest, w, t);
-                double *x;
-                if (r == me) {
-                    size_t to = ownat[s]++;
-                    x = lx + 3 * to;
-                    lo[to] = num;
-                } else {
-                    size_t to = (size_t)sfill[2 * r + s]++;
-                    x = sx + 3 * to;
-                    so[to] = num;
-                }
-                if (px) memcpy(x, px + 3 * (at.k + i), 3 * sizeof(double));
-                else hd_points_get(v, at.k + i, x);
-            }
+            if (scattered)
+                pack_run(v, px, at.k, m, dest, w, t, me, s, num, loc->xyz[s], off[s], &ownat[s], sx, so, sfill, 1);
+            else
+                pack_run(v, px, at.k, m, dest, w, t, me, s, num, loc->xyz[s], off[s], &ownat[s], sx, so, sfill, 0);
+            t += m;
             at.k += m;
             at.num[s] += m;
         }
