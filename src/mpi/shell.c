@@ -189,24 +189,38 @@ static size_t mark_pairs(const gidx_t *gP, size_t nP, const gidx_t *gQ, size_t n
 /* Whether the merge walk of mark_pairs is worth it: at least three
  * quarters of PAIRS_SAMPLE points of P, evenly spaced, have their partner
  * here (each found by a binary search of Q's indices, decoded at random:
- * a few thousand decodes against the walk's 45-60 instructions a point).
- * The correspondence pass wants nine tenths (is_paired), which a sample of
- * 64 misses by that much only at four standard deviations if it were
- * random; two unrelated sets of one size have about 1/K of their partners
- * here (half at K = 2).  A sample that misses a copy only costs that pass,
- * never an answer. */
+ * a few thousand decodes against the walk's 45-60 instructions a point),
+ * and nearer than every one of PAIRS_RIVALS points of Q spread over its
+ * positions (or tied), as a moved copy's partner is and a random point is
+ * not (the engine's gate, docs/engine.md, step 0.5, asks the same of a
+ * sample).  The correspondence pass wants nine tenths (is_paired), which
+ * a sample of 64 misses by that much only at four standard deviations if
+ * it were random; two unrelated sets of one size have about 1/K of their
+ * partners here (half at K = 2), but all of them when each rank's input is
+ * already its region (tiles): the index alone then took two independent
+ * epochs for a copy, ran the engine unfiltered on "pairs" that are not,
+ * and the lidar scene in tiles at K = 2 searched 1.7 % of its points one
+ * by one and held 47.2 bytes a point (docs/scale-out.md).  A sample that
+ * misses a copy only costs that pass, never an answer. */
 #define PAIRS_SAMPLE 64
-static int pairs_likely(const gidx_t *gP, size_t nP, const gidx_t *gQ, size_t nQ) {
-    size_t m = nP < PAIRS_SAMPLE ? nP : PAIRS_SAMPLE, hits = 0;
+#define PAIRS_RIVALS 32
+static int pairs_likely(const double *P, const gidx_t *gP, size_t nP, const double *Q, const gidx_t *gQ,
+                        size_t nQ) {
+    size_t m = nP < PAIRS_SAMPLE ? nP : PAIRS_SAMPLE, hits = 0, step = nQ / PAIRS_RIVALS + 1;
     for (size_t r = 0; r < m && nQ; r++) {
-        uint64_t g = hd__mpi_gidx(gP, r * nP / m);
+        size_t i = r * nP / m;
+        uint64_t g = hd__mpi_gidx(gP, i);
         size_t lo = 0, hi = nQ;
         while (lo < hi) {
             size_t mid = lo + (hi - lo) / 2;
             if (hd__mpi_gidx(gQ, mid) < g) lo = mid + 1;
             else hi = mid;
         }
-        hits += lo < nQ && hd__mpi_gidx(gQ, lo) == g;
+        if (lo == nQ || hd__mpi_gidx(gQ, lo) != g) continue;
+        double d2 = hd__d2(P + 3 * i, Q + 3 * lo);
+        int nearest = 1;
+        for (size_t j = 0; j < nQ && nearest; j += step) nearest = hd__d2(P + 3 * i, Q + 3 * j) >= d2;
+        hits += (size_t)nearest;
     }
     return 4 * hits >= 3 * m;
 }
@@ -279,7 +293,7 @@ int hd__mpi_engine_both(ctx_t *c, double *xyz[2], const gidx_t *g[2], const size
      * done when a sample finds few pairs. */
     int paired = 0;
     size_t nc = 0;
-    if (pairs_likely(g[0], n[0], g[1], n[1])) {
+    if (pairs_likely(xyz[0], g[0], n[0], xyz[1], g[1], n[1])) {
         mask[0] = hd__mpi_alloc(c, n[0], 1);
         mask[1] = hd__mpi_alloc(c, n[1], 1);
         if (!mask[0] || !mask[1]) return hd__mpi_nomem(c, "the pairs", n[0]);
@@ -344,7 +358,7 @@ static int paired_pass(ctx_t *c, const dir_t *d, const hd__box_t *mine, unsigned
     *done = 0;
     *inp = NULL;
     if (pre && !pre->paired) return HD_OK;
-    if (!pre && (!pairs_likely(d->gP, nP, d->gQ, nQ) ||
+    if (!pre && (!pairs_likely(d->P, d->gP, nP, d->Q, d->gQ, nQ) ||
                  !is_paired(nc = mark_pairs(d->gP, nP, d->gQ, nQ, NULL, NULL), nP, nQ)))
         return HD_OK;
     /* P's mask is made the interior's below, so it is this pass's own; Q's

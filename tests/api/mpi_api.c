@@ -579,6 +579,47 @@ static void check_strided_views_over_ranks(void) {
     free(bf);
 }
 
+/* Two independent sets, each rank holding the same index range of both,
+ * and that range a strip of space, as ranks reading their tiles of two
+ * epochs do: every point's partner by index is on its rank, yet the sets
+ * are no copy.  The answer is the single process's, and only the points
+ * the engine refused are searched one by one; taken for pairs (by their
+ * indices alone, as before 2026-11-29), the engine ran unfiltered and the
+ * points within h of a face were searched too, several percent of them. */
+static void check_independent_tiles_are_not_pairs(void) {
+    if (K_ < 2) return;
+    size_t n = BIG;
+    double *a = malloc(n * 3 * sizeof *a), *b = malloc(n * 3 * sizeof *b);
+    if (!a || !b) abort();
+    gen_rng_t g;
+    gen_seed(&g, 77);
+    for (int side = 0; side < 2; side++) {
+        double *x = side ? b : a;
+        for (size_t i = 0; i < n; i++) { /* x grows with the index, blurred by 0.1: block r is
+                                            * about the strip r (exactly, and each rank's sets would
+                                            * be whole sets in one order, which the engine judges) */
+            x[3 * i] = 2.0 * K_ * (double)i / (double)n + 0.1 * gen_unit(&g);
+            x[3 * i + 1] = gen_unit(&g);
+            x[3 * i + 2] = gen_unit(&g);
+        }
+    }
+    snprintf(context_, sizeof context_, "independent sets in strips over %d ranks, seed 77", K_);
+    hd_points_t A = hd_points_f64(a, n), B = hd_points_f64(b, n);
+    hd_symmetric_t ref, got;
+    hd_error_t err;
+    CHECK(hd_hausdorff(&A, &B, NULL, &ref, &err) == HD_OK);
+    hd_mpi_part_t pa[2], pb[2];
+    size_t na = layout(LAY_BLOCKS, 0, a, n, 77, pa, 2), nb = layout(LAY_BLOCKS, 1, b, n, 77, pb, 2);
+    hd_mpi_stats_t st;
+    CHECK(hd_mpi_hausdorff(MPI_COMM_WORLD, pa, na, pb, nb, NULL, &got, &st, &err) == HD_OK);
+    CHECK(SAME_BITS(got.distance, ref.distance) && got.ab.i == ref.ab.i && got.ab.j == ref.ab.j &&
+          got.ba.i == ref.ba.i && got.ba.j == ref.ba.j);
+    CHECK(st.shell_points * 100 < 2 * n); /* under 1 % */
+    if (st.shell_points * 100 >= 2 * n) fprintf(stderr, "shell %llu points\n", (unsigned long long)st.shell_points);
+    free(a);
+    free(b);
+}
+
 /* One call on the large uniform sets in layout `how`, its figures in *st. */
 static void call_big_uniform(const char *what, int how, hd_mpi_stats_t *st) {
     uint64_t seed = 1000 + DS_BIG_UNIFORM;
@@ -631,6 +672,7 @@ int main(int argc, char **argv) {
     if (!only) check_strided_views_over_ranks();
     if (!only) check_own_figures_make_the_maxima();
     if (!only) check_partition_balances();
+    if (!only) check_independent_tiles_are_not_pairs();
     for (int which = 0; which < DS_COUNT; which++) {
         if (only && strcmp(only, "errors") != 0 && atoi(only) != which) continue;
         if (only && strcmp(only, "errors") == 0) break;
