@@ -289,8 +289,9 @@ void hd__grid_nearest(const hd__grid_t *g, const double q[3], double stop2, doub
 
 /* ---- the running maximum shared by the threads of one direction --------------- */
 
-/* A filter on a direction's maximum: keep(ctx, i, d2) says whether point
- * i of A, whose exact squared nearest distance is d2, may be the maximum.
+/* A filter on a direction's maximum: keep(ctx, i, d2, j) says whether
+ * point i of A, whose exact squared nearest distance is d2 and nearest
+ * point of B j (the smallest index at d2), may be the maximum.
  * A point it refuses is left out of the maximum and of the bound that
  * prunes the others, as if it were not in A; every path offers each point
  * that may beat the maximum (hd__max_offer), so the answer is the maximum
@@ -298,7 +299,7 @@ void hd__grid_nearest(const hd__grid_t *g, const double q[3], double stop2, doub
  * offered has a nearest distance no larger than it.  Called under the
  * maximum's lock, so it may record what it refuses. */
 typedef struct {
-    int (*keep)(void *ctx, size_t i, double d2); /* NULL: every point */
+    int (*keep)(void *ctx, size_t i, double d2, size_t j); /* NULL: every point */
     void *ctx;
 } hd__keep_t;
 

@@ -29,7 +29,7 @@ void hd__max_offer(hd__max_t *m, double d2, size_t i, size_t j, hd__best_t *snap
     /* A squared distance of a real point (-1 would read as "nothing yet"). */
     assert(!(d2 < 0) && i != HD__NONE);
     pthread_mutex_lock(&m->lock);
-    int kept = !m->keep.keep || m->keep.keep(m->keep.ctx, i, d2);
+    int kept = !m->keep.keep || m->keep.keep(m->keep.ctx, i, d2, j);
     if (kept) hd__best_offer(&m->best, d2, i, j);
     if (snap) *snap = m->best;
     pthread_mutex_unlock(&m->lock);

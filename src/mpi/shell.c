@@ -21,9 +21,11 @@
  * the engine could not prune and whose faces are not clear of their u),
  * none at K = 2 on the uniform and lidar scenes, where the points within
  * h_I of a face were 3 % (docs/scale-out.md); the rank's largest u (the
- * slabs' scale) is the larger of h_I and the refused points' largest.
- * Unfiltered, the shell is the points whose faces are not clear of the
- * engine's answer, the rank's largest u.  The shell's points get
+ * slabs' scale) is the larger of h_I and the refused points' largest.  A
+ * refused point's nearest point of Q is the engine's own answer (offered
+ * with it: the exact distance and the smallest index at it), so the shell
+ * needs no search of Q.  Unfiltered, the shell is the points whose faces
+ * are not clear of the engine's answer, the rank's largest u, and they get
  * per-point searches (hd_distances).  The engine prunes the points that cannot be the
  * farthest, which per-point searches cannot: on two epochs of one scene it
  * is tens of times faster (docs/scale-out.md), and the shell is the points
@@ -263,11 +265,11 @@ static int pairs_engine(ctx_t *c, double *P, size_t nP, double *Q, size_t nQ, co
  * the filter), and the filter keeps every point, so that the rest of the
  * pass prunes as an unfiltered one does instead of searching every point
  * that nothing kept bounds (A far from the local B: every u large). */
-static int keep_clear(void *ctx, size_t i, double d2) {
+static int keep_clear(void *ctx, size_t i, double d2, size_t j) {
     refused_t *r = ctx;
     if (r->overflow || hd__mpi_faces_clear(r->mine, r->P + 3 * i, d2)) return 1;
     r->d2 = d2 > r->d2 ? d2 : r->d2;
-    if (r->n < r->cap) r->pos[r->n++] = (uint32_t)i;
+    if (r->n < r->cap) r->pos[r->n] = (uint32_t)i, r->near[r->n++] = j;
     else r->overflow = 1;
     return 0;
 }
@@ -276,11 +278,22 @@ static int keep_clear(void *ctx, size_t i, double d2) {
  * points of a million, and refuses those of the shell among them. */
 #define REFUSED_ROOM(n) ((n) / 256 + 256)
 
-void hd__mpi_pre_free(ctx_t *c, pre_t *pre) {
-    hd__mpi_free(c, pre->ref.pos, pre->ref.cap, sizeof(uint32_t));
-    pre->ref.pos = NULL;
-    pre->ref.cap = 0;
+/* The list's arrays, room for r->cap (HD_OK, or the error, charged). */
+static int refused_alloc(ctx_t *c, refused_t *r, size_t n) {
+    r->pos = hd__mpi_alloc(c, r->cap, sizeof(uint32_t));
+    r->near = hd__mpi_alloc(c, r->cap, sizeof(size_t));
+    return r->pos && r->near ? HD_OK : hd__mpi_nomem(c, "the shell", n);
 }
+
+static void refused_free(ctx_t *c, refused_t *r) {
+    hd__mpi_free(c, r->pos, r->cap, sizeof(uint32_t));
+    hd__mpi_free(c, r->near, r->cap, sizeof(size_t));
+    r->pos = NULL;
+    r->near = NULL;
+    r->cap = 0;
+}
+
+void hd__mpi_pre_free(ctx_t *c, pre_t *pre) { refused_free(c, &pre->ref); }
 
 int hd__mpi_engine_both(ctx_t *c, double *xyz[2], const gidx_t *g[2], const size_t n[2], const hd__box_t box[2],
                         const hd__box_t *mine, pre_t pre[2], unsigned char *mask[2]) {
@@ -315,10 +328,9 @@ int hd__mpi_engine_both(ctx_t *c, double *xyz[2], const gidx_t *g[2], const size
          * of their own distance: the interior's maximum, at once (shell_of) */
         hd__keep_t keep[2];
         for (int s = 0; s < 2; s++) {
-            ref[s] = (refused_t){mine, xyz[s], 1, -1.0, NULL, 0, REFUSED_ROOM(n[s]), 0};
+            ref[s] = (refused_t){mine, xyz[s], 1, -1.0, NULL, 0, REFUSED_ROOM(n[s]), 0, NULL};
             keep[s] = (hd__keep_t){keep_clear, &ref[s]};
-            if (!(ref[s].pos = hd__mpi_alloc(c, ref[s].cap, sizeof(uint32_t))))
-                rc = hd__mpi_nomem(c, "the shell", n[s]);
+            if (rc == HD_OK) rc = refused_alloc(c, &ref[s], n[s]);
         }
         hd_points_t Av = hd_points_f64(xyz[0], n[0]), Bv = hd_points_f64(xyz[1], n[1]);
         hd_symmetric_t s;
@@ -450,32 +462,55 @@ uint64_t hd__mpi_shell_g(gcur_t *cu, const shell_t *sh, size_t k) {
     return hd__mpi_gcur_at(cu, sh->own_pos ? sh->own_pos[k] : k);
 }
 
-static int by_u32(const void *x, const void *y) {
+#ifndef NDEBUG
+static int by_u32(const void *x, const void *y) { /* the witness's check below */
     uint32_t a = *(const uint32_t *)x, b = *(const uint32_t *)y;
     return (a > b) - (a < b);
 }
+#endif
 
-/* The refused positions, increasing, each once (the engine may offer a
- * point twice), in an array of exactly their number: *pos NULL when none. */
-static int refused_shell(ctx_t *c, const refused_t *ref, uint32_t **pos, size_t *n) {
+/* A refused point and its nearest position in Q, the engine's answer. */
+typedef struct {
+    uint32_t pos;
+    size_t near;
+} refd_t;
+
+static int by_pos(const void *x, const void *y) {
+    uint32_t a = ((const refd_t *)x)->pos, b = ((const refd_t *)y)->pos;
+    return (a > b) - (a < b);
+}
+
+/* The shell from the filter's complete list: the refused positions,
+ * increasing, each once (the engine may offer a point twice, with the
+ * same answer), and each one's nearest position in Q, the engine's exact
+ * answer with the smallest index at its u, so no search of Q is needed;
+ * in arrays of exactly their number (NULL when none), as
+ * hd__mpi_shell_free frees them. */
+static int refused_shell(ctx_t *c, const refused_t *ref, uint32_t **pos, size_t **near, size_t *n) {
     *pos = NULL;
+    *near = NULL;
     *n = 0;
     if (ref->n == 0) return HD_OK;
-    uint32_t *p = hd__mpi_alloc(c, ref->n, sizeof *p);
-    if (!p) return hd__mpi_nomem(c, "the shell", ref->n);
-    memcpy(p, ref->pos, ref->n * sizeof *p);
-    qsort(p, ref->n, sizeof *p, by_u32);
+    refd_t *t = hd__mpi_alloc(c, ref->n, sizeof *t);
+    if (!t) return hd__mpi_nomem(c, "the shell", ref->n);
+    for (size_t r = 0; r < ref->n; r++) t[r] = (refd_t){ref->pos[r], ref->near[r]};
+    qsort(t, ref->n, sizeof *t, by_pos);
     size_t m = 1;
-    for (size_t r = 1; r < ref->n; r++)
-        if (p[r] != p[m - 1]) p[m++] = p[r];
-    if (m < ref->n) { /* repeats: an array of the distinct ones' size, as freed */
-        uint32_t *q = hd__mpi_alloc(c, m, sizeof *q);
-        if (q) memcpy(q, p, m * sizeof *q);
-        hd__mpi_free(c, p, ref->n, sizeof *p);
-        if (!q) return hd__mpi_nomem(c, "the shell", m);
-        p = q;
+    for (size_t r = 1; r < ref->n; r++) {
+        assert(t[r].pos != t[m - 1].pos || t[r].near == t[m - 1].near);
+        if (t[r].pos != t[m - 1].pos) t[m++] = t[r];
+    }
+    uint32_t *p = hd__mpi_alloc(c, m, sizeof *p);
+    size_t *q = hd__mpi_alloc(c, m, sizeof *q);
+    for (size_t k = 0; p && q && k < m; k++) p[k] = t[k].pos, q[k] = t[k].near;
+    hd__mpi_free(c, t, ref->n, sizeof *t);
+    if (!p || !q) {
+        hd__mpi_free(c, p, m, sizeof *p);
+        hd__mpi_free(c, q, m, sizeof *q);
+        return hd__mpi_nomem(c, "the shell", m);
     }
     *pos = p;
+    *near = q;
     *n = m;
     return HD_OK;
 }
@@ -498,20 +533,20 @@ int hd__mpi_shell_of(ctx_t *c, const dir_t *d, const hd__box_t *mine, qtree_t *q
      * the refused points' list incomplete, or no point kept, the engine
      * runs again on the whole local sets, without the filter. */
     const refused_t *ref = pre && pre->ref.on ? &pre->ref : NULL;
-    refused_t own = {mine, d->P, 0, -1.0, NULL, 0, 0, 0}; /* when the engine runs here */
+    refused_t own = {mine, d->P, 0, -1.0, NULL, 0, 0, 0, NULL}; /* when the engine runs here */
     if (ref && (ref->overflow || pre->e.i == HD__NONE)) pre = NULL, ref = NULL;
     if (rc == HD_OK && !done && pre) e = pre->e;
     if (rc == HD_OK && !done && !pre) {
         own.cap = REFUSED_ROOM(d->nP);
         hd__keep_t keep = {keep_clear, &own};
-        if (!(own.pos = hd__mpi_alloc(c, own.cap, sizeof(uint32_t)))) rc = hd__mpi_nomem(c, "the shell", d->nP);
+        rc = refused_alloc(c, &own, d->nP);
         if (rc == HD_OK && (rc = hd__mpi_engine_kept(c, &Pv, &Qv, &keep, &e)) == HD_OK && !own.overflow &&
             e.i != HD__NONE)
             ref = &own;
     }
     /* The shell's positions, when it is the refused points (below). */
     uint32_t *refpos = NULL;
-    size_t nref = 0;
+    size_t *refnear = NULL, nref = 0;
     if (rc == HD_OK && !done && ref) {
         /* The filter's list is complete, so the shell is the refused
          * points alone, whatever their faces: every other point is either
@@ -520,7 +555,7 @@ int hd__mpi_shell_of(ctx_t *c, const dir_t *d, const hd__box_t *mine, qtree_t *q
          * answer h_I or equal to it at a larger index than the witness
          * (hd__keep_t); and h_I is a kept point's global u, so such a point
          * cannot be the witness on any rank. */
-        rc = refused_shell(c, ref, &refpos, &nref);
+        rc = refused_shell(c, ref, &refpos, &refnear, &nref);
         nI = d->nP - nref;
     } else if (rc == HD_OK && !done && (pre || (rc = hd__mpi_engine_local(c, &Pv, &Qv, NULL, NULL, &e)) == HD_OK)) {
         /* Unfiltered: the engine's answer is the rank's largest u, which
@@ -533,7 +568,8 @@ int hd__mpi_shell_of(ctx_t *c, const dir_t *d, const hd__box_t *mine, qtree_t *q
     if (rc != HD_OK) {
         hd__mpi_free(c, in, d->nP, 1);
         hd__mpi_free(c, refpos, nref, sizeof(uint32_t));
-        hd__mpi_free(c, own.pos, own.cap, sizeof(uint32_t));
+        hd__mpi_free(c, refnear, nref, sizeof(size_t));
+        refused_free(c, &own);
         return rc;
     }
     size_t nS = d->nP - nI;
@@ -553,7 +589,7 @@ int hd__mpi_shell_of(ctx_t *c, const dir_t *d, const hd__box_t *mine, qtree_t *q
     q->M0 = 1.5 * sqrt(done ? sh->inner.d2 : ref && ref->d2 > e.distance2 ? ref->d2 : e.distance2);
     /* A kept witness is interior: it was not refused. */
     assert(done || !ref || !nref || !bsearch(&(uint32_t){(uint32_t)e.i}, refpos, nref, sizeof *refpos, by_u32));
-    hd__mpi_free(c, own.pos, own.cap, sizeof(uint32_t));
+    refused_free(c, &own);
     if (done) {
         /* the interior's answer is the paired pass's */
     } else if (ref || (nI && in[e.i])) {
@@ -565,6 +601,7 @@ int hd__mpi_shell_of(ctx_t *c, const dir_t *d, const hd__box_t *mine, qtree_t *q
     if (rc == HD_OK && ref) { /* the refused points: a proper subset (the witness is kept) */
         assert(nI > 0);
         sh->own_pos = refpos;
+        sh->nearest = refnear; /* exact over all of Q: nothing unproven */
     } else if (rc == HD_OK && nS && nI) { /* a proper subset: its positions */
         sh->n = nS;
         if (!(sh->own_pos = hd__mpi_alloc(c, nS, sizeof(uint32_t)))) rc = hd__mpi_nomem(c, "the shell", nS);
@@ -574,11 +611,11 @@ int hd__mpi_shell_of(ctx_t *c, const dir_t *d, const hd__box_t *mine, qtree_t *q
     sh->n = nS;
     hd__mpi_free(c, in, d->nP, 1);
     if (rc == HD_OK && nS) {
-        sh->nearest = hd__mpi_alloc(c, nS, sizeof(size_t));
+        if (!ref) sh->nearest = hd__mpi_alloc(c, nS, sizeof(size_t));
         sh->unproven = hd__mpi_alloc(c, nS, 1);
         if (!sh->nearest || !sh->unproven) return hd__mpi_nomem(c, "nearest neighbours", nS);
         memset(sh->unproven, 0, nS);
-        rc = hd__mpi_nearest_in_q(c, d, mine, q, d->P, sh->own_pos, nS, sh->nearest, sh->unproven);
+        if (!ref) rc = hd__mpi_nearest_in_q(c, d, mine, q, d->P, sh->own_pos, nS, sh->nearest, sh->unproven);
     }
     return rc;
 }

@@ -158,6 +158,9 @@ typedef struct {
     const double *p;
     double cut, t2;
     int rule; /* 0: the plane, 1: every third index above t2, 2: none kept */
+    const double *q; /* the other set, for offered */
+    size_t nq;
+    int wrong;       /* offers whose distance or nearest index was not the brute force's */
 } keep_rule_t;
 
 static int keep_by_rule(void *ctx, size_t i, double d2) {
@@ -166,6 +169,17 @@ static int keep_by_rule(void *ctx, size_t i, double d2) {
     if (r->rule == 1) return i % 3 != 0 || d2 <= r->t2;
     double g = r->p[3 * i] - r->cut;
     return g * g > d2;
+}
+
+/* The filter as the engine calls it: each offer is also checked against
+ * the brute force (the point's exact nearest distance, and the smallest
+ * index at it, which the MPI library takes as the point's answer). */
+static int offered(void *ctx, size_t i, double d2, size_t j) {
+    keep_rule_t *r = ctx;
+    size_t want;
+    double w2 = brute_nearest(r->p + 3 * i, r->q, r->nq, &want);
+    r->wrong += !(w2 == d2 && want == j);
+    return keep_by_rule(ctx, i, d2);
 }
 
 /* The brute force's maximum over the points of a the rule keeps (d2 = -1
@@ -186,7 +200,9 @@ TEST(a_filtered_maximum_is_the_maximum_over_the_points_kept) {
      * points its filter keeps (every path of the engine offers each point
      * that may beat the maximum; the refused ones raise no bound), ties
      * to the smallest index, at one thread and at three; copies in one
-     * order (whose correspondence path must not run) included. */
+     * order (whose correspondence path must not run) included.  Every
+     * offer carries the point's exact nearest distance and the smallest
+     * index at it. */
     gen_rng_t g;
     for (uint64_t seed = 7000; seed < 7000 + 40 * K_COUNT && !hdt_failed(); seed++) {
         gen_seed(&g, seed);
@@ -200,7 +216,7 @@ TEST(a_filtered_maximum_is_the_maximum_over_the_points_kept) {
         make_pair(&g, kind, a, na, b, nb);
         if (nb == na && seed % 10 == 0) /* a copy in one order */
             for (size_t k = 0; k < 3 * na; k++) b[k] = a[k] + (k % 3 == 0 ? 1e-3 : 0);
-        keep_rule_t ra = {a, a[3 * (na / 2)], 0, rule}, rb = {b, b[3 * (nb / 2)], 0, rule};
+        keep_rule_t ra = {a, a[3 * (na / 2)], 0, rule, b, nb, 0}, rb = {b, b[3 * (nb / 2)], 0, rule, a, na, 0};
         ra.t2 = rb.t2 = brute_directed(a, na, b, nb).d2 / 4;
         brute_t want_ab = brute_kept(a, na, b, nb, &ra), want_ba = brute_kept(b, nb, a, na, &rb);
         hd_points_t A = hd_points_f64(a, na), B = hd_points_f64(b, nb);
@@ -210,7 +226,7 @@ TEST(a_filtered_maximum_is_the_maximum_over_the_points_kept) {
         hd_options_t o;
         hd_options_init(&o);
         o.threads = threads;
-        hd__keep_t keep[2] = {{keep_by_rule, &ra}, {keep_by_rule, &rb}};
+        hd__keep_t keep[2] = {{offered, &ra}, {offered, &rb}};
         hd_symmetric_t s;
         CHECK_RC(hd__engine_hausdorff_kept(&A, &B, &ba, &bb, &o, keep, &s, NULL), HD_OK);
         CHECK_BITS(s.ab.distance2, want_ab.d2);
@@ -219,6 +235,8 @@ TEST(a_filtered_maximum_is_the_maximum_over_the_points_kept) {
         CHECK_EQ(s.ba.i, want_ba.i);
         if (want_ab.i != HD__NONE) CHECK_EQ(s.ab.j, want_ab.j);
         if (want_ba.i != HD__NONE) CHECK_EQ(s.ba.j, want_ba.j);
+        CHECK_EQ(ra.wrong, 0);
+        CHECK_EQ(rb.wrong, 0);
         free(a);
         free(b);
     }
