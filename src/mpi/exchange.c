@@ -299,8 +299,9 @@ int hd__mpi_exchange(ctx_t *c, const input_t *in, const ranges_t *rg, const node
     /* Destinations that change at more than a quarter of the points are
      * packed without a branch on them (pack_run): at K = 2 a branch
      * mispredicted at random costs more than the tables' 20 instructions
-     * a point, which cost an input in tiles 1.8 ns a point (alternated
-     * runs, docs/benchmarks.md). */
+     * a point; packed so, an input in tiles paid 1.8 ns a point for them
+     * (alternated runs, docs/benchmarks.md), and pays 1.6 for the first
+     * pass's counting now. */
     int scattered = switches > nloc / 4;
     size_t ownat[2] = {base[me], base[K + me]};
     for (uint64_t round = 0; round < rounds; round++) {

@@ -430,8 +430,9 @@ typedef struct {
     uint32_t *pos;           /* refused positions in P (repeats possible) */
     size_t n, cap;
     int overflow;            /* more than cap were refused: pos is partial */
-    size_t *near;            /* each one's nearest position in Q, the engine's
-                                (the smallest index at its u), by pos */
+    uint32_t *near;          /* each one's nearest position in Q, the engine's
+                                (the smallest index at its u), by pos: 4
+                                bytes, as the local sets' positions are */
 } refused_t;
 
 typedef struct pre {

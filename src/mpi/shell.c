@@ -269,7 +269,7 @@ static int keep_clear(void *ctx, size_t i, double d2, size_t j) {
     refused_t *r = ctx;
     if (r->overflow || hd__mpi_faces_clear(r->mine, r->P + 3 * i, d2)) return 1;
     r->d2 = d2 > r->d2 ? d2 : r->d2;
-    if (r->n < r->cap) r->pos[r->n] = (uint32_t)i, r->near[r->n++] = j;
+    if (r->n < r->cap) r->pos[r->n] = (uint32_t)i, r->near[r->n++] = (uint32_t)j;
     else r->overflow = 1;
     return 0;
 }
@@ -281,13 +281,13 @@ static int keep_clear(void *ctx, size_t i, double d2, size_t j) {
 /* The list's arrays, room for r->cap (HD_OK, or the error, charged). */
 static int refused_alloc(ctx_t *c, refused_t *r, size_t n) {
     r->pos = hd__mpi_alloc(c, r->cap, sizeof(uint32_t));
-    r->near = hd__mpi_alloc(c, r->cap, sizeof(size_t));
+    r->near = hd__mpi_alloc(c, r->cap, sizeof(uint32_t));
     return r->pos && r->near ? HD_OK : hd__mpi_nomem(c, "the shell", n);
 }
 
 static void refused_free(ctx_t *c, refused_t *r) {
     hd__mpi_free(c, r->pos, r->cap, sizeof(uint32_t));
-    hd__mpi_free(c, r->near, r->cap, sizeof(size_t));
+    hd__mpi_free(c, r->near, r->cap, sizeof(uint32_t));
     r->pos = NULL;
     r->near = NULL;
     r->cap = 0;
@@ -471,8 +471,7 @@ static int by_u32(const void *x, const void *y) { /* the witness's check below *
 
 /* A refused point and its nearest position in Q, the engine's answer. */
 typedef struct {
-    uint32_t pos;
-    size_t near;
+    uint32_t pos, near;
 } refd_t;
 
 static int by_pos(const void *x, const void *y) {
