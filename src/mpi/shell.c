@@ -462,13 +462,6 @@ uint64_t hd__mpi_shell_g(gcur_t *cu, const shell_t *sh, size_t k) {
     return hd__mpi_gcur_at(cu, sh->own_pos ? sh->own_pos[k] : k);
 }
 
-#ifndef NDEBUG
-static int by_u32(const void *x, const void *y) { /* the witness's check below */
-    uint32_t a = *(const uint32_t *)x, b = *(const uint32_t *)y;
-    return (a > b) - (a < b);
-}
-#endif
-
 /* A refused point and its nearest position in Q, the engine's answer. */
 typedef struct {
     uint32_t pos, near;
@@ -587,7 +580,7 @@ int hd__mpi_shell_of(ctx_t *c, const dir_t *d, const hd__box_t *mine, qtree_t *q
     /* h: the largest u of the rank, the kept points' or the refused ones' */
     q->M0 = 1.5 * sqrt(done ? sh->inner.d2 : ref && ref->d2 > e.distance2 ? ref->d2 : e.distance2);
     /* A kept witness is interior: it was not refused. */
-    assert(done || !ref || !nref || !bsearch(&(uint32_t){(uint32_t)e.i}, refpos, nref, sizeof *refpos, by_u32));
+    for (size_t k = 0; !done && ref && k < nref; k++) assert(refpos[k] != e.i);
     refused_free(c, &own);
     if (done) {
         /* the interior's answer is the paired pass's */

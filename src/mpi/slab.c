@@ -212,42 +212,34 @@ static int slab_search(ctx_t *c, const slab_t *sl, const double *pts, const uint
  * uniform at K = 2).  A copy's shell (its pairs cut by a face: about 200)
  * takes the slab. */
 #define SCAN_MAX 16
+_Static_assert(BRUTE_MAX <= SCAN_MAX, "the few the slab left take the scan's pass");
 
-/* The exact nearest point of Q (smallest index on ties) for each of the
- * n <= SCAN_MAX askers X(k), in one pass over Q.  Each starts from its
- * nearest in a strided sample of Q (an upper bound), and a point b of Q
- * is passed over without a distance when it is provably farther than
- * every asker's bound:
+/* One pass over Q for m <= SCAN_MAX askers, asker t at X(list[t]) (list
+ * NULL: X(t)), each from an upper bound of its nearest, best[t] at Q's
+ * position at[t] (INFINITY and SIZE_MAX: none), which it lowers to the
+ * exact nearest with the smallest index.  A point b of Q is passed over
+ * without a distance when it is provably farther than every asker's
+ * bound:
  *  - beyond the askers' box on an axis: g = fl(b_a - hi_a) > 0 with
  *    fl(g g) > MB, the largest bound (or the same below lo_a).  For an
  *    asker x, x_a <= hi_a, so fl(b_a - x_a) >= g (rounding is monotone),
  *    hd__d2(x, b) >= fl(fl(b_a - x_a)^2) >= fl(g g) (the squared sum only
  *    adds non-negative terms), > MB >= x's bound: farther, not tied;
  *  - for one asker, when fl(dx dx) > its bound (the same argument).
- * Every other b is compared exactly, the smaller index winning a tie, so
- * each answer is the nearest with the smallest index. */
-static void scan_q(const dir_t *d, const double *pts, const uint32_t *pos, size_t n, size_t *near) {
-#define X(k) (pts + 3 * (pos ? pos[k] : (k)))
-    double best[SCAN_MAX], lo[3], hi[3];
-    size_t at[SCAN_MAX];
-    assert(n <= SCAN_MAX && d->nQ > 0);
+ * Every other b is compared exactly, the smaller index winning a tie. */
+static void pass_over_q(const dir_t *d, const double *pts, const uint32_t *pos, const uint32_t *list, size_t m,
+                        double *best, size_t *at) {
+#define X(t) (pts + 3 * (pos ? pos[list ? list[t] : (t)] : list ? list[t] : (t)))
+    double lo[3], hi[3];
+    assert(m > 0 && m <= SCAN_MAX);
     for (int a = 0; a < 3; a++) lo[a] = hi[a] = X(0)[a];
-    for (size_t t = 0; t < n; t++) {
-        best[t] = INFINITY, at[t] = SIZE_MAX;
+    for (size_t t = 1; t < m; t++)
         for (int a = 0; a < 3; a++) {
             lo[a] = X(t)[a] < lo[a] ? X(t)[a] : lo[a];
             hi[a] = X(t)[a] > hi[a] ? X(t)[a] : hi[a];
         }
-    }
-    /* the sample: the bounds the pass starts from */
-    size_t step = d->nQ / 1024 + 1;
-    for (size_t j = 0; j < d->nQ; j += step)
-        for (size_t t = 0; t < n; t++) {
-            double d2 = hd__d2(X(t), d->Q + 3 * j);
-            if (d2 < best[t]) best[t] = d2, at[t] = j; /* j increases: the first at a tie */
-        }
     /* the axes, the askers' thinnest first: most points of Q are beyond
-     * the box on it (the shell lies along a face) */
+     * the box on it (a shell lies along a face) */
     int ax[3] = {0, 1, 2};
     for (int a = 1; a < 3; a++)
         for (int k = a; k > 0 && hi[ax[k]] - lo[ax[k]] < hi[ax[k - 1]] - lo[ax[k - 1]]; k--) {
@@ -256,7 +248,7 @@ static void scan_q(const dir_t *d, const double *pts, const uint32_t *pos, size_
         }
     for (size_t j0 = 0; j0 < d->nQ; j0 += 4096) {
         double MB = 0;
-        for (size_t t = 0; t < n; t++) MB = best[t] > MB ? best[t] : MB;
+        for (size_t t = 0; t < m; t++) MB = best[t] > MB ? best[t] : MB;
         size_t j1 = d->nQ - j0 < 4096 ? d->nQ : j0 + 4096;
         for (size_t j = j0; j < j1; j++) {
             const double *b = d->Q + 3 * j;
@@ -269,7 +261,7 @@ static void scan_q(const dir_t *d, const double *pts, const uint32_t *pos, size_
                 far = g > 0 && g * g > MB;
             }
             if (far) continue;
-            for (size_t t = 0; t < n; t++) {
+            for (size_t t = 0; t < m; t++) {
                 const double *x = X(t);
                 double dx = x[0] - b[0];
                 if (dx * dx > best[t]) continue;
@@ -278,8 +270,23 @@ static void scan_q(const dir_t *d, const double *pts, const uint32_t *pos, size_
             }
         }
     }
-    for (size_t t = 0; t < n; t++) near[t] = at[t];
 #undef X
+}
+
+/* The exact nearest point of Q (smallest index on ties) for each of the
+ * n <= SCAN_MAX askers at pts + 3 pos[k] (pos NULL: pts + 3 k): bounds
+ * from a strided sample of Q, then one pass over it. */
+static void scan_q(const dir_t *d, const double *pts, const uint32_t *pos, size_t n, size_t *near) {
+    double best[SCAN_MAX];
+    assert(n <= SCAN_MAX && d->nQ > 0);
+    for (size_t t = 0; t < n; t++) best[t] = INFINITY, near[t] = SIZE_MAX;
+    size_t step = d->nQ / 1024 + 1;
+    for (size_t j = 0; j < d->nQ; j += step)
+        for (size_t t = 0; t < n; t++) {
+            double d2 = hd__d2(pts + 3 * (pos ? pos[t] : t), d->Q + 3 * j);
+            if (d2 < best[t]) best[t] = d2, near[t] = j; /* j increases: the first at a tie */
+        }
+    pass_over_q(d, pts, pos, NULL, n, best, near);
 }
 
 int hd__mpi_nearest_in_q(ctx_t *c, const dir_t *d, const hd__box_t *r, qtree_t *q, const double *pts,
@@ -315,10 +322,7 @@ int hd__mpi_nearest_in_q(ctx_t *c, const dir_t *d, const hd__box_t *r, qtree_t *
         slab_t *sl = level == 2 ? &q->full : &q->sub;
         double M = level == 2 ? INFINITY : q->M0;
         if (level == 1 && m <= BRUTE_MAX) { /* a few: every point of Q, in one pass */
-            /* Each starts from the slab's answer (an upper bound), and a
-             * point b of Q whose x gap alone exceeds it is passed over:
-             * hd__d2(x, b) >= fl(dx * dx) (the sum only adds non-negative
-             * terms, and rounding is monotone), so b is farther, not tied. */
+            /* each from the slab's answer, an upper bound */
             double best[BRUTE_MAX];
             size_t at[BRUTE_MAX];
             for (size_t t = 0; t < m; t++) {
@@ -326,16 +330,7 @@ int hd__mpi_nearest_in_q(ctx_t *c, const dir_t *d, const hd__box_t *r, qtree_t *
                 at[t] = j;
                 best[t] = j == SIZE_MAX ? INFINITY : hd__d2(X(list[t]), d->Q + 3 * j);
             }
-            for (size_t j = 0; j < d->nQ; j++) {
-                const double *b = d->Q + 3 * j;
-                for (size_t t = 0; t < m; t++) {
-                    const double *x = X(list[t]);
-                    double dx = x[0] - b[0];
-                    if (dx * dx > best[t]) continue;
-                    double d2 = hd__d2(x, b);
-                    if (d2 < best[t] || (d2 == best[t] && j < at[t])) best[t] = d2, at[t] = j;
-                }
-            }
+            pass_over_q(d, pts, pos, list, m, best, at);
             for (size_t t = 0; t < m; t++) near[list[t]] = at[t];
             m = 0;
             break;
