@@ -91,7 +91,7 @@ static void box_task(void *vctx, size_t task, int worker) {
     c->part_box[task] = b;
 }
 
-static void key_task(void *vctx, size_t task, int worker) {
+HD__HOT static void key_task(void *vctx, size_t task, int worker) {
     (void)worker;
     key_ctx *c = vctx;
     size_t lo = task * SLICE, hi = lo + SLICE < c->n ? lo + SLICE : c->n;

@@ -665,10 +665,12 @@ static int tree_directed(const hd__tree_t *ta, const hd__tree_t *tb, hd__max_t *
 
 /* The grid pass is chosen when, run over a sample of each query set, it
  * costs at most GRID_COST distances and nodes per point; otherwise both
- * sets get the bucket trees.  The threshold only has to separate two
- * populations that lie far apart: the costs measured on the benchmark's
- * cases on each side of it are in docs/engine.md, "Step 2: the plan". */
-#define GRID_COST 8.0
+ * sets get the bucket trees.  The threshold separates two populations:
+ * the grid's cases cost 1.0 to 2.2, independent uniform cubes 7.5 to 36
+ * (where the grid pass took 2 to 5 times the trees' time) and the other
+ * tree cases 13 and more.  4 is about the geometric mean of 2.2 and 7.5;
+ * the measurements are in docs/engine.md, "Step 2: the plan". */
+#define GRID_COST 4.0
 
 typedef struct {
     hd__src_t src[2]; /* 0: A, 1: B */

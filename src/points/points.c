@@ -12,6 +12,9 @@
 #include "points/points.h"
 
 #include <math.h>
+#ifdef __SSE2__
+#include <emmintrin.h>
+#endif
 #include <stdlib.h>
 #include <string.h>
 
@@ -54,20 +57,53 @@ void hd_points_get(const hd_points_t *p, size_t k, double out[3]) {
     }
 }
 
-void hd__box_of(const double *xyz, size_t n, hd__box_t *out) {
-    /* In locals, stored once: *out may alias xyz as far as the compiler
-     * knows, so updating it in the loop loaded and stored every bound for
-     * every point (27 instructions a point; 11 now). */
+/* Four points (twelve doubles) a step, as six pairs of lanes: pair j
+ * holds coordinates 2j and 2j + 1 of the step, so coordinate c of the
+ * box is the bound over the lanes holding c.  _mm_min_pd(a, b) is a < b ?
+ * a : b, lane by lane, as the scalar loop's select; |v| <= HD_MAX_COORD is
+ * false for NaN and infinities.  About 9 instructions a point, where the
+ * scalar loop, which the compiler does not vectorise, took 21 to 26. */
+HD__HOT int hd__box_checked(const double *xyz, size_t n, hd__box_t *out) {
     double lo[3] = {xyz[0], xyz[1], xyz[2]}, hi[3] = {xyz[0], xyz[1], xyz[2]};
-    for (size_t k = 1; k < n; k++) {
-        const double *q = xyz + 3 * k;
-        for (int c = 0; c < 3; c++) { /* selects, not branches: the compiler's min and max */
-            lo[c] = q[c] < lo[c] ? q[c] : lo[c];
-            hi[c] = q[c] > hi[c] ? q[c] : hi[c];
+    int ok = 1;
+    size_t k = 0;
+#ifdef __SSE2__
+    if (n >= 4) {
+        const __m128d sign = _mm_set1_pd(-0.0), top = _mm_set1_pd(HD_MAX_COORD);
+        __m128d l[6], h[6], good = _mm_castsi128_pd(_mm_set1_epi32(-1));
+        for (int j = 0; j < 6; j++) l[j] = h[j] = _mm_loadu_pd(xyz + 2 * j);
+        for (; k + 4 <= n; k += 4) {
+            const double *q = xyz + 3 * k;
+            for (int j = 0; j < 6; j++) {
+                __m128d v = _mm_loadu_pd(q + 2 * j);
+                good = _mm_and_pd(good, _mm_cmple_pd(_mm_andnot_pd(sign, v), top));
+                l[j] = _mm_min_pd(v, l[j]);
+                h[j] = _mm_max_pd(v, h[j]);
+            }
+        }
+        ok = _mm_movemask_pd(good) == 3;
+        double L[12], H[12];
+        for (int j = 0; j < 6; j++) _mm_storeu_pd(L + 2 * j, l[j]), _mm_storeu_pd(H + 2 * j, h[j]);
+        for (int j = 0; j < 12; j++) {
+            int c = j % 3;
+            lo[c] = L[j] < lo[c] ? L[j] : lo[c];
+            hi[c] = H[j] > hi[c] ? H[j] : hi[c];
         }
     }
+#endif
+    for (; k < n; k++)
+        for (int c = 0; c < 3; c++) {
+            double v = xyz[3 * k + (size_t)c];
+            ok &= fabs(v) <= HD_MAX_COORD;
+            lo[c] = v < lo[c] ? v : lo[c];
+            hi[c] = v > hi[c] ? v : hi[c];
+        }
+    /* In locals until here: *out may alias xyz as far as the compiler knows. */
     for (int c = 0; c < 3; c++) out->lo[c] = lo[c], out->hi[c] = hi[c];
+    return ok;
 }
+
+void hd__box_of(const double *xyz, size_t n, hd__box_t *out) { (void)hd__box_checked(xyz, n, out); }
 
 int hd__points_aligned(const hd_points_t *p, const char *what, hd_error_t *err) {
     hd__src_t s;

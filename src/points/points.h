@@ -82,6 +82,10 @@ HD__INLINE double hd__box_ub2(const hd__box_t *b, const double *p) {
 
 /* Box of n packed xyz doubles (n > 0). */
 void hd__box_of(const double *xyz, size_t n, hd__box_t *out);
+/* The same box, and whether every coordinate v has |v| <= HD_MAX_COORD
+ * (1; 0 when one is larger, infinite or NaN, and then the box is
+ * meaningless).  The one loop both hd__box_of and hd__points_scan run. */
+int hd__box_checked(const double *xyz, size_t n, hd__box_t *out);
 
 /* The computed lower bound hd__box_lb2 without branches (same values: the
  * gap on each axis is max(lo - p, p - hi, 0), evaluated as in hd__box_lb2). */
@@ -247,13 +251,28 @@ HD__INLINE void hd__src_get(const hd__src_t *s, size_t k, double out[3]) {
  * (keys[i] = key << 32 | i), as the builds and the index's queries sort
  * them.  Inline: an out-of-line call made hd_hausdorff measurably slower
  * (docs/benchmarks.md, "Measurements once quoted in the source"). */
-HD__INLINE void hd__src_keys(const hd__src_t *src, const hd__keygrid_t *grid, size_t lo, size_t hi,
-                             uint64_t *keys) {
+HD__INLINE void hd__src_keys_of(const hd__src_t *src, hd__src_kind_t kind, hd__keygrid_t g, size_t lo,
+                                size_t hi, uint64_t *keys) {
     for (size_t i = lo; i < hi; i++) {
         double p[3];
-        hd__src_get(src, i, p);
-        keys[i] = (uint64_t)hd__key30(grid, p) << 32 | (uint64_t)i;
+        if (kind == HD__SRC_F64) {
+            const double *q = (const double *)(const void *)src->base + 3 * i;
+            p[0] = q[0], p[1] = q[1], p[2] = q[2];
+        } else {
+            hd__src_get(src, i, p);
+        }
+        keys[i] = (uint64_t)hd__key30(&g, p) << 32 | (uint64_t)i;
     }
+}
+
+/* The loop specialised for packed doubles without a transform (the
+ * layout the engine's callers mostly pass), with the grid in locals so
+ * that the stores cannot be taken to change it: about half the
+ * instructions of the general loop (docs/benchmarks.md). */
+HD__INLINE void hd__src_keys(const hd__src_t *src, const hd__keygrid_t *grid, size_t lo, size_t hi,
+                             uint64_t *keys) {
+    if (src->kind == HD__SRC_F64 && !src->T) hd__src_keys_of(src, HD__SRC_F64, *grid, lo, hi, keys);
+    else hd__src_keys_of(src, HD__SRC_ANY, *grid, lo, hi, keys);
 }
 
 

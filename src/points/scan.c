@@ -37,24 +37,21 @@ HD__HOT static void scan_task(void *vctx, size_t task, int worker) {
     (void)worker;
     scan_ctx *c = vctx;
     size_t lo = task * SCAN_SLICE, hi = lo + SCAN_SLICE < c->n ? lo + SCAN_SLICE : c->n;
-    double mn[3], mx[3];
+    const size_t m = hi - lo;
+    if (c->p->dtype == HD_FLOAT64) {
+        c->bad[task] = !hd__box_checked((const double *)c->p->data + 3 * lo, m, &c->part[task]);
+        return;
+    }
+    const float *v = (const float *)c->p->data + 3 * lo;
+    double mn[3] = {v[0], v[1], v[2]}, mx[3] = {v[0], v[1], v[2]};
     int ok = 1;
-    /* One loop, compiled once per element type so that each vectorises. */
-#define SCAN_SLICE_OF(T)                                                     \
-    do {                                                                     \
-        const T *v = (const T *)c->p->data + 3 * lo;                         \
-        for (int k = 0; k < 3; k++) mn[k] = mx[k] = v[k];                    \
-        for (size_t i = 0; i < hi - lo; i++)                                 \
-            for (int k = 0; k < 3; k++) {                                    \
-                double x = v[3 * i + k];                                     \
-                ok &= fabs(x) <= HD_MAX_COORD;                               \
-                mn[k] = x < mn[k] ? x : mn[k];                               \
-                mx[k] = x > mx[k] ? x : mx[k];                               \
-            }                                                                \
-    } while (0)
-    if (c->p->dtype == HD_FLOAT64) SCAN_SLICE_OF(double);
-    else SCAN_SLICE_OF(float);
-#undef SCAN_SLICE_OF
+    for (size_t i = 0; i < m; i++)
+        for (int k = 0; k < 3; k++) {
+            double x = v[3 * i + (size_t)k];
+            ok &= fabs(x) <= HD_MAX_COORD;
+            mn[k] = x < mn[k] ? x : mn[k];
+            mx[k] = x > mx[k] ? x : mx[k];
+        }
     for (int k = 0; k < 3; k++) {
         c->part[task].lo[k] = mn[k];
         c->part[task].hi[k] = mx[k];

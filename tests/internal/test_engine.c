@@ -242,6 +242,51 @@ TEST(a_filtered_maximum_is_the_maximum_over_the_points_kept) {
     }
 }
 
+/* hd__box_checked (the validation's and the local boxes' loop, four
+ * points a step) against one coordinate at a time: the same bounds, bit
+ * for bit but for the sign of a zero bound (which no use of a box sees,
+ * and which depends on the order the points are read in), and a refusal
+ * wherever one coordinate is NaN, infinite or beyond HD_MAX_COORD, at
+ * every position of every size up to 41 (the step's remainder 0 to 3). */
+TEST(the_box_and_its_check_agree_with_a_point_at_a_time) {
+    const double bad[4] = {NAN, INFINITY, -INFINITY, 2 * HD_MAX_COORD};
+    gen_rng_t g;
+    for (size_t n = 1; n <= 41; n++) {
+        uint64_t seed = 7100 + n;
+        gen_seed(&g, seed);
+        CONTEXT("seed=%llu n=%zu", (unsigned long long)seed, n);
+        double *p = malloc(24 * n);
+        for (size_t i = 0; i < 3 * n; i++) {
+            uint64_t r = gen_u64(&g);
+            p[i] = r % 7 == 0 ? 0.0 : r % 7 == 1 ? -0.0 : (gen_unit(&g) - 0.5) * 1e6;
+        }
+        hd__box_t want, got;
+        for (int c = 0; c < 3; c++) want.lo[c] = want.hi[c] = p[c];
+        for (size_t i = 1; i < n; i++)
+            for (int c = 0; c < 3; c++) {
+                double v = p[3 * i + (size_t)c];
+                want.lo[c] = v < want.lo[c] ? v : want.lo[c];
+                want.hi[c] = v > want.hi[c] ? v : want.hi[c];
+            }
+        CHECK_EQ(hd__box_checked(p, n, &got), 1);
+        for (int c = 0; c < 3; c++) {
+            CHECK_EQ(got.lo[c] == want.lo[c], 1);
+            CHECK_EQ(got.hi[c] == want.hi[c], 1);
+        }
+        hd__box_of(p, n, &got);
+        for (int c = 0; c < 3; c++) CHECK_EQ(got.lo[c] == want.lo[c] && got.hi[c] == want.hi[c], 1);
+        for (size_t i = 0; i < 3 * n; i++) {
+            double keep = p[i];
+            p[i] = bad[i % 4];
+            CHECK_EQ(hd__box_checked(p, n, &got), 0);
+            hd_points_t v = hd_points_f64(p, n);
+            CHECK_EQ(hd__points_scan(&v, "set", 1, &got, NULL) != HD_OK, 1);
+            p[i] = keep;
+        }
+        free(p);
+    }
+}
+
 TEST(engine_matches_brute_force_on_large_sets) {
     gen_rng_t g;
     for (int kind = 0; kind < K_COUNT; kind++) {
