@@ -777,6 +777,52 @@ static hd__plan_path_t engine_plan_path(const engine_t *e) {
     return all ? HD__PLAN_PAIRS : e->use_tree ? HD__PLAN_TREES : HD__PLAN_GRID;
 }
 
+/* The mean of a set's points (approximate: for the trees' frame only),
+ * summed by slices of CENTROID_SLICE points over the threads, each in
+ * four running sums per coordinate (the adds do not wait on each other),
+ * and the slices' sums added in order: the same value at any thread
+ * count.  Read only for a moved copy (engine_run), so no other case pays
+ * the pass. */
+#define CENTROID_SLICE 65536
+
+typedef struct {
+    const hd__src_t *src;
+    size_t n;
+    double (*sum)[3];
+} centroid_ctx;
+
+static void centroid_task(void *vctx, size_t task, int worker) {
+    (void)worker;
+    centroid_ctx *c = vctx;
+    size_t lo = task * CENTROID_SLICE, hi = lo + CENTROID_SLICE < c->n ? lo + CENTROID_SLICE : c->n;
+    double sum[4][3] = {{0}};
+    for (size_t i = lo; i < hi; i++) {
+        double p[3];
+        hd__src_get(c->src, i, p);
+        double *t = sum[i & 3];
+        t[0] += p[0], t[1] += p[1], t[2] += p[2];
+    }
+    for (int k = 0; k < 3; k++) c->sum[task][k] = (sum[0][k] + sum[1][k]) + (sum[2][k] + sum[3][k]);
+}
+
+static int centroid_of(const hd__src_t *src, size_t n, int threads, double out[3], hd_error_t *err) {
+    if (n == 0) {
+        out[0] = out[1] = out[2] = 0;
+        return HD_OK;
+    }
+    size_t slices = (n + CENTROID_SLICE - 1) / CENTROID_SLICE;
+    centroid_ctx c = {src, n, hd__malloc_array(slices, sizeof *c.sum)};
+    if (!c.sum) return hd__err(err, HD_ENOMEM, "out of memory");
+    hd__parallel_for(hd__thread_count(threads, slices), slices, centroid_task, &c);
+    for (int k = 0; k < 3; k++) {
+        double t = 0;
+        for (size_t s = 0; s < slices; s++) t += c.sum[s][k];
+        out[k] = t / (double)n;
+    }
+    free(c.sum);
+    return HD_OK;
+}
+
 /* force: the plan's choice, or the grid or the trees forced. */
 static int engine_run(engine_t *e, hd__engine_force_t force, hd_result_t out[2], hd_error_t *err) {
     int rc = engine_plan(e, force, err);
@@ -794,13 +840,6 @@ static int engine_run(engine_t *e, hd__engine_force_t force, hd_result_t out[2],
          * subset, a part, a different shape) shares one grid over both
          * boxes, so that equal points get equal keys. */
         double c[2][3], r = 0, ext = 0, skew = 0, move = 0;
-        for (int s2 = 0; s2 < 2; s2++)
-            for (int k = 0; k < 3; k++) {
-                c[s2][k] = e->grid[s2].centroid[k];
-                double u = c[s2][k] - e->box[s2].lo[k], v = e->box[s2].hi[k] - c[s2][k];
-                r = u > r ? u : r;
-                r = v > r ? v : r;
-            }
         for (int k = 0; k < 3; k++) {
             double x0 = e->box[0].hi[k] - e->box[0].lo[k];
             double dlo = e->box[1].lo[k] - e->box[0].lo[k], dhi = e->box[1].hi[k] - e->box[0].hi[k];
@@ -810,6 +849,14 @@ static int engine_run(engine_t *e, hd__engine_force_t force, hd_result_t out[2],
         }
         hd__box_t g[2];
         if (skew <= 1e-4 * ext && move > 1e-4 * ext) {
+            for (int s2 = 0; s2 < 2; s2++) {
+                if ((rc = centroid_of(&e->src[s2], e->n[s2], e->threads, c[s2], err)) != HD_OK) return rc;
+                for (int k = 0; k < 3; k++) {
+                    double u = c[s2][k] - e->box[s2].lo[k], v = e->box[s2].hi[k] - c[s2][k];
+                    r = u > r ? u : r;
+                    r = v > r ? v : r;
+                }
+            }
             for (int s2 = 0; s2 < 2; s2++)
                 for (int k = 0; k < 3; k++) {
                     g[s2].lo[k] = c[s2][k] - r;

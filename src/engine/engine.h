@@ -273,7 +273,6 @@ typedef struct hd__grid {
     uint32_t *perm;       /* n original indices grouped by cell */
     uint32_t *start;      /* 8^bits + 1 offsets into perm */
     double *rep;          /* per cell x, y, z of its representative; NaN if empty */
-    double centroid[3];   /* mean of the points (approximate; for alignment) */
     hd__reuse_t *pool;     /* where the arrays come from and go back to (or NULL) */
 } hd__grid_t;
 

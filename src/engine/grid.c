@@ -149,7 +149,6 @@ typedef struct {
     uint16_t *cell;             /* n: each point's cell from the first pass, or
                                  * NULL when the second computes it again */
     uint32_t *count[MAX_PARTS]; /* per part: counts, then write positions */
-    double sum[MAX_PARTS][3];   /* per part: sums of the coordinates */
 } build_ctx;
 
 /* Point k of a packed double (HD__SRC_F64) or float (HD__SRC_F32) array,
@@ -192,26 +191,20 @@ HD__INLINE uint32_t geom_cell(geom_t q, const double p[3]) {
 }
 
 /* The first pass over points [lo, hi): each point's cell (kept when
- * c->cell is set), the counts per cell and the sums of the coordinates. */
+ * c->cell is set) and the counts per cell. */
 HD__INLINE void count_range(build_ctx *c, size_t part, size_t lo, size_t hi, hd__src_kind_t kind,
                             int keep) {
     const hd__src_t src = c->g->src;
     const geom_t q = geom_of(c->g);
     uint32_t *h = c->count[part];
     uint16_t *cell = c->cell;
-    /* Four running sums per coordinate (points i mod 4), so that the adds
-     * do not wait on each other. */
-    double sum[4][3] = {{0}};
     for (size_t i = lo; i < hi; i++) {
         double p[3];
         src_point(&src, kind, i, p);
         uint32_t k = geom_cell(q, p);
         if (keep) cell[i] = (uint16_t)k;
         h[k]++;
-        double *t = sum[i & 3];
-        t[0] += p[0], t[1] += p[1], t[2] += p[2];
     }
-    for (int k = 0; k < 3; k++) c->sum[part][k] = (sum[0][k] + sum[1][k]) + (sum[2][k] + sum[3][k]);
 }
 
 /* The second pass: each point to its place, in input order within a cell,
@@ -316,11 +309,6 @@ int hd__grid_build(hd__grid_t *g, const hd__src_t *src, size_t n, const hd__box_
     }
     if (ok) {
         hd__parallel_for(c.parts, (size_t)c.parts, count_task, &c);
-        for (int k = 0; k < 3; k++) {
-            double t = 0;
-            for (int p = 0; p < c.parts; p++) t += c.sum[p][k];
-            g->centroid[k] = t / (double)n;
-        }
         /* Cell starts, and each part's first write position in each cell
          * (parts in order, so the order within a cell is the input order). */
         uint32_t sum = 0;

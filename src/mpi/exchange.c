@@ -198,7 +198,9 @@ int hd__mpi_exchange(ctx_t *c, const input_t *in, const ranges_t *rg, const node
      * starts, sdisp[2], and a cursor in it, sfill[2]; one side's counts and
      * displacements for MPI: sc sd rcn rd */
     int *cnt = hd__mpi_alloc(c, 16 * (size_t)K, sizeof(int));
-    size_t *base = hd__mpi_alloc(c, 4 * (size_t)K, sizeof(size_t)); /* base[s K + r], then got[s K + r] */
+    /* base[s K + r], then got[s K + r]; then big[2 r + s], the first
+     * pass's counts (tot) in size_t, checked against INT_MAX once */
+    size_t *base = hd__mpi_alloc(c, 6 * (size_t)K, sizeof(size_t));
     void *dest = hd__mpi_scratch(c, nloc, (size_t)w);
     const hd_mpi_part_t **order[2] = {NULL, NULL};
     uint32_t *off[2] = {NULL, NULL};
@@ -213,7 +215,7 @@ int hd__mpi_exchange(ctx_t *c, const input_t *in, const ranges_t *rg, const node
     if (!cnt || !base || !dest || !order[0] || !order[1]) rc = hd__mpi_nomem(c, "the exchange", nloc);
     int *tot = cnt, *rtot = cnt + 2 * K, *per = cnt + 4 * K, *rper = cnt + 6 * K, *sdisp = cnt + 8 * K,
         *sfill = cnt + 10 * K, *sc = cnt + 12 * K, *sd = cnt + 13 * K, *rcn = cnt + 14 * K, *rd = cnt + 15 * K;
-    size_t *got = base + 2 * K, own = 0, switches = 0; /* points whose destination is not the previous one's */
+    size_t *got = base + 2 * K, *big = base + 4 * K, own = 0, switches = 0; /* points whose destination is not the previous one's */
     /* The rounds: round q walks the input positions [tb[q], tb[q + 1]),
      * up to the (q + 1) C-th point for another rank (the last to the end),
      * and sends rcnt[q 2K + 2 r + s] points of side s to rank r. */
@@ -222,7 +224,7 @@ int hd__mpi_exchange(ctx_t *c, const input_t *in, const ranges_t *rg, const node
     int *rcnt = hd__mpi_alloc(c, maxr * 2 * (size_t)K, sizeof(int));
     if (rc == HD_OK && (!tb || !rcnt)) rc = hd__mpi_nomem(c, "the exchange's rounds", maxr);
     if (rc == HD_OK) {
-        memset(tot, 0, 2 * (size_t)K * sizeof(int));
+        memset(big, 0, 2 * (size_t)K * sizeof(size_t));
         memset(rcnt, 0, maxr * 2 * (size_t)K * sizeof(int));
         size_t t = 0, out = 0, q = 0, cut = C; /* cut: where round q ends, (q + 1) C points sent */
         int prev = -1, *row = rcnt;              /* row: round q's counts */
@@ -241,8 +243,7 @@ int hd__mpi_exchange(ctx_t *c, const input_t *in, const ranges_t *rg, const node
                     dest_set(dest, w, t, r);
                     switches += (size_t)(r != prev);
                     prev = r;
-                    if (tot[2 * r + s] == INT_MAX) rc = HD_EOVERFLOW;
-                    else tot[2 * r + s]++;
+                    big[2 * r + s]++;
                     /* No branch on whether the point stays: in an input
                      * that is not in space's order it does at random (half
                      * the points at K = 2), and the branch was mispredicted
@@ -257,6 +258,10 @@ int hd__mpi_exchange(ctx_t *c, const input_t *in, const ranges_t *rg, const node
         }
         nr = q + 1;
         tb[nr] = nloc;
+        for (int k = 0; k < 2 * K; k++) {
+            if (big[k] > INT_MAX) rc = HD_EOVERFLOW;
+            tot[k] = big[k] > INT_MAX ? INT_MAX : (int)big[k];
+        }
         if (rc != HD_OK)
             rc = hd__err(&c->e, HD_EOVERFLOW, "more than 2^31 - 1 points of a set to send from rank %d to one rank",
                          c->rank);
@@ -419,7 +424,7 @@ done:
     hd__mpi_free(c, tb, maxr + 1, sizeof(size_t));
     hd__mpi_free(c, rcnt, maxr * 2 * (size_t)K, sizeof(int));
     hd__mpi_free(c, cnt, 16 * (size_t)K, sizeof(int));
-    hd__mpi_free(c, base, 4 * (size_t)K, sizeof(size_t));
+    hd__mpi_free(c, base, 6 * (size_t)K, sizeof(size_t));
     hd__mpi_free_scratch(c, dest, nloc, (size_t)w);
     for (int s = 0; s < 2; s++) {
         hd__mpi_free(c, order[s], in->nparts[s], sizeof *order[s]);
