@@ -342,6 +342,11 @@ int hd__grid_directed(const hd__grid_t *ga, const hd__grid_t *gb, hd__max_t *m, 
 void hd__grid_prime(const hd__grid_t *ga, const hd__grid_t *gb, hd__max_t *m,
                     hd__counts_t *counts);
 
+/* The same from A's points alone, before A has a grid: of every
+ * `step`-th point of A, the PRIME_CELLS lying where B is emptiest. */
+void hd__grid_prime_sampled(const hd__src_t *a, size_t na, size_t step, const hd__grid_t *gb,
+                            hd__max_t *m, hd__counts_t *counts);
+
 /* Prime m with the exact nearest distances of points of a sample of A
  * chosen where the maximum is likely, then run the grid pass over the
  * sample; returns its work (distances and nodes) per sampled point, or

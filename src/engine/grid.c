@@ -665,6 +665,39 @@ void hd__grid_prime(const hd__grid_t *ga, const hd__grid_t *gb, hd__max_t *m,
     }
 }
 
+/* As hd__grid_prime, from every step-th point of A instead of A's
+ * representatives: what the plan can prime with before A's grid exists.
+ * A sample follows A's density rather than its extent, so it finds fewer
+ * of the far, sparse places where the maximum tends to be; the plan only
+ * decides on it where that cannot make the grid look cheaper than it is
+ * (engine.c, engine_plan). */
+void hd__grid_prime_sampled(const hd__src_t *a, size_t na, size_t step, const hd__grid_t *gb,
+                            hd__max_t *m, hd__counts_t *counts) {
+    size_t pick[PRIME_CELLS];
+    double score[PRIME_CELLS];
+    int np = 0;
+    hd__box_t gbox;
+    for (int k = 0; k < 3; k++) {
+        gbox.lo[k] = gb->lo[k];
+        gbox.hi[k] = gb->lo[k] + gb->w * (double)(1u << gb->bits);
+    }
+    for (size_t i = 0; i < na; i += step) {
+        double p[3];
+        hd__src_get(a, i, p);
+        uint32_t cb = cell_of(gb, p);
+        uint32_t count = gb->start[cb + 1] - gb->start[cb];
+        double sc = count ? 1.0 / (double)count : 2.0 + hd__box_lb2(&gbox, p);
+        hd__top_insert(score, pick, &np, PRIME_CELLS, sc, i);
+    }
+    for (int k = 0; k < np; k++) {
+        double p[3];
+        hd__src_get(a, pick[k], p);
+        hd__hit_t hit;
+        hd__grid_nearest(gb, p, 0.0, -1.0, &hit, counts);
+        hd__max_offer(m, hit.d2, pick[k], hit.j, NULL);
+    }
+}
+
 /* Prime m for h(A,B) and measure what the grid pass costs: take a strided
  * sample of A; in a few rounds, resolve exactly the sampled points that
  * neither the representative of their cell nor any point found so far

@@ -604,6 +604,93 @@ TEST(independent_clouds_and_shuffled_copies_do_not_take_the_correspondence_path)
     free(b);
 }
 
+/* The plan's early decision (engine.c, EARLY_COST): two independent
+ * uniform cubes of 300K points cost more than EARLY_COST in h(A,B)'s trial
+ * on B's grid alone, so the trees are taken before A's grid is built, and
+ * h(B,A)'s trial is never run (cost 0).  The answer is the one both paths
+ * forced give, bit for bit, witnesses included; each path is checked
+ * against the brute force on the smaller cases above. */
+TEST(uniform_cubes_take_the_trees_before_a_grid_of_a_is_built) {
+    gen_rng_t g;
+    gen_seed(&g, 12150);
+    CONTEXT("seed=12150");
+    size_t n = 300000;
+    double *a = malloc(24 * n), *b = malloc(24 * n);
+    gen_cube(&g, a, n, 0.0, 1.0);
+    gen_cube(&g, b, n, 0.0, 1.0);
+    hd_points_t A = hd_points_f64(a, n), B = hd_points_f64(b, n);
+    hd_options_t o;
+    hd_options_init(&o);
+    hd__engine_plan_t e;
+    CHECK_RC(hd__engine_explain(&A, &B, &o, &e, NULL, 0, NULL), HD_OK);
+    CHECK_EQ(e.path, HD__PLAN_TREES);
+    CHECK(e.grid_cost[0] > 8.0);
+    CHECK_BITS(e.grid_cost[1], 0.0);
+    hd_symmetric_t s[3];
+    for (int f = 0; f < 3; f++) CHECK_RC(hd__engine_forced(&A, &B, &o, (hd__engine_force_t)f, &s[f], NULL), HD_OK);
+    for (int f = 1; f < 3; f++) {
+        CHECK_BITS(s[0].ab.distance2, s[f].ab.distance2);
+        CHECK_BITS(s[0].ba.distance2, s[f].ba.distance2);
+        CHECK_EQ(s[0].ab.i, s[f].ab.i);
+        CHECK_EQ(s[0].ab.j, s[f].ab.j);
+        CHECK_EQ(s[0].ba.i, s[f].ba.i);
+        CHECK_EQ(s[0].ba.j, s[f].ba.j);
+    }
+    free(a);
+    free(b);
+}
+
+/* The early decision under a filter, as the MPI library runs the engine:
+ * only A's points with x < 0.003 are kept (about 900 of 300K), the answer
+ * is the brute force's over them, and every point offered (the sampled
+ * prime's, the trial's, the walk's) comes with its exact nearest distance
+ * and smallest nearest index. */
+typedef struct {
+    const double *a, *b;
+    size_t nb, offers, wrong;
+} slab_rule_t;
+
+static int keep_thin_slab(void *ctx, size_t i, double d2, size_t j) {
+    slab_rule_t *r = ctx;
+    size_t want;
+    r->offers++;
+    r->wrong += !(brute_nearest(r->a + 3 * i, r->b, r->nb, &want) == d2 && want == j);
+    return r->a[3 * i] < 0.003;
+}
+
+TEST(the_early_decision_keeps_a_filtered_maximum_exact) {
+    gen_rng_t g;
+    gen_seed(&g, 12160);
+    CONTEXT("seed=12160");
+    size_t n = 300000;
+    double *a = malloc(24 * n), *b = malloc(24 * n);
+    gen_cube(&g, a, n, 0.0, 1.0);
+    gen_cube(&g, b, n, 0.0, 1.0);
+    brute_t want = {-1.0, HD__NONE, HD__NONE};
+    for (size_t i = 0; i < n; i++) {
+        if (!(a[3 * i] < 0.003)) continue;
+        size_t j;
+        double d2 = brute_nearest(a + 3 * i, b, n, &j);
+        if (d2 > want.d2) want = (brute_t){d2, i, j};
+    }
+    hd_points_t A = hd_points_f64(a, n), B = hd_points_f64(b, n);
+    hd__box_t ba, bb;
+    hd__box_of(a, n, &ba);
+    hd__box_of(b, n, &bb);
+    hd_options_t o;
+    hd_options_init(&o);
+    slab_rule_t rule = {a, b, n, 0, 0};
+    hd__keep_t keep = {keep_thin_slab, &rule};
+    hd_result_t r;
+    CHECK_RC(hd__engine_directed_kept(&A, &B, &ba, &bb, &o, &keep, &r, NULL), HD_OK);
+    CHECK_EQ(rule.wrong, 0);
+    CHECK_BITS(r.distance2, want.d2);
+    CHECK_EQ(r.i, want.i);
+    CHECK_EQ(r.j, want.j);
+    free(a);
+    free(b);
+}
+
 TEST(a_copy_with_more_exchanged_partners_than_the_list_falls_back_exactly) {
     gen_rng_t g;
     gen_seed(&g, 12200);
