@@ -123,6 +123,14 @@ static size_t walk_avail(const input_t *in, const hd_mpi_part_t **order[2], walk
     return 0;
 }
 
+/* The box of n points (none: unchanged) merged into *b. */
+static void box_run(hd__box_t *b, const double *xyz, size_t n) {
+    if (n == 0) return;
+    hd__box_t r;
+    hd__box_of(xyz, n, &r);
+    hd__box_merge(b, &r);
+}
+
 /* Where one part's run of points goes in a round: each point's
  * coordinates and number to its slot in the local arrays (lx, lo at
  * *own, when it stays) or in the send buffer (sx, so at sfill[2 r + s]).
@@ -280,6 +288,7 @@ int hd__mpi_exchange(ctx_t *c, const input_t *in, const ranges_t *rg, const node
             m += (size_t)rtot[2 * r + s];
         }
         loc->n[s] = m;
+        for (int k = 0; k < 3; k++) loc->box[s].lo[k] = INFINITY, loc->box[s].hi[k] = -INFINITY;
         if (m > INT_MAX) {
             rc = hd__err(&c->e, HD_EOVERFLOW, "more than 2^31 - 1 points of %s to receive on rank %d",
                          s ? "B" : "A", c->rank);
@@ -335,10 +344,13 @@ int hd__mpi_exchange(ctx_t *c, const input_t *in, const ranges_t *rg, const node
             at.k += m;
             at.num[s] += m;
         }
-        /* The numbers are encoded while in the cache, as if the runs were
-         * in index order (else encoded again below). */
-        for (int s = 0; s < 2; s++)
+        /* The numbers are encoded, and the points' box taken, while in the
+         * cache: the numbers as if the runs were in index order (else
+         * encoded again below). */
+        for (int s = 0; s < 2; s++) {
             hd__mpi_gidx_put_numbers(&loc->gi[s], rg, me, own0[s], off[s] + own0[s], ownat[s] - own0[s]);
+            box_run(&loc->box[s], loc->xyz[s] + 3 * own0[s], ownat[s] - own0[s]);
+        }
         MPI_GO(c, rc, MPI_Alltoall(per, 2, MPI_INT, rper, 2, MPI_INT, c->comm));
         for (int s = 0; s < 2; s++) {
             for (int r = 0; r < K; r++) {
@@ -351,7 +363,10 @@ int hd__mpi_exchange(ctx_t *c, const input_t *in, const ranges_t *rg, const node
             MPI_GO(c, rc, MPI_Alltoallv(sx, sc, sd, c->q_type, loc->xyz[s], rcn, rd, c->q_type, c->comm));
             MPI_GO(c, rc, MPI_Alltoallv(so, sc, sd, MPI_UINT32_T, off[s], rcn, rd, MPI_UINT32_T, c->comm));
             for (int r = 0; r < K; r++)
-                if (r != me) hd__mpi_gidx_put_numbers(&loc->gi[s], rg, r, (size_t)rd[r], off[s] + rd[r], (size_t)rcn[r]);
+                if (r != me) {
+                    hd__mpi_gidx_put_numbers(&loc->gi[s], rg, r, (size_t)rd[r], off[s] + rd[r], (size_t)rcn[r]);
+                    box_run(&loc->box[s], loc->xyz[s] + 3 * (size_t)rd[r], (size_t)rcn[r]);
+                }
         }
     }
     hd__mpi_free_scratch(c, sx, sendcap, 3 * sizeof(double));

@@ -222,9 +222,7 @@ int hd__mpi_spread(ctx_t *c, const input_t *in, const ranges_t *rg, const uint64
     held_t h;
     for (int s = 0; s < 2; s++) {
         h.n[s] = sp->loc.n[s];
-        if (sp->loc.n[s]) hd__box_of(sp->loc.xyz[s], sp->loc.n[s], &h.box[s]);
-        else
-            for (int k = 0; k < 3; k++) h.box[s].lo[k] = INFINITY, h.box[s].hi[k] = -INFINITY;
+        h.box[s] = sp->loc.box[s]; /* taken by the exchange as the points arrived */
     }
     MPI_TRY(c, MPI_Allgather(&h, (int)sizeof h, MPI_BYTE, sp->held, (int)sizeof h, MPI_BYTE, c->comm));
     return HD_OK;

@@ -325,6 +325,7 @@ int hd__mpi_asked(const node_t *t, const hd__box_t *nbox, const held_t *held, in
 
 typedef struct {
     double *xyz[2];
+    hd__box_t box[2];        /* the exact box of each side's points (empty: lo > hi) */
     gidx_t gi[2];            /* their global indices */
     int merged[2];           /* the senders' runs were merged, */
     size_t *start[2];        /* else K + 1 a side: each sender's run */

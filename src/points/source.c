@@ -12,7 +12,9 @@
  * words (a 30-bit Morton key above a 32-bit point index): three stable
  * counting passes of 10 bits, each counted and scattered in parallel parts
  * whose offsets come from a prefix sum in part order, so the result is the
- * same at any thread count.  Stability makes equal keys keep increasing
+ * same at any thread count.  With one part, the three digits are counted
+ * in one read of the words before the first pass (a pass permutes the
+ * words, which leaves every digit's counts as they were).  Stability makes equal keys keep increasing
  * index order, which is what makes every order built on it a function of
  * the input alone.  The engine's builds, the index's queries and the
  * all-nearest structures all sort with it.
@@ -89,11 +91,24 @@ int hd__radix_sort(uint64_t **a, uint64_t **tmp, size_t n, int threads) {
     c.n = n;
     c.parts = parts;
     c.hist = hist;
+    /* One part: the three digits' counts in one read of the words (a
+     * permutation does not change them), not one read a pass. */
+    size_t (*all)[RADIX] = NULL;
+    if (parts == 1 && (all = hd__calloc_array(3, sizeof *all)) != NULL) {
+        const uint64_t *w = *a;
+        for (size_t k = 0; k < n; k++) {
+            uint64_t v = w[k];
+            all[0][(v >> 32) & (RADIX - 1)]++;
+            all[1][(v >> (32 + RADIX_BITS)) & (RADIX - 1)]++;
+            all[2][(v >> (32 + 2 * RADIX_BITS)) & (RADIX - 1)]++;
+        }
+    }
     for (int pass = 0; pass < 3; pass++) {
         c.src = *a;
         c.dst = *tmp;
         c.shift = 32 + RADIX_BITS * pass;
-        hd__parallel_for(parts, (size_t)parts, radix_count, &c);
+        if (all) memcpy(hist[0], all[pass], sizeof all[pass]);
+        else hd__parallel_for(parts, (size_t)parts, radix_count, &c);
         size_t sum = 0;
         for (unsigned d = 0; d < RADIX; d++)
             for (int p = 0; p < parts; p++) {
@@ -106,6 +121,7 @@ int hd__radix_sort(uint64_t **a, uint64_t **tmp, size_t n, int threads) {
         *a = *tmp;
         *tmp = s;
     }
+    free(all);
     free(hist);
     return HD_OK;
 }
