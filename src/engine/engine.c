@@ -599,7 +599,7 @@ static void walk_task(void *vctx, size_t task, int worker) {
 #define PRIME_SPREAD 64
 #define PRIME_BUCKETS 16
 
-static void prime(dir_ctx *c) {
+static void prime(dir_ctx *c, const size_t *seed, int nseed) {
     const hd__tree_t *ta = c->ta;
     walk_t s;
     /* The points discarded here are walked again later: count the work, not
@@ -607,6 +607,11 @@ static void prime(dir_ctx *c) {
     worker_t w;
     memset(&w, 0, sizeof w);
     walk_init(&s, c, &w);
+    for (int k = 0; k < nseed; k++) {
+        double a[3];
+        hd__src_get(&ta->src, seed[k], a);
+        resolve_point(&s, a, seed[k]);
+    }
     size_t step = ta->n / PRIME_SPREAD + 1;
     for (size_t k = step / 2; k < ta->n; k += step) {
         double a[3];
@@ -634,7 +639,8 @@ static void prime(dir_ctx *c) {
 
 /* The tree walk of h(A,B) over built trees, into the shared maximum m. */
 static int tree_directed(const hd__tree_t *ta, const hd__tree_t *tb, hd__max_t *m, int threads,
-                         hd__counts_t *counts, uint64_t *culled, hd_error_t *err) {
+                         const size_t *seed, int nseed, hd__counts_t *counts, uint64_t *culled,
+                         hd_error_t *err) {
     dir_ctx c;
     memset(&c, 0, sizeof c);
     c.ta = ta;
@@ -649,7 +655,7 @@ static int tree_directed(const hd__tree_t *ta, const hd__tree_t *tb, hd__max_t *
     if (threads < 1) threads = 1;
     c.w = hd__calloc_array((size_t)threads, sizeof *c.w);
     if (!c.w) return hd__err(err, HD_ENOMEM, "out of memory");
-    prime(&c);
+    prime(&c, seed, nseed);
     hd__parallel_for(threads, tasks, walk_task, &c);
     for (int k = 0; k < threads; k++) {
         counts->evals += c.w[k].counts.evals;
@@ -699,6 +705,8 @@ typedef struct {
     hd__counts_t counts[2];
     uint64_t culled[2];
     double cost[2];
+    size_t seed[HD__PRIME_CELLS]; /* h(B,A)'s prime after an early decision */
+    int nseed;
     hd__reuse_t pool;      /* the grids' and trees' arrays, reused as they are freed */
 } engine_t;
 
@@ -733,6 +741,27 @@ static int engine_init(engine_t *e, const hd_points_t *A, const hd_points_t *B,
         }
         e->max_ready = d + 1;
     }
+    return HD_OK;
+}
+
+/* h(B,A)'s prime when the early decision leaves A without a grid: the
+ * representatives of B's cells farthest from a grid of every
+ * SEED_STEP-th point of A (hd__grid_prime_picks_far), kept in e->seed for
+ * the tree walk's prime to resolve exactly once A's tree is built.  The
+ * sample's grid costs about a ninth of A's.  Without the seeds h(B,A)'s
+ * walk started from a weaker maximum (docs/engine.md, "Step 2"). */
+#define SEED_STEP 8
+
+static int early_seeds(engine_t *e, hd_error_t *err) {
+    hd__src_t sub = e->src[0];
+    sub.kind = HD__SRC_ANY; /* every SEED_STEP-th point: the stride grows */
+    sub.ps *= SEED_STEP;
+    size_t ns = (e->n[0] + SEED_STEP - 1) / SEED_STEP;
+    hd__grid_t gs;
+    int rc = hd__grid_build(&gs, &sub, ns, &e->box[0], e->threads, &e->pool, err);
+    if (rc) return rc;
+    e->nseed = hd__grid_prime_picks_far(&e->grid[1], &gs, e->seed);
+    hd__grid_free(&gs);
     return HD_OK;
 }
 
@@ -776,7 +805,7 @@ static int engine_plan(engine_t *e, hd__engine_force_t force, hd_error_t *err) {
         if (early_cost > EARLY_COST) {
             e->cost[0] = early_cost;
             e->use_tree = 1;
-            return HD_OK;
+            return e->directions == 2 && !e->pairs.resolved[1] ? early_seeds(e, err) : HD_OK;
         }
     }
     if ((rc = hd__grid_build(&e->grid[0], &e->src[0], e->n[0], &e->box[0], e->threads, &e->pool, err)))
@@ -912,8 +941,8 @@ static int engine_run(engine_t *e, hd__engine_force_t force, hd_result_t out[2],
         if (e->pairs.resolved[d])
             rc = HD_OK;
         else if (e->use_tree)
-            rc = tree_directed(&e->tree[d], &e->tree[1 - d], &e->max[d], e->threads, &e->counts[d],
-                               &e->culled[d], err);
+            rc = tree_directed(&e->tree[d], &e->tree[1 - d], &e->max[d], e->threads, d ? e->seed : NULL,
+                               d ? e->nseed : 0, &e->counts[d], &e->culled[d], err);
         else
             rc = hd__grid_directed(&e->grid[d], &e->grid[1 - d], &e->max[d], e->threads,
                                    &e->counts[d], &e->culled[d], err);
@@ -943,7 +972,7 @@ int hd__engine_trees(const hd__tree_t *ta, const hd__tree_t *tb, int threads, hd
     if (hd__max_init(&m) != HD_OK) return hd__err(err, HD_ETHREAD, "cannot create a mutex");
     hd__counts_t counts = {0, 0, 0};
     uint64_t culled = 0;
-    int rc = tree_directed(ta, tb, &m, threads, &counts, &culled, err);
+    int rc = tree_directed(ta, tb, &m, threads, NULL, 0, &counts, &culled, err);
     if (rc == HD_OK) {
         memset(out, 0, sizeof *out);
         out->distance2 = m.best.d2;

@@ -337,10 +337,15 @@ HD__INLINE int hd__kills(double cmax2, const hd__best_t *snap, double d2, size_t
 int hd__grid_directed(const hd__grid_t *ga, const hd__grid_t *gb, hd__max_t *m, int threads,
                       hd__counts_t *counts, uint64_t *culled, hd_error_t *err);
 
-/* Prime m with the exact nearest distances of the representatives of A's
- * cells (ga) that lie where B is emptiest. */
+/* Prime m with the exact nearest distances of the HD__PRIME_CELLS
+ * representatives of A's cells (ga) that lie where B is emptiest. */
+#define HD__PRIME_CELLS 32
 void hd__grid_prime(const hd__grid_t *ga, const hd__grid_t *gb, hd__max_t *m,
                     hd__counts_t *counts);
+/* The representatives of A's cells farthest from a grid gs of a sample of
+ * B, for when B has no grid of its own yet: their indices into A (out),
+ * their number returned. */
+int hd__grid_prime_picks_far(const hd__grid_t *ga, const hd__grid_t *gs, size_t out[HD__PRIME_CELLS]);
 
 /* The same from A's points alone, before A has a grid: of every
  * `step`-th point of A, the PRIME_CELLS lying where B is emptiest. */

@@ -635,7 +635,7 @@ int hd__grid_directed(const hd__grid_t *ga, const hd__grid_t *gb, hd__max_t *m, 
  * lying where B is emptiest (B's cells there empty, or nearly) are where
  * the maximum is likely; the PRIME_CELLS of them with the fewest points of
  * B around get exact nearest-neighbour searches in B. */
-#define PRIME_CELLS 32
+#define PRIME_CELLS HD__PRIME_CELLS
 
 void hd__grid_prime(const hd__grid_t *ga, const hd__grid_t *gb, hd__max_t *m,
                     hd__counts_t *counts) {
@@ -663,6 +663,31 @@ void hd__grid_prime(const hd__grid_t *ga, const hd__grid_t *gb, hd__max_t *m,
         hd__grid_nearest(gb, ga->rep + 3 * (size_t)pick[k], 0.0, -1.0, &hit, counts);
         hd__max_offer(m, hit.d2, i, hit.j, NULL);
     }
+}
+
+/* The HD__PRIME_CELLS representatives of A's cells (ga) farthest from a
+ * sample of B (gs, a grid of every few points of B): their distance to
+ * the nearest sampled point bounds their nearest distance in B from above,
+ * and is large only where B is sparse or absent, which is where
+ * hd__grid_prime looks.  A search stops as soon as it finds a sampled
+ * point nearer than the 32nd-largest distance so far (that representative
+ * is not among them), so most end in the first cell they read.  For the
+ * plan's early decision (engine.c), which has no grid of B to count in. */
+int hd__grid_prime_picks_far(const hd__grid_t *ga, const hd__grid_t *gs, size_t out[HD__PRIME_CELLS]) {
+    size_t cells = (size_t)1 << (3 * ga->bits);
+    size_t pick[HD__PRIME_CELLS];
+    double score[HD__PRIME_CELLS];
+    int np = 0;
+    hd__counts_t work = {0, 0, 0};
+    for (size_t c = 0; c < cells; c++) {
+        if (ga->start[c] == ga->start[c + 1]) continue;
+        double bar = np == HD__PRIME_CELLS ? score[np - 1] : 0.0;
+        hd__hit_t hit;
+        hd__grid_nearest(gs, ga->rep + 3 * c, bar, -1.0, &hit, &work);
+        if (!hit.killed) hd__top_insert(score, pick, &np, HD__PRIME_CELLS, hit.d2, c);
+    }
+    for (int k = 0; k < np; k++) out[k] = ga->perm[ga->start[pick[k]]];
+    return np;
 }
 
 /* As hd__grid_prime, from every step-th point of A instead of A's

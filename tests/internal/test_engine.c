@@ -640,25 +640,36 @@ TEST(uniform_cubes_take_the_trees_before_a_grid_of_a_is_built) {
     free(b);
 }
 
-/* The early decision under a filter, as the MPI library runs the engine:
- * only A's points with x < 0.003 are kept (about 900 of 300K), the answer
- * is the brute force's over them, and every point offered (the sampled
- * prime's, the trial's, the walk's) comes with its exact nearest distance
- * and smallest nearest index. */
+/* The early decision under filters, as the MPI library runs the engine:
+ * in each direction only the points with x < 0.003 are kept (about 900 of
+ * 300K), each answer is the brute force's over them, and every point
+ * offered (the sampled prime's, the trial's, the seeds of h(B,A) chosen
+ * without A's grid, the walk's) comes with its exact nearest distance and
+ * smallest nearest index. */
 typedef struct {
     const double *a, *b;
-    size_t nb, offers, wrong;
+    size_t nb, wrong;
 } slab_rule_t;
 
 static int keep_thin_slab(void *ctx, size_t i, double d2, size_t j) {
     slab_rule_t *r = ctx;
     size_t want;
-    r->offers++;
     r->wrong += !(brute_nearest(r->a + 3 * i, r->b, r->nb, &want) == d2 && want == j);
     return r->a[3 * i] < 0.003;
 }
 
-TEST(the_early_decision_keeps_a_filtered_maximum_exact) {
+static brute_t brute_thin_slab(const double *a, size_t na, const double *b, size_t nb) {
+    brute_t want = {-1.0, HD__NONE, HD__NONE};
+    for (size_t i = 0; i < na; i++) {
+        if (!(a[3 * i] < 0.003)) continue;
+        size_t j;
+        double d2 = brute_nearest(a + 3 * i, b, nb, &j);
+        if (d2 > want.d2) want = (brute_t){d2, i, j};
+    }
+    return want;
+}
+
+TEST(the_early_decision_keeps_filtered_maxima_exact) {
     gen_rng_t g;
     gen_seed(&g, 12160);
     CONTEXT("seed=12160");
@@ -666,27 +677,25 @@ TEST(the_early_decision_keeps_a_filtered_maximum_exact) {
     double *a = malloc(24 * n), *b = malloc(24 * n);
     gen_cube(&g, a, n, 0.0, 1.0);
     gen_cube(&g, b, n, 0.0, 1.0);
-    brute_t want = {-1.0, HD__NONE, HD__NONE};
-    for (size_t i = 0; i < n; i++) {
-        if (!(a[3 * i] < 0.003)) continue;
-        size_t j;
-        double d2 = brute_nearest(a + 3 * i, b, n, &j);
-        if (d2 > want.d2) want = (brute_t){d2, i, j};
-    }
+    brute_t want_ab = brute_thin_slab(a, n, b, n), want_ba = brute_thin_slab(b, n, a, n);
     hd_points_t A = hd_points_f64(a, n), B = hd_points_f64(b, n);
     hd__box_t ba, bb;
     hd__box_of(a, n, &ba);
     hd__box_of(b, n, &bb);
     hd_options_t o;
     hd_options_init(&o);
-    slab_rule_t rule = {a, b, n, 0, 0};
-    hd__keep_t keep = {keep_thin_slab, &rule};
-    hd_result_t r;
-    CHECK_RC(hd__engine_directed_kept(&A, &B, &ba, &bb, &o, &keep, &r, NULL), HD_OK);
-    CHECK_EQ(rule.wrong, 0);
-    CHECK_BITS(r.distance2, want.d2);
-    CHECK_EQ(r.i, want.i);
-    CHECK_EQ(r.j, want.j);
+    slab_rule_t ra = {a, b, n, 0}, rb = {b, a, n, 0};
+    hd__keep_t keep[2] = {{keep_thin_slab, &ra}, {keep_thin_slab, &rb}};
+    hd_symmetric_t s;
+    CHECK_RC(hd__engine_hausdorff_kept(&A, &B, &ba, &bb, &o, keep, &s, NULL), HD_OK);
+    CHECK_EQ(ra.wrong, 0);
+    CHECK_EQ(rb.wrong, 0);
+    CHECK_BITS(s.ab.distance2, want_ab.d2);
+    CHECK_EQ(s.ab.i, want_ab.i);
+    CHECK_EQ(s.ab.j, want_ab.j);
+    CHECK_BITS(s.ba.distance2, want_ba.d2);
+    CHECK_EQ(s.ba.i, want_ba.i);
+    CHECK_EQ(s.ba.j, want_ba.j);
     free(a);
     free(b);
 }
