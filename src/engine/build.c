@@ -362,18 +362,23 @@ static int tree_sort(hd__tree_t *t, const hd__src_t *src, size_t n, const hd__bo
     t->grid = kc.grid;
     hd__parallel_for(threads, slices, key_task, &kc);
     if ((rc = hd__radix_sort(&keys, &tmp, n, threads))) goto done;
-    for (size_t s = 0; s < n;) {
-        size_t e = s + 1;
+    /* The runs of equal keys longer than a bucket: the keys are sorted, so
+     * such a run starting at s has key(s) = key(s + HD__BUCKET), and the
+     * first k where that holds is a run's start (an earlier k of the same
+     * run would hold it too).  Comparing each key with the one a bucket on
+     * needs no branch that depends on the run lengths. */
+    for (size_t s = 0; s + HD__BUCKET < n; s++) {
+        if ((keys[s] ^ keys[s + HD__BUCKET]) >> 32) continue;
+        assert(s == 0 || keys[s - 1] >> 32 != keys[s] >> 32);
+        size_t e = s + HD__BUCKET + 1;
         while (e < n && keys[e] >> 32 == keys[s] >> 32) e++;
-        if (e - s > HD__BUCKET) {
-            /* Refining re-keys the run on its own grid; the run's key on
-             * the set's grid is put back afterwards, so that the keys kept
-             * (t->fkey) are all on one grid and never decrease. */
-            uint64_t top = keys[s] >> 32 << 32;
-            if ((rc = refine(src, keys + s, tmp + s, e - s, 0))) goto done;
-            for (size_t i = s; i < e; i++) keys[i] = top | (keys[i] & 0xffffffffu);
-        }
-        s = e;
+        /* Refining re-keys the run on its own grid; the run's key on
+         * the set's grid is put back afterwards, so that the keys kept
+         * (t->fkey) are all on one grid and never decrease. */
+        uint64_t top = keys[s] >> 32 << 32;
+        if ((rc = refine(src, keys + s, tmp + s, e - s, 0))) goto done;
+        for (size_t i = s; i < e; i++) keys[i] = top | (keys[i] & 0xffffffffu);
+        s = e - 1; /* the loop goes on at e */
     }
     /* tmp is spare now: perm and fkey go there, read from the sorted keys. */
     t->perm = (uint32_t *)tmp;

@@ -1008,6 +1008,48 @@ TEST(the_tree_path_holds_at_most_16_bytes_a_point_and_reports_it) {
  * 14.4 in one block).  The pool's peak is checked against that, with room
  * for the blocks' rounding and their header pages; without huge pages it
  * is lower still. */
+/* Two runs of 64 equal Morton keys next to each other in key order (two
+ * clusters in neighbouring cells of the 1024^3 grid, each two blobs of 32
+ * points listed alternately) are both refined: each of the four buckets
+ * they fill holds one blob, so its box is a blob's (1e-5 wide), not the
+ * cluster's (8e-4).  The second run starts right where the first ends. */
+TEST(adjacent_crowded_cells_are_each_refined) {
+    size_t n = 32 + 128 + 1;
+    double *p = malloc(24 * n);
+    gen_rng_t g;
+    gen_seed(&g, 8400);
+    CONTEXT("seed=8400");
+    size_t k = 0;
+    for (int i = 0; i < 32; i++, k++) p[3 * k] = p[3 * k + 1] = p[3 * k + 2] = 0.0;
+    for (int c = 0; c < 2; c++)
+        for (int i = 0; i < 64; i++, k++) {
+            p[3 * k] = (512 + c) / 1024.0 + (i % 2 ? 8e-4 : 0.0) + 1e-5 * gen_unit(&g);
+            p[3 * k + 1] = 0.5 + 1e-5 * gen_unit(&g);
+            p[3 * k + 2] = 0.5 + 1e-5 * gen_unit(&g);
+        }
+    p[3 * k] = p[3 * k + 1] = p[3 * k + 2] = 1.0;
+    hd_points_t P = hd_points_f64(p, n);
+    hd__src_t src[2];
+    hd__box_t box[2];
+    size_t nn[2] = {n, n};
+    for (int s = 0; s < 2; s++) {
+        hd__src_init(&src[s], &P, NULL);
+        CHECK_RC(hd__points_scan(&P, "set", 1, &box[s], NULL), HD_OK);
+    }
+    hd__reuse_t pool;
+    hd__reuse_init(&pool);
+    hd__tree_t t[2];
+    CHECK_RC(hd__tree_build_pair(t, src, nn, box, 1, &pool, NULL), HD_OK);
+    for (size_t b = 1; b <= 4; b++) {
+        const hd__box_t *x = &t[0].bucket[b].box;
+        CHECK(x->hi[0] - x->lo[0] < 1e-4);
+    }
+    hd__tree_free(&t[0]);
+    hd__tree_free(&t[1]);
+    hd__reuse_free(&pool);
+    free(p);
+}
+
 TEST(a_pair_of_trees_keeps_both_quantised_copies_in_one_block) {
     static const size_t sizes[][2] = {{250000, 250000}, {300000, 30000}, {30000, 300000}, {5, 1}, {65536, 65537}};
     for (size_t c = 0; c < sizeof sizes / sizeof sizes[0]; c++) {
