@@ -748,9 +748,10 @@ static int engine_init(engine_t *e, const hd_points_t *A, const hd_points_t *B,
  * representatives of B's cells farthest from a grid of every
  * SEED_STEP-th point of A (hd__grid_prime_picks_far), kept in e->seed for
  * the tree walk's prime to resolve exactly once A's tree is built.  The
- * sample's grid costs about a ninth of A's.  Without the seeds h(B,A)'s
- * walk started from a weaker maximum (docs/engine.md, "Step 2"). */
-#define SEED_STEP 8
+ * sample's grid has the cells A's own would have (hd__grid_build_as), so
+ * its searches read few points a cell.  Without the seeds h(B,A)'s walk
+ * started from a weaker maximum (docs/engine.md, "Step 2"). */
+#define SEED_STEP 16
 
 static int early_seeds(engine_t *e, hd_error_t *err) {
     hd__src_t sub = e->src[0];
@@ -758,7 +759,7 @@ static int early_seeds(engine_t *e, hd_error_t *err) {
     sub.ps *= SEED_STEP;
     size_t ns = (e->n[0] + SEED_STEP - 1) / SEED_STEP;
     hd__grid_t gs;
-    int rc = hd__grid_build(&gs, &sub, ns, &e->box[0], e->threads, &e->pool, err);
+    int rc = hd__grid_build_as(&gs, &sub, ns, e->n[0], &e->box[0], e->threads, &e->pool, err);
     if (rc) return rc;
     e->nseed = hd__grid_prime_picks_far(&e->grid[1], &gs, e->seed);
     hd__grid_free(&gs);

@@ -279,6 +279,10 @@ typedef struct hd__grid {
 /* The grid's arrays come from `pool` (NULL: plain allocations). */
 int hd__grid_build(hd__grid_t *g, const hd__src_t *src, size_t n, const hd__box_t *box,
                    int threads, hd__reuse_t *pool, hd_error_t *err);
+/* The same with the cells a set of n_cells points would get (a sample's
+ * grid as fine as its set's). */
+int hd__grid_build_as(hd__grid_t *g, const hd__src_t *src, size_t n, size_t n_cells,
+                      const hd__box_t *box, int threads, hd__reuse_t *pool, hd_error_t *err);
 void hd__grid_free(hd__grid_t *g);
 
 /* Exact nearest neighbour of q in g, with the early stop of hd__tree_nearest

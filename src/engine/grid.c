@@ -279,6 +279,11 @@ void hd__grid_free(hd__grid_t *g) {
 
 int hd__grid_build(hd__grid_t *g, const hd__src_t *src, size_t n, const hd__box_t *box,
                    int threads, hd__reuse_t *pool, hd_error_t *err) {
+    return hd__grid_build_as(g, src, n, n, box, threads, pool, err);
+}
+
+int hd__grid_build_as(hd__grid_t *g, const hd__src_t *src, size_t n, size_t n_cells,
+                      const hd__box_t *box, int threads, hd__reuse_t *pool, hd_error_t *err) {
     memset(g, 0, sizeof *g);
     g->pool = pool;
     if (n > UINT32_MAX)
@@ -286,7 +291,7 @@ int hd__grid_build(hd__grid_t *g, const hd__src_t *src, size_t n, const hd__box_
                        "the auto engine indexes at most 4294967295 points per set, not %zu", n);
     g->n = n;
     g->src = *src;
-    grid_geometry(g, box, n);
+    grid_geometry(g, box, n_cells);
     size_t cells = (size_t)1 << (3 * g->bits);
     build_ctx c;
     memset(&c, 0, sizeof c);
