@@ -128,6 +128,17 @@ static void grid_geometry(hd__grid_t *g, const hd__box_t *box, size_t n) {
     g->margin = 1e-12 * (G * g->w + mag);
 }
 
+/* The box the grid's cells cover: every point the grid was built over
+ * lies in it (grid_geometry rounds the cell width up). */
+static hd__box_t grid_extent(const hd__grid_t *g) {
+    hd__box_t b;
+    for (int k = 0; k < 3; k++) {
+        b.lo[k] = g->lo[k];
+        b.hi[k] = g->lo[k] + g->w * (double)(1u << g->bits);
+    }
+    return b;
+}
+
 /* The conservative box of the octree node at `level` with Morton prefix p. */
 static inline void node_box(const hd__grid_t *g, int level, uint32_t p, hd__box_t *b) {
     uint32_t c[3] = {compact8(p), compact8(p >> 1), compact8(p >> 2)};
@@ -635,6 +646,16 @@ int hd__grid_directed(const hd__grid_t *ga, const hd__grid_t *gb, hd__max_t *m, 
     return HD_OK;
 }
 
+/* Offer point i of a to m with its exact nearest distance in B's grid
+ * gb; *hit gets the search's answer. */
+static void offer_nearest(const hd__src_t *a, size_t i, const hd__grid_t *gb, hd__max_t *m,
+                          hd__counts_t *counts, hd__hit_t *hit) {
+    double p[3];
+    hd__src_get(a, i, p);
+    hd__grid_nearest(gb, p, 0.0, -1.0, hit, counts);
+    hd__max_offer(m, hit->d2, i, hit->j, NULL);
+}
+
 /* Prime m for h(A,B) from A's own grid: the representatives of A's cells
  * cover the space A occupies evenly, whatever its density, so the ones
  * lying where B is emptiest (B's cells there empty, or nearly) are where
@@ -648,11 +669,7 @@ void hd__grid_prime(const hd__grid_t *ga, const hd__grid_t *gb, hd__max_t *m,
     size_t pick[PRIME_CELLS];
     double score[PRIME_CELLS];
     int np = 0;
-    hd__box_t gbox;
-    for (int k = 0; k < 3; k++) {
-        gbox.lo[k] = gb->lo[k];
-        gbox.hi[k] = gb->lo[k] + gb->w * (double)(1u << gb->bits);
-    }
+    const hd__box_t gbox = grid_extent(gb);
     for (size_t c = 0; c < cells; c++) {
         if (ga->start[c] == ga->start[c + 1]) continue;
         const double *p = ga->rep + 3 * c;
@@ -662,11 +679,9 @@ void hd__grid_prime(const hd__grid_t *ga, const hd__grid_t *gb, hd__max_t *m,
         double sc = count ? 1.0 / (double)count : 2.0 + hd__box_lb2(&gbox, p);
         hd__top_insert(score, pick, &np, PRIME_CELLS, sc, c);
     }
-    for (int k = 0; k < np; k++) {
-        size_t i = ga->perm[ga->start[pick[k]]];
+    for (int k = 0; k < np; k++) { /* the cell's representative: its first point */
         hd__hit_t hit;
-        hd__grid_nearest(gb, ga->rep + 3 * (size_t)pick[k], 0.0, -1.0, &hit, counts);
-        hd__max_offer(m, hit.d2, i, hit.j, NULL);
+        offer_nearest(&ga->src, ga->perm[ga->start[pick[k]]], gb, m, counts, &hit);
     }
 }
 
@@ -706,11 +721,7 @@ void hd__grid_prime_sampled(const hd__src_t *a, size_t na, size_t step, const hd
     size_t pick[PRIME_CELLS];
     double score[PRIME_CELLS];
     int np = 0;
-    hd__box_t gbox;
-    for (int k = 0; k < 3; k++) {
-        gbox.lo[k] = gb->lo[k];
-        gbox.hi[k] = gb->lo[k] + gb->w * (double)(1u << gb->bits);
-    }
+    const hd__box_t gbox = grid_extent(gb);
     for (size_t i = 0; i < na; i += step) {
         double p[3];
         hd__src_get(a, i, p);
@@ -720,11 +731,8 @@ void hd__grid_prime_sampled(const hd__src_t *a, size_t na, size_t step, const hd
         hd__top_insert(score, pick, &np, PRIME_CELLS, sc, i);
     }
     for (int k = 0; k < np; k++) {
-        double p[3];
-        hd__src_get(a, pick[k], p);
         hd__hit_t hit;
-        hd__grid_nearest(gb, p, 0.0, -1.0, &hit, counts);
-        hd__max_offer(m, hit.d2, pick[k], hit.j, NULL);
+        offer_nearest(a, pick[k], gb, m, counts, &hit);
     }
 }
 
@@ -745,11 +753,7 @@ double hd__grid_trial(const hd__src_t *a, size_t na, const hd__grid_t *gb, hd__m
     size_t ns = na < RATE_SAMPLE ? na : RATE_SAMPLE;
     double found[RATE_ROUNDS * RATE_RESOLVE][3];
     int nf = 0;
-    hd__box_t gbox;
-    for (int k = 0; k < 3; k++) {
-        gbox.lo[k] = gb->lo[k];
-        gbox.hi[k] = gb->lo[k] + gb->w * (double)(1u << gb->bits);
-    }
+    const hd__box_t gbox = grid_extent(gb);
     for (int round = 0; round <= RATE_ROUNDS; round++) {
         hd__best_t snap;
         hd__max_snapshot(m, &snap);
@@ -776,11 +780,8 @@ double hd__grid_trial(const hd__src_t *a, size_t na, const hd__grid_t *gb, hd__m
         }
         if (round == RATE_ROUNDS || np == 0) break;
         for (int k = 0; k < np; k++) {
-            double p[3];
-            hd__src_get(a, pick[k], p);
             hd__hit_t hit;
-            hd__grid_nearest(gb, p, 0.0, -1.0, &hit, counts);
-            hd__max_offer(m, hit.d2, pick[k], hit.j, NULL);
+            offer_nearest(a, pick[k], gb, m, counts, &hit);
             memcpy(found[nf++], hit.p, sizeof found[0]);
         }
     }

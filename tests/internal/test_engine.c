@@ -610,15 +610,19 @@ TEST(independent_clouds_and_shuffled_copies_do_not_take_the_correspondence_path)
  * h(B,A)'s trial is never run (cost 0).  The answer is the one both paths
  * forced give, bit for bit, witnesses included; each path is checked
  * against the brute force on the smaller cases above. */
-TEST(uniform_cubes_take_the_trees_before_a_grid_of_a_is_built) {
+/* Two independent uniform cubes of n points (seed printed on failure). */
+static void two_cubes(uint64_t seed, size_t n, double **a, double **b, hd_points_t *A, hd_points_t *B) {
     gen_rng_t g;
-    gen_seed(&g, 12150);
-    CONTEXT("seed=12150");
+    gen_seed(&g, seed);
+    CONTEXT("seed=%llu n=%zu", (unsigned long long)seed, n);
+    gen_cube_pair(&g, n, n, a, b, A, B);
+}
+
+TEST(uniform_cubes_take_the_trees_before_a_grid_of_a_is_built) {
     size_t n = 300000;
-    double *a = malloc(24 * n), *b = malloc(24 * n);
-    gen_cube(&g, a, n, 0.0, 1.0);
-    gen_cube(&g, b, n, 0.0, 1.0);
-    hd_points_t A = hd_points_f64(a, n), B = hd_points_f64(b, n);
+    double *a, *b;
+    hd_points_t A, B;
+    two_cubes(12150, n, &a, &b, &A, &B);
     hd_options_t o;
     hd_options_init(&o);
     hd__engine_plan_t e;
@@ -670,15 +674,11 @@ static brute_t brute_thin_slab(const double *a, size_t na, const double *b, size
 }
 
 TEST(the_early_decision_keeps_filtered_maxima_exact) {
-    gen_rng_t g;
-    gen_seed(&g, 12160);
-    CONTEXT("seed=12160");
     size_t n = 300000;
-    double *a = malloc(24 * n), *b = malloc(24 * n);
-    gen_cube(&g, a, n, 0.0, 1.0);
-    gen_cube(&g, b, n, 0.0, 1.0);
+    double *a, *b;
+    hd_points_t A, B;
+    two_cubes(12160, n, &a, &b, &A, &B);
     brute_t want_ab = brute_thin_slab(a, n, b, n), want_ba = brute_thin_slab(b, n, a, n);
-    hd_points_t A = hd_points_f64(a, n), B = hd_points_f64(b, n);
     hd__box_t ba, bb;
     hd__box_of(a, n, &ba);
     hd__box_of(b, n, &bb);
