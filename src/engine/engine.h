@@ -352,7 +352,7 @@ void hd__grid_prime(const hd__grid_t *ga, const hd__grid_t *gb, hd__max_t *m,
 int hd__grid_prime_picks_far(const hd__grid_t *ga, const hd__grid_t *gs, size_t out[HD__PRIME_CELLS]);
 
 /* The same from A's points alone, before A has a grid: of every
- * `step`-th point of A, the PRIME_CELLS lying where B is emptiest. */
+ * `step`-th point of A, the HD__PRIME_CELLS lying where B is emptiest. */
 void hd__grid_prime_sampled(const hd__src_t *a, size_t na, size_t step, const hd__grid_t *gb,
                             hd__max_t *m, hd__counts_t *counts);
 

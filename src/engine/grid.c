@@ -656,28 +656,31 @@ static void offer_nearest(const hd__src_t *a, size_t i, const hd__grid_t *gb, hd
     hd__max_offer(m, hit->d2, i, hit->j, NULL);
 }
 
+/* How empty B's grid gb is at p, higher being emptier: the inverse of
+ * the points in p's cell of B, or for an empty cell 2 plus p's squared
+ * distance to the box gb covers (gbox = grid_extent(gb)). */
+static double emptiness(const hd__grid_t *gb, const hd__box_t *gbox, const double p[3]) {
+    uint32_t cb = cell_of(gb, p);
+    uint32_t count = gb->start[cb + 1] - gb->start[cb];
+    return count ? 1.0 / (double)count : 2.0 + hd__box_lb2(gbox, p);
+}
+
 /* Prime m for h(A,B) from A's own grid: the representatives of A's cells
  * cover the space A occupies evenly, whatever its density, so the ones
  * lying where B is emptiest (B's cells there empty, or nearly) are where
- * the maximum is likely; the PRIME_CELLS of them with the fewest points of
- * B around get exact nearest-neighbour searches in B. */
-#define PRIME_CELLS HD__PRIME_CELLS
+ * the maximum is likely; the HD__PRIME_CELLS of them with the fewest
+ * points of B around get exact nearest-neighbour searches in B. */
 
 void hd__grid_prime(const hd__grid_t *ga, const hd__grid_t *gb, hd__max_t *m,
                     hd__counts_t *counts) {
     size_t cells = (size_t)1 << (3 * ga->bits);
-    size_t pick[PRIME_CELLS];
-    double score[PRIME_CELLS];
+    size_t pick[HD__PRIME_CELLS];
+    double score[HD__PRIME_CELLS];
     int np = 0;
     const hd__box_t gbox = grid_extent(gb);
     for (size_t c = 0; c < cells; c++) {
         if (ga->start[c] == ga->start[c + 1]) continue;
-        const double *p = ga->rep + 3 * c;
-        uint32_t cb = cell_of(gb, p);
-        uint32_t count = gb->start[cb + 1] - gb->start[cb];
-        /* Higher is emptier: empty cells by their distance to B's box. */
-        double sc = count ? 1.0 / (double)count : 2.0 + hd__box_lb2(&gbox, p);
-        hd__top_insert(score, pick, &np, PRIME_CELLS, sc, c);
+        hd__top_insert(score, pick, &np, HD__PRIME_CELLS, emptiness(gb, &gbox, ga->rep + 3 * c), c);
     }
     for (int k = 0; k < np; k++) { /* the cell's representative: its first point */
         hd__hit_t hit;
@@ -718,17 +721,14 @@ int hd__grid_prime_picks_far(const hd__grid_t *ga, const hd__grid_t *gs, size_t 
  * (engine.c, engine_plan). */
 void hd__grid_prime_sampled(const hd__src_t *a, size_t na, size_t step, const hd__grid_t *gb,
                             hd__max_t *m, hd__counts_t *counts) {
-    size_t pick[PRIME_CELLS];
-    double score[PRIME_CELLS];
+    size_t pick[HD__PRIME_CELLS];
+    double score[HD__PRIME_CELLS];
     int np = 0;
     const hd__box_t gbox = grid_extent(gb);
     for (size_t i = 0; i < na; i += step) {
         double p[3];
         hd__src_get(a, i, p);
-        uint32_t cb = cell_of(gb, p);
-        uint32_t count = gb->start[cb + 1] - gb->start[cb];
-        double sc = count ? 1.0 / (double)count : 2.0 + hd__box_lb2(&gbox, p);
-        hd__top_insert(score, pick, &np, PRIME_CELLS, sc, i);
+        hd__top_insert(score, pick, &np, HD__PRIME_CELLS, emptiness(gb, &gbox, p), i);
     }
     for (int k = 0; k < np; k++) {
         hd__hit_t hit;

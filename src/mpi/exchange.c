@@ -24,6 +24,9 @@
  *    in order, and encoded again from the merged indices when they were
  *    not; the numbers and indices are freed before the call goes on.
  *    Nothing reorders the local arrays' indices afterwards.
+ *  - loc->box is the exact box of each side's local points, merged from
+ *    each run as it lands (the rank's own, each sender's): the same points
+ *    as the local arrays hold, in whatever order the merge leaves them.
  */
 #include "mpi_int.h"
 

@@ -14,9 +14,9 @@
  * whose offsets come from a prefix sum in part order, so the result is the
  * same at any thread count.  With one part, the three digits are counted
  * in one read of the words before the first pass (a pass permutes the
- * words, which leaves every digit's counts as they were).  Stability makes equal keys keep increasing
- * index order, which is what makes every order built on it a function of
- * the input alone.  The engine's builds, the index's queries and the
+ * words, which leaves every digit's counts as they were).  Stability makes
+ * equal keys keep increasing index order, which is what makes every order
+ * built on it a function of the input alone.  The engine's builds, the index's queries and the
  * all-nearest structures all sort with it.
  */
 #include "points/points.h"
