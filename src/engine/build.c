@@ -192,13 +192,17 @@ HD__HOT static void make_bucket(hd__tree_t *t, size_t b) {
     double err = 0;
     for (int c = 0; c < 3; c++) {
         const double *v = p[c];
-        /* Four running extremes each: independent chains, no branches. */
-        double l4[4] = {v[0], v[1], v[2], v[3]}, h4[4] = {v[0], v[1], v[2], v[3]};
-        for (int k = 4; k < HD__BUCKET; k += 4)
-            for (int r = 0; r < 4; r++) {
-                l4[r] = v[k + r] < l4[r] ? v[k + r] : l4[r];
-                h4[r] = v[k + r] > h4[r] ? v[k + r] : h4[r];
-            }
+        /* Four running extremes in a vector each (HD__V4_MIN/MAX: a compare
+         * and a select per four values; GCC leaves the scalar ternaries of
+         * these loops scalar): the same values as the scalar loops. */
+        hd__v4d l4, h4, a;
+        __builtin_memcpy(&l4, v, sizeof l4);
+        h4 = l4;
+        for (int k = 4; k < HD__BUCKET; k += 4) {
+            __builtin_memcpy(&a, v + k, sizeof a);
+            HD__V4_MIN(l4, a);
+            HD__V4_MAX(h4, a);
+        }
         double lo = l4[0], hi = h4[0];
         for (int r = 1; r < 4; r++) {
             lo = l4[r] < lo ? l4[r] : lo;
@@ -208,19 +212,32 @@ HD__HOT static void make_bucket(hd__tree_t *t, size_t b) {
         bk->box.hi[c] = hi;
         double step = (hi - lo) * (1.0 / 65535.0);
         double inv = step > 0 ? 1.0 / step : 0.0;
+        /* Quantise, dequantise and measure four values at a time, with the
+         * scalar code's operations in its order (a - lo, times inv, plus
+         * 0.5, the smaller of that and 65535, truncated; lo + q * step, as
+         * hd__bucket_decode computes it): the same values.  The largest |d|
+         * is the larger of the largest d and the largest -d (both start
+         * at 0). */
+        typedef int32_t v4i __attribute__((vector_size(16), aligned(4)));
+        const hd__v4d lo4 = {lo, lo, lo, lo}, step4 = {step, step, step, step},
+                      inv4 = {inv, inv, inv, inv}, half4 = {0.5, 0.5, 0.5, 0.5},
+                      top4 = {65535.0, 65535.0, 65535.0, 65535.0};
         int32_t qi[HD__BUCKET];
-        for (int k = 0; k < HD__BUCKET; k++) {
-            double u = (v[k] - lo) * inv + 0.5; /* >= 0.5: v[k] >= lo */
-            qi[k] = (int32_t)(u < 65535.0 ? u : 65535.0);
+        hd__v4d dh = {0, 0, 0, 0}, dl = {0, 0, 0, 0};
+        for (int k = 0; k < HD__BUCKET; k += 4) {
+            __builtin_memcpy(&a, v + k, sizeof a);
+            hd__v4d u = (a - lo4) * inv4 + half4, m = top4; /* u >= 0.5: v[k] >= lo */
+            HD__V4_MIN(m, u);
+            v4i qk = __builtin_convertvector(m, v4i);
+            __builtin_memcpy(qi + k, &qk, sizeof qk);
+            hd__v4d d = a - (lo4 + __builtin_convertvector(qk, hd__v4d) * step4);
+            HD__V4_MAX(dh, d);
+            HD__V4_MIN(dl, d);
         }
-        double e4[4] = {0, 0, 0, 0};
-        for (int k = 0; k < HD__BUCKET; k += 4)
-            for (int r = 0; r < 4; r++) {
-                /* The dequantised value exactly as hd__bucket_decode computes it. */
-                double d = fabs(v[k + r] - (lo + (double)qi[k + r] * step));
-                e4[r] = d > e4[r] ? d : e4[r];
-            }
-        for (int r = 0; r < 4; r++) err = e4[r] > err ? e4[r] : err;
+        for (int r = 0; r < 4; r++) {
+            err = dh[r] > err ? dh[r] : err;
+            err = -dl[r] > err ? -dl[r] : err;
+        }
         for (int k = 0; k < HD__BUCKET; k++) q[c * HD__BUCKET + k] = (uint16_t)qi[k];
     }
     /* sqrt(3) rounded up, and slack for the rounding of this product. */

@@ -143,6 +143,13 @@ typedef int64_t hd__v4l __attribute__((vector_size(32), aligned(8)));
         (m) = (hd__v4d)(((hd__v4l)(c) & lt_) | ((hd__v4l)(m) & ~lt_));             \
     } while (0)
 
+/* m = c > m ? c : m in each lane. */
+#define HD__V4_MAX(m, c)                                                           \
+    do {                                                                           \
+        hd__v4l gt_ = (c) > (m);                                                   \
+        (m) = (hd__v4d)(((hd__v4l)(c) & gt_) | ((hd__v4l)(m) & ~gt_));             \
+    } while (0)
+
 HD__INLINE double hd__min32(const double *c) {
     hd__v4d m0, m1, a, b;
     __builtin_memcpy(&m0, c, sizeof m0);

@@ -1050,6 +1050,83 @@ TEST(adjacent_crowded_cells_are_each_refined) {
     free(p);
 }
 
+/* Bucket b of t against its specification, one value at a time: the box
+ * is the exact extremes of its points; each coordinate's code is
+ * (v - lo) / step + 1/2 truncated (at most 65535), step = (hi - lo) /
+ * 65535; err is sqrt(3) (with slack) times the largest |v - (lo + code
+ * step)|, the dequantised value as hd__bucket_decode computes it; a short
+ * bucket's padding repeats its point 0. */
+static void check_bucket_spec(const hd__tree_t *t, const hd_points_t *P, size_t b) {
+    int m = hd__bucket_size(t, b);
+    const hd__bucket_t *bk = &t->bucket[b];
+    const uint16_t *q = t->q + b * 3 * HD__BUCKET;
+    double err = 0;
+    for (int c = 0; c < 3; c++) {
+        double v[HD__BUCKET];
+        for (int k = 0; k < HD__BUCKET; k++) {
+            double p[3];
+            hd_points_get(P, t->perm[b * HD__BUCKET + (size_t)(k < m ? k : 0)], p);
+            v[k] = p[c];
+        }
+        double lo = v[0], hi = v[0];
+        for (int k = 1; k < HD__BUCKET; k++) {
+            lo = v[k] < lo ? v[k] : lo;
+            hi = v[k] > hi ? v[k] : hi;
+        }
+        CHECK_BITS(bk->box.lo[c], lo);
+        CHECK_BITS(bk->box.hi[c], hi);
+        double step = (hi - lo) * (1.0 / 65535.0), inv = step > 0 ? 1.0 / step : 0.0;
+        for (int k = 0; k < HD__BUCKET; k++) {
+            double u = (v[k] - lo) * inv + 0.5;
+            int32_t code = (int32_t)(u < 65535.0 ? u : 65535.0);
+            CHECK_EQ(q[c * HD__BUCKET + k], (uint16_t)code);
+            double d = fabs(v[k] - (lo + (double)code * step));
+            err = d > err ? d : err;
+        }
+    }
+    CHECK_BITS(bk->err, err * 1.7320508075688776 * (1 + 1e-12));
+}
+
+TEST(every_bucket_is_quantised_as_specified) {
+    enum { UNIFORM, FAR, TINY, LATTICE, FLAT, HUGE_RANGE, CASES };
+    static const char *const name[CASES] = {"uniform", "far", "tiny", "lattice", "flat", "huge"};
+    for (int c = 0; c < CASES; c++) {
+        uint64_t seed = 8500 + (uint64_t)c;
+        gen_rng_t g;
+        gen_seed(&g, seed);
+        size_t n[2] = {3000 + 17 * (size_t)c, 2000 + 33 * (size_t)c}; /* short last buckets */
+        CONTEXT("seed=%llu case=%s na=%zu nb=%zu", (unsigned long long)seed, name[c], n[0], n[1]);
+        double *xyz[2];
+        hd_points_t P[2];
+        hd__src_t src[2];
+        hd__box_t box[2];
+        for (int s = 0; s < 2; s++) {
+            xyz[s] = malloc(24 * n[s]);
+            if (c == LATTICE) gen_lattice(&g, xyz[s], n[s], 6); /* duplicates in every bucket */
+            else gen_cube(&g, xyz[s], n[s], 0.0, 1.0);
+            if (c == FAR) gen_affine(xyz[s], n[s], 1e-3, 1e9);
+            if (c == TINY) gen_affine(xyz[s], n[s], 1e-9, 0.0);
+            if (c == HUGE_RANGE) gen_affine(xyz[s], n[s], 1.9e153, -0.95e153); /* near HD_MAX_COORD */
+            if (c == FLAT)
+                for (size_t k = 0; k < n[s]; k++) xyz[s][3 * k + 2] = 0.25; /* step 0 on z */
+            P[s] = hd_points_f64(xyz[s], n[s]);
+            hd__src_init(&src[s], &P[s], NULL);
+            CHECK_RC(hd__points_scan(&P[s], "set", 1, &box[s], NULL), HD_OK);
+        }
+        hd__reuse_t pool;
+        hd__reuse_init(&pool);
+        hd__tree_t t[2];
+        CHECK_RC(hd__tree_build_pair(t, src, n, box, 1 + c % 2, &pool, NULL), HD_OK);
+        for (int s = 0; s < 2 && !hdt_failed(); s++)
+            for (size_t b = 0; b < t[s].nb && !hdt_failed(); b++) check_bucket_spec(&t[s], &P[s], b);
+        hd__tree_free(&t[0]);
+        hd__tree_free(&t[1]);
+        hd__reuse_free(&pool);
+        free(xyz[0]);
+        free(xyz[1]);
+    }
+}
+
 TEST(a_pair_of_trees_keeps_both_quantised_copies_in_one_block) {
     static const size_t sizes[][2] = {{250000, 250000}, {300000, 30000}, {30000, 300000}, {5, 1}, {65536, 65537}};
     for (size_t c = 0; c < sizeof sizes / sizeof sizes[0]; c++) {
