@@ -182,7 +182,7 @@ static inline ptrdiff_t same_place(const walk_t *s, size_t p) {
 /* Points of B tried on each point of A around its partner's expected
  * position (its own position moved by the last partner's offset). */
 #define WINDOW 4 /* one vector of four (hd__v4d) */
-#define SHIFTS 6 /* windows tried on either side of the first, in turn */
+#define SHIFTS 6 /* shifted windows tried after the first: three on each side, in turn */
 #define REACH (SHIFTS / 2 * WINDOW) /* how far the window may move to either side */
 #define WINDOW_REST 8
 #define WINDOW_MISSES 4
@@ -226,7 +226,7 @@ HD__HOT static void try_window(walk_t *s, group_t *g, double cmax2) {
     const ptrdiff_t top = (ptrdiff_t)((b1 + 1 - b0) * HD__BUCKET) - WINDOW;
     const int same_size = ta->n == tb->n;
     ptrdiff_t pd = s->pdrift, last = -1, last_place = 0;
-    s->w->counts.evals += (uint64_t)WINDOW * (uint64_t)__builtin_popcount(g->alive);
+    s->w->counts.evals += (uint64_t)(2 * WINDOW) * (uint64_t)__builtin_popcount(g->alive);
     /* First every live point against the 2 WINDOW points around its place
      * (two vectors), without a branch on the outcome (which went either
      * way about a quarter of the time), all with the drift the group
@@ -510,13 +510,13 @@ HD__HOT static void walk_bucket(walk_t *s, size_t bk) {
     g.alive = g.m == 32 ? 0xffffffffu : (1u << g.m) - 1;
     /* A live point may lose a tie to the witness when its index is larger
      * (the largest index of the group decides, without a branch a point). */
-    size_t top = 0;
+    size_t largest = 0;
     for (int k = 0; k < g.m; k++) {
         g.ia[k] = ta->perm[g.first + (size_t)k];
         assert(g.ia[k] < ta->n);
-        top = g.ia[k] > top ? g.ia[k] : top;
+        largest = g.ia[k] > largest ? g.ia[k] : largest;
     }
-    g.tie2 = top > s->snap.i ? s->snap.d2 : -1.0;
+    g.tie2 = largest > s->snap.i ? s->snap.d2 : -1.0;
     if (s->have_bc) {
         double lim = hd__kill_below(cmax2, g.err + s->bc_err);
         for (int k = 0; k < g.m; k++)
