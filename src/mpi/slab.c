@@ -214,6 +214,16 @@ static int slab_search(ctx_t *c, const slab_t *sl, const double *pts, const uint
 #define SCAN_MAX 16
 _Static_assert(BRUTE_MAX <= SCAN_MAX, "the few the slab left take the scan's pass");
 
+/* Whether point b lies beyond the box [lo, hi] on axis a by more than
+ * sqrt(MB): the larger of its two gaps (positive on one side at most,
+ * since lo <= hi), squared as hd__d2 squares the difference it bounds.
+ * Both tests are taken, without a branch between them (pass_over_q's
+ * first axis runs over every point of Q). */
+static inline int beyond(const double *b, int a, const double lo[3], const double hi[3], double MB) {
+    double g1 = b[a] - hi[a], g2 = lo[a] - b[a], g = g1 > g2 ? g1 : g2;
+    return (g > 0) & (g * g > MB);
+}
+
 /* One pass over Q for m <= SCAN_MAX askers, asker t at X(list[t]) (list
  * NULL: X(t)), each from an upper bound of its nearest, best[t] at Q's
  * position at[t] (INFINITY and SIZE_MAX: none), which it lowers to the
@@ -227,14 +237,6 @@ _Static_assert(BRUTE_MAX <= SCAN_MAX, "the few the slab left take the scan's pas
  *    adds non-negative terms), > MB >= x's bound: farther, not tied;
  *  - for one asker, when fl(dx dx) > its bound (the same argument).
  * Every other b is compared exactly, the smaller index winning a tie. */
-/* Whether point b lies beyond the box [lo, hi] on axis a by more than
- * sqrt(MB): the larger of its two gaps (positive on one side at most,
- * since lo <= hi), squared as hd__d2 squares the difference it bounds. */
-static inline int beyond(const double *b, int a, const double lo[3], const double hi[3], double MB) {
-    double g1 = b[a] - hi[a], g2 = lo[a] - b[a], g = g1 > g2 ? g1 : g2;
-    return g > 0 && g * g > MB;
-}
-
 static void pass_over_q(const dir_t *d, const double *pts, const uint32_t *pos, const uint32_t *list, size_t m,
                         double *best, size_t *at) {
 #define X(t) (pts + 3 * (pos ? pos[list ? list[t] : (t)] : list ? list[t] : (t)))
@@ -254,21 +256,17 @@ static void pass_over_q(const dir_t *d, const double *pts, const uint32_t *pos, 
             int t = ax[k];
             ax[k] = ax[k - 1], ax[k - 1] = t;
         }
-    /* The first axis's test (beyond's, written without a branch) runs over
-     * a block, keeping the points it does not pass over (a shell's askers
-     * lie along a face: most of Q is beyond them on its normal); the rest
-     * runs on those alone. */
+    /* The first axis's test runs over a block, keeping the points it does
+     * not pass over (a shell's askers lie along a face: most of Q is
+     * beyond them on its normal); the rest runs on those alone. */
     uint32_t keep[4096];
     for (size_t j0 = 0; j0 < d->nQ; j0 += 4096) {
         double MB = 0;
         for (size_t t = 0; t < m; t++) MB = best[t] > MB ? best[t] : MB;
         size_t j1 = d->nQ - j0 < 4096 ? d->nQ : j0 + 4096, nk = 0;
-        const int a0 = ax[0];
         for (size_t j = j0; j < j1; j++) {
-            const double *b = d->Q + 3 * j;
-            double g1 = b[a0] - hi[a0], g2 = lo[a0] - b[a0], g = g1 > g2 ? g1 : g2;
             keep[nk] = (uint32_t)(j - j0);
-            nk += !(g > 0) | !(g * g > MB);
+            nk += !beyond(d->Q + 3 * j, ax[0], lo, hi, MB);
         }
         for (size_t i = 0; i < nk; i++) {
             size_t j = j0 + keep[i];
