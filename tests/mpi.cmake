@@ -9,6 +9,11 @@
 #    hd_mpi_summarize, hd_mpi_percentile_of and hd_mpi_histogram equal the
 #    single-process functions bit for bit however the values are spread,
 #    and failures are agreed.  The same K as mpi_api.
+#  - mpi_partition_K: tests/internal/mpi_partition.c under `mpirun -n K`,
+#    white-box: the partition (src/mpi/rcb.c) balances uniform, clustered
+#    and copied points within 5 % with 1024 first samples a rank and with
+#    the fewest (64) that many ranks get, and that count keeps rank 0's
+#    samples bounded.  The same K as mpi_api.
 #  - mpi_gidx: tests/internal/mpi_gidx.c, the encoded global indices of
 #    the local sets (src/mpi/gidx.c) read back by position and by cursor.
 #  - mpi_memory: tests/internal/mpi_memory.c, the call's buffers charged at
@@ -42,6 +47,10 @@ if(HD_MPI)
   target_include_directories(mpi_figures PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/tests/support)
   target_link_libraries(mpi_figures PRIVATE hausdorff_mpi)
   set_target_properties(mpi_figures PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/tests)
+  add_executable(mpi_partition ${CMAKE_CURRENT_SOURCE_DIR}/tests/internal/mpi_partition.c ${CMAKE_CURRENT_SOURCE_DIR}/tests/support/gen.c)
+  target_include_directories(mpi_partition PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/tests/support ${CMAKE_CURRENT_SOURCE_DIR}/src)
+  target_link_libraries(mpi_partition PRIVATE hausdorff_mpi)
+  set_target_properties(mpi_partition PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/tests)
   set(HD_MPIRUN ${HD_MPIEXEC} --oversubscribe --allow-run-as-root)
   set(HD_MPI_ENV "OMPI_ALLOW_RUN_AS_ROOT=1" "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1")
   if(HD_SANITIZE)
@@ -55,6 +64,8 @@ if(HD_MPI)
     set_tests_properties(mpi_api_${k} PROPERTIES TIMEOUT 300 ENVIRONMENT "${HD_MPI_ENV}" PROCESSORS 2)
     add_test(NAME mpi_figures_${k} COMMAND ${HD_MPIRUN} -n ${k} $<TARGET_FILE:mpi_figures>)
     set_tests_properties(mpi_figures_${k} PROPERTIES TIMEOUT 300 ENVIRONMENT "${HD_MPI_ENV}" PROCESSORS 2)
+    add_test(NAME mpi_partition_${k} COMMAND ${HD_MPIRUN} -n ${k} $<TARGET_FILE:mpi_partition>)
+    set_tests_properties(mpi_partition_${k} PROPERTIES TIMEOUT 300 ENVIRONMENT "${HD_MPI_ENV}" PROCESSORS 2)
   endforeach()
   # mpi_gidx: tests/internal/mpi_gidx.c, the local sets' encoded global
   # indices (src/mpi/gidx.c), white-box and without mpirun (no MPI call).

@@ -17,10 +17,11 @@
  * The algorithm, for h(A,B) (the symmetric distance runs it both ways on one
  * partition):
  *  1. Partition.  Every rank samples its points of A and B (evenly spaced in
- *     its own order, as many as its share of 1024 a rank) and sends them to
- *     rank 0, which cuts space by recursive coordinate bisection (RCB): each
- *     node of k ranks splits its samples along their longest axis so that
- *     floor(k/2)/k of them go left.  The split key is a sample's
+ *     its own order, as many as its share of 1024 a rank, fewer beyond 64
+ *     ranks: rcb.c, FIRST_TOTAL) and sends them to rank 0, which cuts
+ *     space by recursive coordinate bisection (RCB): each node of k ranks
+ *     splits its samples along their longest axis so that floor(k/2)/k of
+ *     them go left.  The split key is a sample's
  *     (coordinate, set, global index), so points on the split plane are
  *     divided too (a lattice, or every point equal, still balances); a
  *     point goes left when its key is smaller.  The tree (k - 1 nodes) is
@@ -400,6 +401,7 @@ int hd__mpi_call(MPI_Comm comm, const hd_mpi_part_t *a, size_t na, const hd_mpi_
         MPI_Comm_set_errhandler(c.comm, MPI_ERRORS_RETURN);
         MPI_Comm_rank(c.comm, &c.rank);
         MPI_Comm_size(c.comm, &c.K);
+        c.first = hd__mpi_first_samples(c.K);
         c.threads = opt ? opt->threads : 0;
         if (c.threads < 0) c.threads = 1; /* refused by check_local, on every rank */
         rc = hd__mpi_types_create(&c);

@@ -53,6 +53,7 @@ typedef struct ctx {
     uint64_t shell;            /* points searched one by one (the shells) */
     uint64_t interior_passes;  /* second engine calls on an interior */
     int rounds;
+    int first;                 /* the partition's first samples a rank (rcb.c) */
     MPI_Datatype ans_type, q_type, far_type, sample_type, node_type;
     MPI_Op far_op;
 } ctx_t;
@@ -314,6 +315,15 @@ void hd__mpi_regions(const node_t *t, int node, hd__box_t box, hd__box_t *out);
 hd__box_t hd__mpi_node_boxes(const node_t *t, int node, const held_t *held, int side, hd__box_t *out);
 void hd__mpi_candidates(const node_t *t, const hd__box_t *nbox, const held_t *held, int side, int node,
                         const double *p, double u2, int me, int *list, int *n);
+/* The first samples a rank of K gives rank 0's tree: 1024 up to 64 ranks,
+ * then fewer, so that rank 0 holds at most 65536 of them (at least 64 a
+ * rank, which the second samples still balance: rcb.c). */
+int hd__mpi_first_samples(int K);
+/* Rank 0's tree over n first samples s (reordered) for K ranks: the K - 1
+ * nodes into t, each node's bracket into br[2 id], br[2 id + 1]. */
+void hd__mpi_rcb_tree(sample_t *s, size_t n, int K, node_t *t, double *br);
+/* Cut space into the K ranks' regions (tree, K - 1 nodes): rank 0's tree
+ * over c->first samples a rank, refined by a second sample's counts. */
 int hd__mpi_partition(ctx_t *c, const input_t *in, uint64_t N, node_t *tree);
 /* The ranks other than `me` that p must ask (into list; their number is
  * returned): those whose box of `side` may hold a point within u2 of p,

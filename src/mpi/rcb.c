@@ -31,7 +31,18 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define SAMPLES_PER_RANK 1024
+/* The first samples: FIRST_MOST a rank, but at most FIRST_TOTAL at rank 0
+ * (then FIRST_FEWEST a rank at the least).  Rank 0's tree costs about 24 ns
+ * a sample and level (bench/rcb_bench.c) and its buffer 40 B a sample:
+ * 1024 a rank would be 0.24 s and 41 MB at 1000 ranks, 5.7 s and 0.67 GB
+ * at 16384, all on rank 0 while the others wait.  The second samples
+ * (refine) set the balance; the first only bracket each split, and 64 a
+ * rank left the largest region 0.8-2.9 % above its share at 16 and 64
+ * ranks against 0.6-2.2 % with 1024 (docs/scale-out.md, "Fewer first
+ * samples at many ranks"). */
+#define FIRST_MOST 1024
+#define FIRST_FEWEST 64
+#define FIRST_TOTAL 65536
 #define REFINE_PER_RANK 32768 /* the second samples (refine) */
 #define REFINE_BINS 64
 
@@ -71,6 +82,13 @@ static void select_nth(sample_t *s, size_t n, size_t m, int axis) {
         if (m < store) hi = store - 1;
         else lo = store + 1;
     }
+}
+
+int hd__mpi_first_samples(int K) {
+    int per = K > 0 ? FIRST_TOTAL / K : FIRST_MOST;
+    per = per > FIRST_MOST ? FIRST_MOST : per < FIRST_FEWEST ? FIRST_FEWEST : per;
+    assert(per >= FIRST_FEWEST && per <= FIRST_MOST);
+    return per;
 }
 
 /* Node for k ranks r0.. over samples s[0..n); returns its id or -(r0 + 1).
@@ -117,6 +135,12 @@ static int build(node_t *t, double *br, int *next, sample_t *s, size_t n, int r0
     nd.right = build(t, br, next, s + m, n - m, r0 + kl, k - kl);
     t[id] = nd;
     return id;
+}
+
+void hd__mpi_rcb_tree(sample_t *s, size_t n, int K, node_t *t, double *br) {
+    int next = 0;
+    build(t, br, &next, s, n, 0, K);
+    assert(next == K - 1);
 }
 
 /* Every rank's region: the box its splits bound (infinite elsewhere). */
@@ -218,10 +242,11 @@ static double edge(const double *br, int id, int j) {
 }
 
 /* The second step of the partition.  Rank 0's tree divides the first
- * samples (1024 a rank) exactly, but a sample quantile is off the true one
- * by about a standard deviation of 1 / (2 sqrt(samples)) of the node's
- * points: 1-2 % of a leaf's, and the largest of K regions a few times that
- * (docs/scale-out.md, "The partition refined").  So each split is moved, level by
+ * samples (c->first a rank, 64-1024) exactly, but a sample quantile is off
+ * the true one by about a standard deviation of 1 / (2 sqrt(samples)) of
+ * the node's points: with 1024 a rank 1-2 % of a leaf's, and the largest
+ * of K regions a few times that (docs/scale-out.md, "The partition
+ * refined"); four times more with 64.  So each split is moved, level by
  * level from the root, to the best of REFINE_BINS + 1 planes spread over
  * its bracket (build) or kept, judged by exact counts of a second, larger
  * sample (REFINE_PER_RANK a rank, at most a quarter of the points) routed
@@ -239,7 +264,7 @@ static int refine(ctx_t *c, const input_t *in, uint64_t N, node_t *tree, const d
     uint64_t nloc = in->n[0] + in->n[1];
     double rate = (double)REFINE_PER_RANK * K / (double)N;
     if (rate > 0.25) rate = 0.25;
-    if (rate * (double)N <= 2.0 * SAMPLES_PER_RANK * K) return HD_OK; /* no more than the first samples */
+    if (rate * (double)N <= 2.0 * c->first * K) return HD_OK; /* no more than the first samples */
     size_t ns = sample_count(nloc, rate), width = REFINE_BINS + 3;
     sample_t *r = hd__mpi_alloc(c, ns, sizeof(sample_t));
     int *dep = hd__mpi_alloc(c, 3 * (size_t)nodes, sizeof(int));
@@ -318,12 +343,14 @@ done:
     return rc;
 }
 
-/* Rank 0 builds the RCB tree from everyone's samples; all get it, and
- * refine() then moves its splits by a second sample's exact counts. */
+/* Rank 0 builds the RCB tree from everyone's first samples (c->first a
+ * rank); all get it, and refine() then moves its splits by a second
+ * sample's exact counts. */
 int hd__mpi_partition(ctx_t *c, const input_t *in, uint64_t N, node_t *tree) {
     int rc = HD_OK, K = c->K;
     uint64_t nloc = in->n[0] + in->n[1];
-    uint64_t S = N < (uint64_t)SAMPLES_PER_RANK * (uint64_t)K ? N : (uint64_t)SAMPLES_PER_RANK * (uint64_t)K;
+    uint64_t S = (uint64_t)c->first * (uint64_t)K;
+    if (S > N) S = N;
     size_t ns = sample_count(nloc, (double)S / (double)N);
     sample_t *mine = hd__mpi_alloc(c, ns, sizeof(sample_t));
     int *counts = hd__mpi_alloc(c, 2 * (size_t)K, sizeof(int));
@@ -350,10 +377,7 @@ int hd__mpi_partition(ctx_t *c, const input_t *in, uint64_t N, node_t *tree) {
             e = MPI_TIMED(c, MPI_Gatherv(mine, n, c->sample_type, all, counts, counts + K, c->sample_type, 0, c->comm));
         if (e != MPI_SUCCESS) rc = hd__mpi_failed(c, "MPI_Gatherv", e);
         c->bytes_part += c->rank ? (uint64_t)ns * sizeof(sample_t) : 0;
-        if (rc == HD_OK && c->rank == 0) {
-            int next = 0;
-            build(tree, br, &next, all, total, 0, K);
-        }
+        if (rc == HD_OK && c->rank == 0) hd__mpi_rcb_tree(all, total, K, tree, br);
     }
     if (c->rank == 0) hd__mpi_free(c, all, total, sizeof(sample_t));
     if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
