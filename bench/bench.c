@@ -668,17 +668,6 @@ static void run_scale(bench_t *B, const char *self) {
 
 /* ---- main ------------------------------------------------------------------------ */
 
-static int parse_list(const char *s, size_t *out, int max) {
-    int n = 0;
-    while (*s && n < max) {
-        char *end;
-        out[n++] = (size_t)strtod(s, &end);
-        s = *end == ',' ? end + 1 : end;
-        if (end == s && *s) break;
-    }
-    return n;
-}
-
 static void usage(void) {
     fprintf(stderr,
             "usage: hd_bench [--out FILE] [--peers DIR] [--scripts DIR] [--data DIR]\n"
@@ -696,7 +685,7 @@ int main(int argc, char **argv) {
     B.peers = ".";
     B.scripts = "bench/peers";
     B.data = "data";
-    B.n_sizes = parse_list("10000,100000,1000000", B.sizes, 8);
+    B.n_sizes = bench_parse_sizes("10000,100000,1000000", B.sizes, 8);
     B.threads[0] = 1;
     B.threads[1] = 2;
     B.n_threads = 2;
@@ -716,10 +705,10 @@ int main(int argc, char **argv) {
         else if (!strcmp(o, "--scripts") && v) B.scripts = v, k++;
         else if (!strcmp(o, "--data") && v) B.data = v, k++;
         else if (!strcmp(o, "--case") && v) B.only = v, k++;
-        else if (!strcmp(o, "--sizes") && v) B.n_sizes = parse_list(v, B.sizes, 8), k++;
+        else if (!strcmp(o, "--sizes") && v) B.n_sizes = bench_parse_sizes(v, B.sizes, 8), k++;
         else if (!strcmp(o, "--threads") && v) {
             size_t t[4];
-            B.n_threads = parse_list(v, t, 4);
+            B.n_threads = bench_parse_sizes(v, t, 4);
             for (int i = 0; i < B.n_threads; i++) B.threads[i] = (int)t[i];
             k++;
         } else if (!strcmp(o, "--runs") && v) B.runs = atoi(v), k++;
@@ -731,7 +720,7 @@ int main(int argc, char **argv) {
         else if (!strcmp(o, "--cli") && v) B.cli = v, k++;
         else if (!strcmp(o, "--one-shot") && k + 3 < argc) return one_shot(argv[k + 1], argv[k + 2], atoi(argv[k + 3]));
         else if (!strcmp(o, "--scale")) B.scale = 1;
-        else if (!strcmp(o, "--quick")) B.n_sizes = parse_list("10000,100000", B.sizes, 8), B.runs = 3;
+        else if (!strcmp(o, "--quick")) B.n_sizes = bench_parse_sizes("10000,100000", B.sizes, 8), B.runs = 3;
         else if (!strcmp(o, "--scale-one") && v) scale_n = (size_t)strtod(v, NULL), k++;
         else if (!strcmp(o, "--float32")) f32 = 1;
         else {

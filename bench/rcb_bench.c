@@ -63,8 +63,10 @@ int main(int argc, char **argv) {
     }
     if (runs < 1 || runs > 15) runs = 5;
     printf("# ranks  per-rank  samples     tree(s)  ns/sample/level  rank0 MB   | 1024 a rank: tree(s)  MB     ratio\n");
-    for (const char *p = ranks; *p;) {
-        int K = atoi(p);
+    size_t list[16];
+    int nk = bench_parse_sizes(ranks, list, 16);
+    for (int i = 0; i < nk; i++) {
+        int K = list[i] <= (size_t)1 << 24 ? (int)list[i] : 0;
         if (K >= 2) {
             int per = hd__mpi_first_samples(K);
             size_t now = (size_t)per * (size_t)K, before = (size_t)1024 * (size_t)K;
@@ -73,8 +75,6 @@ int main(int argc, char **argv) {
                    tn / (double)now / log2((double)K) * 1e9, (double)(now * sizeof(sample_t)) / 1e6, tb,
                    (double)(before * sizeof(sample_t)) / 1e6, tb / tn);
         }
-        while (*p && *p != ',') p++;
-        if (*p == ',') p++;
     }
     return 0;
 }

@@ -55,6 +55,17 @@ int bench_listed(const char *list, const char *name) {
     return 0;
 }
 
+int bench_parse_sizes(const char *s, size_t *out, int max) {
+    int n = 0;
+    while (*s && n < max) {
+        char *end;
+        out[n++] = (size_t)strtod(s, &end);
+        s = *end == ',' ? end + 1 : end;
+        if (end == s && *s) break;
+    }
+    return n;
+}
+
 /* ---- the memory-bandwidth floor ------------------------------------------ */
 
 /* One worker's share: a piece of A and a piece of B, and their sum. */

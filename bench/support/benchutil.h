@@ -25,6 +25,11 @@ double bench_median(const double *v, int n);
 /* 1 when `name` is an item of the comma-separated `list`, or list is NULL. */
 int bench_listed(const char *list, const char *name);
 
+/* The numbers of a comma-separated list ("1e6,250000") into out[0..max),
+ * read as doubles and truncated; returns how many, stopping at the first
+ * item that is not a number. */
+int bench_parse_sizes(const char *s, size_t *out, int max);
+
 /* The memory-bandwidth floor: one streaming pass that reads every coordinate
  * of A (na points) and B (nb points) once, split over `threads` threads (the
  * caller's thread is one of them; below 1 counts as 1), each summing its
