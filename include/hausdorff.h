@@ -500,7 +500,8 @@ typedef enum hd_mesh_mode {
 typedef struct hd_read_options {
     const char *format;  /* NULL: by extension, confirmed by magic */
     hd_dtype_t dtype;    /* storage of the result: HD_FLOAT64 default */
-    hd_mesh_mode_t mesh; /* for formats with faces */
+    hd_mesh_mode_t mesh; /* for formats with faces; the others (LAS,
+                            LAZ, XYZ, PCD, NPY) are read as their points */
     size_t sample;       /* points to sample with HD_MESH_SAMPLE */
     uint64_t seed;       /* sampling seed */
     int threads;         /* parsing threads (text and binary): 0 = every core */

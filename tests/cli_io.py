@@ -96,7 +96,6 @@ def unsupported_and_missing_files_exit_2_with_a_way_out(d):
     expect_bad(os.path.join(d, "missing.ply"), "missing.ply: cannot open")
     expect_bad(write(d, "blob.bin", b"\x01\x02\x03"), "use --format")
     expect_bad(write(d, "las.ply", b"LASF" + b"\0" * 300), "the name says ply but the content is las; use --format las")
-    expect_bad(write(d, "x.xyz", "1 2 3\n"), "sampling needs a mesh", args=("--sample", "10"))
 
 
 @test

@@ -23,7 +23,10 @@
  *
  * Meshes (PLY, OBJ, OFF, STL) are read as their vertices by default; with
  * HD_MESH_SAMPLE the reader also collects the faces as triangles and
- * mesh.c draws the requested number of points on the surface.
+ * mesh.c draws the requested number of points on the surface.  A format
+ * that cannot hold faces (LAS, LAZ, XYZ, PCD, NPY) is read as its points
+ * in either mode, so one option serves a mesh compared with a scan; a mesh
+ * format whose file has no faces is refused under HD_MESH_SAMPLE.
  */
 #include "io.h"
 
@@ -435,9 +438,12 @@ static int read_loaded(const hd__file_t *f, const format_t *fmt, int from_extens
             return hd__err(err, HD_EFORMAT, "%s: the name says %s but the content is %s; use --format %s", f->name,
                            fmt->name, seems->name, seems->name);
     }
-    if (opt->mesh == HD_MESH_SAMPLE && !fmt->faces)
-        return hd__err(err, HD_EUNSUPPORTED, "%s: %s holds points, not faces; sampling needs a mesh (ply, obj, off, stl)",
-                       f->name, fmt->name);
+    hd_read_options_t as_points; /* sampling draws on faces: a format without them is read as its points */
+    if (opt->mesh == HD_MESH_SAMPLE && !fmt->faces) {
+        as_points = *opt;
+        as_points.mesh = HD_MESH_VERTICES;
+        opt = &as_points;
+    }
     hd__sink_t sink;
     hd__sink_init(&sink, opt->dtype);
     size_t faces = 0;

@@ -192,9 +192,28 @@ static void check_refused(const char *path, const hd_read_options_t *o, int code
     if (line) CHECK_EQ(e.line, line);
 }
 
+TEST(a_format_without_faces_is_read_as_its_points_under_sampling) {
+    /* a mesh compared with a scan under one --sample: the scan keeps its points */
+    hd_read_options_t o = sampling(10, 1), v;
+    hd_read_options_init(&v);
+    const char *files[] = {tf_printf("p.xyz", "1 2 3\n4 5 6\n"), "data/derived/pinion_gear_c_f8.npy",
+                           "data/derived/pinion_gear_binary.pcd"};
+    for (int k = 0; k < 3; k++) {
+        CONTEXT("%s", files[k]);
+        hd_cloud_t *sampled = read_with(files[k], &o), *points = read_with(files[k], &v);
+        CHECK(same(sampled, points));
+        CHECK_EQ(sampled->n_faces, 0);
+        hd_cloud_free(sampled);
+        hd_cloud_free(points);
+    }
+    uint64_t n = 0; /* and its count is still its header's, for a process's range */
+    hd_error_t e;
+    CHECK_RC(hd_read_count("data/derived/pinion_gear_c_f8.npy", &o, &n, &e), HD_OK);
+    CHECK_EQ(n, 650);
+}
+
 TEST(sampling_is_refused_without_faces_or_points_or_with_bad_indices) {
     hd_read_options_t o = sampling(10, 1);
-    check_refused(tf_printf("p.xyz", "1 2 3\n"), &o, HD_EUNSUPPORTED, "sampling needs a mesh", 0);
     check_refused(tf_printf("noface.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
                                           "property float z\nend_header\n1 2 3\n"),
                   &o, HD_EFORMAT, "no faces to sample", 0);
