@@ -367,7 +367,8 @@ int analysis_handle_empty(const analysis_args_t *an, const char *path_a,
         json_figures(out, an, &r);
         fprintf(out, "}\n");
     } else {
-        fprintf(out, "A: %s (%zu points)\nB: %s (%zu points)\n", path_a, n_a, path_b, n_b);
+        fprintf(out, "A: %s (%zu point%s)\nB: %s (%zu point%s)\n", path_a, n_a, plural(n_a), path_b, n_b,
+                plural(n_b));
         const char *which = !n_a && !n_b ? "A and B are" : !n_a ? "A is" : "B is";
         char t[NUM_TEXT], pt[NUM_TEXT];
         num_text(v, t);
@@ -620,7 +621,7 @@ static void print_histogram(FILE *out, const analysis_args_t *an,
         if (r->hist_ab[k] > top) top = r->hist_ab[k];
         if (r->hist_ba && r->hist_ba[k] > top) top = r->hist_ba[k];
     }
-    fprintf(out, "histogram of distances (%zu bins; bar = share of the largest bin):\n", an->bins);
+    fprintf(out, "histogram of distances (%zu bin%s; bar = share of the largest bin):\n", an->bins, plural(an->bins));
     fprintf(out, "  %-25s %10s %-20s%s\n", "bin", "A->B", "", r->hist_ba ? "      B->A" : "");
     for (size_t k = 0; k < an->bins; k++) {
         double lo = hd_histogram_edge(r->hist_lo, r->hist_hi, an->bins, k);
@@ -656,12 +657,17 @@ void analysis_print(FILE *out, const analysis_args_t *an,
         char how[96] = "";
         if (an->mask_points == MASK_SURFACE)
             snprintf(how, sizeof how, " (%d-D, connectivity %d)", m->surface_dims, m->connectivity);
-        char sp[3][NUM_TEXT];
-        fprintf(out, "%c: NIfTI-%d mask %lldx%lldx%lld, spacing %s x %s x %s%s, %s; %lld foreground voxels, "
-                     "%zu %s points%s\n",
-                k ? 'B' : 'A', m->nifti_version, m->dim[0], m->dim[1], m->dim[2], num_text(m->spacing[0], sp[0]),
-                num_text(m->spacing[1], sp[1]), num_text(m->spacing[2], sp[2]), m->unit_known ? "" : " (unit not given: taken as mm)", m->transform, m->foreground,
-                m->points, an->mask_points == MASK_ALL ? "foreground" : "surface", how);
+        char sp[3][NUM_TEXT]; /* NIfTI-1 stores the spacing as float32 */
+        for (int c = 0; c < 3; c++) {
+            if (m->nifti_version == 1) num_text_single(m->spacing[c], sp[c]);
+            else num_text(m->spacing[c], sp[c]);
+        }
+        fprintf(out, "%c: NIfTI-%d mask %lldx%lldx%lld, spacing %s x %s x %s%s, %s; %lld foreground voxel%s, "
+                     "%zu %s point%s%s\n",
+                k ? 'B' : 'A', m->nifti_version, m->dim[0], m->dim[1], m->dim[2], sp[0], sp[1], sp[2],
+                m->unit_known ? "" : " (unit not given: taken as mm)", m->transform, m->foreground,
+                plural((unsigned long long)m->foreground), m->points,
+                an->mask_points == MASK_ALL ? "foreground" : "surface", plural(m->points), how);
     }
     if (!r->active) return;
     char t[4][NUM_TEXT]; /* shortest text of each figure (numtext.c) */
@@ -699,5 +705,5 @@ void analysis_print(FILE *out, const analysis_args_t *an,
     }
     if (an->render_out) fprintf(out, "picture written to %s (%dx%d)\n", an->render_out, r->render_w, r->render_h);
     if (an->histogram_png) fprintf(out, "histogram picture written to %s\n", an->histogram_png);
-    fprintf(out, "time: %s s for per-point distances\n", num_text(round(r->seconds * 1e6) / 1e6, t[0]));
+    fprintf(out, "time: %s s for per-point distances\n", num_seconds(r->seconds, t[0]));
 }

@@ -30,6 +30,9 @@ typedef struct cli_args {
  * --version, or a usage error, which it has reported). */
 int cli_parse(int argc, char **argv, cli_args_t *a);
 void cli_usage(FILE *out);
+/* The usage text is hausdorff-mpi's (its usage line, description and
+ * examples): hausdorff-mpi calls this before cli_parse. */
+void cli_set_mpi(void);
 /* The program's name for messages ("hausdorff", "hausdorff-mpi"), from
  * argv[0] once cli_parse has run. */
 const char *cli_prog(void);
@@ -41,6 +44,16 @@ void cli_formats(FILE *out);
 enum { NUM_TEXT = 32 };
 const char *num_text(double v, char buf[NUM_TEXT]);
 void num_print(FILE *out, double v);
+/* For a person (numtext.c): a coordinate of a float32 input as the
+ * shortest text of the float nearest it ("11.2" for 11.200000166893005
+ * from a NIfTI-1 header); a ratio to four significant digits ("0.7989");
+ * seconds to three significant digits, never in exponent form
+ * ("0.000098", "0.0131", "1.25"). */
+const char *num_text_single(double v, char buf[NUM_TEXT]);
+const char *num_ratio(double v, char buf[NUM_TEXT]);
+const char *num_seconds(double s, char buf[NUM_TEXT]);
+/* "s" after a count other than one: "%zu point%s", n, plural(n). */
+static inline const char *plural(unsigned long long n) { return n == 1 ? "" : "s"; }
 
 /* JSON output helpers: numbers as num_text prints them (null when not
  * finite); strings escaped. */

@@ -14,12 +14,18 @@
  * so the C locale is assumed, as everywhere in the tool (it never calls
  * setlocale).  Non-finite values print as "inf", "-inf" and "nan"; JSON
  * writes null for them itself.
+ *
+ * The other numbers a person reads: a coordinate of a float32 input as the
+ * shortest text of its float (num_text_single), ratios to four significant
+ * digits (num_ratio) and times in seconds to three significant digits,
+ * never in exponent form (num_seconds).
  */
 #include "cli.h"
 
 #include <float.h>
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 static int reads_back(const char *s, double v) { return strtod(s, NULL) == v; }
 
@@ -44,4 +50,33 @@ const char *num_text(double v, char buf[NUM_TEXT]) {
 void num_print(FILE *out, double v) {
     char buf[NUM_TEXT];
     fputs(num_text(v, buf), out);
+}
+
+const char *num_text_single(double v, char buf[NUM_TEXT]) {
+    if (!isfinite(v) || v == 0 || fabs(v) > FLT_MAX) return num_text(v, buf); /* not a float's */
+    float f = (float)v;
+    /* 9 significant digits always read back as the same float */
+    for (int p = 1; p <= 9; p++) {
+        snprintf(buf, NUM_TEXT, "%.*g", p, (double)f);
+        if (strtof(buf, NULL) == f) break;
+    }
+    return buf;
+}
+
+const char *num_ratio(double v, char buf[NUM_TEXT]) {
+    if (!isfinite(v)) return num_text(v, buf);
+    snprintf(buf, NUM_TEXT, "%.4g", v);
+    return buf;
+}
+
+const char *num_seconds(double s, char buf[NUM_TEXT]) {
+    if (!isfinite(s) || s < 0) return num_text(s, buf);
+    /* three significant digits as decimals, at most to the microsecond:
+     * 0.000614, 0.000098, 0.0131, 1.25, 125 */
+    int decimals = 6;
+    if (s >= 0.0000995) decimals = 2 - (int)floor(log10(s));
+    if (decimals < 0) decimals = 0;
+    if (decimals > 6) decimals = 6;
+    snprintf(buf, NUM_TEXT, "%.*f", decimals, s);
+    return buf;
 }

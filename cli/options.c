@@ -16,14 +16,65 @@ static const char *prog_name = "hausdorff";
 
 const char *cli_prog(void) { return prog_name; }
 
-void cli_usage(FILE *out) {
-    fprintf(out, "usage: %s [options] A B\n", prog_name);
-    fprintf(out,
+/* hausdorff-mpi (cli_set_mpi): its own usage line, description and examples. */
+static int mpi_tool;
+
+void cli_set_mpi(void) { mpi_tool = 1; }
+
+static void usage_head(FILE *out) {
+    if (mpi_tool) {
+        fprintf(out, "usage: mpirun -n K %s [options] A B\n", prog_name);
+        fprintf(out,
 "\n"
-"Exact Hausdorff distance between the point sets in files A and B:\n"
+"Exact Hausdorff distance between the point sets in files A and B on K MPI\n"
+"processes, each reading a share of each side: the same distances, witnesses\n"
+"and per-point outputs as hausdorff, to the bit, plus the exchange's figures\n"
+"(the \"mpi:\" lines; \"mpi\" in the JSON).\n");
+    } else {
+        fprintf(out, "usage: %s [options] A B\n", prog_name);
+        fprintf(out, "\nExact Hausdorff distance between the point sets in files A and B:\n");
+    }
+    fprintf(out,
 "H(A,B) = max(h(A,B), h(B,A)),\n"
 "h(A,B) = max over a in A of min over b in B of |a-b|.\n"
-"Distances are bit-identical to a brute force in double precision.\n"
+"Distances are bit-identical to a brute force in double precision.\n");
+}
+
+static void usage_examples(FILE *out) {
+    if (mpi_tool) {
+        fprintf(out,
+"\n"
+"hausdorff-mpi computes with its own distributed algorithm: --algorithm,\n"
+"--depth, --lambda, --theta, --no-early-break and --no-culling are checked\n"
+"and have no effect; --threads is per process.\n"
+"\n"
+"Examples:\n"
+"  mpirun -n 64 hausdorff-mpi --json tiles2019/ @tiles2024.txt\n"
+"  mpirun -n 64 hausdorff-mpi --distances dev.ply tiles2019/ @tiles2024.txt\n"
+"  mpirun -n 64 hausdorff-mpi --percentile 95 --mean --chamfer --render dev.png \\\n"
+"      tiles2019/ @tiles2024.txt\n"
+"Open MPI refuses to run as root without --allow-run-as-root, and more\n"
+"processes than the machine has slots without --oversubscribe (or a hostfile):\n"
+"  mpirun --allow-run-as-root --oversubscribe -n 4 hausdorff-mpi scan.las model.ply\n");
+    } else {
+        fprintf(out,
+"\n"
+"Examples:\n"
+"  hausdorff scan.ply model.ply\n"
+"  hausdorff --json --algorithm framework a.xyz b.xyz\n"
+"  hausdorff --directed --threads 1 part.ply reference.ply\n"
+"  hausdorff --sample 100000 --seed 7 part.stl scan.las\n"
+"  cat cloud.csv | hausdorff xyz:- model.ply\n"
+"  hausdorff --percentile 95 --mean --render dev.png scan.ply model.ply\n"
+"  hausdorff --json --percentile 95 seg.nii.gz truth.nii.gz\n"
+"  hausdorff --json tiles2019/ @tiles2024.txt\n");
+    }
+    fprintf(out, "\nExit status: 0 success, 1 usage error, 2 bad input, 3 other failure.\n");
+}
+
+void cli_usage(FILE *out) {
+    usage_head(out);
+    fprintf(out,
 "\n"
 "Options:\n"
 "  --algorithm NAME   auto (default), naive, earlybreak, inc, nohd, ohd,\n"
@@ -50,7 +101,8 @@ void cli_usage(FILE *out) {
 "                     (./@x for a file whose name starts with @)\n"
 "  --vertices         read a mesh (ply, obj, off, stl) as its vertices (default)\n"
 "  --sample N         read a mesh as N points drawn uniformly by area on its\n"
-"                     faces, reproducibly for a given --seed\n"
+"                     faces, reproducibly for a given --seed; a point format\n"
+"                     (las, laz, xyz, pcd, npy) is read as its points\n"
 "  --float32          store coordinates as float (half the memory)\n"
 "  --decimal-comma    text files write 1,5 for 1.5: commas are decimal points\n"
 "                     and fields are separated by ';' or blanks (without it\n"
@@ -64,19 +116,7 @@ void cli_usage(FILE *out) {
 "                     is not a terminal, nor with --json)\n"
 "  --help, --version\n");
     analysis_usage(out);
-    fprintf(out,
-"\n"
-"Examples:\n"
-"  hausdorff scan.ply model.ply\n"
-"  hausdorff --json --algorithm framework a.xyz b.xyz\n"
-"  hausdorff --directed --threads 1 part.ply reference.ply\n"
-"  hausdorff --sample 100000 --seed 7 part.stl scan.las\n"
-"  cat cloud.csv | hausdorff xyz:- model.ply\n"
-"  hausdorff --percentile 95 --mean --render dev.png scan.ply model.ply\n"
-"  hausdorff --json --percentile 95 seg.nii.gz truth.nii.gz\n"
-"  hausdorff --json tiles-2019/ @tiles-2024.txt\n"
-"\n"
-"Exit status: 0 success, 1 usage error, 2 bad input, 3 other failure.\n");
+    usage_examples(out);
 }
 
 void cli_formats(FILE *out) {

@@ -5,6 +5,7 @@
  */
 #include "report.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -74,8 +75,9 @@ static void tiles_json(FILE *out, const char *key, const tiles_t *t) {
 static void side_line(FILE *out, const report_t *r, int w) {
     const tiles_t *t = &r->side[w];
     int sampled = r->a->read.mesh == HD_MESH_SAMPLE;
-    fprintf(out, "%c: %s (%zu points, %s", "AB"[w], t->arg, r->n[w], r->format[w]);
-    if (r->faces[w]) fprintf(out, "%s %zu faces", sampled ? " sampled from" : ",", r->faces[w]);
+    fprintf(out, "%c: %s (%zu point%s, %s", "AB"[w], t->arg, r->n[w], plural(r->n[w]), r->format[w]);
+    if (r->faces[w])
+        fprintf(out, "%s %zu face%s", sampled ? " sampled from" : ",", r->faces[w], plural(r->faces[w]));
     if (t->kind != TILES_FILE) {
         char skipped[512];
         tiles_skipped_text(t, skipped, sizeof skipped);
@@ -91,9 +93,26 @@ static void where_text(FILE *out, const tiles_t *t, size_t g) {
     fprintf(out, " = %s[%zu]", t->t[k].path, local);
 }
 
-static void print_point(FILE *out, const double *q) {
-    char x[NUM_TEXT], y[NUM_TEXT], z[NUM_TEXT];
-    fprintf(out, "(%s, %s, %s)", num_text(q[0], x), num_text(q[1], y), num_text(q[2], z));
+/* A point of a side: each coordinate as the shortest text of its double,
+ * or of its float when the side's data was float32 (single). */
+static void print_point(FILE *out, const double *q, int single) {
+    char c[3][NUM_TEXT];
+    for (int k = 0; k < 3; k++) {
+        if (single) num_text_single(q[k], c[k]);
+        else num_text(q[k], c[k]);
+    }
+    fprintf(out, "(%s, %s, %s)", c[0], c[1], c[2]);
+}
+
+int report_single(const hd_points_t *p, const mask_info_t *m) {
+    if (p->dtype == HD_FLOAT32 || (m && m->is_mask && m->nifti_version == 1)) return 1;
+    for (size_t i = 0; i < p->count; i++) {
+        double q[3];
+        hd_points_get(p, i, q);
+        for (int k = 0; k < 3; k++)
+            if (fabs(q[k]) > FLT_MAX || (double)(float)q[k] != q[k]) return 0;
+    }
+    return 1;
 }
 
 static void stats_json(FILE *out, const hd_stats_t *s) {
@@ -189,16 +208,15 @@ void report_text(FILE *out, const report_t *r) {
     const hd_result_t *w = report_witness(a, s, &from_a);
     const tiles_t *TP = &r->side[!from_a], *TQ = &r->side[from_a];
     fprintf(out, "witness: %s[%zu] ", from_a ? "A" : "B", w->i);
-    print_point(out, r->wp);
+    print_point(out, r->wp, r->single[!from_a]);
     where_text(out, TP, w->i);
     fprintf(out, "\n     to  %s[%zu] ", from_a ? "B" : "A", w->j);
-    print_point(out, r->wq);
+    print_point(out, r->wq, r->single[from_a]);
     where_text(out, TQ, w->j);
     fprintf(out, "\n");
     char al[NUM_TEXT], tc[NUM_TEXT], tr[NUM_TEXT];
-    fprintf(out, "overlap alpha = %s%s; algorithm %s\n", num_text(s->alpha, al),
+    fprintf(out, "overlap alpha = %s%s; algorithm %s\n", num_ratio(s->alpha, al),
             s->disjoint ? " (disjoint boxes)" : "", hd_algorithm_name(a->opt.algorithm));
-    /* times are measurements: to the microsecond, then shortest (as in the JSON) */
-    fprintf(out, "time: %s s computing, %s s reading\n", num_text(round(s->seconds * 1e6) / 1e6, tc),
-            num_text(round(r->read_seconds * 1e6) / 1e6, tr));
+    fprintf(out, "time: %s s computing, %s s reading\n", num_seconds(s->seconds, tc),
+            num_seconds(r->read_seconds, tr));
 }

@@ -21,6 +21,8 @@ typedef struct report {
     size_t faces[2];
     double wp[3], wq[3];       /* the points of the witness report_witness names */
     double read_seconds;
+    int single[2];             /* A's, B's coordinates came from float32 data
+                                  (report_single): printed as floats */
 } report_t;
 
 /* The witness a person is shown: h(A,B)'s with --directed or when it is the
@@ -33,6 +35,14 @@ void report_json(FILE *out, const report_t *r);
 
 /* The report for a person, up to the analysis lines. */
 void report_text(FILE *out, const report_t *r);
+
+/* 1 when a side's coordinates came from float32 data, so that the report
+ * prints them as the shortest text of the float: stored as float
+ * (--float32), a NIfTI-1 mask (its transform is float32; m may be NULL),
+ * or every coordinate of p a float (a binary STL, a float PLY, PCD or NPY
+ * read into doubles; vacuously when p is empty).  Reads p to its first
+ * coordinate that is not a float. */
+int report_single(const hd_points_t *p, const mask_info_t *m);
 
 /* Library codes to exit codes: bad input 2, anything else 3. */
 int cli_exit_for(int code);

@@ -275,6 +275,7 @@ int main(int argc, char **argv) {
     quiet_others();
     out_guard_std();
     cli_args_t a;
+    cli_set_mpi();
     int rc = cli_parse(argc, argv, &a); /* the same verdict on every rank */
     if (rc >= 0) return finish(rc == EXIT_OK ? out_finish() : rc);
     hd_error_t err;
@@ -400,7 +401,7 @@ int main(int argc, char **argv) {
 
     /* Everything the report shows, on rank 0. */
     report_t r = {&a, &s, side, {(size_t)0, (size_t)0}, {NULL, NULL}, {0, 0}, {0, 0, 0}, {0, 0, 0},
-                  read_seconds};
+                  read_seconds, {0, 0}};
     char fmt[2][16];
     uint64_t counts[4] = {cloud[0]->count, cloud[1]->count, cloud[0]->n_faces, cloud[1]->n_faces}, sums[4];
     MPI_Allreduce(counts, sums, 4, MPI_UINT64_T, MPI_SUM, MPI_COMM_WORLD);
@@ -410,6 +411,8 @@ int main(int argc, char **argv) {
         r.faces[w] = (size_t)sums[2 + w];
         r.format[w] = fmt[w];
     }
+    int single[2] = {report_single(&part[0].points, &a.an.mask[0]), report_single(&part[1].points, &a.an.mask[1])};
+    MPI_Allreduce(single, r.single, 2, MPI_INT, MPI_LAND, MPI_COMM_WORLD);
     int from_a;
     const hd_result_t *wit = report_witness(&a, &s, &from_a);
     fetch_point(&part[!from_a], wit->i, r.wp);
@@ -441,14 +444,14 @@ int main(int argc, char **argv) {
             report_text(out, &r);
             if (an.active) analysis_print(out, &a.an, &an);
             char b[NUM_TEXT], f[NUM_TEXT], im[NUM_TEXT];
-            fprintf(out, "mpi: %d ranks, %s bytes moved per point, %s of the points forwarded, imbalance %s\n", K_,
-                    num_text((double)(st.bytes_partition + st.bytes_forwarding) / (double)st.points, b),
-                    num_text((double)st.forwarded_points / (double)st.points, f), num_text(st.imbalance, im));
+            fprintf(out, "mpi: %d rank%s, %s bytes moved per point, %s of the points forwarded, imbalance %s\n", K_,
+                    plural((unsigned)K_), num_ratio((double)(st.bytes_partition + st.bytes_forwarding) / (double)st.points, b),
+                    num_ratio((double)st.forwarded_points / (double)st.points, f), num_ratio(st.imbalance, im));
             if (an.active)
                 fprintf(out, "mpi: per-point distances: %s bytes moved per point, %s of the points forwarded\n",
-                        num_text((double)(dst.bytes_partition + dst.bytes_forwarding + dst.bytes_returned) /
-                                     (double)dst.points, b),
-                        num_text((double)dst.forwarded_points / (double)dst.points, f));
+                        num_ratio((double)(dst.bytes_partition + dst.bytes_forwarding + dst.bytes_returned) /
+                                      (double)dst.points, b),
+                        num_ratio((double)dst.forwarded_points / (double)dst.points, f));
         }
         for (int k = 0; k < COLS; k++) free(col[k]);
         if (status == EXIT_OK) status = out_finish();
