@@ -8,6 +8,7 @@ functions behind the numbers are tests/cli_numtext_unit.c's.
 Usage: cli_report.py HAUSDORFF [NAME-FILTER] (hausdorff-mpi from
 HD_MPI_TOOL; the NIfTI cases when HD_CLI_NIFTI is ON).
 """
+import json
 import math
 import os
 import re
@@ -21,6 +22,7 @@ from cli_analysis_support import main, run, run_json, test, write_nifti, write_x
 HERE = os.path.dirname(os.path.abspath(__file__))
 DATA = os.path.join(os.path.dirname(HERE), "data")
 MPI_TOOL = os.environ.get("HD_MPI_TOOL") or None
+MPI_ENV = dict(os.environ, ASAN_OPTIONS="detect_leaks=0")  # Open MPI's own leaks, in a sanitizer build
 
 
 def f32(v):
@@ -42,9 +44,9 @@ def witness_lines(out):
     return [l for l in out.splitlines() if l.startswith(("witness:", "     to"))]
 
 
-def mpirun(*args):
-    p = subprocess.run(["mpirun", "--allow-run-as-root", "--oversubscribe", "-n", "1", MPI_TOOL] + list(args),
-                       capture_output=True, text=True, timeout=300)
+def mpirun(*args, k=1):
+    p = subprocess.run(["mpirun", "--allow-run-as-root", "--oversubscribe", "-n", str(k), MPI_TOOL] + list(args),
+                       capture_output=True, text=True, timeout=300, env=MPI_ENV)
     assert p.returncode == 0, (args, p.stdout, p.stderr)
     return p.stdout
 
@@ -149,7 +151,8 @@ def hausdorff_mpi_prints_its_own_help(tmp):
     if not MPI_TOOL:
         print("     (skipped: hausdorff-mpi is not built)")
         return
-    text = subprocess.run([MPI_TOOL, "--help"], capture_output=True, text=True, timeout=120, check=True).stdout
+    text = subprocess.run([MPI_TOOL, "--help"], capture_output=True, text=True, timeout=120, check=True,
+                          env=MPI_ENV).stdout
     assert text.startswith("usage: mpirun -n K hausdorff-mpi [options] A B\n"), text
     assert "--allow-run-as-root" in text and "--oversubscribe" in text, text
     examples = text[text.index("Examples:"):]
@@ -176,6 +179,21 @@ def hausdorff_mpi_prints_the_same_report_with_figures_for_a_person(tmp):
         assert m, out
         for figure in m.groups():
             assert figure == "%.4g" % float(figure), (figure, out)
+
+
+@test
+def hausdorff_mpi_samples_the_mesh_and_reads_the_scan_by_point_ranges(tmp):
+    if not MPI_TOOL:
+        print("     (skipped: hausdorff-mpi is not built)")
+        return
+    args = ["--sample", "1000", "--seed", "7", os.path.join(DATA, "orig", "Wuson.stl"),
+            os.path.join(DATA, "orig", "Haystack_Rock.las")]
+    keep = lambda out: [l for l in out.splitlines() if not l.startswith(("time:", "mpi:"))]
+    one, _ = run(args)
+    assert "(21932 points, las)" in one, one
+    assert keep(mpirun(*args, k=2)) == keep(one)
+    j = json.loads(mpirun("--json", *args, k=2))
+    assert j["mpi"]["read_by_points"] == [False, True], j["mpi"]
 
 
 if __name__ == "__main__":

@@ -48,6 +48,7 @@ from cli_analysis_support import write_nifti  # noqa: E402  (numpy: Debian's pyt
 
 import numpy as np  # noqa: E402
 
+MPI_ENV = dict(os.environ, ASAN_OPTIONS="detect_leaks=0")  # Open MPI's own leaks, in a sanitizer build
 HEAD_TO_LION = "0.14468150162771326"  # data/README.md: h(cgal_lion_head, cgal_lion), = H
 HEAD = ("scan.ply", "a.ply", "part.ply", "a.xyz", "scan.csv", "cloud.csv", "points.dat", "tiles2019/")
 LION = ("model.ply", "b.ply", "reference.ply", "b.xyz", "reference.dat", "@tiles2024.txt")
@@ -68,7 +69,7 @@ def readme_examples():
 
 
 def help_examples(tool, name):
-    text = subprocess.run([tool, "--help"], capture_output=True, text=True, check=True).stdout
+    text = subprocess.run([tool, "--help"], capture_output=True, text=True, check=True, env=MPI_ENV).stdout
     out, inside, pending = [], False, ""
     for line in text.splitlines():
         if line == "Examples:":
@@ -246,6 +247,8 @@ def run_example(d, src, cmd, env, mpi_tool):
     for f in made:
         if os.path.exists(os.path.join(d, f)):
             os.remove(os.path.join(d, f))
+    if "hausdorff-mpi" in cmd:
+        env = dict(env, ASAN_OPTIONS="detect_leaks=0")  # Open MPI's own leaks, in a sanitizer build
     p = subprocess.run(["/bin/sh", "-c", cmd], cwd=d, env=env, capture_output=True, text=True, timeout=300)
     assert p.returncode == 0, "%s: `%s` (run as `%s`) exited %d\nstdout: %s\nstderr: %s" % (
         src, words, cmd, p.returncode, p.stdout, p.stderr)
