@@ -66,7 +66,8 @@ int main(int argc, char **argv) {
     progress_start(!a.quiet && !a.json && isatty(2), 3);
     char files[2][32] = {"", ""};
     for (int w = 0; w < 2; w++)
-        if (side[w].kind != TILES_FILE) snprintf(files[w], sizeof files[w], " (%zu file%s)", side[w].n, plural(side[w].n));
+        if (side[w].kind != TILES_FILE)
+            snprintf(files[w], sizeof files[w], " (%zu file%s)", side[w].n, plural(side[w].n));
     progress_phase("reading A: %s%s", a.path_a, files[0]);
     if ((rc = tiles_read(&side[0], 0, side[0].n, &a.read, &a.an, 0, &ca, &err)) != HD_OK ||
         (progress_phase("reading B: %s%s", a.path_b, files[1]),
@@ -118,8 +119,11 @@ int main(int argc, char **argv) {
 
     FILE *out = stdout;
     report_t r = {&a, &s, side, {A.count, B.count}, {ca->format, cb->format}, {ca->n_faces, cb->n_faces},
-                  {0, 0, 0}, {0, 0, 0}, read_seconds,
-                  {report_single(&A, &a.an.mask[0]), report_single(&B, &a.an.mask[1])}};
+                  {0, 0, 0}, {0, 0, 0}, read_seconds, {0, 0}};
+    if (!a.json) { /* only the text prints coordinates */
+        r.single[0] = report_single(&A, &a.an.mask[0]);
+        r.single[1] = report_single(&B, &a.an.mask[1]);
+    }
     int from_a;
     const hd_result_t *w = report_witness(&a, &s, &from_a);
     hd_points_get(from_a ? &A : &B, w->i, r.wp);

@@ -411,8 +411,10 @@ int main(int argc, char **argv) {
         r.faces[w] = (size_t)sums[2 + w];
         r.format[w] = fmt[w];
     }
-    int single[2] = {report_single(&part[0].points, &a.an.mask[0]), report_single(&part[1].points, &a.an.mask[1])};
-    MPI_Allreduce(single, r.single, 2, MPI_INT, MPI_LAND, MPI_COMM_WORLD);
+    if (!a.json) { /* only the text prints coordinates: float32 data when it is on every rank */
+        int single[2] = {report_single(&part[0].points, &a.an.mask[0]), report_single(&part[1].points, &a.an.mask[1])};
+        MPI_Allreduce(single, r.single, 2, MPI_INT, MPI_LAND, MPI_COMM_WORLD);
+    }
     int from_a;
     const hd_result_t *wit = report_witness(&a, &s, &from_a);
     fetch_point(&part[!from_a], wit->i, r.wp);
@@ -445,7 +447,8 @@ int main(int argc, char **argv) {
             if (an.active) analysis_print(out, &a.an, &an);
             char b[NUM_TEXT], f[NUM_TEXT], im[NUM_TEXT];
             fprintf(out, "mpi: %d rank%s, %s bytes moved per point, %s of the points forwarded, imbalance %s\n", K_,
-                    plural((unsigned)K_), num_ratio((double)(st.bytes_partition + st.bytes_forwarding) / (double)st.points, b),
+                    plural((unsigned)K_),
+                    num_ratio((double)(st.bytes_partition + st.bytes_forwarding) / (double)st.points, b),
                     num_ratio((double)st.forwarded_points / (double)st.points, f), num_ratio(st.imbalance, im));
             if (an.active)
                 fprintf(out, "mpi: per-point distances: %s bytes moved per point, %s of the points forwarded\n",
