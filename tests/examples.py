@@ -200,8 +200,12 @@ def outputs_of(words):
 
 
 def sides(words):
-    """The two file arguments (the last two words that are not options' values)."""
-    return words[-2], words[-1]
+    """The two sides: the last two words, standard input named by the file
+    `cat` pipes into it."""
+    a, b = words[-2], words[-1]
+    if a.endswith(":-") and words[0] == "cat":
+        a = words[1]
+    return a, b
 
 
 def check_output(src, cmd, words, out):
