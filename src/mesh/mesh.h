@@ -1,0 +1,63 @@
+/*
+ * mesh.h -- the surface layer's front header (src/mesh/): the distance from
+ * a point to a triangle, correctly rounded.
+ *
+ * The kernel's one promise: hd__tri_nearest() returns in `d` the true
+ * Euclidean distance from p to the closed triangle abc (the convex hull of
+ * its three corners, so a degenerate triangle is the segment or the point it
+ * collapses to), rounded to the nearest double, ties to even.  Two calls on
+ * the same doubles return the same bits on every machine with IEEE double
+ * arithmetic, whatever the thread or the order of calls, so a search that
+ * keeps the smallest `d` with the smallest triangle index is bit-identical
+ * to a brute force over every triangle.  Rounding is monotone, so the
+ * rounded distance to a mesh is the smallest rounded distance to its
+ * triangles.
+ *
+ * How (tri.c has the proofs): the nearest feature (a corner, an edge or the
+ * face) is chosen by Ericson's Voronoi-region tests evaluated in doubles,
+ * each accepted only when its computed sign exceeds a proven bound on its
+ * rounding error; the squared distance N/M of that feature is evaluated in
+ * double-double arithmetic with a running error bound; and the rounding of
+ * sqrt(N/M) is decided by the signs of N - m^2 M at the two midpoints m
+ * around the candidate.  When any of these signs is not certain (a point on
+ * a region's boundary, a degenerate or nearly degenerate triangle, a
+ * distance within about 2^-90 of a midpoint, coordinates far apart in
+ * scale), the same questions are answered in exact integer arithmetic
+ * (exact.c): every double is an integer times a power of two.
+ *
+ * The closest point and the barycentric weights are computed in doubles from
+ * the exact feature: they are the point of that feature nearest to p up to a
+ * few rounding errors, not correctly rounded.
+ *
+ * Domain: every coordinate finite with magnitude at most 2^511 (the library
+ * validates points to 1e153); outside it the call returns HD_ERANGE.
+ * Thread safety: none needed; the call reads its arguments and writes *out.
+ */
+#ifndef HD_MESH_H
+#define HD_MESH_H
+
+#include "base/base.h"
+
+/* The feature of the triangle that holds the closest point. */
+typedef enum hd__tri_feature {
+    HD__TRI_FACE = 0,
+    HD__TRI_EDGE_AB, HD__TRI_EDGE_BC, HD__TRI_EDGE_CA,
+    HD__TRI_VERTEX_A, HD__TRI_VERTEX_B, HD__TRI_VERTEX_C
+} hd__tri_feature_t;
+
+typedef struct hd__tri_near {
+    double d;                 /* the distance, correctly rounded */
+    double point[3];          /* the closest point (see above) */
+    double bary[3];           /* its weights of a, b and c, summing to about 1 */
+    hd__tri_feature_t feature;
+    int exact;                /* 1 when exact arithmetic decided (counted by tests) */
+} hd__tri_near_t;
+
+int hd__tri_nearest(const double p[3], const double a[3], const double b[3],
+                    const double c[3], hd__tri_near_t *out);
+
+/* The same answer from exact arithmetic alone (tests compare the two). */
+int hd__tri_nearest_exact(const double p[3], const double a[3], const double b[3],
+                          const double c[3], hd__tri_near_t *out);
+
+#endif

@@ -1,0 +1,427 @@
+/*
+ * tri.c -- the distance from a point to a triangle, correctly rounded
+ * (mesh.h states the promise): the fast path, and when it cannot decide,
+ * exact.c.
+ *
+ * 1. Scale.  All twelve coordinates are multiplied by the power of two that
+ *    puts the largest magnitude in [1, 2).  This is exact when no nonzero
+ *    coordinate becomes subnormal (else: exact path), and it scales every
+ *    squared distance by a power of four, so the rounding of the distance is
+ *    the same in both scales as long as the result is a normal double.
+ *
+ * 2. The feature.  Ericson's tests (Real-Time Collision Detection, 5.1.5)
+ *    name the Voronoi region of p exactly when they are evaluated exactly on
+ *    a non-degenerate triangle.  Each is evaluated in doubles from rounded
+ *    differences, and its sign is accepted only when |value| exceeds
+ *    c u P, where P is the test's permanent (the same polynomial with every
+ *    monomial's absolute value, computed from the absolute values of the
+ *    differences) and u = 2^-53.  Every monomial of the computed value
+ *    carries at most k factors (1 + delta_i), |delta_i| <= u, one for each
+ *    subtraction, product and sum that formed it, so the computed value is
+ *    within gamma_k P of the exact one (Higham, Accuracy and Stability of
+ *    Numerical Algorithms, 3.1); computing P itself rounds it down by at most
+ *    (1 - u)^k.  k is 4 for n = AB x AC, 5 for the dot products d1..d6, 6
+ *    for their differences and 12 for va, vb, vc: c = 8, 8, 8 and 16 cover
+ *    gamma_k (1 - u)^-k with room.  Every bound also carries 2^-1000, what
+ *    underflow could lose, so that no computed zero is ever taken for an
+ *    exact one.  Non-degenerate is accepted when some component of n is
+ *    certainly nonzero.  Any sign not certain sends the call to exact.c.
+ *
+ * 3. The squared distance N / M of that feature (exact.c lists the
+ *    formulas) in double-double arithmetic from the exact differences
+ *    (two_sum).  Each value carries an absolute error bound: a product of
+ *    double-doubles (DWTimesDW1) is within 7 u^2 of the exact product of
+ *    its operands and a sum (AccurateDWPlusDW) within 3 u^2 / (1 - 4u) of the
+ *    exact sum (Joldes, Muller, Popescu, ACM TOMS 44(2), 2017, the bounds
+ *    used here with room: 16 u^2 and 4 u^2 of the result's leading part);
+ *    the operands' own errors propagate as |x| e_y + |y| e_x + e_x e_y and
+ *    e_x + e_y.  Each bound is computed in doubles and multiplied by
+ *    1 + 2^-40, which covers the roundings of its own formula.
+ *
+ * 4. The rounding.  q0 = sqrt(N / M) in doubles is within two ulps of
+ *    t = sqrt(N / M) once N and M are known to 2^-60 relatively.  With
+ *    W >= |N - q0^2 M| from the double-double residual and its bound,
+ *    |t - q0| <= W / (M (t + q0)); when that is below the half gap to both
+ *    neighbours of q0, q0 is the nearest double.  Otherwise the sign of the
+ *    residual says on which side of q0 t lies, and the sign of N - m^2 M at
+ *    the midpoint m on that side (m^2 is the exact sum of q0^2, 2 q0 g and
+ *    g^2 for the half gap g) says whether t rounds to q0 or beyond it.  A
+ *    sign that is not certain (t within about 2^-90 of a midpoint, or equal
+ *    to it) goes to exact.c, which also rounds ties to even.
+ */
+#include <math.h>
+#include <stdint.h>
+#include <string.h>
+
+#include "mesh/mesh_int.h"
+
+#define U 0x1p-53
+#define C_ADD (4 * U * U)
+#define C_MUL (16 * U * U)
+#define SLACK (1 + 0x1p-40)
+#define TINY 0x1p-1000
+
+/* ---- error-free transformations (exact barring overflow and underflow) -- */
+
+HD__INLINE void two_sum(double a, double b, double *s, double *e) {
+    double x = a + b, bb = x - a;
+    *s = x;
+    *e = (a - (x - bb)) + (b - bb);
+}
+
+/* |a| >= |b| or a == 0. */
+HD__INLINE void fast_two_sum(double a, double b, double *s, double *e) {
+    double x = a + b;
+    *s = x;
+    *e = b - (x - a);
+}
+
+HD__INLINE void two_prod(double a, double b, double *p, double *e) {
+    double x = a * b;
+    double ta = 134217729.0 * a, ah = ta - (ta - a), al = a - ah;
+    double tb = 134217729.0 * b, bh = tb - (tb - b), bl = b - bh;
+    *p = x;
+    *e = ((ah * bh - x) + ah * bl + al * bh) + al * bl;
+}
+
+/* ---- powers of two and binades, by their bits -------------------------- */
+
+/* 2^e for a normal result (-1022 <= e <= 1023). */
+HD__INLINE double pow2(int e) {
+    uint64_t bits = (uint64_t)(e + 1023) << 52;
+    double r;
+    memcpy(&r, &bits, sizeof r);
+    return r;
+}
+
+/* floor(log2(x)) for a normal x > 0. */
+HD__INLINE int binade(double x) {
+    uint64_t bits;
+    memcpy(&bits, &x, sizeof bits);
+    return (int)((bits >> 52) & 0x7ff) - 1023;
+}
+
+/* ---- double-doubles with an error bound ------------------------------- */
+
+/* h + l with |l| <= u |h|, within e of the exact value it stands for. */
+typedef struct {
+    double h, l, e;
+} dd_t;
+
+HD__INLINE double dd_mag(dd_t x) { return fabs(x.h) * (1 + 2 * U); }
+
+HD__INLINE dd_t dd_exact(double x) { return (dd_t){x, 0, 0}; }
+
+HD__INLINE dd_t dd_diff(double a, double b) {
+    dd_t r;
+    two_sum(a, -b, &r.h, &r.l);
+    r.e = 0;
+    return r;
+}
+
+HD__INLINE dd_t dd_add(dd_t x, dd_t y) {
+    double sh, sl, th, tl, vh, vl, c, w;
+    dd_t z;
+    two_sum(x.h, y.h, &sh, &sl);
+    two_sum(x.l, y.l, &th, &tl);
+    c = sl + th;
+    fast_two_sum(sh, c, &vh, &vl);
+    w = tl + vl;
+    fast_two_sum(vh, w, &z.h, &z.l);
+    z.e = (C_ADD * fabs(z.h) + x.e + y.e) * SLACK + TINY;
+    return z;
+}
+
+HD__INLINE dd_t dd_neg(dd_t x) { return (dd_t){-x.h, -x.l, x.e}; }
+
+HD__INLINE dd_t dd_sub(dd_t x, dd_t y) { return dd_add(x, dd_neg(y)); }
+
+HD__INLINE dd_t dd_mul(dd_t x, dd_t y) {
+    double ch, cl1, cl2, cl3;
+    dd_t z;
+    two_prod(x.h, y.h, &ch, &cl1);
+    cl2 = x.l * y.h + x.h * y.l;
+    cl3 = cl1 + cl2;
+    fast_two_sum(ch, cl3, &z.h, &z.l);
+    z.e = (C_MUL * fabs(z.h) + dd_mag(x) * y.e + (dd_mag(y) + y.e) * x.e) * SLACK + TINY;
+    return z;
+}
+
+typedef struct {
+    dd_t x[3];
+} ddv_t;
+
+static ddv_t ddv_diff(const double *p, const double *q) {
+    ddv_t r;
+    for (int i = 0; i < 3; i++) r.x[i] = dd_diff(p[i], q[i]);
+    return r;
+}
+
+static dd_t ddv_dot(const ddv_t *a, const ddv_t *b) {
+    dd_t s = dd_mul(a->x[0], b->x[0]);
+    s = dd_add(s, dd_mul(a->x[1], b->x[1]));
+    return dd_add(s, dd_mul(a->x[2], b->x[2]));
+}
+
+static ddv_t ddv_cross(const ddv_t *a, const ddv_t *b) {
+    ddv_t r;
+    for (int i = 0; i < 3; i++) {
+        int j = (i + 1) % 3, k = (i + 2) % 3;
+        r.x[i] = dd_sub(dd_mul(a->x[j], b->x[k]), dd_mul(a->x[k], b->x[j]));
+    }
+    return r;
+}
+
+/* ---- step 2: the feature, from filtered signs ------------------------- */
+
+/* A value computed in doubles and a bound on its distance from the exact. */
+typedef struct {
+    double v, b;
+} est_t;
+
+enum { NO = 0, YES = 1, UNSURE = 2 };
+
+HD__INLINE int le0(est_t x) { return x.v < -x.b ? YES : x.v > x.b ? NO : UNSURE; }
+HD__INLINE int ge0(est_t x) { return x.v > x.b ? YES : x.v < -x.b ? NO : UNSURE; }
+HD__INLINE int all2(int a, int b) { return (a == NO || b == NO) ? NO : (a == YES && b == YES) ? YES : UNSURE; }
+HD__INLINE int all3(int a, int b, int c) { return all2(all2(a, b), c); }
+
+typedef struct {
+    double v[3], m[3];      /* rounded difference and its magnitude */
+} dv_t;
+
+static dv_t dv_diff(const double *p, const double *q) {
+    dv_t r;
+    for (int i = 0; i < 3; i++) {
+        r.v[i] = p[i] - q[i];
+        r.m[i] = fabs(r.v[i]);
+    }
+    return r;
+}
+
+static est_t dot_est(const dv_t *a, const dv_t *b) {
+    est_t r;
+    r.v = a->v[0] * b->v[0] + a->v[1] * b->v[1] + a->v[2] * b->v[2];
+    r.b = a->m[0] * b->m[0] + a->m[1] * b->m[1] + a->m[2] * b->m[2];   /* permanent */
+    return r;
+}
+
+/* x - y, both dot products (k = 6). */
+static est_t diff_est(est_t x, est_t y) { return (est_t){x.v - y.v, x.b + y.b}; }
+
+/* x y - z w of dot products (k = 12); the permanents are still bare. */
+static est_t det_est(est_t x, est_t y, est_t z, est_t w) {
+    return (est_t){x.v * y.v - z.v * w.v, (x.b * y.b + z.b * w.b) * (16 * U) + TINY};
+}
+
+static est_t bounded(est_t x, double c) { return (est_t){x.v, x.b * c + TINY}; }
+
+/* Some component of AB x AC certainly nonzero (k = 4). */
+static int spans_plane(const dv_t *ab, const dv_t *ac) {
+    for (int i = 0; i < 3; i++) {
+        int j = (i + 1) % 3, k = (i + 2) % 3;
+        double v = ab->v[j] * ac->v[k] - ab->v[k] * ac->v[j];
+        double b = (ab->m[j] * ac->m[k] + ab->m[k] * ac->m[j]) * (8 * U) + TINY;
+        if (fabs(v) > b) return 1;
+    }
+    return 0;
+}
+
+typedef struct {
+    hd__tri_feature_t feature;
+    double s, t;            /* the face's closest point: a + s AB + t AC */
+} region_t;
+
+/* Ericson's classification; 0 when a sign it needs is not certain. */
+static int classify(const double *p, const double *a, const double *b, const double *c,
+                    region_t *r) {
+    dv_t ab = dv_diff(b, a), ac = dv_diff(c, a);
+    if (!spans_plane(&ab, &ac)) return 0;
+    dv_t ap = dv_diff(p, a), bp = dv_diff(p, b), cp = dv_diff(p, c);
+    est_t d1 = dot_est(&ab, &ap), d2 = dot_est(&ac, &ap), d3 = dot_est(&ab, &bp);
+    est_t d4 = dot_est(&ac, &bp), d5 = dot_est(&ab, &cp), d6 = dot_est(&ac, &cp);
+    est_t e1 = bounded(d1, 8 * U), e2 = bounded(d2, 8 * U), e3 = bounded(d3, 8 * U);
+    est_t e6 = bounded(d6, 8 * U);
+    int k;
+    if ((k = all2(le0(e1), le0(e2))) != NO) { r->feature = HD__TRI_VERTEX_A; return k == YES; }
+    est_t d43 = bounded(diff_est(d4, d3), 8 * U);
+    if ((k = all2(ge0(e3), le0(d43))) != NO) { r->feature = HD__TRI_VERTEX_B; return k == YES; }
+    est_t vc = det_est(d1, d4, d3, d2);
+    if ((k = all3(le0(vc), ge0(e1), le0(e3))) != NO) {
+        r->feature = HD__TRI_EDGE_AB;
+        return k == YES;
+    }
+    est_t d56 = bounded(diff_est(d5, d6), 8 * U);
+    if ((k = all2(ge0(e6), le0(d56))) != NO) { r->feature = HD__TRI_VERTEX_C; return k == YES; }
+    est_t vb = det_est(d5, d2, d1, d6);
+    if ((k = all3(le0(vb), ge0(e2), le0(e6))) != NO) {
+        r->feature = HD__TRI_EDGE_CA;
+        return k == YES;
+    }
+    est_t va = det_est(d3, d6, d5, d4);
+    if ((k = all3(le0(va), ge0(d43), ge0(d56))) != NO) {
+        r->feature = HD__TRI_EDGE_BC;
+        return k == YES;
+    }
+    double den = va.v + vb.v + vc.v;
+    r->feature = HD__TRI_FACE;
+    r->s = vb.v / den;
+    r->t = vc.v / den;
+    return 1;
+}
+
+/* ---- step 3: N and M of the feature ------------------------------------ */
+
+/* The feature's squared distance N / M and its closest point, in the scale
+ * of the coordinates given: p less its offset from the plane (the face),
+ * x + t xy with t from double-doubles (an edge), or the corner. */
+typedef struct {
+    dd_t N, M;
+    double point[3], t;
+} sqd_t;
+
+static void feature_sqd(const double *p, const double *a, const double *b, const double *c,
+                        hd__tri_feature_t f, sqd_t *r) {
+    const double *x = a, *y = b;
+    switch (f) {
+    case HD__TRI_FACE: {
+        ddv_t ab = ddv_diff(b, a), ac = ddv_diff(c, a), ap = ddv_diff(p, a);
+        ddv_t n = ddv_cross(&ab, &ac);
+        dd_t g = ddv_dot(&n, &ap);
+        r->N = dd_mul(g, g);
+        r->M = ddv_dot(&n, &n);
+        double k = g.h / r->M.h;
+        for (int i = 0; i < 3; i++) r->point[i] = p[i] - n.x[i].h * k;
+        return;
+    }
+    case HD__TRI_VERTEX_A: case HD__TRI_VERTEX_B: case HD__TRI_VERTEX_C: {
+        const double *v = f == HD__TRI_VERTEX_A ? a : f == HD__TRI_VERTEX_B ? b : c;
+        ddv_t vp = ddv_diff(p, v);
+        r->N = ddv_dot(&vp, &vp);
+        r->M = dd_exact(1);
+        memcpy(r->point, v, sizeof r->point);
+        return;
+    }
+    case HD__TRI_EDGE_AB: x = a; y = b; break;
+    case HD__TRI_EDGE_BC: x = b; y = c; break;
+    case HD__TRI_EDGE_CA: x = c; y = a; break;
+    }
+    ddv_t xy = ddv_diff(y, x), xp = ddv_diff(p, x);
+    ddv_t cr = ddv_cross(&xp, &xy);
+    r->N = ddv_dot(&cr, &cr);
+    r->M = ddv_dot(&xy, &xy);
+    r->t = ddv_dot(&xp, &xy).h / r->M.h;
+    for (int i = 0; i < 3; i++) r->point[i] = x[i] + r->t * xy.x[i].h;
+}
+
+/* ---- step 4: the rounding ----------------------------------------------- */
+
+/* N - x M for x = q^2 + 2 sigma q g + g^2 (sigma 0: x = q^2). */
+static dd_t residual(dd_t N, dd_t M, double q, int sigma, double g) {
+    dd_t x;
+    two_prod(q, q, &x.h, &x.l);
+    x.e = 0;
+    if (sigma) {
+        x = dd_add(x, dd_exact(2 * sigma * q * g));
+        x = dd_add(x, dd_exact(g * g));
+    }
+    return dd_sub(N, dd_mul(x, M));
+}
+
+HD__INLINE int certain_sign(dd_t v) {
+    double m = fabs(v.h) * (1 - 2 * U);
+    return m > v.e ? (v.h > 0 ? 1 : -1) : 0;
+}
+
+/* The double nearest sqrt(N / M) into *q; 0 when not decided. */
+static int round_sqrt(dd_t N, dd_t M, double *q) {
+    if (!(N.h > 0 && M.h > 0) || N.e > N.h * 0x1p-60 || M.e > M.h * 0x1p-60) return 0;
+    double q0 = sqrt(N.h / M.h);
+    for (int step = 0; step < 4; step++) {
+        if (!(q0 >= 0x1p-400)) return 0;
+        int ex = binade(q0);
+        double up = pow2(ex - 53);                           /* half the gap above */
+        double down = q0 == pow2(ex) ? up / 2 : up;          /* half the gap below */
+        dd_t v = residual(N, M, q0, 0, 0);
+        double w = fabs(v.h) * (1 + 2 * U) + v.e;
+        double dist = w / (M.h * 2 * q0) * (1 + 0x1p-40);   /* >= |t - q0| */
+        if (dist < down * (1 - 0x1p-30)) { *q = q0; return 1; }
+        int side = certain_sign(v);
+        if (side == 0) return 0;
+        double g = side > 0 ? up : down;
+        int beyond = certain_sign(residual(N, M, q0, side, g));
+        if (beyond == 0) return 0;
+        if (beyond != side) { *q = q0; return 1; }
+        q0 = nextafter(q0, side > 0 ? INFINITY : 0);
+    }
+    return 0;
+}
+
+/* ---- the call ------------------------------------------------------------ */
+
+/* The weights of a, b and c; an edge's from its t in double-doubles, the
+ * face's from Ericson's areas in doubles. */
+static void weigh(hd__tri_near_t *out, const region_t *r, double t) {
+    double *w = out->bary;
+    w[0] = w[1] = w[2] = 0;
+    switch (r->feature) {
+    case HD__TRI_VERTEX_A: w[0] = 1; break;
+    case HD__TRI_VERTEX_B: w[1] = 1; break;
+    case HD__TRI_VERTEX_C: w[2] = 1; break;
+    case HD__TRI_EDGE_AB: w[0] = 1 - t; w[1] = t; break;
+    case HD__TRI_EDGE_BC: w[1] = 1 - t; w[2] = t; break;
+    case HD__TRI_EDGE_CA: w[2] = 1 - t; w[0] = t; break;
+    case HD__TRI_FACE: w[1] = r->s; w[2] = r->t; w[0] = 1 - r->s - r->t; break;
+    }
+}
+
+/* Step 1: the scaled copies; 0 when scaling would not be exact. */
+static int scale(const double *const in[4], double out[4][3], int *s) {
+    double big = 0, small = INFINITY;
+    for (int i = 0; i < 4; i++)
+        for (int k = 0; k < 3; k++) {
+            double m = fabs(in[i][k]);
+            big = m > big ? m : big;
+            if (m > 0 && m < small) small = m;
+        }
+    if (big < 0x1p-900 || big > 0x1p511) return 0;
+    *s = -binade(big);
+    double f = pow2(*s);             /* -511 <= s <= 900: a normal double */
+    if (small * f < 0x1p-1022) return 0;
+    for (int i = 0; i < 4; i++)
+        for (int k = 0; k < 3; k++) out[i][k] = in[i][k] * f;
+    return 1;
+}
+
+int hd__tri_nearest(const double p[3], const double a[3], const double b[3],
+                    const double c[3], hd__tri_near_t *out) {
+    const double *in[4] = {p, a, b, c};
+    double sc[4][3], q;
+    int s;
+    region_t r = {HD__TRI_FACE, 0, 0};
+    for (int i = 0; i < 4; i++)
+        for (int k = 0; k < 3; k++)
+            if (!(fabs(in[i][k]) <= 0x1p511)) return HD_ERANGE;
+    for (int i = 1; i < 4; i++)
+        if (p[0] == in[i][0] && p[1] == in[i][1] && p[2] == in[i][2]) {
+            r.feature = (hd__tri_feature_t)(HD__TRI_VERTEX_A + i - 1);
+            out->d = 0;                 /* p is a corner */
+            out->feature = r.feature;
+            out->exact = 0;
+            memcpy(out->point, p, sizeof out->point);
+            weigh(out, &r, 0);
+            return HD_OK;
+        }
+    if (!scale(in, sc, &s) || !classify(sc[0], sc[1], sc[2], sc[3], &r))
+        return hd__tri_nearest_exact(p, a, b, c, out);
+    sqd_t f = {.t = 0};
+    feature_sqd(sc[0], sc[1], sc[2], sc[3], r.feature, &f);
+    if (!round_sqrt(f.N, f.M, &q) || !(q * pow2(-s) >= 0x1p-1022))
+        return hd__tri_nearest_exact(p, a, b, c, out);
+    out->d = q * pow2(-s);           /* exact: a normal result */
+    out->feature = r.feature;
+    out->exact = 0;
+    for (int i = 0; i < 3; i++) out->point[i] = f.point[i] * pow2(-s);
+    weigh(out, &r, f.t);
+    return HD_OK;
+}
