@@ -47,7 +47,8 @@ def xyz(points):
 
 def make_tiles(tmp, rng):
     """A: a directory of 7 tiles of a jittered lattice (ties across tiles
-    and regions, a duplicate point in two tiles, an empty-looking gap);
+    and regions, a duplicate point in two tiles, an empty-looking gap) and
+    a README.txt (not a tile: skipped and reported);
     B: @list of 5 tiles of the same lattice shifted half a step in x, one
     tile far away (a nearest neighbour regions away)."""
     pts = [(float(x), float(y), float(z)) for x in range(9) for y in range(9) for z in range(6)]
@@ -55,6 +56,7 @@ def make_tiles(tmp, rng):
     a = pts[:300] + [pts[0]]
     for t in range(7):
         write(os.path.join(tmp, "A", "t%d.xyz" % t), xyz(a[t * 43:(t + 1) * 43]))
+    write(os.path.join(tmp, "A", "README.txt"), "Tiles of a lattice.\nOne file a part.\n")  # skipped, reported
     b = [(x + 0.5, y, z) for (x, y, z) in pts[100:400]]
     names = []
     for t in range(4):
@@ -213,6 +215,29 @@ def main():
         # A missing file: every rank fails alike.
         rc, out, err = ranks(mpirun, k, tool, os.path.join(tmp, "nope.xyz"), lion)
         check(rc == 2 and err.count("nope.xyz") == 1, "missing file: exit %d, %r" % (rc, err))
+        # A stream cannot be a tile, nor a side: the ranks read each input
+        # themselves, some twice (a count, then ranges); a FIFO listed as a
+        # tile was used up by the count and read empty (with --empty zero,
+        # a wrong distance).  Refused at once, with hausdorff's message for
+        # a list.
+        fifo = os.path.join(tmp, "stream", "f.xyz")
+        os.makedirs(os.path.dirname(fifo))
+        os.mkfifo(fifo)
+        lst = write(os.path.join(tmp, "stream", "l.txt"), "f.xyz\n" + os.path.join(tmp, "small_b.xyz") + "\n")
+        rc, out, err = ranks(mpirun, k, tool, "--empty", "zero", "@" + lst, lion)
+        rc1, _, err1 = single(hausdorff, "--empty", "zero", "@" + lst, lion)
+        lines = [l for l in err.splitlines() if l.startswith("hausdorff-mpi:")]
+        want = "l.txt:1: %s is a FIFO or pipe, not a regular file" % fifo
+        check(rc == 2 and rc1 == 2 and len(lines) == 1 and want in lines[0] and out == "" and
+              err1.split(": ", 1)[1] == lines[0].split(": ", 1)[1] + "\n",
+              "a FIFO in a list: exit %d / %d, %r, %r" % (rc, rc1, err, err1))
+        for side, stdin in ((fifo, None), ("-", b"1 2 3\n")):
+            p = subprocess.run(mpirun + ["-n", str(k), tool, side, lion], input=stdin, capture_output=True,
+                               timeout=120)
+            err = p.stderr.decode()
+            lines = [l for l in err.splitlines() if l.startswith("hausdorff-mpi:")]
+            check(p.returncode == 2 and len(lines) == 1 and "cannot be read by hausdorff-mpi" in lines[0] and
+                  "save it to a file" in lines[0], "%s as a side: exit %d, %r" % (side, p.returncode, err))
         # --empty: an empty side gets the policy's answer, as hausdorff gives it.
         empty = write(os.path.join(tmp, "empty.xyz"), "# no points\n")
         for args in (["--empty", "inf", empty, lion], ["--empty", "zero", "--directed", lion, empty],
