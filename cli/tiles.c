@@ -574,8 +574,11 @@ uint64_t tiles_digest(const tiles_t *s) {
         const tile_t *t = &s->t[k];
         h = fnv(h, t->path, strlen(t->path) + 1);
         h = fnv(h, t->format ? t->format : "", t->format ? strlen(t->format) + 1 : 1);
-        h = fnv(h, &t->stamped, sizeof t->stamped);
-        if (t->stamped) h = fnv(h, &t->stamp, sizeof t->stamp);
+        /* not st_dev: machines that mount one file system number it apart */
+        const tile_stamp_t *m = &t->stamp;
+        int64_t f[7] = {t->stamped, (int64_t)m->ino, (int64_t)m->size, m->mtime_s, m->mtime_ns, m->ctime_s,
+                        m->ctime_ns};
+        h = fnv(h, f, sizeof f);
     }
     for (size_t k = 0; k < s->n_skipped; k++) h = fnv(h, s->skipped[k].name, strlen(s->skipped[k].name) + 1);
     return h;
@@ -602,17 +605,27 @@ static int starts_number(const char *h, size_t n) {
 int tiles_text_has_numbers(const char *path) {
     FILE *f = fopen(path, "rb");
     if (!f) return -1;
-    unsigned char bom[3];
-    if (fread(bom, 1, 3, f) != 3 || memcmp(bom, "\xef\xbb\xbf", 3) != 0) rewind(f); /* a UTF-8 BOM: skipped */
+    /* a byte-order mark is skipped, and so are NUL bytes: UTF-16 text is
+     * judged by its characters (the reader then refuses it by name) */
+    unsigned char bom[3] = {0, 0, 0};
+    size_t got = fread(bom, 1, 3, f);
+    int skip = got == 3 && memcmp(bom, "\xef\xbb\xbf", 3) == 0                                       ? 3
+               : got >= 2 && ((bom[0] == 0xff && bom[1] == 0xfe) || (bom[0] == 0xfe && bom[1] == 0xff)) ? 2
+                                                                                                        : 0;
+    if (fseek(f, skip, SEEK_SET) != 0) {
+        fclose(f);
+        return -1;
+    }
     char head[16]; /* the start of the line being read */
     size_t n = 0;
     int c, found = 0, open_line = 1; /* open_line: head is still being filled */
     while (!found && (c = getc(f)) != EOF) {
+        if (c == 0) continue;
         if (c == '\n' || c == '\r') { /* '\r' too: a line of a file the reader may refuse, never a skip */
             found = n && starts_number(head, n);
             n = 0;
             open_line = 1;
-        } else if (open_line && !(n == 0 && (c == ' ' || c == '\t' || c == '\f' || c == '\v' || c == ',' || c == ';'))) {
+        } else if (open_line && !(n == 0 && strchr(" \t\f\v,;", c))) {
             head[n++] = (char)c;
             if (n == sizeof head) {
                 found = starts_number(head, n);

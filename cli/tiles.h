@@ -136,7 +136,8 @@ int tiles_read_points(tiles_t *s, uint64_t g, uint64_t m,
                       int which, hd_cloud_t **out, hd_error_t *err);
 
 /* A digest of what expanding a side found: its kind, every tile's path,
- * format and stamp, every skipped entry.  Processes that expanded the same
+ * format and stamp (but its device number, which differs between machines
+ * that mount one file system), every skipped entry.  Processes that expanded the same
  * side each on its own compare digests: a side that changed between their
  * listings is refused rather than read as two different sides. */
 uint64_t tiles_digest(const tiles_t *s);
@@ -147,8 +148,8 @@ uint64_t tiles_digest(const tiles_t *s);
 const char *tiles_stream(const char *path);
 
 /* Whether the text file at path has a line that starts with a number:
- * after blanks, commas and semicolons (and a UTF-8 byte-order mark at the
- * start), a digit, '+', '-' or '.' before a digit, or the word nan, inf or
+ * after blanks, commas and semicolons (a byte-order mark and NUL bytes
+ * aside, so UTF-16 text is judged by its characters), a digit, '+', '-' or '.' before a digit, or the word nan, inf or
  * infinity in any case; blank and comment lines hold none.  1, 0, or -1
  * when the file cannot be read.  A directory's .txt and .csv entries
  * without one are not tiles (a README, a table of words); a file with one

@@ -242,31 +242,36 @@ TEST(count_leaves_unknown_a_tile_that_changed_since_it_was_listed) {
 }
 
 TEST(text_has_numbers_when_a_line_starts_with_one) {
+#define CASE(text, want) {text, sizeof text - 1, want} /* NUL bytes kept */
     static const struct {
         const char *text;
+        size_t len;
         int want;
     } cases[] = {
-        {"", 0},
-        {"This folder holds the 2019 tiles.\nSee notes.\n", 0},
-        {"x,y,z\n", 0},
-        {"tile,date\nA1,2019\n", 0},
-        {"# comment 1 2 3\n// 4 5 6\n\n", 0},
-        {"Information\nnanometres\n", 0},
-        {".\n-\n+x\n", 0},
-        {"x y z\n1 2 3\n", 1},
-        {"  \t1 2 3", 1},
-        {",;-.5,1,2\n", 1},
-        {"+7 zebra\n", 1}, /* a malformed tile stays a tile: reading refuses it */
-        {"NaN 1 2\n", 1},
-        {"-Infinity 1 2\n", 1},
-        {"inf\n", 1},
-        {"\xef\xbb\xbf" "1 2 3\n", 1},
-        {"x y z\r1 2 3\r", 1},
-        {"a very long header line of words, longer than what is kept of it\n2 3 4\n", 1},
+        CASE("", 0),
+        CASE("This folder holds the 2019 tiles.\nSee notes.\n", 0),
+        CASE("x,y,z\n", 0),
+        CASE("tile,date\nA1,2019\n", 0),
+        CASE("# comment 1 2 3\n// 4 5 6\n\n", 0),
+        CASE("Information\nnanometres\n", 0),
+        CASE(".\n-\n+x\n", 0),
+        CASE("x y z\n1 2 3\n", 1),
+        CASE("  \t1 2 3", 1),
+        CASE(",;-.5,1,2\n", 1),
+        CASE("+7 zebra\n", 1), /* a malformed tile stays a tile: reading refuses it */
+        CASE("NaN 1 2\n", 1),
+        CASE("-Infinity 1 2\n", 1),
+        CASE("inf\n", 1),
+        CASE("\xef\xbb\xbf" "1 2 3\n", 1),
+        CASE("x y z\r1 2 3\r", 1),
+        CASE("\xff\xfe" "1\0 \0" "2\0 \0" "3\0", 1), /* UTF-16: a tile, which the reader refuses by name */
+        CASE("\xff\xfe" "R\0e\0a\0d\0", 0),
+        CASE("a very long header line of words, longer than what is kept of it\n2 3 4\n", 1),
     };
+#undef CASE
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
         CONTEXT("case %zu: %s", k, cases[k].text);
-        CHECK_EQ(tiles_text_has_numbers(tf_printf("t.txt", "%s", cases[k].text)), cases[k].want);
+        CHECK_EQ(tiles_text_has_numbers(tf_write("t.txt", cases[k].text, cases[k].len)), cases[k].want);
     }
     CHECK_EQ(tiles_text_has_numbers(tf_path("missing.txt")), -1);
 }

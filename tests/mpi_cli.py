@@ -405,8 +405,10 @@ def main():
             print("mpi_cli: SKIPPED " + skipped[-1], file=sys.stderr)
         else:
             try:
-                refused(["--distances", os.path.join(fullfs, "d.csv"), full_a, full_b], fullfs, "No space left on device")
-                refused(["--distances", os.path.join(fullfs, "d.npy"), full_c, full_c], fullfs, "No space left on device")
+                refused(["--distances", os.path.join(fullfs, "d.csv"), full_a, full_b], fullfs,
+                        "No space left on device")
+                refused(["--distances", os.path.join(fullfs, "d.npy"), full_c, full_c], fullfs,
+                        "No space left on device")
             finally:
                 subprocess.run(["umount", fullfs])
         limited = os.path.join(tmp, "limited")
