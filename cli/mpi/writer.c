@@ -218,11 +218,13 @@ static int put_at(int fd, const unsigned char *buf, size_t n, uint64_t off) {
 }
 
 /* This rank's rows at off of the temporary tmp (rank 0: the header at 0
- * first), then fsync and close: 0, or the errno of the first failure. */
+ * first), then fsync and close: 0, or the errno of the first failure.  A
+ * rank without rows does not open the file. */
 static int rows_at(const char *tmp, const dist_layout_t *lay, const hd_points_t *P, const double *d,
                    const size_t *nearest, uint64_t off, unsigned char *buf) {
     int rank;
     MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+    if (rank != 0 && !P->count) return 0;
     int fd = open(tmp, O_WRONLY | O_CLOEXEC);
     if (fd < 0) return errno ? errno : -1;
     int e = rank == 0 ? put_at(fd, buf, distances_header(lay, (char *)buf), 0) : 0;
@@ -237,10 +239,15 @@ static int rows_at(const char *tmp, const dist_layout_t *lay, const hd_points_t 
     return e;
 }
 
-/* Rank 0, once every rank wrote: the temporary holds exactly `end` bytes. */
+/* Rank 0, once every rank wrote: the temporary holds exactly `end` bytes.
+ * Opened, not stat'ed by name: an open revalidates what a network file
+ * system caches of a file that other machines wrote (NFS's close-to-open). */
 static int check_length(const char *path, const char *tmp, uint64_t end, hd_error_t *err) {
     struct stat st;
-    if (stat(tmp, &st) != 0) return write_failed(path, errno, err);
+    int fd = open(tmp, O_RDONLY | O_CLOEXEC), e = 0;
+    if (fd < 0 || fstat(fd, &st) != 0) e = errno ? errno : -1;
+    if (fd >= 0) close(fd);
+    if (e) return write_failed(path, e, err);
     if ((uint64_t)st.st_size == end) return HD_OK;
     snprintf(err->message, sizeof err->message, "%.800s: cannot write: the file holds %llu bytes of the %llu written",
              path, (unsigned long long)st.st_size, (unsigned long long)end);
