@@ -385,7 +385,7 @@ static int from_list(const tiles_t *s, const tile_t *t, int rc, hd_error_t *err)
 static int changed(const tile_t *t, hd_error_t *err) {
     return fail(err, HD_EIO, 0,
                 "%s: changed during the run (not the file it was when the side was listed: its size, times or "
-                "identity differ, or its header's count); run again once nothing writes it",
+                "identity differ, or its points its header's count); run again once nothing writes it",
                 t->path);
 }
 

@@ -64,7 +64,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-/* Bytes a rank writes per round. */
+/* Bytes a rank formats and writes at a time (and sends, to a stream). */
 #define CHUNK ((size_t)1 << 20)
 
 int mpi_agree(int rc, hd_error_t *err) {
