@@ -12,11 +12,24 @@
  *    the same points whether a side is one file or its tiles.
  *  - Nothing is guessed.  A directory is not recursed; its entries that are
  *    not tiles (hidden, directories, other extensions, NIfTI masks, FIFOs
- *    and devices) are kept in `skipped` with the reason, for the report.
- *    An entry named like a point file that cannot be stat'ed (a dangling
- *    link) stays a tile, so reading it fails with its name instead of the
- *    side silently losing points.  A list's missing or unsuitable file is
- *    an error naming LIST:LINE before any point is read.
+ *    and devices, a .txt or .csv without a line that starts with a number)
+ *    are kept in `skipped` with the reason, for the report.  A text file
+ *    with such a line stays a tile however its later lines read, so a
+ *    malformed tile is an error, never a skip.  An entry named like a
+ *    point file that cannot be stat'ed (a dangling link) stays a tile, so
+ *    reading it fails with its name instead of the side silently losing
+ *    points.  A list's missing or unsuitable file (a directory, a mask, a
+ *    stream) is an error naming LIST:LINE before any point is read.
+ *  - A tile is read as the file it was when listed.  A tile may be read
+ *    more than once and by other processes (hausdorff-mpi counts points
+ *    from headers, then other ranks read ranges), so a tile is a regular
+ *    file: a stream (FIFO, device, standard input) is skipped in a
+ *    directory and refused in a list, since the first read would use it
+ *    up.  Each regular file's stat when listed is its stamp; reading
+ *    compares the file's stat with it before and after (and a range's
+ *    points with the count the header gave), so a tile rewritten, grown
+ *    or replaced between the listing, the count and the read is "changed
+ *    during the run", never read in part.
  *  - One side is one file when it is neither a directory nor @LIST; then
  *    tiles_read is exactly cli_read_points on it (masks, standard input,
  *    the --empty policy; seed + 0), and the cloud it returns is the
@@ -87,9 +100,24 @@ static char *join(const char *dir, size_t dirlen, const char *name) {
     return p;
 }
 
-/* Append a tile (taking `path`); HD_ENOMEM frees it. */
+static tile_stamp_t stamp_of(const struct stat *st) {
+    return (tile_stamp_t){(uint64_t)st->st_dev,      (uint64_t)st->st_ino,   (uint64_t)st->st_size,
+                          (int64_t)st->st_mtim.tv_sec, st->st_mtim.tv_nsec, (int64_t)st->st_ctim.tv_sec,
+                          st->st_ctim.tv_nsec};
+}
+
+/* Whether path is still the regular file stamped t. */
+static int unchanged(const tile_t *t) {
+    struct stat st;
+    if (stat(t->path, &st) != 0 || !S_ISREG(st.st_mode)) return 0;
+    tile_stamp_t now = stamp_of(&st);
+    return memcmp(&now, &t->stamp, sizeof now) == 0;
+}
+
+/* Append a tile (taking `path`, with its stat st when known); HD_ENOMEM
+ * frees it. */
 static int add_tile(tiles_t *s, size_t *cap, char *path, const char *format, long line, uint64_t bytes,
-                    hd_error_t *err) {
+                    const struct stat *st, hd_error_t *err) {
     if (s->n == *cap) {
         size_t nc = *cap ? *cap * 2 : 16;
         tile_t *t = nc <= SIZE_MAX / sizeof *t ? realloc(s->t, nc * sizeof *t) : NULL;
@@ -100,23 +128,35 @@ static int add_tile(tiles_t *s, size_t *cap, char *path, const char *format, lon
         s->t = t;
         *cap = nc;
     }
-    s->t[s->n++] = (tile_t){path, format, line, bytes, 0, 0};
+    tile_t *t = &s->t[s->n++];
+    *t = (tile_t){path, format, line, bytes, 0, 0, 0, {0, 0, 0, 0, 0, 0, 0}};
+    if (st && S_ISREG(st->st_mode)) {
+        t->stamped = 1;
+        t->stamp = stamp_of(st);
+    }
     return HD_OK;
 }
 
 static int by_name(const void *x, const void *y) { return strcmp(*(char *const *)x, *(char *const *)y); }
 
-/* Why a directory entry is not a tile, or NULL when it is one. */
-static const char *not_a_tile(const char *name, const char *path, uint64_t *bytes) {
-    struct stat st;
-    *bytes = 0;
+/* 1 when name ends with .txt or .csv (any case): extensions that other
+ * documents share with text points. */
+static int generic_text(const char *name) {
+    const char *dot = strrchr(name, '.');
+    return dot && (strcasecmp(dot, ".txt") == 0 || strcasecmp(dot, ".csv") == 0);
+}
+
+/* Why a directory entry is not a tile, or NULL when it is one (*st its
+ * stat, *known whether stat succeeded). */
+static const char *not_a_tile(const char *name, const char *path, struct stat *st, int *known) {
     if (name[0] == '.') return "hidden";
-    int known = stat(path, &st) == 0;
-    if (known && S_ISDIR(st.st_mode)) return "a directory, not recursed";
+    *known = stat(path, st) == 0;
+    if (*known && S_ISDIR(st->st_mode)) return "a directory, not recursed";
     if (nifti_is_mask_path(name)) return "a NIfTI mask, read alone and not as a tile";
     if (!hd_format_of_path(name)) return "no point format has this extension";
-    if (known && !S_ISREG(st.st_mode)) return "not a regular file";
-    if (known) *bytes = (uint64_t)st.st_size;
+    if (*known && !S_ISREG(st->st_mode)) return "not a regular file";
+    if (*known && generic_text(name) && tiles_text_has_numbers(path) == 0)
+        return "text without a line that starts with a number";
     return NULL;
 }
 
@@ -152,10 +192,11 @@ static int expand_dir(tiles_t *s, const char *format, hd_error_t *err) {
             rc = fail(err, HD_ENOMEM, 0, "%s: out of memory", s->arg);
             break;
         }
-        uint64_t bytes;
-        const char *why = not_a_tile(names[k], path, &bytes);
+        struct stat st;
+        int known = 0;
+        const char *why = not_a_tile(names[k], path, &st, &known);
         if (!why) {
-            rc = add_tile(s, &tcap, path, format, 0, bytes, err);
+            rc = add_tile(s, &tcap, path, format, 0, known ? (uint64_t)st.st_size : 0, known ? &st : NULL, err);
             continue;
         }
         free(path);
@@ -189,6 +230,21 @@ static char *trim(char *line, size_t len) {
  * is not a list (a binary file given by mistake), and is refused before
  * getline grows its buffer to the size of the file. */
 enum { LINE_MAX_ = 4096 + 64 };
+
+/* What a file that is not regular nor a directory is, for a message. */
+static const char *stream_kind(const struct stat *st) {
+    if (S_ISFIFO(st->st_mode)) return "a FIFO or pipe";
+    if (S_ISCHR(st->st_mode)) return "a character device";
+    if (S_ISBLK(st->st_mode)) return "a block device";
+    if (S_ISSOCK(st->st_mode)) return "a socket";
+    return "not a file";
+}
+
+const char *tiles_stream(const char *path) {
+    struct stat st;
+    if (strcmp(path, "-") == 0) return "standard input";
+    return stat(path, &st) == 0 && !S_ISREG(st.st_mode) && !S_ISDIR(st.st_mode) ? stream_kind(&st) : NULL;
+}
 
 static int expand_list(tiles_t *s, const char *list, const char *format, hd_error_t *err) {
     struct stat st;
@@ -231,6 +287,11 @@ static int expand_list(tiles_t *s, const char *list, const char *format, hd_erro
         else if (S_ISDIR(st.st_mode))
             rc = fail(err, HD_EFORMAT, line, "%s:%ld: %s is a directory (a list names files, one per line)", list,
                       line, path);
+        else if (!S_ISREG(st.st_mode))
+            rc = fail(err, HD_EFORMAT, line,
+                      "%s:%ld: %s is %s, not a regular file: a tile may be read twice, and by other processes, "
+                      "which would find a stream used up (save it to a file)",
+                      list, line, path, stream_kind(&st));
         else if (!fmt && nifti_is_mask_path(path))
             rc = fail(err, HD_EFORMAT, line, "%s:%ld: %s: a NIfTI mask is read alone, not as a tile", list, line,
                       path);
@@ -238,7 +299,7 @@ static int expand_list(tiles_t *s, const char *list, const char *format, hd_erro
             free(path);
             break;
         }
-        rc = add_tile(s, &tcap, path, fmt, line, S_ISREG(st.st_mode) ? (uint64_t)st.st_size : 0, err);
+        rc = add_tile(s, &tcap, path, fmt, line, (uint64_t)st.st_size, &st, err);
     }
     if (rc == HD_OK && ferror(f)) rc = fail(err, HD_EIO, 0, "%s: cannot read the list: %s", list, strerror(errno));
     free(buf);
@@ -261,7 +322,9 @@ int tiles_expand(const char *arg, const char *format, tiles_t *out, hd_error_t *
         out->kind = TILES_FILE;
         size_t cap = 0;
         char *p = strdup(arg);
-        rc = p ? add_tile(out, &cap, p, format, 0, 0, err) : fail(err, HD_ENOMEM, 0, "%s: out of memory", arg);
+        int known = strcmp(arg, "-") != 0 && stat(arg, &st) == 0; /* bytes 0: shared as before (tiles_share) */
+        rc = p ? add_tile(out, &cap, p, format, 0, 0, known ? &st : NULL, err)
+               : fail(err, HD_ENOMEM, 0, "%s: out of memory", arg);
     }
     if (rc != HD_OK) {
         tiles_free(out);
@@ -319,6 +382,13 @@ static int from_list(const tiles_t *s, const tile_t *t, int rc, hd_error_t *err)
     return rc;
 }
 
+static int changed(const tile_t *t, hd_error_t *err) {
+    return fail(err, HD_EIO, 0,
+                "%s: changed during the run (not the file it was when the side was listed: its size, times or "
+                "identity differ, or its points its header's count); run again once nothing writes it",
+                t->path);
+}
+
 /* Read tile k (points [from, from + take) of it when take > 0) and append
  * it to *all (NULL at first: the first tile's buffer becomes the side's).
  * Fills the tile's count and first when it is read whole; a partial read
@@ -332,8 +402,12 @@ static int read_tile(tiles_t *s, size_t k, const hd_read_options_t *ro, analysis
     r.seed = ro->seed + (uint64_t)k;
     r.range_first = from;
     r.range_count = take;
-    hd_cloud_t *c;
-    int rc = cli_read_points(t->path, &r, an, which, &c, err);
+    hd_cloud_t *c = NULL;
+    int rc = t->stamped && !unchanged(t) ? changed(t, err) : cli_read_points(t->path, &r, an, which, &c, err);
+    if (rc == HD_OK && ((t->stamped && !unchanged(t)) || (take && c->count != take))) {
+        hd_cloud_free(c);
+        rc = changed(t, err);
+    }
     if (rc != HD_OK) {
         hd_cloud_free(*all);
         *all = NULL;
@@ -397,6 +471,7 @@ int tiles_count(const tiles_t *s, int rank, int parts, const hd_read_options_t *
     for (size_t k = 0; k < s->n; k++) {
         counts[k] = 0;
         if (k % (size_t)parts != (size_t)rank) continue;
+        if (!s->t[k].stamped || !unchanged(&s->t[k])) continue; /* a stream, or changed: reading tells */
         hd_read_options_t r = *ro;
         if (s->t[k].format) r.format = s->t[k].format;
         uint64_t c;
@@ -483,4 +558,83 @@ void tiles_share(const tiles_t *s, int rank, int parts, size_t *first, size_t *n
         at += s->t[k].bytes;
     }
     if (*n == 0) *first = 0;
+}
+
+/* FNV-1a, 64 bits, of n bytes. */
+static uint64_t fnv(uint64_t h, const void *p, size_t n) {
+    const unsigned char *b = p;
+    for (size_t k = 0; k < n; k++) h = (h ^ b[k]) * 0x100000001b3u;
+    return h;
+}
+
+uint64_t tiles_digest(const tiles_t *s) {
+    uint64_t h = 0xcbf29ce484222325u, n[3] = {(uint64_t)s->kind, s->n, s->n_skipped};
+    h = fnv(h, n, sizeof n);
+    for (size_t k = 0; k < s->n; k++) {
+        const tile_t *t = &s->t[k];
+        h = fnv(h, t->path, strlen(t->path) + 1);
+        h = fnv(h, t->format ? t->format : "", t->format ? strlen(t->format) + 1 : 1);
+        /* not st_dev: machines that mount one file system number it apart */
+        const tile_stamp_t *m = &t->stamp;
+        int64_t f[7] = {t->stamped, (int64_t)m->ino, (int64_t)m->size, m->mtime_s, m->mtime_ns, m->ctime_s,
+                        m->ctime_ns};
+        h = fnv(h, f, sizeof f);
+    }
+    for (size_t k = 0; k < s->n_skipped; k++) h = fnv(h, s->skipped[k].name, strlen(s->skipped[k].name) + 1);
+    return h;
+}
+
+/* Whether the first n characters of a line (after its blanks) can start
+ * a number, n of them at most 16. */
+static int starts_number(const char *h, size_t n) {
+    size_t k = 0;
+    if (k < n && (h[k] == '+' || h[k] == '-')) k++;
+    if (k < n && h[k] == '.') k++;
+    if (k < n && h[k] >= '0' && h[k] <= '9') return 1;
+    if (k != (n && (h[0] == '+' || h[0] == '-'))) return 0; /* a point, then no digit */
+    static const char *const words[] = {"infinity", "inf", "nan"};
+    for (size_t w = 0; w < 3; w++) {
+        size_t len = strlen(words[w]);
+        if (n - k >= len && strncasecmp(h + k, words[w], len) == 0 &&
+            (n - k == len || !((h[k + len] | 0x20) >= 'a' && (h[k + len] | 0x20) <= 'z')))
+            return 1;
+    }
+    return 0;
+}
+
+int tiles_text_has_numbers(const char *path) {
+    FILE *f = fopen(path, "rb");
+    if (!f) return -1;
+    /* a byte-order mark is skipped, and so are NUL bytes: UTF-16 text is
+     * judged by its characters (the reader then refuses it by name) */
+    unsigned char bom[3] = {0, 0, 0};
+    size_t got = fread(bom, 1, 3, f);
+    int skip = got == 3 && memcmp(bom, "\xef\xbb\xbf", 3) == 0                                       ? 3
+               : got >= 2 && ((bom[0] == 0xff && bom[1] == 0xfe) || (bom[0] == 0xfe && bom[1] == 0xff)) ? 2
+                                                                                                        : 0;
+    if (fseek(f, skip, SEEK_SET) != 0) {
+        fclose(f);
+        return -1;
+    }
+    char head[16]; /* the start of the line being read */
+    size_t n = 0;
+    int c, found = 0, open_line = 1; /* open_line: head is still being filled */
+    while (!found && (c = getc(f)) != EOF) {
+        if (c == 0) continue;
+        if (c == '\n' || c == '\r') { /* '\r' too: a line of a file the reader may refuse, never a skip */
+            found = n && starts_number(head, n);
+            n = 0;
+            open_line = 1;
+        } else if (open_line && !(n == 0 && strchr(" \t\f\v,;", c))) {
+            head[n++] = (char)c;
+            if (n == sizeof head) {
+                found = starts_number(head, n);
+                open_line = 0;
+            }
+        }
+    }
+    if (!found && open_line && n) found = starts_number(head, n);
+    int bad = ferror(f);
+    fclose(f);
+    return found ? 1 : bad ? -1 : 0;
 }

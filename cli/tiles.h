@@ -24,14 +24,24 @@
 
 typedef enum { TILES_FILE = 0, TILES_DIR, TILES_LIST } tiles_kind_t;
 
+/* What a regular file was when its side was expanded (stat): a tile whose
+ * stat differs later changed during the run, and reading refuses it. */
+typedef struct tile_stamp {
+    uint64_t dev, ino, size;
+    int64_t mtime_s, mtime_ns, ctime_s, ctime_ns;
+} tile_stamp_t;
+
 typedef struct tile {
     char *path;           /* as it is opened and named in messages */
     const char *format;   /* FORMAT: of its list line, else the side's
                              FORMAT:, else NULL (--format, extension) */
     long line;            /* its line in the list (TILES_LIST), else 0 */
-    uint64_t bytes;       /* its size when expanded (0: not a regular file) */
+    uint64_t bytes;       /* its size when expanded (0: not a regular file,
+                             or the one file of a TILES_FILE side) */
     size_t first, count;  /* filled by tiles_read: its first point's index
                              counted from the range read, its points */
+    int stamped;          /* a regular file when expanded: stamp holds */
+    tile_stamp_t stamp;
 } tile_t;
 
 typedef struct tile_skip {
@@ -65,15 +75,20 @@ const char *tiles_split_format(const char *s, const char **format);
  * is neither a directory nor "@LIST" is one tile, not opened here (reading
  * reports what is wrong with it).  A directory's tiles are its entries
  * whose extension names a format (hd_format_of_path) and that are regular
- * files (through symbolic links), in strcmp order; the other entries are
- * listed in skipped with the reason.  A list's tiles are its lines: blank
+ * files (through symbolic links), in strcmp order, except a .txt or .csv
+ * that has no line starting with a number (a README, a table of words:
+ * tiles_text_has_numbers); the other entries are listed in skipped with
+ * the reason.  A list's tiles are its lines: blank
  * lines and lines whose first non-blank character is '#' are skipped,
  * blanks around a path are dropped, a line may be FORMAT:PATH, and a
- * relative path is taken relative to the list's folder.
+ * relative path is taken relative to the list's folder; each must be a
+ * regular file (through links): a stream (a FIFO, a device, standard
+ * input) cannot be read twice, nor by another process, as hausdorff-mpi
+ * reads tiles.  Every regular file's stat is kept (tile_t.stamp).
  * Errors (err names the list and line, or the directory): HD_EIO (list or
  * directory unreadable; a listed file missing or unreadable), HD_EFORMAT
- * (a listed "-", directory or NIfTI mask; a NUL byte or a line longer
- * than 4096 bytes in the list),
+ * (a listed "-", directory, stream or NIfTI mask; a NUL byte or a line
+ * longer than 4096 bytes in the list),
  * HD_ENOMEM.  An empty directory or list is not an error here: n is 0.
  * On failure *out is left empty (tiles_free is still safe). */
 int tiles_expand(const char *arg, const char *format, tiles_t *out,
@@ -88,7 +103,8 @@ int tiles_expand(const char *arg, const char *format, tiles_t *out,
  * copies of the whole.  Fills each tile's first and count.  The cloud's
  * format is the tiles' common format or "mixed"; n_faces is their sum.
  * Errors: those of cli_read_points (the message names the tile, and its
- * list line), HD_EOVERFLOW (more points than memory can index),
+ * list line), HD_EIO "changed during the run" (a tile whose stat differs,
+ * before or after its read, from its stamp), HD_EOVERFLOW (more points than memory can index),
  * HD_ENOMEM.  An empty tile is an error unless --empty chose a policy
  * (an->empty), as for one file; so is a side of no tiles (an empty
  * directory or list), which with a policy is a cloud of 0 points.  A range
@@ -103,18 +119,42 @@ int tiles_read(tiles_t *s, size_t first, size_t n, const hd_read_options_t *ro,
 /* Split by points, for processes that share a side of few big files.
  * tiles_count: for the tiles k with k % parts == rank, counts[k] = the
  * tile's point count + 1 from its header (hd_read_count), 0 when the header
- * does not say (text, sampled meshes, ...) or the tile cannot be opened
- * (reading it reports that); the other entries are 0, so a sum over the
- * processes gives every tile's.  counts has s->n entries.  Never fails.
+ * does not say (text, sampled meshes, ...), the tile is not a regular file
+ * stamped at expansion, its stat no longer matches the stamp, or it cannot
+ * be opened (reading it reports all of these); the other entries are 0, so
+ * a sum over the processes gives every tile's.  counts has s->n entries.
+ * Never fails.
  * tiles_read_points: the side's points [g, g + m), once every tile's count
  * and first are set (tiles_number): the tiles that meet the range, each
  * read in part (hd_read_options_t.range_first/range_count) and appended.
- * Errors as tiles_read; m = 0 is a cloud of 0 points. */
+ * Errors as tiles_read, and "changed during the run" when a part holds
+ * other than the count the header gave; m = 0 is a cloud of 0 points. */
 int tiles_count(const tiles_t *s, int rank, int parts,
                 const hd_read_options_t *ro, uint64_t *counts);
 int tiles_read_points(tiles_t *s, uint64_t g, uint64_t m,
                       const hd_read_options_t *ro, analysis_args_t *an,
                       int which, hd_cloud_t **out, hd_error_t *err);
+
+/* A digest of what expanding a side found: its kind, every tile's path,
+ * format and stamp (but its device number, which differs between machines
+ * that mount one file system), every skipped entry.  Processes that expanded the same
+ * side each on its own compare digests: a side that changed between their
+ * listings is refused rather than read as two different sides. */
+uint64_t tiles_digest(const tiles_t *s);
+
+/* What path is when it is a stream rather than a file: "standard input"
+ * ("-"), "a FIFO or pipe", "a character device", ...; NULL for a regular
+ * file, a directory, or a path that cannot be stat'ed. */
+const char *tiles_stream(const char *path);
+
+/* Whether the text file at path has a line that starts with a number:
+ * after blanks, commas and semicolons (a byte-order mark and NUL bytes
+ * aside, so UTF-16 text is judged by its characters), a digit, '+', '-' or '.' before a digit, or the word nan, inf or
+ * infinity in any case; blank and comment lines hold none.  1, 0, or -1
+ * when the file cannot be read.  A directory's .txt and .csv entries
+ * without one are not tiles (a README, a table of words); a file with one
+ * is a tile even when a later line is not a point (reading refuses it). */
+int tiles_text_has_numbers(const char *path);
 
 /* Number the whole side from the tiles' counts: first = the counts of the
  * tiles before, summed.  For processes that each read a share: once every

@@ -200,6 +200,37 @@ def a_directory_skips_and_reports_other_entries_and_does_not_recurse(d):
 
 
 @test
+def a_directory_skips_text_in_which_no_line_starts_with_a_number_and_reads_numeric_text(d):
+    t = os.path.join(d, "t")
+    write(os.path.join(t, "a.xyz"), "0 0 0\n")
+    write(os.path.join(t, "README.txt"), "Tiles of the 2019 survey, EPSG:2056.\nOne file a square kilometre.\n")
+    write(os.path.join(t, "index.csv"), "tile,date\nA1,2019-05-01\n")
+    write(os.path.join(t, "p.txt"), "x y z\n5 0 0\n")
+    r = run_json(t, os.path.join(t, "a.xyz"))
+    assert r["n_a"] == 2 and r["hausdorff"] == 5, r
+    why = "text without a line that starts with a number"
+    assert r["skipped_a"] == [{"name": "README.txt", "reason": why}, {"name": "index.csv", "reason": why}], r
+    rc, out, err = run(t, os.path.join(t, "a.xyz"))
+    assert rc == 0 and "2 files; skipped 2: README.txt (%s), index.csv" % why in out, (out, err)
+    # a text tile that starts with a number and breaks later is an error, never a skip
+    bad = write(os.path.join(t, "q.txt"), "1 2 3\n4 five 6\n")
+    expect_error([t, os.path.join(t, "a.xyz")], [bad + ":2: 'five' is not a number"])
+
+
+@test
+def a_stream_cannot_be_a_tile_of_a_list(d):
+    fifo = os.path.join(d, "f.xyz")
+    os.mkfifo(fifo)
+    a = write(os.path.join(d, "a.xyz"), "0 0 0\n")
+    lst = write(os.path.join(d, "l.txt"), "a.xyz\nf.xyz\n")
+    expect_error(["--empty", "zero", "@" + lst, a], ["l.txt:2: %s is a FIFO or pipe, not a regular file" % fifo,
+                                                     "save it to a file"])
+    lst = write(os.path.join(d, "m.txt"), "/dev/stdin\n")
+    p = subprocess.run([os.path.abspath(TOOL), "@" + lst, a], input=b"1 2 3\n", capture_output=True, timeout=120)
+    assert p.returncode == 2 and b"m.txt:1: /dev/stdin is a FIFO or pipe, not a regular file" in p.stderr, p
+
+
+@test
 def a_directory_of_mixed_formats_reads_each_file_by_its_own_format(d):
     rng = random.Random(SEED + 2)
     pts = [cloud(rng, 40) for _ in range(4)]

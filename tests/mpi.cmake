@@ -23,8 +23,10 @@
 #    the slab, both the brute force's answer, ties to the smallest index.
 #  - mpi_cli_3: tests/mpi_cli.py, hausdorff-mpi on 3 ranks against
 #    hausdorff (JSON and text, tiles, scales, a bad tile on one rank, the
-#    --distances files byte for byte and their failures, the figures and
-#    the pictures).
+#    --distances files byte for byte and their failures: an unwritable
+#    name, a full file system (a 64 KiB tmpfs: mounting needs root, and the
+#    case says SKIPPED without it) and a size limit (ulimit -f) on the
+#    ranks; the figures and the pictures).
 # Ranks are oversubscribed on purpose (2 cores, up to 7 ranks) and CI runs
 # as root: hence --oversubscribe and --allow-run-as-root.  Under the
 # sanitizers LeakSanitizer is off for these tests: Open MPI does not free

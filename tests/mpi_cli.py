@@ -47,7 +47,8 @@ def xyz(points):
 
 def make_tiles(tmp, rng):
     """A: a directory of 7 tiles of a jittered lattice (ties across tiles
-    and regions, a duplicate point in two tiles, an empty-looking gap);
+    and regions, a duplicate point in two tiles, an empty-looking gap) and
+    a README.txt (not a tile: skipped and reported);
     B: @list of 5 tiles of the same lattice shifted half a step in x, one
     tile far away (a nearest neighbour regions away)."""
     pts = [(float(x), float(y), float(z)) for x in range(9) for y in range(9) for z in range(6)]
@@ -55,6 +56,7 @@ def make_tiles(tmp, rng):
     a = pts[:300] + [pts[0]]
     for t in range(7):
         write(os.path.join(tmp, "A", "t%d.xyz" % t), xyz(a[t * 43:(t + 1) * 43]))
+    write(os.path.join(tmp, "A", "README.txt"), "Tiles of a lattice.\nOne file a part.\n")  # skipped, reported
     b = [(x + 0.5, y, z) for (x, y, z) in pts[100:400]]
     names = []
     for t in range(4):
@@ -84,7 +86,7 @@ def write_npy(path, points):
 
 def main():
     hausdorff, tool, k, mpirun = sys.argv[1], sys.argv[2], int(sys.argv[3]), sys.argv[4:]
-    failures = []
+    failures, skipped = [], []
 
     def check(cond, what):
         if not cond:
@@ -213,6 +215,29 @@ def main():
         # A missing file: every rank fails alike.
         rc, out, err = ranks(mpirun, k, tool, os.path.join(tmp, "nope.xyz"), lion)
         check(rc == 2 and err.count("nope.xyz") == 1, "missing file: exit %d, %r" % (rc, err))
+        # A stream cannot be a tile, nor a side: the ranks read each input
+        # themselves, some twice (a count, then ranges); a FIFO listed as a
+        # tile was used up by the count and read empty (with --empty zero,
+        # a wrong distance).  Refused at once, with hausdorff's message for
+        # a list.
+        fifo = os.path.join(tmp, "stream", "f.xyz")
+        os.makedirs(os.path.dirname(fifo))
+        os.mkfifo(fifo)
+        lst = write(os.path.join(tmp, "stream", "l.txt"), "f.xyz\n" + os.path.join(tmp, "small_b.xyz") + "\n")
+        rc, out, err = ranks(mpirun, k, tool, "--empty", "zero", "@" + lst, lion)
+        rc1, _, err1 = single(hausdorff, "--empty", "zero", "@" + lst, lion)
+        lines = [l for l in err.splitlines() if l.startswith("hausdorff-mpi:")]
+        want = "l.txt:1: %s is a FIFO or pipe, not a regular file" % fifo
+        check(rc == 2 and rc1 == 2 and len(lines) == 1 and want in lines[0] and out == "" and
+              err1.split(": ", 1)[1] == lines[0].split(": ", 1)[1] + "\n",
+              "a FIFO in a list: exit %d / %d, %r, %r" % (rc, rc1, err, err1))
+        for side, stdin in ((fifo, None), ("-", b"1 2 3\n")):
+            p = subprocess.run(mpirun + ["-n", str(k), tool, side, lion], input=stdin, capture_output=True,
+                               timeout=120)
+            err = p.stderr.decode()
+            lines = [l for l in err.splitlines() if l.startswith("hausdorff-mpi:")]
+            check(p.returncode == 2 and len(lines) == 1 and "cannot be read by hausdorff-mpi" in lines[0] and
+                  "save it to a file" in lines[0], "%s as a side: exit %d, %r" % (side, p.returncode, err))
         # --empty: an empty side gets the policy's answer, as hausdorff gives it.
         empty = write(os.path.join(tmp, "empty.xyz"), "# no points\n")
         for args in (["--empty", "inf", empty, lion], ["--empty", "zero", "--directed", lion, empty],
@@ -349,7 +374,54 @@ def main():
         rc, out, err = ranks(mpirun, k, tool, "--distances", os.path.join(tmp, "nodir", "x.npy"), lion, head)
         check(rc == 3 and err.count("hausdorff-mpi:") == 1 and "cannot write" in err,
               "--distances in no directory: exit %d, %r" % (rc, err))
-    print("mpi_cli on %d ranks: %s" % (k, "%d failed" % len(failures) if failures else "passed"))
+        # A file system that fills up (a 64 KiB tmpfs: A's CSV rows fit,
+        # B's are cut mid-row; 1000 NPY rows twice do not fit) and a file beyond the size limit (ulimit -f, on the
+        # ranks only; SIGXFSZ not ignored, so hausdorff-mpi must ignore it):
+        # exit 3 from every rank, one message with the reason, and no file
+        # left, no temporary either, as hausdorff.  MPI-IO had reported
+        # success for the writes that failed, and the run exited 0 with the
+        # files cut short.
+        full_a = write(os.path.join(tmp, "full", "a.xyz"), xyz([tuple(rng.random() for _ in range(3))
+                                                                 for _ in range(600)]))
+        full_b = write(os.path.join(tmp, "full", "b.xyz"), xyz([tuple(rng.random() + 3 for _ in range(3))
+                                                                 for _ in range(300)]))
+        full_c = write(os.path.join(tmp, "full", "c.xyz"), xyz([tuple(rng.random() for _ in range(3))
+                                                                 for _ in range(1000)]))
+
+        def refused(args, out_dir, reason, launcher=None):
+            p = subprocess.run((launcher or mpirun + ["-n", str(k), tool]) + args, capture_output=True, timeout=120)
+            err = p.stderr.decode()
+            lines = [l for l in err.splitlines() if l.startswith("hausdorff-mpi:")]
+            check(p.returncode == 3 and len(lines) == 1 and ": cannot write: " + reason in lines[0],
+                  "%s: exit %d, expected 3 and one message %r: %r" % (args, p.returncode, reason, err))
+            check(os.listdir(out_dir) == [], "%s: files left: %r" % (args, os.listdir(out_dir)))
+
+        fullfs = os.path.join(tmp, "fullfs")
+        os.makedirs(fullfs)
+        m = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=64k", "tmpfs", fullfs], capture_output=True)
+        if m.returncode != 0:
+            skipped.append("the full file system case: cannot mount a 64 KiB tmpfs (%s); it runs as root"
+                           % m.stderr.decode().strip())
+            print("mpi_cli: SKIPPED " + skipped[-1], file=sys.stderr)
+        else:
+            try:
+                refused(["--distances", os.path.join(fullfs, "d.csv"), full_a, full_b], fullfs,
+                        "No space left on device")
+                refused(["--distances", os.path.join(fullfs, "d.npy"), full_c, full_c], fullfs,
+                        "No space left on device")
+            finally:
+                subprocess.run(["umount", fullfs])
+        limited = os.path.join(tmp, "limited")
+        os.makedirs(limited)
+        # Open MPI's shared-memory transport makes files of megabytes: TCP on
+        # the loopback instead, so that only the --distances file meets the limit
+        ulimit = mpirun + ["--mca", "btl", "self,tcp", "--mca", "btl_tcp_if_include", "lo", "-n", str(k),
+                           "sh", "-c", 'ulimit -f 20 && exec "$0" "$@"', tool]
+        for args in (["--distances", os.path.join(limited, "d.csv")],
+                     ["--directed", "--distances", os.path.join(limited, "d.ply")]):
+            refused(args + [full_a, full_b], limited, "File too large", ulimit)
+    print("mpi_cli on %d ranks: %s%s" % (k, "%d failed" % len(failures) if failures else "passed",
+                                         "".join("; SKIPPED " + s for s in skipped)))
     return 1 if failures else 0
 
 

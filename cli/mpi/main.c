@@ -133,6 +133,35 @@ static void quiet_others(void) {
     if (fd > 2) close(fd);
 }
 
+/* A side of one file that is a stream (standard input, a FIFO, a
+ * device): the ranks read each input themselves, by name, one a count from
+ * its header and others its ranges, and only rank 0 has the standard
+ * input; a stream would be used up by the first read. */
+static int refuse_stream(const char *path, hd_error_t *err) {
+    const char *kind = tiles_stream(path);
+    if (!kind) return HD_OK;
+    snprintf(err->message, sizeof err->message,
+             "%.800s: %s cannot be read by hausdorff-mpi, whose ranks each read their share of every input "
+             "(some more than once); save it to a file",
+             path, kind);
+    return err->code = HD_EFORMAT;
+}
+
+/* Every rank expanded the side itself: they must have found the same
+ * tiles, stat for stat (tiles_digest), or their shares and counts would
+ * belong to different sides.  Collective; the same verdict everywhere. */
+static int same_listing(const tiles_t *t, hd_error_t *err) {
+    uint64_t d = tiles_digest(t), lo = 0, hi = 0;
+    MPI_Allreduce(&d, &lo, 1, MPI_UINT64_T, MPI_MIN, MPI_COMM_WORLD);
+    MPI_Allreduce(&d, &hi, 1, MPI_UINT64_T, MPI_MAX, MPI_COMM_WORLD);
+    if (lo == hi) return HD_OK;
+    snprintf(err->message, sizeof err->message,
+             "%.800s: changed during the run (the ranks listed different files, sizes or times); run again once "
+             "nothing writes it",
+             t->arg);
+    return err->code = HD_EIO;
+}
+
 /* Every tile's count over all ranks (each tile was read by one rank), then
  * tiles_number; *offset is the first index of this rank's range. */
 static int number_tiles(tiles_t *t, size_t first, size_t n, size_t *offset, hd_error_t *err) {
@@ -287,7 +316,8 @@ int main(int argc, char **argv) {
     rc = HD_OK;
     for (int w = 0; w < 2 && rc == HD_OK; w++) {
         rc = tiles_expand(paths[w], formats[w], &side[w], &err);
-        if ((rc = agree(rc, &err)) != HD_OK) break;
+        if (rc == HD_OK && side[w].kind == TILES_FILE) rc = refuse_stream(paths[w], &err);
+        if ((rc = agree(rc, &err)) == HD_OK) rc = same_listing(&side[w], &err);
     }
     if (rc == HD_OK) { /* no output may overwrite an input: rank 0 checks */
         int bad = rank_ == 0 ? out_check_outputs(&a, side) : 0;

@@ -8,30 +8,46 @@
  * not in rank order), so the file is the header, then the ranks' rows in
  * the order of their first indices.  Every rank counts its rows' bytes; an
  * allgather of (first, count, bytes) gives each its offset (the header's
- * length plus the bytes of every run before its own); then all write with
- * MPI_File_write_at_all, rank 0 the header in a first round, then the rows
- * in rounds of at most CHUNK bytes a rank (an allreduce says whether any
- * rank has more), into the temporary rank 0 created with out_open.  A PLY's colour scale and
- * the width of its index column are the same on every rank (the scale is
- * given; the width is an allreduce).  A CSV row's length depends on its
- * numbers, so its bytes are counted in a first pass (formatting, without
- * keeping the text); binary rows have one length.
+ * length plus the bytes of every run before its own) and the file's
+ * length.  Rank 0 creates the temporary with out_open; then every rank
+ * opens it by name and writes its rows at its offset with pwrite, in
+ * pieces of at most CHUNK bytes (rank 0 the header at 0 first).  A PLY's
+ * colour scale and the width of its index column are the same on every
+ * rank (the scale is given; the width is an allreduce).  A CSV row's
+ * length depends on its numbers, so its bytes are counted in a first pass
+ * (formatting, without keeping the text); binary rows have one length.
+ *
+ * Lost bytes are a failure, never a quiet success.  The rows are written
+ * with POSIX calls, not MPI-IO: Open MPI's MPI-IO (OMPIO) returns success
+ * and a full count (MPI_Get_count) from a collective write that a full
+ * file system refused, and a short count without an error from an
+ * independent one, leaving a file cut short, or of the right length with
+ * a hole in the middle.  Here every pwrite's count is checked (a short
+ * write is continued, and the call that fails gives its errno: ENOSPC,
+ * EFBIG, EDQUOT, EIO), then fsync (errors a file system reports only when
+ * the data reach it: NFS's quota, a disk's EIO) and close, on every rank;
+ * once all ranks are done, rank 0 checks that the file's length is the
+ * length agreed (a file truncated or replaced meanwhile).  SIGXFSZ is
+ * ignored on every rank, so a file beyond `ulimit -f` is EFBIG rather than
+ * a rank killed.  Unlike hausdorff's files (output.c), these are fsync'ed:
+ * the ranks may write through other machines' caches, and a file system
+ * that defers its errors reports them there.
  *
  * A target that is not a regular file (a FIFO, a device: out_open writes
- * it in place) cannot be written at offsets, and MPI-IO's writes at
- * offsets into a pipe are lost without an error: there rank 0 writes the
- * file through its stream, the header and then every rank's rows in the
- * order of their first indices, each other rank sending its rows in
- * messages of at most CHUNK bytes and an empty one to end (stream_rows).
- * Rank 0 receives every message even after a write failed, so no sender
- * waits; the failure is agreed after the last.
+ * it in place) cannot be written at offsets: there rank 0 writes the file
+ * through its stream, the header and then every rank's rows in the order of
+ * their first indices, each other rank sending its rows in messages of at
+ * most CHUNK bytes and an empty one to end (stream_rows).  Rank 0 receives
+ * every message even after a write failed, so no sender waits; the
+ * failure is agreed after the last.
  *
- * Failures: rank 0's out_open (an unwritable directory), the MPI-IO open,
- * a write or the close, on any rank, are agreed (mpi_agree): every rank
- * returns the same OUT_EFAIL and message ("PATH: cannot write: reason"),
- * and the caller's out_discard removes the temporary; every rank keeps
- * calling the collective writes until all are done, so no rank waits.
- * The file appears under its name only at rank 0's out_finish.
+ * Failures: rank 0's out_open (an unwritable directory), a rank's open,
+ * write, fsync or close, and the length check are agreed (mpi_agree):
+ * every rank returns the same OUT_EFAIL and message ("PATH: cannot write:
+ * reason", exit 3), and the caller's out_discard removes the temporary.
+ * The file appears under its name only at rank 0's out_finish.  The ranks
+ * open rank 0's temporary by name, so the file must be on a file system
+ * they all see (on one machine, any).
  */
 #include <hausdorff_mpi.h>
 
@@ -41,10 +57,14 @@
 #include "output.h"
 
 #include <errno.h>
+#include <fcntl.h>
+#include <signal.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
-/* Bytes a rank writes per round. */
+/* Bytes a rank formats and writes at a time (and sends, to a stream). */
 #define CHUNK ((size_t)1 << 20)
 
 int mpi_agree(int rc, hd_error_t *err) {
@@ -59,12 +79,9 @@ int mpi_agree(int rc, hd_error_t *err) {
     return err->code;
 }
 
-static int io_failed(const char *path, int code, hd_error_t *err) {
-    char text[MPI_MAX_ERROR_STRING];
-    int len = 0;
-    if (MPI_Error_string(code, text, &len) != MPI_SUCCESS) len = 0;
-    text[len] = '\0';
-    snprintf(err->message, sizeof err->message, "%.700s: cannot write: %s", path, len ? text : "MPI-IO error");
+/* "PATH: cannot write: reason" (e: an errno, or -1 when unknown). */
+static int write_failed(const char *path, int e, hd_error_t *err) {
+    snprintf(err->message, sizeof err->message, "%.800s: cannot write: %s", path, e > 0 ? strerror(e) : "write error");
     return err->code = OUT_EFAIL;
 }
 
@@ -101,18 +118,22 @@ static int rows_of_ranks(uint64_t first, uint64_t count, uint64_t bytes, uint64_
     return HD_OK;
 }
 
-/* Where this rank's rows start: after the header and every rank's rows of
- * smaller indices (B's shares are not in rank order). */
-static int row_offset(uint64_t first, uint64_t count, uint64_t bytes, uint64_t head, uint64_t *off,
+/* Where this rank's rows start (*off: after the header and every rank's
+ * rows of smaller indices; B's shares are not in rank order) and where
+ * the file ends (*end).  Collective. */
+static int row_offset(uint64_t first, uint64_t count, uint64_t bytes, uint64_t head, uint64_t *off, uint64_t *end,
                       hd_error_t *err) {
     int K;
     MPI_Comm_size(MPI_COMM_WORLD, &K);
     uint64_t *all;
     int rc = rows_of_ranks(first, count, bytes, &all, err);
     if (rc != HD_OK) return rc;
-    *off = head;
-    for (int r = 0; r < K; r++)
-        if (all[3 * r + 1] && all[3 * r] < first) *off += all[3 * r + 2];
+    *off = *end = head;
+    for (int r = 0; r < K; r++) {
+        if (!all[3 * r + 1]) continue;
+        if (all[3 * r] < first) *off += all[3 * r + 2];
+        *end += all[3 * r + 2];
+    }
     free(all);
     return HD_OK;
 }
@@ -179,6 +200,60 @@ static int stream_rows(FILE *f, const dist_layout_t *lay, const hd_points_t *P, 
     return mpi_agree(rc, err);
 }
 
+
+/* All n bytes of buf at offset off of fd: 0, or the errno of the call
+ * that failed (-1 when unknown).  A short write is continued: the next
+ * call says why the file system stopped. */
+static int put_at(int fd, const unsigned char *buf, size_t n, uint64_t off) {
+    while (n) {
+        if (off > (uint64_t)INT64_MAX - n) return EFBIG;
+        ssize_t w = pwrite(fd, buf, n, (off_t)off);
+        if (w < 0 && errno == EINTR) continue;
+        if (w <= 0) return w < 0 && errno ? errno : -1;
+        buf += w;
+        n -= (size_t)w;
+        off += (uint64_t)w;
+    }
+    return 0;
+}
+
+/* This rank's rows at off of the temporary tmp (rank 0: the header at 0
+ * first), then fsync and close: 0, or the errno of the first failure.  A
+ * rank without rows does not open the file. */
+static int rows_at(const char *tmp, const dist_layout_t *lay, const hd_points_t *P, const double *d,
+                   const size_t *nearest, uint64_t off, unsigned char *buf) {
+    int rank;
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+    if (rank != 0 && !P->count) return 0;
+    int fd = open(tmp, O_WRONLY | O_CLOEXEC);
+    if (fd < 0) return errno ? errno : -1;
+    int e = rank == 0 ? put_at(fd, buf, distances_header(lay, (char *)buf), 0) : 0;
+    for (size_t k = 0; !e && k < P->count;) {
+        size_t n = fill(lay, P, d, nearest, &k, buf);
+        e = put_at(fd, buf, n, off);
+        off += n;
+    }
+    /* EINVAL: a file system that has no sync (so no deferred error) */
+    if (fsync(fd) != 0 && !e && errno != EINVAL) e = errno ? errno : -1;
+    if (close(fd) != 0 && !e && errno != EINTR) e = errno ? errno : -1;
+    return e;
+}
+
+/* Rank 0, once every rank wrote: the temporary holds exactly `end` bytes.
+ * Opened, not stat'ed by name: an open revalidates what a network file
+ * system caches of a file that other machines wrote (NFS's close-to-open). */
+static int check_length(const char *path, const char *tmp, uint64_t end, hd_error_t *err) {
+    struct stat st;
+    int fd = open(tmp, O_RDONLY | O_CLOEXEC), e = 0;
+    if (fd < 0 || fstat(fd, &st) != 0) e = errno ? errno : -1;
+    if (fd >= 0) close(fd);
+    if (e) return write_failed(path, e, err);
+    if ((uint64_t)st.st_size == end) return HD_OK;
+    snprintf(err->message, sizeof err->message, "%.800s: cannot write: the file holds %llu bytes of the %llu written",
+             path, (unsigned long long)st.st_size, (unsigned long long)end);
+    return err->code = OUT_EFAIL;
+}
+
 int mpi_write_distances(const char *path, const hd_points_t *P, size_t first, const double *d,
                         const size_t *nearest, size_t total, double dmax, hd_error_t *err) {
     int rank;
@@ -188,6 +263,7 @@ int mpi_write_distances(const char *path, const hd_points_t *P, size_t first, co
     dist_layout_t lay;
     int rc = distances_layout(path, total, dmax, any, &lay, err); /* the same verdict on every rank */
     if (rc != HD_OK) return rc;
+    signal(SIGXFSZ, SIG_IGN); /* beyond ulimit -f: EFBIG, reported */
     char tmp[4096] = "";
     FILE *f = NULL; /* rank 0's, kept open when the target is written in place */
     int direct = 0;
@@ -216,43 +292,21 @@ int mpi_write_distances(const char *path, const hd_points_t *P, size_t first, co
         return rc;
     }
     MPI_Bcast(tmp, (int)sizeof tmp, MPI_CHAR, 0, MPI_COMM_WORLD);
-    /* This rank's bytes (text rows: a first pass), then its offset. */
+    /* This rank's bytes (text rows: a first pass), its offset, the end. */
     size_t head = distances_header(&lay, (char *)buf), k = 0;
-    uint64_t bytes = 0, off = 0;
+    uint64_t bytes = 0, off = 0, end = 0;
     if (lay.format == DIST_CSV) {
         while (k < P->count) bytes += fill(&lay, P, d, nearest, &k, buf);
     } else {
         unsigned char row[DIST_ROW_MAX];
         bytes = (uint64_t)P->count * distances_row(&lay, (const double[3]){0, 0, 0}, 0, nearest, row);
     }
-    if ((rc = row_offset(first, P->count, bytes, head, &off, err)) != HD_OK) {
-        free(buf);
-        return rc;
+    if ((rc = row_offset(first, P->count, bytes, head, &off, &end, err)) == HD_OK) {
+        int e = rows_at(tmp, &lay, P, d, nearest, off, buf);
+        if (e) rc = write_failed(path, e, err);
+        if ((rc = mpi_agree(rc, err)) == HD_OK && rank == 0) rc = check_length(path, tmp, end, err);
+        rc = mpi_agree(rc, err);
     }
-    MPI_File fh;
-    int e = MPI_File_open(MPI_COMM_WORLD, tmp, MPI_MODE_WRONLY, MPI_INFO_NULL, &fh);
-    if (e != MPI_SUCCESS) rc = io_failed(path, e, err);
-    if ((rc = mpi_agree(rc, err)) != HD_OK) {
-        free(buf);
-        return rc;
-    }
-    /* The first round: rank 0 writes the header at 0; then the rows. */
-    MPI_Status st;
-    head = rank == 0 ? distances_header(&lay, (char *)buf) : 0;
-    e = MPI_File_write_at_all(fh, 0, buf, (int)head, MPI_BYTE, &st);
-    if (e != MPI_SUCCESS) rc = io_failed(path, e, err);
-    k = 0;
-    for (;;) {
-        int more = k < P->count, anyone = 0;
-        MPI_Allreduce(&more, &anyone, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
-        if (!anyone) break;
-        size_t n = more ? fill(&lay, P, d, nearest, &k, buf) : 0;
-        e = MPI_File_write_at_all(fh, (MPI_Offset)off, buf, (int)n, MPI_BYTE, &st);
-        if (e != MPI_SUCCESS && rc == HD_OK) rc = io_failed(path, e, err);
-        off += n;
-    }
-    e = MPI_File_close(&fh);
-    if (e != MPI_SUCCESS && rc == HD_OK) rc = io_failed(path, e, err);
     free(buf);
-    return mpi_agree(rc, err);
+    return rc;
 }
