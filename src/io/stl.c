@@ -59,8 +59,8 @@ static size_t candidates(void *ctx, const char *p, const char *end) {
 
 /* The first facet that does not have exactly three vertices (serial; only
  * run when the totals disagree). */
-static int report_bad_facet(hd__read_t *r) {
-    const char *p = (const char *)r->f->data, *end = p + r->f->size, *tb, *te;
+static int report_bad_facet(hd__read_t *r, const char *p) {
+    const char *end = (const char *)r->f->data + r->f->size, *tb, *te;
     long long line = 0, facet_line = 0;
     int n = -1;
     for (const char *q, *eol; hd__next_line(&p, end, &q, &eol);) {
@@ -101,20 +101,26 @@ static int text_keyword(const unsigned char *d, size_t size) {
 
 int hd__read_stl(hd__read_t *r) {
     const unsigned char *d = r->f->data;
-    size_t size = r->f->size, k = 0;
-    while (k < size && (d[k] == ' ' || d[k] == '\t' || d[k] == '\r' || d[k] == '\n')) k++;
-    int solid = size - k >= 5 && memcmp(d + k, "solid", 5) == 0;
+    size_t size = r->f->size, k;
     uint64_t n = size >= 84 ? hd__ld_u32(d + 80, 0) : 0;
     int exact = size >= 84 && 84 + 50 * n == size;
+    /* text unless the size says binary: UTF-16 refused, a UTF-8 mark skipped */
+    const char *s = (const char *)d;
+    if (!exact) {
+        int rc = hd__text_begin(r, &s);
+        if (rc) return rc;
+    }
+    k = (size_t)((const unsigned char *)s - d);
+    while (k < size && (d[k] == ' ' || d[k] == '\t' || d[k] == '\r' || d[k] == '\n')) k++;
+    int solid = size - k >= 5 && memcmp(d + k, "solid", 5) == 0;
     if (solid && !exact && size >= 84 && !text_keyword(d, size)) solid = 0;
     if (solid && !exact) {
-        const char *s = (const char *)d;
         uint64_t facets = 0;
         /* the shortest vertex line is "vertex 0 0 0\n" */
         hd__text_job_t job = {chunk, NULL, candidates, 14, NULL};
-        int rc = hd__text_parallel(r, s, s + size, 1, &job, &facets);
+        int rc = hd__text_parallel(r, s, (const char *)d + size, 1, &job, &facets);
         if (rc) return rc;
-        if (r->sink->count != 3 * facets) return report_bad_facet(r);
+        if (r->sink->count != 3 * facets) return report_bad_facet(r, s);
         r->n_faces = (size_t)facets;
         return add_triangles(r, (size_t)facets);
     }
