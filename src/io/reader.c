@@ -420,7 +420,8 @@ static int choose(const char *path, const hd_read_options_t *opt, const format_t
 static int read_loaded(const hd__file_t *f, const format_t *fmt, int from_extension,
                        const hd_read_options_t *opt, hd_cloud_t **out, uint64_t *total, hd_error_t *err) {
     /* text after a UTF-8 byte-order mark is sniffed without it (the readers
-     * skip it too); UTF-16 and UTF-32 text has no format of its own */
+     * skip it too); UTF-16 and UTF-32 text has no format of its own: the
+     * reader the name chose refuses it by its encoding */
     size_t bom;
     int bits = hd__text_encoding(f->data, f->size, &bom);
     hd__file_t text = {f->name, f->data + bom, f->size - bom};
@@ -433,7 +434,8 @@ static int read_loaded(const hd__file_t *f, const format_t *fmt, int from_extens
         if (!fmt)
             return hd__err(err, HD_EUNSUPPORTED, "%s: cannot tell the format from the %s; use --format (see --formats)",
                            f->name, from_extension < 0 ? "content" : "extension or the content");
-    } else if (from_extension > 0 && !(fmt->magic && (fmt->magic(f->data, f->size) || (bom && fmt->magic(text.data, text.size))))) {
+    } else if (from_extension > 0 && bits == 8 &&
+               !(fmt->magic && (fmt->magic(f->data, f->size) || (bom && fmt->magic(text.data, text.size))))) {
         /* The content must confirm the extension.  A format with a
          * signature that is missing is refused when the content has another
          * format's signature; a format without one (OBJ, text) is refused
