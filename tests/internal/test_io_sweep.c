@@ -1025,7 +1025,8 @@ TEST(single_byte_header_mutations_of_counted_text_files_keep_the_contract) {
  * header before binary data). */
 static int starts_as_text(int s) { return s < LAS_12 && s != STL_BINARY; }
 
-static void sweep_byte_order_marks(long long *cases) {
+TEST(a_utf8_byte_order_mark_is_skipped_before_text_and_refused_before_binary) {
+    long long cases = 0;
     setup();
     sweep_ran("text");
     for (int s = 0; s < N_SAMPLES; s++) {
@@ -1037,22 +1038,18 @@ static void sweep_byte_order_marks(long long *cases) {
             char key[128];
             snprintf(key, sizeof key, "%s text utf-8-bom %s", S->id, MODE[m]);
             int out = observe(S, s, b.data, b.size, m, key, NULL);
-            (*cases)++;
+            cases++;
             if (starts_as_text(s) ? out != SAME : out != REFUSED)
                 VIOLATION(key, "a UTF-8 byte-order mark before the file: the file %s (%s)", OUTCOME[out],
                           starts_as_text(s) ? "it is skipped" : "binary: refused");
         }
         tf_free(&b);
     }
-}
-
-TEST(a_utf8_byte_order_mark_is_skipped_before_text_and_refused_before_binary) {
-    long long cases = 0;
-    sweep_byte_order_marks(&cases);
     printf("  %lld files after a UTF-8 byte-order mark\n", cases);
 }
 
-static void sweep_wide_text(long long *cases) {
+TEST(utf16_and_utf32_text_is_refused_naming_its_encoding) {
+    long long cases = 0;
     static const struct {
         const char *name;
         int width, big, bom;
@@ -1072,18 +1069,13 @@ static void sweep_wide_text(long long *cases) {
                 char key[128];
                 snprintf(key, sizeof key, "%s text %s %s", S->id, ENC[k].name, MODE[m]);
                 int out = observe(S, s, b.data, b.size, m, key, NULL);
-                (*cases)++;
+                cases++;
                 if (out != REFUSED) VIOLATION(key, "%s text: the file %s", ENC[k].name, OUTCOME[out]);
                 else if (!strstr(refusal, want)) VIOLATION(key, "message '%s' lacks '%s'", refusal, want);
             }
             tf_free(&b);
         }
     }
-}
-
-TEST(utf16_and_utf32_text_is_refused_naming_its_encoding) {
-    long long cases = 0;
-    sweep_wide_text(&cases);
     printf("  %lld text files in UTF-16 and UTF-32, with and without byte-order marks\n", cases);
 }
 
@@ -1110,7 +1102,8 @@ static tf_buf_t comma_text(const char *sep, int thousands) {
     return b;
 }
 
-static void sweep_commas(long long *cases) {
+TEST(decimal_commas_and_thousands_separators_with_every_separator_are_refused_unless_the_option_says) {
+    long long cases = 0;
     static const char *const SEP[] = {" ", "\t", "  ", " \t ", ";", " ; ", "\t;"};
     static const char *const SEP_NAME[] = {"space", "tab", "spaces", "blanks", "semicolon", "spaced-semicolon",
                                            "tab-semicolon"};
@@ -1128,7 +1121,7 @@ static void sweep_commas(long long *cases) {
                     hd_read_options_t o = options(m);
                     o.decimal_comma = option;
                     int out = observe_with(S, XYZ, b.data, b.size, &o, m, key, NULL);
-                    (*cases)++;
+                    cases++;
                     int want = option && !thousands ? SAME : REFUSED;
                     if (out != want)
                         VIOLATION(key, "%s between fields: the file %s, expected %s", SEP_NAME[k], OUTCOME[out],
@@ -1136,15 +1129,11 @@ static void sweep_commas(long long *cases) {
                 }
             tf_free(&b);
         }
-}
-
-TEST(decimal_commas_and_thousands_separators_with_every_separator_are_refused_unless_the_option_says) {
-    long long cases = 0;
-    sweep_commas(&cases);
     printf("  %lld files with decimal commas or thousands separators\n", cases);
 }
 
-static void sweep_first_lines(long long *cases) {
+TEST(a_malformed_number_on_the_first_line_is_refused_and_a_header_is_skipped) {
+    long long cases = 0;
     static const char *const MALFORMED[] = {"1.#QNAN 2 3", "1.5D+03 0 0", "3.14abc 1 1", "-", "+.5e 1 2", "1.#IND,0,0",
                                             "0x 1 2", ". 1 2"};
     static const char *const HEADER[] = {"x y z", "X,Y,Z", "# comment", "index,x,y,z", "infrared;x", "title\n\nx y z"};
@@ -1171,7 +1160,7 @@ static void sweep_first_lines(long long *cases) {
                         snprintf(key, sizeof key, "%s text %s-line-%d '%s' %s", S->id, kind ? "header" : "malformed",
                                  where + 1, line, MODE[m]);
                         int out = observe(S, TEXT[t], b.data, b.size, m, key, NULL);
-                        (*cases)++;
+                        cases++;
                         int want = kind ? SAME : REFUSED;
                         if (out != want)
                             VIOLATION(key, "'%s' as line %d: the file %s, expected %s", line, where + 1, OUTCOME[out],
@@ -1181,11 +1170,6 @@ static void sweep_first_lines(long long *cases) {
                 }
         }
     }
-}
-
-TEST(a_malformed_number_on_the_first_line_is_refused_and_a_header_is_skipped) {
-    long long cases = 0;
-    sweep_first_lines(&cases);
     printf("  %lld files with a malformed first or second line, or a header\n", cases);
 }
 
