@@ -97,18 +97,19 @@ static int count_fields(const dialect_t *d, const char *q, const char *eol) {
     return n;
 }
 
-/* Whether the field [t, e) can start a number: a sign, a digit or a point
- * first (so the malformed "1.#QNAN", "1.5D+03", "3.14abc", "-" and "+.5e"
- * can), or strtod's words inf, infinity and nan before anything but a
- * letter.  A field that cannot ("x", "X,Y,Z", "index", "infrared") heads a
- * header line. */
-static int starts_number(const char *t, const char *e) {
-    if (t < e && (*t == '+' || *t == '-')) t++;
-    if (t == e || *t == '.' || is_digit((unsigned char)*t)) return 1;
+/* Whether the field at t (ending at a separator or eol) can start a number:
+ * a sign, a digit or a point first (so the malformed "1.#QNAN", "1.5D+03",
+ * "3.14abc", "-" and "+.5e" can), or strtod's words inf, infinity and nan
+ * before anything but a letter.  A field that cannot ("x", "X,Y,Z",
+ * "index", "infrared") heads a header line. */
+static int starts_number(const char *t, const char *eol) {
+    if (is_digit((unsigned char)*t)) return 1;
+    if (t < eol && (*t == '+' || *t == '-')) t++;
+    if (t == eol || *t == '.' || is_digit((unsigned char)*t) || is_sep((unsigned char)*t)) return 1;
     char w[9];
     size_t n = 0;
-    for (; t < e && n < sizeof w && ((*t | 0x20) >= 'a' && (*t | 0x20) <= 'z'); t++) w[n++] = (char)(*t | 0x20);
-    if (t < e && ((*t | 0x20) >= 'a' && (*t | 0x20) <= 'z')) return 0;
+    for (; t < eol && n < sizeof w && ((*t | 0x20) >= 'a' && (*t | 0x20) <= 'z'); t++) w[n++] = (char)(*t | 0x20);
+    if (t < eol && ((*t | 0x20) >= 'a' && (*t | 0x20) <= 'z')) return 0;
     return (n == 3 && (memcmp(w, "inf", 3) == 0 || memcmp(w, "nan", 3) == 0)) || (n == 8 && memcmp(w, "infinity", 8) == 0);
 }
 
@@ -117,9 +118,7 @@ static int starts_number(const char *t, const char *e) {
  * lines aside) are the header. */
 static int candidate(const char *p, const char *eol) {
     while (p < eol && is_sep((unsigned char)*p)) p++;
-    const char *e = p;
-    while (e < eol && !is_sep((unsigned char)*e)) e++;
-    return e > p && starts_number(p, e);
+    return p < eol && starts_number(p, eol);
 }
 
 /* Line 1 holding one field that can start a number: the point count of the
@@ -141,12 +140,49 @@ static int pts_count(hd__chunk_t *c, long long line, const char *q, const char *
     return 1;
 }
 
-/* The separator run [rs, q) between two fields of the blank-and-comma
- * dialect: 1 when it is a lone comma between digits ("4,25", "1,234.5"),
- * 2 when it holds blanks only, 0 otherwise (", " and the like). */
-static int separator_kind(const char *rs, const char *q) {
-    if (q - rs == 1 && *rs == ',') return is_digit((unsigned char)rs[-1]) && is_digit((unsigned char)*q);
-    return memchr(rs, ',', (size_t)(q - rs)) ? 0 : 2;
+/* Whether the comma at p is a lone comma between digits ("4,25",
+ * "1,234.5"): a decimal comma or a thousands separator, if blanks also
+ * separate fields. */
+static int digit_comma(const char *p, const char *eol) {
+    return *p == ',' && p + 1 < eol && is_digit((unsigned char)p[-1]) && is_digit((unsigned char)p[1]);
+}
+
+/* Whether a run of blanks alone separates two fields among the runs of
+ * [p, end) (p at a field; a run that starts before end is followed to its
+ * end, and counts when a field follows it). */
+static int blank_run(const dialect_t *d, const char *p, const char *end, const char *eol) {
+    while (p < end) {
+        if (!is_field_sep(d, (unsigned char)*p)) {
+            p++;
+            continue;
+        }
+        int comma = 0;
+        while (p < eol && is_field_sep(d, (unsigned char)*p)) comma |= *p++ == ',';
+        if (!comma && p < eol) return 1;
+    }
+    return 0;
+}
+
+/* Field `col` (1-based) at *q that the fast path could not read whole: its
+ * value in *v and *q past it (1), or 0 with the problem recorded. */
+static int slow_field(hd__chunk_t *c, const dialect_t *d, long long line, int col, const char **q, const char *eol,
+                      double *v) {
+    const char *t = *q, *e = t;
+    while (e < eol && !is_field_sep(d, (unsigned char)*e)) e++;
+    *q = e;
+    if (!hd__parse_double(t, e, v) && !(d->semicolon && parse_decimal_comma(t, e, v))) {
+        hd__chunk_fail(c, HD_EFORMAT, line, "'%.*s' is not a number (column %d)", (int)(e - t > 40 ? 40 : e - t), t, col);
+        return 0;
+    }
+    if (d->semicolon && !d->decimal_comma && memchr(t, ',', (size_t)(e - t))) {
+        hd__chunk_fail(c, HD_EFORMAT, line,
+                       "'%.*s' has a decimal comma (column %d): 1,500 is 1.5 in one locale and 1500 in "
+                       "another; to read commas as decimal points, give the decimal_comma read option "
+                       "(--decimal-comma in the tool, decimal_comma=True in Python)",
+                       (int)(e - t > 40 ? 40 : e - t), t, col);
+        return 0;
+    }
+    return 1;
 }
 
 /* x y z from [*qp, eol) into v: 1 (and *qp past z), or 0 with the problem
@@ -156,47 +192,28 @@ static int separator_kind(const char *rs, const char *q) {
  * a thousands separator ("1,234.5 2,345.6 3,456.7", "1,234,567.5 2 3"),
  * not a separator: the line is refused, since reading the comma as one
  * gave (4, 25, 5) and (1, 234.5, 2).  "1,2,3", "1, 2, 3" and "1 2 3 4,5"
- * (a decimal comma after z, in a column not read) are read. */
+ * (a decimal comma after z, in a column not read) are read.  A field's
+ * number ends at its separator, so the comma is seen there (in the
+ * semicolon dialect a comma separates nothing and is never there), and
+ * blank runs are looked for only once such a comma is found: the common
+ * line costs one comparison a field. */
 static int row(hd__chunk_t *c, const dialect_t *d, long long line, const char **qp, const char *eol, double v[3]) {
     const char *q = *qp, *comma = NULL;
-    int got = 0, blank = 0;
-    for (;;) {
-        const char *rs = q;
+    int got = 0;
+    while (got < 3) {
         while (q < eol && is_field_sep(d, (unsigned char)*q)) q++;
         if (q == eol) break;
-        if (!d->semicolon && got) { /* the run before field got + 1 */
-            int k = separator_kind(rs, q);
-            if (k == 1 && !comma) comma = rs;
-            blank |= k == 2;
-        }
-        if (got == 3) break;
-        const char *t = q, *e = hd__scan_double(q, eol, &v[got]);
-        if (e && (e == eol || is_field_sep(d, (unsigned char)*e))) {
-            q = e; /* the fast path read the whole token */
-            got++;
-            continue;
-        }
-        while (q < eol && !is_field_sep(d, (unsigned char)*q)) q++;
-        if (!hd__parse_double(t, q, &v[got]) && !(d->semicolon && parse_decimal_comma(t, q, &v[got]))) {
-            hd__chunk_fail(c, HD_EFORMAT, line, "'%.*s' is not a number (column %d)", (int)(q - t > 40 ? 40 : q - t), t,
-                           got + 1);
-            return 0;
-        }
-        if (d->semicolon && !d->decimal_comma && memchr(t, ',', (size_t)(q - t))) {
-            hd__chunk_fail(c, HD_EFORMAT, line,
-                           "'%.*s' has a decimal comma (column %d): 1,500 is 1.5 in one locale and 1500 in "
-                           "another; to read commas as decimal points, give the decimal_comma read option "
-                           "(--decimal-comma in the tool, decimal_comma=True in Python)",
-                           (int)(q - t > 40 ? 40 : q - t), t, got + 1);
-            return 0;
-        }
+        const char *e = hd__scan_double(q, eol, &v[got]);
+        if (e && (e == eol || is_field_sep(d, (unsigned char)*e))) q = e; /* the fast path read the whole token */
+        else if (!slow_field(c, d, line, got + 1, &q, eol, &v[got])) return 0;
+        if (q < eol && *q == ',' && !comma && digit_comma(q, eol)) comma = q;
         got++;
     }
     if (got < 3) {
         hd__chunk_fail(c, HD_EFORMAT, line, "expected 3 numbers (x y z), found %d", got);
         return 0;
     }
-    if (comma && blank) {
+    if (comma && blank_run(d, *qp, q < eol ? q + 1 : q, eol)) {
         const char *t = comma, *e = comma;
         while (t > *qp && !is_blank_sep((unsigned char)t[-1])) t--;
         while (e < eol && !is_blank_sep((unsigned char)*e)) e++;

@@ -1114,15 +1114,16 @@ TEST(decimal_commas_and_thousands_separators_with_every_separator_are_refused_un
         for (int thousands = 0; thousands < 2; thousands++) {
             tf_buf_t b = comma_text(SEP[k], thousands);
             for (int m = 0; m < N_MODES - 1; m++)
-                for (int option = 0; option < 2; option++) {
+                for (int option = 0; option < 4; option++) {
+                    /* options 2 and 3: without the final newline (a heap block ending at the last digit) */
                     char key[128];
-                    snprintf(key, sizeof key, "xyz text %s-%s%s %s", thousands ? "thousands" : "decimal-comma",
-                             SEP_NAME[k], option ? "-option" : "", MODE[m]);
+                    snprintf(key, sizeof key, "xyz text %s-%s%s%s %s", thousands ? "thousands" : "decimal-comma",
+                             SEP_NAME[k], option & 1 ? "-option" : "", option & 2 ? "-no-final-newline" : "", MODE[m]);
                     hd_read_options_t o = options(m);
-                    o.decimal_comma = option;
-                    int out = observe_with(S, XYZ, b.data, b.size, &o, m, key, NULL);
+                    o.decimal_comma = option & 1;
+                    int out = observe_with(S, XYZ, b.data, b.size - (option >> 1), &o, m, key, NULL);
                     cases++;
-                    int want = option && !thousands ? SAME : REFUSED;
+                    int want = (option & 1) && !thousands ? SAME : REFUSED;
                     if (out != want)
                         VIOLATION(key, "%s between fields: the file %s, expected %s", SEP_NAME[k], OUTCOME[out],
                                   OUTCOME[want]);
