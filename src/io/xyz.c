@@ -147,20 +147,26 @@ static int digit_comma(const char *p, const char *eol) {
     return *p == ',' && p + 1 < eol && is_digit((unsigned char)p[-1]) && is_digit((unsigned char)p[1]);
 }
 
-/* Whether a run of blanks alone separates two fields among the runs of
- * [p, end) (p at a field; a run that starts before end is followed to its
- * end, and counts when a field follows it). */
-static int blank_run(const dialect_t *d, const char *p, const char *end, const char *eol) {
+/* The first lone comma between digits among the separator runs of [p,
+ * end) when a run of blanks alone is among them too, else NULL (p at a
+ * field; a run that starts before end is followed to its end, and counts
+ * only when a field follows it). */
+static const char *digit_comma_among_blanks(const dialect_t *d, const char *p, const char *end, const char *eol) {
+    const char *comma = NULL;
+    int blank = 0;
     while (p < end) {
         if (!is_field_sep(d, (unsigned char)*p)) {
             p++;
             continue;
         }
-        int comma = 0;
-        while (p < eol && is_field_sep(d, (unsigned char)*p)) comma |= *p++ == ',';
-        if (!comma && p < eol) return 1;
+        const char *rs = p;
+        int has_comma = 0;
+        while (p < eol && is_field_sep(d, (unsigned char)*p)) has_comma |= *p++ == ',';
+        if (p == eol) break;
+        if (!has_comma) blank = 1;
+        else if (p - rs == 1 && !comma && digit_comma(rs, eol)) comma = rs;
     }
-    return 0;
+    return blank ? comma : NULL;
 }
 
 /* Field `col` (1-based) at *q that the fast path could not read whole: its
@@ -192,28 +198,29 @@ static int slow_field(hd__chunk_t *c, const dialect_t *d, long long line, int co
  * a thousands separator ("1,234.5 2,345.6 3,456.7", "1,234,567.5 2 3"),
  * not a separator: the line is refused, since reading the comma as one
  * gave (4, 25, 5) and (1, 234.5, 2).  "1,2,3", "1, 2, 3" and "1 2 3 4,5"
- * (a decimal comma after z, in a column not read) are read.  A field's
- * number ends at its separator, so the comma is seen there (in the
- * semicolon dialect a comma separates nothing and is never there), and
- * blank runs are looked for only once such a comma is found: the common
- * line costs one comparison a field. */
+ * (a decimal comma after z, in a column not read) are read.  The runs are
+ * looked at only when the numbers ended at a comma and at a blank both (in
+ * the semicolon dialect no number ends at a comma): a line separated by
+ * blanks alone or by commas alone costs a comparison a field. */
 static int row(hd__chunk_t *c, const dialect_t *d, long long line, const char **qp, const char *eol, double v[3]) {
-    const char *q = *qp, *comma = NULL;
+    const char *q = *qp, *comma;
     int got = 0;
+    unsigned ends = 0; /* what the numbers ended at */
     while (got < 3) {
         while (q < eol && is_field_sep(d, (unsigned char)*q)) q++;
         if (q == eol) break;
         const char *e = hd__scan_double(q, eol, &v[got]);
         if (e && (e == eol || is_field_sep(d, (unsigned char)*e))) q = e; /* the fast path read the whole token */
         else if (!slow_field(c, d, line, got + 1, &q, eol, &v[got])) return 0;
-        if (q < eol && *q == ',' && !comma && digit_comma(q, eol)) comma = q;
         got++;
+        if (q == eol) break;
+        ends |= 1u << (*q == ','); /* 1: a blank, 2: a comma */
     }
     if (got < 3) {
         hd__chunk_fail(c, HD_EFORMAT, line, "expected 3 numbers (x y z), found %d", got);
         return 0;
     }
-    if (comma && blank_run(d, *qp, q < eol ? q + 1 : q, eol)) {
+    if (ends == 3 && (comma = digit_comma_among_blanks(d, *qp, q < eol ? q + 1 : q, eol)) != NULL) {
         const char *t = comma, *e = comma;
         while (t > *qp && !is_blank_sep((unsigned char)t[-1])) t--;
         while (e < eol && !is_blank_sep((unsigned char)*e)) e++;
