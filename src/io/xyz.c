@@ -98,10 +98,11 @@ static int count_fields(const dialect_t *d, const char *q, const char *eol) {
 }
 
 /* Whether the field at t (ending at a separator or eol) can start a number:
- * a sign, a digit or a point first (so the malformed "1.#QNAN", "1.5D+03",
- * "3.14abc", "-" and "+.5e" can), or strtod's words inf, infinity and nan
- * before anything but a letter.  A field that cannot ("x", "X,Y,Z",
- * "index", "infrared") heads a header line. */
+ * after an optional sign, a digit or a point first, or nothing (so the
+ * malformed "1.#QNAN", "1.5D+03", "3.14abc", "-" and "+.5e" can), or
+ * strtod's words inf, infinity and nan before anything but a letter.  A
+ * field that cannot ("x", "-x", "X,Y,Z", "index", "infrared") heads a
+ * header line. */
 static int starts_number(const char *t, const char *eol) {
     if (is_digit((unsigned char)*t)) return 1;
     if (t < eol && (*t == '+' || *t == '-')) t++;
