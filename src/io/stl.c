@@ -17,7 +17,10 @@
  * Otherwise a file starting with "solid" is ascii when its first 4 KiB name
  * a "facet" or "endsolid" (every ascii STL with content does), and anything
  * else is binary: a binary header that starts with "solid" is never taken
- * for an empty ascii file.  A binary file must hold exactly its declared
+ * for an empty ascii file.  A file that is not binary by its size is text
+ * first: a UTF-8 byte-order mark is skipped and UTF-16 or UTF-32 refused by
+ * name (hd__text_begin), so an ascii STL saved as UTF-16 is never read as
+ * binary with the triangle count its text makes (1818521189).  A binary file must hold exactly its declared
  * triangles: fewer bytes is a truncation, more is data the count does not
  * cover (a wrong count, or two files joined), and both are errors naming
  * the numbers, never a silent partial read.  Binary corners are
