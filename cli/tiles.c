@@ -226,6 +226,18 @@ static char *trim(char *line, size_t len) {
     return *line && *line != '#' ? line : NULL;
 }
 
+/* 16 or 32 when a list's first line is UTF-16 or UTF-32 (by a byte-order
+ * mark, or by the NUL bytes of its first characters: ASCII text has none),
+ * else 0.  A UTF-8 byte-order mark is skipped instead. */
+static int wide_text(const unsigned char *b, size_t n) {
+    if (n >= 4 && ((b[0] == 0xff && b[1] == 0xfe && !b[2] && !b[3]) || (!b[0] && !b[1] && b[2] == 0xfe && b[3] == 0xff)))
+        return 32;
+    if (n >= 2 && ((b[0] == 0xff && b[1] == 0xfe) || (b[0] == 0xfe && b[1] == 0xff))) return 16;
+    if (n < 4) return 0;
+    if ((b[0] && !b[1] && !b[2] && !b[3]) || (!b[0] && !b[1] && !b[2] && b[3])) return 32;
+    return (b[0] && !b[1] && b[2] && !b[3]) || (!b[0] && b[1] && !b[2] && b[3]) ? 16 : 0;
+}
+
 /* The longest line of a list: a path (PATH_MAX) and some blanks.  Longer
  * is not a list (a binary file given by mistake), and is refused before
  * getline grows its buffer to the size of the file. */
@@ -263,12 +275,16 @@ static int expand_list(tiles_t *s, const char *list, const char *format, hd_erro
     int rc = HD_OK;
     while (rc == HD_OK && (len = getline(&buf, &bufcap, f)) >= 0) {
         line++;
-        if (memchr(buf, '\0', (size_t)len) || len > LINE_MAX_) {
-            rc = fail(err, HD_EFORMAT, line, "%s:%ld: %s (a list is text, one path per line)", list, line,
-                      len > LINE_MAX_ ? "a line longer than 4096 bytes" : "a NUL byte");
+        int wide = line == 1 ? wide_text((const unsigned char *)buf, (size_t)len) : 0;
+        if (wide || memchr(buf, '\0', (size_t)len) || len > LINE_MAX_) {
+            rc = wide ? fail(err, HD_EFORMAT, line, "%s:%ld: UTF-%d text; convert to UTF-8 (a list is text, one path "
+                             "per line)", list, line, wide)
+                      : fail(err, HD_EFORMAT, line, "%s:%ld: %s (a list is text, one path per line)", list, line,
+                             len > LINE_MAX_ ? "a line longer than 4096 bytes" : "a NUL byte");
             break;
         }
-        char *p = trim(buf, (size_t)len);
+        size_t bom = line == 1 && len >= 3 && memcmp(buf, "\xef\xbb\xbf", 3) == 0 ? 3 : 0; /* UTF-8's mark */
+        char *p = trim(buf + bom, (size_t)len - bom);
         if (!p) continue;
         const char *fmt;
         const char *name = tiles_split_format(p, &fmt);

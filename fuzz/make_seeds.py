@@ -7,7 +7,9 @@ only rerun to change them):
   tests/corpus/cli/    command lines (arguments separated by NUL) for fuzz_cli
   tests/corpus/{ply,obj,off,stl}/  meshes with more kinds of faces, for the
                        fuzz_FORMAT_sample targets (and the vertex ones)
-  regress-*            the hostile files of issue 17, one per reader fault
+  regress-*            the hostile files of issue 17, one per reader fault, and
+                       issue 35's text shapes (byte-order marks, UTF-16/32,
+                       decimal commas and thousands separators, first lines)
 
 Files not named regress-* are valid: tests/api/test_io_corpus.c reads every file
 of the reader directories and requires those to read.
@@ -184,8 +186,41 @@ def hostile_seeds():
     put("stl/regress-binary-solid-header", head + struct.pack("<I", len(tris)) + body)
 
 
+
+# ---- issue 35's text shapes -----------------------------------------------------
+STL_FACET = ("solid s\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
+             "endloop\nendfacet\nendsolid s\n")
+
+
+def text_seeds():
+    bom = b"\xef\xbb\xbf"
+    # a UTF-8 byte-order mark, skipped by every text reader (the first point was lost)
+    put("xyz/regress-bom.xyz", bom + b"9 9 9\n1 1 1\n")
+    put("xyz/regress-bom-header.csv", bom + b"x,y,z\n9,9,9\n1,1,1\n")
+    put("obj/regress-bom.obj", bom + b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+    put("off/regress-bom.off", bom + b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n")
+    put("ply/regress-bom.ply", bom + b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
+        b"property float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\n"
+        b"end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n")
+    put("pcd/regress-bom.pcd", bom + b"VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n"
+        b"WIDTH 2\nHEIGHT 1\nPOINTS 2\nDATA ascii\n9 9 9\n1 1 1\n")
+    put("stl/regress-bom.stl", bom + STL_FACET.encode())
+    # UTF-16 and UTF-32, refused by name (the STL was binary with 1818521189 triangles)
+    put("xyz/regress-utf16.xyz", "9 9 9\n1 1 1\n".encode("utf-16"))
+    put("xyz/regress-utf16-no-bom.txt", "x y z\n9 9 9\n".encode("utf-16-le"))
+    put("obj/regress-utf32.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n".encode("utf-32"))
+    put("stl/regress-utf16-solid.stl", STL_FACET.encode("utf-16"))
+    # decimal commas and thousands separators between blank-separated fields
+    put("xyz/regress-tab-decimal-comma.txt", "4,25\t5,5\t6,75\n1,5\t2,5\t3,5\n")
+    put("xyz/regress-thousands.xyz", "1,234.5 2,345.6 3,456.7\n")
+    # a malformed number on line 1, once skipped as a header
+    put("xyz/regress-qnan-line1.xyz", "1.#QNAN 2 3\n1 1 1\n")
+    put("xyz/regress-fortran-exponent-line1.xyz", "1.5D+03 0 0\n1 1 1\n")
+
+
 if __name__ == "__main__":
     nifti_seeds()
     cli_seeds()
     mesh_seeds()
     hostile_seeds()
+    text_seeds()

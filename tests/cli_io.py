@@ -76,6 +76,43 @@ def decimal_comma_csv_is_refused_unless_decimal_comma_is_given(d):
 
 
 @test
+def decimal_commas_and_thousands_between_blank_separated_fields_are_refused_unless_decimal_comma(d):
+    tab = write(d, "tab.txt", "4,25\t5,5\t6,75\n1,5\t2,5\t3,5\n")
+    o = write(d, "o.xyz", "0 0 0\n")
+    expect_bad(tab, "tab.txt:1: '4,25' has a comma between digits where blanks separate fields")
+    expect_bad(write(d, "th.xyz", "0 0 0\n1,234.5 2,345.6 3,456.7\n"), "th.xyz:2: '1,234.5'")
+    rc, out, err = run("--decimal-comma", "--json", tab, o)
+    assert rc == 0, (rc, out, err)
+    r = json.loads(out)
+    assert r["n_a"] == 2 and r["directed_ab"] == (4.25 ** 2 + 5.5 ** 2 + 6.75 ** 2) ** 0.5, r
+
+
+@test
+def a_byte_order_mark_is_skipped_and_utf16_is_refused(d):
+    o = write(d, "o.xyz", "0 0 0\n")
+    for name, text in (("bom.xyz", "9 9 9\n1 1 1\n"), ("bom.obj", "v 9 9 9\nv 1 1 1\n")):
+        path = write(d, name, b"\xef\xbb\xbf" + text.encode())
+        for args in ((path, o), ("-", o)):
+            rc, out, err = run("--json", *args, stdin=open(path, "rb").read())
+            assert rc == 0 and json.loads(out)["n_a"] == 2, (name, args, rc, out, err)
+    for enc in ("utf-16", "utf-16-le", "utf-32"):
+        bits = enc[4:6]
+        expect_bad(write(d, "w.stl", "solid s\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\n"
+                                      "vertex 0 1 0\nendloop\nendfacet\nendsolid s\n".encode(enc)),
+                   "w.stl:1: UTF-%s text; convert to UTF-8" % bits)
+        rc, out, err = run("-", o, stdin="1 2 3\n".encode(enc))
+        assert rc == 2 and "UTF-%s text; convert to UTF-8" % bits in err, (enc, rc, err)
+
+
+@test
+def a_malformed_number_on_the_first_line_is_refused_not_taken_for_a_header(d):
+    for bad in ("1.#QNAN 2 3", "1.5D+03 0 0", "3.14abc 1 1"):
+        expect_bad(write(d, "m.xyz", bad + "\n1 1 1\n"), "m.xyz:1: '%s' is not a number" % bad.split()[0])
+    rc, out, err = run("--json", write(d, "h.csv", "# scan\nX,Y,Z\n1,1,1\n"), write(d, "o.xyz", "0 0 0\n"))
+    assert rc == 0 and json.loads(out)["n_a"] == 1, (rc, out, err)
+
+
+@test
 def bad_binary_input_exits_2_naming_the_file_and_byte_offset(d):
     head = PLY_HEAD.replace("ascii", "binary_little_endian").format(n=3)
     expect_bad(write(d, "a.ply", head.encode() + struct.pack("<6f", 1, 2, 3, 4, 5, 6)),

@@ -163,6 +163,18 @@ def a_missing_file_in_a_list_is_a_read_error_naming_list_and_line(d):
 
 
 @test
+def a_list_with_a_utf8_byte_order_mark_reads_its_first_file_and_utf16_is_refused(d):
+    write(os.path.join(d, "a.xyz"), "0 0 0\n")
+    write(os.path.join(d, "b.xyz"), "1 0 0\n")
+    lst = write(os.path.join(d, "l.txt"), b"\xef\xbb\xbfa.xyz\nb.xyz\n")
+    r = run_json("@" + lst, os.path.join(d, "a.xyz"))
+    assert r["n_a"] == 2 and len(r["tiles_a"]) == 2, r
+    for enc in ("utf-16", "utf-16-be", "utf-32-le"):
+        lst = write(os.path.join(d, "w.txt"), "a.xyz\nb.xyz\n".encode(enc))
+        expect_error(["@" + lst, os.path.join(d, "a.xyz")], ["w.txt:1: UTF-%s text; convert to UTF-8" % enc[4:6]])
+
+
+@test
 def a_list_names_files_not_standard_input_or_directories(d):
     write(os.path.join(d, "a.xyz"), "0 0 0\n")
     os.makedirs(os.path.join(d, "sub"))

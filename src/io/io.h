@@ -157,6 +157,19 @@ const char *hd__scan_double(const char *s, const char *end, double *out);
  * failure or overflow of uint64_t. */
 int hd__parse_u64(const char *s, const char *end, uint64_t *out);
 
+/* The encoding of text starting at d[0..n): 8 (UTF-8 or ASCII; *bom is 3
+ * after a UTF-8 byte-order mark, else 0), 16 or 32 (UTF-16 or UTF-32, by
+ * their byte-order marks FF FE, FE FF, FF FE 00 00, 00 00 FE FF or, without
+ * one, by the NUL bytes of a first line of printable ASCII characters, each
+ * 2 or 4 bytes wide).  ASCII text has no NUL byte, so it is never taken for
+ * UTF-16 or UTF-32. */
+int hd__text_encoding(const unsigned char *d, size_t n, size_t *bom);
+/* Where r's file's text starts: *start past a UTF-8 byte-order mark (the
+ * file's first byte otherwise), and HD_OK; UTF-16 or UTF-32 text is refused
+ * with HD_EFORMAT, "NAME:1: UTF-16 text; convert to UTF-8 ...".  Every text
+ * reader starts here. */
+int hd__text_begin(hd__read_t *r, const char **start);
+
 HD__INLINE int hd__is_blank(int c) { return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v'; }
 
 /* End of the line starting at p (the '\n', or end). */

@@ -134,8 +134,8 @@ static void fix_chunk(void *ctx, hd__chunk_t *c, size_t before) {
 
 /* The first face line whose reference is out of range (serial; only run
  * when one is known to exist). */
-static int report_bad_reference(hd__read_t *r, size_t nv) {
-    const char *p = (const char *)r->f->data, *end = p + r->f->size, *tb, *te;
+static int report_bad_reference(hd__read_t *r, const char *p, size_t nv) {
+    const char *end = (const char *)r->f->data + r->f->size, *tb, *te;
     long long line = 0;
     uint64_t seen = 0;
     for (const char *q, *eol; hd__next_line(&p, end, &q, &eol);) {
@@ -158,16 +158,18 @@ static int report_bad_reference(hd__read_t *r, size_t nv) {
 }
 
 int hd__read_obj(hd__read_t *r) {
-    const char *s = (const char *)r->f->data;
+    const char *s, *end = (const char *)r->f->data + r->f->size;
+    int rc = hd__text_begin(r, &s);
+    if (rc) return rc;
     int want_faces = r->tris != NULL;
     uint64_t faces = 0;
     /* the shortest vertex line is "v 0 0 0\n" */
     hd__text_job_t job = {chunk, fix_chunk, candidates, 8, &want_faces};
-    int rc = hd__text_parallel(r, s, s + r->f->size, 1, &job, &faces);
+    rc = hd__text_parallel(r, s, end, 1, &job, &faces);
     if (rc) return rc;
     r->n_faces = (size_t)faces;
     if (r->tris)
         for (size_t k = 0; k < 3 * r->tris->count; k++)
-            if (r->tris->v[k] >= r->sink->count) return report_bad_reference(r, r->sink->count);
+            if (r->tris->v[k] >= r->sink->count) return report_bad_reference(r, s, r->sink->count);
     return HD_OK;
 }

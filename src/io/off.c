@@ -116,7 +116,9 @@ static int stream_next(stream_t *s, const char **tb, const char **te, int *new_l
 }
 
 int hd__read_off(hd__read_t *r) {
-    const char *s0 = (const char *)r->f->data, *end = s0 + r->f->size, *tb, *te;
+    const char *s0, *end = (const char *)r->f->data + r->f->size, *tb, *te;
+    int rc = hd__text_begin(r, &s0);
+    if (rc) return rc;
     stream_t st = {s0, end, NULL, NULL, 0};
     int nl;
     if (!stream_next(&st, &tb, &te, &nl)) return hd__io_err_line(r, HD_EFORMAT, 1, "empty file: no OFF header");
@@ -166,7 +168,7 @@ int hd__read_off(hd__read_t *r) {
     if (found < nv)
         return hd__io_err_line(r, HD_EFORMAT, line + (long long)lines + 1, "file ends after %llu of %llu vertices",
                                (unsigned long long)found, (unsigned long long)nv);
-    int rc = hd__sink_reserve(r->sink, (size_t)nv);
+    rc = hd__sink_reserve(r->sink, (size_t)nv);
     if (rc) return hd__io_err(r, rc, "cannot allocate %llu vertices", (unsigned long long)nv);
     off_ctx_t o = {0, nv};
     hd__text_job_t job = {chunk, NULL, hd__content_lines, 6, &o};

@@ -99,7 +99,9 @@ static int list(hd__read_t *r, pcd_t *p, const char **q, const char *eol, long l
 }
 
 static int header(hd__read_t *r, pcd_t *p) {
-    const char *s = (const char *)r->f->data, *end = s + r->f->size, *q = s, *tb, *te;
+    const char *s = (const char *)r->f->data, *end = s + r->f->size, *q, *tb, *te;
+    int rc = hd__text_begin(r, &q);
+    if (rc) return rc;
     long long line = 0;
     for (;;) {
         if (q >= end) return hd__io_err_line(r, HD_EFORMAT, line + 1, "header ends before the DATA line");

@@ -110,7 +110,9 @@ static int prop_index(const elem_t *e, const char *name) {
 /* Parse the header into p; sets p->data to the first byte after it. */
 static int header(ply_t *p) {
     hd__read_t *r = p->r;
-    const char *s = (const char *)r->f->data, *end = s + r->f->size, *q = s;
+    const char *s = (const char *)r->f->data, *end = s + r->f->size, *q;
+    int rc = hd__text_begin(r, &q);
+    if (rc) return rc;
     long long line = 0;
     int have_format = 0;
     for (;;) {

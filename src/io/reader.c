@@ -195,7 +195,7 @@ static const format_t *by_content(const hd__file_t *f) {
     if (magic_obj(f->data, f->size)) return by_name("obj");
     size_t k = 0;
     while (k < f->size && (f->data[k] == ' ' || f->data[k] == '\t' || f->data[k] == '\n' || f->data[k] == '\r')) k++;
-    if (k < f->size && (strchr("+-.0123456789", f->data[k]) || f->data[k] == '#')) return by_name("xyz");
+    if (k < f->size && f->data[k] && (strchr("+-.0123456789", f->data[k]) || f->data[k] == '#')) return by_name("xyz");
     /* a header line of printable text ("x,y,z") over a line that starts
      * with a number: a CSV with its header */
     size_t e = k;
@@ -204,7 +204,7 @@ static const format_t *by_content(const hd__file_t *f) {
     if (e > k && e < f->size && f->data[e] == '\n') {
         size_t n = e + 1;
         while (n < f->size && (f->data[n] == ' ' || f->data[n] == '\t' || f->data[n] == '\r')) n++;
-        if (n < f->size && strchr("+-.0123456789", f->data[n])) return by_name("xyz");
+        if (n < f->size && f->data[n] && strchr("+-.0123456789", f->data[n])) return by_name("xyz");
     }
     return NULL;
 }
@@ -422,18 +422,30 @@ static int choose(const char *path, const hd_read_options_t *opt, const format_t
 /* Everything after loading: confirm the format, parse, make the cloud. */
 static int read_loaded(const hd__file_t *f, const format_t *fmt, int from_extension,
                        const hd_read_options_t *opt, hd_cloud_t **out, uint64_t *total, hd_error_t *err) {
+    /* text after a UTF-8 byte-order mark is sniffed without it (the readers
+     * skip it too); UTF-16 and UTF-32 text has no format of its own: the
+     * reader the name chose refuses it by its encoding */
+    size_t bom;
+    int bits = hd__text_encoding(f->data, f->size, &bom);
+    hd__file_t text = {f->name, f->data + bom, f->size - bom};
     if (!fmt) {
         fmt = by_content(f);
+        if (!fmt && bom) fmt = by_content(&text);
+        if (!fmt && bits != 8)
+            return hd__err(err, HD_EFORMAT, "%s: UTF-%d text; convert to UTF-8 (iconv -f UTF-%d -t UTF-8)", f->name,
+                           bits, bits);
         if (!fmt)
             return hd__err(err, HD_EUNSUPPORTED, "%s: cannot tell the format from the %s; use --format (see --formats)",
                            f->name, from_extension < 0 ? "content" : "extension or the content");
-    } else if (from_extension > 0 && !(fmt->magic && fmt->magic(f->data, f->size))) {
+    } else if (from_extension > 0 && bits == 8 &&
+               !(fmt->magic && (fmt->magic(f->data, f->size) || (bom && fmt->magic(text.data, text.size))))) {
         /* The content must confirm the extension.  A format with a
          * signature that is missing is refused when the content has another
          * format's signature; a format without one (OBJ, text) is refused
          * when the content looks like any other format, so an OFF or a PLY
          * named .xyz is never read as a list of numbers. */
         const format_t *seems = by_content(f);
+        if (!seems && bom) seems = by_content(&text);
         if (seems && seems != fmt && (seems->magic || !fmt->magic))
             return hd__err(err, HD_EFORMAT, "%s: the name says %s but the content is %s; use --format %s", f->name,
                            fmt->name, seems->name, seems->name);

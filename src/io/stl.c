@@ -17,7 +17,10 @@
  * Otherwise a file starting with "solid" is ascii when its first 4 KiB name
  * a "facet" or "endsolid" (every ascii STL with content does), and anything
  * else is binary: a binary header that starts with "solid" is never taken
- * for an empty ascii file.  A binary file must hold exactly its declared
+ * for an empty ascii file.  A file that is not binary by its size is text
+ * first: a UTF-8 byte-order mark is skipped and UTF-16 or UTF-32 refused by
+ * name (hd__text_begin), so an ascii STL saved as UTF-16 is never read as
+ * binary with the triangle count its text makes (1818521189).  A binary file must hold exactly its declared
  * triangles: fewer bytes is a truncation, more is data the count does not
  * cover (a wrong count, or two files joined), and both are errors naming
  * the numbers, never a silent partial read.  Binary corners are
@@ -59,8 +62,8 @@ static size_t candidates(void *ctx, const char *p, const char *end) {
 
 /* The first facet that does not have exactly three vertices (serial; only
  * run when the totals disagree). */
-static int report_bad_facet(hd__read_t *r) {
-    const char *p = (const char *)r->f->data, *end = p + r->f->size, *tb, *te;
+static int report_bad_facet(hd__read_t *r, const char *p) {
+    const char *end = (const char *)r->f->data + r->f->size, *tb, *te;
     long long line = 0, facet_line = 0;
     int n = -1;
     for (const char *q, *eol; hd__next_line(&p, end, &q, &eol);) {
@@ -101,20 +104,26 @@ static int text_keyword(const unsigned char *d, size_t size) {
 
 int hd__read_stl(hd__read_t *r) {
     const unsigned char *d = r->f->data;
-    size_t size = r->f->size, k = 0;
-    while (k < size && (d[k] == ' ' || d[k] == '\t' || d[k] == '\r' || d[k] == '\n')) k++;
-    int solid = size - k >= 5 && memcmp(d + k, "solid", 5) == 0;
+    size_t size = r->f->size, k;
     uint64_t n = size >= 84 ? hd__ld_u32(d + 80, 0) : 0;
     int exact = size >= 84 && 84 + 50 * n == size;
+    /* text unless the size says binary: UTF-16 refused, a UTF-8 mark skipped */
+    const char *s = (const char *)d;
+    if (!exact) {
+        int rc = hd__text_begin(r, &s);
+        if (rc) return rc;
+    }
+    k = (size_t)((const unsigned char *)s - d);
+    while (k < size && (d[k] == ' ' || d[k] == '\t' || d[k] == '\r' || d[k] == '\n')) k++;
+    int solid = size - k >= 5 && memcmp(d + k, "solid", 5) == 0;
     if (solid && !exact && size >= 84 && !text_keyword(d, size)) solid = 0;
     if (solid && !exact) {
-        const char *s = (const char *)d;
         uint64_t facets = 0;
         /* the shortest vertex line is "vertex 0 0 0\n" */
         hd__text_job_t job = {chunk, NULL, candidates, 14, NULL};
-        int rc = hd__text_parallel(r, s, s + size, 1, &job, &facets);
+        int rc = hd__text_parallel(r, s, (const char *)d + size, 1, &job, &facets);
         if (rc) return rc;
-        if (r->sink->count != 3 * facets) return report_bad_facet(r);
+        if (r->sink->count != 3 * facets) return report_bad_facet(r, s);
         r->n_faces = (size_t)facets;
         return add_triangles(r, (size_t)facets);
     }

@@ -67,6 +67,46 @@ int hd__io_err(hd__read_t *r, int code, const char *fmt, ...) {
     return code;
 }
 
+/* Whether d[0..n) starts with code units of `width` bytes (2 or 4) holding
+ * printable ASCII (tabs and line ends included) in their low byte, `big`
+ * endian, up to the first line end or 8 units, at least 2 of them: UTF-16
+ * or UTF-32 text without a byte-order mark.  A binary header ("A\0\0\0"
+ * then zeros, say) has a NUL or control unit among them and is not. */
+static int wide_ascii(const unsigned char *d, size_t n, size_t width, int big) {
+    size_t units = 0;
+    for (size_t k = 0; k + width <= n && units < 8; k += width) {
+        unsigned c = d[big ? k + width - 1 : k];
+        for (size_t j = 1; j < width; j++)
+            if (d[big ? k + width - 1 - j : k + j]) return 0;
+        if (!((c >= 0x20 && c < 0x7f) || c == '\t' || c == '\r' || c == '\n')) return 0;
+        units++;
+        if (c == '\n') break;
+    }
+    return units >= 2;
+}
+
+int hd__text_encoding(const unsigned char *d, size_t n, size_t *bom) {
+    *bom = 0;
+    if (n >= 4 && ((d[0] == 0xff && d[1] == 0xfe && !d[2] && !d[3]) || (!d[0] && !d[1] && d[2] == 0xfe && d[3] == 0xff)))
+        return 32;
+    if (n >= 2 && ((d[0] == 0xff && d[1] == 0xfe) || (d[0] == 0xfe && d[1] == 0xff))) return 16;
+    if (n >= 3 && d[0] == 0xef && d[1] == 0xbb && d[2] == 0xbf) {
+        *bom = 3;
+        return 8;
+    }
+    if (wide_ascii(d, n, 4, 0) || wide_ascii(d, n, 4, 1)) return 32;
+    if (wide_ascii(d, n, 2, 0) || wide_ascii(d, n, 2, 1)) return 16;
+    return 8;
+}
+
+int hd__text_begin(hd__read_t *r, const char **start) {
+    size_t bom;
+    int bits = hd__text_encoding(r->f->data, r->f->size, &bom);
+    *start = (const char *)r->f->data + bom;
+    if (bits == 8) return HD_OK;
+    return hd__io_err_line(r, HD_EFORMAT, 1, "UTF-%d text; convert to UTF-8 (iconv -f UTF-%d -t UTF-8)", bits, bits);
+}
+
 int hd__parse_u64(const char *s, const char *end, uint64_t *out) {
     if (s == end) return 0;
     uint64_t v = 0;

@@ -15,22 +15,29 @@
  *    which (the message names the option); if it holds none, fields are
  *    separated by blanks and commas, and a ';' on a later line is refused
  *    naming that line (the file mixes dialects, and any reading of it could
- *    be the wrong one).
+ *    be the wrong one), and so is a line whose numbers blanks separate and
+ *    a comma between digits splits ("4,25<TAB>5,5<TAB>6,75", "1,234.5
+ *    2,345.6 3,456.7": decimal commas or thousands separators; see row()).
  * Reading "1,5;2,5;3,5" as blank/comma/semicolon-separated once gave the
- * silent wrong answer (1, 5, 2).  A comma-separated file whose numbers use
- * decimal commas ("1,5,2,5,3,5") cannot be told from six columns and is
- * read as six columns; docs/formats.md says so.
+ * silent wrong answer (1, 5, 2), and the tab-separated "4,25 5,5 6,75"
+ * gave (4, 25, 5).  A comma-separated file whose numbers use decimal
+ * commas ("1,5,2,5,3,5") cannot be told from six columns and is read as
+ * six columns; docs/formats.md says so.
  * When the first point row holds whole numbers only, every point row must
  * have as many fields as it: that is the pattern of a mesh without its
  * keyword (an OFF named .xyz: a counts row "8356 16674 0", vertex rows of 3
  * fields, face rows "3 i j k" of 4), which was once read as points, faces
  * included, and answered.  Other files may have ragged extra columns.
- * Blank lines and lines starting with '#' or
- * '//' are skipped.  The first line may be a header: if it does not start
- * with a number (a CSV header such as "x,y,z,intensity") it is skipped, and
- * so is a first line holding a single whole number (the point count of the
- * Leica PTS format), which must then equal the number of points read (a
- * count lower or higher than the data is an error, never a partial read).
+ * A UTF-8 byte-order mark is skipped; UTF-16 and UTF-32 are refused
+ * (hd__text_begin).  Blank lines and lines starting with '#' or '//' are
+ * skipped.  The lines before the first data line are the header and are
+ * skipped: their first field cannot start a number (starts_number: "x",
+ * "X,Y,Z,intensity"), so no number is ever skipped; a malformed number
+ * ("1.#QNAN", "1.5D+03", "3.14abc") starts a data line and is refused
+ * there, on line 1 as on any other.  The one exception is a first line
+ * holding a single whole number, the point count of the Leica PTS format,
+ * which must then equal the number of points read (a count lower or higher
+ * than the data is an error, never a partial read).
  * Any other line with fewer than three numbers, or a
  * token among the first three that is not a number, is an error naming the
  * line.
@@ -47,7 +54,8 @@
 typedef struct {
     int semicolon;       /* fields separated by ';' and blanks, not ',' */
     int decimal_comma;   /* the option: a comma in a field is its decimal point */
-    long long data_line; /* the line that decided (for messages) */
+    const char *data_at; /* the first data line (the end when there is none) */
+    long long data_line; /* its line (for messages) */
     int fields;          /* fields of the first point row */
     long long fields_line; /* that row's line */
     int first_int;       /* that row holds whole numbers only */
@@ -60,6 +68,8 @@ static int is_blank_sep(int c) { return c == ' ' || c == '\t' || c == '\r' || c 
 static int is_sep(int c) { return is_blank_sep(c) || c == ',' || c == ';'; }
 
 static int is_field_sep(const dialect_t *d, int c) { return is_blank_sep(c) || c == (d->semicolon ? ';' : ','); }
+
+static int is_digit(int c) { return (unsigned)c - (unsigned)'0' < 10u; }
 
 /* A field with a decimal comma, [t, e), as a double: 1 and *v, or 0.  The
  * comma is replaced by a point in a copy; a field holding a point too, or
@@ -87,6 +97,145 @@ static int count_fields(const dialect_t *d, const char *q, const char *eol) {
     return n;
 }
 
+/* Whether the field at t (ending at a separator or eol) can start a number:
+ * after an optional sign, a digit or a point first, or nothing (so the
+ * malformed "1.#QNAN", "1.5D+03", "3.14abc", "-" and "+.5e" can), or
+ * strtod's words inf, infinity and nan before anything but a letter.  A
+ * field that cannot ("x", "-x", "X,Y,Z", "index", "infrared") heads a
+ * header line. */
+static int starts_number(const char *t, const char *eol) {
+    if (is_digit((unsigned char)*t)) return 1;
+    if (t < eol && (*t == '+' || *t == '-')) t++;
+    if (t == eol || *t == '.' || is_digit((unsigned char)*t) || is_sep((unsigned char)*t)) return 1;
+    char w[9];
+    size_t n = 0;
+    for (; t < eol && n < sizeof w && ((*t | 0x20) >= 'a' && (*t | 0x20) <= 'z'); t++) w[n++] = (char)(*t | 0x20);
+    if (t < eol && ((*t | 0x20) >= 'a' && (*t | 0x20) <= 'z')) return 0;
+    return (n == 3 && (memcmp(w, "inf", 3) == 0 || memcmp(w, "nan", 3) == 0)) || (n == 8 && memcmp(w, "infinity", 8) == 0);
+}
+
+/* Whether the line [p, eol) may hold a point: its first field can start a
+ * number.  The lines before the first one that may (comments and blank
+ * lines aside) are the header. */
+static int candidate(const char *p, const char *eol) {
+    while (p < eol && is_sep((unsigned char)*p)) p++;
+    return p < eol && starts_number(p, eol);
+}
+
+/* Line 1 holding one field that can start a number: the point count of the
+ * PTS format, a whole number kept in c->aux (plus one) and checked at the
+ * end; 1, or 0 with the problem recorded. */
+static int pts_count(hd__chunk_t *c, long long line, const char *q, const char *eol) {
+    const char *e = q;
+    while (e < eol && !is_sep((unsigned char)*e)) e++;
+    double n;
+    if (!hd__parse_double(q, e, &n)) {
+        hd__chunk_fail(c, HD_EFORMAT, line, "'%.*s' is not a number (column 1)", (int)(e - q > 40 ? 40 : e - q), q);
+        return 0;
+    }
+    if (!(n >= 0 && n < 0x1p64 && n == floor(n))) {
+        hd__chunk_fail(c, HD_EFORMAT, line, "expected 3 numbers (x y z), found 1");
+        return 0;
+    }
+    c->aux = (uint64_t)n + 1;
+    return 1;
+}
+
+/* Whether the comma at p is a lone comma between digits ("4,25",
+ * "1,234.5"): a decimal comma or a thousands separator, if blanks also
+ * separate fields. */
+static int digit_comma(const char *p, const char *eol) {
+    return *p == ',' && p + 1 < eol && is_digit((unsigned char)p[-1]) && is_digit((unsigned char)p[1]);
+}
+
+/* The first lone comma between digits among the separator runs of [p,
+ * end) when a run of blanks alone is among them too, else NULL (p at a
+ * field; a run that starts before end is followed to its end, and counts
+ * only when a field follows it). */
+static const char *digit_comma_among_blanks(const dialect_t *d, const char *p, const char *end, const char *eol) {
+    const char *comma = NULL;
+    int blank = 0;
+    while (p < end) {
+        if (!is_field_sep(d, (unsigned char)*p)) {
+            p++;
+            continue;
+        }
+        const char *rs = p;
+        int has_comma = 0;
+        while (p < eol && is_field_sep(d, (unsigned char)*p)) has_comma |= *p++ == ',';
+        if (p == eol) break;
+        if (!has_comma) blank = 1;
+        else if (p - rs == 1 && !comma && digit_comma(rs, eol)) comma = rs;
+    }
+    return blank ? comma : NULL;
+}
+
+/* Field `col` (1-based) at *q that the fast path could not read whole: its
+ * value in *v and *q past it (1), or 0 with the problem recorded. */
+static int slow_field(hd__chunk_t *c, const dialect_t *d, long long line, int col, const char **q, const char *eol,
+                      double *v) {
+    const char *t = *q, *e = t;
+    while (e < eol && !is_field_sep(d, (unsigned char)*e)) e++;
+    *q = e;
+    if (!hd__parse_double(t, e, v) && !(d->semicolon && parse_decimal_comma(t, e, v))) {
+        hd__chunk_fail(c, HD_EFORMAT, line, "'%.*s' is not a number (column %d)", (int)(e - t > 40 ? 40 : e - t), t, col);
+        return 0;
+    }
+    if (d->semicolon && !d->decimal_comma && memchr(t, ',', (size_t)(e - t))) {
+        hd__chunk_fail(c, HD_EFORMAT, line,
+                       "'%.*s' has a decimal comma (column %d): 1,500 is 1.5 in one locale and 1500 in "
+                       "another; to read commas as decimal points, give the decimal_comma read option "
+                       "(--decimal-comma in the tool, decimal_comma=True in Python)",
+                       (int)(e - t > 40 ? 40 : e - t), t, col);
+        return 0;
+    }
+    return 1;
+}
+
+/* x y z from [*qp, eol) into v: 1 (and *qp past z), or 0 with the problem
+ * recorded.  In the blank-and-comma dialect, when the separators between
+ * x, y, z and the next field include both a lone comma between digits and
+ * blanks alone, the comma is a decimal comma ("4,25<TAB>5,5<TAB>6,75") or
+ * a thousands separator ("1,234.5 2,345.6 3,456.7", "1,234,567.5 2 3"),
+ * not a separator: the line is refused, since reading the comma as one
+ * gave (4, 25, 5) and (1, 234.5, 2).  "1,2,3", "1, 2, 3" and "1 2 3 4,5"
+ * (a decimal comma after z, in a column not read) are read.  The runs are
+ * looked at only when the numbers ended at a comma and at a blank both (in
+ * the semicolon dialect no number ends at a comma): a line separated by
+ * blanks alone or by commas alone costs a comparison a field. */
+static int row(hd__chunk_t *c, const dialect_t *d, long long line, const char **qp, const char *eol, double v[3]) {
+    const char *q = *qp, *comma;
+    int got = 0;
+    unsigned ends = 0; /* what the numbers ended at */
+    while (got < 3) {
+        while (q < eol && is_field_sep(d, (unsigned char)*q)) q++;
+        if (q == eol) break;
+        const char *e = hd__scan_double(q, eol, &v[got]);
+        if (e && (e == eol || is_field_sep(d, (unsigned char)*e))) q = e; /* the fast path read the whole token */
+        else if (!slow_field(c, d, line, got + 1, &q, eol, &v[got])) return 0;
+        got++;
+        if (q == eol) break;
+        ends |= 1u << (*q == ','); /* 1: a blank, 2: a comma */
+    }
+    if (got < 3) {
+        hd__chunk_fail(c, HD_EFORMAT, line, "expected 3 numbers (x y z), found %d", got);
+        return 0;
+    }
+    if (ends == 3 && (comma = digit_comma_among_blanks(d, *qp, q < eol ? q + 1 : q, eol)) != NULL) {
+        const char *t = comma, *e = comma;
+        while (t > *qp && !is_blank_sep((unsigned char)t[-1])) t--;
+        while (e < eol && !is_blank_sep((unsigned char)*e)) e++;
+        hd__chunk_fail(c, HD_EFORMAT, line,
+                       "'%.*s' has a comma between digits where blanks separate fields: a decimal comma or a "
+                       "thousands separator; to read decimal commas, give the decimal_comma read option "
+                       "(--decimal-comma in the tool, decimal_comma=True in Python)",
+                       (int)(e - t > 30 ? 30 : e - t), t);
+        return 0;
+    }
+    *qp = q;
+    return 1;
+}
+
 static void chunk(void *ctx, hd__chunk_t *c) {
     const dialect_t *d = ctx;
     const char *p = c->begin, *end = c->end;
@@ -96,59 +245,19 @@ static void chunk(void *ctx, hd__chunk_t *c) {
         const char *ls = q;
         while (q < eol && is_sep((unsigned char)*q)) q++;
         if (q == eol || *q == '#' || (*q == '/' && q + 1 < eol && q[1] == '/')) continue;
-        int first = c->index == 0 && line == 1;
-        double v[3];
-        int got = 0;
-        /* lines before the deciding one are a header, whatever they hold */
-        if (!d->semicolon && !(c->index == 0 && line < d->data_line)) {
-            const char *semi = memchr(ls, ';', (size_t)(eol - ls));
-            if (semi) {
-                hd__chunk_fail(c, HD_EFORMAT, line,
-                               "a ';' in a file whose first data line (line %lld) has none: mixed separators",
-                               d->data_line);
-                return;
-            }
+        if (ls < d->data_at) {
+            /* the header; a candidate here is line 1's PTS count (dialect_of) */
+            if (candidate(q, eol) && !pts_count(c, line, q, eol)) return;
+            continue;
         }
-        while (got < 3) {
-            while (q < eol && is_field_sep(d, (unsigned char)*q)) q++;
-            if (q == eol) break;
-            const char *t = q, *e = hd__scan_double(q, eol, &v[got]);
-            if (e && (e == eol || is_field_sep(d, (unsigned char)*e))) {
-                q = e; /* the fast path read the whole token */
-                got++;
-                continue;
-            }
-            while (q < eol && !is_field_sep(d, (unsigned char)*q)) q++;
-            if (!hd__parse_double(t, q, &v[got]) && !(d->semicolon && parse_decimal_comma(t, q, &v[got]))) {
-                if (first && got == 0) break; /* a header line */
-                hd__chunk_fail(c, HD_EFORMAT, line, "'%.*s' is not a number (column %d)",
-                               (int)(q - t > 40 ? 40 : q - t), t, got + 1);
-                return;
-            }
-            if (d->semicolon && !d->decimal_comma && memchr(t, ',', (size_t)(q - t))) {
-                hd__chunk_fail(c, HD_EFORMAT, line,
-                               "'%.*s' has a decimal comma (column %d): 1,500 is 1.5 in one locale and 1500 in "
-                               "another; to read commas as decimal points, give the decimal_comma read option "
-                               "(--decimal-comma in the tool, decimal_comma=True in Python)",
-                               (int)(q - t > 40 ? 40 : q - t), t, got + 1);
-                return;
-            }
-            got++;
-        }
-        if (first && got <= 1) {
-            /* a header: words, or the single point count of PTS */
-            if (got == 0) continue;
-            while (q < eol && is_field_sep(d, (unsigned char)*q)) q++;
-            double n = v[0];
-            if (q == eol && n >= 0 && n < 0x1p64 && n == floor(n)) {
-                c->aux = (uint64_t)n + 1; /* the PTS count, checked at the end */
-                continue;
-            }
-        }
-        if (got < 3) {
-            hd__chunk_fail(c, HD_EFORMAT, line, "expected 3 numbers (x y z), found %d", got);
+        if (!d->semicolon && memchr(ls, ';', (size_t)(eol - ls))) {
+            hd__chunk_fail(c, HD_EFORMAT, line,
+                           "a ';' in a file whose first data line (line %lld) has none: mixed separators",
+                           d->data_line);
             return;
         }
+        double v[3];
+        if (!row(c, d, line, &q, eol, v)) return;
         int fields = d->first_int ? 3 + count_fields(d, q, eol) : d->fields;
         if (fields != d->fields) {
             hd__chunk_fail(c, HD_EFORMAT, line,
@@ -162,16 +271,6 @@ static void chunk(void *ctx, hd__chunk_t *c) {
     c->lines = line;
 }
 
-/* Whether the line [p, eol) may hold a point: its first field can start a
- * number (digits, sign, point, or the inf/nan that strtod accepts and the
- * point check then refuses). */
-static int candidate(const char *p, const char *eol) {
-    while (p < eol && is_sep((unsigned char)*p)) p++;
-    unsigned char f = (unsigned char)(p < eol ? *p : 0);
-    return ((unsigned)f - (unsigned)'0' < 10u) || f == '-' || f == '+' || f == '.' || f == 'i' || f == 'I' ||
-           f == 'n' || f == 'N';
-}
-
 static size_t candidates(void *ctx, const char *p, const char *end) {
     (void)ctx;
     size_t n = 0;
@@ -179,12 +278,11 @@ static size_t candidates(void *ctx, const char *p, const char *end) {
     return n;
 }
 
-/* The dialect, from the first candidate line (serial; it stops there). */
-/* The dialect and the number of fields, from the first point row: the
+/* The dialect and the number of fields, from the first data line: the
  * first candidate line, or the next one when the first line is a PTS count
  * (a single field).  Serial; it stops there. */
 static dialect_t dialect_of(const char *p, const char *end, int decimal_comma) {
-    dialect_t d = {decimal_comma, decimal_comma, 0, 0, 0, 0};
+    dialect_t d = {decimal_comma, decimal_comma, end, 0, 0, 0, 0};
     for (long long line = 1; p < end; line++) {
         const char *eol = hd__eol(p, end);
         if (candidate(p, eol)) {
@@ -194,11 +292,12 @@ static dialect_t dialect_of(const char *p, const char *end, int decimal_comma) {
             while (q < eol && is_sep((unsigned char)*q)) q++;
             if (!(line == 1 && q == eol)) { /* not a PTS count line */
                 d.semicolon = decimal_comma || memchr(p, ';', (size_t)(eol - p)) != NULL;
+                d.data_at = p;
                 d.data_line = d.fields_line = line;
                 d.fields = count_fields(&d, p, eol);
                 d.first_int = 1;
                 for (const char *t = p; t < eol && d.first_int; t++)
-                    d.first_int = (*t >= '0' && *t <= '9') || *t == '-' || *t == '+' || is_field_sep(&d, (unsigned char)*t);
+                    d.first_int = is_digit((unsigned char)*t) || *t == '-' || *t == '+' || is_field_sep(&d, (unsigned char)*t);
                 break;
             }
         }
@@ -208,12 +307,14 @@ static dialect_t dialect_of(const char *p, const char *end, int decimal_comma) {
 }
 
 int hd__read_xyz(hd__read_t *r) {
-    const char *s = (const char *)r->f->data;
-    dialect_t d = dialect_of(s, s + r->f->size, r->opt->decimal_comma);
+    const char *s, *end = (const char *)r->f->data + r->f->size;
+    int rc = hd__text_begin(r, &s);
+    if (rc) return rc;
+    dialect_t d = dialect_of(s, end, r->opt->decimal_comma);
     /* the shortest point line is "0 0 0\n" */
     hd__text_job_t job = {chunk, NULL, candidates, 6, &d};
     uint64_t count = 0; /* only the first chunk sets it: the PTS count + 1 */
-    int rc = hd__text_parallel(r, s, s + r->f->size, 1, &job, &count);
+    rc = hd__text_parallel(r, s, end, 1, &job, &count);
     if (rc == HD_OK && count && count - 1 != r->sink->count)
         return hd__io_err_line(r, HD_EFORMAT, 1, "the count line says %llu points, the file holds %zu",
                                (unsigned long long)(count - 1), r->sink->count);

@@ -6,7 +6,11 @@
  * type cannot hold overran a 1-byte buffer; an OBJ relative index wrapped
  * onto a real vertex; a semicolon CSV with decimal commas gave wrong
  * points; a binary STL whose header starts with "solid" was taken for an
- * empty ascii file.  The test runs in the release and the ASan builds.
+ * empty ascii file; decimal commas and thousands separators between
+ * blank-separated fields were read as more columns; a UTF-8 byte-order mark
+ * lost the first point, UTF-16 text gave misleading messages (an STL
+ * triangle count of 1818521189); a malformed number on line 1 was skipped
+ * as a header.  The test runs in the release and the ASan builds.
  */
 #include "check.h"
 #include "files.h"
@@ -253,4 +257,158 @@ TEST(sampling_a_mesh_near_the_coordinate_limit_draws_points_on_it) {
     d = c->data;
     for (size_t k = 0; k < 100; k++) CHECK(d[3 * k] >= 0 && d[3 * k + 1] >= 0 && d[3 * k] + d[3 * k + 1] <= 1 + 1e-15);
     hd_cloud_free(c);
+}
+
+/* ---- text encodings, decimal commas with every separator, first lines ---- */
+
+TEST(decimal_commas_between_blank_separated_fields_are_refused_naming_line_and_option) {
+    /* a European spreadsheet's tab export read as (4, 25, 5) */
+    refused(tf_printf("tab.txt", "4,25\t5,5\t6,75\n1,5\t2,5\t3,5\n"), NULL, HD_EFORMAT,
+            "'4,25' has a comma between digits where blanks separate fields", LINE, 1);
+    refused(tf_printf("space.xyz", "# cloud\n1 2 3\n4,25 5,5 6,75\n"), NULL, HD_EFORMAT, "decimal_comma read option",
+            LINE, 3);
+    refused(tf_printf("blanks.txt", "1 2 3\n4  \t 5 6,75\n"), NULL, HD_EFORMAT, "'6,75' has a comma between digits",
+            LINE, 2);
+    refused(tf_printf("z.xyz", "1 2 3,5 100\n"), NULL, HD_EFORMAT, "'3,5'", LINE, 1);
+}
+
+TEST(thousands_separators_between_blank_separated_fields_are_refused) {
+    /* read as (1, 234.5, 2) and (1, 234, 567.5) */
+    refused(tf_printf("th.xyz", "1,234.5 2,345.6 3,456.7\n"), NULL, HD_EFORMAT,
+            "'1,234.5' has a comma between digits where blanks separate fields: a decimal comma or a thousands "
+            "separator", LINE, 1);
+    refused(tf_printf("th2.xyz", "0 0 0\n1,234,567.5 2 3\n"), NULL, HD_EFORMAT, "'1,234,567.5'", LINE, 2);
+    refused(tf_printf("th3.xyz", "0 0 0\n7\t8\t1,000\n"), NULL, HD_EFORMAT, "'1,000'", LINE, 2);
+}
+
+TEST(decimal_commas_with_every_separator_are_read_with_the_option) {
+    hd_read_options_t o;
+    hd_read_options_init(&o);
+    o.decimal_comma = 1;
+    const double want[] = {4.25, 5.5, 6.75, -1.5, 2, 0.25};
+    static const char *const seps[] = {"\t", " ", ";", " ; ", " \t ", "\t;"};
+    for (size_t k = 0; k < sizeof seps / sizeof seps[0]; k++) {
+        const char *s = seps[k];
+        reads(tf_printf("dc.txt", "4,25%s5,5%s6,75\n-1,5%s2%s0,25\n", s, s, s, s), &o, want, 2);
+        /* and without the option: refused, never read otherwise */
+        refused(tf_printf("dc.txt", "4,25%s5,5%s6,75\n-1,5%s2%s0,25\n", s, s, s, s), NULL, HD_EFORMAT, "decimal_comma",
+                LINE, 1);
+    }
+}
+
+TEST(commas_that_separate_fields_are_still_read) {
+    const double want[] = {1, 2, 3, 4, 5, 6};
+    reads(tf_printf("c1.csv", "1,2,3\n4,5,6\n"), NULL, want, 2);
+    reads(tf_printf("c2.csv", "1, 2, 3\n4 ,5 ,6\n"), NULL, want, 2);
+    reads(tf_printf("c3.csv", "x,y,z,name\n1,2,3,a label with blanks\n4,5,6,another one\n"), NULL, want, 2);
+    /* a decimal comma after z is in a column that is not read */
+    reads(tf_printf("c4.xyz", "1 2 3 0,5\n4 5 6 1,5\n"), NULL, want, 2);
+}
+
+/* The same points from `text` with a UTF-8 byte-order mark in front. */
+static void bom_reads_the_same(const char *name, const char *text) {
+    CONTEXT("%s", name);
+    hd_cloud_t *a = NULL, *b = NULL;
+    hd_error_t e;
+    int rc = hd_read_file(tf_printf(name, "%s", text), NULL, &a, &e);
+    if (rc) hdt_fail(__FILE__, __LINE__, "refused without the mark: %s", e.message);
+    rc = hd_read_file(tf_printf(name, "\xef\xbb\xbf%s", text), NULL, &b, &e);
+    if (rc) hdt_fail(__FILE__, __LINE__, "refused with the mark: %s", e.message);
+    if (a && b) {
+        CHECK_EQ(b->count, a->count);
+        CHECK(b->count == a->count && memcmp(a->data, b->data, a->count * 3 * sizeof(double)) == 0);
+    }
+    hd_cloud_free(a);
+    hd_cloud_free(b);
+}
+
+static const char *const PLY_TEXT = "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
+                                    "property float z\nend_header\n9 9 9\n1 2 3\n";
+static const char *const PCD_TEXT = "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 2\n"
+                                    "HEIGHT 1\nPOINTS 2\nDATA ascii\n9 9 9\n1 2 3\n";
+static const char *const STL_TEXT = "solid s\nfacet normal 0 0 1\nouter loop\nvertex 9 9 9\nvertex 1 0 0\n"
+                                    "vertex 0 1 0\nendloop\nendfacet\nendsolid s\n";
+
+TEST(a_utf8_byte_order_mark_is_skipped_by_every_text_reader) {
+    /* the first point was dropped (taken for a header, or `\xef\xbb\xbfv` an unknown statement) */
+    bom_reads_the_same("b.xyz", "9 9 9\n1 2 3\n");
+    bom_reads_the_same("b.csv", "9,9,9\n1,2,3\n");
+    bom_reads_the_same("h.csv", "x,y,z\n9,9,9\n1,2,3\n");
+    bom_reads_the_same("b.pts", "2\n9 9 9 1 2 3 4\n1 2 3 1 2 3 4\n");
+    bom_reads_the_same("b.obj", "v 9 9 9\nv 1 2 3\n");
+    bom_reads_the_same("b.off", "OFF\n2 0 0\n9 9 9\n1 2 3\n");
+    bom_reads_the_same("b.ply", PLY_TEXT);
+    bom_reads_the_same("b.pcd", PCD_TEXT);
+    bom_reads_the_same("b.stl", STL_TEXT);
+    /* and where the content decides the format */
+    bom_reads_the_same("b.dat", "9 9 9\n1 2 3\n");
+    bom_reads_the_same("o.dat", "v 9 9 9\nv 1 2 3\n");
+    bom_reads_the_same("p.dat", PLY_TEXT);
+}
+
+/* `text` as UTF-16 or UTF-32 is refused naming the encoding. */
+static void wide_refused(const char *name, const char *text) {
+    static const struct {
+        int width, big, bom;
+    } enc[] = {{2, 0, 1}, {2, 1, 1}, {2, 0, 0}, {2, 1, 0}, {4, 0, 1}, {4, 1, 1}, {4, 0, 0}, {4, 1, 0}};
+    for (size_t k = 0; k < sizeof enc / sizeof enc[0]; k++) {
+        CONTEXT("%s as UTF-%d, %s endian, %s byte-order mark", name, 8 * enc[k].width, enc[k].big ? "big" : "little",
+                enc[k].bom ? "with a" : "without a");
+        tf_buf_t b = {0};
+        tf_wide(&b, text, strlen(text), enc[k].width, enc[k].big, enc[k].bom);
+        char want[64];
+        snprintf(want, sizeof want, "UTF-%d text; convert to UTF-8", 8 * enc[k].width);
+        refused(tf_finish(&b, name), NULL, HD_EFORMAT, want, NONE, 0);
+    }
+}
+
+TEST(utf16_and_utf32_text_is_refused_naming_the_encoding) {
+    /* once "'' is not a number", "no points", or a UTF-16 ascii STL read as
+     * binary with 1818521189 triangles */
+    wide_refused("w.xyz", "9 9 9\n1 2 3\n");
+    wide_refused("w.csv", "x,y,z\n9,9,9\n1,2,3\n");
+    wide_refused("w.obj", "v 9 9 9\nv 1 2 3\n");
+    wide_refused("w.off", "OFF\n2 0 0\n9 9 9\n1 2 3\n");
+    wide_refused("w.ply", PLY_TEXT);
+    wide_refused("w.pcd", PCD_TEXT);
+    wide_refused("w.stl", STL_TEXT);
+    wide_refused("w.dat", "9 9 9\n1 2 3\n");
+}
+
+TEST(a_binary_stl_whose_header_looks_like_utf16_is_read_by_its_size) {
+    tf_buf_t b = {0};
+    tf_wide(&b, "solid part", 10, 2, 0, 1);
+    while (b.size < 80) tf_u8(&b, 0);
+    tf_u32(&b, 1, 0);
+    for (int k = 0; k < 12; k++) tf_f32(&b, k == 2 || k == 5 || k == 10 ? 1.0f : 0.0f, 0);
+    tf_u16(&b, 0, 0);
+    const double want[] = {0, 0, 1, 0, 0, 0, 0, 1, 0};
+    reads(tf_finish(&b, "w16.stl"), NULL, want, 3);
+}
+
+TEST(a_malformed_number_on_line_1_is_refused_as_on_line_2) {
+    /* line 1 was taken for a header: one point fewer, exit 0 */
+    static const char *const bad[] = {"1.#QNAN 2 3", "1.5D+03 0 0", "3.14abc 1 1", "- 1 2", "+.5e 1 2", "1.#INF,0,0",
+                                      ".x 1 2"};
+    for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
+        char tok[16];
+        snprintf(tok, sizeof tok, "'%.*s'", (int)strcspn(bad[k], " ,"), bad[k]);
+        refused(tf_printf("m1.xyz", "%s\n1 1 1\n", bad[k]), NULL, HD_EFORMAT, tok, LINE, 1);
+        refused(tf_printf("m2.xyz", "1 1 1\n%s\n", bad[k]), NULL, HD_EFORMAT, tok, LINE, 2);
+    }
+    refused(tf_printf("nan.xyz", "nan 1 2\n1 1 1\n"), NULL, HD_ENONFINITE, "NaN", LINE, 1);
+    refused(tf_printf("inf.csv", "-Infinity,1,2\n1,1,1\n"), NULL, HD_ENONFINITE, "infinite", LINE, 1);
+    refused(tf_printf("count.pts", "1.#QNAN\n1 1 1\n"), NULL, HD_EFORMAT, "'1.#QNAN' is not a number", LINE, 1);
+}
+
+TEST(header_lines_are_those_before_the_first_line_that_can_start_a_number) {
+    const double want[] = {1, 2, 3, 4, 5, 6};
+    static const char *const headers[] = {"x y z\n", "X,Y,Z\n", "index,x,y,z\n", "infrared x y\n", "name;x;y;z\n",
+                                          "# exported\nx,y,z\n", "title\n\nx y z (m)\n", "-x -y -z\n", "nanometres\n"};
+    for (size_t k = 0; k < sizeof headers / sizeof headers[0]; k++) {
+        int semi = strchr(headers[k], ';') != NULL;
+        reads(tf_printf("head.csv", "%s1%s2%s3\n4%s5%s6\n", headers[k], semi ? ";" : ",", semi ? ";" : ",",
+                        semi ? ";" : ",", semi ? ";" : ","),
+              NULL, want, 2);
+    }
 }

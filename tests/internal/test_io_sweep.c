@@ -9,6 +9,10 @@
  *   3. followed by one stray byte, a newline, or a second copy of
  *      themselves,
  *   4. mutated one header byte at a time (0x00, 0xff, '9', '-', ' '),
+ *   5. (text) put after a UTF-8 byte-order mark, encoded as UTF-16 and
+ *      UTF-32 with and without marks, written with decimal commas or
+ *      thousands separators between fields separated by every separator,
+ *      given a malformed number or a header as their first line,
  * and read as vertices (double and float storage) and, for the meshes,
  * sampled.  Every variant is copied into a heap block of exactly its size,
  * so a read past its end is an AddressSanitizer error.
@@ -617,8 +621,11 @@ static size_t point_bytes(const hd_cloud_t *c) { return c->dtype == HD_FLOAT32 ?
 /* Read d[0..n) (copied into a block of exactly n bytes) as sample s in
  * `mode`, check the contract, and classify the result.  *kept (may be
  * NULL) receives the cloud on success, else it is freed. */
-static int observe(const sample_t *s, int sidx, const unsigned char *d, size_t n, int mode, const char *key,
-                   hd_cloud_t **kept) {
+/* The message of the last refusal observe() saw. */
+static char refusal[sizeof(((hd_error_t *)0)->message)];
+
+static int observe_with(const sample_t *s, int sidx, const unsigned char *d, size_t n, const hd_read_options_t *opt,
+                        int mode, const char *key, hd_cloud_t **kept) {
     CONTEXT("%s (%zu bytes, sampling seed %u)", key, n, SAMPLE_SEED);
     unsigned char *copy = malloc(n ? n : 1);
     if (!copy) {
@@ -626,7 +633,7 @@ static int observe(const sample_t *s, int sidx, const unsigned char *d, size_t n
         return REFUSED;
     }
     if (n) memcpy(copy, d, n);
-    hd_read_options_t o = options(mode);
+    hd_read_options_t o = *opt;
     hd_cloud_t *c = (hd_cloud_t *)copy; /* must become NULL on failure */
     hd_error_t e;
     memset(&e, 0, sizeof e);
@@ -644,6 +651,7 @@ static int observe(const sample_t *s, int sidx, const unsigned char *d, size_t n
             VIOLATION(key, "%s: a count reached the allocator (more than 1 GiB asked for?): %s", hd_err_name(rc),
                       e.message);
         if (rc == HD_EINVAL) VIOLATION(key, "HD_EINVAL for a file: %s", e.message);
+        snprintf(refusal, sizeof refusal, "%s", e.message);
         return REFUSED;
     }
     if (!c) {
@@ -679,6 +687,12 @@ static int observe(const sample_t *s, int sidx, const unsigned char *d, size_t n
     if (kept) *kept = c;
     else hd_cloud_free(c);
     return out;
+}
+
+static int observe(const sample_t *s, int sidx, const unsigned char *d, size_t n, int mode, const char *key,
+                   hd_cloud_t **kept) {
+    hd_read_options_t o = options(mode);
+    return observe_with(s, sidx, d, n, &o, mode, key, kept);
 }
 
 static void setup(void) {
@@ -1002,6 +1016,162 @@ TEST(single_byte_header_mutations_of_counted_text_files_keep_the_contract) {
     long long cases = 0, read = 0;
     sweep_header_bytes(0, &cases, &read);
     printf("  %lld header byte mutations of counted text files, %lld read\n", cases, read);
+}
+
+/* 5. Text: encodings, decimal commas with every separator, first lines.
+ * Each shape once gave a silent wrong read or a misleading message. */
+
+/* Samples whose first bytes are text (an ascii file, or a PLY or PCD
+ * header before binary data). */
+static int starts_as_text(int s) { return s < LAS_12 && s != STL_BINARY; }
+
+TEST(a_utf8_byte_order_mark_is_skipped_before_text_and_refused_before_binary) {
+    long long cases = 0;
+    setup();
+    sweep_ran("text");
+    for (int s = 0; s < N_SAMPLES; s++) {
+        const sample_t *S = &samples[s];
+        tf_buf_t b = {0};
+        tf_puts(&b, "\xef\xbb\xbf");
+        tf_put(&b, S->b.data, S->b.size);
+        for (int m = 0; m < modes_of(S); m++) {
+            char key[128];
+            snprintf(key, sizeof key, "%s text utf-8-bom %s", S->id, MODE[m]);
+            int out = observe(S, s, b.data, b.size, m, key, NULL);
+            cases++;
+            if (starts_as_text(s) ? out != SAME : out != REFUSED)
+                VIOLATION(key, "a UTF-8 byte-order mark before the file: the file %s (%s)", OUTCOME[out],
+                          starts_as_text(s) ? "it is skipped" : "binary: refused");
+        }
+        tf_free(&b);
+    }
+    printf("  %lld files after a UTF-8 byte-order mark\n", cases);
+}
+
+TEST(utf16_and_utf32_text_is_refused_naming_its_encoding) {
+    long long cases = 0;
+    static const struct {
+        const char *name;
+        int width, big, bom;
+    } ENC[] = {{"utf-16le-bom", 2, 0, 1}, {"utf-16be-bom", 2, 1, 1}, {"utf-16le", 2, 0, 0}, {"utf-16be", 2, 1, 0},
+               {"utf-32le-bom", 4, 0, 1}, {"utf-32be-bom", 4, 1, 1}, {"utf-32le", 4, 0, 0}, {"utf-32be", 4, 1, 0}};
+    setup();
+    sweep_ran("text");
+    for (int s = 0; s < N_SAMPLES; s++) {
+        const sample_t *S = &samples[s];
+        if (S->binary) continue;
+        for (size_t k = 0; k < sizeof ENC / sizeof ENC[0]; k++) {
+            tf_buf_t b = {0};
+            tf_wide(&b, S->b.data, S->b.size, ENC[k].width, ENC[k].big, ENC[k].bom);
+            char want[40];
+            snprintf(want, sizeof want, "UTF-%d text; convert to UTF-8", 8 * ENC[k].width);
+            for (int m = 0; m < modes_of(S); m++) {
+                char key[128];
+                snprintf(key, sizeof key, "%s text %s %s", S->id, ENC[k].name, MODE[m]);
+                int out = observe(S, s, b.data, b.size, m, key, NULL);
+                cases++;
+                if (out != REFUSED) VIOLATION(key, "%s text: the file %s", ENC[k].name, OUTCOME[out]);
+                else if (!strstr(refusal, want)) VIOLATION(key, "message '%s' lacks '%s'", refusal, want);
+            }
+            tf_free(&b);
+        }
+    }
+    printf("  %lld text files in UTF-16 and UTF-32, with and without byte-order marks\n", cases);
+}
+
+/* The XYZ sample's points written with `sep` between the fields, each
+ * with a decimal comma ("-2,25"), or numbers with a thousands separator
+ * ("2,101.5").  Every field holds one comma, so every line has six
+ * comma-separated numbers: read as columns, the file is consistent and
+ * wrong. */
+static tf_buf_t comma_text(const char *sep, int thousands) {
+    tf_buf_t b = {0};
+    for (int k = 0; k < 4; k++) {
+        for (int j = 0; j < 3; j++) {
+            char num[32];
+            if (thousands) {
+                snprintf(num, sizeof num, "%d,%03d.5", 1 + k, 100 * j + k);
+            } else {
+                snprintf(num, sizeof num, "%.2f", PTS[k][j]);
+                *strchr(num, '.') = ',';
+            }
+            tf_putf(&b, "%s%s", j ? sep : "", num);
+        }
+        tf_puts(&b, "\n");
+    }
+    return b;
+}
+
+TEST(decimal_commas_and_thousands_separators_with_every_separator_are_refused_unless_the_option_says) {
+    long long cases = 0;
+    static const char *const SEP[] = {" ", "\t", "  ", " \t ", ";", " ; ", "\t;"};
+    static const char *const SEP_NAME[] = {"space", "tab", "spaces", "blanks", "semicolon", "spaced-semicolon",
+                                           "tab-semicolon"};
+    setup();
+    sweep_ran("text");
+    const sample_t *S = &samples[XYZ];
+    for (size_t k = 0; k < sizeof SEP / sizeof SEP[0]; k++)
+        for (int thousands = 0; thousands < 2; thousands++) {
+            tf_buf_t b = comma_text(SEP[k], thousands);
+            for (int m = 0; m < N_MODES - 1; m++)
+                for (int option = 0; option < 4; option++) {
+                    /* options 2 and 3: without the final newline (a heap block ending at the last digit) */
+                    char key[128];
+                    snprintf(key, sizeof key, "xyz text %s-%s%s%s %s", thousands ? "thousands" : "decimal-comma",
+                             SEP_NAME[k], option & 1 ? "-option" : "", option & 2 ? "-no-final-newline" : "", MODE[m]);
+                    hd_read_options_t o = options(m);
+                    o.decimal_comma = option & 1;
+                    int out = observe_with(S, XYZ, b.data, b.size - (option >> 1), &o, m, key, NULL);
+                    cases++;
+                    int want = (option & 1) && !thousands ? SAME : REFUSED;
+                    if (out != want)
+                        VIOLATION(key, "%s between fields: the file %s, expected %s", SEP_NAME[k], OUTCOME[out],
+                                  OUTCOME[want]);
+                }
+            tf_free(&b);
+        }
+    printf("  %lld files with decimal commas or thousands separators\n", cases);
+}
+
+TEST(a_malformed_number_on_the_first_line_is_refused_and_a_header_is_skipped) {
+    long long cases = 0;
+    static const char *const MALFORMED[] = {"1.#QNAN 2 3", "1.5D+03 0 0", "3.14abc 1 1", "-", "+.5e 1 2", "1.#IND,0,0",
+                                            "0x 1 2", ". 1 2"};
+    static const char *const HEADER[] = {"x y z", "X,Y,Z", "# comment", "index,x,y,z", "infrared;x", "title\n\nx y z"};
+    setup();
+    sweep_ran("text");
+    static const int TEXT[] = {XYZ, CSV};
+    for (size_t t = 0; t < 2; t++) {
+        const sample_t *S = &samples[TEXT[t]];
+        for (int kind = 0; kind < 2; kind++) {
+            size_t n = kind ? sizeof HEADER / sizeof HEADER[0] : sizeof MALFORMED / sizeof MALFORMED[0];
+            for (size_t k = 0; k < n; k++)
+                for (int where = 0; where < 2; where++) {
+                    if (kind && where) continue; /* a header is a first line */
+                    const char *line = kind ? HEADER[k] : MALFORMED[k];
+                    /* line 1, or after the sample's first line */
+                    const unsigned char *nl = memchr(S->b.data, '\n', S->b.size);
+                    size_t cut = where ? (size_t)(nl - S->b.data) + 1 : 0;
+                    tf_buf_t b = {0};
+                    tf_put(&b, S->b.data, cut);
+                    tf_putf(&b, "%s\n", line);
+                    tf_put(&b, S->b.data + cut, S->b.size - cut);
+                    for (int m = 0; m < N_MODES - 1; m++) {
+                        char key[160];
+                        snprintf(key, sizeof key, "%s text %s-line-%d '%s' %s", S->id, kind ? "header" : "malformed",
+                                 where + 1, line, MODE[m]);
+                        int out = observe(S, TEXT[t], b.data, b.size, m, key, NULL);
+                        cases++;
+                        int want = kind ? SAME : REFUSED;
+                        if (out != want)
+                            VIOLATION(key, "'%s' as line %d: the file %s, expected %s", line, where + 1, OUTCOME[out],
+                                      OUTCOME[want]);
+                    }
+                    tf_free(&b);
+                }
+        }
+    }
+    printf("  %lld files with a malformed first or second line, or a header\n", cases);
 }
 
 TEST(zz_every_expected_failure_still_fails) {

@@ -100,6 +100,11 @@ static void put_bytes(tf_buf_t *b, uint64_t v, int n, int big) {
 void tf_u8(tf_buf_t *b, unsigned v) { put_bytes(b, v, 1, 0); }
 void tf_u16(tf_buf_t *b, unsigned v, int big) { put_bytes(b, v, 2, big); }
 void tf_u32(tf_buf_t *b, uint32_t v, int big) { put_bytes(b, v, 4, big); }
+void tf_wide(tf_buf_t *b, const void *text, size_t n, int width, int big, int bom) {
+    const unsigned char *t = text;
+    if (bom) put_bytes(b, 0xfeff, width, big);
+    for (size_t k = 0; k < n; k++) put_bytes(b, t[k], width, big);
+}
 void tf_u64(tf_buf_t *b, uint64_t v, int big) { put_bytes(b, v, 8, big); }
 void tf_f32(tf_buf_t *b, float v, int big) {
     uint32_t u;

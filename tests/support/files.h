@@ -30,6 +30,9 @@ void tf_u8(tf_buf_t *b, unsigned v);
 void tf_u16(tf_buf_t *b, unsigned v, int big);
 void tf_u32(tf_buf_t *b, uint32_t v, int big);
 void tf_u64(tf_buf_t *b, uint64_t v, int big);
+/* The n bytes of text (ASCII) as UTF-16 (width 2) or UTF-32 (width 4) code
+ * units, little- or big-endian, after a byte-order mark when bom is set. */
+void tf_wide(tf_buf_t *b, const void *text, size_t n, int width, int big, int bom);
 void tf_f32(tf_buf_t *b, float v, int big);
 void tf_f64(tf_buf_t *b, double v, int big);
 void tf_free(tf_buf_t *b);
