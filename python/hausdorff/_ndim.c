@@ -11,9 +11,14 @@
  * smallest index.  Eight candidates are summed side by side (eight
  * independent chains of the same operations), which changes no double.
  *
+ * B's rows are sorted by the coordinate along which B spreads most, and a
+ * point's scan goes outwards from its own value of that coordinate, leaving
+ * a side once that coordinate's squared difference alone exceeds the best
+ * so far (see gap2).
+ *
  * The early-break algorithm (Taha and Hanbury, as scipy's
- * directed_hausdorff): points of A are visited in a seeded random order, B
- * in another; the scan of a point stops as soon as a candidate is strictly
+ * directed_hausdorff): points of A are visited in a seeded random order;
+ * the scan of a point stops as soon as a candidate is strictly
  * nearer than the largest nearest squared distance c known so far (the
  * point's own nearest is then below c, so it is not the maximum), or equal
  * to c when the point's index is above the witness's (it can then at most
@@ -43,28 +48,109 @@ enum { LANES = 8, BLOCK = 8 /* coordinates summed between two tests of the bound
  * interleaved (coordinate k of the block's row l at [k * LANES + l]), so
  * that the LANES sums advance side by side on contiguous memory; the last
  * block is padded with zeros, which are never offered.  order[r] is stored
- * row r's index in the caller's B (NULL: r). */
+ * row r's index in the caller's B (NULL: r).  When keys is not NULL the
+ * rows are sorted by coordinate `axis` (keys[r] is row r's), ties by
+ * index. */
 typedef struct {
-    double *blocks;
-    const size_t *order;
-    size_t n, dims;
+    double *blocks, *keys;
+    size_t *order;
+    size_t n, dims, axis;
 } nd_set_t;
 
 static size_t index_of(const nd_set_t *s, size_t r) {
     return s->order ? s->order[r] : r;
 }
 
-/* The blocked copy of B's rows order[0], order[1], ... (NULL: 0, 1, ...);
- * -1 when there is no memory for it. */
-static int set_build(nd_set_t *s, const double *B, size_t nb, size_t dims, const size_t *order) {
+static void set_free(nd_set_t *s) {
+    free(s->blocks);
+    free(s->keys);
+    free(s->order);
+}
+
+/* A double's bits as an unsigned integer of the same order (for finite
+ * values; -0 and +0, equal as doubles, may come in either order). */
+static uint64_t order_bits(double v) {
+    uint64_t u;
+    memcpy(&u, &v, sizeof u);
+    return u >> 63 ? ~u : u | (UINT64_C(1) << 63);
+}
+
+/* order[0..n) sorted by coordinate `axis` of the rows of B (an LSD radix
+ * sort on order_bits,
+ * a byte a pass, passes where every key has the same byte skipped);
+ * tmp holds n more indices and bits 2n integers.  Only the order of keys
+ * matters to the scan, not the order among equal ones. */
+static void radix_sort(const double *B, size_t dims, size_t axis, size_t n, size_t *order,
+                       size_t *tmp, uint64_t *bits) {
+    uint64_t *u = bits, *v = bits + n;
+    if (n == 0) return;
+    for (size_t r = 0; r < n; r++) {
+        order[r] = r;
+        u[r] = order_bits(B[r * dims + axis]);
+    }
+    for (int shift = 0; shift < 64; shift += 8) {
+        size_t count[257] = {0};
+        for (size_t r = 0; r < n; r++) count[((u[r] >> shift) & 255) + 1]++;
+        if (count[((u[0] >> shift) & 255) + 1] == n) continue;
+        for (int d = 0; d < 256; d++) count[d + 1] += count[d];
+        for (size_t r = 0; r < n; r++) {
+            size_t at = count[(u[r] >> shift) & 255]++;
+            v[at] = u[r];
+            tmp[at] = order[r];
+        }
+        uint64_t *sw = u;
+        u = v;
+        v = sw;
+        memcpy(order, tmp, n * sizeof *order);
+    }
+}
+
+/* The coordinate along which B spreads most: its sorted order prunes best. */
+static size_t widest_axis(const double *B, size_t nb, size_t dims) {
+    size_t axis = 0;
+    double widest = -1.0;
+    for (size_t k = 0; k < dims; k++) {
+        double lo = B[k], hi = B[k];
+        for (size_t r = 1; r < nb; r++) {
+            double v = B[r * dims + k];
+            if (v < lo) lo = v;
+            if (v > hi) hi = v;
+        }
+        if (hi - lo > widest) {
+            widest = hi - lo;
+            axis = k;
+        }
+    }
+    return axis;
+}
+
+/* Sort B's rows by their widest coordinate: s->order and s->keys. */
+static int set_sort(nd_set_t *s, const double *B, size_t nb, size_t dims) {
+    size_t *tmp = malloc(nb * sizeof *tmp);
+    uint64_t *bits = nb <= SIZE_MAX / 2 / sizeof *bits ? malloc(2 * nb * sizeof *bits) : NULL;
+    s->order = malloc(nb * sizeof *s->order);
+    s->keys = malloc(nb * sizeof *s->keys);
+    int ok = tmp && bits && s->order && s->keys;
+    if (ok) {
+        s->axis = widest_axis(B, nb, dims);
+        radix_sort(B, dims, s->axis, nb, s->order, tmp, bits);
+        for (size_t r = 0; r < nb; r++) s->keys[r] = B[s->order[r] * dims + s->axis];
+    }
+    free(tmp);
+    free(bits);
+    return ok ? 0 : -1;
+}
+
+/* The blocked copy of B, sorted (see nd_set_t) or in index order; -1 when
+ * there is no memory for it (set_free frees what was had). */
+static int set_build(nd_set_t *s, const double *B, size_t nb, size_t dims, int sorted) {
+    *s = (nd_set_t){NULL, NULL, NULL, nb, dims, 0};
     size_t nblocks = (nb + LANES - 1) / LANES;
+    if (sorted && set_sort(s, B, nb, dims)) return -1;
     s->blocks = dims && nblocks <= SIZE_MAX / sizeof(double) / LANES / dims
                     ? calloc(nblocks * LANES * dims, sizeof(double))
                     : NULL;
     if (!s->blocks) return -1;
-    s->order = order;
-    s->n = nb;
-    s->dims = dims;
     for (size_t r = 0; r < nb; r++) {
         const double *row = B + index_of(s, r) * dims;
         double *dst = s->blocks + (r / LANES) * LANES * dims + r % LANES;
@@ -111,21 +197,74 @@ static void sq_dist_block(const double *a, const double *blk, size_t dims, doubl
     memcpy(s, v, sizeof v);
 }
 
+/* The rows of block q offered to (*best, *best_r); the rows counted. */
+static size_t visit_block(const nd_set_t *s, const double *a, size_t q, double *best,
+                          size_t *best_r) {
+    double d[LANES];
+    size_t r = q * LANES;
+    sq_dist_block(a, s->blocks + r * s->dims, s->dims, *best, d);
+    size_t rows = s->n - r < LANES ? s->n - r : LANES;
+    double least = d[0];
+    for (size_t l = 1; l < rows; l++) least = d[l] < least ? d[l] : least;
+    if (least <= *best)
+        for (size_t l = 0; l < rows; l++) offer(s, d[l], r + l, best, best_r);
+    return rows;
+}
+
+/* The first row whose key is >= x (n when none is), without branches on
+ * the keys: base[0..len) always holds that row or ends before it. */
+static size_t lower_bound(const double *keys, size_t n, double x) {
+    const double *base = keys;
+    size_t len = n;
+    while (len > 1) {
+        size_t half = len / 2;
+        base = base[half] < x ? base + half : base;
+        len -= half;
+    }
+    return (size_t)(base - keys) + (*base < x);
+}
+
+/* fl((x - key)^2): a lower bound of the squared distance of a (x = a[axis])
+ * to a row whose coordinate `axis` is key, and to every row whose key lies
+ * further from x: each partial sum is at least any one of its terms, and
+ * the term of that coordinate grows with |x - key| (rounding is monotone). */
+static double gap2(double x, double key) {
+    double d = x - key;
+    return d * d;
+}
+
 /* Scan B for a's nearest row: *best, *best_r (a stored row).  Stops, and
  * returns 1, as soon as *best < stop; otherwise *best is a's exact nearest
- * squared distance and *best_r the row of the smallest index attaining it. */
+ * squared distance and *best_r the row of the smallest index attaining it.
+ * Sorted rows are visited from a's own key outwards, the nearer side first,
+ * and a side is left once its next block's gap2 exceeds *best (none of its
+ * rows can then reach *best, not even tie). */
 static int scan(const nd_set_t *s, const double *a, double stop, double *best, size_t *best_r,
                 uint64_t *evals) {
     double b = INFINITY;
-    size_t br = 0, r = 0;
+    size_t br = 0, nblocks = (s->n + LANES - 1) / LANES, seen = 0;
     int stopped = 0;
-    for (; !stopped && r < s->n; r += LANES) {
-        double d[LANES];
-        sq_dist_block(a, s->blocks + r * s->dims, s->dims, b, d);
-        for (size_t l = 0; l < LANES && r + l < s->n; l++) offer(s, d[l], r + l, &b, &br);
+    if (!s->keys) {
+        for (size_t q = 0; !stopped && q < nblocks; q++) {
+            seen += visit_block(s, a, q, &b, &br);
+            stopped = b < stop;
+        }
+    } else {
+        double x = a[s->axis];
+        size_t q = lower_bound(s->keys, s->n, x) / LANES;
+        if (q >= nblocks) q = nblocks - 1;
+        seen += visit_block(s, a, q, &b, &br);
         stopped = b < stop;
+        size_t lo = q, hi = q + 1; /* next blocks: lo - 1 below, hi above */
+        while (!stopped) {
+            double glo = lo > 0 ? gap2(x, s->keys[lo * LANES - 1]) : INFINITY;
+            double ghi = hi < nblocks ? gap2(x, s->keys[hi * LANES]) : INFINITY;
+            if (!(glo <= b) && !(ghi <= b)) break;
+            seen += visit_block(s, a, glo <= ghi ? --lo : hi++, &b, &br);
+            stopped = b < stop;
+        }
     }
-    *evals += r < s->n ? r : s->n;
+    *evals += seen;
     *best = b;
     *best_r = br;
     return stopped;
@@ -239,20 +378,18 @@ static void shuffle(size_t *v, size_t n, uint64_t *state) {
 
 int nd_directed(const double *A, size_t na, const double *B, size_t nb, size_t dims,
                 int early, uint64_t seed, int threads, nd_directed_t *out) {
-    size_t *visit = NULL, *order = NULL;
-    nd_set_t set = {NULL, NULL, nb, dims};
-    if (early) { /* both sets in random orders, B copied in its order */
+    size_t *visit = NULL;
+    nd_set_t set = {NULL, NULL, NULL, nb, dims, 0};
+    if (early) { /* A in a random order; B sorted (see scan) */
         visit = malloc(na * sizeof *visit);
-        order = malloc(nb * sizeof *order);
-        if (visit && order) {
+        if (visit) {
             uint64_t state = seed;
             shuffle(visit, na, &state);
-            shuffle(order, nb, &state);
         }
     }
-    if ((early && (!visit || !order)) || set_build(&set, B, nb, dims, order)) {
+    if ((early && !visit) || set_build(&set, B, nb, dims, early)) {
         free(visit);
-        free(order);
+        set_free(&set);
         return -1;
     }
     int T = clamp_threads(threads, na);
@@ -271,8 +408,7 @@ int nd_directed(const double *A, size_t na, const double *B, size_t nb, size_t d
     r.distance_evals = evals;
     *out = r;
     free(visit);
-    free(order);
-    free(set.blocks);
+    set_free(&set);
     return 0;
 }
 
@@ -304,13 +440,16 @@ static void *nearest_job(void *arg) {
 int nd_nearest(const double *A, size_t na, const double *B, size_t nb, size_t dims,
                int threads, double *dist, size_t *nearest) {
     nd_set_t set;
-    if (set_build(&set, B, nb, dims, NULL)) return -1;
+    if (set_build(&set, B, nb, dims, 1)) {
+        set_free(&set);
+        return -1;
+    }
     int T = clamp_threads(threads, na);
     nearest_job_t jobs[64];
     for (int t = 0; t < T; t++)
         jobs[t] = (nearest_job_t){A, na * (size_t)t / (size_t)T, na * (size_t)(t + 1) / (size_t)T,
                                   set, dist, nearest};
     run_jobs(nearest_job, jobs, sizeof jobs[0], T);
-    free(set.blocks);
+    set_free(&set);
     return 0;
 }
