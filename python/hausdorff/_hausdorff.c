@@ -22,12 +22,18 @@
  * the library may read it, and the GIL is released only around library
  * calls, which touch no Python object.
  *
+ * Points of 1 or 2 coordinates are padded with zeros to 3-D (one copy), which
+ * changes no squared distance; points of 4 or more go, as C-ordered doubles,
+ * to _ndim.c, which computes the same doubles as a brute force in any
+ * number of coordinates (the library computes in 3-D only).
+ *
  * An Index keeps its own C-ordered copy of the indexed points: the library's
  * index may borrow the memory it was built on (hausdorff.h allows it), and a
  * Python caller could otherwise change or free that array while the index
- * lives.  The copy is
- * made once and never written again, so queries from many Python threads at
- * once are safe (the C index is immutable).
+ * lives.  The copy is made once and never written again (the array Python
+ * sees has a capsule as its owner, so numpy cannot make it writable), so
+ * queries from many Python threads at once are safe (the C index is
+ * immutable).
  *
  * Library result codes map to Python exceptions by kind: bad input (invalid
  * argument, empty set, NaN or infinite or too large a coordinate, malformed
@@ -629,10 +635,11 @@ static PyStructSequence_Field summary_fields[] = {
     {"mean2_ba", "mean squared distance of B's points to A"},
     {"mean_symmetric", "max(mean_ab, mean_ba): the average Hausdorff distance"},
     {"mean_average", "(mean_ab + mean_ba) / 2"},
-    {"mean_pooled", "(sum_ab + sum_ba) / (n_ab + n_ba): MONAI's symmetric average surface distance"},
+    {"mean_pooled", "(sum_ab + sum_ba) / (n_ab + n_ba): MONAI's symmetric average surface "
+                    "distance, medpy's assd"},
     {"chamfer", "mean2_ab + mean2_ba: the Chamfer distance (as PyTorch3D)"},
     {"chamfer_sum2", "sum2_ab + sum2_ba"},
-    {"chamfer_mean", "mean_ab + mean_ba"},
+    {"chamfer_mean", "mean_ab + mean_ba: point-cloud-utils' chamfer_distance"},
     {"chamfer_sum", "sum_ab + sum_ba"},
     {NULL, NULL},
 };
@@ -651,7 +658,7 @@ static PyStructSequence_Field mean_fields[] = {
     {"ba", "mean distance of B's points to A"},
     {"symmetric", "max(ab, ba): the average Hausdorff distance"},
     {"average", "(ab + ba) / 2"},
-    {"pooled", "mean of both directions' distances together (MONAI's symmetric ASD)"},
+    {"pooled", "mean of both directions' distances together (MONAI's symmetric ASD, medpy's assd)"},
     {NULL, NULL},
 };
 
@@ -717,30 +724,41 @@ static PyObject *nearest_arrays(const hd_index_t *idx, const hd_points_t *A,
  * ---------------------------------------------------------------------- */
 
 PyDoc_STRVAR(directed_doc,
-"directed($module, a, b, seed=0, *, algorithm='auto', threads=None, empty='error')\n--\n\n"
+"directed($module, a, b, seed=0, *, rng=None, algorithm='auto', threads=None,\n"
+"         empty='error')\n--\n\n"
 "The directed Hausdorff distance h(a, b) = max over p in a of min over q in b\n"
 "of |p - q|, exact to the last bit, with its witness.\n"
 "\n"
-"A drop-in for scipy.spatial.distance.directed_hausdorff(u, v, seed=0): the\n"
+"A drop-in for scipy.spatial.distance.directed_hausdorff(u, v, rng=0): the\n"
 "same calls (seed positional or keyword, None included; scipy's names u= and\n"
-"v= for a and b) return the tuple (distance, i, j) where\n"
-"|a[i] - b[j]| == distance, the same double as scipy's.  On ties i is the\n"
-"smallest index in a whose nearest distance is the maximum and j the smallest\n"
-"index in b at that distance, for every algorithm and thread count (scipy's\n"
-"witness depends on its random order instead).\n"
+"v= for a and b, scipy 1.15's rng= for seed) return the tuple\n"
+"(distance, i, j) where |a[i] - b[j]| == distance, the same double as\n"
+"scipy's.  On ties i is the smallest index in a whose nearest distance is\n"
+"the maximum and j the smallest index in b at that distance, for every\n"
+"algorithm, seed and thread count (scipy's witness depends on its random\n"
+"order instead).\n"
 "\n"
-"a, b: (N, 3) or (N, 2) array-likes of real numbers, both with the same\n"
-"    number of columns; a point (x, y) is (x, y, 0), which changes no\n"
-"    distance.  float32 and float64 (N, 3) arrays are read in place (C or\n"
-"    Fortran order or strided views); other dtypes are converted to float64.\n"
-"seed: the seed of the randomised algorithms (earlybreak, ohd); it never\n"
-"    changes the answer.  None is the default seed.\n"
+"a, b: (N, D) array-likes of real numbers or booleans (as 0 and 1), both\n"
+"    with the same number D >= 1 of coordinates.  The squared distance is\n"
+"    the sum of the squared differences from the first coordinate to the\n"
+"    last, and the distance its sqrt, as a brute force (and scipy) computes\n"
+"    them.  D = 1 and 2 are computed as the points padded with zeros to 3-D,\n"
+"    which changes no distance; D >= 4 by the module's own exact engine.\n"
+"    float32 and float64 (N, 3) arrays are read in place (C or Fortran\n"
+"    order or strided views); other dtypes are converted to float64.\n"
+"seed, rng: they never change the answer, only the order the randomised\n"
+"    algorithms (earlybreak, ohd) visit points in: None (the default seed),\n"
+"    any integer (its value modulo 2**64), or a numpy random generator\n"
+"    (Generator, RandomState, BitGenerator, SeedSequence), which is left\n"
+"    untouched.  Give one of the two.\n"
 "algorithm: 'auto' (the fastest exact engine), 'naive', 'earlybreak',\n"
-"    'inc', 'nohd', 'ohd', 'framework' or 'kdtree'.\n"
+"    'inc', 'nohd', 'ohd', 'framework' or 'kdtree'; with D >= 4 'auto',\n"
+"    'earlybreak' or 'naive'.\n"
 "threads: None or 0 for every core, else the number of threads.\n"
 "empty: what an empty set gives: 'error' (ValueError), 'inf', 'nan',\n"
-"    'zero', or 'monai' (inf when one set is empty, NaN when both are); the\n"
-"    witness is then (None, None).\n"
+"    'zero', 'monai' (inf when one set is empty, NaN when both are) or\n"
+"    'skimage' (inf when one set is empty, 0 when both are); the witness is\n"
+"    then (None, None).\n"
 "\n"
 "The GIL is released during the computation.  Raises ValueError for a wrong\n"
 "shape, an empty set, NaN or infinite coordinates, or an unknown algorithm.\n"
@@ -753,8 +771,10 @@ PyDoc_STRVAR(directed_doc,
 "1.118034 2 0\n"
 ">>> hausdorff.directed(a, b).distance == d\n"
 "True\n"
-">>> hausdorff.directed(u=[(0, 0), (3, 4)], v=[(0, 0)], seed=1)\n"
+">>> hausdorff.directed(u=[(0, 0), (3, 4)], v=[(0, 0)], rng=1)\n"
 "hausdorff.DirectedResult(distance=5.0, i=1, j=0)\n"
+">>> hausdorff.directed([[0, 0, 0, 0]], [[1, 1, 1, 1]]).distance\n"
+"2.0\n"
 ">>> hausdorff.directed(a, np.empty((0, 3)), empty='inf').distance\n"
 "inf\n");
 
@@ -942,7 +962,8 @@ static PyObject *py_directed(PyObject *self, PyObject *args, PyObject *kw) {
 }
 
 PyDoc_STRVAR(hausdorff_doc,
-"hausdorff($module, a, b, *, algorithm='auto', threads=None, seed=0, empty='error')\n--\n\n"
+"hausdorff($module, a, b, *, algorithm='auto', threads=None, seed=0, rng=None,\n"
+"          empty='error')\n--\n\n"
 "The Hausdorff distance H(a, b) = max(h(a, b), h(b, a)), exact, with the\n"
 "witnesses of both directions.\n"
 "\n"
@@ -1251,7 +1272,8 @@ PyDoc_STRVAR(mean_doc,
 "b, ba of b's points to a, symmetric = max(ab, ba) (the average Hausdorff\n"
 "distance), average = (ab + ba) / 2 and pooled the mean of all the\n"
 "distances of both directions together (MONAI's symmetric average surface\n"
-"distance).  Empty sets as for directed().\n"
+"distance, and medpy's assd, which averages both lists of distances\n"
+"together).  Empty sets as for directed().\n"
 "\n"
 ">>> import numpy as np, hausdorff\n"
 ">>> a = np.array([[0.0, 0, 0], [2, 0, 0]])\n"
@@ -1269,7 +1291,9 @@ PyDoc_STRVAR(chamfer_doc,
 "The Chamfer distance, the command line's --chamfer: the mean squared\n"
 "distance of a's points to b plus the mean squared distance of b's points\n"
 "to a (as PyTorch3D's chamfer_distance).  summary() has the summed and the\n"
-"unsquared variants.  Empty sets as for directed().\n"
+"unsquared variants; point-cloud-utils' chamfer_distance, the sum of the\n"
+"two mean (unsquared) distances, is summary(a, b).chamfer_mean, not this.\n"
+"Empty sets as for directed().\n"
 "\n"
 ">>> import hausdorff\n"
 ">>> hausdorff.chamfer([[0.0, 0, 0], [2, 0, 0]], [[0.0, 0, 1]])\n"
@@ -1300,7 +1324,9 @@ PyDoc_STRVAR(read_doc,
 "refused unless decimal_comma=True, which reads commas as decimal points\n"
 "and ';' or blanks as separators.\n"
 "start and count read points [start, start + count) only (count None: to\n"
-"the end); LAS, LAZ, NPY and binary PLY/PCD/STL then touch only those\n"
+"the end); both are integers of any kind (int, numpy integers, __index__),\n"
+"start >= 0 and count >= 1, below 2**64; LAS, LAZ, NPY and binary\n"
+"PLY/PCD/STL then touch only those\n"
 "records, so processes can share one big file (hausdorff.count gives its\n"
 "size from the header).  A range past the end raises ValueError.\n"
 "The array takes over the memory the reader filled: no copy.\n"
@@ -1487,8 +1513,10 @@ PyDoc_STRVAR(index_doc,
 "Queries may move the query set by a rigid (or any affine) transform\n"
 "x -> rotation @ x + translation, applied on the fly in double precision in\n"
 "the order the C header documents, without copying the query.\n"
-"An (N, 2) b is indexed as the points (x, y, 0) (index.points has their\n"
-"three columns), and its queries must then be (N, 2) too.\n"
+"An (N, 2) or (N, 1) b is indexed as its points padded with zeros to 3-D\n"
+"(index.points has the three columns), and its queries must then have b's\n"
+"columns too.  Points of 4 or more coordinates are refused (a transform is\n"
+"3-D); directed(), hausdorff() and distances() take them.\n"
 "\n"
 ">>> import numpy as np, hausdorff\n"
 ">>> index = hausdorff.Index(np.array([[0.0, 0, 0], [1, 0, 0]]))\n"
@@ -1682,7 +1710,8 @@ static PyGetSetDef Index_getset[] = {
     {"memory", (getter)Index_get_memory, NULL,
      "bytes the index allocated itself (not counting its copy of the points)", NULL},
     {"points", (getter)Index_get_points, NULL,
-     "the indexed points: the index's own read-only copy of b", NULL},
+     "the indexed points: the index's own copy of b, read-only for good "
+     "(setflags(write=True) raises)", NULL},
     {NULL, NULL, NULL, NULL, NULL},
 };
 

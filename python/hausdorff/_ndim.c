@@ -432,7 +432,7 @@ static void *nearest_job(void *arg) {
         size_t k;
         scan(&J->B, J->A + i * J->B.dims, -INFINITY, &best, &k, &evals);
         if (J->dist) J->dist[i] = sqrt(best);
-        if (J->nearest) J->nearest[i] = k;
+        if (J->nearest) J->nearest[i] = index_of(&J->B, k);
     }
     return NULL;
 }
