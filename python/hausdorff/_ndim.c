@@ -11,16 +11,19 @@
  * smallest index.  Eight candidates are summed side by side (eight
  * independent chains of the same operations), which changes no double.
  *
- * B's rows are sorted by the coordinate along which B spreads most, and a
- * point's scan goes outwards from its own value of that coordinate, leaving
- * a side once that coordinate's squared difference alone exceeds the best
- * so far (see gap2).
+ * Nearest distances (every point's own, with no early stop) in at most
+ * TREE_MAX_DIMS coordinates hold B's rows in a tree of boxes (see nd_set_t):
+ * a point's scan visits the leaf it falls in, then the boxes nearer first,
+ * leaving a box whose lower bound exceeds the best so far (see box_bound).
+ * Otherwise B's rows are scanned in a stored order: index order for the
+ * naive algorithm and nearest distances, a seeded random order for the
+ * early break.
  *
  * The early-break algorithm (Taha and Hanbury, as scipy's
- * directed_hausdorff): points of A are visited in a seeded random order;
- * the scan of a point stops as soon as a candidate is strictly
- * nearer than the largest nearest squared distance c known so far (the
- * point's own nearest is then below c, so it is not the maximum), or equal
+ * directed_hausdorff): points of A are visited in a seeded random order,
+ * B's rows in another; the scan of a point stops as soon as a candidate is
+ * strictly nearer than the largest nearest squared distance c known so far
+ * (the point's own nearest is then below c, so it is not the maximum), or equal
  * to c when the point's index is above the witness's (it can then at most
  * tie with a smaller index).  A point whose scan ends without stopping has
  * its exact nearest squared distance and the smallest index attaining it.
@@ -42,19 +45,34 @@
 #include <stdlib.h>
 #include <string.h>
 
-enum { LANES = 8, BLOCK = 8 /* coordinates summed between two tests of the bound */ };
+enum {
+    LANES = 8,         /* rows summed side by side: a block */
+    BLOCK = 8,         /* coordinates summed between two tests of the bound */
+    TREE_MAX_DIMS = 8  /* nearest(): above, boxes bound too little to pay for their tests */
+};
 
 /* B as scanned: its rows in blocks of LANES, each block's coordinates
  * interleaved (coordinate k of the block's row l at [k * LANES + l]), so
  * that the LANES sums advance side by side on contiguous memory; the last
  * block is padded with zeros, which are never offered.  order[r] is stored
- * row r's index in the caller's B (NULL: r).  When keys is not NULL the
- * rows are sorted by coordinate `axis` (keys[r] is row r's), ties by
- * index. */
+ * row r's index in the caller's B (NULL: r, and no tree).
+ *
+ * The tree: node 0 holds every row; an inner node's rows are split into
+ * its two children at a block boundary, by a median of the coordinate along
+ * which a sample of them spreads most; a leaf holds one block.  box[2 * dims
+ * * node ...] is the node's bounding box, its lows then its highs. */
 typedef struct {
-    double *blocks, *keys;
+    size_t lo, hi;     /* stored rows [lo, hi) */
+    size_t child[2];   /* both 0 for a leaf (node 0, the root, is no child) */
+    size_t axis;       /* an inner node's rows: child 0's have coordinate axis */
+    double split;      /* <= split, child 1's >= split */
+} nd_node_t;
+
+typedef struct {
+    double *blocks, *box;
     size_t *order;
-    size_t n, dims, axis;
+    nd_node_t *nodes;
+    size_t n, dims, nnodes;
 } nd_set_t;
 
 static size_t index_of(const nd_set_t *s, size_t r) {
@@ -63,58 +81,49 @@ static size_t index_of(const nd_set_t *s, size_t r) {
 
 static void set_free(nd_set_t *s) {
     free(s->blocks);
-    free(s->keys);
+    free(s->box);
     free(s->order);
+    free(s->nodes);
 }
 
-/* A double's bits as an unsigned integer of the same order (for finite
- * values; -0 and +0, equal as doubles, may come in either order). */
-static uint64_t order_bits(double v) {
-    uint64_t u;
-    memcpy(&u, &v, sizeof u);
-    return u >> 63 ? ~u : u | (UINT64_C(1) << 63);
+static void swap_sizes(size_t *v, size_t i, size_t j) {
+    size_t t = v[i];
+    v[i] = v[j];
+    v[j] = t;
 }
 
-/* order[0..n) sorted by coordinate `axis` of the rows of B (an LSD radix
- * sort on order_bits,
- * a byte a pass, passes where every key has the same byte skipped);
- * tmp holds n more indices and bits 2n integers.  Only the order of keys
- * matters to the scan, not the order among equal ones. */
-static void radix_sort(const double *B, size_t dims, size_t axis, size_t n, size_t *order,
-                       size_t *tmp, uint64_t *bits) {
-    uint64_t *u = bits, *v = bits + n;
-    if (n == 0) return;
-    for (size_t r = 0; r < n; r++) {
-        order[r] = r;
-        u[r] = order_bits(B[r * dims + axis]);
-    }
-    for (int shift = 0; shift < 64; shift += 8) {
-        size_t count[257] = {0};
-        for (size_t r = 0; r < n; r++) count[((u[r] >> shift) & 255) + 1]++;
-        if (count[((u[0] >> shift) & 255) + 1] == n) continue;
-        for (int d = 0; d < 256; d++) count[d + 1] += count[d];
-        for (size_t r = 0; r < n; r++) {
-            size_t at = count[(u[r] >> shift) & 255]++;
-            v[at] = u[r];
-            tmp[at] = order[r];
+/* Reorder v[0..n) (rows of B) so that v[0..k) have coordinate `axis` <=
+ * that of v[k..n): a quickselect with a three-way partition, so that runs
+ * of equal values (grids) cost no more than others. */
+static void select_rows(size_t *v, size_t n, size_t k, const double *B, size_t dims, size_t axis) {
+    size_t lo = 0, hi = n;
+    while (hi - lo > 1) {
+        double x = B[v[lo] * dims + axis], y = B[v[lo + (hi - lo) / 2] * dims + axis],
+               z = B[v[hi - 1] * dims + axis];
+        double pivot = x < y ? (y < z ? y : x < z ? z : x) : (x < z ? x : y < z ? z : y);
+        size_t lt = lo, i = lo, gt = hi;
+        while (i < gt) {
+            double w = B[v[i] * dims + axis];
+            if (w < pivot) swap_sizes(v, lt++, i++);
+            else if (w > pivot) swap_sizes(v, i, --gt);
+            else i++;
         }
-        uint64_t *sw = u;
-        u = v;
-        v = sw;
-        memcpy(order, tmp, n * sizeof *order);
+        if (k < lt) hi = lt;
+        else if (k >= gt) lo = gt;
+        else return;
     }
 }
 
-/* The coordinate along which B spreads most: its sorted order prunes best. */
-static size_t widest_axis(const double *B, size_t nb, size_t dims) {
-    size_t axis = 0;
+/* The coordinate along which up to 64 of the rows v[0..n) spread most. */
+static size_t split_axis(const size_t *v, size_t n, const double *B, size_t dims) {
+    size_t step = n > 64 ? n / 64 : 1, axis = 0;
     double widest = -1.0;
     for (size_t k = 0; k < dims; k++) {
-        double lo = B[k], hi = B[k];
-        for (size_t r = 1; r < nb; r++) {
-            double v = B[r * dims + k];
-            if (v < lo) lo = v;
-            if (v > hi) hi = v;
+        double lo = B[v[0] * dims + k], hi = lo;
+        for (size_t r = step; r < n; r += step) {
+            double x = B[v[r] * dims + k];
+            lo = x < lo ? x : lo;
+            hi = x > hi ? x : hi;
         }
         if (hi - lo > widest) {
             widest = hi - lo;
@@ -124,33 +133,67 @@ static size_t widest_axis(const double *B, size_t nb, size_t dims) {
     return axis;
 }
 
-/* Sort B's rows by their widest coordinate: s->order and s->keys. */
-static int set_sort(nd_set_t *s, const double *B, size_t nb, size_t dims) {
-    size_t *tmp = malloc(nb * sizeof *tmp);
-    uint64_t *bits = nb <= SIZE_MAX / 2 / sizeof *bits ? malloc(2 * nb * sizeof *bits) : NULL;
-    s->order = malloc(nb * sizeof *s->order);
-    s->keys = malloc(nb * sizeof *s->keys);
-    int ok = tmp && bits && s->order && s->keys;
-    if (ok) {
-        s->axis = widest_axis(B, nb, dims);
-        radix_sort(B, dims, s->axis, nb, s->order, tmp, bits);
-        for (size_t r = 0; r < nb; r++) s->keys[r] = B[s->order[r] * dims + s->axis];
-    }
-    free(tmp);
-    free(bits);
-    return ok ? 0 : -1;
+/* Node `node` over stored rows [lo, hi), and its subtree; s->order is
+ * reordered in place.  Returns the next free node. */
+static size_t tree_split(nd_set_t *s, const double *B, size_t node, size_t lo, size_t hi) {
+    s->nodes[node] = (nd_node_t){lo, hi, {0, 0}, 0, 0.0};
+    if (hi - lo <= LANES) return node + 1;
+    size_t blocks = (hi - lo + LANES - 1) / LANES, mid = lo + blocks / 2 * LANES;
+    size_t *v = s->order + lo, axis = split_axis(v, hi - lo, B, s->dims);
+    select_rows(v, hi - lo, mid - lo, B, s->dims, axis);
+    size_t left = node + 1, right = tree_split(s, B, left, lo, mid);
+    s->nodes[node].child[0] = left;
+    s->nodes[node].child[1] = right;
+    s->nodes[node].axis = axis;
+    s->nodes[node].split = B[s->order[mid] * s->dims + axis];
+    return tree_split(s, B, right, mid, hi);
 }
 
-/* The blocked copy of B, sorted (see nd_set_t) or in index order; -1 when
- * there is no memory for it (set_free frees what was had). */
-static int set_build(nd_set_t *s, const double *B, size_t nb, size_t dims, int sorted) {
-    *s = (nd_set_t){NULL, NULL, NULL, nb, dims, 0};
+/* Every node's box: a leaf's from its rows, an inner node's from its
+ * children's (children come after their parent, so backwards works). */
+static void tree_boxes(nd_set_t *s, const double *B) {
+    size_t dims = s->dims;
+    for (size_t node = s->nnodes; node-- > 0;) {
+        const nd_node_t *nd = &s->nodes[node];
+        double *lo = s->box + 2 * dims * node, *hi = lo + dims;
+        if (!nd->child[0]) {
+            memcpy(lo, B + s->order[nd->lo] * dims, dims * sizeof *lo);
+            memcpy(hi, lo, dims * sizeof *hi);
+            for (size_t r = nd->lo + 1; r < nd->hi; r++)
+                for (size_t k = 0; k < dims; k++) {
+                    double x = B[s->order[r] * dims + k];
+                    lo[k] = x < lo[k] ? x : lo[k];
+                    hi[k] = x > hi[k] ? x : hi[k];
+                }
+            continue;
+        }
+        const double *l = s->box + 2 * dims * nd->child[0], *r = s->box + 2 * dims * nd->child[1];
+        for (size_t k = 0; k < dims; k++) {
+            lo[k] = l[k] < r[k] ? l[k] : r[k];
+            hi[k] = l[dims + k] > r[dims + k] ? l[dims + k] : r[dims + k];
+        }
+    }
+}
+
+/* The blocked copy of B, in the tree's order (tree), or in the order
+ * given (the set then owns it; NULL: index order); -1 when there is no
+ * memory for it (set_free frees what was had). */
+static int set_build(nd_set_t *s, const double *B, size_t nb, size_t dims, int tree,
+                     size_t *order) {
+    *s = (nd_set_t){NULL, NULL, order, NULL, nb, dims, 0};
     size_t nblocks = (nb + LANES - 1) / LANES;
-    if (sorted && set_sort(s, B, nb, dims)) return -1;
-    s->blocks = dims && nblocks <= SIZE_MAX / sizeof(double) / LANES / dims
-                    ? calloc(nblocks * LANES * dims, sizeof(double))
-                    : NULL;
+    if (!dims || nblocks > SIZE_MAX / sizeof(double) / LANES / dims / 4) return -1;
+    s->blocks = calloc(nblocks * LANES * dims, sizeof(double));
     if (!s->blocks) return -1;
+    if (tree) {
+        s->order = malloc(nb * sizeof *s->order);
+        s->nodes = malloc(2 * nblocks * sizeof *s->nodes);
+        s->box = malloc(2 * nblocks * 2 * dims * sizeof *s->box);
+        if (!s->order || !s->nodes || !s->box) return -1;
+        for (size_t r = 0; r < nb; r++) s->order[r] = r;
+        s->nnodes = tree_split(s, B, 0, 0, nb);
+        tree_boxes(s, B);
+    }
     for (size_t r = 0; r < nb; r++) {
         const double *row = B + index_of(s, r) * dims;
         double *dst = s->blocks + (r / LANES) * LANES * dims + r % LANES;
@@ -211,63 +254,76 @@ static size_t visit_block(const nd_set_t *s, const double *a, size_t q, double *
     return rows;
 }
 
-/* The first row whose key is >= x (n when none is), without branches on
- * the keys: base[0..len) always holds that row or ends before it. */
-static size_t lower_bound(const double *keys, size_t n, double x) {
-    const double *base = keys;
-    size_t len = n;
-    while (len > 1) {
-        size_t half = len / 2;
-        base = base[half] < x ? base + half : base;
-        len -= half;
+/* A lower bound of the squared distance of a to every point of node's box,
+ * or a partial sum of it > bound.  Per coordinate, the gap g between a and
+ * the box is fl(lo - a) or fl(a - hi), and a point p of the box is at least
+ * as far: |fl(a - p)| >= g, since rounding is monotone (and symmetric).  So
+ * each term of p's sum is at least g * g, and each partial sum at least the
+ * box's (fl(x + y) grows with x and y): the box's sum never exceeds p's. */
+static double box_bound(const nd_set_t *s, const double *a, size_t node, double bound) {
+    const double *lo = s->box + 2 * s->dims * node, *hi = lo + s->dims;
+    double sum = 0.0;
+    for (size_t k = 0; k < s->dims && sum <= bound; k++) {
+        double g = a[k] < lo[k] ? lo[k] - a[k] : a[k] > hi[k] ? a[k] - hi[k] : 0.0;
+        sum += g * g;
     }
-    return (size_t)(base - keys) + (*base < x);
+    return sum;
 }
 
-/* fl((x - key)^2): a lower bound of the squared distance of a (x = a[axis])
- * to a row whose coordinate `axis` is key, and to every row whose key lies
- * further from x: each partial sum is at least any one of its terms, and
- * the term of that coordinate grows with |x - key| (rounding is monotone). */
-static double gap2(double x, double key) {
-    double d = x - key;
-    return d * d;
+typedef struct {
+    const nd_set_t *s;
+    const double *a;
+    double stop, best;
+    size_t best_r, seen, skip; /* skip: the leaf visited first */
+    int stopped;
+} search_t;
+
+/* The subtree of `node`, whose box is at least `bound` from a: left when
+ * that exceeds the best (none of its rows can reach it, not even tie); the
+ * nearer child first. */
+static void tree_visit(search_t *q, size_t node, double bound) {
+    if (q->stopped || bound > q->best) return;
+    const nd_node_t *nd = &q->s->nodes[node];
+    if (!nd->child[0]) {
+        if (node == q->skip) return;
+        q->seen += visit_block(q->s, q->a, nd->lo / LANES, &q->best, &q->best_r);
+        q->stopped = q->best < q->stop;
+        return;
+    }
+    double b0 = box_bound(q->s, q->a, nd->child[0], q->best);
+    double b1 = box_bound(q->s, q->a, nd->child[1], q->best);
+    int first = b1 < b0;
+    tree_visit(q, nd->child[first], first ? b1 : b0);
+    tree_visit(q, nd->child[!first], first ? b0 : b1);
 }
 
 /* Scan B for a's nearest row: *best, *best_r (a stored row).  Stops, and
  * returns 1, as soon as *best < stop; otherwise *best is a's exact nearest
  * squared distance and *best_r the row of the smallest index attaining it.
- * Sorted rows are visited from a's own key outwards, the nearer side first,
- * and a side is left once its next block's gap2 exceeds *best (none of its
- * rows can then reach *best, not even tie). */
+ * With a tree, the leaf a falls in (by the splits) comes first, as it
+ * most often holds a row near enough to stop at, then the others. */
 static int scan(const nd_set_t *s, const double *a, double stop, double *best, size_t *best_r,
                 uint64_t *evals) {
-    double b = INFINITY;
-    size_t br = 0, nblocks = (s->n + LANES - 1) / LANES, seen = 0;
-    int stopped = 0;
-    if (!s->keys) {
-        for (size_t q = 0; !stopped && q < nblocks; q++) {
-            seen += visit_block(s, a, q, &b, &br);
-            stopped = b < stop;
-        }
+    search_t q = {s, a, stop, INFINITY, 0, 0, 0, 0};
+    if (s->nodes) {
+        size_t leaf = 0;
+        while (s->nodes[leaf].child[0])
+            leaf = s->nodes[leaf].child[a[s->nodes[leaf].axis] >= s->nodes[leaf].split];
+        q.seen = visit_block(s, a, s->nodes[leaf].lo / LANES, &q.best, &q.best_r);
+        q.stopped = q.best < stop;
+        q.skip = leaf;
+        tree_visit(&q, 0, 0.0);
     } else {
-        double x = a[s->axis];
-        size_t q = lower_bound(s->keys, s->n, x) / LANES;
-        if (q >= nblocks) q = nblocks - 1;
-        seen += visit_block(s, a, q, &b, &br);
-        stopped = b < stop;
-        size_t lo = q, hi = q + 1; /* next blocks: lo - 1 below, hi above */
-        while (!stopped) {
-            double glo = lo > 0 ? gap2(x, s->keys[lo * LANES - 1]) : INFINITY;
-            double ghi = hi < nblocks ? gap2(x, s->keys[hi * LANES]) : INFINITY;
-            if (!(glo <= b) && !(ghi <= b)) break;
-            seen += visit_block(s, a, glo <= ghi ? --lo : hi++, &b, &br);
-            stopped = b < stop;
+        size_t nblocks = (s->n + LANES - 1) / LANES;
+        for (size_t b = 0; !q.stopped && b < nblocks; b++) {
+            q.seen += visit_block(s, a, b, &q.best, &q.best_r);
+            q.stopped = q.best < stop;
         }
     }
-    *evals += seen;
-    *best = b;
-    *best_r = br;
-    return stopped;
+    *evals += q.seen;
+    *best = q.best;
+    *best_r = q.best_r;
+    return q.stopped;
 }
 
 /* ------------------------------------------------------------------------
@@ -378,17 +434,20 @@ static void shuffle(size_t *v, size_t n, uint64_t *state) {
 
 int nd_directed(const double *A, size_t na, const double *B, size_t nb, size_t dims,
                 int early, uint64_t seed, int threads, nd_directed_t *out) {
-    size_t *visit = NULL;
-    nd_set_t set = {NULL, NULL, NULL, nb, dims, 0};
-    if (early) { /* A in a random order; B sorted (see scan) */
+    size_t *visit = NULL, *order = NULL;
+    nd_set_t set = {NULL, NULL, NULL, NULL, nb, dims, 0};
+    if (early) { /* A and B in random orders */
         visit = malloc(na * sizeof *visit);
-        if (visit) {
+        order = malloc(nb * sizeof *order);
+        if (visit && order) {
             uint64_t state = seed;
             shuffle(visit, na, &state);
+            shuffle(order, nb, &state);
         }
     }
-    if ((early && !visit) || set_build(&set, B, nb, dims, early)) {
+    if ((early && (!visit || !order)) || set_build(&set, B, nb, dims, 0, order)) {
         free(visit);
+        if (!set.order) free(order);
         set_free(&set);
         return -1;
     }
@@ -440,7 +499,7 @@ static void *nearest_job(void *arg) {
 int nd_nearest(const double *A, size_t na, const double *B, size_t nb, size_t dims,
                int threads, double *dist, size_t *nearest) {
     nd_set_t set;
-    if (set_build(&set, B, nb, dims, 1)) {
+    if (set_build(&set, B, nb, dims, dims <= TREE_MAX_DIMS, NULL)) {
         set_free(&set);
         return -1;
     }

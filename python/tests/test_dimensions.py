@@ -92,14 +92,17 @@ def test_trajectories_as_mdanalysis_flattens_them():
     assert h.distance == max(want_pq[0], want_qp[0])
 
 
-def test_every_distance_function_takes_more_coordinates():
-    a, b = normal(561, 120, 6), normal(562, 90, 6) + 0.3
+@pytest.mark.parametrize("dims, make", [(6, normal), (12, normal), (4, grid), (9, grid)])
+def test_every_distance_function_takes_more_coordinates(dims, make):
+    """Nearest distances: a tree of boxes up to 8 coordinates, a scan above."""
+    a, b = make(561, 120, dims), make(562, 90, dims) + 0.3
     d2_ab, j_ab = brute_nearest(a, b)
     d2_ba, _ = brute_nearest(b, a)
     d_ab, d_ba = np.sqrt(d2_ab), np.sqrt(d2_ba)
-    dist, nearest = hausdorff.distances(a, b, threads=2)
-    np.testing.assert_array_equal(dist, d_ab)
-    np.testing.assert_array_equal(nearest, j_ab)
+    for threads in (1, 2, 3):
+        dist, nearest = hausdorff.distances(a, b, threads=threads)
+        np.testing.assert_array_equal(dist, d_ab)
+        np.testing.assert_array_equal(nearest, j_ab)
     p = hausdorff.percentile(a, b, [50, 95])
     assert [r.ab for r in p] == [np.percentile(d_ab, 50), np.percentile(d_ab, 95)]
     assert p[1].pooled == np.percentile(np.hstack((d_ab, d_ba)), 95)
