@@ -48,7 +48,8 @@
 enum {
     LANES = 8,         /* rows summed side by side: a block */
     BLOCK = 8,         /* coordinates summed between two tests of the bound */
-    TREE_MAX_DIMS = 8  /* nearest(): above, boxes bound too little to pay for their tests */
+    TREE_MAX_DIMS = 8, /* nearest(): above, boxes bound too little to pay for their tests */
+    CENTRAL = 64       /* rows the early break tries first (see central_first) */
 };
 
 /* B as scanned: its rows in blocks of LANES, each block's coordinates
@@ -92,20 +93,25 @@ static void swap_sizes(size_t *v, size_t i, size_t j) {
     v[j] = t;
 }
 
-/* Reorder v[0..n) (rows of B) so that v[0..k) have coordinate `axis` <=
- * that of v[k..n): a quickselect with a three-way partition, so that runs
- * of equal values (grids) cost no more than others. */
-static void select_rows(size_t *v, size_t n, size_t k, const double *B, size_t dims, size_t axis) {
+static void swap_keyed(double *key, size_t *v, size_t i, size_t j) {
+    double k = key[i];
+    key[i] = key[j];
+    key[j] = k;
+    swap_sizes(v, i, j);
+}
+
+/* Reorder key[0..n) and v[0..n) alike so that key[0..k) <= key[k..n): a
+ * quickselect with a three-way partition, so that runs of equal keys
+ * (grids) cost no more than others. */
+static void select_keyed(double *key, size_t *v, size_t n, size_t k) {
     size_t lo = 0, hi = n;
     while (hi - lo > 1) {
-        double x = B[v[lo] * dims + axis], y = B[v[lo + (hi - lo) / 2] * dims + axis],
-               z = B[v[hi - 1] * dims + axis];
+        double x = key[lo], y = key[lo + (hi - lo) / 2], z = key[hi - 1];
         double pivot = x < y ? (y < z ? y : x < z ? z : x) : (x < z ? x : y < z ? z : y);
         size_t lt = lo, i = lo, gt = hi;
         while (i < gt) {
-            double w = B[v[i] * dims + axis];
-            if (w < pivot) swap_sizes(v, lt++, i++);
-            else if (w > pivot) swap_sizes(v, i, --gt);
+            if (key[i] < pivot) swap_keyed(key, v, lt++, i++);
+            else if (key[i] > pivot) swap_keyed(key, v, i, --gt);
             else i++;
         }
         if (k < lt) hi = lt;
@@ -134,19 +140,22 @@ static size_t split_axis(const size_t *v, size_t n, const double *B, size_t dims
 }
 
 /* Node `node` over stored rows [lo, hi), and its subtree; s->order is
- * reordered in place.  Returns the next free node. */
-static size_t tree_split(nd_set_t *s, const double *B, size_t node, size_t lo, size_t hi) {
+ * reordered in place (key: scratch, one double a row).  Returns the next
+ * free node. */
+static size_t tree_split(nd_set_t *s, const double *B, double *key, size_t node, size_t lo,
+                         size_t hi) {
     s->nodes[node] = (nd_node_t){lo, hi, {0, 0}, 0, 0.0};
     if (hi - lo <= LANES) return node + 1;
     size_t blocks = (hi - lo + LANES - 1) / LANES, mid = lo + blocks / 2 * LANES;
     size_t *v = s->order + lo, axis = split_axis(v, hi - lo, B, s->dims);
-    select_rows(v, hi - lo, mid - lo, B, s->dims, axis);
-    size_t left = node + 1, right = tree_split(s, B, left, lo, mid);
+    for (size_t r = lo; r < hi; r++) key[r] = B[s->order[r] * s->dims + axis];
+    select_keyed(key + lo, v, hi - lo, mid - lo);
+    size_t left = node + 1, right = tree_split(s, B, key, left, lo, mid);
     s->nodes[node].child[0] = left;
     s->nodes[node].child[1] = right;
     s->nodes[node].axis = axis;
     s->nodes[node].split = B[s->order[mid] * s->dims + axis];
-    return tree_split(s, B, right, mid, hi);
+    return tree_split(s, B, key, right, mid, hi);
 }
 
 /* Every node's box: a leaf's from its rows, an inner node's from its
@@ -186,12 +195,17 @@ static int set_build(nd_set_t *s, const double *B, size_t nb, size_t dims, int t
     s->blocks = calloc(nblocks * LANES * dims, sizeof(double));
     if (!s->blocks) return -1;
     if (tree) {
+        double *key = malloc(nb * sizeof *key);
         s->order = malloc(nb * sizeof *s->order);
         s->nodes = malloc(2 * nblocks * sizeof *s->nodes);
         s->box = malloc(2 * nblocks * 2 * dims * sizeof *s->box);
-        if (!s->order || !s->nodes || !s->box) return -1;
+        if (!key || !s->order || !s->nodes || !s->box) {
+            free(key);
+            return -1;
+        }
         for (size_t r = 0; r < nb; r++) s->order[r] = r;
-        s->nnodes = tree_split(s, B, 0, 0, nb);
+        s->nnodes = tree_split(s, B, key, 0, 0, nb);
+        free(key);
         tree_boxes(s, B);
     }
     for (size_t r = 0; r < nb; r++) {
@@ -423,8 +437,8 @@ static uint64_t next_random(uint64_t *state) {
     return z ^ (z >> 31);
 }
 
-static void shuffle(size_t *v, size_t n, uint64_t *state) {
-    for (size_t k = 0; k < n; k++) v[k] = k;
+/* v[0..n) in a random order. */
+static void shuffle_part(size_t *v, size_t n, uint64_t *state) {
     for (size_t k = n; k > 1; k--) {
         size_t r = (size_t)(next_random(state) % k), t = v[k - 1];
         v[k - 1] = v[r];
@@ -432,20 +446,80 @@ static void shuffle(size_t *v, size_t n, uint64_t *state) {
     }
 }
 
+/* 0, 1, ..., n - 1 in a random order. */
+static void shuffle(size_t *v, size_t n, uint64_t *state) {
+    for (size_t k = 0; k < n; k++) v[k] = k;
+    shuffle_part(v, n, state);
+}
+
+/* A squared distance for ordering heuristics only (any rounding will do). */
+static double rough_dist2(const double *p, const double *q, size_t dims) {
+    double s = 0.0;
+    for (size_t k = 0; k < dims; k++) s += (p[k] - q[k]) * (p[k] - q[k]);
+    return s;
+}
+
+/* Do the rows order[0..m) come nearer to A's points than order[m..2m) do?
+ * Asked of the first points of `visit` (a random sample of A). */
+static int nearer_first(const double *A, const size_t *visit, size_t na, const double *B,
+                        const size_t *order, size_t m, size_t dims) {
+    size_t wins = 0, tries = na < 64 ? na : 64;
+    for (size_t v = 0; v < tries; v++) {
+        const double *a = A + visit[v] * dims;
+        double best[2] = {INFINITY, INFINITY};
+        for (size_t r = 0; r < 2 * m; r++) {
+            double d = rough_dist2(a, B + order[r] * dims, dims);
+            best[r >= m] = d < best[r >= m] ? d : best[r >= m];
+        }
+        wins += best[0] < best[1];
+    }
+    return 2 * wins > tries;
+}
+
+/* Any order of B gives the same result; the early break is quick when
+ * the first rows are near most points of A.  In many coordinates the rows
+ * nearest A's centroid are (a point is nearer the middle than a random
+ * other point is), in few they are not (nearest neighbours are much nearer
+ * than the middle): so the CENTRAL rows nearest the centroid go first, in
+ * that order, when on a sample of A they come nearer than as many random
+ * rows; the rest stay in random order.  -1 when there is no memory. */
+static int central_first(const double *A, size_t na, const size_t *visit, const double *B,
+                         size_t nb, size_t dims, size_t *order, uint64_t *state) {
+    if (nb < 2 * CENTRAL) return 0;
+    double *c = calloc(dims, sizeof *c), *key = malloc(nb * sizeof *key);
+    if (!c || !key) {
+        free(c);
+        free(key);
+        return -1;
+    }
+    for (size_t i = 0; i < na; i++)
+        for (size_t k = 0; k < dims; k++) c[k] += A[i * dims + k] / (double)na;
+    for (size_t r = 0; r < nb; r++) key[r] = rough_dist2(B + order[r] * dims, c, dims);
+    select_keyed(key, order, nb, CENTRAL);
+    for (size_t r = 1; r < CENTRAL; r++) /* insertion sort of the first CENTRAL */
+        for (size_t q = r; q > 0 && key[q] < key[q - 1]; q--) swap_keyed(key, order, q, q - 1);
+    shuffle_part(order + CENTRAL, nb - CENTRAL, state);
+    if (!nearer_first(A, visit, na, B, order, CENTRAL, dims)) shuffle_part(order, nb, state);
+    free(c);
+    free(key);
+    return 0;
+}
+
 int nd_directed(const double *A, size_t na, const double *B, size_t nb, size_t dims,
                 int early, uint64_t seed, int threads, nd_directed_t *out) {
     size_t *visit = NULL, *order = NULL;
     nd_set_t set = {NULL, NULL, NULL, NULL, nb, dims, 0};
-    if (early) { /* A and B in random orders */
+    if (early) { /* A and B in random orders, central rows of B perhaps first */
         visit = malloc(na * sizeof *visit);
         order = malloc(nb * sizeof *order);
-        if (visit && order) {
-            uint64_t state = seed;
-            shuffle(visit, na, &state);
-            shuffle(order, nb, &state);
-        }
     }
-    if ((early && (!visit || !order)) || set_build(&set, B, nb, dims, 0, order)) {
+    uint64_t state = seed;
+    if (visit && order) {
+        shuffle(visit, na, &state);
+        shuffle(order, nb, &state);
+    }
+    if ((early && (!visit || !order || central_first(A, na, visit, B, nb, dims, order, &state))) ||
+        set_build(&set, B, nb, dims, 0, order)) {
         free(visit);
         if (!set.order) free(order);
         set_free(&set);
