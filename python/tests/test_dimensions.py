@@ -35,6 +35,11 @@ CASES = {  # name: (A, B), every one with its seeds in the name's data
     "single points 9-D": (normal(519, 1, 9), normal(520, 1, 9)),
     "one point against many 4-D": (normal(521, 1, 4), normal(522, 500, 4)),
     "B of 9 points (a block and one) 12-D": (normal(523, 100, 12), normal(524, 9, 12)),
+    # enough rows of B for the early break to try the central ones first
+    "normal 64-D, 300 x 260": (normal(525, 300, 64), normal(526, 260, 64)),
+    "grid 40-D, ties, 250 x 200": (grid(527, 250, 40, 2), grid(528, 200, 40, 2)),
+    "two clusters 24-D": (normal(529, 200, 24),
+                          np.vstack((normal(530, 120, 24) + 3, normal(531, 120, 24) - 3))),
 }
 
 
