@@ -46,9 +46,9 @@ def exactness_flags():
 
 
 static_lib = os.environ.get("HAUSDORFF_STATIC_LIB")
-sources = [os.path.join("hausdorff", "_hausdorff.c")]
+sources = [os.path.join("hausdorff", "_hausdorff.c"), os.path.join("hausdorff", "_ndim.c")]
 extra_objects = []
-depends = [HEADER]
+depends = [HEADER, os.path.join(HERE, "hausdorff", "_ndim.h")]
 link_args = ["-pthread"]
 if static_lib:
     # Link the CMake archive; keep its symbols out of the module's exports.

@@ -232,22 +232,27 @@ def medpy_binary_published_values_on_1d_and_2d_masks(tmp):
     """medpy.metric.binary: asd([1,0], [0,1]) == 1, == 2 with spacing 2, assd
     the same (a 1-D mask, dim[0] = 1); asd is not symmetric on its 4x4 pair
     (the values from its definition), assd is.  asd(result, reference) is
-    our mean.ab, assd = (asd + asd') / 2 our mean.average."""
+    our mean.ab; assd, the mean of both directions' distances together
+    (medpy 0.5 averages the two lists, not the two asd), our mean.pooled,
+    which differs from mean.average = (asd + asd') / 2 on that pair."""
     for sp, want in ((1.0, 1.0), (2.0, 2.0)):
         pa = save(os.path.join(tmp, "r.nii"), MIN_RESULT, (sp, 1, 1))
         pb = save(os.path.join(tmp, "f.nii"), MIN_REFERENCE, (sp, 1, 1))
         r = run_json(["--mean", pa, pb])
         assert r["masks"]["a"]["dim"] == [2, 1, 1]
-        assert r["mean"]["ab"] == want and r["mean"]["average"] == want, r["mean"]
+        assert r["mean"]["ab"] == want and r["mean"]["pooled"] == want, r["mean"]
     pa = save(os.path.join(tmp, "rs.nii"), SYM_RESULT)
     pb = save(os.path.join(tmp, "fs.nii"), SYM_REFERENCE)
     m1 = run_json(["--mean", pa, pb])["mean"]
     m2 = run_json(["--mean", pb, pa])["mean"]
-    asd1 = medpy_surface_distances(SYM_RESULT, SYM_REFERENCE, (1, 1)).mean()
-    asd2 = medpy_surface_distances(SYM_REFERENCE, SYM_RESULT, (1, 1)).mean()
-    assert asd1 != asd2
+    sd1 = medpy_surface_distances(SYM_RESULT, SYM_REFERENCE, (1, 1))
+    sd2 = medpy_surface_distances(SYM_REFERENCE, SYM_RESULT, (1, 1))
+    asd1, asd2, assd = sd1.mean(), sd2.mean(), np.hstack((sd1, sd2)).mean()
+    assert asd1 != asd2 and len(sd1) != len(sd2)
     assert abs(m1["ab"] - asd1) < 1e-15 and abs(m2["ab"] - asd2) < 1e-15, (m1, asd1, m2, asd2)
-    assert m1["ab"] != m2["ab"] and m1["average"] == m2["average"]
+    assert m1["ab"] != m2["ab"] and m1["pooled"] == m2["pooled"]
+    assert abs(m1["pooled"] - assd) < 1e-15, (m1, assd)
+    assert abs(m1["average"] - assd) > 1e-3, (m1, assd)   # the two-means formula is not medpy's
 
 
 def blob(seed, shape, centre, radii):
@@ -261,7 +266,8 @@ def blob(seed, shape, centre, radii):
 def connectivity_is_medpys_on_3d_and_2d_masks(tmp):
     """--connectivity c: the border medpy computes with connectivity=c
     (generate_binary_structure(ndim, c); in 2-D, 3 acts as 2, as scipy's
-    structure does), and its hd, hd95 and assd on it."""
+    structure does), and its hd, hd95 and assd (both directions' distances
+    averaged together: our mean.pooled) on it."""
     sp3 = (0.75, 1.25, 2.0)
     cases = [(blob(1, (20, 17, 13), (10, 8, 6), (7, 6, 4)), blob(2, (20, 17, 13), (9, 9, 6), (7, 5, 4)), sp3),
              (blob(3, (30, 26), (15, 12), (11, 8)), blob(4, (30, 26), (14, 13), (10, 9)), (0.75, 1.25))]
@@ -280,10 +286,10 @@ def connectivity_is_medpys_on_3d_and_2d_masks(tmp):
             h2 = medpy_surface_distances(b, a, sp, c)
             hd = max(h1.max(), h2.max())
             hd95 = np.percentile(np.hstack((h1, h2)), 95)
-            assd = np.mean((h1.mean(), h2.mean()))
+            assd = np.hstack((h1, h2)).mean()
             close(r["hausdorff"], hd, 1e-13, "hd, connectivity %d" % c)
             close(r["percentile"]["pooled"], hd95, 1e-13, "hd95, connectivity %d" % c)
-            close(r["mean"]["average"], assd, 1e-13, "assd, connectivity %d" % c)
+            close(r["mean"]["pooled"], assd, 1e-13, "assd, connectivity %d" % c)
         assert len(counts) == (3 if a.ndim == 3 else 2), counts  # each neighbourhood its own border
 
 

@@ -22,12 +22,18 @@
  * the library may read it, and the GIL is released only around library
  * calls, which touch no Python object.
  *
+ * Points of 1 or 2 coordinates are padded with zeros to 3-D (one copy), which
+ * changes no squared distance; points of 4 or more go, as C-ordered doubles,
+ * to _ndim.c, which computes the same doubles as a brute force in any
+ * number of coordinates (the library computes in 3-D only).
+ *
  * An Index keeps its own C-ordered copy of the indexed points: the library's
  * index may borrow the memory it was built on (hausdorff.h allows it), and a
  * Python caller could otherwise change or free that array while the index
- * lives.  The copy is
- * made once and never written again, so queries from many Python threads at
- * once are safe (the C index is immutable).
+ * lives.  The copy is made once and never written again (the array Python
+ * sees has a capsule as its owner, so numpy cannot make it writable), so
+ * queries from many Python threads at once are safe (the C index is
+ * immutable).
  *
  * Library result codes map to Python exceptions by kind: bad input (invalid
  * argument, empty set, NaN or infinite or too large a coordinate, malformed
@@ -42,11 +48,15 @@
 #define NPY_NO_DEPRECATED_API NPY_1_7_API_VERSION
 #include <numpy/arrayobject.h>
 
+#include <float.h>
 #include <limits.h>
 #include <math.h>
 #include <string.h>
+#include <time.h>
+#include <unistd.h>
 
 #include "hausdorff.h"
+#include "_ndim.h"
 
 /* hd_index_nearest writes size_t indices straight into an intp array. */
 _Static_assert(sizeof(size_t) == sizeof(npy_intp), "size_t and npy_intp differ in size");
@@ -81,19 +91,40 @@ static PyObject *raise_hd(int rc, const hd_error_t *err) {
 
 typedef struct {
     PyArrayObject *arr; /* keeps the memory alive; NULL when unused */
-    hd_points_t pts;
-    int dims;           /* the caller's columns: 2 or 3 (0 for an empty `[]`) */
+    hd_points_t pts;    /* dims <= 3: the (N, 3) view the library reads;
+                           dims > 3: pts.data is C-ordered float64 rows of dims */
+    int dims;           /* the caller's columns (0 for an empty `[]`) */
 } points_arg_t;
 
 static void points_release(points_arg_t *p) {
     Py_CLEAR(p->arr);
 }
 
-/* What a distance function returns for an empty set (the CLI's --empty,
- * plus MONAI's rule).  EMPTY_NONE: the function has no such option. */
-typedef enum { EMPTY_NONE = -1, EMPTY_ERROR, EMPTY_INF, EMPTY_NAN, EMPTY_ZERO, EMPTY_MONAI } empty_t;
+/* Points of more than 3 coordinates: computed by _ndim.c, not the library. */
+static int is_nd(const points_arg_t *p) {
+    return p->dims > 3;
+}
 
-static const char *const empty_names[] = {"error", "inf", "nan", "zero", "monai", NULL};
+/* ------------------------------------------------------------------------
+ * What an empty set gives: every rule lives here (names, values, message).
+ * EMPTY_NONE: the function has no such option (an empty set is an error).
+ * ---------------------------------------------------------------------- */
+
+typedef enum {
+    EMPTY_NONE = -1, EMPTY_ERROR, EMPTY_INF, EMPTY_NAN, EMPTY_ZERO, EMPTY_MONAI, EMPTY_SKIMAGE
+} empty_t;
+
+static const char *const empty_names[] = {"error", "inf", "nan", "zero", "monai", "skimage", NULL};
+
+/* "'a', 'b' or 'c'" of empty_names from index `first` on. */
+static void empty_list(int first, char *buf, size_t size) {
+    buf[0] = '\0';
+    for (int k = first; empty_names[k]; k++) {
+        size_t used = strlen(buf);
+        const char *sep = k == first ? "" : empty_names[k + 1] ? ", " : " or ";
+        snprintf(buf + used, size - used, "%s'%s'", sep, empty_names[k]);
+    }
+}
 
 static int parse_empty(const char *name, empty_t *out) {
     *out = EMPTY_ERROR;
@@ -103,32 +134,48 @@ static int parse_empty(const char *name, empty_t *out) {
             *out = (empty_t)k;
             return 0;
         }
-    PyErr_Format(PyExc_ValueError,
-                 "empty must be 'error', 'inf', 'nan', 'zero' or 'monai', not '%s'", name);
+    char known[128];
+    empty_list(0, known, sizeof known);
+    PyErr_Format(PyExc_ValueError, "empty must be %s, not '%s'", known, name);
     return -1;
 }
 
-/* The value every figure takes when a set is empty: inf, NaN or 0, or as
- * MONAI: inf when one set is empty, NaN when both are. */
+/* The value every figure takes when a set is empty: inf, NaN or 0; as
+ * MONAI: inf when one set is empty, NaN when both are; as scikit-image's
+ * hausdorff_distance: inf when one set is empty, 0 when both are. */
 static double empty_value(empty_t policy, size_t na, size_t nb) {
+    int both = na == 0 && nb == 0;
     switch (policy) {
     case EMPTY_INF: return INFINITY;
     case EMPTY_ZERO: return 0.0;
-    case EMPTY_MONAI: return na == 0 && nb == 0 ? NAN : INFINITY;
+    case EMPTY_MONAI: return both ? NAN : INFINITY;
+    case EMPTY_SKIMAGE: return both ? 0.0 : INFINITY;
     default: return NAN;
     }
 }
 
-/* An (N, 2) array as the (N, 3) array of the points (x, y, 0), of dtype
- * `want` (float32 or float64), C-ordered.  The z difference of two such
- * points is 0, so every squared distance is dx*dx + dy*dy + 0, the same
- * double as dx*dx + dy*dy: nothing is rounded on the way. */
-static PyArrayObject *lift_plane(PyArrayObject *arr, int want) {
+/* The error for an empty set under `empty` (EMPTY_NONE or EMPTY_ERROR). */
+static void empty_error(const char *name, empty_t empty) {
+    char known[128] = "";
+    if (empty == EMPTY_ERROR) empty_list(EMPTY_INF, known, sizeof known);
+    PyErr_Format(PyExc_ValueError, "%s is empty: at least one point is needed%s%s%s", name,
+                 *known ? " (empty=" : "", known, *known ? " gives a value instead)" : "");
+}
+
+/* ------------------------------------------------------------------------
+ * Shapes and coordinates.
+ * ---------------------------------------------------------------------- */
+
+/* An (N, c) array, c < 3, as the (N, 3) array of its points padded with
+ * zeros, of dtype `want` (float32 or float64), C-ordered.  The padded
+ * differences are 0, so every squared distance is the c-column sum plus
+ * +0s, the same double: nothing is rounded on the way. */
+static PyArrayObject *lift_to_3d(PyArrayObject *arr, int want) {
     PyArrayObject *src = (PyArrayObject *)PyArray_FromArray(
         arr, PyArray_DescrFromType(want),
         NPY_ARRAY_ALIGNED | NPY_ARRAY_NOTSWAPPED | NPY_ARRAY_FORCECAST);
     if (!src) return NULL;
-    npy_intp dims[2] = {PyArray_DIM(src, 0), 3};
+    npy_intp dims[2] = {PyArray_DIM(src, 0), 3}, cols = PyArray_DIM(src, 1);
     PyArrayObject *out = (PyArrayObject *)PyArray_ZEROS(2, dims, want, 0);
     if (!out) {
         Py_DECREF(src);
@@ -136,20 +183,75 @@ static PyArrayObject *lift_plane(PyArrayObject *arr, int want) {
     }
     const char *s = PyArray_BYTES(src);
     npy_intp s0 = PyArray_STRIDE(src, 0), s1 = PyArray_STRIDE(src, 1);
-    for (npy_intp k = 0; k < dims[0]; k++) {
-        const char *row = s + k * s0;
-        if (want == NPY_DOUBLE) {
-            double *d = (double *)PyArray_DATA(out) + 3 * k;
-            memcpy(&d[0], row, sizeof(double));
-            memcpy(&d[1], row + s1, sizeof(double));
-        } else {
-            float *f = (float *)PyArray_DATA(out) + 3 * k;
-            memcpy(&f[0], row, sizeof(float));
-            memcpy(&f[1], row + s1, sizeof(float));
-        }
-    }
+    size_t el = want == NPY_DOUBLE ? sizeof(double) : sizeof(float);
+    char *d = PyArray_BYTES(out);
+    for (npy_intp k = 0; k < dims[0]; k++)
+        for (npy_intp c = 0; c < cols; c++)
+            memcpy(d + (size_t)(3 * k + c) * el, s + k * s0 + c * s1, el);
     Py_DECREF(src);
     return out;
+}
+
+/* "A" for "a": the library's name of a set in its messages. */
+static char set_letter(const char *name) {
+    return name[0] >= 'a' && name[0] <= 'z' && !name[1] ? (char)(name[0] - 'a' + 'A') : '?';
+}
+
+/* Points of dims > 3 coordinates (C-ordered doubles): the library's checks,
+ * its messages and codes, with a limit that keeps the sum of dims squared
+ * differences finite (1e153, the library's, while dims * (2e153)^2 fits). */
+static int nd_check(const double *x, size_t n, size_t dims, const char *name) {
+    double limit = sqrt(DBL_MAX / (4.0 * (double)dims));
+    if (limit > HD_MAX_COORD) limit = HD_MAX_COORD;
+    hd_error_t err;
+    for (size_t k = 0; k < n * dims; k++) {
+        double v = x[k];
+        int code = !isfinite(v) ? HD_ENONFINITE : fabs(v) > limit ? HD_ERANGE : HD_OK;
+        if (code == HD_OK) continue;
+        memset(&err, 0, sizeof err);
+        if (code == HD_ENONFINITE)
+            snprintf(err.message, sizeof err.message, "point set %c: point %zu has %s coordinate",
+                     set_letter(name), k / dims, isnan(v) ? "a NaN" : "an infinite");
+        else
+            snprintf(err.message, sizeof err.message,
+                     "point set %c: point %zu has coordinate %g, beyond the limit %g where "
+                     "squared distances in %zu dimensions could overflow",
+                     set_letter(name), k / dims, v, limit, dims);
+        raise_hd(code, &err);
+        return -1;
+    }
+    return 0;
+}
+
+/* The shape check: an (N, D) array with D >= 1, or an empty `[]`. */
+static int shape_ok(PyArrayObject *arr, const char *name) {
+    int nd = PyArray_NDIM(arr);
+    if ((nd == 1 && PyArray_SIZE(arr) == 0) || (nd == 2 && PyArray_DIM(arr, 1) >= 1)) return 0;
+    PyObject *shape = PyObject_GetAttrString((PyObject *)arr, "shape");
+    if (shape) {
+        PyErr_Format(PyExc_ValueError,
+                     "%s must be an (N, D) array of N points of D >= 1 coordinates, got shape %R",
+                     name, shape);
+        Py_DECREF(shape);
+    }
+    return -1;
+}
+
+/* The dtype the library reads arr as: float32 and float64 stay, other real
+ * numbers and booleans (0 and 1, as scipy computes with them) become
+ * float64; -1 with a TypeError for anything else. */
+static int wanted_type(PyArrayObject *arr, const char *name) {
+    int type = PyArray_TYPE(arr);
+    if (type == NPY_DOUBLE || type == NPY_FLOAT) return type;
+    if (PyArray_ISINTEGER(arr) || PyArray_ISFLOAT(arr) || PyArray_ISBOOL(arr)) return NPY_DOUBLE;
+    PyObject *s = PyObject_Str((PyObject *)PyArray_DESCR(arr));
+    if (s) {
+        PyErr_Format(PyExc_TypeError,
+                     "%s must hold real numbers (float32, float64, integers or booleans), got %U",
+                     name, s);
+        Py_DECREF(s);
+    }
+    return -1;
 }
 
 /* Fill *out from an array of points, whose reference it takes (released on
@@ -159,38 +261,16 @@ static PyArrayObject *lift_plane(PyArrayObject *arr, int want) {
 static int points_prepare(PyArrayObject *arr, const char *name, empty_t empty,
                           points_arg_t *out) {
     memset(out, 0, sizeof *out);
-    int nd = PyArray_NDIM(arr);
-    int cols = nd == 2 ? (int)PyArray_DIM(arr, 1) : 0;
-    if (!(nd == 1 && PyArray_SIZE(arr) == 0) && !(nd == 2 && (cols == 2 || cols == 3))) {
-        PyObject *shape = PyObject_GetAttrString((PyObject *)arr, "shape");
-        if (shape) {
-            PyErr_Format(PyExc_ValueError,
-                         "%s must be an (N, 3) or (N, 2) array of points, got shape %R", name,
-                         shape);
-            Py_DECREF(shape);
-        }
+    int want;
+    if (shape_ok(arr, name) || (want = wanted_type(arr, name)) < 0) {
         Py_DECREF(arr);
         return -1;
     }
-    int type = PyArray_TYPE(arr);
-    int want = type;
-    if (type != NPY_DOUBLE && type != NPY_FLOAT) {
-        if (!PyArray_ISINTEGER(arr) && !PyArray_ISFLOAT(arr)) {
-            PyErr_Format(PyExc_TypeError,
-                         "%s must hold real numbers (float32 or float64), got dtype %R",
-                         name, (PyObject *)PyArray_DESCR(arr));
-            Py_DECREF(arr);
-            return -1;
-        }
-        want = NPY_DOUBLE;
-    }
+    int cols = PyArray_NDIM(arr) == 2 ? (int)PyArray_DIM(arr, 1) : 0;
     out->dims = cols;
-    if (nd == 1 || PyArray_DIM(arr, 0) == 0) {
+    if (cols == 0 || PyArray_DIM(arr, 0) == 0) {
         if (empty == EMPTY_NONE || empty == EMPTY_ERROR) {
-            PyErr_Format(PyExc_ValueError, "%s is empty: at least one point is needed%s", name,
-                         empty == EMPTY_ERROR
-                             ? " (empty='inf', 'nan', 'zero' or 'monai' gives a value instead)"
-                             : "");
+            empty_error(name, empty);
             Py_DECREF(arr);
             return -1;
         }
@@ -198,15 +278,27 @@ static int points_prepare(PyArrayObject *arr, const char *name, empty_t empty,
         out->pts.dtype = HD_FLOAT64;
         return 0; /* count 0 */
     }
-    npy_intp s0 = PyArray_STRIDE(arr, 0), s1 = PyArray_STRIDE(arr, 1);
-    if (cols == 2) {
-        PyArrayObject *c = lift_plane(arr, want);
+    if (cols > 3) { /* C-ordered doubles for _ndim.c (float32 widens exactly) */
+        PyArrayObject *c = (PyArrayObject *)PyArray_FromArray(
+            arr, PyArray_DescrFromType(NPY_DOUBLE), NPY_ARRAY_CARRAY_RO | NPY_ARRAY_FORCECAST);
+        Py_DECREF(arr);
+        if (!c) return -1;
+        out->arr = c;
+        out->pts = (hd_points_t){PyArray_DATA(c), (size_t)PyArray_DIM(c, 0), HD_FLOAT64,
+                                 (ptrdiff_t)(cols * sizeof(double)), (ptrdiff_t)sizeof(double)};
+        if (nd_check(PyArray_DATA(c), out->pts.count, (size_t)cols, name)) {
+            points_release(out);
+            return -1;
+        }
+        return 0;
+    }
+    if (cols < 3) {
+        PyArrayObject *c = lift_to_3d(arr, want);
         Py_DECREF(arr);
         if (!c) return -1;
         arr = c;
-        s0 = PyArray_STRIDE(arr, 0);
-        s1 = PyArray_STRIDE(arr, 1);
     }
+    npy_intp s0 = PyArray_STRIDE(arr, 0), s1 = PyArray_STRIDE(arr, 1);
     /* The library reads a zero stride as "packed": materialise broadcasts. */
     int zero_stride = s1 == 0 || (s0 == 0 && PyArray_DIM(arr, 0) > 1);
     if (want != PyArray_TYPE(arr) || !PyArray_ISNOTSWAPPED(arr) || !PyArray_ISALIGNED(arr) ||
@@ -304,6 +396,45 @@ static int parse_threads(PyObject *obj, int *threads) {
     return 0;
 }
 
+/* numpy's random generator objects (numpy.random's Generator, RandomState,
+ * BitGenerator, SeedSequence): scipy's directed_hausdorff takes them as its
+ * seed.  1 when obj is one, 0 when not, -1 with an exception set. */
+static int is_numpy_random(PyObject *obj) {
+    static const char *const names[] = {"Generator", "RandomState", "BitGenerator", "SeedSequence"};
+    PyObject *mod = PyImport_ImportModule("numpy.random");
+    if (!mod) return -1;
+    int found = 0;
+    for (size_t k = 0; !found && k < sizeof names / sizeof names[0]; k++) {
+        PyObject *type = PyObject_GetAttrString(mod, names[k]);
+        if (!type) {
+            PyErr_Clear(); /* an older numpy without it */
+            continue;
+        }
+        found = PyObject_IsInstance(obj, type);
+        Py_DECREF(type);
+    }
+    Py_DECREF(mod);
+    return found;
+}
+
+/* seed (or scipy 1.15's rng): it orders the randomised algorithms' work and
+ * never changes the answer, so every form scipy takes is accepted: None
+ * (the default seed), any integer (its value modulo 2**64, negative and
+ * huge ones included), and a numpy random generator, which gives the default
+ * seed and is left untouched (nothing is drawn from it). */
+static int parse_seed(PyObject *seed, uint64_t *out) {
+    if (!seed || seed == Py_None) return 0;
+    int gen = PyIndex_Check(seed) ? 0 : is_numpy_random(seed);
+    if (gen) return gen < 0 ? -1 : 0;
+    PyObject *i = as_integer(seed, "seed", "None, an integer or a numpy random generator");
+    if (!i) return -1;
+    unsigned long long s = PyLong_AsUnsignedLongLongMask(i);
+    Py_DECREF(i);
+    if (s == (unsigned long long)-1 && PyErr_Occurred()) return -1;
+    *out = (uint64_t)s;
+    return 0;
+}
+
 static int parse_options(const char *algorithm, PyObject *threads, PyObject *seed,
                          hd_options_t *opt) {
     hd_options_init(opt);
@@ -318,19 +449,7 @@ static int parse_options(const char *algorithm, PyObject *threads, PyObject *see
         return -1;
     }
     if (parse_threads(threads, &opt->threads)) return -1;
-    if (seed && seed != Py_None) { /* None, as scipy's: the default seed */
-        PyObject *i = as_integer(seed, "seed", "an integer or None");
-        if (!i) return -1;
-        unsigned long long s = PyLong_AsUnsignedLongLong(i);
-        Py_DECREF(i);
-        if (s == (unsigned long long)-1 && PyErr_Occurred()) {
-            PyErr_Clear();
-            PyErr_SetString(PyExc_ValueError, "seed must be an integer in [0, 2**64)");
-            return -1;
-        }
-        opt->seed = (uint64_t)s;
-    }
-    return 0;
+    return parse_seed(seed, &opt->seed);
 }
 
 /* rotation (3x3) and translation (3,), either may be None.  *use is 0 when
@@ -516,10 +635,11 @@ static PyStructSequence_Field summary_fields[] = {
     {"mean2_ba", "mean squared distance of B's points to A"},
     {"mean_symmetric", "max(mean_ab, mean_ba): the average Hausdorff distance"},
     {"mean_average", "(mean_ab + mean_ba) / 2"},
-    {"mean_pooled", "(sum_ab + sum_ba) / (n_ab + n_ba): MONAI's symmetric average surface distance"},
+    {"mean_pooled", "(sum_ab + sum_ba) / (n_ab + n_ba): MONAI's symmetric average surface "
+                    "distance, medpy's assd"},
     {"chamfer", "mean2_ab + mean2_ba: the Chamfer distance (as PyTorch3D)"},
     {"chamfer_sum2", "sum2_ab + sum2_ba"},
-    {"chamfer_mean", "mean_ab + mean_ba"},
+    {"chamfer_mean", "mean_ab + mean_ba: point-cloud-utils' chamfer_distance"},
     {"chamfer_sum", "sum_ab + sum_ba"},
     {NULL, NULL},
 };
@@ -538,7 +658,7 @@ static PyStructSequence_Field mean_fields[] = {
     {"ba", "mean distance of B's points to A"},
     {"symmetric", "max(ab, ba): the average Hausdorff distance"},
     {"average", "(ab + ba) / 2"},
-    {"pooled", "mean of both directions' distances together (MONAI's symmetric ASD)"},
+    {"pooled", "mean of both directions' distances together (MONAI's symmetric ASD, medpy's assd)"},
     {NULL, NULL},
 };
 
@@ -604,30 +724,41 @@ static PyObject *nearest_arrays(const hd_index_t *idx, const hd_points_t *A,
  * ---------------------------------------------------------------------- */
 
 PyDoc_STRVAR(directed_doc,
-"directed($module, a, b, seed=0, *, algorithm='auto', threads=None, empty='error')\n--\n\n"
+"directed($module, a, b, seed=0, *, rng=None, algorithm='auto', threads=None,\n"
+"         empty='error')\n--\n\n"
 "The directed Hausdorff distance h(a, b) = max over p in a of min over q in b\n"
 "of |p - q|, exact to the last bit, with its witness.\n"
 "\n"
-"A drop-in for scipy.spatial.distance.directed_hausdorff(u, v, seed=0): the\n"
+"A drop-in for scipy.spatial.distance.directed_hausdorff(u, v, rng=0): the\n"
 "same calls (seed positional or keyword, None included; scipy's names u= and\n"
-"v= for a and b) return the tuple (distance, i, j) where\n"
-"|a[i] - b[j]| == distance, the same double as scipy's.  On ties i is the\n"
-"smallest index in a whose nearest distance is the maximum and j the smallest\n"
-"index in b at that distance, for every algorithm and thread count (scipy's\n"
-"witness depends on its random order instead).\n"
+"v= for a and b, scipy 1.15's rng= for seed) return the tuple\n"
+"(distance, i, j) where |a[i] - b[j]| == distance, the same double as\n"
+"scipy's.  On ties i is the smallest index in a whose nearest distance is\n"
+"the maximum and j the smallest index in b at that distance, for every\n"
+"algorithm, seed and thread count (scipy's witness depends on its random\n"
+"order instead).\n"
 "\n"
-"a, b: (N, 3) or (N, 2) array-likes of real numbers, both with the same\n"
-"    number of columns; a point (x, y) is (x, y, 0), which changes no\n"
-"    distance.  float32 and float64 (N, 3) arrays are read in place (C or\n"
-"    Fortran order or strided views); other dtypes are converted to float64.\n"
-"seed: the seed of the randomised algorithms (earlybreak, ohd); it never\n"
-"    changes the answer.  None is the default seed.\n"
+"a, b: (N, D) array-likes of real numbers or booleans (as 0 and 1), both\n"
+"    with the same number D >= 1 of coordinates.  The squared distance is\n"
+"    the sum of the squared differences from the first coordinate to the\n"
+"    last, and the distance its sqrt, as a brute force (and scipy) computes\n"
+"    them.  D = 1 and 2 are computed as the points padded with zeros to 3-D,\n"
+"    which changes no distance; D >= 4 by the module's own exact engine.\n"
+"    float32 and float64 (N, 3) arrays are read in place (C or Fortran\n"
+"    order or strided views); other dtypes are converted to float64.\n"
+"seed, rng: they never change the answer, only the order the randomised\n"
+"    algorithms (earlybreak, ohd) visit points in: None (the default seed),\n"
+"    any integer (its value modulo 2**64), or a numpy random generator\n"
+"    (Generator, RandomState, BitGenerator, SeedSequence), which is left\n"
+"    untouched.  Give one of the two.\n"
 "algorithm: 'auto' (the fastest exact engine), 'naive', 'earlybreak',\n"
-"    'inc', 'nohd', 'ohd', 'framework' or 'kdtree'.\n"
+"    'inc', 'nohd', 'ohd', 'framework' or 'kdtree'; with D >= 4 'auto',\n"
+"    'earlybreak' or 'naive'.\n"
 "threads: None or 0 for every core, else the number of threads.\n"
 "empty: what an empty set gives: 'error' (ValueError), 'inf', 'nan',\n"
-"    'zero', or 'monai' (inf when one set is empty, NaN when both are); the\n"
-"    witness is then (None, None).\n"
+"    'zero', 'monai' (inf when one set is empty, NaN when both are) or\n"
+"    'skimage' (inf when one set is empty, 0 when both are); the witness is\n"
+"    then (None, None).\n"
 "\n"
 "The GIL is released during the computation.  Raises ValueError for a wrong\n"
 "shape, an empty set, NaN or infinite coordinates, or an unknown algorithm.\n"
@@ -640,25 +771,31 @@ PyDoc_STRVAR(directed_doc,
 "1.118034 2 0\n"
 ">>> hausdorff.directed(a, b).distance == d\n"
 "True\n"
-">>> hausdorff.directed(u=[(0, 0), (3, 4)], v=[(0, 0)], seed=1)\n"
+">>> hausdorff.directed(u=[(0, 0), (3, 4)], v=[(0, 0)], rng=1)\n"
 "hausdorff.DirectedResult(distance=5.0, i=1, j=0)\n"
+">>> hausdorff.directed([[0, 0, 0, 0]], [[1, 1, 1, 1]]).distance\n"
+"2.0\n"
 ">>> hausdorff.directed(a, np.empty((0, 3)), empty='inf').distance\n"
 "inf\n");
 
-/* scipy's names u and v for a and b: *out is kw with them renamed (a new
- * reference; NULL when kw is NULL).  Giving both names is a TypeError. */
-static int scipy_names(PyObject *kw, PyObject **out) {
+/* scipy's names for directed()'s parameters: u and v for a and b, and
+ * scipy 1.15's rng for seed.  aliases[first..] apply to the function
+ * `fname`; *out is kw with them renamed (a new reference; NULL when kw is
+ * NULL).  Giving both names of one parameter is a TypeError, as scipy's
+ * "only one may be specified" for seed and rng. */
+static int scipy_names(PyObject *kw, int first, const char *fname, PyObject **out) {
+    static const char *const alias[3][3] = {
+        {"u", "a", "scipy's name for it"}, {"v", "b", "scipy's name for it"},
+        {"rng", "seed", "scipy 1.15's name for it"}};
     *out = NULL;
     if (!kw) return 0;
-    static const char *const alias[2][2] = {{"u", "a"}, {"v", "b"}};
     PyObject *copy = NULL;
-    for (int k = 0; k < 2; k++) {
+    for (int k = first; k < 3; k++) {
         PyObject *val = PyDict_GetItemString(kw, alias[k][0]);
         if (!val) continue;
         if (PyDict_GetItemString(kw, alias[k][1])) {
-            PyErr_Format(PyExc_TypeError,
-                         "directed() got both '%s' and '%s' (scipy's name for it)",
-                         alias[k][1], alias[k][0]);
+            PyErr_Format(PyExc_TypeError, "%s() got both '%s' and '%s' (%s)", fname, alias[k][1],
+                         alias[k][0], alias[k][2]);
             Py_XDECREF(copy);
             return -1;
         }
@@ -677,23 +814,110 @@ static int scipy_names(PyObject *kw, PyObject **out) {
     return 0;
 }
 
+/* The algorithms of points of more than 3 coordinates: 'auto' and
+ * 'earlybreak' run _ndim.c's early break, 'naive' its brute force; the
+ * others are the library's 3-D engines.  *early is 1 for the early break. */
+static int nd_algorithm(const char *algorithm, int dims, int *early) {
+    *early = strcmp(algorithm, "naive") != 0;
+    if (!*early || !strcmp(algorithm, "auto") || !strcmp(algorithm, "earlybreak")) return 0;
+    PyErr_Format(PyExc_ValueError,
+                 "algorithm '%s' computes in 3 dimensions; points of %d coordinates take "
+                 "'auto', 'earlybreak' or 'naive'", algorithm, dims);
+    return -1;
+}
+
+static double now_seconds(void) {
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* The library's thread count of opt->threads (0: every core). */
+static int resolve_threads(int threads) {
+    if (threads > 0) return threads;
+    long n = sysconf(_SC_NPROCESSORS_ONLN);
+    return n > 0 ? (int)(n < 64 ? n : 64) : 1;
+}
+
+/* h(a, b) of points of more than 3 coordinates, as the library's
+ * hd_result_t; -1 with MemoryError when _ndim.c had no memory. */
+static int nd_directed_result(const points_arg_t *a, const points_arg_t *b, int early,
+                              const hd_options_t *opt, hd_result_t *r) {
+    nd_directed_t x;
+    int rc, threads = resolve_threads(opt->threads);
+    double t0 = now_seconds();
+    Py_BEGIN_ALLOW_THREADS
+    rc = nd_directed(a->pts.data, a->pts.count, b->pts.data, b->pts.count, (size_t)a->dims,
+                     early, opt->seed, threads, &x);
+    Py_END_ALLOW_THREADS
+    if (rc) {
+        PyErr_NoMemory();
+        return -1;
+    }
+    memset(r, 0, sizeof *r);
+    r->distance = sqrt(x.d2);
+    r->i = x.i;
+    r->j = x.j;
+    r->algorithm = early ? HD_ALG_EARLYBREAK : HD_ALG_NAIVE;
+    r->seconds = now_seconds() - t0;
+    r->stats.distance_evals = x.distance_evals;
+    return 0;
+}
+
+/* The boxes' overlap of points of more than 3 coordinates: hd_overlap's
+ * definition (hausdorff.h) with a factor per coordinate. */
+static void nd_overlap(const points_arg_t *a, const points_arg_t *b, double *alpha,
+                       int *disjoint) {
+    const double *x[2] = {a->pts.data, b->pts.data};
+    size_t n[2] = {a->pts.count, b->pts.count}, dims = (size_t)a->dims;
+    *alpha = 1.0;
+    *disjoint = 0;
+    for (size_t c = 0; c < dims; c++) {
+        double lo[2], hi[2];
+        for (int s = 0; s < 2; s++) {
+            lo[s] = hi[s] = x[s][c];
+            for (size_t k = 1; k < n[s]; k++) {
+                double v = x[s][k * dims + c];
+                if (v < lo[s]) lo[s] = v;
+                if (v > hi[s]) hi[s] = v;
+            }
+        }
+        double ilo = lo[0] > lo[1] ? lo[0] : lo[1], ihi = hi[0] < hi[1] ? hi[0] : hi[1];
+        double m = fmin(hi[0] - lo[0], hi[1] - lo[1]);
+        if (ihi < ilo) *disjoint = 1;
+        *alpha *= ihi < ilo ? 0.0 : m == 0.0 ? 1.0 : (ihi - ilo) / m;
+    }
+    if (*disjoint) *alpha = 0.0;
+}
+
+/* H(a, b) of points of more than 3 coordinates, as hd_symmetric_t. */
+static int nd_symmetric_result(const points_arg_t *a, const points_arg_t *b, int early,
+                               const hd_options_t *opt, hd_symmetric_t *h) {
+    memset(h, 0, sizeof *h);
+    if (nd_directed_result(a, b, early, opt, &h->ab) || nd_directed_result(b, a, early, opt, &h->ba))
+        return -1;
+    h->distance = h->ab.distance > h->ba.distance ? h->ab.distance : h->ba.distance;
+    h->seconds = h->ab.seconds + h->ba.seconds;
+    nd_overlap(a, b, &h->alpha, &h->disjoint);
+    return 0;
+}
+
 /* directed() and hausdorff(): one computation, one or both directions. */
 static PyObject *distance_call(PyObject *args, PyObject *kw, int symmetric) {
     static char *kw_directed[] = {"a", "b", "seed", "algorithm", "threads", "empty", NULL};
     static char *kw_hausdorff[] = {"a", "b", "algorithm", "threads", "seed", "empty", NULL};
-    PyObject *oa, *ob, *threads = Py_None, *seed = NULL;
+    PyObject *oa, *ob, *threads = Py_None, *seed = NULL, *kw2;
     const char *algorithm = "auto", *empty_name = NULL;
     int ok;
-    if (symmetric) {
-        ok = PyArg_ParseTupleAndKeywords(args, kw, "OO|$sOOs:hausdorff", kw_hausdorff, &oa, &ob,
+    if (scipy_names(kw, symmetric ? 2 : 0, symmetric ? "hausdorff" : "directed", &kw2))
+        return NULL;
+    if (symmetric)
+        ok = PyArg_ParseTupleAndKeywords(args, kw2, "OO|$sOOs:hausdorff", kw_hausdorff, &oa, &ob,
                                          &algorithm, &threads, &seed, &empty_name);
-    } else {
-        PyObject *kw2;
-        if (scipy_names(kw, &kw2)) return NULL;
+    else
         ok = PyArg_ParseTupleAndKeywords(args, kw2, "OO|O$sOs:directed", kw_directed, &oa, &ob,
                                          &seed, &algorithm, &threads, &empty_name);
-        Py_XDECREF(kw2);
-    }
+    Py_XDECREF(kw2);
     if (!ok) return NULL;
     hd_options_t opt;
     empty_t empty;
@@ -711,11 +935,21 @@ static PyObject *distance_call(PyObject *args, PyObject *kw, int symmetric) {
     hd_result_t r;
     hd_symmetric_t h;
     hd_error_t err;
-    int rc;
-    Py_BEGIN_ALLOW_THREADS
-    rc = symmetric ? hd_hausdorff(&a.pts, &b.pts, &opt, &h, &err)
-                   : hd_directed(&a.pts, &b.pts, &opt, &r, &err);
-    Py_END_ALLOW_THREADS
+    int rc = HD_OK, early;
+    if (is_nd(&a)) {
+        if (nd_algorithm(algorithm, a.dims, &early) ||
+            (symmetric ? nd_symmetric_result(&a, &b, early, &opt, &h)
+                       : nd_directed_result(&a, &b, early, &opt, &r))) {
+            points_release(&a);
+            points_release(&b);
+            return NULL;
+        }
+    } else {
+        Py_BEGIN_ALLOW_THREADS
+        rc = symmetric ? hd_hausdorff(&a.pts, &b.pts, &opt, &h, &err)
+                       : hd_directed(&a.pts, &b.pts, &opt, &r, &err);
+        Py_END_ALLOW_THREADS
+    }
     points_release(&a);
     points_release(&b);
     if (rc != HD_OK) return raise_hd(rc, &err);
@@ -728,7 +962,8 @@ static PyObject *py_directed(PyObject *self, PyObject *args, PyObject *kw) {
 }
 
 PyDoc_STRVAR(hausdorff_doc,
-"hausdorff($module, a, b, *, algorithm='auto', threads=None, seed=0, empty='error')\n--\n\n"
+"hausdorff($module, a, b, *, algorithm='auto', threads=None, seed=0, rng=None,\n"
+"          empty='error')\n--\n\n"
 "The Hausdorff distance H(a, b) = max(h(a, b), h(b, a)), exact, with the\n"
 "witnesses of both directions.\n"
 "\n"
@@ -797,12 +1032,17 @@ static PyObject *py_distances(PyObject *self, PyObject *args, PyObject *kw) {
     } else if (dist && nearest) {
         hd_error_t err;
         int rc;
+        double *d = PyArray_DATA(dist);
+        size_t *k = PyArray_DATA(nearest);
         Py_BEGIN_ALLOW_THREADS
-        rc = hd_distances(&a.pts, &b.pts, &opt, (double *)PyArray_DATA(dist),
-                          (size_t *)PyArray_DATA(nearest), NULL, NULL, &err);
+        if (is_nd(&a))
+            rc = nd_nearest(a.pts.data, a.pts.count, b.pts.data, b.pts.count, (size_t)a.dims,
+                            resolve_threads(opt.threads), d, k) ? HD_ENOMEM : HD_OK;
+        else
+            rc = hd_distances(&a.pts, &b.pts, &opt, d, k, NULL, NULL, &err);
         Py_END_ALLOW_THREADS
         if (rc == HD_OK) res = Py_BuildValue("(OO)", dist, nearest);
-        else raise_hd(rc, &err);
+        else raise_hd(rc, is_nd(&a) ? NULL : &err);
     }
     Py_XDECREF(dist);
     Py_XDECREF(nearest);
@@ -826,10 +1066,18 @@ static int both_distances(const points_arg_t *a, const points_arg_t *b, int dire
     hd_error_t err;
     int rc;
     Py_BEGIN_ALLOW_THREADS
-    rc = hd_distances(&a->pts, &b->pts, opt, *d_ab, NULL, *d_ba, NULL, &err);
+    if (is_nd(a)) {
+        int threads = resolve_threads(opt->threads);
+        size_t dims = (size_t)a->dims;
+        rc = nd_nearest(a->pts.data, na, b->pts.data, nb, dims, threads, *d_ab, NULL) ||
+                     (!directed && nd_nearest(b->pts.data, nb, a->pts.data, na, dims, threads, *d_ba, NULL))
+                 ? HD_ENOMEM : HD_OK;
+    } else {
+        rc = hd_distances(&a->pts, &b->pts, opt, *d_ab, NULL, *d_ba, NULL, &err);
+    }
     Py_END_ALLOW_THREADS
     if (rc != HD_OK) {
-        raise_hd(rc, &err);
+        raise_hd(rc, is_nd(a) ? NULL : &err);
         return -1;
     }
     return 0;
@@ -1024,7 +1272,8 @@ PyDoc_STRVAR(mean_doc,
 "b, ba of b's points to a, symmetric = max(ab, ba) (the average Hausdorff\n"
 "distance), average = (ab + ba) / 2 and pooled the mean of all the\n"
 "distances of both directions together (MONAI's symmetric average surface\n"
-"distance).  Empty sets as for directed().\n"
+"distance, and medpy's assd, which averages both lists of distances\n"
+"together).  Empty sets as for directed().\n"
 "\n"
 ">>> import numpy as np, hausdorff\n"
 ">>> a = np.array([[0.0, 0, 0], [2, 0, 0]])\n"
@@ -1042,7 +1291,9 @@ PyDoc_STRVAR(chamfer_doc,
 "The Chamfer distance, the command line's --chamfer: the mean squared\n"
 "distance of a's points to b plus the mean squared distance of b's points\n"
 "to a (as PyTorch3D's chamfer_distance).  summary() has the summed and the\n"
-"unsquared variants.  Empty sets as for directed().\n"
+"unsquared variants; point-cloud-utils' chamfer_distance, the sum of the\n"
+"two mean (unsquared) distances, is summary(a, b).chamfer_mean, not this.\n"
+"Empty sets as for directed().\n"
 "\n"
 ">>> import hausdorff\n"
 ">>> hausdorff.chamfer([[0.0, 0, 0], [2, 0, 0]], [[0.0, 0, 1]])\n"
@@ -1073,7 +1324,9 @@ PyDoc_STRVAR(read_doc,
 "refused unless decimal_comma=True, which reads commas as decimal points\n"
 "and ';' or blanks as separators.\n"
 "start and count read points [start, start + count) only (count None: to\n"
-"the end); LAS, LAZ, NPY and binary PLY/PCD/STL then touch only those\n"
+"the end); both are integers of any kind (int, numpy integers, __index__),\n"
+"start >= 0 and count >= 1, below 2**64; LAS, LAZ, NPY and binary\n"
+"PLY/PCD/STL then touch only those\n"
 "records, so processes can share one big file (hausdorff.count gives its\n"
 "size from the header).  A range past the end raises ValueError.\n"
 "The array takes over the memory the reader filled: no copy.\n"
@@ -1087,24 +1340,47 @@ PyDoc_STRVAR(read_doc,
 ">>> hausdorff.read(path).tolist()\n"
 "[[0.0, 0.0, 0.0], [1.0, 2.0, 3.0]]\n");
 
+/* A count or position given to read(): any integer (int, numpy integer,
+ * __index__) from `least` (0 or 1) below 2**64; a float or another type is
+ * a TypeError, anything out of range a ValueError naming the value. */
+static int parse_u64(PyObject *obj, const char *name, int least, unsigned long long *out) {
+    const char *what = least ? "a positive integer" : "a non-negative integer";
+    PyObject *i = as_integer(obj, name, what);
+    if (!i) return -1;
+    int overflow;
+    long long v = PyLong_AsLongLongAndOverflow(i, &overflow);
+    unsigned long long u = 0;
+    int ok = 0;
+    if (overflow > 0) { /* at least 2**63 */
+        u = PyLong_AsUnsignedLongLong(i);
+        ok = !(u == (unsigned long long)-1 && PyErr_Occurred());
+        PyErr_Clear();
+    } else if (!overflow && !(v == -1 && PyErr_Occurred())) {
+        u = (unsigned long long)v;
+        ok = v >= least;
+    }
+    if (!ok && !PyErr_Occurred())
+        PyErr_Format(PyExc_ValueError, "%s must be %s below 2**64, not %S", name, what, i);
+    Py_DECREF(i);
+    *out = u;
+    return ok ? 0 : -1;
+}
+
 static PyObject *py_read(PyObject *self, PyObject *args, PyObject *kw) {
     (void)self;
     static char *kwlist[] = {"path", "format", "float32", "decimal_comma", "start", "count", NULL};
-    PyObject *path = NULL, *count_obj = Py_None;
+    PyObject *path = NULL, *start_obj = NULL, *count_obj = Py_None;
     const char *format = NULL;
     int float32 = 0, decimal_comma = 0;
     unsigned long long start = 0, count = 0;
-    if (!PyArg_ParseTupleAndKeywords(args, kw, "O&|$zppKO:read", kwlist, PyUnicode_FSConverter,
-                                     &path, &format, &float32, &decimal_comma, &start, &count_obj))
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "O&|$zppOO:read", kwlist, PyUnicode_FSConverter,
+                                     &path, &format, &float32, &decimal_comma, &start_obj,
+                                     &count_obj))
         return NULL;
-    if (count_obj != Py_None) {
-        count = PyLong_AsUnsignedLongLong(count_obj);
-        if (PyErr_Occurred() || count == 0) {
-            PyErr_Clear();
-            Py_DECREF(path);
-            PyErr_SetString(PyExc_ValueError, "read: count must be a positive integer or None");
-            return NULL;
-        }
+    if ((start_obj && parse_u64(start_obj, "read: start", 0, &start)) ||
+        (count_obj != Py_None && parse_u64(count_obj, "read: count", 1, &count))) {
+        Py_DECREF(path);
+        return NULL;
     }
     hd_read_options_t ropt;
     hd_read_options_init(&ropt);
@@ -1237,8 +1513,10 @@ PyDoc_STRVAR(index_doc,
 "Queries may move the query set by a rigid (or any affine) transform\n"
 "x -> rotation @ x + translation, applied on the fly in double precision in\n"
 "the order the C header documents, without copying the query.\n"
-"An (N, 2) b is indexed as the points (x, y, 0) (index.points has their\n"
-"three columns), and its queries must then be (N, 2) too.\n"
+"An (N, 2) or (N, 1) b is indexed as its points padded with zeros to 3-D\n"
+"(index.points has the three columns), and its queries must then have b's\n"
+"columns too.  Points of 4 or more coordinates are refused (a transform is\n"
+"3-D); directed(), hausdorff() and distances() take them.\n"
 "\n"
 ">>> import numpy as np, hausdorff\n"
 ">>> index = hausdorff.Index(np.array([[0.0, 0, 0], [1, 0, 0]]))\n"
@@ -1250,6 +1528,38 @@ PyDoc_STRVAR(index_doc,
 ">>> tuple(index.directed(a, translation=[0, 0, -1]))\n"
 "(1.0, 0, 0)\n");
 
+static void owner_capsule_free(PyObject *capsule) {
+    PyObject *arr = PyCapsule_GetPointer(capsule, "hausdorff.owner");
+    Py_XDECREF(arr);
+}
+
+/* A read-only array of arr's data, whose reference it takes, with a capsule
+ * owning arr as its base.  numpy lets setflags(write=True) succeed only
+ * when an array owns its data or its base chain ends in a writable buffer;
+ * a capsule is neither, so the array can never be made writable, and arr,
+ * reachable only through the capsule, is never written either. */
+static PyArrayObject *read_only_view(PyArrayObject *arr) {
+    PyObject *capsule = PyCapsule_New(arr, "hausdorff.owner", owner_capsule_free);
+    if (!capsule) {
+        Py_DECREF(arr);
+        return NULL;
+    }
+    PyArray_Descr *descr = PyArray_DESCR(arr);
+    Py_INCREF(descr);
+    PyArrayObject *view = (PyArrayObject *)PyArray_NewFromDescr(
+        &PyArray_Type, descr, PyArray_NDIM(arr), PyArray_DIMS(arr), PyArray_STRIDES(arr),
+        PyArray_DATA(arr), 0 /* not writeable */, NULL);
+    if (!view) {
+        Py_DECREF(capsule);
+        return NULL;
+    }
+    if (PyArray_SetBaseObject(view, capsule) < 0) { /* steals capsule */
+        Py_DECREF(view);
+        return NULL;
+    }
+    return view;
+}
+
 static PyObject *Index_new(PyTypeObject *type, PyObject *args, PyObject *kw) {
     static char *kwlist[] = {"b", "threads", NULL};
     PyObject *ob, *threads = Py_None;
@@ -1260,12 +1570,19 @@ static PyObject *Index_new(PyTypeObject *type, PyObject *args, PyObject *kw) {
     points_arg_t b;
     if (points_from_object(ob, "b", EMPTY_NONE, &b)) return NULL;
     int dims = b.dims;
-    /* (N, 2) points were lifted into an array of our own already. */
-    PyArrayObject *own = dims == 2 ? b.arr : (PyArrayObject *)PyArray_NewCopy(b.arr, NPY_CORDER);
-    if (dims == 2) b.arr = NULL;
+    if (is_nd(&b)) {
+        points_release(&b);
+        PyErr_Format(PyExc_ValueError,
+                     "Index takes points of 1, 2 or 3 coordinates (its queries move them by a 3-D "
+                     "transform), got %d; directed(), hausdorff() and distances() take any", dims);
+        return NULL;
+    }
+    /* Points of 1 or 2 coordinates were lifted into an array of our own already. */
+    PyArrayObject *copy = dims < 3 ? b.arr : (PyArrayObject *)PyArray_NewCopy(b.arr, NPY_CORDER);
+    if (dims < 3) b.arr = NULL;
     points_release(&b);
+    PyArrayObject *own = copy ? read_only_view(copy) : NULL;
     if (!own) return NULL;
-    PyArray_CLEARFLAGS(own, NPY_ARRAY_WRITEABLE);
     IndexObject *self = (IndexObject *)type->tp_alloc(type, 0);
     if (!self) {
         Py_DECREF(own);
@@ -1393,7 +1710,8 @@ static PyGetSetDef Index_getset[] = {
     {"memory", (getter)Index_get_memory, NULL,
      "bytes the index allocated itself (not counting its copy of the points)", NULL},
     {"points", (getter)Index_get_points, NULL,
-     "the indexed points: the index's own read-only copy of b", NULL},
+     "the indexed points: the index's own copy of b, read-only for good "
+     "(setflags(write=True) raises)", NULL},
     {NULL, NULL, NULL, NULL, NULL},
 };
 

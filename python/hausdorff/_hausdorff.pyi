@@ -5,13 +5,26 @@ from typing import Dict, List, Literal, Optional, Sequence, Tuple, Union, overlo
 import numpy as np
 import numpy.typing as npt
 
-# Any (N, 3) or (N, 2) array-like of real numbers (a point (x, y) is
-# (x, y, 0)); float32 and float64 (N, 3) arrays are read in place (C or
-# Fortran order, strided or reversed views).
+# Any (N, D) array-like of real numbers or booleans, D >= 1 coordinates
+# (both sets alike; 1 and 2 are lifted to 3-D exactly, 4 and more computed
+# by the module's own engine); float32 and float64 (N, 3) arrays are read in
+# place (C or Fortran order, strided or reversed views).
 Points = npt.ArrayLike
-# What an empty set gives: an error, inf, NaN, 0, or as MONAI (inf when one
-# set is empty, NaN when both are).
-Empty = Literal["error", "inf", "nan", "zero", "monai"]
+# What an empty set gives: an error, inf, NaN, 0, as MONAI (inf when one set
+# is empty, NaN when both are) or as scikit-image (inf when one set is
+# empty, 0 when both are).
+Empty = Literal["error", "inf", "nan", "zero", "monai", "skimage"]
+# A seed: it never changes the answer.  None, any integer (modulo 2**64), or
+# a numpy random generator object (left untouched), as scipy takes them.
+Seed = Union[
+    None,
+    int,
+    np.integer,
+    np.random.Generator,
+    np.random.RandomState,
+    np.random.BitGenerator,
+    np.random.SeedSequence,
+]
 Matrix3 = npt.ArrayLike  # (3, 3)
 Vector3 = npt.ArrayLike  # (3,)
 
@@ -121,8 +134,9 @@ class Summary(Tuple[Union[int, float], ...]):
 def directed(
     a: Points,
     b: Points,
-    seed: Optional[int] = 0,
+    seed: Seed = 0,
     *,
+    rng: Seed = None,
     algorithm: str = "auto",
     threads: Optional[int] = None,
     empty: Empty = "error",
@@ -133,7 +147,8 @@ def hausdorff(
     *,
     algorithm: str = "auto",
     threads: Optional[int] = None,
-    seed: Optional[int] = 0,
+    seed: Seed = 0,
+    rng: Seed = None,
     empty: Empty = "error",
 ) -> HausdorffResult: ...
 def distances(

@@ -2,10 +2,10 @@
 seeded point sets, and the repository's data directory.
 
 The brute force evaluates squared distances as dx*dx + dy*dy + dz*dz, left to
-right, one numpy operation at a time (numpy never fuses a multiply into an
-add), takes the first index of each minimum and maximum (numpy's argmin and
-argmax return the first), and one sqrt at the end: the definition the library
-promises to match to the bit.
+right (as many terms as the points have coordinates), one numpy operation at
+a time (numpy never fuses a multiply into an add), takes the first index of
+each minimum and maximum (numpy's argmin and argmax return the first), and
+one sqrt at the end: the definition the library promises to match to the bit.
 """
 import os
 import pathlib
@@ -24,16 +24,16 @@ def as_f64(x):
 
 def brute_nearest(a, b, chunk=2048):
     """Squared nearest distance of every point of a to b, and the smallest
-    index attaining it."""
+    index attaining it; points of any number of coordinates."""
     a, b = as_f64(a), as_f64(b)
     d2 = np.empty(len(a))
     j = np.empty(len(a), dtype=np.intp)
     for s in range(0, len(a), chunk):
         p = a[s:s + chunk]
-        dx = p[:, None, 0] - b[None, :, 0]
-        dy = p[:, None, 1] - b[None, :, 1]
-        dz = p[:, None, 2] - b[None, :, 2]
-        m = dx * dx + dy * dy + dz * dz
+        m = None
+        for c in range(a.shape[1]):   # columns summed left to right
+            d = p[:, None, c] - b[None, :, c]
+            m = d * d if m is None else m + d * d
         k = np.argmin(m, axis=1)
         j[s:s + chunk] = k
         d2[s:s + chunk] = m[np.arange(len(p)), k]
@@ -41,10 +41,13 @@ def brute_nearest(a, b, chunk=2048):
 
 
 def distance(p, q):
-    """|p - q| evaluated as the library does."""
+    """|p - q| evaluated as the library does (any number of coordinates)."""
     p, q = as_f64(p), as_f64(q)
     d = p - q
-    return float(np.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]))
+    s = d[0] * d[0]
+    for c in range(1, len(d)):
+        s = s + d[c] * d[c]
+    return float(np.sqrt(s))
 
 
 def brute_directed(a, b):

@@ -1,6 +1,7 @@
 """empty=: what the distance functions give for an empty set, as the command
 line's --empty (error, inf, nan, zero) plus MONAI's rule (inf when one set is
-empty, NaN when both are)."""
+empty, NaN when both are) and scikit-image's (inf when one set is empty, 0
+when both are)."""
 import math
 
 import numpy as np
@@ -14,10 +15,12 @@ P = gauss(301, 20)
 
 # (a, b, which) for one set empty, the other, both; `[]` is an empty set too.
 SETS = [(E, P, "a"), (P, E, "b"), (E, E, "both"), ([], P, "a"), (P, [], "b"),
-        (np.zeros((0, 2)), P[:, :2], "a")]
+        (np.zeros((0, 2)), P[:, :2], "a"), (np.zeros((0, 5)), np.ones((3, 5)), "a"),
+        (np.zeros((0, 1)), np.zeros((0, 1)), "both")]
 
 POLICY = {"inf": lambda both: math.inf, "nan": lambda both: math.nan,
-          "zero": lambda both: 0.0, "monai": lambda both: math.nan if both else math.inf}
+          "zero": lambda both: 0.0, "monai": lambda both: math.nan if both else math.inf,
+          "skimage": lambda both: 0.0 if both else math.inf}
 
 
 def same(x, y):
@@ -100,3 +103,13 @@ def test_index_still_refuses_empty_sets():
         hausdorff.Index(E)
     with pytest.raises(ValueError, match="a is empty"):
         hausdorff.Index(P).directed(E)
+
+
+def test_skimage_rule_is_its_hausdorff_distance_of_empty_sets():
+    """skimage.metrics.hausdorff_distance: 0 when both point sets are
+    empty, inf when only one is."""
+    assert hausdorff.hausdorff(E, E, empty="skimage").distance == 0.0
+    assert hausdorff.hausdorff(E, P, empty="skimage").distance == math.inf
+    assert hausdorff.hausdorff(P, E, empty="skimage").distance == math.inf
+    assert tuple(hausdorff.hausdorff(P, P[:3], empty="skimage").ab) == \
+        tuple(hausdorff.hausdorff(P, P[:3]).ab)                # sets with points: no effect

@@ -59,6 +59,24 @@ def test_index_keeps_its_own_copy_of_the_points():
         index.points[0, 0] = 1.0
 
 
+def test_index_points_can_never_be_made_writable():
+    """setflags(write=True) succeeded on the index's own array, and writing
+    then changed the index's answers; its owner is now read-only."""
+    b, a = gauss(89, 100), gauss(90, 50)
+    expected = brute_directed(a, b)
+    for pts in (b, b[:, :2], b[:, :1], b.astype(np.float32)):
+        index = hausdorff.Index(pts)
+        for view in (index.points, index.points[::2], index.points.view()):
+            with pytest.raises(ValueError, match="WRITEABLE"):
+                view.setflags(write=True)
+            assert not view.flags.writeable
+        with pytest.raises(ValueError):
+            np.copyto(index.points, 0.0)
+    index = hausdorff.Index(b)
+    assert tuple(index.directed(a)) == expected
+    assert np.array_equal(index.points, b)
+
+
 def test_index_float32_points_stay_float32():
     b = gauss(89, 500).astype(np.float32)
     index = hausdorff.Index(b)

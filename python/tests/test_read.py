@@ -65,6 +65,42 @@ def test_read_a_range_and_count_from_the_header(tmp_path):
         hausdorff.count(text)
 
 
+class Indexable:
+    def __init__(self, v):
+        self.v = v
+
+    def __index__(self):
+        return self.v
+
+
+def test_start_and_count_are_integers_of_any_kind_never_wrapped(tmp_path):
+    """start was taken modulo 2**64: 2**64 + 5 read from point 5 and -1 was
+    reported as 18446744073709551615.  Both are parsed as count is: any
+    integer (numpy's, __index__), out of range a ValueError naming the value,
+    a float a TypeError."""
+    pts = np.random.default_rng(134).normal(size=(20, 3))
+    path = tmp_path / "p.npy"
+    np.save(path, pts)
+    for make in (int, np.int64, np.uint32, Indexable):
+        assert np.array_equal(hausdorff.read(path, start=make(3), count=make(4)), pts[3:7])
+    for start in (2**64 + 5, 2**64, -1, np.int64(-1)):
+        for count in (None, 1):
+            with pytest.raises(ValueError, match=r"read: start must be a non-negative integer "
+                                                 r"below 2\*\*64, not -?\d+$") as e:
+                hausdorff.read(path, start=start, count=count)
+            assert "18446744073709551615" not in str(e.value) and "overflows" not in str(e.value)
+    for count in (2**64, -1, 0):
+        with pytest.raises(ValueError, match=r"read: count must be a positive integer below 2\*\*64"):
+            hausdorff.read(path, count=count)
+    for bad in (1.0, "1", np.float64(2)):
+        with pytest.raises(TypeError, match="start"):
+            hausdorff.read(path, start=bad)
+        with pytest.raises(TypeError, match="count"):
+            hausdorff.read(path, count=bad)
+    with pytest.raises(ValueError, match=r"start 18446744073709551615 is not below the file's 20"):
+        hausdorff.read(path, start=2**64 - 1)
+
+
 def test_read_errors_map_to_python_exceptions(tmp_path):
     with pytest.raises(OSError, match="cannot open"):
         hausdorff.read(tmp_path / "missing.xyz")

@@ -70,9 +70,22 @@ def exercise(a, b, af32, path):
     hausdorff.percentile(e, b, [50, 95], empty="inf")
     hausdorff.distances(a, e, empty="zero")
     hausdorff.summary(e, e, empty="nan")
-    for bad in (np.zeros((0, 3)), np.full((2, 3), np.nan), np.zeros((2, 2)), np.zeros((2, 4))):
+    wide_a, wide_b = a[:, [0, 1, 2, 0, 1]], b[:, [2, 1, 0, 2, 1]]   # 5 coordinates: _ndim.c
+    hausdorff.directed(wide_a, wide_b, rng=np.random.default_rng(1))
+    hausdorff.hausdorff(wide_a, wide_b, algorithm="naive")
+    hausdorff.distances(wide_a, wide_b)
+    hausdorff.summary(wide_a, wide_b)
+    hausdorff.directed(a[:, :1] > 0, b[:, :1] > 0)
+    for bad in (np.zeros((0, 3)), np.full((2, 3), np.nan), np.zeros((2, 2)), np.zeros((2, 4)),
+                np.full((2, 5), np.inf)):
         with pytest.raises(ValueError):
-            hausdorff.directed(bad, b)
+            hausdorff.directed(bad, b if bad.shape[1] != 5 else wide_b)
+    with pytest.raises(ValueError):
+        hausdorff.directed(wide_a, wide_b, algorithm="kdtree")
+    with pytest.raises(ValueError):
+        hausdorff.Index(wide_b)
+    with pytest.raises(ValueError):
+        hausdorff.read(path, start=-1)
     with pytest.raises(TypeError):
         hausdorff.directed(u=a, a=a, v=b)
     with pytest.raises(OSError):

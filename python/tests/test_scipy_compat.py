@@ -1,7 +1,8 @@
 """directed() as a drop-in for scipy.spatial.distance.directed_hausdorff: the
-same call forms (seed positional or keyword, scipy's u= and v= names), the
-same tuple, (N, 2) points, and integers of any kind (numpy's included)
-wherever an int is taken."""
+same call forms (seed positional or keyword, scipy's u= and v= names, scipy
+1.15's rng= and numpy generators as seeds), the same tuple, (N, 2) points,
+and integers of any kind (numpy's included) wherever an int is taken.
+Points of other dimensions: test_dimensions.py."""
 import numpy as np
 import pytest
 
@@ -104,10 +105,69 @@ def test_two_dimensional_points_work_in_every_function():
         index.directed(A)
 
 
-@pytest.mark.parametrize("shape", [(10, 1), (10, 4), (10, 7)])
-def test_other_dimensions_are_refused_clearly(shape):
-    with pytest.raises(ValueError, match=r"\(N, 3\) or \(N, 2\) array of points, got shape"):
+@pytest.mark.parametrize("shape", [(3,), (2, 3, 1), (10, 0)])
+def test_arrays_that_are_not_rows_of_points_are_refused_clearly(shape):
+    with pytest.raises(ValueError, match=r"a must be an \(N, D\) array of N points of D >= 1 "
+                                         r"coordinates, got shape"):
         hausdorff.directed(np.zeros(shape), np.zeros(shape))
+
+
+# scipy's test_subsets case (gh-11332): its witness depends on the seed,
+# ours is the canonical one, the smallest i and then the smallest j.
+SUBSET_A, SUBSET_B, SUBSET_CANONICAL = [(-5, 3), (0, 0)], [(0, 1), (0, 0), (-5, 3)], (0.0, 0, 2)
+
+SEEDS = {  # every seed scipy 1.15+ documents for seed= and rng=, and integers of any size
+    "None": lambda: None, "0": lambda: 0, "np.int64(0)": lambda: np.int64(0),
+    "77098": lambda: 77098, "2**64 + 5": lambda: 2**64 + 5, "2**300": lambda: 2**300,
+    "-1": lambda: -1, "Generator": lambda: np.random.default_rng(77098),
+    "RandomState": lambda: np.random.RandomState(3), "BitGenerator": lambda: np.random.PCG64(5),
+    "SeedSequence": lambda: np.random.SeedSequence(9),
+}
+
+
+@pytest.mark.parametrize("seed", sorted(SEEDS))
+def test_scipy_115_seed_and_rng_forms_are_accepted(seed):
+    """scipy 1.15 renamed seed to rng (directed_hausdorff(u, v, rng=0)),
+    keeping seed= by keyword; both take an int, a Generator, a RandomState
+    or None.  The seed never changes our answer."""
+    A, B = SUBSET_A, SUBSET_B
+    calls = [
+        lambda s: hausdorff.directed(u=A, v=B, seed=s),
+        lambda s: hausdorff.directed(u=A, v=B, rng=s),
+        lambda s: hausdorff.directed(A, B, s),
+        lambda s: hausdorff.directed(A, B, rng=s),
+        lambda s: hausdorff.hausdorff(A, B, rng=s).ab,
+        lambda s: hausdorff.hausdorff(A, B, seed=s).ab,
+    ]
+    for call in calls:
+        assert tuple(call(SEEDS[seed]())) == SUBSET_CANONICAL
+    a, b = gauss(231, 300), gauss(232, 200)
+    expected = brute_directed(a, b)
+    for algorithm in ("earlybreak", "ohd", "auto"):
+        assert tuple(hausdorff.directed(a, b, rng=SEEDS[seed](), algorithm=algorithm)) == expected
+
+
+def test_a_generator_given_as_seed_is_left_untouched():
+    """Nothing is drawn from it (scipy's shuffle would advance it), and
+    numpy's global state is untouched too."""
+    a, b = gauss(233, 50), gauss(234, 40)
+    g, rs = np.random.default_rng(5), np.random.RandomState(6)
+    before = (g.bit_generator.state, rs.get_state()[1].copy(), np.random.get_state()[1].copy())
+    hausdorff.directed(a, b, rng=g)
+    hausdorff.directed(a, b, rs)
+    hausdorff.hausdorff(a, b, seed=g)
+    assert g.bit_generator.state == before[0]
+    assert (rs.get_state()[1] == before[1]).all() and (np.random.get_state()[1] == before[2]).all()
+
+
+def test_seed_and_rng_cannot_both_be_given():
+    a, b = gauss(235, 5), gauss(236, 5)
+    with pytest.raises(TypeError, match="'seed' and 'rng'"):
+        hausdorff.directed(a, b, seed=1, rng=1)
+    with pytest.raises(TypeError, match="'seed' and 'rng'"):
+        hausdorff.hausdorff(a, b, seed=1, rng=2)
+    with pytest.raises(TypeError):
+        hausdorff.directed(a, b, 1, rng=1)         # positional seed and rng=
 
 
 def test_different_numbers_of_columns_are_refused_as_scipy_does():
@@ -142,12 +202,12 @@ def test_numpy_integers_and_index_objects_are_integers(make):
 
 def test_non_integers_are_still_refused():
     a, b = gauss(225, 5), gauss(226, 5)
-    for bad in (1.5, np.float64(2.0), "3"):
+    for bad in (1.5, np.float64(2.0), "3", [1]):
         with pytest.raises(TypeError, match="threads"):
             hausdorff.directed(a, b, threads=bad)
-        with pytest.raises(TypeError, match="seed"):
+        with pytest.raises(TypeError, match="seed must be None, an integer or a numpy random generator"):
             hausdorff.directed(a, b, seed=bad)
-    with pytest.raises(ValueError, match="seed"):
-        hausdorff.directed(a, b, np.int64(-1))
+        with pytest.raises(TypeError, match="seed"):
+            hausdorff.directed(a, b, rng=bad)
     with pytest.raises(ValueError, match="threads"):
         hausdorff.directed(a, b, threads=np.int8(-2))

@@ -36,10 +36,6 @@ test_massive_arr_overflow = scipy_tests.test_massive_arr_overflow
 # test id (after the file's "::") -> (the exception it fails with, why
 # hausdorff.directed differs); failing with any other exception is a failure.
 EXPECTED_FAILURES = {
-    "TestHausdorff::test_4d_data_reverse": (
-        ValueError,
-        "4-D points are refused with a ValueError: the library computes in 3-D "
-        "((N, 2) points are lifted to (x, y, 0) exactly; a 4th coordinate cannot be)"),
     "TestHausdorff::test_subsets[A2-B2-77098-expected2]": (
         AssertionError,
         "a tie: both points of A lie in B, so every pair (i, nearest j) realises 0.0; "

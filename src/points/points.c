@@ -133,8 +133,8 @@ int hd__points_check(const hd_points_t *p, const char *what, hd__box_t *box,
         for (int c = 0; c < 3; c++) {
             if (!isfinite(q[c]))
                 return hd__err(err, HD_ENONFINITE,
-                               "point set %s: point %zu has a %s coordinate", what,
-                               k, isnan(q[c]) ? "NaN" : "infinite");
+                               "point set %s: point %zu has %s coordinate", what,
+                               k, isnan(q[c]) ? "a NaN" : "an infinite");
             if (fabs(q[c]) > HD_MAX_COORD)
                 return hd__err(err, HD_ERANGE,
                                "point set %s: point %zu has coordinate %g, beyond "
