@@ -182,8 +182,9 @@ typedef struct {
     hd__intcoder_t cic;            /* v1 */
     /* BYTE */
     unsigned nb;
-    hd__symmodel_t *bm; /* v2: nb models */
-    hd__intcoder_t bic; /* v1: nb contexts */
+    hd__symmodel_t **bm; /* v2: nb models, each created at its first symbol
+                            (see bytes_read) */
+    hd__intcoder_t bic;  /* v1: nb contexts */
 } pw_t;
 
 static void pw_free(pw_t *w) {
@@ -201,7 +202,11 @@ static void pw_free(pw_t *w) {
     hd__intcoder_t *ics[] = {&w->intensity, &w->psid, &w->dx, &w->dy, &w->dz, &w->scan1, &w->gic, &w->cic, &w->bic};
     for (size_t i = 0; i < sizeof ics / sizeof ics[0]; i++) hd__intcoder_free(ics[i]);
     if (w->bm)
-        for (unsigned i = 0; i < w->nb; i++) hd__symmodel_free(&w->bm[i]);
+        for (unsigned i = 0; i < w->nb; i++)
+            if (w->bm[i]) {
+                hd__symmodel_free(w->bm[i]);
+                free(w->bm[i]);
+            }
     free(w->bm);
 }
 
@@ -241,7 +246,6 @@ static int pw_new(pw_t *w, const laz_t *z) {
             }
             w->bm = calloc(w->nb, sizeof *w->bm);
             if (!w->bm) return HD_ENOMEM;
-            for (unsigned k = 0; k < w->nb && rc == HD_OK; k++) rc = hd__symmodel_new(&w->bm[k], 256);
         }
     }
     return rc;
@@ -480,11 +484,25 @@ static void rgb_read(pw_t *c, hd__dec_t *d, int v2) {
         if ((sym & (1u << k)) && (k < 2 || (sym & 64))) hd__dec_symbol(d, &c->cdiff[k]);
     }
 }
-static void bytes_read(pw_t *c, hd__dec_t *d, int v2) {
-    for (unsigned k = 0; k < c->nb; k++) {
-        if (v2) hd__dec_symbol(d, &c->bm[k]);
-        else hd__ic_decode(&c->bic, d, 0, k);
+/* BYTE v2 gives each extra byte a model of 256 symbols, created here at its
+ * first symbol (a model's state depends only on the symbols coded with it,
+ * so this is the model LASzip creates with the chunk); a new model is
+ * uniform, so its first symbol costs 8 bits,
+ * and stopping once the decoder runs past its bytes keeps the models
+ * created to about one per byte of the stream (a record of 65,515 extra
+ * bytes would otherwise cost 150 MB of models whatever the file's size).
+ * 0, or -1 when a model could not be allocated. */
+static int bytes_read(pw_t *c, hd__dec_t *d, int v2) {
+    for (unsigned k = 0; k < c->nb && d->over <= 4; k++) {
+        if (!v2) {
+            hd__ic_decode(&c->bic, d, 0, k);
+            continue;
+        }
+        hd__symmodel_t *m = lazy(&c->bm[k], 256);
+        if (!m) return -1;
+        hd__dec_symbol(d, m);
     }
+    return 0;
 }
 
 /* The end of a stream once its chunk's (or layer's) last point is decoded:
@@ -546,8 +564,9 @@ static void pointwise_points(job_t *j, pw_t *w, hd__dec_t *d, size_t n) {
                 }
             } else if (ty == IT_RGB12) {
                 rgb_read(w, d, iv2);
-            } else {
-                bytes_read(w, d, iv2);
+            } else if (bytes_read(w, d, iv2)) {
+                fail(j, HD_ENOMEM, at, "out of memory");
+                return;
             }
         }
         if (d->over > 4) return;

@@ -15,6 +15,9 @@
 #include "io/io.h"
 
 #include <stdlib.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 static const lazw_opts_t plain = {0, 0, 50, NULL, 0, {0.01, 0.01, 0.001}, {1000.5, -20.25, 3}, 0};
 
@@ -491,4 +494,51 @@ TEST(laszip_items_whose_version_is_not_the_one_the_data_was_written_with_are_ref
         tf_free(&b);
         free(p);
     }
+}
+
+/* ---- memory bounded by the file ---------------------------------------------- */
+/* The growth of the peak resident memory (MiB, capped at 255) of reading b
+ * in a child process with one thread; -1 if the child failed to report. */
+static int read_growth_mib(const tf_buf_t *b) {
+    pid_t pid = fork();
+    if (pid == 0) {
+        struct rusage u0, u1;
+        getrusage(RUSAGE_SELF, &u0);
+        hd_cloud_t *c = NULL;
+        hd_error_t e;
+        read_laz(b, 1, HD_FLOAT64, &c, &e);
+        hd_cloud_free(c);
+        getrusage(RUSAGE_SELF, &u1);
+        long mib = (u1.ru_maxrss - u0.ru_maxrss) / 1024;
+        _exit(mib > 255 ? 255 : (int)mib);
+    }
+    int status = 0;
+    if (pid < 0 || waitpid(pid, &status, 0) != pid || !WIFEXITED(status)) return -1;
+    return WEXITSTATUS(status);
+}
+
+TEST(a_record_of_65515_extra_bytes_with_a_stream_of_four_creates_models_only_for_what_it_decodes) {
+    /* one point of 65,515 extra bytes (a 66 KB file) whose header says two:
+     * the second point's BYTE symbols run past the four-byte stream at
+     * once; creating every extra byte's model up front cost 150 MB */
+    lazw_point_t p[1] = {{1, 2, 3, 1, 1, 0}};
+    lazw_opts_t o = plain;
+    o.extra = 65515;
+    o.chunk_size = 1000;
+    tf_buf_t b = {0};
+    lazw_encode(&b, &o, p, 1);
+    CHECK(b.size < 67000);
+    put_u32(&b, 107, 2);
+    refused(&b, HD_EFORMAT, "ran past the chunk's end", -1);
+    int mib = read_growth_mib(&b);
+    if (mib < 0 || mib > 32) hdt_fail(__FILE__, __LINE__, "reading grew the resident memory by %d MiB", mib);
+    tf_free(&b);
+}
+
+TEST(extra_bytes_models_created_at_first_use_decode_a_record_of_65515_extra_bytes) {
+    lazw_point_t *p = points(51, 3, 0);
+    lazw_opts_t o = plain;
+    o.extra = 65515;
+    round_trip(&o, p, 3, 1);
+    free(p);
 }
