@@ -527,11 +527,27 @@ typedef struct hd_read_options {
                               formats are read whole, then cut.  A bad point
                               outside the range is not seen. */
     uint64_t range_count;  /* 0 (default): the whole file */
+    unsigned laz_points_per_byte; /* LAZ: the most points a chunk may hold
+                              per byte of it, which bounds the memory a
+                              small file can ask for (the result's
+                              coordinates, 24 bytes a point in double):
+                              0 = HD_LAZ_POINTS_PER_BYTE; at most
+                              HD_LAZ_POINTS_PER_BYTE_MAX (HD_EINVAL
+                              above).  Real surveys hold under one point
+                              a byte; degenerate data (one point repeated,
+                              a flat grid) up to 147 in LASzip's chunks of
+                              50,000 points and about 600 in one chunk of
+                              millions. */
 } hd_read_options_t;
 
 /* The defaults of stream_limit (2 GiB) and fifo_wait_ms (30 s). */
 #define HD_STREAM_LIMIT ((uint64_t)2 << 30)
 #define HD_FIFO_WAIT_MS 30000
+/* The default of laz_points_per_byte, and its largest value (a LAZ point
+ * costs at least a few thousandths of a bit in the format's most skewed
+ * models). */
+#define HD_LAZ_POINTS_PER_BYTE 256
+#define HD_LAZ_POINTS_PER_BYTE_MAX 4096
 
 /* Fill `opt` with the defaults (by extension, double, vertices). */
 HD_EXTERN void hd_read_options_init(hd_read_options_t *opt);

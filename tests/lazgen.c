@@ -135,6 +135,14 @@ static int seeds(const char *dir) {
     lazw_encode(&b, &r, same, 40000);
     int rc = save(dir, "fmt0_repeated_point", &b);
     tf_free(&b);
+    /* a million copies of one point in one chunk, about 500 a byte: denser
+     * than the reader's default limit (--laz-points-per-byte raises it) */
+    static lazw_point_t many[1000000];
+    for (size_t k = 0; k < 1000000; k++) many[k] = (lazw_point_t){1, 2, 3, 1, 1, 0};
+    r.chunk_size = 1000000;
+    lazw_encode(&b, &r, many, 1000000);
+    rc |= save(dir, "regress-dense-1000000-points", &b);
+    tf_free(&b);
     return rc | lies(dir);
 }
 

@@ -45,9 +45,12 @@
  * start, its chunk count is at most the bytes before it (each chunk is at
  * least one byte), every chunk has bytes and ends before the table, the
  * points per chunk add up to the header's count, and no chunk claims more
- * points than HD__LAZ_POINTS_PER_BYTE per byte of it (a point costs at
- * least a few thousandths of a bit in the format's most skewed models;
- * the limit is generous for real files, see docs/formats.md), and above
+ * points per byte of it than the read options' laz_points_per_byte
+ * (default HD_LAZ_POINTS_PER_BYTE, which degenerate data in LASzip's
+ * chunks stays below; never above HD_LAZ_POINTS_PER_BYTE_MAX: a point
+ * costs at least a few thousandths of a bit in the format's most skewed
+ * models; see docs/formats.md), so that a file's result is bounded by its
+ * size, and above
  * HD__LAZ_EAGER_PER_BYTE points per byte the result is not allocated up
  * front but grown while the chunks are decoded in order, so that only
  * decoded points cost memory; a chunk's
@@ -94,6 +97,7 @@ typedef struct {
     size_t n_chunks;
     uint64_t *start; /* n_chunks + 1 byte offsets */
     uint64_t *first; /* n_chunks + 1 cumulative point counts */
+    unsigned per_byte; /* the most points a chunk may hold per byte of it */
     uint64_t lo, hi; /* the points kept: [lo, hi) of the file's (a range
                         read keeps part; chunks outside it are not decoded) */
     double scale[3], shift[3];
@@ -890,6 +894,22 @@ static int parse_vlr(laz_t *z, const hd__las_header_t *h, uint32_t *chunk_size) 
     return HD_OK;
 }
 
+/* Chunk c of nc, at `at`, claims more than z->per_byte points a byte.
+ * Above HD_LAZ_POINTS_PER_BYTE_MAX no stream can hold them (HD_EFORMAT);
+ * below, the file may be degenerate data, refused by the limit that bounds
+ * its memory, which the message says how to raise (HD_EUNSUPPORTED). */
+static int too_dense(laz_t *z, long long at, size_t c, size_t nc, uint64_t pts, uint64_t bytes) {
+    if (pts > bytes * HD_LAZ_POINTS_PER_BYTE_MAX)
+        return hd__io_err_at(z->r, HD_EFORMAT, at, "chunk %zu of %zu claims %llu points in %llu bytes (no stream holds more than %d a byte)",
+                             c, nc, (unsigned long long)pts, (unsigned long long)bytes, HD_LAZ_POINTS_PER_BYTE_MAX);
+    return hd__io_err_at(z->r, HD_EUNSUPPORTED, at,
+                         "chunk %zu of %zu claims %llu points in %llu bytes, %.0f a byte: above the limit of %u points a "
+                         "compressed byte (%s), which bounds the memory a LAZ file may ask for; raise it up to %d with "
+                         "--laz-points-per-byte N (read option laz_points_per_byte)",
+                         c, nc, (unsigned long long)pts, (unsigned long long)bytes, ceil((double)pts / (double)bytes), z->per_byte,
+                         z->per_byte == HD_LAZ_POINTS_PER_BYTE ? "the default" : "as asked", HD_LAZ_POINTS_PER_BYTE_MAX);
+}
+
 static int read_table(laz_t *z, const hd__las_header_t *h, uint32_t chunk_size) {
     hd__read_t *r = z->r;
     size_t data = h->offset + 8;
@@ -946,9 +966,8 @@ static int read_table(laz_t *z, const hd__las_header_t *h, uint32_t chunk_size) 
         else if (z->first[i + 1] > count)
             rc = hd__io_err_at(r, HD_EFORMAT, (long long)t + 8, "the chunks hold more than the header's %llu points",
                                (unsigned long long)count);
-        else if (pts > (uint64_t)bytes * HD__LAZ_POINTS_PER_BYTE)
-            rc = hd__io_err_at(r, HD_EFORMAT, (long long)z->start[i], "chunk %u of %u claims %u points in %u bytes (at most %d per byte)",
-                               i + 1, nc, pts, bytes, HD__LAZ_POINTS_PER_BYTE);
+        else if (pts > (uint64_t)bytes * z->per_byte)
+            rc = too_dense(z, (long long)z->start[i], i + 1, nc, pts, bytes);
     }
     hd__intcoder_free(&ic);
     if (rc == HD_OK && z->first[nc] != count)
@@ -969,9 +988,7 @@ static int one_chunk(laz_t *z, const hd__las_header_t *h) {
     z->start[1] = end;
     z->first[0] = 0;
     z->first[1] = h->count;
-    if (h->count > (uint64_t)(end - h->offset) * HD__LAZ_POINTS_PER_BYTE)
-        return hd__io_err_at(z->r, HD_EFORMAT, 107, "%llu points in %zu bytes of compressed data (at most %d per byte)",
-                             (unsigned long long)h->count, end - h->offset, HD__LAZ_POINTS_PER_BYTE);
+    if (h->count > (uint64_t)(end - h->offset) * z->per_byte) return too_dense(z, 107, 1, 1, h->count, end - h->offset);
     return HD_OK;
 }
 
@@ -1069,6 +1086,10 @@ int hd__read_laz(hd__read_t *r, const hd__las_header_t *h) {
         z.scale[c] = h->scale[c];
         z.shift[c] = h->shift[c];
     }
+    z.per_byte = r->opt->laz_points_per_byte ? r->opt->laz_points_per_byte : HD_LAZ_POINTS_PER_BYTE;
+    if (z.per_byte > HD_LAZ_POINTS_PER_BYTE_MAX)
+        return hd__io_err(r, HD_EINVAL, "laz_points_per_byte %u is above %d (no LAZ stream holds more points a byte)", z.per_byte,
+                          HD_LAZ_POINTS_PER_BYTE_MAX);
     uint32_t chunk_size = 0;
     int rc = parse_vlr(&z, h, &chunk_size);
     if (rc == HD_OK && h->count == 0) return r->count_only ? HD__COUNTED : HD_OK; /* total stays 0 */

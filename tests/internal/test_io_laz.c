@@ -23,11 +23,13 @@ static const lazw_opts_t plain = {0, 0, 50, NULL, 0, {0.01, 0.01, 0.001}, {1000.
 
 /* Read the LAZ bytes b with `threads`; HD_OK and the cloud, or the code
  * and the message in e. */
+static unsigned per_byte; /* the read options' laz_points_per_byte (0: default) */
 static int read_laz(const tf_buf_t *b, int threads, hd_dtype_t dtype, hd_cloud_t **c, hd_error_t *e) {
     hd_read_options_t o;
     hd_read_options_init(&o);
     o.threads = threads;
     o.dtype = dtype;
+    o.laz_points_per_byte = per_byte;
     return hd__read_buffer(b->data, b->size, "t.laz", &o, c, e);
 }
 
@@ -136,8 +138,9 @@ TEST(a_chunk_whose_z_never_changes_has_an_empty_z_layer_and_keeps_its_z) {
 }
 
 TEST(identical_points_compress_far_below_the_points_per_byte_limit) {
-    /* the reader refuses chunks of more than 4096 points per byte; real
-     * degenerate data (a chunk of one repeated point) stays far below */
+    /* the reader refuses chunks of more than HD_LAZ_POINTS_PER_BYTE points
+     * per byte by default; degenerate data (a chunk of one repeated point)
+     * in LASzip's chunks of 50,000 stays below */
     static lazw_point_t p[50000];
     for (int i = 0; i < 50000; i++) p[i] = (lazw_point_t){5, 6, 7, 1, 1, 0};
     for (int fmt = 0; fmt <= 6; fmt += 6) {
@@ -148,7 +151,7 @@ TEST(identical_points_compress_far_below_the_points_per_byte_limit) {
         tf_buf_t b = {0};
         lazw_encode(&b, &o, p, 50000);
         size_t bytes = b.size - lazw_last.chunk[0];
-        CHECK(50000 / bytes < 4096 / 4);
+        CHECK(50000 / bytes < HD_LAZ_POINTS_PER_BYTE * 2 / 3);
         tf_free(&b);
         round_trip(&o, p, 50000, 1);
     }
@@ -265,9 +268,10 @@ TEST(a_huge_point_count_in_a_tiny_chunk_is_refused_before_allocating) {
 }
 
 TEST(a_chunk_claiming_thousands_of_points_per_byte_fails_as_its_stream_runs_out) {
-    /* a pointwise chunk of 50 real points whose table says 4000 per byte:
-     * the reader takes the sequential path, growing the result as points
-     * are decoded, and stops where the stream runs past the chunk */
+    /* a pointwise chunk of 50 real points whose table says 4000 per byte,
+     * read with the limit raised to 4096: the reader takes the sequential
+     * path, growing the result as points are decoded, and stops where the
+     * stream runs past the chunk */
     lazw_point_t *p = points(9, 50, 0);
     size_t sizes[1] = {50};
     lazw_opts_t o = plain;
@@ -281,7 +285,9 @@ TEST(a_chunk_claiming_thousands_of_points_per_byte_fails_as_its_stream_runs_out)
     b.size = t;
     lazw_table(&b, &cnt, &bytes, 1);
     put_u32(&b, 107, cnt);
+    per_byte = HD_LAZ_POINTS_PER_BYTE_MAX;
     refused(&b, HD_EFORMAT, "ran past the chunk's end", (long long)t);
+    per_byte = 0;
     tf_free(&b);
     free(p);
 }
@@ -540,5 +546,31 @@ TEST(extra_bytes_models_created_at_first_use_decode_a_record_of_65515_extra_byte
     lazw_opts_t o = plain;
     o.extra = 65515;
     round_trip(&o, p, 3, 1);
+    free(p);
+}
+
+TEST(a_chunk_denser_than_the_default_points_per_byte_is_refused_naming_the_limit_and_how_to_raise_it) {
+    /* a million copies of one point in one chunk: a valid stream of about
+     * 500 points a byte, 24 MB of result from 2 KB; the default limit
+     * refuses it before decoding, a raised one reads it */
+    size_t n = 1000000;
+    lazw_point_t *p = malloc(n * sizeof *p);
+    for (size_t k = 0; k < n; k++) p[k] = (lazw_point_t){5, 6, 7, 1, 1, 0};
+    lazw_opts_t o = plain;
+    o.chunk_size = (uint32_t)n;
+    tf_buf_t b = {0};
+    lazw_encode(&b, &o, p, n);
+    size_t bytes = lazw_last.table - lazw_last.chunk[0];
+    CHECK(n / bytes > HD_LAZ_POINTS_PER_BYTE && n / bytes < 1024);
+    refused(&b, HD_EUNSUPPORTED, "above the limit of 256 points a compressed byte (the default)", (long long)lazw_last.chunk[0]);
+    refused(&b, HD_EUNSUPPORTED, "--laz-points-per-byte N (read option laz_points_per_byte)", -1);
+    per_byte = 1024;
+    round_trip(&o, p, n, 2);
+    per_byte = 300;
+    refused(&b, HD_EUNSUPPORTED, "limit of 300 points a compressed byte (as asked)", -1);
+    per_byte = HD_LAZ_POINTS_PER_BYTE_MAX + 1;
+    refused(&b, HD_EINVAL, "laz_points_per_byte 4097 is above 4096", -1);
+    per_byte = 0;
+    tf_free(&b);
     free(p);
 }
