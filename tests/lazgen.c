@@ -71,9 +71,9 @@ static void put_le(tf_buf_t *b, size_t at, uint64_t v, int bytes) {
 
 /* Hostile shapes the reader refuses (regress-*): header counts lower than
  * the data (the one-point chunk, the last of several chunks, LASzip 1's
- * stream, a layered chunk whose own count lies too) and items said to be of
+ * stream, a layered chunk whose own count lies too), items said to be of
  * another version than the data's (LASzip 1 streams whose lie decodes
- * without running past them). */
+ * without running past them), a format byte without its compression bit. */
 static int lies(const char *dir) {
     static const struct {
         const char *name;
@@ -83,12 +83,14 @@ static int lies(const char *dir) {
         uint64_t seed;
         uint32_t count; /* the header's count, 0: kept */
         int item;       /* an item whose version becomes 2, -1: none */
-    } c[] = {{"regress-count-1-of-100", 0, 0, 1000, 100, 11, 1, -1},
-             {"regress-count-99-of-100-last-chunk", 1, 0, 50, 100, 12, 99, -1},
-             {"regress-count-60-of-100-laszip1", 3, 1, 1, 100, 13, 60, -1},
-             {"regress-count-99-of-100-layered", 6, 0, 100, 100, 14, 99, -1},
-             {"regress-point10-v1-said-v2", 0, 1, 1, 6, 3, 0, 0},
-             {"regress-rgb12-v1-said-v2", 2, 1, 1, 3, 3, 0, 1}};
+        int plain;      /* the format byte's compression bit cleared */
+    } c[] = {{"regress-count-1-of-100", 0, 0, 1000, 100, 11, 1, -1, 0},
+             {"regress-count-99-of-100-last-chunk", 1, 0, 50, 100, 12, 99, -1, 0},
+             {"regress-count-60-of-100-laszip1", 3, 1, 1, 100, 13, 60, -1, 0},
+             {"regress-count-99-of-100-layered", 6, 0, 100, 100, 14, 99, -1, 0},
+             {"regress-point10-v1-said-v2", 0, 1, 1, 6, 3, 0, 0, 0},
+             {"regress-rgb12-v1-said-v2", 2, 1, 1, 3, 3, 0, 1, 0},
+             {"regress-compression-bit-cleared", 1, 0, 50, 100, 15, 0, -1, 1}};
     int rc = 0;
     for (size_t k = 0; k < sizeof c / sizeof c[0]; k++) {
         gen_rng_t g;
@@ -105,6 +107,7 @@ static int lies(const char *dir) {
             put_le(&b, 107, c[k].count, 4);
         }
         if (c[k].item >= 0) b.data[lazw_last.vlr + 34 + 6 * (size_t)c[k].item + 4] = 2;
+        if (c[k].plain) b.data[104] &= 0x7f;
         rc |= save(dir, c[k].name, &b);
         tf_free(&b);
     }

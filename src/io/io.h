@@ -132,6 +132,10 @@ typedef struct hd__las_header {
  * result at once; above, it grows it as points are decoded (laz.c). */
 #define HD__LAZ_EAGER_PER_BYTE 64
 int hd__read_laz(hd__read_t *r, const hd__las_header_t *h);
+/* Whether the VLRs of h (lying in d) hold a LASzip VLR (user "laszip
+ * encoded", record 22204): the sign of a LAZ file whose point format byte
+ * lost its compression bit. */
+int hd__laz_vlr_present(const unsigned char *d, const hd__las_header_t *h);
 
 /* ---- errors with a place --------------------------------------------------- */
 /* "NAME:LINE: what" with err->line set. */

@@ -806,24 +806,44 @@ static void decode_chunk(void *ctx, size_t task, int worker) {
 }
 
 /* ---- the VLR, the chunk table ----------------------------------------------- */
+/* The VLRs from h->header: 1 with *p, *n at the LASzip VLR's header and
+ * data size; 0 when none is among them; -1 with *p at VLR *i (from 0)
+ * when its header does not fit before the points, -2 when its data does
+ * not (*n its size). */
+static int scan_vlrs(const unsigned char *d, const hd__las_header_t *h, size_t *p, size_t *n, uint32_t *i) {
+    *p = h->header;
+    for (*i = 0; *i < h->n_vlr; ++*i) {
+        if (*p + 54 > h->offset) return -1;
+        *n = hd__ld_u16(d + *p + 20, 0);
+        if (*p + 54 + *n > h->offset) return -2;
+        if (memcmp(d + *p + 2, "laszip encoded", 14) == 0 && d[*p + 16] == 0 && hd__ld_u16(d + *p + 18, 0) == 22204) return 1;
+        *p += 54 + *n;
+    }
+    return 0;
+}
+
+int hd__laz_vlr_present(const unsigned char *d, const hd__las_header_t *h) {
+    size_t p, n;
+    uint32_t i;
+    return scan_vlrs(d, h, &p, &n, &i) == 1;
+}
+
 static int find_vlr(laz_t *z, const hd__las_header_t *h, const unsigned char **vlr, size_t *len, size_t *vlr_at) {
     hd__read_t *r = z->r;
-    size_t p = h->header;
-    for (uint32_t i = 0; i < h->n_vlr; i++) {
-        if (p + 54 > h->offset)
-            return hd__io_err_at(r, HD_EFORMAT, (long long)p, "VLR %u of %u does not fit before the point data at byte %zu", i + 1,
-                                 h->n_vlr, h->offset);
-        size_t n = hd__ld_u16(z->d + p + 20, 0);
-        if (p + 54 + n > h->offset)
-            return hd__io_err_at(r, HD_EFORMAT, (long long)p + 20, "VLR %u's %zu bytes run past the point data at byte %zu", i + 1,
-                                 n, h->offset);
-        if (memcmp(z->d + p + 2, "laszip encoded", 14) == 0 && z->d[p + 16] == 0 && hd__ld_u16(z->d + p + 18, 0) == 22204) {
-            *vlr = z->d + p + 54;
-            *len = n;
-            *vlr_at = p + 54;
-            return HD_OK;
-        }
-        p += 54 + n;
+    size_t p = 0, n = 0;
+    uint32_t i = 0;
+    int found = scan_vlrs(z->d, h, &p, &n, &i);
+    if (found == -1)
+        return hd__io_err_at(r, HD_EFORMAT, (long long)p, "VLR %u of %u does not fit before the point data at byte %zu", i + 1,
+                             h->n_vlr, h->offset);
+    if (found == -2)
+        return hd__io_err_at(r, HD_EFORMAT, (long long)p + 20, "VLR %u's %zu bytes run past the point data at byte %zu", i + 1, n,
+                             h->offset);
+    if (found == 1) {
+        *vlr = z->d + p + 54;
+        *len = n;
+        *vlr_at = p + 54;
+        return HD_OK;
     }
     return hd__io_err_at(r, HD_EFORMAT, 104,
                          "the point format says compressed (LAZ) but no LASzip VLR (user 'laszip encoded', record 22204) is "

@@ -574,3 +574,15 @@ TEST(a_chunk_denser_than_the_default_points_per_byte_is_refused_naming_the_limit
     tf_free(&b);
     free(p);
 }
+
+TEST(a_laz_file_whose_format_byte_lost_its_compression_bit_is_refused_naming_the_laszip_vlr) {
+    for (int fmt = 0; fmt <= 6; fmt += 6) {
+        CONTEXT("format %d", fmt);
+        tf_buf_t b = {0};
+        sample(&b, fmt, 100, 50);
+        b.data[104] &= 0x7f; /* read as LAS: 100 records do not fit */
+        refused(&b, HD_EFORMAT, "file ends inside the points", (long long)b.size);
+        refused(&b, HD_EFORMAT, "a LASzip VLR (user 'laszip encoded', record 22204), so its points are compressed", -1);
+        tf_free(&b);
+    }
+}
