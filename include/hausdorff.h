@@ -533,11 +533,10 @@ typedef struct hd_read_options {
                               coordinates, 24 bytes a point in double):
                               0 = HD_LAZ_POINTS_PER_BYTE; at most
                               HD_LAZ_POINTS_PER_BYTE_MAX (HD_EINVAL
-                              above).  Real surveys hold under one point
-                              a byte; degenerate data (one point repeated,
-                              a flat grid) up to 147 in LASzip's chunks of
-                              50,000 points and about 600 in one chunk of
-                              millions. */
+                              above).  A denser chunk is refused before it
+                              is decoded (HD_EUNSUPPORTED); the default
+                              reads every shape of data in LASzip's chunks
+                              of 50,000 points (docs/formats.md). */
 } hd_read_options_t;
 
 /* The defaults of stream_limit (2 GiB) and fifo_wait_ms (30 s). */

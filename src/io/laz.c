@@ -491,10 +491,9 @@ static void rgb_read(pw_t *c, hd__dec_t *d, int v2) {
 /* BYTE v2 gives each extra byte a model of 256 symbols, created here at its
  * first symbol (a model's state depends only on the symbols coded with it,
  * so this is the model LASzip creates with the chunk); a new model is
- * uniform, so its first symbol costs 8 bits,
- * and stopping once the decoder runs past its bytes keeps the models
- * created to about one per byte of the stream (a record of 65,515 extra
- * bytes would otherwise cost 150 MB of models whatever the file's size).
+ * uniform, so its first symbol costs 8 bits, and stopping once the decoder
+ * runs past its bytes keeps the models created to about one per byte of
+ * the stream, whatever the record's size.
  * 0, or -1 when a model could not be allocated. */
 static int bytes_read(pw_t *c, hd__dec_t *d, int v2) {
     for (unsigned k = 0; k < c->nb && d->over <= 4; k++) {
@@ -1055,9 +1054,8 @@ static int count_laz(laz_t *z, const hd__las_header_t *h) {
     return rc;
 }
 
-/* The points [z->lo, z->hi) into the sink.  Real data holds under a third
- * of a point per byte; a degenerate file (a repeated point) a few hundred.
- * Up to HD__LAZ_EAGER_PER_BYTE the result is allocated at once and the
+/* The points [z->lo, z->hi) into the sink.  Up to HD__LAZ_EAGER_PER_BYTE
+ * points per byte of chunk data the result is allocated at once and the
  * chunks decoded in parallel; above, chunks are decoded one after the
  * other and the result grows as points are decoded, so a file whose claims
  * its bytes do not back fails before allocating them. */
