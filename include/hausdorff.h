@@ -568,7 +568,9 @@ HD_EXTERN int hd_read_file(const char *path, const hd_read_options_t *opt,
 /* The number of points hd_read_file(path, opt) would give, from the
  * file's header alone: for LAS, LAZ, NPY and binary PLY, PCD and STL (the
  * formats whose range reads touch only the range; see range_first), once
- * the header and the file's size are checked.  For a program that splits
+ * the header and the file's size are checked (LAZ: the chunk table, every
+ * layered chunk's own count, and the last chunk decoded, where a header
+ * count lower than the data shows).  For a program that splits
  * one file between processes.  opt NULL: defaults; its range is ignored.
  * Errors: those of hd_read_file for the header, and HD_EUNSUPPORTED for
  * every other format or variant (text, OBJ, OFF, ascii PLY/PCD/STL, PLY
