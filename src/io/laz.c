@@ -518,7 +518,8 @@ static int bytes_read(pw_t *c, hd__dec_t *d, int v2) {
  * `end` is its end's file offset. */
 static void stream_end(job_t *j, const hd__dec_t *d, const char *what, const char *unit, long long end, size_t n) {
     if (d->over)
-        fail(j, HD_EFORMAT, end, "the chunk's %s ends before its %zu points (the decoder ran past the %s's end)", what, n, unit);
+        fail(j, HD_EFORMAT, end, "the chunk's %s ends before its %zu point%s (the decoder ran past the %s's end)", what, n,
+             n == 1 ? "" : "s", unit);
     else if (d->p != d->end)
         fail(j, HD_EFORMAT, end - (long long)(d->end - d->p),
              "%zu byte%s of the chunk's %s %s left after its %zu point%s: the point count is lower than the data, or "

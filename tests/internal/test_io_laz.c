@@ -467,7 +467,7 @@ TEST(a_one_point_layered_chunk_has_an_empty_stream_of_four_bytes_or_none_per_dec
     /* the one-point chunk's x/y layer of 3 bytes and a z layer of 1 */
     put_u32(&b, nxy_at, 3);
     put_u32(&b, nxy_at + 4, 1);
-    refused(&b, HD_EFORMAT, "chunk 1 of 3: the chunk's x/y layer ends before its 1 points", -1);
+    refused(&b, HD_EFORMAT, "chunk 1 of 3: the chunk's x/y layer ends before its 1 point (the decoder ran past the layer's end)", -1);
     tf_free(&b);
     free(p);
 }
