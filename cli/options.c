@@ -111,6 +111,8 @@ void cli_usage(FILE *out) {
 "                     regular file (standard input, a pipe, a FIFO), with an\n"
 "                     optional K, M or G suffix (default 2G)\n"
 "  --fifo-wait SECONDS  how long a named FIFO's writer is awaited (default 30)\n"
+"  --laz-points-per-byte N  the most points a LAZ chunk may hold per byte,\n"
+"                     bounding a small file's memory (default 256, up to 4096)\n"
 "  --json             print one JSON object\n"
 "  --quiet            no progress bar on stderr (there is none when stderr\n"
 "                     is not a terminal, nor with --json)\n"
@@ -223,7 +225,7 @@ int cli_parse(int argc, char **argv, cli_args_t *a) {
         name[nl] = '\0';
         static const char *const with_arg[] = {"--algorithm", "--threads", "--seed", "--depth",
                                                "--lambda", "--theta", "--format", "--sample",
-                                               "--max-stream-size", "--fifo-wait", NULL};
+                                               "--max-stream-size", "--fifo-wait", "--laz-points-per-byte", NULL};
         int known = 0;
         for (int w = 0; with_arg[w]; w++) known |= strcmp(name, with_arg[w]) == 0;
         if (!known) return bad("unknown option '%s'", s);
@@ -262,6 +264,10 @@ int cli_parse(int argc, char **argv, cli_args_t *a) {
         } else if (strcmp(name, "--fifo-wait") == 0) {
             if (parse_long(v, 1, 86400, &l)) return bad("--fifo-wait needs a whole number of seconds 1..86400, not '%s'", v);
             a->read.fifo_wait_ms = (int)l * 1000;
+        } else if (strcmp(name, "--laz-points-per-byte") == 0) {
+            if (parse_long(v, 1, HD_LAZ_POINTS_PER_BYTE_MAX, &l))
+                return bad("--laz-points-per-byte needs a whole number 1..4096, not '%s'", v);
+            a->read.laz_points_per_byte = (unsigned)l;
         }
     }
     a->read.seed = a->opt.seed; /* --seed also seeds --sample */

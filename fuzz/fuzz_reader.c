@@ -19,7 +19,7 @@
  * least one point, every coordinate finite and within HD_MAX_COORD; as
  * vertices never more points than the input has bytes (no reader may
  * allocate more than the file can hold; a LAZ
- * chunk up to HD__LAZ_POINTS_PER_BYTE points per byte), sampled exactly the sample size.
+ * chunk up to HD_LAZ_POINTS_PER_BYTE points per byte), sampled exactly the sample size.
  * After a success two more reads check the range contract: where the
  * header count answers it equals the count read, and a range read of the
  * middle third gives exactly that slice of the whole read, bit for bit.
@@ -66,10 +66,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     if (c->count != HD_FUZZ_SAMPLE) abort();
 #else
     /* LAZ (named las or laz: the compression bit decides): a chunk may hold
-     * up to HD__LAZ_POINTS_PER_BYTE points per byte (a run of identical
+     * up to HD_LAZ_POINTS_PER_BYTE points per byte (a run of identical
      * points costs a tiny fraction of a bit each) */
     int laz = size > 104 && memcmp(data, "LASF", 4) == 0 && (data[104] & 0x80);
-    if (c->count > (laz ? HD__LAZ_POINTS_PER_BYTE : 1) * size) abort();
+    if (c->count > (laz ? HD_LAZ_POINTS_PER_BYTE : 1) * size) abort();
 #endif
     hd_points_t p = hd_cloud_points(c);
     for (size_t k = 0; k < c->count; k++) {

@@ -528,11 +528,26 @@ typedef struct hd_read_options {
                               formats are read whole, then cut.  A bad point
                               outside the range is not seen. */
     uint64_t range_count;  /* 0 (default): the whole file */
+    unsigned laz_points_per_byte; /* LAZ: the most points a chunk may hold
+                              per byte of it, which bounds the memory a
+                              small file can ask for (the result's
+                              coordinates, 24 bytes a point in double):
+                              0 = HD_LAZ_POINTS_PER_BYTE; at most
+                              HD_LAZ_POINTS_PER_BYTE_MAX (HD_EINVAL
+                              above).  A denser chunk is refused before it
+                              is decoded (HD_EUNSUPPORTED); the default
+                              reads every shape of data in LASzip's chunks
+                              of 50,000 points (docs/formats.md). */
 } hd_read_options_t;
 
 /* The defaults of stream_limit (2 GiB) and fifo_wait_ms (30 s). */
 #define HD_STREAM_LIMIT ((uint64_t)2 << 30)
 #define HD_FIFO_WAIT_MS 30000
+/* The default of laz_points_per_byte, and its largest value (a LAZ point
+ * costs at least a few thousandths of a bit in the format's most skewed
+ * models). */
+#define HD_LAZ_POINTS_PER_BYTE 256
+#define HD_LAZ_POINTS_PER_BYTE_MAX 4096
 
 /* Fill `opt` with the defaults (by extension, double, vertices). */
 HD_EXTERN void hd_read_options_init(hd_read_options_t *opt);
@@ -554,7 +569,9 @@ HD_EXTERN int hd_read_file(const char *path, const hd_read_options_t *opt,
 /* The number of points hd_read_file(path, opt) would give, from the
  * file's header alone: for LAS, LAZ, NPY and binary PLY, PCD and STL (the
  * formats whose range reads touch only the range; see range_first), once
- * the header and the file's size are checked.  For a program that splits
+ * the header and the file's size are checked (LAZ: the chunk table, every
+ * layered chunk's own count, and the last chunk decoded, where a header
+ * count lower than the data shows).  For a program that splits
  * one file between processes.  opt NULL: defaults; its range is ignored.
  * Errors: those of hd_read_file for the header, and HD_EUNSUPPORTED for
  * every other format or variant (text, OBJ, OFF, ascii PLY/PCD/STL, PLY

@@ -147,6 +147,19 @@ def laz_files_are_read_by_extension_and_by_format(d):
 
 
 @test
+def a_laz_file_denser_than_the_points_per_byte_limit_is_refused_unless_the_limit_is_raised(d):
+    """A million points in 2 KB (one point repeated): refused by default,
+    naming the limit and the option; read with the limit raised."""
+    dense = os.path.join(HERE, "corpus", "laz", "regress-dense-1000000-points.laz")
+    expect_bad(dense, "above the limit of 256 points a compressed byte (the default)")
+    expect_bad(dense, "--laz-points-per-byte N")
+    rc, out, err = run("--laz-points-per-byte", "1024", dense, dense)
+    assert rc == 0 and "(1000000 points, laz)" in out, (rc, out, err)
+    rc, out, err = run("--laz-points-per-byte", "4097", dense, dense)
+    assert rc == 1 and "--laz-points-per-byte needs a whole number 1..4096" in err, (rc, err)
+
+
+@test
 def usage_errors_exit_1(d):
     for args in (["--format", "dxf"], ["--sample", "0"], ["--sample", "-5"], ["--sample"]):
         rc, out, err = run(*args, "a.ply", "b.ply")

@@ -54,7 +54,68 @@ static void write_case(const char *dir, const char *name, const lazw_opts_t *o, 
     free(p);
 }
 
-/* The fuzz target's seeds (tests/corpus/laz/): small files of each scheme. */
+static int save(const char *dir, const char *name, const tf_buf_t *b) {
+    char path[4096];
+    snprintf(path, sizeof path, "%s/%s.laz", dir, name);
+    FILE *f = fopen(path, "wb");
+    if (!f || fwrite(b->data, 1, b->size, f) != b->size || fclose(f)) {
+        perror(path);
+        return 1;
+    }
+    return 0;
+}
+
+static void put_le(tf_buf_t *b, size_t at, uint64_t v, int bytes) {
+    for (int i = 0; i < bytes; i++) b->data[at + i] = (unsigned char)(v >> (8 * i));
+}
+
+/* Hostile shapes the reader refuses (regress-*): header counts lower than
+ * the data (the one-point chunk, the last of several chunks, LASzip 1's
+ * stream, a layered chunk whose own count lies too), items said to be of
+ * another version than the data's (LASzip 1 streams whose lie decodes
+ * without running past them), a format byte without its compression bit. */
+static int lies(const char *dir) {
+    static const struct {
+        const char *name;
+        int format, v1;
+        uint32_t chunk;
+        size_t n;
+        uint64_t seed;
+        uint32_t count; /* the header's count, 0: kept */
+        int item;       /* an item whose version becomes 2, -1: none */
+        int plain;      /* the format byte's compression bit cleared */
+    } c[] = {{"regress-count-1-of-100", 0, 0, 1000, 100, 11, 1, -1, 0},
+             {"regress-count-99-of-100-last-chunk", 1, 0, 50, 100, 12, 99, -1, 0},
+             {"regress-count-60-of-100-laszip1", 3, 1, 1, 100, 13, 60, -1, 0},
+             {"regress-count-99-of-100-layered", 6, 0, 100, 100, 14, 99, -1, 0},
+             {"regress-point10-v1-said-v2", 0, 1, 1, 6, 3, 0, 0, 0},
+             {"regress-rgb12-v1-said-v2", 2, 1, 1, 3, 3, 0, 1, 0},
+             {"regress-compression-bit-cleared", 1, 0, 50, 100, 15, 0, -1, 1}};
+    int rc = 0;
+    for (size_t k = 0; k < sizeof c / sizeof c[0]; k++) {
+        gen_rng_t g;
+        gen_seed(&g, c[k].seed);
+        lazw_point_t p[100];
+        lazw_random(&g, p, c[k].n, c[k].format);
+        lazw_opts_t o = {c[k].format, 0, c[k].chunk, NULL, 0, {0.01, 0.01, 0.01}, {-5, 7, 0.5}, c[k].v1};
+        tf_buf_t b = {0};
+        lazw_encode(&b, &o, p, c[k].n);
+        if (c[k].count && c[k].format >= 6) {
+            put_le(&b, 247, c[k].count, 8);
+            put_le(&b, lazw_last.chunk[0] + 30, c[k].count, 4); /* the chunk's own count */
+        } else if (c[k].count) {
+            put_le(&b, 107, c[k].count, 4);
+        }
+        if (c[k].item >= 0) b.data[lazw_last.vlr + 34 + 6 * (size_t)c[k].item + 4] = 2;
+        if (c[k].plain) b.data[104] &= 0x7f;
+        rc |= save(dir, c[k].name, &b);
+        tf_free(&b);
+    }
+    return rc;
+}
+
+/* The fuzz target's seeds (tests/corpus/laz/): small files of each scheme,
+ * and the hostile shapes. */
 static int seeds(const char *dir) {
     static const size_t sizes[] = {9, 1, 20};
     lazw_opts_t o = {0, 0, 16, NULL, 0, {0.01, 0.01, 0.01}, {-5, 7, 0.5}, 0};
@@ -75,12 +136,17 @@ static int seeds(const char *dir) {
     lazw_opts_t r = {0, 0, 40000, NULL, 0, {0.5, 0.5, 0.5}, {0, 0, 0}, 0};
     tf_buf_t b = {0};
     lazw_encode(&b, &r, same, 40000);
-    char path[4096];
-    snprintf(path, sizeof path, "%s/fmt0_repeated_point.laz", dir);
-    FILE *f = fopen(path, "wb");
-    if (!f || fwrite(b.data, 1, b.size, f) != b.size || fclose(f)) return 1;
+    int rc = save(dir, "fmt0_repeated_point", &b);
     tf_free(&b);
-    return 0;
+    /* a million copies of one point in one chunk, about 500 a byte: denser
+     * than the reader's default limit (--laz-points-per-byte raises it) */
+    static lazw_point_t many[1000000];
+    for (size_t k = 0; k < 1000000; k++) many[k] = (lazw_point_t){1, 2, 3, 1, 1, 0};
+    r.chunk_size = 1000000;
+    lazw_encode(&b, &r, many, 1000000);
+    rc |= save(dir, "regress-dense-1000000-points", &b);
+    tf_free(&b);
+    return rc | lies(dir);
 }
 
 int main(int argc, char **argv) {

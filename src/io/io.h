@@ -125,13 +125,17 @@ typedef struct hd__las_header {
     double scale[3], shift[3];
 } hd__las_header_t;
 /* The points of a LAZ (LASzip-compressed) file: laz.c.  A chunk may not
- * claim more than HD__LAZ_POINTS_PER_BYTE points per byte of it: the bound
- * on the allocation a LAZ file can cause. */
-#define HD__LAZ_POINTS_PER_BYTE 4096
+ * claim more than the read options' laz_points_per_byte (default
+ * HD_LAZ_POINTS_PER_BYTE, at most HD_LAZ_POINTS_PER_BYTE_MAX) points per
+ * byte of it: the bound on the allocation a LAZ file can cause. */
 /* Up to this many points per compressed byte the LAZ reader allocates the
  * result at once; above, it grows it as points are decoded (laz.c). */
 #define HD__LAZ_EAGER_PER_BYTE 64
 int hd__read_laz(hd__read_t *r, const hd__las_header_t *h);
+/* Whether the VLRs of h (lying in d) hold a LASzip VLR (user "laszip
+ * encoded", record 22204): the sign of a LAZ file whose point format byte
+ * lost its compression bit. */
+int hd__laz_vlr_present(const unsigned char *d, const hd__las_header_t *h);
 
 /* ---- errors with a place --------------------------------------------------- */
 /* "NAME:LINE: what" with err->line set. */

@@ -22,7 +22,8 @@
  * 64-bit count is refused too); scales and offsets are finite.  A compressed (LAZ) file,
  * recognised by bit 7 of the format byte as LASzip sets it, goes to laz.c
  * once the header is checked (its record length and count describe the
- * points before compression).  Points are converted in parallel from the
+ * points before compression); one whose format byte lost that bit fails
+ * the size checks, and their message then names its LASzip VLR.  Points are converted in parallel from the
  * mapping (hd__binary_read).
  */
 #include "io.h"
@@ -79,17 +80,20 @@ int hd__read_las(hd__read_t *r) {
             return hd__io_err_at(r, HD_EFORMAT, (long long)(isfinite(scale[c]) ? 155 + 8 * c : 131 + 8 * c),
                                  "%c %s is not a finite number", "xyz"[c], isfinite(scale[c]) ? "offset" : "scale factor");
     }
-    if (fmt_byte & 0x80) {
-        uint64_t evlr = minor >= 4 && header >= 247 && hd__ld_u32(d + 243, 0) > 0 ? hd__ld_u64(d + 235, 0) : 0;
-        hd__las_header_t h = {minor, fmt, header, offset, rec, count, hd__ld_u32(d + 100, 0), evlr, {0}, {0}};
-        memcpy(h.scale, scale, sizeof scale);
-        memcpy(h.shift, shift, sizeof shift);
-        return hd__read_laz(r, &h);
-    }
+    uint64_t evlr_at = minor >= 4 && header >= 247 && hd__ld_u32(d + 243, 0) > 0 ? hd__ld_u64(d + 235, 0) : 0;
+    hd__las_header_t h = {minor, fmt, header, offset, rec, count, hd__ld_u32(d + 100, 0), evlr_at, {0}, {0}};
+    memcpy(h.scale, scale, sizeof scale);
+    memcpy(h.shift, shift, sizeof shift);
+    if (fmt_byte & 0x80) return hd__read_laz(r, &h);
+    /* a LAZ file whose format byte lost bit 7 fails the size checks below:
+     * their messages say so */
+    const char *laz = hd__laz_vlr_present(d, &h) ? "; the file has a LASzip VLR (user 'laszip encoded', record 22204), so its "
+                                                   "points are compressed: the point format byte (104) lacks its compression bit 7"
+                                                 : "";
     if (count > (size - offset) / rec)
         return hd__io_err_at(r, HD_EFORMAT, (long long)size,
-                             "file ends inside the points: %llu of %zu bytes declared, room for %zu",
-                             (unsigned long long)count, rec, (size - offset) / rec);
+                             "file ends inside the points: %llu of %zu bytes declared, room for %zu%s",
+                             (unsigned long long)count, rec, (size - offset) / rec, laz);
     /* What follows the points must be accounted for by the header: the
      * waveform data (1.3) or the extended VLRs (1.4) start there.  Other
      * bytes mean the count is lower than the data: never a silent partial
@@ -103,8 +107,8 @@ int hd__read_las(hd__read_t *r) {
         if (!explained)
             return hd__io_err_at(r, HD_EFORMAT, (long long)end,
                                  "%zu bytes after the %llu declared points (%zu bytes each), and the header names "
-                                 "nothing that follows them: the point count is wrong",
-                                 size - end, (unsigned long long)count, rec);
+                                 "nothing that follows them: the point count is wrong%s",
+                                 size - end, (unsigned long long)count, rec, laz);
     }
     hd__layout_t L = {(size_t)count, 1, rec, 0, {0, 4, 8}, {HD__T_I32, HD__T_I32, HD__T_I32}, 0, scale, shift, offset};
     return hd__binary_read(r, d + offset, &L);

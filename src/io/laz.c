@@ -45,15 +45,24 @@
  * start, its chunk count is at most the bytes before it (each chunk is at
  * least one byte), every chunk has bytes and ends before the table, the
  * points per chunk add up to the header's count, and no chunk claims more
- * points than HD__LAZ_POINTS_PER_BYTE per byte of it (a point costs at
- * least a few thousandths of a bit in the format's most skewed models;
- * the limit is generous for real files, see docs/formats.md), and above
+ * points per byte of it than the read options' laz_points_per_byte
+ * (default HD_LAZ_POINTS_PER_BYTE, which degenerate data in LASzip's
+ * chunks stays below; never above HD_LAZ_POINTS_PER_BYTE_MAX: a point
+ * costs at least a few thousandths of a bit in the format's most skewed
+ * models; see docs/formats.md), so that a file's result is bounded by its
+ * size, and above
  * HD__LAZ_EAGER_PER_BYTE points per byte the result is not allocated up
  * front but grown while the chunks are decoded in order, so that only
  * decoded points cost memory; a chunk's
- * layer sizes fit inside it; a stream that reads past its bytes is an
- * error (a valid stream never does: the encoder's last bytes and padding
- * keep the decoder within them).  Chunks are decoded in parallel, each by
+ * layer sizes fill it exactly; every decoded stream (a pointwise chunk's,
+ * a layered chunk's x/y and z layers when they have bytes) ends exactly
+ * where its decoder stops after the chunk's last point: LASzip's encoder
+ * ends a stream with the bytes its decoder reads ahead, so reading past
+ * them means fewer points than counted, and bytes left mean more (or items
+ * other than the VLR's).  A one-point chunk's stream is the four bytes of
+ * an empty one.  The last chunk is decoded by every read, range reads and
+ * hd_read_count included, since a header count lower than the data shows
+ * only there.  Chunks are decoded in parallel, each by
  * itself with models of its own, straight into its window of the sink;
  * the first failing chunk in file order is the error, so the message does
  * not depend on the thread count.  Coordinates are X * scale + offset in
@@ -88,13 +97,14 @@ typedef struct {
     size_t n_chunks;
     uint64_t *start; /* n_chunks + 1 byte offsets */
     uint64_t *first; /* n_chunks + 1 cumulative point counts */
+    unsigned per_byte; /* the most points a chunk may hold per byte of it */
     uint64_t lo, hi; /* the points kept: [lo, hi) of the file's (a range
                         read keeps part; chunks outside it are not decoded) */
     double scale[3], shift[3];
     /* per chunk: the first problem */
     int *rc;
     long long *at;
-    char (*msg)[200];
+    char (*msg)[320];
 } laz_t;
 
 /* ---- one chunk's work ------------------------------------------------------ */
@@ -106,7 +116,7 @@ typedef struct {
     size_t k; /* next point index in the sink */
     int rc;
     long long at;
-    char msg[200];
+    char msg[320];
 } job_t;
 
 static int fail(job_t *j, int code, long long at, const char *fmt, ...) HD__PRINTF(4, 5);
@@ -176,8 +186,9 @@ typedef struct {
     hd__intcoder_t cic;            /* v1 */
     /* BYTE */
     unsigned nb;
-    hd__symmodel_t *bm; /* v2: nb models */
-    hd__intcoder_t bic; /* v1: nb contexts */
+    hd__symmodel_t **bm; /* v2: nb models, each created at its first symbol
+                            (see bytes_read) */
+    hd__intcoder_t bic;  /* v1: nb contexts */
 } pw_t;
 
 static void pw_free(pw_t *w) {
@@ -195,7 +206,11 @@ static void pw_free(pw_t *w) {
     hd__intcoder_t *ics[] = {&w->intensity, &w->psid, &w->dx, &w->dy, &w->dz, &w->scan1, &w->gic, &w->cic, &w->bic};
     for (size_t i = 0; i < sizeof ics / sizeof ics[0]; i++) hd__intcoder_free(ics[i]);
     if (w->bm)
-        for (unsigned i = 0; i < w->nb; i++) hd__symmodel_free(&w->bm[i]);
+        for (unsigned i = 0; i < w->nb; i++)
+            if (w->bm[i]) {
+                hd__symmodel_free(w->bm[i]);
+                free(w->bm[i]);
+            }
     free(w->bm);
 }
 
@@ -235,7 +250,6 @@ static int pw_new(pw_t *w, const laz_t *z) {
             }
             w->bm = calloc(w->nb, sizeof *w->bm);
             if (!w->bm) return HD_ENOMEM;
-            for (unsigned k = 0; k < w->nb && rc == HD_OK; k++) rc = hd__symmodel_new(&w->bm[k], 256);
         }
     }
     return rc;
@@ -474,13 +488,99 @@ static void rgb_read(pw_t *c, hd__dec_t *d, int v2) {
         if ((sym & (1u << k)) && (k < 2 || (sym & 64))) hd__dec_symbol(d, &c->cdiff[k]);
     }
 }
-static void bytes_read(pw_t *c, hd__dec_t *d, int v2) {
-    for (unsigned k = 0; k < c->nb; k++) {
-        if (v2) hd__dec_symbol(d, &c->bm[k]);
-        else hd__ic_decode(&c->bic, d, 0, k);
+/* BYTE v2 gives each extra byte a model of 256 symbols, created here at its
+ * first symbol (a model's state depends only on the symbols coded with it,
+ * so this is the model LASzip creates with the chunk); a new model is
+ * uniform, so its first symbol costs 8 bits, and stopping once the decoder
+ * runs past its bytes keeps the models created to about one per byte of
+ * the stream, whatever the record's size.
+ * 0, or -1 when a model could not be allocated. */
+static int bytes_read(pw_t *c, hd__dec_t *d, int v2) {
+    for (unsigned k = 0; k < c->nb && d->over <= 4; k++) {
+        if (!v2) {
+            hd__ic_decode(&c->bic, d, 0, k);
+            continue;
+        }
+        hd__symmodel_t *m = lazy(&c->bm[k], 256);
+        if (!m) return -1;
+        hd__dec_symbol(d, m);
+    }
+    return 0;
+}
+
+/* The end of a stream once its chunk's (or layer's) last point is decoded:
+ * the decoder must stop exactly at its last byte.  LASzip's encoder ends a
+ * stream with the bytes its decoder reads ahead (done() flushes one or two
+ * bytes and pads with zeros to the four the decoder holds), so a stream that
+ * a decoder leaves unfinished holds more points than the count says, or was
+ * written with other items than the VLR lists; one that it reads past holds
+ * fewer.  `what` names the stream, `unit` its container (chunk, layer),
+ * `end` is its end's file offset. */
+static void stream_end(job_t *j, const hd__dec_t *d, const char *what, const char *unit, long long end, size_t n) {
+    if (d->over)
+        fail(j, HD_EFORMAT, end, "the chunk's %s ends before its %zu point%s (the decoder ran past the %s's end)", what, n,
+             n == 1 ? "" : "s", unit);
+    else if (d->p != d->end)
+        fail(j, HD_EFORMAT, end - (long long)(d->end - d->p),
+             "%zu byte%s of the chunk's %s %s left after its %zu point%s: the point count is lower than the data, or "
+             "the LASzip VLR's items are not the ones it was written with",
+             (size_t)(d->end - d->p), d->end - d->p == 1 ? "" : "s", what, d->end - d->p == 1 ? "is" : "are", n,
+             n == 1 ? "" : "s");
+}
+
+/* Create a pointwise chunk's models and start them from its raw first
+ * point b; HD_OK or HD_ENOMEM. */
+static int pointwise_start(pw_t *w, const laz_t *z, const unsigned char *b) {
+    int rc = pw_new(w, z);
+    if (rc) return rc;
+    for (int i = 0; i < 16; i++) {
+        hd__median5_init(&w->mx[i]);
+        hd__median5_init(&w->my[i]);
+    }
+    memcpy(w->last, b, 20);
+    if (z->items[0].version == 2) w->last[12] = w->last[13] = 0; /* v2: intensity starts at 0 */
+    size_t off = 20;
+    for (unsigned i = 1; i < z->n_items; i++) {
+        if (z->items[i].type == IT_GPSTIME11) w->t[0] = (int64_t)hd__ld_u64(b + off, 0);
+        off += z->items[i].size;
+    }
+    return HD_OK;
+}
+
+/* Points 2..n of a pointwise chunk from d, every item in order. */
+static void pointwise_points(job_t *j, pw_t *w, hd__dec_t *d, size_t n) {
+    laz_t *z = j->z;
+    long long at = (long long)z->start[j->chunk];
+    int v2 = z->items[0].version == 2;
+    for (size_t i = 1; i < n; i++) {
+        if (v2 ? p10_read(w, d) : p10v1_read(w, d)) {
+            fail(j, HD_ENOMEM, at, "out of memory");
+            return;
+        }
+        for (unsigned t = 1; t < z->n_items; t++) {
+            unsigned ty = z->items[t].type, iv2 = z->items[t].version == 2;
+            if (ty == IT_GPSTIME11) {
+                if (!iv2) {
+                    gps1_read(w, d);
+                } else if (gps_read(w, d)) {
+                    fail(j, HD_EFORMAT, at, "point %zu: the GPS time switches sequence more than once", j->k);
+                    return;
+                }
+            } else if (ty == IT_RGB12) {
+                rgb_read(w, d, iv2);
+            } else if (bytes_read(w, d, iv2)) {
+                fail(j, HD_ENOMEM, at, "out of memory");
+                return;
+            }
+        }
+        if (d->over > 4) return;
+        if (put(j, i32_at(w->last), i32_at(w->last + 4), i32_at(w->last + 8))) return;
     }
 }
 
+/* A pointwise chunk: its raw first point, then one stream of the others.
+ * A one-point chunk's stream is the four bytes the decoder reads at its
+ * start (the encoder's end of an empty stream), so it is checked too. */
 static void pointwise_chunk(job_t *j, const unsigned char *b, size_t nb, size_t n) {
     laz_t *z = j->z;
     long long at = (long long)z->start[j->chunk];
@@ -489,60 +589,16 @@ static void pointwise_chunk(job_t *j, const unsigned char *b, size_t nb, size_t 
         return;
     }
     if (put(j, i32_at(b), i32_at(b + 4), i32_at(b + 8))) return;
-    if (n == 1) return;
-    pw_t *w = malloc(sizeof *w);
-    if (!w) {
-        fail(j, HD_ENOMEM, at, "out of memory");
-        return;
-    }
-    if (pw_new(w, z)) {
-        fail(j, HD_ENOMEM, at, "out of memory");
-        goto done;
-    }
-    /* initial state from the raw first point */
-    for (int i = 0; i < 16; i++) {
-        hd__median5_init(&w->mx[i]);
-        hd__median5_init(&w->my[i]);
-    }
-    memcpy(w->last, b, 20);
-    int v2 = z->items[0].version == 2;
-    if (v2) w->last[12] = w->last[13] = 0; /* v2: intensity starts at 0 */
-    size_t off = 20;
-    for (unsigned i = 1; i < z->n_items; i++) {
-        if (z->items[i].type == IT_GPSTIME11) w->t[0] = (int64_t)hd__ld_u64(b + off, 0);
-        off += z->items[i].size;
-    }
     hd__dec_t d;
     hd__dec_init(&d, b + z->rec, nb - z->rec);
-    for (size_t i = 1; i < n; i++) {
-        if (v2 ? p10_read(w, &d) : p10v1_read(w, &d)) {
-            fail(j, HD_ENOMEM, at, "out of memory");
-            goto done;
-        }
-        for (unsigned t = 1; t < z->n_items; t++) {
-            unsigned ty = z->items[t].type, iv2 = z->items[t].version == 2;
-            if (ty == IT_GPSTIME11) {
-                if (!iv2) {
-                    gps1_read(w, &d);
-                } else if (gps_read(w, &d)) {
-                    fail(j, HD_EFORMAT, at, "point %zu: the GPS time switches sequence more than once", j->k);
-                    goto done;
-                }
-            } else if (ty == IT_RGB12) {
-                rgb_read(w, &d, iv2);
-            } else {
-                bytes_read(w, &d, iv2);
-            }
-        }
-        if (d.over > 4) break;
-        if (put(j, i32_at(w->last), i32_at(w->last + 4), i32_at(w->last + 8))) goto done;
+    if (n > 1) {
+        pw_t *w = malloc(sizeof *w);
+        if (!w || pointwise_start(w, z, b)) fail(j, HD_ENOMEM, at, "out of memory");
+        else pointwise_points(j, w, &d, n);
+        if (w) pw_free(w);
+        free(w);
     }
-    if (d.over)
-        fail(j, HD_EFORMAT, (long long)(z->start[j->chunk] + nb),
-             "the chunk's compressed data ends before its %zu points (the decoder ran past the chunk's end)", n);
-done:
-    pw_free(w);
-    free(w);
+    if (!j->rc) stream_end(j, &d, "compressed data", "chunk", at + (long long)nb, n);
 }
 
 /* ---- POINT14 v3/v4, layered: x and y from layer 0, z from layer 1 -------- */
@@ -598,28 +654,102 @@ static int ctx14_start(ctx14_t *c, const ctx14_t *from) {
     return HD_OK;
 }
 
-static void layered_chunk(job_t *j, const unsigned char *b, size_t nb, size_t n) {
+/* The decoding loop of layered_points: channel cur's models are started. */
+static void layered_loop(job_t *j, ctx14_t *cx, unsigned cur, hd__dec_t *dxy, hd__dec_t *dz, int has_z, size_t n) {
+    long long at = (long long)j->z->start[j->chunk];
+    for (size_t i = 1; i < n; i++) {
+        ctx14_t *c = &cx[cur];
+        unsigned lpr = (c->r == 1) + 2 * (c->r >= c->n) + 4 * c->gps_change;
+        uint32_t changed = hd__dec_symbol(dxy, &c->changed[lpr]);
+        if (changed & 64) {
+            unsigned next = (cur + hd__dec_symbol(dxy, &c->scanner) + 1) & 3;
+            if (!cx[next].used && ctx14_start(&cx[next], c)) {
+                fail(j, HD_ENOMEM, at, "out of memory");
+                return;
+            }
+            cur = next;
+            c = &cx[cur];
+        }
+        unsigned gps = (changed >> 4) & 1;
+        unsigned last_n = c->n, last_r = c->r, nn = last_n, r = last_r;
+        if (changed & 4) {
+            hd__symmodel_t *m = lazy(&c->nret[last_n], 16);
+            if (!m) {
+                fail(j, HD_ENOMEM, at, "out of memory");
+                return;
+            }
+            nn = hd__dec_symbol(dxy, m);
+        }
+        switch (changed & 3) {
+        case 1: r = (last_r + 1) & 15; break;
+        case 2: r = (last_r + 15) & 15; break;
+        case 3:
+            if (gps) {
+                hd__symmodel_t *m = lazy(&c->rnum[last_r], 16);
+                if (!m) {
+                    fail(j, HD_ENOMEM, at, "out of memory");
+                    return;
+                }
+                r = hd__dec_symbol(dxy, m);
+            } else {
+                r = (last_r + hd__dec_symbol(dxy, &c->rn_same) + 2) & 15;
+            }
+            break;
+        default: break;
+        }
+        c->n = nn;
+        c->r = r;
+        unsigned m = hd__laz_rmap14[nn][r], l = hd__laz_level(nn, r), mi = m << 1 | gps;
+        int32_t dx = hd__ic_decode(&c->dx, dxy, c->mx[mi].v[2], nn == 1);
+        c->X = (int32_t)((uint32_t)c->X + (uint32_t)dx);
+        hd__median5_add(&c->mx[mi], dx);
+        int32_t dy = hd__ic_decode(&c->dy, dxy, c->my[mi].v[2], (nn == 1) + hd__laz_kctx(c->dx.k, 20));
+        c->Y = (int32_t)((uint32_t)c->Y + (uint32_t)dy);
+        hd__median5_add(&c->my[mi], dy);
+        if (has_z) {
+            c->Z = hd__ic_decode(&c->dz, dz, c->last_z[l], (nn == 1) + hd__laz_kctx((c->dx.k + c->dy.k) / 2, 18));
+            c->last_z[l] = c->Z;
+        }
+        c->gps_change = gps;
+        if (dxy->over > 4 || dz->over > 4) break;
+        if (put(j, c->X, c->Y, c->Z)) return;
+    }
+}
+
+/* A layered chunk's header: its raw first point (stored), its own point
+ * count (the table's), its layer sizes, which fill the chunk exactly; the
+ * sizes of the x/y and z layers in *nxy, *nz.  0 when it failed. */
+static int layered_head(job_t *j, const unsigned char *b, size_t nb, size_t n, size_t *nxy, size_t *nz) {
     laz_t *z = j->z;
     long long at = (long long)z->start[j->chunk];
     size_t head = z->rec + 4 + 4 * (size_t)z->n_layers;
     if (nb < head) {
         fail(j, HD_EFORMAT, at, "chunk of %zu bytes is shorter than its first point and layer sizes (%zu bytes)", nb, head);
-        return;
+        return 0;
     }
-    if (put(j, i32_at(b), i32_at(b + 4), i32_at(b + 8))) return;
+    if (put(j, i32_at(b), i32_at(b + 4), i32_at(b + 8))) return 0;
     uint32_t stored = hd__ld_u32(b + z->rec, 0);
-    if (stored != n)
+    if (stored != n) {
         fail(j, HD_EFORMAT, at + (long long)z->rec, "the chunk says it holds %u points, the chunk table %zu", stored, n);
+        return 0;
+    }
     uint64_t total = 0;
     for (unsigned i = 0; i < z->n_layers; i++) total += hd__ld_u32(b + z->rec + 4 + 4 * i, 0);
-    if (total > nb - head) {
-        fail(j, HD_EFORMAT, at + (long long)z->rec + 4, "the chunk's layers need %llu bytes, it has %zu after its header",
-             (unsigned long long)total, nb - head);
-        return;
+    if (total != nb - head) {
+        fail(j, HD_EFORMAT, at + (long long)z->rec + 4, "the chunk's layers %s %llu bytes, it has %zu after its header",
+             total > nb - head ? "need" : "fill only", (unsigned long long)total, nb - head);
+        return 0;
     }
-    if (j->rc || n == 1) return;
-    size_t nxy = hd__ld_u32(b + z->rec + 4, 0), nz = hd__ld_u32(b + z->rec + 8, 0);
-    const unsigned char *lxy = b + head, *lz = lxy + nxy;
+    *nxy = hd__ld_u32(b + z->rec + 4, 0);
+    *nz = hd__ld_u32(b + z->rec + 8, 0);
+    return 1;
+}
+
+/* Points 2..n of a layered chunk whose raw first point is b: x and y (with
+ * the channel and returns that choose their models) from dxy, z from dz
+ * when has_z (an empty z layer: z constant in the chunk). */
+static void layered_points(job_t *j, const unsigned char *b, hd__dec_t *dxy, hd__dec_t *dz, int has_z, size_t n) {
+    long long at = (long long)j->z->start[j->chunk];
     ctx14_t *cx = calloc(4, sizeof *cx);
     if (!cx) {
         fail(j, HD_ENOMEM, at, "out of memory");
@@ -632,84 +762,35 @@ static void layered_chunk(job_t *j, const unsigned char *b, size_t nb, size_t n)
     first.r = b[14] & 15;
     first.n = b[14] >> 4;
     unsigned cur = (b[15] >> 4) & 3;
-    hd__dec_t dxy, dz;
-    hd__dec_init(&dxy, lxy, nxy);
-    hd__dec_init(&dz, lz, nz);
-    dz.over = 0; /* an empty z layer (z constant in the chunk) is never read */
-    if (ctx14_start(&cx[cur], &first)) {
-        fail(j, HD_ENOMEM, at, "out of memory");
-        goto done;
-    }
-    for (size_t i = 1; i < n; i++) {
-        ctx14_t *c = &cx[cur];
-        unsigned lpr = (c->r == 1) + 2 * (c->r >= c->n) + 4 * c->gps_change;
-        uint32_t changed = hd__dec_symbol(&dxy, &c->changed[lpr]);
-        if (changed & 64) {
-            unsigned next = (cur + hd__dec_symbol(&dxy, &c->scanner) + 1) & 3;
-            if (!cx[next].used && ctx14_start(&cx[next], c)) {
-                fail(j, HD_ENOMEM, at, "out of memory");
-                goto done;
-            }
-            cur = next;
-            c = &cx[cur];
-        }
-        unsigned gps = (changed >> 4) & 1;
-        unsigned last_n = c->n, last_r = c->r, nn = last_n, r = last_r;
-        if (changed & 4) {
-            hd__symmodel_t *m = lazy(&c->nret[last_n], 16);
-            if (!m) {
-                fail(j, HD_ENOMEM, at, "out of memory");
-                goto done;
-            }
-            nn = hd__dec_symbol(&dxy, m);
-        }
-        switch (changed & 3) {
-        case 1: r = (last_r + 1) & 15; break;
-        case 2: r = (last_r + 15) & 15; break;
-        case 3:
-            if (gps) {
-                hd__symmodel_t *m = lazy(&c->rnum[last_r], 16);
-                if (!m) {
-                    fail(j, HD_ENOMEM, at, "out of memory");
-                    goto done;
-                }
-                r = hd__dec_symbol(&dxy, m);
-            } else {
-                r = (last_r + hd__dec_symbol(&dxy, &c->rn_same) + 2) & 15;
-            }
-            break;
-        default: break;
-        }
-        c->n = nn;
-        c->r = r;
-        unsigned m = hd__laz_rmap14[nn][r], l = hd__laz_level(nn, r), mi = m << 1 | gps;
-        int32_t dx = hd__ic_decode(&c->dx, &dxy, c->mx[mi].v[2], nn == 1);
-        c->X = (int32_t)((uint32_t)c->X + (uint32_t)dx);
-        hd__median5_add(&c->mx[mi], dx);
-        int32_t dy = hd__ic_decode(&c->dy, &dxy, c->my[mi].v[2], (nn == 1) + hd__laz_kctx(c->dx.k, 20));
-        c->Y = (int32_t)((uint32_t)c->Y + (uint32_t)dy);
-        hd__median5_add(&c->my[mi], dy);
-        if (nz) {
-            c->Z = hd__ic_decode(&c->dz, &dz, c->last_z[l], (nn == 1) + hd__laz_kctx((c->dx.k + c->dy.k) / 2, 18));
-            c->last_z[l] = c->Z;
-        }
-        c->gps_change = gps;
-        if (dxy.over > 4 || dz.over > 4) break;
-        if (put(j, c->X, c->Y, c->Z)) goto done;
-    }
-    if (dxy.over || dz.over)
-        fail(j, HD_EFORMAT, at + (long long)head + (long long)(dxy.over ? 0 : nxy),
-             "the chunk's %s layer ends before its %zu points (the decoder ran past the layer's end)",
-             dxy.over ? "x/y" : "z", n);
-done:
+    if (ctx14_start(&cx[cur], &first)) fail(j, HD_ENOMEM, at, "out of memory");
+    else layered_loop(j, cx, cur, dxy, dz, has_z, n);
     for (int c = 0; c < 4; c++) ctx14_free(&cx[c]);
     free(cx);
+}
+
+/* A layered chunk: its header, then the x/y and z layers decoded, each
+ * used up exactly when it has bytes (a one-point chunk's layers are the
+ * four bytes of an empty stream, or nothing); the other layers are
+ * stepped over by their sizes. */
+static void layered_chunk(job_t *j, const unsigned char *b, size_t nb, size_t n) {
+    laz_t *z = j->z;
+    long long at = (long long)z->start[j->chunk];
+    size_t nxy = 0, nz = 0, head = z->rec + 4 + 4 * (size_t)z->n_layers;
+    if (!layered_head(j, b, nb, n, &nxy, &nz)) return;
+    hd__dec_t dxy, dz;
+    hd__dec_init(&dxy, b + head, nxy);
+    hd__dec_init(&dz, b + head + nxy, nz);
+    if (n > 1) layered_points(j, b, &dxy, &dz, nz > 0, n);
+    if (!j->rc && (nxy || n > 1)) stream_end(j, &dxy, "x/y layer", "layer", at + (long long)(head + nxy), n);
+    if (!j->rc && nz) stream_end(j, &dz, "z layer", "layer", at + (long long)(head + nxy + nz), n);
 }
 
 static void decode_chunk(void *ctx, size_t task, int worker) {
     (void)worker;
     laz_t *z = ctx;
-    if (z->first[task + 1] <= z->lo || z->first[task] >= z->hi) { /* outside a range read */
+    /* outside a range read: not decoded, but for the last chunk, where a
+     * header count lower than the data shows (see hd__read_laz) */
+    if ((z->first[task + 1] <= z->lo || z->first[task] >= z->hi) && task + 1 < z->n_chunks) {
         z->rc[task] = 0;
         return;
     }
@@ -725,24 +806,44 @@ static void decode_chunk(void *ctx, size_t task, int worker) {
 }
 
 /* ---- the VLR, the chunk table ----------------------------------------------- */
+/* The VLRs from h->header: 1 with *p, *n at the LASzip VLR's header and
+ * data size; 0 when none is among them; -1 with *p at VLR *i (from 0)
+ * when its header does not fit before the points, -2 when its data does
+ * not (*n its size). */
+static int scan_vlrs(const unsigned char *d, const hd__las_header_t *h, size_t *p, size_t *n, uint32_t *i) {
+    *p = h->header;
+    for (*i = 0; *i < h->n_vlr; ++*i) {
+        if (*p + 54 > h->offset) return -1;
+        *n = hd__ld_u16(d + *p + 20, 0);
+        if (*p + 54 + *n > h->offset) return -2;
+        if (memcmp(d + *p + 2, "laszip encoded", 14) == 0 && d[*p + 16] == 0 && hd__ld_u16(d + *p + 18, 0) == 22204) return 1;
+        *p += 54 + *n;
+    }
+    return 0;
+}
+
+int hd__laz_vlr_present(const unsigned char *d, const hd__las_header_t *h) {
+    size_t p, n;
+    uint32_t i;
+    return scan_vlrs(d, h, &p, &n, &i) == 1;
+}
+
 static int find_vlr(laz_t *z, const hd__las_header_t *h, const unsigned char **vlr, size_t *len, size_t *vlr_at) {
     hd__read_t *r = z->r;
-    size_t p = h->header;
-    for (uint32_t i = 0; i < h->n_vlr; i++) {
-        if (p + 54 > h->offset)
-            return hd__io_err_at(r, HD_EFORMAT, (long long)p, "VLR %u of %u does not fit before the point data at byte %zu", i + 1,
-                                 h->n_vlr, h->offset);
-        size_t n = hd__ld_u16(z->d + p + 20, 0);
-        if (p + 54 + n > h->offset)
-            return hd__io_err_at(r, HD_EFORMAT, (long long)p + 20, "VLR %u's %zu bytes run past the point data at byte %zu", i + 1,
-                                 n, h->offset);
-        if (memcmp(z->d + p + 2, "laszip encoded", 14) == 0 && z->d[p + 16] == 0 && hd__ld_u16(z->d + p + 18, 0) == 22204) {
-            *vlr = z->d + p + 54;
-            *len = n;
-            *vlr_at = p + 54;
-            return HD_OK;
-        }
-        p += 54 + n;
+    size_t p = 0, n = 0;
+    uint32_t i = 0;
+    int found = scan_vlrs(z->d, h, &p, &n, &i);
+    if (found == -1)
+        return hd__io_err_at(r, HD_EFORMAT, (long long)p, "VLR %u of %u does not fit before the point data at byte %zu", i + 1,
+                             h->n_vlr, h->offset);
+    if (found == -2)
+        return hd__io_err_at(r, HD_EFORMAT, (long long)p + 20, "VLR %u's %zu bytes run past the point data at byte %zu", i + 1, n,
+                             h->offset);
+    if (found == 1) {
+        *vlr = z->d + p + 54;
+        *len = n;
+        *vlr_at = p + 54;
+        return HD_OK;
     }
     return hd__io_err_at(r, HD_EFORMAT, 104,
                          "the point format says compressed (LAZ) but no LASzip VLR (user 'laszip encoded', record 22204) is "
@@ -813,6 +914,22 @@ static int parse_vlr(laz_t *z, const hd__las_header_t *h, uint32_t *chunk_size) 
     return HD_OK;
 }
 
+/* Chunk c of nc, at `at`, claims more than z->per_byte points a byte.
+ * Above HD_LAZ_POINTS_PER_BYTE_MAX no stream can hold them (HD_EFORMAT);
+ * below, the file may be degenerate data, refused by the limit that bounds
+ * its memory, which the message says how to raise (HD_EUNSUPPORTED). */
+static int too_dense(laz_t *z, long long at, size_t c, size_t nc, uint64_t pts, uint64_t bytes) {
+    if (pts > bytes * HD_LAZ_POINTS_PER_BYTE_MAX)
+        return hd__io_err_at(z->r, HD_EFORMAT, at, "chunk %zu of %zu claims %llu points in %llu bytes (no stream holds more than %d a byte)",
+                             c, nc, (unsigned long long)pts, (unsigned long long)bytes, HD_LAZ_POINTS_PER_BYTE_MAX);
+    return hd__io_err_at(z->r, HD_EUNSUPPORTED, at,
+                         "chunk %zu of %zu claims %llu points in %llu bytes, %.0f a byte: above the limit of %u points a "
+                         "compressed byte (%s), which bounds the memory a LAZ file may ask for; raise it up to %d with "
+                         "--laz-points-per-byte N (read option laz_points_per_byte)",
+                         c, nc, (unsigned long long)pts, (unsigned long long)bytes, ceil((double)pts / (double)bytes), z->per_byte,
+                         z->per_byte == HD_LAZ_POINTS_PER_BYTE ? "the default" : "as asked", HD_LAZ_POINTS_PER_BYTE_MAX);
+}
+
 static int read_table(laz_t *z, const hd__las_header_t *h, uint32_t chunk_size) {
     hd__read_t *r = z->r;
     size_t data = h->offset + 8;
@@ -869,9 +986,8 @@ static int read_table(laz_t *z, const hd__las_header_t *h, uint32_t chunk_size) 
         else if (z->first[i + 1] > count)
             rc = hd__io_err_at(r, HD_EFORMAT, (long long)t + 8, "the chunks hold more than the header's %llu points",
                                (unsigned long long)count);
-        else if (pts > (uint64_t)bytes * HD__LAZ_POINTS_PER_BYTE)
-            rc = hd__io_err_at(r, HD_EFORMAT, (long long)z->start[i], "chunk %u of %u claims %u points in %u bytes (at most %d per byte)",
-                               i + 1, nc, pts, bytes, HD__LAZ_POINTS_PER_BYTE);
+        else if (pts > (uint64_t)bytes * z->per_byte)
+            rc = too_dense(z, (long long)z->start[i], i + 1, nc, pts, bytes);
     }
     hd__intcoder_free(&ic);
     if (rc == HD_OK && z->first[nc] != count)
@@ -892,9 +1008,89 @@ static int one_chunk(laz_t *z, const hd__las_header_t *h) {
     z->start[1] = end;
     z->first[0] = 0;
     z->first[1] = h->count;
-    if (h->count > (uint64_t)(end - h->offset) * HD__LAZ_POINTS_PER_BYTE)
-        return hd__io_err_at(z->r, HD_EFORMAT, 107, "%llu points in %zu bytes of compressed data (at most %d per byte)",
-                             (unsigned long long)h->count, end - h->offset, HD__LAZ_POINTS_PER_BYTE);
+    if (h->count > (uint64_t)(end - h->offset) * z->per_byte) return too_dense(z, 107, 1, 1, h->count, end - h->offset);
+    return HD_OK;
+}
+
+/* The per-chunk outcome arrays; HD_OK or the error. */
+static int alloc_outcomes(laz_t *z) {
+    z->rc = hd__malloc_array(z->n_chunks, sizeof *z->rc);
+    z->at = hd__malloc_array(z->n_chunks, sizeof *z->at);
+    z->msg = hd__malloc_array(z->n_chunks, sizeof *z->msg);
+    return z->rc && z->at && z->msg ? HD_OK : hd__io_err(z->r, HD_ENOMEM, "out of memory");
+}
+
+/* The first failing chunk in file order, as the error; HD_OK when none of
+ * the first n failed. */
+static int first_failure(laz_t *z, size_t n) {
+    for (size_t c = 0; c < n; c++)
+        if (z->rc[c]) return hd__io_err_at(z->r, z->rc[c], z->at[c], "chunk %zu of %zu: %s", c + 1, z->n_chunks, z->msg[c]);
+    return HD_OK;
+}
+
+/* hd_read_count: the header's count once the chunk table is checked, every
+ * layered chunk's own count matches it, and the last chunk, where a header
+ * count lower than the data shows (fixed chunk sizes put the difference
+ * there; LASzip 1.x has no other), decodes to exactly its points.  No
+ * point is kept. */
+static int count_laz(laz_t *z, const hd__las_header_t *h) {
+    z->lo = z->hi = 0;
+    int rc = alloc_outcomes(z);
+    for (size_t c = 0; rc == HD_OK && z->layered && c + 1 < z->n_chunks; c++) {
+        uint64_t stored = z->start[c + 1] - z->start[c] >= z->rec + 4 ? hd__ld_u32(z->d + z->start[c] + z->rec, 0) : 0;
+        if (stored != z->first[c + 1] - z->first[c])
+            rc = hd__io_err_at(z->r, HD_EFORMAT, (long long)(z->start[c] + z->rec),
+                               "chunk %zu of %zu says it holds %llu points, the chunk table %llu", c + 1, z->n_chunks,
+                               (unsigned long long)stored, (unsigned long long)(z->first[c + 1] - z->first[c]));
+    }
+    if (rc == HD_OK) {
+        memset(z->rc, 0, z->n_chunks * sizeof *z->rc);
+        decode_chunk(z, z->n_chunks - 1, 0);
+        rc = first_failure(z, z->n_chunks);
+    }
+    if (rc == HD_OK) {
+        z->r->total = h->count;
+        rc = HD__COUNTED;
+    }
+    return rc;
+}
+
+/* The points [z->lo, z->hi) into the sink.  Up to HD__LAZ_EAGER_PER_BYTE
+ * points per byte of chunk data the result is allocated at once and the
+ * chunks decoded in parallel; above, chunks are decoded one after the
+ * other and the result grows as points are decoded, so a file whose claims
+ * its bytes do not back fails before allocating them. */
+static int decode_laz(laz_t *z, const hd__las_header_t *h) {
+    hd__read_t *r = z->r;
+    z->grow = h->count > (z->start[z->n_chunks] - z->start[0]) * HD__LAZ_EAGER_PER_BYTE;
+    int rc = hd__sink_reserve(r->sink, z->grow ? 0 : (size_t)(z->hi - z->lo));
+    if (rc) return hd__io_err(r, rc, "cannot allocate %llu points: %s", (unsigned long long)h->count, hd_strerror(rc));
+    if ((rc = alloc_outcomes(z)) != HD_OK) return rc;
+    if (!z->grow) hd__parallel_for(hd__thread_count(r->threads, z->n_chunks), z->n_chunks, decode_chunk, z);
+    size_t done = z->grow ? 0 : z->n_chunks;
+    while (done < z->n_chunks) {
+        decode_chunk(z, done, 0);
+        if (z->rc[done++]) break;
+    }
+    rc = first_failure(z, done);
+    if (rc == HD_OK) r->sink->count = (size_t)(z->hi - z->lo);
+    return rc;
+}
+
+/* A range read keeps [lo, hi) and decodes only the chunks that meet it
+ * (and the last). */
+static int laz_range(laz_t *z, const hd__las_header_t *h) {
+    hd__read_t *r = z->r;
+    const hd_read_options_t *o = r->opt;
+    z->lo = 0;
+    z->hi = h->count;
+    if (!o->range_count || o->mesh != HD_MESH_VERTICES) return HD_OK;
+    if (o->range_first > h->count || o->range_count > h->count - o->range_first)
+        return hd__io_err(r, HD_ERANGE, "points [%llu, %llu) asked of a file of %llu points", (unsigned long long)o->range_first,
+                          (unsigned long long)(o->range_first + o->range_count), (unsigned long long)h->count);
+    z->lo = o->range_first;
+    z->hi = o->range_first + o->range_count;
+    r->ranged = 1;
     return HD_OK;
 }
 
@@ -909,54 +1105,18 @@ int hd__read_laz(hd__read_t *r, const hd__las_header_t *h) {
         z.scale[c] = h->scale[c];
         z.shift[c] = h->shift[c];
     }
+    z.per_byte = r->opt->laz_points_per_byte ? r->opt->laz_points_per_byte : HD_LAZ_POINTS_PER_BYTE;
+    if (z.per_byte > HD_LAZ_POINTS_PER_BYTE_MAX)
+        return hd__io_err(r, HD_EINVAL, "laz_points_per_byte %u is above %d (no LAZ stream holds more points a byte)", z.per_byte,
+                          HD_LAZ_POINTS_PER_BYTE_MAX);
     uint32_t chunk_size = 0;
     int rc = parse_vlr(&z, h, &chunk_size);
     if (rc == HD_OK && h->count == 0) return r->count_only ? HD__COUNTED : HD_OK; /* total stays 0 */
     if (rc == HD_OK && z.chunked) rc = read_table(&z, h, chunk_size);
     if (rc == HD_OK && !z.chunked) rc = one_chunk(&z, h);
     if (rc == HD_OK && r->sink->count != 0) rc = hd__io_err(r, HD_EINVAL, "internal: LAZ points into a non-empty sink");
-    if (rc == HD_OK && r->count_only) { /* hd_read_count: the chunk table is checked */
-        r->total = h->count;
-        rc = HD__COUNTED;
-    }
-    /* A range read keeps [lo, hi) and decodes only the chunks that meet it. */
-    z.lo = 0;
-    z.hi = h->count;
-    const hd_read_options_t *o = r->opt;
-    if (rc == HD_OK && o->range_count && o->mesh == HD_MESH_VERTICES) {
-        if (o->range_first > h->count || o->range_count > h->count - o->range_first)
-            rc = hd__io_err(r, HD_ERANGE, "points [%llu, %llu) asked of a file of %llu points",
-                            (unsigned long long)o->range_first, (unsigned long long)(o->range_first + o->range_count),
-                            (unsigned long long)h->count);
-        z.lo = o->range_first;
-        z.hi = o->range_first + o->range_count;
-        r->ranged = 1;
-    }
-    /* Real data holds under a third of a point per byte; a degenerate file
-     * (a repeated point) up to a thousand.  Up to HD__LAZ_EAGER_PER_BYTE the
-     * result is allocated at once and the chunks decoded in parallel; above,
-     * chunks are decoded one after the other and the result grows as points
-     * are decoded, so a file whose claims its bytes do not back fails
-     * before allocating them. */
-    z.grow = rc == HD_OK && h->count > (z.start[z.n_chunks] - z.start[0]) * HD__LAZ_EAGER_PER_BYTE;
-    if (rc == HD_OK && (rc = hd__sink_reserve(r->sink, z.grow ? 0 : (size_t)(z.hi - z.lo))) != HD_OK)
-        rc = hd__io_err(r, rc, "cannot allocate %llu points: %s", (unsigned long long)h->count, hd_strerror(rc));
-    if (rc == HD_OK) {
-        z.rc = hd__malloc_array(z.n_chunks, sizeof *z.rc);
-        z.at = hd__malloc_array(z.n_chunks, sizeof *z.at);
-        z.msg = hd__malloc_array(z.n_chunks, sizeof *z.msg);
-        if (!z.rc || !z.at || !z.msg) rc = hd__io_err(r, HD_ENOMEM, "out of memory");
-    }
-    if (rc == HD_OK) {
-        if (!z.grow) hd__parallel_for(hd__thread_count(r->threads, z.n_chunks), z.n_chunks, decode_chunk, &z);
-        for (size_t c = 0; z.grow && c < z.n_chunks; c++) {
-            decode_chunk(&z, c, 0);
-            if (z.rc[c]) break;
-        }
-        for (size_t c = 0; c < z.n_chunks && rc == HD_OK; c++)
-            if (z.rc[c]) rc = hd__io_err_at(r, z.rc[c], z.at[c], "chunk %zu of %zu: %s", c + 1, z.n_chunks, z.msg[c]);
-        if (rc == HD_OK) r->sink->count = (size_t)(z.hi - z.lo);
-    }
+    if (rc == HD_OK && r->count_only) rc = count_laz(&z, h);
+    else if (rc == HD_OK && (rc = laz_range(&z, h)) == HD_OK) rc = decode_laz(&z, h);
     free(z.start);
     free(z.first);
     free(z.rc);

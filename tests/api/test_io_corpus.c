@@ -61,6 +61,14 @@ static outcome_t regress[] = {
     {"tests/corpus/pcd/regress-bom.pcd", HD_OK, 2, 0, 0, 0},
     {"tests/corpus/npy/regress-empty-shape", HD_EFORMAT, 0, 0, 0, 0},
     {"tests/corpus/las/regress-laz-repeated-items", HD_EFORMAT, 0, 0, 0, 0},
+    {"tests/corpus/laz/regress-count-1-of-100.laz", HD_EFORMAT, 0, 0, 0, 0},
+    {"tests/corpus/laz/regress-count-99-of-100-last-chunk.laz", HD_EFORMAT, 0, 0, 0, 0},
+    {"tests/corpus/laz/regress-count-60-of-100-laszip1.laz", HD_EFORMAT, 0, 0, 0, 0},
+    {"tests/corpus/laz/regress-count-99-of-100-layered.laz", HD_EFORMAT, 0, 0, 0, 0},
+    {"tests/corpus/laz/regress-point10-v1-said-v2.laz", HD_EFORMAT, 0, 0, 0, 0},
+    {"tests/corpus/laz/regress-rgb12-v1-said-v2.laz", HD_EFORMAT, 0, 0, 0, 0},
+    {"tests/corpus/laz/regress-compression-bit-cleared.laz", HD_EFORMAT, 0, 0, 0, 0},
+    {"tests/corpus/laz/regress-dense-1000000-points.laz", HD_EUNSUPPORTED, 0, 0, 0, 0},
 };
 #define N_REGRESS (sizeof regress / sizeof regress[0])
 

@@ -174,7 +174,8 @@ static void chunk10(tf_buf_t *b, const lazw_opts_t *o, const lazw_point_t *p, si
     icnew(&dy, 32, 22);
     icnew(&dz, 32, 20);
     char made[256] = {0};
-    hd__symmodel_t gzero, rgbused, bytes[8];
+    hd__symmodel_t gzero, rgbused, *bytes = calloc(o->extra ? o->extra : 1, sizeof *bytes);
+    assert(bytes);
     symnew(&gzero, 6);
     symnew(&rgbused, 128);
     for (unsigned i = 0; i < o->extra; i++) symnew(&bytes[i], 256);
@@ -211,6 +212,7 @@ static void chunk10(tf_buf_t *b, const lazw_opts_t *o, const lazw_point_t *p, si
     hd__symmodel_free(&gzero);
     hd__symmodel_free(&rgbused);
     for (unsigned i = 0; i < o->extra; i++) hd__symmodel_free(&bytes[i]);
+    free(bytes);
     for (int i = 0; i < 256; i++)
         if (made[i]) hd__symmodel_free(&bitbyte[i]);
     hd__intcoder_free(&dx);

@@ -30,7 +30,8 @@ typedef struct lazw_point {
 
 typedef struct lazw_opts {
     int format;           /* 0, 1, 2, 3 (pointwise) or 6 (layered) */
-    unsigned extra;       /* extra bytes per point (0-8) */
+    unsigned extra;       /* extra bytes per point (0-8; pointwise version 2: up to
+                           * 65515, the most a record of 65535 bytes holds) */
     uint32_t chunk_size;  /* points per chunk; 0: variable, sizes in chunks[] */
     const size_t *chunks; /* variable chunk sizes (n_chunks of them, sum n) */
     size_t n_chunks;

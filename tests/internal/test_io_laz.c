@@ -15,16 +15,21 @@
 #include "io/io.h"
 
 #include <stdlib.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 static const lazw_opts_t plain = {0, 0, 50, NULL, 0, {0.01, 0.01, 0.001}, {1000.5, -20.25, 3}, 0};
 
 /* Read the LAZ bytes b with `threads`; HD_OK and the cloud, or the code
  * and the message in e. */
+static unsigned per_byte; /* the read options' laz_points_per_byte (0: default) */
 static int read_laz(const tf_buf_t *b, int threads, hd_dtype_t dtype, hd_cloud_t **c, hd_error_t *e) {
     hd_read_options_t o;
     hd_read_options_init(&o);
     o.threads = threads;
     o.dtype = dtype;
+    o.laz_points_per_byte = per_byte;
     return hd__read_buffer(b->data, b->size, "t.laz", &o, c, e);
 }
 
@@ -133,8 +138,9 @@ TEST(a_chunk_whose_z_never_changes_has_an_empty_z_layer_and_keeps_its_z) {
 }
 
 TEST(identical_points_compress_far_below_the_points_per_byte_limit) {
-    /* the reader refuses chunks of more than 4096 points per byte; real
-     * degenerate data (a chunk of one repeated point) stays far below */
+    /* the reader refuses chunks of more than HD_LAZ_POINTS_PER_BYTE points
+     * per byte by default; degenerate data (a chunk of one repeated point)
+     * in LASzip's chunks of 50,000 stays below */
     static lazw_point_t p[50000];
     for (int i = 0; i < 50000; i++) p[i] = (lazw_point_t){5, 6, 7, 1, 1, 0};
     for (int fmt = 0; fmt <= 6; fmt += 6) {
@@ -145,7 +151,7 @@ TEST(identical_points_compress_far_below_the_points_per_byte_limit) {
         tf_buf_t b = {0};
         lazw_encode(&b, &o, p, 50000);
         size_t bytes = b.size - lazw_last.chunk[0];
-        CHECK(50000 / bytes < 4096 / 4);
+        CHECK(50000 / bytes < HD_LAZ_POINTS_PER_BYTE * 2 / 3);
         tf_free(&b);
         round_trip(&o, p, 50000, 1);
     }
@@ -262,9 +268,10 @@ TEST(a_huge_point_count_in_a_tiny_chunk_is_refused_before_allocating) {
 }
 
 TEST(a_chunk_claiming_thousands_of_points_per_byte_fails_as_its_stream_runs_out) {
-    /* a pointwise chunk of 50 real points whose table says 4000 per byte:
-     * the reader takes the sequential path, growing the result as points
-     * are decoded, and stops where the stream runs past the chunk */
+    /* a pointwise chunk of 50 real points whose table says 4000 per byte,
+     * read with the limit raised to 4096: the reader takes the sequential
+     * path, growing the result as points are decoded, and stops where the
+     * stream runs past the chunk */
     lazw_point_t *p = points(9, 50, 0);
     size_t sizes[1] = {50};
     lazw_opts_t o = plain;
@@ -278,7 +285,9 @@ TEST(a_chunk_claiming_thousands_of_points_per_byte_fails_as_its_stream_runs_out)
     b.size = t;
     lazw_table(&b, &cnt, &bytes, 1);
     put_u32(&b, 107, cnt);
+    per_byte = HD_LAZ_POINTS_PER_BYTE_MAX;
     refused(&b, HD_EFORMAT, "ran past the chunk's end", (long long)t);
+    per_byte = 0;
     tf_free(&b);
     free(p);
 }
@@ -311,7 +320,10 @@ TEST(a_damaged_layer_size_is_refused_with_the_chunk_offset) {
     tf_free(&b);
     tf_buf_t c = {0};
     sample(&c, 6, 100, 100);
-    put_u32(&c, sizes_at, 3); /* x/y layer of 3 bytes: the decoder runs past it */
+    uint32_t nxy = (uint32_t)hd__ld_u32(c.data + sizes_at, 0), nz = (uint32_t)hd__ld_u32(c.data + sizes_at + 4, 0);
+    put_u32(&c, sizes_at, 3); /* x/y layer of 3 bytes: the layers no longer fill the chunk */
+    refused(&c, HD_EFORMAT, "the chunk's layers fill only", (long long)sizes_at);
+    put_u32(&c, sizes_at + 4, nz + nxy - 3); /* the z layer takes the rest: x/y runs past its 3 bytes */
     refused(&c, HD_EFORMAT, "x/y layer ends before its 100 points", -1);
     tf_free(&c);
     tf_buf_t d = {0};
@@ -372,4 +384,205 @@ TEST(a_laz_point_beyond_the_float_range_is_refused_naming_it) {
     CHECK_EQ(e.offset, (long long)lazw_last.chunk[0]);
     hd_cloud_free(c);
     tf_free(&b);
+}
+
+/* ---- counts and items that do not describe the data ------------------------- */
+/* hd_read_count on the bytes b: its code, the message in e. */
+static int count_laz(const tf_buf_t *b, uint64_t *n, hd_error_t *e) {
+    hd_read_options_t o;
+    hd_read_options_init(&o);
+    return hd__count_buffer(b->data, b->size, "t.laz", &o, n, e);
+}
+
+/* b is refused by a read and by hd_read_count, each message holding needle. */
+static void refused_and_not_counted(const tf_buf_t *b, const char *needle) {
+    refused(b, HD_EFORMAT, needle, -1);
+    uint64_t n = 7;
+    hd_error_t e;
+    CHECK_RC(count_laz(b, &n, &e), HD_EFORMAT);
+    CHECK_EQ(n, 0);
+    if (!strstr(e.message, needle)) hdt_fail(__FILE__, __LINE__, "count's message '%s' lacks '%s'", e.message, needle);
+}
+
+TEST(a_header_count_lower_than_the_data_is_refused_never_read_partly) {
+    /* one chunk of 100, two of 50 (the lie lands in the last), LASzip 1's
+     * single stream; counts 1 (the one-point chunk: its stream must be the
+     * four bytes an empty one is) to 99 */
+    static const uint32_t chunks[3] = {200, 50, 1};
+    static const uint32_t lies[4] = {1, 2, 60, 99};
+    for (int v = 0; v < 3; v++)
+        for (int l = 0; l < 4; l++) {
+            CONTEXT("chunks of %u%s, header count %u of 100", chunks[v], v == 2 ? " (LASzip 1)" : "", lies[l]);
+            tf_buf_t b = {0};
+            sample_v(&b, v == 2 ? 3 : 0, 100, chunks[v], v == 2);
+            put_u32(&b, 107, lies[l]);
+            if (v == 1 && lies[l] <= 50) /* fewer chunks than the table: refused by the table */
+                refused(&b, HD_EFORMAT, "chunks for", -1);
+            else
+                refused_and_not_counted(&b, "left after its");
+            tf_free(&b);
+        }
+}
+
+TEST(a_range_read_decodes_the_last_chunk_so_a_lowered_count_is_refused_there_too) {
+    tf_buf_t b = {0};
+    sample(&b, 0, 100, 50);
+    put_u32(&b, 107, 99);
+    hd_read_options_t o;
+    hd_read_options_init(&o);
+    o.range_first = 0;
+    o.range_count = 10; /* the first chunk only */
+    hd_cloud_t *c = NULL;
+    hd_error_t e;
+    CHECK_RC(hd__read_buffer(b.data, b.size, "t.laz", &o, &c, &e), HD_EFORMAT);
+    if (!strstr(e.message, "chunk 2 of 2: ") || !strstr(e.message, "left after its 49 points"))
+        hdt_fail(__FILE__, __LINE__, "message '%s' does not name the last chunk's unread bytes", e.message);
+    CHECK(c == NULL);
+    tf_free(&b);
+}
+
+TEST(a_layered_chunk_whose_count_and_table_are_both_lowered_leaves_its_x_y_layer_unfinished) {
+    tf_buf_t b = {0};
+    sample(&b, 6, 100, 100);
+    put_u64(&b, 247, 99);
+    put_u32(&b, lazw_last.chunk[0] + 30, 99); /* the chunk's own count */
+    refused_and_not_counted(&b, "of the chunk's x/y layer are left after its 99 points");
+    tf_free(&b);
+}
+
+TEST(a_one_point_layered_chunk_has_an_empty_stream_of_four_bytes_or_none_per_decoded_layer) {
+    static const size_t sizes[3] = {1, 30, 1};
+    lazw_point_t *p = points(41, 32, 6);
+    lazw_opts_t o = plain;
+    o.format = 6;
+    o.chunk_size = 0;
+    o.chunks = sizes;
+    o.n_chunks = 3;
+    round_trip(&o, p, 32, 2);
+    tf_buf_t b = {0};
+    lazw_encode(&b, &o, p, 32);
+    size_t nxy_at = lazw_last.chunk[0] + 30 + 4;
+    CHECK_EQ(hd__ld_u32(b.data + nxy_at, 0), 4);
+    CHECK_EQ(hd__ld_u32(b.data + nxy_at + 4, 0), 0);
+    /* the one-point chunk's x/y layer of 3 bytes and a z layer of 1 */
+    put_u32(&b, nxy_at, 3);
+    put_u32(&b, nxy_at + 4, 1);
+    refused(&b, HD_EFORMAT, "chunk 1 of 3: the chunk's x/y layer ends before its 1 point (the decoder ran past the layer's end)", -1);
+    tf_free(&b);
+    free(p);
+}
+
+TEST(a_skipped_layer_cannot_hide_bytes_the_layer_sizes_do_not_account_for) {
+    tf_buf_t b = {0};
+    sample(&b, 6, 100, 100);
+    size_t sizes_at = lazw_last.chunk[0] + 30 + 4;
+    uint32_t nxy = (uint32_t)hd__ld_u32(b.data + sizes_at, 0);
+    put_u32(&b, sizes_at, nxy - 1); /* one byte of x/y in no layer */
+    refused(&b, HD_EFORMAT, "the chunk's layers fill only", (long long)sizes_at);
+    tf_free(&b);
+}
+
+TEST(laszip_items_whose_version_is_not_the_one_the_data_was_written_with_are_refused) {
+    /* LASzip 1.x streams of version 1 items said to be version 2: POINT10
+     * in format 0, RGB12 in format 2 (item 2).  Seeds and sizes whose lie
+     * decodes without running past the stream: only the bytes left show it. */
+    static const struct { int fmt, item; size_t n; } lie[2] = {{0, 0, 6}, {2, 1, 3}};
+    for (int k = 0; k < 2; k++) {
+        CONTEXT("format %d, item %d of version 1 said to be 2, %zu points, seed 3", lie[k].fmt, lie[k].item + 1, lie[k].n);
+        lazw_point_t *p = points(3, lie[k].n, lie[k].fmt);
+        lazw_opts_t o = plain;
+        o.format = lie[k].fmt;
+        o.v1 = 1;
+        tf_buf_t b = {0};
+        lazw_encode(&b, &o, p, lie[k].n);
+        b.data[lazw_last.vlr + 34 + 6 * lie[k].item + 4] = 2;
+        refused(&b, HD_EFORMAT, "the LASzip VLR's items are not the ones it was written with", -1);
+        tf_free(&b);
+        free(p);
+    }
+}
+
+/* ---- memory bounded by the file ---------------------------------------------- */
+/* The growth of the peak resident memory (MiB, capped at 255) of reading b
+ * in a child process with one thread; -1 if the child failed to report. */
+static int read_growth_mib(const tf_buf_t *b) {
+    pid_t pid = fork();
+    if (pid == 0) {
+        struct rusage u0, u1;
+        getrusage(RUSAGE_SELF, &u0);
+        hd_cloud_t *c = NULL;
+        hd_error_t e;
+        read_laz(b, 1, HD_FLOAT64, &c, &e);
+        hd_cloud_free(c);
+        getrusage(RUSAGE_SELF, &u1);
+        long mib = (u1.ru_maxrss - u0.ru_maxrss) / 1024;
+        _exit(mib > 255 ? 255 : (int)mib);
+    }
+    int status = 0;
+    if (pid < 0 || waitpid(pid, &status, 0) != pid || !WIFEXITED(status)) return -1;
+    return WEXITSTATUS(status);
+}
+
+TEST(a_record_of_65515_extra_bytes_with_a_stream_of_four_creates_models_only_for_what_it_decodes) {
+    /* one point of 65,515 extra bytes (a 66 KB file) whose header says two:
+     * the second point's BYTE symbols run past the four-byte stream at
+     * once; creating every extra byte's model up front cost 150 MB */
+    lazw_point_t p[1] = {{1, 2, 3, 1, 1, 0}};
+    lazw_opts_t o = plain;
+    o.extra = 65515;
+    o.chunk_size = 1000;
+    tf_buf_t b = {0};
+    lazw_encode(&b, &o, p, 1);
+    CHECK(b.size < 67000);
+    put_u32(&b, 107, 2);
+    refused(&b, HD_EFORMAT, "ran past the chunk's end", -1);
+    int mib = read_growth_mib(&b);
+    if (mib < 0 || mib > 32) hdt_fail(__FILE__, __LINE__, "reading grew the resident memory by %d MiB", mib);
+    tf_free(&b);
+}
+
+TEST(extra_bytes_models_created_at_first_use_decode_a_record_of_65515_extra_bytes) {
+    lazw_point_t *p = points(51, 3, 0);
+    lazw_opts_t o = plain;
+    o.extra = 65515;
+    round_trip(&o, p, 3, 1);
+    free(p);
+}
+
+TEST(a_chunk_denser_than_the_default_points_per_byte_is_refused_naming_the_limit_and_how_to_raise_it) {
+    /* a million copies of one point in one chunk: a valid stream of about
+     * 500 points a byte, 24 MB of result from 2 KB; the default limit
+     * refuses it before decoding, a raised one reads it */
+    size_t n = 1000000;
+    lazw_point_t *p = malloc(n * sizeof *p);
+    for (size_t k = 0; k < n; k++) p[k] = (lazw_point_t){5, 6, 7, 1, 1, 0};
+    lazw_opts_t o = plain;
+    o.chunk_size = (uint32_t)n;
+    tf_buf_t b = {0};
+    lazw_encode(&b, &o, p, n);
+    size_t bytes = lazw_last.table - lazw_last.chunk[0];
+    CHECK(n / bytes > HD_LAZ_POINTS_PER_BYTE && n / bytes < 1024);
+    refused(&b, HD_EUNSUPPORTED, "above the limit of 256 points a compressed byte (the default)", (long long)lazw_last.chunk[0]);
+    refused(&b, HD_EUNSUPPORTED, "--laz-points-per-byte N (read option laz_points_per_byte)", -1);
+    per_byte = 1024;
+    round_trip(&o, p, n, 2);
+    per_byte = 300;
+    refused(&b, HD_EUNSUPPORTED, "limit of 300 points a compressed byte (as asked)", -1);
+    per_byte = HD_LAZ_POINTS_PER_BYTE_MAX + 1;
+    refused(&b, HD_EINVAL, "laz_points_per_byte 4097 is above 4096", -1);
+    per_byte = 0;
+    tf_free(&b);
+    free(p);
+}
+
+TEST(a_laz_file_whose_format_byte_lost_its_compression_bit_is_refused_naming_the_laszip_vlr) {
+    for (int fmt = 0; fmt <= 6; fmt += 6) {
+        CONTEXT("format %d", fmt);
+        tf_buf_t b = {0};
+        sample(&b, fmt, 100, 50);
+        b.data[104] &= 0x7f; /* read as LAS: 100 records do not fit */
+        refused(&b, HD_EFORMAT, "file ends inside the points", (long long)b.size);
+        refused(&b, HD_EFORMAT, "a LASzip VLR (user 'laszip encoded', record 22204), so its points are compressed", -1);
+        tf_free(&b);
+    }
 }
