@@ -434,7 +434,10 @@ HD_EXTERN int hd_hausdorff_percentile(const hd_points_t *A,
  * even (Python's math.fsum), so they do not depend on the order of the
  * values (the same at any thread count, and from hausdorff_mpi.h's
  * hd_mpi_summarize for any split over ranks).  Means and Chamfer figures
- * are computed from the rounded sums.  "2" means squared distances
+ * are computed from the rounded sums as doubles without an exponent limit
+ * would compute them: a sum of squares beyond DBL_MAX (possible within the
+ * 1e153 coordinate limit) is +inf, but the means and Chamfer distance made
+ * from it are finite whenever they are at most DBL_MAX.  "2" means squared distances
  * (d * d of each reported distance).  With d_ba NULL every field that needs
  * B's distances is NaN. */
 typedef struct hd_summary {
