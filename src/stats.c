@@ -287,6 +287,12 @@ int hd_histogram(const double *values, size_t n, double lo, double hi,
     for (size_t k = 0; k < n; k++) {
         double x = values[k];
         if (!(x >= lo && x <= hi)) continue; /* outside, or NaN */
+        if (isinf(norm)) { /* a subnormal range (numpy's product is NaN or inf there): by the edges */
+            size_t b = 0;
+            while (b + 1 < bins && x >= edge(lo, hi, bins, b + 1)) b++;
+            counts[b]++;
+            continue;
+        }
         double f = (x - lo) * norm;
         size_t b = f >= (double)bins ? bins : (size_t)f;
         if (b == bins) b--;
