@@ -121,8 +121,10 @@ enum {
 
 /* Context of a failure, filled by any call that takes one (it may be NULL).
  * `message` is a complete sentence such as "cloud.ply:12: expected 3 numbers,
- * found 2"; `line` (1-based, text input) and `offset` (bytes, binary input)
- * are -1 when they do not apply. */
+ * found 2"; a sentence longer than 1023 bytes has its file names shortened
+ * in their middle ("/data/very...t2.xyz"), so that what went wrong and why
+ * stay whole.  `line` (1-based, text input) and `offset` (bytes, binary
+ * input) are -1 when they do not apply. */
 typedef struct hd_error {
     int code;
     long long line;
