@@ -104,7 +104,7 @@ void analysis_usage(FILE *out) {
 
 static int usage_error(const char *fmt, const char *arg) {
     fprintf(stderr, "%s: ", cli_prog());
-    fprintf(stderr, fmt, arg);
+    fprintf(stderr, fmt, safe_text(arg));
     fprintf(stderr, "\nTry '%s --help'.\n", cli_prog());
     return -1;
 }

@@ -67,9 +67,9 @@ int main(int argc, char **argv) {
     char files[2][32] = {"", ""};
     for (int w = 0; w < 2; w++)
         if (side[w].kind != TILES_FILE) snprintf(files[w], sizeof files[w], " (%zu files)", side[w].n);
-    progress_phase("reading A: %s%s", a.path_a, files[0]);
+    progress_phase("reading A: %s%s", safe_text(a.path_a), files[0]);
     if ((rc = tiles_read(&side[0], 0, side[0].n, &a.read, &a.an, 0, &ca, &err)) != HD_OK ||
-        (progress_phase("reading B: %s%s", a.path_b, files[1]),
+        (progress_phase("reading B: %s%s", safe_text(a.path_b), files[1]),
          rc = tiles_read(&side[1], 0, side[1].n, &a.read, &a.an, 1, &cb, &err)) != HD_OK) {
         progress_stop();
         fprintf(stderr, "%s: %s\n", cli_prog(), safe_text(err.message));

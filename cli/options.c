@@ -93,7 +93,7 @@ void cli_formats(FILE *out) {
 
 static int bad(const char *fmt, const char *arg) {
     fprintf(stderr, "%s: ", cli_prog());
-    fprintf(stderr, fmt, arg);
+    fprintf(stderr, fmt, safe_text(arg));
     fprintf(stderr, "\nTry '%s --help'.\n", cli_prog());
     return EXIT_USAGE;
 }

@@ -151,13 +151,13 @@ int out_check_paths(const char *const *outs, const char *const *what, int n,
         for (size_t w = 0; w < n_inputs; w++)
             if (clash(outs[k], inputs[w], 1)) {
                 fprintf(stderr, "%s: %s %s would overwrite input %c (%s); name another file\n", cli_prog(), what[k],
-                        outs[k], side[w], is_stdin(inputs[w], 1) ? "standard input" : inputs[w]);
+                        safe_text(outs[k]), side[w], is_stdin(inputs[w], 1) ? "standard input" : safe_text(inputs[w]));
                 return EXIT_USAGE;
             }
         for (int j = 0; j < k; j++)
             if (outs[j] && clash(outs[k], outs[j], 0)) {
                 fprintf(stderr, "%s: %s %s and %s %s are the same file; name another file\n", cli_prog(), what[j],
-                        outs[j], what[k], outs[k]);
+                        safe_text(outs[j]), what[k], safe_text(outs[k]));
                 return EXIT_USAGE;
             }
     }
@@ -448,7 +448,7 @@ int out_finish(void) {
     }
     hd_error_t err;
     if (commit(&err) != HD_OK) {
-        fprintf(stderr, "%s: %s\n", cli_prog(), err.message);
+        fprintf(stderr, "%s: %s\n", cli_prog(), safe_text(err.message));
         return EXIT_FAILURE_;
     }
     return EXIT_OK;
