@@ -287,9 +287,14 @@ int hd_histogram(const double *values, size_t n, double lo, double hi,
     for (size_t k = 0; k < n; k++) {
         double x = values[k];
         if (!(x >= lo && x <= hi)) continue; /* outside, or NaN */
-        if (isinf(norm)) { /* a subnormal range (numpy's product is NaN or inf there): by the edges */
-            size_t b = 0;
-            while (b + 1 < bins && x >= edge(lo, hi, bins, b + 1)) b++;
+        if (isinf(norm)) { /* a subnormal range (numpy's product is NaN or inf there): the last
+                              bin whose lower edge is at most x, by bisection of the edges */
+            size_t b = 0, top = bins - 1;
+            while (b < top) {
+                size_t mid = b + (top - b + 1) / 2;
+                if (x >= edge(lo, hi, bins, mid)) b = mid;
+                else top = mid - 1;
+            }
             counts[b]++;
             continue;
         }
