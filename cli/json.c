@@ -54,18 +54,24 @@ static int control_at(const unsigned char *s, int n) {
 void json_string(FILE *out, const char *s) {
     const unsigned char *p = (const unsigned char *)s;
     fputc('"', out);
-    while (*p) {
-        int n = utf8_len(p);
-        if (n == 0) fprintf(out, "\\udc%02x", *p++);
-        else if (*p == '"' || *p == '\\') fprintf(out, "\\%c", *p++);
-        else if (control_at(p, n)) fprintf(out, "\\u%04x", n == 1 ? p[0] : p[1]), p += n;
-        else fwrite(p, 1, (size_t)n, out), p += n;
+    for (int n; *p; p += n) {
+        n = utf8_len(p);
+        if (n == 0) {
+            fprintf(out, "\\udc%02x", *p);
+            n = 1;
+        } else if (*p == '"' || *p == '\\') {
+            fprintf(out, "\\%c", *p);
+        } else if (control_at(p, n)) {
+            fprintf(out, "\\u%04x", n == 1 ? p[0] : p[1]);
+        } else {
+            fwrite(p, 1, (size_t)n, out);
+        }
     }
     fputc('"', out);
 }
 
-/* Bytes to escape in text at p: 0, or the length of the character that
- * must be written as \xXX bytes. */
+/* Whether the character at p (*len bytes; a byte that is not valid UTF-8
+ * counts as one) is written as \xXX bytes in text. */
 static int unsafe_at(const unsigned char *p, int *len) {
     int n = utf8_len(p);
     *len = n ? n : 1;
@@ -86,9 +92,12 @@ const char *safe_text(const char *s) {
     if (!t) return "(a name that cannot be shown: out of memory)";
     char *o = t;
     for (const unsigned char *p = (const unsigned char *)s; *p; p += n) {
-        if (!unsafe_at(p, &n)) memcpy(o, p, (size_t)n), o += n;
-        else
+        if (unsafe_at(p, &n)) {
             for (int k = 0; k < n; k++) o += sprintf(o, "\\x%02x", p[k]);
+        } else {
+            memcpy(o, p, (size_t)n);
+            o += n;
+        }
     }
     *o = '\0';
     free(slot[next]);
