@@ -319,8 +319,8 @@ FILE *out_open(const char *path, hd_error_t *err) {
     if (fd < 0) { /* the file itself may be writable: say that its directory is not */
         int e = errno, shown = dirlen < 400 ? dirlen : 400;
         snprintf(err->message, sizeof err->message,
-                 "%.400s: cannot create a temporary file in %.*s (the output is written there, then renamed over "
-                 "its name): %s", path, dirlen ? shown : 2, dirlen ? s->target : "./", reason(e));
+                 "%.400s: cannot write: no temporary file can be created in %.*s (the output is written there, "
+                 "then renamed over its name): %s", path, dirlen ? shown : 2, dirlen ? s->target : "./", reason(e));
         err->code = OUT_EFAIL;
         n_staged--;
         return NULL;

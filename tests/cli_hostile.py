@@ -190,8 +190,8 @@ def a_writable_file_in_a_read_only_directory_names_the_temporary_and_where(d):
         raise unittest.SkipTest("user nobody cannot run the tool or read the data")
     rc, out, err = run("--directed", "--distances", out_csv, a, a, preexec_fn=as_nobody())
     assert rc == 3, err
-    want = "hausdorff: %s: cannot create a temporary file in %s/ (the output is written there, then renamed " \
-           "over its name): Permission denied" % (out_csv, ro)
+    want = "hausdorff: %s: cannot write: no temporary file can be created in %s/ (the output is written there, " \
+           "then renamed over its name): Permission denied" % (out_csv, ro)
     assert err.startswith(want), err
     with open(out_csv) as f:
         assert f.read() == "old\n"
