@@ -8,6 +8,13 @@
  * the caller passes; there is no global or thread-local error state, so the
  * library is reentrant and two threads reading two files never see each
  * other's messages.
+ *
+ * A message longer than the record's 1023 bytes (a path can be 4095) is not
+ * cut at its end, where the reason is: it is formatted again piece by piece
+ * (the format's literal text and each conversion), and its string
+ * arguments (file names, as a rule) are shortened in their middle, the
+ * longest first, to the longest common length that fits; only when that
+ * is not enough (each down to KEEP bytes) is the end cut.
  */
 #include "base/base.h"
 
