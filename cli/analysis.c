@@ -29,6 +29,7 @@
 #include "cli.h"
 
 #include <errno.h>
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -103,7 +104,7 @@ void analysis_usage(FILE *out) {
 
 static int usage_error(const char *fmt, const char *arg) {
     fprintf(stderr, "%s: ", cli_prog());
-    fprintf(stderr, fmt, arg);
+    fprintf(stderr, fmt, safe_text(arg));
     fprintf(stderr, "\nTry '%s --help'.\n", cli_prog());
     return -1;
 }
@@ -112,7 +113,9 @@ static int to_double(const char *s, double *out) {
     char *e;
     errno = 0;
     double v = strtod(s, &e);
-    if (e == s || *e || errno || !isfinite(v)) return -1;
+    /* ERANGE also says a result is subnormal (1e-320), or below the
+     * smallest subnormal (taken as 0): both read as the value returned */
+    if (e == s || *e || (errno && !(errno == ERANGE && fabs(v) <= DBL_MIN)) || !isfinite(v)) return -1;
     *out = v;
     return 0;
 }
@@ -174,8 +177,13 @@ int analysis_parse_option(int argc, char **argv, int *k, analysis_args_t *an) {
         an->distances_out = v;
         break;
     case OPT_MAX_DISTANCE:
-        if (to_double(v, &d) || !(d > 0))
+        if (to_double(v, &d) || !(d > 0)) {
+            errno = 0;
+            double u = strtod(v, NULL); /* 1e-400: positive, but no double */
+            if (u == 0 && errno == ERANGE && !signbit(u))
+                return usage_error("--max-distance %s is below the smallest positive double, 4.9e-324", v);
             return usage_error("--max-distance needs a positive number, not '%s'", v);
+        }
         an->max_distance = d;
         break;
     case OPT_RENDER:
@@ -341,7 +349,7 @@ int analysis_handle_empty(const analysis_args_t *an, const char *path_a,
     FILE *out = stdout;
     hd_error_t err;
     if (an->distances_out && write_empty_files(an, A, B, directed, v, &err) != HD_OK) {
-        fprintf(stderr, "%s: %s\n", cli_prog(), err.message);
+        fprintf(stderr, "%s: %s\n", cli_prog(), safe_text(err.message));
         return EXIT_FAILURE_;
     }
     if (an->render_out || an->histogram_png)
@@ -367,8 +375,8 @@ int analysis_handle_empty(const analysis_args_t *an, const char *path_a,
         json_figures(out, an, &r);
         fprintf(out, "}\n");
     } else {
-        fprintf(out, "A: %s (%zu point%s)\nB: %s (%zu point%s)\n", path_a, n_a, plural(n_a), path_b, n_b,
-                plural(n_b));
+        fprintf(out, "A: %s (%zu point%s)\nB: %s (%zu point%s)\n", safe_text(path_a), n_a, plural(n_a),
+                safe_text(path_b), n_b, plural(n_b));
         const char *which = !n_a && !n_b ? "A and B are" : !n_a ? "A is" : "B is";
         char t[NUM_TEXT], pt[NUM_TEXT];
         num_text(v, t);
@@ -699,11 +707,11 @@ void analysis_print(FILE *out, const analysis_args_t *an,
     }
     if (an->histogram) print_histogram(out, an, r);
     if (an->distances_out) {
-        fprintf(out, "per-point distances written to %s", r->dist_path_a);
-        if (!r->directed) fprintf(out, " and %s", r->dist_path_b);
+        fprintf(out, "per-point distances written to %s", safe_text(r->dist_path_a));
+        if (!r->directed) fprintf(out, " and %s", safe_text(r->dist_path_b));
         fputc('\n', out);
     }
-    if (an->render_out) fprintf(out, "picture written to %s (%dx%d)\n", an->render_out, r->render_w, r->render_h);
-    if (an->histogram_png) fprintf(out, "histogram picture written to %s\n", an->histogram_png);
+    if (an->render_out) fprintf(out, "picture written to %s (%dx%d)\n", safe_text(an->render_out), r->render_w, r->render_h);
+    if (an->histogram_png) fprintf(out, "histogram picture written to %s\n", safe_text(an->histogram_png));
     fprintf(out, "time: %s s for per-point distances\n", num_seconds(r->seconds, t[0]));
 }

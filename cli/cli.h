@@ -56,8 +56,13 @@ const char *num_seconds(double s, char buf[NUM_TEXT]);
 static inline const char *plural(unsigned long long n) { return n == 1 ? "" : "s"; }
 
 /* JSON output helpers: numbers as num_text prints them (null when not
- * finite); strings escaped. */
+ * finite); strings escaped (bytes that are not UTF-8 as \udcXX, control
+ * characters as \u00XX: json.c). */
 void json_number(FILE *out, double v);
 void json_string(FILE *out, const char *s);
+/* s for a person to read: s itself when it holds no control character and
+ * only valid UTF-8, else a copy with those bytes as \xXX (valid until four
+ * more calls; not thread-safe). */
+const char *safe_text(const char *s);
 
 #endif

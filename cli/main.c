@@ -50,7 +50,7 @@ int main(int argc, char **argv) {
     memset(side, 0, sizeof side);
     if ((rc = tiles_expand(a.path_a, a.format_a, &side[0], &err)) != HD_OK ||
         (rc = tiles_expand(a.path_b, a.format_b, &side[1], &err)) != HD_OK) {
-        fprintf(stderr, "%s: %s\n", cli_prog(), err.message);
+        fprintf(stderr, "%s: %s\n", cli_prog(), safe_text(err.message));
         tiles_free(&side[0]);
         return cli_exit_for(rc);
     }
@@ -68,12 +68,12 @@ int main(int argc, char **argv) {
     for (int w = 0; w < 2; w++)
         if (side[w].kind != TILES_FILE)
             snprintf(files[w], sizeof files[w], " (%zu file%s)", side[w].n, plural(side[w].n));
-    progress_phase("reading A: %s%s", a.path_a, files[0]);
+    progress_phase("reading A: %s%s", safe_text(a.path_a), files[0]);
     if ((rc = tiles_read(&side[0], 0, side[0].n, &a.read, &a.an, 0, &ca, &err)) != HD_OK ||
-        (progress_phase("reading B: %s%s", a.path_b, files[1]),
+        (progress_phase("reading B: %s%s", safe_text(a.path_b), files[1]),
          rc = tiles_read(&side[1], 0, side[1].n, &a.read, &a.an, 1, &cb, &err)) != HD_OK) {
         progress_stop();
-        fprintf(stderr, "%s: %s\n", cli_prog(), err.message);
+        fprintf(stderr, "%s: %s\n", cli_prog(), safe_text(err.message));
         hd_cloud_free(ca);
         tiles_free(&side[0]);
         tiles_free(&side[1]);
@@ -109,7 +109,7 @@ int main(int argc, char **argv) {
         analysis_free(&an);
     progress_stop();
     if (rc != HD_OK) {
-        fprintf(stderr, "%s: %s\n", cli_prog(), err.message);
+        fprintf(stderr, "%s: %s\n", cli_prog(), safe_text(err.message));
         hd_cloud_free(ca);
         hd_cloud_free(cb);
         tiles_free(&side[0]);

@@ -110,7 +110,8 @@ void cli_usage(FILE *out) {
 "  --max-stream-size SIZE  most bytes read from an input that is not a\n"
 "                     regular file (standard input, a pipe, a FIFO), with an\n"
 "                     optional K, M or G suffix (default 2G)\n"
-"  --fifo-wait SECONDS  how long a named FIFO's writer is awaited (default 30)\n"
+"  --fifo-wait SECONDS  how long a FIFO's writer (input) or reader (output)\n"
+"                     is awaited (default 30)\n"
 "  --laz-points-per-byte N  the most points a LAZ chunk may hold per byte,\n"
 "                     bounding a small file's memory (default 256, up to 4096)\n"
 "  --json             print one JSON object\n"
@@ -134,7 +135,7 @@ void cli_formats(FILE *out) {
 
 static int bad(const char *fmt, const char *arg) {
     fprintf(stderr, "%s: ", cli_prog());
-    fprintf(stderr, fmt, arg);
+    fprintf(stderr, fmt, safe_text(arg));
     fprintf(stderr, "\nTry '%s --help'.\n", cli_prog());
     return EXIT_USAGE;
 }

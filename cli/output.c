@@ -33,7 +33,9 @@
  *  - Symbolic links are followed: the file a link names is replaced and the
  *    link stays.  A target that exists and is not a regular file
  *    (/dev/null, a FIFO, /dev/stdout) is written in place and checked the
- *    same way; it cannot be staged.
+ *    same way; it cannot be staged.  A FIFO's reader is awaited as long as
+ *    an input FIFO's writer (--fifo-wait, 30 s by default): without one the
+ *    run fails (exit 3) instead of blocking for ever.
  *  - Signals: while temporaries exist, SIGINT, SIGTERM, SIGHUP and SIGPIPE
  *    (those not ignored) remove them before the tool dies of the signal,
  *    and SIGXFSZ is ignored, so that a file beyond `ulimit -f` is a write
@@ -59,6 +61,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <time.h>
 #include <unistd.h>
 
 #ifndef PATH_MAX
@@ -82,6 +85,7 @@ typedef struct {
 static staged_t S[MAX_STAGED];
 static volatile sig_atomic_t n_staged;
 static int stdout_closed, installed;
+static int fifo_wait_ms; /* how long an output FIFO's reader is awaited (--fifo-wait; 0: the default) */
 static const int SIGNALS[] = {SIGINT, SIGTERM, SIGHUP, SIGPIPE};
 
 /* ---- standard descriptors ------------------------------------------------- */
@@ -147,13 +151,13 @@ int out_check_paths(const char *const *outs, const char *const *what, int n,
         for (size_t w = 0; w < n_inputs; w++)
             if (clash(outs[k], inputs[w], 1)) {
                 fprintf(stderr, "%s: %s %s would overwrite input %c (%s); name another file\n", cli_prog(), what[k],
-                        outs[k], side[w], is_stdin(inputs[w], 1) ? "standard input" : inputs[w]);
+                        safe_text(outs[k]), side[w], is_stdin(inputs[w], 1) ? "standard input" : safe_text(inputs[w]));
                 return EXIT_USAGE;
             }
         for (int j = 0; j < k; j++)
             if (outs[j] && clash(outs[k], outs[j], 0)) {
                 fprintf(stderr, "%s: %s %s and %s %s are the same file; name another file\n", cli_prog(), what[j],
-                        outs[j], what[k], outs[k]);
+                        safe_text(outs[j]), what[k], safe_text(outs[k]));
                 return EXIT_USAGE;
             }
     }
@@ -163,6 +167,7 @@ int out_check_paths(const char *const *outs, const char *const *what, int n,
 /* Refuse an output that would overwrite an input (any tile, or a list of
  * them) or another output. */
 int out_check_outputs(const cli_args_t *a, const tiles_t *side) {
+    fifo_wait_ms = a->read.fifo_wait_ms; /* outputs await a reader as inputs await a writer */
     char path_b[4096];
     const char *outs[4] = {a->an.distances_out, NULL, a->an.render_out, a->an.histogram_png};
     const char *const what[4] = {"--distances", "--distances (B's rows)", "--render", "--histogram-png"};
@@ -233,6 +238,30 @@ static void drop_tmp(staged_t *s) {
     }
 }
 
+/* A FIFO opened for writing once a reader has opened it, awaited at most
+ * fifo_wait_ms (a FIFO without a reader would block open() for ever): an
+ * open without blocking fails with ENXIO while no reader is there, so it
+ * is tried again every 10 ms; the descriptor then blocks as a pipe does. */
+static FILE *open_fifo(const char *target, const char *path, hd_error_t *err) {
+    int ms = fifo_wait_ms > 0 ? fifo_wait_ms : HD_FIFO_WAIT_MS, fd;
+    for (int waited = 0;; waited += 10) {
+        if ((fd = open(target, O_WRONLY | O_NONBLOCK)) >= 0 || errno != ENXIO) break;
+        if (waited >= ms) {
+            snprintf(err->message, sizeof err->message, "%.800s: a FIFO that no reader opened within %d s (--fifo-wait)",
+                     path, ms / 1000);
+            err->code = OUT_EFAIL;
+            return NULL;
+        }
+        nanosleep(&(struct timespec){0, 10000000}, NULL);
+    }
+    FILE *f = NULL;
+    if (fd < 0 || fcntl(fd, F_SETFL, fcntl(fd, F_GETFL) & ~O_NONBLOCK) != 0 || !(f = fdopen(fd, "wb"))) {
+        fail(err, path, "cannot write", errno);
+        if (fd >= 0) close(fd);
+    }
+    return f;
+}
+
 FILE *out_open(const char *path, hd_error_t *err) {
     if (n_staged == MAX_STAGED) {
         fail(err, path, "cannot write", EMFILE);
@@ -256,8 +285,9 @@ FILE *out_open(const char *path, hd_error_t *err) {
             return NULL;
         }
         if (!S_ISREG(st.st_mode)) { /* a device or a FIFO: written in place */
-            if (!(s->f = fopen(s->target, "wb"))) {
-                fail(err, path, "cannot write", errno);
+            s->f = S_ISFIFO(st.st_mode) ? open_fifo(s->target, path, err) : fopen(s->target, "wb");
+            if (!s->f) {
+                if (!S_ISFIFO(st.st_mode)) fail(err, path, "cannot write", errno);
                 return NULL;
             }
             s->direct = 1;
@@ -286,8 +316,12 @@ FILE *out_open(const char *path, hd_error_t *err) {
     install();
     n_staged++; /* before the file exists, so that a signal finds it */
     int fd = mkstemp(s->tmp);
-    if (fd < 0) {
-        fail(err, path, "cannot write", errno);
+    if (fd < 0) { /* the file itself may be writable: say that its directory is not */
+        int e = errno, shown = dirlen < 400 ? dirlen : 400;
+        snprintf(err->message, sizeof err->message,
+                 "%.400s: cannot write: no temporary file can be created in %.*s (the output is written there, "
+                 "then renamed over its name): %s", path, dirlen ? shown : 2, dirlen ? s->target : "./", reason(e));
+        err->code = OUT_EFAIL;
         n_staged--;
         return NULL;
     }
@@ -414,7 +448,7 @@ int out_finish(void) {
     }
     hd_error_t err;
     if (commit(&err) != HD_OK) {
-        fprintf(stderr, "%s: %s\n", cli_prog(), err.message);
+        fprintf(stderr, "%s: %s\n", cli_prog(), safe_text(err.message));
         return EXIT_FAILURE_;
     }
     return EXIT_OK;

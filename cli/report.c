@@ -75,13 +75,13 @@ static void tiles_json(FILE *out, const char *key, const tiles_t *t) {
 static void side_line(FILE *out, const report_t *r, int w) {
     const tiles_t *t = &r->side[w];
     int sampled = r->a->read.mesh == HD_MESH_SAMPLE;
-    fprintf(out, "%c: %s (%zu point%s, %s", "AB"[w], t->arg, r->n[w], plural(r->n[w]), r->format[w]);
+    fprintf(out, "%c: %s (%zu point%s, %s", "AB"[w], safe_text(t->arg), r->n[w], plural(r->n[w]), r->format[w]);
     if (r->faces[w])
         fprintf(out, "%s %zu face%s", sampled ? " sampled from" : ",", r->faces[w], plural(r->faces[w]));
     if (t->kind != TILES_FILE) {
         char skipped[512];
         tiles_skipped_text(t, skipped, sizeof skipped);
-        fprintf(out, ", %zu file%s%s%s", t->n, t->n == 1 ? "" : "s", skipped[0] ? "; " : "", skipped);
+        fprintf(out, ", %zu file%s%s%s", t->n, t->n == 1 ? "" : "s", skipped[0] ? "; " : "", safe_text(skipped));
     }
     fprintf(out, ")\n");
 }
@@ -90,7 +90,7 @@ static void side_line(FILE *out, const report_t *r, int w) {
 static void where_text(FILE *out, const tiles_t *t, size_t g) {
     if (t->kind == TILES_FILE) return;
     size_t local, k = tiles_locate(t, g, &local);
-    fprintf(out, " = %s[%zu]", t->t[k].path, local);
+    fprintf(out, " = %s[%zu]", safe_text(t->t[k].path), local);
 }
 
 /* A point of a side: each coordinate as the shortest text of its double,

@@ -121,8 +121,10 @@ enum {
 
 /* Context of a failure, filled by any call that takes one (it may be NULL).
  * `message` is a complete sentence such as "cloud.ply:12: expected 3 numbers,
- * found 2"; `line` (1-based, text input) and `offset` (bytes, binary input)
- * are -1 when they do not apply. */
+ * found 2"; a sentence longer than 1023 bytes has its file names shortened
+ * in their middle ("/data/very...t2.xyz"), so that what went wrong and why
+ * stay whole.  `line` (1-based, text input) and `offset` (bytes, binary
+ * input) are -1 when they do not apply. */
 typedef struct hd_error {
     int code;
     long long line;
@@ -434,7 +436,10 @@ HD_EXTERN int hd_hausdorff_percentile(const hd_points_t *A,
  * even (Python's math.fsum), so they do not depend on the order of the
  * values (the same at any thread count, and from hausdorff_mpi.h's
  * hd_mpi_summarize for any split over ranks).  Means and Chamfer figures
- * are computed from the rounded sums.  "2" means squared distances
+ * are computed from the rounded sums as doubles without an exponent limit
+ * would compute them: a sum of squares beyond DBL_MAX (possible within the
+ * 1e153 coordinate limit) is +inf, but the means and Chamfer distance made
+ * from it are finite whenever they are at most DBL_MAX.  "2" means squared distances
  * (d * d of each reported distance).  With d_ba NULL every field that needs
  * B's distances is NaN. */
 typedef struct hd_summary {

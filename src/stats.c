@@ -42,7 +42,10 @@
  *    (src/mpi/figures.c) is the same to the bit.  Squared terms are d * d
  *    of the reported distance d = sqrt(d2), which may differ from the
  *    evaluated d2 in the last bit.  The derived figures (means, Chamfer
- *    distances) are computed from the rounded sums by hd__summary_derive.
+ *    distances) are computed from the rounded sums by hd__summary_derive,
+ *    and again from sums scaled by a power of two where one overflows: a
+ *    mean of squares within the 1e153 domain is finite even when their sum
+ *    is beyond DBL_MAX.
  *  - Histograms reproduce numpy.histogram(values, bins, range=(lo, hi)) to
  *    the count: the same edges (numpy.linspace: k * step + lo, the last edge
  *    hi itself) and the same rule for values on an edge (each bin is
@@ -242,8 +245,7 @@ int hd_summarize(const double *d_ab, size_t n_a, const double *d_ba,
     if (d_ba && n_b == 0) return hd__err(err, HD_EEMPTY, "distances B to A are empty");
     if (n_b) max_ba = hd__xsum_values(&s[2], &s[3], d_ba, n_b, -INFINITY);
     if (s[2].nan) return hd__nan_check(d_ba, n_b, 0, "B to A", err);
-    hd__summary_derive(out, n_a, max_ab, hd__xsum_round(&s[0]), hd__xsum_round(&s[1]), n_b, max_ba,
-                       n_b ? hd__xsum_round(&s[2]) : NAN, n_b ? hd__xsum_round(&s[3]) : NAN);
+    hd__summary_derive(out, n_a, max_ab, n_b, max_ba, s);
     return HD_OK;
 }
 
@@ -285,6 +287,17 @@ int hd_histogram(const double *values, size_t n, double lo, double hi,
     for (size_t k = 0; k < n; k++) {
         double x = values[k];
         if (!(x >= lo && x <= hi)) continue; /* outside, or NaN */
+        if (isinf(norm)) { /* a subnormal range (numpy's product is NaN or inf there): the last
+                              bin whose lower edge is at most x, by bisection of the edges */
+            size_t b = 0, top = bins - 1;
+            while (b < top) {
+                size_t mid = b + (top - b + 1) / 2;
+                if (x >= edge(lo, hi, bins, mid)) b = mid;
+                else top = mid - 1;
+            }
+            counts[b]++;
+            continue;
+        }
         double f = (x - lo) * norm;
         size_t b = f >= (double)bins ? bins : (size_t)f;
         if (b == bins) b--;

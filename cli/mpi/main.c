@@ -118,7 +118,7 @@ static int finish(int status) {
 }
 
 static int fail(int rc, const hd_error_t *err) {
-    fprintf(stderr, "hausdorff-mpi: %s\n", err->message);
+    fprintf(stderr, "hausdorff-mpi: %s\n", safe_text(err->message));
     out_discard();
     return finish(cli_exit_for(rc));
 }

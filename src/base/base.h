@@ -207,6 +207,9 @@ void hd__xsum_merge(hd__xsum_t *dst, const hd__xsum_t *src);
  * -inf together, or a NaN, give NaN.  An exact zero is +0.0 (as a loop
  * starting from 0.0 gives).  s is unchanged. */
 double hd__xsum_round(const hd__xsum_t *s);
+/* The exact sum times 2^-k (0 <= k < 2187) rounded once, as
+ * hd__xsum_round rounds (subnormal results at 2^-1074 of the scaled value). */
+double hd__xsum_round_scaled(const hd__xsum_t *s, int k);
 /* s += x without counting it in pending: the caller counts its additions
  * with hd__xsum_count, at most HD__XSUM_PENDING_MAX / 2 between two calls
  * (a loop keeps its counter in a register so).  x = m 2^(e - 1075) with the
@@ -251,13 +254,16 @@ HD__INLINE void hd__xsum_add(hd__xsum_t *s, double x) {
 double hd__xsum_values(hd__xsum_t *sum, hd__xsum_t *sum2, const double *d, size_t n, double m);
 
 /* ---- the summary's derived figures (xsum.c) ------------------------------- */
-/* Fill every field of out from the counts, maxima and exactly rounded sums
- * (sum_ab, sum2_ab: of d and of d * d over A's n_a distances; likewise for
- * B, n_b = 0 when B's are absent: its fields are then NaN).  The one place
+/* Fill every field of out from the counts, maxima and exact sums (sums[0],
+ * sums[1]: of d and of d * d over A's n_a distances; sums[2], sums[3]: B's,
+ * n_b = 0 when B's are absent: its fields are then NaN).  The one place
  * where hd_summarize's means and Chamfer figures are defined, for
- * hd_summarize and the MPI library's distributed version. */
-void hd__summary_derive(hd_summary_t *out, size_t n_a, double max_ab, double sum_ab, double sum2_ab,
-                        size_t n_b, double max_ba, double sum_ba, double sum2_ba);
+ * hd_summarize and the MPI library's distributed version: computed from
+ * the sums rounded once, and again from the sums scaled by a power of two
+ * where a figure overflowed (a mean is finite whenever it is at most
+ * DBL_MAX, though its sum may be beyond). */
+void hd__summary_derive(hd_summary_t *out, size_t n_a, double max_ab, size_t n_b, double max_ba,
+                        const hd__xsum_t sums[4]);
 
 /* ---- a bound that only grows, shared by threads ------------------------- */
 /* A lower bound on h(A,B)^2 that threads raise together (the engine's

@@ -43,6 +43,26 @@
  * significand is odd).  Infinities and NaN are counted apart and decide the
  * result as IEEE addition would (+inf and -inf together give NaN).
  *
+ * Scaled rounding (hd__xsum_round_scaled): the sum times 2^-k rounded once,
+ * the same rule with the significand's lowest bit at least bit k (the
+ * scaled value's smallest subnormal).  Where no subnormal is involved this
+ * is hd__xsum_round's result times 2^-k exactly: scaling by a power of two
+ * commutes with rounding.
+ *
+ * Figures beyond the exponent range: a sum of squared distances within the
+ * 1e153 coordinate domain can exceed DBL_MAX (each square is below 1.2e307,
+ * so 15 of them can), while the mean of those squares (a Chamfer distance)
+ * cannot.  hd__summary_derive computes every figure from the rounded sums;
+ * a figure that comes out infinite is computed again from the sums rounded
+ * at 2^-SCALE and scaled back.  Every sum of doubles is below 2^1088 (2^64
+ * values below 2^1024), so the scaled sums and everything computed from
+ * them stay below 2^961, and a figure that overflowed involves a value of
+ * at least 2^1023, far above the subnormals, where any smaller operand's
+ * scaled rounding is too small to change a result: the figure is the one
+ * doubles without an exponent limit would give, the same operations on
+ * the same rounded sums, to the bit.  Figures that stay finite are the
+ * plain computation's; a figure beyond DBL_MAX stays infinite.
+ *
  * The tests: tests/api/test_sums.c against Python's math.fsum (expected bits
  * written into the test when it was generated).
  */
@@ -51,6 +71,9 @@
 #include <assert.h>
 #include <math.h>
 #include <string.h>
+
+/* hd__summary_derive's second computation: sums scaled by 2^-SCALE. */
+#define SCALE 128
 
 void hd__xsum_init(hd__xsum_t *s) {
     memset(s, 0, sizeof *s);
@@ -107,7 +130,8 @@ static int any_below(const int64_t *l, int b) {
     return ((uint64_t)l[w] & (((uint64_t)1 << (b & 31)) - 1)) != 0;
 }
 
-double hd__xsum_round(const hd__xsum_t *s) {
+double hd__xsum_round_scaled(const hd__xsum_t *s, int k) {
+    assert(k >= 0 && k < 32 * HD__XSUM_LIMBS - 53);
     if (s->nan || (s->pinf && s->ninf)) return NAN;
     if (s->pinf) return INFINITY;
     if (s->ninf) return -INFINITY;
@@ -115,7 +139,7 @@ double hd__xsum_round(const hd__xsum_t *s) {
     hd__xsum_normalize(&t);
     double sign = 1.0;
     if (t.limb[HD__XSUM_LIMBS - 1] < 0) {
-        for (int k = 0; k < HD__XSUM_LIMBS; k++) t.limb[k] = -t.limb[k];
+        for (int j = 0; j < HD__XSUM_LIMBS; j++) t.limb[j] = -t.limb[j];
         hd__xsum_normalize(&t);
         sign = -1.0;
     }
@@ -126,17 +150,21 @@ double hd__xsum_round(const hd__xsum_t *s) {
     assert(top < HD__XSUM_LIMBS - 1 && t.limb[top] < ((int64_t)1 << 32));
     int h = 32 * top + 31;
     while (!bit_at(t.limb, h)) h--;
-    if (h < 53) return sign * ldexp((double)bits53(t.limb, 0), -1074);
-    uint64_t m = bits53(t.limb, h - 52);
-    if (bit_at(t.limb, h - 53) && ((m & 1) || any_below(t.limb, h - 53))) {
+    /* the significand's lowest bit: 53 bits below h + 1, or the scaled
+     * value's smallest subnormal, bit k, whichever is higher */
+    int lo = h - 52 > k ? h - 52 : k;
+    uint64_t m = bits53(t.limb, lo);
+    if (lo > 0 && bit_at(t.limb, lo - 1) && ((m & 1) || any_below(t.limb, lo - 1))) {
         m++;
         if (m == (uint64_t)1 << 53) {
             m >>= 1;
-            h++;
+            lo++;
         }
     }
-    return sign * ldexp((double)m, h - 52 - 1074);
+    return sign * ldexp((double)m, lo - k - 1074);
 }
+
+double hd__xsum_round(const hd__xsum_t *s) { return hd__xsum_round_scaled(s, 0); }
 
 double hd__xsum_values(hd__xsum_t *sum, hd__xsum_t *sum2, const double *d, size_t n, double m) {
     enum { BLOCK = HD__XSUM_PENDING_MAX / 2 };
@@ -154,29 +182,60 @@ double hd__xsum_values(hd__xsum_t *sum, hd__xsum_t *sum2, const double *d, size_
     return m;
 }
 
-void hd__summary_derive(hd_summary_t *out, size_t n_a, double max_ab, double sum_ab, double sum2_ab,
-                        size_t n_b, double max_ba, double sum_ba, double sum2_ba) {
+/* The figures from sums given scaled by 2^-k (sum[0..3]: A's sum and sum
+ * of squares, then B's), each figure scaled back by 2^k. */
+static void figures(hd_summary_t *out, size_t n_a, size_t n_b, const double sum[4], int k) {
     out->n_ab = n_a;
     out->n_ba = n_b;
-    out->max_ab = max_ab;
-    out->sum_ab = sum_ab;
-    out->sum2_ab = sum2_ab;
-    out->mean_ab = sum_ab / (double)n_a;
-    out->mean2_ab = sum2_ab / (double)n_a;
+    out->sum_ab = ldexp(sum[0], k);
+    out->sum2_ab = ldexp(sum[1], k);
+    out->mean_ab = ldexp(sum[0] / (double)n_a, k);
+    out->mean2_ab = ldexp(sum[1] / (double)n_a, k);
     out->max_ba = out->sum_ba = out->sum2_ba = out->mean_ba = out->mean2_ba = NAN;
     out->mean_symmetric = out->mean_average = out->mean_pooled = NAN;
     out->chamfer = out->chamfer_sum2 = out->chamfer_mean = out->chamfer_sum = NAN;
     if (n_b == 0) return;
-    out->max_ba = max_ba;
-    out->sum_ba = sum_ba;
-    out->sum2_ba = sum2_ba;
-    out->mean_ba = sum_ba / (double)n_b;
-    out->mean2_ba = sum2_ba / (double)n_b;
-    out->mean_symmetric = out->mean_ab >= out->mean_ba ? out->mean_ab : out->mean_ba;
-    out->mean_average = (out->mean_ab + out->mean_ba) / 2.0;
-    out->mean_pooled = (sum_ab + sum_ba) / ((double)n_a + (double)n_b);
-    out->chamfer = out->mean2_ab + out->mean2_ba;
-    out->chamfer_sum2 = sum2_ab + sum2_ba;
-    out->chamfer_mean = out->mean_ab + out->mean_ba;
-    out->chamfer_sum = sum_ab + sum_ba;
+    double mean_ab = sum[0] / (double)n_a, mean2_ab = sum[1] / (double)n_a;
+    double mean_ba = sum[2] / (double)n_b, mean2_ba = sum[3] / (double)n_b;
+    out->sum_ba = ldexp(sum[2], k);
+    out->sum2_ba = ldexp(sum[3], k);
+    out->mean_ba = ldexp(mean_ba, k);
+    out->mean2_ba = ldexp(mean2_ba, k);
+    out->mean_symmetric = ldexp(mean_ab >= mean_ba ? mean_ab : mean_ba, k);
+    out->mean_average = ldexp((mean_ab + mean_ba) / 2.0, k);
+    out->mean_pooled = ldexp((sum[0] + sum[2]) / ((double)n_a + (double)n_b), k);
+    out->chamfer = ldexp(mean2_ab + mean2_ba, k);
+    out->chamfer_sum2 = ldexp(sum[1] + sum[3], k);
+    out->chamfer_mean = ldexp(mean_ab + mean_ba, k);
+    out->chamfer_sum = ldexp(sum[0] + sum[2], k);
+}
+
+/* The figures of hd_summary_t that are computed, in the struct's order. */
+#define FIGURES(X)                                                                                          \
+    X(sum_ab) X(sum_ba) X(sum2_ab) X(sum2_ba) X(mean_ab) X(mean_ba) X(mean2_ab) X(mean2_ba)                 \
+    X(mean_symmetric) X(mean_average) X(mean_pooled) X(chamfer) X(chamfer_sum2) X(chamfer_mean) X(chamfer_sum)
+
+void hd__summary_derive(hd_summary_t *out, size_t n_a, double max_ab, size_t n_b, double max_ba,
+                        const hd__xsum_t sums[4]) {
+    double r[4];
+    for (int j = 0; j < 4; j++) r[j] = j < 2 || n_b ? hd__xsum_round(&sums[j]) : NAN;
+    figures(out, n_a, n_b, r, 0);
+    int overflowed = 0;
+#define HD__INF(f) overflowed |= isinf(out->f);
+    FIGURES(HD__INF)
+#undef HD__INF
+    if (overflowed) {
+        /* Some figure overflowed: computed again from the sums scaled by
+         * 2^-SCALE, it is what doubles without an exponent limit give (see
+         * above); a figure still infinite is beyond DBL_MAX (or a sum
+         * holds an infinity). */
+        hd_summary_t big;
+        for (int j = 0; j < 4; j++) r[j] = j < 2 || n_b ? hd__xsum_round_scaled(&sums[j], SCALE) : NAN;
+        figures(&big, n_a, n_b, r, SCALE);
+#define HD__FINITE(f) if (isinf(out->f)) out->f = big.f;
+        FIGURES(HD__FINITE)
+#undef HD__FINITE
+    }
+    out->max_ab = max_ab;
+    out->max_ba = n_b ? max_ba : NAN;
 }

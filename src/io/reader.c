@@ -312,8 +312,14 @@ static int load(const char *path, const hd_read_options_t *opt, hd__file_t *f, i
         }
         void *p = mmap(NULL, (size_t)st.st_size, PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, 0);
         close(fd);
-        if (p == MAP_FAILED)
-            return hd__err(err, HD_EIO, "%s: cannot map: %s", path, strerror(errno));
+        if (p == MAP_FAILED) {
+            /* ENOMEM: no address space (RLIMIT_AS, or the mappings' count);
+             * EAGAIN: too much memory locked (RLIMIT_MEMLOCK under
+             * mlockall): a lack of memory, not a bad file */
+            int e = errno, nomem = e == ENOMEM || e == EAGAIN;
+            return hd__err(err, nomem ? HD_ENOMEM : HD_EIO, "%s: cannot map its %llu bytes: %s%s", path,
+                           (unsigned long long)st.st_size, strerror(e), nomem ? " (out of memory)" : "");
+        }
         madvise(p, (size_t)st.st_size, MADV_SEQUENTIAL | MADV_WILLNEED);
         f->data = p;
         f->size = (size_t)st.st_size;

@@ -123,8 +123,7 @@ static int summarize_body(ctx_t *c, const hd_options_t *opt, input_t *in, void *
     hd__mpi_free(c, maxes, 2 * (size_t)c->K, sizeof *maxes);
     if (e != MPI_SUCCESS) return hd__mpi_failed(c, "MPI_Allgather", e);
     size_t nb = a->v.has_ba ? (size_t)a->v.N[1] : 0;
-    hd__summary_derive(a->out, (size_t)a->v.N[0], m[0], hd__xsum_round(&s[0]), hd__xsum_round(&s[1]), nb,
-                       nb ? m[1] : NAN, nb ? hd__xsum_round(&s[2]) : NAN, nb ? hd__xsum_round(&s[3]) : NAN);
+    hd__summary_derive(a->out, (size_t)a->v.N[0], m[0], nb, m[1], s);
     return HD_OK;
 }
 

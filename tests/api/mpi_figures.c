@@ -32,9 +32,10 @@
 
 /* ---- arrays ------------------------------------------------------------------ */
 
-enum { AR_SPREAD, AR_TIES, AR_EQUAL, AR_ONE, AR_EXTREME, AR_SIGNED, AR_CANCEL, AR_COUNT };
+enum { AR_SPREAD, AR_TIES, AR_EQUAL, AR_ONE, AR_EXTREME, AR_SIGNED, AR_CANCEL, AR_HUGE, AR_COUNT };
 static const char *const ar_name[AR_COUNT] = {"distinct magnitudes", "lattice ties", "all equal", "one value",
-                                              "extremes", "signed", "cancelling pairs"};
+                                              "extremes", "signed", "cancelling pairs",
+                                              "squares summing beyond DBL_MAX"};
 
 /* n values of kind `which`, seeded. */
 static double *make_values(int which, uint64_t seed, size_t *n) {
@@ -57,6 +58,7 @@ static double *make_values(int which, uint64_t seed, size_t *n) {
         }
         case AR_SIGNED: v[k] = gen_normal(&g) * 1e3 + (k % 5 == 0 ? 1.0 : 0.0); break;
         case AR_CANCEL: v[k] = k % 2 ? -v[k - 1] * (1 + 0x1p-40) : gen_normal(&g) * 1e15; break;
+        case AR_HUGE: v[k] = 3.4641016151377544e153 * (0.5 + gen_unit(&g) / 2); break; /* within 1e153 coordinates */
         }
         if (v[k] == 0.0) v[k] = 0.0; /* never -0.0: the percentile's one documented difference */
     }

@@ -10,6 +10,7 @@
 
 #include <math.h>
 #include <stdlib.h>
+#include <sys/stat.h>
 
 enum { NONE, LINE, OFFSET };
 
@@ -477,4 +478,52 @@ TEST(unreadable_and_unknown_files_are_refused_with_a_reason) {
     CHECK_RC(hd_read_file(tf_printf("x.xyz", "1 2 3\n"), &o, &c, &e), HD_EUNSUPPORTED);
     CHECK(strstr(e.message, "unknown format 'dxf'") != NULL);
     CHECK_RC(hd_read_file(NULL, NULL, &c, &e), HD_EINVAL);
+}
+
+/* A directory chain of 5 names of 240 bytes under the temporary directory
+ * (made, with its file NAME holding text, when text is not NULL). */
+static const char *deep_path(const char *name, const char *text) {
+    static char path[2048];
+    char part[241];
+    memset(part, 'd', 240);
+    part[240] = '\0';
+    snprintf(path, sizeof path, "%s", tf_path("deep"));
+    for (int k = 0; k < 5; k++) {
+        if (text) mkdir(path, 0755);
+        size_t l = strlen(path);
+        snprintf(path + l, sizeof path - l, "/%.239s%d", part, k);
+    }
+    if (text) mkdir(path, 0755);
+    size_t l = strlen(path);
+    snprintf(path + l, sizeof path - l, "/%s", name);
+    if (text) {
+        FILE *f = fopen(path, "w");
+        fputs(text, f);
+        fclose(f);
+    }
+    return path;
+}
+
+TEST(a_message_too_long_for_the_record_shortens_the_file_name_and_keeps_the_reason) {
+    hd_cloud_t *c;
+    hd_error_t e;
+    const char *missing = deep_path("missing.xyz", NULL);
+    CHECK(strlen(missing) > 1200);
+    CHECK_RC(hd_read_file(missing, NULL, &c, &e), HD_EIO);
+    CONTEXT("message '%s'", e.message);
+    CHECK(strlen(e.message) <= sizeof e.message - 1);
+    CHECK(strncmp(e.message, missing, 40) == 0); /* the path's start, */
+    CHECK(strstr(e.message, "...") != NULL);    /* its middle left out, */
+    size_t n = strlen(e.message);                /* its end and the reason whole */
+    const char *end = "/missing.xyz: cannot open: No such file or directory";
+    CHECK(n > strlen(end) && strcmp(e.message + n - strlen(end), end) == 0);
+    /* numbers in the message stay whole too, and the name's UTF-8 */
+    const char *bad = deep_path("Z\xc3\xbcrich.xyz", "1 2 3\n1 2 x\n");
+    CHECK_RC(hd_read_file(bad, NULL, &c, &e), HD_EFORMAT);
+    CONTEXT("message '%s'", e.message);
+    CHECK_EQ(e.line, 2);
+    const char *why = "/Z\xc3\xbcrich.xyz:2: 'x' is not a number (column 3)";
+    n = strlen(e.message);
+    CHECK(n > strlen(why) && strcmp(e.message + n - strlen(why), why) == 0);
+    CHECK(n >= sizeof e.message - 1 - 4); /* shortened no more than needed */
 }

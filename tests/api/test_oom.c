@@ -31,6 +31,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/mman.h>
 
 /* ---- the failing allocator ------------------------------------------------ */
 
@@ -70,6 +71,19 @@ int __wrap_pthread_create(pthread_t *t, const pthread_attr_t *attr, void *(*fn)(
     if (!atomic_load(&no_threads)) return __real_pthread_create(t, attr, fn, arg);
     atomic_fetch_add(&refused, 1);
     return EAGAIN;
+}
+
+/* Mappings of files too: while map_errno is set, mapping a file fails with
+ * it (the address space is gone: RLIMIT_AS), as mmap reports it.
+ * Anonymous mappings (the library's large blocks) are not touched. */
+void *__real_mmap(void *addr, size_t len, int prot, int flags, int fd, off_t off);
+static atomic_int map_errno;
+
+void *__wrap_mmap(void *addr, size_t len, int prot, int flags, int fd, off_t off) {
+    int e = atomic_load(&map_errno);
+    if (!e || fd < 0) return __real_mmap(addr, len, prot, flags, fd, off);
+    errno = e;
+    return MAP_FAILED;
 }
 
 static void arm(long k) {
@@ -525,4 +539,32 @@ TEST(every_allocation_of_sampling_a_mesh_can_fail_cleanly) {
     c.opt.seed = 7;
     c.opt.threads = 2;
     exhaust_read(&c, "hd_read_file data/orig/lion-head.off, 5000 points sampled, seed=7");
+}
+
+TEST(a_file_that_cannot_be_mapped_for_want_of_memory_is_out_of_memory_not_bad_input) {
+    /* ENOMEM (address space) and EAGAIN (locked memory) are a lack of
+     * memory: HD_ENOMEM, which the tools exit 3 for; another failure of
+     * the mapping stays an input error */
+    static const int errs[3] = {ENOMEM, EAGAIN, ENODEV};
+    static const int codes[3] = {HD_ENOMEM, HD_ENOMEM, HD_EIO};
+    const char *path = "tests/corpus/ply/ascii.ply";
+    for (int k = 0; k < 3; k++) {
+        CONTEXT("mmap failing with %s", strerror(errs[k]));
+        hd_cloud_t *c = NULL;
+        hd_error_t err;
+        atomic_store(&map_errno, errs[k]);
+        int rc = hd_read_file(path, NULL, &c, &err);
+        atomic_store(&map_errno, 0);
+        CHECK_RC(rc, codes[k]);
+        CHECK(c == NULL);
+        CHECK(strstr(err.message, path) && strstr(err.message, strerror(errs[k])));
+        uint64_t n;
+        atomic_store(&map_errno, errs[k]);
+        rc = hd_read_count(path, NULL, &n, &err);
+        atomic_store(&map_errno, 0);
+        CHECK_RC(rc, codes[k]);
+    }
+    hd_cloud_t *c = NULL;
+    CHECK_RC(hd_read_file(path, NULL, &c, NULL), HD_OK); /* and mapped again once memory is back */
+    hd_cloud_free(c);
 }

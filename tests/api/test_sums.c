@@ -178,3 +178,52 @@ TEST(a_million_equal_values_are_summed_exactly) {
     CHECK_BITS(sum_of(v, n), 100000.0);
     free(v);
 }
+
+/* What the figures are without an exponent limit: x computed at 2^-128
+ * (exact there) and scaled back. */
+static double mean_unlimited(double each, size_t copies) {
+    double scaled = ldexp(each, -128) * (double)copies; /* the exact sum, rounded once */
+    return ldexp(scaled / (double)copies, 128);
+}
+
+TEST(chamfer_is_finite_when_the_sum_of_squares_overflows_within_the_1e153_domain) {
+    /* 100 points at (1e153, 1e153, 1e153) against one at -1e153: every
+     * distance is sqrt(3) 2e153, its square 1.2e307, 100 squares 1.2e309
+     * (beyond DBL_MAX), their mean 1.2e307 again */
+    double d = sqrt(3.0 * 2e153 * 2e153);
+    double ab[100], ba[1] = {d};
+    for (int k = 0; k < 100; k++) ab[k] = d;
+    hd_summary_t s;
+    CHECK_RC(hd_summarize(ab, 100, ba, 1, &s, NULL), HD_OK);
+    CHECK_BITS(s.sum2_ab, INFINITY); /* a sum truly beyond DBL_MAX */
+    CHECK_BITS(s.chamfer_sum2, INFINITY);
+    CHECK_BITS(s.mean2_ab, mean_unlimited(d * d, 100));
+    CHECK_BITS(s.mean2_ba, d * d);
+    CHECK_BITS(s.chamfer, mean_unlimited(d * d, 100) + d * d);
+    CHECK(isfinite(s.chamfer) && s.chamfer > 2.39e307 && s.chamfer < 2.41e307);
+    CHECK_BITS(s.mean_ab, mean_unlimited(d, 100)); /* sums of distances never overflow there */
+    CHECK_BITS(s.sum_ab, 100 * d);
+    CHECK_BITS(s.chamfer_mean, s.mean_ab + d);
+}
+
+TEST(means_are_finite_when_their_sum_overflows) {
+    /* distances given by the caller may be anything finite: the mean of
+     * DBL_MAX and DBL_MAX is DBL_MAX, though their sum is not a double */
+    double a[2] = {DBL_MAX, DBL_MAX}, b[1] = {DBL_MAX};
+    hd_summary_t s;
+    CHECK_RC(hd_summarize(a, 2, b, 1, &s, NULL), HD_OK);
+    CHECK_BITS(s.sum_ab, INFINITY);
+    CHECK_BITS(s.mean_ab, DBL_MAX);
+    CHECK_BITS(s.mean_ba, DBL_MAX);
+    CHECK_BITS(s.mean_symmetric, DBL_MAX);
+    CHECK_BITS(s.mean_average, DBL_MAX);
+    CHECK_BITS(s.mean_pooled, DBL_MAX);
+    CHECK_BITS(s.chamfer_mean, INFINITY); /* 2 DBL_MAX: beyond, and said so */
+    CHECK_BITS(s.mean2_ab, INFINITY);     /* DBL_MAX * DBL_MAX is inf itself */
+    /* a sum past DBL_MAX with a mean at the top of the range: each mean is
+     * the exact sum rounded once, then divided */
+    double c[3] = {DBL_MAX, DBL_MAX, 0x1p1000};
+    CHECK_RC(hd_summarize(c, 3, NULL, 0, &s, NULL), HD_OK);
+    CHECK_BITS(s.mean_ab, ldexp((ldexp(DBL_MAX, -128) * 2 + 0x1p872) / 3, 128));
+    CHECK(isnan(s.mean_pooled)); /* no B: still NaN */
+}

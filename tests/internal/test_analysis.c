@@ -906,6 +906,24 @@ TEST(histogram_edges_are_linspace_and_the_last_bin_is_closed) {
     CHECK_EQ(c[1], 2); /* 0.5 on the edge goes up; 1.0 closes the last bin */
 }
 
+TEST(histogram_of_a_subnormal_range_counts_each_value_in_its_bin) {
+    /* [0, 1e-320] in 20 bins: bins / (hi - lo) is inf, so the usual
+     * product is NaN at 0 (it was cast to an index far out of the array) */
+    double v[] = {0.0, 1e-320, 3e-321, 0x1p-1074, 1.0};
+    uint64_t c[20];
+    CHECK_RC(hd_histogram(v, 5, 0, 1e-320, 20, c, NULL), HD_OK);
+    uint64_t total = 0;
+    for (int k = 0; k < 20; k++) {
+        total += c[k];
+        CONTEXT("bin %d", k);
+        CHECK(c[k] == 0 || k == 0 || k == 19 || k == 6); /* 3e-321 is in [edge 6, edge 7) */
+    }
+    CHECK_EQ(total, 4); /* 1.0 is beyond the range */
+    CHECK_EQ(c[0], 2);  /* 0 and the least subnormal */
+    CHECK_EQ(c[19], 1); /* the top closes the last bin */
+    CHECK(hd_histogram_edge(0, 1e-320, 20, 6) <= 3e-321 && 3e-321 < hd_histogram_edge(0, 1e-320, 20, 7));
+}
+
 TEST(histogram_refuses_bad_ranges_and_zero_bins) {
     double v[] = {1};
     uint64_t c[1];
