@@ -19,7 +19,7 @@
  *  - After the rounds, local order is global index order: as received when
  *    the runs follow each other in index order, else after a K-way merge
  *    applied in place (the numbers become 8-byte indices first).  The
- *    indices are then held encoded (gidx_t, gidx.c): each round's numbers
+ *    indices are then held encoded (hd__mpi_gidx_t, gidx.c): each round's numbers
  *    are encoded as they arrive (still in the cache), as if the runs were
  *    in order, and encoded again from the merged indices when they were
  *    not; the numbers and indices are freed before the call goes on.
@@ -113,7 +113,7 @@ typedef struct { int s; size_t p, k; uint64_t num[2]; } walk_t;
 
 /* The points left in the cursor's part, after moving past finished parts
  * (0 at the end of the input). */
-static size_t walk_avail(const input_t *in, const hd_mpi_part_t **order[2], walk_t *w) {
+static size_t walk_avail(const hd__mpi_input_t *in, const hd_mpi_part_t **order[2], walk_t *w) {
     while (w->s < 2) {
         if (w->p < in->nparts[w->s]) {
             size_t n = order[w->s][w->p]->points.count;
@@ -189,7 +189,7 @@ HD__INLINE void pack_run(const hd_points_t *v, const double *px, size_t k0, size
 
 /* Move every point to the rank of its region.  Each point goes as its
  * coordinates and a 4-byte number: its rank among the sender's points of
- * its set in index order (ranges_t turns it back into the global index).
+ * its set in index order (hd__mpi_ranges_t turns it back into the global index).
  * Each source's run is received straight into its slot of the local
  * arrays, in rounds of at most an eighth of the sender's points, so no
  * copy of all the points is ever held twice; a rank's own points are
@@ -200,7 +200,7 @@ HD__INLINE void pack_run(const hd_points_t *v, const double *px, size_t k0, size
  * each sender's run), else the numbers become indices and the arrays are
  * merged in place (a permutation from a K-way merge, 4 bytes a point;
  * loc->merged).  Either way loc->gi holds the indices encoded. */
-int hd__mpi_exchange(ctx_t *c, const input_t *in, const ranges_t *rg, const node_t *tree, local_t *loc) {
+int hd__mpi_exchange(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const hd__mpi_ranges_t *rg, const hd__mpi_node_t *tree, hd__mpi_local_t *loc) {
     int K = c->K, me = c->rank, rc = HD_OK, w = K <= 256 ? 1 : K <= 65536 ? 2 : 4;
     size_t nloc = (size_t)(in->n[0] + in->n[1]), C = nloc / ROUND_SHARE, sendcap = 0;
     if (C < ROUND_MIN) C = ROUND_MIN;
@@ -282,7 +282,7 @@ int hd__mpi_exchange(ctx_t *c, const input_t *in, const ranges_t *rg, const node
             if (r != me) c->bytes_part += ((uint64_t)tot[2 * r] + (uint64_t)tot[2 * r + 1]) * (3 * sizeof(double) + 4);
     }
     if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
-    MPI_GO(c, rc, MPI_Alltoall(tot, 2, MPI_INT, rtot, 2, MPI_INT, c->comm));
+    HD__MPI_GO(c, rc, MPI_Alltoall(tot, 2, MPI_INT, rtot, 2, MPI_INT, c->comm));
     for (int s = 0; s < 2 && rc == HD_OK; s++) {
         size_t m = 0;
         for (int r = 0; r < K; r++) {
@@ -311,7 +311,7 @@ int hd__mpi_exchange(ctx_t *c, const input_t *in, const ranges_t *rg, const node
     }
     if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
     uint64_t mine = nr, rounds = 0;
-    MPI_GO(c, rc, MPI_Allreduce(&mine, &rounds, 1, MPI_UINT64_T, MPI_MAX, c->comm));
+    HD__MPI_GO(c, rc, MPI_Allreduce(&mine, &rounds, 1, MPI_UINT64_T, MPI_MAX, c->comm));
     walk_t at = {0, 0, 0, {0, 0}};
     /* Destinations that change at more than a quarter of the points are
      * packed without a branch on them (pack_run): at K = 2 a branch
@@ -354,7 +354,7 @@ int hd__mpi_exchange(ctx_t *c, const input_t *in, const ranges_t *rg, const node
             hd__mpi_gidx_put_numbers(&loc->gi[s], rg, me, own0[s], off[s] + own0[s], ownat[s] - own0[s]);
             box_run(&loc->box[s], loc->xyz[s] + 3 * own0[s], ownat[s] - own0[s]);
         }
-        MPI_GO(c, rc, MPI_Alltoall(per, 2, MPI_INT, rper, 2, MPI_INT, c->comm));
+        HD__MPI_GO(c, rc, MPI_Alltoall(per, 2, MPI_INT, rper, 2, MPI_INT, c->comm));
         for (int s = 0; s < 2; s++) {
             for (int r = 0; r < K; r++) {
                 sc[r] = per[2 * r + s];
@@ -363,8 +363,8 @@ int hd__mpi_exchange(ctx_t *c, const input_t *in, const ranges_t *rg, const node
                 rd[r] = (int)(base[s * K + r] + got[s * K + r]);
                 got[s * K + r] += (size_t)rcn[r];
             }
-            MPI_GO(c, rc, MPI_Alltoallv(sx, sc, sd, c->q_type, loc->xyz[s], rcn, rd, c->q_type, c->comm));
-            MPI_GO(c, rc, MPI_Alltoallv(so, sc, sd, MPI_UINT32_T, off[s], rcn, rd, MPI_UINT32_T, c->comm));
+            HD__MPI_GO(c, rc, MPI_Alltoallv(sx, sc, sd, c->q_type, loc->xyz[s], rcn, rd, c->q_type, c->comm));
+            HD__MPI_GO(c, rc, MPI_Alltoallv(so, sc, sd, MPI_UINT32_T, off[s], rcn, rd, MPI_UINT32_T, c->comm));
             for (int r = 0; r < K; r++)
                 if (r != me) {
                     hd__mpi_gidx_put_numbers(&loc->gi[s], rg, r, (size_t)rd[r], off[s] + rd[r], (size_t)rcn[r]);

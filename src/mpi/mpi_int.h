@@ -6,9 +6,10 @@
  * pass and its shell (shell.c), the forwarding and the reduction of one
  * direction (forward.c), and the entry points (mpi.c, whose essay has the
  * algorithm).  Internal: names hd__mpi_*, and nothing outside src/mpi/
- * includes it but its white-box test (tests/internal/mpi_gidx.c).
+ * includes it but the white-box tests (tests/internal/mpi_*.c) and the
+ * partition's benchmark (bench/rcb_bench.c).
  *
- * Conventions of every function here: a ctx_t carries the call's
+ * Conventions of every function here: a hd__mpi_ctx_t carries the call's
  * communicator, its error (c->e, what hd__mpi_agree() broadcasts) and its
  * count of bytes held (every buffer through hd__mpi_alloc/hd__mpi_free, so
  * the peak is known and the call can assert that it freed everything); a
@@ -32,15 +33,15 @@
 
 /* ---- the call's context (context.c) -------------------------------------- */
 
-typedef struct { double d2; uint64_t g; } ans_t;                 /* an answer */
-typedef struct { double d2; uint64_t i, j; } far_t;              /* a witness */
-typedef struct { double x[3]; uint64_t g, side; } sample_t;
+typedef struct { double d2; uint64_t g; } hd__mpi_ans_t;                 /* an answer */
+typedef struct { double d2; uint64_t i, j; } hd__mpi_far_t;              /* a witness */
+typedef struct { double x[3]; uint64_t g, side; } hd__mpi_sample_t;
 /* An RCB node: left/right >= 0 are nodes, < 0 are ranks -(r + 1). */
-typedef struct { double s; uint64_t side, g; int axis, left, right, pad; } node_t;
+typedef struct { double s; uint64_t side, g; int axis, left, right, pad; } hd__mpi_node_t;
 /* What each rank holds after the partition. */
-typedef struct { hd__box_t box[2]; uint64_t n[2]; } held_t;
+typedef struct { hd__box_t box[2]; uint64_t n[2]; } hd__mpi_held_t;
 
-typedef struct ctx {
+typedef struct hd__mpi_ctx {
     MPI_Comm comm;
     int rank, K, threads;
     hd_error_t e;
@@ -56,56 +57,56 @@ typedef struct ctx {
     int first;                 /* the partition's first samples a rank (rcb.c) */
     MPI_Datatype ans_type, q_type, far_type, sample_type, node_type;
     MPI_Op far_op;
-} ctx_t;
+} hd__mpi_ctx_t;
 
 
 double hd__mpi_cpu(void);
-void *hd__mpi_alloc(ctx_t *c, size_t n, size_t size);
-void hd__mpi_free(ctx_t *c, void *p, size_t n, size_t size);
+void *hd__mpi_alloc(hd__mpi_ctx_t *c, size_t n, size_t size);
+void hd__mpi_free(hd__mpi_ctx_t *c, void *p, size_t n, size_t size);
 /* A buffer freed before the engine's pass (the exchange's), which may be
  * rounded up to whole huge pages and is charged so; freed by
  * hd__mpi_free_scratch with the same count and size. */
-void *hd__mpi_scratch(ctx_t *c, size_t n, size_t size);
-void hd__mpi_free_scratch(ctx_t *c, void *p, size_t n, size_t size);
-void hd__mpi_charge(ctx_t *c, size_t bytes);
-int hd__mpi_engine(ctx_t *c, const hd_points_t *P, const hd_points_t *Q, hd_result_t *e);
-int hd__mpi_engine_local(ctx_t *c, const hd_points_t *P, const hd_points_t *Q, const hd__box_t *bp,
+void *hd__mpi_scratch(hd__mpi_ctx_t *c, size_t n, size_t size);
+void hd__mpi_free_scratch(hd__mpi_ctx_t *c, void *p, size_t n, size_t size);
+void hd__mpi_charge(hd__mpi_ctx_t *c, size_t bytes);
+int hd__mpi_engine(hd__mpi_ctx_t *c, const hd_points_t *P, const hd_points_t *Q, hd_result_t *e);
+int hd__mpi_engine_local(hd__mpi_ctx_t *c, const hd_points_t *P, const hd_points_t *Q, const hd__box_t *bp,
                          const hd__box_t *bq, hd_result_t *e);
-int hd__mpi_engine_sym(ctx_t *c, const hd_points_t *P, const hd_points_t *Q, const hd__box_t *bp,
+int hd__mpi_engine_sym(hd__mpi_ctx_t *c, const hd_points_t *P, const hd_points_t *Q, const hd__box_t *bp,
                        const hd__box_t *bq, const hd__keep_t keep[2], hd_symmetric_t *s);
-int hd__mpi_engine_above(ctx_t *c, const hd_points_t *P, const hd_points_t *Q, double floor2, size_t floor_i,
+int hd__mpi_engine_above(hd__mpi_ctx_t *c, const hd_points_t *P, const hd_points_t *Q, double floor2, size_t floor_i,
                          hd_result_t *e);
-int hd__mpi_engine_kept(ctx_t *c, const hd_points_t *P, const hd_points_t *Q, const hd__keep_t *keep,
+int hd__mpi_engine_kept(hd__mpi_ctx_t *c, const hd_points_t *P, const hd_points_t *Q, const hd__keep_t *keep,
                         hd_result_t *e);
-int hd__mpi_nomem(ctx_t *c, const char *what, size_t n);
-int hd__mpi_failed(ctx_t *c, const char *call, int code);
-int hd__mpi_agree(ctx_t *c, int rc);
-int hd__mpi_types_create(ctx_t *c);
-void hd__mpi_types_free(ctx_t *c);
+int hd__mpi_nomem(hd__mpi_ctx_t *c, const char *what, size_t n);
+int hd__mpi_failed(hd__mpi_ctx_t *c, const char *call, int code);
+int hd__mpi_agree(hd__mpi_ctx_t *c, int rc);
+int hd__mpi_types_create(hd__mpi_ctx_t *c);
+void hd__mpi_types_free(hd__mpi_ctx_t *c);
 
 /* The witness order: larger d2 first, then the smaller index i. */
-static inline int hd__mpi_far_better(const far_t *x, const far_t *y) {
+static inline int hd__mpi_far_better(const hd__mpi_far_t *x, const hd__mpi_far_t *y) {
     return x->d2 > y->d2 || (x->d2 == y->d2 && x->i < y->i);
 }
 
 /* Every MPI call is timed (thread CPU): what is left of the call's CPU
  * besides them and the searches is its bookkeeping (stats->other_cpu). */
-#define MPI_TIMED(c, call) (mpi_t0_ = hd__mpi_cpu(), mpi_rc_ = (call), (c)->mpi_cpu += hd__mpi_cpu() - mpi_t0_, mpi_rc_)
+#define HD__MPI_TIMED(c, call) (mpi_t0_ = hd__mpi_cpu(), mpi_rc_ = (call), (c)->mpi_cpu += hd__mpi_cpu() - mpi_t0_, mpi_rc_)
 
-#define MPI_TRY(c, call)                                                      \
+#define HD__MPI_TRY(c, call)                                                      \
     do {                                                                      \
         double mpi_t0_;                                                       \
         int mpi_rc_;                                                          \
-        mpi_rc_ = MPI_TIMED(c, call);                                         \
+        mpi_rc_ = HD__MPI_TIMED(c, call);                                         \
         if (mpi_rc_ != MPI_SUCCESS) return hd__mpi_failed(c, #call, mpi_rc_); \
     } while (0)
 
 /* The same in a function that frees its buffers at `done`. */
-#define MPI_GO(c, rc, call)                         \
+#define HD__MPI_GO(c, rc, call)                         \
     do {                                            \
         double mpi_t0_;                             \
         int mpi_rc_;                                \
-        mpi_rc_ = MPI_TIMED(c, call);               \
+        mpi_rc_ = HD__MPI_TIMED(c, call);               \
         if (mpi_rc_ != MPI_SUCCESS) {               \
             rc = hd__mpi_failed(c, #call, mpi_rc_); \
             goto done;                              \
@@ -119,7 +120,7 @@ typedef struct {
     size_t nparts[2];
     uint64_t n[2];            /* local points of A, B (input) */
     hd__box_t box[2];         /* local boxes (input) */
-} input_t;
+} hd__mpi_input_t;
 
 /* A view of packed doubles (the common layout) as its array, read in
  * place; NULL for any other layout, read through hd_points_get. */
@@ -137,7 +138,7 @@ static inline void hd__mpi_get_point(const hd_points_t *p, size_t k, double out[
     else hd_points_get(p, k, out);
 }
 
-typedef struct { uint64_t lo, hi; int side, rank; } range_t;
+typedef struct { uint64_t lo, hi; int side, rank; } hd__mpi_range_t;
 
 /* Every rank's nonempty parts (all-gathered by check_ranges), sorted by
  * (side, rank, first index): side s, rank r's are all[seg[s (K + 1) + r]]
@@ -149,19 +150,19 @@ typedef struct { uint64_t lo, hi; int side, rank; } range_t;
  * same positions seg[s (K + 1)] .. seg[s (K + 1) + K] as in all), and
  * ord[i] is the number of side indices below bylo[i].lo over all ranks:
  * index g of run i is the side's ordinal ord[i] + (g - lo), dense in
- * 0 .. N_side - 1 (what gidx_t encodes). */
-struct ranges {
+ * 0 .. N_side - 1 (what hd__mpi_gidx_t encodes). */
+struct hd__mpi_ranges {
     int K;
-    range_t *all;
+    hd__mpi_range_t *all;
     size_t total;
     size_t *seg;
     uint64_t *first;
-    range_t *bylo;
+    hd__mpi_range_t *bylo;
     uint64_t *ord;
 };
 
 /* The global indices of a local set, by position (gidx.c).  Local order is
- * global index order, so the ordinals (ranges_t.ord) of a local set
+ * global index order, so the ordinals (hd__mpi_ranges_t.ord) of a local set
  * increase with the position, and they are held Elias-Fano coded: with
  * n points among the side's U indices and l = floor(log2(U / n)), the low
  * l bits of each ordinal in a packed array, and the high part h of the
@@ -174,40 +175,40 @@ struct ranges {
  * numbers, or from the 8-byte indices of merged runs, both freed then),
  * and they are never reordered afterwards (split and unsplit move
  * coordinates only), so position k's index is fixed for the call.  An index is the ordinal's run's first index plus the ordinal's
- * offset in it (run, rord: the side's runs of ranges_t by first index). */
-typedef struct ranges ranges_t;
+ * offset in it (run, rord: the side's runs of hd__mpi_ranges_t by first index). */
+typedef struct hd__mpi_ranges hd__mpi_ranges_t;
 typedef struct {
     uint64_t *w;             /* one allocation: low, high, samp */
     size_t words;            /* its words (charged) */
     const uint64_t *low, *high, *samp;
     size_t n;                /* positions */
     int l;                   /* low bits an ordinal */
-    const range_t *run;      /* the side's runs by first index */
+    const hd__mpi_range_t *run;      /* the side's runs by first index */
     const uint64_t *rord;    /* each one's first ordinal */
     size_t nrun;
     int side;
-} gidx_t;
+} hd__mpi_gidx_t;
 
-int hd__mpi_gidx_init(ctx_t *c, gidx_t *x, const ranges_t *rg, int side, size_t n);
+int hd__mpi_gidx_init(hd__mpi_ctx_t *c, hd__mpi_gidx_t *x, const hd__mpi_ranges_t *rg, int side, size_t n);
 /* Positions k .. k + n - 1's indices are g[0 .. n - 1] (increasing, and
  * above those of the positions before k), or the indices of numbers
  * num[0 .. n - 1] at their sender r (increasing: a run received in index
  * order).  The code is written once, from calls covering 0 .. x->n - 1. */
-void hd__mpi_gidx_put_indices(gidx_t *x, size_t k, const uint64_t *g, size_t n);
-void hd__mpi_gidx_put_numbers(gidx_t *x, const ranges_t *rg, int r, size_t k, const uint32_t *num, size_t n);
+void hd__mpi_gidx_put_indices(hd__mpi_gidx_t *x, size_t k, const uint64_t *g, size_t n);
+void hd__mpi_gidx_put_numbers(hd__mpi_gidx_t *x, const hd__mpi_ranges_t *rg, int r, size_t k, const uint32_t *num, size_t n);
 /* The code emptied (every word zero), to be written again. */
-void hd__mpi_gidx_clear(gidx_t *x);
-void hd__mpi_gidx_free(ctx_t *c, gidx_t *x);
+void hd__mpi_gidx_clear(hd__mpi_gidx_t *x);
+void hd__mpi_gidx_free(hd__mpi_ctx_t *c, hd__mpi_gidx_t *x);
 /* Position k's index, at any k (a select from the sample before it and a
  * binary search of the runs). */
-uint64_t hd__mpi_gidx(const gidx_t *x, size_t k);
+uint64_t hd__mpi_gidx(const hd__mpi_gidx_t *x, size_t k);
 /* Positions k .. k + m - 1's indices into g[0 .. m - 1]: a select for the
  * first, then the 1s of the high bits in order and the runs only forward
  * (a fraction of a cursor's cost a position, when all are wanted). */
-void hd__mpi_gidx_decode(const gidx_t *x, size_t k, size_t m, uint64_t *g);
+void hd__mpi_gidx_decode(const hd__mpi_gidx_t *x, size_t k, size_t m, uint64_t *g);
 
 /* The low l bits of position k's ordinal. */
-static inline uint64_t hd__mpi_gidx_low(const gidx_t *x, size_t k) {
+static inline uint64_t hd__mpi_gidx_low(const hd__mpi_gidx_t *x, size_t k) {
     if (x->l == 0) return 0;
     uint64_t bit = (uint64_t)k * (uint64_t)x->l;
     size_t w = (size_t)(bit >> 6);
@@ -224,7 +225,7 @@ static inline uint64_t hd__mpi_gidx_low(const gidx_t *x, size_t k) {
  * hd__mpi_gcur_next's.  Positions may also go back (then as
  * hd__mpi_gidx). */
 typedef struct {
-    const gidx_t *x;
+    const hd__mpi_gidx_t *x;
     size_t k;                /* the last position decoded (SIZE_MAX: none) */
     size_t wi;               /* the word of the high bits holding its 1 */
     uint64_t w;              /* that word's 1s after it */
@@ -232,12 +233,12 @@ typedef struct {
     uint64_t first, span, lo; /* that run: ordinals first .. first + span
                                  name indices lo .. lo + span */
     uint64_t g;              /* its index */
-} gcur_t;
+} hd__mpi_gcur_t;
 
-void hd__mpi_gcur_init(gcur_t *cu, const gidx_t *x);
-uint64_t hd__mpi_gcur_next(gcur_t *cu, size_t k);
+void hd__mpi_gcur_init(hd__mpi_gcur_t *cu, const hd__mpi_gidx_t *x);
+uint64_t hd__mpi_gcur_next(hd__mpi_gcur_t *cu, size_t k);
 
-static inline uint64_t hd__mpi_gcur_at(gcur_t *cu, size_t k) {
+static inline uint64_t hd__mpi_gcur_at(hd__mpi_gcur_t *cu, size_t k) {
     if (k == cu->k) return cu->g;
     if (k == cu->k + 1 && cu->run != SIZE_MAX) { /* k < n: a 1 follows */
         size_t wi = cu->wi;
@@ -256,44 +257,44 @@ static inline uint64_t hd__mpi_gcur_at(gcur_t *cu, size_t k) {
 }
 
 /* The rank whose parts hold the cursor's last index. */
-static inline int hd__mpi_gcur_rank(const gcur_t *cu) {
+static inline int hd__mpi_gcur_rank(const hd__mpi_gcur_t *cu) {
     return cu->x->run[cu->run].rank;
 }
 
 typedef struct {
     double *P;               /* local points asking, packed xyz (reordered
                                 and restored by split/unsplit) */
-    const gidx_t *gP;        /* their global indices, by position */
+    const hd__mpi_gidx_t *gP;        /* their global indices, by position */
     size_t nP;
     double *Q;               /* local points searched */
-    const gidx_t *gQ;
+    const hd__mpi_gidx_t *gQ;
     size_t nQ;
     int qside;               /* 0: Q is A, 1: Q is B */
-    const struct pre *pre;   /* the engine's answer, when computed for both
+    const struct hd__mpi_pre *pre;   /* the engine's answer, when computed for both
                                 directions at once (NULL: not) */
-} dir_t;
+} hd__mpi_dir_t;
 
 int hd__mpi_by_offset(const void *x, const void *y);
-int hd__mpi_by_range(const void *x, const void *y); /* range_t by (side, lo) */
-void hd__mpi_ranges_free(ctx_t *c, ranges_t *rg);
-int hd__mpi_ranges_index(ctx_t *c, ranges_t *rg);
-void hd__mpi_ranges_globals(const ranges_t *rg, int s, int r, size_t *i, const uint32_t *num, size_t n, uint64_t *g);
-uint64_t hd__mpi_ranges_global(const ranges_t *rg, int s, int r, uint64_t m);
+int hd__mpi_by_range(const void *x, const void *y); /* hd__mpi_range_t by (side, lo) */
+void hd__mpi_ranges_free(hd__mpi_ctx_t *c, hd__mpi_ranges_t *rg);
+int hd__mpi_ranges_index(hd__mpi_ctx_t *c, hd__mpi_ranges_t *rg);
+void hd__mpi_ranges_globals(const hd__mpi_ranges_t *rg, int s, int r, size_t *i, const uint32_t *num, size_t n, uint64_t *g);
+uint64_t hd__mpi_ranges_global(const hd__mpi_ranges_t *rg, int s, int r, uint64_t m);
 /* *i, a run of rank r's side s at or before number m's (numbers only grow
  * along a walk), becomes the run holding number m. */
-static inline void hd__mpi_ranges_seek(const ranges_t *rg, int s, int r, size_t *i, uint64_t m) {
+static inline void hd__mpi_ranges_seek(const hd__mpi_ranges_t *rg, int s, int r, size_t *i, uint64_t m) {
     while (m - rg->first[*i] > rg->all[*i].hi - rg->all[*i].lo) ++*i;
     assert(*i < rg->seg[(size_t)s * ((size_t)rg->K + 1) + (size_t)r + 1] && m >= rg->first[*i]);
     (void)s, (void)r; /* the assert's */
 }
-int hd__mpi_check_ranges(ctx_t *c, const input_t *in, ranges_t *rg);
-int hd__mpi_check_local(ctx_t *c, const hd_options_t *opt, input_t *in, const void *out);
+int hd__mpi_check_ranges(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, hd__mpi_ranges_t *rg);
+int hd__mpi_check_local(hd__mpi_ctx_t *c, const hd_options_t *opt, hd__mpi_input_t *in, const void *out);
 
 /* ---- the partition (rcb.c) and the exchange (exchange.c) ----------------- */
 
 /* Whether a point (coordinates x, set side, global index g) goes to the
  * left of a node: its key (coordinate, set, index) below the split's. */
-static inline int hd__mpi_goes_left(const node_t *nd, const double *x, uint64_t side, uint64_t g) {
+static inline int hd__mpi_goes_left(const hd__mpi_node_t *nd, const double *x, uint64_t side, uint64_t g) {
     double v = x[nd->axis];
     if (v != nd->s) return v < nd->s;
     if (side != nd->side) return side < nd->side;
@@ -302,7 +303,7 @@ static inline int hd__mpi_goes_left(const node_t *nd, const double *x, uint64_t 
 
 /* The rank whose region holds the point (a walk down the tree; inline,
  * since the exchange asks it for every point). */
-static inline int hd__mpi_rank_of(const node_t *t, int K, const double *x, uint64_t side, uint64_t g) {
+static inline int hd__mpi_rank_of(const hd__mpi_node_t *t, int K, const double *x, uint64_t side, uint64_t g) {
     if (K == 1) return 0;
     int k = 0;
     for (;;) {
@@ -311,9 +312,9 @@ static inline int hd__mpi_rank_of(const node_t *t, int K, const double *x, uint6
         k = next;
     }
 }
-void hd__mpi_regions(const node_t *t, int node, hd__box_t box, hd__box_t *out);
-hd__box_t hd__mpi_node_boxes(const node_t *t, int node, const held_t *held, int side, hd__box_t *out);
-void hd__mpi_candidates(const node_t *t, const hd__box_t *nbox, const held_t *held, int side, int node,
+void hd__mpi_regions(const hd__mpi_node_t *t, int node, hd__box_t box, hd__box_t *out);
+hd__box_t hd__mpi_node_boxes(const hd__mpi_node_t *t, int node, const hd__mpi_held_t *held, int side, hd__box_t *out);
+void hd__mpi_candidates(const hd__mpi_node_t *t, const hd__box_t *nbox, const hd__mpi_held_t *held, int side, int node,
                         const double *p, double u2, int me, int *list, int *n);
 /* The first samples a rank of K gives rank 0's tree: 1024 up to 64 ranks,
  * then fewer, so that rank 0 holds at most 65536 of them (at least 64 a
@@ -321,28 +322,28 @@ void hd__mpi_candidates(const node_t *t, const hd__box_t *nbox, const held_t *he
 int hd__mpi_first_samples(int K);
 /* Rank 0's tree over n first samples s (reordered) for K ranks: the K - 1
  * nodes into t, each node's bracket into br[2 id], br[2 id + 1]. */
-void hd__mpi_rcb_tree(sample_t *s, size_t n, int K, node_t *t, double *br);
+void hd__mpi_rcb_tree(hd__mpi_sample_t *s, size_t n, int K, hd__mpi_node_t *t, double *br);
 /* Cut space into the K ranks' regions (tree, K - 1 nodes): rank 0's tree
  * over c->first samples a rank, refined by a second sample's counts. */
-int hd__mpi_partition(ctx_t *c, const input_t *in, uint64_t N, node_t *tree);
+int hd__mpi_partition(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, uint64_t N, hd__mpi_node_t *tree);
 /* The ranks other than `me` that p must ask (into list; their number is
  * returned): those whose box of `side` may hold a point within u2 of p,
  * ties included; when this rank holds no point of `side` (none_here), u2
  * is first lowered to the nearest farthest corner of the nonempty boxes,
  * which bounds the distance to the nearest point from above. */
-int hd__mpi_asked(const node_t *t, const hd__box_t *nbox, const held_t *held, int K, int side, int none_here,
+int hd__mpi_asked(const hd__mpi_node_t *t, const hd__box_t *nbox, const hd__mpi_held_t *held, int K, int side, int none_here,
                   const double *p, double u2, int me, int *list);
 
 typedef struct {
     double *xyz[2];
     hd__box_t box[2];        /* the exact box of each side's points (empty: lo > hi) */
-    gidx_t gi[2];            /* their global indices */
+    hd__mpi_gidx_t gi[2];            /* their global indices */
     int merged[2];           /* the senders' runs were merged, */
     size_t *start[2];        /* else K + 1 a side: each sender's run */
     size_t n[2];
-} local_t;
+} hd__mpi_local_t;
 
-int hd__mpi_exchange(ctx_t *c, const input_t *in, const ranges_t *rg, const node_t *tree, local_t *loc);
+int hd__mpi_exchange(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const hd__mpi_ranges_t *rg, const hd__mpi_node_t *tree, hd__mpi_local_t *loc);
 
 /* ---- the per-point searches (slab.c) ------------------------------------- */
 
@@ -370,27 +371,27 @@ typedef struct {
     size_t n, bytes;         /* its points (named by their positions in Q) */
     double M;                /* its margin (infinite: all of Q) */
     hd__box_t kb;            /* the key box its askers use too */
-} slab_t;
+} hd__mpi_slab_t;
 
 typedef struct {
-    slab_t sub, full;
+    hd__mpi_slab_t sub, full;
     double M0;               /* the first slab's margin (set by shell_of) */
-} qtree_t;
+} hd__mpi_qtree_t;
 
-void hd__mpi_qtree_free(ctx_t *c, qtree_t *q);
+void hd__mpi_qtree_free(hd__mpi_ctx_t *c, hd__mpi_qtree_t *q);
 /* The nearest layer's structure of v (sel NULL), or of v's m points
  * sel[0..m) named by names[] or their positions in v (hd__an_build_sel),
  * charged at its build's measured peak while built, then at what it
  * holds (*bytes, to subtract when it is freed). */
-int hd__mpi_an_build(ctx_t *c, hd__an_t *s, const hd_points_t *v, const uint32_t *sel, const uint32_t *names,
+int hd__mpi_an_build(hd__mpi_ctx_t *c, hd__an_t *s, const hd_points_t *v, const uint32_t *sel, const uint32_t *names,
                      size_t m, const hd__box_t *kb, int threads, size_t *bytes);
 /* hd__an_nearest_paired(asking, searched, pair_at) into near (no
  * distances; pair_at may be NULL: no partners), its own arrays charged
  * while it runs. */
-int hd__mpi_an_nearest(ctx_t *c, const hd__an_t *asking, const hd__an_t *searched, const uint32_t *pair_at,
+int hd__mpi_an_nearest(hd__mpi_ctx_t *c, const hd__an_t *asking, const hd__an_t *searched, const uint32_t *pair_at,
                        int threads, size_t *near);
 /* Frees a structure hd__mpi_an_build made and takes its bytes off the count. */
-void hd__mpi_an_release(ctx_t *c, hd__an_t *s, size_t bytes);
+void hd__mpi_an_release(hd__mpi_ctx_t *c, hd__an_t *s, size_t bytes);
 /* For each of n points, point k at pts + 3 pos[k] (pos NULL: pts + 3 k),
  * its nearest point of Q into near[k] (exact, smallest index on ties, as
  * hd_distances gives it), from q's slabs (slab.c), built as needed.  With
@@ -399,7 +400,7 @@ void hd__mpi_an_release(ctx_t *c, hd__an_t *s, size_t bytes);
  * an upper bound of its nearest distance) and flagged, for the caller to
  * prove by a smaller answer from elsewhere (hd__mpi_slab_proves with the
  * first slab's margin, q->M0) or to ask again without `unproven`. */
-int hd__mpi_nearest_in_q(ctx_t *c, const dir_t *d, const hd__box_t *r, qtree_t *q, const double *pts,
+int hd__mpi_nearest_in_q(hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, const hd__box_t *r, hd__mpi_qtree_t *q, const double *pts,
                          const uint32_t *pos, size_t n, size_t *near, unsigned char *unproven);
 /* Whether every point of Q farther than M from all of r's finite faces is
  * farther from x than sqrt(d2) (slab.c's proof). */
@@ -414,22 +415,18 @@ typedef struct {
     uint32_t *own_pos;       /* each one's position in P (NULL: all of P) */
     unsigned char *unproven; /* each one's: nearest[] only a point of the first slab
                                 (hd__mpi_nearest_in_q), or NULL */
-    far_t inner;             /* exact over the interior; d2 = -1 if none
+    hd__mpi_far_t inner;             /* exact over the interior; d2 = -1 if none
                                 or not known (lazy) */
     int lazy;                /* the interior's maximum was not computed */
-    far_t h;                 /* then: the engine's answer, whose witness
+    hd__mpi_far_t h;                 /* then: the engine's answer, whose witness
                                 is in the shell and bounds the interior */
-} shell_t;
+} hd__mpi_shell_t;
 
 /* The shell's point k: its coordinates are P's, not a copy. */
-static inline const double *hd__mpi_shell_pt(const dir_t *d, const shell_t *sh, size_t k) {
+static inline const double *hd__mpi_shell_pt(const hd__mpi_dir_t *d, const hd__mpi_shell_t *sh, size_t k) {
     return d->P + 3 * (sh->own_pos ? sh->own_pos[k] : k);
 }
 
-/* The engine's answer for a direction, computed before it runs: the
- * symmetric call runs the engine once for both directions
- * (hd__mpi_engine_both), since each of its calls builds both sets'
- * structures. */
 /* The points of P the engine's maximum refused (shell.c, keep_clear):
  * those whose region faces are not clear of their own local nearest
  * distance, which may be only local. */
@@ -444,90 +441,94 @@ typedef struct {
     uint32_t *near;          /* each one's nearest position in Q, the engine's
                                 (the smallest index at its u), by pos: 4
                                 bytes, as the local sets' positions are */
-} refused_t;
+} hd__mpi_refused_t;
 
-typedef struct pre {
+/* The engine's answer for a direction, computed before it runs: the
+ * symmetric call runs the engine once for both directions
+ * (hd__mpi_engine_both), since each of its calls builds both sets'
+ * structures. */
+typedef struct hd__mpi_pre {
     int have;                /* 0: the direction runs the engine itself */
     int paired;              /* the answer is on the pairs (P_c, Q_c) */
     hd_result_t e;           /* positions in P and Q, or in P_c and Q_c */
     const unsigned char *inp, *inq; /* paired: the pairs' masks of P, Q */
-    refused_t ref;           /* not paired: what e's maximum left out */
-} pre_t;
+    hd__mpi_refused_t ref;           /* not paired: what e's maximum left out */
+} hd__mpi_pre_t;
 
 /* mask[s]: NULL, or the pairs' mask of side s (n[s] bytes) when paired,
  * which the caller frees (hd__mpi_free) after both directions, as it
  * frees pre[s] (hd__mpi_pre_free).  mine: the rank's region. */
-int hd__mpi_engine_both(ctx_t *c, double *xyz[2], const gidx_t *g[2], const size_t n[2], const hd__box_t box[2],
-                        const hd__box_t *mine, pre_t pre[2], unsigned char *mask[2]);
-void hd__mpi_pre_free(ctx_t *c, pre_t *pre);
-void hd__mpi_shell_free(ctx_t *c, shell_t *sh);
-int hd__mpi_interior_max(ctx_t *c, const dir_t *d, const hd__box_t *mine, const shell_t *sh, double h2,
-                         const far_t *G, far_t *out);
-uint64_t hd__mpi_shell_g(gcur_t *cu, const shell_t *sh, size_t k);
-int hd__mpi_shell_of(ctx_t *c, const dir_t *d, const hd__box_t *mine, qtree_t *q, shell_t *sh);
+int hd__mpi_engine_both(hd__mpi_ctx_t *c, double *xyz[2], const hd__mpi_gidx_t *g[2], const size_t n[2], const hd__box_t box[2],
+                        const hd__box_t *mine, hd__mpi_pre_t pre[2], unsigned char *mask[2]);
+void hd__mpi_pre_free(hd__mpi_ctx_t *c, hd__mpi_pre_t *pre);
+void hd__mpi_shell_free(hd__mpi_ctx_t *c, hd__mpi_shell_t *sh);
+int hd__mpi_interior_max(hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, const hd__box_t *mine, const hd__mpi_shell_t *sh, double h2,
+                         const hd__mpi_far_t *G, hd__mpi_far_t *out);
+uint64_t hd__mpi_shell_g(hd__mpi_gcur_t *cu, const hd__mpi_shell_t *sh, size_t k);
+int hd__mpi_shell_of(hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, const hd__box_t *mine, hd__mpi_qtree_t *q, hd__mpi_shell_t *sh);
 
 /* ---- one direction over the partition (forward.c) ------------------------ */
 
 /* Forwarded queries: point k of the asking set to rank dest. */
-typedef struct { size_t k; int dest; int pad; } pair_t;
-typedef struct { pair_t *p; size_t n, cap; } pairs_t;
-int hd__mpi_pairs_add(ctx_t *c, pairs_t *pr, size_t k, const int *list, int n);
-void hd__mpi_pairs_free(ctx_t *c, pairs_t *pr);
+typedef struct { size_t k; int dest; int pad; } hd__mpi_pair_t;
+typedef struct { hd__mpi_pair_t *p; size_t n, cap; } hd__mpi_pairs_t;
+int hd__mpi_pairs_add(hd__mpi_ctx_t *c, hd__mpi_pairs_t *pr, size_t k, const int *list, int n);
+void hd__mpi_pairs_free(hd__mpi_ctx_t *c, hd__mpi_pairs_t *pr);
 
 /* Answers m queries pts against this rank's local set: exact (d2,
  * smallest global index), or (infinity, UINT64_MAX) when it holds none. */
-typedef int (*hd__mpi_answer_t)(ctx_t *c, void *arg, const double *pts, size_t m, ans_t *ans);
+typedef int (*hd__mpi_answer_t)(hd__mpi_ctx_t *c, void *arg, const double *pts, size_t m, hd__mpi_ans_t *ans);
 
 /* One round of forwarding (collective; rc is the caller's status, agreed
  * first): each pair (k, r) sends point k of P (at P + 3 pos[k], pos NULL:
  * P + 3 k) to rank r, every rank answers what it receives with fn, and
  * each answer replaces (u2[k], jj[k]) when smaller (d2 first, then the
  * index). */
-int hd__mpi_round(ctx_t *c, int rc, const double *P, const uint32_t *pos, const pairs_t *pr,
+int hd__mpi_round(hd__mpi_ctx_t *c, int rc, const double *P, const uint32_t *pos, const hd__mpi_pairs_t *pr,
                   hd__mpi_answer_t fn, void *arg, double *u2, uint64_t *jj);
 
-int hd__mpi_direction(ctx_t *c, const dir_t *d, const node_t *tree, const hd__box_t *region, const held_t *held,
-                      far_t *result);
+int hd__mpi_direction(hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, const hd__mpi_node_t *tree, const hd__box_t *region, const hd__mpi_held_t *held,
+                      hd__mpi_far_t *result);
 
 /* ---- the course of a call (mpi.c) ---------------------------------------- */
 
 /* What the ranks hold after the partition (K > 1). */
 typedef struct {
-    node_t *tree;            /* K - 1 nodes */
+    hd__mpi_node_t *tree;            /* K - 1 nodes */
     hd__box_t *region;       /* K: every rank's region */
-    held_t *held;            /* K: every rank's count and box a set */
-    local_t loc;             /* this rank's points */
-} spread_t;
+    hd__mpi_held_t *held;            /* K: every rank's count and box a set */
+    hd__mpi_local_t loc;             /* this rank's points */
+} hd__mpi_spread_t;
 
 /* K = 1: each set as one view (the caller's, or packed in index order). */
 typedef struct {
     hd_points_t v[2];
     double *own[2];
     const hd_mpi_part_t **order[2];
-} views_t;
+} hd__mpi_views_t;
 
 /* What a call's body holds from its start to its end. */
 typedef struct {
-    ranges_t rg;
-    spread_t sp;             /* K > 1 */
+    hd__mpi_ranges_t rg;
+    hd__mpi_spread_t sp;             /* K > 1 */
     uint64_t N[2];           /* points of A and B over all ranks */
     double t0, cpu0;         /* the body's start (wall, thread CPU) */
-} course_t;
+} hd__mpi_course_t;
 
-void hd__mpi_course_init(ctx_t *c, course_t *cs);
-void hd__mpi_course_free(ctx_t *c, course_t *cs);
-int hd__mpi_figures(ctx_t *c, const course_t *cs, uint64_t pts, hd_mpi_stats_t *st, double *tmax);
+void hd__mpi_course_init(hd__mpi_ctx_t *c, hd__mpi_course_t *cs);
+void hd__mpi_course_free(hd__mpi_ctx_t *c, hd__mpi_course_t *cs);
+int hd__mpi_figures(hd__mpi_ctx_t *c, const hd__mpi_course_t *cs, uint64_t pts, hd_mpi_stats_t *st, double *tmax);
 
 /* A call's body, run by hd__mpi_call inside its context. */
-typedef int (*hd__mpi_body_t)(ctx_t *c, const hd_options_t *opt, input_t *in, void *arg, hd_mpi_stats_t *st);
+typedef int (*hd__mpi_body_t)(hd__mpi_ctx_t *c, const hd_options_t *opt, hd__mpi_input_t *in, void *arg, hd_mpi_stats_t *st);
 
 int hd__mpi_call(MPI_Comm comm, const hd_mpi_part_t *a, size_t na, const hd_mpi_part_t *b, size_t nb,
                  const hd_options_t *opt, hd__mpi_body_t body, void *arg, hd_mpi_stats_t *st, hd_error_t *err);
-int hd__mpi_begin(ctx_t *c, const hd_options_t *opt, input_t *in, const void *res, ranges_t *rg, uint64_t N[2],
+int hd__mpi_begin(hd__mpi_ctx_t *c, const hd_options_t *opt, hd__mpi_input_t *in, const void *res, hd__mpi_ranges_t *rg, uint64_t N[2],
                   double corners[2][6]);
-int hd__mpi_spread(ctx_t *c, const input_t *in, const ranges_t *rg, const uint64_t N[2], spread_t *sp);
-void hd__mpi_spread_free(ctx_t *c, spread_t *sp);
-int hd__mpi_views(ctx_t *c, const input_t *in, views_t *vw);
-void hd__mpi_views_free(ctx_t *c, const input_t *in, views_t *vw);
+int hd__mpi_spread(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const hd__mpi_ranges_t *rg, const uint64_t N[2], hd__mpi_spread_t *sp);
+void hd__mpi_spread_free(hd__mpi_ctx_t *c, hd__mpi_spread_t *sp);
+int hd__mpi_views(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, hd__mpi_views_t *vw);
+void hd__mpi_views_free(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, hd__mpi_views_t *vw);
 
 #endif /* HD_MPI_INT_H */
