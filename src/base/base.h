@@ -170,6 +170,20 @@ double hd__lerp(double a, double b, double t);
  * hd_percentile_of and the MPI library's, which pass their offset). */
 int hd__nan_check(const double *d, size_t n, size_t first, const char *what, hd_error_t *err);
 
+/* Keep the k items with the largest scores, in decreasing order of score,
+ * in score[0..*n) and item[0..*n) (*n grows to k). */
+HD__INLINE void hd__top_insert(double *score, size_t *item, int *n, int k, double sc, size_t it) {
+    if (*n == k && !(sc > score[k - 1])) return;
+    int at = *n < k ? (*n)++ : k - 1;
+    while (at > 0 && score[at - 1] < sc) {
+        score[at] = score[at - 1];
+        item[at] = item[at - 1];
+        at--;
+    }
+    score[at] = sc;
+    item[at] = it;
+}
+
 /* ---- exact sums (xsum.c) -------------------------------------------------- */
 /* An exact accumulator of doubles: the sum of any number of finite doubles
  * held without rounding, as a fixed-point number in int64 limbs of 32-bit

@@ -54,7 +54,7 @@
  * 13.7.  The second tree's q lies in the first's block (q_borrowed): the
  * pair is freed together.
  */
-#include "engine/engine.h"
+#include "engine/tree.h"
 
 #include <assert.h>
 #include <math.h>

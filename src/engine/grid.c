@@ -55,7 +55,7 @@
  * this pass and the bucket trees with hd__grid_trial, both here because
  * they run this file's point-by-point test on a sample.
  */
-#include "engine/engine.h"
+#include "engine/grid.h"
 
 #include <assert.h>
 #include <math.h>

@@ -97,6 +97,35 @@ HD__INLINE double hd__box_lb2s(const hd__box_t *b, double x, double y, double z)
     return gx * gx + gy * gy + gz * gz;
 }
 
+/* Smallest computed squared distance between a point of box a and a point of
+ * box b (0 when they meet).  Same operation order as hd__d2: with exact
+ * boxes it never exceeds hd__d2 of a point pair drawn from them.  The one
+ * box-to-box bound: INC's MBRs (classic/) and the engine's walk over two
+ * trees (engine/walk.c) both use it. */
+HD__INLINE double hd__box_box_lb2(const hd__box_t *a, const hd__box_t *b) {
+    double d[3];
+    for (int k = 0; k < 3; k++) {
+        double v = 0.0;
+        if (b->lo[k] > a->hi[k]) v = b->lo[k] - a->hi[k];
+        else if (a->lo[k] > b->hi[k]) v = a->lo[k] - b->hi[k];
+        d[k] = v;
+    }
+    return d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+}
+
+/* Largest computed squared distance between a point of box a and a point of
+ * box b (the farthest pair of corners); never below hd__d2 of such a pair. */
+HD__INLINE double hd__box_box_ub2(const hd__box_t *a, const hd__box_t *b) {
+    double d[3];
+    for (int k = 0; k < 3; k++) {
+        double u = a->hi[k] - b->lo[k], v = b->hi[k] - a->lo[k];
+        if (u < 0) u = -u;
+        if (v < 0) v = -v;
+        d[k] = u > v ? u : v;
+    }
+    return d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+}
+
 /* ---- the running maximum with its witness ------------------------------- */
 /* best.d2 = -1 means "nothing yet".  Merge keeps the larger d2 and, on a
  * tie, the smaller i: so the witness is independent of evaluation order. */
