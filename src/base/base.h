@@ -105,12 +105,12 @@ void hd__reuse_shrink(hd__reuse_t *pool, void *p, size_t bytes);
 
 /* Map the pages of the fresh block p[0..bytes) now, in one call, rather
  * than one page fault per page as it is first written (a fault costs far
- * more than the write on virtual machines: docs/engine.md, "Threads and
- * memory"; on the machine of docs/scale-out.md, "Memory pages on this
- * machine", 1.25 ns a byte mapped so against 2.6 by faults).  For arrays
- * about to be written whole; a no-op below HD__PREFAULT_MIN bytes (16
- * pages; it was 1 MiB, which left the MPI layer's slab structures to
- * faults) and where the system has no such call.  hd__reuse_get does it
+ * more than the write on virtual machines: bench/page_cost.c measures
+ * both ways; docs/engine.md, "Threads and memory", and docs/scale-out.md,
+ * "Memory pages on this machine", have the figures).  For arrays about to
+ * be written whole; a no-op below HD__PREFAULT_MIN bytes (16 pages, small
+ * enough that the MPI layer's slab structures are mapped so too) and
+ * where the system has no such call.  hd__reuse_get does it
  * for the fresh blocks it allocates. */
 #define HD__PREFAULT_MIN (1u << 16)
 void hd__prefault(void *p, size_t bytes);

@@ -46,8 +46,8 @@
  * point, then both quantised copies, in one block, and boxes.  That block
  * is the buffer the first sort's keys end in (its tmp: the radix sort
  * makes three passes), given back after it and asked for at max(8 n0,
- * 6 (n0 + n1)) bytes so that it can take both copies: two blocks would each keep a last
- * 2 MiB page whole (0.6 MB each on 250K points).  So at no time are more
+ * 6 (n0 + n1)) bytes so that it can take both copies: two blocks would
+ * each keep a last 2 MiB page whole.  So at no time are more
  * than max(16 n0, 7.4 n0 + max(8 n0, 6 (n0 + n1)) + 8 n1, 13.375 (n0 + n1))
  * bytes held (n0 the larger set), at most 16 bytes per point of both sets,
  * plus pages lost to rounding and the pool's chunks; on sets of one size

@@ -47,11 +47,13 @@
 
 /* The grid pass is chosen when, run over a sample of each query set, it
  * costs at most GRID_COST distances and nodes per point; otherwise both
- * sets get the bucket trees.  The threshold separates two populations:
- * the grid's cases cost 1.0 to 2.2, independent uniform cubes 7.5 to 36
- * (where the grid pass took 2 to 5 times the trees' time) and the other
- * tree cases 13 and more.  4 is about the geometric mean of 2.2 and 7.5;
- * the measurements are in docs/engine.md, "Step 2: the plan". */
+ * sets get the bucket trees.  The threshold separates two populations of
+ * hd_bench's cases (bench/bench.c prints each case's trial cost and
+ * plan): the cases the grid pass answers faster cost less, those the trees
+ * answer faster (independent uniform cubes among them) cost more, and the
+ * threshold lies near the geometric mean of the costliest of the first and
+ * the cheapest of the second.  The figures are in docs/engine.md, "Step 2:
+ * the plan". */
 #define GRID_COST 4.0
 
 /* The early decision (engine_plan): for sets of EARLY_MIN points or more,
@@ -59,12 +61,11 @@
  * (n / EARLY_SAMPLE + 1)-th point of A (hd__grid_prime_sampled) rather
  * than from A's grid, and above EARLY_COST the trees are taken at once,
  * A's grid never built: on the trees' cases that grid and the other
- * direction's prime and trial were work thrown away, about a third of the
- * plan.  With the weaker prime the trial discards fewer of its points, so
- * its cost tends to come out higher than the full plan's (by up to 0.4 on
- * the grid's cases measured); EARLY_COST keeps a margin above GRID_COST,
- * and the costs measured on each side of it are in docs/engine.md, "Step
- * 2: the plan". */
+ * direction's prime and trial are work thrown away.  With the weaker prime
+ * the trial discards fewer of its points, so its cost tends to come out
+ * higher than the full plan's; EARLY_COST keeps a margin above GRID_COST
+ * for that (hd_bench prints the costs on each side of it; the figures are
+ * in docs/engine.md, "Step 2: the plan"). */
 #define EARLY_MIN 65536
 #define EARLY_SAMPLE 65536
 #define EARLY_COST 8.0

@@ -63,10 +63,10 @@ HD__INLINE int hd__bucket_decode(const hd__tree_t *t, size_t b, double *x, doubl
 /* The smallest of c[0..HD__BUCKET).  A short bucket is padded with copies
  * of its point 0 (build.c), whose values equal c[0], so padding never
  * changes the minimum.  Eight running minima in two vectors of four (GCC
- * vector extensions: one compare and one select per four values, where the
- * scalar loop this replaces compiled to one vminsd per value; callgrind,
- * docs/benchmarks.md, issue 15); each lane keeps m = c < m ? c : m, the
- * same value as that scalar loop for any input. */
+ * vector extensions: one compare and one select per four values, where a
+ * scalar loop compiles to one vminsd per value; callgrind on hd_bench
+ * counts both, docs/benchmarks.md); each lane keeps m = c < m ? c : m, the
+ * same value as the scalar loop for any input. */
 typedef double hd__v4d __attribute__((vector_size(32), aligned(8)));
 typedef int64_t hd__v4l __attribute__((vector_size(32), aligned(8)));
 

@@ -134,8 +134,9 @@ static const double *group_exact(const hd__tree_t *ta, group_t *g, int k) {
 
 /* The position along B's curve at the same relative place as position p
  * along A's (a guess: only speed depends on it).  A product, not a
- * quotient: the division in the window's loop was a sixth of its
- * instructions (callgrind) and on the path to its loads. */
+ * quotient: a division in the window's loop would lie on the path to its
+ * loads (callgrind on hd_bench's cases counts what it cost,
+ * docs/engine.md). */
 static inline ptrdiff_t same_place(const walk_t *s, size_t p) {
     return (ptrdiff_t)((double)(ptrdiff_t)p * s->ratio); /* signed: one conversion, no branch */
 }
@@ -189,13 +190,12 @@ HD__HOT static void try_window(walk_t *s, group_t *g, double cmax2) {
     ptrdiff_t pd = s->pdrift, last = -1, last_place = 0;
     s->w->counts.evals += (uint64_t)(2 * WINDOW) * (uint64_t)__builtin_popcount(g->alive);
     /* First every live point against the 2 WINDOW points around its place
-     * (two vectors), without a branch on the outcome (which went either
-     * way about a quarter of the time), all with the drift the group
-     * started with: eight points rather than four, since that drift is
-     * stale by up to a bucket (on independent uniform sets four settled
-     * 52 % of the points, eight 68 %, 1M + 1M, one thread).  The last
-     * point settled is remembered and its partner found again after the
-     * loop. */
+     * (two vectors), without a branch on the outcome (which goes either way
+     * too often to be predicted), all with the drift the group started
+     * with: eight points rather than four, since that drift is stale by up
+     * to a bucket (hd_bench's independent uniform sets show how many more
+     * points eight settle: docs/engine.md).  The last point settled is
+     * remembered and its partner found again after the loop. */
     uint32_t hit = 0;
     int hk = -1;
     ptrdiff_t hw = 0;

@@ -27,10 +27,10 @@
  * 256 bins of the next 8 bits, one MPI_Allreduce adds the counts, and
  * every rank walks the same sums to the bin holding rank k (the prefix
  * grows by 8 bits, k drops by the counts below the bin).  Small digits
- * keep the reductions small (2 KB a figure): with 16-bit digits (four
- * rounds of 512 KB) tests/api/mpi_figures.c took 22 s on 7 oversubscribed
- * ranks instead of 4, and a local pass costs less than a large reduction
- * across many ranks.  After two rounds (the sign, the exponent and 4 bits
+ * keep the reductions small (2 KB a figure, where 16-bit digits would
+ * reduce 512 KB a round), and a local pass costs less than a large
+ * reduction across many ranks (tests/api/mpi_figures.c on oversubscribed
+ * ranks shows it; the times are in docs/scale-out.md).  After two rounds (the sign, the exponent and 4 bits
  * of the significand) few values still match the prefix as a rule: when at
  * most an eighth of a rank's do, their keys are copied once and the later
  * rounds count only those (compact(); the smallest key above the prefix's

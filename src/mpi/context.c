@@ -39,9 +39,10 @@ double hd__mpi_cpu(void) {
 /* ---- memory: every buffer counted, so the peak can be reported ---------- */
 
 /* Large buffers ask for transparent huge pages: each is written once,
- * right after it is allocated, and on the machine of docs/scale-out.md a
- * 4 KiB page costs 1.3 (mapped in advance) to 2.6 ns a byte (a fault each)
- * against 0.07 for a 2 MiB page ("Memory pages on this machine").  A
+ * right after it is allocated, and a 4 KiB page costs many times more a
+ * byte than a 2 MiB page, most when each takes a fault (bench/page_cost.c
+ * measures the three; docs/scale-out.md, "Memory pages on this
+ * machine").  A
  * buffer of HUGE_BYTES or more starts on a 2 MiB boundary and its whole
  * 2 MiB pages are marked; what is left after them, which the kernel maps
  * in small pages, is mapped in one call (hd__prefault), not a fault a
@@ -125,7 +126,7 @@ void hd__mpi_charge(hd__mpi_ctx_t *c, size_t bytes) {
  * layer held meanwhile.  On the local arrays (packed doubles, validated before the
  * exchange) it takes the engine's internal entries with the sets' boxes
  * (bp, bq; NULL: computed here), since hd_directed would validate every
- * point again (a pass over both sets, about 50 instructions a point); on
+ * point again (a pass over both sets); on
  * the caller's views (one rank: any layout) the public hd_directed.  s:
  * both directions at once (hd__engine_hausdorff), else h(P, Q) into e,
  * from a floor when floor2 >= 0 (hd__engine_directed_above); keep: NULL,

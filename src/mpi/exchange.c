@@ -314,11 +314,10 @@ int hd__mpi_exchange(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const hd__mpi_
     HD__MPI_GO(c, rc, MPI_Allreduce(&mine, &rounds, 1, MPI_UINT64_T, MPI_MAX, c->comm));
     walk_t at = {0, 0, 0, {0, 0}};
     /* Destinations that change at more than a quarter of the points are
-     * packed without a branch on them (pack_run): at K = 2 a branch
-     * mispredicted at random costs more than the tables' 20 instructions
-     * a point; packed so, an input in tiles paid 1.8 ns a point for them
-     * (alternated runs, docs/benchmarks.md), and pays 1.6 for the first
-     * pass's counting now. */
+     * packed without a branch on them (pack_run): a branch mispredicted at
+     * random costs more than the tables' few instructions a point, and an
+     * input in space's order (tiles) keeps the branch, which is predicted
+     * (mpi_bench times both orders; the figures are in docs/scale-out.md). */
     int scattered = switches > nloc / 4;
     size_t ownat[2] = {base[me], base[K + me]};
     for (uint64_t round = 0; round < rounds; round++) {

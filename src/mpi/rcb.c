@@ -32,14 +32,14 @@
 #include <string.h>
 
 /* The first samples: FIRST_MOST a rank, but at most FIRST_TOTAL at rank 0
- * (then FIRST_FEWEST a rank at the least).  Rank 0's tree costs about 24 ns
- * a sample and level (bench/rcb_bench.c) and its buffer 40 B a sample:
- * 1024 a rank would be 0.24 s and 41 MB at 1000 ranks, 5.7 s and 0.67 GB
- * at 16384, all on rank 0 while the others wait.  The second samples
- * (refine) set the balance; the first only bracket each split, and 64 a
- * rank left the largest region 0.8-2.9 % above its share at 16 and 64
- * ranks against 0.6-2.2 % with 1024 (docs/scale-out.md, "Fewer first
- * samples at many ranks"). */
+ * (then FIRST_FEWEST a rank at the least).  Rank 0's tree costs time in
+ * proportion to its samples times its levels and a hd__mpi_sample_t of
+ * buffer a sample, all on rank 0 while the others wait, so the total is
+ * capped (bench/rcb_bench.c measures the tree's time and memory).  The
+ * second samples (refine) set the balance; the first only bracket each
+ * split, so fewer first samples move the largest region's excess over its
+ * share little (mpi_partition's balance check bounds it; the figures are
+ * in docs/scale-out.md, "Fewer first samples at many ranks"). */
 #define FIRST_MOST 1024
 #define FIRST_FEWEST 64
 #define FIRST_TOTAL 65536

@@ -27,8 +27,8 @@
  * needs no search of Q.  Unfiltered, the shell is the points whose faces
  * are not clear of the engine's answer, the rank's largest u, and they get
  * per-point searches (hd_distances).  The engine prunes the points that cannot be the
- * farthest, which per-point searches cannot: on two epochs of one scene it
- * is tens of times faster (docs/scale-out.md), and the shell is the points
+ * farthest, which per-point searches cannot (mpi_bench times both on two
+ * epochs of one scene; docs/scale-out.md), and the shell is the points
  * within h of the region's faces.
  *
  * Invariants: the local arrays' coordinates are moved (split) and put back
@@ -70,9 +70,10 @@ typedef struct {
  *    the reverse walk recovers by counting down.
  * A swap moves twice the bytes of a move, so the pairs take an aside when
  * it is small (aside_for: at most a 64th of the points, as the unpaired
- * points of a copy are; docs/scale-out.md has the instructions both ways
- * cost), and the interior's pass always swaps: it may be the rank's peak,
- * and its shell is 3-10 % of the points. */
+ * points of a copy are; callgrind on mpi_bench counts both ways, and
+ * docs/scale-out.md has the counts), and the interior's pass always swaps:
+ * it may be the rank's peak, and its shell is a small part of the
+ * points. */
 HD__INLINE void swap3(double *xyz, size_t i, size_t k) {
     double t[3];
     memcpy(t, xyz + 3 * i, sizeof t);
@@ -191,7 +192,7 @@ static size_t mark_pairs(const hd__mpi_gidx_t *gP, size_t nP, const hd__mpi_gidx
 /* Whether the merge walk of mark_pairs is worth it: at least three
  * quarters of PAIRS_SAMPLE points of P, evenly spaced, have their partner
  * here (each found by a binary search of Q's indices, decoded at random:
- * a few thousand decodes against the walk's 45-60 instructions a point),
+ * a few thousand decodes, little beside the walk over every point),
  * and nearer than every one of PAIRS_RIVALS points of Q spread over its
  * positions (or tied), as a moved copy's partner is and a random point is
  * not (the engine's gate, docs/engine.md, step 0.5, asks the same of a

@@ -200,17 +200,17 @@ static int slab_search(hd__mpi_ctx_t *c, const hd__mpi_slab_t *sl, const double 
  * rather than searched in a wider slab.  One pass over Q serves them all,
  * and a point of Q is mostly passed over after one coordinate's gap; the
  * wider slab costs two passes over Q measuring face gaps and a structure
- * over the points in it.  Measured (callgrind, the copy at K = 2, 400K
- * points a rank): 160M instructions with 4, 176M with 0 or 1. */
+ * over the points in it.  The value is the one with the fewest
+ * instructions on mpi_bench's copy case (callgrind; the counts are in
+ * docs/scale-out.md). */
 #define BRUTE_MAX 4
 
 /* At most this many askers, while no slab is built, are answered by one
  * pass over all of Q (scan_q) instead: the engine's filter leaves a shell
- * of a few points on most ranks (1 to 36 a direction on the uniform and
- * lidar scenes, 1M a rank, K = 2 and 4), for which the slab's two passes
- * over Q and its structure were 39 instructions a local point (callgrind,
- * uniform at K = 2).  A copy's shell (its pairs cut by a face: about 200)
- * takes the slab. */
+ * of a few points on most ranks, for which the slab's two passes over Q
+ * and its structure cost more than one pass (callgrind on mpi_bench's
+ * uniform and lidar scenes; the counts are in docs/scale-out.md).  A
+ * copy's shell (its pairs cut by a face) is larger and takes the slab. */
 #define SCAN_MAX 16
 _Static_assert(BRUTE_MAX <= SCAN_MAX, "the few the slab left take the scan's pass");
 

@@ -296,8 +296,8 @@ HD__INLINE void hd__src_keys_of(const hd__src_t *src, hd__src_kind_t kind, hd__k
 
 /* The loop specialised for packed doubles without a transform (the
  * layout the engine's callers mostly pass), with the grid in locals so
- * that the stores cannot be taken to change it: about half the
- * instructions of the general loop (docs/benchmarks.md). */
+ * that the stores cannot be taken to change it: fewer instructions than
+ * the general loop (callgrind; the counts are in docs/benchmarks.md). */
 HD__INLINE void hd__src_keys(const hd__src_t *src, const hd__keygrid_t *grid, size_t lo, size_t hi,
                              uint64_t *keys) {
     if (src->kind == HD__SRC_F64 && !src->T) hd__src_keys_of(src, HD__SRC_F64, *grid, lo, hi, keys);
