@@ -131,6 +131,16 @@ void hd__rng_permute(hd__rng_t *r, size_t *perm, size_t n);
 /* ---- threads ------------------------------------------------------------ */
 /* Number of threads to use for `requested` (0 = every core) and n items. */
 int hd__thread_count(int requested, size_t work_items);
+/* The fewest points a part of a parallel pass over a point set gets: each
+ * part has its own table or histogram to fill and merge, which a smaller
+ * part would not repay. */
+#define HD__PART_MIN_POINTS 65536
+/* At most `parts` parts for a pass over n points, and no more than one a
+ * HD__PART_MIN_POINTS points (at least one). */
+HD__INLINE int hd__parts_for(size_t n, int parts) {
+    size_t most = n / HD__PART_MIN_POINTS + 1;
+    return (size_t)parts > most ? (int)most : parts;
+}
 
 /* Run fn(ctx, task, worker) for task in [0, n_tasks) on `threads` threads
  * (the caller's thread is worker 0).  Tasks are handed out in increasing

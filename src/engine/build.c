@@ -175,7 +175,7 @@ HD__HOT static void make_bucket(hd__tree_t *t, size_t b) {
     if (t->src.kind != HD__SRC_ANY && b + 1 < t->nb) {
         /* The points are scattered in memory: ask for the next bucket's
          * points early so their loads overlap with this bucket's work. */
-        ptrdiff_t el = t->src.kind == HD__SRC_F64 ? 24 : 12;
+        ptrdiff_t el = hd__src_packed_stride(&t->src);
         size_t e = s + HD__BUCKET, pe = e + HD__BUCKET < t->n ? e + HD__BUCKET : t->n;
         for (size_t i = e; i < pe; i++) __builtin_prefetch(t->src.base + (ptrdiff_t)t->perm[i] * el);
     }

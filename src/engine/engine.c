@@ -266,6 +266,13 @@ static int centroid_of(const hd__src_t *src, size_t n, int threads, double out[3
 }
 
 /* force: the plan's choice, or the grid or the trees forced. */
+/* B is taken for a moved copy of A (engine_run's grids) when its box is
+ * A's moved by one vector: the two corners' moves differ by at most this
+ * fraction of A's extent, and the move itself is larger.  A bound on
+ * relative noise only decides which grid the trees get, never the
+ * answer. */
+#define MOVED_SKEW 1e-4
+
 static int engine_run(engine_t *e, hd__engine_force_t force, hd_result_t out[2], hd_error_t *err) {
     int rc = engine_plan(e, force, err);
     if (rc) return rc;
@@ -275,8 +282,8 @@ static int engine_run(engine_t *e, hd__engine_force_t force, hd_result_t out[2],
          * point of both sets: hd__tree_build_pair); the maxima found so far
          * stay valid.  Both trees' Morton grids have the same cell size, and
          * the walk's neighbour scans rely on the two curves lining up.  When B's box is A's box moved (both
-         * corners by the same vector, within 1e-4 of the extent, and by more
-         * than that), B looks like a moved copy: each grid is centred on its
+         * corners by the same vector, within MOVED_SKEW of the extent, and
+         * by more than that), B looks like a moved copy: each grid is centred on its
          * own set's centroid, so that the copy lists its points in nearly
          * the original's order.  Any other pair (nearly identical sets, a
          * subset, a part, a different shape) shares one grid over both
@@ -290,7 +297,7 @@ static int engine_run(engine_t *e, hd__engine_force_t force, hd_result_t out[2],
             move = fabs(dlo) > move ? fabs(dlo) : move;
         }
         hd__box_t g[2];
-        if (skew <= 1e-4 * ext && move > 1e-4 * ext) {
+        if (skew <= MOVED_SKEW * ext && move > MOVED_SKEW * ext) {
             for (int s2 = 0; s2 < 2; s2++) {
                 if ((rc = centroid_of(&e->src[s2], e->n[s2], e->threads, c[s2], err)) != HD_OK) return rc;
                 for (int k = 0; k < 3; k++) {

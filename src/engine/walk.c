@@ -367,7 +367,7 @@ HD__HOT static int try_bucket(walk_t *s, group_t *g, size_t i, double cmax2) {
      * decided exactly; their scattered loads are started together. */
     const hd__tree_t *ta = s->c->ta;
     if (ta->src.kind != HD__SRC_ANY && tb->src.kind != HD__SRC_ANY) {
-        ptrdiff_t ea = ta->src.kind == HD__SRC_F64 ? 24 : 12, eb = tb->src.kind == HD__SRC_F64 ? 24 : 12;
+        ptrdiff_t ea = hd__src_packed_stride(&ta->src), eb = hd__src_packed_stride(&tb->src);
         for (int r = 0; r < n_close; r++) {
             __builtin_prefetch(ta->src.base + (ptrdiff_t)ta->perm[g->first + (size_t)close_k[r]] * ea);
             __builtin_prefetch(tb->src.base + (ptrdiff_t)tb->perm[i * HD__BUCKET + (size_t)close_b[r]] * eb);
@@ -587,7 +587,7 @@ HD__HOT static void walk_bucket(walk_t *s, size_t bk) {
     if (!g.alive) return;
     /* The points left are read exactly; start all their loads at once. */
     if (ta->src.kind != HD__SRC_ANY) {
-        ptrdiff_t el = ta->src.kind == HD__SRC_F64 ? 24 : 12;
+        ptrdiff_t el = hd__src_packed_stride(&ta->src);
         for (int k = 0; k < g.m; k++)
             if ((g.alive >> k & 1u) && !(g.read >> k & 1u))
                 __builtin_prefetch(ta->src.base + (ptrdiff_t)ta->perm[g.first + (size_t)k] * el);
@@ -667,6 +667,15 @@ static void prime(dir_ctx *c, const size_t *seed, int nseed) {
     c->w[0].counts.nodes += w.counts.nodes;
 }
 
+/* Tasks are subtrees of A's tree at this level: 2^6 = 64 buckets each
+ * (fewer when the tree is lower), many per thread so the shared counter
+ * balances them, each long enough to repay taking it. */
+#define TASK_LEVEL 6
+/* A bucket of a set much sparser than B spans that many more buckets of B:
+ * its shared walk may visit up to 2^EXTRA_LEVEL_MOST = 16 times more (the
+ * walk's extra_level, log2 of |B| / |A| in buckets, stops here). */
+#define EXTRA_LEVEL_MOST 4
+
 int hd__walk_directed(const hd__tree_t *ta, const hd__tree_t *tb, hd__max_t *m, int threads,
                       const size_t *seed, int nseed, hd__counts_t *counts, uint64_t *culled,
                       hd_error_t *err) {
@@ -675,11 +684,8 @@ int hd__walk_directed(const hd__tree_t *ta, const hd__tree_t *tb, hd__max_t *m, 
     c.ta = ta;
     c.tb = tb;
     c.m = m;
-    /* Tasks are subtrees of about 64 buckets. */
-    c.task_level = ta->levels - 1 < 6 ? ta->levels - 1 : 6;
-    /* A bucket of a set much sparser than B spans that many more buckets of
-     * B: its shared walk may visit proportionally more (at most 16 times). */
-    while (c.extra_level < 4 && (ta->nb << (c.extra_level + 1)) <= tb->nb) c.extra_level++;
+    c.task_level = ta->levels - 1 < TASK_LEVEL ? ta->levels - 1 : TASK_LEVEL;
+    while (c.extra_level < EXTRA_LEVEL_MOST && (ta->nb << (c.extra_level + 1)) <= tb->nb) c.extra_level++;
     size_t tasks = ta->count[c.task_level];
     if (threads < 1) threads = 1;
     c.w = hd__calloc_array((size_t)threads, sizeof *c.w);

@@ -233,7 +233,7 @@ static void gather_task(void *vctx, size_t task, int worker) {
         for (size_t at = lo; at < hi; at++) {
             if (at + 16 < s->n && c->src.kind != HD__SRC_ANY)
                 __builtin_prefetch(c->src.base + (ptrdiff_t)sel[(uint32_t)c->b[at + 16]] *
-                                                     (c->src.kind == HD__SRC_F64 ? 24 : 12));
+                                                     hd__src_packed_stride(&c->src));
             uint32_t i = (uint32_t)c->b[at < s->n ? at : s->n - 1];
             double p[3];
             hd__src_get(&c->src, sel[i], p);
@@ -244,7 +244,7 @@ static void gather_task(void *vctx, size_t task, int worker) {
     }
     for (size_t at = lo; at < hi; at++) {
         if (at + 16 < s->n && c->src.kind != HD__SRC_ANY)
-            __builtin_prefetch(c->src.base + (ptrdiff_t)(uint32_t)c->b[at + 16] * (c->src.kind == HD__SRC_F64 ? 24 : 12));
+            __builtin_prefetch(c->src.base + (ptrdiff_t)(uint32_t)c->b[at + 16] * hd__src_packed_stride(&c->src));
         uint32_t i = (uint32_t)c->b[at < s->n ? at : s->n - 1];
         double p[3];
         hd__src_get(&c->src, i, p);
@@ -509,7 +509,7 @@ static int build(hd__an_t *s, const hd_points_t *p, const uint32_t *sel, const u
     hd__src_init(&c.src, p, T);
     hd__keygrid_init(&c.grid, keybox);
     c.parts = threads > MAX_PARTS ? MAX_PARTS : threads;
-    if ((size_t)c.parts > n / 65536 + 1) c.parts = (int)(n / 65536 + 1);
+    c.parts = hd__parts_for(n, c.parts);
     /* Node and bucket arrays grow as the octree is cut (a bucket usually
      * holds a few dozen points; at worst there are fewer than 2n nodes,
      * since every inner node has two children or more). */

@@ -251,6 +251,13 @@ typedef struct hd__src {
 
 void hd__src_init(hd__src_t *s, const hd_points_t *p, const hd_transform_t *T);
 
+/* The bytes from one point to the next of a packed source (HD__SRC_F64 or
+ * HD__SRC_F32): what a prefetch of point k adds to base, k times.  The
+ * one place the two packed strides are written for the readers ahead. */
+HD__INLINE ptrdiff_t hd__src_packed_stride(const hd__src_t *s) {
+    return s->kind == HD__SRC_F64 ? 24 : 12;
+}
+
 /* Point k of the source (original numbering), transformed if T is set. */
 HD__INLINE void hd__src_get(const hd__src_t *s, size_t k, double out[3]) {
     double p[3];
