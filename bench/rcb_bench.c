@@ -12,7 +12,7 @@
  * ratio.  The gather of the samples and the broadcast of the tree are not
  * in it: docs/scale-out.md's model prices them from the link.
  */
-#include "mpi/mpi_int.h"
+#include "mpi/partition.h"
 
 #include <math.h>
 #include <stdio.h>

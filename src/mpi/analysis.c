@@ -50,7 +50,8 @@
  * pointer, the percentile, A's distances, then B's), so the code is the
  * one hd_summarize or hd_percentile_of returns on the concatenation.
  */
-#include "mpi_int.h"
+#include "mpi/course.h"
+#include "mpi/search.h"
 
 #include <assert.h>
 #include <limits.h>

@@ -1,5 +1,5 @@
 /*
- * context.c -- what every step of an MPI call shares (mpi_int.h's hd__mpi_ctx_t):
+ * context.c -- what every step of an MPI call shares (context.h's hd__mpi_ctx_t):
  * the count of the bytes it holds, the CPU it spends in MPI, the agreement
  * on a status, and the MPI types and the witness reduction.
  *
@@ -20,7 +20,7 @@
  *    bookkeeping's CPU (stats->other_cpu) is what remains of the call's
  *    besides the MPI calls and the searches.
  */
-#include "mpi_int.h"
+#include "mpi/context.h"
 #include "engine/engine.h"
 
 #include <stdio.h>

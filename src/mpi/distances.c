@@ -71,7 +71,8 @@
  * Measured peak: 53-55 bytes a local point, the search of a direction
  * (docs/scale-out.md).
  */
-#include "mpi_int.h"
+#include "mpi/course.h"
+#include "mpi/search.h"
 
 #include <assert.h>
 #include <limits.h>

@@ -28,7 +28,7 @@
  *    each run as it lands (the rank's own, each sender's): the same points
  *    as the local arrays hold, in whatever order the merge leaves them.
  */
-#include "mpi_int.h"
+#include "mpi/partition.h"
 
 #include <assert.h>
 #include <limits.h>

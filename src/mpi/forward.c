@@ -24,10 +24,13 @@
  *  - One round of forwarding a direction: every bound is final before
  *    anything is sent.  Every collective is preceded by hd__mpi_agree.
  */
-#include "mpi_int.h"
+#include "mpi/search.h"
 
 #include <limits.h>
 #include <stdlib.h>
+
+/* A forwarded query: point k of the asking set to rank dest. */
+typedef struct hd__mpi_pair { size_t k; int dest; int pad; } hd__mpi_pair_t;
 
 static int pack_queries(hd__mpi_ctx_t *c, const double *P, const uint32_t *pos, const hd__mpi_pair_t *pairs, size_t np,
                         int *scount, int *sdispl, double **send, size_t **order) {

@@ -1,6 +1,6 @@
 /*
  * gidx.c -- the global indices of a local set, Elias-Fano coded over the
- * side's dense ordinals (mpi_int.h's hd__mpi_gidx_t), with random access and a
+ * side's dense ordinals (ranges.h's hd__mpi_gidx_t), with random access and a
  * sequential cursor.
  *
  * Invariants.
@@ -40,7 +40,7 @@
  *    one, the next, or else searched (binary).  So any order of positions
  *    is correct, and nondecreasing ones cost a few operations each.
  */
-#include "mpi_int.h"
+#include "mpi/ranges.h"
 
 #include <assert.h>
 

@@ -12,7 +12,10 @@
  * types), ranges.c the validation and the index runs, rcb.c the partition
  * (step 1), exchange.c the exchange (2), shell.c the engine's pass (3),
  * slab.c the per-point searches, forward.c the forwarding and reduction
- * (4 to 6); mpi_int.h what they share.  Each opens with its invariants.
+ * (4 to 6); gidx.c the local sets' indices, distances.c and analysis.c
+ * the per-point distances and their figures.  What they share is in
+ * private headers by concern: context.h, ranges.h, partition.h,
+ * search.h and course.h.  Each file opens with its invariants.
  *
  * The algorithm, for h(A,B) (the symmetric distance runs it both ways on one
  * partition):
@@ -126,7 +129,8 @@
  * failing rank, then its code and message broadcast), so every rank returns
  * the same code and message and none waits for a rank that gave up.
  */
-#include "mpi_int.h"
+#include "mpi/course.h"
+#include "mpi/search.h"
 
 #include <assert.h>
 #include <stdlib.h>

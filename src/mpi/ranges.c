@@ -1,6 +1,6 @@
 /*
  * ranges.c -- the validation of a call's input and the index runs that name
- * every point (mpi_int.h's hd__mpi_ranges_t).
+ * every point (ranges.h's hd__mpi_ranges_t).
  *
  * Invariants.
  *  - hd__mpi_check_local refuses, before a point is read, more than
@@ -18,7 +18,7 @@
  *    (ord), they number a set's indices densely (the ordinals gidx.c
  *    encodes).
  */
-#include "mpi_int.h"
+#include "mpi/ranges.h"
 
 #include <assert.h>
 #include <string.h>
@@ -77,7 +77,7 @@ uint64_t hd__mpi_ranges_global(const hd__mpi_ranges_t *rg, int s, int r, uint64_
     return rg->all[lo].lo + (m - rg->first[lo]);
 }
 
-/* The runs' orders (mpi_int.h's hd__mpi_ranges_t): rg->all (any order, rg->total
+/* The runs' orders (ranges.h's hd__mpi_ranges_t): rg->all (any order, rg->total
  * runs of rg->K ranks, no two of a side sharing an index) sorted by owner
  * with seg and first, and bylo with ord.  Local (check_ranges runs it on
  * every rank after the all-gather); fails only for memory. */

@@ -23,7 +23,7 @@
  *    hd__box_lb2 <= u2 (ties included); a node's box is the union of its
  *    ranks', so a subtree pruned by its box holds no candidate.
  */
-#include "mpi_int.h"
+#include "mpi/partition.h"
 
 #include <assert.h>
 #include <limits.h>

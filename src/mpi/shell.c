@@ -36,7 +36,7 @@
  * its own point again when a function here returns, and its index (gidx)
  * never changes.
  */
-#include "mpi_int.h"
+#include "mpi/search.h"
 
 #include <assert.h>
 #include <stdlib.h>

@@ -31,7 +31,7 @@
  * d2 < lb^2 (1 - 1e-9), far beyond the few ulps involved; below 1e-140 no
  * proof is tried.
  */
-#include "mpi_int.h"
+#include "mpi/search.h"
 
 #include <assert.h>
 #include <stdlib.h>

@@ -1,6 +1,6 @@
 /*
  * mpi_gidx.c -- the local sets' global indices of the MPI library
- * (src/mpi/gidx.c, mpi_int.h's hd__mpi_gidx_t): a set of indices of a side,
+ * (src/mpi/gidx.c, ranges.h's hd__mpi_gidx_t): a set of indices of a side,
  * encoded in increasing order over the side's index runs, gives back every
  * index by position (hd__mpi_gidx), through a cursor (hd__mpi_gcur_at)
  * walked in order, with jumps, and backwards, with the rank whose run holds
@@ -12,7 +12,7 @@
  */
 #include "check.h"
 #include "gen.h"
-#include "mpi/mpi_int.h"
+#include "mpi/ranges.h"
 
 #include <stdlib.h>
 

@@ -10,7 +10,7 @@
  * only counts bytes), so this runs without mpirun.
  */
 #include "check.h"
-#include "mpi/mpi_int.h"
+#include "mpi/context.h"
 
 #include <stdint.h>
 #include <stdlib.h>

@@ -11,7 +11,7 @@
 #include "brute.h"
 #include "check.h"
 #include "gen.h"
-#include "mpi/mpi_int.h"
+#include "mpi/search.h"
 
 #include <math.h>
 #include <stdlib.h>

@@ -16,7 +16,7 @@
  * 16 and 64 ranks in docs/scale-out.md ("Fewer first samples at many
  * ranks").
  */
-#include "mpi/mpi_int.h"
+#include "mpi/course.h"
 
 #include <math.h>
 #include <stdio.h>
