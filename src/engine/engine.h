@@ -39,6 +39,8 @@
 
 #include <stdint.h>
 
+/* ---- the index of one point set (build.c, search.c) ------------------------------ */
+
 /* Points per bucket (at most 32: live points are tracked in 32-bit masks). */
 #define HD__BUCKET 32
 _Static_assert(HD__BUCKET % 4 == 0 && HD__BUCKET <= 32, "bucket size");
@@ -106,6 +108,8 @@ typedef struct hd__counts {
  * tie2 = -1 for a full search. */
 void hd__tree_nearest(const hd__tree_t *t, const double q[3], double stop2, double tie2,
                       size_t hint, hd__hit_t *hit, hd__counts_t *n);
+
+/* ---- the filter on a direction's maximum -------------------------------------- */
 
 /* A filter on a direction's maximum: keep(ctx, i, d2, j) says whether
  * point i of A, whose exact squared nearest distance is d2 and nearest
