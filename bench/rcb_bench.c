@@ -12,7 +12,7 @@
  * ratio.  The gather of the samples and the broadcast of the tree are not
  * in it: docs/scale-out.md's model prices them from the link.
  */
-#include "mpi/mpi_int.h"
+#include "mpi/partition.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -25,8 +25,8 @@
 /* Median seconds of `runs` trees over S samples for K ranks (the samples
  * drawn afresh each run: the build reorders them). */
 static double tree_seconds(size_t S, int K, int runs) {
-    sample_t *s = malloc(S * sizeof *s);
-    node_t *t = malloc((size_t)K * sizeof *t);
+    hd__mpi_sample_t *s = malloc(S * sizeof *s);
+    hd__mpi_node_t *t = malloc((size_t)K * sizeof *t);
     double *br = malloc(2 * (size_t)K * sizeof *br), sec[15];
     if (!s || !t || !br) {
         fprintf(stderr, "rcb_bench: out of memory for %zu samples\n", S);
@@ -72,8 +72,8 @@ int main(int argc, char **argv) {
             size_t now = (size_t)per * (size_t)K, before = (size_t)1024 * (size_t)K;
             double tn = tree_seconds(now, K, runs), tb = tree_seconds(before, K, runs);
             printf("%7d %9d %9zu %11.4f %16.1f %9.1f   | %20.4f %6.1f %8.1f\n", K, per, now, tn,
-                   tn / (double)now / log2((double)K) * 1e9, (double)(now * sizeof(sample_t)) / 1e6, tb,
-                   (double)(before * sizeof(sample_t)) / 1e6, tb / tn);
+                   tn / (double)now / log2((double)K) * 1e9, (double)(now * sizeof(hd__mpi_sample_t)) / 1e6, tb,
+                   (double)(before * sizeof(hd__mpi_sample_t)) / 1e6, tb / tn);
         }
     }
     return 0;

@@ -356,10 +356,9 @@ HD_EXTERN int hd_index_directed(const hd_index_t *idx, const hd_points_t *A,
  * index in B at that distance.  Either output may be NULL; each has
  * Q->count elements.  Exact, at any thread count.  The answers come from
  * the per-point structures hd_distances uses, built for B and T(Q) during
- * the call (about 36 bytes per point of each, freed before returning; on
- * 1M points about 45 ms each): the index's own tree is made for the
- * Hausdorff distance's early breaking, and one complete search of it per
- * point costs several times more.  opt: as hd_index_directed (only
+ * the call (about 36 bytes per point of each, freed before returning):
+ * the index's own tree is made for the Hausdorff distance's early
+ * breaking, and one complete search of it per point costs more.  opt: as hd_index_directed (only
  * opt->threads is read; `algorithm` is ignored).  Errors: as
  * hd_index_directed. */
 HD_EXTERN int hd_index_nearest(const hd_index_t *idx, const hd_points_t *Q,

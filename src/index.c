@@ -38,6 +38,7 @@
  * to their element (hd__points_check refuses them otherwise).
  */
 #include "engine/engine.h"
+#include "index.h"
 #include "nearest/nearest.h"
 
 #include <math.h>

@@ -105,12 +105,12 @@ void hd__reuse_shrink(hd__reuse_t *pool, void *p, size_t bytes);
 
 /* Map the pages of the fresh block p[0..bytes) now, in one call, rather
  * than one page fault per page as it is first written (a fault costs far
- * more than the write on virtual machines: docs/engine.md, "Threads and
- * memory"; on the machine of docs/scale-out.md, "Memory pages on this
- * machine", 1.25 ns a byte mapped so against 2.6 by faults).  For arrays
- * about to be written whole; a no-op below HD__PREFAULT_MIN bytes (16
- * pages; it was 1 MiB, which left the MPI layer's slab structures to
- * faults) and where the system has no such call.  hd__reuse_get does it
+ * more than the write on virtual machines: bench/page_cost.c measures
+ * both ways; docs/engine.md, "Threads and memory", and docs/scale-out.md,
+ * "Memory pages on this machine", have the figures).  For arrays about to
+ * be written whole; a no-op below HD__PREFAULT_MIN bytes (16 pages, small
+ * enough that the MPI layer's slab structures are mapped so too) and
+ * where the system has no such call.  hd__reuse_get does it
  * for the fresh blocks it allocates. */
 #define HD__PREFAULT_MIN (1u << 16)
 void hd__prefault(void *p, size_t bytes);
@@ -131,6 +131,16 @@ void hd__rng_permute(hd__rng_t *r, size_t *perm, size_t n);
 /* ---- threads ------------------------------------------------------------ */
 /* Number of threads to use for `requested` (0 = every core) and n items. */
 int hd__thread_count(int requested, size_t work_items);
+/* The fewest points a part of a parallel pass over a point set gets: each
+ * part has its own table or histogram to fill and merge, which a smaller
+ * part would not repay. */
+#define HD__PART_MIN_POINTS 65536
+/* At most `parts` parts for a pass over n points, and no more than one a
+ * HD__PART_MIN_POINTS points (at least one). */
+HD__INLINE int hd__parts_for(size_t n, int parts) {
+    size_t most = n / HD__PART_MIN_POINTS + 1;
+    return (size_t)parts > most ? (int)most : parts;
+}
 
 /* Run fn(ctx, task, worker) for task in [0, n_tasks) on `threads` threads
  * (the caller's thread is worker 0).  Tasks are handed out in increasing
@@ -169,6 +179,20 @@ double hd__lerp(double a, double b, double t);
  * <what>", else HD_OK: the per-point figures' check (hd_summarize,
  * hd_percentile_of and the MPI library's, which pass their offset). */
 int hd__nan_check(const double *d, size_t n, size_t first, const char *what, hd_error_t *err);
+
+/* Keep the k items with the largest scores, in decreasing order of score,
+ * in score[0..*n) and item[0..*n) (*n grows to k). */
+HD__INLINE void hd__top_insert(double *score, size_t *item, int *n, int k, double sc, size_t it) {
+    if (*n == k && !(sc > score[k - 1])) return;
+    int at = *n < k ? (*n)++ : k - 1;
+    while (at > 0 && score[at - 1] < sc) {
+        score[at] = score[at - 1];
+        item[at] = item[at - 1];
+        at--;
+    }
+    score[at] = sc;
+    item[at] = it;
+}
 
 /* ---- exact sums (xsum.c) -------------------------------------------------- */
 /* An exact accumulator of doubles: the sum of any number of finite doubles

@@ -1,8 +1,10 @@
 /*
- * classic.h -- the paper's algorithms (src/classic/): NAIVEHDD, EARLYBREAK,
- * INC, NOHD, OHD and the framework that chooses among them, with the
- * octree they share and the kd-tree baseline.  Each computes h(A,B) on a
- * job of packed doubles; the dispatcher (framework.c) runs one by name.
+ * classic.h -- the front header of the paper's algorithms (src/classic/):
+ * NAIVEHDD, EARLYBREAK, INC, NOHD, OHD and the framework that chooses among
+ * them, and the kd-tree baseline.  Each computes h(A,B) on a job of packed
+ * doubles; the dispatcher (framework.c) runs one by name.  What the
+ * folder's own files share besides (the octree, the scans) is in the
+ * private classic_int.h.
  */
 #ifndef HD_CLASSIC_H
 #define HD_CLASSIC_H
@@ -43,43 +45,53 @@ double hd__alpha(const hd__box_t *a, const hd__box_t *b, int *disjoint);
 hd_algorithm_t hd__framework_choice(const hd__box_t *a, const hd__box_t *b,
                                     double theta);
 
-/* ---- brute-force scans (naive.c) --------------------------------------- */
-/* Exact nearest distance of p to n packed points with the smallest index at
- * that distance (a full scan). */
-double hd__nn_scan(const double *p, const double *xyz, size_t n, size_t *j,
-                   uint64_t *evals);
+/* ---- the kd-tree (kdtree.c) ------------------------------------------------ */
+/* An exact kd-tree over one point set: build, nearest-neighbour search,
+ * and the "kdtree" algorithm (hd__kdtree, one exact search per point of A);
+ * the per-point distances (stats.c) search it too.  The tree owns a
+ * structure-of-arrays copy of the points in tree order (x[], y[], z[]) and
+ * the original index of each (idx[]).  Nodes live in one flat array in
+ * preorder: a node's left child is the next node, its right child is node
+ * `right`.  Every node's box is the exact bounding box of the points below
+ * it, so hd__box_lb2 of a node never exceeds the computed squared distance
+ * to any of its points (see the essay in points/points.h). */
 
-/* Smallest j in B with d2(p, B[j]) == d2; used to canonicalise a witness
- * after an algorithm found *some* nearest point at the winning distance. */
-size_t hd__first_at(const double *p, const double *xyz, size_t n, double d2,
-                    uint64_t *evals);
+/* Largest number of points in a leaf. */
+#define HD__KD_LEAF 16
 
-/* ---- shared by the paper's algorithms (earlybreak.c, nohd.c, ohd.c) ---- */
-/* The inner loop of Algorithms 2 and 5: scan the n packed points for x's
- * nearest neighbour, giving up ("cut short") when some squared distance d is
- * below `bound` or equal to `tie`.  Returns 1 with the minimum in *d2 and
- * the smallest original index at it in *j (idx[k] is point k's original
- * index; NULL means k), or 0 when cut short.  Whether a scan is cut short
- * does not depend on the order of the points, so it is decided per block,
- * and *evals counts every distance evaluated. */
-int hd__scan_break(const double *x, const double *pts, const size_t *idx, size_t n,
-                   double bound, double tie, double *d2, size_t *j, uint64_t *evals);
+typedef struct hd__kdnode {
+    hd__box_t box;
+    size_t begin, end; /* the node's points are [begin, end) in tree order */
+    size_t right;      /* index of the right child; 0 for a leaf */
+} hd__kdnode_t;
 
-/* EARLYBREAK's loop (Algorithm 2, lines 4-15) over the points of A listed
- * in `order` (visited in that order), against B scanned in a random order
- * drawn from rng; with exclude_common, points of A equal to a point of B
- * are skipped (counted in stats->points_culled).  On return *best is the
- * largest exact nearest-neighbour distance among the points that were not
- * cut short, with the smallest i among those and the smallest j at that
- * distance.  A point is cut short only when a distance below the shared
- * bound proves its nn distance smaller than the final value, or equal to a
- * value already found at a smaller index; so the witness is canonical among
- * the points not excluded.  OHD uses it for its AHD. */
-int hd__eb_loop(const hd__job_t *job, const size_t *order, size_t n_order,
-                int exclude_common, hd__rng_t *rng, hd__best_t *best,
-                hd_stats_t *stats, hd_error_t *err);
+typedef struct hd__kd {
+    size_t n;
+    double *x, *y, *z;    /* coordinates in tree order */
+    size_t *idx;          /* original index of each point in tree order */
+    hd__kdnode_t *nodes;  /* preorder; nodes[0] is the root */
+    size_t n_nodes;
+} hd__kd_t;
 
-#include "classic/octree.h"
-#include "classic/kdtree.h"
+/* Counters of one search (added to, never reset). */
+typedef struct hd__kdcount {
+    uint64_t evals;
+    uint64_t nodes;
+} hd__kdcount_t;
+
+/* Build the tree of a validated view (every point finite and in range),
+ * using up to `threads` threads.  Returns HD_OK, HD_ENOMEM or HD_EOVERFLOW. */
+int hd__kd_build(hd__kd_t *kd, const hd_points_t *p, int threads, hd_error_t *err);
+void hd__kd_free(hd__kd_t *kd);
+
+/* The exact nearest squared distance from q to the set, with *j the
+ * smallest original index at that distance.  When `stop2` is positive the
+ * search may end early, as soon as it has found a point with squared
+ * distance < stop2 (strictly): it then returns that distance, which is
+ * < stop2, and *j is that point, not necessarily the nearest.  A result
+ * >= stop2 is always the exact nearest distance.  Pass stop2 = 0 for a full
+ * search. */
+double hd__kd_nearest(const hd__kd_t *kd, const double q[3], double stop2, size_t *j,
+                      hd__kdcount_t *count);
 
 #endif /* HD_CLASSIC_H */

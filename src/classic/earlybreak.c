@@ -45,7 +45,7 @@
  * breaks are decided by the rules above, the result and the witness are the
  * same at any thread count; only the counters may differ.
  */
-#include "classic/classic.h"
+#include "classic/classic_int.h"
 
 #include <math.h>
 #include <stdlib.h>

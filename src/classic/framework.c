@@ -16,7 +16,7 @@
  * The auto engine is not dispatched here: it reads the caller's views
  * without packed copies (api.c calls it directly).
  */
-#include "classic/classic.h"
+#include "classic/classic_int.h"
 
 #include <math.h>
 #include <string.h>

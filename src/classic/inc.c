@@ -25,7 +25,7 @@
  *  - Nutanong et al. use R-trees; we use this project's octree (octree.c)
  *    on both sets, split down to INC_LEAF points per leaf (depth capped at
  *    INC_MAX_DEPTH), with each node's tight box as its MBR.  Their bounds
- *    between MBRs become hd__box_box_lb2 / hd__box_box_ub2 (octree.h), and
+ *    between MBRs become hd__box_box_lb2 / hd__box_box_ub2 (points.h), and
  *    between a point and a box hd__box_lb2 / hd__box_ub2, all evaluated in
  *    hd__d2's operation order, so they bracket the computed distances
  *    exactly (points/points.h); between two points the bound is hd__d2 itself.
@@ -47,7 +47,7 @@
  * Counters: distance_evals counts point-to-point hd__d2; nodes_visited the
  * entries taken from the queue.
  */
-#include "classic/classic.h"
+#include "classic/classic_int.h"
 
 #include <math.h>
 #include <stdlib.h>

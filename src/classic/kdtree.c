@@ -32,7 +32,7 @@
  * distance and the smallest original index attaining it, in any visiting
  * order.
  */
-#include "classic/classic.h"
+#include "classic/classic_int.h"
 
 #include <math.h>
 #include <stdlib.h>

@@ -15,7 +15,7 @@
  * The work over A is cut into slices run by hd__parallel_for; partial
  * results merge with hd__best_offer.
  */
-#include "classic/classic.h"
+#include "classic/classic_int.h"
 
 #include <stdlib.h>
 

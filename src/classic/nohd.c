@@ -56,7 +56,7 @@
  * nodes_visited counts CubeToPoints calls, each of which evaluates up to
  * 2|B| box bounds.
  */
-#include "classic/classic.h"
+#include "classic/classic_int.h"
 
 #include <math.h>
 #include <stdlib.h>

@@ -30,7 +30,7 @@
  *    what stops the subdivision of coincident points (OHD with AHD = 0);
  *  - nodes come from an arena, and node[id] lists them in depth-first order.
  */
-#include "classic/classic.h"
+#include "classic/classic_int.h"
 
 #include <math.h>
 #include <stdlib.h>

@@ -58,7 +58,7 @@
  * nodes_visited counts APQ entries processed; points_culled the culled
  * points of A.
  */
-#include "classic/classic.h"
+#include "classic/classic_int.h"
 
 #include <math.h>
 #include <stdlib.h>

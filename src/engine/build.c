@@ -46,15 +46,15 @@
  * point, then both quantised copies, in one block, and boxes.  That block
  * is the buffer the first sort's keys end in (its tmp: the radix sort
  * makes three passes), given back after it and asked for at max(8 n0,
- * 6 (n0 + n1)) bytes so that it can take both copies: two blocks would each keep a last
- * 2 MiB page whole (0.6 MB each on 250K points).  So at no time are more
+ * 6 (n0 + n1)) bytes so that it can take both copies: two blocks would
+ * each keep a last 2 MiB page whole.  So at no time are more
  * than max(16 n0, 7.4 n0 + max(8 n0, 6 (n0 + n1)) + 8 n1, 13.375 (n0 + n1))
  * bytes held (n0 the larger set), at most 16 bytes per point of both sets,
  * plus pages lost to rounding and the pool's chunks; on sets of one size
  * 13.7.  The second tree's q lies in the first's block (q_borrowed): the
  * pair is freed together.
  */
-#include "engine/engine.h"
+#include "engine/tree.h"
 
 #include <assert.h>
 #include <math.h>
@@ -175,7 +175,7 @@ HD__HOT static void make_bucket(hd__tree_t *t, size_t b) {
     if (t->src.kind != HD__SRC_ANY && b + 1 < t->nb) {
         /* The points are scattered in memory: ask for the next bucket's
          * points early so their loads overlap with this bucket's work. */
-        ptrdiff_t el = t->src.kind == HD__SRC_F64 ? 24 : 12;
+        ptrdiff_t el = hd__src_packed_stride(&t->src);
         size_t e = s + HD__BUCKET, pe = e + HD__BUCKET < t->n ? e + HD__BUCKET : t->n;
         for (size_t i = e; i < pe; i++) __builtin_prefetch(t->src.base + (ptrdiff_t)t->perm[i] * el);
     }

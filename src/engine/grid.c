@@ -55,7 +55,7 @@
  * this pass and the bucket trees with hd__grid_trial, both here because
  * they run this file's point-by-point test on a sample.
  */
-#include "engine/engine.h"
+#include "engine/grid.h"
 
 #include <assert.h>
 #include <math.h>
@@ -718,9 +718,9 @@ int hd__grid_prime_picks_far(const hd__grid_t *ga, const hd__grid_t *gs, size_t 
  * A sample follows A's density rather than its extent, so it finds fewer
  * of the far, sparse places where the maximum tends to be.  The trial
  * after it may then come out higher or lower than with hd__grid_prime
- * (within 0.4 on the grid's cases; 20.1 against 25.8 on a 3M uniform
- * cube: docs/engine.md, "Step 2: the plan"), so the plan decides on it
- * only far from GRID_COST (engine.c, EARLY_COST). */
+ * (hd_bench prints both; the figures are in docs/engine.md, "Step 2: the
+ * plan"), so the plan decides on it only far from GRID_COST (engine.c,
+ * EARLY_COST). */
 void hd__grid_prime_sampled(const hd__src_t *a, size_t na, size_t step, const hd__grid_t *gb,
                             hd__max_t *m, hd__counts_t *counts) {
     size_t pick[HD__PRIME_CELLS];

@@ -12,7 +12,7 @@
  * maximum nor the bound, so the others are pruned only against points
  * kept.
  */
-#include "engine/engine.h"
+#include "engine/max.h"
 
 #include <assert.h>
 

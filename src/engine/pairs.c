@@ -58,7 +58,7 @@
  * is not found, after a first window that keeps unrelated sets from paying
  * more than a few hundred reads.
  */
-#include "engine/engine.h"
+#include "engine/pairs.h"
 
 #include <assert.h>
 #include <math.h>

@@ -29,7 +29,7 @@
  * index attaining it, or a proof that some point is strictly within stop2
  * (or within tie2), whatever the visiting order and the starting bucket.
  */
-#include "engine/engine.h"
+#include "engine/tree.h"
 
 #include <assert.h>
 #include <math.h>

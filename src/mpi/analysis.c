@@ -27,10 +27,10 @@
  * 256 bins of the next 8 bits, one MPI_Allreduce adds the counts, and
  * every rank walks the same sums to the bin holding rank k (the prefix
  * grows by 8 bits, k drops by the counts below the bin).  Small digits
- * keep the reductions small (2 KB a figure): with 16-bit digits (four
- * rounds of 512 KB) tests/api/mpi_figures.c took 22 s on 7 oversubscribed
- * ranks instead of 4, and a local pass costs less than a large reduction
- * across many ranks.  After two rounds (the sign, the exponent and 4 bits
+ * keep the reductions small (2 KB a figure, where 16-bit digits would
+ * reduce 512 KB a round), and a local pass costs less than a large
+ * reduction across many ranks (tests/api/mpi_figures.c on oversubscribed
+ * ranks shows it; the times are in docs/scale-out.md).  After two rounds (the sign, the exponent and 4 bits
  * of the significand) few values still match the prefix as a rule: when at
  * most an eighth of a rank's do, their keys are copied once and the later
  * rounds count only those (compact(); the smallest key above the prefix's
@@ -50,7 +50,8 @@
  * pointer, the percentile, A's distances, then B's), so the code is the
  * one hd_summarize or hd_percentile_of returns on the concatenation.
  */
-#include "mpi_int.h"
+#include "mpi/course.h"
+#include "mpi/search.h"
 
 #include <assert.h>
 #include <limits.h>
@@ -68,14 +69,14 @@ typedef struct {
 /* The checks hd_summarize and hd_percentile_of make, over the ranks:
  * this rank's NULL pointers, then (agreed) the totals, then NaN in A's
  * distances, then in B's, each with its global index. */
-static int check_dists(ctx_t *c, dists_t *v, int rc) {
+static int check_dists(hd__mpi_ctx_t *c, dists_t *v, int rc) {
     static const char *what[2] = {"A to B", "B to A"};
     if (rc == HD_OK && !v->d[0] && v->n[0]) rc = hd__err(&c->e, HD_EINVAL, "distances A to B are NULL");
     if (!v->d[1]) v->n[1] = 0;
     if ((rc = hd__mpi_agree(c, rc))) return rc;
     uint64_t mine[3] = {v->n[0], v->n[1], v->d[1] != NULL}, all[3], before[2] = {0, 0};
-    MPI_TRY(c, MPI_Allreduce(mine, all, 3, MPI_UINT64_T, MPI_SUM, c->comm));
-    MPI_TRY(c, MPI_Exscan(mine, before, 2, MPI_UINT64_T, MPI_SUM, c->comm));
+    HD__MPI_TRY(c, MPI_Allreduce(mine, all, 3, MPI_UINT64_T, MPI_SUM, c->comm));
+    HD__MPI_TRY(c, MPI_Exscan(mine, before, 2, MPI_UINT64_T, MPI_SUM, c->comm));
     if (c->rank == 0) before[0] = before[1] = 0; /* MPI_Exscan leaves rank 0's undefined */
     v->N[0] = all[0];
     v->N[1] = all[1];
@@ -95,7 +96,7 @@ typedef struct {
     hd_summary_t *out;
 } summary_arg_t;
 
-static int summarize_body(ctx_t *c, const hd_options_t *opt, input_t *in, void *arg, hd_mpi_stats_t *st) {
+static int summarize_body(hd__mpi_ctx_t *c, const hd_options_t *opt, hd__mpi_input_t *in, void *arg, hd_mpi_stats_t *st) {
     (void)opt, (void)in, (void)st;
     summary_arg_t *a = arg;
     int rc = a->out ? HD_OK : hd__err(&c->e, HD_EINVAL, "result pointer is NULL");
@@ -109,7 +110,7 @@ static int summarize_body(ctx_t *c, const hd_options_t *opt, input_t *in, void *
         hd__xsum_normalize(&s[2 * d + 1]);
     }
     /* the limbs (and the pending and special counts) of every rank added */
-    MPI_TRY(c, MPI_Allreduce(MPI_IN_PLACE, s, 4 * HD__XSUM_WORDS, MPI_INT64_T, MPI_SUM, c->comm));
+    HD__MPI_TRY(c, MPI_Allreduce(MPI_IN_PLACE, s, 4 * HD__XSUM_WORDS, MPI_INT64_T, MPI_SUM, c->comm));
     double *maxes = hd__mpi_alloc(c, 2 * (size_t)c->K, sizeof *maxes);
     rc = maxes ? HD_OK : hd__mpi_nomem(c, "the ranks' maxima", 2 * (size_t)c->K);
     if ((rc = hd__mpi_agree(c, rc))) {
@@ -198,7 +199,7 @@ static void count_digits(const dists_t *v, const sel_t *sel, const cand_t *cd, i
 /* After COMPACT_AFTER rounds: the keys still matching the prefix, when
  * they are at most an eighth of the local values (a local choice: without
  * memory the arrays are scanned, with the same counts). */
-static void compact(ctx_t *c, const dists_t *v, const sel_t *sel, cand_t *cd) {
+static void compact(hd__mpi_ctx_t *c, const dists_t *v, const sel_t *sel, cand_t *cd) {
     int shift = 64 - DIGIT * COMPACT_AFTER;
     size_t all = 0, m = 0;
     uint64_t beyond = UINT64_MAX;
@@ -245,7 +246,7 @@ static uint64_t key_above(const dists_t *v, const sel_t *sel, const cand_t *cd, 
 
 /* Ranks k of every selection in sel[0..ns), and of k + 1 in *next
  * (next[s] = the key of rank k + 1). */
-static int select_ranks(ctx_t *c, const dists_t *v, sel_t *sel, int ns, uint64_t *key, uint64_t *next) {
+static int select_ranks(hd__mpi_ctx_t *c, const dists_t *v, sel_t *sel, int ns, uint64_t *key, uint64_t *next) {
     size_t words = (size_t)ns * BINS;
     cand_t cd[3] = {{NULL, 0, 0}, {NULL, 0, 0}, {NULL, 0, 0}};
     uint64_t *hist = hd__mpi_alloc(c, words, sizeof *hist);
@@ -281,7 +282,7 @@ static int select_ranks(ctx_t *c, const dists_t *v, sel_t *sel, int ns, uint64_t
         hd__mpi_free(c, cd[s].keys, cd[s].n ? cd[s].n : 1, sizeof *cd[s].keys);
     }
     if (rc) return rc;
-    MPI_TRY(c, MPI_Allreduce(MPI_IN_PLACE, above, ns, MPI_UINT64_T, MPI_MIN, c->comm));
+    HD__MPI_TRY(c, MPI_Allreduce(MPI_IN_PLACE, above, ns, MPI_UINT64_T, MPI_MIN, c->comm));
     for (int s = 0; s < ns; s++) next[s] = sel[s].k + 1 < sel[s].same ? key[s] : above[s];
     return HD_OK;
 }
@@ -292,7 +293,7 @@ typedef struct {
     hd_percentile_t *out;
 } percentile_arg_t;
 
-static int percentile_body(ctx_t *c, const hd_options_t *opt, input_t *in, void *arg, hd_mpi_stats_t *st) {
+static int percentile_body(hd__mpi_ctx_t *c, const hd_options_t *opt, hd__mpi_input_t *in, void *arg, hd_mpi_stats_t *st) {
     (void)opt, (void)in, (void)st;
     percentile_arg_t *a = arg;
     int rc = a->out ? HD_OK : hd__err(&c->e, HD_EINVAL, "result pointer is NULL");
@@ -341,13 +342,13 @@ typedef struct {
     uint64_t *counts;
 } histogram_arg_t;
 
-static int histogram_body(ctx_t *c, const hd_options_t *opt, input_t *in, void *arg, hd_mpi_stats_t *st) {
+static int histogram_body(hd__mpi_ctx_t *c, const hd_options_t *opt, hd__mpi_input_t *in, void *arg, hd_mpi_stats_t *st) {
     (void)opt, (void)in, (void)st;
     histogram_arg_t *a = arg;
     int rc = a->bins > INT_MAX ? hd__err(&c->e, HD_EOVERFLOW, "%zu bins are more than MPI can add", a->bins)
                                : hd_histogram(a->values, a->n, a->lo, a->hi, a->bins, a->counts, &c->e);
     if ((rc = hd__mpi_agree(c, rc))) return rc;
-    MPI_TRY(c, MPI_Allreduce(MPI_IN_PLACE, a->counts, (int)a->bins, MPI_UINT64_T, MPI_SUM, c->comm));
+    HD__MPI_TRY(c, MPI_Allreduce(MPI_IN_PLACE, a->counts, (int)a->bins, MPI_UINT64_T, MPI_SUM, c->comm));
     return HD_OK;
 }
 

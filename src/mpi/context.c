@@ -1,5 +1,5 @@
 /*
- * context.c -- what every step of an MPI call shares (mpi_int.h's ctx_t):
+ * context.c -- what every step of an MPI call shares (context.h's hd__mpi_ctx_t):
  * the count of the bytes it holds, the CPU it spends in MPI, the agreement
  * on a status, and the MPI types and the witness reduction.
  *
@@ -16,11 +16,11 @@
  *    code and message broadcast.  Every collective a failed rank would not
  *    reach is preceded by it, so no rank waits for one that gave up, and
  *    every rank returns the same code and message.
- *  - Every MPI call's thread CPU is added to c->mpi_cpu (MPI_TIMED), so the
+ *  - Every MPI call's thread CPU is added to c->mpi_cpu (HD__MPI_TIMED), so the
  *    bookkeeping's CPU (stats->other_cpu) is what remains of the call's
  *    besides the MPI calls and the searches.
  */
-#include "mpi_int.h"
+#include "mpi/context.h"
 #include "engine/engine.h"
 
 #include <stdio.h>
@@ -39,9 +39,10 @@ double hd__mpi_cpu(void) {
 /* ---- memory: every buffer counted, so the peak can be reported ---------- */
 
 /* Large buffers ask for transparent huge pages: each is written once,
- * right after it is allocated, and on the machine of docs/scale-out.md a
- * 4 KiB page costs 1.3 (mapped in advance) to 2.6 ns a byte (a fault each)
- * against 0.07 for a 2 MiB page ("Memory pages on this machine").  A
+ * right after it is allocated, and a 4 KiB page costs many times more a
+ * byte than a 2 MiB page, most when each takes a fault (bench/page_cost.c
+ * measures the three; docs/scale-out.md, "Memory pages on this
+ * machine").  A
  * buffer of HUGE_BYTES or more starts on a 2 MiB boundary and its whole
  * 2 MiB pages are marked; what is left after them, which the kernel maps
  * in small pages, is mapped in one call (hd__prefault), not a fault a
@@ -68,7 +69,7 @@ static size_t span_of(size_t bytes, int scratch) {
     return bytes;
 }
 
-static void *alloc_span(ctx_t *c, size_t n, size_t size, int scratch) {
+static void *alloc_span(hd__mpi_ctx_t *c, size_t n, size_t size, int scratch) {
     if (size && n > SIZE_MAX / size) return NULL;
     size_t bytes = n * size, span = span_of(bytes, scratch);
     void *p = NULL;
@@ -95,17 +96,17 @@ static void *alloc_span(ctx_t *c, size_t n, size_t size, int scratch) {
     return p;
 }
 
-void *hd__mpi_alloc(ctx_t *c, size_t n, size_t size) { return alloc_span(c, n, size, 0); }
+void *hd__mpi_alloc(hd__mpi_ctx_t *c, size_t n, size_t size) { return alloc_span(c, n, size, 0); }
 
-void *hd__mpi_scratch(ctx_t *c, size_t n, size_t size) { return alloc_span(c, n, size, 1); }
+void *hd__mpi_scratch(hd__mpi_ctx_t *c, size_t n, size_t size) { return alloc_span(c, n, size, 1); }
 
-void hd__mpi_free(ctx_t *c, void *p, size_t n, size_t size) {
+void hd__mpi_free(hd__mpi_ctx_t *c, void *p, size_t n, size_t size) {
     if (!p) return;
     c->cur -= n * size;
     free(p);
 }
 
-void hd__mpi_free_scratch(ctx_t *c, void *p, size_t n, size_t size) {
+void hd__mpi_free_scratch(hd__mpi_ctx_t *c, void *p, size_t n, size_t size) {
     if (!p) return;
     c->cur -= span_of(n * size, 1);
     free(p);
@@ -113,7 +114,7 @@ void hd__mpi_free_scratch(ctx_t *c, void *p, size_t n, size_t size) {
 
 /* Memory this layer does not allocate itself but the call holds: counted
  * in the peak while held. */
-void hd__mpi_charge(ctx_t *c, size_t bytes) {
+void hd__mpi_charge(hd__mpi_ctx_t *c, size_t bytes) {
     c->cur += bytes;
     if (c->cur > c->peak) c->peak = c->cur;
 }
@@ -125,13 +126,13 @@ void hd__mpi_charge(ctx_t *c, size_t bytes) {
  * layer held meanwhile.  On the local arrays (packed doubles, validated before the
  * exchange) it takes the engine's internal entries with the sets' boxes
  * (bp, bq; NULL: computed here), since hd_directed would validate every
- * point again (a pass over both sets, about 50 instructions a point); on
+ * point again (a pass over both sets); on
  * the caller's views (one rank: any layout) the public hd_directed.  s:
  * both directions at once (hd__engine_hausdorff), else h(P, Q) into e,
  * from a floor when floor2 >= 0 (hd__engine_directed_above); keep: NULL,
  * or the filter on each direction's maximum (hd__keep_t; s: two). */
 enum { VIEWS, LOCAL };
-static int engine_call(ctx_t *c, int where, const hd_points_t *P, const hd_points_t *Q, const hd__box_t *bp,
+static int engine_call(hd__mpi_ctx_t *c, int where, const hd_points_t *P, const hd_points_t *Q, const hd__box_t *bp,
                        const hd__box_t *bq, double floor2, size_t floor_i, const hd__keep_t *keep, hd_result_t *e,
                        hd_symmetric_t *s) {
     hd_options_t o;
@@ -155,17 +156,17 @@ static int engine_call(ctx_t *c, int where, const hd_points_t *P, const hd_point
     return rc;
 }
 
-int hd__mpi_engine(ctx_t *c, const hd_points_t *P, const hd_points_t *Q, hd_result_t *e) {
+int hd__mpi_engine(hd__mpi_ctx_t *c, const hd_points_t *P, const hd_points_t *Q, hd_result_t *e) {
     return engine_call(c, VIEWS, P, Q, NULL, NULL, -1.0, 0, NULL, e, NULL);
 }
 
-int hd__mpi_engine_local(ctx_t *c, const hd_points_t *P, const hd_points_t *Q, const hd__box_t *bp,
+int hd__mpi_engine_local(hd__mpi_ctx_t *c, const hd_points_t *P, const hd_points_t *Q, const hd__box_t *bp,
                          const hd__box_t *bq, hd_result_t *e) {
     return engine_call(c, LOCAL, P, Q, bp, bq, -1.0, 0, NULL, e, NULL);
 }
 
 /* h(P, Q) over the points *keep keeps (hd__keep_t). */
-int hd__mpi_engine_kept(ctx_t *c, const hd_points_t *P, const hd_points_t *Q, const hd__keep_t *keep,
+int hd__mpi_engine_kept(hd__mpi_ctx_t *c, const hd_points_t *P, const hd_points_t *Q, const hd__keep_t *keep,
                         hd_result_t *e) {
     return engine_call(c, LOCAL, P, Q, NULL, NULL, -1.0, 0, keep, e, NULL);
 }
@@ -173,7 +174,7 @@ int hd__mpi_engine_kept(ctx_t *c, const hd_points_t *P, const hd_points_t *Q, co
 /* h(P, Q) where only an answer beating (floor2, floor_i) matters: the
  * points that cannot beat it are pruned as soon as one point of Q shows
  * it. */
-int hd__mpi_engine_above(ctx_t *c, const hd_points_t *P, const hd_points_t *Q, double floor2, size_t floor_i,
+int hd__mpi_engine_above(hd__mpi_ctx_t *c, const hd_points_t *P, const hd_points_t *Q, double floor2, size_t floor_i,
                          hd_result_t *e) {
     return engine_call(c, LOCAL, P, Q, NULL, NULL, floor2, floor_i, NULL, e, NULL);
 }
@@ -181,16 +182,16 @@ int hd__mpi_engine_above(ctx_t *c, const hd_points_t *P, const hd_points_t *Q, d
 /* Both directions in one call: the engine builds each set's structures
  * once for both (hd_directed builds both sets' too).  keep: NULL, or a
  * filter on each direction's maximum (hd__keep_t). */
-int hd__mpi_engine_sym(ctx_t *c, const hd_points_t *P, const hd_points_t *Q, const hd__box_t *bp,
+int hd__mpi_engine_sym(hd__mpi_ctx_t *c, const hd_points_t *P, const hd_points_t *Q, const hd__box_t *bp,
                        const hd__box_t *bq, const hd__keep_t keep[2], hd_symmetric_t *s) {
     return engine_call(c, LOCAL, P, Q, bp, bq, -1.0, 0, keep, NULL, s);
 }
 
-int hd__mpi_nomem(ctx_t *c, const char *what, size_t n) {
+int hd__mpi_nomem(hd__mpi_ctx_t *c, const char *what, size_t n) {
     return hd__err(&c->e, HD_ENOMEM, "out of memory for %s (%zu items)", what, n);
 }
 
-int hd__mpi_failed(ctx_t *c, const char *call, int code) {
+int hd__mpi_failed(hd__mpi_ctx_t *c, const char *call, int code) {
     char text[MPI_MAX_ERROR_STRING];
     int len = 0;
     if (MPI_Error_string(code, text, &len) != MPI_SUCCESS) len = 0;
@@ -202,11 +203,11 @@ int hd__mpi_failed(ctx_t *c, const char *call, int code) {
  * code with its message ("rank R: ..."), or HD_OK when none failed.  The
  * only place where ranks learn of each other's failures, called before
  * every collective that a failed rank would not reach. */
-int hd__mpi_agree(ctx_t *c, int rc) {
+int hd__mpi_agree(hd__mpi_ctx_t *c, int rc) {
     int mine = rc != HD_OK ? c->rank : c->K, first = c->K;
     double mpi_t0_;
     int mpi_rc_;
-    if (MPI_TIMED(c, MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, c->comm)) != MPI_SUCCESS)
+    if (HD__MPI_TIMED(c, MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, c->comm)) != MPI_SUCCESS)
         return rc != HD_OK ? rc : hd__err(&c->e, HD_EIO, "MPI_Allreduce failed while agreeing on a status");
     if (first == c->K) return HD_OK;
     hd_error_t e = c->e;
@@ -214,7 +215,7 @@ int hd__mpi_agree(ctx_t *c, int rc) {
         e.code = rc;
         snprintf(e.message, sizeof e.message, "rank %d: %.1000s", first, c->e.message);
     }
-    if (MPI_TIMED(c, MPI_Bcast(&e, (int)sizeof e, MPI_BYTE, first, c->comm)) != MPI_SUCCESS)
+    if (HD__MPI_TIMED(c, MPI_Bcast(&e, (int)sizeof e, MPI_BYTE, first, c->comm)) != MPI_SUCCESS)
         return hd__err(&c->e, HD_EIO, "MPI_Bcast failed while agreeing on a status");
     c->e = e;
     return e.code;
@@ -224,25 +225,25 @@ int hd__mpi_agree(ctx_t *c, int rc) {
 
 static void far_reduce(void *in, void *inout, int *len, MPI_Datatype *type) {
     (void)type;
-    const far_t *x = in;
-    far_t *y = inout;
+    const hd__mpi_far_t *x = in;
+    hd__mpi_far_t *y = inout;
     for (int k = 0; k < *len; k++)
         if (hd__mpi_far_better(&x[k], &y[k])) y[k] = x[k];
 }
 
-int hd__mpi_types_create(ctx_t *c) {
-    MPI_TRY(c, MPI_Type_contiguous((int)sizeof(ans_t), MPI_BYTE, &c->ans_type));
-    MPI_TRY(c, MPI_Type_contiguous(3, MPI_DOUBLE, &c->q_type));
-    MPI_TRY(c, MPI_Type_contiguous((int)sizeof(far_t), MPI_BYTE, &c->far_type));
-    MPI_TRY(c, MPI_Type_contiguous((int)sizeof(sample_t), MPI_BYTE, &c->sample_type));
-    MPI_TRY(c, MPI_Type_contiguous((int)sizeof(node_t), MPI_BYTE, &c->node_type));
+int hd__mpi_types_create(hd__mpi_ctx_t *c) {
+    HD__MPI_TRY(c, MPI_Type_contiguous((int)sizeof(hd__mpi_ans_t), MPI_BYTE, &c->ans_type));
+    HD__MPI_TRY(c, MPI_Type_contiguous(3, MPI_DOUBLE, &c->q_type));
+    HD__MPI_TRY(c, MPI_Type_contiguous((int)sizeof(hd__mpi_far_t), MPI_BYTE, &c->far_type));
+    HD__MPI_TRY(c, MPI_Type_contiguous((int)sizeof(hd__mpi_sample_t), MPI_BYTE, &c->sample_type));
+    HD__MPI_TRY(c, MPI_Type_contiguous((int)sizeof(hd__mpi_node_t), MPI_BYTE, &c->node_type));
     MPI_Datatype *all[] = {&c->ans_type, &c->q_type, &c->far_type, &c->sample_type, &c->node_type};
-    for (size_t k = 0; k < sizeof all / sizeof *all; k++) MPI_TRY(c, MPI_Type_commit(all[k]));
-    MPI_TRY(c, MPI_Op_create(far_reduce, 1, &c->far_op));
+    for (size_t k = 0; k < sizeof all / sizeof *all; k++) HD__MPI_TRY(c, MPI_Type_commit(all[k]));
+    HD__MPI_TRY(c, MPI_Op_create(far_reduce, 1, &c->far_op));
     return HD_OK;
 }
 
-void hd__mpi_types_free(ctx_t *c) {
+void hd__mpi_types_free(hd__mpi_ctx_t *c) {
     MPI_Datatype *all[] = {&c->ans_type, &c->q_type, &c->far_type, &c->sample_type, &c->node_type};
     for (size_t k = 0; k < sizeof all / sizeof *all; k++)
         if (*all[k] != MPI_DATATYPE_NULL) MPI_Type_free(all[k]);

@@ -51,7 +51,7 @@
  * structure keeps exact copies in its own order, so each local array of
  * coordinates is freed once its structure exists, and point k is read from
  * the structure through the inverse of its order (an_t.pos, 4 bytes).  So:
- * the encoded indices (gidx_t, under a byte), the two structures (about 37
+ * the encoded indices (hd__mpi_gidx_t, under a byte), the two structures (about 37
  * bytes a point of each set, 38 while one is built) with their inverse
  * orders, held through both directions (each set asks in one and is
  * searched in the other), and per point of the direction being computed:
@@ -71,7 +71,8 @@
  * Measured peak: 53-55 bytes a local point, the search of a direction
  * (docs/scale-out.md).
  */
-#include "mpi_int.h"
+#include "mpi/course.h"
+#include "mpi/search.h"
 
 #include <assert.h>
 #include <limits.h>
@@ -94,7 +95,7 @@ typedef struct {
     size_t n;
 } an_t;
 
-static void an_free(ctx_t *c, an_t *t) {
+static void an_free(hd__mpi_ctx_t *c, an_t *t) {
     if (t->built) hd__mpi_an_release(c, &t->s, t->bytes);
     hd__mpi_free(c, t->pos, t->n, sizeof(uint32_t));
     memset(t, 0, sizeof *t);
@@ -107,9 +108,9 @@ static inline void an_point(const an_t *t, size_t k, double out[3]) {
 
 /* The structure of local set xyz (n points), then its inverse order; the
  * coordinates are the caller's to free. */
-static int an_of_set(ctx_t *c, const double *xyz, size_t n, const hd__box_t *kb, an_t *t);
+static int an_of_set(hd__mpi_ctx_t *c, const double *xyz, size_t n, const hd__box_t *kb, an_t *t);
 
-static int an_of(ctx_t *c, const double *xyz, size_t n, const hd__box_t *kb, an_t *t) {
+static int an_of(hd__mpi_ctx_t *c, const double *xyz, size_t n, const hd__box_t *kb, an_t *t) {
     memset(t, 0, sizeof *t);
     if (n == 0) return HD_OK;
     if (n > HD__AN_MAX_POINTS)
@@ -121,7 +122,7 @@ static int an_of(ctx_t *c, const double *xyz, size_t n, const hd__box_t *kb, an_
     return rc;
 }
 
-static int an_of_set(ctx_t *c, const double *xyz, size_t n, const hd__box_t *kb, an_t *t) {
+static int an_of_set(hd__mpi_ctx_t *c, const double *xyz, size_t n, const hd__box_t *kb, an_t *t) {
     int rc = an_of(c, xyz, n, kb, t);
     if (rc != HD_OK || n == 0) return rc;
     if (!(t->pos = hd__mpi_alloc(c, n, sizeof(uint32_t)))) return hd__mpi_nomem(c, "the structures", n);
@@ -133,7 +134,7 @@ static int an_of_set(ctx_t *c, const double *xyz, size_t n, const hd__box_t *kb,
 /* Side s's parts in offset order (the order the exchange walks them) and,
  * for each, where its first point goes in the outputs (part order as
  * given: part 0's points, then part 1's, ...). */
-static int walk_order(ctx_t *c, const input_t *in, int s, const hd_mpi_part_t ***order, size_t **base) {
+static int walk_order(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, int s, const hd_mpi_part_t ***order, size_t **base) {
     size_t np = in->nparts[s];
     *order = hd__mpi_alloc(c, np, sizeof **order);
     *base = hd__mpi_alloc(c, np, sizeof **base);
@@ -153,7 +154,7 @@ static int walk_order(ctx_t *c, const input_t *in, int s, const hd_mpi_part_t **
     return HD_OK;
 }
 
-static void walk_order_free(ctx_t *c, const input_t *in, int s, const hd_mpi_part_t **order, size_t *base) {
+static void walk_order_free(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, int s, const hd_mpi_part_t **order, size_t *base) {
     hd__mpi_free(c, order, in->nparts[s], sizeof *order);
     hd__mpi_free(c, base, in->nparts[s], sizeof *base);
 }
@@ -163,8 +164,8 @@ static void walk_order_free(ctx_t *c, const input_t *in, int s, const hd_mpi_par
 /* hd_distances on the views; its positions (index order) become global
  * indices, and the answers go to the outputs in part order (directly when
  * the nonempty parts are given in offset order, else through a copy). */
-static int single(ctx_t *c, const input_t *in, const ranges_t *rg, const int want[2], outs_t *o) {
-    views_t vw;
+static int single(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const hd__mpi_ranges_t *rg, const int want[2], outs_t *o) {
+    hd__mpi_views_t vw;
     double *td[2] = {NULL, NULL};
     size_t *tn[2] = {NULL, NULL};
     const hd_mpi_part_t **order[2] = {NULL, NULL};
@@ -223,10 +224,10 @@ static int single(ctx_t *c, const input_t *in, const ranges_t *rg, const int wan
 /* The answers (d2, index) of side s's local points go back to the ranks
  * that hold them (step 3 of the essay), which write them to their outputs.
  * d2 is made the distance in place; d2 and j are freed here. */
-static int give_back(ctx_t *c, const spread_t *sp, const input_t *in, int s, double **d2p,
+static int give_back(hd__mpi_ctx_t *c, const hd__mpi_spread_t *sp, const hd__mpi_input_t *in, int s, double **d2p,
                      uint64_t **jp, outs_t *o) {
     int K = c->K, rc = HD_OK;
-    const local_t *loc = &sp->loc;
+    const hd__mpi_local_t *loc = &sp->loc;
     size_t n = loc->n[s], own = (size_t)in->n[s], m = 0;
     double *d2 = *d2p, *sd = d2, *rd = NULL;
     uint64_t *j = *jp, *sj = j, *rj = NULL;
@@ -252,7 +253,7 @@ static int give_back(ctx_t *c, const spread_t *sp, const input_t *in, int s, dou
         packed = 1;
         if (!sd || !sj) rc = hd__mpi_nomem(c, "the answers", n);
         if (rc == HD_OK) {
-            gcur_t cu;
+            hd__mpi_gcur_t cu;
             memset(scount, 0, (size_t)K * sizeof(int));
             hd__mpi_gcur_init(&cu, &loc->gi[s]);
             for (size_t k = 0; k < n; k++) hd__mpi_gcur_at(&cu, k), scount[hd__mpi_gcur_rank(&cu)]++;
@@ -273,7 +274,7 @@ static int give_back(ctx_t *c, const spread_t *sp, const input_t *in, int s, dou
         rc = hd__err(&c->e, HD_EOVERFLOW, "%zu points of %s on rank %d exceed MPI's int counts", own, s ? "B" : "A",
                      c->rank);
     if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
-    MPI_GO(c, rc, MPI_Alltoall(scount, 1, MPI_INT, rcount, 1, MPI_INT, c->comm));
+    HD__MPI_GO(c, rc, MPI_Alltoall(scount, 1, MPI_INT, rcount, 1, MPI_INT, c->comm));
     for (int r = 0; r < K; r++) {
         rdispl[r] = (int)m;
         m += (size_t)rcount[r];
@@ -284,13 +285,13 @@ static int give_back(ctx_t *c, const spread_t *sp, const input_t *in, int s, dou
      * next receive buffer is had (8 bytes a point less at the peak). */
     if (!(rd = hd__mpi_alloc(c, m, sizeof(double)))) rc = hd__mpi_nomem(c, "the answers", m);
     if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
-    MPI_GO(c, rc, MPI_Alltoallv(sd, scount, sdispl, MPI_DOUBLE, rd, rcount, rdispl, MPI_DOUBLE, c->comm));
+    HD__MPI_GO(c, rc, MPI_Alltoallv(sd, scount, sdispl, MPI_DOUBLE, rd, rcount, rdispl, MPI_DOUBLE, c->comm));
     if (sd == *d2p) *d2p = NULL; /* not packed: the caller's array, freed here */
     hd__mpi_free(c, sd, n, sizeof(double));
     sd = NULL;
     if (!(rj = hd__mpi_alloc(c, m, sizeof(uint64_t)))) rc = hd__mpi_nomem(c, "the answers", m);
     if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
-    MPI_GO(c, rc, MPI_Alltoallv(sj, scount, sdispl, MPI_UINT64_T, rj, rcount, rdispl, MPI_UINT64_T, c->comm));
+    HD__MPI_GO(c, rc, MPI_Alltoallv(sj, scount, sdispl, MPI_UINT64_T, rj, rcount, rdispl, MPI_UINT64_T, c->comm));
     if (sj == *jp) *jp = NULL;
     hd__mpi_free(c, sj, n, sizeof(uint64_t));
     sj = NULL;
@@ -330,7 +331,7 @@ _Static_assert(sizeof(size_t) <= sizeof(uint64_t), "a position's slot holds a gl
 
 /* The n global indices of a local set in local order (8 bytes a point,
  * charged), or NULL when they cannot be had. */
-static uint64_t *decode(ctx_t *c, const gidx_t *gi, size_t n) {
+static uint64_t *decode(hd__mpi_ctx_t *c, const hd__mpi_gidx_t *gi, size_t n) {
     uint64_t *g = hd__mpi_alloc(c, n, sizeof(uint64_t));
     if (g) hd__mpi_gidx_decode(gi, 0, n, g);
     return g;
@@ -346,9 +347,9 @@ static uint64_t *decode(ctx_t *c, const gidx_t *gi, size_t n) {
  * neighbours' spacing), as a copy's partners are; two independent
  * samplings of one scene have theirs anywhere.  The samples' indices are
  * decoded at random (a binary search over Q's), a few thousand decodes. */
-static int partners_near(const spread_t *sp, int s, const an_t *asking, const an_t *searched) {
+static int partners_near(const hd__mpi_spread_t *sp, int s, const an_t *asking, const an_t *searched) {
     size_t nP = sp->loc.n[s], nQ = sp->loc.n[1 - s], m = nP < PAIR_SAMPLES ? nP : PAIR_SAMPLES, near = 0;
-    const gidx_t *gp = &sp->loc.gi[s], *gq = &sp->loc.gi[1 - s];
+    const hd__mpi_gidx_t *gp = &sp->loc.gi[s], *gq = &sp->loc.gi[1 - s];
     const hd__an_t *t = &searched->s;
     for (size_t r = 0; r < m && nQ; r++) {
         size_t kp = r * nP / m, lo = 0, hi = nQ;
@@ -385,7 +386,7 @@ static int partners_near(const spread_t *sp, int s, const an_t *asking, const an
  * local orders are their global indices' order, so one merge of the two
  * finds them (gq: Q's indices in local order).  NULL (no partners) when
  * the array cannot be had: no answer depends on the partners. */
-static uint32_t *partners(ctx_t *c, const spread_t *sp, int s, const an_t *asking, const an_t *searched,
+static uint32_t *partners(hd__mpi_ctx_t *c, const hd__mpi_spread_t *sp, int s, const an_t *asking, const an_t *searched,
                           const uint64_t *gq) {
     size_t nP = sp->loc.n[s], nQ = sp->loc.n[1 - s];
     uint32_t *at = nP && nQ ? hd__mpi_alloc(c, nP, sizeof(uint32_t)) : NULL;
@@ -408,14 +409,14 @@ typedef struct {
     const an_t *searched;
     const hd__box_t *kb;
     size_t nQ;
-    const gidx_t *gQ;
+    const hd__mpi_gidx_t *gQ;
 } answer_t;
 
-static int answer(ctx_t *c, void *arg, const double *pts, size_t m, ans_t *ans) {
+static int answer(hd__mpi_ctx_t *c, void *arg, const double *pts, size_t m, hd__mpi_ans_t *ans) {
     const answer_t *a = arg;
     if (m == 0) return HD_OK;
     if (a->nQ == 0) {
-        for (size_t k = 0; k < m; k++) ans[k] = (ans_t){INFINITY, UINT64_MAX};
+        for (size_t k = 0; k < m; k++) ans[k] = (hd__mpi_ans_t){INFINITY, UINT64_MAX};
         return HD_OK;
     }
     size_t *near = hd__mpi_alloc(c, m, sizeof(size_t));
@@ -423,12 +424,12 @@ static int answer(ctx_t *c, void *arg, const double *pts, size_t m, ans_t *ans) 
     int rc = near ? an_of(c, pts, m, a->kb, &asked) : hd__mpi_nomem(c, "answers", m);
     if (rc == HD_OK)
         rc = hd__mpi_an_nearest(c, &asked.s, &a->searched->s, NULL, hd__thread_count(c->threads, m), near);
-    gcur_t cq;
+    hd__mpi_gcur_t cq;
     hd__mpi_gcur_init(&cq, a->gQ);
     for (size_t k = 0; k < m && rc == HD_OK; k++) {
         double q[3];
         an_point(a->searched, near[k], q);
-        ans[k] = (ans_t){hd__d2(pts + 3 * k, q), hd__mpi_gcur_at(&cq, near[k])};
+        ans[k] = (hd__mpi_ans_t){hd__d2(pts + 3 * k, q), hd__mpi_gcur_at(&cq, near[k])};
     }
     if (near) an_free(c, &asked);
     hd__mpi_free(c, near, m, sizeof(size_t));
@@ -438,10 +439,10 @@ static int answer(ctx_t *c, void *arg, const double *pts, size_t m, ans_t *ans) 
 /* The exact answers of side s's local points against all of the other
  * side (steps 1 and 2), then returned (step 3).  `asking` and `searched`
  * are the structures of local P and local Q on the key box kb. */
-static int direction(ctx_t *c, const spread_t *sp, const input_t *in, int s, int paired,
+static int direction(hd__mpi_ctx_t *c, const hd__mpi_spread_t *sp, const hd__mpi_input_t *in, int s, int paired,
                      const an_t *asking, const an_t *searched, const hd__box_t *kb, outs_t *o) {
     int K = c->K, rc = HD_OK, qs = 1 - s;
-    const local_t *loc = &sp->loc;
+    const hd__mpi_local_t *loc = &sp->loc;
     size_t nP = loc->n[s], nQ = loc->n[qs], nf = 0;
     const hd__box_t *mine = &sp->region[c->rank];
     double *u2 = NULL;
@@ -453,7 +454,7 @@ static int direction(ctx_t *c, const spread_t *sp, const input_t *in, int s, int
     size_t *near = (size_t *)(void *)slot;
     hd__box_t *nbox = hd__mpi_alloc(c, (size_t)K - 1, sizeof(hd__box_t));
     int *list = hd__mpi_alloc(c, (size_t)K, sizeof(int));
-    pairs_t pr = {NULL, 0, 0};
+    hd__mpi_pairs_t pr = {NULL, 0, 0};
     if (!slot || !nbox || !list) rc = hd__mpi_nomem(c, "the distances", nP);
     /* 1. The local pass: the partners first (when the sides have one size
      * and a sample finds them near), from Q's indices decoded in order. */
@@ -535,11 +536,11 @@ static int direction(ctx_t *c, const spread_t *sp, const input_t *in, int s, int
 
 /* ---- the call ------------------------------------------------------------ */
 
-static int distances(ctx_t *c, const hd_options_t *opt, input_t *in, void *arg, hd_mpi_stats_t *st) {
+static int distances(hd__mpi_ctx_t *c, const hd_options_t *opt, hd__mpi_input_t *in, void *arg, hd_mpi_stats_t *st) {
     outs_t *o = arg;
-    course_t cs;
+    hd__mpi_course_t cs;
     hd__mpi_course_init(c, &cs);
-    spread_t *sp = &cs.sp;
+    hd__mpi_spread_t *sp = &cs.sp;
     an_t an[2];
     memset(an, 0, sizeof an);
     int rc = hd__mpi_begin(c, opt, in, o, &cs.rg, cs.N, NULL);
@@ -547,7 +548,7 @@ static int distances(ctx_t *c, const hd_options_t *opt, input_t *in, void *arg, 
     uint64_t pts = in->n[0] + in->n[1];
     /* A direction runs when some rank asks for it. */
     int asks[2] = {o->dist[0] || o->nearest[0], o->dist[1] || o->nearest[1]}, want[2];
-    MPI_GO(c, rc, MPI_Allreduce(asks, want, 2, MPI_INT, MPI_MAX, c->comm));
+    HD__MPI_GO(c, rc, MPI_Allreduce(asks, want, 2, MPI_INT, MPI_MAX, c->comm));
     if (c->K == 1) {
         if ((rc = single(c, in, &cs.rg, want, o)) != HD_OK) goto done;
     } else if (want[0] || want[1]) {

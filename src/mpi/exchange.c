@@ -19,7 +19,7 @@
  *  - After the rounds, local order is global index order: as received when
  *    the runs follow each other in index order, else after a K-way merge
  *    applied in place (the numbers become 8-byte indices first).  The
- *    indices are then held encoded (gidx_t, gidx.c): each round's numbers
+ *    indices are then held encoded (hd__mpi_gidx_t, gidx.c): each round's numbers
  *    are encoded as they arrive (still in the cache), as if the runs were
  *    in order, and encoded again from the merged indices when they were
  *    not; the numbers and indices are freed before the call goes on.
@@ -28,7 +28,7 @@
  *    each run as it lands (the rank's own, each sender's): the same points
  *    as the local arrays hold, in whatever order the merge leaves them.
  */
-#include "mpi_int.h"
+#include "mpi/partition.h"
 
 #include <assert.h>
 #include <limits.h>
@@ -113,7 +113,7 @@ typedef struct { int s; size_t p, k; uint64_t num[2]; } walk_t;
 
 /* The points left in the cursor's part, after moving past finished parts
  * (0 at the end of the input). */
-static size_t walk_avail(const input_t *in, const hd_mpi_part_t **order[2], walk_t *w) {
+static size_t walk_avail(const hd__mpi_input_t *in, const hd_mpi_part_t **order[2], walk_t *w) {
     while (w->s < 2) {
         if (w->p < in->nparts[w->s]) {
             size_t n = order[w->s][w->p]->points.count;
@@ -181,114 +181,149 @@ HD__INLINE void pack_run(const hd_points_t *v, const double *px, size_t k0, size
     *own = cur[1];
 }
 
-/* Points sent per round by a rank: an eighth of its points (at least 64K),
- * so the send buffer is at most 28/8 = 3.5 bytes a point (the minimum
- * also makes the tests' larger sets take several rounds). */
+/* Points sent per round by a rank: an eighth of its points (at least
+ * ROUND_MIN), so the send buffer is at most 28/8 = 3.5 bytes a point (the
+ * minimum also makes the tests' larger sets take several rounds). */
 #define ROUND_SHARE 8
 #define ROUND_MIN 4096
 
-/* Move every point to the rank of its region.  Each point goes as its
- * coordinates and a 4-byte number: its rank among the sender's points of
- * its set in index order (ranges_t turns it back into the global index).
- * Each source's run is received straight into its slot of the local
- * arrays, in rounds of at most an eighth of the sender's points, so no
- * copy of all the points is ever held twice; a rank's own points are
- * copied from the input into their slot.  Runs are in index order, since
- * senders walk their parts in offset order; when the runs follow each
- * other in index order too (each rank's parts lie above the previous
- * rank's) the local arrays are in global order as received (loc->start:
- * each sender's run), else the numbers become indices and the arrays are
- * merged in place (a permutation from a K-way merge, 4 bytes a point;
- * loc->merged).  Either way loc->gi holds the indices encoded. */
-int hd__mpi_exchange(ctx_t *c, const input_t *in, const ranges_t *rg, const node_t *tree, local_t *loc) {
-    int K = c->K, me = c->rank, rc = HD_OK, w = K <= 256 ? 1 : K <= 65536 ? 2 : 4;
-    size_t nloc = (size_t)(in->n[0] + in->n[1]), C = nloc / ROUND_SHARE, sendcap = 0;
-    if (C < ROUND_MIN) C = ROUND_MIN;
-    /* ints per rank: totals sent tot[2] and received rtot[2]; this round's
-     * per[2] and rper[2]; where each (rank, side) block of the send buffer
-     * starts, sdisp[2], and a cursor in it, sfill[2]; one side's counts and
-     * displacements for MPI: sc sd rcn rd */
-    int *cnt = hd__mpi_alloc(c, 16 * (size_t)K, sizeof(int));
-    /* base[s K + r], then got[s K + r]; then big[2 r + s], the first
-     * pass's counts (tot) in size_t, checked against INT_MAX once */
-    size_t *base = hd__mpi_alloc(c, 6 * (size_t)K, sizeof(size_t));
-    void *dest = hd__mpi_scratch(c, nloc, (size_t)w);
-    const hd_mpi_part_t **order[2] = {NULL, NULL};
-    uint32_t *off[2] = {NULL, NULL};
-    double *sx = NULL;
-    uint32_t *so = NULL;
-    uint32_t *perm = NULL;
-    size_t permn = 0, gn = 0;
-    uint64_t *g = NULL;      /* the indices of merged runs */
-    run_t *runs = NULL;
-    int *heap = NULL;
-    for (int s = 0; s < 2; s++) order[s] = hd__mpi_alloc(c, in->nparts[s], sizeof *order[s]);
-    if (!cnt || !base || !dest || !order[0] || !order[1]) rc = hd__mpi_nomem(c, "the exchange", nloc);
-    int *tot = cnt, *rtot = cnt + 2 * K, *per = cnt + 4 * K, *rper = cnt + 6 * K, *sdisp = cnt + 8 * K,
-        *sfill = cnt + 10 * K, *sc = cnt + 12 * K, *sd = cnt + 13 * K, *rcn = cnt + 14 * K, *rd = cnt + 15 * K;
-    size_t *got = base + 2 * K, *big = base + 4 * K, own = 0, switches = 0; /* points whose destination is not the previous one's */
-    /* The rounds: round q walks the input positions [tb[q], tb[q + 1]),
-     * up to the (q + 1) C-th point for another rank (the last to the end),
-     * and sends rcnt[q 2K + 2 r + s] points of side s to rank r. */
-    size_t maxr = nloc / C + 2, nr = 1;
-    size_t *tb = hd__mpi_alloc(c, maxr + 1, sizeof(size_t));
-    int *rcnt = hd__mpi_alloc(c, maxr * 2 * (size_t)K, sizeof(int));
-    if (rc == HD_OK && (!tb || !rcnt)) rc = hd__mpi_nomem(c, "the exchange's rounds", maxr);
-    if (rc == HD_OK) {
-        memset(big, 0, 2 * (size_t)K * sizeof(size_t));
-        memset(rcnt, 0, maxr * 2 * (size_t)K * sizeof(int));
-        size_t t = 0, out = 0, q = 0, cut = C; /* cut: where round q ends, (q + 1) C points sent */
-        int prev = -1, *row = rcnt;              /* row: round q's counts */
-        tb[0] = 0;
-        for (int s = 0; s < 2; s++) {
-            for (size_t p = 0; p < in->nparts[s]; p++) order[s][p] = &in->parts[s][p];
-            qsort(order[s], in->nparts[s], sizeof *order[s], hd__mpi_by_offset);
-            for (size_t p = 0; p < in->nparts[s]; p++) {
-                const hd_points_t *v = &order[s][p]->points;
-                const double *px = hd__mpi_packed(v);
-                uint64_t g0 = order[s][p]->offset;
-                for (size_t k = 0; k < v->count; k++, t++) {
-                    double xb[3];
-                    const double *x = px ? px + 3 * k : (hd_points_get(v, k, xb), xb);
-                    int r = hd__mpi_rank_of(tree, K, x, (uint64_t)s, g0 + k);
-                    dest_set(dest, w, t, r);
-                    switches += (size_t)(r != prev);
-                    prev = r;
-                    big[2 * r + s]++;
-                    /* No branch on whether the point stays: in an input
-                     * that is not in space's order it does at random (half
-                     * the points at K = 2), and the branch was mispredicted
-                     * as often (callgrind's branch simulation). */
-                    int other = r != me;
-                    if (out == cut && other) tb[++q] = t, row += 2 * (size_t)K, cut += C;
-                    assert(q < maxr && cut == (q + 1) * C && row == rcnt + q * 2 * (size_t)K);
-                    row[2 * r + s] += other;
-                    out += (size_t)other;
-                }
+/* The exchange's state.  Counts by (rank r, side s) are at 2 r + s, sizes
+ * by (side s, rank r) at s K + r. */
+typedef struct {
+    int K, me, w;                   /* ranks, this rank, bytes of a destination (dest_get) */
+    size_t nloc, C;                 /* local input points; at most C sent a round */
+    const hd_mpi_part_t **order[2]; /* each side's parts by offset: the walking order */
+    void *dest;                     /* each input position's rank (scratch) */
+    size_t switches;                /* positions whose rank is not the previous one's */
+    /* The rounds: round q walks the input positions [tb[q], tb[q + 1]), up
+     * to the (q + 1) C-th point for another rank (the last to the end), and
+     * sends rcnt[q 2K + 2 r + s] points of side s to rank r. */
+    size_t maxr, nr, *tb;
+    int *rcnt;
+    int *tot, *rtot;                /* 2K: points sent in all, and received */
+    int *per, *rper;                /* 2K: this round's, sent and received */
+    int *sdisp, *sfill;             /* 2K: each block of the send buffer, and a cursor in it */
+    int *sc, *sd, *rcn, *rd;        /* K: one side's counts and displacements for MPI */
+    size_t *big;                    /* 2K: tot counted in size_t, checked against INT_MAX */
+    size_t *base, *got;             /* 2K: where rank r's run of side s lands here, and how much arrived */
+    double *sx;                     /* the send buffer (sendcap points) and the points' numbers */
+    uint32_t *so;
+    size_t sendcap;
+    uint32_t *off[2];               /* each local point's number at its sender (scratch) */
+} xch_t;
+
+/* The arrays of K or 2K counts, each its own allocation. */
+#define XCH_INTS(x) {&(x)->tot, &(x)->rtot, &(x)->per, &(x)->rper, &(x)->sdisp, &(x)->sfill, \
+                     &(x)->sc, &(x)->sd, &(x)->rcn, &(x)->rd}
+#define XCH_INTS_2K 6 /* the first six have 2K, the others K */
+#define XCH_SIZES(x) {&(x)->big, &(x)->base, &(x)->got}
+
+static int xch_alloc(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, xch_t *x) {
+    memset(x, 0, sizeof *x);
+    x->K = c->K, x->me = c->rank, x->w = c->K <= 256 ? 1 : c->K <= 65536 ? 2 : 4;
+    x->nloc = (size_t)(in->n[0] + in->n[1]);
+    x->C = x->nloc / ROUND_SHARE < ROUND_MIN ? ROUND_MIN : x->nloc / ROUND_SHARE;
+    x->maxr = x->nloc / x->C + 2, x->nr = 1;
+    int **ints[] = XCH_INTS(x);
+    size_t **sizes[] = XCH_SIZES(x);
+    int ok = 1;
+    for (int k = 0; k < (int)(sizeof ints / sizeof *ints); k++)
+        ok &= (*ints[k] = hd__mpi_alloc(c, (k < XCH_INTS_2K ? 2 : 1) * (size_t)x->K, sizeof(int))) != NULL;
+    for (int k = 0; k < (int)(sizeof sizes / sizeof *sizes); k++)
+        ok &= (*sizes[k] = hd__mpi_alloc(c, 2 * (size_t)x->K, sizeof(size_t))) != NULL;
+    for (int s = 0; s < 2; s++) ok &= (x->order[s] = hd__mpi_alloc(c, in->nparts[s], sizeof *x->order[s])) != NULL;
+    x->dest = hd__mpi_scratch(c, x->nloc, (size_t)x->w);
+    if (!ok || !x->dest) return hd__mpi_nomem(c, "the exchange", x->nloc);
+    x->tb = hd__mpi_alloc(c, x->maxr + 1, sizeof(size_t));
+    x->rcnt = hd__mpi_alloc(c, x->maxr * 2 * (size_t)x->K, sizeof(int));
+    if (!x->tb || !x->rcnt) return hd__mpi_nomem(c, "the exchange's rounds", x->maxr);
+    return HD_OK;
+}
+
+static void xch_free_sends(hd__mpi_ctx_t *c, xch_t *x) {
+    hd__mpi_free_scratch(c, x->sx, x->sendcap, 3 * sizeof(double));
+    hd__mpi_free_scratch(c, x->so, x->sendcap, sizeof(uint32_t));
+    hd__mpi_free_scratch(c, x->dest, x->nloc, (size_t)x->w);
+    x->sx = NULL, x->so = NULL, x->dest = NULL;
+}
+
+static void xch_free(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, xch_t *x, const hd__mpi_local_t *loc) {
+    int **ints[] = XCH_INTS(x);
+    size_t **sizes[] = XCH_SIZES(x);
+    for (int k = 0; k < (int)(sizeof ints / sizeof *ints); k++)
+        hd__mpi_free(c, *ints[k], (k < XCH_INTS_2K ? 2 : 1) * (size_t)x->K, sizeof(int));
+    for (int k = 0; k < (int)(sizeof sizes / sizeof *sizes); k++) hd__mpi_free(c, *sizes[k], 2 * (size_t)x->K, sizeof(size_t));
+    hd__mpi_free(c, x->tb, x->maxr + 1, sizeof(size_t));
+    hd__mpi_free(c, x->rcnt, x->maxr * 2 * (size_t)x->K, sizeof(int));
+    for (int s = 0; s < 2; s++) {
+        hd__mpi_free(c, x->order[s], in->nparts[s], sizeof *x->order[s]);
+        hd__mpi_free_scratch(c, x->off[s], loc->n[s], sizeof(uint32_t));
+    }
+    xch_free_sends(c, x);
+}
+
+/* The first pass: each input position's rank (dest), the totals to each
+ * rank (tot), and the rounds' cuts and counts (tb, rcnt). */
+static int xch_plan(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const hd__mpi_node_t *tree, xch_t *x) {
+    int K = x->K, me = x->me, rc = HD_OK;
+    memset(x->big, 0, 2 * (size_t)K * sizeof(size_t));
+    memset(x->rcnt, 0, x->maxr * 2 * (size_t)K * sizeof(int));
+    size_t t = 0, out = 0, q = 0, cut = x->C; /* cut: where round q ends, (q + 1) C points sent */
+    int prev = -1, *row = x->rcnt;            /* row: round q's counts */
+    x->tb[0] = 0;
+    for (int s = 0; s < 2; s++) {
+        for (size_t p = 0; p < in->nparts[s]; p++) x->order[s][p] = &in->parts[s][p];
+        qsort(x->order[s], in->nparts[s], sizeof *x->order[s], hd__mpi_by_offset);
+        for (size_t p = 0; p < in->nparts[s]; p++) {
+            const hd_points_t *v = &x->order[s][p]->points;
+            const double *px = hd__mpi_packed(v);
+            uint64_t g0 = x->order[s][p]->offset;
+            for (size_t k = 0; k < v->count; k++, t++) {
+                double xb[3];
+                const double *pt = px ? px + 3 * k : (hd_points_get(v, k, xb), xb);
+                int r = hd__mpi_rank_of(tree, K, pt, (uint64_t)s, g0 + k);
+                dest_set(x->dest, x->w, t, r);
+                x->switches += (size_t)(r != prev);
+                prev = r;
+                x->big[2 * r + s]++;
+                /* No branch on whether the point stays: in an input
+                 * that is not in space's order it does at random (half
+                 * the points at K = 2), and the branch was mispredicted
+                 * as often (callgrind's branch simulation). */
+                int other = r != me;
+                if (out == cut && other) x->tb[++q] = t, row += 2 * (size_t)K, cut += x->C;
+                assert(q < x->maxr && cut == (q + 1) * x->C && row == x->rcnt + q * 2 * (size_t)K);
+                row[2 * r + s] += other;
+                out += (size_t)other;
             }
         }
-        nr = q + 1;
-        tb[nr] = nloc;
-        for (int k = 0; k < 2 * K; k++) {
-            if (big[k] > INT_MAX) rc = HD_EOVERFLOW;
-            tot[k] = big[k] > INT_MAX ? INT_MAX : (int)big[k];
-        }
-        if (rc != HD_OK)
-            rc = hd__err(&c->e, HD_EOVERFLOW, "more than 2^31 - 1 points of a set to send from rank %d to one rank",
-                         c->rank);
-        own = (size_t)tot[2 * me] + (size_t)tot[2 * me + 1];
-        sendcap = nloc - own < C ? nloc - own : C;
-        for (int r = 0; r < K; r++)
-            if (r != me) c->bytes_part += ((uint64_t)tot[2 * r] + (uint64_t)tot[2 * r + 1]) * (3 * sizeof(double) + 4);
     }
-    if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
-    MPI_GO(c, rc, MPI_Alltoall(tot, 2, MPI_INT, rtot, 2, MPI_INT, c->comm));
+    x->nr = q + 1;
+    x->tb[x->nr] = x->nloc;
+    for (int k = 0; k < 2 * K; k++) {
+        if (x->big[k] > INT_MAX) rc = HD_EOVERFLOW;
+        x->tot[k] = x->big[k] > INT_MAX ? INT_MAX : (int)x->big[k];
+    }
+    if (rc != HD_OK)
+        return hd__err(&c->e, HD_EOVERFLOW, "more than 2^31 - 1 points of a set to send from rank %d to one rank",
+                       c->rank);
+    size_t own = (size_t)x->tot[2 * me] + (size_t)x->tot[2 * me + 1];
+    x->sendcap = x->nloc - own < x->C ? x->nloc - own : x->C;
+    for (int r = 0; r < K; r++)
+        if (r != me) c->bytes_part += ((uint64_t)x->tot[2 * r] + (uint64_t)x->tot[2 * r + 1]) * (3 * sizeof(double) + 4);
+    return HD_OK;
+}
+
+/* From the totals received (rtot): where each sender's run lands (base),
+ * the local arrays, their indices' code, and the send buffer. */
+static int xch_local(hd__mpi_ctx_t *c, const hd__mpi_ranges_t *rg, xch_t *x, hd__mpi_local_t *loc) {
+    int K = x->K, rc = HD_OK;
     for (int s = 0; s < 2 && rc == HD_OK; s++) {
         size_t m = 0;
         for (int r = 0; r < K; r++) {
-            base[s * K + r] = m;
-            got[s * K + r] = 0;
-            m += (size_t)rtot[2 * r + s];
+            x->base[s * K + r] = m;
+            x->got[s * K + r] = 0;
+            m += (size_t)x->rtot[2 * r + s];
         }
         loc->n[s] = m;
         for (int k = 0; k < 3; k++) loc->box[s].lo[k] = INFINITY, loc->box[s].hi[k] = -INFINITY;
@@ -300,159 +335,186 @@ int hd__mpi_exchange(ctx_t *c, const input_t *in, const ranges_t *rg, const node
     }
     for (int s = 0; s < 2 && rc == HD_OK; s++) {
         loc->xyz[s] = hd__mpi_alloc(c, loc->n[s], 3 * sizeof(double));
-        off[s] = hd__mpi_scratch(c, loc->n[s], sizeof(uint32_t));
-        if (!loc->xyz[s] || !off[s]) rc = hd__mpi_nomem(c, "the local points", loc->n[s]);
+        x->off[s] = hd__mpi_scratch(c, loc->n[s], sizeof(uint32_t));
+        if (!loc->xyz[s] || !x->off[s]) rc = hd__mpi_nomem(c, "the local points", loc->n[s]);
         else rc = hd__mpi_gidx_init(c, &loc->gi[s], rg, s, loc->n[s]);
     }
     if (rc == HD_OK) {
-        sx = hd__mpi_scratch(c, sendcap, 3 * sizeof(double));
-        so = hd__mpi_scratch(c, sendcap, sizeof(uint32_t));
-        if (!sx || !so) rc = hd__mpi_nomem(c, "points to send", sendcap);
+        x->sx = hd__mpi_scratch(c, x->sendcap, 3 * sizeof(double));
+        x->so = hd__mpi_scratch(c, x->sendcap, sizeof(uint32_t));
+        if (!x->sx || !x->so) rc = hd__mpi_nomem(c, "points to send", x->sendcap);
     }
-    if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
-    uint64_t mine = nr, rounds = 0;
-    MPI_GO(c, rc, MPI_Allreduce(&mine, &rounds, 1, MPI_UINT64_T, MPI_MAX, c->comm));
-    walk_t at = {0, 0, 0, {0, 0}};
+    return rc;
+}
+
+/* Round `round`'s positions packed into the send buffer, a part's run at a
+ * time, and this rank's own points into their slots (from ownat[s] on);
+ * their numbers encoded and their box taken while in the cache (as if the
+ * runs were in index order, else encoded again by xch_order). */
+static void xch_pack(const hd__mpi_input_t *in, const hd__mpi_ranges_t *rg, xch_t *x, hd__mpi_local_t *loc,
+                     uint64_t round, walk_t *at, size_t ownat[2]) {
+    int K = x->K, me = x->me;
+    if (round < x->nr) memcpy(x->per, x->rcnt + round * 2 * (size_t)K, 2 * (size_t)K * sizeof(int));
+    else memset(x->per, 0, 2 * (size_t)K * sizeof(int));
+    int pos = 0; /* the send buffer: A's blocks by rank, then B's */
+    for (int s = 0; s < 2; s++)
+        for (int r = 0; r < K; r++) {
+            x->sdisp[2 * r + s] = x->sfill[2 * r + s] = pos;
+            pos += x->per[2 * r + s];
+        }
     /* Destinations that change at more than a quarter of the points are
-     * packed without a branch on them (pack_run): at K = 2 a branch
-     * mispredicted at random costs more than the tables' 20 instructions
-     * a point; packed so, an input in tiles paid 1.8 ns a point for them
-     * (alternated runs, docs/benchmarks.md), and pays 1.6 for the first
-     * pass's counting now. */
-    int scattered = switches > nloc / 4;
-    size_t ownat[2] = {base[me], base[K + me]};
+     * packed without a branch on them (pack_run): a branch mispredicted at
+     * random costs more than the tables' few instructions a point, and an
+     * input in space's order (tiles) keeps the branch, which is predicted
+     * (mpi_bench times both orders; the figures are in docs/scale-out.md). */
+    int scattered = x->switches > x->nloc / 4;
+    size_t own0[2] = {ownat[0], ownat[1]};
+    for (size_t t = round < x->nr ? x->tb[round] : x->nloc, t1 = round < x->nr ? x->tb[round + 1] : x->nloc; t < t1;) {
+        size_t avail = walk_avail(in, x->order, at), m = t1 - t < avail ? t1 - t : avail;
+        assert(avail > 0);
+        int s = at->s;
+        const hd_points_t *v = &x->order[s][at->p]->points;
+        const double *px = hd__mpi_packed(v);
+        uint32_t num = (uint32_t)at->num[s];
+        if (scattered)
+            pack_run(v, px, at->k, m, x->dest, x->w, t, me, s, num, loc->xyz[s], x->off[s], &ownat[s], x->sx, x->so,
+                     x->sfill, 1);
+        else
+            pack_run(v, px, at->k, m, x->dest, x->w, t, me, s, num, loc->xyz[s], x->off[s], &ownat[s], x->sx, x->so,
+                     x->sfill, 0);
+        t += m;
+        at->k += m;
+        at->num[s] += m;
+    }
+    for (int s = 0; s < 2; s++) {
+        hd__mpi_gidx_put_numbers(&loc->gi[s], rg, me, own0[s], x->off[s] + own0[s], ownat[s] - own0[s]);
+        box_run(&loc->box[s], loc->xyz[s] + 3 * own0[s], ownat[s] - own0[s]);
+    }
+}
+
+/* Every round (as many as the rank with the most): pack, then each side's
+ * blocks to their ranks, received straight into the local arrays, whose
+ * numbers are encoded and box taken as they land (collective). */
+static int xch_rounds(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const hd__mpi_ranges_t *rg, xch_t *x,
+                      hd__mpi_local_t *loc) {
+    int K = x->K, me = x->me;
+    uint64_t mine = x->nr, rounds = 0;
+    HD__MPI_TRY(c, MPI_Allreduce(&mine, &rounds, 1, MPI_UINT64_T, MPI_MAX, c->comm));
+    walk_t at = {0, 0, 0, {0, 0}};
+    size_t ownat[2] = {x->base[me], x->base[K + me]};
     for (uint64_t round = 0; round < rounds; round++) {
-        if (round < nr) memcpy(per, rcnt + round * 2 * (size_t)K, 2 * (size_t)K * sizeof(int));
-        else memset(per, 0, 2 * (size_t)K * sizeof(int));
-        int pos = 0; /* the send buffer: A's blocks by rank, then B's */
-        for (int s = 0; s < 2; s++)
-            for (int r = 0; r < K; r++) {
-                sdisp[2 * r + s] = sfill[2 * r + s] = pos;
-                pos += per[2 * r + s];
-            }
-        size_t own0[2] = {ownat[0], ownat[1]};
-        /* Pack the round's positions, a part's run at a time. */
-        for (size_t t = round < nr ? tb[round] : nloc, t1 = round < nr ? tb[round + 1] : nloc; t < t1;) {
-            size_t avail = walk_avail(in, order, &at), m = t1 - t < avail ? t1 - t : avail;
-            assert(avail > 0);
-            int s = at.s;
-            const hd_points_t *v = &order[s][at.p]->points;
-            const double *px = hd__mpi_packed(v);
-            uint32_t num = (uint32_t)at.num[s];
-            if (scattered)
-                pack_run(v, px, at.k, m, dest, w, t, me, s, num, loc->xyz[s], off[s], &ownat[s], sx, so, sfill, 1);
-            else
-                pack_run(v, px, at.k, m, dest, w, t, me, s, num, loc->xyz[s], off[s], &ownat[s], sx, so, sfill, 0);
-            t += m;
-            at.k += m;
-            at.num[s] += m;
-        }
-        /* The numbers are encoded, and the points' box taken, while in the
-         * cache: the numbers as if the runs were in index order (else
-         * encoded again below). */
-        for (int s = 0; s < 2; s++) {
-            hd__mpi_gidx_put_numbers(&loc->gi[s], rg, me, own0[s], off[s] + own0[s], ownat[s] - own0[s]);
-            box_run(&loc->box[s], loc->xyz[s] + 3 * own0[s], ownat[s] - own0[s]);
-        }
-        MPI_GO(c, rc, MPI_Alltoall(per, 2, MPI_INT, rper, 2, MPI_INT, c->comm));
+        xch_pack(in, rg, x, loc, round, &at, ownat);
+        HD__MPI_TRY(c, MPI_Alltoall(x->per, 2, MPI_INT, x->rper, 2, MPI_INT, c->comm));
         for (int s = 0; s < 2; s++) {
             for (int r = 0; r < K; r++) {
-                sc[r] = per[2 * r + s];
-                sd[r] = sdisp[2 * r + s];
-                rcn[r] = rper[2 * r + s];
-                rd[r] = (int)(base[s * K + r] + got[s * K + r]);
-                got[s * K + r] += (size_t)rcn[r];
+                x->sc[r] = x->per[2 * r + s];
+                x->sd[r] = x->sdisp[2 * r + s];
+                x->rcn[r] = x->rper[2 * r + s];
+                x->rd[r] = (int)(x->base[s * K + r] + x->got[s * K + r]);
+                x->got[s * K + r] += (size_t)x->rcn[r];
             }
-            MPI_GO(c, rc, MPI_Alltoallv(sx, sc, sd, c->q_type, loc->xyz[s], rcn, rd, c->q_type, c->comm));
-            MPI_GO(c, rc, MPI_Alltoallv(so, sc, sd, MPI_UINT32_T, off[s], rcn, rd, MPI_UINT32_T, c->comm));
+            HD__MPI_TRY(c, MPI_Alltoallv(x->sx, x->sc, x->sd, c->q_type, loc->xyz[s], x->rcn, x->rd, c->q_type, c->comm));
+            HD__MPI_TRY(c, MPI_Alltoallv(x->so, x->sc, x->sd, MPI_UINT32_T, x->off[s], x->rcn, x->rd, MPI_UINT32_T,
+                                         c->comm));
             for (int r = 0; r < K; r++)
                 if (r != me) {
-                    hd__mpi_gidx_put_numbers(&loc->gi[s], rg, r, (size_t)rd[r], off[s] + rd[r], (size_t)rcn[r]);
-                    box_run(&loc->box[s], loc->xyz[s] + 3 * (size_t)rd[r], (size_t)rcn[r]);
+                    hd__mpi_gidx_put_numbers(&loc->gi[s], rg, r, (size_t)x->rd[r], x->off[s] + x->rd[r],
+                                             (size_t)x->rcn[r]);
+                    box_run(&loc->box[s], loc->xyz[s] + 3 * (size_t)x->rd[r], (size_t)x->rcn[r]);
                 }
         }
     }
-    hd__mpi_free_scratch(c, sx, sendcap, 3 * sizeof(double));
-    hd__mpi_free_scratch(c, so, sendcap, sizeof(uint32_t));
-    hd__mpi_free_scratch(c, dest, nloc, (size_t)w);
-    sx = NULL, so = NULL, dest = NULL;
-    assert(ownat[0] == base[me] + (size_t)rtot[2 * me] && ownat[1] == base[K + me] + (size_t)rtot[2 * me + 1]);
-    /* The runs in index order as received (each rank's parts above the
-     * previous rank's): the numbers were encoded as received, and are
-     * freed.  Else the numbers become indices (8 bytes), the runs are
-     * merged into index order, and the indices are encoded afresh. */
-    for (int s = 0; s < 2 && rc == HD_OK; s++) {
-        loc->start[s] = hd__mpi_alloc(c, (size_t)K + 1, sizeof(size_t));
-        if (!loc->start[s]) {
-            rc = hd__mpi_nomem(c, "the local indices", (size_t)K);
-            break;
+    assert(ownat[0] == x->base[me] + (size_t)x->rtot[2 * me] &&
+           ownat[1] == x->base[K + me] + (size_t)x->rtot[2 * me + 1]);
+    return HD_OK;
+}
+
+/* Side s's runs put in index order: when they arrived so (each rank's
+ * parts above the previous rank's), the numbers were encoded as received
+ * and are freed; else they become indices (8 bytes), the runs are merged
+ * into index order, and the indices are encoded afresh. */
+static int xch_order(hd__mpi_ctx_t *c, const hd__mpi_ranges_t *rg, xch_t *x, hd__mpi_local_t *loc, int s) {
+    int K = x->K;
+    size_t n = loc->n[s];
+    loc->start[s] = hd__mpi_alloc(c, (size_t)K + 1, sizeof(size_t));
+    if (!loc->start[s]) return hd__mpi_nomem(c, "the local indices", (size_t)K);
+    int sorted = 1;
+    uint64_t last = 0;
+    for (int r = 0; r < K; r++) {
+        size_t lo = x->base[s * K + r], hi = lo + (size_t)x->rtot[2 * r + s];
+        loc->start[s][r] = lo;
+        if (hi > lo) {
+            if (lo > 0 && hd__mpi_ranges_global(rg, s, r, x->off[s][lo]) < last) sorted = 0;
+            last = hd__mpi_ranges_global(rg, s, r, x->off[s][hi - 1]);
         }
-        int sorted = 1;
-        uint64_t last = 0;
-        for (int r = 0; r < K; r++) {
-            size_t lo = base[s * K + r], hi = lo + (size_t)rtot[2 * r + s];
-            loc->start[s][r] = lo;
-            if (hi > lo) {
-                if (lo > 0 && hd__mpi_ranges_global(rg, s, r, off[s][lo]) < last) sorted = 0;
-                last = hd__mpi_ranges_global(rg, s, r, off[s][hi - 1]);
-            }
-        }
-        loc->start[s][K] = loc->n[s];
-        if (sorted) {
-            hd__mpi_free_scratch(c, off[s], loc->n[s], sizeof(uint32_t));
-            off[s] = NULL;
-            continue;
-        }
+    }
+    loc->start[s][K] = n;
+    if (!sorted) {
         loc->merged[s] = 1;
-        g = hd__mpi_alloc(c, loc->n[s], sizeof(uint64_t));
-        if (!g) {
-            rc = hd__mpi_nomem(c, "the local indices", loc->n[s]);
-            break;
-        }
-        gn = loc->n[s];
+        uint64_t *g = hd__mpi_alloc(c, n, sizeof(uint64_t));
+        if (!g) return hd__mpi_nomem(c, "the local indices", n);
         for (int r = 0; r < K; r++) {
-            size_t lo = base[s * K + r], hi = lo + (size_t)rtot[2 * r + s],
+            size_t lo = x->base[s * K + r], hi = lo + (size_t)x->rtot[2 * r + s],
                    i = rg->seg[(size_t)s * ((size_t)K + 1) + (size_t)r];
-            hd__mpi_ranges_globals(rg, s, r, &i, off[s] + lo, hi - lo, g + lo);
+            hd__mpi_ranges_globals(rg, s, r, &i, x->off[s] + lo, hi - lo, g + lo);
         }
-        hd__mpi_free_scratch(c, off[s], loc->n[s], sizeof(uint32_t));
-        off[s] = NULL;
-        permn = loc->n[s];
-        perm = hd__mpi_alloc(c, permn, sizeof(uint32_t));
-        runs = hd__mpi_alloc(c, (size_t)K, sizeof(run_t));
-        heap = hd__mpi_alloc(c, (size_t)K, sizeof(int));
-        if (!perm || !runs || !heap) {
-            rc = hd__mpi_nomem(c, "the merge", loc->n[s]);
-            break;
+        hd__mpi_free_scratch(c, x->off[s], n, sizeof(uint32_t));
+        x->off[s] = NULL;
+        uint32_t *perm = hd__mpi_alloc(c, n, sizeof(uint32_t));
+        run_t *runs = hd__mpi_alloc(c, (size_t)K, sizeof(run_t));
+        int *heap = hd__mpi_alloc(c, (size_t)K, sizeof(int));
+        int rc = perm && runs && heap ? HD_OK : hd__mpi_nomem(c, "the merge", n);
+        if (rc == HD_OK) {
+            for (int r = 0; r < K; r++)
+                runs[r] = (run_t){x->base[s * K + r], x->base[s * K + r] + (size_t)x->rtot[2 * r + s]};
+            merge_order(g, runs, K, heap, perm);
+            permute(loc->xyz[s], g, perm, n);
         }
-        for (int r = 0; r < K; r++) runs[r] = (run_t){base[s * K + r], base[s * K + r] + (size_t)rtot[2 * r + s]};
-        merge_order(g, runs, K, heap, perm);
-        permute(loc->xyz[s], g, perm, loc->n[s]);
-        hd__mpi_free(c, perm, permn, sizeof(uint32_t));
+        hd__mpi_free(c, perm, n, sizeof(uint32_t));
         hd__mpi_free(c, runs, (size_t)K, sizeof(run_t));
         hd__mpi_free(c, heap, (size_t)K, sizeof(int));
-        perm = NULL, runs = NULL, heap = NULL;
-        hd__mpi_gidx_clear(&loc->gi[s]);
-        hd__mpi_gidx_put_indices(&loc->gi[s], 0, g, loc->n[s]);
-        hd__mpi_free(c, g, gn, sizeof(uint64_t));
-        g = NULL;
+        if (rc == HD_OK) {
+            hd__mpi_gidx_clear(&loc->gi[s]);
+            hd__mpi_gidx_put_indices(&loc->gi[s], 0, g, n);
+        }
+        hd__mpi_free(c, g, n, sizeof(uint64_t));
+        return rc;
     }
+    hd__mpi_free_scratch(c, x->off[s], n, sizeof(uint32_t));
+    x->off[s] = NULL;
+    return HD_OK;
+}
+
+/* Move every point to the rank of its region.  Each point goes as its
+ * coordinates and a 4-byte number: its rank among the sender's points of
+ * its set in index order (hd__mpi_ranges_t turns it back into the global index).
+ * Each source's run is received straight into its slot of the local
+ * arrays, in rounds of at most an eighth of the sender's points, so no
+ * copy of all the points is ever held twice; a rank's own points are
+ * copied from the input into their slot.  Runs are in index order, since
+ * senders walk their parts in offset order; when the runs follow each
+ * other in index order too (each rank's parts lie above the previous
+ * rank's) the local arrays are in global order as received (loc->start:
+ * each sender's run), else the numbers become indices and the arrays are
+ * merged in place (a permutation from a K-way merge, 4 bytes a point;
+ * loc->merged).  Either way loc->gi holds the indices encoded.  The
+ * phases: the plan (a first pass), the totals, the local arrays, the
+ * rounds, the order; every rank agrees on a status before each
+ * collective. */
+int hd__mpi_exchange(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const hd__mpi_ranges_t *rg,
+                     const hd__mpi_node_t *tree, hd__mpi_local_t *loc) {
+    xch_t x;
+    int rc = xch_alloc(c, in, &x);
+    if (rc == HD_OK) rc = xch_plan(c, in, tree, &x);
+    if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
+    HD__MPI_GO(c, rc, MPI_Alltoall(x.tot, 2, MPI_INT, x.rtot, 2, MPI_INT, c->comm));
+    rc = xch_local(c, rg, &x, loc);
+    if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
+    if ((rc = xch_rounds(c, in, rg, &x, loc)) != HD_OK) goto done;
+    xch_free_sends(c, &x);
+    for (int s = 0; s < 2 && rc == HD_OK; s++) rc = xch_order(c, rg, &x, loc, s);
     rc = hd__mpi_agree(c, rc);
 done:
-    hd__mpi_free(c, tb, maxr + 1, sizeof(size_t));
-    hd__mpi_free(c, rcnt, maxr * 2 * (size_t)K, sizeof(int));
-    hd__mpi_free(c, cnt, 16 * (size_t)K, sizeof(int));
-    hd__mpi_free(c, base, 6 * (size_t)K, sizeof(size_t));
-    hd__mpi_free_scratch(c, dest, nloc, (size_t)w);
-    for (int s = 0; s < 2; s++) {
-        hd__mpi_free(c, order[s], in->nparts[s], sizeof *order[s]);
-        hd__mpi_free_scratch(c, off[s], loc->n[s], sizeof(uint32_t));
-    }
-    hd__mpi_free_scratch(c, sx, sendcap, 3 * sizeof(double));
-    hd__mpi_free_scratch(c, so, sendcap, sizeof(uint32_t));
-    hd__mpi_free(c, perm, permn, sizeof(uint32_t));
-    hd__mpi_free(c, runs, (size_t)K, sizeof(run_t));
-    hd__mpi_free(c, heap, (size_t)K, sizeof(int));
-    hd__mpi_free(c, g, gn, sizeof(uint64_t));
+    xch_free(c, in, &x, loc);
     return rc;
 }

@@ -24,12 +24,15 @@
  *  - One round of forwarding a direction: every bound is final before
  *    anything is sent.  Every collective is preceded by hd__mpi_agree.
  */
-#include "mpi_int.h"
+#include "mpi/search.h"
 
 #include <limits.h>
 #include <stdlib.h>
 
-static int pack_queries(ctx_t *c, const double *P, const uint32_t *pos, const pair_t *pairs, size_t np,
+/* A forwarded query: point k of the asking set to rank dest. */
+typedef struct hd__mpi_pair { size_t k; int dest; int pad; } hd__mpi_pair_t;
+
+static int pack_queries(hd__mpi_ctx_t *c, const double *P, const uint32_t *pos, const hd__mpi_pair_t *pairs, size_t np,
                         int *scount, int *sdispl, double **send, size_t **order) {
     for (int r = 0; r < c->K; r++) scount[r] = 0;
     for (size_t t = 0; t < np; t++) scount[pairs[t].dest]++;
@@ -54,39 +57,39 @@ static int pack_queries(ctx_t *c, const double *P, const uint32_t *pos, const pa
     return HD_OK;
 }
 
-void hd__mpi_pairs_free(ctx_t *c, pairs_t *pr) {
-    hd__mpi_free(c, pr->p, pr->cap, sizeof(pair_t));
+void hd__mpi_pairs_free(hd__mpi_ctx_t *c, hd__mpi_pairs_t *pr) {
+    hd__mpi_free(c, pr->p, pr->cap, sizeof(hd__mpi_pair_t));
     memset(pr, 0, sizeof *pr);
 }
 
-int hd__mpi_pairs_add(ctx_t *c, pairs_t *pr, size_t k, const int *list, int n) {
+int hd__mpi_pairs_add(hd__mpi_ctx_t *c, hd__mpi_pairs_t *pr, size_t k, const int *list, int n) {
     if (pr->n + (size_t)n > pr->cap) {
         size_t ncap = pr->cap ? 2 * pr->cap : 1024;
         while (ncap < pr->n + (size_t)n) ncap *= 2;
-        pair_t *grown = hd__mpi_alloc(c, ncap, sizeof(pair_t));
+        hd__mpi_pair_t *grown = hd__mpi_alloc(c, ncap, sizeof(hd__mpi_pair_t));
         if (!grown) return hd__mpi_nomem(c, "forwarded queries", ncap);
-        if (pr->n) memcpy(grown, pr->p, pr->n * sizeof(pair_t));
-        hd__mpi_free(c, pr->p, pr->cap, sizeof(pair_t));
+        if (pr->n) memcpy(grown, pr->p, pr->n * sizeof(hd__mpi_pair_t));
+        hd__mpi_free(c, pr->p, pr->cap, sizeof(hd__mpi_pair_t));
         pr->p = grown;
         pr->cap = ncap;
     }
-    for (int t = 0; t < n; t++) pr->p[pr->n++] = (pair_t){k, list[t], 0};
+    for (int t = 0; t < n; t++) pr->p[pr->n++] = (hd__mpi_pair_t){k, list[t], 0};
     return HD_OK;
 }
 
-int hd__mpi_round(ctx_t *c, int rc, const double *P, const uint32_t *pos, const pairs_t *pr,
+int hd__mpi_round(hd__mpi_ctx_t *c, int rc, const double *P, const uint32_t *pos, const hd__mpi_pairs_t *pr,
                   hd__mpi_answer_t fn, void *arg, double *u2, uint64_t *jj) {
     int K = c->K;
     size_t np = pr->n, m = 0, *order = NULL;
     int *cnt = hd__mpi_alloc(c, 4 * (size_t)K, sizeof(int)); /* scount sdispl rcount rdispl */
     double *sendq = NULL, *recvq = NULL;
-    ans_t *ans = NULL, *back = NULL;
+    hd__mpi_ans_t *ans = NULL, *back = NULL;
     if (rc == HD_OK && !cnt) rc = hd__mpi_nomem(c, "forwarded queries", np);
     int *scount = cnt, *sdispl = cnt + K, *rcount = cnt + 2 * K, *rdispl = cnt + 3 * K;
     if (rc == HD_OK && np > INT_MAX) rc = hd__err(&c->e, HD_EOVERFLOW, "%zu forwarded queries exceed MPI's int counts", np);
     if (rc == HD_OK) rc = pack_queries(c, P, pos, pr->p, np, scount, sdispl, &sendq, &order);
     if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
-    MPI_GO(c, rc, MPI_Alltoall(scount, 1, MPI_INT, rcount, 1, MPI_INT, c->comm));
+    HD__MPI_GO(c, rc, MPI_Alltoall(scount, 1, MPI_INT, rcount, 1, MPI_INT, c->comm));
     for (int r = 0; r < K; r++) {
         if (m > INT_MAX) break;
         rdispl[r] = (int)m;
@@ -95,22 +98,22 @@ int hd__mpi_round(ctx_t *c, int rc, const double *P, const uint32_t *pos, const 
     if (m > INT_MAX) rc = hd__err(&c->e, HD_EOVERFLOW, "%zu queries received exceed MPI's int counts", m);
     if (rc == HD_OK) {
         recvq = hd__mpi_alloc(c, m, 3 * sizeof(double));
-        ans = hd__mpi_alloc(c, m, sizeof(ans_t));
-        back = hd__mpi_alloc(c, np, sizeof(ans_t));
+        ans = hd__mpi_alloc(c, m, sizeof(hd__mpi_ans_t));
+        back = hd__mpi_alloc(c, np, sizeof(hd__mpi_ans_t));
         if (!recvq || !ans || !back) rc = hd__mpi_nomem(c, "forwarded queries", m);
     }
     if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
-    MPI_GO(c, rc, MPI_Alltoallv(sendq, scount, sdispl, c->q_type, recvq, rcount, rdispl, c->q_type, c->comm));
+    HD__MPI_GO(c, rc, MPI_Alltoallv(sendq, scount, sdispl, c->q_type, recvq, rcount, rdispl, c->q_type, c->comm));
     double t = hd__now(), u = hd__mpi_cpu();
     rc = fn(c, arg, recvq, m, ans);
     c->search += hd__now() - t;
     c->search_cpu += hd__mpi_cpu() - u;
     c->answered += m;
     if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
-    MPI_GO(c, rc, MPI_Alltoallv(ans, rcount, rdispl, c->ans_type, back, scount, sdispl, c->ans_type, c->comm));
+    HD__MPI_GO(c, rc, MPI_Alltoallv(ans, rcount, rdispl, c->ans_type, back, scount, sdispl, c->ans_type, c->comm));
     c->rounds++;
     c->forwarded += np;
-    c->bytes_fwd += (uint64_t)np * (3 * sizeof(double) + sizeof(ans_t));
+    c->bytes_fwd += (uint64_t)np * (3 * sizeof(double) + sizeof(hd__mpi_ans_t));
     for (size_t t = 0; t < np; t++) {
         size_t k = order[t];
         if (back[t].d2 < u2[k] || (back[t].d2 == u2[k] && back[t].g < jj[k])) {
@@ -123,34 +126,34 @@ done:
     hd__mpi_free(c, sendq, np, 3 * sizeof(double));
     hd__mpi_free(c, order, np, sizeof(size_t));
     hd__mpi_free(c, recvq, m, 3 * sizeof(double));
-    hd__mpi_free(c, ans, m, sizeof(ans_t));
-    hd__mpi_free(c, back, np, sizeof(ans_t));
+    hd__mpi_free(c, ans, m, sizeof(hd__mpi_ans_t));
+    hd__mpi_free(c, back, np, sizeof(hd__mpi_ans_t));
     return rc;
 }
 
 /* Answer m queries against the local Q: exact nearest, smallest index. */
 typedef struct {
-    const dir_t *d;
+    const hd__mpi_dir_t *d;
     const hd__box_t *mine;
-    qtree_t *q;
+    hd__mpi_qtree_t *q;
 } answer_t;
 
-static int answer(ctx_t *c, void *arg, const double *pts, size_t m, ans_t *ans) {
+static int answer(hd__mpi_ctx_t *c, void *arg, const double *pts, size_t m, hd__mpi_ans_t *ans) {
     const answer_t *a = arg;
-    const dir_t *d = a->d;
+    const hd__mpi_dir_t *d = a->d;
     if (m == 0) return HD_OK;
     if (d->nQ == 0) {
-        for (size_t k = 0; k < m; k++) ans[k] = (ans_t){INFINITY, UINT64_MAX};
+        for (size_t k = 0; k < m; k++) ans[k] = (hd__mpi_ans_t){INFINITY, UINT64_MAX};
         return HD_OK;
     }
     size_t *near = hd__mpi_alloc(c, m, sizeof(size_t));
     if (!near) return hd__mpi_nomem(c, "answers", m);
     int rc = hd__mpi_nearest_in_q(c, d, a->mine, a->q, pts, NULL, m, near, NULL);
-    gcur_t cq;
+    hd__mpi_gcur_t cq;
     hd__mpi_gcur_init(&cq, d->gQ);
     if (rc == HD_OK)
         for (size_t k = 0; k < m; k++)
-            ans[k] = (ans_t){hd__d2(pts + 3 * k, d->Q + 3 * near[k]), hd__mpi_gcur_at(&cq, near[k])};
+            ans[k] = (hd__mpi_ans_t){hd__d2(pts + 3 * k, d->Q + 3 * near[k]), hd__mpi_gcur_at(&cq, near[k])};
     hd__mpi_free(c, near, m, sizeof(size_t));
     return rc;
 }
@@ -158,7 +161,7 @@ static int answer(ctx_t *c, void *arg, const double *pts, size_t m, ans_t *ans) 
 /* Whether the shell's point k, at u2, is below (L, i_L) in the witness
  * order, so that it cannot be the witness (cu: a cursor on P's indices,
  * asked in increasing k). */
-static int loses(gcur_t *cu, const shell_t *sh, size_t k, double u2, double L, uint64_t iL) {
+static int loses(hd__mpi_gcur_t *cu, const hd__mpi_shell_t *sh, size_t k, double u2, double L, uint64_t iL) {
     return u2 < L || (u2 == L && hd__mpi_shell_g(cu, sh, k) > iL);
 }
 
@@ -170,9 +173,9 @@ static int loses(gcur_t *cu, const shell_t *sh, size_t k, double u2, double L, u
  * of Q (hd__mpi_nearest_in_q again), and the smaller answer is kept (d2
  * first, then the index).  The flags of the points settled without a
  * search are cleared on the way. */
-static int resolve(ctx_t *c, const dir_t *d, const hd__box_t *mine, qtree_t *q, const shell_t *sh, double *u2,
+static int resolve(hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, const hd__box_t *mine, hd__mpi_qtree_t *q, const hd__mpi_shell_t *sh, double *u2,
                    uint64_t *jj, double L, uint64_t iL) {
-    gcur_t cp;
+    hd__mpi_gcur_t cp;
     size_t m = 0;
     hd__mpi_gcur_init(&cp, d->gP);
     for (size_t k = 0; k < sh->n; k++) {
@@ -204,12 +207,12 @@ static int resolve(ctx_t *c, const dir_t *d, const hd__box_t *mine, qtree_t *q, 
     return rc;
 }
 
-int hd__mpi_direction(ctx_t *c, const dir_t *d, const node_t *tree, const hd__box_t *region,
-                     const held_t *held, far_t *result) {
+int hd__mpi_direction(hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, const hd__mpi_node_t *tree, const hd__box_t *region,
+                     const hd__mpi_held_t *held, hd__mpi_far_t *result) {
     int K = c->K, rc = HD_OK;
     const hd__box_t *mine = &region[c->rank];
-    shell_t sh;
-    qtree_t q;
+    hd__mpi_shell_t sh;
+    hd__mpi_qtree_t q;
     memset(&q, 0, sizeof q);
     double t0 = hd__now(), u0 = hd__mpi_cpu();
     rc = hd__mpi_shell_of(c, d, mine, &q, &sh);
@@ -222,10 +225,10 @@ int hd__mpi_direction(ctx_t *c, const dir_t *d, const node_t *tree, const hd__bo
     unsigned char *exact = hd__mpi_alloc(c, nP, 1);
     hd__box_t *nbox = hd__mpi_alloc(c, K > 1 ? (size_t)K - 1 : 1, sizeof(hd__box_t));
     int *list = hd__mpi_alloc(c, (size_t)K, sizeof(int));
-    pairs_t pr = {NULL, 0, 0};
+    hd__mpi_pairs_t pr = {NULL, 0, 0};
     if (rc == HD_OK && (!u2 || !jj || !exact || !nbox || !list)) rc = hd__mpi_nomem(c, "per-point bounds", nP);
-    far_t Lmine = sh.inner, Lall;
-    gcur_t cp, cq; /* P's indices (the shell's, in order) and Q's */
+    hd__mpi_far_t Lmine = sh.inner, Lall;
+    hd__mpi_gcur_t cp, cq; /* P's indices (the shell's, in order) and Q's */
     if (rc == HD_OK) {
         hd__mpi_gcur_init(&cp, d->gP);
         hd__mpi_gcur_init(&cq, d->gQ);
@@ -241,7 +244,7 @@ int hd__mpi_direction(ctx_t *c, const dir_t *d, const node_t *tree, const hd__bo
             jj[k] = hd__mpi_gcur_at(&cq, sh.nearest[k]);
             /* an answer the first slab did not prove is not exact yet (resolve) */
             exact[k] = (unsigned char)(!(sh.unproven && sh.unproven[k]) && hd__mpi_faces_clear(mine, p, u2[k]));
-            far_t f = {u2[k], hd__mpi_shell_g(&cp, &sh, k), jj[k]};
+            hd__mpi_far_t f = {u2[k], hd__mpi_shell_g(&cp, &sh, k), jj[k]};
             if (exact[k] && hd__mpi_far_better(&f, &Lmine)) Lmine = f;
         }
         if (K > 1) hd__mpi_node_boxes(tree, 0, held, d->qside, nbox);
@@ -265,7 +268,7 @@ int hd__mpi_direction(ctx_t *c, const dir_t *d, const node_t *tree, const hd__bo
     if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
     /* L and the smallest index i_L of a confirmed point at L: a point
      * with u2 < L, or u2 = L and a larger index, cannot be the witness. */
-    MPI_GO(c, rc, MPI_Allreduce(&Lmine, &Lall, 1, c->far_type, c->far_op, c->comm));
+    HD__MPI_GO(c, rc, MPI_Allreduce(&Lmine, &Lall, 1, c->far_type, c->far_op, c->comm));
     double L = Lall.d2;
     uint64_t iL = Lall.i;
     /* The points to forward, as (point, rank) pairs. */
@@ -287,11 +290,11 @@ int hd__mpi_direction(ctx_t *c, const dir_t *d, const node_t *tree, const hd__bo
     if (nP && d->nQ) rc = resolve(c, d, mine, &q, &sh, u2, jj, L, iL);
     /* Every point that could win is now exact; the others cannot win (a
      * point at L with a larger index than i_L loses to i_L). */
-    far_t best = sh.inner;
+    hd__mpi_far_t best = sh.inner;
     hd__mpi_gcur_init(&cp, d->gP);
     for (size_t k = 0; k < nP; k++) {
         if (loses(&cp, &sh, k, u2[k], L, iL)) continue;
-        far_t f = {u2[k], hd__mpi_shell_g(&cp, &sh, k), jj[k]};
+        hd__mpi_far_t f = {u2[k], hd__mpi_shell_g(&cp, &sh, k), jj[k]};
         if (hd__mpi_far_better(&f, &best)) best = f;
     }
     /* The interior's maximum, when not known, is needed only where the
@@ -300,10 +303,10 @@ int hd__mpi_direction(ctx_t *c, const dir_t *d, const node_t *tree, const hd__bo
      * and a* is the smallest index at h2), so it cannot beat what (h2, a*)
      * does not. */
     DIRECTION_FREE();
-    far_t G;
-    MPI_GO(c, rc, MPI_Allreduce(&best, &G, 1, c->far_type, c->far_op, c->comm));
+    hd__mpi_far_t G;
+    HD__MPI_GO(c, rc, MPI_Allreduce(&best, &G, 1, c->far_type, c->far_op, c->comm));
     if (rc == HD_OK && sh.lazy && hd__mpi_far_better(&sh.h, &G)) {
-        far_t I = {-1.0, UINT64_MAX, UINT64_MAX};
+        hd__mpi_far_t I = {-1.0, UINT64_MAX, UINT64_MAX};
         double t1 = hd__now(), u1 = hd__mpi_cpu();
         rc = hd__mpi_interior_max(c, d, mine, &sh, sh.h.d2, &G, &I);
         c->search += hd__now() - t1;
@@ -312,7 +315,7 @@ int hd__mpi_direction(ctx_t *c, const dir_t *d, const node_t *tree, const hd__bo
         if (hd__mpi_far_better(&I, &best)) best = I;
     }
     if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
-    MPI_GO(c, rc, MPI_Allreduce(&best, result, 1, c->far_type, c->far_op, c->comm));
+    HD__MPI_GO(c, rc, MPI_Allreduce(&best, result, 1, c->far_type, c->far_op, c->comm));
 done:
     DIRECTION_FREE();
     hd__mpi_shell_free(c, &sh);

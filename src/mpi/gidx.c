@@ -1,11 +1,11 @@
 /*
  * gidx.c -- the global indices of a local set, Elias-Fano coded over the
- * side's dense ordinals (mpi_int.h's gidx_t), with random access and a
+ * side's dense ordinals (ranges.h's hd__mpi_gidx_t), with random access and a
  * sequential cursor.
  *
  * Invariants.
  *  - Ordinals.  The side's index runs over all ranks, by first index
- *    (ranges_t.bylo), with the number of indices below each (ranges_t.ord),
+ *    (hd__mpi_ranges_t.bylo), with the number of indices below each (hd__mpi_ranges_t.ord),
  *    map every global index g of the side to its ordinal, the number of the
  *    side's indices below g: ord[i] + (g - lo) for g in run i.  The map is
  *    strictly increasing, so a local set (in global index order, without
@@ -40,7 +40,7 @@
  *    one, the next, or else searched (binary).  So any order of positions
  *    is correct, and nondecreasing ones cost a few operations each.
  */
-#include "mpi_int.h"
+#include "mpi/ranges.h"
 
 #include <assert.h>
 
@@ -91,7 +91,7 @@ static inline uint64_t ones_from(const uint64_t *high, size_t *wi, uint64_t *w, 
 }
 
 /* The k-th 1 of high, through the sample before it. */
-static inline uint64_t select1(const gidx_t *x, size_t k, size_t *wi, uint64_t *w) {
+static inline uint64_t select1(const hd__mpi_gidx_t *x, size_t k, size_t *wi, uint64_t *w) {
     uint64_t at = x->samp[k >> 6];
     *wi = (size_t)(at >> 6);
     *w = x->high[*wi] & (~UINT64_C(0) << (at & 63));
@@ -99,7 +99,7 @@ static inline uint64_t select1(const gidx_t *x, size_t k, size_t *wi, uint64_t *
 }
 
 /* The run of ordinal o: the last whose first ordinal is <= o. */
-static size_t run_of(const gidx_t *x, uint64_t o) {
+static size_t run_of(const hd__mpi_gidx_t *x, uint64_t o) {
     size_t lo = 0, hi = x->nrun - 1;
     while (lo < hi) {
         size_t mid = lo + (hi - lo + 1) / 2;
@@ -109,7 +109,7 @@ static size_t run_of(const gidx_t *x, uint64_t o) {
     return lo;
 }
 
-int hd__mpi_gidx_init(ctx_t *c, gidx_t *x, const ranges_t *rg, int side, size_t n) {
+int hd__mpi_gidx_init(hd__mpi_ctx_t *c, hd__mpi_gidx_t *x, const hd__mpi_ranges_t *rg, int side, size_t n) {
     memset(x, 0, sizeof *x);
     size_t a = rg->seg[(size_t)side * ((size_t)rg->K + 1)], b = rg->seg[(size_t)side * ((size_t)rg->K + 1) + (size_t)rg->K];
     x->run = rg->bylo + a;
@@ -136,7 +136,7 @@ int hd__mpi_gidx_init(ctx_t *c, gidx_t *x, const ranges_t *rg, int side, size_t 
 }
 
 /* The run holding index g (one of the side's). */
-static size_t run_at(const gidx_t *x, uint64_t g) {
+static size_t run_at(const hd__mpi_gidx_t *x, uint64_t g) {
     size_t lo = 0, hi = x->nrun - 1;
     while (lo < hi) {
         size_t mid = lo + (hi - lo + 1) / 2;
@@ -158,7 +158,7 @@ typedef struct {
     uint64_t hacc;           /* and its bits so far */
 } seq_t;
 
-static void seq_begin(seq_t *q, gidx_t *x, size_t k) {
+static void seq_begin(seq_t *q, hd__mpi_gidx_t *x, size_t k) {
     q->low = x->w, q->high = x->w + (x->high - x->low), q->samp = x->w + (x->samp - x->low);
     q->l = x->l;
     q->lbit = (uint64_t)k * (uint64_t)x->l, q->lacc = 0;
@@ -190,7 +190,7 @@ static void seq_end(seq_t *q) {
     if (q->l && (q->lbit & 63)) q->low[q->lbit >> 6] |= q->lacc;
 }
 
-void hd__mpi_gidx_put_numbers(gidx_t *x, const ranges_t *rg, int r, size_t k, const uint32_t *num, size_t n) {
+void hd__mpi_gidx_put_numbers(hd__mpi_gidx_t *x, const hd__mpi_ranges_t *rg, int r, size_t k, const uint32_t *num, size_t n) {
     if (n == 0) return;
     seq_t q;
     seq_begin(&q, x, k);
@@ -209,7 +209,7 @@ void hd__mpi_gidx_put_numbers(gidx_t *x, const ranges_t *rg, int r, size_t k, co
     seq_end(&q);
 }
 
-void hd__mpi_gidx_put_indices(gidx_t *x, size_t k, const uint64_t *g, size_t n) {
+void hd__mpi_gidx_put_indices(hd__mpi_gidx_t *x, size_t k, const uint64_t *g, size_t n) {
     if (n == 0) return;
     seq_t q;
     seq_begin(&q, x, k);
@@ -222,17 +222,17 @@ void hd__mpi_gidx_put_indices(gidx_t *x, size_t k, const uint64_t *g, size_t n) 
     seq_end(&q);
 }
 
-void hd__mpi_gidx_clear(gidx_t *x) {
+void hd__mpi_gidx_clear(hd__mpi_gidx_t *x) {
     if (x->words) memset(x->w, 0, x->words * sizeof(uint64_t));
 }
 
-void hd__mpi_gidx_free(ctx_t *c, gidx_t *x) {
+void hd__mpi_gidx_free(hd__mpi_ctx_t *c, hd__mpi_gidx_t *x) {
     hd__mpi_free(c, x->w, x->words, sizeof(uint64_t));
     x->w = NULL;
     x->words = 0;
 }
 
-uint64_t hd__mpi_gidx(const gidx_t *x, size_t k) {
+uint64_t hd__mpi_gidx(const hd__mpi_gidx_t *x, size_t k) {
     assert(k < x->n);
     size_t wi;
     uint64_t w, o = ((select1(x, k, &wi, &w) - k) << x->l) | hd__mpi_gidx_low(x, k);
@@ -240,7 +240,7 @@ uint64_t hd__mpi_gidx(const gidx_t *x, size_t k) {
     return x->run[r].lo + (o - x->rord[r]);
 }
 
-void hd__mpi_gidx_decode(const gidx_t *x, size_t k, size_t m, uint64_t *g) {
+void hd__mpi_gidx_decode(const hd__mpi_gidx_t *x, size_t k, size_t m, uint64_t *g) {
     if (m == 0) return;
     assert(k + m <= x->n);
     size_t wi, r = SIZE_MAX;
@@ -257,7 +257,7 @@ void hd__mpi_gidx_decode(const gidx_t *x, size_t k, size_t m, uint64_t *g) {
     }
 }
 
-void hd__mpi_gcur_init(gcur_t *cu, const gidx_t *x) {
+void hd__mpi_gcur_init(hd__mpi_gcur_t *cu, const hd__mpi_gidx_t *x) {
     memset(cu, 0, sizeof *cu);
     cu->x = x;
     cu->k = SIZE_MAX;
@@ -268,8 +268,8 @@ void hd__mpi_gcur_init(gcur_t *cu, const gidx_t *x) {
  * or two at the densest: about what a select from the sample costs). */
 #define GCUR_STEP 48
 
-uint64_t hd__mpi_gcur_next(gcur_t *cu, size_t k) {
-    const gidx_t *x = cu->x;
+uint64_t hd__mpi_gcur_next(hd__mpi_gcur_t *cu, size_t k) {
+    const hd__mpi_gidx_t *x = cu->x;
     assert(k < x->n);
     if (k == cu->k) return cu->g;
     uint64_t at;

@@ -12,7 +12,10 @@
  * types), ranges.c the validation and the index runs, rcb.c the partition
  * (step 1), exchange.c the exchange (2), shell.c the engine's pass (3),
  * slab.c the per-point searches, forward.c the forwarding and reduction
- * (4 to 6); mpi_int.h what they share.  Each opens with its invariants.
+ * (4 to 6); gidx.c the local sets' indices, distances.c and analysis.c
+ * the per-point distances and their figures.  What they share is in
+ * private headers by concern: context.h, ranges.h, partition.h,
+ * search.h and course.h.  Each file opens with its invariants.
  *
  * The algorithm, for h(A,B) (the symmetric distance runs it both ways on one
  * partition):
@@ -47,7 +50,7 @@
  *     become 8-byte indices and the arrays are merged in place (a
  *     permutation, 4 bytes a point): local order is global index order,
  *     and a local "smallest index on ties" is the global one.  The indices
- *     are then held Elias-Fano coded over the set's dense ordinals (gidx_t:
+ *     are then held Elias-Fano coded over the set's dense ordinals (hd__mpi_gidx_t:
  *     3 + log2(N_side / n) bits a point or so, under 1 byte at K <= 16;
  *     the numbers and indices are freed), so a point costs 24 bytes and a
  *     fraction through the engine's pass, and an index is decoded where
@@ -126,7 +129,8 @@
  * failing rank, then its code and message broadcast), so every rank returns
  * the same code and message and none waits for a rank that gave up.
  */
-#include "mpi_int.h"
+#include "mpi/course.h"
+#include "mpi/search.h"
 
 #include <assert.h>
 #include <stdlib.h>
@@ -137,7 +141,7 @@
  * parts are packed into one array in index order (24 bytes a point).  Its
  * local indices become global ones (ranges_global): local order is index
  * order, so a smallest index on ties is the global one. */
-int hd__mpi_views(ctx_t *c, const input_t *in, views_t *vw) {
+int hd__mpi_views(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, hd__mpi_views_t *vw) {
     memset(vw, 0, sizeof *vw);
     for (int s = 0; s < 2; s++) {
         size_t nonempty = 0, last = 0;
@@ -162,7 +166,7 @@ int hd__mpi_views(ctx_t *c, const input_t *in, views_t *vw) {
     return HD_OK;
 }
 
-void hd__mpi_views_free(ctx_t *c, const input_t *in, views_t *vw) {
+void hd__mpi_views_free(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, hd__mpi_views_t *vw) {
     for (int s = 0; s < 2; s++) {
         hd__mpi_free(c, vw->own[s], in->n[s], 3 * sizeof(double));
         hd__mpi_free(c, vw->order[s], in->nparts[s], sizeof *vw->order[s]);
@@ -171,14 +175,14 @@ void hd__mpi_views_free(ctx_t *c, const input_t *in, views_t *vw) {
 }
 
 /* K = 1: the engine on the views. */
-static int single(ctx_t *c, const input_t *in, const ranges_t *rg, int both, far_t *f) {
-    views_t vw;
+static int single(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const hd__mpi_ranges_t *rg, int both, hd__mpi_far_t *f) {
+    hd__mpi_views_t vw;
     int rc = hd__mpi_views(c, in, &vw);
     double t0 = hd__now(), u0 = hd__mpi_cpu();
     for (int s = 0; s < (both ? 2 : 1) && rc == HD_OK; s++) {
         hd_result_t e;
         if ((rc = hd__mpi_engine(c, &vw.v[s], &vw.v[1 - s], &e)) == HD_OK)
-            f[s] = (far_t){e.distance2, hd__mpi_ranges_global(rg, s, 0, e.i), hd__mpi_ranges_global(rg, 1 - s, 0, e.j)};
+            f[s] = (hd__mpi_far_t){e.distance2, hd__mpi_ranges_global(rg, s, 0, e.i), hd__mpi_ranges_global(rg, 1 - s, 0, e.j)};
     }
     c->search += hd__now() - t0;
     c->search_cpu += hd__mpi_cpu() - u0;
@@ -189,78 +193,78 @@ static int single(ctx_t *c, const input_t *in, const ranges_t *rg, int both, far
 /* The start of every call: the local checks (agreed), the index runs, the
  * global counts N (an empty set is HD_EEMPTY) and, when box is not NULL,
  * the global boxes of A and B as hd_overlap's corner pairs. */
-int hd__mpi_begin(ctx_t *c, const hd_options_t *opt, input_t *in, const void *res, ranges_t *rg, uint64_t N[2],
+int hd__mpi_begin(hd__mpi_ctx_t *c, const hd_options_t *opt, hd__mpi_input_t *in, const void *res, hd__mpi_ranges_t *rg, uint64_t N[2],
                   double corners[2][6]) {
     int rc = hd__mpi_check_local(c, opt, in, res);
     if ((rc = hd__mpi_agree(c, rc)) != HD_OK) return rc;
     if ((rc = hd__mpi_check_ranges(c, in, rg)) != HD_OK) return rc;
     uint64_t n[2] = {in->n[0], in->n[1]};
-    MPI_TRY(c, MPI_Allreduce(n, N, 2, MPI_UINT64_T, MPI_SUM, c->comm));
+    HD__MPI_TRY(c, MPI_Allreduce(n, N, 2, MPI_UINT64_T, MPI_SUM, c->comm));
     if (N[0] == 0 || N[1] == 0) return hd__err(&c->e, HD_EEMPTY, "point set %s is empty", N[0] ? "B" : "A");
     if (!corners) return HD_OK;
     /* Global boxes (hi negated: one MIN). */
     double bx[12], gb[12];
     for (int s = 0; s < 2; s++)
         for (int k = 0; k < 3; k++) bx[6 * s + k] = in->box[s].lo[k], bx[6 * s + 3 + k] = -in->box[s].hi[k];
-    MPI_TRY(c, MPI_Allreduce(bx, gb, 12, MPI_DOUBLE, MPI_MIN, c->comm));
+    HD__MPI_TRY(c, MPI_Allreduce(bx, gb, 12, MPI_DOUBLE, MPI_MIN, c->comm));
     for (int s = 0; s < 2; s++)
         for (int k = 0; k < 3; k++) corners[s][k] = gb[6 * s + k], corners[s][3 + k] = -gb[6 * s + 3 + k];
     return HD_OK;
 }
 
 /* K > 1: the partition, the exchange and what every rank holds. */
-int hd__mpi_spread(ctx_t *c, const input_t *in, const ranges_t *rg, const uint64_t N[2], spread_t *sp) {
+int hd__mpi_spread(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const hd__mpi_ranges_t *rg, const uint64_t N[2], hd__mpi_spread_t *sp) {
     int K = c->K, rc = HD_OK;
-    sp->tree = hd__mpi_alloc(c, (size_t)K - 1, sizeof(node_t));
+    sp->tree = hd__mpi_alloc(c, (size_t)K - 1, sizeof(hd__mpi_node_t));
     sp->region = hd__mpi_alloc(c, (size_t)K, sizeof(hd__box_t));
-    sp->held = hd__mpi_alloc(c, (size_t)K, sizeof(held_t));
+    sp->held = hd__mpi_alloc(c, (size_t)K, sizeof(hd__mpi_held_t));
     if (!sp->tree || !sp->region || !sp->held) rc = hd__mpi_nomem(c, "the partition", (size_t)K);
     if ((rc = hd__mpi_agree(c, rc)) != HD_OK) return rc;
     if ((rc = hd__mpi_partition(c, in, N[0] + N[1], sp->tree)) != HD_OK) return rc;
     hd__box_t all = {{-INFINITY, -INFINITY, -INFINITY}, {INFINITY, INFINITY, INFINITY}};
     hd__mpi_regions(sp->tree, 0, all, sp->region);
     if ((rc = hd__mpi_exchange(c, in, rg, sp->tree, &sp->loc)) != HD_OK) return rc;
-    held_t h;
+    hd__mpi_held_t h;
     for (int s = 0; s < 2; s++) {
         h.n[s] = sp->loc.n[s];
         h.box[s] = sp->loc.box[s]; /* taken by the exchange as the points arrived */
     }
-    MPI_TRY(c, MPI_Allgather(&h, (int)sizeof h, MPI_BYTE, sp->held, (int)sizeof h, MPI_BYTE, c->comm));
+    HD__MPI_TRY(c, MPI_Allgather(&h, (int)sizeof h, MPI_BYTE, sp->held, (int)sizeof h, MPI_BYTE, c->comm));
     return HD_OK;
 }
 
-void hd__mpi_spread_free(ctx_t *c, spread_t *sp) {
+void hd__mpi_spread_free(hd__mpi_ctx_t *c, hd__mpi_spread_t *sp) {
     int K = c->K;
     for (int s = 0; s < 2; s++) {
         hd__mpi_free(c, sp->loc.xyz[s], sp->loc.n[s], 3 * sizeof(double));
         hd__mpi_gidx_free(c, &sp->loc.gi[s]);
         if (sp->loc.start[s]) hd__mpi_free(c, sp->loc.start[s], (size_t)K + 1, sizeof(size_t));
     }
-    hd__mpi_free(c, sp->tree, (size_t)K - 1, sizeof(node_t));
+    hd__mpi_free(c, sp->tree, (size_t)K - 1, sizeof(hd__mpi_node_t));
     hd__mpi_free(c, sp->region, (size_t)K, sizeof(hd__box_t));
-    hd__mpi_free(c, sp->held, (size_t)K, sizeof(held_t));
+    hd__mpi_free(c, sp->held, (size_t)K, sizeof(hd__mpi_held_t));
     memset(sp, 0, sizeof *sp);
 }
 
 /* The figures every call reports (collective): pts is this rank's points
  * after the partition; *tmax receives the slowest rank's seconds. */
-int hd__mpi_figures(ctx_t *c, const course_t *cs, uint64_t pts, hd_mpi_stats_t *st, double *tmax) {
+int hd__mpi_figures(hd__mpi_ctx_t *c, const hd__mpi_course_t *cs, uint64_t pts, hd_mpi_stats_t *st, double *tmax) {
     int K = c->K;
     const uint64_t *N = cs->N;
     double t0 = cs->t0, cpu0 = cs->cpu0;
     double other = hd__mpi_cpu() - cpu0 - c->search_cpu - c->mpi_cpu;
     double secs = hd__now() - t0, tsum = secs, mine[4] = {secs, c->search, c->search_cpu, other}, most[4];
-    MPI_TRY(c, MPI_Allreduce(mine, most, 4, MPI_DOUBLE, MPI_MAX, c->comm));
+    HD__MPI_TRY(c, MPI_Allreduce(mine, most, 4, MPI_DOUBLE, MPI_MAX, c->comm));
     *tmax = most[0];
-    MPI_TRY(c, MPI_Allreduce(&secs, &tsum, 1, MPI_DOUBLE, MPI_SUM, c->comm));
+    HD__MPI_TRY(c, MPI_Allreduce(&secs, &tsum, 1, MPI_DOUBLE, MPI_SUM, c->comm));
     if (!st) return HD_OK;
     uint64_t work = pts + c->answered;
     uint64_t sums[7] = {c->bytes_part, c->bytes_fwd, c->forwarded, c->forwarded_points, work, c->shell,
                         c->bytes_back},
              gs[7];
     uint64_t maxes[3] = {pts, work, c->peak}, gm[3];
-    MPI_TRY(c, MPI_Allreduce(sums, gs, 7, MPI_UINT64_T, MPI_SUM, c->comm));
-    MPI_TRY(c, MPI_Allreduce(maxes, gm, 3, MPI_UINT64_T, MPI_MAX, c->comm));
+    HD__MPI_TRY(c, MPI_Allreduce(sums, gs, 7, MPI_UINT64_T, MPI_SUM, c->comm));
+    HD__MPI_TRY(c, MPI_Allreduce(maxes, gm, 3, MPI_UINT64_T, MPI_MAX, c->comm));
     memset(st, 0, sizeof *st);
     st->ranks = K;
     st->points = N[0] + N[1];
@@ -289,14 +293,14 @@ int hd__mpi_figures(ctx_t *c, const course_t *cs, uint64_t pts, hd_mpi_stats_t *
     return HD_OK;
 }
 
-void hd__mpi_course_init(ctx_t *c, course_t *cs) {
+void hd__mpi_course_init(hd__mpi_ctx_t *c, hd__mpi_course_t *cs) {
     memset(cs, 0, sizeof *cs);
     cs->rg.K = c->K;
     cs->t0 = hd__now();
     cs->cpu0 = hd__mpi_cpu();
 }
 
-void hd__mpi_course_free(ctx_t *c, course_t *cs) {
+void hd__mpi_course_free(hd__mpi_ctx_t *c, hd__mpi_course_t *cs) {
     hd__mpi_spread_free(c, &cs->sp);
     hd__mpi_ranges_free(c, &cs->rg);
 }
@@ -307,13 +311,13 @@ typedef struct { int mode; void *res; } what_t;
 
 /* The Hausdorff distance's course.  what->mode is a MODE_*: what->res is
  * an hd_result_t, an hd_symmetric_t or an overlap_t. */
-static int run(ctx_t *c, const hd_options_t *opt, input_t *in, void *arg, hd_mpi_stats_t *st) {
+static int run(hd__mpi_ctx_t *c, const hd_options_t *opt, hd__mpi_input_t *in, void *arg, hd_mpi_stats_t *st) {
     const what_t *what = arg;
     int both = what->mode;
     void *res = what->res;
     hd_symmetric_t *out = both == MODE_BOTH ? res : NULL;
     int K = c->K;
-    course_t cs;
+    hd__mpi_course_t cs;
     hd__mpi_course_init(c, &cs);
     double corners[2][6];
     int rc = hd__mpi_begin(c, opt, in, res, &cs.rg, cs.N, corners);
@@ -327,24 +331,24 @@ static int run(ctx_t *c, const hd_options_t *opt, input_t *in, void *arg, hd_mpi
     memset(res, 0, both ? sizeof(hd_symmetric_t) : sizeof(hd_result_t));
     if (both && (rc = hd_overlap(&ca, &cb, &out->alpha, &out->disjoint, &c->e)) != HD_OK) goto done;
 
-    far_t f[2];
+    hd__mpi_far_t f[2];
     uint64_t pts;
     if (K == 1) {
         if ((rc = single(c, in, &cs.rg, both, f)) != HD_OK) goto done;
         pts = in->n[0] + in->n[1];
     } else {
-        spread_t *sp = &cs.sp;
+        hd__mpi_spread_t *sp = &cs.sp;
         if ((rc = hd__mpi_spread(c, in, &cs.rg, cs.N, sp)) != HD_OK) goto done;
-        local_t *loc = &sp->loc;
+        hd__mpi_local_t *loc = &sp->loc;
         /* Both directions: the engine once for both (each of its calls
          * builds both sets' structures); its failure is agreed on before
          * the first direction. */
-        pre_t pre[2];
+        hd__mpi_pre_t pre[2];
         memset(pre, 0, sizeof pre);
         unsigned char *mask[2] = {NULL, NULL};
         int pre_rc = HD_OK;
         if (both) {
-            const gidx_t *gp[2] = {&sp->loc.gi[0], &sp->loc.gi[1]};
+            const hd__mpi_gidx_t *gp[2] = {&sp->loc.gi[0], &sp->loc.gi[1]};
             double t1 = hd__now(), u1 = hd__mpi_cpu();
             pre_rc = hd__mpi_engine_both(c, loc->xyz, gp, loc->n, sp->held[c->rank].box, &sp->region[c->rank], pre,
                                          mask);
@@ -353,7 +357,7 @@ static int run(ctx_t *c, const hd_options_t *opt, input_t *in, void *arg, hd_mpi
         }
         rc = hd__mpi_agree(c, pre_rc);
         for (int s = 0; s < (both ? 2 : 1) && rc == HD_OK; s++) {
-            dir_t d = {loc->xyz[s], &sp->loc.gi[s], loc->n[s], loc->xyz[1 - s], &sp->loc.gi[1 - s], loc->n[1 - s], 1 - s,
+            hd__mpi_dir_t d = {loc->xyz[s], &sp->loc.gi[s], loc->n[s], loc->xyz[1 - s], &sp->loc.gi[1 - s], loc->n[1 - s], 1 - s,
                        &pre[s]};
             rc = hd__mpi_direction(c, &d, sp->tree, sp->region, sp->held, &f[s]);
         }
@@ -384,7 +388,7 @@ done:
 int hd__mpi_call(MPI_Comm comm, const hd_mpi_part_t *a, size_t na, const hd_mpi_part_t *b, size_t nb,
                  const hd_options_t *opt, hd__mpi_body_t body, void *arg, hd_mpi_stats_t *st, hd_error_t *err) {
     hd__err_clear(err);
-    ctx_t c;
+    hd__mpi_ctx_t c;
     memset(&c, 0, sizeof c);
     c.ans_type = c.q_type = c.far_type = c.sample_type = c.node_type = MPI_DATATYPE_NULL;
     c.far_op = MPI_OP_NULL;
@@ -406,7 +410,7 @@ int hd__mpi_call(MPI_Comm comm, const hd_mpi_part_t *a, size_t na, const hd_mpi_
         if (c.threads < 0) c.threads = 1; /* refused by check_local, on every rank */
         rc = hd__mpi_types_create(&c);
         if ((rc = hd__mpi_agree(&c, rc)) == HD_OK) {
-            input_t in = {{a, b}, {na, nb}, {0, 0}, {{{0}, {0}}, {{0}, {0}}}};
+            hd__mpi_input_t in = {{a, b}, {na, nb}, {0, 0}, {{{0}, {0}}, {{0}, {0}}}};
             rc = body(&c, opt, &in, arg, st);
         }
         /* Every buffer of the call was freed, on every path (the

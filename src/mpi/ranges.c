@@ -1,6 +1,6 @@
 /*
  * ranges.c -- the validation of a call's input and the index runs that name
- * every point (mpi_int.h's ranges_t).
+ * every point (ranges.h's hd__mpi_ranges_t).
  *
  * Invariants.
  *  - hd__mpi_check_local refuses, before a point is read, more than
@@ -18,7 +18,7 @@
  *    (ord), they number a set's indices densely (the ordinals gidx.c
  *    encodes).
  */
-#include "mpi_int.h"
+#include "mpi/ranges.h"
 
 #include <assert.h>
 #include <string.h>
@@ -34,23 +34,23 @@ int hd__mpi_by_offset(const void *x, const void *y) {
 }
 
 int hd__mpi_by_range(const void *x, const void *y) {
-    const range_t *p = x, *q = y;
+    const hd__mpi_range_t *p = x, *q = y;
     if (p->side != q->side) return p->side - q->side;
     return p->lo < q->lo ? -1 : p->lo > q->lo;
 }
 
 static int by_owner(const void *x, const void *y) {
-    const range_t *p = x, *q = y;
+    const hd__mpi_range_t *p = x, *q = y;
     if (p->side != q->side) return p->side - q->side;
     if (p->rank != q->rank) return p->rank - q->rank;
     return p->lo < q->lo ? -1 : p->lo > q->lo;
 }
 
-void hd__mpi_ranges_free(ctx_t *c, ranges_t *rg) {
-    hd__mpi_free(c, rg->all, rg->total, sizeof(range_t));
+void hd__mpi_ranges_free(hd__mpi_ctx_t *c, hd__mpi_ranges_t *rg) {
+    hd__mpi_free(c, rg->all, rg->total, sizeof(hd__mpi_range_t));
     if (rg->seg) hd__mpi_free(c, rg->seg, 2 * ((size_t)rg->K + 1), sizeof(size_t));
     hd__mpi_free(c, rg->first, rg->total, sizeof(uint64_t));
-    hd__mpi_free(c, rg->bylo, rg->total, sizeof(range_t));
+    hd__mpi_free(c, rg->bylo, rg->total, sizeof(hd__mpi_range_t));
     hd__mpi_free(c, rg->ord, rg->total, sizeof(uint64_t));
     rg->all = NULL, rg->seg = NULL, rg->first = NULL, rg->bylo = NULL, rg->ord = NULL;
 }
@@ -58,7 +58,7 @@ void hd__mpi_ranges_free(ctx_t *c, ranges_t *rg) {
 /* g[k] = the global index of point number num[k] of rank r's side s, for
  * num[] increasing; *i is a run of rank r's side s at or before num[0]'s
  * (its first: rg->seg[s (K + 1) + r]), and becomes num[n - 1]'s. */
-void hd__mpi_ranges_globals(const ranges_t *rg, int s, int r, size_t *i, const uint32_t *num, size_t n, uint64_t *g) {
+void hd__mpi_ranges_globals(const hd__mpi_ranges_t *rg, int s, int r, size_t *i, const uint32_t *num, size_t n, uint64_t *g) {
     for (size_t k = 0; k < n; k++) {
         hd__mpi_ranges_seek(rg, s, r, i, num[k]);
         g[k] = rg->all[*i].lo + (num[k] - rg->first[*i]);
@@ -66,7 +66,7 @@ void hd__mpi_ranges_globals(const ranges_t *rg, int s, int r, size_t *i, const u
 }
 
 /* The global index of point number m (any) of rank r's side s. */
-uint64_t hd__mpi_ranges_global(const ranges_t *rg, int s, int r, uint64_t m) {
+uint64_t hd__mpi_ranges_global(const hd__mpi_ranges_t *rg, int s, int r, uint64_t m) {
     size_t lo = rg->seg[(size_t)s * ((size_t)rg->K + 1) + (size_t)r],
            hi = rg->seg[(size_t)s * ((size_t)rg->K + 1) + (size_t)r + 1] - 1;
     while (lo < hi) { /* the last part whose first number is <= m */
@@ -77,27 +77,27 @@ uint64_t hd__mpi_ranges_global(const ranges_t *rg, int s, int r, uint64_t m) {
     return rg->all[lo].lo + (m - rg->first[lo]);
 }
 
-/* The runs' orders (mpi_int.h's ranges_t): rg->all (any order, rg->total
+/* The runs' orders (ranges.h's hd__mpi_ranges_t): rg->all (any order, rg->total
  * runs of rg->K ranks, no two of a side sharing an index) sorted by owner
  * with seg and first, and bylo with ord.  Local (check_ranges runs it on
  * every rank after the all-gather); fails only for memory. */
-int hd__mpi_ranges_index(ctx_t *c, ranges_t *rg) {
+int hd__mpi_ranges_index(hd__mpi_ctx_t *c, hd__mpi_ranges_t *rg) {
     int K = rg->K;
     size_t total = rg->total;
     if (!rg->seg && !(rg->seg = hd__mpi_alloc(c, 2 * ((size_t)K + 1), sizeof(size_t))))
         return hd__mpi_nomem(c, "index ranges", (size_t)K);
     if (!rg->first && !(rg->first = hd__mpi_alloc(c, total, sizeof(uint64_t))))
         return hd__mpi_nomem(c, "index ranges", total);
-    rg->bylo = hd__mpi_alloc(c, total, sizeof(range_t));
+    rg->bylo = hd__mpi_alloc(c, total, sizeof(hd__mpi_range_t));
     rg->ord = hd__mpi_alloc(c, total, sizeof(uint64_t));
     if (!rg->bylo || !rg->ord) return hd__mpi_nomem(c, "index ranges", total);
-    memcpy(rg->bylo, rg->all, total * sizeof(range_t));
-    qsort(rg->bylo, total, sizeof(range_t), hd__mpi_by_range);
+    memcpy(rg->bylo, rg->all, total * sizeof(hd__mpi_range_t));
+    qsort(rg->bylo, total, sizeof(hd__mpi_range_t), hd__mpi_by_range);
     for (size_t i = 0; i < total; i++) {
         int same = i > 0 && rg->bylo[i].side == rg->bylo[i - 1].side;
         rg->ord[i] = same ? rg->ord[i - 1] + (rg->bylo[i - 1].hi - rg->bylo[i - 1].lo + 1) : 0;
     }
-    qsort(rg->all, total, sizeof(range_t), by_owner);
+    qsort(rg->all, total, sizeof(hd__mpi_range_t), by_owner);
     size_t k = 0;
     for (int s = 0; s < 2; s++)
         for (int r = 0; r <= K; r++) {
@@ -113,7 +113,7 @@ int hd__mpi_ranges_index(ctx_t *c, ranges_t *rg) {
 
 /* Over all ranks, no two parts of one set share an index; rg receives
  * every rank's parts. */
-int hd__mpi_check_ranges(ctx_t *c, const input_t *in, ranges_t *rg) {
+int hd__mpi_check_ranges(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, hd__mpi_ranges_t *rg) {
     int n = 0, rc = HD_OK, K = c->K;
     for (int s = 0; s < 2; s++)
         for (size_t k = 0; k < in->nparts[s]; k++) n += in->parts[s][k].points.count > 0;
@@ -122,37 +122,37 @@ int hd__mpi_check_ranges(ctx_t *c, const input_t *in, ranges_t *rg) {
     rg->seg = hd__mpi_alloc(c, 2 * ((size_t)K + 1), sizeof(size_t));
     if (!counts || !rg->seg) rc = hd__mpi_nomem(c, "index ranges", (size_t)K);
     if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
-    MPI_GO(c, rc, MPI_Allgather(&n, 1, MPI_INT, counts, 1, MPI_INT, c->comm));
+    HD__MPI_GO(c, rc, MPI_Allgather(&n, 1, MPI_INT, counts, 1, MPI_INT, c->comm));
     size_t total = 0;
     int *displ = counts + K;
     for (int r = 0; r < K; r++) {
-        displ[r] = (int)(total * sizeof(range_t));
+        displ[r] = (int)(total * sizeof(hd__mpi_range_t));
         total += (size_t)counts[r];
-        counts[r] *= (int)sizeof(range_t);
+        counts[r] *= (int)sizeof(hd__mpi_range_t);
     }
-    range_t *mine = hd__mpi_alloc(c, (size_t)n, sizeof(range_t));
-    rg->all = hd__mpi_alloc(c, total, sizeof(range_t));
+    hd__mpi_range_t *mine = hd__mpi_alloc(c, (size_t)n, sizeof(hd__mpi_range_t));
+    rg->all = hd__mpi_alloc(c, total, sizeof(hd__mpi_range_t));
     rg->first = hd__mpi_alloc(c, total, sizeof(uint64_t));
     rg->total = total;
-    if (!mine || !rg->all || !rg->first || total * sizeof(range_t) > INT_MAX) rc = hd__mpi_nomem(c, "index ranges", total);
+    if (!mine || !rg->all || !rg->first || total * sizeof(hd__mpi_range_t) > INT_MAX) rc = hd__mpi_nomem(c, "index ranges", total);
     if ((rc = hd__mpi_agree(c, rc)) == HD_OK) {
         int t = 0;
         for (int s = 0; s < 2; s++)
             for (size_t k = 0; k < in->nparts[s]; k++) {
                 const hd_mpi_part_t *p = &in->parts[s][k];
                 if (p->points.count)
-                    mine[t++] = (range_t){p->offset, p->offset + (p->points.count - 1), s, c->rank};
+                    mine[t++] = (hd__mpi_range_t){p->offset, p->offset + (p->points.count - 1), s, c->rank};
             }
         double mpi_t0_;
         int mpi_rc_,
-            e = MPI_TIMED(c, MPI_Allgatherv(mine, n * (int)sizeof(range_t), MPI_BYTE, rg->all, counts, displ,
+            e = HD__MPI_TIMED(c, MPI_Allgatherv(mine, n * (int)sizeof(hd__mpi_range_t), MPI_BYTE, rg->all, counts, displ,
                                             MPI_BYTE, c->comm));
         if (e != MPI_SUCCESS) rc = hd__mpi_failed(c, "MPI_Allgatherv", e);
     }
-    hd__mpi_free(c, mine, (size_t)n, sizeof(range_t));
+    hd__mpi_free(c, mine, (size_t)n, sizeof(hd__mpi_range_t));
     if (rc == HD_OK) {
-        range_t *all = rg->all;
-        qsort(all, total, sizeof(range_t), hd__mpi_by_range);
+        hd__mpi_range_t *all = rg->all;
+        qsort(all, total, sizeof(hd__mpi_range_t), hd__mpi_by_range);
         for (size_t k = 1; k < total; k++)
             if (all[k].side == all[k - 1].side && all[k].lo <= all[k - 1].hi) {
                 rc = hd__err(&c->e, HD_EINVAL,
@@ -172,7 +172,7 @@ done:
 
 /* Local checks: options, parts (views valid, finite, in range, indices
  * within size_t), with the local counts and boxes. */
-int hd__mpi_check_local(ctx_t *c, const hd_options_t *opt, input_t *in, const void *out) {
+int hd__mpi_check_local(hd__mpi_ctx_t *c, const hd_options_t *opt, hd__mpi_input_t *in, const void *out) {
     if (!out) return hd__err(&c->e, HD_EINVAL, "the result pointer is NULL");
     if (opt && opt->threads < 0)
         return hd__err(&c->e, HD_EINVAL, "threads must be 0 (every core) or positive, not %d", opt->threads);

@@ -23,7 +23,7 @@
  *    hd__box_lb2 <= u2 (ties included); a node's box is the union of its
  *    ranks', so a subtree pruned by its box holds no candidate.
  */
-#include "mpi_int.h"
+#include "mpi/partition.h"
 
 #include <assert.h>
 #include <limits.h>
@@ -32,14 +32,14 @@
 #include <string.h>
 
 /* The first samples: FIRST_MOST a rank, but at most FIRST_TOTAL at rank 0
- * (then FIRST_FEWEST a rank at the least).  Rank 0's tree costs about 24 ns
- * a sample and level (bench/rcb_bench.c) and its buffer 40 B a sample:
- * 1024 a rank would be 0.24 s and 41 MB at 1000 ranks, 5.7 s and 0.67 GB
- * at 16384, all on rank 0 while the others wait.  The second samples
- * (refine) set the balance; the first only bracket each split, and 64 a
- * rank left the largest region 0.8-2.9 % above its share at 16 and 64
- * ranks against 0.6-2.2 % with 1024 (docs/scale-out.md, "Fewer first
- * samples at many ranks"). */
+ * (then FIRST_FEWEST a rank at the least).  Rank 0's tree costs time in
+ * proportion to its samples times its levels and a hd__mpi_sample_t of
+ * buffer a sample, all on rank 0 while the others wait, so the total is
+ * capped (bench/rcb_bench.c measures the tree's time and memory).  The
+ * second samples (refine) set the balance; the first only bracket each
+ * split, so fewer first samples move the largest region's excess over its
+ * share little (mpi_partition's balance check bounds it; the figures are
+ * in docs/scale-out.md, "Fewer first samples at many ranks"). */
 #define FIRST_MOST 1024
 #define FIRST_FEWEST 64
 #define FIRST_TOTAL 65536
@@ -53,12 +53,12 @@ static int key_less(const double *x, uint64_t side, uint64_t g, int axis,
     return g < yg;
 }
 
-static int sample_less(const sample_t *p, const sample_t *q, int axis) {
+static int sample_less(const hd__mpi_sample_t *p, const hd__mpi_sample_t *q, int axis) {
     return key_less(p->x, p->side, p->g, axis, q->x, q->side, q->g);
 }
 
-static void swap_samples(sample_t *a, sample_t *b) {
-    sample_t t = *a;
+static void swap_samples(hd__mpi_sample_t *a, hd__mpi_sample_t *b) {
+    hd__mpi_sample_t t = *a;
     *a = *b;
     *b = t;
 }
@@ -66,7 +66,7 @@ static void swap_samples(sample_t *a, sample_t *b) {
 /* Reorder s[0..n) so that s[m] is the m-th smallest key and everything
  * before it is smaller (keys are distinct: (set, index) names one point).
  * Quickselect with the median of three. */
-static void select_nth(sample_t *s, size_t n, size_t m, int axis) {
+static void select_nth(hd__mpi_sample_t *s, size_t n, size_t m, int axis) {
     size_t lo = 0, hi = n - 1;
     while (hi > lo) {
         size_t mid = lo + (hi - lo) / 2;
@@ -95,10 +95,10 @@ int hd__mpi_first_samples(int K) {
  * br[2 id], br[2 id + 1]: the coordinates, on the node's axis, of the
  * samples about three standard deviations of a sample quantile either side
  * of the split (the range refine() searches; lo > hi: none). */
-static int build(node_t *t, double *br, int *next, sample_t *s, size_t n, int r0, int k) {
+static int build(hd__mpi_node_t *t, double *br, int *next, hd__mpi_sample_t *s, size_t n, int r0, int k) {
     if (k == 1) return -(r0 + 1);
     int id = (*next)++, kl = k / 2;
-    node_t nd = {INFINITY, 0, 0, 0, 0, 0, 0}; /* no samples: all go left */
+    hd__mpi_node_t nd = {INFINITY, 0, 0, 0, 0, 0, 0}; /* no samples: all go left */
     size_t m = 0;
     br[2 * id] = INFINITY;
     br[2 * id + 1] = -INFINITY;
@@ -137,19 +137,19 @@ static int build(node_t *t, double *br, int *next, sample_t *s, size_t n, int r0
     return id;
 }
 
-void hd__mpi_rcb_tree(sample_t *s, size_t n, int K, node_t *t, double *br) {
+void hd__mpi_rcb_tree(hd__mpi_sample_t *s, size_t n, int K, hd__mpi_node_t *t, double *br) {
     int next = 0;
     build(t, br, &next, s, n, 0, K);
     assert(next == K - 1);
 }
 
 /* Every rank's region: the box its splits bound (infinite elsewhere). */
-void hd__mpi_regions(const node_t *t, int node, hd__box_t box, hd__box_t *out) {
+void hd__mpi_regions(const hd__mpi_node_t *t, int node, hd__box_t box, hd__box_t *out) {
     if (node < 0) {
         out[-node - 1] = box;
         return;
     }
-    const node_t *nd = &t[node];
+    const hd__mpi_node_t *nd = &t[node];
     hd__box_t l = box, r = box;
     if (nd->s < l.hi[nd->axis]) l.hi[nd->axis] = nd->s;
     if (nd->s > r.lo[nd->axis]) r.lo[nd->axis] = nd->s;
@@ -159,7 +159,7 @@ void hd__mpi_regions(const node_t *t, int node, hd__box_t box, hd__box_t *out) {
 
 /* Node boxes for the candidate search: the union of its ranks' boxes of
  * the searched set (empty ranks have lo = +inf, hi = -inf). */
-hd__box_t hd__mpi_node_boxes(const node_t *t, int node, const held_t *held, int side, hd__box_t *out) {
+hd__box_t hd__mpi_node_boxes(const hd__mpi_node_t *t, int node, const hd__mpi_held_t *held, int side, hd__box_t *out) {
     if (node < 0) return held[-node - 1].box[side];
     hd__box_t b = hd__mpi_node_boxes(t, t[node].left, held, side, out);
     hd__box_t r = hd__mpi_node_boxes(t, t[node].right, held, side, out);
@@ -170,7 +170,7 @@ hd__box_t hd__mpi_node_boxes(const node_t *t, int node, const held_t *held, int 
 
 /* Ranks other than `me` whose box of the searched set may hold a point
  * within u2 of p (ties included), appended to list. */
-void hd__mpi_candidates(const node_t *t, const hd__box_t *nbox, const held_t *held, int side, int node,
+void hd__mpi_candidates(const hd__mpi_node_t *t, const hd__box_t *nbox, const hd__mpi_held_t *held, int side, int node,
                        const double *p, double u2, int me, int *list, int *n) {
     if (node < 0) {
         int r = -node - 1;
@@ -182,7 +182,7 @@ void hd__mpi_candidates(const node_t *t, const hd__box_t *nbox, const held_t *he
     hd__mpi_candidates(t, nbox, held, side, t[node].right, p, u2, me, list, n);
 }
 
-int hd__mpi_asked(const node_t *t, const hd__box_t *nbox, const held_t *held, int K, int side, int none_here,
+int hd__mpi_asked(const hd__mpi_node_t *t, const hd__box_t *nbox, const hd__mpi_held_t *held, int K, int side, int none_here,
                   const double *p, double u2, int me, int *list) {
     double bound = u2;
     if (none_here)
@@ -198,7 +198,7 @@ int hd__mpi_asked(const node_t *t, const hd__box_t *nbox, const held_t *held, in
 
 /* ns samples of this rank's nloc points (A's parts in order, then B's:
  * local point t is the t-th of them), evenly spaced, into out. */
-static void take_samples(const input_t *in, uint64_t nloc, size_t ns, sample_t *out) {
+static void take_samples(const hd__mpi_input_t *in, uint64_t nloc, size_t ns, hd__mpi_sample_t *out) {
     int side = 0;
     size_t part = 0;
     uint64_t base = 0; /* local number of the part's first point */
@@ -227,7 +227,7 @@ static size_t sample_count(uint64_t nloc, double rate) {
 }
 
 /* Node id's depth and number of ranks (leaves) below it. */
-static int shape(const node_t *t, int node, int depth, int *dep, int *ranks) {
+static int shape(const hd__mpi_node_t *t, int node, int depth, int *dep, int *ranks) {
     if (node < 0) return 1;
     dep[node] = depth;
     ranks[node] = shape(t, t[node].left, depth + 1, dep, ranks) + shape(t, t[node].right, depth + 1, dep, ranks);
@@ -259,14 +259,14 @@ static double edge(const double *br, int id, int j) {
  * floor(k/2)/k than the split it replaces (never worse on what it
  * measures); any split is a valid partition, so the result never depends
  * on it, only the balance does. */
-static int refine(ctx_t *c, const input_t *in, uint64_t N, node_t *tree, const double *br) {
+static int refine(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, uint64_t N, hd__mpi_node_t *tree, const double *br) {
     int rc = HD_OK, K = c->K, nodes = K - 1;
     uint64_t nloc = in->n[0] + in->n[1];
     double rate = (double)REFINE_PER_RANK * K / (double)N;
     if (rate > 0.25) rate = 0.25;
     if (rate * (double)N <= 2.0 * c->first * K) return HD_OK; /* no more than the first samples */
     size_t ns = sample_count(nloc, rate), width = REFINE_BINS + 3;
-    sample_t *r = hd__mpi_alloc(c, ns, sizeof(sample_t));
+    hd__mpi_sample_t *r = hd__mpi_alloc(c, ns, sizeof(hd__mpi_sample_t));
     int *dep = hd__mpi_alloc(c, 3 * (size_t)nodes, sizeof(int));
     int *at = hd__mpi_alloc(c, ns, sizeof(int)); /* each sample's node at the current depth */
     uint64_t *cnt = hd__mpi_alloc(c, 2 * (size_t)nodes * width, sizeof(uint64_t));
@@ -291,7 +291,7 @@ static int refine(ctx_t *c, const input_t *in, uint64_t N, node_t *tree, const d
             int id = at[q];
             if (id < 0) continue;
             assert(slot[id] >= 0);
-            const node_t *nd = &tree[id];
+            const hd__mpi_node_t *nd = &tree[id];
             uint64_t *h = cnt + (size_t)slot[id] * width;
             double v = r[q].x[nd->axis];
             const double *e = edges + (size_t)id * (REFINE_BINS + 1);
@@ -307,7 +307,7 @@ static int refine(ctx_t *c, const input_t *in, uint64_t N, node_t *tree, const d
             h[lo]++;
             h[REFINE_BINS + 2] += (uint64_t)hd__mpi_goes_left(nd, r[q].x, r[q].side, r[q].g);
         }
-        MPI_GO(c, rc, MPI_Allreduce(cnt, sum, (int)((size_t)level * width), MPI_UINT64_T, MPI_SUM, c->comm));
+        HD__MPI_GO(c, rc, MPI_Allreduce(cnt, sum, (int)((size_t)level * width), MPI_UINT64_T, MPI_SUM, c->comm));
         c->bytes_part += (uint64_t)level * width * sizeof *cnt; /* what this rank contributed */
         for (int id = 0; id < nodes; id++) {
             if (slot[id] < 0 || br[2 * id] > br[2 * id + 1]) continue; /* no bracket: no samples (s infinite) */
@@ -330,12 +330,12 @@ static int refine(ctx_t *c, const input_t *in, uint64_t N, node_t *tree, const d
         }
         for (size_t q = 0; q < ns; q++)
             if (at[q] >= 0) {
-                const node_t *nd = &tree[at[q]];
+                const hd__mpi_node_t *nd = &tree[at[q]];
                 at[q] = hd__mpi_goes_left(nd, r[q].x, r[q].side, r[q].g) ? nd->left : nd->right;
             }
     }
 done:
-    hd__mpi_free(c, r, ns, sizeof(sample_t));
+    hd__mpi_free(c, r, ns, sizeof(hd__mpi_sample_t));
     hd__mpi_free(c, dep, 3 * (size_t)nodes, sizeof(int));
     hd__mpi_free(c, at, ns, sizeof(int));
     hd__mpi_free(c, cnt, 2 * (size_t)nodes * width, sizeof(uint64_t));
@@ -346,13 +346,13 @@ done:
 /* Rank 0 builds the RCB tree from everyone's first samples (c->first a
  * rank); all get it, and refine() then moves its splits by a second
  * sample's exact counts. */
-int hd__mpi_partition(ctx_t *c, const input_t *in, uint64_t N, node_t *tree) {
+int hd__mpi_partition(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, uint64_t N, hd__mpi_node_t *tree) {
     int rc = HD_OK, K = c->K;
     uint64_t nloc = in->n[0] + in->n[1];
     uint64_t S = (uint64_t)c->first * (uint64_t)K;
     if (S > N) S = N;
     size_t ns = sample_count(nloc, (double)S / (double)N);
-    sample_t *mine = hd__mpi_alloc(c, ns, sizeof(sample_t));
+    hd__mpi_sample_t *mine = hd__mpi_alloc(c, ns, sizeof(hd__mpi_sample_t));
     int *counts = hd__mpi_alloc(c, 2 * (size_t)K, sizeof(int));
     double *br = hd__mpi_alloc(c, 2 * (size_t)K, sizeof(double));
     if (!mine || !counts || !br) rc = hd__mpi_nomem(c, "samples", ns);
@@ -360,33 +360,33 @@ int hd__mpi_partition(ctx_t *c, const input_t *in, uint64_t N, node_t *tree) {
     if (rc == HD_OK) take_samples(in, nloc, ns, mine);
     if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
     int n = (int)ns;
-    MPI_GO(c, rc, MPI_Gather(&n, 1, MPI_INT, counts, 1, MPI_INT, 0, c->comm));
+    HD__MPI_GO(c, rc, MPI_Gather(&n, 1, MPI_INT, counts, 1, MPI_INT, 0, c->comm));
     size_t total = 0;
-    sample_t *all = NULL;
+    hd__mpi_sample_t *all = NULL;
     if (c->rank == 0) {
         for (int r = 0; r < K; r++) {
             counts[K + r] = (int)total;
             total += (size_t)counts[r];
         }
-        all = hd__mpi_alloc(c, total, sizeof(sample_t));
+        all = hd__mpi_alloc(c, total, sizeof(hd__mpi_sample_t));
         if (!all) rc = hd__mpi_nomem(c, "samples", total);
     }
     if ((rc = hd__mpi_agree(c, rc)) == HD_OK) {
         double mpi_t0_;
         int mpi_rc_,
-            e = MPI_TIMED(c, MPI_Gatherv(mine, n, c->sample_type, all, counts, counts + K, c->sample_type, 0, c->comm));
+            e = HD__MPI_TIMED(c, MPI_Gatherv(mine, n, c->sample_type, all, counts, counts + K, c->sample_type, 0, c->comm));
         if (e != MPI_SUCCESS) rc = hd__mpi_failed(c, "MPI_Gatherv", e);
-        c->bytes_part += c->rank ? (uint64_t)ns * sizeof(sample_t) : 0;
+        c->bytes_part += c->rank ? (uint64_t)ns * sizeof(hd__mpi_sample_t) : 0;
         if (rc == HD_OK && c->rank == 0) hd__mpi_rcb_tree(all, total, K, tree, br);
     }
-    if (c->rank == 0) hd__mpi_free(c, all, total, sizeof(sample_t));
+    if (c->rank == 0) hd__mpi_free(c, all, total, sizeof(hd__mpi_sample_t));
     if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
-    if (K > 1) MPI_GO(c, rc, MPI_Bcast(tree, K - 1, c->node_type, 0, c->comm));
-    if (K > 1) MPI_GO(c, rc, MPI_Bcast(br, 2 * (K - 1), MPI_DOUBLE, 0, c->comm));
+    if (K > 1) HD__MPI_GO(c, rc, MPI_Bcast(tree, K - 1, c->node_type, 0, c->comm));
+    if (K > 1) HD__MPI_GO(c, rc, MPI_Bcast(br, 2 * (K - 1), MPI_DOUBLE, 0, c->comm));
     if (K > 1) rc = refine(c, in, N, tree, br);
 done:
     hd__mpi_free(c, br, 2 * (size_t)K, sizeof(double));
-    hd__mpi_free(c, mine, ns, sizeof(sample_t));
+    hd__mpi_free(c, mine, ns, sizeof(hd__mpi_sample_t));
     hd__mpi_free(c, counts, 2 * (size_t)K, sizeof(int));
     return rc;
 }

@@ -27,8 +27,8 @@
  * needs no search of Q.  Unfiltered, the shell is the points whose faces
  * are not clear of the engine's answer, the rank's largest u, and they get
  * per-point searches (hd_distances).  The engine prunes the points that cannot be the
- * farthest, which per-point searches cannot: on two epochs of one scene it
- * is tens of times faster (docs/scale-out.md), and the shell is the points
+ * farthest, which per-point searches cannot (mpi_bench times both on two
+ * epochs of one scene; docs/scale-out.md), and the shell is the points
  * within h of the region's faces.
  *
  * Invariants: the local arrays' coordinates are moved (split) and put back
@@ -36,12 +36,12 @@
  * its own point again when a function here returns, and its index (gidx)
  * never changes.
  */
-#include "mpi_int.h"
+#include "mpi/search.h"
 
 #include <assert.h>
 #include <stdlib.h>
 
-void hd__mpi_shell_free(ctx_t *c, shell_t *sh) {
+void hd__mpi_shell_free(hd__mpi_ctx_t *c, hd__mpi_shell_t *sh) {
     hd__mpi_free(c, sh->own_pos, sh->n, sizeof(uint32_t));
     hd__mpi_free(c, sh->unproven, sh->n, 1);
     hd__mpi_free(c, sh->nearest, sh->n, sizeof(size_t));
@@ -70,9 +70,10 @@ typedef struct {
  *    the reverse walk recovers by counting down.
  * A swap moves twice the bytes of a move, so the pairs take an aside when
  * it is small (aside_for: at most a 64th of the points, as the unpaired
- * points of a copy are; docs/scale-out.md has the instructions both ways
- * cost), and the interior's pass always swaps: it may be the rank's peak,
- * and its shell is 3-10 % of the points. */
+ * points of a copy are; callgrind on mpi_bench counts both ways, and
+ * docs/scale-out.md has the counts), and the interior's pass always swaps:
+ * it may be the rank's peak, and its shell is a small part of the
+ * points. */
 HD__INLINE void swap3(double *xyz, size_t i, size_t k) {
     double t[3];
     memcpy(t, xyz + 3 * i, sizeof t);
@@ -80,7 +81,7 @@ HD__INLINE void swap3(double *xyz, size_t i, size_t k) {
     memcpy(xyz + 3 * k, t, sizeof t);
 }
 
-static double *aside_for(ctx_t *c, size_t n, size_t dropped) {
+static double *aside_for(hd__mpi_ctx_t *c, size_t n, size_t dropped) {
     return dropped <= n / 64 ? hd__mpi_alloc(c, dropped, 3 * sizeof(double)) : NULL;
 }
 
@@ -162,10 +163,10 @@ static size_t kept_at(keep_t kp, size_t n, size_t m) {
  * have the same global index (the masks zeroed by the caller; both NULL:
  * count only), and returns their number.  One merge walk over both index
  * orders. */
-static size_t mark_pairs(const gidx_t *gP, size_t nP, const gidx_t *gQ, size_t nQ, unsigned char *inp,
+static size_t mark_pairs(const hd__mpi_gidx_t *gP, size_t nP, const hd__mpi_gidx_t *gQ, size_t nQ, unsigned char *inp,
                          unsigned char *inq) {
     if (nP == 0 || nQ == 0) return 0;
-    gcur_t cp, cq;
+    hd__mpi_gcur_t cp, cq;
     hd__mpi_gcur_init(&cp, gP);
     hd__mpi_gcur_init(&cq, gQ);
     size_t i = 0, j = 0, nc = 0;
@@ -191,7 +192,7 @@ static size_t mark_pairs(const gidx_t *gP, size_t nP, const gidx_t *gQ, size_t n
 /* Whether the merge walk of mark_pairs is worth it: at least three
  * quarters of PAIRS_SAMPLE points of P, evenly spaced, have their partner
  * here (each found by a binary search of Q's indices, decoded at random:
- * a few thousand decodes against the walk's 45-60 instructions a point),
+ * a few thousand decodes, little beside the walk over every point),
  * and nearer than every one of PAIRS_RIVALS points of Q spread over its
  * positions (or tied), as a moved copy's partner is and a random point is
  * not (the engine's gate, docs/engine.md, step 0.5, asks the same of a
@@ -206,7 +207,7 @@ static size_t mark_pairs(const gidx_t *gP, size_t nP, const gidx_t *gQ, size_t n
  * misses a copy only costs that pass, never an answer. */
 #define PAIRS_SAMPLE 64
 #define PAIRS_RIVALS 32
-static int pairs_likely(const double *P, const gidx_t *gP, size_t nP, const double *Q, const gidx_t *gQ,
+static int pairs_likely(const double *P, const hd__mpi_gidx_t *gP, size_t nP, const double *Q, const hd__mpi_gidx_t *gQ,
                         size_t nQ) {
     size_t m = nP < PAIRS_SAMPLE ? nP : PAIRS_SAMPLE, hits = 0, step = nQ / PAIRS_RIVALS + 1;
     for (size_t r = 0; r < m && nQ; r++) {
@@ -239,7 +240,7 @@ static int is_paired(size_t nc, size_t nP, size_t nQ) {
  * sym: both directions (e[0] P to Q, e[1] Q to P), else e[0] only.  box:
  * NULL, or the boxes of all of P and Q, which hold the pairs (the engine
  * needs a box that holds its points, not the smallest). */
-static int pairs_engine(ctx_t *c, double *P, size_t nP, double *Q, size_t nQ, const unsigned char *inp,
+static int pairs_engine(hd__mpi_ctx_t *c, double *P, size_t nP, double *Q, size_t nQ, const unsigned char *inp,
                         const unsigned char *inq, size_t nc, int sym, const hd__box_t *box, hd_result_t e[2]) {
     double *py = aside_for(c, nP, nP - nc), *qx = aside_for(c, nQ, nQ - nc);
     split(P, nP, (keep_t){inp, NULL, 0}, py);
@@ -266,7 +267,7 @@ static int pairs_engine(ctx_t *c, double *P, size_t nP, double *Q, size_t nQ, co
  * pass prunes as an unfiltered one does instead of searching every point
  * that nothing kept bounds (A far from the local B: every u large). */
 static int keep_clear(void *ctx, size_t i, double d2, size_t j) {
-    refused_t *r = ctx;
+    hd__mpi_refused_t *r = ctx;
     if (r->overflow || hd__mpi_faces_clear(r->mine, r->P + 3 * i, d2)) return 1;
     r->d2 = d2 > r->d2 ? d2 : r->d2;
     if (r->n < r->cap) r->pos[r->n] = (uint32_t)i, r->near[r->n++] = (uint32_t)j;
@@ -279,13 +280,13 @@ static int keep_clear(void *ctx, size_t i, double d2, size_t j) {
 #define REFUSED_ROOM(n) ((n) / 256 + 256)
 
 /* The list's arrays, room for r->cap (HD_OK, or the error, charged). */
-static int refused_alloc(ctx_t *c, refused_t *r, size_t n) {
+static int refused_alloc(hd__mpi_ctx_t *c, hd__mpi_refused_t *r, size_t n) {
     r->pos = hd__mpi_alloc(c, r->cap, sizeof(uint32_t));
     r->near = hd__mpi_alloc(c, r->cap, sizeof(uint32_t));
     return r->pos && r->near ? HD_OK : hd__mpi_nomem(c, "the shell", n);
 }
 
-static void refused_free(ctx_t *c, refused_t *r) {
+static void refused_free(hd__mpi_ctx_t *c, hd__mpi_refused_t *r) {
     hd__mpi_free(c, r->pos, r->cap, sizeof(uint32_t));
     hd__mpi_free(c, r->near, r->cap, sizeof(uint32_t));
     r->pos = NULL;
@@ -293,10 +294,10 @@ static void refused_free(ctx_t *c, refused_t *r) {
     r->cap = 0;
 }
 
-void hd__mpi_pre_free(ctx_t *c, pre_t *pre) { refused_free(c, &pre->ref); }
+void hd__mpi_pre_free(hd__mpi_ctx_t *c, hd__mpi_pre_t *pre) { refused_free(c, &pre->ref); }
 
-int hd__mpi_engine_both(ctx_t *c, double *xyz[2], const gidx_t *g[2], const size_t n[2], const hd__box_t box[2],
-                        const hd__box_t *mine, pre_t pre[2], unsigned char *mask[2]) {
+int hd__mpi_engine_both(hd__mpi_ctx_t *c, double *xyz[2], const hd__mpi_gidx_t *g[2], const size_t n[2], const hd__box_t box[2],
+                        const hd__box_t *mine, hd__mpi_pre_t pre[2], unsigned char *mask[2]) {
     memset(pre, 0, 2 * sizeof *pre);
     mask[0] = mask[1] = NULL;
     if (n[0] == 0 || n[1] == 0) return HD_OK; /* shell_of has nothing to ask the engine */
@@ -320,7 +321,7 @@ int hd__mpi_engine_both(ctx_t *c, double *xyz[2], const gidx_t *g[2], const size
         }
     }
     hd_result_t e[2];
-    refused_t ref[2];
+    hd__mpi_refused_t ref[2];
     memset(ref, 0, sizeof ref);
     int rc = HD_OK;
     if (!paired) {
@@ -328,7 +329,7 @@ int hd__mpi_engine_both(ctx_t *c, double *xyz[2], const gidx_t *g[2], const size
          * of their own distance: the interior's maximum, at once (shell_of) */
         hd__keep_t keep[2];
         for (int s = 0; s < 2; s++) {
-            ref[s] = (refused_t){mine, xyz[s], 1, -1.0, NULL, 0, REFUSED_ROOM(n[s]), 0, NULL};
+            ref[s] = (hd__mpi_refused_t){mine, xyz[s], 1, -1.0, NULL, 0, REFUSED_ROOM(n[s]), 0, NULL};
             keep[s] = (hd__keep_t){keep_clear, &ref[s]};
             if (rc == HD_OK) rc = refused_alloc(c, &ref[s], n[s]);
         }
@@ -340,7 +341,7 @@ int hd__mpi_engine_both(ctx_t *c, double *xyz[2], const gidx_t *g[2], const size
         rc = pairs_engine(c, xyz[0], n[0], xyz[1], n[1], mask[0], mask[1], nc, 1, box, e);
     }
     for (int s = 0; s < 2; s++)
-        pre[s] = rc == HD_OK ? (pre_t){1, paired, e[s], mask[s], mask[1 - s], ref[s]} : (pre_t){.ref = ref[s]};
+        pre[s] = rc == HD_OK ? (hd__mpi_pre_t){1, paired, e[s], mask[s], mask[1 - s], ref[s]} : (hd__mpi_pre_t){.ref = ref[s]};
     return rc;
 }
 
@@ -363,10 +364,10 @@ int hd__mpi_engine_both(ctx_t *c, double *xyz[2], const gidx_t *g[2], const size
  * a*'s (the engine's tie rule).  The witness's j is the engine's, or the
  * smallest index of Q_x at exactly h_c.  Otherwise (*done = 0) the caller
  * runs the engine on the whole local sets (or takes d->pre's answer). */
-static int paired_pass(ctx_t *c, const dir_t *d, const hd__box_t *mine, unsigned char **inp, size_t *nI,
-                       far_t *inner, int *done) {
+static int paired_pass(hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, const hd__box_t *mine, unsigned char **inp, size_t *nI,
+                       hd__mpi_far_t *inner, int *done) {
     size_t nP = d->nP, nQ = d->nQ, nc;
-    const pre_t *pre = d->pre && d->pre->have ? d->pre : NULL;
+    const hd__mpi_pre_t *pre = d->pre && d->pre->have ? d->pre : NULL;
     *done = 0;
     *inp = NULL;
     if (pre && !pre->paired) return HD_OK;
@@ -411,7 +412,7 @@ static int paired_pass(ctx_t *c, const dir_t *d, const hd__box_t *mine, unsigned
         }
         uint64_t jv = jx == SIZE_MAX ? UINT64_MAX : hd__mpi_gidx(d->gQ, jx);
         if (in[astar] && v >= e[0].distance2) {
-            *inner = (far_t){e[0].distance2, gi, v == e[0].distance2 && jv < jc ? jv : jc};
+            *inner = (hd__mpi_far_t){e[0].distance2, gi, v == e[0].distance2 && jv < jc ? jv : jc};
             *done = 1;
         }
     }
@@ -430,15 +431,15 @@ done:
  * interior: the interior's maximum is what G was computed without).  The
  * points that cannot are pruned as soon as one point of Q shows it, which
  * is most of them. */
-int hd__mpi_interior_max(ctx_t *c, const dir_t *d, const hd__box_t *mine, const shell_t *sh, double h2,
-                         const far_t *G, far_t *out) {
-    *out = (far_t){-1.0, UINT64_MAX, UINT64_MAX};
+int hd__mpi_interior_max(hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, const hd__box_t *mine, const hd__mpi_shell_t *sh, double h2,
+                         const hd__mpi_far_t *G, hd__mpi_far_t *out) {
+    *out = (hd__mpi_far_t){-1.0, UINT64_MAX, UINT64_MAX};
     /* The interior is what the shell is not (shell_of: the points whose
      * faces are not clear of the same h2, a proper subset: own_pos). */
     assert(sh->own_pos && sh->n < d->nP);
     keep_t in = {NULL, sh->own_pos, sh->n};
     size_t below = 0;
-    gcur_t cu;
+    hd__mpi_gcur_t cu;
     hd__mpi_gcur_init(&cu, d->gP);
     for (size_t k = 0, o = 0; k < d->nP && hd__mpi_gcur_at(&cu, k) < G->i; k++) below += !dropped(&in, k, &o);
     size_t nI = split(d->P, d->nP, in, NULL); /* by swaps: this pass may be the peak */
@@ -452,13 +453,13 @@ int hd__mpi_interior_max(ctx_t *c, const dir_t *d, const hd__box_t *mine, const 
     int rc = G->d2 >= 0 ? hd__mpi_engine_above(c, &Iv, &Qv, G->d2, below, &e) : hd__mpi_engine_local(c, &Iv, &Qv, NULL, NULL, &e);
     unsplit(d->P, d->nP, in, NULL);
     if (rc == HD_OK && (G->d2 < 0 || e.distance2 > G->d2 || (e.distance2 == G->d2 && e.i < below)))
-        *out = (far_t){e.distance2, hd__mpi_gidx(d->gP, kept_at(in, d->nP, e.i)), hd__mpi_gidx(d->gQ, e.j)};
+        *out = (hd__mpi_far_t){e.distance2, hd__mpi_gidx(d->gP, kept_at(in, d->nP, e.i)), hd__mpi_gidx(d->gQ, e.j)};
     return rc;
 }
 
 /* The global index of the shell's point k, through a cursor on P's
  * indices (the shell's points are in P's order). */
-uint64_t hd__mpi_shell_g(gcur_t *cu, const shell_t *sh, size_t k) {
+uint64_t hd__mpi_shell_g(hd__mpi_gcur_t *cu, const hd__mpi_shell_t *sh, size_t k) {
     return hd__mpi_gcur_at(cu, sh->own_pos ? sh->own_pos[k] : k);
 }
 
@@ -478,7 +479,7 @@ static int by_pos(const void *x, const void *y) {
  * answer with the smallest index at its u, so no search of Q is needed;
  * in arrays of exactly their number (NULL when none), as
  * hd__mpi_shell_free frees them. */
-static int refused_shell(ctx_t *c, const refused_t *ref, uint32_t **pos, size_t **near, size_t *n) {
+static int refused_shell(hd__mpi_ctx_t *c, const hd__mpi_refused_t *ref, uint32_t **pos, size_t **near, size_t *n) {
     *pos = NULL;
     *near = NULL;
     *n = 0;
@@ -507,9 +508,9 @@ static int refused_shell(ctx_t *c, const refused_t *ref, uint32_t **pos, size_t 
     return HD_OK;
 }
 
-int hd__mpi_shell_of(ctx_t *c, const dir_t *d, const hd__box_t *mine, qtree_t *q, shell_t *sh) {
+int hd__mpi_shell_of(hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, const hd__box_t *mine, hd__mpi_qtree_t *q, hd__mpi_shell_t *sh) {
     memset(sh, 0, sizeof *sh);
-    sh->inner = (far_t){-1.0, UINT64_MAX, UINT64_MAX};
+    sh->inner = (hd__mpi_far_t){-1.0, UINT64_MAX, UINT64_MAX};
     sh->n = d->nP;
     if (d->nP == 0 || d->nQ == 0) return HD_OK;
     hd_points_t Pv = hd_points_f64(d->P, d->nP), Qv = hd_points_f64(d->Q, d->nQ);
@@ -518,14 +519,14 @@ int hd__mpi_shell_of(ctx_t *c, const dir_t *d, const hd__box_t *mine, qtree_t *q
     size_t nI = 0;
     int done = 0;
     int rc = paired_pass(c, d, mine, &in, &nI, &sh->inner, &done);
-    const pre_t *pre = d->pre && d->pre->have && !d->pre->paired ? d->pre : NULL;
+    const hd__mpi_pre_t *pre = d->pre && d->pre->have && !d->pre->paired ? d->pre : NULL;
     /* The engine's answer over the points kept (hd__mpi_engine_both): every
      * point of P either was refused (its faces not clear of its own u), or
      * has u no larger than the answer, which a kept point attains.  With
      * the refused points' list incomplete, or no point kept, the engine
      * runs again on the whole local sets, without the filter. */
-    const refused_t *ref = pre && pre->ref.on ? &pre->ref : NULL;
-    refused_t own = {mine, d->P, 0, -1.0, NULL, 0, 0, 0, NULL}; /* when the engine runs here */
+    const hd__mpi_refused_t *ref = pre && pre->ref.on ? &pre->ref : NULL;
+    hd__mpi_refused_t own = {mine, d->P, 0, -1.0, NULL, 0, 0, 0, NULL}; /* when the engine runs here */
     if (ref && (ref->overflow || pre->e.i == HD__NONE)) pre = NULL, ref = NULL;
     if (rc == HD_OK && !done && pre) e = pre->e;
     if (rc == HD_OK && !done && !pre) {
@@ -585,10 +586,10 @@ int hd__mpi_shell_of(ctx_t *c, const dir_t *d, const hd__box_t *mine, qtree_t *q
     if (done) {
         /* the interior's answer is the paired pass's */
     } else if (ref || (nI && in[e.i])) {
-        sh->inner = (far_t){e.distance2, hd__mpi_gidx(d->gP, e.i), hd__mpi_gidx(d->gQ, e.j)};
+        sh->inner = (hd__mpi_far_t){e.distance2, hd__mpi_gidx(d->gP, e.i), hd__mpi_gidx(d->gQ, e.j)};
     } else if (nI) {
         sh->lazy = 1; /* interior_max, only if it can matter */
-        sh->h = (far_t){e.distance2, hd__mpi_gidx(d->gP, e.i), hd__mpi_gidx(d->gQ, e.j)};
+        sh->h = (hd__mpi_far_t){e.distance2, hd__mpi_gidx(d->gP, e.i), hd__mpi_gidx(d->gQ, e.j)};
     }
     if (rc == HD_OK && ref) { /* the refused points: a proper subset (the witness is kept) */
         assert(nI > 0);

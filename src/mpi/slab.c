@@ -31,7 +31,7 @@
  * d2 < lb^2 (1 - 1e-9), far beyond the few ulps involved; below 1e-140 no
  * proof is tried.
  */
-#include "mpi_int.h"
+#include "mpi/search.h"
 
 #include <assert.h>
 #include <stdlib.h>
@@ -39,7 +39,7 @@
 /* A structure is charged, once built, at the most its build held (the
  * build's own account: what it allocated, hd__an_t.peak) on top of what
  * this layer held meanwhile, then at what it keeps. */
-int hd__mpi_an_build(ctx_t *c, hd__an_t *s, const hd_points_t *v, const uint32_t *sel, const uint32_t *names,
+int hd__mpi_an_build(hd__mpi_ctx_t *c, hd__an_t *s, const hd_points_t *v, const uint32_t *sel, const uint32_t *names,
                      size_t m, const hd__box_t *kb, int threads, size_t *bytes) {
     int rc = sel ? hd__an_build_sel(s, v, sel, names, m, kb, threads, &c->e)
                  : hd__an_build(s, v, NULL, kb, threads, &c->e);
@@ -52,7 +52,7 @@ int hd__mpi_an_build(ctx_t *c, hd__an_t *s, const hd_points_t *v, const uint32_t
     return rc;
 }
 
-int hd__mpi_an_nearest(ctx_t *c, const hd__an_t *asking, const hd__an_t *searched, const uint32_t *pair_at,
+int hd__mpi_an_nearest(hd__mpi_ctx_t *c, const hd__an_t *asking, const hd__an_t *searched, const uint32_t *pair_at,
                        int threads, size_t *near) {
     size_t b = hd__an_nearest_bytes(asking, searched, threads);
     hd__mpi_charge(c, b);
@@ -61,17 +61,17 @@ int hd__mpi_an_nearest(ctx_t *c, const hd__an_t *asking, const hd__an_t *searche
     return rc;
 }
 
-void hd__mpi_an_release(ctx_t *c, hd__an_t *s, size_t bytes) {
+void hd__mpi_an_release(hd__mpi_ctx_t *c, hd__an_t *s, size_t bytes) {
     hd__an_free(s);
     c->cur -= bytes;
 }
 
-static void slab_free(ctx_t *c, slab_t *sl) {
+static void slab_free(hd__mpi_ctx_t *c, hd__mpi_slab_t *sl) {
     if (sl->built) hd__mpi_an_release(c, &sl->s, sl->bytes);
     memset(sl, 0, sizeof *sl);
 }
 
-void hd__mpi_qtree_free(ctx_t *c, qtree_t *q) {
+void hd__mpi_qtree_free(hd__mpi_ctx_t *c, hd__mpi_qtree_t *q) {
     slab_free(c, &q->sub);
     slab_free(c, &q->full);
 }
@@ -117,7 +117,7 @@ static int near_face(const faces_t *f, const double *b, double M) {
 /* Build the slab of margin M (infinite: all of Q).  Its structure names
  * its points by their positions in Q (hd__an_build_sel): no copy of them
  * is made, and its answers need no map back. */
-static int slab_build(ctx_t *c, const dir_t *d, const hd__box_t *r, double M, slab_t *sl) {
+static int slab_build(hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, const hd__box_t *r, double M, hd__mpi_slab_t *sl) {
     memset(sl, 0, sizeof *sl);
     sl->M = M;
     uint32_t *sel = NULL;
@@ -166,7 +166,7 @@ static int slab_build(ctx_t *c, const dir_t *d, const hd__box_t *r, double M, sl
  * set) would otherwise raise the call's peak by 50 bytes a point of it.
  * Every asker's answer is its own exact nearest point, whatever batch it
  * is in. */
-static int slab_search(ctx_t *c, const slab_t *sl, const double *pts, const uint32_t *pos, const uint32_t *list,
+static int slab_search(hd__mpi_ctx_t *c, const hd__mpi_slab_t *sl, const double *pts, const uint32_t *pos, const uint32_t *list,
                        size_t m, size_t batch, size_t *near) {
     if (m == 0) return HD_OK;
     if (sl->n == 0) {
@@ -200,17 +200,17 @@ static int slab_search(ctx_t *c, const slab_t *sl, const double *pts, const uint
  * rather than searched in a wider slab.  One pass over Q serves them all,
  * and a point of Q is mostly passed over after one coordinate's gap; the
  * wider slab costs two passes over Q measuring face gaps and a structure
- * over the points in it.  Measured (callgrind, the copy at K = 2, 400K
- * points a rank): 160M instructions with 4, 176M with 0 or 1. */
+ * over the points in it.  The value is the one with the fewest
+ * instructions on mpi_bench's copy case (callgrind; the counts are in
+ * docs/scale-out.md). */
 #define BRUTE_MAX 4
 
 /* At most this many askers, while no slab is built, are answered by one
  * pass over all of Q (scan_q) instead: the engine's filter leaves a shell
- * of a few points on most ranks (1 to 36 a direction on the uniform and
- * lidar scenes, 1M a rank, K = 2 and 4), for which the slab's two passes
- * over Q and its structure were 39 instructions a local point (callgrind,
- * uniform at K = 2).  A copy's shell (its pairs cut by a face: about 200)
- * takes the slab. */
+ * of a few points on most ranks, for which the slab's two passes over Q
+ * and its structure cost more than one pass (callgrind on mpi_bench's
+ * uniform and lidar scenes; the counts are in docs/scale-out.md).  A
+ * copy's shell (its pairs cut by a face) is larger and takes the slab. */
 #define SCAN_MAX 16
 _Static_assert(BRUTE_MAX <= SCAN_MAX, "the few the slab left take the scan's pass");
 
@@ -237,7 +237,7 @@ static inline int beyond(const double *b, int a, const double lo[3], const doubl
  *    adds non-negative terms), > MB >= x's bound: farther, not tied;
  *  - for one asker, when fl(dx dx) > its bound (the same argument).
  * Every other b is compared exactly, the smaller index winning a tie. */
-static void pass_over_q(const dir_t *d, const double *pts, const uint32_t *pos, const uint32_t *list, size_t m,
+static void pass_over_q(const hd__mpi_dir_t *d, const double *pts, const uint32_t *pos, const uint32_t *list, size_t m,
                         double *best, size_t *at) {
 #define X(t) (pts + 3 * (pos ? pos[list ? list[t] : (t)] : list ? list[t] : (t)))
     double lo[3], hi[3];
@@ -287,7 +287,7 @@ static void pass_over_q(const dir_t *d, const double *pts, const uint32_t *pos, 
 /* The exact nearest point of Q (smallest index on ties) for each of the
  * n <= SCAN_MAX askers at pts + 3 pos[k] (pos NULL: pts + 3 k): bounds
  * from a strided sample of Q, then one pass over it. */
-static void scan_q(const dir_t *d, const double *pts, const uint32_t *pos, size_t n, size_t *near) {
+static void scan_q(const hd__mpi_dir_t *d, const double *pts, const uint32_t *pos, size_t n, size_t *near) {
     double best[SCAN_MAX];
     assert(n <= SCAN_MAX && d->nQ > 0);
     for (size_t t = 0; t < n; t++) best[t] = INFINITY, near[t] = SIZE_MAX;
@@ -300,7 +300,7 @@ static void scan_q(const dir_t *d, const double *pts, const uint32_t *pos, size_
     pass_over_q(d, pts, pos, NULL, n, best, near);
 }
 
-int hd__mpi_nearest_in_q(ctx_t *c, const dir_t *d, const hd__box_t *r, qtree_t *q, const double *pts,
+int hd__mpi_nearest_in_q(hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, const hd__box_t *r, hd__mpi_qtree_t *q, const double *pts,
                          const uint32_t *pos, size_t n, size_t *near, unsigned char *unproven) {
     if (n == 0) return HD_OK;
     if (n <= SCAN_MAX && !q->sub.built && !q->full.built && d->nQ > 0) {
@@ -330,7 +330,7 @@ int hd__mpi_nearest_in_q(ctx_t *c, const dir_t *d, const hd__box_t *r, qtree_t *
     for (size_t k = 0; k < n; k++) list[k] = (uint32_t)k;
     /* the slab, a wider one for what it did not prove, then all of Q */
     for (int level = 0; level < 3 && m > 0 && rc == HD_OK; level++) {
-        slab_t *sl = level == 2 ? &q->full : &q->sub;
+        hd__mpi_slab_t *sl = level == 2 ? &q->full : &q->sub;
         double M = level == 2 ? INFINITY : q->M0;
         if (level == 1 && m <= BRUTE_MAX) { /* a few: every point of Q, in one pass */
             /* each from the slab's answer, an upper bound */

@@ -233,7 +233,7 @@ static void gather_task(void *vctx, size_t task, int worker) {
         for (size_t at = lo; at < hi; at++) {
             if (at + 16 < s->n && c->src.kind != HD__SRC_ANY)
                 __builtin_prefetch(c->src.base + (ptrdiff_t)sel[(uint32_t)c->b[at + 16]] *
-                                                     (c->src.kind == HD__SRC_F64 ? 24 : 12));
+                                                     hd__src_packed_stride(&c->src));
             uint32_t i = (uint32_t)c->b[at < s->n ? at : s->n - 1];
             double p[3];
             hd__src_get(&c->src, sel[i], p);
@@ -244,7 +244,7 @@ static void gather_task(void *vctx, size_t task, int worker) {
     }
     for (size_t at = lo; at < hi; at++) {
         if (at + 16 < s->n && c->src.kind != HD__SRC_ANY)
-            __builtin_prefetch(c->src.base + (ptrdiff_t)(uint32_t)c->b[at + 16] * (c->src.kind == HD__SRC_F64 ? 24 : 12));
+            __builtin_prefetch(c->src.base + (ptrdiff_t)(uint32_t)c->b[at + 16] * hd__src_packed_stride(&c->src));
         uint32_t i = (uint32_t)c->b[at < s->n ? at : s->n - 1];
         double p[3];
         hd__src_get(&c->src, i, p);
@@ -509,7 +509,7 @@ static int build(hd__an_t *s, const hd_points_t *p, const uint32_t *sel, const u
     hd__src_init(&c.src, p, T);
     hd__keygrid_init(&c.grid, keybox);
     c.parts = threads > MAX_PARTS ? MAX_PARTS : threads;
-    if ((size_t)c.parts > n / 65536 + 1) c.parts = (int)(n / 65536 + 1);
+    c.parts = hd__parts_for(n, c.parts);
     /* Node and bucket arrays grow as the octree is cut (a bucket usually
      * holds a few dozen points; at worst there are fewer than 2n nodes,
      * since every inner node has two children or more). */
@@ -881,14 +881,227 @@ static void scatter_answers(void *vctx, size_t task, int worker) {
         for (size_t k = lo; k < hi; k++) c->nearest[idx[k]] = c->sj[k];
 }
 
+/* Queries first .. first + m - 1 of q (at most HD__AN_GROUP, one key
+ * group or a piece of it) while query_task answers them: their box, each
+ * one's best answer so far (a real point's squared distance) and its name,
+ * its partner's name, and its seed bucket on t's curve. */
+typedef struct {
+    size_t first, m;
+    hd__box_t box;
+    double best[HD__AN_GROUP];
+    uint32_t bj[HD__AN_GROUP], pj[HD__AN_GROUP];
+    size_t seed[HD__AN_GROUP];
+} qgroup_t;
+
+HD__INLINE void qgroup_box(const hd__an_t *q, qgroup_t *G) {
+    const double *v[3] = {q->x, q->y, q->z};
+    for (int d = 0; d < 3; d++) {
+        G->box.lo[d] = G->box.hi[d] = v[d][G->first];
+        for (size_t k = G->first + 1; k < G->first + G->m; k++) {
+            G->box.lo[d] = v[d][k] < G->box.lo[d] ? v[d][k] : G->box.lo[d];
+            G->box.hi[d] = v[d][k] > G->box.hi[d] ? v[d][k] : G->box.hi[d];
+        }
+    }
+}
+
+/* Each query's place on t's curve: the searched bucket at its own
+ * bucket's key (h: the query's bucket, s0: the last seed, both carried
+ * from query to query of a key group). */
+HD__INLINE void qgroup_seeds(const hd__an_t *q, const hd__an_t *t, qgroup_t *G, size_t *h, size_t *s0) {
+    for (size_t k = 0; k < G->m; k++) {
+        while (q->start[*h + 1] <= G->first + k) ++*h;
+        if (k == 0 || q->start[*h] == G->first + k) *s0 = bucket_at(t, q->key[*h], *s0);
+        G->seed[k] = *s0;
+    }
+}
+
+/* The partner path's first answers: each query's partner (a point of the
+ * caller's partner set at the query's own index, read there, or a point
+ * of t named by pair_at) and its distance.  Returns the largest, which
+ * bounds every answer of the group (infinite when a query has no
+ * partner). */
+HD__INLINE double partner_bests(const query_ctx *c, const hd__src_t *psrc, qgroup_t *G) {
+    const hd__an_t *q = c->q, *t = c->t;
+    size_t first = G->first, m = G->m;
+    double U = 0;
+    if (c->partner) {
+        /* The partners are read in the original order, far apart: ask for
+         * the next chunk's while this one is worked on. */
+        for (size_t k = first + m; k < first + 2 * m && k < q->n; k++)
+            __builtin_prefetch(psrc->base + (ptrdiff_t)q->idx[k] * psrc->ps);
+        for (size_t k = 0; k < m; k++) {
+            double p[3];
+            uint32_t i = q->idx[first + k];
+            hd__src_get(psrc, i, p);
+            G->best[k] = hd__d2s(q->x[first + k], q->y[first + k], q->z[first + k], p[0], p[1], p[2]);
+            G->pj[k] = G->bj[k] = i;
+            U = G->best[k] > U ? G->best[k] : U;
+        }
+        return U;
+    }
+    /* The partners are points of t, near in its order when near in space;
+     * a query without one has no bound (U infinite: the seeds go on from
+     * the others). */
+    for (size_t k = 0; k < m; k++) {
+        uint32_t at = c->pair_at[first + k];
+        G->pj[k] = UINT32_MAX;
+        if (at == HD__AN_NO_PARTNER) {
+            U = INFINITY;
+            continue;
+        }
+        assert(at < t->n);
+        G->best[k] = hd__d2s(q->x[first + k], q->y[first + k], q->z[first + k], t->x[at], t->y[at], t->z[at]);
+        G->pj[k] = G->bj[k] = t->idx[at];
+        U = G->best[k] > U ? G->best[k] : U;
+    }
+    return U;
+}
+
+/* The window path's first answers (query_task's essay): each query's best
+ * among the WINDOW points of t around its own place on t's curve (the
+ * seeds must be set).  Returns U, the largest best of the queries not set
+ * apart (those above 16 times, in squares, the geometric mean of the
+ * group's bests, from their exponents), with their number in *apart. */
+HD__INLINE double window_bests(const hd__an_t *q, const hd__an_t *t, qgroup_t *G, size_t *apart) {
+    size_t first = G->first, m = G->m;
+    int64_t esum = 0;
+    for (size_t k = 0, p = 0, b = 0; k < m; k++) {
+        uint32_t kq = q->key32[first + k];
+        b = bucket_at(t, kq, b > G->seed[k] ? b : G->seed[k]);
+        p = p > t->start[b] ? p : t->start[b];
+        while (p < t->start[b + 1] && t->key32[p] < kq) p++;
+        size_t k0 = p & ~(size_t)3;
+        k0 = k0 >= WINDOW / 2 ? k0 - WINDOW / 2 : 0;
+        size_t e = k0 + WINDOW < t->n ? k0 + WINDOW : t->n;
+        scan_span(t, k0, e, q->x[first + k], q->y[first + k], q->z[first + k], &G->best[k], &G->bj[k]);
+        uint64_t u;
+        __builtin_memcpy(&u, &G->best[k], sizeof u);
+        esum += (int64_t)(u >> 52);
+    }
+    int64_t ecut = esum / (int64_t)m + 4;
+    uint64_t ucut = (uint64_t)(ecut < 2047 ? ecut : 2047) << 52;
+    double cut, U = 0;
+    __builtin_memcpy(&cut, &ucut, sizeof cut);
+    *apart = 0;
+    for (size_t k = 0; k < m; k++) {
+        int far = G->best[k] > cut;
+        *apart += (size_t)far;
+        U = !far && G->best[k] > U ? G->best[k] : U;
+    }
+    return U;
+}
+
+/* The seeds' answers, when no path listed the candidates: the searched
+ * buckets at each query's place on the curve (the seeds must be set), and
+ * the bucket nearest to the group's box, give every query a real point;
+ * U, the largest of these distances (or the nearest bucket's bound Ub,
+ * when smaller), bounds every answer of the group and lists its
+ * candidates into cd.  Returns the nearest bucket. */
+HD__INLINE size_t seed_bests(const hd__an_t *q, const hd__an_t *t, qgroup_t *G, cands_t *cd, double *U) {
+    double Ub = INFINITY;
+    size_t near = nearest_leaf(t, &G->box, &Ub);
+    *U = 0;
+    /* A seed bucket whose box is farther from the group's than Ub holds no
+     * answer of the group and is not listed (U <= Ub below): it is not
+     * scanned either (disjoint sets, where the curve's seeds are far and
+     * the nearest leaf is near). */
+    size_t last = SIZE_MAX;
+    int useful[SEEDS] = {0};
+    for (size_t k = 0; k < G->m; k++) {
+        double qx = q->x[G->first + k], qy = q->y[G->first + k], qz = q->z[G->first + k];
+        if (G->seed[k] != last) {
+            last = G->seed[k];
+            for (size_t b = last; b < last + SEEDS; b++)
+                useful[b - last] = b < t->nb && node_lb2(&G->box, t, t->leaf[b]) <= Ub;
+        }
+        for (size_t b = G->seed[k]; b < G->seed[k] + SEEDS; b++)
+            if (useful[b - G->seed[k]]) scan_bucket(t, b, qx, qy, qz, &G->best[k], &G->bj[k]);
+        if (near < G->seed[k] || near >= G->seed[k] + SEEDS) scan_bucket(t, near, qx, qy, qz, &G->best[k], &G->bj[k]);
+        *U = G->best[k] > *U ? G->best[k] : *U;
+    }
+    *U = Ub < *U ? Ub : *U;
+    candidates(t, &G->box, *U, SIZE_MAX, cd);
+    return near;
+}
+
+/* Every query of the group answered exactly from the candidates listed
+ * within U, into c->sd and c->sj.  A windowed query whose best is still
+ * above U after its seed buckets may have its answer outside the list:
+ * it gets candidates of its own, within its best.  Returns how many
+ * answers were the partners (for the partner path's upkeep). */
+HD__INLINE size_t qgroup_finish(query_ctx *c, cands_t *cd, qgroup_t *G, double U, int paired, int windowed,
+                                size_t near) {
+    const hd__an_t *q = c->q, *t = c->t;
+    size_t first = G->first, kept = 0, napart = 0;
+    uint32_t apart[HD__AN_GROUP];
+    for (size_t k = 0; k < G->m; k++) {
+        double qx = q->x[first + k], qy = q->y[first + k], qz = q->z[first + k];
+        if (windowed && G->best[k] > U) {
+            /* Set apart: its seed buckets usually bring it within U, and
+             * then the list holds its answer; if not: later. */
+            for (size_t b = G->seed[k]; b < G->seed[k] + SEEDS && b < t->nb; b++)
+                scan_bucket(t, b, qx, qy, qz, &G->best[k], &G->bj[k]);
+            if (G->best[k] > U) {
+                apart[napart++] = (uint32_t)k;
+                cd->counts.apart++;
+                continue;
+            }
+            finish_query(t, cd, qx, qy, qz, U, G->seed[k], G->seed[k] + SEEDS, SIZE_MAX, &G->best[k], &G->bj[k]);
+        } else if (paired) finish_query(t, cd, qx, qy, qz, U, 0, 0, SIZE_MAX, &G->best[k], &G->bj[k]);
+        else finish_query(t, cd, qx, qy, qz, U, G->seed[k], G->seed[k] + SEEDS, near, &G->best[k], &G->bj[k]);
+        c->sd[first + k] = G->best[k];
+        c->sj[first + k] = G->bj[k];
+        kept += paired && !windowed && G->bj[k] == G->pj[k];
+    }
+    /* The queries set apart: each one's own candidates, the buckets within
+     * its best so far (a real point's distance, so at least its answer) of
+     * the query itself. */
+    for (size_t r = 0; r < napart; r++) {
+        size_t k = apart[r];
+        double qx = q->x[first + k], qy = q->y[first + k], qz = q->z[first + k];
+        hd__box_t pb = {{qx, qy, qz}, {qx, qy, qz}};
+        candidates(t, &pb, G->best[k], SIZE_MAX, cd);
+        finish_query(t, cd, qx, qy, qz, G->best[k], 0, 0, SIZE_MAX, &G->best[k], &G->bj[k]);
+        c->sd[first + k] = G->best[k];
+        c->sj[first + k] = G->bj[k];
+    }
+    return kept;
+}
+
+/* The groups of a task, each answered in phases: its box; first answers
+ * by the partner path or the window path while they pay, each listing the
+ * group's candidates when its bound lists few; else the seeds' answers
+ * and their candidates; then every query exactly (qgroup_finish).
+ *
+ * The partner path: when the sets are a copy and its original in the same
+ * order, each query's partner (the searched point of its own original
+ * index) is usually at or next to its answer.  Its distance is a real
+ * point's, so the largest over the group bounds every answer; if few
+ * buckets lie within it, they are the candidates and no seed is scanned.
+ * Otherwise the partners still stand as first answers for the seeds to
+ * improve on.
+ *
+ * The window path: a near-copy in another order (or two sets sampled
+ * alike) puts each query's answer at about its own place on t's curve,
+ * the two orders being taken on one grid: p, the first point of t whose
+ * key is not below the query's (found from its seed bucket's start, the
+ * queries' keys growing).  The WINDOW points of t around it are real
+ * points, so each query's best among them bounds its answer.  A few
+ * queries whose answer lies across a jump of the curve get a far worse
+ * best than the others; U, the largest best of the rest, bounds their
+ * answers and lists few candidates, and those few (best above U) are
+ * searched on their own afterwards.
+ *
+ * A task drops either path once most of the groups it tried, PAIR_TRIAL
+ * at least, failed (for the partners: did not find most answers at the
+ * partners; for the window: more than an eighth of the queries apart, or
+ * too many candidates); no answer depends on any of this. */
 HD__HOT static void query_task(void *vctx, size_t task, int worker) {
     query_ctx *c = vctx;
     const hd__an_t *q = c->q, *t = c->t;
     cands_t *cd = &c->cand[worker];
     size_t g0 = task * GROUPS_PER_TASK, g1 = g0 + GROUPS_PER_TASK < q->ng ? g0 + GROUPS_PER_TASK : q->ng;
-    double best[HD__AN_GROUP];
-    uint32_t bj[HD__AN_GROUP], pj[HD__AN_GROUP]; /* pj: the partners' names */
-    size_t seed[HD__AN_GROUP];
+    qgroup_t G;
     size_t at0 = g0 < g1 ? bucket_at(t, q->key[q->glead[g0]], 0) : 0;
     hd__src_t psrc;
     if (c->partner) hd__src_init(&psrc, c->partner, NULL);
@@ -899,202 +1112,39 @@ HD__HOT static void query_task(void *vctx, size_t task, int worker) {
         size_t h = q->glead[g], s0 = at0;
         at0 = bucket_at(t, q->key[h], at0);
         for (size_t first = q->gstart[g]; first < q->gstart[g + 1]; first += HD__AN_GROUP) {
-            size_t m = q->gstart[g + 1] - first < HD__AN_GROUP ? q->gstart[g + 1] - first : HD__AN_GROUP;
-            hd__box_t gbox;
-            const double *v[3] = {q->x, q->y, q->z};
-            for (int d = 0; d < 3; d++) {
-                gbox.lo[d] = gbox.hi[d] = v[d][first];
-                for (size_t k = first + 1; k < first + m; k++) {
-                    gbox.lo[d] = v[d][k] < gbox.lo[d] ? v[d][k] : gbox.lo[d];
-                    gbox.hi[d] = v[d][k] > gbox.hi[d] ? v[d][k] : gbox.hi[d];
-                }
-            }
-            /* The partner path: when the sets are a copy and its
-             * original in the same order, each query's partner (the
-             * searched point of its own original index) is usually at or
-             * next to its answer.  Its distance is a real point's, so the
-             * largest over the group bounds every answer; if few buckets
-             * lie within it, they are the candidates and no seed is
-             * scanned.  Otherwise the partners still stand as first
-             * answers for the seeds to improve on.  A task drops the path
-             * once most of the groups it tried, PAIR_TRIAL at least, did
-             * not find most answers at the partners; no answer depends on
-             * any of this. */
+            G.first = first;
+            G.m = q->gstart[g + 1] - first < HD__AN_GROUP ? q->gstart[g + 1] - first : HD__AN_GROUP;
+            qgroup_box(q, &G);
             double U = 0;
             int paired = 0, windowed = 0, seeded = 0;
-            for (size_t k = 0; k < m; k++) best[k] = INFINITY, bj[k] = UINT32_MAX;
+            for (size_t k = 0; k < G.m; k++) G.best[k] = INFINITY, G.bj[k] = UINT32_MAX;
             if ((c->partner || c->pair_at) && (tried < PAIR_TRIAL || 2 * kept_groups >= tried)) {
-                if (c->partner) {
-                    /* The partners are read in the original order, far
-                     * apart: ask for the next chunk's while this one is
-                     * worked on. */
-                    for (size_t k = first + m; k < first + 2 * m && k < q->n; k++)
-                        __builtin_prefetch(psrc.base + (ptrdiff_t)q->idx[k] * psrc.ps);
-                    for (size_t k = 0; k < m; k++) {
-                        double p[3];
-                        uint32_t i = q->idx[first + k];
-                        hd__src_get(&psrc, i, p);
-                        best[k] = hd__d2s(q->x[first + k], q->y[first + k], q->z[first + k], p[0], p[1], p[2]);
-                        pj[k] = bj[k] = i;
-                        U = best[k] > U ? best[k] : U;
-                    }
-                } else {
-                    /* The partners are points of t, near in its order when
-                     * near in space; a query without one has no bound
-                     * (U infinite: the seeds go on from the others). */
-                    for (size_t k = 0; k < m; k++) {
-                        uint32_t at = c->pair_at[first + k];
-                        pj[k] = UINT32_MAX;
-                        if (at == HD__AN_NO_PARTNER) {
-                            U = INFINITY;
-                            continue;
-                        }
-                        assert(at < t->n);
-                        best[k] = hd__d2s(q->x[first + k], q->y[first + k], q->z[first + k], t->x[at], t->y[at],
-                                          t->z[at]);
-                        pj[k] = bj[k] = t->idx[at];
-                        U = best[k] > U ? best[k] : U;
-                    }
-                }
-                paired = candidates(t, &gbox, U, PAIR_CANDIDATES, cd);
+                U = partner_bests(c, &psrc, &G);
+                paired = candidates(t, &G.box, U, PAIR_CANDIDATES, cd);
                 tried++;
                 cd->counts.paired += (size_t)paired;
             } else if (wtried < PAIR_TRIAL || 2 * wkept >= wtried) {
-                /* The window path: a near-copy in another order (or two
-                 * sets sampled alike) puts each query's answer at about
-                 * its own place on t's curve, the two orders being taken
-                 * on one grid: p, the first point of t whose key is not
-                 * below the query's (found from its seed bucket's start,
-                 * the queries' keys growing).  The WINDOW points of t around
-                 * it are real points, so each query's best among them
-                 * bounds its answer.  A few queries whose answer lies
-                 * across a jump of the curve get a far worse best than
-                 * the others; U, the largest best of the rest, bounds
-                 * their answers and lists few candidates, and those few
-                 * (best above U) are searched on their own afterwards.
-                 * The cut between them: 16 times (in squares) the
-                 * geometric mean of the group's bests, from their
-                 * exponents.  Dropped by a task, as the partners are,
-                 * when most groups tried fail (more than an eighth of
-                 * the queries apart, or too many candidates); no answer
-                 * depends on any of this. */
-                /* Each query's place on t's curve: the searched bucket
-                 * at its own bucket's key. */
-                for (size_t k = 0; k < m; k++) {
-                    while (q->start[h + 1] <= first + k) h++;
-                    if (k == 0 || q->start[h] == first + k) s0 = bucket_at(t, q->key[h], s0);
-                    seed[k] = s0;
-                }
+                qgroup_seeds(q, t, &G, &h, &s0);
                 seeded = 1;
-                int64_t esum = 0;
-                for (size_t k = 0, p = 0, b = 0; k < m; k++) {
-                    uint32_t kq = q->key32[first + k];
-                    b = bucket_at(t, kq, b > seed[k] ? b : seed[k]);
-                    p = p > t->start[b] ? p : t->start[b];
-                    while (p < t->start[b + 1] && t->key32[p] < kq) p++;
-                    size_t k0 = p & ~(size_t)3;
-                    k0 = k0 >= WINDOW / 2 ? k0 - WINDOW / 2 : 0;
-                    size_t e = k0 + WINDOW < t->n ? k0 + WINDOW : t->n;
-                    scan_span(t, k0, e, q->x[first + k], q->y[first + k], q->z[first + k], &best[k], &bj[k]);
-                    uint64_t u;
-                    __builtin_memcpy(&u, &best[k], sizeof u);
-                    esum += (int64_t)(u >> 52);
-                }
-                int64_t ecut = esum / (int64_t)m + 4;
-                uint64_t ucut = (uint64_t)(ecut < 2047 ? ecut : 2047) << 52;
-                double cut;
-                __builtin_memcpy(&cut, &ucut, sizeof cut);
-                size_t apart = 0;
-                for (size_t k = 0; k < m; k++) {
-                    int far = best[k] > cut;
-                    apart += (size_t)far;
-                    U = !far && best[k] > U ? best[k] : U;
-                }
-                if (8 * apart <= m) paired = candidates(t, &gbox, U, PAIR_CANDIDATES, cd);
+                size_t apart;
+                U = window_bests(q, t, &G, &apart);
+                if (8 * apart <= G.m) paired = candidates(t, &G.box, U, PAIR_CANDIDATES, cd);
                 windowed = paired;
                 wtried++;
                 wkept += (size_t)paired;
                 cd->counts.windowed += (size_t)paired;
             }
-            /* Seeds: the searched buckets at each query's place on the
-             * curve, and the bucket nearest to the group's box, give every
-             * query a real point; U, the largest of these distances,
-             * bounds every answer of the group. */
             size_t near = SIZE_MAX;
             if (!paired) {
-                if (!seeded) {
-                    /* Each query's place on t's curve: the searched bucket
-                     * at its own bucket's key. */
-                    for (size_t k = 0; k < m; k++) {
-                        while (q->start[h + 1] <= first + k) h++;
-                        if (k == 0 || q->start[h] == first + k) s0 = bucket_at(t, q->key[h], s0);
-                        seed[k] = s0;
-                    }
-                }
-                double Ub = INFINITY;
-                near = nearest_leaf(t, &gbox, &Ub);
-                U = 0;
-                /* A seed bucket whose box is farther from the group's
-                 * than Ub holds no answer of the group and is not listed
-                 * (U <= Ub below): it is not scanned either (disjoint sets,
-                 * where the curve's seeds are far and the nearest leaf is
-                 * near). */
-                size_t last = SIZE_MAX;
-                int useful[SEEDS] = {0};
-                for (size_t k = 0; k < m; k++) {
-                    double qx = q->x[first + k], qy = q->y[first + k], qz = q->z[first + k];
-                    if (seed[k] != last) {
-                        last = seed[k];
-                        for (size_t b = last; b < last + SEEDS; b++)
-                            useful[b - last] = b < t->nb && node_lb2(&gbox, t, t->leaf[b]) <= Ub;
-                    }
-                    for (size_t b = seed[k]; b < seed[k] + SEEDS; b++)
-                        if (useful[b - seed[k]]) scan_bucket(t, b, qx, qy, qz, &best[k], &bj[k]);
-                    if (near < seed[k] || near >= seed[k] + SEEDS) scan_bucket(t, near, qx, qy, qz, &best[k], &bj[k]);
-                    U = best[k] > U ? best[k] : U;
-                }
-                U = Ub < U ? Ub : U;
-                candidates(t, &gbox, U, SIZE_MAX, cd);
+                if (!seeded) qgroup_seeds(q, t, &G, &h, &s0);
+                near = seed_bests(q, t, &G, cd, &U);
             }
-            size_t kept = 0, napart = 0;
-            uint32_t apart[HD__AN_GROUP];
-            for (size_t k = 0; k < m; k++) {
-                double qx = q->x[first + k], qy = q->y[first + k], qz = q->z[first + k];
-                if (windowed && best[k] > U) {
-                    /* Set apart: its seed buckets usually bring it within
-                     * U, and then the list holds its answer; if not, its
-                     * answer may lie outside the list: later. */
-                    for (size_t b = seed[k]; b < seed[k] + SEEDS && b < t->nb; b++)
-                        scan_bucket(t, b, qx, qy, qz, &best[k], &bj[k]);
-                    if (best[k] > U) {
-                        apart[napart++] = (uint32_t)k;
-                        cd->counts.apart++;
-                        continue;
-                    }
-                    finish_query(t, cd, qx, qy, qz, U, seed[k], seed[k] + SEEDS, SIZE_MAX, &best[k], &bj[k]);
-                } else if (paired) finish_query(t, cd, qx, qy, qz, U, 0, 0, SIZE_MAX, &best[k], &bj[k]);
-                else finish_query(t, cd, qx, qy, qz, U, seed[k], seed[k] + SEEDS, near, &best[k], &bj[k]);
-                c->sd[first + k] = best[k];
-                c->sj[first + k] = bj[k];
-                kept += paired && !windowed && bj[k] == pj[k];
-            }
-            /* The queries set apart: each one's own candidates, the
-             * buckets within its best so far (a real point's distance, so
-             * at least its answer) of the query itself. */
-            for (size_t r = 0; r < napart; r++) {
-                size_t k = apart[r];
-                double qx = q->x[first + k], qy = q->y[first + k], qz = q->z[first + k];
-                hd__box_t pb = {{qx, qy, qz}, {qx, qy, qz}};
-                candidates(t, &pb, best[k], SIZE_MAX, cd);
-                finish_query(t, cd, qx, qy, qz, best[k], 0, 0, SIZE_MAX, &best[k], &bj[k]);
-                c->sd[first + k] = best[k];
-                c->sj[first + k] = bj[k];
-            }
-            /* The path pays when the partners are the answers (a copy),
-             * not merely near enough to list few candidates (a few
-             * buckets of repeated points): it is kept on while at least
-             * half of the groups tried had half of their answers there. */
-            kept_groups += !windowed && 2 * kept >= m;
+            size_t kept = qgroup_finish(c, cd, &G, U, paired, windowed, near);
+            /* The path pays when the partners are the answers (a copy), not
+             * merely near enough to list few candidates (a few buckets of
+             * repeated points): it is kept on while at least half of the
+             * groups tried had half of their answers there. */
+            kept_groups += !windowed && 2 * kept >= G.m;
         }
     }
 }

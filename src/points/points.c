@@ -61,8 +61,9 @@ void hd_points_get(const hd_points_t *p, size_t k, double out[3]) {
  * holds coordinates 2j and 2j + 1 of the step, so coordinate c of the
  * box is the bound over the lanes holding c.  _mm_min_pd(a, b) is a < b ?
  * a : b, lane by lane, as the scalar loop's select; |v| <= HD_MAX_COORD is
- * false for NaN and infinities.  About 10 instructions a point, where the
- * scalar loop, which the compiler does not vectorise, took 21 to 26. */
+ * false for NaN and infinities.  The scalar loop, which the compiler does
+ * not vectorise, takes more instructions a point (callgrind on hd_bench's
+ * cases; the counts are in docs/benchmarks.md). */
 HD__HOT int hd__box_checked(const double *xyz, size_t n, hd__box_t *out) {
     double lo[3] = {xyz[0], xyz[1], xyz[2]}, hi[3] = {xyz[0], xyz[1], xyz[2]};
     int ok = 1;

@@ -97,6 +97,35 @@ HD__INLINE double hd__box_lb2s(const hd__box_t *b, double x, double y, double z)
     return gx * gx + gy * gy + gz * gz;
 }
 
+/* Smallest computed squared distance between a point of box a and a point of
+ * box b (0 when they meet).  Same operation order as hd__d2: with exact
+ * boxes it never exceeds hd__d2 of a point pair drawn from them.  The one
+ * box-to-box bound: INC's MBRs (classic/) and the engine's walk over two
+ * trees (engine/walk.c) both use it. */
+HD__INLINE double hd__box_box_lb2(const hd__box_t *a, const hd__box_t *b) {
+    double d[3];
+    for (int k = 0; k < 3; k++) {
+        double v = 0.0;
+        if (b->lo[k] > a->hi[k]) v = b->lo[k] - a->hi[k];
+        else if (a->lo[k] > b->hi[k]) v = a->lo[k] - b->hi[k];
+        d[k] = v;
+    }
+    return d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+}
+
+/* Largest computed squared distance between a point of box a and a point of
+ * box b (the farthest pair of corners); never below hd__d2 of such a pair. */
+HD__INLINE double hd__box_box_ub2(const hd__box_t *a, const hd__box_t *b) {
+    double d[3];
+    for (int k = 0; k < 3; k++) {
+        double u = a->hi[k] - b->lo[k], v = b->hi[k] - a->lo[k];
+        if (u < 0) u = -u;
+        if (v < 0) v = -v;
+        d[k] = u > v ? u : v;
+    }
+    return d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+}
+
 /* ---- the running maximum with its witness ------------------------------- */
 /* best.d2 = -1 means "nothing yet".  Merge keeps the larger d2 and, on a
  * tie, the smaller i: so the witness is independent of evaluation order. */
@@ -222,6 +251,13 @@ typedef struct hd__src {
 
 void hd__src_init(hd__src_t *s, const hd_points_t *p, const hd_transform_t *T);
 
+/* The bytes from one point to the next of a packed source (HD__SRC_F64 or
+ * HD__SRC_F32): what a prefetch of point k adds to base, k times.  The
+ * one place the two packed strides are written for the readers ahead. */
+HD__INLINE ptrdiff_t hd__src_packed_stride(const hd__src_t *s) {
+    return s->kind == HD__SRC_F64 ? 24 : 12;
+}
+
 /* Point k of the source (original numbering), transformed if T is set. */
 HD__INLINE void hd__src_get(const hd__src_t *s, size_t k, double out[3]) {
     double p[3];
@@ -267,8 +303,8 @@ HD__INLINE void hd__src_keys_of(const hd__src_t *src, hd__src_kind_t kind, hd__k
 
 /* The loop specialised for packed doubles without a transform (the
  * layout the engine's callers mostly pass), with the grid in locals so
- * that the stores cannot be taken to change it: about half the
- * instructions of the general loop (docs/benchmarks.md). */
+ * that the stores cannot be taken to change it: fewer instructions than
+ * the general loop (callgrind; the counts are in docs/benchmarks.md). */
 HD__INLINE void hd__src_keys(const hd__src_t *src, const hd__keygrid_t *grid, size_t lo, size_t hi,
                              uint64_t *keys) {
     if (src->kind == HD__SRC_F64 && !src->T) hd__src_keys_of(src, HD__SRC_F64, *grid, lo, hi, keys);

@@ -84,7 +84,7 @@ static void radix_scatter(void *vctx, size_t part, int worker) {
 int hd__radix_sort(uint64_t **a, uint64_t **tmp, size_t n, int threads) {
     int parts = threads;
     if (parts > MAX_SORT_THREADS) parts = MAX_SORT_THREADS;
-    if ((size_t)parts > n / 65536 + 1) parts = (int)(n / 65536 + 1);
+    parts = hd__parts_for(n, parts);
     size_t(*hist)[RADIX] = hd__malloc_array((size_t)parts, sizeof *hist);
     if (!hist) return HD_ENOMEM;
     radix_ctx c;

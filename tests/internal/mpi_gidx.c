@@ -1,6 +1,6 @@
 /*
  * mpi_gidx.c -- the local sets' global indices of the MPI library
- * (src/mpi/gidx.c, mpi_int.h's gidx_t): a set of indices of a side,
+ * (src/mpi/gidx.c, ranges.h's hd__mpi_gidx_t): a set of indices of a side,
  * encoded in increasing order over the side's index runs, gives back every
  * index by position (hd__mpi_gidx), through a cursor (hd__mpi_gcur_at)
  * walked in order, with jumps, and backwards, with the rank whose run holds
@@ -12,14 +12,14 @@
  */
 #include "check.h"
 #include "gen.h"
-#include "mpi/mpi_int.h"
+#include "mpi/ranges.h"
 
 #include <stdlib.h>
 
 /* A scene: both sides' runs of K ranks and, for each side, a local set. */
 typedef struct {
-    ctx_t c;
-    ranges_t rg;
+    hd__mpi_ctx_t c;
+    hd__mpi_ranges_t rg;
     uint64_t *g[2];           /* the local sets' indices, increasing */
     int *owner[2];            /* the rank of each one's run */
     size_t n[2];
@@ -34,14 +34,14 @@ static void scene_free(scene_t *sc) {
     CHECK_EQ(sc->c.cur, 0); /* every byte given back */
 }
 
-/* The runs (lo, hi, side, rank) as ranges_t, and each side's local set:
+/* The runs (lo, hi, side, rank) as hd__mpi_ranges_t, and each side's local set:
  * every index of a run with probability keep (1: all of them). */
-static void scene_make(scene_t *sc, int K, const range_t *runs, size_t nruns, double keep, gen_rng_t *rng) {
+static void scene_make(scene_t *sc, int K, const hd__mpi_range_t *runs, size_t nruns, double keep, gen_rng_t *rng) {
     memset(sc, 0, sizeof *sc);
     sc->rg.K = K;
     sc->rg.total = nruns;
-    sc->rg.all = hd__mpi_alloc(&sc->c, nruns, sizeof(range_t));
-    memcpy(sc->rg.all, runs, nruns * sizeof(range_t));
+    sc->rg.all = hd__mpi_alloc(&sc->c, nruns, sizeof(hd__mpi_range_t));
+    memcpy(sc->rg.all, runs, nruns * sizeof(hd__mpi_range_t));
     CHECK_RC(hd__mpi_ranges_index(&sc->c, &sc->rg), HD_OK);
     for (int s = 0; s < 2; s++) {
         size_t a = sc->rg.seg[(size_t)s * ((size_t)K + 1)], b = sc->rg.seg[(size_t)s * ((size_t)K + 1) + (size_t)K],
@@ -65,7 +65,7 @@ static void check_side(scene_t *sc, int s, gen_rng_t *rng) {
     size_t n = sc->n[s];
     const uint64_t *g = sc->g[s];
     size_t before = sc->c.cur;
-    gidx_t x;
+    hd__mpi_gidx_t x;
     CHECK_RC(hd__mpi_gidx_init(&sc->c, &x, &sc->rg, s, n), HD_OK);
     for (size_t k = 0, m; k < n; k += m) /* in pieces of any length, as the exchange's runs */
         hd__mpi_gidx_put_indices(&x, k, g + k, m = 1 + (size_t)(gen_u64(rng) % (n - k)));
@@ -83,7 +83,7 @@ static void check_side(scene_t *sc, int s, gen_rng_t *rng) {
     for (size_t k = 0; k < n && !hdt_failed(); k++) CHECK_EQ(hd__mpi_gidx(&x, k), g[k]);
     /* the cursor in order, each position twice (the second from the
      * cursor's memory), with its run's rank */
-    gcur_t cu;
+    hd__mpi_gcur_t cu;
     hd__mpi_gcur_init(&cu, &x);
     for (size_t k = 0; k < n && !hdt_failed(); k++) {
         CHECK_EQ(hd__mpi_gcur_at(&cu, k), g[k]);
@@ -120,7 +120,7 @@ static void check_side(scene_t *sc, int s, gen_rng_t *rng) {
     CHECK_EQ(sc->c.cur, before);
 }
 
-static void check_scene(int K, const range_t *runs, size_t nruns, double keep, uint64_t seed) {
+static void check_scene(int K, const hd__mpi_range_t *runs, size_t nruns, double keep, uint64_t seed) {
     gen_rng_t rng;
     gen_seed(&rng, seed);
     scene_t sc;
@@ -134,14 +134,14 @@ static void check_scene(int K, const range_t *runs, size_t nruns, double keep, u
 }
 
 TEST(an_empty_set_holds_nothing_and_frees_cleanly) {
-    range_t runs[] = {{0, 999, 0, 0}, {5, 5, 1, 1}};
+    hd__mpi_range_t runs[] = {{0, 999, 0, 0}, {5, 5, 1, 1}};
     check_scene(2, runs, 2, 0.0, 1);
 }
 
 TEST(one_point_among_many_is_found) {
     gen_rng_t rng;
     gen_seed(&rng, 2);
-    range_t runs[] = {{100, 100099, 0, 0}, {0, 0, 1, 0}};
+    hd__mpi_range_t runs[] = {{100, 100099, 0, 0}, {0, 0, 1, 0}};
     scene_t sc;
     scene_make(&sc, 1, runs, 2, 0.0, &rng);
     sc.g[0][0] = 77777, sc.owner[0][0] = 0, sc.n[0] = 1; /* one point of A */
@@ -155,13 +155,13 @@ TEST(one_point_among_many_is_found) {
 }
 
 TEST(all_points_of_a_side_on_one_rank_take_no_low_bits) {
-    range_t runs[] = {{0, 9999, 0, 0}, {10000, 20000, 0, 1}, {30000, 30000, 0, 0}, {0, 4095, 1, 1}};
+    hd__mpi_range_t runs[] = {{0, 9999, 0, 0}, {10000, 20000, 0, 1}, {30000, 30000, 0, 0}, {0, 4095, 1, 1}};
     check_scene(2, runs, 4, 1.0, 3); /* every index of both sides: l = 0 */
 }
 
 TEST(sparse_huge_offsets_near_two_to_the_63_and_the_top) {
     uint64_t top = UINT64_MAX - 1; /* the largest index a part may hold */
-    range_t runs[] = {
+    hd__mpi_range_t runs[] = {
         {(UINT64_C(1) << 63) - 1000, (UINT64_C(1) << 63) + 1000, 0, 2}, /* across 2^63 */
         {(UINT64_C(1) << 63) + 5000, (UINT64_C(1) << 63) + 5000, 0, 0}, /* a gap, one index */
         {UINT64_C(1) << 40, (UINT64_C(1) << 40) + 3000, 0, 1},
@@ -184,12 +184,12 @@ TEST(random_runs_and_densities_read_back_exactly) {
         gen_seed(&rng, seed);
         int K = 1 + (int)(gen_u64(&rng) % 9);
         size_t nruns = 1 + gen_u64(&rng) % 40, maxlen = 1 + gen_u64(&rng) % 3000;
-        range_t *runs = malloc(nruns * sizeof *runs);
+        hd__mpi_range_t *runs = malloc(nruns * sizeof *runs);
         uint64_t at[2] = {gen_u64(&rng) % 2 ? 0 : gen_u64(&rng) >> 2, gen_u64(&rng) >> 3};
         for (size_t i = 0; i < nruns; i++) {
             int s = (int)(gen_u64(&rng) % 2);
             uint64_t len = 1 + gen_u64(&rng) % maxlen, gap = gen_u64(&rng) % 3 ? gen_u64(&rng) % 5 : gen_u64(&rng) >> 14;
-            runs[i] = (range_t){at[s], at[s] + len - 1, s, (int)(gen_u64(&rng) % (uint64_t)K)};
+            runs[i] = (hd__mpi_range_t){at[s], at[s] + len - 1, s, (int)(gen_u64(&rng) % (uint64_t)K)};
             at[s] += len + gap;
         }
         double keep = gen_u64(&rng) % 4 == 0 ? 1.0 : gen_unit(&rng) * gen_unit(&rng);

@@ -10,7 +10,7 @@
  * only counts bytes), so this runs without mpirun.
  */
 #include "check.h"
-#include "mpi/mpi_int.h"
+#include "mpi/context.h"
 
 #include <stdint.h>
 #include <stdlib.h>
@@ -22,7 +22,7 @@
 static void fill(void *p, size_t bytes) { memset(p, 0x5a, bytes); }
 
 TEST(a_long_lived_buffer_is_charged_its_bytes_however_close_to_whole_pages) {
-    ctx_t c;
+    hd__mpi_ctx_t c;
     memset(&c, 0, sizeof c);
     /* 995,704 points of 24 bytes: 22.8 MiB, 0.8 MiB past whole pages */
     size_t n = 995704;
@@ -36,7 +36,7 @@ TEST(a_long_lived_buffer_is_charged_its_bytes_however_close_to_whole_pages) {
 }
 
 TEST(a_scratch_buffer_within_an_eighth_of_whole_pages_is_charged_the_whole_pages) {
-    ctx_t c;
+    hd__mpi_ctx_t c;
     memset(&c, 0, sizeof c);
     size_t n = 1000000; /* 4,000,000 bytes: 4 MiB wastes 4.6 % */
     uint32_t *o = hd__mpi_scratch(&c, n, sizeof(uint32_t));
@@ -53,7 +53,7 @@ TEST(a_scratch_buffer_within_an_eighth_of_whole_pages_is_charged_the_whole_pages
 }
 
 TEST(a_scratch_buffer_far_from_whole_pages_is_charged_its_bytes) {
-    ctx_t c;
+    hd__mpi_ctx_t c;
     memset(&c, 0, sizeof c);
     size_t sizes[] = {1000000, 3 * MIB, 5 * MIB / 2, 100, 0}; /* 2 MiB, 4 MiB or 3 MiB would waste more than an eighth */
     for (size_t k = 0; k < sizeof sizes / sizeof *sizes; k++) {
@@ -68,7 +68,7 @@ TEST(a_scratch_buffer_far_from_whole_pages_is_charged_its_bytes) {
 }
 
 TEST(the_peak_counts_a_rounded_scratch_buffer_with_what_else_is_held) {
-    ctx_t c;
+    hd__mpi_ctx_t c;
     memset(&c, 0, sizeof c);
     unsigned char *a = hd__mpi_alloc(&c, 1000, 1);
     unsigned char *s = hd__mpi_scratch(&c, 2000000, 1); /* 2 MiB wastes 4.9 % */
@@ -85,7 +85,7 @@ TEST(the_peak_counts_a_rounded_scratch_buffer_with_what_else_is_held) {
 }
 
 TEST(a_count_whose_bytes_overflow_gets_nothing_and_charges_nothing) {
-    ctx_t c;
+    hd__mpi_ctx_t c;
     memset(&c, 0, sizeof c);
     CHECK(hd__mpi_scratch(&c, SIZE_MAX / 2, 4) == NULL);
     CHECK(hd__mpi_alloc(&c, SIZE_MAX / 8 + 1, 16) == NULL);

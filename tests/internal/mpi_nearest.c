@@ -11,7 +11,7 @@
 #include "brute.h"
 #include "check.h"
 #include "gen.h"
-#include "mpi/mpi_int.h"
+#include "mpi/search.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -28,15 +28,15 @@ static size_t brute(const double *x, const double *Q, size_t nQ) {
  * answers checked against the brute force; unproven NULL, so every answer
  * must be exact. */
 static void check_against_brute(const hd__box_t *r, double *P, const uint32_t *pos, size_t n, double *Q, size_t nQ) {
-    ctx_t c;
+    hd__mpi_ctx_t c;
     memset(&c, 0, sizeof c);
     c.threads = 1;
-    qtree_t q;
+    hd__mpi_qtree_t q;
     memset(&q, 0, sizeof q);
     q.M0 = 0.5;
     size_t nP = 0;
     for (size_t k = 0; k < n; k++) nP = pos && pos[k] + 1 > nP ? pos[k] + 1 : nP;
-    dir_t d = {P, NULL, pos ? nP : n, Q, NULL, nQ, 1, NULL};
+    hd__mpi_dir_t d = {P, NULL, pos ? nP : n, Q, NULL, nQ, 1, NULL};
     size_t *near = malloc(n * sizeof *near);
     CHECK(near != NULL);
     CHECK_EQ(hd__mpi_nearest_in_q(&c, &d, r, &q, P, pos, n, near, NULL), HD_OK);

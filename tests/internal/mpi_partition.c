@@ -7,7 +7,7 @@
  * sanitizer build).
  *
  * White-box: the body runs inside hd__mpi_call's context, sets the first
- * samples a rank (ctx_t.first) itself, calls hd__mpi_partition and routes
+ * samples a rank (hd__mpi_ctx_t.first) itself, calls hd__mpi_partition and routes
  * every local point with hd__mpi_rank_of, as the exchange does.  The
  * imbalance is the largest rank's count over the mean.  The partition is a
  * deterministic function of the points and their spread, so each check
@@ -16,7 +16,7 @@
  * 16 and 64 ranks in docs/scale-out.md ("Fewer first samples at many
  * ranks").
  */
-#include "mpi/mpi_int.h"
+#include "mpi/course.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -54,13 +54,13 @@ typedef struct {
     double imbalance; /* out: the largest rank's points over the mean */
 } probe_t;
 
-static int partition_body(ctx_t *c, const hd_options_t *opt, input_t *in, void *arg, hd_mpi_stats_t *st) {
+static int partition_body(hd__mpi_ctx_t *c, const hd_options_t *opt, hd__mpi_input_t *in, void *arg, hd_mpi_stats_t *st) {
     (void)st;
     probe_t *pr = arg;
-    course_t cs;
+    hd__mpi_course_t cs;
     hd__mpi_course_init(c, &cs);
     int rc = hd__mpi_begin(c, opt, in, pr, &cs.rg, cs.N, NULL);
-    node_t *tree = hd__mpi_alloc(c, (size_t)c->K, sizeof(node_t));
+    hd__mpi_node_t *tree = hd__mpi_alloc(c, (size_t)c->K, sizeof(hd__mpi_node_t));
     uint64_t *count = hd__mpi_alloc(c, 2 * (size_t)c->K, sizeof(uint64_t));
     if (rc == HD_OK && (!tree || !count)) rc = hd__mpi_nomem(c, "the test's counts", (size_t)c->K);
     if ((rc = hd__mpi_agree(c, rc)) == HD_OK) {
@@ -86,7 +86,7 @@ static int partition_body(ctx_t *c, const hd_options_t *opt, input_t *in, void *
         }
         pr->imbalance = (double)most * c->K / (double)all;
     }
-    hd__mpi_free(c, tree, (size_t)c->K, sizeof(node_t));
+    hd__mpi_free(c, tree, (size_t)c->K, sizeof(hd__mpi_node_t));
     hd__mpi_free(c, count, 2 * (size_t)c->K, sizeof(uint64_t));
     hd__mpi_course_free(c, &cs);
     return rc;

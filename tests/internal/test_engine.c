@@ -20,6 +20,8 @@
 #include "check.h"
 #include "gen.h"
 #include "engine/engine.h"
+#include "engine/grid.h" /* white-box: the grid pass, the maximum, the tree kernels */
+#include "engine/tree.h"
 
 #include <math.h>
 #include <stdlib.h>

@@ -7,8 +7,8 @@
  */
 #include "brute.h"
 #include "check.h"
-#include "engine/engine.h" /* hd__index_nearest_by and its paths */
 #include "gen.h"
+#include "index.h" /* hd__index_nearest_by and its paths */
 
 #include <math.h>
 #include <pthread.h>

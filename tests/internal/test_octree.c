@@ -10,7 +10,7 @@
 #include "brute.h"
 #include "check.h"
 #include "gen.h"
-#include "classic/classic.h"
+#include "classic/classic_int.h" /* white-box: the octree */
 
 #include <math.h>
 #include <stdlib.h>

@@ -1,0 +1,60 @@
+/*
+ * course.h -- private to src/mpi/: the course of a call (mpi.c, whose
+ * essay has the algorithm): what the ranks hold after the partition, the
+ * one-rank views, and the steps every entry point takes.
+ *
+ * Conventions of every function here: a hd__mpi_ctx_t carries the call's
+ * communicator, its error (c->e, what hd__mpi_agree() broadcasts) and its
+ * count of bytes held (every buffer through hd__mpi_alloc/hd__mpi_free, so
+ * the peak is known and the call can assert that it freed everything); a
+ * function that can fail returns an HD_* code with c->e set, and collective
+ * functions agree on a status before every collective a failed rank would
+ * not reach.
+ */
+#ifndef HD_MPI_COURSE_H
+#define HD_MPI_COURSE_H
+
+#include "mpi/partition.h"
+
+/* ---- the course of a call (mpi.c) ---------------------------------------- */
+
+/* What the ranks hold after the partition (K > 1). */
+typedef struct {
+    hd__mpi_node_t *tree;            /* K - 1 nodes */
+    hd__box_t *region;       /* K: every rank's region */
+    hd__mpi_held_t *held;            /* K: every rank's count and box a set */
+    hd__mpi_local_t loc;             /* this rank's points */
+} hd__mpi_spread_t;
+
+/* K = 1: each set as one view (the caller's, or packed in index order). */
+typedef struct {
+    hd_points_t v[2];
+    double *own[2];
+    const hd_mpi_part_t **order[2];
+} hd__mpi_views_t;
+
+/* What a call's body holds from its start to its end. */
+typedef struct {
+    hd__mpi_ranges_t rg;
+    hd__mpi_spread_t sp;             /* K > 1 */
+    uint64_t N[2];           /* points of A and B over all ranks */
+    double t0, cpu0;         /* the body's start (wall, thread CPU) */
+} hd__mpi_course_t;
+
+void hd__mpi_course_init(hd__mpi_ctx_t *c, hd__mpi_course_t *cs);
+void hd__mpi_course_free(hd__mpi_ctx_t *c, hd__mpi_course_t *cs);
+int hd__mpi_figures(hd__mpi_ctx_t *c, const hd__mpi_course_t *cs, uint64_t pts, hd_mpi_stats_t *st, double *tmax);
+
+/* A call's body, run by hd__mpi_call inside its context. */
+typedef int (*hd__mpi_body_t)(hd__mpi_ctx_t *c, const hd_options_t *opt, hd__mpi_input_t *in, void *arg, hd_mpi_stats_t *st);
+
+int hd__mpi_call(MPI_Comm comm, const hd_mpi_part_t *a, size_t na, const hd_mpi_part_t *b, size_t nb,
+                 const hd_options_t *opt, hd__mpi_body_t body, void *arg, hd_mpi_stats_t *st, hd_error_t *err);
+int hd__mpi_begin(hd__mpi_ctx_t *c, const hd_options_t *opt, hd__mpi_input_t *in, const void *res, hd__mpi_ranges_t *rg, uint64_t N[2],
+                  double corners[2][6]);
+int hd__mpi_spread(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const hd__mpi_ranges_t *rg, const uint64_t N[2], hd__mpi_spread_t *sp);
+void hd__mpi_spread_free(hd__mpi_ctx_t *c, hd__mpi_spread_t *sp);
+int hd__mpi_views(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, hd__mpi_views_t *vw);
+void hd__mpi_views_free(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, hd__mpi_views_t *vw);
+
+#endif /* HD_MPI_COURSE_H */
