@@ -25,7 +25,7 @@ import sys
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 if len(sys.argv) > 1:  # another tree (the checker's own test)
     ROOT = os.path.abspath(sys.argv[1])
-LEVEL = {"base": 0, "points": 1, "io": 2, "classic": 2, "engine": 2, "nearest": 2, "mesh": 2, "": 3, "mpi": 4}
+LEVEL = {"base": 0, "points": 1, "io": 2, "classic": 2, "engine": 2, "nearest": 2, "mesh": 2, "masks": 2, "": 3, "mpi": 4}
 # The public headers: hausdorff.h anywhere, hausdorff_mpi.h only in the MPI
 # library and the MPI tool (cli/mpi/).
 PUBLIC_MPI = "hausdorff_mpi.h"
