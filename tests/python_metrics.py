@@ -70,6 +70,7 @@ def test_figures_agree_with_monai_and_medpy_definitions(seed, shape, connectivit
     for k, p in enumerate([95, 50]):
         assert close(m.percentile[k], max(np.percentile(d_pg, p), np.percentile(d_gp, p)), **rt)  # MONAI
         assert close(m.percentile_pooled[k], np.percentile(np.concatenate([d_pg, d_gp]), p), **rt)  # medpy
+        assert close(m.percentile_ab[k], np.percentile(d_pg, p), **rt)  # MONAI directed=True
     assert close(m.assd, np.concatenate([d_pg, d_gp]).mean(), **rt)  # MONAI >= 1.0, medpy 0.5
     assert close(m.assd_average, (d_pg.mean() + d_gp.mean()) / 2, **rt)  # MONAI 0.x
     if connectivity == 1:
@@ -178,3 +179,10 @@ def test_point_set_scores_equal_the_command_line():
         assert (s["precision"], s["recall"], s["fscore"], s["nsd"]) == t[1:5]
     d = scores.dtu(a, b, 0.5)
     assert (j["dtu"]["accuracy"], j["dtu"]["completeness"], j["dtu"]["overall"]) == d[:3]
+
+
+def test_docstring_examples_run():
+    import doctest
+    for module in (masks, scores):
+        failed, _ = doctest.testmod(module, optionflags=doctest.ELLIPSIS)
+        assert failed == 0, module.__name__

@@ -141,6 +141,8 @@ class MaskMetrics:
     hausdorff_ba: float          #: gt -> pred
     percentile: List[float]      #: MONAI's: max(P(pred->gt), P(gt->pred))
     percentile_pooled: List[float]  #: medpy's: P of both directions pooled
+    percentile_ab: List[float]   #: P of pred -> gt (MONAI's directed=True)
+    percentile_ba: List[float]   #: P of gt -> pred
     assd: float                  #: pooled (MONAI >= 1.0, medpy 0.5)
     assd_average: float          #: mean of the two directed means (MONAI 0.x)
     asd_ab: float                #: mean pred -> gt (medpy's asd(pred, gt))
@@ -198,14 +200,15 @@ def metrics(pred, gt, spacing=None, *, percentile: Union[float, Sequence[float],
             inf_a if len(a) else None, inf_b if len(b) else None, None, None, None, taus, strict, 0.0)[2]
         if len(taus) and not len(a) and not len(b):
             sc = [(t, math.nan, math.nan, math.nan, math.nan, 0, 0) for t in taus]
-        return MaskMetrics(v, v, v, [v] * len(ps), [v] * len(ps), v, v, v, v,
+        return MaskMetrics(v, v, v, [v] * len(ps), [v] * len(ps), [v] * len(ps), [v] * len(ps), v, v, v, v,
                            [s[4] if len(a) or len(b) else math.nan for s in sc],
                            [s[1] for s in sc], [s[2] for s in sc], [s[3] for s in sc],
                            dice(pred, gt), (len(a), len(b)), fg)
     d_ab, _ = _hausdorff.distances(a, b, threads=threads)
     d_ba, _ = _hausdorff.distances(b, a, threads=threads)
     s, pc, sc, _cap = _hausdorff._figures(d_ab, d_ba, None, None, pcts, taus, strict, 0.0)
-    return MaskMetrics(max(s[0], s[1]), s[0], s[1], [p[3] for p in pc], [p[4] for p in pc], s[6], s[5],
+    return MaskMetrics(max(s[0], s[1]), s[0], s[1], [p[3] for p in pc], [p[4] for p in pc], [p[1] for p in pc],
+                       [p[2] for p in pc], s[6], s[5],
                        s[2], s[3], [t[4] for t in sc], [t[1] for t in sc], [t[2] for t in sc],
                        [t[3] for t in sc], dice(pred, gt), (len(a), len(b)), fg)
 
