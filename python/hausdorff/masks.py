@@ -106,7 +106,9 @@ def surface(mask, spacing=None, *, connectivity: int = 1, dims="auto", all: bool
     s = _spacing(spacing, v.ndim)
     if connectivity not in (1, 2, 3):
         raise ValueError(f"connectivity is 1, 2 or 3, not {connectivity!r}")
-    raw, _fg, _sd, _c = _hausdorff._mask_points(v.tobytes(order="F"), n[0], n[1], n[2], s[0], s[1], s[2],
+    # v is Fortran-ordered (axis 0 fastest, as the library reads voxels);
+    # its transpose is the same memory, C-contiguous, read without a copy
+    raw, _fg, _sd, _c = _hausdorff._mask_points(v.T, n[0], n[1], n[2], s[0], s[1], s[2],
                                                 connectivity, _dims(dims), bool(all))
     return np.frombuffer(raw, dtype=np.float64).reshape(-1, 3).copy()
 
