@@ -95,30 +95,35 @@ def _dims(dims) -> int:
     raise ValueError(f"dims is 'auto', 2 or 3, not {dims!r}")
 
 
-def surface(mask, spacing=None, *, connectivity: int = 1, dims="auto", all: bool = False) -> np.ndarray:
-    """The (n, 3) float64 points of a mask's surface voxels (every
-    foreground voxel with all=True), in storage order of axis 0 fastest.
-    connectivity 1, 2, 3 as medpy's; dims "auto" erodes along the axes of
-    more than one voxel, 2 each slice of constant axis 2 on its own, 3 all
-    three (the command line's --mask-dims)."""
-    v = _voxels(mask, "mask")
+def _points(v: np.ndarray, spacing, connectivity: int, dims, all: bool) -> Tuple[np.ndarray, int]:
+    """The points of the converted mask v (_voxels) and its foreground count."""
     n = list(v.shape) + [1] * (3 - v.ndim)
     s = _spacing(spacing, v.ndim)
     if connectivity not in (1, 2, 3):
         raise ValueError(f"connectivity is 1, 2 or 3, not {connectivity!r}")
     # v is Fortran-ordered (axis 0 fastest, as the library reads voxels);
     # its transpose is the same memory, C-contiguous, read without a copy
-    raw, _fg, _sd, _c = _hausdorff._mask_points(v.T, n[0], n[1], n[2], s[0], s[1], s[2],
-                                                connectivity, _dims(dims), bool(all))
-    return np.frombuffer(raw, dtype=np.float64).reshape(-1, 3).copy()
+    raw, fg, _sd, _c = _hausdorff._mask_points(v.T, n[0], n[1], n[2], s[0], s[1], s[2],
+                                               connectivity, _dims(dims), bool(all))
+    return np.frombuffer(raw, dtype=np.float64).reshape(-1, 3).copy(), fg
+
+
+def surface(mask, spacing=None, *, connectivity: int = 1, dims="auto", all: bool = False) -> np.ndarray:
+    """The (n, 3) float64 points of a mask's surface voxels (every
+    foreground voxel with all=True), in storage order of axis 0 fastest.
+    connectivity 1, 2, 3 as medpy's; dims "auto" erodes along the axes of
+    more than one voxel, 2 each slice of constant axis 2 on its own, 3 all
+    three (the command line's --mask-dims)."""
+    return _points(_voxels(mask, "mask"), spacing, connectivity, dims, all)[0]
 
 
 def _pair(pred, gt, spacing, connectivity, dims):
-    p, g = np.asarray(pred), np.asarray(gt)
-    if p.shape != g.shape:
-        raise ValueError(f"pred and gt have different shapes: {p.shape} and {g.shape}")
-    return (surface(p, spacing, connectivity=connectivity, dims=dims),
-            surface(g, spacing, connectivity=connectivity, dims=dims))
+    """(pred's points, gt's points, pred's voxels, gt's voxels, foreground counts)."""
+    vp, vg = _voxels(pred, "pred"), _voxels(gt, "gt")
+    if vp.shape != vg.shape:
+        raise ValueError(f"pred and gt have different shapes: {vp.shape} and {vg.shape}")
+    (a, fa), (b, fb) = (_points(v, spacing, connectivity, dims, False) for v in (vp, vg))
+    return a, b, vp, vg, (fa, fb)
 
 
 def distances(pred, gt, spacing=None, *, connectivity: int = 1, dims="auto",
@@ -126,7 +131,7 @@ def distances(pred, gt, spacing=None, *, connectivity: int = 1, dims="auto",
     """(distances of pred's surface voxels to gt's surface, of gt's to
     pred's), each in storage order; empty arrays for an empty mask's side
     and inf for the other's when one mask is empty."""
-    a, b = _pair(pred, gt, spacing, connectivity, dims)
+    a, b = _pair(pred, gt, spacing, connectivity, dims)[:2]
     if len(a) and len(b):
         d_ab, _ = _hausdorff.distances(a, b, threads=threads)
         d_ba, _ = _hausdorff.distances(b, a, threads=threads)
@@ -164,14 +169,18 @@ def _empty_value(empty: str, n_a: int, n_b: int) -> float:
     return {"inf": math.inf, "nan": math.nan, "zero": 0.0}[empty]
 
 
+def _dice(vp: np.ndarray, vg: np.ndarray, fg: Tuple[int, int]) -> float:
+    total = fg[0] + fg[1]
+    return 2 * int(np.count_nonzero(vp & vg)) / total if total else math.nan
+
+
 def dice(pred, gt) -> float:
     """2 |pred and gt| / (|pred| + |gt|) over the foreground voxels; NaN
     when both masks are empty (DeepMind's compute_dice_coefficient)."""
-    p, g = _voxels(pred, "pred").astype(bool), _voxels(gt, "gt").astype(bool)
-    if p.shape != g.shape:
-        raise ValueError(f"pred and gt have different shapes: {p.shape} and {g.shape}")
-    total = int(p.sum()) + int(g.sum())
-    return 2 * int((p & g).sum()) / total if total else math.nan
+    vp, vg = _voxels(pred, "pred"), _voxels(gt, "gt")
+    if vp.shape != vg.shape:
+        raise ValueError(f"pred and gt have different shapes: {vp.shape} and {vg.shape}")
+    return _dice(vp, vg, (int(np.count_nonzero(vp)), int(np.count_nonzero(vg))))
 
 
 def _floats(v) -> np.ndarray:
@@ -186,8 +195,7 @@ def metrics(pred, gt, spacing=None, *, percentile: Union[float, Sequence[float],
     (MONAI, DeepMind)."""
     if empty not in _EMPTY:
         raise ValueError(f"empty is one of {', '.join(_EMPTY)}, not {empty!r}")
-    a, b = _pair(pred, gt, spacing, connectivity, dims)
-    fg = (int(_voxels(pred, "pred").sum()), int(_voxels(gt, "gt").sum()))
+    a, b, vp, vg, fg = _pair(pred, gt, spacing, connectivity, dims)
     ps = [] if percentile is None else [float(p) for p in np.atleast_1d(percentile)]
     taus = _floats([] if tau is None else tau)
     pcts = _floats(ps) if ps else None
@@ -205,14 +213,14 @@ def metrics(pred, gt, spacing=None, *, percentile: Union[float, Sequence[float],
         return MaskMetrics(v, v, v, [v] * len(ps), [v] * len(ps), [v] * len(ps), [v] * len(ps), v, v, v, v,
                            [s[4] if len(a) or len(b) else math.nan for s in sc],
                            [s[1] for s in sc], [s[2] for s in sc], [s[3] for s in sc],
-                           dice(pred, gt), (len(a), len(b)), fg)
+                           _dice(vp, vg, fg), (len(a), len(b)), fg)
     d_ab, _ = _hausdorff.distances(a, b, threads=threads)
     d_ba, _ = _hausdorff.distances(b, a, threads=threads)
     s, pc, sc, _cap = _hausdorff._figures(d_ab, d_ba, None, None, pcts, taus, strict, 0.0)
     return MaskMetrics(max(s[0], s[1]), s[0], s[1], [p[3] for p in pc], [p[4] for p in pc], [p[1] for p in pc],
                        [p[2] for p in pc], s[6], s[5],
                        s[2], s[3], [t[4] for t in sc], [t[1] for t in sc], [t[2] for t in sc],
-                       [t[3] for t in sc], dice(pred, gt), (len(a), len(b)), fg)
+                       [t[3] for t in sc], _dice(vp, vg, fg), (len(a), len(b)), fg)
 
 
 def hausdorff(pred, gt, spacing=None, *, percentile: Optional[float] = None, definition: str = "monai",
