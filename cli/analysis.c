@@ -7,7 +7,9 @@
  * distances per direction (hd_distances): the percentile figures
  * (hd_percentile_of: "ab", "ba", "symmetric" = max of the two as MONAI,
  * "pooled" = both directions together as medpy), the means and Chamfer
- * distances (hd_summarize) and the histograms (hd_histogram, numpy's bins).
+ * distances (hd_summarize), the histograms (hd_histogram, numpy's bins),
+ * the scores at tolerances (--tau: hd_tolerance_scores, precision, recall,
+ * F-score, NSD) and DTU's capped means (--dtu-cap: hd_capped_means).
  * The tool only adds files (writers.c, render.c) and text.  The per-point
  * distances are computed once, and only when an option needs them, so a
  * plain run costs exactly what it did before.

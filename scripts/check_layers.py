@@ -5,8 +5,8 @@ src/ is built in layers, each a folder, each offering one header:
 
     base     base/base.h       errors, memory, rng, threads, selection, heap
     points   points/points.h   distance, boxes, keys, views, sources, sort
-    io, classic, engine, nearest   (siblings: none includes another)
-    src/*.c  api.c, index.c, stats.c: the public entry points, over all
+    io, classic, engine, nearest, mesh, masks   (siblings: none includes another)
+    src/*.c  api.c, index.c, stats.c, metrics.c: the public entry points, over all
     mpi      (hausdorff_mpi.h) the optional MPI library, over the public API
 
 A file may include the standard library, "hausdorff.h", headers of its own
