@@ -7,7 +7,9 @@
  * distances per direction (hd_distances): the percentile figures
  * (hd_percentile_of: "ab", "ba", "symmetric" = max of the two as MONAI,
  * "pooled" = both directions together as medpy), the means and Chamfer
- * distances (hd_summarize) and the histograms (hd_histogram, numpy's bins).
+ * distances (hd_summarize), the histograms (hd_histogram, numpy's bins),
+ * the scores at tolerances (--tau: hd_tolerance_scores, precision, recall,
+ * F-score, NSD) and DTU's capped means (--dtu-cap: hd_capped_means).
  * The tool only adds files (writers.c, render.c) and text.  The per-point
  * distances are computed once, and only when an option needs them, so a
  * plain run costs exactly what it did before.
@@ -34,6 +36,10 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+
+static int scores_figures(const analysis_args_t *an, const double *d_ab, size_t n_a, const double *d_ba,
+                          size_t n_b, analysis_result_t *r, hd_error_t *err);
+static void print_scores(FILE *out, const analysis_args_t *an, const analysis_result_t *r, const char *unit);
 
 /* ---- options -------------------------------------------------------------- */
 
@@ -76,6 +82,17 @@ void analysis_usage(FILE *out) {
 "  --units TEXT       the distances' unit, shown in the report, the JSON and\n"
 "                     the pictures (a label: nothing is scaled); masks whose\n"
 "                     header names mm, um or m are in mm without it\n"
+"\n"
+"Scores at a tolerance (A: the prediction or reconstruction, B: the reference):\n"
+"  --tau T[,T...]     at each tolerance T (up to 64): precision (share of A\n"
+"                     within T of B), recall (of B within T of A), F-score,\n"
+"                     and NSD, the normalized surface Dice counted per point\n"
+"                     (MONAI's compute_surface_dice on masks' surfaces)\n"
+"  --tau-rule le|lt   within means d <= T (le, default: MONAI, DeepMind) or\n"
+"                     d < T (lt: the Tanks and Temples evaluation)\n"
+"  --dtu-cap D        DTU accuracy (mean A->B distance) and completeness\n"
+"                     (mean B->A) over the distances below D, and overall =\n"
+"                     their average, as the DTU MVS evaluation (D = 20 there)\n"
 "\n"
 "Medical masks: A or B may be a NIfTI-1/2 mask (.nii, .nii.gz)%s.\n"
 "  Voxels with a nonzero value are foreground; each becomes the world\n"
@@ -120,6 +137,23 @@ static int to_double(const char *s, double *out) {
     return 0;
 }
 
+/* --tau T[,T...]: each a number >= 0; 1, or -1 after a usage error. */
+static int parse_taus(const char *v, analysis_args_t *an) {
+    char buf[4096];
+    if (strlen(v) >= sizeof buf) return usage_error("--tau: the list is too long ('%s')", v);
+    snprintf(buf, sizeof buf, "%s", v);
+    an->n_taus = 0;
+    char *save = NULL;
+    for (char *t = strtok_r(buf, ",", &save); t; t = strtok_r(NULL, ",", &save)) {
+        double d;
+        if (to_double(t, &d) || d < 0) return usage_error("--tau needs numbers >= 0 separated by commas, not '%s'", v);
+        if (an->n_taus == ANALYSIS_MAX_TAUS) return usage_error("--tau takes at most 64 tolerances ('%s')", v);
+        an->taus[an->n_taus++] = d;
+    }
+    if (!an->n_taus) return usage_error("--tau needs numbers >= 0 separated by commas, not '%s'", v);
+    return 1;
+}
+
 /* The options that take a value, by their place in value_names. */
 typedef enum {
     OPT_PERCENTILE,
@@ -133,6 +167,9 @@ typedef enum {
     OPT_CONNECTIVITY,
     OPT_MASK_DIMS,
     OPT_UNITS,
+    OPT_TAU,
+    OPT_TAU_RULE,
+    OPT_DTU_CAP,
     OPT_COUNT
 } value_option_t;
 
@@ -142,7 +179,9 @@ static const char *const value_names[OPT_COUNT + 1] = {
     [OPT_RENDER] = "--render",           [OPT_HISTOGRAM_PNG] = "--histogram-png",
     [OPT_MASK_POINTS] = "--mask-points", [OPT_EMPTY] = "--empty",
     [OPT_CONNECTIVITY] = "--connectivity", [OPT_MASK_DIMS] = "--mask-dims",
-    [OPT_UNITS] = "--units",             [OPT_COUNT] = NULL};
+    [OPT_UNITS] = "--units",             [OPT_TAU] = "--tau",
+    [OPT_TAU_RULE] = "--tau-rule",       [OPT_DTU_CAP] = "--dtu-cap",
+    [OPT_COUNT] = NULL};
 
 int analysis_parse_option(int argc, char **argv, int *k, analysis_args_t *an) {
     const char *s = argv[*k];
@@ -229,6 +268,19 @@ int analysis_parse_option(int argc, char **argv, int *k, analysis_args_t *an) {
                 return usage_error("--units needs printable ASCII (the pictures' font has no other), not '%s'", v);
         an->units = v;
         break;
+    case OPT_TAU:
+        return parse_taus(v, an);
+    case OPT_TAU_RULE:
+        if (strcmp(v, "le") == 0) an->tau_rule = HD_AT_MOST;
+        else if (strcmp(v, "lt") == 0) an->tau_rule = HD_BELOW;
+        else return usage_error("--tau-rule is le (d <= tau) or lt (d < tau), not '%s'", v);
+        break;
+    case OPT_DTU_CAP:
+        if (strcmp(v, "inf") == 0) d = INFINITY;
+        else if (to_double(v, &d) || !(d > 0))
+            return usage_error("--dtu-cap needs a positive number or inf, not '%s'", v);
+        an->dtu_cap = d;
+        break;
     }
     return 1;
 }
@@ -242,7 +294,7 @@ const char *analysis_units(const analysis_args_t *an) {
 
 int analysis_active(const analysis_args_t *an) {
     return an->percentile_on || an->mean || an->chamfer || an->histogram || an->distances_out ||
-           an->render_out || an->histogram_png;
+           an->render_out || an->histogram_png || an->n_taus || an->dtu_cap > 0;
 }
 
 /* ---- empty sets ------------------------------------------------------------ */
@@ -267,6 +319,14 @@ typedef struct {
     const char *key;
     double value;
 } member_t;
+
+/* `, "key": value` for each member, NaN as null. */
+static void json_object_members(FILE *out, const member_t *m, size_t n) {
+    for (size_t k = 0; k < n; k++) {
+        fprintf(out, ", \"%s\": ", m[k].key);
+        json_number(out, m[k].value);
+    }
+}
 
 /* `, "name": {head, "key": value, ...}` with NaN as null. */
 static void json_object(FILE *out, const char *name, const char *head,
@@ -294,6 +354,31 @@ static void json_figures(FILE *out, const analysis_args_t *an,
         member_t m[] = {{"ab", s->mean_ab}, {"ba", s->mean_ba}, {"symmetric", s->mean_symmetric},
                         {"average", s->mean_average}, {"pooled", s->mean_pooled}};
         json_object(out, "mean", NULL, m, sizeof m / sizeof m[0]);
+    }
+    if (an->n_taus) {
+        fprintf(out, ", \"tolerance\": {\"rule\": \"%s\", \"scores\": [", an->tau_rule == HD_BELOW ? "d < tau" : "d <= tau");
+        for (size_t k = 0; k < an->n_taus; k++) {
+            const hd_tolerance_t *t = &r->tol[k];
+            fputs(k ? ", {\"tau\": " : "{\"tau\": ", out);
+            json_number(out, an->taus[k]);
+            member_t m[] = {{"precision", t->precision}, {"recall", t->recall}, {"fscore", t->fscore}, {"nsd", t->nsd}};
+            for (size_t q = 0; q < sizeof m / sizeof m[0]; q++) {
+                fprintf(out, ", \"%s\": ", m[q].key);
+                json_number(out, m[q].value);
+            }
+            fprintf(out, ", \"within_ab\": %zu, \"within_ba\": ", t->count_ab);
+            if (r->directed) fputs("null}", out);
+            else fprintf(out, "%zu}", t->count_ba);
+        }
+        fputs("]}", out);
+    }
+    if (an->dtu_cap > 0) {
+        member_t m[] = {{"accuracy", r->dtu.accuracy}, {"completeness", r->dtu.completeness}, {"overall", r->dtu.overall},
+                        {"kept_ab", (double)r->dtu.kept_ab}, {"kept_ba", r->directed ? NAN : (double)r->dtu.kept_ba}};
+        fputs(", \"dtu\": {\"cap\": ", out);
+        json_number(out, an->dtu_cap);
+        json_object_members(out, m, sizeof m / sizeof m[0]);
+        fputc('}', out);
     }
     if (an->chamfer) {
         member_t m[] = {{"value", r->directed ? s->mean2_ab : s->chamfer}, {"mean_squared", s->chamfer},
@@ -336,6 +421,27 @@ static int write_empty_files(const analysis_args_t *an, const hd_points_t *A,
     return rc;
 }
 
+/* --tau and --dtu-cap when a set is empty: the other set's points have
+ * nothing to be near (distance +inf), so none is within any tolerance: the
+ * NSD is 0 with one set empty and NaN with both (MONAI's), a share of no
+ * points NaN, and a capped mean of no values NaN. */
+static int empty_scores(const analysis_args_t *an, size_t n_a, size_t n_b, int directed, analysis_result_t *r) {
+    if (!an->n_taus && !(an->dtu_cap > 0)) return HD_OK;
+    size_t n = n_a > n_b ? n_a : n_b;
+    double *inf = malloc((n ? n : 1) * sizeof *inf);
+    hd_error_t err;
+    if (!inf) {
+        fprintf(stderr, "%s: out of memory for %zu distances\n", cli_prog(), n);
+        return HD_ENOMEM;
+    }
+    for (size_t k = 0; k < n; k++) inf[k] = INFINITY;
+    r->directed = directed;
+    int rc = scores_figures(an, inf, n_a, directed ? NULL : inf, n_b, r, &err);
+    free(inf);
+    if (rc != HD_OK) fprintf(stderr, "%s: %s\n", cli_prog(), err.message);
+    return rc;
+}
+
 double analysis_empty_value(const analysis_args_t *an, size_t n_a, size_t n_b) {
     return policy_value(an->empty, n_a, n_b);
 }
@@ -372,6 +478,7 @@ int analysis_handle_empty(const analysis_args_t *an, const char *path_a,
         json_string(out, path_b);
         analysis_result_t r;
         empty_result(&r, an, v, directed);
+        if (empty_scores(an, n_a, n_b, directed, &r) != HD_OK) return EXIT_FAILURE_;
         json_figures(out, an, &r);
         fprintf(out, "}\n");
     } else {
@@ -385,6 +492,10 @@ int analysis_handle_empty(const analysis_args_t *an, const char *path_a,
         if (an->percentile_on) fprintf(out, "percentile %s: %s\n", num_text(an->percentile, pt), t);
         if (an->mean) fprintf(out, "mean distance: %s\n", t);
         if (an->chamfer) fprintf(out, "Chamfer distance: %s\n", t);
+        analysis_result_t r;
+        empty_result(&r, an, v, directed);
+        if (empty_scores(an, n_a, n_b, directed, &r) != HD_OK) return EXIT_FAILURE_;
+        print_scores(out, an, &r, "");
     }
     return EXIT_OK;
 }
@@ -417,6 +528,23 @@ static size_t beyond(const uint64_t *counts, size_t bins, size_t n) {
     return n - (size_t)in;
 }
 
+/* --tau and --dtu-cap from the per-point distances (d_ba NULL: directed,
+ * and then every figure that needs B's distances is NaN). */
+static int scores_figures(const analysis_args_t *an, const double *d_ab, size_t n_a, const double *d_ba,
+                          size_t n_b, analysis_result_t *r, hd_error_t *err) {
+    if (!d_ba) n_b = 0;
+    int rc = HD_OK;
+    if (an->n_taus)
+        rc = hd_tolerance_scores(d_ab, NULL, n_a, d_ba, NULL, n_b, an->taus, an->n_taus, an->tau_rule, r->tol, err);
+    for (size_t k = 0; rc == HD_OK && !d_ba && k < an->n_taus; k++)
+        r->tol[k].recall = r->tol[k].fscore = r->tol[k].nsd = NAN;
+    if (rc == HD_OK && an->dtu_cap > 0) {
+        rc = hd_capped_means(d_ab, n_a, d_ba, n_b, an->dtu_cap, &r->dtu, err);
+        if (!d_ba) r->dtu.completeness = r->dtu.overall = NAN;
+    }
+    return rc;
+}
+
 double analysis_scale(const analysis_args_t *an, const analysis_result_t *r) {
     double largest = r->directed || r->sum.max_ab >= r->sum.max_ba ? r->sum.max_ab : r->sum.max_ba;
     return an->max_distance > 0 ? an->max_distance : largest;
@@ -426,6 +554,14 @@ int analysis_figures(const analysis_args_t *an, const analysis_ops_t *ops, const
                      const double *d_ba, size_t n_b, analysis_result_t *r, hd_error_t *err) {
     int rc;
     if ((rc = ops->summarize(d_ab, n_a, r->directed ? NULL : d_ba, n_b, &r->sum, err))) return rc;
+    if (an->n_taus || an->dtu_cap > 0) {
+        if (ops->summarize != hd_summarize) {
+            snprintf(err->message, sizeof err->message, "--tau and --dtu-cap are computed by hausdorff only, "
+                                                        "not over the ranks of hausdorff-mpi");
+            return err->code = HD_EUNSUPPORTED;
+        }
+        if ((rc = scores_figures(an, d_ab, n_a, r->directed ? NULL : d_ba, n_b, r, err))) return rc;
+    }
     if (an->percentile_on &&
         (rc = ops->percentile_of(d_ab, n_a, r->directed ? NULL : d_ba, n_b, an->percentile, &r->pct, err)))
         return rc;
@@ -655,6 +791,28 @@ static void print_histogram(FILE *out, const analysis_args_t *an,
     }
 }
 
+/* The --tau and --dtu-cap lines; unit is "" or " (mm)". */
+static void print_scores(FILE *out, const analysis_args_t *an, const analysis_result_t *r, const char *unit) {
+    char t[4][NUM_TEXT];
+    for (size_t k = 0; k < an->n_taus; k++) {
+        const hd_tolerance_t *tl = &r->tol[k];
+        fprintf(out, "at tolerance %s%s (%s): precision %s", num_text(an->taus[k], t[0]), unit,
+                an->tau_rule == HD_BELOW ? "d < tau" : "d <= tau", num_text(tl->precision, t[1]));
+        if (!r->directed)
+            fprintf(out, ", recall %s, F-score %s, NSD %s", num_text(tl->recall, t[1]), num_text(tl->fscore, t[2]),
+                    num_text(tl->nsd, t[3]));
+        fputc('\n', out);
+    }
+    if (an->dtu_cap > 0) {
+        fprintf(out, "DTU (distances below %s%s): accuracy %s", num_text(an->dtu_cap, t[0]), unit,
+                num_text(r->dtu.accuracy, t[1]));
+        if (!r->directed)
+            fprintf(out, ", completeness %s, overall %s", num_text(r->dtu.completeness, t[2]),
+                    num_text(r->dtu.overall, t[3]));
+        fputc('\n', out);
+    }
+}
+
 void analysis_print(FILE *out, const analysis_args_t *an,
                     const analysis_result_t *r) {
     char unit[40] = "";
@@ -705,6 +863,7 @@ void analysis_print(FILE *out, const analysis_args_t *an,
                     num_text(r->sum.chamfer, t[0]), num_text(r->sum.chamfer_sum2, t[1]),
                     num_text(r->sum.chamfer_mean, t[2]), num_text(r->sum.chamfer_sum, t[3]));
     }
+    print_scores(out, an, r, unit);
     if (an->histogram) print_histogram(out, an, r);
     if (an->distances_out) {
         fprintf(out, "per-point distances written to %s", safe_text(r->dist_path_a));

@@ -31,6 +31,8 @@ typedef struct mask_info {
     int connectivity;          /* its connectivity (1..surface_dims) */
 } mask_info_t;
 
+enum { ANALYSIS_MAX_TAUS = 64 };
+
 typedef struct analysis_args {
     int percentile_on;
     double percentile;
@@ -46,6 +48,10 @@ typedef struct analysis_args {
     const char *units;         /* --units TEXT, or NULL */
     empty_policy_t empty;
     mask_info_t mask[2];       /* for A and B */
+    size_t n_taus;             /* --tau T[,T...]: scores at these tolerances */
+    double taus[ANALYSIS_MAX_TAUS];
+    hd_tolerance_rule_t tau_rule; /* --tau-rule le|lt (default le: d <= tau) */
+    double dtu_cap;            /* --dtu-cap D: DTU accuracy/completeness (0: off) */
 } analysis_args_t;
 
 /* ---- options (analysis.c) ---------------------------------------------- */
@@ -124,6 +130,8 @@ typedef struct analysis_result {
     render_info_t render;
     int n_hist_markers;
     hist_marker_t hist_markers[4];
+    hd_tolerance_t tol[ANALYSIS_MAX_TAUS]; /* --tau, in the order given */
+    hd_capped_mean_t dtu;      /* --dtu-cap */
 } analysis_result_t;
 
 /* The unit of the distances: --units, else "mm" when a mask's header

@@ -42,8 +42,9 @@
  *  - surface (default): the foreground voxels that binary erosion removes,
  *    the image outside counting as background (border value 0): medpy's
  *    border (mask ^ binary_erosion(mask, generate_binary_structure(ndim,
- *    connectivity))), which MONAI uses too with connectivity 1.  The
- *    neighbourhood (neighbourhood()) has --connectivity 1|2|3 (faces; and
+ *    connectivity))), which MONAI uses too with connectivity 1, found by the
+ *    library's hd_mask_points (src/masks/surface.c), as for Python.  The
+ *    neighbourhood has --connectivity 1|2|3 (faces; and
  *    edges; and corners: 6, 18 or 26 neighbours in 3-D, 4 or 8 in 2-D) over
  *    the axes --mask-dims chooses: by default the axes of more than one
  *    voxel, so that a single slice (nz = 1, or dim[0] = 2) has the in-plane
@@ -518,61 +519,6 @@ static unsigned char *foreground_of(const nifti_image *nim, size_t nvox, long lo
     return fg;
 }
 
-/* The neighbourhood that defines the surface: scipy's
- * generate_binary_structure(rank, connectivity) over the axes in use, as
- * offsets -- every (di, dj, dk) in {-1, 0, 1}^3 that is 0 on the axes not
- * in use, not all 0, and has at most `connectivity` nonzero entries (a
- * connectivity above the rank acts as the rank, as scipy's does).  Face
- * neighbours come first, so that most border voxels stop at the first few. */
-typedef struct {
-    int used[3];        /* the axes of the neighbourhood */
-    int rank;           /* how many */
-    int n;              /* offsets */
-    ptrdiff_t step[26]; /* each offset as a voxel index difference */
-} neighbourhood_t;
-
-static void neighbourhood(neighbourhood_t *nb, const long long n[3], int mask_dims, int connectivity) {
-    assert(connectivity >= 1 && connectivity <= 3 && (mask_dims == 0 || mask_dims == 2 || mask_dims == 3));
-    memset(nb, 0, sizeof *nb);
-    for (int a = 0; a < 3; a++) {
-        /* auto: the axes of more than one voxel (a single slice is a 2-D
-         * mask); 2: i and j, each slice k on its own; 3: all three */
-        nb->used[a] = mask_dims == 3 ? 1 : mask_dims == 2 ? a < 2 : n[a] > 1;
-        nb->rank += nb->used[a];
-    }
-    for (int order = 1; order <= 3 && order <= connectivity; order++)
-        for (int o = 0; o < 27; o++) {
-            int d[3] = {o % 3 - 1, o / 3 % 3 - 1, o / 9 - 1}, nz = 0, ok = 1;
-            for (int a = 0; a < 3; a++) {
-                nz += d[a] != 0;
-                if (d[a] && !nb->used[a]) ok = 0;
-            }
-            if (!ok || nz != order) continue;
-            assert(nb->n < 26);
-            nb->step[nb->n++] = (ptrdiff_t)d[0] + (ptrdiff_t)d[1] * (ptrdiff_t)n[0] +
-                                (ptrdiff_t)d[2] * (ptrdiff_t)(n[0] * n[1]);
-        }
-}
-
-/* A foreground voxel is on the surface when binary erosion with the
- * neighbourhood removes it: some neighbour is background or lies outside
- * the image (border value 0, as medpy and MONAI erode).  Every
- * neighbourhood holds the face neighbours along the axes in use, so a voxel
- * on the image's edge along such an axis is on the surface at once; inside,
- * every neighbour is within the image.  With no axis in use (a mask of one
- * voxel, automatically) the voxel is its own surface. */
-static int on_surface(const unsigned char *fg, const long long n[3], const neighbourhood_t *nb,
-                      long long i, long long j, long long k) {
-    if (nb->rank == 0) return 1;
-    const long long at[3] = {i, j, k};
-    for (int a = 0; a < 3; a++)
-        if (nb->used[a] && (at[a] == 0 || at[a] == n[a] - 1)) return 1;
-    size_t v = (size_t)((k * n[1] + j) * n[0] + i);
-    for (int q = 0; q < nb->n; q++)
-        if (!fg[(size_t)((ptrdiff_t)v + nb->step[q])]) return 1;
-    return 0;
-}
-
 /* x = ((m0 i + m1 j) + m2 k) + m3, then the unit. */
 static double world(const nifti_dmat44 *m, int c, double i, double j, double k, double to_mm) {
     double q = ((m->m[c][0] * i + m->m[c][1] * j) + m->m[c][2] * k) + m->m[c][3];
@@ -651,37 +597,31 @@ static int read_mask(const char *path, const hd_read_options_t *ro,
     info->to_mm = to_mm;
     info->unit_known = nim->xyz_units == NIFTI_UNITS_METER || nim->xyz_units == NIFTI_UNITS_MM ||
                        nim->xyz_units == NIFTI_UNITS_MICRON;
-    neighbourhood_t nb;
-    neighbourhood(&nb, n, an->mask_dims, an->connectivity);
-    if (which == MASK_SURFACE) {
-        info->surface_dims = nb.rank;
-        info->connectivity = an->connectivity < nb.rank ? an->connectivity : nb.rank;
+    /* the library finds the surface (medpy's and MONAI's erosion) and
+     * places each voxel's centre as world() does */
+    hd_mask_t mk;
+    hd_mask_init(&mk, fg, (size_t)n[0], (size_t)n[1], (size_t)n[2], NULL);
+    for (int r = 0; r < 3; r++)
+        for (int c = 0; c < 4; c++) mk.m[r][c] = m->m[r][c];
+    mk.scale = to_mm;
+    hd_mask_options_t mo;
+    hd_mask_options_init(&mo);
+    mo.points = which == MASK_ALL ? HD_MASK_ALL : HD_MASK_SURFACE;
+    mo.connectivity = an->connectivity;
+    mo.dims = an->mask_dims;
+    mo.dtype = ro->dtype;
+    hd_mask_info_t mi;
+    rc = hd_mask_points(&mk, &mo, out, &mi, err);
+    if (rc != HD_OK) {
+        char m2[768];
+        snprintf(m2, sizeof m2, "%.700s", err->message);
+        fail(err, rc, path, m2);
+    } else {
+        snprintf((*out)->format, sizeof (*out)->format, "%s", which == MASK_ALL ? "nifti:all" : "nifti:surface");
+        info->surface_dims = mi.surface_dims;
+        info->connectivity = mi.connectivity;
     }
-    /* count the points, then fill exactly that many */
-    size_t np = 0;
-    for (int pass = 0; pass < 2; pass++) {
-        if (pass == 1 && !(*out = cli_cloud_new(np, ro->dtype, which == MASK_ALL ? "nifti:all" : "nifti:surface"))) {
-            rc = fail(err, HD_ENOMEM, path, "out of memory for the mask's points");
-            break;
-        }
-        size_t p = 0;
-        for (long long k = 0; k < n[2]; k++)
-            for (long long j = 0; j < n[1]; j++)
-                for (long long i = 0; i < n[0]; i++) {
-                    size_t v = (size_t)((k * n[1] + j) * n[0] + i);
-                    if (!fg[v] || (which == MASK_SURFACE && !on_surface(fg, n, &nb, i, j, k))) continue;
-                    if (pass == 1) {
-                        double q[3];
-                        for (int c = 0; c < 3; c++) q[c] = world(m, c, (double)i, (double)j, (double)k, to_mm);
-                        if (ro->dtype == HD_FLOAT32)
-                            for (int c = 0; c < 3; c++) ((float *)(*out)->data)[3 * p + c] = (float)q[c];
-                        else
-                            memcpy((double *)(*out)->data + 3 * p, q, sizeof q);
-                    }
-                    p++;
-                }
-        np = p;
-    }
+    size_t np = rc == HD_OK ? mi.points : 0;
     info->points = np;
     free(fg);
     nifti_image_free(nim);

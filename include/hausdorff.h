@@ -481,6 +481,133 @@ HD_EXTERN double hd_histogram_edge(double lo, double hi, size_t bins,
                                    size_t k);
 
 /* ------------------------------------------------------------------------
+ * Scores at a distance tolerance, and capped means.  From per-point
+ * distances (hd_distances, or any caller's): docs/analysis.md, "Scores at
+ * a tolerance", has the definitions and the libraries each one agrees with.
+ * ---------------------------------------------------------------------- */
+
+/* How a distance d is compared with a tolerance tau. */
+typedef enum hd_tolerance_rule {
+    HD_AT_MOST = 0, /* d <= tau: MONAI's compute_surface_dice, DeepMind's
+                       surface_distance (NSD) */
+    HD_BELOW = 1    /* d < tau: the Tanks and Temples evaluation and the
+                       Open3D scripts of reconstruction papers (F-score) */
+} hd_tolerance_rule_t;
+
+/* The figures at one tolerance.  A's points are the prediction (a
+ * reconstruction, a segmentation), B's the reference.  A "weight" is 1 per
+ * point, or the caller's weight (a surfel's area); sums of weights are
+ * exact, rounded once (as hd_summarize's sums). */
+typedef struct hd_tolerance {
+    double tau;
+    size_t count_ab, count_ba;   /* points of A (of B) within tau of the other set */
+    double within_ab, within_ba; /* their weights (= the counts when unweighted) */
+    double total_a, total_b;     /* the weights of all of A, of all of B */
+    double precision;            /* within_ab / total_a: A's share near B */
+    double recall;               /* within_ba / total_b: B's share near A */
+    double fscore;               /* 2 precision recall / (precision + recall);
+                                    0 when both are 0 */
+    double nsd;                  /* (within_ab + within_ba) / (total_a + total_b):
+                                    the normalized surface Dice */
+} hd_tolerance_t;
+
+/* The figures at each of n_tau tolerances (taus[k] -> out[k]) in one pass
+ * over the distances.  d_ab: n_a distances of A's points to B; d_ba: n_b
+ * of B's to A.  w_a, w_b: a weight per point (finite, >= 0), or NULL for
+ * 1 each.  Each comparison is made on the double given, so equal inputs
+ * give equal counts on every machine.  A distance may be +inf (a point
+ * with nothing to be near: never within).  A ratio whose denominator is 0
+ * is NaN (an empty side's precision or recall; the NSD of two empty
+ * sets); the F-score is NaN when precision or recall is.
+ * Errors: HD_EINVAL (NULL where n > 0, a tau NaN or negative, a weight
+ * negative or not finite, an unknown rule), HD_ENONFINITE (a NaN distance).
+ * Thread safe; nothing is allocated. */
+HD_EXTERN int hd_tolerance_scores(const double *d_ab, const double *w_a, size_t n_a,
+                                  const double *d_ba, const double *w_b, size_t n_b,
+                                  const double *taus, size_t n_tau, hd_tolerance_rule_t rule,
+                                  hd_tolerance_t *out, hd_error_t *err);
+
+/* DTU's accuracy and completeness: means of the distances below a cap
+ * (the DTU MVS evaluation drops the larger ones as outliers).
+ * accuracy = mean of the d_ab < cap, completeness = mean of the d_ba < cap,
+ * overall = (accuracy + completeness) / 2; kept_* count the values used.
+ * A mean of no values is NaN.  cap = +inf keeps every finite distance.
+ * Sums are exact, rounded once.  Errors: HD_EINVAL (NULL where n > 0, cap
+ * NaN or <= 0), HD_ENONFINITE (a NaN distance).  Thread safe. */
+typedef struct hd_capped_mean {
+    double cap;
+    size_t kept_ab, kept_ba;
+    double accuracy, completeness, overall;
+} hd_capped_mean_t;
+HD_EXTERN int hd_capped_means(const double *d_ab, size_t n_a, const double *d_ba, size_t n_b,
+                              double cap, hd_capped_mean_t *out, hd_error_t *err);
+
+/* ------------------------------------------------------------------------
+ * Masks: a binary image (a segmentation) as the point set of its surface
+ * voxels, the definition medpy and MONAI use for HD, HD95, ASSD and NSD
+ * (docs/analysis.md, "Medical masks").  The command line's NIfTI masks and
+ * the Python module's numpy masks both come through here.
+ * ---------------------------------------------------------------------- */
+
+/* An image of n[0] x n[1] x n[2] voxels, one byte each, nonzero meaning
+ * foreground, voxel (i, j, k) at voxels[(k * n[1] + j) * n[0] + i] (i
+ * fastest, as NIfTI stores them; a 2-D image has n[2] = 1).  Its centre
+ * goes to the world coordinates
+ *     x_c = (((m[c][0] i + m[c][1] j) + m[c][2] k) + m[c][3]) * scale
+ * in double, in this order (the multiplication skipped when scale is 1),
+ * c = 0, 1, 2.  hd_mask_init sets m to the diagonal of the spacing. */
+typedef struct hd_mask {
+    const uint8_t *voxels;
+    size_t n[3];
+    double m[3][4];
+    double scale;
+} hd_mask_t;
+HD_EXTERN void hd_mask_init(hd_mask_t *mask, const uint8_t *voxels, size_t n0, size_t n1, size_t n2,
+                            const double spacing[3]);
+
+typedef enum hd_mask_points {
+    HD_MASK_SURFACE = 0, /* the foreground voxels binary erosion removes */
+    HD_MASK_ALL = 1      /* every foreground voxel */
+} hd_mask_points_t;
+
+typedef struct hd_mask_options {
+    hd_mask_points_t points; /* HD_MASK_SURFACE (default) */
+    int connectivity;        /* 1 (default), 2, 3: scipy's
+                                generate_binary_structure(rank, connectivity),
+                                6, 18 or 26 neighbours in 3-D, 4 or 8 in 2-D */
+    int dims;                /* the erosion's axes: 0 (default) those of more
+                                than one voxel; 2: i and j (each slice k on its
+                                own); 3: all three */
+    hd_dtype_t dtype;        /* the cloud's storage (HD_FLOAT64 default) */
+} hd_mask_options_t;
+HD_EXTERN void hd_mask_options_init(hd_mask_options_t *opt);
+
+struct hd_cloud; /* hd_cloud_t, below (Reading files) */
+
+/* What hd_mask_points saw. */
+typedef struct hd_mask_info {
+    size_t foreground;   /* foreground voxels */
+    size_t points;       /* points made */
+    int surface_dims;    /* axes of the erosion (HD_MASK_SURFACE) */
+    int connectivity;    /* its connectivity, at most surface_dims */
+} hd_mask_info_t;
+
+/* The points of a mask: with HD_MASK_SURFACE the foreground voxels that
+ * binary erosion with the neighbourhood removes, the image's outside
+ * counting as background (medpy's mask ^ binary_erosion(mask, structure),
+ * MONAI's get_mask_edges; a mask with no axis of more than one voxel is its
+ * own surface); with HD_MASK_ALL every foreground voxel.  Points are in
+ * storage order (i fastest), so an index names a voxel; the cloud may have
+ * 0 points (an empty mask: the caller's empty policy decides).  *out is
+ * the library's (hd_cloud_free), format "mask"; info may be NULL.
+ * Errors: HD_EINVAL (NULL, a dimension 0, bad options), HD_EOVERFLOW (the
+ * voxel count overflows), HD_ENONFINITE or HD_ERANGE (a corner of the
+ * image maps beyond HD_MAX_COORD, or beyond float range with
+ * HD_FLOAT32), HD_ENOMEM.  On failure *out is NULL.  Thread safe. */
+HD_EXTERN int hd_mask_points(const hd_mask_t *mask, const hd_mask_options_t *opt, struct hd_cloud **out,
+                             hd_mask_info_t *info, hd_error_t *err);
+
+/* ------------------------------------------------------------------------
  * Reading files.
  * ---------------------------------------------------------------------- */
 

@@ -46,9 +46,10 @@ def exactness_flags():
 
 
 static_lib = os.environ.get("HAUSDORFF_STATIC_LIB")
-sources = [os.path.join("hausdorff", "_hausdorff.c"), os.path.join("hausdorff", "_ndim.c")]
+sources = [os.path.join("hausdorff", "_hausdorff.c"), os.path.join("hausdorff", "_ndim.c"),
+           os.path.join("hausdorff", "_masks.c")]
 extra_objects = []
-depends = [HEADER, os.path.join(HERE, "hausdorff", "_ndim.h")]
+depends = [HEADER, os.path.join(HERE, "hausdorff", "_ndim.h"), os.path.join(HERE, "hausdorff", "_masks.h")]
 link_args = ["-pthread"]
 if static_lib:
     # Link the CMake archive; keep its symbols out of the module's exports.

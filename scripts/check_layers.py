@@ -7,8 +7,8 @@ the folders above it; its other headers are private to the folder's files
 
     base     base/base.h       errors, memory, rng, threads, selection, heap
     points   points/points.h   distance, boxes, keys, views, sources, sort
-    io, classic, engine, nearest   (siblings: none uses another)
-    src/*.c  api.c, index.c, stats.c: the public entry points, over all
+    io, classic, engine, nearest, mesh, masks   (siblings: none uses another)
+    src/*.c  api.c, index.c, stats.c, metrics.c: the public entry points, over all
     mpi      (hausdorff_mpi.h) the optional MPI library, over the public API
 
 What is checked:
@@ -39,7 +39,8 @@ import re
 import subprocess
 import sys
 
-LEVEL = {"base": 0, "points": 1, "io": 2, "classic": 2, "engine": 2, "nearest": 2, "mesh": 2, "": 3, "mpi": 4}
+LEVEL = {"base": 0, "points": 1, "io": 2, "classic": 2, "engine": 2, "nearest": 2, "mesh": 2, "masks": 2,
+         "": 3, "mpi": 4}
 # The front header of each folder: what the folders above may include.
 FRONT = {f: f"{f}/{f}.h" for f in LEVEL if f}
 # The public headers: hausdorff.h anywhere, hausdorff_mpi.h only in the MPI

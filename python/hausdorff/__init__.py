@@ -37,6 +37,7 @@ from ._hausdorff import (
     read,
     summary,
 )
+from . import masks, scores  # segmentation masks; reconstruction scores (masks.py, scores.py)
 
 __all__ = [
     "DirectedResult",

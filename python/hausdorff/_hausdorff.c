@@ -57,6 +57,7 @@
 
 #include "hausdorff.h"
 #include "_ndim.h"
+#include "_masks.h"
 
 /* hd_index_nearest writes size_t indices straight into an intp array. */
 _Static_assert(sizeof(size_t) == sizeof(npy_intp), "size_t and npy_intp differ in size");
@@ -1813,6 +1814,7 @@ PyMODINIT_FUNC PyInit__hausdorff(void) {
         goto fail;
     }
     if (PyModule_AddStringConstant(m, "__version__", hd_version()) < 0) goto fail;
+    if (PyModule_AddFunctions(m, hd_py_mask_methods) < 0) goto fail; /* hausdorff.masks' (_masks.c) */
     return m;
 fail:
     Py_DECREF(m);

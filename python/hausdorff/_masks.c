@@ -1,0 +1,152 @@
+/*
+ * _masks.c -- the C side of hausdorff.masks (masks.py): a mask's surface
+ * points (hd_mask_points, the command line's NIfTI masks' function) and the
+ * figures of per-point distances (hd_summarize, hd_percentile_of,
+ * hd_tolerance_scores, hd_capped_means), so that Python's numbers are the
+ * command line's to the bit.
+ *
+ * Arrays come through the buffer protocol, already in the layout the
+ * library reads (masks.py converts them: a mask to uint8 in Fortran order,
+ * i.e. axis 0 fastest; distances to contiguous float64), and results go
+ * back as bytes or tuples for masks.py to wrap.  The library's work runs
+ * without the GIL.
+ */
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+
+#include <math.h>
+#include <string.h>
+
+#include "hausdorff.h"
+#include "_masks.h"
+
+static PyObject *raise_hd(int rc, const hd_error_t *err) {
+    PyErr_SetString(rc == HD_ENOMEM ? PyExc_MemoryError : PyExc_ValueError, err->message);
+    return NULL;
+}
+
+/* _mask_points(voxels, n0, n1, n2, s0, s1, s2, connectivity, dims, all)
+ * -> (bytes of n * 3 float64, foreground, surface_dims, connectivity) */
+static PyObject *py_mask_points(PyObject *self, PyObject *args) {
+    (void)self;
+    Py_buffer vox;
+    Py_ssize_t n[3];
+    double sp[3];
+    int connectivity, dims, all;
+    if (!PyArg_ParseTuple(args, "y*nnndddiip", &vox, &n[0], &n[1], &n[2], &sp[0], &sp[1], &sp[2],
+                          &connectivity, &dims, &all))
+        return NULL;
+    if (n[0] < 1 || n[1] < 1 || n[2] < 1 || vox.len != n[0] * n[1] * n[2]) {
+        PyBuffer_Release(&vox);
+        PyErr_SetString(PyExc_ValueError, "the mask's buffer does not hold its shape");
+        return NULL;
+    }
+    hd_mask_t mk;
+    hd_mask_init(&mk, vox.buf, (size_t)n[0], (size_t)n[1], (size_t)n[2], sp);
+    hd_mask_options_t mo;
+    hd_mask_options_init(&mo);
+    mo.points = all ? HD_MASK_ALL : HD_MASK_SURFACE;
+    mo.connectivity = connectivity;
+    mo.dims = dims;
+    hd_cloud_t *c = NULL;
+    hd_mask_info_t info;
+    hd_error_t err;
+    int rc;
+    Py_BEGIN_ALLOW_THREADS
+    rc = hd_mask_points(&mk, &mo, &c, &info, &err);
+    Py_END_ALLOW_THREADS
+    PyBuffer_Release(&vox);
+    if (rc != HD_OK) return raise_hd(rc, &err);
+    PyObject *bytes = PyBytes_FromStringAndSize(c->data, (Py_ssize_t)(c->count * 3 * sizeof(double)));
+    hd_cloud_free(c);
+    if (!bytes) return NULL;
+    return Py_BuildValue("Nnii", bytes, (Py_ssize_t)info.foreground, info.surface_dims, info.connectivity);
+}
+
+/* A float64 buffer, or None (NULL, 0 values). */
+static int get_doubles(PyObject *o, Py_buffer *b, const double **p, size_t *n) {
+    memset(b, 0, sizeof *b);
+    *p = NULL;
+    *n = 0;
+    if (o == Py_None) return 0;
+    if (PyObject_GetBuffer(o, b, PyBUF_C_CONTIGUOUS) < 0) return -1;
+    *p = b->buf;
+    *n = (size_t)b->len / sizeof(double);
+    return 0;
+}
+
+static void release(Py_buffer *b) {
+    if (b->obj) PyBuffer_Release(b);
+}
+
+/* _figures(d_ab, d_ba, w_a, w_b, percentiles, taus, strict, cap)
+ * -> (summary tuple, [percentile tuples], [tolerance tuples], capped tuple
+ *    or None); d_ba None: directed.  With no d_ab the summary is NaN and no
+ *    percentile is computed (the caller asks for tolerances only). */
+static PyObject *py_figures(PyObject *self, PyObject *args) {
+    (void)self;
+    PyObject *o[6];
+    int strict;
+    double cap;
+    if (!PyArg_ParseTuple(args, "OOOOOOpd", &o[0], &o[1], &o[2], &o[3], &o[4], &o[5], &strict, &cap)) return NULL;
+    Py_buffer b[6];
+    const double *p[6];
+    size_t n[6];
+    int got = 0;
+    for (; got < 6; got++)
+        if (get_doubles(o[got], &b[got], &p[got], &n[got]) < 0) break;
+    PyObject *res = NULL;
+    if (got < 6) goto done;
+    hd_summary_t s;
+    hd_percentile_t *pct = PyMem_Calloc(n[4] ? n[4] : 1, sizeof *pct);
+    hd_tolerance_t *tol = PyMem_Calloc(n[5] ? n[5] : 1, sizeof *tol);
+    hd_capped_mean_t cm;
+    hd_error_t err;
+    int rc = HD_OK;
+    if (!pct || !tol) {
+        PyErr_NoMemory();
+        goto out;
+    }
+    Py_BEGIN_ALLOW_THREADS
+    if (n[0]) rc = hd_summarize(p[0], n[0], p[1], n[1], &s, &err);
+    else s.max_ab = s.max_ba = s.mean_ab = s.mean_ba = s.mean_symmetric = s.mean_average = s.mean_pooled =
+        s.chamfer = s.chamfer_sum2 = NAN; /* an empty side: only the tolerances are asked */
+    for (size_t k = 0; rc == HD_OK && n[0] && k < n[4]; k++) rc = hd_percentile_of(p[0], n[0], p[1], n[1], p[4][k], &pct[k], &err);
+    if (rc == HD_OK)
+        rc = hd_tolerance_scores(p[0], p[2], n[0], p[1], p[3], n[1], p[5], n[5], strict ? HD_BELOW : HD_AT_MOST, tol, &err);
+    if (rc == HD_OK && cap > 0) rc = hd_capped_means(p[0], n[0], p[1], n[1], cap, &cm, &err);
+    Py_END_ALLOW_THREADS
+    if (rc != HD_OK) {
+        raise_hd(rc, &err);
+        goto out;
+    }
+    PyObject *lp = PyList_New((Py_ssize_t)n[4]), *lt = PyList_New((Py_ssize_t)n[5]);
+    for (size_t k = 0; lp && k < n[4]; k++)
+        PyList_SET_ITEM(lp, (Py_ssize_t)k, Py_BuildValue("ddddd", pct[k].p, pct[k].ab, pct[k].ba, pct[k].symmetric,
+                                                         pct[k].pooled));
+    for (size_t k = 0; lt && k < n[5]; k++)
+        PyList_SET_ITEM(lt, (Py_ssize_t)k, Py_BuildValue("dddddnn", tol[k].tau, tol[k].precision, tol[k].recall,
+                                                         tol[k].fscore, tol[k].nsd, (Py_ssize_t)tol[k].count_ab,
+                                                         (Py_ssize_t)tol[k].count_ba));
+    PyObject *cs = cap > 0 ? Py_BuildValue("dddnn", cm.accuracy, cm.completeness, cm.overall, (Py_ssize_t)cm.kept_ab,
+                                           (Py_ssize_t)cm.kept_ba)
+                           : (Py_INCREF(Py_None), Py_None);
+    PyObject *ss = Py_BuildValue("ddddddddd", s.max_ab, s.max_ba, s.mean_ab, s.mean_ba, s.mean_symmetric,
+                                 s.mean_average, s.mean_pooled, s.chamfer, s.chamfer_sum2);
+    if (lp && lt && cs && ss) res = Py_BuildValue("NNNN", ss, lp, lt, cs);
+    else {
+        Py_XDECREF(lp), Py_XDECREF(lt), Py_XDECREF(cs), Py_XDECREF(ss);
+    }
+out:
+    PyMem_Free(pct);
+    PyMem_Free(tol);
+done:
+    for (int k = 0; k < got; k++) release(&b[k]);
+    return res;
+}
+
+PyMethodDef hd_py_mask_methods[] = {
+    {"_mask_points", py_mask_points, METH_VARARGS, "A mask's surface points (hausdorff.masks)."},
+    {"_figures", py_figures, METH_VARARGS, "Figures of per-point distances (hausdorff.masks)."},
+    {NULL, NULL, 0, NULL},
+};

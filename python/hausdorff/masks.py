@@ -1,0 +1,275 @@
+"""Distances between segmentation masks (numpy arrays), exact.
+
+The metrics MONAI, medpy and DeepMind's surface-distance compute on masks:
+Hausdorff distance and its percentiles (HD95), average surface distances
+(ASSD), the normalized surface Dice at a tolerance (NSD), Dice, and the
+precision / recall / F-score of the surfaces at a tolerance.  A mask is any
+numpy array of 1 to 3 dimensions (bool or numbers: nonzero is foreground);
+``spacing`` gives the voxel size along each axis (default 1).
+
+Surfaces are what medpy and MONAI erode them to: the foreground voxels that
+binary erosion with scipy's ``generate_binary_structure(ndim,
+connectivity)`` removes, the outside of the array counting as background.
+The surface is found by the C library's ``hd_mask_points``, the function the
+command line reads NIfTI masks with, and every figure is the library's, so
+the numbers equal the command line's (``hausdorff pred.nii.gz gt.nii.gz
+--percentile 95 --mean --tau 1``) to the bit.  A voxel (i, j, k) is the
+point (i * spacing[0], j * spacing[1], k * spacing[2]): axis order is the
+array's.
+
+>>> import numpy as np
+>>> from hausdorff import masks
+>>> gt = np.zeros((20, 20, 20), bool); gt[5:15, 5:15, 5:15] = True
+>>> pred = np.roll(gt, 2, axis=0)
+>>> masks.hausdorff(pred, gt, spacing=(0.5, 1, 1))
+1.0
+>>> m = masks.metrics(pred, gt, spacing=(0.5, 1, 1), percentile=95, tau=[0.5, 1])
+>>> m.nsd
+[0.6639344262295082, 1.0]
+
+Which figure is whose (docs/analysis.md has the formulas):
+
+- ``hausdorff(..., percentile=P, definition="monai")``: max of the two
+  directed P-th percentiles, MONAI's ``compute_hausdorff_distance``;
+  ``definition="medpy"``: the P-th percentile of both directions' distances
+  pooled, medpy's ``hd95``.  Without a percentile both are the maximum.
+- ``assd(..., definition="pooled")``: the mean of both directions'
+  distances together, MONAI's ``compute_average_surface_distance(
+  symmetric=True)`` and medpy 0.5's ``assd``; ``"average"``: the mean of the
+  two directed means (MONAI 0.x).
+- ``nsd(..., definition="monai")``: MONAI's ``compute_surface_dice`` (voxel
+  counts, ``use_subvoxels=False``): the surface voxels of both masks within
+  tau of the other surface, over all surface voxels.
+- ``dice``: 2 |A and B| / (|A| + |B|), NaN when both are empty.
+
+Empty masks follow ``empty`` as the rest of the module: "error" (the
+default) raises ValueError; "monai" gives inf for a distance when one mask
+is empty and NaN when both are, and an NSD of 0 or NaN, as MONAI does;
+"inf", "nan", "zero" give that value for every distance.
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+from typing import List, Optional, Sequence, Tuple, Union
+
+import numpy as np
+
+from . import _hausdorff
+
+__all__ = ["MaskMetrics", "surface", "distances", "hausdorff", "assd", "nsd", "dice", "fscore", "metrics"]
+
+_EMPTY = ("error", "inf", "nan", "zero", "monai")
+
+
+def _voxels(mask, name: str) -> np.ndarray:
+    m = np.asarray(mask)
+    if m.ndim < 1 or m.ndim > 3:
+        raise ValueError(f"{name}: a mask has 1 to 3 dimensions, not {m.ndim}")
+    if m.size == 0:
+        raise ValueError(f"{name}: the mask has no voxels (shape {m.shape})")
+    if m.dtype.kind == "f" and np.isnan(m).any():
+        fg = (m != 0) & ~np.isnan(m)  # NaN is background, as the NIfTI reader has it
+    else:
+        fg = m != 0
+    return np.asfortranarray(fg, dtype=np.uint8)
+
+
+def _spacing(spacing, ndim: int) -> Tuple[float, float, float]:
+    if spacing is None:
+        s = [1.0] * ndim
+    else:
+        s = [float(v) for v in np.atleast_1d(np.asarray(spacing, dtype=np.float64))]
+        if len(s) != ndim:
+            raise ValueError(f"spacing has {len(s)} values; the masks have {ndim} dimensions")
+        if not all(math.isfinite(v) and v > 0 for v in s):
+            raise ValueError(f"spacing must be finite and positive, not {tuple(s)}")
+    return tuple(s + [1.0] * (3 - ndim))  # type: ignore[return-value]
+
+
+def _dims(dims) -> int:
+    if dims in ("auto", 0, None):
+        return 0
+    if dims in (2, 3):
+        return int(dims)
+    raise ValueError(f"dims is 'auto', 2 or 3, not {dims!r}")
+
+
+def _points(v: np.ndarray, spacing, connectivity: int, dims, all: bool) -> Tuple[np.ndarray, int]:
+    """The points of the converted mask v (_voxels) and its foreground count."""
+    n = list(v.shape) + [1] * (3 - v.ndim)
+    s = _spacing(spacing, v.ndim)
+    if connectivity not in (1, 2, 3):
+        raise ValueError(f"connectivity is 1, 2 or 3, not {connectivity!r}")
+    # v is Fortran-ordered (axis 0 fastest, as the library reads voxels);
+    # its transpose is the same memory, C-contiguous, read without a copy
+    raw, fg, _sd, _c = _hausdorff._mask_points(v.T, n[0], n[1], n[2], s[0], s[1], s[2],
+                                               connectivity, _dims(dims), bool(all))
+    return np.frombuffer(raw, dtype=np.float64).reshape(-1, 3).copy(), fg
+
+
+def surface(mask, spacing=None, *, connectivity: int = 1, dims="auto", all: bool = False) -> np.ndarray:
+    """The (n, 3) float64 points of a mask's surface voxels (every
+    foreground voxel with all=True), in storage order of axis 0 fastest.
+    connectivity 1, 2, 3 as medpy's; dims "auto" erodes along the axes of
+    more than one voxel, 2 each slice of constant axis 2 on its own, 3 all
+    three (the command line's --mask-dims)."""
+    return _points(_voxels(mask, "mask"), spacing, connectivity, dims, all)[0]
+
+
+def _pair(pred, gt, spacing, connectivity, dims):
+    """(pred's points, gt's points, pred's voxels, gt's voxels, foreground counts)."""
+    vp, vg = _voxels(pred, "pred"), _voxels(gt, "gt")
+    if vp.shape != vg.shape:
+        raise ValueError(f"pred and gt have different shapes: {vp.shape} and {vg.shape}")
+    (a, fa), (b, fb) = (_points(v, spacing, connectivity, dims, False) for v in (vp, vg))
+    return a, b, vp, vg, (fa, fb)
+
+
+def distances(pred, gt, spacing=None, *, connectivity: int = 1, dims="auto",
+              threads: Optional[int] = None) -> Tuple[np.ndarray, np.ndarray]:
+    """(distances of pred's surface voxels to gt's surface, of gt's to
+    pred's), each in storage order; empty arrays for an empty mask's side
+    and inf for the other's when one mask is empty."""
+    a, b = _pair(pred, gt, spacing, connectivity, dims)[:2]
+    if len(a) and len(b):
+        d_ab, _ = _hausdorff.distances(a, b, threads=threads)
+        d_ba, _ = _hausdorff.distances(b, a, threads=threads)
+        return d_ab, d_ba
+    return np.full(len(a), np.inf), np.full(len(b), np.inf)
+
+
+@dataclasses.dataclass(frozen=True)
+class MaskMetrics:
+    """Every figure of one pred/gt pair (metrics()).  Distances in the
+    spacing's unit; lists follow the order of the percentiles and taus."""
+    hausdorff: float             #: max of the two directed maxima
+    hausdorff_ab: float          #: pred -> gt
+    hausdorff_ba: float          #: gt -> pred
+    percentile: List[float]      #: MONAI's: max(P(pred->gt), P(gt->pred))
+    percentile_pooled: List[float]  #: medpy's: P of both directions pooled
+    percentile_ab: List[float]   #: P of pred -> gt (MONAI's directed=True)
+    percentile_ba: List[float]   #: P of gt -> pred
+    assd: float                  #: pooled (MONAI >= 1.0, medpy 0.5)
+    assd_average: float          #: mean of the two directed means (MONAI 0.x)
+    asd_ab: float                #: mean pred -> gt (medpy's asd(pred, gt))
+    asd_ba: float                #: mean gt -> pred
+    nsd: List[float]             #: MONAI's compute_surface_dice at each tau
+    precision: List[float]       #: share of pred's surface within tau of gt's
+    recall: List[float]          #: share of gt's surface within tau of pred's
+    fscore: List[float]          #: 2 P R / (P + R)
+    dice: float                  #: volume Dice of the masks
+    points: Tuple[int, int]      #: surface voxels of pred, of gt
+    foreground: Tuple[int, int]  #: foreground voxels of pred, of gt
+
+
+def _empty_value(empty: str, n_a: int, n_b: int) -> float:
+    if empty == "monai":
+        return math.inf if n_a or n_b else math.nan
+    return {"inf": math.inf, "nan": math.nan, "zero": 0.0}[empty]
+
+
+def _dice(vp: np.ndarray, vg: np.ndarray, fg: Tuple[int, int]) -> float:
+    total = fg[0] + fg[1]
+    return 2 * int(np.count_nonzero(vp & vg)) / total if total else math.nan
+
+
+def dice(pred, gt) -> float:
+    """2 |pred and gt| / (|pred| + |gt|) over the foreground voxels; NaN
+    when both masks are empty (DeepMind's compute_dice_coefficient)."""
+    vp, vg = _voxels(pred, "pred"), _voxels(gt, "gt")
+    if vp.shape != vg.shape:
+        raise ValueError(f"pred and gt have different shapes: {vp.shape} and {vg.shape}")
+    return _dice(vp, vg, (int(np.count_nonzero(vp)), int(np.count_nonzero(vg))))
+
+
+def _floats(v) -> np.ndarray:
+    return np.ascontiguousarray(np.atleast_1d(np.asarray(v, dtype=np.float64)))
+
+
+def metrics(pred, gt, spacing=None, *, percentile: Union[float, Sequence[float], None] = 95,
+            tau: Union[float, Sequence[float], None] = None, strict: bool = False, connectivity: int = 1,
+            dims="auto", empty: str = "error", threads: Optional[int] = None) -> MaskMetrics:
+    """Every figure at once, from one pass of per-point distances.
+    strict: within tau means d < tau (Tanks and Temples) instead of d <= tau
+    (MONAI, DeepMind)."""
+    if empty not in _EMPTY:
+        raise ValueError(f"empty is one of {', '.join(_EMPTY)}, not {empty!r}")
+    a, b, vp, vg, fg = _pair(pred, gt, spacing, connectivity, dims)
+    ps = [] if percentile is None else [float(p) for p in np.atleast_1d(percentile)]
+    taus = _floats([] if tau is None else tau)
+    pcts = _floats(ps) if ps else None
+    if len(a) == 0 or len(b) == 0:
+        if empty == "error":
+            which = "pred and gt are" if not len(a) and not len(b) else "pred is" if not len(a) else "gt is"
+            raise ValueError(f"{which} empty: there is no surface distance (empty='monai', 'inf', 'nan' "
+                             "or 'zero' reports one)")
+        v = _empty_value(empty, len(a), len(b))
+        inf_a, inf_b = np.full(len(a), np.inf), np.full(len(b), np.inf)
+        sc = [] if not len(taus) else _hausdorff._figures(
+            inf_a if len(a) else None, inf_b if len(b) else None, None, None, None, taus, strict, 0.0)[2]
+        if len(taus) and not len(a) and not len(b):
+            sc = [(t, math.nan, math.nan, math.nan, math.nan, 0, 0) for t in taus]
+        return MaskMetrics(v, v, v, [v] * len(ps), [v] * len(ps), [v] * len(ps), [v] * len(ps), v, v, v, v,
+                           [s[4] if len(a) or len(b) else math.nan for s in sc],
+                           [s[1] for s in sc], [s[2] for s in sc], [s[3] for s in sc],
+                           _dice(vp, vg, fg), (len(a), len(b)), fg)
+    d_ab, _ = _hausdorff.distances(a, b, threads=threads)
+    d_ba, _ = _hausdorff.distances(b, a, threads=threads)
+    s, pc, sc, _cap = _hausdorff._figures(d_ab, d_ba, None, None, pcts, taus, strict, 0.0)
+    return MaskMetrics(max(s[0], s[1]), s[0], s[1], [p[3] for p in pc], [p[4] for p in pc], [p[1] for p in pc],
+                       [p[2] for p in pc], s[6], s[5],
+                       s[2], s[3], [t[4] for t in sc], [t[1] for t in sc], [t[2] for t in sc],
+                       [t[3] for t in sc], _dice(vp, vg, fg), (len(a), len(b)), fg)
+
+
+def hausdorff(pred, gt, spacing=None, *, percentile: Optional[float] = None, definition: str = "monai",
+              connectivity: int = 1, dims="auto", empty: str = "error", threads: Optional[int] = None) -> float:
+    """The Hausdorff distance between the masks' surfaces, or its
+    percentile: definition "monai" = max of the directed percentiles
+    (compute_hausdorff_distance), "medpy" = percentile of both directions
+    pooled (medpy's hd95)."""
+    if definition not in ("monai", "medpy"):
+        raise ValueError(f"definition is 'monai' or 'medpy', not {definition!r}")
+    m = metrics(pred, gt, spacing, percentile=percentile, connectivity=connectivity, dims=dims, empty=empty,
+                threads=threads)
+    if percentile is None:
+        return m.hausdorff
+    return m.percentile[0] if definition == "monai" else m.percentile_pooled[0]
+
+
+def assd(pred, gt, spacing=None, *, definition: str = "pooled", connectivity: int = 1, dims="auto",
+         empty: str = "error", threads: Optional[int] = None) -> float:
+    """Average symmetric surface distance: "pooled" (MONAI >= 1.0
+    symmetric=True, medpy 0.5's assd) or "average" (MONAI 0.x)."""
+    if definition not in ("pooled", "average"):
+        raise ValueError(f"definition is 'pooled' or 'average', not {definition!r}")
+    m = metrics(pred, gt, spacing, percentile=None, connectivity=connectivity, dims=dims, empty=empty,
+                threads=threads)
+    return m.assd if definition == "pooled" else m.assd_average
+
+
+def nsd(pred, gt, tau, spacing=None, *, definition: str = "monai", connectivity: int = 1, dims="auto",
+        empty: str = "monai", threads: Optional[int] = None):
+    """Normalized surface Dice at tolerance tau (a number, or a list for
+    several): definition "monai" counts surface voxels, as MONAI's
+    compute_surface_dice(use_subvoxels=False): (pred's surface voxels
+    within tau of gt's surface + gt's within tau of pred's) / (all of
+    both).  d <= tau.  An empty mask gives 0, two give NaN (MONAI's)."""
+    if definition != "monai":
+        raise ValueError(f"definition is 'monai', not {definition!r} (DeepMind's surfel areas are not "
+                         "computed by this module)")
+    m = metrics(pred, gt, spacing, percentile=None, tau=tau, connectivity=connectivity, dims=dims,
+                empty=empty, threads=threads)
+    return m.nsd if np.ndim(tau) else m.nsd[0]
+
+
+def fscore(pred, gt, tau, spacing=None, *, strict: bool = False, connectivity: int = 1, dims="auto",
+           empty: str = "monai", threads: Optional[int] = None):
+    """(precision, recall, F-score) of the surfaces at tau (lists for
+    several taus): precision = share of pred's surface within tau of gt's."""
+    m = metrics(pred, gt, spacing, percentile=None, tau=tau, strict=strict, connectivity=connectivity,
+                dims=dims, empty=empty, threads=threads)
+    if np.ndim(tau):
+        return m.precision, m.recall, m.fscore
+    return m.precision[0], m.recall[0], m.fscore[0]
