@@ -1,0 +1,318 @@
+/*
+ * bvh.c -- a bounding-volume hierarchy over triangles and the nearest
+ * triangle of a point, bit-identical to a loop over every triangle.
+ *
+ * The rule that makes the search equal the loop.  The loop keeps the
+ * smallest rounded distance hd__tri_nearest returns and, among the
+ * triangles at that distance, the smallest index.  The search keeps the
+ * same pair (d, index) over the triangles it evaluates, and it skips a
+ * triangle, or every triangle under a node, only when a lower bound L on
+ * its true distance proves L > next(d), where next(d) is the double after
+ * d: then the true distance t > next(d), and rounding being monotone,
+ * round(t) >= next(d) > d, so the skipped triangle could neither beat d
+ * nor tie it (a tie would need its index compared).  As d only decreases,
+ * a triangle skipped once stays skippable.  So the search ends with the
+ * loop's pair, whatever the order of visits, the seed or the thread.
+ *
+ * The bounds L are computed in doubles and then shrunk by a factor
+ * (1 - 2^-48) that exceeds their accumulated rounding error (at most a few
+ * units of 2^-53, proofs at each function); results in the range where
+ * underflow could add an absolute error are replaced by 0, which is
+ * always a valid lower bound.  Coordinates are at most 2^511 in magnitude
+ * (the library checks 1e153), so no intermediate overflows: a difference
+ * is below 2^512, a sum of three squares below 2^1026 / 2 ... within
+ * DBL_MAX for the checked inputs (|difference| < 2.1e153, 3 * 2.1e153^2 <
+ * 1.4e307).
+ *
+ * The tree: nodes split at the median of the triangles' centroids along
+ * the longest axis of their box, down to leaves of at most LEAF
+ * triangles; each node's box is the exact minimum and maximum of its
+ * corners (no rounding).  A query descends nearest child first and
+ * starts from a seed triangle (the previous query's nearest: neighbouring
+ * queries are close, so the seed's distance is nearly the answer and
+ * most of the tree is skipped at once).  Within a leaf a triangle gets a
+ * cheap support-plane bound (hd__tri_lower) before the correctly rounded
+ * kernel, which runs only for triangles whose bound leaves them possible.
+ */
+#include "mesh/mesh.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define LEAF 4
+/* The shrink factor of every bound: exceeds (1 + 2^-53)^16 - 1. */
+#define SHRINK (1.0 - 0x1p-48)
+/* Below this a computed square or quotient may carry underflow's absolute
+ * error (at most 2^-1074 an operation): bounds there are taken as 0. */
+#define TINY 0x1p-1000
+#define MAX_DEPTH 128
+
+/* ---- lower bounds ------------------------------------------------------- */
+
+/* Box: the gap g on each axis is a difference of doubles rounded once
+ * (relative error <= u = 2^-53, and exact when it is not normal), its
+ * square adds one rounding, the two sums two more, the square root half a
+ * unit and one more rounding: the computed sqrt(s) is at most the true
+ * distance times (1 + u)^5.5 when s >= TINY (underflow could only add
+ * 2^-1072 to s, a relative 2^-72).  The final product rounds once more.
+ * (1 + u)^6.5 * SHRINK < 1, so the result never exceeds the true
+ * distance from p to the box. */
+double hd__box_lower(const hd__box_t *b, const double p[3]) {
+    double s = hd__box_lb2s(b, p[0], p[1], p[2]);
+    if (!(s >= TINY)) return 0.0;
+    return sqrt(s) * SHRINK;
+}
+
+/* Ericson's closest point on triangle abc, in plain doubles (Real-Time
+ * Collision Detection, 5.1.5).  Only a direction is taken from it, so it
+ * need not be exact; on a degenerate triangle it may be NaN. */
+static void rough_closest(const double *p, const double (*v)[3], double *q) {
+    const double *a = v[0], *b = v[1], *c = v[2];
+    double ab[3], ac[3], ap[3], bp[3], cp[3];
+    for (int i = 0; i < 3; i++) {
+        ab[i] = b[i] - a[i], ac[i] = c[i] - a[i];
+        ap[i] = p[i] - a[i], bp[i] = p[i] - b[i], cp[i] = p[i] - c[i];
+    }
+#define DOT(x, y) ((x)[0] * (y)[0] + (x)[1] * (y)[1] + (x)[2] * (y)[2])
+    double d1 = DOT(ab, ap), d2 = DOT(ac, ap);
+    double d3 = DOT(ab, bp), d4 = DOT(ac, bp);
+    double d5 = DOT(ab, cp), d6 = DOT(ac, cp);
+#undef DOT
+    double s = 0, t = 0;
+    double va = 0, vb = 0, vc = 0;
+    if (d1 <= 0 && d2 <= 0) {
+        s = 0, t = 0;
+    } else if (d3 >= 0 && d4 <= d3) {
+        s = 1, t = 0;
+    } else if (d6 >= 0 && d5 <= d6) {
+        s = 0, t = 1;
+    } else if ((vc = d1 * d4 - d3 * d2) <= 0 && d1 >= 0 && d3 <= 0) {
+        s = d1 / (d1 - d3), t = 0;
+    } else if ((vb = d5 * d2 - d1 * d6) <= 0 && d2 >= 0 && d6 <= 0) {
+        s = 0, t = d2 / (d2 - d6);
+    } else if ((va = d3 * d6 - d5 * d4) <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0) {
+        t = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        s = 1 - t;
+    } else {
+        double den = 1 / (va + vb + vc);
+        s = vb * den, t = vc * den;
+    }
+    for (int i = 0; i < 3; i++) q[i] = a[i] + s * ab[i] + t * ac[i];
+}
+
+/* Support bound: for any vector w, every point x of the triangle (a convex
+ * combination of its corners) has w.(p - x) >= min over corners k of
+ * w.(p - v_k), so |p - x| >= that minimum / |w| (Cauchy-Schwarz).  With w
+ * the direction from a rough closest point to p the bound is nearly the
+ * distance; any w is valid, so w need not be exact.
+ *
+ * Rounding, for the w actually stored (scaled by a power of two so that
+ * its largest component lies in [1/2, 1)): each difference y = p - v_k
+ * is rounded once (|y - (p - v_k)| <= u |p - v_k|), the dot product
+ * s = w.y adds at most gamma_3 = 3u/(1 - 3u) of A = sum |w_i y_i| (plus
+ * 3 * 2^-1074 of underflow), so |s - w.(p - v_k)| <= 4.01u A + 2^-1072;
+ * the computed A is within (1 + u)^3 of the true one, and e = 2^-50 A +
+ * 2^-1020 exceeds the error.  So m = min(s_k - e_k), rounded once
+ * (relative u), is at most the true minimum times (1 + u) when positive.
+ * |w|^2 >= 1/4 is computed with relative error <= 3u (underflowed squares
+ * add at most 2^-1072), its root within (1 + u)^2.5 of |w|, and the
+ * quotient rounds once: m / |w| computed is at most the true bound times
+ * (1 + u)^5; the product by SHRINK rounds once more.  Quotients below TINY
+ * are taken as 0. */
+double hd__tri_lower(const hd__tri_t *t, const double p[3]) {
+    double q[3], w[3], big = 0;
+    rough_closest(p, (const double(*)[3])t->v, q);
+    for (int i = 0; i < 3; i++) {
+        w[i] = p[i] - q[i];
+        big = fabs(w[i]) > big ? fabs(w[i]) : big;
+    }
+    if (!(big > 0) || !isfinite(big)) {
+        if (big == 0 && isfinite(q[0] + q[1] + q[2])) return 0.0; /* p on the triangle, roughly */
+        big = 0;
+        for (int i = 0; i < 3; i++) { /* the centroid's direction instead */
+            w[i] = p[i] - (t->v[0][i] + t->v[1][i] + t->v[2][i]) / 3;
+            big = fabs(w[i]) > big ? fabs(w[i]) : big;
+        }
+        if (!(big > 0) || !isfinite(big)) return 0.0;
+    }
+    int e;
+    frexp(big, &e);
+    for (int i = 0; i < 3; i++) w[i] = ldexp(w[i], -e);
+    double m = INFINITY;
+    for (int k = 0; k < 3; k++) {
+        double y0 = p[0] - t->v[k][0], y1 = p[1] - t->v[k][1], y2 = p[2] - t->v[k][2];
+        double s = w[0] * y0 + w[1] * y1 + w[2] * y2;
+        double A = fabs(w[0] * y0) + fabs(w[1] * y1) + fabs(w[2] * y2);
+        double v = s - (0x1p-50 * A + 0x1p-1020);
+        m = v < m ? v : m;
+    }
+    if (!(m > 0)) return 0.0;
+    double r = m / sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+    return r >= TINY ? r * SHRINK : 0.0;
+}
+
+/* ---- the tree ----------------------------------------------------------- */
+
+static void tri_box(const hd__tri_t *t, hd__box_t *b) {
+    for (int k = 0; k < 3; k++) {
+        double lo = t->v[0][k], hi = lo;
+        for (int j = 1; j < 3; j++) {
+            lo = t->v[j][k] < lo ? t->v[j][k] : lo;
+            hi = t->v[j][k] > hi ? t->v[j][k] : hi;
+        }
+        b->lo[k] = lo, b->hi[k] = hi;
+    }
+}
+
+/* Three times the centroid on axis k (only an order for the split). */
+static double centre3(const hd__tri_t *t, int k) { return t->v[0][k] + t->v[1][k] + t->v[2][k]; }
+
+/* Partial sort: tris[mid] is the element of that rank by centre3 on axis
+ * k, with no larger one before it and no smaller one after (Hoare's
+ * selection, middle pivot). */
+static void select_mid(hd__tri_t *tris, size_t n, size_t mid, int k) {
+    size_t lo = 0, hi = n - 1;
+    while (lo < hi) {
+        double pivot = centre3(&tris[lo + (hi - lo) / 2], k);
+        size_t i = lo, j = hi;
+        while (i <= j) {
+            while (centre3(&tris[i], k) < pivot) i++;
+            while (centre3(&tris[j], k) > pivot) j--;
+            if (i <= j) {
+                hd__tri_t s = tris[i];
+                tris[i] = tris[j], tris[j] = s;
+                i++;
+                if (j == 0) break;
+                j--;
+            }
+        }
+        if (mid <= j) hi = j;
+        else if (mid >= i) lo = i;
+        else return;
+    }
+}
+
+typedef struct {
+    hd__bvh_t *t;
+    size_t used;
+} builder_t;
+
+/* Node for tris[first, first + n); returns its position. */
+static size_t build_node(builder_t *B, size_t first, size_t n) {
+    size_t me = B->used++;
+    hd__bvh_node_t *node = &B->t->nodes[me];
+    hd__tri_t *tris = B->t->tris + first;
+    hd__box_t box, cbox;
+    tri_box(&tris[0], &box);
+    for (int k = 0; k < 3; k++) cbox.lo[k] = cbox.hi[k] = centre3(&tris[0], k);
+    for (size_t i = 1; i < n; i++) {
+        hd__box_t b;
+        tri_box(&tris[i], &b);
+        hd__box_merge(&box, &b);
+        for (int k = 0; k < 3; k++) {
+            double c = centre3(&tris[i], k);
+            cbox.lo[k] = c < cbox.lo[k] ? c : cbox.lo[k];
+            cbox.hi[k] = c > cbox.hi[k] ? c : cbox.hi[k];
+        }
+    }
+    node->box = box;
+    if (n <= LEAF) {
+        node->first_or_second = (uint32_t)first;
+        node->count = (uint32_t)n;
+        return me;
+    }
+    int axis = 0;
+    for (int k = 1; k < 3; k++)
+        if (cbox.hi[k] - cbox.lo[k] > cbox.hi[axis] - cbox.lo[axis]) axis = k;
+    size_t half = n / 2;
+    select_mid(tris, n, half, axis);
+    node->count = 0;
+    build_node(B, first, half);
+    size_t second = build_node(B, first + half, n - half);
+    B->t->nodes[me].first_or_second = (uint32_t)second; /* nodes did not move */
+    return me;
+}
+
+int hd__bvh_build(hd__bvh_t *t, hd__tri_t *tris, size_t n) {
+    memset(t, 0, sizeof *t);
+    if (n == 0 || n > ((size_t)1 << 31)) return HD_EOVERFLOW;
+    t->tris = tris;
+    t->n_tris = n;
+    t->nodes = hd__malloc_array(2 * n, sizeof *t->nodes);
+    if (!t->nodes) return HD_ENOMEM;
+    builder_t B = {t, 0};
+    build_node(&B, 0, n);
+    t->n_nodes = B.used;
+    return HD_OK;
+}
+
+void hd__bvh_free(hd__bvh_t *t) {
+    free(t->tris);
+    free(t->nodes);
+    memset(t, 0, sizeof *t);
+}
+
+/* ---- the query ---------------------------------------------------------- */
+
+typedef struct {
+    hd__tri_near_t best;
+    size_t index, pos;
+    double next; /* next(best.d): a bound above it prunes */
+} search_t;
+
+static void evaluate(const hd__bvh_t *t, const double *p, size_t pos, search_t *s, hd__bvh_stats_t *st) {
+    const hd__tri_t *tr = &t->tris[pos];
+    hd__tri_near_t r;
+    hd__tri_nearest(p, tr->v[0], tr->v[1], tr->v[2], &r); /* inputs checked: cannot fail */
+    st->kernel++;
+    st->exact += (uint64_t)r.exact;
+    if (s->pos == SIZE_MAX || r.d < s->best.d || (r.d == s->best.d && tr->index < s->index)) {
+        s->best = r;
+        s->index = tr->index;
+        s->pos = pos;
+        s->next = nextafter(r.d, INFINITY);
+    }
+}
+
+static void leaf(const hd__bvh_t *t, const hd__bvh_node_t *node, const double *p, size_t seed, search_t *s,
+                 hd__bvh_stats_t *st) {
+    for (size_t k = node->first_or_second, end = k + node->count; k < end; k++) {
+        if (k == seed) continue;
+        st->bounded++;
+        if (hd__tri_lower(&t->tris[k], p) > s->next) continue;
+        evaluate(t, p, k, s, st);
+    }
+}
+
+size_t hd__bvh_nearest(const hd__bvh_t *t, const double p[3], size_t seed, hd__tri_near_t *best,
+                       size_t *index, hd__bvh_stats_t *st) {
+    search_t s = {.index = SIZE_MAX, .pos = SIZE_MAX, .next = INFINITY};
+    if (seed < t->n_tris) evaluate(t, p, seed, &s, st);
+    struct { uint32_t node; double lb; } stack[MAX_DEPTH];
+    int top = 0;
+    stack[top].node = 0, stack[top++].lb = hd__box_lower(&t->nodes[0].box, p);
+    while (top > 0) {
+        --top;
+        if (stack[top].lb > s.next) continue;
+        const hd__bvh_node_t *node = &t->nodes[stack[top].node];
+        st->nodes++;
+        if (node->count) {
+            leaf(t, node, p, seed, &s, st);
+            continue;
+        }
+        uint32_t a = (uint32_t)(node - t->nodes) + 1, b = node->first_or_second;
+        double la = hd__box_lower(&t->nodes[a].box, p), lb = hd__box_lower(&t->nodes[b].box, p);
+        if (la > lb) {
+            uint32_t x = a; a = b, b = x;
+            double y = la; la = lb, lb = y;
+        }
+        /* nearer child on top; a depth beyond MAX_DEPTH cannot occur: the
+         * median split halves the count at each level */
+        if (lb <= s.next) stack[top].node = b, stack[top++].lb = lb;
+        if (la <= s.next) stack[top].node = a, stack[top++].lb = la;
+    }
+    *best = s.best;
+    *index = s.index;
+    return s.pos;
+}
