@@ -48,6 +48,8 @@
 #define TINY 0x1p-1000
 #define MAX_DEPTH 128
 
+static void tri_box(const struct hd__tri *t, hd__box_t *b);
+
 /* ---- lower bounds ------------------------------------------------------- */
 
 /* Box: the gap g on each axis is a difference of doubles rounded once
@@ -62,6 +64,24 @@ double hd__box_lower(const hd__box_t *b, const double p[3]) {
     double s = hd__box_lb2s(b, p[0], p[1], p[2]);
     if (!(s >= TINY)) return 0.0;
     return sqrt(s) * SHRINK;
+}
+
+/* The same test without the square root: whether the box is certainly
+ * farther than a distance whose square is at most thr2 (below).  The
+ * computed s is at most the true squared distance times (1 + u)^5 when
+ * s >= TINY, and s * SHRINK, rounded, is below s / (1 + u)^5: so
+ * s * SHRINK > thr2 >= next^2 proves the box farther than next (and when
+ * s < TINY, s * SHRINK < thr2 as thr2 >= 2^-990). */
+static int box_beyond(const hd__box_t *b, const double p[3], double thr2) {
+    return hd__box_lb2s(b, p[0], p[1], p[2]) * SHRINK > thr2;
+}
+
+/* An upper bound on next^2, at least 2^-990: the product rounds once
+ * (relative u when normal), the factor covers it; below 2^-990 the floor
+ * stands in for it. */
+static double square_up(double next) {
+    double t = next * next * (1.0 + 0x1p-48);
+    return t > 0x1p-990 ? t : 0x1p-990;
 }
 
 /* Ericson's closest point on triangle abc, in plain doubles (Real-Time
@@ -107,16 +127,18 @@ static void rough_closest(const double *p, const double (*v)[3], double *q) {
  * the direction from a rough closest point to p the bound is nearly the
  * distance; any w is valid, so w need not be exact.
  *
- * Rounding, for the w actually stored (scaled by a power of two so that
- * its largest component lies in [1/2, 1)): each difference y = p - v_k
+ * Rounding, for the w actually stored (scaled by a power of two to a
+ * largest component in [1/2, 1) when it is below 2^-500, so that |w|^2 >=
+ * 2^-1000 in every case, and |w|^2 < 1.3e307 as p and q lie within the
+ * checked range): each difference y = p - v_k
  * is rounded once (|y - (p - v_k)| <= u |p - v_k|), the dot product
  * s = w.y adds at most gamma_3 = 3u/(1 - 3u) of A = sum |w_i y_i| (plus
  * 3 * 2^-1074 of underflow), so |s - w.(p - v_k)| <= 4.01u A + 2^-1072;
  * the computed A is within (1 + u)^3 of the true one, and e = 2^-50 A +
  * 2^-1020 exceeds the error.  So m = min(s_k - e_k), rounded once
  * (relative u), is at most the true minimum times (1 + u) when positive.
- * |w|^2 >= 1/4 is computed with relative error <= 3u (underflowed squares
- * add at most 2^-1072), its root within (1 + u)^2.5 of |w|, and the
+ * |w|^2 >= 2^-1000 is computed with relative error <= 3u (underflowed
+ * squares add at most 3 * 2^-1074, a relative 2^-72), its root within (1 + u)^2.5 of |w|, and the
  * quotient rounds once: m / |w| computed is at most the true bound times
  * (1 + u)^5; the product by SHRINK rounds once more.  Quotients below TINY
  * are taken as 0. */
@@ -136,9 +158,11 @@ double hd__tri_lower(const hd__tri_t *t, const double p[3]) {
         }
         if (!(big > 0) || !isfinite(big)) return 0.0;
     }
-    int e;
-    frexp(big, &e);
-    for (int i = 0; i < 3; i++) w[i] = ldexp(w[i], -e);
+    if (big < 0x1p-500) { /* only then can |w|^2 underflow: scale it up */
+        int e;
+        frexp(big, &e);
+        for (int i = 0; i < 3; i++) w[i] = ldexp(w[i], -e);
+    }
     double m = INFINITY;
     for (int k = 0; k < 3; k++) {
         double y0 = p[0] - t->v[k][0], y1 = p[1] - t->v[k][1], y2 = p[2] - t->v[k][2];
@@ -258,7 +282,8 @@ void hd__bvh_free(hd__bvh_t *t) {
 typedef struct {
     hd__tri_near_t best;
     size_t index, pos;
-    double next; /* next(best.d): a bound above it prunes */
+    double next;  /* next(best.d): a bound above it prunes */
+    double next2; /* square_up(next) */
 } search_t;
 
 static void evaluate(const hd__bvh_t *t, const double *p, size_t pos, search_t *s, hd__bvh_stats_t *st) {
@@ -272,6 +297,7 @@ static void evaluate(const hd__bvh_t *t, const double *p, size_t pos, search_t *
         s->index = tr->index;
         s->pos = pos;
         s->next = nextafter(r.d, INFINITY);
+        s->next2 = square_up(s->next);
     }
 }
 
@@ -279,6 +305,9 @@ static void leaf(const hd__bvh_t *t, const hd__bvh_node_t *node, const double *p
                  hd__bvh_stats_t *st) {
     for (size_t k = node->first_or_second, end = k + node->count; k < end; k++) {
         if (k == seed) continue;
+        hd__box_t b;
+        tri_box(&t->tris[k], &b);
+        if (box_beyond(&b, p, s->next2)) continue;
         st->bounded++;
         if (hd__tri_lower(&t->tris[k], p) > s->next) continue;
         evaluate(t, p, k, s, st);
@@ -287,30 +316,27 @@ static void leaf(const hd__bvh_t *t, const hd__bvh_node_t *node, const double *p
 
 size_t hd__bvh_nearest(const hd__bvh_t *t, const double p[3], size_t seed, hd__tri_near_t *best,
                        size_t *index, hd__bvh_stats_t *st) {
-    search_t s = {.index = SIZE_MAX, .pos = SIZE_MAX, .next = INFINITY};
+    search_t s = {.index = SIZE_MAX, .pos = SIZE_MAX, .next = INFINITY, .next2 = INFINITY};
     if (seed < t->n_tris) evaluate(t, p, seed, &s, st);
-    struct { uint32_t node; double lb; } stack[MAX_DEPTH];
+    uint32_t stack[MAX_DEPTH];
     int top = 0;
-    stack[top].node = 0, stack[top++].lb = hd__box_lower(&t->nodes[0].box, p);
+    stack[top++] = 0;
     while (top > 0) {
-        --top;
-        if (stack[top].lb > s.next) continue;
-        const hd__bvh_node_t *node = &t->nodes[stack[top].node];
+        const hd__bvh_node_t *node = &t->nodes[stack[--top]];
+        if (box_beyond(&node->box, p, s.next2)) continue;
         st->nodes++;
         if (node->count) {
             leaf(t, node, p, seed, &s, st);
             continue;
         }
         uint32_t a = (uint32_t)(node - t->nodes) + 1, b = node->first_or_second;
-        double la = hd__box_lower(&t->nodes[a].box, p), lb = hd__box_lower(&t->nodes[b].box, p);
-        if (la > lb) {
-            uint32_t x = a; a = b, b = x;
-            double y = la; la = lb, lb = y;
-        }
-        /* nearer child on top; a depth beyond MAX_DEPTH cannot occur: the
-         * median split halves the count at each level */
-        if (lb <= s.next) stack[top].node = b, stack[top++].lb = lb;
-        if (la <= s.next) stack[top].node = a, stack[top++].lb = la;
+        double la = hd__box_lb2s(&t->nodes[a].box, p[0], p[1], p[2]);
+        double lb = hd__box_lb2s(&t->nodes[b].box, p[0], p[1], p[2]);
+        /* the nearer child on top (only an order: each is tested when
+         * popped); the median split halves the count at each level, so
+         * the stack never holds more than the depth plus one */
+        if (la > lb) stack[top++] = a, stack[top++] = b;
+        else stack[top++] = b, stack[top++] = a;
     }
     *best = s.best;
     *index = s.index;
