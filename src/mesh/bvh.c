@@ -48,8 +48,6 @@
 #define TINY 0x1p-1000
 #define MAX_DEPTH 128
 
-static void tri_box(const struct hd__tri *t, hd__box_t *b);
-
 /* ---- lower bounds ------------------------------------------------------- */
 
 /* Box: the gap g on each axis is a difference of doubles rounded once
@@ -264,16 +262,24 @@ int hd__bvh_build(hd__bvh_t *t, hd__tri_t *tris, size_t n) {
     t->tris = tris;
     t->n_tris = n;
     t->nodes = hd__malloc_array(2 * n, sizeof *t->nodes);
-    if (!t->nodes) return HD_ENOMEM;
+    t->boxes = hd__malloc_array(n, sizeof *t->boxes);
+    if (!t->nodes || !t->boxes) { /* the triangles stay the caller's */
+        free(t->nodes);
+        free(t->boxes);
+        memset(t, 0, sizeof *t);
+        return HD_ENOMEM;
+    }
     builder_t B = {t, 0};
     build_node(&B, 0, n);
     t->n_nodes = B.used;
+    for (size_t k = 0; k < n; k++) tri_box(&t->tris[k], &t->boxes[k]);
     return HD_OK;
 }
 
 void hd__bvh_free(hd__bvh_t *t) {
     free(t->tris);
     free(t->nodes);
+    free(t->boxes);
     memset(t, 0, sizeof *t);
 }
 
@@ -305,9 +311,7 @@ static void leaf(const hd__bvh_t *t, const hd__bvh_node_t *node, const double *p
                  hd__bvh_stats_t *st) {
     for (size_t k = node->first_or_second, end = k + node->count; k < end; k++) {
         if (k == seed) continue;
-        hd__box_t b;
-        tri_box(&t->tris[k], &b);
-        if (box_beyond(&b, p, s->next2)) continue;
+        if (box_beyond(&t->boxes[k], p, s->next2)) continue;
         st->bounded++;
         if (hd__tri_lower(&t->tris[k], p) > s->next) continue;
         evaluate(t, p, k, s, st);
@@ -318,12 +322,13 @@ size_t hd__bvh_nearest(const hd__bvh_t *t, const double p[3], size_t seed, hd__t
                        size_t *index, hd__bvh_stats_t *st) {
     search_t s = {.index = SIZE_MAX, .pos = SIZE_MAX, .next = INFINITY, .next2 = INFINITY};
     if (seed < t->n_tris) evaluate(t, p, seed, &s, st);
-    uint32_t stack[MAX_DEPTH];
+    struct { uint32_t node; double s; } stack[MAX_DEPTH]; /* s: the box's computed hd__box_lb2s */
     int top = 0;
-    stack[top++] = 0;
+    stack[top].node = 0, stack[top++].s = hd__box_lb2s(&t->nodes[0].box, p[0], p[1], p[2]);
     while (top > 0) {
-        const hd__bvh_node_t *node = &t->nodes[stack[--top]];
-        if (box_beyond(&node->box, p, s.next2)) continue;
+        --top;
+        if (stack[top].s * SHRINK > s.next2) continue; /* box_beyond, from the stored square */
+        const hd__bvh_node_t *node = &t->nodes[stack[top].node];
         st->nodes++;
         if (node->count) {
             leaf(t, node, p, seed, &s, st);
@@ -332,11 +337,14 @@ size_t hd__bvh_nearest(const hd__bvh_t *t, const double p[3], size_t seed, hd__t
         uint32_t a = (uint32_t)(node - t->nodes) + 1, b = node->first_or_second;
         double la = hd__box_lb2s(&t->nodes[a].box, p[0], p[1], p[2]);
         double lb = hd__box_lb2s(&t->nodes[b].box, p[0], p[1], p[2]);
-        /* the nearer child on top (only an order: each is tested when
-         * popped); the median split halves the count at each level, so
-         * the stack never holds more than the depth plus one */
-        if (la > lb) stack[top++] = a, stack[top++] = b;
-        else stack[top++] = b, stack[top++] = a;
+        if (la > lb) {
+            uint32_t x = a; a = b, b = x;
+            double y = la; la = lb, lb = y;
+        }
+        /* the nearer child on top; the median split halves the count at
+         * each level, so the stack never holds more than the depth plus one */
+        if (lb * SHRINK <= s.next2) stack[top].node = b, stack[top++].s = lb;
+        if (la * SHRINK <= s.next2) stack[top].node = a, stack[top++].s = la;
     }
     *best = s.best;
     *index = s.index;

@@ -80,13 +80,15 @@ typedef struct hd__bvh_node {
 
 typedef struct hd__bvh {
     hd__tri_t *tris;        /* in leaf order */
+    hd__box_t *boxes;       /* each triangle's box, in the same order */
     hd__bvh_node_t *nodes;
     size_t n_tris, n_nodes;
 } hd__bvh_t;
 
 /* The tree over n triangles given as corner triples (tris[k].index = k's
  * index in the mesh; the array is taken over and reordered).  HD_OK or
- * HD_ENOMEM / HD_EOVERFLOW (more than 2^31 triangles). */
+ * HD_ENOMEM / HD_EOVERFLOW (more than 2^31 triangles), and then the array
+ * is still the caller's. */
 int hd__bvh_build(hd__bvh_t *t, hd__tri_t *tris, size_t n);
 void hd__bvh_free(hd__bvh_t *t);
 
