@@ -30,9 +30,14 @@
  * corners (no rounding).  A query descends nearest child first and
  * starts from a seed triangle (the previous query's nearest: neighbouring
  * queries are close, so the seed's distance is nearly the answer and
- * most of the tree is skipped at once).  Within a leaf a triangle gets a
- * cheap support-plane bound (hd__tri_lower) before the correctly rounded
- * kernel, which runs only for triangles whose bound leaves them possible.
+ * most of the tree is skipped at once).  A node of at most GROUP
+ * triangles is first given a support bound over all its corners in the
+ * direction of its box's centre (hd__tris_lower: for a point far from the
+ * node nearly its distance, where a box bound is short by up to the box's
+ * size); within a leaf each triangle gets its own box bound, then a
+ * support bound in the direction of its rough closest point
+ * (hd__tri_lower), and the correctly rounded kernel runs only for
+ * triangles whose bounds leave them possible.
  */
 #include "mesh/mesh.h"
 
@@ -47,6 +52,9 @@
  * error (at most 2^-1074 an operation): bounds there are taken as 0. */
 #define TINY 0x1p-1000
 #define MAX_DEPTH 128
+/* Nodes of at most GROUP triangles get the support bound over all their
+ * corners (leaf_lower) before they are opened. */
+#define GROUP 8
 
 /* ---- lower bounds ------------------------------------------------------- */
 
@@ -140,38 +148,50 @@ static void rough_closest(const double *p, const double (*v)[3], double *q) {
  * quotient rounds once: m / |w| computed is at most the true bound times
  * (1 + u)^5; the product by SHRINK rounds once more.  Quotients below TINY
  * are taken as 0. */
-double hd__tri_lower(const hd__tri_t *t, const double p[3]) {
-    double q[3], w[3], big = 0;
-    rough_closest(p, (const double(*)[3])t->v, q);
-    for (int i = 0; i < 3; i++) {
-        w[i] = p[i] - q[i];
-        big = fabs(w[i]) > big ? fabs(w[i]) : big;
-    }
-    if (!(big > 0) || !isfinite(big)) {
-        if (big == 0 && isfinite(q[0] + q[1] + q[2])) return 0.0; /* p on the triangle, roughly */
-        big = 0;
-        for (int i = 0; i < 3; i++) { /* the centroid's direction instead */
-            w[i] = p[i] - (t->v[0][i] + t->v[1][i] + t->v[2][i]) / 3;
-            big = fabs(w[i]) > big ? fabs(w[i]) : big;
-        }
-        if (!(big > 0) || !isfinite(big)) return 0.0;
-    }
+/* The support bound for direction w over the corners of the n triangles
+ * t[0 .. n): min over corners of w.(p - v) / |w|, shrunk (the proof
+ * above); 0 when w is zero, not finite, or the bound is not positive. */
+static double support_lower(const hd__tri_t *t, size_t n, const double p[3], double *w) {
+    double big = fabs(w[0]) > fabs(w[1]) ? fabs(w[0]) : fabs(w[1]);
+    big = fabs(w[2]) > big ? fabs(w[2]) : big;
+    if (!(big > 0) || !isfinite(big)) return 0.0;
     if (big < 0x1p-500) { /* only then can |w|^2 underflow: scale it up */
         int e;
         frexp(big, &e);
         for (int i = 0; i < 3; i++) w[i] = ldexp(w[i], -e);
     }
     double m = INFINITY;
-    for (int k = 0; k < 3; k++) {
-        double y0 = p[0] - t->v[k][0], y1 = p[1] - t->v[k][1], y2 = p[2] - t->v[k][2];
-        double s = w[0] * y0 + w[1] * y1 + w[2] * y2;
-        double A = fabs(w[0] * y0) + fabs(w[1] * y1) + fabs(w[2] * y2);
-        double v = s - (0x1p-50 * A + 0x1p-1020);
-        m = v < m ? v : m;
-    }
+    for (size_t j = 0; j < n; j++)
+        for (int k = 0; k < 3; k++) {
+            const double *v = t[j].v[k];
+            double y0 = p[0] - v[0], y1 = p[1] - v[1], y2 = p[2] - v[2];
+            double s = w[0] * y0 + w[1] * y1 + w[2] * y2;
+            double A = fabs(w[0] * y0) + fabs(w[1] * y1) + fabs(w[2] * y2);
+            double e = s - (0x1p-50 * A + 0x1p-1020);
+            m = e < m ? e : m;
+        }
     if (!(m > 0)) return 0.0;
     double r = m / sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
     return r >= TINY ? r * SHRINK : 0.0;
+}
+
+double hd__tri_lower(const hd__tri_t *t, const double p[3]) {
+    double q[3], w[3];
+    rough_closest(p, (const double(*)[3])t->v, q);
+    for (int i = 0; i < 3; i++) w[i] = p[i] - q[i];
+    if (w[0] == 0 && w[1] == 0 && w[2] == 0) return 0.0; /* p on the triangle, roughly */
+    if (!isfinite(w[0] + w[1] + w[2])) /* a degenerate triangle: the centroid's direction */
+        for (int i = 0; i < 3; i++) w[i] = p[i] - (t->v[0][i] + t->v[1][i] + t->v[2][i]) / 3;
+    return support_lower(t, 1, p, w);
+}
+
+/* A bound for every triangle of a leaf at once: the support bound over
+ * all their corners in the direction from the leaf box's centre to p
+ * (nearly the true direction when p is far from the leaf). */
+double hd__tris_lower(const hd__tri_t *t, size_t n, const hd__box_t *b, const double p[3]) {
+    double w[3];
+    for (int i = 0; i < 3; i++) w[i] = p[i] - (b->lo[i] / 2 + b->hi[i] / 2);
+    return support_lower(t, n, p, w);
 }
 
 /* ---- the tree ----------------------------------------------------------- */
@@ -322,29 +342,36 @@ size_t hd__bvh_nearest(const hd__bvh_t *t, const double p[3], size_t seed, hd__t
                        size_t *index, hd__bvh_stats_t *st) {
     search_t s = {.index = SIZE_MAX, .pos = SIZE_MAX, .next = INFINITY, .next2 = INFINITY};
     if (seed < t->n_tris) evaluate(t, p, seed, &s, st);
-    struct { uint32_t node; double s; } stack[MAX_DEPTH]; /* s: the box's computed hd__box_lb2s */
+    /* s: the box's computed hd__box_lb2s; [first, first + n): the node's
+     * triangles (the build gives a node's first child the first n / 2) */
+    typedef struct { uint32_t node, first, n; double s; } entry_t;
+    entry_t stack[MAX_DEPTH], *e;
     int top = 0;
-    stack[top].node = 0, stack[top++].s = hd__box_lb2s(&t->nodes[0].box, p[0], p[1], p[2]);
+    stack[0] = (entry_t){0, 0, (uint32_t)t->n_tris, hd__box_lb2s(&t->nodes[0].box, p[0], p[1], p[2])};
+    top = 1;
     while (top > 0) {
-        --top;
-        if (stack[top].s * SHRINK > s.next2) continue; /* box_beyond, from the stored square */
-        const hd__bvh_node_t *node = &t->nodes[stack[top].node];
+        e = &stack[--top];
+        if (e->s * SHRINK > s.next2) continue; /* box_beyond, from the stored square */
+        const hd__bvh_node_t *node = &t->nodes[e->node];
+        uint32_t first = e->first, n = e->n;
+        if (n <= GROUP && s.pos != SIZE_MAX && hd__tris_lower(&t->tris[first], n, &node->box, p) > s.next) continue;
         st->nodes++;
         if (node->count) {
             leaf(t, node, p, seed, &s, st);
             continue;
         }
-        uint32_t a = (uint32_t)(node - t->nodes) + 1, b = node->first_or_second;
+        uint32_t a = e->node + 1, b = node->first_or_second, na = n / 2, fa = first, fb = first + n / 2;
         double la = hd__box_lb2s(&t->nodes[a].box, p[0], p[1], p[2]);
         double lb = hd__box_lb2s(&t->nodes[b].box, p[0], p[1], p[2]);
-        if (la > lb) {
-            uint32_t x = a; a = b, b = x;
-            double y = la; la = lb, lb = y;
-        }
         /* the nearer child on top; the median split halves the count at
          * each level, so the stack never holds more than the depth plus one */
-        if (lb * SHRINK <= s.next2) stack[top].node = b, stack[top++].s = lb;
-        if (la * SHRINK <= s.next2) stack[top].node = a, stack[top++].s = la;
+        if (la > lb) {
+            if (la * SHRINK <= s.next2) stack[top++] = (entry_t){a, fa, na, la};
+            if (lb * SHRINK <= s.next2) stack[top++] = (entry_t){b, fb, n - na, lb};
+        } else {
+            if (lb * SHRINK <= s.next2) stack[top++] = (entry_t){b, fb, n - na, lb};
+            if (la * SHRINK <= s.next2) stack[top++] = (entry_t){a, fa, na, la};
+        }
     }
     *best = s.best;
     *index = s.index;

@@ -112,6 +112,8 @@ size_t hd__bvh_nearest(const hd__bvh_t *t, const double p[3], size_t seed,
  * is certain.  Exposed for the tests. */
 double hd__box_lower(const hd__box_t *b, const double p[3]);
 double hd__tri_lower(const hd__tri_t *t, const double p[3]);
+/* ... for every triangle of t[0 .. n) at once (b: a box holding them). */
+double hd__tris_lower(const hd__tri_t *t, size_t n, const hd__box_t *b, const double p[3]);
 
 /* 1 when the corners are collinear or coincident (the triangle is a
  * segment or a point), decided exactly. */

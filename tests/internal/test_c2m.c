@@ -377,6 +377,35 @@ TEST(the_lower_bounds_never_exceed_the_distance) {
             break;
         }
     }
+    /* the bound of a group of triangles stays below each one's distance */
+    for (int k = 0; k < 20000 / SCALE; k++) {
+        hd__tri_t t[8];
+        hd__box_t b;
+        double p[3], sc = scales[k % 6], least = INFINITY;
+        for (int j = 0; j < 8; j++)
+            for (int v = 0; v < 3; v++)
+                for (int c = 0; c < 3; c++) t[j].v[v][c] = sc * (gen_unit(&g) - 0.5) * (j + 1) / 8;
+        for (int c = 0; c < 3; c++) {
+            b.lo[c] = b.hi[c] = t[0].v[0][c];
+            p[c] = sc * (k % 2 ? 2 : 1e-3) * (gen_unit(&g) - 0.5) + (k % 3 ? 0 : sc);
+        }
+        for (int j = 0; j < 8; j++) {
+            hd__tri_near_t r;
+            CHECK_RC(hd__tri_nearest(p, t[j].v[0], t[j].v[1], t[j].v[2], &r), HD_OK);
+            least = r.d < least ? r.d : least;
+            for (int v = 0; v < 3; v++)
+                for (int c = 0; c < 3; c++) {
+                    b.lo[c] = fmin(b.lo[c], t[j].v[v][c]);
+                    b.hi[c] = fmax(b.hi[c], t[j].v[v][c]);
+                }
+        }
+        double gl = hd__tris_lower(t, 8, &b, p);
+        if (gl > least) {
+            CONTEXT("seed 77, group case %d: nearest %.17g, group bound %.17g", k, least, gl);
+            CHECK(gl <= least);
+            break;
+        }
+    }
     /* and the triangle bound is nearly the distance, as pruning needs */
     CONTEXT("seed 77: %d of %d far cases tight", tight, far_cases);
     CHECK(tight >= far_cases * 9 / 10);
