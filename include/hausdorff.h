@@ -669,7 +669,7 @@ typedef struct hd_surface_result {
  * dist and triangle hold P->count elements, closest and bary 3 * P->count.
  * out (may be NULL) receives h(P, surface) with its witness and the
  * counters.  The triangles are put in a bounding-volume hierarchy for the
- * call (about 100 bytes a triangle, freed before returning) and the
+ * call (about 240 bytes a triangle, freed before returning) and the
  * points are visited along a Morton curve, each starting from its
  * predecessor's nearest triangle.
  * opt: NULL for defaults; only opt->threads is read.
