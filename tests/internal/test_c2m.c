@@ -228,6 +228,51 @@ TEST(duplicated_triangles_tie_to_the_smallest_index) {
     soup_free(&s);
 }
 
+/* Two triangles whose true distances differ but round to the same double:
+ * the smaller index wins even when its true distance is the larger, as
+ * in the brute force, wherever the nearer one sits in the tree. */
+TEST(equal_rounded_distances_tie_to_the_smallest_index_whatever_the_true_order) {
+    double o[3] = {0, 0, 0}, v1[3] = {1, 1, 0}, v0[3] = {1, 1, 0};
+    hd__tri_near_t r0, r1;
+    double e1[3] = {11, 1, 0}, e2[3] = {1, 11, 0};
+    CHECK_RC(hd__tri_nearest(o, v1, e1, e2, &r1), HD_OK);
+    int found = 0;
+    for (int k = 1; k < 64 && !found; k++) { /* |v0| > sqrt(2), rounded alike */
+        v0[1] = 1 + k * 0x1p-52;
+        double f1[3] = {11, v0[1], 0}, f2[3] = {1, v0[1] + 10, 0};
+        CHECK_RC(hd__tri_nearest(o, v0, f1, f2, &r0), HD_OK);
+        found = r0.d == r1.d;
+    }
+    CHECK(found);
+    if (!found) return;
+    gen_rng_t g;
+    gen_seed(&g, 41);
+    soup_t s;
+    soup_random(&g, &s, 300, 0.3); /* in [-0.15, 1.15]^3, then 4 higher: never nearest */
+    for (size_t k = 0; k < 3 * s.nv; k += 3) s.v[k + 2] += 4;
+    double tri0[9] = {v0[0], v0[1], 0, 11, v0[1], 0, 1, v0[1] + 10, 0};
+    double tri1[9] = {1, 1, 0, 11, 1, 0, 1, 11, 0};
+    for (int place = 0; place < 2; place++) {
+        /* the farther-but-equal triangle first (index 0) or last; the other
+         * at the other end */
+        size_t a = place ? s.nt - 1 : 0, b = place ? 0 : s.nt - 1;
+        memcpy(s.v + 9 * a, tri0, sizeof tri0);
+        memcpy(s.v + 9 * b, tri1, sizeof tri1);
+        double p[3 * 64];
+        for (int i = 0; i < 64; i++) /* the origin, between other points */
+            for (int c = 0; c < 3; c++) p[3 * i + c] = i % 2 ? 0 : 0.01 * (gen_unit(&g) - 0.5);
+        same_as_brute(&s, p, 64, place ? "equal rounded distances, farther last" : "equal rounded distances, farther first");
+        hd_points_t P = hd_points_f64(o, 1);
+        hd_mesh_t M = view(&s);
+        double d;
+        size_t t;
+        CHECK_RC(hd_mesh_distances(&P, &M, NULL, &d, &t, NULL, NULL, NULL, NULL), HD_OK);
+        CHECK_BITS(d, r1.d);
+        CHECK_EQ(t, a < b ? a : b);
+    }
+    soup_free(&s);
+}
+
 TEST(degenerate_triangles_are_their_hulls_and_counted) {
     /* a segment (collinear corners), a repeated index, a point (coincident
      * distinct vertices), a needle, and one proper triangle */
