@@ -23,6 +23,7 @@ typedef struct cli_args {
     int directed;
     int json;
     int quiet;
+    int surface; /* --surface: B measured as its triangles (surface.c) */
     analysis_args_t an; /* analysis options (analysis.h) */
 } cli_args_t;
 

@@ -24,6 +24,7 @@
 #include "output.h"
 #include "progress.h"
 #include "report.h"
+#include "surface.h"
 #include "tiles.h"
 
 #include <stdlib.h>
@@ -42,6 +43,10 @@ int main(int argc, char **argv) {
     cli_args_t a;
     int rc = cli_parse(argc, argv, &a);
     if (rc >= 0) return rc == EXIT_OK ? out_finish() : rc; /* --help, --version, --formats printed */
+    if (a.surface) {
+        rc = surface_run(&a);
+        return rc == EXIT_OK ? out_finish() : failed(rc);
+    }
 
     hd_error_t err;
     /* each side's files (one, a directory's or a list's), before anything

@@ -100,6 +100,8 @@ void cli_usage(FILE *out) {
 "                     that order; the witness is named by file and index\n"
 "                     (./@x for a file whose name starts with @)\n"
 "  --vertices         read a mesh (ply, obj, off, stl) as its vertices (default)\n"
+"  --surface          measure B, a mesh, as its surface: each point of A to its\n"
+"                     nearest triangle, correctly rounded (A must be points)\n"
 "  --sample N         read a mesh as N points drawn uniformly by area on its\n"
 "                     faces, reproducibly for a given --seed; a point format\n"
 "                     (las, laz, xyz, pcd, npy) is read as its points\n"
@@ -213,6 +215,7 @@ int cli_parse(int argc, char **argv, cli_args_t *a) {
         if (strcmp(s, "--float32") == 0) { a->read.dtype = HD_FLOAT32; continue; }
         if (strcmp(s, "--decimal-comma") == 0) { a->read.decimal_comma = 1; continue; }
         if (strcmp(s, "--vertices") == 0) { a->read.mesh = HD_MESH_VERTICES; continue; }
+        if (strcmp(s, "--surface") == 0) { a->surface = 1; continue; }
         if (strcmp(s, "--formats") == 0) { cli_formats(stdout); return EXIT_OK; }
         int an = analysis_parse_option(argc, argv, &k, &a->an);
         if (an < 0) return EXIT_USAGE;

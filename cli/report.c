@@ -84,6 +84,7 @@ static void side_line(FILE *out, const report_t *r, int w) {
         fprintf(out, ", %zu file%s%s%s", t->n, t->n == 1 ? "" : "s", skipped[0] ? "; " : "", safe_text(skipped));
     }
     fprintf(out, ")\n");
+    if (w == 1 && r->faces[w] && !sampled) fprintf(out, "   B is a mesh read as its vertices: --surface measures its triangles\n");
 }
 
 /* " = dir/t2.xyz[3]" for a point of a side of many files, else nothing. */

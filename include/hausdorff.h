@@ -729,6 +729,109 @@ HD_EXTERN const char *hd_format_description(const char *name);
  * hd_read_file may still refuse the content.  Never fails; thread safe. */
 HD_EXTERN const char *hd_format_of_path(const char *path);
 
+/* ------------------------------------------------------------------------
+ * Surfaces: the distance from every point of a cloud to a triangle mesh.
+ *
+ * The distance from a point to a triangle is the true Euclidean distance
+ * to the closed triangle (its convex hull: a degenerate triangle, with
+ * collinear or coincident corners, is the segment or the point it
+ * collapses to), correctly rounded: the real number rounded to the nearest
+ * double, ties to even, decided by exact arithmetic where doubles cannot
+ * decide it.  The distance to a mesh is the smallest over its triangles
+ * (rounding is monotone, so it is the correctly rounded distance to the
+ * union), and the nearest triangle is the smallest index at that distance:
+ * the answers equal a loop over every triangle, bit for bit, at any
+ * thread count.
+ * ---------------------------------------------------------------------- */
+typedef enum hd_index_type { HD_INDEX_U32 = 0, HD_INDEX_U64 = 1 } hd_index_type_t;
+
+/* A triangle mesh as a view over caller memory (nothing is copied by the
+ * view itself).  `vertices` is a point view as above (any dtype and
+ * strides); `triangles` holds 3 * n_triangles packed indices into it, of
+ * uint32_t or uint64_t as index_type says (aligned to their type), corner
+ * order free.  Both are borrowed for the duration of the call they are
+ * passed to.  A vertex no triangle uses is never read. */
+typedef struct hd_mesh {
+    hd_points_t vertices;
+    const void *triangles;
+    size_t n_triangles;
+    hd_index_type_t index_type;
+} hd_mesh_t;
+
+/* A mesh read from a file; the library owns it (hd_mesh_file_free).
+ * Polygons are split into fans (v0, v[k], v[k+1]), k = 1 .. n-2, in file
+ * order; an STL's corners are merged into one vertex where their three
+ * coordinates are bit-equal (n_merged counts the corners so merged). */
+typedef struct hd_mesh_file {
+    double *vertices;      /* n_vertices packed xyz doubles (float files
+                              widened exactly) */
+    size_t n_vertices;
+    uint64_t *triangles;   /* 3 * n_triangles indices, each < n_vertices */
+    size_t n_triangles;
+    size_t n_faces;        /* faces (polygons, facets) in the file */
+    size_t n_degenerate;   /* triangles with collinear or coincident
+                              corners (repeated indices included): measured
+                              as their hull, never an error */
+    size_t n_merged;       /* STL corners merged into an earlier vertex */
+    char format[16];       /* "ply", "obj", "off" or "stl" */
+} hd_mesh_file_t;
+
+/* Read the vertices and faces of a PLY, OBJ, OFF or STL file.  opt: NULL
+ * for the defaults; `format`, `threads`, `stream_limit`, `fifo_wait_ms`
+ * are read, `dtype` and `mesh` are ignored (vertices are doubles), a range
+ * is refused (HD_EINVAL).  Errors: those of hd_read_file, and
+ * HD_EUNSUPPORTED for a format without faces, HD_EFORMAT for a face that
+ * refers to a vertex the file does not have (the message names the file
+ * and the face), HD_EEMPTY for a file without vertices or without faces.
+ * A non-finite vertex is HD_ENONFINITE at its line or offset, as in
+ * hd_read_file.  On failure *out is NULL.  Thread safe. */
+HD_EXTERN int hd_read_mesh(const char *path, const hd_read_options_t *opt,
+                           hd_mesh_file_t **out, hd_error_t *err);
+
+/* Free a mesh read by hd_read_mesh.  NULL is accepted. */
+HD_EXTERN void hd_mesh_file_free(hd_mesh_file_t *mesh);
+
+/* A view over a mesh read from a file (valid while it lives). */
+HD_EXTERN hd_mesh_t hd_mesh_file_view(const hd_mesh_file_t *mesh);
+
+/* What hd_mesh_distances found and did.  The counters sum over threads. */
+typedef struct hd_surface_result {
+    double distance;        /* h(points, surface): the largest distance */
+    size_t i;               /* its point (the smallest index on ties) */
+    size_t triangle;        /* that point's nearest triangle */
+    size_t n_degenerate;    /* degenerate triangles of the mesh */
+    uint64_t kernel_calls;  /* point-to-triangle distances computed */
+    uint64_t exact_calls;   /* ... of them decided by exact arithmetic */
+    uint64_t triangles_bounded; /* triangles given a cheap lower bound */
+    uint64_t nodes_visited; /* tree nodes opened */
+    double seconds;         /* wall-clock time of the call */
+} hd_surface_result_t;
+
+/* For every point k of P, its distance to the surface of M (see above):
+ * dist[k], the nearest triangle triangle[k] (the smallest index among the
+ * triangles at that rounded distance), the closest point closest[3k ..
+ * 3k+2] on that triangle and its barycentric weights bary[3k .. 3k+2] of
+ * the triangle's corners in their stored order (closest point and weights
+ * are computed in doubles from the exact nearest feature: within a few
+ * rounding errors, not correctly rounded).  Each output may be NULL;
+ * dist and triangle hold P->count elements, closest and bary 3 * P->count.
+ * out (may be NULL) receives h(P, surface) with its witness and the
+ * counters.  The triangles are put in a bounding-volume hierarchy for the
+ * call (about 240 bytes a triangle, freed before returning) and the
+ * points are visited along a Morton curve, each starting from its
+ * predecessor's nearest triangle.
+ * opt: NULL for defaults; only opt->threads is read.
+ * Errors: HD_EINVAL (NULL P or M, unknown index_type, an index beyond the
+ *   vertices: the message names the triangle), HD_EEMPTY (no points, no
+ *   triangles, or triangles without vertices), HD_ENONFINITE / HD_ERANGE
+ *   (a point, or a corner of a triangle: the message names it), HD_ENOMEM.
+ * Thread safety: reentrant; it may start opt->threads threads. */
+HD_EXTERN int hd_mesh_distances(const hd_points_t *P, const hd_mesh_t *M,
+                                const hd_options_t *opt, double *dist,
+                                size_t *triangle, double *closest,
+                                double *bary, hd_surface_result_t *out,
+                                hd_error_t *err);
+
 #ifdef __cplusplus
 }
 #endif

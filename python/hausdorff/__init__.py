@@ -15,7 +15,8 @@ hausdorff.DirectedResult(distance=1.0, i=1, j=0)
 
 Functions: directed (a drop-in for scipy's directed_hausdorff), hausdorff,
 distances, percentile, summary, mean, chamfer, read, count, formats;
-the class Index (build once, query many times, optionally transformed).
+the class Index (build once, query many times, optionally transformed);
+the class Mesh and read_mesh (points to a triangle surface, correctly rounded).
 """
 from ._hausdorff import (
     DirectedResult,
@@ -37,15 +38,19 @@ from ._hausdorff import (
     read,
     summary,
 )
+from ._hausdorff import _mesh_distances, _read_mesh
+from ._surface import Mesh, SurfaceDistances, read_mesh
 from . import masks, scores  # segmentation masks; reconstruction scores (masks.py, scores.py)
 
 __all__ = [
     "DirectedResult",
     "HausdorffResult",
     "Index",
+    "Mesh",
     "MeanResult",
     "PercentileResult",
     "Summary",
+    "SurfaceDistances",
     "__version__",
     "algorithms",
     "chamfer",
@@ -57,5 +62,6 @@ __all__ = [
     "mean",
     "percentile",
     "read",
+    "read_mesh",
     "summary",
 ]

@@ -1735,10 +1735,131 @@ static PyTypeObject IndexType = {
 };
 
 /* ------------------------------------------------------------------------
+ * Surfaces: points to a triangle mesh (hausdorff.Mesh in __init__.py).
+ * ---------------------------------------------------------------------- */
+
+/* faces: an (M, 3) array of non-negative integers, as a new C-ordered
+ * uint64 array (NULL with the exception set). */
+static PyArrayObject *faces_array(PyObject *obj) {
+    PyArrayObject *raw = (PyArrayObject *)PyArray_FROM_O(obj);
+    if (!raw) return NULL;
+    if (PyArray_NDIM(raw) != 2 || PyArray_DIM(raw, 1) != 3 ||
+        !(PyArray_ISINTEGER(raw) || PyArray_SIZE(raw) == 0)) {
+        PyObject *shape = PyObject_GetAttrString((PyObject *)raw, "shape");
+        if (shape)
+            PyErr_Format(PyExc_ValueError, "faces must be an (M, 3) array of vertex indices (integers), got "
+                                           "shape %R and dtype %R", shape, (PyObject *)PyArray_DESCR(raw));
+        Py_XDECREF(shape);
+        Py_DECREF(raw);
+        return NULL;
+    }
+    PyArrayObject *i64 = (PyArrayObject *)PyArray_FromArray(raw, PyArray_DescrFromType(NPY_INT64),
+                                                            NPY_ARRAY_CARRAY | NPY_ARRAY_FORCECAST);
+    Py_DECREF(raw);
+    if (!i64) return NULL;
+    const int64_t *v = PyArray_DATA(i64);
+    for (npy_intp k = 0; k < PyArray_SIZE(i64); k++)
+        if (v[k] < 0) {
+            PyErr_Format(PyExc_ValueError, "faces: face %zd refers to vertex %lld (indices start at 0)",
+                         (Py_ssize_t)(k / 3), (long long)v[k]);
+            Py_DECREF(i64);
+            return NULL;
+        }
+    return i64; /* non-negative int64: the same bits as uint64 */
+}
+
+static PyObject *py_mesh_distances(PyObject *self, PyObject *args, PyObject *kw) {
+    (void)self;
+    static char *kwlist[] = {"points", "vertices", "faces", "threads", NULL};
+    PyObject *op, *ov, *of, *threads = Py_None;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "OOO|$O:_mesh_distances", kwlist, &op, &ov, &of, &threads))
+        return NULL;
+    hd_options_t opt;
+    if (parse_options(NULL, threads, NULL, &opt)) return NULL;
+    points_arg_t p, v;
+    if (points_from_object(op, "points", EMPTY_ERROR, &p)) return NULL;
+    if (points_from_object(ov, "vertices", EMPTY_ERROR, &v)) {
+        points_release(&p);
+        return NULL;
+    }
+    PyArrayObject *f = faces_array(of);
+    npy_intp n = (npy_intp)p.pts.count, n3[2] = {n, 3};
+    PyArrayObject *dist = NULL, *face = NULL, *closest = NULL, *bary = NULL;
+    PyObject *res = NULL;
+    if (f) {
+        dist = (PyArrayObject *)PyArray_SimpleNew(1, &n, NPY_DOUBLE);
+        face = (PyArrayObject *)PyArray_SimpleNew(1, &n, NPY_INTP);
+        closest = (PyArrayObject *)PyArray_SimpleNew(2, n3, NPY_DOUBLE);
+        bary = (PyArrayObject *)PyArray_SimpleNew(2, n3, NPY_DOUBLE);
+    }
+    if (dist && face && closest && bary) {
+        hd_mesh_t M = {v.pts, PyArray_DATA(f), (size_t)PyArray_DIM(f, 0), HD_INDEX_U64};
+        hd_surface_result_t r;
+        hd_error_t err;
+        int rc;
+        Py_BEGIN_ALLOW_THREADS
+        rc = hd_mesh_distances(&p.pts, &M, &opt, PyArray_DATA(dist), PyArray_DATA(face), PyArray_DATA(closest),
+                               PyArray_DATA(bary), &r, &err);
+        Py_END_ALLOW_THREADS
+        if (rc == HD_OK)
+            res = Py_BuildValue("(OOOOdnnn)", dist, face, closest, bary, r.distance, (Py_ssize_t)r.i,
+                                (Py_ssize_t)r.triangle, (Py_ssize_t)r.n_degenerate);
+        else
+            raise_hd(rc, &err);
+    }
+    Py_XDECREF(dist);
+    Py_XDECREF(face);
+    Py_XDECREF(closest);
+    Py_XDECREF(bary);
+    Py_XDECREF(f);
+    points_release(&p);
+    points_release(&v);
+    return res;
+}
+
+static PyObject *py_read_mesh(PyObject *self, PyObject *args, PyObject *kw) {
+    (void)self;
+    static char *kwlist[] = {"path", "format", NULL};
+    PyObject *opath;
+    const char *format = NULL;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "O&|$z:_read_mesh", kwlist, PyUnicode_FSConverter, &opath, &format))
+        return NULL;
+    hd_read_options_t ro;
+    hd_read_options_init(&ro);
+    ro.format = format;
+    hd_mesh_file_t *m = NULL;
+    hd_error_t err;
+    int rc;
+    Py_BEGIN_ALLOW_THREADS
+    rc = hd_read_mesh(PyBytes_AS_STRING(opath), &ro, &m, &err);
+    Py_END_ALLOW_THREADS
+    Py_DECREF(opath);
+    if (rc != HD_OK) return raise_hd(rc, &err);
+    npy_intp dv[2] = {(npy_intp)m->n_vertices, 3}, dt[2] = {(npy_intp)m->n_triangles, 3};
+    PyArrayObject *verts = (PyArrayObject *)PyArray_SimpleNew(2, dv, NPY_DOUBLE);
+    PyArrayObject *faces = (PyArrayObject *)PyArray_SimpleNew(2, dt, NPY_INTP);
+    PyObject *res = NULL;
+    if (verts && faces) {
+        memcpy(PyArray_DATA(verts), m->vertices, 3 * m->n_vertices * sizeof(double));
+        npy_intp *o = PyArray_DATA(faces);
+        for (size_t k = 0; k < 3 * m->n_triangles; k++) o[k] = (npy_intp)m->triangles[k];
+        res = Py_BuildValue("(OOnns)", verts, faces, (Py_ssize_t)m->n_faces, (Py_ssize_t)m->n_degenerate, m->format);
+    }
+    Py_XDECREF(verts);
+    Py_XDECREF(faces);
+    hd_mesh_file_free(m);
+    return res;
+}
+
+/* ------------------------------------------------------------------------
  * The module.
  * ---------------------------------------------------------------------- */
 
 static PyMethodDef module_methods[] = {
+    {"_mesh_distances", (PyCFunction)(void (*)(void))py_mesh_distances, METH_VARARGS | METH_KEYWORDS,
+     "_mesh_distances(points, vertices, faces, *, threads=None): hausdorff.Mesh.distances's engine"},
+    {"_read_mesh", (PyCFunction)(void (*)(void))py_read_mesh, METH_VARARGS | METH_KEYWORDS,
+     "_read_mesh(path, *, format=None): hausdorff.read_mesh's engine"},
     {"directed", (PyCFunction)(void (*)(void))py_directed, METH_VARARGS | METH_KEYWORDS,
      directed_doc},
     {"hausdorff", (PyCFunction)(void (*)(void))py_hausdorff, METH_VARARGS | METH_KEYWORDS,

@@ -214,3 +214,31 @@ class Index:
         translation: Optional[Vector3] = None,
         threads: Optional[int] = None,
     ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.intp]]: ...
+
+def _mesh_distances(
+    points: Points, vertices: Points, faces: npt.ArrayLike, *, threads: Optional[int] = None
+) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.intp], npt.NDArray[np.float64],
+           npt.NDArray[np.float64], float, int, int, int]: ...
+def _read_mesh(
+    path: Union[str, bytes, os.PathLike[str], os.PathLike[bytes]], *, format: Optional[str] = None
+) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.intp], int, int, str]: ...
+
+class SurfaceDistances(Tuple[npt.NDArray[np.float64], npt.NDArray[np.intp], npt.NDArray[np.float64],
+                             npt.NDArray[np.float64], float, int, int]):
+    distances: npt.NDArray[np.float64]
+    faces: npt.NDArray[np.intp]
+    closest: npt.NDArray[np.float64]
+    barycentric: npt.NDArray[np.float64]
+    distance: float
+    i: int
+    face: int
+
+class Mesh:
+    vertices: npt.NDArray[np.generic]
+    faces: npt.NDArray[np.generic]
+    def __init__(self, vertices: Points, faces: npt.ArrayLike) -> None: ...
+    def distances(self, points: Points, *, threads: Optional[int] = None) -> SurfaceDistances: ...
+
+def read_mesh(
+    path: Union[str, bytes, os.PathLike[str], os.PathLike[bytes]], *, format: Optional[str] = None
+) -> Mesh: ...

@@ -81,6 +81,13 @@ int hd__read_buffer(const void *data, size_t size, const char *name,
 int hd__count_buffer(const void *data, size_t size, const char *name,
                      const hd_read_options_t *opt, uint64_t *total, hd_error_t *err);
 
+/* The vertices (into verts, whose dtype the caller chose) and the faces
+ * (into tris) of the mesh file at path, as hd_read_file would find and
+ * confirm its format; a format without faces is HD_EUNSUPPORTED.  *format
+ * is the format's name.  For hd_read_mesh (src/surface.c). */
+int hd__read_faces(const char *path, const hd_read_options_t *opt, hd__sink_t *verts, hd__tris_t *tris,
+                   size_t *n_faces, const char **format, hd_error_t *err);
+
 /* ---- one reader call --------------------------------------------------- */
 typedef struct hd__read {
     const hd__file_t *f;

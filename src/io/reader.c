@@ -425,12 +425,12 @@ static int choose(const char *path, const hd_read_options_t *opt, const format_t
     return HD_OK;
 }
 
-/* Everything after loading: confirm the format, parse, make the cloud. */
-static int read_loaded(const hd__file_t *f, const format_t *fmt, int from_extension,
-                       const hd_read_options_t *opt, hd_cloud_t **out, uint64_t *total, hd_error_t *err) {
-    /* text after a UTF-8 byte-order mark is sniffed without it (the readers
-     * skip it too); UTF-16 and UTF-32 text has no format of its own: the
-     * reader the name chose refuses it by its encoding */
+/* The format of loaded content: fmt when the content confirms it, else
+ * the content's (*fmt set), or an error.  Text after a UTF-8 byte-order mark
+ * is sniffed without it (the readers skip it too); UTF-16 and UTF-32 text has
+ * no format of its own: the reader the name chose refuses it by its encoding. */
+static int confirm(const hd__file_t *f, const format_t **pfmt, int from_extension, hd_error_t *err) {
+    const format_t *fmt = *pfmt;
     size_t bom;
     int bits = hd__text_encoding(f->data, f->size, &bom);
     hd__file_t text = {f->name, f->data + bom, f->size - bom};
@@ -456,6 +456,15 @@ static int read_loaded(const hd__file_t *f, const format_t *fmt, int from_extens
             return hd__err(err, HD_EFORMAT, "%s: the name says %s but the content is %s; use --format %s", f->name,
                            fmt->name, seems->name, seems->name);
     }
+    *pfmt = fmt;
+    return HD_OK;
+}
+
+/* Everything after loading: confirm the format, parse, make the cloud. */
+static int read_loaded(const hd__file_t *f, const format_t *fmt, int from_extension,
+                       const hd_read_options_t *opt, hd_cloud_t **out, uint64_t *total, hd_error_t *err) {
+    int rc0 = confirm(f, &fmt, from_extension, err);
+    if (rc0) return rc0;
     hd_read_options_t as_points; /* sampling draws on faces: a format without them is read as its points */
     if (opt->mesh == HD_MESH_SAMPLE && !fmt->faces) {
         as_points = *opt;
@@ -570,4 +579,28 @@ hd_points_t hd_cloud_points(const hd_cloud_t *cloud) {
     p.count = cloud->count;
     p.dtype = cloud->dtype;
     return p;
+}
+
+int hd__read_faces(const char *path, const hd_read_options_t *opt, hd__sink_t *verts, hd__tris_t *tris,
+                   size_t *n_faces, const char **format, hd_error_t *err) {
+    const format_t *fmt;
+    int from_extension;
+    int rc = check_options(path, opt, err);
+    if (rc || (rc = choose(path, opt, &fmt, &from_extension, err))) return rc;
+    if (!fmt && strcmp(path, "-") == 0) from_extension = -1;
+    hd__file_t f;
+    int mapped;
+    if ((rc = load(path, opt, &f, &mapped, err))) return rc;
+    rc = confirm(&f, &fmt, from_extension, err);
+    if (rc == HD_OK && !fmt->faces)
+        rc = hd__err(err, HD_EUNSUPPORTED, "%s: %s has no faces (meshes are read from PLY, OBJ, OFF and STL)", f.name,
+                     fmt->name);
+    if (rc == HD_OK) {
+        hd__read_t r = {&f, opt, hd__thread_count(opt->threads, 1024), verts, tris, 0, err, 0, 0, 0};
+        rc = fmt->read(&r);
+        *n_faces = r.n_faces;
+        *format = fmt->name;
+    }
+    unload(&f, mapped);
+    return rc;
 }

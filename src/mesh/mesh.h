@@ -37,6 +37,7 @@
 #define HD_MESH_H
 
 #include "base/base.h"
+#include "points/points.h"
 
 /* The feature of the triangle that holds the closest point. */
 typedef enum hd__tri_feature {
@@ -59,5 +60,63 @@ int hd__tri_nearest(const double p[3], const double a[3], const double b[3],
 /* The same answer from exact arithmetic alone (tests compare the two). */
 int hd__tri_nearest_exact(const double p[3], const double a[3], const double b[3],
                           const double c[3], hd__tri_near_t *out);
+
+/* ---- the surface: a tree of triangles and the queries on it (bvh.c) ----- */
+
+/* One triangle as the tree stores it: its corners and its index in the
+ * caller's mesh. */
+typedef struct hd__tri {
+    double v[3][3];
+    size_t index;
+} hd__tri_t;
+
+/* A node: its box (exact minima and maxima of its corners); a leaf holds
+ * tris[first, first + count), an inner node (count == 0) has its first
+ * child at the next node and its second at `second`. */
+typedef struct hd__bvh_node {
+    hd__box_t box;
+    uint32_t first_or_second, count;
+} hd__bvh_node_t;
+
+typedef struct hd__bvh {
+    hd__tri_t *tris;        /* in leaf order */
+    hd__box_t *boxes;       /* each triangle's box, in the same order */
+    hd__bvh_node_t *nodes;
+    size_t n_tris, n_nodes;
+} hd__bvh_t;
+
+/* The tree over n triangles given as corner triples (tris[k].index = k's
+ * index in the mesh; the array is taken over and reordered).  HD_OK or
+ * HD_ENOMEM / HD_EOVERFLOW (more than 2^31 triangles), and then the array
+ * is still the caller's. */
+int hd__bvh_build(hd__bvh_t *t, hd__tri_t *tris, size_t n);
+void hd__bvh_free(hd__bvh_t *t);
+
+/* The counters of the queries (summed per thread, then over threads). */
+typedef struct hd__bvh_stats {
+    uint64_t nodes, bounded, kernel, exact;
+} hd__bvh_stats_t;
+
+/* The triangle nearest to p: *best (its distance correctly rounded, its
+ * closest point and weights) and *index (the smallest index among the
+ * triangles at that rounded distance), bit-identical to a loop over every
+ * triangle with hd__tri_nearest.  `seed` (a position in t->tris, or
+ * SIZE_MAX) is tried first: any triangle is correct, a near one makes the
+ * search short.  Returns the position of the nearest triangle in t->tris
+ * (the next query's seed). */
+size_t hd__bvh_nearest(const hd__bvh_t *t, const double p[3], size_t seed,
+                       hd__tri_near_t *best, size_t *index, hd__bvh_stats_t *st);
+
+/* Lower bounds on distances, proven not to exceed the true distance with
+ * every rounding error counted (bvh.c has the proofs); 0 when no bound
+ * is certain.  Exposed for the tests. */
+double hd__box_lower(const hd__box_t *b, const double p[3]);
+double hd__tri_lower(const hd__tri_t *t, const double p[3]);
+/* ... for every triangle of t[0 .. n) at once (b: a box holding them). */
+double hd__tris_lower(const hd__tri_t *t, size_t n, const hd__box_t *b, const double p[3]);
+
+/* 1 when the corners are collinear or coincident (the triangle is a
+ * segment or a point), decided exactly. */
+int hd__tri_degenerate(const double a[3], const double b[3], const double c[3]);
 
 #endif

@@ -1,0 +1,379 @@
+/*
+ * bvh.c -- a bounding-volume hierarchy over triangles and the nearest
+ * triangle of a point, bit-identical to a loop over every triangle.
+ *
+ * The rule that makes the search equal the loop.  The loop keeps the
+ * smallest rounded distance hd__tri_nearest returns and, among the
+ * triangles at that distance, the smallest index.  The search keeps the
+ * same pair (d, index) over the triangles it evaluates, and it skips a
+ * triangle, or every triangle under a node, only when a lower bound L on
+ * its true distance proves L > next(d), where next(d) is the double after
+ * d: then the true distance t > next(d), and rounding being monotone,
+ * round(t) >= next(d) > d, so the skipped triangle could neither beat d
+ * nor tie it (a tie would need its index compared).  As d only decreases,
+ * a triangle skipped once stays skippable.  So the search ends with the
+ * loop's pair, whatever the order of visits, the seed or the thread.
+ *
+ * The bounds L are computed in doubles and then shrunk by a factor
+ * (1 - 2^-48) that exceeds their accumulated rounding error (at most a few
+ * units of 2^-53, proofs at each function); results in the range where
+ * underflow could add an absolute error are replaced by 0, which is
+ * always a valid lower bound.  Coordinates are at most 2^511 in magnitude
+ * (the library checks 1e153), so no intermediate overflows: a difference
+ * is below 2^512, a sum of three squares below 2^1026 / 2 ... within
+ * DBL_MAX for the checked inputs (|difference| < 2.1e153, 3 * 2.1e153^2 <
+ * 1.4e307).
+ *
+ * The tree: nodes split at the median of the triangles' centroids along
+ * the longest axis of their box, down to leaves of at most LEAF
+ * triangles; each node's box is the exact minimum and maximum of its
+ * corners (no rounding).  A query descends nearest child first and
+ * starts from a seed triangle (the previous query's nearest: neighbouring
+ * queries are close, so the seed's distance is nearly the answer and
+ * most of the tree is skipped at once).  A node of at most GROUP
+ * triangles is first given a support bound over all its corners in the
+ * direction of its box's centre (hd__tris_lower: for a point far from the
+ * node nearly its distance, where a box bound is short by up to the box's
+ * size); within a leaf each triangle gets its own box bound, then a
+ * support bound in the direction of its rough closest point
+ * (hd__tri_lower), and the correctly rounded kernel runs only for
+ * triangles whose bounds leave them possible.
+ */
+#include "mesh/mesh.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define LEAF 4
+/* The shrink factor of every bound: exceeds (1 + 2^-53)^16 - 1. */
+#define SHRINK (1.0 - 0x1p-48)
+/* Below this a computed square or quotient may carry underflow's absolute
+ * error (at most 2^-1074 an operation): bounds there are taken as 0. */
+#define TINY 0x1p-1000
+#define MAX_DEPTH 128
+/* Nodes of at most GROUP triangles get the support bound over all their
+ * corners (leaf_lower) before they are opened. */
+#define GROUP 8
+
+/* ---- lower bounds ------------------------------------------------------- */
+
+/* Box: the gap g on each axis is a difference of doubles rounded once
+ * (relative error <= u = 2^-53, and exact when it is not normal), its
+ * square adds one rounding, the two sums two more, the square root half a
+ * unit and one more rounding: the computed sqrt(s) is at most the true
+ * distance times (1 + u)^5.5 when s >= TINY (underflow could only add
+ * 2^-1072 to s, a relative 2^-72).  The final product rounds once more.
+ * (1 + u)^6.5 * SHRINK < 1, so the result never exceeds the true
+ * distance from p to the box. */
+double hd__box_lower(const hd__box_t *b, const double p[3]) {
+    double s = hd__box_lb2s(b, p[0], p[1], p[2]);
+    if (!(s >= TINY)) return 0.0;
+    return sqrt(s) * SHRINK;
+}
+
+/* The same test without the square root: whether the box is certainly
+ * farther than a distance whose square is at most thr2 (below).  The
+ * computed s is at most the true squared distance times (1 + u)^5 when
+ * s >= TINY, and s * SHRINK, rounded, is below s / (1 + u)^5: so
+ * s * SHRINK > thr2 >= next^2 proves the box farther than next (and when
+ * s < TINY, s * SHRINK < thr2 as thr2 >= 2^-990). */
+static int box_beyond(const hd__box_t *b, const double p[3], double thr2) {
+    return hd__box_lb2s(b, p[0], p[1], p[2]) * SHRINK > thr2;
+}
+
+/* An upper bound on next^2, at least 2^-990: the product rounds once
+ * (relative u when normal), the factor covers it; below 2^-990 the floor
+ * stands in for it. */
+static double square_up(double next) {
+    double t = next * next * (1.0 + 0x1p-48);
+    return t > 0x1p-990 ? t : 0x1p-990;
+}
+
+/* Ericson's closest point on triangle abc, in plain doubles (Real-Time
+ * Collision Detection, 5.1.5).  Only a direction is taken from it, so it
+ * need not be exact; on a degenerate triangle it may be NaN. */
+static void rough_closest(const double *p, const double (*v)[3], double *q) {
+    const double *a = v[0], *b = v[1], *c = v[2];
+    double ab[3], ac[3], ap[3], bp[3], cp[3];
+    for (int i = 0; i < 3; i++) {
+        ab[i] = b[i] - a[i], ac[i] = c[i] - a[i];
+        ap[i] = p[i] - a[i], bp[i] = p[i] - b[i], cp[i] = p[i] - c[i];
+    }
+#define DOT(x, y) ((x)[0] * (y)[0] + (x)[1] * (y)[1] + (x)[2] * (y)[2])
+    double d1 = DOT(ab, ap), d2 = DOT(ac, ap);
+    double d3 = DOT(ab, bp), d4 = DOT(ac, bp);
+    double d5 = DOT(ab, cp), d6 = DOT(ac, cp);
+#undef DOT
+    double s = 0, t = 0;
+    double va = 0, vb = 0, vc = 0;
+    if (d1 <= 0 && d2 <= 0) {
+        s = 0, t = 0;
+    } else if (d3 >= 0 && d4 <= d3) {
+        s = 1, t = 0;
+    } else if (d6 >= 0 && d5 <= d6) {
+        s = 0, t = 1;
+    } else if ((vc = d1 * d4 - d3 * d2) <= 0 && d1 >= 0 && d3 <= 0) {
+        s = d1 / (d1 - d3), t = 0;
+    } else if ((vb = d5 * d2 - d1 * d6) <= 0 && d2 >= 0 && d6 <= 0) {
+        s = 0, t = d2 / (d2 - d6);
+    } else if ((va = d3 * d6 - d5 * d4) <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0) {
+        t = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        s = 1 - t;
+    } else {
+        double den = 1 / (va + vb + vc);
+        s = vb * den, t = vc * den;
+    }
+    for (int i = 0; i < 3; i++) q[i] = a[i] + s * ab[i] + t * ac[i];
+}
+
+/* Support bound: for any vector w, every point x of the triangle (a convex
+ * combination of its corners) has w.(p - x) >= min over corners k of
+ * w.(p - v_k), so |p - x| >= that minimum / |w| (Cauchy-Schwarz).  With w
+ * the direction from a rough closest point to p the bound is nearly the
+ * distance; any w is valid, so w need not be exact.
+ *
+ * Rounding, for the w actually stored (scaled by a power of two to a
+ * largest component in [1/2, 1) when it is below 2^-500, so that |w|^2 >=
+ * 2^-1000 in every case, and |w|^2 < 1.3e307 as p and q lie within the
+ * checked range): each difference y = p - v_k
+ * is rounded once (|y - (p - v_k)| <= u |p - v_k|), the dot product
+ * s = w.y adds at most gamma_3 = 3u/(1 - 3u) of A = sum |w_i y_i| (plus
+ * 3 * 2^-1074 of underflow), so |s - w.(p - v_k)| <= 4.01u A + 2^-1072;
+ * the computed A is within (1 + u)^3 of the true one, and e = 2^-50 A +
+ * 2^-1020 exceeds the error.  So m = min(s_k - e_k), rounded once
+ * (relative u), is at most the true minimum times (1 + u) when positive.
+ * |w|^2 >= 2^-1000 is computed with relative error <= 3u (underflowed
+ * squares add at most 3 * 2^-1074, a relative 2^-72), its root within (1 + u)^2.5 of |w|, and the
+ * quotient rounds once: m / |w| computed is at most the true bound times
+ * (1 + u)^5; the product by SHRINK rounds once more.  Quotients below TINY
+ * are taken as 0. */
+/* The support bound for direction w over the corners of the n triangles
+ * t[0 .. n): min over corners of w.(p - v) / |w|, shrunk (the proof
+ * above); 0 when w is zero, not finite, or the bound is not positive. */
+static double support_lower(const hd__tri_t *t, size_t n, const double p[3], double *w) {
+    double big = fabs(w[0]) > fabs(w[1]) ? fabs(w[0]) : fabs(w[1]);
+    big = fabs(w[2]) > big ? fabs(w[2]) : big;
+    if (!(big > 0) || !isfinite(big)) return 0.0;
+    if (big < 0x1p-500) { /* only then can |w|^2 underflow: scale it up */
+        int e;
+        frexp(big, &e);
+        for (int i = 0; i < 3; i++) w[i] = ldexp(w[i], -e);
+    }
+    double m = INFINITY;
+    for (size_t j = 0; j < n; j++)
+        for (int k = 0; k < 3; k++) {
+            const double *v = t[j].v[k];
+            double y0 = p[0] - v[0], y1 = p[1] - v[1], y2 = p[2] - v[2];
+            double s = w[0] * y0 + w[1] * y1 + w[2] * y2;
+            double A = fabs(w[0] * y0) + fabs(w[1] * y1) + fabs(w[2] * y2);
+            double e = s - (0x1p-50 * A + 0x1p-1020);
+            m = e < m ? e : m;
+        }
+    if (!(m > 0)) return 0.0;
+    double r = m / sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+    return r >= TINY ? r * SHRINK : 0.0;
+}
+
+double hd__tri_lower(const hd__tri_t *t, const double p[3]) {
+    double q[3], w[3];
+    rough_closest(p, (const double(*)[3])t->v, q);
+    for (int i = 0; i < 3; i++) w[i] = p[i] - q[i];
+    if (w[0] == 0 && w[1] == 0 && w[2] == 0) return 0.0; /* p on the triangle, roughly */
+    if (!isfinite(w[0] + w[1] + w[2])) /* a degenerate triangle: the centroid's direction */
+        for (int i = 0; i < 3; i++) w[i] = p[i] - (t->v[0][i] + t->v[1][i] + t->v[2][i]) / 3;
+    return support_lower(t, 1, p, w);
+}
+
+/* A bound for every triangle of a leaf at once: the support bound over
+ * all their corners in the direction from the leaf box's centre to p
+ * (nearly the true direction when p is far from the leaf). */
+double hd__tris_lower(const hd__tri_t *t, size_t n, const hd__box_t *b, const double p[3]) {
+    double w[3];
+    for (int i = 0; i < 3; i++) w[i] = p[i] - (b->lo[i] / 2 + b->hi[i] / 2);
+    return support_lower(t, n, p, w);
+}
+
+/* ---- the tree ----------------------------------------------------------- */
+
+static void tri_box(const hd__tri_t *t, hd__box_t *b) {
+    for (int k = 0; k < 3; k++) {
+        double lo = t->v[0][k], hi = lo;
+        for (int j = 1; j < 3; j++) {
+            lo = t->v[j][k] < lo ? t->v[j][k] : lo;
+            hi = t->v[j][k] > hi ? t->v[j][k] : hi;
+        }
+        b->lo[k] = lo, b->hi[k] = hi;
+    }
+}
+
+/* Three times the centroid on axis k (only an order for the split). */
+static double centre3(const hd__tri_t *t, int k) { return t->v[0][k] + t->v[1][k] + t->v[2][k]; }
+
+/* Partial sort: tris[mid] is the element of that rank by centre3 on axis
+ * k, with no larger one before it and no smaller one after (Hoare's
+ * selection, middle pivot). */
+static void select_mid(hd__tri_t *tris, size_t n, size_t mid, int k) {
+    size_t lo = 0, hi = n - 1;
+    while (lo < hi) {
+        double pivot = centre3(&tris[lo + (hi - lo) / 2], k);
+        size_t i = lo, j = hi;
+        while (i <= j) {
+            while (centre3(&tris[i], k) < pivot) i++;
+            while (centre3(&tris[j], k) > pivot) j--;
+            if (i <= j) {
+                hd__tri_t s = tris[i];
+                tris[i] = tris[j], tris[j] = s;
+                i++;
+                if (j == 0) break;
+                j--;
+            }
+        }
+        if (mid <= j) hi = j;
+        else if (mid >= i) lo = i;
+        else return;
+    }
+}
+
+typedef struct {
+    hd__bvh_t *t;
+    size_t used;
+} builder_t;
+
+/* Node for tris[first, first + n); returns its position. */
+static size_t build_node(builder_t *B, size_t first, size_t n) {
+    size_t me = B->used++;
+    hd__bvh_node_t *node = &B->t->nodes[me];
+    hd__tri_t *tris = B->t->tris + first;
+    hd__box_t box, cbox;
+    tri_box(&tris[0], &box);
+    for (int k = 0; k < 3; k++) cbox.lo[k] = cbox.hi[k] = centre3(&tris[0], k);
+    for (size_t i = 1; i < n; i++) {
+        hd__box_t b;
+        tri_box(&tris[i], &b);
+        hd__box_merge(&box, &b);
+        for (int k = 0; k < 3; k++) {
+            double c = centre3(&tris[i], k);
+            cbox.lo[k] = c < cbox.lo[k] ? c : cbox.lo[k];
+            cbox.hi[k] = c > cbox.hi[k] ? c : cbox.hi[k];
+        }
+    }
+    node->box = box;
+    if (n <= LEAF) {
+        node->first_or_second = (uint32_t)first;
+        node->count = (uint32_t)n;
+        return me;
+    }
+    int axis = 0;
+    for (int k = 1; k < 3; k++)
+        if (cbox.hi[k] - cbox.lo[k] > cbox.hi[axis] - cbox.lo[axis]) axis = k;
+    size_t half = n / 2;
+    select_mid(tris, n, half, axis);
+    node->count = 0;
+    build_node(B, first, half);
+    size_t second = build_node(B, first + half, n - half);
+    B->t->nodes[me].first_or_second = (uint32_t)second; /* nodes did not move */
+    return me;
+}
+
+int hd__bvh_build(hd__bvh_t *t, hd__tri_t *tris, size_t n) {
+    memset(t, 0, sizeof *t);
+    if (n == 0 || n > ((size_t)1 << 31)) return HD_EOVERFLOW;
+    t->tris = tris;
+    t->n_tris = n;
+    t->nodes = hd__malloc_array(2 * n, sizeof *t->nodes);
+    t->boxes = hd__malloc_array(n, sizeof *t->boxes);
+    if (!t->nodes || !t->boxes) { /* the triangles stay the caller's */
+        free(t->nodes);
+        free(t->boxes);
+        memset(t, 0, sizeof *t);
+        return HD_ENOMEM;
+    }
+    builder_t B = {t, 0};
+    build_node(&B, 0, n);
+    t->n_nodes = B.used;
+    for (size_t k = 0; k < n; k++) tri_box(&t->tris[k], &t->boxes[k]);
+    return HD_OK;
+}
+
+void hd__bvh_free(hd__bvh_t *t) {
+    free(t->tris);
+    free(t->nodes);
+    free(t->boxes);
+    memset(t, 0, sizeof *t);
+}
+
+/* ---- the query ---------------------------------------------------------- */
+
+typedef struct {
+    hd__tri_near_t best;
+    size_t index, pos;
+    double next;  /* next(best.d): a bound above it prunes */
+    double next2; /* square_up(next) */
+} search_t;
+
+static void evaluate(const hd__bvh_t *t, const double *p, size_t pos, search_t *s, hd__bvh_stats_t *st) {
+    const hd__tri_t *tr = &t->tris[pos];
+    hd__tri_near_t r;
+    hd__tri_nearest(p, tr->v[0], tr->v[1], tr->v[2], &r); /* inputs checked: cannot fail */
+    st->kernel++;
+    st->exact += (uint64_t)r.exact;
+    if (s->pos == SIZE_MAX || r.d < s->best.d || (r.d == s->best.d && tr->index < s->index)) {
+        s->best = r;
+        s->index = tr->index;
+        s->pos = pos;
+        s->next = nextafter(r.d, INFINITY);
+        s->next2 = square_up(s->next);
+    }
+}
+
+static void leaf(const hd__bvh_t *t, const hd__bvh_node_t *node, const double *p, size_t seed, search_t *s,
+                 hd__bvh_stats_t *st) {
+    for (size_t k = node->first_or_second, end = k + node->count; k < end; k++) {
+        if (k == seed) continue;
+        if (box_beyond(&t->boxes[k], p, s->next2)) continue;
+        st->bounded++;
+        if (hd__tri_lower(&t->tris[k], p) > s->next) continue;
+        evaluate(t, p, k, s, st);
+    }
+}
+
+size_t hd__bvh_nearest(const hd__bvh_t *t, const double p[3], size_t seed, hd__tri_near_t *best,
+                       size_t *index, hd__bvh_stats_t *st) {
+    search_t s = {.index = SIZE_MAX, .pos = SIZE_MAX, .next = INFINITY, .next2 = INFINITY};
+    if (seed < t->n_tris) evaluate(t, p, seed, &s, st);
+    /* s: the box's computed hd__box_lb2s; [first, first + n): the node's
+     * triangles (the build gives a node's first child the first n / 2) */
+    typedef struct { uint32_t node, first, n; double s; } entry_t;
+    entry_t stack[MAX_DEPTH], *e;
+    int top = 0;
+    stack[0] = (entry_t){0, 0, (uint32_t)t->n_tris, hd__box_lb2s(&t->nodes[0].box, p[0], p[1], p[2])};
+    top = 1;
+    while (top > 0) {
+        e = &stack[--top];
+        if (e->s * SHRINK > s.next2) continue; /* box_beyond, from the stored square */
+        const hd__bvh_node_t *node = &t->nodes[e->node];
+        uint32_t first = e->first, n = e->n;
+        if (n <= GROUP && s.pos != SIZE_MAX && hd__tris_lower(&t->tris[first], n, &node->box, p) > s.next) continue;
+        st->nodes++;
+        if (node->count) {
+            leaf(t, node, p, seed, &s, st);
+            continue;
+        }
+        uint32_t a = e->node + 1, b = node->first_or_second, na = n / 2, fa = first, fb = first + n / 2;
+        double la = hd__box_lb2s(&t->nodes[a].box, p[0], p[1], p[2]);
+        double lb = hd__box_lb2s(&t->nodes[b].box, p[0], p[1], p[2]);
+        /* the nearer child on top; the median split halves the count at
+         * each level, so the stack never holds more than the depth plus one */
+        if (la > lb) {
+            if (la * SHRINK <= s.next2) stack[top++] = (entry_t){a, fa, na, la};
+            if (lb * SHRINK <= s.next2) stack[top++] = (entry_t){b, fb, n - na, lb};
+        } else {
+            if (lb * SHRINK <= s.next2) stack[top++] = (entry_t){b, fb, n - na, lb};
+            if (la * SHRINK <= s.next2) stack[top++] = (entry_t){a, fa, na, la};
+        }
+    }
+    *best = s.best;
+    *index = s.index;
+    return s.pos;
+}

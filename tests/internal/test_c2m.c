@@ -1,0 +1,485 @@
+/*
+ * test_c2m.c -- the distance from points to a triangle mesh
+ * (hd_mesh_distances) equals a brute force over every triangle with the
+ * same kernel, bit for bit: each point's distance and nearest triangle
+ * (ties: the smallest index), its closest point and weights, and the
+ * witness of the largest distance, at 1 and 3 threads.  The meshes: random
+ * triangle soups, bundled models (their faces read from data/orig/),
+ * degenerate and duplicated triangles, integer lattices with points on
+ * corners, edges and faces, and points far away.  The tree's lower bounds
+ * are checked directly against the kernel, and bad meshes get their error.
+ */
+#include "check.h"
+#include "gen.h"
+#include "mesh/mesh.h"
+
+#include <math.h>
+#include <stdlib.h>
+
+#ifdef __SANITIZE_ADDRESS__
+#define SCALE 4 /* the sanitizer build runs fewer cases */
+#else
+#define SCALE 1
+#endif
+
+typedef struct {
+    double *v;
+    size_t nv;
+    uint64_t *t;
+    size_t nt;
+} soup_t;
+
+static hd_mesh_t view(const soup_t *s) {
+    hd_mesh_t m = {hd_points_f64(s->v, s->nv), s->t, s->nt, HD_INDEX_U64};
+    return m;
+}
+
+/* The brute force: every triangle, smallest distance, smallest index. */
+static void brute(const soup_t *s, const double *p, hd__tri_near_t *best, size_t *index) {
+    *index = SIZE_MAX;
+    for (size_t k = 0; k < s->nt; k++) {
+        hd__tri_near_t r;
+        const uint64_t *f = s->t + 3 * k;
+        CHECK_RC(hd__tri_nearest(p, s->v + 3 * f[0], s->v + 3 * f[1], s->v + 3 * f[2], &r), HD_OK);
+        if (*index == SIZE_MAX || r.d < best->d) *best = r, *index = k;
+    }
+}
+
+/* hd_mesh_distances at 1 and 3 threads equals the brute force on every
+ * point; returns the number of points whose nearest triangle was exact. */
+static void same_as_brute(const soup_t *s, const double *pts, size_t n, const char *what) {
+    hd_points_t P = hd_points_f64(pts, n);
+    hd_mesh_t M = view(s);
+    double *d = malloc(n * sizeof *d), *cp = malloc(3 * n * sizeof *cp), *bc = malloc(3 * n * sizeof *bc);
+    size_t *tri = malloc(n * sizeof *tri);
+    double far = -1;
+    size_t far_i = 0, far_t = 0;
+    hd__tri_near_t *want = malloc(n * sizeof *want);
+    size_t *want_t = malloc(n * sizeof *want_t);
+    for (size_t i = 0; i < n; i++) {
+        brute(s, pts + 3 * i, &want[i], &want_t[i]);
+        if (want[i].d > far) far = want[i].d, far_i = i, far_t = want_t[i];
+    }
+    for (int threads = 1; threads <= 3; threads += 2) {
+        CONTEXT("%s, %d threads", what, threads);
+        hd_options_t opt;
+        hd_options_init(&opt);
+        opt.threads = threads;
+        hd_surface_result_t r;
+        hd_error_t err;
+        int rc = hd_mesh_distances(&P, &M, &opt, d, tri, cp, bc, &r, &err);
+        CHECK_RC(rc, HD_OK);
+        if (rc) {
+            printf("%s\n", err.message);
+            break;
+        }
+        size_t bad = 0;
+        for (size_t i = 0; i < n && bad < 5; i++) {
+            int ok = memcmp(&d[i], &want[i].d, sizeof d[i]) == 0 && tri[i] == want_t[i] &&
+                     memcmp(cp + 3 * i, want[i].point, sizeof want[i].point) == 0 &&
+                     memcmp(bc + 3 * i, want[i].bary, sizeof want[i].bary) == 0;
+            if (!ok) {
+                bad++;
+                CONTEXT("%s, %d threads, point %zu (%.17g %.17g %.17g): %.17g tri %zu, brute %.17g tri %zu", what,
+                        threads, i, pts[3 * i], pts[3 * i + 1], pts[3 * i + 2], d[i], tri[i], want[i].d, want_t[i]);
+                CHECK(ok);
+            }
+        }
+        CHECK_BITS(r.distance, far);
+        CHECK_EQ(r.i, far_i);
+        CHECK_EQ(r.triangle, far_t);
+        CHECK(r.kernel_calls >= n);
+    }
+    free(d), free(cp), free(bc), free(tri), free(want), free(want_t);
+}
+
+static void soup_random(gen_rng_t *g, soup_t *s, size_t nt, double size) {
+    s->nv = 3 * nt, s->nt = nt;
+    s->v = malloc(3 * s->nv * sizeof *s->v);
+    s->t = malloc(3 * nt * sizeof *s->t);
+    for (size_t k = 0; k < nt; k++) {
+        double c[3] = {gen_unit(g), gen_unit(g), gen_unit(g)};
+        for (int j = 0; j < 3; j++) {
+            for (int i = 0; i < 3; i++) s->v[9 * k + 3 * j + i] = c[i] + size * (gen_unit(g) - 0.5);
+            s->t[3 * k + j] = 3 * k + j;
+        }
+    }
+}
+
+static void soup_free(soup_t *s) {
+    free(s->v);
+    free(s->t);
+}
+
+/* n points: a third uniform in the cube [-1, 2]^3, a third near corners
+ * and edges of the mesh, a third far (1e3 away). */
+static double *points_around(gen_rng_t *g, const soup_t *s, size_t n) {
+    double *p = malloc(3 * n * sizeof *p);
+    for (size_t i = 0; i < n; i++) {
+        double *q = p + 3 * i;
+        const uint64_t *f = s->t + 3 * (gen_u64(g) % s->nt);
+        double w = gen_unit(g);
+        switch (i % 3) {
+        case 0:
+            for (int c = 0; c < 3; c++) q[c] = 3 * gen_unit(g) - 1;
+            break;
+        case 1:
+            for (int c = 0; c < 3; c++)
+                q[c] = w * s->v[3 * f[0] + c] + (1 - w) * s->v[3 * f[1] + c] + 1e-9 * (gen_unit(g) - 0.5);
+            break;
+        default:
+            for (int c = 0; c < 3; c++) q[c] = 1e3 * (gen_unit(g) - 0.5) + s->v[3 * f[0] + c];
+        }
+    }
+    return p;
+}
+
+TEST(random_soups_equal_the_brute_force_at_1_and_3_threads) {
+    for (uint64_t seed = 1; seed <= 6; seed++) {
+        gen_rng_t g;
+        gen_seed(&g, seed);
+        soup_t s;
+        soup_random(&g, &s, seed < 4 ? 50 : 400 / SCALE, seed % 2 ? 0.2 : 0.02);
+        size_t n = 1500 / SCALE;
+        double *p = points_around(&g, &s, n);
+        char what[64];
+        snprintf(what, sizeof what, "random soup, seed %llu", (unsigned long long)seed);
+        same_as_brute(&s, p, n, what);
+        free(p);
+        soup_free(&s);
+    }
+}
+
+/* A triangulated grid of side x side unit squares in z = 0 (integer
+ * corners), each square split along its diagonal into two triangles. */
+static void soup_grid(soup_t *s, int side) {
+    s->nv = (size_t)(side + 1) * (side + 1), s->nt = 2 * (size_t)side * side;
+    s->v = malloc(3 * s->nv * sizeof *s->v);
+    s->t = malloc(3 * s->nt * sizeof *s->t);
+    for (int y = 0; y <= side; y++)
+        for (int x = 0; x <= side; x++) {
+            double *v = s->v + 3 * ((size_t)y * (side + 1) + x);
+            v[0] = x, v[1] = y, v[2] = 0;
+        }
+    size_t k = 0;
+    for (int y = 0; y < side; y++)
+        for (int x = 0; x < side; x++) {
+            uint64_t a = (uint64_t)y * (side + 1) + x, b = a + 1, c = a + side + 1, d = c + 1;
+            uint64_t *t = s->t + 3 * k;
+            t[0] = a, t[1] = b, t[2] = d, t[3] = a, t[4] = d, t[5] = c;
+            k += 2;
+        }
+}
+
+TEST(points_on_corners_edges_and_faces_are_at_zero_from_the_smallest_triangle) {
+    soup_t s;
+    soup_grid(&s, 8);
+    /* corners (up to 6 triangles), edge midpoints (2), face points, and the
+     * same raised by 1/4 (the same ties at distance 0.25) */
+    size_t n = 0;
+    double p[3 * 400];
+    for (int y = 0; y < 8; y++)
+        for (int x = 0; x < 8; x++)
+            for (int k = 0; k < 3 && n < 400; k++) {
+                double q[3][3] = {{x, y, 0}, {x + 0.5, y, 0}, {x + 0.75, y + 0.25, 0}};
+                memcpy(p + 3 * n++, q[k], sizeof q[k]);
+            }
+    size_t flat = n;
+    for (size_t i = 0; i < flat && n < 400; i++, n++) {
+        memcpy(p + 3 * n, p + 3 * i, 3 * sizeof *p);
+        p[3 * n + 2] = 0.25;
+    }
+    same_as_brute(&s, p, n, "grid, points on features");
+    hd_points_t P = hd_points_f64(p, 1);
+    hd_mesh_t M = view(&s);
+    double d;
+    size_t t;
+    CHECK_RC(hd_mesh_distances(&P, &M, NULL, &d, &t, NULL, NULL, NULL, NULL), HD_OK);
+    CHECK_BITS(d, 0.0); /* the corner (0,0,0): triangles 0 and 1 touch it */
+    CHECK_EQ(t, 0);
+    soup_free(&s);
+}
+
+TEST(duplicated_triangles_tie_to_the_smallest_index) {
+    soup_t s;
+    soup_grid(&s, 4);
+    /* append every triangle again, corners rotated, in reverse order */
+    size_t nt = s.nt;
+    s.t = realloc(s.t, 6 * nt * sizeof *s.t);
+    for (size_t k = 0; k < nt; k++) {
+        const uint64_t *f = s.t + 3 * (nt - 1 - k);
+        uint64_t *o = s.t + 3 * (nt + k);
+        o[0] = f[1], o[1] = f[2], o[2] = f[0];
+    }
+    s.nt = 2 * nt;
+    gen_rng_t g;
+    gen_seed(&g, 11);
+    double p[3 * 300];
+    for (int i = 0; i < 300; i++) {
+        p[3 * i] = 5 * gen_unit(&g) - 0.5, p[3 * i + 1] = 5 * gen_unit(&g) - 0.5;
+        p[3 * i + 2] = i % 2 ? 0 : gen_unit(&g) - 0.5;
+    }
+    same_as_brute(&s, p, 300, "grid with every triangle twice");
+    hd_points_t P = hd_points_f64(p, 300);
+    hd_mesh_t M = view(&s);
+    size_t tri[300];
+    CHECK_RC(hd_mesh_distances(&P, &M, NULL, NULL, tri, NULL, NULL, NULL, NULL), HD_OK);
+    for (int i = 0; i < 300; i++) CHECK(tri[i] < nt);
+    soup_free(&s);
+}
+
+/* Two triangles whose true distances differ but round to the same double:
+ * the smaller index wins even when its true distance is the larger, as
+ * in the brute force, wherever the nearer one sits in the tree. */
+TEST(equal_rounded_distances_tie_to_the_smallest_index_whatever_the_true_order) {
+    double o[3] = {0, 0, 0}, v1[3] = {1, 1, 0}, v0[3] = {1, 1, 0};
+    hd__tri_near_t r0, r1;
+    double e1[3] = {11, 1, 0}, e2[3] = {1, 11, 0};
+    CHECK_RC(hd__tri_nearest(o, v1, e1, e2, &r1), HD_OK);
+    int found = 0;
+    for (int k = 1; k < 64 && !found; k++) { /* |v0| > sqrt(2), rounded alike */
+        v0[1] = 1 + k * 0x1p-52;
+        double f1[3] = {11, v0[1], 0}, f2[3] = {1, v0[1] + 10, 0};
+        CHECK_RC(hd__tri_nearest(o, v0, f1, f2, &r0), HD_OK);
+        found = r0.d == r1.d;
+    }
+    CHECK(found);
+    if (!found) return;
+    gen_rng_t g;
+    gen_seed(&g, 41);
+    soup_t s;
+    soup_random(&g, &s, 300, 0.3); /* in [-0.15, 1.15]^3, then 4 higher: never nearest */
+    for (size_t k = 0; k < 3 * s.nv; k += 3) s.v[k + 2] += 4;
+    double tri0[9] = {v0[0], v0[1], 0, 11, v0[1], 0, 1, v0[1] + 10, 0};
+    double tri1[9] = {1, 1, 0, 11, 1, 0, 1, 11, 0};
+    for (int place = 0; place < 2; place++) {
+        /* the farther-but-equal triangle first (index 0) or last; the other
+         * at the other end */
+        size_t a = place ? s.nt - 1 : 0, b = place ? 0 : s.nt - 1;
+        memcpy(s.v + 9 * a, tri0, sizeof tri0);
+        memcpy(s.v + 9 * b, tri1, sizeof tri1);
+        double p[3 * 64];
+        for (int i = 0; i < 64; i++) /* the origin, between other points */
+            for (int c = 0; c < 3; c++) p[3 * i + c] = i % 2 ? 0 : 0.01 * (gen_unit(&g) - 0.5);
+        same_as_brute(&s, p, 64, place ? "equal rounded distances, farther last" : "equal rounded distances, farther first");
+        hd_points_t P = hd_points_f64(o, 1);
+        hd_mesh_t M = view(&s);
+        double d;
+        size_t t;
+        CHECK_RC(hd_mesh_distances(&P, &M, NULL, &d, &t, NULL, NULL, NULL, NULL), HD_OK);
+        CHECK_BITS(d, r1.d);
+        CHECK_EQ(t, a < b ? a : b);
+    }
+    soup_free(&s);
+}
+
+TEST(degenerate_triangles_are_their_hulls_and_counted) {
+    /* a segment (collinear corners), a repeated index, a point (coincident
+     * distinct vertices), a needle, and one proper triangle */
+    double v[] = {0, 0, 0, 1, 0, 0, 3, 0, 0,    /* 0-2 collinear */
+                  0, 2, 0, 0, 2, 0, 0, 2, 0,    /* 3-5 one point thrice */
+                  5, 5, 5, 6, 5, 5, 5.5, 5 + 0x1p-50, 5, /* 6-8 nearly collinear: a triangle */
+                  0, 0, 4, 1, 0, 4, 0, 1, 4};   /* 9-11 proper */
+    uint64_t t[] = {0, 1, 2, 1, 1, 9, 3, 4, 5, 6, 7, 8, 9, 10, 11, 2, 2, 2};
+    soup_t s = {v, 12, t, 6};
+    gen_rng_t g;
+    gen_seed(&g, 5);
+    double p[3 * 600];
+    for (int i = 0; i < 600; i++)
+        for (int c = 0; c < 3; c++) p[3 * i + c] = 8 * gen_unit(&g) - 1.5;
+    same_as_brute(&s, p, 600, "degenerate triangles");
+    hd_points_t P = hd_points_f64(p, 600);
+    hd_mesh_t M = view(&s);
+    hd_surface_result_t r;
+    CHECK_RC(hd_mesh_distances(&P, &M, NULL, NULL, NULL, NULL, NULL, &r, NULL), HD_OK);
+    CHECK_EQ(r.n_degenerate, 4); /* 0-1-2, 1-1-9, 3-4-5, 2-2-2 */
+    double q[3] = {2, 1, 0};
+    P = hd_points_f64(q, 1);
+    double d;
+    size_t tr;
+    CHECK_RC(hd_mesh_distances(&P, &M, NULL, &d, &tr, NULL, NULL, NULL, NULL), HD_OK);
+    CHECK_BITS(d, 1.0); /* to the segment (0,0,0)-(3,0,0) */
+    CHECK_EQ(tr, 0);
+}
+
+/* A mesh file's vertices and faces as a soup. */
+static int soup_read(const char *path, soup_t *s) {
+    hd_mesh_file_t *m;
+    hd_error_t err;
+    int rc = hd_read_mesh(path, NULL, &m, &err);
+    CHECK_RC(rc, HD_OK);
+    if (rc) {
+        printf("%s\n", err.message);
+        return rc;
+    }
+    s->nv = m->n_vertices, s->nt = m->n_triangles;
+    s->v = malloc(3 * s->nv * sizeof *s->v);
+    s->t = malloc(3 * s->nt * sizeof *s->t);
+    memcpy(s->v, m->vertices, 3 * s->nv * sizeof *s->v);
+    memcpy(s->t, m->triangles, 3 * s->nt * sizeof *s->t);
+    hd_mesh_file_free(m);
+    return HD_OK;
+}
+
+TEST(bundled_models_equal_the_brute_force) {
+    const char *files[] = {"data/orig/pinion.off", "data/orig/cow.off", "data/orig/Wuson.stl",
+                           "data/orig/WusonOBJ.obj", "data/orig/stanford_bunny_reduced.ply"};
+    for (size_t f = 0; f < sizeof files / sizeof *files; f++) {
+        soup_t s;
+        if (soup_read(files[f], &s)) continue;
+        gen_rng_t g;
+        gen_seed(&g, 100 + f);
+        /* the box's scale: points around it, near its surface, far away */
+        double lo[3], hi[3];
+        for (int c = 0; c < 3; c++) lo[c] = hi[c] = s.v[c];
+        for (size_t k = 0; k < s.nv; k++)
+            for (int c = 0; c < 3; c++) {
+                lo[c] = s.v[3 * k + c] < lo[c] ? s.v[3 * k + c] : lo[c];
+                hi[c] = s.v[3 * k + c] > hi[c] ? s.v[3 * k + c] : hi[c];
+            }
+        size_t n = 240 / SCALE;
+        double *p = malloc(3 * n * sizeof *p);
+        for (size_t i = 0; i < n; i++) {
+            const uint64_t *t = s.t + 3 * (gen_u64(&g) % s.nt);
+            double u = gen_unit(&g), w = gen_unit(&g) * (1 - u);
+            for (int c = 0; c < 3; c++) {
+                double ext = hi[c] - lo[c];
+                double on = u * s.v[3 * t[0] + c] + w * s.v[3 * t[1] + c] + (1 - u - w) * s.v[3 * t[2] + c];
+                p[3 * i + c] = i % 4 == 0   ? s.v[3 * t[0] + c]                                  /* a vertex */
+                               : i % 4 == 1 ? on + 1e-3 * ext * (gen_unit(&g) - 0.5)          /* near */
+                               : i % 4 == 2 ? lo[c] - ext + 3 * ext * gen_unit(&g)            /* box x3 */
+                                            : lo[c] + 50 * ext * (gen_unit(&g) - 0.5);        /* far */
+            }
+        }
+        same_as_brute(&s, p, n, files[f]);
+        free(p);
+        soup_free(&s);
+    }
+}
+
+TEST(float32_strided_vertices_and_uint32_indices_give_the_same_answers) {
+    gen_rng_t g;
+    gen_seed(&g, 21);
+    soup_t s;
+    soup_random(&g, &s, 100, 0.3);
+    float *vf = malloc(4 * s.nv * sizeof *vf); /* x y z and a pad, as float */
+    uint32_t *t32 = malloc(3 * s.nt * sizeof *t32);
+    for (size_t k = 0; k < s.nv; k++)
+        for (int c = 0; c < 3; c++) {
+            vf[4 * k + c] = (float)s.v[3 * k + c];
+            s.v[3 * k + c] = vf[4 * k + c]; /* the soup holds the widened floats */
+        }
+    for (size_t k = 0; k < 3 * s.nt; k++) t32[k] = (uint32_t)s.t[k];
+    size_t n = 300;
+    double *p = points_around(&g, &s, n);
+    hd_points_t P = hd_points_f64(p, n);
+    hd_mesh_t M64 = view(&s);
+    hd_mesh_t M32 = {{vf, s.nv, HD_FLOAT32, 4 * sizeof(float), 0}, t32, s.nt, HD_INDEX_U32};
+    double d64[300], d32[300];
+    size_t t64[300], tt32[300];
+    CHECK_RC(hd_mesh_distances(&P, &M64, NULL, d64, t64, NULL, NULL, NULL, NULL), HD_OK);
+    CHECK_RC(hd_mesh_distances(&P, &M32, NULL, d32, tt32, NULL, NULL, NULL, NULL), HD_OK);
+    CHECK(memcmp(d64, d32, sizeof d64) == 0);
+    CHECK(memcmp(t64, tt32, sizeof t64) == 0);
+    free(vf), free(t32), free(p);
+    soup_free(&s);
+}
+
+/* The bounds the tree prunes with never exceed the kernel's distance
+ * (which is within half an ulp of the true one): on random, degenerate and
+ * tiny or huge triangles, with points near and far. */
+TEST(the_lower_bounds_never_exceed_the_distance) {
+    gen_rng_t g;
+    gen_seed(&g, 77);
+    const double scales[] = {1e-300, 1e-150, 1e-20, 1, 1e20, 1e150};
+    int far_cases = 0, tight = 0;
+    for (int k = 0; k < 60000 / SCALE; k++) {
+        double sc = scales[k % 6];
+        hd__tri_t t;
+        double p[3];
+        for (int j = 0; j < 3; j++)
+            for (int c = 0; c < 3; c++) t.v[j][c] = sc * (gen_unit(&g) - 0.5);
+        if (k % 5 == 1) memcpy(t.v[2], t.v[1], sizeof t.v[1]);                  /* a segment */
+        if (k % 5 == 2) for (int c = 0; c < 3; c++) t.v[2][c] = 2 * t.v[1][c] - t.v[0][c]; /* collinear */
+        double far = k % 3 == 0 ? 1e-6 : k % 3 == 1 || sc > 1e100 ? 1 : 1e6;
+        for (int c = 0; c < 3; c++) p[c] = t.v[0][c] + sc * far * (gen_unit(&g) - 0.5);
+        hd__tri_near_t r;
+        CHECK_RC(hd__tri_nearest(p, t.v[0], t.v[1], t.v[2], &r), HD_OK);
+        /* the true distance is at least r.d minus half its ulp */
+        double floor_d = r.d - (nextafter(r.d, INFINITY) - r.d);
+        double lb = hd__tri_lower(&t, p);
+        hd__box_t b;
+        for (int c = 0; c < 3; c++) {
+            b.lo[c] = fmin(fmin(t.v[0][c], t.v[1][c]), t.v[2][c]);
+            b.hi[c] = fmax(fmax(t.v[0][c], t.v[1][c]), t.v[2][c]);
+        }
+        double bl = hd__box_lower(&b, p);
+        if (far > 1) far_cases++, tight += lb >= r.d * (1 - 1e-9);
+        if (lb > r.d || bl > r.d) {
+            CONTEXT("seed 77, case %d: d %.17g, triangle bound %.17g, box bound %.17g (floor %.17g)", k, r.d, lb, bl,
+                    floor_d);
+            CHECK(lb <= r.d && bl <= r.d);
+            break;
+        }
+    }
+    /* the bound of a group of triangles stays below each one's distance */
+    for (int k = 0; k < 20000 / SCALE; k++) {
+        hd__tri_t t[8];
+        hd__box_t b;
+        double p[3], sc = scales[k % 6], least = INFINITY;
+        for (int j = 0; j < 8; j++)
+            for (int v = 0; v < 3; v++)
+                for (int c = 0; c < 3; c++) t[j].v[v][c] = sc * (gen_unit(&g) - 0.5) * (j + 1) / 8;
+        for (int c = 0; c < 3; c++) {
+            b.lo[c] = b.hi[c] = t[0].v[0][c];
+            p[c] = sc * (k % 2 ? 2 : 1e-3) * (gen_unit(&g) - 0.5) + (k % 3 ? 0 : sc);
+        }
+        for (int j = 0; j < 8; j++) {
+            hd__tri_near_t r;
+            CHECK_RC(hd__tri_nearest(p, t[j].v[0], t[j].v[1], t[j].v[2], &r), HD_OK);
+            least = r.d < least ? r.d : least;
+            for (int v = 0; v < 3; v++)
+                for (int c = 0; c < 3; c++) {
+                    b.lo[c] = fmin(b.lo[c], t[j].v[v][c]);
+                    b.hi[c] = fmax(b.hi[c], t[j].v[v][c]);
+                }
+        }
+        double gl = hd__tris_lower(t, 8, &b, p);
+        if (gl > least) {
+            CONTEXT("seed 77, group case %d: nearest %.17g, group bound %.17g", k, least, gl);
+            CHECK(gl <= least);
+            break;
+        }
+    }
+    /* and the triangle bound is nearly the distance, as pruning needs */
+    CONTEXT("seed 77: %d of %d far cases tight", tight, far_cases);
+    CHECK(tight >= far_cases * 9 / 10);
+}
+
+TEST(bad_meshes_get_an_error_naming_the_triangle) {
+    double v[] = {0, 0, 0, 1, 0, 0, 0, 1, 0, NAN, 0, 0};
+    uint64_t t[] = {0, 1, 2, 0, 1, 4};
+    double q[3] = {0, 0, 1};
+    hd_points_t P = hd_points_f64(q, 1);
+    hd_error_t err;
+    hd_mesh_t M = {hd_points_f64(v, 4), t, 2, HD_INDEX_U64};
+    CHECK_RC(hd_mesh_distances(&P, &M, NULL, NULL, NULL, NULL, NULL, NULL, &err), HD_EINVAL);
+    CHECK(strstr(err.message, "triangle 1 refers to vertex 4, but there are 4 vertices") != NULL);
+    t[5] = 3;
+    CHECK_RC(hd_mesh_distances(&P, &M, NULL, NULL, NULL, NULL, NULL, NULL, &err), HD_ENONFINITE);
+    CHECK(strstr(err.message, "triangle 1, corner 2 (vertex 3)") != NULL);
+    M.n_triangles = 1; /* vertex 3 unused: never read */
+    CHECK_RC(hd_mesh_distances(&P, &M, NULL, NULL, NULL, NULL, NULL, NULL, &err), HD_OK);
+    M.n_triangles = 0;
+    CHECK_RC(hd_mesh_distances(&P, &M, NULL, NULL, NULL, NULL, NULL, NULL, &err), HD_EEMPTY);
+    M.n_triangles = 1;
+    M.vertices.count = 0;
+    CHECK_RC(hd_mesh_distances(&P, &M, NULL, NULL, NULL, NULL, NULL, NULL, &err), HD_EEMPTY);
+    CHECK(strstr(err.message, "no vertices") != NULL);
+    M.vertices.count = 4;
+    M.index_type = (hd_index_type_t)7;
+    CHECK_RC(hd_mesh_distances(&P, &M, NULL, NULL, NULL, NULL, NULL, NULL, &err), HD_EINVAL);
+    M.index_type = HD_INDEX_U64;
+    q[2] = NAN;
+    CHECK_RC(hd_mesh_distances(&P, &M, NULL, NULL, NULL, NULL, NULL, NULL, &err), HD_ENONFINITE);
+}
