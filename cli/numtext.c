@@ -78,5 +78,11 @@ const char *num_seconds(double s, char buf[NUM_TEXT]) {
     if (decimals < 0) decimals = 0;
     if (decimals > 6) decimals = 6;
     snprintf(buf, NUM_TEXT, "%.*f", decimals, s);
+    /* a trailing zero after the point says nothing: 0.0170 -> 0.017, 2.00 -> 2 */
+    char *end = buf + strlen(buf);
+    if (strchr(buf, '.')) {
+        while (end[-1] == '0') *--end = '\0';
+        if (end[-1] == '.') *--end = '\0';
+    }
     return buf;
 }
