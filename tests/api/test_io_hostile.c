@@ -10,7 +10,8 @@
  * blank-separated fields were read as more columns; a UTF-8 byte-order mark
  * lost the first point, UTF-16 text gave misleading messages (an STL
  * triangle count of 1818521189); a malformed number on line 1 was skipped
- * as a header.  The test runs in the release and the ASan builds.
+ * as a header; classic Mac OS line ends (a '\r' alone) made a file one
+ * line, read as its first point.  The test runs in the release and the ASan builds.
  */
 #include "check.h"
 #include "files.h"
@@ -411,4 +412,37 @@ TEST(header_lines_are_those_before_the_first_line_that_can_start_a_number) {
                         semi ? ";" : ",", semi ? ";" : ","),
               NULL, want, 2);
     }
+}
+
+TEST(a_carriage_return_that_ends_no_line_is_refused_by_every_text_reader) {
+    /* every reader ends lines at '\n' and takes '\r' for a blank: classic Mac
+     * OS line ends made one line of the file, read as its first point alone
+     * ("1.5 2 3\r4 5 6\r" as (1.5, 2, 3); a PTS count "3\r1 2 3\r..." as the
+     * point (3, 1, 2)), exit 0 */
+    const char *const want = "carriage return";
+    refused(tf_printf("mac.xyz", "1.5 2 3\r4 5 6\r7 8 9\r"), NULL, HD_EFORMAT, want, LINE, 1);
+    refused(tf_printf("mac.pts", "3\r1 2 3\r4 5 6\r7 8 9\r"), NULL, HD_EFORMAT, want, LINE, 1);
+    refused(tf_printf("mac.csv", "x,y,z\r1,2,3\r4,5,6\r"), NULL, HD_EFORMAT, want, LINE, 1);
+    refused(tf_printf("mac.obj", "v 1 2 3\rv 4 5 6\rv 7 8 9\r"), NULL, HD_EFORMAT, want, LINE, 1);
+    refused(tf_printf("mac.stl", "solid s\rfacet normal 0 0 1\router loop\rvertex 9 9 9\rvertex 1 0 0\r"
+                                 "vertex 0 1 0\rendloop\rendfacet\rendsolid s\r"),
+            NULL, HD_EFORMAT, want, LINE, 1);
+    /* a stray one in a file of LF or CR LF lines, naming its line */
+    refused(tf_printf("mixed.xyz", "0 0 0\n1 2 3\r4 5 6\n7 8 9\n"), NULL, HD_EFORMAT, want, LINE, 2);
+    refused(tf_printf("mixed.obj", "v 0 0 0\r\nv 1 2 3\rv 4 5 6\r\n"), NULL, HD_EFORMAT, want, LINE, 2);
+    refused(tf_printf("mixed.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                                   "property float z\nend_header\n0 0 0\n1 2 3\r4 5 6\n7 8 9\n"),
+            NULL, HD_EFORMAT, want, LINE, 9);
+    refused(tf_printf("mixed.off", "OFF\n3 0 0\n0 0 0\n1 2 3\r4 5 6\n7 8 9\n"), NULL, HD_EFORMAT, want, LINE, 4);
+    refused(tf_printf("mixed.pcd", "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 3\n"
+                                   "HEIGHT 1\nPOINTS 3\nDATA ascii\n0 0 0\n1 2 3\r4 5 6\n7 8 9\n"),
+            NULL, HD_EFORMAT, want, LINE, 11);
+}
+
+TEST(line_ends_of_cr_lf_and_cr_cr_lf_are_read) {
+    const double want[] = {1, 2, 3, 4, 5, 6};
+    reads(tf_printf("crlf.xyz", "1 2 3\r\n4 5 6\r\n"), NULL, want, 2);
+    reads(tf_printf("crcrlf.xyz", "1 2 3\r\r\n4 5 6\r\r\n"), NULL, want, 2);
+    reads(tf_printf("crend.xyz", "1 2 3\r\n4 5 6\r"), NULL, want, 2);
+    reads(tf_printf("crlf.obj", "v 1 2 3\r\nv 4 5 6\r\n"), NULL, want, 2);
 }
