@@ -102,8 +102,12 @@ static int count_fields(const dialect_t *d, const char *q, const char *eol) {
  * malformed "1.#QNAN", "1.5D+03", "3.14abc", "-" and "+.5e" can), or
  * strtod's words inf, infinity and nan before anything but a letter.  A
  * field that cannot ("x", "-x", "X,Y,Z", "index", "infrared") heads a
- * header line. */
+ * header line.  A double quote first is passed over: "\"1.5\",\"2\",\"3\""
+ * is a line of numbers, refused since quotes are not read, where taking it
+ * for a header once read a file of quoted numbers as no points (and with
+ * --empty zero as the distance 0). */
 static int starts_number(const char *t, const char *eol) {
+    if (*t == '"' && t + 1 < eol) t++; /* a quoted number starts a number too, and is then refused as one */
     if (is_digit((unsigned char)*t)) return 1;
     if (t < eol && (*t == '+' || *t == '-')) t++;
     if (t == eol || *t == '.' || is_digit((unsigned char)*t) || is_sep((unsigned char)*t)) return 1;
@@ -178,7 +182,8 @@ static int slow_field(hd__chunk_t *c, const dialect_t *d, long long line, int co
     while (e < eol && !is_field_sep(d, (unsigned char)*e)) e++;
     *q = e;
     if (!hd__parse_double(t, e, v) && !(d->semicolon && parse_decimal_comma(t, e, v))) {
-        hd__chunk_fail(c, HD_EFORMAT, line, "'%.*s' is not a number (column %d)", (int)(e - t > 40 ? 40 : e - t), t, col);
+        hd__chunk_fail(c, HD_EFORMAT, line, "'%.*s' is not a number (column %d)%s", (int)(e - t > 40 ? 40 : e - t), t,
+                       col, *t == '"' ? ": quoted numbers are not read (write the file without quotes around numbers)" : "");
         return 0;
     }
     if (d->semicolon && !d->decimal_comma && memchr(t, ',', (size_t)(e - t))) {

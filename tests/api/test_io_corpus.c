@@ -59,6 +59,7 @@ static outcome_t regress[] = {
     {"tests/corpus/xyz/regress-qnan-line1.xyz", HD_EFORMAT, 0, 0, 0, 0},
     {"tests/corpus/xyz/regress-fortran-exponent-line1.xyz", HD_EFORMAT, 0, 0, 0, 0},
     {"tests/corpus/xyz/regress-mac-line-ends.xyz", HD_EFORMAT, 0, 0, 0, 0},
+    {"tests/corpus/xyz/regress-quoted-numbers.csv", HD_EFORMAT, 0, 0, 0, 0},
     {"tests/corpus/pcd/regress-empty-window", HD_EFORMAT, 0, 0, 0, 0},
     {"tests/corpus/pcd/regress-bom.pcd", HD_OK, 2, 0, 0, 0},
     {"tests/corpus/npy/regress-empty-shape", HD_EFORMAT, 0, 0, 0, 0},

@@ -446,3 +446,16 @@ TEST(line_ends_of_cr_lf_and_cr_cr_lf_are_read) {
     reads(tf_printf("crend.xyz", "1 2 3\r\n4 5 6\r"), NULL, want, 2);
     reads(tf_printf("crlf.obj", "v 1 2 3\r\nv 4 5 6\r\n"), NULL, want, 2);
 }
+
+TEST(quoted_numbers_are_refused_naming_the_line_never_read_as_a_header) {
+    /* "\"1\",\"2\",\"3\"" was a header line: a file of quoted numbers read as
+     * no points (with the empty policy zero, the distance 0, exit 0) */
+    refused(tf_printf("q.csv", "\"x\",\"y\",\"z\"\n\"1.5\",\"2\",\"3\"\n\"4\",\"5\",\"6\"\n"), NULL, HD_EFORMAT,
+            "quoted numbers are not read", LINE, 2);
+    refused(tf_printf("q1.csv", "\"1.5\",\"2\",\"3\"\n"), NULL, HD_EFORMAT, "'\"1.5\"' is not a number", LINE, 1);
+    refused(tf_printf("q2.txt", "\"-1\"\t\"2\"\t\"3\"\n"), NULL, HD_EFORMAT, "quoted numbers", LINE, 1);
+    /* quoted names still head a header */
+    const double want[] = {1, 2, 3};
+    reads(tf_printf("qh.csv", "\"x\",\"y\",\"z\"\n1,2,3\n"), NULL, want, 1);
+    reads(tf_printf("qh2.csv", "\"\",\"name\"\n1,2,3\n"), NULL, want, 1);
+}
