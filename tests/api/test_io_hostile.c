@@ -459,3 +459,18 @@ TEST(quoted_numbers_are_refused_naming_the_line_never_read_as_a_header) {
     reads(tf_printf("qh.csv", "\"x\",\"y\",\"z\"\n1,2,3\n"), NULL, want, 1);
     reads(tf_printf("qh2.csv", "\"\",\"name\"\n1,2,3\n"), NULL, want, 1);
 }
+
+TEST(with_the_decimal_comma_option_a_point_is_refused_as_a_thousands_separator) {
+    /* "1.234;2.345;3,5" (a German export whose numbers have a thousands
+     * separator: 1234, 2345, 3.5) was read as (1.234, 2.345, 3.5), exit 0 */
+    hd_read_options_t o;
+    hd_read_options_init(&o);
+    o.decimal_comma = 1;
+    refused(tf_printf("de.csv", "1;2;3\n1.234;2.345;3,5\n"), &o, HD_EFORMAT, "'1.234' has a point (column 1)", LINE, 2);
+    refused(tf_printf("de2.txt", "0,5\t2\t1.000\n"), &o, HD_EFORMAT, "'1.000' has a point (column 3)", LINE, 1);
+    refused(tf_printf("de3.csv", "1.234,5;2;3\n"), &o, HD_EFORMAT, "'1.234,5' is not a number", LINE, 1);
+    refused(tf_printf("de4.csv", "1e3;.5;3\n"), &o, HD_EFORMAT, "'.5' has a point (column 2)", LINE, 1);
+    /* without the option a point is the decimal point */
+    const double want[] = {1.234, 2.345, 3.5};
+    reads(tf_printf("en.csv", "1.234;2.345;3.5\n"), NULL, want, 1);
+}
