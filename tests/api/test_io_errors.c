@@ -377,6 +377,18 @@ TEST(npy_unsupported_arrays_and_truncated_data_are_refused_with_their_offset) {
     refused(tf_write("j.npy", "NUMPY", 5), HD_EFORMAT, "not a NumPy", OFFSET, 0);
 }
 
+TEST(npy_header_giving_a_key_twice_is_refused) {
+    /* Python keeps the last value: numpy reads (1, 3) and 1 point, where the
+     * first 'shape' once read 2 */
+    double d[6] = {1, 2, 3, 4, 5, 6};
+    refused(npy("s2.npy", "{'descr': '<f8', 'fortran_order': False, 'shape': (2, 3), 'shape': (1, 3), }", d, 48),
+            HD_EFORMAT, "'shape' twice", OFFSET, 10);
+    refused(npy("d2.npy", "{'descr': '<f8', 'fortran_order': False, 'descr': '<f4', 'shape': (4, 3), }", d, 48),
+            HD_EFORMAT, "'descr' twice", OFFSET, 10);
+    refused(npy("f2.npy", "{'descr': '<f8', 'fortran_order': False, 'shape': (2, 3), \"fortran_order\": True}", d, 48),
+            HD_EFORMAT, "'fortran_order' twice", OFFSET, 10);
+}
+
 /* ---- counts lower than the data: never a silent partial read ---------------- */
 
 TEST(ply_count_lower_than_the_data_is_refused_naming_the_extra_data) {
