@@ -220,6 +220,8 @@ def text_seeds():
     # classic Mac OS line ends (a '\r' alone): the file was one line, read as its first point alone
     put("xyz/regress-mac-line-ends.xyz", "1.5 2 3\r4 5 6\r7 8 9\r")
     put("obj/regress-mac-line-ends.obj", "v 0 0 0\rv 1 0 0\rv 0 1 0\rf 1 2 3\r")
+    # an ascii STL on one line, once its solid line alone: no points
+    put("stl/regress-one-line.stl", STL_FACET.replace("\n", " ").replace("endsolid s ", "endsolid s\n"))
     # quoted numbers, once a header: the file read as no points
     put("xyz/regress-quoted-numbers.csv", '"x","y","z"\n"1.5","2","3"\n')
 

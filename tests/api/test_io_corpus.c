@@ -47,6 +47,7 @@ static outcome_t regress[] = {
     {"tests/corpus/stl/regress-empty-window", HD_EFORMAT, 0, HD_EFORMAT, 0, 0},
     {"tests/corpus/stl/regress-bom.stl", HD_OK, 3, HD_OK, 8, 0},
     {"tests/corpus/stl/regress-utf16-solid.stl", HD_EFORMAT, 0, HD_EFORMAT, 0, 0},
+    {"tests/corpus/stl/regress-one-line.stl", HD_EFORMAT, 0, HD_EFORMAT, 0, 0},
     {"tests/corpus/xyz/regress-decimal-comma.csv", HD_EFORMAT, 0, 0, 0, 0},
     {"tests/corpus/xyz/regress-empty-window", HD_EEMPTY, 0, 0, 0, 0},
     {"tests/corpus/xyz/regress-pts-count-2e64", HD_EFORMAT, 0, 0, 0, 0},

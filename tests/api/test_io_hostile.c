@@ -474,3 +474,26 @@ TEST(with_the_decimal_comma_option_a_point_is_refused_as_a_thousands_separator) 
     const double want[] = {1.234, 2.345, 3.5};
     reads(tf_printf("en.csv", "1.234;2.345;3.5\n"), NULL, want, 1);
 }
+
+TEST(an_ascii_stl_statement_after_another_on_its_line_is_refused) {
+    /* the rest of a line was skipped: "vertex 0 0 0 vertex 5 5 5" lost (5, 5,
+     * 5) and "vertex 0 0 0 7" read, exit 0; a file written on one line was
+     * its solid line alone, read as no points */
+    refused(tf_printf("one.stl", "solid s facet normal 0 0 1 outer loop vertex 0 0 0 vertex 1 0 0 vertex 0 1 0 "
+                                 "endloop endfacet endsolid s\n"),
+            NULL, HD_EFORMAT, "'facet normal", LINE, 1);
+    refused(tf_printf("v2.stl", "solid s\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0 vertex 5 5 5\nvertex 1 0 0\n"
+                                "vertex 0 1 0\nendloop\nendfacet\nendsolid s\n"),
+            NULL, HD_EFORMAT, "'vertex' after 'vertex' on one line", LINE, 4);
+    refused(tf_printf("v4.stl", "solid s\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0 7\nvertex 1 0 0\n"
+                                "vertex 0 1 0\nendloop\nendfacet\nendsolid s\n"),
+            NULL, HD_EFORMAT, "'7' after 'vertex'", LINE, 4);
+    refused(tf_printf("fo.stl", "solid s\nfacet normal 0 0 1 outer loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
+                                "endloop endfacet\nendsolid s\n"),
+            NULL, HD_EFORMAT, "'outer' after 'facet'", LINE, 2);
+    /* a solid's name is any words */
+    const double want[] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    reads(tf_printf("name.stl", "solid facet normal maps, outer vertex loop\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\n"
+                                "vertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\nendsolid facet normal maps\n"),
+          NULL, want, 3);
+}
