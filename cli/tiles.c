@@ -603,6 +603,10 @@ uint64_t tiles_digest(const tiles_t *s) {
 /* Whether the first n characters of a line (after its blanks) can start
  * a number, n of them at most 16. */
 static int starts_number(const char *h, size_t n) {
+    if (n > 1 && h[0] == '"') { /* a quoted number: the reader refuses it, never a skip */
+        h++;
+        n--;
+    }
     size_t k = 0;
     if (k < n && (h[k] == '+' || h[k] == '-')) k++;
     if (k < n && h[k] == '.') k++;

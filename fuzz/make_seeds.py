@@ -9,7 +9,8 @@ only rerun to change them):
                        fuzz_FORMAT_sample targets (and the vertex ones)
   regress-*            the hostile files of issue 17, one per reader fault, and
                        issue 35's text shapes (byte-order marks, UTF-16/32,
-                       decimal commas and thousands separators, first lines)
+                       decimal commas and thousands separators, first lines,
+                       line ends of a '\r' alone)
 
 Files not named regress-* are valid: tests/api/test_io_corpus.c reads every file
 of the reader directories and requires those to read.
@@ -216,6 +217,13 @@ def text_seeds():
     # a malformed number on line 1, once skipped as a header
     put("xyz/regress-qnan-line1.xyz", "1.#QNAN 2 3\n1 1 1\n")
     put("xyz/regress-fortran-exponent-line1.xyz", "1.5D+03 0 0\n1 1 1\n")
+    # classic Mac OS line ends (a '\r' alone): the file was one line, read as its first point alone
+    put("xyz/regress-mac-line-ends.xyz", "1.5 2 3\r4 5 6\r7 8 9\r")
+    put("obj/regress-mac-line-ends.obj", "v 0 0 0\rv 1 0 0\rv 0 1 0\rf 1 2 3\r")
+    # an ascii STL on one line, once its solid line alone: no points
+    put("stl/regress-one-line.stl", STL_FACET.replace("\n", " ").replace("endsolid s ", "endsolid s\n"))
+    # quoted numbers, once a header: the file read as no points
+    put("xyz/regress-quoted-numbers.csv", '"x","y","z"\n"1.5","2","3"\n')
 
 
 if __name__ == "__main__":

@@ -267,6 +267,8 @@ TEST(text_has_numbers_when_a_line_starts_with_one) {
         CASE("\xff\xfe" "1\0 \0" "2\0 \0" "3\0", 1), /* UTF-16: a tile, which the reader refuses by name */
         CASE("\xff\xfe" "R\0e\0a\0d\0", 0),
         CASE("a very long header line of words, longer than what is kept of it\n2 3 4\n", 1),
+        CASE("\"x\",\"y\",\"z\"\n\"1.5\",\"2\",\"3\"\n", 1), /* quoted numbers: the reader refuses them */
+        CASE("\"name\",\"date\"\n\"\n", 0),
     };
 #undef CASE
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {

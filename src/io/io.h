@@ -261,6 +261,7 @@ typedef struct hd__chunk {
     int index;               /* 0 for the chunk at `begin` */
     long long lines;         /* lines parsed: set by the parser when it finishes */
     size_t room;             /* candidate lines: the window's size */
+    const char *lone_cr;     /* the chunk's first '\r' that ends no line (NULL: none) */
     hd__sink_t pts;          /* the window */
     hd__tris_t tris;
     uint64_t aux;            /* free for the reader (e.g. faces counted) */

@@ -29,8 +29,8 @@ static const char *skip_ws(const char *p, const char *end) {
     return p;
 }
 
-/* The value text after 'key': in the dict [p, end): *vb..*ve. */
-static int find_key(const char *p, const char *end, const char *key, const char **vb, const char **ve) {
+/* The value text after the first 'key' in the dict [p, end): *vb..*ve. */
+static int first_key(const char *p, const char *end, const char *key, const char **vb, const char **ve) {
     size_t n = strlen(key);
     for (const char *q = p; q + n + 2 <= end; q++) {
         if ((*q != '\'' && *q != '"') || memcmp(q + 1, key, n) != 0 || q[n + 1] != *q) continue;
@@ -56,6 +56,15 @@ static int find_key(const char *p, const char *end, const char *key, const char 
     return 0;
 }
 
+/* The value text after 'key' in the dict [p, end): *vb..*ve and 1, 0 when
+ * the key is missing, or -1 when it is given twice (Python keeps the last
+ * value, so numpy reads a shape other than the first one given). */
+static int find_key(const char *p, const char *end, const char *key, const char **vb, const char **ve) {
+    const char *b2, *e2;
+    if (!first_key(p, end, key, vb, ve)) return 0;
+    return first_key(*ve, end, key, &b2, &e2) ? -1 : 1;
+}
+
 int hd__read_npy(hd__read_t *r) {
     const unsigned char *d = r->f->data;
     size_t size = r->f->size;
@@ -77,6 +86,10 @@ int hd__read_npy(hd__read_t *r) {
         return hd__io_err_at(r, HD_EFORMAT, (long long)size, "file ends inside the .npy header (%zu bytes declared)", hlen);
     const char *h = (const char *)d + hstart, *he = h + hlen, *vb, *ve;
     size_t data = hstart + hlen;
+    static const char *const keys[] = {"descr", "fortran_order", "shape"};
+    for (int k = 0; k < 3; k++)
+        if (find_key(h, he, keys[k], &vb, &ve) < 0)
+            return hd__io_err_at(r, HD_EFORMAT, (long long)hstart, "the header gives '%s' twice", keys[k]);
     if (!find_key(h, he, "descr", &vb, &ve))
         return hd__io_err_at(r, HD_EFORMAT, (long long)hstart, "the header has no 'descr'");
     size_t dl = (size_t)(ve - vb);

@@ -233,6 +233,9 @@ int hd__read_pcd(hd__read_t *r) {
         uint64_t off = 0, tok = 0;
         for (int k = 0; k < p->n; k++) {
             if (word(p->f[k].name, p->f[k].name + p->f[k].len, d == 0 ? "x" : d == 1 ? "y" : "z")) {
+                for (int j = k + 1; j < p->n; j++)
+                    if (word(p->f[j].name, p->f[j].name + p->f[j].len, d == 0 ? "x" : d == 1 ? "y" : "z"))
+                        rc = hd__io_err(r, HD_EFORMAT, "FIELDS names '%c' twice", "xyz"[d]);
                 p->xyz[d] = k;
                 p->off[d] = off;
                 p->token[d] = tok;

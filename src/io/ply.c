@@ -101,11 +101,14 @@ static const char *type_name(hd__type_t t) {
     return names[t];
 }
 
-static int prop_index(const elem_t *e, const char *name) {
-    for (int k = 0; k < e->n_props; k++)
+/* The first property of e after index `after` named `name`, or -1. */
+static int prop_index_after(const elem_t *e, int after, const char *name) {
+    for (int k = after + 1; k < e->n_props; k++)
         if (is(e->props[k].name, e->props[k].len, name)) return k;
     return -1;
 }
+
+static int prop_index(const elem_t *e, const char *name) { return prop_index_after(e, -1, name); }
 
 /* Parse the header into p; sets p->data to the first byte after it. */
 static int header(ply_t *p) {
@@ -517,8 +520,12 @@ int hd__read_ply(hd__read_t *r) {
     int v = -1, face_el = -1, face = -1, xyz[3] = {-1, -1, -1};
     for (int k = 0; rc == HD_OK && k < p->n_el; k++) {
         const elem_t *e = &p->el[k];
-        if (v < 0 && is(e->name, e->len, "vertex")) v = k;
-        if (face_el < 0 && is(e->name, e->len, "face")) face_el = k;
+        int *seen = is(e->name, e->len, "vertex") ? &v : is(e->name, e->len, "face") ? &face_el : NULL;
+        if (seen && *seen >= 0) /* which one other readers take is anybody's guess */
+            rc = hd__io_err_line(r, HD_EFORMAT, e->line, "element '%.*s' declared twice (first on line %lld)",
+                                 (int)e->len, e->name, p->el[*seen].line);
+        else if (seen)
+            *seen = k;
     }
     if (rc == HD_OK && v < 0) rc = hd__io_err(r, HD_EFORMAT, "the header declares no element 'vertex'");
     for (int c = 0; rc == HD_OK && c < 3; c++) {
@@ -526,6 +533,8 @@ int hd__read_ply(hd__read_t *r) {
         xyz[c] = prop_index(&p->el[v], name);
         if (xyz[c] < 0)
             rc = hd__io_err_line(r, HD_EFORMAT, p->el[v].line, "element vertex has no property '%s'", name);
+        else if (prop_index_after(&p->el[v], xyz[c], name) >= 0)
+            rc = hd__io_err_line(r, HD_EFORMAT, p->el[v].line, "element vertex declares property '%s' twice", name);
         else if (p->el[v].props[xyz[c]].count_type)
             rc = hd__io_err_line(r, HD_EFORMAT, p->el[v].line, "vertex property '%s' is a list", name);
     }

@@ -30,9 +30,40 @@
  */
 #include "io.h"
 
+#include <stdio.h>
+
 static int word(const char *tb, const char *te, const char *w) {
     size_t n = strlen(w);
     return (size_t)(te - tb) == n && memcmp(tb, w, n) == 0;
+}
+
+static int keyword(const char *tb, const char *te) {
+    return word(tb, te, "vertex") || word(tb, te, "facet") || word(tb, te, "outer") || word(tb, te, "endloop") ||
+           word(tb, te, "endfacet") || word(tb, te, "endsolid");
+}
+
+/* Whether the rest [q, eol) of a line whose statement is `what` holds
+ * another statement, which reading a statement a line would skip: any
+ * token after a vertex's x y z, a keyword after facet, outer, endloop or
+ * endfacet, or "facet normal" then "outer loop" on the solid line (whose
+ * name is any words; a file written on one line was read as no points).
+ * Then the problem is recorded and 1 returned. */
+static int another_statement(hd__chunk_t *c, long long line, const char *what, const char *q, const char *eol) {
+    const char *tb, *te, *prev = q, *pte = q, *facet = NULL;
+    int solid = strcmp(what, "solid") == 0, vertex = strcmp(what, "vertex") == 0;
+    while (hd__token(&q, eol, &tb, &te)) {
+        if (solid && !facet && word(tb, te, "normal") && word(prev, pte, "facet")) facet = prev;
+        int found = solid ? facet && word(tb, te, "loop") && word(prev, pte, "outer") : vertex || keyword(tb, te);
+        prev = tb;
+        pte = te;
+        if (found && solid) tb = facet;
+        if (found) {
+            hd__chunk_fail(c, HD_EFORMAT, line, "'%.*s' after '%s' on one line: an ascii STL is read one statement a line",
+                           (int)(te - tb > 40 ? 40 : te - tb), tb, what);
+            return 1;
+        }
+    }
+    return 0;
 }
 
 static void chunk(void *ctx, hd__chunk_t *c) {
@@ -43,11 +74,17 @@ static void chunk(void *ctx, hd__chunk_t *c) {
         line++;
         if (!hd__token(&q, eol, &tb, &te)) continue;
         if (word(tb, te, "vertex")) {
-            if (!hd__chunk_vertex(c, &q, eol, line, "vertex: ", "vertex: expected x y z", 0)) return;
-        } else if (word(tb, te, "facet")) {
-            c->aux++;
-        } else if (!word(tb, te, "outer") && !word(tb, te, "endloop") && !word(tb, te, "endfacet") &&
-                   !word(tb, te, "solid") && !word(tb, te, "endsolid")) {
+            if (!hd__chunk_vertex(c, &q, eol, line, "vertex: ", "vertex: expected x y z", 0) ||
+                another_statement(c, line, "vertex", q, eol))
+                return;
+        } else if (word(tb, te, "endsolid")) {
+            continue;
+        } else if (word(tb, te, "solid") || keyword(tb, te)) {
+            char what[16];
+            snprintf(what, sizeof what, "%.*s", (int)(te - tb), tb);
+            if (another_statement(c, line, what, q, eol)) return;
+            c->aux += strcmp(what, "facet") == 0;
+        } else {
             hd__chunk_fail(c, HD_EFORMAT, line, "unknown ascii STL keyword '%.*s'", (int)(te - tb > 40 ? 40 : te - tb), tb);
             return;
         }

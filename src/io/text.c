@@ -189,10 +189,21 @@ size_t hd__content_lines(void *ctx, const char *begin, const char *end) {
     return (size_t)found;
 }
 
+/* The first '\r' of [p, end) followed by a byte other than '\n' or '\r'
+ * (a line end of classic Mac OS, or a stray one inside a line), or NULL.
+ * Every reader ends lines at '\n' only and takes '\r' for a blank, so the
+ * lines such a '\r' ends would be read as one: "1 2 3\r4 5 6\r" as the
+ * point (1, 2, 3) and nothing else.  "\r\n" and "\r\r\n" end lines. */
+static const char *lone_cr(const char *p, const char *end) {
+    while ((p = memchr(p, '\r', (size_t)(end - p))) != NULL && p + 1 < end && (p[1] == '\n' || p[1] == '\r')) p++;
+    return p && p + 1 < end ? p : NULL;
+}
+
 static void count_chunk(void *ctx, size_t task, int worker) {
     (void)worker;
     run_t *run = ctx;
     hd__chunk_t *c = &run->chunks[task];
+    c->lone_cr = lone_cr(c->begin, c->end);
     size_t (*count)(void *, const char *, const char *) = run->job->candidates ? run->job->candidates : all_lines;
     size_t n = count(run->job->ctx, c->begin, c->end);
     size_t most = ((size_t)(c->end - c->begin) + 1) / (run->job->min_line ? run->job->min_line : 1);
@@ -212,6 +223,21 @@ static long long count_lines(const char *p, const char *end) {
 }
 
 #define CHUNK_BYTES ((size_t)1 << 20)
+
+/* HD_EFORMAT naming the line of the first lone '\r' of the chunks (in
+ * file order), or HD_OK when there is none. */
+static int refuse_lone_cr(hd__read_t *r, const hd__chunk_t *chunks, size_t used, long long first_line) {
+    long long line = first_line;
+    for (size_t k = 0; k < used; k++) {
+        if (chunks[k].lone_cr)
+            return hd__io_err_line(r, HD_EFORMAT, line + count_lines(chunks[k].begin, chunks[k].lone_cr),
+                                   "a carriage return ('\\r') that no line feed follows: lines end with LF or "
+                                   "CR LF here, and this one would run into the next (classic Mac OS line ends? "
+                                   "convert them: tr '\\r' '\\n')");
+        line += count_lines(chunks[k].begin, chunks[k].end);
+    }
+    return HD_OK;
+}
 
 int hd__text_parallel(hd__read_t *r, const char *begin, const char *end,
                       long long first_line, const hd__text_job_t *job,
@@ -248,8 +274,8 @@ int hd__text_parallel(hd__read_t *r, const char *begin, const char *end,
     hd__parallel_for(r->threads, used, count_chunk, &run);
     size_t total = 0;
     for (size_t k = 0; k < used; k++) total += chunks[k].room;
-    int rc = hd__sink_reserve(s, total);
-    if (rc)
+    int rc = refuse_lone_cr(r, chunks, used, first_line);
+    if (rc == HD_OK && (rc = hd__sink_reserve(s, total)) != HD_OK)
         hd__io_err(r, rc, "cannot allocate %zu points", total);
     /* 2: every chunk parses into its window of the array */
     size_t at = s->count;

@@ -6,7 +6,9 @@
  * numbers is decided once per file:
  *  - with the decimal_comma option, commas are decimal separators and
  *    fields are separated by ';' and blanks: the dialect European
- *    spreadsheets write ("4,25;5,5;6,75" is 4.25 5.5 6.75);
+ *    spreadsheets write ("4,25;5,5;6,75" is 4.25 5.5 6.75); a field
+ *    holding a point is refused, since there a point is a thousands
+ *    separator ("1.234" is 1234, once read as 1.234);
  *  - otherwise the first data line (the first line whose first field can
  *    start a number, the same test as the candidate count below) decides:
  *    if it holds a ';', fields are separated by ';' and blanks, and a
@@ -102,8 +104,12 @@ static int count_fields(const dialect_t *d, const char *q, const char *eol) {
  * malformed "1.#QNAN", "1.5D+03", "3.14abc", "-" and "+.5e" can), or
  * strtod's words inf, infinity and nan before anything but a letter.  A
  * field that cannot ("x", "-x", "X,Y,Z", "index", "infrared") heads a
- * header line. */
+ * header line.  A double quote first is passed over: "\"1.5\",\"2\",\"3\""
+ * is a line of numbers, refused since quotes are not read, where taking it
+ * for a header once read a file of quoted numbers as no points (and with
+ * --empty zero as the distance 0). */
 static int starts_number(const char *t, const char *eol) {
+    if (*t == '"' && t + 1 < eol) t++; /* a quoted number starts a number too, and is then refused as one */
     if (is_digit((unsigned char)*t)) return 1;
     if (t < eol && (*t == '+' || *t == '-')) t++;
     if (t == eol || *t == '.' || is_digit((unsigned char)*t) || is_sep((unsigned char)*t)) return 1;
@@ -178,7 +184,16 @@ static int slow_field(hd__chunk_t *c, const dialect_t *d, long long line, int co
     while (e < eol && !is_field_sep(d, (unsigned char)*e)) e++;
     *q = e;
     if (!hd__parse_double(t, e, v) && !(d->semicolon && parse_decimal_comma(t, e, v))) {
-        hd__chunk_fail(c, HD_EFORMAT, line, "'%.*s' is not a number (column %d)", (int)(e - t > 40 ? 40 : e - t), t, col);
+        hd__chunk_fail(c, HD_EFORMAT, line, "'%.*s' is not a number (column %d)%s", (int)(e - t > 40 ? 40 : e - t), t,
+                       col, *t == '"' ? ": quoted numbers are not read (write the file without quotes around numbers)" : "");
+        return 0;
+    }
+    if (d->decimal_comma && memchr(t, '.', (size_t)(e - t))) {
+        hd__chunk_fail(c, HD_EFORMAT, line,
+                       "'%.*s' has a point (column %d) where the decimal_comma read option makes commas the "
+                       "decimal points: a thousands separator (1.234 is 1234 where 1,5 is 1.5)? write the "
+                       "numbers without one",
+                       (int)(e - t > 40 ? 40 : e - t), t, col);
         return 0;
     }
     if (d->semicolon && !d->decimal_comma && memchr(t, ',', (size_t)(e - t))) {
@@ -211,7 +226,8 @@ static int row(hd__chunk_t *c, const dialect_t *d, long long line, const char **
         while (q < eol && is_field_sep(d, (unsigned char)*q)) q++;
         if (q == eol) break;
         const char *e = hd__scan_double(q, eol, &v[got]);
-        if (e && (e == eol || is_field_sep(d, (unsigned char)*e))) q = e; /* the fast path read the whole token */
+        if (e && (e == eol || is_field_sep(d, (unsigned char)*e)) && !(d->decimal_comma && memchr(q, '.', (size_t)(e - q))))
+            q = e; /* the fast path read the whole token */
         else if (!slow_field(c, d, line, got + 1, &q, eol, &v[got])) return 0;
         got++;
         if (q == eol) break;

@@ -377,7 +377,38 @@ TEST(npy_unsupported_arrays_and_truncated_data_are_refused_with_their_offset) {
     refused(tf_write("j.npy", "NUMPY", 5), HD_EFORMAT, "not a NumPy", OFFSET, 0);
 }
 
+TEST(npy_header_giving_a_key_twice_is_refused) {
+    /* Python keeps the last value: numpy reads (1, 3) and 1 point, where the
+     * first 'shape' once read 2 */
+    double d[6] = {1, 2, 3, 4, 5, 6};
+    refused(npy("s2.npy", "{'descr': '<f8', 'fortran_order': False, 'shape': (2, 3), 'shape': (1, 3), }", d, 48),
+            HD_EFORMAT, "'shape' twice", OFFSET, 10);
+    refused(npy("d2.npy", "{'descr': '<f8', 'fortran_order': False, 'descr': '<f4', 'shape': (4, 3), }", d, 48),
+            HD_EFORMAT, "'descr' twice", OFFSET, 10);
+    refused(npy("f2.npy", "{'descr': '<f8', 'fortran_order': False, 'shape': (2, 3), \"fortran_order\": True}", d, 48),
+            HD_EFORMAT, "'fortran_order' twice", OFFSET, 10);
+}
+
 /* ---- counts lower than the data: never a silent partial read ---------------- */
+
+TEST(ply_and_pcd_naming_a_coordinate_or_the_vertices_twice_are_refused) {
+    /* the first x, the first vertex element, were read: (1, 2, 3) where a
+     * reader taking the last one reads 9 or (4, 5, 6) */
+    const char *head = "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n";
+    refused(tf_printf("px.ply", "%sproperty float x\nend_header\n1 2 3 9\n", head), HD_EFORMAT,
+            "declares property 'x' twice", LINE, 3);
+    refused(tf_printf("pv.ply", "%selement vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n"
+                                "1 2 3\n4 5 6\n",
+                      head),
+            HD_EFORMAT, "element 'vertex' declared twice (first on line 3)", LINE, 7);
+    refused(tf_printf("pf.ply", "%selement face 0\nproperty list uchar int vertex_indices\nelement face 0\n"
+                                "property list uchar int vertex_indices\nend_header\n1 2 3\n",
+                      head),
+            HD_EFORMAT, "element 'face' declared twice", LINE, 9);
+    refused(tf_printf("px.pcd", "VERSION 0.7\nFIELDS x y z x\nSIZE 4 4 4 4\nTYPE F F F F\nCOUNT 1 1 1 1\nWIDTH 1\n"
+                                "HEIGHT 1\nPOINTS 1\nDATA ascii\n1 2 3 9\n"),
+            HD_EFORMAT, "FIELDS names 'x' twice", NONE, 0);
+}
 
 TEST(ply_count_lower_than_the_data_is_refused_naming_the_extra_data) {
     refused(tf_printf("low.ply", "%s1 2 3\n4 5 6\n7 8 9\n", ply_head("ascii", "1", "float")), HD_EFORMAT,

@@ -10,7 +10,8 @@
  * blank-separated fields were read as more columns; a UTF-8 byte-order mark
  * lost the first point, UTF-16 text gave misleading messages (an STL
  * triangle count of 1818521189); a malformed number on line 1 was skipped
- * as a header.  The test runs in the release and the ASan builds.
+ * as a header; classic Mac OS line ends (a '\r' alone) made a file one
+ * line, read as its first point.  The test runs in the release and the ASan builds.
  */
 #include "check.h"
 #include "files.h"
@@ -411,4 +412,88 @@ TEST(header_lines_are_those_before_the_first_line_that_can_start_a_number) {
                         semi ? ";" : ",", semi ? ";" : ","),
               NULL, want, 2);
     }
+}
+
+TEST(a_carriage_return_that_ends_no_line_is_refused_by_every_text_reader) {
+    /* every reader ends lines at '\n' and takes '\r' for a blank: classic Mac
+     * OS line ends made one line of the file, read as its first point alone
+     * ("1.5 2 3\r4 5 6\r" as (1.5, 2, 3); a PTS count "3\r1 2 3\r..." as the
+     * point (3, 1, 2)), exit 0 */
+    const char *const want = "carriage return";
+    refused(tf_printf("mac.xyz", "1.5 2 3\r4 5 6\r7 8 9\r"), NULL, HD_EFORMAT, want, LINE, 1);
+    refused(tf_printf("mac.pts", "3\r1 2 3\r4 5 6\r7 8 9\r"), NULL, HD_EFORMAT, want, LINE, 1);
+    refused(tf_printf("mac.csv", "x,y,z\r1,2,3\r4,5,6\r"), NULL, HD_EFORMAT, want, LINE, 1);
+    refused(tf_printf("mac.obj", "v 1 2 3\rv 4 5 6\rv 7 8 9\r"), NULL, HD_EFORMAT, want, LINE, 1);
+    refused(tf_printf("mac.stl", "solid s\rfacet normal 0 0 1\router loop\rvertex 9 9 9\rvertex 1 0 0\r"
+                                 "vertex 0 1 0\rendloop\rendfacet\rendsolid s\r"),
+            NULL, HD_EFORMAT, want, LINE, 1);
+    /* a stray one in a file of LF or CR LF lines, naming its line */
+    refused(tf_printf("mixed.xyz", "0 0 0\n1 2 3\r4 5 6\n7 8 9\n"), NULL, HD_EFORMAT, want, LINE, 2);
+    refused(tf_printf("mixed.obj", "v 0 0 0\r\nv 1 2 3\rv 4 5 6\r\n"), NULL, HD_EFORMAT, want, LINE, 2);
+    refused(tf_printf("mixed.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                                   "property float z\nend_header\n0 0 0\n1 2 3\r4 5 6\n7 8 9\n"),
+            NULL, HD_EFORMAT, want, LINE, 9);
+    refused(tf_printf("mixed.off", "OFF\n3 0 0\n0 0 0\n1 2 3\r4 5 6\n7 8 9\n"), NULL, HD_EFORMAT, want, LINE, 4);
+    refused(tf_printf("mixed.pcd", "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 3\n"
+                                   "HEIGHT 1\nPOINTS 3\nDATA ascii\n0 0 0\n1 2 3\r4 5 6\n7 8 9\n"),
+            NULL, HD_EFORMAT, want, LINE, 11);
+}
+
+TEST(line_ends_of_cr_lf_and_cr_cr_lf_are_read) {
+    const double want[] = {1, 2, 3, 4, 5, 6};
+    reads(tf_printf("crlf.xyz", "1 2 3\r\n4 5 6\r\n"), NULL, want, 2);
+    reads(tf_printf("crcrlf.xyz", "1 2 3\r\r\n4 5 6\r\r\n"), NULL, want, 2);
+    reads(tf_printf("crend.xyz", "1 2 3\r\n4 5 6\r"), NULL, want, 2);
+    reads(tf_printf("crlf.obj", "v 1 2 3\r\nv 4 5 6\r\n"), NULL, want, 2);
+}
+
+TEST(quoted_numbers_are_refused_naming_the_line_never_read_as_a_header) {
+    /* "\"1\",\"2\",\"3\"" was a header line: a file of quoted numbers read as
+     * no points (with the empty policy zero, the distance 0, exit 0) */
+    refused(tf_printf("q.csv", "\"x\",\"y\",\"z\"\n\"1.5\",\"2\",\"3\"\n\"4\",\"5\",\"6\"\n"), NULL, HD_EFORMAT,
+            "quoted numbers are not read", LINE, 2);
+    refused(tf_printf("q1.csv", "\"1.5\",\"2\",\"3\"\n"), NULL, HD_EFORMAT, "'\"1.5\"' is not a number", LINE, 1);
+    refused(tf_printf("q2.txt", "\"-1\"\t\"2\"\t\"3\"\n"), NULL, HD_EFORMAT, "quoted numbers", LINE, 1);
+    /* quoted names still head a header */
+    const double want[] = {1, 2, 3};
+    reads(tf_printf("qh.csv", "\"x\",\"y\",\"z\"\n1,2,3\n"), NULL, want, 1);
+    reads(tf_printf("qh2.csv", "\"\",\"name\"\n1,2,3\n"), NULL, want, 1);
+}
+
+TEST(with_the_decimal_comma_option_a_point_is_refused_as_a_thousands_separator) {
+    /* "1.234;2.345;3,5" (a German export whose numbers have a thousands
+     * separator: 1234, 2345, 3.5) was read as (1.234, 2.345, 3.5), exit 0 */
+    hd_read_options_t o;
+    hd_read_options_init(&o);
+    o.decimal_comma = 1;
+    refused(tf_printf("de.csv", "1;2;3\n1.234;2.345;3,5\n"), &o, HD_EFORMAT, "'1.234' has a point (column 1)", LINE, 2);
+    refused(tf_printf("de2.txt", "0,5\t2\t1.000\n"), &o, HD_EFORMAT, "'1.000' has a point (column 3)", LINE, 1);
+    refused(tf_printf("de3.csv", "1.234,5;2;3\n"), &o, HD_EFORMAT, "'1.234,5' is not a number", LINE, 1);
+    refused(tf_printf("de4.csv", "1e3;.5;3\n"), &o, HD_EFORMAT, "'.5' has a point (column 2)", LINE, 1);
+    /* without the option a point is the decimal point */
+    const double want[] = {1.234, 2.345, 3.5};
+    reads(tf_printf("en.csv", "1.234;2.345;3.5\n"), NULL, want, 1);
+}
+
+TEST(an_ascii_stl_statement_after_another_on_its_line_is_refused) {
+    /* the rest of a line was skipped: "vertex 0 0 0 vertex 5 5 5" lost (5, 5,
+     * 5) and "vertex 0 0 0 7" read, exit 0; a file written on one line was
+     * its solid line alone, read as no points */
+    refused(tf_printf("one.stl", "solid s facet normal 0 0 1 outer loop vertex 0 0 0 vertex 1 0 0 vertex 0 1 0 "
+                                 "endloop endfacet endsolid s\n"),
+            NULL, HD_EFORMAT, "'facet normal", LINE, 1);
+    refused(tf_printf("v2.stl", "solid s\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0 vertex 5 5 5\nvertex 1 0 0\n"
+                                "vertex 0 1 0\nendloop\nendfacet\nendsolid s\n"),
+            NULL, HD_EFORMAT, "'vertex' after 'vertex' on one line", LINE, 4);
+    refused(tf_printf("v4.stl", "solid s\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0 7\nvertex 1 0 0\n"
+                                "vertex 0 1 0\nendloop\nendfacet\nendsolid s\n"),
+            NULL, HD_EFORMAT, "'7' after 'vertex'", LINE, 4);
+    refused(tf_printf("fo.stl", "solid s\nfacet normal 0 0 1 outer loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
+                                "endloop endfacet\nendsolid s\n"),
+            NULL, HD_EFORMAT, "'outer' after 'facet'", LINE, 2);
+    /* a solid's name is any words */
+    const double want[] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    reads(tf_printf("name.stl", "solid facet normal maps, outer vertex loop\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\n"
+                                "vertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\nendsolid facet normal maps\n"),
+          NULL, want, 3);
 }
