@@ -4,10 +4,12 @@
  * exact.c.
  *
  * 1. Scale.  All twelve coordinates are multiplied by the power of two that
- *    puts the largest magnitude in [1, 2).  This is exact when no nonzero
- *    coordinate becomes subnormal (else: exact path), and it scales every
- *    squared distance by a power of four, so the rounding of the distance is
- *    the same in both scales as long as the result is a normal double.
+ *    puts the largest magnitude in [1, 2), unless it already lies in
+ *    [2^-8, 2) (every argument below needs only magnitudes below 2).  This
+ *    is exact when no nonzero coordinate is or becomes subnormal (else:
+ *    exact path), and it scales every squared distance by a power of four,
+ *    so the rounding of the distance is the same in both scales as long as
+ *    the result is a normal double.
  *
  * 2. The feature.  Ericson's tests (Real-Time Collision Detection, 5.1.5)
  *    name the Voronoi region of p exactly when they are evaluated exactly on
@@ -501,27 +503,46 @@ static void weigh(hd__tri_near_t *out, const region_t *r, double t) {
     }
 }
 
-/* Step 1: the scaled copies; 0 when scaling would not be exact. */
-static int scale(const double *const in[4], double out[4][3], int *s) {
-    double big = 0, small = INFINITY;
+/* Step 1.  A magnitude's bits order like the magnitude (NaN above infinity
+ * above every finite value), so one pass of integer max and min finds the
+ * largest magnitude and the smallest nonzero one (m - 1 wraps 0 to the top).
+ * Coordinates whose largest magnitude is already in [2^-8, 2) are used as
+ * they are (*use = in); otherwise *use = out, the copies scaled to put it in
+ * [1, 2).  -1 outside the domain, 0 when a nonzero coordinate is or would
+ * become subnormal (the exact path). */
+static int scale(const double *const in[4], double out[4][3], const double **use, int *s) {
+    uint64_t big = 0, small = UINT64_MAX;
     for (int i = 0; i < 4; i++)
         for (int k = 0; k < 3; k++) {
-            double m = fabs(in[i][k]);
+            uint64_t m;
+            memcpy(&m, &in[i][k], sizeof m);
+            m &= ~(UINT64_C(1) << 63);
             big = m > big ? m : big;
-            if (m > 0 && m < small) small = m;
+            small = m - 1 < small ? m - 1 : small;
         }
-    if (big < 0x1p-900 || big > 0x1p511) return 0;
-    *s = -binade(big);
-    double f = pow2(*s);             /* -511 <= s <= 900: a normal double */
-    if (small * f < 0x1p-1022) return 0;
-    for (int i = 0; i < 4; i++)
+    if (big > UINT64_C(0x5fe0000000000000)) return -1;     /* beyond 2^511, or not a number */
+    int eb = (int)(big >> 52) - 1023;
+    double least, f;
+    small += 1;
+    memcpy(&least, &small, sizeof least);
+    if (eb < -900) return 0;
+    *s = eb >= -8 && eb <= 0 ? 0 : -eb;
+    f = pow2(*s);                     /* -511 <= s <= 900: a normal double */
+    if (least * f < 0x1p-1022) return 0;
+    if (*s == 0) {
+        for (int i = 0; i < 4; i++) use[i] = in[i];
+        return 1;
+    }
+    for (int i = 0; i < 4; i++) {
         for (int k = 0; k < 3; k++) out[i][k] = in[i][k] * f;
+        use[i] = out[i];
+    }
     return 1;
 }
 
 /* Steps 3 and 4 on the scaled coordinates with the feature known: 1 and
  * *out (but for the unscaling) when decided. */
-HD__INLINE int decide(const double sc[4][3], const region_t *r, int s, hd__tri_near_t *out,
+HD__INLINE int decide(const double *const sc[4], const region_t *r, int s, hd__tri_near_t *out,
                       int fma) {
     sqd_t f = {.t = 0};
     double q;
@@ -536,26 +557,24 @@ HD__INLINE int decide(const double sc[4][3], const region_t *r, int s, hd__tri_n
     return 1;
 }
 
-static int decide_plain(const double sc[4][3], const region_t *r, int s, hd__tri_near_t *out) {
+static int decide_plain(const double *const sc[4], const region_t *r, int s, hd__tri_near_t *out) {
     return decide(sc, r, s, out, 0);
 }
 
 #if TRI_FMA_CLONE
 __attribute__((target("fma")))
-static int decide_fma(const double sc[4][3], const region_t *r, int s, hd__tri_near_t *out) {
+static int decide_fma(const double *const sc[4], const region_t *r, int s, hd__tri_near_t *out) {
     return decide(sc, r, s, out, 1);
 }
 #endif
 
 int hd__tri_nearest(const double p[3], const double a[3], const double b[3],
                     const double c[3], hd__tri_near_t *out) {
-    const double *in[4] = {p, a, b, c};
-    double sc[4][3];
-    int s, ok;
+    const double *in[4] = {p, a, b, c}, *sc[4];
+    double scaled[4][3];
+    int s = 0, ok, sc_ok = scale(in, scaled, sc, &s);
     region_t r = {HD__TRI_FACE, 0, 0};
-    for (int i = 0; i < 4; i++)
-        for (int k = 0; k < 3; k++)
-            if (!(fabs(in[i][k]) <= 0x1p511)) return HD_ERANGE;
+    if (sc_ok < 0) return HD_ERANGE;
     for (int i = 1; i < 4; i++)
         if (p[0] == in[i][0] && p[1] == in[i][1] && p[2] == in[i][2]) {
             r.feature = (hd__tri_feature_t)(HD__TRI_VERTEX_A + i - 1);
@@ -566,7 +585,7 @@ int hd__tri_nearest(const double p[3], const double a[3], const double b[3],
             weigh(out, &r, 0);
             return HD_OK;
         }
-    if (!scale(in, sc, &s) || !classify(sc[0], sc[1], sc[2], sc[3], &r))
+    if (!sc_ok || !classify(sc[0], sc[1], sc[2], sc[3], &r))
         return hd__tri_nearest_exact(p, a, b, c, out);
 #if TRI_FMA_CLONE
     ok = __builtin_cpu_supports("fma") ? decide_fma(sc, &r, s, out) : decide_plain(sc, &r, s, out);
