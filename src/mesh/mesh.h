@@ -56,6 +56,18 @@ typedef struct hd__tri_near {
 int hd__tri_nearest(const double p[3], const double a[3], const double b[3],
                     const double c[3], hd__tri_near_t *out);
 
+/* Rigorous bounds lo2 <= d^2 <= hi2 on the exact squared distance from p to
+ * the closed triangle abc, from plain doubles (tri.c has the proof): no sign
+ * is decided, so they hold for every triangle, degenerate ones too.  They
+ * are within about 2^-45 relatively of d^2 when p is not much nearer the
+ * triangle than the triangle's size times 2^-20 and the triangle is not a
+ * sliver; a degenerate triangle gets lo2 = 0.  A search discards a triangle
+ * whose lo2 exceeds another's hi2 without calling hd__tri_nearest.  For any
+ * coordinate beyond the domain (or NaN) and for coordinates of 2^100 and
+ * more whose scaling would not be exact: lo2 = 0, hi2 = infinity. */
+void hd__tri_bounds(const double p[3], const double a[3], const double b[3], const double c[3],
+                    double *lo2, double *hi2);
+
 /* The same answer from exact arithmetic alone (tests compare the two). */
 int hd__tri_nearest_exact(const double p[3], const double a[3], const double b[3],
                           const double c[3], hd__tri_near_t *out);
