@@ -510,7 +510,7 @@ static void weigh(hd__tri_near_t *out, const region_t *r, double t) {
  * they are (*use = in); otherwise *use = out, the copies scaled to put it in
  * [1, 2).  -1 outside the domain, 0 when a nonzero coordinate is or would
  * become subnormal (the exact path). */
-static int scale(const double *const in[4], double out[4][3], const double **use, int *s) {
+int hd__tri_scale(const double *const in[4], double out[4][3], const double **use, int *s) {
     uint64_t big = 0, small = UINT64_MAX;
     for (int i = 0; i < 4; i++)
         for (int k = 0; k < 3; k++) {
@@ -572,7 +572,7 @@ int hd__tri_nearest(const double p[3], const double a[3], const double b[3],
                     const double c[3], hd__tri_near_t *out) {
     const double *in[4] = {p, a, b, c}, *sc[4];
     double scaled[4][3];
-    int s = 0, ok, sc_ok = scale(in, scaled, sc, &s);
+    int s = 0, ok, sc_ok = hd__tri_scale(in, scaled, sc, &s);
     region_t r = {HD__TRI_FACE, 0, 0};
     if (sc_ok < 0) return HD_ERANGE;
     for (int i = 1; i < 4; i++)
@@ -593,190 +593,4 @@ int hd__tri_nearest(const double p[3], const double a[3], const double b[3],
     ok = decide_plain(sc, &r, s, out);
 #endif
     return ok ? HD_OK : hd__tri_nearest_exact(p, a, b, c, out);
-}
-
-/* ---- bounds in plain doubles ---------------------------------------------
- *
- * d^2 = h^2 + delta^2 for h the distance from p to the plane of a
- * non-degenerate triangle (h^2 = g^2 / M, g = n . AP, M = |n|^2) and delta the
- * distance, in the plane, from p's projection p' to the triangle.  The
- * triangle lies inside each edge's line, on the side of the opposite corner:
- * with L_C = n . (AB x AP), L_B = n . (AP x AC) and L_A = M - L_B - L_C (the
- * three sum to |n|^2), p' is L_X / (|n| |e|) inside the line of the edge e
- * opposite X, so delta >= max(0, -L_X) / (|n| |e|) for every edge, and
- * delta = 0 when no L_X is negative.  That gives lo2, or |XP|^2 when p is
- * certainly in the corner X's region (corner_lo2).  hi2 is h^2 when every
- * L_X is certainly >= 0, else the least squared distance to a point of the
- * triangle: the foot of p on each edge it may lie beyond, its parameter
- * clamped to [0, 1] (a point of the edge whatever the rounding; in an edge's
- * or a corner's region it is the closest point).
- *
- * Every quantity is computed in doubles from rounded differences, and each
- * carries a bound on its error.  A polynomial evaluated through k roundings
- * on every path (the difference counted) is within gamma_k P of the exact
- * (Higham 3.1), P its permanent from the exact differences' magnitudes;
- * computing P from the rounded ones loses at most a factor (1 - u)^-(2k),
- * so (k + 2) u P in doubles bounds the error: k = 3 for n, 4 for the
- * corner tests' dot products, 6 for g, 9 for L_B and L_C.  M = sum n_i^2 is within sum (2 |n_i| + e_i) e_i + 4u M of
- * the computed sum, an edge's |e|^2 within 6u of its computed value, and a
- * foot's component r = XP - tau XY within 2u (|r| + |XP| + 2 |tau XY|).
- * Every result is then moved outward by 2^-48 relatively and 2^-1060
- * absolutely, which covers the roundings of the bound formulas, including
- * a subnormal result: a squared ratio is formed as (x / y) x, and a lower
- * bound drops a term whose factors are not normal (their rounding would
- * not be relative), an upper bound adds 2^-1000 to the ratio.  Coordinates below 2^100 in magnitude keep every
- * factor a rounding error is multiplied by under 2^306, so the 2^-700 every
- * error bound carries covers what underflow could lose; other coordinates
- * are first scaled by a power of two (step 1), and where that would not be
- * exact the bounds are [0, infinity].
- */
-
-#define TB 0x1p-700
-#define OUT_LO (1 - 0x1p-48)
-#define OUT_HI (1 + 0x1p-48)
-
-typedef struct {
-    double v[3];
-} v3_t;
-
-HD__INLINE v3_t v3_diff(const double *p, const double *q) {
-    return (v3_t){{p[0] - q[0], p[1] - q[1], p[2] - q[2]}};
-}
-
-HD__INLINE double v3_dot(const v3_t *a, const v3_t *b) {
-    return a->v[0] * b->v[0] + a->v[1] * b->v[1] + a->v[2] * b->v[2];
-}
-
-/* a x b and each component's permanent. */
-HD__INLINE v3_t v3_cross(const v3_t *a, const v3_t *b, v3_t *perm) {
-    v3_t r;
-    for (int i = 0; i < 3; i++) {
-        int j = (i + 1) % 3, k = (i + 2) % 3;
-        r.v[i] = a->v[j] * b->v[k] - a->v[k] * b->v[j];
-        perm->v[i] = fabs(a->v[j] * b->v[k]) + fabs(a->v[k] * b->v[j]);
-    }
-    return r;
-}
-
-HD__INLINE double v3_pdot(const v3_t *pa, const v3_t *b) {
-    return pa->v[0] * fabs(b->v[0]) + pa->v[1] * fabs(b->v[1]) + pa->v[2] * fabs(b->v[2]);
-}
-
-/* An upper bound on |XP - tau XY|^2, tau = XP.XY / |XY|^2 clamped to [0, 1]. */
-static double foot_hi2(const v3_t *xp, const v3_t *xy) {
-    double den = v3_dot(xy, xy), num = v3_dot(xp, xy), s = 0;
-    double tau = den > 0 && num > 0 ? (num < den ? num / den : 1) : 0;
-    for (int i = 0; i < 3; i++) {
-        double t = tau * xy->v[i], r = xp->v[i] - t;
-        double m = fabs(r) + 2 * U * (fabs(r) + fabs(xp->v[i]) + 2 * fabs(t)) + TB;
-        s += m * m;
-    }
-    return s * OUT_HI + 0x1p-1060;
-}
-
-/* |XP|^2 when p is certainly in the corner X's region (XY . XP <= 0 and
- * XZ . XP <= 0: then every point x of the triangle has (x - X) . XP <= 0,
- * so |p - x|^2 >= |XP|^2), else 0; a lower bound either way. */
-static double corner_lo2(const v3_t *xp, const v3_t *xy, const v3_t *xz) {
-    v3_t m = {{fabs(xp->v[0]), fabs(xp->v[1]), fabs(xp->v[2])}};
-    double e1 = v3_dot(xy, xp) + (6 * U * v3_pdot(&m, xy) + TB);
-    double e2 = v3_dot(xz, xp) + (6 * U * v3_pdot(&m, xz) + TB);
-    return e1 <= 0 && e2 <= 0 ? v3_dot(xp, xp) * (1 - 6 * U) : 0;
-}
-
-/* x y for a lower bound: 0 unless both factors are normal, so that each
- * carries only its relative rounding (and the product an absolute one). */
-HD__INLINE double lower_product(double x, double y) {
-    return x > 0x1p-900 && y > 0x1p-900 ? x * y : 0;
-}
-
-/* The bounds for coordinates below 2^100 in magnitude. */
-static void bounds_core(const double *p, const double *a, const double *b, const double *c,
-                        double *lo2, double *hi2) {
-    v3_t ab = v3_diff(b, a), ac = v3_diff(c, a), ap = v3_diff(p, a), pn, pw, pv, bc, bp;
-    v3_t n = v3_cross(&ab, &ac, &pn), w = v3_cross(&ab, &ap, &pw), v = v3_cross(&ap, &ac, &pv);
-    double g = v3_dot(&n, &ap), eg = 8 * U * v3_pdot(&pn, &ap) + TB;
-    double M = v3_dot(&n, &n), eM = 4 * U * M;
-    for (int i = 0; i < 3; i++) {
-        double e = 5 * U * pn.v[i] + TB;
-        eM += (2 * fabs(n.v[i]) + e) * e;
-    }
-    eM = eM * SLACK + TB;
-    double L[3], eL[3], len2[3];
-    L[2] = v3_dot(&n, &w);
-    L[1] = v3_dot(&n, &v);
-    eL[2] = 11 * U * (pn.v[0] * pw.v[0] + pn.v[1] * pw.v[1] + pn.v[2] * pw.v[2]) + TB;
-    eL[1] = 11 * U * (pn.v[0] * pv.v[0] + pn.v[1] * pv.v[1] + pn.v[2] * pv.v[2]) + TB;
-    L[0] = (M - L[1]) - L[2];
-    eL[0] = (eM + eL[1] + eL[2] + 2 * U * (M + fabs(L[1]) + fabs(L[2]))) * SLACK;
-    bc = v3_diff(c, b);
-    bp = v3_diff(p, b);
-    len2[0] = v3_dot(&bc, &bc);       /* the edge opposite a */
-    len2[1] = v3_dot(&ac, &ac);
-    len2[2] = v3_dot(&ab, &ab);
-    int certain[3], inside = M - eM > 0;
-    double lo = 0, hi = INFINITY;
-    if (inside) {
-        double gl = fabs(g) - eg, Mu = M + eM, out = 0;
-        lo = lower_product(gl, gl / Mu);
-        for (int i = 0; i < 3; i++) {
-            double o = -L[i] - eL[i];
-            certain[i] = L[i] - eL[i] >= 0;
-            inside &= certain[i];
-            if (o > 0x1p-900) {
-                double q = lower_product(o / Mu, o / (len2[i] * (1 + 6 * U) + TB));
-                out = q > out ? q : out;
-            }
-        }
-        lo += out;
-    }
-    if (inside) {
-        double gh = fabs(g) + eg;
-        hi = (gh / (M - eM) + 0x1p-1000) * gh * OUT_HI + 0x1p-1060;
-    } else {
-        int all = !(M - eM > 0);
-        if (all || !certain[2]) { double h = foot_hi2(&ap, &ab); hi = h < hi ? h : hi; }
-        if (all || !certain[1]) { double h = foot_hi2(&ap, &ac); hi = h < hi ? h : hi; }
-        if (all || !certain[0]) { double h = foot_hi2(&bp, &bc); hi = h < hi ? h : hi; }
-        v3_t cp = v3_diff(p, c), ba = {{-ab.v[0], -ab.v[1], -ab.v[2]}};
-        v3_t ca = {{-ac.v[0], -ac.v[1], -ac.v[2]}}, cb = {{-bc.v[0], -bc.v[1], -bc.v[2]}};
-        double q = corner_lo2(&ap, &ab, &ac);
-        lo = q > lo ? q : lo;
-        q = corner_lo2(&bp, &ba, &bc);
-        lo = q > lo ? q : lo;
-        q = corner_lo2(&cp, &ca, &cb);
-        lo = q > lo ? q : lo;
-    }
-    lo = lo * OUT_LO - 0x1p-1060;
-    *lo2 = lo > 0 ? lo : 0;
-    *hi2 = hi;
-}
-
-void hd__tri_bounds(const double p[3], const double a[3], const double b[3], const double c[3],
-                    double *lo2, double *hi2) {
-    const double *in[4] = {p, a, b, c}, *sc[4];
-    double scaled[4][3];
-    uint64_t big = 0;
-    for (int i = 0; i < 4; i++)
-        for (int k = 0; k < 3; k++) {
-            uint64_t m;
-            memcpy(&m, &in[i][k], sizeof m);
-            m &= ~(UINT64_C(1) << 63);
-            big = m > big ? m : big;
-        }
-    if (big < UINT64_C(0x4630000000000000)) {               /* below 2^100 */
-        bounds_core(p, a, b, c, lo2, hi2);
-        return;
-    }
-    int s = 0;
-    *lo2 = 0;
-    *hi2 = INFINITY;
-    if (scale(in, scaled, sc, &s) <= 0) return;
-    double lo, hi, f = pow2(-s);
-    bounds_core(sc[0], sc[1], sc[2], sc[3], &lo, &hi);
-    /* Scaled down by 2^s <= 2^-1: unscaling only grows, exact but for
-     * overflow, where the lower bound still exceeds every double. */
-    lo = lo * f * f;
-    *lo2 = lo < INFINITY ? lo : 1.7976931348623157e308;
-    *hi2 = hi * f * f;
 }

@@ -335,6 +335,26 @@ TEST(the_bounds_are_tight_off_the_boundaries) {
     }
 }
 
+TEST(a_prepared_triangle_gives_the_same_bounds) {
+    for (int f = 0; f < F_COUNT; f++) {
+        gen_rng_t g;
+        uint64_t seed = 4000 + (uint64_t)f;
+        gen_seed(&g, seed);
+        for (long i = 0; i < 2000 && !hdt_failed(); i++) {
+            tri_case_t t;
+            hd__tri_prep_t tp;
+            double lo2, hi2, plo2, phi2;
+            make_case(&g, f, &t);
+            CONTEXT("family %s, seed %llu, case %ld", family_name[f], (unsigned long long)seed, i);
+            hd__tri_bounds(t.p, t.a, t.b, t.c, &lo2, &hi2);
+            hd__tri_prep(t.a, t.b, t.c, &tp);
+            hd__tri_bounds_prep(t.p, &tp, &plo2, &phi2);
+            CHECK_BITS(plo2, lo2);
+            CHECK_BITS(phi2, hi2);
+        }
+    }
+}
+
 TEST(the_bounds_of_hand_cases) {
     tri_case_t t;
     double lo2, hi2;
