@@ -48,6 +48,12 @@ double hd__big_frexp(const hd__big_t *a, int *k);
  * coordinate is or would become subnormal. */
 int hd__tri_scale(const double *const in[4], double out[4][3], const double **use, int *s);
 
+/* hd__tri_nearest with Dekker's TwoProd (fma 0) or the CPU's fused
+ * multiply-add where it has one (fma 1, what hd__tri_nearest uses): the
+ * same bits either way, which tests check. */
+int hd__tri_nearest_variant(const double p[3], const double a[3], const double b[3],
+                            const double c[3], hd__tri_near_t *out, int fma);
+
 /* The exponent of the last bit of x's significand, with trailing zeros
  * dropped: x is a multiple of 2^hd__ulp_exp(x). x != 0, finite. */
 int hd__ulp_exp(double x);

@@ -568,8 +568,8 @@ static int decide_fma(const double *const sc[4], const region_t *r, int s, hd__t
 }
 #endif
 
-int hd__tri_nearest(const double p[3], const double a[3], const double b[3],
-                    const double c[3], hd__tri_near_t *out) {
+int hd__tri_nearest_variant(const double p[3], const double a[3], const double b[3],
+                            const double c[3], hd__tri_near_t *out, int fma) {
     const double *in[4] = {p, a, b, c}, *sc[4];
     double scaled[4][3];
     int s = 0, ok, sc_ok = hd__tri_scale(in, scaled, sc, &s);
@@ -588,9 +588,16 @@ int hd__tri_nearest(const double p[3], const double a[3], const double b[3],
     if (!sc_ok || !classify(sc[0], sc[1], sc[2], sc[3], &r))
         return hd__tri_nearest_exact(p, a, b, c, out);
 #if TRI_FMA_CLONE
-    ok = __builtin_cpu_supports("fma") ? decide_fma(sc, &r, s, out) : decide_plain(sc, &r, s, out);
+    ok = fma && __builtin_cpu_supports("fma") ? decide_fma(sc, &r, s, out)
+                                              : decide_plain(sc, &r, s, out);
 #else
+    (void)fma;
     ok = decide_plain(sc, &r, s, out);
 #endif
     return ok ? HD_OK : hd__tri_nearest_exact(p, a, b, c, out);
+}
+
+int hd__tri_nearest(const double p[3], const double a[3], const double b[3],
+                    const double c[3], hd__tri_near_t *out) {
+    return hd__tri_nearest_variant(p, a, b, c, out, 1);
 }

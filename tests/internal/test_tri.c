@@ -16,6 +16,7 @@
 #include "check.h"
 #include "gen.h"
 #include "mesh/mesh.h"
+#include "mesh/mesh_int.h"
 
 #include <math.h>
 #include <stdint.h>
@@ -250,6 +251,26 @@ TEST(the_fast_path_gives_the_exact_paths_distance) {
         }
         printf("  %-22s exact path decided %5.2f %% of %ld\n", family_name[f],
                100.0 * (double)exact / (double)per_family, per_family);
+    }
+}
+
+TEST(dekkers_product_and_the_fused_multiply_add_give_the_same_bits) {
+    /* On a CPU without fused multiply-add both calls take Dekker's path. */
+    for (int f = 0; f < F_COUNT; f++) {
+        gen_rng_t g;
+        uint64_t seed = 5000 + (uint64_t)f;
+        gen_seed(&g, seed);
+        for (long i = 0; i < 5000 && !hdt_failed(); i++) {
+            tri_case_t t;
+            hd__tri_near_t x, y;
+            make_case(&g, f, &t);
+            CONTEXT("family %s, seed %llu, case %ld", family_name[f], (unsigned long long)seed, i);
+            CHECK_RC(hd__tri_nearest_variant(t.p, t.a, t.b, t.c, &x, 0), HD_OK);
+            CHECK_RC(hd__tri_nearest_variant(t.p, t.a, t.b, t.c, &y, 1), HD_OK);
+            CHECK_BITS(x.d, y.d);
+            CHECK_EQ(x.exact, y.exact);
+            CHECK_EQ(x.feature, y.feature);
+        }
     }
 }
 
