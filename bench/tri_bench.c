@@ -9,9 +9,9 @@
  * alone (on N/20 calls), the plain-double bounds (hd__tri_bounds) and the
  * same from prepared triangles (hd__tri_bounds_prep, the preparation not
  * counted), both over the first HOT cases again and again, as a search
- * meets its triangles in cache; the
- * share of calls the exact path decided.  KIND (0, 1 or 2) runs one kind
- * only (for instruction counts under callgrind).
+ * meets its triangles in cache; the share of calls the exact path decided.
+ * KIND (0, 1 or 2) runs one kind only (for instruction counts under
+ * callgrind).
  *
  *     build/bench/tri_bench [N [R [KIND]]]
  */
