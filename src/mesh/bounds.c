@@ -34,8 +34,10 @@
  * sum |AP_i| (1.01 e_w,i + 4.1 u |w_i|): the weights (1.01 e + 4.1 u |w|)
  * are the triangle's, so a point pays three products and two sums for each
  * bound.  M = sum n_i^2 is within sum (2 |n_i| + e_i) e_i + 4u M of the
- * computed sum, an edge's |e|^2 within 6u of its computed value, and a
- * foot's component r = XP - tau XY within 2u (|r| + |XP| + 2 |tau XY|).
+ * computed sum, an edge's |e|^2 below (1 - u)^-5 times its computed value
+ * (8u is used), and a foot's component r = XP - tau XY within
+ * 2u (|r| + |XP| + 2 |tau XY|).  A reciprocal rounded down is
+ * fl(fl(1 / fl(x (1 + 2u))) (1 - 2u)) <= 1 / x, and up symmetrically.
  * Every bound is multiplied by 1 + 2^-40, which covers the roundings of its
  * own formula.  The results are moved outward by 2^-48 relatively and
  * 2^-1060 absolutely, which covers the roundings of the final formulas,
@@ -137,7 +139,7 @@ static void prep_core(const double *a, const double *b, const double *c, hd__tri
     t->rMu = recip_down(M + eM);
     t->rMl = t->flat ? 0 : recip_up(M - eM);
     for (int i = 0; i < 3; i++) {
-        t->rl[i] = recip_down(len2[i] * (1 + 6 * U) + TB);
+        t->rl[i] = recip_down(len2[i] * (1 + 8 * U) + TB);
         t->rd[i] = len2[i] > 0 ? 1 / len2[i] : 0;
     }
 }
