@@ -41,15 +41,15 @@
  * Every bound is multiplied by 1 + 2^-40, which covers the roundings of its
  * own formula.  The results are moved outward by 2^-48 relatively and
  * 2^-1060 absolutely, which covers the roundings of the final formulas,
- * including a subnormal result: reciprocals are rounded outward by 2u, a
- * squared ratio is formed as (x / y) x, a lower bound drops a term whose
- * factors are not normal (their rounding would not be relative), and an
- * upper bound adds 2^-1000 to the ratio.  Coordinates below 2^100 in
- * magnitude keep every factor a rounding error is multiplied by under
- * 2^306, so the 2^-700 every error bound carries covers what underflow
- * could lose.  Other coordinates are first scaled by a power of two (the
- * kernel's step 1); where that would not be exact, or beyond the domain,
- * the bounds are [0, infinity].
+ * including a subnormal result: reciprocals are rounded outward, a squared
+ * ratio x^2 / y is formed as x (x r) with r such a reciprocal of y, a
+ * lower bound drops a term whose factors are not normal (their rounding
+ * would not be relative), and an upper bound adds 2^-1000 to x r.
+ * Coordinates below 2^100 in magnitude keep every factor a rounding error
+ * is multiplied by under 2^306, so the 2^-700 every error bound carries
+ * covers what underflow could lose.  Other coordinates are first scaled by
+ * a power of two (the kernel's step 1); where that would not be exact, or
+ * beyond the domain, the bounds are [0, infinity].
  */
 #include <math.h>
 #include <string.h>
