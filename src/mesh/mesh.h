@@ -63,11 +63,11 @@ int hd__tri_nearest(const double p[3], const double a[3], const double b[3],
  * the closed triangle abc, from plain doubles (bounds.c has the proof): no
  * sign is decided, so they hold for every triangle, degenerate ones too.
  * A search discards a triangle whose lo2 exceeds another's hi2 without
- * calling hd__tri_nearest.  They are within about 2^-45 relatively of d^2
- * when p is not much nearer the triangle than its size times 2^-10 and the
- * triangle is not a sliver, and informative when the triangle's edges are
- * longer than about 2^-170 (with coordinates below 2^100; larger ones are
- * scaled by a power of two).  A degenerate triangle gets lo2 = 0 unless p is
+ * calling hd__tri_nearest.  Their gap is about u times the triangle's size
+ * over the distance, more on slivers (docs/surfaces.md has figures), and
+ * they are informative when the triangle's edges are longer than about
+ * 2^-170 (with coordinates below 2^100; larger ones are scaled by a power
+ * of two).  A degenerate triangle gets lo2 = 0 unless p is
  * certainly in a corner's region.  A NaN or a coordinate beyond 2^511, or
  * large coordinates whose scaling would not be exact: lo2 = 0,
  * hi2 = infinity.  Thread safety: none needed. */
