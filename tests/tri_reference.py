@@ -13,7 +13,8 @@ projection onto the plane when its barycentric coordinates, from the 2x2
 normal equations of the Gram matrix, are all non-negative; the squared
 distance is the least of those candidates, a ratio of integers; and its
 square root is rounded to the nearest double, ties to even, from an integer
-square root with a sticky bit. Every double is an integer over a power of
+square root with a sticky bit. It also checks that the plain-double bounds
+hd__tri_bounds gives contain the exact squared distance, as rationals. Every double is an integer over a power of
 two, so scaling all twelve coordinates by their common denominator makes
 every quantity an integer.
 
@@ -101,16 +102,29 @@ def round_to_double(s, sticky, exp):
 
 
 def reference(case):
+    """The correctly rounded distance and the exact squared distance (num, den)."""
     ints, den = as_integers(case)
     p, a, b, c = (tuple(ints[i:i + 3]) for i in range(0, 12, 3))
     num, d = squared_distance(p, a, b, c)
-    if num == 0:
-        return 0.0
     qden = d * den * den                            # t^2 = num / qden
+    if num == 0:
+        return 0.0, (num, qden)
     k = max(0, 70 - (num.bit_length() - qden.bit_length()) // 2)
     x = num << (2 * k)
     s = isqrt(x // qden)
-    return round_to_double(s, s * s * qden != x, -k)
+    return round_to_double(s, s * s * qden != x, -k), (num, qden)
+
+
+def within(lo2, hi2, sq):
+    """lo2 <= num / den <= hi2, exactly (hi2 may be infinite)."""
+    num, den = sq
+    lo_n, lo_d = lo2.as_integer_ratio()
+    if lo_n * den > num * lo_d:
+        return False
+    if math.isinf(hi2):
+        return True
+    hi_n, hi_d = hi2.as_integer_ratio()
+    return num * hi_d <= hi_n * den
 
 
 # ---- the cases ---------------------------------------------------------------
@@ -191,9 +205,9 @@ def run_filter(prog, cases, exact):
     data = b"".join(struct.pack("<12d", *cs) for cs in cases)
     out = subprocess.run([prog] + (["--exact"] if exact else []), input=data,
                          stdout=subprocess.PIPE, check=True).stdout
-    if len(out) != 9 * len(cases):
+    if len(out) != 25 * len(cases):
         sys.exit("tri_cases wrote %d bytes for %d cases" % (len(out), len(cases)))
-    return [struct.unpack_from("<dB", out, 9 * i) for i in range(len(cases))]
+    return [struct.unpack_from("<dBdd", out, 25 * i) for i in range(len(cases))]
 
 
 def check_chunk(args, r, first, count, per, tally):
@@ -202,17 +216,21 @@ def check_chunk(args, r, first, count, per, tally):
     cases = [make_case(r, f) for f in fams]
     fast = run_filter(args.prog, cases, False)
     exact = run_filter(args.prog, cases, True)
-    for i, (cs, f, (d_fast, flag), (d_exact, flag2)) in enumerate(zip(cases, fams, fast, exact)):
-        want = reference(cs)
+    for i, (cs, f, (d_fast, flag, lo2, hi2), (d_exact, flag2, _, _)) in enumerate(
+            zip(cases, fams, fast, exact)):
+        want, sq = reference(cs)
         per[FAMILIES[f]][0] += 1
         per[FAMILIES[f]][1] += flag == 1
-        if flag != 2 and flag2 != 2 and d_fast == want and d_exact == want:
+        bounded = within(lo2, hi2, sq)
+        if flag != 2 and flag2 != 2 and d_fast == want and d_exact == want and bounded:
             tally[0] += 1
             continue
         tally[1] += 1
         if tally[1] <= 10:
-            print("FAIL case %d (seed %d, family %s): want %r, fast path %r, exact path %r; case %s"
-                  % (first + i, args.seed, FAMILIES[f], want, d_fast, d_exact, [x.hex() for x in cs]))
+            print("FAIL case %d (seed %d, family %s): want %r, fast path %r, exact path %r, "
+                  "bounds [%r, %r] %s; case %s"
+                  % (first + i, args.seed, FAMILIES[f], want, d_fast, d_exact, lo2, hi2,
+                     "hold" if bounded else "do not hold", [x.hex() for x in cs]))
 
 
 def main():

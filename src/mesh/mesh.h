@@ -16,10 +16,13 @@
  * How (tri.c has the proofs): the nearest feature (a corner, an edge or the
  * face) is chosen by Ericson's Voronoi-region tests evaluated in doubles,
  * each accepted only when its computed sign exceeds a proven bound on its
- * rounding error; the squared distance N/M of that feature is evaluated in
- * double-double arithmetic with a running error bound; and the rounding of
- * sqrt(N/M) is decided by the signs of N - m^2 M at the two midpoints m
- * around the candidate.  When any of these signs is not certain (a point on
+ * rounding error; the squared distance N/M of that feature is evaluated as
+ * compensated sums of products (double-double accuracy) with one a-priori
+ * error bound per quantity; and the rounding of sqrt(N/M) is decided by one
+ * Newton step with a proven error bound, or failing that by the signs of
+ * N - m^2 M at the midpoints m around the candidate.  The same bits come
+ * from the Dekker and the fused multiply-add products the kernel picks
+ * between at run time.  When any of these signs is not certain (a point on
  * a region's boundary, a degenerate or nearly degenerate triangle, a
  * distance within about 2^-90 of a midpoint, coordinates far apart in
  * scale), the same questions are answered in exact integer arithmetic
@@ -56,6 +59,38 @@ typedef struct hd__tri_near {
 
 int hd__tri_nearest(const double p[3], const double a[3], const double b[3],
                     const double c[3], hd__tri_near_t *out);
+
+/* Rigorous bounds lo2 <= d^2 <= hi2 on the exact squared distance from p to
+ * the closed triangle abc, from plain doubles (bounds.c has the proof): no
+ * sign is decided, so they hold for every triangle, degenerate ones too.
+ * A search discards a triangle whose lo2 exceeds another's hi2 without
+ * calling hd__tri_nearest.  Their gap is about u times the triangle's size
+ * over the distance, more on slivers (docs/surfaces.md has figures), and
+ * they are informative when the triangle's edges are longer than about
+ * 2^-170 (with coordinates below 2^100; larger ones are scaled by a power
+ * of two).  A degenerate triangle gets lo2 = 0 unless p is
+ * certainly in a corner's region.  A NaN or a coordinate beyond 2^511, or
+ * large coordinates whose scaling would not be exact: lo2 = 0,
+ * hi2 = infinity.  Thread safety: none needed. */
+void hd__tri_bounds(const double p[3], const double a[3], const double b[3], const double c[3],
+                    double *lo2, double *hi2);
+
+/* A triangle prepared once for hd__tri_bounds_prep: its corners, rounded
+ * edges, n = AB x AC, the two edge normals n x AB and AC x n, the error
+ * weights of their dot products with a point's AP, |n|^2 and its bound,
+ * and outward-rounded reciprocals.  hd__tri_bounds_prep(p, &t, ..) gives
+ * the same bits as hd__tri_bounds(p, a, b, c, ..) at about a third of the
+ * cost.  Read-only after hd__tri_prep: share it between threads. */
+typedef struct hd__tri_prep {
+    double a[3], b[3], c[3], ab[3], ac[3], bc[3];
+    double n[3], wn[3], mb[3], wb[3], mc[3], wc[3];
+    double M, eM, rMu, rMl, rl[3], rd[3];
+    int flat;                 /* |n|^2 not certainly positive: no plane */
+    int direct;               /* corners below 2^100: no scaling needed */
+} hd__tri_prep_t;
+
+void hd__tri_prep(const double a[3], const double b[3], const double c[3], hd__tri_prep_t *t);
+void hd__tri_bounds_prep(const double p[3], const hd__tri_prep_t *t, double *lo2, double *hi2);
 
 /* The same answer from exact arithmetic alone (tests compare the two). */
 int hd__tri_nearest_exact(const double p[3], const double a[3], const double b[3],

@@ -42,6 +42,18 @@ int hd__big_sign(const hd__big_t *a);
 /* a ~= f * 2^k with f in [0.5, 1) (0 for zero), f from a's top 64 bits. */
 double hd__big_frexp(const hd__big_t *a, int *k);
 
+/* The kernel's step 1 (tri.c): *use = the coordinates, or their copies in
+ * out scaled by 2^s to put the largest magnitude in [1, 2) unless it
+ * already lies in [2^-8, 2); -1 outside the domain, 0 when a nonzero
+ * coordinate is or would become subnormal. */
+int hd__tri_scale(const double *const in[4], double out[4][3], const double **use, int *s);
+
+/* hd__tri_nearest with Dekker's TwoProd (fma 0) or the CPU's fused
+ * multiply-add where it has one (fma 1, what hd__tri_nearest uses): the
+ * same bits either way, which tests check. */
+int hd__tri_nearest_variant(const double p[3], const double a[3], const double b[3],
+                            const double c[3], hd__tri_near_t *out, int fma);
+
 /* The exponent of the last bit of x's significand, with trailing zeros
  * dropped: x is a multiple of 2^hd__ulp_exp(x). x != 0, finite. */
 int hd__ulp_exp(double x);

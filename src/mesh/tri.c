@@ -4,10 +4,12 @@
  * exact.c.
  *
  * 1. Scale.  All twelve coordinates are multiplied by the power of two that
- *    puts the largest magnitude in [1, 2).  This is exact when no nonzero
- *    coordinate becomes subnormal (else: exact path), and it scales every
- *    squared distance by a power of four, so the rounding of the distance is
- *    the same in both scales as long as the result is a normal double.
+ *    puts the largest magnitude in [1, 2), unless it already lies in
+ *    [2^-8, 2) (every argument below needs only magnitudes below 2).  This
+ *    is exact when no nonzero coordinate is or becomes subnormal (else:
+ *    exact path), and it scales every squared distance by a power of four,
+ *    so the rounding of the distance is the same in both scales as long as
+ *    the result is a normal double.
  *
  * 2. The feature.  Ericson's tests (Real-Time Collision Detection, 5.1.5)
  *    name the Voronoi region of p exactly when they are evaluated exactly on
@@ -28,26 +30,48 @@
  *    certainly nonzero.  Any sign not certain sends the call to exact.c.
  *
  * 3. The squared distance N / M of that feature (exact.c lists the
- *    formulas) in double-double arithmetic from the exact differences
- *    (two_sum).  Each value carries an absolute error bound: a product of
- *    double-doubles (DWTimesDW1) is within 7 u^2 of the exact product of
- *    its operands and a sum (AccurateDWPlusDW) within 3 u^2 / (1 - 4u) of the
- *    exact sum (Joldes, Muller, Popescu, ACM TOMS 44(2), 2017, the bounds
- *    used here with room: 16 u^2 and 4 u^2 of the result's leading part);
- *    the operands' own errors propagate as |x| e_y + |y| e_x + e_x e_y and
- *    e_x + e_y.  Each bound is computed in doubles and multiplied by
- *    1 + 2^-40, which covers the roundings of its own formula.
+ *    formulas) from the exact differences (two_sum), every polynomial a
+ *    compensated sum of products (cdot): each product x y of double-doubles
+ *    is TwoProd(xh, yh) = p + pi exactly plus xh yl + xl yh rounded, the p
+ *    are summed with TwoSum, and every error term (the TwoSum errors sigma,
+ *    the pi, the cross products) is summed in plain doubles into c; the
+ *    value is TwoSum(s, c).  One a-priori bound per quantity replaces a
+ *    running bound per operation (Higham 3.1, the leaves being these
+ *    terms): with P = sum |xh_i yh_i| and n products, the terms sum in
+ *    magnitude to at most (n + 2) u P (1 + n u) (|sigma_i| <= u |s_i|,
+ *    |pi_i| <= u |p_i|, each cross product <= u |xh yh|), each passes
+ *    through at most 3n + 1 roundings, and the dropped xl yl are at most
+ *    u^2 P: the error is within gamma_{3n+1} (n + 2) u P + u^2 P, below
+ *    C_n u^2 P with C_1 = 16, C_2 = 32, C_3 = 64.  An operand that carries
+ *    its own error e (a component of n = AB x AC or of XP x XY) adds
+ *    sum e_i |y_i| to a dot product and (2 |x_i| + e_i) e_i to a square.
+ *    Each bound is computed in doubles from the leading parts (|x| <=
+ *    |xh| (1 + u)) and multiplied by 1 + 2^-40, which covers the roundings
+ *    of its own formula; every bound also carries 2^-1000, what underflow
+ *    could lose (coordinates scaled below 2 keep every factor a result is
+ *    multiplied by under 2^20).  TwoProd is Dekker's product, or on a CPU
+ *    with fused multiply-add (chosen at run time) p = xh yh and
+ *    pi = fma(xh, yh, -p): both exact, so both give the same N and M bits.
  *
- * 4. The rounding.  q0 = sqrt(N / M) in doubles is within two ulps of
- *    t = sqrt(N / M) once N and M are known to 2^-60 relatively.  With
- *    W >= |N - q0^2 M| from the double-double residual and its bound,
- *    |t - q0| <= W / (M (t + q0)); when that is below the half gap to both
- *    neighbours of q0, q0 is the nearest double.  Otherwise the sign of the
- *    residual says on which side of q0 t lies, and the sign of N - m^2 M at
- *    the midpoint m on that side (m^2 is the exact sum of q0^2, 2 q0 g and
- *    g^2 for the half gap g) says whether t rounds to q0 or beyond it.  A
- *    sign that is not certain (t within about 2^-90 of a midpoint, or equal
- *    to it) goes to exact.c, which also rounds ties to even.
+ * 4. The rounding.  q0 = sqrt(N / M) in doubles, N and M known to 2^-60
+ *    relatively.  With t the true distance and z = t - q0,
+ *    z (2 q0 + z) M = R = N - q0^2 M, computed as r (q0^2 exactly by
+ *    TwoProd, the rest as in cdot) within wr.  Then with mu >= |M / Mh - 1|
+ *    and zeta >= |z| / (2 q0) (from t + q0 >= q0), both below 2^-40, the
+ *    Newton step corr = r / (2 q0 Mh) in doubles is within
+ *    ez = (wr + |r| (mu + zeta)) / (2 q0 Mh) (1 + 2^-37) + 2.02 u |corr|
+ *    of z.  q = fl(q0 + corr); d = corr - (q - q0) is exact (the rounding
+ *    error of that sum) and t - q lies in [d - ez, d + ez]: when that
+ *    interval is strictly inside the half gaps around q, q is the nearest
+ *    double.  Otherwise (t within about 2^-45 ulp of a midpoint) the sign
+ *    of the residual says on which side of q0 t lies, and the sign of
+ *    N - m^2 M at the midpoint m on that side (m^2 is the exact sum of
+ *    q0^2, 2 q0 g and g^2 for the half gap g, in double-doubles with a
+ *    running bound: Joldes, Muller, Popescu, ACM TOMS 44(2), 2017, 7 u^2
+ *    for a product and 3 u^2 / (1 - 4u) for a sum, used with room as
+ *    16 u^2 and 4 u^2) says whether t rounds to q0 or beyond it.  A sign
+ *    that is not certain (t within about 2^-90 of a midpoint, or equal to
+ *    it) goes to exact.c, which also rounds ties to even.
  */
 #include <math.h>
 #include <stdint.h>
@@ -82,6 +106,27 @@ HD__INLINE void two_prod(double a, double b, double *p, double *e) {
     double tb = 134217729.0 * b, bh = tb - (tb - b), bl = b - bh;
     *p = x;
     *e = ((ah * bh - x) + ah * bl + al * bh) + al * bl;
+}
+
+/* TwoProd by the CPU's fused multiply-add when fma is 1 (a constant after
+ * inlining: the kernel is compiled once for each), else Dekker's. */
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+#define TRI_FMA_CLONE 1
+#else
+#define TRI_FMA_CLONE 0
+#endif
+
+HD__INLINE void two_prod_x(double a, double b, double *p, double *e, int fma) {
+#if TRI_FMA_CLONE
+    if (fma) {
+        double x = a * b;
+        *p = x;
+        *e = __builtin_fma(a, b, -x);
+        return;
+    }
+#endif
+    (void)fma;
+    two_prod(a, b, p, e);
 }
 
 /* ---- powers of two and binades, by their bits -------------------------- */
@@ -145,31 +190,6 @@ HD__INLINE dd_t dd_mul(dd_t x, dd_t y) {
     fast_two_sum(ch, cl3, &z.h, &z.l);
     z.e = (C_MUL * fabs(z.h) + dd_mag(x) * y.e + (dd_mag(y) + y.e) * x.e) * SLACK + TINY;
     return z;
-}
-
-typedef struct {
-    dd_t x[3];
-} ddv_t;
-
-static ddv_t ddv_diff(const double *p, const double *q) {
-    ddv_t r;
-    for (int i = 0; i < 3; i++) r.x[i] = dd_diff(p[i], q[i]);
-    return r;
-}
-
-static dd_t ddv_dot(const ddv_t *a, const ddv_t *b) {
-    dd_t s = dd_mul(a->x[0], b->x[0]);
-    s = dd_add(s, dd_mul(a->x[1], b->x[1]));
-    return dd_add(s, dd_mul(a->x[2], b->x[2]));
-}
-
-static ddv_t ddv_cross(const ddv_t *a, const ddv_t *b) {
-    ddv_t r;
-    for (int i = 0; i < 3; i++) {
-        int j = (i + 1) % 3, k = (i + 2) % 3;
-        r.x[i] = dd_sub(dd_mul(a->x[j], b->x[k]), dd_mul(a->x[k], b->x[j]));
-    }
-    return r;
 }
 
 /* ---- step 2: the feature, from filtered signs ------------------------- */
@@ -272,46 +292,127 @@ static int classify(const double *p, const double *a, const double *b, const dou
 
 /* ---- step 3: N and M of the feature ------------------------------------ */
 
+typedef struct {
+    double h, l;
+} dw_t;
+
+typedef struct {
+    dw_t x[3];
+} dwv_t;
+
+#define C1 (16 * U * U)
+#define C2 (32 * U * U)
+#define C3 (64 * U * U)
+
+/* sum of x_i y_i for i < n as h + l with |l| <= u |h|, within
+ * C_n u^2 sum |xh_i yh_i| of the exact (the file's comment, step 3). */
+HD__INLINE dw_t cdot(const dw_t *x, const dw_t *y, int n, int fma) {
+    double s, c, p, e, sg;
+    dw_t r;
+    two_prod_x(x[0].h, y[0].h, &s, &c, fma);
+    c += x[0].h * y[0].l + x[0].l * y[0].h;
+    for (int i = 1; i < n; i++) {
+        two_prod_x(x[i].h, y[i].h, &p, &e, fma);
+        two_sum(s, p, &s, &sg);
+        c += (sg + e) + (x[i].h * y[i].l + x[i].l * y[i].h);
+    }
+    two_sum(s, c, &r.h, &r.l);
+    return r;
+}
+
+HD__INLINE dwv_t dwv_diff(const double *p, const double *q) {
+    dwv_t r;
+    for (int i = 0; i < 3; i++) two_sum(p[i], -q[i], &r.x[i].h, &r.x[i].l);
+    return r;
+}
+
+/* a x b of exact vectors, and each component's error bound. */
+HD__INLINE dwv_t dwv_cross(const dwv_t *a, const dwv_t *b, double e[3], int fma) {
+    dwv_t r;
+    for (int i = 0; i < 3; i++) {
+        int j = (i + 1) % 3, k = (i + 2) % 3;
+        dw_t x[2] = {a->x[j], {-a->x[k].h, -a->x[k].l}}, y[2] = {b->x[k], b->x[j]};
+        r.x[i] = cdot(x, y, 2, fma);
+        e[i] = C2 * (fabs(a->x[j].h * b->x[k].h) + fabs(a->x[k].h * b->x[j].h)) * SLACK + TINY;
+    }
+    return r;
+}
+
+/* x . y for x within ex of exact and y exact. */
+HD__INLINE dd_t dwv_dot(const dwv_t *x, const double ex[3], const dwv_t *y, int fma) {
+    dw_t v = cdot(x->x, y->x, 3, fma);
+    double b = 0;
+    for (int i = 0; i < 3; i++) b += fabs(y->x[i].h) * (C3 * fabs(x->x[i].h) + ex[i] * (1 + 2 * U));
+    return (dd_t){v.h, v.l, b * SLACK + TINY};
+}
+
+/* |x|^2 for x within ex of exact: |X^2 - x^2| <= (2 |x| + e) e. */
+HD__INLINE dd_t dwv_norm2(const dwv_t *x, const double ex[3], int fma) {
+    dw_t v = cdot(x->x, x->x, 3, fma);
+    double b = 0;
+    for (int i = 0; i < 3; i++) {
+        double m = fabs(x->x[i].h);
+        b += C3 * m * m + (2 * m * (1 + 2 * U) + ex[i]) * ex[i];
+    }
+    return (dd_t){v.h, v.l, b * SLACK + TINY};
+}
+
+/* g^2 for g within g.e of exact. */
+HD__INLINE dd_t dd_square(dd_t g, int fma) {
+    dw_t x = {g.h, g.l}, v = cdot(&x, &x, 1, fma);
+    double m = fabs(g.h);
+    return (dd_t){v.h, v.l, (C1 * m * m + (2 * m * (1 + 2 * U) + g.e) * g.e) * SLACK + TINY};
+}
+
 /* The feature's squared distance N / M and its closest point, in the scale
  * of the coordinates given: p less its offset from the plane (the face),
- * x + t xy with t from double-doubles (an edge), or the corner. */
+ * x + t xy with t in doubles (an edge), or the corner. */
 typedef struct {
     dd_t N, M;
     double point[3], t;
 } sqd_t;
 
-static void feature_sqd(const double *p, const double *a, const double *b, const double *c,
-                        hd__tri_feature_t f, sqd_t *r) {
-    const double *x = a, *y = b;
+static const double no_err[3] = {0, 0, 0};
+
+HD__INLINE void face_sqd(const double *p, const double *a, const double *b, const double *c,
+                         sqd_t *r, int fma) {
+    double en[3];
+    dwv_t ab = dwv_diff(b, a), ac = dwv_diff(c, a), ap = dwv_diff(p, a);
+    dwv_t n = dwv_cross(&ab, &ac, en, fma);
+    dd_t g = dwv_dot(&n, en, &ap, fma);
+    r->N = dd_square(g, fma);
+    r->M = dwv_norm2(&n, en, fma);
+    double k = g.h / r->M.h;
+    for (int i = 0; i < 3; i++) r->point[i] = p[i] - n.x[i].h * k;
+}
+
+HD__INLINE void edge_sqd(const double *p, const double *x, const double *y, sqd_t *r, int fma) {
+    double ec[3];
+    dwv_t xy = dwv_diff(y, x), xp = dwv_diff(p, x);
+    dwv_t cr = dwv_cross(&xp, &xy, ec, fma);
+    r->N = dwv_norm2(&cr, ec, fma);
+    r->M = dwv_norm2(&xy, no_err, fma);
+    double along = xp.x[0].h * xy.x[0].h + xp.x[1].h * xy.x[1].h + xp.x[2].h * xy.x[2].h;
+    r->t = along / r->M.h;
+    for (int i = 0; i < 3; i++) r->point[i] = x[i] + r->t * xy.x[i].h;
+}
+
+HD__INLINE void feature_sqd(const double *p, const double *a, const double *b, const double *c,
+                            hd__tri_feature_t f, sqd_t *r, int fma) {
     switch (f) {
-    case HD__TRI_FACE: {
-        ddv_t ab = ddv_diff(b, a), ac = ddv_diff(c, a), ap = ddv_diff(p, a);
-        ddv_t n = ddv_cross(&ab, &ac);
-        dd_t g = ddv_dot(&n, &ap);
-        r->N = dd_mul(g, g);
-        r->M = ddv_dot(&n, &n);
-        double k = g.h / r->M.h;
-        for (int i = 0; i < 3; i++) r->point[i] = p[i] - n.x[i].h * k;
-        return;
-    }
+    case HD__TRI_FACE: face_sqd(p, a, b, c, r, fma); return;
     case HD__TRI_VERTEX_A: case HD__TRI_VERTEX_B: case HD__TRI_VERTEX_C: {
         const double *v = f == HD__TRI_VERTEX_A ? a : f == HD__TRI_VERTEX_B ? b : c;
-        ddv_t vp = ddv_diff(p, v);
-        r->N = ddv_dot(&vp, &vp);
+        dwv_t vp = dwv_diff(p, v);
+        r->N = dwv_norm2(&vp, no_err, fma);
         r->M = dd_exact(1);
         memcpy(r->point, v, sizeof r->point);
         return;
     }
-    case HD__TRI_EDGE_AB: x = a; y = b; break;
-    case HD__TRI_EDGE_BC: x = b; y = c; break;
-    case HD__TRI_EDGE_CA: x = c; y = a; break;
+    case HD__TRI_EDGE_AB: edge_sqd(p, a, b, r, fma); return;
+    case HD__TRI_EDGE_BC: edge_sqd(p, b, c, r, fma); return;
+    case HD__TRI_EDGE_CA: edge_sqd(p, c, a, r, fma); return;
     }
-    ddv_t xy = ddv_diff(y, x), xp = ddv_diff(p, x);
-    ddv_t cr = ddv_cross(&xp, &xy);
-    r->N = ddv_dot(&cr, &cr);
-    r->M = ddv_dot(&xy, &xy);
-    r->t = ddv_dot(&xp, &xy).h / r->M.h;
-    for (int i = 0; i < 3; i++) r->point[i] = x[i] + r->t * xy.x[i].h;
 }
 
 /* ---- step 4: the rounding ----------------------------------------------- */
@@ -331,6 +432,33 @@ static dd_t residual(dd_t N, dd_t M, double q, int sigma, double g) {
 HD__INLINE int certain_sign(dd_t v) {
     double m = fabs(v.h) * (1 - 2 * U);
     return m > v.e ? (v.h > 0 ? 1 : -1) : 0;
+}
+
+/* The double nearest sqrt(N / M) from one Newton step; 0 when t may be
+ * too near a midpoint (the file's comment, step 4). */
+HD__INLINE int round_newton(dd_t N, dd_t M, double *q, int fma) {
+    if (!(N.h > 0 && M.h > 0) || N.e > N.h * 0x1p-60 || M.e > M.h * 0x1p-60) return 0;
+    double q0 = sqrt(N.h / M.h);
+    if (!(q0 >= 0x1p-400)) return 0;
+    double qh, ql, ph, pe, s, sg;
+    two_prod_x(q0, q0, &qh, &ql, fma);
+    two_prod_x(qh, M.h, &ph, &pe, fma);
+    two_sum(N.h, -ph, &s, &sg);
+    double r = s + (((sg + N.l) - pe) - (qh * M.l + ql * M.h));
+    double wr = (U * fabs(r) + 6 * U * U * (fabs(s) + N.h + 4 * fabs(ph)) + N.e +
+                 qh * M.e * (1 + 2 * U)) * SLACK + TINY;
+    double mu = (fabs(M.l) + M.e) / M.h * SLACK;
+    double zeta = (fabs(r) + wr) / (2 * M.h * (1 - mu) * q0 * q0) * SLACK;
+    if (!(mu < 0x1p-40 && zeta < 0x1p-40)) return 0;
+    double d0 = 2 * q0 * M.h, corr = r / d0;
+    double ez = ((wr + fabs(r) * (mu + zeta) * (1 + 0x1p-39)) / d0 + 2.02 * U * fabs(corr)) *
+                (1 + 0x1p-37);
+    double qq = q0 + corr, d = corr - (qq - q0);   /* both exact */
+    int ex = binade(qq);
+    double up = pow2(ex - 53), down = qq == pow2(ex) ? up / 2 : up;
+    if (!(d + ez <= up * (1 - 0x1p-40) && ez - d <= down * (1 - 0x1p-40))) return 0;
+    *q = qq;
+    return 1;
 }
 
 /* The double nearest sqrt(N / M) into *q; 0 when not decided. */
@@ -375,33 +503,78 @@ static void weigh(hd__tri_near_t *out, const region_t *r, double t) {
     }
 }
 
-/* Step 1: the scaled copies; 0 when scaling would not be exact. */
-static int scale(const double *const in[4], double out[4][3], int *s) {
-    double big = 0, small = INFINITY;
+/* Step 1.  A magnitude's bits order like the magnitude (NaN above infinity
+ * above every finite value), so one pass of integer max and min finds the
+ * largest magnitude and the smallest nonzero one (m - 1 wraps 0 to the top).
+ * Coordinates whose largest magnitude is already in [2^-8, 2) are used as
+ * they are (*use = in); otherwise *use = out, the copies scaled to put it in
+ * [1, 2).  -1 outside the domain, 0 when a nonzero coordinate is or would
+ * become subnormal (the exact path). */
+int hd__tri_scale(const double *const in[4], double out[4][3], const double **use, int *s) {
+    uint64_t big = 0, small = UINT64_MAX;
     for (int i = 0; i < 4; i++)
         for (int k = 0; k < 3; k++) {
-            double m = fabs(in[i][k]);
+            uint64_t m;
+            memcpy(&m, &in[i][k], sizeof m);
+            m &= ~(UINT64_C(1) << 63);
             big = m > big ? m : big;
-            if (m > 0 && m < small) small = m;
+            small = m - 1 < small ? m - 1 : small;
         }
-    if (big < 0x1p-900 || big > 0x1p511) return 0;
-    *s = -binade(big);
-    double f = pow2(*s);             /* -511 <= s <= 900: a normal double */
-    if (small * f < 0x1p-1022) return 0;
-    for (int i = 0; i < 4; i++)
+    if (big > UINT64_C(0x5fe0000000000000)) return -1;     /* beyond 2^511, or not a number */
+    int eb = (int)(big >> 52) - 1023;
+    double least, f;
+    small += 1;
+    memcpy(&least, &small, sizeof least);
+    if (eb < -900) return 0;
+    *s = eb >= -8 && eb <= 0 ? 0 : -eb;
+    f = pow2(*s);                     /* -511 <= s <= 900: a normal double */
+    if (least * f < 0x1p-1022) return 0;
+    if (*s == 0) {
+        for (int i = 0; i < 4; i++) use[i] = in[i];
+        return 1;
+    }
+    for (int i = 0; i < 4; i++) {
         for (int k = 0; k < 3; k++) out[i][k] = in[i][k] * f;
+        use[i] = out[i];
+    }
     return 1;
 }
 
-int hd__tri_nearest(const double p[3], const double a[3], const double b[3],
-                    const double c[3], hd__tri_near_t *out) {
-    const double *in[4] = {p, a, b, c};
-    double sc[4][3], q;
-    int s;
+/* Steps 3 and 4 on the scaled coordinates with the feature known: 1 and
+ * *out (but for the unscaling) when decided. */
+HD__INLINE int decide(const double *const sc[4], const region_t *r, int s, hd__tri_near_t *out,
+                      int fma) {
+    sqd_t f = {.t = 0};
+    double q;
+    feature_sqd(sc[0], sc[1], sc[2], sc[3], r->feature, &f, fma);
+    if (!round_newton(f.N, f.M, &q, fma) && !round_sqrt(f.N, f.M, &q)) return 0;
+    if (!(q * pow2(-s) >= 0x1p-1022)) return 0;
+    out->d = q * pow2(-s);           /* exact: a normal result */
+    out->feature = r->feature;
+    out->exact = 0;
+    for (int i = 0; i < 3; i++) out->point[i] = f.point[i] * pow2(-s);
+    weigh(out, r, f.t);
+    return 1;
+}
+
+static int decide_plain(const double *const sc[4], const region_t *r, int s, hd__tri_near_t *out) {
+    return decide(sc, r, s, out, 0);
+}
+
+#if TRI_FMA_CLONE
+__attribute__((target("fma")))
+static int decide_fma(const double *const sc[4], const region_t *r, int s, hd__tri_near_t *out) {
+    return decide(sc, r, s, out, 1);
+}
+#endif
+
+int hd__tri_nearest_variant(const double p[3], const double a[3], const double b[3],
+                            const double c[3], hd__tri_near_t *out, int fma) {
+    const double *in[4] = {p, a, b, c}, *sc[4];
+    double scaled[4][3];
+    int s = 0, ok, sc_ok = hd__tri_scale(in, scaled, sc, &s);
     region_t r = {HD__TRI_FACE, 0, 0};
-    for (int i = 0; i < 4; i++)
-        for (int k = 0; k < 3; k++)
-            if (!(fabs(in[i][k]) <= 0x1p511)) return HD_ERANGE;
+    if (sc_ok < 0) return HD_ERANGE;
     for (int i = 1; i < 4; i++)
         if (p[0] == in[i][0] && p[1] == in[i][1] && p[2] == in[i][2]) {
             r.feature = (hd__tri_feature_t)(HD__TRI_VERTEX_A + i - 1);
@@ -412,16 +585,19 @@ int hd__tri_nearest(const double p[3], const double a[3], const double b[3],
             weigh(out, &r, 0);
             return HD_OK;
         }
-    if (!scale(in, sc, &s) || !classify(sc[0], sc[1], sc[2], sc[3], &r))
+    if (!sc_ok || !classify(sc[0], sc[1], sc[2], sc[3], &r))
         return hd__tri_nearest_exact(p, a, b, c, out);
-    sqd_t f = {.t = 0};
-    feature_sqd(sc[0], sc[1], sc[2], sc[3], r.feature, &f);
-    if (!round_sqrt(f.N, f.M, &q) || !(q * pow2(-s) >= 0x1p-1022))
-        return hd__tri_nearest_exact(p, a, b, c, out);
-    out->d = q * pow2(-s);           /* exact: a normal result */
-    out->feature = r.feature;
-    out->exact = 0;
-    for (int i = 0; i < 3; i++) out->point[i] = f.point[i] * pow2(-s);
-    weigh(out, &r, f.t);
-    return HD_OK;
+#if TRI_FMA_CLONE
+    ok = fma && __builtin_cpu_supports("fma") ? decide_fma(sc, &r, s, out)
+                                              : decide_plain(sc, &r, s, out);
+#else
+    (void)fma;
+    ok = decide_plain(sc, &r, s, out);
+#endif
+    return ok ? HD_OK : hd__tri_nearest_exact(p, a, b, c, out);
+}
+
+int hd__tri_nearest(const double p[3], const double a[3], const double b[3],
+                    const double c[3], hd__tri_near_t *out) {
+    return hd__tri_nearest_variant(p, a, b, c, out, 1);
 }

@@ -16,6 +16,7 @@
 #include "check.h"
 #include "gen.h"
 #include "mesh/mesh.h"
+#include "mesh/mesh_int.h"
 
 #include <math.h>
 #include <stdint.h>
@@ -253,6 +254,26 @@ TEST(the_fast_path_gives_the_exact_paths_distance) {
     }
 }
 
+TEST(dekkers_product_and_the_fused_multiply_add_give_the_same_bits) {
+    /* On a CPU without fused multiply-add both calls take Dekker's path. */
+    for (int f = 0; f < F_COUNT; f++) {
+        gen_rng_t g;
+        uint64_t seed = 5000 + (uint64_t)f;
+        gen_seed(&g, seed);
+        for (long i = 0; i < 5000 && !hdt_failed(); i++) {
+            tri_case_t t;
+            hd__tri_near_t x, y;
+            make_case(&g, f, &t);
+            CONTEXT("family %s, seed %llu, case %ld", family_name[f], (unsigned long long)seed, i);
+            CHECK_RC(hd__tri_nearest_variant(t.p, t.a, t.b, t.c, &x, 0), HD_OK);
+            CHECK_RC(hd__tri_nearest_variant(t.p, t.a, t.b, t.c, &y, 1), HD_OK);
+            CHECK_BITS(x.d, y.d);
+            CHECK_EQ(x.exact, y.exact);
+            CHECK_EQ(x.feature, y.feature);
+        }
+    }
+}
+
 TEST(every_feature_is_reached_and_sums_its_weights_to_one) {
     gen_rng_t g;
     gen_seed(&g, 7);
@@ -269,4 +290,118 @@ TEST(every_feature_is_reached_and_sums_its_weights_to_one) {
         CONTEXT("feature %d", f);
         CHECK(seen[f] > 100);
     }
+}
+
+/* ---- bounds from plain doubles -------------------------------------------- */
+
+/* lo2 <= t^2 <= hi2 for the true distance t, seen through the correctly
+ * rounded d: t lies within half a gap of d, so sqrt(lo2) (correctly rounded,
+ * monotone) is at most the double above d, and sqrt(hi2) at least the one
+ * below.  (tests/tri_reference.py checks lo2 <= t^2 <= hi2 exactly.) */
+static int bounds_hold(double lo2, double hi2, double d) {
+    return lo2 >= 0 && lo2 <= hi2 && sqrt(lo2) <= nextafter(d, INFINITY) &&
+           sqrt(hi2) >= nextafter(d, 0);
+}
+
+TEST(the_bounds_contain_the_distance_on_every_family) {
+    const long per_family = 20000;
+    for (int f = 0; f < F_COUNT; f++) {
+        gen_rng_t g;
+        uint64_t seed = 2000 + (uint64_t)f;
+        gen_seed(&g, seed);
+        long tight = 0;
+        for (long i = 0; i < per_family && !hdt_failed(); i++) {
+            tri_case_t t;
+            hd__tri_near_t o;
+            double lo2, hi2;
+            make_case(&g, f, &t);
+            CONTEXT("family %s, seed %llu, case %ld", family_name[f], (unsigned long long)seed, i);
+            CHECK_RC(hd__tri_nearest(t.p, t.a, t.b, t.c, &o), HD_OK);
+            hd__tri_bounds(t.p, t.a, t.b, t.c, &lo2, &hi2);
+            CHECK(bounds_hold(lo2, hi2, o.d));
+            tight += hi2 <= lo2 * (1 + 0x1p-40);
+        }
+        printf("  %-22s bounds within 2^-40 relatively: %5.2f %% of %ld\n", family_name[f],
+               100.0 * (double)tight / (double)per_family, per_family);
+    }
+}
+
+TEST(the_bounds_are_tight_off_the_boundaries) {
+    /* Random points and triangles, and points at 1e-3 of the triangle's
+     * size from its face: both bounds within 2^-30 of each other on 97 % or
+     * more (the plain-double errors are u times the size over the distance,
+     * more on the random slivers). */
+    for (int near = 0; near <= 1; near++) {
+        gen_rng_t g;
+        gen_seed(&g, 3000 + (uint64_t)near);
+        long tight = 0, n = 20000;
+        for (long i = 0; i < n; i++) {
+            tri_case_t t;
+            double lo2, hi2;
+            make_case(&g, F_RANDOM, &t);
+            if (near) {
+                double e1[3], e2[3], nv[3], s = gen_unit(&g), r = gen_unit(&g) * (1 - s);
+                for (int k = 0; k < 3; k++) { e1[k] = t.b[k] - t.a[k]; e2[k] = t.c[k] - t.a[k]; }
+                nv[0] = e1[1] * e2[2] - e1[2] * e2[1];
+                nv[1] = e1[2] * e2[0] - e1[0] * e2[2];
+                nv[2] = e1[0] * e2[1] - e1[1] * e2[0];
+                axpy(t.p, t.a, s, e1); axpy(t.p, t.p, r, e2);
+                axpy(t.p, t.p, 1e-3 * (gen_unit(&g) - 0.5), nv);
+            }
+            hd__tri_bounds(t.p, t.a, t.b, t.c, &lo2, &hi2);
+            tight += hi2 <= lo2 * (1 + 0x1p-30);
+        }
+        CONTEXT("%s: %ld of %ld tight", near ? "near the face" : "random", tight, n);
+        CHECK(tight >= n * 97 / 100);
+    }
+}
+
+TEST(a_prepared_triangle_gives_the_same_bounds) {
+    for (int f = 0; f < F_COUNT; f++) {
+        gen_rng_t g;
+        uint64_t seed = 4000 + (uint64_t)f;
+        gen_seed(&g, seed);
+        for (long i = 0; i < 2000 && !hdt_failed(); i++) {
+            tri_case_t t;
+            hd__tri_prep_t tp;
+            double lo2, hi2, plo2, phi2;
+            make_case(&g, f, &t);
+            CONTEXT("family %s, seed %llu, case %ld", family_name[f], (unsigned long long)seed, i);
+            hd__tri_bounds(t.p, t.a, t.b, t.c, &lo2, &hi2);
+            hd__tri_prep(t.a, t.b, t.c, &tp);
+            hd__tri_bounds_prep(t.p, &tp, &plo2, &phi2);
+            CHECK_BITS(plo2, lo2);
+            CHECK_BITS(phi2, hi2);
+        }
+    }
+}
+
+TEST(the_bounds_of_hand_cases) {
+    tri_case_t t;
+    double lo2, hi2;
+    set3(t.a, 0, 0, 0); set3(t.b, 4, 0, 0); set3(t.c, 0, 4, 0);
+    set3(t.p, 1, 1, 3);                            /* above the face: 9 */
+    hd__tri_bounds(t.p, t.a, t.b, t.c, &lo2, &hi2);
+    CHECK(lo2 <= 9 && hi2 >= 9 && hi2 - lo2 < 1e-12);
+    set3(t.p, 2, -3, 4);                           /* beyond AB: 25 */
+    hd__tri_bounds(t.p, t.a, t.b, t.c, &lo2, &hi2);
+    CHECK(lo2 <= 25 && hi2 >= 25 && hi2 - lo2 < 1e-12);
+    set3(t.p, -3, -4, 0);                          /* beyond A: 25, lo2 from the edge lines */
+    hd__tri_bounds(t.p, t.a, t.b, t.c, &lo2, &hi2);
+    CHECK(lo2 <= 25 && hi2 >= 25 && lo2 >= 16 && hi2 - 25 < 1e-12);
+    set3(t.c, 8, 0, 0);                            /* collinear: the segment [0, 8] */
+    set3(t.p, 5, 3, 4);
+    hd__tri_bounds(t.p, t.a, t.b, t.c, &lo2, &hi2);
+    CHECK(lo2 == 0 && hi2 >= 25 && hi2 - 25 < 1e-12);
+    t.c[0] = NAN;                                  /* outside the domain: no information */
+    hd__tri_bounds(t.p, t.a, t.b, t.c, &lo2, &hi2);
+    CHECK(lo2 == 0 && hi2 == INFINITY);
+    set3(t.c, 0x1p400, 0x1p-1070, 0);              /* scaling would not be exact */
+    hd__tri_bounds(t.p, t.a, t.b, t.c, &lo2, &hi2);
+    CHECK(lo2 == 0 && hi2 == INFINITY);
+    set3(t.a, 0, 0, 0x1p300); set3(t.b, 0x1p300, 0, 0x1p300); set3(t.c, 0, 0x1p300, 0x1p300);
+    set3(t.p, 0x1p298, 0x1p298, 0);                /* 2^300 below the face: scaled */
+    hd__tri_bounds(t.p, t.a, t.b, t.c, &lo2, &hi2);
+    CHECK(lo2 <= 0x1p600 && hi2 >= 0x1p600 && hi2 <= 0x1p600 * (1 + 0x1p-40) &&
+          lo2 >= 0x1p600 * (1 - 0x1p-40));
 }
