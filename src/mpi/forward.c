@@ -307,27 +307,33 @@ static int sample_bounds(hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, hd__mpi_shell
         for (size_t k = 0; k < sh->n; k++) exact[k] &= 1;
         return HD_OK;
     }
-    uint32_t *pos = hd__mpi_alloc(c, m, sizeof(uint32_t)), *ks = hd__mpi_alloc(c, m, sizeof(uint32_t));
-    size_t *near = hd__mpi_alloc(c, m, sizeof(size_t));
-    int rc = pos && ks && near ? HD_OK : hd__mpi_nomem(c, "the searches", m);
-    for (size_t k = 0, t = 0; k < sh->n; k++) {
-        if (!(exact[k] & 2)) continue;
-        exact[k] = 0;
-        if (rc == HD_OK) ks[t] = (uint32_t)k, pos[t++] = sh->own_pos ? sh->own_pos[k] : (uint32_t)k;
-    }
-    size_t batch = (d->nP + d->nQ) / 32 > 4096 ? (d->nP + d->nQ) / 32 : 4096;
-    if (rc == HD_OK) rc = hd__mpi_nearest_among(c, qs->xyz, qs->n, d->P, pos, m, batch, near);
-    for (size_t t = 0; t < m && rc == HD_OK; t++) {
-        size_t k = ks[t];
-        offer(d, sh, qs, k, near[t], u2, jj);
-        if (qs->whole) {
-            exact[k] = 1;
-            if (sh->unproven) sh->unproven[k] = 0;
+    /* The marked points in chunks of one batch: their positions, shell
+     * numbers and answers take 16 bytes a point of a chunk, not of the
+     * shell (a shell can be half a rank's points). */
+    size_t batch = (d->nP + d->nQ) / 32 > 4096 ? (d->nP + d->nQ) / 32 : 4096, cap = m < batch ? m : batch;
+    uint32_t *pos = hd__mpi_alloc(c, cap, sizeof(uint32_t)), *ks = hd__mpi_alloc(c, cap, sizeof(uint32_t));
+    size_t *near = hd__mpi_alloc(c, cap, sizeof(size_t));
+    int rc = pos && ks && near ? HD_OK : hd__mpi_nomem(c, "the searches", cap);
+    for (size_t k = 0; k < sh->n;) {
+        size_t t = 0;
+        for (; k < sh->n && t < cap; k++) {
+            if (!(exact[k] & 2)) continue;
+            exact[k] = 0;
+            if (rc == HD_OK) ks[t] = (uint32_t)k, pos[t] = sh->own_pos ? sh->own_pos[k] : (uint32_t)k;
+            t++;
+        }
+        if (rc == HD_OK) rc = hd__mpi_nearest_among(c, qs->xyz, qs->n, d->P, pos, t, batch, near);
+        for (size_t u = 0; u < t && rc == HD_OK; u++) {
+            offer(d, sh, qs, ks[u], near[u], u2, jj);
+            if (qs->whole) {
+                exact[ks[u]] = 1;
+                if (sh->unproven) sh->unproven[ks[u]] = 0;
+            }
         }
     }
-    hd__mpi_free(c, pos, m, sizeof(uint32_t));
-    hd__mpi_free(c, ks, m, sizeof(uint32_t));
-    hd__mpi_free(c, near, m, sizeof(size_t));
+    hd__mpi_free(c, pos, cap, sizeof(uint32_t));
+    hd__mpi_free(c, ks, cap, sizeof(uint32_t));
+    hd__mpi_free(c, near, cap, sizeof(size_t));
     return rc;
 }
 
