@@ -399,6 +399,25 @@ static int resolve(hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, const hd__box_t *mi
     return rc;
 }
 
+/* The best of L and what the shell's points bound h^2 with: each exact
+ * point's (u2, index), and, when held is not NULL, each other point's
+ * lower bound (lower_bound, for a local answer exact over the local Q)
+ * with no index (forward.c's invariants). */
+static hd__mpi_far_t bounds_below(const hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, const hd__mpi_shell_t *sh,
+                                  const hd__mpi_held_t *held, const double *u2, const uint64_t *jj,
+                                  const unsigned char *exact, hd__mpi_far_t L) {
+    hd__mpi_gcur_t cp;
+    hd__mpi_gcur_init(&cp, d->gP);
+    for (size_t k = 0; k < sh->n; k++) {
+        hd__mpi_far_t f = {u2[k], hd__mpi_shell_g(&cp, sh, k), jj[k]};
+        if (!exact[k] && (!held || (sh->unproven && sh->unproven[k]))) continue;
+        if (!exact[k])
+            f = (hd__mpi_far_t){lower_bound(c, held, d->qside, hd__mpi_shell_pt(d, sh, k), u2[k]), UINT64_MAX, UINT64_MAX};
+        if (hd__mpi_far_better(&f, &L)) L = f;
+    }
+    return L;
+}
+
 /* One round of forwarding (collective; rc is the caller's status): every
  * shell point not exact, that may still win over (L, i_L), and, when
  * pick is not NULL, picked (pick[k] = 1), goes to the ranks that may
@@ -507,14 +526,7 @@ int hd__mpi_direction(hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, const hd__mpi_no
      * into L (with the smallest index i_L of a confirmed point at L, none
      * for a lower bound: a point with u2 < L, or u2 = L and a larger
      * index, cannot be the witness); then the sample's upper bounds. */
-    hd__mpi_gcur_init(&cp, d->gP);
-    for (size_t k = 0; k < nP && rc == HD_OK; k++) {
-        const double *p = hd__mpi_shell_pt(d, &sh, k);
-        hd__mpi_far_t f = {u2[k], hd__mpi_shell_g(&cp, &sh, k), jj[k]};
-        if (!exact[k] && !(sh.unproven && sh.unproven[k]))
-            f = (hd__mpi_far_t){lower_bound(c, held, d->qside, p, u2[k]), UINT64_MAX, UINT64_MAX};
-        if ((exact[k] || f.i == UINT64_MAX) && hd__mpi_far_better(&f, &Lmine)) Lmine = f;
-    }
+    if (rc == HD_OK) Lmine = bounds_below(c, d, &sh, held, u2, jj, exact, Lmine);
     if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
     HD__MPI_GO(c, rc, MPI_Allreduce(&Lmine, &Lall, 1, c->far_type, c->far_op, c->comm));
     if ((rc = sample_q(c, rc, d, held, &qs)) != HD_OK) goto done;
@@ -527,13 +539,8 @@ int hd__mpi_direction(hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, const hd__mpi_no
      * and those the whole sample made exact, raise L. */
     cull_pick(d, &sh, u2, exact, Lall.d2, Lall.i, pick);
     if ((rc = forward(c, rc, d, &sh, tree, nbox, held, pick, Lall.d2, Lall.i, list, &an, u2, jj, exact)) != HD_OK) goto done;
-    Lmine = Lall;
-    hd__mpi_gcur_init(&cp, d->gP);
-    for (size_t k = 0; k < nP; k++) {
-        exact[k] |= pick[k] == 2;
-        hd__mpi_far_t f = {u2[k], hd__mpi_shell_g(&cp, &sh, k), jj[k]};
-        if (exact[k] && hd__mpi_far_better(&f, &Lmine)) Lmine = f;
-    }
+    for (size_t k = 0; k < nP; k++) exact[k] |= pick[k] == 2;
+    Lmine = bounds_below(c, d, &sh, NULL, u2, jj, exact, Lall);
     HD__MPI_GO(c, rc, MPI_Allreduce(&Lmine, &Lall, 1, c->far_type, c->far_op, c->comm));
     double L = Lall.d2;
     uint64_t iL = Lall.i;
