@@ -61,6 +61,13 @@
  *    sampling of the same scene, one building demolished and one new.
  *  - copy: B is A with noise of 1 cm on a 1 km scene (a re-registered
  *    scan), same point order.
+ *  - apart, near, tinyb, tinya, change, lattice (issue 41's hard cases:
+ *    scene.h): fixed sizes a side whatever --points and --per-rank say,
+ *    every point made from its global index, so that every K (and K = 1:
+ *    the single process) computes on the same sets; rank r holds A's
+ *    points [N_A r / K, N_A (r + 1) / K) and B's block (r + K/2) mod K,
+ *    rotated as hausdorff-mpi rotates B's shares.  --check makes both sets
+ *    on rank 0 and compares with hd_hausdorff.
  * Layouts: "random" (each rank's points spread over the whole scene: every
  * point may move) or "tiles" (rank r generates the strip r of K in x, as a
  * rank reading its share of tile files does: most points stay).
@@ -236,6 +243,39 @@ static void bench_distances(const char *c, const double *a, const double *b, siz
     for (int s = 0; s < 2; s++) free(d[s]), free(j[s]), free(gd[s]), free(gj[s]);
 }
 
+/* A sized case's share of side s on this rank: its first global index
+ * and count, and its points (malloc'd). */
+static double *sized_share(const char *c, int s, const uint64_t N[2], size_t *offset, size_t *n) {
+    int blk = s ? (rank_ + K_ / 2) % K_ : rank_;
+    uint64_t lo = N[s] * (uint64_t)blk / (uint64_t)K_, hi = N[s] * (uint64_t)(blk + 1) / (uint64_t)K_;
+    double *p = malloc(3 * (size_t)(hi - lo) * sizeof(double) + 8);
+    if (!p) {
+        fprintf(stderr, "mpi_bench: out of memory\n");
+        MPI_Abort(MPI_COMM_WORLD, 1);
+    }
+    for (uint64_t g = lo; g < hi; g++) scene_point(c, s, g, p + 3 * (g - lo));
+    *offset = (size_t)lo, *n = (size_t)(hi - lo);
+    return p;
+}
+
+/* --check of a sized case: rank 0 makes both sets whole and compares. */
+static void sized_check(const char *c, const uint64_t N[2], const hd_symmetric_t *r) {
+    if (rank_ != 0) return;
+    double *all[2];
+    for (int s = 0; s < 2; s++) {
+        all[s] = malloc(3 * (size_t)N[s] * sizeof(double));
+        for (uint64_t g = 0; g < N[s]; g++) scene_point(c, s, g, all[s] + 3 * g);
+    }
+    hd_points_t A = hd_points_f64(all[0], (size_t)N[0]), B = hd_points_f64(all[1], (size_t)N[1]);
+    hd_symmetric_t ref;
+    hd_error_t err;
+    hd_hausdorff(&A, &B, NULL, &ref, &err);
+    int same = ref.distance == r->distance && ref.ab.i == r->ab.i && ref.ab.j == r->ab.j && ref.ba.i == r->ba.i &&
+               ref.ba.j == r->ba.j;
+    printf("#   check: %s (H = %.17g)\n", same ? "identical to hd_hausdorff" : "DIFFERS", r->distance);
+    free(all[0]), free(all[1]);
+}
+
 static double maxrss(void) {
     struct rusage ru;
     return getrusage(RUSAGE_SELF, &ru) == 0 ? 1024.0 * (double)ru.ru_maxrss : 0;
@@ -286,12 +326,23 @@ int main(int argc, char **argv) {
     snprintf(list, sizeof list, "%s", cases);
     for (char *c = strtok(list, ","); c; c = strtok(NULL, ","))
       for (int rep = 0; rep < (repeat > 0 ? repeat : 1); rep++) {
-        scene_make(c, tiles ? rank_ : 0, tiles ? K_ : 1, 7, (uint64_t)rank_, a, b, n);
-        if (dist) {
-            bench_distances(c, a, b, n, offset, threads);
+        uint64_t NS[2];
+        int sized = scene_sized(c, NS);
+        double *sa = NULL, *sb = NULL;
+        size_t oa = offset, ob = offset, na = n, nb = n;
+        if (sized) {
+            sa = sized_share(c, 0, NS, &oa, &na);
+            sb = sized_share(c, 1, NS, &ob, &nb);
+        } else {
+            scene_make(c, tiles ? rank_ : 0, tiles ? K_ : 1, 7, (uint64_t)rank_, a, b, n);
+        }
+        if (dist) { /* the sized cases are for hd_mpi_hausdorff */
+            if (!sized) bench_distances(c, a, b, n, offset, threads);
+            else if (rank_ == 0) printf("# %s: --distances runs on uniform, lidar and copy only\n", c);
+            free(sa), free(sb);
             continue;
         }
-        hd_mpi_part_t pa = {hd_points_f64(a, n), offset}, pb = {hd_points_f64(b, n), offset};
+        hd_mpi_part_t pa = {hd_points_f64(sized ? sa : a, na), oa}, pb = {hd_points_f64(sized ? sb : b, nb), ob};
         hd_options_t opt;
         hd_options_init(&opt);
         opt.threads = threads;
@@ -340,7 +391,8 @@ int main(int argc, char **argv) {
                        all[3 * q], all[3 * q + 1]);
             free(all);
         }
-        if (check) { /* gather everything on rank 0 and compare */
+        if (check && sized) sized_check(c, NS, &r);
+        if (check && !sized) { /* gather everything on rank 0 and compare */
             double *all[2] = {NULL, NULL};
             int cnt = (int)(3 * n), *cnts = malloc((size_t)K_ * sizeof(int)), *disp = malloc((size_t)K_ * sizeof(int));
             MPI_Gather(&cnt, 1, MPI_INT, cnts, 1, MPI_INT, 0, MPI_COMM_WORLD);
@@ -364,6 +416,7 @@ int main(int argc, char **argv) {
             free(disp);
         }
         fflush(stdout);
+        free(sa), free(sb);
     }
     free(a);
     free(b);

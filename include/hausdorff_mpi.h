@@ -106,8 +106,11 @@ typedef struct hd_mpi_stats {
     uint64_t shell_points;      /* points searched one by one, in both
                                    directions (the shells: the others are
                                    settled by the engine's pruned pass) */
-    int rounds;                 /* forwarding rounds (one per direction;
-                                   0 on one rank, where none is needed) */
+    int rounds;                 /* forwarding rounds (two per direction of
+                                   the Hausdorff distance: the likeliest
+                                   points first, then the rest; one per
+                                   direction of hd_mpi_distances; 0 on one
+                                   rank, where none is needed) */
     uint64_t points_max;        /* most points (A and B) a rank computed on */
     double imbalance;           /* points_max over the mean per rank */
     double work_imbalance;      /* the same with forwarded queries answered

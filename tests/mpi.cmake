@@ -14,6 +14,11 @@
 #    and copied points within 5 % with 1024 first samples a rank and with
 #    the fewest (64) that many ranks get, and that count keeps rank 0's
 #    samples bounded.  The same K as mpi_api.
+#  - mpi_shapes_K: tests/api/mpi_shapes.c under `mpirun -n K`: the shapes
+#    of issue 41 (cubes far apart and 2 apart, a tiny side both ways, a
+#    tower in one epoch, a lattice against its half-step shift) give
+#    hd_hausdorff's and hd_directed's answers bit for bit, and at most 2 %
+#    of the points are forwarded.  The same K as mpi_api.
 #  - mpi_gidx: tests/internal/mpi_gidx.c, the encoded global indices of
 #    the local sets (src/mpi/gidx.c) read back by position and by cursor.
 #  - mpi_memory: tests/internal/mpi_memory.c, the call's buffers charged at
@@ -49,6 +54,10 @@ if(HD_MPI)
   target_include_directories(mpi_figures PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/tests/support)
   target_link_libraries(mpi_figures PRIVATE hausdorff_mpi)
   set_target_properties(mpi_figures PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/tests)
+  add_executable(mpi_shapes ${CMAKE_CURRENT_SOURCE_DIR}/tests/api/mpi_shapes.c ${CMAKE_CURRENT_SOURCE_DIR}/tests/support/gen.c)
+  target_include_directories(mpi_shapes PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/tests/support)
+  target_link_libraries(mpi_shapes PRIVATE hausdorff_mpi)
+  set_target_properties(mpi_shapes PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/tests)
   add_executable(mpi_partition ${CMAKE_CURRENT_SOURCE_DIR}/tests/internal/mpi_partition.c ${CMAKE_CURRENT_SOURCE_DIR}/tests/support/gen.c)
   target_include_directories(mpi_partition PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/tests/support ${CMAKE_CURRENT_SOURCE_DIR}/src)
   target_link_libraries(mpi_partition PRIVATE hausdorff_mpi)
@@ -66,6 +75,8 @@ if(HD_MPI)
     set_tests_properties(mpi_api_${k} PROPERTIES TIMEOUT 300 ENVIRONMENT "${HD_MPI_ENV}" PROCESSORS 2)
     add_test(NAME mpi_figures_${k} COMMAND ${HD_MPIRUN} -n ${k} $<TARGET_FILE:mpi_figures>)
     set_tests_properties(mpi_figures_${k} PROPERTIES TIMEOUT 300 ENVIRONMENT "${HD_MPI_ENV}" PROCESSORS 2)
+    add_test(NAME mpi_shapes_${k} COMMAND ${HD_MPIRUN} -n ${k} $<TARGET_FILE:mpi_shapes>)
+    set_tests_properties(mpi_shapes_${k} PROPERTIES TIMEOUT 300 ENVIRONMENT "${HD_MPI_ENV}" PROCESSORS 2)
     add_test(NAME mpi_partition_${k} COMMAND ${HD_MPIRUN} -n ${k} $<TARGET_FILE:mpi_partition>)
     set_tests_properties(mpi_partition_${k} PROPERTIES TIMEOUT 300 ENVIRONMENT "${HD_MPI_ENV}" PROCESSORS 2)
   endforeach()

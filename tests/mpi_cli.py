@@ -93,6 +93,11 @@ def main():
             failures.append(what)
             print("FAIL (K=%d, seed %d): %s" % (k, SEED, what), file=sys.stderr)
 
+    # --version names the library's version and the MPI it runs on, once
+    rc, out, err = ranks(mpirun, k, tool, "--version")
+    check(rc == 0 and out.startswith("hausdorff-mpi ") and "(MPI " in out and out.count("\n") == 1,
+          "--version: exit %d: %r %r" % (rc, out, err))
+
     def same_json(args, keys=SAME_KEYS):
         """The members `keys` equal (None: every member but the times, the
         engine's counters and "mpi"); None if a run failed, else both."""

@@ -297,6 +297,28 @@ static void mpi_json(FILE *out, const hd_mpi_stats_t *st, const hd_mpi_stats_t *
     fputc('}', out);
 }
 
+/* Whether --version comes before --help, -h and "--" (cli_parse takes the
+ * first of them): then rank 0 also says which MPI the tool runs on. */
+static int asks_version(int argc, char **argv) {
+    for (int k = 1; k < argc; k++) {
+        if (!strcmp(argv[k], "--") || !strcmp(argv[k], "--help") || !strcmp(argv[k], "-h")) return 0;
+        if (!strcmp(argv[k], "--version")) return 1;
+    }
+    return 0;
+}
+
+static int print_version(void) {
+    char lib[MPI_MAX_LIBRARY_VERSION_STRING];
+    int len = 0, major = 0, minor = 0;
+    MPI_Get_library_version(lib, &len);
+    MPI_Get_version(&major, &minor);
+    lib[len > 0 && len < MPI_MAX_LIBRARY_VERSION_STRING ? len : 0] = '\0';
+    char *nl = strpbrk(lib, "\r\n,");
+    if (nl) *nl = '\0'; /* the library's first line, name and version */
+    if (rank_ == 0) printf("hausdorff-mpi %s (MPI %d.%d: %s)\n", hd_version(), major, minor, lib);
+    return finish(EXIT_OK);
+}
+
 int main(int argc, char **argv) {
     MPI_Init(&argc, &argv);
     MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
@@ -305,6 +327,7 @@ int main(int argc, char **argv) {
     out_guard_std();
     cli_args_t a;
     cli_set_mpi();
+    if (asks_version(argc, argv)) return print_version();
     int rc = cli_parse(argc, argv, &a); /* the same verdict on every rank */
     if (rc >= 0) return finish(rc == EXIT_OK ? out_finish() : rc);
     hd_error_t err;

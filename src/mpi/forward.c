@@ -21,8 +21,28 @@
  *    it are a superset of those it needs, and u2 below (L, i_L) still
  *    means it cannot win.  After the round its answer is proven by the
  *    slab's test, or searched again in all of the local Q (resolve).
- *  - One round of forwarding a direction: every bound is final before
- *    anything is sent.  Every collective is preceded by hd__mpi_agree.
+ *  - Bounds before forwarding.  Every rank holds the same sample of Q
+ *    (sample_q: at most SAMPLE_TOTAL points, each rank's share in
+ *    proportion to its points, in global index order; all of Q when Q
+ *    has no more).  A shell point not yet exact takes the nearest sample
+ *    point (d2, global index) when it is smaller (d2 first, then the
+ *    index): a point of Q, so still an upper bound u2 of its nearest
+ *    distance, and the ranks within it are those its exact answer needs;
+ *    when the sample is all of Q it is the exact global answer (the
+ *    smallest position on ties is the smallest index) and the point is
+ *    exact.  Each shell point whose local answer is exact over the local
+ *    Q (not unproven; infinite when Q is empty here) also has a lower
+ *    bound lb = min(local u2, hd__box_lb2 of every other rank's box of Q):
+ *    a computed lower bound of its global nearest, so h(P,Q)^2 >= lb.
+ *    The largest lb enters L as (lb, UINT64_MAX), an index no point
+ *    has: a point whose u2 < L cannot be the witness, and one at u2 = L
+ *    still can (loses() never drops it), so ties are kept.
+ *  - Two rounds of forwarding a direction: first the CULL_FIRST points of
+ *    each rank with the largest u2 that may win; their exact answers
+ *    raise L (as exact points, with their indices), then every other
+ *    point that may still win goes in the second round.  Every bound is
+ *    final before its round's points are sent.  Every collective is
+ *    preceded by hd__mpi_agree.
  */
 #include "mpi/search.h"
 
@@ -158,6 +178,178 @@ static int answer(hd__mpi_ctx_t *c, void *arg, const double *pts, size_t m, hd__
     return rc;
 }
 
+/* The sample of Q every rank holds: at most this many points over all ranks. */
+#define SAMPLE_TOTAL 4096
+/* Points of each rank forwarded in the first round (the culling). */
+#define CULL_FIRST 16
+
+typedef struct {
+    double *xyz;             /* n points, packed, in global index order */
+    uint64_t *g;             /* their global indices */
+    size_t n;
+    int whole;               /* the sample is all of Q */
+} qsample_t;
+
+static void qsample_free(hd__mpi_ctx_t *c, qsample_t *qs) {
+    hd__mpi_free(c, qs->xyz, qs->n, 3 * sizeof(double));
+    hd__mpi_free(c, qs->g, qs->n, sizeof(uint64_t));
+    memset(qs, 0, sizeof *qs);
+}
+
+static int by_g(const void *x, const void *y) {
+    const hd__mpi_sample_t *a = x, *b = y;
+    return (a->g > b->g) - (a->g < b->g);
+}
+
+/* Each rank's share of the sample: all its points when Q has at most
+ * SAMPLE_TOTAL, else n_r SAMPLE_TOTAL / N_Q of them (every rank computes
+ * every share from held[]). */
+static size_t sample_share(const hd__mpi_held_t *held, int r, int side, uint64_t NQ) {
+    uint64_t n = held[r].n[side];
+    return NQ <= SAMPLE_TOTAL ? (size_t)n : (size_t)(n * SAMPLE_TOTAL / NQ);
+}
+
+/* The sample of Q (collective; rc is the caller's status, agreed first):
+ * rank r's share evenly spaced over its local Q, all-gathered and sorted
+ * by global index. */
+static int sample_q(hd__mpi_ctx_t *c, int rc, const hd__mpi_dir_t *d, const hd__mpi_held_t *held, qsample_t *qs) {
+    int K = c->K;
+    uint64_t NQ = 0;
+    memset(qs, 0, sizeof *qs);
+    for (int r = 0; r < K; r++) NQ += held[r].n[d->qside];
+    size_t total = 0, mine = sample_share(held, c->rank, d->qside, NQ);
+    for (int r = 0; r < K; r++) total += sample_share(held, r, d->qside, NQ);
+    int *cnt = hd__mpi_alloc(c, 2 * (size_t)K, sizeof(int));
+    hd__mpi_sample_t *own = hd__mpi_alloc(c, mine ? mine : 1, sizeof *own), *all = hd__mpi_alloc(c, total ? total : 1, sizeof *all);
+    if (rc == HD_OK && (!cnt || !own || !all)) rc = hd__mpi_nomem(c, "the sample of the other set", total);
+    if (rc == HD_OK) {
+        qs->n = total;
+        qs->whole = NQ <= SAMPLE_TOTAL;
+        qs->xyz = hd__mpi_alloc(c, total, 3 * sizeof(double));
+        qs->g = hd__mpi_alloc(c, total, sizeof(uint64_t));
+        if (total && (!qs->xyz || !qs->g)) rc = hd__mpi_nomem(c, "the sample of the other set", total);
+    }
+    if (rc == HD_OK) {
+        int t = 0;
+        for (int r = 0; r < K; r++) cnt[r] = (int)sample_share(held, r, d->qside, NQ), cnt[K + r] = t, t += cnt[r];
+        for (size_t k = 0; k < mine; k++) {
+            size_t j = (size_t)((uint64_t)k * d->nQ / mine);
+            memcpy(own[k].x, d->Q + 3 * j, sizeof own[k].x);
+            own[k].g = hd__mpi_gidx(d->gQ, j);
+            own[k].side = (uint64_t)d->qside;
+        }
+    }
+    if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
+    HD__MPI_GO(c, rc, MPI_Allgatherv(own, (int)mine, c->sample_type, all, cnt, cnt + K, c->sample_type, c->comm));
+    qsort(all, total, sizeof *all, by_g);
+    for (size_t k = 0; k < total; k++) memcpy(qs->xyz + 3 * k, all[k].x, sizeof all[k].x), qs->g[k] = all[k].g;
+done:
+    hd__mpi_free(c, cnt, 2 * (size_t)K, sizeof(int));
+    hd__mpi_free(c, own, mine ? mine : 1, sizeof *own);
+    hd__mpi_free(c, all, total ? total : 1, sizeof *all);
+    return rc;
+}
+
+/* Takes sample point j as point k's answer when smaller (d2 first, then
+ * the index); returns its d2. */
+static double offer(const hd__mpi_dir_t *d, const hd__mpi_shell_t *sh, const qsample_t *qs, size_t k, size_t j, double *u2,
+                    uint64_t *jj) {
+    double d2 = hd__d2(hd__mpi_shell_pt(d, sh, k), qs->xyz + 3 * j);
+    if (d2 < u2[k] || (d2 == u2[k] && qs->g[j] < jj[k])) u2[k] = d2, jj[k] = qs->g[j];
+    return d2;
+}
+
+/* The sample point nearest to the centre of the shell's box (a first
+ * guess for every point of it). */
+static size_t central(const hd__mpi_dir_t *d, const hd__mpi_shell_t *sh, const qsample_t *qs) {
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY}, m[3];
+    for (size_t k = 0; k < sh->n; k++)
+        for (int a = 0; a < 3; a++) {
+            double x = hd__mpi_shell_pt(d, sh, k)[a];
+            lo[a] = x < lo[a] ? x : lo[a], hi[a] = x > hi[a] ? x : hi[a];
+        }
+    for (int a = 0; a < 3; a++) m[a] = 0.5 * lo[a] + 0.5 * hi[a];
+    size_t best = 0;
+    double b2 = INFINITY;
+    for (size_t j = 0; j < qs->n; j++) {
+        double d2 = hd__d2(m, qs->xyz + 3 * j);
+        if (d2 < b2) b2 = d2, best = j;
+    }
+    return best;
+}
+
+/* The shell's points not yet exact take the sample's nearest point when
+ * it is smaller (forward.c's invariants); with the whole of Q sampled
+ * they become exact.  The paper's early break first: a point to which a
+ * sample point is nearer than L (the central one, or the last one that
+ * was) cannot be the witness, and takes that point, which keeps it below
+ * L, without a search. */
+static int sample_bounds(hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, hd__mpi_shell_t *sh, const qsample_t *qs, double L,
+                         double *u2, uint64_t *jj, unsigned char *exact) {
+    size_t m = 0;
+    if (qs->n == 0) return HD_OK;
+    size_t guess[2] = {central(d, sh, qs), 0};
+    guess[1] = guess[0];
+    for (size_t k = 0; k < sh->n; k++) {
+        if (exact[k]) continue;
+        if (!qs->whole) {
+            int t = 0;
+            while (t < 2 && !(offer(d, sh, qs, k, guess[t], u2, jj) < L)) t++;
+            if (t < 2) {
+                guess[1] = guess[t];
+                continue;
+            }
+        }
+        exact[k] |= 2; /* searched below (a mark, cleared there) */
+        m++;
+    }
+    if (m == 0 || m > HD__AN_MAX_POINTS) {
+        for (size_t k = 0; k < sh->n; k++) exact[k] &= 1;
+        return HD_OK;
+    }
+    /* The marked points in chunks of one batch: their positions, shell
+     * numbers and answers take 16 bytes a point of a chunk, not of the
+     * shell (a shell can be half a rank's points). */
+    size_t batch = (d->nP + d->nQ) / 32 > 4096 ? (d->nP + d->nQ) / 32 : 4096, cap = m < batch ? m : batch;
+    uint32_t *pos = hd__mpi_alloc(c, cap, sizeof(uint32_t)), *ks = hd__mpi_alloc(c, cap, sizeof(uint32_t));
+    size_t *near = hd__mpi_alloc(c, cap, sizeof(size_t));
+    int rc = pos && ks && near ? HD_OK : hd__mpi_nomem(c, "the searches", cap);
+    for (size_t k = 0; k < sh->n;) {
+        size_t t = 0;
+        for (; k < sh->n && t < cap; k++) {
+            if (!(exact[k] & 2)) continue;
+            exact[k] = 0;
+            if (rc == HD_OK) ks[t] = (uint32_t)k, pos[t] = sh->own_pos ? sh->own_pos[k] : (uint32_t)k;
+            t++;
+        }
+        if (rc == HD_OK) rc = hd__mpi_nearest_among(c, qs->xyz, qs->n, d->P, pos, t, batch, near);
+        for (size_t u = 0; u < t && rc == HD_OK; u++) {
+            offer(d, sh, qs, ks[u], near[u], u2, jj);
+            if (qs->whole) {
+                exact[ks[u]] = 1;
+                if (sh->unproven) sh->unproven[ks[u]] = 0;
+            }
+        }
+    }
+    hd__mpi_free(c, pos, cap, sizeof(uint32_t));
+    hd__mpi_free(c, ks, cap, sizeof(uint32_t));
+    hd__mpi_free(c, near, cap, sizeof(size_t));
+    return rc;
+}
+
+/* A lower bound of the shell's point p's global nearest distance (its
+ * local answer exact over the local Q: u2, infinite when Q is empty
+ * here): the smaller of u2 and every other rank's box of Q. */
+static double lower_bound(const hd__mpi_ctx_t *c, const hd__mpi_held_t *held, int side, const double *p, double u2) {
+    double lb = u2;
+    for (int r = 0; r < c->K; r++) {
+        if (r == c->rank || held[r].n[side] == 0) continue;
+        double b = hd__box_lb2(&held[r].box[side], p);
+        lb = b < lb ? b : lb;
+    }
+    return lb;
+}
+
 /* Whether the shell's point k, at u2, is below (L, i_L) in the witness
  * order, so that it cannot be the witness (cu: a cursor on P's indices,
  * asked in increasing k). */
@@ -207,13 +399,81 @@ static int resolve(hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, const hd__box_t *mi
     return rc;
 }
 
+/* The best of L and what the shell's points bound h^2 with: each exact
+ * point's (u2, index), and, when held is not NULL, each other point's
+ * lower bound (lower_bound, for a local answer exact over the local Q)
+ * with no index (forward.c's invariants). */
+static hd__mpi_far_t bounds_below(const hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, const hd__mpi_shell_t *sh,
+                                  const hd__mpi_held_t *held, const double *u2, const uint64_t *jj,
+                                  const unsigned char *exact, hd__mpi_far_t L) {
+    hd__mpi_gcur_t cp;
+    hd__mpi_gcur_init(&cp, d->gP);
+    for (size_t k = 0; k < sh->n; k++) {
+        hd__mpi_far_t f = {u2[k], hd__mpi_shell_g(&cp, sh, k), jj[k]};
+        if (!exact[k] && (!held || (sh->unproven && sh->unproven[k]))) continue;
+        if (!exact[k])
+            f = (hd__mpi_far_t){lower_bound(c, held, d->qside, hd__mpi_shell_pt(d, sh, k), u2[k]), UINT64_MAX, UINT64_MAX};
+        if (hd__mpi_far_better(&f, &L)) L = f;
+    }
+    return L;
+}
+
+/* One round of forwarding (collective; rc is the caller's status): every
+ * shell point not exact, that may still win over (L, i_L), and, when
+ * pick is not NULL, picked (pick[k] = 1), goes to the ranks that may
+ * hold a point as near (ties included); one that none may is exact.  A
+ * picked point forwarded is marked pick[k] = 2: it is exact after the
+ * round (pick never holds an unproven point). */
+static int forward(hd__mpi_ctx_t *c, int rc, const hd__mpi_dir_t *d, const hd__mpi_shell_t *sh, const hd__mpi_node_t *tree,
+                   const hd__box_t *nbox, const hd__mpi_held_t *held, unsigned char *pick, double L, uint64_t iL,
+                   int *list, answer_t *an, double *u2, uint64_t *jj, unsigned char *exact) {
+    hd__mpi_pairs_t pr = {NULL, 0, 0};
+    hd__mpi_gcur_t cp;
+    hd__mpi_gcur_init(&cp, d->gP);
+    for (size_t k = 0; k < sh->n && rc == HD_OK; k++) {
+        if (exact[k] || (pick && !pick[k]) || loses(&cp, sh, k, u2[k], L, iL)) continue;
+        int n = hd__mpi_asked(tree, nbox, held, c->K, d->qside, d->nQ == 0, hd__mpi_shell_pt(d, sh, k), u2[k],
+                              c->rank, list);
+        if (n == 0) {
+            exact[k] = !(sh->unproven && sh->unproven[k]); /* no other rank holds a point as near */
+            continue;
+        }
+        c->forwarded_points++;
+        if (pick) pick[k] = 2;
+        rc = hd__mpi_pairs_add(c, &pr, k, list, n);
+    }
+    rc = hd__mpi_round(c, rc, d->P, sh->own_pos, &pr, answer, an, u2, jj);
+    hd__mpi_pairs_free(c, &pr);
+    return rc;
+}
+
+/* Picks (pick[k] = 1) the CULL_FIRST shell points with the largest u2
+ * that are not exact, not unproven and may still win over (L, i_L). */
+static void cull_pick(const hd__mpi_dir_t *d, const hd__mpi_shell_t *sh, const double *u2, const unsigned char *exact,
+                      double L, uint64_t iL, unsigned char *pick) {
+    size_t top[CULL_FIRST], nt = 0;
+    hd__mpi_gcur_t cp;
+    hd__mpi_gcur_init(&cp, d->gP);
+    memset(pick, 0, sh->n);
+    for (size_t k = 0; k < sh->n; k++) {
+        if (exact[k] || (sh->unproven && sh->unproven[k]) || loses(&cp, sh, k, u2[k], L, iL)) continue;
+        if (nt == CULL_FIRST && !(u2[k] > u2[top[nt - 1]])) continue;
+        size_t t = nt < CULL_FIRST ? nt++ : nt - 1; /* insertion, largest first */
+        for (; t > 0 && u2[top[t - 1]] < u2[k]; t--) top[t] = top[t - 1];
+        top[t] = k;
+    }
+    for (size_t t = 0; t < nt; t++) pick[top[t]] = 1;
+}
+
 int hd__mpi_direction(hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, const hd__mpi_node_t *tree, const hd__box_t *region,
                      const hd__mpi_held_t *held, hd__mpi_far_t *result) {
     int K = c->K, rc = HD_OK;
     const hd__box_t *mine = &region[c->rank];
     hd__mpi_shell_t sh;
     hd__mpi_qtree_t q;
+    qsample_t qs;
     memset(&q, 0, sizeof q);
+    memset(&qs, 0, sizeof qs);
     double t0 = hd__now(), u0 = hd__mpi_cpu();
     rc = hd__mpi_shell_of(c, d, mine, &q, &sh);
     c->search += hd__now() - t0;
@@ -222,15 +482,13 @@ int hd__mpi_direction(hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, const hd__mpi_no
     size_t nP = sh.n;
     double *u2 = hd__mpi_alloc(c, nP, sizeof(double));
     uint64_t *jj = hd__mpi_alloc(c, nP, sizeof(uint64_t));
-    unsigned char *exact = hd__mpi_alloc(c, nP, 1);
+    unsigned char *exact = hd__mpi_alloc(c, nP, 1), *pick = hd__mpi_alloc(c, nP, 1);
     hd__box_t *nbox = hd__mpi_alloc(c, K > 1 ? (size_t)K - 1 : 1, sizeof(hd__box_t));
     int *list = hd__mpi_alloc(c, (size_t)K, sizeof(int));
-    hd__mpi_pairs_t pr = {NULL, 0, 0};
-    if (rc == HD_OK && (!u2 || !jj || !exact || !nbox || !list)) rc = hd__mpi_nomem(c, "per-point bounds", nP);
+    if (rc == HD_OK && (!u2 || !jj || !exact || !pick || !nbox || !list)) rc = hd__mpi_nomem(c, "per-point bounds", nP);
     hd__mpi_far_t Lmine = sh.inner, Lall;
     hd__mpi_gcur_t cp, cq; /* P's indices (the shell's, in order) and Q's */
     if (rc == HD_OK) {
-        hd__mpi_gcur_init(&cp, d->gP);
         hd__mpi_gcur_init(&cq, d->gQ);
         for (size_t k = 0; k < nP; k++) {
             const double *p = hd__mpi_shell_pt(d, &sh, k);
@@ -244,8 +502,6 @@ int hd__mpi_direction(hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, const hd__mpi_no
             jj[k] = hd__mpi_gcur_at(&cq, sh.nearest[k]);
             /* an answer the first slab did not prove is not exact yet (resolve) */
             exact[k] = (unsigned char)(!(sh.unproven && sh.unproven[k]) && hd__mpi_faces_clear(mine, p, u2[k]));
-            hd__mpi_far_t f = {u2[k], hd__mpi_shell_g(&cp, &sh, k), jj[k]};
-            if (exact[k] && hd__mpi_far_better(&f, &Lmine)) Lmine = f;
         }
         if (K > 1) hd__mpi_node_boxes(tree, 0, held, d->qside, nbox);
     }
@@ -256,36 +512,40 @@ int hd__mpi_direction(hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, const hd__mpi_no
         hd__mpi_free(c, u2, nP, sizeof(double));                                 \
         hd__mpi_free(c, jj, nP, sizeof(uint64_t));                               \
         hd__mpi_free(c, exact, nP, 1);                                           \
+        hd__mpi_free(c, pick, nP, 1);                                            \
         hd__mpi_free(c, nbox, K > 1 ? (size_t)K - 1 : 1, sizeof(hd__box_t));     \
         hd__mpi_free(c, list, (size_t)K, sizeof(int));                           \
-        hd__mpi_pairs_free(c, &pr);                                              \
-        u2 = NULL, jj = NULL, exact = NULL, nbox = NULL, list = NULL;            \
+        u2 = NULL, jj = NULL, exact = NULL, pick = NULL, nbox = NULL, list = NULL; \
         hd__mpi_free(c, sh.nearest, sh.n, sizeof(size_t));                       \
         hd__mpi_free(c, sh.unproven, sh.n, 1);                                   \
         sh.nearest = NULL, sh.unproven = NULL;                                   \
         hd__mpi_qtree_free(c, &q);                                               \
+        qsample_free(c, &qs);                                                    \
     } while (0)
+    /* Bounds before forwarding: the exact points and every lower bound
+     * into L (with the smallest index i_L of a confirmed point at L, none
+     * for a lower bound: a point with u2 < L, or u2 = L and a larger
+     * index, cannot be the witness); then the sample's upper bounds. */
+    if (rc == HD_OK) Lmine = bounds_below(c, d, &sh, held, u2, jj, exact, Lmine);
     if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
-    /* L and the smallest index i_L of a confirmed point at L: a point
-     * with u2 < L, or u2 = L and a larger index, cannot be the witness. */
+    HD__MPI_GO(c, rc, MPI_Allreduce(&Lmine, &Lall, 1, c->far_type, c->far_op, c->comm));
+    if ((rc = sample_q(c, rc, d, held, &qs)) != HD_OK) goto done;
+    t0 = hd__now(), u0 = hd__mpi_cpu();
+    rc = sample_bounds(c, d, &sh, &qs, Lall.d2, u2, jj, exact);
+    c->search += hd__now() - t0;
+    c->search_cpu += hd__mpi_cpu() - u0;
+    answer_t an = {d, mine, &q};
+    /* The first round: the few likeliest to win; their exact answers,
+     * and those the whole sample made exact, raise L. */
+    cull_pick(d, &sh, u2, exact, Lall.d2, Lall.i, pick);
+    if ((rc = forward(c, rc, d, &sh, tree, nbox, held, pick, Lall.d2, Lall.i, list, &an, u2, jj, exact)) != HD_OK) goto done;
+    for (size_t k = 0; k < nP; k++) exact[k] |= pick[k] == 2;
+    Lmine = bounds_below(c, d, &sh, NULL, u2, jj, exact, Lall);
     HD__MPI_GO(c, rc, MPI_Allreduce(&Lmine, &Lall, 1, c->far_type, c->far_op, c->comm));
     double L = Lall.d2;
     uint64_t iL = Lall.i;
-    /* The points to forward, as (point, rank) pairs. */
-    hd__mpi_gcur_init(&cp, d->gP);
-    for (size_t k = 0; k < nP && rc == HD_OK; k++) {
-        if (exact[k] || loses(&cp, &sh, k, u2[k], L, iL)) continue;
-        int n = hd__mpi_asked(tree, nbox, held, K, d->qside, d->nQ == 0, hd__mpi_shell_pt(d, &sh, k), u2[k],
-                                c->rank, list);
-        if (n == 0) {
-            exact[k] = !(sh.unproven && sh.unproven[k]); /* no other rank holds a point as near */
-            continue;
-        }
-        c->forwarded_points++;
-        rc = hd__mpi_pairs_add(c, &pr, k, list, n);
-    }
-    answer_t an = {d, mine, &q};
-    if ((rc = hd__mpi_round(c, rc, d->P, sh.own_pos, &pr, answer, &an, u2, jj)) != HD_OK) goto done;
+    /* The second round: every other point that may still win. */
+    if ((rc = forward(c, rc, d, &sh, tree, nbox, held, NULL, L, iL, list, &an, u2, jj, exact)) != HD_OK) goto done;
     /* local: a failure goes on to the agreement below, as the interior's */
     if (nP && d->nQ) rc = resolve(c, d, mine, &q, &sh, u2, jj, L, iL);
     /* Every point that could win is now exact; the others cannot win (a

@@ -102,7 +102,15 @@
  *     ties.  L, the largest confirmed u^2 over all ranks with the smallest
  *     index i_L of a confirmed point at L (one allreduce), bounds h(A,B)^2
  *     from below: a point with u(a)^2 < L, or u(a)^2 = L and an index above
- *     i_L, cannot be the witness and is never forwarded.  (Skipping every
+ *     i_L, cannot be the witness and is never forwarded.  Every other
+ *     point adds its own lower bound to L before anything travels: the
+ *     smaller of its local u(a)^2 and hd__box_lb2 to every other rank's
+ *     box of B (a computed lower bound of its global nearest distance, so
+ *     of h^2), entered with no index, so that a point at exactly L is
+ *     kept.  Then a sample of B that every rank holds (forward.c) lowers
+ *     u(a) to an upper bound from all of B; a point with a sample point
+ *     nearer than L is settled as a loser, and when the sample is all of
+ *     B (a tiny side) it is the exact answer.  (Skipping every
  *     u(a)^2 <= L would lose ties: a point at exactly L with a smaller
  *     index is the witness, and its smallest-index nearest point may lie on
  *     another rank; tests/api/mpi_api.c's checkerboard fails that way.)
@@ -116,8 +124,10 @@
  *     the nonempty boxes (hd__box_ub2: at least the distance to every point
  *     inside), so it asks only the candidate ranks.  The asked ranks answer
  *     with their exact nearest (squared distance, smallest global index),
- *     and the asker keeps the smaller pair: the exact global answer.  One
- *     round: the bound is final before anything is sent.
+ *     and the asker keeps the smaller pair: the exact global answer.  Two
+ *     rounds: first the few points a rank with the largest upper bounds,
+ *     whose exact answers raise L, then every point still able to win;
+ *     each round's bounds are final before it is sent.
  *  6. Each rank's farthest exact point (largest d2, smallest index on ties)
  *     is max-reduced; then the ranks of step 3 whose engine answer beats
  *     that add their interior's maximum, and it is reduced again.  The

@@ -87,6 +87,13 @@ void hd__mpi_an_release(hd__mpi_ctx_t *c, hd__an_t *s, size_t bytes);
  * first slab's margin, q->M0) or to ask again without `unproven`. */
 int hd__mpi_nearest_in_q(hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, const hd__box_t *r, hd__mpi_qtree_t *q, const double *pts,
                          const uint32_t *pos, size_t n, size_t *near, unsigned char *unproven);
+/* For each of n points, point k at pts + 3 pos[k] (pos NULL: pts + 3 k;
+ * pos increasing), its nearest of the m points S (packed xyz) into
+ * near[k]: exact, the smallest position on ties (SIZE_MAX when m = 0);
+ * the askers go in batches of at most `batch`.  n and m at most
+ * HD__AN_MAX_POINTS. */
+int hd__mpi_nearest_among(hd__mpi_ctx_t *c, const double *S, size_t m, const double *pts, const uint32_t *pos, size_t n,
+                          size_t batch, size_t *near);
 /* Whether every point of Q farther than M from all of r's finite faces is
  * farther from x than sqrt(d2) (slab.c's proof). */
 int hd__mpi_slab_proves(const hd__box_t *r, double M, const double *x, double d2);

@@ -300,6 +300,24 @@ static void scan_q(const hd__mpi_dir_t *d, const double *pts, const uint32_t *po
     pass_over_q(d, pts, pos, NULL, n, best, near);
 }
 
+int hd__mpi_nearest_among(hd__mpi_ctx_t *c, const double *S, size_t m, const double *pts, const uint32_t *pos, size_t n,
+                          size_t batch, size_t *near) {
+    if (n == 0) return HD_OK;
+    hd__mpi_dir_t d;
+    memset(&d, 0, sizeof d);
+    d.Q = (double *)S; /* only read */
+    d.nQ = m;
+    hd__mpi_slab_t sl;
+    uint32_t *list = hd__mpi_alloc(c, n, sizeof(uint32_t));
+    if (!list) return hd__mpi_nomem(c, "the searches", n);
+    for (size_t k = 0; k < n; k++) list[k] = (uint32_t)k;
+    int rc = slab_build(c, &d, NULL, INFINITY, &sl); /* an infinite margin: all of S, no region read */
+    if (rc == HD_OK) rc = slab_search(c, &sl, pts, pos, list, n, batch, near);
+    slab_free(c, &sl);
+    hd__mpi_free(c, list, n, sizeof(uint32_t));
+    return rc;
+}
+
 int hd__mpi_nearest_in_q(hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, const hd__box_t *r, hd__mpi_qtree_t *q, const double *pts,
                          const uint32_t *pos, size_t n, size_t *near, unsigned char *unproven) {
     if (n == 0) return HD_OK;

@@ -318,7 +318,7 @@ static void check_equal(int which, int how, uint64_t seed) {
     CHECK(got.ba.i == ref.ba.i && got.ba.j == ref.ba.j);
     CHECK(SAME_BITS(got.alpha, ref.alpha));
     CHECK(got.disjoint == ref.disjoint);
-    CHECK(st.points == s.na + s.nb && st.ranks == K_ && st.rounds == (K_ > 1 ? 2 : 0));
+    CHECK(st.points == s.na + s.nb && st.ranks == K_ && st.rounds == (K_ > 1 ? 4 : 0));
     if (got.ab.i != ref.ab.i || got.ab.j != ref.ab.j || got.ba.i != ref.ba.i || got.ba.j != ref.ba.j ||
         !SAME_BITS(got.distance, ref.distance))
         fprintf(stderr, "rank %d: got ab %.17g (%zu,%zu) ba %.17g (%zu,%zu); expected ab %.17g (%zu,%zu) ba "
