@@ -79,8 +79,9 @@ ensure_root() {
     debootstrap --variant=minbase "$SUITE" "$CACHE/root.new" "$MIRROR"
     root_complete "$CACHE/root.new" || { echo "fresh-check: debootstrap left an incomplete root" >&2; exit 1; }
     mv "$CACHE/root.new" "$CACHE/root"
+    echo "=== fresh-check: debootstrap: ok ($(( $(now) - t )) s)"
     summary="$summary
-  debootstrap (pristine root, cached)  $(( $(now) - t )) s"
+  $(printf '%-36s %5d s' "debootstrap (cached for next runs)" "$(( $(now) - t ))")"
   fi
   flock -u 9
 }
@@ -158,14 +159,14 @@ step() {  # NAME COMMAND
 # opening comment, written to FILE.
 header_program() {  # HEADER FILE
   awk '/^ \*     /{p=1; sub(/^ \*     /, ""); print; next} p && /^ \*$/{print ""; next} p{exit}' \
-    "$work/root/hausdorff/$1" > "$work/root/hausdorff/$2"
-  [ -s "$work/root/hausdorff/$2" ] || { echo "fresh-check: no program in $1's opening comment" >&2; exit 1; }
+    "$work/root/root/hausdorff/$1" > "$work/root/root/hausdorff/$2"
+  [ -s "$work/root/root/hausdorff/$2" ] || { echo "fresh-check: no program in $1's opening comment" >&2; exit 1; }
 }
 
 # The text between backquotes that follows WORDS in a header's opening
 # comment (joined into one line first), e.g. "Build with".
 header_says() {  # HEADER WORDS
-  awk '/^ \*\//{exit} {sub(/^ \* ?/, ""); printf "%s ", $0}' "$work/root/hausdorff/$1" |
+  awk '/^ \*\//{exit} {sub(/^ \* ?/, ""); printf "%s ", $0}' "$work/root/root/hausdorff/$1" |
     sed -n "s/.*$2 \`\([^\`]*\)\`.*/\1/p"
 }
 
