@@ -116,7 +116,12 @@ prepare_run_root() {
   say "copying the pristine root into $work/root"
   cp -a "$CACHE/root" "$work/root"
   r=$work/root
+  # What an installed machine has and debootstrap leaves out: the name
+  # server, and /etc/hosts as Debian's installer writes it (without it every
+  # lookup of the host's name, as mpirun makes, waits for the name server).
   cp /etc/resolv.conf "$r/etc/resolv.conf"
+  [ -e "$r/etc/hosts" ] || printf '127.0.0.1\tlocalhost\n127.0.1.1\t%s\n::1\tlocalhost ip6-localhost ip6-loopback\n' \
+    "$(uname -n)" > "$r/etc/hosts"
   mount_in proc "$r/proc" -t proc
   mount_in sysfs "$r/sys" -t sysfs -o ro
   mount_in /dev "$r/dev" --bind
