@@ -19,30 +19,44 @@ all: $(BUILD)/hausdorff
 deps:
 	@scripts/deps.sh build extras mpi
 
-$(BUILD)/CMakeCache.txt:
+# A finished configure: CMake writes CMakeCache.txt even when configuring
+# fails, so the proof is a stamp written after it succeeded.  A failed try
+# leaves no stamp, and the next `make` configures again (over the same cache,
+# whose failed searches CMake repeats).
+CONFIGURED = $(BUILD)/.hd-configured
+$(CONFIGURED):
 	@scripts/deps.sh build extras mpi
 	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release $(CMAKE_ARGS)
+	@touch $@
 
-$(BUILD)/hausdorff: $(BUILD)/CMakeCache.txt FORCE
+$(BUILD)/hausdorff: $(CONFIGURED) FORCE
 	cmake --build $(BUILD) -j$(JOBS)
 
 FORCE:
 
 # The command-line tool alone (`make` builds everything: tests, benchmarks,
 # the Python module).
-cli: $(BUILD)/CMakeCache.txt
+cli: $(CONFIGURED)
 	cmake --build $(BUILD) -j$(JOBS) --target hausdorff_cli
 
 # The main job: the exact Hausdorff distance between two bundled models.
 run: cli
-	./$(BUILD)/hausdorff data/cgal_lion.ply data/cgal_lion_head.ply
-	./$(BUILD)/hausdorff data/wuson_obj.ply data/wuson_stl.ply
+	$(BUILD)/hausdorff data/cgal_lion.ply data/cgal_lion_head.ply
+	$(BUILD)/hausdorff data/wuson_obj.ply data/wuson_stl.ply
 
-test: test-release test-asan
+# Both halves run, whatever the first gives; each is reported, and the
+# status is non-zero when either failed.
+test:
+	@release=passed; asan=passed; \
+	$(MAKE) test-release || release=FAILED; \
+	$(MAKE) test-asan || asan=FAILED; \
+	echo "make test: release build $$release ($(BUILD)), sanitizer build $$asan ($(ASAN_BUILD))"; \
+	[ $$release = passed ] && [ $$asan = passed ]
 
 test-release:
 	@scripts/deps.sh build extras test python mpi
 	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release $(CMAKE_ARGS)
+	@touch $(CONFIGURED)
 	cmake --build $(BUILD) -j$(JOBS)
 	cd $(BUILD) && ctest --output-on-failure -j$(JOBS)
 
@@ -52,13 +66,13 @@ test-asan:
 	cmake --build $(ASAN_BUILD) -j$(JOBS)
 	cd $(ASAN_BUILD) && ASAN_OPTIONS=detect_leaks=1 ctest --output-on-failure -j$(JOBS)
 
-# Installs the library, header, tool, man page, pkg-config file and CMake
-# package (PREFIX=/some/where for another prefix than the configured one,
+# Installs the libraries, headers, tools, man page, pkg-config files and CMake
+# package, the MPI library and hausdorff-mpi among them when MPI was found (PREFIX=/some/where for another prefix than the configured one,
 # /usr/local by default; DESTDIR=/stage to stage).  Into /usr or /usr/local as
 # root it runs ldconfig, so that programs find libhausdorff.so.0; otherwise it
 # says what to set.  Builds only what it installs.
-install: $(BUILD)/CMakeCache.txt
-	cmake --build $(BUILD) -j$(JOBS) --target hausdorff hausdorff_static hausdorff_cli
+install: $(CONFIGURED)
+	cmake --build $(BUILD) -j$(JOBS) --target hd_installed
 	cmake --install $(BUILD) $(if $(PREFIX),--prefix $(PREFIX))
 	@prefix='$(PREFIX)'; cache='$(BUILD)/CMakeCache.txt'; \
 	[ -n "$$prefix" ] || prefix=$$(sed -n 's/^CMAKE_INSTALL_PREFIX:[A-Z]*=//p' "$$cache"); \
@@ -81,6 +95,7 @@ install: $(BUILD)/CMakeCache.txt
 python:
 	@scripts/deps.sh build extras python
 	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release $(CMAKE_ARGS)
+	@touch $(CONFIGURED)
 	cmake --build $(BUILD) -j$(JOBS) --target hausdorff_python
 
 # The threaded tests under ThreadSanitizer (clang's: gcc 12's fails to start

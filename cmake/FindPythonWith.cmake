@@ -17,3 +17,17 @@ function(hd_find_python out probe)
   endforeach()
   set(${out} "${found}" PARENT_SCOPE)
 endfunction()
+
+# hd_python3_test(NAME ARG...) -- a test that runs `python3 ARG...` (any
+# python3: the standard library only).  Without python3 the configure still
+# succeeds (`make run` needs none) and the test fails, saying what to
+# install: it is never skipped (`make test` installs python3).
+function(hd_python3_test name)
+  find_program(HD_PYTHON3 NAMES python3)
+  if(HD_PYTHON3)
+    add_test(NAME ${name} COMMAND ${HD_PYTHON3} ${ARGN})
+  else()
+    add_test(NAME ${name} COMMAND sh -c
+             "echo '${name}: needs python3 (Debian: python3; scripts/deps.sh test installs it)' >&2; exit 1")
+  endif()
+endfunction()

@@ -11,7 +11,7 @@
  * (hd_mpi_distances).  docs/scale-out.md explains the algorithm and its
  * costs.
  *
- * A first program (run with `mpirun -n 4 ./prog`):
+ * A first program:
  *
  *     #include <hausdorff_mpi.h>
  *     #include <stdio.h>
@@ -39,8 +39,15 @@
  *         return rc != HD_OK;
  *     }
  *
- * Build with `mpicc prog.c -lhausdorff_mpi -lhausdorff -lm -lpthread`, or in
- * CMake with the targets hausdorff_mpi and MPI::MPI_C.
+ * Build with `mpicc -o prog prog.c -lhausdorff_mpi -lhausdorff` (installed
+ * elsewhere than /usr/local or /usr: `mpicc -o prog prog.c $(pkg-config
+ * --cflags --libs hausdorff_mpi)`), or in CMake with
+ * `find_package(hausdorff COMPONENTS mpi)` and
+ * `target_link_libraries(app hausdorff::hausdorff_mpi)`
+ * (hausdorff::hausdorff_mpi_static for the static libraries), and run with
+ * `mpirun -n 4 ./prog`: it prints H = 1.1180339887498949, A[1] to B[0].  As
+ * root Open MPI also wants --allow-run-as-root, and on fewer cores than
+ * ranks --oversubscribe (or a hostfile that gives the slots).
  *
  * Conventions: those of hausdorff.h (result codes, hd_error_t, ownership,
  * exactness, the tie rule), and for MPI:

@@ -16,9 +16,10 @@ for group in "$@"; do
     build)  add gcc make cmake pkg-config libc6-dev ;;
     extras) add libpng-dev libnifti2-dev zlib1g-dev ;;
     # python3-nibabel: tests/cli_nifti_reference.py writes MONAI's and medpy's test masks with it.
-    # nodejs and npm: tests/laz_lazperf.py installs laz-perf (npm) to check
-    # the tests' LAZ files with an independent decoder.
-    test)   add python3 locales python3-nibabel nodejs npm ;;
+    # Not nodejs and npm: the laz-perf cross-check that needs them and the
+    # npm registry is an extra that `make test` runs only where they are
+    # (tests/laz_lazperf.cmake); nothing in it needs a registry but Debian's.
+    test)   add python3 locales python3-nibabel ;;
     # python3-venv and python3-wheel: README's `pip install --no-build-isolation
     # ./python` in a venv (tests/python_venv.sh).
     python) add python3 python3-dev python3-numpy python3-setuptools python3-pytest python3-scipy \
@@ -34,13 +35,6 @@ for group in "$@"; do
 done
 missing=""
 for p in $pkgs; do
-  # node and npm may come from elsewhere than Debian (NodeSource's nodejs
-  # bundles npm and conflicts with Debian's npm package): a command on the
-  # PATH is enough.
-  case "$p" in
-    nodejs) command -v node >/dev/null 2>&1 && continue ;;
-    npm)    command -v npm >/dev/null 2>&1 && continue ;;
-  esac
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"
 done
 [ -z "$missing" ] && exit 0

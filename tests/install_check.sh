@@ -4,14 +4,25 @@
 #   install_check.sh prefix BUILD SOURCE   cmake --install into a temporary
 #       prefix; a C program built with pkg-config and one with CMake's
 #       find_package(hausdorff), each run and its answer checked; the
-#       .pc and the CMake package must name that prefix.
+#       .pc and the CMake package must name that prefix.  With MPICC and
+#       MPIRUN set (the MPI library was built), hausdorff_mpi.h's first
+#       program, taken from the installed header, built with the header's
+#       link line, with pkg-config (hausdorff_mpi.pc), statically and with
+#       find_package(hausdorff COMPONENTS mpi), each run under
+#       `mpirun -n 4` as the header says and its answer checked.
 #   install_check.sh make BUILD SOURCE     `make install PREFIX=...` writes a
 #       .pc for that prefix and says what to set; no "Entering directory"
 #       lines; `make run` builds the command-line tool only.
 #   install_check.sh deps SOURCE           scripts/deps.sh's message for a
 #       non-root user: each package once, no sudo, --no-install-recommends.
+#   install_check.sh makefile SOURCE       the Makefile's own rules, with
+#       cmake and ctest replaced by stand-ins that fail on demand: a failed
+#       configure is tried again by the next `make run`; `make test` runs
+#       the sanitizer half after a failed release half, reports both and
+#       fails when either failed.
 #
-# CC, CMAKE, PKG_CONFIG and MAKE may name the tools.
+# CC, CMAKE, PKG_CONFIG and MAKE may name the tools; MPICC and MPIRUN the
+# MPI compiler wrapper and launcher.
 set -eu
 what=$1; shift
 CC=${CC:-cc}; CMAKE=${CMAKE:-cmake}; PKG_CONFIG=${PKG_CONFIG:-pkg-config}; MAKE=${MAKE:-make}
@@ -51,6 +62,81 @@ check_loads() {  # PROGRAM LIBDIR (with LD_LIBRARY_PATH as set by the caller)
   so=$(ldd "$1" | sed -n 's/^[[:space:]]*libhausdorff\.so[^ ]* => \([^ ]*\).*/\1/p')
   [ -n "$so" ] || fail "$1 does not link libhausdorff.so: $(ldd "$1")"
   case "$so" in "$2"/*) ;; *) fail "$1 loads $so, not the one in $2" ;; esac
+}
+
+# hausdorff_mpi.h's first program: its opening comment's first block
+# indented by five spaces.  On 4 ranks, A's points (r,0,0), (r,1,0) and B's
+# (r,0,0.5) for r = 0..3: H = sqrt(1.25), from A[1] (rank 0's (0,1,0)) to
+# B[0].
+write_mpi_prog() {  # HEADER FILE
+  awk '/^ \*     /{p=1; sub(/^ \*     /, ""); print; next} p && /^ \*$/{print ""; next} p{exit}' "$1" > "$2"
+  grep -q hd_mpi_hausdorff "$2" || fail "no program in $1's opening comment"
+}
+mpi_expect="H = 1.1180339887498949, A[1] to B[0]"
+run_mpi() {  # NAME PROGRAM (with LD_LIBRARY_PATH as set by the caller)
+  # As the header says (mpirun -n 4); as root and on fewer than 4 cores
+  # Open MPI also wants these two flags.
+  out=$("$MPIRUN" --allow-run-as-root --oversubscribe -n 4 "$2") || fail "$1: mpirun -n 4 $2 failed: $out"
+  [ "$out" = "$mpi_expect" ] || fail "$1 printed '$out', expected '$mpi_expect'"
+  echo "ok: $1 on 4 ranks: $out"
+}
+check_mpi() {  # PREFIX LIBDIR
+  prefix=$1 libdir=$2
+  so="$libdir/libhausdorff_mpi.so"
+  [ -e "$so" ] && [ -e "$libdir/libhausdorff_mpi.a" ] || fail "libhausdorff_mpi.so and .a not both installed in $libdir"
+  # The shared library exports the header's calls only: the core it holds
+  # stays private, and the program's hd_* calls go to libhausdorff.so.
+  extra=$(nm -D --defined-only "$so" | awk '{print $3}' | grep -v '^hd_mpi_' | grep -v '^$' || true)
+  [ -z "$extra" ] || fail "libhausdorff_mpi.so exports more than hd_mpi_*: $extra"
+  nm -D --defined-only "$so" | grep -q ' hd_mpi_hausdorff$' || fail "libhausdorff_mpi.so does not export hd_mpi_hausdorff"
+  echo "ok: libhausdorff_mpi.so exports hd_mpi_* only"
+  write_mpi_prog "$prefix/include/hausdorff_mpi.h" "$tmp/prog_mpi.c"
+
+  # The header's link line, with the prefix's folders named (installed into
+  # /usr/local or /usr they are searched already).
+  link=$(awk '/^ \*\//{exit} {sub(/^ \* ?/, ""); printf "%s ", $0}' "$prefix/include/hausdorff_mpi.h" |
+    sed -n 's/.*Build with `mpicc -o prog prog\.c \([^`]*\)`.*/\1/p')
+  [ "$link" = "-lhausdorff_mpi -lhausdorff" ] || fail "hausdorff_mpi.h's link line is '$link'"
+  # shellcheck disable=SC2086
+  "$MPICC" -o "$tmp/prog_mpi_l" "$tmp/prog_mpi.c" -I"$prefix/include" -L"$libdir" $link \
+    || fail "mpicc prog.c $link (-I$prefix/include -L$libdir)"
+  LD_LIBRARY_PATH="$libdir" run_mpi "header's link line (mpicc prog.c $link)" "$tmp/prog_mpi_l"
+
+  export PKG_CONFIG_PATH="$libdir/pkgconfig"
+  [ "$("$PKG_CONFIG" --variable=prefix hausdorff_mpi)" = "$prefix" ] || fail "hausdorff_mpi.pc does not name $prefix"
+  flags=$("$PKG_CONFIG" --cflags --libs hausdorff_mpi)
+  # shellcheck disable=SC2086
+  "$MPICC" -o "$tmp/prog_mpi_pc" "$tmp/prog_mpi.c" $flags || fail "mpicc prog.c \$(pkg-config --cflags --libs hausdorff_mpi)"
+  unset PKG_CONFIG_PATH
+  so=$(LD_LIBRARY_PATH="$libdir" ldd "$tmp/prog_mpi_pc" | sed -n 's/^[[:space:]]*libhausdorff_mpi\.so[^ ]* => \([^ ]*\).*/\1/p')
+  case "$so" in "$libdir"/*) ;; *) fail "the pkg-config MPI program loads '$so', not $libdir's libhausdorff_mpi.so" ;; esac
+  LD_LIBRARY_PATH="$libdir" run_mpi "pkg-config MPI program ($flags)" "$tmp/prog_mpi_pc"
+
+  # Static: the MPI library before the core, which holds the internal names.
+  "$MPICC" -o "$tmp/prog_mpi_static" "$tmp/prog_mpi.c" -I"$prefix/include" \
+    "$libdir/libhausdorff_mpi.a" "$libdir/libhausdorff.a" -lm -pthread || fail "static MPI link"
+  run_mpi "static MPI program" "$tmp/prog_mpi_static"
+
+  mkdir "$tmp/cmake_mpi"
+  cp "$tmp/prog_mpi.c" "$tmp/cmake_mpi/prog.c"
+  cat > "$tmp/cmake_mpi/CMakeLists.txt" <<'CM'
+cmake_minimum_required(VERSION 3.16)
+project(consumer_mpi C)
+find_package(hausdorff 0.1 REQUIRED COMPONENTS mpi)
+add_executable(prog_shared prog.c)
+target_link_libraries(prog_shared PRIVATE hausdorff::hausdorff_mpi)
+add_executable(prog_static prog.c)
+target_link_libraries(prog_static PRIVATE hausdorff::hausdorff_mpi_static)
+CM
+  "$CMAKE" -S "$tmp/cmake_mpi" -B "$tmp/cmake_mpi/build" -DCMAKE_PREFIX_PATH="$prefix" \
+    -DCMAKE_C_COMPILER="$CC" -DCMAKE_BUILD_TYPE=Release > "$tmp/cmake_mpi.log" 2>&1 \
+    || { cat "$tmp/cmake_mpi.log"; fail "find_package(hausdorff COMPONENTS mpi) with CMAKE_PREFIX_PATH=$prefix"; }
+  "$CMAKE" --build "$tmp/cmake_mpi/build" > "$tmp/cmake_mpi_build.log" 2>&1 \
+    || { cat "$tmp/cmake_mpi_build.log"; fail "building against hausdorff::hausdorff_mpi"; }
+  run_mpi "find_package program (hausdorff::hausdorff_mpi)" "$tmp/cmake_mpi/build/prog_shared"
+  run_mpi "find_package program (hausdorff::hausdorff_mpi_static)" "$tmp/cmake_mpi/build/prog_static"
+  "$prefix/bin/hausdorff-mpi" --version > /dev/null || fail "$prefix/bin/hausdorff-mpi --version"
+  echo "ok: $prefix/bin/hausdorff-mpi runs"
 }
 
 case "$what" in
@@ -113,6 +199,7 @@ CM
   # The installed tool runs.
   "$prefix/bin/hausdorff" --version > /dev/null || fail "$prefix/bin/hausdorff --version"
   echo "ok: $prefix/bin/hausdorff runs"
+  [ -n "${MPICC:-}" ] && check_mpi "$prefix" "$libdir"
   ;;
 
 make)
@@ -168,6 +255,58 @@ deps)
     done
   done
   echo "ok: deps.sh names each package once, without sudo, with --no-install-recommends"
+  ;;
+makefile)
+  source=$1
+  unset MAKEFLAGS MAKELEVEL MFLAGS MAKEOVERRIDES || true
+  cd "$source"
+  mkdir "$tmp/bin"
+  # Every package installed: deps.sh installs nothing.
+  printf '#!/bin/sh\necho "install ok installed"\n' > "$tmp/bin/dpkg-query"
+  # cmake and ctest log their calls and fail when the call (with ctest's
+  # folder) matches the pattern in $tmp/fail.  A configure writes
+  # CMakeCache.txt first, as CMake does even when configuring fails; a
+  # build writes a hausdorff that does nothing.
+  cat > "$tmp/bin/cmake" <<EOF
+#!/bin/sh
+echo "cmake \$*" >> "$tmp/log"
+[ "\$1" = -S ] && mkdir -p "\$4" && touch "\$4/CMakeCache.txt"
+[ "\$1" = --build ] && printf '#!/bin/sh\\n' > "\$2/hausdorff" && chmod +x "\$2/hausdorff"
+pat=\$(cat "$tmp/fail"); case "cmake \$*" in \$pat) exit 1 ;; esac; exit 0
+EOF
+  cat > "$tmp/bin/ctest" <<EOF
+#!/bin/sh
+echo "ctest in \$PWD" >> "$tmp/log"
+pat=\$(cat "$tmp/fail"); case "ctest in \$PWD" in \$pat) exit 1 ;; esac; exit 0
+EOF
+  chmod +x "$tmp/bin/dpkg-query" "$tmp/bin/cmake" "$tmp/bin/ctest"
+  mk() { PATH="$tmp/bin:$PATH" "$MAKE" BUILD="$tmp/rel" ASAN_BUILD="$tmp/asan" "$@" > "$tmp/out" 2>&1; }
+  configures() { grep -c "^cmake -S . -B $tmp/rel " "$tmp/log" || true; }
+
+  # A configure that fails leaves CMakeCache.txt; the next try configures again.
+  : > "$tmp/log"; echo "cmake -S*" > "$tmp/fail"
+  mk run && { cat "$tmp/out"; fail "make run passed with a failing configure"; }
+  [ "$(configures)" = 1 ] || { cat "$tmp/log"; fail "make run did not configure"; }
+  echo "no match" > "$tmp/fail"
+  mk run || { cat "$tmp/out"; fail "make run failed once the configure passes"; }
+  [ "$(configures)" = 2 ] || { cat "$tmp/log"; fail "after a failed configure, make run did not configure again"; }
+  grep -q "^cmake --build $tmp/rel .*--target hausdorff_cli" "$tmp/log" || { cat "$tmp/log"; fail "make run built nothing"; }
+  mk run || fail "make run, a third time"
+  [ "$(configures)" = 2 ] || { cat "$tmp/log"; fail "make run configures again after a finished configure"; }
+  echo "ok: a failed configure is tried again by the next make run, a finished one is not"
+
+  # make test: both halves whatever the first gives, both reported.
+  for case in "$tmp/rel:FAILED:passed:1" "$tmp/asan:passed:FAILED:1" "none:passed:passed:0"; do
+    failing=${case%%:*}; rest=${case#*:}; rel=${rest%%:*}; rest=${rest#*:}; asan=${rest%%:*}; want=${rest#*:}
+    : > "$tmp/log"; echo "ctest in $failing" > "$tmp/fail"
+    rc=0; mk test || rc=$?
+    [ $(( rc != 0 )) = "$want" ] || { cat "$tmp/out"; fail "make test exited $rc with $failing's tests failing"; }
+    grep -q "^ctest in $tmp/rel\$" "$tmp/log" && grep -q "^ctest in $tmp/asan\$" "$tmp/log" \
+      || { cat "$tmp/log"; fail "make test did not run both halves with $failing's tests failing"; }
+    grep -q "release build $rel .*sanitizer build $asan" "$tmp/out" \
+      || { cat "$tmp/out"; fail "make test did not report release $rel, sanitizers $asan"; }
+    echo "ok: make test with $failing's tests failing: both halves ran, release $rel, sanitizers $asan, exit $rc"
+  done
   ;;
 *) fail "unknown check $what" ;;
 esac

@@ -4,10 +4,7 @@
 # header only; from this build's objects (nm), no folder uses a symbol of a
 # higher one or declares one, and no folder's files use each other in a
 # cycle.  tests/layers_check.py also shows the check failing on trees that
-# break the rules (compiled with this build's C compiler).  python3 is
-# required (make test installs it), so a missing interpreter fails the
-# configure, not the rule.
-find_program(HD_LAYERS_PYTHON NAMES python3 REQUIRED)
-add_test(NAME layers COMMAND ${HD_LAYERS_PYTHON} ${CMAKE_CURRENT_SOURCE_DIR}/tests/layers_check.py
-         ${CMAKE_BINARY_DIR})
+# break the rules (compiled with this build's C compiler).  Without python3
+# the test fails (make test installs it), never skips (hd_python3_test).
+hd_python3_test(layers ${CMAKE_CURRENT_SOURCE_DIR}/tests/layers_check.py ${CMAKE_BINARY_DIR})
 set_tests_properties(layers PROPERTIES TIMEOUT 120 ENVIRONMENT "CC=${CMAKE_C_COMPILER}")

@@ -101,8 +101,7 @@ if(HD_MPI)
   target_link_libraries(mpi_nearest PRIVATE hausdorff_mpi)
   set_target_properties(mpi_nearest PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/tests)
   add_test(NAME mpi_nearest COMMAND mpi_nearest)
-  find_program(HD_MPI_PYTHON NAMES python3 REQUIRED)
-  add_test(NAME mpi_cli_3 COMMAND ${HD_MPI_PYTHON} ${CMAKE_CURRENT_SOURCE_DIR}/tests/mpi_cli.py
-           $<TARGET_FILE:hausdorff_cli> $<TARGET_FILE:hausdorff_mpi_cli> 3 ${HD_MPIRUN})
+  hd_python3_test(mpi_cli_3 ${CMAKE_CURRENT_SOURCE_DIR}/tests/mpi_cli.py
+                  $<TARGET_FILE:hausdorff_cli> $<TARGET_FILE:hausdorff_mpi_cli> 3 ${HD_MPIRUN})
   set_tests_properties(mpi_cli_3 PROPERTIES TIMEOUT 300 ENVIRONMENT "${HD_MPI_ENV}" PROCESSORS 2)
 endif()
