@@ -129,13 +129,6 @@ fail:
     return HD_ENOMEM;
 }
 
-void hd__intcoder_init(hd__intcoder_t *ic) {
-    for (uint32_t i = 0; i < ic->contexts; i++) ic->mbits[i].ready = 0;
-    hd__bitmodel_init(&ic->corr0);
-    for (uint32_t i = 1; i <= ic->corr_bits; i++) ic->corr[i].ready = 0;
-    ic->k = 0;
-}
-
 void hd__intcoder_free(hd__intcoder_t *ic) {
     if (ic->mbits)
         for (uint32_t i = 0; i < ic->contexts; i++) hd__symmodel_free(&ic->mbits[i]);

@@ -175,7 +175,6 @@ typedef struct hd__intcoder {
 
 /* bits: 1 to 32 (LAZ uses 8, 16, 32); HD_OK or HD_ENOMEM. */
 int hd__intcoder_new(hd__intcoder_t *ic, uint32_t bits, uint32_t contexts);
-void hd__intcoder_init(hd__intcoder_t *ic);
 void hd__intcoder_free(hd__intcoder_t *ic);
 
 /* The model m, initialised at its first use. */
