@@ -50,7 +50,7 @@ void analysis_args_init(analysis_args_t *an) {
     an->mask_points = MASK_SURFACE;
     an->connectivity = 1;
     an->mask_dims = 0;
-    an->empty = EMPTY_ERROR;
+    an->empty = HD_EMPTY_ERROR;
 }
 
 void analysis_usage(FILE *out) {
@@ -244,11 +244,9 @@ int analysis_parse_option(int argc, char **argv, int *k, analysis_args_t *an) {
         else return usage_error("--mask-points is surface or all, not '%s'", v);
         break;
     case OPT_EMPTY:
-        if (strcmp(v, "inf") == 0) an->empty = EMPTY_INF;
-        else if (strcmp(v, "nan") == 0) an->empty = EMPTY_NAN;
-        else if (strcmp(v, "zero") == 0) an->empty = EMPTY_ZERO;
-        else if (strcmp(v, "monai") == 0) an->empty = EMPTY_MONAI;
-        else return usage_error("--empty is inf, nan, zero or monai, not '%s'", v);
+        if (hd_empty_policy_from_name(v, &an->empty) != HD_OK || an->empty < HD_EMPTY_INF ||
+            an->empty > HD_EMPTY_MONAI)
+            return usage_error("--empty is inf, nan, zero or monai, not '%s'", v);
         break;
     case OPT_CONNECTIVITY:
         if (strcmp(v, "1") && strcmp(v, "2") && strcmp(v, "3"))
@@ -305,15 +303,6 @@ static int alloc_fail(hd_error_t *err, size_t n) {
 }
 
 
-static const char *policy_name(empty_policy_t p) {
-    return p == EMPTY_INF ? "inf" : p == EMPTY_NAN ? "nan" : p == EMPTY_ZERO ? "zero" : p == EMPTY_MONAI ? "monai" : "error";
-}
-
-/* The value every figure takes when A (n_a points) or B (n_b) is empty. */
-static double policy_value(empty_policy_t p, size_t n_a, size_t n_b) {
-    if (p == EMPTY_MONAI) return n_a || n_b ? INFINITY : NAN; /* MONAI: inf for one, NaN for both */
-    return p == EMPTY_INF ? INFINITY : p == EMPTY_NAN ? NAN : 0.0;
-}
 
 typedef struct {
     const char *key;
@@ -442,16 +431,12 @@ static int empty_scores(const analysis_args_t *an, size_t n_a, size_t n_b, int d
     return rc;
 }
 
-double analysis_empty_value(const analysis_args_t *an, size_t n_a, size_t n_b) {
-    return policy_value(an->empty, n_a, n_b);
-}
-
 int analysis_handle_empty(const analysis_args_t *an, const char *path_a,
                           const char *path_b, const hd_points_t *A,
                           const hd_points_t *B, int directed, int json) {
     size_t n_a = A->count, n_b = B->count;
     if (n_a && n_b) return -1;
-    double v = policy_value(an->empty, n_a, n_b);
+    double v = hd_empty_value(an->empty, n_a, n_b);
     FILE *out = stdout;
     hd_error_t err;
     if (an->distances_out && write_empty_files(an, A, B, directed, v, &err) != HD_OK) {
@@ -471,7 +456,7 @@ int analysis_handle_empty(const analysis_args_t *an, const char *path_a,
         fprintf(out, ", \"witness_ab\": null, \"witness_ba\": null, \"witness_ab_files\": null, "
                      "\"witness_ba_files\": null");
         fprintf(out, ", \"empty\": {\"a\": %s, \"b\": %s, \"policy\": \"%s\"}", n_a ? "false" : "true",
-                n_b ? "false" : "true", policy_name(an->empty));
+                n_b ? "false" : "true", hd_empty_policy_name(an->empty));
         fprintf(out, ", \"n_a\": %zu, \"n_b\": %zu, \"file_a\": ", n_a, n_b);
         json_string(out, path_a);
         fprintf(out, ", \"file_b\": ");
@@ -488,7 +473,7 @@ int analysis_handle_empty(const analysis_args_t *an, const char *path_a,
         char t[NUM_TEXT], pt[NUM_TEXT];
         num_text(v, t);
         fprintf(out, "%s = %s   (%s empty; --empty %s)\n", directed ? "h(A,B)" : "Hausdorff distance H(A,B)", t,
-                which, policy_name(an->empty));
+                which, hd_empty_policy_name(an->empty));
         if (an->percentile_on) fprintf(out, "percentile %s: %s\n", num_text(an->percentile, pt), t);
         if (an->mean) fprintf(out, "mean distance: %s\n", t);
         if (an->chamfer) fprintf(out, "Chamfer distance: %s\n", t);

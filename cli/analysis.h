@@ -11,9 +11,6 @@
 #include <stdint.h>
 #include <stdio.h>
 
-/* --empty: an error, or every figure inf, NaN or 0; MONAI's convention is
- * inf when one set is empty and NaN when both are. */
-typedef enum { EMPTY_ERROR = 0, EMPTY_INF, EMPTY_NAN, EMPTY_ZERO, EMPTY_MONAI } empty_policy_t;
 typedef enum { MASK_SURFACE = 0, MASK_ALL } mask_points_t;
 
 /* What a mask file turned into (filled by cli_read_points). */
@@ -46,7 +43,7 @@ typedef struct analysis_args {
     int connectivity;          /* --connectivity 1|2|3 (default 1: faces) */
     int mask_dims;             /* --mask-dims: 0 auto, 2 slice by slice, 3 */
     const char *units;         /* --units TEXT, or NULL */
-    empty_policy_t empty;
+    hd_empty_policy_t empty;   /* --empty: error (default), inf, nan, zero, monai */
     mask_info_t mask[2];       /* for A and B */
     size_t n_taus;             /* --tau T[,T...]: scores at these tolerances */
     double taus[ANALYSIS_MAX_TAUS];
@@ -139,8 +136,6 @@ typedef struct analysis_result {
 const char *analysis_units(const analysis_args_t *an);
 /* Does anything need the per-point distances? */
 int analysis_active(const analysis_args_t *an);
-/* The --empty policy's value for sides of n_a and n_b points (one 0). */
-double analysis_empty_value(const analysis_args_t *an, size_t n_a, size_t n_b);
 /* When A or B is empty: report the --empty policy's values (or the error)
  * and return the exit code; -1 when both sets have points. */
 int analysis_handle_empty(const analysis_args_t *an, const char *path_a,

@@ -666,7 +666,7 @@ int cli_read_points(const char *path, const hd_read_options_t *ro,
         rc = hd_read_file(path, ro, out, err);
     }
     if (rc != HD_EEMPTY) return rc;
-    if (an->empty == EMPTY_ERROR) {
+    if (an->empty == HD_EMPTY_ERROR) {
         size_t len = strlen(err->message);
         snprintf(err->message + len, sizeof err->message - len,
                  " (an empty set has no distance; --empty inf|nan|zero|monai reports one)");

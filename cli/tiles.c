@@ -461,7 +461,7 @@ int tiles_read(tiles_t *s, size_t first, size_t n, const hd_read_options_t *ro, 
     *out = NULL;
     if (first > s->n || n > s->n - first) return fail(err, HD_EINVAL, 0, "%s: tiles out of range", s->arg);
     if (n == 0) { /* no tiles: a share of none, or an empty side */
-        if (s->n == 0 && an->empty == EMPTY_ERROR) {
+        if (s->n == 0 && an->empty == HD_EMPTY_ERROR) {
             char skipped[512];
             tiles_skipped_text(s, skipped, sizeof skipped);
             return fail(err, HD_EEMPTY, 0,

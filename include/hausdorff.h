@@ -466,6 +466,36 @@ typedef struct hd_summary {
 HD_EXTERN int hd_summarize(const double *d_ab, size_t n_a, const double *d_ba,
                            size_t n_b, hd_summary_t *out, hd_error_t *err);
 
+/* What the distance figures are when A or B is empty (no point): by
+ * default an error (HD_EEMPTY), else one value for every figure, because
+ * tools disagree: MONAI returns inf or NaN, medpy raises, scikit-image's
+ * hausdorff_distance returns inf or 0, some pipelines count a miss as 0.
+ * The library's computations refuse an empty set whatever the policy; the
+ * tools and the Python module apply it with hd_empty_value. */
+typedef enum hd_empty_policy {
+    HD_EMPTY_ERROR = 0, /* "error": an empty set is an error (the default) */
+    HD_EMPTY_INF,       /* "inf": every figure +inf */
+    HD_EMPTY_NAN,       /* "nan": every figure NaN */
+    HD_EMPTY_ZERO,      /* "zero": every figure 0 */
+    HD_EMPTY_MONAI,     /* "monai": inf when one set is empty, NaN when both are */
+    HD_EMPTY_SKIMAGE    /* "skimage": inf when one set is empty, 0 when both are */
+} hd_empty_policy_t;
+
+/* The value of every distance figure under `policy` for sets of n_a and n_b
+ * points, one of them (or both) 0.  NaN for HD_EMPTY_ERROR, which has no
+ * value (the caller reports HD_EEMPTY), and for an unknown policy.  Pure,
+ * thread-safe. */
+HD_EXTERN double hd_empty_value(hd_empty_policy_t policy, size_t n_a,
+                                size_t n_b);
+/* The policy's name as above ("error", "inf", ..., "skimage"); NULL for a
+ * value that is not a policy, so that a caller can list them all by
+ * counting up from 0.  Static storage; thread-safe. */
+HD_EXTERN const char *hd_empty_policy_name(hd_empty_policy_t policy);
+/* The policy of a name (exact, case-sensitive).  Errors: HD_EINVAL (an
+ * unknown name or NULL; *out unchanged).  Thread-safe. */
+HD_EXTERN int hd_empty_policy_from_name(const char *name,
+                                        hd_empty_policy_t *out);
+
 /* numpy.histogram(values, bins, range=(lo, hi)) to the count: bins equal
  * bins on [lo, hi] (widened to [lo - 0.5, hi + 0.5] when lo == hi), bin k
  * is [edge k, edge k+1) except the last, which includes hi; values outside

@@ -377,7 +377,7 @@ int main(int argc, char **argv) {
              * gets a file with no rows) */
             int status = EXIT_OK;
             if (a.an.distances_out) {
-                double v = analysis_empty_value(&a.an, (size_t)all[0], (size_t)all[1]);
+                double v = hd_empty_value(a.an.empty, (size_t)all[0], (size_t)all[1]);
                 size_t most = part[0].points.count > part[1].points.count ? part[0].points.count
                                                                           : part[1].points.count;
                 double *d = malloc((most ? most : 1) * sizeof *d);

@@ -107,58 +107,37 @@ static int is_nd(const points_arg_t *p) {
 }
 
 /* ------------------------------------------------------------------------
- * What an empty set gives: every rule lives here (names, values, message).
+ * What an empty set gives: the library's policies (hd_empty_policy_t, their
+ * names and values); the option's parsing and message live here.
  * EMPTY_NONE: the function has no such option (an empty set is an error).
  * ---------------------------------------------------------------------- */
 
-typedef enum {
-    EMPTY_NONE = -1, EMPTY_ERROR, EMPTY_INF, EMPTY_NAN, EMPTY_ZERO, EMPTY_MONAI, EMPTY_SKIMAGE
-} empty_t;
+typedef hd_empty_policy_t empty_t;
+#define EMPTY_NONE ((empty_t)-1)
 
-static const char *const empty_names[] = {"error", "inf", "nan", "zero", "monai", "skimage", NULL};
-
-/* "'a', 'b' or 'c'" of empty_names from index `first` on. */
-static void empty_list(int first, char *buf, size_t size) {
+/* "'a', 'b' or 'c'" of the policies' names from `first` on. */
+static void empty_list(empty_t first, char *buf, size_t size) {
     buf[0] = '\0';
-    for (int k = first; empty_names[k]; k++) {
+    for (int k = (int)first; hd_empty_policy_name((empty_t)k); k++) {
         size_t used = strlen(buf);
-        const char *sep = k == first ? "" : empty_names[k + 1] ? ", " : " or ";
-        snprintf(buf + used, size - used, "%s'%s'", sep, empty_names[k]);
+        const char *sep = k == (int)first ? "" : hd_empty_policy_name((empty_t)(k + 1)) ? ", " : " or ";
+        snprintf(buf + used, size - used, "%s'%s'", sep, hd_empty_policy_name((empty_t)k));
     }
 }
 
 static int parse_empty(const char *name, empty_t *out) {
-    *out = EMPTY_ERROR;
-    if (!name) return 0;
-    for (int k = 0; empty_names[k]; k++)
-        if (strcmp(name, empty_names[k]) == 0) {
-            *out = (empty_t)k;
-            return 0;
-        }
+    *out = HD_EMPTY_ERROR;
+    if (!name || hd_empty_policy_from_name(name, out) == HD_OK) return 0;
     char known[128];
-    empty_list(0, known, sizeof known);
+    empty_list(HD_EMPTY_ERROR, known, sizeof known);
     PyErr_Format(PyExc_ValueError, "empty must be %s, not '%s'", known, name);
     return -1;
 }
 
-/* The value every figure takes when a set is empty: inf, NaN or 0; as
- * MONAI: inf when one set is empty, NaN when both are; as scikit-image's
- * hausdorff_distance: inf when one set is empty, 0 when both are. */
-static double empty_value(empty_t policy, size_t na, size_t nb) {
-    int both = na == 0 && nb == 0;
-    switch (policy) {
-    case EMPTY_INF: return INFINITY;
-    case EMPTY_ZERO: return 0.0;
-    case EMPTY_MONAI: return both ? NAN : INFINITY;
-    case EMPTY_SKIMAGE: return both ? 0.0 : INFINITY;
-    default: return NAN;
-    }
-}
-
-/* The error for an empty set under `empty` (EMPTY_NONE or EMPTY_ERROR). */
+/* The error for an empty set under `empty` (EMPTY_NONE or HD_EMPTY_ERROR). */
 static void empty_error(const char *name, empty_t empty) {
     char known[128] = "";
-    if (empty == EMPTY_ERROR) empty_list(EMPTY_INF, known, sizeof known);
+    if (empty == HD_EMPTY_ERROR) empty_list(HD_EMPTY_INF, known, sizeof known);
     PyErr_Format(PyExc_ValueError, "%s is empty: at least one point is needed%s%s%s", name,
                  *known ? " (empty=" : "", known, *known ? " gives a value instead)" : "");
 }
@@ -270,7 +249,7 @@ static int points_prepare(PyArrayObject *arr, const char *name, empty_t empty,
     int cols = PyArray_NDIM(arr) == 2 ? (int)PyArray_DIM(arr, 1) : 0;
     out->dims = cols;
     if (cols == 0 || PyArray_DIM(arr, 0) == 0) {
-        if (empty == EMPTY_NONE || empty == EMPTY_ERROR) {
+        if (empty == EMPTY_NONE || empty == HD_EMPTY_ERROR) {
             empty_error(name, empty);
             Py_DECREF(arr);
             return -1;
@@ -930,7 +909,7 @@ static PyObject *distance_call(PyObject *args, PyObject *kw, int symmetric) {
     if (!na || !nb) {
         points_release(&a);
         points_release(&b);
-        double v = empty_value(empty, na, nb);
+        double v = hd_empty_value(empty, na, nb);
         return symmetric ? hausdorff_empty(v) : directed_empty(v);
     }
     hd_result_t r;
@@ -1024,7 +1003,7 @@ static PyObject *py_distances(PyObject *self, PyObject *args, PyObject *kw) {
     PyArrayObject *nearest = (PyArrayObject *)PyArray_SimpleNew(1, &n, NPY_INTP);
     PyObject *res = NULL;
     if (dist && nearest && (!a.pts.count || !b.pts.count)) {
-        double v = empty_value(empty, a.pts.count, b.pts.count);
+        double v = hd_empty_value(empty, a.pts.count, b.pts.count);
         for (npy_intp k = 0; k < n; k++) {
             ((double *)PyArray_DATA(dist))[k] = v;
             ((npy_intp *)PyArray_DATA(nearest))[k] = -1;
@@ -1157,7 +1136,7 @@ static PyObject *py_percentile(PyObject *self, PyObject *args, PyObject *kw) {
         goto done;
     }
     if (!na || !nb) {
-        double v = empty_value(empty, na, nb);
+        double v = hd_empty_value(empty, na, nb);
         for (size_t k = 0; k < np_; k++) res[k] = (hd_percentile_t){p[k], v, v, v, v};
     } else {
         if (both_distances(&a, &b, 0, &opt, &d_ab, &d_ba)) goto done;
@@ -1221,7 +1200,7 @@ static PyObject *summary_call(PyObject *args, PyObject *kw, int want) {
     PyObject *out = NULL;
     double *d_ab = NULL, *d_ba = NULL;
     if (!na || !nb) {
-        double v = empty_value(empty, na, nb), w = directed ? NAN : v;
+        double v = hd_empty_value(empty, na, nb), w = directed ? NAN : v;
         s = (hd_summary_t){na, directed ? 0 : nb, v, w, v, w, v, w, v, w, v, w,
                            w, w, w, w, w, w, w};
     } else {
@@ -1777,8 +1756,8 @@ static PyObject *py_mesh_distances(PyObject *self, PyObject *args, PyObject *kw)
     hd_options_t opt;
     if (parse_options(NULL, threads, NULL, &opt)) return NULL;
     points_arg_t p, v;
-    if (points_from_object(op, "points", EMPTY_ERROR, &p)) return NULL;
-    if (points_from_object(ov, "vertices", EMPTY_ERROR, &v)) {
+    if (points_from_object(op, "points", HD_EMPTY_ERROR, &p)) return NULL;
+    if (points_from_object(ov, "vertices", HD_EMPTY_ERROR, &v)) {
         points_release(&p);
         return NULL;
     }

@@ -224,6 +224,8 @@ void hd__xsum_init(hd__xsum_t *s);
 /* Carry every limb into [0, 2^32) (the top one keeps the sign); pending = 1. */
 void hd__xsum_normalize(hd__xsum_t *s);
 void hd__xsum_add_special(hd__xsum_t *s, double x);
+/* dst += src (src unchanged). */
+void hd__xsum_merge(hd__xsum_t *dst, const hd__xsum_t *src);
 /* The exact sum rounded once to nearest even: subnormal results are exact
  * or rounded as any other, |sum| >= 2^1024 - 2^970 gives +-inf; +inf and
  * -inf together, or a NaN, give NaN.  An exact zero is +0.0 (as a loop

@@ -97,6 +97,17 @@ void hd__xsum_add_special(hd__xsum_t *s, double x) {
     else s->ninf++;
 }
 
+void hd__xsum_merge(hd__xsum_t *dst, const hd__xsum_t *src) {
+    hd__xsum_t t = *src;
+    hd__xsum_normalize(&t);
+    if (dst->pending > HD__XSUM_PENDING_MAX / 2) hd__xsum_normalize(dst);
+    for (int k = 0; k < HD__XSUM_LIMBS; k++) dst->limb[k] += t.limb[k];
+    dst->pending += t.pending;
+    dst->pinf += t.pinf;
+    dst->ninf += t.ninf;
+    dst->nan += t.nan;
+}
+
 /* Bit b of the normalised, non-negative limbs. */
 static uint64_t bit_at(const int64_t *l, int b) {
     return ((uint64_t)l[b >> 5] >> (b & 31)) & 1;

@@ -36,6 +36,37 @@ TEST(algorithm_names_round_trip) {
     CHECK_RC(hd_algorithm_from_name("fastest", &a), HD_EALGORITHM);
 }
 
+TEST(empty_policy_names_round_trip_and_end_with_null) {
+    int k = 0;
+    for (; hd_empty_policy_name((hd_empty_policy_t)k); k++) {
+        hd_empty_policy_t p;
+        CHECK_RC(hd_empty_policy_from_name(hd_empty_policy_name((hd_empty_policy_t)k), &p), HD_OK);
+        CHECK_EQ(p, k);
+    }
+    CHECK_EQ(k, HD_EMPTY_SKIMAGE + 1);
+    hd_empty_policy_t p = HD_EMPTY_INF;
+    CHECK_RC(hd_empty_policy_from_name("Inf", &p), HD_EINVAL);
+    CHECK_EQ(p, HD_EMPTY_INF);
+    CHECK_RC(hd_empty_policy_from_name(NULL, &p), HD_EINVAL);
+}
+
+TEST(empty_policy_values_for_one_and_both_sets_empty) {
+    /* one side empty (either), then both */
+    for (int side = 0; side < 2; side++) {
+        size_t na = side ? 0 : 5, nb = side ? 5 : 0;
+        CHECK(isinf(hd_empty_value(HD_EMPTY_INF, na, nb)) && hd_empty_value(HD_EMPTY_INF, na, nb) > 0);
+        CHECK(isnan(hd_empty_value(HD_EMPTY_NAN, na, nb)));
+        CHECK(hd_empty_value(HD_EMPTY_ZERO, na, nb) == 0.0);
+        CHECK(isinf(hd_empty_value(HD_EMPTY_MONAI, na, nb)));
+        CHECK(isinf(hd_empty_value(HD_EMPTY_SKIMAGE, na, nb)));
+        CHECK(isnan(hd_empty_value(HD_EMPTY_ERROR, na, nb)));
+    }
+    CHECK(isinf(hd_empty_value(HD_EMPTY_INF, 0, 0)));
+    CHECK(isnan(hd_empty_value(HD_EMPTY_MONAI, 0, 0)));
+    CHECK(hd_empty_value(HD_EMPTY_SKIMAGE, 0, 0) == 0.0);
+    CHECK(isnan(hd_empty_value((hd_empty_policy_t)99, 0, 0)));
+}
+
 TEST(defaults_are_the_papers_parameters) {
     hd_options_t o;
     hd_options_init(&o);
