@@ -1261,17 +1261,20 @@ int hd__an_nearest_paired(const hd__an_t *asking, const hd__an_t *searched, cons
  * percentile closely, those are few, which is what makes a percentile
  * cheaper than every distance.
  *
- * The search of one point: its bucket's two seed buckets (as hd__an_nearest
- * seeds a query), then the candidate buckets of its asking bucket within
- * min(hi2, U) of that bucket's box, U being the largest seed distance of
- * the bucket's open points (an actual point's distance, so it bounds each
- * of their answers, and a band with hi2 = +inf stays a local search).
- * Candidates whose box holds the point are scanned first (they usually
- * settle it below), then the others within min(best, hi2).  The minimiser
- * of a point whose d2 is at most hi2 lies in a bucket whose bound is at
- * most d2, at most its best and at most hi2: it is scanned, so a point
- * kept in the band has its exact d2.  Copies of one point (a bucket whose
- * stop is start + 1) are settled once for all of them.  The counts and the
+ * The search of one point: the WINDOW points of the searched set around
+ * its own key on the searched set's curve (window_best), which settle most
+ * points below; for the others, the searched bucket nearest to the box of
+ * its asking bucket (nearest_leaf), then the candidate buckets within
+ * min(hi2, U) of that box, U the smaller of the path's node bounds and the
+ * largest best of the bucket's open points (each an actual point's
+ * distance, so U bounds each of their answers, and a band with hi2 = +inf
+ * stays a local search).  Candidates whose box holds the point are scanned
+ * first (they usually settle it below), then the others within
+ * min(best, hi2).  The minimiser of a point whose d2 is at most hi2 lies in
+ * a bucket whose bound is at most d2, at most its best and at most hi2: it
+ * is scanned, so a point kept in the band has its exact d2.  Copies of
+ * one point (a bucket whose stop is start + 1) are settled once for all of
+ * them.  The counts and the
  * kept values (as a multiset) depend on nothing but the two sets and the
  * band, whatever the threads.
  */
