@@ -1337,25 +1337,29 @@ HD__INLINE double band_finish(const band_ctx *c, cands_t *cd, double qx, double 
 }
 
 /* Points [first, end) of asking bucket b (at most HD__AN_BUCKET), each
- * standing for `times` copies: the window of each point on t's curve,
- * then, for those it left open, the bucket nearest to b's box, then the
- * candidates.  *wb and *wp carry the window's place (window_best). */
+ * standing for `times` copies: all below at once when a node on the path
+ * to the searched bucket nearest to b's box is within lo2 of every point
+ * of the box (node_ub2 is never below the computed distance of a pair
+ * drawn from the two boxes, and a node holds a point); else the window of
+ * each point on t's curve, then, for those it left open, that nearest
+ * bucket, then the candidates.  *wb and *wp carry the window's place (window_best). */
 HD__INLINE void band_points(const band_ctx *c, cands_t *cd, band_out_t *o, size_t b, size_t first, size_t end,
                         size_t times, size_t *wb, size_t *wp) {
     const hd__an_t *q = c->q, *t = c->t;
     double best[HD__AN_BUCKET], U = INFINITY, V = 0;
-    size_t open = 0, near = SIZE_MAX;
+    size_t open = 0, node = q->leaf[b];
     hd__box_t box;
+    for (int d = 0; d < 3; d++) box.lo[d] = q->lo[d][node], box.hi[d] = q->hi[d][node];
+    size_t near = nearest_leaf(t, &box, &U);
+    if (U < c->lo2) { /* every point of the box has a point of t within U */
+        o->below += (end - first) * times;
+        return;
+    }
     for (size_t k = first; k < end; k++) {
         uint32_t j = UINT32_MAX;
         double *bk = &best[k - first];
         *bk = INFINITY;
         window_best(q, t, k, wb, wp, bk, &j);
-        if (!(*bk < c->lo2) && near == SIZE_MAX) {
-            size_t node = q->leaf[b];
-            for (int d = 0; d < 3; d++) box.lo[d] = q->lo[d][node], box.hi[d] = q->hi[d][node];
-            near = nearest_leaf(t, &box, &U);
-        }
         if (!(*bk < c->lo2)) scan_bucket(t, near, q->x[k], q->y[k], q->z[k], bk, &j);
         if (*bk < c->lo2) {
             band_settle(c, o, *bk, times);
