@@ -4,3 +4,6 @@
 hd_add_bench(analysis_bench ${CMAKE_CURRENT_LIST_DIR}/analysis_bench.c)
 # summarize_bench: hd_summarize's exact sums per value, against a plain loop.
 hd_add_bench(summarize_bench ${CMAKE_CURRENT_LIST_DIR}/summarize_bench.c)
+# percentile_bench: HD95 from bands (hd_hausdorff_percentile) against every
+# distance then a selection, on issue 39's cases a-e.
+hd_add_bench(percentile_bench ${CMAKE_CURRENT_LIST_DIR}/percentile_bench.c)

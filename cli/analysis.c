@@ -295,6 +295,12 @@ int analysis_active(const analysis_args_t *an) {
            an->render_out || an->histogram_png || an->n_taus || an->dtu_cap > 0;
 }
 
+/* Only the percentile asked for: no figure needs every distance. */
+static int analysis_percentile_only(const analysis_args_t *an) {
+    return an->percentile_on && !an->mean && !an->chamfer && !an->histogram && !an->distances_out &&
+           !an->render_out && !an->histogram_png;
+}
+
 /* ---- empty sets ------------------------------------------------------------ */
 
 static int alloc_fail(hd_error_t *err, size_t n) {
@@ -583,6 +589,12 @@ int analysis_run(const analysis_args_t *an, const hd_options_t *opt,
     r->n_a = A->count;
     r->n_b = B->count;
     if (!r->active) return HD_OK;
+    if (!directed && analysis_percentile_only(an)) { /* the library's selection without every distance */
+        double t0 = seconds_now();
+        int rc = hd_hausdorff_percentile(A, B, opt, an->percentile, &r->pct, err);
+        r->seconds = seconds_now() - t0;
+        return rc;
+    }
     r->d_ab = malloc(A->count * sizeof *r->d_ab);
     r->j_ab = malloc(A->count * sizeof *r->j_ab);
     if (!r->d_ab || !r->j_ab) return alloc_fail(err, A->count);

@@ -423,8 +423,15 @@ HD_EXTERN int hd_percentile_of(const double *d_ab, size_t n_a,
                                const double *d_ba, size_t n_b, double p,
                                hd_percentile_t *out, hd_error_t *err);
 
-/* From the point sets: hd_distances (so only opt->threads is read), then
- * hd_percentile_of. */
+/* From the point sets: the same bits as hd_distances then
+ * hd_percentile_of, at any thread count, without computing every distance:
+ * the exact distances of a sample bracket the percentile's ranks, the
+ * points proven outside the brackets are only counted, and the ranks are
+ * selected among the exact distances of the others (docs/analysis.md,
+ * "Without every distance").  Only opt->threads is read.  It holds the
+ * structures hd_distances holds, and the distances inside the brackets.
+ * Thread safe.  Errors: as hd_distances, and HD_EINVAL for p outside
+ * [0, 100]. */
 HD_EXTERN int hd_hausdorff_percentile(const hd_points_t *A,
                                       const hd_points_t *B,
                                       const hd_options_t *opt, double p,

@@ -110,21 +110,6 @@ static int kd_distances(const hd_points_t *A, const hd_points_t *B, int threads,
     return HD_OK;
 }
 
-typedef struct {
-    const hd_points_t *set[2];
-    const hd__box_t *keybox;
-    int threads; /* for each build */
-    int rc[2];
-    hd_error_t err[2];
-    hd__an_t s[2];
-} build_ctx;
-
-static void build_task(void *vctx, size_t task, int worker) {
-    (void)worker;
-    build_ctx *c = vctx;
-    c->rc[task] = hd__an_build(&c->s[task], c->set[task], NULL, c->keybox, c->threads, &c->err[task]);
-}
-
 int hd_distances(const hd_points_t *A, const hd_points_t *B,
                  const hd_options_t *opt, double *dist_ab, size_t *nearest_ab,
                  double *dist_ba, size_t *nearest_ba, hd_error_t *err) {
@@ -147,25 +132,18 @@ int hd_distances(const hd_points_t *A, const hd_points_t *B,
      * buckets it searches are neighbours in memory too. */
     keybox = box_a;
     hd__box_merge(&keybox, &box_b);
-    /* The two structures are built side by side: part of each build is
-     * serial (the octree), so two builds on half the threads each finish
-     * sooner than one after the other on all of them. */
-    build_ctx c = {{A, B}, &keybox, threads < 2 ? 1 : threads / 2, {HD_OK, HD_OK}, {{0}, {0}}, {{0}, {0}}};
-    hd__parallel_for(threads < 2 ? 1 : 2, 2, build_task, &c);
-    for (int k = 0; k < 2 && rc == HD_OK; k++)
-        if (c.rc[k]) {
-            rc = c.rc[k];
-            if (err) *err = c.err[k];
-        }
+    hd__an_t s[2];
+    rc = hd__an_build_pair(A, B, &keybox, threads, s, err);
+    if (rc) return rc;
     /* Sets of one size may be a copy and its original in the same order:
      * point i of each is then tried first as the other's answer. */
     int same = A->count == B->count;
     if (rc == HD_OK && ab)
-        rc = hd__an_nearest(&c.s[0], &c.s[1], same ? B : NULL, threads, dist_ab, nearest_ab, NULL, err);
+        rc = hd__an_nearest(&s[0], &s[1], same ? B : NULL, threads, dist_ab, nearest_ab, NULL, err);
     if (rc == HD_OK && ba)
-        rc = hd__an_nearest(&c.s[1], &c.s[0], same ? A : NULL, threads, dist_ba, nearest_ba, NULL, err);
-    hd__an_free(&c.s[0]);
-    hd__an_free(&c.s[1]);
+        rc = hd__an_nearest(&s[1], &s[0], same ? A : NULL, threads, dist_ba, nearest_ba, NULL, err);
+    hd__an_free(&s[0]);
+    hd__an_free(&s[1]);
     return rc;
 }
 
@@ -208,15 +186,11 @@ int hd_percentile_of(const double *d_ab, size_t n_a, const double *d_ba,
     return rc;
 }
 
-int hd_hausdorff_percentile(const hd_points_t *A, const hd_points_t *B,
-                            const hd_options_t *opt, double p,
-                            hd_percentile_t *out, hd_error_t *err) {
-    hd__err_clear(err);
-    if (!out) return hd__err(err, HD_EINVAL, "result pointer is NULL");
-    int rc;
-    if ((rc = hd__percentile_check(p, err))) return rc;
-    if ((rc = hd__points_check(A, "A", NULL, err))) return rc;
-    if ((rc = hd__points_check(B, "B", NULL, err))) return rc;
+/* Every distance, then the selection: the sets too large for the
+ * structures' 32-bit fields. */
+static int percentile_all(const hd_points_t *A, const hd_points_t *B, const hd_options_t *opt, double p,
+                          hd_percentile_t *out, hd_error_t *err) {
+    int rc = HD_OK;
     double *ab = hd__malloc_array(A->count, sizeof *ab);
     double *ba = hd__malloc_array(B->count, sizeof *ba);
     if (!ab || !ba) rc = hd__err(err, HD_ENOMEM, "cannot allocate %zu + %zu distances", A->count, B->count);
@@ -224,6 +198,33 @@ int hd_hausdorff_percentile(const hd_points_t *A, const hd_points_t *B,
     if (rc == HD_OK) rc = hd_percentile_of(ab, A->count, ba, B->count, p, out, err);
     free(ab);
     free(ba);
+    return rc;
+}
+
+int hd_hausdorff_percentile(const hd_points_t *A, const hd_points_t *B,
+                            const hd_options_t *opt, double p,
+                            hd_percentile_t *out, hd_error_t *err) {
+    hd__err_clear(err);
+    if (!out) return hd__err(err, HD_EINVAL, "result pointer is NULL");
+    if (opt && opt->threads < 0)
+        return hd__err(err, HD_EINVAL, "threads must be 0 (every core) or positive, not %d", opt->threads);
+    int rc;
+    if ((rc = hd__percentile_check(p, err))) return rc;
+    hd__box_t box_a, box_b;
+    size_t most = A && B ? (A->count > B->count ? A->count : B->count) : 1;
+    int threads = hd__thread_count(opt ? opt->threads : 0, most);
+    if ((rc = hd__points_scan(A, "A", threads, &box_a, err))) return rc;
+    if ((rc = hd__points_scan(B, "B", threads, &box_b, err))) return rc;
+    if (A->count > HD__AN_MAX_POINTS || B->count > HD__AN_MAX_POINTS) return percentile_all(A, B, opt, p, out, err);
+    /* The structures hd_distances builds; only the points near each
+     * percentile are searched completely (nearest/percentile.c). */
+    hd__box_t keybox = box_a;
+    hd__box_merge(&keybox, &box_b);
+    hd__an_t s[2];
+    if ((rc = hd__an_build_pair(A, B, &keybox, threads, s, err))) return rc;
+    rc = hd__percentile_points(A, B, s, &keybox, threads, p, out, err);
+    hd__an_free(&s[0]);
+    hd__an_free(&s[1]);
     return rc;
 }
 

@@ -1138,6 +1138,14 @@ static PyObject *py_percentile(PyObject *self, PyObject *args, PyObject *kw) {
     if (!na || !nb) {
         double v = hd_empty_value(empty, na, nb);
         for (size_t k = 0; k < np_; k++) res[k] = (hd_percentile_t){p[k], v, v, v, v};
+    } else if (np_ == 1 && !is_nd(&a)) { /* one percentile: without every distance */
+        Py_BEGIN_ALLOW_THREADS
+        rc = hd_hausdorff_percentile(&a.pts, &b.pts, &opt, p[0], &res[0], &err);
+        Py_END_ALLOW_THREADS
+        if (rc != HD_OK) {
+            raise_hd(rc, &err);
+            goto done;
+        }
     } else {
         if (both_distances(&a, &b, 0, &opt, &d_ab, &d_ba)) goto done;
         Py_BEGIN_ALLOW_THREADS

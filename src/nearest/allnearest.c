@@ -957,6 +957,22 @@ HD__INLINE double partner_bests(const query_ctx *c, const hd__src_t *psrc, qgrou
     return U;
 }
 
+/* Query k of q against the WINDOW points of t around its own key on t's
+ * curve, into *best and *bj.  *b and *p carry the bucket and the point of
+ * t reached by the previous query (keys grow along q: start both at 0, or
+ * *b at a bucket whose key is at most the query's). */
+HD__INLINE void window_best(const hd__an_t *q, const hd__an_t *t, size_t k, size_t *b, size_t *p, double *best,
+                            uint32_t *bj) {
+    uint32_t kq = q->key32[k];
+    *b = bucket_at(t, kq, *b);
+    *p = *p > t->start[*b] ? *p : t->start[*b];
+    while (*p < t->start[*b + 1] && t->key32[*p] < kq) ++*p;
+    size_t k0 = *p & ~(size_t)3;
+    k0 = k0 >= WINDOW / 2 ? k0 - WINDOW / 2 : 0;
+    size_t e = k0 + WINDOW < t->n ? k0 + WINDOW : t->n;
+    scan_span(t, k0, e, q->x[k], q->y[k], q->z[k], best, bj);
+}
+
 /* The window path's first answers (query_task's essay): each query's best
  * among the WINDOW points of t around its own place on t's curve (the
  * seeds must be set).  Returns U, the largest best of the queries not set
@@ -966,14 +982,8 @@ HD__INLINE double window_bests(const hd__an_t *q, const hd__an_t *t, qgroup_t *G
     size_t first = G->first, m = G->m;
     int64_t esum = 0;
     for (size_t k = 0, p = 0, b = 0; k < m; k++) {
-        uint32_t kq = q->key32[first + k];
-        b = bucket_at(t, kq, b > G->seed[k] ? b : G->seed[k]);
-        p = p > t->start[b] ? p : t->start[b];
-        while (p < t->start[b + 1] && t->key32[p] < kq) p++;
-        size_t k0 = p & ~(size_t)3;
-        k0 = k0 >= WINDOW / 2 ? k0 - WINDOW / 2 : 0;
-        size_t e = k0 + WINDOW < t->n ? k0 + WINDOW : t->n;
-        scan_span(t, k0, e, q->x[first + k], q->y[first + k], q->z[first + k], &G->best[k], &G->bj[k]);
+        b = b > G->seed[k] ? b : G->seed[k];
+        window_best(q, t, first + k, &b, &p, &G->best[k], &G->bj[k]);
         uint64_t u;
         __builtin_memcpy(&u, &G->best[k], sizeof u);
         esum += (int64_t)(u >> 52);
@@ -1160,6 +1170,38 @@ size_t hd__an_nearest_bytes(const hd__an_t *asking, const hd__an_t *searched, in
            asking->n * (sizeof(double) + sizeof(uint32_t));
 }
 
+/* Room for a candidate list of every bucket of a structure of nb buckets
+ * in each of the `workers` lists cand[] (zeroed); HD_OK or HD_ENOMEM. */
+static int cands_alloc(cands_t *cand, int workers, size_t nb) {
+    for (int w = 0; w < workers; w++) {
+        cands_t *cd = &cand[w];
+        cd->bucket = hd__malloc_array(nb, sizeof *cd->bucket);
+        cd->keep = hd__malloc_array(nb, sizeof *cd->keep);
+        cd->lb2 = hd__malloc_array(nb, sizeof *cd->lb2);
+        int ok = cd->bucket && cd->keep && cd->lb2;
+        for (int d = 0; d < 3; d++) {
+            cd->lo[d] = hd__malloc_array(nb, sizeof(double));
+            cd->hi[d] = hd__malloc_array(nb, sizeof(double));
+            ok = ok && cd->lo[d] && cd->hi[d];
+        }
+        if (!ok) return HD_ENOMEM;
+    }
+    return HD_OK;
+}
+
+/* Frees what cands_alloc allocated, and the array cand itself (NULL is
+ * allowed). */
+static void cands_free(cands_t *cand, int workers) {
+    for (int w = 0; cand && w < workers; w++) {
+        cands_t *cd = &cand[w];
+        free(cd->bucket);
+        free(cd->keep);
+        free(cd->lb2);
+        for (int d = 0; d < 3; d++) free(cd->lo[d]), free(cd->hi[d]);
+    }
+    free(cand);
+}
+
 /* hd__an_nearest with the partners of a view (partner) or at positions
  * of searched (pair_at), at most one of them. */
 static int nearest_run(const hd__an_t *asking, const hd__an_t *searched, const hd_points_t *partner,
@@ -1177,20 +1219,7 @@ static int nearest_run(const hd__an_t *asking, const hd__an_t *searched, const h
     /* Every answer is written: their pages mapped at once. */
     hd__prefault(c.sd, asking->n * sizeof *c.sd);
     hd__prefault(c.sj, asking->n * sizeof *c.sj);
-    size_t nb = searched->nb;
-    for (int w = 0; w < threads && rc == HD_OK; w++) {
-        cands_t *cd = &c.cand[w];
-        cd->bucket = hd__malloc_array(nb, sizeof *cd->bucket);
-        cd->keep = hd__malloc_array(nb, sizeof *cd->keep);
-        cd->lb2 = hd__malloc_array(nb, sizeof *cd->lb2);
-        int ok = cd->bucket && cd->keep && cd->lb2;
-        for (int d = 0; d < 3; d++) {
-            cd->lo[d] = hd__malloc_array(nb, sizeof(double));
-            cd->hi[d] = hd__malloc_array(nb, sizeof(double));
-            ok = ok && cd->lo[d] && cd->hi[d];
-        }
-        if (!ok) rc = HD_ENOMEM;
-    }
+    if (rc == HD_OK) rc = cands_alloc(c.cand, threads, searched->nb);
     if (rc == HD_OK) {
         hd__parallel_for(threads, tasks, query_task, &c);
         hd__parallel_for(threads, (asking->n + SCATTER_TASK - 1) / SCATTER_TASK, scatter_answers, &c);
@@ -1201,14 +1230,7 @@ static int nearest_run(const hd__an_t *asking, const hd__an_t *searched, const h
         counts->windowed += c.cand[w].counts.windowed;
         counts->apart += c.cand[w].counts.apart;
     }
-    for (int w = 0; c.cand && w < threads; w++) {
-        cands_t *cd = &c.cand[w];
-        free(cd->bucket);
-        free(cd->keep);
-        free(cd->lb2);
-        for (int d = 0; d < 3; d++) free(cd->lo[d]), free(cd->hi[d]);
-    }
-    free(c.cand);
+    cands_free(c.cand, threads);
     free(c.sd);
     free(c.sj);
     if (rc != HD_OK) return hd__err(err, rc, "cannot allocate the candidate lists");
@@ -1223,4 +1245,216 @@ int hd__an_nearest(const hd__an_t *asking, const hd__an_t *searched, const hd_po
 int hd__an_nearest_paired(const hd__an_t *asking, const hd__an_t *searched, const uint32_t *pair_at, int threads,
                           double *dist, size_t *nearest, hd__an_counts_t *counts, hd_error_t *err) {
     return nearest_run(asking, searched, NULL, pair_at, threads, dist, nearest, counts, err);
+}
+
+/* ---- within a band: ranks without every distance ------------------------------ */
+
+/*
+ * hd__an_band classifies every asking point by its exact nearest squared
+ * distance d2 against a band [lo2, hi2]: below (d2 < lo2) and above
+ * (d2 > hi2) are only counted, and d2 itself is kept only for the points
+ * within the band.  A point is settled below as soon as any searched point
+ * lies at a computed squared distance under lo2 (the nearest is at most
+ * that), and above when no bucket's bound is at most hi2 (a bound never
+ * exceeds the computed distance of a point it holds).  Only the points
+ * within the band need their complete search; when the band brackets a
+ * percentile closely, those are few, which is what makes a percentile
+ * cheaper than every distance.
+ *
+ * The search of one point: the WINDOW points of the searched set around
+ * its own key on the searched set's curve (window_best), which settle most
+ * points below; for the others, the searched bucket nearest to the box of
+ * its asking bucket (nearest_leaf), then the candidate buckets within
+ * min(hi2, U) of that box, U the smaller of the path's node bounds and the
+ * largest best of the bucket's open points (each an actual point's
+ * distance, so U bounds each of their answers, and a band with hi2 = +inf
+ * stays a local search).  Candidates whose box holds the point are scanned
+ * first (they usually settle it below), then the others within
+ * min(best, hi2).  The minimiser of a point whose d2 is at most hi2 lies in
+ * a bucket whose bound is at most d2, at most its best and at most hi2: it
+ * is scanned, so a point kept in the band has its exact d2.  Copies of
+ * one point (a bucket whose stop is start + 1) are settled once for all of
+ * them.  The counts and the
+ * kept values (as a multiset) depend on nothing but the two sets and the
+ * band, whatever the threads.
+ */
+
+#define BAND_TASK 64 /* asking buckets per task */
+
+typedef struct {
+    double *v;
+    size_t n, cap;
+    size_t below, above;
+    int nomem;
+} band_out_t;
+
+typedef struct {
+    const hd__an_t *q, *t;
+    double lo2, hi2;
+    cands_t *cand;
+    band_out_t *out; /* per worker */
+} band_ctx;
+
+/* Settles one value, of `times` points, into o. */
+HD__INLINE void band_settle(const band_ctx *c, band_out_t *o, double d2, size_t times) {
+    if (d2 < c->lo2) {
+        o->below += times;
+        return;
+    }
+    if (d2 > c->hi2) {
+        o->above += times;
+        return;
+    }
+    if (o->n + times > o->cap) {
+        size_t cap = o->cap ? 2 * o->cap : 1024;
+        while (cap < o->n + times) cap *= 2;
+        double *v = hd__realloc_array(o->v, cap, sizeof *v);
+        if (!v) {
+            o->nomem = 1;
+            return;
+        }
+        o->v = v, o->cap = cap;
+    }
+    for (size_t k = 0; k < times; k++) o->v[o->n++] = d2;
+}
+
+/* The rest of one point's search on the candidate list cd (seed buckets
+ * [s0, s1) scanned already, best their smallest distance): its best
+ * distance, exact when at most hi2, or some distance under lo2. */
+HD__INLINE double band_finish(const band_ctx *c, cands_t *cd, double qx, double qy, double qz, double best,
+                          size_t near) {
+    const hd__an_t *t = c->t;
+    uint32_t j = UINT32_MAX;
+    candidate_bounds(cd, cd->n, qx, qy, qz);
+    for (int pass = 0; pass < 2; pass++)
+        for (size_t r = 0; r < cd->n && !(best < c->lo2); r++) {
+            double lb = cd->lb2[r], lim = best < c->hi2 ? best : c->hi2;
+            size_t b = cd->bucket[r];
+            if ((pass == 0) != (lb <= 0) || lb > lim || b == near) continue;
+            scan_bucket(t, b, qx, qy, qz, &best, &j);
+        }
+    return best;
+}
+
+/* Points [first, end) of asking bucket b (at most HD__AN_BUCKET), each
+ * standing for `times` copies: all below at once when a node on the path
+ * to the searched bucket nearest to b's box is within lo2 of every point
+ * of the box (node_ub2 is never below the computed distance of a pair
+ * drawn from the two boxes, and a node holds a point); else the window of
+ * each point on t's curve, then, for those it left open, that nearest
+ * bucket, then the candidates.  *wb and *wp carry the window's place (window_best). */
+HD__INLINE void band_points(const band_ctx *c, cands_t *cd, band_out_t *o, size_t b, size_t first, size_t end,
+                        size_t times, size_t *wb, size_t *wp) {
+    const hd__an_t *q = c->q, *t = c->t;
+    double best[HD__AN_BUCKET], U = INFINITY, V = 0;
+    size_t open = 0, node = q->leaf[b];
+    hd__box_t box;
+    for (int d = 0; d < 3; d++) box.lo[d] = q->lo[d][node], box.hi[d] = q->hi[d][node];
+    size_t near = nearest_leaf(t, &box, &U);
+    if (U < c->lo2) { /* every point of the box has a point of t within U */
+        o->below += (end - first) * times;
+        return;
+    }
+    for (size_t k = first; k < end; k++) {
+        uint32_t j = UINT32_MAX;
+        double *bk = &best[k - first];
+        *bk = INFINITY;
+        window_best(q, t, k, wb, wp, bk, &j);
+        if (!(*bk < c->lo2)) scan_bucket(t, near, q->x[k], q->y[k], q->z[k], bk, &j);
+        if (*bk < c->lo2) {
+            band_settle(c, o, *bk, times);
+            *bk = -1; /* settled */
+            continue;
+        }
+        open++;
+        V = *bk > V ? *bk : V;
+    }
+    if (!open) return;
+    U = U < V ? U : V;
+    candidates(t, &box, U < c->hi2 ? U : c->hi2, SIZE_MAX, cd);
+    for (size_t k = first; k < end; k++)
+        if (best[k - first] >= 0)
+            band_settle(c, o, band_finish(c, cd, q->x[k], q->y[k], q->z[k], best[k - first], near), times);
+}
+
+/* Asking bucket b, HD__AN_BUCKET points at a time (a bucket of equal keys
+ * may hold more). */
+HD__INLINE void band_bucket(const band_ctx *c, cands_t *cd, band_out_t *o, size_t b, size_t *wb, size_t *wp) {
+    const hd__an_t *q = c->q;
+    size_t first = q->start[b], end = q->stop[b], times = end == first + 1 ? q->start[b + 1] - first : 1;
+    for (size_t k = first; k < end; k += HD__AN_BUCKET)
+        band_points(c, cd, o, b, k, end - k < HD__AN_BUCKET ? end : k + HD__AN_BUCKET, times, wb, wp);
+}
+
+static HD__HOT void band_task(void *vctx, size_t task, int worker) {
+    band_ctx *c = vctx;
+    size_t b0 = task * BAND_TASK, b1 = b0 + BAND_TASK < c->q->nb ? b0 + BAND_TASK : c->q->nb;
+    size_t wb = 0, wp = 0;
+    for (size_t b = b0; b < b1; b++) band_bucket(c, &c->cand[worker], &c->out[worker], b, &wb, &wp);
+}
+
+int hd__an_band(const hd__an_t *asking, const hd__an_t *searched, double lo2, double hi2, int threads,
+                hd__an_band_t *out, hd_error_t *err) {
+    memset(out, 0, sizeof *out);
+    size_t tasks = (asking->nb + BAND_TASK - 1) / BAND_TASK;
+    threads = hd__thread_count(threads, tasks);
+    band_ctx c = {asking, searched, lo2, hi2, NULL, NULL};
+    c.cand = hd__calloc_array((size_t)threads, sizeof *c.cand);
+    c.out = hd__calloc_array((size_t)threads, sizeof *c.out);
+    int rc = c.cand && c.out ? HD_OK : HD_ENOMEM;
+    if (rc == HD_OK) rc = cands_alloc(c.cand, threads, searched->nb);
+    if (rc == HD_OK) hd__parallel_for(threads, tasks, band_task, &c);
+    size_t kept = 0;
+    for (int w = 0; c.out && w < threads; w++) {
+        out->below += c.out[w].below, out->above += c.out[w].above, kept += c.out[w].n;
+        if (c.out[w].nomem) rc = HD_ENOMEM;
+    }
+    if (rc == HD_OK && !(out->v = hd__malloc_array(kept ? kept : 1, sizeof *out->v))) rc = HD_ENOMEM;
+    for (int w = 0; rc == HD_OK && w < threads; w++) {
+        if (c.out[w].n) memcpy(out->v + out->n, c.out[w].v, c.out[w].n * sizeof *out->v);
+        out->n += c.out[w].n;
+    }
+    for (int w = 0; c.out && w < threads; w++) free(c.out[w].v);
+    free(c.out);
+    cands_free(c.cand, threads);
+    if (rc != HD_OK) {
+        free(out->v);
+        memset(out, 0, sizeof *out);
+        return hd__err(err, rc, "cannot allocate the distances within the band");
+    }
+    return HD_OK;
+}
+
+/* ---- both sets side by side --------------------------------------------------- */
+
+typedef struct {
+    const hd_points_t *set[2];
+    const hd__box_t *keybox;
+    int threads; /* for each build */
+    int rc[2];
+    hd_error_t err[2];
+    hd__an_t *s;
+} pair_ctx;
+
+static void pair_task(void *vctx, size_t task, int worker) {
+    (void)worker;
+    pair_ctx *c = vctx;
+    c->rc[task] = hd__an_build(&c->s[task], c->set[task], NULL, c->keybox, c->threads, &c->err[task]);
+}
+
+int hd__an_build_pair(const hd_points_t *A, const hd_points_t *B, const hd__box_t *keybox, int threads,
+                      hd__an_t s[2], hd_error_t *err) {
+    /* Part of each build is serial (the octree), so two builds on half the
+     * threads each finish sooner than one after the other on all of them. */
+    pair_ctx c = {{A, B}, keybox, threads < 2 ? 1 : threads / 2, {HD_OK, HD_OK}, {{0}, {0}}, s};
+    memset(s, 0, 2 * sizeof *s);
+    hd__parallel_for(threads < 2 ? 1 : 2, 2, pair_task, &c);
+    for (int k = 0; k < 2; k++)
+        if (c.rc[k]) {
+            if (err) *err = c.err[k];
+            hd__an_free(&s[0]);
+            hd__an_free(&s[1]);
+            return c.rc[k];
+        }
+    return HD_OK;
 }

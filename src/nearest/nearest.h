@@ -110,4 +110,37 @@ int hd__an_nearest(const hd__an_t *asking, const hd__an_t *searched, const hd_po
 int hd__an_nearest_paired(const hd__an_t *asking, const hd__an_t *searched, const uint32_t *pair_at, int threads,
                           double *dist, size_t *nearest, hd__an_counts_t *counts, hd_error_t *err);
 
+/* Every point of `asking` classified by its exact nearest squared distance
+ * d2 to `searched` (the smallest hd__d2s) against the band [lo2, hi2]:
+ * out->below counts d2 < lo2, out->above counts d2 > hi2, and out->v
+ * holds the out->n values d2 with lo2 <= d2 <= hi2, in no particular order
+ * (malloc'd; the caller frees it).  The counts and the values as a
+ * multiset are the same at any thread count.  Only the points near the
+ * band are searched completely (allnearest.c, "within a band"), so a band
+ * that brackets a percentile closely costs far less than every distance.
+ * lo2 = 0 counts nothing below, hi2 = +inf nothing above.  Returns HD_OK
+ * or HD_ENOMEM (out zeroed, err filled). */
+typedef struct hd__an_band {
+    size_t below, above;
+    size_t n;
+    double *v;
+} hd__an_band_t;
+int hd__an_band(const hd__an_t *asking, const hd__an_t *searched, double lo2, double hi2, int threads,
+                hd__an_band_t *out, hd_error_t *err);
+
+/* Both structures of A and B (validated views of at most
+ * HD__AN_MAX_POINTS each) on one key box, built side by side on the
+ * threads.  On failure neither is left allocated.  Returns as
+ * hd__an_build. */
+int hd__an_build_pair(const hd_points_t *A, const hd_points_t *B, const hd__box_t *keybox, int threads,
+                      hd__an_t s[2], hd_error_t *err);
+
+/* The percentile figures of hd_hausdorff_percentile from the structures
+ * s[0] of A and s[1] of B (hd__an_build_pair on keybox), without every
+ * distance (percentile.c): the same bits as hd_percentile_of on every
+ * exact distance, at any thread count.  Returns HD_OK, HD_ENOMEM or
+ * HD_EOVERFLOW. */
+int hd__percentile_points(const hd_points_t *A, const hd_points_t *B, const hd__an_t s[2],
+                          const hd__box_t *keybox, int threads, double p, hd_percentile_t *out, hd_error_t *err);
+
 #endif /* HD_ALLNEAREST_H */

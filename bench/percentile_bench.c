@@ -1,0 +1,111 @@
+/*
+ * percentile_bench.c -- percentile Hausdorff distances (HD95) without every
+ * distance, against every distance then a selection (docs/benchmarks.md,
+ * "Percentiles").
+ *
+ * The five cases of issue 39, generated in memory with fixed seeds:
+ *   a overlapping  two N(0, 1) Gaussians, N + N points
+ *   b disjoint     B's mean 20 sigma from A's along x
+ *   c partial      B's mean 2 sigma from A's
+ *   d N / N/100    overlapping Gaussians, B a hundredth the size
+ *   e shuffled     B = A + N(0, (1e-3)^2) noise, in random order
+ * For each, median of RUNS alternated runs at THREADS threads:
+ *   H       hd_hausdorff (auto engine): the Hausdorff distance alone
+ *   all     hd_distances (both directions, no indices) then hd_percentile_of
+ *   band    hd_hausdorff_percentile (the bands of nearest/percentile.c)
+ * and it checks that "all" and "band" give the same four figures to the
+ * bit.  With --write DIR it also writes each case as DIR/<case>_A.bin and
+ * _B.bin (raw float64 triples) for the peer programs
+ * (bench/peers/nanoflann_hd: tree + 1-NN of every point, both directions).
+ *
+ * usage: percentile_bench [N] [RUNS] [THREADS] [P] [--write DIR]
+ *        (default 1000000 5 1 95)
+ */
+#include "benchutil.h"
+#include "gen.h"
+
+#include <hausdorff.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static int same_bits(double x, double y) { return memcmp(&x, &y, sizeof x) == 0; }
+
+static int write_bin(const char *dir, const char *name, const char *side, const double *p, size_t n) {
+    char path[1024];
+    snprintf(path, sizeof path, "%s/%s_%s.bin", dir, name, side);
+    FILE *f = fopen(path, "wb");
+    if (!f || fwrite(p, 24, n, f) != n) return 1;
+    return fclose(f) != 0;
+}
+
+int main(int argc, char **argv) {
+    const char *dir = NULL;
+    int pos = 0;
+    double arg[4] = {1000000, 5, 1, 95};
+    for (int k = 1; k < argc; k++) {
+        if (!strcmp(argv[k], "--write") && k + 1 < argc) dir = argv[++k];
+        else if (pos < 4) arg[pos++] = atof(argv[k]);
+    }
+    size_t n = (size_t)arg[0];
+    int runs = (int)arg[1], threads = (int)arg[2];
+    double p = arg[3];
+    if (runs < 1 || runs > 50) runs = 5;
+    double *a = malloc(24 * n), *b = malloc(24 * n), *dab = malloc(8 * n), *dba = malloc(8 * n);
+    if (!a || !b || !dab || !dba) return 1;
+    static const char *const cases[] = {"a_overlapping", "b_disjoint", "c_partial", "d_small_B", "e_shuffled"};
+    hd_options_t o;
+    hd_options_init(&o);
+    o.threads = threads;
+    hd_error_t err;
+    printf("| case | |A| | |B| | H | all + selection | bands | all / bands | bands / H |\n|---|---|---|---|---|---|---|---|\n");
+    for (int c = 0; c < 5; c++) {
+        gen_rng_t g;
+        gen_seed(&g, 39 + (uint64_t)c);
+        size_t nb = c == 3 ? n / 100 : n;
+        double m0[3] = {0, 0, 0}, m1[3] = {c == 1 ? 20.0 : c == 2 ? 2.0 : 0.0, 0, 0};
+        gen_gauss(&g, a, n, m0, 1.0);
+        if (c == 4) {
+            for (size_t k = 0; k < 3 * n; k++) b[k] = a[k] + 1e-3 * gen_normal(&g);
+            for (size_t k = n; k > 1; k--) gen_swap(b, k - 1, gen_u64(&g) % k);
+        } else {
+            gen_gauss(&g, b, nb, m1, 1.0);
+        }
+        if (dir && (write_bin(dir, cases[c], "A", a, n) || write_bin(dir, cases[c], "B", b, nb))) {
+            fprintf(stderr, "percentile_bench: cannot write %s\n", dir);
+            return 1;
+        }
+        hd_points_t A = hd_points_f64(a, n), B = hd_points_f64(b, nb);
+        double th[50], ta[50], tb[50];
+        for (int r = 0; r < runs; r++) {
+            hd_symmetric_t s;
+            hd_percentile_t pa, pb;
+            double t0 = bench_now();
+            if (hd_hausdorff(&A, &B, &o, &s, &err)) goto fail;
+            th[r] = bench_now() - t0;
+            t0 = bench_now();
+            if (hd_distances(&A, &B, &o, dab, NULL, dba, NULL, &err) ||
+                hd_percentile_of(dab, n, dba, nb, p, &pa, &err))
+                goto fail;
+            ta[r] = bench_now() - t0;
+            t0 = bench_now();
+            if (hd_hausdorff_percentile(&A, &B, &o, p, &pb, &err)) goto fail;
+            tb[r] = bench_now() - t0;
+            if (!same_bits(pa.ab, pb.ab) || !same_bits(pa.ba, pb.ba) || !same_bits(pa.pooled, pb.pooled) ||
+                !same_bits(pa.symmetric, pb.symmetric)) {
+                fprintf(stderr, "%s: the figures differ: %.17g %.17g %.17g / %.17g %.17g %.17g\n", cases[c], pa.ab,
+                        pa.ba, pa.pooled, pb.ab, pb.ba, pb.pooled);
+                return 2;
+            }
+        }
+        double mh = bench_median(th, runs), ma = bench_median(ta, runs), mb = bench_median(tb, runs);
+        printf("| %s | %zu | %zu | %.4f s | %.4f s | %.4f s | %.1fx | %.1fx |\n", cases[c], n, nb, mh, ma, mb,
+               ma / mb, mb / mh);
+        fflush(stdout);
+    }
+    free(a), free(b), free(dab), free(dba);
+    return 0;
+fail:
+    fprintf(stderr, "percentile_bench: %s\n", err.message);
+    return 1;
+}

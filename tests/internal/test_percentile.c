@@ -1,0 +1,225 @@
+/*
+ * test_percentile.c -- percentiles without every distance
+ * (hd_hausdorff_percentile through nearest/percentile.c and hd__an_band) as
+ * a specification: every figure (A->B, B->A, MONAI's symmetric, medpy's
+ * pooled) has the bits of numpy's linear percentile on a full sort of every
+ * exact distance, at 1 and 3 threads, on sets small enough to be sampled
+ * whole and large enough to be sampled, with ties (lattices, where many
+ * distances equal the percentile), duplicates, very unequal sizes and
+ * P = 0, 95, 99.9, 100 and others; a sample that misleads the bands on
+ * either side still gives the same bits; the band pass counts and keeps
+ * exactly what a brute classification does.  The exact distances of the
+ * reference are hd_distances' (test_analysis.c checks them against a brute
+ * force).
+ */
+#include "brute.h"
+#include "check.h"
+#include "gen.h"
+#include "nearest/nearest.h"
+
+#include <math.h>
+#include <stdlib.h>
+
+static int cmp_d(const void *x, const void *y) {
+    double a = *(const double *)x, b = *(const double *)y;
+    return (a > b) - (a < b);
+}
+
+/* numpy.percentile(v, p) written from its documentation on a full sort
+ * (v is sorted in place). */
+static double sorted_percentile(double *v, size_t n, double p) {
+    qsort(v, n, sizeof *v, cmp_d);
+    double pos = (double)(n - 1) * (p / 100.0);
+    if (pos >= (double)(n - 1)) return v[n - 1];
+    size_t lo = (size_t)floor(pos);
+    double t = pos - floor(pos), a = v[lo], b = v[lo + 1];
+    return t >= 0.5 ? b - (b - a) * (1.0 - t) : a + (b - a) * t;
+}
+
+/* The four figures from every exact distance, sorted. */
+static hd_percentile_t reference(const hd_points_t *A, const hd_points_t *B, double p) {
+    size_t na = A->count, nb = B->count;
+    double *d = malloc(8 * (na + nb)), *e = malloc(8 * (na + nb));
+    CHECK_RC(hd_distances(A, B, NULL, d, NULL, d + na, NULL, NULL), HD_OK);
+    memcpy(e, d, 8 * (na + nb));
+    hd_percentile_t r = {p, sorted_percentile(e, na, p), sorted_percentile(e + na, nb, p), 0,
+                         sorted_percentile(d, na + nb, p)};
+    r.symmetric = r.ab >= r.ba ? r.ab : r.ba;
+    free(d);
+    free(e);
+    return r;
+}
+
+static void check_figures(const hd_points_t *A, const hd_points_t *B, double p) {
+    hd_percentile_t want = reference(A, B, p);
+    for (int threads = 1; threads <= 3; threads += 2) {
+        hd_options_t o;
+        hd_options_init(&o);
+        o.threads = threads;
+        hd_percentile_t got;
+        CHECK_RC(hd_hausdorff_percentile(A, B, &o, p, &got, NULL), HD_OK);
+        CHECK_BITS(got.p, p);
+        CHECK_BITS(got.ab, want.ab);
+        CHECK_BITS(got.ba, want.ba);
+        CHECK_BITS(got.symmetric, want.symmetric);
+        CHECK_BITS(got.pooled, want.pooled);
+    }
+}
+
+/* Two sets by seed: kind 0 Gaussians, 1 lattices of 8 per side (many
+ * distances tie), 2 lattices of 3 per side (duplicates in both), 3 a
+ * large set against a few points, 4 a noisy copy in random order. */
+static void make_pair(uint64_t seed, size_t n, double **a, double **b, hd_points_t *A, hd_points_t *B) {
+    int kind = (int)(seed % 5);
+    gen_rng_t g;
+    gen_seed(&g, seed);
+    size_t na = n, nb = kind == 3 ? 1 + gen_u64(&g) % 40 : kind == 4 ? n : 1 + n / 2 + gen_u64(&g) % n;
+    *a = malloc(24 * na);
+    *b = malloc(24 * nb);
+    double m0[3] = {0, 0, 0}, m1[3] = {0.5, 0, 0};
+    if (kind == 0 || kind == 3) {
+        gen_gauss(&g, *a, na, m0, 1.0);
+        gen_gauss(&g, *b, nb, m1, 1.0);
+    } else if (kind == 1 || kind == 2) {
+        gen_lattice(&g, *a, na, kind == 1 ? 8 : 3);
+        gen_lattice(&g, *b, nb, kind == 1 ? 8 : 3);
+        gen_affine(*b, nb, 1.0, 0.5);
+    } else {
+        gen_gauss(&g, *a, na, m0, 1.0);
+        for (size_t k = 0; k < 3 * na; k++) (*b)[k] = (*a)[k] + 1e-3 * gen_normal(&g);
+        for (size_t k = nb; k > 1; k--) gen_swap(*b, k - 1, gen_u64(&g) % k);
+    }
+    *A = hd_points_f64(*a, na);
+    *B = hd_points_f64(*b, nb);
+    CONTEXT("seed=%llu kind=%d |A|=%zu |B|=%zu", (unsigned long long)seed, kind, na, nb);
+}
+
+TEST(percentiles_equal_a_full_sort_on_tiny_and_sampled_sets) {
+    static const double ps[] = {0, 95, 99.9, 100, 50, 5, 0.01};
+    for (uint64_t seed = 1; seed <= 30; seed++) {
+        size_t n = seed % 3 == 0 ? 1 + seed % 7 : seed % 3 == 1 ? 3000 : 12000;
+        double *a, *b;
+        hd_points_t A, B;
+        make_pair(seed, n, &a, &b, &A, &B);
+        for (size_t k = 0; k < sizeof ps / sizeof ps[0]; k++) check_figures(&A, &B, ps[k]);
+        free(a);
+        free(b);
+        if (hdt_failed()) return;
+    }
+}
+
+TEST(percentiles_equal_a_full_sort_where_many_distances_tie_at_the_percentile) {
+    /* Integer lattices against the same lattice shifted by half a step:
+     * every distance is one of a few values, so the ranks around the
+     * percentile all hold the same value and the bands' edges fall on it. */
+    for (uint64_t seed = 100; seed < 106; seed++) {
+        gen_rng_t g;
+        gen_seed(&g, seed);
+        size_t n = 20000;
+        double *a = malloc(24 * n), *b = malloc(24 * n);
+        gen_lattice(&g, a, n, 30);
+        gen_lattice(&g, b, n, 30);
+        gen_affine(b, n, 1.0, 0.5 * (double)(seed % 2));
+        hd_points_t A = hd_points_f64(a, n), B = hd_points_f64(b, n);
+        CONTEXT("seed=%llu lattice 30, shift %g", (unsigned long long)seed, 0.5 * (double)(seed % 2));
+        check_figures(&A, &B, 95);
+        check_figures(&A, &B, 50 + (double)(seed % 7) * 7.125);
+        free(a);
+        free(b);
+        if (hdt_failed()) return;
+    }
+}
+
+/* A of n points whose sampled points (index k * n / SAMPLE: every point
+ * of the sample stride) lie on B's points and the others `far` away, or
+ * the reverse (near = 0): the sample sees the opposite of the set. */
+static void misleading(size_t n, int sampled_near, double **a, double **b, hd_points_t *A, hd_points_t *B) {
+    gen_rng_t g;
+    gen_seed(&g, 7);
+    *b = malloc(24 * n);
+    *a = malloc(24 * n);
+    gen_cube(&g, *b, n, 0, 1);
+    char *sampled = calloc(n, 1);
+    for (size_t k = 0; k < 4096; k++) sampled[(uint64_t)k * n / 4096] = 1;
+    for (size_t i = 0; i < n; i++) {
+        int near = sampled[i] == sampled_near;
+        for (int d = 0; d < 3; d++) (*a)[3 * i + d] = (*b)[3 * i + d] + (near ? 0.0 : 5.0 + 1e-3 * (double)(i % 97));
+    }
+    free(sampled);
+    *A = hd_points_f64(*a, n);
+    *B = hd_points_f64(*b, n);
+}
+
+TEST(a_misleading_sample_changes_no_bit) {
+    for (int sampled_near = 0; sampled_near < 2; sampled_near++) {
+        CONTEXT("sampled points %s", sampled_near ? "on B, the others far" : "far, the others on B");
+        double *a, *b;
+        hd_points_t A, B;
+        misleading(4096 * 3 + 17, sampled_near, &a, &b, &A, &B);
+        static const double ps[] = {5, 50, 95, 100, 0};
+        for (size_t k = 0; k < sizeof ps / sizeof ps[0]; k++) check_figures(&A, &B, ps[k]);
+        free(a);
+        free(b);
+    }
+}
+
+TEST(the_band_pass_counts_and_keeps_what_a_full_classification_does) {
+    for (uint64_t seed = 200; seed < 206; seed++) {
+        double *a, *b;
+        hd_points_t A, B;
+        make_pair(seed, 2500, &a, &b, &A, &B);
+        size_t na = A.count;
+        double *d2 = malloc(8 * na), *want = malloc(8 * na);
+        for (size_t i = 0; i < na; i++) d2[i] = brute_nearest(a + 3 * i, b, B.count, NULL);
+        hd__box_t ba, bb;
+        CHECK_RC(hd__points_scan(&A, "A", 1, &ba, NULL), HD_OK);
+        CHECK_RC(hd__points_scan(&B, "B", 1, &bb, NULL), HD_OK);
+        hd__box_merge(&ba, &bb);
+        hd__an_t s[2];
+        CHECK_RC(hd__an_build_pair(&A, &B, &ba, 2, s, NULL), HD_OK);
+        gen_rng_t g;
+        gen_seed(&g, seed);
+        for (int trial = 0; trial < 6; trial++) {
+            /* edges on actual values, so that ties sit on them */
+            double lo2 = trial == 0 ? 0 : d2[gen_u64(&g) % na], hi2 = trial == 1 ? INFINITY : d2[gen_u64(&g) % na];
+            if (lo2 > hi2) {
+                double t = lo2;
+                lo2 = hi2, hi2 = t;
+            }
+            size_t below = 0, above = 0, in = 0;
+            for (size_t i = 0; i < na; i++) {
+                below += d2[i] < lo2;
+                above += d2[i] > hi2;
+                if (d2[i] >= lo2 && d2[i] <= hi2) want[in++] = d2[i];
+            }
+            qsort(want, in, 8, cmp_d);
+            for (int threads = 1; threads <= 3; threads += 2) {
+                CONTEXT("seed=%llu band [%.17g, %.17g] threads=%d", (unsigned long long)seed, lo2, hi2, threads);
+                hd__an_band_t got;
+                CHECK_RC(hd__an_band(&s[0], &s[1], lo2, hi2, threads, &got, NULL), HD_OK);
+                CHECK_EQ(got.below, below);
+                CHECK_EQ(got.above, above);
+                CHECK_EQ(got.n, in);
+                qsort(got.v, got.n, 8, cmp_d);
+                for (size_t k = 0; k < in && k < got.n; k++) CHECK_BITS(got.v[k], want[k]);
+                free(got.v);
+            }
+        }
+        hd__an_free(&s[0]);
+        hd__an_free(&s[1]);
+        free(d2);
+        free(want);
+        free(a);
+        free(b);
+        if (hdt_failed()) return;
+    }
+}
+
+TEST(an_empty_side_is_refused_as_before) {
+    double p[3] = {0, 0, 0};
+    hd_points_t A = hd_points_f64(p, 1), E = hd_points_f64(p, 0);
+    hd_percentile_t r;
+    CHECK_RC(hd_hausdorff_percentile(&A, &E, NULL, 95, &r, NULL), HD_EEMPTY);
+    CHECK_RC(hd_hausdorff_percentile(&E, &A, NULL, 95, &r, NULL), HD_EEMPTY);
+    CHECK_RC(hd_hausdorff_percentile(&A, &A, NULL, 100.5, &r, NULL), HD_EINVAL);
+}
