@@ -1,8 +1,9 @@
 /*
  * hausdorff.h -- exact Hausdorff distance between 3D point sets.
  *
- * This is the only public header of libhausdorff.  Everything a C user needs
- * is declared and documented here; nothing else needs to be read.
+ * This is the public header of libhausdorff (the optional MPI library adds
+ * hausdorff_mpi.h).  Everything a C user needs is declared and documented
+ * here; nothing else needs to be read.
  *
  * A first program:
  *

@@ -26,8 +26,8 @@
  * (the division by 2^32 is exact: v - (v mod 2^32)), every 512 additions:
  * 70 limbs, a fraction of an operation per addition.  The top limb keeps
  * the sign, and the 70 limbs reach 2^1166, so the sum of 2^64 doubles
- * (< 2^1088) never reaches it.  Cost: about 1-2 ns a value more than
- * Neumaier's summation (docs/benchmarks.md, "Exact sums").
+ * (< 2^1088) never reaches it.  Its cost against Neumaier's summation is
+ * measured by bench/summarize_bench.c (docs/benchmarks.md, "Exact sums").
  *
  * Rounding: the normalised limbs are a two's complement number; a negative
  * one is negated limb by limb and normalised again, so the magnitude is a

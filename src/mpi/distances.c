@@ -17,7 +17,7 @@
  *     hd_distances pairs point i with point i) is tried first when it is
  *     here (partners: one merge of the two sides' indices), if a sample
  *     says the partners are near (a copy and its original; not two
- *     samplings of one scene, where the merge would cost 2 % for nothing).
+ *     samplings of one scene, where the merge would cost time for nothing).
  *     No answer depends on them.
  *  2. Forwarding.  a is exact when its region's faces are clear of u(a)^2
  *     (hd__mpi_faces_clear, the proof of mpi.c's step 4: every point of
@@ -341,7 +341,7 @@ static uint64_t *decode(hd__mpi_ctx_t *c, const hd__mpi_gidx_t *gi, size_t n) {
 #define PAIR_CHUNK 512 /* indices of P decoded at once by the partners' merge */
 
 /* Whether the partners are worth their merge (an index decoded for every
- * point of both sides, about 2 % of a search on unrelated sets): at least
+ * point of both sides, wasted on unrelated sets: mpi_bench measures it): at least
  * half of PAIR_SAMPLES points of P, evenly spaced, have their partner
  * here and within the diagonal of its bucket's box (the scale of its
  * neighbours' spacing), as a copy's partners are; two independent

@@ -31,8 +31,9 @@
  *     broadcast, and each split is then moved, level by level, to the plane
  *     of its node's bracket that divides a second, larger sample (up to
  *     32768 a rank) nearest to floor(k/2)/k, counted exactly by one
- *     all-reduce a level (rcb.c, refine: 1024 samples a rank leave a region
- *     up to 13 % above its share, the second ones within 2 %).  Any
+ *     all-reduce a level (rcb.c, refine: a sample quantile is off by about
+ *     a standard deviation, the exact counts are not; mpi_partition_K and
+ *     mpi_bench measure the balance, docs/scale-out.md).  Any
  *     tree is a correct partition; the samples decide only the balance.
  *     Each rank's region is a box (faces at split coordinates,
  *     infinite outside), and every point of another region lies on or

@@ -244,9 +244,9 @@ static double edge(const double *br, int id, int j) {
 /* The second step of the partition.  Rank 0's tree divides the first
  * samples (c->first a rank, 64-1024) exactly, but a sample quantile is off
  * the true one by about a standard deviation of 1 / (2 sqrt(samples)) of
- * the node's points: with 1024 a rank 1-2 % of a leaf's, and the largest
- * of K regions a few times that (docs/scale-out.md, "The partition
- * refined"); four times more with 64.  So each split is moved, level by
+ * the node's points, and the largest of K regions a few times that
+ * (mpi_bench's imbalance, docs/scale-out.md); four times more with 64
+ * samples than with 1024.  So each split is moved, level by
  * level from the root, to the best of REFINE_BINS + 1 planes spread over
  * its bracket (build) or kept, judged by exact counts of a second, larger
  * sample (REFINE_PER_RANK a rank, at most a quarter of the points) routed

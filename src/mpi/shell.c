@@ -19,8 +19,8 @@
  * witness (hd__keep_t), so it cannot be the witness on any rank, whatever
  * other ranks hold near it.  The shell is the refused points alone (those
  * the engine could not prune and whose faces are not clear of their u),
- * none at K = 2 on the uniform and lidar scenes, where the points within
- * h_I of a face were 3 % (docs/scale-out.md); the rank's largest u (the
+ * few on the benchmark's scenes, far fewer than the points within h_I of a
+ * face (mpi_bench counts both, docs/scale-out.md); the rank's largest u (the
  * slabs' scale) is the larger of h_I and the refused points' largest.  A
  * refused point's nearest point of Q is the engine's own answer (offered
  * with it: the exact distance and the smallest index at it), so the shell
@@ -202,8 +202,8 @@ static size_t mark_pairs(const hd__mpi_gidx_t *gP, size_t nP, const hd__mpi_gidx
  * partners here (half at K = 2), but all of them when each rank's input is
  * already its region (tiles): the index alone then took two independent
  * epochs for a copy, ran the engine unfiltered on "pairs" that are not,
- * and the lidar scene in tiles at K = 2 searched 1.7 % of its points one
- * by one and held 47.2 bytes a point (docs/scale-out.md).  A sample that
+ * and searched many more points one by one with a higher peak (mpi_bench
+ * --layout tiles measures it, docs/scale-out.md).  A sample that
  * misses a copy only costs that pass, never an answer. */
 #define PAIRS_SAMPLE 64
 #define PAIRS_RIVALS 32
