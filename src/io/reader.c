@@ -501,6 +501,17 @@ static int read_loaded(const hd__file_t *f, const format_t *fmt, int from_extens
     return HD_OK;
 }
 
+/* The options checked, the format the name or --format gives (if any) and
+ * the file loaded: what every read of a path starts with.  On success the
+ * caller unloads f. */
+static int open_input(const char *path, const hd_read_options_t *opt, const format_t **fmt, int *from_extension,
+                      hd__file_t *f, int *mapped, hd_error_t *err) {
+    int rc = check_options(path, opt, err);
+    if (rc || (rc = choose(path, opt, fmt, from_extension, err))) return rc;
+    if (!*fmt && strcmp(path, "-") == 0) *from_extension = -1;
+    return load(path, opt, f, mapped, err);
+}
+
 /* hd_read_file, or hd_read_count when total is not NULL. */
 static int read_path(const char *path, const hd_read_options_t *opt, hd_cloud_t **out, uint64_t *total,
                      hd_error_t *err) {
@@ -510,13 +521,10 @@ static int read_path(const char *path, const hd_read_options_t *opt, hd_cloud_t 
         opt = &defaults;
     }
     const format_t *fmt;
-    int from_extension;
-    int rc = check_options(path, opt, err);
-    if (rc || (rc = choose(path, opt, &fmt, &from_extension, err))) return rc;
-    if (!fmt && strcmp(path, "-") == 0) from_extension = -1;
+    int from_extension, mapped;
     hd__file_t f;
-    int mapped;
-    if ((rc = load(path, opt, &f, &mapped, err))) return rc;
+    int rc = open_input(path, opt, &fmt, &from_extension, &f, &mapped, err);
+    if (rc) return rc;
     rc = read_loaded(&f, fmt, from_extension, opt, out, total, err);
     unload(&f, mapped);
     return rc;
@@ -584,13 +592,10 @@ hd_points_t hd_cloud_points(const hd_cloud_t *cloud) {
 int hd__read_faces(const char *path, const hd_read_options_t *opt, hd__sink_t *verts, hd__tris_t *tris,
                    size_t *n_faces, const char **format, hd_error_t *err) {
     const format_t *fmt;
-    int from_extension;
-    int rc = check_options(path, opt, err);
-    if (rc || (rc = choose(path, opt, &fmt, &from_extension, err))) return rc;
-    if (!fmt && strcmp(path, "-") == 0) from_extension = -1;
+    int from_extension, mapped;
     hd__file_t f;
-    int mapped;
-    if ((rc = load(path, opt, &f, &mapped, err))) return rc;
+    int rc = open_input(path, opt, &fmt, &from_extension, &f, &mapped, err);
+    if (rc) return rc;
     rc = confirm(&f, &fmt, from_extension, err);
     if (rc == HD_OK && !fmt->faces)
         rc = hd__err(err, HD_EUNSUPPORTED, "%s: %s has no faces (meshes are read from PLY, OBJ, OFF and STL)", f.name,
