@@ -108,8 +108,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
         if (!(an->percentile >= 0 && an->percentile <= 100) || an->bins < 1 || an->bins > 100000) abort();
         if (!(an->max_distance >= 0) || !isfinite(an->max_distance)) abort();
         if (an->mask_points != MASK_SURFACE && an->mask_points != MASK_ALL) abort();
-        if (an->empty != EMPTY_ERROR && an->empty != EMPTY_INF && an->empty != EMPTY_NAN && an->empty != EMPTY_ZERO &&
-            an->empty != EMPTY_MONAI)
+        if (an->empty != HD_EMPTY_ERROR && an->empty != HD_EMPTY_INF && an->empty != HD_EMPTY_NAN && an->empty != HD_EMPTY_ZERO &&
+            an->empty != HD_EMPTY_MONAI)
             abort();
         if (an->distances_out && !distances_format_known(an->distances_out)) abort();
         if (an->connectivity < 1 || an->connectivity > 3) abort();

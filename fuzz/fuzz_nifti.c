@@ -66,7 +66,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     analysis_args_t an;
     memset(&an, 0, sizeof an);
     an.mask_points = size & 2 ? MASK_ALL : MASK_SURFACE;
-    an.empty = size & 4 ? EMPTY_ZERO : EMPTY_ERROR;
+    an.empty = size & 4 ? HD_EMPTY_ZERO : HD_EMPTY_ERROR;
     an.connectivity = (int)((size >> 3) % 3) + 1;
     an.mask_dims = (int[]){0, 2, 3}[(size >> 5) % 3];
     hd_cloud_t *c = (hd_cloud_t *)&an; /* must become NULL on failure */
@@ -79,7 +79,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     }
     if (!c || c->dtype != ro.dtype) abort();
     if (c->count == 0) {
-        if (an.empty == EMPTY_ERROR) abort();
+        if (an.empty == HD_EMPTY_ERROR) abort();
     } else {
         const mask_info_t *m = &an.mask[0];
         if (!m->is_mask || m->points != c->count || m->foreground < 1 ||
