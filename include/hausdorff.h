@@ -942,9 +942,9 @@ typedef struct hd_surface_options {
     int relative;      /* 1: tolerance times the diagonal of the bounding
                           box of A and B together; 0: absolute */
     int threads;       /* 0: every core; 1: serial */
-    uint64_t max_splits; /* per face of X: at most this many splits, then
-                          its bound stands as it is (converged 0); 0 =
-                          no limit */
+    uint64_t max_splits; /* 2^20: per face of X, at most this many
+                          splits, then its bound stands as it is
+                          (converged 0); 0: no limit */
 } hd_surface_options_t;
 
 /* Fill `opt` with the defaults shown above. */
