@@ -139,11 +139,6 @@ static int is_vertex(const corner_t *c, int level) {
     return c->k[0] == one || c->k[1] == one || c->k[2] == one;
 }
 
-typedef struct ctx {
-    const hd__m2m_job_t *job;
-    face_t *faces;
-} ctx_t;
-
 static void evaluate(const hd__m2m_job_t *J, const hd__tri_t *t, double e, corner_t *c, int level, size_t seed,
                      hd__bvh_stats_t *st) {
     hd__tri_near_t near;
@@ -316,33 +311,100 @@ static double upper_of(const hd__m2m_job_t *J, const sub_t *s, double e, uint64_
 
 /* ---- phase 1: every face's corners -------------------------------------- */
 
+/* A corner of a face as phase 0 finds it. */
+typedef struct found {
+    double r, near[3];
+    size_t pos, index;
+} found_t;
+
+typedef struct ctx {
+    const hd__m2m_job_t *job;
+    face_t *faces;
+    const uint64_t *order; /* the corners (3 f + j) in Morton order, in the low 32 bits */
+    found_t *found;        /* by corner */
+    size_t n_corners;
+} ctx_t;
+
+#define CORNER(J, id) ((J)->from[(id) / 3].v[(id) % 3])
+
+/* Phase 0: each corner's nearest triangle, in Morton order so that each
+ * search starts from its predecessor's answer; a corner equal to its
+ * predecessor copies it (the answer is the brute force's: it depends on
+ * the point alone). */
+static void phase0(void *vctx, size_t task, int worker) {
+    (void)worker;
+    ctx_t *C = vctx;
+    const hd__m2m_job_t *J = C->job;
+    size_t lo = task * CHUNK * 3, hi = lo + CHUNK * 3 < C->n_corners ? lo + CHUNK * 3 : C->n_corners;
+    size_t seed = SIZE_MAX, prev = SIZE_MAX;
+    hd__bvh_stats_t st = {0, 0, 0, 0};
+    for (size_t k = lo; k < hi; k++) {
+        size_t id = C->order ? (size_t)(C->order[k] & 0xffffffffu) : k;
+        found_t *F = &C->found[id];
+        if (J->drop && J->drop[id / 3]) continue;
+        if (prev != SIZE_MAX && memcmp(CORNER(J, id), CORNER(J, prev), 3 * sizeof(double)) == 0) {
+            *F = C->found[prev];
+            continue;
+        }
+        hd__tri_near_t near;
+        F->pos = seed = hd__bvh_nearest(J->to, CORNER(J, id), seed, &near, &F->index, &st);
+        F->r = near.d;
+        memcpy(F->near, near.point, sizeof F->near);
+        prev = id;
+    }
+    C->faces[lo / 3].kernel += st.kernel; /* counted on the chunk's first face */
+}
+
 static void phase1(void *vctx, size_t task, int worker) {
     (void)worker;
     ctx_t *C = vctx;
     const hd__m2m_job_t *J = C->job;
-    size_t lo = task * CHUNK, hi = lo + CHUNK < J->n_from ? lo + CHUNK : J->n_from, seed = SIZE_MAX;
+    size_t lo = task * CHUNK, hi = lo + CHUNK < J->n_from ? lo + CHUNK : J->n_from;
     for (size_t f = lo; f < hi; f++) {
         face_t *F = &C->faces[f];
-        memset(F, 0, sizeof *F);
-        if (J->drop && J->drop[f]) {
-            F->done = 1;
-            continue;
-        }
-        const hd__tri_t *t = &J->from[f];
-        hd__bvh_stats_t st = {0, 0, 0, 0};
+        if (F->done) continue;
         for (int i = 0; i < 3; i++) {
             corner_t *c = &F->top.c[i];
+            const found_t *x = &C->found[3 * f + (size_t)i];
             c->k[0] = c->k[1] = c->k[2] = 0;
             c->k[i] = 1;
-            evaluate(J, t, 0, c, 0, seed, &st);
-            seed = c->pos;
+            memcpy(c->p, J->from[f].v[i], sizeof c->p);
+            c->r = c->lower = x->r;
+            c->pos = x->pos;
+            c->index = x->index;
+            memcpy(c->near, x->near, sizeof c->near);
             offer(&F->best, c, 0, 0);
         }
         F->top.level = 0;
         F->top.U = upper_of(J, &F->top, 0, &F->kernel);
         F->upper = F->top.U;
-        F->kernel += st.kernel;
     }
+}
+
+/* The corners' Morton order (NULL when there are too many to key; any
+ * order is correct). */
+static int corner_order(const hd__m2m_job_t *J, int threads, uint64_t **out) {
+    *out = NULL;
+    size_t n = 3 * J->n_from;
+    if (n > UINT32_MAX) return HD_OK;
+    uint64_t *keys = hd__malloc_array(n, sizeof *keys), *tmp = hd__malloc_array(n, sizeof *tmp);
+    if (!keys || !tmp) {
+        free(keys);
+        free(tmp);
+        return HD_ENOMEM;
+    }
+    hd__box_t box = {{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
+    for (size_t id = 0; id < n; id++)
+        for (int d = 0; d < 3; d++)
+            box.lo[d] = fmin(box.lo[d], CORNER(J, id)[d]), box.hi[d] = fmax(box.hi[d], CORNER(J, id)[d]);
+    hd__keygrid_t g;
+    hd__keygrid_init(&g, &box);
+    for (size_t id = 0; id < n; id++) keys[id] = (uint64_t)hd__key30(&g, CORNER(J, id)) << 32 | (uint64_t)id;
+    int rc = hd__radix_sort(&keys, &tmp, n, threads);
+    free(tmp);
+    if (rc) free(keys);
+    else *out = keys;
+    return rc;
 }
 
 /* ---- phase 2: refining one face ----------------------------------------- */
@@ -542,14 +604,31 @@ int hd__m2m_run(const hd__m2m_job_t *J, hd__m2m_result_t *R) {
     memset(R, 0, sizeof *R);
     R->face = R->face_b = SIZE_MAX;
     size_t n = J->n_from;
-    ctx_t C = {J, hd__malloc_array(n ? n : 1, sizeof(face_t))};
+    ctx_t C = {J, hd__malloc_array(n ? n : 1, sizeof(face_t)), NULL, NULL, 0};
     rank_t *rk = hd__malloc_array(n ? n : 1, sizeof *rk);
     if (!C.faces || !rk) {
         free(C.faces);
         free(rk);
         return HD_ENOMEM;
     }
+    C.n_corners = 3 * n;
+    C.found = hd__malloc_array(n ? 3 * n : 1, sizeof *C.found);
+    uint64_t *order = NULL;
+    if (!C.found || corner_order(J, J->threads, &order)) {
+        free(C.faces);
+        free(rk);
+        free(C.found);
+        return HD_ENOMEM;
+    }
+    C.order = order;
+    for (size_t f = 0; f < n; f++) {
+        memset(&C.faces[f], 0, sizeof C.faces[f]);
+        C.faces[f].done = J->drop && J->drop[f];
+    }
+    hd__parallel_for(J->threads, (n + CHUNK - 1) / CHUNK, phase0, &C);
     hd__parallel_for(J->threads, (n + CHUNK - 1) / CHUNK, phase1, &C);
+    free(order);
+    free(C.found);
     size_t live = 0;
     for (size_t f = 0; f < n; f++) {
         take_best(R, &C.faces[f], f);
