@@ -118,7 +118,14 @@ def surface_hausdorff(a, b, *, tolerance=1e-9, relative=True, directed=False, th
     [lower, upper] no wider than the tolerance (relative: times the
     diagonal of both sides' bounding box; 0: as tight as doubles allow).
     Returns a SurfaceHausdorff: lower and upper of H (of h(a, b) when
-    directed), ab and ba with their witnesses."""
+    directed), ab and ba with their witnesses.
+
+    >>> import numpy as np, hausdorff
+    >>> v = np.array([[0, 0, 0], [4, 0, 0], [0, 4, 0]], dtype=float)
+    >>> r = hausdorff.surface_hausdorff(hausdorff.Mesh(v, [[0, 1, 2]]), v, tolerance=1e-12)
+    >>> r.lower <= 8 ** 0.5 <= r.upper   # the hypotenuse's midpoint, far from every corner
+    True
+    """
     av, af, bv, bf = _sides(a, b)
     ab, ba = _hausdorff._surface(av, af, bv, bf, tolerance=tolerance, relative=bool(relative),
                                  threads=threads, max_splits=max_splits, directed=bool(directed))

@@ -1,6 +1,7 @@
 """hausdorff.surface_hausdorff, surface_within and face_maxima: the distance
 between surfaces as an enclosure, checked against dense samples of A whose
 distances come from Mesh.distances (exact on exactly representable samples)."""
+import doctest
 import math
 
 import numpy as np
@@ -85,3 +86,8 @@ def test_bad_input_is_refused():
         hausdorff.surface_hausdorff(a, hausdorff.Mesh(QUAD, [[0, 1, 7]]))
     with pytest.raises(ValueError):
         hausdorff.surface_hausdorff(a, a, tolerance=-1)
+
+
+def test_docstring_examples_run():
+    failed, attempted = doctest.testmod(hausdorff._surface, optionflags=doctest.ELLIPSIS)
+    assert attempted > 0 and failed == 0
