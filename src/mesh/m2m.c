@@ -291,10 +291,14 @@ static double pair_bound(const hd__m2m_job_t *J, const sub_t *s, double U, uint6
     return U;
 }
 
-static double upper_of(const hd__m2m_job_t *J, const sub_t *s, double e, uint64_t *kernel) {
+/* The sub-triangle's upper bound; once the point bound alone is at most
+ * `enough` (the sub-triangle will be discarded whatever its bound) the
+ * dearer bounds are skipped. */
+static double upper_of(const hd__m2m_job_t *J, const sub_t *s, double e, double enough, uint64_t *kernel) {
     double rmax = 0;
     for (int i = 0; i < 3; i++) rmax = fmax(rmax, up(s->c[i].r));
     double U = up(rmax + reach(s));
+    if ((s->level ? up(U + e) : U) <= enough) return s->level ? up(U + e) : U;
     for (int i = 0; i < 3; i++) { /* Tang's bound over the corners' nearest triangles */
         size_t cand = s->c[i].pos;
         int seen = 0;
@@ -376,7 +380,7 @@ static void phase1(void *vctx, size_t task, int worker) {
             offer(&F->best, c, 0, 0);
         }
         F->top.level = 0;
-        F->top.U = upper_of(J, &F->top, 0, &F->kernel);
+        F->top.U = upper_of(J, &F->top, 0, -INFINITY, &F->kernel);
         F->upper = F->top.U;
     }
 }
@@ -447,9 +451,14 @@ static size_t pool_put(pool_t *P, const sub_t *s) {
 }
 
 /* The four children of s (corners 0, 1, 2; midpoints m01, m12, m20). */
-static void split(const hd__m2m_job_t *J, const hd__tri_t *t, double e, const sub_t *s, sub_t kids[4],
+static double threshold(const hd__m2m_job_t *J, double L, const face_t *F) {
+    double thr = J->per_face ? F->best.lower : fmax(L, F->best.lower);
+    return thr;
+}
+
+static void split(const hd__m2m_job_t *J, const hd__tri_t *t, double e, double L, const sub_t *s, sub_t kids[4],
                   face_t *F, hd__bvh_stats_t *st) {
-    int L = s->level + 1;
+    int level = s->level + 1;
     corner_t c[3], m[3];
     for (int i = 0; i < 3; i++) {
         c[i] = s->c[i];
@@ -458,21 +467,17 @@ static void split(const hd__m2m_job_t *J, const hd__tri_t *t, double e, const su
     for (int i = 0; i < 3; i++) {
         const corner_t *p = &s->c[i], *q = &s->c[(i + 1) % 3];
         for (int j = 0; j < 3; j++) m[i].k[j] = p->k[j] + q->k[j];
-        evaluate(J, t, e, &m[i], L, p->pos, st);
-        offer(&F->best, &m[i], L, e);
+        evaluate(J, t, e, &m[i], level, p->pos, st);
+        offer(&F->best, &m[i], level, e);
     }
     const corner_t *tri[4][3] = {{&c[0], &m[0], &m[2]}, {&m[0], &c[1], &m[1]}, {&m[2], &m[1], &c[2]},
                                  {&m[0], &m[1], &m[2]}};
+    double enough = fmax(threshold(J, L, F), J->done_below);
     for (int q = 0; q < 4; q++) {
         for (int i = 0; i < 3; i++) kids[q].c[i] = *tri[q][i];
-        kids[q].level = L;
-        kids[q].U = upper_of(J, &kids[q], e, &F->kernel);
+        kids[q].level = level;
+        kids[q].U = upper_of(J, &kids[q], e, enough, &F->kernel);
     }
-}
-
-static double threshold(const hd__m2m_job_t *J, double L, const face_t *F) {
-    double thr = J->per_face ? F->best.lower : fmax(L, F->best.lower);
-    return thr;
 }
 
 /* Refine face f against the lower bound L of the batches before it. */
@@ -507,7 +512,7 @@ static void refine(const hd__m2m_job_t *J, face_t *F, size_t f, double L, pool_t
             break;
         }
         sub_t kids[4];
-        split(J, t, e, &s, kids, F, &st);
+        split(J, t, e, L, &s, kids, F, &st);
         F->splits++;
         thr = threshold(J, L, F);
         for (int q = 0; q < 4; q++) {
