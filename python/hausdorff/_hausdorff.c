@@ -629,12 +629,12 @@ static PyStructSequence_Field summary_fields[] = {
     {"mean2_ba", "mean squared distance of B's points to A"},
     {"mean_symmetric", "max(mean_ab, mean_ba): the average Hausdorff distance"},
     {"mean_average", "(mean_ab + mean_ba) / 2"},
-    {"mean_pooled", "(sum_ab + sum_ba) / (n_ab + n_ba): MONAI's symmetric average surface "
-                    "distance, medpy's assd"},
+    {"mean_pooled", "math.fsum of both sets' distances / (n_ab + n_ba): MONAI's symmetric "
+                    "average surface distance, medpy's assd"},
     {"chamfer", "mean2_ab + mean2_ba: the Chamfer distance (as PyTorch3D)"},
-    {"chamfer_sum2", "sum2_ab + sum2_ba"},
+    {"chamfer_sum2", "math.fsum of both sets' squared distances"},
     {"chamfer_mean", "mean_ab + mean_ba: point-cloud-utils' chamfer_distance"},
-    {"chamfer_sum", "sum_ab + sum_ba"},
+    {"chamfer_sum", "math.fsum of both sets' distances"},
     {NULL, NULL},
 };
 
