@@ -408,9 +408,9 @@ static int write_empty_files(const analysis_args_t *an, const hd_points_t *A,
     for (size_t k = 0; k < n; k++) d[k] = v;
     int rc = write_distances(an->distances_out, A, d, NULL, 1.0, err);
     if (rc == HD_OK && !directed) {
-        char path_b[4096];
-        path_with_suffix(an->distances_out, "_b", path_b, sizeof path_b);
-        rc = write_distances(path_b, B, d, NULL, 1.0, err);
+        char *path_b = path_with_suffix(an->distances_out, "_b");
+        rc = path_b ? write_distances(path_b, B, d, NULL, 1.0, err) : alloc_fail(err, n);
+        free(path_b);
     }
     free(d);
     return rc;
@@ -492,12 +492,6 @@ int analysis_handle_empty(const analysis_args_t *an, const char *path_a,
 }
 
 /* ---- the run ----------------------------------------------------------------- */
-
-static double seconds_now(void) {
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 /* The last component of a path, without the '/' that may end a directory's
  * ("tiles/" -> "tiles"), into buf. */
@@ -603,30 +597,30 @@ int analysis_run(const analysis_args_t *an, const hd_options_t *opt,
         r->j_ba = malloc(B->count * sizeof *r->j_ba);
         if (!r->d_ba || !r->j_ba) return alloc_fail(err, B->count);
     }
-    double t0 = seconds_now();
+    double t0 = cli_now();
     int rc = hd_distances(A, B, opt, r->d_ab, r->j_ab, r->d_ba, r->j_ba, err);
-    r->seconds = seconds_now() - t0;
+    r->seconds = cli_now() - t0;
     if (rc) return rc;
     static const analysis_ops_t here = {hd_summarize, hd_percentile_of, hd_histogram};
     if ((rc = analysis_figures(an, &here, r->d_ab, A->count, r->d_ba, directed ? 0 : B->count, r, err))) return rc;
     double scale = analysis_scale(an, r);
     if (an->distances_out) {
-        snprintf(r->dist_path_a, sizeof r->dist_path_a, "%s", an->distances_out);
+        r->dist_path_a = an->distances_out;
         if ((rc = write_distances(r->dist_path_a, A, r->d_ab, r->j_ab, scale, err))) return rc;
         if (!directed) {
-            path_with_suffix(an->distances_out, "_b", r->dist_path_b, sizeof r->dist_path_b);
+            if (!(r->dist_path_b = path_with_suffix(an->distances_out, "_b"))) return alloc_fail(err, B->count);
             if ((rc = write_distances(r->dist_path_b, B, r->d_ba, r->j_ba, scale, err))) return rc;
         }
     }
+    render_notes_t notes = {analysis_units(an), an->percentile_on, r->pct};
     if (an->render_out) {
         char title[640];
         analysis_render_title(path_a, A->count, path_b, title, sizeof title);
-        render_notes_t notes = {analysis_units(an), an->percentile_on, r->pct};
         if ((rc = render_distances(an->render_out, A, B, r->d_ab, scale, s, directed, &notes, title, r->markers,
                                    &r->n_markers, &r->render, &r->render_w, &r->render_h, err)))
             return rc;
     }
-    if (an->histogram_png && (rc = render_histogram(an->histogram_png, r, an, an->bins, r->hist_markers,
+    if (an->histogram_png && (rc = render_histogram(an->histogram_png, r, &notes, an->bins, r->hist_markers,
                                                     &r->n_hist_markers, err)))
         return rc;
     return HD_OK;
@@ -639,6 +633,7 @@ void analysis_free(analysis_result_t *r) {
     free(r->j_ba);
     free(r->hist_ab);
     free(r->hist_ba);
+    free(r->dist_path_b);
     memset(r, 0, sizeof *r);
 }
 

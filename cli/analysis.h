@@ -121,7 +121,8 @@ typedef struct analysis_result {
     double hist_lo, hist_hi;
     uint64_t *hist_ab, *hist_ba;
     size_t above_ab, above_ba; /* values beyond the histogram range */
-    char dist_path_a[4096], dist_path_b[4096];
+    const char *dist_path_a;   /* --distances */
+    char *dist_path_b;         /* its _b file (malloc: analysis_free) */
     int render_w, render_h, n_markers;
     render_marker_t markers[6];
     render_info_t render;
@@ -210,9 +211,6 @@ int distances_wide(const size_t *nearest, size_t n);
 size_t distances_header(const dist_layout_t *f, char buf[DIST_HEAD_MAX]);
 size_t distances_row(const dist_layout_t *f, const double q[3], double d, const size_t *nearest,
                      unsigned char buf[DIST_ROW_MAX]);
-/* OUT.ext -> OUT_b.ext */
-void path_with_suffix(const char *path, const char *suffix, char *out,
-                      size_t size);
 
 /* ---- pictures (render.c) ------------------------------------------------- */
 int render_available(void);
@@ -280,7 +278,7 @@ int render_compose(const char *path, const render_scene_t *sc, const render_laye
 /* A bar chart of the histogram(s) with the percentile and mean marked;
  * where those lines were drawn goes into marks (at most 4). */
 int render_histogram(const char *path, const analysis_result_t *r,
-                     const analysis_args_t *an, size_t bins,
+                     const render_notes_t *notes, size_t bins,
                      hist_marker_t marks[4], int *n_marks, hd_error_t *err);
 
 /* ---- text (font.c) --------------------------------------------------------- */

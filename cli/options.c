@@ -10,12 +10,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* The program's name in messages: the last part of argv[0] as cli_parse
- * saw it ("hausdorff", "hausdorff-mpi"); "hausdorff" before that. */
-static const char *prog_name = "hausdorff";
-
-const char *cli_prog(void) { return prog_name; }
-
 /* hausdorff-mpi (cli_set_mpi): its own usage line, description and examples. */
 static int mpi_tool;
 
@@ -23,7 +17,7 @@ void cli_set_mpi(void) { mpi_tool = 1; }
 
 static void usage_head(FILE *out) {
     if (mpi_tool) {
-        fprintf(out, "usage: mpirun -n K %s [options] A B\n", prog_name);
+        fprintf(out, "usage: mpirun -n K %s [options] A B\n", cli_prog());
         fprintf(out,
 "\n"
 "Exact Hausdorff distance between the point sets in files A and B on K MPI\n"
@@ -31,7 +25,7 @@ static void usage_head(FILE *out) {
 "and per-point outputs as hausdorff, to the bit, plus the exchange's figures\n"
 "(the \"mpi:\" lines; \"mpi\" in the JSON).\n");
     } else {
-        fprintf(out, "usage: %s [options] A B\n", prog_name);
+        fprintf(out, "usage: %s [options] A B\n", cli_prog());
         fprintf(out, "\nExact Hausdorff distance between the point sets in files A and B:\n");
     }
     fprintf(out,
@@ -188,10 +182,7 @@ static int parse_double(const char *s, double *out) {
 
 int cli_parse(int argc, char **argv, cli_args_t *a) {
     memset(a, 0, sizeof *a);
-    if (argc > 0 && argv[0] && argv[0][0]) {
-        const char *slash = strrchr(argv[0], '/');
-        prog_name = slash && slash[1] ? slash + 1 : argv[0];
-    }
+    if (argc > 0) cli_set_prog(argv[0]);
     hd_options_init(&a->opt);
     hd_read_options_init(&a->read);
     analysis_args_init(&a->an);
@@ -206,7 +197,7 @@ int cli_parse(int argc, char **argv, cli_args_t *a) {
         }
         if (strcmp(s, "--") == 0) { only_files = 1; continue; }
         if (strcmp(s, "--help") == 0 || strcmp(s, "-h") == 0) { cli_usage(stdout); return EXIT_OK; }
-        if (strcmp(s, "--version") == 0) { printf("%s %s\n", prog_name, hd_version()); return EXIT_OK; }
+        if (strcmp(s, "--version") == 0) { printf("%s %s\n", cli_prog(), hd_version()); return EXIT_OK; }
         if (strcmp(s, "--directed") == 0) { a->directed = 1; continue; }
         if (strcmp(s, "--json") == 0) { a->json = 1; continue; }
         if (strcmp(s, "--quiet") == 0 || strcmp(s, "-q") == 0) { a->quiet = 1; continue; }

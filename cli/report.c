@@ -11,12 +11,6 @@
 #include <string.h>
 #include <time.h>
 
-double cli_now(void) {
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 /* Library codes to exit codes; an output failure (OUT_EFAIL) is 3. */
 int cli_exit_for(int code) {
     switch (code) {

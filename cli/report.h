@@ -47,7 +47,4 @@ int report_single(const hd_points_t *p, const mask_info_t *m);
 /* Library codes to exit codes: bad input 2, anything else 3. */
 int cli_exit_for(int code);
 
-/* Seconds on a monotonic clock. */
-double cli_now(void);
-
 #endif

@@ -86,12 +86,16 @@ static int distances_mpi(const cli_args_t *a, const hd_mpi_part_t part[2], const
 static int distances_files_mpi(const cli_args_t *a, const hd_mpi_part_t part[2], const uint64_t total[2],
                                const hd_symmetric_t *s, analysis_result_t *r, hd_error_t *err) {
     double scale = a->an.max_distance > 0 ? a->an.max_distance : s->distance;
-    snprintf(r->dist_path_a, sizeof r->dist_path_a, "%s", a->an.distances_out);
-    if (!a->directed) path_with_suffix(a->an.distances_out, "_b", r->dist_path_b, sizeof r->dist_path_b);
+    r->dist_path_a = a->an.distances_out;
+    int rc = HD_OK;
+    if (!a->directed && !(r->dist_path_b = path_with_suffix(a->an.distances_out, "_b"))) {
+        snprintf(err->message, sizeof err->message, "out of memory for a file name");
+        rc = err->code = HD_ENOMEM;
+    }
+    rc = agree(rc, err); /* every rank writes, or none */
     const char *path[2] = {r->dist_path_a, r->dist_path_b};
     const double *d[2] = {r->d_ab, r->d_ba};
     const size_t *j[2] = {r->j_ab, r->j_ba};
-    int rc = HD_OK;
     for (int w = 0; w < (a->directed ? 1 : 2) && rc == HD_OK; w++)
         rc = mpi_write_distances(path[w], &part[w].points, part[w].offset, d[w], j[w], (size_t)total[w], scale,
                                  err);
@@ -381,16 +385,16 @@ int main(int argc, char **argv) {
                 size_t most = part[0].points.count > part[1].points.count ? part[0].points.count
                                                                           : part[1].points.count;
                 double *d = malloc((most ? most : 1) * sizeof *d);
-                char path_b[4096];
-                path_with_suffix(a.an.distances_out, "_b", path_b, sizeof path_b);
+                char *path_b = path_with_suffix(a.an.distances_out, "_b");
                 const char *path[2] = {a.an.distances_out, path_b};
-                rc = d ? HD_OK : HD_ENOMEM;
-                if (!d) snprintf(err.message, sizeof err.message, "out of memory for %zu per-point distances", most);
+                rc = d && path_b ? HD_OK : HD_ENOMEM;
+                if (rc) snprintf(err.message, sizeof err.message, "out of memory for %zu per-point distances", most);
                 for (size_t k = 0; k < most && d; k++) d[k] = v;
                 for (int w = 0; w < (a.directed ? 1 : 2) && (rc = agree(rc, &err)) == HD_OK; w++)
                     rc = mpi_write_distances(path[w], &part[w].points, part[w].offset, d, NULL, (size_t)all[w], 1.0,
                                              &err);
                 free(d);
+                free(path_b);
                 if (rc != HD_OK) {
                     for (int w = 0; w < 2; w++) {
                         hd_cloud_free(cloud[w]);
