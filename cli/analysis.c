@@ -1,5 +1,5 @@
 /*
- * analysis.c -- the command line's analysis options: parsing them, running
+ * analysis.c -- the command line's analysis options (options.c parses them): running
  * them after the Hausdorff distance, and reporting them for a person or in
  * the JSON object.
  *
@@ -30,8 +30,6 @@
 #include "analysis.h"
 #include "cli.h"
 
-#include <errno.h>
-#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -117,170 +115,6 @@ void analysis_usage(FILE *out) {
             render_available() ? "" : " (unavailable: built without libpng)",
             render_available() ? "" : " (unavailable)",
             nifti_available() ? "" : " (unavailable: built without libnifti2)");
-}
-
-static int usage_error(const char *fmt, const char *arg) {
-    fprintf(stderr, "%s: ", cli_prog());
-    fprintf(stderr, fmt, safe_text(arg));
-    fprintf(stderr, "\nTry '%s --help'.\n", cli_prog());
-    return -1;
-}
-
-static int to_double(const char *s, double *out) {
-    char *e;
-    errno = 0;
-    double v = strtod(s, &e);
-    /* ERANGE also says a result is subnormal (1e-320), or below the
-     * smallest subnormal (taken as 0): both read as the value returned */
-    if (e == s || *e || (errno && !(errno == ERANGE && fabs(v) <= DBL_MIN)) || !isfinite(v)) return -1;
-    *out = v;
-    return 0;
-}
-
-/* --tau T[,T...]: each a number >= 0; 1, or -1 after a usage error. */
-static int parse_taus(const char *v, analysis_args_t *an) {
-    char buf[4096];
-    if (strlen(v) >= sizeof buf) return usage_error("--tau: the list is too long ('%s')", v);
-    snprintf(buf, sizeof buf, "%s", v);
-    an->n_taus = 0;
-    char *save = NULL;
-    for (char *t = strtok_r(buf, ",", &save); t; t = strtok_r(NULL, ",", &save)) {
-        double d;
-        if (to_double(t, &d) || d < 0) return usage_error("--tau needs numbers >= 0 separated by commas, not '%s'", v);
-        if (an->n_taus == ANALYSIS_MAX_TAUS) return usage_error("--tau takes at most 64 tolerances ('%s')", v);
-        an->taus[an->n_taus++] = d;
-    }
-    if (!an->n_taus) return usage_error("--tau needs numbers >= 0 separated by commas, not '%s'", v);
-    return 1;
-}
-
-/* The options that take a value, by their place in value_names. */
-typedef enum {
-    OPT_PERCENTILE,
-    OPT_BINS,
-    OPT_DISTANCES,
-    OPT_MAX_DISTANCE,
-    OPT_RENDER,
-    OPT_HISTOGRAM_PNG,
-    OPT_MASK_POINTS,
-    OPT_EMPTY,
-    OPT_CONNECTIVITY,
-    OPT_MASK_DIMS,
-    OPT_UNITS,
-    OPT_TAU,
-    OPT_TAU_RULE,
-    OPT_DTU_CAP,
-    OPT_COUNT
-} value_option_t;
-
-static const char *const value_names[OPT_COUNT + 1] = {
-    [OPT_PERCENTILE] = "--percentile",   [OPT_BINS] = "--bins",
-    [OPT_DISTANCES] = "--distances",     [OPT_MAX_DISTANCE] = "--max-distance",
-    [OPT_RENDER] = "--render",           [OPT_HISTOGRAM_PNG] = "--histogram-png",
-    [OPT_MASK_POINTS] = "--mask-points", [OPT_EMPTY] = "--empty",
-    [OPT_CONNECTIVITY] = "--connectivity", [OPT_MASK_DIMS] = "--mask-dims",
-    [OPT_UNITS] = "--units",             [OPT_TAU] = "--tau",
-    [OPT_TAU_RULE] = "--tau-rule",       [OPT_DTU_CAP] = "--dtu-cap",
-    [OPT_COUNT] = NULL};
-
-int analysis_parse_option(int argc, char **argv, int *k, analysis_args_t *an) {
-    const char *s = argv[*k];
-    if (strcmp(s, "--mean") == 0) return an->mean = 1;
-    if (strcmp(s, "--chamfer") == 0) return an->chamfer = 1;
-    if (strcmp(s, "--histogram") == 0) return an->histogram = 1;
-    const char *eq = strchr(s, '=');
-    size_t nl = eq ? (size_t)(eq - s) : strlen(s);
-    int which = -1;
-    for (int w = 0; value_names[w]; w++)
-        if (strlen(value_names[w]) == nl && strncmp(s, value_names[w], nl) == 0) which = w;
-    if (which < 0) return 0;
-    const char *name = value_names[which];
-    const char *v = eq ? eq + 1 : (*k + 1 < argc ? argv[++*k] : NULL);
-    if (!v) return usage_error("option '%s' needs a value", name);
-    double d;
-    switch (which) {
-    case OPT_PERCENTILE:
-        if (to_double(v, &d) || d < 0 || d > 100)
-            return usage_error("--percentile needs a number in [0, 100], not '%s'", v);
-        an->percentile_on = 1;
-        an->percentile = d;
-        break;
-    case OPT_BINS:
-        if (to_double(v, &d) || d < 1 || d > 100000 || d != floor(d))
-            return usage_error("--bins needs a whole number 1..100000, not '%s'", v);
-        an->bins = (size_t)d;
-        break;
-    case OPT_DISTANCES:
-        if (!distances_format_known(v))
-            return usage_error("--distances: cannot tell the format of '%s'; name it .csv, .ply or .npy", v);
-        an->distances_out = v;
-        break;
-    case OPT_MAX_DISTANCE:
-        if (to_double(v, &d) || !(d > 0)) {
-            errno = 0;
-            double u = strtod(v, NULL); /* 1e-400: positive, but no double */
-            if (u == 0 && errno == ERANGE && !signbit(u))
-                return usage_error("--max-distance %s is below the smallest positive double, 4.9e-324", v);
-            return usage_error("--max-distance needs a positive number, not '%s'", v);
-        }
-        an->max_distance = d;
-        break;
-    case OPT_RENDER:
-    case OPT_HISTOGRAM_PNG:
-        if (!render_available())
-            return usage_error("%s is unavailable: this hausdorff was built without libpng "
-                               "(Debian: libpng-dev)", name);
-        if (!render_path_ok(v)) {
-            char m[4200];
-            snprintf(m, sizeof m, "%s %s: pictures are written as PNG only; name the file .png", name, v);
-            return usage_error("%s", m);
-        }
-        if (which == OPT_RENDER) an->render_out = v;
-        else an->histogram_png = v;
-        break;
-    case OPT_MASK_POINTS:
-        if (strcmp(v, "surface") == 0) an->mask_points = MASK_SURFACE;
-        else if (strcmp(v, "all") == 0) an->mask_points = MASK_ALL;
-        else return usage_error("--mask-points is surface or all, not '%s'", v);
-        break;
-    case OPT_EMPTY:
-        if (hd_empty_policy_from_name(v, &an->empty) != HD_OK || an->empty < HD_EMPTY_INF ||
-            an->empty > HD_EMPTY_MONAI)
-            return usage_error("--empty is inf, nan, zero or monai, not '%s'", v);
-        break;
-    case OPT_CONNECTIVITY:
-        if (strcmp(v, "1") && strcmp(v, "2") && strcmp(v, "3"))
-            return usage_error("--connectivity is 1, 2 or 3 (faces, and edges, and corners), not '%s'", v);
-        an->connectivity = v[0] - '0';
-        break;
-    case OPT_MASK_DIMS:
-        if (strcmp(v, "auto") == 0) an->mask_dims = 0;
-        else if (strcmp(v, "2") == 0 || strcmp(v, "3") == 0) an->mask_dims = v[0] - '0';
-        else return usage_error("--mask-dims is auto, 2 or 3, not '%s'", v);
-        break;
-    case OPT_UNITS:
-        if (!v[0] || strlen(v) > 16 || strpbrk(v, "\"\\") || strspn(v, " ") == strlen(v))
-            return usage_error("--units needs a short label (1 to 16 characters, no quotes), not '%s'", v);
-        for (const char *c = v; *c; c++)
-            if ((unsigned char)*c < ' ' || (unsigned char)*c > '~')
-                return usage_error("--units needs printable ASCII (the pictures' font has no other), not '%s'", v);
-        an->units = v;
-        break;
-    case OPT_TAU:
-        return parse_taus(v, an);
-    case OPT_TAU_RULE:
-        if (strcmp(v, "le") == 0) an->tau_rule = HD_AT_MOST;
-        else if (strcmp(v, "lt") == 0) an->tau_rule = HD_BELOW;
-        else return usage_error("--tau-rule is le (d <= tau) or lt (d < tau), not '%s'", v);
-        break;
-    case OPT_DTU_CAP:
-        if (strcmp(v, "inf") == 0) d = INFINITY;
-        else if (to_double(v, &d) || !(d > 0))
-            return usage_error("--dtu-cap needs a positive number or inf, not '%s'", v);
-        an->dtu_cap = d;
-        break;
-    }
-    return 1;
 }
 
 const char *analysis_units(const analysis_args_t *an) {

@@ -2,7 +2,8 @@
  * analysis.h -- the command line's analysis features: per-point distances
  * and their statistics (analysis.c), the files they are written to
  * (writers.c), pictures (render.c, font.c), and NIfTI masks (nifti.c).
- * options.c and main.c only hook these in; everything else is here.
+ * options.c parses their options (one table for every option of the tool)
+ * and main.c runs them; everything else is here.
  */
 #ifndef HD_CLI_ANALYSIS_H
 #define HD_CLI_ANALYSIS_H
@@ -53,10 +54,6 @@ typedef struct analysis_args {
 
 /* ---- options (analysis.c) ---------------------------------------------- */
 void analysis_args_init(analysis_args_t *an);
-/* Look at argv[*k]: 0 when it is not an analysis option; 1 when it was one
- * (its value consumed, *k advanced past it); -1 after reporting a usage
- * error on stderr. */
-int analysis_parse_option(int argc, char **argv, int *k, analysis_args_t *an);
 /* The options' part of --help. */
 void analysis_usage(FILE *out);
 

@@ -7,6 +7,8 @@
 #include "tiles.h"
 
 #include <errno.h>
+#include <float.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -171,12 +173,205 @@ static int parse_size(const char *s, uint64_t *out) {
     return 0;
 }
 
-static int parse_double(const char *s, double *out) {
+/* A finite number filling s up to end; a subnormal (1e-320), or one below
+ * the smallest subnormal (read as 0), is the value strtod returns. */
+static int parse_double_upto(const char *s, const char *end, double *out) {
     char *e;
     errno = 0;
     double v = strtod(s, &e);
-    if (e == s || *e || errno) return -1;
+    if (e == s || e != end || (errno && !(errno == ERANGE && fabs(v) <= DBL_MIN)) || !isfinite(v)) return -1;
     *out = v;
+    return 0;
+}
+
+static int parse_double(const char *s, double *out) { return parse_double_upto(s, s + strlen(s), out); }
+
+/* Every option that takes a value, as "--opt VALUE" or "--opt=VALUE": the
+ * run's (before OPT_PERCENTILE) and the analysis's (analysis.h). */
+typedef enum {
+    OPT_ALGORITHM, OPT_THREADS, OPT_SEED, OPT_DEPTH, OPT_LAMBDA, OPT_THETA, OPT_FORMAT, OPT_SAMPLE,
+    OPT_MAX_STREAM_SIZE, OPT_FIFO_WAIT, OPT_LAZ_POINTS_PER_BYTE,
+    OPT_PERCENTILE, OPT_BINS, OPT_DISTANCES, OPT_MAX_DISTANCE, OPT_RENDER, OPT_HISTOGRAM_PNG,
+    OPT_MASK_POINTS, OPT_EMPTY, OPT_CONNECTIVITY, OPT_MASK_DIMS, OPT_UNITS, OPT_TAU, OPT_TAU_RULE,
+    OPT_DTU_CAP,
+    OPT_COUNT
+} value_option_t;
+
+static const char *const value_names[OPT_COUNT] = {
+    [OPT_ALGORITHM] = "--algorithm",     [OPT_THREADS] = "--threads",
+    [OPT_SEED] = "--seed",               [OPT_DEPTH] = "--depth",
+    [OPT_LAMBDA] = "--lambda",           [OPT_THETA] = "--theta",
+    [OPT_FORMAT] = "--format",           [OPT_SAMPLE] = "--sample",
+    [OPT_MAX_STREAM_SIZE] = "--max-stream-size", [OPT_FIFO_WAIT] = "--fifo-wait",
+    [OPT_LAZ_POINTS_PER_BYTE] = "--laz-points-per-byte",
+    [OPT_PERCENTILE] = "--percentile",   [OPT_BINS] = "--bins",
+    [OPT_DISTANCES] = "--distances",     [OPT_MAX_DISTANCE] = "--max-distance",
+    [OPT_RENDER] = "--render",           [OPT_HISTOGRAM_PNG] = "--histogram-png",
+    [OPT_MASK_POINTS] = "--mask-points", [OPT_EMPTY] = "--empty",
+    [OPT_CONNECTIVITY] = "--connectivity", [OPT_MASK_DIMS] = "--mask-dims",
+    [OPT_UNITS] = "--units",             [OPT_TAU] = "--tau",
+    [OPT_TAU_RULE] = "--tau-rule",       [OPT_DTU_CAP] = "--dtu-cap"};
+
+/* The option that "--name" or "--name=VALUE" names, or -1. */
+static int value_option(const char *s) {
+    const char *eq = strchr(s, '=');
+    size_t nl = eq ? (size_t)(eq - s) : strlen(s);
+    for (int w = 0; w < OPT_COUNT; w++)
+        if (strlen(value_names[w]) == nl && strncmp(s, value_names[w], nl) == 0) return w;
+    return -1;
+}
+
+/* A run option's value (hd_options_t, hd_read_options_t): 0, or
+ * EXIT_USAGE after a message. */
+static int set_run(cli_args_t *a, int which, const char *v) {
+    long l;
+    if (which == OPT_ALGORITHM) {
+        if (hd_algorithm_from_name(v, &a->opt.algorithm) != HD_OK)
+            return bad("unknown algorithm '%s'", v);
+    } else if (which == OPT_THREADS) {
+        if (parse_long(v, 0, 1024, &l)) return bad("--threads needs a whole number 0..1024, not '%s'", v);
+        a->opt.threads = (int)l;
+    } else if (which == OPT_SEED) {
+        if (parse_u64(v, &a->opt.seed)) return bad("--seed needs a non-negative whole number, not '%s'", v);
+    } else if (which == OPT_DEPTH) {
+        if (parse_long(v, 1, 21, &l)) return bad("--depth needs a whole number 1..21, not '%s'", v);
+        a->opt.depth = (int)l;
+    } else if (which == OPT_LAMBDA) {
+        if (parse_double(v, &a->opt.lambda) || !(a->opt.lambda > 0 && a->opt.lambda <= 1))
+            return bad("--lambda needs a number in (0, 1], not '%s'", v);
+    } else if (which == OPT_THETA) {
+        if (parse_double(v, &a->opt.theta) || !(a->opt.theta >= 0 && a->opt.theta <= 1))
+            return bad("--theta needs a number in [0, 1], not '%s'", v);
+    } else if (which == OPT_FORMAT) {
+        if (!(a->read.format = tiles_format_named(v, strlen(v))))
+            return bad("unknown format '%s' (see --formats)", v);
+    } else if (which == OPT_SAMPLE) {
+        uint64_t n;
+        if (parse_u64(v, &n) || n == 0 || n > (uint64_t)1 << 40)
+            return bad("--sample needs a whole number of points 1..2^40, not '%s'", v);
+        a->read.mesh = HD_MESH_SAMPLE;
+        a->read.sample = (size_t)n;
+    } else if (which == OPT_MAX_STREAM_SIZE) {
+        if (parse_size(v, &a->read.stream_limit))
+            return bad("--max-stream-size needs a positive size in bytes (K, M or G may follow), not '%s'", v);
+    } else if (which == OPT_FIFO_WAIT) {
+        if (parse_long(v, 1, 86400, &l)) return bad("--fifo-wait needs a whole number of seconds 1..86400, not '%s'", v);
+        a->read.fifo_wait_ms = (int)l * 1000;
+    } else if (which == OPT_LAZ_POINTS_PER_BYTE) {
+        if (parse_long(v, 1, HD_LAZ_POINTS_PER_BYTE_MAX, &l))
+            return bad("--laz-points-per-byte needs a whole number 1..4096, not '%s'", v);
+        a->read.laz_points_per_byte = (unsigned)l;
+    }
+    return 0;
+}
+
+/* --tau T[,T...]: each a number >= 0, at most ANALYSIS_MAX_TAUS of them;
+ * 0, or EXIT_USAGE after a message.  Each field is read in place, its end
+ * the next comma, so a list of any length needs no copy. */
+static int set_taus(analysis_args_t *an, const char *v) {
+    an->n_taus = 0;
+    for (const char *t = v;; t++) {
+        const char *comma = strchr(t, ',');
+        size_t len = comma ? (size_t)(comma - t) : strlen(t);
+        double d;
+        if (len) {
+            if (parse_double_upto(t, t + len, &d) || d < 0)
+                return bad("--tau needs numbers >= 0 separated by commas, not '%s'", v);
+            if (an->n_taus == ANALYSIS_MAX_TAUS) return bad("--tau takes at most 64 tolerances ('%s')", v);
+            an->taus[an->n_taus++] = d;
+        }
+        if (!comma) break;
+        t = comma;
+    }
+    if (!an->n_taus) return bad("--tau needs numbers >= 0 separated by commas, not '%s'", v);
+    return 0;
+}
+
+/* An analysis option's value (analysis.h): 0, or EXIT_USAGE after a message. */
+static int set_analysis(analysis_args_t *an, int which, const char *name, const char *v) {
+    double d;
+    switch (which) {
+    case OPT_PERCENTILE:
+        if (parse_double(v, &d) || d < 0 || d > 100)
+            return bad("--percentile needs a number in [0, 100], not '%s'", v);
+        an->percentile_on = 1;
+        an->percentile = d;
+        break;
+    case OPT_BINS:
+        if (parse_double(v, &d) || d < 1 || d > 100000 || d != floor(d))
+            return bad("--bins needs a whole number 1..100000, not '%s'", v);
+        an->bins = (size_t)d;
+        break;
+    case OPT_DISTANCES:
+        if (!distances_format_known(v))
+            return bad("--distances: cannot tell the format of '%s'; name it .csv, .ply or .npy", v);
+        an->distances_out = v;
+        break;
+    case OPT_MAX_DISTANCE:
+        if (parse_double(v, &d) || !(d > 0)) {
+            errno = 0;
+            double u = strtod(v, NULL); /* 1e-400: positive, but no double */
+            if (u == 0 && errno == ERANGE && !signbit(u))
+                return bad("--max-distance %s is below the smallest positive double, 4.9e-324", v);
+            return bad("--max-distance needs a positive number, not '%s'", v);
+        }
+        an->max_distance = d;
+        break;
+    case OPT_RENDER:
+    case OPT_HISTOGRAM_PNG:
+        if (!render_available())
+            return bad("%s is unavailable: this hausdorff was built without libpng "
+                               "(Debian: libpng-dev)", name);
+        if (!render_path_ok(v)) {
+            fprintf(stderr, "%s: %s %s: pictures are written as PNG only; name the file .png\nTry '%s --help'.\n",
+                    cli_prog(), name, safe_text(v), cli_prog());
+            return EXIT_USAGE;
+        }
+        if (which == OPT_RENDER) an->render_out = v;
+        else an->histogram_png = v;
+        break;
+    case OPT_MASK_POINTS:
+        if (strcmp(v, "surface") == 0) an->mask_points = MASK_SURFACE;
+        else if (strcmp(v, "all") == 0) an->mask_points = MASK_ALL;
+        else return bad("--mask-points is surface or all, not '%s'", v);
+        break;
+    case OPT_EMPTY:
+        if (hd_empty_policy_from_name(v, &an->empty) != HD_OK || an->empty < HD_EMPTY_INF ||
+            an->empty > HD_EMPTY_MONAI)
+            return bad("--empty is inf, nan, zero or monai, not '%s'", v);
+        break;
+    case OPT_CONNECTIVITY:
+        if (strcmp(v, "1") && strcmp(v, "2") && strcmp(v, "3"))
+            return bad("--connectivity is 1, 2 or 3 (faces, and edges, and corners), not '%s'", v);
+        an->connectivity = v[0] - '0';
+        break;
+    case OPT_MASK_DIMS:
+        if (strcmp(v, "auto") == 0) an->mask_dims = 0;
+        else if (strcmp(v, "2") == 0 || strcmp(v, "3") == 0) an->mask_dims = v[0] - '0';
+        else return bad("--mask-dims is auto, 2 or 3, not '%s'", v);
+        break;
+    case OPT_UNITS:
+        if (!v[0] || strlen(v) > 16 || strpbrk(v, "\"\\") || strspn(v, " ") == strlen(v))
+            return bad("--units needs a short label (1 to 16 characters, no quotes), not '%s'", v);
+        for (const char *c = v; *c; c++)
+            if ((unsigned char)*c < ' ' || (unsigned char)*c > '~')
+                return bad("--units needs printable ASCII (the pictures' font has no other), not '%s'", v);
+        an->units = v;
+        break;
+    case OPT_TAU:
+        return set_taus(an, v);
+    case OPT_TAU_RULE:
+        if (strcmp(v, "le") == 0) an->tau_rule = HD_AT_MOST;
+        else if (strcmp(v, "lt") == 0) an->tau_rule = HD_BELOW;
+        else return bad("--tau-rule is le (d <= tau) or lt (d < tau), not '%s'", v);
+        break;
+    case OPT_DTU_CAP:
+        if (strcmp(v, "inf") == 0) d = INFINITY;
+        else if (parse_double(v, &d) || !(d > 0))
+            return bad("--dtu-cap needs a positive number or inf, not '%s'", v);
+        an->dtu_cap = d;
+        break;
+    }
     return 0;
 }
 
@@ -208,62 +403,16 @@ int cli_parse(int argc, char **argv, cli_args_t *a) {
         if (strcmp(s, "--vertices") == 0) { a->read.mesh = HD_MESH_VERTICES; continue; }
         if (strcmp(s, "--surface") == 0) { a->surface = 1; continue; }
         if (strcmp(s, "--formats") == 0) { cli_formats(stdout); return EXIT_OK; }
-        int an = analysis_parse_option(argc, argv, &k, &a->an);
-        if (an < 0) return EXIT_USAGE;
-        if (an > 0) continue;
-        /* options with an argument, as "--opt VALUE" or "--opt=VALUE" */
-        const char *eq = strchr(s, '=');
-        char name[64];
-        size_t nl = eq ? (size_t)(eq - s) : strlen(s);
-        if (nl >= sizeof name) return bad("unknown option '%s'", s);
-        memcpy(name, s, nl);
-        name[nl] = '\0';
-        static const char *const with_arg[] = {"--algorithm", "--threads", "--seed", "--depth",
-                                               "--lambda", "--theta", "--format", "--sample",
-                                               "--max-stream-size", "--fifo-wait", "--laz-points-per-byte", NULL};
-        int known = 0;
-        for (int w = 0; with_arg[w]; w++) known |= strcmp(name, with_arg[w]) == 0;
-        if (!known) return bad("unknown option '%s'", s);
+        if (strcmp(s, "--mean") == 0) { a->an.mean = 1; continue; }
+        if (strcmp(s, "--chamfer") == 0) { a->an.chamfer = 1; continue; }
+        if (strcmp(s, "--histogram") == 0) { a->an.histogram = 1; continue; }
+        int which = value_option(s);
+        if (which < 0) return bad("unknown option '%s'", s);
+        const char *eq = strchr(s, '='), *name = value_names[which];
         const char *v = eq ? eq + 1 : (k + 1 < argc ? argv[++k] : NULL);
         if (!v) return bad("option '%s' needs a value", name);
-        long l;
-        if (strcmp(name, "--algorithm") == 0) {
-            if (hd_algorithm_from_name(v, &a->opt.algorithm) != HD_OK)
-                return bad("unknown algorithm '%s'", v);
-        } else if (strcmp(name, "--threads") == 0) {
-            if (parse_long(v, 0, 1024, &l)) return bad("--threads needs a whole number 0..1024, not '%s'", v);
-            a->opt.threads = (int)l;
-        } else if (strcmp(name, "--seed") == 0) {
-            if (parse_u64(v, &a->opt.seed)) return bad("--seed needs a non-negative whole number, not '%s'", v);
-        } else if (strcmp(name, "--depth") == 0) {
-            if (parse_long(v, 1, 21, &l)) return bad("--depth needs a whole number 1..21, not '%s'", v);
-            a->opt.depth = (int)l;
-        } else if (strcmp(name, "--lambda") == 0) {
-            if (parse_double(v, &a->opt.lambda) || !(a->opt.lambda > 0 && a->opt.lambda <= 1))
-                return bad("--lambda needs a number in (0, 1], not '%s'", v);
-        } else if (strcmp(name, "--theta") == 0) {
-            if (parse_double(v, &a->opt.theta) || !(a->opt.theta >= 0 && a->opt.theta <= 1))
-                return bad("--theta needs a number in [0, 1], not '%s'", v);
-        } else if (strcmp(name, "--format") == 0) {
-            if (!(a->read.format = tiles_format_named(v, strlen(v))))
-                return bad("unknown format '%s' (see --formats)", v);
-        } else if (strcmp(name, "--sample") == 0) {
-            uint64_t n;
-            if (parse_u64(v, &n) || n == 0 || n > (uint64_t)1 << 40)
-                return bad("--sample needs a whole number of points 1..2^40, not '%s'", v);
-            a->read.mesh = HD_MESH_SAMPLE;
-            a->read.sample = (size_t)n;
-        } else if (strcmp(name, "--max-stream-size") == 0) {
-            if (parse_size(v, &a->read.stream_limit))
-                return bad("--max-stream-size needs a positive size in bytes (K, M or G may follow), not '%s'", v);
-        } else if (strcmp(name, "--fifo-wait") == 0) {
-            if (parse_long(v, 1, 86400, &l)) return bad("--fifo-wait needs a whole number of seconds 1..86400, not '%s'", v);
-            a->read.fifo_wait_ms = (int)l * 1000;
-        } else if (strcmp(name, "--laz-points-per-byte") == 0) {
-            if (parse_long(v, 1, HD_LAZ_POINTS_PER_BYTE_MAX, &l))
-                return bad("--laz-points-per-byte needs a whole number 1..4096, not '%s'", v);
-            a->read.laz_points_per_byte = (unsigned)l;
-        }
+        int rc = which < OPT_PERCENTILE ? set_run(a, which, v) : set_analysis(&a->an, which, name, v);
+        if (rc) return rc;
     }
     a->read.seed = a->opt.seed; /* --seed also seeds --sample */
     if (nfiles != 2) {
