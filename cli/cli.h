@@ -33,8 +33,9 @@ typedef struct cli_args {
 int cli_parse(int argc, char **argv, cli_args_t *a);
 void cli_usage(FILE *out);
 /* The usage text is hausdorff-mpi's (its usage line, description and
- * examples): hausdorff-mpi calls this before cli_parse. */
-void cli_set_mpi(void);
+ * examples) and --version prints with version(out): hausdorff-mpi calls
+ * this before cli_parse. */
+void cli_set_mpi(void (*version)(FILE *out));
 /* The formats the reader knows, one per line (--formats). */
 void cli_formats(FILE *out);
 

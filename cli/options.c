@@ -12,10 +12,20 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* hausdorff-mpi (cli_set_mpi): its own usage line, description and examples. */
+/* hausdorff-mpi (cli_set_mpi): its own usage line, description, examples
+ * and --version line. */
 static int mpi_tool;
+static void (*mpi_version)(FILE *out);
 
-void cli_set_mpi(void) { mpi_tool = 1; }
+void cli_set_mpi(void (*version)(FILE *out)) {
+    mpi_tool = 1;
+    mpi_version = version;
+}
+
+static void print_version(FILE *out) {
+    if (mpi_version) mpi_version(out);
+    else fprintf(out, "%s %s\n", cli_prog(), hd_version());
+}
 
 static void usage_head(FILE *out) {
     if (mpi_tool) {
@@ -392,7 +402,7 @@ int cli_parse(int argc, char **argv, cli_args_t *a) {
         }
         if (strcmp(s, "--") == 0) { only_files = 1; continue; }
         if (strcmp(s, "--help") == 0 || strcmp(s, "-h") == 0) { cli_usage(stdout); return EXIT_OK; }
-        if (strcmp(s, "--version") == 0) { printf("%s %s\n", cli_prog(), hd_version()); return EXIT_OK; }
+        if (strcmp(s, "--version") == 0) { print_version(stdout); return EXIT_OK; }
         if (strcmp(s, "--directed") == 0) { a->directed = 1; continue; }
         if (strcmp(s, "--json") == 0) { a->json = 1; continue; }
         if (strcmp(s, "--quiet") == 0 || strcmp(s, "-q") == 0) { a->quiet = 1; continue; }

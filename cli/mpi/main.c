@@ -121,10 +121,11 @@ static int finish(int status) {
     return status;
 }
 
+/* A failed run's message (rank 0's), its files discarded: the exit code. */
 static int fail(int rc, const hd_error_t *err) {
     fprintf(stderr, "hausdorff-mpi: %s\n", safe_text(err->message));
     out_discard();
-    return finish(cli_exit_for(rc));
+    return cli_exit_for(rc);
 }
 
 /* Silence every rank but 0: one message, one report. */
@@ -301,17 +302,8 @@ static void mpi_json(FILE *out, const hd_mpi_stats_t *st, const hd_mpi_stats_t *
     fputc('}', out);
 }
 
-/* Whether --version comes before --help, -h and "--" (cli_parse takes the
- * first of them): then rank 0 also says which MPI the tool runs on. */
-static int asks_version(int argc, char **argv) {
-    for (int k = 1; k < argc; k++) {
-        if (!strcmp(argv[k], "--") || !strcmp(argv[k], "--help") || !strcmp(argv[k], "-h")) return 0;
-        if (!strcmp(argv[k], "--version")) return 1;
-    }
-    return 0;
-}
-
-static int print_version(void) {
+/* --version (cli_parse): the library's version and the MPI the tool runs on. */
+static void print_version(FILE *out) {
     char lib[MPI_MAX_LIBRARY_VERSION_STRING];
     int len = 0, major = 0, minor = 0;
     MPI_Get_library_version(lib, &len);
@@ -319,27 +311,17 @@ static int print_version(void) {
     lib[len > 0 && len < MPI_MAX_LIBRARY_VERSION_STRING ? len : 0] = '\0';
     char *nl = strpbrk(lib, "\r\n,");
     if (nl) *nl = '\0'; /* the library's first line, name and version */
-    if (rank_ == 0) printf("hausdorff-mpi %s (MPI %d.%d: %s)\n", hd_version(), major, minor, lib);
-    return finish(EXIT_OK);
+    fprintf(out, "hausdorff-mpi %s (MPI %d.%d: %s)\n", hd_version(), major, minor, lib);
 }
 
-int main(int argc, char **argv) {
-    MPI_Init(&argc, &argv);
-    MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
-    MPI_Comm_size(MPI_COMM_WORLD, &K_);
-    quiet_others();
-    out_guard_std();
-    cli_args_t a;
-    cli_set_mpi();
-    if (asks_version(argc, argv)) return print_version();
-    int rc = cli_parse(argc, argv, &a); /* the same verdict on every rank */
-    if (rc >= 0) return finish(rc == EXIT_OK ? out_finish() : rc);
+/* The run after parsing, collective: its exit status (every rank's;
+ * rank 0's is the one printed).  What it makes goes into side, cloud and
+ * an, which main frees in one place. */
+static int run(cli_args_t *a, tiles_t side[2], hd_cloud_t *cloud[2], analysis_result_t *an) {
     hd_error_t err;
     memset(&err, 0, sizeof err);
-    tiles_t side[2];
-    memset(side, 0, sizeof side);
-    hd_cloud_t *cloud[2] = {NULL, NULL};
-    const char *paths[2] = {a.path_a, a.path_b}, *formats[2] = {a.format_a, a.format_b};
+    int rc;
+    const char *paths[2] = {a->path_a, a->path_b}, *formats[2] = {a->format_a, a->format_b};
     rc = HD_OK;
     for (int w = 0; w < 2 && rc == HD_OK; w++) {
         rc = tiles_expand(paths[w], formats[w], &side[w], &err);
@@ -347,12 +329,9 @@ int main(int argc, char **argv) {
         if ((rc = agree(rc, &err)) == HD_OK) rc = same_listing(&side[w], &err);
     }
     if (rc == HD_OK) { /* no output may overwrite an input: rank 0 checks */
-        int bad = rank_ == 0 ? out_check_outputs(&a, side) : 0;
+        int bad = rank_ == 0 ? out_check_outputs(a, side) : 0;
         MPI_Bcast(&bad, 1, MPI_INT, 0, MPI_COMM_WORLD);
-        if (bad) {
-            for (int w = 0; w < 2; w++) tiles_free(&side[w]);
-            return finish(bad);
-        }
+        if (bad) return bad;
     }
     /* Each rank reads its share of each side. */
     double t0 = cli_now();
@@ -361,13 +340,13 @@ int main(int argc, char **argv) {
     int split[2] = {0, 0};
     for (int w = 0; w < 2 && rc == HD_OK; w++) {
         int share = w ? (rank_ + K_ / 2) % K_ : rank_;
-        rc = read_split(&side[w], share, &a, &a.an, w, &split[w], &cloud[w], &part[w].offset, &err);
+        rc = read_split(&side[w], share, a, &a->an, w, &split[w], &cloud[w], &part[w].offset, &err);
         if ((rc = agree(rc, &err)) != HD_OK || split[w]) {
             if (rc == HD_OK) part[w].points = hd_cloud_points(cloud[w]);
             continue;
         }
         tiles_share(&side[w], share, K_, &first[w], &n[w]);
-        rc = tiles_read(&side[w], first[w], n[w], &a.read, &a.an, w, &cloud[w], &err);
+        rc = tiles_read(&side[w], first[w], n[w], &a->read, &a->an, w, &cloud[w], &err);
         if ((rc = agree(rc, &err)) == HD_OK) rc = number_tiles(&side[w], first[w], n[w], &part[w].offset, &err);
         if (rc == HD_OK) part[w].points = hd_cloud_points(cloud[w]);
     }
@@ -380,41 +359,31 @@ int main(int argc, char **argv) {
              * policy's value with nearest index -1 (a side with no point
              * gets a file with no rows) */
             int status = EXIT_OK;
-            if (a.an.distances_out) {
-                double v = hd_empty_value(a.an.empty, (size_t)all[0], (size_t)all[1]);
+            if (a->an.distances_out) {
+                double v = hd_empty_value(a->an.empty, (size_t)all[0], (size_t)all[1]);
                 size_t most = part[0].points.count > part[1].points.count ? part[0].points.count
                                                                           : part[1].points.count;
                 double *d = malloc((most ? most : 1) * sizeof *d);
-                char *path_b = path_with_suffix(a.an.distances_out, "_b");
-                const char *path[2] = {a.an.distances_out, path_b};
+                char *path_b = path_with_suffix(a->an.distances_out, "_b");
+                const char *path[2] = {a->an.distances_out, path_b};
                 rc = d && path_b ? HD_OK : HD_ENOMEM;
                 if (rc) snprintf(err.message, sizeof err.message, "out of memory for %zu per-point distances", most);
                 for (size_t k = 0; k < most && d; k++) d[k] = v;
-                for (int w = 0; w < (a.directed ? 1 : 2) && (rc = agree(rc, &err)) == HD_OK; w++)
+                for (int w = 0; w < (a->directed ? 1 : 2) && (rc = agree(rc, &err)) == HD_OK; w++)
                     rc = mpi_write_distances(path[w], &part[w].points, part[w].offset, d, NULL, (size_t)all[w], 1.0,
                                              &err);
                 free(d);
                 free(path_b);
-                if (rc != HD_OK) {
-                    for (int w = 0; w < 2; w++) {
-                        hd_cloud_free(cloud[w]);
-                        tiles_free(&side[w]);
-                    }
-                    return fail(rc, &err);
-                }
+                if (rc != HD_OK) return fail(rc, &err);
             }
             /* the policy's answer, printed as hausdorff prints it: the
              * views carry the counts only (the files are written) */
-            analysis_args_t printed = a.an;
+            analysis_args_t printed = a->an;
             printed.distances_out = NULL;
             hd_points_t A = hd_points_f64(NULL, (size_t)all[0]), B = hd_points_f64(NULL, (size_t)all[1]);
-            if (rank_ == 0) status = analysis_handle_empty(&printed, a.path_a, a.path_b, &A, &B, a.directed, a.json);
+            if (rank_ == 0) status = analysis_handle_empty(&printed, a->path_a, a->path_b, &A, &B, a->directed, a->json);
             if (rank_ == 0) status = status == EXIT_OK ? out_finish() : (out_discard(), status);
-            for (int w = 0; w < 2; w++) {
-                hd_cloud_free(cloud[w]);
-                tiles_free(&side[w]);
-            }
-            return finish(status);
+            return status;
         }
     }
     hd_symmetric_t s;
@@ -423,41 +392,32 @@ int main(int argc, char **argv) {
     memset(&st, 0, sizeof st);
     if (rc == HD_OK) {
         MPI_Allreduce(&read_local, &read_seconds, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
-        if (a.directed) {
-            rc = hd_mpi_directed(MPI_COMM_WORLD, &part[0], 1, &part[1], 1, &a.opt, &s.ab, &st, &err);
+        if (a->directed) {
+            rc = hd_mpi_directed(MPI_COMM_WORLD, &part[0], 1, &part[1], 1, &a->opt, &s.ab, &st, &err);
             if (rc == HD_OK) {
                 s.distance = s.ab.distance;
                 s.seconds = s.ab.seconds;
                 rc = hd_mpi_overlap(MPI_COMM_WORLD, &part[0], 1, &part[1], 1, &s.alpha, &s.disjoint, &err);
             }
         } else {
-            rc = hd_mpi_hausdorff(MPI_COMM_WORLD, &part[0], 1, &part[1], 1, &a.opt, &s, &st, &err);
+            rc = hd_mpi_hausdorff(MPI_COMM_WORLD, &part[0], 1, &part[1], 1, &a->opt, &s, &st, &err);
         }
     }
-    analysis_result_t an;
     hd_mpi_stats_t dst; /* the per-point distances' call, when made */
-    memset(&an, 0, sizeof an);
     memset(&dst, 0, sizeof dst);
-    if (rc == HD_OK && analysis_active(&a.an)) {
+    if (rc == HD_OK && analysis_active(&a->an)) {
         uint64_t mine[2] = {part[0].points.count, part[1].points.count}, total[2];
         MPI_Allreduce(mine, total, 2, MPI_UINT64_T, MPI_SUM, MPI_COMM_WORLD);
         /* as analysis_run: the distances, the figures, the files, the pictures */
-        if ((rc = distances_mpi(&a, part, total, &an, &dst, &err)) == HD_OK)
-            rc = mpi_figures(&a.an, an.d_ab, part[0].points.count, an.d_ba, part[1].points.count, &an, &err);
-        if (rc == HD_OK && a.an.distances_out) rc = distances_files_mpi(&a, part, total, &s, &an, &err);
-        if (rc == HD_OK && a.an.render_out) rc = render_mpi(&a, part, &s, &an, &err);
+        if ((rc = distances_mpi(a, part, total, an, &dst, &err)) == HD_OK)
+            rc = mpi_figures(&a->an, an->d_ab, part[0].points.count, an->d_ba, part[1].points.count, an, &err);
+        if (rc == HD_OK && a->an.distances_out) rc = distances_files_mpi(a, part, total, &s, an, &err);
+        if (rc == HD_OK && a->an.render_out) rc = render_mpi(a, part, &s, an, &err);
     }
-    if (rc != HD_OK) {
-        analysis_free(&an);
-        for (int w = 0; w < 2; w++) {
-            hd_cloud_free(cloud[w]);
-            tiles_free(&side[w]);
-        }
-        return fail(rc, &err);
-    }
+    if (rc != HD_OK) return fail(rc, &err);
 
     /* Everything the report shows, on rank 0. */
-    report_t r = {&a, &s, side, {(size_t)0, (size_t)0}, {NULL, NULL}, {0, 0}, {0, 0, 0}, {0, 0, 0},
+    report_t r = {a, &s, side, {(size_t)0, (size_t)0}, {NULL, NULL}, {0, 0}, {0, 0, 0}, {0, 0, 0},
                   read_seconds, {0, 0}};
     char fmt[2][16];
     uint64_t counts[4] = {cloud[0]->count, cloud[1]->count, cloud[0]->n_faces, cloud[1]->n_faces}, sums[4];
@@ -468,12 +428,12 @@ int main(int argc, char **argv) {
         r.faces[w] = (size_t)sums[2 + w];
         r.format[w] = fmt[w];
     }
-    if (!a.json) { /* only the text prints coordinates: float32 data when it is on every rank */
-        int single[2] = {report_single(&part[0].points, &a.an.mask[0]), report_single(&part[1].points, &a.an.mask[1])};
+    if (!a->json) { /* only the text prints coordinates: float32 data when it is on every rank */
+        int single[2] = {report_single(&part[0].points, &a->an.mask[0]), report_single(&part[1].points, &a->an.mask[1])};
         MPI_Allreduce(single, r.single, 2, MPI_INT, MPI_LAND, MPI_COMM_WORLD);
     }
     int from_a;
-    const hd_result_t *wit = report_witness(&a, &s, &from_a);
+    const hd_result_t *wit = report_witness(a, &s, &from_a);
     fetch_point(&part[!from_a], wit->i, r.wp);
     fetch_point(&part[from_a], wit->j, r.wq);
     struct rusage ru;
@@ -494,20 +454,20 @@ int main(int argc, char **argv) {
         if (!ok) {
             fprintf(stderr, "hausdorff-mpi: out of memory\n");
             status = EXIT_FAILURE_;
-        } else if (a.json) {
+        } else if (a->json) {
             report_json(out, &r);
-            if (an.active) analysis_json(out, &a.an, &an);
-            mpi_json(out, &st, an.active ? &dst : NULL, col, split);
+            if (an->active) analysis_json(out, &a->an, an);
+            mpi_json(out, &st, an->active ? &dst : NULL, col, split);
             fprintf(out, "}\n");
         } else {
             report_text(out, &r);
-            if (an.active) analysis_print(out, &a.an, &an);
+            if (an->active) analysis_print(out, &a->an, an);
             char b[NUM_TEXT], f[NUM_TEXT], im[NUM_TEXT];
             fprintf(out, "mpi: %d rank%s, %s bytes moved per point, %s of the points forwarded, imbalance %s\n", K_,
                     plural((unsigned)K_),
                     num_ratio((double)(st.bytes_partition + st.bytes_forwarding) / (double)st.points, b),
                     num_ratio((double)st.forwarded_points / (double)st.points, f), num_ratio(st.imbalance, im));
-            if (an.active)
+            if (an->active)
                 fprintf(out, "mpi: per-point distances: %s bytes moved per point, %s of the points forwarded\n",
                         num_ratio((double)(dst.bytes_partition + dst.bytes_forwarding + dst.bytes_returned) /
                                       (double)dst.points, b),
@@ -518,10 +478,29 @@ int main(int argc, char **argv) {
         else out_discard();
     }
     free(all);
+    return status;
+}
+
+int main(int argc, char **argv) {
+    MPI_Init(&argc, &argv);
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
+    MPI_Comm_size(MPI_COMM_WORLD, &K_);
+    quiet_others();
+    out_guard_std();
+    cli_args_t a;
+    cli_set_mpi(print_version);
+    int rc = cli_parse(argc, argv, &a); /* the same verdict on every rank */
+    if (rc >= 0) return finish(rc == EXIT_OK ? out_finish() : rc);
+    tiles_t side[2];
+    hd_cloud_t *cloud[2] = {NULL, NULL};
+    analysis_result_t an;
+    memset(side, 0, sizeof side);
+    memset(&an, 0, sizeof an);
+    rc = run(&a, side, cloud, &an);
     analysis_free(&an);
     for (int w = 0; w < 2; w++) {
         hd_cloud_free(cloud[w]);
         tiles_free(&side[w]);
     }
-    return finish(status);
+    return finish(rc);
 }
