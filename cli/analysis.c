@@ -117,6 +117,10 @@ void analysis_usage(FILE *out) {
             nifti_available() ? "" : " (unavailable: built without libnifti2)");
 }
 
+render_notes_t analysis_notes(const analysis_args_t *an, const analysis_result_t *r) {
+    return (render_notes_t){analysis_units(an), an->percentile_on, r->pct};
+}
+
 const char *analysis_units(const analysis_args_t *an) {
     if (an->units) return an->units;
     for (int k = 0; k < 2; k++)
@@ -446,7 +450,7 @@ int analysis_run(const analysis_args_t *an, const hd_options_t *opt,
             if ((rc = write_distances(r->dist_path_b, B, r->d_ba, r->j_ba, scale, err))) return rc;
         }
     }
-    render_notes_t notes = {analysis_units(an), an->percentile_on, r->pct};
+    render_notes_t notes = analysis_notes(an, r);
     if (an->render_out) {
         char title[640];
         analysis_render_title(path_a, A->count, path_b, title, sizeof title);

@@ -166,6 +166,9 @@ int analysis_figures(const analysis_args_t *an, const analysis_ops_t *ops, const
 /* The picture's title line: "A's name (N points) coloured by distance to
  * B's name". */
 void analysis_render_title(const char *path_a, size_t n_a, const char *path_b, char *title, size_t size);
+/* What the pictures say besides the points: the unit and the percentile
+ * figures asked for. */
+render_notes_t analysis_notes(const analysis_args_t *an, const analysis_result_t *r);
 /* The colour and histogram scale: --max-distance, else the largest
  * distance (r->sum). */
 double analysis_scale(const analysis_args_t *an, const analysis_result_t *r);
