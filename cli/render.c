@@ -658,9 +658,9 @@ int render_distances(const char *path, const hd_points_t *A,
 }
 
 int render_histogram(const char *path, const analysis_result_t *r,
-                     const analysis_args_t *an, size_t bins,
+                     const render_notes_t *notes, size_t bins,
                      hist_marker_t marks[4], int *n_marks, hd_error_t *err) {
-    (void)path, (void)r, (void)an, (void)bins, (void)marks;
+    (void)path, (void)r, (void)notes, (void)bins, (void)marks;
     *n_marks = 0;
     return unavailable(err);
 }
