@@ -422,9 +422,9 @@ int analysis_run(const analysis_args_t *an, const hd_options_t *opt,
     r->n_b = B->count;
     if (!r->active) return HD_OK;
     if (!directed && analysis_percentile_only(an)) { /* the library's selection without every distance */
-        double t0 = seconds_now();
+        double t0 = cli_now();
         int rc = hd_hausdorff_percentile(A, B, opt, an->percentile, &r->pct, err);
-        r->seconds = seconds_now() - t0;
+        r->seconds = cli_now() - t0;
         return rc;
     }
     r->d_ab = malloc(A->count * sizeof *r->d_ab);
