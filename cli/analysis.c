@@ -221,25 +221,10 @@ static void json_figures(FILE *out, const analysis_args_t *an,
     }
 }
 
-/* A result whose every figure is the --empty policy's value v (NaN for
- * what a directed run does not compute). */
-static void empty_result(analysis_result_t *r, const analysis_args_t *an,
-                         double v, int directed) {
-    memset(r, 0, sizeof *r);
-    r->directed = directed;
-    double w = directed ? NAN : v;
-    r->pct = (hd_percentile_t){an->percentile, v, w, w, w};
-    r->sum.mean_ab = r->sum.mean2_ab = v;
-    r->sum.mean_ba = r->sum.mean_symmetric = r->sum.mean_average = r->sum.mean_pooled = w;
-    r->sum.mean2_ba = r->sum.chamfer = r->sum.chamfer_sum2 = r->sum.chamfer_mean = r->sum.chamfer_sum = w;
-}
-
-/* The per-point files of a run with an empty set: the other set's rows get
- * the policy's distance and nearest index -1; an empty set gets a file with
- * no rows, so that scripts find the files they asked for. */
-static int write_empty_files(const analysis_args_t *an, const hd_points_t *A,
-                             const hd_points_t *B, int directed, double v,
-                             hd_error_t *err) {
+/* The per-point files of a run with an empty set (analysis.h). */
+int analysis_empty_files(const analysis_args_t *an, const hd_points_t *A, const hd_points_t *B, int directed,
+                         double v, hd_error_t *err) {
+    if (!an->distances_out) return HD_OK;
     size_t n = A->count > B->count ? A->count : B->count;
     double *d = malloc((n ? n : 1) * sizeof *d);
     if (!d) return alloc_fail(err, n);
@@ -258,75 +243,36 @@ static int write_empty_files(const analysis_args_t *an, const hd_points_t *A,
  * nothing to be near (distance +inf), so none is within any tolerance: the
  * NSD is 0 with one set empty and NaN with both (MONAI's), a share of no
  * points NaN, and a capped mean of no values NaN. */
-static int empty_scores(const analysis_args_t *an, size_t n_a, size_t n_b, int directed, analysis_result_t *r) {
+static int empty_scores(const analysis_args_t *an, size_t n_a, size_t n_b, int directed, analysis_result_t *r,
+                        hd_error_t *err) {
     if (!an->n_taus && !(an->dtu_cap > 0)) return HD_OK;
     size_t n = n_a > n_b ? n_a : n_b;
     double *inf = malloc((n ? n : 1) * sizeof *inf);
-    hd_error_t err;
-    if (!inf) {
-        fprintf(stderr, "%s: out of memory for %zu distances\n", cli_prog(), n);
-        return HD_ENOMEM;
-    }
+    if (!inf) return alloc_fail(err, n);
     for (size_t k = 0; k < n; k++) inf[k] = INFINITY;
-    r->directed = directed;
-    int rc = scores_figures(an, inf, n_a, directed ? NULL : inf, n_b, r, &err);
+    int rc = scores_figures(an, inf, n_a, directed ? NULL : inf, n_b, r, err);
     free(inf);
-    if (rc != HD_OK) fprintf(stderr, "%s: %s\n", cli_prog(), err.message);
     return rc;
 }
 
-int analysis_handle_empty(const analysis_args_t *an, const char *path_a,
-                          const char *path_b, const hd_points_t *A,
-                          const hd_points_t *B, int directed, int json) {
-    size_t n_a = A->count, n_b = B->count;
-    if (n_a && n_b) return -1;
-    double v = hd_empty_value(an->empty, n_a, n_b);
-    FILE *out = stdout;
-    hd_error_t err;
-    if (an->distances_out && write_empty_files(an, A, B, directed, v, &err) != HD_OK) {
-        fprintf(stderr, "%s: %s\n", cli_prog(), safe_text(err.message));
-        return EXIT_FAILURE_;
-    }
+int analysis_empty(const analysis_args_t *an, size_t n_a, size_t n_b, int directed, hd_symmetric_t *s,
+                   analysis_result_t *r, hd_error_t *err) {
+    double v = hd_empty_value(an->empty, n_a, n_b), w = directed ? NAN : v;
+    memset(s, 0, sizeof *s);
+    s->distance = s->ab.distance = v;
+    s->ba.distance = w;
     if (an->render_out || an->histogram_png)
         fprintf(stderr, "%s: no picture drawn: %s is empty\n", cli_prog(), n_a ? "B" : "A");
-    if (json) {
-        fprintf(out, "{\"hausdorff\": ");
-        json_number(out, v);
-        fprintf(out, ", \"directed_ab\": ");
-        json_number(out, v);
-        fprintf(out, ", \"directed_ba\": ");
-        if (directed) fputs("null", out);
-        else json_number(out, v);
-        fprintf(out, ", \"witness_ab\": null, \"witness_ba\": null, \"witness_ab_files\": null, "
-                     "\"witness_ba_files\": null");
-        fprintf(out, ", \"empty\": {\"a\": %s, \"b\": %s, \"policy\": \"%s\"}", n_a ? "false" : "true",
-                n_b ? "false" : "true", hd_empty_policy_name(an->empty));
-        fprintf(out, ", \"n_a\": %zu, \"n_b\": %zu, \"file_a\": ", n_a, n_b);
-        json_string(out, path_a);
-        fprintf(out, ", \"file_b\": ");
-        json_string(out, path_b);
-        analysis_result_t r;
-        empty_result(&r, an, v, directed);
-        if (empty_scores(an, n_a, n_b, directed, &r) != HD_OK) return EXIT_FAILURE_;
-        json_figures(out, an, &r);
-        fprintf(out, "}\n");
-    } else {
-        fprintf(out, "A: %s (%zu point%s)\nB: %s (%zu point%s)\n", safe_text(path_a), n_a, plural(n_a),
-                safe_text(path_b), n_b, plural(n_b));
-        const char *which = !n_a && !n_b ? "A and B are" : !n_a ? "A is" : "B is";
-        char t[NUM_TEXT], pt[NUM_TEXT];
-        num_text(v, t);
-        fprintf(out, "%s = %s   (%s empty; --empty %s)\n", directed ? "h(A,B)" : "Hausdorff distance H(A,B)", t,
-                which, hd_empty_policy_name(an->empty));
-        if (an->percentile_on) fprintf(out, "percentile %s: %s\n", num_text(an->percentile, pt), t);
-        if (an->mean) fprintf(out, "mean distance: %s\n", t);
-        if (an->chamfer) fprintf(out, "Chamfer distance: %s\n", t);
-        analysis_result_t r;
-        empty_result(&r, an, v, directed);
-        if (empty_scores(an, n_a, n_b, directed, &r) != HD_OK) return EXIT_FAILURE_;
-        print_scores(out, an, &r, "");
-    }
-    return EXIT_OK;
+    memset(r, 0, sizeof *r);
+    r->empty = 1;
+    r->directed = directed;
+    r->n_a = n_a;
+    r->n_b = n_b;
+    r->pct = (hd_percentile_t){an->percentile, v, w, w, w};
+    r->sum.mean_ab = r->sum.mean2_ab = v;
+    r->sum.mean_ba = r->sum.mean_symmetric = r->sum.mean_average = r->sum.mean_pooled = w;
+    r->sum.mean2_ba = r->sum.chamfer = r->sum.chamfer_sum2 = r->sum.chamfer_mean = r->sum.chamfer_sum = w;
+    return empty_scores(an, n_a, n_b, directed, r, err);
 }
 
 /* ---- the run ----------------------------------------------------------------- */
@@ -523,6 +469,10 @@ void analysis_json(FILE *out, const analysis_args_t *an,
         json_mask(out, &an->mask[1]);
         fputc('}', out);
     }
+    if (r->empty) { /* nothing measured: the policy's figures */
+        json_figures(out, an, r);
+        return;
+    }
     if (!r->active) return;
     fprintf(out, ", \"distances_seconds\": "); /* to the microsecond, as "seconds" */
     json_number(out, round(r->seconds * 1e6) / 1e6);
@@ -665,8 +615,16 @@ void analysis_print(FILE *out, const analysis_args_t *an,
                 plural((unsigned long long)m->foreground), m->points,
                 an->mask_points == MASK_ALL ? "foreground" : "surface", plural(m->points), how);
     }
-    if (!r->active) return;
     char t[4][NUM_TEXT]; /* shortest text of each figure (numtext.c) */
+    if (r->empty) { /* nothing measured: each figure asked for is the policy's value */
+        num_text(r->sum.mean_ab, t[0]);
+        if (an->percentile_on) fprintf(out, "percentile %s: %s\n", num_text(an->percentile, t[1]), t[0]);
+        if (an->mean) fprintf(out, "mean distance: %s\n", t[0]);
+        if (an->chamfer) fprintf(out, "Chamfer distance: %s\n", t[0]);
+        print_scores(out, an, r, "");
+        return;
+    }
+    if (!r->active) return;
     if (an->percentile_on) {
         fprintf(out, "percentile P = %s of the per-point distances%s:\n", num_text(r->pct.p, t[1]), unit);
         fprintf(out, "  A->B %s\n", num_text(r->pct.ab, t[0]));

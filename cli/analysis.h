@@ -108,6 +108,8 @@ typedef struct hist_marker {
 
 typedef struct analysis_result {
     int active;                /* some analysis option was given */
+    int empty;                 /* A or B is empty: every figure is the
+                                  --empty policy's value (analysis_empty) */
     int directed;
     size_t n_a, n_b;
     double *d_ab, *d_ba;       /* per-point distances (d_ba NULL: directed) */
@@ -134,11 +136,20 @@ typedef struct analysis_result {
 const char *analysis_units(const analysis_args_t *an);
 /* Does anything need the per-point distances? */
 int analysis_active(const analysis_args_t *an);
-/* When A or B is empty: report the --empty policy's values (or the error)
- * and return the exit code; -1 when both sets have points. */
-int analysis_handle_empty(const analysis_args_t *an, const char *path_a,
-                          const char *path_b, const hd_points_t *A,
-                          const hd_points_t *B, int directed, int json);
+/* When A or B is empty (the counts n_a, n_b), under the --empty policy:
+ * every figure asked for is the policy's value (the scores of --tau and
+ * --dtu-cap: none within, NaN for no points) into r, and s the distances
+ * (H, h(A,B), h(B,A)) as the report prints them; says on stderr that no
+ * picture is drawn when one was asked for.  The per-point files are the
+ * caller's (analysis_empty_files for hausdorff).  Returns HD_OK or
+ * HD_ENOMEM with err filled. */
+int analysis_empty(const analysis_args_t *an, size_t n_a, size_t n_b, int directed, hd_symmetric_t *s,
+                   analysis_result_t *r, hd_error_t *err);
+/* The per-point files of a run with an empty set (--distances): the other
+ * set's rows at the policy's value v with nearest index -1; an empty set
+ * gets a file with no rows, so that scripts find the files they asked for. */
+int analysis_empty_files(const analysis_args_t *an, const hd_points_t *A, const hd_points_t *B, int directed,
+                         double v, hd_error_t *err);
 /* Compute per-point distances and every figure asked for, write the files
  * asked for.  Returns HD_OK or a library code with err filled. */
 int analysis_run(const analysis_args_t *an, const hd_options_t *opt,

@@ -97,29 +97,31 @@ static int compute(run_t *r, const hd_points_t *A, const hd_points_t *B, hd_symm
     return rc;
 }
 
+/* A or B empty (only under --empty: reading refuses it otherwise): the
+ * policy's values in s and the analysis, its files written. */
+static int compute_empty(run_t *r, const hd_points_t *A, const hd_points_t *B, hd_symmetric_t *s, hd_error_t *err) {
+    const cli_args_t *a = &r->a;
+    int rc = analysis_empty(&a->an, A->count, B->count, a->directed, s, &r->an, err);
+    return rc == HD_OK ? analysis_empty_files(&a->an, A, B, a->directed, s->ab.distance, err) : rc;
+}
+
 /* The report, for a person or as JSON. */
 static void print_report(const run_t *r, const hd_points_t *A, const hd_points_t *B, const hd_symmetric_t *s) {
     const cli_args_t *a = &r->a;
-    FILE *out = stdout;
     const hd_cloud_t *ca = r->cloud[0], *cb = r->cloud[1];
     report_t rep = {a, s, r->side, {A->count, B->count}, {ca->format, cb->format}, {ca->n_faces, cb->n_faces},
-                    {0, 0, 0}, {0, 0, 0}, r->read_seconds, {0, 0}};
-    if (!a->json) { /* only the text prints coordinates */
-        rep.single[0] = report_single(A, &a->an.mask[0]);
-        rep.single[1] = report_single(B, &a->an.mask[1]);
+                    {0, 0, 0}, {0, 0, 0}, r->read_seconds, {0, 0}, r->an.empty};
+    if (!rep.empty) {
+        if (!a->json) { /* only the text prints coordinates */
+            rep.single[0] = report_single(A, &a->an.mask[0]);
+            rep.single[1] = report_single(B, &a->an.mask[1]);
+        }
+        int from_a;
+        const hd_result_t *w = report_witness(a, s, &from_a);
+        hd_points_get(from_a ? A : B, w->i, rep.wp);
+        hd_points_get(from_a ? B : A, w->j, rep.wq);
     }
-    int from_a;
-    const hd_result_t *w = report_witness(a, s, &from_a);
-    hd_points_get(from_a ? A : B, w->i, rep.wp);
-    hd_points_get(from_a ? B : A, w->j, rep.wq);
-    if (a->json) {
-        report_json(out, &rep);
-        analysis_json(out, &a->an, &r->an);
-        fprintf(out, "}\n");
-    } else {
-        report_text(out, &rep);
-        analysis_print(out, &a->an, &r->an);
-    }
+    report_print(stdout, &rep, &r->an, NULL, NULL);
 }
 
 /* The run after parsing: its exit status. */
@@ -140,12 +142,9 @@ static int run(run_t *r) {
     if ((rc = read_sides(r, &err)) == HD_OK) {
         hd_points_t A = hd_cloud_points(r->cloud[0]), B = hd_cloud_points(r->cloud[1]);
         progress_phase("computing (%zu x %zu points)", A.count, B.count);
-        int empty = analysis_handle_empty(&a->an, a->path_a, a->path_b, &A, &B, a->directed, a->json);
-        if (empty >= 0) {
-            progress_stop();
-            return empty == EXIT_OK ? out_finish() : failed(empty);
-        }
-        if ((rc = compute(r, &A, &B, &s, &err)) == HD_OK) {
+        int empty = !A.count || !B.count;
+        rc = empty ? compute_empty(r, &A, &B, &s, &err) : compute(r, &A, &B, &s, &err);
+        if (rc == HD_OK) {
             progress_stop();
             print_report(r, &A, &B, &s);
             return out_finish();

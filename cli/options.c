@@ -196,39 +196,81 @@ static int parse_double_upto(const char *s, const char *end, double *out) {
 
 static int parse_double(const char *s, double *out) { return parse_double_upto(s, s + strlen(s), out); }
 
-/* Every option that takes a value, as "--opt VALUE" or "--opt=VALUE": the
- * run's (before OPT_PERCENTILE) and the analysis's (analysis.h). */
+/* Every option, in one table: first those that take a value, as
+ * "--opt VALUE" or "--opt=VALUE" (the run's before OPT_PERCENTILE, then
+ * the analysis's: analysis.h), then the flags, which take none. */
 typedef enum {
     OPT_ALGORITHM, OPT_THREADS, OPT_SEED, OPT_DEPTH, OPT_LAMBDA, OPT_THETA, OPT_FORMAT, OPT_SAMPLE,
     OPT_MAX_STREAM_SIZE, OPT_FIFO_WAIT, OPT_LAZ_POINTS_PER_BYTE,
     OPT_PERCENTILE, OPT_BINS, OPT_DISTANCES, OPT_MAX_DISTANCE, OPT_RENDER, OPT_HISTOGRAM_PNG,
     OPT_MASK_POINTS, OPT_EMPTY, OPT_CONNECTIVITY, OPT_MASK_DIMS, OPT_UNITS, OPT_TAU, OPT_TAU_RULE,
     OPT_DTU_CAP,
+    OPT_FLAGS, /* the first flag */
+    OPT_HELP = OPT_FLAGS, OPT_VERSION, OPT_FORMATS, OPT_DIRECTED, OPT_JSON, OPT_QUIET, OPT_NO_EARLY_BREAK,
+    OPT_NO_CULLING, OPT_FLOAT32, OPT_DECIMAL_COMMA, OPT_VERTICES, OPT_SURFACE, OPT_MEAN, OPT_CHAMFER,
+    OPT_HISTOGRAM,
     OPT_COUNT
-} value_option_t;
+} option_t;
 
-static const char *const value_names[OPT_COUNT] = {
-    [OPT_ALGORITHM] = "--algorithm",     [OPT_THREADS] = "--threads",
-    [OPT_SEED] = "--seed",               [OPT_DEPTH] = "--depth",
-    [OPT_LAMBDA] = "--lambda",           [OPT_THETA] = "--theta",
-    [OPT_FORMAT] = "--format",           [OPT_SAMPLE] = "--sample",
-    [OPT_MAX_STREAM_SIZE] = "--max-stream-size", [OPT_FIFO_WAIT] = "--fifo-wait",
-    [OPT_LAZ_POINTS_PER_BYTE] = "--laz-points-per-byte",
-    [OPT_PERCENTILE] = "--percentile",   [OPT_BINS] = "--bins",
-    [OPT_DISTANCES] = "--distances",     [OPT_MAX_DISTANCE] = "--max-distance",
-    [OPT_RENDER] = "--render",           [OPT_HISTOGRAM_PNG] = "--histogram-png",
-    [OPT_MASK_POINTS] = "--mask-points", [OPT_EMPTY] = "--empty",
-    [OPT_CONNECTIVITY] = "--connectivity", [OPT_MASK_DIMS] = "--mask-dims",
-    [OPT_UNITS] = "--units",             [OPT_TAU] = "--tau",
-    [OPT_TAU_RULE] = "--tau-rule",       [OPT_DTU_CAP] = "--dtu-cap"};
+static const struct {
+    const char *name, *alias; /* alias: a short form, or NULL */
+} options[OPT_COUNT] = {
+    [OPT_ALGORITHM] = {"--algorithm"},     [OPT_THREADS] = {"--threads"},
+    [OPT_SEED] = {"--seed"},               [OPT_DEPTH] = {"--depth"},
+    [OPT_LAMBDA] = {"--lambda"},           [OPT_THETA] = {"--theta"},
+    [OPT_FORMAT] = {"--format"},           [OPT_SAMPLE] = {"--sample"},
+    [OPT_MAX_STREAM_SIZE] = {"--max-stream-size"}, [OPT_FIFO_WAIT] = {"--fifo-wait"},
+    [OPT_LAZ_POINTS_PER_BYTE] = {"--laz-points-per-byte"},
+    [OPT_PERCENTILE] = {"--percentile"},   [OPT_BINS] = {"--bins"},
+    [OPT_DISTANCES] = {"--distances"},     [OPT_MAX_DISTANCE] = {"--max-distance"},
+    [OPT_RENDER] = {"--render"},           [OPT_HISTOGRAM_PNG] = {"--histogram-png"},
+    [OPT_MASK_POINTS] = {"--mask-points"}, [OPT_EMPTY] = {"--empty"},
+    [OPT_CONNECTIVITY] = {"--connectivity"}, [OPT_MASK_DIMS] = {"--mask-dims"},
+    [OPT_UNITS] = {"--units"},             [OPT_TAU] = {"--tau"},
+    [OPT_TAU_RULE] = {"--tau-rule"},       [OPT_DTU_CAP] = {"--dtu-cap"},
+    [OPT_HELP] = {"--help", "-h"},         [OPT_VERSION] = {"--version"},
+    [OPT_FORMATS] = {"--formats"},         [OPT_DIRECTED] = {"--directed"},
+    [OPT_JSON] = {"--json"},               [OPT_QUIET] = {"--quiet", "-q"},
+    [OPT_NO_EARLY_BREAK] = {"--no-early-break"}, [OPT_NO_CULLING] = {"--no-culling"},
+    [OPT_FLOAT32] = {"--float32"},         [OPT_DECIMAL_COMMA] = {"--decimal-comma"},
+    [OPT_VERTICES] = {"--vertices"},       [OPT_SURFACE] = {"--surface"},
+    [OPT_MEAN] = {"--mean"},               [OPT_CHAMFER] = {"--chamfer"},
+    [OPT_HISTOGRAM] = {"--histogram"}};
 
-/* The option that "--name" or "--name=VALUE" names, or -1. */
-static int value_option(const char *s) {
+/* The option that s names: "--name", its alias, or "--name=VALUE" for an
+ * option that takes a value; -1 for none. */
+static int option_named(const char *s) {
     const char *eq = strchr(s, '=');
     size_t nl = eq ? (size_t)(eq - s) : strlen(s);
-    for (int w = 0; w < OPT_COUNT; w++)
-        if (strlen(value_names[w]) == nl && strncmp(s, value_names[w], nl) == 0) return w;
+    for (int w = 0; w < OPT_COUNT; w++) {
+        if (eq && w >= OPT_FLAGS) break;
+        if ((strlen(options[w].name) == nl && strncmp(s, options[w].name, nl) == 0) ||
+            (!eq && options[w].alias && strcmp(s, options[w].alias) == 0))
+            return w;
+    }
     return -1;
+}
+
+/* A flag: 1 when the run ends here (--help, --version, --formats: printed), else 0. */
+static int set_flag(cli_args_t *a, int which) {
+    switch (which) {
+    case OPT_HELP: cli_usage(stdout); return 1;
+    case OPT_VERSION: print_version(stdout); return 1;
+    case OPT_FORMATS: cli_formats(stdout); return 1;
+    case OPT_DIRECTED: a->directed = 1; break;
+    case OPT_JSON: a->json = 1; break;
+    case OPT_QUIET: a->quiet = 1; break;
+    case OPT_NO_EARLY_BREAK: a->opt.early_break = 0; break;
+    case OPT_NO_CULLING: a->opt.culling = 0; break;
+    case OPT_FLOAT32: a->read.dtype = HD_FLOAT32; break;
+    case OPT_DECIMAL_COMMA: a->read.decimal_comma = 1; break;
+    case OPT_VERTICES: a->read.mesh = HD_MESH_VERTICES; break;
+    case OPT_SURFACE: a->surface = 1; break;
+    case OPT_MEAN: a->an.mean = 1; break;
+    case OPT_CHAMFER: a->an.chamfer = 1; break;
+    case OPT_HISTOGRAM: a->an.histogram = 1; break;
+    }
+    return 0;
 }
 
 /* A run option's value (hd_options_t, hd_read_options_t): 0, or
@@ -401,24 +443,13 @@ int cli_parse(int argc, char **argv, cli_args_t *a) {
             continue;
         }
         if (strcmp(s, "--") == 0) { only_files = 1; continue; }
-        if (strcmp(s, "--help") == 0 || strcmp(s, "-h") == 0) { cli_usage(stdout); return EXIT_OK; }
-        if (strcmp(s, "--version") == 0) { print_version(stdout); return EXIT_OK; }
-        if (strcmp(s, "--directed") == 0) { a->directed = 1; continue; }
-        if (strcmp(s, "--json") == 0) { a->json = 1; continue; }
-        if (strcmp(s, "--quiet") == 0 || strcmp(s, "-q") == 0) { a->quiet = 1; continue; }
-        if (strcmp(s, "--no-early-break") == 0) { a->opt.early_break = 0; continue; }
-        if (strcmp(s, "--no-culling") == 0) { a->opt.culling = 0; continue; }
-        if (strcmp(s, "--float32") == 0) { a->read.dtype = HD_FLOAT32; continue; }
-        if (strcmp(s, "--decimal-comma") == 0) { a->read.decimal_comma = 1; continue; }
-        if (strcmp(s, "--vertices") == 0) { a->read.mesh = HD_MESH_VERTICES; continue; }
-        if (strcmp(s, "--surface") == 0) { a->surface = 1; continue; }
-        if (strcmp(s, "--formats") == 0) { cli_formats(stdout); return EXIT_OK; }
-        if (strcmp(s, "--mean") == 0) { a->an.mean = 1; continue; }
-        if (strcmp(s, "--chamfer") == 0) { a->an.chamfer = 1; continue; }
-        if (strcmp(s, "--histogram") == 0) { a->an.histogram = 1; continue; }
-        int which = value_option(s);
+        int which = option_named(s);
         if (which < 0) return bad("unknown option '%s'", s);
-        const char *eq = strchr(s, '='), *name = value_names[which];
+        if (which >= OPT_FLAGS) {
+            if (set_flag(a, which)) return EXIT_OK;
+            continue;
+        }
+        const char *eq = strchr(s, '='), *name = options[which].name;
         const char *v = eq ? eq + 1 : (k + 1 < argc ? argv[++k] : NULL);
         if (!v) return bad("option '%s' needs a value", name);
         int rc = which < OPT_PERCENTILE ? set_run(a, which, v) : set_analysis(&a->an, which, name, v);
