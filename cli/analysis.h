@@ -54,8 +54,6 @@ typedef struct analysis_args {
 
 /* ---- options (analysis.c) ---------------------------------------------- */
 void analysis_args_init(analysis_args_t *an);
-/* The options' part of --help. */
-void analysis_usage(FILE *out);
 
 /* ---- reading (nifti.c) --------------------------------------------------- */
 /* Read a point set: NIfTI masks (.nii, .nii.gz) become the world

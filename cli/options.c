@@ -78,55 +78,11 @@ static void usage_examples(FILE *out) {
     fprintf(out, "\nExit status: 0 success, 1 usage error, 2 bad input, 3 other failure.\n");
 }
 
+static void usage_options(FILE *out); /* from the option table, below */
+
 void cli_usage(FILE *out) {
     usage_head(out);
-    fprintf(out,
-"\n"
-"Options:\n"
-"  --algorithm NAME   auto (default), naive, earlybreak, inc, nohd, ohd,\n"
-"                     framework, kdtree\n"
-"  --directed         compute only h(A,B)\n"
-"  --threads N        threads to use (default: every core; 1 = serial)\n"
-"  --seed N           seed for randomised steps (default 0)\n"
-"  --depth N          NOHD octree depth (default 6)\n"
-"  --lambda X         OHD sample fraction of |A| (default 0.01)\n"
-"  --theta X          framework overlap threshold (default 0.33)\n"
-"  --no-early-break   NOHD without early breaking (the paper's nNOHD)\n"
-"  --no-culling       OHD without point culling (the paper's nOHD)\n"
-"  --format NAME      read both files as NAME instead of by extension\n"
-"                     (a file named - is standard input: its format is\n"
-"                     --format's, else told from its content); one file's\n"
-"                     format: FORMAT:PATH, e.g. xyz:- or ply:scan.dat\n"
-"                     (./ply:x for a file whose name holds a colon)\n"
-"  --formats          list the file formats and exit\n"
-"  A or B as tiles:   a directory (its point files by extension, sorted by\n"
-"                     name in byte order, not recursed) or @LIST (a file of\n"
-"                     paths, one a line, relative to the list's folder; '#'\n"
-"                     comments; a line may be FORMAT:PATH): their points in\n"
-"                     that order; the witness is named by file and index\n"
-"                     (./@x for a file whose name starts with @)\n"
-"  --vertices         read a mesh (ply, obj, off, stl) as its vertices (default)\n"
-"  --surface          measure B, a mesh, as its surface: each point of A to its\n"
-"                     nearest triangle, correctly rounded (A must be points)\n"
-"  --sample N         read a mesh as N points drawn uniformly by area on its\n"
-"                     faces, reproducibly for a given --seed; a point format\n"
-"                     (las, laz, xyz, pcd, npy) is read as its points\n"
-"  --float32          store coordinates as float (half the memory)\n"
-"  --decimal-comma    text files write 1,5 for 1.5: commas are decimal points\n"
-"                     and fields are separated by ';' or blanks (without it\n"
-"                     a decimal comma is refused with its line)\n"
-"  --max-stream-size SIZE  most bytes read from an input that is not a\n"
-"                     regular file (standard input, a pipe, a FIFO), with an\n"
-"                     optional K, M or G suffix (default 2G)\n"
-"  --fifo-wait SECONDS  how long a FIFO's writer (input) or reader (output)\n"
-"                     is awaited (default 30)\n"
-"  --laz-points-per-byte N  the most points a LAZ chunk may hold per byte,\n"
-"                     bounding a small file's memory (default 256, up to 4096)\n"
-"  --json             print one JSON object\n"
-"  --quiet            no progress bar on stderr (there is none when stderr\n"
-"                     is not a terminal, nor with --json)\n"
-"  --help, --version\n");
-    analysis_usage(out);
+    usage_options(out);
     usage_examples(out);
 }
 
@@ -196,10 +152,11 @@ static int parse_double_upto(const char *s, const char *end, double *out) {
 
 static int parse_double(const char *s, double *out) { return parse_double_upto(s, s + strlen(s), out); }
 
-/* Every option, in one table: first those that take a value, as
- * "--opt VALUE" or "--opt=VALUE" (the run's before OPT_PERCENTILE, then
- * the analysis's: analysis.h), then the flags, which take none. */
+/* Every option: first those that take a value, as "--opt VALUE" or
+ * "--opt=VALUE" (the run's before OPT_PERCENTILE, then the analysis's:
+ * analysis.h), then the flags, which take none. */
 typedef enum {
+    OPT_NONE = -1, /* a heading or note of the help, not an option */
     OPT_ALGORITHM, OPT_THREADS, OPT_SEED, OPT_DEPTH, OPT_LAMBDA, OPT_THETA, OPT_FORMAT, OPT_SAMPLE,
     OPT_MAX_STREAM_SIZE, OPT_FIFO_WAIT, OPT_LAZ_POINTS_PER_BYTE,
     OPT_PERCENTILE, OPT_BINS, OPT_DISTANCES, OPT_MAX_DISTANCE, OPT_RENDER, OPT_HISTOGRAM_PNG,
@@ -212,43 +169,228 @@ typedef enum {
     OPT_COUNT
 } option_t;
 
-static const struct {
-    const char *name, *alias; /* alias: a short form, or NULL */
-} options[OPT_COUNT] = {
-    [OPT_ALGORITHM] = {"--algorithm"},     [OPT_THREADS] = {"--threads"},
-    [OPT_SEED] = {"--seed"},               [OPT_DEPTH] = {"--depth"},
-    [OPT_LAMBDA] = {"--lambda"},           [OPT_THETA] = {"--theta"},
-    [OPT_FORMAT] = {"--format"},           [OPT_SAMPLE] = {"--sample"},
-    [OPT_MAX_STREAM_SIZE] = {"--max-stream-size"}, [OPT_FIFO_WAIT] = {"--fifo-wait"},
-    [OPT_LAZ_POINTS_PER_BYTE] = {"--laz-points-per-byte"},
-    [OPT_PERCENTILE] = {"--percentile"},   [OPT_BINS] = {"--bins"},
-    [OPT_DISTANCES] = {"--distances"},     [OPT_MAX_DISTANCE] = {"--max-distance"},
-    [OPT_RENDER] = {"--render"},           [OPT_HISTOGRAM_PNG] = {"--histogram-png"},
-    [OPT_MASK_POINTS] = {"--mask-points"}, [OPT_EMPTY] = {"--empty"},
-    [OPT_CONNECTIVITY] = {"--connectivity"}, [OPT_MASK_DIMS] = {"--mask-dims"},
-    [OPT_UNITS] = {"--units"},             [OPT_TAU] = {"--tau"},
-    [OPT_TAU_RULE] = {"--tau-rule"},       [OPT_DTU_CAP] = {"--dtu-cap"},
-    [OPT_HELP] = {"--help", "-h"},         [OPT_VERSION] = {"--version"},
-    [OPT_FORMATS] = {"--formats"},         [OPT_DIRECTED] = {"--directed"},
-    [OPT_JSON] = {"--json"},               [OPT_QUIET] = {"--quiet", "-q"},
-    [OPT_NO_EARLY_BREAK] = {"--no-early-break"}, [OPT_NO_CULLING] = {"--no-culling"},
-    [OPT_FLOAT32] = {"--float32"},         [OPT_DECIMAL_COMMA] = {"--decimal-comma"},
-    [OPT_VERTICES] = {"--vertices"},       [OPT_SURFACE] = {"--surface"},
-    [OPT_MEAN] = {"--mean"},               [OPT_CHAMFER] = {"--chamfer"},
-    [OPT_HISTOGRAM] = {"--histogram"}};
+/* The one table of options, in the order --help lists them: the name, a
+ * short alias, the argument's name (NULL for a flag), what it needs ('p'
+ * libpng, 'n' libnifti2: the %s in the help says when it is unavailable)
+ * and the help text (continuation lines are indented to the help column;
+ * options without help share one line).  OPT_NONE entries are the help's
+ * headings and notes. */
+typedef struct {
+    int id;
+    const char *name, *alias, *arg;
+    char needs;
+    const char *help;
+} option_entry_t;
+
+static const option_entry_t options[] = {
+    {OPT_NONE, NULL, NULL, NULL, 0,
+     "\n"
+     "Options:\n"},
+    {OPT_ALGORITHM, "--algorithm", NULL, "NAME", 0,
+     "auto (default), naive, earlybreak, inc, nohd, ohd,\n"
+     "framework, kdtree"},
+    {OPT_DIRECTED, "--directed", NULL, NULL, 0,
+     "compute only h(A,B)"},
+    {OPT_THREADS, "--threads", NULL, "N", 0,
+     "threads to use (default: every core; 1 = serial)"},
+    {OPT_SEED, "--seed", NULL, "N", 0,
+     "seed for randomised steps (default 0)"},
+    {OPT_DEPTH, "--depth", NULL, "N", 0,
+     "NOHD octree depth (default 6)"},
+    {OPT_LAMBDA, "--lambda", NULL, "X", 0,
+     "OHD sample fraction of |A| (default 0.01)"},
+    {OPT_THETA, "--theta", NULL, "X", 0,
+     "framework overlap threshold (default 0.33)"},
+    {OPT_NO_EARLY_BREAK, "--no-early-break", NULL, NULL, 0,
+     "NOHD without early breaking (the paper's nNOHD)"},
+    {OPT_NO_CULLING, "--no-culling", NULL, NULL, 0,
+     "OHD without point culling (the paper's nOHD)"},
+    {OPT_FORMAT, "--format", NULL, "NAME", 0,
+     "read both files as NAME instead of by extension\n"
+     "(a file named - is standard input: its format is\n"
+     "--format's, else told from its content); one file's\n"
+     "format: FORMAT:PATH, e.g. xyz:- or ply:scan.dat\n"
+     "(./ply:x for a file whose name holds a colon)"},
+    {OPT_FORMATS, "--formats", NULL, NULL, 0,
+     "list the file formats and exit"},
+    {OPT_NONE, "A or B as tiles:", NULL, NULL, 0,
+     "a directory (its point files by extension, sorted by\n"
+     "name in byte order, not recursed) or @LIST (a file of\n"
+     "paths, one a line, relative to the list's folder; '#'\n"
+     "comments; a line may be FORMAT:PATH): their points in\n"
+     "that order; the witness is named by file and index\n"
+     "(./@x for a file whose name starts with @)"},
+    {OPT_VERTICES, "--vertices", NULL, NULL, 0,
+     "read a mesh (ply, obj, off, stl) as its vertices (default)"},
+    {OPT_SURFACE, "--surface", NULL, NULL, 0,
+     "measure B, a mesh, as its surface: each point of A to its\n"
+     "nearest triangle, correctly rounded (A must be points)"},
+    {OPT_SAMPLE, "--sample", NULL, "N", 0,
+     "read a mesh as N points drawn uniformly by area on its\n"
+     "faces, reproducibly for a given --seed; a point format\n"
+     "(las, laz, xyz, pcd, npy) is read as its points"},
+    {OPT_FLOAT32, "--float32", NULL, NULL, 0,
+     "store coordinates as float (half the memory)"},
+    {OPT_DECIMAL_COMMA, "--decimal-comma", NULL, NULL, 0,
+     "text files write 1,5 for 1.5: commas are decimal points\n"
+     "and fields are separated by ';' or blanks (without it\n"
+     "a decimal comma is refused with its line)"},
+    {OPT_MAX_STREAM_SIZE, "--max-stream-size", NULL, "SIZE", 0,
+     "most bytes read from an input that is not a\n"
+     "regular file (standard input, a pipe, a FIFO), with an\n"
+     "optional K, M or G suffix (default 2G)"},
+    {OPT_FIFO_WAIT, "--fifo-wait", NULL, "SECONDS", 0,
+     "how long a FIFO's writer (input) or reader (output)\n"
+     "is awaited (default 30)"},
+    {OPT_LAZ_POINTS_PER_BYTE, "--laz-points-per-byte", NULL, "N", 0,
+     "the most points a LAZ chunk may hold per byte,\n"
+     "bounding a small file's memory (default 256, up to 4096)"},
+    {OPT_JSON, "--json", NULL, NULL, 0,
+     "print one JSON object"},
+    {OPT_QUIET, "--quiet", "-q", NULL, 0,
+     "no progress bar on stderr (there is none when stderr\n"
+     "is not a terminal, nor with --json)"},
+    {OPT_HELP, "--help", "-h", NULL, 0, NULL},
+    {OPT_VERSION, "--version", NULL, NULL, 0, NULL},
+    {OPT_NONE, NULL, NULL, NULL, 0,
+     "\n"
+     "Where the deviation is (per-point nearest-neighbour distances):\n"},
+    {OPT_PERCENTILE, "--percentile", NULL, "P", 0,
+     "percentile Hausdorff, e.g. 95 for HD95: the P-th\n"
+     "percentile (numpy's linear interpolation) of the\n"
+     "distances of A's points to B (ab), of B's to A (ba),\n"
+     "symmetric = max(ab, ba) as MONAI, pooled = both\n"
+     "directions together as medpy; P = 100 is H(A,B)"},
+    {OPT_MEAN, "--mean", NULL, NULL, 0,
+     "mean distances: A->B, B->A, their max (the average\n"
+     "Hausdorff distance), their average, and pooled"},
+    {OPT_CHAMFER, "--chamfer", NULL, NULL, 0,
+     "Chamfer distance = mean squared distance A->B + mean\n"
+     "squared distance B->A (as PyTorch3D); the JSON also\n"
+     "has the summed and the unsquared variants"},
+    {OPT_HISTOGRAM, "--histogram", NULL, NULL, 0,
+     "histogram of the distances (--bins N, default 20) on\n"
+     "[0, largest distance] or [0, --max-distance]"},
+    {OPT_DISTANCES, "--distances", NULL, "OUT", 0,
+     "write A's points with distance and nearest index in B\n"
+     "(.csv: x,y,z,distance,nearest; .ply: also a viridis\n"
+     "colour; .npy: (N, 5) float64); B's go to OUT_b.EXT"},
+    {OPT_MAX_DISTANCE, "--max-distance", NULL, "D", 0,
+     "top of the colour and histogram scale (default: the\n"
+     "Hausdorff distance)"},
+    {OPT_RENDER, "--render", NULL, "OUT.png", 'p',
+     "picture of A coloured by distance to B: front, side\n"
+     "and top views, colour bar, the Hausdorff witness pair\n"
+     "marked, the --percentile figure on the bar%s"},
+    {OPT_HISTOGRAM_PNG, "--histogram-png", NULL, "OUT.png", 'p',
+     "the histogram as a picture%s\n"
+     "(pictures are PNG: OUT must end in .png)"},
+    {OPT_UNITS, "--units", NULL, "TEXT", 0,
+     "the distances' unit, shown in the report, the JSON and\n"
+     "the pictures (a label: nothing is scaled); masks whose\n"
+     "header names mm, um or m are in mm without it"},
+    {OPT_NONE, NULL, NULL, NULL, 0,
+     "\n"
+     "Scores at a tolerance (A: the prediction or reconstruction, B: the reference):\n"},
+    {OPT_TAU, "--tau", NULL, "T[,T...]", 0,
+     "at each tolerance T (up to 64): precision (share of A\n"
+     "within T of B), recall (of B within T of A), F-score,\n"
+     "and NSD, the normalized surface Dice counted per point\n"
+     "(MONAI's compute_surface_dice on masks' surfaces)"},
+    {OPT_TAU_RULE, "--tau-rule", NULL, "le|lt", 0,
+     "within means d <= T (le, default: MONAI, DeepMind) or\n"
+     "d < T (lt: the Tanks and Temples evaluation)"},
+    {OPT_DTU_CAP, "--dtu-cap", NULL, "D", 0,
+     "DTU accuracy (mean A->B distance) and completeness\n"
+     "(mean B->A) over the distances below D, and overall =\n"
+     "their average, as the DTU MVS evaluation (D = 20 there)"},
+    {OPT_NONE, NULL, NULL, NULL, 'n',
+     "\n"
+     "Medical masks: A or B may be a NIfTI-1/2 mask (.nii, .nii.gz)%s.\n"
+     "  Voxels with a nonzero value are foreground; each becomes the world\n"
+     "  coordinate of its centre (sform when sform_code > 0, else qform, else\n"
+     "  pixdim), in millimetres (m and um are converted).  Distances are in mm.\n"},
+    {OPT_MASK_POINTS, "--mask-points", NULL, "surface|all", 0,
+     "surface (default): the foreground voxels that\n"
+     "binary erosion removes, outside the image counting as\n"
+     "background (as medpy and MONAI); all: every foreground\n"
+     "voxel"},
+    {OPT_CONNECTIVITY, "--connectivity", NULL, "1|2|3", 0,
+     "the surface's neighbourhood, as medpy's connectivity:\n"
+     "1 (default) 6-neighbour in 3-D, 4 in 2-D; 2: 18 (8 in\n"
+     "2-D); 3: 26"},
+    {OPT_MASK_DIMS, "--mask-dims", NULL, "auto|2|3", 0,
+     "the axes of that neighbourhood: auto (default) those\n"
+     "of more than one voxel (a single slice is a 2-D mask);\n"
+     "2: each slice (constant k) on its own, a stack of\n"
+     "in-plane contours; 3: all three, a one-voxel axis too"},
+    {OPT_EMPTY, "--empty", NULL, "inf|nan|zero|monai", 0,
+     "an empty mask or file is an error by default;\n"
+     "with this option every distance is reported as inf, NaN\n"
+     "or 0 instead; monai: inf when one set is empty, NaN when\n"
+     "both are, as MONAI (JSON: null for inf and NaN, and an\n"
+     "\"empty\" member)"},
+};
+enum { N_OPTIONS = sizeof options / sizeof options[0], HELP_COLUMN = 21 };
+
+/* The help's note for an option that needs what this build lacks. */
+static const char *missing(char needs) {
+    if (needs == 'p' && !render_available()) return " (unavailable: built without libpng)";
+    if (needs == 'n' && !nifti_available()) return " (unavailable: built without libnifti2)";
+    return "";
+}
+
+/* t with its "%s" (at most one) as note, each line after a newline
+ * indented by indent. */
+static void put_text(FILE *out, const char *t, const char *note, int indent) {
+    for (; *t; t++) {
+        if (t[0] == '%' && t[1] == 's') {
+            fputs(note, out);
+            t++;
+            continue;
+        }
+        fputc(*t, out);
+        if (*t == '\n' && indent && t[1]) fprintf(out, "%*s", indent, "");
+    }
+}
+
+/* The options' part of --help, from the table. */
+static void usage_options(FILE *out) {
+    for (size_t k = 0; k < N_OPTIONS; k++) {
+        const option_entry_t *o = &options[k];
+        if (!o->name) {
+            put_text(out, o->help, missing(o->needs), 0);
+        } else if (!o->help) { /* "  --help, --version" */
+            fprintf(out, "%s%s", k && !options[k - 1].help ? ", " : "  ", o->name);
+            if (k + 1 == N_OPTIONS || options[k + 1].help) fputc('\n', out);
+        } else {
+            int n = fprintf(out, "  %s%s%s", o->name, o->arg ? " " : "", o->arg ? o->arg : "");
+            fprintf(out, "%*s", n < HELP_COLUMN ? HELP_COLUMN - n : 2, "");
+            put_text(out, o->help, missing(o->needs), HELP_COLUMN);
+            fputc('\n', out);
+        }
+    }
+}
 
 /* The option that s names: "--name", its alias, or "--name=VALUE" for an
  * option that takes a value; -1 for none. */
 static int option_named(const char *s) {
     const char *eq = strchr(s, '=');
     size_t nl = eq ? (size_t)(eq - s) : strlen(s);
-    for (int w = 0; w < OPT_COUNT; w++) {
-        if (eq && w >= OPT_FLAGS) break;
-        if ((strlen(options[w].name) == nl && strncmp(s, options[w].name, nl) == 0) ||
-            (!eq && options[w].alias && strcmp(s, options[w].alias) == 0))
-            return w;
+    for (size_t k = 0; k < N_OPTIONS; k++) {
+        const option_entry_t *o = &options[k];
+        if (o->id == OPT_NONE || (eq && !o->arg)) continue;
+        if ((strlen(o->name) == nl && strncmp(s, o->name, nl) == 0) || (!eq && o->alias && strcmp(s, o->alias) == 0))
+            return o->id;
     }
     return -1;
+}
+
+/* An option's name ("--tau") for messages. */
+static const char *option_name(int id) {
+    for (size_t k = 0; k < N_OPTIONS; k++)
+        if (options[k].id == id) return options[k].name;
+    return "?";
 }
 
 /* A flag: 1 when the run ends here (--help, --version, --formats: printed), else 0. */
@@ -449,7 +591,7 @@ int cli_parse(int argc, char **argv, cli_args_t *a) {
             if (set_flag(a, which)) return EXIT_OK;
             continue;
         }
-        const char *eq = strchr(s, '='), *name = options[which].name;
+        const char *eq = strchr(s, '='), *name = option_name(which);
         const char *v = eq ? eq + 1 : (k + 1 < argc ? argv[++k] : NULL);
         if (!v) return bad("option '%s' needs a value", name);
         int rc = which < OPT_PERCENTILE ? set_run(a, which, v) : set_analysis(&a->an, which, name, v);
