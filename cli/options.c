@@ -174,7 +174,8 @@ typedef enum {
  * libpng, 'n' libnifti2: the %s in the help says when it is unavailable)
  * and the help text (continuation lines are indented to the help column;
  * options without help share one line).  OPT_NONE entries are the help's
- * headings and notes. */
+ * headings and notes.  An option missing here is unknown to the parser:
+ * every one has its entry and its help. */
 typedef struct {
     int id;
     const char *name, *alias, *arg;
@@ -271,6 +272,8 @@ static const option_entry_t options[] = {
     {OPT_HISTOGRAM, "--histogram", NULL, NULL, 0,
      "histogram of the distances (--bins N, default 20) on\n"
      "[0, largest distance] or [0, --max-distance]"},
+    {OPT_BINS, "--bins", NULL, "N", 0,
+     "the histogram's number of bins, 1 to 100000 (default 20)"},
     {OPT_DISTANCES, "--distances", NULL, "OUT", 0,
      "write A's points with distance and nearest index in B\n"
      "(.csv: x,y,z,distance,nearest; .ply: also a viridis\n"
