@@ -4,9 +4,8 @@
  * B) with its witness: the point, its nearest triangle and the closest
  * point on it.
  *
- * A is read as points (hd_read_file); a mesh as A is refused, since the
- * direction from a surface is a supremum over the whole surface (mesh to
- * mesh is a later piece of work).  B is read with hd_read_mesh: its
+ * A is read as points (hd_read_file); a mesh as A goes to m2m.c (the
+ * distance from a surface, enclosed).  B is read with hd_read_mesh: its
  * polygons as fans, an STL's equal corners merged, degenerate triangles
  * counted and measured as their hulls.  A side given as tiles and the
  * analysis options are not yet measured against a surface: refused with
@@ -88,12 +87,14 @@ int surface_run(const cli_args_t *a) {
     hd_cloud_t *ca = NULL;
     hd_mesh_file_t *m = NULL;
     int rc = hd_read_file(a->path_a, &ro, &ca, &err);
-    if (rc == HD_OK && ca->n_faces > 0) {
-        fprintf(stderr, "%s: --surface: A (%s) is a mesh with %zu faces: the distance from a surface is a supremum "
-                        "over the whole surface (mesh to mesh), not yet measured; give A as points, or drop "
-                        "--surface to compare the vertices\n", cli_prog(), a->path_a, ca->n_faces);
+    if (rc == HD_OK && ca->n_faces > 0) { /* a surface measured from: an enclosure */
         hd_cloud_free(ca);
-        return EXIT_USAGE;
+        return m2m_run(a);
+    }
+    if (rc == HD_OK && (a->tolerance_set || a->within_set)) {
+        hd_cloud_free(ca);
+        return refuse(a->within_set ? "--within needs a mesh as A (h(points, surface) is exact: compare it)"
+                                    : "--tolerance needs a mesh as A (h(points, surface) is exact, correctly rounded)");
     }
     ro.format = a->format_b ? a->format_b : a->read.format;
     if (rc == HD_OK) rc = hd_read_mesh(a->path_b, &ro, &m, &err);
