@@ -178,29 +178,39 @@ static int directed(const side_t *x, side_t *y, const ask_t *q, hd_enclosure_t *
     return HD_OK;
 }
 
-static ask_t ask_of(const hd_surface_options_t *o, double tol) {
-    ask_t q = {tol, -INFINITY, INFINITY, 0, o->threads, o->max_splits, NULL, NULL};
-    return q;
+/* Every entry point's first steps: the options checked, A's triangles,
+ * B's (a mesh, or the point set P when B is NULL), and what a search asks
+ * by default.  On failure nothing is left to free. */
+static int open_sides(const hd_surface_options_t *opt, const hd_mesh_t *A, const hd_mesh_t *B,
+                      const hd_points_t *P, side_t *a, side_t *b, ask_t *q, hd_error_t *err) {
+    hd__err_clear(err);
+    hd_surface_options_t o;
+    int rc = check_options(opt, &o, err);
+    if (rc || (rc = side_mesh(A, "A", a, err))) return rc;
+    if ((rc = B || !P ? side_mesh(B, "B", b, err) : side_points(P, b, err))) {
+        side_free(a);
+        return rc;
+    }
+    ask_t d = {tolerance_of(&o, a, b), -INFINITY, INFINITY, 0, o.threads, o.max_splits, NULL, NULL};
+    *q = d;
+    return HD_OK;
+}
+
+static void close_sides(side_t *a, side_t *b) {
+    side_free(a);
+    side_free(b);
 }
 
 int hd_surface_hausdorff(const hd_mesh_t *A, const hd_mesh_t *B, const hd_surface_options_t *opt,
                          hd_enclosure_t *ab, hd_enclosure_t *ba, hd_error_t *err) {
-    hd__err_clear(err);
-    hd_surface_options_t o;
     side_t a, b;
-    int rc = check_options(opt, &o, err);
-    if (rc) return rc;
+    ask_t q;
     if (!ab && !ba) return hd__err(err, HD_EINVAL, "both outputs are NULL");
-    if ((rc = side_mesh(A, "A", &a, err))) return rc;
-    if ((rc = side_mesh(B, "B", &b, err))) {
-        side_free(&a);
-        return rc;
-    }
-    ask_t q = ask_of(&o, tolerance_of(&o, &a, &b));
+    int rc = open_sides(opt, A, B, NULL, &a, &b, &q, err);
+    if (rc) return rc;
     if (ab) rc = directed(&a, &b, &q, ab, err);
     if (ba && rc == HD_OK) rc = directed(&b, &a, &q, ba, err);
-    side_free(&a);
-    side_free(&b);
+    close_sides(&a, &b);
     return rc;
 }
 
@@ -231,42 +241,28 @@ static int points_to_surface(const hd_points_t *B, const hd_mesh_t *A, const sid
 
 int hd_surface_points_hausdorff(const hd_mesh_t *A, const hd_points_t *B, const hd_surface_options_t *opt,
                                 hd_enclosure_t *ab, hd_enclosure_t *ba, hd_error_t *err) {
-    hd__err_clear(err);
-    hd_surface_options_t o;
     side_t a, b;
-    int rc = check_options(opt, &o, err);
-    if (rc) return rc;
+    ask_t q;
     if (!ab && !ba) return hd__err(err, HD_EINVAL, "both outputs are NULL");
-    if ((rc = side_mesh(A, "A", &a, err))) return rc;
-    if ((rc = side_points(B, &b, err))) {
-        side_free(&a);
-        return rc;
-    }
-    ask_t q = ask_of(&o, tolerance_of(&o, &a, &b));
+    if (!B) return hd__err(err, HD_EINVAL, "point set B is NULL");
+    int rc = open_sides(opt, A, NULL, B, &a, &b, &q, err);
+    if (rc) return rc;
     if (ab) rc = directed(&a, &b, &q, ab, err);
     if (ba && rc == HD_OK) rc = points_to_surface(B, A, &a, &q, ba, err);
-    side_free(&a);
-    side_free(&b);
+    close_sides(&a, &b);
     return rc;
 }
 
 int hd_surface_within(const hd_mesh_t *A, const hd_mesh_t *B, double d, int directed_only,
                       const hd_surface_options_t *opt, int *answer, hd_enclosure_t *ab, hd_enclosure_t *ba,
                       hd_error_t *err) {
-    hd__err_clear(err);
-    hd_surface_options_t o;
     side_t a, b;
-    int rc = check_options(opt, &o, err);
-    if (rc) return rc;
+    ask_t q;
     if (!answer) return hd__err(err, HD_EINVAL, "answer is NULL");
     *answer = -1;
     if (!(d >= 0)) return hd__err(err, HD_EINVAL, "the distance must be >= 0, not %g", d);
-    if ((rc = side_mesh(A, "A", &a, err))) return rc;
-    if ((rc = side_mesh(B, "B", &b, err))) {
-        side_free(&a);
-        return rc;
-    }
-    ask_t q = ask_of(&o, tolerance_of(&o, &a, &b));
+    int rc = open_sides(opt, A, B, NULL, &a, &b, &q, err);
+    if (rc) return rc;
     q.done_below = d;
     q.stop_above = d;
     hd_enclosure_t e[2];
@@ -286,32 +282,23 @@ int hd_surface_within(const hd_mesh_t *A, const hd_mesh_t *B, double d, int dire
             else enclosure_init(ba), ba->upper = INFINITY, ba->tolerance = q.tol;
         }
     }
-    side_free(&a);
-    side_free(&b);
+    close_sides(&a, &b);
     return rc;
 }
 
 int hd_surface_face_maxima(const hd_mesh_t *A, const hd_mesh_t *B, const hd_surface_options_t *opt,
                            double *face_lower, double *face_upper, hd_enclosure_t *ab, hd_error_t *err) {
-    hd__err_clear(err);
-    hd_surface_options_t o;
     side_t a, b;
-    int rc = check_options(opt, &o, err);
-    if (rc) return rc;
+    ask_t q;
     if (!face_lower && !face_upper) return hd__err(err, HD_EINVAL, "both face arrays are NULL");
-    if ((rc = side_mesh(A, "A", &a, err))) return rc;
-    if ((rc = side_mesh(B, "B", &b, err))) {
-        side_free(&a);
-        return rc;
-    }
-    ask_t q = ask_of(&o, tolerance_of(&o, &a, &b));
+    int rc = open_sides(opt, A, B, NULL, &a, &b, &q, err);
+    if (rc) return rc;
     q.per_face = 1;
     q.face_lower = face_lower;
     q.face_upper = face_upper;
     hd_enclosure_t e;
     rc = directed(&a, &b, &q, &e, err);
     if (rc == HD_OK && ab) *ab = e;
-    side_free(&a);
-    side_free(&b);
+    close_sides(&a, &b);
     return rc;
 }
