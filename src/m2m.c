@@ -17,10 +17,12 @@
 #include <string.h>
 
 /* The tolerance 0 stands for the smallest that the rounding of the
- * computed points of X leaves meaningful (mesh/m2m.c: a point is off by
- * up to 8 u (|x| + |y| + |z|) <= 24 u max|coordinate|, and both bounds
- * carry it): 2^-46 (3 max|coordinate| + diagonal). */
-#define FLOOR_SCALE 0x1p-46
+ * computed points of X leaves meaningful: mesh/m2m.c's slack e of a face
+ * is at most 6 u max|coordinate| + 24 u diagonal (plus 2^-1060), both
+ * bounds carry it, so the width cannot go below about 2 e; the floor is
+ * 2^-48 max|coordinate| + 2^-46 diagonal >= 4 e. */
+#define FLOOR_COORD 0x1p-48
+#define FLOOR_DIAG 0x1p-46
 
 void hd_surface_options_init(hd_surface_options_t *opt) {
     if (!opt) return;
@@ -117,7 +119,7 @@ static double tolerance_of(const hd_surface_options_t *o, const side_t *x, const
                 }
     double dx = hi[0] - lo[0], dy = hi[1] - lo[1], dz = hi[2] - lo[2];
     double diag = sqrt(dx * dx + dy * dy + dz * dz);
-    double floor_ = (3 * big + diag) * FLOOR_SCALE;
+    double floor_ = big * FLOOR_COORD + diag * FLOOR_DIAG + 0x1p-1000;
     double tol = o->relative ? o->tolerance * diag : o->tolerance;
     return fmax(tol, floor_);
 }

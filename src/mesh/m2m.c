@@ -12,14 +12,20 @@
  * stop at MAX_LEVEL (weights below 2^63).
  *
  * Computed corners.  A corner's point is computed in doubles as
- * fl(fl(w0 a) + fl(w1 b)) + fl(w2 c) with w = fl(k) 2^-L: each weight is
- * off by at most u w (u = 2^-53), each of the five operations adds at most
- * u of its result or 2^-1075 on underflow, so per coordinate the error is
- * at most (u + gamma_3 (1 + u)) M_k + 3 2^-1075 <= 4.01 u M_k + 2^-1072,
- * with M_k the largest |coordinate k| of the face's corners, and over the
- * three coordinates at most 4.01 u (Mx + My + Mz) + 2^-1070.  slack() uses
- * 8 u (Mx + My + Mz) + 2^-1060: e.  A corner that is a vertex of the face
- * (one weight 2^L) is that vertex, exactly (e = 0).
+ * x = fl(a + fl(fl(w1 fl(b - a)) + fl(w2 fl(c - a)))) with w = fl(k) 2^-L
+ * (each weight off by at most u w, u = 2^-53; ldexp is exact for
+ * 2^-62 <= w <= 1).  Per coordinate, with s* = w1 (b - a) + w2 (c - a)
+ * and the computed sum s: each product is within gamma_3 of w (b - a)
+ * (difference, weight, product), so |s - s*| <= (gamma_3 + u (1 +
+ * gamma_3)) (w1 |b - a| + w2 |c - a|) + 3 2^-1075 <= 4.01 u D_k + 2^-1073
+ * with D_k = max(|b_k - a_k|, |c_k - a_k|) (w1 + w2 <= 1), and the last
+ * addition adds at most u |a + s| <= u M_k (1 + 5u) with M_k the largest
+ * |coordinate k| of the corners (x* lies in their hull).  Over the three
+ * coordinates: at most 1.01 u (Mx + My + Mz) + 4.01 u (Dx + Dy + Dz) +
+ * 2^-1071.  slack() uses e = 2 u sum M + 8 u sum D + 2^-1060 (the computed
+ * differences are within a factor 1 + u of the exact ones).  A corner that
+ * is a vertex of the face (one weight 2^L) is that vertex, exactly
+ * (e = 0).
  *
  * Bounds.  Each corner v gets r = RN(d(v, Y)) from the exact kernel through
  * the tree (hd__bvh_nearest), so d(v, Y) <= next_up(r).
@@ -113,12 +119,14 @@ typedef struct face {
 } face_t;
 
 static double slack(const hd__tri_t *t) {
-    double m = 0;
+    double m = 0, d = 0;
     for (int k = 0; k < 3; k++) {
         double mk = fmax(fabs(t->v[0][k]), fmax(fabs(t->v[1][k]), fabs(t->v[2][k])));
+        double dk = fmax(fabs(t->v[1][k] - t->v[0][k]), fabs(t->v[2][k] - t->v[0][k]));
         m = up(m + mk);
+        d = up(d + dk);
     }
-    return up(m * 0x1p-50 + 0x1p-1060);
+    return up(up(m * 0x1p-52 + d * 0x1p-50) + 0x1p-1060);
 }
 
 /* The corner's point from its weights at `level` (see the top). */
@@ -129,9 +137,11 @@ static void corner_point(const hd__tri_t *t, corner_t *c, int level) {
             memcpy(c->p, t->v[j], sizeof c->p);
             return;
         }
-    double w[3];
-    for (int j = 0; j < 3; j++) w[j] = ldexp((double)c->k[j], -level);
-    for (int d = 0; d < 3; d++) c->p[d] = w[0] * t->v[0][d] + w[1] * t->v[1][d] + w[2] * t->v[2][d];
+    double w1 = ldexp((double)c->k[1], -level), w2 = ldexp((double)c->k[2], -level);
+    for (int d = 0; d < 3; d++) {
+        double d1 = t->v[1][d] - t->v[0][d], d2 = t->v[2][d] - t->v[0][d];
+        c->p[d] = t->v[0][d] + (w1 * d1 + w2 * d2);
+    }
 }
 
 static int is_vertex(const corner_t *c, int level) {
