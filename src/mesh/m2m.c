@@ -79,8 +79,18 @@
 /* Below this a squared edge may have underflowed: R from |dx|+|dy|+|dz|. */
 #define TINY2 0x1p-960
 
-static double up(double x) { return nextafter(x, INFINITY); }
-static double down(double x) { return nextafter(x, -INFINITY); }
+/* The next double up (down) from a finite x, as nextafter(x, +-infinity)
+ * gives it (inline: the bounds take several a sub-triangle). */
+static double up(double x) {
+    uint64_t b;
+    memcpy(&b, &x, sizeof b);
+    if (x == 0) return 0x1p-1074;
+    if (!isfinite(x)) return x;
+    b += x > 0 ? 1 : (uint64_t)-1;
+    memcpy(&x, &b, sizeof b);
+    return x;
+}
+static double down(double x) { return -up(-x); }
 static double sqrt_up(double x) { return x <= 0 ? 0 : up(sqrt(x)); }
 
 typedef struct corner {
@@ -275,18 +285,35 @@ static int shared_convex(const hd__tri_t *s, const hd__tri_t *t) {
     return convex_pair(s->v[ip], s->v[iq], s->v[ia], t->v[jb]);
 }
 
+/* A worker's prepared triangles of Y, by position in the tree (direct
+ * mapped): hd__tri_bounds_prep gives hd__tri_bounds's bits. */
+#define CACHE 1024
+typedef struct cache {
+    size_t pos[CACHE];
+    hd__tri_prep_t prep[CACHE];
+} cache_t;
+
+static const hd__tri_prep_t *prepared(cache_t *C, size_t pos, const hd__tri_t *t) {
+    size_t k = pos & (CACHE - 1);
+    if (C->pos[k] != pos) {
+        hd__tri_prep(t->v[0], t->v[1], t->v[2], &C->prep[k]);
+        C->pos[k] = pos;
+    }
+    return &C->prep[k];
+}
+
 /* d(v, t) <= this (v's own nearest triangle: next_up(r)). */
-static double corner_to(const corner_t *c, size_t pos, const hd__tri_t *t, uint64_t *kernel) {
+static double corner_to(const corner_t *c, size_t pos, const hd__tri_t *t, cache_t *C, uint64_t *kernel) {
     if (c->pos == pos) return up(c->r);
     double lo2, hi2;
-    hd__tri_bounds(c->p, t->v[0], t->v[1], t->v[2], &lo2, &hi2);
+    hd__tri_bounds_prep(c->p, prepared(C, pos, t), &lo2, &hi2);
     (*kernel)++;
     return sqrt_up(hi2);
 }
 
 /* Over a convex union W of two triangles of Y, the distance to W is convex
  * too: its largest value over the sub-triangle is at a corner. */
-static double pair_bound(const hd__m2m_job_t *J, const sub_t *s, double U, uint64_t *kernel) {
+static double pair_bound(const hd__m2m_job_t *J, const sub_t *s, double U, cache_t *C, uint64_t *kernel) {
     for (int i = 0; i < 3; i++)
         for (int j = i + 1; j < 3; j++) {
             size_t p1 = s->c[i].pos, p2 = s->c[j].pos;
@@ -295,7 +322,7 @@ static double pair_bound(const hd__m2m_job_t *J, const sub_t *s, double U, uint6
             if (!shared_convex(t1, t2)) continue;
             double m = 0;
             for (int k = 0; k < 3 && m < U; k++)
-                m = fmax(m, fmin(corner_to(&s->c[k], p1, t1, kernel), corner_to(&s->c[k], p2, t2, kernel)));
+                m = fmax(m, fmin(corner_to(&s->c[k], p1, t1, C, kernel), corner_to(&s->c[k], p2, t2, C, kernel)));
             U = fmin(U, m);
         }
     return U;
@@ -304,7 +331,8 @@ static double pair_bound(const hd__m2m_job_t *J, const sub_t *s, double U, uint6
 /* The sub-triangle's upper bound; once the point bound alone is at most
  * `enough` (the sub-triangle will be discarded whatever its bound) the
  * dearer bounds are skipped. */
-static double upper_of(const hd__m2m_job_t *J, const sub_t *s, double e, double enough, uint64_t *kernel) {
+static double upper_of(const hd__m2m_job_t *J, const sub_t *s, double e, double enough, cache_t *C,
+                       uint64_t *kernel) {
     double rmax = 0;
     for (int i = 0; i < 3; i++) rmax = fmax(rmax, up(s->c[i].r));
     double U = up(rmax + reach(s));
@@ -316,10 +344,10 @@ static double upper_of(const hd__m2m_job_t *J, const sub_t *s, double e, double 
         if (seen) continue;
         const hd__tri_t *t = &J->to->tris[cand];
         double m = 0;
-        for (int j = 0; j < 3 && m < U; j++) m = fmax(m, corner_to(&s->c[j], cand, t, kernel));
+        for (int j = 0; j < 3 && m < U; j++) m = fmax(m, corner_to(&s->c[j], cand, t, C, kernel));
         U = fmin(U, m);
     }
-    if (s->c[0].pos != s->c[1].pos || s->c[1].pos != s->c[2].pos) U = pair_bound(J, s, U, kernel);
+    if (s->c[0].pos != s->c[1].pos || s->c[1].pos != s->c[2].pos) U = pair_bound(J, s, U, C, kernel);
     return s->level ? up(U + e) : U;
 }
 
@@ -337,6 +365,7 @@ typedef struct ctx {
     const uint64_t *order; /* the corners (3 f + j) in Morton order, in the low 32 bits */
     found_t *found;        /* by corner */
     size_t n_corners;
+    cache_t *caches;       /* one per worker */
 } ctx_t;
 
 #define CORNER(J, id) ((J)->from[(id) / 3].v[(id) % 3])
@@ -370,7 +399,6 @@ static void phase0(void *vctx, size_t task, int worker) {
 }
 
 static void phase1(void *vctx, size_t task, int worker) {
-    (void)worker;
     ctx_t *C = vctx;
     const hd__m2m_job_t *J = C->job;
     size_t lo = task * CHUNK, hi = lo + CHUNK < J->n_from ? lo + CHUNK : J->n_from;
@@ -390,7 +418,7 @@ static void phase1(void *vctx, size_t task, int worker) {
             offer(&F->best, c, 0, 0);
         }
         F->top.level = 0;
-        F->top.U = upper_of(J, &F->top, 0, -INFINITY, &F->kernel);
+        F->top.U = upper_of(J, &F->top, 0, -INFINITY, &C->caches[worker], &F->kernel);
         F->upper = F->top.U;
     }
 }
@@ -430,6 +458,7 @@ typedef struct pool {
     size_t *free_;
     size_t n_free;
     hd__heap_t heap;
+    cache_t *cache;
     int failed;
 } pool_t;
 
@@ -467,7 +496,7 @@ static double threshold(const hd__m2m_job_t *J, double L, const face_t *F) {
 }
 
 static void split(const hd__m2m_job_t *J, const hd__tri_t *t, double e, double L, const sub_t *s, sub_t kids[4],
-                  face_t *F, hd__bvh_stats_t *st) {
+                  face_t *F, pool_t *P, hd__bvh_stats_t *st) {
     int level = s->level + 1;
     corner_t c[3], m[3];
     for (int i = 0; i < 3; i++) {
@@ -486,7 +515,7 @@ static void split(const hd__m2m_job_t *J, const hd__tri_t *t, double e, double L
     for (int q = 0; q < 4; q++) {
         for (int i = 0; i < 3; i++) kids[q].c[i] = *tri[q][i];
         kids[q].level = level;
-        kids[q].U = upper_of(J, &kids[q], e, enough, &F->kernel);
+        kids[q].U = upper_of(J, &kids[q], e, enough, P->cache, &F->kernel);
     }
 }
 
@@ -522,7 +551,7 @@ static void refine(const hd__m2m_job_t *J, face_t *F, size_t f, double L, pool_t
             break;
         }
         sub_t kids[4];
-        split(J, t, e, L, &s, kids, F, &st);
+        split(J, t, e, L, &s, kids, F, P, &st);
         F->splits++;
         thr = threshold(J, L, F);
         for (int q = 0; q < 4; q++) {
@@ -588,7 +617,10 @@ static int run_batches(const hd__m2m_job_t *J, ctx_t *C, rank_t *rk, size_t n, h
     pool_t *pools = calloc((size_t)J->threads, sizeof *pools);
     size_t *order = hd__malloc_array(MAX_BATCH, sizeof *order);
     int rc = pools && order ? HD_OK : HD_ENOMEM;
-    for (int w = 0; pools && w < J->threads; w++) hd__heap_init(&pools[w].heap, 1);
+    for (int w = 0; pools && w < J->threads; w++) {
+        hd__heap_init(&pools[w].heap, 1);
+        pools[w].cache = &C->caches[w];
+    }
     size_t next = 0, size = FIRST_BATCH;
     while (rc == HD_OK && next < n) {
         if (R->lower > J->stop_above) break; /* the predicate is answered */
@@ -619,7 +651,7 @@ int hd__m2m_run(const hd__m2m_job_t *J, hd__m2m_result_t *R) {
     memset(R, 0, sizeof *R);
     R->face = R->face_b = SIZE_MAX;
     size_t n = J->n_from;
-    ctx_t C = {J, hd__malloc_array(n ? n : 1, sizeof(face_t)), NULL, NULL, 0};
+    ctx_t C = {J, hd__malloc_array(n ? n : 1, sizeof(face_t)), NULL, NULL, 0, NULL};
     rank_t *rk = hd__malloc_array(n ? n : 1, sizeof *rk);
     if (!C.faces || !rk) {
         free(C.faces);
@@ -628,13 +660,17 @@ int hd__m2m_run(const hd__m2m_job_t *J, hd__m2m_result_t *R) {
     }
     C.n_corners = 3 * n;
     C.found = hd__malloc_array(n ? 3 * n : 1, sizeof *C.found);
+    C.caches = hd__malloc_array((size_t)J->threads, sizeof *C.caches);
     uint64_t *order = NULL;
-    if (!C.found || corner_order(J, J->threads, &order)) {
+    if (!C.found || !C.caches || corner_order(J, J->threads, &order)) {
         free(C.faces);
         free(rk);
         free(C.found);
+        free(C.caches);
         return HD_ENOMEM;
     }
+    for (int w = 0; w < J->threads; w++)
+        for (size_t k = 0; k < CACHE; k++) C.caches[w].pos[k] = SIZE_MAX;
     C.order = order;
     for (size_t f = 0; f < n; f++) {
         memset(&C.faces[f], 0, sizeof C.faces[f]);
@@ -656,6 +692,7 @@ int hd__m2m_run(const hd__m2m_job_t *J, hd__m2m_result_t *R) {
     for (size_t f = 0; f < n; f++) finish_face(R, J, &C.faces[f], f);
     R->upper = fmax(R->upper, R->lower);
     free(C.faces);
+    free(C.caches);
     free(rk);
     return rc;
 }
