@@ -227,12 +227,14 @@ static double solid_winding(const soup_t *s, const double *p) {
  * the sign agrees with the ray parity and the rounded solid-angle sum
  * (whose distance to its integer is checked below 0.01), and the exact
  * winding number equals that integer.  Returns the points inside. */
-static size_t against_references(const soup_t *s, uint64_t seed, size_t n, double lo, double hi, double gap) {
+static size_t against_box(const soup_t *s, uint64_t seed, size_t n, const double lo[3], const double hi[3],
+                          double gap) {
     gen_rng_t r;
     gen_seed(&r, seed);
     double *p = malloc(3 * n * sizeof *p), *d = malloc(n * sizeof *d);
     int8_t *sg = malloc(n);
-    gen_cube(&r, p, n, lo, hi);
+    gen_cube(&r, p, n, 0, 1);
+    for (size_t k = 0; k < 3 * n; k++) p[k] = lo[k % 3] + (hi[k % 3] - lo[k % 3]) * p[k];
     hd_error_t err;
     size_t inside = 0, compared = 0;
     CHECK_RC(signs(s, p, n, sg, d, &err), HD_OK);
@@ -265,6 +267,10 @@ static size_t against_references(const soup_t *s, uint64_t seed, size_t n, doubl
     hd__solid_free(solid);
     free(w), free(p), free(d), free(sg);
     return inside;
+}
+
+static size_t against_references(const soup_t *s, uint64_t seed, size_t n, double lo, double hi, double gap) {
+    return against_box(s, seed, n, (double[3]){lo, lo, lo}, (double[3]){hi, hi, hi}, gap);
 }
 
 /* ---- behaviours -------------------------------------------------------- */
@@ -540,4 +546,51 @@ TEST(points_on_the_icosphere_vertices_and_edges) {
     }
     free(p), free(d), free(sg);
     soup_free(&s);
+}
+
+/* A bundled model as a soup (copies of its arrays). */
+static int read_model(const char *path, soup_t *s) {
+    hd_mesh_file_t *m;
+    hd_error_t err;
+    int rc = hd_read_mesh(path, NULL, &m, &err);
+    CHECK_RC(rc, HD_OK);
+    if (rc) return rc;
+    s->nv = m->n_vertices, s->nt = m->n_triangles;
+    s->v = malloc(3 * s->nv * sizeof *s->v);
+    s->t = malloc(3 * s->nt * sizeof *s->t);
+    memcpy(s->v, m->vertices, 3 * s->nv * sizeof *s->v);
+    memcpy(s->t, m->triangles, 3 * s->nt * sizeof *s->t);
+    hd_mesh_file_free(m);
+    return HD_OK;
+}
+
+TEST(bundled_closed_models_match_the_references) {
+    const char *files[] = {"data/orig/pinion.off", "data/orig/cow.off", "data/orig/fandisk_large.off"};
+    for (int f = 0; f < 3; f++) {
+        soup_t s;
+        CONTEXT("%s", files[f]);
+        if (read_model(files[f], &s)) continue;
+        double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+        for (size_t k = 0; k < 3 * s.nv; k++) lo[k % 3] = fmin(lo[k % 3], s.v[k]), hi[k % 3] = fmax(hi[k % 3], s.v[k]);
+        size_t inside = against_box(&s, 31 + (uint64_t)f, 600 / SCALE, lo, hi, 1e-9 * (hi[0] - lo[0]));
+        CHECK(inside > 0);
+        soup_free(&s);
+    }
+}
+
+TEST(bundled_open_models_are_refused) {
+    const char *files[] = {"data/orig/Wuson.stl", "data/orig/stanford_bunny_reduced.ply", "data/orig/lion.off"};
+    for (int f = 0; f < 3; f++) {
+        soup_t s;
+        CONTEXT("%s", files[f]);
+        if (read_model(files[f], &s)) continue;
+        double p[3] = {0, 0, 0};
+        int8_t sg[1];
+        hd_points_t P = hd_points_f64(p, 1);
+        hd_mesh_t M = view(&s);
+        hd_error_t err;
+        CHECK_RC(hd_mesh_signed_distances(&P, &M, NULL, NULL, NULL, NULL, NULL, sg, NULL, &err), HD_EINVAL);
+        CHECK(strstr(err.message, "alone (a boundary)") != NULL);
+        soup_free(&s);
+    }
 }
