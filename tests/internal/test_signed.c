@@ -594,3 +594,74 @@ TEST(bundled_open_models_are_refused) {
         soup_free(&s);
     }
 }
+
+/* The boundary of a random set of unit voxels in a 5^3 grid, outward:
+ * voxels touching along an edge only give non-manifold edges (four faces,
+ * two each way) and vertices; rays from lattice points run along grid lines
+ * through edges and vertices everywhere. */
+#define G 5
+static void voxels(soup_t *s, const uint8_t *fill) {
+    memset(s, 0, sizeof *s);
+    for (int z = 0; z <= G; z++)
+        for (int y = 0; y <= G; y++)
+            for (int x = 0; x <= G; x++) add_vertex(s, x, y, z);
+    for (int i = 0; i < G * G * G; i++) {
+        if (!fill[i]) continue;
+        int c[3] = {i % G, i / G % G, i / (G * G)};
+        for (int axis = 0; axis < 3; axis++)
+            for (int side = 0; side <= 1; side++) {
+                int nb[3] = {c[0], c[1], c[2]};
+                nb[axis] += side ? 1 : -1;
+                if (nb[axis] >= 0 && nb[axis] < G && fill[nb[0] + G * nb[1] + G * G * nb[2]]) continue;
+                int a1 = (axis + 1) % 3, a2 = (axis + 2) % 3;
+                uint64_t q[4];
+                for (int k = 0; k < 4; k++) {
+                    int v[3] = {c[0], c[1], c[2]};
+                    v[axis] += side;
+                    v[a1] += k == 1 || k == 2;
+                    v[a2] += k >= 2;
+                    q[k] = (uint64_t)(v[0] + (G + 1) * v[1] + (G + 1) * (G + 1) * v[2]);
+                }
+                /* (e_a1) x (e_a2) = e_axis: outward when side = 1. */
+                if (side) add_tri(s, q[0], q[1], q[2]), add_tri(s, q[0], q[2], q[3]);
+                else add_tri(s, q[0], q[2], q[1]), add_tri(s, q[0], q[3], q[2]);
+            }
+    }
+}
+
+TEST(voxel_solids_on_their_lattice) {
+    for (uint64_t seed = 1; seed <= 6; seed++) {
+        gen_rng_t r;
+        gen_seed(&r, seed);
+        uint8_t fill[G * G * G];
+        for (int i = 0; i < G * G * G; i++) fill[i] = gen_unit(&r) < 0.45;
+        soup_t s;
+        voxels(&s, fill);
+        if (!s.nt) continue;
+        enum { STEPS = 2 * G + 3 };
+        double *p = malloc(3 * STEPS * STEPS * STEPS * sizeof *p), *d = malloc(STEPS * STEPS * STEPS * sizeof *d);
+        int8_t *sg = malloc(STEPS * STEPS * STEPS);
+        size_t n = 0;
+        for (int i = 0; i < STEPS; i++)
+            for (int j = 0; j < STEPS; j++)
+                for (int k = 0; k < STEPS; k++, n++)
+                    p[3 * n] = i / 2.0 - 0.5, p[3 * n + 1] = j / 2.0 - 0.5, p[3 * n + 2] = k / 2.0 - 0.5;
+        hd_error_t err;
+        CONTEXT("seed %llu", (unsigned long long)seed);
+        int rc = signs(&s, p, n, sg, d, &err);
+        CHECK_RC(rc, HD_OK);
+        for (size_t i = 0; i < n && rc == HD_OK; i++) {
+            const double *q = p + 3 * i;
+            int c[3], in = 1;
+            for (int a = 0; a < 3; a++) {
+                c[a] = (int)floor(q[a]);
+                in &= c[a] >= 0 && c[a] < G;
+            }
+            int want = d[i] == 0 ? 0 : in && fill[c[0] + G * c[1] + G * G * c[2]] ? -1 : 1;
+            CONTEXT("seed %llu, point (%g %g %g)", (unsigned long long)seed, q[0], q[1], q[2]);
+            CHECK_EQ(sg[i], want);
+        }
+        free(p), free(d), free(sg);
+        soup_free(&s);
+    }
+}
