@@ -128,22 +128,11 @@ static void add_sphere(soup_t *s, const double c[3], double r, int levels, int b
     free(tri);
 }
 
-/* A torus (R, r) around the z axis, nu x nv quads split in two, shared
- * vertices, outward. */
+/* The torus mesh of gen.h. */
 static void torus(soup_t *s, double R, double r, int nu, int nv) {
-    memset(s, 0, sizeof *s);
-    for (int i = 0; i < nu; i++)
-        for (int j = 0; j < nv; j++) {
-            double u = 2 * M_PI * i / nu, v = 2 * M_PI * j / nv;
-            add_vertex(s, (R + r * cos(v)) * cos(u), (R + r * cos(v)) * sin(u), r * sin(v));
-        }
-    for (int i = 0; i < nu; i++)
-        for (int j = 0; j < nv; j++) {
-            uint64_t a = (uint64_t)(i * nv + j), b = (uint64_t)(((i + 1) % nu) * nv + j),
-                     c = (uint64_t)(((i + 1) % nu) * nv + (j + 1) % nv), d = (uint64_t)(i * nv + (j + 1) % nv);
-            add_tri(s, a, b, c);
-            add_tri(s, a, c, d);
-        }
+    gen_torus_mesh(R, r, nu, nv, &s->v, &s->t);
+    s->nv = (size_t)nu * (size_t)nv;
+    s->nt = 2 * s->nv;
 }
 
 static hd_mesh_t view(const soup_t *s) {
