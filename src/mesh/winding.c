@@ -34,11 +34,17 @@
  * last two are comparisons of doubles.  An edge shared by two triangles is
  * seen with opposite signs from both, perturbation included, so no crossing
  * is counted twice or missed.  Every sign is exact: computed in doubles and
- * accepted when it exceeds a bound on its rounding error (the sum of the
- * absolute values of the terms times 8u for orient2, 16u for orient3, with
- * u = 2^-53; the usual bounds are 3u and 7u, Shewchuk 1997), otherwise
- * computed with the kernel's exact integers (mesh_int.h).  Underflowing or
- * overflowing products go to the exact path.
+ * accepted when it exceeds a bound on its rounding error, otherwise
+ * computed with the kernel's exact integers (mesh_int.h).  The bound is the
+ * sum of the absolute values of the products times 8u for orient2 (two
+ * differences, a product and the difference of two: at most 4u and its
+ * square) and 16u for orient3 (seven roundings on a term's path: Shewchuk
+ * 1997 proves 7u + 56u^2), u = 2^-53, plus UFL = 2^-1070 for each product
+ * that may underflow (a subnormal result errs by at most 2^-1075; a
+ * difference of doubles that is subnormal is exact), times the largest
+ * factor a product of orient3 is later multiplied by (lever).  Coordinates
+ * are below 1e153, so orient2's products are finite; orient3's may
+ * overflow, and an infinite or NaN bound or value goes to the exact path.
  *
  * If orient3 is exactly 0 for a crossed triangle, p lies on that (closed)
  * triangle: p is on the surface and has no winding number; the caller is
@@ -56,7 +62,7 @@
 #include <string.h>
 
 #define U 0x1p-53
-#define TINY 0x1p-900 /* below it a product may have lost bits to underflow */
+#define UFL 0x1p-1070 /* more than the error of a product that underflows */
 #define LEAF 4
 
 /* ---- exact signs -------------------------------------------------------- */
@@ -92,8 +98,8 @@ static int orient2_exact(const double *a, const double *b, const double *p) {
 
 static int orient2(const double *a, const double *b, const double *p) {
     double t1 = (a[1] - p[1]) * (b[2] - p[2]), t2 = (a[2] - p[2]) * (b[1] - p[1]);
-    double f = t1 - t2, bound = 8 * U * (fabs(t1) + fabs(t2));
-    if (fabs(f) > bound && bound > TINY && isfinite(bound)) return f > 0 ? 1 : -1;
+    double f = t1 - t2, bound = 8 * U * (fabs(t1) + fabs(t2)) + UFL;
+    if (fabs(f) > bound && isfinite(bound)) return f > 0 ? 1 : -1;
     return orient2_exact(a, b, p);
 }
 
@@ -131,15 +137,16 @@ static int orient3_exact(const double *a, const double *b, const double *c, cons
 static int orient3(const double *a, const double *b, const double *c, const double *p) {
     double ad[3], bd[3], cd[3];
     for (int k = 0; k < 3; k++) ad[k] = a[k] - p[k], bd[k] = b[k] - p[k], cd[k] = c[k] - p[k];
-    double det = 0, perm = 0;
+    double det = 0, perm = 0, lever = 1;
     for (int k = 0; k < 3; k++) {
         int k1 = (k + 1) % 3, k2 = (k + 2) % 3;
         double m1 = bd[k1] * cd[k2], m2 = bd[k2] * cd[k1];
         det += ad[k] * (m1 - m2);
         perm += fabs(ad[k]) * (fabs(m1) + fabs(m2));
+        lever += fabs(ad[k]);
     }
-    double bound = 16 * U * perm;
-    if (fabs(det) > bound && bound > TINY && isfinite(bound)) return det > 0 ? -1 : 1;
+    double bound = 16 * U * perm + 4 * UFL * lever;
+    if (fabs(det) > bound && isfinite(bound)) return det > 0 ? -1 : 1;
     return orient3_exact(a, b, c, p);
 }
 

@@ -654,3 +654,24 @@ TEST(voxel_solids_on_their_lattice) {
         soup_free(&s);
     }
 }
+
+TEST(scaled_cubes_far_from_one) {
+    /* The filters give up (orient3 overflows near 1e150, products underflow
+     * near 1e-300) and the exact path decides; rays run through diagonals
+     * and along edges. */
+    const double scales[] = {1e150, 0x1p-1000, 3e-300, 1e-170};
+    for (int k = 0; k < 4; k++) {
+        double x = scales[k];
+        soup_t s = {0};
+        add_cube(&s, (double[3]){0, 0, 0}, (double[3]){x, x, x}, 0);
+        double p[] = {x / 2, x / 2, x / 2, x / 4, x / 2, x / 2, -x, x / 2, x / 2, -x, 0, 0, 2 * x, x / 2, 0,
+                      x / 4, x / 4, x / 4, x / 2, x / 2, x, -x, x, x};
+        int8_t want[] = {-1, -1, 1, 1, 1, -1, 0, 1}, sg[8];
+        double d[8];
+        hd_error_t err;
+        CONTEXT("scale %g", x);
+        CHECK_RC(signs(&s, p, 8, sg, d, &err), HD_OK);
+        for (int i = 0; i < 8; i++) CHECK_EQ(sg[i], want[i]);
+        soup_free(&s);
+    }
+}
