@@ -889,7 +889,9 @@ HD_EXTERN int hd_mesh_distances(const hd_points_t *P, const hd_mesh_t *M,
  * way).  The vertex indices and triangles of the mesh are as for
  * hd_mesh_distances; the other outputs too, bit for bit (each may be NULL,
  * sign too: then only the check and the distances run).  sign holds
- * P->count elements.
+ * P->count elements.  The check and the winding tree take about 400 bytes
+ * a triangle at their peak, beside hd_mesh_distances' tree, freed before
+ * returning.
  * Errors: those of hd_mesh_distances, and HD_EINVAL when the mesh is not
  *   closed and consistently oriented: the message names an offending edge
  *   by its two vertex indices (the smallest index at those coordinates) and
