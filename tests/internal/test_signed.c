@@ -13,6 +13,7 @@
 #include "gen.h"
 #include "mesh/mesh.h"
 
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 
@@ -674,4 +675,79 @@ TEST(scaled_cubes_far_from_one) {
         for (int i = 0; i < 8; i++) CHECK_EQ(sg[i], want[i]);
         soup_free(&s);
     }
+}
+
+/* The winding number of the mesh and point with coordinates rotated
+ * (x, y, z) -> (y, z, x) `rot` times, or mirrored in x (w changes sign):
+ * the same solid, seen along another ray through other degeneracies. */
+static long winding_moved(const soup_t *s, const double *p, int rot, int mirror, int *on) {
+    hd__wtri_t *w = malloc(s->nt * sizeof *w);
+    double q[3];
+    for (int c = 0; c < 3; c++) q[c] = p[(c + rot) % 3];
+    if (mirror) q[0] = -q[0];
+    for (size_t k = 0; k < s->nt; k++)
+        for (int j = 0; j < 3; j++) {
+            const double *v = s->v + 3 * s->t[3 * k + j];
+            w[k].vi[j] = s->t[3 * k + j];
+            for (int c = 0; c < 3; c++) w[k].v[j][c] = v[(c + rot) % 3];
+            if (mirror) w[k].v[j][0] = -w[k].v[j][0];
+        }
+    hd__solid_t *S;
+    hd_error_t err;
+    long r = LONG_MIN;
+    if (hd__solid_build(&S, w, s->nt, &err) == HD_OK) {
+        r = hd__solid_winding(S, q, on);
+        hd__solid_free(S);
+    }
+    free(w);
+    return mirror ? -r : r;
+}
+
+TEST(points_a_hair_from_the_surface_agree_along_every_axis) {
+    /* Points within a few ulps of faces, edges and vertices, where the
+     * solid-angle sum cannot be trusted: the exact count along x, along y
+     * and z (rotated) and along -x (mirrored) agree. */
+    soup_t meshes[3] = {{0}};
+    add_sphere(&meshes[0], (double[3]){0.1, 0.2, 0.3}, 1.0, 1, 1, 0);
+    torus(&meshes[1], 1.0, 0.4, 12, 8);
+    uint8_t fill[G * G * G];
+    gen_rng_t r;
+    gen_seed(&r, 77);
+    for (int i = 0; i < G * G * G; i++) fill[i] = gen_unit(&r) < 0.45;
+    voxels(&meshes[2], fill);
+    for (int m = 0; m < 3; m++) {
+        const soup_t *s = &meshes[m];
+        for (int i = 0; i < 60 / SCALE; i++) {
+            size_t t = gen_u64(&r) % s->nt;
+            const double *a = s->v + 3 * s->t[3 * t], *b = s->v + 3 * s->t[3 * t + 1], *c = s->v + 3 * s->t[3 * t + 2];
+            double u = gen_unit(&r), v = gen_unit(&r), p[3];
+            int where = i % 3; /* face, edge, vertex */
+            if (where == 1) v = 0;
+            if (where == 2) u = v = 0;
+            if (u + v > 1) u = 1 - u, v = 1 - v;
+            for (int k = 0; k < 3; k++) {
+                p[k] = a[k] + u * (b[k] - a[k]) + v * (c[k] - a[k]);
+                int ulps = (int)(gen_u64(&r) % 5) - 2;
+                for (; ulps > 0; ulps--) p[k] = nextafter(p[k], INFINITY);
+                for (; ulps < 0; ulps++) p[k] = nextafter(p[k], -INFINITY);
+            }
+            double d[1];
+            int8_t sg[1];
+            hd_error_t err;
+            CONTEXT("mesh %d, triangle %zu, point (%.17g %.17g %.17g)", m, t, p[0], p[1], p[2]);
+            CHECK_RC(signs(s, p, 1, sg, d, &err), HD_OK);
+            if (d[0] == 0) {
+                CHECK_EQ(sg[0], 0);
+                continue;
+            }
+            int on;
+            long w0 = winding_moved(s, p, 0, 0, &on);
+            CHECK_EQ(on, 0);
+            CHECK_EQ(sg[0], w0 != 0 ? -1 : 1);
+            for (int rot = 1; rot < 3; rot++) CHECK_EQ(winding_moved(s, p, rot, 0, &on), w0);
+            CHECK_EQ(winding_moved(s, p, 0, 1, &on), w0);
+            CHECK(w0 == 0 || w0 == 1);
+        }
+    }
+    for (int m = 0; m < 3; m++) soup_free(&meshes[m]);
 }
