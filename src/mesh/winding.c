@@ -242,68 +242,97 @@ static int cmp_corner(const void *x, const void *y) {
     return (a->vertex > b->vertex) - (a->vertex < b->vertex);
 }
 
+static void corner_of(const hd__wtri_t *t, size_t slot, corner_t *c) {
+    for (int k = 0; k < 3; k++) c->xyz[k] = t[slot / 3].v[slot % 3][k] + 0.0; /* -0 -> +0 */
+    c->vertex = t[slot / 3].vi[slot % 3];
+    c->slot = slot;
+}
+
+/* 30 bits of the corner's coordinates: equal coordinates, equal bits. */
+static uint64_t corner_hash(const corner_t *c) {
+    uint64_t h = 0x9e3779b97f4a7c15u, b;
+    for (int k = 0; k < 3; k++) {
+        memcpy(&b, &c->xyz[k], 8);
+        h = (h ^ b) * 0xff51afd7ed558ccdu;
+        h ^= h >> 33;
+    }
+    return h >> 34;
+}
+
+/* The vertex id of every corner (id[3t + j]) and, per id, a representative:
+ * the smallest caller index with those coordinates (rep[id]).  The corners
+ * are radix-sorted by a hash of their coordinates; each run of one hash
+ * (the corners of one vertex, and rarely a colliding other) is sorted by
+ * coordinates and caller index, so equal coordinates are grouped exactly. */
+static int vertex_ids(const hd__wtri_t *t, size_t n, size_t *id, uint64_t *rep, size_t *n_ids) {
+    size_t m = 3 * n;
+    uint64_t *key = hd__malloc_array(m, sizeof *key), *tmp = hd__malloc_array(m, sizeof *tmp);
+    corner_t *run = NULL;
+    size_t cap = 0;
+    int rc = key && tmp ? HD_OK : HD_ENOMEM;
+    for (size_t s = 0; rc == HD_OK && s < m; s++) {
+        corner_t c;
+        corner_of(t, s, &c);
+        key[s] = corner_hash(&c) << 32 | (uint64_t)s;
+    }
+    if (rc == HD_OK) rc = hd__radix_sort(&key, &tmp, m, 1);
+    size_t ids = 0;
+    for (size_t a = 0; rc == HD_OK && a < m;) {
+        size_t b = a + 1;
+        while (b < m && key[b] >> 32 == key[a] >> 32) b++;
+        if (b - a > cap) {
+            free(run);
+            cap = 2 * (b - a);
+            if (!(run = hd__malloc_array(cap, sizeof *run))) rc = HD_ENOMEM;
+        }
+        for (size_t k = a; rc == HD_OK && k < b; k++) corner_of(t, (size_t)(key[k] & 0xffffffffu), &run[k - a]);
+        if (rc == HD_OK && b - a > 1) qsort(run, b - a, sizeof *run, cmp_corner);
+        for (size_t x = 0; rc == HD_OK && x < b - a;) {
+            size_t y = x + 1;
+            while (y < b - a && memcmp(run[x].xyz, run[y].xyz, sizeof run[x].xyz) == 0) y++;
+            rep[ids] = run[x].vertex;
+            for (size_t k = x; k < y; k++) id[run[k].slot] = ids;
+            ids++;
+            x = y;
+        }
+        a = b;
+    }
+    free(key), free(tmp), free(run);
+    *n_ids = ids;
+    return rc;
+}
+
 typedef struct {
-    size_t lo, hi; /* vertex ids, lo < hi */
+    size_t hi;  /* the other vertex id, above the bucket's */
     size_t tri;
-    int dir; /* +1: used from lo to hi */
+    int dir;    /* +1: used from the bucket's vertex to hi */
 } edge_t;
 
 static int cmp_edge(const void *x, const void *y) {
     const edge_t *a = x, *b = y;
-    if (a->lo != b->lo) return a->lo < b->lo ? -1 : 1;
     if (a->hi != b->hi) return a->hi < b->hi ? -1 : 1;
     return (a->tri > b->tri) - (a->tri < b->tri);
 }
 
-/* The vertex id of every corner (id[3t + j]) and, per id, a representative:
- * the smallest caller index with those coordinates (rep[id]). */
-static int vertex_ids(const hd__wtri_t *t, size_t n, size_t *id, uint64_t **rep_out) {
-    corner_t *c = hd__malloc_array(3 * n, sizeof *c);
-    uint64_t *rep = hd__malloc_array(3 * n, sizeof *rep);
-    if (!c || !rep) {
-        free(c);
-        free(rep);
-        return HD_ENOMEM;
-    }
-    for (size_t s = 0; s < 3 * n; s++) {
-        for (int k = 0; k < 3; k++) c[s].xyz[k] = t[s / 3].v[s % 3][k] + 0.0; /* -0 -> +0 */
-        c[s].vertex = t[s / 3].vi[s % 3];
-        c[s].slot = s;
-    }
-    qsort(c, 3 * n, sizeof *c, cmp_corner);
-    size_t ids = 0;
-    for (size_t a = 0; a < 3 * n;) {
-        size_t b = a + 1;
-        while (b < 3 * n && memcmp(c[a].xyz, c[b].xyz, sizeof c[a].xyz) == 0) b++;
-        rep[ids] = c[a].vertex;
-        for (size_t k = a; k < b; k++) id[c[k].slot] = ids;
-        ids++;
-        a = b;
-    }
-    free(c);
-    *rep_out = rep;
-    return HD_OK;
-}
-
-/* An unbalanced edge e[a .. b) named in the error. */
-static int open_edge(const edge_t *e, size_t a, size_t b, const uint64_t *rep, hd_error_t *err) {
+/* An unbalanced edge e[0 .. n) between ids lo and e->hi named in the error. */
+static int open_edge(const edge_t *e, size_t n, size_t lo, const uint64_t *rep, hd_error_t *err) {
     size_t fwd = 0, back = 0, tf = SIZE_MAX, tb = SIZE_MAX;
-    for (size_t k = a; k < b; k++) {
+    for (size_t k = 0; k < n; k++) {
         if (e[k].dir > 0) fwd++, tf = tf == SIZE_MAX ? e[k].tri : tf;
         else back++, tb = tb == SIZE_MAX ? e[k].tri : tb;
     }
-    unsigned long long u = rep[e[a].lo], v = rep[e[a].hi]; /* e[k].dir > 0: used from u to v */
-    if (b - a == 1)
+    unsigned long long u = rep[lo], v = rep[e->hi]; /* dir > 0: used from u to v */
+    if (n == 1)
         return hd__err(err, HD_EINVAL,
                        "mesh is not closed: the edge between vertices %llu and %llu is used by triangle %zu "
                        "alone (a boundary); a signed distance needs a closed, consistently oriented mesh",
-                       u < v ? u : v, u < v ? v : u, e[a].tri);
+                       u < v ? u : v, u < v ? v : u, e->tri);
     if (fwd == 0 || back == 0)
         return hd__err(err, HD_EINVAL,
                        "mesh is not consistently oriented: triangles %zu and %zu both use the edge from "
                        "vertex %llu to vertex %llu (a flipped face?); a signed distance needs a closed, "
                        "consistently oriented mesh",
-                       e[a].tri, e[a + 1].tri, fwd ? u : v, fwd ? v : u);
+                       e[0].tri, e[1].tri, fwd ? u : v, fwd ? v : u);
     return hd__err(err, HD_EINVAL,
                    "mesh is not closed: the edge between vertices %llu and %llu is used %zu times from %llu "
                    "and %zu times from %llu (triangles %zu and %zu among them); a signed distance needs "
@@ -311,32 +340,54 @@ static int open_edge(const edge_t *e, size_t a, size_t b, const uint64_t *rep, h
                    u, v, fwd, u, back, v, tf, tb);
 }
 
-static int check_closed(const hd__wtri_t *t, size_t n, hd_error_t *err) {
-    size_t *id = hd__malloc_array(3 * n, sizeof *id);
+/* Every edge balanced: the edges are put in buckets by their lower vertex
+ * id (a counting sort), each bucket sorted by the other id and triangle,
+ * and each run of one edge summed.  The first unbalanced edge in that
+ * order is named. */
+static int balanced(const size_t *id, size_t n, size_t ids, const uint64_t *rep, hd_error_t *err) {
+    size_t *start = hd__calloc_array(ids + 1, sizeof *start);
     edge_t *e = hd__malloc_array(3 * n, sizeof *e);
-    uint64_t *rep = NULL;
-    int rc = id && e ? vertex_ids(t, n, id, &rep) : HD_ENOMEM;
-    size_t ne = 0;
-    for (size_t k = 0; rc == HD_OK && k < n; k++) {
-        const size_t *f = id + 3 * k;
-        if (f[0] == f[1] || f[1] == f[2] || f[2] == f[0]) continue; /* no area, no edge */
-        for (int j = 0; j < 3; j++) {
-            size_t u = f[j], v = f[(j + 1) % 3];
-            e[ne++] = (edge_t){u < v ? u : v, u < v ? v : u, k, u < v ? 1 : -1};
+    int rc = start && e ? HD_OK : HD_ENOMEM;
+    for (int pass = 0; rc == HD_OK && pass < 2; pass++) {
+        for (size_t k = 0; k < n; k++) {
+            const size_t *f = id + 3 * k;
+            if (f[0] == f[1] || f[1] == f[2] || f[2] == f[0]) continue; /* no area, no edge */
+            for (int j = 0; j < 3; j++) {
+                size_t u = f[j], v = f[(j + 1) % 3], lo = u < v ? u : v;
+                if (pass == 0) start[lo + 1]++;
+                else e[start[lo]++] = (edge_t){u < v ? v : u, k, u < v ? 1 : -1};
+            }
+        }
+        if (pass == 0)
+            for (size_t x = 0; x < ids; x++) start[x + 1] += start[x];
+        else
+            for (size_t x = ids; x > 0; x--) start[x] = start[x - 1]; /* back to the bucket starts */
+        if (pass == 1) start[0] = 0;
+    }
+    for (size_t lo = 0; rc == HD_OK && lo < ids; lo++) {
+        edge_t *b = e + start[lo];
+        size_t nb = start[lo + 1] - start[lo];
+        qsort(b, nb, sizeof *b, cmp_edge);
+        for (size_t x = 0; rc == HD_OK && x < nb;) {
+            size_t y = x;
+            long sum = 0;
+            while (y < nb && b[y].hi == b[x].hi) sum += b[y++].dir;
+            if (sum != 0) rc = open_edge(b + x, y - x, lo, rep, err);
+            x = y;
         }
     }
-    if (rc == HD_OK) qsort(e, ne, sizeof *e, cmp_edge);
-    for (size_t a = 0; rc == HD_OK && a < ne;) {
-        size_t b = a;
-        long sum = 0;
-        while (b < ne && e[b].lo == e[a].lo && e[b].hi == e[a].hi) sum += e[b++].dir;
-        if (sum != 0) rc = open_edge(e, a, b, rep, err);
-        a = b;
-    }
     if (rc == HD_ENOMEM) hd__err(err, rc, "mesh: out of memory checking the edges of %zu triangles", n);
-    free(id);
-    free(e);
-    free(rep);
+    free(start), free(e);
+    return rc;
+}
+
+static int check_closed(const hd__wtri_t *t, size_t n, hd_error_t *err) {
+    size_t *id = hd__malloc_array(3 * n, sizeof *id), ids = 0;
+    uint64_t *rep = hd__malloc_array(3 * n, sizeof *rep);
+    int rc = id && rep ? vertex_ids(t, n, id, rep, &ids) : HD_ENOMEM;
+    if (rc == HD_OK) rc = balanced(id, n, ids, rep, err);
+    else hd__err(err, rc, "mesh: out of memory merging the corners of %zu triangles", n);
+    free(id), free(rep);
     return rc;
 }
 
@@ -344,7 +395,9 @@ static int check_closed(const hd__wtri_t *t, size_t n, hd_error_t *err) {
 
 int hd__solid_build(hd__solid_t **out, const hd__wtri_t *t, size_t n, hd_error_t *err) {
     *out = NULL;
-    if (n > UINT32_MAX / 2) return hd__err(err, HD_EOVERFLOW, "mesh: more than 2^31 triangles to sign");
+    if (n > UINT32_MAX / 3) /* corners are numbered in 32 bits */
+        return hd__err(err, HD_EOVERFLOW, "mesh: %zu triangles, more than the %u a signed distance takes", n,
+                       (unsigned)(UINT32_MAX / 3));
     int rc = check_closed(t, n, err);
     if (rc) return rc;
     struct hd__solid *S = calloc(1, sizeof *S);
