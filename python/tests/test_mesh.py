@@ -125,6 +125,6 @@ def test_open_or_flipped_meshes_are_refused_for_signs():
     flipped = [f[::-1] if k == 4 else f for k, f in enumerate(CUBE_F)]
     with pytest.raises(ValueError, match="not consistently oriented"):
         hausdorff.Mesh(CUBE_V, flipped).distances([[0.5, 0.5, 0.5]], signed=True)
-    with pytest.raises(ValueError, match="is used by triangle 2184 alone"):
+    with pytest.raises(ValueError, match=r"is used by triangle \d+ alone \(a boundary\)"):
         hausdorff.read_mesh(DATA / "Wuson.stl").distances([[0, 0, 0]], signed=True)
     assert SQUARE.distances([[0, 0, 1]]).distances.tolist() == [1.0]  # open meshes still measure
