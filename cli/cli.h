@@ -29,6 +29,7 @@ typedef struct cli_args {
     int tolerance_set, tolerance_relative; /* given; with the 'd' suffix */
     double within;          /* --within D: is the distance <= D? */
     int within_set;
+    int signed_distance; /* --signed: with --surface, each distance's sign */
     analysis_args_t an; /* analysis options (analysis.h) */
 } cli_args_t;
 

@@ -164,8 +164,8 @@ typedef enum {
     OPT_DTU_CAP,
     OPT_FLAGS, /* the first flag */
     OPT_HELP = OPT_FLAGS, OPT_VERSION, OPT_FORMATS, OPT_DIRECTED, OPT_JSON, OPT_QUIET, OPT_NO_EARLY_BREAK,
-    OPT_NO_CULLING, OPT_FLOAT32, OPT_DECIMAL_COMMA, OPT_VERTICES, OPT_SURFACE, OPT_MEAN, OPT_CHAMFER,
-    OPT_HISTOGRAM,
+    OPT_NO_CULLING, OPT_FLOAT32, OPT_DECIMAL_COMMA, OPT_VERTICES, OPT_SURFACE, OPT_SIGNED, OPT_MEAN,
+    OPT_CHAMFER, OPT_HISTOGRAM,
     OPT_COUNT
 } option_t;
 
@@ -225,9 +225,16 @@ static const option_entry_t options[] = {
      "read a mesh (ply, obj, off, stl) as its vertices (default)"},
     {OPT_SURFACE, "--surface", NULL, NULL, 0,
      "measure meshes as surfaces: each point of A to B's\n"
-     "nearest triangle, correctly rounded; with a mesh as A,\n"
-     "every point of A's surface against B (a mesh or points):\n"
-     "the distance enclosed in [lower, upper] with a witness"},
+     "nearest triangle, correctly rounded (the analysis\n"
+     "options below work on these distances); with a mesh\n"
+     "as A, every point of A's surface against B (a mesh or\n"
+     "points): the distance enclosed in [lower, upper] with\n"
+     "a witness"},
+    {OPT_SIGNED, "--signed", NULL, NULL, 0,
+     "with --surface: each distance's sign, -1 inside B, +1\n"
+     "outside, 0 on it, from B's winding number (exact); B must\n"
+     "be closed and consistently oriented, else it is refused\n"
+     "naming an edge"},
     {OPT_TOLERANCE, "--tolerance", NULL, "T", 0,
      "with --surface and a mesh as A: upper - lower <= T,\n"
      "absolute, or with a d suffix a fraction of the\n"
@@ -421,6 +428,7 @@ static int set_flag(cli_args_t *a, int which) {
     case OPT_DECIMAL_COMMA: a->read.decimal_comma = 1; break;
     case OPT_VERTICES: a->read.mesh = HD_MESH_VERTICES; break;
     case OPT_SURFACE: a->surface = 1; break;
+    case OPT_SIGNED: a->signed_distance = 1; break;
     case OPT_MEAN: a->an.mean = 1; break;
     case OPT_CHAMFER: a->an.chamfer = 1; break;
     case OPT_HISTOGRAM: a->an.histogram = 1; break;
@@ -625,6 +633,8 @@ int cli_parse(int argc, char **argv, cli_args_t *a) {
     if ((a->tolerance_set || a->within_set) && !a->surface)
         return bad("%s measures a surface: it needs --surface (and a mesh as A)",
                    a->within_set ? "--within" : "--tolerance");
+    if (a->signed_distance && !a->surface)
+        return bad("--signed needs --surface: a sign is taken from the surface of the mesh B%s", "");
     if (nfiles != 2) {
         /* one line and a pointer, not the whole help */
         fprintf(stderr, "%s: expected two files, A and B, not %d\n"
