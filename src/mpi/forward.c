@@ -465,6 +465,136 @@ static void cull_pick(const hd__mpi_dir_t *d, const hd__mpi_shell_t *sh, const d
     for (size_t t = 0; t < nt; t++) pick[top[t]] = 1;
 }
 
+/* A rank holding no point of Q (two sets apart, one tiny side: every
+ * point of P may be in its shell) keeps per-point state only for the
+ * shell points that may still win after the sample's bounds; the others
+ * lose to (L, i_L) now and at every later step, since L only grows and
+ * an upper bound only falls (loses()), so dropping them changes no
+ * answer.  Their lower bounds (lower_bound from the local Q's box, none
+ * when Q is empty here, and every other rank's) enter L as bounds_below
+ * enters them, computed without arrays.  A deferred shell (shell.c: most
+ * of P, not searched one by one) takes the same course, and its points
+ * that may still win are then searched in the local Q (deferred_answers). */
+static hd__mpi_far_t one_sided_below(const hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, const hd__mpi_shell_t *sh,
+                                     const hd__mpi_held_t *held, hd__mpi_far_t L) {
+    const hd__box_t *own = &held[c->rank].box[d->qside];
+    for (size_t k = 0; k < sh->n; k++) {
+        const double *p = hd__mpi_shell_pt(d, sh, k);
+        double lb = d->nQ ? hd__box_lb2(own, p) : INFINITY; /* the local Q's box: below every local answer */
+        hd__mpi_far_t f = {lower_bound(c, held, d->qside, p, lb), UINT64_MAX, UINT64_MAX};
+        if (hd__mpi_far_better(&f, &L)) L = f;
+    }
+    return L;
+}
+
+/* The sample's bounds (sample_bounds) on P's positions pos[0..n) as a
+ * shell of their own, into arrays of n. */
+static int one_sided_bounds(hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, const qsample_t *qs, hd__mpi_far_t L,
+                            uint32_t *pos, size_t n, double *u2, uint64_t *jj, unsigned char *exact) {
+    hd__mpi_shell_t part;
+    memset(&part, 0, sizeof part);
+    part.n = n;
+    part.own_pos = pos;
+    for (size_t k = 0; k < n; k++) u2[k] = INFINITY, jj[k] = UINT64_MAX, exact[k] = 0;
+    return sample_bounds(c, d, &part, qs, L.d2, u2, jj, exact);
+}
+
+static int one_sided_loses(const hd__mpi_dir_t *d, uint32_t pos, double u2, hd__mpi_far_t L) {
+    return u2 < L.d2 || (u2 == L.d2 && hd__mpi_gidx(d->gP, pos) > L.i);
+}
+
+/* The shell of a rank without Q (all of P), or a deferred one (shell.c:
+ * most of P, no local answers yet), cut to the points that may still win: the sample's bounds a chunk of P at a time
+ * mark them (a bit each), then their bounds are computed again into
+ * arrays of their number (the same answers: a point kept had no sample
+ * point below L, so both passes searched the whole sample for it, and the
+ * nearest sample point, d2 first, then the index, does not depend on the
+ * order).  On success the shell is the kept positions and *u2, *jj,
+ * *exact hold *n of them. */
+static int one_sided_shell(hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, hd__mpi_shell_t *sh, const qsample_t *qs,
+                           hd__mpi_far_t L, double **u2, uint64_t **jj, unsigned char **exact, size_t *n) {
+    size_t nP = sh->n, ch = nP / 8 > 65536 ? nP / 8 : 65536, kept = 0, nb = (nP + 7) / 8;
+    if (ch > nP) ch = nP;
+    uint32_t *pos = hd__mpi_alloc(c, ch, sizeof(uint32_t));
+    double *cu = hd__mpi_alloc(c, ch, sizeof(double));
+    uint64_t *cj = hd__mpi_alloc(c, ch, sizeof(uint64_t));
+    unsigned char *ce = hd__mpi_alloc(c, ch, 1), *win = hd__mpi_alloc(c, nb, 1);
+    int rc = pos && cu && cj && ce && win ? HD_OK : hd__mpi_nomem(c, "per-point bounds", ch);
+    if (rc == HD_OK) memset(win, 0, nb);
+    for (size_t k0 = 0; k0 < nP && rc == HD_OK; k0 += ch) {
+        size_t m = nP - k0 < ch ? nP - k0 : ch;
+        for (size_t t = 0; t < m; t++) pos[t] = sh->own_pos ? sh->own_pos[k0 + t] : (uint32_t)(k0 + t);
+        rc = one_sided_bounds(c, d, qs, L, pos, m, cu, cj, ce);
+        for (size_t t = 0; t < m && rc == HD_OK; t++)
+            if (!one_sided_loses(d, pos[t], cu[t], L)) win[(k0 + t) / 8] |= (unsigned char)(1u << ((k0 + t) % 8)), kept++;
+    }
+    hd__mpi_free(c, pos, ch, sizeof(uint32_t));
+    hd__mpi_free(c, cu, ch, sizeof(double));
+    hd__mpi_free(c, cj, ch, sizeof(uint64_t));
+    hd__mpi_free(c, ce, ch, 1);
+    uint32_t *kp = NULL;
+    double *ku = NULL;
+    uint64_t *kj = NULL;
+    unsigned char *ke = NULL;
+    if (rc == HD_OK) {
+        kp = hd__mpi_alloc(c, kept, sizeof(uint32_t));
+        ku = hd__mpi_alloc(c, kept, sizeof(double));
+        kj = hd__mpi_alloc(c, kept, sizeof(uint64_t));
+        ke = hd__mpi_alloc(c, kept, 1);
+        if (!kp || !ku || !kj || !ke) rc = hd__mpi_nomem(c, "per-point bounds", kept);
+    }
+    for (size_t k = 0, t = 0; k < nP && rc == HD_OK; k++)
+        if (win[k / 8] >> (k % 8) & 1) kp[t++] = sh->own_pos ? sh->own_pos[k] : (uint32_t)k;
+    hd__mpi_free(c, win, nb, 1);
+    if (rc == HD_OK) rc = one_sided_bounds(c, d, qs, L, kp, kept, ku, kj, ke);
+    if (rc != HD_OK) {
+        hd__mpi_free(c, kp, kept, sizeof(uint32_t));
+        hd__mpi_free(c, ku, kept, sizeof(double));
+        hd__mpi_free(c, kj, kept, sizeof(uint64_t));
+        hd__mpi_free(c, ke, kept, 1);
+        return rc;
+    }
+    hd__mpi_free(c, sh->own_pos, sh->n, sizeof(uint32_t));
+    sh->own_pos = kp;
+    sh->n = kept;
+    *u2 = ku, *jj = kj, *exact = ke, *n = kept;
+    return HD_OK;
+}
+
+/* A deferred shell's points, once cut (one_sided_shell), get their
+ * nearest in the local Q (hd__mpi_nearest_in_q: exact, or a point of the
+ * first slab, marked unproven for resolve), kept when smaller than the
+ * sample's (d2 first, then the index); a point is exact when its answer is
+ * proven and its faces are clear of it (then no other rank holds a point
+ * as near: the sample's point, if it came from another rank, would lie
+ * beyond a face within u), or when the whole of Q was the sample. */
+static int deferred_answers(hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, const hd__box_t *mine, hd__mpi_qtree_t *q,
+                            hd__mpi_shell_t *sh, double *u2, uint64_t *jj, unsigned char *exact) {
+    size_t n = sh->n;
+    size_t *near = hd__mpi_alloc(c, n, sizeof(size_t));
+    sh->unproven = hd__mpi_alloc(c, n, 1);
+    if (!near || !sh->unproven) {
+        hd__mpi_free(c, near, n, sizeof(size_t));
+        return hd__mpi_nomem(c, "nearest neighbours", n);
+    }
+    memset(sh->unproven, 0, n);
+    int rc = hd__mpi_nearest_in_q(c, d, mine, q, d->P, sh->own_pos, n, near, sh->unproven);
+    hd__mpi_gcur_t cq;
+    hd__mpi_gcur_init(&cq, d->gQ);
+    for (size_t k = 0; k < n && rc == HD_OK; k++) {
+        const double *p = hd__mpi_shell_pt(d, sh, k);
+        if (near[k] != SIZE_MAX) {
+            double d2 = hd__d2(p, d->Q + 3 * near[k]);
+            uint64_t g = hd__mpi_gcur_at(&cq, near[k]);
+            if (d2 < u2[k] || (d2 == u2[k] && g < jj[k])) u2[k] = d2, jj[k] = g;
+        }
+        if (exact[k]) sh->unproven[k] = 0; /* the sample was all of Q */
+        else exact[k] = (unsigned char)(!sh->unproven[k] && hd__mpi_faces_clear(mine, p, u2[k]));
+    }
+    hd__mpi_free(c, near, n, sizeof(size_t));
+    return rc;
+}
+
 int hd__mpi_direction(hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, const hd__mpi_node_t *tree, const hd__box_t *region,
                      const hd__mpi_held_t *held, hd__mpi_far_t *result) {
     int K = c->K, rc = HD_OK;
@@ -479,9 +609,18 @@ int hd__mpi_direction(hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, const hd__mpi_no
     c->search += hd__now() - t0;
     c->search_cpu += hd__mpi_cpu() - u0;
     c->shell += sh.n;
-    size_t nP = sh.n;
+    /* one: the rank holds no Q; its shell is cut after the sample's
+     * bounds (one_sided_shell), and its arrays are had then */
+    int one = rc == HD_OK && sh.n > 0 && (d->nQ == 0 || sh.deferred);
+    size_t nP = one ? 0 : sh.n;
+    /* Each point's answer's index takes the slot of its local nearest
+     * position (written once read, by memcpy: the slot's type becomes
+     * uint64_t's), so the two are never held at once. */
+    _Static_assert(sizeof(size_t) == sizeof(uint64_t), "a position's slot holds an index");
+    uint64_t *jj = sh.nearest ? (uint64_t *)(void *)sh.nearest : hd__mpi_alloc(c, nP, sizeof(uint64_t));
+    size_t *near = sh.nearest;
+    sh.nearest = NULL;
     double *u2 = hd__mpi_alloc(c, nP, sizeof(double));
-    uint64_t *jj = hd__mpi_alloc(c, nP, sizeof(uint64_t));
     unsigned char *exact = hd__mpi_alloc(c, nP, 1), *pick = hd__mpi_alloc(c, nP, 1);
     hd__box_t *nbox = hd__mpi_alloc(c, K > 1 ? (size_t)K - 1 : 1, sizeof(hd__box_t));
     int *list = hd__mpi_alloc(c, (size_t)K, sizeof(int));
@@ -498,8 +637,10 @@ int hd__mpi_direction(hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, const hd__mpi_no
                 exact[k] = 0;
                 continue;
             }
-            u2[k] = hd__d2(p, d->Q + 3 * sh.nearest[k]);
-            jj[k] = hd__mpi_gcur_at(&cq, sh.nearest[k]);
+            size_t j = near[k];
+            uint64_t g = hd__mpi_gcur_at(&cq, j);
+            u2[k] = hd__d2(p, d->Q + 3 * j);
+            memcpy(&jj[k], &g, sizeof g);
             /* an answer the first slab did not prove is not exact yet (resolve) */
             exact[k] = (unsigned char)(!(sh.unproven && sh.unproven[k]) && hd__mpi_faces_clear(mine, p, u2[k]));
         }
@@ -526,18 +667,29 @@ int hd__mpi_direction(hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, const hd__mpi_no
      * into L (with the smallest index i_L of a confirmed point at L, none
      * for a lower bound: a point with u2 < L, or u2 = L and a larger
      * index, cannot be the witness); then the sample's upper bounds. */
-    if (rc == HD_OK) Lmine = bounds_below(c, d, &sh, held, u2, jj, exact, Lmine);
+    if (rc == HD_OK) Lmine = one ? one_sided_below(c, d, &sh, held, Lmine) : bounds_below(c, d, &sh, held, u2, jj, exact, Lmine);
     if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
     HD__MPI_GO(c, rc, MPI_Allreduce(&Lmine, &Lall, 1, c->far_type, c->far_op, c->comm));
     if ((rc = sample_q(c, rc, d, held, &qs)) != HD_OK) goto done;
     t0 = hd__now(), u0 = hd__mpi_cpu();
-    rc = sample_bounds(c, d, &sh, &qs, Lall.d2, u2, jj, exact);
+    if (one) {
+        hd__mpi_free(c, u2, 0, sizeof(double));
+        hd__mpi_free(c, jj, 0, sizeof(uint64_t));
+        hd__mpi_free(c, exact, 0, 1);
+        hd__mpi_free(c, pick, 0, 1);
+        u2 = NULL, jj = NULL, exact = NULL, pick = NULL;
+        rc = one_sided_shell(c, d, &sh, &qs, Lall, &u2, &jj, &exact, &nP);
+        if (rc == HD_OK && !(pick = hd__mpi_alloc(c, nP, 1))) rc = hd__mpi_nomem(c, "per-point bounds", nP);
+        if (rc == HD_OK && d->nQ) rc = deferred_answers(c, d, mine, &q, &sh, u2, jj, exact);
+    } else {
+        rc = sample_bounds(c, d, &sh, &qs, Lall.d2, u2, jj, exact);
+    }
     c->search += hd__now() - t0;
     c->search_cpu += hd__mpi_cpu() - u0;
     answer_t an = {d, mine, &q};
     /* The first round: the few likeliest to win; their exact answers,
      * and those the whole sample made exact, raise L. */
-    cull_pick(d, &sh, u2, exact, Lall.d2, Lall.i, pick);
+    if (rc == HD_OK) cull_pick(d, &sh, u2, exact, Lall.d2, Lall.i, pick);
     if ((rc = forward(c, rc, d, &sh, tree, nbox, held, pick, Lall.d2, Lall.i, list, &an, u2, jj, exact)) != HD_OK) goto done;
     for (size_t k = 0; k < nP; k++) exact[k] |= pick[k] == 2;
     Lmine = bounds_below(c, d, &sh, NULL, u2, jj, exact, Lall);

@@ -111,7 +111,12 @@
  *     kept.  Then a sample of B that every rank holds (forward.c) lowers
  *     u(a) to an upper bound from all of B; a point with a sample point
  *     nearer than L is settled as a loser, and when the sample is all of
- *     B (a tiny side) it is the exact answer.  (Skipping every
+ *     B (a tiny side) it is the exact answer.  A rank without B, or whose
+ *     shell is most of its A (sets far apart), searches none of it one by
+ *     one before that: the sample's bounds come first, the points they
+ *     show cannot win are dropped with their per-point state, and only the
+ *     rest are searched in the local B (forward.c, one_sided_shell).
+ *     (Skipping every
  *     u(a)^2 <= L would lose ties: a point at exactly L with a smaller
  *     index is the witness, and its smallest-index nearest point may lie on
  *     another rank; tests/api/mpi_api.c's checkerboard fails that way.)

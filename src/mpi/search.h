@@ -110,6 +110,9 @@ typedef struct {
     hd__mpi_far_t inner;             /* exact over the interior; d2 = -1 if none
                                 or not known (lazy) */
     int lazy;                /* the interior's maximum was not computed */
+    int deferred;            /* no local answers yet (nearest and unproven NULL):
+                                a shell too large to search one by one, bounded
+                                by the sample first (forward.c, one_sided_shell) */
     hd__mpi_far_t h;                 /* then: the engine's answer, whose witness
                                 is in the shell and bounds the interior */
 } hd__mpi_shell_t;

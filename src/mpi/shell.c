@@ -508,6 +508,12 @@ static int refused_shell(hd__mpi_ctx_t *c, const hd__mpi_refused_t *ref, uint32_
     return HD_OK;
 }
 
+/* The smallest shell searched after the sample's bounds rather than one by
+ * one (below), when it is also at least half of P: a shell of a few
+ * points is searched at once, and on two epochs of one scene the shell is
+ * a small part of P, so neither takes this course. */
+#define DEFER_MIN 1024
+
 int hd__mpi_shell_of(hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, const hd__box_t *mine, hd__mpi_qtree_t *q, hd__mpi_shell_t *sh) {
     memset(sh, 0, sizeof *sh);
     sh->inner = (hd__mpi_far_t){-1.0, UINT64_MAX, UINT64_MAX};
@@ -603,6 +609,17 @@ int hd__mpi_shell_of(hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, const hd__box_t *
     }
     sh->n = nS;
     hd__mpi_free(c, in, d->nP, 1);
+    /* A shell of most of P (sets far apart: every point within h of a
+     * face) is not searched one by one here: the sample's bounds come
+     * first and only the points that may still win are searched
+     * (forward.c, one_sided_shell), as on a rank without Q.  Not when
+     * the interior's maximum may be needed (lazy): hd__mpi_interior_max
+     * takes the interior as what the shell's positions leave, which the
+     * cut would change. */
+    if (rc == HD_OK && nS && !ref && !sh->lazy && nS >= DEFER_MIN && 2 * nS >= d->nP) {
+        sh->deferred = 1;
+        return rc;
+    }
     if (rc == HD_OK && nS) {
         if (!ref) sh->nearest = hd__mpi_alloc(c, nS, sizeof(size_t));
         sh->unproven = hd__mpi_alloc(c, nS, 1);

@@ -318,6 +318,62 @@ int hd__mpi_nearest_among(hd__mpi_ctx_t *c, const double *S, size_t m, const dou
     return rc;
 }
 
+/* The points of Q a structure over all of Q holds at once: a quarter of
+ * the rank's points (both sets), at least CHUNK_MIN.  A structure takes
+ * about 38 bytes a point of it while built, so all of Q on a rank that
+ * holds Q alone (two sets far apart: every point of one set on some
+ * ranks) would add 38 bytes a local point to the 25 the points take;
+ * chunks add at most a quarter of that. */
+#define CHUNK_MIN 65536
+static size_t chunk_of(const hd__mpi_dir_t *d) {
+    size_t ch = (d->nP + d->nQ) / 4;
+    return ch > CHUNK_MIN ? ch : CHUNK_MIN;
+}
+
+/* All of Q searched by the m askers list[0..m) in chunks of consecutive
+ * positions, one structure at a time: each asker keeps the nearest over
+ * the chunks (d2 first, then the smaller position: the smaller index,
+ * since local order is index order), so its answer is its exact nearest
+ * in Q with the smallest index on ties, as one structure over all of Q
+ * gives it.  near[k] holds an upper bound's position or SIZE_MAX on
+ * entry. */
+static int chunked_search(hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, const double *pts, const uint32_t *pos,
+                          const uint32_t *list, size_t m, size_t batch, size_t n, size_t *near) {
+#define X(k) (pts + 3 * (pos ? pos[k] : (k)))
+    size_t ch = chunk_of(d);
+    size_t *part = hd__mpi_alloc(c, n, sizeof(size_t));
+    uint32_t *sel = hd__mpi_alloc(c, ch < d->nQ ? ch : d->nQ, sizeof(uint32_t));
+    int rc = part && sel ? HD_OK : hd__mpi_nomem(c, "the searches", m);
+    for (size_t j0 = 0; j0 < d->nQ && rc == HD_OK; j0 += ch) {
+        size_t nj = d->nQ - j0 < ch ? d->nQ - j0 : ch;
+        hd__mpi_slab_t sl;
+        memset(&sl, 0, sizeof sl);
+        sl.M = INFINITY;
+        sl.n = nj;
+        for (size_t t = 0; t < nj; t++) sel[t] = (uint32_t)(j0 + t);
+        hd__box_of(d->Q + 3 * j0, nj, &sl.kb);
+        hd_points_t v = hd_points_f64(d->Q, d->nQ);
+        rc = hd__mpi_an_build(c, &sl.s, &v, sel, NULL, nj, &sl.kb, hd__thread_count(c->threads, nj), &sl.bytes);
+        sl.built = 1;
+        if (rc == HD_OK) rc = slab_search(c, &sl, pts, pos, list, m, batch, part);
+        slab_free(c, &sl);
+        for (size_t t = 0; t < m && rc == HD_OK; t++) {
+            size_t k = list[t], j = part[k], b = near[k];
+            double d2 = hd__d2(X(k), d->Q + 3 * j);
+            if (b == SIZE_MAX) {
+                near[k] = j;
+                continue;
+            }
+            double b2 = hd__d2(X(k), d->Q + 3 * b);
+            if (d2 < b2 || (d2 == b2 && j < b)) near[k] = j;
+        }
+    }
+    hd__mpi_free(c, part, n, sizeof(size_t));
+    hd__mpi_free(c, sel, ch < d->nQ ? ch : d->nQ, sizeof(uint32_t));
+    return rc;
+#undef X
+}
+
 int hd__mpi_nearest_in_q(hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, const hd__box_t *r, hd__mpi_qtree_t *q, const double *pts,
                          const uint32_t *pos, size_t n, size_t *near, unsigned char *unproven) {
     if (n == 0) return HD_OK;
@@ -375,6 +431,10 @@ int hd__mpi_nearest_in_q(hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, const hd__box
             M = 1.125 * need;
             if (!isfinite(M) || M <= q->sub.M) continue;
             slab_free(c, &q->sub);
+        }
+        if (level == 2 && !sl->built && d->nQ > chunk_of(d)) { /* all of Q, a chunk at a time */
+            rc = chunked_search(c, d, pts, pos, list, m, batch, n, near);
+            break;
         }
         if (!sl->built && (rc = slab_build(c, d, r, M, sl)) != HD_OK) break;
         if ((rc = slab_search(c, sl, pts, pos, list, m, batch, near)) != HD_OK) break;

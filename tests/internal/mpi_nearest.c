@@ -27,7 +27,8 @@ static size_t brute(const double *x, const double *Q, size_t nQ) {
 /* hd__mpi_nearest_in_q for n askers against Q in the region r, its
  * answers checked against the brute force; unproven NULL, so every answer
  * must be exact. */
-static void check_against_brute(const hd__box_t *r, double *P, const uint32_t *pos, size_t n, double *Q, size_t nQ) {
+static void check_against_brute_peak(const hd__box_t *r, double *P, const uint32_t *pos, size_t n, double *Q, size_t nQ,
+                                     size_t *peak) {
     hd__mpi_ctx_t c;
     memset(&c, 0, sizeof c);
     c.threads = 1;
@@ -46,7 +47,12 @@ static void check_against_brute(const hd__box_t *r, double *P, const uint32_t *p
     }
     hd__mpi_qtree_free(&c, &q);
     CHECK_EQ(c.cur, 0);
+    if (peak) *peak = c.peak;
     free(near);
+}
+
+static void check_against_brute(const hd__box_t *r, double *P, const uint32_t *pos, size_t n, double *Q, size_t nQ) {
+    check_against_brute_peak(r, P, pos, n, Q, nQ, NULL);
 }
 
 static const hd__box_t everything = {{-INFINITY, -INFINITY, -INFINITY}, {INFINITY, INFINITY, INFINITY}};
@@ -125,4 +131,27 @@ TEST(more_askers_than_the_scan_takes_ask_the_slab_and_get_the_same_answers) {
         free(Q);
         free(P);
     }
+}
+
+TEST(askers_of_all_of_a_large_q_search_it_a_chunk_at_a_time_with_the_same_answers) {
+    /* A rank holding Q alone answers other ranks' queries from all of Q
+     * (no face to cut a slab at): a structure over a chunk of Q at a
+     * time, never over all of it (about 38 bytes a point of it while
+     * built), and every answer the brute force's, ties across chunks to
+     * the smallest index (a lattice with each point repeated in every
+     * chunk, askers halfway between its planes). */
+    gen_rng_t g;
+    gen_seed(&g, 11);
+    CONTEXT("seed=11");
+    size_t nQ = 300000, n = 64;
+    double *Q = malloc(nQ * 3 * sizeof *Q), *P = malloc(n * 3 * sizeof *P);
+    CHECK(Q != NULL && P != NULL);
+    gen_lattice(&g, Q, nQ, 12);
+    for (size_t k = 0; k < n; k++)
+        for (int a = 0; a < 3; a++) P[3 * k + a] = (double)(gen_u64(&g) % 26) * 0.5 - 0.5;
+    size_t peak = 0;
+    check_against_brute_peak(&everything, P, NULL, n, Q, nQ, &peak);
+    CHECK(peak < 16 * nQ); /* a structure over all of Q alone takes more */
+    free(Q);
+    free(P);
 }
