@@ -824,6 +824,8 @@ static size_t bucket_at(const hd__an_t *t, uint32_t key, size_t from) {
 #define PAIR_CANDIDATES 32 /* most candidates of a group for the partner path */
 #define PAIR_TRIAL 8        /* groups of a task tried before the partner path may be dropped */
 #define WINDOW 8            /* points of t scanned around a query's key (a multiple of 8) */
+#define CHUNK 16            /* queries answered from one chunk list */
+#define CHUNK_LIST 256      /* a group list longer than this is not filtered but listed again per chunk */
 
 /* The rest of one query's search, on the candidate list cd (the buckets
  * within U of a box holding the query, U at least its answer): every
@@ -861,7 +863,9 @@ typedef struct {
                                  * (HD__AN_NO_PARTNER: none), or NULL */
     double *dist;
     size_t *nearest;
-    cands_t *cand; /* per worker: room for every bucket of t */
+    cands_t *cand; /* per worker w: cand[w] the group's list, cand[workers + w] a chunk's,
+                    * each with room for every bucket of t */
+    int workers;
     double *sd;    /* answers in q's order: squared distances */
     uint32_t *sj;  /* and nearest original indices */
 } query_ctx;
@@ -1034,21 +1038,54 @@ HD__INLINE size_t seed_bests(const hd__an_t *q, const hd__an_t *t, qgroup_t *G, 
     return near;
 }
 
+/* The candidates of cd within Uc of the box q, into ck: filtered from
+ * cd, or listed afresh from t's root when cd is long (a group spread
+ * over many of t's buckets, a sparse set asking a dense one).  A bucket
+ * left out has node_lb2 above Uc from the box, so above the answer of
+ * every query in it whose answer is at most Uc. */
+HD__INLINE void chunk_candidates(const hd__an_t *t, const cands_t *cd, const hd__box_t *q, double Uc, cands_t *ck) {
+    if (cd->n > CHUNK_LIST) {
+        candidates(t, q, Uc, SIZE_MAX, ck);
+        return;
+    }
+    size_t m = 0;
+    for (size_t r = 0; r < cd->n; r++) {
+        double g[3];
+        for (int d = 0; d < 3; d++) {
+            double u = cd->lo[d][r] - q->hi[d], v = q->lo[d] - cd->hi[d][r];
+            g[d] = u > v ? u : v;
+            g[d] = g[d] > 0 ? g[d] : 0;
+        }
+        double lb = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
+        ck->bucket[m] = cd->bucket[r];
+        for (int d = 0; d < 3; d++) ck->lo[d][m] = cd->lo[d][r], ck->hi[d][m] = cd->hi[d][r];
+        m += lb <= Uc;
+    }
+    ck->n = m;
+}
+
 /* Every query of the group answered exactly from the candidates listed
  * within U, into c->sd and c->sj.  A windowed query whose best is still
  * above U after its seed buckets may have its answer outside the list:
- * it gets candidates of its own, within its best.  Returns how many
- * answers were the partners (for the partner path's upkeep). */
-HD__INLINE size_t qgroup_finish(query_ctx *c, cands_t *cd, qgroup_t *G, double U, int paired, int windowed,
-                                size_t near) {
+ * it gets candidates of its own, within its best.  The others are
+ * answered CHUNK at a time (consecutive on the curve, so close): the
+ * chunk's own list holds the group's candidates within Uc of the chunk's
+ * box, Uc = min(U, the chunk's largest best), which bounds the answer of
+ * each of its queries (each answer is at most U and at most its best);
+ * a short group list is used as it is.  Returns how many answers were
+ * the partners (for the partner path's upkeep). */
+HD__INLINE size_t qgroup_finish(query_ctx *c, cands_t *cd, cands_t *ck, qgroup_t *G, double U, int paired,
+                                int windowed, size_t near) {
     const hd__an_t *q = c->q, *t = c->t;
-    size_t first = G->first, kept = 0, napart = 0;
-    uint32_t apart[HD__AN_GROUP];
+    size_t first = G->first, kept = 0, napart = 0, nlisted = 0;
+    uint32_t apart[HD__AN_GROUP], listed[HD__AN_GROUP];
+    uint8_t seeded[HD__AN_GROUP];
     for (size_t k = 0; k < G->m; k++) {
-        double qx = q->x[first + k], qy = q->y[first + k], qz = q->z[first + k];
-        if (windowed && G->best[k] > U) {
+        seeded[k] = windowed && G->best[k] > U;
+        if (seeded[k]) {
             /* Set apart: its seed buckets usually bring it within U, and
              * then the list holds its answer; if not: later. */
+            double qx = q->x[first + k], qy = q->y[first + k], qz = q->z[first + k];
             for (size_t b = G->seed[k]; b < G->seed[k] + SEEDS && b < t->nb; b++)
                 scan_bucket(t, b, qx, qy, qz, &G->best[k], &G->bj[k]);
             if (G->best[k] > U) {
@@ -1056,12 +1093,38 @@ HD__INLINE size_t qgroup_finish(query_ctx *c, cands_t *cd, qgroup_t *G, double U
                 cd->counts.apart++;
                 continue;
             }
-            finish_query(t, cd, qx, qy, qz, U, G->seed[k], G->seed[k] + SEEDS, SIZE_MAX, &G->best[k], &G->bj[k]);
-        } else if (paired) finish_query(t, cd, qx, qy, qz, U, 0, 0, SIZE_MAX, &G->best[k], &G->bj[k]);
-        else finish_query(t, cd, qx, qy, qz, U, G->seed[k], G->seed[k] + SEEDS, near, &G->best[k], &G->bj[k]);
-        c->sd[first + k] = G->best[k];
-        c->sj[first + k] = G->bj[k];
-        kept += paired && !windowed && G->bj[k] == G->pj[k];
+        }
+        listed[nlisted++] = (uint32_t)k;
+    }
+    for (size_t r0 = 0; r0 < nlisted; r0 += CHUNK) {
+        size_t r1 = r0 + CHUNK < nlisted ? r0 + CHUNK : nlisted;
+        const cands_t *list = cd;
+        if (cd->n > CHUNK) {
+            hd__box_t box;
+            double Uc = 0;
+            for (size_t r = r0; r < r1; r++) {
+                size_t k = first + listed[r];
+                double p[3] = {q->x[k], q->y[k], q->z[k]};
+                for (int d = 0; d < 3; d++) {
+                    box.lo[d] = r == r0 || p[d] < box.lo[d] ? p[d] : box.lo[d];
+                    box.hi[d] = r == r0 || p[d] > box.hi[d] ? p[d] : box.hi[d];
+                }
+                Uc = G->best[listed[r]] > Uc ? G->best[listed[r]] : Uc;
+            }
+            chunk_candidates(t, cd, &box, Uc < U ? Uc : U, ck);
+            list = ck;
+        }
+        for (size_t r = r0; r < r1; r++) {
+            size_t k = listed[r];
+            double qx = q->x[first + k], qy = q->y[first + k], qz = q->z[first + k];
+            cands_t *l = (cands_t *)list;
+            if (seeded[k]) finish_query(t, l, qx, qy, qz, U, G->seed[k], G->seed[k] + SEEDS, SIZE_MAX, &G->best[k], &G->bj[k]);
+            else if (paired) finish_query(t, l, qx, qy, qz, U, 0, 0, SIZE_MAX, &G->best[k], &G->bj[k]);
+            else finish_query(t, l, qx, qy, qz, U, G->seed[k], G->seed[k] + SEEDS, near, &G->best[k], &G->bj[k]);
+            c->sd[first + k] = G->best[k];
+            c->sj[first + k] = G->bj[k];
+            kept += paired && !windowed && G->bj[k] == G->pj[k];
+        }
     }
     /* The queries set apart: each one's own candidates, the buckets within
      * its best so far (a real point's distance, so at least its answer) of
@@ -1076,6 +1139,25 @@ HD__INLINE size_t qgroup_finish(query_ctx *c, cands_t *cd, qgroup_t *G, double U
         c->sj[first + k] = G->bj[k];
     }
     return kept;
+}
+
+/* The solo path: a group of queries spread over more of t's buckets than
+ * it has queries (a sparse set asking a dense one) shares no work, and
+ * each of its queries is searched on its own: its WINDOW points on t's
+ * curve (an actual point's distance, so a bound on its answer), then the
+ * buckets within that bound of the query itself (candidates), then
+ * finish_query on them.  *b and *p carry the window's place (the keys
+ * grow along q). */
+HD__INLINE void solo_query(query_ctx *c, cands_t *cd, size_t k, size_t *b, size_t *p) {
+    const hd__an_t *q = c->q, *t = c->t;
+    double qx = q->x[k], qy = q->y[k], qz = q->z[k], best = INFINITY;
+    uint32_t j = UINT32_MAX;
+    window_best(q, t, k, b, p, &best, &j);
+    hd__box_t pb = {{qx, qy, qz}, {qx, qy, qz}};
+    candidates(t, &pb, best, SIZE_MAX, cd);
+    finish_query(t, cd, qx, qy, qz, best, 0, 0, SIZE_MAX, &best, &j);
+    c->sd[k] = best;
+    c->sj[k] = j;
 }
 
 /* The groups of a task, each answered in phases: its box; first answers
@@ -1109,7 +1191,7 @@ HD__INLINE size_t qgroup_finish(query_ctx *c, cands_t *cd, qgroup_t *G, double U
 HD__HOT static void query_task(void *vctx, size_t task, int worker) {
     query_ctx *c = vctx;
     const hd__an_t *q = c->q, *t = c->t;
-    cands_t *cd = &c->cand[worker];
+    cands_t *cd = &c->cand[worker], *ck = &c->cand[c->workers + worker];
     size_t g0 = task * GROUPS_PER_TASK, g1 = g0 + GROUPS_PER_TASK < q->ng ? g0 + GROUPS_PER_TASK : q->ng;
     qgroup_t G;
     size_t at0 = g0 < g1 ? bucket_at(t, q->key[q->glead[g0]], 0) : 0;
@@ -1125,6 +1207,11 @@ HD__HOT static void query_task(void *vctx, size_t task, int worker) {
             G.first = first;
             G.m = q->gstart[g + 1] - first < HD__AN_GROUP ? q->gstart[g + 1] - first : HD__AN_GROUP;
             qgroup_box(q, &G);
+            if (!candidates(t, &G.box, 0, G.m, cd)) {
+                for (size_t k = first, wb = 0, wp = 0; k < first + G.m; k++) solo_query(c, cd, k, &wb, &wp);
+                cd->counts.solo += G.m;
+                continue;
+            }
             double U = 0;
             int paired = 0, windowed = 0, seeded = 0;
             for (size_t k = 0; k < G.m; k++) G.best[k] = INFINITY, G.bj[k] = UINT32_MAX;
@@ -1149,7 +1236,7 @@ HD__HOT static void query_task(void *vctx, size_t task, int worker) {
                 if (!seeded) qgroup_seeds(q, t, &G, &h, &s0);
                 near = seed_bests(q, t, &G, cd, &U);
             }
-            size_t kept = qgroup_finish(c, cd, &G, U, paired, windowed, near);
+            size_t kept = qgroup_finish(c, cd, ck, &G, U, paired, windowed, near);
             /* The path pays when the partners are the answers (a copy), not
              * merely near enough to list few candidates (a few buckets of
              * repeated points): it is kept on while at least half of the
@@ -1166,7 +1253,7 @@ static int query_threads(const hd__an_t *asking, int threads) {
 
 size_t hd__an_nearest_bytes(const hd__an_t *asking, const hd__an_t *searched, int threads) {
     size_t w = (size_t)query_threads(asking, threads);
-    return w * (sizeof(cands_t) + searched->nb * (2 * sizeof(uint32_t) + 7 * sizeof(double))) +
+    return 2 * w * (sizeof(cands_t) + searched->nb * (2 * sizeof(uint32_t) + 7 * sizeof(double))) +
            asking->n * (sizeof(double) + sizeof(uint32_t));
 }
 
@@ -1211,15 +1298,15 @@ static int nearest_run(const hd__an_t *asking, const hd__an_t *searched, const h
     threads = query_threads(asking, threads);
     assert(!partner || !pair_at);
     query_ctx c = {asking, searched, partner && partner->count == asking->n ? partner : NULL, pair_at, dist, nearest,
-                   NULL, NULL, NULL};
-    c.cand = hd__calloc_array((size_t)threads, sizeof *c.cand);
+                   NULL, threads, NULL, NULL};
+    c.cand = hd__calloc_array(2 * (size_t)threads, sizeof *c.cand);
     c.sd = hd__malloc_array(asking->n, sizeof *c.sd);
     c.sj = hd__malloc_array(asking->n, sizeof *c.sj);
     int rc = c.cand && c.sd && c.sj ? HD_OK : HD_ENOMEM;
     /* Every answer is written: their pages mapped at once. */
     hd__prefault(c.sd, asking->n * sizeof *c.sd);
     hd__prefault(c.sj, asking->n * sizeof *c.sj);
-    if (rc == HD_OK) rc = cands_alloc(c.cand, threads, searched->nb);
+    if (rc == HD_OK) rc = cands_alloc(c.cand, 2 * threads, searched->nb);
     if (rc == HD_OK) {
         hd__parallel_for(threads, tasks, query_task, &c);
         hd__parallel_for(threads, (asking->n + SCATTER_TASK - 1) / SCATTER_TASK, scatter_answers, &c);
@@ -1229,8 +1316,9 @@ static int nearest_run(const hd__an_t *asking, const hd__an_t *searched, const h
         counts->paired += c.cand[w].counts.paired;
         counts->windowed += c.cand[w].counts.windowed;
         counts->apart += c.cand[w].counts.apart;
+        counts->solo += c.cand[w].counts.solo;
     }
-    cands_free(c.cand, threads);
+    cands_free(c.cand, 2 * threads);
     free(c.sd);
     free(c.sj);
     if (rc != HD_OK) return hd__err(err, rc, "cannot allocate the candidate lists");
