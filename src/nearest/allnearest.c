@@ -749,31 +749,33 @@ typedef double v4d __attribute__((vector_size(32)));
 typedef int64_t v4l __attribute__((vector_size(32)));
 typedef uint32_t v4u __attribute__((vector_size(16)));
 
-/* The distances of (vx, vy, vz) to the four points from position k. */
-#define D4(t, k, vx, vy, vz, out)                                         \
+/* The distances of (vx, vy, vz) to the four points from position k of
+ * the arrays x, y, z. */
+#define D4(x, y, z, k, vx, vy, vz, out)                                   \
     do {                                                                  \
         v4d x_, y_, z_;                                                   \
-        __builtin_memcpy(&x_, (t)->x + (k), sizeof x_);                   \
-        __builtin_memcpy(&y_, (t)->y + (k), sizeof y_);                   \
-        __builtin_memcpy(&z_, (t)->z + (k), sizeof z_);                   \
+        __builtin_memcpy(&x_, (x) + (k), sizeof x_);                      \
+        __builtin_memcpy(&y_, (y) + (k), sizeof y_);                      \
+        __builtin_memcpy(&z_, (z) + (k), sizeof z_);                      \
         x_ = (vx)-x_, y_ = (vy)-y_, z_ = (vz)-z_;                         \
         (out) = x_ * x_ + y_ * y_ + z_ * z_;                              \
     } while (0)
 
-/* The points [k0, e) of t, k0 a multiple of four, e at most n + 1 (the
- * last group of four read may run past e, into the copies of the last
- * point stored after the end): each lane keeps its smallest distance and
- * the smallest index at it. */
-HD__INLINE void scan_span(const hd__an_t *t, size_t k0, size_t e, double qx, double qy, double qz,
-                          double *best, uint32_t *bj) {
+/* The points [0, n) of the arrays x, y, z (names idx), n > 0, read four
+ * at a time (the last four may run past n: the caller makes sure those are
+ * points of the set too): each lane keeps its smallest distance and the
+ * smallest index at it, then the lanes' minimum and its smallest index
+ * replace *best and *bj when smaller, or equal with a smaller index. */
+HD__INLINE void scan_arrays(const double *x, const double *y, const double *z, const uint32_t *idx, size_t n,
+                            double qx, double qy, double qz, double *best, uint32_t *bj) {
     v4d vx = {qx, qx, qx, qx}, vy = {qy, qy, qy, qy}, vz = {qz, qz, qz, qz}, mv, d;
     v4u iu;
-    D4(t, k0, vx, vy, vz, mv);
-    __builtin_memcpy(&iu, t->idx + k0, sizeof iu);
+    D4(x, y, z, 0, vx, vy, vz, mv);
+    __builtin_memcpy(&iu, idx, sizeof iu);
     v4l jv = __builtin_convertvector(iu, v4l);
-    for (size_t k = k0 + 4; k < e; k += 4) {
-        D4(t, k, vx, vy, vz, d);
-        __builtin_memcpy(&iu, t->idx + k, sizeof iu);
+    for (size_t k = 4; k < n; k += 4) {
+        D4(x, y, z, k, vx, vy, vz, d);
+        __builtin_memcpy(&iu, idx + k, sizeof iu);
         v4l jl = __builtin_convertvector(iu, v4l);
         v4l take = (d < mv) | ((d == mv) & (jl < jv));
         mv = (v4d)(((v4l)d & take) | ((v4l)mv & ~take));
@@ -793,6 +795,14 @@ HD__INLINE void scan_span(const hd__an_t *t, size_t k0, size_t e, double qx, dou
         *best = m;
         *bj = j;
     }
+}
+
+/* The points [k0, e) of t, k0 a multiple of four, e at most n + 1 (the
+ * last group of four read may run past e, into the copies of the last
+ * point stored after the end). */
+HD__INLINE void scan_span(const hd__an_t *t, size_t k0, size_t e, double qx, double qy, double qz,
+                          double *best, uint32_t *bj) {
+    scan_arrays(t->x + k0, t->y + k0, t->z + k0, t->idx + k0, e - k0, qx, qy, qz, best, bj);
 }
 
 /* One bucket: from the group of four that holds its first point to the
@@ -826,6 +836,7 @@ static size_t bucket_at(const hd__an_t *t, uint32_t key, size_t from) {
 #define WINDOW 8            /* points of t scanned around a query's key (a multiple of 8) */
 #define CHUNK 16            /* queries answered from one chunk list */
 #define CHUNK_LIST 256      /* a group list longer than this is not filtered but listed again per chunk */
+#define POINT_LIST 512      /* most points of a group's candidate buckets for a point list */
 
 /* The rest of one query's search, on the candidate list cd (the buckets
  * within U of a box holding the query, U at least its answer): every
@@ -1064,6 +1075,90 @@ HD__INLINE void chunk_candidates(const hd__an_t *t, const cands_t *cd, const hd_
     ck->n = m;
 }
 
+/* Candidate points, shared by queries whose box is small next to the
+ * distances to their answers (a dense set asking a sparse one): many
+ * queries, few points that can be any of their answers.  x, y, z, idx in
+ * structure of arrays, n of them, padded to a multiple of four with
+ * copies of the last (a copy changes no minimum and no smallest index). */
+typedef struct {
+    size_t n;
+    double x[POINT_LIST + 4], y[POINT_LIST + 4], z[POINT_LIST + 4];
+    uint32_t idx[POINT_LIST + 4];
+} plist_t;
+
+/* The smallest and the largest computed squared distance between the
+ * point (px, py, pz) and a point of box q (node_lb2's and node_ub2's
+ * expressions with a box of one point; see the essay). */
+HD__INLINE void point_bounds(const hd__box_t *q, double px, double py, double pz, double *lb, double *ub) {
+    double p[3] = {px, py, pz}, g[3], h[3];
+    for (int d = 0; d < 3; d++) {
+        double u = p[d] - q->hi[d], v = q->lo[d] - p[d];
+        g[d] = u > v ? u : v;
+        g[d] = g[d] > 0 ? g[d] : 0;
+        u = q->hi[d] - p[d], v = p[d] - q->lo[d];
+        h[d] = u > v ? u : v;
+    }
+    *lb = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
+    *ub = h[0] * h[0] + h[1] * h[1] + h[2] * h[2];
+}
+
+HD__INLINE void plist_pad(plist_t *l) {
+    for (size_t k = l->n; l->n && k < ((l->n + 3) & ~(size_t)3); k++)
+        l->x[k] = l->x[l->n - 1], l->y[k] = l->y[l->n - 1], l->z[k] = l->z[l->n - 1], l->idx[k] = l->idx[l->n - 1];
+}
+
+/* The points of the buckets listed in cd that can be the answer of a
+ * query in box q whose answer is at most U, into out: V, the smallest
+ * node_ub2 of a listed point from the box, bounds every such answer too
+ * (the point is within V of each query), and a point whose bound from
+ * the box is above min(U, V) is farther than that answer.  Returns 0 when
+ * the buckets hold more than POINT_LIST points (then nothing is listed). */
+static int group_points(const hd__an_t *t, const cands_t *cd, const hd__box_t *q, double U, plist_t *out) {
+    size_t total = 0;
+    for (size_t r = 0; r < cd->n; r++) total += t->stop[cd->bucket[r]] - t->start[cd->bucket[r]];
+    if (total > POINT_LIST) return 0;
+    double lb[POINT_LIST], V = U;
+    size_t m = 0;
+    for (size_t r = 0; r < cd->n; r++)
+        for (size_t k = t->start[cd->bucket[r]]; k < t->stop[cd->bucket[r]]; k++, m++) {
+            double ub;
+            point_bounds(q, t->x[k], t->y[k], t->z[k], &lb[m], &ub);
+            V = ub < V ? ub : V;
+            out->x[m] = t->x[k], out->y[m] = t->y[k], out->z[m] = t->z[k], out->idx[m] = t->idx[k];
+        }
+    size_t n = 0;
+    for (size_t k = 0; k < m; k++) {
+        out->x[n] = out->x[k], out->y[n] = out->y[k], out->z[n] = out->z[k], out->idx[n] = out->idx[k];
+        n += lb[k] <= V;
+    }
+    out->n = n;
+    return 1;
+}
+
+/* The points of `from` that can be the answer of a query in the box q
+ * (a chunk of the group's, answers at most U), the same way, into out. */
+static void chunk_points(const plist_t *from, const hd__box_t *q, double U, plist_t *out) {
+    double lb[POINT_LIST], V = U;
+    for (size_t k = 0; k < from->n; k++) {
+        double ub;
+        point_bounds(q, from->x[k], from->y[k], from->z[k], &lb[k], &ub);
+        V = ub < V ? ub : V;
+    }
+    size_t n = 0;
+    for (size_t k = 0; k < from->n; k++) {
+        out->x[n] = from->x[k], out->y[n] = from->y[k], out->z[n] = from->z[k], out->idx[n] = from->idx[k];
+        n += lb[k] <= V;
+    }
+    out->n = n;
+    plist_pad(out);
+}
+
+/* One query against every point of l (padded: the reads past l->n are
+ * copies of its last point), into *best and *bj. */
+HD__INLINE void scan_points(const plist_t *l, double qx, double qy, double qz, double *best, uint32_t *bj) {
+    if (l->n) scan_arrays(l->x, l->y, l->z, l->idx, l->n, qx, qy, qz, best, bj);
+}
+
 /* Every query of the group answered exactly from the candidates listed
  * within U, into c->sd and c->sj.  A windowed query whose best is still
  * above U after its seed buckets may have its answer outside the list:
@@ -1096,22 +1191,42 @@ HD__INLINE size_t qgroup_finish(query_ctx *c, cands_t *cd, cands_t *ck, qgroup_t
         }
         listed[nlisted++] = (uint32_t)k;
     }
+    /* A group small next to its answers' distances shares its candidate
+     * points, chunk by chunk, while the chunks' lists stay short. */
+    plist_t gp, cp;
+    int points = nlisted >= 2 * CHUNK && group_points(t, cd, &G->box, U, &gp);
     for (size_t r0 = 0; r0 < nlisted; r0 += CHUNK) {
         size_t r1 = r0 + CHUNK < nlisted ? r0 + CHUNK : nlisted;
         const cands_t *list = cd;
-        if (cd->n > CHUNK) {
-            hd__box_t box;
-            double Uc = 0;
-            for (size_t r = r0; r < r1; r++) {
-                size_t k = first + listed[r];
-                double p[3] = {q->x[k], q->y[k], q->z[k]};
-                for (int d = 0; d < 3; d++) {
-                    box.lo[d] = r == r0 || p[d] < box.lo[d] ? p[d] : box.lo[d];
-                    box.hi[d] = r == r0 || p[d] > box.hi[d] ? p[d] : box.hi[d];
-                }
-                Uc = G->best[listed[r]] > Uc ? G->best[listed[r]] : Uc;
+        hd__box_t box;
+        double Uc = 0;
+        for (size_t r = r0; r < r1; r++) {
+            size_t k = first + listed[r];
+            double p[3] = {q->x[k], q->y[k], q->z[k]};
+            for (int d = 0; d < 3; d++) {
+                box.lo[d] = r == r0 || p[d] < box.lo[d] ? p[d] : box.lo[d];
+                box.hi[d] = r == r0 || p[d] > box.hi[d] ? p[d] : box.hi[d];
             }
-            chunk_candidates(t, cd, &box, Uc < U ? Uc : U, ck);
+            Uc = G->best[listed[r]] > Uc ? G->best[listed[r]] : Uc;
+        }
+        Uc = Uc < U ? Uc : U;
+        if (points) {
+            chunk_points(&gp, &box, Uc, &cp);
+            points = cp.n <= 2 * CHUNK;
+        }
+        if (points) {
+            for (size_t r = r0; r < r1; r++) {
+                size_t k = listed[r];
+                scan_points(&cp, q->x[first + k], q->y[first + k], q->z[first + k], &G->best[k], &G->bj[k]);
+                c->sd[first + k] = G->best[k];
+                c->sj[first + k] = G->bj[k];
+                kept += paired && !windowed && G->bj[k] == G->pj[k];
+            }
+            cd->counts.pointed += r1 - r0;
+            continue;
+        }
+        if (cd->n > CHUNK) {
+            chunk_candidates(t, cd, &box, Uc, ck);
             list = ck;
         }
         for (size_t r = r0; r < r1; r++) {
@@ -1317,6 +1432,7 @@ static int nearest_run(const hd__an_t *asking, const hd__an_t *searched, const h
         counts->windowed += c.cand[w].counts.windowed;
         counts->apart += c.cand[w].counts.apart;
         counts->solo += c.cand[w].counts.solo;
+        counts->pointed += c.cand[w].counts.pointed;
     }
     cands_free(c.cand, 2 * threads);
     free(c.sd);

@@ -85,6 +85,7 @@ typedef struct hd__an_counts {
     size_t windowed; /* groups settled by the window on the other curve */
     size_t apart;    /* queries of those searched on their own */
     size_t solo;     /* queries of sparse groups, each searched on its own */
+    size_t pointed;  /* queries answered from a chunk's list of candidate points */
 } hd__an_counts_t;
 
 /* For every point of `asking`, the exact nearest distance to `searched`
