@@ -1483,12 +1483,13 @@ int hd__an_nearest_paired(const hd__an_t *asking, const hd__an_t *searched, cons
  * band, whatever the threads.
  */
 
-#define BAND_TASK 64 /* asking buckets per task */
+#define BAND_TASK 64   /* asking buckets per task */
+#define BAND_SHARED 16 /* most candidates per open point of a bucket for one shared list */
 
 typedef struct {
     double *v;
     size_t n, cap;
-    size_t below, above;
+    size_t below, above, solo;
     int nomem;
 } band_out_t;
 
@@ -1575,10 +1576,24 @@ HD__INLINE void band_points(const band_ctx *c, cands_t *cd, band_out_t *o, size_
     }
     if (!open) return;
     U = U < V ? U : V;
-    candidates(t, &box, U < c->hi2 ? U : c->hi2, SIZE_MAX, cd);
-    for (size_t k = first; k < end; k++)
-        if (best[k - first] >= 0)
-            band_settle(c, o, band_finish(c, cd, q->x[k], q->y[k], q->z[k], best[k - first], near), times);
+    double lim = U < c->hi2 ? U : c->hi2;
+    if (candidates(t, &box, lim, open * BAND_SHARED, cd)) {
+        for (size_t k = first; k < end; k++)
+            if (best[k - first] >= 0)
+                band_settle(c, o, band_finish(c, cd, q->x[k], q->y[k], q->z[k], best[k - first], near), times);
+        return;
+    }
+    /* A bucket spread over more of t's buckets than BAND_SHARED per open
+     * point (a sparse set asking a dense one): each open point lists its
+     * own candidates, within its best and hi2 of the point itself. */
+    for (size_t k = first; k < end; k++) {
+        double bk = best[k - first];
+        if (bk < 0) continue;
+        hd__box_t pb = {{q->x[k], q->y[k], q->z[k]}, {q->x[k], q->y[k], q->z[k]}};
+        candidates(t, &pb, bk < c->hi2 ? bk : c->hi2, SIZE_MAX, cd);
+        o->solo += times;
+        band_settle(c, o, band_finish(c, cd, q->x[k], q->y[k], q->z[k], bk, near), times);
+    }
 }
 
 /* Asking bucket b, HD__AN_BUCKET points at a time (a bucket of equal keys
@@ -1611,6 +1626,7 @@ int hd__an_band(const hd__an_t *asking, const hd__an_t *searched, double lo2, do
     size_t kept = 0;
     for (int w = 0; c.out && w < threads; w++) {
         out->below += c.out[w].below, out->above += c.out[w].above, kept += c.out[w].n;
+        out->solo += c.out[w].solo;
         if (c.out[w].nomem) rc = HD_ENOMEM;
     }
     if (rc == HD_OK && !(out->v = hd__malloc_array(kept ? kept : 1, sizeof *out->v))) rc = HD_ENOMEM;

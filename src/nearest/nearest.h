@@ -126,6 +126,8 @@ typedef struct hd__an_band {
     size_t below, above;
     size_t n;
     double *v;
+    size_t solo; /* points whose candidates were listed around the point alone
+                  * (a sparse set asking a dense one; for tests) */
 } hd__an_band_t;
 int hd__an_band(const hd__an_t *asking, const hd__an_t *searched, double lo2, double hi2, int threads,
                 hd__an_band_t *out, hd_error_t *err);
