@@ -284,6 +284,23 @@ static void box_task(void *vctx, size_t task, int worker) {
     }
 }
 
+/* The end of the run of keys from e (below hi) with e's digit at `shift`:
+ * within a cell the digits grow, so a galloping search then a bisection
+ * find it in a logarithm of the run's length (a linear scan read every
+ * key once per level of the octree). */
+static size_t digit_end(const uint64_t *keys, size_t e, size_t hi, int shift) {
+    uint64_t digit = keys[e] >> shift & 7;
+    size_t step = 1, in = e; /* keys[in] has the digit; the end is in (in, out] */
+    while (in + step < hi && (keys[in + step] >> shift & 7) == digit) in += step, step *= 2;
+    size_t out = in + step < hi ? in + step : hi;
+    while (out - in > 1) {
+        size_t mid = in + (out - in) / 2;
+        if ((keys[mid] >> shift & 7) == digit) in = mid;
+        else out = mid;
+    }
+    return out;
+}
+
 /* The children of the octree cell [lo, hi) of the sorted keys at `shift`
  * (the cell's keys agree above it): the ends of its non-empty sub-cells,
  * in order.  Cells with one sub-cell are split further at once, so every
@@ -292,12 +309,7 @@ static void box_task(void *vctx, size_t task, int worker) {
 static int split_cell(const uint64_t *keys, size_t lo, size_t hi, int *shift, size_t ends[8]) {
     for (;;) {
         int nc = 0;
-        size_t e = lo;
-        while (e < hi) {
-            uint64_t digit = keys[e] >> *shift & 7;
-            while (e < hi && (keys[e] >> *shift & 7) == digit) e++;
-            ends[nc++] = e;
-        }
+        for (size_t e = lo; e < hi;) ends[nc++] = e = digit_end(keys, e, hi, *shift);
         *shift -= 3;
         if (nc > 1 || *shift < 32) return nc;
     }
