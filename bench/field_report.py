@@ -11,10 +11,9 @@ Columns, each the median of R runs:
   build       its two structures                               field_bench
   percentile  hd_hausdorff_percentile, P = 95                  percentile_bench
   nanoflann   tree + 1-NN of every point, both directions      BUILD/bench/nanoflann_hd (make bench builds it)
-  C2C         CloudCompare's cloud-to-cloud distance (float32), both directions, when `CloudCompare` is
-              installed (Debian package cloudcompare): each direction's command timed with and without
-              -C2C_DIST, the difference being the computation without reading; its default threads
-              (every core)
+  C2C         CloudCompare's cloud-to-cloud distance (float32), both directions, at one thread
+              (-MAX_TCOUNT 1), when `CloudCompare` is installed (Debian package cloudcompare): the
+              times it reports for its two steps, reading excluded
 and the ratios nanoflann / field, nanoflann / percentile and C2C / field.  A
 column whose program is missing prints "-".  With --doc the table replaces
 what lies between <!-- field-results:begin --> and <!-- field-results:end -->
@@ -76,15 +75,16 @@ def write_ply(path, binpath):
         f.write(p.tobytes())
 
 
-def cloudcompare_once(cc, compared, reference, c2c):
-    cmd = [cc, "-SILENT", "-NO_TIMESTAMP", "-AUTO_SAVE", "OFF", "-O", compared, "-O", reference]
-    if c2c:
-        cmd.append("-C2C_DIST")
+def cloudcompare_once(cc, compared, reference):
+    """One C2C run at one thread: the sum of the times CloudCompare reports
+    for its two steps (approximate distances, then the exact ones), which
+    exclude reading; None when it fails."""
+    cmd = [cc, "-SILENT", "-NO_TIMESTAMP", "-AUTO_SAVE", "OFF", "-O", compared, "-O", reference, "-C2C_DIST",
+           "-MAX_TCOUNT", "1"]
     env = dict(os.environ, QT_QPA_PLATFORM="offscreen")
-    t0 = time.perf_counter()
-    r = subprocess.run(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env)
-    t = time.perf_counter() - t0
-    return t if r.returncode == 0 else None
+    r = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, env=env)
+    steps = re.findall(r"\[(?:computeApproxDistances|ComputeDistances)\] Time: ([0-9.]+) s", r.stdout)
+    return sum(float(t) for t in steps) if r.returncode == 0 and len(steps) == 2 else None
 
 
 def cloudcompare(cc, d, case, runs):
@@ -95,14 +95,10 @@ def cloudcompare(cc, d, case, runs):
     write_ply(b, os.path.join(d, case + "_B.bin"))
     total = 0.0
     for compared, reference in ((a, b), (b, a)):
-        with_c2c, without = [], []
-        for _ in range(runs):
-            t1, t0 = cloudcompare_once(cc, compared, reference, True), cloudcompare_once(cc, compared, reference, False)
-            if t1 is None or t0 is None:
-                return None
-            with_c2c.append(t1)
-            without.append(t0)
-        total += max(statistics.median(with_c2c) - statistics.median(without), 0.0)
+        times = [cloudcompare_once(cc, compared, reference) for _ in range(runs)]
+        if None in times:
+            return None
+        total += statistics.median(times)
     return total
 
 

@@ -93,6 +93,26 @@
  *    an eighth of its queries are set apart or more than PAIR_CANDIDATES
  *    buckets are listed; a task drops the path as it drops the partners.
  *    How often each route runs is in docs/benchmarks.md, "Issue 15".
+ *  - Chunks.  A group's list serves its queries CHUNK at a time: the
+ *    chunk's own list keeps the group's candidates within Uc of the
+ *    chunk's box, Uc the smaller of U and the chunk's largest best (each
+ *    query's answer is at most both), so each query computes fewer
+ *    bounds; a list longer than CHUNK_LIST is not filtered but listed
+ *    again from the root for the chunk's box.
+ *  - Sparse groups (the solo path).  A group of queries whose box
+ *    overlaps more of the searched buckets than it has queries (a sparse
+ *    set asking a dense one: 10K points asking 1M) shares nothing: its
+ *    list would hold thousands of buckets, each bounded for every query.
+ *    Each of its queries is searched on its own instead: its window, then
+ *    the buckets within that best of the query itself, then the scans.
+ *  - Point lists.  A group small next to the distances to its answers (a
+ *    dense set asking a sparse one: 1M points asking 10K) has many queries
+ *    and few points that can be any of their answers.  When its listed
+ *    buckets hold at most POINT_LIST points, those within min(U, V) of the
+ *    group's box are kept, V the smallest upper bound from the box to one
+ *    of them; each chunk keeps, the same way, those that can be any of its
+ *    answers, and while that stays at most 2 CHUNK points its queries scan
+ *    just them (no bucket bounds, no per-query lists).
  *  - Scans.  A bucket is scanned four points at a time with GCC's vector
  *    extension (each lane evaluates hd__d2s's expression: no fused
  *    multiply-add, -ffp-contract=off), each lane keeping its smallest
@@ -134,6 +154,15 @@
  *    distance): none of its points can be the nearest, nor tie with it.  A
  *    bound equal to the best is not enough: the candidate may hold a point
  *    at the same distance with a smaller original index.
+ *  - A chunk's list and a solo query's list are lists of the same kind,
+ *    within a bound that is at least the answer of each query using them
+ *    (Uc; a solo query's best).  A point list drops a point only when its
+ *    bound from the box (node_lb2's expression for a box of one point)
+ *    exceeds min(U, V): V is node_ub2's expression from the box to a kept
+ *    point, never below that point's computed distance to a query in the
+ *    box, so the answer is at most V, and the dropped point is farther.
+ *    Its scans are the buckets' scans (scan_arrays), over copies of points
+ *    of the set only.
  *  - A point replaces the best on a smaller squared distance, or on an
  *    equal one with a smaller original index; reading a point twice (seed
  *    and candidate, overlapping scans) or reading extra points of the set
@@ -1488,7 +1517,10 @@ int hd__an_nearest_paired(const hd__an_t *asking, const hd__an_t *searched, cons
  * first (they usually settle it below), then the others within
  * min(best, hi2).  The minimiser of a point whose d2 is at most hi2 lies in
  * a bucket whose bound is at most d2, at most its best and at most hi2: it
- * is scanned, so a point kept in the band has its exact d2.  Copies of
+ * is scanned, so a point kept in the band has its exact d2.  An asking
+ * bucket that would list more than BAND_SHARED candidates per open point
+ * (a sparse set asking a dense one) lists them per point instead, around
+ * the point within its best and hi2: the same argument.  Copies of
  * one point (a bucket whose stop is start + 1) are settled once for all of
  * them.  The counts and the
  * kept values (as a multiset) depend on nothing but the two sets and the
