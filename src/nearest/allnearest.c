@@ -1232,10 +1232,14 @@ HD__INLINE size_t qgroup_finish(query_ctx *c, cands_t *cd, cands_t *ck, qgroup_t
         }
         listed[nlisted++] = (uint32_t)k;
     }
-    /* A group small next to its answers' distances shares its candidate
-     * points, chunk by chunk, while the chunks' lists stay short. */
+    /* A group small next to its answers' distances (its box's diagonal
+     * at most twice the bound U on them) shares its candidate points,
+     * chunk by chunk, while the chunks' lists stay short.  (Which groups
+     * try decides only the cost.) */
     plist_t gp, cp;
-    int points = nlisted >= 2 * CHUNK && group_points(t, cd, &G->box, U, &gp);
+    double diag2 = 0;
+    for (int d = 0; d < 3; d++) diag2 += (G->box.hi[d] - G->box.lo[d]) * (G->box.hi[d] - G->box.lo[d]);
+    int points = nlisted >= 2 * CHUNK && diag2 <= 4 * U && group_points(t, cd, &G->box, U, &gp);
     for (size_t r0 = 0; r0 < nlisted; r0 += CHUNK) {
         size_t r1 = r0 + CHUNK < nlisted ? r0 + CHUNK : nlisted;
         const cands_t *list = cd;
