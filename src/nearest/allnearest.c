@@ -1245,7 +1245,7 @@ HD__INLINE size_t qgroup_finish(query_ctx *c, cands_t *cd, cands_t *ck, qgroup_t
         const cands_t *list = cd;
         hd__box_t box;
         double Uc = 0;
-        for (size_t r = r0; r < r1; r++) {
+        for (size_t r = r0; r < r1 && (points || cd->n > CHUNK); r++) {
             size_t k = first + listed[r];
             double p[3] = {q->x[k], q->y[k], q->z[k]};
             for (int d = 0; d < 3; d++) {
@@ -1322,8 +1322,10 @@ HD__INLINE void solo_query(query_ctx *c, cands_t *cd, size_t k, size_t *b, size_
 
 /* The groups of a task, each answered in phases: its box; first answers
  * by the partner path or the window path while they pay, each listing the
- * group's candidates when its bound lists few; else the seeds' answers
- * and their candidates; then every query exactly (qgroup_finish).
+ * group's candidates when its bound lists few; else, when the group's box
+ * overlaps more of t's buckets than it has queries, the solo path; else
+ * the seeds' answers and their candidates; then every query exactly
+ * (qgroup_finish).
  *
  * The partner path: when the sets are a copy and its original in the same
  * order, each query's partner (the searched point of its own original
@@ -1367,11 +1369,6 @@ HD__HOT static void query_task(void *vctx, size_t task, int worker) {
             G.first = first;
             G.m = q->gstart[g + 1] - first < HD__AN_GROUP ? q->gstart[g + 1] - first : HD__AN_GROUP;
             qgroup_box(q, &G);
-            if (!candidates(t, &G.box, 0, G.m, cd)) {
-                for (size_t k = first, wb = 0, wp = 0; k < first + G.m; k++) solo_query(c, cd, k, &wb, &wp);
-                cd->counts.solo += G.m;
-                continue;
-            }
             double U = 0;
             int paired = 0, windowed = 0, seeded = 0;
             for (size_t k = 0; k < G.m; k++) G.best[k] = INFINITY, G.bj[k] = UINT32_MAX;
@@ -1392,6 +1389,12 @@ HD__HOT static void query_task(void *vctx, size_t task, int worker) {
                 cd->counts.windowed += (size_t)paired;
             }
             size_t near = SIZE_MAX;
+            if (!paired && !candidates(t, &G.box, 0, G.m, cd)) {
+                /* Spread over more of t's buckets than it has queries. */
+                for (size_t k = first, wb = 0, wp = 0; k < first + G.m; k++) solo_query(c, cd, k, &wb, &wp);
+                cd->counts.solo += G.m;
+                continue;
+            }
             if (!paired) {
                 if (!seeded) qgroup_seeds(q, t, &G, &h, &s0);
                 near = seed_bests(q, t, &G, cd, &U);
