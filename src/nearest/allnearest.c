@@ -271,6 +271,19 @@ static void gather_task(void *vctx, size_t task, int worker) {
         }
         return;
     }
+    if (c->src.kind == HD__SRC_F64 && !c->src.T) {
+        /* Packed doubles, the layout most callers pass: the same reads as
+         * hd__src_get's, without its tests per point. */
+        const double *base = (const double *)(const void *)c->src.base;
+        for (size_t at = lo; at < hi; at++) {
+            if (at + 16 < s->n) __builtin_prefetch(base + 3 * (size_t)(uint32_t)c->b[at + 16]);
+            uint32_t i = (uint32_t)c->b[at < s->n ? at : s->n - 1];
+            const double *q = base + 3 * (size_t)i;
+            s->x[at] = q[0], s->y[at] = q[1], s->z[at] = q[2];
+            s->idx[at] = i;
+        }
+        return;
+    }
     for (size_t at = lo; at < hi; at++) {
         if (at + 16 < s->n && c->src.kind != HD__SRC_ANY)
             __builtin_prefetch(c->src.base + (ptrdiff_t)(uint32_t)c->b[at + 16] * hd__src_packed_stride(&c->src));
