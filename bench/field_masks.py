@@ -94,9 +94,10 @@ def main():
                 sys.exit("field_masks: %s" % r.stderr.strip())
             ours = r.stdout.strip()
         ref = []
+        sp32 = tuple(float(np.float32(v)) for v in sp)  # the spacing the NIfTI header holds (float32)
         for _ in range(args.runs):
             t0 = time.perf_counter()
-            v, npred, ngt = monai_hd95(pred, gt, sp)
+            v, npred, ngt = monai_hd95(pred, gt, sp32)
             ref.append(time.perf_counter() - t0)
     tt, tr = statistics.median(tool), statistics.median(ref)
     print("masks %s, spacing %s, border voxels %d + %d" % ("x".join(map(str, shape)), sp, npred, ngt))
