@@ -183,8 +183,9 @@
  * Memory: about 36 bytes per point and set (28 for the coordinates and
  * indices, 4 for the keys, the rest for buckets, groups and nodes with their boxes, of
  * which there are far fewer than points), 12 bytes
- * per asking point for the answers in its order, and, per thread, 64
- * bytes per searched bucket for the candidates.  While a set is built it
+ * per asking point for the answers in its order, and, per thread, 128
+ * bytes per searched bucket for the candidates (the group's list and a
+ * chunk's), with about 40 KB of stack for the point lists.  While a set is built it
  * holds up to about 38 bytes per point: 8 of sort keys beside the
  * coordinates and indices (the sort's other buffer is x[]'s memory), and
  * the node and per-bucket arrays, which grow as the octree is cut (sized
