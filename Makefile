@@ -135,6 +135,8 @@ bench:
 	  --cli $(BUILD)/hausdorff --out $(BUILD)/bench/engine.jsonl $(BENCH_ARGS)
 	/usr/bin/python3 bench/report.py $(BUILD)/bench/engine.jsonl --doc docs/benchmarks.md \
 	  --plots docs/img --command "make bench$(if $(filter-out --scale,$(BENCH_ARGS)), BENCH_ARGS=\"$(BENCH_ARGS)\")"
+	cmake --build $(BUILD) -j$(JOBS) --target field_bench percentile_bench
+	/usr/bin/python3 bench/field_report.py --build $(BUILD) --doc docs/benchmarks.md --command "make bench"
 
 clean:
 	rm -rf $(BUILD) $(ASAN_BUILD) $(TSAN_BUILD) build-fuzz

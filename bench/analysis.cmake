@@ -6,4 +6,8 @@ hd_add_bench(analysis_bench ${CMAKE_CURRENT_LIST_DIR}/analysis_bench.c)
 hd_add_bench(summarize_bench ${CMAKE_CURRENT_LIST_DIR}/summarize_bench.c)
 # percentile_bench: HD95 from bands (hd_hausdorff_percentile) against every
 # distance then a selection, on issue 39's cases a-e.
-hd_add_bench(percentile_bench ${CMAKE_CURRENT_LIST_DIR}/percentile_bench.c)
+hd_add_bench(percentile_bench ${CMAKE_CURRENT_LIST_DIR}/percentile_bench.c ${CMAKE_CURRENT_LIST_DIR}/support/field_cases.c)
+# field_bench: the per-point field (hd_distances) on issue 39's cases a-e,
+# phase by phase (build, each direction), against the Hausdorff distance.
+hd_add_bench(field_bench ${CMAKE_CURRENT_LIST_DIR}/field_bench.c ${CMAKE_CURRENT_LIST_DIR}/support/field_cases.c)
+target_include_directories(field_bench PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/src)

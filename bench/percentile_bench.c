@@ -3,12 +3,7 @@
  * distance, against every distance then a selection (docs/benchmarks.md,
  * "Percentiles").
  *
- * The five cases of issue 39, generated in memory with fixed seeds:
- *   a overlapping  two N(0, 1) Gaussians, N + N points
- *   b disjoint     B's mean 20 sigma from A's along x
- *   c partial      B's mean 2 sigma from A's
- *   d N / N/100    overlapping Gaussians, B a hundredth the size
- *   e shuffled     B = A + N(0, (1e-3)^2) noise, in random order
+ * The five cases of issue 39 (bench/support/field_cases.h).
  * For each, median of RUNS alternated runs at THREADS threads:
  *   H       hd_hausdorff (auto engine): the Hausdorff distance alone
  *   all     hd_distances (both directions, no indices) then hd_percentile_of
@@ -22,7 +17,7 @@
  *        (default 1000000 5 1 95)
  */
 #include "benchutil.h"
-#include "gen.h"
+#include "field_cases.h"
 
 #include <hausdorff.h>
 #include <stdio.h>
@@ -53,24 +48,15 @@ int main(int argc, char **argv) {
     if (runs < 1 || runs > 50) runs = 5;
     double *a = malloc(24 * n), *b = malloc(24 * n), *dab = malloc(8 * n), *dba = malloc(8 * n);
     if (!a || !b || !dab || !dba) return 1;
-    static const char *const cases[] = {"a_overlapping", "b_disjoint", "c_partial", "d_small_B", "e_shuffled"};
+    const char *const *cases = field_case_names;
     hd_options_t o;
     hd_options_init(&o);
     o.threads = threads;
     hd_error_t err;
     printf("| case | |A| | |B| | H | all + selection | bands | all / bands | bands / H |\n|---|---|---|---|---|---|---|---|\n");
-    for (int c = 0; c < 5; c++) {
-        gen_rng_t g;
-        gen_seed(&g, 39 + (uint64_t)c);
-        size_t nb = c == 3 ? n / 100 : n;
-        double m0[3] = {0, 0, 0}, m1[3] = {c == 1 ? 20.0 : c == 2 ? 2.0 : 0.0, 0, 0};
-        gen_gauss(&g, a, n, m0, 1.0);
-        if (c == 4) {
-            for (size_t k = 0; k < 3 * n; k++) b[k] = a[k] + 1e-3 * gen_normal(&g);
-            for (size_t k = n; k > 1; k--) gen_swap(b, k - 1, gen_u64(&g) % k);
-        } else {
-            gen_gauss(&g, b, nb, m1, 1.0);
-        }
+    for (int c = 0; c < FIELD_CASES; c++) {
+        size_t nb;
+        field_case(c, n, a, b, &nb);
         if (dir && (write_bin(dir, cases[c], "A", a, n) || write_bin(dir, cases[c], "B", b, nb))) {
             fprintf(stderr, "percentile_bench: cannot write %s\n", dir);
             return 1;

@@ -93,6 +93,26 @@
  *    an eighth of its queries are set apart or more than PAIR_CANDIDATES
  *    buckets are listed; a task drops the path as it drops the partners.
  *    How often each route runs is in docs/benchmarks.md, "Issue 15".
+ *  - Chunks.  A group's list serves its queries CHUNK at a time: the
+ *    chunk's own list keeps the group's candidates within Uc of the
+ *    chunk's box, Uc the smaller of U and the chunk's largest best (each
+ *    query's answer is at most both), so each query computes fewer
+ *    bounds; a list longer than CHUNK_LIST is not filtered but listed
+ *    again from the root for the chunk's box.
+ *  - Sparse groups (the solo path).  A group of queries whose box
+ *    overlaps more of the searched buckets than it has queries (a sparse
+ *    set asking a dense one: 10K points asking 1M) shares nothing: its
+ *    list would hold thousands of buckets, each bounded for every query.
+ *    Each of its queries is searched on its own instead: its window, then
+ *    the buckets within that best of the query itself, then the scans.
+ *  - Point lists.  A group small next to the distances to its answers (a
+ *    dense set asking a sparse one: 1M points asking 10K) has many queries
+ *    and few points that can be any of their answers.  When its listed
+ *    buckets hold at most POINT_LIST points, those within min(U, V) of the
+ *    group's box are kept, V the smallest upper bound from the box to one
+ *    of them; each chunk keeps, the same way, those that can be any of its
+ *    answers, and while that stays at most 2 CHUNK points its queries scan
+ *    just them (no bucket bounds, no per-query lists).
  *  - Scans.  A bucket is scanned four points at a time with GCC's vector
  *    extension (each lane evaluates hd__d2s's expression: no fused
  *    multiply-add, -ffp-contract=off), each lane keeping its smallest
@@ -134,6 +154,15 @@
  *    distance): none of its points can be the nearest, nor tie with it.  A
  *    bound equal to the best is not enough: the candidate may hold a point
  *    at the same distance with a smaller original index.
+ *  - A chunk's list and a solo query's list are lists of the same kind,
+ *    within a bound that is at least the answer of each query using them
+ *    (Uc; a solo query's best).  A point list drops a point only when its
+ *    bound from the box (node_lb2's expression for a box of one point)
+ *    exceeds min(U, V): V is node_ub2's expression from the box to a kept
+ *    point, never below that point's computed distance to a query in the
+ *    box, so the answer is at most V, and the dropped point is farther.
+ *    Its scans are the buckets' scans (scan_arrays), over copies of points
+ *    of the set only.
  *  - A point replaces the best on a smaller squared distance, or on an
  *    equal one with a smaller original index; reading a point twice (seed
  *    and candidate, overlapping scans) or reading extra points of the set
@@ -154,8 +183,9 @@
  * Memory: about 36 bytes per point and set (28 for the coordinates and
  * indices, 4 for the keys, the rest for buckets, groups and nodes with their boxes, of
  * which there are far fewer than points), 12 bytes
- * per asking point for the answers in its order, and, per thread, 64
- * bytes per searched bucket for the candidates.  While a set is built it
+ * per asking point for the answers in its order, and, per thread, 128
+ * bytes per searched bucket for the candidates (the group's list and a
+ * chunk's), with about 40 KB of stack for the point lists.  While a set is built it
  * holds up to about 38 bytes per point: 8 of sort keys beside the
  * coordinates and indices (the sort's other buffer is x[]'s memory), and
  * the node and per-bucket arrays, which grow as the octree is cut (sized
@@ -242,6 +272,19 @@ static void gather_task(void *vctx, size_t task, int worker) {
         }
         return;
     }
+    if (c->src.kind == HD__SRC_F64 && !c->src.T) {
+        /* Packed doubles, the layout most callers pass: the same reads as
+         * hd__src_get's, without its tests per point. */
+        const double *base = (const double *)(const void *)c->src.base;
+        for (size_t at = lo; at < hi; at++) {
+            if (at + 16 < s->n) __builtin_prefetch(base + 3 * (size_t)(uint32_t)c->b[at + 16]);
+            uint32_t i = (uint32_t)c->b[at < s->n ? at : s->n - 1];
+            const double *q = base + 3 * (size_t)i;
+            s->x[at] = q[0], s->y[at] = q[1], s->z[at] = q[2];
+            s->idx[at] = i;
+        }
+        return;
+    }
     for (size_t at = lo; at < hi; at++) {
         if (at + 16 < s->n && c->src.kind != HD__SRC_ANY)
             __builtin_prefetch(c->src.base + (ptrdiff_t)(uint32_t)c->b[at + 16] * hd__src_packed_stride(&c->src));
@@ -284,6 +327,23 @@ static void box_task(void *vctx, size_t task, int worker) {
     }
 }
 
+/* The end of the run of keys from e (below hi) with e's digit at `shift`:
+ * within a cell the digits grow, so a galloping search then a bisection
+ * find it in a logarithm of the run's length (a linear scan read every
+ * key once per level of the octree). */
+static size_t digit_end(const uint64_t *keys, size_t e, size_t hi, int shift) {
+    uint64_t digit = keys[e] >> shift & 7;
+    size_t step = 1, in = e; /* keys[in] has the digit; the end is in (in, out] */
+    while (in + step < hi && (keys[in + step] >> shift & 7) == digit) in += step, step *= 2;
+    size_t out = in + step < hi ? in + step : hi;
+    while (out - in > 1) {
+        size_t mid = in + (out - in) / 2;
+        if ((keys[mid] >> shift & 7) == digit) in = mid;
+        else out = mid;
+    }
+    return out;
+}
+
 /* The children of the octree cell [lo, hi) of the sorted keys at `shift`
  * (the cell's keys agree above it): the ends of its non-empty sub-cells,
  * in order.  Cells with one sub-cell are split further at once, so every
@@ -292,12 +352,7 @@ static void box_task(void *vctx, size_t task, int worker) {
 static int split_cell(const uint64_t *keys, size_t lo, size_t hi, int *shift, size_t ends[8]) {
     for (;;) {
         int nc = 0;
-        size_t e = lo;
-        while (e < hi) {
-            uint64_t digit = keys[e] >> *shift & 7;
-            while (e < hi && (keys[e] >> *shift & 7) == digit) e++;
-            ends[nc++] = e;
-        }
+        for (size_t e = lo; e < hi;) ends[nc++] = e = digit_end(keys, e, hi, *shift);
         *shift -= 3;
         if (nc > 1 || *shift < 32) return nc;
     }
@@ -749,31 +804,33 @@ typedef double v4d __attribute__((vector_size(32)));
 typedef int64_t v4l __attribute__((vector_size(32)));
 typedef uint32_t v4u __attribute__((vector_size(16)));
 
-/* The distances of (vx, vy, vz) to the four points from position k. */
-#define D4(t, k, vx, vy, vz, out)                                         \
+/* The distances of (vx, vy, vz) to the four points from position k of
+ * the arrays x, y, z. */
+#define D4(x, y, z, k, vx, vy, vz, out)                                   \
     do {                                                                  \
         v4d x_, y_, z_;                                                   \
-        __builtin_memcpy(&x_, (t)->x + (k), sizeof x_);                   \
-        __builtin_memcpy(&y_, (t)->y + (k), sizeof y_);                   \
-        __builtin_memcpy(&z_, (t)->z + (k), sizeof z_);                   \
+        __builtin_memcpy(&x_, (x) + (k), sizeof x_);                      \
+        __builtin_memcpy(&y_, (y) + (k), sizeof y_);                      \
+        __builtin_memcpy(&z_, (z) + (k), sizeof z_);                      \
         x_ = (vx)-x_, y_ = (vy)-y_, z_ = (vz)-z_;                         \
         (out) = x_ * x_ + y_ * y_ + z_ * z_;                              \
     } while (0)
 
-/* The points [k0, e) of t, k0 a multiple of four, e at most n + 1 (the
- * last group of four read may run past e, into the copies of the last
- * point stored after the end): each lane keeps its smallest distance and
- * the smallest index at it. */
-HD__INLINE void scan_span(const hd__an_t *t, size_t k0, size_t e, double qx, double qy, double qz,
-                          double *best, uint32_t *bj) {
+/* The points [0, n) of the arrays x, y, z (names idx), n > 0, read four
+ * at a time (the last four may run past n: the caller makes sure those are
+ * points of the set too): each lane keeps its smallest distance and the
+ * smallest index at it, then the lanes' minimum and its smallest index
+ * replace *best and *bj when smaller, or equal with a smaller index. */
+HD__INLINE void scan_arrays(const double *x, const double *y, const double *z, const uint32_t *idx, size_t n,
+                            double qx, double qy, double qz, double *best, uint32_t *bj) {
     v4d vx = {qx, qx, qx, qx}, vy = {qy, qy, qy, qy}, vz = {qz, qz, qz, qz}, mv, d;
     v4u iu;
-    D4(t, k0, vx, vy, vz, mv);
-    __builtin_memcpy(&iu, t->idx + k0, sizeof iu);
+    D4(x, y, z, 0, vx, vy, vz, mv);
+    __builtin_memcpy(&iu, idx, sizeof iu);
     v4l jv = __builtin_convertvector(iu, v4l);
-    for (size_t k = k0 + 4; k < e; k += 4) {
-        D4(t, k, vx, vy, vz, d);
-        __builtin_memcpy(&iu, t->idx + k, sizeof iu);
+    for (size_t k = 4; k < n; k += 4) {
+        D4(x, y, z, k, vx, vy, vz, d);
+        __builtin_memcpy(&iu, idx + k, sizeof iu);
         v4l jl = __builtin_convertvector(iu, v4l);
         v4l take = (d < mv) | ((d == mv) & (jl < jv));
         mv = (v4d)(((v4l)d & take) | ((v4l)mv & ~take));
@@ -793,6 +850,14 @@ HD__INLINE void scan_span(const hd__an_t *t, size_t k0, size_t e, double qx, dou
         *best = m;
         *bj = j;
     }
+}
+
+/* The points [k0, e) of t, k0 a multiple of four, e at most n + 1 (the
+ * last group of four read may run past e, into the copies of the last
+ * point stored after the end). */
+HD__INLINE void scan_span(const hd__an_t *t, size_t k0, size_t e, double qx, double qy, double qz,
+                          double *best, uint32_t *bj) {
+    scan_arrays(t->x + k0, t->y + k0, t->z + k0, t->idx + k0, e - k0, qx, qy, qz, best, bj);
 }
 
 /* One bucket: from the group of four that holds its first point to the
@@ -824,6 +889,9 @@ static size_t bucket_at(const hd__an_t *t, uint32_t key, size_t from) {
 #define PAIR_CANDIDATES 32 /* most candidates of a group for the partner path */
 #define PAIR_TRIAL 8        /* groups of a task tried before the partner path may be dropped */
 #define WINDOW 8            /* points of t scanned around a query's key (a multiple of 8) */
+#define CHUNK 16            /* queries answered from one chunk list */
+#define CHUNK_LIST 256      /* a group list longer than this is not filtered but listed again per chunk */
+#define POINT_LIST 512      /* most points of a group's candidate buckets for a point list */
 
 /* The rest of one query's search, on the candidate list cd (the buckets
  * within U of a box holding the query, U at least its answer): every
@@ -861,7 +929,9 @@ typedef struct {
                                  * (HD__AN_NO_PARTNER: none), or NULL */
     double *dist;
     size_t *nearest;
-    cands_t *cand; /* per worker: room for every bucket of t */
+    cands_t *cand; /* per worker w: cand[w] the group's list, cand[workers + w] a chunk's,
+                    * each with room for every bucket of t */
+    int workers;
     double *sd;    /* answers in q's order: squared distances */
     uint32_t *sj;  /* and nearest original indices */
 } query_ctx;
@@ -1034,21 +1104,138 @@ HD__INLINE size_t seed_bests(const hd__an_t *q, const hd__an_t *t, qgroup_t *G, 
     return near;
 }
 
+/* The candidates of cd within Uc of the box q, into ck: filtered from
+ * cd, or listed afresh from t's root when cd is long (a group spread
+ * over many of t's buckets, a sparse set asking a dense one).  A bucket
+ * left out has node_lb2 above Uc from the box, so above the answer of
+ * every query in it whose answer is at most Uc. */
+HD__INLINE void chunk_candidates(const hd__an_t *t, const cands_t *cd, const hd__box_t *q, double Uc, cands_t *ck) {
+    if (cd->n > CHUNK_LIST) {
+        candidates(t, q, Uc, SIZE_MAX, ck);
+        return;
+    }
+    size_t m = 0;
+    for (size_t r = 0; r < cd->n; r++) {
+        double g[3];
+        for (int d = 0; d < 3; d++) {
+            double u = cd->lo[d][r] - q->hi[d], v = q->lo[d] - cd->hi[d][r];
+            g[d] = u > v ? u : v;
+            g[d] = g[d] > 0 ? g[d] : 0;
+        }
+        double lb = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
+        ck->bucket[m] = cd->bucket[r];
+        for (int d = 0; d < 3; d++) ck->lo[d][m] = cd->lo[d][r], ck->hi[d][m] = cd->hi[d][r];
+        m += lb <= Uc;
+    }
+    ck->n = m;
+}
+
+/* Candidate points, shared by queries whose box is small next to the
+ * distances to their answers (a dense set asking a sparse one): many
+ * queries, few points that can be any of their answers.  x, y, z, idx in
+ * structure of arrays, n of them, padded to a multiple of four with
+ * copies of the last (a copy changes no minimum and no smallest index). */
+typedef struct {
+    size_t n;
+    double x[POINT_LIST + 4], y[POINT_LIST + 4], z[POINT_LIST + 4];
+    uint32_t idx[POINT_LIST + 4];
+} plist_t;
+
+/* The smallest and the largest computed squared distance between the
+ * point (px, py, pz) and a point of box q (node_lb2's and node_ub2's
+ * expressions with a box of one point; see the essay). */
+HD__INLINE void point_bounds(const hd__box_t *q, double px, double py, double pz, double *lb, double *ub) {
+    double p[3] = {px, py, pz}, g[3], h[3];
+    for (int d = 0; d < 3; d++) {
+        double u = p[d] - q->hi[d], v = q->lo[d] - p[d];
+        g[d] = u > v ? u : v;
+        g[d] = g[d] > 0 ? g[d] : 0;
+        u = q->hi[d] - p[d], v = p[d] - q->lo[d];
+        h[d] = u > v ? u : v;
+    }
+    *lb = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
+    *ub = h[0] * h[0] + h[1] * h[1] + h[2] * h[2];
+}
+
+HD__INLINE void plist_pad(plist_t *l) {
+    for (size_t k = l->n; l->n && k < ((l->n + 3) & ~(size_t)3); k++)
+        l->x[k] = l->x[l->n - 1], l->y[k] = l->y[l->n - 1], l->z[k] = l->z[l->n - 1], l->idx[k] = l->idx[l->n - 1];
+}
+
+/* The points of the buckets listed in cd that can be the answer of a
+ * query in box q whose answer is at most U, into out: V, the smallest
+ * node_ub2 of a listed point from the box, bounds every such answer too
+ * (the point is within V of each query), and a point whose bound from
+ * the box is above min(U, V) is farther than that answer.  Returns 0 when
+ * the buckets hold more than POINT_LIST points (then nothing is listed). */
+static int group_points(const hd__an_t *t, const cands_t *cd, const hd__box_t *q, double U, plist_t *out) {
+    size_t total = 0;
+    for (size_t r = 0; r < cd->n; r++) total += t->stop[cd->bucket[r]] - t->start[cd->bucket[r]];
+    if (total > POINT_LIST) return 0;
+    double lb[POINT_LIST], V = U;
+    size_t m = 0;
+    for (size_t r = 0; r < cd->n; r++)
+        for (size_t k = t->start[cd->bucket[r]]; k < t->stop[cd->bucket[r]]; k++, m++) {
+            double ub;
+            point_bounds(q, t->x[k], t->y[k], t->z[k], &lb[m], &ub);
+            V = ub < V ? ub : V;
+            out->x[m] = t->x[k], out->y[m] = t->y[k], out->z[m] = t->z[k], out->idx[m] = t->idx[k];
+        }
+    size_t n = 0;
+    for (size_t k = 0; k < m; k++) {
+        out->x[n] = out->x[k], out->y[n] = out->y[k], out->z[n] = out->z[k], out->idx[n] = out->idx[k];
+        n += lb[k] <= V;
+    }
+    out->n = n;
+    return 1;
+}
+
+/* The points of `from` that can be the answer of a query in the box q
+ * (a chunk of the group's, answers at most U), the same way, into out. */
+static void chunk_points(const plist_t *from, const hd__box_t *q, double U, plist_t *out) {
+    double lb[POINT_LIST], V = U;
+    for (size_t k = 0; k < from->n; k++) {
+        double ub;
+        point_bounds(q, from->x[k], from->y[k], from->z[k], &lb[k], &ub);
+        V = ub < V ? ub : V;
+    }
+    size_t n = 0;
+    for (size_t k = 0; k < from->n; k++) {
+        out->x[n] = from->x[k], out->y[n] = from->y[k], out->z[n] = from->z[k], out->idx[n] = from->idx[k];
+        n += lb[k] <= V;
+    }
+    out->n = n;
+    plist_pad(out);
+}
+
+/* One query against every point of l (padded: the reads past l->n are
+ * copies of its last point), into *best and *bj. */
+HD__INLINE void scan_points(const plist_t *l, double qx, double qy, double qz, double *best, uint32_t *bj) {
+    if (l->n) scan_arrays(l->x, l->y, l->z, l->idx, l->n, qx, qy, qz, best, bj);
+}
+
 /* Every query of the group answered exactly from the candidates listed
  * within U, into c->sd and c->sj.  A windowed query whose best is still
  * above U after its seed buckets may have its answer outside the list:
- * it gets candidates of its own, within its best.  Returns how many
- * answers were the partners (for the partner path's upkeep). */
-HD__INLINE size_t qgroup_finish(query_ctx *c, cands_t *cd, qgroup_t *G, double U, int paired, int windowed,
-                                size_t near) {
+ * it gets candidates of its own, within its best.  The others are
+ * answered CHUNK at a time (consecutive on the curve, so close): the
+ * chunk's own list holds the group's candidates within Uc of the chunk's
+ * box, Uc = min(U, the chunk's largest best), which bounds the answer of
+ * each of its queries (each answer is at most U and at most its best);
+ * a short group list is used as it is.  Returns how many answers were
+ * the partners (for the partner path's upkeep). */
+HD__INLINE size_t qgroup_finish(query_ctx *c, cands_t *cd, cands_t *ck, qgroup_t *G, double U, int paired,
+                                int windowed, size_t near) {
     const hd__an_t *q = c->q, *t = c->t;
-    size_t first = G->first, kept = 0, napart = 0;
-    uint32_t apart[HD__AN_GROUP];
+    size_t first = G->first, kept = 0, napart = 0, nlisted = 0;
+    uint32_t apart[HD__AN_GROUP], listed[HD__AN_GROUP];
+    uint8_t seeded[HD__AN_GROUP];
     for (size_t k = 0; k < G->m; k++) {
-        double qx = q->x[first + k], qy = q->y[first + k], qz = q->z[first + k];
-        if (windowed && G->best[k] > U) {
+        seeded[k] = windowed && G->best[k] > U;
+        if (seeded[k]) {
             /* Set apart: its seed buckets usually bring it within U, and
              * then the list holds its answer; if not: later. */
+            double qx = q->x[first + k], qy = q->y[first + k], qz = q->z[first + k];
             for (size_t b = G->seed[k]; b < G->seed[k] + SEEDS && b < t->nb; b++)
                 scan_bucket(t, b, qx, qy, qz, &G->best[k], &G->bj[k]);
             if (G->best[k] > U) {
@@ -1056,12 +1243,62 @@ HD__INLINE size_t qgroup_finish(query_ctx *c, cands_t *cd, qgroup_t *G, double U
                 cd->counts.apart++;
                 continue;
             }
-            finish_query(t, cd, qx, qy, qz, U, G->seed[k], G->seed[k] + SEEDS, SIZE_MAX, &G->best[k], &G->bj[k]);
-        } else if (paired) finish_query(t, cd, qx, qy, qz, U, 0, 0, SIZE_MAX, &G->best[k], &G->bj[k]);
-        else finish_query(t, cd, qx, qy, qz, U, G->seed[k], G->seed[k] + SEEDS, near, &G->best[k], &G->bj[k]);
-        c->sd[first + k] = G->best[k];
-        c->sj[first + k] = G->bj[k];
-        kept += paired && !windowed && G->bj[k] == G->pj[k];
+        }
+        listed[nlisted++] = (uint32_t)k;
+    }
+    /* A group small next to its answers' distances (its box's diagonal
+     * at most twice the bound U on them) shares its candidate points,
+     * chunk by chunk, while the chunks' lists stay short.  (Which groups
+     * try decides only the cost.) */
+    plist_t gp, cp;
+    double diag2 = 0;
+    for (int d = 0; d < 3; d++) diag2 += (G->box.hi[d] - G->box.lo[d]) * (G->box.hi[d] - G->box.lo[d]);
+    int points = nlisted >= 2 * CHUNK && diag2 <= 4 * U && group_points(t, cd, &G->box, U, &gp);
+    for (size_t r0 = 0; r0 < nlisted; r0 += CHUNK) {
+        size_t r1 = r0 + CHUNK < nlisted ? r0 + CHUNK : nlisted;
+        const cands_t *list = cd;
+        hd__box_t box;
+        double Uc = 0;
+        for (size_t r = r0; r < r1 && (points || cd->n > CHUNK); r++) {
+            size_t k = first + listed[r];
+            double p[3] = {q->x[k], q->y[k], q->z[k]};
+            for (int d = 0; d < 3; d++) {
+                box.lo[d] = r == r0 || p[d] < box.lo[d] ? p[d] : box.lo[d];
+                box.hi[d] = r == r0 || p[d] > box.hi[d] ? p[d] : box.hi[d];
+            }
+            Uc = G->best[listed[r]] > Uc ? G->best[listed[r]] : Uc;
+        }
+        Uc = Uc < U ? Uc : U;
+        if (points) {
+            chunk_points(&gp, &box, Uc, &cp);
+            points = cp.n <= 2 * CHUNK;
+        }
+        if (points) {
+            for (size_t r = r0; r < r1; r++) {
+                size_t k = listed[r];
+                scan_points(&cp, q->x[first + k], q->y[first + k], q->z[first + k], &G->best[k], &G->bj[k]);
+                c->sd[first + k] = G->best[k];
+                c->sj[first + k] = G->bj[k];
+                kept += paired && !windowed && G->bj[k] == G->pj[k];
+            }
+            cd->counts.pointed += r1 - r0;
+            continue;
+        }
+        if (cd->n > CHUNK) {
+            chunk_candidates(t, cd, &box, Uc, ck);
+            list = ck;
+        }
+        for (size_t r = r0; r < r1; r++) {
+            size_t k = listed[r];
+            double qx = q->x[first + k], qy = q->y[first + k], qz = q->z[first + k];
+            cands_t *l = (cands_t *)list;
+            if (seeded[k]) finish_query(t, l, qx, qy, qz, U, G->seed[k], G->seed[k] + SEEDS, SIZE_MAX, &G->best[k], &G->bj[k]);
+            else if (paired) finish_query(t, l, qx, qy, qz, U, 0, 0, SIZE_MAX, &G->best[k], &G->bj[k]);
+            else finish_query(t, l, qx, qy, qz, U, G->seed[k], G->seed[k] + SEEDS, near, &G->best[k], &G->bj[k]);
+            c->sd[first + k] = G->best[k];
+            c->sj[first + k] = G->bj[k];
+            kept += paired && !windowed && G->bj[k] == G->pj[k];
+        }
     }
     /* The queries set apart: each one's own candidates, the buckets within
      * its best so far (a real point's distance, so at least its answer) of
@@ -1078,10 +1315,31 @@ HD__INLINE size_t qgroup_finish(query_ctx *c, cands_t *cd, qgroup_t *G, double U
     return kept;
 }
 
+/* The solo path: a group of queries spread over more of t's buckets than
+ * it has queries (a sparse set asking a dense one) shares no work, and
+ * each of its queries is searched on its own: its WINDOW points on t's
+ * curve (an actual point's distance, so a bound on its answer), then the
+ * buckets within that bound of the query itself (candidates), then
+ * finish_query on them.  *b and *p carry the window's place (the keys
+ * grow along q). */
+HD__INLINE void solo_query(query_ctx *c, cands_t *cd, size_t k, size_t *b, size_t *p) {
+    const hd__an_t *q = c->q, *t = c->t;
+    double qx = q->x[k], qy = q->y[k], qz = q->z[k], best = INFINITY;
+    uint32_t j = UINT32_MAX;
+    window_best(q, t, k, b, p, &best, &j);
+    hd__box_t pb = {{qx, qy, qz}, {qx, qy, qz}};
+    candidates(t, &pb, best, SIZE_MAX, cd);
+    finish_query(t, cd, qx, qy, qz, best, 0, 0, SIZE_MAX, &best, &j);
+    c->sd[k] = best;
+    c->sj[k] = j;
+}
+
 /* The groups of a task, each answered in phases: its box; first answers
  * by the partner path or the window path while they pay, each listing the
- * group's candidates when its bound lists few; else the seeds' answers
- * and their candidates; then every query exactly (qgroup_finish).
+ * group's candidates when its bound lists few; else, when the group's box
+ * overlaps more of t's buckets than it has queries, the solo path; else
+ * the seeds' answers and their candidates; then every query exactly
+ * (qgroup_finish).
  *
  * The partner path: when the sets are a copy and its original in the same
  * order, each query's partner (the searched point of its own original
@@ -1109,7 +1367,7 @@ HD__INLINE size_t qgroup_finish(query_ctx *c, cands_t *cd, qgroup_t *G, double U
 HD__HOT static void query_task(void *vctx, size_t task, int worker) {
     query_ctx *c = vctx;
     const hd__an_t *q = c->q, *t = c->t;
-    cands_t *cd = &c->cand[worker];
+    cands_t *cd = &c->cand[worker], *ck = &c->cand[c->workers + worker];
     size_t g0 = task * GROUPS_PER_TASK, g1 = g0 + GROUPS_PER_TASK < q->ng ? g0 + GROUPS_PER_TASK : q->ng;
     qgroup_t G;
     size_t at0 = g0 < g1 ? bucket_at(t, q->key[q->glead[g0]], 0) : 0;
@@ -1145,11 +1403,17 @@ HD__HOT static void query_task(void *vctx, size_t task, int worker) {
                 cd->counts.windowed += (size_t)paired;
             }
             size_t near = SIZE_MAX;
+            if (!paired && !candidates(t, &G.box, 0, G.m, cd)) {
+                /* Spread over more of t's buckets than it has queries. */
+                for (size_t k = first, wb = 0, wp = 0; k < first + G.m; k++) solo_query(c, cd, k, &wb, &wp);
+                cd->counts.solo += G.m;
+                continue;
+            }
             if (!paired) {
                 if (!seeded) qgroup_seeds(q, t, &G, &h, &s0);
                 near = seed_bests(q, t, &G, cd, &U);
             }
-            size_t kept = qgroup_finish(c, cd, &G, U, paired, windowed, near);
+            size_t kept = qgroup_finish(c, cd, ck, &G, U, paired, windowed, near);
             /* The path pays when the partners are the answers (a copy), not
              * merely near enough to list few candidates (a few buckets of
              * repeated points): it is kept on while at least half of the
@@ -1166,7 +1430,7 @@ static int query_threads(const hd__an_t *asking, int threads) {
 
 size_t hd__an_nearest_bytes(const hd__an_t *asking, const hd__an_t *searched, int threads) {
     size_t w = (size_t)query_threads(asking, threads);
-    return w * (sizeof(cands_t) + searched->nb * (2 * sizeof(uint32_t) + 7 * sizeof(double))) +
+    return 2 * w * (sizeof(cands_t) + searched->nb * (2 * sizeof(uint32_t) + 7 * sizeof(double))) +
            asking->n * (sizeof(double) + sizeof(uint32_t));
 }
 
@@ -1211,15 +1475,15 @@ static int nearest_run(const hd__an_t *asking, const hd__an_t *searched, const h
     threads = query_threads(asking, threads);
     assert(!partner || !pair_at);
     query_ctx c = {asking, searched, partner && partner->count == asking->n ? partner : NULL, pair_at, dist, nearest,
-                   NULL, NULL, NULL};
-    c.cand = hd__calloc_array((size_t)threads, sizeof *c.cand);
+                   NULL, threads, NULL, NULL};
+    c.cand = hd__calloc_array(2 * (size_t)threads, sizeof *c.cand);
     c.sd = hd__malloc_array(asking->n, sizeof *c.sd);
     c.sj = hd__malloc_array(asking->n, sizeof *c.sj);
     int rc = c.cand && c.sd && c.sj ? HD_OK : HD_ENOMEM;
     /* Every answer is written: their pages mapped at once. */
     hd__prefault(c.sd, asking->n * sizeof *c.sd);
     hd__prefault(c.sj, asking->n * sizeof *c.sj);
-    if (rc == HD_OK) rc = cands_alloc(c.cand, threads, searched->nb);
+    if (rc == HD_OK) rc = cands_alloc(c.cand, 2 * threads, searched->nb);
     if (rc == HD_OK) {
         hd__parallel_for(threads, tasks, query_task, &c);
         hd__parallel_for(threads, (asking->n + SCATTER_TASK - 1) / SCATTER_TASK, scatter_answers, &c);
@@ -1229,8 +1493,10 @@ static int nearest_run(const hd__an_t *asking, const hd__an_t *searched, const h
         counts->paired += c.cand[w].counts.paired;
         counts->windowed += c.cand[w].counts.windowed;
         counts->apart += c.cand[w].counts.apart;
+        counts->solo += c.cand[w].counts.solo;
+        counts->pointed += c.cand[w].counts.pointed;
     }
-    cands_free(c.cand, threads);
+    cands_free(c.cand, 2 * threads);
     free(c.sd);
     free(c.sj);
     if (rc != HD_OK) return hd__err(err, rc, "cannot allocate the candidate lists");
@@ -1272,19 +1538,23 @@ int hd__an_nearest_paired(const hd__an_t *asking, const hd__an_t *searched, cons
  * first (they usually settle it below), then the others within
  * min(best, hi2).  The minimiser of a point whose d2 is at most hi2 lies in
  * a bucket whose bound is at most d2, at most its best and at most hi2: it
- * is scanned, so a point kept in the band has its exact d2.  Copies of
+ * is scanned, so a point kept in the band has its exact d2.  An asking
+ * bucket that would list more than BAND_SHARED candidates per open point
+ * (a sparse set asking a dense one) lists them per point instead, around
+ * the point within its best and hi2: the same argument.  Copies of
  * one point (a bucket whose stop is start + 1) are settled once for all of
  * them.  The counts and the
  * kept values (as a multiset) depend on nothing but the two sets and the
  * band, whatever the threads.
  */
 
-#define BAND_TASK 64 /* asking buckets per task */
+#define BAND_TASK 64   /* asking buckets per task */
+#define BAND_SHARED 16 /* most candidates per open point of a bucket for one shared list */
 
 typedef struct {
     double *v;
     size_t n, cap;
-    size_t below, above;
+    size_t below, above, solo;
     int nomem;
 } band_out_t;
 
@@ -1371,10 +1641,24 @@ HD__INLINE void band_points(const band_ctx *c, cands_t *cd, band_out_t *o, size_
     }
     if (!open) return;
     U = U < V ? U : V;
-    candidates(t, &box, U < c->hi2 ? U : c->hi2, SIZE_MAX, cd);
-    for (size_t k = first; k < end; k++)
-        if (best[k - first] >= 0)
-            band_settle(c, o, band_finish(c, cd, q->x[k], q->y[k], q->z[k], best[k - first], near), times);
+    double lim = U < c->hi2 ? U : c->hi2;
+    if (candidates(t, &box, lim, open * BAND_SHARED, cd)) {
+        for (size_t k = first; k < end; k++)
+            if (best[k - first] >= 0)
+                band_settle(c, o, band_finish(c, cd, q->x[k], q->y[k], q->z[k], best[k - first], near), times);
+        return;
+    }
+    /* A bucket spread over more of t's buckets than BAND_SHARED per open
+     * point (a sparse set asking a dense one): each open point lists its
+     * own candidates, within its best and hi2 of the point itself. */
+    for (size_t k = first; k < end; k++) {
+        double bk = best[k - first];
+        if (bk < 0) continue;
+        hd__box_t pb = {{q->x[k], q->y[k], q->z[k]}, {q->x[k], q->y[k], q->z[k]}};
+        candidates(t, &pb, bk < c->hi2 ? bk : c->hi2, SIZE_MAX, cd);
+        o->solo += times;
+        band_settle(c, o, band_finish(c, cd, q->x[k], q->y[k], q->z[k], bk, near), times);
+    }
 }
 
 /* Asking bucket b, HD__AN_BUCKET points at a time (a bucket of equal keys
@@ -1407,6 +1691,7 @@ int hd__an_band(const hd__an_t *asking, const hd__an_t *searched, double lo2, do
     size_t kept = 0;
     for (int w = 0; c.out && w < threads; w++) {
         out->below += c.out[w].below, out->above += c.out[w].above, kept += c.out[w].n;
+        out->solo += c.out[w].solo;
         if (c.out[w].nomem) rc = HD_ENOMEM;
     }
     if (rc == HD_OK && !(out->v = hd__malloc_array(kept ? kept : 1, sizeof *out->v))) rc = HD_ENOMEM;

@@ -84,6 +84,8 @@ typedef struct hd__an_counts {
     size_t paired;   /* groups of queries settled by the partners */
     size_t windowed; /* groups settled by the window on the other curve */
     size_t apart;    /* queries of those searched on their own */
+    size_t solo;     /* queries of sparse groups, each searched on its own */
+    size_t pointed;  /* queries answered from a chunk's list of candidate points */
 } hd__an_counts_t;
 
 /* For every point of `asking`, the exact nearest distance to `searched`
@@ -124,6 +126,8 @@ typedef struct hd__an_band {
     size_t below, above;
     size_t n;
     double *v;
+    size_t solo; /* points whose candidates were listed around the point alone
+                  * (a sparse set asking a dense one; for tests) */
 } hd__an_band_t;
 int hd__an_band(const hd__an_t *asking, const hd__an_t *searched, double lo2, double hi2, int threads,
                 hd__an_band_t *out, hd_error_t *err);

@@ -327,7 +327,7 @@ static size_t partner_groups(const double *a, const double *b, size_t n, int thr
     hd_points_t A = hd_points_f64(a, n), B = hd_points_f64(b, n);
     hd__box_t box = union_box(a, b, n);
     hd__an_t sa, sb;
-    hd__an_counts_t counts = {0, 0, 0};
+    hd__an_counts_t counts = {0};
     CHECK_RC(hd__an_build(&sa, &A, NULL, &box, threads, NULL), HD_OK);
     CHECK_RC(hd__an_build(&sb, &B, NULL, &box, threads, NULL), HD_OK);
     CHECK_RC(hd__an_nearest(&sa, &sb, &B, threads, NULL, NULL, &counts, NULL), HD_OK);
@@ -408,7 +408,7 @@ TEST(shuffled_copies_are_exact_and_mostly_settled_by_the_window) {
         gen_copy(&g, how, a, b, n);
         for (size_t k = n; k > 1; k--) gen_swap(b, k - 1, gen_u64(&g) % k);
         if (tiny) gen_affine(a, n, 1e-9, 0.0), gen_affine(b, n, 1e-9, 0.0);
-        hd__an_counts_t c = {0, 0, 0};
+        hd__an_counts_t c = {0};
         check_window(a, b, n, threads, &c);
         check_window(b, a, n, threads, &c);
         check_packed(a, n, b, n, threads);
@@ -422,6 +422,66 @@ TEST(shuffled_copies_are_exact_and_mostly_settled_by_the_window) {
             apart);
     CHECK(windowed >= cases / 2);
     CHECK(apart >= 4);
+}
+
+TEST(a_sparse_set_asking_a_dense_one_is_searched_point_by_point_and_stays_exact) {
+    /* A few points asking many: each group of queries spreads over far
+     * more searched buckets than it has queries, so its queries are
+     * searched on their own (the solo path); the dense set asking the
+     * sparse one answers a chunk of queries at a time from the few
+     * points that can be any of their answers (point lists).  Ties and copies included: half-lattice coordinates, some
+     * queries repeated. */
+    size_t solo = 0, pointed = 0;
+    for (uint64_t seed = 32000; seed < 32006 && !hdt_failed(); seed++) {
+        gen_rng_t g;
+        gen_seed(&g, seed);
+        int threads = seed % 2 ? 1 : 3;
+        size_t na = 300 + gen_u64(&g) % 700, nb = 40000 + gen_u64(&g) % 20000;
+        CONTEXT("seed=%llu na=%zu nb=%zu threads=%d", (unsigned long long)seed, na, nb, threads);
+        double *a = malloc(24 * nb), *b = malloc(24 * nb);
+        double m0[3] = {0, 0, 0}, m1[3] = {seed % 3 ? 0.0 : 0.5, 0, 0};
+        gen_gauss(&g, a, na, m0, 1.0);
+        gen_gauss(&g, b, nb, m1, 1.0);
+        if (seed % 2 == 0)
+            for (size_t k = 0; k < 3 * nb; k++) b[k] = 0.125 * (double)(long)(b[k] * 8);
+        for (size_t k = 0; k + 1 < na; k += 5) memcpy(a + 3 * (k + 1), a + 3 * k, 24);
+        hd__an_counts_t c = {0};
+        double *both = malloc(24 * (na + nb));
+        memcpy(both, a, 24 * na), memcpy(both + 3 * na, b, 24 * nb);
+        hd__box_t box;
+        hd__box_of(both, na + nb, &box);
+        hd_points_t A = hd_points_f64(a, na), B = hd_points_f64(b, nb);
+        hd__an_t sa, sb;
+        double *d = malloc(8 * nb);
+        size_t *j = malloc(sizeof(size_t) * nb);
+        CHECK_RC(hd__an_build(&sa, &A, NULL, &box, threads, NULL), HD_OK);
+        CHECK_RC(hd__an_build(&sb, &B, NULL, &box, threads, NULL), HD_OK);
+        CHECK_RC(hd__an_nearest(&sa, &sb, NULL, threads, d, j, &c, NULL), HD_OK);
+        for (size_t i = 0; i < na && !hdt_failed(); i++) {
+            size_t jb;
+            double d2 = brute_nearest(a + 3 * i, b, nb, &jb);
+            CONTEXT("seed=%llu A->B query %zu", (unsigned long long)seed, i);
+            CHECK_BITS(d[i], sqrt(d2));
+            CHECK_EQ(j[i], jb);
+        }
+        solo += c.solo;
+        hd__an_counts_t cb = {0};
+        CHECK_RC(hd__an_nearest(&sb, &sa, NULL, threads, d, j, &cb, NULL), HD_OK);
+        pointed += cb.pointed;
+        for (size_t i = 0; i < nb && !hdt_failed(); i += 7) {
+            size_t ja;
+            double d2 = brute_nearest(b + 3 * i, a, na, &ja);
+            CONTEXT("seed=%llu B->A query %zu", (unsigned long long)seed, i);
+            CHECK_BITS(d[i], sqrt(d2));
+            CHECK_EQ(j[i], ja);
+        }
+        hd__an_free(&sa);
+        hd__an_free(&sb);
+        free(a), free(b), free(both), free(d), free(j);
+    }
+    CONTEXT("queries searched on their own: %zu, answered from point lists: %zu", solo, pointed);
+    CHECK(solo > 0);
+    CHECK(pointed > 0);
 }
 
 TEST(a_structure_over_selected_points_answers_with_their_names) {
@@ -496,7 +556,7 @@ TEST(partners_given_by_position_leave_every_answer_exact) {
         hd_points_t A = hd_points_f64(a, n), B = hd_points_f64(b, n);
         hd__box_t box = union_box(a, b, n);
         hd__an_t qa, qb;
-        hd__an_counts_t counts = {0, 0, 0};
+        hd__an_counts_t counts = {0};
         CHECK_RC(hd__an_build(&qa, &A, NULL, &box, threads, NULL), HD_OK);
         CHECK_RC(hd__an_build_sel(&qb, &B, sb, NULL, mb, &box, threads, NULL), HD_OK);
         for (size_t k = 0; k < n; k++) pos[k] = HD__AN_NO_PARTNER; /* B's number -> position in qb */
@@ -565,7 +625,7 @@ TEST(the_window_gives_up_on_disjoint_sets_and_stays_exact) {
             gen_plane(&g, b, n);
             gen_affine(b, n, 1.0, 50.0);
         }
-        hd__an_counts_t c = {0, 0, 0};
+        hd__an_counts_t c = {0};
         check_window(a, b, n, (int)seed % 3 + 1, &c);
         check_window(b, a, n, (int)seed % 3 + 1, &c);
         free(a), free(b);

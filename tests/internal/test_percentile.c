@@ -215,6 +215,65 @@ TEST(the_band_pass_counts_and_keeps_what_a_full_classification_does) {
     }
 }
 
+TEST(a_sparse_set_classified_against_a_dense_one_counts_and_keeps_what_a_full_classification_does) {
+    /* A few hundred points against tens of thousands: each bucket of the
+     * few spreads over many buckets of the many, and its points list
+     * their candidates on their own.  Lattice coordinates put ties on the
+     * band's edges. */
+    size_t solo = 0;
+    for (uint64_t seed = 230; seed < 234 && !hdt_failed(); seed++) {
+        gen_rng_t g;
+        gen_seed(&g, seed);
+        size_t na = 200 + gen_u64(&g) % 300, nb = 30000 + gen_u64(&g) % 10000;
+        double *a = malloc(24 * na), *b = malloc(24 * nb), m0[3] = {0, 0, 0};
+        gen_gauss(&g, a, na, m0, 1.0);
+        gen_gauss(&g, b, nb, m0, 1.0);
+        for (size_t k = 0; seed % 2 && k < 3 * nb; k++) b[k] = 0.0625 * floor(b[k] * 16);
+        for (size_t k = 0; seed % 2 && k < 3 * na; k++) a[k] = 0.0625 * floor(a[k] * 16) + 0.03125;
+        hd_points_t A = hd_points_f64(a, na), B = hd_points_f64(b, nb);
+        double *d2 = malloc(8 * na), *want = malloc(8 * na);
+        for (size_t i = 0; i < na; i++) d2[i] = brute_nearest(a + 3 * i, b, nb, NULL);
+        hd__box_t ba, bb;
+        CHECK_RC(hd__points_scan(&A, "A", 1, &ba, NULL), HD_OK);
+        CHECK_RC(hd__points_scan(&B, "B", 1, &bb, NULL), HD_OK);
+        hd__box_merge(&ba, &bb);
+        hd__an_t s[2];
+        CHECK_RC(hd__an_build_pair(&A, &B, &ba, 2, s, NULL), HD_OK);
+        for (int trial = 0; trial < 4; trial++) {
+            double lo2 = trial == 0 ? 0 : d2[gen_u64(&g) % na], hi2 = trial == 1 ? INFINITY : d2[gen_u64(&g) % na];
+            if (lo2 > hi2) {
+                double t = lo2;
+                lo2 = hi2, hi2 = t;
+            }
+            size_t below = 0, above = 0, in = 0;
+            for (size_t i = 0; i < na; i++) {
+                below += d2[i] < lo2;
+                above += d2[i] > hi2;
+                if (d2[i] >= lo2 && d2[i] <= hi2) want[in++] = d2[i];
+            }
+            qsort(want, in, 8, cmp_d);
+            for (int threads = 1; threads <= 3; threads += 2) {
+                CONTEXT("seed=%llu |A|=%zu |B|=%zu band [%.17g, %.17g] threads=%d", (unsigned long long)seed, na, nb,
+                        lo2, hi2, threads);
+                hd__an_band_t got;
+                CHECK_RC(hd__an_band(&s[0], &s[1], lo2, hi2, threads, &got, NULL), HD_OK);
+                CHECK_EQ(got.below, below);
+                CHECK_EQ(got.above, above);
+                CHECK_EQ(got.n, in);
+                qsort(got.v, got.n, 8, cmp_d);
+                for (size_t k = 0; k < in && k < got.n; k++) CHECK_BITS(got.v[k], want[k]);
+                solo += got.solo;
+                free(got.v);
+            }
+        }
+        hd__an_free(&s[0]);
+        hd__an_free(&s[1]);
+        free(a), free(b), free(d2), free(want);
+    }
+    CONTEXT("points that listed their own candidates: %zu", solo);
+    CHECK(solo > 0);
+}
+
 TEST(an_empty_side_is_refused_as_before) {
     double p[3] = {0, 0, 0};
     hd_points_t A = hd_points_f64(p, 1), E = hd_points_f64(p, 0);
