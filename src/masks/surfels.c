@@ -1,0 +1,202 @@
+/*
+ * surfels.c -- a binary image's surface as surfels, the elements DeepMind's
+ * surface-distance weighs by area (and MONAI's compute_surface_dice with
+ * use_subvoxels=True): one per cube of 2 x 2 x 2 voxels (2 x 2 pixels in
+ * 2-D) whose corners are neither all foreground nor all background, placed
+ * at the cube's centre, its area that of the marching-cubes surface inside
+ * the cube.
+ *
+ * The polygons of each of the 256 corner configurations are derived here,
+ * not tabulated: the surface crosses each cube edge whose two corners
+ * differ, at its midpoint; on each face the crossings pair into segments
+ * (two crossings: one segment; four, the face's two foreground corners
+ * diagonal: each foreground corner is cut off on its own, so foreground
+ * meets across an edge of the cube, never across a face diagonal); every
+ * crossing lies on two faces, so the segments close into loops, the
+ * polygons.  A configuration of more than four foreground corners takes
+ * the polygons of its complement (the same boundary seen from the other
+ * side), so that a configuration and its complement have one area.  Each
+ * loop is cut into a fan of triangles from its first crossing (crossings
+ * numbered by edge, loops walked from their smallest), and a surfel's area
+ * is the sum of its triangles' areas after the image's linear map (the
+ * spacing): for an axis-aligned map this is DeepMind's scaling of each
+ * triangle's area vector by the products of the other axes' spacings.
+ * Planar loops (every configuration of one, two or four face-adjacent
+ * corners, i.e. all that flat or axis-aligned boundaries produce) have an
+ * area independent of the fan; a non-planar loop's area depends on it.
+ * In 2-D the cubes are squares, the loops segments between edge midpoints
+ * (marching squares), a surfel's "area" their length.
+ */
+#include "masks.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Corner v of the unit cube is (v & 1, v >> 1 & 1, v >> 2 & 1).  Edge e
+ * runs from corner *c0 to *c1 along axis e / 4 (edge_corners). */
+static void edge_corners(int e, int *c0, int *c1) {
+    int axis = e / 4, q = e % 4; /* q: the other two bits, low first */
+    int lo = axis == 0 ? 1 : 0, hi = axis == 2 ? 1 : 2;
+    int v = ((q & 1) << lo) | ((q >> 1 & 1) << hi);
+    *c0 = v;
+    *c1 = v | 1 << axis;
+}
+
+static int edge_of(int v, int w) {
+    int axis = (v ^ w) == 1 ? 0 : (v ^ w) == 2 ? 1 : 2;
+    int base = v & w, lo = axis == 0 ? 1 : 0, hi = axis == 2 ? 1 : 2;
+    return axis * 4 + (base >> lo & 1) + 2 * (base >> hi & 1);
+}
+
+/* The crossing edges of `code`'s loops, each loop's edges in walking order,
+ * loops separated by -1 (at most 12 crossings and 4 loops). */
+static int loops_of(int code, int dims, int *out) {
+    int popc = 0;
+    for (int v = 0; v < 8; v++) popc += code >> v & 1;
+    if (popc > 4) code ^= 0xff;
+    int nbr[12][2], deg[12] = {0}, n2 = 0;
+    int faces = dims == 2 ? 1 : 6;
+    for (int f = 0; f < faces; f++) {
+        int axis = dims == 2 ? 2 : f / 2, side = dims == 2 ? 0 : f % 2;
+        int b = axis == 0 ? 1 : 0, c = axis == 2 ? 1 : 2, q[4];
+        int corner[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+        for (int t = 0; t < 4; t++) q[t] = side << axis | corner[t][0] << b | corner[t][1] << c;
+        int cross[4], nc = 0, e[4];
+        for (int t = 0; t < 4; t++) {
+            e[t] = edge_of(q[t], q[(t + 1) % 4]);
+            if ((code >> q[t] & 1) != (code >> q[(t + 1) % 4] & 1)) cross[nc++] = t;
+        }
+        int pair[2][2], np = 0;
+        if (nc == 2) pair[np][0] = e[cross[0]], pair[np++][1] = e[cross[1]];
+        else if (nc == 4) {
+            int first = code >> q[0] & 1 ? 3 : 0; /* cut off each foreground corner */
+            for (int s = 0; s < 2; s++) pair[np][0] = e[(first + 2 * s) % 4], pair[np++][1] = e[(first + 2 * s + 1) % 4];
+        }
+        for (int s = 0; s < np; s++) {
+            int x = pair[s][0], y = pair[s][1];
+            if (dims == 2) { /* one face: each segment is a loop */
+                out[n2++] = x, out[n2++] = y, out[n2++] = -1;
+                continue;
+            }
+            nbr[x][deg[x]++] = y;
+            nbr[y][deg[y]++] = x;
+        }
+    }
+    if (dims == 2) return n2;
+    int used[12] = {0}, n = 0;
+    for (int e0 = 0; e0 < 12; e0++) {
+        if (!deg[e0] || used[e0]) continue;
+        int prev = -1, cur = e0;
+        do {
+            used[cur] = 1;
+            out[n++] = cur;
+            int next = nbr[cur][0] != prev ? nbr[cur][0] : nbr[cur][1];
+            prev = cur;
+            cur = next;
+        } while (cur != e0 && !used[cur]);
+        out[n++] = -1;
+    }
+    return n;
+}
+
+static void midpoint(int e, double p[3]) {
+    int c0, c1;
+    edge_corners(e, &c0, &c1);
+    for (int a = 0; a < 3; a++) p[a] = ((c0 >> a & 1) + (c1 >> a & 1)) * 0.5;
+}
+
+static void mapped(const double lin[3][3], const double p[3], double q[3]) {
+    for (int c = 0; c < 3; c++) q[c] = (lin[c][0] * p[0] + lin[c][1] * p[1]) + lin[c][2] * p[2];
+}
+
+static double norm3(const double v[3]) { return sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]); }
+
+/* The area of one loop (or, in 2-D, the length of one segment). */
+static double loop_area(const int *loop, int len, int dims, const double lin[3][3]) {
+    double p[12][3];
+    for (int t = 0; t < len; t++) {
+        double u[3];
+        midpoint(loop[t], u);
+        mapped(lin, u, p[t]);
+    }
+    if (dims == 2) {
+        double d[3] = {p[1][0] - p[0][0], p[1][1] - p[0][1], p[1][2] - p[0][2]};
+        return len == 2 ? norm3(d) : 0.0;
+    }
+    double area = 0;
+    for (int t = 1; t + 1 < len; t++) {
+        double u[3], v[3], w[3];
+        for (int c = 0; c < 3; c++) u[c] = p[t][c] - p[0][c], v[c] = p[t + 1][c] - p[0][c];
+        w[0] = u[1] * v[2] - u[2] * v[1];
+        w[1] = u[2] * v[0] - u[0] * v[2];
+        w[2] = u[0] * v[1] - u[1] * v[0];
+        area += norm3(w) / 2;
+    }
+    return area;
+}
+
+void hd__surfel_areas(int dims, const double lin[3][3], double area[256]) {
+    int codes = dims == 2 ? 16 : 256;
+    memset(area, 0, 256 * sizeof *area);
+    for (int code = 1; code < codes - 1; code++) {
+        int ed[48], n = loops_of(code, dims, ed), start = 0;
+        double a = 0;
+        for (int t = 0; t < n; t++)
+            if (ed[t] < 0) {
+                a += loop_area(ed + start, t - start, dims, lin);
+                start = t + 1;
+            }
+        area[code] = a;
+    }
+}
+
+int hd__surfel_loops(int code, int dims, int *edges) { return loops_of(code, dims, edges); }
+
+/* ---- extraction over a window ---------------------------------------------------- */
+
+static uint8_t fg_at(const uint8_t *fg, const size_t w[3], ptrdiff_t i, ptrdiff_t j, ptrdiff_t k) {
+    if (i < 0 || j < 0 || k < 0 || (size_t)i >= w[0] || (size_t)j >= w[1] || (size_t)k >= w[2]) return 0;
+    return fg[((size_t)k * w[1] + (size_t)j) * w[0] + (size_t)i] != 0;
+}
+
+static int push_surfel(hd__surfels_t *s, double x, double y, double z, double area) {
+    if (s->count == s->cap) {
+        size_t cap = s->cap ? 2 * s->cap : 1024;
+        double *xyz = realloc(s->xyz, cap * 3 * sizeof *xyz), *ar;
+        if (!xyz) return -1;
+        s->xyz = xyz;
+        ar = realloc(s->area, cap * sizeof *ar);
+        if (!ar) return -1;
+        s->area = ar;
+        s->cap = cap;
+    }
+    s->xyz[3 * s->count] = x, s->xyz[3 * s->count + 1] = y, s->xyz[3 * s->count + 2] = z;
+    s->area[s->count++] = area;
+    return 0;
+}
+
+int hd__window_surfels(const uint8_t *fg, const size_t w[3], const size_t off[3], const double m[3][4], double scale,
+                       int dims, const double area[256], hd__surfels_t *out) {
+    int full = dims == 2 ? 15 : 255;
+    for (ptrdiff_t k = dims == 2 ? 0 : -1; k < (ptrdiff_t)w[2]; k++)
+        for (ptrdiff_t j = -1; j < (ptrdiff_t)w[1]; j++)
+            for (ptrdiff_t i = -1; i < (ptrdiff_t)w[0]; i++) {
+                int code = 0;
+                for (int v = 0; v < (dims == 2 ? 4 : 8); v++)
+                    code |= fg_at(fg, w, i + (v & 1), j + (v >> 1 & 1), k + (v >> 2 & 1)) << v;
+                if (code == 0 || code == full) continue;
+                double ci = (double)off[0] + (double)i + 0.5, cj = (double)off[1] + (double)j + 0.5;
+                double ck = (double)off[2] + (double)k + (dims == 2 ? 0.0 : 0.5);
+                if (push_surfel(out, hd__voxel_world(m, scale, 0, ci, cj, ck), hd__voxel_world(m, scale, 1, ci, cj, ck),
+                                hd__voxel_world(m, scale, 2, ci, cj, ck), area[code]) < 0)
+                    return -1;
+            }
+    return 0;
+}
+
+void hd__surfels_free(hd__surfels_t *s) {
+    free(s->xyz);
+    free(s->area);
+    memset(s, 0, sizeof *s);
+}
