@@ -645,6 +645,23 @@ typedef struct hd_mask_info {
 HD_EXTERN int hd_mask_points(const hd_mask_t *mask, const hd_mask_options_t *opt, struct hd_cloud **out,
                              hd_mask_info_t *info, hd_error_t *err);
 
+/* The surfels of a mask, DeepMind's surface-distance's surface (and
+ * MONAI's with use_subvoxels=True): one per cube of 2 x 2 x 2 voxels
+ * (dims 3) or 2 x 2 pixels of each slice k (dims 2; dims 0: 2 when
+ * n[2] = 1, else 3) whose corners are not all foreground nor all
+ * background, the outside of the image counting as background, in storage
+ * order of the cubes (the cube of voxels i..i+1, j..j+1, k..k+1 for i =
+ * -1 .. n[0]-1, i fastest).  Each is placed at its cube's centre, voxel
+ * index (i + 1/2, j + 1/2, k + 1/2) through the mask's map (k itself with
+ * dims 2), and weighted by the area of the marching-cubes surface inside
+ * its cube after the map's linear part (the length of the boundary in
+ * 2-D): docs/analysis.md, "Surfels".  *points (format "surfels") and
+ * *areas (count doubles, from malloc: free) are the caller's.
+ * Errors: as hd_mask_points (dims other than 0, 2, 3: HD_EINVAL).  On
+ * failure both are NULL.  Thread safe. */
+HD_EXTERN int hd_mask_surfels(const hd_mask_t *mask, int dims, struct hd_cloud **points, double **areas,
+                              hd_error_t *err);
+
 /* ------------------------------------------------------------------------
  * Label maps: an integer image (a multi-class segmentation) against
  * another, every label's figures in one call (docs/analysis.md, "Label

@@ -15,6 +15,7 @@
 #include <Python.h>
 
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "hausdorff.h"
@@ -239,8 +240,41 @@ done:
 }
 
 
+/* _mask_surfels(voxels, n0, n1, n2, s0, s1, s2, dims)
+ * -> (bytes of n * 3 float64 centres, bytes of n float64 areas) */
+static PyObject *py_mask_surfels(PyObject *self, PyObject *args) {
+    (void)self;
+    Py_buffer vox;
+    Py_ssize_t n[3];
+    double sp[3];
+    int dims;
+    if (!PyArg_ParseTuple(args, "y*nnndddi", &vox, &n[0], &n[1], &n[2], &sp[0], &sp[1], &sp[2], &dims)) return NULL;
+    if (n[0] < 1 || n[1] < 1 || n[2] < 1 || vox.len != n[0] * n[1] * n[2]) {
+        PyBuffer_Release(&vox);
+        PyErr_SetString(PyExc_ValueError, "the mask's buffer does not hold its shape");
+        return NULL;
+    }
+    hd_mask_t mk;
+    hd_mask_init(&mk, vox.buf, (size_t)n[0], (size_t)n[1], (size_t)n[2], sp);
+    hd_cloud_t *c = NULL;
+    double *areas = NULL;
+    hd_error_t err;
+    int rc;
+    Py_BEGIN_ALLOW_THREADS
+    rc = hd_mask_surfels(&mk, dims, &c, &areas, &err);
+    Py_END_ALLOW_THREADS
+    PyBuffer_Release(&vox);
+    if (rc != HD_OK) return raise_hd(rc, &err);
+    PyObject *res = Py_BuildValue("y#y#", (const char *)c->data, (Py_ssize_t)(c->count * 3 * sizeof(double)),
+                                  (const char *)areas, (Py_ssize_t)(c->count * sizeof(double)));
+    hd_cloud_free(c);
+    free(areas);
+    return res;
+}
+
 PyMethodDef hd_py_mask_methods[] = {
     {"_mask_points", py_mask_points, METH_VARARGS, "A mask's surface points (hausdorff.masks)."},
+    {"_mask_surfels", py_mask_surfels, METH_VARARGS, "A mask's surfels (hausdorff.masks.surfels)."},
     {"_label_map", py_label_map, METH_VARARGS, "Every label's figures (hausdorff.masks.label_map)."},
     {"_figures", py_figures, METH_VARARGS, "Figures of per-point distances (hausdorff.masks)."},
     {NULL, NULL, 0, NULL},

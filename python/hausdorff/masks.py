@@ -58,7 +58,7 @@ import numpy as np
 from . import _hausdorff
 
 __all__ = ["MaskMetrics", "surface", "distances", "hausdorff", "assd", "nsd", "dice", "fscore", "metrics",
-           "label_map", "components", "ROW_FIELDS", "COMPONENT_FIELDS"]
+           "label_map", "components", "surfels", "surface_distances", "ROW_FIELDS", "COMPONENT_FIELDS"]
 
 _EMPTY = ("error", "inf", "nan", "zero", "monai", "skimage")
 
@@ -227,11 +227,18 @@ def metrics(pred, gt, spacing=None, *, percentile: Union[float, Sequence[float],
 def hausdorff(pred, gt, spacing=None, *, percentile: Optional[float] = None, definition: str = "monai",
               connectivity: int = 1, dims="auto", empty: str = "error", threads: Optional[int] = None) -> float:
     """The Hausdorff distance between the masks' surfaces, or its
-    percentile: definition "monai" = max of the directed percentiles
-    (compute_hausdorff_distance), "medpy" = percentile of both directions
-    pooled (medpy's hd95)."""
-    if definition not in ("monai", "medpy"):
-        raise ValueError(f"definition is 'monai' or 'medpy', not {definition!r}")
+    percentile: definition "monai" = max of the directed percentiles of the
+    surface voxels (compute_hausdorff_distance), "medpy" = percentile of
+    both directions pooled (medpy's hd95), "deepmind" = DeepMind's
+    compute_robust_hausdorff: surfels weighted by area, the smallest
+    distance whose surfels hold the percentile's share of the area, the
+    larger of the two directions (without a percentile: 100)."""
+    if definition not in ("monai", "medpy", "deepmind"):
+        raise ValueError(f"definition is 'monai', 'medpy' or 'deepmind', not {definition!r}")
+    if definition == "deepmind":
+        if empty == "error":
+            _refuse_empty(pred, gt)
+        return _binary_row(pred, gt, spacing, percentile, 1.0, connectivity, dims, empty, threads)["hd_surfel"]
     m = metrics(pred, gt, spacing, percentile=percentile, connectivity=connectivity, dims=dims, empty=empty,
                 threads=threads)
     if percentile is None:
@@ -239,27 +246,60 @@ def hausdorff(pred, gt, spacing=None, *, percentile: Optional[float] = None, def
     return m.percentile[0] if definition == "monai" else m.percentile_pooled[0]
 
 
+def _refuse_empty(pred, gt) -> None:
+    e = [not np.any(_voxels(m, name)) for m, name in ((pred, "pred"), (gt, "gt"))]
+    if any(e):
+        which = "pred and gt are" if all(e) else "pred is" if e[0] else "gt is"
+        raise ValueError(f"{which} empty: there is no surface distance (empty='monai', 'inf', 'nan' "
+                         "or 'zero' reports one)")
+
+
 def assd(pred, gt, spacing=None, *, definition: str = "pooled", connectivity: int = 1, dims="auto",
          empty: str = "error", threads: Optional[int] = None) -> float:
     """Average symmetric surface distance: "pooled" (MONAI >= 1.0
-    symmetric=True, medpy 0.5's assd) or "average" (MONAI 0.x)."""
-    if definition not in ("pooled", "average"):
-        raise ValueError(f"definition is 'pooled' or 'average', not {definition!r}")
+    symmetric=True, medpy 0.5's assd), "average" (MONAI 0.x: the mean of
+    the two directed means) or "deepmind" (the mean of the two
+    area-weighted directed means of DeepMind's
+    compute_average_surface_distance, which returns them as a pair)."""
+    if definition not in ("pooled", "average", "deepmind"):
+        raise ValueError(f"definition is 'pooled', 'average' or 'deepmind', not {definition!r}")
+    if definition == "deepmind":
+        if empty == "error":
+            _refuse_empty(pred, gt)
+        r = _binary_row(pred, gt, spacing, None, 1.0, connectivity, dims, empty, threads)
+        if r["empty"]:
+            return r["asd_surfel_pred_gt"]
+        return (r["asd_surfel_pred_gt"] + r["asd_surfel_gt_pred"]) / 2
     m = metrics(pred, gt, spacing, percentile=None, connectivity=connectivity, dims=dims, empty=empty,
                 threads=threads)
     return m.assd if definition == "pooled" else m.assd_average
 
 
+_NSD = ("monai", "deepmind", "monai_subvoxels")
+
+
 def nsd(pred, gt, tau, spacing=None, *, definition: str = "monai", connectivity: int = 1, dims="auto",
         empty: str = "monai", threads: Optional[int] = None):
     """Normalized surface Dice at tolerance tau (a number, or a list for
-    several): definition "monai" counts surface voxels, as MONAI's
-    compute_surface_dice(use_subvoxels=False): (pred's surface voxels
-    within tau of gt's surface + gt's within tau of pred's) / (all of
-    both).  d <= tau.  An empty mask gives 0, two give NaN (MONAI's)."""
+    several), d <= tau.  Two definitions:
+
+    - "monai": surface voxels counted, as MONAI's
+      compute_surface_dice(use_subvoxels=False): (pred's surface voxels
+      within tau of gt's surface + gt's within tau of pred's) / (all of
+      both);
+    - "deepmind" (the same as "monai_subvoxels"): surfels weighted by their
+      marching-cubes area, as DeepMind's compute_surface_dice_at_tolerance
+      and MONAI's compute_surface_dice(use_subvoxels=True): (area of the
+      surfels within tau of the other side's surfels) / (all the area).
+
+    An empty mask gives 0, two give NaN (MONAI's and DeepMind's)."""
+    if definition not in _NSD:
+        raise ValueError(f"definition is one of {', '.join(_NSD)}, not {definition!r}")
     if definition != "monai":
-        raise ValueError(f"definition is 'monai', not {definition!r} (DeepMind's surfel areas are not "
-                         "computed by this module)")
+        taus = [float(t) for t in np.atleast_1d(tau)]
+        out = [_binary_row(pred, gt, spacing, None, t, connectivity, dims, empty, threads)["nsd_surfel"]
+               for t in taus]
+        return out if np.ndim(tau) else out[0]
     m = metrics(pred, gt, spacing, percentile=None, tau=tau, connectivity=connectivity, dims=dims,
                 empty=empty, threads=threads)
     return m.nsd if np.ndim(tau) else m.nsd[0]
@@ -393,3 +433,51 @@ def _binary_row(pred, gt, spacing, percentile, tau, connectivity, dims, empty, t
         raise ValueError(f"pred and gt have different shapes: {vp.shape} and {vg.shape}")
     return label_map(vp, vg, spacing, labels=[1], percentile=100 if percentile is None else percentile, tau=tau,
                      connectivity=connectivity, dims=dims, empty=empty, threads=threads)[0]
+
+
+# ---- surfels (hd_mask_surfels): DeepMind's surface-distance ----------------------------
+
+def _surfel_dims(dims, ndim: int) -> int:
+    if dims in ("auto", 0, None):
+        return 2 if ndim <= 2 else 3
+    if dims in (2, 3):
+        return int(dims)
+    raise ValueError(f"dims is 'auto', 2 or 3, not {dims!r}")
+
+
+def surfels(mask, spacing=None, *, dims="auto") -> Tuple[np.ndarray, np.ndarray]:
+    """(centres (n, 3), areas (n,)) of the mask's surfels: the cubes of
+    2 x 2 x 2 voxels (2 x 2 pixels for a 2-D mask) that the boundary
+    crosses, each weighted by the area (length in 2-D) of its
+    marching-cubes surface, as DeepMind's surface-distance and MONAI's
+    use_subvoxels=True weigh them.  Cube (i, j, k) holds voxels i..i+1,
+    j..j+1, k..k+1 (i from -1), its centre (i + 0.5) * spacing[0], ...;
+    storage order, axis 0 fastest."""
+    v = _voxels(mask, "mask")
+    n = list(v.shape) + [1] * (3 - v.ndim)
+    s = _spacing(spacing, v.ndim)
+    raw, ar = _hausdorff._mask_surfels(v.T, n[0], n[1], n[2], s[0], s[1], s[2], _surfel_dims(dims, v.ndim))
+    return np.frombuffer(raw, dtype=np.float64).reshape(-1, 3).copy(), np.frombuffer(ar, dtype=np.float64).copy()
+
+
+def surface_distances(pred, gt, spacing=None, *, dims="auto", threads: Optional[int] = None) -> dict:
+    """DeepMind's compute_surface_distances(mask_gt, mask_pred, spacing)
+    dict: distances_gt_to_pred, distances_pred_to_gt (each sorted
+    ascending) and surfel_areas_gt, surfel_areas_pred (in the same order:
+    ties keep the storage order).  A side with no surfel gives empty arrays
+    and the other side's distances are inf.  Distances are exact
+    nearest-surfel distances (DeepMind's distance transform gives the
+    same); note the argument order: pred first, as everywhere in this
+    module."""
+    vp, vg = _voxels(pred, "pred"), _voxels(gt, "gt")
+    if vp.shape != vg.shape:
+        raise ValueError(f"pred and gt have different shapes: {vp.shape} and {vg.shape}")
+    (pa, wa), (pb, wb) = surfels(pred, spacing, dims=dims), surfels(gt, spacing, dims=dims)
+    if len(pa) and len(pb):
+        d_pg, _ = _hausdorff.distances(pa, pb, threads=threads)
+        d_gp, _ = _hausdorff.distances(pb, pa, threads=threads)
+    else:
+        d_pg, d_gp = np.full(len(pa), np.inf), np.full(len(pb), np.inf)
+    o_p, o_g = np.argsort(d_pg, kind="stable"), np.argsort(d_gp, kind="stable")
+    return {"distances_gt_to_pred": np.asarray(d_gp)[o_g], "distances_pred_to_gt": np.asarray(d_pg)[o_p],
+            "surfel_areas_gt": wb[o_g], "surfel_areas_pred": wa[o_p]}

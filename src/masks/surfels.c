@@ -124,10 +124,14 @@ static double loop_area(const int *loop, int len, int dims, const double lin[3][
         double d[3] = {p[1][0] - p[0][0], p[1][1] - p[0][1], p[1][2] - p[0][2]};
         return len == 2 ? norm3(d) : 0.0;
     }
-    double area = 0;
-    for (int t = 1; t + 1 < len; t++) {
+    double c[3] = {0, 0, 0}, area = 0;
+    for (int t = 0; t < len; t++)
+        for (int q = 0; q < 3; q++) c[q] += p[t][q];
+    for (int q = 0; q < 3; q++) c[q] /= len;
+    for (int t = 0; t < len; t++) {
+        const double *p0 = p[t], *p1 = p[(t + 1) % len];
         double u[3], v[3], w[3];
-        for (int c = 0; c < 3; c++) u[c] = p[t][c] - p[0][c], v[c] = p[t + 1][c] - p[0][c];
+        for (int q = 0; q < 3; q++) u[q] = p0[q] - c[q], v[q] = p1[q] - c[q];
         w[0] = u[1] * v[2] - u[2] * v[1];
         w[1] = u[2] * v[0] - u[0] * v[2];
         w[2] = u[0] * v[1] - u[1] * v[0];
