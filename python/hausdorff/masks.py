@@ -428,7 +428,7 @@ def components(pred, gt, spacing=None, *, connectivity: int = 26, labels=None, p
 
 def _binary_row(pred, gt, spacing, percentile, tau, connectivity, dims, empty, threads) -> dict:
     """The label-map row of two masks (foreground = label 1)."""
-    vp, vg = (_voxels(m, name).T for m, name in ((pred, "pred"), (gt, "gt")))  # back to the arrays' order
+    vp, vg = (_voxels(m, name) for m, name in ((pred, "pred"), (gt, "gt")))
     if vp.shape != vg.shape:
         raise ValueError(f"pred and gt have different shapes: {vp.shape} and {vg.shape}")
     return label_map(vp, vg, spacing, labels=[1], percentile=100 if percentile is None else percentile, tau=tau,
