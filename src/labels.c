@@ -176,12 +176,39 @@ static void load_row(const hd_label_image_t *img, size_t v, size_t len, int64_t 
     }
 }
 
-static void widen_box(label_stat_t *st, size_t i, size_t j, size_t k) {
-    const size_t at[3] = {i, j, k};
+/* Voxels [i0, i1) of row (j, k) hold `st`'s label on one side. */
+static void add_run(label_stat_t *st, size_t i0, size_t i1, size_t j, size_t k) {
+    const size_t lo[3] = {i0, j, k}, hi[3] = {i1 - 1, j, k};
+    int first = st->count[0] + st->count[1] == 0;
     for (int a = 0; a < 3; a++) {
-        if (at[a] < st->lo[a]) st->lo[a] = at[a];
-        if (at[a] > st->hi[a] || st->count[0] + st->count[1] == 0) st->hi[a] = at[a];
+        if (lo[a] < st->lo[a]) st->lo[a] = lo[a];
+        if (first || hi[a] > st->hi[a]) st->hi[a] = hi[a];
     }
+}
+
+/* One row of both images, a run of equal labels at a time (background
+ * comes in long runs, so the table is consulted once per run). */
+static int scan_row(label_set_t *set, const int64_t *ra, const int64_t *rb, size_t n0, size_t j, size_t k) {
+    label_stat_t *last = NULL;
+    for (int side = 0; side < 2; side++) {
+        const int64_t *row = side ? rb : ra;
+        for (size_t i = 0; i < n0;) {
+            int64_t l = row[i];
+            size_t s = i;
+            while (i < n0 && row[i] == l) i++;
+            label_stat_t *st = last && last->label == l ? last : find_label(set, l, 1);
+            if (!st) return -1;
+            add_run(st, s, i, j, k);
+            st->count[side] += i - s;
+            if (side == 0) {
+                size_t same = 0;
+                for (size_t q = s; q < i; q++) same += rb[q] == l;
+                st->overlap += same;
+            }
+            last = st;
+        }
+    }
+    return 0;
 }
 
 static int scan(const hd_label_image_t *a, const hd_label_image_t *b, label_set_t *set, hd_error_t *err) {
@@ -193,20 +220,10 @@ static int scan(const hd_label_image_t *a, const hd_label_image_t *b, label_set_
             size_t v = (k * n[1] + j) * n[0];
             load_row(a, v, n[0], row);
             load_row(b, v, n[0], row + n[0]);
-            label_stat_t *last = NULL;
-            for (int side = 0; side < 2; side++)
-                for (size_t i = 0; i < n[0]; i++) {
-                    int64_t l = row[side * n[0] + i];
-                    label_stat_t *st = last && last->label == l ? last : find_label(set, l, 1);
-                    if (!st) {
-                        free(row);
-                        return hd__err(err, HD_ENOMEM, "out of memory for the labels");
-                    }
-                    widen_box(st, i, j, k);
-                    st->count[side]++;
-                    if (side == 0 && row[n[0] + i] == l) st->overlap++;
-                    last = st;
-                }
+            if (scan_row(set, row, row + n[0], n[0], j, k) < 0) {
+                free(row);
+                return hd__err(err, HD_ENOMEM, "out of memory for the labels");
+            }
         }
     free(row);
     return HD_OK;

@@ -242,8 +242,8 @@ def test_components_match_scipy_label(seed, conn):
     want = []
     for side, (m, o) in enumerate(((pred == 2, gt == 2), (gt == 2, pred == 2))):
         lab, n = ndimage.label(m, structure)
-        # number components by their first voxel with axis 0 fastest, as the library does
-        flat = lab.ravel(order="F")
+        # components are numbered by their first voxel in memory order (C here)
+        flat = lab.ravel(order="C")
         firsts = list(dict.fromkeys(flat[flat != 0]))
         so, su = monai_surface(o), monai_surface(m)
         oc = coords(np.argwhere(so), spacing)

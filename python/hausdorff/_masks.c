@@ -182,21 +182,33 @@ static PyObject *table_lists(const hd_label_table_t *t) {
     return NULL;
 }
 
+/* An image of ndim axes, its spacing s given by the array's axes: stored
+ * axis 0 fastest (corder 0: library axis c is array axis c), or the last
+ * axis fastest (corder 1: library axis ndim-1-c is array axis c).  Either
+ * way array axis c goes to world axis c at s[c] per voxel, and, the map
+ * having one nonzero per row, each coordinate is s[c] times the index,
+ * exactly, as hd_mask_init's diagonal gives it. */
+static void place(hd_label_image_t *im, const double s[3], int ndim, int corder) {
+    memset(im->m, 0, sizeof im->m);
+    for (int c = 0; c < 3; c++) im->m[c][corder && c < ndim ? ndim - 1 - c : c] = s[c];
+}
+
 /* _label_map(a, b, type, n0, n1, n2, (sa0, sa1, sa2), (sb0, sb1, sb2),
  *            labels bytes of int64 or None, percentile, tau, strict,
- *            connectivity, dims, empty name, components, threads)
- * -> ([row tuples], [component tuples]) */
+ *            connectivity, dims, empty name, components, threads, ndim,
+ *            corder)
+ * -> ([row tuples], [component tuples]); n0 is the fastest axis. */
 static PyObject *py_label_map(PyObject *self, PyObject *args) {
     (void)self;
     Py_buffer va, vb;
     PyObject *lab;
     Py_ssize_t n[3];
     double sa[3], sb[3], pct, tau;
-    int type, strict, conn, dims, comps, threads;
+    int type, strict, conn, dims, comps, threads, ndim, corder;
     const char *empty;
-    if (!PyArg_ParseTuple(args, "y*y*innn(ddd)(ddd)Oddpiisii", &va, &vb, &type, &n[0], &n[1], &n[2], &sa[0], &sa[1],
+    if (!PyArg_ParseTuple(args, "y*y*innn(ddd)(ddd)Oddpiisiiip", &va, &vb, &type, &n[0], &n[1], &n[2], &sa[0], &sa[1],
                           &sa[2], &sb[0], &sb[1], &sb[2], &lab, &pct, &tau, &strict, &conn, &dims, &empty, &comps,
-                          &threads))
+                          &threads, &ndim, &corder))
         return NULL;
     PyObject *res = NULL;
     Py_buffer lb;
@@ -224,6 +236,8 @@ static PyObject *py_label_map(PyObject *self, PyObject *args) {
     hd_label_image_t ia, ib;
     hd_label_image_init(&ia, va.buf, (hd_label_type_t)type, (size_t)n[0], (size_t)n[1], (size_t)n[2], sa);
     hd_label_image_init(&ib, vb.buf, (hd_label_type_t)type, (size_t)n[0], (size_t)n[1], (size_t)n[2], sb);
+    place(&ia, sa, ndim, corder);
+    place(&ib, sb, ndim, corder);
     hd_label_table_t *t = NULL;
     int rc;
     Py_BEGIN_ALLOW_THREADS

@@ -360,9 +360,23 @@ def _table(pred, gt, spacing, spacing_gt, labels, percentile, tau, strict, conne
     t = np.promote_types(a.dtype, b.dtype)
     if t not in _LABEL_TYPES:
         t = np.dtype(np.int64)
-    # axis 0 fastest, as the library reads them: the transposed C order
-    a, b = (np.ascontiguousarray(v.astype(t, copy=False).T) for v in (a, b))
-    n = list(a.shape[::-1]) + [1] * (3 - a.ndim)
+    # The library reads the arrays where they are: Fortran order (nibabel's)
+    # as axis 0 fastest, C order as the last axis fastest with the axes'
+    # spacings placed accordingly (the coordinates are the same doubles);
+    # anything else is copied to C order.
+    # (dims=2 and the 2-D surfels of a 3-D array whose axis 2 has one voxel
+    # name the array's axis 2: those go through Fortran order.)
+    a, b = a.astype(t, copy=False), b.astype(t, copy=False)
+    ndim = a.ndim
+    corder = not (a.flags.f_contiguous and b.flags.f_contiguous)
+    if corder and ndim == 3 and (_dims(dims) == 2 or a.shape[0] == 1 or a.shape[2] == 1):
+        a, b, corder = np.asfortranarray(a), np.asfortranarray(b), False
+    if corder:
+        a, b = np.ascontiguousarray(a), np.ascontiguousarray(b)
+        n = list(a.shape[::-1]) + [1] * (3 - ndim)
+    else:
+        a, b = a.T, b.T  # C-contiguous views of the same memory
+        n = list(a.shape[::-1]) + [1] * (3 - ndim)
     sa = _spacing(spacing, a.ndim)
     sb = sa if spacing_gt is None else _spacing(spacing_gt, a.ndim)
     lab = None if labels is None else np.ascontiguousarray(np.atleast_1d(np.asarray(labels, dtype=np.int64)))
@@ -372,7 +386,7 @@ def _table(pred, gt, spacing, spacing_gt, labels, percentile, tau, strict, conne
         raise ValueError(f"connectivity is 1, 2 or 3, not {connectivity!r}")
     return _hausdorff._label_map(a, b, _LABEL_TYPES[t], n[0], n[1], n[2], sa, sb, lab, float(percentile),
                                  float(tau), bool(strict), connectivity, _dims(dims), empty, int(comps or 0),
-                                 0 if threads is None else int(threads))
+                                 0 if threads is None else int(threads), ndim, corder)
 
 
 def label_map(pred, gt, spacing=None, *, labels=None, percentile: float = 95, tau: float = 1.0,
@@ -413,8 +427,9 @@ def components(pred, gt, spacing=None, *, connectivity: int = 26, labels=None, p
     (inf when the other side has no such label), overlap its voxels that
     the other side also labels so, detected whether it overlaps or comes
     within tau.  Order: per label, pred's components, then gt's, each
-    numbered 1.. by its first voxel in storage order (axis 0 fastest).
-    A bool array is one label (1)."""
+    numbered 1.. by its first voxel in the arrays' memory order (axis 0
+    fastest for Fortran-ordered arrays such as nibabel's, the last axis
+    fastest otherwise).  A bool array is one label (1)."""
     _, comps = _table(pred, gt, spacing, spacing_gt, labels, percentile, tau, strict, surface_connectivity, dims,
                       empty, connectivity, threads)
     out = []

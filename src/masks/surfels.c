@@ -113,7 +113,24 @@ static void mapped(const double lin[3][3], const double p[3], double q[3]) {
 static double norm3(const double v[3]) { return sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]); }
 
 /* The area of one loop (or, in 2-D, the length of one segment). */
-static double loop_area(const int *loop, int len, int dims, const double lin[3][3]) {
+static int by_value(const void *x, const void *y) {
+    double a = *(const double *)x, b = *(const double *)y;
+    return (a > b) - (a < b);
+}
+
+/* The sum of n values in ascending order: the same double whatever order
+ * they came in (a loop's crossings are walked in an order that depends on
+ * the numbering of the cube's edges, which the axes' order changes). */
+static double sorted_sum(double *v, int n) {
+    qsort(v, (size_t)n, sizeof *v, by_value);
+    double s = 0;
+    for (int t = 0; t < n; t++) s += v[t];
+    return s;
+}
+
+/* Appends to part[] the areas of one loop's triangles (or, in 2-D, the
+ * length of one segment); returns how many. */
+static int loop_parts(const int *loop, int len, int dims, const double lin[3][3], double *part) {
     double p[12][3];
     for (int t = 0; t < len; t++) {
         double u[3];
@@ -122,12 +139,14 @@ static double loop_area(const int *loop, int len, int dims, const double lin[3][
     }
     if (dims == 2) {
         double d[3] = {p[1][0] - p[0][0], p[1][1] - p[0][1], p[1][2] - p[0][2]};
-        return len == 2 ? norm3(d) : 0.0;
+        part[0] = len == 2 ? norm3(d) : 0.0;
+        return 1;
     }
-    double c[3] = {0, 0, 0}, area = 0;
-    for (int t = 0; t < len; t++)
-        for (int q = 0; q < 3; q++) c[q] += p[t][q];
-    for (int q = 0; q < 3; q++) c[q] /= len;
+    double c[3], coord[12];
+    for (int q = 0; q < 3; q++) {
+        for (int t = 0; t < len; t++) coord[t] = p[t][q];
+        c[q] = sorted_sum(coord, len) / len;
+    }
     for (int t = 0; t < len; t++) {
         const double *p0 = p[t], *p1 = p[(t + 1) % len];
         double u[3], v[3], w[3];
@@ -135,34 +154,29 @@ static double loop_area(const int *loop, int len, int dims, const double lin[3][
         w[0] = u[1] * v[2] - u[2] * v[1];
         w[1] = u[2] * v[0] - u[0] * v[2];
         w[2] = u[0] * v[1] - u[1] * v[0];
-        area += norm3(w) / 2;
+        part[t] = norm3(w) / 2;
     }
-    return area;
+    return len;
 }
 
 void hd__surfel_areas(int dims, const double lin[3][3], double area[256]) {
     int codes = dims == 2 ? 16 : 256;
     memset(area, 0, 256 * sizeof *area);
     for (int code = 1; code < codes - 1; code++) {
-        int ed[48], n = loops_of(code, dims, ed), start = 0;
-        double a = 0;
+        int ed[48], n = loops_of(code, dims, ed), start = 0, np = 0;
+        double part[48];
         for (int t = 0; t < n; t++)
             if (ed[t] < 0) {
-                a += loop_area(ed + start, t - start, dims, lin);
+                np += loop_parts(ed + start, t - start, dims, lin, part + np);
                 start = t + 1;
             }
-        area[code] = a;
+        area[code] = sorted_sum(part, np);
     }
 }
 
 int hd__surfel_loops(int code, int dims, int *edges) { return loops_of(code, dims, edges); }
 
 /* ---- extraction over a window ---------------------------------------------------- */
-
-static uint8_t fg_at(const uint8_t *fg, const size_t w[3], ptrdiff_t i, ptrdiff_t j, ptrdiff_t k) {
-    if (i < 0 || j < 0 || k < 0 || (size_t)i >= w[0] || (size_t)j >= w[1] || (size_t)k >= w[2]) return 0;
-    return fg[((size_t)k * w[1] + (size_t)j) * w[0] + (size_t)i] != 0;
-}
 
 static int push_surfel(hd__surfels_t *s, double x, double y, double z, double area) {
     if (s->count == s->cap) {
@@ -180,23 +194,64 @@ static int push_surfel(hd__surfels_t *s, double x, double y, double z, double ar
     return 0;
 }
 
+/* The window with one voxel of background around it (0 or 1 each), so that
+ * every cube meeting the window reads its corners without a test. */
+static uint8_t *padded(const uint8_t *fg, const size_t w[3], int dims, size_t p[3]) {
+    for (int a = 0; a < 3; a++) p[a] = w[a] + (a < 2 || dims == 3 ? 2 : 0);
+    size_t kp = dims == 3 ? 1 : 0;
+    uint8_t *out = calloc(p[0] * p[1] * p[2], 1);
+    if (!out) return NULL;
+    for (size_t k = 0; k < w[2]; k++)
+        for (size_t j = 0; j < w[1]; j++) {
+            const uint8_t *src = fg + (k * w[1] + j) * w[0];
+            uint8_t *dst = out + ((k + kp) * p[1] + j + 1) * p[0] + 1;
+            for (size_t i = 0; i < w[0]; i++) dst[i] = src[i] != 0;
+        }
+    return out;
+}
+
 int hd__window_surfels(const uint8_t *fg, const size_t w[3], const size_t off[3], const double m[3][4], double scale,
                        int dims, const double area[256], hd__surfels_t *out) {
-    int full = dims == 2 ? 15 : 255;
-    for (ptrdiff_t k = dims == 2 ? 0 : -1; k < (ptrdiff_t)w[2]; k++)
-        for (ptrdiff_t j = -1; j < (ptrdiff_t)w[1]; j++)
-            for (ptrdiff_t i = -1; i < (ptrdiff_t)w[0]; i++) {
-                int code = 0;
-                for (int v = 0; v < (dims == 2 ? 4 : 8); v++)
-                    code |= fg_at(fg, w, i + (v & 1), j + (v >> 1 & 1), k + (v >> 2 & 1)) << v;
-                if (code == 0 || code == full) continue;
-                double ci = (double)off[0] + (double)i + 0.5, cj = (double)off[1] + (double)j + 0.5;
-                double ck = (double)off[2] + (double)k + (dims == 2 ? 0.0 : 0.5);
-                if (push_surfel(out, hd__voxel_world(m, scale, 0, ci, cj, ck), hd__voxel_world(m, scale, 1, ci, cj, ck),
-                                hd__voxel_world(m, scale, 2, ci, cj, ck), area[code]) < 0)
-                    return -1;
+    size_t p[3];
+    uint8_t *pad = padded(fg, w, dims, p);
+    if (!pad) return -1;
+    int full = dims == 2 ? 15 : 255, rc = 0;
+    size_t cubes_k = dims == 2 ? p[2] : p[2] - 1, dk = dims == 2 ? 0 : p[0] * p[1];
+    /* cube (i, j, k) of the padded window covers its voxels i..i+1, j..j+1
+     * (k..k+1): the window's cube (i - 1, j - 1, k - 1) (k itself in 2-D).
+     * col[i] holds the corners of column i at their bit (v & 1 = 0), and
+     * the cube's code is col[i] | col[i + 1] << 1. */
+    uint8_t *col = malloc(p[0]);
+    if (!col) {
+        free(pad);
+        return -1;
+    }
+    for (size_t k = 0; k < cubes_k && !rc; k++)
+        for (size_t j = 0; j + 1 < p[1] && !rc; j++) {
+            const uint8_t *r00 = pad + (k * p[1] + j) * p[0], *r10 = r00 + p[0];
+            int any = 0;
+            for (size_t i = 0; i < p[0]; i++) {
+                int c = r00[i] | r10[i] << 2;
+                if (dims == 3) c |= r00[i + dk] << 4 | r10[i + dk] << 6;
+                col[i] = (uint8_t)c;
+                any |= c;
             }
-    return 0;
+            if (!any) continue;
+            for (size_t i = 0; i + 1 < p[0]; i++) {
+                int code = col[i] | col[i + 1] << 1;
+                if (code == 0 || code == full) continue;
+                double ci = (double)off[0] + (double)i - 0.5, cj = (double)off[1] + (double)j - 0.5;
+                double ck = dims == 2 ? (double)(off[2] + k) : (double)off[2] + (double)k - 0.5;
+                if (push_surfel(out, hd__voxel_world(m, scale, 0, ci, cj, ck), hd__voxel_world(m, scale, 1, ci, cj, ck),
+                                hd__voxel_world(m, scale, 2, ci, cj, ck), area[code]) < 0) {
+                    rc = -1;
+                    break;
+                }
+            }
+        }
+    free(col);
+    free(pad);
+    return rc;
 }
 
 void hd__surfels_free(hd__surfels_t *s) {
