@@ -16,14 +16,21 @@
  * polygons.  A configuration of more than four foreground corners takes
  * the polygons of its complement (the same boundary seen from the other
  * side), so that a configuration and its complement have one area.  Each
- * loop is cut into a fan of triangles from its first crossing (crossings
- * numbered by edge, loops walked from their smallest), and a surfel's area
- * is the sum of its triangles' areas after the image's linear map (the
- * spacing): for an axis-aligned map this is DeepMind's scaling of each
- * triangle's area vector by the products of the other axes' spacings.
- * Planar loops (every configuration of one, two or four face-adjacent
- * corners, i.e. all that flat or axis-aligned boundaries produce) have an
- * area independent of the fan; a non-planar loop's area depends on it.
+ * loop is cut into a fan of triangles from one of its crossings, and a
+ * surfel's area is the sum of its triangles' areas after the image's
+ * linear map (the spacing): for an axis-aligned map this is DeepMind's
+ * scaling of each triangle's area vector by the products of the other
+ * axes' spacings.  A planar loop (every loop of one, two or four
+ * face-adjacent corners, i.e. all that flat or axis-aligned boundaries
+ * produce) is convex, and every fan gives its area.  A non-planar loop
+ * (three corners of a face; four corners in a chain) has no one area; the
+ * fan taken is the one of largest area, which depends on no numbering of
+ * the cube (a fan is a set of triangles whatever the walk's start or
+ * direction, and each sum is taken in sorted order), so a rotation or
+ * reflection of the image (with isotropic spacing) leaves every surfel's
+ * area unchanged; on those loops it is the triangulation of the classic
+ * marching-cubes table, as the areas of DeepMind's table show
+ * (docs/analysis.md, "Surfels").
  * In 2-D the cubes are squares, the loops segments between edge midpoints
  * (marching squares), a surfel's "area" their length.
  */
@@ -142,21 +149,29 @@ static int loop_parts(const int *loop, int len, int dims, const double lin[3][3]
         part[0] = len == 2 ? norm3(d) : 0.0;
         return 1;
     }
-    double c[3], coord[12];
-    for (int q = 0; q < 3; q++) {
-        for (int t = 0; t < len; t++) coord[t] = p[t][q];
-        c[q] = sorted_sum(coord, len) / len;
+    /* the fan from crossing f: triangles (f, t, t + 1) around the loop; as
+     * a set it does not depend on where the walk started or its direction */
+    double best = -1, fan[12];
+    int nfan = len - 2;
+    for (int f = 0; f < len; f++) {
+        double tri[12];
+        for (int t = 1; t + 1 < len; t++) {
+            const double *p0 = p[f], *p1 = p[(f + t) % len], *p2 = p[(f + t + 1) % len];
+            double u[3], v[3], w[3];
+            for (int q = 0; q < 3; q++) u[q] = p1[q] - p0[q], v[q] = p2[q] - p0[q];
+            w[0] = u[1] * v[2] - u[2] * v[1];
+            w[1] = u[2] * v[0] - u[0] * v[2];
+            w[2] = u[0] * v[1] - u[1] * v[0];
+            tri[t - 1] = norm3(w) / 2;
+        }
+        double sum = sorted_sum(tri, nfan);
+        if (sum > best) {
+            best = sum;
+            memcpy(fan, tri, (size_t)nfan * sizeof *fan);
+        }
     }
-    for (int t = 0; t < len; t++) {
-        const double *p0 = p[t], *p1 = p[(t + 1) % len];
-        double u[3], v[3], w[3];
-        for (int q = 0; q < 3; q++) u[q] = p0[q] - c[q], v[q] = p1[q] - c[q];
-        w[0] = u[1] * v[2] - u[2] * v[1];
-        w[1] = u[2] * v[0] - u[0] * v[2];
-        w[2] = u[0] * v[1] - u[1] * v[0];
-        part[t] = norm3(w) / 2;
-    }
-    return len;
+    memcpy(part, fan, (size_t)nfan * sizeof *part);
+    return nfan;
 }
 
 void hd__surfel_areas(int dims, const double lin[3][3], double area[256]) {

@@ -37,6 +37,20 @@ TEST(surfel_areas_of_the_planar_configurations_are_their_polygons) {
     CHECK(close_to(area[0x09], 2 * sqrt(3) / 8)); /* corners 0, 3: a face diagonal, two triangles */
 }
 
+/* Non-planar loops: the largest fan from a crossing.  Three corners of the
+ * face k = 0 (0, 1, 2): the pentagon's largest fan is the triangle of the
+ * three k-edge midpoints, in the plane k = 1/2 (area 1/2), and two
+ * triangles of area vectors (1, 1, 1)/4 and (1, 1, 1)/8 (as DeepMind's
+ * table has it for this configuration).  Four corners in a chain (1, 0, 2,
+ * 6 as i, j, k steps): the hexagon's largest fan has triangles sqrt(3)/8,
+ * 3 sqrt(3)/8 and two of sqrt(2)/4 (DeepMind's: the same four). */
+TEST(surfel_areas_of_non_planar_loops_are_their_largest_fans) {
+    double area[256];
+    hd__surfel_areas(3, ident, area);
+    CHECK(close_to(area[0x07], 0.5 + sqrt(3) / 4 + sqrt(3) / 8));
+    CHECK(close_to(area[0x47], sqrt(3) / 2 + sqrt(2) / 2));
+}
+
 TEST(surfel_areas_follow_the_spacing) {
     const double s[3] = {3, 2, 1}, lin[3][3] = {{3, 0, 0}, {0, 2, 0}, {0, 0, 1}};
     double area[256];
