@@ -186,47 +186,97 @@ static void add_run(label_stat_t *st, size_t i0, size_t i1, size_t j, size_t k) 
     }
 }
 
-/* One row of both images, a run of equal labels at a time (background
- * comes in long runs, so the table is consulted once per run). */
-static int scan_row(label_set_t *set, const int64_t *ra, const int64_t *rb, size_t n0, size_t j, size_t k) {
-    label_stat_t *last = NULL;
-    for (int side = 0; side < 2; side++) {
-        const int64_t *row = side ? rb : ra;
-        for (size_t i = 0; i < n0;) {
-            int64_t l = row[i];
-            size_t s = i;
-            while (i < n0 && row[i] == l) i++;
-            label_stat_t *st = last && last->label == l ? last : find_label(set, l, 1);
-            if (!st) return -1;
-            add_run(st, s, i, j, k);
-            st->count[side] += i - s;
-            if (side == 0) {
-                size_t same = 0;
-                for (size_t q = s; q < i; q++) same += rb[q] == l;
-                st->overlap += same;
-            }
-            last = st;
-        }
+/* The end of the run of l starting at i: eight bytes at a time where the
+ * type is small (the background's long runs), then one value at a time. */
+#define HD__RUN_END(T)                                                                                                 \
+    static size_t run_end_##T(const T *row, size_t i, size_t n, T l) {                                               \
+        if (sizeof(T) <= 2) {                                                                                          \
+            uint64_t pat = 0;                                                                                          \
+            for (size_t b = 0; b < 8 / sizeof(T); b++) memcpy((char *)&pat + b * sizeof(T), &l, sizeof(T));         \
+            while (i + 8 / sizeof(T) <= n) {                                                                           \
+                uint64_t w;                                                                                            \
+                memcpy(&w, row + i, 8);                                                                                \
+                if (w != pat) break;                                                                                   \
+                i += 8 / sizeof(T);                                                                                    \
+            }                                                                                                          \
+        }                                                                                                              \
+        while (i < n && row[i] == l) i++;                                                                              \
+        return i;                                                                                                      \
     }
-    return 0;
-}
+HD__RUN_END(uint8_t)
+HD__RUN_END(int8_t)
+HD__RUN_END(uint16_t)
+HD__RUN_END(int16_t)
+HD__RUN_END(uint32_t)
+HD__RUN_END(int32_t)
+HD__RUN_END(int64_t)
+HD__RUN_END(uint64_t)
+#undef HD__RUN_END
 
-static int scan(const hd_label_image_t *a, const hd_label_image_t *b, label_set_t *set, hd_error_t *err) {
-    const size_t *n = a->n;
-    int64_t *row = hd__malloc_array(2 * n[0], sizeof *row);
-    if (!row) return hd__err(err, HD_ENOMEM, "out of memory for a row of %zu labels", n[0]);
-    for (size_t k = 0; k < n[2]; k++)
-        for (size_t j = 0; j < n[1]; j++) {
+/* One row of both images (values of type T at pa and pb), a run of equal
+ * labels at a time: background comes in long runs, so the table is
+ * consulted once per run.  The overlap of label 0 is counted only when
+ * asked for (it is the bulk of the image). */
+#define HD__SCAN_ROW(name, T)                                                                                          \
+    static int name(label_set_t *set, const void *pa, const void *pb, size_t n0, size_t j, size_t k, int zero) {      \
+        const T *ra = pa, *rb = pb;                                                                                    \
+        label_stat_t *last = NULL;                                                                                     \
+        for (int side = 0; side < 2; side++) {                                                                         \
+            const T *row = side ? rb : ra;                                                                             \
+            for (size_t i = 0; i < n0;) {                                                                              \
+                T l = row[i];                                                                                          \
+                size_t s = i;                                                                                          \
+                i = run_end_##T(row, i, n0, l);                                                                        \
+                label_stat_t *st = last && last->label == (int64_t)l ? last : find_label(set, (int64_t)l, 1);         \
+                if (!st) return -1;                                                                                    \
+                add_run(st, s, i, j, k);                                                                               \
+                st->count[side] += i - s;                                                                              \
+                if (side == 0 && (l != 0 || zero)) {                                                                   \
+                    size_t same = 0;                                                                                   \
+                    for (size_t q = s; q < i; q++) same += rb[q] == l;                                                 \
+                    st->overlap += same;                                                                               \
+                }                                                                                                      \
+                last = st;                                                                                             \
+            }                                                                                                          \
+        }                                                                                                              \
+        return 0;                                                                                                      \
+    }
+HD__SCAN_ROW(scan_u8, uint8_t)
+HD__SCAN_ROW(scan_i8, int8_t)
+HD__SCAN_ROW(scan_u16, uint16_t)
+HD__SCAN_ROW(scan_i16, int16_t)
+HD__SCAN_ROW(scan_u32, uint32_t)
+HD__SCAN_ROW(scan_i32, int32_t)
+HD__SCAN_ROW(scan_i64, int64_t)
+HD__SCAN_ROW(scan_u64, uint64_t)
+#undef HD__SCAN_ROW
+
+typedef int (*scan_row_fn)(label_set_t *, const void *, const void *, size_t, size_t, size_t, int);
+
+/* Both images a row at a time, read in their own type (as int64 when the
+ * two types differ). */
+static int scan(const hd_label_image_t *a, const hd_label_image_t *b, int zero, label_set_t *set, hd_error_t *err) {
+    static const scan_row_fn fn[] = {scan_u8, scan_i8, scan_u16, scan_i16, scan_u32, scan_i32, scan_i64, scan_u64};
+    static const size_t size[] = {1, 1, 2, 2, 4, 4, 8, 8};
+    const size_t *n = a->n, z = size[a->type];
+    int64_t *row = a->type != b->type ? hd__malloc_array(2 * n[0], sizeof *row) : NULL;
+    if (a->type != b->type && !row) return hd__err(err, HD_ENOMEM, "out of memory for a row of %zu labels", n[0]);
+    int rc = HD_OK;
+    for (size_t k = 0; k < n[2] && rc == HD_OK; k++)
+        for (size_t j = 0; j < n[1] && rc == HD_OK; j++) {
             size_t v = (k * n[1] + j) * n[0];
-            load_row(a, v, n[0], row);
-            load_row(b, v, n[0], row + n[0]);
-            if (scan_row(set, row, row + n[0], n[0], j, k) < 0) {
-                free(row);
-                return hd__err(err, HD_ENOMEM, "out of memory for the labels");
-            }
+            int bad;
+            if (row) {
+                load_row(a, v, n[0], row);
+                load_row(b, v, n[0], row + n[0]);
+                bad = scan_i64(set, row, row + n[0], n[0], j, k, zero);
+            } else
+                bad = fn[a->type](set, (const char *)a->labels + v * z, (const char *)b->labels + v * z, n[0], j, k,
+                                  zero);
+            if (bad) rc = hd__err(err, HD_ENOMEM, "out of memory for the labels");
         }
     free(row);
-    return HD_OK;
+    return rc;
 }
 
 /* ---- one label ------------------------------------------------------------------- */
@@ -573,7 +623,9 @@ int hd_label_map(const hd_label_image_t *a, const hd_label_image_t *b, const hd_
     set.slots = 64;
     set.slot = calloc(set.slots, sizeof *set.slot);
     if (!set.slot) return hd__err(err, HD_ENOMEM, "out of memory");
-    rc = scan(a, b, &set, err);
+    int zero = 0; /* is label 0 asked for? */
+    for (size_t k = 0; opt->labels && k < opt->n_labels; k++) zero |= opt->labels[k] == 0;
+    rc = scan(a, b, zero, &set, err);
     size_t n_rows = 0;
     int64_t *labels = rc == HD_OK ? chosen_labels(&set, opt, &n_rows) : NULL;
     hd_label_table_t *t = calloc(1, sizeof *t);
