@@ -55,9 +55,49 @@ typedef struct {
     double d, w;
 } dw_t;
 
-static int by_distance(const void *x, const void *y) {
-    double a = ((const dw_t *)x)->d, b = ((const dw_t *)y)->d;
-    return (a > b) - (a < b);
+/* share(x) >= p: the exact sum x, rounded once, over the total. */
+static int holds(const hd__xsum_t *x, double all, double p) { return hd__xsum_round(x) / all >= p / 100; }
+
+/* The smallest distance d of s[0..n) with holds(weights of the distances
+ * <= d), by a three-way quickselect: the values below the pivot either
+ * already hold the share (the answer is among them) or not (then the
+ * pivot, if it completes the share, or the values above it).  Sums are
+ * exact, so the decision at each distinct value is the one a sorted pass
+ * makes; past the end (the share never held after rounding), the largest
+ * distance. */
+static double weighted_select(dw_t *s, size_t n, double all, double p) {
+    size_t lo = 0, hi = n;
+    double largest = s[0].d;
+    for (size_t k = 1; k < n; k++)
+        if (s[k].d > largest) largest = s[k].d;
+    hd__xsum_t acc;
+    hd__xsum_init(&acc);
+    while (lo < hi) {
+        double a = s[lo].d, b = s[lo + (hi - lo) / 2].d, c = s[hi - 1].d;
+        double v = a < b ? (b < c ? b : a < c ? c : a) : (a < c ? a : b < c ? c : b);
+        size_t lt = lo, i = lo, gt = hi; /* [lo, lt) < v, [lt, i) == v, [gt, hi) > v */
+        while (i < gt) {
+            if (s[i].d < v) {
+                dw_t t = s[i];
+                s[i++] = s[lt], s[lt++] = t;
+            } else if (s[i].d > v) {
+                dw_t t = s[i];
+                s[i] = s[--gt], s[gt] = t;
+            } else
+                i++;
+        }
+        hd__xsum_t below = acc;
+        for (size_t k = lo; k < lt; k++) hd__xsum_add(&below, s[k].w);
+        if (lt > lo && holds(&below, all, p)) {
+            hi = lt;
+            continue;
+        }
+        for (size_t k = lt; k < gt; k++) hd__xsum_add(&below, s[k].w);
+        if (holds(&below, all, p)) return v;
+        acc = below;
+        lo = gt;
+    }
+    return largest;
 }
 
 int hd_weighted_percentile(const double *d, const double *w, size_t n, double p, double *out, hd_error_t *err) {
@@ -69,9 +109,8 @@ int hd_weighted_percentile(const double *d, const double *w, size_t n, double p,
     if (rc != HD_OK) return rc;
     dw_t *s = hd__malloc_array(n, sizeof *s);
     if (!s) return hd__err(err, HD_ENOMEM, "out of memory for %zu distances", n);
-    hd__xsum_t total, run;
+    hd__xsum_t total;
     hd__xsum_init(&total);
-    hd__xsum_init(&run);
     for (size_t k = 0; k < n; k++) {
         if (!(w[k] >= 0) || isinf(w[k])) {
             free(s);
@@ -85,22 +124,8 @@ int hd_weighted_percentile(const double *d, const double *w, size_t n, double p,
         free(s);
         return hd__err(err, HD_EINVAL, "the weights add up to 0");
     }
-    qsort(s, n, sizeof *s, by_distance);
-    /* At the end of each run of equal distances (where the running sum is
-     * that of a set, whatever the order inside the run) the share is
-     * compared with p / 100, as DeepMind's searchsorted on the cumulated
-     * share does; past the end, the largest distance. */
-    double found = s[n - 1].d;
-    for (size_t k = 0; k < n; k++) {
-        hd__xsum_add(&run, s[k].w);
-        if (k + 1 < n && s[k + 1].d == s[k].d) continue;
-        if (hd__xsum_round(&run) / all >= p / 100) {
-            found = s[k].d;
-            break;
-        }
-    }
+    *out = weighted_select(s, n, all, p);
     free(s);
-    *out = found;
     return HD_OK;
 }
 

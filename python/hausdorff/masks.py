@@ -40,7 +40,19 @@ Which figure is whose (docs/analysis.md has the formulas):
 - ``nsd(..., definition="monai")``: MONAI's ``compute_surface_dice`` (voxel
   counts, ``use_subvoxels=False``): the surface voxels of both masks within
   tau of the other surface, over all surface voxels.
+  ``definition="deepmind"`` (= ``"monai_subvoxels"``): DeepMind's
+  ``compute_surface_dice_at_tolerance`` and MONAI's ``use_subvoxels=True``:
+  surfels (cubes of 2 x 2 x 2 voxels the boundary crosses) weighted by
+  their marching-cubes area.
+- ``hausdorff(..., definition="deepmind")``, ``assd(...,
+  definition="deepmind")``: DeepMind's area-weighted ``compute_robust_hausdorff``
+  and the mean of its ``compute_average_surface_distance`` pair.
 - ``dice``: 2 |A and B| / (|A| + |B|), NaN when both are empty.
+- ``label_map(pred_labels, gt_labels, spacing)``: every label's figures
+  (all of the above) in one call, a list of dicts; ``components(...)``:
+  each connected component's directed distances and detection.
+- ``surfels``, ``surface_distances``: DeepMind's surfels and its
+  ``compute_surface_distances`` dict.
 
 Empty masks follow ``empty`` as the rest of the module: "error" (the
 default) raises ValueError; "monai" gives inf for a distance when one mask

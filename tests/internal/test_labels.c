@@ -323,3 +323,45 @@ TEST(bad_label_maps_are_refused) {
     CHECK_EQ(t->n_rows, 0);
     hd_label_table_free(t);
 }
+
+static int by_d(const void *x, const void *y) {
+    const double *a = x, *b = y;
+    return (a[0] > b[0]) - (a[0] < b[0]);
+}
+
+/* The reference: sort, then the running weight at the end of each run of
+ * equal distances (weights are multiples of 1/8 below 2^20: every partial
+ * sum is exact in a double). */
+TEST(weighted_percentile_equals_a_sorted_pass) {
+    for (uint64_t seed = 1; seed <= 200; seed++) {
+        gen_rng_t r;
+        gen_seed(&r, seed);
+        size_t n = 1 + gen_u64(&r) % 200;
+        double *d = malloc(n * sizeof *d), *w = malloc(n * sizeof *w), *pair = malloc(2 * n * sizeof *pair);
+        double all = 0;
+        for (size_t k = 0; k < n; k++) {
+            d[k] = (double)(gen_u64(&r) % 30) / 4;
+            w[k] = seed % 5 == 0 && k % 3 ? 0.0 : (double)(gen_u64(&r) % 64) / 8;
+            if (k == n - 1 && all + w[k] == 0) w[k] = 1;
+            all += w[k];
+            pair[2 * k] = d[k], pair[2 * k + 1] = w[k];
+        }
+        qsort(pair, n, 2 * sizeof *pair, by_d);
+        double p = seed % 7 == 0 ? 100.0 : seed % 11 == 0 ? 0.0 : (double)(gen_u64(&r) % 1001) / 10;
+        double want = pair[2 * (n - 1)], run = 0;
+        for (size_t k = 0; k < n; k++) {
+            run += pair[2 * k + 1];
+            if (k + 1 < n && pair[2 * k + 2] == pair[2 * k]) continue;
+            if (run / all >= p / 100) {
+                want = pair[2 * k];
+                break;
+            }
+        }
+        double got;
+        hd_error_t err;
+        CONTEXT("seed %llu, n %zu, p %g", (unsigned long long)seed, n, p);
+        CHECK_RC(hd_weighted_percentile(d, w, n, p, &got, &err), HD_OK);
+        CHECK_BITS(got, want);
+        free(d), free(w), free(pair);
+    }
+}
