@@ -12,6 +12,9 @@
   code with numpy, the area of each code taken from the library's own
   table (its values are checked by tests/internal/test_labels.c), and
   DeepMind's metric functions re-written from their definitions.
+- MONAI's use_subvoxels=True values (test_compute_surface_dice_subvoxel of
+  MONAI tests/metrics/test_surface_dice.py at commit
+  2e4424e43b686409e5190111122ce16a0d704421).
 - Components against scipy.ndimage.label.
 Seeds are in the test names' parameters.
 """
@@ -300,3 +303,33 @@ def test_label_types_and_float_labels():
         masks.label_map(base + 0.5, base)
     with pytest.raises(ValueError, match="different shapes"):
         masks.label_map(base, base[1:])
+
+
+def test_monai_compute_surface_dice_subvoxel():
+    """MONAI tests/metrics/test_surface_dice.py @2e4424e43b686409e5190111122ce16a0d704421,
+    test_compute_surface_dice_subvoxel (use_subvoxels=True)."""
+    gt, pred = np.zeros((128, 128, 128), bool), np.zeros((128, 128, 128), bool)
+    gt[50, 60, 70] = 1
+    assert masks.nsd(pred, gt, 1.0, (3, 2, 1), definition="monai_subvoxels") == 0.0
+    gt[50, 60, 70] = 0
+    pred[50, 60, 72] = 1
+    assert masks.nsd(pred, gt, 1.0, (3, 2, 1), definition="monai_subvoxels") == 0.0
+    gt[50, 60, 70] = 1
+    assert masks.nsd(pred, gt, 1.0, (3, 2, 1), definition="monai_subvoxels") == 0.5
+    gt, pred = np.zeros((100, 100, 100), bool), np.zeros((100, 100, 100), bool)
+    gt[0:50] = 1
+    pred[0:51] = 1
+    got = masks.nsd(pred, gt, 1.0, (2, 1, 1), definition="monai_subvoxels")
+    assert abs(got - 0.836145) <= 1e-3 + 1e-3 * 0.836145
+
+
+def test_c_and_fortran_order_give_the_same_rows():
+    rng = np.random.default_rng(11)
+    c = ndimage.median_filter(rng.integers(0, 4, (9, 11, 7)), size=2).astype(np.uint8)
+    g = ndimage.median_filter(rng.integers(0, 4, (9, 11, 7)), size=2).astype(np.uint8)
+    sp = (0.7, 1.1, 2.3)
+    a = masks.label_map(c, g, sp, components=18)
+    b = masks.label_map(np.asfortranarray(c), np.asfortranarray(g), sp, components=18)
+    assert a == b  # every figure to the bit (no label is empty here: no NaN)
+    assert len(masks.components(c, g, sp, connectivity=18)) == sum(r["components_pred"] + r["components_gt"]
+                                                                   for r in a)
