@@ -484,7 +484,8 @@ static int side_components(label_work_t *lw, int side, int64_t label, size_t *n_
             if (d[k] > out.hausdorff) out.hausdorff = d[k];
             if (d[k] < out.nearest) out.nearest = d[k];
         }
-        rc = hd_percentile(d, np, lw->opt->percentile, &out.hd_p, err);
+        if (other->points) rc = hd_percentile(d, np, lw->opt->percentile, &out.hd_p, err);
+        else out.hd_p = INFINITY; /* every distance is +inf: no interpolation between them */
         int within = lw->opt->rule == HD_AT_MOST ? out.nearest <= lw->opt->tau : out.nearest < lw->opt->tau;
         out.detected = out.overlap > 0 || within;
         if (rc == HD_OK && push_component(lw, &out) < 0) rc = hd__err(err, HD_ENOMEM, "out of memory for components");

@@ -295,6 +295,16 @@ TEST(components_are_listed_per_label_and_side) {
     CHECK(c[2].side == 1 && c[2].voxels == 2 && c[2].detected);
     CHECK_BITS(c[2].hausdorff, 1.0);
     hd_label_table_free(t);
+    /* B without the label: A's components are at +inf, not detected */
+    memset(b, 0, sizeof b);
+    o.empty = HD_EMPTY_MONAI;
+    CHECK_RC(hd_label_map(&ia, &ib, &o, &t, &err), HD_OK);
+    CHECK_EQ(t->n_components, 2);
+    for (size_t k = 0; k < t->n_components; k++) {
+        CHECK(isinf(t->components[k].hausdorff) && isinf(t->components[k].hd_p) && isinf(t->components[k].nearest));
+        CHECK(!t->components[k].detected);
+    }
+    hd_label_table_free(t);
 }
 
 TEST(bad_label_maps_are_refused) {
