@@ -250,10 +250,18 @@ int labels_run(const cli_args_t *a) {
     hd_error_t err;
     const char *paths[2] = {a->path_a, a->path_b};
     for (int w = 0; w < 2 && rc == HD_OK; w++) rc = nifti_read_labels(paths[w], &map[w], &err);
-    if (rc == HD_OK) rc = hd_label_map(&map[0].img, &map[1].img, &o, &t, &err);
     int code = EXIT_OK;
+    const size_t *na = map[0].img.n, *nb = map[1].img.n;
+    if (rc == HD_OK && (na[0] != nb[0] || na[1] != nb[1] || na[2] != nb[2])) {
+        fprintf(stderr, "%s: %s has %zu x %zu x %zu voxels and %s %zu x %zu x %zu: label maps are compared voxel "
+                        "by voxel\n", cli_prog(), safe_text(paths[0]), na[0], na[1], na[2], safe_text(paths[1]), nb[0],
+                nb[1], nb[2]);
+        code = EXIT_BADINPUT;
+    } else if (rc == HD_OK) {
+        rc = hd_label_map(&map[0].img, &map[1].img, &o, &t, &err);
+    }
     if (rc != HD_OK) code = say(rc, &err);
-    else {
+    else if (code == EXIT_OK) {
         const char *unit = an->units ? an->units : map[0].info.unit_known ? "mm" : "voxel units";
         if (a->json) print_json(stdout, t, &o, unit);
         else if (an->csv) print_csv(stdout, t);
