@@ -74,6 +74,7 @@ static void usage_examples(FILE *out) {
 "  cat cloud.csv | hausdorff xyz:- model.ply\n"
 "  hausdorff --percentile 95 --mean --render dev.png scan.ply model.ply\n"
 "  hausdorff --json --percentile 95 seg.nii.gz truth.nii.gz\n"
+"  hausdorff --labels all --components 26 --csv seg.nii.gz truth.nii.gz\n"
 "  hausdorff --json tiles2019/ @tiles2024.txt\n");
     }
     fprintf(out, "\nExit status: 0 success, 1 usage error, 2 bad input, 3 other failure.\n");
