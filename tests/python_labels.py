@@ -333,3 +333,34 @@ def test_c_and_fortran_order_give_the_same_rows():
     assert a == b  # every figure to the bit (no label is empty here: no NaN)
     assert len(masks.components(c, g, sp, connectivity=18)) == sum(r["components_pred"] + r["components_gt"]
                                                                    for r in a)
+
+
+@pytest.mark.skipif(not os.environ.get("HD_CLI"), reason="the command line is built without libnifti2")
+def test_label_map_equals_the_command_line(tmp_path):
+    """The same label maps as NIfTI files: every figure of every row and
+    component of `hausdorff --labels all --json --components 18` equals
+    label_map's and components' to the bit."""
+    import json
+    import sys
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    from cli_analysis_support import write_nifti
+    rng = np.random.default_rng(12)
+    p = ndimage.median_filter(rng.integers(0, 4, (12, 10, 7)), size=3).astype(np.int16)
+    g = ndimage.median_filter(rng.integers(0, 4, (12, 10, 7)), size=3).astype(np.int16)
+    sp = (0.5, 1.25, 2.0)
+    write_nifti(str(tmp_path / "p.nii"), p, pixdim=sp)
+    write_nifti(str(tmp_path / "g.nii.gz"), g, pixdim=sp)
+    out = subprocess.run([os.environ["HD_CLI"], "--labels", "all", "--json", "--components", "18", "--percentile",
+                          "90", "--tau", "1.5", str(tmp_path / "p.nii"), str(tmp_path / "g.nii.gz")],
+                         capture_output=True, text=True, check=True).stdout
+    j = json.loads(out)
+    rows = masks.label_map(p, g, sp, percentile=90, tau=1.5, components=18)
+    # NIfTI stores i fastest: Fortran order numbers the components as the tool does
+    comps = masks.components(np.asfortranarray(p), np.asfortranarray(g), sp, connectivity=18, percentile=90,
+                             tau=1.5)
+    assert len(rows) == len(j["labels"])
+    for r, c in zip(rows, j["labels"]):
+        assert [r[k] for k in masks.ROW_FIELDS] == [math.nan if v is None else v for v in c.values()], r["label"]
+    key = ("label", "side", "index", "voxels", "overlap", "points", "hausdorff", "hd_p", "nearest", "detected")
+    assert [tuple(c[k] for k in key) for c in comps] == \
+        [(c["label"], {"A": "pred", "B": "gt"}[c["side"]]) + tuple(c[k] for k in key[2:]) for c in j["components"]]

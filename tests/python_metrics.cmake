@@ -23,4 +23,4 @@ add_test(NAME python_labels
   COMMAND ${HD_METRICS_PYTEST} -m pytest -q -p no:cacheprovider ${CMAKE_CURRENT_SOURCE_DIR}/tests/python_labels.py
   WORKING_DIRECTORY ${CMAKE_BINARY_DIR})
 set_tests_properties(python_labels PROPERTIES TIMEOUT 600 ENVIRONMENT
-  "PYTHONPATH=${CMAKE_BINARY_DIR}/python;PYTHONDONTWRITEBYTECODE=1")
+  "PYTHONPATH=${CMAKE_BINARY_DIR}/python;PYTHONDONTWRITEBYTECODE=1;HD_CLI=$<$<BOOL:${HD_CLI_NIFTI}>:$<TARGET_FILE:hausdorff_cli>>")
