@@ -814,8 +814,11 @@ typedef struct hd_label_table {
  * One pass over both images finds each label's counts and box; then, a
  * label at a time, its windows are cut, their surface voxels and surfels
  * found once, the per-point distances found in both directions
- * (hd_distances) and every figure derived from them.  *out is the
- * library's (hd_label_table_free).  Errors: HD_EINVAL (NULL, sizes that
+ * (hd_distances) and every figure derived from them.  Memory beyond the
+ * images: the largest label's two windows, points and surfels, and about
+ * 100 bytes per distinct value in the images (an image of a million
+ * distinct values, an intensity image given by mistake, costs that much
+ * and a window per value).  *out is the library's (hd_label_table_free).  Errors: HD_EINVAL (NULL, sizes that
  * differ or are 0, an unknown type, bad options: percentile outside
  * [0, 100], tau NaN or < 0, connectivity, dims, components), HD_EEMPTY
  * (a label absent from a side under HD_EMPTY_ERROR: the message names
