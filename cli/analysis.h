@@ -50,6 +50,9 @@ typedef struct analysis_args {
     double taus[ANALYSIS_MAX_TAUS];
     hd_tolerance_rule_t tau_rule; /* --tau-rule le|lt (default le: d <= tau) */
     double dtu_cap;            /* --dtu-cap D: DTU accuracy/completeness (0: off) */
+    const char *labels;        /* --labels all|L[,L...]: label maps (labels.c); NULL: off */
+    int components;            /* --components 6|18|26|4|8 (0: off) */
+    int csv;                   /* --csv: the label table as CSV */
 } analysis_args_t;
 
 /* ---- options (analysis.c) ---------------------------------------------- */
@@ -72,6 +75,17 @@ hd_cloud_t *cli_cloud_new(size_t count, hd_dtype_t dtype, const char *format);
 int nifti_is_mask_path(const char *path);
 /* 1 when the tool was built with the NIfTI library. */
 int nifti_available(void);
+/* A NIfTI label map (--labels): its values in their own integer type (a
+ * float image's whole numbers as int64), placed as a mask's voxels are
+ * (the same map and unit); info as for a mask (foreground 0). */
+typedef struct nifti_labels {
+    hd_label_image_t img;
+    mask_info_t info;
+    void *image;       /* the nifti_image holding the values */
+    int64_t *converted; /* a float image's labels */
+} nifti_labels_t;
+int nifti_read_labels(const char *path, nifti_labels_t *out, hd_error_t *err);
+void nifti_labels_free(nifti_labels_t *l);
 
 /* ---- the run (analysis.c) ---------------------------------------------- */
 /* Where a witness point was drawn in a picture. */

@@ -23,6 +23,7 @@
 #include <math.h>
 #include "output.h"
 #include "progress.h"
+#include "labels.h"
 #include "report.h"
 #include "surface.h"
 #include "tiles.h"
@@ -159,6 +160,10 @@ int main(int argc, char **argv) {
     static run_t r; /* zero: run_free frees what was made */
     int rc = cli_parse(argc, argv, &r.a);
     if (rc >= 0) return rc == EXIT_OK ? out_finish() : rc; /* --help, --version, --formats printed */
+    if (r.a.an.labels) {
+        rc = labels_run(&r.a);
+        return rc == EXIT_OK ? out_finish() : failed(rc);
+    }
     if (r.a.surface) {
         rc = surface_run(&r.a);
         return rc == EXIT_OK ? out_finish() : failed(rc);

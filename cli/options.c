@@ -4,6 +4,7 @@
  * line on stderr saying what was wrong.
  */
 #include "cli.h"
+#include "labels.h"
 #include "tiles.h"
 
 #include <errno.h>
@@ -73,6 +74,7 @@ static void usage_examples(FILE *out) {
 "  cat cloud.csv | hausdorff xyz:- model.ply\n"
 "  hausdorff --percentile 95 --mean --render dev.png scan.ply model.ply\n"
 "  hausdorff --json --percentile 95 seg.nii.gz truth.nii.gz\n"
+"  hausdorff --labels all --components 26 --csv seg.nii.gz truth.nii.gz\n"
 "  hausdorff --json tiles2019/ @tiles2024.txt\n");
     }
     fprintf(out, "\nExit status: 0 success, 1 usage error, 2 bad input, 3 other failure.\n");
@@ -161,11 +163,11 @@ typedef enum {
     OPT_MAX_STREAM_SIZE, OPT_FIFO_WAIT, OPT_LAZ_POINTS_PER_BYTE, OPT_TOLERANCE, OPT_WITHIN,
     OPT_PERCENTILE, OPT_BINS, OPT_DISTANCES, OPT_MAX_DISTANCE, OPT_RENDER, OPT_HISTOGRAM_PNG,
     OPT_MASK_POINTS, OPT_EMPTY, OPT_CONNECTIVITY, OPT_MASK_DIMS, OPT_UNITS, OPT_TAU, OPT_TAU_RULE,
-    OPT_DTU_CAP,
+    OPT_DTU_CAP, OPT_LABELS, OPT_COMPONENTS,
     OPT_FLAGS, /* the first flag */
     OPT_HELP = OPT_FLAGS, OPT_VERSION, OPT_FORMATS, OPT_DIRECTED, OPT_JSON, OPT_QUIET, OPT_NO_EARLY_BREAK,
     OPT_NO_CULLING, OPT_FLOAT32, OPT_DECIMAL_COMMA, OPT_VERTICES, OPT_SURFACE, OPT_SIGNED, OPT_MEAN,
-    OPT_CHAMFER, OPT_HISTOGRAM,
+    OPT_CHAMFER, OPT_HISTOGRAM, OPT_CSV,
     OPT_COUNT
 } option_t;
 
@@ -350,6 +352,25 @@ static const option_entry_t options[] = {
      "or 0 instead; monai: inf when one set is empty, NaN when\n"
      "both are, as MONAI (JSON: null for inf and NaN, and an\n"
      "\"empty\" member)"},
+    {OPT_NONE, NULL, NULL, NULL, 'n',
+     "\n"
+     "Label maps: A (the prediction) and B (the reference) are NIfTI label maps%s\n"
+     "  of one size, one integer label a voxel (0: background).\n"},
+    {OPT_LABELS, "--labels", NULL, "all|L[,L...]", 0,
+     "every nonzero label in A or B (all), or these: per\n"
+     "label Dice, HD, HD_P (--percentile, default 95: max of\n"
+     "the directed ones as MONAI, and pooled as medpy), ASSD,\n"
+     "NSD at --tau (default 1) counted per surface voxel\n"
+     "(MONAI) and weighted by surfel area (DeepMind), and\n"
+     "DeepMind's HD_P; a table, --csv or --json; a label\n"
+     "absent from a side follows --empty (else an error)"},
+    {OPT_COMPONENTS, "--components", NULL, "CONN", 0,
+     "with --labels, also each connected component (CONN\n"
+     "6, 18 or 26; 4 or 8 in 2-D) of each side: its directed\n"
+     "HD, HD_P and nearest distance to the other side, and\n"
+     "whether it overlaps or comes within --tau (detected)"},
+    {OPT_CSV, "--csv", NULL, NULL, 0,
+     "with --labels, print the table as CSV"},
 };
 enum { N_OPTIONS = sizeof options / sizeof options[0], HELP_COLUMN = 21 };
 
@@ -432,6 +453,7 @@ static int set_flag(cli_args_t *a, int which) {
     case OPT_MEAN: a->an.mean = 1; break;
     case OPT_CHAMFER: a->an.chamfer = 1; break;
     case OPT_HISTOGRAM: a->an.histogram = 1; break;
+    case OPT_CSV: a->an.csv = 1; break;
     }
     return 0;
 }
@@ -596,6 +618,15 @@ static int set_analysis(analysis_args_t *an, int which, const char *name, const 
         else if (parse_double(v, &d) || !(d > 0))
             return bad("--dtu-cap needs a positive number or inf, not '%s'", v);
         an->dtu_cap = d;
+        break;
+    case OPT_LABELS:
+        if (!labels_list_ok(v)) return bad("--labels is all or whole numbers separated by commas, not '%s'", v);
+        an->labels = v;
+        break;
+    case OPT_COMPONENTS:
+        if (strcmp(v, "6") && strcmp(v, "18") && strcmp(v, "26") && strcmp(v, "4") && strcmp(v, "8"))
+            return bad("--components is 6, 18 or 26 (4 or 8 in 2-D), not '%s'", v);
+        an->components = atoi(v);
         break;
     }
     return 0;

@@ -648,6 +648,199 @@ typedef struct hd_mask_info {
 HD_EXTERN int hd_mask_points(const hd_mask_t *mask, const hd_mask_options_t *opt, struct hd_cloud **out,
                              hd_mask_info_t *info, hd_error_t *err);
 
+/* The surfels of a mask, DeepMind's surface-distance's surface (and
+ * MONAI's with use_subvoxels=True): one per cube of 2 x 2 x 2 voxels
+ * (dims 3) or 2 x 2 pixels of each slice k (dims 2; dims 0: 2 when
+ * n[2] = 1, else 3) whose corners are not all foreground nor all
+ * background, the outside of the image counting as background, in storage
+ * order of the cubes (the cube of voxels i..i+1, j..j+1, k..k+1 for i =
+ * -1 .. n[0]-1, i fastest).  Each is placed at its cube's centre, voxel
+ * index (i + 1/2, j + 1/2, k + 1/2) through the mask's map (k itself with
+ * dims 2), and weighted by the area of the marching-cubes surface inside
+ * its cube after the map's linear part (the length of the boundary in
+ * 2-D): docs/analysis.md, "Surfels".  *points (format "surfels") and
+ * *areas (count doubles, from malloc: free) are the caller's.
+ * Errors: as hd_mask_points (dims other than 0, 2, 3: HD_EINVAL).  On
+ * failure both are NULL.  Thread safe. */
+HD_EXTERN int hd_mask_surfels(const hd_mask_t *mask, int dims, struct hd_cloud **points, double **areas,
+                              hd_error_t *err);
+
+/* ------------------------------------------------------------------------
+ * Label maps: an integer image (a multi-class segmentation) against
+ * another, every label's figures in one call (docs/analysis.md, "Label
+ * maps", defines each figure and names the library whose convention it
+ * follows).  A is the prediction, B the reference.  Per label, the two
+ * binary masks "voxel == label" are cut to the box of the label's voxels
+ * in either image (one voxel of margin), so the memory held is bounded by
+ * the largest label's box, not by the number of labels; the points are
+ * placed by the whole image's indices, so the figures are bit for bit
+ * those of the two masks given whole (hd_mask_points and hd_distances).
+ * Two surfaces are measured per label:
+ *   voxel surfaces (MONAI's and medpy's): the surface voxels of
+ *     hd_mask_points, each counting 1: HD, HD_P (MONAI's max of directed
+ *     percentiles and medpy's pooled one), ASSD, NSD (MONAI's
+ *     compute_surface_dice, use_subvoxels=False);
+ *   surfels (DeepMind's surface-distance, and MONAI's compute_surface_dice
+ *     with use_subvoxels=True): one per 2 x 2 x 2 cube of voxels (2 x 2 in
+ *     2-D) that the boundary crosses, at the cube's centre, weighted by the
+ *     area of the marching-cubes surface in it (masks/surfels.c derives
+ *     it): their NSD, the area-weighted directed mean distances and
+ *     DeepMind's robust Hausdorff distance (area-weighted percentile).
+ * ---------------------------------------------------------------------- */
+
+/* The voxel type of a label image. */
+typedef enum hd_label_type {
+    HD_LABEL_U8 = 0,
+    HD_LABEL_I8,
+    HD_LABEL_U16,
+    HD_LABEL_I16,
+    HD_LABEL_U32,
+    HD_LABEL_I32,
+    HD_LABEL_I64,
+    HD_LABEL_U64
+} hd_label_type_t;
+
+/* A label image: n[0] x n[1] x n[2] values of `type` at `labels`, laid out
+ * and placed as hd_mask_t's voxels (i fastest; a 2-D image has n[2] = 1).
+ * hd_label_image_init sets m to the diagonal of the spacing (NULL: 1). */
+typedef struct hd_label_image {
+    const void *labels;
+    hd_label_type_t type;
+    size_t n[3];
+    double m[3][4];
+    double scale;
+} hd_label_image_t;
+HD_EXTERN void hd_label_image_init(hd_label_image_t *img, const void *labels, hd_label_type_t type, size_t n0,
+                                   size_t n1, size_t n2, const double spacing[3]);
+
+typedef struct hd_label_options {
+    const int64_t *labels;    /* the labels to measure, in this order; NULL:
+                                 every label other than 0 present in A or B,
+                                 ascending */
+    size_t n_labels;
+    double percentile;        /* P of HD_P (default 95) */
+    double tau;               /* the NSD's tolerance (default 1), in the
+                                 spacing's unit */
+    hd_tolerance_rule_t rule; /* HD_AT_MOST (default: MONAI's, DeepMind's) */
+    int connectivity;         /* of the surface voxels' erosion: 1 (default),
+                                 2, 3, as hd_mask_options_t */
+    int dims;                 /* 0 (default): the image's axes of more than
+                                 one voxel; 2: each slice on its own (the
+                                 erosion as hd_mask_options_t's, the surfels'
+                                 squares); 3 */
+    hd_empty_policy_t empty;  /* a label absent from A or B (or both):
+                                 HD_EMPTY_ERROR (default) fails with
+                                 HD_EEMPTY naming it; otherwise every
+                                 distance figure of that label is
+                                 hd_empty_value's, the NSDs and Dice are
+                                 computed (0 with one side empty, NaN with
+                                 both, as MONAI and DeepMind) */
+    int components;           /* 0 (default): none; else the connectivity of
+                                 connected components, 6, 18 or 26 in 3-D
+                                 (4 or 8 in 2-D, as 6 and 18 act on one
+                                 slice), each listed in the table */
+    int threads;              /* for hd_distances: 0 = every core */
+} hd_label_options_t;
+HD_EXTERN void hd_label_options_init(hd_label_options_t *opt);
+
+/* One label's figures.  Distances in the unit of the image's map. */
+typedef struct hd_label_row {
+    int64_t label;
+    int empty;                 /* 0, or 1 (A has no such voxel), 2 (B has
+                                  none), 3 (neither): the distance figures
+                                  then follow the policy */
+    size_t voxels_a, voxels_b; /* foreground voxels */
+    size_t overlap;            /* voxels of the label in both */
+    double dice;               /* 2 overlap / (voxels_a + voxels_b); NaN
+                                  when both are 0 */
+    size_t points_a, points_b; /* surface voxels */
+    double hausdorff;          /* max(hd_ab, hd_ba) */
+    double hd_ab, hd_ba;       /* directed: A's surface voxels to B's, ... */
+    double hd_p;               /* max of the directed P-th percentiles
+                                  (MONAI's compute_hausdorff_distance) */
+    double hd_p_pooled;        /* P-th percentile of both directions
+                                  pooled (medpy's hd95) */
+    double assd;               /* mean of both directions pooled (MONAI's
+                                  symmetric ASSD, medpy's assd) */
+    double asd_ab, asd_ba;     /* directed means (medpy's asd) */
+    double nsd;                /* NSD by voxel counts (MONAI's
+                                  compute_surface_dice) */
+    size_t surfels_a, surfels_b;
+    double area_a, area_b;     /* the surfels' total areas */
+    double nsd_surfel;         /* NSD by surfel areas (DeepMind's
+                                  compute_surface_dice_at_tolerance, MONAI's
+                                  use_subvoxels=True) */
+    double overlap_ab, overlap_ba; /* DeepMind's surface overlap at tau:
+                                  the share of A's (B's) surfel area within
+                                  tau of the other's surfels */
+    double hd_surfel;          /* DeepMind's compute_robust_hausdorff at
+                                  P: max over both directions of the
+                                  smallest distance d whose surfels at most
+                                  d hold P percent of the direction's area */
+    double asd_surfel_ab, asd_surfel_ba; /* DeepMind's
+                                  compute_average_surface_distance: the
+                                  area-weighted mean distance, A's surfels
+                                  to B's, B's to A's */
+    size_t components_a, components_b; /* with options.components */
+} hd_label_row_t;
+
+/* One connected component of one side of one label. */
+typedef struct hd_label_component {
+    int64_t label;
+    int side;          /* 0: a component of A, 1: of B */
+    size_t index;      /* 1.. in storage order of their first voxel */
+    size_t voxels;     /* its voxels */
+    size_t overlap;    /* of them, voxels of the label on the other side */
+    size_t points;     /* its surface voxels */
+    double hausdorff;  /* the directed HD of its surface voxels to the
+                          other side's surface (+inf when that is empty) */
+    double hd_p;       /* the P-th percentile of those distances */
+    double nearest;    /* the smallest of them */
+    int detected;      /* 1 when it overlaps the other side's label or
+                          nearest is within tau (by the options' rule) */
+} hd_label_component_t;
+
+/* The table: rows in the order of the labels, then every component of a
+ * row's A side, then of its B side, row after row. */
+typedef struct hd_label_table {
+    hd_label_row_t *rows;
+    size_t n_rows;
+    hd_label_component_t *components;
+    size_t n_components;
+} hd_label_table_t;
+
+/* Every label's figures, A (prediction) against B (reference), which have
+ * the same sizes (their maps may differ: each places its own voxels).
+ * One pass over both images finds each label's counts and box; then, a
+ * label at a time, its windows are cut, their surface voxels and surfels
+ * found once, the per-point distances found in both directions
+ * (hd_distances) and every figure derived from them.  Memory beyond the
+ * images: the largest label's two windows, points and surfels, and about
+ * 100 bytes per distinct value in the images (an image of a million
+ * distinct values, an intensity image given by mistake, costs that much
+ * and a window per value).  *out is the library's (hd_label_table_free).  Errors: HD_EINVAL (NULL, sizes that
+ * differ or are 0, an unknown type, bad options: percentile outside
+ * [0, 100], tau NaN or < 0, connectivity, dims, components), HD_EEMPTY
+ * (a label absent from a side under HD_EMPTY_ERROR: the message names
+ * it), HD_EOVERFLOW, HD_ENONFINITE or HD_ERANGE (as hd_mask_points),
+ * HD_ENOMEM.  On failure *out is NULL.  Thread safe (the images are only
+ * read); threads as hd_distances. */
+HD_EXTERN int hd_label_map(const hd_label_image_t *a, const hd_label_image_t *b, const hd_label_options_t *opt,
+                           hd_label_table_t **out, hd_error_t *err);
+/* Frees a table; NULL is accepted. */
+HD_EXTERN void hd_label_table_free(hd_label_table_t *table);
+
+/* The area-weighted percentile of DeepMind's compute_robust_hausdorff:
+ * the smallest of the n distances d such that the weights of the
+ * distances at most d add up to at least p / 100 of all the weights (sums
+ * exact, rounded once; p = 0 gives the smallest distance of positive
+ * weight... p = 100 the largest of positive weight).  Errors: HD_EINVAL
+ * (NULL, p outside [0, 100], a weight negative or not finite, all weights
+ * 0), HD_EEMPTY (n = 0), HD_ENONFINITE (a NaN distance), HD_ENOMEM.
+ * Thread safe. */
+HD_EXTERN int hd_weighted_percentile(const double *d, const double *w, size_t n, double p, double *out,
+                                     hd_error_t *err);
+
 /* ------------------------------------------------------------------------
  * Reading files.
  * ---------------------------------------------------------------------- */
