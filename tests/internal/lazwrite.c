@@ -1,10 +1,6 @@
 /*
- * lazwrite.c -- the tests' LAZ writer (lazwrite.h).  The encoder mirrors
- * the decoder of src/io/lazcoder.h: an interval [base, base + length) of
- * 32 bits, a byte shifted out whenever length < 2^24, a carry propagated
- * back through the bytes already written; done() leaves one or two final
- * bytes and pads with zeros to four, so that a decoder, which reads four
- * bytes ahead, consumes the stream exactly.
+ * lazwrite.c -- the tests' LAZ writer (lazwrite.h), over the library's
+ * range encoder (src/io/lazcoder.h).
  */
 #include "lazwrite.h"
 
@@ -16,114 +12,13 @@
 
 lazw_layout_t lazw_last;
 
-typedef struct {
-    tf_buf_t out;
-    uint32_t base, length;
-} enc_t;
-
-static void enc_init(enc_t *e) {
-    memset(e, 0, sizeof *e);
-    e->length = 0xFFFFFFFFu;
-}
-static void carry(enc_t *e) {
-    size_t i = e->out.size;
-    while (i > 0 && e->out.data[i - 1] == 0xFF) e->out.data[--i] = 0;
-    assert(i > 0);
-    e->out.data[i - 1]++;
-}
-static void renorm(enc_t *e) {
-    do {
-        tf_u8(&e->out, e->base >> 24);
-        e->base <<= 8;
-    } while ((e->length <<= 8) < HD__AC_MIN);
-}
-static void enc_bit(enc_t *e, hd__bitmodel_t *m, uint32_t sym) {
-    uint32_t x = m->p0 * (e->length >> HD__BM_SHIFT);
-    if (sym == 0) {
-        e->length = x;
-        m->c0++;
-    } else {
-        uint32_t b = e->base;
-        e->base += x;
-        e->length -= x;
-        if (b > e->base) carry(e);
-    }
-    if (e->length < HD__AC_MIN) renorm(e);
-    if (--m->until == 0) hd__bitmodel_update(m);
-}
-static void enc_symbol(enc_t *e, hd__symmodel_t *m, uint32_t sym) {
-    assert(sym < m->n);
-    uint32_t x, b = e->base;
-    if (sym == m->n - 1) {
-        x = m->dist[sym] * (e->length >> HD__DM_SHIFT);
-        e->base += x;
-        e->length -= x;
-    } else {
-        x = m->dist[sym] * (e->length >>= HD__DM_SHIFT);
-        e->base += x;
-        e->length = m->dist[sym + 1] * e->length - x;
-    }
-    if (b > e->base) carry(e);
-    if (e->length < HD__AC_MIN) renorm(e);
-    m->count[sym]++;
-    if (--m->until == 0) hd__symmodel_update(m);
-}
-static void enc_raw(enc_t *e, unsigned bits, uint32_t sym) {
-    if (bits > 19) {
-        enc_raw(e, 16, sym & 0xFFFF);
-        sym >>= 16;
-        bits -= 16;
-    }
-    uint32_t b = e->base;
-    e->base += sym * (e->length >>= bits);
-    if (b > e->base) carry(e);
-    if (e->length < HD__AC_MIN) renorm(e);
-}
-static void enc_done(enc_t *e) {
-    uint32_t b = e->base;
-    int another = 1;
-    if (e->length > 2 * HD__AC_MIN) {
-        e->base += HD__AC_MIN;
-        e->length = HD__AC_MIN >> 1;
-    } else {
-        e->base += HD__AC_MIN >> 1;
-        e->length = HD__AC_MIN >> 9;
-        another = 0;
-    }
-    if (b > e->base) carry(e);
-    renorm(e);
-    tf_u8(&e->out, 0);
-    tf_u8(&e->out, 0);
-    if (another) tf_u8(&e->out, 0);
-}
-
-static void ic_encode(hd__intcoder_t *ic, enc_t *e, int32_t pred, int32_t real, uint32_t ctx) {
-    int64_t c = (int32_t)((uint32_t)real - (uint32_t)pred);
-    if (ic->corr_range) {
-        if (c < ic->corr_min) c += ic->corr_range;
-        else if (c > ic->corr_max) c -= ic->corr_range;
-    }
-    int64_t c1 = c <= 0 ? -c : c - 1;
-    uint32_t k = 0;
-    while (c1) {
-        c1 >>= 1;
-        k++;
-    }
-    ic->k = k;
-    enc_symbol(e, hd__ic_model(&ic->mbits[ctx]), k);
-    if (k) {
-        c = c < 0 ? c + (((int64_t)1 << k) - 1) : c - 1;
-        if (k <= 8) {
-            enc_symbol(e, hd__ic_model(&ic->corr[k]), (uint32_t)c);
-        } else {
-            unsigned k1 = k - 8;
-            enc_symbol(e, hd__ic_model(&ic->corr[k]), (uint32_t)(c >> k1));
-            enc_raw(e, k1, (uint32_t)(c & (((int64_t)1 << k1) - 1)));
-        }
-    } else {
-        enc_bit(e, &ic->corr0, (uint32_t)c);
-    }
-}
+/* The library's encoder (src/io/lazcoder.c), its output a tf_buf_t's
+ * bytes. */
+typedef hd__enc_t enc_t;
+#define enc_init hd__enc_init
+#define enc_symbol hd__enc_symbol
+#define enc_done hd__enc_done
+#define ic_encode hd__ic_encode
 
 static void symnew(hd__symmodel_t *m, uint32_t n) {
     if (hd__symmodel_new(m, n)) abort();
@@ -206,8 +101,8 @@ static void chunk10(tf_buf_t *b, const lazw_opts_t *o, const lazw_point_t *p, si
         for (unsigned k = 0; k < o->extra; k++) enc_symbol(&e, &bytes[k], 0);
     }
     enc_done(&e);
-    tf_put(b, e.out.data, e.out.size);
-    tf_free(&e.out);
+    tf_put(b, e.buf, e.size);
+    hd__enc_free(&e);
     hd__symmodel_free(&changed);
     hd__symmodel_free(&gzero);
     hd__symmodel_free(&rgbused);
@@ -266,8 +161,8 @@ static void chunk10v1(tf_buf_t *b, const lazw_opts_t *o, const lazw_point_t *p, 
         for (unsigned q = 0; q < o->extra; q++) ic_encode(&bic, &e, 40 + q, 40 + q, q);
     }
     enc_done(&e);
-    tf_put(b, e.out.data, e.out.size);
-    tf_free(&e.out);
+    tf_put(b, e.buf, e.size);
+    hd__enc_free(&e);
     hd__symmodel_t *ms[] = {&changed, &gzero, &rgbused};
     for (int i = 0; i < 3; i++) hd__symmodel_free(ms[i]);
     for (int i = 0; i < 256; i++)
@@ -363,13 +258,13 @@ static void chunk14(tf_buf_t *b, const lazw_opts_t *o, const lazw_point_t *p, si
     }
     enc_done(&exy);
     if (zchanges) enc_done(&ez);
-    tf_u32(b, (uint32_t)exy.out.size, 0);
-    tf_u32(b, (uint32_t)ez.out.size, 0);
+    tf_u32(b, (uint32_t)exy.size, 0);
+    tf_u32(b, (uint32_t)ez.size, 0);
     for (unsigned i = 2; i < 9 + o->extra; i++) tf_u32(b, 0, 0); /* unchanged layers: empty */
-    tf_put(b, exy.out.data, exy.out.size);
-    tf_put(b, ez.out.data, ez.out.size);
-    tf_free(&exy.out);
-    tf_free(&ez.out);
+    tf_put(b, exy.buf, exy.size);
+    tf_put(b, ez.buf, ez.size);
+    hd__enc_free(&exy);
+    hd__enc_free(&ez);
     for (int i = 0; i < 4; i++) c14_free(&cx[i]);
     free(cx);
 }
@@ -386,8 +281,8 @@ void lazw_table(tf_buf_t *out, const uint32_t *counts, const uint32_t *bytes, si
         ic_encode(&ic, &e, c ? (int32_t)bytes[c - 1] : 0, (int32_t)bytes[c], 1);
     }
     enc_done(&e);
-    tf_put(out, e.out.data, e.out.size);
-    tf_free(&e.out);
+    tf_put(out, e.buf, e.size);
+    hd__enc_free(&e);
     hd__intcoder_free(&ic);
 }
 
