@@ -186,6 +186,28 @@ int hd__write_text(hd__writer_t *w, int obj);
  * separate). */
 const char *hd__xyz_data_start(const char *p, const char *end, int decimal_comma, int *semicolon);
 
+/* A LAZ file's LASzip VLR and chunks, for the LAZ writer (laz.c): the
+ * VLR's data at vlr_at (vlr_len bytes), its items, and per chunk its first
+ * byte (start[c], start[n_chunks] the end of the last) and its first
+ * point's number (first[c]); the chunk table at [table, table_end). */
+typedef struct hd__laz_chunks {
+    int layered, chunked;
+    unsigned n_layers, n_items;
+    unsigned type[32], size[32];
+    uint32_t chunk_size;
+    size_t vlr_at, vlr_len;
+    size_t n_chunks;
+    uint64_t *start, *first;
+    size_t table, table_end;
+} hd__laz_chunks_t;
+/* Checks as the reader does; HD_OK or its error. */
+int hd__laz_chunks(hd__read_t *r, const hd__las_header_t *h, hd__laz_chunks_t *out);
+void hd__laz_chunks_free(hd__laz_chunks_t *c);
+/* The scanner channel of every point of layered chunk `chunk` into chan
+ * (its point count of them), from decoding its x/y layer. */
+int hd__laz_chunk_channels(hd__read_t *r, const hd__las_header_t *h, const hd__laz_chunks_t *c, size_t chunk,
+                           unsigned char *chan);
+
 /* ---- errors with a place --------------------------------------------------- */
 /* "NAME:LINE: what" with err->line set. */
 int hd__io_err_line(hd__read_t *r, int code, long long line, const char *fmt,

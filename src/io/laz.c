@@ -98,6 +98,7 @@ typedef struct {
     uint64_t *start; /* n_chunks + 1 byte offsets */
     uint64_t *first; /* n_chunks + 1 cumulative point counts */
     unsigned per_byte; /* the most points a chunk may hold per byte of it */
+    size_t start_table, table_end; /* the chunk table's first byte and its end */
     uint64_t lo, hi; /* the points kept: [lo, hi) of the file's (a range
                         read keeps part; chunks outside it are not decoded) */
     double scale[3], shift[3];
@@ -117,6 +118,8 @@ typedef struct {
     int rc;
     long long at;
     char msg[320];
+    unsigned char *chan; /* NULL, or the scanner channel of each point of a
+                            layered chunk (hd__laz_chunk_channels) */
 } job_t;
 
 static int fail(job_t *j, int code, long long at, const char *fmt, ...) HD__PRINTF(4, 5);
@@ -670,6 +673,7 @@ static void layered_loop(job_t *j, ctx14_t *cx, unsigned cur, hd__dec_t *dxy, hd
             cur = next;
             c = &cx[cur];
         }
+        if (j->chan) j->chan[i] = (unsigned char)cur;
         unsigned gps = (changed >> 4) & 1;
         unsigned last_n = c->n, last_r = c->r, nn = last_n, r = last_r;
         if (changed & 4) {
@@ -762,6 +766,7 @@ static void layered_points(job_t *j, const unsigned char *b, hd__dec_t *dxy, hd_
     first.r = b[14] & 15;
     first.n = b[14] >> 4;
     unsigned cur = (b[15] >> 4) & 3;
+    if (j->chan) j->chan[0] = (unsigned char)cur;
     if (ctx14_start(&cx[cur], &first)) fail(j, HD_ENOMEM, at, "out of memory");
     else layered_loop(j, cx, cur, dxy, dz, has_z, n);
     for (int c = 0; c < 4; c++) ctx14_free(&cx[c]);
@@ -795,7 +800,7 @@ static void decode_chunk(void *ctx, size_t task, int worker) {
         return;
     }
     job_t j = {z, task, z->r->sink, z->r->sink->dtype == HD_FLOAT32 ? (double)FLT_MAX : HD_MAX_COORD,
-               (size_t)z->first[task], 0, -1, ""};
+               (size_t)z->first[task], 0, -1, "", NULL};
     const unsigned char *b = z->d + z->start[task];
     size_t nb = (size_t)(z->start[task + 1] - z->start[task]), n = (size_t)(z->first[task + 1] - z->first[task]);
     if (z->layered) layered_chunk(&j, b, nb, n);
@@ -990,6 +995,8 @@ static int read_table(laz_t *z, const hd__las_header_t *h, uint32_t chunk_size) 
             rc = too_dense(z, (long long)z->start[i], i + 1, nc, pts, bytes);
     }
     hd__intcoder_free(&ic);
+    z->start_table = t;
+    z->table_end = (size_t)(d.p - z->d); /* a stream is used up exactly by its decoder */
     if (rc == HD_OK && z->first[nc] != count)
         rc = hd__io_err_at(r, HD_EFORMAT, (long long)t + 8, "the chunks hold %llu points, the header says %llu",
                            (unsigned long long)z->first[nc], (unsigned long long)count);
@@ -1123,4 +1130,72 @@ int hd__read_laz(hd__read_t *r, const hd__las_header_t *h) {
     free(z.at);
     free(z.msg);
     return rc;
+}
+
+/* ---- for the LAZ writer (write_laz.c) ---------------------------------------- */
+void hd__laz_chunks_free(hd__laz_chunks_t *c) {
+    free(c->start);
+    free(c->first);
+    c->start = c->first = NULL;
+}
+
+int hd__laz_chunks(hd__read_t *r, const hd__las_header_t *h, hd__laz_chunks_t *out) {
+    laz_t z;
+    memset(&z, 0, sizeof z);
+    memset(out, 0, sizeof *out);
+    z.r = r;
+    z.d = r->f->data;
+    z.size = r->f->size;
+    z.rec = h->rec;
+    z.per_byte = r->opt->laz_points_per_byte ? r->opt->laz_points_per_byte : HD_LAZ_POINTS_PER_BYTE;
+    uint32_t chunk_size = 0;
+    int rc = parse_vlr(&z, h, &chunk_size);
+    if (rc == HD_OK && h->count && z.chunked) rc = read_table(&z, h, chunk_size);
+    if (rc == HD_OK) {
+        const unsigned char *v;
+        size_t len, at;
+        find_vlr(&z, h, &v, &len, &at);
+        out->vlr_at = at;
+        out->vlr_len = len;
+        out->layered = z.layered;
+        out->chunked = z.chunked;
+        out->n_layers = z.n_layers;
+        out->n_items = z.n_items;
+        for (unsigned i = 0; i < z.n_items; i++) {
+            out->type[i] = z.items[i].type;
+            out->size[i] = z.items[i].size;
+        }
+        out->chunk_size = chunk_size;
+        out->n_chunks = h->count ? z.n_chunks : 0;
+        out->start = z.start;
+        out->first = z.first;
+        z.start = z.first = NULL;
+        /* the table's end: where the decoder of its entries stopped */
+        out->table = h->count ? z.start_table : h->offset + 8;
+        out->table_end = h->count ? z.table_end : h->offset + 8;
+    }
+    free(z.start);
+    free(z.first);
+    return rc;
+}
+
+int hd__laz_chunk_channels(hd__read_t *r, const hd__las_header_t *h, const hd__laz_chunks_t *c, size_t chunk,
+                           unsigned char *chan) {
+    laz_t z;
+    memset(&z, 0, sizeof z);
+    z.r = r;
+    z.d = r->f->data;
+    z.size = r->f->size;
+    z.rec = h->rec;
+    z.layered = 1;
+    z.n_layers = c->n_layers;
+    z.start = c->start;
+    z.first = c->first;
+    z.n_chunks = c->n_chunks;
+    z.lo = z.hi = 0; /* decoded, not kept */
+    job_t j = {&z, chunk, r->sink, HD_MAX_COORD, (size_t)c->first[chunk], 0, -1, "", chan};
+    const unsigned char *b = z.d + c->start[chunk];
+    layered_chunk(&j, b, (size_t)(c->start[chunk + 1] - c->start[chunk]), (size_t)(c->first[chunk + 1] - c->first[chunk]));
+    if (j.rc) return hd__io_err_at(r, j.rc, j.at, "chunk %zu of %zu: %s", chunk + 1, c->n_chunks, j.msg);
+    return HD_OK;
 }

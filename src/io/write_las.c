@@ -85,7 +85,6 @@ static void descriptor(unsigned char *p, unsigned type, unsigned options, const 
 
 int hd__las_plan(hd__writer_t *w, hd__las_plan_t *pl) {
     const unsigned char *d = w->in->data;
-    size_t size = w->in->size;
     memset(pl, 0, sizeof *pl);
     pl->minor = d[25];
     pl->header = hd__ld_u16(d + 94, 0);
@@ -131,7 +130,6 @@ int hd__las_plan(hd__writer_t *w, hd__las_plan_t *pl) {
                                            "format %u's fields",
                        w->in->name, described, extra, pl->fmt);
     pl->end = pl->offset + (size_t)pl->count * pl->rec;
-    if (pl->end > size) return hd__err(w->err, HD_EFORMAT, "%s: the points run past the file's end", w->in->name);
     pl->gap = pl->add ? extra - described : 0;
     pl->n_desc = pl->add ? 1 + (pl->gap + 254) / 255 : 0; /* an undocumented descriptor holds 255 bytes at most */
     size_t old_len = pl->eb_at ? hd__ld_u16(d + pl->eb_at + 20, 0) : 0;
@@ -204,7 +202,9 @@ void hd__las_write_head(hd__writer_t *w, const hd__las_plan_t *pl, uint64_t kept
     for (uint32_t i = 0; i < pl->n_vlr; i++) {
         size_t len = hd__ld_u16(d + p + 20, 0);
         if (laz_vlr && p + 54 == laz_vlr_at) { /* the LASzip VLR, rewritten by the LAZ writer */
-            hd__w_put(w, d + p, 54);
+            memcpy(desc, d + p, 54);
+            st_u16(desc + 20, (unsigned)laz_vlr_len);
+            hd__w_put(w, desc, 54);
             hd__w_put(w, laz_vlr, laz_vlr_len);
         } else if (pl->add && p == pl->eb_at) {
             memcpy(desc, d + p, 54);
@@ -267,6 +267,7 @@ int hd__write_las(hd__writer_t *w) {
     if (rc) return rc;
     if (pl.count != w->n)
         return hd__err(w->err, HD_EINVAL, "%s: %zu values for %llu points", w->in->name, w->n, (unsigned long long)pl.count);
+    if (pl.end > w->in->size) return hd__err(w->err, HD_EFORMAT, "%s: the points run past the file's end", w->in->name);
     const unsigned char *d = w->in->data;
     uint64_t by_return[16] = {0}, kept = 0;
     double bounds[6] = {0}, scale[3], shift[3], lo, hi;
