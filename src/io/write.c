@@ -98,7 +98,10 @@ static const char *input_format(const hd__file_t *f, const hd_read_options_t *ro
 /* Map the regular file at path into f (size 0: data points at a static
  * byte); HD_OK or the error. */
 static int map_input(const char *path, hd__file_t *f, struct stat *st, hd_error_t *err) {
-    int fd = open(path, O_RDONLY);
+    if (strcmp(path, "-") == 0)
+        return hd__err(err, HD_EUNSUPPORTED, "-: standard input cannot take a field: writing one reads the input twice; "
+                                             "save it to a file first");
+    int fd = open(path, O_RDONLY | O_NONBLOCK); /* a FIFO must not block here: it is refused below */
     if (fd < 0) return hd__err(err, HD_EIO, "%s: cannot open: %s", path, strerror(errno));
     if (fstat(fd, st) != 0 || !S_ISREG(st->st_mode)) {
         close(fd);
