@@ -185,7 +185,7 @@ def npm(lazgen, fixtures, work, update):
         with open(os.path.join(fixtures, DIGESTS), "w") as f:
             f.write("# %s's decoding of each file here, written by `tests/laz_lazperf.py npm ... --update`\n"
                     "# once it decoded every one exactly as the writer was given it (tests/laz_lazperf.py).\n"
-                    "# NAME  POINTS  SHA-256 of its \"X Y Z\" lines (integer coordinates, file order)\n" % LAZPERF)
+                    "# NAME  POINTS  SHA-256 of its \"X Y Z\" lines (integer coordinates, file order; field_*: \"X Y Z HEX\")\n" % LAZPERF)
             for name in sorted(digests):
                 f.write("%s %d %s\n" % (name, digests[name][0], digests[name][1]))
         print("laz_lazperf: %d fixtures written into %s" % (len(names), fixtures))
