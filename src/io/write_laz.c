@@ -178,56 +178,68 @@ typedef struct {
     hd__laz_chunks_t c;
     hd__read_t r;
     hd__sink_t sink;
-    unsigned char *layers; /* every chunk's new layers, back to back */
-    size_t layers_size;
-    uint64_t *at;          /* n_chunks + 1: chunk k's new layers start at layers + at[k] */
-    uint32_t *sizes;       /* NB per chunk */
-    uint64_t *bytes;       /* each chunk's new byte size */
-    int v4;                /* the BYTE14 item's version is 4 (else 3) */
+    unsigned char **layers; /* per chunk: its new layers, back to back */
+    size_t *layers_size;
+    uint32_t *sizes;        /* NB per chunk */
+    uint64_t *bytes;        /* each chunk's new byte size */
+    int *rc;                /* per chunk: HD_OK or the failure ... */
+    hd_error_t *err;        /* ... and its message */
+    int v4;                 /* the BYTE14 item's version is 4 (else 3) */
 } lazw_t;
 
-/* Encode every chunk's new layers (first pass: the sizes are needed
- * before anything after the header is written). */
-static int encode_chunks(lazw_t *z) {
-    size_t nc = z->c.n_chunks, most = 0;
-    z->at = hd__calloc_array(nc + 1, sizeof *z->at);
-    z->sizes = hd__calloc_array(nc * NB + 1, sizeof *z->sizes);
-    z->bytes = hd__calloc_array(nc + 1, sizeof *z->bytes);
-    if (!z->at || !z->sizes || !z->bytes) return hd__err(z->w->err, HD_ENOMEM, "out of memory");
-    for (size_t k = 0; k < nc; k++)
-        if (z->c.first[k + 1] - z->c.first[k] > most) most = (size_t)(z->c.first[k + 1] - z->c.first[k]);
-    unsigned char *chan = malloc(most + 1);
+/* Chunk `task`'s new layers (a task of hd__parallel_for: every chunk has
+ * its own encoders, models and error). */
+static void encode_chunk(void *ctx, size_t k, int worker) {
+    (void)worker;
+    lazw_t *z = ctx;
+    size_t n = (size_t)(z->c.first[k + 1] - z->c.first[k]);
+    hd_error_t *err = &z->err[k];
+    hd__read_t r = z->r;
+    r.err = err;
+    unsigned char *chan = malloc(n + 1);
     hd__enc_t enc[NB];
     for (int b = 0; b < NB; b++) hd__enc_init(&enc[b]);
-    int rc = chan ? HD_OK : hd__err(z->w->err, HD_ENOMEM, "out of memory");
-    for (size_t k = 0; k < nc && rc == HD_OK; k++) {
-        size_t n = (size_t)(z->c.first[k + 1] - z->c.first[k]);
+    int rc = chan ? HD_OK : hd__err(err, HD_ENOMEM, "out of memory");
+    if (rc == HD_OK) {
         memset(chan, 0, n);
-        if (n > 1) rc = hd__laz_chunk_channels(&z->r, &z->h, &z->c, k, chan);
+        if (n > 1) rc = hd__laz_chunk_channels(&r, &z->h, &z->c, k, chan);
         else chan[0] = (z->w->in->data[z->c.start[k] + 15] >> 4) & 3;
-        if (rc == HD_OK && (rc = encode_bytes(z->w, (size_t)z->c.first[k], n, chan, z->v4, enc, z->sizes + NB * k)))
-            rc = hd__err(z->w->err, rc, "out of memory");
-        size_t add = 0;
-        for (int b = 0; b < NB; b++) add += z->sizes[NB * k + b];
-        if (rc == HD_OK && add > SIZE_MAX - z->layers_size) rc = hd__err(z->w->err, HD_EOVERFLOW, "size overflow");
-        if (rc == HD_OK && add) {
-            unsigned char *p = realloc(z->layers, z->layers_size + add);
-            if (!p) rc = hd__err(z->w->err, HD_ENOMEM, "out of memory");
-            else z->layers = p;
-        }
-        for (int b = 0; b < NB && rc == HD_OK; b++) {
-            memcpy(z->layers + z->layers_size, enc[b].buf, z->sizes[NB * k + b]);
-            z->layers_size += z->sizes[NB * k + b];
-        }
-        z->at[k + 1] = z->layers_size;
-        uint64_t old = z->c.start[k + 1] - z->c.start[k];
-        z->bytes[k] = old + NB + 4 * NB + add;
-        if (rc == HD_OK && z->bytes[k] > 0xFFFFFFFFu)
-            rc = hd__err(z->w->err, HD_EUNSUPPORTED, "%s: chunk %zu would exceed 4 GiB", z->w->in->name, k + 1);
     }
+    if (rc == HD_OK && encode_bytes(z->w, (size_t)z->c.first[k], n, chan, z->v4, enc, z->sizes + NB * k))
+        rc = hd__err(err, HD_ENOMEM, "out of memory");
+    size_t add = 0;
+    for (int b = 0; b < NB; b++) add += z->sizes[NB * k + b];
+    if (rc == HD_OK && add && !(z->layers[k] = malloc(add))) rc = hd__err(err, HD_ENOMEM, "out of memory");
+    for (int b = 0, at = 0; b < NB && rc == HD_OK; b++) {
+        memcpy(z->layers[k] + at, enc[b].buf, z->sizes[NB * k + b]);
+        at += (int)z->sizes[NB * k + b];
+    }
+    z->layers_size[k] = add;
+    z->bytes[k] = z->c.start[k + 1] - z->c.start[k] + NB + 4 * NB + add;
+    if (rc == HD_OK && z->bytes[k] > 0xFFFFFFFFu)
+        rc = hd__err(err, HD_EUNSUPPORTED, "%s: chunk %zu would exceed 4 GiB", z->w->in->name, k + 1);
     for (int b = 0; b < NB; b++) hd__enc_free(&enc[b]);
     free(chan);
-    return rc;
+    z->rc[k] = rc;
+}
+
+/* Encode every chunk's new layers, in parallel (first pass: the sizes are
+ * needed before anything after the header is written); the first failing
+ * chunk in file order is the error. */
+static int encode_chunks(lazw_t *z) {
+    size_t nc = z->c.n_chunks;
+    z->layers = hd__calloc_array(nc + 1, sizeof *z->layers);
+    z->layers_size = hd__calloc_array(nc + 1, sizeof *z->layers_size);
+    z->sizes = hd__calloc_array(nc * NB + 1, sizeof *z->sizes);
+    z->bytes = hd__calloc_array(nc + 1, sizeof *z->bytes);
+    z->rc = hd__calloc_array(nc + 1, sizeof *z->rc);
+    z->err = hd__calloc_array(nc + 1, sizeof *z->err);
+    if (!z->layers || !z->layers_size || !z->sizes || !z->bytes || !z->rc || !z->err)
+        return hd__err(z->w->err, HD_ENOMEM, "out of memory");
+    hd__parallel_for(hd__thread_count(z->w->ropt->threads, nc), nc, encode_chunk, z);
+    for (size_t k = 0; k < nc; k++)
+        if (z->rc[k]) return hd__err(z->w->err, z->rc[k], "%s", z->err[k].message);
+    return HD_OK;
 }
 
 /* One chunk: first point raw and its value, the count, the old sizes and
@@ -245,7 +257,7 @@ static void write_chunk(lazw_t *z, size_t k) {
         for (int q = 0; q < 4; q++) s[4 * i + q] = (unsigned char)(z->sizes[NB * k + i] >> (8 * q));
     hd__w_put(w, s, sizeof s);
     hd__w_put(w, b + head, nb - head);
-    hd__w_put(w, z->layers + z->at[k], (size_t)(z->at[k + 1] - z->at[k]));
+    hd__w_put(w, z->layers[k], z->layers_size[k]);
 }
 
 static int write_layered(lazw_t *z) {
@@ -321,10 +333,13 @@ int hd__write_laz(hd__writer_t *w) {
         rc = hd__err(w->err, HD_EINVAL, "%s: %zu values for %llu points", w->in->name, w->n, (unsigned long long)z.pl.count);
     if (rc == HD_OK) rc = write_layered(&z);
     hd__laz_chunks_free(&z.c);
+    for (size_t k = 0; z.layers && k < z.c.n_chunks; k++) free(z.layers[k]);
     free(z.layers);
-    free(z.at);
+    free(z.layers_size);
     free(z.sizes);
     free(z.bytes);
+    free(z.rc);
+    free(z.err);
     hd__sink_free(&z.sink);
     return rc;
 }
