@@ -3,9 +3,10 @@
 // print its points' integer coordinates, one "X Y Z" line per point in file
 // order, after a first line "count N"; with `field`, each line also gets
 // the record's last eight bytes as a little-endian 64-bit integer in
-// hexadecimal (the value hd_write_field added).
+// hexadecimal (the value hd_write_field added); with `record`, each line is
+// the whole record in hexadecimal, byte by byte, instead.
 //
-//   node laz_lazperf.js NODE_MODULES_DIR FILE.laz [field]
+//   node laz_lazperf.js NODE_MODULES_DIR FILE.laz [field | record]
 //
 // tests/laz_lazperf.py runs it on the files the tests' LAZ writer makes and
 // compares with the points the writer was given.
@@ -29,6 +30,10 @@ const { createLazPerf } = require(path.resolve(modules, 'laz-perf'));
     laz.getPoint(pp);
     const v = new DataView(lp.HEAPU8.buffer, pp, len);
     let line = v.getInt32(0, true) + ' ' + v.getInt32(4, true) + ' ' + v.getInt32(8, true);
+    if (field === 'record') {
+      line = '';
+      for (let b = 0; b < len; b++) line += v.getUint8(b).toString(16).padStart(2, '0');
+    }
     if (field === 'field') {
       let hex = '';
       for (let b = len - 1; b >= len - 8; b--) hex += v.getUint8(b).toString(16).padStart(2, '0');

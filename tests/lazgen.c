@@ -20,6 +20,11 @@
  * channel 0 unless the channel changes at that very point, where LASzip
  * hands the point's channel: on files with other channels it decodes
  * extra bytes wrongly, so they are checked by test_write_laz alone.)
+ * The cases named record_* are hd_write_field's output on pointwise LAZ
+ * whose every field varies (tests/internal/lazwrite.c's lazw_pointwise),
+ * all points or those whose value is > 0.25: their NAME.txt lines are each
+ * written record in hexadecimal, byte by byte, the value's eight bytes
+ * last.
  */
 #include "files.h"
 #include "gen.h"
@@ -105,6 +110,53 @@ static void field_case(const char *dir, const char *name, const lazw_opts_t *o, 
     printf("%s\n", name);
     tf_free(&b);
     free(p);
+    free(v);
+}
+
+/* The record case NAME: see the top of the file. */
+static void record_case(const char *dir, const char *name, int fmt, unsigned extra, int subset, uint64_t seed, size_t n) {
+    gen_rng_t g;
+    gen_seed(&g, seed);
+    size_t rec;
+    unsigned char *recs = lazw_rich_records(&g, fmt, extra, n, &rec);
+    double *v = malloc(n * sizeof *v);
+    if (!recs || !v) exit(1);
+    for (size_t k = 0; k < n; k++) v[k] = k % 4 ? gen_normal(&g) : 0.5;
+    tf_buf_t b = {0};
+    lazw_pointwise(&b, fmt, extra, recs, rec, n, 1000);
+    char in[4096], out[4096];
+    snprintf(in, sizeof in, "%s/%s-input.laz", dir, name);
+    snprintf(out, sizeof out, "%s/%s.laz", dir, name);
+    FILE *f = fopen(in, "wb");
+    if (!f || fwrite(b.data, 1, b.size, f) != b.size || fclose(f)) {
+        perror(in);
+        exit(1);
+    }
+    hd_write_options_t o;
+    hd_write_options_init(&o);
+    o.keep = subset ? HD_KEEP_FARTHER : HD_KEEP_ALL;
+    o.threshold = 0.25;
+    hd_error_t err;
+    if (hd_write_field(in, out, v, n, &o, NULL, &err) != HD_OK) {
+        fprintf(stderr, "lazgen: %s\n", err.message);
+        exit(1);
+    }
+    remove(in);
+    snprintf(out, sizeof out, "%s/%s.txt", dir, name);
+    f = fopen(out, "w");
+    if (!f) exit(1);
+    for (size_t k = 0; k < n; k++) {
+        if (subset && !(v[k] > 0.25)) continue;
+        unsigned char val[8];
+        memcpy(val, &v[k], 8);
+        for (size_t i = 0; i < rec; i++) fprintf(f, "%02x", recs[k * rec + i]);
+        for (int i = 0; i < 8; i++) fprintf(f, "%02x", val[i]);
+        fputc('\n', f);
+    }
+    if (fclose(f)) exit(1);
+    printf("%s\n", name);
+    tf_free(&b);
+    free(recs);
     free(v);
 }
 
@@ -231,5 +283,9 @@ int main(int argc, char **argv) {
     field_case(argv[1], "field_format6_extra0", &w, 400, 2500);
     w.extra = 3, w.chunk_size = 0, w.chunks = sizes, w.n_chunks = 5;
     field_case(argv[1], "field_format6_extra3_variable_chunks", &w, 401, 4000);
+    record_case(argv[1], "record_format1_extra0", 1, 0, 0, 500, 2500);
+    record_case(argv[1], "record_format2_extra3", 2, 3, 0, 501, 2500);
+    record_case(argv[1], "record_format3_extra1_subset", 3, 1, 1, 502, 3001);
+    record_case(argv[1], "record_format0_extra0_subset", 0, 0, 1, 503, 2500);
     return 0;
 }

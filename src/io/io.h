@@ -193,7 +193,7 @@ const char *hd__xyz_data_start(const char *p, const char *end, int decimal_comma
 typedef struct hd__laz_chunks {
     int layered, chunked;
     unsigned n_layers, n_items;
-    unsigned type[32], size[32];
+    unsigned type[32], size[32], version[32];
     uint32_t chunk_size;
     size_t vlr_at, vlr_len;
     size_t n_chunks;
@@ -207,6 +207,10 @@ void hd__laz_chunks_free(hd__laz_chunks_t *c);
  * (its point count of them), from decoding its x/y layer. */
 int hd__laz_chunk_channels(hd__read_t *r, const hd__las_header_t *h, const hd__laz_chunks_t *c, size_t chunk,
                            unsigned char *chan);
+/* Every whole record of pointwise chunk `chunk` (items of version 2) into
+ * recs (its point count times the record length). */
+int hd__laz_chunk_records(hd__read_t *r, const hd__las_header_t *h, const hd__laz_chunks_t *c, size_t chunk,
+                          unsigned char *recs);
 
 /* ---- errors with a place --------------------------------------------------- */
 /* "NAME:LINE: what" with err->line set. */

@@ -41,4 +41,19 @@ void hd__las_scale(const unsigned char *d, double scale[3], double shift[3]);
 void hd__w_range(const hd__writer_t *w, double *lo, double *hi);
 void hd__st_u64(unsigned char *p, uint64_t v);
 
+/* For the LAZ writers (write_laz.c, write_lazpw.c). */
+typedef struct hd__enc hd__enc_t;
+/* The header las.c builds from the input's (already accepted). */
+void hd__las_header_of(const hd__writer_t *w, const hd__las_plan_t *pl, hd__las_header_t *h);
+/* The chunk table's entries (counts only when variable) into e. */
+int hd__laz_table_encode(int variable, size_t nc, const uint32_t *counts, const uint64_t *bytes, hd__enc_t *e);
+/* Pointwise LAZ (point formats 0-3, items of version 2): write_lazpw.c.
+ * hd__laz_encode_pointwise: the stream of a chunk of n records (rec bytes
+ * each; the items' types and sizes) after its raw first record, into e:
+ * HD_OK or HD_ENOMEM. */
+int hd__laz_encode_pointwise(const unsigned char *recs, size_t n, size_t rec, const unsigned *type, const unsigned *sz,
+                             unsigned n_items, hd__enc_t *e);
+int hd__write_laz_pointwise(hd__writer_t *w, hd__las_plan_t *pl, const hd__las_header_t *h, const hd__laz_chunks_t *c,
+                            hd__read_t *r);
+
 #endif

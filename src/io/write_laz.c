@@ -110,7 +110,7 @@ static int encode_bytes(const hd__writer_t *w, size_t first, size_t n, const uns
 }
 
 /* The header las.c builds, from a header it has accepted. */
-static void las_header(const hd__writer_t *w, const hd__las_plan_t *pl, hd__las_header_t *h) {
+void hd__las_header_of(const hd__writer_t *w, const hd__las_plan_t *pl, hd__las_header_t *h) {
     const unsigned char *d = w->in->data;
     memset(h, 0, sizeof *h);
     h->minor = pl->minor;
@@ -152,23 +152,29 @@ static int new_vlr(const hd__writer_t *w, const hd__laz_chunks_t *c, unsigned ch
     return HD_OK;
 }
 
-/* The chunk table: version 0, the chunk count, then per chunk its point
- * count (variable chunk sizes only) and its byte size, each predicted by
- * the previous chunk's, in one stream. */
-static int encode_table(const hd__laz_chunks_t *c, const uint64_t *bytes, hd__enc_t *e) {
+/* The chunk table's entries: per chunk its point count (variable chunk
+ * sizes only) and its byte size, each predicted by the previous chunk's,
+ * in one stream (the table's version and chunk count precede it). */
+int hd__laz_table_encode(int variable, size_t nc, const uint32_t *counts, const uint64_t *bytes, hd__enc_t *e) {
     hd__intcoder_t ic;
     if (hd__intcoder_new(&ic, 32, 2)) return HD_ENOMEM;
-    int variable = c->chunk_size == 0 || c->chunk_size == 0xFFFFFFFFu;
     hd__enc_reset(e);
-    for (size_t k = 0; k < c->n_chunks; k++) {
-        if (variable)
-            hd__ic_encode(&ic, e, k ? (int32_t)(c->first[k] - c->first[k - 1]) : 0, (int32_t)(c->first[k + 1] - c->first[k]),
-                          0);
+    for (size_t k = 0; k < nc; k++) {
+        if (variable) hd__ic_encode(&ic, e, k ? (int32_t)counts[k - 1] : 0, (int32_t)counts[k], 0);
         hd__ic_encode(&ic, e, k ? (int32_t)bytes[k - 1] : 0, (int32_t)bytes[k], 1);
     }
     hd__enc_done(e);
     hd__intcoder_free(&ic);
     return e->oom ? HD_ENOMEM : HD_OK;
+}
+
+static int encode_table(const hd__laz_chunks_t *c, const uint64_t *bytes, hd__enc_t *e) {
+    uint32_t *counts = hd__malloc_array(c->n_chunks + 1, sizeof *counts);
+    if (!counts) return HD_ENOMEM;
+    for (size_t k = 0; k < c->n_chunks; k++) counts[k] = (uint32_t)(c->first[k + 1] - c->first[k]);
+    int rc = hd__laz_table_encode(c->chunk_size == 0 || c->chunk_size == 0xFFFFFFFFu, c->n_chunks, counts, bytes, e);
+    free(counts);
+    return rc;
 }
 
 typedef struct {
@@ -304,25 +310,26 @@ int hd__write_laz(hd__writer_t *w) {
     z.w = w;
     int rc = hd__las_plan(w, &z.pl);
     if (rc) return rc;
-    if (w->keep != HD_KEEP_ALL)
-        return hd__err(w->err, HD_EUNSUPPORTED,
-                       "%s: a subset of a LAZ file is not written (its points would be compressed again, every "
-                       "field; the LAZ writer compresses only the added field)",
-                       w->in->name);
-    if (!z.pl.add) { /* no field, every point: the file as it is */
+    if (!z.pl.add && w->keep == HD_KEEP_ALL) { /* no field, every point: the file as it is */
         hd__w_put(w, w->in->data, w->in->size);
         w->written = w->n;
         return HD_OK;
     }
-    las_header(w, &z.pl, &z.h);
+    hd__las_header_of(w, &z.pl, &z.h);
     hd__sink_init(&z.sink, HD_FLOAT64);
     hd__read_t r = {w->in, w->ropt, 1, &z.sink, NULL, 0, w->err, 0, 0, 0};
     z.r = r;
     rc = hd__laz_chunks(&z.r, &z.h, &z.c);
-    if (rc == HD_OK && !z.c.layered)
+    if (rc == HD_OK && !z.c.layered) {
+        rc = hd__write_laz_pointwise(w, &z.pl, &z.h, &z.c, &z.r);
+        hd__laz_chunks_free(&z.c);
+        hd__sink_free(&z.sink);
+        return rc;
+    }
+    if (rc == HD_OK && w->keep != HD_KEEP_ALL)
         rc = hd__err(w->err, HD_EUNSUPPORTED,
-                     "%s: point format %u is compressed pointwise (every field of a point in one stream), which the LAZ "
-                     "writer does not compress again; only layered LAZ (point formats 6-10) takes an added field",
+                     "%s: a subset of a layered LAZ file (point format %u) is not written: its points would be compressed "
+                     "again, every field, and the layered encoder compresses only the added field",
                      w->in->name, z.pl.fmt);
     if (rc == HD_OK) /* the BYTE14 item's version: the existing one's, or POINT14's for a new one */
         z.v4 = hd__ld_u16(w->in->data + z.c.vlr_at + 34 + 6 * (size_t)(z.c.type[z.c.n_items - 1] == IT_BYTE14 ? z.c.n_items - 1 : 0) + 4,

@@ -4,6 +4,7 @@
  */
 #include "lazwrite.h"
 
+#include "io/lasfield.h"
 #include "io/lazcoder.h"
 
 #include <assert.h>
@@ -395,3 +396,95 @@ void lazw_random(gen_rng_t *g, lazw_point_t *p, size_t n, int format) {
         p[i] = (lazw_point_t){x, y, z, (unsigned char)r, (unsigned char)nn, (unsigned char)ch};
     }
 }
+
+/* ---- pointwise files of whole records (the library's encoder) ------------ */
+/* n random records of point format fmt (0-3) with `extra` extra bytes:
+ * every field varies (returns, flags, classification, scan angle, user
+ * data, point source, intensity, GPS times repeated, stepping and jumping,
+ * colours grey and not, extra bytes). */
+unsigned char *lazw_rich_records(gen_rng_t *g, int fmt, unsigned extra, size_t n, size_t *rec) {
+    static const unsigned base[4] = {20, 28, 26, 34};
+    *rec = base[fmt] + extra;
+    unsigned char *r = calloc(n, *rec);
+    int32_t x = 0, y = 0, z = 0;
+    uint64_t t = 0x41C0000000000000ull;
+    uint16_t rgb[3] = {100, 200, 300};
+    for (size_t k = 0; k < n; k++) {
+        unsigned char *p = r + k * *rec;
+        uint64_t u = gen_u64(g);
+        x += (int32_t)(u % 2001) - 1000, y += (int32_t)(u >> 16 & 255) - 128, z += (int32_t)(u >> 24 & 15) - 7;
+        if (u % 97 == 0) x = (int32_t)gen_u64(g);
+        for (int b = 0; b < 4; b++) p[b] = (unsigned char)(x >> 8 * b), p[4 + b] = (unsigned char)(y >> 8 * b), p[8 + b] = (unsigned char)(z >> 8 * b);
+        unsigned nr = 1 + (unsigned)(u >> 32) % 5, ret = 1 + (unsigned)(u >> 36) % nr;
+        uint16_t inten = (uint16_t)(u >> 40 & 7 ? 500 + (u >> 44 & 63) : u >> 48);
+        p[12] = (unsigned char)inten, p[13] = (unsigned char)(inten >> 8);
+        p[14] = (unsigned char)(ret | nr << 3 | (u >> 50 & 3) << 6);
+        p[15] = (unsigned char)(u >> 52 & 3 ? 2 : u >> 54 & 31);
+        p[16] = (unsigned char)(u >> 56 & 1 ? (int8_t)(u >> 57 & 63) - 30 : 0);
+        p[17] = (unsigned char)(u >> 59 & 1 ? 7 : u >> 40);
+        p[18] = (unsigned char)(u >> 61 & 1 ? 11 : u >> 20), p[19] = 0;
+        size_t off = 20;
+        if (fmt == 1 || fmt == 3) {
+            uint64_t w = gen_u64(g);
+            t = w % 4 == 0 ? t : w % 4 == 1 ? t + 1000 : w % 4 == 2 ? t + (w >> 8 & 0xFFFFF) : w % 16 == 3 ? t + (w << 30) : t - 5;
+            for (int b = 0; b < 8; b++) p[off + b] = (unsigned char)(t >> 8 * b);
+            off += 8;
+        }
+        if (fmt >= 2) {
+            uint64_t w = gen_u64(g);
+            if (w % 3 == 0) rgb[0] = rgb[1] = rgb[2] = (uint16_t)(w >> 8); /* grey */
+            else if (w % 3 == 1) rgb[0] = (uint16_t)(rgb[0] + (w >> 8 & 15)), rgb[2] = (uint16_t)(w >> 24);
+            for (int c = 0; c < 3; c++) p[off + 2 * c] = (unsigned char)rgb[c], p[off + 2 * c + 1] = (unsigned char)(rgb[c] >> 8);
+            off += 6;
+        }
+        for (unsigned e = 0; e < extra; e++) p[off + e] = (unsigned char)(k % 7 ? 40 + e : gen_u64(g));
+    }
+    return r;
+}
+
+/* A pointwise LAZ file (LAS 1.2, chunks of `chunk` points) of the records,
+ * compressed by the library's pointwise encoder. */
+void lazw_pointwise(tf_buf_t *b, int fmt, unsigned extra, const unsigned char *recs, size_t rec, size_t n,
+                           size_t chunk) {
+    unsigned type[4], size[4], ni = 0;
+    type[ni] = 6, size[ni++] = 20;
+    if (fmt == 1 || fmt == 3) type[ni] = 7, size[ni++] = 8;
+    if (fmt >= 2) type[ni] = 8, size[ni++] = 6;
+    if (extra) type[ni] = 0, size[ni++] = extra;
+    size_t vlr = 34 + 6 * ni, offset = 227 + 54 + vlr;
+    tf_put(b, "LASF", 4);
+    while (b->size < 24) tf_u8(b, 0);
+    tf_u8(b, 1), tf_u8(b, 2);
+    while (b->size < 94) tf_u8(b, 0);
+    tf_u16(b, 227, 0), tf_u32(b, (uint32_t)offset, 0), tf_u32(b, 1, 0);
+    tf_u8(b, (unsigned)fmt | 0x80), tf_u16(b, (unsigned)rec, 0), tf_u32(b, (uint32_t)n, 0);
+    while (b->size < 131) tf_u8(b, 0);
+    for (int c = 0; c < 3; c++) tf_f64(b, 0.01, 0);
+    for (int c = 0; c < 3; c++) tf_f64(b, 0, 0);
+    while (b->size < 227) tf_u8(b, 0);
+    char user[16] = "laszip encoded", desc[32] = "";
+    tf_u16(b, 0, 0), tf_put(b, user, 16), tf_u16(b, 22204, 0), tf_u16(b, (unsigned)vlr, 0), tf_put(b, desc, 32);
+    tf_u16(b, 2, 0), tf_u16(b, 0, 0), tf_u8(b, 2), tf_u8(b, 2), tf_u16(b, 0, 0), tf_u32(b, 0, 0);
+    tf_u32(b, (uint32_t)chunk, 0), tf_u64(b, (uint64_t)-1, 0), tf_u64(b, (uint64_t)-1, 0), tf_u16(b, ni, 0);
+    for (unsigned i = 0; i < ni; i++) tf_u16(b, type[i], 0), tf_u16(b, size[i], 0), tf_u16(b, 2, 0);
+    size_t ptr = b->size, nc = (n + chunk - 1) / chunk;
+    tf_u64(b, 0, 0);
+    uint64_t *bytes = calloc(nc + 1, sizeof *bytes);
+    hd__enc_t e;
+    hd__enc_init(&e);
+    for (size_t c = 0; c < nc; c++) {
+        size_t k = n - c * chunk < chunk ? n - c * chunk : chunk;
+        if (hd__laz_encode_pointwise(recs + c * chunk * rec, k, rec, type, size, ni, &e)) abort();
+        tf_put(b, recs + c * chunk * rec, rec);
+        tf_put(b, e.buf, e.size);
+        bytes[c] = rec + e.size;
+    }
+    uint64_t tab = b->size;
+    for (int i = 0; i < 8; i++) b->data[ptr + i] = (unsigned char)(tab >> 8 * i);
+    tf_u32(b, 0, 0), tf_u32(b, (uint32_t)nc, 0);
+    if (hd__laz_table_encode(0, nc, NULL, bytes, &e)) abort();
+    tf_put(b, e.buf, e.size);
+    hd__enc_free(&e);
+    free(bytes);
+}
+

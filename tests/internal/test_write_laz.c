@@ -7,14 +7,20 @@
  * eight new BYTE14 layers decoded by this file's own loop over the
  * coder's primitives with LASzip's v3 rule for the scanner channels (the
  * channel of each point known from the points given to the writer), so
- * every value comes back bit for bit.  laz-perf checks the same output
- * where it can (tests/writeback_lazperf.py).  And the LAZ refusals.
+ * every value comes back bit for bit.  Pointwise LAZ (formats 0-3) whose
+ * every field varies, compressed by the library's pointwise encoder, is
+ * decoded back to its records, and hd_write_field's output (all points, a
+ * subset) to the same records with the values after them.  laz-perf
+ * checks these outputs too where it can (tests/laz_lazperf.py, field_*
+ * cases).  And the LAZ refusals.
  */
 #include "check.h"
 #include "files.h"
 #include "gen.h"
 #include "lazwrite.h"
 
+#include "io/io.h"
+#include "io/lasfield.h"
 #include "io/lazcoder.h"
 
 #include <stdlib.h>
@@ -194,22 +200,98 @@ TEST(layered_laz_gains_the_field_as_byte14_layers) {
     laz_case(&o, 5, 6);
 }
 
-TEST(pointwise_laz_and_laz_subsets_are_refused_by_name) {
+/* ---- pointwise LAZ: every field compressed again ------------------------- */
+/* Every whole record of the LAZ file at path, decoded by laz.c. */
+static unsigned char *records_of(const char *path, size_t *n, size_t *rec) {
+    size_t size;
+    unsigned char *d = slurp(path, &size);
+    hd__file_t f = {path, d, size};
+    hd_read_options_t o;
+    hd_read_options_init(&o);
+    hd__sink_t sink;
+    hd__sink_init(&sink, HD_FLOAT64);
+    hd_error_t err;
+    hd__read_t r = {&f, &o, 1, &sink, NULL, 0, &err, 0, 0, 0};
+    hd__las_header_t h;
+    memset(&h, 0, sizeof h);
+    h.minor = d[25], h.fmt = d[104] & 63, h.header = le(d + 94, 2), h.offset = le(d + 96, 4), h.rec = le(d + 105, 2);
+    h.count = le(d + 107, 4), h.n_vlr = (uint32_t)le(d + 100, 4);
+    hd__laz_chunks_t c;
+    CHECK_RC(hd__laz_chunks(&r, &h, &c), HD_OK);
+    unsigned char *out = calloc(h.count + 1, h.rec);
+    for (size_t k = 0; k < c.n_chunks && !hdt_failed(); k++) {
+        int rc = hd__laz_chunk_records(&r, &h, &c, k, out + c.first[k] * h.rec);
+        if (rc) CONTEXT("%s", err.message);
+        CHECK_RC(rc, HD_OK);
+    }
+    hd__laz_chunks_free(&c);
+    *n = h.count, *rec = h.rec;
+    free(d);
+    return out;
+}
+
+TEST(pointwise_laz_is_compressed_again_with_every_field) {
+    for (int fmt = 0; fmt <= 3; fmt++)
+        for (unsigned extra = 0; extra <= 3; extra += 3) {
+            CONTEXT("format %d extra %u", fmt, extra);
+            gen_rng_t g;
+            gen_seed(&g, 77 + (uint64_t)fmt * 10 + extra);
+            size_t n = 3001, rec;
+            unsigned char *recs = lazw_rich_records(&g, fmt, extra, n, &rec);
+            tf_buf_t b = {0};
+            lazw_pointwise(&b, fmt, extra, recs, rec, n, 1000);
+            const char *in = tf_finish(&b, "rich.laz");
+            size_t m, mrec;
+            unsigned char *back = records_of(in, &m, &mrec); /* the encoder's file decodes to its records */
+            CHECK(m == n && mrec == rec && memcmp(back, recs, n * rec) == 0);
+            free(back);
+            double *v = malloc(n * sizeof *v);
+            for (size_t k = 0; k < n; k++) v[k] = k % 4 ? gen_normal(&g) : 0.5;
+            hd_error_t err;
+            hd_write_options_t o;
+            hd_write_options_init(&o);
+            for (int keep = 0; keep < 2; keep++) {
+                o.keep = keep ? HD_KEEP_FARTHER : HD_KEEP_ALL;
+                o.threshold = 0.25;
+                size_t written = 0;
+                CHECK_RC(hd_write_field(in, tf_path("rich_out.laz"), v, n, &o, &written, &err), HD_OK);
+                unsigned char *out = records_of(tf_path("rich_out.laz"), &m, &mrec);
+                CHECK(mrec == rec + 8 && m == written);
+                for (size_t k = 0, j = 0; k < n && !hdt_failed(); k++) {
+                    if (keep && !(v[k] > 0.25)) continue;
+                    CHECK(memcmp(out + j * mrec, recs + k * rec, rec) == 0);
+                    double got;
+                    memcpy(&got, out + j * mrec + rec, 8);
+                    CHECK_BITS(got, v[k]);
+                    j++;
+                }
+                free(out);
+            }
+            free(v);
+            free(recs);
+        }
+}
+
+TEST(laszip1_streams_and_layered_subsets_are_refused_by_name) {
     gen_rng_t g;
     gen_seed(&g, 9);
     lazw_point_t p[20];
     lazw_random(&g, p, 20, 1);
-    lazw_opts_t o = {1, 0, 10, NULL, 0, {0.01, 0.01, 0.01}, {0, 0, 0}, 0};
+    lazw_opts_t o = {1, 0, 10, NULL, 0, {0.01, 0.01, 0.01}, {0, 0, 0}, 1};
     tf_buf_t b = {0};
     lazw_encode(&b, &o, p, 20);
-    const char *in = tf_finish(&b, "pw.laz");
+    const char *in = tf_finish(&b, "v1.laz");
     double v[20] = {0};
     hd_error_t err;
-    CHECK_RC(hd_write_field(in, tf_path("pw_out.laz"), v, 20, NULL, NULL, &err), HD_EUNSUPPORTED);
-    CHECK(strstr(err.message, "point format 1 is compressed pointwise"));
+    CHECK_RC(hd_write_field(in, tf_path("v1_out.laz"), v, 20, NULL, NULL, &err), HD_EUNSUPPORTED);
+    CHECK(strstr(err.message, "LASzip 1.x compression"));
+    lazw_random(&g, p, 20, 6);
+    o.format = 6, o.v1 = 0;
+    lazw_encode(&b, &o, p, 20);
+    in = tf_finish(&b, "l.laz");
     hd_write_options_t w;
     hd_write_options_init(&w);
     w.keep = HD_KEEP_FARTHER;
-    CHECK_RC(hd_write_field(in, tf_path("pw_out.laz"), v, 20, &w, NULL, &err), HD_EUNSUPPORTED);
-    CHECK(strstr(err.message, "a subset of a LAZ file is not written"));
+    CHECK_RC(hd_write_field(in, tf_path("l_out.laz"), v, 20, &w, NULL, &err), HD_EUNSUPPORTED);
+    CHECK(strstr(err.message, "a subset of a layered LAZ file (point format 6) is not written"));
 }
