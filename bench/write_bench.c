@@ -7,7 +7,10 @@
  * It writes POINTS points (1 000 000 by default: seeded random walks of the
  * tests' LAZ writer, tests/internal/lazwrite.c) as LAS 1.4 point format 6
  * (uncompressed, 30-byte records) and as layered LAZ (chunks of 50 000, all
- * four scanner channels) to DIR (default /tmp), and seeded values; then
+ * four scanner channels), and POINTS records of point format 3 whose every
+ * field varies (lazw_rich_records) as pointwise LAZ (chunks of 50 000,
+ * compressed by the library's pointwise encoder) to DIR (default /tmp), and
+ * seeded values; then
  * times RUNS runs (default 5) of `cp FILE DIR/copy` and of hd_write_field
  * (which reads the input once through hd_read_file, to check it and count
  * its points, then writes the output and fsyncs it), and prints the medians
@@ -72,8 +75,9 @@ static off_t size_of(const char *path) {
 
 static void row(const char *name, const char *in, const char *dir, const double *v, size_t n, int runs) {
     char out[4096], copy[4096], cmd[9000];
-    snprintf(out, sizeof out, "%s/write_bench_out.%s", dir, name);
-    snprintf(copy, sizeof copy, "%s/write_bench_copy.%s", dir, name);
+    const char *ext = strrchr(in, '.');
+    snprintf(out, sizeof out, "%s/write_bench_out_%s%s", dir, name, ext);
+    snprintf(copy, sizeof copy, "%s/write_bench_copy_%s%s", dir, name, ext);
     snprintf(cmd, sizeof cmd, "cp '%s' '%s' && sync '%s'", in, copy, copy);
     double *tc = malloc(runs * sizeof *tc), *tw = malloc(runs * sizeof *tw), *cpu = malloc(runs * sizeof *cpu);
     for (int r = 0; r < runs; r++) {
@@ -120,7 +124,8 @@ int main(int argc, char **argv) {
     double *v = malloc(n * sizeof *v);
     lazw_random(&g, p, n, 6);
     for (size_t k = 0; k < n; k++) v[k] = gen_unit(&g) * 0.05;
-    char las[4096], laz[4096];
+    char las[4096], laz[4096], laz3[4096];
+    snprintf(laz3, sizeof laz3, "%s/write_bench_in3.laz", dir);
     snprintf(las, sizeof las, "%s/write_bench_in.las", dir);
     snprintf(laz, sizeof laz, "%s/write_bench_in.laz", dir);
     tf_buf_t b = {0};
@@ -131,12 +136,20 @@ int main(int argc, char **argv) {
     lazw_encode(&b, &o, p, n);
     save(laz, &b);
     tf_free(&b);
+    size_t rec;
+    unsigned char *recs = lazw_rich_records(&g, 3, 0, n, &rec);
+    lazw_pointwise(&b, 3, 0, recs, rec, n, 50000);
+    save(laz3, &b);
+    tf_free(&b);
+    free(recs);
     printf("| format | input | output | copy (cp + sync) | hd_write_field | its CPU | Mpoints/s |\n|---|---|---|---|---|---|---|\n");
     row("las", las, dir, v, n, runs);
     row("laz", laz, dir, v, n, runs);
+    row("laz3", laz3, dir, v, n, runs);
     if (!keep) {
         remove(las);
         remove(laz);
+        remove(laz3);
     }
     free(p);
     free(v);

@@ -808,9 +808,8 @@ HD_EXTERN void hd_write_options_init(hd_write_options_t *opt);
  * opt->keep selects (in file order).  values holds n doubles, n being the
  * number of points hd_read_file gives for in_path with opt->read (for
  * meshes: the vertices); it is borrowed for the call.
- * Formats (the input's, confirmed as hd_read_file does; out_path's
- * extension must name the same format, or .las for a LAZ input's subset,
- * see below):
+ * Formats (the input's, as its signature or the read options' format
+ * or its extension say; out_path's extension must name the same format):
  *  - PLY ascii and binary: `property double NAME` appended to element
  *    vertex, in the input's encoding and byte order; a value is written
  *    as the shortest decimal that reads back to the same double (ascii).
@@ -823,10 +822,12 @@ HD_EXTERN void hd_write_options_init(hd_write_options_t *opt);
  *    "undocumented" one for bytes it did not describe), the record
  *    length, offsets and (subset) counts, counts by return and bounds
  *    updated; waveform data and extended VLRs follow the points as before.
- *  - LAZ: point formats 6-10 (layered): every layer of every chunk copied
- *    as it is and the field's 8 bytes added as BYTE14 layers encoded by
- *    the project's encoder (src/io/lazwrite.c).  Point formats 0-5 and
- *    any LAZ subset are HD_EUNSUPPORTED, the message naming the reason.
+ *  - LAZ, point formats 6-10 (layered): every layer of every chunk copied
+ *    as it is and the field's 8 bytes added as BYTE14 layers; a subset is
+ *    HD_EUNSUPPORTED.  Point formats 0-3 (pointwise, LASzip items of
+ *    version 2): every chunk decoded and compressed again, the field's 8
+ *    bytes in the BYTE item; subsets too.  LASzip 1.x streams are
+ *    HD_EUNSUPPORTED.  The library's own encoder writes both.
  *  - XYZ, CSV, TXT, PTS, ASC: every line kept, the value appended to each
  *    point line with the file's separator (a CSV header line gets the
  *    name; a PTS count line the subset's count).  OBJ: a subset keeps its

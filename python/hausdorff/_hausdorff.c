@@ -1432,7 +1432,7 @@ PyDoc_STRVAR(write_field_doc,
 "            farther_than=None, nearer_than=None, format=None,\n"
 "            decimal_comma=False)\n--\n\n"
 "Write out_path: the points of in_path in its own format (PLY ascii or\n"
-"binary, LAS, LAZ point formats 6-10, xyz/csv/pts text; OBJ subsets) with\n"
+"binary, LAS, LAZ, xyz/csv/pts text; OBJ subsets) with\n"
 "values[k] added to point k as the field `name` (a PLY vertex property, a\n"
 "LAS/LAZ extra-bytes dimension, a text column); every other property,\n"
 "element, record and line of the input is kept.  values: one float per\n"
