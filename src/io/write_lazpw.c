@@ -379,6 +379,94 @@ static int write_chunks(pw_t *z, const hd__las_header_t *h, const hd__laz_chunks
     return rc;
 }
 
+/* Every point kept, the input's chunks kept: the chunks are decoded and
+ * encoded in parallel, a batch of a few per thread at a time (each task
+ * with its own buffers, encoder and error), and written in order. */
+typedef struct {
+    pw_t *z;
+    const hd__las_header_t *h;
+    const hd__laz_chunks_t *c;
+    hd__read_t *r;
+    size_t base, most;
+    unsigned char **in, **out;
+    hd__enc_t *enc;
+    int *rc;
+    hd_error_t *err;
+} batch_t;
+
+static void batch_task(void *ctx, size_t t, int worker) {
+    (void)worker;
+    batch_t *B = ctx;
+    pw_t *z = B->z;
+    size_t k = B->base + t, n = (size_t)(B->c->first[k + 1] - B->c->first[k]), f = (size_t)B->c->first[k];
+    size_t rec = z->pl->rec, orec = z->pl->out_rec;
+    hd__read_t r = *B->r;
+    r.err = &B->err[t];
+    if (!B->in[t]) B->in[t] = hd__malloc_array(B->most + 1, rec);
+    if (!B->out[t]) B->out[t] = hd__malloc_array(B->most + 1, orec);
+    if (!B->in[t] || !B->out[t]) {
+        B->rc[t] = hd__err(&B->err[t], HD_ENOMEM, "out of memory for chunks of %zu points", B->most);
+        return;
+    }
+    int rc = hd__laz_chunk_records(&r, B->h, B->c, k, B->in[t]);
+    for (size_t i = 0; i < n && rc == HD_OK; i++) {
+        memcpy(B->out[t] + i * orec, B->in[t] + i * rec, rec);
+        uint64_t u;
+        memcpy(&u, &z->w->v[f + i], 8);
+        hd__st_u64(B->out[t] + i * orec + rec, u);
+    }
+    if (rc == HD_OK && hd__laz_encode_pointwise(B->out[t], n, orec, z->type, z->size, z->n_items, &B->enc[t]))
+        rc = hd__err(&B->err[t], HD_ENOMEM, "out of memory");
+    B->rc[t] = rc;
+}
+
+static int write_all_parallel(pw_t *z, const hd__las_header_t *h, const hd__laz_chunks_t *c, hd__read_t *r) {
+    hd__writer_t *w = z->w;
+    int threads = hd__thread_count(w->ropt->threads, c->n_chunks);
+    size_t per = 2 * (size_t)threads, most = 0;
+    for (size_t k = 0; k < c->n_chunks; k++)
+        if (c->first[k + 1] - c->first[k] > most) most = (size_t)(c->first[k + 1] - c->first[k]);
+    batch_t B = {z, h, c, r, 0, most, calloc(per, sizeof(void *)), calloc(per, sizeof(void *)),
+                 calloc(per, sizeof(hd__enc_t)), calloc(per, sizeof(int)), calloc(per, sizeof(hd_error_t))};
+    int rc = B.in && B.out && B.enc && B.rc && B.err ? HD_OK : hd__err(w->err, HD_ENOMEM, "out of memory");
+    for (size_t t = 0; rc == HD_OK && t < per; t++) hd__enc_init(&B.enc[t]);
+    for (B.base = 0; rc == HD_OK && B.base < c->n_chunks && !w->werr; B.base += per) {
+        size_t m = c->n_chunks - B.base < per ? c->n_chunks - B.base : per;
+        hd__parallel_for(threads, m, batch_task, &B);
+        for (size_t t = 0; t < m && rc == HD_OK; t++) {
+            if (B.rc[t]) {
+                rc = hd__err(w->err, B.rc[t], "%s", B.err[t].message);
+                break;
+            }
+            size_t k = B.base + t;
+            if (z->n_chunks == z->cap_chunks) {
+                size_t cap = z->cap_chunks ? 2 * z->cap_chunks : 64;
+                uint32_t *cc = hd__realloc_array(z->counts, cap, sizeof *cc);
+                if (cc) z->counts = cc;
+                uint64_t *bb = hd__realloc_array(z->bytes, cap, sizeof *bb);
+                if (bb) z->bytes = bb;
+                if (!cc || !bb) {
+                    rc = hd__err(w->err, HD_ENOMEM, "out of memory");
+                    break;
+                }
+                z->cap_chunks = cap;
+            }
+            z->counts[z->n_chunks] = (uint32_t)(c->first[k + 1] - c->first[k]);
+            z->bytes[z->n_chunks++] = z->pl->out_rec + B.enc[t].size;
+            hd__w_put(w, B.out[t], z->pl->out_rec);
+            hd__w_put(w, B.enc[t].buf, B.enc[t].size);
+        }
+    }
+    z->kept = w->n;
+    for (size_t t = 0; t < per; t++) {
+        if (B.in) free(B.in[t]);
+        if (B.out) free(B.out[t]);
+        if (B.enc) hd__enc_free(&B.enc[t]);
+    }
+    free(B.in), free(B.out), free(B.enc), free(B.rc), free(B.err);
+    return rc;
+}
+
 int hd__write_laz_pointwise(hd__writer_t *w, hd__las_plan_t *pl, const hd__las_header_t *h, const hd__laz_chunks_t *c,
                             hd__read_t *r) {
     if (!c->chunked)
@@ -408,7 +496,7 @@ int hd__write_laz_pointwise(hd__writer_t *w, hd__las_plan_t *pl, const hd__las_h
         table_ptr = ftello(w->out);
         unsigned char zero[8] = {0};
         hd__w_put(w, zero, 8);
-        rc = write_chunks(&z, h, c, r, all ? 0 : HD__LAZ_CHUNK);
+        rc = all && pl->add ? write_all_parallel(&z, h, c, r) : write_chunks(&z, h, c, r, all ? 0 : HD__LAZ_CHUNK);
     }
     if (rc == HD_OK && !w->werr) {
         off_t table = ftello(w->out);
