@@ -217,7 +217,7 @@ static void encode_chunk(void *ctx, size_t k, int worker) {
     for (int b = 0; b < NB; b++) add += z->sizes[NB * k + b];
     if (rc == HD_OK && add && !(z->layers[k] = malloc(add))) rc = hd__err(err, HD_ENOMEM, "out of memory");
     for (int b = 0, at = 0; b < NB && rc == HD_OK; b++) {
-        memcpy(z->layers[k] + at, enc[b].buf, z->sizes[NB * k + b]);
+        if (z->sizes[NB * k + b]) memcpy(z->layers[k] + at, enc[b].buf, z->sizes[NB * k + b]);
         at += (int)z->sizes[NB * k + b];
     }
     z->layers_size[k] = add;
