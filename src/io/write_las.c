@@ -261,6 +261,21 @@ void hd__w_range(const hd__writer_t *w, double *lo, double *hi) {
         }
 }
 
+/* The header las.c builds, from a header it has accepted. */
+void hd__las_header_of(const hd__writer_t *w, const hd__las_plan_t *pl, hd__las_header_t *h) {
+    const unsigned char *d = w->in->data;
+    memset(h, 0, sizeof *h);
+    h->minor = pl->minor;
+    h->fmt = pl->fmt;
+    h->header = pl->header;
+    h->offset = pl->offset;
+    h->rec = pl->rec;
+    h->count = pl->count;
+    h->n_vlr = pl->n_vlr;
+    h->evlr = pl->minor >= 4 && pl->header >= 247 && hd__ld_u32(d + 243, 0) > 0 ? hd__ld_u64(d + 235, 0) : 0;
+    hd__las_scale(d, h->scale, h->shift);
+}
+
 int hd__write_las(hd__writer_t *w) {
     hd__las_plan_t pl;
     int rc = hd__las_plan(w, &pl);

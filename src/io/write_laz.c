@@ -109,21 +109,6 @@ static int encode_bytes(const hd__writer_t *w, size_t first, size_t n, const uns
     return rc;
 }
 
-/* The header las.c builds, from a header it has accepted. */
-void hd__las_header_of(const hd__writer_t *w, const hd__las_plan_t *pl, hd__las_header_t *h) {
-    const unsigned char *d = w->in->data;
-    memset(h, 0, sizeof *h);
-    h->minor = pl->minor;
-    h->fmt = pl->fmt;
-    h->header = pl->header;
-    h->offset = pl->offset;
-    h->rec = pl->rec;
-    h->count = pl->count;
-    h->n_vlr = pl->n_vlr;
-    h->evlr = pl->minor >= 4 && pl->header >= 247 && hd__ld_u32(d + 243, 0) > 0 ? hd__ld_u64(d + 235, 0) : 0;
-    hd__las_scale(d, h->scale, h->shift);
-}
-
 /* The LASzip VLR's data with the BYTE14 item grown by 8 or added: into
  * *out (malloc'd), its length in *len. */
 static int new_vlr(const hd__writer_t *w, const hd__laz_chunks_t *c, unsigned char **out, size_t *len) {
@@ -150,22 +135,6 @@ static int new_vlr(const hd__writer_t *w, const hd__laz_chunks_t *c, unsigned ch
     }
     *out = p;
     return HD_OK;
-}
-
-/* The chunk table's entries: per chunk its point count (variable chunk
- * sizes only) and its byte size, each predicted by the previous chunk's,
- * in one stream (the table's version and chunk count precede it). */
-int hd__laz_table_encode(int variable, size_t nc, const uint32_t *counts, const uint64_t *bytes, hd__enc_t *e) {
-    hd__intcoder_t ic;
-    if (hd__intcoder_new(&ic, 32, 2)) return HD_ENOMEM;
-    hd__enc_reset(e);
-    for (size_t k = 0; k < nc; k++) {
-        if (variable) hd__ic_encode(&ic, e, k ? (int32_t)counts[k - 1] : 0, (int32_t)counts[k], 0);
-        hd__ic_encode(&ic, e, k ? (int32_t)bytes[k - 1] : 0, (int32_t)bytes[k], 1);
-    }
-    hd__enc_done(e);
-    hd__intcoder_free(&ic);
-    return e->oom ? HD_ENOMEM : HD_OK;
 }
 
 static int encode_table(const hd__laz_chunks_t *c, const uint64_t *bytes, hd__enc_t *e) {

@@ -266,6 +266,22 @@ int hd__laz_encode_pointwise(const unsigned char *recs, size_t n, size_t rec, co
     return rc;
 }
 
+/* The chunk table's entries: per chunk its point count (variable chunk
+ * sizes only) and its byte size, each predicted by the previous chunk's,
+ * in one stream (the table's version and chunk count precede it). */
+int hd__laz_table_encode(int variable, size_t nc, const uint32_t *counts, const uint64_t *bytes, hd__enc_t *e) {
+    hd__intcoder_t ic;
+    if (hd__intcoder_new(&ic, 32, 2)) return HD_ENOMEM;
+    hd__enc_reset(e);
+    for (size_t k = 0; k < nc; k++) {
+        if (variable) hd__ic_encode(&ic, e, k ? (int32_t)counts[k - 1] : 0, (int32_t)counts[k], 0);
+        hd__ic_encode(&ic, e, k ? (int32_t)bytes[k - 1] : 0, (int32_t)bytes[k], 1);
+    }
+    hd__enc_done(e);
+    hd__intcoder_free(&ic);
+    return e->oom ? HD_ENOMEM : HD_OK;
+}
+
 typedef struct {
     hd__writer_t *w;
     hd__las_plan_t *pl;
