@@ -70,6 +70,30 @@ static void write_case(const char *dir, const char *name, const lazw_opts_t *o, 
     free(p);
 }
 
+/* The input b saved as DIR/NAME-input.laz, hd_write_field of the n values
+ * v into DIR/NAME.laz (o: NULL for the defaults), the input removed, and
+ * DIR/NAME.txt opened for the expected lines. */
+static FILE *write_field_of(const char *dir, const char *name, const tf_buf_t *b, const double *v, size_t n,
+                            const hd_write_options_t *o) {
+    char in[4096], out[4096];
+    snprintf(in, sizeof in, "%s/%s-input.laz", dir, name);
+    snprintf(out, sizeof out, "%s/%s.laz", dir, name);
+    FILE *f = fopen(in, "wb");
+    if (!f || fwrite(b->data, 1, b->size, f) != b->size || fclose(f)) {
+        perror(in);
+        exit(1);
+    }
+    hd_error_t err;
+    if (hd_write_field(in, out, v, n, o, NULL, &err) != HD_OK) {
+        fprintf(stderr, "lazgen: %s\n", err.message);
+        exit(1);
+    }
+    remove(in);
+    snprintf(out, sizeof out, "%s/%s.txt", dir, name);
+    if (!(f = fopen(out, "w"))) exit(1);
+    return f;
+}
+
 /* The field case NAME: see the top of the file. */
 static void field_case(const char *dir, const char *name, const lazw_opts_t *o, uint64_t seed, size_t n) {
     gen_rng_t g;
@@ -84,23 +108,7 @@ static void field_case(const char *dir, const char *name, const lazw_opts_t *o, 
     }
     tf_buf_t b = {0};
     lazw_encode(&b, o, p, n);
-    char in[4096], out[4096];
-    snprintf(in, sizeof in, "%s/%s-input.laz", dir, name);
-    snprintf(out, sizeof out, "%s/%s.laz", dir, name);
-    FILE *f = fopen(in, "wb");
-    if (!f || fwrite(b.data, 1, b.size, f) != b.size || fclose(f)) {
-        perror(in);
-        exit(1);
-    }
-    hd_error_t err;
-    if (hd_write_field(in, out, v, n, NULL, NULL, &err) != HD_OK) {
-        fprintf(stderr, "lazgen: %s\n", err.message);
-        exit(1);
-    }
-    remove(in);
-    snprintf(out, sizeof out, "%s/%s.txt", dir, name);
-    f = fopen(out, "w");
-    if (!f) exit(1);
+    FILE *f = write_field_of(dir, name, &b, v, n, NULL);
     for (size_t k = 0; k < n; k++) {
         uint64_t u;
         memcpy(&u, &v[k], 8);
@@ -124,27 +132,11 @@ static void record_case(const char *dir, const char *name, int fmt, unsigned ext
     for (size_t k = 0; k < n; k++) v[k] = k % 4 ? gen_normal(&g) : 0.5;
     tf_buf_t b = {0};
     lazw_pointwise(&b, fmt, extra, recs, rec, n, 1000);
-    char in[4096], out[4096];
-    snprintf(in, sizeof in, "%s/%s-input.laz", dir, name);
-    snprintf(out, sizeof out, "%s/%s.laz", dir, name);
-    FILE *f = fopen(in, "wb");
-    if (!f || fwrite(b.data, 1, b.size, f) != b.size || fclose(f)) {
-        perror(in);
-        exit(1);
-    }
     hd_write_options_t o;
     hd_write_options_init(&o);
     o.keep = subset ? HD_KEEP_FARTHER : HD_KEEP_ALL;
     o.threshold = 0.25;
-    hd_error_t err;
-    if (hd_write_field(in, out, v, n, &o, NULL, &err) != HD_OK) {
-        fprintf(stderr, "lazgen: %s\n", err.message);
-        exit(1);
-    }
-    remove(in);
-    snprintf(out, sizeof out, "%s/%s.txt", dir, name);
-    f = fopen(out, "w");
-    if (!f) exit(1);
+    FILE *f = write_field_of(dir, name, &b, v, n, &o);
     for (size_t k = 0; k < n; k++) {
         if (subset && !(v[k] > 0.25)) continue;
         unsigned char val[8];

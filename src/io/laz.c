@@ -203,16 +203,11 @@ typedef struct {
 
 static void pw_free(pw_t *w) {
     hd__symmodel_t *models[] = {&w->changed, &w->scan[0], &w->scan[1], &w->gmulti, &w->gzero, &w->used};
-    for (size_t i = 0; i < sizeof models / sizeof models[0]; i++) hd__symmodel_free(models[i]);
+    hd__symmodels_free(models, sizeof models / sizeof models[0]);
     for (int i = 0; i < 6; i++) hd__symmodel_free(&w->cdiff[i]);
-    for (int i = 0; i < 256; i++) {
-        hd__symmodel_t **t[3] = {w->bitbyte, w->cls, w->user};
-        for (int a = 0; a < 3; a++)
-            if (t[a][i]) {
-                hd__symmodel_free(t[a][i]);
-                free(t[a][i]);
-            }
-    }
+    hd__lazy_models_free(w->bitbyte, 256);
+    hd__lazy_models_free(w->cls, 256);
+    hd__lazy_models_free(w->user, 256);
     hd__intcoder_t *ics[] = {&w->intensity, &w->psid, &w->dx, &w->dy, &w->dz, &w->scan1, &w->gic, &w->cic, &w->bic};
     for (size_t i = 0; i < sizeof ics / sizeof ics[0]; i++) hd__intcoder_free(ics[i]);
     if (w->bm)
@@ -1255,20 +1250,28 @@ int hd__laz_chunks(hd__read_t *r, const hd__las_header_t *h, hd__laz_chunks_t *o
     return rc;
 }
 
+/* A laz_t over the chunks c found by hd__laz_chunks (borrowed), decoding
+ * without keeping points. */
+static void laz_over(laz_t *z, hd__read_t *r, const hd__las_header_t *h, const hd__laz_chunks_t *c) {
+    memset(z, 0, sizeof *z);
+    z->r = r;
+    z->d = r->f->data;
+    z->size = r->f->size;
+    z->rec = h->rec;
+    z->layered = c->layered;
+    z->n_layers = c->n_layers;
+    z->n_items = c->n_items;
+    for (unsigned i = 0; i < c->n_items; i++) z->items[i] = (item_t){c->type[i], c->size[i], c->version[i]};
+    z->start = c->start;
+    z->first = c->first;
+    z->n_chunks = c->n_chunks;
+    z->lo = z->hi = 0; /* decoded, not kept */
+}
+
 int hd__laz_chunk_channels(hd__read_t *r, const hd__las_header_t *h, const hd__laz_chunks_t *c, size_t chunk,
                            unsigned char *chan) {
     laz_t z;
-    memset(&z, 0, sizeof z);
-    z.r = r;
-    z.d = r->f->data;
-    z.size = r->f->size;
-    z.rec = h->rec;
-    z.layered = 1;
-    z.n_layers = c->n_layers;
-    z.start = c->start;
-    z.first = c->first;
-    z.n_chunks = c->n_chunks;
-    z.lo = z.hi = 0; /* decoded, not kept */
+    laz_over(&z, r, h, c);
     job_t j = {&z, chunk, r->sink, HD_MAX_COORD, (size_t)c->first[chunk], 0, -1, "", chan, NULL};
     const unsigned char *b = z.d + c->start[chunk];
     layered_chunk(&j, b, (size_t)(c->start[chunk + 1] - c->start[chunk]), (size_t)(c->first[chunk + 1] - c->first[chunk]));
@@ -1279,17 +1282,7 @@ int hd__laz_chunk_channels(hd__read_t *r, const hd__las_header_t *h, const hd__l
 int hd__laz_chunk_records(hd__read_t *r, const hd__las_header_t *h, const hd__laz_chunks_t *c, size_t chunk,
                           unsigned char *recs) {
     laz_t z;
-    memset(&z, 0, sizeof z);
-    z.r = r;
-    z.d = r->f->data;
-    z.size = r->f->size;
-    z.rec = h->rec;
-    z.n_items = c->n_items;
-    for (unsigned i = 0; i < c->n_items; i++) z.items[i] = (item_t){c->type[i], c->size[i], c->version[i]};
-    z.start = c->start;
-    z.first = c->first;
-    z.n_chunks = c->n_chunks;
-    z.lo = z.hi = 0;
+    laz_over(&z, r, h, c);
     job_t j = {&z, chunk, r->sink, HD_MAX_COORD, (size_t)c->first[chunk], 0, -1, "", NULL, recs};
     pointwise_chunk(&j, z.d + c->start[chunk], (size_t)(c->start[chunk + 1] - c->start[chunk]),
                     (size_t)(c->first[chunk + 1] - c->first[chunk]));

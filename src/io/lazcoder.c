@@ -100,6 +100,19 @@ void hd__symmodel_free(hd__symmodel_t *m) {
     m->dist = m->count = m->table = NULL;
 }
 
+void hd__symmodels_free(hd__symmodel_t *const *m, size_t n) {
+    for (size_t i = 0; i < n; i++) hd__symmodel_free(m[i]);
+}
+
+void hd__lazy_models_free(hd__symmodel_t **slots, size_t n) {
+    for (size_t i = 0; i < n; i++)
+        if (slots[i]) {
+            hd__symmodel_free(slots[i]);
+            free(slots[i]);
+            slots[i] = NULL;
+        }
+}
+
 int hd__intcoder_new(hd__intcoder_t *ic, uint32_t bits, uint32_t contexts) {
     assert(bits >= 1 && bits <= 32);
     memset(ic, 0, sizeof *ic);

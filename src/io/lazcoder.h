@@ -70,6 +70,11 @@ int hd__symmodel_new(hd__symmodel_t *m, uint32_t n);
 void hd__symmodel_init(hd__symmodel_t *m);
 void hd__symmodel_update(hd__symmodel_t *m);
 void hd__symmodel_free(hd__symmodel_t *m);
+/* Free the n models whose addresses are in m. */
+void hd__symmodels_free(hd__symmodel_t *const *m, size_t n);
+/* Free the models created on first use in slots[0..n) (NULL: never used),
+ * and their memory. */
+void hd__lazy_models_free(hd__symmodel_t **slots, size_t n);
 
 /* ---- decoder ------------------------------------------------------------ */
 typedef struct hd__dec {

@@ -69,14 +69,12 @@ typedef struct {
 } pwe_t;
 
 static void pwe_free(pwe_t *p) {
-    hd__symmodel_t *m[] = {&p->changed, &p->scan[0], &p->scan[1], &p->gmulti, &p->gzero, &p->used};
-    for (size_t i = 0; i < sizeof m / sizeof m[0]; i++) hd__symmodel_free(m[i]);
-    for (int i = 0; i < 6; i++) hd__symmodel_free(&p->cdiff[i]);
-    for (int i = 0; i < 256; i++) {
-        hd__symmodel_t **t[3] = {p->bitbyte, p->cls, p->user};
-        for (int a = 0; a < 3; a++)
-            if (t[a][i]) hd__symmodel_free(t[a][i]), free(t[a][i]);
-    }
+    hd__symmodel_t *m[] = {&p->changed, &p->scan[0], &p->scan[1], &p->gmulti, &p->gzero, &p->used,
+                           &p->cdiff[0], &p->cdiff[1], &p->cdiff[2], &p->cdiff[3], &p->cdiff[4], &p->cdiff[5]};
+    hd__symmodels_free(m, sizeof m / sizeof m[0]);
+    hd__lazy_models_free(p->bitbyte, 256);
+    hd__lazy_models_free(p->cls, 256);
+    hd__lazy_models_free(p->user, 256);
     hd__intcoder_t *ic[] = {&p->intensity, &p->psid, &p->dx, &p->dy, &p->dz, &p->gic};
     for (size_t i = 0; i < sizeof ic / sizeof ic[0]; i++) hd__intcoder_free(ic[i]);
     for (unsigned i = 0; p->bm && i < p->nb; i++) hd__symmodel_free(&p->bm[i]);
@@ -333,6 +331,25 @@ static int plan_items(pw_t *z, const hd__laz_chunks_t *c, uint32_t chunk) {
     return HD_OK;
 }
 
+/* Write a chunk (its first record raw, then its stream e) and note its
+ * count and bytes for the chunk table; HD_OK or HD_ENOMEM. */
+static int put_chunk(pw_t *z, size_t n, const unsigned char *first, const hd__enc_t *e) {
+    if (z->n_chunks == z->cap_chunks) {
+        size_t cap = z->cap_chunks ? 2 * z->cap_chunks : 64;
+        uint32_t *c = hd__realloc_array(z->counts, cap, sizeof *c);
+        if (c) z->counts = c;
+        uint64_t *b = hd__realloc_array(z->bytes, cap, sizeof *b);
+        if (b) z->bytes = b;
+        if (!c || !b) return HD_ENOMEM;
+        z->cap_chunks = cap;
+    }
+    z->counts[z->n_chunks] = (uint32_t)n;
+    z->bytes[z->n_chunks++] = z->pl->out_rec + e->size;
+    hd__w_put(z->w, first, z->pl->out_rec);
+    hd__w_put(z->w, e->buf, e->size);
+    return HD_OK;
+}
+
 /* Encode and write the gathered output chunk. */
 static int flush_chunk(pw_t *z) {
     if (z->n_out == 0) return HD_OK;
@@ -340,19 +357,7 @@ static int flush_chunk(pw_t *z) {
     size_t rec = z->pl->out_rec;
     if (hd__laz_encode_pointwise(z->out, z->n_out, rec, z->type, z->size, z->n_items, &z->enc))
         return hd__err(w->err, HD_ENOMEM, "out of memory");
-    if (z->n_chunks == z->cap_chunks) {
-        size_t cap = z->cap_chunks ? 2 * z->cap_chunks : 64;
-        uint32_t *c = hd__realloc_array(z->counts, cap, sizeof *c);
-        if (c) z->counts = c;
-        uint64_t *b = hd__realloc_array(z->bytes, cap, sizeof *b);
-        if (b) z->bytes = b;
-        if (!c || !b) return hd__err(w->err, HD_ENOMEM, "out of memory");
-        z->cap_chunks = cap;
-    }
-    z->counts[z->n_chunks] = (uint32_t)z->n_out;
-    z->bytes[z->n_chunks++] = rec + z->enc.size;
-    hd__w_put(w, z->out, rec);
-    hd__w_put(w, z->enc.buf, z->enc.size);
+    if (put_chunk(z, z->n_out, z->out, &z->enc)) return hd__err(w->err, HD_ENOMEM, "out of memory");
     z->n_out = 0;
     return HD_OK;
 }
@@ -455,22 +460,8 @@ static int write_all_parallel(pw_t *z, const hd__las_header_t *h, const hd__laz_
                 break;
             }
             size_t k = B.base + t;
-            if (z->n_chunks == z->cap_chunks) {
-                size_t cap = z->cap_chunks ? 2 * z->cap_chunks : 64;
-                uint32_t *cc = hd__realloc_array(z->counts, cap, sizeof *cc);
-                if (cc) z->counts = cc;
-                uint64_t *bb = hd__realloc_array(z->bytes, cap, sizeof *bb);
-                if (bb) z->bytes = bb;
-                if (!cc || !bb) {
-                    rc = hd__err(w->err, HD_ENOMEM, "out of memory");
-                    break;
-                }
-                z->cap_chunks = cap;
-            }
-            z->counts[z->n_chunks] = (uint32_t)(c->first[k + 1] - c->first[k]);
-            z->bytes[z->n_chunks++] = z->pl->out_rec + B.enc[t].size;
-            hd__w_put(w, B.out[t], z->pl->out_rec);
-            hd__w_put(w, B.enc[t].buf, B.enc[t].size);
+            if (put_chunk(z, (size_t)(c->first[k + 1] - c->first[k]), B.out[t], &B.enc[t]))
+                rc = hd__err(w->err, HD_ENOMEM, "out of memory");
         }
     }
     z->kept = w->n;

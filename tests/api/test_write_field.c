@@ -21,22 +21,6 @@
 #include <unistd.h>
 
 /* ---- helpers -------------------------------------------------------------- */
-static unsigned char *slurp(const char *path, size_t *n) {
-    FILE *f = fopen(path, "rb");
-    if (!f) return NULL;
-    fseek(f, 0, SEEK_END);
-    long len = ftell(f);
-    rewind(f);
-    unsigned char *d = malloc((size_t)len + 1);
-    if (d && fread(d, 1, (size_t)len, f) != (size_t)len) {
-        free(d);
-        d = NULL;
-    }
-    fclose(f);
-    if (d) d[len] = 0;
-    *n = (size_t)len;
-    return d;
-}
 
 static uint64_t le(const unsigned char *p, int n) {
     uint64_t v = 0;
@@ -119,7 +103,7 @@ TEST(ply_ascii_keeps_every_line_and_adds_the_property) {
     CHECK_RC(write_field(in, out, v, 4, HD_KEEP_ALL, 0, &written, &err), HD_OK);
     CHECK_EQ(written, 4);
     size_t n;
-    char *d = (char *)slurp(out, &n);
+    char *d = (char *)tf_read(out, &n);
     CHECK(d && strstr(d, "property uchar red\r\nproperty double distance\r\nelement face 2\r\n"));
     CHECK(d && strstr(d, "comment kept\r\n"));
     CHECK(d && strstr(d, "\r\n3 0 1 2\r\n3 1 2 3\r\n"));
@@ -165,14 +149,14 @@ static void binary_case(int big) {
     CONTEXT("big-endian %d", big);
     const char *in = binary_ply(big ? "be.ply" : "le.ply", big);
     size_t nin;
-    unsigned char *src = slurp(in, &nin);
+    unsigned char *src = tf_read(in, &nin);
     double v[3];
     values(v, 3);
     const char *out = tf_path(big ? "be_out.ply" : "le_out.ply");
     hd_error_t err;
     CHECK_RC(write_field(in, out, v, 3, HD_KEEP_ALL, 0, NULL, &err), HD_OK);
     size_t n;
-    unsigned char *d = slurp(out, &n);
+    unsigned char *d = tf_read(out, &n);
     const char *hend = d ? strstr((char *)d, "end_header\n") : NULL;
     CHECK(hend && strstr((char *)d, "property uchar quality\nproperty double distance\nelement face 1\n"));
     if (!hend || !src) return;
@@ -209,7 +193,7 @@ TEST(ply_subset_keeps_the_vertices_past_the_threshold_only) {
     CHECK_RC(write_field(in, out, v, 3, HD_KEEP_FARTHER, 1.0, &written, &err), HD_OK);
     CHECK_EQ(written, 2);
     size_t n;
-    char *d = (char *)slurp(out, &n);
+    char *d = (char *)tf_read(out, &n);
     CHECK(d && strstr(d, "element vertex 2\n") && !strstr(d, "element face") && !strstr(d, "element extra"));
     size_t m;
     double *xyz = points_of(out, &m);
@@ -219,7 +203,7 @@ TEST(ply_subset_keeps_the_vertices_past_the_threshold_only) {
     /* d <= D: the complement, the field included */
     CHECK_RC(write_field(in, tf_path("near.ply"), v, 3, HD_KEEP_NEARER, 1.0, &written, &err), HD_OK);
     CHECK_EQ(written, 1);
-    d = (char *)slurp(tf_path("near.ply"), &n);
+    d = (char *)tf_read(tf_path("near.ply"), &n);
     const char *h = d ? strstr(d, "end_header\n") : NULL;
     CHECK(h && n == (size_t)(h + 11 - d) + 25 && le_f64((unsigned char *)h + 11 + 17) == 1.0);
     free(d);
@@ -332,7 +316,7 @@ static void las_case(unsigned minor, unsigned fmt) {
     hd_error_t err;
     CHECK_RC(write_field(in, out, v, n, HD_KEEP_ALL, 0, NULL, &err), HD_OK);
     size_t ni, no;
-    unsigned char *s = slurp(in, &ni), *d = slurp(out, &no);
+    unsigned char *s = tf_read(in, &ni), *d = tf_read(out, &no);
     las_t I, O;
     las_parse(s, &I);
     CHECK(las_parse(d, &O));
@@ -363,7 +347,7 @@ static void las_case(unsigned minor, unsigned fmt) {
     /* the subset: counts, counts by return and bounds of the kept points */
     size_t written = 0;
     CHECK_RC(write_field(in, out, v, n, HD_KEEP_FARTHER, 100.0, &written, &err), HD_OK);
-    d = slurp(out, &no);
+    d = tf_read(out, &no);
     CHECK(las_parse(d, &O));
     CHECK_EQ(O.count, written);
     uint64_t by[4] = {0};
@@ -411,7 +395,7 @@ TEST(las_with_the_dimension_already_is_refused) {
     o.name = "second";
     CHECK_RC(hd_write_field(tf_path("eb1.las"), tf_path("eb2.las"), v, 4, &o, NULL, &err), HD_OK);
     size_t n;
-    unsigned char *d = slurp(tf_path("eb2.las"), &n);
+    unsigned char *d = tf_read(tf_path("eb2.las"), &n);
     las_t L;
     CHECK(d && las_parse(d, &L) && L.eb_len == 384 && L.rec == 36);
     CHECK(d && strcmp((const char *)L.eb + 192 + 4, "second") == 0 && le_f64(d + L.offset + 36 * 3 + 28) == 4.0);
@@ -425,14 +409,14 @@ TEST(text_lines_kept_with_the_value_as_a_column) {
     hd_error_t err;
     CHECK_RC(write_field(in, tf_path("o.csv"), v, 2, HD_KEEP_ALL, 0, NULL, &err), HD_OK);
     size_t n;
-    char *d = (char *)slurp(tf_path("o.csv"), &n);
+    char *d = (char *)tf_read(tf_path("o.csv"), &n);
     CHECK(d && strcmp(d, "X,Y,Z,distance\n# a comment\n1.5,2,3,0.1\n\n4,5,6,7,0.6666666666666666\n") == 0);
     free(d);
     /* a PTS count line gets the subset's count */
     in = tf_printf("s.pts", "3\n1 2 3\n4 5 6\n7 8 9\n");
     double w[3] = {5, 1, 6};
     CHECK_RC(write_field(in, tf_path("o.pts"), w, 3, HD_KEEP_FARTHER, 2, NULL, &err), HD_OK);
-    d = (char *)slurp(tf_path("o.pts"), &n);
+    d = (char *)tf_read(tf_path("o.pts"), &n);
     CHECK(d && strcmp(d, "2\n1 2 3 5\n7 8 9 6\n") == 0);
     free(d);
     /* semicolons and decimal commas */
@@ -445,7 +429,7 @@ TEST(text_lines_kept_with_the_value_as_a_column) {
     in = tf_printf("dc.csv", "1,5;2;3\r\n");
     double u = 0.25;
     CHECK_RC(hd_write_field(in, tf_path("dc_out.csv"), &u, 1, &o, NULL, &err), HD_OK);
-    d = (char *)slurp(tf_path("dc_out.csv"), &n);
+    d = (char *)tf_read(tf_path("dc_out.csv"), &n);
     CHECK(d && strcmp(d, "1,5;2;3;0,25\r\n") == 0);
     free(d);
 }
@@ -457,7 +441,7 @@ TEST(obj_subset_keeps_its_lines_without_the_faces) {
     size_t written;
     CHECK_RC(write_field(in, tf_path("m_out.obj"), v, 3, HD_KEEP_FARTHER, 1, &written, &err), HD_OK);
     size_t n;
-    char *d = (char *)slurp(tf_path("m_out.obj"), &n);
+    char *d = (char *)tf_read(tf_path("m_out.obj"), &n);
     CHECK(d && strcmp(d, "# cube\nv 0 0 0\nvn 0 0 1\nv 0 1 0\n") == 0);
     free(d);
     CHECK_RC(write_field(in, tf_path("m_all.obj"), v, 3, HD_KEEP_ALL, 0, NULL, &err), HD_EUNSUPPORTED);

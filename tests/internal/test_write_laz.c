@@ -32,21 +32,6 @@ static uint64_t le(const unsigned char *p, int n) {
     return v;
 }
 
-static unsigned char *slurp(const char *path, size_t *n) {
-    FILE *f = fopen(path, "rb");
-    if (!f) return NULL;
-    fseek(f, 0, SEEK_END);
-    long len = ftell(f);
-    rewind(f);
-    unsigned char *d = malloc((size_t)len + 1);
-    if (d && fread(d, 1, (size_t)len, f) != (size_t)len) {
-        free(d);
-        d = NULL;
-    }
-    fclose(f);
-    *n = (size_t)len;
-    return d;
-}
 
 typedef struct {
     size_t offset, rec, vlr; /* the LASzip VLR's data */
@@ -146,7 +131,7 @@ static void laz_case(const lazw_opts_t *o, size_t n, uint64_t seed) {
     CHECK_RC(hd_write_field(in, out, v, n, NULL, &written, &err), HD_OK);
     CHECK_EQ(written, n);
     size_t no;
-    unsigned char *d = slurp(out, &no);
+    unsigned char *d = tf_read(out, &no);
     laz_t I, O;
     parse(src, &I);
     parse(d, &O);
@@ -204,7 +189,7 @@ TEST(layered_laz_gains_the_field_as_byte14_layers) {
 /* Every whole record of the LAZ file at path, decoded by laz.c. */
 static unsigned char *records_of(const char *path, size_t *n, size_t *rec) {
     size_t size;
-    unsigned char *d = slurp(path, &size);
+    unsigned char *d = tf_read(path, &size);
     hd__file_t f = {path, d, size};
     hd_read_options_t o;
     hd_read_options_init(&o);
