@@ -516,7 +516,7 @@ int render_distances(const char *path, const hd_points_t *A,
 /* ---- the histogram ----------------------------------------------------------------- */
 
 int render_histogram(const char *path, const analysis_result_t *r,
-                     const analysis_args_t *an, size_t bins,
+                     const render_notes_t *notes, size_t bins,
                      hist_marker_t marks[4], int *n_marks, hd_error_t *err) {
     *n_marks = 0;
     enum { HW = 1000, HH = 580, L = 110, R = 30, T = 104, B = 80 };
@@ -575,7 +575,7 @@ int render_histogram(const char *path, const analysis_result_t *r,
         if (!logy && v > (double)top + 0.5) break;
     }
     text(&c, 8, T - 26, 2, logy ? "count (log scale)" : "count", DARK);
-    const char *unit = analysis_units(an);
+    const char *unit = notes->unit;
     char buf[256];
     snprintf(buf, sizeof buf, "distance to the nearest point of the other set%s%s%s", unit ? " (" : "",
              unit ? unit : "", unit ? ")" : "");
@@ -588,7 +588,7 @@ int render_histogram(const char *path, const analysis_result_t *r,
         const unsigned char *col = sidx ? AMBER : BLUE;
         double v[2] = {sidx ? r->sum.mean_ba : r->sum.mean_ab, sidx ? r->pct.ba : r->pct.ab};
         for (int kind = 0; kind < 2; kind++) {
-            if ((kind == 1 && !an->percentile_on) || !(v[kind] >= lo && v[kind] <= hi)) continue;
+            if ((kind == 1 && !notes->percentile_on) || !(v[kind] >= lo && v[kind] <= hi)) continue;
             int x = L + (int)lround(pw * (v[kind] - lo) / (hi - lo));
             int dash = kind ? 6 : ph, period = kind ? 12 : ph;
             for (int y = T; y < T + ph; y += period) {
@@ -618,9 +618,9 @@ int render_histogram(const char *path, const analysis_result_t *r,
     fill_rect(&c, lx, ly + 6, lx + 24, ly + 8, DARK);
     text(&c, lx + 30, ly - 1, 2, "mean", DARK);
     lx += 30 + 2 * font_width("mean") + 24;
-    if (an->percentile_on) {
+    if (notes->percentile_on) {
         for (int x = 0; x < 24; x += 8) fill_rect(&c, lx + x, ly + 6, lx + x + 4, ly + 8, DARK);
-        snprintf(buf, sizeof buf, "percentile %g", an->percentile);
+        snprintf(buf, sizeof buf, "percentile %g", notes->pct.p);
         text(&c, lx + 30, ly - 1, 2, buf, DARK);
     }
     if (r->above_ab || r->above_ba) {
@@ -658,9 +658,9 @@ int render_distances(const char *path, const hd_points_t *A,
 }
 
 int render_histogram(const char *path, const analysis_result_t *r,
-                     const analysis_args_t *an, size_t bins,
+                     const render_notes_t *notes, size_t bins,
                      hist_marker_t marks[4], int *n_marks, hd_error_t *err) {
-    (void)path, (void)r, (void)an, (void)bins, (void)marks;
+    (void)path, (void)r, (void)notes, (void)bins, (void)marks;
     *n_marks = 0;
     return unavailable(err);
 }

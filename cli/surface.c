@@ -19,11 +19,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-static int analysis_asked(const analysis_args_t *an) {
-    return an->percentile_on || an->mean || an->chamfer || an->histogram || an->distances_out || an->render_out ||
-           an->histogram_png;
-}
-
 static int refuse(const char *why) {
     fprintf(stderr, "%s: --surface %s\n", cli_prog(), why);
     return EXIT_USAGE;
@@ -80,7 +75,7 @@ static int is_tiles(const char *path) {
 }
 
 int surface_run(const cli_args_t *a) {
-    if (analysis_asked(&a->an))
+    if (analysis_active(&a->an))
         return refuse("measures h(A, surface of B) only: the analysis options are not yet computed on surface "
                       "distances");
     if (a->read.mesh == HD_MESH_SAMPLE) return refuse("and --sample measure B in two different ways: choose one");

@@ -68,13 +68,6 @@ void colormap_viridis(double t, unsigned char rgb[3]) {
     }
 }
 
-void path_with_suffix(const char *path, const char *suffix, char *out,
-                      size_t size) {
-    const char *dot = strrchr(path, '.'), *slash = strrchr(path, '/');
-    if (!dot || (slash && dot < slash)) dot = path + strlen(path);
-    snprintf(out, size, "%.*s%s%s", (int)(dot - path), path, suffix, dot);
-}
-
 static int format_of(const char *path) {
     const char *dot = strrchr(path, '.');
     if (!dot) return DIST_UNKNOWN;

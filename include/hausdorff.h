@@ -459,14 +459,17 @@ typedef struct hd_summary {
     double mean_symmetric;      /* max(mean_ab, mean_ba): the average
                                    Hausdorff distance (Taha & Hanbury) */
     double mean_average;        /* (mean_ab + mean_ba) / 2 */
-    double mean_pooled;         /* (sum_ab + sum_ba) / (n_ab + n_ba): MONAI's
-                                   symmetric average surface distance */
+    double mean_pooled;         /* the sum of both sets' distances (rounded
+                                   once) / (n_ab + n_ba): MONAI's symmetric
+                                   average surface distance */
     double chamfer;             /* mean2_ab + mean2_ba: THE Chamfer distance
                                    here (squared, mean per set, summed; as
                                    PyTorch3D's chamfer_distance) */
-    double chamfer_sum2;        /* sum2_ab + sum2_ba (squared, summed) */
+    double chamfer_sum2;        /* squared, summed over both sets (the exact
+                                   sum rounded once, not sum2_ab + sum2_ba) */
     double chamfer_mean;        /* mean_ab + mean_ba (not squared, mean) */
-    double chamfer_sum;         /* sum_ab + sum_ba (not squared, summed) */
+    double chamfer_sum;         /* not squared, summed over both sets (rounded
+                                   once, not sum_ab + sum_ba) */
 } hd_summary_t;
 
 /* Errors: HD_EINVAL, HD_EEMPTY (n_a = 0, or d_ba given with n_b = 0),

@@ -75,8 +75,10 @@ with tempfile.TemporaryDirectory() as tmp:
     p = run("--surface", square, pts)
     check(p.returncode == 1 and "mesh to mesh" in p.stderr and p.stdout == "",
           "a mesh as A is refused: the direction from a surface is mesh to mesh", p)
-    p = run("--surface", "--mean", pts, square)
-    check(p.returncode == 1 and "analysis options" in p.stderr, "the analysis options are refused with --surface", p)
+    for opt in (["--mean"], ["--tau", "0.5"], ["--dtu-cap", "1"]):
+        p = run("--surface", *opt, pts, square)
+        check(p.returncode == 1 and "analysis options" in p.stderr and p.stdout == "",
+              "the analysis options are refused with --surface: %s" % opt[0], p)
     p = run("--surface", "--sample", "10", pts, square)
     check(p.returncode == 1 and "--sample" in p.stderr, "--sample is refused with --surface", p)
     bad = put("bad.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 5\n")

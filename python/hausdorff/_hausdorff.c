@@ -51,6 +51,7 @@
 #include <float.h>
 #include <limits.h>
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 #include <time.h>
 #include <unistd.h>
@@ -177,6 +178,15 @@ static char set_letter(const char *name) {
     return name[0] >= 'a' && name[0] <= 'z' && !name[1] ? (char)(name[0] - 'a' + 'A') : '?';
 }
 
+/* v as the shortest "%.Ng" text that reads back to the same double, so that
+ * a coordinate just beyond a limit never prints equal to it. */
+static void shortest_text(char *buf, size_t size, double v) {
+    for (int digits = 1; digits <= 17; digits++) {
+        snprintf(buf, size, "%.*g", digits, v);
+        if (strtod(buf, NULL) == v) return;
+    }
+}
+
 /* Points of dims > 3 coordinates (C-ordered doubles): the library's checks,
  * its messages and codes, with a limit that keeps the sum of dims squared
  * differences finite (1e153, the library's, while dims * (2e153)^2 fits). */
@@ -192,11 +202,15 @@ static int nd_check(const double *x, size_t n, size_t dims, const char *name) {
         if (code == HD_ENONFINITE)
             snprintf(err.message, sizeof err.message, "point set %c: point %zu has %s coordinate",
                      set_letter(name), k / dims, isnan(v) ? "a NaN" : "an infinite");
-        else
+        else {
+            char vt[32], lt[32];
+            shortest_text(vt, sizeof vt, v);
+            shortest_text(lt, sizeof lt, limit);
             snprintf(err.message, sizeof err.message,
-                     "point set %c: point %zu has coordinate %g, beyond the limit %g where "
+                     "point set %c: point %zu has coordinate %s, beyond the limit %s where "
                      "squared distances in %zu dimensions could overflow",
-                     set_letter(name), k / dims, v, limit, dims);
+                     set_letter(name), k / dims, vt, lt, dims);
+        }
         raise_hd(code, &err);
         return -1;
     }
@@ -615,12 +629,12 @@ static PyStructSequence_Field summary_fields[] = {
     {"mean2_ba", "mean squared distance of B's points to A"},
     {"mean_symmetric", "max(mean_ab, mean_ba): the average Hausdorff distance"},
     {"mean_average", "(mean_ab + mean_ba) / 2"},
-    {"mean_pooled", "(sum_ab + sum_ba) / (n_ab + n_ba): MONAI's symmetric average surface "
-                    "distance, medpy's assd"},
+    {"mean_pooled", "math.fsum of both sets' distances / (n_ab + n_ba): MONAI's symmetric "
+                    "average surface distance, medpy's assd"},
     {"chamfer", "mean2_ab + mean2_ba: the Chamfer distance (as PyTorch3D)"},
-    {"chamfer_sum2", "sum2_ab + sum2_ba"},
+    {"chamfer_sum2", "math.fsum of both sets' squared distances"},
     {"chamfer_mean", "mean_ab + mean_ba: point-cloud-utils' chamfer_distance"},
-    {"chamfer_sum", "sum_ab + sum_ba"},
+    {"chamfer_sum", "math.fsum of both sets' distances"},
     {NULL, NULL},
 };
 
