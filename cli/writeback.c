@@ -10,6 +10,7 @@
  * usage error, not a failure after the distances are computed).
  */
 #include "cli.h"
+#include "output.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -96,6 +97,36 @@ int analysis_check_outputs(const analysis_args_t *an, const char *path_a, const 
     return HD_OK;
 }
 
+/* hd_write_field into out's temporary from output.c, so that out appears
+ * with the run's other files when the run succeeds (out_finish) and not at
+ * all when it fails (out_discard); its failures to write are output
+ * failures (OUT_EFAIL: exit 3). */
+static int write_staged(const char *in, const char *out, const double *d, size_t n, hd_write_options_t *o,
+                        size_t *written, hd_error_t *err) {
+    FILE *f = out_open(out, err);
+    if (!f) return err->code;
+    const char *tmp = out_file_path(f);
+    char *name = tmp ? strdup(tmp) : NULL;
+    int direct = out_is_direct(f), rc = out_close(f, 0, err);
+    if (rc == HD_OK && (!name || direct)) {
+        snprintf(err->message, sizeof err->message, "%s: %s", out,
+                 direct ? "a device or FIFO cannot take a file written back (it is renamed into place); name a file"
+                        : "out of memory");
+        rc = err->code = direct ? HD_EINVAL : HD_ENOMEM;
+    }
+    o->format = hd_format_of_path(out);
+    if (rc == HD_OK) rc = hd_write_field(in, name, d, n, o, written, err);
+    if (rc == HD_EIO && name && strncmp(err->message, name, strlen(name)) == 0) {
+        /* the temporary's name in the message is the output's */
+        char reason[200];
+        snprintf(reason, sizeof reason, "%s", err->message + strlen(name));
+        snprintf(err->message, sizeof err->message, "%.800s%s", out, reason);
+        rc = err->code = OUT_EFAIL;
+    }
+    free(name);
+    return rc;
+}
+
 int analysis_write_back(const analysis_args_t *an, const char *path_a, const char *path_b, const double *d_ab,
                         size_t n_a, const double *d_ba, size_t n_b, int directed, analysis_result_t *r,
                         hd_error_t *err) {
@@ -117,7 +148,7 @@ int analysis_write_back(const analysis_args_t *an, const char *path_a, const cha
                 o.keep = k == 1 ? HD_KEEP_FARTHER : HD_KEEP_NEARER;
                 o.threshold = an->subset[k - 1].d;
             }
-            int rc = hd_write_field(path[w], out, d[w], n[w], &o, &r->wb_points[k][w], err);
+            int rc = write_staged(path[w], out, d[w], n[w], &o, &r->wb_points[k][w], err);
             if (rc) return rc;
             r->wb_done[k] = 1;
         }

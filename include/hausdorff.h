@@ -795,6 +795,10 @@ typedef struct hd_write_options {
     hd_keep_t keep;    /* which points are written */
     double threshold;  /* D of HD_KEEP_FARTHER / HD_KEEP_NEARER; finite
                           (a NaN value is neither > D nor <= D: never kept) */
+    const char *format; /* the output's format ("ply", "las", ...): NULL
+                          = the one out_path's extension names; either way
+                          it must be the input's (for writing under a
+                          temporary name) */
     const hd_read_options_t *read; /* how the input is read (NULL: the
                           defaults): `format`, `decimal_comma` and
                           `laz_points_per_byte` are used, so the points
@@ -812,7 +816,8 @@ HD_EXTERN void hd_write_options_init(hd_write_options_t *opt);
  * number of points hd_read_file gives for in_path with opt->read (for
  * meshes: the vertices); it is borrowed for the call.
  * Formats (the input's, as its signature or the read options' format
- * or its extension say; out_path's extension must name the same format):
+ * or its extension say; out_path's extension, or opt->format, must name
+ * the same format):
  *  - PLY ascii and binary: `property double NAME` appended to element
  *    vertex, in the input's encoding and byte order; a value is written
  *    as the shortest decimal that reads back to the same double (ascii).
@@ -842,7 +847,8 @@ HD_EXTERN void hd_write_options_init(hd_write_options_t *opt);
  * points written.
  * Errors: HD_EINVAL (NULL arguments, n not the file's point count, a bad
  *   name, a field of that name already in the input, out_path the input
- *   itself, a non-finite threshold), HD_EUNSUPPORTED (an input that is not
+ *   itself or an existing file that is not a regular file (a device, a
+ *   FIFO: the result is renamed into place), a non-finite threshold), HD_EUNSUPPORTED (an input that is not
  *   a regular file: it must be read twice; a format or variant above), the
  *   errors of hd_read_file for the input, HD_EIO (out_path cannot be
  *   created or written: the message names it and the system's reason,

@@ -190,9 +190,9 @@ static int dispatch(hd__writer_t *w, const char *fmt) {
 }
 
 /* out_path's extension must name the input's format. */
-static int check_output(const char *in_path, const char *out_path, const char *fmt, const struct stat *in_st,
-                        hd_error_t *err) {
-    const char *ofmt = hd_format_of_path(out_path);
+static int check_output(const char *in_path, const char *out_path, const char *out_format, const char *fmt,
+                        const struct stat *in_st, hd_error_t *err) {
+    const char *ofmt = out_format ? out_format : hd_format_of_path(out_path);
     if (!ofmt || strcmp(ofmt, fmt) != 0)
         return hd__err(err, HD_EINVAL,
                        "%s: the input %s is %s, so the output is %s too: name it with the extension of that format "
@@ -201,6 +201,10 @@ static int check_output(const char *in_path, const char *out_path, const char *f
     struct stat st;
     if (stat(out_path, &st) == 0 && st.st_dev == in_st->st_dev && st.st_ino == in_st->st_ino)
         return hd__err(err, HD_EINVAL, "%s: is the input itself; write to another file", out_path);
+    if (lstat(out_path, &st) == 0 && !S_ISREG(st.st_mode) && !S_ISLNK(st.st_mode))
+        return hd__err(err, HD_EINVAL, "%s: exists and is not a regular file (the result is renamed into place); "
+                                       "name a file",
+                       out_path);
     return HD_OK;
 }
 
@@ -224,7 +228,7 @@ int hd_write_field(const char *in_path, const char *out_path, const double *valu
     size_t count = 0;
     if (!fmt)
         rc = hd__err(err, HD_EUNSUPPORTED, "%s: cannot tell the input's format from its name", in_path);
-    if (rc == HD_OK) rc = check_output(in_path, out_path, fmt, &st, err);
+    if (rc == HD_OK) rc = check_output(in_path, out_path, o.format, fmt, &st, err);
     if (rc == HD_OK) rc = count_points(in_path, &ro, &count, err);
     if (rc == HD_OK && count != n)
         rc = hd__err(err, HD_EINVAL, "%s: %zu values for a file of %zu points", in_path, n, count);
