@@ -52,7 +52,7 @@ void analysis_args_init(analysis_args_t *an) {
 }
 
 render_notes_t analysis_notes(const analysis_args_t *an, const analysis_result_t *r) {
-    return (render_notes_t){analysis_units(an), an->percentile_on, r->pct};
+    return (render_notes_t){analysis_units(an), an->percentile_on, r->pct, r->surface};
 }
 
 const char *analysis_units(const analysis_args_t *an) {
@@ -324,15 +324,26 @@ int analysis_run(const analysis_args_t *an, const hd_options_t *opt,
     int rc = hd_distances(A, B, opt, r->d_ab, r->j_ab, r->d_ba, r->j_ba, err);
     r->seconds = cli_now() - t0;
     if (rc) return rc;
+    return analysis_finish(an, A, B, s, NULL, path_a, path_b, NULL, r, err);
+}
+
+int analysis_finish(const analysis_args_t *an, const hd_points_t *A, const hd_points_t *B,
+                    const hd_symmetric_t *s, const double *wq, const char *path_a, const char *path_b,
+                    const surface_columns_t *surf, analysis_result_t *r, hd_error_t *err) {
+    int rc, directed = r->directed;
     static const analysis_ops_t here = {hd_summarize, hd_percentile_of, hd_histogram};
     if ((rc = analysis_figures(an, &here, r->d_ab, A->count, r->d_ba, directed ? 0 : B->count, r, err))) return rc;
     double scale = analysis_scale(an, r);
-    if ((rc = analysis_write_back(an, path_a, path_b, r->d_ab, A->count, r->d_ba, directed ? 0 : B->count, directed, r,
-                                  err)))
+    /* files written back: point sets only (--surface refuses them, and its
+     * --distances is always its table) */
+    if (!surf && (rc = analysis_write_back(an, path_a, path_b, r->d_ab, A->count, r->d_ba, directed ? 0 : B->count,
+                                           directed, r, err)))
         return rc;
-    if (an->distances_out && !analysis_writes_back(an->distances_out, path_a, an->format[0])) {
+    if (an->distances_out && (surf || !analysis_writes_back(an->distances_out, path_a, an->format[0]))) {
         r->dist_path_a = an->distances_out;
-        if ((rc = write_distances(r->dist_path_a, A, r->d_ab, r->j_ab, scale, err))) return rc;
+        rc = surf ? write_surface_distances(r->dist_path_a, A, r->d_ab, surf, scale, err)
+                  : write_distances(r->dist_path_a, A, r->d_ab, r->j_ab, scale, err);
+        if (rc) return rc;
         if (!directed) {
             if (!(r->dist_path_b = path_with_suffix(an->distances_out, "_b"))) return alloc_fail(err, B->count);
             if ((rc = write_distances(r->dist_path_b, B, r->d_ba, r->j_ba, scale, err))) return rc;
@@ -342,7 +353,7 @@ int analysis_run(const analysis_args_t *an, const hd_options_t *opt,
     if (an->render_out) {
         char title[640];
         analysis_render_title(path_a, A->count, path_b, title, sizeof title);
-        if ((rc = render_distances(an->render_out, A, B, r->d_ab, scale, s, directed, &notes, title, r->markers,
+        if ((rc = render_distances(an->render_out, A, B, r->d_ab, scale, s, wq, directed, &notes, title, r->markers,
                                    &r->n_markers, &r->render, &r->render_w, &r->render_h, err)))
             return rc;
     }

@@ -97,6 +97,8 @@ typedef struct render_notes {
     const char *unit;
     int percentile_on;
     hd_percentile_t pct;
+    int surface;               /* the witness's partner is the closest point
+                                  on triangle j of B (--surface) */
 } render_notes_t;
 /* What render_distances drew as text and where it marked the percentile
  * on the colour bar (pct_y < 0: not marked), for the JSON and the tests. */
@@ -142,6 +144,8 @@ typedef struct analysis_result {
     char *wb_path_b[3];
     size_t wb_points[3][2];
     int wb_done[3];
+    int surface;               /* d_ab: distances to B's triangles, j_ab
+                                  the nearest triangles (--surface) */
 } analysis_result_t;
 
 /* The unit of the distances: --units, else "mm" when a mask's header
@@ -166,6 +170,16 @@ int analysis_empty_files(const analysis_args_t *an, const hd_points_t *A, const 
                          double v, const char *path_a, const char *path_b, analysis_result_t *r, hd_error_t *err);
 /* Compute per-point distances and every figure asked for, write the files
  * asked for.  Returns HD_OK or a library code with err filled. */
+struct surface_columns; /* below, with the writers */
+/* The figures, files and pictures asked for from per-point distances
+ * already in r (d_ab and j_ab; d_ba and j_ba unless r->directed; n_a,
+ * n_b, seconds), whatever computed them.  s holds the witness; wq (NULL:
+ * B's point s->ab.j or s->ba.j) is its partner's position in the picture;
+ * surf (NULL: point sets) gives the --distances files the surface's
+ * columns. */
+int analysis_finish(const analysis_args_t *an, const hd_points_t *A, const hd_points_t *B,
+                    const hd_symmetric_t *s, const double *wq, const char *path_a, const char *path_b,
+                    const struct surface_columns *surf, analysis_result_t *r, hd_error_t *err);
 int analysis_run(const analysis_args_t *an, const hd_options_t *opt,
                  const hd_points_t *A, const hd_points_t *B,
                  const hd_symmetric_t *s, int directed, const char *path_a,
@@ -212,6 +226,19 @@ void colormap_viridis(double t, unsigned char rgb[3]);
  * at d / dmax: CSV, PLY or NPY by the path's extension (writers.c). */
 int write_distances(const char *path, const hd_points_t *P, const double *d,
                     const size_t *nearest, double dmax, hd_error_t *err);
+/* What a point's distance to a surface adds to its row (--surface): the
+ * nearest face, the closest point on it, its barycentric weights u v w of
+ * the face's corners, and the sign (NULL: no sign column). */
+typedef struct surface_columns {
+    const size_t *face;
+    const double *closest, *bary; /* 3 a point */
+    const int8_t *sign;
+} surface_columns_t;
+/* Write points with their distance to a surface: the columns x y z
+ * distance face closest_x closest_y closest_z u v w [sign], in CSV, PLY
+ * (with the distance's colour) or NPY (float64) by the path's extension. */
+int write_surface_distances(const char *path, const hd_points_t *P, const double *d,
+                            const surface_columns_t *c, double dmax, hd_error_t *err);
 /* 1 when the path names a format write_distances knows. */
 int distances_format_known(const char *path);
 
@@ -270,7 +297,7 @@ int render_path_ok(const char *path);
  * bar, the witness pair of the Hausdorff distance marked and labelled. */
 int render_distances(const char *path, const hd_points_t *A,
                      const hd_points_t *B, const double *d_a, double dmax,
-                     const hd_symmetric_t *s, int directed,
+                     const hd_symmetric_t *s, const double *wq, int directed,
                      const render_notes_t *notes, const char *title,
                      render_marker_t markers[6], int *n_markers,
                      render_info_t *info, int *width, int *height,

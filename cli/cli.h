@@ -25,6 +25,7 @@ typedef struct cli_args {
     int json;
     int quiet;
     int surface; /* --surface: B measured as its triangles (surface.c) */
+    int signed_distance; /* --signed: with --surface, each distance's sign */
     analysis_args_t an; /* analysis options (analysis.h) */
 } cli_args_t;
 

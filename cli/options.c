@@ -164,8 +164,8 @@ typedef enum {
     OPT_DTU_CAP, OPT_FARTHER_THAN, OPT_NEARER_THAN, /* these two take D and OUT */
     OPT_FLAGS, /* the first flag */
     OPT_HELP = OPT_FLAGS, OPT_VERSION, OPT_FORMATS, OPT_DIRECTED, OPT_JSON, OPT_QUIET, OPT_NO_EARLY_BREAK,
-    OPT_NO_CULLING, OPT_FLOAT32, OPT_DECIMAL_COMMA, OPT_VERTICES, OPT_SURFACE, OPT_MEAN, OPT_CHAMFER,
-    OPT_HISTOGRAM,
+    OPT_NO_CULLING, OPT_FLOAT32, OPT_DECIMAL_COMMA, OPT_VERTICES, OPT_SURFACE, OPT_SIGNED, OPT_MEAN,
+    OPT_CHAMFER, OPT_HISTOGRAM,
     OPT_COUNT
 } option_t;
 
@@ -225,7 +225,13 @@ static const option_entry_t options[] = {
      "read a mesh (ply, obj, off, stl) as its vertices (default)"},
     {OPT_SURFACE, "--surface", NULL, NULL, 0,
      "measure B, a mesh, as its surface: each point of A to its\n"
-     "nearest triangle, correctly rounded (A must be points)"},
+     "nearest triangle, correctly rounded (A must be points);\n"
+     "the analysis options below work on these distances"},
+    {OPT_SIGNED, "--signed", NULL, NULL, 0,
+     "with --surface: each distance's sign, -1 inside B, +1\n"
+     "outside, 0 on it, from B's winding number (exact); B must\n"
+     "be closed and consistently oriented, else it is refused\n"
+     "naming an edge"},
     {OPT_SAMPLE, "--sample", NULL, "N", 0,
      "read a mesh as N points drawn uniformly by area on its\n"
      "faces, reproducibly for a given --seed; a point format\n"
@@ -422,6 +428,7 @@ static int set_flag(cli_args_t *a, int which) {
     case OPT_DECIMAL_COMMA: a->read.decimal_comma = 1; break;
     case OPT_VERTICES: a->read.mesh = HD_MESH_VERTICES; break;
     case OPT_SURFACE: a->surface = 1; break;
+    case OPT_SIGNED: a->signed_distance = 1; break;
     case OPT_MEAN: a->an.mean = 1; break;
     case OPT_CHAMFER: a->an.chamfer = 1; break;
     case OPT_HISTOGRAM: a->an.histogram = 1; break;
@@ -650,6 +657,8 @@ int cli_parse(int argc, char **argv, cli_args_t *a) {
                             : "%s: files in an input's own format are not written with --surface (its --distances "
                               "writes .csv, .ply or .npy tables)",
                    subset ? "--farther-than / --nearer-than" : a->an.distances_out);
+    if (a->signed_distance && !a->surface)
+        return bad("--signed needs --surface: a sign is taken from the surface of the mesh B%s", "");
     if (nfiles != 2) {
         /* one line and a pointer, not the whole help */
         fprintf(stderr, "%s: expected two files, A and B, not %d\n"

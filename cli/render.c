@@ -393,7 +393,8 @@ int render_compose(const char *path, const render_scene_t *sc, const render_laye
         ring(&c, px, py, 8.5, 9.8, RED);
         char lp[64], lq[64];
         snprintf(lp, sizeof lp, "%c[%zu]", from_a ? 'A' : 'B', w->i);
-        snprintf(lq, sizeof lq, "%c[%zu]", from_a ? 'B' : 'A', w->j);
+        if (notes->surface) snprintf(lq, sizeof lq, "triangle %zu", w->j);
+        else snprintf(lq, sizeof lq, "%c[%zu]", from_a ? 'B' : 'A', w->j);
         int side = qx >= px ? -1 : 1; /* labels away from each other */
         int lpx = side > 0 ? px + 13 : px - 13 - 2 * font_width(lp);
         int lqx = side > 0 ? qx - 11 - 2 * font_width(lq) : qx + 11;
@@ -453,10 +454,15 @@ int render_compose(const char *path, const render_scene_t *sc, const render_laye
     fmt_num(hv, sizeof hv, w->distance);
     const char *u = notes->unit ? notes->unit : "";
     snprintf(info->caption[0], sizeof info->caption[0], "%s", title);
-    snprintf(info->caption[1], sizeof info->caption[1],
-             "%s = %s%s%s between %c[%zu] (red) and %c[%zu] (orange); grey: B only",
-             directed ? "h(A,B)" : "H(A,B)", hv, *u ? " " : "", u, from_a ? 'A' : 'B', w->i, from_a ? 'B' : 'A',
-             w->j);
+    if (notes->surface)
+        snprintf(info->caption[1], sizeof info->caption[1],
+                 "h(A, surface of B) = %s%s%s between A[%zu] (red) and its closest point on triangle %zu "
+                 "(orange); grey: B's vertices", hv, *u ? " " : "", u, w->i, w->j);
+    else
+        snprintf(info->caption[1], sizeof info->caption[1],
+                 "%s = %s%s%s between %c[%zu] (red) and %c[%zu] (orange); grey: B only",
+                 directed ? "h(A,B)" : "H(A,B)", hv, *u ? " " : "", u, from_a ? 'A' : 'B', w->i,
+                 from_a ? 'B' : 'A', w->j);
     if (py >= 0) {
         char ab[64], sym[64], pooled[64];
         fmt_num(ab, sizeof ab, notes->pct.ab);
@@ -483,7 +489,7 @@ int render_compose(const char *path, const render_scene_t *sc, const render_laye
 
 int render_distances(const char *path, const hd_points_t *A,
                      const hd_points_t *B, const double *d_a, double dmax,
-                     const hd_symmetric_t *s, int directed,
+                     const hd_symmetric_t *s, const double *wq_at, int directed,
                      const render_notes_t *notes, const char *title,
                      render_marker_t markers[6], int *n_markers,
                      render_info_t *info, int *width, int *height,
@@ -506,7 +512,8 @@ int render_distances(const char *path, const hd_points_t *A,
     const hd_result_t *w = from_a ? &s->ab : &s->ba;
     double wp[3], wq[3];
     hd_points_get(from_a ? A : B, w->i, wp);
-    hd_points_get(from_a ? B : A, w->j, wq);
+    if (wq_at) memcpy(wq, wq_at, sizeof wq);
+    else hd_points_get(from_a ? B : A, w->j, wq);
     int rc = render_compose(path, &sc, &L, wp, wq, s, directed, notes, title, markers, n_markers, info, width,
                             height, err);
     render_layers_free(&L);
@@ -644,12 +651,13 @@ static int unavailable(hd_error_t *err) {
 
 int render_distances(const char *path, const hd_points_t *A,
                      const hd_points_t *B, const double *d_a, double dmax,
-                     const hd_symmetric_t *s, int directed,
+                     const hd_symmetric_t *s, const double *wq_at, int directed,
                      const render_notes_t *notes, const char *title,
                      render_marker_t markers[6], int *n_markers,
                      render_info_t *info, int *width, int *height,
                      hd_error_t *err) {
     (void)path, (void)A, (void)B, (void)d_a, (void)dmax, (void)s, (void)directed, (void)notes, (void)title;
+    (void)wq_at;
     (void)markers, (void)width, (void)height;
     memset(info, 0, sizeof *info);
     info->pct_y = -1;

@@ -95,16 +95,18 @@ def mean_and_chamfer_follow_their_stated_definitions(tmp):
         m, c = r["mean"], r["chamfer"]
         mab, mba = math.fsum(dab) / len(dab), math.fsum(dba) / len(dba)
         s2ab, s2ba = math.fsum(dab * dab), math.fsum(dba * dba)
+        both = np.concatenate([dab, dba])
         want = {"mean ab": (m["ab"], mab), "mean ba": (m["ba"], mba),
                 "mean symmetric": (m["symmetric"], max(mab, mba)),
                 "mean average": (m["average"], (mab + mba) / 2),
-                "mean pooled": (m["pooled"], (math.fsum(dab) + math.fsum(dba)) / (len(dab) + len(dba))),
+                "mean pooled": (m["pooled"], math.fsum(both) / (len(dab) + len(dba))),
                 "chamfer": (c["value"], s2ab / len(dab) + s2ba / len(dba)),
-                "chamfer sum of squares": (c["sum_squared"], s2ab + s2ba),
+                "chamfer sum of squares": (c["sum_squared"], math.fsum(both * both)),
                 "chamfer unsquared": (c["mean"], mab + mba),
-                "chamfer unsquared sum": (c["sum"], math.fsum(dab) + math.fsum(dba))}
-        # the sums are correctly rounded (math.fsum's), so every figure is
-        # the same double as its definition computed from them
+                "chamfer unsquared sum": (c["sum"], math.fsum(both))}
+        # the sums are correctly rounded (math.fsum's; the pooled ones over
+        # both lists at once), so every figure is the same double as its
+        # definition computed from them
         for what, (got, ref) in want.items():
             assert got == ref, "%s %s: %r vs %r" % (name, what, got, ref)
         assert c["definition"] == "mean_squared" and c["value"] == c["mean_squared"]

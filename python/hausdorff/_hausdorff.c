@@ -1849,9 +1849,11 @@ static PyArrayObject *faces_array(PyObject *obj) {
 
 static PyObject *py_mesh_distances(PyObject *self, PyObject *args, PyObject *kw) {
     (void)self;
-    static char *kwlist[] = {"points", "vertices", "faces", "threads", NULL};
+    static char *kwlist[] = {"points", "vertices", "faces", "threads", "signed", NULL};
     PyObject *op, *ov, *of, *threads = Py_None;
-    if (!PyArg_ParseTupleAndKeywords(args, kw, "OOO|$O:_mesh_distances", kwlist, &op, &ov, &of, &threads))
+    int want_sign = 0;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "OOO|$Op:_mesh_distances", kwlist, &op, &ov, &of, &threads,
+                                     &want_sign))
         return NULL;
     hd_options_t opt;
     if (parse_options(NULL, threads, NULL, &opt)) return NULL;
@@ -1863,26 +1865,32 @@ static PyObject *py_mesh_distances(PyObject *self, PyObject *args, PyObject *kw)
     }
     PyArrayObject *f = faces_array(of);
     npy_intp n = (npy_intp)p.pts.count, n3[2] = {n, 3};
-    PyArrayObject *dist = NULL, *face = NULL, *closest = NULL, *bary = NULL;
+    PyArrayObject *dist = NULL, *face = NULL, *closest = NULL, *bary = NULL, *sign = NULL;
     PyObject *res = NULL;
     if (f) {
         dist = (PyArrayObject *)PyArray_SimpleNew(1, &n, NPY_DOUBLE);
         face = (PyArrayObject *)PyArray_SimpleNew(1, &n, NPY_INTP);
         closest = (PyArrayObject *)PyArray_SimpleNew(2, n3, NPY_DOUBLE);
         bary = (PyArrayObject *)PyArray_SimpleNew(2, n3, NPY_DOUBLE);
+        if (want_sign) sign = (PyArrayObject *)PyArray_SimpleNew(1, &n, NPY_INT8);
     }
-    if (dist && face && closest && bary) {
+    if (dist && face && closest && bary && (sign || !want_sign)) {
         hd_mesh_t M = {v.pts, PyArray_DATA(f), (size_t)PyArray_DIM(f, 0), HD_INDEX_U64};
         hd_surface_result_t r;
         hd_error_t err;
         int rc;
         Py_BEGIN_ALLOW_THREADS
-        rc = hd_mesh_distances(&p.pts, &M, &opt, PyArray_DATA(dist), PyArray_DATA(face), PyArray_DATA(closest),
-                               PyArray_DATA(bary), &r, &err);
+        if (want_sign)
+            rc = hd_mesh_signed_distances(&p.pts, &M, &opt, PyArray_DATA(dist), PyArray_DATA(face),
+                                          PyArray_DATA(closest), PyArray_DATA(bary), PyArray_DATA(sign), &r, &err);
+        else
+            rc = hd_mesh_distances(&p.pts, &M, &opt, PyArray_DATA(dist), PyArray_DATA(face), PyArray_DATA(closest),
+                                   PyArray_DATA(bary), &r, &err);
         Py_END_ALLOW_THREADS
         if (rc == HD_OK)
-            res = Py_BuildValue("(OOOOdnnn)", dist, face, closest, bary, r.distance, (Py_ssize_t)r.i,
-                                (Py_ssize_t)r.triangle, (Py_ssize_t)r.n_degenerate);
+            res = Py_BuildValue("(OOOOdnnnO)", dist, face, closest, bary, r.distance, (Py_ssize_t)r.i,
+                                (Py_ssize_t)r.triangle, (Py_ssize_t)r.n_degenerate,
+                                sign ? (PyObject *)sign : Py_None);
         else
             raise_hd(rc, &err);
     }
@@ -1890,6 +1898,7 @@ static PyObject *py_mesh_distances(PyObject *self, PyObject *args, PyObject *kw)
     Py_XDECREF(face);
     Py_XDECREF(closest);
     Py_XDECREF(bary);
+    Py_XDECREF(sign);
     Py_XDECREF(f);
     points_release(&p);
     points_release(&v);
@@ -1936,7 +1945,7 @@ static PyObject *py_read_mesh(PyObject *self, PyObject *args, PyObject *kw) {
 
 static PyMethodDef module_methods[] = {
     {"_mesh_distances", (PyCFunction)(void (*)(void))py_mesh_distances, METH_VARARGS | METH_KEYWORDS,
-     "_mesh_distances(points, vertices, faces, *, threads=None): hausdorff.Mesh.distances's engine"},
+     "_mesh_distances(points, vertices, faces, *, threads=None, signed=False): hausdorff.Mesh.distances's engine"},
     {"_read_mesh", (PyCFunction)(void (*)(void))py_read_mesh, METH_VARARGS | METH_KEYWORDS,
      "_read_mesh(path, *, format=None): hausdorff.read_mesh's engine"},
     {"directed", (PyCFunction)(void (*)(void))py_directed, METH_VARARGS | METH_KEYWORDS,

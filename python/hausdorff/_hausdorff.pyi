@@ -227,15 +227,16 @@ class Index:
     ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.intp]]: ...
 
 def _mesh_distances(
-    points: Points, vertices: Points, faces: npt.ArrayLike, *, threads: Optional[int] = None
+    points: Points, vertices: Points, faces: npt.ArrayLike, *, threads: Optional[int] = None,
+    signed: bool = False
 ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.intp], npt.NDArray[np.float64],
-           npt.NDArray[np.float64], float, int, int, int]: ...
+           npt.NDArray[np.float64], float, int, int, int, Optional[npt.NDArray[np.int8]]]: ...
 def _read_mesh(
     path: Union[str, bytes, os.PathLike[str], os.PathLike[bytes]], *, format: Optional[str] = None
 ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.intp], int, int, str]: ...
 
 class SurfaceDistances(Tuple[npt.NDArray[np.float64], npt.NDArray[np.intp], npt.NDArray[np.float64],
-                             npt.NDArray[np.float64], float, int, int]):
+                             npt.NDArray[np.float64], float, int, int, Optional[npt.NDArray[np.int8]]]):
     distances: npt.NDArray[np.float64]
     faces: npt.NDArray[np.intp]
     closest: npt.NDArray[np.float64]
@@ -243,12 +244,15 @@ class SurfaceDistances(Tuple[npt.NDArray[np.float64], npt.NDArray[np.intp], npt.
     distance: float
     i: int
     face: int
+    signs: Optional[npt.NDArray[np.int8]]
 
 class Mesh:
     vertices: npt.NDArray[np.generic]
     faces: npt.NDArray[np.generic]
     def __init__(self, vertices: Points, faces: npt.ArrayLike) -> None: ...
-    def distances(self, points: Points, *, threads: Optional[int] = None) -> SurfaceDistances: ...
+    def distances(
+        self, points: Points, *, threads: Optional[int] = None, signed: bool = False
+    ) -> SurfaceDistances: ...
 
 def read_mesh(
     path: Union[str, bytes, os.PathLike[str], os.PathLike[bytes]], *, format: Optional[str] = None

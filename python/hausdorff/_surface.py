@@ -6,7 +6,7 @@ to), correctly rounded to the nearest double; the distance to the mesh is
 the smallest over its triangles and the face is the smallest index at that
 distance: bit-identical to a loop over every triangle, at any thread count.
 """
-from typing import NamedTuple
+from typing import NamedTuple, Optional
 
 import numpy as np
 
@@ -23,6 +23,7 @@ class SurfaceDistances(NamedTuple):
     distance: float         #: h(points, surface): the largest distance
     i: int                  #: its point (smallest index on ties)
     face: int               #: that point's nearest face
+    signs: Optional[np.ndarray] = None  #: (N,) int8 with signed=True: -1 inside, +1 outside, 0 on the surface
 
 
 class Mesh:
@@ -40,14 +41,21 @@ class Mesh:
     def __repr__(self):
         return "hausdorff.Mesh(%d vertices, %d faces)" % (len(self.vertices), len(self.faces))
 
-    def distances(self, points, *, threads=None):
+    def distances(self, points, *, threads=None, signed=False):
         """Each point's correctly rounded distance to the surface, its
         nearest face, closest point and barycentric weights, and the
         largest distance h(points, surface) with its point and face
-        (a SurfaceDistances)."""
-        d, f, c, b, h, i, face, _ = _hausdorff._mesh_distances(points, self.vertices, self.faces,
-                                                                threads=threads)
-        return SurfaceDistances(d, f, c, b, h, i, face)
+        (a SurfaceDistances).
+
+        signed=True also returns `signs` (int8): -1 inside the surface, +1
+        outside, 0 where the distance is 0.  Inside means a nonzero winding
+        number, decided exactly; it needs a closed, consistently oriented
+        mesh (every edge used as often each way once vertices with equal
+        coordinates are merged) and raises ValueError naming an edge
+        otherwise.  The signed distance is signs * distances."""
+        d, f, c, b, h, i, face, _, s = _hausdorff._mesh_distances(points, self.vertices, self.faces,
+                                                                   threads=threads, signed=bool(signed))
+        return SurfaceDistances(d, f, c, b, h, i, face, s)
 
 
 def read_mesh(path, *, format=None):
