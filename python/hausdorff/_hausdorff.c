@@ -1457,7 +1457,15 @@ PyDoc_STRVAR(write_field_doc,
 "of points written.  The file appears whole or not at all.  Raises\n"
 "ValueError (bad arguments, a name the input already has, a format that\n"
 "cannot hold the field) and OSError (out_path cannot be written).\n"
-"The library's hd_write_field; formats: docs/formats.md.\n");
+"The library's hd_write_field; formats: docs/formats.md.\n\n"
+">>> import os, tempfile, hausdorff\n"
+">>> d = tempfile.mkdtemp()\n"
+">>> src = os.path.join(d, 'a.xyz')\n"
+">>> _ = open(src, 'w').write('0 0 0\\n1 0 0\\n')\n"
+">>> hausdorff.write_field(src, os.path.join(d, 'far.xyz'), [0.5, 2.0], farther_than=1.0)\n"
+"1\n"
+">>> print(open(os.path.join(d, 'far.xyz')).read(), end='')\n"
+"1 0 0 2\n");
 
 static PyObject *py_write_field(PyObject *self, PyObject *args, PyObject *kw) {
     (void)self;

@@ -178,15 +178,16 @@ def test_las_fixtures_gain_an_extra_bytes_dimension(tmp_path):
         assert np.array_equal(hausdorff.read(far), pts[d > 0.5])
 
 
-def test_layered_laz_fixtures_read_back(tmp_path):
-    for name in ("fmt6_channels.laz", "fmt6_variable_extra1.laz"):
+def test_laz_fixtures_read_back(tmp_path):
+    for name in ("fmt6_channels.laz", "fmt6_variable_extra1.laz", "fmt0_chunks16.laz", "fmt1_variable.laz",
+                 "fmt3_extra2.laz"):
         src = os.path.join(CORPUS, "laz", name)
         pts = hausdorff.read(src)
         out = tmp_path / name
         assert hausdorff.write_field(src, out, np.arange(len(pts), dtype=float)) == len(pts)
         assert np.array_equal(hausdorff.read(out), pts)
-    with pytest.raises(ValueError, match="compressed pointwise"):
-        src = os.path.join(CORPUS, "laz", "fmt3_extra2.laz")
+    with pytest.raises(ValueError, match="LASzip 1.x compression"):
+        src = os.path.join(CORPUS, "laz", "fmt3_laszip1_extra1.laz")
         hausdorff.write_field(src, tmp_path / "x.laz", np.zeros(len(hausdorff.read(src))))
 
 
