@@ -848,8 +848,9 @@ HD_EXTERN void hd_write_options_init(hd_write_options_t *opt);
  * Errors: HD_EINVAL (NULL arguments, n not the file's point count, a bad
  *   name, a field of that name already in the input, out_path the input
  *   itself or an existing file that is not a regular file (a device, a
- *   FIFO: the result is renamed into place), a non-finite threshold), HD_EUNSUPPORTED (an input that is not
- *   a regular file: it must be read twice; a format or variant above), the
+ *   FIFO: the result is renamed into place), a non-finite threshold),
+ *   HD_EUNSUPPORTED (an input that is not a regular file: it must be
+ *   read twice; a format or variant above), the
  *   errors of hd_read_file for the input, HD_EIO (out_path cannot be
  *   created or written: the message names it and the system's reason,
  *   a full disk or a file size limit included), HD_ENOMEM.

@@ -95,26 +95,36 @@ static int map_input(const char *path, hd__file_t *f, struct stat *st, hd_error_
 }
 
 /* The temporary beside out_path: its name in *tmp (malloc'd) and a
- * buffered stream, or NULL with err set. */
+ * buffered stream, or NULL with err set.  Created with open(O_EXCL, 0666),
+ * so it gets a new file's permissions under the process's umask (mkstemp's
+ * 0600 would need umask() to widen, which is not thread safe). */
 static FILE *open_temp(const char *out_path, char **tmp, hd_error_t *err) {
     size_t n = strlen(out_path);
-    *tmp = malloc(n + 16);
+    *tmp = malloc(n + 32);
     if (!*tmp) {
         hd__err(err, HD_ENOMEM, "out of memory");
         return NULL;
     }
-    snprintf(*tmp, n + 16, "%s.tmp-XXXXXX", out_path);
-    int fd = mkstemp(*tmp);
+    static const char digits[] = "0123456789abcdefghijklmnopqrstuvwxyz";
+    uint64_t seed = (uint64_t)getpid() * 0x9E3779B97F4A7C15ull ^ (uint64_t)(uintptr_t)tmp ^ (uint64_t)(hd__now() * 1e9);
+    int fd = -1;
+    for (int attempt = 0; attempt < 100 && fd < 0; attempt++) {
+        char suffix[7];
+        for (int k = 0; k < 6; k++) {
+            seed = seed * 6364136223846793005ull + 1442695040888963407ull;
+            suffix[k] = digits[(seed >> 33) % 36];
+        }
+        suffix[6] = 0;
+        snprintf(*tmp, n + 32, "%s.tmp-%s", out_path, suffix);
+        fd = open(*tmp, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+        if (fd < 0 && errno != EEXIST) break;
+    }
     if (fd < 0) {
         hd__err(err, HD_EIO, "%s: cannot create: %s", out_path, strerror(errno));
         free(*tmp);
         *tmp = NULL;
         return NULL;
     }
-    /* mkstemp makes it 0600: give it fopen's 0666 less the umask */
-    mode_t um = umask(0);
-    umask(um);
-    fchmod(fd, 0666 & ~um);
     FILE *f = fdopen(fd, "wb");
     if (!f) {
         hd__err(err, HD_EIO, "%s: cannot open: %s", out_path, strerror(errno));
