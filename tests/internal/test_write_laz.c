@@ -185,6 +185,36 @@ TEST(layered_laz_gains_the_field_as_byte14_layers) {
     laz_case(&o, 5, 6);
 }
 
+TEST(laz_extended_vlrs_follow_the_points_with_their_offset_moved) {
+    gen_rng_t g;
+    gen_seed(&g, 31);
+    lazw_point_t p[300];
+    lazw_random(&g, p, 300, 6);
+    lazw_opts_t o = {6, 0, 100, NULL, 0, {0.01, 0.01, 0.01}, {0, 0, 0}, 0};
+    tf_buf_t b = {0};
+    lazw_encode(&b, &o, p, 300);
+    uint64_t at = b.size; /* an extended VLR after the chunk table */
+    for (int i = 0; i < 8; i++) b.data[235 + i] = (unsigned char)(at >> 8 * i);
+    b.data[243] = 1;
+    char user[16] = "someone", desc[32] = "kept";
+    tf_u16(&b, 0, 0), tf_put(&b, user, 16), tf_u16(&b, 9, 0), tf_u64(&b, 4, 0), tf_put(&b, desc, 32), tf_put(&b, "EVLR", 4);
+    const char *in = tf_finish(&b, "evlr.laz");
+    double v[300];
+    for (int k = 0; k < 300; k++) v[k] = k * 0.5;
+    hd_error_t err;
+    CHECK_RC(hd_write_field(in, tf_path("evlr_out.laz"), v, 300, NULL, NULL, &err), HD_OK);
+    size_t n;
+    unsigned char *d = tf_read(tf_path("evlr_out.laz"), &n);
+    CHECK(d && n > 64 && memcmp(d + n - 4, "EVLR", 4) == 0);
+    CHECK_EQ(le(d + 235, 8), n - 64);
+    CHECK_EQ(le(d + 243, 4), 1);
+    hd_cloud_t *c = NULL;
+    CHECK_RC(hd_read_file(tf_path("evlr_out.laz"), NULL, &c, &err), HD_OK);
+    CHECK(c && c->count == 300);
+    hd_cloud_free(c);
+    free(d);
+}
+
 /* ---- pointwise LAZ: every field compressed again ------------------------- */
 /* Every whole record of the LAZ file at path, decoded by laz.c. */
 static unsigned char *records_of(const char *path, size_t *n, size_t *rec) {
