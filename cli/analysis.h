@@ -245,8 +245,8 @@ int distances_format_known(const char *path);
 /* ---- files in the inputs' own formats (writeback.c) -------------------- */
 /* Whether --distances OUT writes the side read from in_path (format: its
  * FORMAT: or --format, else NULL) back into its own format: .las, .laz,
- * .xyz, .txt, .pts, .asc, and .ply when the side is a PLY file; .csv, .npy
- * and .ply for other inputs are write_distances' tables. */
+ * .xyz, .txt, .pts, .asc; .csv, .npy and .ply are write_distances' tables
+ * (the files hausdorff-mpi writes too). */
 int analysis_writes_back(const char *out, const char *in_path, const char *format);
 /* 1 when OUT can name a file written back (--farther-than, --nearer-than:
  * .ply .las .laz .xyz .txt .csv .pts .asc .obj). */

@@ -1,8 +1,9 @@
 /*
  * writeback.c -- per-point distances written into the inputs' own files
  * (hd_write_field): --distances OUT when OUT names the side's format
- * (.las, .laz, text, or .ply for a PLY side: a `distance` field added to
- * every point, everything else kept), and --farther-than D OUT /
+ * (.las, .laz, text: a `distance` field added to every point, everything
+ * else kept; .ply stays the table both tools write, byte for byte), and
+ * --farther-than D OUT /
  * --nearer-than D OUT (the points whose distance is > D / <= D, in their
  * file's format, the field included).  A's file gets A's distances to B;
  * without --directed, B's file OUT_b.EXT gets B's to A.  What can be
@@ -29,12 +30,12 @@ static const char *side_format(const char *in_path, const char *format, const hd
 }
 
 int analysis_writes_back(const char *out, const char *in_path, const char *format) {
+    (void)in_path, (void)format;
     const char *e = ext_of(out);
-    if (strcasecmp(e, "csv") == 0 || strcasecmp(e, "npy") == 0) return 0;
-    if (strcasecmp(e, "ply") == 0) {
-        const char *f = format ? format : hd_format_of_path(in_path);
-        return f && strcmp(f, "ply") == 0;
-    }
+    /* .csv, .npy and .ply are the tables hausdorff-mpi writes too, byte for
+     * byte (a PLY side's own file with the field: --farther-than 0 /
+     * --nearer-than, the library, Python) */
+    if (strcasecmp(e, "csv") == 0 || strcasecmp(e, "npy") == 0 || strcasecmp(e, "ply") == 0) return 0;
     return hd_format_of_path(out) != NULL;
 }
 

@@ -1,10 +1,11 @@
 """Command-line tests of the files written back into the inputs' formats:
---distances OUT when OUT has A's format (a `distance` field added to A's
-file, B's to OUT_b), --farther-than D OUT and --nearer-than D OUT (the
-points past D in their file's format), against the table --distances
-writes (.csv: x,y,z,distance,nearest), which gives every distance: the
-field written back equals it bit for bit (checked by parsers written here:
-PLY ascii lines, LAS extra bytes).  Mismatched formats, --sample, masks,
+--distances OUT when OUT has A's format (.las, .laz, text: a `distance`
+field added to A's file, B's to OUT_b; .ply stays the table), and
+--farther-than D OUT / --nearer-than D OUT (the points past D in their
+file's format), against the table --distances writes (.csv:
+x,y,z,distance,nearest), which gives every distance: the field written
+back equals it bit for bit (checked by parsers written here: text and PLY
+ascii lines, LAS extra bytes).  Mismatched formats, --sample, masks,
 hausdorff-mpi's and --surface's refusals are usage errors (exit 1) before
 anything is read; a file that cannot be written is exit 3 and leaves none.
 Standard library only; run as:  cli_writeback.py PATH/TO/hausdorff
@@ -83,18 +84,22 @@ def las_field(path, name="distance"):
 
 
 @test
-def ply_written_back_equals_the_table(tmp):
-    rc, out, err = run("--distances", tmp + "/t.csv", A, B)
+def ply_distances_stay_the_table_and_text_is_written_back(tmp):
+    """--distances OUT.ply is the table hausdorff-mpi writes too; a text A gets its column."""
+    rc, out, err = run("--distances", tmp + "/t.ply", FACES, B)
     assert rc == 0, err
-    rc, out, err = run("--distances", tmp + "/w.ply", A, B)
+    head = open(tmp + "/t.ply", "rb").read().split(b"end_header")[0].decode()
+    assert "property int nearest" in head and "element face" not in head, head
+    xyz = os.path.join(tmp, "a.xyz")
+    with open(xyz, "w") as f:
+        f.write("# a comment\n1.5 2 3\n4 5 6.25\n")
+    rc, out, err = run("--directed", "--distances", tmp + "/t.csv", xyz, B)
     assert rc == 0, err
-    assert "distances written into %s/w.ply and %s/w_b.ply" % (tmp, tmp) in out, out
-    assert ply_field(tmp + "/w.ply") == table(tmp + "/t.csv")
-    assert ply_field(tmp + "/w_b.ply") == table(tmp + "/t_b.csv")
-    rc, out, err = run("--directed", "--distances", tmp + "/f.ply", FACES, B)
+    rc, out, err = run("--directed", "--distances", tmp + "/w.txt", xyz, B)
     assert rc == 0, err
-    head = open(tmp + "/f.ply", "rb").read().split(b"end_header")[0].decode()
-    assert "property double distance\nelement face" in head, head
+    lines = open(tmp + "/w.txt").read().splitlines()
+    assert lines[0] == "# a comment" and lines[1].startswith("1.5 2 3 ") and lines[2].startswith("4 5 6.25 "), lines
+    assert [float(l.split()[3]) for l in lines[1:]] == table(tmp + "/t.csv")
 
 
 @test
@@ -146,7 +151,8 @@ def mismatches_are_usage_errors_before_reading(tmp):
         (["--distances", tmp + "/o.las", A, B], "A (%s) is ply, %s/o.las is las" % (A, tmp)),
         (["--farther-than", "1", tmp + "/o.ply", LAS, B], "is las, %s/o.ply is ply" % tmp),
         (["--farther-than", "1", tmp + "/o.ply", A, LAS], "B (%s) is las" % LAS),
-        (["--sample", "100", "--distances", tmp + "/o.ply", A, B], "with --sample the points are drawn on the faces"),
+        (["--sample", "100", "--farther-than", "0", tmp + "/o.ply", FACES, B],
+         "with --sample the points are drawn on the faces"),
         (["--farther-than", "x", tmp + "/o.ply", A, B], "needs a distance >= 0"),
         (["--farther-than", "1", tmp + "/o.dat", A, B], "cannot tell the format of"),
         (["--farther-than", "1"], "needs a distance and a file"),
@@ -171,9 +177,9 @@ def an_unwritable_file_is_exit_3_and_leaves_nothing(tmp):
 
 @test
 def a_field_already_there_is_refused(tmp):
-    rc, out, err = run("--directed", "--distances", tmp + "/w.ply", A, B)
+    rc, out, err = run("--directed", "--farther-than", "0", tmp + "/w.ply", A, B)
     assert rc == 0, err
-    rc, out, err = run("--directed", "--distances", tmp + "/w2.ply", tmp + "/w.ply", B)
+    rc, out, err = run("--directed", "--farther-than", "0", tmp + "/w2.ply", tmp + "/w.ply", B)
     assert rc != 0 and "already has a property 'distance'" in err, (rc, err)
     assert not os.path.exists(tmp + "/w2.ply")
 
