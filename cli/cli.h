@@ -25,6 +25,10 @@ typedef struct cli_args {
     int json;
     int quiet;
     int surface; /* --surface: B measured as its triangles (surface.c) */
+    double tolerance;       /* --tolerance: the enclosure's (m2m.c) */
+    int tolerance_set, tolerance_relative; /* given; with the 'd' suffix */
+    double within;          /* --within D: is the distance <= D? */
+    int within_set;
     int signed_distance; /* --signed: with --surface, each distance's sign */
     analysis_args_t an; /* analysis options (analysis.h) */
 } cli_args_t;

@@ -158,7 +158,7 @@ static int parse_double(const char *s, double *out) { return parse_double_upto(s
 typedef enum {
     OPT_NONE = -1, /* a heading or note of the help, not an option */
     OPT_ALGORITHM, OPT_THREADS, OPT_SEED, OPT_DEPTH, OPT_LAMBDA, OPT_THETA, OPT_FORMAT, OPT_SAMPLE,
-    OPT_MAX_STREAM_SIZE, OPT_FIFO_WAIT, OPT_LAZ_POINTS_PER_BYTE,
+    OPT_MAX_STREAM_SIZE, OPT_FIFO_WAIT, OPT_LAZ_POINTS_PER_BYTE, OPT_TOLERANCE, OPT_WITHIN,
     OPT_PERCENTILE, OPT_BINS, OPT_DISTANCES, OPT_MAX_DISTANCE, OPT_RENDER, OPT_HISTOGRAM_PNG,
     OPT_MASK_POINTS, OPT_EMPTY, OPT_CONNECTIVITY, OPT_MASK_DIMS, OPT_UNITS, OPT_TAU, OPT_TAU_RULE,
     OPT_DTU_CAP, OPT_FARTHER_THAN, OPT_NEARER_THAN, /* these two take D and OUT */
@@ -224,14 +224,25 @@ static const option_entry_t options[] = {
     {OPT_VERTICES, "--vertices", NULL, NULL, 0,
      "read a mesh (ply, obj, off, stl) as its vertices (default)"},
     {OPT_SURFACE, "--surface", NULL, NULL, 0,
-     "measure B, a mesh, as its surface: each point of A to its\n"
-     "nearest triangle, correctly rounded (A must be points);\n"
-     "the analysis options below work on these distances"},
+     "measure meshes as surfaces: each point of A to B's\n"
+     "nearest triangle, correctly rounded (the analysis\n"
+     "options below work on these distances); with a mesh\n"
+     "as A, every point of A's surface against B (a mesh or\n"
+     "points): the distance enclosed in [lower, upper] with\n"
+     "a witness"},
     {OPT_SIGNED, "--signed", NULL, NULL, 0,
      "with --surface: each distance's sign, -1 inside B, +1\n"
      "outside, 0 on it, from B's winding number (exact); B must\n"
      "be closed and consistently oriented, else it is refused\n"
      "naming an edge"},
+    {OPT_TOLERANCE, "--tolerance", NULL, "T", 0,
+     "with --surface and a mesh as A: upper - lower <= T,\n"
+     "absolute, or with a d suffix a fraction of the\n"
+     "bounding-box diagonal (default 1e-9d; 0: as tight\n"
+     "as doubles allow)"},
+    {OPT_WITHIN, "--within", NULL, "D", 0,
+     "with --surface and two meshes: only answer whether\n"
+     "H(A,B) <= D (h(A,B) with --directed), stopping early"},
     {OPT_SAMPLE, "--sample", NULL, "N", 0,
      "read a mesh as N points drawn uniformly by area on its\n"
      "faces, reproducibly for a given --seed; a point format\n"
@@ -472,6 +483,17 @@ static int set_run(cli_args_t *a, int which, const char *v) {
     } else if (which == OPT_FIFO_WAIT) {
         if (parse_long(v, 1, 86400, &l)) return bad("--fifo-wait needs a whole number of seconds 1..86400, not '%s'", v);
         a->read.fifo_wait_ms = (int)l * 1000;
+    } else if (which == OPT_TOLERANCE) {
+        size_t n = strlen(v);
+        a->tolerance_relative = n > 1 && v[n - 1] == 'd';
+        if (parse_double_upto(v, v + n - (size_t)a->tolerance_relative, &a->tolerance) ||
+            !(a->tolerance >= 0) || isinf(a->tolerance))
+            return bad("--tolerance needs a number >= 0, optionally with the suffix d (of the diagonal), not '%s'", v);
+        a->tolerance_set = 1;
+    } else if (which == OPT_WITHIN) {
+        if (parse_double(v, &a->within) || !(a->within >= 0) || isinf(a->within))
+            return bad("--within needs a distance >= 0, not '%s'", v);
+        a->within_set = 1;
     } else if (which == OPT_LAZ_POINTS_PER_BYTE) {
         if (parse_long(v, 1, HD_LAZ_POINTS_PER_BYTE_MAX, &l))
             return bad("--laz-points-per-byte needs a whole number 1..4096, not '%s'", v);
@@ -657,6 +679,9 @@ int cli_parse(int argc, char **argv, cli_args_t *a) {
                             : "%s: files in an input's own format are not written with --surface (its --distances "
                               "writes .csv, .ply or .npy tables)",
                    subset ? "--farther-than / --nearer-than" : a->an.distances_out);
+    if ((a->tolerance_set || a->within_set) && !a->surface)
+        return bad("%s measures a surface: it needs --surface (and a mesh as A)",
+                   a->within_set ? "--within" : "--tolerance");
     if (a->signed_distance && !a->surface)
         return bad("--signed needs --surface: a sign is taken from the surface of the mesh B%s", "");
     if (nfiles != 2) {

@@ -4,9 +4,8 @@
  * B) with its witness: the point, its nearest triangle and the closest
  * point on it.
  *
- * A is read as points (hd_read_file); a mesh as A is refused, since the
- * direction from a surface is a supremum over the whole surface (mesh to
- * mesh is a later piece of work).  B is read with hd_read_mesh: its
+ * A is read as points (hd_read_file); a mesh as A goes to m2m.c (the
+ * distance from a surface, enclosed).  B is read with hd_read_mesh: its
  * polygons as fans, an STL's equal corners merged, degenerate triangles
  * counted and measured as their hulls.  With --signed, each distance's
  * sign comes from B's winding number (hd_mesh_signed_distances; B must be
@@ -189,12 +188,17 @@ int surface_run(const cli_args_t *a) {
     memset(&s, 0, sizeof s);
     hd_error_t err;
     int rc = read_sides(a, &s, &err);
-    if (rc == HD_OK && s.ca->n_faces > 0) {
-        fprintf(stderr, "%s: --surface: A (%s) is a mesh with %zu faces: the distance from a surface is a supremum "
-                        "over the whole surface (mesh to mesh), not yet measured; give A as points, or drop "
-                        "--surface to compare the vertices\n", cli_prog(), a->path_a, s.ca->n_faces);
+    if (rc == HD_OK && s.ca->n_faces > 0) { /* a surface measured from: an enclosure (m2m.c) */
         surf_free(&s);
-        return EXIT_USAGE;
+        if (analysis_active(&a->an) || a->signed_distance)
+            return refuse("with a mesh as A gives the distance from its surface as an enclosure: the analysis "
+                          "options and --signed are not computed there");
+        return m2m_run(a);
+    }
+    if (rc == HD_OK && (a->tolerance_set || a->within_set)) {
+        surf_free(&s);
+        return refuse(a->within_set ? "--within needs a mesh as A (h(points, surface) is exact: compare it)"
+                                    : "--tolerance needs a mesh as A (h(points, surface) is exact, correctly rounded)");
     }
     int bad_mesh = 0;
     if (rc == HD_OK) bad_mesh = (rc = measure(a, &s, &err)) == HD_EINVAL; /* B's faces: not closed, say */

@@ -41,11 +41,13 @@ from ._hausdorff import (
     write_field,
 )
 from ._hausdorff import _mesh_distances, _read_mesh
-from ._surface import Mesh, SurfaceDistances, read_mesh
+from ._surface import (Enclosure, Mesh, SurfaceDistances, SurfaceHausdorff, SurfaceWitness, face_maxima,
+                       read_mesh, surface_hausdorff, surface_within)
 from . import masks, scores  # segmentation masks; reconstruction scores (masks.py, scores.py)
 
 __all__ = [
     "DirectedResult",
+    "Enclosure",
     "HausdorffResult",
     "Index",
     "Mesh",
@@ -53,12 +55,15 @@ __all__ = [
     "PercentileResult",
     "Summary",
     "SurfaceDistances",
+    "SurfaceHausdorff",
+    "SurfaceWitness",
     "__version__",
     "algorithms",
     "chamfer",
     "count",
     "directed",
     "distances",
+    "face_maxima",
     "formats",
     "hausdorff",
     "mean",
@@ -66,5 +71,7 @@ __all__ = [
     "read",
     "read_mesh",
     "summary",
+    "surface_hausdorff",
+    "surface_within",
     "write_field",
 ]

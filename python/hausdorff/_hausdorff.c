@@ -1913,6 +1913,130 @@ static PyObject *py_mesh_distances(PyObject *self, PyObject *args, PyObject *kw)
     return res;
 }
 
+/* ------------------------------------------------------------------------
+ * Surface to surface: enclosures (hausdorff.surface_hausdorff etc. in
+ * _surface.py).
+ * ---------------------------------------------------------------------- */
+
+/* An enclosure as a tuple (lower, upper, tolerance, converged, face_a,
+ * index_a, bary_a, point_a, witness_distance, witness_error, face_b,
+ * index_b, point_b, faces_dropped, faces_split, kernel_calls, seconds);
+ * SIZE_MAX indices as -1. */
+static PyObject *enclosure_tuple(const hd_enclosure_t *e) {
+#define HD__IX(v) ((v) == SIZE_MAX ? (Py_ssize_t)-1 : (Py_ssize_t)(v))
+    return Py_BuildValue("(ddd" "Onn" "(ddd)(ddd)" "dd" "nn(ddd)" "KKKd)", e->lower, e->upper, e->tolerance,
+                         e->converged ? Py_True : Py_False, HD__IX(e->face_a), HD__IX(e->index_a), e->bary_a[0],
+                         e->bary_a[1], e->bary_a[2], e->point_a[0], e->point_a[1], e->point_a[2],
+                         e->witness_distance, e->witness_error, HD__IX(e->face_b), HD__IX(e->index_b),
+                         e->point_b[0], e->point_b[1], e->point_b[2], (unsigned long long)e->faces_dropped,
+                         (unsigned long long)e->faces_split, (unsigned long long)e->kernel_calls, e->seconds);
+#undef HD__IX
+}
+
+/* A mesh argument: its vertices and faces held until mesh_release. */
+typedef struct mesh_arg {
+    points_arg_t v;
+    PyArrayObject *f;
+    hd_mesh_t m;
+} mesh_arg_t;
+
+static void mesh_release(mesh_arg_t *m) {
+    points_release(&m->v);
+    Py_XDECREF(m->f);
+    m->f = NULL;
+}
+
+static int mesh_from_objects(PyObject *ov, PyObject *of, const char *name, mesh_arg_t *out) {
+    memset(out, 0, sizeof *out);
+    if (points_from_object(ov, name, HD_EMPTY_ERROR, &out->v)) return -1;
+    out->f = faces_array(of);
+    if (!out->f) {
+        points_release(&out->v);
+        return -1;
+    }
+    hd_mesh_t m = {out->v.pts, PyArray_DATA(out->f), (size_t)PyArray_DIM(out->f, 0), HD_INDEX_U64};
+    out->m = m;
+    return 0;
+}
+
+static int surface_options(double tolerance, int relative, PyObject *threads, unsigned long long max_splits,
+                           hd_surface_options_t *o) {
+    hd_surface_options_init(o);
+    o->tolerance = tolerance;
+    o->relative = relative;
+    o->max_splits = max_splits;
+    return parse_threads(threads, &o->threads);
+}
+
+/* _surface_hausdorff(a_vertices, a_faces, b_vertices, b_faces, *, tolerance,
+ * relative, threads, max_splits, directed, d, what): b_faces None makes B a
+ * point set; what "hausdorff" -> (ab, ba or None), "within" -> (answer,
+ * ab, ba), "faces" -> (face_lower, face_upper, ab). */
+static PyObject *py_surface(PyObject *self, PyObject *args, PyObject *kw) {
+    (void)self;
+    static char *kwlist[] = {"a_vertices", "a_faces", "b_vertices", "b_faces", "tolerance", "relative",
+                             "threads", "max_splits", "directed", "d", "what", NULL};
+    PyObject *oav, *oaf, *obv, *obf, *threads = Py_None;
+    double tolerance = 1e-9, d = 0;
+    int relative = 1, directed = 0;
+    unsigned long long max_splits = 1ull << 20;
+    const char *what = "hausdorff";
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "OOOO|$dpOKpds:_surface", kwlist, &oav, &oaf, &obv, &obf,
+                                     &tolerance, &relative, &threads, &max_splits, &directed, &d, &what))
+        return NULL;
+    hd_surface_options_t o;
+    if (surface_options(tolerance, relative, threads, max_splits, &o)) return NULL;
+    mesh_arg_t a, b;
+    memset(&b, 0, sizeof b);
+    if (mesh_from_objects(oav, oaf, "A's vertices", &a)) return NULL;
+    int points = obf == Py_None;
+    int bad = points ? points_from_object(obv, "B", HD_EMPTY_ERROR, &b.v) : mesh_from_objects(obv, obf, "B's vertices", &b);
+    if (bad) {
+        mesh_release(&a);
+        return NULL;
+    }
+    hd_enclosure_t ab, ba;
+    hd_error_t err;
+    int rc = HD_OK, answer = -1, faces = strcmp(what, "faces") == 0, within = strcmp(what, "within") == 0;
+    PyArrayObject *lo = NULL, *hi = NULL;
+    if (faces) {
+        npy_intp n = (npy_intp)a.m.n_triangles;
+        lo = (PyArrayObject *)PyArray_SimpleNew(1, &n, NPY_DOUBLE);
+        hi = (PyArrayObject *)PyArray_SimpleNew(1, &n, NPY_DOUBLE);
+        if (!lo || !hi) rc = HD_ENOMEM;
+    }
+    if (rc == HD_OK) {
+        Py_BEGIN_ALLOW_THREADS
+        if (faces) rc = hd_surface_face_maxima(&a.m, &b.m, &o, PyArray_DATA(lo), PyArray_DATA(hi), &ab, &err);
+        else if (within) rc = hd_surface_within(&a.m, &b.m, d, directed, &o, &answer, &ab, &ba, &err);
+        else if (points) rc = hd_surface_points_hausdorff(&a.m, &b.v.pts, &o, &ab, directed ? NULL : &ba, &err);
+        else rc = hd_surface_hausdorff(&a.m, &b.m, &o, &ab, directed ? NULL : &ba, &err);
+        Py_END_ALLOW_THREADS
+    }
+    PyObject *res = NULL;
+    if (rc == HD_ENOMEM && faces && (!lo || !hi)) {
+        if (!PyErr_Occurred()) PyErr_NoMemory();
+    } else if (rc != HD_OK) {
+        raise_hd(rc, &err);
+    } else if (faces) {
+        res = Py_BuildValue("(OON)", lo, hi, enclosure_tuple(&ab));
+    } else {
+        PyObject *pa = enclosure_tuple(&ab), *pb = NULL;
+        if (directed && !within) {
+            pb = Py_None;
+            Py_INCREF(pb);
+        } else {
+            pb = enclosure_tuple(&ba);
+        }
+        res = within ? Py_BuildValue("(iNN)", answer, pa, pb) : Py_BuildValue("(NN)", pa, pb);
+    }
+    Py_XDECREF(lo);
+    Py_XDECREF(hi);
+    mesh_release(&a);
+    mesh_release(&b);
+    return res;
+}
+
 static PyObject *py_read_mesh(PyObject *self, PyObject *args, PyObject *kw) {
     (void)self;
     static char *kwlist[] = {"path", "format", NULL};
@@ -1956,6 +2080,9 @@ static PyMethodDef module_methods[] = {
      "_mesh_distances(points, vertices, faces, *, threads=None, signed=False): hausdorff.Mesh.distances's engine"},
     {"_read_mesh", (PyCFunction)(void (*)(void))py_read_mesh, METH_VARARGS | METH_KEYWORDS,
      "_read_mesh(path, *, format=None): hausdorff.read_mesh's engine"},
+    {"_surface", (PyCFunction)(void (*)(void))py_surface, METH_VARARGS | METH_KEYWORDS,
+     "_surface(a_vertices, a_faces, b_vertices, b_faces, *, tolerance, relative, threads, max_splits, "
+     "directed, d, what): the engine of hausdorff.surface_hausdorff, surface_within and face_maxima"},
     {"directed", (PyCFunction)(void (*)(void))py_directed, METH_VARARGS | METH_KEYWORDS,
      directed_doc},
     {"hausdorff", (PyCFunction)(void (*)(void))py_hausdorff, METH_VARARGS | METH_KEYWORDS,
