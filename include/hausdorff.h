@@ -964,6 +964,96 @@ HD_EXTERN const char *hd_format_description(const char *name);
 HD_EXTERN const char *hd_format_of_path(const char *path);
 
 /* ------------------------------------------------------------------------
+ * Writing a per-point field back into the input's own format.
+ *
+ * A deviation is most useful in the file people opened: a `distance`
+ * property in PLY, an extra-bytes dimension in LAS and LAZ, a column in
+ * text, and the changed points alone in the same format.  Every byte of
+ * the input that is not a point left out is kept: PLY's other properties
+ * and elements (faces too) in the input's encoding, LAS/LAZ's header, VLRs,
+ * point records, waveform data and extended VLRs, text lines verbatim.
+ * The formats and what each keeps: docs/formats.md, "Writing a field".
+ * ---------------------------------------------------------------------- */
+typedef enum hd_keep {
+    HD_KEEP_ALL = 0,     /* every point, with the field added */
+    HD_KEEP_FARTHER = 1, /* only the points whose value v > threshold */
+    HD_KEEP_NEARER = 2   /* only the points whose value v <= threshold */
+} hd_keep_t;
+
+typedef struct hd_write_options {
+    const char *name;  /* the field's name: NULL = "distance"; letters,
+                          digits and '_' (at most 31 bytes, LAS's limit).
+                          "" writes no field (a subset of the input as it
+                          is; with HD_KEEP_ALL a copy) */
+    hd_keep_t keep;    /* which points are written */
+    double threshold;  /* D of HD_KEEP_FARTHER / HD_KEEP_NEARER; finite
+                          (a NaN value is neither > D nor <= D: never kept) */
+    const char *format; /* the output's format ("ply", "las", ...): NULL
+                          = the one out_path's extension names; either way
+                          it must be the input's (for writing under a
+                          temporary name) */
+    const hd_read_options_t *read; /* how the input is read (NULL: the
+                          defaults): `format`, `decimal_comma` and
+                          `laz_points_per_byte` are used, so the points
+                          are numbered as hd_read_file numbers them with
+                          these options; a range or mesh sampling is
+                          refused (HD_EINVAL) */
+} hd_write_options_t;
+
+/* Fill `opt` with the defaults: "distance", HD_KEEP_ALL, threshold 0. */
+HD_EXTERN void hd_write_options_init(hd_write_options_t *opt);
+
+/* Write out_path: the points of in_path in its own format, point k with
+ * values[k] added as the field opt->name, keeping the points that
+ * opt->keep selects (in file order).  values holds n doubles, n being the
+ * number of points hd_read_file gives for in_path with opt->read (for
+ * meshes: the vertices); it is borrowed for the call.
+ * Formats (the input's, as its signature or the read options' format
+ * or its extension say; out_path's extension, or opt->format, must name
+ * the same format):
+ *  - PLY ascii and binary: `property double NAME` appended to element
+ *    vertex, in the input's encoding and byte order; a value is written
+ *    as the shortest decimal that reads back to the same double (ascii).
+ *    Every other element and property is kept; a subset keeps element
+ *    vertex only (the other elements, faces included, refer to vertices
+ *    by index and are left out).
+ *  - LAS 1.0-1.4: the header, VLRs and records kept, 8 bytes appended to
+ *    each record, described by an extra-bytes VLR (record 4, user
+ *    "LASF_Spec"; an existing one gets the descriptor appended, after an
+ *    "undocumented" one for bytes it did not describe), the record
+ *    length, offsets and (subset) counts, counts by return and bounds
+ *    updated; waveform data and extended VLRs follow the points as before.
+ *  - LAZ, point formats 6-10 (layered): every layer of every chunk copied
+ *    as it is and the field's 8 bytes added as BYTE14 layers; a subset is
+ *    HD_EUNSUPPORTED.  Point formats 0-3 (pointwise, LASzip items of
+ *    version 2): every chunk decoded and compressed again, the field's 8
+ *    bytes in the BYTE item; subsets too.  LASzip 1.x streams are
+ *    HD_EUNSUPPORTED.  The library's own encoder writes both.
+ *  - XYZ, CSV, TXT, PTS, ASC: every line kept, the value appended to each
+ *    point line with the file's separator (a CSV header line gets the
+ *    name; a PTS count line the subset's count).  OBJ: a subset keeps its
+ *    lines but the vertices left out and the faces; no field (HD_KEEP_ALL
+ *    with a name is HD_EUNSUPPORTED).  Other formats: HD_EUNSUPPORTED.
+ * The file is written to a temporary beside out_path and renamed over it
+ * once complete and flushed to disk, so out_path is either the whole
+ * result or untouched.  *written (may be NULL) receives the number of
+ * points written.
+ * Errors: HD_EINVAL (NULL arguments, n not the file's point count, a bad
+ *   name, a field of that name already in the input, out_path the input
+ *   itself or an existing file that is not a regular file (a device, a
+ *   FIFO: the result is renamed into place), a non-finite threshold),
+ *   HD_EUNSUPPORTED (an input that is not a regular file: it must be
+ *   read twice; a format or variant above), the
+ *   errors of hd_read_file for the input, HD_EIO (out_path cannot be
+ *   created or written: the message names it and the system's reason,
+ *   a full disk or a file size limit included), HD_ENOMEM.
+ * Thread safe (nothing is shared between calls). */
+HD_EXTERN int hd_write_field(const char *in_path, const char *out_path,
+                             const double *values, size_t n,
+                             const hd_write_options_t *opt, size_t *written,
+                             hd_error_t *err);
+
+/* ------------------------------------------------------------------------
  * Surfaces: the distance from every point of a cloud to a triangle mesh.
  *
  * The distance from a point to a triangle is the true Euclidean distance
