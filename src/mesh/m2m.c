@@ -281,6 +281,9 @@ static int shared_convex(const hd__tri_t *s, const hd__tri_t *t) {
             if (memcmp(s->v[i], t->v[j], sizeof s->v[i]) == 0) same[i] = j, n++;
     if (n != 2) return 0;
     int ia = same[0] < 0 ? 0 : same[1] < 0 ? 1 : 2, ip = (ia + 1) % 3, iq = (ia + 2) % 3;
+    /* two corners of s equal to one corner of t (s has repeated corners):
+     * no shared edge */
+    if (same[ip] == same[iq]) return 0;
     int jb = 3 - same[ip] - same[iq];
     return convex_pair(s->v[ip], s->v[iq], s->v[ia], t->v[jb]);
 }
