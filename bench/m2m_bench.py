@@ -94,7 +94,10 @@ def cgal(args, case, tol, which):
 def dense(args, x, y, enclosures, timeout):
     """Dense check of h(x, y) against every enclosure of that direction."""
     upper = min(e["upper"] for e in enclosures)
-    cmd = [args.dense, x, y, "--upper", repr(upper), "--samples", str(args.dense_samples)]
+    # at least level 2 (the edge midpoints) however large the mesh
+    nt = int(open(x).read(200).split()[2])
+    level = max(2, int(math.sqrt(2.0 * args.dense_samples / max(nt, 1))))
+    cmd = [args.dense, x, y, "--upper", repr(upper), "--level", str(level)]
     for e in enclosures:
         p = e["point_a"]
         cmd += ["--witness", ",".join(repr(v) for v in p + [e["witness_distance"], e["witness_error"]])]
