@@ -450,7 +450,7 @@ def main():
     bench = os.path.join(args.build, "bench")
     args.run, args.cgal = os.path.join(bench, "m2m_run"), os.path.join(bench, "m2m_cgal")
     args.dense = os.path.join(args.build, "tests", "m2m_dense")
-    out = os.path.join(bench, "m2m_quick" if args.quick else "m2m_cases")
+    out = os.path.join(bench, "m2m_pairs_quick" if args.quick else "m2m_pairs")
     os.makedirs(out, exist_ok=True)
     subprocess.run([os.path.join(bench, "m2m_cases"), args.data, out] + (["--quick"] if args.quick else []),
                    check=True)
