@@ -870,6 +870,138 @@ HD_EXTERN int hd_mesh_distances(const hd_points_t *P, const hd_mesh_t *M,
                                 double *bary, hd_surface_result_t *out,
                                 hd_error_t *err);
 
+/* ------------------------------------------------------------------------
+ * Surface to surface: the Hausdorff distance between two triangle meshes
+ * as surfaces (every point of A's triangles, not only its vertices), and
+ * between a surface and a point set.
+ *
+ * The distance from a surface is in general not a rational number (its
+ * maximiser can lie inside a triangle of A, on the medial axis of B), so
+ * it is returned as an enclosure [lower, upper]:
+ *  - upper is rigorous under floating point: the true h(A, B) <= upper.
+ *    Every bound is rounded outward, and the rounding error of every point
+ *    computed on A is added to the bounds of its sub-triangle.
+ *  - lower comes from an explicit witness point of A (point_a, on face_a
+ *    at weights bary_a): witness_distance is the correctly rounded
+ *    distance from point_a (the double point) to B.  point_a is within
+ *    witness_error of the exact point of face_a at those weights (0 when
+ *    it is a vertex of A); lower = witness_distance when witness_error is
+ *    0, else the largest double below witness_distance minus
+ *    witness_error, rounded down: a distance some point of A certainly
+ *    has.  So the correctly rounded h lies in [lower, upper].
+ *  - upper - lower <= tolerance (the absolute tolerance as used), unless
+ *    `converged` is 0 (see hd_surface_options_t.max_splits).
+ * Branch and bound over A's triangles: each is split into four at its
+ * edge midpoints while its upper bound can exceed the best lower bound by
+ * more than the tolerance; a sub-triangle's upper bound is the smaller of
+ * Tang et al.'s (the least, over the triangles of B nearest to its
+ * corners, of the largest corner distance to that triangle: the distance
+ * to a triangle is convex) and the point bound (the largest corner
+ * distance to B plus the farthest a point of the sub-triangle can be from
+ * its nearest corner).  Faces of A whose corners are bit-identical to a
+ * face of B's are at distance 0 and dropped first.  Degenerate triangles
+ * are their hulls on both sides.  The result does not depend on the
+ * thread count: the same enclosure, witness and counters at 1 thread or
+ * many (triangles are taken in fixed batches, each refined against the
+ * lower bound of the batches before it).
+ * ---------------------------------------------------------------------- */
+
+/* One directed distance h(X, Y) as an enclosure.  "a" is the side the
+ * distance is measured from (X), "b" the side it is measured to (Y): for
+ * the `ba` output of the calls below, face_a indexes B and face_b A. */
+typedef struct hd_enclosure {
+    double lower, upper;      /* lower <= RN(h) <= upper, h <= upper */
+    double tolerance;         /* the absolute tolerance used */
+    int converged;            /* 1: upper - lower <= tolerance */
+    size_t face_a;            /* the witness's triangle of X (SIZE_MAX
+                                 when X is a point set) */
+    size_t index_a;           /* the witness's point of X when X is a
+                                 point set (SIZE_MAX otherwise) */
+    double bary_a[3];         /* its weights of face_a's corners, in
+                                 their stored order (dyadic; rounded to
+                                 double) */
+    double point_a[3];        /* the witness point, as computed */
+    double witness_distance;  /* RN(distance from point_a to Y) */
+    double witness_error;     /* |point_a - the exact point| bound */
+    size_t face_b;            /* point_a's nearest triangle of Y (SIZE_MAX
+                                 when Y is a point set) */
+    size_t index_b;           /* its nearest point of Y when Y is a point
+                                 set (SIZE_MAX otherwise) */
+    double point_b[3];        /* that nearest point (within a few
+                                 rounding errors) */
+    uint64_t faces_dropped;   /* faces of X shared with Y */
+    uint64_t faces_split;     /* sub-triangles split in four */
+    uint64_t kernel_calls;    /* point-to-triangle distances computed */
+    double seconds;           /* wall-clock time of this direction */
+} hd_enclosure_t;
+
+typedef struct hd_surface_options {
+    double tolerance;  /* 1e-9; 0: as tight as doubles allow (then the
+                          tolerance used is a few rounding errors of the
+                          coordinates: see docs/surfaces.md) */
+    int relative;      /* 1: tolerance times the diagonal of the bounding
+                          box of A and B together; 0: absolute */
+    int threads;       /* 0: every core; 1: serial */
+    uint64_t max_splits; /* 2^20: per face of X, at most this many
+                          splits, then its bound stands as it is
+                          (converged 0); 0: no limit */
+} hd_surface_options_t;
+
+/* Fill `opt` with the defaults shown above. */
+HD_EXTERN void hd_surface_options_init(hd_surface_options_t *opt);
+
+/* h(surface A, surface B) into *ab and h(surface B, surface A) into *ba,
+ * each enclosed as described above; either may be NULL (a directed
+ * distance), not both.  The symmetric H lies in [max(lower), max(upper)].
+ * opt: NULL for the defaults.  Errors: HD_EINVAL (NULL meshes, both
+ * outputs NULL, a negative or non-finite tolerance, threads < 0, a bad
+ * mesh as in hd_mesh_distances), HD_EEMPTY (a mesh without triangles),
+ * HD_ENONFINITE, HD_ERANGE, HD_ENOMEM.  Thread safety: reentrant; it may
+ * start opt->threads threads. */
+HD_EXTERN int hd_surface_hausdorff(const hd_mesh_t *A, const hd_mesh_t *B,
+                                   const hd_surface_options_t *opt,
+                                   hd_enclosure_t *ab, hd_enclosure_t *ba,
+                                   hd_error_t *err);
+
+/* A surface and a point set: *ab = h(surface A, points B) (the farthest
+ * point of A's surface from the cloud, enclosed; index_b is its nearest
+ * point of B) and *ba = h(points B, surface A), which is exact: lower =
+ * upper = the correctly rounded distance (index_a is B's farthest point,
+ * face_b its nearest triangle of A).  Either output may be NULL, not both.
+ * Errors: as hd_surface_hausdorff, for B as in hd_mesh_distances. */
+HD_EXTERN int hd_surface_points_hausdorff(const hd_mesh_t *A,
+                                          const hd_points_t *B,
+                                          const hd_surface_options_t *opt,
+                                          hd_enclosure_t *ab,
+                                          hd_enclosure_t *ba,
+                                          hd_error_t *err);
+
+/* The predicate "H(A, B) <= d?" (h(A, B) <= d when `directed` is 1),
+ * with early exit: the search stops as soon as one face of A (or B) is
+ * proven farther than d, or every face is proven within d.  *answer: 1
+ * (proven <= d), 0 (proven > d), or -1 when the distance lies within the
+ * tolerance of d and the enclosure cannot decide (the enclosures say how
+ * close).  ab, ba: NULL, or the enclosures as far as the search went (their
+ * width is then not bounded by the tolerance).  Errors: as
+ * hd_surface_hausdorff, and HD_EINVAL for d negative or NaN. */
+HD_EXTERN int hd_surface_within(const hd_mesh_t *A, const hd_mesh_t *B,
+                                double d, int directed,
+                                const hd_surface_options_t *opt,
+                                int *answer, hd_enclosure_t *ab,
+                                hd_enclosure_t *ba, hd_error_t *err);
+
+/* Per-face maxima: for every triangle k of A, face_lower[k] <= RN(the
+ * largest distance from a point of triangle k to surface B) and that
+ * largest distance <= face_upper[k], each to the tolerance (each face is
+ * refined on its own, so this costs more than hd_surface_hausdorff).
+ * Shared faces get [0, 0].  ab (may be NULL) receives h(A, B) from the
+ * same work.  face_lower and face_upper hold A->n_triangles doubles each;
+ * either may be NULL, not both.  Errors: as hd_surface_hausdorff. */
+HD_EXTERN int hd_surface_face_maxima(const hd_mesh_t *A, const hd_mesh_t *B,
+                                     const hd_surface_options_t *opt,
+                                     double *face_lower, double *face_upper,
+                                     hd_enclosure_t *ab, hd_error_t *err);
+
 #ifdef __cplusplus
 }
 #endif

@@ -14,6 +14,7 @@
  */
 #include "io/io.h"
 #include "mesh/mesh.h"
+#include "surface.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -156,7 +157,7 @@ hd_mesh_t hd_mesh_file_view(const hd_mesh_file_t *mesh) {
 
 /* The mesh's triangles as the tree stores them, every index and corner
  * checked; *n_degenerate counted. */
-static int mesh_triangles(const hd_mesh_t *M, hd__tri_t **out, size_t *n_degenerate, hd_error_t *err) {
+int hd__mesh_triangles(const hd_mesh_t *M, hd__tri_t **out, size_t *n_degenerate, hd_error_t *err) {
     const hd_points_t *V = &M->vertices;
     if (M->index_type != HD_INDEX_U32 && M->index_type != HD_INDEX_U64)
         return hd__err(err, HD_EINVAL, "mesh: unknown index type %d", (int)M->index_type);
@@ -315,7 +316,7 @@ int hd_mesh_distances(const hd_points_t *P, const hd_mesh_t *M, const hd_options
     hd__box_t box;
     int rc = hd__points_check(P, "P", &box, err);
     hd__tri_t *tris = NULL;
-    if (rc || (rc = mesh_triangles(M, &tris, &res.n_degenerate, err))) return rc;
+    if (rc || (rc = hd__mesh_triangles(M, &tris, &res.n_degenerate, err))) return rc;
     hd__bvh_t bvh;
     if ((rc = hd__bvh_build(&bvh, tris, M->n_triangles))) {
         free(tris);

@@ -154,4 +154,45 @@ double hd__tris_lower(const hd__tri_t *t, size_t n, const hd__box_t *b, const do
  * segment or a point), decided exactly. */
 int hd__tri_degenerate(const double a[3], const double b[3], const double c[3]);
 
+/* ---- surface to surface: the enclosure's branch and bound (m2m.c) ------- */
+
+/* One directed search h(X, Y): X's triangles in index order, Y's tree. */
+typedef struct hd__m2m_job {
+    const hd__tri_t *from;
+    size_t n_from;
+    const hd__bvh_t *to;
+    const unsigned char *drop; /* 1 for a face of X to skip (shared), or NULL */
+    double tol;                /* absolute, > 0 */
+    double done_below;         /* a face is finished once its bound is <= this
+                                  (the predicate's d; -infinity otherwise) */
+    double stop_above;         /* stop once a lower bound exceeds this (the
+                                  predicate's d; +infinity otherwise) */
+    int per_face;              /* refine every face against its own lower
+                                  bound only (per-face maxima) */
+    uint64_t max_splits;       /* per face; 0: no limit */
+    int threads;               /* >= 1 */
+    double *face_lower, *face_upper; /* n_from each, or NULL */
+} hd__m2m_job_t;
+
+typedef struct hd__m2m_result {
+    double lower, upper;
+    size_t face;               /* the witness's face of X (SIZE_MAX: none) */
+    double bary[3], point[3], witness_distance, witness_error;
+    size_t face_b;             /* its nearest triangle's index in Y */
+    double point_b[3];
+    uint64_t dropped, splits, kernel_calls;
+    int capped;                /* some face stopped at max_splits or the
+                                  deepest level */
+} hd__m2m_result_t;
+
+/* Run the search (m2m.c has the proof that lower <= RN(h) and h <= upper).
+ * The result does not depend on job->threads.  HD_OK or HD_ENOMEM. */
+int hd__m2m_run(const hd__m2m_job_t *job, hd__m2m_result_t *out);
+
+/* drop[k] = 1 for each triangle of x whose three corners are, as a set,
+ * bit-identical to those of a triangle of y; *count of them.  HD_OK or
+ * HD_ENOMEM. */
+int hd__m2m_shared(const hd__tri_t *x, size_t nx, const hd__tri_t *y, size_t ny, unsigned char *drop,
+                   size_t *count);
+
 #endif

@@ -1,0 +1,599 @@
+/*
+ * m2m.c -- the distance from a surface to a surface, enclosed: branch and
+ * bound over the triangles of X (the side measured from) against the tree
+ * of Y's triangles (a point set is a tree of point-triangles).
+ *
+ * Sub-triangles.  A sub-triangle of a face abc of X is kept as three
+ * corners, each with exact integer barycentric weights (k0, k1, k2),
+ * k0 + k1 + k2 = 2^L at the sub-triangle's level L; splitting at the edge
+ * midpoints doubles the weights of the old corners and adds those of two
+ * corners for a midpoint, so the four children tile their parent exactly
+ * (in real arithmetic) and the leaves of a face tile the face.  Levels
+ * stop at MAX_LEVEL (weights below 2^63).
+ *
+ * Computed corners.  A corner's point is computed in doubles as
+ * fl(fl(w0 a) + fl(w1 b)) + fl(w2 c) with w = fl(k) 2^-L: each weight is
+ * off by at most u w (u = 2^-53), each of the five operations adds at most
+ * u of its result or 2^-1075 on underflow, so per coordinate the error is
+ * at most (u + gamma_3 (1 + u)) M_k + 3 2^-1075 <= 4.01 u M_k + 2^-1072,
+ * with M_k the largest |coordinate k| of the face's corners, and over the
+ * three coordinates at most 4.01 u (Mx + My + Mz) + 2^-1070.  slack() uses
+ * 8 u (Mx + My + Mz) + 2^-1060: e.  A corner that is a vertex of the face
+ * (one weight 2^L) is that vertex, exactly (e = 0).
+ *
+ * Bounds.  Each corner v gets r = RN(d(v, Y)) from the exact kernel through
+ * the tree (hd__bvh_nearest), so d(v, Y) <= next_up(r).
+ *  - Lower: a point of X at distance >= r' from Y with r' = r at a vertex
+ *    (the witness is exact), else r' = down(next_down(r) - e): the exact
+ *    point of the face at the corner's weights is within e of v, so its
+ *    distance is at least d(v, Y) - e >= next_down(r) - e.
+ *  - Upper, for the hull T of the three computed corners: every y in T has
+ *    d(y, Y) <= d(v, Y) + |y - v| for each corner v, so
+ *    d(y, Y) <= max_v next_up(r_v) + R with R >= the largest distance from a
+ *    point of T to its nearest corner (the point bound: R <= the longest
+ *    edge over sqrt 3 for every triangle, the circumradius bound of a
+ *    non-obtuse triangle, and half the longest edge for an obtuse one).
+ *    And for any triangle t of Y, d(., t) is convex, so its maximum over T
+ *    is at a corner: d(y, Y) <= min over t of max_v d(v, t) (Tang et al.),
+ *    taken over the corners' nearest triangles with d(v, t) <= sqrt_up(hi2)
+ *    from hd__tri_bounds (or next_up(r) for v's own nearest).  The exact
+ *    sub-triangle of the face is within e of T point by point (the weights
+ *    of a point of the exact sub-triangle applied to the computed corners
+ *    give a point of T within e), so U = up(min(both) + e) (e = 0 at level
+ *    0, whose corners are exact).
+ * All upper sums and square roots are rounded to nearest and then moved one
+ * double up (next_up), which is at least the exact value.
+ *
+ * The search.  Phase 1 evaluates every face's corners (fixed chunks, any
+ * thread) and sets the lower bound L to the best corner.  Phase 2 takes the
+ * faces by decreasing upper bound in batches of fixed sizes; the faces of a
+ * batch are refined in parallel, each on its own against L as it was
+ * before the batch (and its own corners' lower bounds): a face pops its
+ * sub-triangle of largest U, stops when U <= max(L, own lower) + tolerance
+ * (or the predicate's bound), else splits it and keeps the children whose
+ * U exceeds that threshold.  The batches merge in order, the witness is the
+ * first best in face order, so nothing depends on the thread count.  The
+ * face's upper bound is the largest U it stopped at or discarded; h's
+ * upper bound is the largest over faces (faces skipped because their
+ * first U was <= L contribute that U).
+ */
+#include "mesh/mesh.h"
+#include "mesh/mesh_int.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define MAX_LEVEL 62
+/* The batches of phase 2: FIRST_BATCH faces, doubling up to MAX_BATCH. */
+#define FIRST_BATCH 8
+#define MAX_BATCH 1024
+/* Faces per task in phase 1. */
+#define CHUNK 256
+/* Below this a squared edge may have underflowed: R from |dx|+|dy|+|dz|. */
+#define TINY2 0x1p-960
+
+static double up(double x) { return nextafter(x, INFINITY); }
+static double down(double x) { return nextafter(x, -INFINITY); }
+static double sqrt_up(double x) { return x <= 0 ? 0 : up(sqrt(x)); }
+
+typedef struct corner {
+    double p[3];
+    uint64_t k[3];
+    double r;      /* RN(d(p, Y)) */
+    double lower;  /* a distance a point of X has, from this corner */
+    size_t pos;    /* p's nearest triangle: its position in the tree */
+    size_t index;  /* ... and its index in Y */
+    double near[3];/* the nearest point on it */
+} corner_t;
+
+typedef struct sub {
+    corner_t c[3];
+    double U;
+    int level;
+} sub_t;
+
+/* The best lower bound of a face and its witness. */
+typedef struct best {
+    double lower;
+    int set;
+    corner_t c;
+    int level;
+    double e;
+} best_t;
+
+/* A face's state between the phases and its result. */
+typedef struct face {
+    sub_t top;          /* level 0 */
+    best_t best;
+    double upper;       /* the face's upper bound so far */
+    uint64_t splits, kernel;
+    int capped;         /* stopped by max_splits or MAX_LEVEL */
+    int done;
+} face_t;
+
+static double slack(const hd__tri_t *t) {
+    double m = 0;
+    for (int k = 0; k < 3; k++) {
+        double mk = fmax(fabs(t->v[0][k]), fmax(fabs(t->v[1][k]), fabs(t->v[2][k])));
+        m = up(m + mk);
+    }
+    return up(m * 0x1p-50 + 0x1p-1060);
+}
+
+/* The corner's point from its weights at `level` (see the top). */
+static void corner_point(const hd__tri_t *t, corner_t *c, int level) {
+    uint64_t one = (uint64_t)1 << level;
+    for (int j = 0; j < 3; j++)
+        if (c->k[j] == one) {
+            memcpy(c->p, t->v[j], sizeof c->p);
+            return;
+        }
+    double w[3];
+    for (int j = 0; j < 3; j++) w[j] = ldexp((double)c->k[j], -level);
+    for (int d = 0; d < 3; d++) c->p[d] = w[0] * t->v[0][d] + w[1] * t->v[1][d] + w[2] * t->v[2][d];
+}
+
+static int is_vertex(const corner_t *c, int level) {
+    uint64_t one = (uint64_t)1 << level;
+    return c->k[0] == one || c->k[1] == one || c->k[2] == one;
+}
+
+typedef struct ctx {
+    const hd__m2m_job_t *job;
+    face_t *faces;
+} ctx_t;
+
+static void evaluate(const hd__m2m_job_t *J, const hd__tri_t *t, double e, corner_t *c, int level, size_t seed,
+                     hd__bvh_stats_t *st) {
+    hd__tri_near_t near;
+    corner_point(t, c, level);
+    c->pos = hd__bvh_nearest(J->to, c->p, seed, &near, &c->index, st);
+    c->r = near.d;
+    memcpy(c->near, near.point, sizeof c->near);
+    c->lower = is_vertex(c, level) ? c->r : fmax(0.0, down(down(c->r) - e));
+}
+
+static void offer(best_t *b, const corner_t *c, int level, double e) {
+    if (!b->set || c->lower > b->lower) {
+        b->set = 1;
+        b->lower = c->lower;
+        b->c = *c;
+        b->level = level;
+        b->e = is_vertex(c, level) ? 0 : e;
+    }
+}
+
+/* R: the farthest a point of the hull of the corners can be from its
+ * nearest corner, rounded up (see the top). */
+static double reach(const sub_t *s) {
+    double l2[3], l1 = 0;
+    for (int i = 0; i < 3; i++) {
+        const double *p = s->c[i].p, *q = s->c[(i + 1) % 3].p;
+        double dx = p[0] - q[0], dy = p[1] - q[1], dz = p[2] - q[2];
+        l2[i] = dx * dx + dy * dy + dz * dz;
+        l1 = up(l1 + up(up(fabs(dx) + fabs(dy)) + fabs(dz)));
+    }
+    double a2 = fmax(l2[0], fmax(l2[1], l2[2]));
+    if (a2 < TINY2) return up(l1 * (1 + 0x1p-40));
+    double rest = l2[0] + l2[1] + l2[2] - a2;
+    /* a2 > rest by a margin far above the rounding of the squares: obtuse */
+    double f = a2 > rest * (1 + 0x1p-40) ? 0.5 : 0.57735026918962584;
+    return up(sqrt(a2) * f * (1 + 0x1p-40));
+}
+
+/* ---- two coplanar triangles whose union is convex ----------------------- */
+
+/* Exactly: p q a and p q b are coplanar, on opposite sides of pq, and the
+ * quadrilateral a p b q is convex (segment ab meets line pq between p and
+ * q), so that the union of the two triangles is a convex set.  A filter in
+ * doubles rejects the clearly non-coplanar first. */
+static int filtered_apart(const double *p, const double *q, const double *a, const double *b) {
+    double u[3], x[3], y[3];
+    for (int i = 0; i < 3; i++) u[i] = q[i] - p[i], x[i] = a[i] - p[i], y[i] = b[i] - p[i];
+    double c0 = u[1] * y[2] - u[2] * y[1], c1 = u[2] * y[0] - u[0] * y[2], c2 = u[0] * y[1] - u[1] * y[0];
+    double det = x[0] * c0 + x[1] * c1 + x[2] * c2;
+    double perm = fabs(x[0]) * (fabs(u[1] * y[2]) + fabs(u[2] * y[1])) +
+                  fabs(x[1]) * (fabs(u[2] * y[0]) + fabs(u[0] * y[2])) +
+                  fabs(x[2]) * (fabs(u[0] * y[1]) + fabs(u[1] * y[0]));
+    return fabs(det) > perm * 0x1p-48 + 0x1p-1000;
+}
+
+static void big_cross(hd__big_t r[3], const hd__big_t x[3], const hd__big_t y[3]) {
+    hd__big_t s, t;
+    for (int i = 0; i < 3; i++) {
+        int j = (i + 1) % 3, k = (i + 2) % 3;
+        hd__big_mul(&s, &x[j], &y[k]);
+        hd__big_mul(&t, &x[k], &y[j]);
+        hd__big_sub(&r[i], &s, &t);
+    }
+}
+
+static int big_dot_sign(const hd__big_t x[3], const hd__big_t y[3]) {
+    hd__big_t s, t, acc;
+    hd__big_set_u64(&acc, 0);
+    for (int i = 0; i < 3; i++) {
+        hd__big_mul(&s, &x[i], &y[i]);
+        hd__big_add(&t, &acc, &s);
+        acc = t;
+    }
+    return hd__big_sign(&acc);
+}
+
+static int convex_pair(const double *p, const double *q, const double *a, const double *b) {
+    if (filtered_apart(p, q, a, b)) return 0;
+    const double *in[4] = {p, q, a, b};
+    int e0 = 0, any = 0;
+    for (int i = 0; i < 4; i++)
+        for (int k = 0; k < 3; k++)
+            if (in[i][k] != 0) {
+                int e = hd__ulp_exp(in[i][k]);
+                e0 = !any || e < e0 ? e : e0;
+                any = 1;
+            }
+    if (!any) return 0;
+    hd__big_t P[4][3], u[3], x[3], y[3], w[3], na[3], nb[3], c[3];
+    for (int i = 0; i < 4; i++)
+        for (int k = 0; k < 3; k++) hd__big_set_double(&P[i][k], in[i][k], e0);
+    for (int k = 0; k < 3; k++) {
+        hd__big_sub(&u[k], &P[1][k], &P[0][k]);
+        hd__big_sub(&x[k], &P[2][k], &P[0][k]);
+        hd__big_sub(&y[k], &P[3][k], &P[0][k]);
+        hd__big_sub(&w[k], &P[3][k], &P[2][k]);
+    }
+    big_cross(na, u, x);
+    big_cross(nb, u, y);
+    big_cross(c, na, nb);
+    for (int k = 0; k < 3; k++)
+        if (hd__big_sign(&c[k]) != 0) return 0; /* not coplanar */
+    if (big_dot_sign(na, nb) >= 0) return 0;         /* same side, or degenerate */
+    hd__big_t pa[3], qa[3], mp[3], mq[3];
+    for (int k = 0; k < 3; k++) {
+        hd__big_sub(&pa[k], &P[0][k], &P[2][k]);
+        hd__big_sub(&qa[k], &P[1][k], &P[2][k]);
+    }
+    big_cross(mp, w, pa);
+    big_cross(mq, w, qa);
+    return big_dot_sign(mp, mq) <= 0; /* p and q on opposite sides of ab */
+}
+
+/* When triangles s and t of the tree share an edge and their union is
+ * convex: 1, with the shared corners p, q and the others a (of s), b. */
+static int shared_convex(const hd__tri_t *s, const hd__tri_t *t) {
+    int same[3] = {-1, -1, -1}, n = 0;
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3 && same[i] < 0; j++)
+            if (memcmp(s->v[i], t->v[j], sizeof s->v[i]) == 0) same[i] = j, n++;
+    if (n != 2) return 0;
+    int ia = same[0] < 0 ? 0 : same[1] < 0 ? 1 : 2, ip = (ia + 1) % 3, iq = (ia + 2) % 3;
+    int jb = 3 - same[ip] - same[iq];
+    return convex_pair(s->v[ip], s->v[iq], s->v[ia], t->v[jb]);
+}
+
+/* d(v, t) <= this (v's own nearest triangle: next_up(r)). */
+static double corner_to(const corner_t *c, size_t pos, const hd__tri_t *t, uint64_t *kernel) {
+    if (c->pos == pos) return up(c->r);
+    double lo2, hi2;
+    hd__tri_bounds(c->p, t->v[0], t->v[1], t->v[2], &lo2, &hi2);
+    (*kernel)++;
+    return sqrt_up(hi2);
+}
+
+/* Over a convex union W of two triangles of Y, the distance to W is convex
+ * too: its largest value over the sub-triangle is at a corner. */
+static double pair_bound(const hd__m2m_job_t *J, const sub_t *s, double U, uint64_t *kernel) {
+    for (int i = 0; i < 3; i++)
+        for (int j = i + 1; j < 3; j++) {
+            size_t p1 = s->c[i].pos, p2 = s->c[j].pos;
+            if (p1 == p2) continue;
+            const hd__tri_t *t1 = &J->to->tris[p1], *t2 = &J->to->tris[p2];
+            if (!shared_convex(t1, t2)) continue;
+            double m = 0;
+            for (int k = 0; k < 3 && m < U; k++)
+                m = fmax(m, fmin(corner_to(&s->c[k], p1, t1, kernel), corner_to(&s->c[k], p2, t2, kernel)));
+            U = fmin(U, m);
+        }
+    return U;
+}
+
+static double upper_of(const hd__m2m_job_t *J, const sub_t *s, double e, uint64_t *kernel) {
+    double rmax = 0;
+    for (int i = 0; i < 3; i++) rmax = fmax(rmax, up(s->c[i].r));
+    double U = up(rmax + reach(s));
+    for (int i = 0; i < 3; i++) { /* Tang's bound over the corners' nearest triangles */
+        size_t cand = s->c[i].pos;
+        int seen = 0;
+        for (int j = 0; j < i; j++) seen |= s->c[j].pos == cand;
+        if (seen) continue;
+        const hd__tri_t *t = &J->to->tris[cand];
+        double m = 0;
+        for (int j = 0; j < 3 && m < U; j++) m = fmax(m, corner_to(&s->c[j], cand, t, kernel));
+        U = fmin(U, m);
+    }
+    if (s->c[0].pos != s->c[1].pos || s->c[1].pos != s->c[2].pos) U = pair_bound(J, s, U, kernel);
+    return s->level ? up(U + e) : U;
+}
+
+/* ---- phase 1: every face's corners -------------------------------------- */
+
+static void phase1(void *vctx, size_t task, int worker) {
+    (void)worker;
+    ctx_t *C = vctx;
+    const hd__m2m_job_t *J = C->job;
+    size_t lo = task * CHUNK, hi = lo + CHUNK < J->n_from ? lo + CHUNK : J->n_from, seed = SIZE_MAX;
+    for (size_t f = lo; f < hi; f++) {
+        face_t *F = &C->faces[f];
+        memset(F, 0, sizeof *F);
+        if (J->drop && J->drop[f]) {
+            F->done = 1;
+            continue;
+        }
+        const hd__tri_t *t = &J->from[f];
+        hd__bvh_stats_t st = {0, 0, 0, 0};
+        for (int i = 0; i < 3; i++) {
+            corner_t *c = &F->top.c[i];
+            c->k[0] = c->k[1] = c->k[2] = 0;
+            c->k[i] = 1;
+            evaluate(J, t, 0, c, 0, seed, &st);
+            seed = c->pos;
+            offer(&F->best, c, 0, 0);
+        }
+        F->top.level = 0;
+        F->top.U = upper_of(J, &F->top, 0, &F->kernel);
+        F->upper = F->top.U;
+        F->kernel += st.kernel;
+    }
+}
+
+/* ---- phase 2: refining one face ----------------------------------------- */
+
+/* A worker's sub-triangles: a pool with a free list, ordered by a heap. */
+typedef struct pool {
+    sub_t *s;
+    size_t n, cap;
+    size_t *free_;
+    size_t n_free;
+    hd__heap_t heap;
+    int failed;
+} pool_t;
+
+static size_t pool_put(pool_t *P, const sub_t *s) {
+    size_t k;
+    if (P->n_free) {
+        k = P->free_[--P->n_free];
+    } else {
+        if (P->n == P->cap) {
+            size_t cap = P->cap ? 2 * P->cap : 64;
+            sub_t *ns = realloc(P->s, cap * sizeof *ns);
+            size_t *nf = realloc(P->free_, cap * sizeof *nf);
+            if (ns) P->s = ns;
+            if (nf) P->free_ = nf;
+            if (!ns || !nf) {
+                P->failed = 1;
+                return SIZE_MAX;
+            }
+            P->cap = cap;
+        }
+        k = P->n++;
+    }
+    P->s[k] = *s;
+    if (hd__heap_push(&P->heap, s->U, k)) {
+        P->failed = 1;
+        return SIZE_MAX;
+    }
+    return k;
+}
+
+/* The four children of s (corners 0, 1, 2; midpoints m01, m12, m20). */
+static void split(const hd__m2m_job_t *J, const hd__tri_t *t, double e, const sub_t *s, sub_t kids[4],
+                  face_t *F, hd__bvh_stats_t *st) {
+    int L = s->level + 1;
+    corner_t c[3], m[3];
+    for (int i = 0; i < 3; i++) {
+        c[i] = s->c[i];
+        for (int j = 0; j < 3; j++) c[i].k[j] = 2 * s->c[i].k[j];
+    }
+    for (int i = 0; i < 3; i++) {
+        const corner_t *p = &s->c[i], *q = &s->c[(i + 1) % 3];
+        for (int j = 0; j < 3; j++) m[i].k[j] = p->k[j] + q->k[j];
+        evaluate(J, t, e, &m[i], L, p->pos, st);
+        offer(&F->best, &m[i], L, e);
+    }
+    const corner_t *tri[4][3] = {{&c[0], &m[0], &m[2]}, {&m[0], &c[1], &m[1]}, {&m[2], &m[1], &c[2]},
+                                 {&m[0], &m[1], &m[2]}};
+    for (int q = 0; q < 4; q++) {
+        for (int i = 0; i < 3; i++) kids[q].c[i] = *tri[q][i];
+        kids[q].level = L;
+        kids[q].U = upper_of(J, &kids[q], e, &F->kernel);
+    }
+}
+
+static double threshold(const hd__m2m_job_t *J, double L, const face_t *F) {
+    double thr = J->per_face ? F->best.lower : fmax(L, F->best.lower);
+    return thr;
+}
+
+/* Refine face f against the lower bound L of the batches before it. */
+static void refine(const hd__m2m_job_t *J, face_t *F, size_t f, double L, pool_t *P) {
+    const hd__tri_t *t = &J->from[f];
+    double e = slack(t), cut = 0; /* cut: the largest U discarded */
+    hd__bvh_stats_t st = {0, 0, 0, 0};
+    hd__heap_clear(&P->heap);
+    P->n = P->n_free = 0;
+    if (pool_put(P, &F->top) == SIZE_MAX) return;
+    for (;;) {
+        if (hd__heap_size(&P->heap) == 0) {
+            F->upper = cut;
+            break;
+        }
+        const hd__heap_item_t *top = hd__heap_top(&P->heap);
+        double thr = threshold(J, L, F);
+        if (top->key - thr <= J->tol || top->key <= J->done_below || F->best.lower > J->stop_above) {
+            F->upper = fmax(top->key, cut);
+            break;
+        }
+        hd__heap_item_t it = hd__heap_pop(&P->heap);
+        sub_t s = P->s[it.val];
+        P->free_[P->n_free++] = (size_t)it.val;
+        if (s.level >= MAX_LEVEL || (J->max_splits && F->splits >= J->max_splits)) {
+            F->capped = 1;
+            if (s.level >= MAX_LEVEL) {
+                cut = fmax(cut, s.U);
+                continue;
+            }
+            F->upper = fmax(s.U, cut);
+            break;
+        }
+        sub_t kids[4];
+        split(J, t, e, &s, kids, F, &st);
+        F->splits++;
+        thr = threshold(J, L, F);
+        for (int q = 0; q < 4; q++) {
+            if (kids[q].U <= fmax(thr, J->done_below)) cut = fmax(cut, kids[q].U);
+            else if (pool_put(P, &kids[q]) == SIZE_MAX) return;
+        }
+    }
+    F->kernel += st.kernel;
+    F->done = 1;
+}
+
+typedef struct batch {
+    ctx_t *C;
+    const size_t *order;
+    double L;
+    pool_t *pools;
+} batch_t;
+
+static void phase2(void *vctx, size_t task, int worker) {
+    batch_t *B = vctx;
+    size_t f = B->order[task];
+    pool_t *P = &B->pools[worker];
+    if (!P->failed) refine(B->C->job, &B->C->faces[f], f, B->L, P);
+}
+
+/* ---- the whole search ---------------------------------------------------- */
+
+typedef struct rank {
+    double U;
+    size_t f;
+} rank_t;
+
+static int by_upper(const void *x, const void *y) {
+    const rank_t *a = x, *b = y;
+    if (a->U != b->U) return a->U > b->U ? -1 : 1;
+    return (a->f > b->f) - (a->f < b->f);
+}
+
+static void take_best(hd__m2m_result_t *R, const face_t *F, size_t f) {
+    if (!F->best.set) return;
+    if (R->face != SIZE_MAX && !(F->best.lower > R->lower)) return;
+    const corner_t *c = &F->best.c;
+    R->lower = F->best.lower;
+    R->face = f;
+    for (int j = 0; j < 3; j++) R->bary[j] = ldexp((double)c->k[j], -F->best.level);
+    memcpy(R->point, c->p, sizeof R->point);
+    R->witness_distance = c->r;
+    R->witness_error = F->best.e;
+    R->face_b = c->index;
+    memcpy(R->point_b, c->near, sizeof R->point_b);
+}
+
+static void finish_face(hd__m2m_result_t *R, const hd__m2m_job_t *J, const face_t *F, size_t f) {
+    if (J->face_lower) J->face_lower[f] = F->best.set ? F->best.lower : 0;
+    if (J->face_upper) J->face_upper[f] = F->upper;
+    R->upper = fmax(R->upper, F->upper);
+    R->splits += F->splits;
+    R->kernel_calls += F->kernel;
+    R->capped |= F->capped;
+}
+
+static int run_batches(const hd__m2m_job_t *J, ctx_t *C, rank_t *rk, size_t n, hd__m2m_result_t *R) {
+    pool_t *pools = calloc((size_t)J->threads, sizeof *pools);
+    size_t *order = hd__malloc_array(MAX_BATCH, sizeof *order);
+    int rc = pools && order ? HD_OK : HD_ENOMEM;
+    for (int w = 0; pools && w < J->threads; w++) hd__heap_init(&pools[w].heap, 1);
+    size_t next = 0, size = FIRST_BATCH;
+    while (rc == HD_OK && next < n) {
+        if (R->lower > J->stop_above) break; /* the predicate is answered */
+        size_t m = 0;
+        /* faces whose first bound cannot exceed L (or the predicate's d) are finished */
+        for (; next < n && m < size; next++) {
+            face_t *F = &C->faces[rk[next].f];
+            if (J->per_face || (F->top.U - R->lower > J->tol && F->top.U > J->done_below)) order[m++] = rk[next].f;
+        }
+        batch_t B = {C, order, J->per_face ? -INFINITY : R->lower, pools};
+        hd__parallel_for(J->threads, m, phase2, &B);
+        for (int w = 0; w < J->threads; w++)
+            if (pools[w].failed) rc = HD_ENOMEM;
+        for (size_t k = 0; k < m; k++) take_best(R, &C->faces[order[k]], order[k]);
+        if (size < MAX_BATCH) size *= 2;
+    }
+    for (int w = 0; pools && w < J->threads; w++) {
+        free(pools[w].s);
+        free(pools[w].free_);
+        hd__heap_free(&pools[w].heap);
+    }
+    free(pools);
+    free(order);
+    return rc;
+}
+
+int hd__m2m_run(const hd__m2m_job_t *J, hd__m2m_result_t *R) {
+    memset(R, 0, sizeof *R);
+    R->face = R->face_b = SIZE_MAX;
+    size_t n = J->n_from;
+    ctx_t C = {J, hd__malloc_array(n ? n : 1, sizeof(face_t))};
+    rank_t *rk = hd__malloc_array(n ? n : 1, sizeof *rk);
+    if (!C.faces || !rk) {
+        free(C.faces);
+        free(rk);
+        return HD_ENOMEM;
+    }
+    hd__parallel_for(J->threads, (n + CHUNK - 1) / CHUNK, phase1, &C);
+    size_t live = 0;
+    for (size_t f = 0; f < n; f++) {
+        take_best(R, &C.faces[f], f);
+        if (!C.faces[f].done) rk[live++] = (rank_t){C.faces[f].top.U, f};
+        else R->dropped++;
+    }
+    if (R->face == SIZE_MAX) R->lower = 0; /* every face shared: h = 0 */
+    qsort(rk, live, sizeof *rk, by_upper);
+    int rc = run_batches(J, &C, rk, live, R);
+    for (size_t f = 0; f < n; f++) finish_face(R, J, &C.faces[f], f);
+    R->upper = fmax(R->upper, R->lower);
+    free(C.faces);
+    free(rk);
+    return rc;
+}
+
+/* ---- shared faces -------------------------------------------------------- */
+
+typedef struct key {
+    double v[3][3];
+} facekey_t;
+
+static int cmp_corner3(const void *x, const void *y) { return memcmp(x, y, 3 * sizeof(double)); }
+
+static void key_of(const hd__tri_t *t, facekey_t *k) {
+    memcpy(k->v, t->v, sizeof k->v);
+    qsort(k->v, 3, sizeof k->v[0], cmp_corner3);
+}
+
+static int cmp_key(const void *x, const void *y) { return memcmp(x, y, sizeof(facekey_t)); }
+
+int hd__m2m_shared(const hd__tri_t *x, size_t nx, const hd__tri_t *y, size_t ny, unsigned char *drop,
+                   size_t *count) {
+    *count = 0;
+    facekey_t *ky = hd__malloc_array(ny ? ny : 1, sizeof *ky);
+    if (!ky) return HD_ENOMEM;
+    for (size_t k = 0; k < ny; k++) key_of(&y[k], &ky[k]);
+    qsort(ky, ny, sizeof *ky, cmp_key);
+    for (size_t k = 0; k < nx; k++) {
+        facekey_t kx;
+        key_of(&x[k], &kx);
+        drop[k] = bsearch(&kx, ky, ny, sizeof *ky, cmp_key) != NULL;
+        *count += drop[k];
+    }
+    free(ky);
+    return HD_OK;
+}

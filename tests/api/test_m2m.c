@@ -1,0 +1,388 @@
+/*
+ * test_m2m.c -- the distance between surfaces as an enclosure
+ * (hd_surface_hausdorff, hd_surface_points_hausdorff, hd_surface_within,
+ * hd_surface_face_maxima) against a dense check: every triangle of A
+ * sampled on a barycentric grid of N = 2^k steps whose points are exactly
+ * on A (integer corners, so every sample is computed without rounding),
+ * each sample's correctly rounded distance to B from hd_mesh_distances.
+ * What must hold: every sample's distance <= upper; the largest sample <=
+ * lower + tolerance; the witness's distance as documented; the same
+ * enclosure, witness and counters at 1 and 3 threads; both directions.
+ */
+#include "check.h"
+#include "gen.h"
+
+#include <math.h>
+#include <stdlib.h>
+
+#ifdef __SANITIZE_ADDRESS__
+#define SCALE 4
+#else
+#define SCALE 1
+#endif
+
+typedef struct {
+    double *v;
+    size_t nv;
+    uint64_t *t;
+    size_t nt;
+} soup_t;
+
+static hd_mesh_t view(const soup_t *s) {
+    hd_mesh_t m = {hd_points_f64(s->v, s->nv), s->t, s->nt, HD_INDEX_U64};
+    return m;
+}
+
+static soup_t soup_new(size_t nv, size_t nt) {
+    soup_t s = {calloc(3 * nv + 1, sizeof(double)), nv, calloc(3 * nt + 1, sizeof(uint64_t)), nt};
+    return s;
+}
+
+static void soup_free(soup_t *s) {
+    free(s->v);
+    free(s->t);
+}
+
+static soup_t soup_of(const double *v, size_t nv, const uint64_t *t, size_t nt) {
+    soup_t s = soup_new(nv, nt);
+    memcpy(s.v, v, 3 * nv * sizeof *v);
+    memcpy(s.t, t, 3 * nt * sizeof *t);
+    return s;
+}
+
+/* A soup of nt random triangles with integer corners in [-side, side]. */
+static soup_t random_soup(gen_rng_t *r, size_t nt, int side) {
+    soup_t s = soup_new(3 * nt, nt);
+    for (size_t k = 0; k < 3 * nt * 3; k++) s.v[k] = (double)((int)(gen_u64(r) % (uint64_t)(2 * side + 1)) - side);
+    for (size_t k = 0; k < 3 * nt; k++) s.t[k] = k;
+    return s;
+}
+
+/* Samples of face k of A on the grid of n steps (exact: integer corners,
+ * n a power of two, coordinates below 2^40). */
+static size_t face_samples(const soup_t *A, size_t k, int n, double *out) {
+    const double *a = A->v + 3 * A->t[3 * k], *b = A->v + 3 * A->t[3 * k + 1], *c = A->v + 3 * A->t[3 * k + 2];
+    size_t m = 0;
+    for (int i = 0; i <= n; i++)
+        for (int j = 0; i + j <= n; j++, m++)
+            for (int d = 0; d < 3; d++)
+                out[3 * m + d] = ((double)(n - i - j) * a[d] + (double)i * b[d] + (double)j * c[d]) / n;
+    return m;
+}
+
+/* The correctly rounded distances of n points to B. */
+static double *distances(const double *pts, size_t n, const soup_t *B) {
+    double *d = malloc(n * sizeof *d);
+    hd_points_t P = hd_points_f64(pts, n);
+    hd_mesh_t M = view(B);
+    CHECK_RC(hd_mesh_distances(&P, &M, NULL, d, NULL, NULL, NULL, NULL, NULL), HD_OK);
+    return d;
+}
+
+static double dist1(const double *p, const soup_t *B) {
+    double *d = distances(p, 1, B), r = d[0];
+    free(d);
+    return r;
+}
+
+/* The largest sampled distance of each face of A to B (grid of n). */
+static double *dense(const soup_t *A, const soup_t *B, int n) {
+    size_t per = (size_t)(n + 1) * (size_t)(n + 2) / 2;
+    double *pts = malloc(3 * per * A->nt * sizeof *pts), *best = malloc(A->nt * sizeof *best);
+    for (size_t k = 0; k < A->nt; k++) face_samples(A, k, n, pts + 3 * per * k);
+    double *d = distances(pts, per * A->nt, B);
+    for (size_t k = 0; k < A->nt; k++) {
+        best[k] = 0;
+        for (size_t s = 0; s < per; s++) best[k] = fmax(best[k], d[per * k + s]);
+    }
+    free(pts);
+    free(d);
+    return best;
+}
+
+/* The witness is what the header says: its distance correctly rounded,
+ * lower derived from it, the point where its weights put it. */
+static void witness_holds(const hd_enclosure_t *e, const soup_t *X, const soup_t *Y) {
+    if (e->face_a == SIZE_MAX) {
+        CHECK(e->lower == 0 && e->upper == 0);
+        return;
+    }
+    CHECK(e->face_a < X->nt);
+    CHECK_BITS(e->witness_distance, dist1(e->point_a, Y));
+    if (e->witness_error == 0) {
+        CHECK_BITS(e->lower, e->witness_distance);
+    } else {
+        double want = fmax(0.0, nextafter(nextafter(e->witness_distance, 0) - e->witness_error, -INFINITY));
+        CHECK_BITS(e->lower, want);
+    }
+    const uint64_t *f = X->t + 3 * e->face_a;
+    double sum = e->bary_a[0] + e->bary_a[1] + e->bary_a[2];
+    CHECK(fabs(sum - 1) <= 1e-15);
+    for (int d = 0; d < 3; d++) {
+        double want = e->bary_a[0] * X->v[3 * f[0] + d] + e->bary_a[1] * X->v[3 * f[1] + d] +
+                      e->bary_a[2] * X->v[3 * f[2] + d];
+        CHECK(fabs(want - e->point_a[d]) <= e->witness_error + 1e-12 * fabs(want));
+    }
+}
+
+/* The enclosure of h(X, Y) holds against the dense check of grid n. */
+static void encloses(const hd_enclosure_t *e, const soup_t *X, const soup_t *Y, int n) {
+    CHECK(e->lower <= e->upper);
+    CHECK(e->converged);
+    CHECK(e->upper - e->lower <= e->tolerance);
+    double *best = dense(X, Y, n), far = 0;
+    for (size_t k = 0; k < X->nt; k++) far = fmax(far, best[k]);
+    CHECK(far <= e->upper);
+    CHECK(far <= e->lower + e->tolerance);
+    if (far > e->upper || far > e->lower + e->tolerance)
+        CONTEXT("dense %.17g, enclosure [%.17g, %.17g], tolerance %.3g", far, e->lower, e->upper, e->tolerance);
+    witness_holds(e, X, Y);
+    free(best);
+}
+
+static void same_enclosure(const hd_enclosure_t *x, const hd_enclosure_t *y) {
+    CHECK_BITS(x->lower, y->lower);
+    CHECK_BITS(x->upper, y->upper);
+    CHECK_EQ(x->face_a, y->face_a);
+    CHECK_EQ(x->face_b, y->face_b);
+    for (int d = 0; d < 3; d++) CHECK_BITS(x->point_a[d], y->point_a[d]);
+    CHECK_EQ(x->faces_split, y->faces_split);
+    CHECK_EQ(x->kernel_calls, y->kernel_calls);
+}
+
+static hd_surface_options_t options(double tol, int relative, int threads) {
+    hd_surface_options_t o;
+    hd_surface_options_init(&o);
+    o.tolerance = tol;
+    o.relative = relative;
+    o.threads = threads;
+    return o;
+}
+
+/* Both directions at 1 and 3 threads, each enclosing, the same at both. */
+static void both_ways(const soup_t *A, const soup_t *B, double tol, int n) {
+    hd_mesh_t a = view(A), b = view(B);
+    hd_enclosure_t ab1, ba1, ab3, ba3;
+    hd_surface_options_t o1 = options(tol, 1, 1), o3 = options(tol, 1, 3);
+    CHECK_RC(hd_surface_hausdorff(&a, &b, &o1, &ab1, &ba1, NULL), HD_OK);
+    CHECK_RC(hd_surface_hausdorff(&a, &b, &o3, &ab3, &ba3, NULL), HD_OK);
+    encloses(&ab1, A, B, n);
+    encloses(&ba1, B, A, n);
+    same_enclosure(&ab1, &ab3);
+    same_enclosure(&ba1, &ba3);
+}
+
+TEST(identical_meshes_are_zero) {
+    const double v[] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 1};
+    const uint64_t t[] = {0, 1, 2, 1, 3, 2};
+    soup_t A = soup_of(v, 4, t, 2);
+    hd_mesh_t a = view(&A);
+    hd_enclosure_t ab, ba;
+    CHECK_RC(hd_surface_hausdorff(&a, &a, NULL, &ab, &ba, NULL), HD_OK);
+    CHECK(ab.lower == 0 && ab.upper == 0 && ba.upper == 0);
+    CHECK_EQ(ab.faces_dropped, 2);
+    CHECK_EQ(ab.faces_split, 0);
+    soup_free(&A);
+}
+
+TEST(parallel_shifted_triangle_is_its_shift) {
+    const double v[] = {0, 0, 0, 8, 0, 0, 0, 8, 0, 0, 0, 3, 8, 0, 3, 0, 8, 3};
+    const uint64_t ta[] = {0, 1, 2}, tb[] = {3, 4, 5};
+    soup_t A = soup_of(v, 6, ta, 1), B = soup_of(v, 6, tb, 1);
+    hd_mesh_t a = view(&A), b = view(&B);
+    hd_enclosure_t ab;
+    hd_surface_options_t o = options(0, 0, 1);
+    CHECK_RC(hd_surface_hausdorff(&a, &b, &o, &ab, NULL, NULL), HD_OK);
+    CHECK_BITS(ab.lower, 3.0);
+    CHECK(ab.upper >= 3.0 && ab.upper - 3.0 <= 1e-12);
+    CHECK_EQ(ab.witness_error, 0);
+    encloses(&ab, &A, &B, 16);
+    soup_free(&A);
+    soup_free(&B);
+}
+
+/* A right triangle against its three corners as points: the farthest
+ * point is the hypotenuse's midpoint, at the circumradius 2 sqrt 2. */
+TEST(triangle_to_its_corners_is_the_circumradius) {
+    const double v[] = {0, 0, 0, 4, 0, 0, 0, 4, 0};
+    const uint64_t t[] = {0, 1, 2};
+    soup_t A = soup_of(v, 3, t, 1);
+    hd_mesh_t a = view(&A);
+    hd_points_t B = hd_points_f64(v, 3);
+    hd_enclosure_t ab, ba;
+    hd_surface_options_t o = options(1e-12, 1, 1);
+    CHECK_RC(hd_surface_points_hausdorff(&a, &B, &o, &ab, &ba, NULL), HD_OK);
+    double r = sqrt(8.0);
+    CHECK(ab.lower <= r && r <= ab.upper);
+    CHECK(ab.upper - ab.lower <= ab.tolerance);
+    CHECK(ab.index_b < 3 && ab.face_b == SIZE_MAX);
+    CHECK(ba.lower == 0 && ba.upper == 0); /* the points are A's corners */
+    /* the same with tolerance 0: a few rounding errors wide */
+    o = options(0, 0, 1);
+    CHECK_RC(hd_surface_points_hausdorff(&a, &B, &o, &ab, NULL, NULL), HD_OK);
+    CHECK(ab.lower <= r && r <= ab.upper);
+    CHECK(ab.upper - ab.lower <= 1e-13);
+    soup_free(&A);
+}
+
+/* The two triangulations of a non-planar quad share every vertex, so a
+ * vertex-only distance is 0; the surfaces are apart along the diagonals. */
+TEST(quad_split_two_ways_is_not_zero) {
+    const double v[] = {0, 0, 0, 4, 0, 0, 4, 4, 4, 0, 4, 0};
+    const uint64_t ta[] = {0, 1, 2, 0, 2, 3}, tb[] = {0, 1, 3, 1, 2, 3};
+    soup_t A = soup_of(v, 4, ta, 2), B = soup_of(v, 4, tb, 2);
+    double *corners = dense(&A, &B, 1); /* grid 1: the vertices */
+    CHECK(corners[0] == 0 && corners[1] == 0);
+    free(corners);
+    both_ways(&A, &B, 1e-9, 64 / SCALE);
+    hd_mesh_t a = view(&A), b = view(&B);
+    hd_enclosure_t ab;
+    CHECK_RC(hd_surface_hausdorff(&a, &b, NULL, &ab, NULL, NULL), HD_OK);
+    CHECK(ab.lower >= 2 / sqrt(3.0) - 1e-6); /* the diagonal's midpoint */
+    /* planar: the same two triangulations of a flat square are one surface */
+    const double w[] = {0, 0, 0, 4, 0, 0, 4, 4, 0, 0, 4, 0};
+    soup_t F = soup_of(w, 4, ta, 2), G = soup_of(w, 4, tb, 2);
+    hd_mesh_t f = view(&F), g = view(&G);
+    CHECK_RC(hd_surface_hausdorff(&f, &g, NULL, &ab, NULL, NULL), HD_OK);
+    CHECK(ab.lower == 0 && ab.upper <= ab.tolerance);
+    soup_free(&A), soup_free(&B), soup_free(&F), soup_free(&G);
+}
+
+TEST(tetrahedron_against_its_scaled_copy) {
+    const double v[] = {0, 0, 0, 8, 0, 0, 0, 8, 0, 0, 0, 8, -4, -4, -4, 12, -4, -4, -4, 12, -4, -4, -4, 12};
+    const uint64_t ta[] = {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3}, tb[] = {4, 6, 5, 4, 5, 7, 4, 7, 6, 5, 6, 7};
+    soup_t A = soup_of(v, 8, ta, 4), B = soup_of(v, 8, tb, 4);
+    both_ways(&A, &B, 1e-9, 64 / SCALE);
+    both_ways(&A, &B, 1e-4, 32 / SCALE);
+    soup_free(&A);
+    soup_free(&B);
+}
+
+TEST(degenerate_faces_are_their_hulls) {
+    /* A: a proper triangle, a segment (collinear), a point (repeated
+     * index); B: a sliver and a segment */
+    const double v[] = {0, 0, 0, 8, 0, 0, 0, 8, 0, 16, 0, 0, 24, 0, 0, 4, 4, 4,
+                        0, 0, 4, 8, 0, 4, 16, 8, 4, -8, 0, 2, 0, 8, 6};
+    const uint64_t ta[] = {0, 1, 2, 1, 3, 4, 5, 5, 5}, tb[] = {6, 7, 8, 9, 10, 10};
+    soup_t A = soup_of(v, 11, ta, 3), B = soup_of(v, 11, tb, 2);
+    both_ways(&A, &B, 1e-9, 64 / SCALE);
+    soup_free(&A);
+    soup_free(&B);
+}
+
+TEST(random_soups_both_ways) {
+    for (uint64_t seed = 1; seed <= 12 / SCALE; seed++) {
+        CONTEXT("seed %llu", (unsigned long long)seed);
+        gen_rng_t r;
+        gen_seed(&r, seed);
+        soup_t A = random_soup(&r, 2 + seed % 5, 16), B = random_soup(&r, 1 + seed % 7, 16);
+        both_ways(&A, &B, seed % 2 ? 1e-9 : 1e-5, 32);
+        soup_free(&A);
+        soup_free(&B);
+        if (hdt_failed()) break;
+    }
+}
+
+TEST(surface_to_points_encloses_and_points_to_surface_is_exact) {
+    for (uint64_t seed = 1; seed <= 6 / SCALE + 1; seed++) {
+        CONTEXT("seed %llu", (unsigned long long)seed);
+        gen_rng_t r;
+        gen_seed(&r, seed);
+        soup_t A = random_soup(&r, 4, 16), Bt = random_soup(&r, 5, 16);
+        /* B: the points, and the same points as point-triangles for the check */
+        soup_t Bp = soup_new(Bt.nv, Bt.nv);
+        memcpy(Bp.v, Bt.v, 3 * Bt.nv * sizeof(double));
+        for (size_t k = 0; k < Bt.nv; k++) Bp.t[3 * k] = Bp.t[3 * k + 1] = Bp.t[3 * k + 2] = k;
+        hd_mesh_t a = view(&A);
+        hd_points_t B = hd_points_f64(Bt.v, Bt.nv);
+        hd_enclosure_t ab, ba, ab3;
+        hd_surface_options_t o1 = options(1e-9, 1, 1), o3 = options(1e-9, 1, 3);
+        CHECK_RC(hd_surface_points_hausdorff(&a, &B, &o1, &ab, &ba, NULL), HD_OK);
+        CHECK_RC(hd_surface_points_hausdorff(&a, &B, &o3, &ab3, NULL, NULL), HD_OK);
+        encloses(&ab, &A, &Bp, 32);
+        same_enclosure(&ab, &ab3);
+        hd_surface_result_t want;
+        CHECK_RC(hd_mesh_distances(&B, &a, NULL, NULL, NULL, NULL, NULL, &want, NULL), HD_OK);
+        CHECK_BITS(ba.lower, want.distance);
+        CHECK_BITS(ba.upper, want.distance);
+        CHECK_EQ(ba.index_a, want.i);
+        CHECK_EQ(ba.face_b, want.triangle);
+        soup_free(&A), soup_free(&Bt), soup_free(&Bp);
+        if (hdt_failed()) break;
+    }
+}
+
+TEST(predicate_agrees_with_the_enclosure) {
+    for (uint64_t seed = 1; seed <= 6 / SCALE + 1; seed++) {
+        CONTEXT("seed %llu", (unsigned long long)seed);
+        gen_rng_t r;
+        gen_seed(&r, seed);
+        soup_t A = random_soup(&r, 4, 16), B = random_soup(&r, 4, 16);
+        hd_mesh_t a = view(&A), b = view(&B);
+        hd_enclosure_t ab, ba;
+        hd_surface_options_t o = options(1e-9, 1, 2);
+        CHECK_RC(hd_surface_hausdorff(&a, &b, &o, &ab, &ba, NULL), HD_OK);
+        double lo = fmax(ab.lower, ba.lower), hi = fmax(ab.upper, ba.upper);
+        int answer;
+        CHECK_RC(hd_surface_within(&a, &b, hi * (1 + 1e-6), 0, &o, &answer, NULL, NULL, NULL), HD_OK);
+        CHECK_EQ(answer, 1);
+        CHECK_RC(hd_surface_within(&a, &b, lo * (1 - 1e-6), 0, &o, &answer, NULL, NULL, NULL), HD_OK);
+        CHECK_EQ(answer, 0);
+        CHECK_RC(hd_surface_within(&a, &b, ab.upper * (1 + 1e-6), 1, &o, &answer, NULL, NULL, NULL), HD_OK);
+        CHECK_EQ(answer, 1);
+        CHECK_RC(hd_surface_within(&a, &b, ab.lower * (1 - 1e-6), 1, &o, &answer, NULL, NULL, NULL), HD_OK);
+        CHECK_EQ(answer, 0);
+        soup_free(&A), soup_free(&B);
+        if (hdt_failed()) break;
+    }
+}
+
+TEST(face_maxima_enclose_each_face) {
+    gen_rng_t r;
+    gen_seed(&r, 7);
+    soup_t A = random_soup(&r, 6, 16), B = random_soup(&r, 5, 16);
+    hd_mesh_t a = view(&A), b = view(&B);
+    double lo[6], hi[6], lo3[6], hi3[6];
+    hd_enclosure_t ab, all;
+    hd_surface_options_t o = options(1e-9, 1, 1), o3 = options(1e-9, 1, 3);
+    CHECK_RC(hd_surface_face_maxima(&a, &b, &o, lo, hi, &ab, NULL), HD_OK);
+    CHECK_RC(hd_surface_face_maxima(&a, &b, &o3, lo3, hi3, NULL, NULL), HD_OK);
+    CHECK_RC(hd_surface_hausdorff(&a, &b, &o, &all, NULL, NULL), HD_OK);
+    double *best = dense(&A, &B, 32), top = 0;
+    for (int k = 0; k < 6; k++) {
+        CONTEXT("face %d: dense %.17g in [%.17g, %.17g]", k, best[k], lo[k], hi[k]);
+        CHECK(best[k] <= hi[k]);
+        CHECK(lo[k] <= hi[k] && hi[k] - lo[k] <= ab.tolerance);
+        CHECK(best[k] <= lo[k] + ab.tolerance);
+        CHECK_BITS(lo[k], lo3[k]);
+        CHECK_BITS(hi[k], hi3[k]);
+        top = fmax(top, hi[k]);
+    }
+    CHECK(top >= all.lower);
+    free(best);
+    soup_free(&A), soup_free(&B);
+}
+
+TEST(bad_input_is_refused) {
+    const double v[] = {0, 0, 0, 1, 0, 0, 0, 1, 0, NAN, 0, 0};
+    const uint64_t t[] = {0, 1, 2}, bad[] = {0, 1, 3}, far[] = {0, 1, 9};
+    soup_t A = soup_of(v, 4, t, 1), N = soup_of(v, 4, bad, 1), F = soup_of(v, 4, far, 1);
+    hd_mesh_t a = view(&A), n = view(&N), f = view(&F), e = view(&A);
+    e.n_triangles = 0;
+    hd_enclosure_t ab;
+    hd_error_t err;
+    CHECK_RC(hd_surface_hausdorff(&a, &n, NULL, &ab, NULL, &err), HD_ENONFINITE);
+    CHECK(strstr(err.message, "B") != NULL);
+    CHECK_RC(hd_surface_hausdorff(&f, &a, NULL, &ab, NULL, &err), HD_EINVAL);
+    CHECK_RC(hd_surface_hausdorff(&a, &e, NULL, &ab, NULL, &err), HD_EEMPTY);
+    CHECK_RC(hd_surface_hausdorff(&a, &a, NULL, NULL, NULL, &err), HD_EINVAL);
+    hd_surface_options_t o = options(-1, 1, 1);
+    CHECK_RC(hd_surface_hausdorff(&a, &a, &o, &ab, NULL, &err), HD_EINVAL);
+    o = options(NAN, 1, 1);
+    CHECK_RC(hd_surface_hausdorff(&a, &a, &o, &ab, NULL, &err), HD_EINVAL);
+    int answer;
+    CHECK_RC(hd_surface_within(&a, &a, -1, 0, NULL, &answer, NULL, NULL, &err), HD_EINVAL);
+    hd_points_t none = hd_points_f64(v, 0);
+    CHECK_RC(hd_surface_points_hausdorff(&a, &none, NULL, &ab, NULL, &err), HD_EEMPTY);
+    soup_free(&A), soup_free(&N), soup_free(&F);
+}
