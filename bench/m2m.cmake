@@ -4,6 +4,7 @@
 # HD_BENCH_PEERS) the CGAL peer.  Built with the project; not a test (the
 # dense check it runs is tests/m2m_dense.cmake's).
 hd_add_bench(m2m_cases ${CMAKE_CURRENT_LIST_DIR}/m2m_cases.c)
+hd_add_bench(m2m_run ${CMAKE_CURRENT_LIST_DIR}/m2m_run.c)
 
 option(HD_BENCH_CGAL "Build the CGAL peer of the surface-to-surface benchmark (libcgal-dev)" OFF)
 if(HD_BENCH_CGAL OR HD_BENCH_PEERS)

@@ -203,28 +203,41 @@ static void same_enclosure(const hd_enclosure_t *x, const hd_enclosure_t *y) {
     CHECK_EQ(x->face_a, y->face_a);
 }
 
+/* The tolerances tried: 1e-3 of the diagonal must converge; the default
+ * (1e-9) and 0 run with a cap on the splits per face (a maximiser on B's
+ * medial axis needs about tolerance^-1/2 sub-triangles), and whether they
+ * converged or not, the enclosure must hold. */
+static const struct {
+    double tolerance;
+    int relative;
+    uint64_t max_splits;
+    const char *name;
+} tolerances[] = {{1e-3, 1, 0, "1e-3 relative"}, {1e-9, 1, 2000, "1e-9 relative, 2000 splits a face"},
+                  {0, 0, 200, "0, 200 splits a face"}};
+
 TEST(enclosures_hold_against_the_dense_check) {
-    for (uint64_t seed = 1; seed <= 100; seed++) {
+    for (uint64_t seed = 1; seed <= 40; seed++) {
         small_t a, b;
         pair_of(seed, &a, &b);
         hd_mesh_t A = small_view(&a), B = small_view(&b);
         m2m_dense_t dab, dba;
         hd_error_t err;
         CONTEXT("seed %llu: dense check", (unsigned long long)seed);
-        CHECK_RC(m2m_dense_run(&A, &B, m2m_dense_level(A.n_triangles, 20000), 1, &dab, &err), HD_OK);
-        CHECK_RC(m2m_dense_run(&B, &A, m2m_dense_level(B.n_triangles, 20000), 1, &dba, &err), HD_OK);
-        for (int tight = 0; tight < 2; tight++) {
+        CHECK_RC(m2m_dense_run(&A, &B, m2m_dense_level(A.n_triangles, 10000), 1, &dab, &err), HD_OK);
+        CHECK_RC(m2m_dense_run(&B, &A, m2m_dense_level(B.n_triangles, 10000), 1, &dba, &err), HD_OK);
+        for (size_t k = 0; k < sizeof tolerances / sizeof *tolerances; k++) {
             hd_enclosure_t first_ab, first_ba;
             for (int threads = 1; threads <= 3; threads += 2) {
-                CONTEXT("seed %llu, tolerance %s, %d threads", (unsigned long long)seed,
-                        tight ? "0" : "1e-3 relative", threads);
+                CONTEXT("seed %llu, tolerance %s, %d threads", (unsigned long long)seed, tolerances[k].name, threads);
                 hd_surface_options_t opt;
                 hd_surface_options_init(&opt);
-                opt.tolerance = tight ? 0 : 1e-3, opt.relative = !tight, opt.threads = threads;
+                opt.tolerance = tolerances[k].tolerance, opt.relative = tolerances[k].relative;
+                opt.max_splits = tolerances[k].max_splits, opt.threads = threads;
                 hd_enclosure_t ab, ba;
                 CHECK_RC(hd_surface_hausdorff(&A, &B, &opt, &ab, &ba, &err), HD_OK);
                 check_enclosure(&ab, &A, &B, &dab);
                 check_enclosure(&ba, &B, &A, &dba);
+                if (!opt.max_splits) CHECK(ab.converged && ba.converged);
                 if (threads == 1) first_ab = ab, first_ba = ba;
                 else same_enclosure(&ab, &first_ab), same_enclosure(&ba, &first_ba);
             }
@@ -254,10 +267,11 @@ TEST(surface_to_points_holds_against_the_dense_check) {
         for (int threads = 1; threads <= 3; threads += 2) {
             hd_surface_options_t opt;
             hd_surface_options_init(&opt);
-            opt.tolerance = 0, opt.relative = 0, opt.threads = threads;
+            opt.tolerance = 1e-3, opt.threads = threads;
             hd_enclosure_t ab, ba;
             CHECK_RC(hd_surface_points_hausdorff(&A, &B, &opt, &ab, &ba, &err), HD_OK);
             check_enclosure(&ab, &A, &P, &d);
+            CHECK(ab.converged);
             CHECK_BITS(ba.lower, exact.distance);
             CHECK_BITS(ba.upper, exact.distance);
         }
