@@ -191,6 +191,10 @@ static void check_enclosure(const hd_enclosure_t *e, const hd_mesh_t *X, const h
     CHECK(e->lower <= e->upper);
     CHECK(!e->converged || e->upper - e->lower <= e->tolerance);
     CHECK(d->largest <= e->upper);
+    if (e->face_a == SIZE_MAX) { /* no witness: every face of X is one of Y's */
+        CHECK_BITS(e->lower, 0.0);
+        return;
+    }
     CHECK_BITS(m2m_dense_point(e->point_a, Y, 1, &err), e->witness_distance);
     CHECK(m2m_dense_point(e->point_a, X, 1, &err) <= e->witness_error);
     CHECK(e->lower <= e->witness_distance);
