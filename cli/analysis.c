@@ -1,5 +1,5 @@
 /*
- * analysis.c -- the command line's analysis options: parsing them, running
+ * analysis.c -- the command line's analysis options (options.c parses them): running
  * them after the Hausdorff distance, and reporting them for a person or in
  * the JSON object.
  *
@@ -30,8 +30,6 @@
 #include "analysis.h"
 #include "cli.h"
 
-#include <errno.h>
-#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -53,234 +51,8 @@ void analysis_args_init(analysis_args_t *an) {
     an->empty = HD_EMPTY_ERROR;
 }
 
-void analysis_usage(FILE *out) {
-    fprintf(out,
-"\n"
-"Where the deviation is (per-point nearest-neighbour distances):\n"
-"  --percentile P     percentile Hausdorff, e.g. 95 for HD95: the P-th\n"
-"                     percentile (numpy's linear interpolation) of the\n"
-"                     distances of A's points to B (ab), of B's to A (ba),\n"
-"                     symmetric = max(ab, ba) as MONAI, pooled = both\n"
-"                     directions together as medpy; P = 100 is H(A,B)\n"
-"  --mean             mean distances: A->B, B->A, their max (the average\n"
-"                     Hausdorff distance), their average, and pooled\n"
-"  --chamfer          Chamfer distance = mean squared distance A->B + mean\n"
-"                     squared distance B->A (as PyTorch3D); the JSON also\n"
-"                     has the summed and the unsquared variants\n"
-"  --histogram        histogram of the distances (--bins N, default 20) on\n"
-"                     [0, largest distance] or [0, --max-distance]\n"
-"  --distances OUT    write A's points with distance and nearest index in B\n"
-"                     (.csv: x,y,z,distance,nearest; .ply: also a viridis\n"
-"                     colour; .npy: (N, 5) float64); B's go to OUT_b.EXT\n"
-"  --max-distance D   top of the colour and histogram scale (default: the\n"
-"                     Hausdorff distance)\n"
-"  --render OUT.png   picture of A coloured by distance to B: front, side\n"
-"                     and top views, colour bar, the Hausdorff witness pair\n"
-"                     marked, the --percentile figure on the bar%s\n"
-"  --histogram-png OUT.png  the histogram as a picture%s\n"
-"                     (pictures are PNG: OUT must end in .png)\n"
-"  --units TEXT       the distances' unit, shown in the report, the JSON and\n"
-"                     the pictures (a label: nothing is scaled); masks whose\n"
-"                     header names mm, um or m are in mm without it\n"
-"\n"
-"Scores at a tolerance (A: the prediction or reconstruction, B: the reference):\n"
-"  --tau T[,T...]     at each tolerance T (up to 64): precision (share of A\n"
-"                     within T of B), recall (of B within T of A), F-score,\n"
-"                     and NSD, the normalized surface Dice counted per point\n"
-"                     (MONAI's compute_surface_dice on masks' surfaces)\n"
-"  --tau-rule le|lt   within means d <= T (le, default: MONAI, DeepMind) or\n"
-"                     d < T (lt: the Tanks and Temples evaluation)\n"
-"  --dtu-cap D        DTU accuracy (mean A->B distance) and completeness\n"
-"                     (mean B->A) over the distances below D, and overall =\n"
-"                     their average, as the DTU MVS evaluation (D = 20 there)\n"
-"\n"
-"Medical masks: A or B may be a NIfTI-1/2 mask (.nii, .nii.gz)%s.\n"
-"  Voxels with a nonzero value are foreground; each becomes the world\n"
-"  coordinate of its centre (sform when sform_code > 0, else qform, else\n"
-"  pixdim), in millimetres (m and um are converted).  Distances are in mm.\n"
-"  --mask-points surface|all  surface (default): the foreground voxels that\n"
-"                     binary erosion removes, outside the image counting as\n"
-"                     background (as medpy and MONAI); all: every foreground\n"
-"                     voxel\n"
-"  --connectivity 1|2|3  the surface's neighbourhood, as medpy's connectivity:\n"
-"                     1 (default) 6-neighbour in 3-D, 4 in 2-D; 2: 18 (8 in\n"
-"                     2-D); 3: 26\n"
-"  --mask-dims auto|2|3  the axes of that neighbourhood: auto (default) those\n"
-"                     of more than one voxel (a single slice is a 2-D mask);\n"
-"                     2: each slice (constant k) on its own, a stack of\n"
-"                     in-plane contours; 3: all three, a one-voxel axis too\n"
-"  --empty inf|nan|zero|monai  an empty mask or file is an error by default;\n"
-"                     with this option every distance is reported as inf, NaN\n"
-"                     or 0 instead; monai: inf when one set is empty, NaN when\n"
-"                     both are, as MONAI (JSON: null for inf and NaN, and an\n"
-"                     \"empty\" member)\n",
-            render_available() ? "" : " (unavailable: built without libpng)",
-            render_available() ? "" : " (unavailable)",
-            nifti_available() ? "" : " (unavailable: built without libnifti2)");
-}
-
-static int usage_error(const char *fmt, const char *arg) {
-    fprintf(stderr, "%s: ", cli_prog());
-    fprintf(stderr, fmt, safe_text(arg));
-    fprintf(stderr, "\nTry '%s --help'.\n", cli_prog());
-    return -1;
-}
-
-static int to_double(const char *s, double *out) {
-    char *e;
-    errno = 0;
-    double v = strtod(s, &e);
-    /* ERANGE also says a result is subnormal (1e-320), or below the
-     * smallest subnormal (taken as 0): both read as the value returned */
-    if (e == s || *e || (errno && !(errno == ERANGE && fabs(v) <= DBL_MIN)) || !isfinite(v)) return -1;
-    *out = v;
-    return 0;
-}
-
-/* --tau T[,T...]: each a number >= 0; 1, or -1 after a usage error. */
-static int parse_taus(const char *v, analysis_args_t *an) {
-    char buf[4096];
-    if (strlen(v) >= sizeof buf) return usage_error("--tau: the list is too long ('%s')", v);
-    snprintf(buf, sizeof buf, "%s", v);
-    an->n_taus = 0;
-    char *save = NULL;
-    for (char *t = strtok_r(buf, ",", &save); t; t = strtok_r(NULL, ",", &save)) {
-        double d;
-        if (to_double(t, &d) || d < 0) return usage_error("--tau needs numbers >= 0 separated by commas, not '%s'", v);
-        if (an->n_taus == ANALYSIS_MAX_TAUS) return usage_error("--tau takes at most 64 tolerances ('%s')", v);
-        an->taus[an->n_taus++] = d;
-    }
-    if (!an->n_taus) return usage_error("--tau needs numbers >= 0 separated by commas, not '%s'", v);
-    return 1;
-}
-
-/* The options that take a value, by their place in value_names. */
-typedef enum {
-    OPT_PERCENTILE,
-    OPT_BINS,
-    OPT_DISTANCES,
-    OPT_MAX_DISTANCE,
-    OPT_RENDER,
-    OPT_HISTOGRAM_PNG,
-    OPT_MASK_POINTS,
-    OPT_EMPTY,
-    OPT_CONNECTIVITY,
-    OPT_MASK_DIMS,
-    OPT_UNITS,
-    OPT_TAU,
-    OPT_TAU_RULE,
-    OPT_DTU_CAP,
-    OPT_COUNT
-} value_option_t;
-
-static const char *const value_names[OPT_COUNT + 1] = {
-    [OPT_PERCENTILE] = "--percentile",   [OPT_BINS] = "--bins",
-    [OPT_DISTANCES] = "--distances",     [OPT_MAX_DISTANCE] = "--max-distance",
-    [OPT_RENDER] = "--render",           [OPT_HISTOGRAM_PNG] = "--histogram-png",
-    [OPT_MASK_POINTS] = "--mask-points", [OPT_EMPTY] = "--empty",
-    [OPT_CONNECTIVITY] = "--connectivity", [OPT_MASK_DIMS] = "--mask-dims",
-    [OPT_UNITS] = "--units",             [OPT_TAU] = "--tau",
-    [OPT_TAU_RULE] = "--tau-rule",       [OPT_DTU_CAP] = "--dtu-cap",
-    [OPT_COUNT] = NULL};
-
-int analysis_parse_option(int argc, char **argv, int *k, analysis_args_t *an) {
-    const char *s = argv[*k];
-    if (strcmp(s, "--mean") == 0) return an->mean = 1;
-    if (strcmp(s, "--chamfer") == 0) return an->chamfer = 1;
-    if (strcmp(s, "--histogram") == 0) return an->histogram = 1;
-    const char *eq = strchr(s, '=');
-    size_t nl = eq ? (size_t)(eq - s) : strlen(s);
-    int which = -1;
-    for (int w = 0; value_names[w]; w++)
-        if (strlen(value_names[w]) == nl && strncmp(s, value_names[w], nl) == 0) which = w;
-    if (which < 0) return 0;
-    const char *name = value_names[which];
-    const char *v = eq ? eq + 1 : (*k + 1 < argc ? argv[++*k] : NULL);
-    if (!v) return usage_error("option '%s' needs a value", name);
-    double d;
-    switch (which) {
-    case OPT_PERCENTILE:
-        if (to_double(v, &d) || d < 0 || d > 100)
-            return usage_error("--percentile needs a number in [0, 100], not '%s'", v);
-        an->percentile_on = 1;
-        an->percentile = d;
-        break;
-    case OPT_BINS:
-        if (to_double(v, &d) || d < 1 || d > 100000 || d != floor(d))
-            return usage_error("--bins needs a whole number 1..100000, not '%s'", v);
-        an->bins = (size_t)d;
-        break;
-    case OPT_DISTANCES:
-        if (!distances_format_known(v))
-            return usage_error("--distances: cannot tell the format of '%s'; name it .csv, .ply or .npy", v);
-        an->distances_out = v;
-        break;
-    case OPT_MAX_DISTANCE:
-        if (to_double(v, &d) || !(d > 0)) {
-            errno = 0;
-            double u = strtod(v, NULL); /* 1e-400: positive, but no double */
-            if (u == 0 && errno == ERANGE && !signbit(u))
-                return usage_error("--max-distance %s is below the smallest positive double, 4.9e-324", v);
-            return usage_error("--max-distance needs a positive number, not '%s'", v);
-        }
-        an->max_distance = d;
-        break;
-    case OPT_RENDER:
-    case OPT_HISTOGRAM_PNG:
-        if (!render_available())
-            return usage_error("%s is unavailable: this hausdorff was built without libpng "
-                               "(Debian: libpng-dev)", name);
-        if (!render_path_ok(v)) {
-            char m[4200];
-            snprintf(m, sizeof m, "%s %s: pictures are written as PNG only; name the file .png", name, v);
-            return usage_error("%s", m);
-        }
-        if (which == OPT_RENDER) an->render_out = v;
-        else an->histogram_png = v;
-        break;
-    case OPT_MASK_POINTS:
-        if (strcmp(v, "surface") == 0) an->mask_points = MASK_SURFACE;
-        else if (strcmp(v, "all") == 0) an->mask_points = MASK_ALL;
-        else return usage_error("--mask-points is surface or all, not '%s'", v);
-        break;
-    case OPT_EMPTY:
-        if (hd_empty_policy_from_name(v, &an->empty) != HD_OK || an->empty < HD_EMPTY_INF ||
-            an->empty > HD_EMPTY_MONAI)
-            return usage_error("--empty is inf, nan, zero or monai, not '%s'", v);
-        break;
-    case OPT_CONNECTIVITY:
-        if (strcmp(v, "1") && strcmp(v, "2") && strcmp(v, "3"))
-            return usage_error("--connectivity is 1, 2 or 3 (faces, and edges, and corners), not '%s'", v);
-        an->connectivity = v[0] - '0';
-        break;
-    case OPT_MASK_DIMS:
-        if (strcmp(v, "auto") == 0) an->mask_dims = 0;
-        else if (strcmp(v, "2") == 0 || strcmp(v, "3") == 0) an->mask_dims = v[0] - '0';
-        else return usage_error("--mask-dims is auto, 2 or 3, not '%s'", v);
-        break;
-    case OPT_UNITS:
-        if (!v[0] || strlen(v) > 16 || strpbrk(v, "\"\\") || strspn(v, " ") == strlen(v))
-            return usage_error("--units needs a short label (1 to 16 characters, no quotes), not '%s'", v);
-        for (const char *c = v; *c; c++)
-            if ((unsigned char)*c < ' ' || (unsigned char)*c > '~')
-                return usage_error("--units needs printable ASCII (the pictures' font has no other), not '%s'", v);
-        an->units = v;
-        break;
-    case OPT_TAU:
-        return parse_taus(v, an);
-    case OPT_TAU_RULE:
-        if (strcmp(v, "le") == 0) an->tau_rule = HD_AT_MOST;
-        else if (strcmp(v, "lt") == 0) an->tau_rule = HD_BELOW;
-        else return usage_error("--tau-rule is le (d <= tau) or lt (d < tau), not '%s'", v);
-        break;
-    case OPT_DTU_CAP:
-        if (strcmp(v, "inf") == 0) d = INFINITY;
-        else if (to_double(v, &d) || !(d > 0))
-            return usage_error("--dtu-cap needs a positive number or inf, not '%s'", v);
-        an->dtu_cap = d;
-        break;
-    }
-    return 1;
+render_notes_t analysis_notes(const analysis_args_t *an, const analysis_result_t *r) {
+    return (render_notes_t){analysis_units(an), an->percentile_on, r->pct, r->surface};
 }
 
 const char *analysis_units(const analysis_args_t *an) {
@@ -383,34 +155,19 @@ static void json_figures(FILE *out, const analysis_args_t *an,
     }
 }
 
-/* A result whose every figure is the --empty policy's value v (NaN for
- * what a directed run does not compute). */
-static void empty_result(analysis_result_t *r, const analysis_args_t *an,
-                         double v, int directed) {
-    memset(r, 0, sizeof *r);
-    r->directed = directed;
-    double w = directed ? NAN : v;
-    r->pct = (hd_percentile_t){an->percentile, v, w, w, w};
-    r->sum.mean_ab = r->sum.mean2_ab = v;
-    r->sum.mean_ba = r->sum.mean_symmetric = r->sum.mean_average = r->sum.mean_pooled = w;
-    r->sum.mean2_ba = r->sum.chamfer = r->sum.chamfer_sum2 = r->sum.chamfer_mean = r->sum.chamfer_sum = w;
-}
-
-/* The per-point files of a run with an empty set: the other set's rows get
- * the policy's distance and nearest index -1; an empty set gets a file with
- * no rows, so that scripts find the files they asked for. */
-static int write_empty_files(const analysis_args_t *an, const hd_points_t *A,
-                             const hd_points_t *B, int directed, double v,
-                             hd_error_t *err) {
+/* The per-point files of a run with an empty set (analysis.h). */
+int analysis_empty_files(const analysis_args_t *an, const hd_points_t *A, const hd_points_t *B, int directed,
+                         double v, hd_error_t *err) {
+    if (!an->distances_out) return HD_OK;
     size_t n = A->count > B->count ? A->count : B->count;
     double *d = malloc((n ? n : 1) * sizeof *d);
     if (!d) return alloc_fail(err, n);
     for (size_t k = 0; k < n; k++) d[k] = v;
     int rc = write_distances(an->distances_out, A, d, NULL, 1.0, err);
     if (rc == HD_OK && !directed) {
-        char path_b[4096];
-        path_with_suffix(an->distances_out, "_b", path_b, sizeof path_b);
-        rc = write_distances(path_b, B, d, NULL, 1.0, err);
+        char *path_b = path_with_suffix(an->distances_out, "_b");
+        rc = path_b ? write_distances(path_b, B, d, NULL, 1.0, err) : alloc_fail(err, n);
+        free(path_b);
     }
     free(d);
     return rc;
@@ -420,84 +177,39 @@ static int write_empty_files(const analysis_args_t *an, const hd_points_t *A,
  * nothing to be near (distance +inf), so none is within any tolerance: the
  * NSD is 0 with one set empty and NaN with both (MONAI's), a share of no
  * points NaN, and a capped mean of no values NaN. */
-static int empty_scores(const analysis_args_t *an, size_t n_a, size_t n_b, int directed, analysis_result_t *r) {
+static int empty_scores(const analysis_args_t *an, size_t n_a, size_t n_b, int directed, analysis_result_t *r,
+                        hd_error_t *err) {
     if (!an->n_taus && !(an->dtu_cap > 0)) return HD_OK;
     size_t n = n_a > n_b ? n_a : n_b;
     double *inf = malloc((n ? n : 1) * sizeof *inf);
-    hd_error_t err;
-    if (!inf) {
-        fprintf(stderr, "%s: out of memory for %zu distances\n", cli_prog(), n);
-        return HD_ENOMEM;
-    }
+    if (!inf) return alloc_fail(err, n);
     for (size_t k = 0; k < n; k++) inf[k] = INFINITY;
-    r->directed = directed;
-    int rc = scores_figures(an, inf, n_a, directed ? NULL : inf, n_b, r, &err);
+    int rc = scores_figures(an, inf, n_a, directed ? NULL : inf, n_b, r, err);
     free(inf);
-    if (rc != HD_OK) fprintf(stderr, "%s: %s\n", cli_prog(), err.message);
     return rc;
 }
 
-int analysis_handle_empty(const analysis_args_t *an, const char *path_a,
-                          const char *path_b, const hd_points_t *A,
-                          const hd_points_t *B, int directed, int json) {
-    size_t n_a = A->count, n_b = B->count;
-    if (n_a && n_b) return -1;
-    double v = hd_empty_value(an->empty, n_a, n_b);
-    FILE *out = stdout;
-    hd_error_t err;
-    if (an->distances_out && write_empty_files(an, A, B, directed, v, &err) != HD_OK) {
-        fprintf(stderr, "%s: %s\n", cli_prog(), safe_text(err.message));
-        return EXIT_FAILURE_;
-    }
+int analysis_empty(const analysis_args_t *an, size_t n_a, size_t n_b, int directed, hd_symmetric_t *s,
+                   analysis_result_t *r, hd_error_t *err) {
+    double v = hd_empty_value(an->empty, n_a, n_b), w = directed ? NAN : v;
+    memset(s, 0, sizeof *s);
+    s->distance = s->ab.distance = v;
+    s->ba.distance = w;
     if (an->render_out || an->histogram_png)
         fprintf(stderr, "%s: no picture drawn: %s is empty\n", cli_prog(), n_a ? "B" : "A");
-    if (json) {
-        fprintf(out, "{\"hausdorff\": ");
-        json_number(out, v);
-        fprintf(out, ", \"directed_ab\": ");
-        json_number(out, v);
-        fprintf(out, ", \"directed_ba\": ");
-        if (directed) fputs("null", out);
-        else json_number(out, v);
-        fprintf(out, ", \"witness_ab\": null, \"witness_ba\": null, \"witness_ab_files\": null, "
-                     "\"witness_ba_files\": null");
-        fprintf(out, ", \"empty\": {\"a\": %s, \"b\": %s, \"policy\": \"%s\"}", n_a ? "false" : "true",
-                n_b ? "false" : "true", hd_empty_policy_name(an->empty));
-        fprintf(out, ", \"n_a\": %zu, \"n_b\": %zu, \"file_a\": ", n_a, n_b);
-        json_string(out, path_a);
-        fprintf(out, ", \"file_b\": ");
-        json_string(out, path_b);
-        analysis_result_t r;
-        empty_result(&r, an, v, directed);
-        if (empty_scores(an, n_a, n_b, directed, &r) != HD_OK) return EXIT_FAILURE_;
-        json_figures(out, an, &r);
-        fprintf(out, "}\n");
-    } else {
-        fprintf(out, "A: %s (%zu point%s)\nB: %s (%zu point%s)\n", safe_text(path_a), n_a, plural(n_a),
-                safe_text(path_b), n_b, plural(n_b));
-        const char *which = !n_a && !n_b ? "A and B are" : !n_a ? "A is" : "B is";
-        char t[NUM_TEXT], pt[NUM_TEXT];
-        num_text(v, t);
-        fprintf(out, "%s = %s   (%s empty; --empty %s)\n", directed ? "h(A,B)" : "Hausdorff distance H(A,B)", t,
-                which, hd_empty_policy_name(an->empty));
-        if (an->percentile_on) fprintf(out, "percentile %s: %s\n", num_text(an->percentile, pt), t);
-        if (an->mean) fprintf(out, "mean distance: %s\n", t);
-        if (an->chamfer) fprintf(out, "Chamfer distance: %s\n", t);
-        analysis_result_t r;
-        empty_result(&r, an, v, directed);
-        if (empty_scores(an, n_a, n_b, directed, &r) != HD_OK) return EXIT_FAILURE_;
-        print_scores(out, an, &r, "");
-    }
-    return EXIT_OK;
+    memset(r, 0, sizeof *r);
+    r->empty = 1;
+    r->directed = directed;
+    r->n_a = n_a;
+    r->n_b = n_b;
+    r->pct = (hd_percentile_t){an->percentile, v, w, w, w};
+    r->sum.mean_ab = r->sum.mean2_ab = v;
+    r->sum.mean_ba = r->sum.mean_symmetric = r->sum.mean_average = r->sum.mean_pooled = w;
+    r->sum.mean2_ba = r->sum.chamfer = r->sum.chamfer_sum2 = r->sum.chamfer_mean = r->sum.chamfer_sum = w;
+    return empty_scores(an, n_a, n_b, directed, r, err);
 }
 
 /* ---- the run ----------------------------------------------------------------- */
-
-static double seconds_now(void) {
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 /* The last component of a path, without the '/' that may end a directory's
  * ("tiles/" -> "tiles"), into buf. */
@@ -590,9 +302,9 @@ int analysis_run(const analysis_args_t *an, const hd_options_t *opt,
     r->n_b = B->count;
     if (!r->active) return HD_OK;
     if (!directed && analysis_percentile_only(an)) { /* the library's selection without every distance */
-        double t0 = seconds_now();
+        double t0 = cli_now();
         int rc = hd_hausdorff_percentile(A, B, opt, an->percentile, &r->pct, err);
-        r->seconds = seconds_now() - t0;
+        r->seconds = cli_now() - t0;
         return rc;
     }
     r->d_ab = malloc(A->count * sizeof *r->d_ab);
@@ -603,30 +315,39 @@ int analysis_run(const analysis_args_t *an, const hd_options_t *opt,
         r->j_ba = malloc(B->count * sizeof *r->j_ba);
         if (!r->d_ba || !r->j_ba) return alloc_fail(err, B->count);
     }
-    double t0 = seconds_now();
+    double t0 = cli_now();
     int rc = hd_distances(A, B, opt, r->d_ab, r->j_ab, r->d_ba, r->j_ba, err);
-    r->seconds = seconds_now() - t0;
+    r->seconds = cli_now() - t0;
     if (rc) return rc;
+    return analysis_finish(an, A, B, s, NULL, path_a, path_b, NULL, r, err);
+}
+
+int analysis_finish(const analysis_args_t *an, const hd_points_t *A, const hd_points_t *B,
+                    const hd_symmetric_t *s, const double *wq, const char *path_a, const char *path_b,
+                    const surface_columns_t *surf, analysis_result_t *r, hd_error_t *err) {
+    int rc, directed = r->directed;
     static const analysis_ops_t here = {hd_summarize, hd_percentile_of, hd_histogram};
     if ((rc = analysis_figures(an, &here, r->d_ab, A->count, r->d_ba, directed ? 0 : B->count, r, err))) return rc;
     double scale = analysis_scale(an, r);
     if (an->distances_out) {
-        snprintf(r->dist_path_a, sizeof r->dist_path_a, "%s", an->distances_out);
-        if ((rc = write_distances(r->dist_path_a, A, r->d_ab, r->j_ab, scale, err))) return rc;
+        r->dist_path_a = an->distances_out;
+        rc = surf ? write_surface_distances(r->dist_path_a, A, r->d_ab, surf, scale, err)
+                  : write_distances(r->dist_path_a, A, r->d_ab, r->j_ab, scale, err);
+        if (rc) return rc;
         if (!directed) {
-            path_with_suffix(an->distances_out, "_b", r->dist_path_b, sizeof r->dist_path_b);
+            if (!(r->dist_path_b = path_with_suffix(an->distances_out, "_b"))) return alloc_fail(err, B->count);
             if ((rc = write_distances(r->dist_path_b, B, r->d_ba, r->j_ba, scale, err))) return rc;
         }
     }
+    render_notes_t notes = analysis_notes(an, r);
     if (an->render_out) {
         char title[640];
         analysis_render_title(path_a, A->count, path_b, title, sizeof title);
-        render_notes_t notes = {analysis_units(an), an->percentile_on, r->pct};
-        if ((rc = render_distances(an->render_out, A, B, r->d_ab, scale, s, directed, &notes, title, r->markers,
+        if ((rc = render_distances(an->render_out, A, B, r->d_ab, scale, s, wq, directed, &notes, title, r->markers,
                                    &r->n_markers, &r->render, &r->render_w, &r->render_h, err)))
             return rc;
     }
-    if (an->histogram_png && (rc = render_histogram(an->histogram_png, r, an, an->bins, r->hist_markers,
+    if (an->histogram_png && (rc = render_histogram(an->histogram_png, r, &notes, an->bins, r->hist_markers,
                                                     &r->n_hist_markers, err)))
         return rc;
     return HD_OK;
@@ -639,6 +360,7 @@ void analysis_free(analysis_result_t *r) {
     free(r->j_ba);
     free(r->hist_ab);
     free(r->hist_ba);
+    free(r->dist_path_b);
     memset(r, 0, sizeof *r);
 }
 
@@ -689,6 +411,10 @@ void analysis_json(FILE *out, const analysis_args_t *an,
         fprintf(out, ", \"b\": ");
         json_mask(out, &an->mask[1]);
         fputc('}', out);
+    }
+    if (r->empty) { /* nothing measured: the policy's figures */
+        json_figures(out, an, r);
+        return;
     }
     if (!r->active) return;
     fprintf(out, ", \"distances_seconds\": "); /* to the microsecond, as "seconds" */
@@ -832,8 +558,16 @@ void analysis_print(FILE *out, const analysis_args_t *an,
                 plural((unsigned long long)m->foreground), m->points,
                 an->mask_points == MASK_ALL ? "foreground" : "surface", plural(m->points), how);
     }
-    if (!r->active) return;
     char t[4][NUM_TEXT]; /* shortest text of each figure (numtext.c) */
+    if (r->empty) { /* nothing measured: each figure asked for is the policy's value */
+        num_text(r->sum.mean_ab, t[0]);
+        if (an->percentile_on) fprintf(out, "percentile %s: %s\n", num_text(an->percentile, t[1]), t[0]);
+        if (an->mean) fprintf(out, "mean distance: %s\n", t[0]);
+        if (an->chamfer) fprintf(out, "Chamfer distance: %s\n", t[0]);
+        print_scores(out, an, r, "");
+        return;
+    }
+    if (!r->active) return;
     if (an->percentile_on) {
         fprintf(out, "percentile P = %s of the per-point distances%s:\n", num_text(r->pct.p, t[1]), unit);
         fprintf(out, "  A->B %s\n", num_text(r->pct.ab, t[0]));

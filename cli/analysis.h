@@ -2,7 +2,8 @@
  * analysis.h -- the command line's analysis features: per-point distances
  * and their statistics (analysis.c), the files they are written to
  * (writers.c), pictures (render.c, font.c), and NIfTI masks (nifti.c).
- * options.c and main.c only hook these in; everything else is here.
+ * options.c parses their options (one table for every option of the tool)
+ * and main.c runs them; everything else is here.
  */
 #ifndef HD_CLI_ANALYSIS_H
 #define HD_CLI_ANALYSIS_H
@@ -53,12 +54,6 @@ typedef struct analysis_args {
 
 /* ---- options (analysis.c) ---------------------------------------------- */
 void analysis_args_init(analysis_args_t *an);
-/* Look at argv[*k]: 0 when it is not an analysis option; 1 when it was one
- * (its value consumed, *k advanced past it); -1 after reporting a usage
- * error on stderr. */
-int analysis_parse_option(int argc, char **argv, int *k, analysis_args_t *an);
-/* The options' part of --help. */
-void analysis_usage(FILE *out);
 
 /* ---- reading (nifti.c) --------------------------------------------------- */
 /* Read a point set: NIfTI masks (.nii, .nii.gz) become the world
@@ -93,6 +88,8 @@ typedef struct render_notes {
     const char *unit;
     int percentile_on;
     hd_percentile_t pct;
+    int surface;               /* the witness's partner is the closest point
+                                  on triangle j of B (--surface) */
 } render_notes_t;
 /* What render_distances drew as text and where it marked the percentile
  * on the colour bar (pct_y < 0: not marked), for the JSON and the tests. */
@@ -111,6 +108,8 @@ typedef struct hist_marker {
 
 typedef struct analysis_result {
     int active;                /* some analysis option was given */
+    int empty;                 /* A or B is empty: every figure is the
+                                  --empty policy's value (analysis_empty) */
     int directed;
     size_t n_a, n_b;
     double *d_ab, *d_ba;       /* per-point distances (d_ba NULL: directed) */
@@ -121,7 +120,8 @@ typedef struct analysis_result {
     double hist_lo, hist_hi;
     uint64_t *hist_ab, *hist_ba;
     size_t above_ab, above_ba; /* values beyond the histogram range */
-    char dist_path_a[4096], dist_path_b[4096];
+    const char *dist_path_a;   /* --distances */
+    char *dist_path_b;         /* its _b file (malloc: analysis_free) */
     int render_w, render_h, n_markers;
     render_marker_t markers[6];
     render_info_t render;
@@ -129,6 +129,8 @@ typedef struct analysis_result {
     hist_marker_t hist_markers[4];
     hd_tolerance_t tol[ANALYSIS_MAX_TAUS]; /* --tau, in the order given */
     hd_capped_mean_t dtu;      /* --dtu-cap */
+    int surface;               /* d_ab: distances to B's triangles, j_ab
+                                  the nearest triangles (--surface) */
 } analysis_result_t;
 
 /* The unit of the distances: --units, else "mm" when a mask's header
@@ -136,13 +138,32 @@ typedef struct analysis_result {
 const char *analysis_units(const analysis_args_t *an);
 /* Does anything need the per-point distances? */
 int analysis_active(const analysis_args_t *an);
-/* When A or B is empty: report the --empty policy's values (or the error)
- * and return the exit code; -1 when both sets have points. */
-int analysis_handle_empty(const analysis_args_t *an, const char *path_a,
-                          const char *path_b, const hd_points_t *A,
-                          const hd_points_t *B, int directed, int json);
+/* When A or B is empty (the counts n_a, n_b), under the --empty policy:
+ * every figure asked for is the policy's value (the scores of --tau and
+ * --dtu-cap: none within, NaN for no points) into r, and s the distances
+ * (H, h(A,B), h(B,A)) as the report prints them; says on stderr that no
+ * picture is drawn when one was asked for.  The per-point files are the
+ * caller's (analysis_empty_files for hausdorff).  Returns HD_OK or
+ * HD_ENOMEM with err filled. */
+int analysis_empty(const analysis_args_t *an, size_t n_a, size_t n_b, int directed, hd_symmetric_t *s,
+                   analysis_result_t *r, hd_error_t *err);
+/* The per-point files of a run with an empty set (--distances): the other
+ * set's rows at the policy's value v with nearest index -1; an empty set
+ * gets a file with no rows, so that scripts find the files they asked for. */
+int analysis_empty_files(const analysis_args_t *an, const hd_points_t *A, const hd_points_t *B, int directed,
+                         double v, hd_error_t *err);
 /* Compute per-point distances and every figure asked for, write the files
  * asked for.  Returns HD_OK or a library code with err filled. */
+struct surface_columns; /* below, with the writers */
+/* The figures, files and pictures asked for from per-point distances
+ * already in r (d_ab and j_ab; d_ba and j_ba unless r->directed; n_a,
+ * n_b, seconds), whatever computed them.  s holds the witness; wq (NULL:
+ * B's point s->ab.j or s->ba.j) is its partner's position in the picture;
+ * surf (NULL: point sets) gives the --distances files the surface's
+ * columns. */
+int analysis_finish(const analysis_args_t *an, const hd_points_t *A, const hd_points_t *B,
+                    const hd_symmetric_t *s, const double *wq, const char *path_a, const char *path_b,
+                    const struct surface_columns *surf, analysis_result_t *r, hd_error_t *err);
 int analysis_run(const analysis_args_t *an, const hd_options_t *opt,
                  const hd_points_t *A, const hd_points_t *B,
                  const hd_symmetric_t *s, int directed, const char *path_a,
@@ -168,6 +189,9 @@ int analysis_figures(const analysis_args_t *an, const analysis_ops_t *ops, const
 /* The picture's title line: "A's name (N points) coloured by distance to
  * B's name". */
 void analysis_render_title(const char *path_a, size_t n_a, const char *path_b, char *title, size_t size);
+/* What the pictures say besides the points: the unit and the percentile
+ * figures asked for. */
+render_notes_t analysis_notes(const analysis_args_t *an, const analysis_result_t *r);
 /* The colour and histogram scale: --max-distance, else the largest
  * distance (r->sum). */
 double analysis_scale(const analysis_args_t *an, const analysis_result_t *r);
@@ -186,6 +210,19 @@ void colormap_viridis(double t, unsigned char rgb[3]);
  * at d / dmax: CSV, PLY or NPY by the path's extension (writers.c). */
 int write_distances(const char *path, const hd_points_t *P, const double *d,
                     const size_t *nearest, double dmax, hd_error_t *err);
+/* What a point's distance to a surface adds to its row (--surface): the
+ * nearest face, the closest point on it, its barycentric weights u v w of
+ * the face's corners, and the sign (NULL: no sign column). */
+typedef struct surface_columns {
+    const size_t *face;
+    const double *closest, *bary; /* 3 a point */
+    const int8_t *sign;
+} surface_columns_t;
+/* Write points with their distance to a surface: the columns x y z
+ * distance face closest_x closest_y closest_z u v w [sign], in CSV, PLY
+ * (with the distance's colour) or NPY (float64) by the path's extension. */
+int write_surface_distances(const char *path, const hd_points_t *P, const double *d,
+                            const surface_columns_t *c, double dmax, hd_error_t *err);
 /* 1 when the path names a format write_distances knows. */
 int distances_format_known(const char *path);
 /* The pieces of a distances file, for a writer that places the rows
@@ -210,9 +247,6 @@ int distances_wide(const size_t *nearest, size_t n);
 size_t distances_header(const dist_layout_t *f, char buf[DIST_HEAD_MAX]);
 size_t distances_row(const dist_layout_t *f, const double q[3], double d, const size_t *nearest,
                      unsigned char buf[DIST_ROW_MAX]);
-/* OUT.ext -> OUT_b.ext */
-void path_with_suffix(const char *path, const char *suffix, char *out,
-                      size_t size);
 
 /* ---- pictures (render.c) ------------------------------------------------- */
 int render_available(void);
@@ -223,7 +257,7 @@ int render_path_ok(const char *path);
  * bar, the witness pair of the Hausdorff distance marked and labelled. */
 int render_distances(const char *path, const hd_points_t *A,
                      const hd_points_t *B, const double *d_a, double dmax,
-                     const hd_symmetric_t *s, int directed,
+                     const hd_symmetric_t *s, const double *wq, int directed,
                      const render_notes_t *notes, const char *title,
                      render_marker_t markers[6], int *n_markers,
                      render_info_t *info, int *width, int *height,
@@ -280,7 +314,7 @@ int render_compose(const char *path, const render_scene_t *sc, const render_laye
 /* A bar chart of the histogram(s) with the percentile and mean marked;
  * where those lines were drawn goes into marks (at most 4). */
 int render_histogram(const char *path, const analysis_result_t *r,
-                     const analysis_args_t *an, size_t bins,
+                     const render_notes_t *notes, size_t bins,
                      hist_marker_t marks[4], int *n_marks, hd_error_t *err);
 
 /* ---- text (font.c) --------------------------------------------------------- */

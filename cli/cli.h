@@ -9,6 +9,7 @@
 #include <stdio.h>
 
 #include "analysis.h"
+#include "common.h"
 
 /* Exit codes: the contract scripts rely on. */
 enum { EXIT_OK = 0, EXIT_USAGE = 1, EXIT_BADINPUT = 2, EXIT_FAILURE_ = 3 };
@@ -24,6 +25,11 @@ typedef struct cli_args {
     int json;
     int quiet;
     int surface; /* --surface: B measured as its triangles (surface.c) */
+    double tolerance;       /* --tolerance: the enclosure's (m2m.c) */
+    int tolerance_set, tolerance_relative; /* given; with the 'd' suffix */
+    double within;          /* --within D: is the distance <= D? */
+    int within_set;
+    int signed_distance; /* --signed: with --surface, each distance's sign */
     analysis_args_t an; /* analysis options (analysis.h) */
 } cli_args_t;
 
@@ -32,38 +38,10 @@ typedef struct cli_args {
 int cli_parse(int argc, char **argv, cli_args_t *a);
 void cli_usage(FILE *out);
 /* The usage text is hausdorff-mpi's (its usage line, description and
- * examples): hausdorff-mpi calls this before cli_parse. */
-void cli_set_mpi(void);
-/* The program's name for messages ("hausdorff", "hausdorff-mpi"), from
- * argv[0] once cli_parse has run. */
-const char *cli_prog(void);
+ * examples) and --version prints with version(out): hausdorff-mpi calls
+ * this before cli_parse. */
+void cli_set_mpi(void (*version)(FILE *out));
 /* The formats the reader knows, one per line (--formats). */
 void cli_formats(FILE *out);
-
-/* A double as the shortest text that reads back as the same double
- * ("0.1", "5.9296880000000001" only when needed; numtext.c). */
-enum { NUM_TEXT = 32 };
-const char *num_text(double v, char buf[NUM_TEXT]);
-void num_print(FILE *out, double v);
-/* For a person (numtext.c): a coordinate of a float32 input as the
- * shortest text of the float nearest it ("11.2" for 11.200000166893005
- * from a NIfTI-1 header); a ratio to four significant digits ("0.7989");
- * seconds to three significant digits, never in exponent form
- * ("0.000098", "0.0131", "1.25"). */
-const char *num_text_single(double v, char buf[NUM_TEXT]);
-const char *num_ratio(double v, char buf[NUM_TEXT]);
-const char *num_seconds(double s, char buf[NUM_TEXT]);
-/* "s" after a count other than one: "%zu point%s", n, plural(n). */
-static inline const char *plural(unsigned long long n) { return n == 1 ? "" : "s"; }
-
-/* JSON output helpers: numbers as num_text prints them (null when not
- * finite); strings escaped (bytes that are not UTF-8 as \udcXX, control
- * characters as \u00XX: json.c). */
-void json_number(FILE *out, double v);
-void json_string(FILE *out, const char *s);
-/* s for a person to read: s itself when it holds no control character and
- * only valid UTF-8, else a copy with those bytes as \xXX (valid until four
- * more calls; not thread-safe). */
-const char *safe_text(const char *s);
 
 #endif

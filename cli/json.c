@@ -19,7 +19,7 @@
  *    hold an escape sequence that a terminal would obey; a name with
  *    neither is printed as it is.
  */
-#include "cli.h"
+#include "common.h"
 
 #include <math.h>
 #include <stdlib.h>

@@ -20,7 +20,7 @@
  * digits (num_ratio) and times in seconds to three significant digits,
  * never in exponent form (num_seconds).
  */
-#include "cli.h"
+#include "common.h"
 
 #include <float.h>
 #include <math.h>

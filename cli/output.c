@@ -168,30 +168,32 @@ int out_check_paths(const char *const *outs, const char *const *what, int n,
  * them) or another output. */
 int out_check_outputs(const cli_args_t *a, const tiles_t *side) {
     fifo_wait_ms = a->read.fifo_wait_ms; /* outputs await a reader as inputs await a writer */
-    char path_b[4096];
+    char *path_b = NULL;
     const char *outs[4] = {a->an.distances_out, NULL, a->an.render_out, a->an.histogram_png};
     const char *const what[4] = {"--distances", "--distances (B's rows)", "--render", "--histogram-png"};
     if (a->an.distances_out && !a->directed) {
-        path_with_suffix(a->an.distances_out, "_b", path_b, sizeof path_b);
-        outs[1] = path_b;
+        if (!(outs[1] = path_b = path_with_suffix(a->an.distances_out, "_b"))) {
+            fprintf(stderr, "%s: out of memory\n", cli_prog());
+            return EXIT_FAILURE_;
+        }
     }
     if (!outs[0] && !outs[2] && !outs[3]) return 0;
     size_t n = side[0].n + side[1].n + 2, m = 0;
     const char **in = malloc(n * sizeof *in);
     char *which = malloc(n);
+    int rc = EXIT_FAILURE_;
     if (!in || !which) {
-        free(in);
-        free(which);
         fprintf(stderr, "%s: out of memory\n", cli_prog());
-        return EXIT_FAILURE_;
+    } else {
+        for (int w = 0; w < 2; w++) {
+            if (side[w].kind == TILES_LIST) in[m] = side[w].arg + 1, which[m++] = "AB"[w];
+            for (size_t k = 0; k < side[w].n; k++) in[m] = side[w].t[k].path, which[m++] = "AB"[w];
+        }
+        rc = out_check_paths(outs, what, 4, in, which, m);
     }
-    for (int w = 0; w < 2; w++) {
-        if (side[w].kind == TILES_LIST) in[m] = side[w].arg + 1, which[m++] = "AB"[w];
-        for (size_t k = 0; k < side[w].n; k++) in[m] = side[w].t[k].path, which[m++] = "AB"[w];
-    }
-    int rc = out_check_paths(outs, what, 4, in, which, m);
     free(in);
     free(which);
+    free(path_b);
     return rc;
 }
 

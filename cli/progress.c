@@ -9,6 +9,7 @@
  * changes or reporting stops, a drawn line is erased with "\r\033[K".
  */
 #include "progress.h"
+#include "common.h"
 
 #include <pthread.h>
 #include <stdarg.h>
@@ -27,12 +28,6 @@ static struct {
     pthread_mutex_t mu;
     pthread_cond_t cv;
 } P = {.mu = PTHREAD_MUTEX_INITIALIZER, .cv = PTHREAD_COND_INITIALIZER};
-
-static double clock_s(void) {
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 static void erase_locked(void) {
     if (P.drawn) {
@@ -57,7 +52,7 @@ static void *run(void *arg) {
         }
         pthread_cond_timedwait(&P.cv, &P.mu, &until);
         if (P.stop || !P.name[0]) continue;
-        double age = clock_s() - P.since;
+        double age = cli_now() - P.since;
         if (age < PROGRESS_DELAY) continue;
         char bar[BAR + 1];
         int fill = P.phases > 0 ? P.done * BAR / P.phases : 0;
@@ -93,7 +88,7 @@ void progress_phase(const char *fmt, ...) {
     vsnprintf(P.name, sizeof P.name, fmt, ap);
     va_end(ap);
     P.done++;
-    P.since = clock_s();
+    P.since = cli_now();
     pthread_mutex_unlock(&P.mu);
 }
 

@@ -393,7 +393,8 @@ int render_compose(const char *path, const render_scene_t *sc, const render_laye
         ring(&c, px, py, 8.5, 9.8, RED);
         char lp[64], lq[64];
         snprintf(lp, sizeof lp, "%c[%zu]", from_a ? 'A' : 'B', w->i);
-        snprintf(lq, sizeof lq, "%c[%zu]", from_a ? 'B' : 'A', w->j);
+        if (notes->surface) snprintf(lq, sizeof lq, "triangle %zu", w->j);
+        else snprintf(lq, sizeof lq, "%c[%zu]", from_a ? 'B' : 'A', w->j);
         int side = qx >= px ? -1 : 1; /* labels away from each other */
         int lpx = side > 0 ? px + 13 : px - 13 - 2 * font_width(lp);
         int lqx = side > 0 ? qx - 11 - 2 * font_width(lq) : qx + 11;
@@ -453,10 +454,15 @@ int render_compose(const char *path, const render_scene_t *sc, const render_laye
     fmt_num(hv, sizeof hv, w->distance);
     const char *u = notes->unit ? notes->unit : "";
     snprintf(info->caption[0], sizeof info->caption[0], "%s", title);
-    snprintf(info->caption[1], sizeof info->caption[1],
-             "%s = %s%s%s between %c[%zu] (red) and %c[%zu] (orange); grey: B only",
-             directed ? "h(A,B)" : "H(A,B)", hv, *u ? " " : "", u, from_a ? 'A' : 'B', w->i, from_a ? 'B' : 'A',
-             w->j);
+    if (notes->surface)
+        snprintf(info->caption[1], sizeof info->caption[1],
+                 "h(A, surface of B) = %s%s%s between A[%zu] (red) and its closest point on triangle %zu "
+                 "(orange); grey: B's vertices", hv, *u ? " " : "", u, w->i, w->j);
+    else
+        snprintf(info->caption[1], sizeof info->caption[1],
+                 "%s = %s%s%s between %c[%zu] (red) and %c[%zu] (orange); grey: B only",
+                 directed ? "h(A,B)" : "H(A,B)", hv, *u ? " " : "", u, from_a ? 'A' : 'B', w->i,
+                 from_a ? 'B' : 'A', w->j);
     if (py >= 0) {
         char ab[64], sym[64], pooled[64];
         fmt_num(ab, sizeof ab, notes->pct.ab);
@@ -483,7 +489,7 @@ int render_compose(const char *path, const render_scene_t *sc, const render_laye
 
 int render_distances(const char *path, const hd_points_t *A,
                      const hd_points_t *B, const double *d_a, double dmax,
-                     const hd_symmetric_t *s, int directed,
+                     const hd_symmetric_t *s, const double *wq_at, int directed,
                      const render_notes_t *notes, const char *title,
                      render_marker_t markers[6], int *n_markers,
                      render_info_t *info, int *width, int *height,
@@ -506,7 +512,8 @@ int render_distances(const char *path, const hd_points_t *A,
     const hd_result_t *w = from_a ? &s->ab : &s->ba;
     double wp[3], wq[3];
     hd_points_get(from_a ? A : B, w->i, wp);
-    hd_points_get(from_a ? B : A, w->j, wq);
+    if (wq_at) memcpy(wq, wq_at, sizeof wq);
+    else hd_points_get(from_a ? B : A, w->j, wq);
     int rc = render_compose(path, &sc, &L, wp, wq, s, directed, notes, title, markers, n_markers, info, width,
                             height, err);
     render_layers_free(&L);
@@ -516,7 +523,7 @@ int render_distances(const char *path, const hd_points_t *A,
 /* ---- the histogram ----------------------------------------------------------------- */
 
 int render_histogram(const char *path, const analysis_result_t *r,
-                     const analysis_args_t *an, size_t bins,
+                     const render_notes_t *notes, size_t bins,
                      hist_marker_t marks[4], int *n_marks, hd_error_t *err) {
     *n_marks = 0;
     enum { HW = 1000, HH = 580, L = 110, R = 30, T = 104, B = 80 };
@@ -575,7 +582,7 @@ int render_histogram(const char *path, const analysis_result_t *r,
         if (!logy && v > (double)top + 0.5) break;
     }
     text(&c, 8, T - 26, 2, logy ? "count (log scale)" : "count", DARK);
-    const char *unit = analysis_units(an);
+    const char *unit = notes->unit;
     char buf[256];
     snprintf(buf, sizeof buf, "distance to the nearest point of the other set%s%s%s", unit ? " (" : "",
              unit ? unit : "", unit ? ")" : "");
@@ -588,7 +595,7 @@ int render_histogram(const char *path, const analysis_result_t *r,
         const unsigned char *col = sidx ? AMBER : BLUE;
         double v[2] = {sidx ? r->sum.mean_ba : r->sum.mean_ab, sidx ? r->pct.ba : r->pct.ab};
         for (int kind = 0; kind < 2; kind++) {
-            if ((kind == 1 && !an->percentile_on) || !(v[kind] >= lo && v[kind] <= hi)) continue;
+            if ((kind == 1 && !notes->percentile_on) || !(v[kind] >= lo && v[kind] <= hi)) continue;
             int x = L + (int)lround(pw * (v[kind] - lo) / (hi - lo));
             int dash = kind ? 6 : ph, period = kind ? 12 : ph;
             for (int y = T; y < T + ph; y += period) {
@@ -618,9 +625,9 @@ int render_histogram(const char *path, const analysis_result_t *r,
     fill_rect(&c, lx, ly + 6, lx + 24, ly + 8, DARK);
     text(&c, lx + 30, ly - 1, 2, "mean", DARK);
     lx += 30 + 2 * font_width("mean") + 24;
-    if (an->percentile_on) {
+    if (notes->percentile_on) {
         for (int x = 0; x < 24; x += 8) fill_rect(&c, lx + x, ly + 6, lx + x + 4, ly + 8, DARK);
-        snprintf(buf, sizeof buf, "percentile %g", an->percentile);
+        snprintf(buf, sizeof buf, "percentile %g", notes->pct.p);
         text(&c, lx + 30, ly - 1, 2, buf, DARK);
     }
     if (r->above_ab || r->above_ba) {
@@ -644,12 +651,13 @@ static int unavailable(hd_error_t *err) {
 
 int render_distances(const char *path, const hd_points_t *A,
                      const hd_points_t *B, const double *d_a, double dmax,
-                     const hd_symmetric_t *s, int directed,
+                     const hd_symmetric_t *s, const double *wq_at, int directed,
                      const render_notes_t *notes, const char *title,
                      render_marker_t markers[6], int *n_markers,
                      render_info_t *info, int *width, int *height,
                      hd_error_t *err) {
     (void)path, (void)A, (void)B, (void)d_a, (void)dmax, (void)s, (void)directed, (void)notes, (void)title;
+    (void)wq_at;
     (void)markers, (void)width, (void)height;
     memset(info, 0, sizeof *info);
     info->pct_y = -1;
@@ -658,9 +666,9 @@ int render_distances(const char *path, const hd_points_t *A,
 }
 
 int render_histogram(const char *path, const analysis_result_t *r,
-                     const analysis_args_t *an, size_t bins,
+                     const render_notes_t *notes, size_t bins,
                      hist_marker_t marks[4], int *n_marks, hd_error_t *err) {
-    (void)path, (void)r, (void)an, (void)bins, (void)marks;
+    (void)path, (void)r, (void)notes, (void)bins, (void)marks;
     *n_marks = 0;
     return unavailable(err);
 }

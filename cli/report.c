@@ -11,12 +11,6 @@
 #include <string.h>
 #include <time.h>
 
-double cli_now(void) {
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 /* Library codes to exit codes; an output failure (OUT_EFAIL) is 3. */
 int cli_exit_for(int code) {
     switch (code) {
@@ -75,7 +69,8 @@ static void tiles_json(FILE *out, const char *key, const tiles_t *t) {
 static void side_line(FILE *out, const report_t *r, int w) {
     const tiles_t *t = &r->side[w];
     int sampled = r->a->read.mesh == HD_MESH_SAMPLE;
-    fprintf(out, "%c: %s (%zu point%s, %s", "AB"[w], safe_text(t->arg), r->n[w], plural(r->n[w]), r->format[w]);
+    fprintf(out, "%c: %s (%zu point%s", "AB"[w], safe_text(t->arg), r->n[w], plural(r->n[w]));
+    if (r->n[w]) fprintf(out, ", %s", r->format[w]); /* an empty side has no format to tell */
     if (r->faces[w])
         fprintf(out, "%s %zu face%s", sampled ? " sampled from" : ",", r->faces[w], plural(r->faces[w]));
     if (t->kind != TILES_FILE) {
@@ -129,20 +124,11 @@ const hd_result_t *report_witness(const cli_args_t *a, const hd_symmetric_t *s, 
     return w;
 }
 
-void report_json(FILE *out, const report_t *r) {
+/* The witnesses, the algorithms and the overlap of a computed run. */
+static void witnesses_json(FILE *out, const report_t *r) {
     const cli_args_t *a = r->a;
     const hd_symmetric_t *s = r->s;
     const tiles_t *side = r->side;
-    /* with --directed H(A,B) is not computed: null, like directed_ba
-     * (it once held h(A,B), which a script could take for H) */
-    fprintf(out, "{\"hausdorff\": ");
-    if (a->directed) fputs("null", out);
-    else json_number(out, s->distance);
-    fprintf(out, ", \"directed_ab\": ");
-    json_number(out, s->ab.distance);
-    fprintf(out, ", \"directed_ba\": ");
-    if (a->directed) fputs("null", out);
-    else json_number(out, s->ba.distance);
     fprintf(out, ", \"witness_ab\": ");
     witness_json(out, &s->ab);
     fprintf(out, ", \"witness_ba\": ");
@@ -168,6 +154,29 @@ void report_json(FILE *out, const report_t *r) {
     fprintf(out, ", \"alpha\": ");
     json_number(out, s->alpha);
     fprintf(out, ", \"disjoint\": %s", s->disjoint ? "true" : "false");
+}
+
+void report_json(FILE *out, const report_t *r) {
+    const cli_args_t *a = r->a;
+    const hd_symmetric_t *s = r->s;
+    const tiles_t *side = r->side;
+    /* with --directed H(A,B) is not computed: null, like directed_ba
+     * (it once held h(A,B), which a script could take for H) */
+    fprintf(out, "{\"hausdorff\": ");
+    if (a->directed) fputs("null", out);
+    else json_number(out, s->distance);
+    fprintf(out, ", \"directed_ab\": ");
+    json_number(out, s->ab.distance);
+    fprintf(out, ", \"directed_ba\": ");
+    if (a->directed) fputs("null", out);
+    else json_number(out, s->ba.distance);
+    if (r->empty) {
+        fprintf(out, ", \"witness_ab\": null, \"witness_ba\": null, \"witness_ab_files\": null, "
+                     "\"witness_ba_files\": null, \"empty\": {\"a\": %s, \"b\": %s, \"policy\": \"%s\"}",
+                r->n[0] ? "false" : "true", r->n[1] ? "false" : "true", hd_empty_policy_name(a->an.empty));
+    } else {
+        witnesses_json(out, r);
+    }
     fprintf(out, ", \"n_a\": %zu, \"n_b\": %zu", r->n[0], r->n[1]);
     fprintf(out, ", \"file_a\": ");
     json_string(out, a->path_a);
@@ -175,6 +184,7 @@ void report_json(FILE *out, const report_t *r) {
     json_string(out, a->path_b);
     tiles_json(out, "a", &side[0]);
     tiles_json(out, "b", &side[1]);
+    if (r->empty) return; /* nothing computed: no times, no counters */
     /* times are measurements: to the microsecond, then shortest */
     fprintf(out, ", \"seconds\": ");
     json_number(out, round(s->seconds * 1e6) / 1e6);
@@ -196,6 +206,12 @@ void report_text(FILE *out, const report_t *r) {
     const char *unit = analysis_units(&a->an); /* " mm" after each distance, when known */
     const char *sp = unit ? " " : "";
     if (!unit) unit = "";
+    if (r->empty) {
+        const char *which = !r->n[0] && !r->n[1] ? "A and B are" : !r->n[0] ? "A is" : "B is";
+        fprintf(out, "%s = %s%s%s   (%s empty; --empty %s)\n", a->directed ? "h(A,B)" : "Hausdorff distance H(A,B)",
+                num_text(s->ab.distance, d), sp, unit, which, hd_empty_policy_name(a->an.empty));
+        return;
+    }
     if (a->directed) {
         fprintf(out, "h(A,B) = %s%s%s\n", num_text(s->ab.distance, d), sp, unit);
     } else {
@@ -220,4 +236,18 @@ void report_text(FILE *out, const report_t *r) {
             s->disjoint ? " (disjoint boxes)" : "", hd_algorithm_name(a->opt.algorithm));
     fprintf(out, "time: %s s computing, %s s reading\n", num_seconds(s->seconds, tc),
             num_seconds(r->read_seconds, tr));
+}
+
+void report_print(FILE *out, const report_t *r, const analysis_result_t *an, report_more_t more, const void *ctx) {
+    const analysis_args_t *args = &r->a->an;
+    if (r->a->json) {
+        report_json(out, r);
+        if (an) analysis_json(out, args, an);
+        if (more) more(out, 1, ctx);
+        fprintf(out, "}\n");
+    } else {
+        report_text(out, r);
+        if (an) analysis_print(out, args, an);
+        if (more) more(out, 0, ctx);
+    }
 }

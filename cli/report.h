@@ -23,6 +23,9 @@ typedef struct report {
     double read_seconds;
     int single[2];             /* A's, B's coordinates came from float32 data
                                   (report_single): printed as floats */
+    int empty;                 /* A or B is empty (--empty): s holds the
+                                  policy's values (analysis_empty), no
+                                  witness, nothing computed */
 } report_t;
 
 /* The witness a person is shown: h(A,B)'s with --directed or when it is the
@@ -36,6 +39,12 @@ void report_json(FILE *out, const report_t *r);
 /* The report for a person, up to the analysis lines. */
 void report_text(FILE *out, const report_t *r);
 
+/* The whole report: report_json and analysis_json (an NULL: no analysis)
+ * closed by "}", or report_text and analysis_print; more (may be NULL)
+ * adds the caller's own JSON members or lines after the analysis. */
+typedef void (*report_more_t)(FILE *out, int json, const void *ctx);
+void report_print(FILE *out, const report_t *r, const analysis_result_t *an, report_more_t more, const void *ctx);
+
 /* 1 when a side's coordinates came from float32 data, so that the report
  * prints them as the shortest text of the float: stored as float
  * (--float32), a NIfTI-1 mask (its transform is float32; m may be NULL),
@@ -46,8 +55,5 @@ int report_single(const hd_points_t *p, const mask_info_t *m);
 
 /* Library codes to exit codes: bad input 2, anything else 3. */
 int cli_exit_for(int code);
-
-/* Seconds on a monotonic clock. */
-double cli_now(void);
 
 #endif

@@ -11,4 +11,8 @@
  * print; returns the exit code (the caller finishes standard output). */
 int surface_run(const cli_args_t *a);
 
+/* The same with a mesh as A: its surface against B, a mesh or a point
+ * set, as an enclosure (m2m.c). */
+int m2m_run(const cli_args_t *a);
+
 #endif

@@ -68,13 +68,6 @@ void colormap_viridis(double t, unsigned char rgb[3]) {
     }
 }
 
-void path_with_suffix(const char *path, const char *suffix, char *out,
-                      size_t size) {
-    const char *dot = strrchr(path, '.'), *slash = strrchr(path, '/');
-    if (!dot || (slash && dot < slash)) dot = path + strlen(path);
-    snprintf(out, size, "%.*s%s%s", (int)(dot - path), path, suffix, dot);
-}
-
 static int format_of(const char *path) {
     const char *dot = strrchr(path, '.');
     if (!dot) return DIST_UNKNOWN;
@@ -110,6 +103,24 @@ int distances_wide(const size_t *nearest, size_t n) {
     return wide;
 }
 
+/* An NPY header of a (count, cols) float64 array: magic (6) + version (2)
+ * + length (2) + dict, padded with spaces and a newline to a multiple of
+ * 64 bytes. */
+static int npy_header(char buf[DIST_HEAD_MAX], size_t count, int cols) {
+    char dict[128];
+    int m = snprintf(dict, sizeof dict, "{'descr': '<f8', 'fortran_order': False, 'shape': (%zu, %d), }", count,
+                     cols);
+    size_t total = 10 + (size_t)m + 1, padded = (total + 63) / 64 * 64;
+    unsigned char head[10] = {0x93, 'N', 'U', 'M', 'P', 'Y', 1, 0, 0, 0};
+    uint16_t hl = (uint16_t)(padded - 10);
+    put_le(head + 8, &hl, 2);
+    memcpy(buf, head, 10);
+    memcpy(buf + 10, dict, (size_t)m);
+    memset(buf + 10 + m, ' ', padded - total);
+    buf[padded - 1] = '\n';
+    return (int)padded;
+}
+
 size_t distances_header(const dist_layout_t *f, char buf[DIST_HEAD_MAX]) {
     int n = 0;
     if (f->format == DIST_CSV) {
@@ -125,20 +136,7 @@ size_t distances_header(const dist_layout_t *f, char buf[DIST_HEAD_MAX]) {
                      "property uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n",
                      hd_version(), num_text(f->dmax, dm), f->count, f->wide ? "double" : "int");
     } else {
-        char dict[128];
-        int m = snprintf(dict, sizeof dict, "{'descr': '<f8', 'fortran_order': False, 'shape': (%zu, 5), }",
-                         f->count);
-        /* magic (6) + version (2) + length (2) + dict, padded with spaces
-         * and a newline to a multiple of 64 bytes */
-        size_t total = 10 + (size_t)m + 1, padded = (total + 63) / 64 * 64;
-        unsigned char head[10] = {0x93, 'N', 'U', 'M', 'P', 'Y', 1, 0, 0, 0};
-        uint16_t hl = (uint16_t)(padded - 10);
-        put_le(head + 8, &hl, 2);
-        memcpy(buf, head, 10);
-        memcpy(buf + 10, dict, (size_t)m);
-        memset(buf + 10 + m, ' ', padded - total);
-        buf[padded - 1] = '\n';
-        n = (int)padded;
+        n = npy_header(buf, f->count, 5);
     }
     return n < 0 ? 0 : (size_t)n;
 }
@@ -177,24 +175,136 @@ size_t distances_row(const dist_layout_t *f, const double q[3], double d, const 
 /* errno of a failed write; -1 when unknown, never 0 */
 static int write_errno(void) { return errno ? errno : -1; }
 
-int write_distances(const char *path, const hd_points_t *P, const double *d,
-                    const size_t *nearest, double dmax, hd_error_t *err) {
-    dist_layout_t lay;
-    if (distances_layout(path, P->count, dmax, distances_wide(nearest, P->count), &lay, err)) return err->code;
+/* One file of rows: the header, then row(k) for every point (its bytes in
+ * buf, at most ROW_MAX), stopping at the first write that fails. */
+enum { ROW_MAX = 12 * NUM_TEXT + 64 };
+typedef size_t (*row_fn)(const dist_layout_t *f, const double q[3], size_t k, const void *ctx,
+                         unsigned char buf[ROW_MAX]);
+
+static int write_rows(const char *path, const hd_points_t *P, const dist_layout_t *lay, const char *head,
+                      size_t n, row_fn row, const void *ctx, hd_error_t *err) {
     FILE *f = out_open(path, err);
     if (!f) return err->code;
     errno = 0;
-    char head[DIST_HEAD_MAX];
-    size_t n = distances_header(&lay, head);
     int werr = fwrite(head, 1, n, f) != n ? write_errno() : 0;
-    unsigned char row[DIST_ROW_MAX];
+    unsigned char buf[ROW_MAX];
     for (size_t k = 0; k < P->count && !werr; k++) {
         double q[3];
         hd_points_get(P, k, q);
-        n = distances_row(&lay, q, d[k], nearest ? &nearest[k] : NULL, row);
-        if (fwrite(row, 1, n, f) != n) werr = write_errno();
+        n = row(lay, q, k, ctx, buf);
+        if (fwrite(buf, 1, n, f) != n) werr = write_errno();
     }
     return out_close(f, werr, err);
 }
 
+typedef struct {
+    const double *d;
+    const size_t *nearest;
+} plain_cols_t;
+
+static size_t plain_row(const dist_layout_t *f, const double q[3], size_t k, const void *ctx,
+                        unsigned char buf[ROW_MAX]) {
+    const plain_cols_t *c = ctx;
+    return distances_row(f, q, c->d[k], c->nearest ? &c->nearest[k] : NULL, buf);
+}
+
+_Static_assert((int)ROW_MAX >= (int)DIST_ROW_MAX, "a row of write_distances fits");
+
+int write_distances(const char *path, const hd_points_t *P, const double *d,
+                    const size_t *nearest, double dmax, hd_error_t *err) {
+    dist_layout_t lay;
+    if (distances_layout(path, P->count, dmax, distances_wide(nearest, P->count), &lay, err)) return err->code;
+    char head[DIST_HEAD_MAX];
+    size_t n = distances_header(&lay, head);
+    plain_cols_t c = {d, nearest};
+    return write_rows(path, P, &lay, head, n, plain_row, &c, err);
+}
+
 int distances_format_known(const char *path) { return format_of(path) != DIST_UNKNOWN; }
+
+/* ---- distances to a surface (--surface) ---------------------------------------- */
+
+
+static size_t surface_header(const dist_layout_t *f, int sign, char buf[DIST_HEAD_MAX]) {
+    int n = 0;
+    if (f->format == DIST_CSV) {
+        n = snprintf(buf, DIST_HEAD_MAX, "x,y,z,distance,face,closest_x,closest_y,closest_z,u,v,w%s\n",
+                     sign ? ",sign" : "");
+    } else if (f->format == DIST_PLY) {
+        char dm[NUM_TEXT];
+        n = snprintf(buf, DIST_HEAD_MAX, "ply\nformat binary_little_endian 1.0\n"
+                     "comment written by hausdorff %s: distance to the nearest face of the surface of B\n"
+                     "comment colour: viridis, 0 to %s\n"
+                     "element vertex %zu\n"
+                     "property double x\nproperty double y\nproperty double z\n"
+                     "property double distance\nproperty %s face\n"
+                     "property double closest_x\nproperty double closest_y\nproperty double closest_z\n"
+                     "property double u\nproperty double v\nproperty double w\n%s"
+                     "property uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n",
+                     hd_version(), num_text(f->dmax, dm), f->count, f->wide ? "double" : "int",
+                     sign ? "property char sign\n" : "");
+    } else {
+        n = npy_header(buf, f->count, sign ? 12 : 11);
+    }
+    return n < 0 ? 0 : (size_t)n;
+}
+
+static size_t surface_row(const dist_layout_t *f, const double q[3], double d, const surface_columns_t *c,
+                          size_t k, unsigned char buf[ROW_MAX]) {
+    const double *cp = c->closest + 3 * k, *b = c->bary + 3 * k;
+    if (f->format == DIST_CSV) {
+        char t[10][NUM_TEXT], sg[8] = "";
+        if (c->sign) snprintf(sg, sizeof sg, ",%d", c->sign[k]);
+        int n = snprintf((char *)buf, ROW_MAX, "%s,%s,%s,%s,%zu,%s,%s,%s,%s,%s,%s%s\n", num_text(q[0], t[0]),
+                         num_text(q[1], t[1]), num_text(q[2], t[2]), num_text(d, t[3]), c->face[k],
+                         num_text(cp[0], t[4]), num_text(cp[1], t[5]), num_text(cp[2], t[6]), num_text(b[0], t[7]),
+                         num_text(b[1], t[8]), num_text(b[2], t[9]), sg);
+        return n < 0 ? 0 : (size_t)n;
+    }
+    size_t o = 0;
+    double v[4] = {q[0], q[1], q[2], d}, face = (double)c->face[k];
+    for (int i = 0; i < 4; i++, o += 8) put_le(buf + o, &v[i], 8);
+    if (f->format == DIST_NPY || f->wide) {
+        put_le(buf + o, &face, 8);
+        o += 8;
+    } else {
+        int32_t j = (int32_t)c->face[k];
+        put_le(buf + o, &j, 4);
+        o += 4;
+    }
+    for (int i = 0; i < 3; i++, o += 8) put_le(buf + o, &cp[i], 8);
+    for (int i = 0; i < 3; i++, o += 8) put_le(buf + o, &b[i], 8);
+    if (c->sign && f->format == DIST_NPY) {
+        double s = c->sign[k];
+        put_le(buf + o, &s, 8);
+        o += 8;
+    } else if (c->sign) {
+        buf[o++] = (unsigned char)c->sign[k];
+    }
+    if (f->format == DIST_PLY) {
+        colormap_viridis(f->dmax > 0 ? d / f->dmax : 0.0, buf + o);
+        o += 3;
+    }
+    return o;
+}
+
+typedef struct {
+    const double *d;
+    const surface_columns_t *c;
+} surf_cols_t;
+
+static size_t surf_row(const dist_layout_t *f, const double q[3], size_t k, const void *ctx,
+                       unsigned char buf[ROW_MAX]) {
+    const surf_cols_t *s = ctx;
+    return surface_row(f, q, s->d[k], s->c, k, buf);
+}
+
+int write_surface_distances(const char *path, const hd_points_t *P, const double *d,
+                            const surface_columns_t *c, double dmax, hd_error_t *err) {
+    dist_layout_t lay;
+    if (distances_layout(path, P->count, dmax, distances_wide(c->face, P->count), &lay, err)) return err->code;
+    char head[DIST_HEAD_MAX];
+    size_t n = surface_header(&lay, c->sign != NULL, head);
+    surf_cols_t s = {d, c};
+    return write_rows(path, P, &lay, head, n, surf_row, &s, err);
+}

@@ -1,7 +1,7 @@
 /*
  * fuzz_cli.c -- a libFuzzer target for the command line's argument parser,
- * cli_parse() (cli/options.c) with the analysis options it hands to
- * analysis_parse_option() (cli/analysis.c).
+ * cli_parse() (cli/options.c: one table and one parser for every option,
+ * the analysis options included).
  *
  * The input is split at NUL bytes into arguments (at most 64) after
  * argv[0] = "hausdorff"; a seed file is a command line written as

@@ -459,14 +459,17 @@ typedef struct hd_summary {
     double mean_symmetric;      /* max(mean_ab, mean_ba): the average
                                    Hausdorff distance (Taha & Hanbury) */
     double mean_average;        /* (mean_ab + mean_ba) / 2 */
-    double mean_pooled;         /* (sum_ab + sum_ba) / (n_ab + n_ba): MONAI's
-                                   symmetric average surface distance */
+    double mean_pooled;         /* the sum of both sets' distances (rounded
+                                   once) / (n_ab + n_ba): MONAI's symmetric
+                                   average surface distance */
     double chamfer;             /* mean2_ab + mean2_ba: THE Chamfer distance
                                    here (squared, mean per set, summed; as
                                    PyTorch3D's chamfer_distance) */
-    double chamfer_sum2;        /* sum2_ab + sum2_ba (squared, summed) */
+    double chamfer_sum2;        /* squared, summed over both sets (the exact
+                                   sum rounded once, not sum2_ab + sum2_ba) */
     double chamfer_mean;        /* mean_ab + mean_ba (not squared, mean) */
-    double chamfer_sum;         /* sum_ab + sum_ba (not squared, summed) */
+    double chamfer_sum;         /* not squared, summed over both sets (rounded
+                                   once, not sum_ab + sum_ba) */
 } hd_summary_t;
 
 /* Errors: HD_EINVAL, HD_EEMPTY (n_a = 0, or d_ba given with n_b = 0),
@@ -1001,6 +1004,41 @@ HD_EXTERN int hd_surface_face_maxima(const hd_mesh_t *A, const hd_mesh_t *B,
                                      const hd_surface_options_t *opt,
                                      double *face_lower, double *face_upper,
                                      hd_enclosure_t *ab, hd_error_t *err);
+
+/* hd_mesh_distances with the sign of every distance, for a closed,
+ * consistently oriented mesh: sign[k] = -1 when point k is inside the
+ * surface, +1 when it is outside, 0 when its distance is 0 (on the
+ * surface, or nearer than half the least subnormal).  Inside means that the
+ * winding number of the surface around the point (the generalised winding
+ * number of Jacobson et al. 2013: the solid angle the surface subtends over
+ * 4 pi, an integer on a closed mesh) is not 0; it is decided exactly (the
+ * signed count of a ray's crossings with exact predicates and simulation of
+ * simplicity, docs/surfaces.md), so points on an edge's or a vertex's line
+ * of sight get no guessed sign.  Nested shells: a point is inside when the
+ * shells around it do not cancel (an inner shell oriented inward makes a
+ * cavity, outward an inner solid).
+ * Closed: corners with equal coordinates (-0 = +0) are one vertex; a
+ * triangle with two corners on one vertex is skipped; every edge is used as
+ * often from u to v as from v to u by the other triangles (once each way on
+ * a manifold edge; a non-manifold edge shared by 2k triangles k times each
+ * way).  The vertex indices and triangles of the mesh are as for
+ * hd_mesh_distances; the other outputs too, bit for bit (each may be NULL,
+ * sign too: then only the check and the distances run).  sign holds
+ * P->count elements.  The check and the winding tree take about 400 bytes
+ * a triangle at their peak, beside hd_mesh_distances' tree, freed before
+ * returning.
+ * Errors: those of hd_mesh_distances, and HD_EINVAL when the mesh is not
+ *   closed and consistently oriented: the message names an offending edge
+ *   by its two vertex indices (the smallest index at those coordinates) and
+ *   a triangle using it; no output is written then.
+ * Thread safety: reentrant; it may start opt->threads threads. */
+HD_EXTERN int hd_mesh_signed_distances(const hd_points_t *P,
+                                       const hd_mesh_t *M,
+                                       const hd_options_t *opt, double *dist,
+                                       size_t *triangle, double *closest,
+                                       double *bary, int8_t *sign,
+                                       hd_surface_result_t *out,
+                                       hd_error_t *err);
 
 #ifdef __cplusplus
 }

@@ -17,10 +17,12 @@
 #include <string.h>
 
 /* The tolerance 0 stands for the smallest that the rounding of the
- * computed points of X leaves meaningful (mesh/m2m.c: a point is off by
- * up to 8 u (|x| + |y| + |z|) <= 24 u max|coordinate|, and both bounds
- * carry it): 2^-46 (3 max|coordinate| + diagonal). */
-#define FLOOR_SCALE 0x1p-46
+ * computed points of X leaves meaningful: mesh/m2m.c's slack e of a face
+ * is at most 6 u max|coordinate| + 24 u diagonal (plus 2^-1060), both
+ * bounds carry it, so the width cannot go below about 2 e; the floor is
+ * 2^-48 max|coordinate| + 2^-46 diagonal >= 4 e. */
+#define FLOOR_COORD 0x1p-48
+#define FLOOR_DIAG 0x1p-46
 
 void hd_surface_options_init(hd_surface_options_t *opt) {
     if (!opt) return;
@@ -117,7 +119,7 @@ static double tolerance_of(const hd_surface_options_t *o, const side_t *x, const
                 }
     double dx = hi[0] - lo[0], dy = hi[1] - lo[1], dz = hi[2] - lo[2];
     double diag = sqrt(dx * dx + dy * dy + dz * dz);
-    double floor_ = (3 * big + diag) * FLOOR_SCALE;
+    double floor_ = big * FLOOR_COORD + diag * FLOOR_DIAG + 0x1p-1000;
     double tol = o->relative ? o->tolerance * diag : o->tolerance;
     return fmax(tol, floor_);
 }
@@ -178,29 +180,39 @@ static int directed(const side_t *x, side_t *y, const ask_t *q, hd_enclosure_t *
     return HD_OK;
 }
 
-static ask_t ask_of(const hd_surface_options_t *o, double tol) {
-    ask_t q = {tol, -INFINITY, INFINITY, 0, o->threads, o->max_splits, NULL, NULL};
-    return q;
+/* Every entry point's first steps: the options checked, A's triangles,
+ * B's (a mesh, or the point set P when B is NULL), and what a search asks
+ * by default.  On failure nothing is left to free. */
+static int open_sides(const hd_surface_options_t *opt, const hd_mesh_t *A, const hd_mesh_t *B,
+                      const hd_points_t *P, side_t *a, side_t *b, ask_t *q, hd_error_t *err) {
+    hd__err_clear(err);
+    hd_surface_options_t o;
+    int rc = check_options(opt, &o, err);
+    if (rc || (rc = side_mesh(A, "A", a, err))) return rc;
+    if ((rc = B || !P ? side_mesh(B, "B", b, err) : side_points(P, b, err))) {
+        side_free(a);
+        return rc;
+    }
+    ask_t d = {tolerance_of(&o, a, b), -INFINITY, INFINITY, 0, o.threads, o.max_splits, NULL, NULL};
+    *q = d;
+    return HD_OK;
+}
+
+static void close_sides(side_t *a, side_t *b) {
+    side_free(a);
+    side_free(b);
 }
 
 int hd_surface_hausdorff(const hd_mesh_t *A, const hd_mesh_t *B, const hd_surface_options_t *opt,
                          hd_enclosure_t *ab, hd_enclosure_t *ba, hd_error_t *err) {
-    hd__err_clear(err);
-    hd_surface_options_t o;
     side_t a, b;
-    int rc = check_options(opt, &o, err);
-    if (rc) return rc;
+    ask_t q;
     if (!ab && !ba) return hd__err(err, HD_EINVAL, "both outputs are NULL");
-    if ((rc = side_mesh(A, "A", &a, err))) return rc;
-    if ((rc = side_mesh(B, "B", &b, err))) {
-        side_free(&a);
-        return rc;
-    }
-    ask_t q = ask_of(&o, tolerance_of(&o, &a, &b));
+    int rc = open_sides(opt, A, B, NULL, &a, &b, &q, err);
+    if (rc) return rc;
     if (ab) rc = directed(&a, &b, &q, ab, err);
     if (ba && rc == HD_OK) rc = directed(&b, &a, &q, ba, err);
-    side_free(&a);
-    side_free(&b);
+    close_sides(&a, &b);
     return rc;
 }
 
@@ -231,42 +243,28 @@ static int points_to_surface(const hd_points_t *B, const hd_mesh_t *A, const sid
 
 int hd_surface_points_hausdorff(const hd_mesh_t *A, const hd_points_t *B, const hd_surface_options_t *opt,
                                 hd_enclosure_t *ab, hd_enclosure_t *ba, hd_error_t *err) {
-    hd__err_clear(err);
-    hd_surface_options_t o;
     side_t a, b;
-    int rc = check_options(opt, &o, err);
-    if (rc) return rc;
+    ask_t q;
     if (!ab && !ba) return hd__err(err, HD_EINVAL, "both outputs are NULL");
-    if ((rc = side_mesh(A, "A", &a, err))) return rc;
-    if ((rc = side_points(B, &b, err))) {
-        side_free(&a);
-        return rc;
-    }
-    ask_t q = ask_of(&o, tolerance_of(&o, &a, &b));
+    if (!B) return hd__err(err, HD_EINVAL, "point set B is NULL");
+    int rc = open_sides(opt, A, NULL, B, &a, &b, &q, err);
+    if (rc) return rc;
     if (ab) rc = directed(&a, &b, &q, ab, err);
     if (ba && rc == HD_OK) rc = points_to_surface(B, A, &a, &q, ba, err);
-    side_free(&a);
-    side_free(&b);
+    close_sides(&a, &b);
     return rc;
 }
 
 int hd_surface_within(const hd_mesh_t *A, const hd_mesh_t *B, double d, int directed_only,
                       const hd_surface_options_t *opt, int *answer, hd_enclosure_t *ab, hd_enclosure_t *ba,
                       hd_error_t *err) {
-    hd__err_clear(err);
-    hd_surface_options_t o;
     side_t a, b;
-    int rc = check_options(opt, &o, err);
-    if (rc) return rc;
+    ask_t q;
     if (!answer) return hd__err(err, HD_EINVAL, "answer is NULL");
     *answer = -1;
     if (!(d >= 0)) return hd__err(err, HD_EINVAL, "the distance must be >= 0, not %g", d);
-    if ((rc = side_mesh(A, "A", &a, err))) return rc;
-    if ((rc = side_mesh(B, "B", &b, err))) {
-        side_free(&a);
-        return rc;
-    }
-    ask_t q = ask_of(&o, tolerance_of(&o, &a, &b));
+    int rc = open_sides(opt, A, B, NULL, &a, &b, &q, err);
+    if (rc) return rc;
     q.done_below = d;
     q.stop_above = d;
     hd_enclosure_t e[2];
@@ -286,32 +284,23 @@ int hd_surface_within(const hd_mesh_t *A, const hd_mesh_t *B, double d, int dire
             else enclosure_init(ba), ba->upper = INFINITY, ba->tolerance = q.tol;
         }
     }
-    side_free(&a);
-    side_free(&b);
+    close_sides(&a, &b);
     return rc;
 }
 
 int hd_surface_face_maxima(const hd_mesh_t *A, const hd_mesh_t *B, const hd_surface_options_t *opt,
                            double *face_lower, double *face_upper, hd_enclosure_t *ab, hd_error_t *err) {
-    hd__err_clear(err);
-    hd_surface_options_t o;
     side_t a, b;
-    int rc = check_options(opt, &o, err);
-    if (rc) return rc;
+    ask_t q;
     if (!face_lower && !face_upper) return hd__err(err, HD_EINVAL, "both face arrays are NULL");
-    if ((rc = side_mesh(A, "A", &a, err))) return rc;
-    if ((rc = side_mesh(B, "B", &b, err))) {
-        side_free(&a);
-        return rc;
-    }
-    ask_t q = ask_of(&o, tolerance_of(&o, &a, &b));
+    int rc = open_sides(opt, A, B, NULL, &a, &b, &q, err);
+    if (rc) return rc;
     q.per_face = 1;
     q.face_lower = face_lower;
     q.face_upper = face_upper;
     hd_enclosure_t e;
     rc = directed(&a, &b, &q, &e, err);
     if (rc == HD_OK && ab) *ab = e;
-    side_free(&a);
-    side_free(&b);
+    close_sides(&a, &b);
     return rc;
 }

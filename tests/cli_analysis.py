@@ -11,14 +11,16 @@ usage: cli_analysis.py HAUSDORFF [NAME-FILTER]
 import json
 import math
 import os
+import re
 import struct
+import subprocess
 import sys
 
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from cli_analysis_support import (lattice_clouds, main, nearest, read_png, run, run_json, same,  # noqa: E402
-                                  test, write_xyz)
+                                  test, tool, write_xyz)
 
 
 def pictures_built():
@@ -93,16 +95,18 @@ def mean_and_chamfer_follow_their_stated_definitions(tmp):
         m, c = r["mean"], r["chamfer"]
         mab, mba = math.fsum(dab) / len(dab), math.fsum(dba) / len(dba)
         s2ab, s2ba = math.fsum(dab * dab), math.fsum(dba * dba)
+        both = np.concatenate([dab, dba])
         want = {"mean ab": (m["ab"], mab), "mean ba": (m["ba"], mba),
                 "mean symmetric": (m["symmetric"], max(mab, mba)),
                 "mean average": (m["average"], (mab + mba) / 2),
-                "mean pooled": (m["pooled"], (math.fsum(dab) + math.fsum(dba)) / (len(dab) + len(dba))),
+                "mean pooled": (m["pooled"], math.fsum(both) / (len(dab) + len(dba))),
                 "chamfer": (c["value"], s2ab / len(dab) + s2ba / len(dba)),
-                "chamfer sum of squares": (c["sum_squared"], s2ab + s2ba),
+                "chamfer sum of squares": (c["sum_squared"], math.fsum(both * both)),
                 "chamfer unsquared": (c["mean"], mab + mba),
-                "chamfer unsquared sum": (c["sum"], math.fsum(dab) + math.fsum(dba))}
-        # the sums are correctly rounded (math.fsum's), so every figure is
-        # the same double as its definition computed from them
+                "chamfer unsquared sum": (c["sum"], math.fsum(both))}
+        # the sums are correctly rounded (math.fsum's; the pooled ones over
+        # both lists at once), so every figure is the same double as its
+        # definition computed from them
         for what, (got, ref) in want.items():
             assert got == ref, "%s %s: %r vs %r" % (name, what, got, ref)
         assert c["definition"] == "mean_squared" and c["value"] == c["mean_squared"]
@@ -347,6 +351,41 @@ def an_empty_file_is_an_error_unless_empty_chooses_a_value(tmp):
         assert f.read() == "x,y,z,distance,nearest\n"
     r = run_json(["--empty", "nan", pe, pa])
     assert r["hausdorff"] is None and r["empty"] == {"a": True, "b": False, "policy": "nan"}
+
+
+@test
+def an_empty_set_fills_the_report_every_run_prints(tmp):
+    a, b = gauss_clouds(17, 30, 20)
+    pa, pb, pe = os.path.join(tmp, "a.xyz"), os.path.join(tmp, "b.xyz"), os.path.join(tmp, "e.xyz")
+    write_xyz(pa, a)
+    write_xyz(pb, b)
+    open(pe, "w").close()
+    tiles = os.path.join(tmp, "tiles")
+    os.mkdir(tiles)
+    write_xyz(os.path.join(tiles, "t.xyz"), a)
+    full = run_json(["--directed", tiles, pb])
+    empty = run_json(["--directed", "--empty", "zero", tiles, pe])
+    # the members of the report, in its order: those of nothing computed left out
+    computed = {"algorithm", "requested_algorithm", "alpha", "disjoint", "seconds", "read_seconds", "stats_ab",
+                "stats_ba"}
+    assert [k for k in full if k not in computed] == [k for k in empty if k != "empty"], (list(full), list(empty))
+    # --directed: H is not computed, in either case; the witnesses are null
+    assert full["hausdorff"] is None and empty["hausdorff"] is None and empty["directed_ab"] == 0, empty
+    assert empty["witness_ab"] is None and empty["tiles_a"] == [{"file": os.path.join(tiles, "t.xyz"), "first": 0,
+                                                                  "count": 30}], empty
+    out, _ = run(["--empty", "inf", pe, pb])
+    assert out.startswith("A: %s (0 points)\nB: %s (20 points, xyz)\n" % (pe, pb)), out
+
+
+@test
+def every_option_the_help_lists_is_one_the_parser_knows(tmp):
+    out, _ = run(["--help"])
+    names = sorted({w.rstrip(",") for line in out.splitlines() for w in line.split()[:2]
+                    if re.fullmatch(r"--[a-z0-9-]+,?", w)})
+    assert len(names) > 35 and "--bins" in names, names
+    for name in names:
+        p = subprocess.run([tool(), name], capture_output=True, text=True)
+        assert "unknown option" not in p.stderr, (name, p.stderr)
 
 
 @test

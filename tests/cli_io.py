@@ -64,6 +64,21 @@ def bad_text_input_exits_2_naming_the_file_and_line(d):
 
 
 @test
+def obj_vertex_line_with_a_second_statement_is_refused(d):
+    expect_bad(write(d, "two.obj", "v 0 0 0\nv 1 2 3 v 4 5 6\n"),
+               "two.obj:2: vertex: 'v' after x y z is not a number")
+
+
+@test
+def obj_vertex_line_keeps_w_colour_and_comment(d):
+    path = write(d, "tail.obj", "v 0 0 0 1 # w\nv 3 4 0 0.5 0.25 1.0\n")
+    o = write(d, "o.xyz", "0 0 0\n")
+    rc, out, err = run(path, o)
+    assert rc == 0, err
+    assert "H(A,B) = 5\n" in out, out
+
+
+@test
 def decimal_comma_csv_is_refused_unless_decimal_comma_is_given(d):
     eu = write(d, "german.csv", "1,5;2,5;3,5\n4,25;5,5;6,75\n")
     o = write(d, "o.xyz", "0 0 0\n")

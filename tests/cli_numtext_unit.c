@@ -68,7 +68,8 @@ TEST(a_ratio_prints_four_significant_digits) {
 TEST(times_print_in_seconds_to_three_digits_never_in_exponent_form_nor_with_trailing_zeros) {
     static const case_t c[] = {{0.000614, "0.000614"}, {9.8e-05, "0.000098"}, {3e-07, "0"},
                                {0, "0"}, {0.013149, "0.0131"}, {1.2549, "1.25"}, {0.017, "0.017"},
-                               {2.001, "2"}, {125.3, "125"}, {4321.9, "4322"}};
+                               {2.001, "2"}, {125.3, "125"}, {4321.9, "4322"},
+                               {0.0011999, "0.0012"}, {1.2, "1.2"}};
     check_cases(num_seconds, "num_seconds", c, sizeof c / sizeof c[0]);
 }
 

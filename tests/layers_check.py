@@ -57,7 +57,7 @@ class Layers(unittest.TestCase):
                               capture_output=True, text=True)
 
     def test_this_tree_keeps_its_layers(self):
-        r = subprocess.run(CHECK + (["--build", BUILD] if BUILD else []), capture_output=True, text=True)
+        r = subprocess.run(CHECK + (["--build", BUILD, "--cli"] if BUILD else []), capture_output=True, text=True)
         self.assertEqual(r.returncode, 0, r.stdout)
 
     def test_an_outsider_including_a_private_header_fails(self):

@@ -52,8 +52,9 @@ int mpi_figures(const analysis_args_t *an, const double *d_ab, size_t n_a, const
     }
     if ((rc = mpi_agree(rc, err)) != HD_OK) return rc;
     if ((rc = analysis_figures(an, &all_ranks, d_ab, n_a, d_ba, n_b, r, err)) != HD_OK) return rc;
+    render_notes_t notes = analysis_notes(an, r);
     if (an->histogram_png && rank == 0)
-        rc = render_histogram(an->histogram_png, r, an, an->bins, r->hist_markers, &r->n_hist_markers, err);
+        rc = render_histogram(an->histogram_png, r, &notes, an->bins, r->hist_markers, &r->n_hist_markers, err);
     return mpi_agree(rc, err);
 }
 
@@ -123,7 +124,7 @@ int mpi_render(const analysis_args_t *an, const hd_mpi_part_t part[2], const dou
     if (rc == HD_OK && rank == 0) {
         char title[640];
         analysis_render_title(path_a, r->n_a, path_b, title, sizeof title);
-        render_notes_t notes = {analysis_units(an), an->percentile_on, r->pct};
+        render_notes_t notes = analysis_notes(an, r);
         rc = render_compose(an->render_out, &sc, &L, wp, wq, s, r->directed, &notes, title, r->markers,
                             &r->n_markers, &r->render, &r->render_w, &r->render_h, err);
     }

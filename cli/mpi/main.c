@@ -22,8 +22,8 @@
  * rank's per-point distances (hd_mpi_distances), the figures over the
  * ranks and the pictures from merged layers (figures.c), the --distances
  * files written by every rank at its offset (writer.c).  Under --empty a side
- * whose ranks read no point at all gets the policy's answer, printed by
- * rank 0 with the single-process code (analysis_handle_empty), and
+ * whose ranks read no point at all gets the policy's answer
+ * (analysis_empty) in the same report as every run (report_print), and
  * --distances files with the policy's value.
  */
 #include <hausdorff_mpi.h>
@@ -86,12 +86,16 @@ static int distances_mpi(const cli_args_t *a, const hd_mpi_part_t part[2], const
 static int distances_files_mpi(const cli_args_t *a, const hd_mpi_part_t part[2], const uint64_t total[2],
                                const hd_symmetric_t *s, analysis_result_t *r, hd_error_t *err) {
     double scale = a->an.max_distance > 0 ? a->an.max_distance : s->distance;
-    snprintf(r->dist_path_a, sizeof r->dist_path_a, "%s", a->an.distances_out);
-    if (!a->directed) path_with_suffix(a->an.distances_out, "_b", r->dist_path_b, sizeof r->dist_path_b);
+    r->dist_path_a = a->an.distances_out;
+    int rc = HD_OK;
+    if (!a->directed && !(r->dist_path_b = path_with_suffix(a->an.distances_out, "_b"))) {
+        snprintf(err->message, sizeof err->message, "out of memory for a file name");
+        rc = err->code = HD_ENOMEM;
+    }
+    rc = agree(rc, err); /* every rank writes, or none */
     const char *path[2] = {r->dist_path_a, r->dist_path_b};
     const double *d[2] = {r->d_ab, r->d_ba};
     const size_t *j[2] = {r->j_ab, r->j_ba};
-    int rc = HD_OK;
     for (int w = 0; w < (a->directed ? 1 : 2) && rc == HD_OK; w++)
         rc = mpi_write_distances(path[w], &part[w].points, part[w].offset, d[w], j[w], (size_t)total[w], scale,
                                  err);
@@ -117,10 +121,11 @@ static int finish(int status) {
     return status;
 }
 
+/* A failed run's message (rank 0's), its files discarded: the exit code. */
 static int fail(int rc, const hd_error_t *err) {
     fprintf(stderr, "hausdorff-mpi: %s\n", safe_text(err->message));
     out_discard();
-    return finish(cli_exit_for(rc));
+    return cli_exit_for(rc);
 }
 
 /* Silence every rank but 0: one message, one report. */
@@ -297,17 +302,8 @@ static void mpi_json(FILE *out, const hd_mpi_stats_t *st, const hd_mpi_stats_t *
     fputc('}', out);
 }
 
-/* Whether --version comes before --help, -h and "--" (cli_parse takes the
- * first of them): then rank 0 also says which MPI the tool runs on. */
-static int asks_version(int argc, char **argv) {
-    for (int k = 1; k < argc; k++) {
-        if (!strcmp(argv[k], "--") || !strcmp(argv[k], "--help") || !strcmp(argv[k], "-h")) return 0;
-        if (!strcmp(argv[k], "--version")) return 1;
-    }
-    return 0;
-}
-
-static int print_version(void) {
+/* --version (cli_parse): the library's version and the MPI the tool runs on. */
+static void print_version(FILE *out) {
     char lib[MPI_MAX_LIBRARY_VERSION_STRING];
     int len = 0, major = 0, minor = 0;
     MPI_Get_library_version(lib, &len);
@@ -315,8 +311,205 @@ static int print_version(void) {
     lib[len > 0 && len < MPI_MAX_LIBRARY_VERSION_STRING ? len : 0] = '\0';
     char *nl = strpbrk(lib, "\r\n,");
     if (nl) *nl = '\0'; /* the library's first line, name and version */
-    if (rank_ == 0) printf("hausdorff-mpi %s (MPI %d.%d: %s)\n", hd_version(), major, minor, lib);
-    return finish(EXIT_OK);
+    fprintf(out, "hausdorff-mpi %s (MPI %d.%d: %s)\n", hd_version(), major, minor, lib);
+}
+
+/* What a run holds, made by its phases and freed by main in one place. */
+typedef struct run {
+    cli_args_t a;
+    tiles_t side[2];
+    hd_cloud_t *cloud[2];
+    analysis_result_t an;
+    hd_mpi_part_t part[2];
+    int split[2];              /* a side read by points (read_split), not by files */
+    uint64_t total[2];         /* the sides' points over all ranks */
+    double read_seconds;       /* the slowest rank's */
+    hd_symmetric_t s;
+    hd_mpi_stats_t st, dst;    /* the distance call's and the per-point distances' */
+} run_t;
+
+/* Each side's files, checked alike on every rank, then this rank's share of
+ * each side read.  Collective. */
+static int read_sides(run_t *r, hd_error_t *err) {
+    cli_args_t *a = &r->a;
+    const char *paths[2] = {a->path_a, a->path_b}, *formats[2] = {a->format_a, a->format_b};
+    int rc = HD_OK;
+    for (int w = 0; w < 2 && rc == HD_OK; w++) {
+        rc = tiles_expand(paths[w], formats[w], &r->side[w], err);
+        if (rc == HD_OK && r->side[w].kind == TILES_FILE) rc = refuse_stream(paths[w], err);
+        if ((rc = agree(rc, err)) == HD_OK) rc = same_listing(&r->side[w], err);
+    }
+    if (rc == HD_OK) { /* no output may overwrite an input: rank 0 checks */
+        int bad = rank_ == 0 ? out_check_outputs(a, r->side) : 0;
+        MPI_Bcast(&bad, 1, MPI_INT, 0, MPI_COMM_WORLD);
+        if (bad) return bad;
+    }
+    double t0 = cli_now();
+    for (int w = 0; w < 2 && rc == HD_OK; w++) {
+        hd_mpi_part_t *part = &r->part[w];
+        int share = w ? (rank_ + K_ / 2) % K_ : rank_;
+        rc = read_split(&r->side[w], share, a, &a->an, w, &r->split[w], &r->cloud[w], &part->offset, err);
+        if ((rc = agree(rc, err)) != HD_OK || r->split[w]) {
+            if (rc == HD_OK) part->points = hd_cloud_points(r->cloud[w]);
+            continue;
+        }
+        size_t first, n;
+        tiles_share(&r->side[w], share, K_, &first, &n);
+        rc = tiles_read(&r->side[w], first, n, &a->read, &a->an, w, &r->cloud[w], err);
+        if ((rc = agree(rc, err)) == HD_OK) rc = number_tiles(&r->side[w], first, n, &part->offset, err);
+        if (rc == HD_OK) part->points = hd_cloud_points(r->cloud[w]);
+    }
+    if (rc != HD_OK) return rc;
+    double read_local = cli_now() - t0;
+    MPI_Allreduce(&read_local, &r->read_seconds, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+    uint64_t mine[2] = {r->part[0].points.count, r->part[1].points.count};
+    MPI_Allreduce(mine, r->total, 2, MPI_UINT64_T, MPI_SUM, MPI_COMM_WORLD);
+    return HD_OK;
+}
+
+/* A side with no point (only under --empty: reading refuses it otherwise):
+ * the policy's answer, as hausdorff gives it, and with --distances the
+ * files hausdorff writes, every row at the policy's value with nearest
+ * index -1 (a side with no point gets a file with no rows).  Collective. */
+static int compute_empty(run_t *r, hd_error_t *err) {
+    const cli_args_t *a = &r->a;
+    int rc = agree(analysis_empty(&a->an, (size_t)r->total[0], (size_t)r->total[1], a->directed, &r->s, &r->an,
+                                  err), err);
+    if (rc != HD_OK || !a->an.distances_out) return rc;
+    size_t most = r->part[0].points.count > r->part[1].points.count ? r->part[0].points.count
+                                                                    : r->part[1].points.count;
+    double *d = malloc((most ? most : 1) * sizeof *d);
+    char *path_b = path_with_suffix(a->an.distances_out, "_b");
+    const char *path[2] = {a->an.distances_out, path_b};
+    if (!d || !path_b) {
+        snprintf(err->message, sizeof err->message, "out of memory for %zu per-point distances", most);
+        rc = err->code = HD_ENOMEM;
+    }
+    for (size_t k = 0; k < most && d; k++) d[k] = r->s.ab.distance;
+    for (int w = 0; w < (a->directed ? 1 : 2) && (rc = agree(rc, err)) == HD_OK; w++)
+        rc = mpi_write_distances(path[w], &r->part[w].points, r->part[w].offset, d, NULL, (size_t)r->total[w], 1.0,
+                                 err);
+    free(d);
+    free(path_b);
+    return rc;
+}
+
+/* The distance (h(A,B) with --directed) and the analysis asked for: as
+ * analysis_run, the distances, the figures, the files, the pictures.
+ * Collective. */
+static int compute(run_t *r, hd_error_t *err) {
+    cli_args_t *a = &r->a;
+    const hd_mpi_part_t *part = r->part;
+    hd_symmetric_t *s = &r->s;
+    int rc;
+    if (a->directed) {
+        rc = hd_mpi_directed(MPI_COMM_WORLD, &part[0], 1, &part[1], 1, &a->opt, &s->ab, &r->st, err);
+        if (rc == HD_OK) {
+            s->distance = s->ab.distance;
+            s->seconds = s->ab.seconds;
+            rc = hd_mpi_overlap(MPI_COMM_WORLD, &part[0], 1, &part[1], 1, &s->alpha, &s->disjoint, err);
+        }
+    } else {
+        rc = hd_mpi_hausdorff(MPI_COMM_WORLD, &part[0], 1, &part[1], 1, &a->opt, s, &r->st, err);
+    }
+    if (rc != HD_OK || !analysis_active(&a->an)) return rc;
+    if ((rc = distances_mpi(a, part, r->total, &r->an, &r->dst, err)) == HD_OK)
+        rc = mpi_figures(&a->an, r->an.d_ab, part[0].points.count, r->an.d_ba, part[1].points.count, &r->an, err);
+    if (rc == HD_OK && a->an.distances_out) rc = distances_files_mpi(a, part, r->total, s, &r->an, err);
+    if (rc == HD_OK && a->an.render_out) rc = render_mpi(a, part, s, &r->an, err);
+    return rc;
+}
+
+/* What "mpi" adds to the report (report_print's more): the exchange's
+ * figures, per rank in col[] (gathered by print_report). */
+typedef struct mpi_more {
+    const run_t *r;
+    double *col[5];
+} mpi_more_t;
+
+static void mpi_more(FILE *out, int json, const void *ctx) {
+    const mpi_more_t *m = ctx;
+    const hd_mpi_stats_t *st = &m->r->st, *dst = m->r->an.active ? &m->r->dst : NULL;
+    if (json) {
+        mpi_json(out, st, dst, m->col, m->r->split);
+        return;
+    }
+    char b[NUM_TEXT], f[NUM_TEXT], im[NUM_TEXT];
+    fprintf(out, "mpi: %d rank%s, %s bytes moved per point, %s of the points forwarded, imbalance %s\n", K_,
+            plural((unsigned)K_), num_ratio((double)(st->bytes_partition + st->bytes_forwarding) / (double)st->points, b),
+            num_ratio((double)st->forwarded_points / (double)st->points, f), num_ratio(st->imbalance, im));
+    if (dst)
+        fprintf(out, "mpi: per-point distances: %s bytes moved per point, %s of the points forwarded\n",
+                num_ratio((double)(dst->bytes_partition + dst->bytes_forwarding + dst->bytes_returned) /
+                              (double)dst->points, b),
+                num_ratio((double)dst->forwarded_points / (double)dst->points, f));
+}
+
+/* Everything the report shows, gathered to rank 0, which prints it (the
+ * exchange's figures unless a side was empty) and finishes the outputs:
+ * the exit status (rank 0's).  Collective. */
+static int print_report(const run_t *r) {
+    const cli_args_t *a = &r->a;
+    int empty = r->an.empty;
+    report_t rep = {a, &r->s, r->side, {(size_t)r->total[0], (size_t)r->total[1]}, {NULL, NULL}, {0, 0},
+                    {0, 0, 0}, {0, 0, 0}, r->read_seconds, {0, 0}, empty};
+    char fmt[2][16];
+    uint64_t faces[2] = {r->cloud[0]->n_faces, r->cloud[1]->n_faces}, sums[2];
+    MPI_Allreduce(faces, sums, 2, MPI_UINT64_T, MPI_SUM, MPI_COMM_WORLD);
+    for (int w = 0; w < 2; w++) {
+        side_format(r->cloud[w], fmt[w]);
+        rep.faces[w] = (size_t)sums[w];
+        rep.format[w] = fmt[w];
+    }
+    if (!empty) {
+        if (!a->json) { /* only the text prints coordinates: float32 data when it is on every rank */
+            int single[2] = {report_single(&r->part[0].points, &a->an.mask[0]),
+                             report_single(&r->part[1].points, &a->an.mask[1])};
+            MPI_Allreduce(single, rep.single, 2, MPI_INT, MPI_LAND, MPI_COMM_WORLD);
+        }
+        int from_a;
+        const hd_result_t *wit = report_witness(a, &r->s, &from_a);
+        fetch_point(&r->part[!from_a], wit->i, rep.wp);
+        fetch_point(&r->part[from_a], wit->j, rep.wq);
+    }
+    struct rusage ru;
+    enum { COLS = 5 }; /* per rank: seconds, peak; RSS; the distances call's seconds, peak */
+    double mine[COLS] = {r->st.seconds, (double)r->st.peak_bytes, 0, r->dst.seconds, (double)r->dst.peak_bytes};
+    double *all = rank_ == 0 ? calloc(COLS * (size_t)K_, sizeof(double)) : NULL;
+    if (getrusage(RUSAGE_SELF, &ru) == 0) mine[2] = 1024.0 * (double)ru.ru_maxrss;
+    MPI_Gather(mine, COLS, MPI_DOUBLE, all, COLS, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+    int status = EXIT_OK;
+    if (rank_ == 0) {
+        mpi_more_t more = {r, {NULL}};
+        int ok = all != NULL;
+        for (int k = 0; k < COLS && ok; k++) {
+            ok = (more.col[k] = malloc((size_t)K_ * sizeof(double))) != NULL;
+            for (int q = 0; q < K_ && ok; q++) more.col[k][q] = all[COLS * q + k];
+        }
+        if (ok) {
+            report_print(stdout, &rep, r->an.active || empty ? &r->an : NULL, empty ? NULL : mpi_more, &more);
+            status = out_finish();
+        } else {
+            fprintf(stderr, "hausdorff-mpi: out of memory\n");
+            out_discard();
+            status = EXIT_FAILURE_;
+        }
+        for (int k = 0; k < COLS; k++) free(more.col[k]);
+    }
+    free(all);
+    return status;
+}
+
+/* The run after parsing, collective: its exit status (every rank's;
+ * rank 0's is the one printed). */
+static int run(run_t *r) {
+    hd_error_t err;
+    memset(&err, 0, sizeof err);
+    int rc = read_sides(r, &err);
+    if (rc > 0) return rc; /* an output would overwrite an input: said */
+    if (rc == HD_OK) rc = !r->total[0] || !r->total[1] ? compute_empty(r, &err) : compute(r, &err);
+    if (rc != HD_OK) return fail(rc, &err);
+    return print_report(r);
 }
 
 int main(int argc, char **argv) {
@@ -325,199 +518,15 @@ int main(int argc, char **argv) {
     MPI_Comm_size(MPI_COMM_WORLD, &K_);
     quiet_others();
     out_guard_std();
-    cli_args_t a;
-    cli_set_mpi();
-    if (asks_version(argc, argv)) return print_version();
-    int rc = cli_parse(argc, argv, &a); /* the same verdict on every rank */
+    static run_t r; /* zero: what was made is freed below */
+    cli_set_mpi(print_version);
+    int rc = cli_parse(argc, argv, &r.a); /* the same verdict on every rank */
     if (rc >= 0) return finish(rc == EXIT_OK ? out_finish() : rc);
-    hd_error_t err;
-    memset(&err, 0, sizeof err);
-    tiles_t side[2];
-    memset(side, 0, sizeof side);
-    hd_cloud_t *cloud[2] = {NULL, NULL};
-    const char *paths[2] = {a.path_a, a.path_b}, *formats[2] = {a.format_a, a.format_b};
-    rc = HD_OK;
-    for (int w = 0; w < 2 && rc == HD_OK; w++) {
-        rc = tiles_expand(paths[w], formats[w], &side[w], &err);
-        if (rc == HD_OK && side[w].kind == TILES_FILE) rc = refuse_stream(paths[w], &err);
-        if ((rc = agree(rc, &err)) == HD_OK) rc = same_listing(&side[w], &err);
-    }
-    if (rc == HD_OK) { /* no output may overwrite an input: rank 0 checks */
-        int bad = rank_ == 0 ? out_check_outputs(&a, side) : 0;
-        MPI_Bcast(&bad, 1, MPI_INT, 0, MPI_COMM_WORLD);
-        if (bad) {
-            for (int w = 0; w < 2; w++) tiles_free(&side[w]);
-            return finish(bad);
-        }
-    }
-    /* Each rank reads its share of each side. */
-    double t0 = cli_now();
-    hd_mpi_part_t part[2];
-    size_t first[2] = {0, 0}, n[2] = {0, 0};
-    int split[2] = {0, 0};
-    for (int w = 0; w < 2 && rc == HD_OK; w++) {
-        int share = w ? (rank_ + K_ / 2) % K_ : rank_;
-        rc = read_split(&side[w], share, &a, &a.an, w, &split[w], &cloud[w], &part[w].offset, &err);
-        if ((rc = agree(rc, &err)) != HD_OK || split[w]) {
-            if (rc == HD_OK) part[w].points = hd_cloud_points(cloud[w]);
-            continue;
-        }
-        tiles_share(&side[w], share, K_, &first[w], &n[w]);
-        rc = tiles_read(&side[w], first[w], n[w], &a.read, &a.an, w, &cloud[w], &err);
-        if ((rc = agree(rc, &err)) == HD_OK) rc = number_tiles(&side[w], first[w], n[w], &part[w].offset, &err);
-        if (rc == HD_OK) part[w].points = hd_cloud_points(cloud[w]);
-    }
-    double read_local = cli_now() - t0, read_seconds = read_local;
-    if (rc == HD_OK) { /* an empty side (only under --empty: else reading refused it) */
-        uint64_t mine[2] = {cloud[0]->count, cloud[1]->count}, all[2];
-        MPI_Allreduce(mine, all, 2, MPI_UINT64_T, MPI_SUM, MPI_COMM_WORLD);
-        if (!all[0] || !all[1]) {
-            /* --distances: the files hausdorff writes, every row at the
-             * policy's value with nearest index -1 (a side with no point
-             * gets a file with no rows) */
-            int status = EXIT_OK;
-            if (a.an.distances_out) {
-                double v = hd_empty_value(a.an.empty, (size_t)all[0], (size_t)all[1]);
-                size_t most = part[0].points.count > part[1].points.count ? part[0].points.count
-                                                                          : part[1].points.count;
-                double *d = malloc((most ? most : 1) * sizeof *d);
-                char path_b[4096];
-                path_with_suffix(a.an.distances_out, "_b", path_b, sizeof path_b);
-                const char *path[2] = {a.an.distances_out, path_b};
-                rc = d ? HD_OK : HD_ENOMEM;
-                if (!d) snprintf(err.message, sizeof err.message, "out of memory for %zu per-point distances", most);
-                for (size_t k = 0; k < most && d; k++) d[k] = v;
-                for (int w = 0; w < (a.directed ? 1 : 2) && (rc = agree(rc, &err)) == HD_OK; w++)
-                    rc = mpi_write_distances(path[w], &part[w].points, part[w].offset, d, NULL, (size_t)all[w], 1.0,
-                                             &err);
-                free(d);
-                if (rc != HD_OK) {
-                    for (int w = 0; w < 2; w++) {
-                        hd_cloud_free(cloud[w]);
-                        tiles_free(&side[w]);
-                    }
-                    return fail(rc, &err);
-                }
-            }
-            /* the policy's answer, printed as hausdorff prints it: the
-             * views carry the counts only (the files are written) */
-            analysis_args_t printed = a.an;
-            printed.distances_out = NULL;
-            hd_points_t A = hd_points_f64(NULL, (size_t)all[0]), B = hd_points_f64(NULL, (size_t)all[1]);
-            if (rank_ == 0) status = analysis_handle_empty(&printed, a.path_a, a.path_b, &A, &B, a.directed, a.json);
-            if (rank_ == 0) status = status == EXIT_OK ? out_finish() : (out_discard(), status);
-            for (int w = 0; w < 2; w++) {
-                hd_cloud_free(cloud[w]);
-                tiles_free(&side[w]);
-            }
-            return finish(status);
-        }
-    }
-    hd_symmetric_t s;
-    hd_mpi_stats_t st;
-    memset(&s, 0, sizeof s);
-    memset(&st, 0, sizeof st);
-    if (rc == HD_OK) {
-        MPI_Allreduce(&read_local, &read_seconds, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
-        if (a.directed) {
-            rc = hd_mpi_directed(MPI_COMM_WORLD, &part[0], 1, &part[1], 1, &a.opt, &s.ab, &st, &err);
-            if (rc == HD_OK) {
-                s.distance = s.ab.distance;
-                s.seconds = s.ab.seconds;
-                rc = hd_mpi_overlap(MPI_COMM_WORLD, &part[0], 1, &part[1], 1, &s.alpha, &s.disjoint, &err);
-            }
-        } else {
-            rc = hd_mpi_hausdorff(MPI_COMM_WORLD, &part[0], 1, &part[1], 1, &a.opt, &s, &st, &err);
-        }
-    }
-    analysis_result_t an;
-    hd_mpi_stats_t dst; /* the per-point distances' call, when made */
-    memset(&an, 0, sizeof an);
-    memset(&dst, 0, sizeof dst);
-    if (rc == HD_OK && analysis_active(&a.an)) {
-        uint64_t mine[2] = {part[0].points.count, part[1].points.count}, total[2];
-        MPI_Allreduce(mine, total, 2, MPI_UINT64_T, MPI_SUM, MPI_COMM_WORLD);
-        /* as analysis_run: the distances, the figures, the files, the pictures */
-        if ((rc = distances_mpi(&a, part, total, &an, &dst, &err)) == HD_OK)
-            rc = mpi_figures(&a.an, an.d_ab, part[0].points.count, an.d_ba, part[1].points.count, &an, &err);
-        if (rc == HD_OK && a.an.distances_out) rc = distances_files_mpi(&a, part, total, &s, &an, &err);
-        if (rc == HD_OK && a.an.render_out) rc = render_mpi(&a, part, &s, &an, &err);
-    }
-    if (rc != HD_OK) {
-        analysis_free(&an);
-        for (int w = 0; w < 2; w++) {
-            hd_cloud_free(cloud[w]);
-            tiles_free(&side[w]);
-        }
-        return fail(rc, &err);
-    }
-
-    /* Everything the report shows, on rank 0. */
-    report_t r = {&a, &s, side, {(size_t)0, (size_t)0}, {NULL, NULL}, {0, 0}, {0, 0, 0}, {0, 0, 0},
-                  read_seconds, {0, 0}};
-    char fmt[2][16];
-    uint64_t counts[4] = {cloud[0]->count, cloud[1]->count, cloud[0]->n_faces, cloud[1]->n_faces}, sums[4];
-    MPI_Allreduce(counts, sums, 4, MPI_UINT64_T, MPI_SUM, MPI_COMM_WORLD);
+    rc = run(&r);
+    analysis_free(&r.an);
     for (int w = 0; w < 2; w++) {
-        side_format(cloud[w], fmt[w]);
-        r.n[w] = (size_t)sums[w];
-        r.faces[w] = (size_t)sums[2 + w];
-        r.format[w] = fmt[w];
+        hd_cloud_free(r.cloud[w]);
+        tiles_free(&r.side[w]);
     }
-    if (!a.json) { /* only the text prints coordinates: float32 data when it is on every rank */
-        int single[2] = {report_single(&part[0].points, &a.an.mask[0]), report_single(&part[1].points, &a.an.mask[1])};
-        MPI_Allreduce(single, r.single, 2, MPI_INT, MPI_LAND, MPI_COMM_WORLD);
-    }
-    int from_a;
-    const hd_result_t *wit = report_witness(&a, &s, &from_a);
-    fetch_point(&part[!from_a], wit->i, r.wp);
-    fetch_point(&part[from_a], wit->j, r.wq);
-    struct rusage ru;
-    enum { COLS = 5 }; /* per rank: seconds, peak; RSS; the distances call's seconds, peak */
-    double mine[COLS] = {st.seconds, (double)st.peak_bytes, 0, dst.seconds, (double)dst.peak_bytes};
-    double *all = rank_ == 0 ? calloc(COLS * (size_t)K_, sizeof(double)) : NULL;
-    if (getrusage(RUSAGE_SELF, &ru) == 0) mine[2] = 1024.0 * (double)ru.ru_maxrss;
-    MPI_Gather(mine, COLS, MPI_DOUBLE, all, COLS, MPI_DOUBLE, 0, MPI_COMM_WORLD);
-    int status = EXIT_OK;
-    if (rank_ == 0) {
-        double *col[COLS] = {NULL};
-        int ok = all != NULL;
-        for (int k = 0; k < COLS && ok; k++) {
-            ok = (col[k] = malloc((size_t)K_ * sizeof(double))) != NULL;
-            for (int q = 0; q < K_ && ok; q++) col[k][q] = all[COLS * q + k];
-        }
-        FILE *out = stdout;
-        if (!ok) {
-            fprintf(stderr, "hausdorff-mpi: out of memory\n");
-            status = EXIT_FAILURE_;
-        } else if (a.json) {
-            report_json(out, &r);
-            if (an.active) analysis_json(out, &a.an, &an);
-            mpi_json(out, &st, an.active ? &dst : NULL, col, split);
-            fprintf(out, "}\n");
-        } else {
-            report_text(out, &r);
-            if (an.active) analysis_print(out, &a.an, &an);
-            char b[NUM_TEXT], f[NUM_TEXT], im[NUM_TEXT];
-            fprintf(out, "mpi: %d rank%s, %s bytes moved per point, %s of the points forwarded, imbalance %s\n", K_,
-                    plural((unsigned)K_),
-                    num_ratio((double)(st.bytes_partition + st.bytes_forwarding) / (double)st.points, b),
-                    num_ratio((double)st.forwarded_points / (double)st.points, f), num_ratio(st.imbalance, im));
-            if (an.active)
-                fprintf(out, "mpi: per-point distances: %s bytes moved per point, %s of the points forwarded\n",
-                        num_ratio((double)(dst.bytes_partition + dst.bytes_forwarding + dst.bytes_returned) /
-                                      (double)dst.points, b),
-                        num_ratio((double)dst.forwarded_points / (double)dst.points, f));
-        }
-        for (int k = 0; k < COLS; k++) free(col[k]);
-        if (status == EXIT_OK) status = out_finish();
-        else out_discard();
-    }
-    free(all);
-    analysis_free(&an);
-    for (int w = 0; w < 2; w++) {
-        hd_cloud_free(cloud[w]);
-        tiles_free(&side[w]);
-    }
-    return finish(status);
+    return finish(rc);
 }

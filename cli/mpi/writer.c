@@ -58,6 +58,7 @@
 
 #include <errno.h>
 #include <fcntl.h>
+#include <limits.h>
 #include <signal.h>
 #include <stdlib.h>
 #include <string.h>
@@ -254,6 +255,27 @@ static int check_length(const char *path, const char *tmp, uint64_t end, hd_erro
     return err->code = OUT_EFAIL;
 }
 
+/* Rank 0's name (any length) on every rank, in *out from malloc; HD_OK on
+ * every rank, or HD_ENOMEM on every rank with err filled.  Collective. */
+static int share_name(const char *mine, int rank, char **out, const char *path, hd_error_t *err) {
+    unsigned long long len = rank == 0 ? strlen(mine) : 0;
+    MPI_Bcast(&len, 1, MPI_UNSIGNED_LONG_LONG, 0, MPI_COMM_WORLD);
+    int rc = HD_OK;
+    if (len >= INT_MAX || !(*out = malloc((size_t)len + 1))) {
+        snprintf(err->message, sizeof err->message, "out of memory for writing %s", path);
+        rc = err->code = HD_ENOMEM;
+    } else if (rank == 0) {
+        memcpy(*out, mine, (size_t)len + 1);
+    }
+    if ((rc = mpi_agree(rc, err)) != HD_OK) {
+        free(*out);
+        *out = NULL;
+        return rc;
+    }
+    MPI_Bcast(*out, (int)len + 1, MPI_CHAR, 0, MPI_COMM_WORLD);
+    return HD_OK;
+}
+
 int mpi_write_distances(const char *path, const hd_points_t *P, size_t first, const double *d,
                         const size_t *nearest, size_t total, double dmax, hd_error_t *err) {
     int rank;
@@ -264,7 +286,7 @@ int mpi_write_distances(const char *path, const hd_points_t *P, size_t first, co
     int rc = distances_layout(path, total, dmax, any, &lay, err); /* the same verdict on every rank */
     if (rc != HD_OK) return rc;
     signal(SIGXFSZ, SIG_IGN); /* beyond ulimit -f: EFBIG, reported */
-    char tmp[4096] = "";
+    const char *tmp0 = NULL; /* rank 0's temporary, which every rank writes by name */
     FILE *f = NULL; /* rank 0's, kept open when the target is written in place */
     int direct = 0;
     if (rank == 0) {
@@ -272,7 +294,7 @@ int mpi_write_distances(const char *path, const hd_points_t *P, size_t first, co
         if (!f) {
             rc = err->code;
         } else if (!(direct = out_is_direct(f))) {
-            snprintf(tmp, sizeof tmp, "%s", out_file_path(f));
+            tmp0 = out_file_path(f); /* out.c's: valid until the outputs are finished */
             rc = out_close(f, 0, err); /* empty: the ranks write it by name */
         }
     }
@@ -291,7 +313,11 @@ int mpi_write_distances(const char *path, const hd_points_t *P, size_t first, co
         free(buf);
         return rc;
     }
-    MPI_Bcast(tmp, (int)sizeof tmp, MPI_CHAR, 0, MPI_COMM_WORLD);
+    char *tmp = NULL;
+    if ((rc = share_name(tmp0, rank, &tmp, path, err)) != HD_OK) {
+        free(buf);
+        return rc;
+    }
     /* This rank's bytes (text rows: a first pass), its offset, the end. */
     size_t head = distances_header(&lay, (char *)buf), k = 0;
     uint64_t bytes = 0, off = 0, end = 0;
@@ -308,5 +334,6 @@ int mpi_write_distances(const char *path, const hd_points_t *P, size_t first, co
         rc = mpi_agree(rc, err);
     }
     free(buf);
+    free(tmp);
     return rc;
 }

@@ -39,11 +39,13 @@ from ._hausdorff import (
     summary,
 )
 from ._hausdorff import _mesh_distances, _read_mesh
-from ._surface import Mesh, SurfaceDistances, read_mesh
+from ._surface import (Enclosure, Mesh, SurfaceDistances, SurfaceHausdorff, SurfaceWitness, face_maxima,
+                       read_mesh, surface_hausdorff, surface_within)
 from . import masks, scores  # segmentation masks; reconstruction scores (masks.py, scores.py)
 
 __all__ = [
     "DirectedResult",
+    "Enclosure",
     "HausdorffResult",
     "Index",
     "Mesh",
@@ -51,12 +53,15 @@ __all__ = [
     "PercentileResult",
     "Summary",
     "SurfaceDistances",
+    "SurfaceHausdorff",
+    "SurfaceWitness",
     "__version__",
     "algorithms",
     "chamfer",
     "count",
     "directed",
     "distances",
+    "face_maxima",
     "formats",
     "hausdorff",
     "mean",
@@ -64,4 +69,6 @@ __all__ = [
     "read",
     "read_mesh",
     "summary",
+    "surface_hausdorff",
+    "surface_within",
 ]

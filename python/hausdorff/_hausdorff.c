@@ -51,6 +51,7 @@
 #include <float.h>
 #include <limits.h>
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 #include <time.h>
 #include <unistd.h>
@@ -177,6 +178,15 @@ static char set_letter(const char *name) {
     return name[0] >= 'a' && name[0] <= 'z' && !name[1] ? (char)(name[0] - 'a' + 'A') : '?';
 }
 
+/* v as the shortest "%.Ng" text that reads back to the same double, so that
+ * a coordinate just beyond a limit never prints equal to it. */
+static void shortest_text(char *buf, size_t size, double v) {
+    for (int digits = 1; digits <= 17; digits++) {
+        snprintf(buf, size, "%.*g", digits, v);
+        if (strtod(buf, NULL) == v) return;
+    }
+}
+
 /* Points of dims > 3 coordinates (C-ordered doubles): the library's checks,
  * its messages and codes, with a limit that keeps the sum of dims squared
  * differences finite (1e153, the library's, while dims * (2e153)^2 fits). */
@@ -192,11 +202,15 @@ static int nd_check(const double *x, size_t n, size_t dims, const char *name) {
         if (code == HD_ENONFINITE)
             snprintf(err.message, sizeof err.message, "point set %c: point %zu has %s coordinate",
                      set_letter(name), k / dims, isnan(v) ? "a NaN" : "an infinite");
-        else
+        else {
+            char vt[32], lt[32];
+            shortest_text(vt, sizeof vt, v);
+            shortest_text(lt, sizeof lt, limit);
             snprintf(err.message, sizeof err.message,
-                     "point set %c: point %zu has coordinate %g, beyond the limit %g where "
+                     "point set %c: point %zu has coordinate %s, beyond the limit %s where "
                      "squared distances in %zu dimensions could overflow",
-                     set_letter(name), k / dims, v, limit, dims);
+                     set_letter(name), k / dims, vt, lt, dims);
+        }
         raise_hd(code, &err);
         return -1;
     }
@@ -615,12 +629,12 @@ static PyStructSequence_Field summary_fields[] = {
     {"mean2_ba", "mean squared distance of B's points to A"},
     {"mean_symmetric", "max(mean_ab, mean_ba): the average Hausdorff distance"},
     {"mean_average", "(mean_ab + mean_ba) / 2"},
-    {"mean_pooled", "(sum_ab + sum_ba) / (n_ab + n_ba): MONAI's symmetric average surface "
-                    "distance, medpy's assd"},
+    {"mean_pooled", "math.fsum of both sets' distances / (n_ab + n_ba): MONAI's symmetric "
+                    "average surface distance, medpy's assd"},
     {"chamfer", "mean2_ab + mean2_ba: the Chamfer distance (as PyTorch3D)"},
-    {"chamfer_sum2", "sum2_ab + sum2_ba"},
+    {"chamfer_sum2", "math.fsum of both sets' squared distances"},
     {"chamfer_mean", "mean_ab + mean_ba: point-cloud-utils' chamfer_distance"},
-    {"chamfer_sum", "sum_ab + sum_ba"},
+    {"chamfer_sum", "math.fsum of both sets' distances"},
     {NULL, NULL},
 };
 
@@ -1757,9 +1771,11 @@ static PyArrayObject *faces_array(PyObject *obj) {
 
 static PyObject *py_mesh_distances(PyObject *self, PyObject *args, PyObject *kw) {
     (void)self;
-    static char *kwlist[] = {"points", "vertices", "faces", "threads", NULL};
+    static char *kwlist[] = {"points", "vertices", "faces", "threads", "signed", NULL};
     PyObject *op, *ov, *of, *threads = Py_None;
-    if (!PyArg_ParseTupleAndKeywords(args, kw, "OOO|$O:_mesh_distances", kwlist, &op, &ov, &of, &threads))
+    int want_sign = 0;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "OOO|$Op:_mesh_distances", kwlist, &op, &ov, &of, &threads,
+                                     &want_sign))
         return NULL;
     hd_options_t opt;
     if (parse_options(NULL, threads, NULL, &opt)) return NULL;
@@ -1771,26 +1787,32 @@ static PyObject *py_mesh_distances(PyObject *self, PyObject *args, PyObject *kw)
     }
     PyArrayObject *f = faces_array(of);
     npy_intp n = (npy_intp)p.pts.count, n3[2] = {n, 3};
-    PyArrayObject *dist = NULL, *face = NULL, *closest = NULL, *bary = NULL;
+    PyArrayObject *dist = NULL, *face = NULL, *closest = NULL, *bary = NULL, *sign = NULL;
     PyObject *res = NULL;
     if (f) {
         dist = (PyArrayObject *)PyArray_SimpleNew(1, &n, NPY_DOUBLE);
         face = (PyArrayObject *)PyArray_SimpleNew(1, &n, NPY_INTP);
         closest = (PyArrayObject *)PyArray_SimpleNew(2, n3, NPY_DOUBLE);
         bary = (PyArrayObject *)PyArray_SimpleNew(2, n3, NPY_DOUBLE);
+        if (want_sign) sign = (PyArrayObject *)PyArray_SimpleNew(1, &n, NPY_INT8);
     }
-    if (dist && face && closest && bary) {
+    if (dist && face && closest && bary && (sign || !want_sign)) {
         hd_mesh_t M = {v.pts, PyArray_DATA(f), (size_t)PyArray_DIM(f, 0), HD_INDEX_U64};
         hd_surface_result_t r;
         hd_error_t err;
         int rc;
         Py_BEGIN_ALLOW_THREADS
-        rc = hd_mesh_distances(&p.pts, &M, &opt, PyArray_DATA(dist), PyArray_DATA(face), PyArray_DATA(closest),
-                               PyArray_DATA(bary), &r, &err);
+        if (want_sign)
+            rc = hd_mesh_signed_distances(&p.pts, &M, &opt, PyArray_DATA(dist), PyArray_DATA(face),
+                                          PyArray_DATA(closest), PyArray_DATA(bary), PyArray_DATA(sign), &r, &err);
+        else
+            rc = hd_mesh_distances(&p.pts, &M, &opt, PyArray_DATA(dist), PyArray_DATA(face), PyArray_DATA(closest),
+                                   PyArray_DATA(bary), &r, &err);
         Py_END_ALLOW_THREADS
         if (rc == HD_OK)
-            res = Py_BuildValue("(OOOOdnnn)", dist, face, closest, bary, r.distance, (Py_ssize_t)r.i,
-                                (Py_ssize_t)r.triangle, (Py_ssize_t)r.n_degenerate);
+            res = Py_BuildValue("(OOOOdnnnO)", dist, face, closest, bary, r.distance, (Py_ssize_t)r.i,
+                                (Py_ssize_t)r.triangle, (Py_ssize_t)r.n_degenerate,
+                                sign ? (PyObject *)sign : Py_None);
         else
             raise_hd(rc, &err);
     }
@@ -1798,9 +1820,134 @@ static PyObject *py_mesh_distances(PyObject *self, PyObject *args, PyObject *kw)
     Py_XDECREF(face);
     Py_XDECREF(closest);
     Py_XDECREF(bary);
+    Py_XDECREF(sign);
     Py_XDECREF(f);
     points_release(&p);
     points_release(&v);
+    return res;
+}
+
+/* ------------------------------------------------------------------------
+ * Surface to surface: enclosures (hausdorff.surface_hausdorff etc. in
+ * _surface.py).
+ * ---------------------------------------------------------------------- */
+
+/* An enclosure as a tuple (lower, upper, tolerance, converged, face_a,
+ * index_a, bary_a, point_a, witness_distance, witness_error, face_b,
+ * index_b, point_b, faces_dropped, faces_split, kernel_calls, seconds);
+ * SIZE_MAX indices as -1. */
+static PyObject *enclosure_tuple(const hd_enclosure_t *e) {
+#define HD__IX(v) ((v) == SIZE_MAX ? (Py_ssize_t)-1 : (Py_ssize_t)(v))
+    return Py_BuildValue("(ddd" "Onn" "(ddd)(ddd)" "dd" "nn(ddd)" "KKKd)", e->lower, e->upper, e->tolerance,
+                         e->converged ? Py_True : Py_False, HD__IX(e->face_a), HD__IX(e->index_a), e->bary_a[0],
+                         e->bary_a[1], e->bary_a[2], e->point_a[0], e->point_a[1], e->point_a[2],
+                         e->witness_distance, e->witness_error, HD__IX(e->face_b), HD__IX(e->index_b),
+                         e->point_b[0], e->point_b[1], e->point_b[2], (unsigned long long)e->faces_dropped,
+                         (unsigned long long)e->faces_split, (unsigned long long)e->kernel_calls, e->seconds);
+#undef HD__IX
+}
+
+/* A mesh argument: its vertices and faces held until mesh_release. */
+typedef struct mesh_arg {
+    points_arg_t v;
+    PyArrayObject *f;
+    hd_mesh_t m;
+} mesh_arg_t;
+
+static void mesh_release(mesh_arg_t *m) {
+    points_release(&m->v);
+    Py_XDECREF(m->f);
+    m->f = NULL;
+}
+
+static int mesh_from_objects(PyObject *ov, PyObject *of, const char *name, mesh_arg_t *out) {
+    memset(out, 0, sizeof *out);
+    if (points_from_object(ov, name, HD_EMPTY_ERROR, &out->v)) return -1;
+    out->f = faces_array(of);
+    if (!out->f) {
+        points_release(&out->v);
+        return -1;
+    }
+    hd_mesh_t m = {out->v.pts, PyArray_DATA(out->f), (size_t)PyArray_DIM(out->f, 0), HD_INDEX_U64};
+    out->m = m;
+    return 0;
+}
+
+static int surface_options(double tolerance, int relative, PyObject *threads, unsigned long long max_splits,
+                           hd_surface_options_t *o) {
+    hd_surface_options_init(o);
+    o->tolerance = tolerance;
+    o->relative = relative;
+    o->max_splits = max_splits;
+    return parse_threads(threads, &o->threads);
+}
+
+/* _surface_hausdorff(a_vertices, a_faces, b_vertices, b_faces, *, tolerance,
+ * relative, threads, max_splits, directed, d, what): b_faces None makes B a
+ * point set; what "hausdorff" -> (ab, ba or None), "within" -> (answer,
+ * ab, ba), "faces" -> (face_lower, face_upper, ab). */
+static PyObject *py_surface(PyObject *self, PyObject *args, PyObject *kw) {
+    (void)self;
+    static char *kwlist[] = {"a_vertices", "a_faces", "b_vertices", "b_faces", "tolerance", "relative",
+                             "threads", "max_splits", "directed", "d", "what", NULL};
+    PyObject *oav, *oaf, *obv, *obf, *threads = Py_None;
+    double tolerance = 1e-9, d = 0;
+    int relative = 1, directed = 0;
+    unsigned long long max_splits = 1ull << 20;
+    const char *what = "hausdorff";
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "OOOO|$dpOKpds:_surface", kwlist, &oav, &oaf, &obv, &obf,
+                                     &tolerance, &relative, &threads, &max_splits, &directed, &d, &what))
+        return NULL;
+    hd_surface_options_t o;
+    if (surface_options(tolerance, relative, threads, max_splits, &o)) return NULL;
+    mesh_arg_t a, b;
+    memset(&b, 0, sizeof b);
+    if (mesh_from_objects(oav, oaf, "A's vertices", &a)) return NULL;
+    int points = obf == Py_None;
+    int bad = points ? points_from_object(obv, "B", HD_EMPTY_ERROR, &b.v) : mesh_from_objects(obv, obf, "B's vertices", &b);
+    if (bad) {
+        mesh_release(&a);
+        return NULL;
+    }
+    hd_enclosure_t ab, ba;
+    hd_error_t err;
+    int rc = HD_OK, answer = -1, faces = strcmp(what, "faces") == 0, within = strcmp(what, "within") == 0;
+    PyArrayObject *lo = NULL, *hi = NULL;
+    if (faces) {
+        npy_intp n = (npy_intp)a.m.n_triangles;
+        lo = (PyArrayObject *)PyArray_SimpleNew(1, &n, NPY_DOUBLE);
+        hi = (PyArrayObject *)PyArray_SimpleNew(1, &n, NPY_DOUBLE);
+        if (!lo || !hi) rc = HD_ENOMEM;
+    }
+    if (rc == HD_OK) {
+        Py_BEGIN_ALLOW_THREADS
+        if (faces) rc = hd_surface_face_maxima(&a.m, &b.m, &o, PyArray_DATA(lo), PyArray_DATA(hi), &ab, &err);
+        else if (within) rc = hd_surface_within(&a.m, &b.m, d, directed, &o, &answer, &ab, &ba, &err);
+        else if (points) rc = hd_surface_points_hausdorff(&a.m, &b.v.pts, &o, &ab, directed ? NULL : &ba, &err);
+        else rc = hd_surface_hausdorff(&a.m, &b.m, &o, &ab, directed ? NULL : &ba, &err);
+        Py_END_ALLOW_THREADS
+    }
+    PyObject *res = NULL;
+    if (rc == HD_ENOMEM && faces && (!lo || !hi)) {
+        if (!PyErr_Occurred()) PyErr_NoMemory();
+    } else if (rc != HD_OK) {
+        raise_hd(rc, &err);
+    } else if (faces) {
+        res = Py_BuildValue("(OON)", lo, hi, enclosure_tuple(&ab));
+    } else {
+        PyObject *pa = enclosure_tuple(&ab), *pb = NULL;
+        if (directed && !within) {
+            pb = Py_None;
+            Py_INCREF(pb);
+        } else {
+            pb = enclosure_tuple(&ba);
+        }
+        res = within ? Py_BuildValue("(iNN)", answer, pa, pb) : Py_BuildValue("(NN)", pa, pb);
+    }
+    Py_XDECREF(lo);
+    Py_XDECREF(hi);
+    mesh_release(&a);
+    mesh_release(&b);
     return res;
 }
 
@@ -1844,9 +1991,12 @@ static PyObject *py_read_mesh(PyObject *self, PyObject *args, PyObject *kw) {
 
 static PyMethodDef module_methods[] = {
     {"_mesh_distances", (PyCFunction)(void (*)(void))py_mesh_distances, METH_VARARGS | METH_KEYWORDS,
-     "_mesh_distances(points, vertices, faces, *, threads=None): hausdorff.Mesh.distances's engine"},
+     "_mesh_distances(points, vertices, faces, *, threads=None, signed=False): hausdorff.Mesh.distances's engine"},
     {"_read_mesh", (PyCFunction)(void (*)(void))py_read_mesh, METH_VARARGS | METH_KEYWORDS,
      "_read_mesh(path, *, format=None): hausdorff.read_mesh's engine"},
+    {"_surface", (PyCFunction)(void (*)(void))py_surface, METH_VARARGS | METH_KEYWORDS,
+     "_surface(a_vertices, a_faces, b_vertices, b_faces, *, tolerance, relative, threads, max_splits, "
+     "directed, d, what): the engine of hausdorff.surface_hausdorff, surface_within and face_maxima"},
     {"directed", (PyCFunction)(void (*)(void))py_directed, METH_VARARGS | METH_KEYWORDS,
      directed_doc},
     {"hausdorff", (PyCFunction)(void (*)(void))py_hausdorff, METH_VARARGS | METH_KEYWORDS,

@@ -1,6 +1,6 @@
 """Type stubs of the hausdorff C extension (see the docstrings for details)."""
 import os
-from typing import Dict, List, Literal, Optional, Sequence, Tuple, Union, overload
+from typing import Any, Dict, List, Literal, Optional, Sequence, Tuple, Union, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -216,15 +216,16 @@ class Index:
     ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.intp]]: ...
 
 def _mesh_distances(
-    points: Points, vertices: Points, faces: npt.ArrayLike, *, threads: Optional[int] = None
+    points: Points, vertices: Points, faces: npt.ArrayLike, *, threads: Optional[int] = None,
+    signed: bool = False
 ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.intp], npt.NDArray[np.float64],
-           npt.NDArray[np.float64], float, int, int, int]: ...
+           npt.NDArray[np.float64], float, int, int, int, Optional[npt.NDArray[np.int8]]]: ...
 def _read_mesh(
     path: Union[str, bytes, os.PathLike[str], os.PathLike[bytes]], *, format: Optional[str] = None
 ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.intp], int, int, str]: ...
 
 class SurfaceDistances(Tuple[npt.NDArray[np.float64], npt.NDArray[np.intp], npt.NDArray[np.float64],
-                             npt.NDArray[np.float64], float, int, int]):
+                             npt.NDArray[np.float64], float, int, int, Optional[npt.NDArray[np.int8]]]):
     distances: npt.NDArray[np.float64]
     faces: npt.NDArray[np.intp]
     closest: npt.NDArray[np.float64]
@@ -232,13 +233,64 @@ class SurfaceDistances(Tuple[npt.NDArray[np.float64], npt.NDArray[np.intp], npt.
     distance: float
     i: int
     face: int
+    signs: Optional[npt.NDArray[np.int8]]
 
 class Mesh:
     vertices: npt.NDArray[np.generic]
     faces: npt.NDArray[np.generic]
     def __init__(self, vertices: Points, faces: npt.ArrayLike) -> None: ...
-    def distances(self, points: Points, *, threads: Optional[int] = None) -> SurfaceDistances: ...
+    def distances(
+        self, points: Points, *, threads: Optional[int] = None, signed: bool = False
+    ) -> SurfaceDistances: ...
 
 def read_mesh(
     path: Union[str, bytes, os.PathLike[str], os.PathLike[bytes]], *, format: Optional[str] = None
 ) -> Mesh: ...
+
+def _surface(
+    a_vertices: Points, a_faces: npt.ArrayLike, b_vertices: Points, b_faces: Optional[npt.ArrayLike], *,
+    tolerance: float = 1e-9, relative: bool = True, threads: Optional[int] = None, max_splits: int = 1 << 20,
+    directed: bool = False, d: float = 0.0, what: str = "hausdorff"
+) -> Tuple[Any, ...]: ...
+
+class SurfaceWitness(Tuple[int, int, Tuple[float, float, float], Tuple[float, float, float], float, float,
+                           int, int, Tuple[float, float, float]]):
+    face_a: int
+    index_a: int
+    bary_a: Tuple[float, float, float]
+    point_a: Tuple[float, float, float]
+    distance: float
+    error: float
+    face_b: int
+    index_b: int
+    point_b: Tuple[float, float, float]
+
+class Enclosure(Tuple[float, float, float, bool, SurfaceWitness, int, int, int, float]):
+    lower: float
+    upper: float
+    tolerance: float
+    converged: bool
+    witness: SurfaceWitness
+    faces_dropped: int
+    faces_split: int
+    kernel_calls: int
+    seconds: float
+
+class SurfaceHausdorff(Tuple[float, float, Enclosure, Optional[Enclosure]]):
+    lower: float
+    upper: float
+    ab: Enclosure
+    ba: Optional[Enclosure]
+
+def surface_hausdorff(
+    a: Mesh, b: Union[Mesh, Points], *, tolerance: float = 1e-9, relative: bool = True,
+    directed: bool = False, threads: Optional[int] = None, max_splits: int = 1 << 20
+) -> SurfaceHausdorff: ...
+def surface_within(
+    a: Mesh, b: Mesh, d: float, *, directed: bool = False, tolerance: float = 1e-9, relative: bool = True,
+    threads: Optional[int] = None, max_splits: int = 1 << 20
+) -> Optional[bool]: ...
+def face_maxima(
+    a: Mesh, b: Mesh, *, tolerance: float = 1e-9, relative: bool = True, threads: Optional[int] = None,
+    max_splits: int = 1 << 20
+) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], Enclosure]: ...

@@ -164,6 +164,13 @@ def test_more_coordinates_check_values_as_the_library_does():
         hausdorff.Index(normal(585, 5, 4))
 
 
+def test_a_coordinate_just_beyond_the_limit_prints_unlike_the_limit():
+    a = np.zeros((2, 4))
+    a[1, 2] = np.nextafter(1e153, np.inf)
+    with pytest.raises(ValueError, match=r"coordinate 1\.0000000000000002e\+153, beyond the limit 1e\+153 "):
+        hausdorff.directed(a, a[:1])
+
+
 def test_a_line_whose_gaps_grow_is_exact_in_any_visiting_order():
     """Nearest distances increase along the line: an order that met the
     points in that order would scan all of B for each of them."""

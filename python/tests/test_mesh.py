@@ -63,3 +63,68 @@ def test_bad_meshes_raise_with_the_face_named():
         hausdorff.Mesh(SQUARE.vertices, [[0.5, 1, 2]]).distances([[0, 0, 1]])
     with pytest.raises(ValueError, match="has no faces"):
         hausdorff.read_mesh(pathlib.Path(__file__).resolve().parents[2] / "data" / "pinion_gear.ply")
+
+
+# ---- signed distances ---------------------------------------------------------
+
+CUBE_V = [[x, y, z] for z in (0, 1) for y in (0, 1) for x in (0, 1)]
+CUBE_F = [[0, 2, 3], [0, 3, 1], [4, 5, 7], [4, 7, 6], [0, 1, 5], [0, 5, 4],
+          [2, 6, 7], [2, 7, 3], [0, 4, 6], [0, 6, 2], [1, 3, 7], [1, 7, 5]]
+CUBE = hausdorff.Mesh(CUBE_V, CUBE_F)
+
+
+def test_signs_inside_outside_and_on_the_surface():
+    pts = [[0.5, 0.5, 0.5], [2.0, 0.5, 0.5], [-1.0, 0.0, 0.0], [0.5, 0.0, 0.0], [2.0, 0.5, 0.0],
+           [0.25, 0.5, 0.5]]
+    r = CUBE.distances(pts, signed=True)
+    assert r.signs.dtype == np.int8
+    assert r.signs.tolist() == [-1, 1, 1, 0, 1, -1]
+    assert (r.signs * r.distances).tolist() == [-0.5, 1.0, 1.0, 0.0, 1.0, -0.25]
+    assert CUBE.distances(pts).signs is None
+
+
+def test_signed_keeps_every_other_output_and_thread_count():
+    mesh = hausdorff.read_mesh(DATA / "cow.off")
+    rng = np.random.default_rng(7)
+    lo, hi = mesh.vertices.min(0), mesh.vertices.max(0)
+    pts = lo - 0.2 * (hi - lo) + 1.4 * (hi - lo) * rng.random((3000, 3))
+    plain = mesh.distances(pts)
+    one = mesh.distances(pts, signed=True, threads=1)
+    three = mesh.distances(pts, signed=True, threads=3)
+    for k in range(7):
+        assert np.array_equal(plain[k], one[k])
+    assert np.array_equal(one.signs, three.signs)
+    assert set(np.unique(one.signs)) <= {-1, 0, 1} and (one.signs == -1).any() and (one.signs == 1).any()
+
+
+def test_signs_match_a_ball():
+    # The cube's points against a polyhedral approximation is covered in C; here
+    # a sphere from the cube's vertices refined: inside the inscribed ball is
+    # inside, outside the circumscribed one outside.
+    u, v = np.meshgrid(np.linspace(0, np.pi, 17)[1:-1], np.linspace(0, 2 * np.pi, 33)[:-1], indexing="ij")
+    ring = np.stack([np.sin(u) * np.cos(v), np.sin(u) * np.sin(v), np.cos(u)], -1).reshape(-1, 3)
+    verts = np.vstack([[0, 0, 1], [0, 0, -1], ring])
+    faces, nu, nv = [], 15, 32
+    at = lambda i, j: 2 + i * nv + j % nv  # noqa: E731
+    for j in range(nv):
+        faces.append([0, at(0, j), at(0, j + 1)])
+        faces.append([1, at(nu - 1, j + 1), at(nu - 1, j)])
+        for i in range(nu - 1):
+            faces.append([at(i, j), at(i + 1, j), at(i + 1, j + 1)])
+            faces.append([at(i, j), at(i + 1, j + 1), at(i, j + 1)])
+    ball = hausdorff.Mesh(verts, faces)
+    pts = np.random.default_rng(1).uniform(-1.5, 1.5, (4000, 3))
+    s = ball.distances(pts, signed=True).signs
+    radius = np.linalg.norm(pts, axis=1)
+    assert (s[radius < 0.97] == -1).all() and (s[radius > 1.0] == 1).all()
+
+
+def test_open_or_flipped_meshes_are_refused_for_signs():
+    with pytest.raises(ValueError, match="not closed: the edge between vertices"):
+        hausdorff.Mesh(CUBE_V, CUBE_F[:-1]).distances([[0.5, 0.5, 0.5]], signed=True)
+    flipped = [f[::-1] if k == 4 else f for k, f in enumerate(CUBE_F)]
+    with pytest.raises(ValueError, match="not consistently oriented"):
+        hausdorff.Mesh(CUBE_V, flipped).distances([[0.5, 0.5, 0.5]], signed=True)
+    with pytest.raises(ValueError, match=r"is used by triangle \d+ alone \(a boundary\)"):
+        hausdorff.read_mesh(DATA / "Wuson.stl").distances([[0, 0, 0]], signed=True)
+    assert SQUARE.distances([[0, 0, 1]]).distances.tolist() == [1.0]  # open meshes still measure

@@ -102,7 +102,9 @@ def test_summary_agrees_with_exact_sums_of_the_brute_force(case):
         assert got == math.fsum(values)  # correctly rounded, whatever the order
     assert s.mean_ab == s.sum_ab / len(a) and s.mean2_ba == s.sum2_ba / len(b)
     assert s.mean_symmetric == max(s.mean_ab, s.mean_ba)
-    assert s.mean_pooled == (s.sum_ab + s.sum_ba) / (len(a) + len(b))
+    both = np.concatenate([d_ab, d_ba])
+    assert s.mean_pooled == math.fsum(both) / (len(a) + len(b))
+    assert s.chamfer_sum == math.fsum(both) and s.chamfer_sum2 == math.fsum(both * both)
     assert s.chamfer == s.mean2_ab + s.mean2_ba
 
 

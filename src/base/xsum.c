@@ -183,8 +183,12 @@ double hd__xsum_values(hd__xsum_t *sum, hd__xsum_t *sum2, const double *d, size_
 }
 
 /* The figures from sums given scaled by 2^-k (sum[0..3]: A's sum and sum
- * of squares, then B's), each figure scaled back by 2^k. */
-static void figures(hd_summary_t *out, size_t n_a, size_t n_b, const double sum[4], int k) {
+ * of squares, then B's; sum[4..5]: the sum and the sum of squares of both
+ * sets' distances together, each rounded once), each figure scaled back by
+ * 2^k.  The pooled figures come from sum[4..5], not from sum[0] + sum[2]:
+ * adding two rounded sums rounds twice, and the pooled mean would then differ
+ * from math.fsum of all the distances over their count. */
+static void figures(hd_summary_t *out, size_t n_a, size_t n_b, const double sum[6], int k) {
     out->n_ab = n_a;
     out->n_ba = n_b;
     out->sum_ab = ldexp(sum[0], k);
@@ -203,11 +207,11 @@ static void figures(hd_summary_t *out, size_t n_a, size_t n_b, const double sum[
     out->mean2_ba = ldexp(mean2_ba, k);
     out->mean_symmetric = ldexp(mean_ab >= mean_ba ? mean_ab : mean_ba, k);
     out->mean_average = ldexp((mean_ab + mean_ba) / 2.0, k);
-    out->mean_pooled = ldexp((sum[0] + sum[2]) / ((double)n_a + (double)n_b), k);
+    out->mean_pooled = ldexp(sum[4] / ((double)n_a + (double)n_b), k);
     out->chamfer = ldexp(mean2_ab + mean2_ba, k);
-    out->chamfer_sum2 = ldexp(sum[1] + sum[3], k);
+    out->chamfer_sum2 = ldexp(sum[5], k);
     out->chamfer_mean = ldexp(mean_ab + mean_ba, k);
-    out->chamfer_sum = ldexp(sum[0] + sum[2], k);
+    out->chamfer_sum = ldexp(sum[4], k);
 }
 
 /* The figures of hd_summary_t that are computed, in the struct's order. */
@@ -217,8 +221,14 @@ static void figures(hd_summary_t *out, size_t n_a, size_t n_b, const double sum[
 
 void hd__summary_derive(hd_summary_t *out, size_t n_a, double max_ab, size_t n_b, double max_ba,
                         const hd__xsum_t sums[4]) {
-    double r[4];
-    for (int j = 0; j < 4; j++) r[j] = j < 2 || n_b ? hd__xsum_round(&sums[j]) : NAN;
+    hd__xsum_t both[2] = {sums[0], sums[1]};
+    if (n_b) {
+        hd__xsum_merge(&both[0], &sums[2]);
+        hd__xsum_merge(&both[1], &sums[3]);
+    }
+    const hd__xsum_t *all[6] = {&sums[0], &sums[1], &sums[2], &sums[3], &both[0], &both[1]};
+    double r[6];
+    for (int j = 0; j < 6; j++) r[j] = j < 2 || n_b ? hd__xsum_round(all[j]) : NAN;
     figures(out, n_a, n_b, r, 0);
     int overflowed = 0;
 #define HD__INF(f) overflowed |= isinf(out->f);
@@ -230,7 +240,7 @@ void hd__summary_derive(hd_summary_t *out, size_t n_a, double max_ab, size_t n_b
          * above); a figure still infinite is beyond DBL_MAX (or a sum
          * holds an infinity). */
         hd_summary_t big;
-        for (int j = 0; j < 4; j++) r[j] = j < 2 || n_b ? hd__xsum_round_scaled(&sums[j], SCALE) : NAN;
+        for (int j = 0; j < 6; j++) r[j] = j < 2 || n_b ? hd__xsum_round_scaled(all[j], SCALE) : NAN;
         figures(&big, n_a, n_b, r, SCALE);
 #define HD__FINITE(f) if (isinf(out->f)) out->f = big.f;
         FIGURES(HD__FINITE)

@@ -58,6 +58,24 @@ static int face_ref(const char *tb, const char *te, int64_t *value) {
     return 1;
 }
 
+/* What may follow a vertex's x y z: numbers (w, or a colour r g b some
+ * writers append) and a comment.  Anything else - another statement on the
+ * same line, "v 1 2 3 v 4 5 6" - would otherwise lose a vertex without a
+ * word: 1 when the tail is acceptable, 0 after failing the chunk. */
+static int vertex_tail(hd__chunk_t *c, const char *q, const char *eol, long long line) {
+    const char *tb, *te;
+    double ignored;
+    int k;
+    while ((k = hd__next_double(&q, eol, &ignored, &tb, &te)) != 0) {
+        if (k > 0) continue;
+        if (*tb == '#') return 1;
+        hd__chunk_fail(c, HD_EFORMAT, line, "vertex: '%.*s' after x y z is not a number (one statement a line)",
+                       (int)(te - tb > 40 ? 40 : te - tb), tb);
+        return 0;
+    }
+    return 1;
+}
+
 static void chunk(void *ctx, hd__chunk_t *c) {
     const int *want_faces = ctx;
     const char *p = c->begin, *end = c->end, *tb, *te;
@@ -67,7 +85,9 @@ static void chunk(void *ctx, hd__chunk_t *c) {
         line++;
         if (!hd__token(&q, eol, &tb, &te) || te - tb != 1) continue;
         if (*tb == 'v') {
-            if (!hd__chunk_vertex(c, &q, eol, line, "vertex: ", "vertex: expected x y z", 0)) return;
+            if (!hd__chunk_vertex(c, &q, eol, line, "vertex: ", "vertex: expected x y z", 0) ||
+                !vertex_tail(c, q, eol, line))
+                return;
         } else if (*tb == 'f') {
             c->aux++;
             if (!*want_faces) continue;

@@ -12,14 +12,20 @@
  * stop at MAX_LEVEL (weights below 2^63).
  *
  * Computed corners.  A corner's point is computed in doubles as
- * fl(fl(w0 a) + fl(w1 b)) + fl(w2 c) with w = fl(k) 2^-L: each weight is
- * off by at most u w (u = 2^-53), each of the five operations adds at most
- * u of its result or 2^-1075 on underflow, so per coordinate the error is
- * at most (u + gamma_3 (1 + u)) M_k + 3 2^-1075 <= 4.01 u M_k + 2^-1072,
- * with M_k the largest |coordinate k| of the face's corners, and over the
- * three coordinates at most 4.01 u (Mx + My + Mz) + 2^-1070.  slack() uses
- * 8 u (Mx + My + Mz) + 2^-1060: e.  A corner that is a vertex of the face
- * (one weight 2^L) is that vertex, exactly (e = 0).
+ * x = fl(a + fl(fl(w1 fl(b - a)) + fl(w2 fl(c - a)))) with w = fl(k) 2^-L
+ * (each weight off by at most u w, u = 2^-53; ldexp is exact for
+ * 2^-62 <= w <= 1).  Per coordinate, with s* = w1 (b - a) + w2 (c - a)
+ * and the computed sum s: each product is within gamma_3 of w (b - a)
+ * (difference, weight, product), so |s - s*| <= (gamma_3 + u (1 +
+ * gamma_3)) (w1 |b - a| + w2 |c - a|) + 3 2^-1075 <= 4.01 u D_k + 2^-1073
+ * with D_k = max(|b_k - a_k|, |c_k - a_k|) (w1 + w2 <= 1), and the last
+ * addition adds at most u |a + s| <= u M_k (1 + 5u) with M_k the largest
+ * |coordinate k| of the corners (x* lies in their hull).  Over the three
+ * coordinates: at most 1.01 u (Mx + My + Mz) + 4.01 u (Dx + Dy + Dz) +
+ * 2^-1071.  slack() uses e = 2 u sum M + 8 u sum D + 2^-1060 (the computed
+ * differences are within a factor 1 + u of the exact ones).  A corner that
+ * is a vertex of the face (one weight 2^L) is that vertex, exactly
+ * (e = 0).
  *
  * Bounds.  Each corner v gets r = RN(d(v, Y)) from the exact kernel through
  * the tree (hd__bvh_nearest), so d(v, Y) <= next_up(r).
@@ -73,8 +79,18 @@
 /* Below this a squared edge may have underflowed: R from |dx|+|dy|+|dz|. */
 #define TINY2 0x1p-960
 
-static double up(double x) { return nextafter(x, INFINITY); }
-static double down(double x) { return nextafter(x, -INFINITY); }
+/* The next double up (down) from a finite x, as nextafter(x, +-infinity)
+ * gives it (inline: the bounds take several a sub-triangle). */
+static double up(double x) {
+    uint64_t b;
+    memcpy(&b, &x, sizeof b);
+    if (x == 0) return 0x1p-1074;
+    if (!isfinite(x)) return x;
+    b += x > 0 ? 1 : (uint64_t)-1;
+    memcpy(&x, &b, sizeof b);
+    return x;
+}
+static double down(double x) { return -up(-x); }
 static double sqrt_up(double x) { return x <= 0 ? 0 : up(sqrt(x)); }
 
 typedef struct corner {
@@ -113,12 +129,14 @@ typedef struct face {
 } face_t;
 
 static double slack(const hd__tri_t *t) {
-    double m = 0;
+    double m = 0, d = 0;
     for (int k = 0; k < 3; k++) {
         double mk = fmax(fabs(t->v[0][k]), fmax(fabs(t->v[1][k]), fabs(t->v[2][k])));
+        double dk = fmax(fabs(t->v[1][k] - t->v[0][k]), fabs(t->v[2][k] - t->v[0][k]));
         m = up(m + mk);
+        d = up(d + dk);
     }
-    return up(m * 0x1p-50 + 0x1p-1060);
+    return up(up(m * 0x1p-52 + d * 0x1p-50) + 0x1p-1060);
 }
 
 /* The corner's point from its weights at `level` (see the top). */
@@ -129,20 +147,17 @@ static void corner_point(const hd__tri_t *t, corner_t *c, int level) {
             memcpy(c->p, t->v[j], sizeof c->p);
             return;
         }
-    double w[3];
-    for (int j = 0; j < 3; j++) w[j] = ldexp((double)c->k[j], -level);
-    for (int d = 0; d < 3; d++) c->p[d] = w[0] * t->v[0][d] + w[1] * t->v[1][d] + w[2] * t->v[2][d];
+    double w1 = ldexp((double)c->k[1], -level), w2 = ldexp((double)c->k[2], -level);
+    for (int d = 0; d < 3; d++) {
+        double d1 = t->v[1][d] - t->v[0][d], d2 = t->v[2][d] - t->v[0][d];
+        c->p[d] = t->v[0][d] + (w1 * d1 + w2 * d2);
+    }
 }
 
 static int is_vertex(const corner_t *c, int level) {
     uint64_t one = (uint64_t)1 << level;
     return c->k[0] == one || c->k[1] == one || c->k[2] == one;
 }
-
-typedef struct ctx {
-    const hd__m2m_job_t *job;
-    face_t *faces;
-} ctx_t;
 
 static void evaluate(const hd__m2m_job_t *J, const hd__tri_t *t, double e, corner_t *c, int level, size_t seed,
                      hd__bvh_stats_t *st) {
@@ -270,18 +285,35 @@ static int shared_convex(const hd__tri_t *s, const hd__tri_t *t) {
     return convex_pair(s->v[ip], s->v[iq], s->v[ia], t->v[jb]);
 }
 
+/* A worker's prepared triangles of Y, by position in the tree (direct
+ * mapped): hd__tri_bounds_prep gives hd__tri_bounds's bits. */
+#define CACHE 1024
+typedef struct cache {
+    size_t pos[CACHE];
+    hd__tri_prep_t prep[CACHE];
+} cache_t;
+
+static const hd__tri_prep_t *prepared(cache_t *C, size_t pos, const hd__tri_t *t) {
+    size_t k = pos & (CACHE - 1);
+    if (C->pos[k] != pos) {
+        hd__tri_prep(t->v[0], t->v[1], t->v[2], &C->prep[k]);
+        C->pos[k] = pos;
+    }
+    return &C->prep[k];
+}
+
 /* d(v, t) <= this (v's own nearest triangle: next_up(r)). */
-static double corner_to(const corner_t *c, size_t pos, const hd__tri_t *t, uint64_t *kernel) {
+static double corner_to(const corner_t *c, size_t pos, const hd__tri_t *t, cache_t *C, uint64_t *kernel) {
     if (c->pos == pos) return up(c->r);
     double lo2, hi2;
-    hd__tri_bounds(c->p, t->v[0], t->v[1], t->v[2], &lo2, &hi2);
+    hd__tri_bounds_prep(c->p, prepared(C, pos, t), &lo2, &hi2);
     (*kernel)++;
     return sqrt_up(hi2);
 }
 
 /* Over a convex union W of two triangles of Y, the distance to W is convex
  * too: its largest value over the sub-triangle is at a corner. */
-static double pair_bound(const hd__m2m_job_t *J, const sub_t *s, double U, uint64_t *kernel) {
+static double pair_bound(const hd__m2m_job_t *J, const sub_t *s, double U, cache_t *C, uint64_t *kernel) {
     for (int i = 0; i < 3; i++)
         for (int j = i + 1; j < 3; j++) {
             size_t p1 = s->c[i].pos, p2 = s->c[j].pos;
@@ -290,16 +322,21 @@ static double pair_bound(const hd__m2m_job_t *J, const sub_t *s, double U, uint6
             if (!shared_convex(t1, t2)) continue;
             double m = 0;
             for (int k = 0; k < 3 && m < U; k++)
-                m = fmax(m, fmin(corner_to(&s->c[k], p1, t1, kernel), corner_to(&s->c[k], p2, t2, kernel)));
+                m = fmax(m, fmin(corner_to(&s->c[k], p1, t1, C, kernel), corner_to(&s->c[k], p2, t2, C, kernel)));
             U = fmin(U, m);
         }
     return U;
 }
 
-static double upper_of(const hd__m2m_job_t *J, const sub_t *s, double e, uint64_t *kernel) {
+/* The sub-triangle's upper bound; once the point bound alone is at most
+ * `enough` (the sub-triangle will be discarded whatever its bound) the
+ * dearer bounds are skipped. */
+static double upper_of(const hd__m2m_job_t *J, const sub_t *s, double e, double enough, cache_t *C,
+                       uint64_t *kernel) {
     double rmax = 0;
     for (int i = 0; i < 3; i++) rmax = fmax(rmax, up(s->c[i].r));
     double U = up(rmax + reach(s));
+    if ((s->level ? up(U + e) : U) <= enough) return s->level ? up(U + e) : U;
     for (int i = 0; i < 3; i++) { /* Tang's bound over the corners' nearest triangles */
         size_t cand = s->c[i].pos;
         int seen = 0;
@@ -307,42 +344,109 @@ static double upper_of(const hd__m2m_job_t *J, const sub_t *s, double e, uint64_
         if (seen) continue;
         const hd__tri_t *t = &J->to->tris[cand];
         double m = 0;
-        for (int j = 0; j < 3 && m < U; j++) m = fmax(m, corner_to(&s->c[j], cand, t, kernel));
+        for (int j = 0; j < 3 && m < U; j++) m = fmax(m, corner_to(&s->c[j], cand, t, C, kernel));
         U = fmin(U, m);
     }
-    if (s->c[0].pos != s->c[1].pos || s->c[1].pos != s->c[2].pos) U = pair_bound(J, s, U, kernel);
+    if (s->c[0].pos != s->c[1].pos || s->c[1].pos != s->c[2].pos) U = pair_bound(J, s, U, C, kernel);
     return s->level ? up(U + e) : U;
 }
 
 /* ---- phase 1: every face's corners -------------------------------------- */
 
-static void phase1(void *vctx, size_t task, int worker) {
+/* A corner of a face as phase 0 finds it. */
+typedef struct found {
+    double r, near[3];
+    size_t pos, index;
+} found_t;
+
+typedef struct ctx {
+    const hd__m2m_job_t *job;
+    face_t *faces;
+    const uint64_t *order; /* the corners (3 f + j) in Morton order, in the low 32 bits */
+    found_t *found;        /* by corner */
+    size_t n_corners;
+    cache_t *caches;       /* one per worker */
+} ctx_t;
+
+#define CORNER(J, id) ((J)->from[(id) / 3].v[(id) % 3])
+
+/* Phase 0: each corner's nearest triangle, in Morton order so that each
+ * search starts from its predecessor's answer; a corner equal to its
+ * predecessor copies it (the answer is the brute force's: it depends on
+ * the point alone). */
+static void phase0(void *vctx, size_t task, int worker) {
     (void)worker;
     ctx_t *C = vctx;
     const hd__m2m_job_t *J = C->job;
-    size_t lo = task * CHUNK, hi = lo + CHUNK < J->n_from ? lo + CHUNK : J->n_from, seed = SIZE_MAX;
-    for (size_t f = lo; f < hi; f++) {
-        face_t *F = &C->faces[f];
-        memset(F, 0, sizeof *F);
-        if (J->drop && J->drop[f]) {
-            F->done = 1;
+    size_t lo = task * CHUNK * 3, hi = lo + CHUNK * 3 < C->n_corners ? lo + CHUNK * 3 : C->n_corners;
+    size_t seed = SIZE_MAX, prev = SIZE_MAX;
+    hd__bvh_stats_t st = {0, 0, 0, 0};
+    for (size_t k = lo; k < hi; k++) {
+        size_t id = C->order ? (size_t)(C->order[k] & 0xffffffffu) : k;
+        found_t *F = &C->found[id];
+        if (J->drop && J->drop[id / 3]) continue;
+        if (prev != SIZE_MAX && memcmp(CORNER(J, id), CORNER(J, prev), 3 * sizeof(double)) == 0) {
+            *F = C->found[prev];
             continue;
         }
-        const hd__tri_t *t = &J->from[f];
-        hd__bvh_stats_t st = {0, 0, 0, 0};
+        hd__tri_near_t near;
+        F->pos = seed = hd__bvh_nearest(J->to, CORNER(J, id), seed, &near, &F->index, &st);
+        F->r = near.d;
+        memcpy(F->near, near.point, sizeof F->near);
+        prev = id;
+    }
+    C->faces[lo / 3].kernel += st.kernel; /* counted on the chunk's first face */
+}
+
+static void phase1(void *vctx, size_t task, int worker) {
+    ctx_t *C = vctx;
+    const hd__m2m_job_t *J = C->job;
+    size_t lo = task * CHUNK, hi = lo + CHUNK < J->n_from ? lo + CHUNK : J->n_from;
+    for (size_t f = lo; f < hi; f++) {
+        face_t *F = &C->faces[f];
+        if (F->done) continue;
         for (int i = 0; i < 3; i++) {
             corner_t *c = &F->top.c[i];
+            const found_t *x = &C->found[3 * f + (size_t)i];
             c->k[0] = c->k[1] = c->k[2] = 0;
             c->k[i] = 1;
-            evaluate(J, t, 0, c, 0, seed, &st);
-            seed = c->pos;
+            memcpy(c->p, J->from[f].v[i], sizeof c->p);
+            c->r = c->lower = x->r;
+            c->pos = x->pos;
+            c->index = x->index;
+            memcpy(c->near, x->near, sizeof c->near);
             offer(&F->best, c, 0, 0);
         }
         F->top.level = 0;
-        F->top.U = upper_of(J, &F->top, 0, &F->kernel);
+        F->top.U = upper_of(J, &F->top, 0, -INFINITY, &C->caches[worker], &F->kernel);
         F->upper = F->top.U;
-        F->kernel += st.kernel;
     }
+}
+
+/* The corners' Morton order (NULL when there are too many to key; any
+ * order is correct). */
+static int corner_order(const hd__m2m_job_t *J, int threads, uint64_t **out) {
+    *out = NULL;
+    size_t n = 3 * J->n_from;
+    if (n > UINT32_MAX) return HD_OK;
+    uint64_t *keys = hd__malloc_array(n, sizeof *keys), *tmp = hd__malloc_array(n, sizeof *tmp);
+    if (!keys || !tmp) {
+        free(keys);
+        free(tmp);
+        return HD_ENOMEM;
+    }
+    hd__box_t box = {{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
+    for (size_t id = 0; id < n; id++)
+        for (int d = 0; d < 3; d++)
+            box.lo[d] = fmin(box.lo[d], CORNER(J, id)[d]), box.hi[d] = fmax(box.hi[d], CORNER(J, id)[d]);
+    hd__keygrid_t g;
+    hd__keygrid_init(&g, &box);
+    for (size_t id = 0; id < n; id++) keys[id] = (uint64_t)hd__key30(&g, CORNER(J, id)) << 32 | (uint64_t)id;
+    int rc = hd__radix_sort(&keys, &tmp, n, threads);
+    free(tmp);
+    if (rc) free(keys);
+    else *out = keys;
+    return rc;
 }
 
 /* ---- phase 2: refining one face ----------------------------------------- */
@@ -354,6 +458,7 @@ typedef struct pool {
     size_t *free_;
     size_t n_free;
     hd__heap_t heap;
+    cache_t *cache;
     int failed;
 } pool_t;
 
@@ -385,9 +490,14 @@ static size_t pool_put(pool_t *P, const sub_t *s) {
 }
 
 /* The four children of s (corners 0, 1, 2; midpoints m01, m12, m20). */
-static void split(const hd__m2m_job_t *J, const hd__tri_t *t, double e, const sub_t *s, sub_t kids[4],
-                  face_t *F, hd__bvh_stats_t *st) {
-    int L = s->level + 1;
+static double threshold(const hd__m2m_job_t *J, double L, const face_t *F) {
+    double thr = J->per_face ? F->best.lower : fmax(L, F->best.lower);
+    return thr;
+}
+
+static void split(const hd__m2m_job_t *J, const hd__tri_t *t, double e, double L, const sub_t *s, sub_t kids[4],
+                  face_t *F, pool_t *P, hd__bvh_stats_t *st) {
+    int level = s->level + 1;
     corner_t c[3], m[3];
     for (int i = 0; i < 3; i++) {
         c[i] = s->c[i];
@@ -396,21 +506,17 @@ static void split(const hd__m2m_job_t *J, const hd__tri_t *t, double e, const su
     for (int i = 0; i < 3; i++) {
         const corner_t *p = &s->c[i], *q = &s->c[(i + 1) % 3];
         for (int j = 0; j < 3; j++) m[i].k[j] = p->k[j] + q->k[j];
-        evaluate(J, t, e, &m[i], L, p->pos, st);
-        offer(&F->best, &m[i], L, e);
+        evaluate(J, t, e, &m[i], level, p->pos, st);
+        offer(&F->best, &m[i], level, e);
     }
     const corner_t *tri[4][3] = {{&c[0], &m[0], &m[2]}, {&m[0], &c[1], &m[1]}, {&m[2], &m[1], &c[2]},
                                  {&m[0], &m[1], &m[2]}};
+    double enough = fmax(threshold(J, L, F), J->done_below);
     for (int q = 0; q < 4; q++) {
         for (int i = 0; i < 3; i++) kids[q].c[i] = *tri[q][i];
-        kids[q].level = L;
-        kids[q].U = upper_of(J, &kids[q], e, &F->kernel);
+        kids[q].level = level;
+        kids[q].U = upper_of(J, &kids[q], e, enough, P->cache, &F->kernel);
     }
-}
-
-static double threshold(const hd__m2m_job_t *J, double L, const face_t *F) {
-    double thr = J->per_face ? F->best.lower : fmax(L, F->best.lower);
-    return thr;
 }
 
 /* Refine face f against the lower bound L of the batches before it. */
@@ -445,7 +551,7 @@ static void refine(const hd__m2m_job_t *J, face_t *F, size_t f, double L, pool_t
             break;
         }
         sub_t kids[4];
-        split(J, t, e, &s, kids, F, &st);
+        split(J, t, e, L, &s, kids, F, P, &st);
         F->splits++;
         thr = threshold(J, L, F);
         for (int q = 0; q < 4; q++) {
@@ -511,7 +617,10 @@ static int run_batches(const hd__m2m_job_t *J, ctx_t *C, rank_t *rk, size_t n, h
     pool_t *pools = calloc((size_t)J->threads, sizeof *pools);
     size_t *order = hd__malloc_array(MAX_BATCH, sizeof *order);
     int rc = pools && order ? HD_OK : HD_ENOMEM;
-    for (int w = 0; pools && w < J->threads; w++) hd__heap_init(&pools[w].heap, 1);
+    for (int w = 0; pools && w < J->threads; w++) {
+        hd__heap_init(&pools[w].heap, 1);
+        pools[w].cache = &C->caches[w];
+    }
     size_t next = 0, size = FIRST_BATCH;
     while (rc == HD_OK && next < n) {
         if (R->lower > J->stop_above) break; /* the predicate is answered */
@@ -542,14 +651,35 @@ int hd__m2m_run(const hd__m2m_job_t *J, hd__m2m_result_t *R) {
     memset(R, 0, sizeof *R);
     R->face = R->face_b = SIZE_MAX;
     size_t n = J->n_from;
-    ctx_t C = {J, hd__malloc_array(n ? n : 1, sizeof(face_t))};
+    ctx_t C = {J, hd__malloc_array(n ? n : 1, sizeof(face_t)), NULL, NULL, 0, NULL};
     rank_t *rk = hd__malloc_array(n ? n : 1, sizeof *rk);
     if (!C.faces || !rk) {
         free(C.faces);
         free(rk);
         return HD_ENOMEM;
     }
+    C.n_corners = 3 * n;
+    C.found = hd__malloc_array(n ? 3 * n : 1, sizeof *C.found);
+    C.caches = hd__malloc_array((size_t)J->threads, sizeof *C.caches);
+    uint64_t *order = NULL;
+    if (!C.found || !C.caches || corner_order(J, J->threads, &order)) {
+        free(C.faces);
+        free(rk);
+        free(C.found);
+        free(C.caches);
+        return HD_ENOMEM;
+    }
+    for (int w = 0; w < J->threads; w++)
+        for (size_t k = 0; k < CACHE; k++) C.caches[w].pos[k] = SIZE_MAX;
+    C.order = order;
+    for (size_t f = 0; f < n; f++) {
+        memset(&C.faces[f], 0, sizeof C.faces[f]);
+        C.faces[f].done = J->drop && J->drop[f];
+    }
+    hd__parallel_for(J->threads, (n + CHUNK - 1) / CHUNK, phase0, &C);
     hd__parallel_for(J->threads, (n + CHUNK - 1) / CHUNK, phase1, &C);
+    free(order);
+    free(C.found);
     size_t live = 0;
     for (size_t f = 0; f < n; f++) {
         take_best(R, &C.faces[f], f);
@@ -562,6 +692,7 @@ int hd__m2m_run(const hd__m2m_job_t *J, hd__m2m_result_t *R) {
     for (size_t f = 0; f < n; f++) finish_face(R, J, &C.faces[f], f);
     R->upper = fmax(R->upper, R->lower);
     free(C.faces);
+    free(C.caches);
     free(rk);
     return rc;
 }

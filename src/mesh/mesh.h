@@ -194,5 +194,33 @@ int hd__m2m_run(const hd__m2m_job_t *job, hd__m2m_result_t *out);
  * HD_ENOMEM. */
 int hd__m2m_shared(const hd__tri_t *x, size_t nx, const hd__tri_t *y, size_t ny, unsigned char *drop,
                    size_t *count);
+/* ---- the sign: the winding number of a closed mesh (winding.c) --------- */
+
+/* One triangle to sign against: its corners and the caller's indices of
+ * them (the messages name vertices by these; the k-th record is triangle
+ * k). */
+typedef struct hd__wtri {
+    double v[3][3];
+    uint64_t vi[3];
+} hd__wtri_t;
+
+/* A closed mesh prepared for winding numbers (read-only once built: share
+ * it between threads). */
+typedef struct hd__solid hd__solid_t;
+
+/* Check that the n triangles form a closed, consistently oriented surface
+ * (winding.c states the rule: corners with equal coordinates are one
+ * vertex, every edge used as often each way) and prepare them.  HD_EINVAL
+ * naming an offending edge (its vertices, by the smallest caller index at
+ * those coordinates, and a triangle using it) when they do not;
+ * HD_ENOMEM, HD_EOVERFLOW.  Corners must be finite. */
+int hd__solid_build(hd__solid_t **out, const hd__wtri_t *t, size_t n, hd_error_t *err);
+void hd__solid_free(hd__solid_t *s);
+
+/* The winding number of the surface around p, exact, for p off the
+ * surface.  *on_surface = 1 (and the count is meaningless) when the search
+ * met a triangle holding p; a point on the surface may also go unnoticed,
+ * so callers decide "on the surface" by the distance. */
+long hd__solid_winding(const hd__solid_t *s, const double p[3], int *on_surface);
 
 #endif

@@ -283,6 +283,31 @@ TEST(random_soups_both_ways) {
     }
 }
 
+/* Far from the origin (2^20 + k 2^-26): every point the search computes
+ * inside a face is rounded, so the bounds must carry the rounding error
+ * of the computed corners; the samples stay exact (52 bits). */
+TEST(meshes_far_from_the_origin) {
+    for (uint64_t seed = 1; seed <= 6 / SCALE + 1; seed++) {
+        CONTEXT("seed %llu", (unsigned long long)seed);
+        gen_rng_t r;
+        gen_seed(&r, seed);
+        soup_t A = random_soup(&r, 3, 1024), B = random_soup(&r, 3, 1024);
+        for (size_t k = 0; k < 3 * A.nv; k++) A.v[k] = 0x1p20 + A.v[k] * 0x1p-26;
+        for (size_t k = 0; k < 3 * B.nv; k++) B.v[k] = 0x1p20 + B.v[k] * 0x1p-26;
+        hd_mesh_t a = view(&A), b = view(&B);
+        hd_enclosure_t ab, ba, ab3, ba3;
+        hd_surface_options_t o1 = options(0, 0, 1), o3 = options(0, 0, 3);
+        CHECK_RC(hd_surface_hausdorff(&a, &b, &o1, &ab, &ba, NULL), HD_OK);
+        CHECK_RC(hd_surface_hausdorff(&a, &b, &o3, &ab3, &ba3, NULL), HD_OK);
+        encloses(&ab, &A, &B, 16);
+        encloses(&ba, &B, &A, 16);
+        same_enclosure(&ab, &ab3);
+        same_enclosure(&ba, &ba3);
+        soup_free(&A), soup_free(&B);
+        if (hdt_failed()) break;
+    }
+}
+
 TEST(surface_to_points_encloses_and_points_to_surface_is_exact) {
     for (uint64_t seed = 1; seed <= 6 / SCALE + 1; seed++) {
         CONTEXT("seed %llu", (unsigned long long)seed);

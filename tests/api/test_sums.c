@@ -227,3 +227,21 @@ TEST(means_are_finite_when_their_sum_overflows) {
     CHECK_BITS(s.mean_ab, ldexp((ldexp(DBL_MAX, -128) * 2 + 0x1p872) / 3, 128));
     CHECK(isnan(s.mean_pooled)); /* no B: still NaN */
 }
+
+TEST(pooled_figures_round_the_sum_of_both_sets_once) {
+    /* B's sum 2^-53 + 2^-106 rounds to 2^-53 (a tie, to even), and 1 + 2^-53
+     * is a tie again: adding the two rounded sums gives 1, while the exact
+     * sum of all three distances is above the tie and rounds to 1 + 2^-52
+     * (math.fsum([1.0, 2**-53, 2**-106]) == 1 + 2**-52). */
+    double a[1] = {1.0}, b[2] = {0x1p-53, 0x1p-106};
+    hd_summary_t s;
+    CHECK_RC(hd_summarize(a, 1, b, 2, &s, NULL), HD_OK);
+    CHECK_BITS(s.sum_ba, 0x1p-53);
+    CHECK_BITS(s.chamfer_sum, 1.0 + 0x1p-52);
+    CHECK_BITS(s.mean_pooled, (1.0 + 0x1p-52) / 3.0);
+    /* squares 1 and 2^-54, 2^-54, 2^-106: the same two ties */
+    double e[3] = {0x1p-27, 0x1p-27, 0x1p-53};
+    CHECK_RC(hd_summarize(a, 1, e, 3, &s, NULL), HD_OK);
+    CHECK_BITS(s.sum2_ba, 0x1p-53);
+    CHECK_BITS(s.chamfer_sum2, 1.0 + 0x1p-52);
+}

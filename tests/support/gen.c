@@ -84,6 +84,29 @@ void gen_torus(gen_rng_t *r, double *xyz, size_t n, double R, double rr) {
     }
 }
 
+void gen_torus_mesh(double R, double rr, int nu, int nv, double **v, uint64_t **t) {
+    size_t n = (size_t)nu * (size_t)nv;
+    *v = malloc(3 * n * sizeof **v);
+    *t = malloc(6 * n * sizeof **t);
+    if (!*v || !*t) {
+        fprintf(stderr, "gen_torus_mesh: out of memory\n");
+        abort();
+    }
+    for (int i = 0; i < nu; i++)
+        for (int j = 0; j < nv; j++) {
+            double a = 6.283185307179586 * i / nu, b = 6.283185307179586 * j / nv, *x = *v + 3 * (i * (size_t)nv + j);
+            x[0] = (R + rr * cos(b)) * cos(a), x[1] = (R + rr * cos(b)) * sin(a), x[2] = rr * sin(b);
+        }
+    uint64_t *f = *t;
+    for (int i = 0; i < nu; i++)
+        for (int j = 0; j < nv; j++) {
+            uint64_t a = (uint64_t)i * nv + j, b = (uint64_t)((i + 1) % nu) * nv + j,
+                     c = (uint64_t)((i + 1) % nu) * nv + (j + 1) % nv, d = (uint64_t)i * nv + (j + 1) % nv;
+            f[0] = a, f[1] = b, f[2] = c, f[3] = a, f[4] = c, f[5] = d;
+            f += 6;
+        }
+}
+
 void gen_affine(double *xyz, size_t n, double scale, double offset) {
     for (size_t k = 0; k < 3 * n; k++) xyz[k] = xyz[k] * scale + offset;
 }

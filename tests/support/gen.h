@@ -32,6 +32,12 @@ void gen_line(gen_rng_t *r, double *xyz, size_t n);
 void gen_plane(gen_rng_t *r, double *xyz, size_t n);
 /* n points on a torus (major radius R, minor radius rr), centred at 0. */
 void gen_torus(gen_rng_t *r, double *xyz, size_t n, double R, double rr);
+/* A closed torus mesh (major radius R, minor radius rr) around the z axis:
+ * nu x nv vertices on the smooth torus, each grid quad split into two
+ * outward triangles (2 nu nv in all).  New arrays *v (packed xyz, nu nv
+ * vertices) and *t (3 indices a triangle); the caller frees them.  Aborts
+ * the program when out of memory. */
+void gen_torus_mesh(double R, double rr, int nu, int nv, double **v, uint64_t **t);
 /* Scale and shift every coordinate: x -> x * scale + offset. */
 void gen_affine(double *xyz, size_t n, double scale, double offset);
 /* n points uniform by area on the surface of a spur gear centred at 0, axis
