@@ -15,7 +15,7 @@ faces), it measures:
     every witness's distance recomputed.
 Then it writes the tables into docs/benchmarks.md ("Surface to surface", between the m2m-results markers,
 and rows of the current-figures table) and docs/surfaces.md (the m2m-summary markers), and the raw results
-to BUILD/bench/m2m.jsonl.  Times are medians; the ratios use processor seconds (the machine is shared), and
+to BUILD/bench/m2m.jsonl (m2m_quick.jsonl with --quick).  Times are medians; the ratios use processor seconds (the machine is shared), and
 the wall-clock seconds are in the tables beside them.
 """
 import argparse
@@ -392,7 +392,7 @@ def figure_rows(results, meta):
 
 def write_docs(args, results, meta):
     body = tables(results, meta) + "\n#### Targets\n\n" + targets(results)
-    with open(os.path.join(args.build, "bench", "m2m.md"), "w") as f:
+    with open(os.path.join(args.build, "bench", "m2m_quick.md" if args.quick else "m2m.md"), "w") as f:
         f.write(body)
     if not args.doc:
         return
@@ -481,7 +481,7 @@ def main():
             "load": "%.1f" % os.getloadavg()[0], "repeats": args.repeats, "peer_repeats": args.peer_repeats,
             "command_text": args.command}
     results = []
-    with open(os.path.join(bench, "m2m.jsonl"), "w") as log:
+    with open(os.path.join(bench, "m2m_quick.jsonl" if args.quick else "m2m.jsonl"), "w") as log:
         for case in cases:
             print("%s: %d against %d triangles" % (case["name"], case["na"], case["nb"]), flush=True)
             res = measure(args, case)
