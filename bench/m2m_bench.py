@@ -440,7 +440,11 @@ case), `through` a model against a turned and moved copy passing through it (Tan
 corners), `shared` the lion head against the lion (every lion face is in the head).  CGAL returns its lower
 bound, which it initialises to the tolerance, so on `nearzero` at 1e-4 its value is the tolerance itself:
 above the true distance, but within what it promises.  CGAL's Surface_mesh refuses faces with a repeated
-index or non-manifold edges; `m2m_cgal` gives those faces corners of their own, the same triangles.
+index or non-manifold edges; `m2m_cgal` gives those faces corners of their own, the same triangles, and CGAL
+then measures them as the segments or points they are (no assertion fails with CGAL's assertions on; its
+polygon-soup repair would instead delete them).  The machine is shared: at a load of 15-20 on 2 cores the
+wall-clock times are several times the processor times and a second thread gains nothing, so the ratios use
+processor seconds at 1 thread, where CGAL is sequential too.
 
     make bench-m2m                      # M2M_ARGS="--quick" for the smaller cases
 """
