@@ -985,7 +985,8 @@ HD_EXTERN int hd_surface_points_hausdorff(const hd_mesh_t *A,
  * (proven <= d), 0 (proven > d), or -1 when the distance lies within the
  * tolerance of d and the enclosure cannot decide (the enclosures say how
  * close).  ab, ba: NULL, or the enclosures as far as the search went (their
- * width is then not bounded by the tolerance).  Errors: as
+ * width is then not bounded by the tolerance; ba has lower 0 and upper
+ * infinity when h(A, B) alone proved the answer 0).  Errors: as
  * hd_surface_hausdorff, and HD_EINVAL for d negative or NaN. */
 HD_EXTERN int hd_surface_within(const hd_mesh_t *A, const hd_mesh_t *B,
                                 double d, int directed,
