@@ -465,10 +465,21 @@ def main():
     ap.add_argument("--doc", help="docs/benchmarks.md to update")
     ap.add_argument("--surfaces", help="docs/surfaces.md to update")
     ap.add_argument("--command", default="make bench-m2m", help="the command named in the docs")
+    ap.add_argument("--report-only", action="store_true",
+                    help="measure nothing: write the docs from the last run's results file")
     args = ap.parse_args()
     bench = os.path.join(args.build, "bench")
     args.run, args.cgal = os.path.join(bench, "m2m_run"), os.path.join(bench, "m2m_cgal")
     args.dense = os.path.join(args.build, "tests", "m2m_dense")
+    results_file = os.path.join(bench, "m2m_quick.jsonl" if args.quick else "m2m.jsonl")
+    if args.report_only:
+        with open(results_file) as f:
+            lines = [json.loads(l) for l in f]
+        meta, results = lines[0]["meta"], lines[1:]
+        meta["command_text"] = args.command
+        write_docs(args, results, meta)
+        print(tables(results, meta) + targets(results))
+        return 0
     out = os.path.join(bench, "m2m_pairs_quick" if args.quick else "m2m_pairs")
     os.makedirs(out, exist_ok=True)
     subprocess.run([os.path.join(bench, "m2m_cases"), args.data, out] + (["--quick"] if args.quick else []),
@@ -485,7 +496,8 @@ def main():
             "load": "%.1f" % os.getloadavg()[0], "repeats": args.repeats, "peer_repeats": args.peer_repeats,
             "command_text": args.command}
     results = []
-    with open(os.path.join(bench, "m2m_quick.jsonl" if args.quick else "m2m.jsonl"), "w") as log:
+    with open(results_file, "w") as log:
+        log.write(json.dumps({"meta": meta}) + "\n")
         for case in cases:
             print("%s: %d against %d triangles" % (case["name"], case["na"], case["nb"]), flush=True)
             res = measure(args, case)
