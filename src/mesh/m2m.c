@@ -289,15 +289,44 @@ static int shared_convex(const hd__tri_t *s, const hd__tri_t *t) {
 }
 
 /* A worker's prepared triangles of Y, by position in the tree (direct
- * mapped): hd__tri_bounds_prep gives hd__tri_bounds's bits. */
-#define CACHE 1024
+ * mapped, a power of two entries up to MAX_CACHE, enough for all of Y
+ * when it is smaller): hd__tri_bounds_prep gives hd__tri_bounds's bits,
+ * so what the cache holds never changes a result. */
+#define MAX_CACHE 32768
 typedef struct cache {
-    size_t pos[CACHE];
-    hd__tri_prep_t prep[CACHE];
+    size_t mask;
+    size_t *pos;
+    hd__tri_prep_t *prep;
 } cache_t;
 
+static void caches_free(cache_t *C, int n) {
+    for (int w = 0; C && w < n; w++) {
+        free(C[w].pos);
+        free(C[w].prep);
+    }
+    free(C);
+}
+
+/* n workers' caches for a tree of n_tris triangles, or NULL. */
+static cache_t *caches_new(int n, size_t n_tris) {
+    size_t size = 64;
+    while (size < n_tris && size < MAX_CACHE) size *= 2;
+    cache_t *C = calloc((size_t)n, sizeof *C);
+    for (int w = 0; C && w < n; w++) {
+        C[w].mask = size - 1;
+        C[w].pos = hd__malloc_array(size, sizeof *C[w].pos);
+        C[w].prep = hd__malloc_array(size, sizeof *C[w].prep);
+        if (!C[w].pos || !C[w].prep) {
+            caches_free(C, n);
+            return NULL;
+        }
+        for (size_t k = 0; k < size; k++) C[w].pos[k] = SIZE_MAX;
+    }
+    return C;
+}
+
 static const hd__tri_prep_t *prepared(cache_t *C, size_t pos, const hd__tri_t *t) {
-    size_t k = pos & (CACHE - 1);
+    size_t k = pos & C->mask;
     if (C->pos[k] != pos) {
         hd__tri_prep(t->v[0], t->v[1], t->v[2], &C->prep[k]);
         C->pos[k] = pos;
@@ -785,17 +814,15 @@ int hd__m2m_run(const hd__m2m_job_t *J, hd__m2m_result_t *R) {
     }
     C.n_corners = 3 * n;
     C.found = hd__malloc_array(n ? 3 * n : 1, sizeof *C.found);
-    C.caches = hd__malloc_array((size_t)J->threads, sizeof *C.caches);
+    C.caches = caches_new(J->threads, J->to->n_tris);
     uint64_t *order = NULL;
     if (!C.found || !C.caches || corner_order(J, J->threads, &order)) {
         free(C.faces);
         free(rk);
         free(C.found);
-        free(C.caches);
+        caches_free(C.caches, J->threads);
         return HD_ENOMEM;
     }
-    for (int w = 0; w < J->threads; w++)
-        for (size_t k = 0; k < CACHE; k++) C.caches[w].pos[k] = SIZE_MAX;
     C.order = order;
     for (size_t f = 0; f < n; f++) {
         memset(&C.faces[f], 0, sizeof C.faces[f]);
@@ -819,7 +846,7 @@ int hd__m2m_run(const hd__m2m_job_t *J, hd__m2m_result_t *R) {
     for (size_t f = 0; f < n; f++) finish_face(R, J, &C.faces[f], f);
     R->upper = fmax(R->upper, R->lower);
     free(C.faces);
-    free(C.caches);
+    caches_free(C.caches, J->threads);
     free(rk);
     return rc;
 }
