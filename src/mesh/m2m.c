@@ -339,10 +339,8 @@ static const hd__tri_prep_t *prepared(cache_t *C, size_t pos, const hd__tri_t *t
 /* Every point of the box is at squared distance above h2 from p (the
  * computed hd__box_lb2s is within a factor (1 + u)^11 of the exact square
  * when it is at least 2^-1000, bvh.c's proof). */
-static int beyond(const hd__box_t *b, const double p[3], double h2) {
-    double s = hd__box_lb2s(b, p[0], p[1], p[2]);
-    return s >= 0x1p-1000 && s * (1 - 0x1p-46) > h2;
-}
+static int far2(double s, double h2) { return s >= 0x1p-1000 && s * (1 - 0x1p-46) > h2; }
+static int beyond(const hd__box_t *b, const double p[3], double h2) { return far2(hd__box_lb2s(b, p[0], p[1], p[2]), h2); }
 
 #define DEPTH 130
 /* lo <= d(p, Y) <= hi from hd__tri_bounds_prep alone: hi from the triangle
@@ -360,13 +358,13 @@ static size_t interval(const hd__bvh_t *T, const double p[3], size_t seed, cache
         best = hi2, low = lo2, pos = seed;
         (*count)++;
     }
-    uint32_t stack[DEPTH];
+    struct { uint32_t id; double s; } stack[DEPTH]; /* s: the box's hd__box_lb2s */
     int top = 0;
-    stack[top++] = 0;
+    stack[top].id = 0, stack[top++].s = hd__box_lb2s(&T->nodes[0].box, p[0], p[1], p[2]);
     while (top > 0) {
-        uint32_t id = stack[--top];
+        uint32_t id = stack[--top].id;
+        if (far2(stack[top].s, best)) continue;
         const hd__bvh_node_t *node = &T->nodes[id];
-        if (beyond(&node->box, p, best)) continue;
         if (node->count) {
             for (size_t k = node->first_or_second; k < (size_t)node->first_or_second + node->count; k++) {
                 if (k == seed || beyond(&T->boxes[k], p, best)) continue;
@@ -380,8 +378,13 @@ static size_t interval(const hd__bvh_t *T, const double p[3], size_t seed, cache
         uint32_t a = id + 1, b = node->first_or_second;
         double la = hd__box_lb2s(&T->nodes[a].box, p[0], p[1], p[2]);
         double lb = hd__box_lb2s(&T->nodes[b].box, p[0], p[1], p[2]);
-        if (la > lb) stack[top++] = a, stack[top++] = b; /* the nearer on top */
-        else stack[top++] = b, stack[top++] = a;
+        if (la < lb) { /* the nearer on top */
+            uint32_t t = a;
+            double u = la;
+            a = b, la = lb, b = t, lb = u;
+        }
+        if (!far2(la, best)) stack[top].id = a, stack[top++].s = la;
+        if (!far2(lb, best)) stack[top].id = b, stack[top++].s = lb;
     }
     *lo = low > 0 ? down(sqrt(low)) : 0;
     *hi = sqrt_up(best);
