@@ -862,9 +862,19 @@ typedef struct key {
 
 static int cmp_corner3(const void *x, const void *y) { return memcmp(x, y, 3 * sizeof(double)); }
 
+static void swap_if(double a[3], double b[3]) {
+    if (cmp_corner3(a, b) > 0) {
+        double t[3];
+        memcpy(t, a, sizeof t), memcpy(a, b, sizeof t), memcpy(b, t, sizeof t);
+    }
+}
+
+/* The corners in memcmp order (three compare-exchanges). */
 static void key_of(const hd__tri_t *t, facekey_t *k) {
     memcpy(k->v, t->v, sizeof k->v);
-    qsort(k->v, 3, sizeof k->v[0], cmp_corner3);
+    swap_if(k->v[0], k->v[1]);
+    swap_if(k->v[1], k->v[2]);
+    swap_if(k->v[0], k->v[1]);
 }
 
 static int cmp_key(const void *x, const void *y) { return memcmp(x, y, sizeof(facekey_t)); }
