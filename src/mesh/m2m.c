@@ -543,6 +543,10 @@ static void phase0_exact(void *vctx, size_t task, int worker) {
     C->faces[lo / 3].kernel += st.kernel;
 }
 
+/* Phase 1: each face's corners and first bound.  A face whose point bound
+ * is at most the bar (<= L) is never refined and its bound cannot raise
+ * the upper bound above L, so the dearer bounds are skipped (unless each
+ * face's upper bound is asked for). */
 static void phase1(void *vctx, size_t task, int worker) {
     ctx_t *C = vctx;
     const hd__m2m_job_t *J = C->job;
@@ -565,7 +569,7 @@ static void phase1(void *vctx, size_t task, int worker) {
             if (c->exact) offer(&F->best, c, 0, 0);
         }
         F->top.level = 0;
-        F->top.U = upper_of(J, &F->top, 0, -INFINITY, &C->caches[worker], &F->kernel);
+        F->top.U = upper_of(J, &F->top, 0, J->face_upper ? -INFINITY : C->bar, &C->caches[worker], &F->kernel);
         F->upper = F->top.U;
     }
 }
