@@ -444,7 +444,10 @@ index or non-manifold edges; `m2m_cgal` gives those faces corners of their own, 
 then measures them as the segments or points they are (no assertion fails with CGAL's assertions on; its
 polygon-soup repair would instead delete them).  The machine is shared: at a load of 15-20 on 2 cores the
 wall-clock times are several times the processor times and a second thread gains nothing, so the ratios use
-processor seconds at 1 thread, where CGAL is sequential too.
+processor seconds at 1 thread, where CGAL is sequential too.  CGAL's value falls outside our enclosure at
+the same tolerance in two ways, both within what it promises: below the true distance by up to its
+tolerance (it returns its lower bound), and a few units in the last place below a tight enclosure (its
+distances are not correctly rounded: `through`).
 
     make bench-m2m                      # M2M_ARGS="--quick" for the smaller cases
 """
