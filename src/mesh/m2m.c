@@ -292,7 +292,7 @@ static int shared_convex(const hd__tri_t *s, const hd__tri_t *t) {
  * mapped, a power of two entries up to MAX_CACHE, enough for all of Y
  * when it is smaller): hd__tri_bounds_prep gives hd__tri_bounds's bits,
  * so what the cache holds never changes a result. */
-#define MAX_CACHE 32768
+#define MAX_CACHE 2048
 typedef struct cache {
     size_t mask;
     size_t *pos;
