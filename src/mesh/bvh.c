@@ -283,16 +283,21 @@ int hd__bvh_build(hd__bvh_t *t, hd__tri_t *tris, size_t n) {
     t->n_tris = n;
     t->nodes = hd__malloc_array(2 * n, sizeof *t->nodes);
     t->boxes = hd__malloc_array(n, sizeof *t->boxes);
-    if (!t->nodes || !t->boxes) { /* the triangles stay the caller's */
+    t->prep = hd__malloc_array(n, sizeof *t->prep);
+    if (!t->nodes || !t->boxes || !t->prep) { /* the triangles stay the caller's */
         free(t->nodes);
         free(t->boxes);
+        free(t->prep);
         memset(t, 0, sizeof *t);
         return HD_ENOMEM;
     }
     builder_t B = {t, 0};
     build_node(&B, 0, n);
     t->n_nodes = B.used;
-    for (size_t k = 0; k < n; k++) tri_box(&t->tris[k], &t->boxes[k]);
+    for (size_t k = 0; k < n; k++) {
+        tri_box(&t->tris[k], &t->boxes[k]);
+        hd__tri_prep(t->tris[k].v[0], t->tris[k].v[1], t->tris[k].v[2], &t->prep[k]);
+    }
     return HD_OK;
 }
 
@@ -300,16 +305,42 @@ void hd__bvh_free(hd__bvh_t *t) {
     free(t->tris);
     free(t->nodes);
     free(t->boxes);
+    free(t->prep);
     memset(t, 0, sizeof *t);
 }
 
 /* ---- the query ---------------------------------------------------------- */
 
+/* An upper bound on next(d*)^2 from an upper bound h2 on the exact squared
+ * distance t*^2 of some triangle, for the final d* = round(t*) of the
+ * search: t* <= sqrt(h2), so d* <= round(sqrt(h2)) <= sqrt(h2) (1 + u),
+ * next(d*) <= d* (1 + 2u) when normal, and next(d*)^2 <= h2 (1 + 3.1 u)^2
+ * < h2 (1 + 2^-50); the computed h2 (1 + 2^-48) rounds down by at most a
+ * relative u and stays above that.  When next(d*) is below 2^-495 (d*
+ * subnormal included) the floor 2^-990 is above its square. */
+static double thr_from_hi(double h2) {
+    double t = h2 * (1.0 + 0x1p-48);
+    return t > 0x1p-990 ? t : 0x1p-990;
+}
+
+/* A candidate: a triangle (its position) whose lower bound lo2 did not
+ * discard it; the kernel runs for candidates in increasing lo2 until lo2
+ * exceeds the threshold. */
+typedef struct {
+    double lo2;
+    size_t pos;
+} cand_t;
+
+#define CANDS 64
+
 typedef struct {
     hd__tri_near_t best;
     size_t index, pos;
-    double next;  /* next(best.d): a bound above it prunes */
-    double next2; /* square_up(next) */
+    /* thr >= next(d*)^2 for the answer d* (at least 2^-990): the least of
+     * square_up(next(best.d)) and thr_from_hi of every hi2 computed */
+    double thr;
+    size_t n_cand;
+    cand_t cand[CANDS];
 } search_t;
 
 static void evaluate(const hd__bvh_t *t, const double *p, size_t pos, search_t *s, hd__bvh_stats_t *st) {
@@ -322,26 +353,73 @@ static void evaluate(const hd__bvh_t *t, const double *p, size_t pos, search_t *
         s->best = r;
         s->index = tr->index;
         s->pos = pos;
-        s->next = nextafter(r.d, INFINITY);
-        s->next2 = square_up(s->next);
+        double t2 = square_up(nextafter(r.d, INFINITY));
+        s->thr = t2 < s->thr ? t2 : s->thr;
     }
+}
+
+/* The kernel for the candidates, nearest lower bound first, while their
+ * lower bound is not above the threshold (which each call may lower);
+ * the list is emptied.  A candidate not evaluated has lo2 > thr >=
+ * next(d*)^2: the file's rule discards it. */
+static void flush(const hd__bvh_t *t, const double *p, search_t *s, hd__bvh_stats_t *st) {
+    cand_t *c = s->cand;
+    size_t n = s->n_cand;
+    for (size_t i = 1; i < n; i++) { /* insertion sort: the list is short */
+        cand_t x = c[i];
+        size_t j = i;
+        for (; j > 0 && c[j - 1].lo2 > x.lo2; j--) c[j] = c[j - 1];
+        c[j] = x;
+    }
+    for (size_t i = 0; i < n && c[i].lo2 <= s->thr; i++) evaluate(t, p, c[i].pos, s, st);
+    s->n_cand = 0;
+}
+
+/* Triangle k's prepared bounds: discarded when lo2 > thr, else a
+ * candidate, and its hi2 may lower thr. */
+static void consider(const hd__bvh_t *t, const double *p, size_t k, search_t *s, hd__bvh_stats_t *st) {
+    double lo2, hi2;
+    st->bounded++;
+    hd__tri_bounds_prep(p, &t->prep[k], &lo2, &hi2);
+    if (lo2 > s->thr) return;
+    double h = thr_from_hi(hi2);
+    s->thr = h < s->thr ? h : s->thr;
+    if (s->n_cand == CANDS) flush(t, p, s, st);
+    s->cand[s->n_cand++] = (cand_t){lo2, k};
 }
 
 static void leaf(const hd__bvh_t *t, const hd__bvh_node_t *node, const double *p, size_t seed, search_t *s,
                  hd__bvh_stats_t *st) {
     for (size_t k = node->first_or_second, end = k + node->count; k < end; k++) {
-        if (k == seed) continue;
-        if (box_beyond(&t->boxes[k], p, s->next2)) continue;
-        st->bounded++;
-        if (hd__tri_lower(&t->tris[k], p) > s->next) continue;
-        evaluate(t, p, k, s, st);
+        if (k == seed || box_beyond(&t->boxes[k], p, s->thr)) continue;
+        consider(t, p, k, s, st);
     }
+}
+
+/* A lower bound L on a distance, squared and rounded down: fl(L L) is at
+ * most L^2 (1 + u), and the product by 1 - 2^-50 rounds to below L^2
+ * (an underflowed product is below 2^-990 <= thr, so it discards nothing). */
+static double square_down(double L) { return L * L * (1.0 - 0x1p-50); }
+
+static void search_init(search_t *s) {
+    s->index = s->pos = SIZE_MAX;
+    s->thr = INFINITY;
+    s->n_cand = 0;
+}
+
+static size_t search_end(const hd__bvh_t *t, const double *p, search_t *s, hd__tri_near_t *best, size_t *index,
+                         hd__bvh_stats_t *st) {
+    flush(t, p, s, st);
+    *best = s->best;
+    *index = s->index;
+    return s->pos;
 }
 
 size_t hd__bvh_nearest(const hd__bvh_t *t, const double p[3], size_t seed, hd__tri_near_t *best,
                        size_t *index, hd__bvh_stats_t *st) {
-    search_t s = {.index = SIZE_MAX, .pos = SIZE_MAX, .next = INFINITY, .next2 = INFINITY};
-    if (seed < t->n_tris) evaluate(t, p, seed, &s, st);
+    search_t s;
+    search_init(&s);
+    if (seed < t->n_tris) consider(t, p, seed, &s, st);
     /* s: the box's computed hd__box_lb2s; [first, first + n): the node's
      * triangles (the build gives a node's first child the first n / 2) */
     typedef struct { uint32_t node, first, n; double s; } entry_t;
@@ -351,10 +429,11 @@ size_t hd__bvh_nearest(const hd__bvh_t *t, const double p[3], size_t seed, hd__t
     top = 1;
     while (top > 0) {
         e = &stack[--top];
-        if (e->s * SHRINK > s.next2) continue; /* box_beyond, from the stored square */
+        if (e->s * SHRINK > s.thr) continue; /* box_beyond, from the stored square */
         const hd__bvh_node_t *node = &t->nodes[e->node];
         uint32_t first = e->first, n = e->n;
-        if (n <= GROUP && s.pos != SIZE_MAX && hd__tris_lower(&t->tris[first], n, &node->box, p) > s.next) continue;
+        if (n <= GROUP && s.thr < INFINITY && square_down(hd__tris_lower(&t->tris[first], n, &node->box, p)) > s.thr)
+            continue;
         st->nodes++;
         if (node->count) {
             leaf(t, node, p, seed, &s, st);
@@ -366,14 +445,57 @@ size_t hd__bvh_nearest(const hd__bvh_t *t, const double p[3], size_t seed, hd__t
         /* the nearer child on top; the median split halves the count at
          * each level, so the stack never holds more than the depth plus one */
         if (la > lb) {
-            if (la * SHRINK <= s.next2) stack[top++] = (entry_t){a, fa, na, la};
-            if (lb * SHRINK <= s.next2) stack[top++] = (entry_t){b, fb, n - na, lb};
+            if (la * SHRINK <= s.thr) stack[top++] = (entry_t){a, fa, na, la};
+            if (lb * SHRINK <= s.thr) stack[top++] = (entry_t){b, fb, n - na, lb};
         } else {
-            if (lb * SHRINK <= s.next2) stack[top++] = (entry_t){b, fb, n - na, lb};
-            if (la * SHRINK <= s.next2) stack[top++] = (entry_t){a, fa, na, la};
+            if (lb * SHRINK <= s.thr) stack[top++] = (entry_t){b, fb, n - na, lb};
+            if (la * SHRINK <= s.thr) stack[top++] = (entry_t){a, fa, na, la};
         }
     }
-    *best = s.best;
-    *index = s.index;
-    return s.pos;
+    return search_end(t, p, &s, best, index, st);
+}
+
+/* ---- a group of points sharing one list --------------------------------- */
+
+/* The box-to-box bound has the box bound's error (one rounding per
+ * difference, square and sum): the same SHRINK proves it. */
+static int boxes_beyond(const hd__box_t *a, const hd__box_t *b, double r2) {
+    return hd__box_box_lb2(a, b) * SHRINK > r2;
+}
+
+size_t hd__bvh_collect(const hd__bvh_t *t, const hd__box_t *B, double r2, uint32_t *out, size_t cap) {
+    uint32_t stack[MAX_DEPTH];
+    int top = 0;
+    size_t n = 0;
+    if (boxes_beyond(&t->nodes[0].box, B, r2)) return 0;
+    stack[top++] = 0;
+    while (top > 0) {
+        const hd__bvh_node_t *node = &t->nodes[stack[--top]];
+        if (node->count) {
+            for (size_t k = node->first_or_second, end = k + node->count; k < end; k++) {
+                if (boxes_beyond(&t->boxes[k], B, r2)) continue;
+                if (n == cap) return SIZE_MAX;
+                out[n++] = (uint32_t)k;
+            }
+            continue;
+        }
+        uint32_t a = (uint32_t)(node - t->nodes) + 1, b = node->first_or_second;
+        if (!boxes_beyond(&t->nodes[b].box, B, r2)) stack[top++] = b;
+        if (!boxes_beyond(&t->nodes[a].box, B, r2)) stack[top++] = a;
+    }
+    return n;
+}
+
+size_t hd__bvh_nearest_in(const hd__bvh_t *t, const double p[3], const uint32_t *list, size_t n, size_t seed,
+                          hd__tri_near_t *best, size_t *index, hd__bvh_stats_t *st) {
+    search_t s;
+    search_init(&s);
+    if (seed < t->n_tris) consider(t, p, seed, &s, st);
+    for (size_t i = 0; i < n; i++) {
+        size_t k = list[i];
+        if (k == seed || box_beyond(&t->boxes[k], p, s.thr)) continue;
+        consider(t, p, k, &s, st);
+    }
+    st->listed += n;
+    return search_end(t, p, &s, best, index, st);
 }
