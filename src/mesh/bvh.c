@@ -56,6 +56,11 @@
  * corners (leaf_lower) before they are opened. */
 #define GROUP 8
 
+/* A lower bound L on a distance, squared and rounded down: fl(L L) is at
+ * most L^2 (1 + u), and the product by 1 - 2^-50 rounds to below L^2
+ * (an underflowed product is below 2^-990 <= thr, so it discards nothing). */
+static double square_down(double L) { return L * L * (1.0 - 0x1p-50); }
+
 /* ---- lower bounds ------------------------------------------------------- */
 
 /* Box: the gap g on each axis is a difference of doubles rounded once
@@ -78,9 +83,7 @@ double hd__box_lower(const hd__box_t *b, const double p[3]) {
  * s >= TINY, and s * SHRINK, rounded, is below s / (1 + u)^5: so
  * s * SHRINK > thr2 >= next^2 proves the box farther than next (and when
  * s < TINY, s * SHRINK < thr2 as thr2 >= 2^-990). */
-static int box_beyond(const hd__box_t *b, const double p[3], double thr2) {
-    return hd__box_lb2s(b, p[0], p[1], p[2]) * SHRINK > thr2;
-}
+static int box_beyond(double s, double thr2) { return s * SHRINK > thr2; }
 
 /* An upper bound on next^2, at least 2^-990: the product rounds once
  * (relative u when normal), the factor covers it; below 2^-990 the floor
@@ -88,43 +91,6 @@ static int box_beyond(const hd__box_t *b, const double p[3], double thr2) {
 static double square_up(double next) {
     double t = next * next * (1.0 + 0x1p-48);
     return t > 0x1p-990 ? t : 0x1p-990;
-}
-
-/* Ericson's closest point on triangle abc, in plain doubles (Real-Time
- * Collision Detection, 5.1.5).  Only a direction is taken from it, so it
- * need not be exact; on a degenerate triangle it may be NaN. */
-static void rough_closest(const double *p, const double (*v)[3], double *q) {
-    const double *a = v[0], *b = v[1], *c = v[2];
-    double ab[3], ac[3], ap[3], bp[3], cp[3];
-    for (int i = 0; i < 3; i++) {
-        ab[i] = b[i] - a[i], ac[i] = c[i] - a[i];
-        ap[i] = p[i] - a[i], bp[i] = p[i] - b[i], cp[i] = p[i] - c[i];
-    }
-#define DOT(x, y) ((x)[0] * (y)[0] + (x)[1] * (y)[1] + (x)[2] * (y)[2])
-    double d1 = DOT(ab, ap), d2 = DOT(ac, ap);
-    double d3 = DOT(ab, bp), d4 = DOT(ac, bp);
-    double d5 = DOT(ab, cp), d6 = DOT(ac, cp);
-#undef DOT
-    double s = 0, t = 0;
-    double va = 0, vb = 0, vc = 0;
-    if (d1 <= 0 && d2 <= 0) {
-        s = 0, t = 0;
-    } else if (d3 >= 0 && d4 <= d3) {
-        s = 1, t = 0;
-    } else if (d6 >= 0 && d5 <= d6) {
-        s = 0, t = 1;
-    } else if ((vc = d1 * d4 - d3 * d2) <= 0 && d1 >= 0 && d3 <= 0) {
-        s = d1 / (d1 - d3), t = 0;
-    } else if ((vb = d5 * d2 - d1 * d6) <= 0 && d2 >= 0 && d6 <= 0) {
-        s = 0, t = d2 / (d2 - d6);
-    } else if ((va = d3 * d6 - d5 * d4) <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0) {
-        t = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-        s = 1 - t;
-    } else {
-        double den = 1 / (va + vb + vc);
-        s = vb * den, t = vc * den;
-    }
-    for (int i = 0; i < 3; i++) q[i] = a[i] + s * ab[i] + t * ac[i];
 }
 
 /* Support bound: for any vector w, every point x of the triangle (a convex
@@ -151,7 +117,7 @@ static void rough_closest(const double *p, const double (*v)[3], double *q) {
 /* The support bound for direction w over the corners of the n triangles
  * t[0 .. n): min over corners of w.(p - v) / |w|, shrunk (the proof
  * above); 0 when w is zero, not finite, or the bound is not positive. */
-static double support_lower(const hd__tri_t *t, size_t n, const double p[3], double *w) {
+double hd__support_lower(const hd__tri_t *t, size_t n, const double p[3], double *w) {
     double big = fabs(w[0]) > fabs(w[1]) ? fabs(w[0]) : fabs(w[1]);
     big = fabs(w[2]) > big ? fabs(w[2]) : big;
     if (!(big > 0) || !isfinite(big)) return 0.0;
@@ -175,23 +141,102 @@ static double support_lower(const hd__tri_t *t, size_t n, const double p[3], dou
     return r >= TINY ? r * SHRINK : 0.0;
 }
 
-double hd__tri_lower(const hd__tri_t *t, const double p[3]) {
-    double q[3], w[3];
-    rough_closest(p, (const double(*)[3])t->v, q);
-    for (int i = 0; i < 3; i++) w[i] = p[i] - q[i];
-    if (w[0] == 0 && w[1] == 0 && w[2] == 0) return 0.0; /* p on the triangle, roughly */
-    if (!isfinite(w[0] + w[1] + w[2])) /* a degenerate triangle: the centroid's direction */
-        for (int i = 0; i < 3; i++) w[i] = p[i] - (t->v[0][i] + t->v[1][i] + t->v[2][i]) / 3;
-    return support_lower(t, 1, p, w);
+
+/* The slab bound.  A set of corners x_v (a node's or a triangle's) is
+ * described by a centre c, a direction m with |m|^2 in [1 - e, 1 + e]
+ * (e = 2^-48), h >= max |m . (x_v - c)| and r >= max |x_v - c| (true
+ * values).  For any w, splitting w and x = x_v - c along m and across it,
+ * w . x <= |w . m| h / (1 - e) + sqrt(|w|^2 - (w . m)^2 / (1 + e)) r =: T,
+ * and every point x of their hull has w . (p - x) >= w . (p - c) - T, so
+ * |p - x| >= (w . (p - c) - T) / |w| (Cauchy-Schwarz).  With w the
+ * computed p - c this is nearly the distance when p lies far along m (a
+ * flat patch seen from the front loses only about r^2 / |p - c|), where a
+ * box or a sphere loses about its size.
+ *
+ * Rounding, for the stored w and doubles of at most 2^512 (|w|^2 < 1.3e307):
+ * W2 = |w|^2 computed is within (1 +- 4u) of the true one; w . (p - c) =
+ * |w|^2 + w . (p - c - w) >= W2 (1 - 6u) (each w_i is p_i - c_i rounded
+ * once); w . m computed is within 4u sum |w_i m_i| (+ 2^-1000 for
+ * underflow); each formula below rounds outward by factors that exceed its
+ * own roundings (each named at its line), and every upper bound adds
+ * 2^-1000 against underflow; W2 below 2^-900 gives no bound. */
+#define U 0x1p-53
+
+static int slab_parts(const hd__slab_t *sl, const double p[3], double *num, double *den) {
+    double w[3] = {p[0] - sl->c[0], p[1] - sl->c[1], p[2] - sl->c[2]};
+    double W2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
+    if (!(W2 >= 0x1p-900)) return 0;
+    double wm = w[0] * sl->m[0] + w[1] * sl->m[1] + w[2] * sl->m[2];
+    double ewm = 4 * U * (fabs(w[0] * sl->m[0]) + fabs(w[1] * sl->m[1]) + fabs(w[2] * sl->m[2])) + 0x1p-1000;
+    double a = fabs(wm) + ewm, bl = fabs(wm) - ewm;                     /* a >= |w.m| >= bl */
+    bl = bl > 0 ? bl : 0;
+    /* |w|^2 - (w.m)^2 / (1 + e) <= W2 (1 + 8u) - bl^2 (1 - 64u), each
+     * side rounded once or twice, and the difference rounded up by 8u */
+    double perp = (W2 * (1 + 0x1p-50) - bl * bl * (1 - 0x1p-47)) * (1 + 0x1p-50);
+    double sq = perp > 0 ? sqrt(perp) * (1 + 0x1p-50) : 0;
+    /* a h / (1 - e) <= fl(a h) (1 + 64u); the sum and sq r round three
+     * times more: 16u */
+    double T = (a * sl->h * (1 + 0x1p-47) + sq * sl->r) * (1 + 0x1p-49) + 0x1p-1000;
+    double A = W2 * (1 - 0x1p-50) - 0x1p-1000;                           /* <= w.(p - c) */
+    *num = (A - T) * (1 - 0x1p-50);                                      /* rounded down */
+    *den = sqrt(W2 * (1 + 0x1p-50)) * (1 + 0x1p-51);                     /* >= |w| */
+    return *num > 0x1p-450;
 }
 
-/* A bound for every triangle of a leaf at once: the support bound over
- * all their corners in the direction from the leaf box's centre to p
- * (nearly the true direction when p is far from the leaf). */
-double hd__tris_lower(const hd__tri_t *t, size_t n, const hd__box_t *b, const double p[3]) {
-    double w[3];
-    for (int i = 0; i < 3; i++) w[i] = p[i] - (b->lo[i] / 2 + b->hi[i] / 2);
-    return support_lower(t, n, p, w);
+double hd__slab_lower(const hd__slab_t *sl, const double p[3]) {
+    double num, den;
+    if (!slab_parts(sl, p, &num, &den)) return 0.0;
+    return num / den * (1 - 0x1p-50); /* one rounding of the quotient */
+}
+
+/* Whether the slab bound proves the distance above sqrt(thr), thr at
+ * least 2^-990 (square_down's proof). */
+static int slab_beyond(const hd__slab_t *sl, const double p[3], double thr) {
+    return thr < INFINITY && square_down(hd__slab_lower(sl, p)) > thr;
+}
+
+/* A unit m (|m|^2 within 2^-50 of 1 when computed, so within e of it) in
+ * the direction of n, or (1, 0, 0) when n is too small to normalise. */
+static void unit_direction(const double n[3], double m[3]) {
+    double l2 = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
+    if (l2 > 0x1p-900 && l2 < 0x1p900) {
+        double l = sqrt(l2);
+        for (int i = 0; i < 3; i++) m[i] = n[i] / l;
+        double c = m[0] * m[0] + m[1] * m[1] + m[2] * m[2];
+        if (fabs(c - 1) <= 0x1p-50) return;
+    }
+    m[0] = 1, m[1] = 0, m[2] = 0;
+}
+
+/* The slab of triangles t[0 .. n) (box b holds them): c the box's centre,
+ * m their normals' sum (each turned towards the first one's side), h and
+ * r over every corner: |m . x| and |x| computed for x = v - c rounded
+ * (u |x|) carry at most 4.1u sum |m_i x_i| and 3.1u |x|^2 more, covered by
+ * the margins below. */
+void hd__slab_make(const hd__tri_t *t, size_t n, const hd__box_t *b, hd__slab_t *sl) {
+    double sum[3] = {0, 0, 0}, first[3] = {0, 0, 0}, h = 0, r2 = 0;
+    for (size_t j = 0; j < n; j++) {
+        const double *a = t[j].v[0], *bb = t[j].v[1], *cc = t[j].v[2];
+        double u[3] = {bb[0] - a[0], bb[1] - a[1], bb[2] - a[2]}, v[3] = {cc[0] - a[0], cc[1] - a[1], cc[2] - a[2]};
+        double nn[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]}, m[3];
+        unit_direction(nn, m);
+        if (j == 0) memcpy(first, m, sizeof first);
+        double sgn = m[0] * first[0] + m[1] * first[1] + m[2] * first[2] < 0 ? -1 : 1;
+        for (int i = 0; i < 3; i++) sum[i] += sgn * m[i];
+    }
+    unit_direction(sum, sl->m);
+    for (int i = 0; i < 3; i++) sl->c[i] = b->lo[i] / 2 + b->hi[i] / 2;
+    for (size_t j = 0; j < n; j++)
+        for (int k = 0; k < 3; k++) {
+            double x[3] = {t[j].v[k][0] - sl->c[0], t[j].v[k][1] - sl->c[1], t[j].v[k][2] - sl->c[2]};
+            double d = fabs(x[0] * sl->m[0] + x[1] * sl->m[1] + x[2] * sl->m[2]) +
+                       0x1p-49 * (fabs(x[0] * sl->m[0]) + fabs(x[1] * sl->m[1]) + fabs(x[2] * sl->m[2]));
+            double q = x[0] * x[0] + x[1] * x[1] + x[2] * x[2];
+            h = d > h ? d : h;
+            r2 = q > r2 ? q : r2;
+        }
+    sl->h = h * (1 + 0x1p-50) + 0x1p-1000;
+    sl->r = sqrt(r2 * (1 + 0x1p-49)) * (1 + 0x1p-50) + 0x1p-1000;
 }
 
 /* ---- the tree ----------------------------------------------------------- */
@@ -259,6 +304,7 @@ static size_t build_node(builder_t *B, size_t first, size_t n) {
         }
     }
     node->box = box;
+    hd__slab_make(tris, n, &box, &B->t->nslab[me]);
     if (n <= LEAF) {
         node->first_or_second = (uint32_t)first;
         node->count = (uint32_t)n;
@@ -284,10 +330,14 @@ int hd__bvh_build(hd__bvh_t *t, hd__tri_t *tris, size_t n) {
     t->nodes = hd__malloc_array(2 * n, sizeof *t->nodes);
     t->boxes = hd__malloc_array(n, sizeof *t->boxes);
     t->prep = hd__malloc_array(n, sizeof *t->prep);
-    if (!t->nodes || !t->boxes || !t->prep) { /* the triangles stay the caller's */
+    t->nslab = hd__malloc_array(2 * n, sizeof *t->nslab);
+    t->tslab = hd__malloc_array(n, sizeof *t->tslab);
+    if (!t->nodes || !t->boxes || !t->prep || !t->nslab || !t->tslab) { /* the triangles stay the caller's */
         free(t->nodes);
         free(t->boxes);
         free(t->prep);
+        free(t->nslab);
+        free(t->tslab);
         memset(t, 0, sizeof *t);
         return HD_ENOMEM;
     }
@@ -297,6 +347,7 @@ int hd__bvh_build(hd__bvh_t *t, hd__tri_t *tris, size_t n) {
     for (size_t k = 0; k < n; k++) {
         tri_box(&t->tris[k], &t->boxes[k]);
         hd__tri_prep(t->tris[k].v[0], t->tris[k].v[1], t->tris[k].v[2], &t->prep[k]);
+        hd__slab_make(&t->tris[k], 1, &t->boxes[k], &t->tslab[k]);
     }
     return HD_OK;
 }
@@ -306,6 +357,8 @@ void hd__bvh_free(hd__bvh_t *t) {
     free(t->nodes);
     free(t->boxes);
     free(t->prep);
+    free(t->nslab);
+    free(t->tslab);
     memset(t, 0, sizeof *t);
 }
 
@@ -323,9 +376,14 @@ static double thr_from_hi(double h2) {
     return t > 0x1p-990 ? t : 0x1p-990;
 }
 
-/* A candidate: a triangle (its position) whose lower bound lo2 did not
- * discard it; the kernel runs for candidates in increasing lo2 until lo2
- * exceeds the threshold. */
+/* A candidate: a triangle (its position) with a lower bound lo2 on its
+ * squared distance that did not discard it.  Two stages: the cheap
+ * bounds (the triangle's box and slab) give a first lo2, and the
+ * triangles are then taken in increasing lo2 for the prepared bounds
+ * (hd__tri_bounds_prep), whose lo2 orders the kernel calls in turn; each
+ * stage stops at the first lo2 above the threshold, which every hi2 and
+ * every kernel call may lower.  A candidate left has lo2 > thr >=
+ * next(d*)^2: the file's rule discards it. */
 typedef struct {
     double lo2;
     size_t pos;
@@ -339,8 +397,8 @@ typedef struct {
     /* thr >= next(d*)^2 for the answer d* (at least 2^-990): the least of
      * square_up(next(best.d)) and thr_from_hi of every hi2 computed */
     double thr;
-    size_t n_cand;
-    cand_t cand[CANDS];
+    size_t n_cheap, n_prep;
+    cand_t cheap[CANDS], prep[CANDS];
 } search_t;
 
 static void evaluate(const hd__bvh_t *t, const double *p, size_t pos, search_t *s, hd__bvh_stats_t *st) {
@@ -358,25 +416,24 @@ static void evaluate(const hd__bvh_t *t, const double *p, size_t pos, search_t *
     }
 }
 
-/* The kernel for the candidates, nearest lower bound first, while their
- * lower bound is not above the threshold (which each call may lower);
- * the list is emptied.  A candidate not evaluated has lo2 > thr >=
- * next(d*)^2: the file's rule discards it. */
-static void flush(const hd__bvh_t *t, const double *p, search_t *s, hd__bvh_stats_t *st) {
-    cand_t *c = s->cand;
-    size_t n = s->n_cand;
-    for (size_t i = 1; i < n; i++) { /* insertion sort: the list is short */
+static void sort_cands(cand_t *c, size_t n) {
+    for (size_t i = 1; i < n; i++) { /* insertion sort: the lists are short */
         cand_t x = c[i];
         size_t j = i;
         for (; j > 0 && c[j - 1].lo2 > x.lo2; j--) c[j] = c[j - 1];
         c[j] = x;
     }
-    for (size_t i = 0; i < n && c[i].lo2 <= s->thr; i++) evaluate(t, p, c[i].pos, s, st);
-    s->n_cand = 0;
+}
+
+/* The kernel for the prepared stage's candidates; the list is emptied. */
+static void flush_prep(const hd__bvh_t *t, const double *p, search_t *s, hd__bvh_stats_t *st) {
+    sort_cands(s->prep, s->n_prep);
+    for (size_t i = 0; i < s->n_prep && s->prep[i].lo2 <= s->thr; i++) evaluate(t, p, s->prep[i].pos, s, st);
+    s->n_prep = 0;
 }
 
 /* Triangle k's prepared bounds: discarded when lo2 > thr, else a
- * candidate, and its hi2 may lower thr. */
+ * candidate of the kernel, and its hi2 may lower thr. */
 static void consider(const hd__bvh_t *t, const double *p, size_t k, search_t *s, hd__bvh_stats_t *st) {
     double lo2, hi2;
     st->bounded++;
@@ -384,32 +441,46 @@ static void consider(const hd__bvh_t *t, const double *p, size_t k, search_t *s,
     if (lo2 > s->thr) return;
     double h = thr_from_hi(hi2);
     s->thr = h < s->thr ? h : s->thr;
-    if (s->n_cand == CANDS) flush(t, p, s, st);
-    s->cand[s->n_cand++] = (cand_t){lo2, k};
+    if (s->n_prep == CANDS) flush_prep(t, p, s, st);
+    s->prep[s->n_prep++] = (cand_t){lo2, k};
+}
+
+static void flush_cheap(const hd__bvh_t *t, const double *p, search_t *s, hd__bvh_stats_t *st) {
+    sort_cands(s->cheap, s->n_cheap);
+    for (size_t i = 0; i < s->n_cheap && s->cheap[i].lo2 <= s->thr; i++) consider(t, p, s->cheap[i].pos, s, st);
+    s->n_cheap = 0;
+}
+
+/* Triangle k's cheap bounds: the box's (hd__box_lb2s shrunk, below d^2 by
+ * box_beyond's proof) and the slab's squared (square_down). */
+static void screen(const hd__bvh_t *t, const double *p, size_t k, search_t *s, hd__bvh_stats_t *st) {
+    double b = hd__box_lb2s(&t->boxes[k], p[0], p[1], p[2]);
+    if (box_beyond(b, s->thr)) return;
+    b *= SHRINK;
+    double w[3] = {p[0] - t->tslab[k].c[0], p[1] - t->tslab[k].c[1], p[2] - t->tslab[k].c[2]};
+    double l = square_down(hd__support_lower(&t->tris[k], 1, p, w));
+    l = l > b ? l : b;
+    if (l > s->thr) return;
+    if (s->n_cheap == CANDS) flush_cheap(t, p, s, st);
+    s->cheap[s->n_cheap++] = (cand_t){l, k};
 }
 
 static void leaf(const hd__bvh_t *t, const hd__bvh_node_t *node, const double *p, size_t seed, search_t *s,
                  hd__bvh_stats_t *st) {
-    for (size_t k = node->first_or_second, end = k + node->count; k < end; k++) {
-        if (k == seed || box_beyond(&t->boxes[k], p, s->thr)) continue;
-        consider(t, p, k, s, st);
-    }
+    for (size_t k = node->first_or_second, end = k + node->count; k < end; k++)
+        if (k != seed) screen(t, p, k, s, st);
 }
-
-/* A lower bound L on a distance, squared and rounded down: fl(L L) is at
- * most L^2 (1 + u), and the product by 1 - 2^-50 rounds to below L^2
- * (an underflowed product is below 2^-990 <= thr, so it discards nothing). */
-static double square_down(double L) { return L * L * (1.0 - 0x1p-50); }
 
 static void search_init(search_t *s) {
     s->index = s->pos = SIZE_MAX;
     s->thr = INFINITY;
-    s->n_cand = 0;
+    s->n_cheap = s->n_prep = 0;
 }
 
 static size_t search_end(const hd__bvh_t *t, const double *p, search_t *s, hd__tri_near_t *best, size_t *index,
                          hd__bvh_stats_t *st) {
-    flush(t, p, s, st);
+    flush_cheap(t, p, s, st);
+    flush_prep(t, p, s, st);
     *best = s->best;
     *index = s->index;
     return s->pos;
@@ -429,11 +500,10 @@ size_t hd__bvh_nearest(const hd__bvh_t *t, const double p[3], size_t seed, hd__t
     top = 1;
     while (top > 0) {
         e = &stack[--top];
-        if (e->s * SHRINK > s.thr) continue; /* box_beyond, from the stored square */
+        if (box_beyond(e->s, s.thr)) continue;
         const hd__bvh_node_t *node = &t->nodes[e->node];
         uint32_t first = e->first, n = e->n;
-        if (n <= GROUP && s.thr < INFINITY && square_down(hd__tris_lower(&t->tris[first], n, &node->box, p)) > s.thr)
-            continue;
+        if (slab_beyond(&t->nslab[e->node], p, s.thr)) continue;
         st->nodes++;
         if (node->count) {
             leaf(t, node, p, seed, &s, st);
@@ -445,11 +515,11 @@ size_t hd__bvh_nearest(const hd__bvh_t *t, const double p[3], size_t seed, hd__t
         /* the nearer child on top; the median split halves the count at
          * each level, so the stack never holds more than the depth plus one */
         if (la > lb) {
-            if (la * SHRINK <= s.thr) stack[top++] = (entry_t){a, fa, na, la};
-            if (lb * SHRINK <= s.thr) stack[top++] = (entry_t){b, fb, n - na, lb};
+            if (!box_beyond(la, s.thr)) stack[top++] = (entry_t){a, fa, na, la};
+            if (!box_beyond(lb, s.thr)) stack[top++] = (entry_t){b, fb, n - na, lb};
         } else {
-            if (lb * SHRINK <= s.thr) stack[top++] = (entry_t){b, fb, n - na, lb};
-            if (la * SHRINK <= s.thr) stack[top++] = (entry_t){a, fa, na, la};
+            if (!box_beyond(lb, s.thr)) stack[top++] = (entry_t){b, fb, n - na, lb};
+            if (!box_beyond(la, s.thr)) stack[top++] = (entry_t){a, fa, na, la};
         }
     }
     return search_end(t, p, &s, best, index, st);
@@ -493,8 +563,7 @@ size_t hd__bvh_nearest_in(const hd__bvh_t *t, const double p[3], const uint32_t 
     if (seed < t->n_tris) consider(t, p, seed, &s, st);
     for (size_t i = 0; i < n; i++) {
         size_t k = list[i];
-        if (k == seed || box_beyond(&t->boxes[k], p, s.thr)) continue;
-        consider(t, p, k, &s, st);
+        if (k != seed) screen(t, p, k, &s, st);
     }
     st->listed += n;
     return search_end(t, p, &s, best, index, st);

@@ -113,10 +113,18 @@ typedef struct hd__bvh_node {
     uint32_t first_or_second, count;
 } hd__bvh_node_t;
 
+/* The slab bound's description of a set of corners (bvh.c has the proof):
+ * a centre c, a unit direction m, h >= max |m . (v - c)|, r >= max |v - c|. */
+typedef struct hd__slab {
+    double c[3], m[3], h, r;
+} hd__slab_t;
+
 typedef struct hd__bvh {
     hd__tri_t *tris;        /* in leaf order */
     hd__box_t *boxes;       /* each triangle's box, in the same order */
     hd__tri_prep_t *prep;   /* each triangle prepared (hd__tri_prep), in the same order */
+    hd__slab_t *tslab;      /* each triangle's slab, in the same order */
+    hd__slab_t *nslab;      /* each node's slab (over its triangles' corners) */
     hd__bvh_node_t *nodes;
     size_t n_tris, n_nodes;
 } hd__bvh_t;
@@ -157,11 +165,14 @@ size_t hd__bvh_nearest_in(const hd__bvh_t *t, const double p[3], const uint32_t 
 
 /* Lower bounds on distances, proven not to exceed the true distance with
  * every rounding error counted (bvh.c has the proofs); 0 when no bound
- * is certain.  Exposed for the tests. */
+ * is certain.  hd__slab_make describes the corners of t[0 .. n) (b: a box
+ * holding them) for hd__slab_lower.  Exposed for the tests. */
 double hd__box_lower(const hd__box_t *b, const double p[3]);
-double hd__tri_lower(const hd__tri_t *t, const double p[3]);
-/* ... for every triangle of t[0 .. n) at once (b: a box holding them). */
-double hd__tris_lower(const hd__tri_t *t, size_t n, const hd__box_t *b, const double p[3]);
+void hd__slab_make(const hd__tri_t *t, size_t n, const hd__box_t *b, hd__slab_t *sl);
+double hd__slab_lower(const hd__slab_t *sl, const double p[3]);
+/* The support bound: min over the corners v of t[0 .. n) of
+ * w . (p - v) / |w|, shrunk; any w (it may be rescaled in place). */
+double hd__support_lower(const hd__tri_t *t, size_t n, const double p[3], double *w);
 
 /* 1 when the corners are collinear or coincident (the triangle is a
  * segment or a point), decided exactly. */
