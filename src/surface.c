@@ -22,7 +22,7 @@
 
 #define RUN 512
 #define GROUP_POINTS 16
-#define LIST 512
+#define LIST 128
 
 /* ---- reading ------------------------------------------------------------ */
 
@@ -250,7 +250,7 @@ static void run(void *ctx, size_t task, int worker) {
     job_t *J = ctx;
     size_t lo = task * RUN, hi = lo + RUN < J->n ? lo + RUN : J->n, seed = SIZE_MAX;
     far_t far = {-1.0, SIZE_MAX, SIZE_MAX};
-    hd__bvh_stats_t st = {0, 0, 0, 0, 0};
+    hd__bvh_stats_t st = {0, 0, 0, 0, 0, 0};
     uint32_t list[LIST];
     for (size_t g = lo; g < hi; g += GROUP_POINTS) {
         size_t end = g + GROUP_POINTS < hi ? g + GROUP_POINTS : hi, index, n_list = SIZE_MAX;

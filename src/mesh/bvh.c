@@ -331,13 +331,11 @@ int hd__bvh_build(hd__bvh_t *t, hd__tri_t *tris, size_t n) {
     t->boxes = hd__malloc_array(n, sizeof *t->boxes);
     t->prep = hd__malloc_array(n, sizeof *t->prep);
     t->nslab = hd__malloc_array(2 * n, sizeof *t->nslab);
-    t->tslab = hd__malloc_array(n, sizeof *t->tslab);
-    if (!t->nodes || !t->boxes || !t->prep || !t->nslab || !t->tslab) { /* the triangles stay the caller's */
+    if (!t->nodes || !t->boxes || !t->prep || !t->nslab) { /* the triangles stay the caller's */
         free(t->nodes);
         free(t->boxes);
         free(t->prep);
         free(t->nslab);
-        free(t->tslab);
         memset(t, 0, sizeof *t);
         return HD_ENOMEM;
     }
@@ -347,7 +345,6 @@ int hd__bvh_build(hd__bvh_t *t, hd__tri_t *tris, size_t n) {
     for (size_t k = 0; k < n; k++) {
         tri_box(&t->tris[k], &t->boxes[k]);
         hd__tri_prep(t->tris[k].v[0], t->tris[k].v[1], t->tris[k].v[2], &t->prep[k]);
-        hd__slab_make(&t->tris[k], 1, &t->boxes[k], &t->tslab[k]);
     }
     return HD_OK;
 }
@@ -358,7 +355,6 @@ void hd__bvh_free(hd__bvh_t *t) {
     free(t->boxes);
     free(t->prep);
     free(t->nslab);
-    free(t->tslab);
     memset(t, 0, sizeof *t);
 }
 
@@ -425,10 +421,58 @@ static void sort_cands(cand_t *c, size_t n) {
     }
 }
 
+/* A tie at a shared corner without the kernel.  When the best triangle's
+ * nearest feature is a corner V and triangle k has a corner X bit-equal to
+ * V with p certainly in X's region of k (XY . XP < 0 and XZ . XP < 0,
+ * each with its rounding error bound: bounds.c's corner test, 6u of the
+ * products' magnitudes plus 2^-700, for coordinates below 2^100), then for
+ * every x of k, |p - x|^2 = |p - X|^2 + |x - X|^2 - 2 (x - X) . (p - X)
+ * >= |p - X|^2: k's true distance is |p - V|, the best one's, so the
+ * kernel would round it alike, and it returns the corner as the closest
+ * point with weight 1 (tri.c's and exact.c's corner cases).  So k is
+ * decided here: it wins exactly when its index is smaller.  1 when
+ * decided. */
+static int corner_tie(const hd__bvh_t *t, const double *p, size_t k, search_t *s) {
+    const hd__tri_prep_t *q = &t->prep[k];
+    if (s->best.feature < HD__TRI_VERTEX_A || !q->direct) return 0;
+    if (!(fabs(p[0]) < 0x1p100 && fabs(p[1]) < 0x1p100 && fabs(p[2]) < 0x1p100)) return 0;
+    const double *corner[3] = {q->a, q->b, q->c};
+    int x = 0;
+    while (x < 3 && memcmp(corner[x], s->best.point, sizeof q->a) != 0) x++;
+    if (x == 3) return 0;
+    /* the two edges from X, rounded as the prepared ones are */
+    double e[2][3];
+    for (int i = 0; i < 3; i++) {
+        double ab = q->ab[i], ac = q->ac[i], bc = q->bc[i];
+        e[0][i] = x == 0 ? ab : x == 1 ? -ab : -ac;
+        e[1][i] = x == 0 ? ac : x == 1 ? bc : -bc;
+    }
+    const double *X = corner[x];
+    double xp[3] = {p[0] - X[0], p[1] - X[1], p[2] - X[2]};
+    for (int j = 0; j < 2; j++) {
+        double dot = e[j][0] * xp[0] + e[j][1] * xp[1] + e[j][2] * xp[2];
+        double mag = fabs(e[j][0] * xp[0]) + fabs(e[j][1] * xp[1]) + fabs(e[j][2] * xp[2]);
+        if (!(dot + (6 * 0x1p-53 * mag + 0x1p-700) < 0)) return 0;
+    }
+    size_t index = t->tris[k].index;
+    if (index < s->index) {
+        s->index = index;
+        s->pos = k;
+        s->best.feature = (hd__tri_feature_t)(HD__TRI_VERTEX_A + x);
+        s->best.exact = 0;
+        for (int i = 0; i < 3; i++) s->best.bary[i] = i == x;
+    }
+    return 1;
+}
+
 /* The kernel for the prepared stage's candidates; the list is emptied. */
 static void flush_prep(const hd__bvh_t *t, const double *p, search_t *s, hd__bvh_stats_t *st) {
     sort_cands(s->prep, s->n_prep);
-    for (size_t i = 0; i < s->n_prep && s->prep[i].lo2 <= s->thr; i++) evaluate(t, p, s->prep[i].pos, s, st);
+    for (size_t i = 0; i < s->n_prep && s->prep[i].lo2 <= s->thr; i++) {
+        size_t k = s->prep[i].pos;
+        if (s->pos != SIZE_MAX && corner_tie(t, p, k, s)) st->ties++;
+        else evaluate(t, p, k, s, st);
+    }
     s->n_prep = 0;
 }
 
@@ -451,18 +495,54 @@ static void flush_cheap(const hd__bvh_t *t, const double *p, search_t *s, hd__bv
     s->n_cheap = 0;
 }
 
-/* Triangle k's cheap bounds: the box's (hd__box_lb2s shrunk, below d^2 by
- * box_beyond's proof) and the slab's squared (square_down). */
+/* The support bound of triangle t as a test: whether every point x of it
+ * is proven farther than sqrt(thr) from p.  With w the computed p - c (c
+ * any point, here the centre of the triangle's box) and x_k = v_k - c,
+ * w . (p - x) >= w . (p - c) - max_k w . x_k for x in the hull, and
+ * |p - x| >= w . (p - x) / |w|, so num^2 > thr |w|^2 with num below
+ * w . (p - c) - max_k w . x_k proves it; no square root, no quotient.
+ *
+ * Rounding: each w_i is p_i - c_i rounded once, so w . (p - c) >= W2
+ * (1 - 1.01u) for the true W2 = |w|^2, and the computed W2c is within
+ * 3.01u of it (W2c >= 2^-900: underflow adds a relative 2^-170 at most);
+ * x_k rounded once per component and the dot product give w . x_k below
+ * s_k + 4.1u A_k (A_k = sum |w_i x_ki| computed), and m_k = s_k +
+ * 2^-49 A_k + 2^-1000, computed, is above it (the extra 8u A_k covers the
+ * sum's rounding, 2^-1000 underflow).  X = W2c (1 - 2^-50) rounds to below
+ * W2 (1 - 4.1u); (X - max m_k) (1 - 2^-50) rounds to below the difference
+ * when positive: num.  num^2 (1 - 2^-50) rounds to below num^2, and
+ * thr W2c (1 + 2^-49) to above thr W2 when it is at least 2^-1000 (then
+ * thr W2c was rounded as a normal number). */
+static int support_beyond(const hd__tri_t *t, const double *c, const double *p, double thr) {
+    double w[3] = {p[0] - c[0], p[1] - c[1], p[2] - c[2]};
+    double W2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
+    if (!(W2 >= 0x1p-900)) return 0;
+    double M = -INFINITY;
+    for (int k = 0; k < 3; k++) {
+        const double *v = t->v[k];
+        double x0 = v[0] - c[0], x1 = v[1] - c[1], x2 = v[2] - c[2];
+        double sk = w[0] * x0 + w[1] * x1 + w[2] * x2;
+        double Ak = fabs(w[0] * x0) + fabs(w[1] * x1) + fabs(w[2] * x2);
+        double mk = sk + (0x1p-49 * Ak + 0x1p-1000);
+        M = mk > M ? mk : M;
+    }
+    double num = (W2 * (1 - 0x1p-50) - M) * (1 - 0x1p-50);
+    if (!(num > 0)) return 0;
+    double rhs = thr * W2 * (1 + 0x1p-49);
+    return rhs >= 0x1p-1000 && num * num * (1 - 0x1p-50) > rhs;
+}
+
+/* Triangle k's cheap bounds: its box's (hd__box_lb2s shrunk, below d^2
+ * by box_beyond's proof) and the support bound; a triangle left is a
+ * candidate of the prepared stage with the box's bound as its key. */
 static void screen(const hd__bvh_t *t, const double *p, size_t k, search_t *s, hd__bvh_stats_t *st) {
-    double b = hd__box_lb2s(&t->boxes[k], p[0], p[1], p[2]);
+    const hd__box_t *bx = &t->boxes[k];
+    double b = hd__box_lb2s(bx, p[0], p[1], p[2]);
     if (box_beyond(b, s->thr)) return;
-    b *= SHRINK;
-    double w[3] = {p[0] - t->tslab[k].c[0], p[1] - t->tslab[k].c[1], p[2] - t->tslab[k].c[2]};
-    double l = square_down(hd__support_lower(&t->tris[k], 1, p, w));
-    l = l > b ? l : b;
-    if (l > s->thr) return;
+    double c[3] = {bx->lo[0] / 2 + bx->hi[0] / 2, bx->lo[1] / 2 + bx->hi[1] / 2, bx->lo[2] / 2 + bx->hi[2] / 2};
+    if (support_beyond(&t->tris[k], c, p, s->thr)) return;
     if (s->n_cheap == CANDS) flush_cheap(t, p, s, st);
-    s->cheap[s->n_cheap++] = (cand_t){l, k};
+    s->cheap[s->n_cheap++] = (cand_t){b * SHRINK, k};
 }
 
 static void leaf(const hd__bvh_t *t, const hd__bvh_node_t *node, const double *p, size_t seed, search_t *s,
@@ -533,6 +613,45 @@ static int boxes_beyond(const hd__box_t *a, const hd__box_t *b, double r2) {
     return hd__box_box_lb2(a, b) * SHRINK > r2;
 }
 
+/* The support bound between a triangle and a box B: with w the computed
+ * centre of B less c (the centre of the triangle's box), every q of B and
+ * x of the triangle have w . (q - x) = w . (q - c) - w . (x - c) >=
+ * sum_i min(w_i (lo_i - c_i), w_i (hi_i - c_i)) - max_k w . x_k, and
+ * |q - x| >= w . (q - x) / |w|.  Rounding: each of the terms is formed by
+ * a rounded difference and a rounded product (2.01u of the larger of its
+ * two computed magnitudes, a_i), the three summed (2.01u of their sum),
+ * and w . x_k as in support_beyond (4.1u A_k); the three subtractions
+ * below round by at most u of |Q| + |M| + E each: E = 2^-48 (sum a_i +
+ * max A_k) + 2^-1000 exceeds all of it (32u against 11u), and the test
+ * then is support_beyond's with r2 for thr. */
+static int group_beyond(const hd__tri_t *t, const hd__box_t *tb, const hd__box_t *B, double r2) {
+    double c[3], w[3], Q = 0, S = 0;
+    for (int i = 0; i < 3; i++) {
+        c[i] = tb->lo[i] / 2 + tb->hi[i] / 2;
+        w[i] = (B->lo[i] / 2 + B->hi[i] / 2) - c[i];
+    }
+    double W2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
+    if (!(W2 >= 0x1p-900)) return 0;
+    for (int i = 0; i < 3; i++) {
+        double x = w[i] * (B->lo[i] - c[i]), y = w[i] * (B->hi[i] - c[i]);
+        Q += x < y ? x : y;
+        S += fabs(x) > fabs(y) ? fabs(x) : fabs(y);
+    }
+    double M = -INFINITY, A = 0;
+    for (int k = 0; k < 3; k++) {
+        const double *v = t->v[k];
+        double x0 = v[0] - c[0], x1 = v[1] - c[1], x2 = v[2] - c[2];
+        double sk = w[0] * x0 + w[1] * x1 + w[2] * x2;
+        double Ak = fabs(w[0] * x0) + fabs(w[1] * x1) + fabs(w[2] * x2);
+        M = sk > M ? sk : M;
+        A = Ak > A ? Ak : A;
+    }
+    double num = ((Q - M) - (0x1p-48 * (S + A) + 0x1p-1000)) * (1 - 0x1p-50);
+    if (!(num > 0)) return 0;
+    double rhs = r2 * W2 * (1 + 0x1p-49);
+    return rhs >= 0x1p-1000 && num * num * (1 - 0x1p-50) > rhs;
+}
+
 size_t hd__bvh_collect(const hd__bvh_t *t, const hd__box_t *B, double r2, uint32_t *out, size_t cap) {
     uint32_t stack[MAX_DEPTH];
     int top = 0;
@@ -543,7 +662,7 @@ size_t hd__bvh_collect(const hd__bvh_t *t, const hd__box_t *B, double r2, uint32
         const hd__bvh_node_t *node = &t->nodes[stack[--top]];
         if (node->count) {
             for (size_t k = node->first_or_second, end = k + node->count; k < end; k++) {
-                if (boxes_beyond(&t->boxes[k], B, r2)) continue;
+                if (boxes_beyond(&t->boxes[k], B, r2) || group_beyond(&t->tris[k], &t->boxes[k], B, r2)) continue;
                 if (n == cap) return SIZE_MAX;
                 out[n++] = (uint32_t)k;
             }

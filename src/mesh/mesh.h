@@ -123,7 +123,6 @@ typedef struct hd__bvh {
     hd__tri_t *tris;        /* in leaf order */
     hd__box_t *boxes;       /* each triangle's box, in the same order */
     hd__tri_prep_t *prep;   /* each triangle prepared (hd__tri_prep), in the same order */
-    hd__slab_t *tslab;      /* each triangle's slab, in the same order */
     hd__slab_t *nslab;      /* each node's slab (over its triangles' corners) */
     hd__bvh_node_t *nodes;
     size_t n_tris, n_nodes;
@@ -138,7 +137,7 @@ void hd__bvh_free(hd__bvh_t *t);
 
 /* The counters of the queries (summed per thread, then over threads). */
 typedef struct hd__bvh_stats {
-    uint64_t nodes, bounded, kernel, exact, listed;
+    uint64_t nodes, bounded, kernel, exact, listed, ties;
 } hd__bvh_stats_t;
 
 /* The triangle nearest to p: *best (its distance correctly rounded, its
