@@ -342,6 +342,12 @@ int hd__bvh_build(hd__bvh_t *t, hd__tri_t *tris, size_t n) {
     builder_t B = {t, 0};
     build_node(&B, 0, n);
     t->n_nodes = B.used;
+    /* at most 2n nodes were reserved; give back the rest (a failed
+     * shrink keeps the larger arrays) */
+    hd__bvh_node_t *nodes = realloc(t->nodes, t->n_nodes * sizeof *t->nodes);
+    hd__slab_t *slabs = realloc(t->nslab, t->n_nodes * sizeof *t->nslab);
+    if (nodes) t->nodes = nodes;
+    if (slabs) t->nslab = slabs;
     for (size_t k = 0; k < n; k++) {
         tri_box(&t->tris[k], &t->boxes[k]);
         hd__tri_prep(t->tris[k].v[0], t->tris[k].v[1], t->tris[k].v[2], &t->prep[k]);
