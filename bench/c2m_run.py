@@ -114,7 +114,7 @@ def main():
         for cloud in a.clouds.split(","):
             prev = {}
             for n in sizes:
-                runs = 3 if n <= 10 ** 6 else 1
+                runs = 3 if n <= 10 ** 5 else 1
                 peer_runs = 3 if n <= 10 ** 5 else 1
                 res = {"mesh": mname, "cloud": cloud, "points": n, "date": date, "commit": commit,
                        "load": round(load, 1)}

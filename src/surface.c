@@ -22,7 +22,7 @@
 
 #define RUN 512
 #define GROUP_POINTS 16
-#define LIST 128
+#define LIST 64
 
 /* ---- reading ------------------------------------------------------------ */
 
@@ -245,10 +245,13 @@ static void keep(job_t *J, size_t i, const hd__tri_near_t *best, size_t index, f
 /* Points [lo, hi) of the Morton order as groups of up to GROUP_POINTS:
  * the group's first point searches the tree, the others search the list
  * of the triangles that may be nearest to some point of the group's box
- * (hd__bvh_collect), or the tree when that list is longer than LIST. */
+ * (hd__bvh_collect), or the tree when that list is longer than LIST; after
+ * a list too long, the next groups (1, 2, 4 .. 64 of them) do not try. */
 static void run(void *ctx, size_t task, int worker) {
     job_t *J = ctx;
     size_t lo = task * RUN, hi = lo + RUN < J->n ? lo + RUN : J->n, seed = SIZE_MAX;
+    int corner = 0; /* the previous answer was at a corner */
+    size_t skip = 0, backoff = 0;
     far_t far = {-1.0, SIZE_MAX, SIZE_MAX};
     hd__bvh_stats_t st = {0, 0, 0, 0, 0, 0};
     uint32_t list[LIST];
@@ -267,11 +270,19 @@ static void run(void *ctx, size_t task, int worker) {
         for (size_t r = g; r < end; r++) {
             hd__tri_near_t best;
             if (n_list == SIZE_MAX) {
-                seed = hd__bvh_nearest(J->bvh, p[r - g], seed, &best, &index, &st);
-                if (r == g && end - g > 1) n_list = hd__bvh_collect(J->bvh, &B, group_r2(best.d, &B), list, LIST);
+                seed = hd__bvh_nearest(J->bvh, p[r - g], seed, corner, &best, &index, &st);
+                if (r == g && end - g > 1 && skip == 0) {
+                    n_list = hd__bvh_collect(J->bvh, &B, group_r2(best.d, &B), list, LIST);
+                    /* a list too long: the next 1, 2, 4 .. 64 groups search the tree */
+                    backoff = n_list == SIZE_MAX ? (backoff ? (backoff < 64 ? 2 * backoff : 64) : 1) : 0;
+                    skip = backoff;
+                } else if (r == g && skip > 0) {
+                    skip--;
+                }
             } else {
-                seed = hd__bvh_nearest_in(J->bvh, p[r - g], list, n_list, seed, &best, &index, &st);
+                seed = hd__bvh_nearest_in(J->bvh, p[r - g], list, n_list, seed, corner, &best, &index, &st);
             }
+            corner = best.feature >= HD__TRI_VERTEX_A;
             keep(J, J->order ? J->order[r] : r, &best, index, &far);
         }
     }

@@ -56,10 +56,6 @@
  * corners (leaf_lower) before they are opened. */
 #define GROUP 8
 
-/* A lower bound L on a distance, squared and rounded down: fl(L L) is at
- * most L^2 (1 + u), and the product by 1 - 2^-50 rounds to below L^2
- * (an underflowed product is below 2^-990 <= thr, so it discards nothing). */
-static double square_down(double L) { return L * L * (1.0 - 0x1p-50); }
 
 /* ---- lower bounds ------------------------------------------------------- */
 
@@ -142,103 +138,6 @@ double hd__support_lower(const hd__tri_t *t, size_t n, const double p[3], double
 }
 
 
-/* The slab bound.  A set of corners x_v (a node's or a triangle's) is
- * described by a centre c, a direction m with |m|^2 in [1 - e, 1 + e]
- * (e = 2^-48), h >= max |m . (x_v - c)| and r >= max |x_v - c| (true
- * values).  For any w, splitting w and x = x_v - c along m and across it,
- * w . x <= |w . m| h / (1 - e) + sqrt(|w|^2 - (w . m)^2 / (1 + e)) r =: T,
- * and every point x of their hull has w . (p - x) >= w . (p - c) - T, so
- * |p - x| >= (w . (p - c) - T) / |w| (Cauchy-Schwarz).  With w the
- * computed p - c this is nearly the distance when p lies far along m (a
- * flat patch seen from the front loses only about r^2 / |p - c|), where a
- * box or a sphere loses about its size.
- *
- * Rounding, for the stored w and doubles of at most 2^512 (|w|^2 < 1.3e307):
- * W2 = |w|^2 computed is within (1 +- 4u) of the true one; w . (p - c) =
- * |w|^2 + w . (p - c - w) >= W2 (1 - 6u) (each w_i is p_i - c_i rounded
- * once); w . m computed is within 4u sum |w_i m_i| (+ 2^-1000 for
- * underflow); each formula below rounds outward by factors that exceed its
- * own roundings (each named at its line), and every upper bound adds
- * 2^-1000 against underflow; W2 below 2^-900 gives no bound. */
-#define U 0x1p-53
-
-static int slab_parts(const hd__slab_t *sl, const double p[3], double *num, double *den) {
-    double w[3] = {p[0] - sl->c[0], p[1] - sl->c[1], p[2] - sl->c[2]};
-    double W2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
-    if (!(W2 >= 0x1p-900)) return 0;
-    double wm = w[0] * sl->m[0] + w[1] * sl->m[1] + w[2] * sl->m[2];
-    double ewm = 4 * U * (fabs(w[0] * sl->m[0]) + fabs(w[1] * sl->m[1]) + fabs(w[2] * sl->m[2])) + 0x1p-1000;
-    double a = fabs(wm) + ewm, bl = fabs(wm) - ewm;                     /* a >= |w.m| >= bl */
-    bl = bl > 0 ? bl : 0;
-    /* |w|^2 - (w.m)^2 / (1 + e) <= W2 (1 + 8u) - bl^2 (1 - 64u), each
-     * side rounded once or twice, and the difference rounded up by 8u */
-    double perp = (W2 * (1 + 0x1p-50) - bl * bl * (1 - 0x1p-47)) * (1 + 0x1p-50);
-    double sq = perp > 0 ? sqrt(perp) * (1 + 0x1p-50) : 0;
-    /* a h / (1 - e) <= fl(a h) (1 + 64u); the sum and sq r round three
-     * times more: 16u */
-    double T = (a * sl->h * (1 + 0x1p-47) + sq * sl->r) * (1 + 0x1p-49) + 0x1p-1000;
-    double A = W2 * (1 - 0x1p-50) - 0x1p-1000;                           /* <= w.(p - c) */
-    *num = (A - T) * (1 - 0x1p-50);                                      /* rounded down */
-    *den = sqrt(W2 * (1 + 0x1p-50)) * (1 + 0x1p-51);                     /* >= |w| */
-    return *num > 0x1p-450;
-}
-
-double hd__slab_lower(const hd__slab_t *sl, const double p[3]) {
-    double num, den;
-    if (!slab_parts(sl, p, &num, &den)) return 0.0;
-    return num / den * (1 - 0x1p-50); /* one rounding of the quotient */
-}
-
-/* Whether the slab bound proves the distance above sqrt(thr), thr at
- * least 2^-990 (square_down's proof). */
-static int slab_beyond(const hd__slab_t *sl, const double p[3], double thr) {
-    return thr < INFINITY && square_down(hd__slab_lower(sl, p)) > thr;
-}
-
-/* A unit m (|m|^2 within 2^-50 of 1 when computed, so within e of it) in
- * the direction of n, or (1, 0, 0) when n is too small to normalise. */
-static void unit_direction(const double n[3], double m[3]) {
-    double l2 = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
-    if (l2 > 0x1p-900 && l2 < 0x1p900) {
-        double l = sqrt(l2);
-        for (int i = 0; i < 3; i++) m[i] = n[i] / l;
-        double c = m[0] * m[0] + m[1] * m[1] + m[2] * m[2];
-        if (fabs(c - 1) <= 0x1p-50) return;
-    }
-    m[0] = 1, m[1] = 0, m[2] = 0;
-}
-
-/* The slab of triangles t[0 .. n) (box b holds them): c the box's centre,
- * m their normals' sum (each turned towards the first one's side), h and
- * r over every corner: |m . x| and |x| computed for x = v - c rounded
- * (u |x|) carry at most 4.1u sum |m_i x_i| and 3.1u |x|^2 more, covered by
- * the margins below. */
-void hd__slab_make(const hd__tri_t *t, size_t n, const hd__box_t *b, hd__slab_t *sl) {
-    double sum[3] = {0, 0, 0}, first[3] = {0, 0, 0}, h = 0, r2 = 0;
-    for (size_t j = 0; j < n; j++) {
-        const double *a = t[j].v[0], *bb = t[j].v[1], *cc = t[j].v[2];
-        double u[3] = {bb[0] - a[0], bb[1] - a[1], bb[2] - a[2]}, v[3] = {cc[0] - a[0], cc[1] - a[1], cc[2] - a[2]};
-        double nn[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]}, m[3];
-        unit_direction(nn, m);
-        if (j == 0) memcpy(first, m, sizeof first);
-        double sgn = m[0] * first[0] + m[1] * first[1] + m[2] * first[2] < 0 ? -1 : 1;
-        for (int i = 0; i < 3; i++) sum[i] += sgn * m[i];
-    }
-    unit_direction(sum, sl->m);
-    for (int i = 0; i < 3; i++) sl->c[i] = b->lo[i] / 2 + b->hi[i] / 2;
-    for (size_t j = 0; j < n; j++)
-        for (int k = 0; k < 3; k++) {
-            double x[3] = {t[j].v[k][0] - sl->c[0], t[j].v[k][1] - sl->c[1], t[j].v[k][2] - sl->c[2]};
-            double d = fabs(x[0] * sl->m[0] + x[1] * sl->m[1] + x[2] * sl->m[2]) +
-                       0x1p-49 * (fabs(x[0] * sl->m[0]) + fabs(x[1] * sl->m[1]) + fabs(x[2] * sl->m[2]));
-            double q = x[0] * x[0] + x[1] * x[1] + x[2] * x[2];
-            h = d > h ? d : h;
-            r2 = q > r2 ? q : r2;
-        }
-    sl->h = h * (1 + 0x1p-50) + 0x1p-1000;
-    sl->r = sqrt(r2 * (1 + 0x1p-49)) * (1 + 0x1p-50) + 0x1p-1000;
-}
-
 /* ---- the tree ----------------------------------------------------------- */
 
 static void tri_box(const hd__tri_t *t, hd__box_t *b) {
@@ -304,7 +203,6 @@ static size_t build_node(builder_t *B, size_t first, size_t n) {
         }
     }
     node->box = box;
-    hd__slab_make(tris, n, &box, &B->t->nslab[me]);
     if (n <= LEAF) {
         node->first_or_second = (uint32_t)first;
         node->count = (uint32_t)n;
@@ -330,12 +228,10 @@ int hd__bvh_build(hd__bvh_t *t, hd__tri_t *tris, size_t n) {
     t->nodes = hd__malloc_array(2 * n, sizeof *t->nodes);
     t->boxes = hd__malloc_array(n, sizeof *t->boxes);
     t->prep = hd__malloc_array(n, sizeof *t->prep);
-    t->nslab = hd__malloc_array(2 * n, sizeof *t->nslab);
-    if (!t->nodes || !t->boxes || !t->prep || !t->nslab) { /* the triangles stay the caller's */
+    if (!t->nodes || !t->boxes || !t->prep) { /* the triangles stay the caller's */
         free(t->nodes);
         free(t->boxes);
         free(t->prep);
-        free(t->nslab);
         memset(t, 0, sizeof *t);
         return HD_ENOMEM;
     }
@@ -343,11 +239,9 @@ int hd__bvh_build(hd__bvh_t *t, hd__tri_t *tris, size_t n) {
     build_node(&B, 0, n);
     t->n_nodes = B.used;
     /* at most 2n nodes were reserved; give back the rest (a failed
-     * shrink keeps the larger arrays) */
+     * shrink keeps the larger array) */
     hd__bvh_node_t *nodes = realloc(t->nodes, t->n_nodes * sizeof *t->nodes);
-    hd__slab_t *slabs = realloc(t->nslab, t->n_nodes * sizeof *t->nslab);
     if (nodes) t->nodes = nodes;
-    if (slabs) t->nslab = slabs;
     for (size_t k = 0; k < n; k++) {
         tri_box(&t->tris[k], &t->boxes[k]);
         hd__tri_prep(t->tris[k].v[0], t->tris[k].v[1], t->tris[k].v[2], &t->prep[k]);
@@ -360,7 +254,6 @@ void hd__bvh_free(hd__bvh_t *t) {
     free(t->nodes);
     free(t->boxes);
     free(t->prep);
-    free(t->nslab);
     memset(t, 0, sizeof *t);
 }
 
@@ -497,7 +390,11 @@ static void consider(const hd__bvh_t *t, const double *p, size_t k, search_t *s,
 
 static void flush_cheap(const hd__bvh_t *t, const double *p, search_t *s, hd__bvh_stats_t *st) {
     sort_cands(s->cheap, s->n_cheap);
-    for (size_t i = 0; i < s->n_cheap && s->cheap[i].lo2 <= s->thr; i++) consider(t, p, s->cheap[i].pos, s, st);
+    for (size_t i = 0; i < s->n_cheap && s->cheap[i].lo2 <= s->thr; i++) {
+        size_t k = s->cheap[i].pos;
+        if (s->pos != SIZE_MAX && corner_tie(t, p, k, s)) st->ties++;
+        else consider(t, p, k, s, st);
+    }
     s->n_cheap = 0;
 }
 
@@ -572,11 +469,20 @@ static size_t search_end(const hd__bvh_t *t, const double *p, search_t *s, hd__t
     return s->pos;
 }
 
-size_t hd__bvh_nearest(const hd__bvh_t *t, const double p[3], size_t seed, hd__tri_near_t *best,
+/* The seed: the kernel at once when asked (a best corner early lets
+ * corner_tie decide the triangles around it), else a first candidate. */
+static void start(const hd__bvh_t *t, const double *p, size_t seed, int seed_kernel, search_t *s,
+                  hd__bvh_stats_t *st) {
+    search_init(s);
+    if (seed >= t->n_tris) return;
+    if (seed_kernel) evaluate(t, p, seed, s, st);
+    else consider(t, p, seed, s, st);
+}
+
+size_t hd__bvh_nearest(const hd__bvh_t *t, const double p[3], size_t seed, int seed_kernel, hd__tri_near_t *best,
                        size_t *index, hd__bvh_stats_t *st) {
     search_t s;
-    search_init(&s);
-    if (seed < t->n_tris) consider(t, p, seed, &s, st);
+    start(t, p, seed, seed_kernel, &s, st);
     /* s: the box's computed hd__box_lb2s; [first, first + n): the node's
      * triangles (the build gives a node's first child the first n / 2) */
     typedef struct { uint32_t node, first, n; double s; } entry_t;
@@ -589,7 +495,6 @@ size_t hd__bvh_nearest(const hd__bvh_t *t, const double p[3], size_t seed, hd__t
         if (box_beyond(e->s, s.thr)) continue;
         const hd__bvh_node_t *node = &t->nodes[e->node];
         uint32_t first = e->first, n = e->n;
-        if (slab_beyond(&t->nslab[e->node], p, s.thr)) continue;
         st->nodes++;
         if (node->count) {
             leaf(t, node, p, seed, &s, st);
@@ -682,10 +587,9 @@ size_t hd__bvh_collect(const hd__bvh_t *t, const hd__box_t *B, double r2, uint32
 }
 
 size_t hd__bvh_nearest_in(const hd__bvh_t *t, const double p[3], const uint32_t *list, size_t n, size_t seed,
-                          hd__tri_near_t *best, size_t *index, hd__bvh_stats_t *st) {
+                          int seed_kernel, hd__tri_near_t *best, size_t *index, hd__bvh_stats_t *st) {
     search_t s;
-    search_init(&s);
-    if (seed < t->n_tris) consider(t, p, seed, &s, st);
+    start(t, p, seed, seed_kernel, &s, st);
     for (size_t i = 0; i < n; i++) {
         size_t k = list[i];
         if (k != seed) screen(t, p, k, &s, st);

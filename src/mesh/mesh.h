@@ -113,17 +113,10 @@ typedef struct hd__bvh_node {
     uint32_t first_or_second, count;
 } hd__bvh_node_t;
 
-/* The slab bound's description of a set of corners (bvh.c has the proof):
- * a centre c, a unit direction m, h >= max |m . (v - c)|, r >= max |v - c|. */
-typedef struct hd__slab {
-    double c[3], m[3], h, r;
-} hd__slab_t;
-
 typedef struct hd__bvh {
     hd__tri_t *tris;        /* in leaf order */
     hd__box_t *boxes;       /* each triangle's box, in the same order */
     hd__tri_prep_t *prep;   /* each triangle prepared (hd__tri_prep), in the same order */
-    hd__slab_t *nslab;      /* each node's slab (over its triangles' corners) */
     hd__bvh_node_t *nodes;
     size_t n_tris, n_nodes;
 } hd__bvh_t;
@@ -145,9 +138,12 @@ typedef struct hd__bvh_stats {
  * triangles at that rounded distance), bit-identical to a loop over every
  * triangle with hd__tri_nearest.  `seed` (a position in t->tris, or
  * SIZE_MAX) is tried first: any triangle is correct, a near one makes the
- * search short.  Returns the position of the nearest triangle in t->tris
- * (the next query's seed). */
-size_t hd__bvh_nearest(const hd__bvh_t *t, const double p[3], size_t seed,
+ * search short; seed_kernel 1 evaluates it with the kernel before
+ * anything else (worth it when the previous answer was at a corner: the
+ * triangles around a corner then tie without the kernel), 0 bounds it
+ * first like any other.  Returns the position of the nearest triangle in
+ * t->tris (the next query's seed). */
+size_t hd__bvh_nearest(const hd__bvh_t *t, const double p[3], size_t seed, int seed_kernel,
                        hd__tri_near_t *best, size_t *index, hd__bvh_stats_t *st);
 
 /* Work shared by the points of a box B.  hd__bvh_collect writes to out
@@ -160,15 +156,12 @@ size_t hd__bvh_nearest(const hd__bvh_t *t, const double p[3], size_t seed,
  * hd__bvh_nearest's answer for each q in B. */
 size_t hd__bvh_collect(const hd__bvh_t *t, const hd__box_t *B, double r2, uint32_t *out, size_t cap);
 size_t hd__bvh_nearest_in(const hd__bvh_t *t, const double p[3], const uint32_t *list, size_t n, size_t seed,
-                          hd__tri_near_t *best, size_t *index, hd__bvh_stats_t *st);
+                          int seed_kernel, hd__tri_near_t *best, size_t *index, hd__bvh_stats_t *st);
 
 /* Lower bounds on distances, proven not to exceed the true distance with
  * every rounding error counted (bvh.c has the proofs); 0 when no bound
- * is certain.  hd__slab_make describes the corners of t[0 .. n) (b: a box
- * holding them) for hd__slab_lower.  Exposed for the tests. */
+ * is certain.  Exposed for the tests. */
 double hd__box_lower(const hd__box_t *b, const double p[3]);
-void hd__slab_make(const hd__tri_t *t, size_t n, const hd__box_t *b, hd__slab_t *sl);
-double hd__slab_lower(const hd__slab_t *sl, const double p[3]);
 /* The support bound: min over the corners v of t[0 .. n) of
  * w . (p - v) / |w|, shrunk; any w (it may be rescaled in place). */
 double hd__support_lower(const hd__tri_t *t, size_t n, const double p[3], double *w);
