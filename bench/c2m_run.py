@@ -108,9 +108,9 @@ def main():
     load = os.getloadavg()[0]
     out = open(a.out, "w") if a.out else None
     rows = []
-    case = os.path.join(a.build, "bench", "c2m_case.bin")
     for mname in meshes:
         mesh, levels = MESHES[mname]
+        case = os.path.join(a.build, "bench", "c2m_case_%s.bin" % mname)
         for cloud in a.clouds.split(","):
             prev = {}
             for n in sizes:

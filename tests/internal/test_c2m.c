@@ -558,6 +558,20 @@ TEST(equidistant_points_of_a_symmetric_mesh_tie_to_the_smallest_index) {
         p[n++] = q[rot], p[n++] = q[(rot + 1) % 3], p[n++] = q[(rot + 2) % 3];
     }
     same_as_brute(&s, p, n / 3, "octahedron, equidistant points");
+    /* far beyond a corner: the 4 triangles around it tie there, and only
+     * the first needs the kernel (the others are decided at the corner) */
+    gen_rng_t g;
+    gen_seed(&g, 400);
+    for (int i = 0; i < 400; i++) {
+        p[3 * i] = 50 + gen_unit(&g), p[3 * i + 1] = gen_unit(&g) - 0.5, p[3 * i + 2] = gen_unit(&g) - 0.5;
+    }
+    same_as_brute(&s, p, 400, "octahedron, beyond the corner (1, 0, 0) (seed 400)");
+    hd_points_t P = hd_points_f64(p, 400);
+    hd_mesh_t M = view(&s);
+    hd_surface_result_t r;
+    CHECK_RC(hd_mesh_distances(&P, &M, NULL, NULL, NULL, NULL, NULL, &r, NULL), HD_OK);
+    CONTEXT("octahedron, 400 points beyond a corner: %llu kernel calls", (unsigned long long)r.kernel_calls);
+    CHECK(r.kernel_calls <= 440);
 }
 
 /* The same soups and clouds with every coordinate scaled by a power of
