@@ -20,7 +20,7 @@ every triangle for a sample of its points (bit-identical distances and
 triangles), Open3D at each thread count and CGAL at 1 thread (it has no
 threads of its own).  A peer whose time, projected from the same case at the
 previous size, would exceed --peer-budget seconds is not run ("-" in the
-table).  The exact fallback's share of the time is its calls times the exact
+table), nor at the larger sizes after it.  The exact fallback's share of the time is its calls times the exact
 path's cost a call (build/bench/tri_bench, measured at the start) over the
 processor time.  Results: one JSON line a run in --out; with --doc, the
 table between the markers "<!-- c2m-table begin -->" and "<!-- c2m-table
@@ -127,7 +127,7 @@ def main():
                     print("hd %s %s %d pts %d thr: wall %.3f cpu %.3f" % (mname, cloud, n, t, r["wall"], r["cpu"]),
                           flush=True)
                 for peer in ["open3d_%d" % t for t in threads] + ["cgal_1"]:
-                    if peer in prev and prev[peer] is not None and prev[peer]["wall"] * n / prev["n"] > a.peer_budget:
+                    if peer in prev and (prev[peer] is None or prev[peer]["wall"] * n / prev["n"] > a.peer_budget):
                         res[peer] = None
                         continue
                     t = int(peer.split("_")[1])
