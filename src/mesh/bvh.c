@@ -5,39 +5,41 @@
  * The rule that makes the search equal the loop.  The loop keeps the
  * smallest rounded distance hd__tri_nearest returns and, among the
  * triangles at that distance, the smallest index.  The search keeps the
- * same pair (d, index) over the triangles it evaluates, and it skips a
- * triangle, or every triangle under a node, only when a lower bound L on
- * its true distance proves L > next(d), where next(d) is the double after
- * d: then the true distance t > next(d), and rounding being monotone,
- * round(t) >= next(d) > d, so the skipped triangle could neither beat d
- * nor tie it (a tie would need its index compared).  As d only decreases,
- * a triangle skipped once stays skippable.  So the search ends with the
- * loop's pair, whatever the order of visits, the seed or the thread.
+ * same pair (d*, index) over the triangles it evaluates and a threshold
+ * thr, a proven upper bound on next(d*)^2 for the final d* (next(d) is the
+ * double after d): each kernel call lowers it to next(d)^2 rounded up,
+ * and each rigorous upper bound hi2 on a triangle's squared distance to
+ * thr_from_hi(hi2).  It skips a triangle, or every triangle under a node,
+ * only when a lower bound L2 on its exact squared distance proves
+ * L2 > thr: then its true distance t > next(d*), and rounding being
+ * monotone, round(t) >= next(d*) > d*, so the skipped triangle could
+ * neither beat the answer nor tie it (a tie would need its index
+ * compared).  As thr only decreases, a triangle skipped once stays
+ * skippable.  So the search ends with the loop's pair, whatever the order
+ * of visits, the seed, the group or the thread.
  *
- * The bounds L are computed in doubles and then shrunk by a factor
- * (1 - 2^-48) that exceeds their accumulated rounding error (at most a few
- * units of 2^-53, proofs at each function); results in the range where
- * underflow could add an absolute error are replaced by 0, which is
- * always a valid lower bound.  Coordinates are at most 2^511 in magnitude
- * (the library checks 1e153), so no intermediate overflows: a difference
- * is below 2^512, a sum of three squares below 2^1026 / 2 ... within
- * DBL_MAX for the checked inputs (|difference| < 2.1e153, 3 * 2.1e153^2 <
+ * The bounds are computed in doubles and moved outward by more than their
+ * accumulated rounding error (proofs at each function); where underflow
+ * could add an absolute error they give no information.  Coordinates are
+ * at most 2^511 in magnitude (the library checks 1e153), so no
+ * intermediate overflows: a difference is below 2^512 ... within DBL_MAX
+ * for the checked inputs (|difference| < 2.1e153, 3 * 2.1e153^2 <
  * 1.4e307).
  *
  * The tree: nodes split at the median of the triangles' centroids along
  * the longest axis of their box, down to leaves of at most LEAF
  * triangles; each node's box is the exact minimum and maximum of its
- * corners (no rounding).  A query descends nearest child first and
- * starts from a seed triangle (the previous query's nearest: neighbouring
- * queries are close, so the seed's distance is nearly the answer and
- * most of the tree is skipped at once).  A node of at most GROUP
- * triangles is first given a support bound over all its corners in the
- * direction of its box's centre (hd__tris_lower: for a point far from the
- * node nearly its distance, where a box bound is short by up to the box's
- * size); within a leaf each triangle gets its own box bound, then a
- * support bound in the direction of its rough closest point
- * (hd__tri_lower), and the correctly rounded kernel runs only for
- * triangles whose bounds leave them possible.
+ * corners (no rounding), each triangle prepared once (hd__tri_prep).  A
+ * query starts from a seed triangle (the previous query's nearest) and
+ * descends nearest child first, discarding nodes by their boxes.  A leaf's
+ * triangles pass three stages, each in increasing order of its lower
+ * bound and each stopping at the first bound above thr: the cheap bounds
+ * (the triangle's box, then the support bound in the direction of its
+ * box's centre), the prepared bounds (hd__tri_bounds_prep: lo2 discards,
+ * hi2 lowers thr), and the kernel.  Triangles that share the best one's
+ * nearest corner and certainly have it as theirs are decided without the
+ * kernel (corner_tie).  hd__bvh_collect and hd__bvh_nearest_in let a
+ * group of neighbouring points share one list of triangles.
  */
 #include "mesh/mesh.h"
 
@@ -52,10 +54,6 @@
  * error (at most 2^-1074 an operation): bounds there are taken as 0. */
 #define TINY 0x1p-1000
 #define MAX_DEPTH 128
-/* Nodes of at most GROUP triangles get the support bound over all their
- * corners (leaf_lower) before they are opened. */
-#define GROUP 8
-
 
 /* ---- lower bounds ------------------------------------------------------- */
 
