@@ -271,7 +271,7 @@ static double thr_from_hi(double h2) {
 
 /* A candidate: a triangle (its position) with a lower bound lo2 on its
  * squared distance that did not discard it.  Two stages: the cheap
- * bounds (the triangle's box and slab) give a first lo2, and the
+ * bounds (the triangle's box and support bound) give a first lo2, and the
  * triangles are then taken in increasing lo2 for the prepared bounds
  * (hd__tri_bounds_prep), whose lo2 orders the kernel calls in turn; each
  * stage stops at the first lo2 above the threshold, which every hi2 and
