@@ -1141,9 +1141,9 @@ typedef struct hd_surface_result {
  * dist and triangle hold P->count elements, closest and bary 3 * P->count.
  * out (may be NULL) receives h(P, surface) with its witness and the
  * counters.  The triangles are put in a bounding-volume hierarchy for the
- * call (about 240 bytes a triangle, freed before returning) and the
- * points are visited along a Morton curve, each starting from its
- * predecessor's nearest triangle.
+ * call (its size a triangle: docs/surfaces.md, "Memory"; freed before
+ * returning) and the points are visited along a Morton curve in groups of
+ * neighbours, each starting from its predecessor's nearest triangle.
  * opt: NULL for defaults; only opt->threads is read.
  * Errors: HD_EINVAL (NULL P or M, unknown index_type, an index beyond the
  *   vertices: the message names the triangle), HD_EEMPTY (no points, no

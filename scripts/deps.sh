@@ -24,9 +24,9 @@ for group in "$@"; do
     # ./python` in a venv (tests/python_venv.sh).
     python) add python3 python3-dev python3-numpy python3-setuptools python3-pytest python3-scipy \
                 python3-venv python3-wheel ;;
-    bench)  add libnanoflann-dev libpcl-dev python3-scipy python3-numpy python3-open3d g++ libomp-dev libcgal-dev ;;
+    bench)  add libnanoflann-dev libpcl-dev python3-scipy python3-numpy python3-open3d g++ libomp-dev libcgal-dev libgmp-dev libmpfr-dev ;;
     # The surface-to-surface benchmark's CGAL peer (bench/peers/m2m_cgal.cpp, header-only).
-    cgal)   add g++ libcgal-dev ;;
+    cgal)   add g++ libcgal-dev libgmp-dev libmpfr-dev ;;
     plot)   add python3-matplotlib python3-numpy ;;
     # Open MPI: the optional scale-out library and tool (cmake/mpi.cmake), and
     # mpirun for their tests (tests/mpi.cmake).
