@@ -417,7 +417,7 @@ static double could(const corner_t *c, int level, double e) {
 /* The corner's exact distance through the tree (the witness's lower bound). */
 static void make_exact(const hd__m2m_job_t *J, corner_t *c, int level, double e, hd__bvh_stats_t *st) {
     hd__tri_near_t near;
-    size_t pos = hd__bvh_nearest(J->to, c->p, c->pos, &near, &c->index, st);
+    size_t pos = hd__bvh_nearest(J->to, c->p, c->pos, 0, &near, &c->index, st);
     c->r = near.d;
     memcpy(c->near, near.point, sizeof c->near);
     c->lower = is_vertex(c, level) ? c->r : fmax(0.0, down(down(c->r) - e));
@@ -546,12 +546,12 @@ static void phase0_exact(void *vctx, size_t task, int worker) {
     ctx_t *C = vctx;
     const hd__m2m_job_t *J = C->job;
     size_t lo = task * CHUNK * 3, hi = lo + CHUNK * 3 < C->n_corners ? lo + CHUNK * 3 : C->n_corners;
-    hd__bvh_stats_t st = {0, 0, 0, 0};
+    hd__bvh_stats_t st = {0};
     for (size_t id = lo; id < hi; id++) {
         found_t *F = &C->found[id];
         if ((J->drop && J->drop[id / 3]) || F->hi < C->bar) continue;
         hd__tri_near_t near;
-        F->pos = hd__bvh_nearest(J->to, CORNER(J, id), F->pos, &near, &F->index, &st);
+        F->pos = hd__bvh_nearest(J->to, CORNER(J, id), F->pos, 0, &near, &F->index, &st);
         F->r = near.d;
         F->hi = up(near.d);
         memcpy(F->near, near.point, sizeof F->near);
@@ -701,7 +701,7 @@ static void split(const hd__m2m_job_t *J, const hd__tri_t *t, double e, double L
 static void refine(const hd__m2m_job_t *J, face_t *F, size_t f, double L, pool_t *P) {
     const hd__tri_t *t = &J->from[f];
     double e = slack(t), cut = 0; /* cut: the largest U discarded */
-    hd__bvh_stats_t st = {0, 0, 0, 0};
+    hd__bvh_stats_t st = {0};
     hd__heap_clear(&P->heap);
     P->n = P->n_free = 0;
     if (pool_put(P, &F->top) == SIZE_MAX) return;
