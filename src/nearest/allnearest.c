@@ -1556,6 +1556,7 @@ typedef struct {
     size_t n, cap;
     size_t below, above, solo;
     int nomem;
+    uint64_t *counts; /* hd__an_hist: this worker's counts */
 } band_out_t;
 
 typedef struct {
@@ -1563,6 +1564,7 @@ typedef struct {
     double lo2, hi2;
     cands_t *cand;
     band_out_t *out; /* per worker */
+    const hd__hist_t *h; /* hd__an_hist: the bins (lo2 = 0, hi2 = +inf) */
 } band_ctx;
 
 /* Settles one value, of `times` points, into o. */
@@ -1682,7 +1684,7 @@ int hd__an_band(const hd__an_t *asking, const hd__an_t *searched, double lo2, do
     memset(out, 0, sizeof *out);
     size_t tasks = (asking->nb + BAND_TASK - 1) / BAND_TASK;
     threads = hd__thread_count(threads, tasks);
-    band_ctx c = {asking, searched, lo2, hi2, NULL, NULL};
+    band_ctx c = {asking, searched, lo2, hi2, NULL, NULL, NULL};
     c.cand = hd__calloc_array((size_t)threads, sizeof *c.cand);
     c.out = hd__calloc_array((size_t)threads, sizeof *c.out);
     int rc = c.cand && c.out ? HD_OK : HD_ENOMEM;
@@ -1707,6 +1709,128 @@ int hd__an_band(const hd__an_t *asking, const hd__an_t *searched, double lo2, do
         memset(out, 0, sizeof *out);
         return hd__err(err, rc, "cannot allocate the distances within the band");
     }
+    return HD_OK;
+}
+
+/* ---- histograms from bounds ------------------------------------------------- */
+
+/*
+ * hd__an_hist counts every asking point's exact nearest distance sqrt(d2)
+ * in numpy's bins (histogram.c) without computing it where bounds decide
+ * the bin.  Bounds on d2, each rounding included:
+ *  - an asking bucket's box: above by U, the smallest node_ub2 on the path
+ *    to the searched bucket nearest to the box (a node holds a point, so
+ *    every point of the box has one within U); below by the smallest
+ *    node_lb2 from the box to the buckets listed within U of it, and U
+ *    itself (a bucket left out has bound > U >= every point's d2);
+ *  - one point: above by its best after the window and that bucket (the
+ *    computed distance of an actual point); below by the smallest
+ *    hd__box_lb2s of the other listed buckets, and that best.
+ * sqrt is monotone, so sqrt of the bounds bound the distance.  When the
+ * bounds of a bucket, else of a point, are placed alike
+ * (hd__hist_decided), every value between them is, the distance included;
+ * otherwise the point is searched completely (band_finish with the band
+ * [0, +inf], whose list within U holds its minimiser's bucket) and its
+ * exact distance is placed by the same rule.
+ */
+
+/* Counts `times` values into bin b (SIZE_MAX: outside the range). */
+HD__INLINE void hist_count(band_out_t *o, size_t b, size_t times) {
+    if (b != SIZE_MAX) o->counts[b] += times;
+}
+
+/* 1 when bounds [l2, u2] on squared distances decide the bin of `times`
+ * values, then counted. */
+HD__INLINE int hist_bounded(const band_ctx *c, band_out_t *o, double l2, double u2, size_t times) {
+    size_t b;
+    if (!hd__hist_decided(c->h, sqrt(l2), sqrt(u2), &b)) return 0;
+    hist_count(o, b, times);
+    return 1;
+}
+
+/* The smallest box bound from box q to the n listed candidates of cd. */
+static double listed_lb2(const cands_t *cd, const hd__box_t *q) {
+    double least = INFINITY;
+    for (size_t r = 0; r < cd->n; r++) {
+        double g[3];
+        for (int d = 0; d < 3; d++) {
+            double u = cd->lo[d][r] - q->hi[d], v = q->lo[d] - cd->hi[d][r];
+            g[d] = u > v ? u : v;
+            g[d] = g[d] > 0 ? g[d] : 0;
+        }
+        double lb = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
+        least = lb < least ? lb : least;
+    }
+    return least;
+}
+
+/* Points [first, end) of asking bucket b, each standing for `times`
+ * copies: the bucket at once when its bounds decide, else point by point. */
+static void hist_points(const band_ctx *c, cands_t *cd, band_out_t *o, size_t b, size_t first, size_t end,
+                        size_t times, size_t *wb, size_t *wp) {
+    const hd__an_t *q = c->q, *t = c->t;
+    double U = INFINITY;
+    size_t node = q->leaf[b];
+    hd__box_t box;
+    for (int d = 0; d < 3; d++) box.lo[d] = q->lo[d][node], box.hi[d] = q->hi[d][node];
+    size_t near = nearest_leaf(t, &box, &U);
+    int shared = candidates(t, &box, U, (end - first) * BAND_SHARED, cd);
+    if (shared) {
+        double L = listed_lb2(cd, &box);
+        if (hist_bounded(c, o, L < U ? L : U, U, (end - first) * times)) return;
+    }
+    for (size_t k = first; k < end; k++) {
+        double qx = q->x[k], qy = q->y[k], qz = q->z[k], best = INFINITY;
+        uint32_t j = UINT32_MAX;
+        window_best(q, t, k, wb, wp, &best, &j);
+        scan_bucket(t, near, qx, qy, qz, &best, &j);
+        if (!shared) { /* a sparse set asking a dense one: the point's own list */
+            hd__box_t pb = {{qx, qy, qz}, {qx, qy, qz}};
+            candidates(t, &pb, best, SIZE_MAX, cd);
+            o->solo += times;
+        }
+        candidate_bounds(cd, cd->n, qx, qy, qz);
+        double L = best;
+        for (size_t r = 0; r < cd->n; r++)
+            if (cd->bucket[r] != near && cd->lb2[r] < L) L = cd->lb2[r];
+        if (hist_bounded(c, o, L, best, times)) continue;
+        double d2 = band_finish(c, cd, qx, qy, qz, best, near);
+        size_t guess;
+        hist_count(o, hd__hist_place(c->h, sqrt(d2), &guess), times);
+    }
+}
+
+static HD__HOT void hist_task(void *vctx, size_t task, int worker) {
+    band_ctx *c = vctx;
+    const hd__an_t *q = c->q;
+    size_t b0 = task * BAND_TASK, b1 = b0 + BAND_TASK < q->nb ? b0 + BAND_TASK : q->nb;
+    size_t wb = 0, wp = 0;
+    for (size_t b = b0; b < b1; b++) { /* HD__AN_BUCKET points at a time (equal keys may hold more) */
+        size_t first = q->start[b], end = q->stop[b], times = end == first + 1 ? q->start[b + 1] - first : 1;
+        for (size_t k = first; k < end; k += HD__AN_BUCKET)
+            hist_points(c, &c->cand[worker], &c->out[worker], b, k, end - k < HD__AN_BUCKET ? end : k + HD__AN_BUCKET,
+                        times, &wb, &wp);
+    }
+}
+
+int hd__an_hist(const hd__an_t *asking, const hd__an_t *searched, const hd__hist_t *h, int threads,
+                uint64_t *counts, hd_error_t *err) {
+    size_t tasks = (asking->nb + BAND_TASK - 1) / BAND_TASK;
+    threads = hd__thread_count(threads, tasks);
+    band_ctx c = {asking, searched, 0.0, INFINITY, NULL, NULL, h};
+    c.cand = hd__calloc_array((size_t)threads, sizeof *c.cand);
+    c.out = hd__calloc_array((size_t)threads, sizeof *c.out);
+    int rc = c.cand && c.out ? HD_OK : HD_ENOMEM;
+    for (int w = 0; rc == HD_OK && w < threads; w++)
+        if (!(c.out[w].counts = hd__calloc_array(h->bins, sizeof *counts))) rc = HD_ENOMEM;
+    if (rc == HD_OK) rc = cands_alloc(c.cand, threads, searched->nb);
+    if (rc == HD_OK) hd__parallel_for(threads, tasks, hist_task, &c);
+    for (int w = 0; rc == HD_OK && w < threads; w++)
+        for (size_t k = 0; k < h->bins; k++) counts[k] += c.out[w].counts[k];
+    for (int w = 0; c.out && w < threads; w++) free(c.out[w].counts);
+    free(c.out);
+    cands_free(c.cand, threads);
+    if (rc != HD_OK) return hd__err(err, rc, "cannot allocate the histogram's search lists");
     return HD_OK;
 }
 
