@@ -307,17 +307,20 @@ int hd_hausdorff_histogram(const hd_points_t *A, const hd_points_t *B,
     if ((rc = hd__points_scan(B, "B", threads, &box_b, err))) return rc;
     if (A->count > HD__AN_MAX_POINTS || B->count > HD__AN_MAX_POINTS)
         return histogram_all(A, B, opt, bins, lo, hi, counts_ab, counts_ba, err);
-    /* The structures hd_distances builds; only the points whose bounds
-     * straddle an edge are searched completely (nearest/allnearest.c). */
+    /* The structures hd_distances builds; only the points of the buckets
+     * whose bounds straddle an edge get their distances
+     * (nearest/allnearest.c). */
     hd__box_t keybox = box_a;
     hd__box_merge(&keybox, &box_b);
     hd__an_t s[2];
     if ((rc = hd__an_build_pair(A, B, &keybox, threads, s, err))) return rc;
+    const hd_points_t *set[2] = {A, B};
+    int same = A->count == B->count; /* as hd_distances: a copy and its original may pair up */
     uint64_t *counts[2] = {counts_ab, counts_ba};
     for (int d = 0; d < 2; d++)
         if (counts[d]) memset(counts[d], 0, bins * sizeof *counts[d]);
     for (int d = 0; d < 2 && rc == HD_OK; d++)
-        if (counts[d]) rc = hd__an_hist(&s[d], &s[1 - d], &h, threads, counts[d], err);
+        if (counts[d]) rc = hd__an_hist(&s[d], &s[1 - d], set[d], same ? set[1 - d] : NULL, &keybox, &h, threads, counts[d], err);
     hd__an_free(&s[0]);
     hd__an_free(&s[1]);
     return rc;

@@ -1556,7 +1556,6 @@ typedef struct {
     size_t n, cap;
     size_t below, above, solo;
     int nomem;
-    uint64_t *counts; /* hd__an_hist: this worker's counts */
 } band_out_t;
 
 typedef struct {
@@ -1564,7 +1563,6 @@ typedef struct {
     double lo2, hi2;
     cands_t *cand;
     band_out_t *out; /* per worker */
-    const hd__hist_t *h; /* hd__an_hist: the bins (lo2 = 0, hi2 = +inf) */
 } band_ctx;
 
 /* Settles one value, of `times` points, into o. */
@@ -1684,7 +1682,7 @@ int hd__an_band(const hd__an_t *asking, const hd__an_t *searched, double lo2, do
     memset(out, 0, sizeof *out);
     size_t tasks = (asking->nb + BAND_TASK - 1) / BAND_TASK;
     threads = hd__thread_count(threads, tasks);
-    band_ctx c = {asking, searched, lo2, hi2, NULL, NULL, NULL};
+    band_ctx c = {asking, searched, lo2, hi2, NULL, NULL};
     c.cand = hd__calloc_array((size_t)threads, sizeof *c.cand);
     c.out = hd__calloc_array((size_t)threads, sizeof *c.out);
     int rc = c.cand && c.out ? HD_OK : HD_ENOMEM;
@@ -1716,122 +1714,183 @@ int hd__an_band(const hd__an_t *asking, const hd__an_t *searched, double lo2, do
 
 /*
  * hd__an_hist counts every asking point's exact nearest distance sqrt(d2)
- * in numpy's bins (histogram.c) without computing it where bounds decide
- * the bin.  Bounds on d2, each rounding included:
- *  - an asking bucket's box: above by U, the smallest node_ub2 on the path
- *    to the searched bucket nearest to the box (a node holds a point, so
- *    every point of the box has one within U); below by the smallest
- *    node_lb2 from the box to the buckets listed within U of it, and U
- *    itself (a bucket left out has bound > U >= every point's d2);
- *  - one point: above by its best after the window and that bucket (the
- *    computed distance of an actual point); below by the smallest
- *    hd__box_lb2s of the other listed buckets, and that best.
- * sqrt is monotone, so sqrt of the bounds bound the distance.  When the
- * bounds of a bucket, else of a point, are placed alike
- * (hd__hist_decided), every value between them is, the distance included;
- * otherwise the point is searched completely (band_finish with the band
- * [0, +inf], whose list within U holds its minimiser's bucket) and its
- * exact distance is placed by the same rule.
+ * in numpy's bins (histogram.c), computing it only for the points of the
+ * asking buckets whose bounds do not decide the bin.  Bounds on the d2 of
+ * every point of an asking bucket's box, rounding included:
+ *  - above: U, the smallest node_ub2 on the path to the searched bucket
+ *    nearest to the box (a node holds a point, so every point of the box
+ *    has one within U);
+ *  - below: L, the smallest node_lb2 from the box to a searched bucket
+ *    (the minimiser of each point lies in one), found by a descent that
+ *    skips the nodes whose bound is not below the smallest so far.
+ * sqrt is monotone, so sqrt(L) and sqrt(U) bound the distances.  When they
+ * are placed alike (hd__hist_decided), so is every value between them: the
+ * bucket's points are counted at once.  (When the bounds of a sample of
+ * the buckets decide few points, no bucket is tried.)  The points of the other buckets
+ * get their exact distances from hd__an_nearest (on a structure of those
+ * points alone when they are at most half, else on all of asking, with
+ * the partners hd_distances gives it) and are placed by the same rule.
  */
 
-/* Counts `times` values into bin b (SIZE_MAX: outside the range). */
-HD__INLINE void hist_count(band_out_t *o, size_t b, size_t times) {
-    if (b != SIZE_MAX) o->counts[b] += times;
-}
+#define HIST_TASK 64  /* asking buckets per task of the bound pass */
+#define HIST_PROBE 16 /* one bucket in HIST_PROBE tried before the bound pass */
 
-/* 1 when bounds [l2, u2] on squared distances decide the bin of `times`
- * values, then counted. */
-HD__INLINE int hist_bounded(const band_ctx *c, band_out_t *o, double l2, double u2, size_t times) {
-    size_t b;
-    if (!hd__hist_decided(c->h, sqrt(l2), sqrt(u2), &b)) return 0;
-    hist_count(o, b, times);
-    return 1;
-}
+typedef struct {
+    const hd__an_t *q, *t;
+    const hd__hist_t *h;
+    uint8_t *open;      /* per asking bucket: 1 when its bounds did not decide */
+    uint64_t **counts;  /* per worker */
+} hist_ctx;
 
-/* The smallest box bound from box q to the n listed candidates of cd. */
-static double listed_lb2(const cands_t *cd, const hd__box_t *q) {
-    double least = INFINITY;
-    for (size_t r = 0; r < cd->n; r++) {
-        double g[3];
-        for (int d = 0; d < 3; d++) {
-            double u = cd->lo[d][r] - q->hi[d], v = q->lo[d] - cd->hi[d][r];
-            g[d] = u > v ? u : v;
-            g[d] = g[d] > 0 ? g[d] : 0;
+/* The smallest node_lb2 from box q to a bucket of t, or some bound below
+ * `enough` as soon as one is found (a lower bound that small decides
+ * nothing). */
+static double tree_lb2(const hd__an_t *t, const hd__box_t *q, double enough) {
+    uint32_t stack[8 * 11 + 8];
+    double slb[8 * 11 + 8], least = INFINITY;
+    int sp = 0;
+    stack[sp] = 0, slb[sp] = node_lb2(q, t, 0), sp++;
+    while (sp > 0 && !(least < enough)) {
+        sp--;
+        if (slb[sp] >= least) continue;
+        size_t k = stack[sp];
+        if (!t->count[k]) {
+            least = slb[sp];
+            continue;
         }
-        double lb = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
-        least = lb < least ? lb : least;
+        size_t f = t->first[k];
+        int top = sp;
+        for (int i = 0; i < t->count[k]; i++) {
+            double lb = node_lb2(q, t, f + (size_t)i);
+            if (lb >= least) continue;
+            stack[sp] = (uint32_t)(f + (size_t)i), slb[sp] = lb, sp++;
+            if (lb < slb[top]) { /* the nearest child at top */
+                uint32_t ks = stack[top];
+                double ls = slb[top];
+                stack[top] = stack[sp - 1], slb[top] = slb[sp - 1];
+                stack[sp - 1] = ks, slb[sp - 1] = ls;
+            }
+        }
+        if (sp > top + 1) { /* then on the stack's top, searched first */
+            uint32_t ks = stack[top];
+            double ls = slb[top];
+            stack[top] = stack[sp - 1], slb[top] = slb[sp - 1];
+            stack[sp - 1] = ks, slb[sp - 1] = ls;
+        }
     }
     return least;
 }
 
-/* Points [first, end) of asking bucket b, each standing for `times`
- * copies: the bucket at once when its bounds decide, else point by point. */
-static void hist_points(const band_ctx *c, cands_t *cd, band_out_t *o, size_t b, size_t first, size_t end,
-                        size_t times, size_t *wb, size_t *wp) {
+/* Below this squared distance a lower bound cannot place an interval
+ * ending at u = sqrt(U) in u's bin (or above hi): just under the square
+ * of that bin's lower edge.  It only spares work: the decision is
+ * hd__hist_decided's. */
+static double useful_lb2(const hd__hist_t *h, double U) {
+    size_t guess, b = hd__hist_place(h, sqrt(U), &guess);
+    double e = b == SIZE_MAX ? h->hi : hd__hist_edge(h, b);
+    return e > 0 ? 0.999 * e * e : 0.0;
+}
+
+/* 1 when the bounds of asking bucket b decide its bin, in *bin. */
+static int hist_bucket(const hist_ctx *c, size_t b, size_t *bin) {
     const hd__an_t *q = c->q, *t = c->t;
-    double U = INFINITY;
     size_t node = q->leaf[b];
     hd__box_t box;
     for (int d = 0; d < 3; d++) box.lo[d] = q->lo[d][node], box.hi[d] = q->hi[d][node];
-    size_t near = nearest_leaf(t, &box, &U);
-    int shared = candidates(t, &box, U, (end - first) * BAND_SHARED, cd);
-    if (shared) {
-        double L = listed_lb2(cd, &box);
-        if (hist_bounded(c, o, L < U ? L : U, U, (end - first) * times)) return;
-    }
-    for (size_t k = first; k < end; k++) {
-        double qx = q->x[k], qy = q->y[k], qz = q->z[k], best = INFINITY;
-        uint32_t j = UINT32_MAX;
-        window_best(q, t, k, wb, wp, &best, &j);
-        scan_bucket(t, near, qx, qy, qz, &best, &j);
-        if (!shared) { /* a sparse set asking a dense one: the point's own list */
-            hd__box_t pb = {{qx, qy, qz}, {qx, qy, qz}};
-            candidates(t, &pb, best, SIZE_MAX, cd);
-            o->solo += times;
-        }
-        candidate_bounds(cd, cd->n, qx, qy, qz);
-        double L = best;
-        for (size_t r = 0; r < cd->n; r++)
-            if (cd->bucket[r] != near && cd->lb2[r] < L) L = cd->lb2[r];
-        if (hist_bounded(c, o, L, best, times)) continue;
-        double d2 = band_finish(c, cd, qx, qy, qz, best, near);
-        size_t guess;
-        hist_count(o, hd__hist_place(c->h, sqrt(d2), &guess), times);
-    }
+    double U = INFINITY;
+    nearest_leaf(t, &box, &U);
+    double L = hd__hist_decided(c->h, 0.0, sqrt(U), bin) ? 0.0 : tree_lb2(t, &box, useful_lb2(c->h, U));
+    return hd__hist_decided(c->h, sqrt(L), sqrt(U), bin);
 }
 
 static HD__HOT void hist_task(void *vctx, size_t task, int worker) {
-    band_ctx *c = vctx;
+    hist_ctx *c = vctx;
     const hd__an_t *q = c->q;
-    size_t b0 = task * BAND_TASK, b1 = b0 + BAND_TASK < q->nb ? b0 + BAND_TASK : q->nb;
-    size_t wb = 0, wp = 0;
-    for (size_t b = b0; b < b1; b++) { /* HD__AN_BUCKET points at a time (equal keys may hold more) */
-        size_t first = q->start[b], end = q->stop[b], times = end == first + 1 ? q->start[b + 1] - first : 1;
-        for (size_t k = first; k < end; k += HD__AN_BUCKET)
-            hist_points(c, &c->cand[worker], &c->out[worker], b, k, end - k < HD__AN_BUCKET ? end : k + HD__AN_BUCKET,
-                        times, &wb, &wp);
+    size_t b0 = task * HIST_TASK, b1 = b0 + HIST_TASK < q->nb ? b0 + HIST_TASK : q->nb, bin;
+    for (size_t b = b0; b < b1; b++) {
+        c->open[b] = !hist_bucket(c, b, &bin);
+        if (!c->open[b] && bin != SIZE_MAX) c->counts[worker][bin] += q->start[b + 1] - q->start[b];
     }
 }
 
-int hd__an_hist(const hd__an_t *asking, const hd__an_t *searched, const hd__hist_t *h, int threads,
-                uint64_t *counts, hd_error_t *err) {
-    size_t tasks = (asking->nb + BAND_TASK - 1) / BAND_TASK;
-    threads = hd__thread_count(threads, tasks);
-    band_ctx c = {asking, searched, 0.0, INFINITY, NULL, NULL, h};
-    c.cand = hd__calloc_array((size_t)threads, sizeof *c.cand);
-    c.out = hd__calloc_array((size_t)threads, sizeof *c.out);
-    int rc = c.cand && c.out ? HD_OK : HD_ENOMEM;
-    for (int w = 0; rc == HD_OK && w < threads; w++)
-        if (!(c.out[w].counts = hd__calloc_array(h->bins, sizeof *counts))) rc = HD_ENOMEM;
-    if (rc == HD_OK) rc = cands_alloc(c.cand, threads, searched->nb);
-    if (rc == HD_OK) hd__parallel_for(threads, tasks, hist_task, &c);
-    for (int w = 0; rc == HD_OK && w < threads; w++)
-        for (size_t k = 0; k < h->bins; k++) counts[k] += c.out[w].counts[k];
-    for (int w = 0; c.out && w < threads; w++) free(c.out[w].counts);
-    free(c.out);
-    cands_free(c.cand, threads);
-    if (rc != HD_OK) return hd__err(err, rc, "cannot allocate the histogram's search lists");
-    return HD_OK;
+/* 1 when the bounds of every HIST_PROBE-th bucket decide at least a
+ * quarter of their points: the bound pass then spares more than it costs.
+ * Only the cost depends on it. */
+static int hist_worth(const hist_ctx *c) {
+    const hd__an_t *q = c->q;
+    size_t seen = 0, decided = 0, bin;
+    for (size_t b = 0; b < q->nb; b += HIST_PROBE) {
+        size_t m = q->start[b + 1] - q->start[b];
+        seen += m;
+        if (hist_bucket(c, b, &bin)) decided += m;
+    }
+    return 4 * decided >= seen;
+}
+
+/* The exact distances of the open buckets' points, placed. */
+static int hist_open(const hist_ctx *c, const hd_points_t *P, const hd_points_t *partner, const hd__box_t *keybox,
+                     int threads, uint64_t *counts, hd_error_t *err) {
+    const hd__an_t *q = c->q;
+    size_t m = 0, n = q->start[q->nb];
+    for (size_t b = 0; b < q->nb; b++)
+        if (c->open[b]) m += q->start[b + 1] - q->start[b];
+    if (!m) return HD_OK;
+    double *dist = hd__malloc_array(P->count, sizeof *dist);
+    uint8_t *mark = hd__calloc_array(P->count, 1);
+    uint32_t *sel = NULL;
+    int rc = dist && mark ? HD_OK : hd__err(err, HD_ENOMEM, "cannot allocate %zu distances", P->count);
+    for (size_t b = 0; rc == HD_OK && b < q->nb; b++)
+        if (c->open[b])
+            for (size_t k = q->start[b]; k < q->start[b + 1]; k++) mark[q->idx[k]] = 1;
+    if (rc == HD_OK && 2 * m > n) { /* most points: the structure of them all */
+        rc = hd__an_nearest(q, c->t, partner, threads, dist, NULL, NULL, err);
+    } else if (rc == HD_OK) { /* a structure of the open points (increasing names) */
+        if (!(sel = hd__malloc_array(m, sizeof *sel))) rc = hd__err(err, HD_ENOMEM, "cannot allocate %zu indices", m);
+        size_t k = 0;
+        for (size_t i = 0; rc == HD_OK && i < P->count; i++)
+            if (mark[i]) sel[k++] = (uint32_t)i;
+        hd__an_t one;
+        if (rc == HD_OK && (rc = hd__an_build_sel(&one, P, sel, NULL, m, keybox, threads, err)) == HD_OK) {
+            rc = hd__an_nearest(&one, c->t, NULL, threads, dist, NULL, NULL, err);
+            hd__an_free(&one);
+        }
+    }
+    for (size_t i = 0; rc == HD_OK && i < P->count; i++)
+        if (mark[i]) {
+            size_t guess, b = hd__hist_place(c->h, dist[i], &guess);
+            if (b != SIZE_MAX) counts[b]++;
+        }
+    free(dist);
+    free(mark);
+    free(sel);
+    return rc;
+}
+
+int hd__an_hist(const hd__an_t *asking, const hd__an_t *searched, const hd_points_t *P, const hd_points_t *partner,
+                const hd__box_t *keybox, const hd__hist_t *h, int threads, uint64_t *counts, hd_error_t *err) {
+    size_t tasks = (asking->nb + HIST_TASK - 1) / HIST_TASK;
+    int workers = hd__thread_count(threads, tasks ? tasks : 1);
+    hist_ctx c = {asking, searched, h, NULL, NULL};
+    c.open = hd__malloc_array(asking->nb ? asking->nb : 1, 1);
+    c.counts = hd__calloc_array((size_t)workers, sizeof *c.counts);
+    int rc = c.open && c.counts ? HD_OK : HD_ENOMEM;
+    for (int w = 0; rc == HD_OK && w < workers; w++)
+        if (!(c.counts[w] = hd__calloc_array(h->bins, sizeof *counts))) rc = HD_ENOMEM;
+    if (rc != HD_OK) {
+        rc = hd__err(err, rc, "cannot allocate the histogram's counts");
+    } else {
+        if (hist_worth(&c)) hd__parallel_for(workers, tasks, hist_task, &c);
+        else memset(c.open, 1, asking->nb);
+        uint64_t *sum = c.counts[0];
+        for (int w = 1; w < workers; w++)
+            for (size_t k = 0; k < h->bins; k++) sum[k] += c.counts[w][k];
+        rc = hist_open(&c, P, partner, keybox, threads, sum, err);
+        for (size_t k = 0; rc == HD_OK && k < h->bins; k++) counts[k] += sum[k];
+    }
+    for (int w = 0; c.counts && w < workers; w++) free(c.counts[w]);
+    free(c.counts);
+    free(c.open);
+    return rc;
 }
 
 /* ---- both sets side by side --------------------------------------------------- */

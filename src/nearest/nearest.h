@@ -173,12 +173,16 @@ size_t hd__hist_place(const hd__hist_t *h, double x, size_t *guess);
 int hd__hist_decided(const hd__hist_t *h, double l, double u, size_t *bin);
 
 /* Adds to counts[0..h->bins) the histogram of the exact nearest distances
- * sqrt(d2) of asking's points to searched, as hd__hist_place places them:
- * a point (or an asking bucket) whose cheap lower and upper bounds are
- * placed alike (hd__hist_decided) is counted without its exact distance,
- * the others are searched completely.  The same counts at any thread
- * count.  Returns HD_OK or HD_ENOMEM (counts unchanged, err filled). */
-int hd__an_hist(const hd__an_t *asking, const hd__an_t *searched, const hd__hist_t *h, int threads,
-                uint64_t *counts, hd_error_t *err);
+ * of asking's points (the structure of P on keybox) to searched, as
+ * hd__hist_place places them: an asking bucket whose cheap lower and upper
+ * bounds are placed alike (hd__hist_decided) is counted without its
+ * distances, the other points get their exact distance (allnearest.c,
+ * "histograms from bounds"); partner as hd__an_nearest's, tried only
+ * when most points need their distance.  The same counts at any thread
+ * count.
+ * Returns HD_OK, HD_ENOMEM or HD_EOVERFLOW (counts unspecified, err
+ * filled). */
+int hd__an_hist(const hd__an_t *asking, const hd__an_t *searched, const hd_points_t *P, const hd_points_t *partner,
+                const hd__box_t *keybox, const hd__hist_t *h, int threads, uint64_t *counts, hd_error_t *err);
 
 #endif /* HD_ALLNEAREST_H */
