@@ -8,7 +8,7 @@ ASAN_BUILD ?= build-asan
 JOBS       ?= 2
 CMAKE_ARGS ?=
 
-.PHONY: all deps configure cli run test test-release test-asan test-tsan install bench experiments fuzz python clean
+.PHONY: all deps configure cli run test test-release test-asan test-tsan install bench bench-c2m bench-m2m experiments fuzz python clean
 
 # Quiet: no "make[1]: Entering/Leaving directory" pair around each step of
 # every cmake --build (the sub-makes read MAKEFLAGS); errors still print.
@@ -137,6 +137,34 @@ bench:
 	  --plots docs/img --command "make bench$(if $(filter-out --scale,$(BENCH_ARGS)), BENCH_ARGS=\"$(BENCH_ARGS)\")"
 	cmake --build $(BUILD) -j$(JOBS) --target field_bench percentile_bench
 	/usr/bin/python3 bench/field_report.py --build $(BUILD) --doc docs/benchmarks.md --command "make bench"
+	$(MAKE) bench-c2m C2M_ARGS="$(C2M_ARGS)"
+	$(MAKE) bench-m2m
+
+# The surface-to-surface benchmark (docs/benchmarks.md, "Surface to surface"; part of `make bench`, not of
+# `make test`): hd_surface_hausdorff's enclosures against CGAL's bounded-error distances and the sampled
+# estimates on every case of bench/m2m_cases.c, each checked by the dense check (tests/m2m_dense.c).
+# M2M_ARGS="--quick" for the smaller cases (a few minutes).
+M2M_ARGS ?=
+bench-m2m:
+	@scripts/deps.sh build cgal
+	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release -DHD_BENCH_CGAL=ON $(CMAKE_ARGS)
+	cmake --build $(BUILD) -j$(JOBS) --target m2m_cases m2m_run m2m_cgal m2m_dense
+	/usr/bin/python3 bench/m2m_bench.py --build $(BUILD) --data data --doc docs/benchmarks.md \
+	  --surfaces docs/surfaces.md --command "make bench-m2m$(if $(strip $(M2M_ARGS)), M2M_ARGS=\"$(strip $(M2M_ARGS))\")" \
+	  $(M2M_ARGS)
+
+# The cloud-to-mesh benchmark (docs/benchmarks.md, "Cloud to mesh"): every
+# mesh size (10^3, 10^5, 10^6 triangles), cloud size (10^5, 10^6, 10^7) and
+# kind (near, far) at 1 and 2 threads against Open3D and CGAL in the same run,
+# then its table in the doc.  C2M_ARGS=--quick leaves out the 10^7-point
+# clouds and the 10^6-triangle mesh (`make bench BENCH_ARGS=--quick` implies it).
+C2M_ARGS ?= $(if $(filter --quick,$(BENCH_ARGS)),--quick)
+bench-c2m:
+	@scripts/deps.sh build bench
+	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release -DHD_BENCH_CGAL=ON $(CMAKE_ARGS)
+	cmake --build $(BUILD) -j$(JOBS) --target c2m_bench c2m_cgal tri_bench
+	/usr/bin/python3 bench/c2m_run.py --build $(BUILD) --out $(BUILD)/bench/c2m.jsonl --doc docs/benchmarks.md \
+	  --command "make bench-c2m$(if $(strip $(C2M_ARGS)), C2M_ARGS=$(strip $(C2M_ARGS)))" $(C2M_ARGS)
 
 clean:
 	rm -rf $(BUILD) $(ASAN_BUILD) $(TSAN_BUILD) build-fuzz

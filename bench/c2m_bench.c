@@ -3,9 +3,15 @@
  * optionally subdivided, against near and far query clouds.
  *
  *   c2m_bench MESH LEVELS N near|far THREADS [REPEATS] [OUT.bin]
+ *             [--perturb] [--check K] [--json]
  *
  * LEVELS: each triangle is split into four (edge midpoints) that many
- * times.  near: points uniform by area on the surface plus uniform noise
+ * times; --perturb moves each new midpoint by up to 1 % of its edge's
+ * length in a direction drawn from its own bits (so the two triangles of
+ * an edge move it alike: no cracks, and no longer coplanar).  --check K:
+ * K points spread over the cloud are also answered by a brute force over
+ * every triangle with the same kernel, and the answers compared (distance
+ * bits and triangle).  --json: one JSON object instead of the text line.  near: points uniform by area on the surface plus uniform noise
  * of 1e-3 of the box's diagonal; far: uniform in the box grown three times
  * about its centre.  Seeded (seed 1).  Prints the triangle count, the
  * median wall time of REPEATS calls (tree build included) and their median
@@ -15,6 +21,7 @@
  * peers' comparison: n, then 3n doubles of points, then n distances).
  */
 #include "benchutil.h"
+#include "mesh/mesh.h"
 
 #include <hausdorff.h>
 #include <math.h>
@@ -35,7 +42,20 @@ typedef struct {
     size_t nv, nt;
 } mesh_t;
 
-static void subdivide(mesh_t *m) {
+/* A value in [-0.5, 0.5) from the bits of a point and a salt. */
+static double jitter(const double *x, int salt) {
+    uint64_t h = 0x9e3779b97f4a7c15u * (uint64_t)(salt + 1);
+    for (int c = 0; c < 3; c++) {
+        uint64_t b;
+        memcpy(&b, &x[c], sizeof b);
+        h ^= b + 0x9e3779b97f4a7c15u + (h << 6) + (h >> 2);
+        h *= 0xff51afd7ed558ccdu;
+    }
+    h ^= h >> 33;
+    return (double)(h >> 11) * 0x1p-53 - 0.5;
+}
+
+static void subdivide(mesh_t *m, int perturb) {
     double *v = malloc((m->nv + 3 * m->nt) * 3 * sizeof *v);
     uint64_t *t = malloc(12 * m->nt * sizeof *t);
     memcpy(v, m->v, 3 * m->nv * sizeof *v);
@@ -45,7 +65,12 @@ static void subdivide(mesh_t *m) {
         uint64_t mid[3];
         for (int e = 0; e < 3; e++) {
             const double *a = m->v + 3 * f[e], *b = m->v + 3 * f[(e + 1) % 3];
-            for (int c = 0; c < 3; c++) v[3 * nv + c] = (a[c] + b[c]) / 2;
+            double *o = v + 3 * nv, len = 0;
+            for (int c = 0; c < 3; c++) o[c] = (a[c] + b[c]) / 2, len += (b[c] - a[c]) * (b[c] - a[c]);
+            if (perturb) {
+                double mid[3] = {o[0], o[1], o[2]};
+                for (int c = 0; c < 3; c++) o[c] += 0.02 * sqrt(len) * jitter(mid, c);
+            }
             mid[e] = nv++;
         }
         uint64_t q[12] = {f[0], mid[0], mid[2], mid[0], f[1], mid[1], mid[2], mid[1], f[2], mid[0], mid[1], mid[2]};
@@ -60,11 +85,43 @@ static int cmp_double(const void *a, const void *b) {
     return (x > y) - (x < y);
 }
 
+/* The brute force over every triangle for k points spread over the cloud:
+ * the number of points whose distance bits or triangle differ. */
+static size_t brute_check(const mesh_t *m, const double *p, size_t n, const double *d, const size_t *tri, size_t k) {
+    size_t bad = 0;
+    for (size_t j = 0; j < k && j < n; j++) {
+        size_t i = k >= n ? j : j * (n / k);
+        double best = INFINITY;
+        size_t bt = 0;
+        for (size_t t = 0; t < m->nt; t++) {
+            hd__tri_near_t r;
+            const uint64_t *f = m->t + 3 * t;
+            hd__tri_nearest(p + 3 * i, m->v + 3 * f[0], m->v + 3 * f[1], m->v + 3 * f[2], &r);
+            if (r.d < best) best = r.d, bt = t;
+        }
+        bad += memcmp(&best, &d[i], sizeof best) != 0 || bt != tri[i];
+    }
+    return bad;
+}
+
 int main(int argc, char **argv) {
-    if (argc < 6) {
-        fprintf(stderr, "usage: c2m_bench MESH LEVELS N near|far THREADS [REPEATS] [OUT.bin]\n");
+    int perturb = 0, json = 0;
+    size_t check = 0;
+    char *pos[8];
+    int np = 0;
+    for (int a = 1; a < argc; a++) {
+        if (strcmp(argv[a], "--perturb") == 0) perturb = 1;
+        else if (strcmp(argv[a], "--json") == 0) json = 1;
+        else if (strcmp(argv[a], "--check") == 0 && a + 1 < argc) check = (size_t)atof(argv[++a]);
+        else if (np < 8) pos[np++] = argv[a];
+    }
+    if (np < 5) {
+        fprintf(stderr, "usage: c2m_bench MESH LEVELS N near|far THREADS [REPEATS] [OUT.bin] [--perturb] "
+                        "[--check K] [--json]\n");
         return 2;
     }
+    argc = np + 1;
+    argv = pos - 1;
     hd_mesh_file_t *f;
     hd_error_t err;
     if (hd_read_mesh(argv[1], NULL, &f, &err)) {
@@ -76,7 +133,7 @@ int main(int argc, char **argv) {
     memcpy(m.v, f->vertices, 3 * m.nv * sizeof(double));
     memcpy(m.t, f->triangles, 3 * m.nt * sizeof(uint64_t));
     hd_mesh_file_free(f);
-    for (int l = atoi(argv[2]); l > 0; l--) subdivide(&m);
+    for (int l = atoi(argv[2]); l > 0; l--) subdivide(&m, perturb);
     size_t n = (size_t)atof(argv[3]);
     int far = strcmp(argv[4], "far") == 0, threads = atoi(argv[5]), reps = argc > 6 ? atoi(argv[6]) : 3;
     double lo[3], hi[3];
@@ -133,11 +190,23 @@ int main(int argc, char **argv) {
     }
     qsort(times, (size_t)reps, sizeof *times, cmp_double);
     qsort(cpu, (size_t)reps, sizeof *cpu, cmp_double);
-    printf("%s levels %s: %zu triangles, %zu %s points, %d threads: median %.3f s of %d (cpu %.3f s); h = %.17g; "
-           "kernel %.2f a point (exact %llu), bounded %.1f, nodes %.1f\n",
-           argv[1], argv[2], m.nt, n, far ? "far" : "near", threads, times[reps / 2], reps, cpu[reps / 2], r.distance,
-           (double)r.kernel_calls / (double)n, (unsigned long long)r.exact_calls,
-           (double)r.triangles_bounded / (double)n, (double)r.nodes_visited / (double)n);
+    size_t bad = check ? brute_check(&m, p, n, d, tri, check) : 0;
+    double fn = (double)n;
+    if (json)
+        printf("{\"mesh\": \"%s\", \"levels\": %s, \"perturb\": %d, \"triangles\": %zu, \"points\": %zu, "
+               "\"cloud\": \"%s\", \"threads\": %d, \"runs\": %d, \"wall\": %.6g, \"cpu\": %.6g, "
+               "\"h\": %.17g, \"kernel\": %.4g, \"exact\": %llu, \"bounded\": %.4g, \"nodes\": %.4g, "
+               "\"checked\": %zu, \"check_differ\": %zu}\n",
+               argv[1], argv[2], perturb, m.nt, n, far ? "far" : "near", threads, reps, times[reps / 2], cpu[reps / 2],
+               r.distance, (double)r.kernel_calls / fn, (unsigned long long)r.exact_calls,
+               (double)r.triangles_bounded / fn, (double)r.nodes_visited / fn, check < n ? check : n, bad);
+    else
+        printf("%s levels %s: %zu triangles, %zu %s points, %d threads: median %.3f s of %d (cpu %.3f s); "
+               "h = %.17g; kernel %.2f a point (exact %llu), bounded %.1f, nodes %.1f%s\n",
+               argv[1], argv[2], m.nt, n, far ? "far" : "near", threads, times[reps / 2], reps, cpu[reps / 2],
+               r.distance, (double)r.kernel_calls / fn, (unsigned long long)r.exact_calls,
+               (double)r.triangles_bounded / fn, (double)r.nodes_visited / fn,
+               check ? (bad ? "; BRUTE FORCE DIFFERS" : "; brute force agrees") : "");
     if (argc > 7) {
         FILE *o = fopen(argv[7], "wb");
         uint64_t nn = n;
@@ -152,5 +221,5 @@ int main(int argc, char **argv) {
         fclose(o);
     }
     free(p), free(d), free(tri), free(times), free(cpu), free(cum), free(m.v), free(m.t);
-    return 0;
+    return bad ? 1 : 0;
 }

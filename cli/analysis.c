@@ -64,13 +64,13 @@ const char *analysis_units(const analysis_args_t *an) {
 
 int analysis_active(const analysis_args_t *an) {
     return an->percentile_on || an->mean || an->chamfer || an->histogram || an->distances_out ||
-           an->render_out || an->histogram_png || an->n_taus || an->dtu_cap > 0;
+           an->render_out || an->histogram_png || an->n_taus || an->dtu_cap > 0 || an->subset[0].on || an->subset[1].on;
 }
 
 /* Only the percentile asked for: no figure needs every distance. */
 static int analysis_percentile_only(const analysis_args_t *an) {
     return an->percentile_on && !an->mean && !an->chamfer && !an->histogram && !an->distances_out &&
-           !an->render_out && !an->histogram_png;
+           !an->render_out && !an->histogram_png && !an->subset[0].on && !an->subset[1].on;
 }
 
 /* Only the percentile and the histogram asked for (the text or JSON
@@ -165,17 +165,22 @@ static void json_figures(FILE *out, const analysis_args_t *an,
 
 /* The per-point files of a run with an empty set (analysis.h). */
 int analysis_empty_files(const analysis_args_t *an, const hd_points_t *A, const hd_points_t *B, int directed,
-                         double v, hd_error_t *err) {
-    if (!an->distances_out) return HD_OK;
+                         double v, const char *path_a, const char *path_b, analysis_result_t *r, hd_error_t *err) {
+    if (!an->distances_out && !an->subset[0].on && !an->subset[1].on) return HD_OK;
     size_t n = A->count > B->count ? A->count : B->count;
     double *d = malloc((n ? n : 1) * sizeof *d);
     if (!d) return alloc_fail(err, n);
     for (size_t k = 0; k < n; k++) d[k] = v;
-    int rc = write_distances(an->distances_out, A, d, NULL, 1.0, err);
+    int rc = analysis_write_back(an, path_a, path_b, d, A->count, d, B->count, directed, r, err);
+    if (rc != HD_OK || !an->distances_out || analysis_writes_back(an->distances_out, path_a, an->format[0])) {
+        free(d);
+        return rc;
+    }
+    rc = write_distances(an->distances_out, A, d, NULL, 1.0, err);
+    if (rc == HD_OK) r->dist_path_a = an->distances_out;
     if (rc == HD_OK && !directed) {
-        char *path_b = path_with_suffix(an->distances_out, "_b");
-        rc = path_b ? write_distances(path_b, B, d, NULL, 1.0, err) : alloc_fail(err, n);
-        free(path_b);
+        r->dist_path_b = path_with_suffix(an->distances_out, "_b");
+        rc = r->dist_path_b ? write_distances(r->dist_path_b, B, d, NULL, 1.0, err) : alloc_fail(err, n);
     }
     free(d);
     return rc;
@@ -362,7 +367,12 @@ int analysis_finish(const analysis_args_t *an, const hd_points_t *A, const hd_po
     static const analysis_ops_t here = {hd_summarize, hd_percentile_of, hd_histogram};
     if ((rc = analysis_figures(an, &here, r->d_ab, A->count, r->d_ba, directed ? 0 : B->count, r, err))) return rc;
     double scale = analysis_scale(an, r);
-    if (an->distances_out) {
+    /* files written back: point sets only (--surface refuses them, and its
+     * --distances is always its table) */
+    if (!surf && (rc = analysis_write_back(an, path_a, path_b, r->d_ab, A->count, r->d_ba, directed ? 0 : B->count,
+                                           directed, r, err)))
+        return rc;
+    if (an->distances_out && (surf || !analysis_writes_back(an->distances_out, path_a, an->format[0]))) {
         r->dist_path_a = an->distances_out;
         rc = surf ? write_surface_distances(r->dist_path_a, A, r->d_ab, surf, scale, err)
                   : write_distances(r->dist_path_a, A, r->d_ab, r->j_ab, scale, err);
@@ -394,6 +404,7 @@ void analysis_free(analysis_result_t *r) {
     free(r->hist_ab);
     free(r->hist_ba);
     free(r->dist_path_b);
+    for (int k = 0; k < 3; k++) free(r->wb_path_b[k]);
     memset(r, 0, sizeof *r);
 }
 
@@ -468,7 +479,8 @@ void analysis_json(FILE *out, const analysis_args_t *an,
         else fputs("null", out);
         fputc('}', out);
     }
-    if (an->distances_out) {
+    analysis_write_back_json(out, an, r);
+    if (an->distances_out && r->dist_path_a) {
         fprintf(out, ", \"distances_file\": {\"a\": ");
         json_string(out, r->dist_path_a);
         fprintf(out, ", \"b\": ");
@@ -629,7 +641,8 @@ void analysis_print(FILE *out, const analysis_args_t *an,
     }
     print_scores(out, an, r, unit);
     if (an->histogram) print_histogram(out, an, r);
-    if (an->distances_out) {
+    analysis_write_back_print(out, an, r);
+    if (an->distances_out && r->dist_path_a) {
         fprintf(out, "per-point distances written to %s", safe_text(r->dist_path_a));
         if (!r->directed) fprintf(out, " and %s", safe_text(r->dist_path_b));
         fputc('\n', out);

@@ -50,7 +50,19 @@ typedef struct analysis_args {
     double taus[ANALYSIS_MAX_TAUS];
     hd_tolerance_rule_t tau_rule; /* --tau-rule le|lt (default le: d <= tau) */
     double dtu_cap;            /* --dtu-cap D: DTU accuracy/completeness (0: off) */
+    const char *labels;        /* --labels all|L[,L...]: label maps (labels.c); NULL: off */
+    int components;            /* --components 6|18|26|4|8 (0: off) */
+    int csv;                   /* --csv: the label table as CSV */
+    /* --farther-than D OUT, --nearer-than D OUT (writeback.c): the points
+     * whose distance is > D / <= D, in their file's own format */
+    struct { int on; double d; const char *out; } subset[2];
+    /* how the sides were read, for the files written back into their
+     * format: the read options, each side's FORMAT: (or NULL) */
+    hd_read_options_t read;
+    const char *format[2];
 } analysis_args_t;
+
+enum { SUBSET_FARTHER = 0, SUBSET_NEARER = 1 };
 
 /* ---- options (analysis.c) ---------------------------------------------- */
 void analysis_args_init(analysis_args_t *an);
@@ -72,6 +84,17 @@ hd_cloud_t *cli_cloud_new(size_t count, hd_dtype_t dtype, const char *format);
 int nifti_is_mask_path(const char *path);
 /* 1 when the tool was built with the NIfTI library. */
 int nifti_available(void);
+/* A NIfTI label map (--labels): its values in their own integer type (a
+ * float image's whole numbers as int64), placed as a mask's voxels are
+ * (the same map and unit); info as for a mask (foreground 0). */
+typedef struct nifti_labels {
+    hd_label_image_t img;
+    mask_info_t info;
+    void *image;       /* the nifti_image holding the values */
+    int64_t *converted; /* a float image's labels */
+} nifti_labels_t;
+int nifti_read_labels(const char *path, nifti_labels_t *out, hd_error_t *err);
+void nifti_labels_free(nifti_labels_t *l);
 
 /* ---- the run (analysis.c) ---------------------------------------------- */
 /* Where a witness point was drawn in a picture. */
@@ -129,6 +152,12 @@ typedef struct analysis_result {
     hist_marker_t hist_markers[4];
     hd_tolerance_t tol[ANALYSIS_MAX_TAUS]; /* --tau, in the order given */
     hd_capped_mean_t dtu;      /* --dtu-cap */
+    /* the files written back into the sides' formats (writeback.c): [0]
+     * --distances, [1] --farther-than, [2] --nearer-than; per side the
+     * path (A's is the option's, B's malloc'd) and the points written */
+    char *wb_path_b[3];
+    size_t wb_points[3][2];
+    int wb_done[3];
     int surface;               /* d_ab: distances to B's triangles, j_ab
                                   the nearest triangles (--surface) */
 } analysis_result_t;
@@ -147,11 +176,12 @@ int analysis_active(const analysis_args_t *an);
  * HD_ENOMEM with err filled. */
 int analysis_empty(const analysis_args_t *an, size_t n_a, size_t n_b, int directed, hd_symmetric_t *s,
                    analysis_result_t *r, hd_error_t *err);
-/* The per-point files of a run with an empty set (--distances): the other
- * set's rows at the policy's value v with nearest index -1; an empty set
- * gets a file with no rows, so that scripts find the files they asked for. */
+/* The per-point files of a run with an empty set (--distances, and the
+ * files written back): the other set's rows at the policy's value v with
+ * nearest index -1; an empty set gets a file with no rows, so that scripts
+ * find the files they asked for. */
 int analysis_empty_files(const analysis_args_t *an, const hd_points_t *A, const hd_points_t *B, int directed,
-                         double v, hd_error_t *err);
+                         double v, const char *path_a, const char *path_b, analysis_result_t *r, hd_error_t *err);
 /* Compute per-point distances and every figure asked for, write the files
  * asked for.  Returns HD_OK or a library code with err filled. */
 struct surface_columns; /* below, with the writers */
@@ -225,6 +255,30 @@ int write_surface_distances(const char *path, const hd_points_t *P, const double
                             const surface_columns_t *c, double dmax, hd_error_t *err);
 /* 1 when the path names a format write_distances knows. */
 int distances_format_known(const char *path);
+
+/* ---- files in the inputs' own formats (writeback.c) -------------------- */
+/* Whether --distances OUT writes the side read from in_path (format: its
+ * FORMAT: or --format, else NULL) back into its own format: .las, .laz,
+ * .xyz, .txt, .pts, .asc; .csv, .npy and .ply are write_distances' tables
+ * (the files hausdorff-mpi writes too). */
+int analysis_writes_back(const char *out, const char *in_path, const char *format);
+/* 1 when OUT can name a file written back (--farther-than, --nearer-than:
+ * .ply .las .laz .xyz .txt .csv .pts .asc .obj). */
+int analysis_writeback_format_known(const char *out);
+/* Before reading: every file written back names its side's format, and
+ * the sides are files read as their points (not sampled, not a mask or a
+ * directory of tiles).  HD_OK, or HD_EINVAL with the reason in err. */
+int analysis_check_outputs(const analysis_args_t *an, const char *path_a, const char *path_b, int directed,
+                           hd_error_t *err);
+/* After the distances: the files written back (--distances into the
+ * inputs' formats, --farther-than, --nearer-than), A's from d_ab and, when
+ * not directed, B's from d_ba into OUT_b.EXT; what was written into r. */
+int analysis_write_back(const analysis_args_t *an, const char *path_a, const char *path_b, const double *d_ab,
+                        size_t n_a, const double *d_ba, size_t n_b, int directed, analysis_result_t *r,
+                        hd_error_t *err);
+/* Their lines in the report and their JSON members. */
+void analysis_write_back_print(FILE *out, const analysis_args_t *an, const analysis_result_t *r);
+void analysis_write_back_json(FILE *out, const analysis_args_t *an, const analysis_result_t *r);
 /* The pieces of a distances file, for a writer that places the rows
  * itself (hausdorff-mpi: each rank writes its rows at its offset): the
  * header, then one row a point, each row's bytes depending on that row

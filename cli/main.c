@@ -23,6 +23,7 @@
 #include <math.h>
 #include "output.h"
 #include "progress.h"
+#include "labels.h"
 #include "report.h"
 #include "surface.h"
 #include "tiles.h"
@@ -102,7 +103,8 @@ static int compute(run_t *r, const hd_points_t *A, const hd_points_t *B, hd_symm
 static int compute_empty(run_t *r, const hd_points_t *A, const hd_points_t *B, hd_symmetric_t *s, hd_error_t *err) {
     const cli_args_t *a = &r->a;
     int rc = analysis_empty(&a->an, A->count, B->count, a->directed, s, &r->an, err);
-    return rc == HD_OK ? analysis_empty_files(&a->an, A, B, a->directed, s->ab.distance, err) : rc;
+    return rc == HD_OK ? analysis_empty_files(&a->an, A, B, a->directed, s->ab.distance, a->path_a, a->path_b, &r->an, err)
+                       : rc;
 }
 
 /* The report, for a person or as JSON. */
@@ -135,6 +137,10 @@ static int run(run_t *r) {
         (rc = tiles_expand(a->path_b, a->format_b, &r->side[1], &err)) != HD_OK)
         return say(rc, &err);
     if ((rc = out_check_outputs(a, r->side)) != 0) return rc;
+    if (analysis_check_outputs(&a->an, a->path_a, a->path_b, a->directed, &err) != HD_OK) {
+        fprintf(stderr, "%s: %s\n", cli_prog(), safe_text(err.message));
+        return EXIT_USAGE;
+    }
 
     /* progress by phase (read A, read B, compute), only for a person */
     progress_start(!a->quiet && !a->json && isatty(2), 3);
@@ -159,6 +165,10 @@ int main(int argc, char **argv) {
     static run_t r; /* zero: run_free frees what was made */
     int rc = cli_parse(argc, argv, &r.a);
     if (rc >= 0) return rc == EXIT_OK ? out_finish() : rc; /* --help, --version, --formats printed */
+    if (r.a.an.labels) {
+        rc = labels_run(&r.a);
+        return rc == EXIT_OK ? out_finish() : failed(rc);
+    }
     if (r.a.surface) {
         rc = surface_run(&r.a);
         return rc == EXIT_OK ? out_finish() : failed(rc);

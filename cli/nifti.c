@@ -525,14 +525,24 @@ static double world(const nifti_dmat44 *m, int c, double i, double j, double k, 
     return to_mm != 1.0 ? q * to_mm : q;
 }
 
-static int read_mask(const char *path, const hd_read_options_t *ro,
-                     const analysis_args_t *an, mask_info_t *info, hd_cloud_t **out,
-                     hd_error_t *err) {
-    mask_points_t which = an->mask_points;
-    if (access(path, R_OK) != 0) return fail(err, HD_EIO, path, "cannot open the mask");
+/* An image opened and checked: its header, the voxels libnifti2 read
+ * (with our dimensions and type), the map and unit factor. */
+typedef struct {
     header_t h;
     geometry_t g;
-    int rc = read_header(path, &h, &g, err);
+    nifti_image *nim;
+    const nifti_dmat44 *m; /* sform when sform_code > 0, else qform */
+    double to_mm;
+} opened_t;
+
+/* Read the header, check it, read the voxels, check the corners' world
+ * coordinates against limit (float32: float range); on failure nothing is
+ * held. */
+static int open_image(const char *path, double limit, int float32, opened_t *o, hd_error_t *err) {
+    memset(o, 0, sizeof *o);
+    if (access(path, R_OK) != 0) return fail(err, HD_EIO, path, "cannot open the mask");
+    header_t *h = &o->h;
+    int rc = read_header(path, h, &o->g, err);
     if (rc) return rc;
 
     captured_t cap;
@@ -547,19 +557,18 @@ static int read_mask(const char *path, const hd_read_options_t *ro,
                         "corrupt gzip stream)", lib);
     }
     /* libnifti2 must have read what the header says, or we walk nothing */
-    const long long *n = g.n;
-    if ((int64_t)nim->nvox != g.nvox || nim->nx != n[0] || nim->ny != n[1] || nim->nz != n[2] ||
-        nim->datatype != h.datatype || nim->nbyper != g.nbyper) {
+    const long long *n = o->g.n;
+    if ((int64_t)nim->nvox != o->g.nvox || nim->nx != n[0] || nim->ny != n[1] || nim->nz != n[2] ||
+        nim->datatype != h->datatype || nim->nbyper != o->g.nbyper) {
         nifti_image_free(nim);
         return fail(err, HD_EFORMAT, path,
                     "libnifti2 read other dimensions or another voxel type than the header has");
     }
-    const nifti_dmat44 *m = h.sform_code > 0 ? &nim->sto_xyz : &nim->qto_xyz;
+    const nifti_dmat44 *m = h->sform_code > 0 ? &nim->sto_xyz : &nim->qto_xyz;
     double to_mm = 1.0;
     if (nim->xyz_units == NIFTI_UNITS_METER) to_mm = 1000.0;
     else if (nim->xyz_units == NIFTI_UNITS_MICRON) to_mm = 0.001;
     /* the coordinates of the box's corners bound every voxel's */
-    double limit = ro->dtype == HD_FLOAT32 ? FLT_MAX : HD_MAX_COORD;
     for (int corner = 0; corner < 8 && rc == HD_OK; corner++) {
         double i = corner & 1 ? (double)(n[0] - 1) : 0, j = corner & 2 ? (double)(n[1] - 1) : 0,
                k = corner & 4 ? (double)(n[2] - 1) : 0;
@@ -568,42 +577,60 @@ static int read_mask(const char *path, const hd_read_options_t *ro,
             if (!(fabs(q) <= limit)) {
                 char msg[256], b[32];
                 snprintf(msg, sizeof msg, "the %s maps voxel (%.0f, %.0f, %.0f) to %c = %s mm, %s",
-                         h.sform_code > 0 ? "sform" : h.qform_code > 0 ? "qform" : "pixdim scaling", i, j, k,
+                         h->sform_code > 0 ? "sform" : h->qform_code > 0 ? "qform" : "pixdim scaling", i, j, k,
                          "xyz"[c], shown(q, b),
-                         ro->dtype == HD_FLOAT32 ? "beyond float range (--float32)"
-                                                 : "beyond the limit 1e153 of coordinates");
+                         float32 ? "beyond float range (--float32)" : "beyond the limit 1e153 of coordinates");
                 rc = fail(err, isnan(q) || isinf(q) ? HD_ENONFINITE : HD_ERANGE, path, msg);
                 break;
             }
         }
     }
-    unsigned char *fg = NULL;
-    long long count = 0;
-    if (rc == HD_OK && !(fg = foreground_of(nim, (size_t)g.nvox, &count)))
-        rc = fail(err, HD_ENOMEM, path, "out of memory");
     if (rc) {
         nifti_image_free(nim);
         return rc;
     }
+    o->nim = nim, o->m = m, o->to_mm = to_mm;
+    return HD_OK;
+}
+
+/* What every read image tells the report. */
+static void describe(const opened_t *o, long long foreground, mask_info_t *info) {
     memset(info, 0, sizeof *info);
     info->is_mask = 1;
-    info->nifti_version = h.version;
+    info->nifti_version = o->h.version;
     for (int a = 0; a < 3; a++) {
-        info->dim[a] = n[a];
-        info->spacing[a] = h.pixdim[a + 1];
+        info->dim[a] = o->g.n[a];
+        info->spacing[a] = o->h.pixdim[a + 1];
     }
-    info->foreground = count;
-    info->transform = h.sform_code > 0 ? "sform" : h.qform_code > 0 ? "qform" : "pixdim";
-    info->to_mm = to_mm;
-    info->unit_known = nim->xyz_units == NIFTI_UNITS_METER || nim->xyz_units == NIFTI_UNITS_MM ||
-                       nim->xyz_units == NIFTI_UNITS_MICRON;
+    info->foreground = foreground;
+    info->transform = o->h.sform_code > 0 ? "sform" : o->h.qform_code > 0 ? "qform" : "pixdim";
+    info->to_mm = o->to_mm;
+    info->unit_known = o->nim->xyz_units == NIFTI_UNITS_METER || o->nim->xyz_units == NIFTI_UNITS_MM ||
+                       o->nim->xyz_units == NIFTI_UNITS_MICRON;
+}
+
+static int read_mask(const char *path, const hd_read_options_t *ro,
+                     const analysis_args_t *an, mask_info_t *info, hd_cloud_t **out,
+                     hd_error_t *err) {
+    mask_points_t which = an->mask_points;
+    opened_t o;
+    int rc = open_image(path, ro->dtype == HD_FLOAT32 ? FLT_MAX : HD_MAX_COORD, ro->dtype == HD_FLOAT32, &o, err);
+    if (rc) return rc;
+    const long long *n = o.g.n;
+    unsigned char *fg = NULL;
+    long long count = 0;
+    if (!(fg = foreground_of(o.nim, (size_t)o.g.nvox, &count))) {
+        nifti_image_free(o.nim);
+        return fail(err, HD_ENOMEM, path, "out of memory");
+    }
+    describe(&o, count, info);
     /* the library finds the surface (medpy's and MONAI's erosion) and
      * places each voxel's centre as world() does */
     hd_mask_t mk;
     hd_mask_init(&mk, fg, (size_t)n[0], (size_t)n[1], (size_t)n[2], NULL);
     for (int r = 0; r < 3; r++)
-        for (int c = 0; c < 4; c++) mk.m[r][c] = m->m[r][c];
-    mk.scale = to_mm;
+        for (int c = 0; c < 4; c++) mk.m[r][c] = o.m->m[r][c];
+    mk.scale = o.to_mm;
     hd_mask_options_t mo;
     hd_mask_options_init(&mo);
     mo.points = which == MASK_ALL ? HD_MASK_ALL : HD_MASK_SURFACE;
@@ -624,13 +651,92 @@ static int read_mask(const char *path, const hd_read_options_t *ro,
     size_t np = rc == HD_OK ? mi.points : 0;
     info->points = np;
     free(fg);
-    nifti_image_free(nim);
+    nifti_image_free(o.nim);
     return rc;
+}
+
+/* The label type of a NIfTI integer datatype; -1 for a float type. */
+static int label_type_of(int datatype) {
+    switch (datatype) {
+    case DT_UINT8: return HD_LABEL_U8;
+    case DT_INT8: return HD_LABEL_I8;
+    case DT_UINT16: return HD_LABEL_U16;
+    case DT_INT16: return HD_LABEL_I16;
+    case DT_UINT32: return HD_LABEL_U32;
+    case DT_INT32: return HD_LABEL_I32;
+    case DT_INT64: return HD_LABEL_I64;
+    case DT_UINT64: return HD_LABEL_U64;
+    default: return -1;
+    }
+}
+
+/* Float voxels as int64 labels: each must be a whole number within
+ * +-2^53 (labels stored as float are small integers); NaN is refused. */
+static int64_t *whole_labels(const nifti_image *nim, size_t nvox, const char *path, hd_error_t *err) {
+    int64_t *l = malloc(nvox ? nvox * sizeof *l : 1);
+    if (!l) {
+        fail(err, HD_ENOMEM, path, "out of memory");
+        return NULL;
+    }
+    for (size_t v = 0; v < nvox; v++) {
+        double f = nim->datatype == DT_FLOAT32 ? (double)((const float *)nim->data)[v]
+                                               : ((const double *)nim->data)[v];
+        if (!(f == floor(f) && fabs(f) <= 9007199254740992.0)) {
+            char msg[160], b[32];
+            snprintf(msg, sizeof msg, "voxel %zu holds %s: a label map of floats holds whole numbers only", v,
+                     shown(f, b));
+            free(l);
+            fail(err, HD_EFORMAT, path, msg);
+            return NULL;
+        }
+        l[v] = (int64_t)f;
+    }
+    return l;
+}
+
+int nifti_read_labels(const char *path, nifti_labels_t *out, hd_error_t *err) {
+    memset(out, 0, sizeof *out);
+    opened_t o;
+    int rc = open_image(path, HD_MAX_COORD, 0, &o, err);
+    if (rc) return rc;
+    const long long *n = o.g.n;
+    int type = label_type_of(o.nim->datatype);
+    const void *values = o.nim->data;
+    if (type < 0) {
+        if (!(out->converted = whole_labels(o.nim, (size_t)o.g.nvox, path, err))) {
+            nifti_image_free(o.nim);
+            return err->code ? err->code : HD_ENOMEM;
+        }
+        values = out->converted;
+        type = HD_LABEL_I64;
+    }
+    describe(&o, 0, &out->info);
+    hd_label_image_init(&out->img, values, (hd_label_type_t)type, (size_t)n[0], (size_t)n[1], (size_t)n[2], NULL);
+    for (int r = 0; r < 3; r++)
+        for (int c = 0; c < 4; c++) out->img.m[r][c] = o.m->m[r][c];
+    out->img.scale = o.to_mm;
+    out->image = o.nim;
+    return HD_OK;
+}
+
+void nifti_labels_free(nifti_labels_t *l) {
+    if (l->image) nifti_image_free(l->image);
+    free(l->converted);
+    memset(l, 0, sizeof *l);
 }
 
 #else
 
 int nifti_available(void) { return 0; }
+
+int nifti_read_labels(const char *path, nifti_labels_t *out, hd_error_t *err) {
+    memset(out, 0, sizeof *out);
+    return fail(err, HD_EUNSUPPORTED, path,
+                "NIfTI label maps are unavailable: this hausdorff was built without libnifti2 "
+                "(Debian: libnifti2-dev)");
+}
+
+void nifti_labels_free(nifti_labels_t *l) { memset(l, 0, sizeof *l); }
 
 static int read_mask(const char *path, const hd_read_options_t *ro,
                      const analysis_args_t *an, mask_info_t *info, hd_cloud_t **out,

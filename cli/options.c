@@ -4,6 +4,7 @@
  * line on stderr saying what was wrong.
  */
 #include "cli.h"
+#include "labels.h"
 #include "tiles.h"
 
 #include <errno.h>
@@ -73,6 +74,7 @@ static void usage_examples(FILE *out) {
 "  cat cloud.csv | hausdorff xyz:- model.ply\n"
 "  hausdorff --percentile 95 --mean --render dev.png scan.ply model.ply\n"
 "  hausdorff --json --percentile 95 seg.nii.gz truth.nii.gz\n"
+"  hausdorff --labels all --components 26 --csv seg.nii.gz truth.nii.gz\n"
 "  hausdorff --json tiles2019/ @tiles2024.txt\n");
     }
     fprintf(out, "\nExit status: 0 success, 1 usage error, 2 bad input, 3 other failure.\n");
@@ -161,11 +163,12 @@ typedef enum {
     OPT_MAX_STREAM_SIZE, OPT_FIFO_WAIT, OPT_LAZ_POINTS_PER_BYTE, OPT_TOLERANCE, OPT_WITHIN,
     OPT_PERCENTILE, OPT_BINS, OPT_DISTANCES, OPT_MAX_DISTANCE, OPT_RENDER, OPT_HISTOGRAM_PNG,
     OPT_MASK_POINTS, OPT_EMPTY, OPT_CONNECTIVITY, OPT_MASK_DIMS, OPT_UNITS, OPT_TAU, OPT_TAU_RULE,
-    OPT_DTU_CAP,
+    OPT_DTU_CAP, OPT_LABELS, OPT_COMPONENTS,
+    OPT_FARTHER_THAN, OPT_NEARER_THAN, /* these two take D and OUT */
     OPT_FLAGS, /* the first flag */
     OPT_HELP = OPT_FLAGS, OPT_VERSION, OPT_FORMATS, OPT_DIRECTED, OPT_JSON, OPT_QUIET, OPT_NO_EARLY_BREAK,
     OPT_NO_CULLING, OPT_FLOAT32, OPT_DECIMAL_COMMA, OPT_VERTICES, OPT_SURFACE, OPT_SIGNED, OPT_MEAN,
-    OPT_CHAMFER, OPT_HISTOGRAM,
+    OPT_CHAMFER, OPT_HISTOGRAM, OPT_CSV,
     OPT_COUNT
 } option_t;
 
@@ -294,7 +297,18 @@ static const option_entry_t options[] = {
     {OPT_DISTANCES, "--distances", NULL, "OUT", 0,
      "write A's points with distance and nearest index in B\n"
      "(.csv: x,y,z,distance,nearest; .ply: also a viridis\n"
-     "colour; .npy: (N, 5) float64); B's go to OUT_b.EXT"},
+     "colour; .npy: (N, 5) float64); B's go to OUT_b.EXT.\n"
+     "OUT of A's own format (.las, .laz, .xyz/.txt/.pts): A's\n"
+     "file with a field `distance` added to every point,\n"
+     "everything else kept (a LAS/LAZ extra-bytes dimension,\n"
+     "a column)"},
+    {OPT_FARTHER_THAN, "--farther-than", NULL, "D OUT", 0,
+     "write the points of A farther than D from B (d > D),\n"
+     "with their distance, as a file of A's own format (PLY,\n"
+     "LAS, LAZ, text, OBJ); B's farther than D from A to\n"
+     "OUT_b.EXT"},
+    {OPT_NEARER_THAN, "--nearer-than", NULL, "D OUT", 0,
+     "the same for the points within D (d <= D)"},
     {OPT_MAX_DISTANCE, "--max-distance", NULL, "D", 0,
      "top of the colour and histogram scale (default: the\n"
      "Hausdorff distance)"},
@@ -350,6 +364,25 @@ static const option_entry_t options[] = {
      "or 0 instead; monai: inf when one set is empty, NaN when\n"
      "both are, as MONAI (JSON: null for inf and NaN, and an\n"
      "\"empty\" member)"},
+    {OPT_NONE, NULL, NULL, NULL, 'n',
+     "\n"
+     "Label maps: A (the prediction) and B (the reference) are NIfTI label maps%s\n"
+     "  of one size, one integer label a voxel (0: background).\n"},
+    {OPT_LABELS, "--labels", NULL, "all|L[,L...]", 0,
+     "every nonzero label in A or B (all), or these: per\n"
+     "label Dice, HD, HD_P (--percentile, default 95: max of\n"
+     "the directed ones as MONAI, and pooled as medpy), ASSD,\n"
+     "NSD at --tau (default 1) counted per surface voxel\n"
+     "(MONAI) and weighted by surfel area (DeepMind), and\n"
+     "DeepMind's HD_P; a table, --csv or --json; a label\n"
+     "absent from a side follows --empty (else an error)"},
+    {OPT_COMPONENTS, "--components", NULL, "CONN", 0,
+     "with --labels, also each connected component (CONN\n"
+     "6, 18 or 26; 4 or 8 in 2-D) of each side: its directed\n"
+     "HD, HD_P and nearest distance to the other side, and\n"
+     "whether it overlaps or comes within --tau (detected)"},
+    {OPT_CSV, "--csv", NULL, NULL, 0,
+     "with --labels, print the table as CSV"},
 };
 enum { N_OPTIONS = sizeof options / sizeof options[0], HELP_COLUMN = 21 };
 
@@ -432,6 +465,7 @@ static int set_flag(cli_args_t *a, int which) {
     case OPT_MEAN: a->an.mean = 1; break;
     case OPT_CHAMFER: a->an.chamfer = 1; break;
     case OPT_HISTOGRAM: a->an.histogram = 1; break;
+    case OPT_CSV: a->an.csv = 1; break;
     }
     return 0;
 }
@@ -513,6 +547,28 @@ static int set_taus(analysis_args_t *an, const char *v) {
     return 0;
 }
 
+/* --farther-than D OUT, --nearer-than D OUT: 0, or EXIT_USAGE after a
+ * message. */
+static int set_subset(analysis_args_t *an, int which, const char *name, const char *v, const char *out) {
+    double d;
+    char msg[600];
+    if (parse_double(v, &d) || !(d >= 0)) {
+        snprintf(msg, sizeof msg, "%s needs a distance >= 0 and a file (%s D OUT), not '%s'", name, name, v);
+        return bad("%s", msg);
+    }
+    if (!analysis_writeback_format_known(out)) {
+        snprintf(msg, sizeof msg,
+                 "%s %s: cannot tell the format of '%s'; the points are written in their file's format: name it "
+                 "with its extension (.ply, .las, .laz, .xyz, .csv, .obj)",
+                 name, v, out);
+        return bad("%s", msg);
+    }
+    an->subset[which].on = 1;
+    an->subset[which].d = d;
+    an->subset[which].out = out;
+    return 0;
+}
+
 /* An analysis option's value (analysis.h): 0, or EXIT_USAGE after a message. */
 static int set_analysis(analysis_args_t *an, int which, const char *name, const char *v) {
     double d;
@@ -529,8 +585,10 @@ static int set_analysis(analysis_args_t *an, int which, const char *name, const 
         an->bins = (size_t)d;
         break;
     case OPT_DISTANCES:
-        if (!distances_format_known(v))
-            return bad("--distances: cannot tell the format of '%s'; name it .csv, .ply or .npy", v);
+        if (!distances_format_known(v) && !analysis_writeback_format_known(v))
+            return bad("--distances: cannot tell the format of '%s'; name it .csv, .ply or .npy (or the extension "
+                       "of A's format: .las, .laz, .xyz)",
+                       v);
         an->distances_out = v;
         break;
     case OPT_MAX_DISTANCE:
@@ -597,6 +655,15 @@ static int set_analysis(analysis_args_t *an, int which, const char *name, const 
             return bad("--dtu-cap needs a positive number or inf, not '%s'", v);
         an->dtu_cap = d;
         break;
+    case OPT_LABELS:
+        if (!labels_list_ok(v)) return bad("--labels is all or whole numbers separated by commas, not '%s'", v);
+        an->labels = v;
+        break;
+    case OPT_COMPONENTS:
+        if (strcmp(v, "6") && strcmp(v, "18") && strcmp(v, "26") && strcmp(v, "4") && strcmp(v, "8"))
+            return bad("--components is 6, 18 or 26 (4 or 8 in 2-D), not '%s'", v);
+        an->components = atoi(v);
+        break;
     }
     return 0;
 }
@@ -626,10 +693,24 @@ int cli_parse(int argc, char **argv, cli_args_t *a) {
         const char *eq = strchr(s, '='), *name = option_name(which);
         const char *v = eq ? eq + 1 : (k + 1 < argc ? argv[++k] : NULL);
         if (!v) return bad("option '%s' needs a value", name);
+        if (which == OPT_FARTHER_THAN || which == OPT_NEARER_THAN) {
+            const char *out = k + 1 < argc ? argv[++k] : NULL;
+            if (!out) return bad("%s needs a distance and a file: --farther-than D OUT (or --nearer-than D OUT)", name);
+            if (set_subset(&a->an, which == OPT_FARTHER_THAN ? SUBSET_FARTHER : SUBSET_NEARER, name, v, out))
+                return EXIT_USAGE;
+            continue;
+        }
         int rc = which < OPT_PERCENTILE ? set_run(a, which, v) : set_analysis(&a->an, which, name, v);
         if (rc) return rc;
     }
     a->read.seed = a->opt.seed; /* --seed also seeds --sample */
+    int subset = a->an.subset[0].on || a->an.subset[1].on;
+    if ((mpi_tool || a->surface) && (subset || (a->an.distances_out && !distances_format_known(a->an.distances_out))))
+        return bad(mpi_tool ? "%s: files in an input's own format are written by hausdorff, not hausdorff-mpi "
+                              "(whose --distances writes .csv, .ply or .npy tables)"
+                            : "%s: files in an input's own format are not written with --surface (its --distances "
+                              "writes .csv, .ply or .npy tables)",
+                   subset ? "--farther-than / --nearer-than" : a->an.distances_out);
     if ((a->tolerance_set || a->within_set) && !a->surface)
         return bad("%s measures a surface: it needs --surface (and a mesh as A)",
                    a->within_set ? "--within" : "--tolerance");
@@ -644,5 +725,8 @@ int cli_parse(int argc, char **argv, cli_args_t *a) {
     }
     a->path_a = tiles_split_format(files[0], &a->format_a);
     a->path_b = tiles_split_format(files[1], &a->format_b);
+    a->an.read = a->read; /* for the files written back (writeback.c) */
+    a->an.format[0] = a->format_a;
+    a->an.format[1] = a->format_b;
     return -1;
 }

@@ -168,16 +168,23 @@ int out_check_paths(const char *const *outs, const char *const *what, int n,
  * them) or another output. */
 int out_check_outputs(const cli_args_t *a, const tiles_t *side) {
     fifo_wait_ms = a->read.fifo_wait_ms; /* outputs await a reader as inputs await a writer */
-    char *path_b = NULL;
-    const char *outs[4] = {a->an.distances_out, NULL, a->an.render_out, a->an.histogram_png};
-    const char *const what[4] = {"--distances", "--distances (B's rows)", "--render", "--histogram-png"};
-    if (a->an.distances_out && !a->directed) {
-        if (!(outs[1] = path_b = path_with_suffix(a->an.distances_out, "_b"))) {
+    char *path_b[3] = {NULL, NULL, NULL};
+    const char *outs[8] = {a->an.distances_out, NULL, a->an.render_out, a->an.histogram_png,
+                           a->an.subset[0].on ? a->an.subset[0].out : NULL, NULL,
+                           a->an.subset[1].on ? a->an.subset[1].out : NULL, NULL};
+    const char *const what[8] = {"--distances", "--distances (B's rows)", "--render", "--histogram-png",
+                                 "--farther-than", "--farther-than (B's points)", "--nearer-than",
+                                 "--nearer-than (B's points)"};
+    static const int with_b[3] = {0, 4, 6};
+    for (int k = 0; k < 3; k++)
+        if (outs[with_b[k]] && !a->directed && !(outs[with_b[k] + 1] = path_b[k] = path_with_suffix(outs[with_b[k]], "_b"))) {
             fprintf(stderr, "%s: out of memory\n", cli_prog());
+            free(path_b[0]), free(path_b[1]);
             return EXIT_FAILURE_;
         }
-    }
-    if (!outs[0] && !outs[2] && !outs[3]) return 0;
+    int any = 0;
+    for (int k = 0; k < 8; k++) any |= outs[k] != NULL;
+    if (!any) return 0;
     size_t n = side[0].n + side[1].n + 2, m = 0;
     const char **in = malloc(n * sizeof *in);
     char *which = malloc(n);
@@ -189,11 +196,11 @@ int out_check_outputs(const cli_args_t *a, const tiles_t *side) {
             if (side[w].kind == TILES_LIST) in[m] = side[w].arg + 1, which[m++] = "AB"[w];
             for (size_t k = 0; k < side[w].n; k++) in[m] = side[w].t[k].path, which[m++] = "AB"[w];
         }
-        rc = out_check_paths(outs, what, 4, in, which, m);
+        rc = out_check_paths(outs, what, 8, in, which, m);
     }
     free(in);
     free(which);
-    free(path_b);
+    for (int k = 0; k < 3; k++) free(path_b[k]);
     return rc;
 }
 

@@ -668,6 +668,199 @@ typedef struct hd_mask_info {
 HD_EXTERN int hd_mask_points(const hd_mask_t *mask, const hd_mask_options_t *opt, struct hd_cloud **out,
                              hd_mask_info_t *info, hd_error_t *err);
 
+/* The surfels of a mask, DeepMind's surface-distance's surface (and
+ * MONAI's with use_subvoxels=True): one per cube of 2 x 2 x 2 voxels
+ * (dims 3) or 2 x 2 pixels of each slice k (dims 2; dims 0: 2 when
+ * n[2] = 1, else 3) whose corners are not all foreground nor all
+ * background, the outside of the image counting as background, in storage
+ * order of the cubes (the cube of voxels i..i+1, j..j+1, k..k+1 for i =
+ * -1 .. n[0]-1, i fastest).  Each is placed at its cube's centre, voxel
+ * index (i + 1/2, j + 1/2, k + 1/2) through the mask's map (k itself with
+ * dims 2), and weighted by the area of the marching-cubes surface inside
+ * its cube after the map's linear part (the length of the boundary in
+ * 2-D): docs/analysis.md, "Surfels".  *points (format "surfels") and
+ * *areas (count doubles, from malloc: free) are the caller's.
+ * Errors: as hd_mask_points (dims other than 0, 2, 3: HD_EINVAL).  On
+ * failure both are NULL.  Thread safe. */
+HD_EXTERN int hd_mask_surfels(const hd_mask_t *mask, int dims, struct hd_cloud **points, double **areas,
+                              hd_error_t *err);
+
+/* ------------------------------------------------------------------------
+ * Label maps: an integer image (a multi-class segmentation) against
+ * another, every label's figures in one call (docs/analysis.md, "Label
+ * maps", defines each figure and names the library whose convention it
+ * follows).  A is the prediction, B the reference.  Per label, the two
+ * binary masks "voxel == label" are cut to the box of the label's voxels
+ * in either image (one voxel of margin), so the memory held is bounded by
+ * the largest label's box, not by the number of labels; the points are
+ * placed by the whole image's indices, so the figures are bit for bit
+ * those of the two masks given whole (hd_mask_points and hd_distances).
+ * Two surfaces are measured per label:
+ *   voxel surfaces (MONAI's and medpy's): the surface voxels of
+ *     hd_mask_points, each counting 1: HD, HD_P (MONAI's max of directed
+ *     percentiles and medpy's pooled one), ASSD, NSD (MONAI's
+ *     compute_surface_dice, use_subvoxels=False);
+ *   surfels (DeepMind's surface-distance, and MONAI's compute_surface_dice
+ *     with use_subvoxels=True): one per 2 x 2 x 2 cube of voxels (2 x 2 in
+ *     2-D) that the boundary crosses, at the cube's centre, weighted by the
+ *     area of the marching-cubes surface in it (masks/surfels.c derives
+ *     it): their NSD, the area-weighted directed mean distances and
+ *     DeepMind's robust Hausdorff distance (area-weighted percentile).
+ * ---------------------------------------------------------------------- */
+
+/* The voxel type of a label image. */
+typedef enum hd_label_type {
+    HD_LABEL_U8 = 0,
+    HD_LABEL_I8,
+    HD_LABEL_U16,
+    HD_LABEL_I16,
+    HD_LABEL_U32,
+    HD_LABEL_I32,
+    HD_LABEL_I64,
+    HD_LABEL_U64
+} hd_label_type_t;
+
+/* A label image: n[0] x n[1] x n[2] values of `type` at `labels`, laid out
+ * and placed as hd_mask_t's voxels (i fastest; a 2-D image has n[2] = 1).
+ * hd_label_image_init sets m to the diagonal of the spacing (NULL: 1). */
+typedef struct hd_label_image {
+    const void *labels;
+    hd_label_type_t type;
+    size_t n[3];
+    double m[3][4];
+    double scale;
+} hd_label_image_t;
+HD_EXTERN void hd_label_image_init(hd_label_image_t *img, const void *labels, hd_label_type_t type, size_t n0,
+                                   size_t n1, size_t n2, const double spacing[3]);
+
+typedef struct hd_label_options {
+    const int64_t *labels;    /* the labels to measure, in this order; NULL:
+                                 every label other than 0 present in A or B,
+                                 ascending */
+    size_t n_labels;
+    double percentile;        /* P of HD_P (default 95) */
+    double tau;               /* the NSD's tolerance (default 1), in the
+                                 spacing's unit */
+    hd_tolerance_rule_t rule; /* HD_AT_MOST (default: MONAI's, DeepMind's) */
+    int connectivity;         /* of the surface voxels' erosion: 1 (default),
+                                 2, 3, as hd_mask_options_t */
+    int dims;                 /* 0 (default): the image's axes of more than
+                                 one voxel; 2: each slice on its own (the
+                                 erosion as hd_mask_options_t's, the surfels'
+                                 squares); 3 */
+    hd_empty_policy_t empty;  /* a label absent from A or B (or both):
+                                 HD_EMPTY_ERROR (default) fails with
+                                 HD_EEMPTY naming it; otherwise every
+                                 distance figure of that label is
+                                 hd_empty_value's, the NSDs and Dice are
+                                 computed (0 with one side empty, NaN with
+                                 both, as MONAI and DeepMind) */
+    int components;           /* 0 (default): none; else the connectivity of
+                                 connected components, 6, 18 or 26 in 3-D
+                                 (4 or 8 in 2-D, as 6 and 18 act on one
+                                 slice), each listed in the table */
+    int threads;              /* for hd_distances: 0 = every core */
+} hd_label_options_t;
+HD_EXTERN void hd_label_options_init(hd_label_options_t *opt);
+
+/* One label's figures.  Distances in the unit of the image's map. */
+typedef struct hd_label_row {
+    int64_t label;
+    int empty;                 /* 0, or 1 (A has no such voxel), 2 (B has
+                                  none), 3 (neither): the distance figures
+                                  then follow the policy */
+    size_t voxels_a, voxels_b; /* foreground voxels */
+    size_t overlap;            /* voxels of the label in both */
+    double dice;               /* 2 overlap / (voxels_a + voxels_b); NaN
+                                  when both are 0 */
+    size_t points_a, points_b; /* surface voxels */
+    double hausdorff;          /* max(hd_ab, hd_ba) */
+    double hd_ab, hd_ba;       /* directed: A's surface voxels to B's, ... */
+    double hd_p;               /* max of the directed P-th percentiles
+                                  (MONAI's compute_hausdorff_distance) */
+    double hd_p_pooled;        /* P-th percentile of both directions
+                                  pooled (medpy's hd95) */
+    double assd;               /* mean of both directions pooled (MONAI's
+                                  symmetric ASSD, medpy's assd) */
+    double asd_ab, asd_ba;     /* directed means (medpy's asd) */
+    double nsd;                /* NSD by voxel counts (MONAI's
+                                  compute_surface_dice) */
+    size_t surfels_a, surfels_b;
+    double area_a, area_b;     /* the surfels' total areas */
+    double nsd_surfel;         /* NSD by surfel areas (DeepMind's
+                                  compute_surface_dice_at_tolerance, MONAI's
+                                  use_subvoxels=True) */
+    double overlap_ab, overlap_ba; /* DeepMind's surface overlap at tau:
+                                  the share of A's (B's) surfel area within
+                                  tau of the other's surfels */
+    double hd_surfel;          /* DeepMind's compute_robust_hausdorff at
+                                  P: max over both directions of the
+                                  smallest distance d whose surfels at most
+                                  d hold P percent of the direction's area */
+    double asd_surfel_ab, asd_surfel_ba; /* DeepMind's
+                                  compute_average_surface_distance: the
+                                  area-weighted mean distance, A's surfels
+                                  to B's, B's to A's */
+    size_t components_a, components_b; /* with options.components */
+} hd_label_row_t;
+
+/* One connected component of one side of one label. */
+typedef struct hd_label_component {
+    int64_t label;
+    int side;          /* 0: a component of A, 1: of B */
+    size_t index;      /* 1.. in storage order of their first voxel */
+    size_t voxels;     /* its voxels */
+    size_t overlap;    /* of them, voxels of the label on the other side */
+    size_t points;     /* its surface voxels */
+    double hausdorff;  /* the directed HD of its surface voxels to the
+                          other side's surface (+inf when that is empty) */
+    double hd_p;       /* the P-th percentile of those distances */
+    double nearest;    /* the smallest of them */
+    int detected;      /* 1 when it overlaps the other side's label or
+                          nearest is within tau (by the options' rule) */
+} hd_label_component_t;
+
+/* The table: rows in the order of the labels, then every component of a
+ * row's A side, then of its B side, row after row. */
+typedef struct hd_label_table {
+    hd_label_row_t *rows;
+    size_t n_rows;
+    hd_label_component_t *components;
+    size_t n_components;
+} hd_label_table_t;
+
+/* Every label's figures, A (prediction) against B (reference), which have
+ * the same sizes (their maps may differ: each places its own voxels).
+ * One pass over both images finds each label's counts and box; then, a
+ * label at a time, its windows are cut, their surface voxels and surfels
+ * found once, the per-point distances found in both directions
+ * (hd_distances) and every figure derived from them.  Memory beyond the
+ * images: the largest label's two windows, points and surfels, and about
+ * 100 bytes per distinct value in the images (an image of a million
+ * distinct values, an intensity image given by mistake, costs that much
+ * and a window per value).  *out is the library's (hd_label_table_free).  Errors: HD_EINVAL (NULL, sizes that
+ * differ or are 0, an unknown type, bad options: percentile outside
+ * [0, 100], tau NaN or < 0, connectivity, dims, components), HD_EEMPTY
+ * (a label absent from a side under HD_EMPTY_ERROR: the message names
+ * it), HD_EOVERFLOW, HD_ENONFINITE or HD_ERANGE (as hd_mask_points),
+ * HD_ENOMEM.  On failure *out is NULL.  Thread safe (the images are only
+ * read); threads as hd_distances. */
+HD_EXTERN int hd_label_map(const hd_label_image_t *a, const hd_label_image_t *b, const hd_label_options_t *opt,
+                           hd_label_table_t **out, hd_error_t *err);
+/* Frees a table; NULL is accepted. */
+HD_EXTERN void hd_label_table_free(hd_label_table_t *table);
+
+/* The area-weighted percentile of DeepMind's compute_robust_hausdorff:
+ * the smallest of the n distances d such that the weights of the
+ * distances at most d add up to at least p / 100 of all the weights (sums
+ * exact, rounded once; p = 0 gives the smallest distance of positive
+ * weight... p = 100 the largest of positive weight).  Errors: HD_EINVAL
+ * (NULL, p outside [0, 100], a weight negative or not finite, all weights
+ * 0), HD_EEMPTY (n = 0), HD_ENONFINITE (a NaN distance), HD_ENOMEM.
+ * Thread safe. */
+HD_EXTERN int hd_weighted_percentile(const double *d, const double *w, size_t n, double p, double *out,
+                                     hd_error_t *err);
+
 /* ------------------------------------------------------------------------
  * Reading files.
  * ---------------------------------------------------------------------- */
@@ -791,6 +984,96 @@ HD_EXTERN const char *hd_format_description(const char *name);
 HD_EXTERN const char *hd_format_of_path(const char *path);
 
 /* ------------------------------------------------------------------------
+ * Writing a per-point field back into the input's own format.
+ *
+ * A deviation is most useful in the file people opened: a `distance`
+ * property in PLY, an extra-bytes dimension in LAS and LAZ, a column in
+ * text, and the changed points alone in the same format.  Every byte of
+ * the input that is not a point left out is kept: PLY's other properties
+ * and elements (faces too) in the input's encoding, LAS/LAZ's header, VLRs,
+ * point records, waveform data and extended VLRs, text lines verbatim.
+ * The formats and what each keeps: docs/formats.md, "Writing a field".
+ * ---------------------------------------------------------------------- */
+typedef enum hd_keep {
+    HD_KEEP_ALL = 0,     /* every point, with the field added */
+    HD_KEEP_FARTHER = 1, /* only the points whose value v > threshold */
+    HD_KEEP_NEARER = 2   /* only the points whose value v <= threshold */
+} hd_keep_t;
+
+typedef struct hd_write_options {
+    const char *name;  /* the field's name: NULL = "distance"; letters,
+                          digits and '_' (at most 31 bytes, LAS's limit).
+                          "" writes no field (a subset of the input as it
+                          is; with HD_KEEP_ALL a copy) */
+    hd_keep_t keep;    /* which points are written */
+    double threshold;  /* D of HD_KEEP_FARTHER / HD_KEEP_NEARER; finite
+                          (a NaN value is neither > D nor <= D: never kept) */
+    const char *format; /* the output's format ("ply", "las", ...): NULL
+                          = the one out_path's extension names; either way
+                          it must be the input's (for writing under a
+                          temporary name) */
+    const hd_read_options_t *read; /* how the input is read (NULL: the
+                          defaults): `format`, `decimal_comma` and
+                          `laz_points_per_byte` are used, so the points
+                          are numbered as hd_read_file numbers them with
+                          these options; a range or mesh sampling is
+                          refused (HD_EINVAL) */
+} hd_write_options_t;
+
+/* Fill `opt` with the defaults: "distance", HD_KEEP_ALL, threshold 0. */
+HD_EXTERN void hd_write_options_init(hd_write_options_t *opt);
+
+/* Write out_path: the points of in_path in its own format, point k with
+ * values[k] added as the field opt->name, keeping the points that
+ * opt->keep selects (in file order).  values holds n doubles, n being the
+ * number of points hd_read_file gives for in_path with opt->read (for
+ * meshes: the vertices); it is borrowed for the call.
+ * Formats (the input's, as its signature or the read options' format
+ * or its extension say; out_path's extension, or opt->format, must name
+ * the same format):
+ *  - PLY ascii and binary: `property double NAME` appended to element
+ *    vertex, in the input's encoding and byte order; a value is written
+ *    as the shortest decimal that reads back to the same double (ascii).
+ *    Every other element and property is kept; a subset keeps element
+ *    vertex only (the other elements, faces included, refer to vertices
+ *    by index and are left out).
+ *  - LAS 1.0-1.4: the header, VLRs and records kept, 8 bytes appended to
+ *    each record, described by an extra-bytes VLR (record 4, user
+ *    "LASF_Spec"; an existing one gets the descriptor appended, after an
+ *    "undocumented" one for bytes it did not describe), the record
+ *    length, offsets and (subset) counts, counts by return and bounds
+ *    updated; waveform data and extended VLRs follow the points as before.
+ *  - LAZ, point formats 6-10 (layered): every layer of every chunk copied
+ *    as it is and the field's 8 bytes added as BYTE14 layers; a subset is
+ *    HD_EUNSUPPORTED.  Point formats 0-3 (pointwise, LASzip items of
+ *    version 2): every chunk decoded and compressed again, the field's 8
+ *    bytes in the BYTE item; subsets too.  LASzip 1.x streams are
+ *    HD_EUNSUPPORTED.  The library's own encoder writes both.
+ *  - XYZ, CSV, TXT, PTS, ASC: every line kept, the value appended to each
+ *    point line with the file's separator (a CSV header line gets the
+ *    name; a PTS count line the subset's count).  OBJ: a subset keeps its
+ *    lines but the vertices left out and the faces; no field (HD_KEEP_ALL
+ *    with a name is HD_EUNSUPPORTED).  Other formats: HD_EUNSUPPORTED.
+ * The file is written to a temporary beside out_path and renamed over it
+ * once complete and flushed to disk, so out_path is either the whole
+ * result or untouched.  *written (may be NULL) receives the number of
+ * points written.
+ * Errors: HD_EINVAL (NULL arguments, n not the file's point count, a bad
+ *   name, a field of that name already in the input, out_path the input
+ *   itself or an existing file that is not a regular file (a device, a
+ *   FIFO: the result is renamed into place), a non-finite threshold),
+ *   HD_EUNSUPPORTED (an input that is not a regular file: it must be
+ *   read twice; a format or variant above), the
+ *   errors of hd_read_file for the input, HD_EIO (out_path cannot be
+ *   created or written: the message names it and the system's reason,
+ *   a full disk or a file size limit included), HD_ENOMEM.
+ * Thread safe (nothing is shared between calls). */
+HD_EXTERN int hd_write_field(const char *in_path, const char *out_path,
+                             const double *values, size_t n,
+                             const hd_write_options_t *opt, size_t *written,
+                             hd_error_t *err);
+
+/* ------------------------------------------------------------------------
  * Surfaces: the distance from every point of a cloud to a triangle mesh.
  *
  * The distance from a point to a triangle is the true Euclidean distance
@@ -878,9 +1161,9 @@ typedef struct hd_surface_result {
  * dist and triangle hold P->count elements, closest and bary 3 * P->count.
  * out (may be NULL) receives h(P, surface) with its witness and the
  * counters.  The triangles are put in a bounding-volume hierarchy for the
- * call (about 240 bytes a triangle, freed before returning) and the
- * points are visited along a Morton curve, each starting from its
- * predecessor's nearest triangle.
+ * call (its size a triangle: docs/surfaces.md, "Memory"; freed before
+ * returning) and the points are visited along a Morton curve in groups of
+ * neighbours, each starting from its predecessor's nearest triangle.
  * opt: NULL for defaults; only opt->threads is read.
  * Errors: HD_EINVAL (NULL P or M, unknown index_type, an index beyond the
  *   vertices: the message names the triangle), HD_EEMPTY (no points, no

@@ -1,6 +1,6 @@
 #!/bin/sh
 # Install the Debian packages a make target needs, when they are missing.
-# usage: scripts/deps.sh GROUP...   (groups: build test python bench plot fuzz extras mpi)
+# usage: scripts/deps.sh GROUP...   (groups: build test python bench cgal plot fuzz extras mpi)
 # Runs apt-get only as root and only for packages not yet installed, without
 # recommends (the minimal set); as another user it prints the same command,
 # to run as root, instead.  Each package is named once.
@@ -24,7 +24,9 @@ for group in "$@"; do
     # ./python` in a venv (tests/python_venv.sh).
     python) add python3 python3-dev python3-numpy python3-setuptools python3-pytest python3-scipy \
                 python3-venv python3-wheel ;;
-    bench)  add libnanoflann-dev libpcl-dev python3-scipy python3-numpy python3-open3d g++ libomp-dev ;;
+    bench)  add libnanoflann-dev libpcl-dev python3-scipy python3-numpy python3-open3d g++ libomp-dev libcgal-dev libgmp-dev libmpfr-dev ;;
+    # The surface-to-surface benchmark's CGAL peer (bench/peers/m2m_cgal.cpp, header-only).
+    cgal)   add g++ libcgal-dev libgmp-dev libmpfr-dev ;;
     plot)   add python3-matplotlib python3-numpy ;;
     # Open MPI: the optional scale-out library and tool (cmake/mpi.cmake), and
     # mpirun for their tests (tests/mpi.cmake).

@@ -275,3 +275,40 @@ int hd_mask_points(const hd_mask_t *mask, const hd_mask_options_t *opt, hd_cloud
     *out = c;
     return HD_OK;
 }
+
+int hd_mask_surfels(const hd_mask_t *mask, int dims, hd_cloud_t **points, double **areas, hd_error_t *err) {
+    hd__err_clear(err);
+    if (!points || !areas) return hd__err(err, HD_EINVAL, "result pointers are NULL");
+    *points = NULL, *areas = NULL;
+    if (dims != 0 && dims != 2 && dims != 3) return hd__err(err, HD_EINVAL, "dims is %d; it is 0 (auto), 2 or 3", dims);
+    hd_mask_options_t o;
+    hd_mask_options_init(&o);
+    size_t nvox;
+    int rc = check_mask(mask, &o, &nvox, err);
+    if (rc != HD_OK) return rc;
+    if (dims == 0) dims = mask->n[2] == 1 ? 2 : 3;
+    double lin[3][3], area[256];
+    for (int c = 0; c < 3; c++)
+        for (int a = 0; a < 3; a++) lin[c][a] = mask->scale != 1.0 ? mask->m[c][a] * mask->scale : mask->m[c][a];
+    hd__surfel_areas(dims, lin, area);
+    hd__surfels_t sf = {0};
+    const size_t off[3] = {0, 0, 0};
+    hd_cloud_t *c = calloc(1, sizeof *c);
+    if (!c || hd__window_surfels(mask->voxels, mask->n, off, mask->m, mask->scale, dims, area, &sf) < 0) {
+        free(c);
+        hd__surfels_free(&sf);
+        return hd__err(err, HD_ENOMEM, "out of memory for the mask's surfels");
+    }
+    if (!sf.count) { /* an empty mask: still the caller's buffers */
+        sf.xyz = malloc(3 * sizeof *sf.xyz), sf.area = malloc(sizeof *sf.area);
+        if (!sf.xyz || !sf.area) {
+            free(c);
+            hd__surfels_free(&sf);
+            return hd__err(err, HD_ENOMEM, "out of memory");
+        }
+    }
+    c->data = sf.xyz, c->count = sf.count, c->dtype = HD_FLOAT64;
+    memcpy(c->format, "surfels", 8);
+    *points = c, *areas = sf.area;
+    return HD_OK;
+}

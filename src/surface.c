@@ -22,6 +22,8 @@
 #include <string.h>
 
 #define RUN 512
+#define GROUP_POINTS 16
+#define LIST 64
 
 /* ---- reading ------------------------------------------------------------ */
 
@@ -219,26 +221,76 @@ typedef struct {
     hd__bvh_stats_t *stats; /* one per worker */
 } job_t;
 
+/* An r2 for hd__bvh_collect over the box B of a group of points, one of
+ * which (p0) is at rounded distance d0 from the mesh: every q in B has
+ * t*(q) <= t*(p0) + |q - p0| <= d0 (1 + u) + |B| (1 + u)^5 (|B| the
+ * diagonal, computed with five roundings), so its rounded distance d*(q)
+ * and the double after it are at most (d0 + |B|) (1 + u)^9; the computed
+ * (d0 + |B|) (1 + 2^-48), squared and grown once more, is above
+ * next(d*(q))^2.  Below 2^-495 the floor 2^-980 is above it. */
+static double group_r2(double d0, const hd__box_t *B) {
+    double x = B->hi[0] - B->lo[0], y = B->hi[1] - B->lo[1], z = B->hi[2] - B->lo[2];
+    double r = (d0 + sqrt(x * x + y * y + z * z)) * (1.0 + 0x1p-48);
+    double r2 = r * r * (1.0 + 0x1p-48);
+    return r2 > 0x1p-980 ? r2 : 0x1p-980;
+}
+
+static void keep(job_t *J, size_t i, const hd__tri_near_t *best, size_t index, far_t *far) {
+    if (J->dist) J->dist[i] = best->d;
+    if (J->triangle) J->triangle[i] = index;
+    if (J->closest) memcpy(J->closest + 3 * i, best->point, sizeof best->point);
+    if (J->bary) memcpy(J->bary + 3 * i, best->bary, sizeof best->bary);
+    if (best->d > far->d || (best->d == far->d && i < far->i)) *far = (far_t){best->d, i, index};
+}
+
+/* Points [lo, hi) of the Morton order as groups of up to GROUP_POINTS:
+ * the group's first point searches the tree, the others search the list
+ * of the triangles that may be nearest to some point of the group's box
+ * (hd__bvh_collect), or the tree when that list is longer than LIST; after
+ * a list too long, the next groups (1, 2, 4 .. 64 of them) do not try. */
 static void run(void *ctx, size_t task, int worker) {
     job_t *J = ctx;
     size_t lo = task * RUN, hi = lo + RUN < J->n ? lo + RUN : J->n, seed = SIZE_MAX;
+    int corner = 0; /* the previous answer was at a corner */
+    size_t skip = 0, backoff = 0;
     far_t far = {-1.0, SIZE_MAX, SIZE_MAX};
-    hd__bvh_stats_t st = {0, 0, 0, 0};
-    for (size_t r = lo; r < hi; r++) {
-        size_t i = J->order ? J->order[r] : r, index;
-        double p[3];
-        hd__tri_near_t best;
-        hd__src_get(&J->src, i, p);
-        seed = hd__bvh_nearest(J->bvh, p, seed, &best, &index, &st);
-        if (J->dist) J->dist[i] = best.d;
-        if (J->triangle) J->triangle[i] = index;
-        if (J->closest) memcpy(J->closest + 3 * i, best.point, sizeof best.point);
-        if (J->bary) memcpy(J->bary + 3 * i, best.bary, sizeof best.bary);
-        if (best.d > far.d || (best.d == far.d && i < far.i)) far = (far_t){best.d, i, index};
+    hd__bvh_stats_t st = {0, 0, 0, 0, 0, 0};
+    uint32_t list[LIST];
+    for (size_t g = lo; g < hi; g += GROUP_POINTS) {
+        size_t end = g + GROUP_POINTS < hi ? g + GROUP_POINTS : hi, index, n_list = SIZE_MAX;
+        double p[GROUP_POINTS][3];
+        hd__box_t B;
+        for (size_t r = g; r < end; r++) {
+            hd__src_get(&J->src, J->order ? J->order[r] : r, p[r - g]);
+            if (r == g) memcpy(B.lo, p[0], sizeof B.lo), memcpy(B.hi, p[0], sizeof B.hi);
+            for (int c = 0; c < 3; c++) {
+                B.lo[c] = p[r - g][c] < B.lo[c] ? p[r - g][c] : B.lo[c];
+                B.hi[c] = p[r - g][c] > B.hi[c] ? p[r - g][c] : B.hi[c];
+            }
+        }
+        for (size_t r = g; r < end; r++) {
+            hd__tri_near_t best;
+            if (n_list == SIZE_MAX) {
+                seed = hd__bvh_nearest(J->bvh, p[r - g], seed, corner, &best, &index, &st);
+                if (r == g && end - g > 1 && skip == 0) {
+                    n_list = hd__bvh_collect(J->bvh, &B, group_r2(best.d, &B), list, LIST);
+                    /* a list too long: the next 1, 2, 4 .. 64 groups search the tree */
+                    backoff = n_list == SIZE_MAX ? (backoff ? (backoff < 64 ? 2 * backoff : 64) : 1) : 0;
+                    skip = backoff;
+                } else if (r == g && skip > 0) {
+                    skip--;
+                }
+            } else {
+                seed = hd__bvh_nearest_in(J->bvh, p[r - g], list, n_list, seed, corner, &best, &index, &st);
+            }
+            corner = best.feature >= HD__TRI_VERTEX_A;
+            keep(J, J->order ? J->order[r] : r, &best, index, &far);
+        }
     }
     J->far[task] = far;
     hd__bvh_stats_t *w = &J->stats[worker];
     w->nodes += st.nodes, w->bounded += st.bounded, w->kernel += st.kernel, w->exact += st.exact;
+    w->listed += st.listed;
 }
 
 /* The points' Morton order (NULL when there are too many to key; any

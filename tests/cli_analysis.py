@@ -412,7 +412,7 @@ def bad_analysis_options_are_usage_errors(tmp):
     a, b = gauss_clouds(14, 5, 5)
     pa, pb = files(tmp, a, b)
     for args, words in ((["--percentile", "101"], "[0, 100]"), (["--percentile", "x"], "percentile"),
-                        (["--distances", "out.txt"], ".csv, .ply or .npy"),
+                        (["--distances", "out.dat"], ".csv, .ply or .npy"),
                         (["--bins", "0"], "--bins"), (["--max-distance", "-1"], "positive"),
                         (["--mask-points", "edges"], "surface or all"), (["--units", ""], "--units"), (["--empty", "none"], "inf, nan, zero or monai"),
                         (["--percentile"], "needs a value")):

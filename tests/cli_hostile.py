@@ -99,8 +99,8 @@ def the_text_report_and_messages_escape_control_characters_and_bytes_not_utf8(d)
     rc, out, err = run(b"missing\x1b]0;owned\x07.xyz", b"e\x1b[31mvil.xyz", cwd=d)
     assert rc == 2, err
     assert "missing\\x1b]0;owned\\x07.xyz: cannot open" in err and "\x1b" not in err, err
-    rc, out, err = run("--distances", b"out\x1b[2J.txt", b"e\x1b[31mvil.xyz", b"e\x1b[31mvil.xyz", cwd=d)
-    assert rc == 1 and "'out\\x1b[2J.txt'" in err and "\x1b" not in err, err
+    rc, out, err = run("--distances", b"out\x1b[2J.dat", b"e\x1b[31mvil.xyz", b"e\x1b[31mvil.xyz", cwd=d)
+    assert rc == 1 and "'out\\x1b[2J.dat'" in err and "\x1b" not in err, err
     # UTF-8 names stay as they are
     write(d, "Zürich.xyz", "1 1 1\n")
     rc, out, err = run("Zürich.xyz", b"e\x1b[31mvil.xyz", cwd=d)

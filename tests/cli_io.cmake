@@ -10,6 +10,11 @@
 #               files: their points concatenated in order, bit-identical to
 #               one concatenated file, the witness by file and index, every
 #               bad tile or list line named.
+#   cli_writeback (tests/cli_writeback.py) --distances into A's own format
+#               and --farther-than / --nearer-than: the fields written back
+#               equal the --distances table bit for bit (PLY, LAS, LAZ), the
+#               refusals before reading, exit 3 and no file when one cannot
+#               be written.
 #   cli_tiles_unit (tests/cli_tiles_unit.c) cli/tiles.c as hausdorff-mpi
 #               uses it: tiles_share, tiles_read of a range, tiles_locate.
 add_executable(cli_tiles_unit tests/cli_tiles_unit.c cli/tiles.c cli/nifti.c ${HD_TEST_SUPPORT})
@@ -31,6 +36,9 @@ set_tests_properties(cli_io PROPERTIES TIMEOUT 300)
 add_test(NAME cli_output
   COMMAND ${HD_CLI_IO_PYTHON} ${CMAKE_CURRENT_SOURCE_DIR}/tests/cli_output.py $<TARGET_FILE:hausdorff_cli>)
 set_tests_properties(cli_output PROPERTIES TIMEOUT 300)
+add_test(NAME cli_writeback
+  COMMAND ${HD_CLI_IO_PYTHON} ${CMAKE_CURRENT_SOURCE_DIR}/tests/cli_writeback.py $<TARGET_FILE:hausdorff_cli>)
+set_tests_properties(cli_writeback PROPERTIES TIMEOUT 300)
 add_test(NAME cli_tiles
   COMMAND ${HD_CLI_IO_PYTHON} ${CMAKE_CURRENT_SOURCE_DIR}/tests/cli_tiles.py $<TARGET_FILE:hausdorff_cli>)
 set_tests_properties(cli_tiles PROPERTIES TIMEOUT 300)

@@ -21,6 +21,7 @@
 # The writer (tests/internal/lazwrite.c) uses the coder's models from src/,
 # so it is not in tests/support, which the api tests share without src/.
 target_sources(test_io_laz PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/tests/internal/lazwrite.c)
+target_sources(test_write_laz PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/tests/internal/lazwrite.c)
 add_executable(lazgen tests/lazgen.c tests/internal/lazwrite.c tests/support/files.c tests/support/gen.c)
 target_include_directories(lazgen PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/src ${CMAKE_CURRENT_SOURCE_DIR}/tests/support
                            ${CMAKE_CURRENT_SOURCE_DIR}/tests/internal)

@@ -11,10 +11,26 @@
  *   lazgen --seeds DIR
  *
  * writes the fuzz target's seed files (tests/corpus/laz/, committed).
+ *
+ * The cases named field_* are the output of hd_write_field (the library's
+ * LAZ writer) on a file of the tests' writer whose points all lie in
+ * scanner channel 0, with seeded values: their NAME.txt lines are
+ * "X Y Z HEX", HEX the value's eight bytes as a little-endian 64-bit
+ * integer in hexadecimal.  (laz-perf 0.0.7 hands its BYTE14 decoder
+ * channel 0 unless the channel changes at that very point, where LASzip
+ * hands the point's channel: on files with other channels it decodes
+ * extra bytes wrongly, so they are checked by test_write_laz alone.)
+ * The cases named record_* are hd_write_field's output on pointwise LAZ
+ * whose every field varies (tests/internal/lazwrite.c's lazw_pointwise),
+ * all points or those whose value is > 0.25: their NAME.txt lines are each
+ * written record in hexadecimal, byte by byte, the value's eight bytes
+ * last.
  */
 #include "files.h"
 #include "gen.h"
 #include "lazwrite.h"
+
+#include <hausdorff.h>
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -52,6 +68,88 @@ static void write_case(const char *dir, const char *name, const lazw_opts_t *o, 
     printf("%s\n", name);
     tf_free(&b);
     free(p);
+}
+
+/* The input b saved as DIR/NAME-input.laz, hd_write_field of the n values
+ * v into DIR/NAME.laz (o: NULL for the defaults), the input removed, and
+ * DIR/NAME.txt opened for the expected lines. */
+static FILE *write_field_of(const char *dir, const char *name, const tf_buf_t *b, const double *v, size_t n,
+                            const hd_write_options_t *o) {
+    char in[4096], out[4096];
+    snprintf(in, sizeof in, "%s/%s-input.laz", dir, name);
+    snprintf(out, sizeof out, "%s/%s.laz", dir, name);
+    FILE *f = fopen(in, "wb");
+    if (!f || fwrite(b->data, 1, b->size, f) != b->size || fclose(f)) {
+        perror(in);
+        exit(1);
+    }
+    hd_error_t err;
+    if (hd_write_field(in, out, v, n, o, NULL, &err) != HD_OK) {
+        fprintf(stderr, "lazgen: %s\n", err.message);
+        exit(1);
+    }
+    remove(in);
+    snprintf(out, sizeof out, "%s/%s.txt", dir, name);
+    if (!(f = fopen(out, "w"))) exit(1);
+    return f;
+}
+
+/* The field case NAME: see the top of the file. */
+static void field_case(const char *dir, const char *name, const lazw_opts_t *o, uint64_t seed, size_t n) {
+    gen_rng_t g;
+    gen_seed(&g, seed);
+    lazw_point_t *p = malloc(n * sizeof *p);
+    double *v = malloc(n * sizeof *v);
+    if (!p || !v) exit(1);
+    lazw_random(&g, p, n, o->format);
+    for (size_t k = 0; k < n; k++) {
+        p[k].channel = 0;
+        v[k] = k % 3 == 0 ? gen_unit(&g) * 100 : k % 3 == 1 ? v[k - 1] : gen_normal(&g);
+    }
+    tf_buf_t b = {0};
+    lazw_encode(&b, o, p, n);
+    FILE *f = write_field_of(dir, name, &b, v, n, NULL);
+    for (size_t k = 0; k < n; k++) {
+        uint64_t u;
+        memcpy(&u, &v[k], 8);
+        fprintf(f, "%d %d %d %016llx\n", (int)p[k].x, (int)p[k].y, (int)p[k].z, (unsigned long long)u);
+    }
+    if (fclose(f)) exit(1);
+    printf("%s\n", name);
+    tf_free(&b);
+    free(p);
+    free(v);
+}
+
+/* The record case NAME: see the top of the file. */
+static void record_case(const char *dir, const char *name, int fmt, unsigned extra, int subset, uint64_t seed, size_t n) {
+    gen_rng_t g;
+    gen_seed(&g, seed);
+    size_t rec;
+    unsigned char *recs = lazw_rich_records(&g, fmt, extra, n, &rec);
+    double *v = malloc(n * sizeof *v);
+    if (!recs || !v) exit(1);
+    for (size_t k = 0; k < n; k++) v[k] = k % 4 ? gen_normal(&g) : 0.5;
+    tf_buf_t b = {0};
+    lazw_pointwise(&b, fmt, extra, recs, rec, n, 1000);
+    hd_write_options_t o;
+    hd_write_options_init(&o);
+    o.keep = subset ? HD_KEEP_FARTHER : HD_KEEP_ALL;
+    o.threshold = 0.25;
+    FILE *f = write_field_of(dir, name, &b, v, n, &o);
+    for (size_t k = 0; k < n; k++) {
+        if (subset && !(v[k] > 0.25)) continue;
+        unsigned char val[8];
+        memcpy(val, &v[k], 8);
+        for (size_t i = 0; i < rec; i++) fprintf(f, "%02x", recs[k * rec + i]);
+        for (int i = 0; i < 8; i++) fprintf(f, "%02x", val[i]);
+        fputc('\n', f);
+    }
+    if (fclose(f)) exit(1);
+    printf("%s\n", name);
+    tf_free(&b);
+    free(recs);
+    free(v);
 }
 
 static int save(const char *dir, const char *name, const tf_buf_t *b) {
@@ -173,5 +271,13 @@ int main(int argc, char **argv) {
     write_case(argv[1], "format6_variable_chunks", &v, 300, 4000, 1);
     v.format = 1;
     write_case(argv[1], "format1_variable_chunks", &v, 301, 4000, 1);
+    lazw_opts_t w = {6, 0, 1000, NULL, 0, {0.001, 0.001, 0.001}, {0, 0, 0}, 0};
+    field_case(argv[1], "field_format6_extra0", &w, 400, 2500);
+    w.extra = 3, w.chunk_size = 0, w.chunks = sizes, w.n_chunks = 5;
+    field_case(argv[1], "field_format6_extra3_variable_chunks", &w, 401, 4000);
+    record_case(argv[1], "record_format1_extra0", 1, 0, 0, 500, 2500);
+    record_case(argv[1], "record_format2_extra3", 2, 3, 0, 501, 2500);
+    record_case(argv[1], "record_format3_extra1_subset", 3, 1, 1, 502, 3001);
+    record_case(argv[1], "record_format0_extra0_subset", 0, 0, 1, 503, 2500);
     return 0;
 }

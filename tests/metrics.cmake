@@ -11,3 +11,11 @@ add_test(NAME metrics_cli
   COMMAND ${HD_METRICS_PYTHON} ${CMAKE_CURRENT_SOURCE_DIR}/tests/metrics_cli.py $<TARGET_FILE:hausdorff_cli>)
 # without libnifti2 the mask cases are skipped (HD_NIFTI=0), the point sets' still run
 set_tests_properties(metrics_cli PROPERTIES TIMEOUT 600 ENVIRONMENT "HD_NIFTI=$<BOOL:${HD_CLI_NIFTI}>")
+# Label maps through the command line (--labels, --components, --csv):
+# tests/labels_cli.py against a brute-force numpy reference, in both builds;
+# NIfTI label maps need libnifti2.
+if(HD_CLI_NIFTI)
+  add_test(NAME labels_cli
+    COMMAND ${HD_METRICS_PYTHON} ${CMAKE_CURRENT_SOURCE_DIR}/tests/labels_cli.py $<TARGET_FILE:hausdorff_cli>)
+  set_tests_properties(labels_cli PROPERTIES TIMEOUT 600)
+endif()

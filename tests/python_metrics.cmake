@@ -16,3 +16,11 @@ add_test(NAME python_metrics
   WORKING_DIRECTORY ${CMAKE_BINARY_DIR})
 set_tests_properties(python_metrics PROPERTIES TIMEOUT 600 ENVIRONMENT
   "PYTHONPATH=${CMAKE_BINARY_DIR}/python;PYTHONDONTWRITEBYTECODE=1;HD_CLI=$<$<BOOL:${HD_CLI_NIFTI}>:$<TARGET_FILE:hausdorff_cli>>")
+# Label maps, DeepMind's surfels and components (tests/python_labels.py):
+# DeepMind's published surface_distance_test.py values, brute-force numpy
+# references and scipy.ndimage.label.
+add_test(NAME python_labels
+  COMMAND ${HD_METRICS_PYTEST} -m pytest -q -p no:cacheprovider ${CMAKE_CURRENT_SOURCE_DIR}/tests/python_labels.py
+  WORKING_DIRECTORY ${CMAKE_BINARY_DIR})
+set_tests_properties(python_labels PROPERTIES TIMEOUT 600 ENVIRONMENT
+  "PYTHONPATH=${CMAKE_BINARY_DIR}/python;PYTHONDONTWRITEBYTECODE=1;HD_CLI=$<$<BOOL:${HD_CLI_NIFTI}>:$<TARGET_FILE:hausdorff_cli>>")

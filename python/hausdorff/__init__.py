@@ -14,7 +14,8 @@ hausdorff.DirectedResult(distance=1.0, i=1, j=0)
 2.0
 
 Functions: directed (a drop-in for scipy's directed_hausdorff), hausdorff,
-distances, percentile, summary, mean, chamfer, read, count, formats;
+distances, percentile, summary, mean, chamfer, read, count, formats,
+write_field (a per-point field written back into the input's format);
 the class Index (build once, query many times, optionally transformed);
 the class Mesh and read_mesh (points to a triangle surface, correctly rounded).
 """
@@ -37,6 +38,7 @@ from ._hausdorff import (
     percentile,
     read,
     summary,
+    write_field,
 )
 from ._hausdorff import _mesh_distances, _read_mesh
 from ._surface import (Enclosure, Mesh, SurfaceDistances, SurfaceHausdorff, SurfaceWitness, face_maxima,
@@ -71,4 +73,5 @@ __all__ = [
     "summary",
     "surface_hausdorff",
     "surface_within",
+    "write_field",
 ]

@@ -189,6 +189,17 @@ def count(
     format: Optional[str] = None,
 ) -> int: ...
 def formats() -> Dict[str, str]: ...
+def write_field(
+    in_path: Union[str, bytes, os.PathLike[str], os.PathLike[bytes]],
+    out_path: Union[str, bytes, os.PathLike[str], os.PathLike[bytes]],
+    values: npt.ArrayLike,
+    *,
+    name: str = "distance",
+    farther_than: Optional[float] = None,
+    nearer_than: Optional[float] = None,
+    format: Optional[str] = None,
+    decimal_comma: bool = False,
+) -> int: ...
 
 class Index:
     """An index of b, built once and queried many times."""

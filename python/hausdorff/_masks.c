@@ -15,6 +15,7 @@
 #include <Python.h>
 
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "hausdorff.h"
@@ -145,8 +146,150 @@ done:
     return res;
 }
 
+
+/* The row of a label map as a tuple, in the order masks.py's _ROW names. */
+static PyObject *row_tuple(const hd_label_row_t *r) {
+    return Py_BuildValue("Linnnd" "nnddddddddd" "nndddddddd" "nn", (long long)r->label, r->empty,
+                         (Py_ssize_t)r->voxels_a, (Py_ssize_t)r->voxels_b, (Py_ssize_t)r->overlap, r->dice,
+                         (Py_ssize_t)r->points_a, (Py_ssize_t)r->points_b, r->hausdorff, r->hd_ab, r->hd_ba, r->hd_p,
+                         r->hd_p_pooled, r->assd, r->asd_ab, r->asd_ba, r->nsd, (Py_ssize_t)r->surfels_a,
+                         (Py_ssize_t)r->surfels_b, r->area_a, r->area_b, r->nsd_surfel, r->overlap_ab, r->overlap_ba,
+                         r->hd_surfel, r->asd_surfel_ab, r->asd_surfel_ba, (Py_ssize_t)r->components_a,
+                         (Py_ssize_t)r->components_b);
+}
+
+static PyObject *component_tuple(const hd_label_component_t *c) {
+    return Py_BuildValue("Linnnndddi", (long long)c->label, c->side, (Py_ssize_t)c->index, (Py_ssize_t)c->voxels,
+                         (Py_ssize_t)c->overlap, (Py_ssize_t)c->points, c->hausdorff, c->hd_p, c->nearest,
+                         c->detected);
+}
+
+static PyObject *table_lists(const hd_label_table_t *t) {
+    PyObject *rows = PyList_New((Py_ssize_t)t->n_rows), *comps = PyList_New((Py_ssize_t)t->n_components);
+    int ok = rows && comps;
+    for (size_t k = 0; ok && k < t->n_rows; k++) {
+        PyObject *o = row_tuple(&t->rows[k]);
+        if (!o) ok = 0;
+        else PyList_SET_ITEM(rows, (Py_ssize_t)k, o);
+    }
+    for (size_t k = 0; ok && k < t->n_components; k++) {
+        PyObject *o = component_tuple(&t->components[k]);
+        if (!o) ok = 0;
+        else PyList_SET_ITEM(comps, (Py_ssize_t)k, o);
+    }
+    if (ok) return Py_BuildValue("NN", rows, comps);
+    Py_XDECREF(rows), Py_XDECREF(comps);
+    return NULL;
+}
+
+/* An image of ndim axes, its spacing s given by the array's axes: stored
+ * axis 0 fastest (corder 0: library axis c is array axis c), or the last
+ * axis fastest (corder 1: library axis ndim-1-c is array axis c).  Either
+ * way array axis c goes to world axis c at s[c] per voxel, and, the map
+ * having one nonzero per row, each coordinate is s[c] times the index,
+ * exactly, as hd_mask_init's diagonal gives it. */
+static void place(hd_label_image_t *im, const double s[3], int ndim, int corder) {
+    memset(im->m, 0, sizeof im->m);
+    for (int c = 0; c < 3; c++) im->m[c][corder && c < ndim ? ndim - 1 - c : c] = s[c];
+}
+
+/* _label_map(a, b, type, n0, n1, n2, (sa0, sa1, sa2), (sb0, sb1, sb2),
+ *            labels bytes of int64 or None, percentile, tau, strict,
+ *            connectivity, dims, empty name, components, threads, ndim,
+ *            corder)
+ * -> ([row tuples], [component tuples]); n0 is the fastest axis. */
+static PyObject *py_label_map(PyObject *self, PyObject *args) {
+    (void)self;
+    Py_buffer va, vb;
+    PyObject *lab;
+    Py_ssize_t n[3];
+    double sa[3], sb[3], pct, tau;
+    int type, strict, conn, dims, comps, threads, ndim, corder;
+    const char *empty;
+    if (!PyArg_ParseTuple(args, "y*y*innn(ddd)(ddd)Oddpiisiiip", &va, &vb, &type, &n[0], &n[1], &n[2], &sa[0], &sa[1],
+                          &sa[2], &sb[0], &sb[1], &sb[2], &lab, &pct, &tau, &strict, &conn, &dims, &empty, &comps,
+                          &threads, &ndim, &corder))
+        return NULL;
+    PyObject *res = NULL;
+    Py_buffer lb;
+    memset(&lb, 0, sizeof lb);
+    hd_label_options_t o;
+    hd_label_options_init(&o);
+    hd_error_t err;
+    if (hd_empty_policy_from_name(empty, &o.empty) != HD_OK) {
+        PyErr_Format(PyExc_ValueError, "unknown empty policy %s", empty);
+        goto done;
+    }
+    if (lab != Py_None) {
+        if (PyObject_GetBuffer(lab, &lb, PyBUF_C_CONTIGUOUS) < 0) goto done;
+        o.labels = lb.buf;
+        o.n_labels = (size_t)lb.len / sizeof(int64_t);
+    }
+    o.percentile = pct, o.tau = tau, o.rule = strict ? HD_BELOW : HD_AT_MOST;
+    o.connectivity = conn, o.dims = dims, o.components = comps, o.threads = threads;
+    static const int size[] = {1, 1, 2, 2, 4, 4, 8, 8};
+    if (type < 0 || type > 7 || n[0] < 1 || n[1] < 1 || n[2] < 1 || va.len != n[0] * n[1] * n[2] * size[type] ||
+        vb.len != va.len) {
+        PyErr_SetString(PyExc_ValueError, "the label images' buffers do not hold their shape");
+        goto done;
+    }
+    hd_label_image_t ia, ib;
+    hd_label_image_init(&ia, va.buf, (hd_label_type_t)type, (size_t)n[0], (size_t)n[1], (size_t)n[2], sa);
+    hd_label_image_init(&ib, vb.buf, (hd_label_type_t)type, (size_t)n[0], (size_t)n[1], (size_t)n[2], sb);
+    place(&ia, sa, ndim, corder);
+    place(&ib, sb, ndim, corder);
+    hd_label_table_t *t = NULL;
+    int rc;
+    Py_BEGIN_ALLOW_THREADS
+    rc = hd_label_map(&ia, &ib, &o, &t, &err);
+    Py_END_ALLOW_THREADS
+    if (rc != HD_OK) raise_hd(rc, &err);
+    else res = table_lists(t);
+    hd_label_table_free(t);
+done:
+    if (lb.obj) PyBuffer_Release(&lb);
+    PyBuffer_Release(&va);
+    PyBuffer_Release(&vb);
+    return res;
+}
+
+
+/* _mask_surfels(voxels, n0, n1, n2, s0, s1, s2, dims)
+ * -> (bytes of n * 3 float64 centres, bytes of n float64 areas) */
+static PyObject *py_mask_surfels(PyObject *self, PyObject *args) {
+    (void)self;
+    Py_buffer vox;
+    Py_ssize_t n[3];
+    double sp[3];
+    int dims;
+    if (!PyArg_ParseTuple(args, "y*nnndddi", &vox, &n[0], &n[1], &n[2], &sp[0], &sp[1], &sp[2], &dims)) return NULL;
+    if (n[0] < 1 || n[1] < 1 || n[2] < 1 || vox.len != n[0] * n[1] * n[2]) {
+        PyBuffer_Release(&vox);
+        PyErr_SetString(PyExc_ValueError, "the mask's buffer does not hold its shape");
+        return NULL;
+    }
+    hd_mask_t mk;
+    hd_mask_init(&mk, vox.buf, (size_t)n[0], (size_t)n[1], (size_t)n[2], sp);
+    hd_cloud_t *c = NULL;
+    double *areas = NULL;
+    hd_error_t err;
+    int rc;
+    Py_BEGIN_ALLOW_THREADS
+    rc = hd_mask_surfels(&mk, dims, &c, &areas, &err);
+    Py_END_ALLOW_THREADS
+    PyBuffer_Release(&vox);
+    if (rc != HD_OK) return raise_hd(rc, &err);
+    PyObject *res = Py_BuildValue("y#y#", (const char *)c->data, (Py_ssize_t)(c->count * 3 * sizeof(double)),
+                                  (const char *)areas, (Py_ssize_t)(c->count * sizeof(double)));
+    hd_cloud_free(c);
+    free(areas);
+    return res;
+}
+
 PyMethodDef hd_py_mask_methods[] = {
     {"_mask_points", py_mask_points, METH_VARARGS, "A mask's surface points (hausdorff.masks)."},
+    {"_mask_surfels", py_mask_surfels, METH_VARARGS, "A mask's surfels (hausdorff.masks.surfels)."},
+    {"_label_map", py_label_map, METH_VARARGS, "Every label's figures (hausdorff.masks.label_map)."},
     {"_figures", py_figures, METH_VARARGS, "Figures of per-point distances (hausdorff.masks)."},
     {NULL, NULL, 0, NULL},
 };

@@ -8,6 +8,7 @@
 
 #include "points/points.h"
 
+#include <stdio.h>
 #include <string.h>
 
 /* A whole input file in memory (mapped when it is a regular file). */
@@ -143,6 +144,73 @@ int hd__read_laz(hd__read_t *r, const hd__las_header_t *h);
  * encoded", record 22204): the sign of a LAZ file whose point format byte
  * lost its compression bit. */
 int hd__laz_vlr_present(const unsigned char *d, const hd__las_header_t *h);
+
+/* ---- writing a field back (write.c, hd_write_field) ---------------------- */
+typedef struct hd__writer {
+    const hd__file_t *in;    /* the input, mapped */
+    const char *out_name;    /* for messages */
+    FILE *out;               /* the temporary being written */
+    const double *v;         /* n values, point k's is v[k] */
+    size_t n;
+    const char *name;        /* the field's name; "": no field */
+    hd_keep_t keep;
+    double threshold;
+    const hd_read_options_t *ropt;
+    size_t written;          /* points written */
+    int werr;                /* errno of the first failed write (0: none) */
+    hd_error_t *err;
+} hd__writer_t;
+
+/* Whether point k is written. */
+HD__INLINE int hd__w_keep(const hd__writer_t *w, size_t k) {
+    return w->keep == HD_KEEP_ALL || (w->keep == HD_KEEP_FARTHER ? w->v[k] > w->threshold : w->v[k] <= w->threshold);
+}
+/* How many points are written. */
+size_t hd__w_kept(const hd__writer_t *w);
+/* Append n bytes (nothing once a write has failed: w->werr). */
+void hd__w_put(hd__writer_t *w, const void *p, size_t n);
+/* Append a double in the given byte order. */
+void hd__w_value(hd__writer_t *w, double v, int big);
+/* The shortest decimal text that reads back (strtod) to v; its length. */
+size_t hd__shortest(double v, char buf[32]);
+
+/* The writers of each format: HD_OK, or an error for what they cannot
+ * write (their write failures are in w->werr). */
+int hd__write_ply(hd__writer_t *w);
+int hd__write_las(hd__writer_t *w);
+int hd__write_laz(hd__writer_t *w);
+int hd__write_text(hd__writer_t *w, int obj);
+/* The first data line of the xyz text in [p, end) as its reader finds it
+ * (the lines before it are the header; end when there is none) and the
+ * field separator of its dialect (';' or ','; ',' also when blanks alone
+ * separate). */
+const char *hd__xyz_data_start(const char *p, const char *end, int decimal_comma, int *semicolon);
+
+/* A LAZ file's LASzip VLR and chunks, for the LAZ writer (laz.c): the
+ * VLR's data at vlr_at (vlr_len bytes), its items, and per chunk its first
+ * byte (start[c], start[n_chunks] the end of the last) and its first
+ * point's number (first[c]); the chunk table at [table, table_end). */
+typedef struct hd__laz_chunks {
+    int layered, chunked;
+    unsigned n_layers, n_items;
+    unsigned type[32], size[32], version[32];
+    uint32_t chunk_size;
+    size_t vlr_at, vlr_len;
+    size_t n_chunks;
+    uint64_t *start, *first;
+    size_t table, table_end;
+} hd__laz_chunks_t;
+/* Checks as the reader does; HD_OK or its error. */
+int hd__laz_chunks(hd__read_t *r, const hd__las_header_t *h, hd__laz_chunks_t *out);
+void hd__laz_chunks_free(hd__laz_chunks_t *c);
+/* The scanner channel of every point of layered chunk `chunk` into chan
+ * (its point count of them), from decoding its x/y layer. */
+int hd__laz_chunk_channels(hd__read_t *r, const hd__las_header_t *h, const hd__laz_chunks_t *c, size_t chunk,
+                           unsigned char *chan);
+/* Every whole record of pointwise chunk `chunk` (items of version 2) into
+ * recs (its point count times the record length). */
+int hd__laz_chunk_records(hd__read_t *r, const hd__las_header_t *h, const hd__laz_chunks_t *c, size_t chunk,
+                          unsigned char *recs);
 
 /* ---- errors with a place --------------------------------------------------- */
 /* "NAME:LINE: what" with err->line set. */

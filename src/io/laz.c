@@ -98,6 +98,7 @@ typedef struct {
     uint64_t *start; /* n_chunks + 1 byte offsets */
     uint64_t *first; /* n_chunks + 1 cumulative point counts */
     unsigned per_byte; /* the most points a chunk may hold per byte of it */
+    size_t start_table, table_end; /* the chunk table's first byte and its end */
     uint64_t lo, hi; /* the points kept: [lo, hi) of the file's (a range
                         read keeps part; chunks outside it are not decoded) */
     double scale[3], shift[3];
@@ -117,6 +118,10 @@ typedef struct {
     int rc;
     long long at;
     char msg[320];
+    unsigned char *chan; /* NULL, or the scanner channel of each point of a
+                            layered chunk (hd__laz_chunk_channels) */
+    unsigned char *recs; /* NULL, or every whole record of a pointwise chunk
+                            (hd__laz_chunk_records) */
 } job_t;
 
 static int fail(job_t *j, int code, long long at, const char *fmt, ...) HD__PRINTF(4, 5);
@@ -189,20 +194,20 @@ typedef struct {
     hd__symmodel_t **bm; /* v2: nb models, each created at its first symbol
                             (see bytes_read) */
     hd__intcoder_t bic;  /* v1: nb contexts */
+    /* the values of RGB12 v2 and BYTE v2, followed only when whole records
+     * are asked for (job_t's recs: hd__laz_chunk_records) */
+    int values;
+    uint16_t rgb[3];
+    unsigned char *blast; /* nb bytes */
 } pw_t;
 
 static void pw_free(pw_t *w) {
     hd__symmodel_t *models[] = {&w->changed, &w->scan[0], &w->scan[1], &w->gmulti, &w->gzero, &w->used};
-    for (size_t i = 0; i < sizeof models / sizeof models[0]; i++) hd__symmodel_free(models[i]);
+    hd__symmodels_free(models, sizeof models / sizeof models[0]);
     for (int i = 0; i < 6; i++) hd__symmodel_free(&w->cdiff[i]);
-    for (int i = 0; i < 256; i++) {
-        hd__symmodel_t **t[3] = {w->bitbyte, w->cls, w->user};
-        for (int a = 0; a < 3; a++)
-            if (t[a][i]) {
-                hd__symmodel_free(t[a][i]);
-                free(t[a][i]);
-            }
-    }
+    hd__lazy_models_free(w->bitbyte, 256);
+    hd__lazy_models_free(w->cls, 256);
+    hd__lazy_models_free(w->user, 256);
     hd__intcoder_t *ics[] = {&w->intensity, &w->psid, &w->dx, &w->dy, &w->dz, &w->scan1, &w->gic, &w->cic, &w->bic};
     for (size_t i = 0; i < sizeof ics / sizeof ics[0]; i++) hd__intcoder_free(ics[i]);
     if (w->bm)
@@ -212,6 +217,7 @@ static void pw_free(pw_t *w) {
                 free(w->bm[i]);
             }
     free(w->bm);
+    free(w->blast);
 }
 
 /* Create the models of every item, in the version the VLR gives it. */
@@ -473,6 +479,39 @@ static int gps_read(pw_t *g, hd__dec_t *d) {
     return -1;
 }
 
+/* RGB12 v2's values (LASzip's RGB12 v2 scheme: per byte of red, its
+ * change; green and blue, when the colour is not grey, predicted from red's
+ * change, clamped to a byte, and coded as the correction). */
+static unsigned clamp8(int v) { return v < 0 ? 0u : v > 255 ? 255u : (unsigned)v; }
+static void rgb12_values(pw_t *c, hd__dec_t *d, uint32_t sym) {
+    const uint16_t *last = c->rgb;
+    uint16_t it[3];
+    unsigned lo = sym & 1 ? (hd__dec_symbol(d, &c->cdiff[0]) + (last[0] & 255)) & 255 : last[0] & 255;
+    unsigned hi = sym & 2 ? (hd__dec_symbol(d, &c->cdiff[1]) + (last[0] >> 8)) & 255 : last[0] >> 8;
+    it[0] = (uint16_t)(hi << 8 | lo);
+    if (sym & 64) {
+        int diff = (int)(it[0] & 255) - (int)(last[0] & 255);
+        unsigned g = sym & 4 ? (hd__dec_symbol(d, &c->cdiff[2]) + clamp8(diff + (last[1] & 255))) & 255 : last[1] & 255;
+        unsigned b = last[2] & 255;
+        if (sym & 16) {
+            diff = (diff + ((int)g - (int)(last[1] & 255))) / 2;
+            b = (hd__dec_symbol(d, &c->cdiff[4]) + clamp8(diff + (last[2] & 255))) & 255;
+        }
+        diff = (int)(it[0] >> 8) - (int)(last[0] >> 8);
+        unsigned gh = sym & 8 ? (hd__dec_symbol(d, &c->cdiff[3]) + clamp8(diff + (last[1] >> 8))) & 255 : last[1] >> 8;
+        unsigned bh = last[2] >> 8;
+        if (sym & 32) {
+            diff = (diff + ((int)gh - (int)(last[1] >> 8))) / 2;
+            bh = (hd__dec_symbol(d, &c->cdiff[5]) + clamp8(diff + (last[2] >> 8))) & 255;
+        }
+        it[1] = (uint16_t)(gh << 8 | g);
+        it[2] = (uint16_t)(bh << 8 | b);
+    } else {
+        it[1] = it[2] = it[0];
+    }
+    memcpy(c->rgb, it, sizeof it);
+}
+
 /* RGB12 v2 and v1, BYTE v2 and v1: their values never steer the stream,
  * so only their symbols are decoded. */
 static void rgb_read(pw_t *c, hd__dec_t *d, int v2) {
@@ -480,6 +519,10 @@ static void rgb_read(pw_t *c, hd__dec_t *d, int v2) {
     if (!v2) {
         for (unsigned k = 0; k < 6; k++)
             if (sym & (1u << k)) hd__ic_decode(&c->cic, d, 0, k);
+        return;
+    }
+    if (c->values) {
+        rgb12_values(c, d, sym);
         return;
     }
     static const unsigned char order[6] = {0, 1, 2, 4, 3, 5};
@@ -503,7 +546,8 @@ static int bytes_read(pw_t *c, hd__dec_t *d, int v2) {
         }
         hd__symmodel_t *m = lazy(&c->bm[k], 256);
         if (!m) return -1;
-        hd__dec_symbol(d, m);
+        uint32_t sym = hd__dec_symbol(d, m);
+        if (c->values) c->blast[k] = (unsigned char)(c->blast[k] + sym);
     }
     return 0;
 }
@@ -530,8 +574,9 @@ static void stream_end(job_t *j, const hd__dec_t *d, const char *what, const cha
 
 /* Create a pointwise chunk's models and start them from its raw first
  * point b; HD_OK or HD_ENOMEM. */
-static int pointwise_start(pw_t *w, const laz_t *z, const unsigned char *b) {
+static int pointwise_start(pw_t *w, const laz_t *z, const unsigned char *b, int values) {
     int rc = pw_new(w, z);
+    w->values = values;
     if (rc) return rc;
     for (int i = 0; i < 16; i++) {
         hd__median5_init(&w->mx[i]);
@@ -542,9 +587,35 @@ static int pointwise_start(pw_t *w, const laz_t *z, const unsigned char *b) {
     size_t off = 20;
     for (unsigned i = 1; i < z->n_items; i++) {
         if (z->items[i].type == IT_GPSTIME11) w->t[0] = (int64_t)hd__ld_u64(b + off, 0);
+        if (z->items[i].type == IT_RGB12)
+            for (int c = 0; c < 3; c++) w->rgb[c] = hd__ld_u16(b + off + 2 * c, 0);
+        if (z->items[i].type == IT_BYTE && w->values) {
+            if (!(w->blast = malloc(w->nb + 1))) return HD_ENOMEM;
+            memcpy(w->blast, b + off, w->nb);
+        }
         off += z->items[i].size;
     }
     return HD_OK;
+}
+
+/* The whole record of the point just decoded (v2 items): POINT10 with its
+ * intensity (v2 keeps it per return context), then each item's value. */
+static void record(const laz_t *z, const pw_t *w, unsigned char *out) {
+    memcpy(out, w->last, 20);
+    unsigned m = hd__laz_rmap10[(w->last[14] >> 3) & 7][w->last[14] & 7];
+    out[12] = (unsigned char)w->last_int[m];
+    out[13] = (unsigned char)(w->last_int[m] >> 8);
+    size_t off = 20;
+    for (unsigned i = 1; i < z->n_items; i++) {
+        unsigned t = z->items[i].type;
+        if (t == IT_GPSTIME11)
+            for (int b = 0; b < 8; b++) out[off + b] = (unsigned char)((uint64_t)w->t[w->glast] >> (8 * b));
+        else if (t == IT_RGB12)
+            for (int c = 0; c < 3; c++) out[off + 2 * c] = (unsigned char)w->rgb[c], out[off + 2 * c + 1] = (unsigned char)(w->rgb[c] >> 8);
+        else
+            memcpy(out + off, w->blast, w->nb);
+        off += z->items[i].size;
+    }
 }
 
 /* Points 2..n of a pointwise chunk from d, every item in order. */
@@ -574,6 +645,7 @@ static void pointwise_points(job_t *j, pw_t *w, hd__dec_t *d, size_t n) {
             }
         }
         if (d->over > 4) return;
+        if (j->recs) record(z, w, j->recs + i * z->rec);
         if (put(j, i32_at(w->last), i32_at(w->last + 4), i32_at(w->last + 8))) return;
     }
 }
@@ -589,11 +661,12 @@ static void pointwise_chunk(job_t *j, const unsigned char *b, size_t nb, size_t 
         return;
     }
     if (put(j, i32_at(b), i32_at(b + 4), i32_at(b + 8))) return;
+    if (j->recs) memcpy(j->recs, b, z->rec);
     hd__dec_t d;
     hd__dec_init(&d, b + z->rec, nb - z->rec);
     if (n > 1) {
         pw_t *w = malloc(sizeof *w);
-        if (!w || pointwise_start(w, z, b)) fail(j, HD_ENOMEM, at, "out of memory");
+        if (!w || pointwise_start(w, z, b, j->recs != NULL)) fail(j, HD_ENOMEM, at, "out of memory");
         else pointwise_points(j, w, &d, n);
         if (w) pw_free(w);
         free(w);
@@ -670,6 +743,7 @@ static void layered_loop(job_t *j, ctx14_t *cx, unsigned cur, hd__dec_t *dxy, hd
             cur = next;
             c = &cx[cur];
         }
+        if (j->chan) j->chan[i] = (unsigned char)cur;
         unsigned gps = (changed >> 4) & 1;
         unsigned last_n = c->n, last_r = c->r, nn = last_n, r = last_r;
         if (changed & 4) {
@@ -762,6 +836,7 @@ static void layered_points(job_t *j, const unsigned char *b, hd__dec_t *dxy, hd_
     first.r = b[14] & 15;
     first.n = b[14] >> 4;
     unsigned cur = (b[15] >> 4) & 3;
+    if (j->chan) j->chan[0] = (unsigned char)cur;
     if (ctx14_start(&cx[cur], &first)) fail(j, HD_ENOMEM, at, "out of memory");
     else layered_loop(j, cx, cur, dxy, dz, has_z, n);
     for (int c = 0; c < 4; c++) ctx14_free(&cx[c]);
@@ -795,7 +870,7 @@ static void decode_chunk(void *ctx, size_t task, int worker) {
         return;
     }
     job_t j = {z, task, z->r->sink, z->r->sink->dtype == HD_FLOAT32 ? (double)FLT_MAX : HD_MAX_COORD,
-               (size_t)z->first[task], 0, -1, ""};
+               (size_t)z->first[task], 0, -1, "", NULL, NULL};
     const unsigned char *b = z->d + z->start[task];
     size_t nb = (size_t)(z->start[task + 1] - z->start[task]), n = (size_t)(z->first[task + 1] - z->first[task]);
     if (z->layered) layered_chunk(&j, b, nb, n);
@@ -990,6 +1065,8 @@ static int read_table(laz_t *z, const hd__las_header_t *h, uint32_t chunk_size) 
             rc = too_dense(z, (long long)z->start[i], i + 1, nc, pts, bytes);
     }
     hd__intcoder_free(&ic);
+    z->start_table = t;
+    z->table_end = (size_t)(d.p - z->d); /* a stream is used up exactly by its decoder */
     if (rc == HD_OK && z->first[nc] != count)
         rc = hd__io_err_at(r, HD_EFORMAT, (long long)t + 8, "the chunks hold %llu points, the header says %llu",
                            (unsigned long long)z->first[nc], (unsigned long long)count);
@@ -1123,4 +1200,92 @@ int hd__read_laz(hd__read_t *r, const hd__las_header_t *h) {
     free(z.at);
     free(z.msg);
     return rc;
+}
+
+/* ---- for the LAZ writer (write_laz.c) ---------------------------------------- */
+void hd__laz_chunks_free(hd__laz_chunks_t *c) {
+    free(c->start);
+    free(c->first);
+    c->start = c->first = NULL;
+}
+
+int hd__laz_chunks(hd__read_t *r, const hd__las_header_t *h, hd__laz_chunks_t *out) {
+    laz_t z;
+    memset(&z, 0, sizeof z);
+    memset(out, 0, sizeof *out);
+    z.r = r;
+    z.d = r->f->data;
+    z.size = r->f->size;
+    z.rec = h->rec;
+    z.per_byte = r->opt->laz_points_per_byte ? r->opt->laz_points_per_byte : HD_LAZ_POINTS_PER_BYTE;
+    uint32_t chunk_size = 0;
+    int rc = parse_vlr(&z, h, &chunk_size);
+    if (rc == HD_OK && h->count && z.chunked) rc = read_table(&z, h, chunk_size);
+    if (rc == HD_OK) {
+        const unsigned char *v;
+        size_t len, at;
+        find_vlr(&z, h, &v, &len, &at);
+        out->vlr_at = at;
+        out->vlr_len = len;
+        out->layered = z.layered;
+        out->chunked = z.chunked;
+        out->n_layers = z.n_layers;
+        out->n_items = z.n_items;
+        for (unsigned i = 0; i < z.n_items; i++) {
+            out->type[i] = z.items[i].type;
+            out->size[i] = z.items[i].size;
+            out->version[i] = z.items[i].version;
+        }
+        out->chunk_size = chunk_size;
+        out->n_chunks = h->count ? z.n_chunks : 0;
+        out->start = z.start;
+        out->first = z.first;
+        z.start = z.first = NULL;
+        /* the table's end: where the decoder of its entries stopped */
+        out->table = h->count ? z.start_table : h->offset + 8;
+        out->table_end = h->count ? z.table_end : h->offset + 8;
+    }
+    free(z.start);
+    free(z.first);
+    return rc;
+}
+
+/* A laz_t over the chunks c found by hd__laz_chunks (borrowed), decoding
+ * without keeping points. */
+static void laz_over(laz_t *z, hd__read_t *r, const hd__las_header_t *h, const hd__laz_chunks_t *c) {
+    memset(z, 0, sizeof *z);
+    z->r = r;
+    z->d = r->f->data;
+    z->size = r->f->size;
+    z->rec = h->rec;
+    z->layered = c->layered;
+    z->n_layers = c->n_layers;
+    z->n_items = c->n_items;
+    for (unsigned i = 0; i < c->n_items; i++) z->items[i] = (item_t){c->type[i], c->size[i], c->version[i]};
+    z->start = c->start;
+    z->first = c->first;
+    z->n_chunks = c->n_chunks;
+    z->lo = z->hi = 0; /* decoded, not kept */
+}
+
+int hd__laz_chunk_channels(hd__read_t *r, const hd__las_header_t *h, const hd__laz_chunks_t *c, size_t chunk,
+                           unsigned char *chan) {
+    laz_t z;
+    laz_over(&z, r, h, c);
+    job_t j = {&z, chunk, r->sink, HD_MAX_COORD, (size_t)c->first[chunk], 0, -1, "", chan, NULL};
+    const unsigned char *b = z.d + c->start[chunk];
+    layered_chunk(&j, b, (size_t)(c->start[chunk + 1] - c->start[chunk]), (size_t)(c->first[chunk + 1] - c->first[chunk]));
+    if (j.rc) return hd__io_err_at(r, j.rc, j.at, "chunk %zu of %zu: %s", chunk + 1, c->n_chunks, j.msg);
+    return HD_OK;
+}
+
+int hd__laz_chunk_records(hd__read_t *r, const hd__las_header_t *h, const hd__laz_chunks_t *c, size_t chunk,
+                          unsigned char *recs) {
+    laz_t z;
+    laz_over(&z, r, h, c);
+    job_t j = {&z, chunk, r->sink, HD_MAX_COORD, (size_t)c->first[chunk], 0, -1, "", NULL, recs};
+    pointwise_chunk(&j, z.d + c->start[chunk], (size_t)(c->start[chunk + 1] - c->start[chunk]),
+                    (size_t)(c->first[chunk + 1] - c->first[chunk]));
+    if (j.rc) return hd__io_err_at(r, j.rc, j.at, "chunk %zu of %zu: %s", chunk + 1, c->n_chunks, j.msg);
+    return HD_OK;
 }

@@ -100,6 +100,19 @@ void hd__symmodel_free(hd__symmodel_t *m) {
     m->dist = m->count = m->table = NULL;
 }
 
+void hd__symmodels_free(hd__symmodel_t *const *m, size_t n) {
+    for (size_t i = 0; i < n; i++) hd__symmodel_free(m[i]);
+}
+
+void hd__lazy_models_free(hd__symmodel_t **slots, size_t n) {
+    for (size_t i = 0; i < n; i++)
+        if (slots[i]) {
+            hd__symmodel_free(slots[i]);
+            free(slots[i]);
+            slots[i] = NULL;
+        }
+}
+
 int hd__intcoder_new(hd__intcoder_t *ic, uint32_t bits, uint32_t contexts) {
     assert(bits >= 1 && bits <= 32);
     memset(ic, 0, sizeof *ic);
@@ -209,3 +222,130 @@ const unsigned char hd__laz_rmap14[16][16] = {
     {5, 3, 4, 4, 4, 4, 4, 4, 4, 4, 5, 4, 4, 4, 4, 4}, {5, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5, 4, 4, 4},
     {5, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5, 5, 4, 4}, {5, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5, 5, 4},
     {5, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5, 5}, {5, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5}};
+
+/* ---- encoder ------------------------------------------------------------- */
+void hd__enc_init(hd__enc_t *e) {
+    memset(e, 0, sizeof *e);
+    e->length = 0xFFFFFFFFu;
+}
+void hd__enc_reset(hd__enc_t *e) {
+    e->size = 0;
+    e->base = 0;
+    e->length = 0xFFFFFFFFu;
+}
+void hd__enc_free(hd__enc_t *e) {
+    free(e->buf);
+    e->buf = NULL;
+    e->size = e->cap = 0;
+}
+static void enc_byte(hd__enc_t *e, unsigned char b) {
+    if (e->size == e->cap) {
+        size_t cap = e->cap ? 2 * e->cap : 4096;
+        unsigned char *p = realloc(e->buf, cap);
+        if (!p) {
+            e->oom = 1;
+            return;
+        }
+        e->buf = p;
+        e->cap = cap;
+    }
+    e->buf[e->size++] = b;
+}
+static void enc_carry(hd__enc_t *e) {
+    size_t i = e->size;
+    while (i > 0 && e->buf[i - 1] == 0xFF) e->buf[--i] = 0;
+    if (i > 0) e->buf[i - 1]++; /* i = 0 only after a failed allocation */
+}
+static void enc_renorm(hd__enc_t *e) {
+    do {
+        enc_byte(e, (unsigned char)(e->base >> 24));
+        e->base <<= 8;
+    } while ((e->length <<= 8) < HD__AC_MIN);
+}
+void hd__enc_bit(hd__enc_t *e, hd__bitmodel_t *m, uint32_t sym) {
+    uint32_t x = m->p0 * (e->length >> HD__BM_SHIFT);
+    if (sym == 0) {
+        e->length = x;
+        m->c0++;
+    } else {
+        uint32_t b = e->base;
+        e->base += x;
+        e->length -= x;
+        if (b > e->base) enc_carry(e);
+    }
+    if (e->length < HD__AC_MIN) enc_renorm(e);
+    if (--m->until == 0) hd__bitmodel_update(m);
+}
+void hd__enc_symbol(hd__enc_t *e, hd__symmodel_t *m, uint32_t sym) {
+    assert(sym < m->n);
+    uint32_t x, b = e->base;
+    if (sym == m->n - 1) {
+        x = m->dist[sym] * (e->length >> HD__DM_SHIFT);
+        e->base += x;
+        e->length -= x;
+    } else {
+        x = m->dist[sym] * (e->length >>= HD__DM_SHIFT);
+        e->base += x;
+        e->length = m->dist[sym + 1] * e->length - x;
+    }
+    if (b > e->base) enc_carry(e);
+    if (e->length < HD__AC_MIN) enc_renorm(e);
+    m->count[sym]++;
+    if (--m->until == 0) hd__symmodel_update(m);
+}
+void hd__enc_raw(hd__enc_t *e, unsigned bits, uint32_t sym) {
+    if (bits > 19) {
+        hd__enc_raw(e, 16, sym & 0xFFFF);
+        sym >>= 16;
+        bits -= 16;
+    }
+    uint32_t b = e->base;
+    e->base += sym * (e->length >>= bits);
+    if (b > e->base) enc_carry(e);
+    if (e->length < HD__AC_MIN) enc_renorm(e);
+}
+void hd__enc_done(hd__enc_t *e) {
+    uint32_t b = e->base;
+    int another = 1;
+    if (e->length > 2 * HD__AC_MIN) {
+        e->base += HD__AC_MIN;
+        e->length = HD__AC_MIN >> 1;
+    } else {
+        e->base += HD__AC_MIN >> 1;
+        e->length = HD__AC_MIN >> 9;
+        another = 0;
+    }
+    if (b > e->base) enc_carry(e);
+    enc_renorm(e);
+    enc_byte(e, 0);
+    enc_byte(e, 0);
+    if (another) enc_byte(e, 0);
+}
+
+void hd__ic_encode(hd__intcoder_t *ic, hd__enc_t *e, int32_t pred, int32_t real, uint32_t ctx) {
+    int64_t c = (int32_t)((uint32_t)real - (uint32_t)pred);
+    if (ic->corr_range) {
+        if (c < ic->corr_min) c += ic->corr_range;
+        else if (c > ic->corr_max) c -= ic->corr_range;
+    }
+    int64_t c1 = c <= 0 ? -c : c - 1;
+    uint32_t k = 0;
+    while (c1) {
+        c1 >>= 1;
+        k++;
+    }
+    ic->k = k;
+    hd__enc_symbol(e, hd__ic_model(&ic->mbits[ctx]), k);
+    if (k) {
+        c = c < 0 ? c + (((int64_t)1 << k) - 1) : c - 1;
+        if (k <= 8) {
+            hd__enc_symbol(e, hd__ic_model(&ic->corr[k]), (uint32_t)c);
+        } else {
+            unsigned k1 = k - 8;
+            hd__enc_symbol(e, hd__ic_model(&ic->corr[k]), (uint32_t)(c >> k1));
+            hd__enc_raw(e, k1, (uint32_t)(c & (((int64_t)1 << k1) - 1)));
+        }
+    } else {
+        hd__enc_bit(e, &ic->corr0, (uint32_t)c);
+    }
+}

@@ -1,10 +1,11 @@
 /*
  * lazcoder.h -- the entropy coder of LASzip: an adaptive range coder with
  * 32-bit registers (Amir Said's FastAC as LASzip adapted it), its bit and
- * symbol models, and LASzip's integer compressor.  Shared by the LAZ reader
- * (laz.c) and the tests' LAZ writer, which encodes with the same models;
- * the writer's files are checked by an independent decoder (laz-perf), so a
- * model mistake shared by both sides cannot pass unnoticed.
+ * symbol models, and LASzip's integer compressor, decoding and encoding.
+ * Shared by the LAZ reader (laz.c), the LAZ writer of hd_write_field
+ * (write_laz.c) and the tests' LAZ writer; the writers' files are checked
+ * by an independent decoder (laz-perf), so a model mistake shared by both
+ * sides cannot pass unnoticed.
  *
  * Facts of the format (from the LASzip sources' description, not their
  * code): the interval has a 32-bit length, renormalised a byte at a time
@@ -69,6 +70,11 @@ int hd__symmodel_new(hd__symmodel_t *m, uint32_t n);
 void hd__symmodel_init(hd__symmodel_t *m);
 void hd__symmodel_update(hd__symmodel_t *m);
 void hd__symmodel_free(hd__symmodel_t *m);
+/* Free the n models whose addresses are in m. */
+void hd__symmodels_free(hd__symmodel_t *const *m, size_t n);
+/* Free the models created on first use in slots[0..n) (NULL: never used),
+ * and their memory. */
+void hd__lazy_models_free(hd__symmodel_t **slots, size_t n);
 
 /* ---- decoder ------------------------------------------------------------ */
 typedef struct hd__dec {
@@ -210,6 +216,31 @@ HD__INLINE int32_t hd__ic_decode(hd__intcoder_t *ic, hd__dec_t *d, int32_t pred,
     }
     return (int32_t)real;
 }
+
+/* ---- encoder (the mirror of the decoder) ---------------------------------
+ * An interval [base, base + length) of 32 bits, a byte shifted out whenever
+ * length < 2^24, a carry propagated back through the bytes already
+ * written; done() leaves one or two final bytes and pads with zeros to
+ * four, so that a decoder, which reads four bytes ahead, consumes the
+ * stream exactly.  Output grows in memory; a failed allocation sets `oom`
+ * and the rest is not stored (the caller checks oom once at the end). */
+typedef struct hd__enc {
+    unsigned char *buf;
+    size_t size, cap;
+    uint32_t base, length;
+    int oom;
+} hd__enc_t;
+
+void hd__enc_init(hd__enc_t *e);   /* empty, no memory yet */
+void hd__enc_reset(hd__enc_t *e);  /* a new stream, keeping the memory */
+void hd__enc_free(hd__enc_t *e);
+void hd__enc_bit(hd__enc_t *e, hd__bitmodel_t *m, uint32_t sym);
+void hd__enc_symbol(hd__enc_t *e, hd__symmodel_t *m, uint32_t sym);
+/* `bits` raw bits of sym, 1 <= bits <= 32. */
+void hd__enc_raw(hd__enc_t *e, unsigned bits, uint32_t sym);
+void hd__enc_done(hd__enc_t *e);
+/* The integer compressor: real given its prediction, in context ctx. */
+void hd__ic_encode(hd__intcoder_t *ic, hd__enc_t *e, int32_t pred, int32_t real, uint32_t ctx);
 
 /* ---- facts shared by the POINT10 and POINT14 schemes -------------------- */
 /* LASzip's streaming median of the last five values: v[2]; the update rule

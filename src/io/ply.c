@@ -567,3 +567,156 @@ int hd__read_ply(hd__read_t *r) {
     free(p);
     return rc;
 }
+
+/* ---- writing a field back (hd_write_field) ------------------------------ */
+/* The file is copied element by element.  Header: every line as it is,
+ * except `element vertex N` (a subset's count), `property double NAME`
+ * added after the vertex element's last property, and, in a subset, the
+ * lines of the other elements left out (their instances refer to vertices
+ * by index).  Data: a vertex instance is copied with the value after it
+ * (binary: 8 bytes in the file's byte order; ascii: a blank and the
+ * shortest decimal that reads back to it, before the line's end); other
+ * elements' bytes are copied as they are. */
+
+/* Bytes of the binary instance of e at pos, or 0 when it does not fit in
+ * size (the reader has accepted the file, so this is a guard). */
+static size_t instance_size(const elem_t *e, const unsigned char *d, size_t pos, size_t size, int big) {
+    if (!e->has_list) return e->fixed <= size - pos ? e->fixed : 0;
+    size_t at = pos;
+    for (int j = 0; j < e->n_props; j++) {
+        const prop_t *pr = &e->props[j];
+        size_t cs = hd__type_size(pr->count_type ? pr->count_type : pr->type);
+        if (cs > size - at) return 0;
+        if (!pr->count_type) {
+            at += cs;
+            continue;
+        }
+        double c = hd__ld_value(d + at, pr->count_type, big);
+        at += cs;
+        if (!(c >= 0) || c > (double)((size - at) / hd__type_size(pr->type))) return 0;
+        at += (size_t)c * hd__type_size(pr->type);
+    }
+    return at - pos;
+}
+
+/* The line terminator of the line ending at eol ("\r\n", "\n" or none). */
+static const char *line_end(const char *q, const char *eol, const char *end) {
+    if (eol == end) return "\n";
+    return eol > q && eol[-1] == '\r' ? "\r\n" : "\n";
+}
+
+static void put_str(hd__writer_t *w, const char *s) { hd__w_put(w, s, strlen(s)); }
+
+/* The header as described above. */
+static void write_header(hd__writer_t *w, const ply_t *p, int v, int subset, size_t kept) {
+    const char *s = (const char *)w->in->data, *hend = s + p->data, *q = s, *eol;
+    int k = -1, add = w->name[0] != 0;
+    for (const char *line; hd__next_line(&q, hend, &line, &eol);) {
+        const char *cur = line, *tb, *te;
+        int tok = hd__token(&cur, eol, &tb, &te);
+        int is_el = tok && is(tb, (size_t)(te - tb), "element"), is_end = tok && is(tb, (size_t)(te - tb), "end_header");
+        const char *nl = line_end(line, eol, hend);
+        if ((is_el || is_end) && k == v && add) {
+            put_str(w, "property double ");
+            put_str(w, w->name);
+            put_str(w, nl);
+        }
+        if (is_el) k++;
+        if (subset && k >= 0 && k != v && !is_end) continue; /* another element: left out */
+        if (is_el && k == v && subset) {
+            char buf[64];
+            snprintf(buf, sizeof buf, "element %.*s %zu", (int)p->el[v].len, p->el[v].name, kept);
+            put_str(w, buf);
+            put_str(w, nl);
+            continue;
+        }
+        hd__w_put(w, line, (size_t)(q - line));
+    }
+}
+
+static int write_binary(hd__writer_t *w, const ply_t *p, int v, int subset) {
+    const unsigned char *d = w->in->data;
+    size_t pos = p->data, size = w->in->size;
+    int big = p->format == 2, add = w->name[0] != 0;
+    for (int k = 0; k < p->n_el; k++) {
+        const elem_t *e = &p->el[k];
+        size_t from = pos;
+        for (uint64_t i = 0; i < e->count; i++) {
+            size_t n = instance_size(e, d, pos, size, big);
+            if (n == 0 && (e->has_list || e->fixed))
+                return hd__err(w->err, HD_EFORMAT, "%s: byte %zu: element %.*s ends early", w->in->name, pos, (int)e->len,
+                               e->name);
+            if (k == v && hd__w_keep(w, (size_t)i)) {
+                hd__w_put(w, d + pos, n);
+                if (add) hd__w_value(w, w->v[i], big);
+                w->written++;
+            }
+            pos += n;
+            if (k != v && !e->has_list) { /* fixed instances: the block at once */
+                pos = from + (size_t)e->count * e->fixed;
+                break;
+            }
+        }
+        if (k != v && !subset) hd__w_put(w, d + from, pos - from);
+    }
+    return HD_OK;
+}
+
+static int write_ascii(hd__writer_t *w, const ply_t *p, int v, int subset) {
+    const char *s = (const char *)w->in->data, *end = s + w->in->size, *q = s + p->data;
+    int add = w->name[0] != 0;
+    char num[40];
+    num[0] = ' ';
+    for (int k = 0; k < p->n_el; k++) {
+        const elem_t *e = &p->el[k];
+        const char *from = q;
+        if (k != v) {
+            uint64_t got;
+            q = hd__skip_lines(q, end, e->count, &got);
+            if (!subset) hd__w_put(w, from, (size_t)(q - from));
+            continue;
+        }
+        for (uint64_t i = 0; i < e->count; i++) {
+            const char *line, *eol;
+            if (!hd__next_line(&q, end, &line, &eol))
+                return hd__err(w->err, HD_EFORMAT, "%s: file ends inside element %.*s", w->in->name, (int)e->len, e->name);
+            if (!hd__w_keep(w, (size_t)i)) continue;
+            const char *c = eol;
+            while (c > line && hd__is_blank((unsigned char)c[-1])) c--;
+            hd__w_put(w, line, (size_t)(c - line));
+            if (add) hd__w_put(w, num, 1 + hd__shortest(w->v[i], num + 1));
+            put_str(w, line_end(line, eol, end));
+            w->written++;
+        }
+    }
+    if (!subset) hd__w_put(w, q, (size_t)(end - q)); /* blank lines after the last element */
+    return HD_OK;
+}
+
+int hd__write_ply(hd__writer_t *w) {
+    ply_t *p = calloc(1, sizeof *p);
+    if (!p) return hd__err(w->err, HD_ENOMEM, "out of memory");
+    hd__sink_t none;
+    hd__sink_init(&none, HD_FLOAT64);
+    hd__read_t r = {w->in, w->ropt, 1, &none, NULL, 0, w->err, 0, 0, 0};
+    p->r = &r;
+    int rc = header(p), v = -1;
+    for (int k = 0; rc == HD_OK && k < p->n_el; k++)
+        if (is(p->el[k].name, p->el[k].len, "vertex")) v = k;
+    if (rc == HD_OK && v < 0) rc = hd__err(w->err, HD_EFORMAT, "%s: the header declares no element 'vertex'", w->in->name);
+    if (rc == HD_OK && w->name[0] && prop_index(&p->el[v], w->name) >= 0)
+        rc = hd__err(w->err, HD_EINVAL, "%s: element vertex already has a property '%s' (line %lld's element); choose "
+                                        "another name",
+                     w->in->name, w->name, p->el[v].line);
+    if (rc == HD_OK && p->el[v].count != w->n)
+        rc = hd__err(w->err, HD_EINVAL, "%s: %zu values for %llu vertices", w->in->name, w->n,
+                     (unsigned long long)p->el[v].count);
+    int subset = w->keep != HD_KEEP_ALL;
+    if (rc == HD_OK) {
+        write_header(w, p, v, subset, hd__w_kept(w));
+        rc = p->format ? write_binary(w, p, v, subset) : write_ascii(w, p, v, subset);
+    }
+    for (int k = 0; k < p->n_el; k++) free(p->el[k].props);
+    free(p);
+    return rc;
+}

@@ -336,3 +336,9 @@ int hd__read_xyz(hd__read_t *r) {
                                (unsigned long long)(count - 1), r->sink->count);
     return rc;
 }
+
+const char *hd__xyz_data_start(const char *p, const char *end, int decimal_comma, int *semicolon) {
+    dialect_t d = dialect_of(p, end, decimal_comma);
+    *semicolon = d.semicolon;
+    return d.data_at;
+}

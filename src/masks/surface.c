@@ -33,6 +33,7 @@ void hd__neighbourhood(hd__neighbourhood_t *nb, const size_t n[3], int dims, int
             }
             if (!ok || nz != order) continue;
             assert(nb->n < 26);
+            memcpy(nb->d[nb->n], d, sizeof d);
             nb->step[nb->n++] = (ptrdiff_t)d[0] + (ptrdiff_t)d[1] * (ptrdiff_t)n[0] +
                                 (ptrdiff_t)d[2] * (ptrdiff_t)(n[0] * n[1]);
         }
@@ -53,4 +54,22 @@ int hd__on_surface(const uint8_t *fg, const size_t n[3], const hd__neighbourhood
 double hd__voxel_world(const double m[3][4], double scale, int c, double i, double j, double k) {
     double q = ((m[c][0] * i + m[c][1] * j) + m[c][2] * k) + m[c][3];
     return scale != 1.0 ? q * scale : q;
+}
+
+void hd__window_points(const uint8_t *fg, const size_t w[3], const size_t off[3], const double m[3][4], double scale,
+                       const hd__neighbourhood_t *nb, double *xyz, size_t *voxel, size_t *count) {
+    size_t p = 0;
+    for (size_t k = 0; k < w[2]; k++)
+        for (size_t j = 0; j < w[1]; j++)
+            for (size_t i = 0; i < w[0]; i++) {
+                size_t v = (k * w[1] + j) * w[0] + i;
+                if (!fg[v] || !hd__on_surface(fg, w, nb, i, j, k)) continue;
+                if (xyz) {
+                    double gi = (double)(off[0] + i), gj = (double)(off[1] + j), gk = (double)(off[2] + k);
+                    for (int a = 0; a < 3; a++) xyz[3 * p + a] = hd__voxel_world(m, scale, a, gi, gj, gk);
+                    if (voxel) voxel[p] = v;
+                }
+                p++;
+            }
+    *count = p;
 }

@@ -5,39 +5,41 @@
  * The rule that makes the search equal the loop.  The loop keeps the
  * smallest rounded distance hd__tri_nearest returns and, among the
  * triangles at that distance, the smallest index.  The search keeps the
- * same pair (d, index) over the triangles it evaluates, and it skips a
- * triangle, or every triangle under a node, only when a lower bound L on
- * its true distance proves L > next(d), where next(d) is the double after
- * d: then the true distance t > next(d), and rounding being monotone,
- * round(t) >= next(d) > d, so the skipped triangle could neither beat d
- * nor tie it (a tie would need its index compared).  As d only decreases,
- * a triangle skipped once stays skippable.  So the search ends with the
- * loop's pair, whatever the order of visits, the seed or the thread.
+ * same pair (d*, index) over the triangles it evaluates and a threshold
+ * thr, a proven upper bound on next(d*)^2 for the final d* (next(d) is the
+ * double after d): each kernel call lowers it to next(d)^2 rounded up,
+ * and each rigorous upper bound hi2 on a triangle's squared distance to
+ * thr_from_hi(hi2).  It skips a triangle, or every triangle under a node,
+ * only when a lower bound L2 on its exact squared distance proves
+ * L2 > thr: then its true distance t > next(d*), and rounding being
+ * monotone, round(t) >= next(d*) > d*, so the skipped triangle could
+ * neither beat the answer nor tie it (a tie would need its index
+ * compared).  As thr only decreases, a triangle skipped once stays
+ * skippable.  So the search ends with the loop's pair, whatever the order
+ * of visits, the seed, the group or the thread.
  *
- * The bounds L are computed in doubles and then shrunk by a factor
- * (1 - 2^-48) that exceeds their accumulated rounding error (at most a few
- * units of 2^-53, proofs at each function); results in the range where
- * underflow could add an absolute error are replaced by 0, which is
- * always a valid lower bound.  Coordinates are at most 2^511 in magnitude
- * (the library checks 1e153), so no intermediate overflows: a difference
- * is below 2^512, a sum of three squares below 2^1026 / 2 ... within
- * DBL_MAX for the checked inputs (|difference| < 2.1e153, 3 * 2.1e153^2 <
+ * The bounds are computed in doubles and moved outward by more than their
+ * accumulated rounding error (proofs at each function); where underflow
+ * could add an absolute error they give no information.  Coordinates are
+ * at most 2^511 in magnitude (the library checks 1e153), so no
+ * intermediate overflows: a difference is below 2^512 ... within DBL_MAX
+ * for the checked inputs (|difference| < 2.1e153, 3 * 2.1e153^2 <
  * 1.4e307).
  *
  * The tree: nodes split at the median of the triangles' centroids along
  * the longest axis of their box, down to leaves of at most LEAF
  * triangles; each node's box is the exact minimum and maximum of its
- * corners (no rounding).  A query descends nearest child first and
- * starts from a seed triangle (the previous query's nearest: neighbouring
- * queries are close, so the seed's distance is nearly the answer and
- * most of the tree is skipped at once).  A node of at most GROUP
- * triangles is first given a support bound over all its corners in the
- * direction of its box's centre (hd__tris_lower: for a point far from the
- * node nearly its distance, where a box bound is short by up to the box's
- * size); within a leaf each triangle gets its own box bound, then a
- * support bound in the direction of its rough closest point
- * (hd__tri_lower), and the correctly rounded kernel runs only for
- * triangles whose bounds leave them possible.
+ * corners (no rounding), each triangle prepared once (hd__tri_prep).  A
+ * query starts from a seed triangle (the previous query's nearest) and
+ * descends nearest child first, discarding nodes by their boxes.  A leaf's
+ * triangles pass three stages, each in increasing order of its lower
+ * bound and each stopping at the first bound above thr: the cheap bounds
+ * (the triangle's box, then the support bound in the direction of its
+ * box's centre), the prepared bounds (hd__tri_bounds_prep: lo2 discards,
+ * hi2 lowers thr), and the kernel.  Triangles that share the best one's
+ * nearest corner and certainly have it as theirs are decided without the
+ * kernel (corner_tie).  hd__bvh_collect and hd__bvh_nearest_in let a
+ * group of neighbouring points share one list of triangles.
  */
 #include "mesh/mesh.h"
 
@@ -52,9 +54,6 @@
  * error (at most 2^-1074 an operation): bounds there are taken as 0. */
 #define TINY 0x1p-1000
 #define MAX_DEPTH 128
-/* Nodes of at most GROUP triangles get the support bound over all their
- * corners (leaf_lower) before they are opened. */
-#define GROUP 8
 
 /* ---- lower bounds ------------------------------------------------------- */
 
@@ -78,9 +77,7 @@ double hd__box_lower(const hd__box_t *b, const double p[3]) {
  * s >= TINY, and s * SHRINK, rounded, is below s / (1 + u)^5: so
  * s * SHRINK > thr2 >= next^2 proves the box farther than next (and when
  * s < TINY, s * SHRINK < thr2 as thr2 >= 2^-990). */
-static int box_beyond(const hd__box_t *b, const double p[3], double thr2) {
-    return hd__box_lb2s(b, p[0], p[1], p[2]) * SHRINK > thr2;
-}
+static int box_beyond(double s, double thr2) { return s * SHRINK > thr2; }
 
 /* An upper bound on next^2, at least 2^-990: the product rounds once
  * (relative u when normal), the factor covers it; below 2^-990 the floor
@@ -88,43 +85,6 @@ static int box_beyond(const hd__box_t *b, const double p[3], double thr2) {
 static double square_up(double next) {
     double t = next * next * (1.0 + 0x1p-48);
     return t > 0x1p-990 ? t : 0x1p-990;
-}
-
-/* Ericson's closest point on triangle abc, in plain doubles (Real-Time
- * Collision Detection, 5.1.5).  Only a direction is taken from it, so it
- * need not be exact; on a degenerate triangle it may be NaN. */
-static void rough_closest(const double *p, const double (*v)[3], double *q) {
-    const double *a = v[0], *b = v[1], *c = v[2];
-    double ab[3], ac[3], ap[3], bp[3], cp[3];
-    for (int i = 0; i < 3; i++) {
-        ab[i] = b[i] - a[i], ac[i] = c[i] - a[i];
-        ap[i] = p[i] - a[i], bp[i] = p[i] - b[i], cp[i] = p[i] - c[i];
-    }
-#define DOT(x, y) ((x)[0] * (y)[0] + (x)[1] * (y)[1] + (x)[2] * (y)[2])
-    double d1 = DOT(ab, ap), d2 = DOT(ac, ap);
-    double d3 = DOT(ab, bp), d4 = DOT(ac, bp);
-    double d5 = DOT(ab, cp), d6 = DOT(ac, cp);
-#undef DOT
-    double s = 0, t = 0;
-    double va = 0, vb = 0, vc = 0;
-    if (d1 <= 0 && d2 <= 0) {
-        s = 0, t = 0;
-    } else if (d3 >= 0 && d4 <= d3) {
-        s = 1, t = 0;
-    } else if (d6 >= 0 && d5 <= d6) {
-        s = 0, t = 1;
-    } else if ((vc = d1 * d4 - d3 * d2) <= 0 && d1 >= 0 && d3 <= 0) {
-        s = d1 / (d1 - d3), t = 0;
-    } else if ((vb = d5 * d2 - d1 * d6) <= 0 && d2 >= 0 && d6 <= 0) {
-        s = 0, t = d2 / (d2 - d6);
-    } else if ((va = d3 * d6 - d5 * d4) <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0) {
-        t = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-        s = 1 - t;
-    } else {
-        double den = 1 / (va + vb + vc);
-        s = vb * den, t = vc * den;
-    }
-    for (int i = 0; i < 3; i++) q[i] = a[i] + s * ab[i] + t * ac[i];
 }
 
 /* Support bound: for any vector w, every point x of the triangle (a convex
@@ -151,7 +111,7 @@ static void rough_closest(const double *p, const double (*v)[3], double *q) {
 /* The support bound for direction w over the corners of the n triangles
  * t[0 .. n): min over corners of w.(p - v) / |w|, shrunk (the proof
  * above); 0 when w is zero, not finite, or the bound is not positive. */
-static double support_lower(const hd__tri_t *t, size_t n, const double p[3], double *w) {
+double hd__support_lower(const hd__tri_t *t, size_t n, const double p[3], double *w) {
     double big = fabs(w[0]) > fabs(w[1]) ? fabs(w[0]) : fabs(w[1]);
     big = fabs(w[2]) > big ? fabs(w[2]) : big;
     if (!(big > 0) || !isfinite(big)) return 0.0;
@@ -175,24 +135,6 @@ static double support_lower(const hd__tri_t *t, size_t n, const double p[3], dou
     return r >= TINY ? r * SHRINK : 0.0;
 }
 
-double hd__tri_lower(const hd__tri_t *t, const double p[3]) {
-    double q[3], w[3];
-    rough_closest(p, (const double(*)[3])t->v, q);
-    for (int i = 0; i < 3; i++) w[i] = p[i] - q[i];
-    if (w[0] == 0 && w[1] == 0 && w[2] == 0) return 0.0; /* p on the triangle, roughly */
-    if (!isfinite(w[0] + w[1] + w[2])) /* a degenerate triangle: the centroid's direction */
-        for (int i = 0; i < 3; i++) w[i] = p[i] - (t->v[0][i] + t->v[1][i] + t->v[2][i]) / 3;
-    return support_lower(t, 1, p, w);
-}
-
-/* A bound for every triangle of a leaf at once: the support bound over
- * all their corners in the direction from the leaf box's centre to p
- * (nearly the true direction when p is far from the leaf). */
-double hd__tris_lower(const hd__tri_t *t, size_t n, const hd__box_t *b, const double p[3]) {
-    double w[3];
-    for (int i = 0; i < 3; i++) w[i] = p[i] - (b->lo[i] / 2 + b->hi[i] / 2);
-    return support_lower(t, n, p, w);
-}
 
 /* ---- the tree ----------------------------------------------------------- */
 
@@ -283,16 +225,25 @@ int hd__bvh_build(hd__bvh_t *t, hd__tri_t *tris, size_t n) {
     t->n_tris = n;
     t->nodes = hd__malloc_array(2 * n, sizeof *t->nodes);
     t->boxes = hd__malloc_array(n, sizeof *t->boxes);
-    if (!t->nodes || !t->boxes) { /* the triangles stay the caller's */
+    t->prep = hd__malloc_array(n, sizeof *t->prep);
+    if (!t->nodes || !t->boxes || !t->prep) { /* the triangles stay the caller's */
         free(t->nodes);
         free(t->boxes);
+        free(t->prep);
         memset(t, 0, sizeof *t);
         return HD_ENOMEM;
     }
     builder_t B = {t, 0};
     build_node(&B, 0, n);
     t->n_nodes = B.used;
-    for (size_t k = 0; k < n; k++) tri_box(&t->tris[k], &t->boxes[k]);
+    /* at most 2n nodes were reserved; give back the rest (a failed
+     * shrink keeps the larger array) */
+    hd__bvh_node_t *nodes = realloc(t->nodes, t->n_nodes * sizeof *t->nodes);
+    if (nodes) t->nodes = nodes;
+    for (size_t k = 0; k < n; k++) {
+        tri_box(&t->tris[k], &t->boxes[k]);
+        hd__tri_prep(t->tris[k].v[0], t->tris[k].v[1], t->tris[k].v[2], &t->prep[k]);
+    }
     return HD_OK;
 }
 
@@ -300,16 +251,47 @@ void hd__bvh_free(hd__bvh_t *t) {
     free(t->tris);
     free(t->nodes);
     free(t->boxes);
+    free(t->prep);
     memset(t, 0, sizeof *t);
 }
 
 /* ---- the query ---------------------------------------------------------- */
 
+/* An upper bound on next(d*)^2 from an upper bound h2 on the exact squared
+ * distance t*^2 of some triangle, for the final d* = round(t*) of the
+ * search: t* <= sqrt(h2), so d* <= round(sqrt(h2)) <= sqrt(h2) (1 + u),
+ * next(d*) <= d* (1 + 2u) when normal, and next(d*)^2 <= h2 (1 + 3.1 u)^2
+ * < h2 (1 + 2^-50); the computed h2 (1 + 2^-48) rounds down by at most a
+ * relative u and stays above that.  When next(d*) is below 2^-495 (d*
+ * subnormal included) the floor 2^-990 is above its square. */
+static double thr_from_hi(double h2) {
+    double t = h2 * (1.0 + 0x1p-48);
+    return t > 0x1p-990 ? t : 0x1p-990;
+}
+
+/* A candidate: a triangle (its position) with a lower bound lo2 on its
+ * squared distance that did not discard it.  Two stages: the cheap
+ * bounds (the triangle's box and support bound) give a first lo2, and the
+ * triangles are then taken in increasing lo2 for the prepared bounds
+ * (hd__tri_bounds_prep), whose lo2 orders the kernel calls in turn; each
+ * stage stops at the first lo2 above the threshold, which every hi2 and
+ * every kernel call may lower.  A candidate left has lo2 > thr >=
+ * next(d*)^2: the file's rule discards it. */
+typedef struct {
+    double lo2;
+    size_t pos;
+} cand_t;
+
+#define CANDS 64
+
 typedef struct {
     hd__tri_near_t best;
     size_t index, pos;
-    double next;  /* next(best.d): a bound above it prunes */
-    double next2; /* square_up(next) */
+    /* thr >= next(d*)^2 for the answer d* (at least 2^-990): the least of
+     * square_up(next(best.d)) and thr_from_hi of every hi2 computed */
+    double thr;
+    size_t n_cheap, n_prep;
+    cand_t cheap[CANDS], prep[CANDS];
 } search_t;
 
 static void evaluate(const hd__bvh_t *t, const double *p, size_t pos, search_t *s, hd__bvh_stats_t *st) {
@@ -322,26 +304,183 @@ static void evaluate(const hd__bvh_t *t, const double *p, size_t pos, search_t *
         s->best = r;
         s->index = tr->index;
         s->pos = pos;
-        s->next = nextafter(r.d, INFINITY);
-        s->next2 = square_up(s->next);
+        double t2 = square_up(nextafter(r.d, INFINITY));
+        s->thr = t2 < s->thr ? t2 : s->thr;
     }
+}
+
+static void sort_cands(cand_t *c, size_t n) {
+    for (size_t i = 1; i < n; i++) { /* insertion sort: the lists are short */
+        cand_t x = c[i];
+        size_t j = i;
+        for (; j > 0 && c[j - 1].lo2 > x.lo2; j--) c[j] = c[j - 1];
+        c[j] = x;
+    }
+}
+
+/* A tie at a shared corner without the kernel.  When the best triangle's
+ * nearest feature is a corner V and triangle k has a corner X bit-equal to
+ * V with p certainly in X's region of k (XY . XP < 0 and XZ . XP < 0,
+ * each with its rounding error bound: bounds.c's corner test, 6u of the
+ * products' magnitudes plus 2^-700, for coordinates below 2^100), then for
+ * every x of k, |p - x|^2 = |p - X|^2 + |x - X|^2 - 2 (x - X) . (p - X)
+ * >= |p - X|^2: k's true distance is |p - V|, the best one's, so the
+ * kernel would round it alike, and it returns the corner as the closest
+ * point with weight 1 (tri.c's and exact.c's corner cases).  So k is
+ * decided here: it wins exactly when its index is smaller.  1 when
+ * decided. */
+static int corner_tie(const hd__bvh_t *t, const double *p, size_t k, search_t *s) {
+    const hd__tri_prep_t *q = &t->prep[k];
+    if (s->best.feature < HD__TRI_VERTEX_A || !q->direct) return 0;
+    if (!(fabs(p[0]) < 0x1p100 && fabs(p[1]) < 0x1p100 && fabs(p[2]) < 0x1p100)) return 0;
+    const double *corner[3] = {q->a, q->b, q->c};
+    int x = 0;
+    while (x < 3 && memcmp(corner[x], s->best.point, sizeof q->a) != 0) x++;
+    if (x == 3) return 0;
+    /* the two edges from X, rounded as the prepared ones are */
+    double e[2][3];
+    for (int i = 0; i < 3; i++) {
+        double ab = q->ab[i], ac = q->ac[i], bc = q->bc[i];
+        e[0][i] = x == 0 ? ab : x == 1 ? -ab : -ac;
+        e[1][i] = x == 0 ? ac : x == 1 ? bc : -bc;
+    }
+    const double *X = corner[x];
+    double xp[3] = {p[0] - X[0], p[1] - X[1], p[2] - X[2]};
+    for (int j = 0; j < 2; j++) {
+        double dot = e[j][0] * xp[0] + e[j][1] * xp[1] + e[j][2] * xp[2];
+        double mag = fabs(e[j][0] * xp[0]) + fabs(e[j][1] * xp[1]) + fabs(e[j][2] * xp[2]);
+        if (!(dot + (6 * 0x1p-53 * mag + 0x1p-700) < 0)) return 0;
+    }
+    size_t index = t->tris[k].index;
+    if (index < s->index) {
+        s->index = index;
+        s->pos = k;
+        s->best.feature = (hd__tri_feature_t)(HD__TRI_VERTEX_A + x);
+        s->best.exact = 0;
+        for (int i = 0; i < 3; i++) s->best.bary[i] = i == x;
+    }
+    return 1;
+}
+
+/* The kernel for the prepared stage's candidates; the list is emptied. */
+static void flush_prep(const hd__bvh_t *t, const double *p, search_t *s, hd__bvh_stats_t *st) {
+    sort_cands(s->prep, s->n_prep);
+    for (size_t i = 0; i < s->n_prep && s->prep[i].lo2 <= s->thr; i++) {
+        size_t k = s->prep[i].pos;
+        if (s->pos != SIZE_MAX && corner_tie(t, p, k, s)) st->ties++;
+        else evaluate(t, p, k, s, st);
+    }
+    s->n_prep = 0;
+}
+
+/* Triangle k's prepared bounds: discarded when lo2 > thr, else a
+ * candidate of the kernel, and its hi2 may lower thr. */
+static void consider(const hd__bvh_t *t, const double *p, size_t k, search_t *s, hd__bvh_stats_t *st) {
+    double lo2, hi2;
+    st->bounded++;
+    hd__tri_bounds_prep(p, &t->prep[k], &lo2, &hi2);
+    if (lo2 > s->thr) return;
+    double h = thr_from_hi(hi2);
+    s->thr = h < s->thr ? h : s->thr;
+    if (s->n_prep == CANDS) flush_prep(t, p, s, st);
+    s->prep[s->n_prep++] = (cand_t){lo2, k};
+}
+
+static void flush_cheap(const hd__bvh_t *t, const double *p, search_t *s, hd__bvh_stats_t *st) {
+    sort_cands(s->cheap, s->n_cheap);
+    for (size_t i = 0; i < s->n_cheap && s->cheap[i].lo2 <= s->thr; i++) {
+        size_t k = s->cheap[i].pos;
+        if (s->pos != SIZE_MAX && corner_tie(t, p, k, s)) st->ties++;
+        else consider(t, p, k, s, st);
+    }
+    s->n_cheap = 0;
+}
+
+/* The support bound of triangle t as a test: whether every point x of it
+ * is proven farther than sqrt(thr) from p.  With w the computed p - c (c
+ * any point, here the centre of the triangle's box) and x_k = v_k - c,
+ * w . (p - x) >= w . (p - c) - max_k w . x_k for x in the hull, and
+ * |p - x| >= w . (p - x) / |w|, so num^2 > thr |w|^2 with num below
+ * w . (p - c) - max_k w . x_k proves it; no square root, no quotient.
+ *
+ * Rounding: each w_i is p_i - c_i rounded once, so w . (p - c) >= W2
+ * (1 - 1.01u) for the true W2 = |w|^2, and the computed W2c is within
+ * 3.01u of it (W2c >= 2^-900: underflow adds a relative 2^-170 at most);
+ * x_k rounded once per component and the dot product give w . x_k below
+ * s_k + 4.1u A_k (A_k = sum |w_i x_ki| computed), and m_k = s_k +
+ * 2^-49 A_k + 2^-1000, computed, is above it (the extra 8u A_k covers the
+ * sum's rounding, 2^-1000 underflow).  X = W2c (1 - 2^-50) rounds to below
+ * W2 (1 - 4.1u); (X - max m_k) (1 - 2^-50) rounds to below the difference
+ * when positive: num.  num^2 (1 - 2^-50) rounds to below num^2, and
+ * thr W2c (1 + 2^-49) to above thr W2 when it is at least 2^-1000 (then
+ * thr W2c was rounded as a normal number). */
+static int support_beyond(const hd__tri_t *t, const double *c, const double *p, double thr) {
+    double w[3] = {p[0] - c[0], p[1] - c[1], p[2] - c[2]};
+    double W2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
+    if (!(W2 >= 0x1p-900)) return 0;
+    double M = -INFINITY;
+    for (int k = 0; k < 3; k++) {
+        const double *v = t->v[k];
+        double x0 = v[0] - c[0], x1 = v[1] - c[1], x2 = v[2] - c[2];
+        double sk = w[0] * x0 + w[1] * x1 + w[2] * x2;
+        double Ak = fabs(w[0] * x0) + fabs(w[1] * x1) + fabs(w[2] * x2);
+        double mk = sk + (0x1p-49 * Ak + 0x1p-1000);
+        M = mk > M ? mk : M;
+    }
+    double num = (W2 * (1 - 0x1p-50) - M) * (1 - 0x1p-50);
+    if (!(num > 0)) return 0;
+    double rhs = thr * W2 * (1 + 0x1p-49);
+    return rhs >= 0x1p-1000 && num * num * (1 - 0x1p-50) > rhs;
+}
+
+/* Triangle k's cheap bounds: its box's (hd__box_lb2s shrunk, below d^2
+ * by box_beyond's proof) and the support bound; a triangle left is a
+ * candidate of the prepared stage with the box's bound as its key. */
+static void screen(const hd__bvh_t *t, const double *p, size_t k, search_t *s, hd__bvh_stats_t *st) {
+    const hd__box_t *bx = &t->boxes[k];
+    double b = hd__box_lb2s(bx, p[0], p[1], p[2]);
+    if (box_beyond(b, s->thr)) return;
+    double c[3] = {bx->lo[0] / 2 + bx->hi[0] / 2, bx->lo[1] / 2 + bx->hi[1] / 2, bx->lo[2] / 2 + bx->hi[2] / 2};
+    if (support_beyond(&t->tris[k], c, p, s->thr)) return;
+    if (s->n_cheap == CANDS) flush_cheap(t, p, s, st);
+    s->cheap[s->n_cheap++] = (cand_t){b * SHRINK, k};
 }
 
 static void leaf(const hd__bvh_t *t, const hd__bvh_node_t *node, const double *p, size_t seed, search_t *s,
                  hd__bvh_stats_t *st) {
-    for (size_t k = node->first_or_second, end = k + node->count; k < end; k++) {
-        if (k == seed) continue;
-        if (box_beyond(&t->boxes[k], p, s->next2)) continue;
-        st->bounded++;
-        if (hd__tri_lower(&t->tris[k], p) > s->next) continue;
-        evaluate(t, p, k, s, st);
-    }
+    for (size_t k = node->first_or_second, end = k + node->count; k < end; k++)
+        if (k != seed) screen(t, p, k, s, st);
 }
 
-size_t hd__bvh_nearest(const hd__bvh_t *t, const double p[3], size_t seed, hd__tri_near_t *best,
+static void search_init(search_t *s) {
+    s->index = s->pos = SIZE_MAX;
+    s->thr = INFINITY;
+    s->n_cheap = s->n_prep = 0;
+}
+
+static size_t search_end(const hd__bvh_t *t, const double *p, search_t *s, hd__tri_near_t *best, size_t *index,
+                         hd__bvh_stats_t *st) {
+    flush_cheap(t, p, s, st);
+    flush_prep(t, p, s, st);
+    *best = s->best;
+    *index = s->index;
+    return s->pos;
+}
+
+/* The seed: the kernel at once when asked (a best corner early lets
+ * corner_tie decide the triangles around it), else a first candidate. */
+static void start(const hd__bvh_t *t, const double *p, size_t seed, int seed_kernel, search_t *s,
+                  hd__bvh_stats_t *st) {
+    search_init(s);
+    if (seed >= t->n_tris) return;
+    if (seed_kernel) evaluate(t, p, seed, s, st);
+    else consider(t, p, seed, s, st);
+}
+
+size_t hd__bvh_nearest(const hd__bvh_t *t, const double p[3], size_t seed, int seed_kernel, hd__tri_near_t *best,
                        size_t *index, hd__bvh_stats_t *st) {
-    search_t s = {.index = SIZE_MAX, .pos = SIZE_MAX, .next = INFINITY, .next2 = INFINITY};
-    if (seed < t->n_tris) evaluate(t, p, seed, &s, st);
+    search_t s;
+    start(t, p, seed, seed_kernel, &s, st);
     /* s: the box's computed hd__box_lb2s; [first, first + n): the node's
      * triangles (the build gives a node's first child the first n / 2) */
     typedef struct { uint32_t node, first, n; double s; } entry_t;
@@ -351,10 +490,9 @@ size_t hd__bvh_nearest(const hd__bvh_t *t, const double p[3], size_t seed, hd__t
     top = 1;
     while (top > 0) {
         e = &stack[--top];
-        if (e->s * SHRINK > s.next2) continue; /* box_beyond, from the stored square */
+        if (box_beyond(e->s, s.thr)) continue;
         const hd__bvh_node_t *node = &t->nodes[e->node];
         uint32_t first = e->first, n = e->n;
-        if (n <= GROUP && s.pos != SIZE_MAX && hd__tris_lower(&t->tris[first], n, &node->box, p) > s.next) continue;
         st->nodes++;
         if (node->count) {
             leaf(t, node, p, seed, &s, st);
@@ -366,14 +504,94 @@ size_t hd__bvh_nearest(const hd__bvh_t *t, const double p[3], size_t seed, hd__t
         /* the nearer child on top; the median split halves the count at
          * each level, so the stack never holds more than the depth plus one */
         if (la > lb) {
-            if (la * SHRINK <= s.next2) stack[top++] = (entry_t){a, fa, na, la};
-            if (lb * SHRINK <= s.next2) stack[top++] = (entry_t){b, fb, n - na, lb};
+            if (!box_beyond(la, s.thr)) stack[top++] = (entry_t){a, fa, na, la};
+            if (!box_beyond(lb, s.thr)) stack[top++] = (entry_t){b, fb, n - na, lb};
         } else {
-            if (lb * SHRINK <= s.next2) stack[top++] = (entry_t){b, fb, n - na, lb};
-            if (la * SHRINK <= s.next2) stack[top++] = (entry_t){a, fa, na, la};
+            if (!box_beyond(lb, s.thr)) stack[top++] = (entry_t){b, fb, n - na, lb};
+            if (!box_beyond(la, s.thr)) stack[top++] = (entry_t){a, fa, na, la};
         }
     }
-    *best = s.best;
-    *index = s.index;
-    return s.pos;
+    return search_end(t, p, &s, best, index, st);
+}
+
+/* ---- a group of points sharing one list --------------------------------- */
+
+/* The box-to-box bound has the box bound's error (one rounding per
+ * difference, square and sum): the same SHRINK proves it. */
+static int boxes_beyond(const hd__box_t *a, const hd__box_t *b, double r2) {
+    return hd__box_box_lb2(a, b) * SHRINK > r2;
+}
+
+/* The support bound between a triangle and a box B: with w the computed
+ * centre of B less c (the centre of the triangle's box), every q of B and
+ * x of the triangle have w . (q - x) = w . (q - c) - w . (x - c) >=
+ * sum_i min(w_i (lo_i - c_i), w_i (hi_i - c_i)) - max_k w . x_k, and
+ * |q - x| >= w . (q - x) / |w|.  Rounding: each of the terms is formed by
+ * a rounded difference and a rounded product (2.01u of the larger of its
+ * two computed magnitudes, a_i), the three summed (2.01u of their sum),
+ * and w . x_k as in support_beyond (4.1u A_k); the three subtractions
+ * below round by at most u of |Q| + |M| + E each: E = 2^-48 (sum a_i +
+ * max A_k) + 2^-1000 exceeds all of it (32u against 11u), and the test
+ * then is support_beyond's with r2 for thr. */
+static int group_beyond(const hd__tri_t *t, const hd__box_t *tb, const hd__box_t *B, double r2) {
+    double c[3], w[3], Q = 0, S = 0;
+    for (int i = 0; i < 3; i++) {
+        c[i] = tb->lo[i] / 2 + tb->hi[i] / 2;
+        w[i] = (B->lo[i] / 2 + B->hi[i] / 2) - c[i];
+    }
+    double W2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
+    if (!(W2 >= 0x1p-900)) return 0;
+    for (int i = 0; i < 3; i++) {
+        double x = w[i] * (B->lo[i] - c[i]), y = w[i] * (B->hi[i] - c[i]);
+        Q += x < y ? x : y;
+        S += fabs(x) > fabs(y) ? fabs(x) : fabs(y);
+    }
+    double M = -INFINITY, A = 0;
+    for (int k = 0; k < 3; k++) {
+        const double *v = t->v[k];
+        double x0 = v[0] - c[0], x1 = v[1] - c[1], x2 = v[2] - c[2];
+        double sk = w[0] * x0 + w[1] * x1 + w[2] * x2;
+        double Ak = fabs(w[0] * x0) + fabs(w[1] * x1) + fabs(w[2] * x2);
+        M = sk > M ? sk : M;
+        A = Ak > A ? Ak : A;
+    }
+    double num = ((Q - M) - (0x1p-48 * (S + A) + 0x1p-1000)) * (1 - 0x1p-50);
+    if (!(num > 0)) return 0;
+    double rhs = r2 * W2 * (1 + 0x1p-49);
+    return rhs >= 0x1p-1000 && num * num * (1 - 0x1p-50) > rhs;
+}
+
+size_t hd__bvh_collect(const hd__bvh_t *t, const hd__box_t *B, double r2, uint32_t *out, size_t cap) {
+    uint32_t stack[MAX_DEPTH];
+    int top = 0;
+    size_t n = 0;
+    if (boxes_beyond(&t->nodes[0].box, B, r2)) return 0;
+    stack[top++] = 0;
+    while (top > 0) {
+        const hd__bvh_node_t *node = &t->nodes[stack[--top]];
+        if (node->count) {
+            for (size_t k = node->first_or_second, end = k + node->count; k < end; k++) {
+                if (boxes_beyond(&t->boxes[k], B, r2) || group_beyond(&t->tris[k], &t->boxes[k], B, r2)) continue;
+                if (n == cap) return SIZE_MAX;
+                out[n++] = (uint32_t)k;
+            }
+            continue;
+        }
+        uint32_t a = (uint32_t)(node - t->nodes) + 1, b = node->first_or_second;
+        if (!boxes_beyond(&t->nodes[b].box, B, r2)) stack[top++] = b;
+        if (!boxes_beyond(&t->nodes[a].box, B, r2)) stack[top++] = a;
+    }
+    return n;
+}
+
+size_t hd__bvh_nearest_in(const hd__bvh_t *t, const double p[3], const uint32_t *list, size_t n, size_t seed,
+                          int seed_kernel, hd__tri_near_t *best, size_t *index, hd__bvh_stats_t *st) {
+    search_t s;
+    start(t, p, seed, seed_kernel, &s, st);
+    for (size_t i = 0; i < n; i++) {
+        size_t k = list[i];
+        if (k != seed) screen(t, p, k, &s, st);
+    }
+    st->listed += n;
+    return search_end(t, p, &s, best, index, st);
 }

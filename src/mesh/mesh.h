@@ -116,6 +116,7 @@ typedef struct hd__bvh_node {
 typedef struct hd__bvh {
     hd__tri_t *tris;        /* in leaf order */
     hd__box_t *boxes;       /* each triangle's box, in the same order */
+    hd__tri_prep_t *prep;   /* each triangle prepared (hd__tri_prep), in the same order */
     hd__bvh_node_t *nodes;
     size_t n_tris, n_nodes;
 } hd__bvh_t;
@@ -129,7 +130,7 @@ void hd__bvh_free(hd__bvh_t *t);
 
 /* The counters of the queries (summed per thread, then over threads). */
 typedef struct hd__bvh_stats {
-    uint64_t nodes, bounded, kernel, exact;
+    uint64_t nodes, bounded, kernel, exact, listed, ties;
 } hd__bvh_stats_t;
 
 /* The triangle nearest to p: *best (its distance correctly rounded, its
@@ -137,18 +138,33 @@ typedef struct hd__bvh_stats {
  * triangles at that rounded distance), bit-identical to a loop over every
  * triangle with hd__tri_nearest.  `seed` (a position in t->tris, or
  * SIZE_MAX) is tried first: any triangle is correct, a near one makes the
- * search short.  Returns the position of the nearest triangle in t->tris
- * (the next query's seed). */
-size_t hd__bvh_nearest(const hd__bvh_t *t, const double p[3], size_t seed,
+ * search short; seed_kernel 1 evaluates it with the kernel before
+ * anything else (worth it when the previous answer was at a corner: the
+ * triangles around a corner then tie without the kernel), 0 bounds it
+ * first like any other.  Returns the position of the nearest triangle in
+ * t->tris (the next query's seed). */
+size_t hd__bvh_nearest(const hd__bvh_t *t, const double p[3], size_t seed, int seed_kernel,
                        hd__tri_near_t *best, size_t *index, hd__bvh_stats_t *st);
+
+/* Work shared by the points of a box B.  hd__bvh_collect writes to out
+ * the positions of the triangles whose box is not proven farther than
+ * sqrt(r2) from B, in leaf order, and returns their number, or SIZE_MAX
+ * when there are more than cap.  For r2 at least next(d*(q))^2 for every
+ * point q of B (d*(q) its rounded distance to the mesh), every triangle
+ * left out is farther than next(d*(q)) from each q: so
+ * hd__bvh_nearest_in, which searches only the list (seed first), gives
+ * hd__bvh_nearest's answer for each q in B. */
+size_t hd__bvh_collect(const hd__bvh_t *t, const hd__box_t *B, double r2, uint32_t *out, size_t cap);
+size_t hd__bvh_nearest_in(const hd__bvh_t *t, const double p[3], const uint32_t *list, size_t n, size_t seed,
+                          int seed_kernel, hd__tri_near_t *best, size_t *index, hd__bvh_stats_t *st);
 
 /* Lower bounds on distances, proven not to exceed the true distance with
  * every rounding error counted (bvh.c has the proofs); 0 when no bound
  * is certain.  Exposed for the tests. */
 double hd__box_lower(const hd__box_t *b, const double p[3]);
-double hd__tri_lower(const hd__tri_t *t, const double p[3]);
-/* ... for every triangle of t[0 .. n) at once (b: a box holding them). */
-double hd__tris_lower(const hd__tri_t *t, size_t n, const hd__box_t *b, const double p[3]);
+/* The support bound: min over the corners v of t[0 .. n) of
+ * w . (p - v) / |w|, shrunk; any w (it may be rescaled in place). */
+double hd__support_lower(const hd__tri_t *t, size_t n, const double p[3], double *w);
 
 /* 1 when the corners are collinear or coincident (the triangle is a
  * segment or a point), decided exactly. */

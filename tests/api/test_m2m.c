@@ -248,6 +248,56 @@ TEST(quad_split_two_ways_is_not_zero) {
     soup_free(&A), soup_free(&B), soup_free(&F), soup_free(&G);
 }
 
+/* A's vertices one ulp apart in height over a flat B: their bounds
+ * without the kernel are tens of ulps wide and overlap, and the farthest
+ * vertex, right above a vertex of B, has an upper bound below the others'.
+ * Only exact distances tell it is the farthest: with a tolerance that
+ * stops at the corners the lower bound is its distance. */
+TEST(corners_whose_bounds_overlap_give_the_exact_farthest) {
+    enum { N = 12, M = 8, NB = (M + 1) * (M + 1) };
+    soup_t A = soup_new(N * N, 2 * (N - 1) * (N - 1)), B = soup_new(NB + 4, 2 * M * M + 2);
+    for (int i = 0; i < N * N; i++) {
+        double *p = A.v + 3 * i;
+        p[0] = (i % N + 0.37) / N, p[1] = (i / N + 0.61) / N;
+        p[2] = 1 + (double)((i * 37 + 11) % (N * N)) * 0x1p-52; /* the farthest: i = 132, column 0 */
+    }
+    for (int i = 0; i < NB; i++) {
+        double *p = B.v + 3 * i;
+        p[0] = 0.1 + 1.0 * (i % (M + 1)) / M, p[1] = -0.1 + 1.2 * (i / (M + 1)) / M, p[2] = 0;
+    }
+    A.v[3 * 132] = B.v[3 * 72], A.v[3 * 132 + 1] = B.v[3 * 72 + 1]; /* above a vertex of B */
+    const double big[4][3] = {{-0.2, -1e3, 0}, {0.1, -1e3, 0}, {0.1, 1e3, 0}, {-0.2, 1e3, 0}};
+    memcpy(B.v + 3 * NB, big, sizeof big);
+    for (int k = 0, q = 0; q < (N - 1) * (N - 1); q++) {
+        uint64_t a = (uint64_t)(q % (N - 1) + q / (N - 1) * N);
+        uint64_t t[6] = {a, a + 1, a + N + 1, a, a + N + 1, a + N};
+        for (int j = 0; j < 6; j++) A.t[k++] = t[j];
+    }
+    int k = 0;
+    for (int q = 0; q < M * M; q++) {
+        uint64_t a = (uint64_t)(q % M + q / M * (M + 1));
+        uint64_t t[6] = {a, a + 1, a + M + 2, a, a + M + 2, a + M + 1};
+        for (int j = 0; j < 6; j++) B.t[k++] = t[j];
+    }
+    const uint64_t sq[6] = {NB, NB + 1, NB + 2, NB, NB + 2, NB + 3};
+    for (int j = 0; j < 6; j++) B.t[k++] = sq[j];
+    double *d = distances(A.v, A.nv, &B), far = 0;
+    for (size_t i = 0; i < A.nv; i++) far = fmax(far, d[i]);
+    free(d);
+    hd_mesh_t a = view(&A), b = view(&B);
+    hd_enclosure_t ab1, ab3;
+    hd_surface_options_t o1 = options(1, 1, 1), o3 = options(1, 1, 3);
+    CHECK_RC(hd_surface_hausdorff(&a, &b, &o1, &ab1, NULL, NULL), HD_OK);
+    CHECK_RC(hd_surface_hausdorff(&a, &b, &o3, &ab3, NULL, NULL), HD_OK);
+    CHECK_BITS(far, 1 + 143 * 0x1p-52);
+    CHECK_BITS(ab1.lower, far);
+    CHECK_EQ(ab1.witness_error, 0);
+    witness_holds(&ab1, &A, &B);
+    same_enclosure(&ab1, &ab3);
+    soup_free(&A);
+    soup_free(&B);
+}
+
 TEST(tetrahedron_against_its_scaled_copy) {
     const double v[] = {0, 0, 0, 8, 0, 0, 0, 8, 0, 0, 0, 8, -4, -4, -4, 12, -4, -4, -4, 12, -4, -4, -4, 12};
     const uint64_t ta[] = {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3}, tb[] = {4, 6, 5, 4, 5, 7, 4, 7, 6, 5, 6, 7};

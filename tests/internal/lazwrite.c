@@ -1,13 +1,10 @@
 /*
- * lazwrite.c -- the tests' LAZ writer (lazwrite.h).  The encoder mirrors
- * the decoder of src/io/lazcoder.h: an interval [base, base + length) of
- * 32 bits, a byte shifted out whenever length < 2^24, a carry propagated
- * back through the bytes already written; done() leaves one or two final
- * bytes and pads with zeros to four, so that a decoder, which reads four
- * bytes ahead, consumes the stream exactly.
+ * lazwrite.c -- the tests' LAZ writer (lazwrite.h), over the library's
+ * range encoder (src/io/lazcoder.h).
  */
 #include "lazwrite.h"
 
+#include "io/lasfield.h"
 #include "io/lazcoder.h"
 
 #include <assert.h>
@@ -16,114 +13,13 @@
 
 lazw_layout_t lazw_last;
 
-typedef struct {
-    tf_buf_t out;
-    uint32_t base, length;
-} enc_t;
-
-static void enc_init(enc_t *e) {
-    memset(e, 0, sizeof *e);
-    e->length = 0xFFFFFFFFu;
-}
-static void carry(enc_t *e) {
-    size_t i = e->out.size;
-    while (i > 0 && e->out.data[i - 1] == 0xFF) e->out.data[--i] = 0;
-    assert(i > 0);
-    e->out.data[i - 1]++;
-}
-static void renorm(enc_t *e) {
-    do {
-        tf_u8(&e->out, e->base >> 24);
-        e->base <<= 8;
-    } while ((e->length <<= 8) < HD__AC_MIN);
-}
-static void enc_bit(enc_t *e, hd__bitmodel_t *m, uint32_t sym) {
-    uint32_t x = m->p0 * (e->length >> HD__BM_SHIFT);
-    if (sym == 0) {
-        e->length = x;
-        m->c0++;
-    } else {
-        uint32_t b = e->base;
-        e->base += x;
-        e->length -= x;
-        if (b > e->base) carry(e);
-    }
-    if (e->length < HD__AC_MIN) renorm(e);
-    if (--m->until == 0) hd__bitmodel_update(m);
-}
-static void enc_symbol(enc_t *e, hd__symmodel_t *m, uint32_t sym) {
-    assert(sym < m->n);
-    uint32_t x, b = e->base;
-    if (sym == m->n - 1) {
-        x = m->dist[sym] * (e->length >> HD__DM_SHIFT);
-        e->base += x;
-        e->length -= x;
-    } else {
-        x = m->dist[sym] * (e->length >>= HD__DM_SHIFT);
-        e->base += x;
-        e->length = m->dist[sym + 1] * e->length - x;
-    }
-    if (b > e->base) carry(e);
-    if (e->length < HD__AC_MIN) renorm(e);
-    m->count[sym]++;
-    if (--m->until == 0) hd__symmodel_update(m);
-}
-static void enc_raw(enc_t *e, unsigned bits, uint32_t sym) {
-    if (bits > 19) {
-        enc_raw(e, 16, sym & 0xFFFF);
-        sym >>= 16;
-        bits -= 16;
-    }
-    uint32_t b = e->base;
-    e->base += sym * (e->length >>= bits);
-    if (b > e->base) carry(e);
-    if (e->length < HD__AC_MIN) renorm(e);
-}
-static void enc_done(enc_t *e) {
-    uint32_t b = e->base;
-    int another = 1;
-    if (e->length > 2 * HD__AC_MIN) {
-        e->base += HD__AC_MIN;
-        e->length = HD__AC_MIN >> 1;
-    } else {
-        e->base += HD__AC_MIN >> 1;
-        e->length = HD__AC_MIN >> 9;
-        another = 0;
-    }
-    if (b > e->base) carry(e);
-    renorm(e);
-    tf_u8(&e->out, 0);
-    tf_u8(&e->out, 0);
-    if (another) tf_u8(&e->out, 0);
-}
-
-static void ic_encode(hd__intcoder_t *ic, enc_t *e, int32_t pred, int32_t real, uint32_t ctx) {
-    int64_t c = (int32_t)((uint32_t)real - (uint32_t)pred);
-    if (ic->corr_range) {
-        if (c < ic->corr_min) c += ic->corr_range;
-        else if (c > ic->corr_max) c -= ic->corr_range;
-    }
-    int64_t c1 = c <= 0 ? -c : c - 1;
-    uint32_t k = 0;
-    while (c1) {
-        c1 >>= 1;
-        k++;
-    }
-    ic->k = k;
-    enc_symbol(e, hd__ic_model(&ic->mbits[ctx]), k);
-    if (k) {
-        c = c < 0 ? c + (((int64_t)1 << k) - 1) : c - 1;
-        if (k <= 8) {
-            enc_symbol(e, hd__ic_model(&ic->corr[k]), (uint32_t)c);
-        } else {
-            unsigned k1 = k - 8;
-            enc_symbol(e, hd__ic_model(&ic->corr[k]), (uint32_t)(c >> k1));
-            enc_raw(e, k1, (uint32_t)(c & (((int64_t)1 << k1) - 1)));
-        }
-    } else {
-        enc_bit(e, &ic->corr0, (uint32_t)c);
-    }
-}
+/* The library's encoder (src/io/lazcoder.c), its output a tf_buf_t's
+ * bytes. */
+typedef hd__enc_t enc_t;
+#define enc_init hd__enc_init
+#define enc_symbol hd__enc_symbol
+#define enc_done hd__enc_done
+#define ic_encode hd__ic_encode
 
 static void symnew(hd__symmodel_t *m, uint32_t n) {
     if (hd__symmodel_new(m, n)) abort();
@@ -206,8 +102,8 @@ static void chunk10(tf_buf_t *b, const lazw_opts_t *o, const lazw_point_t *p, si
         for (unsigned k = 0; k < o->extra; k++) enc_symbol(&e, &bytes[k], 0);
     }
     enc_done(&e);
-    tf_put(b, e.out.data, e.out.size);
-    tf_free(&e.out);
+    tf_put(b, e.buf, e.size);
+    hd__enc_free(&e);
     hd__symmodel_free(&changed);
     hd__symmodel_free(&gzero);
     hd__symmodel_free(&rgbused);
@@ -266,8 +162,8 @@ static void chunk10v1(tf_buf_t *b, const lazw_opts_t *o, const lazw_point_t *p, 
         for (unsigned q = 0; q < o->extra; q++) ic_encode(&bic, &e, 40 + q, 40 + q, q);
     }
     enc_done(&e);
-    tf_put(b, e.out.data, e.out.size);
-    tf_free(&e.out);
+    tf_put(b, e.buf, e.size);
+    hd__enc_free(&e);
     hd__symmodel_t *ms[] = {&changed, &gzero, &rgbused};
     for (int i = 0; i < 3; i++) hd__symmodel_free(ms[i]);
     for (int i = 0; i < 256; i++)
@@ -363,13 +259,13 @@ static void chunk14(tf_buf_t *b, const lazw_opts_t *o, const lazw_point_t *p, si
     }
     enc_done(&exy);
     if (zchanges) enc_done(&ez);
-    tf_u32(b, (uint32_t)exy.out.size, 0);
-    tf_u32(b, (uint32_t)ez.out.size, 0);
+    tf_u32(b, (uint32_t)exy.size, 0);
+    tf_u32(b, (uint32_t)ez.size, 0);
     for (unsigned i = 2; i < 9 + o->extra; i++) tf_u32(b, 0, 0); /* unchanged layers: empty */
-    tf_put(b, exy.out.data, exy.out.size);
-    tf_put(b, ez.out.data, ez.out.size);
-    tf_free(&exy.out);
-    tf_free(&ez.out);
+    tf_put(b, exy.buf, exy.size);
+    tf_put(b, ez.buf, ez.size);
+    hd__enc_free(&exy);
+    hd__enc_free(&ez);
     for (int i = 0; i < 4; i++) c14_free(&cx[i]);
     free(cx);
 }
@@ -386,8 +282,8 @@ void lazw_table(tf_buf_t *out, const uint32_t *counts, const uint32_t *bytes, si
         ic_encode(&ic, &e, c ? (int32_t)bytes[c - 1] : 0, (int32_t)bytes[c], 1);
     }
     enc_done(&e);
-    tf_put(out, e.out.data, e.out.size);
-    tf_free(&e.out);
+    tf_put(out, e.buf, e.size);
+    hd__enc_free(&e);
     hd__intcoder_free(&ic);
 }
 
@@ -500,3 +396,95 @@ void lazw_random(gen_rng_t *g, lazw_point_t *p, size_t n, int format) {
         p[i] = (lazw_point_t){x, y, z, (unsigned char)r, (unsigned char)nn, (unsigned char)ch};
     }
 }
+
+/* ---- pointwise files of whole records (the library's encoder) ------------ */
+/* n random records of point format fmt (0-3) with `extra` extra bytes:
+ * every field varies (returns, flags, classification, scan angle, user
+ * data, point source, intensity, GPS times repeated, stepping and jumping,
+ * colours grey and not, extra bytes). */
+unsigned char *lazw_rich_records(gen_rng_t *g, int fmt, unsigned extra, size_t n, size_t *rec) {
+    static const unsigned base[4] = {20, 28, 26, 34};
+    *rec = base[fmt] + extra;
+    unsigned char *r = calloc(n, *rec);
+    int32_t x = 0, y = 0, z = 0;
+    uint64_t t = 0x41C0000000000000ull;
+    uint16_t rgb[3] = {100, 200, 300};
+    for (size_t k = 0; k < n; k++) {
+        unsigned char *p = r + k * *rec;
+        uint64_t u = gen_u64(g);
+        x += (int32_t)(u % 2001) - 1000, y += (int32_t)(u >> 16 & 255) - 128, z += (int32_t)(u >> 24 & 15) - 7;
+        if (u % 97 == 0) x = (int32_t)gen_u64(g);
+        for (int b = 0; b < 4; b++) p[b] = (unsigned char)(x >> 8 * b), p[4 + b] = (unsigned char)(y >> 8 * b), p[8 + b] = (unsigned char)(z >> 8 * b);
+        unsigned nr = 1 + (unsigned)(u >> 32) % 5, ret = 1 + (unsigned)(u >> 36) % nr;
+        uint16_t inten = (uint16_t)(u >> 40 & 7 ? 500 + (u >> 44 & 63) : u >> 48);
+        p[12] = (unsigned char)inten, p[13] = (unsigned char)(inten >> 8);
+        p[14] = (unsigned char)(ret | nr << 3 | (u >> 50 & 3) << 6);
+        p[15] = (unsigned char)(u >> 52 & 3 ? 2 : u >> 54 & 31);
+        p[16] = (unsigned char)(u >> 56 & 1 ? (int8_t)(u >> 57 & 63) - 30 : 0);
+        p[17] = (unsigned char)(u >> 59 & 1 ? 7 : u >> 40);
+        p[18] = (unsigned char)(u >> 61 & 1 ? 11 : u >> 20), p[19] = 0;
+        size_t off = 20;
+        if (fmt == 1 || fmt == 3) {
+            uint64_t w = gen_u64(g);
+            t = w % 4 == 0 ? t : w % 4 == 1 ? t + 1000 : w % 4 == 2 ? t + (w >> 8 & 0xFFFFF) : w % 16 == 3 ? t + (w << 30) : t - 5;
+            for (int b = 0; b < 8; b++) p[off + b] = (unsigned char)(t >> 8 * b);
+            off += 8;
+        }
+        if (fmt >= 2) {
+            uint64_t w = gen_u64(g);
+            if (w % 3 == 0) rgb[0] = rgb[1] = rgb[2] = (uint16_t)(w >> 8); /* grey */
+            else if (w % 3 == 1) rgb[0] = (uint16_t)(rgb[0] + (w >> 8 & 15)), rgb[2] = (uint16_t)(w >> 24);
+            for (int c = 0; c < 3; c++) p[off + 2 * c] = (unsigned char)rgb[c], p[off + 2 * c + 1] = (unsigned char)(rgb[c] >> 8);
+            off += 6;
+        }
+        for (unsigned e = 0; e < extra; e++) p[off + e] = (unsigned char)(k % 7 ? 40 + e : gen_u64(g));
+    }
+    return r;
+}
+
+/* A pointwise LAZ file (LAS 1.2, chunks of `chunk` points) of the records,
+ * compressed by the library's pointwise encoder. */
+void lazw_pointwise(tf_buf_t *b, int fmt, unsigned extra, const unsigned char *recs, size_t rec, size_t n,
+                           size_t chunk) {
+    unsigned type[4], size[4], ni = 0;
+    type[ni] = 6, size[ni++] = 20;
+    if (fmt == 1 || fmt == 3) type[ni] = 7, size[ni++] = 8;
+    if (fmt >= 2) type[ni] = 8, size[ni++] = 6;
+    if (extra) type[ni] = 0, size[ni++] = extra;
+    size_t vlr = 34 + 6 * ni, offset = 227 + 54 + vlr;
+    tf_put(b, "LASF", 4);
+    while (b->size < 24) tf_u8(b, 0);
+    tf_u8(b, 1), tf_u8(b, 2);
+    while (b->size < 94) tf_u8(b, 0);
+    tf_u16(b, 227, 0), tf_u32(b, (uint32_t)offset, 0), tf_u32(b, 1, 0);
+    tf_u8(b, (unsigned)fmt | 0x80), tf_u16(b, (unsigned)rec, 0), tf_u32(b, (uint32_t)n, 0);
+    while (b->size < 131) tf_u8(b, 0);
+    for (int c = 0; c < 3; c++) tf_f64(b, 0.01, 0);
+    for (int c = 0; c < 3; c++) tf_f64(b, 0, 0);
+    while (b->size < 227) tf_u8(b, 0);
+    char user[16] = "laszip encoded", desc[32] = "";
+    tf_u16(b, 0, 0), tf_put(b, user, 16), tf_u16(b, 22204, 0), tf_u16(b, (unsigned)vlr, 0), tf_put(b, desc, 32);
+    tf_u16(b, 2, 0), tf_u16(b, 0, 0), tf_u8(b, 2), tf_u8(b, 2), tf_u16(b, 0, 0), tf_u32(b, 0, 0);
+    tf_u32(b, (uint32_t)chunk, 0), tf_u64(b, (uint64_t)-1, 0), tf_u64(b, (uint64_t)-1, 0), tf_u16(b, ni, 0);
+    for (unsigned i = 0; i < ni; i++) tf_u16(b, type[i], 0), tf_u16(b, size[i], 0), tf_u16(b, 2, 0);
+    size_t ptr = b->size, nc = (n + chunk - 1) / chunk;
+    tf_u64(b, 0, 0);
+    uint64_t *bytes = calloc(nc + 1, sizeof *bytes);
+    hd__enc_t e;
+    hd__enc_init(&e);
+    for (size_t c = 0; c < nc; c++) {
+        size_t k = n - c * chunk < chunk ? n - c * chunk : chunk;
+        if (hd__laz_encode_pointwise(recs + c * chunk * rec, k, rec, type, size, ni, &e)) abort();
+        tf_put(b, recs + c * chunk * rec, rec);
+        tf_put(b, e.buf, e.size);
+        bytes[c] = rec + e.size;
+    }
+    uint64_t tab = b->size;
+    for (int i = 0; i < 8; i++) b->data[ptr + i] = (unsigned char)(tab >> 8 * i);
+    tf_u32(b, 0, 0), tf_u32(b, (uint32_t)nc, 0);
+    if (hd__laz_table_encode(0, nc, NULL, bytes, &e)) abort();
+    tf_put(b, e.buf, e.size);
+    hd__enc_free(&e);
+    free(bytes);
+}
+

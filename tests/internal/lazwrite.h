@@ -60,4 +60,15 @@ typedef struct lazw_layout {
 } lazw_layout_t;
 extern lazw_layout_t lazw_last;
 
+/* n random whole records of point format fmt (0-3) with `extra` extra
+ * bytes, every field varying (returns, flags, classification, scan angle,
+ * user data, point source, intensity, GPS times repeated, stepping and
+ * jumping, colours grey and not, extra bytes); malloc'd, *rec bytes each. */
+unsigned char *lazw_rich_records(gen_rng_t *g, int fmt, unsigned extra, size_t n, size_t *rec);
+/* The pointwise LAZ file (LAS 1.2, LASzip items of version 2, chunks of
+ * `chunk` points) of those records, compressed by the library's pointwise
+ * encoder (hd__laz_encode_pointwise, src/io/write_lazpw.c), appended to b. */
+void lazw_pointwise(tf_buf_t *b, int fmt, unsigned extra, const unsigned char *recs, size_t rec, size_t n,
+                    size_t chunk);
+
 #endif

@@ -385,7 +385,9 @@ TEST(float32_strided_vertices_and_uint32_indices_give_the_same_answers) {
     soup_free(&s);
 }
 
-/* The bounds the tree prunes with never exceed the kernel's distance
+/* The bounds the search discards with (a box's, the support bound in the
+ * direction of the box's centre) never exceed the
+ * kernel's distance
  * (which is within half an ulp of the true one): on random, degenerate and
  * tiny or huge triangles, with points near and far. */
 TEST(the_lower_bounds_never_exceed_the_distance) {
@@ -407,16 +409,17 @@ TEST(the_lower_bounds_never_exceed_the_distance) {
         CHECK_RC(hd__tri_nearest(p, t.v[0], t.v[1], t.v[2], &r), HD_OK);
         /* the true distance is at least r.d minus half its ulp */
         double floor_d = r.d - (nextafter(r.d, INFINITY) - r.d);
-        double lb = hd__tri_lower(&t, p);
         hd__box_t b;
         for (int c = 0; c < 3; c++) {
             b.lo[c] = fmin(fmin(t.v[0][c], t.v[1][c]), t.v[2][c]);
             b.hi[c] = fmax(fmax(t.v[0][c], t.v[1][c]), t.v[2][c]);
         }
-        double bl = hd__box_lower(&b, p);
-        if (far > 1) far_cases++, tight += lb >= r.d * (1 - 1e-9);
+        double w[3];
+        for (int c = 0; c < 3; c++) w[c] = p[c] - (b.lo[c] / 2 + b.hi[c] / 2);
+        double lb = hd__support_lower(&t, 1, p, w), bl = hd__box_lower(&b, p);
+        if (far > 1) far_cases++, tight += lb >= r.d * (1 - 1e-5);
         if (lb > r.d || bl > r.d) {
-            CONTEXT("seed 77, case %d: d %.17g, triangle bound %.17g, box bound %.17g (floor %.17g)", k, r.d, lb, bl,
+            CONTEXT("seed 77, case %d: d %.17g, support bound %.17g, box bound %.17g (floor %.17g)", k, r.d, lb, bl,
                     floor_d);
             CHECK(lb <= r.d && bl <= r.d);
             break;
@@ -444,14 +447,16 @@ TEST(the_lower_bounds_never_exceed_the_distance) {
                     b.hi[c] = fmax(b.hi[c], t[j].v[v][c]);
                 }
         }
-        double gl = hd__tris_lower(t, 8, &b, p);
+        double w[3];
+        for (int c = 0; c < 3; c++) w[c] = p[c] - (b.lo[c] / 2 + b.hi[c] / 2);
+        double gl = hd__support_lower(t, 8, p, w);
         if (gl > least) {
             CONTEXT("seed 77, group case %d: nearest %.17g, group bound %.17g", k, least, gl);
             CHECK(gl <= least);
             break;
         }
     }
-    /* and the triangle bound is nearly the distance, as pruning needs */
+    /* and the support bound is nearly the distance far away, as pruning needs */
     CONTEXT("seed 77: %d of %d far cases tight", tight, far_cases);
     CHECK(tight >= far_cases * 9 / 10);
 }
@@ -482,4 +487,165 @@ TEST(bad_meshes_get_an_error_naming_the_triangle) {
     M.index_type = HD_INDEX_U64;
     q[2] = NAN;
     CHECK_RC(hd_mesh_distances(&P, &M, NULL, NULL, NULL, NULL, NULL, NULL, &err), HD_ENONFINITE);
+}
+
+/* ---- the discards of the search: far, clustered, tied, scaled ---------- */
+
+/* The corners' box of a soup. */
+static void soup_box(const soup_t *s, double lo[3], double hi[3]) {
+    for (int c = 0; c < 3; c++) lo[c] = hi[c] = s->v[c];
+    for (size_t k = 0; k < s->nv; k++)
+        for (int c = 0; c < 3; c++) {
+            lo[c] = s->v[3 * k + c] < lo[c] ? s->v[3 * k + c] : lo[c];
+            hi[c] = s->v[3 * k + c] > hi[c] ? s->v[3 * k + c] : hi[c];
+        }
+}
+
+/* Dense clouds far from a model (the box grown 3 and 100 times: the
+ * neighbouring points share one list of triangles) and clusters of points
+ * a millionth of the model apart (tiny groups, many equal seeds). */
+TEST(far_and_clustered_clouds_equal_the_brute_force) {
+    const char *files[] = {"data/orig/pinion.off", "data/orig/cow.off"};
+    for (size_t f = 0; f < 2; f++) {
+        soup_t s;
+        if (soup_read(files[f], &s)) continue;
+        double lo[3], hi[3];
+        soup_box(&s, lo, hi);
+        gen_rng_t g;
+        gen_seed(&g, 300 + f);
+        size_t n = 3000 / SCALE;
+        double *p = malloc(3 * n * sizeof *p);
+        for (size_t i = 0; i < n; i++)
+            for (int c = 0; c < 3; c++) {
+                double ext = hi[c] - lo[c], mid = lo[c] / 2 + hi[c] / 2;
+                p[3 * i + c] = i < n / 3 ? mid + 1.5 * ext * (2 * gen_unit(&g) - 1)
+                               : i < 2 * n / 3 ? mid + 50 * ext * (2 * gen_unit(&g) - 1)
+                                               : 0; /* clusters: below */
+            }
+        for (size_t i = 2 * n / 3; i < n; i++) { /* 20 clusters around vertices and beyond the box */
+            size_t k = i % 20;
+            const double *v = s.v + 3 * ((k * 7919) % s.nv);
+            for (int c = 0; c < 3; c++)
+                p[3 * i + c] = v[c] * (k % 2 ? 1 : 1.5) + 1e-6 * (hi[c] - lo[c]) * (gen_unit(&g) - 0.5);
+        }
+        char what[96];
+        snprintf(what, sizeof what, "%s, far and clustered clouds (seed %zu)", files[f], 300 + f);
+        same_as_brute(&s, p, n, what);
+        free(p);
+        soup_free(&s);
+    }
+}
+
+/* The regular octahedron: its centre is at the same distance from all 8
+ * faces, a point on an axis from the 4 faces of a corner, a point on a
+ * diagonal plane from 2 faces: every such point ties, in groups of equal
+ * and of nearby points. */
+TEST(equidistant_points_of_a_symmetric_mesh_tie_to_the_smallest_index) {
+    double v[] = {1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1};
+    uint64_t t[] = {0, 2, 4, 2, 1, 4, 1, 3, 4, 3, 0, 4, 2, 0, 5, 1, 2, 5, 3, 1, 5, 0, 3, 5};
+    soup_t s = {v, 6, t, 8};
+    double p[3 * 400];
+    size_t n = 0;
+    for (int i = 0; i < 40; i++) p[n++] = 0, p[n++] = 0, p[n++] = 0; /* the centre, 40 times */
+    for (int i = 0; i < 120; i++) { /* on the axes, near and far, both sides */
+        double r = ldexp(1.0 + i % 7, i / 7 - 8) * (i % 2 ? 1 : -1);
+        p[n++] = i % 3 == 0 ? r : 0, p[n++] = i % 3 == 1 ? r : 0, p[n++] = i % 3 == 2 ? r : 0;
+    }
+    for (int i = 0; i < 240; i++) { /* on the planes x = y, y = z, z = x, and x = y = z */
+        double a = ldexp(1.0 + i % 5, i / 20 - 6), b = i % 4 ? a / 3 : a;
+        double q[3] = {a, a, b};
+        int rot = i % 3;
+        p[n++] = q[rot], p[n++] = q[(rot + 1) % 3], p[n++] = q[(rot + 2) % 3];
+    }
+    same_as_brute(&s, p, n / 3, "octahedron, equidistant points");
+    /* far beyond a corner: the 4 triangles around it tie there, and only
+     * the first needs the kernel (the others are decided at the corner) */
+    gen_rng_t g;
+    gen_seed(&g, 400);
+    for (int i = 0; i < 400; i++) {
+        p[3 * i] = 50 + gen_unit(&g), p[3 * i + 1] = gen_unit(&g) - 0.5, p[3 * i + 2] = gen_unit(&g) - 0.5;
+    }
+    same_as_brute(&s, p, 400, "octahedron, beyond the corner (1, 0, 0) (seed 400)");
+    hd_points_t P = hd_points_f64(p, 400);
+    hd_mesh_t M = view(&s);
+    hd_surface_result_t r;
+    CHECK_RC(hd_mesh_distances(&P, &M, NULL, NULL, NULL, NULL, NULL, &r, NULL), HD_OK);
+    CONTEXT("octahedron, 400 points beyond a corner: %llu kernel calls", (unsigned long long)r.kernel_calls);
+    CHECK(r.kernel_calls <= 440);
+}
+
+/* The same soups and clouds with every coordinate scaled by a power of
+ * two from 2^-990 to 2^480 (rounding unchanged, underflow and huge bounds
+ * not), and by 1e-300 and 1e150 (rounded). */
+TEST(huge_and_tiny_coordinates_equal_the_brute_force) {
+    const double scales[] = {0x1p-990, 1e-300, 0x1p-500, 1e-20, 1e20, 1e150, 0x1p480};
+    for (size_t k = 0; k < sizeof scales / sizeof *scales; k++) {
+        gen_rng_t g;
+        gen_seed(&g, 500 + k);
+        soup_t s;
+        soup_random(&g, &s, 200 / SCALE, k % 2 ? 0.2 : 0.02);
+        size_t n = 900 / SCALE;
+        double *p = points_around(&g, &s, n);
+        for (size_t i = 0; i < 3 * s.nv; i++) s.v[i] *= scales[k];
+        for (size_t i = 0; i < 3 * n; i++) p[i] *= scales[k];
+        char what[64];
+        snprintf(what, sizeof what, "random soup scaled by %g (seed %zu)", scales[k], 500 + k);
+        same_as_brute(&s, p, n, what);
+        free(p);
+        soup_free(&s);
+    }
+}
+
+/* Degenerate triangles (segments, points, needles) among proper ones,
+ * with clouds clustered on them and far from them. */
+TEST(clusters_on_degenerate_triangles_equal_the_brute_force) {
+    gen_rng_t g;
+    gen_seed(&g, 600);
+    soup_t s;
+    soup_random(&g, &s, 300 / SCALE, 0.1);
+    for (size_t k = 0; k < s.nt; k += 3) { /* every third: a segment, a point or a needle */
+        double *a = s.v + 9 * k, *b = a + 3, *c = a + 6;
+        for (int i = 0; i < 3; i++)
+            c[i] = k % 9 == 0 ? 2 * b[i] - a[i] : k % 9 == 3 ? a[i] : b[i] + 0x1p-40 * (a[i] - b[i]);
+        if (k % 9 == 3) memcpy(b, a, 3 * sizeof *a);
+    }
+    size_t n = 1500 / SCALE;
+    double *p = malloc(3 * n * sizeof *p);
+    for (size_t i = 0; i < n; i++) {
+        const double *v = s.v + 9 * (3 * (i % (s.nt / 3)));
+        double sc = i % 3 == 0 ? 1e-9 : i % 3 == 1 ? 1e-3 : 30;
+        for (int c = 0; c < 3; c++) p[3 * i + c] = v[c] + sc * (gen_unit(&g) - 0.5);
+    }
+    same_as_brute(&s, p, n, "clusters on degenerate triangles (seed 600)");
+    free(p);
+    soup_free(&s);
+}
+
+/* The prepared bounds decide before the kernel: on a cloud near a smooth
+ * model the kernel runs for about one triangle a point (the nearest),
+ * and on a cloud far from it for its ties only. */
+TEST(the_kernel_runs_about_once_a_point) {
+    soup_t s;
+    if (soup_read("data/orig/cow.off", &s)) return;
+    double lo[3], hi[3];
+    soup_box(&s, lo, hi);
+    gen_rng_t g;
+    gen_seed(&g, 700);
+    size_t n = 4000 / SCALE;
+    double *p = malloc(3 * n * sizeof *p);
+    for (size_t i = 0; i < n; i++) {
+        const uint64_t *t = s.t + 3 * (gen_u64(&g) % s.nt);
+        double u = gen_unit(&g), w = gen_unit(&g) * (1 - u);
+        for (int c = 0; c < 3; c++)
+            p[3 * i + c] = u * s.v[3 * t[0] + c] + w * s.v[3 * t[1] + c] + (1 - u - w) * s.v[3 * t[2] + c] +
+                           1e-3 * (hi[c] - lo[c]) * (gen_unit(&g) - 0.5);
+    }
+    hd_points_t P = hd_points_f64(p, n);
+    hd_mesh_t M = view(&s);
+    hd_surface_result_t r;
+    CHECK_RC(hd_mesh_distances(&P, &M, NULL, NULL, NULL, NULL, NULL, &r, NULL), HD_OK);
+    CONTEXT("cow, %zu near points (seed 700): %llu kernel calls", n, (unsigned long long)r.kernel_calls);
+    CHECK(r.kernel_calls <= n + n / 50);
+    free(p);
+    soup_free(&s);
 }

@@ -127,3 +127,21 @@ const char *tf_finish(tf_buf_t *b, const char *name) {
     tf_free(b);
     return p;
 }
+
+unsigned char *tf_read(const char *path, size_t *n) {
+    FILE *f = fopen(path, "rb");
+    *n = 0;
+    if (!f) return NULL;
+    unsigned char *d = NULL;
+    long len = fseek(f, 0, SEEK_END) == 0 ? ftell(f) : -1;
+    if (len >= 0 && fseek(f, 0, SEEK_SET) == 0 && (d = malloc((size_t)len + 1)) &&
+        fread(d, 1, (size_t)len, f) == (size_t)len) {
+        d[len] = 0;
+        *n = (size_t)len;
+    } else {
+        free(d);
+        d = NULL;
+    }
+    fclose(f);
+    return d;
+}

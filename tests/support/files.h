@@ -36,6 +36,9 @@ void tf_wide(tf_buf_t *b, const void *text, size_t n, int width, int big, int bo
 void tf_f32(tf_buf_t *b, float v, int big);
 void tf_f64(tf_buf_t *b, double v, int big);
 void tf_free(tf_buf_t *b);
+/* The whole file at path, malloc'd with a NUL after its *n bytes; NULL
+ * (and *n 0) when it cannot be read. */
+unsigned char *tf_read(const char *path, size_t *n);
 /* Write the buffer to NAME, free it, and return the path (as tf_write). */
 const char *tf_finish(tf_buf_t *b, const char *name);
 

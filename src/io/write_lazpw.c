@@ -1,0 +1,532 @@
+/*
+ * write_lazpw.c -- a field written back into pointwise LAZ (LAS point
+ * formats 0-3, LASzip compressor 2), or the points past a threshold.
+ *
+ * Pointwise LAZ codes every field of a point in one stream per chunk, so
+ * the field's bytes cannot be added beside the old data: every chunk is
+ * decoded to whole records (laz.c, items of version 2) and the records,
+ * each with the value's eight bytes after it, are compressed again by this
+ * file's encoder: POINT10, GPSTIME11, RGB12 and BYTE, version 2 each, the
+ * mirror of laz.c's decoder (the same models, contexts and predictions;
+ * lazcoder.h has the coder):
+ *  - POINT10 v2: a symbol of 64 saying which of the return byte,
+ *    intensity (kept per return context m), classification, scan angle,
+ *    user data, point source changed; each changed one (bytes by a model
+ *    chosen by their last value, the scan angle as a difference, the
+ *    others by the integer compressor); then dx and dy against the median
+ *    of the last five of context m and z against the last z of the return
+ *    level, their contexts from the magnitudes k of the previous ones.
+ *  - GPSTIME11 v2: the decoder follows four sequences of times; this
+ *    encoder uses one of its codings for each point: unchanged, a
+ *    difference that fits 32 bits (against 0 or the sequence's last
+ *    difference), or the whole value (a new sequence).  Any such choice
+ *    decodes to the same times in every LASzip decoder; LASzip's own
+ *    encoder also uses multiples of the last difference and switches back
+ *    to older sequences, which only compress better.
+ *  - RGB12 v2: which of the six bytes changed and whether the colour is
+ *    grey (a symbol of 128); red's bytes as differences; green's and
+ *    blue's, when not grey, as corrections to red's difference (for blue
+ *    averaged with green's) added to their last value and clamped to a
+ *    byte.
+ *  - BYTE v2: each extra byte as its difference to its last value, one
+ *    model per byte.
+ * Chunks keep the input's point counts when every point is written; a
+ * subset is cut into chunks of HD__LAZ_CHUNK points.  The header, VLRs and
+ * chunk table are written as for layered LAZ; the header is written again
+ * and the chunk table's place patched once the chunks are out (the file
+ * is a regular temporary, so it can seek), which keeps one input chunk and
+ * one output chunk in memory at a time.
+ */
+#include "io.h"
+#include "lasfield.h"
+#include "lazcoder.h"
+
+#include <errno.h>
+#include <stdlib.h>
+#include <sys/types.h>
+
+enum { IT_BYTE = 0, IT_POINT10 = 6, IT_GPSTIME11 = 7, IT_RGB12 = 8 };
+#define HD__LAZ_CHUNK 50000 /* LASzip's default chunk size */
+
+typedef struct {
+    hd__symmodel_t changed, scan[2], *bitbyte[256], *cls[256], *user[256];
+    hd__intcoder_t intensity, psid, dx, dy, dz;
+    hd__median5_t mx[16], my[16];
+    uint16_t last_int[16];
+    int32_t last_h[8];
+    unsigned char last[20];
+    hd__symmodel_t gmulti, gzero;
+    hd__intcoder_t gic;
+    int64_t t[4];
+    int32_t gdiff[4];
+    unsigned glast, gnext;
+    hd__symmodel_t used, cdiff[6];
+    uint16_t rgb[3];
+    unsigned nb;
+    hd__symmodel_t *bm;
+    unsigned char *blast;
+    int oom;
+} pwe_t;
+
+static void pwe_free(pwe_t *p) {
+    hd__symmodel_t *m[] = {&p->changed, &p->scan[0], &p->scan[1], &p->gmulti, &p->gzero, &p->used,
+                           &p->cdiff[0], &p->cdiff[1], &p->cdiff[2], &p->cdiff[3], &p->cdiff[4], &p->cdiff[5]};
+    hd__symmodels_free(m, sizeof m / sizeof m[0]);
+    hd__lazy_models_free(p->bitbyte, 256);
+    hd__lazy_models_free(p->cls, 256);
+    hd__lazy_models_free(p->user, 256);
+    hd__intcoder_t *ic[] = {&p->intensity, &p->psid, &p->dx, &p->dy, &p->dz, &p->gic};
+    for (size_t i = 0; i < sizeof ic / sizeof ic[0]; i++) hd__intcoder_free(ic[i]);
+    for (unsigned i = 0; p->bm && i < p->nb; i++) hd__symmodel_free(&p->bm[i]);
+    free(p->bm);
+    free(p->blast);
+}
+
+/* The models of a chunk, started from its first record r (items: the
+ * output's, sizes sz). */
+static int pwe_start(pwe_t *p, const unsigned char *r, const unsigned *type, const unsigned *sz, unsigned n_items) {
+    memset(p, 0, sizeof *p);
+    int rc = hd__symmodel_new(&p->changed, 64);
+    rc = rc ? rc : hd__symmodel_new(&p->scan[0], 256);
+    rc = rc ? rc : hd__symmodel_new(&p->scan[1], 256);
+    rc = rc ? rc : hd__intcoder_new(&p->intensity, 16, 4);
+    rc = rc ? rc : hd__intcoder_new(&p->psid, 16, 1);
+    rc = rc ? rc : hd__intcoder_new(&p->dx, 32, 2);
+    rc = rc ? rc : hd__intcoder_new(&p->dy, 32, 22);
+    rc = rc ? rc : hd__intcoder_new(&p->dz, 32, 20);
+    rc = rc ? rc : hd__symmodel_new(&p->gmulti, 516);
+    rc = rc ? rc : hd__symmodel_new(&p->gzero, 6);
+    rc = rc ? rc : hd__intcoder_new(&p->gic, 32, 9);
+    rc = rc ? rc : hd__symmodel_new(&p->used, 128);
+    for (int i = 0; i < 6 && rc == HD_OK; i++) rc = hd__symmodel_new(&p->cdiff[i], 256);
+    for (int i = 0; i < 16; i++) hd__median5_init(&p->mx[i]), hd__median5_init(&p->my[i]);
+    memcpy(p->last, r, 20);
+    size_t off = 20;
+    for (unsigned i = 1; i < n_items && rc == HD_OK; i++) {
+        if (type[i] == IT_GPSTIME11) p->t[0] = (int64_t)hd__ld_u64(r + off, 0);
+        if (type[i] == IT_RGB12)
+            for (int c = 0; c < 3; c++) p->rgb[c] = hd__ld_u16(r + off + 2 * c, 0);
+        if (type[i] == IT_BYTE) {
+            p->nb = sz[i];
+            p->bm = calloc(p->nb, sizeof *p->bm);
+            p->blast = malloc(p->nb);
+            if (!p->bm || !p->blast) return HD_ENOMEM;
+            memcpy(p->blast, r + off, p->nb);
+            for (unsigned k = 0; k < p->nb && rc == HD_OK; k++) rc = hd__symmodel_new(&p->bm[k], 256);
+        }
+        off += sz[i];
+    }
+    return rc;
+}
+
+/* The model at *slot (256 symbols), created on first use. */
+static hd__symmodel_t *model(pwe_t *p, hd__symmodel_t **slot) {
+    if (!*slot) {
+        hd__symmodel_t *m = malloc(sizeof *m);
+        if (!m || hd__symmodel_new(m, 256)) {
+            free(m);
+            p->oom = 1;
+            return NULL;
+        }
+        *slot = m;
+    }
+    return *slot;
+}
+
+static void byte_by_last(pwe_t *p, hd__enc_t *e, hd__symmodel_t **models, unsigned char *last, unsigned char now) {
+    hd__symmodel_t *m = model(p, &models[*last]);
+    if (m) hd__enc_symbol(e, m, now);
+    *last = now;
+}
+
+static void point10(pwe_t *p, hd__enc_t *e, const unsigned char *r) {
+    unsigned char *L = p->last;
+    unsigned n = (r[14] >> 3) & 7, ret = r[14] & 7, m = hd__laz_rmap10[n][ret], l = hd__laz_level(n, ret);
+    uint16_t inten = hd__ld_u16(r + 12, 0);
+    unsigned changed = (r[14] != L[14]) << 5 | (inten != p->last_int[m]) << 4 | (r[15] != L[15]) << 3 |
+                       (r[16] != L[16]) << 2 | (r[17] != L[17]) << 1 | (hd__ld_u16(r + 18, 0) != hd__ld_u16(L + 18, 0));
+    hd__enc_symbol(e, &p->changed, changed);
+    if (changed & 32) byte_by_last(p, e, p->bitbyte, &L[14], r[14]);
+    if (changed & 16) {
+        hd__ic_encode(&p->intensity, e, p->last_int[m], inten, m < 3 ? m : 3);
+        p->last_int[m] = inten;
+    }
+    if (changed & 8) byte_by_last(p, e, p->cls, &L[15], r[15]);
+    if (changed & 4) {
+        hd__enc_symbol(e, &p->scan[(r[14] >> 6) & 1], (unsigned)(r[16] - L[16]) & 255);
+        L[16] = r[16];
+    }
+    if (changed & 2) byte_by_last(p, e, p->user, &L[17], r[17]);
+    if (changed & 1) {
+        hd__ic_encode(&p->psid, e, hd__ld_u16(L + 18, 0), hd__ld_u16(r + 18, 0), 0);
+        L[18] = r[18], L[19] = r[19];
+    }
+    int32_t X = (int32_t)hd__ld_u32(r, 0), Y = (int32_t)hd__ld_u32(r + 4, 0), Z = (int32_t)hd__ld_u32(r + 8, 0);
+    int32_t dx = (int32_t)((uint32_t)X - hd__ld_u32(L, 0)), dy = (int32_t)((uint32_t)Y - hd__ld_u32(L + 4, 0));
+    hd__ic_encode(&p->dx, e, p->mx[m].v[2], dx, n == 1);
+    hd__median5_add(&p->mx[m], dx);
+    hd__ic_encode(&p->dy, e, p->my[m].v[2], dy, (n == 1) + hd__laz_kctx(p->dx.k, 20));
+    hd__median5_add(&p->my[m], dy);
+    hd__ic_encode(&p->dz, e, p->last_h[l], Z, (n == 1) + hd__laz_kctx((p->dx.k + p->dy.k) / 2, 18));
+    p->last_h[l] = Z;
+    memcpy(L, r, 12);
+}
+
+/* GPSTIME11 v2, one of the decoder's codings per point (see the top). */
+static void gpstime(pwe_t *p, hd__enc_t *e, int64_t T) {
+    unsigned L = p->glast;
+    int64_t diff = (int64_t)((uint64_t)T - (uint64_t)p->t[L]);
+    int fits = diff >= INT32_MIN && diff <= INT32_MAX;
+    if (p->gdiff[L] == 0) {
+        hd__enc_symbol(e, &p->gzero, T == p->t[L] ? 0 : fits ? 1 : 2);
+        if (T == p->t[L]) return;
+        if (fits) {
+            hd__ic_encode(&p->gic, e, 0, (int32_t)diff, 0);
+            p->gdiff[L] = (int32_t)diff;
+            p->t[L] = T;
+            return;
+        }
+    } else {
+        hd__enc_symbol(e, &p->gmulti, T == p->t[L] ? 511 : fits ? 1 : 512);
+        if (T == p->t[L]) return;
+        if (fits) {
+            hd__ic_encode(&p->gic, e, p->gdiff[L], (int32_t)diff, 1);
+            p->t[L] = T;
+            return;
+        }
+    }
+    /* the whole value, as a new sequence */
+    p->gnext = (p->gnext + 1) & 3;
+    hd__ic_encode(&p->gic, e, (int32_t)((uint64_t)p->t[L] >> 32), (int32_t)((uint64_t)T >> 32), 8);
+    hd__enc_raw(e, 16, (uint32_t)T & 0xFFFF);
+    hd__enc_raw(e, 16, ((uint32_t)T >> 16) & 0xFFFF);
+    p->t[p->gnext] = T;
+    p->glast = p->gnext;
+    p->gdiff[p->glast] = 0;
+}
+
+static unsigned clamp8(int v) { return v < 0 ? 0u : v > 255 ? 255u : (unsigned)v; }
+
+static void rgb12(pwe_t *p, hd__enc_t *e, const unsigned char *r) {
+    uint16_t it[3], *last = p->rgb;
+    for (int c = 0; c < 3; c++) it[c] = hd__ld_u16(r + 2 * c, 0);
+    unsigned sym = ((last[0] & 255) != (it[0] & 255)) | ((last[0] >> 8) != (it[0] >> 8)) << 1 |
+                   ((last[1] & 255) != (it[1] & 255)) << 2 | ((last[1] >> 8) != (it[1] >> 8)) << 3 |
+                   ((last[2] & 255) != (it[2] & 255)) << 4 | ((last[2] >> 8) != (it[2] >> 8)) << 5 |
+                   (it[0] != it[1] || it[0] != it[2]) << 6;
+    hd__enc_symbol(e, &p->used, sym);
+    int dl = (int)(it[0] & 255) - (int)(last[0] & 255), dh = (int)(it[0] >> 8) - (int)(last[0] >> 8);
+    if (sym & 1) hd__enc_symbol(e, &p->cdiff[0], (unsigned)dl & 255);
+    if (sym & 2) hd__enc_symbol(e, &p->cdiff[1], (unsigned)dh & 255);
+    if (sym & 64) {
+        if (sym & 4) hd__enc_symbol(e, &p->cdiff[2], (unsigned)((int)(it[1] & 255) - (int)clamp8(dl + (last[1] & 255))) & 255);
+        if (sym & 16) {
+            int d = (dl + ((int)(it[1] & 255) - (int)(last[1] & 255))) / 2;
+            hd__enc_symbol(e, &p->cdiff[4], (unsigned)((int)(it[2] & 255) - (int)clamp8(d + (last[2] & 255))) & 255);
+        }
+        if (sym & 8) hd__enc_symbol(e, &p->cdiff[3], (unsigned)((int)(it[1] >> 8) - (int)clamp8(dh + (last[1] >> 8))) & 255);
+        if (sym & 32) {
+            int d = (dh + ((int)(it[1] >> 8) - (int)(last[1] >> 8))) / 2;
+            hd__enc_symbol(e, &p->cdiff[5], (unsigned)((int)(it[2] >> 8) - (int)clamp8(d + (last[2] >> 8))) & 255);
+        }
+    }
+    memcpy(last, it, sizeof it);
+}
+
+static void bytes(pwe_t *p, hd__enc_t *e, const unsigned char *r) {
+    for (unsigned k = 0; k < p->nb; k++) {
+        hd__enc_symbol(e, &p->bm[k], (unsigned)(r[k] - p->blast[k]) & 255);
+        p->blast[k] = r[k];
+    }
+}
+
+int hd__laz_encode_pointwise(const unsigned char *recs, size_t n, size_t rec, const unsigned *type, const unsigned *sz,
+                        unsigned n_items, hd__enc_t *e) {
+    pwe_t *p = malloc(sizeof *p);
+    if (!p) return HD_ENOMEM;
+    hd__enc_reset(e);
+    int rc = pwe_start(p, recs, type, sz, n_items);
+    for (size_t i = 1; i < n && rc == HD_OK; i++) {
+        const unsigned char *r = recs + i * rec;
+        point10(p, e, r);
+        size_t off = 20;
+        for (unsigned t = 1; t < n_items; t++) {
+            if (type[t] == IT_GPSTIME11) gpstime(p, e, (int64_t)hd__ld_u64(r + off, 0));
+            else if (type[t] == IT_RGB12) rgb12(p, e, r + off);
+            else bytes(p, e, r + off);
+            off += sz[t];
+        }
+    }
+    if (rc == HD_OK) hd__enc_done(e);
+    if (rc == HD_OK && (p->oom || e->oom)) rc = HD_ENOMEM;
+    pwe_free(p);
+    free(p);
+    return rc;
+}
+
+/* The chunk table's entries: per chunk its point count (variable chunk
+ * sizes only) and its byte size, each predicted by the previous chunk's,
+ * in one stream (the table's version and chunk count precede it). */
+int hd__laz_table_encode(int variable, size_t nc, const uint32_t *counts, const uint64_t *bytes, hd__enc_t *e) {
+    hd__intcoder_t ic;
+    if (hd__intcoder_new(&ic, 32, 2)) return HD_ENOMEM;
+    hd__enc_reset(e);
+    for (size_t k = 0; k < nc; k++) {
+        if (variable) hd__ic_encode(&ic, e, k ? (int32_t)counts[k - 1] : 0, (int32_t)counts[k], 0);
+        hd__ic_encode(&ic, e, k ? (int32_t)bytes[k - 1] : 0, (int32_t)bytes[k], 1);
+    }
+    hd__enc_done(e);
+    hd__intcoder_free(&ic);
+    return e->oom ? HD_ENOMEM : HD_OK;
+}
+
+typedef struct {
+    hd__writer_t *w;
+    hd__las_plan_t *pl;
+    unsigned type[32], size[32], n_items;
+    unsigned char *vlr;  /* the output's LASzip VLR data */
+    size_t vlr_len;
+    unsigned char *out;  /* the output chunk being gathered */
+    size_t n_out, cap_out;
+    uint32_t *counts;    /* per output chunk */
+    uint64_t *bytes;
+    size_t n_chunks, cap_chunks;
+    hd__enc_t enc;
+    uint64_t kept, by_return[16];
+    double bounds[6], scale[3], shift[3];
+} pw_t;
+
+/* The output's items (every input item of version 2; the BYTE item grown
+ * by 8, or added) and its LASzip VLR (the input's, items rewritten;
+ * compressor 2, the chunk size `chunk`). */
+static int plan_items(pw_t *z, const hd__laz_chunks_t *c, uint32_t chunk) {
+    hd__writer_t *w = z->w;
+    for (unsigned i = 0; i < c->n_items; i++)
+        if (c->version[i] != 2)
+            return hd__err(w->err, HD_EUNSUPPORTED,
+                           "%s: LASzip item %u is of version %u: a field is written into pointwise LAZ of version 2 "
+                           "items (LASzip 2 and later) only",
+                           w->in->name, i + 1, c->version[i]);
+    z->n_items = c->n_items;
+    memcpy(z->type, c->type, sizeof z->type);
+    memcpy(z->size, c->size, sizeof z->size);
+    if (z->pl->add) {
+        if (z->type[z->n_items - 1] == IT_BYTE) z->size[z->n_items - 1] += 8;
+        else z->type[z->n_items] = IT_BYTE, z->size[z->n_items++] = 8;
+    }
+    const unsigned char *v = w->in->data + c->vlr_at;
+    size_t tail = c->vlr_len - (34 + 6 * (size_t)c->n_items); /* bytes after the items, kept */
+    z->vlr_len = 34 + 6 * (size_t)z->n_items + tail;
+    if (!(z->vlr = malloc(z->vlr_len))) return hd__err(w->err, HD_ENOMEM, "out of memory");
+    memcpy(z->vlr, v, 34);
+    z->vlr[0] = 2, z->vlr[1] = 0; /* pointwise chunked */
+    for (int b = 0; b < 4; b++) z->vlr[12 + b] = (unsigned char)(chunk >> (8 * b));
+    z->vlr[32] = (unsigned char)z->n_items, z->vlr[33] = 0;
+    for (unsigned i = 0; i < z->n_items; i++) {
+        unsigned char *q = z->vlr + 34 + 6 * i;
+        q[0] = (unsigned char)z->type[i], q[1] = 0, q[2] = (unsigned char)z->size[i], q[3] = (unsigned char)(z->size[i] >> 8);
+        q[4] = 2, q[5] = 0;
+    }
+    memcpy(z->vlr + 34 + 6 * z->n_items, v + 34 + 6 * c->n_items, tail);
+    return HD_OK;
+}
+
+/* Write a chunk (its first record raw, then its stream e) and note its
+ * count and bytes for the chunk table; HD_OK or HD_ENOMEM. */
+static int put_chunk(pw_t *z, size_t n, const unsigned char *first, const hd__enc_t *e) {
+    if (z->n_chunks == z->cap_chunks) {
+        size_t cap = z->cap_chunks ? 2 * z->cap_chunks : 64;
+        uint32_t *c = hd__realloc_array(z->counts, cap, sizeof *c);
+        if (c) z->counts = c;
+        uint64_t *b = hd__realloc_array(z->bytes, cap, sizeof *b);
+        if (b) z->bytes = b;
+        if (!c || !b) return HD_ENOMEM;
+        z->cap_chunks = cap;
+    }
+    z->counts[z->n_chunks] = (uint32_t)n;
+    z->bytes[z->n_chunks++] = z->pl->out_rec + e->size;
+    hd__w_put(z->w, first, z->pl->out_rec);
+    hd__w_put(z->w, e->buf, e->size);
+    return HD_OK;
+}
+
+/* Encode and write the gathered output chunk. */
+static int flush_chunk(pw_t *z) {
+    if (z->n_out == 0) return HD_OK;
+    hd__writer_t *w = z->w;
+    size_t rec = z->pl->out_rec;
+    if (hd__laz_encode_pointwise(z->out, z->n_out, rec, z->type, z->size, z->n_items, &z->enc))
+        return hd__err(w->err, HD_ENOMEM, "out of memory");
+    if (put_chunk(z, z->n_out, z->out, &z->enc)) return hd__err(w->err, HD_ENOMEM, "out of memory");
+    z->n_out = 0;
+    return HD_OK;
+}
+
+/* Every input chunk decoded to records; the kept ones, with their values,
+ * gathered into output chunks of `per` points (0: the input's chunks). */
+static int write_chunks(pw_t *z, const hd__las_header_t *h, const hd__laz_chunks_t *c, hd__read_t *r, size_t per) {
+    hd__writer_t *w = z->w;
+    size_t most = 0, rec = z->pl->rec, orec = z->pl->out_rec;
+    for (size_t k = 0; k < c->n_chunks; k++)
+        if (c->first[k + 1] - c->first[k] > most) most = (size_t)(c->first[k + 1] - c->first[k]);
+    size_t cap = per ? per : most;
+    unsigned char *in = hd__malloc_array(most + 1, rec);
+    z->out = hd__malloc_array(cap + 1, orec);
+    if (!in || !z->out) {
+        free(in);
+        return hd__err(w->err, HD_ENOMEM, "out of memory for chunks of %zu points", most);
+    }
+    int rc = HD_OK;
+    for (size_t k = 0; k < c->n_chunks && rc == HD_OK && !w->werr; k++) {
+        size_t n = (size_t)(c->first[k + 1] - c->first[k]), f = (size_t)c->first[k];
+        if ((rc = hd__laz_chunk_records(r, h, c, k, in))) break;
+        for (size_t i = 0; i < n && rc == HD_OK; i++) {
+            if (!hd__w_keep(w, f + i)) continue;
+            unsigned char *o = z->out + z->n_out++ * orec;
+            memcpy(o, in + i * rec, rec);
+            if (z->pl->add) {
+                uint64_t u;
+                memcpy(&u, &w->v[f + i], 8);
+                hd__st_u64(o + rec, u);
+            }
+            z->by_return[hd__las_return(o, z->pl->fmt)]++;
+            hd__las_bound(z->bounds, o, z->scale, z->shift, z->kept++ == 0);
+            if (per && z->n_out == per) rc = flush_chunk(z);
+        }
+        if (!per && rc == HD_OK) rc = flush_chunk(z);
+    }
+    if (rc == HD_OK) rc = flush_chunk(z);
+    free(in);
+    return rc;
+}
+
+/* Every point kept, the input's chunks kept: the chunks are decoded and
+ * encoded in parallel, a batch of a few per thread at a time (each task
+ * with its own buffers, encoder and error), and written in order. */
+typedef struct {
+    pw_t *z;
+    const hd__las_header_t *h;
+    const hd__laz_chunks_t *c;
+    hd__read_t *r;
+    size_t base, most;
+    unsigned char **in, **out;
+    hd__enc_t *enc;
+    int *rc;
+    hd_error_t *err;
+} batch_t;
+
+static void batch_task(void *ctx, size_t t, int worker) {
+    (void)worker;
+    batch_t *B = ctx;
+    pw_t *z = B->z;
+    size_t k = B->base + t, n = (size_t)(B->c->first[k + 1] - B->c->first[k]), f = (size_t)B->c->first[k];
+    size_t rec = z->pl->rec, orec = z->pl->out_rec;
+    hd__read_t r = *B->r;
+    r.err = &B->err[t];
+    if (!B->in[t]) B->in[t] = hd__malloc_array(B->most + 1, rec);
+    if (!B->out[t]) B->out[t] = hd__malloc_array(B->most + 1, orec);
+    if (!B->in[t] || !B->out[t]) {
+        B->rc[t] = hd__err(&B->err[t], HD_ENOMEM, "out of memory for chunks of %zu points", B->most);
+        return;
+    }
+    int rc = hd__laz_chunk_records(&r, B->h, B->c, k, B->in[t]);
+    for (size_t i = 0; i < n && rc == HD_OK; i++) {
+        memcpy(B->out[t] + i * orec, B->in[t] + i * rec, rec);
+        uint64_t u;
+        memcpy(&u, &z->w->v[f + i], 8);
+        hd__st_u64(B->out[t] + i * orec + rec, u);
+    }
+    if (rc == HD_OK && hd__laz_encode_pointwise(B->out[t], n, orec, z->type, z->size, z->n_items, &B->enc[t]))
+        rc = hd__err(&B->err[t], HD_ENOMEM, "out of memory");
+    B->rc[t] = rc;
+}
+
+static int write_all_parallel(pw_t *z, const hd__las_header_t *h, const hd__laz_chunks_t *c, hd__read_t *r) {
+    hd__writer_t *w = z->w;
+    int threads = hd__thread_count(w->ropt->threads, c->n_chunks);
+    size_t per = 2 * (size_t)threads, most = 0;
+    for (size_t k = 0; k < c->n_chunks; k++)
+        if (c->first[k + 1] - c->first[k] > most) most = (size_t)(c->first[k + 1] - c->first[k]);
+    batch_t B = {z, h, c, r, 0, most, calloc(per, sizeof(void *)), calloc(per, sizeof(void *)),
+                 calloc(per, sizeof(hd__enc_t)), calloc(per, sizeof(int)), calloc(per, sizeof(hd_error_t))};
+    int rc = B.in && B.out && B.enc && B.rc && B.err ? HD_OK : hd__err(w->err, HD_ENOMEM, "out of memory");
+    for (size_t t = 0; rc == HD_OK && t < per; t++) hd__enc_init(&B.enc[t]);
+    for (B.base = 0; rc == HD_OK && B.base < c->n_chunks && !w->werr; B.base += per) {
+        size_t m = c->n_chunks - B.base < per ? c->n_chunks - B.base : per;
+        hd__parallel_for(threads, m, batch_task, &B);
+        for (size_t t = 0; t < m && rc == HD_OK; t++) {
+            if (B.rc[t]) {
+                rc = hd__err(w->err, B.rc[t], "%s", B.err[t].message);
+                break;
+            }
+            size_t k = B.base + t;
+            if (put_chunk(z, (size_t)(c->first[k + 1] - c->first[k]), B.out[t], &B.enc[t]))
+                rc = hd__err(w->err, HD_ENOMEM, "out of memory");
+        }
+    }
+    z->kept = w->n;
+    for (size_t t = 0; t < per; t++) {
+        if (B.in) free(B.in[t]);
+        if (B.out) free(B.out[t]);
+        if (B.enc) hd__enc_free(&B.enc[t]);
+    }
+    free(B.in), free(B.out), free(B.enc), free(B.rc), free(B.err);
+    return rc;
+}
+
+int hd__write_laz_pointwise(hd__writer_t *w, hd__las_plan_t *pl, const hd__las_header_t *h, const hd__laz_chunks_t *c,
+                            hd__read_t *r) {
+    if (!c->chunked)
+        return hd__err(w->err, HD_EUNSUPPORTED,
+                       "%s: LASzip 1.x compression (one stream, items of version 1): a field is written into "
+                       "chunked pointwise LAZ (LASzip 2 and later) only",
+                       w->in->name);
+    pw_t z;
+    memset(&z, 0, sizeof z);
+    z.w = w;
+    z.pl = pl;
+    hd__enc_init(&z.enc);
+    hd__las_scale(w->in->data, z.scale, z.shift);
+    int all = w->keep == HD_KEEP_ALL;
+    uint32_t chunk = all ? c->chunk_size : HD__LAZ_CHUNK;
+    int variable = chunk == 0 || chunk == 0xFFFFFFFFu;
+    int rc = plan_items(&z, c, chunk);
+    double lo, hi;
+    hd__w_range(w, &lo, &hi);
+    off_t head_at = 0, table_ptr = 0;
+    if (rc == HD_OK) {
+        pl->vlr_added += z.vlr_len - c->vlr_len;
+        pl->end = c->table_end;
+        /* provisional: counts, bounds and the offsets after the points are
+         * written again below */
+        hd__las_write_head(w, pl, 0, z.by_return, z.bounds, lo, hi, 0, z.vlr, c->vlr_at, z.vlr_len);
+        table_ptr = ftello(w->out);
+        unsigned char zero[8] = {0};
+        hd__w_put(w, zero, 8);
+        rc = all && pl->add ? write_all_parallel(&z, h, c, r) : write_chunks(&z, h, c, r, all ? 0 : HD__LAZ_CHUNK);
+    }
+    if (rc == HD_OK && !w->werr) {
+        off_t table = ftello(w->out);
+        unsigned char head[8] = {0, 0, 0, 0};
+        for (int b = 0; b < 4; b++) head[4 + b] = (unsigned char)(z.n_chunks >> (8 * b));
+        hd__w_put(w, head, 8);
+        if (hd__laz_table_encode(variable, z.n_chunks, z.counts, z.bytes, &z.enc)) rc = hd__err(w->err, HD_ENOMEM, "out of memory");
+        hd__w_put(w, z.enc.buf, z.enc.size);
+        hd__w_put(w, w->in->data + c->table_end, w->in->size - c->table_end); /* extended VLRs */
+        uint64_t points = (uint64_t)(ftello(w->out) - table_ptr) - (w->in->size - c->table_end);
+        if (rc == HD_OK && !w->werr && fseeko(w->out, head_at, SEEK_SET) != 0) w->werr = errno ? errno : EIO;
+        hd__las_write_head(w, pl, z.kept, z.by_return, z.bounds, lo, hi, points, z.vlr, c->vlr_at, z.vlr_len);
+        unsigned char t[8];
+        hd__st_u64(t, (uint64_t)table);
+        if (!w->werr && fseeko(w->out, table_ptr, SEEK_SET) != 0) w->werr = errno ? errno : EIO;
+        hd__w_put(w, t, 8);
+        if (!w->werr && fseeko(w->out, 0, SEEK_END) != 0) w->werr = errno ? errno : EIO;
+        w->written = (size_t)z.kept;
+    }
+    free(z.vlr);
+    free(z.out);
+    free(z.counts);
+    free(z.bytes);
+    hd__enc_free(&z.enc);
+    return rc;
+}

@@ -1,0 +1,206 @@
+"""Command-line tests of the files written back into the inputs' formats:
+--distances OUT when OUT has A's format (.las, .laz, text: a `distance`
+field added to A's file, B's to OUT_b; .ply stays the table), and
+--farther-than D OUT / --nearer-than D OUT (the points past D in their
+file's format), against the table --distances writes (.csv:
+x,y,z,distance,nearest), which gives every distance: the field written
+back equals it bit for bit (checked by parsers written here: text and PLY
+ascii lines, LAS extra bytes).  Mismatched formats, --sample, masks,
+hausdorff-mpi's and --surface's refusals are usage errors (exit 1) before
+anything is read; a file that cannot be written is exit 3 and leaves none.
+Standard library only; run as:  cli_writeback.py PATH/TO/hausdorff
+"""
+import json
+import os
+import shutil
+import struct
+import subprocess
+import sys
+import tempfile
+
+TOOL = None
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+A = os.path.join(ROOT, "data", "pinion_gear.ply")  # ascii PLY
+FACES = os.path.join(ROOT, "tests", "corpus", "ply", "binary_little_endian.ply")  # with faces
+B = os.path.join(ROOT, "data", "teapot_792.ply")
+LAS = os.path.join(ROOT, "data", "orig", "Haystack_Rock.las")
+LAS_B = os.path.join(ROOT, "tests", "corpus", "las", "v14_fmt6.las")
+LAZ = os.path.join(ROOT, "tests", "corpus", "laz", "fmt6_channels.laz")
+TESTS = []
+
+
+def test(fn):
+    TESTS.append(fn)
+    return fn
+
+
+def run(*args):
+    p = subprocess.run([TOOL] + list(args), capture_output=True, text=True, timeout=300)
+    return p.returncode, p.stdout, p.stderr
+
+
+def table(path):
+    """The distances of a --distances CSV, as floats parsed from their text."""
+    with open(path) as f:
+        rows = f.read().splitlines()[1:]
+    return [float(r.split(",")[3]) for r in rows]
+
+
+def ply_field(path, name="distance"):
+    """The values of a vertex property of an ascii PLY, parsed here."""
+    with open(path) as f:
+        lines = f.read().splitlines()
+    end = lines.index("end_header")
+    props, count, in_vertex = [], 0, False
+    for line in lines[:end]:
+        w = line.split()
+        if w[:2] == ["element", "vertex"]:
+            in_vertex, count = True, int(w[2])
+        elif w and w[0] == "element":
+            in_vertex = False
+        elif in_vertex and w and w[0] == "property":
+            props.append(w[-1])
+    col = props.index(name)
+    return [float(l.split()[col]) for l in lines[end + 1:end + 1 + count]]
+
+
+def las_field(path, name="distance"):
+    """An extra-bytes dimension (a double) of a LAS file, read from its VLR."""
+    d = open(path, "rb").read()
+    header, offset, n_vlr = struct.unpack_from("<HII", d, 94)
+    fmt, rec = d[104] & 0x3F, struct.unpack_from("<H", d, 105)[0]
+    count = struct.unpack_from("<I", d, 107)[0] or (struct.unpack_from("<Q", d, 247)[0] if header >= 375 else 0)
+    at, p = [20, 28, 26, 34, 57, 63, 30, 36, 38, 59, 67][fmt], header
+    for _ in range(n_vlr):
+        length = struct.unpack_from("<H", d, p + 20)[0]
+        if d[p + 2:p + 11] == b"LASF_Spec" and struct.unpack_from("<H", d, p + 18)[0] == 4:
+            for q in range(p + 54, p + 54 + length, 192):
+                if d[q + 4:q + 36].rstrip(b"\0").decode() == name:
+                    return [struct.unpack_from("<d", d, offset + k * rec + at)[0] for k in range(count)]
+                at += d[q + 3] if d[q + 2] == 0 else 8
+        p += 54 + length
+    raise KeyError(name)
+
+
+@test
+def ply_distances_stay_the_table_and_text_is_written_back(tmp):
+    """--distances OUT.ply is the table hausdorff-mpi writes too; a text A gets its column."""
+    rc, out, err = run("--distances", tmp + "/t.ply", FACES, B)
+    assert rc == 0, err
+    head = open(tmp + "/t.ply", "rb").read().split(b"end_header")[0].decode()
+    assert "property int nearest" in head and "element face" not in head, head
+    xyz = os.path.join(tmp, "a.xyz")
+    with open(xyz, "w") as f:
+        f.write("# a comment\n1.5 2 3\n4 5 6.25\n")
+    rc, out, err = run("--directed", "--distances", tmp + "/t.csv", xyz, B)
+    assert rc == 0, err
+    rc, out, err = run("--directed", "--distances", tmp + "/w.txt", xyz, B)
+    assert rc == 0, err
+    lines = open(tmp + "/w.txt").read().splitlines()
+    assert lines[0] == "# a comment" and lines[1].startswith("1.5 2 3 ") and lines[2].startswith("4 5 6.25 "), lines
+    assert [float(l.split()[3]) for l in lines[1:]] == table(tmp + "/t.csv")
+
+
+@test
+def farther_and_nearer_split_the_points(tmp):
+    d = table_of(tmp)
+    D = sorted(d)[len(d) // 2]
+    rc, out, err = run("--json", "--farther-than", str(D), tmp + "/far.ply", "--nearer-than", str(D), tmp + "/near.ply",
+                       A, B)
+    assert rc == 0, err
+    j = json.loads(out)
+    far, near = ply_field(tmp + "/far.ply"), ply_field(tmp + "/near.ply")
+    assert far == [x for x in d if x > D] and near == [x for x in d if x <= D]
+    assert j["farther_than"]["a"] == {"file": tmp + "/far.ply", "points": len(far)}
+    assert j["nearer_than"]["b"]["points"] + j["farther_than"]["b"]["points"] == 792
+    head = open(tmp + "/far.ply").read().split("end_header")[0]
+    assert "element vertex %d" % len(far) in head and "element face" not in head
+
+
+def table_of(tmp):
+    rc, out, err = run("--directed", "--distances", tmp + "/d.csv", A, B)
+    assert rc == 0, err
+    return table(tmp + "/d.csv")
+
+
+@test
+def las_gets_an_extra_bytes_dimension(tmp):
+    rc, out, err = run("--directed", "--distances", tmp + "/t.csv", LAS, LAS_B)
+    assert rc == 0, err
+    rc, out, err = run("--directed", "--distances", tmp + "/w.las", LAS, LAS_B)
+    assert rc == 0, err
+    assert las_field(tmp + "/w.las") == table(tmp + "/t.csv")
+    rc, out, err = run("--directed", "--farther-than", "0", tmp + "/f.las", LAS, LAS_B)
+    assert rc == 0, err
+    assert las_field(tmp + "/f.las") == [x for x in table(tmp + "/t.csv") if x > 0]
+
+
+@test
+def laz_written_back_reads_back(tmp):
+    rc, out, err = run("--directed", "--distances", tmp + "/w.laz", LAZ, LAS_B)
+    assert rc == 0, err
+    rc2, out2, err2 = run("--directed", tmp + "/w.laz", LAS_B)
+    rc3, out3, err3 = run("--directed", LAZ, LAS_B)
+    assert rc2 == 0 and out2.splitlines()[2] == out3.splitlines()[2], (err2, out2, out3)  # h(A,B)
+
+
+@test
+def mismatches_are_usage_errors_before_reading(tmp):
+    cases = [
+        (["--distances", tmp + "/o.las", A, B], "A (%s) is ply, %s/o.las is las" % (A, tmp)),
+        (["--farther-than", "1", tmp + "/o.ply", LAS, B], "is las, %s/o.ply is ply" % tmp),
+        (["--farther-than", "1", tmp + "/o.ply", A, LAS], "B (%s) is las" % LAS),
+        (["--sample", "100", "--farther-than", "0", tmp + "/o.ply", FACES, B],
+         "with --sample the points are drawn on the faces"),
+        (["--farther-than", "x", tmp + "/o.ply", A, B], "needs a distance >= 0"),
+        (["--farther-than", "1", tmp + "/o.dat", A, B], "cannot tell the format of"),
+        (["--farther-than", "1"], "needs a distance and a file"),
+        (["--surface", "--farther-than", "1", tmp + "/o.ply", A, B], "not written with --surface"),
+    ]
+    for args, needle in cases:
+        rc, out, err = run(*args)
+        assert rc == 1, (args, rc, err)
+        assert err.startswith("hausdorff: ") and needle in err, (args, err)
+    assert os.listdir(tmp) == [], os.listdir(tmp)
+
+
+@test
+def an_unwritable_file_is_exit_3_and_leaves_nothing(tmp):
+    rc, out, err = run("--farther-than", "0", tmp + "/missing/far.ply", A, B)
+    assert rc == 3, (rc, err)
+    assert err.startswith("hausdorff: %s/missing/far.ply: cannot write" % tmp), err
+    rc, out, err = run("--directed", "--distances", tmp + "/w.ply", tmp + "/x.ply", B)
+    assert rc == 2, (rc, err)  # A missing: its read fails before anything is written
+    assert os.listdir(tmp) == [], os.listdir(tmp)
+
+
+@test
+def a_field_already_there_is_refused(tmp):
+    rc, out, err = run("--directed", "--farther-than", "0", tmp + "/w.ply", A, B)
+    assert rc == 0, err
+    rc, out, err = run("--directed", "--farther-than", "0", tmp + "/w2.ply", tmp + "/w.ply", B)
+    assert rc != 0 and "already has a property 'distance'" in err, (rc, err)
+    assert not os.path.exists(tmp + "/w2.ply")
+
+
+def main():
+    global TOOL
+    TOOL = os.path.abspath(sys.argv[1])
+    passed = failed = 0
+    for fn in TESTS:
+        tmp = tempfile.mkdtemp(prefix="hd-writeback-")
+        try:
+            fn(tmp)
+            passed += 1
+            print("ok   " + fn.__name__)
+        except AssertionError as e:
+            failed += 1
+            print("FAIL %s: %s" % (fn.__name__, e))
+        finally:
+            shutil.rmtree(tmp, ignore_errors=True)
+    print("%d passed, %d failed" % (passed, failed))
+    sys.exit(1 if failed else 0)
+
+
+main()

@@ -1,0 +1,312 @@
+/*
+ * test_write_laz.c -- hd_write_field into layered LAZ (src/io/write_laz.c):
+ * files of the tests' LAZ writer (random points in every scanner channel,
+ * fixed and variable chunks, with and without extra bytes) get a field;
+ * the output is taken apart here: its header and LASzip VLR, its chunk
+ * table, every chunk's old layers byte for byte as they were, and the
+ * eight new BYTE14 layers decoded by this file's own loop over the
+ * coder's primitives with LASzip's v3 rule for the scanner channels (the
+ * channel of each point known from the points given to the writer), so
+ * every value comes back bit for bit.  Pointwise LAZ (formats 0-3) whose
+ * every field varies, compressed by the library's pointwise encoder, is
+ * decoded back to its records, and hd_write_field's output (all points, a
+ * subset) to the same records with the values after them.  laz-perf
+ * checks these outputs too where it can (tests/laz_lazperf.py, field_*
+ * cases).  And the LAZ refusals.
+ */
+#include "check.h"
+#include "files.h"
+#include "gen.h"
+#include "lazwrite.h"
+
+#include "io/io.h"
+#include "io/lasfield.h"
+#include "io/lazcoder.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+static uint64_t le(const unsigned char *p, int n) {
+    uint64_t v = 0;
+    for (int i = n - 1; i >= 0; i--) v = v << 8 | p[i];
+    return v;
+}
+
+
+typedef struct {
+    size_t offset, rec, vlr; /* the LASzip VLR's data */
+    unsigned n_items, last_type, last_size;
+    uint64_t table;
+} laz_t;
+
+static void parse(const unsigned char *d, laz_t *L) {
+    L->offset = le(d + 96, 4);
+    L->rec = le(d + 105, 2);
+    size_t p = le(d + 94, 2);
+    for (unsigned i = 0; i < le(d + 100, 4); i++) {
+        if (memcmp(d + p + 2, "laszip encoded", 14) == 0) L->vlr = p + 54;
+        p += 54 + le(d + p + 20, 2);
+    }
+    L->n_items = (unsigned)le(d + L->vlr + 32, 2);
+    L->last_type = (unsigned)le(d + L->vlr + 34 + 6 * (L->n_items - 1), 2);
+    L->last_size = (unsigned)le(d + L->vlr + 34 + 6 * (L->n_items - 1) + 2, 2);
+    L->table = le(d + L->offset, 8);
+}
+
+/* The chunk table's byte sizes (and counts when variable) of nc chunks. */
+static void table(const unsigned char *d, size_t size, uint64_t at, int variable, size_t nc, uint32_t *bytes,
+                  uint32_t *counts) {
+    hd__intcoder_t ic;
+    CHECK(hd__intcoder_new(&ic, 32, 2) == HD_OK);
+    hd__dec_t dec;
+    hd__dec_init(&dec, d + at + 8, size - at - 8);
+    uint32_t pc = 0, pb = 0;
+    for (size_t k = 0; k < nc; k++) {
+        if (variable) pc = counts[k] = (uint32_t)hd__ic_decode(&ic, &dec, (int32_t)pc, 0);
+        pb = bytes[k] = (uint32_t)hd__ic_decode(&ic, &dec, (int32_t)pb, 1);
+    }
+    hd__intcoder_free(&ic);
+}
+
+/* The eight BYTE14 layers at `layers` (sizes `sz`) of a chunk of n
+ * points with channels p[].channel, decoded with LASzip's v3 rule: a
+ * channel's models and last bytes start from the last bytes of the
+ * channel before it when it first appears; at a switch to a channel seen
+ * before, the point is predicted from (and updates) the last bytes of
+ * the channel it follows. */
+static void decode_bytes(const unsigned char *first, const unsigned char *layers, const uint32_t sz[8],
+                         const lazw_point_t *p, size_t n, double *out) {
+    hd__dec_t dec[8];
+    hd__symmodel_t m[4][8];
+    unsigned char last[4][8];
+    int used[4] = {0};
+    size_t at = 0;
+    for (int b = 0; b < 8; b++) {
+        hd__dec_init(&dec[b], layers + at, sz[b]);
+        at += sz[b];
+        for (int c = 0; c < 4; c++) CHECK(hd__symmodel_new(&m[c][b], 256) == HD_OK);
+    }
+    unsigned cur = p[0].channel;
+    memcpy(last[cur], first, 8);
+    used[cur] = 1;
+    memcpy(&out[0], first, 8);
+    for (size_t i = 1; i < n; i++) {
+        unsigned char *L = last[cur];
+        if (p[i].channel != cur) {
+            cur = p[i].channel;
+            if (!used[cur]) {
+                used[cur] = 1;
+                memcpy(last[cur], L, 8);
+                L = last[cur];
+            }
+        }
+        for (int b = 0; b < 8; b++)
+            if (sz[b]) L[b] = (unsigned char)(L[b] + hd__dec_symbol(&dec[b], &m[cur][b]));
+        memcpy(&out[i], L, 8);
+    }
+    for (int b = 0; b < 8; b++) {
+        CHECK(sz[b] == 0 || (dec[b].over == 0 && dec[b].p == dec[b].end)); /* each layer used up exactly */
+        for (int c = 0; c < 4; c++) hd__symmodel_free(&m[c][b]);
+    }
+}
+
+static void laz_case(const lazw_opts_t *o, size_t n, uint64_t seed) {
+    CONTEXT("format %d extra %u chunk %u seed %llu", o->format, o->extra, o->chunk_size, (unsigned long long)seed);
+    gen_rng_t g;
+    gen_seed(&g, seed);
+    lazw_point_t *p = malloc(n * sizeof *p);
+    lazw_random(&g, p, n, o->format);
+    tf_buf_t b = {0};
+    lazw_encode(&b, o, p, n);
+    size_t nin = b.size;
+    unsigned char *src = malloc(nin);
+    memcpy(src, b.data, nin);
+    const char *in = tf_finish(&b, "in.laz");
+    double *v = malloc(n * sizeof *v), *got = malloc(n * sizeof *got);
+    for (size_t k = 0; k < n; k++) /* runs of equal values, small steps, any double */
+        v[k] = k % 5 == 0 ? gen_unit(&g) * 1e3 : k % 5 == 1 ? v[k - 1] : k % 5 == 2 ? v[k - 1] + 1e-9 : gen_normal(&g);
+    const char *out = tf_path("out.laz");
+    hd_error_t err;
+    size_t written = 0;
+    CHECK_RC(hd_write_field(in, out, v, n, NULL, &written, &err), HD_OK);
+    CHECK_EQ(written, n);
+    size_t no;
+    unsigned char *d = tf_read(out, &no);
+    laz_t I, O;
+    parse(src, &I);
+    parse(d, &O);
+    CHECK_EQ(O.rec, I.rec + 8);
+    CHECK_EQ(O.last_type, 14);
+    CHECK_EQ(O.last_size, o->extra + 8);
+    CHECK_EQ(O.n_items, I.n_items + (o->extra == 0));
+    size_t nc = o->chunk_size ? (n + o->chunk_size - 1) / o->chunk_size : o->n_chunks;
+    uint32_t *ib = calloc(nc, 4), *ob = calloc(nc, 4), *ic = calloc(nc, 4), *oc = calloc(nc, 4);
+    table(src, nin, I.table, !o->chunk_size, nc, ib, ic);
+    table(d, no, O.table, !o->chunk_size, nc, ob, oc);
+    CHECK(memcmp(ic, oc, nc * 4) == 0);
+    size_t at_i = I.offset + 8, at_o = O.offset + 8, first = 0, layers = 9 + o->extra;
+    for (size_t c = 0; c < nc && !hdt_failed(); c++) {
+        size_t k = o->chunk_size ? (n - first < o->chunk_size ? n - first : o->chunk_size) : o->chunks[c];
+        const unsigned char *ci = src + at_i, *co = d + at_o;
+        CHECK(memcmp(co, ci, I.rec) == 0);                           /* the first point */
+        CHECK(memcmp(co + I.rec + 8, ci + I.rec, 4 + 4 * layers) == 0); /* count, old sizes */
+        uint32_t sz[8], old = 0, add = 0;
+        for (size_t q = 0; q < layers; q++) old += (uint32_t)le(ci + I.rec + 4 + 4 * q, 4);
+        for (int q = 0; q < 8; q++) add += sz[q] = (uint32_t)le(co + I.rec + 8 + 4 + 4 * layers + 4 * q, 4);
+        size_t hi = I.rec + 4 + 4 * layers, ho = hi + 8 + 32;
+        CHECK(memcmp(co + ho, ci + hi, old) == 0); /* the old layers */
+        CHECK_EQ(ob[c], ib[c] + 8 + 32 + add);
+        decode_bytes(co + I.rec, co + ho + old, sz, p + first, k, got + first);
+        at_i += ib[c];
+        at_o += ob[c];
+        first += k;
+    }
+    for (size_t k = 0; k < n && !hdt_failed(); k++) CHECK_BITS(got[k], v[k]);
+    /* the points read back as before */
+    hd_cloud_t *a = NULL, *c = NULL;
+    CHECK_RC(hd_read_file(in, NULL, &a, &err), HD_OK);
+    CHECK_RC(hd_read_file(out, NULL, &c, &err), HD_OK);
+    CHECK(a && c && a->count == c->count && memcmp(a->data, c->data, 3 * n * sizeof(double)) == 0);
+    hd_cloud_free(a);
+    hd_cloud_free(c);
+    free(ib), free(ob), free(ic), free(oc);
+    free(d), free(src), free(v), free(got), free(p);
+}
+
+TEST(layered_laz_gains_the_field_as_byte14_layers) {
+    lazw_opts_t o = {6, 0, 50, NULL, 0, {0.01, 0.01, 0.001}, {1000.5, -20.25, 3}, 0};
+    for (uint64_t seed = 1; seed <= 3; seed++) laz_case(&o, 1000, seed);
+    o.extra = 3; /* a BYTE14 item grows */
+    laz_case(&o, 777, 4);
+    size_t chunks[4] = {1, 300, 2, 197};
+    lazw_opts_t v = {6, 2, 0, chunks, 4, {0.01, 0.01, 0.01}, {0, 0, 0}, 0};
+    laz_case(&v, 500, 5);
+    o.chunk_size = 1; /* one-point chunks: empty layers */
+    laz_case(&o, 5, 6);
+}
+
+TEST(laz_extended_vlrs_follow_the_points_with_their_offset_moved) {
+    gen_rng_t g;
+    gen_seed(&g, 31);
+    lazw_point_t p[300];
+    lazw_random(&g, p, 300, 6);
+    lazw_opts_t o = {6, 0, 100, NULL, 0, {0.01, 0.01, 0.01}, {0, 0, 0}, 0};
+    tf_buf_t b = {0};
+    lazw_encode(&b, &o, p, 300);
+    uint64_t at = b.size; /* an extended VLR after the chunk table */
+    for (int i = 0; i < 8; i++) b.data[235 + i] = (unsigned char)(at >> 8 * i);
+    b.data[243] = 1;
+    char user[16] = "someone", desc[32] = "kept";
+    tf_u16(&b, 0, 0), tf_put(&b, user, 16), tf_u16(&b, 9, 0), tf_u64(&b, 4, 0), tf_put(&b, desc, 32), tf_put(&b, "EVLR", 4);
+    const char *in = tf_finish(&b, "evlr.laz");
+    double v[300];
+    for (int k = 0; k < 300; k++) v[k] = k * 0.5;
+    hd_error_t err;
+    CHECK_RC(hd_write_field(in, tf_path("evlr_out.laz"), v, 300, NULL, NULL, &err), HD_OK);
+    size_t n;
+    unsigned char *d = tf_read(tf_path("evlr_out.laz"), &n);
+    CHECK(d && n > 64 && memcmp(d + n - 4, "EVLR", 4) == 0);
+    CHECK_EQ(le(d + 235, 8), n - 64);
+    CHECK_EQ(le(d + 243, 4), 1);
+    hd_cloud_t *c = NULL;
+    CHECK_RC(hd_read_file(tf_path("evlr_out.laz"), NULL, &c, &err), HD_OK);
+    CHECK(c && c->count == 300);
+    hd_cloud_free(c);
+    free(d);
+}
+
+/* ---- pointwise LAZ: every field compressed again ------------------------- */
+/* Every whole record of the LAZ file at path, decoded by laz.c. */
+static unsigned char *records_of(const char *path, size_t *n, size_t *rec) {
+    size_t size;
+    unsigned char *d = tf_read(path, &size);
+    hd__file_t f = {path, d, size};
+    hd_read_options_t o;
+    hd_read_options_init(&o);
+    hd__sink_t sink;
+    hd__sink_init(&sink, HD_FLOAT64);
+    hd_error_t err;
+    hd__read_t r = {&f, &o, 1, &sink, NULL, 0, &err, 0, 0, 0};
+    hd__las_header_t h;
+    memset(&h, 0, sizeof h);
+    h.minor = d[25], h.fmt = d[104] & 63, h.header = le(d + 94, 2), h.offset = le(d + 96, 4), h.rec = le(d + 105, 2);
+    h.count = le(d + 107, 4), h.n_vlr = (uint32_t)le(d + 100, 4);
+    hd__laz_chunks_t c;
+    CHECK_RC(hd__laz_chunks(&r, &h, &c), HD_OK);
+    unsigned char *out = calloc(h.count + 1, h.rec);
+    for (size_t k = 0; k < c.n_chunks && !hdt_failed(); k++) {
+        int rc = hd__laz_chunk_records(&r, &h, &c, k, out + c.first[k] * h.rec);
+        if (rc) CONTEXT("%s", err.message);
+        CHECK_RC(rc, HD_OK);
+    }
+    hd__laz_chunks_free(&c);
+    *n = h.count, *rec = h.rec;
+    free(d);
+    return out;
+}
+
+TEST(pointwise_laz_is_compressed_again_with_every_field) {
+    for (int fmt = 0; fmt <= 3; fmt++)
+        for (unsigned extra = 0; extra <= 3; extra += 3) {
+            CONTEXT("format %d extra %u", fmt, extra);
+            gen_rng_t g;
+            gen_seed(&g, 77 + (uint64_t)fmt * 10 + extra);
+            size_t n = 3001, rec;
+            unsigned char *recs = lazw_rich_records(&g, fmt, extra, n, &rec);
+            tf_buf_t b = {0};
+            lazw_pointwise(&b, fmt, extra, recs, rec, n, 1000);
+            const char *in = tf_finish(&b, "rich.laz");
+            size_t m, mrec;
+            unsigned char *back = records_of(in, &m, &mrec); /* the encoder's file decodes to its records */
+            CHECK(m == n && mrec == rec && memcmp(back, recs, n * rec) == 0);
+            free(back);
+            double *v = malloc(n * sizeof *v);
+            for (size_t k = 0; k < n; k++) v[k] = k % 4 ? gen_normal(&g) : 0.5;
+            hd_error_t err;
+            hd_write_options_t o;
+            hd_write_options_init(&o);
+            for (int keep = 0; keep < 2; keep++) {
+                o.keep = keep ? HD_KEEP_FARTHER : HD_KEEP_ALL;
+                o.threshold = 0.25;
+                size_t written = 0;
+                CHECK_RC(hd_write_field(in, tf_path("rich_out.laz"), v, n, &o, &written, &err), HD_OK);
+                unsigned char *out = records_of(tf_path("rich_out.laz"), &m, &mrec);
+                CHECK(mrec == rec + 8 && m == written);
+                for (size_t k = 0, j = 0; k < n && !hdt_failed(); k++) {
+                    if (keep && !(v[k] > 0.25)) continue;
+                    CHECK(memcmp(out + j * mrec, recs + k * rec, rec) == 0);
+                    double got;
+                    memcpy(&got, out + j * mrec + rec, 8);
+                    CHECK_BITS(got, v[k]);
+                    j++;
+                }
+                free(out);
+            }
+            free(v);
+            free(recs);
+        }
+}
+
+TEST(laszip1_streams_and_layered_subsets_are_refused_by_name) {
+    gen_rng_t g;
+    gen_seed(&g, 9);
+    lazw_point_t p[20];
+    lazw_random(&g, p, 20, 1);
+    lazw_opts_t o = {1, 0, 10, NULL, 0, {0.01, 0.01, 0.01}, {0, 0, 0}, 1};
+    tf_buf_t b = {0};
+    lazw_encode(&b, &o, p, 20);
+    const char *in = tf_finish(&b, "v1.laz");
+    double v[20] = {0};
+    hd_error_t err;
+    CHECK_RC(hd_write_field(in, tf_path("v1_out.laz"), v, 20, NULL, NULL, &err), HD_EUNSUPPORTED);
+    CHECK(strstr(err.message, "LASzip 1.x compression"));
+    lazw_random(&g, p, 20, 6);
+    o.format = 6, o.v1 = 0;
+    lazw_encode(&b, &o, p, 20);
+    in = tf_finish(&b, "l.laz");
+    hd_write_options_t w;
+    hd_write_options_init(&w);
+    w.keep = HD_KEEP_FARTHER;
+    CHECK_RC(hd_write_field(in, tf_path("l_out.laz"), v, 20, &w, NULL, &err), HD_EUNSUPPORTED);
+    CHECK(strstr(err.message, "a subset of a layered LAZ file (point format 6) is not written"));
+}
