@@ -11,3 +11,6 @@ hd_add_bench(percentile_bench ${CMAKE_CURRENT_LIST_DIR}/percentile_bench.c ${CMA
 # phase by phase (build, each direction), against the Hausdorff distance.
 hd_add_bench(field_bench ${CMAKE_CURRENT_LIST_DIR}/field_bench.c ${CMAKE_CURRENT_LIST_DIR}/support/field_cases.c)
 target_include_directories(field_bench PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/src)
+# field_histogram_bench: histograms from bounds (hd_hausdorff_histogram)
+# against every distance then hd_histogram, on issue 39's cases a-e.
+hd_add_bench(field_histogram_bench ${CMAKE_CURRENT_LIST_DIR}/field_histogram_bench.c ${CMAKE_CURRENT_LIST_DIR}/support/field_cases.c)

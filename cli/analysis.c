@@ -73,6 +73,14 @@ static int analysis_percentile_only(const analysis_args_t *an) {
            !an->render_out && !an->histogram_png && !an->subset[0].on && !an->subset[1].on;
 }
 
+/* Only the percentile and the histogram asked for (the text or JSON
+ * histogram, not its picture): the library gives both without every
+ * distance. */
+static int analysis_from_bounds(const analysis_args_t *an) {
+    return (an->percentile_on || an->histogram) && !an->mean && !an->chamfer && !an->distances_out &&
+           !an->render_out && !an->histogram_png && !an->n_taus && an->dtu_cap <= 0;
+}
+
 /* ---- empty sets ------------------------------------------------------------ */
 
 static int alloc_fail(hd_error_t *err, size_t n) {
@@ -296,6 +304,30 @@ void analysis_render_title(const char *path_a, size_t n_a, const char *path_b, c
              last_name(path_b, base_b));
 }
 
+/* --histogram (with or without --percentile) from the library's bounds
+ * instead of every distance: the range's top is --max-distance or the
+ * Hausdorff distance s, the largest distance of either direction. */
+static int histogram_from_bounds(const analysis_args_t *an, const hd_options_t *opt, const hd_points_t *A,
+                                 const hd_points_t *B, const hd_symmetric_t *s, analysis_result_t *r,
+                                 hd_error_t *err) {
+    double t0 = cli_now();
+    int rc = HD_OK;
+    if (an->percentile_on) rc = hd_hausdorff_percentile(A, B, opt, an->percentile, &r->pct, err);
+    double largest = s->ab.distance >= s->ba.distance ? s->ab.distance : s->ba.distance;
+    r->hist_lo = 0.0;
+    r->hist_hi = an->max_distance > 0 ? an->max_distance : largest;
+    r->hist_ab = calloc(an->bins, sizeof *r->hist_ab);
+    r->hist_ba = calloc(an->bins, sizeof *r->hist_ba);
+    if (rc == HD_OK && (!r->hist_ab || !r->hist_ba)) rc = alloc_fail(err, an->bins);
+    if (rc == HD_OK)
+        rc = hd_hausdorff_histogram(A, B, opt, an->bins, r->hist_lo, r->hist_hi, r->hist_ab, r->hist_ba, err);
+    r->seconds = cli_now() - t0;
+    if (rc) return rc;
+    r->above_ab = beyond(r->hist_ab, an->bins, r->n_a);
+    r->above_ba = beyond(r->hist_ba, an->bins, r->n_b);
+    return HD_OK;
+}
+
 int analysis_run(const analysis_args_t *an, const hd_options_t *opt,
                  const hd_points_t *A, const hd_points_t *B,
                  const hd_symmetric_t *s, int directed, const char *path_a,
@@ -312,6 +344,7 @@ int analysis_run(const analysis_args_t *an, const hd_options_t *opt,
         r->seconds = cli_now() - t0;
         return rc;
     }
+    if (!directed && analysis_from_bounds(an)) return histogram_from_bounds(an, opt, A, B, s, r, err);
     r->d_ab = malloc(A->count * sizeof *r->d_ab);
     r->j_ab = malloc(A->count * sizeof *r->j_ab);
     if (!r->d_ab || !r->j_ab) return alloc_fail(err, A->count);

@@ -521,6 +521,26 @@ HD_EXTERN int hd_histogram(const double *values, size_t n, double lo,
 HD_EXTERN double hd_histogram_edge(double lo, double hi, size_t bins,
                                    size_t k);
 
+/* The histograms hd_histogram gives of the distances of A's points to B
+ * (counts_ab) and of B's points to A (counts_ba), as hd_distances computes
+ * them, without computing every distance: a point whose cheap lower and
+ * upper bounds on its distance fall in one bin (or both outside [lo, hi])
+ * is counted from them; only the others get their exact distance.  The
+ * counts equal hd_histogram's on every exact distance, to the count, at
+ * any thread count.  counts_ab (required) and counts_ba (NULL: that
+ * direction is skipped) have `bins` elements each, owned by the caller,
+ * and are overwritten.  opt may be NULL (the defaults); opt->threads is
+ * used.  Errors: HD_EINVAL (NULL counts_ab, bins = 0, lo > hi, a bound
+ * not finite, negative threads, invalid points), HD_ERANGE (hi - lo
+ * overflows), HD_EEMPTY (an empty set), HD_ENOMEM; the counts are then
+ * unspecified.  Thread-safe on distinct outputs. */
+HD_EXTERN int hd_hausdorff_histogram(const hd_points_t *A,
+                                     const hd_points_t *B,
+                                     const hd_options_t *opt, size_t bins,
+                                     double lo, double hi,
+                                     uint64_t *counts_ab, uint64_t *counts_ba,
+                                     hd_error_t *err);
+
 /* ------------------------------------------------------------------------
  * Scores at a distance tolerance, and capped means.  From per-point
  * distances (hd_distances, or any caller's): docs/analysis.md, "Scores at

@@ -252,60 +252,76 @@ int hd_summarize(const double *d_ab, size_t n_a, const double *d_ba,
 
 /* ---- histograms --------------------------------------------------------- */
 
-/* numpy widens an empty range by half a unit on each side. */
-static void widen(double *lo, double *hi) {
-    if (*lo == *hi) {
-        *lo = *lo - 0.5;
-        *hi = *hi + 0.5;
-    }
-}
-
-/* Edge k of `bins` equal bins on [lo, hi] (lo < hi), as numpy.linspace. */
-static double edge(double lo, double hi, size_t bins, size_t k) {
-    if (k >= bins) return hi;
-    double delta = hi - lo, step = delta / (double)bins;
-    if (step == 0.0) return (double)k / (double)bins * delta + lo;
-    return (double)k * step + lo;
-}
-
 double hd_histogram_edge(double lo, double hi, size_t bins, size_t k) {
-    widen(&lo, &hi);
-    return edge(lo, hi, bins, k);
+    hd__hist_t h = {lo, hi, 0.0, bins};
+    if (lo == hi) h.lo = lo - 0.5, h.hi = hi + 0.5; /* numpy widens an empty range */
+    return hd__hist_edge(&h, k);
 }
 
 int hd_histogram(const double *values, size_t n, double lo, double hi,
                  size_t bins, uint64_t *counts, hd_error_t *err) {
     hd__err_clear(err);
     if ((!values && n) || !counts) return hd__err(err, HD_EINVAL, "values or counts pointer is NULL");
-    if (bins == 0) return hd__err(err, HD_EINVAL, "a histogram needs at least one bin");
-    if (!isfinite(lo) || !isfinite(hi) || lo > hi)
-        return hd__err(err, HD_EINVAL, "histogram range [%g, %g] is not a finite interval", lo, hi);
-    widen(&lo, &hi);
-    if (!isfinite(hi - lo))
-        return hd__err(err, HD_ERANGE, "histogram range [%g, %g] is too wide", lo, hi);
+    hd__hist_t h;
+    int rc = hd__hist_init(&h, lo, hi, bins, err);
+    if (rc) return rc;
     memset(counts, 0, bins * sizeof *counts);
-    double norm = (double)bins / (hi - lo);
     for (size_t k = 0; k < n; k++) {
-        double x = values[k];
-        if (!(x >= lo && x <= hi)) continue; /* outside, or NaN */
-        if (isinf(norm)) { /* a subnormal range (numpy's product is NaN or inf there): the last
-                              bin whose lower edge is at most x, by bisection of the edges */
-            size_t b = 0, top = bins - 1;
-            while (b < top) {
-                size_t mid = b + (top - b + 1) / 2;
-                if (x >= edge(lo, hi, bins, mid)) b = mid;
-                else top = mid - 1;
-            }
-            counts[b]++;
-            continue;
-        }
-        double f = (x - lo) * norm;
-        size_t b = f >= (double)bins ? bins : (size_t)f;
-        if (b == bins) b--;
-        /* numpy's corrections for values that rounding put in a neighbour */
-        if (x < edge(lo, hi, bins, b)) b--;
-        else if (b != bins - 1 && x >= edge(lo, hi, bins, b + 1)) b++;
-        counts[b]++;
+        size_t guess, b = hd__hist_place(&h, values[k], &guess);
+        if (b != SIZE_MAX) counts[b]++;
     }
     return HD_OK;
+}
+
+/* Every distance, then hd_histogram (sets beyond the structures' size). */
+static int histogram_all(const hd_points_t *A, const hd_points_t *B, const hd_options_t *opt, size_t bins,
+                         double lo, double hi, uint64_t *counts_ab, uint64_t *counts_ba, hd_error_t *err) {
+    int rc = HD_OK;
+    double *ab = hd__malloc_array(A->count, sizeof *ab);
+    double *ba = counts_ba ? hd__malloc_array(B->count, sizeof *ba) : NULL;
+    if (!ab || (counts_ba && !ba))
+        rc = hd__err(err, HD_ENOMEM, "cannot allocate %zu + %zu distances", A->count, B->count);
+    if (rc == HD_OK) rc = hd_distances(A, B, opt, ab, NULL, ba, NULL, err);
+    if (rc == HD_OK) rc = hd_histogram(ab, A->count, lo, hi, bins, counts_ab, err);
+    if (rc == HD_OK && counts_ba) rc = hd_histogram(ba, B->count, lo, hi, bins, counts_ba, err);
+    free(ab);
+    free(ba);
+    return rc;
+}
+
+int hd_hausdorff_histogram(const hd_points_t *A, const hd_points_t *B,
+                           const hd_options_t *opt, size_t bins, double lo,
+                           double hi, uint64_t *counts_ab,
+                           uint64_t *counts_ba, hd_error_t *err) {
+    hd__err_clear(err);
+    if (!counts_ab) return hd__err(err, HD_EINVAL, "counts pointer is NULL");
+    if (opt && opt->threads < 0)
+        return hd__err(err, HD_EINVAL, "threads must be 0 (every core) or positive, not %d", opt->threads);
+    hd__hist_t h;
+    int rc;
+    if ((rc = hd__hist_init(&h, lo, hi, bins, err))) return rc;
+    hd__box_t box_a, box_b;
+    size_t most = A && B ? (A->count > B->count ? A->count : B->count) : 1;
+    int threads = hd__thread_count(opt ? opt->threads : 0, most);
+    if ((rc = hd__points_scan(A, "A", threads, &box_a, err))) return rc;
+    if ((rc = hd__points_scan(B, "B", threads, &box_b, err))) return rc;
+    if (A->count > HD__AN_MAX_POINTS || B->count > HD__AN_MAX_POINTS)
+        return histogram_all(A, B, opt, bins, lo, hi, counts_ab, counts_ba, err);
+    /* The structures hd_distances builds; only the points of the buckets
+     * whose bounds straddle an edge get their distances
+     * (nearest/allnearest.c). */
+    hd__box_t keybox = box_a;
+    hd__box_merge(&keybox, &box_b);
+    hd__an_t s[2];
+    if ((rc = hd__an_build_pair(A, B, &keybox, threads, s, err))) return rc;
+    const hd_points_t *set[2] = {A, B};
+    int same = A->count == B->count; /* as hd_distances: a copy and its original may pair up */
+    uint64_t *counts[2] = {counts_ab, counts_ba};
+    for (int d = 0; d < 2; d++)
+        if (counts[d]) memset(counts[d], 0, bins * sizeof *counts[d]);
+    for (int d = 0; d < 2 && rc == HD_OK; d++)
+        if (counts[d]) rc = hd__an_hist(&s[d], &s[1 - d], set[d], same ? set[1 - d] : NULL, &keybox, &h, threads, counts[d], err);
+    hd__an_free(&s[0]);
+    hd__an_free(&s[1]);
+    return rc;
 }

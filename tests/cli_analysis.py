@@ -130,6 +130,25 @@ def histogram_counts_are_numpys(tmp):
     assert "histogram of distances (5 bins" in out
 
 
+@test
+def histogram_from_bounds_equals_the_histogram_of_every_distance(tmp):
+    # --histogram alone or with --percentile counts from the library's
+    # bounds (hd_hausdorff_histogram); with --mean every distance is
+    # computed: the same counts, numpy's, at 1 and 3 threads
+    for name, pa, pb, dab, dba in cases_with_files(tmp):
+        top = max(dab.max(), dba.max())
+        for bins, extra in ((1, []), (20, ["--percentile", "95"]), (500, []), (9, ["--max-distance", repr(top / 3)])):
+            hi = top / 3 if "--max-distance" in extra else top
+            want = (np.histogram(dab, bins, range=(0, hi))[0].tolist(), np.histogram(dba, bins, range=(0, hi))[0].tolist())
+            for more in (["--threads", "1"], ["--threads", "3"], ["--mean"]):
+                r = run_json(["--histogram", "--bins", str(bins)] + extra + more + [pa, pb])
+                what = "%s bins=%d %s" % (name, bins, " ".join(extra + more))
+                assert (r["histogram"]["ab"], r["histogram"]["ba"]) == want, what
+                assert r["histogram"]["above_ba"] == int((dba > hi).sum()), what
+                if extra and extra[0] == "--percentile":
+                    same(r["percentile"]["pooled"], np.percentile(np.hstack((dab, dba)), 95), what)
+
+
 def check_rows(rows, pts, d, j, what):
     assert rows.shape == (len(pts), 5), what
     assert np.array_equal(rows[:, :3], pts), what + ": coordinates"

@@ -1710,6 +1710,189 @@ int hd__an_band(const hd__an_t *asking, const hd__an_t *searched, double lo2, do
     return HD_OK;
 }
 
+/* ---- histograms from bounds ------------------------------------------------- */
+
+/*
+ * hd__an_hist counts every asking point's exact nearest distance sqrt(d2)
+ * in numpy's bins (histogram.c), computing it only for the points of the
+ * asking buckets whose bounds do not decide the bin.  Bounds on the d2 of
+ * every point of an asking bucket's box, rounding included:
+ *  - above: U, the smallest node_ub2 on the path to the searched bucket
+ *    nearest to the box (a node holds a point, so every point of the box
+ *    has one within U);
+ *  - below: L, the smallest node_lb2 from the box to a searched bucket
+ *    (the minimiser of each point lies in one), found by a descent that
+ *    skips the nodes whose bound is not below the smallest so far.
+ * sqrt is monotone, so sqrt(L) and sqrt(U) bound the distances.  When they
+ * are placed alike (hd__hist_decided), so is every value between them: the
+ * bucket's points are counted at once.  (When the bounds of a sample of
+ * the buckets decide few points, no bucket is tried.)  The points of the other buckets
+ * get their exact distances from hd__an_nearest (on a structure of those
+ * points alone when they are at most half, else on all of asking, with
+ * the partners hd_distances gives it) and are placed by the same rule.
+ */
+
+#define HIST_TASK 64  /* asking buckets per task of the bound pass */
+#define HIST_PROBE 16 /* one bucket in HIST_PROBE tried before the bound pass */
+
+typedef struct {
+    const hd__an_t *q, *t;
+    const hd__hist_t *h;
+    uint8_t *open;      /* per asking bucket: 1 when its bounds did not decide */
+    uint64_t **counts;  /* per worker */
+} hist_ctx;
+
+/* The smallest node_lb2 from box q to a bucket of t, or some bound below
+ * `enough` as soon as one is found (a lower bound that small decides
+ * nothing). */
+static double tree_lb2(const hd__an_t *t, const hd__box_t *q, double enough) {
+    uint32_t stack[8 * 11 + 8];
+    double slb[8 * 11 + 8], least = INFINITY;
+    int sp = 0;
+    stack[sp] = 0, slb[sp] = node_lb2(q, t, 0), sp++;
+    while (sp > 0 && !(least < enough)) {
+        sp--;
+        if (slb[sp] >= least) continue;
+        size_t k = stack[sp];
+        if (!t->count[k]) {
+            least = slb[sp];
+            continue;
+        }
+        size_t f = t->first[k];
+        int top = sp;
+        for (int i = 0; i < t->count[k]; i++) {
+            double lb = node_lb2(q, t, f + (size_t)i);
+            if (lb >= least) continue;
+            stack[sp] = (uint32_t)(f + (size_t)i), slb[sp] = lb, sp++;
+            if (lb < slb[top]) { /* the nearest child at top */
+                uint32_t ks = stack[top];
+                double ls = slb[top];
+                stack[top] = stack[sp - 1], slb[top] = slb[sp - 1];
+                stack[sp - 1] = ks, slb[sp - 1] = ls;
+            }
+        }
+        if (sp > top + 1) { /* then on the stack's top, searched first */
+            uint32_t ks = stack[top];
+            double ls = slb[top];
+            stack[top] = stack[sp - 1], slb[top] = slb[sp - 1];
+            stack[sp - 1] = ks, slb[sp - 1] = ls;
+        }
+    }
+    return least;
+}
+
+/* Below this squared distance a lower bound cannot place an interval
+ * ending at u = sqrt(U) in u's bin (or above hi): just under the square
+ * of that bin's lower edge.  It only spares work: the decision is
+ * hd__hist_decided's. */
+static double useful_lb2(const hd__hist_t *h, double U) {
+    size_t guess, b = hd__hist_place(h, sqrt(U), &guess);
+    double e = b == SIZE_MAX ? h->hi : hd__hist_edge(h, b);
+    return e > 0 ? 0.999 * e * e : 0.0;
+}
+
+/* 1 when the bounds of asking bucket b decide its bin, in *bin. */
+static int hist_bucket(const hist_ctx *c, size_t b, size_t *bin) {
+    const hd__an_t *q = c->q, *t = c->t;
+    size_t node = q->leaf[b];
+    hd__box_t box;
+    for (int d = 0; d < 3; d++) box.lo[d] = q->lo[d][node], box.hi[d] = q->hi[d][node];
+    double U = INFINITY;
+    nearest_leaf(t, &box, &U);
+    double L = hd__hist_decided(c->h, 0.0, sqrt(U), bin) ? 0.0 : tree_lb2(t, &box, useful_lb2(c->h, U));
+    return hd__hist_decided(c->h, sqrt(L), sqrt(U), bin);
+}
+
+static HD__HOT void hist_task(void *vctx, size_t task, int worker) {
+    hist_ctx *c = vctx;
+    const hd__an_t *q = c->q;
+    size_t b0 = task * HIST_TASK, b1 = b0 + HIST_TASK < q->nb ? b0 + HIST_TASK : q->nb, bin;
+    for (size_t b = b0; b < b1; b++) {
+        c->open[b] = !hist_bucket(c, b, &bin);
+        if (!c->open[b] && bin != SIZE_MAX) c->counts[worker][bin] += q->start[b + 1] - q->start[b];
+    }
+}
+
+/* 1 when the bounds of every HIST_PROBE-th bucket decide at least a
+ * quarter of their points: the bound pass then spares more than it costs.
+ * Only the cost depends on it. */
+static int hist_worth(const hist_ctx *c) {
+    const hd__an_t *q = c->q;
+    size_t seen = 0, decided = 0, bin;
+    for (size_t b = 0; b < q->nb; b += HIST_PROBE) {
+        size_t m = q->start[b + 1] - q->start[b];
+        seen += m;
+        if (hist_bucket(c, b, &bin)) decided += m;
+    }
+    return 4 * decided >= seen;
+}
+
+/* The exact distances of the open buckets' points, placed. */
+static int hist_open(const hist_ctx *c, const hd_points_t *P, const hd_points_t *partner, const hd__box_t *keybox,
+                     int threads, uint64_t *counts, hd_error_t *err) {
+    const hd__an_t *q = c->q;
+    size_t m = 0, n = q->start[q->nb];
+    for (size_t b = 0; b < q->nb; b++)
+        if (c->open[b]) m += q->start[b + 1] - q->start[b];
+    if (!m) return HD_OK;
+    double *dist = hd__malloc_array(P->count, sizeof *dist);
+    uint8_t *mark = hd__calloc_array(P->count, 1);
+    uint32_t *sel = NULL;
+    int rc = dist && mark ? HD_OK : hd__err(err, HD_ENOMEM, "cannot allocate %zu distances", P->count);
+    for (size_t b = 0; rc == HD_OK && b < q->nb; b++)
+        if (c->open[b])
+            for (size_t k = q->start[b]; k < q->start[b + 1]; k++) mark[q->idx[k]] = 1;
+    if (rc == HD_OK && 2 * m > n) { /* most points: the structure of them all */
+        rc = hd__an_nearest(q, c->t, partner, threads, dist, NULL, NULL, err);
+    } else if (rc == HD_OK) { /* a structure of the open points (increasing names) */
+        if (!(sel = hd__malloc_array(m, sizeof *sel))) rc = hd__err(err, HD_ENOMEM, "cannot allocate %zu indices", m);
+        size_t k = 0;
+        for (size_t i = 0; rc == HD_OK && i < P->count; i++)
+            if (mark[i]) sel[k++] = (uint32_t)i;
+        hd__an_t one;
+        if (rc == HD_OK && (rc = hd__an_build_sel(&one, P, sel, NULL, m, keybox, threads, err)) == HD_OK) {
+            rc = hd__an_nearest(&one, c->t, NULL, threads, dist, NULL, NULL, err);
+            hd__an_free(&one);
+        }
+    }
+    for (size_t i = 0; rc == HD_OK && i < P->count; i++)
+        if (mark[i]) {
+            size_t guess, b = hd__hist_place(c->h, dist[i], &guess);
+            if (b != SIZE_MAX) counts[b]++;
+        }
+    free(dist);
+    free(mark);
+    free(sel);
+    return rc;
+}
+
+int hd__an_hist(const hd__an_t *asking, const hd__an_t *searched, const hd_points_t *P, const hd_points_t *partner,
+                const hd__box_t *keybox, const hd__hist_t *h, int threads, uint64_t *counts, hd_error_t *err) {
+    size_t tasks = (asking->nb + HIST_TASK - 1) / HIST_TASK;
+    int workers = hd__thread_count(threads, tasks ? tasks : 1);
+    hist_ctx c = {asking, searched, h, NULL, NULL};
+    c.open = hd__malloc_array(asking->nb ? asking->nb : 1, 1);
+    c.counts = hd__calloc_array((size_t)workers, sizeof *c.counts);
+    int rc = c.open && c.counts ? HD_OK : HD_ENOMEM;
+    for (int w = 0; rc == HD_OK && w < workers; w++)
+        if (!(c.counts[w] = hd__calloc_array(h->bins, sizeof *counts))) rc = HD_ENOMEM;
+    if (rc != HD_OK) {
+        rc = hd__err(err, rc, "cannot allocate the histogram's counts");
+    } else {
+        if (hist_worth(&c)) hd__parallel_for(workers, tasks, hist_task, &c);
+        else memset(c.open, 1, asking->nb);
+        uint64_t *sum = c.counts[0];
+        for (int w = 1; w < workers; w++)
+            for (size_t k = 0; k < h->bins; k++) sum[k] += c.counts[w][k];
+        rc = hist_open(&c, P, partner, keybox, threads, sum, err);
+        for (size_t k = 0; rc == HD_OK && k < h->bins; k++) counts[k] += sum[k];
+    }
+    for (int w = 0; c.counts && w < workers; w++) free(c.counts[w]);
+    free(c.counts);
+    free(c.open);
+    return rc;
+}
+
 /* ---- both sets side by side --------------------------------------------------- */
 
 typedef struct {

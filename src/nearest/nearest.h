@@ -147,4 +147,42 @@ int hd__an_build_pair(const hd_points_t *A, const hd_points_t *B, const hd__box_
 int hd__percentile_points(const hd_points_t *A, const hd_points_t *B, const hd__an_t s[2],
                           const hd__box_t *keybox, int threads, double p, hd_percentile_t *out, hd_error_t *err);
 
+/* ---- histograms (histogram.c) ------------------------------------------- */
+
+/* numpy.histogram's bins on [lo, hi]: the range (widened by half a unit on
+ * each side when lo == hi) and norm = bins / (hi - lo). */
+typedef struct hd__hist {
+    double lo, hi, norm;
+    size_t bins;
+} hd__hist_t;
+
+/* Checks and widens the range as numpy does.  Errors: HD_EINVAL (bins =
+ * 0, lo > hi, a bound not finite), HD_ERANGE (hi - lo overflows). */
+int hd__hist_init(hd__hist_t *h, double lo, double hi, size_t bins, hd_error_t *err);
+/* Edge k (0..bins) as numpy.linspace computes it; edge bins is hi. */
+double hd__hist_edge(const hd__hist_t *h, size_t k);
+/* The bin numpy.histogram places x in, or SIZE_MAX for a value outside
+ * [lo, hi] (or NaN).  *guess receives the bin before numpy's one-step
+ * correction (or the bin itself on a subnormal range): for a fixed guess
+ * the bin is a non-decreasing function of x, and the guess is one of x.
+ * So every x in [l, u] lies in bin k when l and u have the same guess and
+ * both lie in bin k (histogram.c). */
+size_t hd__hist_place(const hd__hist_t *h, double x, size_t *guess);
+/* 1 when every value of [l, u] (l <= u) is placed alike: in one bin,
+ * returned in *bin, or all outside the range (*bin = SIZE_MAX). */
+int hd__hist_decided(const hd__hist_t *h, double l, double u, size_t *bin);
+
+/* Adds to counts[0..h->bins) the histogram of the exact nearest distances
+ * of asking's points (the structure of P on keybox) to searched, as
+ * hd__hist_place places them: an asking bucket whose cheap lower and upper
+ * bounds are placed alike (hd__hist_decided) is counted without its
+ * distances, the other points get their exact distance (allnearest.c,
+ * "histograms from bounds"); partner as hd__an_nearest's, tried only
+ * when most points need their distance.  The same counts at any thread
+ * count.
+ * Returns HD_OK, HD_ENOMEM or HD_EOVERFLOW (counts unspecified, err
+ * filled). */
+int hd__an_hist(const hd__an_t *asking, const hd__an_t *searched, const hd_points_t *P, const hd_points_t *partner,
+                const hd__box_t *keybox, const hd__hist_t *h, int threads, uint64_t *counts, hd_error_t *err);
+
 #endif /* HD_ALLNEAREST_H */
