@@ -229,7 +229,8 @@ int hd__mpi_begin(hd__mpi_ctx_t *c, const hd_options_t *opt, hd__mpi_input_t *in
 }
 
 /* K > 1: the partition, the exchange and what every rank holds. */
-int hd__mpi_spread(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const hd__mpi_ranges_t *rg, const uint64_t N[2], hd__mpi_spread_t *sp) {
+int hd__mpi_spread(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const hd__mpi_ranges_t *rg, const uint64_t N[2],
+                   const hd__mpi_prune_t *pr, hd__mpi_spread_t *sp) {
     int K = c->K, rc = HD_OK;
     sp->tree = hd__mpi_alloc(c, (size_t)K - 1, sizeof(hd__mpi_node_t));
     sp->region = hd__mpi_alloc(c, (size_t)K, sizeof(hd__box_t));
@@ -239,7 +240,7 @@ int hd__mpi_spread(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const hd__mpi_ra
     if ((rc = hd__mpi_partition(c, in, N[0] + N[1], sp->tree)) != HD_OK) return rc;
     hd__box_t all = {{-INFINITY, -INFINITY, -INFINITY}, {INFINITY, INFINITY, INFINITY}};
     hd__mpi_regions(sp->tree, 0, all, sp->region);
-    if ((rc = hd__mpi_exchange(c, in, rg, sp->tree, &sp->loc)) != HD_OK) return rc;
+    if ((rc = hd__mpi_exchange(c, in, rg, sp->tree, pr, &sp->loc)) != HD_OK) return rc;
     hd__mpi_held_t h;
     for (int s = 0; s < 2; s++) {
         h.n[s] = sp->loc.n[s];
@@ -354,7 +355,13 @@ static int run(hd__mpi_ctx_t *c, const hd_options_t *opt, hd__mpi_input_t *in, v
         pts = in->n[0] + in->n[1];
     } else {
         hd__mpi_spread_t *sp = &cs.sp;
-        if ((rc = hd__mpi_spread(c, in, &cs.rg, cs.N, sp)) != HD_OK) goto done;
+        /* The points that cannot change the answer stay where they are
+         * (prune.c), unless HD_MPI_NO_PRUNE is set (mpi_bench's and the
+         * tests' comparison of what moves). */
+        hd__mpi_prune_t pr = {0};
+        const char *off = getenv("HD_MPI_NO_PRUNE");
+        if (!(off && *off) && (rc = hd__mpi_prune(c, in, cs.N, corners, both, &pr)) != HD_OK) goto done;
+        if ((rc = hd__mpi_spread(c, in, &cs.rg, cs.N, &pr, sp)) != HD_OK) goto done;
         hd__mpi_local_t *loc = &sp->loc;
         /* Both directions: the engine once for both (each of its calls
          * builds both sets' structures); its failure is agreed on before
