@@ -237,7 +237,7 @@ int hd__mpi_spread(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const hd__mpi_ra
     sp->held = hd__mpi_alloc(c, (size_t)K, sizeof(hd__mpi_held_t));
     if (!sp->tree || !sp->region || !sp->held) rc = hd__mpi_nomem(c, "the partition", (size_t)K);
     if ((rc = hd__mpi_agree(c, rc)) != HD_OK) return rc;
-    if ((rc = hd__mpi_partition(c, in, N[0] + N[1], sp->tree)) != HD_OK) return rc;
+    if ((rc = hd__mpi_partition(c, in, pr, N[0] + N[1], sp->tree)) != HD_OK) return rc;
     hd__box_t all = {{-INFINITY, -INFINITY, -INFINITY}, {INFINITY, INFINITY, INFINITY}};
     hd__mpi_regions(sp->tree, 0, all, sp->region);
     if ((rc = hd__mpi_exchange(c, in, rg, sp->tree, pr, &sp->loc)) != HD_OK) return rc;
@@ -276,11 +276,11 @@ int hd__mpi_figures(hd__mpi_ctx_t *c, const hd__mpi_course_t *cs, uint64_t pts, 
     HD__MPI_TRY(c, MPI_Allreduce(&secs, &tsum, 1, MPI_DOUBLE, MPI_SUM, c->comm));
     if (!st) return HD_OK;
     uint64_t work = pts + c->answered;
-    uint64_t sums[7] = {c->bytes_part, c->bytes_fwd, c->forwarded, c->forwarded_points, work, c->shell,
-                        c->bytes_back},
-             gs[7];
+    uint64_t sums[8] = {c->bytes_part, c->bytes_fwd, c->forwarded, c->forwarded_points, work, c->shell,
+                        c->bytes_back, pts},
+             gs[8];
     uint64_t maxes[3] = {pts, work, c->peak}, gm[3];
-    HD__MPI_TRY(c, MPI_Allreduce(sums, gs, 7, MPI_UINT64_T, MPI_SUM, c->comm));
+    HD__MPI_TRY(c, MPI_Allreduce(sums, gs, 8, MPI_UINT64_T, MPI_SUM, c->comm));
     HD__MPI_TRY(c, MPI_Allreduce(maxes, gm, 3, MPI_UINT64_T, MPI_MAX, c->comm));
     memset(st, 0, sizeof *st);
     st->ranks = K;
@@ -293,7 +293,9 @@ int hd__mpi_figures(hd__mpi_ctx_t *c, const hd__mpi_course_t *cs, uint64_t pts, 
     st->shell_points = gs[5];
     st->rounds = c->rounds;
     st->points_max = gm[0];
-    st->imbalance = (double)gm[0] * K / (double)st->points;
+    /* over the points the partition placed (those prune.c left out are
+     * on no rank's list) */
+    st->imbalance = gs[7] ? (double)gm[0] * K / (double)gs[7] : 1.0;
     st->work_imbalance = (double)gm[1] * K / (double)gs[4];
     st->seconds_max = most[0];
     st->seconds_mean = tsum / K;
