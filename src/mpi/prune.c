@@ -34,6 +34,11 @@
 /* Sample points a side in all (each rank its share of its input). */
 #define PRUNE_SAMPLE 1024
 
+static int by_side(const void *x, const void *y) {
+    const hd__mpi_sample_t *a = x, *b = y;
+    return (a->side > b->side) - (a->side < b->side);
+}
+
 static size_t share(uint64_t n, uint64_t N) { return N <= PRUNE_SAMPLE ? (size_t)n : (size_t)(n * PRUNE_SAMPLE / N); }
 
 int hd__mpi_prune(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const uint64_t N[2], const double corners[2][6], int both,
@@ -102,28 +107,36 @@ int hd__mpi_prune(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const uint64_t N[
             box[k] = b;
         }
         for (size_t k = 0; k < 2 * NC; k++) full[k] = box[k].lo[0] <= box[k].hi[0];
+        /* The sample by set (A's first), then L (a sample point whose
+         * bound is already at most L cannot raise it), then U (the
+         * smallest: a larger one would keep more cells). */
+        qsort(all, total, sizeof *all, by_side);
+        size_t split = 0, from[2], to[2];
+        while (split < total && all[split].side == 0) split++;
+        from[0] = 0, to[0] = split, from[1] = split, to[1] = total;
         double L[2] = {-1.0, -1.0};
         for (int s = 0; s < 2; s++) {
             int t = 1 - s;
-            for (size_t k = 0; k < NC; k++) {
-                double u = INFINITY;
-                if (full[s * NC + k])
-                    for (size_t j = 0; j < total; j++)
-                        if (all[j].side == (uint64_t)t) {
-                            double d = hd__box_ub2(&box[s * NC + k], all[j].x);
-                            u = d < u ? d : u;
-                        }
-                U[s * NC + k] = u;
-            }
-            for (size_t j = 0; j < total; j++) {
-                if (all[j].side != (uint64_t)s) continue;
+            for (size_t j = from[s]; j < to[s]; j++) {
                 double lb = INFINITY;
-                for (size_t k = 0; k < NC; k++)
+                for (size_t k = 0; k < NC && lb > L[s]; k++)
                     if (full[t * NC + k]) {
                         double d = hd__box_lb2(&box[t * NC + k], all[j].x);
                         lb = d < lb ? d : lb;
                     }
                 L[s] = lb > L[s] ? lb : L[s];
+            }
+        }
+        for (int s = 0; s < 2; s++) {
+            int t = 1 - s;
+            for (size_t k = 0; k < NC; k++) {
+                double u = INFINITY;
+                if (full[s * NC + k])
+                    for (size_t j = from[t]; j < to[t]; j++) {
+                        double d = hd__box_ub2(&box[s * NC + k], all[j].x);
+                        u = d < u ? d : u;
+                    }
+                U[s * NC + k] = u;
             }
         }
         /* Cell k of s is kept when it may hold the witness of direction s;
