@@ -39,6 +39,32 @@ static int by_side(const void *x, const void *y) {
     return (a->side > b->side) - (a->side < b->side);
 }
 
+/* U of cell k of set s (prune.c's invariants), computed when first
+ * asked (U[] < 0 until then): the sample of the other set is
+ * all[from[t]..to[t]). */
+static double cell_u(double *U, const hd__box_t *box, const hd__mpi_sample_t *all, const size_t *from, const size_t *to,
+                     int s, size_t k) {
+    enum { NC = HD__MPI_CELLS * HD__MPI_CELLS * HD__MPI_CELLS };
+    double *u = &U[(size_t)s * NC + k];
+    if (*u >= 0) return *u;
+    int t = 1 - s;
+    double m = INFINITY;
+    for (size_t j = from[t]; j < to[t]; j++) {
+        double d = hd__box_ub2(&box[(size_t)s * NC + k], all[j].x);
+        m = d < m ? d : m;
+    }
+    return *u = m;
+}
+
+/* The squared half diagonal of a box: every point's farthest corner is at
+ * least that far (in reals; the caller halves it again, far beyond any
+ * rounding), so a cell with L below it is a query without its U. */
+static double half_diag2(const hd__box_t *b) {
+    double d = 0;
+    for (int a = 0; a < 3; a++) d += 0.25 * (b->hi[a] - b->lo[a]) * (b->hi[a] - b->lo[a]);
+    return d;
+}
+
 static size_t share(uint64_t n, uint64_t N) { return N <= PRUNE_SAMPLE ? (size_t)n : (size_t)(n * PRUNE_SAMPLE / N); }
 
 int hd__mpi_prune(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const uint64_t N[2], const double corners[2][6], int both,
@@ -127,18 +153,7 @@ int hd__mpi_prune(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const uint64_t N[
                 L[s] = lb > L[s] ? lb : L[s];
             }
         }
-        for (int s = 0; s < 2; s++) {
-            int t = 1 - s;
-            for (size_t k = 0; k < NC; k++) {
-                double u = INFINITY;
-                if (full[s * NC + k])
-                    for (size_t j = from[t]; j < to[t]; j++) {
-                        double d = hd__box_ub2(&box[s * NC + k], all[j].x);
-                        u = d < u ? d : u;
-                    }
-                U[s * NC + k] = u;
-            }
-        }
+        for (size_t k = 0; k < 2 * NC; k++) U[k] = -1.0; /* not computed: cell_u */
         /* Cell k of s is kept when it may hold the witness of direction s;
          * then every kept point that is asked for its nearest (both sets'
          * in the symmetric call, A's in the directed one) keeps every cell
@@ -149,7 +164,8 @@ int hd__mpi_prune(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const uint64_t N[
         unsigned char (*kp)[NC] = pr->keep;
         for (int s = 0; s < 2; s++)
             for (size_t k = 0; k < NC; k++)
-                kp[s][k] = full[s * NC + k] && (s == 0 || both) && !(U[s * NC + k] < L[s]);
+                kp[s][k] = full[s * NC + k] && (s == 0 || both) &&
+                           (L[s] < 0.5 * half_diag2(&box[s * NC + k]) || !(cell_u(U, box, all, from, to, s, k) < L[s]));
         for (int changed = 1; changed;) {
             changed = 0;
             for (int s = 0; s < (both ? 2 : 1); s++) {
@@ -158,7 +174,7 @@ int hd__mpi_prune(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const uint64_t N[
                     if (!kp[s][k]) continue;
                     for (size_t j = 0; j < NC; j++)
                         if (!kp[t][j] && full[t * NC + j] &&
-                            hd__box_box_lb2(&box[s * NC + k], &box[t * NC + j]) <= U[s * NC + k])
+                            hd__box_box_lb2(&box[s * NC + k], &box[t * NC + j]) <= cell_u(U, box, all, from, to, s, k))
                             kp[t][j] = 1, changed = 1;
                 }
             }
