@@ -52,7 +52,9 @@ int hd__mpi_call(MPI_Comm comm, const hd_mpi_part_t *a, size_t na, const hd_mpi_
                  const hd_options_t *opt, hd__mpi_body_t body, void *arg, hd_mpi_stats_t *st, hd_error_t *err);
 int hd__mpi_begin(hd__mpi_ctx_t *c, const hd_options_t *opt, hd__mpi_input_t *in, const void *res, hd__mpi_ranges_t *rg, uint64_t N[2],
                   double corners[2][6]);
-int hd__mpi_spread(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const hd__mpi_ranges_t *rg, const uint64_t N[2], hd__mpi_spread_t *sp);
+/* pr: the points that stay out of the course (NULL: none; prune.c). */
+int hd__mpi_spread(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const hd__mpi_ranges_t *rg, const uint64_t N[2],
+                   const hd__mpi_prune_t *pr, hd__mpi_spread_t *sp);
 void hd__mpi_spread_free(hd__mpi_ctx_t *c, hd__mpi_spread_t *sp);
 int hd__mpi_views(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, hd__mpi_views_t *vw);
 void hd__mpi_views_free(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, hd__mpi_views_t *vw);

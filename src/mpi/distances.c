@@ -552,7 +552,7 @@ static int distances(hd__mpi_ctx_t *c, const hd_options_t *opt, hd__mpi_input_t 
     if (c->K == 1) {
         if ((rc = single(c, in, &cs.rg, want, o)) != HD_OK) goto done;
     } else if (want[0] || want[1]) {
-        if ((rc = hd__mpi_spread(c, in, &cs.rg, cs.N, sp)) != HD_OK) goto done;
+        if ((rc = hd__mpi_spread(c, in, &cs.rg, cs.N, NULL, sp)) != HD_OK) goto done;
         pts = sp->loc.n[0] + sp->loc.n[1];
         /* Both structures on one key box: the queries' groups and the
          * buckets they search are neighbours in memory (as hd_distances). */

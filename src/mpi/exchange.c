@@ -24,6 +24,10 @@
  *    in order, and encoded again from the merged indices when they were
  *    not; the numbers and indices are freed before the call goes on.
  *    Nothing reorders the local arrays' indices afterwards.
+ *  - A point of a cell prune.c leaves out (hd__mpi_moves false) goes
+ *    nowhere, not even into this rank's own arrays: its destination is K,
+ *    it keeps its number (the numbers count every input point), and no
+ *    count, round or box includes it.
  *  - loc->box is the exact box of each side's local points, merged from
  *    each run as it lands (the rank's own, each sender's): the same points
  *    as the local arrays hold, in whatever order the merge leaves them.
@@ -151,13 +155,14 @@ static void box_run(hd__box_t *b, const double *xyz, size_t n) {
  * Inlined with a constant `branchless`, so each way is its own loop. */
 HD__INLINE void pack_run(const hd_points_t *v, const double *px, size_t k0, size_t m, const void *dest, int w,
                          size_t t, int me, int s, uint32_t num, double *lx, uint32_t *lo, size_t *own, double *sx,
-                         uint32_t *so, int *sfill, int branchless) {
+                         uint32_t *so, int *sfill, int branchless, int drop) {
     double *const xto[2] = {sx, lx};
     uint32_t *const oto[2] = {so, lo};
     size_t cur[2] = {0, *own};
     for (size_t i = 0; i < m; i++, t++, num++) {
         int r = dest_get(dest, w, t);
         double *x;
+        if (r == drop) continue; /* it stays, out of the course (prune.c) */
         if (branchless) {
             int mine = r == me;
             cur[0] = (size_t)sfill[2 * r + s];
@@ -190,7 +195,8 @@ HD__INLINE void pack_run(const hd_points_t *v, const double *px, size_t k0, size
 /* The exchange's state.  Counts by (rank r, side s) are at 2 r + s, sizes
  * by (side s, rank r) at s K + r. */
 typedef struct {
-    int K, me, w;                   /* ranks, this rank, bytes of a destination (dest_get) */
+    int K, me, w;                   /* ranks, this rank, bytes of a destination (dest_get; K: the point stays out) */
+    const hd__mpi_prune_t *pr;      /* the points that stay out (NULL: none) */
     size_t nloc, C;                 /* local input points; at most C sent a round */
     const hd_mpi_part_t **order[2]; /* each side's parts by offset: the walking order */
     void *dest;                     /* each input position's rank (scratch) */
@@ -220,7 +226,7 @@ typedef struct {
 
 static int xch_alloc(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, xch_t *x) {
     memset(x, 0, sizeof *x);
-    x->K = c->K, x->me = c->rank, x->w = c->K <= 256 ? 1 : c->K <= 65536 ? 2 : 4;
+    x->K = c->K, x->me = c->rank, x->w = c->K < 256 ? 1 : c->K < 65536 ? 2 : 4;
     x->nloc = (size_t)(in->n[0] + in->n[1]);
     x->C = x->nloc / ROUND_SHARE < ROUND_MIN ? ROUND_MIN : x->nloc / ROUND_SHARE;
     x->maxr = x->nloc / x->C + 2, x->nr = 1;
@@ -281,6 +287,10 @@ static int xch_plan(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const hd__mpi_n
             for (size_t k = 0; k < v->count; k++, t++) {
                 double xb[3];
                 const double *pt = px ? px + 3 * k : (hd_points_get(v, k, xb), xb);
+                if (!hd__mpi_moves(x->pr, s, pt)) {
+                    dest_set(x->dest, x->w, t, K);
+                    continue;
+                }
                 int r = hd__mpi_rank_of(tree, K, pt, (uint64_t)s, g0 + k);
                 dest_set(x->dest, x->w, t, r);
                 x->switches += (size_t)(r != prev);
@@ -378,10 +388,10 @@ static void xch_pack(const hd__mpi_input_t *in, const hd__mpi_ranges_t *rg, xch_
         uint32_t num = (uint32_t)at->num[s];
         if (scattered)
             pack_run(v, px, at->k, m, x->dest, x->w, t, me, s, num, loc->xyz[s], x->off[s], &ownat[s], x->sx, x->so,
-                     x->sfill, 1);
+                     x->sfill, 1, K);
         else
             pack_run(v, px, at->k, m, x->dest, x->w, t, me, s, num, loc->xyz[s], x->off[s], &ownat[s], x->sx, x->so,
-                     x->sfill, 0);
+                     x->sfill, 0, K);
         t += m;
         at->k += m;
         at->num[s] += m;
@@ -502,9 +512,10 @@ static int xch_order(hd__mpi_ctx_t *c, const hd__mpi_ranges_t *rg, xch_t *x, hd_
  * rounds, the order; every rank agrees on a status before each
  * collective. */
 int hd__mpi_exchange(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const hd__mpi_ranges_t *rg,
-                     const hd__mpi_node_t *tree, hd__mpi_local_t *loc) {
+                     const hd__mpi_node_t *tree, const hd__mpi_prune_t *pr, hd__mpi_local_t *loc) {
     xch_t x;
     int rc = xch_alloc(c, in, &x);
+    x.pr = pr;
     if (rc == HD_OK) rc = xch_plan(c, in, tree, &x);
     if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
     HD__MPI_GO(c, rc, MPI_Alltoall(x.tot, 2, MPI_INT, x.rtot, 2, MPI_INT, c->comm));

@@ -229,17 +229,18 @@ int hd__mpi_begin(hd__mpi_ctx_t *c, const hd_options_t *opt, hd__mpi_input_t *in
 }
 
 /* K > 1: the partition, the exchange and what every rank holds. */
-int hd__mpi_spread(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const hd__mpi_ranges_t *rg, const uint64_t N[2], hd__mpi_spread_t *sp) {
+int hd__mpi_spread(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const hd__mpi_ranges_t *rg, const uint64_t N[2],
+                   const hd__mpi_prune_t *pr, hd__mpi_spread_t *sp) {
     int K = c->K, rc = HD_OK;
     sp->tree = hd__mpi_alloc(c, (size_t)K - 1, sizeof(hd__mpi_node_t));
     sp->region = hd__mpi_alloc(c, (size_t)K, sizeof(hd__box_t));
     sp->held = hd__mpi_alloc(c, (size_t)K, sizeof(hd__mpi_held_t));
     if (!sp->tree || !sp->region || !sp->held) rc = hd__mpi_nomem(c, "the partition", (size_t)K);
     if ((rc = hd__mpi_agree(c, rc)) != HD_OK) return rc;
-    if ((rc = hd__mpi_partition(c, in, N[0] + N[1], sp->tree)) != HD_OK) return rc;
+    if ((rc = hd__mpi_partition(c, in, pr, N[0] + N[1], sp->tree)) != HD_OK) return rc;
     hd__box_t all = {{-INFINITY, -INFINITY, -INFINITY}, {INFINITY, INFINITY, INFINITY}};
     hd__mpi_regions(sp->tree, 0, all, sp->region);
-    if ((rc = hd__mpi_exchange(c, in, rg, sp->tree, &sp->loc)) != HD_OK) return rc;
+    if ((rc = hd__mpi_exchange(c, in, rg, sp->tree, pr, &sp->loc)) != HD_OK) return rc;
     hd__mpi_held_t h;
     for (int s = 0; s < 2; s++) {
         h.n[s] = sp->loc.n[s];
@@ -275,11 +276,11 @@ int hd__mpi_figures(hd__mpi_ctx_t *c, const hd__mpi_course_t *cs, uint64_t pts, 
     HD__MPI_TRY(c, MPI_Allreduce(&secs, &tsum, 1, MPI_DOUBLE, MPI_SUM, c->comm));
     if (!st) return HD_OK;
     uint64_t work = pts + c->answered;
-    uint64_t sums[7] = {c->bytes_part, c->bytes_fwd, c->forwarded, c->forwarded_points, work, c->shell,
-                        c->bytes_back},
-             gs[7];
+    uint64_t sums[8] = {c->bytes_part, c->bytes_fwd, c->forwarded, c->forwarded_points, work, c->shell,
+                        c->bytes_back, pts},
+             gs[8];
     uint64_t maxes[3] = {pts, work, c->peak}, gm[3];
-    HD__MPI_TRY(c, MPI_Allreduce(sums, gs, 7, MPI_UINT64_T, MPI_SUM, c->comm));
+    HD__MPI_TRY(c, MPI_Allreduce(sums, gs, 8, MPI_UINT64_T, MPI_SUM, c->comm));
     HD__MPI_TRY(c, MPI_Allreduce(maxes, gm, 3, MPI_UINT64_T, MPI_MAX, c->comm));
     memset(st, 0, sizeof *st);
     st->ranks = K;
@@ -292,7 +293,9 @@ int hd__mpi_figures(hd__mpi_ctx_t *c, const hd__mpi_course_t *cs, uint64_t pts, 
     st->shell_points = gs[5];
     st->rounds = c->rounds;
     st->points_max = gm[0];
-    st->imbalance = (double)gm[0] * K / (double)st->points;
+    /* over the points the partition placed (those prune.c left out are
+     * on no rank's list) */
+    st->imbalance = gs[7] ? (double)gm[0] * K / (double)gs[7] : 1.0;
     st->work_imbalance = (double)gm[1] * K / (double)gs[4];
     st->seconds_max = most[0];
     st->seconds_mean = tsum / K;
@@ -354,7 +357,13 @@ static int run(hd__mpi_ctx_t *c, const hd_options_t *opt, hd__mpi_input_t *in, v
         pts = in->n[0] + in->n[1];
     } else {
         hd__mpi_spread_t *sp = &cs.sp;
-        if ((rc = hd__mpi_spread(c, in, &cs.rg, cs.N, sp)) != HD_OK) goto done;
+        /* The points that cannot change the answer stay where they are
+         * (prune.c), unless HD_MPI_NO_PRUNE is set (mpi_bench's and the
+         * tests' comparison of what moves). */
+        hd__mpi_prune_t pr = {0};
+        const char *off = getenv("HD_MPI_NO_PRUNE");
+        if (!(off && *off) && (rc = hd__mpi_prune(c, in, cs.N, corners, both, &pr)) != HD_OK) goto done;
+        if ((rc = hd__mpi_spread(c, in, &cs.rg, cs.N, &pr, sp)) != HD_OK) goto done;
         hd__mpi_local_t *loc = &sp->loc;
         /* Both directions: the engine once for both (each of its calls
          * builds both sets' structures); its failure is agreed on before

@@ -197,8 +197,13 @@ int hd__mpi_asked(const hd__mpi_node_t *t, const hd__box_t *nbox, const hd__mpi_
 }
 
 /* ns samples of this rank's nloc points (A's parts in order, then B's:
- * local point t is the t-th of them), evenly spaced, into out. */
-static void take_samples(const hd__mpi_input_t *in, uint64_t nloc, size_t ns, hd__mpi_sample_t *out) {
+ * local point t is the t-th of them), evenly spaced, into out, without
+ * those that stay out (pr, prune.c: the regions balance the points that
+ * move), but at least the first when every one stays out; returns how
+ * many were taken. */
+static size_t take_samples(const hd__mpi_input_t *in, const hd__mpi_prune_t *pr, uint64_t nloc, size_t ns,
+                           hd__mpi_sample_t *out) {
+    size_t taken = 0;
     int side = 0;
     size_t part = 0;
     uint64_t base = 0; /* local number of the part's first point */
@@ -211,10 +216,13 @@ static void take_samples(const hd__mpi_input_t *in, uint64_t nloc, size_t ns, hd
             else side++, part = 0;
         }
         const hd_mpi_part_t *p = &in->parts[side][part];
-        hd__mpi_get_point(&p->points, (size_t)(at - base), out[t].x);
-        out[t].g = p->offset + (at - base);
-        out[t].side = (uint64_t)side;
+        hd__mpi_sample_t *o = &out[taken];
+        hd__mpi_get_point(&p->points, (size_t)(at - base), o->x);
+        o->g = p->offset + (at - base);
+        o->side = (uint64_t)side;
+        taken += hd__mpi_moves(pr, side, o->x) || (taken == 0 && t + 1 == ns);
     }
+    return taken;
 }
 
 /* How many of this rank's nloc points to sample, when the job samples
@@ -259,7 +267,8 @@ static double edge(const double *br, int id, int j) {
  * floor(k/2)/k than the split it replaces (never worse on what it
  * measures); any split is a valid partition, so the result never depends
  * on it, only the balance does. */
-static int refine(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, uint64_t N, hd__mpi_node_t *tree, const double *br) {
+static int refine(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const hd__mpi_prune_t *pr, uint64_t N, hd__mpi_node_t *tree,
+                  const double *br) {
     int rc = HD_OK, K = c->K, nodes = K - 1;
     uint64_t nloc = in->n[0] + in->n[1];
     double rate = (double)REFINE_PER_RANK * K / (double)N;
@@ -273,10 +282,10 @@ static int refine(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, uint64_t N, hd__m
     double *edges = hd__mpi_alloc(c, (size_t)nodes * (REFINE_BINS + 1), sizeof(double));
     if (!r || !dep || !at || !cnt || !edges) rc = hd__mpi_nomem(c, "the partition's second samples", ns);
     if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
-    take_samples(in, nloc, ns, r);
+    size_t nr = take_samples(in, pr, nloc, ns, r); /* ns stays the arrays' size */
     int *ranks = dep + nodes, *slot = dep + 2 * (size_t)nodes; /* slot: index among its depth's nodes */
     shape(tree, 0, 0, dep, ranks);
-    for (size_t q = 0; q < ns; q++) at[q] = 0;
+    for (size_t q = 0; q < nr; q++) at[q] = 0;
     for (int depth = 0;; depth++) {
         int level = 0;
         for (int id = 0; id < nodes; id++) {
@@ -287,7 +296,7 @@ static int refine(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, uint64_t N, hd__m
         if (!level) break;
         uint64_t *sum = cnt + (size_t)level * width;
         memset(cnt, 0, (size_t)level * width * sizeof *cnt);
-        for (size_t q = 0; q < ns; q++) {
+        for (size_t q = 0; q < nr; q++) {
             int id = at[q];
             if (id < 0) continue;
             assert(slot[id] >= 0);
@@ -328,7 +337,7 @@ static int refine(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, uint64_t N, hd__m
                 tree[id].g = 0;
             }
         }
-        for (size_t q = 0; q < ns; q++)
+        for (size_t q = 0; q < nr; q++)
             if (at[q] >= 0) {
                 const hd__mpi_node_t *nd = &tree[at[q]];
                 at[q] = hd__mpi_goes_left(nd, r[q].x, r[q].side, r[q].g) ? nd->left : nd->right;
@@ -346,7 +355,8 @@ done:
 /* Rank 0 builds the RCB tree from everyone's first samples (c->first a
  * rank); all get it, and refine() then moves its splits by a second
  * sample's exact counts. */
-int hd__mpi_partition(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, uint64_t N, hd__mpi_node_t *tree) {
+int hd__mpi_partition(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const hd__mpi_prune_t *pr, uint64_t N,
+                      hd__mpi_node_t *tree) {
     int rc = HD_OK, K = c->K;
     uint64_t nloc = in->n[0] + in->n[1];
     uint64_t S = (uint64_t)c->first * (uint64_t)K;
@@ -357,9 +367,9 @@ int hd__mpi_partition(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, uint64_t N, h
     double *br = hd__mpi_alloc(c, 2 * (size_t)K, sizeof(double));
     if (!mine || !counts || !br) rc = hd__mpi_nomem(c, "samples", ns);
     if (rc == HD_OK && ns > INT_MAX / 64) rc = hd__err(&c->e, HD_EOVERFLOW, "too many samples");
-    if (rc == HD_OK) take_samples(in, nloc, ns, mine);
+    size_t nt = rc == HD_OK ? take_samples(in, pr, nloc, ns, mine) : 0;
     if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
-    int n = (int)ns;
+    int n = (int)nt;
     HD__MPI_GO(c, rc, MPI_Gather(&n, 1, MPI_INT, counts, 1, MPI_INT, 0, c->comm));
     size_t total = 0;
     hd__mpi_sample_t *all = NULL;
@@ -376,14 +386,14 @@ int hd__mpi_partition(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, uint64_t N, h
         int mpi_rc_,
             e = HD__MPI_TIMED(c, MPI_Gatherv(mine, n, c->sample_type, all, counts, counts + K, c->sample_type, 0, c->comm));
         if (e != MPI_SUCCESS) rc = hd__mpi_failed(c, "MPI_Gatherv", e);
-        c->bytes_part += c->rank ? (uint64_t)ns * sizeof(hd__mpi_sample_t) : 0;
+        c->bytes_part += c->rank ? (uint64_t)nt * sizeof(hd__mpi_sample_t) : 0;
         if (rc == HD_OK && c->rank == 0) hd__mpi_rcb_tree(all, total, K, tree, br);
     }
     if (c->rank == 0) hd__mpi_free(c, all, total, sizeof(hd__mpi_sample_t));
     if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
     if (K > 1) HD__MPI_GO(c, rc, MPI_Bcast(tree, K - 1, c->node_type, 0, c->comm));
     if (K > 1) HD__MPI_GO(c, rc, MPI_Bcast(br, 2 * (K - 1), MPI_DOUBLE, 0, c->comm));
-    if (K > 1) rc = refine(c, in, N, tree, br);
+    if (K > 1) rc = refine(c, in, pr, N, tree, br);
 done:
     hd__mpi_free(c, br, 2 * (size_t)K, sizeof(double));
     hd__mpi_free(c, mine, ns, sizeof(hd__mpi_sample_t));

@@ -65,7 +65,7 @@ static int partition_body(hd__mpi_ctx_t *c, const hd_options_t *opt, hd__mpi_inp
     if (rc == HD_OK && (!tree || !count)) rc = hd__mpi_nomem(c, "the test's counts", (size_t)c->K);
     if ((rc = hd__mpi_agree(c, rc)) == HD_OK) {
         c->first = pr->first;
-        rc = hd__mpi_partition(c, in, cs.N[0] + cs.N[1], tree);
+        rc = hd__mpi_partition(c, in, NULL, cs.N[0] + cs.N[1], tree);
     }
     if (rc == HD_OK) {
         memset(count, 0, (size_t)c->K * sizeof *count);

@@ -1,0 +1,192 @@
+/*
+ * prune.c -- the points that stay where they are (issue 41): before the
+ * partition moves anything, a grid of cells over each set's global box,
+ * the exact box of every cell's points (all-reduced) and a small sample
+ * of each set (all-gathered) decide which cells' points cannot change the
+ * answer; the exchange leaves those on their rank and the course never
+ * sees them.
+ *
+ * Invariants (every bound is one of points.h's computed bounds, evaluated
+ * in hd__d2's operation order, so each holds for the computed squared
+ * distances the engine compares, not only for the real ones):
+ *  - U[s][c] = min over the sample of the other set of hd__box_ub2(cell
+ *    box, o): at least the computed d2 of every point of the cell to its
+ *    nearest in the other set (the sample's points are points of it).
+ *  - L[s] = max over the sample of s of min over the other set's nonempty
+ *    cells of hd__box_lb2(cell box, p): at most the computed d2 of the
+ *    sample point p to its nearest, so at most h^2 of the direction s.
+ *  - A cell of s whose U < L holds no point at h (every point's d2 <= U
+ *    < L <= h^2): as a query it cannot be the witness, nor tie with it.
+ *  - Every kept cell that is asked (both sets' in the symmetric call,
+ *    A's in the directed one) keeps each cell of the other set within its
+ *    U (hd__box_box_lb2 <= U, ties kept), to a fixed point: every point of
+ *    a cell beyond that is farther from each of the cell's points than
+ *    its own nearest, so it is nobody's nearest nor tied with one, and a
+ *    kept point's nearest among the kept points is its nearest among all
+ *    (a point kept as a searched one only keeps d2 <= U < L: it cannot
+ *    win).  The other cells' points do not move.
+ */
+#include "mpi/partition.h"
+
+#include <math.h>
+#include <stdlib.h>
+
+/* Sample points a side in all (each rank its share of its input). */
+#define PRUNE_SAMPLE 1024
+
+static int by_side(const void *x, const void *y) {
+    const hd__mpi_sample_t *a = x, *b = y;
+    return (a->side > b->side) - (a->side < b->side);
+}
+
+/* U of cell k of set s (prune.c's invariants), computed when first
+ * asked (U[] < 0 until then): the sample of the other set is
+ * all[from[t]..to[t]). */
+static double cell_u(double *U, const hd__box_t *box, const hd__mpi_sample_t *all, const size_t *from, const size_t *to,
+                     int s, size_t k) {
+    enum { NC = HD__MPI_CELLS * HD__MPI_CELLS * HD__MPI_CELLS };
+    double *u = &U[(size_t)s * NC + k];
+    if (*u >= 0) return *u;
+    int t = 1 - s;
+    double m = INFINITY;
+    for (size_t j = from[t]; j < to[t]; j++) {
+        double d = hd__box_ub2(&box[(size_t)s * NC + k], all[j].x);
+        m = d < m ? d : m;
+    }
+    return *u = m;
+}
+
+/* The squared half diagonal of a box: every point's farthest corner is at
+ * least that far (in reals; the caller halves it again, far beyond any
+ * rounding), so a cell with L below it is a query without its U. */
+static double half_diag2(const hd__box_t *b) {
+    double d = 0;
+    for (int a = 0; a < 3; a++) d += 0.25 * (b->hi[a] - b->lo[a]) * (b->hi[a] - b->lo[a]);
+    return d;
+}
+
+static size_t share(uint64_t n, uint64_t N) { return N <= PRUNE_SAMPLE ? (size_t)n : (size_t)(n * PRUNE_SAMPLE / N); }
+
+int hd__mpi_prune(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const uint64_t N[2], const double corners[2][6], int both,
+                  hd__mpi_prune_t *pr) {
+    enum { NC = HD__MPI_CELLS * HD__MPI_CELLS * HD__MPI_CELLS };
+    int K = c->K, rc = HD_OK;
+    memset(pr, 0, sizeof *pr);
+    for (int s = 0; s < 2; s++)
+        for (int k = 0; k < 3; k++) {
+            pr->gbox[s].lo[k] = corners[s][k], pr->gbox[s].hi[k] = corners[s][3 + k];
+            double w = corners[s][3 + k] - corners[s][k];
+            pr->inv[s][k] = w > 0 ? HD__MPI_CELLS / w : 0.0;
+        }
+    /* Each cell's box over all ranks (hi negated: one MIN). */
+    double *cb = hd__mpi_alloc(c, 2 * NC * 6, sizeof(double)), *gb = hd__mpi_alloc(c, 2 * NC * 6, sizeof(double));
+    size_t mine[2] = {share(in->n[0], N[0]), share(in->n[1], N[1])};
+    hd__mpi_sample_t *own = hd__mpi_alloc(c, mine[0] + mine[1] + 1, sizeof *own);
+    int *cnt = hd__mpi_alloc(c, 2 * (size_t)K, sizeof(int));
+    hd__mpi_sample_t *all = NULL;
+    double *U = hd__mpi_alloc(c, 2 * NC, sizeof(double));
+    size_t total = 0;
+    if (!cb || !gb || !own || !cnt || !U) rc = hd__mpi_nomem(c, "the cells", NC);
+    if (rc == HD_OK) {
+        for (size_t k = 0; k < 2 * NC; k++)
+            for (int a = 0; a < 6; a++) cb[6 * k + a] = INFINITY;
+        size_t o = 0;
+        for (int s = 0; s < 2; s++) {
+            size_t t = 0, i = 0, ns = mine[s];
+            uint64_t n = in->n[s];
+            for (size_t p = 0; p < in->nparts[s]; p++) {
+                const hd_points_t *v = &in->parts[s][p].points;
+                const double *px = hd__mpi_packed(v);
+                for (size_t k = 0; k < v->count; k++, t++) {
+                    double xb[3];
+                    const double *x = px ? px + 3 * k : (hd_points_get(v, k, xb), xb);
+                    double *b = cb + 6 * ((size_t)s * NC + (size_t)hd__mpi_cell(pr, s, x));
+                    for (int a = 0; a < 3; a++) {
+                        b[a] = x[a] < b[a] ? x[a] : b[a];
+                        b[3 + a] = -x[a] < b[3 + a] ? -x[a] : b[3 + a];
+                    }
+                    /* the share: position i n / ns for i < ns (increasing, ns <= n) */
+                    if (i < ns && (uint64_t)i * n / ns == t) {
+                        memcpy(own[o].x, x, sizeof own[o].x);
+                        own[o].g = 0, own[o].side = (uint64_t)s;
+                        o++, i++;
+                    }
+                }
+            }
+        }
+    }
+    if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
+    HD__MPI_GO(c, rc, MPI_Allreduce(cb, gb, 2 * NC * 6, MPI_DOUBLE, MPI_MIN, c->comm));
+    int m = (int)(mine[0] + mine[1]);
+    HD__MPI_GO(c, rc, MPI_Allgather(&m, 1, MPI_INT, cnt, 1, MPI_INT, c->comm));
+    for (int r = 0; r < K; r++) cnt[K + r] = (int)total, total += (size_t)cnt[r];
+    all = hd__mpi_alloc(c, total ? total : 1, sizeof *all);
+    if (!all) rc = hd__mpi_nomem(c, "the sample", total);
+    if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
+    HD__MPI_GO(c, rc, MPI_Allgatherv(own, m, c->sample_type, all, cnt, cnt + K, c->sample_type, c->comm));
+    {
+        hd__box_t *box = (hd__box_t *)(void *)cb; /* the global cell boxes, reused */
+        unsigned char *full = (unsigned char *)(void *)gb; /* gb read into box first */
+        for (size_t k = 0; k < 2 * NC; k++) {
+            hd__box_t b;
+            for (int a = 0; a < 3; a++) b.lo[a] = gb[6 * k + a], b.hi[a] = -gb[6 * k + 3 + a];
+            box[k] = b;
+        }
+        for (size_t k = 0; k < 2 * NC; k++) full[k] = box[k].lo[0] <= box[k].hi[0];
+        /* The sample by set (A's first), then L (a sample point whose
+         * bound is already at most L cannot raise it), then U (the
+         * smallest: a larger one would keep more cells). */
+        qsort(all, total, sizeof *all, by_side);
+        size_t split = 0, from[2], to[2];
+        while (split < total && all[split].side == 0) split++;
+        from[0] = 0, to[0] = split, from[1] = split, to[1] = total;
+        double L[2] = {-1.0, -1.0};
+        for (int s = 0; s < 2; s++) {
+            int t = 1 - s;
+            for (size_t j = from[s]; j < to[s]; j++) {
+                double lb = INFINITY;
+                for (size_t k = 0; k < NC && lb > L[s]; k++)
+                    if (full[t * NC + k]) {
+                        double d = hd__box_lb2(&box[t * NC + k], all[j].x);
+                        lb = d < lb ? d : lb;
+                    }
+                L[s] = lb > L[s] ? lb : L[s];
+            }
+        }
+        for (size_t k = 0; k < 2 * NC; k++) U[k] = -1.0; /* not computed: cell_u */
+        /* Cell k of s is kept when it may hold the witness of direction s;
+         * then every kept point that is asked for its nearest (both sets'
+         * in the symmetric call, A's in the directed one) keeps every cell
+         * of the other set within its U, ties included, until nothing
+         * changes: a kept point's nearest among the kept points is its
+         * nearest among all, so a point kept only as a searched one keeps
+         * its d2 <= U < L and cannot win either. */
+        unsigned char (*kp)[NC] = pr->keep;
+        for (int s = 0; s < 2; s++)
+            for (size_t k = 0; k < NC; k++)
+                kp[s][k] = full[s * NC + k] && (s == 0 || both) &&
+                           (L[s] < 0.5 * half_diag2(&box[s * NC + k]) || !(cell_u(U, box, all, from, to, s, k) < L[s]));
+        for (int changed = 1; changed;) {
+            changed = 0;
+            for (int s = 0; s < (both ? 2 : 1); s++) {
+                int t = 1 - s;
+                for (size_t k = 0; k < NC; k++) {
+                    if (!kp[s][k]) continue;
+                    for (size_t j = 0; j < NC; j++)
+                        if (!kp[t][j] && full[t * NC + j] &&
+                            hd__box_box_lb2(&box[s * NC + k], &box[t * NC + j]) <= cell_u(U, box, all, from, to, s, k))
+                            kp[t][j] = 1, changed = 1;
+                }
+            }
+        }
+    }
+    pr->on = 1;
+done:
+    hd__mpi_free(c, cb, 2 * NC * 6, sizeof(double));
+    hd__mpi_free(c, gb, 2 * NC * 6, sizeof(double));
+    hd__mpi_free(c, own, mine[0] + mine[1] + 1, sizeof *own);
+    hd__mpi_free(c, cnt, 2 * (size_t)K, sizeof(int));
+    hd__mpi_free(c, all, total ? total : 1, sizeof *all);
+    hd__mpi_free(c, U, 2 * NC, sizeof(double));
+    return rc;
+}
