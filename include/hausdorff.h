@@ -1220,7 +1220,10 @@ typedef struct hd_enclosure {
     double tolerance;         /* the absolute tolerance used */
     int converged;            /* 1: upper - lower <= tolerance */
     size_t face_a;            /* the witness's triangle of X (SIZE_MAX
-                                 when X is a point set) */
+                                 when X is a point set, and when every
+                                 face of X is shared with Y: then there
+                                 is no witness, point_a is (0, 0, 0) and
+                                 the enclosure is [0, 0]) */
     size_t index_a;           /* the witness's point of X when X is a
                                  point set (SIZE_MAX otherwise) */
     double bary_a[3];         /* its weights of face_a's corners, in
