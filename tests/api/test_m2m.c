@@ -21,38 +21,21 @@
 #define SCALE 1
 #endif
 
-typedef struct {
-    double *v;
-    size_t nv;
-    uint64_t *t;
-    size_t nt;
-} soup_t;
-
-static hd_mesh_t view(const soup_t *s) {
-    hd_mesh_t m = {hd_points_f64(s->v, s->nv), s->t, s->nt, HD_INDEX_U64};
-    return m;
-}
-
-static soup_t soup_new(size_t nv, size_t nt) {
-    soup_t s = {calloc(3 * nv + 1, sizeof(double)), nv, calloc(3 * nt + 1, sizeof(uint64_t)), nt};
+static gen_soup_t soup_new(size_t nv, size_t nt) {
+    gen_soup_t s = {calloc(3 * nv + 1, sizeof(double)), nv, calloc(3 * nt + 1, sizeof(uint64_t)), nt};
     return s;
 }
 
-static void soup_free(soup_t *s) {
-    free(s->v);
-    free(s->t);
-}
-
-static soup_t soup_of(const double *v, size_t nv, const uint64_t *t, size_t nt) {
-    soup_t s = soup_new(nv, nt);
+static gen_soup_t soup_of(const double *v, size_t nv, const uint64_t *t, size_t nt) {
+    gen_soup_t s = soup_new(nv, nt);
     memcpy(s.v, v, 3 * nv * sizeof *v);
     memcpy(s.t, t, 3 * nt * sizeof *t);
     return s;
 }
 
 /* A soup of nt random triangles with integer corners in [-side, side]. */
-static soup_t random_soup(gen_rng_t *r, size_t nt, int side) {
-    soup_t s = soup_new(3 * nt, nt);
+static gen_soup_t random_soup(gen_rng_t *r, size_t nt, int side) {
+    gen_soup_t s = soup_new(3 * nt, nt);
     for (size_t k = 0; k < 3 * nt * 3; k++) s.v[k] = (double)((int)(gen_u64(r) % (uint64_t)(2 * side + 1)) - side);
     for (size_t k = 0; k < 3 * nt; k++) s.t[k] = k;
     return s;
@@ -60,7 +43,7 @@ static soup_t random_soup(gen_rng_t *r, size_t nt, int side) {
 
 /* Samples of face k of A on the grid of n steps (exact: integer corners,
  * n a power of two, coordinates below 2^40). */
-static size_t face_samples(const soup_t *A, size_t k, int n, double *out) {
+static size_t face_samples(const gen_soup_t *A, size_t k, int n, double *out) {
     const double *a = A->v + 3 * A->t[3 * k], *b = A->v + 3 * A->t[3 * k + 1], *c = A->v + 3 * A->t[3 * k + 2];
     size_t m = 0;
     for (int i = 0; i <= n; i++)
@@ -71,22 +54,22 @@ static size_t face_samples(const soup_t *A, size_t k, int n, double *out) {
 }
 
 /* The correctly rounded distances of n points to B. */
-static double *distances(const double *pts, size_t n, const soup_t *B) {
+static double *distances(const double *pts, size_t n, const gen_soup_t *B) {
     double *d = malloc(n * sizeof *d);
     hd_points_t P = hd_points_f64(pts, n);
-    hd_mesh_t M = view(B);
+    hd_mesh_t M = gen_soup_view(B);
     CHECK_RC(hd_mesh_distances(&P, &M, NULL, d, NULL, NULL, NULL, NULL, NULL), HD_OK);
     return d;
 }
 
-static double dist1(const double *p, const soup_t *B) {
+static double dist1(const double *p, const gen_soup_t *B) {
     double *d = distances(p, 1, B), r = d[0];
     free(d);
     return r;
 }
 
 /* The largest sampled distance of each face of A to B (grid of n). */
-static double *dense(const soup_t *A, const soup_t *B, int n) {
+static double *dense(const gen_soup_t *A, const gen_soup_t *B, int n) {
     size_t per = (size_t)(n + 1) * (size_t)(n + 2) / 2;
     double *pts = malloc(3 * per * A->nt * sizeof *pts), *best = malloc(A->nt * sizeof *best);
     for (size_t k = 0; k < A->nt; k++) face_samples(A, k, n, pts + 3 * per * k);
@@ -102,7 +85,7 @@ static double *dense(const soup_t *A, const soup_t *B, int n) {
 
 /* The witness is what the header says: its distance correctly rounded,
  * lower derived from it, the point where its weights put it. */
-static void witness_holds(const hd_enclosure_t *e, const soup_t *X, const soup_t *Y) {
+static void witness_holds(const hd_enclosure_t *e, const gen_soup_t *X, const gen_soup_t *Y) {
     if (e->face_a == SIZE_MAX) {
         CHECK(e->lower == 0 && e->upper == 0);
         return;
@@ -126,7 +109,7 @@ static void witness_holds(const hd_enclosure_t *e, const soup_t *X, const soup_t
 }
 
 /* The enclosure of h(X, Y) holds against the dense check of grid n. */
-static void encloses(const hd_enclosure_t *e, const soup_t *X, const soup_t *Y, int n) {
+static void encloses(const hd_enclosure_t *e, const gen_soup_t *X, const gen_soup_t *Y, int n) {
     CHECK(e->lower <= e->upper);
     CHECK(e->converged);
     CHECK(e->upper - e->lower <= e->tolerance);
@@ -160,8 +143,8 @@ static hd_surface_options_t options(double tol, int relative, int threads) {
 }
 
 /* Both directions at 1 and 3 threads, each enclosing, the same at both. */
-static void both_ways(const soup_t *A, const soup_t *B, double tol, int n) {
-    hd_mesh_t a = view(A), b = view(B);
+static void both_ways(const gen_soup_t *A, const gen_soup_t *B, double tol, int n) {
+    hd_mesh_t a = gen_soup_view(A), b = gen_soup_view(B);
     hd_enclosure_t ab1, ba1, ab3, ba3;
     hd_surface_options_t o1 = options(tol, 1, 1), o3 = options(tol, 1, 3);
     CHECK_RC(hd_surface_hausdorff(&a, &b, &o1, &ab1, &ba1, NULL), HD_OK);
@@ -175,21 +158,21 @@ static void both_ways(const soup_t *A, const soup_t *B, double tol, int n) {
 TEST(identical_meshes_are_zero) {
     const double v[] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 1};
     const uint64_t t[] = {0, 1, 2, 1, 3, 2};
-    soup_t A = soup_of(v, 4, t, 2);
-    hd_mesh_t a = view(&A);
+    gen_soup_t A = soup_of(v, 4, t, 2);
+    hd_mesh_t a = gen_soup_view(&A);
     hd_enclosure_t ab, ba;
     CHECK_RC(hd_surface_hausdorff(&a, &a, NULL, &ab, &ba, NULL), HD_OK);
     CHECK(ab.lower == 0 && ab.upper == 0 && ba.upper == 0);
     CHECK_EQ(ab.faces_dropped, 2);
     CHECK_EQ(ab.faces_split, 0);
-    soup_free(&A);
+    gen_soup_free(&A);
 }
 
 TEST(parallel_shifted_triangle_is_its_shift) {
     const double v[] = {0, 0, 0, 8, 0, 0, 0, 8, 0, 0, 0, 3, 8, 0, 3, 0, 8, 3};
     const uint64_t ta[] = {0, 1, 2}, tb[] = {3, 4, 5};
-    soup_t A = soup_of(v, 6, ta, 1), B = soup_of(v, 6, tb, 1);
-    hd_mesh_t a = view(&A), b = view(&B);
+    gen_soup_t A = soup_of(v, 6, ta, 1), B = soup_of(v, 6, tb, 1);
+    hd_mesh_t a = gen_soup_view(&A), b = gen_soup_view(&B);
     hd_enclosure_t ab;
     hd_surface_options_t o = options(0, 0, 1);
     CHECK_RC(hd_surface_hausdorff(&a, &b, &o, &ab, NULL, NULL), HD_OK);
@@ -197,8 +180,8 @@ TEST(parallel_shifted_triangle_is_its_shift) {
     CHECK(ab.upper >= 3.0 && ab.upper - 3.0 <= 1e-12);
     CHECK_EQ(ab.witness_error, 0);
     encloses(&ab, &A, &B, 16);
-    soup_free(&A);
-    soup_free(&B);
+    gen_soup_free(&A);
+    gen_soup_free(&B);
 }
 
 /* A right triangle against its three corners as points: the farthest
@@ -206,8 +189,8 @@ TEST(parallel_shifted_triangle_is_its_shift) {
 TEST(triangle_to_its_corners_is_the_circumradius) {
     const double v[] = {0, 0, 0, 4, 0, 0, 0, 4, 0};
     const uint64_t t[] = {0, 1, 2};
-    soup_t A = soup_of(v, 3, t, 1);
-    hd_mesh_t a = view(&A);
+    gen_soup_t A = soup_of(v, 3, t, 1);
+    hd_mesh_t a = gen_soup_view(&A);
     hd_points_t B = hd_points_f64(v, 3);
     hd_enclosure_t ab, ba;
     hd_surface_options_t o = options(1e-12, 1, 1);
@@ -222,7 +205,7 @@ TEST(triangle_to_its_corners_is_the_circumradius) {
     CHECK_RC(hd_surface_points_hausdorff(&a, &B, &o, &ab, NULL, NULL), HD_OK);
     CHECK(ab.lower <= r && r <= ab.upper);
     CHECK(ab.upper - ab.lower <= 1e-13);
-    soup_free(&A);
+    gen_soup_free(&A);
 }
 
 /* The two triangulations of a non-planar quad share every vertex, so a
@@ -230,22 +213,22 @@ TEST(triangle_to_its_corners_is_the_circumradius) {
 TEST(quad_split_two_ways_is_not_zero) {
     const double v[] = {0, 0, 0, 4, 0, 0, 4, 4, 4, 0, 4, 0};
     const uint64_t ta[] = {0, 1, 2, 0, 2, 3}, tb[] = {0, 1, 3, 1, 2, 3};
-    soup_t A = soup_of(v, 4, ta, 2), B = soup_of(v, 4, tb, 2);
+    gen_soup_t A = soup_of(v, 4, ta, 2), B = soup_of(v, 4, tb, 2);
     double *corners = dense(&A, &B, 1); /* grid 1: the vertices */
     CHECK(corners[0] == 0 && corners[1] == 0);
     free(corners);
     both_ways(&A, &B, 1e-9, 64 / SCALE);
-    hd_mesh_t a = view(&A), b = view(&B);
+    hd_mesh_t a = gen_soup_view(&A), b = gen_soup_view(&B);
     hd_enclosure_t ab;
     CHECK_RC(hd_surface_hausdorff(&a, &b, NULL, &ab, NULL, NULL), HD_OK);
     CHECK(ab.lower >= 2 / sqrt(3.0) - 1e-6); /* the diagonal's midpoint */
     /* planar: the same two triangulations of a flat square are one surface */
     const double w[] = {0, 0, 0, 4, 0, 0, 4, 4, 0, 0, 4, 0};
-    soup_t F = soup_of(w, 4, ta, 2), G = soup_of(w, 4, tb, 2);
-    hd_mesh_t f = view(&F), g = view(&G);
+    gen_soup_t F = soup_of(w, 4, ta, 2), G = soup_of(w, 4, tb, 2);
+    hd_mesh_t f = gen_soup_view(&F), g = gen_soup_view(&G);
     CHECK_RC(hd_surface_hausdorff(&f, &g, NULL, &ab, NULL, NULL), HD_OK);
     CHECK(ab.lower == 0 && ab.upper <= ab.tolerance);
-    soup_free(&A), soup_free(&B), soup_free(&F), soup_free(&G);
+    gen_soup_free(&A), gen_soup_free(&B), gen_soup_free(&F), gen_soup_free(&G);
 }
 
 /* A's vertices one ulp apart in height over a flat B: their bounds
@@ -255,7 +238,7 @@ TEST(quad_split_two_ways_is_not_zero) {
  * stops at the corners the lower bound is its distance. */
 TEST(corners_whose_bounds_overlap_give_the_exact_farthest) {
     enum { N = 12, M = 8, NB = (M + 1) * (M + 1) };
-    soup_t A = soup_new(N * N, 2 * (N - 1) * (N - 1)), B = soup_new(NB + 4, 2 * M * M + 2);
+    gen_soup_t A = soup_new(N * N, 2 * (N - 1) * (N - 1)), B = soup_new(NB + 4, 2 * M * M + 2);
     for (int i = 0; i < N * N; i++) {
         double *p = A.v + 3 * i;
         p[0] = (i % N + 0.37) / N, p[1] = (i / N + 0.61) / N;
@@ -284,7 +267,7 @@ TEST(corners_whose_bounds_overlap_give_the_exact_farthest) {
     double *d = distances(A.v, A.nv, &B), far = 0;
     for (size_t i = 0; i < A.nv; i++) far = fmax(far, d[i]);
     free(d);
-    hd_mesh_t a = view(&A), b = view(&B);
+    hd_mesh_t a = gen_soup_view(&A), b = gen_soup_view(&B);
     hd_enclosure_t ab1, ab3;
     hd_surface_options_t o1 = options(1, 1, 1), o3 = options(1, 1, 3);
     CHECK_RC(hd_surface_hausdorff(&a, &b, &o1, &ab1, NULL, NULL), HD_OK);
@@ -294,18 +277,18 @@ TEST(corners_whose_bounds_overlap_give_the_exact_farthest) {
     CHECK_EQ(ab1.witness_error, 0);
     witness_holds(&ab1, &A, &B);
     same_enclosure(&ab1, &ab3);
-    soup_free(&A);
-    soup_free(&B);
+    gen_soup_free(&A);
+    gen_soup_free(&B);
 }
 
 TEST(tetrahedron_against_its_scaled_copy) {
     const double v[] = {0, 0, 0, 8, 0, 0, 0, 8, 0, 0, 0, 8, -4, -4, -4, 12, -4, -4, -4, 12, -4, -4, -4, 12};
     const uint64_t ta[] = {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3}, tb[] = {4, 6, 5, 4, 5, 7, 4, 7, 6, 5, 6, 7};
-    soup_t A = soup_of(v, 8, ta, 4), B = soup_of(v, 8, tb, 4);
+    gen_soup_t A = soup_of(v, 8, ta, 4), B = soup_of(v, 8, tb, 4);
     both_ways(&A, &B, 1e-9, 64 / SCALE);
     both_ways(&A, &B, 1e-4, 32 / SCALE);
-    soup_free(&A);
-    soup_free(&B);
+    gen_soup_free(&A);
+    gen_soup_free(&B);
 }
 
 TEST(degenerate_faces_are_their_hulls) {
@@ -314,10 +297,10 @@ TEST(degenerate_faces_are_their_hulls) {
     const double v[] = {0, 0, 0, 8, 0, 0, 0, 8, 0, 16, 0, 0, 24, 0, 0, 4, 4, 4,
                         0, 0, 4, 8, 0, 4, 16, 8, 4, -8, 0, 2, 0, 8, 6};
     const uint64_t ta[] = {0, 1, 2, 1, 3, 4, 5, 5, 5}, tb[] = {6, 7, 8, 9, 10, 10};
-    soup_t A = soup_of(v, 11, ta, 3), B = soup_of(v, 11, tb, 2);
+    gen_soup_t A = soup_of(v, 11, ta, 3), B = soup_of(v, 11, tb, 2);
     both_ways(&A, &B, 1e-9, 64 / SCALE);
-    soup_free(&A);
-    soup_free(&B);
+    gen_soup_free(&A);
+    gen_soup_free(&B);
 }
 
 TEST(random_soups_both_ways) {
@@ -325,10 +308,10 @@ TEST(random_soups_both_ways) {
         CONTEXT("seed %llu", (unsigned long long)seed);
         gen_rng_t r;
         gen_seed(&r, seed);
-        soup_t A = random_soup(&r, 2 + seed % 5, 16), B = random_soup(&r, 1 + seed % 7, 16);
+        gen_soup_t A = random_soup(&r, 2 + seed % 5, 16), B = random_soup(&r, 1 + seed % 7, 16);
         both_ways(&A, &B, seed % 2 ? 1e-9 : 1e-5, 32);
-        soup_free(&A);
-        soup_free(&B);
+        gen_soup_free(&A);
+        gen_soup_free(&B);
         if (hdt_failed()) break;
     }
 }
@@ -341,10 +324,10 @@ TEST(meshes_far_from_the_origin) {
         CONTEXT("seed %llu", (unsigned long long)seed);
         gen_rng_t r;
         gen_seed(&r, seed);
-        soup_t A = random_soup(&r, 3, 1024), B = random_soup(&r, 3, 1024);
+        gen_soup_t A = random_soup(&r, 3, 1024), B = random_soup(&r, 3, 1024);
         for (size_t k = 0; k < 3 * A.nv; k++) A.v[k] = 0x1p20 + A.v[k] * 0x1p-26;
         for (size_t k = 0; k < 3 * B.nv; k++) B.v[k] = 0x1p20 + B.v[k] * 0x1p-26;
-        hd_mesh_t a = view(&A), b = view(&B);
+        hd_mesh_t a = gen_soup_view(&A), b = gen_soup_view(&B);
         hd_enclosure_t ab, ba, ab3, ba3;
         hd_surface_options_t o1 = options(0, 0, 1), o3 = options(0, 0, 3);
         CHECK_RC(hd_surface_hausdorff(&a, &b, &o1, &ab, &ba, NULL), HD_OK);
@@ -353,7 +336,7 @@ TEST(meshes_far_from_the_origin) {
         encloses(&ba, &B, &A, 16);
         same_enclosure(&ab, &ab3);
         same_enclosure(&ba, &ba3);
-        soup_free(&A), soup_free(&B);
+        gen_soup_free(&A), gen_soup_free(&B);
         if (hdt_failed()) break;
     }
 }
@@ -363,12 +346,12 @@ TEST(surface_to_points_encloses_and_points_to_surface_is_exact) {
         CONTEXT("seed %llu", (unsigned long long)seed);
         gen_rng_t r;
         gen_seed(&r, seed);
-        soup_t A = random_soup(&r, 4, 16), Bt = random_soup(&r, 5, 16);
+        gen_soup_t A = random_soup(&r, 4, 16), Bt = random_soup(&r, 5, 16);
         /* B: the points, and the same points as point-triangles for the check */
-        soup_t Bp = soup_new(Bt.nv, Bt.nv);
+        gen_soup_t Bp = soup_new(Bt.nv, Bt.nv);
         memcpy(Bp.v, Bt.v, 3 * Bt.nv * sizeof(double));
         for (size_t k = 0; k < Bt.nv; k++) Bp.t[3 * k] = Bp.t[3 * k + 1] = Bp.t[3 * k + 2] = k;
-        hd_mesh_t a = view(&A);
+        hd_mesh_t a = gen_soup_view(&A);
         hd_points_t B = hd_points_f64(Bt.v, Bt.nv);
         hd_enclosure_t ab, ba, ab3;
         hd_surface_options_t o1 = options(1e-9, 1, 1), o3 = options(1e-9, 1, 3);
@@ -382,7 +365,7 @@ TEST(surface_to_points_encloses_and_points_to_surface_is_exact) {
         CHECK_BITS(ba.upper, want.distance);
         CHECK_EQ(ba.index_a, want.i);
         CHECK_EQ(ba.face_b, want.triangle);
-        soup_free(&A), soup_free(&Bt), soup_free(&Bp);
+        gen_soup_free(&A), gen_soup_free(&Bt), gen_soup_free(&Bp);
         if (hdt_failed()) break;
     }
 }
@@ -392,8 +375,8 @@ TEST(predicate_agrees_with_the_enclosure) {
         CONTEXT("seed %llu", (unsigned long long)seed);
         gen_rng_t r;
         gen_seed(&r, seed);
-        soup_t A = random_soup(&r, 4, 16), B = random_soup(&r, 4, 16);
-        hd_mesh_t a = view(&A), b = view(&B);
+        gen_soup_t A = random_soup(&r, 4, 16), B = random_soup(&r, 4, 16);
+        hd_mesh_t a = gen_soup_view(&A), b = gen_soup_view(&B);
         hd_enclosure_t ab, ba;
         hd_surface_options_t o = options(1e-9, 1, 2);
         CHECK_RC(hd_surface_hausdorff(&a, &b, &o, &ab, &ba, NULL), HD_OK);
@@ -407,7 +390,7 @@ TEST(predicate_agrees_with_the_enclosure) {
         CHECK_EQ(answer, 1);
         CHECK_RC(hd_surface_within(&a, &b, ab.lower * (1 - 1e-6), 1, &o, &answer, NULL, NULL, NULL), HD_OK);
         CHECK_EQ(answer, 0);
-        soup_free(&A), soup_free(&B);
+        gen_soup_free(&A), gen_soup_free(&B);
         if (hdt_failed()) break;
     }
 }
@@ -415,8 +398,8 @@ TEST(predicate_agrees_with_the_enclosure) {
 TEST(face_maxima_enclose_each_face) {
     gen_rng_t r;
     gen_seed(&r, 7);
-    soup_t A = random_soup(&r, 6, 16), B = random_soup(&r, 5, 16);
-    hd_mesh_t a = view(&A), b = view(&B);
+    gen_soup_t A = random_soup(&r, 6, 16), B = random_soup(&r, 5, 16);
+    hd_mesh_t a = gen_soup_view(&A), b = gen_soup_view(&B);
     double lo[6], hi[6], lo3[6], hi3[6];
     hd_enclosure_t ab, all;
     hd_surface_options_t o = options(1e-9, 1, 1), o3 = options(1e-9, 1, 3);
@@ -435,14 +418,14 @@ TEST(face_maxima_enclose_each_face) {
     }
     CHECK(top >= all.lower);
     free(best);
-    soup_free(&A), soup_free(&B);
+    gen_soup_free(&A), gen_soup_free(&B);
 }
 
 TEST(bad_input_is_refused) {
     const double v[] = {0, 0, 0, 1, 0, 0, 0, 1, 0, NAN, 0, 0};
     const uint64_t t[] = {0, 1, 2}, bad[] = {0, 1, 3}, far[] = {0, 1, 9};
-    soup_t A = soup_of(v, 4, t, 1), N = soup_of(v, 4, bad, 1), F = soup_of(v, 4, far, 1);
-    hd_mesh_t a = view(&A), n = view(&N), f = view(&F), e = view(&A);
+    gen_soup_t A = soup_of(v, 4, t, 1), N = soup_of(v, 4, bad, 1), F = soup_of(v, 4, far, 1);
+    hd_mesh_t a = gen_soup_view(&A), n = gen_soup_view(&N), f = gen_soup_view(&F), e = gen_soup_view(&A);
     e.n_triangles = 0;
     hd_enclosure_t ab;
     hd_error_t err;
@@ -459,5 +442,5 @@ TEST(bad_input_is_refused) {
     CHECK_RC(hd_surface_within(&a, &a, -1, 0, NULL, &answer, NULL, NULL, &err), HD_EINVAL);
     hd_points_t none = hd_points_f64(v, 0);
     CHECK_RC(hd_surface_points_hausdorff(&a, &none, NULL, &ab, NULL, &err), HD_EEMPTY);
-    soup_free(&A), soup_free(&N), soup_free(&F);
+    gen_soup_free(&A), gen_soup_free(&N), gen_soup_free(&F);
 }

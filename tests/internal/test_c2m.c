@@ -22,20 +22,8 @@
 #define SCALE 1
 #endif
 
-typedef struct {
-    double *v;
-    size_t nv;
-    uint64_t *t;
-    size_t nt;
-} soup_t;
-
-static hd_mesh_t view(const soup_t *s) {
-    hd_mesh_t m = {hd_points_f64(s->v, s->nv), s->t, s->nt, HD_INDEX_U64};
-    return m;
-}
-
 /* The brute force: every triangle, smallest distance, smallest index. */
-static void brute(const soup_t *s, const double *p, hd__tri_near_t *best, size_t *index) {
+static void brute(const gen_soup_t *s, const double *p, hd__tri_near_t *best, size_t *index) {
     *index = SIZE_MAX;
     for (size_t k = 0; k < s->nt; k++) {
         hd__tri_near_t r;
@@ -47,9 +35,9 @@ static void brute(const soup_t *s, const double *p, hd__tri_near_t *best, size_t
 
 /* hd_mesh_distances at 1 and 3 threads equals the brute force on every
  * point; returns the number of points whose nearest triangle was exact. */
-static void same_as_brute(const soup_t *s, const double *pts, size_t n, const char *what) {
+static void same_as_brute(const gen_soup_t *s, const double *pts, size_t n, const char *what) {
     hd_points_t P = hd_points_f64(pts, n);
-    hd_mesh_t M = view(s);
+    hd_mesh_t M = gen_soup_view(s);
     double *d = malloc(n * sizeof *d), *cp = malloc(3 * n * sizeof *cp), *bc = malloc(3 * n * sizeof *bc);
     size_t *tri = malloc(n * sizeof *tri);
     double far = -1;
@@ -93,7 +81,7 @@ static void same_as_brute(const soup_t *s, const double *pts, size_t n, const ch
     free(d), free(cp), free(bc), free(tri), free(want), free(want_t);
 }
 
-static void soup_random(gen_rng_t *g, soup_t *s, size_t nt, double size) {
+static void soup_random(gen_rng_t *g, gen_soup_t *s, size_t nt, double size) {
     s->nv = 3 * nt, s->nt = nt;
     s->v = malloc(3 * s->nv * sizeof *s->v);
     s->t = malloc(3 * nt * sizeof *s->t);
@@ -106,14 +94,9 @@ static void soup_random(gen_rng_t *g, soup_t *s, size_t nt, double size) {
     }
 }
 
-static void soup_free(soup_t *s) {
-    free(s->v);
-    free(s->t);
-}
-
 /* n points: a third uniform in the cube [-1, 2]^3, a third near corners
  * and edges of the mesh, a third far (1e3 away). */
-static double *points_around(gen_rng_t *g, const soup_t *s, size_t n) {
+static double *points_around(gen_rng_t *g, const gen_soup_t *s, size_t n) {
     double *p = malloc(3 * n * sizeof *p);
     for (size_t i = 0; i < n; i++) {
         double *q = p + 3 * i;
@@ -138,7 +121,7 @@ TEST(random_soups_equal_the_brute_force_at_1_and_3_threads) {
     for (uint64_t seed = 1; seed <= 6; seed++) {
         gen_rng_t g;
         gen_seed(&g, seed);
-        soup_t s;
+        gen_soup_t s;
         soup_random(&g, &s, seed < 4 ? 50 : 400 / SCALE, seed % 2 ? 0.2 : 0.02);
         size_t n = 1500 / SCALE;
         double *p = points_around(&g, &s, n);
@@ -146,13 +129,13 @@ TEST(random_soups_equal_the_brute_force_at_1_and_3_threads) {
         snprintf(what, sizeof what, "random soup, seed %llu", (unsigned long long)seed);
         same_as_brute(&s, p, n, what);
         free(p);
-        soup_free(&s);
+        gen_soup_free(&s);
     }
 }
 
 /* A triangulated grid of side x side unit squares in z = 0 (integer
  * corners), each square split along its diagonal into two triangles. */
-static void soup_grid(soup_t *s, int side) {
+static void soup_grid(gen_soup_t *s, int side) {
     s->nv = (size_t)(side + 1) * (side + 1), s->nt = 2 * (size_t)side * side;
     s->v = malloc(3 * s->nv * sizeof *s->v);
     s->t = malloc(3 * s->nt * sizeof *s->t);
@@ -172,7 +155,7 @@ static void soup_grid(soup_t *s, int side) {
 }
 
 TEST(points_on_corners_edges_and_faces_are_at_zero_from_the_smallest_triangle) {
-    soup_t s;
+    gen_soup_t s;
     soup_grid(&s, 8);
     /* corners (up to 6 triangles), edge midpoints (2), face points, and the
      * same raised by 1/4 (the same ties at distance 0.25) */
@@ -191,17 +174,17 @@ TEST(points_on_corners_edges_and_faces_are_at_zero_from_the_smallest_triangle) {
     }
     same_as_brute(&s, p, n, "grid, points on features");
     hd_points_t P = hd_points_f64(p, 1);
-    hd_mesh_t M = view(&s);
+    hd_mesh_t M = gen_soup_view(&s);
     double d;
     size_t t;
     CHECK_RC(hd_mesh_distances(&P, &M, NULL, &d, &t, NULL, NULL, NULL, NULL), HD_OK);
     CHECK_BITS(d, 0.0); /* the corner (0,0,0): triangles 0 and 1 touch it */
     CHECK_EQ(t, 0);
-    soup_free(&s);
+    gen_soup_free(&s);
 }
 
 TEST(duplicated_triangles_tie_to_the_smallest_index) {
-    soup_t s;
+    gen_soup_t s;
     soup_grid(&s, 4);
     /* append every triangle again, corners rotated, in reverse order */
     size_t nt = s.nt;
@@ -221,11 +204,11 @@ TEST(duplicated_triangles_tie_to_the_smallest_index) {
     }
     same_as_brute(&s, p, 300, "grid with every triangle twice");
     hd_points_t P = hd_points_f64(p, 300);
-    hd_mesh_t M = view(&s);
+    hd_mesh_t M = gen_soup_view(&s);
     size_t tri[300];
     CHECK_RC(hd_mesh_distances(&P, &M, NULL, NULL, tri, NULL, NULL, NULL, NULL), HD_OK);
     for (int i = 0; i < 300; i++) CHECK(tri[i] < nt);
-    soup_free(&s);
+    gen_soup_free(&s);
 }
 
 /* Two triangles whose true distances differ but round to the same double:
@@ -247,7 +230,7 @@ TEST(equal_rounded_distances_tie_to_the_smallest_index_whatever_the_true_order) 
     if (!found) return;
     gen_rng_t g;
     gen_seed(&g, 41);
-    soup_t s;
+    gen_soup_t s;
     soup_random(&g, &s, 300, 0.3); /* in [-0.15, 1.15]^3, then 4 higher: never nearest */
     for (size_t k = 0; k < 3 * s.nv; k += 3) s.v[k + 2] += 4;
     double tri0[9] = {v0[0], v0[1], 0, 11, v0[1], 0, 1, v0[1] + 10, 0};
@@ -263,14 +246,14 @@ TEST(equal_rounded_distances_tie_to_the_smallest_index_whatever_the_true_order) 
             for (int c = 0; c < 3; c++) p[3 * i + c] = i % 2 ? 0 : 0.01 * (gen_unit(&g) - 0.5);
         same_as_brute(&s, p, 64, place ? "equal rounded distances, farther last" : "equal rounded distances, farther first");
         hd_points_t P = hd_points_f64(o, 1);
-        hd_mesh_t M = view(&s);
+        hd_mesh_t M = gen_soup_view(&s);
         double d;
         size_t t;
         CHECK_RC(hd_mesh_distances(&P, &M, NULL, &d, &t, NULL, NULL, NULL, NULL), HD_OK);
         CHECK_BITS(d, r1.d);
         CHECK_EQ(t, a < b ? a : b);
     }
-    soup_free(&s);
+    gen_soup_free(&s);
 }
 
 TEST(degenerate_triangles_are_their_hulls_and_counted) {
@@ -281,7 +264,7 @@ TEST(degenerate_triangles_are_their_hulls_and_counted) {
                   5, 5, 5, 6, 5, 5, 5.5, 5 + 0x1p-50, 5, /* 6-8 nearly collinear: a triangle */
                   0, 0, 4, 1, 0, 4, 0, 1, 4};   /* 9-11 proper */
     uint64_t t[] = {0, 1, 2, 1, 1, 9, 3, 4, 5, 6, 7, 8, 9, 10, 11, 2, 2, 2};
-    soup_t s = {v, 12, t, 6};
+    gen_soup_t s = {v, 12, t, 6};
     gen_rng_t g;
     gen_seed(&g, 5);
     double p[3 * 600];
@@ -289,7 +272,7 @@ TEST(degenerate_triangles_are_their_hulls_and_counted) {
         for (int c = 0; c < 3; c++) p[3 * i + c] = 8 * gen_unit(&g) - 1.5;
     same_as_brute(&s, p, 600, "degenerate triangles");
     hd_points_t P = hd_points_f64(p, 600);
-    hd_mesh_t M = view(&s);
+    hd_mesh_t M = gen_soup_view(&s);
     hd_surface_result_t r;
     CHECK_RC(hd_mesh_distances(&P, &M, NULL, NULL, NULL, NULL, NULL, &r, NULL), HD_OK);
     CHECK_EQ(r.n_degenerate, 4); /* 0-1-2, 1-1-9, 3-4-5, 2-2-2 */
@@ -303,7 +286,7 @@ TEST(degenerate_triangles_are_their_hulls_and_counted) {
 }
 
 /* A mesh file's vertices and faces as a soup. */
-static int soup_read(const char *path, soup_t *s) {
+static int soup_read(const char *path, gen_soup_t *s) {
     hd_mesh_file_t *m;
     hd_error_t err;
     int rc = hd_read_mesh(path, NULL, &m, &err);
@@ -325,7 +308,7 @@ TEST(bundled_models_equal_the_brute_force) {
     const char *files[] = {"data/orig/pinion.off", "data/orig/cow.off", "data/orig/Wuson.stl",
                            "data/orig/WusonOBJ.obj", "data/orig/stanford_bunny_reduced.ply"};
     for (size_t f = 0; f < sizeof files / sizeof *files; f++) {
-        soup_t s;
+        gen_soup_t s;
         if (soup_read(files[f], &s)) continue;
         gen_rng_t g;
         gen_seed(&g, 100 + f);
@@ -353,14 +336,14 @@ TEST(bundled_models_equal_the_brute_force) {
         }
         same_as_brute(&s, p, n, files[f]);
         free(p);
-        soup_free(&s);
+        gen_soup_free(&s);
     }
 }
 
 TEST(float32_strided_vertices_and_uint32_indices_give_the_same_answers) {
     gen_rng_t g;
     gen_seed(&g, 21);
-    soup_t s;
+    gen_soup_t s;
     soup_random(&g, &s, 100, 0.3);
     float *vf = malloc(4 * s.nv * sizeof *vf); /* x y z and a pad, as float */
     uint32_t *t32 = malloc(3 * s.nt * sizeof *t32);
@@ -373,7 +356,7 @@ TEST(float32_strided_vertices_and_uint32_indices_give_the_same_answers) {
     size_t n = 300;
     double *p = points_around(&g, &s, n);
     hd_points_t P = hd_points_f64(p, n);
-    hd_mesh_t M64 = view(&s);
+    hd_mesh_t M64 = gen_soup_view(&s);
     hd_mesh_t M32 = {{vf, s.nv, HD_FLOAT32, 4 * sizeof(float), 0}, t32, s.nt, HD_INDEX_U32};
     double d64[300], d32[300];
     size_t t64[300], tt32[300];
@@ -382,7 +365,7 @@ TEST(float32_strided_vertices_and_uint32_indices_give_the_same_answers) {
     CHECK(memcmp(d64, d32, sizeof d64) == 0);
     CHECK(memcmp(t64, tt32, sizeof t64) == 0);
     free(vf), free(t32), free(p);
-    soup_free(&s);
+    gen_soup_free(&s);
 }
 
 /* The bounds the search discards with (a box's, the support bound in the
@@ -492,7 +475,7 @@ TEST(bad_meshes_get_an_error_naming_the_triangle) {
 /* ---- the discards of the search: far, clustered, tied, scaled ---------- */
 
 /* The corners' box of a soup. */
-static void soup_box(const soup_t *s, double lo[3], double hi[3]) {
+static void soup_box(const gen_soup_t *s, double lo[3], double hi[3]) {
     for (int c = 0; c < 3; c++) lo[c] = hi[c] = s->v[c];
     for (size_t k = 0; k < s->nv; k++)
         for (int c = 0; c < 3; c++) {
@@ -507,7 +490,7 @@ static void soup_box(const soup_t *s, double lo[3], double hi[3]) {
 TEST(far_and_clustered_clouds_equal_the_brute_force) {
     const char *files[] = {"data/orig/pinion.off", "data/orig/cow.off"};
     for (size_t f = 0; f < 2; f++) {
-        soup_t s;
+        gen_soup_t s;
         if (soup_read(files[f], &s)) continue;
         double lo[3], hi[3];
         soup_box(&s, lo, hi);
@@ -532,7 +515,7 @@ TEST(far_and_clustered_clouds_equal_the_brute_force) {
         snprintf(what, sizeof what, "%s, far and clustered clouds (seed %zu)", files[f], 300 + f);
         same_as_brute(&s, p, n, what);
         free(p);
-        soup_free(&s);
+        gen_soup_free(&s);
     }
 }
 
@@ -543,7 +526,7 @@ TEST(far_and_clustered_clouds_equal_the_brute_force) {
 TEST(equidistant_points_of_a_symmetric_mesh_tie_to_the_smallest_index) {
     double v[] = {1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1};
     uint64_t t[] = {0, 2, 4, 2, 1, 4, 1, 3, 4, 3, 0, 4, 2, 0, 5, 1, 2, 5, 3, 1, 5, 0, 3, 5};
-    soup_t s = {v, 6, t, 8};
+    gen_soup_t s = {v, 6, t, 8};
     double p[3 * 400];
     size_t n = 0;
     for (int i = 0; i < 40; i++) p[n++] = 0, p[n++] = 0, p[n++] = 0; /* the centre, 40 times */
@@ -567,7 +550,7 @@ TEST(equidistant_points_of_a_symmetric_mesh_tie_to_the_smallest_index) {
     }
     same_as_brute(&s, p, 400, "octahedron, beyond the corner (1, 0, 0) (seed 400)");
     hd_points_t P = hd_points_f64(p, 400);
-    hd_mesh_t M = view(&s);
+    hd_mesh_t M = gen_soup_view(&s);
     hd_surface_result_t r;
     CHECK_RC(hd_mesh_distances(&P, &M, NULL, NULL, NULL, NULL, NULL, &r, NULL), HD_OK);
     CONTEXT("octahedron, 400 points beyond a corner: %llu kernel calls", (unsigned long long)r.kernel_calls);
@@ -582,7 +565,7 @@ TEST(huge_and_tiny_coordinates_equal_the_brute_force) {
     for (size_t k = 0; k < sizeof scales / sizeof *scales; k++) {
         gen_rng_t g;
         gen_seed(&g, 500 + k);
-        soup_t s;
+        gen_soup_t s;
         soup_random(&g, &s, 200 / SCALE, k % 2 ? 0.2 : 0.02);
         size_t n = 900 / SCALE;
         double *p = points_around(&g, &s, n);
@@ -592,7 +575,7 @@ TEST(huge_and_tiny_coordinates_equal_the_brute_force) {
         snprintf(what, sizeof what, "random soup scaled by %g (seed %zu)", scales[k], 500 + k);
         same_as_brute(&s, p, n, what);
         free(p);
-        soup_free(&s);
+        gen_soup_free(&s);
     }
 }
 
@@ -601,7 +584,7 @@ TEST(huge_and_tiny_coordinates_equal_the_brute_force) {
 TEST(clusters_on_degenerate_triangles_equal_the_brute_force) {
     gen_rng_t g;
     gen_seed(&g, 600);
-    soup_t s;
+    gen_soup_t s;
     soup_random(&g, &s, 300 / SCALE, 0.1);
     for (size_t k = 0; k < s.nt; k += 3) { /* every third: a segment, a point or a needle */
         double *a = s.v + 9 * k, *b = a + 3, *c = a + 6;
@@ -618,14 +601,14 @@ TEST(clusters_on_degenerate_triangles_equal_the_brute_force) {
     }
     same_as_brute(&s, p, n, "clusters on degenerate triangles (seed 600)");
     free(p);
-    soup_free(&s);
+    gen_soup_free(&s);
 }
 
 /* The prepared bounds decide before the kernel: on a cloud near a smooth
  * model the kernel runs for about one triangle a point (the nearest),
  * and on a cloud far from it for its ties only. */
 TEST(the_kernel_runs_about_once_a_point) {
-    soup_t s;
+    gen_soup_t s;
     if (soup_read("data/orig/cow.off", &s)) return;
     double lo[3], hi[3];
     soup_box(&s, lo, hi);
@@ -641,11 +624,11 @@ TEST(the_kernel_runs_about_once_a_point) {
                            1e-3 * (hi[c] - lo[c]) * (gen_unit(&g) - 0.5);
     }
     hd_points_t P = hd_points_f64(p, n);
-    hd_mesh_t M = view(&s);
+    hd_mesh_t M = gen_soup_view(&s);
     hd_surface_result_t r;
     CHECK_RC(hd_mesh_distances(&P, &M, NULL, NULL, NULL, NULL, NULL, &r, NULL), HD_OK);
     CONTEXT("cow, %zu near points (seed 700): %llu kernel calls", n, (unsigned long long)r.kernel_calls);
     CHECK(r.kernel_calls <= n + n / 50);
     free(p);
-    soup_free(&s);
+    gen_soup_free(&s);
 }

@@ -56,32 +56,10 @@ static double largest(const hd_points_t *A, const hd_points_t *B, size_t pick, d
     return m;
 }
 
-/* Two sets by seed: kind 0 Gaussians, 1 lattices of 8 per side (ties),
- * 2 lattices of 3 per side (duplicates in both), 3 a large set against a
- * few points, 4 a noisy copy in random order. */
+/* Two sets by seed (gen_mixed_pair), named in the failure context. */
 static void make_pair(uint64_t seed, size_t n, double **a, double **b, hd_points_t *A, hd_points_t *B) {
-    int kind = (int)(seed % 5);
-    gen_rng_t g;
-    gen_seed(&g, seed);
-    size_t na = n, nb = kind == 3 ? 1 + gen_u64(&g) % 40 : kind == 4 ? n : 1 + n / 2 + gen_u64(&g) % n;
-    *a = malloc(24 * na);
-    *b = malloc(24 * nb);
-    double m0[3] = {0, 0, 0}, m1[3] = {0.5, 0, 0};
-    if (kind == 0 || kind == 3) {
-        gen_gauss(&g, *a, na, m0, 1.0);
-        gen_gauss(&g, *b, nb, m1, 1.0);
-    } else if (kind == 1 || kind == 2) {
-        gen_lattice(&g, *a, na, kind == 1 ? 8 : 3);
-        gen_lattice(&g, *b, nb, kind == 1 ? 8 : 3);
-        gen_affine(*b, nb, 1.0, 0.5);
-    } else {
-        gen_gauss(&g, *a, na, m0, 1.0);
-        for (size_t k = 0; k < 3 * na; k++) (*b)[k] = (*a)[k] + 1e-3 * gen_normal(&g);
-        for (size_t k = nb; k > 1; k--) gen_swap(*b, k - 1, gen_u64(&g) % k);
-    }
-    *A = hd_points_f64(*a, na);
-    *B = hd_points_f64(*b, nb);
-    CONTEXT("seed=%llu kind=%d |A|=%zu |B|=%zu", (unsigned long long)seed, kind, na, nb);
+    int kind = gen_mixed_pair(seed, n, a, b, A, B);
+    CONTEXT("seed=%llu kind=%d |A|=%zu |B|=%zu", (unsigned long long)seed, kind, A->count, B->count);
 }
 
 TEST(counts_equal_every_distance_for_any_bins_and_range) {

@@ -23,25 +23,13 @@
 #define SCALE 1
 #endif
 
-typedef struct {
-    double *v;
-    size_t nv;
-    uint64_t *t;
-    size_t nt;
-} soup_t;
-
-static void soup_free(soup_t *s) {
-    free(s->v);
-    free(s->t);
-}
-
-static size_t add_vertex(soup_t *s, double x, double y, double z) {
+static size_t add_vertex(gen_soup_t *s, double x, double y, double z) {
     s->v = realloc(s->v, 3 * (s->nv + 1) * sizeof *s->v);
     s->v[3 * s->nv] = x, s->v[3 * s->nv + 1] = y, s->v[3 * s->nv + 2] = z;
     return s->nv++;
 }
 
-static void add_tri(soup_t *s, uint64_t a, uint64_t b, uint64_t c) {
+static void add_tri(gen_soup_t *s, uint64_t a, uint64_t b, uint64_t c) {
     s->t = realloc(s->t, 3 * (s->nt + 1) * sizeof *s->t);
     s->t[3 * s->nt] = a, s->t[3 * s->nt + 1] = b, s->t[3 * s->nt + 2] = c;
     s->nt++;
@@ -49,7 +37,7 @@ static void add_tri(soup_t *s, uint64_t a, uint64_t b, uint64_t c) {
 
 /* The box [lo, hi]^3 with 8 shared vertices and 12 outward triangles;
  * flip != 0 orients it inward. */
-static void add_cube(soup_t *s, const double lo[3], const double hi[3], int flip) {
+static void add_cube(gen_soup_t *s, const double lo[3], const double hi[3], int flip) {
     size_t base = s->nv;
     for (int k = 0; k < 8; k++) add_vertex(s, k & 1 ? hi[0] : lo[0], k & 2 ? hi[1] : lo[1], k & 4 ? hi[2] : lo[2]);
     static const int q[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
@@ -65,7 +53,7 @@ static void add_cube(soup_t *s, const double lo[3], const double hi[3], int flip
     }
 }
 
-static void unit_cube(soup_t *s) {
+static void unit_cube(gen_soup_t *s) {
     memset(s, 0, sizeof *s);
     add_cube(s, (double[3]){0, 0, 0}, (double[3]){1, 1, 1}, 0);
 }
@@ -85,7 +73,7 @@ static double bumpy(const double *u) {
 /* An icosphere of radius r around c, subdivided `levels` times, as a soup
  * of separately stored corners (shared by equal coordinates only); bump
  * moves each vertex radially by bumpy(); flip orients it inward. */
-static void add_sphere(soup_t *s, const double c[3], double r, int levels, int bump, int flip) {
+static void add_sphere(gen_soup_t *s, const double c[3], double r, int levels, int bump, int flip) {
     const double t = (1 + sqrt(5.0)) / 2;
     double ico[12][3] = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
                          {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
@@ -130,22 +118,17 @@ static void add_sphere(soup_t *s, const double c[3], double r, int levels, int b
 }
 
 /* The torus mesh of gen.h. */
-static void torus(soup_t *s, double R, double r, int nu, int nv) {
+static void torus(gen_soup_t *s, double R, double r, int nu, int nv) {
     gen_torus_mesh(R, r, nu, nv, &s->v, &s->t);
     s->nv = (size_t)nu * (size_t)nv;
     s->nt = 2 * s->nv;
 }
 
-static hd_mesh_t view(const soup_t *s) {
-    hd_mesh_t m = {hd_points_f64(s->v, s->nv), s->t, s->nt, HD_INDEX_U64};
-    return m;
-}
-
 /* The signs of n points (1 and 3 threads must agree, and the distances
  * must be hd_mesh_distances'); returns HD_OK or the error. */
-static int signs(const soup_t *s, const double *pts, size_t n, int8_t *sg, double *dist, hd_error_t *err) {
+static int signs(const gen_soup_t *s, const double *pts, size_t n, int8_t *sg, double *dist, hd_error_t *err) {
     hd_points_t P = hd_points_f64(pts, n);
-    hd_mesh_t M = view(s);
+    hd_mesh_t M = gen_soup_view(s);
     hd_options_t opt;
     hd_options_init(&opt);
     opt.threads = 1;
@@ -172,7 +155,7 @@ static int signs(const soup_t *s, const double *pts, size_t n, int8_t *sg, doubl
 /* Hits of the ray p + t dir, t > 0, with the triangles (Moller-Trumbore in
  * doubles): its parity is inside/outside for points and directions in
  * general position. */
-static int ray_parity(const soup_t *s, const double *p, const double *dir) {
+static int ray_parity(const gen_soup_t *s, const double *p, const double *dir) {
     int hits = 0;
     for (size_t k = 0; k < s->nt; k++) {
         const double *a = s->v + 3 * s->t[3 * k], *b = s->v + 3 * s->t[3 * k + 1], *c = s->v + 3 * s->t[3 * k + 2];
@@ -193,7 +176,7 @@ static int ray_parity(const soup_t *s, const double *p, const double *dir) {
 }
 
 /* The solid angles' sum over 4 pi (Van Oosterom-Strackee), in doubles. */
-static double solid_winding(const soup_t *s, const double *p) {
+static double solid_winding(const gen_soup_t *s, const double *p) {
     double sum = 0;
     for (size_t k = 0; k < s->nt; k++) {
         double a[3], b[3], c[3];
@@ -217,7 +200,7 @@ static double solid_winding(const soup_t *s, const double *p) {
  * the sign agrees with the ray parity and the rounded solid-angle sum
  * (whose distance to its integer is checked below 0.01), and the exact
  * winding number equals that integer.  Returns the points inside. */
-static size_t against_box(const soup_t *s, uint64_t seed, size_t n, const double lo[3], const double hi[3],
+static size_t against_box(const gen_soup_t *s, uint64_t seed, size_t n, const double lo[3], const double hi[3],
                           double gap) {
     gen_rng_t r;
     gen_seed(&r, seed);
@@ -259,14 +242,14 @@ static size_t against_box(const soup_t *s, uint64_t seed, size_t n, const double
     return inside;
 }
 
-static size_t against_references(const soup_t *s, uint64_t seed, size_t n, double lo, double hi, double gap) {
+static size_t against_references(const gen_soup_t *s, uint64_t seed, size_t n, double lo, double hi, double gap) {
     return against_box(s, seed, n, (double[3]){lo, lo, lo}, (double[3]){hi, hi, hi}, gap);
 }
 
 /* ---- behaviours -------------------------------------------------------- */
 
 TEST(cube_points_inside_outside_and_on_it) {
-    soup_t s;
+    gen_soup_t s;
     unit_cube(&s);
     const double tiny = 0x1p-1000;
     double p[][3] = {
@@ -288,13 +271,13 @@ TEST(cube_points_inside_outside_and_on_it) {
         CHECK_EQ(sg[i], want[i]);
         CHECK_EQ(d[i] == 0, want[i] == 0);
     }
-    soup_free(&s);
+    gen_soup_free(&s);
 }
 
 TEST(cube_lattice_points_agree_with_the_box) {
     /* Points on a lattice of quarter steps: many lie on the planes, edges
      * and vertices of the cube, and their rays run along edges. */
-    soup_t s;
+    gen_soup_t s;
     unit_cube(&s);
     double p[9 * 9 * 9 * 3];
     size_t n = 0;
@@ -314,23 +297,23 @@ TEST(cube_lattice_points_agree_with_the_box) {
         CONTEXT("point (%g %g %g)", q[0], q[1], q[2]);
         CHECK_EQ(sg[i], on ? 0 : in ? -1 : 1);
     }
-    soup_free(&s);
+    gen_soup_free(&s);
 }
 
 TEST(icospheres_match_the_references) {
     for (int bump = 0; bump <= 1; bump++) {
-        soup_t s = {0};
+        gen_soup_t s = {0};
         add_sphere(&s, (double[3]){0.1, -0.2, 0.3}, 1.0, 3, bump, 0);
         size_t inside = against_references(&s, 11 + (uint64_t)bump, 4000 / SCALE, -1.5, 1.5, 1e-6);
         CHECK(inside > 0);
-        soup_free(&s);
+        gen_soup_free(&s);
     }
 }
 
 TEST(inward_sphere_is_inside_too) {
     /* Consistently oriented inward: the winding number is -1 inside, and
      * the sign is still -1 there. */
-    soup_t s = {0};
+    gen_soup_t s = {0};
     add_sphere(&s, (double[3]){0, 0, 0}, 1.0, 2, 0, 1);
     double p[] = {0, 0, 0, 0.3, 0.2, 0.1, 2, 0, 0};
     int8_t sg[3];
@@ -340,11 +323,11 @@ TEST(inward_sphere_is_inside_too) {
     CHECK_EQ(sg[0], -1);
     CHECK_EQ(sg[1], -1);
     CHECK_EQ(sg[2], 1);
-    soup_free(&s);
+    gen_soup_free(&s);
 }
 
 TEST(torus_matches_its_tube) {
-    soup_t s;
+    gen_soup_t s;
     torus(&s, 1.0, 0.4, 48, 24);
     gen_rng_t r;
     gen_seed(&r, 5);
@@ -370,14 +353,14 @@ TEST(torus_matches_its_tube) {
     CHECK(inside > 100 / SCALE);
     free(p), free(d), free(sg);
     against_references(&s, 6, 2000 / SCALE, -1.6, 1.6, 1e-6);
-    soup_free(&s);
+    gen_soup_free(&s);
 }
 
 TEST(nested_shells) {
     /* A hollow ball (the inner shell inward: a cavity) and two outward
      * shells (the inner region has winding number 2: inside). */
     for (int cavity = 0; cavity <= 1; cavity++) {
-        soup_t s = {0};
+        gen_soup_t s = {0};
         add_sphere(&s, (double[3]){0, 0, 0}, 2.0, 2, 0, 0);
         add_sphere(&s, (double[3]){0.1, 0, 0}, 1.0, 2, 1, cavity);
         double p[] = {0, 0, 0, 0.2, 0.1, -0.3, 1.6, 0, 0, 0, -1.5, 0.2, 3, 0, 0};
@@ -389,14 +372,14 @@ TEST(nested_shells) {
         CHECK_RC(signs(&s, p, 5, sg, d, &err), HD_OK);
         for (int i = 0; i < 5; i++) CHECK_EQ(sg[i], want[i]);
         against_references(&s, 21 + (uint64_t)cavity, 2000 / SCALE, -2.5, 2.5, 1e-6);
-        soup_free(&s);
+        gen_soup_free(&s);
     }
 }
 
 TEST(cube_soup_and_signed_zeros_are_one_vertex) {
     /* Every triangle with corners of its own, some zeros negative: the
      * corners merge by value and the mesh is closed. */
-    soup_t c, s = {0};
+    gen_soup_t c, s = {0};
     unit_cube(&c);
     for (size_t k = 0; k < c.nt; k++) {
         uint64_t id[3];
@@ -415,13 +398,13 @@ TEST(cube_soup_and_signed_zeros_are_one_vertex) {
     CHECK_RC(signs(&s, p, 2, sg, d, &err), HD_OK);
     CHECK_EQ(sg[0], -1);
     CHECK_EQ(sg[1], 1);
-    soup_free(&c), soup_free(&s);
+    gen_soup_free(&c), gen_soup_free(&s);
 }
 
 TEST(non_manifold_edge_shared_both_ways_is_closed) {
     /* Two cubes touching along an edge: that edge has four triangles, two
      * each way.  A degenerate triangle with a repeated corner is skipped. */
-    soup_t s = {0};
+    gen_soup_t s = {0};
     add_cube(&s, (double[3]){0, 0, 0}, (double[3]){1, 1, 1}, 0);
     add_cube(&s, (double[3]){1, 1, 0}, (double[3]){2, 2, 1}, 0);
     add_tri(&s, 0, 0, 5);
@@ -431,18 +414,18 @@ TEST(non_manifold_edge_shared_both_ways_is_closed) {
     hd_error_t err;
     CHECK_RC(signs(&s, p, 5, sg, d, &err), HD_OK);
     for (int i = 0; i < 5; i++) CHECK_EQ(sg[i], want[i]);
-    soup_free(&s);
+    gen_soup_free(&s);
 }
 
 TEST(open_mesh_is_refused_naming_an_edge) {
-    soup_t s;
+    gen_soup_t s;
     unit_cube(&s);
     s.nt--; /* the last triangle (1, 7, 5) gone: edges 1-7, 7-5, 5-1 are boundaries */
     double p[] = {0.5, 0.5, 0.5};
     int8_t sg[1] = {42};
     double d[1];
     hd_points_t P = hd_points_f64(p, 1);
-    hd_mesh_t M = view(&s);
+    hd_mesh_t M = gen_soup_view(&s);
     hd_error_t err;
     CHECK_RC(hd_mesh_signed_distances(&P, &M, NULL, d, NULL, NULL, NULL, sg, NULL, &err), HD_EINVAL);
     CHECK(strstr(err.message, "not closed") != NULL);
@@ -452,33 +435,33 @@ TEST(open_mesh_is_refused_naming_an_edge) {
     CHECK_EQ(sg[0], 42);
     /* The distances alone still work on an open mesh. */
     CHECK_RC(hd_mesh_distances(&P, &M, NULL, d, NULL, NULL, NULL, NULL, &err), HD_OK);
-    soup_free(&s);
+    gen_soup_free(&s);
 }
 
 TEST(flipped_face_is_refused) {
-    soup_t s;
+    gen_soup_t s;
     unit_cube(&s);
     uint64_t x = s.t[3 * 4 + 1]; /* triangle 4 reversed */
     s.t[3 * 4 + 1] = s.t[3 * 4 + 2], s.t[3 * 4 + 2] = x;
     double p[] = {0.5, 0.5, 0.5};
     int8_t sg[1];
     hd_points_t P = hd_points_f64(p, 1);
-    hd_mesh_t M = view(&s);
+    hd_mesh_t M = gen_soup_view(&s);
     hd_error_t err;
     CHECK_RC(hd_mesh_signed_distances(&P, &M, NULL, NULL, NULL, NULL, NULL, sg, NULL, &err), HD_EINVAL);
     CHECK(strstr(err.message, "not consistently oriented") != NULL);
     CHECK(strstr(err.message, "triangles 4 and") || strstr(err.message, "and 4 both"));
-    soup_free(&s);
+    gen_soup_free(&s);
 }
 
 TEST(bad_meshes_get_the_distance_errors) {
-    soup_t s;
+    gen_soup_t s;
     unit_cube(&s);
     s.t[5] = 99;
     double p[] = {0.5, 0.5, 0.5};
     int8_t sg[1];
     hd_points_t P = hd_points_f64(p, 1);
-    hd_mesh_t M = view(&s);
+    hd_mesh_t M = gen_soup_view(&s);
     hd_error_t err;
     CHECK_RC(hd_mesh_signed_distances(&P, &M, NULL, NULL, NULL, NULL, NULL, sg, NULL, &err), HD_EINVAL);
     CHECK(strstr(err.message, "refers to vertex 99") != NULL);
@@ -486,11 +469,11 @@ TEST(bad_meshes_get_the_distance_errors) {
     s.v[4] = NAN;
     CHECK_RC(hd_mesh_signed_distances(&P, &M, NULL, NULL, NULL, NULL, NULL, sg, NULL, &err), HD_ENONFINITE);
     CHECK_RC(hd_mesh_signed_distances(NULL, &M, NULL, NULL, NULL, NULL, NULL, sg, NULL, &err), HD_EINVAL);
-    soup_free(&s);
+    gen_soup_free(&s);
 }
 
 TEST(float32_vertices_and_u32_indices) {
-    soup_t s = {0};
+    gen_soup_t s = {0};
     add_sphere(&s, (double[3]){0, 0, 0}, 1.0, 2, 1, 0);
     float *v = malloc(3 * s.nv * sizeof *v);
     uint32_t *t = malloc(3 * s.nt * sizeof *t);
@@ -506,13 +489,13 @@ TEST(float32_vertices_and_u32_indices) {
     CHECK_EQ(sg[1], -1);
     CHECK_EQ(sg[2], 1);
     free(v), free(t);
-    soup_free(&s);
+    gen_soup_free(&s);
 }
 
 TEST(points_on_the_icosphere_vertices_and_edges) {
     /* Every vertex and edge midpoint of a bumpy sphere is on the surface
      * (sign 0); the same points scaled by 1 -/+ 2^-40 are inside/outside. */
-    soup_t s = {0};
+    gen_soup_t s = {0};
     add_sphere(&s, (double[3]){0, 0, 0}, 1.0, 1, 1, 0);
     size_t n = 3 * s.nt;
     double *p = malloc(3 * 3 * n * sizeof *p), *d = malloc(3 * n * sizeof *d);
@@ -535,11 +518,11 @@ TEST(points_on_the_icosphere_vertices_and_edges) {
         CHECK_EQ(sg[3 * k + 2], 1);
     }
     free(p), free(d), free(sg);
-    soup_free(&s);
+    gen_soup_free(&s);
 }
 
 /* A bundled model as a soup (copies of its arrays). */
-static int read_model(const char *path, soup_t *s) {
+static int read_model(const char *path, gen_soup_t *s) {
     hd_mesh_file_t *m;
     hd_error_t err;
     int rc = hd_read_mesh(path, NULL, &m, &err);
@@ -557,31 +540,31 @@ static int read_model(const char *path, soup_t *s) {
 TEST(bundled_closed_models_match_the_references) {
     const char *files[] = {"data/orig/pinion.off", "data/orig/cow.off", "data/orig/fandisk_large.off"};
     for (int f = 0; f < 3; f++) {
-        soup_t s;
+        gen_soup_t s;
         CONTEXT("%s", files[f]);
         if (read_model(files[f], &s)) continue;
         double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
         for (size_t k = 0; k < 3 * s.nv; k++) lo[k % 3] = fmin(lo[k % 3], s.v[k]), hi[k % 3] = fmax(hi[k % 3], s.v[k]);
         size_t inside = against_box(&s, 31 + (uint64_t)f, 600 / SCALE, lo, hi, 1e-9 * (hi[0] - lo[0]));
         CHECK(inside > 0);
-        soup_free(&s);
+        gen_soup_free(&s);
     }
 }
 
 TEST(bundled_open_models_are_refused) {
     const char *files[] = {"data/orig/Wuson.stl", "data/orig/stanford_bunny_reduced.ply", "data/orig/lion.off"};
     for (int f = 0; f < 3; f++) {
-        soup_t s;
+        gen_soup_t s;
         CONTEXT("%s", files[f]);
         if (read_model(files[f], &s)) continue;
         double p[3] = {0, 0, 0};
         int8_t sg[1];
         hd_points_t P = hd_points_f64(p, 1);
-        hd_mesh_t M = view(&s);
+        hd_mesh_t M = gen_soup_view(&s);
         hd_error_t err;
         CHECK_RC(hd_mesh_signed_distances(&P, &M, NULL, NULL, NULL, NULL, NULL, sg, NULL, &err), HD_EINVAL);
         CHECK(strstr(err.message, "alone (a boundary)") != NULL);
-        soup_free(&s);
+        gen_soup_free(&s);
     }
 }
 
@@ -590,7 +573,7 @@ TEST(bundled_open_models_are_refused) {
  * two each way) and vertices; rays from lattice points run along grid lines
  * through edges and vertices everywhere. */
 #define G 5
-static void voxels(soup_t *s, const uint8_t *fill) {
+static void voxels(gen_soup_t *s, const uint8_t *fill) {
     memset(s, 0, sizeof *s);
     for (int z = 0; z <= G; z++)
         for (int y = 0; y <= G; y++)
@@ -625,7 +608,7 @@ TEST(voxel_solids_on_their_lattice) {
         gen_seed(&r, seed);
         uint8_t fill[G * G * G];
         for (int i = 0; i < G * G * G; i++) fill[i] = gen_unit(&r) < 0.45;
-        soup_t s;
+        gen_soup_t s;
         voxels(&s, fill);
         if (!s.nt) continue;
         enum { STEPS = 2 * G + 3 };
@@ -652,7 +635,7 @@ TEST(voxel_solids_on_their_lattice) {
             CHECK_EQ(sg[i], want);
         }
         free(p), free(d), free(sg);
-        soup_free(&s);
+        gen_soup_free(&s);
     }
 }
 
@@ -663,7 +646,7 @@ TEST(scaled_cubes_far_from_one) {
     const double scales[] = {1e150, 0x1p-1000, 3e-300, 1e-170};
     for (int k = 0; k < 4; k++) {
         double x = scales[k];
-        soup_t s = {0};
+        gen_soup_t s = {0};
         add_cube(&s, (double[3]){0, 0, 0}, (double[3]){x, x, x}, 0);
         double p[] = {x / 2, x / 2, x / 2, x / 4, x / 2, x / 2, -x, x / 2, x / 2, -x, 0, 0, 2 * x, x / 2, 0,
                       x / 4, x / 4, x / 4, x / 2, x / 2, x, -x, x, x};
@@ -673,14 +656,14 @@ TEST(scaled_cubes_far_from_one) {
         CONTEXT("scale %g", x);
         CHECK_RC(signs(&s, p, 8, sg, d, &err), HD_OK);
         for (int i = 0; i < 8; i++) CHECK_EQ(sg[i], want[i]);
-        soup_free(&s);
+        gen_soup_free(&s);
     }
 }
 
 /* The winding number of the mesh and point with coordinates rotated
  * (x, y, z) -> (y, z, x) `rot` times, or mirrored in x (w changes sign):
  * the same solid, seen along another ray through other degeneracies. */
-static long winding_moved(const soup_t *s, const double *p, int rot, int mirror, int *on) {
+static long winding_moved(const gen_soup_t *s, const double *p, int rot, int mirror, int *on) {
     hd__wtri_t *w = malloc(s->nt * sizeof *w);
     double q[3];
     for (int c = 0; c < 3; c++) q[c] = p[(c + rot) % 3];
@@ -707,7 +690,7 @@ TEST(points_a_hair_from_the_surface_agree_along_every_axis) {
     /* Points within a few ulps of faces, edges and vertices, where the
      * solid-angle sum cannot be trusted: the exact count along x, along y
      * and z (rotated) and along -x (mirrored) agree. */
-    soup_t meshes[3] = {{0}};
+    gen_soup_t meshes[3] = {{0}};
     add_sphere(&meshes[0], (double[3]){0.1, 0.2, 0.3}, 1.0, 1, 1, 0);
     torus(&meshes[1], 1.0, 0.4, 12, 8);
     uint8_t fill[G * G * G];
@@ -716,7 +699,7 @@ TEST(points_a_hair_from_the_surface_agree_along_every_axis) {
     for (int i = 0; i < G * G * G; i++) fill[i] = gen_unit(&r) < 0.45;
     voxels(&meshes[2], fill);
     for (int m = 0; m < 3; m++) {
-        const soup_t *s = &meshes[m];
+        const gen_soup_t *s = &meshes[m];
         for (int i = 0; i < 60 / SCALE; i++) {
             size_t t = gen_u64(&r) % s->nt;
             const double *a = s->v + 3 * s->t[3 * t], *b = s->v + 3 * s->t[3 * t + 1], *c = s->v + 3 * s->t[3 * t + 2];
@@ -749,5 +732,5 @@ TEST(points_a_hair_from_the_surface_agree_along_every_axis) {
             CHECK(w0 == 0 || w0 == 1);
         }
     }
-    for (int m = 0; m < 3; m++) soup_free(&meshes[m]);
+    for (int m = 0; m < 3; m++) gen_soup_free(&meshes[m]);
 }

@@ -54,6 +54,48 @@ void gen_cube_pair(gen_rng_t *r, size_t na, size_t nb, double **a, double **b, h
     *B = hd_points_f64(*b, nb);
 }
 
+int gen_mixed_pair(uint64_t seed, size_t n, double **a, double **b, hd_points_t *A, hd_points_t *B) {
+    int kind = (int)(seed % 5);
+    gen_rng_t g;
+    gen_seed(&g, seed);
+    size_t na = n, nb = kind == 3 ? 1 + gen_u64(&g) % 40 : kind == 4 ? n : 1 + n / 2 + gen_u64(&g) % n;
+    *a = malloc(24 * na);
+    *b = malloc(24 * nb);
+    if (!*a || !*b) {
+        fprintf(stderr, "gen_mixed_pair: out of memory for %zu + %zu points\n", na, nb);
+        abort();
+    }
+    double m0[3] = {0, 0, 0}, m1[3] = {0.5, 0, 0};
+    if (kind == 0 || kind == 3) {
+        gen_gauss(&g, *a, na, m0, 1.0);
+        gen_gauss(&g, *b, nb, m1, 1.0);
+    } else if (kind == 1 || kind == 2) {
+        gen_lattice(&g, *a, na, kind == 1 ? 8 : 3);
+        gen_lattice(&g, *b, nb, kind == 1 ? 8 : 3);
+        gen_affine(*b, nb, 1.0, 0.5);
+    } else {
+        gen_gauss(&g, *a, na, m0, 1.0);
+        for (size_t k = 0; k < 3 * na; k++) (*b)[k] = (*a)[k] + 1e-3 * gen_normal(&g);
+        for (size_t k = nb; k > 1; k--) gen_swap(*b, k - 1, gen_u64(&g) % k);
+    }
+    *A = hd_points_f64(*a, na);
+    *B = hd_points_f64(*b, nb);
+    return kind;
+}
+
+hd_mesh_t gen_soup_view(const gen_soup_t *s) {
+    hd_mesh_t m = {hd_points_f64(s->v, s->nv), s->t, s->nt, HD_INDEX_U64};
+    return m;
+}
+
+void gen_soup_free(gen_soup_t *s) {
+    free(s->v);
+    free(s->t);
+    s->v = NULL;
+    s->t = NULL;
+    s->nv = s->nt = 0;
+}
+
 void gen_lattice(gen_rng_t *r, double *xyz, size_t n, int side) {
     for (size_t k = 0; k < 3 * n; k++) xyz[k] = (double)(gen_u64(r) % (uint64_t)side);
 }

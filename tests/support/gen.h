@@ -25,6 +25,23 @@ void gen_cube(gen_rng_t *r, double *xyz, size_t n, double lo, double hi);
  * with their views; the caller frees *a and *b.  Aborts the test program
  * when out of memory. */
 void gen_cube_pair(gen_rng_t *r, size_t na, size_t nb, double **a, double **b, hd_points_t *A, hd_points_t *B);
+/* Two new arrays by seed, with their views (the caller frees *a and *b):
+ * kind seed % 5 (returned) is 0 Gaussians, 1 lattices of 8 per side (many
+ * distances tie), 2 lattices of 3 per side (duplicates in both), 3 n
+ * points against 1-40, 4 a noisy copy of A in random order.  A has n
+ * points.  Aborts the test program when out of memory. */
+int gen_mixed_pair(uint64_t seed, size_t n, double **a, double **b, hd_points_t *A, hd_points_t *B);
+
+/* A triangle soup: nv packed xyz vertices and nt index triples, owned by
+ * the test (gen_soup_free), seen by the library through gen_soup_view. */
+typedef struct {
+    double *v;
+    size_t nv;
+    uint64_t *t;
+    size_t nt;
+} gen_soup_t;
+hd_mesh_t gen_soup_view(const gen_soup_t *s);
+void gen_soup_free(gen_soup_t *s);
 /* Integer lattice points chosen at random in [0, side)^3 (ties galore). */
 void gen_lattice(gen_rng_t *r, double *xyz, size_t n, int side);
 /* n points on a random line segment / plane patch through the origin. */
