@@ -10,29 +10,12 @@ usage: cli_m2m.py PATH/TO/hausdorff
 """
 import json
 import math
-import os
-import subprocess
 import sys
 import tempfile
 
-TOOL = sys.argv[1]
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-failures = 0
+from cli_checks import check, finish, run, start, writer
 
-
-def run(*args):
-    return subprocess.run([TOOL, *args], capture_output=True, text=True, cwd=ROOT)
-
-
-def check(cond, what, proc=None):
-    global failures
-    if not cond:
-        failures += 1
-        print("FAIL", what)
-        if proc is not None:
-            print("  exit", proc.returncode, "stdout:", proc.stdout.strip()[:2000], "stderr:", proc.stderr.strip())
-    else:
-        print("ok  ", what)
+start(sys.argv[1])
 
 
 def js(p):
@@ -40,11 +23,7 @@ def js(p):
 
 
 with tempfile.TemporaryDirectory() as tmp:
-    def put(name, text):
-        path = os.path.join(tmp, name)
-        with open(path, "w") as f:
-            f.write(text)
-        return path
+    put = writer(tmp)
 
     # two triangulations of one bent quad: every vertex shared, the surfaces
     # apart along the diagonals (a vertex-only distance would say 0)
@@ -135,5 +114,4 @@ with tempfile.TemporaryDirectory() as tmp:
     p = run("--surface", "--within", "1", pts, qb)
     check(p.returncode == 1 and "mesh as A" in p.stderr, "--within with points as A is refused", p)
 
-print("%d failed" % failures)
-sys.exit(1 if failures else 0)
+finish()

@@ -12,36 +12,16 @@ usage: cli_surface.py PATH/TO/hausdorff
 """
 import json
 import os
-import subprocess
 import sys
 import tempfile
 
-TOOL = sys.argv[1]
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-failures = 0
+from cli_checks import check, finish, run, start, writer
 
-
-def run(*args):
-    return subprocess.run([TOOL, *args], capture_output=True, text=True, cwd=ROOT)
-
-
-def check(cond, what, proc=None):
-    global failures
-    if not cond:
-        failures += 1
-        print("FAIL", what)
-        if proc is not None:
-            print("  exit", proc.returncode, "stdout:", proc.stdout.strip(), "stderr:", proc.stderr.strip())
-    else:
-        print("ok  ", what)
+start(sys.argv[1])
 
 
 with tempfile.TemporaryDirectory() as tmp:
-    def put(name, text):
-        path = os.path.join(tmp, name)
-        with open(path, "w") as f:
-            f.write(text)
-        return path
+    put = writer(tmp)
 
     # a unit square as one quad (two triangles) and a degenerate triangle
     square = put("square.off", "OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n3 0 0 0\n")
@@ -148,5 +128,4 @@ with tempfile.TemporaryDirectory() as tmp:
     p = run("--surface", pts, nofaces)
     check(p.returncode == 2 and "no faces" in p.stderr, "a mesh without faces: exit 2", p)
 
-print("%d failed" % failures)
-sys.exit(1 if failures else 0)
+finish()
