@@ -15,7 +15,8 @@
  * accepts: threads 0..1024, depth 1..21, lambda in (0, 1], theta in [0, 1],
  * a known algorithm and format, sampling with 1..2^40 points, the sampling
  * seed equal to --seed, percentile in [0, 100], bins 1..100000, a
- * non-negative --max-distance, known --mask-points and --empty values,
+ * non-negative --max-distance, known --mask-points and --empty values, a
+ * --distances path whose extension names a table or a write-back format,
  * --connectivity 1..3, --mask-dims auto, 2 or 3, picture names a PNG may
  * have, a --units label of 1 to 16 characters.
  */
@@ -111,7 +112,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
         if (an->empty != HD_EMPTY_ERROR && an->empty != HD_EMPTY_INF && an->empty != HD_EMPTY_NAN && an->empty != HD_EMPTY_ZERO &&
             an->empty != HD_EMPTY_MONAI)
             abort();
-        if (an->distances_out && !distances_format_known(an->distances_out)) abort();
+        if (an->distances_out && !distances_format_known(an->distances_out) &&
+            !analysis_writeback_format_known(an->distances_out))
+            abort();
         if (an->connectivity < 1 || an->connectivity > 3) abort();
         if (an->mask_dims != 0 && an->mask_dims != 2 && an->mask_dims != 3) abort();
         if ((an->render_out && !render_path_ok(an->render_out)) ||
