@@ -163,6 +163,32 @@ static void json_figures(FILE *out, const analysis_args_t *an,
     }
 }
 
+/* --distances as tables (writers.c) for each side whose file is not
+ * written back into its own format (writeback.c): A's to OUT, B's (unless
+ * directed) to OUT_b.EXT; surf: A's distances are to a surface. */
+static int distance_tables(const analysis_args_t *an, const hd_points_t *A, const hd_points_t *B, const char *path_a,
+                           const char *path_b, const double *d_ab, const size_t *j_ab, const double *d_ba,
+                           const size_t *j_ba, const surface_columns_t *surf, double scale, int directed,
+                           analysis_result_t *r, hd_error_t *err) {
+    if (!an->distances_out) return HD_OK;
+    int rc = HD_OK;
+    if (!analysis_writes_back(an, 0, an->distances_out, path_a)) {
+        r->dist_path_a = an->distances_out;
+        rc = surf ? write_surface_distances(r->dist_path_a, A, d_ab, surf, scale, err)
+                  : write_distances(r->dist_path_a, A, d_ab, j_ab, scale, err);
+        if (rc) return rc;
+    }
+    if (directed) return HD_OK;
+    char *out_b = path_with_suffix(an->distances_out, "_b");
+    if (!out_b) return alloc_fail(err, B->count);
+    if (analysis_writes_back(an, 1, out_b, path_b)) {
+        free(out_b);
+        return HD_OK;
+    }
+    r->dist_path_b = out_b;
+    return write_distances(out_b, B, d_ba, j_ba, scale, err);
+}
+
 /* The per-point files of a run with an empty set (analysis.h). */
 int analysis_empty_files(const analysis_args_t *an, const hd_points_t *A, const hd_points_t *B, int directed,
                          double v, const char *path_a, const char *path_b, analysis_result_t *r, hd_error_t *err) {
@@ -171,17 +197,9 @@ int analysis_empty_files(const analysis_args_t *an, const hd_points_t *A, const 
     double *d = malloc((n ? n : 1) * sizeof *d);
     if (!d) return alloc_fail(err, n);
     for (size_t k = 0; k < n; k++) d[k] = v;
-    int rc = analysis_write_back(an, path_a, path_b, d, A->count, d, B->count, directed, r, err);
-    if (rc != HD_OK || !an->distances_out || analysis_writes_back(an->distances_out, path_a, an->format[0])) {
-        free(d);
-        return rc;
-    }
-    rc = write_distances(an->distances_out, A, d, NULL, 1.0, err);
-    if (rc == HD_OK) r->dist_path_a = an->distances_out;
-    if (rc == HD_OK && !directed) {
-        r->dist_path_b = path_with_suffix(an->distances_out, "_b");
-        rc = r->dist_path_b ? write_distances(r->dist_path_b, B, d, NULL, 1.0, err) : alloc_fail(err, n);
-    }
+    writeback_side_t side[2] = {{d, A->count, NULL, NULL}, {d, B->count, NULL, NULL}};
+    int rc = analysis_write_back(an, path_a, path_b, side, directed, 0, r, err);
+    if (rc == HD_OK) rc = distance_tables(an, A, B, path_a, path_b, d, NULL, d, NULL, NULL, 1.0, directed, r, err);
     free(d);
     return rc;
 }
@@ -367,21 +385,13 @@ int analysis_finish(const analysis_args_t *an, const hd_points_t *A, const hd_po
     static const analysis_ops_t here = {hd_summarize, hd_percentile_of, hd_histogram};
     if ((rc = analysis_figures(an, &here, r->d_ab, A->count, r->d_ba, directed ? 0 : B->count, r, err))) return rc;
     double scale = analysis_scale(an, r);
-    /* files written back: point sets only (--surface refuses them, and its
-     * --distances is always its table) */
-    if (!surf && (rc = analysis_write_back(an, path_a, path_b, r->d_ab, A->count, r->d_ba, directed ? 0 : B->count,
-                                           directed, r, err)))
+    /* files written back into the sides' formats, then the tables */
+    writeback_side_t side[2] = {{r->d_ab, A->count, r->j_ab, surf ? surf->sign : NULL},
+                                {r->d_ba, directed ? 0 : B->count, r->j_ba, NULL}};
+    if ((rc = analysis_write_back(an, path_a, path_b, side, directed, surf != NULL, r, err)) ||
+        (rc = distance_tables(an, A, B, path_a, path_b, r->d_ab, r->j_ab, r->d_ba, r->j_ba,
+                              surf && an->distances_out ? surf : NULL, scale, directed, r, err)))
         return rc;
-    if (an->distances_out && (surf || !analysis_writes_back(an->distances_out, path_a, an->format[0]))) {
-        r->dist_path_a = an->distances_out;
-        rc = surf ? write_surface_distances(r->dist_path_a, A, r->d_ab, surf, scale, err)
-                  : write_distances(r->dist_path_a, A, r->d_ab, r->j_ab, scale, err);
-        if (rc) return rc;
-        if (!directed) {
-            if (!(r->dist_path_b = path_with_suffix(an->distances_out, "_b"))) return alloc_fail(err, B->count);
-            if ((rc = write_distances(r->dist_path_b, B, r->d_ba, r->j_ba, scale, err))) return rc;
-        }
-    }
     render_notes_t notes = analysis_notes(an, r);
     if (an->render_out) {
         char title[640];
@@ -480,12 +490,13 @@ void analysis_json(FILE *out, const analysis_args_t *an,
         fputc('}', out);
     }
     analysis_write_back_json(out, an, r);
-    if (an->distances_out && r->dist_path_a) {
+    if (an->distances_out && (r->dist_path_a || r->dist_path_b)) {
         fprintf(out, ", \"distances_file\": {\"a\": ");
-        json_string(out, r->dist_path_a);
+        if (r->dist_path_a) json_string(out, r->dist_path_a);
+        else fputs("null", out);
         fprintf(out, ", \"b\": ");
-        if (r->directed) fputs("null", out);
-        else json_string(out, r->dist_path_b);
+        if (r->dist_path_b) json_string(out, r->dist_path_b);
+        else fputs("null", out);
         fputc('}', out);
     }
     if (an->render_out) {
@@ -642,9 +653,9 @@ void analysis_print(FILE *out, const analysis_args_t *an,
     print_scores(out, an, r, unit);
     if (an->histogram) print_histogram(out, an, r);
     analysis_write_back_print(out, an, r);
-    if (an->distances_out && r->dist_path_a) {
-        fprintf(out, "per-point distances written to %s", safe_text(r->dist_path_a));
-        if (!r->directed) fprintf(out, " and %s", safe_text(r->dist_path_b));
+    if (an->distances_out && (r->dist_path_a || r->dist_path_b)) {
+        fprintf(out, "per-point distances written to %s", safe_text(r->dist_path_a ? r->dist_path_a : r->dist_path_b));
+        if (r->dist_path_a && r->dist_path_b) fprintf(out, " and %s", safe_text(r->dist_path_b));
         fputc('\n', out);
     }
     if (an->render_out) fprintf(out, "picture written to %s (%dx%d)\n", safe_text(an->render_out), r->render_w, r->render_h);

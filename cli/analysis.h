@@ -157,7 +157,7 @@ typedef struct analysis_result {
      * path (A's is the option's, B's malloc'd) and the points written */
     char *wb_path_b[3];
     size_t wb_points[3][2];
-    int wb_done[3];
+    int wb_sides[3];           /* bit 0: A's written, bit 1: B's */
     int surface;               /* d_ab: distances to B's triangles, j_ab
                                   the nearest triangles (--surface) */
 } analysis_result_t;
@@ -257,11 +257,12 @@ int write_surface_distances(const char *path, const hd_points_t *P, const double
 int distances_format_known(const char *path);
 
 /* ---- files in the inputs' own formats (writeback.c) -------------------- */
-/* Whether --distances OUT writes the side read from in_path (format: its
- * FORMAT: or --format, else NULL) back into its own format: .las, .laz,
- * .xyz, .txt, .pts, .asc; .csv, .npy and .ply are write_distances' tables
- * (the files hausdorff-mpi writes too). */
-int analysis_writes_back(const char *out, const char *in_path, const char *format);
+/* Whether --distances writes side w (read from in_path) back into its own
+ * format as `out` (A's: OUT, B's: OUT_b.EXT): .las, .laz, .xyz, .txt,
+ * .pts, .asc always; .ply when the side is a PLY file read as its own
+ * points and out is not a FIFO or device; .csv and .npy never (they, and
+ * .ply otherwise, are write_distances' tables). */
+int analysis_writes_back(const analysis_args_t *an, int w, const char *out, const char *in_path);
 /* 1 when OUT can name a file written back (--farther-than, --nearer-than:
  * .ply .las .laz .xyz .txt .csv .pts .asc .obj). */
 int analysis_writeback_format_known(const char *out);
@@ -270,11 +271,21 @@ int analysis_writeback_format_known(const char *out);
  * directory of tiles).  HD_OK, or HD_EINVAL with the reason in err. */
 int analysis_check_outputs(const analysis_args_t *an, const char *path_a, const char *path_b, int directed,
                            hd_error_t *err);
+/* A side's per-point values for the files written back: n distances,
+ * the nearest point's (or with --surface face's) index (NULL: -1 for
+ * every point) and the sign (--signed; NULL: none). */
+typedef struct writeback_side {
+    const double *d;
+    size_t n;
+    const size_t *index;
+    const int8_t *sign;
+} writeback_side_t;
 /* After the distances: the files written back (--distances into the
- * inputs' formats, --farther-than, --nearer-than), A's from d_ab and, when
- * not directed, B's from d_ba into OUT_b.EXT; what was written into r. */
-int analysis_write_back(const analysis_args_t *an, const char *path_a, const char *path_b, const double *d_ab,
-                        size_t n_a, const double *d_ba, size_t n_b, int directed, analysis_result_t *r,
+ * inputs' formats, --farther-than, --nearer-than), A's from side[0] and,
+ * when not directed, B's from side[1] into OUT_b.EXT; surface: the index
+ * is a face's; what was written into r. */
+int analysis_write_back(const analysis_args_t *an, const char *path_a, const char *path_b,
+                        const writeback_side_t side[2], int directed, int surface, analysis_result_t *r,
                         hd_error_t *err);
 /* Their lines in the report and their JSON members. */
 void analysis_write_back_print(FILE *out, const analysis_args_t *an, const analysis_result_t *r);

@@ -704,13 +704,6 @@ int cli_parse(int argc, char **argv, cli_args_t *a) {
         if (rc) return rc;
     }
     a->read.seed = a->opt.seed; /* --seed also seeds --sample */
-    int subset = a->an.subset[0].on || a->an.subset[1].on;
-    if ((mpi_tool || a->surface) && (subset || (a->an.distances_out && !distances_format_known(a->an.distances_out))))
-        return bad(mpi_tool ? "%s: files in an input's own format are written by hausdorff, not hausdorff-mpi "
-                              "(whose --distances writes .csv, .ply or .npy tables)"
-                            : "%s: files in an input's own format are not written with --surface (its --distances "
-                              "writes .csv, .ply or .npy tables)",
-                   subset ? "--farther-than / --nearer-than" : a->an.distances_out);
     if ((a->tolerance_set || a->within_set) && !a->surface)
         return bad("%s measures a surface: it needs --surface (and a mesh as A)",
                    a->within_set ? "--within" : "--tolerance");

@@ -158,8 +158,7 @@ static int analyse(const cli_args_t *a, surf_run_t *s, hd_error_t *err) {
     w.ab.i = s->r.i;
     w.ab.j = s->r.triangle;
     surface_columns_t cols = {s->an.j_ab, s->closest, s->bary, s->sign};
-    return analysis_finish(&a->an, &A, &B, &w, s->closest + 3 * s->r.i, a->path_a, a->path_b,
-                           a->an.distances_out ? &cols : NULL, &s->an, err);
+    return analysis_finish(&a->an, &A, &B, &w, s->closest + 3 * s->r.i, a->path_a, a->path_b, &cols, &s->an, err);
 }
 
 static void report(const cli_args_t *a, const surf_run_t *s) {
@@ -187,6 +186,10 @@ int surface_run(const cli_args_t *a) {
     surf_run_t s;
     memset(&s, 0, sizeof s);
     hd_error_t err;
+    if (analysis_check_outputs(&a->an, a->path_a, a->path_b, 1, &err) != HD_OK) { /* A's file only */
+        fprintf(stderr, "%s: %s\n", cli_prog(), safe_text(err.message));
+        return EXIT_USAGE;
+    }
     int rc = read_sides(a, &s, &err);
     if (rc == HD_OK && s.ca->n_faces > 0) { /* a surface measured from: an enclosure (m2m.c) */
         surf_free(&s);

@@ -1,14 +1,26 @@
 /*
  * writeback.c -- per-point distances written into the inputs' own files
  * (hd_write_field): --distances OUT when OUT names the side's format
- * (.las, .laz, text: a `distance` field added to every point, everything
- * else kept; .ply stays the table both tools write, byte for byte), and
- * --farther-than D OUT /
- * --nearer-than D OUT (the points whose distance is > D / <= D, in their
- * file's format, the field included).  A's file gets A's distances to B;
- * without --directed, B's file OUT_b.EXT gets B's to A.  What can be
- * written is checked before anything is read (a mismatch of formats is a
- * usage error, not a failure after the distances are computed).
+ * (.las, .laz, .ply, text: a `distance` field added to every point,
+ * everything else kept), and --farther-than D OUT / --nearer-than D OUT
+ * (the points whose distance is > D / <= D, in their file's format, the
+ * field included).  A's file gets A's distances to B; without --directed,
+ * B's file OUT_b.EXT gets B's to A.  What can be written is checked before
+ * anything is read (a mismatch of formats is a usage error, not a failure
+ * after the distances are computed).
+ *
+ * .csv and .npy are always the per-point tables (writers.c).  .ply is the
+ * side's own PLY with the fields when that side was read from a PLY file as
+ * its points (not sampled, not a mask, not standard input) and OUT is not
+ * an existing FIFO or device (a file written back is renamed into place);
+ * otherwise the table.  So a PLY written back holds what the table held
+ * for each point: `distance`, then the table's index column as a double
+ * (`nearest`, -1 with an empty other side; `face` with --surface), and
+ * `sign` with --signed.  Other formats get `distance` (and `sign`) only.
+ *
+ * More than one field is written by chaining hd_write_field: each call
+ * reads the previous one's file and adds one field, the last into the
+ * output's temporary; the intermediate files are removed whatever happens.
  */
 #include "cli.h"
 #include "output.h"
@@ -16,6 +28,8 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 static const char *ext_of(const char *path) {
     const char *dot = strrchr(path, '.'), *slash = strrchr(path, '/');
@@ -29,13 +43,27 @@ static const char *side_format(const char *in_path, const char *format, const hd
     return hd_format_of_path(in_path);
 }
 
-int analysis_writes_back(const char *out, const char *in_path, const char *format) {
-    (void)in_path, (void)format;
+/* 1 when path exists and is not a regular file (a FIFO, a device): the
+ * tables are written into it in place, a file written back cannot be. */
+static int is_special(const char *path) {
+    struct stat st;
+    return stat(path, &st) == 0 && !S_ISREG(st.st_mode);
+}
+
+/* 1 when side w's points are its file's own points, numbered as the file
+ * holds them (not drawn on faces, not a mask's voxels, not a pipe). */
+static int own_points(const analysis_args_t *an, int w, const char *in_path) {
+    return an->read.mesh != HD_MESH_SAMPLE && !an->mask[w].is_mask && !nifti_is_mask_path(in_path) &&
+           strcmp(in_path, "-") != 0;
+}
+
+int analysis_writes_back(const analysis_args_t *an, int w, const char *out, const char *in_path) {
     const char *e = ext_of(out);
-    /* .csv, .npy and .ply are the tables hausdorff-mpi writes too, byte for
-     * byte (a PLY side's own file with the field: --farther-than 0 /
-     * --nearer-than, the library, Python) */
-    if (strcasecmp(e, "csv") == 0 || strcasecmp(e, "npy") == 0 || strcasecmp(e, "ply") == 0) return 0;
+    if (strcasecmp(e, "csv") == 0 || strcasecmp(e, "npy") == 0) return 0;
+    if (strcasecmp(e, "ply") == 0) {
+        const char *in = side_format(in_path, an->format[w], &an->read);
+        return in && strcmp(in, "ply") == 0 && own_points(an, w, in_path) && !is_special(out);
+    }
     return hd_format_of_path(out) != NULL;
 }
 
@@ -48,14 +76,17 @@ int analysis_writeback_format_known(const char *out) {
 static const char *const what[3] = {"--distances", "--farther-than", "--nearer-than"};
 
 /* The output of kind k for side w (B's: OUT_b.EXT, malloc'd into *owned),
- * or NULL when that kind writes nothing for the side. */
+ * or NULL when that kind writes nothing into the side's format. */
 static const char *output(const analysis_args_t *an, int k, int w, const char *path, char **owned) {
     const char *out = k == 0 ? an->distances_out : an->subset[k - 1].on ? an->subset[k - 1].out : NULL;
     *owned = NULL;
-    if (!out || (k == 0 && !analysis_writes_back(out, path, an->format[w] ? an->format[w] : an->read.format)))
-        return NULL;
-    if (w == 0) return out;
-    return *owned = path_with_suffix(out, "_b");
+    if (!out) return NULL;
+    if (w && !(out = *owned = path_with_suffix(out, "_b"))) return NULL;
+    if (k == 0 && !analysis_writes_back(an, w, out, path)) {
+        free(*owned);
+        return *owned = NULL;
+    }
+    return out;
 }
 
 static int check_side(const analysis_args_t *an, int k, const char *out, const char *path, int w, hd_error_t *err) {
@@ -98,14 +129,63 @@ int analysis_check_outputs(const analysis_args_t *an, const char *path_a, const 
     return HD_OK;
 }
 
-/* hd_write_field into out's temporary from output.c, so that out appears
- * with the run's other files when the run succeeds (out_finish) and not at
- * all when it fails (out_discard); its failures to write are output
- * failures (OUT_EFAIL: exit 3). */
-static int write_staged(const char *in, const char *out, const double *d, size_t n, hd_write_options_t *o,
-                        size_t *written, hd_error_t *err) {
+/* ---- the fields of one file ---------------------------------------------- */
+
+enum { MAX_FIELDS = 3 };
+typedef struct {
+    const char *name[MAX_FIELDS];
+    const double *v[MAX_FIELDS]; /* v[0]: the distances, every point; the others the kept points' */
+    size_t n[MAX_FIELDS];
+    double *owned[MAX_FIELDS];
+    int count;
+} fields_t;
+
+static void fields_free(fields_t *f) {
+    for (int i = 0; i < f->count; i++) free(f->owned[i]);
+}
+
+/* Whether point k is kept by o (the library's rule: a NaN is never). */
+static int kept(const hd_write_options_t *o, double d) {
+    return o->keep == HD_KEEP_ALL || (o->keep == HD_KEEP_FARTHER ? d > o->threshold : d <= o->threshold);
+}
+
+/* One more field of the kept points: index (as double, -1 for none) or sign. */
+static int add_field(fields_t *f, const char *name, const writeback_side_t *s, const hd_write_options_t *o,
+                     int is_sign, hd_error_t *err) {
+    double *v = malloc((s->n ? s->n : 1) * sizeof *v);
+    if (!v) {
+        snprintf(err->message, sizeof err->message, "out of memory for %zu values of '%s'", s->n, name);
+        return err->code = HD_ENOMEM;
+    }
+    size_t m = 0;
+    for (size_t k = 0; k < s->n; k++)
+        if (kept(o, s->d[k]))
+            v[m++] = is_sign ? (double)s->sign[k] : s->index ? (double)s->index[k] : -1.0;
+    f->name[f->count] = name, f->v[f->count] = v, f->n[f->count] = m, f->owned[f->count++] = v;
+    return HD_OK;
+}
+
+/* The fields of kind k's file for side s: distance; in a PLY written by
+ * --distances the table's index column; with --signed the sign. */
+static int side_fields(int k, const char *out, const writeback_side_t *s, int surface, const hd_write_options_t *o,
+                       fields_t *f, hd_error_t *err) {
+    memset(f, 0, sizeof *f);
+    f->name[0] = "distance", f->v[0] = s->d, f->n[0] = s->n, f->count = 1;
+    const char *fmt = hd_format_of_path(out);
+    int rc = HD_OK;
+    if (k == 0 && fmt && strcmp(fmt, "ply") == 0) rc = add_field(f, surface ? "face" : "nearest", s, o, 0, err);
+    if (rc == HD_OK && s->sign) rc = add_field(f, "sign", s, o, 1, err);
+    return rc;
+}
+
+/* ---- writing ------------------------------------------------------------- */
+
+/* The name of out's temporary from output.c (malloc'd), so that out
+ * appears with the run's other files when the run succeeds (out_finish)
+ * and not at all when it fails (out_discard); NULL with err set. */
+static char *stage(const char *out, hd_error_t *err) {
     FILE *f = out_open(out, err);
-    if (!f) return err->code;
+    if (!f) return NULL;
     const char *tmp = out_file_path(f);
     char *name = tmp ? strdup(tmp) : NULL;
     int direct = out_is_direct(f), rc = out_close(f, 0, err);
@@ -113,27 +193,65 @@ static int write_staged(const char *in, const char *out, const double *d, size_t
         snprintf(err->message, sizeof err->message, "%s: %s", out,
                  direct ? "a device or FIFO cannot take a file written back (it is renamed into place); name a file"
                         : "out of memory");
-        rc = err->code = direct ? HD_EINVAL : HD_ENOMEM;
+        err->code = direct ? HD_EINVAL : HD_ENOMEM;
+        rc = err->code;
     }
-    o->format = hd_format_of_path(out);
-    if (rc == HD_OK) rc = hd_write_field(in, name, d, n, o, written, err);
-    if (rc == HD_EIO && name && strncmp(err->message, name, strlen(name)) == 0) {
-        /* the temporary's name in the message is the output's */
+    if (rc != HD_OK) {
+        free(name);
+        return NULL;
+    }
+    return name;
+}
+
+/* A failure to write a file of ours is the output's (OUT_EFAIL: exit 3),
+ * named as the output. */
+static int as_output(int rc, const char *name, const char *out, hd_error_t *err) {
+    if (rc == HD_EIO && strncmp(err->message, name, strlen(name)) == 0) {
         char reason[200];
-        snprintf(reason, sizeof reason, "%s", err->message + strlen(name));
+        const char *r = err->message + strlen(name);
+        while (*r && *r != ':') r++; /* past an intermediate's suffix */
+        snprintf(reason, sizeof reason, "%s", r);
         snprintf(err->message, sizeof err->message, "%.800s%s", out, reason);
         rc = err->code = OUT_EFAIL;
+    }
+    return rc;
+}
+
+/* The fields into out: field i from file i (the input, then the
+ * intermediates name.1, name.2 beside the temporary) into file i + 1 (the
+ * temporary last), the subset taken by the first call. */
+static int write_chain(const char *in, const char *out, const fields_t *f, const hd_write_options_t *first,
+                       size_t *written, hd_error_t *err) {
+    char *name = stage(out, err);
+    if (!name) return err->code;
+    size_t len = strlen(name) + 8;
+    char *file[MAX_FIELDS + 1] = {(char *)in};
+    int rc = HD_OK;
+    for (int i = 1; i < f->count && rc == HD_OK; i++)
+        if (!(file[i] = malloc(len)) || snprintf(file[i], len, "%s.%d", name, i) < 0)
+            rc = err->code = HD_ENOMEM, snprintf(err->message, sizeof err->message, "out of memory");
+    file[f->count] = name;
+    hd_read_options_t ro = *first->read;
+    ro.format = first->format;
+    for (int i = 0; i < f->count && rc == HD_OK; i++) {
+        hd_write_options_t o = *first;
+        o.name = f->name[i];
+        if (i > 0) o.keep = HD_KEEP_ALL, o.read = &ro;
+        rc = hd_write_field(file[i], file[i + 1], f->v[i], f->n[i], &o, i ? NULL : written, err);
+    }
+    rc = as_output(rc, name, out, err);
+    for (int i = 1; i < f->count; i++) {
+        if (file[i]) unlink(file[i]);
+        free(file[i]);
     }
     free(name);
     return rc;
 }
 
-int analysis_write_back(const analysis_args_t *an, const char *path_a, const char *path_b, const double *d_ab,
-                        size_t n_a, const double *d_ba, size_t n_b, int directed, analysis_result_t *r,
+int analysis_write_back(const analysis_args_t *an, const char *path_a, const char *path_b,
+                        const writeback_side_t side[2], int directed, int surface, analysis_result_t *r,
                         hd_error_t *err) {
     const char *path[2] = {path_a, path_b};
-    const double *d[2] = {d_ab, d_ba};
-    size_t n[2] = {n_a, n_b};
     for (int k = 0; k < 3; k++)
         for (int w = 0; w < (directed ? 1 : 2); w++) {
             char *owned;
@@ -145,28 +263,38 @@ int analysis_write_back(const analysis_args_t *an, const char *path_a, const cha
             hd_write_options_t o;
             hd_write_options_init(&o);
             o.read = &ro;
+            o.format = hd_format_of_path(out);
             if (k) {
                 o.keep = k == 1 ? HD_KEEP_FARTHER : HD_KEEP_NEARER;
                 o.threshold = an->subset[k - 1].d;
             }
-            int rc = write_staged(path[w], out, d[w], n[w], &o, &r->wb_points[k][w], err);
+            fields_t f;
+            int rc = side_fields(k, out, &side[w], surface, &o, &f, err);
+            if (rc == HD_OK) rc = write_chain(path[w], out, &f, &o, &r->wb_points[k][w], err);
+            fields_free(&f);
             if (rc) return rc;
-            r->wb_done[k] = 1;
+            r->wb_sides[k] |= 1 << w;
         }
     return HD_OK;
+}
+
+/* The file side w got from kind k. */
+static const char *side_out(const analysis_args_t *an, const analysis_result_t *r, int k, int w) {
+    return w ? r->wb_path_b[k] : k == 0 ? an->distances_out : an->subset[k - 1].out;
 }
 
 void analysis_write_back_print(FILE *out, const analysis_args_t *an, const analysis_result_t *r) {
     char t[NUM_TEXT];
     for (int k = 0; k < 3; k++) {
-        if (!r->wb_done[k]) continue;
-        const char *a = k == 0 ? an->distances_out : an->subset[k - 1].out;
-        if (k == 0) fprintf(out, "distances written into %s", safe_text(a));
-        else fprintf(out, "points %s %s written: %zu of A's to %s", k == 1 ? "farther than" : "within",
-                     num_text(an->subset[k - 1].d, t), r->wb_points[k][0], safe_text(a));
-        if (!r->directed && r->wb_path_b[k]) {
-            if (k == 0) fprintf(out, " and %s", safe_text(r->wb_path_b[k]));
-            else fprintf(out, ", %zu of B's to %s", r->wb_points[k][1], safe_text(r->wb_path_b[k]));
+        int sides = r->wb_sides[k];
+        if (!sides) continue;
+        if (k == 0) {
+            fprintf(out, "distances written into %s", safe_text(side_out(an, r, 0, !(sides & 1))));
+            if (sides == 3) fprintf(out, " and %s", safe_text(side_out(an, r, 0, 1)));
+        } else {
+            fprintf(out, "points %s %s written: %zu of A's to %s", k == 1 ? "farther than" : "within",
+                    num_text(an->subset[k - 1].d, t), r->wb_points[k][0], safe_text(side_out(an, r, k, 0)));
+            if (sides & 2) fprintf(out, ", %zu of B's to %s", r->wb_points[k][1], safe_text(side_out(an, r, k, 1)));
         }
         fputc('\n', out);
     }
@@ -175,22 +303,22 @@ void analysis_write_back_print(FILE *out, const analysis_args_t *an, const analy
 void analysis_write_back_json(FILE *out, const analysis_args_t *an, const analysis_result_t *r) {
     static const char *const key[3] = {"distances_written_back", "farther_than", "nearer_than"};
     for (int k = 0; k < 3; k++) {
-        if (!r->wb_done[k]) continue;
+        if (!r->wb_sides[k]) continue;
         fprintf(out, ", \"%s\": {", key[k]);
         if (k) {
             fputs("\"d\": ", out);
             json_number(out, an->subset[k - 1].d);
             fputs(", ", out);
         }
-        fputs("\"a\": {\"file\": ", out);
-        json_string(out, k == 0 ? an->distances_out : an->subset[k - 1].out);
-        fprintf(out, ", \"points\": %zu}, \"b\": ", r->wb_points[k][0]);
-        if (r->directed || !r->wb_path_b[k]) {
-            fputs("null", out);
-        } else {
+        for (int w = 0; w < 2; w++) {
+            fputs(w ? ", \"b\": " : "\"a\": ", out);
+            if (!(r->wb_sides[k] >> w & 1)) {
+                fputs("null", out);
+                continue;
+            }
             fputs("{\"file\": ", out);
-            json_string(out, r->wb_path_b[k]);
-            fprintf(out, ", \"points\": %zu}", r->wb_points[k][1]);
+            json_string(out, side_out(an, r, k, w));
+            fprintf(out, ", \"points\": %zu}", r->wb_points[k][w]);
         }
         fputc('}', out);
     }

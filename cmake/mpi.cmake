@@ -50,7 +50,7 @@ if(HD_WITH_MPI AND MPI_C_FOUND)
 
   # The tool: cli/mpi/main.c over the tool's shared objects (report, tiles,
   # options) and the MPI library.
-  add_executable(hausdorff_mpi_cli ${CMAKE_CURRENT_SOURCE_DIR}/cli/mpi/main.c ${CMAKE_CURRENT_SOURCE_DIR}/cli/mpi/writer.c
+  add_executable(hausdorff_mpi_cli ${CMAKE_CURRENT_SOURCE_DIR}/cli/mpi/main.c ${CMAKE_CURRENT_SOURCE_DIR}/cli/mpi/writer.c ${CMAKE_CURRENT_SOURCE_DIR}/cli/mpi/writeback.c
     ${CMAKE_CURRENT_SOURCE_DIR}/cli/mpi/figures.c)
   set_target_properties(hausdorff_mpi_cli PROPERTIES OUTPUT_NAME hausdorff-mpi
     RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR})

@@ -80,26 +80,14 @@ static int distances_mpi(const cli_args_t *a, const hd_mpi_part_t part[2], const
     return rc;
 }
 
-/* --distances: r's per-rank distances written to OUT (and OUT_b unless
- * --directed) by all ranks (writer.c), the colour scale as hausdorff's
- * (--max-distance, else the Hausdorff distance).  Collective. */
+/* --distances, --farther-than, --nearer-than: r's per-rank distances
+ * written as hausdorff writes them (writeback.c), the colour scale as
+ * hausdorff's (--max-distance, else the Hausdorff distance).  Collective. */
 static int distances_files_mpi(const cli_args_t *a, const hd_mpi_part_t part[2], const uint64_t total[2],
                                const hd_symmetric_t *s, analysis_result_t *r, hd_error_t *err) {
     double scale = a->an.max_distance > 0 ? a->an.max_distance : s->distance;
-    r->dist_path_a = a->an.distances_out;
-    int rc = HD_OK;
-    if (!a->directed && !(r->dist_path_b = path_with_suffix(a->an.distances_out, "_b"))) {
-        snprintf(err->message, sizeof err->message, "out of memory for a file name");
-        rc = err->code = HD_ENOMEM;
-    }
-    rc = agree(rc, err); /* every rank writes, or none */
-    const char *path[2] = {r->dist_path_a, r->dist_path_b};
-    const double *d[2] = {r->d_ab, r->d_ba};
-    const size_t *j[2] = {r->j_ab, r->j_ba};
-    for (int w = 0; w < (a->directed ? 1 : 2) && rc == HD_OK; w++)
-        rc = mpi_write_distances(path[w], &part[w].points, part[w].offset, d[w], j[w], (size_t)total[w], scale,
-                                 err);
-    return rc;
+    return mpi_write_files(&a->an, a->path_a, a->path_b, part, r->d_ab, r->j_ab, r->d_ba, r->j_ba, total, scale,
+                           a->directed, r, err);
 }
 
 /* --render: the witness pair's points from the ranks that hold them, then
@@ -341,6 +329,11 @@ static int read_sides(run_t *r, hd_error_t *err) {
     }
     if (rc == HD_OK) { /* no output may overwrite an input: rank 0 checks */
         int bad = rank_ == 0 ? out_check_outputs(a, r->side) : 0;
+        hd_error_t e;
+        if (rank_ == 0 && !bad && analysis_check_outputs(&a->an, a->path_a, a->path_b, a->directed, &e) != HD_OK) {
+            fprintf(stderr, "%s: %s\n", cli_prog(), safe_text(e.message));
+            bad = EXIT_USAGE;
+        }
         MPI_Bcast(&bad, 1, MPI_INT, 0, MPI_COMM_WORLD);
         if (bad) return bad;
     }
@@ -375,22 +368,19 @@ static int compute_empty(run_t *r, hd_error_t *err) {
     const cli_args_t *a = &r->a;
     int rc = agree(analysis_empty(&a->an, (size_t)r->total[0], (size_t)r->total[1], a->directed, &r->s, &r->an,
                                   err), err);
-    if (rc != HD_OK || !a->an.distances_out) return rc;
+    if (rc != HD_OK || (!a->an.distances_out && !a->an.subset[0].on && !a->an.subset[1].on)) return rc;
     size_t most = r->part[0].points.count > r->part[1].points.count ? r->part[0].points.count
                                                                     : r->part[1].points.count;
     double *d = malloc((most ? most : 1) * sizeof *d);
-    char *path_b = path_with_suffix(a->an.distances_out, "_b");
-    const char *path[2] = {a->an.distances_out, path_b};
-    if (!d || !path_b) {
+    if (!d) {
         snprintf(err->message, sizeof err->message, "out of memory for %zu per-point distances", most);
         rc = err->code = HD_ENOMEM;
     }
     for (size_t k = 0; k < most && d; k++) d[k] = r->s.ab.distance;
-    for (int w = 0; w < (a->directed ? 1 : 2) && (rc = agree(rc, err)) == HD_OK; w++)
-        rc = mpi_write_distances(path[w], &r->part[w].points, r->part[w].offset, d, NULL, (size_t)r->total[w], 1.0,
-                                 err);
+    if ((rc = agree(rc, err)) == HD_OK)
+        rc = mpi_write_files(&a->an, a->path_a, a->path_b, r->part, d, NULL, d, NULL, r->total, 1.0, a->directed,
+                             &r->an, err);
     free(d);
-    free(path_b);
     return rc;
 }
 
@@ -415,7 +405,8 @@ static int compute(run_t *r, hd_error_t *err) {
     if (rc != HD_OK || !analysis_active(&a->an)) return rc;
     if ((rc = distances_mpi(a, part, r->total, &r->an, &r->dst, err)) == HD_OK)
         rc = mpi_figures(&a->an, r->an.d_ab, part[0].points.count, r->an.d_ba, part[1].points.count, &r->an, err);
-    if (rc == HD_OK && a->an.distances_out) rc = distances_files_mpi(a, part, r->total, s, &r->an, err);
+    if (rc == HD_OK && (a->an.distances_out || a->an.subset[0].on || a->an.subset[1].on))
+        rc = distances_files_mpi(a, part, r->total, s, &r->an, err);
     if (rc == HD_OK && a->an.render_out) rc = render_mpi(a, part, s, &r->an, err);
     return rc;
 }

@@ -18,6 +18,20 @@ int mpi_agree(int rc, hd_error_t *err);
 int mpi_write_distances(const char *path, const hd_points_t *P, size_t first, const double *d,
                         const size_t *nearest, size_t total, double dmax, hd_error_t *err);
 
+/* The per-point files (writeback.c): --distances (tables by every rank,
+ * files written back into a side's own format by rank 0 from the
+ * gathered distances), --farther-than, --nearer-than, as hausdorff writes
+ * them; d_ab, j_ab (d_ba, j_ba) this rank's values of part[0] ([1]), j
+ * NULL: -1; total the sides' counts; what was written into r (rank 0).
+ * Collective; the same code and message on every rank. */
+struct analysis_args;
+struct analysis_result;
+struct hd_mpi_part;
+int mpi_write_files(const struct analysis_args *an, const char *path_a, const char *path_b,
+                    const struct hd_mpi_part part[2], const double *d_ab, const size_t *j_ab, const double *d_ba,
+                    const size_t *j_ba, const uint64_t total[2], double dmax, int directed,
+                    struct analysis_result *r, hd_error_t *err);
+
 /* The figures hausdorff computes from per-point distances (--percentile,
  * --mean, --chamfer, --histogram, --histogram-png) over the ranks
  * (figures.c): d_ab and d_ba are this rank's distances (d_ba NULL when
