@@ -1,12 +1,15 @@
 """Command-line tests of the files written back into the inputs' formats:
---distances OUT when OUT has A's format (.las, .laz, text: a `distance`
-field added to A's file, B's to OUT_b; .ply stays the table), and
+--distances OUT when OUT has A's format (.las, .laz, text, and .ply when
+A is a PLY file: a `distance` field added to A's file, B's to OUT_b; a PLY
+also gets the table's `nearest`, and --surface's `face`; --signed adds
+`sign`; .ply of a side that is not a PLY file, or into a FIFO, stays the
+table), and
 --farther-than D OUT / --nearer-than D OUT (the points past D in their
 file's format), against the table --distances writes (.csv:
 x,y,z,distance,nearest), which gives every distance: the field written
 back equals it bit for bit (checked by parsers written here: text and PLY
 ascii lines, LAS extra bytes).  Mismatched formats, --sample, masks,
-hausdorff-mpi's and --surface's refusals are usage errors (exit 1) before
+are usage errors (exit 1) before
 anything is read; a file that cannot be written is exit 3 and leaves none.
 Standard library only; run as:  cli_writeback.py PATH/TO/hausdorff
 """
@@ -17,12 +20,14 @@ import struct
 import subprocess
 import sys
 import tempfile
+import threading
 
 TOOL = None
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 A = os.path.join(ROOT, "data", "pinion_gear.ply")  # ascii PLY
 FACES = os.path.join(ROOT, "tests", "corpus", "ply", "binary_little_endian.ply")  # with faces
+BIG_ENDIAN = os.path.join(ROOT, "tests", "corpus", "ply", "binary_big_endian.ply")
 B = os.path.join(ROOT, "data", "teapot_792.ply")
 LAS = os.path.join(ROOT, "data", "orig", "Haystack_Rock.las")
 LAS_B = os.path.join(ROOT, "tests", "corpus", "las", "v14_fmt6.las")
@@ -83,16 +88,124 @@ def las_field(path, name="distance"):
     raise KeyError(name)
 
 
+PLY_TYPES = {"char": "b", "int8": "b", "uchar": "B", "uint8": "B", "short": "h", "int16": "h", "ushort": "H",
+             "uint16": "H", "int": "i", "int32": "i", "uint": "I", "uint32": "I", "float": "f", "float32": "f",
+             "double": "d", "float64": "d"}
+
+
+def read_ply(path):
+    """A PLY file (ascii or binary, either byte order) parsed here: (header
+    lines, [(element, [property names], [rows])]), a row a tuple of values
+    (a list property's values as a tuple)."""
+    data = open(path, "rb").read()
+    end = data.index(b"end_header") + len(b"end_header")
+    end = data.index(b"\n", end) + 1
+    header = data[:end].decode().splitlines()
+    fmt = header[1].split()[1]
+    elems = []
+    for line in header:
+        w = line.split()
+        if w[:1] == ["element"]:
+            elems.append((w[1], int(w[2]), []))
+        elif w[:1] == ["property"]:
+            elems[-1][2].append((w[-1], w[1:-1]))
+    bo = ">" if fmt == "binary_big_endian" else "<"
+    pos, out = end, []
+    text = data[end:].decode().split() if fmt == "ascii" else None
+    t = 0
+    for name, count, props in elems:
+        rows = []
+        for _ in range(count):
+            row = []
+            for pname, kind in props:
+                if kind[0] == "list":
+                    if text is not None:
+                        n = int(text[t]); t += 1
+                        row.append(tuple(float(x) for x in text[t:t + n])); t += n
+                    else:
+                        c = PLY_TYPES[kind[1]]
+                        n = struct.unpack_from(bo + c, data, pos)[0]; pos += struct.calcsize(c)
+                        e = PLY_TYPES[kind[2]]
+                        row.append(struct.unpack_from(bo + e * n, data, pos)); pos += n * struct.calcsize(e)
+                elif text is not None:
+                    row.append(float(text[t])); t += 1
+                else:
+                    c = PLY_TYPES[kind[0]]
+                    row.append(struct.unpack_from(bo + c, data, pos)[0]); pos += struct.calcsize(c)
+            rows.append(tuple(row))
+        out.append((name, [p for p, _ in props], rows))
+    return header, out
+
+
+def table_columns(path):
+    """The columns of a --distances CSV by name, as floats parsed from their text."""
+    with open(path) as f:
+        rows = f.read().splitlines()
+    names = rows[0].split(",")
+    return {n: [float(r.split(",")[i]) for r in rows[1:]] for i, n in enumerate(names)}
+
+
+def check_written_back(inp, out, fields):
+    """out is inp with the vertex properties fields (name: values, equal bit
+    for bit) appended, every other element and property as they were."""
+    h_in, e_in = read_ply(inp)
+    h_out, e_out = read_ply(out)
+    adds = ["property double %s" % n for n in fields]
+    at = h_out.index(adds[0])
+    assert h_out[:at] + h_out[at + len(adds):] == h_in and h_out[at:at + len(adds)] == adds, (h_in, h_out)
+    for (name, props, rows), (name2, props2, rows2) in zip(e_in, e_out):
+        if name != "vertex":
+            assert (name, props, rows) == (name2, props2, rows2), name
+            continue
+        assert props2 == props + list(fields), props2
+        assert [r[:len(props)] for r in rows2] == rows, "the vertices' own properties changed"
+        for k, (n, want) in enumerate(fields.items()):
+            got = [r[len(props) + k] for r in rows2]
+            assert [struct.pack("<d", x) for x in got] == [struct.pack("<d", x) for x in want], n
+
+
 @test
-def ply_distances_stay_the_table_and_text_is_written_back(tmp):
-    """--distances OUT.ply is the table hausdorff-mpi writes too; a text A gets its column."""
-    rc, out, err = run("--distances", tmp + "/t.ply", FACES, B)
-    assert rc == 0, err
-    head = open(tmp + "/t.ply", "rb").read().split(b"end_header")[0].decode()
-    assert "property int nearest" in head and "element face" not in head, head
+def a_ply_side_gets_distance_and_nearest_in_its_own_file(tmp):
+    """--distances OUT.ply writes a PLY A (binary, with faces) and a PLY B
+    (ascii, big-endian binary) back: the table's distance and nearest as
+    doubles, every other element and property kept."""
+    for a, b in ((FACES, B), (A, BIG_ENDIAN)):
+        rc, out, err = run("--distances", tmp + "/t.csv", a, b)
+        assert rc == 0, err
+        rc, out, err = run("--json", "--distances", tmp + "/w.ply", a, b)
+        assert rc == 0, err
+        j = json.loads(out)
+        assert j.get("distances_written_back", {}).get("a", {}).get("file") == tmp + "/w.ply" and \
+            "distances_file" not in j, j
+        for side, path in (("", a), ("_b", b)):
+            t = table_columns(tmp + "/t%s.csv" % side)
+            check_written_back(path, tmp + "/w%s.ply" % side, {"distance": t["distance"], "nearest": t["nearest"]})
+
+
+@test
+def other_sides_and_fifos_get_the_table_and_text_is_written_back(tmp):
+    """.ply of a side that is not a PLY file, or into a FIFO (nothing to
+    rename into place), is the table hausdorff-mpi writes too; a text A
+    gets its column."""
     xyz = os.path.join(tmp, "a.xyz")
     with open(xyz, "w") as f:
         f.write("# a comment\n1.5 2 3\n4 5 6.25\n")
+    rc, out, err = run("--distances", tmp + "/t.ply", xyz, B)
+    assert rc == 0, err
+    head = open(tmp + "/t.ply", "rb").read().split(b"end_header")[0].decode()
+    assert "property int nearest" in head and "element face" not in head, head
+    head = open(tmp + "/t_b.ply", "rb").read().split(b"end_header")[0].decode()
+    assert "property double distance\nproperty double nearest\nend_header" in head + "end_header", head
+    fifo = os.path.join(tmp, "fifo.ply")
+    os.mkfifo(fifo)
+    got = []
+    reader = threading.Thread(target=lambda: got.append(open(fifo, "rb").read()))
+    reader.start()
+    rc, out, err = run("--directed", "--distances", fifo, FACES, B)
+    if reader.is_alive():
+        open(fifo, "wb").close()
+    reader.join()
+    assert rc == 0 and got and b"property int nearest" in got[0] and b"element face" not in got[0], (rc, err)
     rc, out, err = run("--directed", "--distances", tmp + "/t.csv", xyz, B)
     assert rc == 0, err
     rc, out, err = run("--directed", "--distances", tmp + "/w.txt", xyz, B)
@@ -100,6 +213,44 @@ def ply_distances_stay_the_table_and_text_is_written_back(tmp):
     lines = open(tmp + "/w.txt").read().splitlines()
     assert lines[0] == "# a comment" and lines[1].startswith("1.5 2 3 ") and lines[2].startswith("4 5 6.25 "), lines
     assert [float(l.split()[3]) for l in lines[1:]] == table(tmp + "/t.csv")
+
+
+CUBE = ("OFF\n8 12 0\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n0 0 1\n1 0 1\n0 1 1\n1 1 1\n"
+        "3 0 2 3\n3 0 3 1\n3 4 5 7\n3 4 7 6\n3 0 1 5\n3 0 5 4\n3 2 6 7\n3 2 7 3\n3 0 4 6\n3 0 6 2\n"
+        "3 1 3 7\n3 1 7 5\n")
+
+
+@test
+def surface_distances_are_written_back_with_face_and_sign(tmp):
+    """--surface --signed: A's PLY gets distance, face and sign, its LAS
+    distance and sign, its subsets distance and sign, equal to the table's."""
+    cube = os.path.join(tmp, "cube.off")
+    with open(cube, "w") as f:
+        f.write(CUBE)
+    pts = [(0.5, 0.5, 0.5), (2, 0.5, 0.5), (0.5, 0, 0), (0.25, 0.5, 0.75), (-1, 0.125, 3.5)]
+    ply = os.path.join(tmp, "p.ply")
+    with open(ply, "wb") as f:
+        f.write(b"ply\nformat binary_big_endian 1.0\nelement vertex 5\nproperty double x\nproperty float y\n"
+                b"property double z\nproperty uchar q\nend_header\n")
+        for k, (x, y, z) in enumerate(pts):
+            f.write(struct.pack(">dfdB", x, y, z, k))
+    rc, out, err = run("--surface", "--signed", "--distances", tmp + "/t.csv", ply, cube)
+    assert rc == 0, err
+    t = table_columns(tmp + "/t.csv")
+    rc, out, err = run("--surface", "--signed", "--distances", tmp + "/w.ply", "--farther-than", "0.25",
+                       tmp + "/f.ply", ply, cube)
+    assert rc == 0, err
+    check_written_back(ply, tmp + "/w.ply", {"distance": t["distance"], "face": t["face"], "sign": t["sign"]})
+    far = [k for k, d in enumerate(t["distance"]) if d > 0.25]
+    _, el = read_ply(tmp + "/f.ply")
+    assert el[0][1][-2:] == ["distance", "sign"] and [r[-2:] for r in el[0][2]] == \
+        [(t["distance"][k], t["sign"][k]) for k in far], el
+    rc, out, err = run("--surface", "--signed", "--distances", tmp + "/t.csv", LAS, cube)
+    assert rc == 0, err
+    t = table_columns(tmp + "/t.csv")
+    rc, out, err = run("--surface", "--signed", "--distances", tmp + "/w.las", LAS, cube)
+    assert rc == 0, err
+    assert las_field(tmp + "/w.las") == t["distance"] and las_field(tmp + "/w.las", "sign") == t["sign"]
 
 
 @test
@@ -156,7 +307,7 @@ def mismatches_are_usage_errors_before_reading(tmp):
         (["--farther-than", "x", tmp + "/o.ply", A, B], "needs a distance >= 0"),
         (["--farther-than", "1", tmp + "/o.dat", A, B], "cannot tell the format of"),
         (["--farther-than", "1"], "needs a distance and a file"),
-        (["--surface", "--farther-than", "1", tmp + "/o.ply", A, B], "not written with --surface"),
+        (["--surface", "--farther-than", "1", tmp + "/o.las", A, B], "A (%s) is ply, %s/o.las is las" % (A, tmp)),
     ]
     for args, needle in cases:
         rc, out, err = run(*args)

@@ -18,6 +18,7 @@ import threading
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 DATA = os.path.join(os.path.dirname(HERE), "data")
+CORPUS = os.path.join(HERE, "corpus")
 SEED = 1414
 SAME_KEYS = ["hausdorff", "directed_ab", "directed_ba", "witness_ab", "witness_ba", "witness_ab_files",
              "witness_ba_files", "alpha", "disjoint", "n_a", "n_b", "file_a", "file_b", "tiles_a", "tiles_b",
@@ -344,6 +345,30 @@ def main():
         same_files(["--empty", "monai", empty, empty], "npy", False)
         same_files(["--max-distance", "0.25", A, B], "ply", False)
 
+        # Files written back into the sides' own formats (rank 0 writes them
+        # from the gathered distances): PLY sides above, LAS, LAZ, text, and
+        # the subsets of --farther-than / --nearer-than, byte for byte.
+        las, las_b = os.path.join(DATA, "orig", "Haystack_Rock.las"), os.path.join(CORPUS, "las", "v14_fmt6.las")
+        laz = os.path.join(CORPUS, "laz", "fmt6_channels.laz")
+        same_files([las, las_b], "las", False)
+        same_files(["--directed", laz, las_b], "laz", True)
+
+        def same_subsets(args, ext, d_cut):
+            d = tempfile.mkdtemp(dir=tmp)
+            outs = lambda p: ["--farther-than", d_cut, os.path.join(d, p + "f." + ext), "--nearer-than", d_cut,
+                              os.path.join(d, p + "n." + ext)]
+            rc1, out1, err1 = single(hausdorff, *outs("s"), *args)
+            rc2, out2, err2 = ranks(mpirun, k, tool, *outs("m"), *args)
+            what = "--farther-than / --nearer-than %s %s" % (d_cut, args)
+            check(rc1 == 0 and rc2 == 0, "%s: exit %d / %d: %s %s" % (what, rc1, rc2, err1, err2))
+            for name in ("f", "n", "f_b", "n_b"):
+                f1, f2 = os.path.join(d, "s%s.%s" % (name, ext)), os.path.join(d, "m%s.%s" % (name, ext))
+                check(os.path.exists(f1) and os.path.exists(f2) and open(f1, "rb").read() == open(f2, "rb").read(),
+                      "%s: %s differs from hausdorff's" % (what, f2))
+
+        same_subsets([lion, head], "ply", "0.01")
+        same_subsets([las, las_b], "las", "1")
+
         # A FIFO (not a regular file: no offsets to write at) gets the bytes
         # hausdorff writes, through rank 0, in order.
         def same_through_fifo(args, ext):
@@ -366,7 +391,7 @@ def main():
 
         same_through_fifo([A, B], "csv")
         same_through_fifo([lion, head], "npy")
-        same_through_fifo(["--empty", "zero", lion, empty], "ply")
+        same_through_fifo(["--empty", "zero", npy, empty], "ply")  # a PLY side's .ply is written back: not here
         # A file that cannot be written (B's rows' name is a directory),
         # after A's was: one message, exit 3 from every rank, no file.
         d = tempfile.mkdtemp(dir=tmp)
