@@ -15,6 +15,7 @@ Standard library only; run as:  cli_writeback.py PATH/TO/hausdorff
 """
 import json
 import os
+import resource
 import shutil
 import struct
 import subprocess
@@ -323,6 +324,14 @@ def an_unwritable_file_is_exit_3_and_leaves_nothing(tmp):
     assert err.startswith("hausdorff: %s/missing/far.ply: cannot write" % tmp), err
     rc, out, err = run("--directed", "--distances", tmp + "/w.ply", tmp + "/x.ply", B)
     assert rc == 2, (rc, err)  # A missing: its read fails before anything is written
+    assert os.listdir(tmp) == [], os.listdir(tmp)
+    # a file size limit between the file with `distance` (30,172 bytes,
+    # the intermediate) and the one with `nearest` too: exit 3, and neither
+    # the intermediate nor a temporary left
+    limit = lambda: resource.setrlimit(resource.RLIMIT_FSIZE, (31000, 31000))
+    p = subprocess.run([TOOL, "--directed", "--distances", tmp + "/w.ply", A, B], capture_output=True, text=True,
+                       timeout=300, preexec_fn=limit)
+    assert p.returncode == 3 and "w.ply: cannot write: File too large" in p.stderr, (p.returncode, p.stderr)
     assert os.listdir(tmp) == [], os.listdir(tmp)
 
 
