@@ -298,10 +298,11 @@ static const option_entry_t options[] = {
      "write A's points with distance and nearest index in B\n"
      "(.csv: x,y,z,distance,nearest; .ply: also a viridis\n"
      "colour; .npy: (N, 5) float64); B's go to OUT_b.EXT.\n"
-     "OUT of A's own format (.las, .laz, .xyz/.txt/.pts): A's\n"
-     "file with a field `distance` added to every point,\n"
-     "everything else kept (a LAS/LAZ extra-bytes dimension,\n"
-     "a column)"},
+     "OUT of A's own format (.las, .laz, .xyz/.txt/.pts, .ply\n"
+     "when A is a PLY file): A's file with a field `distance`\n"
+     "added to every point, everything else kept (a PLY\n"
+     "property, with `nearest` too; a LAS/LAZ extra-bytes\n"
+     "dimension; a column)"},
     {OPT_FARTHER_THAN, "--farther-than", NULL, "D OUT", 0,
      "write the points of A farther than D from B (d > D),\n"
      "with their distance, as a file of A's own format (PLY,\n"
