@@ -308,6 +308,8 @@ def mismatches_are_usage_errors_before_reading(tmp):
         (["--farther-than", "x", tmp + "/o.ply", A, B], "needs a distance >= 0"),
         (["--farther-than", "1", tmp + "/o.dat", A, B], "cannot tell the format of"),
         (["--farther-than", "1"], "needs a distance and a file"),
+        (["--directed", "--nearer-than", "1", tmp + "/o.laz", LAZ, B],
+         "is a layered LAZ file (point format 6), whose subsets are not written"),
         (["--surface", "--farther-than", "1", tmp + "/o.las", A, B], "A (%s) is ply, %s/o.las is las" % (A, tmp)),
     ]
     for args, needle in cases:
