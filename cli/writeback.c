@@ -50,11 +50,13 @@ static int is_special(const char *path) {
     return stat(path, &st) == 0 && !S_ISREG(st.st_mode);
 }
 
-/* 1 when side w's points are its file's own points, numbered as the file
- * holds them (not drawn on faces, not a mask's voxels, not a pipe). */
+/* 1 when side w's points are its one regular file's own points, numbered
+ * as the file holds them (not drawn on faces, not a mask's voxels, not a
+ * pipe or standard input, not a directory of tiles). */
 static int own_points(const analysis_args_t *an, int w, const char *in_path) {
+    struct stat st;
     return an->read.mesh != HD_MESH_SAMPLE && !an->mask[w].is_mask && !nifti_is_mask_path(in_path) &&
-           strcmp(in_path, "-") != 0;
+           strcmp(in_path, "-") != 0 && stat(in_path, &st) == 0 && S_ISREG(st.st_mode);
 }
 
 int analysis_writes_back(const analysis_args_t *an, int w, const char *out, const char *in_path) {
