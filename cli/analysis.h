@@ -259,9 +259,10 @@ int distances_format_known(const char *path);
 /* ---- files in the inputs' own formats (writeback.c) -------------------- */
 /* Whether --distances writes side w (read from in_path) back into its own
  * format as `out` (A's: OUT, B's: OUT_b.EXT): .las, .laz, .xyz, .txt,
- * .pts, .asc always; .ply when the side is a PLY file read as its own
- * points and out is not a FIFO or device; .csv and .npy never (they, and
- * .ply otherwise, are write_distances' tables). */
+ * .pts, .asc always; .ply when the side is one regular PLY file read as
+ * its own points; .csv and .npy never (they, and .ply otherwise, are
+ * write_distances' tables).  A FIFO or device as out gets the bytes of
+ * the file written back. */
 int analysis_writes_back(const analysis_args_t *an, int w, const char *out, const char *in_path);
 /* 1 when OUT can name a file written back (--farther-than, --nearer-than:
  * .ply .las .laz .xyz .txt .csv .pts .asc .obj). */

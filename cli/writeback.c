@@ -10,10 +10,9 @@
  * after the distances are computed).
  *
  * .csv and .npy are always the per-point tables (writers.c).  .ply is the
- * side's own PLY with the fields when that side was read from a PLY file as
- * its points (not sampled, not a mask, not standard input) and OUT is not
- * an existing FIFO or device (a file written back is renamed into place);
- * otherwise the table.  So a PLY written back holds what the table held
+ * side's own PLY with the fields when that side was read from one regular
+ * PLY file as its points (not sampled, not a mask, not standard input, not
+ * tiles); otherwise the table.  So a PLY written back holds what the table held
  * for each point: `distance`, then the table's index column as a double
  * (`nearest`, -1 with an empty other side; `face` with --surface), and
  * `sign` with --signed.  Other formats get `distance` (and `sign`) only.
@@ -21,10 +20,13 @@
  * More than one field is written by chaining hd_write_field: each call
  * reads the previous one's file and adds one field, the last into the
  * output's temporary; the intermediate files are removed whatever happens.
+ * A FIFO or device as OUT (hd_write_field renames its result into place)
+ * gets the bytes of the finished file, made under $TMPDIR and removed.
  */
 #include "cli.h"
 #include "output.h"
 
+#include <errno.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
@@ -43,8 +45,8 @@ static const char *side_format(const char *in_path, const char *format, const hd
     return hd_format_of_path(in_path);
 }
 
-/* 1 when path exists and is not a regular file (a FIFO, a device): the
- * tables are written into it in place, a file written back cannot be. */
+/* 1 when path exists and is not a regular file (a FIFO, a device): it is
+ * written in place, not renamed into place. */
 static int is_special(const char *path) {
     struct stat st;
     return stat(path, &st) == 0 && !S_ISREG(st.st_mode);
@@ -64,7 +66,7 @@ int analysis_writes_back(const analysis_args_t *an, int w, const char *out, cons
     if (strcasecmp(e, "csv") == 0 || strcasecmp(e, "npy") == 0) return 0;
     if (strcasecmp(e, "ply") == 0) {
         const char *in = side_format(in_path, an->format[w], &an->read);
-        return in && strcmp(in, "ply") == 0 && own_points(an, w, in_path) && !is_special(out);
+        return in && strcmp(in, "ply") == 0 && own_points(an, w, in_path);
     }
     return hd_format_of_path(out) != NULL;
 }
@@ -238,12 +240,53 @@ static int as_output(int rc, const char *name, const char *out, hd_error_t *err)
     return rc;
 }
 
+/* A new empty file under $TMPDIR (else /tmp), for a FIFO's or device's
+ * file: its name (malloc'd), or NULL with err set. */
+static char *scratch(const char *out, hd_error_t *err) {
+    const char *dir = getenv("TMPDIR");
+    if (!dir || !*dir) dir = "/tmp";
+    size_t len = strlen(dir) + 32;
+    char *name = malloc(len);
+    int fd = -1;
+    if (name) {
+        snprintf(name, len, "%s/hausdorff-XXXXXX", dir);
+        fd = mkstemp(name);
+    }
+    if (fd < 0) {
+        snprintf(err->message, sizeof err->message, "%.600s: cannot make a file in %.300s to write it from: %s", out,
+                 dir, name ? strerror(errno) : "out of memory");
+        err->code = OUT_EFAIL;
+        free(name);
+        return NULL;
+    }
+    close(fd);
+    return name;
+}
+
+/* The finished file's bytes into out, a FIFO or device (out_open writes
+ * it in place). */
+static int copy_into(const char *from, const char *out, hd_error_t *err) {
+    FILE *f = out_open(out, err);
+    if (!f) return err->code;
+    FILE *in = fopen(from, "rb");
+    int werr = in ? 0 : errno ? errno : -1;
+    static char buf[1 << 16];
+    for (size_t n; !werr && (n = fread(buf, 1, sizeof buf, in)) > 0;)
+        if (fwrite(buf, 1, n, f) != n) werr = errno ? errno : -1;
+    if (in && ferror(in) && !werr) werr = EIO;
+    if (in) fclose(in);
+    return out_close(f, werr, err);
+}
+
 /* The fields into out: field i from file i (the input, then the
- * intermediates name.1, name.2 beside the temporary) into file i + 1 (the
- * temporary last), the subset taken by the first call. */
+ * intermediates name.1, name.2 beside the last) into file i + 1, the
+ * subset taken by the first call.  The last is out's temporary from
+ * output.c; for a FIFO or device, a scratch file whose bytes are then
+ * copied into it. */
 static int write_chain(const char *in, const char *out, const fields_t *f, const hd_write_options_t *first,
                        size_t *written, hd_error_t *err) {
-    char *name = stage(out, err);
+    int special = is_special(out);
+    char *name = special ? scratch(out, err) : stage(out, err);
     if (!name) return err->code;
     size_t len = strlen(name) + 8;
     char *file[MAX_FIELDS + 1] = {(char *)in};
@@ -264,6 +307,10 @@ static int write_chain(const char *in, const char *out, const fields_t *f, const
     for (int i = 1; i < f->count; i++) {
         if (file[i]) unlink(file[i]);
         free(file[i]);
+    }
+    if (special) {
+        if (rc == HD_OK) rc = copy_into(name, out, err);
+        unlink(name);
     }
     free(name);
     return rc;

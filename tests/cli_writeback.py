@@ -184,10 +184,10 @@ def a_ply_side_gets_distance_and_nearest_in_its_own_file(tmp):
 
 
 @test
-def other_sides_and_fifos_get_the_table_and_text_is_written_back(tmp):
-    """.ply of a side that is not a PLY file, or into a FIFO (nothing to
-    rename into place), is the table hausdorff-mpi writes too; a text A
-    gets its column."""
+def other_sides_get_the_table_and_fifos_the_file_written_back(tmp):
+    """.ply of a side that is not a PLY file is the table; a FIFO gets the
+    bytes a regular file gets (PLY and LAS written back); a text A gets its
+    column."""
     xyz = os.path.join(tmp, "a.xyz")
     with open(xyz, "w") as f:
         f.write("# a comment\n1.5 2 3\n4 5 6.25\n")
@@ -197,16 +197,23 @@ def other_sides_and_fifos_get_the_table_and_text_is_written_back(tmp):
     assert "property int nearest" in head and "element face" not in head, head
     head = open(tmp + "/t_b.ply", "rb").read().split(b"end_header")[0].decode()
     assert "property double distance\nproperty double nearest\nend_header" in head + "end_header", head
-    fifo = os.path.join(tmp, "fifo.ply")
-    os.mkfifo(fifo)
-    got = []
-    reader = threading.Thread(target=lambda: got.append(open(fifo, "rb").read()))
-    reader.start()
-    rc, out, err = run("--directed", "--distances", fifo, FACES, B)
-    if reader.is_alive():
-        open(fifo, "wb").close()
-    reader.join()
-    assert rc == 0 and got and b"property int nearest" in got[0] and b"element face" not in got[0], (rc, err)
+    for a, ext, more in ((FACES, "ply", []), (LAS, "las", ["--surface", "--signed"])):
+        b = B if ext == "ply" else os.path.join(tmp, "cube.off")
+        with open(os.path.join(tmp, "cube.off"), "w") as f:
+            f.write(CUBE)
+        fifo = os.path.join(tmp, "fifo." + ext)
+        os.mkfifo(fifo)
+        got = []
+        reader = threading.Thread(target=lambda: got.append(open(fifo, "rb").read()))
+        reader.start()
+        rc, out, err = run(*more, "--directed", "--distances", fifo, a, b)
+        if reader.is_alive():
+            open(fifo, "wb").close()
+        reader.join()
+        rc2, out2, err2 = run(*more, "--directed", "--distances", tmp + "/r." + ext, a, b)
+        assert rc == 0 and rc2 == 0 and got and got[0] == open(tmp + "/r." + ext, "rb").read(), (ext, rc, err, err2)
+    assert sorted(os.listdir(tmp)) == sorted(["a.xyz", "t.ply", "t_b.ply", "cube.off", "fifo.ply", "fifo.las",
+                                              "r.ply", "r.las"]), os.listdir(tmp)
     rc, out, err = run("--directed", "--distances", tmp + "/t.csv", xyz, B)
     assert rc == 0, err
     rc, out, err = run("--directed", "--distances", tmp + "/w.txt", xyz, B)

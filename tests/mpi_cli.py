@@ -391,7 +391,8 @@ def main():
 
         same_through_fifo([A, B], "csv")
         same_through_fifo([lion, head], "npy")
-        same_through_fifo(["--empty", "zero", npy, empty], "ply")  # a PLY side's .ply is written back: not here
+        same_through_fifo(["--empty", "zero", lion, empty], "ply")  # A's PLY written back
+        same_through_fifo(["--empty", "zero", npy, empty], "ply")  # the table
         # A file that cannot be written (B's rows' name is a directory),
         # after A's was: one message, exit 3 from every rank, no file.
         d = tempfile.mkdtemp(dir=tmp)

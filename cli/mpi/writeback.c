@@ -14,8 +14,8 @@
  * point of each such side (8 without the index) on top of its share.  A
  * table (.csv, .npy, and .ply of a side that is not a PLY file) is written
  * by every rank at its offset (writer.c).  Which side gets which is
- * decided on rank 0 (a FIFO or device named .ply takes the table) and
- * broadcast, so every rank takes the same path.
+ * decided on rank 0 (it looks at the files) and broadcast, so every rank
+ * takes the same path.
  */
 #include <hausdorff_mpi.h>
 
