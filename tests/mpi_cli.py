@@ -352,6 +352,7 @@ def main():
         laz = os.path.join(CORPUS, "laz", "fmt6_channels.laz")
         same_files([las, las_b], "las", False)
         same_files(["--directed", laz, las_b], "laz", True)
+        same_files([os.path.join(tmp, "A", "t0.xyz"), os.path.join(tmp, "B", "b0.xyz")], "xyz", False)
 
         def same_subsets(args, ext, d_cut):
             d = tempfile.mkdtemp(dir=tmp)
