@@ -34,25 +34,53 @@
 /* Sample points a side in all (each rank its share of its input). */
 #define PRUNE_SAMPLE 1024
 
-static int by_side(const void *x, const void *y) {
+/* By set, then by cell (the cell in g: prune() puts it there). */
+static int by_side_cell(const void *x, const void *y) {
     const hd__mpi_sample_t *a = x, *b = y;
-    return (a->side > b->side) - (a->side < b->side);
+    if (a->side != b->side) return (a->side > b->side) - (a->side < b->side);
+    return (a->g > b->g) - (a->g < b->g);
 }
 
-/* U of cell k of set s (prune.c's invariants), computed when first
- * asked (U[] < 0 until then): the sample of the other set is
- * all[from[t]..to[t]). */
-static double cell_u(double *U, const hd__box_t *box, const hd__mpi_sample_t *all, const size_t *from, const size_t *to,
-                     int s, size_t k) {
-    enum { NC = HD__MPI_CELLS * HD__MPI_CELLS * HD__MPI_CELLS };
-    double *u = &U[(size_t)s * NC + k];
+/* The sample of each set sorted by set, then by its cell in its own set's
+ * grid: set s's sample points of cell k are all[at[s][k] .. at[s][k + 1]). */
+typedef struct {
+    const hd__mpi_prune_t *pr;
+    const hd__box_t *box;            /* 2 NC global cell boxes */
+    const hd__mpi_sample_t *all;
+    size_t (*at)[HD__MPI_CELLS * HD__MPI_CELLS * HD__MPI_CELLS + 1];
+    double *U;                       /* 2 NC, < 0 until computed */
+} cells_t;
+
+/* U of cell k of set s (prune.c's invariants), computed when first asked.
+ * Any sample point of the other set gives an upper bound; the smallest is
+ * sought among the sample points of the other set's cells around the one
+ * nearest the cell's centre, ring by ring (Chebyshev distance in cells),
+ * up to one ring beyond the first that holds a sample point: the points
+ * farther out are farther from every corner too, up to a cell or two, and
+ * a larger U only keeps more cells. */
+static double cell_u(cells_t *cl, int s, size_t k) {
+    enum { NC = HD__MPI_CELLS * HD__MPI_CELLS * HD__MPI_CELLS, M = HD__MPI_CELLS };
+    double *u = &cl->U[(size_t)s * NC + k];
     if (*u >= 0) return *u;
     int t = 1 - s;
+    const hd__box_t *b = &cl->box[(size_t)s * NC + k];
+    double mid[3] = {0.5 * b->lo[0] + 0.5 * b->hi[0], 0.5 * b->lo[1] + 0.5 * b->hi[1], 0.5 * b->lo[2] + 0.5 * b->hi[2]};
+    int c = hd__mpi_cell(cl->pr, t, mid), ci[3] = {c % M, c / M % M, c / (M * M)};
     double m = INFINITY;
-    for (size_t j = from[t]; j < to[t]; j++) {
-        double d = hd__box_ub2(&box[(size_t)s * NC + k], all[j].x);
-        m = d < m ? d : m;
-    }
+    for (int r = 0, last = M; r <= last; r++)
+        for (int z = ci[2] - r; z <= ci[2] + r; z++)
+            for (int y = ci[1] - r; y <= ci[1] + r; y++)
+                for (int x = ci[0] - r; x <= ci[0] + r; x++) {
+                    int dz = abs(z - ci[2]), dy = abs(y - ci[1]), dx = abs(x - ci[0]);
+                    if (x < 0 || y < 0 || z < 0 || x >= M || y >= M || z >= M) continue;
+                    if ((dx > dy ? dx : dy) < r && dz < r) continue; /* an inner ring's */
+                    size_t j = (size_t)x + (size_t)M * ((size_t)y + (size_t)M * (size_t)z);
+                    for (size_t q = cl->at[t][j]; q < cl->at[t][j + 1]; q++) {
+                        double d = hd__box_ub2(b, cl->all[q].x);
+                        m = d < m ? d : m;
+                    }
+                    if (m < INFINITY && last > r + 1) last = r + 1;
+                }
     return *u = m;
 }
 
@@ -85,31 +113,34 @@ int hd__mpi_prune(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const uint64_t N[
     int *cnt = hd__mpi_alloc(c, 2 * (size_t)K, sizeof(int));
     hd__mpi_sample_t *all = NULL;
     double *U = hd__mpi_alloc(c, 2 * NC, sizeof(double));
+    size_t (*at)[NC + 1] = hd__mpi_alloc(c, 2, sizeof *at), *todo = hd__mpi_alloc(c, 2 * NC, sizeof(size_t));
     size_t total = 0;
-    if (!cb || !gb || !own || !cnt || !U) rc = hd__mpi_nomem(c, "the cells", NC);
+    if (!cb || !gb || !own || !cnt || !U || !at || !todo) rc = hd__mpi_nomem(c, "the cells", NC);
     if (rc == HD_OK) {
         for (size_t k = 0; k < 2 * NC; k++)
             for (int a = 0; a < 6; a++) cb[6 * k + a] = INFINITY;
         size_t o = 0;
         for (int s = 0; s < 2; s++) {
             size_t t = 0, i = 0, ns = mine[s];
-            uint64_t n = in->n[s];
+            uint64_t n = in->n[s], next = 0; /* the share's next position: i n / ns */
             for (size_t p = 0; p < in->nparts[s]; p++) {
                 const hd_points_t *v = &in->parts[s][p].points;
                 const double *px = hd__mpi_packed(v);
                 for (size_t k = 0; k < v->count; k++, t++) {
                     double xb[3];
                     const double *x = px ? px + 3 * k : (hd_points_get(v, k, xb), xb);
-                    double *b = cb + 6 * ((size_t)s * NC + (size_t)hd__mpi_cell(pr, s, x));
+                    int cell = hd__mpi_cell(pr, s, x);
+                    double *b = cb + 6 * ((size_t)s * NC + (size_t)cell);
                     for (int a = 0; a < 3; a++) {
                         b[a] = x[a] < b[a] ? x[a] : b[a];
                         b[3 + a] = -x[a] < b[3 + a] ? -x[a] : b[3 + a];
                     }
                     /* the share: position i n / ns for i < ns (increasing, ns <= n) */
-                    if (i < ns && (uint64_t)i * n / ns == t) {
+                    if (i < ns && next == t) {
                         memcpy(own[o].x, x, sizeof own[o].x);
-                        own[o].g = 0, own[o].side = (uint64_t)s;
+                        own[o].g = (uint64_t)cell, own[o].side = (uint64_t)s;
                         o++, i++;
+                        next = (uint64_t)i * n / ns;
                     }
                 }
             }
@@ -133,17 +164,27 @@ int hd__mpi_prune(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const uint64_t N[
             box[k] = b;
         }
         for (size_t k = 0; k < 2 * NC; k++) full[k] = box[k].lo[0] <= box[k].hi[0];
-        /* The sample by set (A's first), then L (a sample point whose
-         * bound is already at most L cannot raise it), then U (the
-         * smallest: a larger one would keep more cells). */
-        qsort(all, total, sizeof *all, by_side);
+        /* The sample by set (A's first) and cell, then L (a sample point
+         * whose bound is already at most L cannot raise it: the cell of
+         * the other set nearest it is tried first), then U (the smallest
+         * found: a larger one would keep more cells). */
+        qsort(all, total, sizeof *all, by_side_cell);
         size_t split = 0, from[2], to[2];
         while (split < total && all[split].side == 0) split++;
         from[0] = 0, to[0] = split, from[1] = split, to[1] = total;
+        for (int s = 0; s < 2; s++) {
+            size_t q = from[s];
+            for (size_t k = 0; k <= NC; k++) {
+                while (q < to[s] && all[q].g < k) q++;
+                at[s][k] = q;
+            }
+        }
         double L[2] = {-1.0, -1.0};
         for (int s = 0; s < 2; s++) {
             int t = 1 - s;
             for (size_t j = from[s]; j < to[s]; j++) {
+                size_t near = (size_t)hd__mpi_cell(pr, t, all[j].x);
+                if (full[t * NC + near] && hd__box_lb2(&box[t * NC + near], all[j].x) <= L[s]) continue;
                 double lb = INFINITY;
                 for (size_t k = 0; k < NC && lb > L[s]; k++)
                     if (full[t * NC + k]) {
@@ -154,30 +195,34 @@ int hd__mpi_prune(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const uint64_t N[
             }
         }
         for (size_t k = 0; k < 2 * NC; k++) U[k] = -1.0; /* not computed: cell_u */
+        cells_t cl = {pr, box, all, at, U};
         /* Cell k of s is kept when it may hold the witness of direction s;
          * then every kept point that is asked for its nearest (both sets'
          * in the symmetric call, A's in the directed one) keeps every cell
-         * of the other set within its U, ties included, until nothing
-         * changes: a kept point's nearest among the kept points is its
-         * nearest among all, so a point kept only as a searched one keeps
-         * its d2 <= U < L and cannot win either. */
+         * of the other set within its U, ties included, each kept cell
+         * once (a list of the cells still to look from): a kept point's
+         * nearest among the kept points is its nearest among all, so a
+         * point kept only as a searched one keeps its d2 <= U < L and
+         * cannot win either. */
         unsigned char (*kp)[NC] = pr->keep;
+        size_t nq = 0, out[2] = {0, 0}; /* out: the nonempty cells not kept */
         for (int s = 0; s < 2; s++)
-            for (size_t k = 0; k < NC; k++)
+            for (size_t k = 0; k < NC; k++) {
                 kp[s][k] = full[s * NC + k] && (s == 0 || both) &&
-                           (L[s] < 0.5 * half_diag2(&box[s * NC + k]) || !(cell_u(U, box, all, from, to, s, k) < L[s]));
-        for (int changed = 1; changed;) {
-            changed = 0;
-            for (int s = 0; s < (both ? 2 : 1); s++) {
-                int t = 1 - s;
-                for (size_t k = 0; k < NC; k++) {
-                    if (!kp[s][k]) continue;
-                    for (size_t j = 0; j < NC; j++)
-                        if (!kp[t][j] && full[t * NC + j] &&
-                            hd__box_box_lb2(&box[s * NC + k], &box[t * NC + j]) <= cell_u(U, box, all, from, to, s, k))
-                            kp[t][j] = 1, changed = 1;
-                }
+                           (L[s] < 0.5 * half_diag2(&box[s * NC + k]) || !(cell_u(&cl, s, k) < L[s]));
+                if (kp[s][k]) todo[nq++] = (size_t)s * NC + k;
+                out[s] += full[s * NC + k] && !kp[s][k];
             }
+        while (nq) {
+            size_t sk = todo[--nq];
+            int s = (int)(sk / NC), t = 1 - s;
+            if (!out[t]) continue; /* every cell of t kept: nothing to add */
+            double u = cell_u(&cl, s, sk % NC);
+            for (size_t j = 0; j < NC; j++)
+                if (!kp[t][j] && full[t * NC + j] && hd__box_box_lb2(&box[sk], &box[t * NC + j]) <= u) {
+                    kp[t][j] = 1, out[t]--;
+                    if (t == 0 || both) todo[nq++] = (size_t)t * NC + j;
+                }
         }
     }
     pr->on = 1;
@@ -188,5 +233,7 @@ done:
     hd__mpi_free(c, cnt, 2 * (size_t)K, sizeof(int));
     hd__mpi_free(c, all, total ? total : 1, sizeof *all);
     hd__mpi_free(c, U, 2 * NC, sizeof(double));
+    hd__mpi_free(c, at, 2, sizeof *at);
+    hd__mpi_free(c, todo, 2 * NC, sizeof(size_t));
     return rc;
 }

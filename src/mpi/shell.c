@@ -530,12 +530,15 @@ int hd__mpi_shell_of(hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, const hd__box_t *
      * point of P either was refused (its faces not clear of its own u), or
      * has u no larger than the answer, which a kept point attains.  With
      * the refused points' list incomplete, or no point kept, the engine
-     * runs again on the whole local sets, without the filter. */
+     * runs again on the whole local sets, without the filter: the same
+     * filter over the same sets would fail again (it refuses by the same
+     * faces), so it is run here only when it has not run yet. */
     const hd__mpi_refused_t *ref = pre && pre->ref.on ? &pre->ref : NULL;
     hd__mpi_refused_t own = {mine, d->P, 0, -1.0, NULL, 0, 0, 0, NULL}; /* when the engine runs here */
+    int filter = !ref; /* not tried yet */
     if (ref && (ref->overflow || pre->e.i == HD__NONE)) pre = NULL, ref = NULL;
     if (rc == HD_OK && !done && pre) e = pre->e;
-    if (rc == HD_OK && !done && !pre) {
+    if (rc == HD_OK && !done && !pre && filter) {
         own.cap = REFUSED_ROOM(d->nP);
         hd__keep_t keep = {keep_clear, &own};
         rc = refused_alloc(c, &own, d->nP);
