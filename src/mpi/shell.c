@@ -269,10 +269,30 @@ static int pairs_engine(hd__mpi_ctx_t *c, double *P, size_t nP, double *Q, size_
 static int keep_clear(void *ctx, size_t i, double d2, size_t j) {
     hd__mpi_refused_t *r = ctx;
     if (r->overflow || hd__mpi_faces_clear(r->mine, r->P + 3 * i, d2)) return 1;
+    if (r->n == r->cap) {
+        r->overflow = 1;
+        return 1; /* kept, as every point after it: each refused point is listed (overflow_max) */
+    }
     r->d2 = d2 > r->d2 ? d2 : r->d2;
-    if (r->n < r->cap) r->pos[r->n] = (uint32_t)i, r->near[r->n++] = (uint32_t)j;
-    else r->overflow = 1;
+    r->pos[r->n] = (uint32_t)i, r->near[r->n++] = (uint32_t)j;
     return 0;
+}
+
+/* The engine's unfiltered answer from a pass whose list overflowed (e,
+ * its answer over the points kept, a real point): every point offered was
+ * kept (exact) or refused and listed with its exact nearest (keep_clear
+ * keeps every point from the overflow on), and a point never offered has
+ * u below e's or equal to it at a larger index (hd__keep_t), so the rank's
+ * largest u, smallest index on ties, is the larger of e and the listed
+ * points' (local order is index order): what the engine gives without the
+ * filter, without running it again. */
+static hd_result_t overflow_max(const hd__mpi_refused_t *r, const double *Q, hd_result_t e) {
+    for (size_t k = 0; k < r->n; k++) {
+        size_t i = r->pos[k], j = r->near[k];
+        double d2 = hd__d2(r->P + 3 * i, Q + 3 * j);
+        if (d2 > e.distance2 || (d2 == e.distance2 && i < e.i)) e.distance2 = d2, e.distance = sqrt(d2), e.i = i, e.j = j;
+    }
+    return e;
 }
 
 /* Room for the refused points: an engine pass offers a few thousand
@@ -535,16 +555,23 @@ int hd__mpi_shell_of(hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, const hd__box_t *
      * faces), so it is run here only when it has not run yet. */
     const hd__mpi_refused_t *ref = pre && pre->ref.on ? &pre->ref : NULL;
     hd__mpi_refused_t own = {mine, d->P, 0, -1.0, NULL, 0, 0, 0, NULL}; /* when the engine runs here */
-    int filter = !ref; /* not tried yet */
-    if (ref && (ref->overflow || pre->e.i == HD__NONE)) pre = NULL, ref = NULL;
-    if (rc == HD_OK && !done && pre) e = pre->e;
+    int filter = !ref, have = 0; /* the filter not tried yet; e unfiltered */
+    if (ref && ref->overflow && pre->e.i != HD__NONE) {
+        e = overflow_max(ref, d->Q, pre->e), have = 1;
+        pre = NULL, ref = NULL;
+    } else if (ref && (ref->overflow || pre->e.i == HD__NONE)) {
+        pre = NULL, ref = NULL;
+    } else if (rc == HD_OK && !done && pre) {
+        e = pre->e, have = !ref;
+    }
     if (rc == HD_OK && !done && !pre && filter) {
         own.cap = REFUSED_ROOM(d->nP);
         hd__keep_t keep = {keep_clear, &own};
         rc = refused_alloc(c, &own, d->nP);
-        if (rc == HD_OK && (rc = hd__mpi_engine_kept(c, &Pv, &Qv, &keep, &e)) == HD_OK && !own.overflow &&
-            e.i != HD__NONE)
-            ref = &own;
+        if (rc == HD_OK && (rc = hd__mpi_engine_kept(c, &Pv, &Qv, &keep, &e)) == HD_OK && e.i != HD__NONE) {
+            if (!own.overflow) ref = &own;
+            else e = overflow_max(&own, d->Q, e), have = 1;
+        }
     }
     /* The shell's positions, when it is the refused points (below). */
     uint32_t *refpos = NULL;
@@ -559,7 +586,7 @@ int hd__mpi_shell_of(hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, const hd__box_t *
          * cannot be the witness on any rank. */
         rc = refused_shell(c, ref, &refpos, &refnear, &nref);
         nI = d->nP - nref;
-    } else if (rc == HD_OK && !done && (pre || (rc = hd__mpi_engine_local(c, &Pv, &Qv, NULL, NULL, &e)) == HD_OK)) {
+    } else if (rc == HD_OK && !done && (have || (rc = hd__mpi_engine_local(c, &Pv, &Qv, NULL, NULL, &e)) == HD_OK)) {
         /* Unfiltered: the engine's answer is the rank's largest u, which
          * only the points whose faces are clear of it may take as global */
         if (!in && !(in = hd__mpi_alloc(c, d->nP, 1))) rc = hd__mpi_nomem(c, "the interior", d->nP);
