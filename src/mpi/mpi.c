@@ -73,8 +73,10 @@
  *     refuse is interior: kept (exact), or never offered, so below h_I or
  *     at it with a larger index than the witness (hd__keep_t), which no
  *     other rank's points can change; the shell is the refused points
- *     alone.  When the filter's list of refused points overflows, or it
- *     keeps none, the engine runs unfiltered and:
+ *     alone.  When the filter's list of refused points overflows, the
+ *     filter keeps every point from then on, and the larger of its answer
+ *     and the listed points' exact u is the unfiltered answer (no second
+ *     pass); when it keeps none, the engine runs unfiltered.  Unfiltered:
  *     When the engine's witness is interior, it is the
  *     interior's maximum; else the interior's maximum is computed (one
  *     more engine call on it, its maximum starting at G, so what cannot

@@ -9,9 +9,11 @@
  * Invariants (every bound is one of points.h's computed bounds, evaluated
  * in hd__d2's operation order, so each holds for the computed squared
  * distances the engine compares, not only for the real ones):
- *  - U[s][c] = min over the sample of the other set of hd__box_ub2(cell
- *    box, o): at least the computed d2 of every point of the cell to its
- *    nearest in the other set (the sample's points are points of it).
+ *  - U[s][c] = min over some sample points o of the other set of
+ *    hd__box_ub2(cell box, o) (those of the other set's cells around the
+ *    one nearest the cell's centre: cell_u): at least the computed d2 of
+ *    every point of the cell to its nearest in the other set (the
+ *    sample's points are points of it), whichever points are tried.
  *  - L[s] = max over the sample of s of min over the other set's nonempty
  *    cells of hd__box_lb2(cell box, p): at most the computed d2 of the
  *    sample point p to its nearest, so at most h^2 of the direction s.

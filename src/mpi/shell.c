@@ -24,7 +24,9 @@
  * slabs' scale) is the larger of h_I and the refused points' largest.  A
  * refused point's nearest point of Q is the engine's own answer (offered
  * with it: the exact distance and the smallest index at it), so the shell
- * needs no search of Q.  Unfiltered, the shell is the points whose faces
+ * needs no search of Q.  When the list overflows, every point from then
+ * on is kept, so the larger of the answer and the listed points' is the
+ * unfiltered answer (overflow_max).  Unfiltered, the shell is the points whose faces
  * are not clear of the engine's answer, the rank's largest u, and they get
  * per-point searches (hd_distances).  The engine prunes the points that cannot be the
  * farthest, which per-point searches cannot (mpi_bench times both on two
