@@ -35,6 +35,8 @@
 
 /* Sample points a side in all (each rank its share of its input). */
 #define PRUNE_SAMPLE 1024
+/* Cells a set. */
+enum { NC = HD__MPI_CELLS * HD__MPI_CELLS * HD__MPI_CELLS };
 
 /* By set, then by cell (the cell in g: prune() puts it there). */
 static int by_side_cell(const void *x, const void *y) {
@@ -48,8 +50,9 @@ static int by_side_cell(const void *x, const void *y) {
 typedef struct {
     const hd__mpi_prune_t *pr;
     const hd__box_t *box;            /* 2 NC global cell boxes */
+    const unsigned char *full;       /* 2 NC: the cell holds a point */
     const hd__mpi_sample_t *all;
-    size_t (*at)[HD__MPI_CELLS * HD__MPI_CELLS * HD__MPI_CELLS + 1];
+    size_t (*at)[NC + 1];
     double *U;                       /* 2 NC, < 0 until computed */
 } cells_t;
 
@@ -61,7 +64,7 @@ typedef struct {
  * farther out are farther from every corner too, up to a cell or two, and
  * a larger U only keeps more cells. */
 static double cell_u(cells_t *cl, int s, size_t k) {
-    enum { NC = HD__MPI_CELLS * HD__MPI_CELLS * HD__MPI_CELLS, M = HD__MPI_CELLS };
+    enum { M = HD__MPI_CELLS };
     double *u = &cl->U[(size_t)s * NC + k];
     if (*u >= 0) return *u;
     int t = 1 - s;
@@ -97,9 +100,113 @@ static double half_diag2(const hd__box_t *b) {
 
 static size_t share(uint64_t n, uint64_t N) { return N <= PRUNE_SAMPLE ? (size_t)n : (size_t)(n * PRUNE_SAMPLE / N); }
 
+/* This rank's points into the cells' boxes cb (2 NC boxes, hi negated, at
+ * +INFINITY on entry) and its share of the sample into own (mine[s] of
+ * set s, evenly spaced in its own order; a point's g holds its cell). */
+static void take_cells(const hd__mpi_input_t *in, const hd__mpi_prune_t *pr, const size_t mine[2], double *cb,
+                       hd__mpi_sample_t *own) {
+    size_t o = 0;
+    for (int s = 0; s < 2; s++) {
+        size_t t = 0, i = 0, ns = mine[s];
+        uint64_t n = in->n[s], next = 0; /* the share's next position: i n / ns */
+        for (size_t p = 0; p < in->nparts[s]; p++) {
+            const hd_points_t *v = &in->parts[s][p].points;
+            const double *px = hd__mpi_packed(v);
+            for (size_t k = 0; k < v->count; k++, t++) {
+                double xb[3];
+                const double *x = px ? px + 3 * k : (hd_points_get(v, k, xb), xb);
+                int cell = hd__mpi_cell(pr, s, x);
+                double *b = cb + 6 * ((size_t)s * NC + (size_t)cell);
+                for (int a = 0; a < 3; a++) {
+                    b[a] = x[a] < b[a] ? x[a] : b[a];
+                    b[3 + a] = -x[a] < b[3 + a] ? -x[a] : b[3 + a];
+                }
+                /* the share: position i n / ns for i < ns (increasing, ns <= n) */
+                if (i < ns && next == t) {
+                    memcpy(own[o].x, x, sizeof own[o].x);
+                    own[o].g = (uint64_t)cell, own[o].side = (uint64_t)s;
+                    o++, i++;
+                    next = (uint64_t)i * n / ns;
+                }
+            }
+        }
+    }
+}
+
+/* The sample (total points, every rank's) by set (A's first) and cell:
+ * set s's points are all[from[s] .. to[s]), those of its cell k
+ * all[at[s][k] .. at[s][k + 1]). */
+static void sort_sample(hd__mpi_sample_t *all, size_t total, size_t from[2], size_t to[2], size_t (*at)[NC + 1]) {
+    qsort(all, total, sizeof *all, by_side_cell);
+    size_t split = 0;
+    while (split < total && all[split].side == 0) split++;
+    from[0] = 0, to[0] = split, from[1] = split, to[1] = total;
+    for (int s = 0; s < 2; s++) {
+        size_t q = from[s];
+        for (size_t k = 0; k <= NC; k++) {
+            while (q < to[s] && all[q].g < k) q++;
+            at[s][k] = q;
+        }
+    }
+}
+
+/* L of set s (prune.c's invariants) over its sample all[from .. to): a
+ * sample point whose bound is already at most L cannot raise it, and the
+ * other set's cell nearest it is tried first. */
+static double lower_L(const cells_t *cl, int s, size_t from, size_t to) {
+    int t = 1 - s;
+    const hd__box_t *box = cl->box + (size_t)t * NC;
+    const unsigned char *full = cl->full + (size_t)t * NC;
+    double L = -1.0;
+    for (size_t j = from; j < to; j++) {
+        const double *x = cl->all[j].x;
+        size_t near = (size_t)hd__mpi_cell(cl->pr, t, x);
+        if (full[near] && hd__box_lb2(&box[near], x) <= L) continue;
+        double lb = INFINITY;
+        for (size_t k = 0; k < NC && lb > L; k++)
+            if (full[k]) {
+                double d = hd__box_lb2(&box[k], x);
+                lb = d < lb ? d : lb;
+            }
+        L = lb > L ? lb : L;
+    }
+    return L;
+}
+
+/* The cells kept (kp): cell k of s is kept when it may hold the witness of
+ * direction s; then every kept point that is asked for its nearest (both
+ * sets' in the symmetric call, A's in the directed one) keeps every cell
+ * of the other set within its U, ties included, each kept cell once (todo,
+ * 2 NC: the cells still to look from), and not at all once every cell of
+ * the other set is kept: a kept point's nearest among the kept points is
+ * its nearest among all, so a point kept only as a searched one keeps its
+ * d2 <= U < L and cannot win either. */
+static void keep_cells(cells_t *cl, const double L[2], int both, size_t *todo, unsigned char (*kp)[NC]) {
+    const hd__box_t *box = cl->box;
+    const unsigned char *full = cl->full;
+    size_t nq = 0, out[2] = {0, 0}; /* out: the nonempty cells not kept */
+    for (int s = 0; s < 2; s++)
+        for (size_t k = 0; k < NC; k++) {
+            kp[s][k] = full[s * NC + k] && (s == 0 || both) &&
+                       (L[s] < 0.5 * half_diag2(&box[s * NC + k]) || !(cell_u(cl, s, k) < L[s]));
+            if (kp[s][k]) todo[nq++] = (size_t)s * NC + k;
+            out[s] += full[s * NC + k] && !kp[s][k];
+        }
+    while (nq) {
+        size_t sk = todo[--nq];
+        int s = (int)(sk / NC), t = 1 - s;
+        if (!out[t]) continue;
+        double u = cell_u(cl, s, sk % NC);
+        for (size_t j = 0; j < NC; j++)
+            if (!kp[t][j] && full[t * NC + j] && hd__box_box_lb2(&box[sk], &box[t * NC + j]) <= u) {
+                kp[t][j] = 1, out[t]--;
+                if (t == 0 || both) todo[nq++] = (size_t)t * NC + j;
+            }
+    }
+}
+
 int hd__mpi_prune(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const uint64_t N[2], const double corners[2][6], int both,
                   hd__mpi_prune_t *pr) {
-    enum { NC = HD__MPI_CELLS * HD__MPI_CELLS * HD__MPI_CELLS };
     int K = c->K, rc = HD_OK;
     memset(pr, 0, sizeof *pr);
     for (int s = 0; s < 2; s++)
@@ -121,32 +228,7 @@ int hd__mpi_prune(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const uint64_t N[
     if (rc == HD_OK) {
         for (size_t k = 0; k < 2 * NC; k++)
             for (int a = 0; a < 6; a++) cb[6 * k + a] = INFINITY;
-        size_t o = 0;
-        for (int s = 0; s < 2; s++) {
-            size_t t = 0, i = 0, ns = mine[s];
-            uint64_t n = in->n[s], next = 0; /* the share's next position: i n / ns */
-            for (size_t p = 0; p < in->nparts[s]; p++) {
-                const hd_points_t *v = &in->parts[s][p].points;
-                const double *px = hd__mpi_packed(v);
-                for (size_t k = 0; k < v->count; k++, t++) {
-                    double xb[3];
-                    const double *x = px ? px + 3 * k : (hd_points_get(v, k, xb), xb);
-                    int cell = hd__mpi_cell(pr, s, x);
-                    double *b = cb + 6 * ((size_t)s * NC + (size_t)cell);
-                    for (int a = 0; a < 3; a++) {
-                        b[a] = x[a] < b[a] ? x[a] : b[a];
-                        b[3 + a] = -x[a] < b[3 + a] ? -x[a] : b[3 + a];
-                    }
-                    /* the share: position i n / ns for i < ns (increasing, ns <= n) */
-                    if (i < ns && next == t) {
-                        memcpy(own[o].x, x, sizeof own[o].x);
-                        own[o].g = (uint64_t)cell, own[o].side = (uint64_t)s;
-                        o++, i++;
-                        next = (uint64_t)i * n / ns;
-                    }
-                }
-            }
-        }
+        take_cells(in, pr, mine, cb, own);
     }
     if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
     HD__MPI_GO(c, rc, MPI_Allreduce(cb, gb, 2 * NC * 6, MPI_DOUBLE, MPI_MIN, c->comm));
@@ -166,66 +248,14 @@ int hd__mpi_prune(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const uint64_t N[
             box[k] = b;
         }
         for (size_t k = 0; k < 2 * NC; k++) full[k] = box[k].lo[0] <= box[k].hi[0];
-        /* The sample by set (A's first) and cell, then L (a sample point
-         * whose bound is already at most L cannot raise it: the cell of
-         * the other set nearest it is tried first), then U (the smallest
-         * found: a larger one would keep more cells). */
-        qsort(all, total, sizeof *all, by_side_cell);
-        size_t split = 0, from[2], to[2];
-        while (split < total && all[split].side == 0) split++;
-        from[0] = 0, to[0] = split, from[1] = split, to[1] = total;
-        for (int s = 0; s < 2; s++) {
-            size_t q = from[s];
-            for (size_t k = 0; k <= NC; k++) {
-                while (q < to[s] && all[q].g < k) q++;
-                at[s][k] = q;
-            }
-        }
-        double L[2] = {-1.0, -1.0};
-        for (int s = 0; s < 2; s++) {
-            int t = 1 - s;
-            for (size_t j = from[s]; j < to[s]; j++) {
-                size_t near = (size_t)hd__mpi_cell(pr, t, all[j].x);
-                if (full[t * NC + near] && hd__box_lb2(&box[t * NC + near], all[j].x) <= L[s]) continue;
-                double lb = INFINITY;
-                for (size_t k = 0; k < NC && lb > L[s]; k++)
-                    if (full[t * NC + k]) {
-                        double d = hd__box_lb2(&box[t * NC + k], all[j].x);
-                        lb = d < lb ? d : lb;
-                    }
-                L[s] = lb > L[s] ? lb : L[s];
-            }
-        }
+        /* The sample by set and cell, then L, then U as the cells need it
+         * (the smallest found: a larger one would keep more cells). */
+        size_t from[2], to[2];
+        sort_sample(all, total, from, to, at);
         for (size_t k = 0; k < 2 * NC; k++) U[k] = -1.0; /* not computed: cell_u */
-        cells_t cl = {pr, box, all, at, U};
-        /* Cell k of s is kept when it may hold the witness of direction s;
-         * then every kept point that is asked for its nearest (both sets'
-         * in the symmetric call, A's in the directed one) keeps every cell
-         * of the other set within its U, ties included, each kept cell
-         * once (a list of the cells still to look from): a kept point's
-         * nearest among the kept points is its nearest among all, so a
-         * point kept only as a searched one keeps its d2 <= U < L and
-         * cannot win either. */
-        unsigned char (*kp)[NC] = pr->keep;
-        size_t nq = 0, out[2] = {0, 0}; /* out: the nonempty cells not kept */
-        for (int s = 0; s < 2; s++)
-            for (size_t k = 0; k < NC; k++) {
-                kp[s][k] = full[s * NC + k] && (s == 0 || both) &&
-                           (L[s] < 0.5 * half_diag2(&box[s * NC + k]) || !(cell_u(&cl, s, k) < L[s]));
-                if (kp[s][k]) todo[nq++] = (size_t)s * NC + k;
-                out[s] += full[s * NC + k] && !kp[s][k];
-            }
-        while (nq) {
-            size_t sk = todo[--nq];
-            int s = (int)(sk / NC), t = 1 - s;
-            if (!out[t]) continue; /* every cell of t kept: nothing to add */
-            double u = cell_u(&cl, s, sk % NC);
-            for (size_t j = 0; j < NC; j++)
-                if (!kp[t][j] && full[t * NC + j] && hd__box_box_lb2(&box[sk], &box[t * NC + j]) <= u) {
-                    kp[t][j] = 1, out[t]--;
-                    if (t == 0 || both) todo[nq++] = (size_t)t * NC + j;
-                }
-        }
+        cells_t cl = {pr, box, full, all, at, U};
+        double L[2] = {lower_L(&cl, 0, from[0], to[0]), lower_L(&cl, 1, from[1], to[1])};
+        keep_cells(&cl, L, both, todo, pr->keep);
     }
     pr->on = 1;
 done:
