@@ -3,7 +3,7 @@
  *     mpirun -n K build/bench/mpi_bench [--points N] [--per-rank] [--cases LIST]
  *                                       [--layout random|tiles] [--threads T]
  *                                       [--check] [--repeat R] [--distances]
- *                                       [--rank-cpu]
+ *                                       [--rank-cpu] [--no-prune]
  * For each case, every rank generates its share of A and B (N points per
  * side in total, or per rank with --per-rank: weak scaling), and one call
  * of hd_mpi_hausdorff is timed; rank 0 prints one line per case with the
@@ -38,7 +38,8 @@
  * rank's own searchcpu and othercpu per local point and the core it ended
  * on (with `mpirun --bind-to core` rank r stays on core r: on the machine of
  * docs/scale-out.md one core ran 1.4 times slower than the other for an
- * hour on 2026-11-29).
+ * hour on 2026-11-29).  --no-prune sets hd_mpi_options_t's prune to 0:
+ * every point moves, the comparison for what the cells keep home.
  *
  * --distances times hd_mpi_distances (both directions, every point's nearest
  * neighbour; the faster of two calls) instead, and prints per case: bytes moved per input point by
@@ -171,9 +172,9 @@ static double *gather(const double *v, size_t n, int w, size_t *total) {
 static void bench_distances(const char *c, const double *a, const double *b, size_t n, size_t offset,
                             int threads) {
     hd_mpi_part_t pa = {hd_points_f64(a, n), offset}, pb = {hd_points_f64(b, n), offset};
-    hd_options_t opt;
-    hd_options_init(&opt);
-    opt.threads = threads;
+    hd_mpi_options_t opt;
+    hd_mpi_options_init(&opt);
+    opt.engine.threads = threads;
     double *d[2] = {malloc(n * sizeof(double) + 8), malloc(n * sizeof(double) + 8)};
     size_t *j[2] = {malloc(n * sizeof(size_t) + 8), malloc(n * sizeof(size_t) + 8)};
     for (int s = 0; s < 2; s++) { /* touched, as the single process's are when it runs again */
@@ -286,7 +287,7 @@ int main(int argc, char **argv) {
     MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
     MPI_Comm_size(MPI_COMM_WORLD, &K_);
     size_t N = 1000000;
-    int per_rank = 0, tiles = 0, threads = 1, check = 0, repeat = 1, dist = 0, rank_cpu = 0;
+    int per_rank = 0, tiles = 0, threads = 1, check = 0, repeat = 1, dist = 0, rank_cpu = 0, prune = 1;
     const char *cases = "uniform,lidar,copy";
     for (int k = 1; k < argc; k++) {
         if (!strcmp(argv[k], "--points") && k + 1 < argc) N = (size_t)atof(argv[++k]);
@@ -298,6 +299,7 @@ int main(int argc, char **argv) {
         else if (!strcmp(argv[k], "--repeat") && k + 1 < argc) repeat = atoi(argv[++k]);
         else if (!strcmp(argv[k], "--distances")) dist = 1;
         else if (!strcmp(argv[k], "--rank-cpu")) rank_cpu = 1;
+        else if (!strcmp(argv[k], "--no-prune")) prune = 0;
         else {
             if (rank_ == 0) fprintf(stderr, "mpi_bench: unknown argument %s\n", argv[k]);
             MPI_Finalize();
@@ -343,9 +345,10 @@ int main(int argc, char **argv) {
             continue;
         }
         hd_mpi_part_t pa = {hd_points_f64(sized ? sa : a, na), oa}, pb = {hd_points_f64(sized ? sb : b, nb), ob};
-        hd_options_t opt;
-        hd_options_init(&opt);
-        opt.threads = threads;
+        hd_mpi_options_t opt;
+        hd_mpi_options_init(&opt);
+        opt.engine.threads = threads;
+        opt.prune = prune;
         hd_symmetric_t r;
         hd_mpi_stats_t st;
         hd_error_t err;

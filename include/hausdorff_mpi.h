@@ -60,7 +60,7 @@
  *  - The library duplicates `comm` for its own messages (so they never
  *    match the caller's) and frees the duplicate before returning.  MPI
  *    must be initialised.  Only the calling thread makes MPI calls; the
- *    threads the library starts (opt->threads) make none, so
+ *    threads the library starts (opt->engine.threads) make none, so
  *    MPI_THREAD_FUNNELED is the level the standard asks for.
  *  - Points are read during the call only, and may be laid out in any way
  *    over the ranks: any rank may hold any points of either set, or none.
@@ -93,6 +93,30 @@ typedef struct hd_mpi_part {
     hd_points_t points;
     size_t offset;
 } hd_mpi_part_t;
+
+/* The options of the calls over the ranks.  hd_mpi_options_init fills the
+ * defaults; NULL in a call means them. */
+typedef struct hd_mpi_options {
+    hd_options_t engine; /* the single-machine options: engine.threads is
+                            the number of threads each rank uses (< 0 is
+                            HD_EINVAL) and engine.algorithm must be a
+                            valid one (HD_EALGORITHM), although the default
+                            engine's per-point search always runs; the
+                            other fields are ignored */
+    int prune;           /* 1 (default): before the partition, the points
+                            that the cells' bounds prove cannot change the
+                            result stay on the rank that holds them
+                            (docs/scale-out.md, "The points that stay");
+                            0: every point moves to its region's rank.
+                            The result is the same bit for bit; only the
+                            work and the bytes moved differ (a comparison
+                            for benchmarks).  hd_mpi_distances ignores
+                            it: every point needs its own answer */
+} hd_mpi_options_t;
+
+/* Fill `opt` with the defaults: hd_options_init's engine options and
+ * prune = 1. */
+void hd_mpi_options_init(hd_mpi_options_t *opt);
 
 /* What the exchange cost, the same on every rank (sums and maxima over the
  * ranks) except the fields marked "this rank". */
@@ -128,7 +152,7 @@ typedef struct hd_mpi_stats {
                                    searches (its own points and the
                                    queries it answered) */
     double search_cpu_max;      /* the same in CPU seconds of the calling
-                                   thread: with opt->threads = 1 the
+                                   thread: with opt->engine.threads = 1 the
                                    searches' own cost, whatever the load */
     double other_cpu_max;       /* the most CPU seconds of a rank's calling
                                    thread outside the searches and the MPI
@@ -160,10 +184,8 @@ typedef struct hd_mpi_stats {
  * a, na: this rank's parts of A (na may be 0, a is then not read); b, nb
  *   likewise for B.  Read during the call only.  A part with no points is
  *   allowed.  Over all ranks each set must have a point (HD_EEMPTY).
- * opt: NULL for the defaults; opt->threads is the number of threads each
- *   rank uses (< 0 is HD_EINVAL) and opt->algorithm must be a valid one
- *   (HD_EALGORITHM), although the default engine's per-point search always
- *   runs (out->ab.algorithm is HD_ALG_AUTO); other fields are ignored.
+ * opt: NULL for the defaults (hd_mpi_options_t above; out->ab.algorithm
+ *   is HD_ALG_AUTO whatever engine.algorithm says).
  * out: receives the result on every rank; its stats are zero and its
  *   seconds are the slowest rank's.
  * stats: NULL, or receives the exchange figures above.
@@ -177,14 +199,14 @@ typedef struct hd_mpi_stats {
  *   communicator. */
 int hd_mpi_hausdorff(MPI_Comm comm, const hd_mpi_part_t *a, size_t na,
                      const hd_mpi_part_t *b, size_t nb,
-                     const hd_options_t *opt, hd_symmetric_t *out,
+                     const hd_mpi_options_t *opt, hd_symmetric_t *out,
                      hd_mpi_stats_t *stats, hd_error_t *err);
 
 /* h(A,B) alone, as hd_directed() gives it: the same arguments and errors
  * as hd_mpi_hausdorff, half the work. */
 int hd_mpi_directed(MPI_Comm comm, const hd_mpi_part_t *a, size_t na,
                     const hd_mpi_part_t *b, size_t nb,
-                    const hd_options_t *opt, hd_result_t *out,
+                    const hd_mpi_options_t *opt, hd_result_t *out,
                     hd_mpi_stats_t *stats, hd_error_t *err);
 
 /* Per-point nearest neighbours over the ranks, as hd_distances() gives
@@ -194,8 +216,8 @@ int hd_mpi_directed(MPI_Comm comm, const hd_mpi_part_t *a, size_t na,
  * at that distance; dist_ba and nearest_ba likewise for this rank's points
  * of B against all of A.  Collective over comm.
  *
- * a, na, b, nb, opt: as hd_mpi_hausdorff (only opt->threads is read
- *   besides the checks).
+ * a, na, b, nb, opt: as hd_mpi_hausdorff (only opt->engine.threads is
+ *   read besides the checks).
  * dist_ab, nearest_ab: NULL, or arrays of this rank's points of A (the sum
  *   of its parts' counts), filled in the order of its parts: part 0's
  *   points, then part 1's, ...; dist_ba, nearest_ba likewise for B.  A
@@ -226,7 +248,7 @@ int hd_mpi_directed(MPI_Comm comm, const hd_mpi_part_t *a, size_t na,
  * Thread safety: as hd_mpi_hausdorff. */
 int hd_mpi_distances(MPI_Comm comm, const hd_mpi_part_t *a, size_t na,
                      const hd_mpi_part_t *b, size_t nb,
-                     const hd_options_t *opt, double *dist_ab,
+                     const hd_mpi_options_t *opt, double *dist_ab,
                      size_t *nearest_ab, double *dist_ba,
                      size_t *nearest_ba, hd_mpi_stats_t *stats,
                      hd_error_t *err);

@@ -73,9 +73,12 @@ static int distances_mpi(const cli_args_t *a, const hd_mpi_part_t part[2], const
         }
     }
     memset(st, 0, sizeof *st);
+    hd_mpi_options_t mo;
+    hd_mpi_options_init(&mo);
+    mo.engine = a->opt;
     if ((rc = agree(rc, err)) == HD_OK)
-        rc = hd_mpi_distances(MPI_COMM_WORLD, &part[0], 1, &part[1], 1, &a->opt, r->d_ab, r->j_ab, r->d_ba,
-                              r->j_ba, st, err);
+        rc = hd_mpi_distances(MPI_COMM_WORLD, &part[0], 1, &part[1], 1, &mo, r->d_ab, r->j_ab, r->d_ba, r->j_ba, st,
+                              err);
     r->seconds = rc == HD_OK ? st->seconds_max : 0;
     return rc;
 }
@@ -391,16 +394,19 @@ static int compute(run_t *r, hd_error_t *err) {
     cli_args_t *a = &r->a;
     const hd_mpi_part_t *part = r->part;
     hd_symmetric_t *s = &r->s;
+    hd_mpi_options_t mo;
+    hd_mpi_options_init(&mo);
+    mo.engine = a->opt;
     int rc;
     if (a->directed) {
-        rc = hd_mpi_directed(MPI_COMM_WORLD, &part[0], 1, &part[1], 1, &a->opt, &s->ab, &r->st, err);
+        rc = hd_mpi_directed(MPI_COMM_WORLD, &part[0], 1, &part[1], 1, &mo, &s->ab, &r->st, err);
         if (rc == HD_OK) {
             s->distance = s->ab.distance;
             s->seconds = s->ab.seconds;
             rc = hd_mpi_overlap(MPI_COMM_WORLD, &part[0], 1, &part[1], 1, &s->alpha, &s->disjoint, err);
         }
     } else {
-        rc = hd_mpi_hausdorff(MPI_COMM_WORLD, &part[0], 1, &part[1], 1, &a->opt, s, &r->st, err);
+        rc = hd_mpi_hausdorff(MPI_COMM_WORLD, &part[0], 1, &part[1], 1, &mo, s, &r->st, err);
     }
     if (rc != HD_OK || !analysis_active(&a->an)) return rc;
     if ((rc = distances_mpi(a, part, r->total, &r->an, &r->dst, err)) == HD_OK)

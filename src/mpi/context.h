@@ -56,6 +56,7 @@ typedef struct hd__mpi_ctx {
     uint64_t interior_passes;  /* second engine calls on an interior */
     int rounds;
     int first;                 /* the partition's first samples a rank (rcb.c) */
+    int prune;                 /* hd_mpi_options_t's: cells that cannot matter stay (prune.c) */
     MPI_Datatype ans_type, q_type, far_type, sample_type, node_type;
     MPI_Op far_op;
 } hd__mpi_ctx_t;

@@ -45,11 +45,12 @@ void hd__mpi_course_init(hd__mpi_ctx_t *c, hd__mpi_course_t *cs);
 void hd__mpi_course_free(hd__mpi_ctx_t *c, hd__mpi_course_t *cs);
 int hd__mpi_figures(hd__mpi_ctx_t *c, const hd__mpi_course_t *cs, uint64_t pts, hd_mpi_stats_t *st, double *tmax);
 
-/* A call's body, run by hd__mpi_call inside its context. */
+/* A call's body, run by hd__mpi_call inside its context (opt: the engine's
+ * options of the call's hd_mpi_options_t, NULL for the defaults). */
 typedef int (*hd__mpi_body_t)(hd__mpi_ctx_t *c, const hd_options_t *opt, hd__mpi_input_t *in, void *arg, hd_mpi_stats_t *st);
 
 int hd__mpi_call(MPI_Comm comm, const hd_mpi_part_t *a, size_t na, const hd_mpi_part_t *b, size_t nb,
-                 const hd_options_t *opt, hd__mpi_body_t body, void *arg, hd_mpi_stats_t *st, hd_error_t *err);
+                 const hd_mpi_options_t *opt, hd__mpi_body_t body, void *arg, hd_mpi_stats_t *st, hd_error_t *err);
 int hd__mpi_begin(hd__mpi_ctx_t *c, const hd_options_t *opt, hd__mpi_input_t *in, const void *res, hd__mpi_ranges_t *rg, uint64_t N[2],
                   double corners[2][6]);
 /* pr: the points that stay out of the course (NULL: none; prune.c). */

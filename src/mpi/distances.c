@@ -581,7 +581,7 @@ done:
 }
 
 int hd_mpi_distances(MPI_Comm comm, const hd_mpi_part_t *a, size_t na, const hd_mpi_part_t *b, size_t nb,
-                     const hd_options_t *opt, double *dist_ab, size_t *nearest_ab, double *dist_ba,
+                     const hd_mpi_options_t *opt, double *dist_ab, size_t *nearest_ab, double *dist_ba,
                      size_t *nearest_ba, hd_mpi_stats_t *stats, hd_error_t *err) {
     outs_t o = {{dist_ab, dist_ba}, {nearest_ab, nearest_ba}};
     return hd__mpi_call(comm, a, na, b, nb, opt, distances, &o, stats, err);

@@ -278,6 +278,33 @@ static size_t central(const hd__mpi_dir_t *d, const hd__mpi_shell_t *sh, const q
     return best;
 }
 
+/* Before the sample's structure is built for many points (m marked in
+ * exact[] with 2), a pilot: PILOT of them, evenly spread, take their
+ * nearest sample point by brute force.  When none of them comes below L,
+ * the sample is too sparse for these points (a lattice whose every point
+ * is at L: a sample point is never that near), and the search is skipped
+ * (returns 0): the bounds only spare work later, every point keeps the
+ * upper bound it has, and the answers do not depend on them. */
+#define PILOT 16
+#define PILOT_MIN 256
+static int pilot(const hd__mpi_dir_t *d, const hd__mpi_shell_t *sh, const qsample_t *qs, double L, double *u2, uint64_t *jj,
+                 const unsigned char *exact, size_t m) {
+    int below = 0;
+    for (size_t k = 0, i = 0, t = 0; k < sh->n && t < PILOT; k++) {
+        if (!(exact[k] & 2)) continue;
+        if (i++ != t * m / PILOT) continue;
+        t++;
+        size_t best = 0;
+        double b2 = INFINITY;
+        for (size_t j = 0; j < qs->n; j++) {
+            double d2 = hd__d2(hd__mpi_shell_pt(d, sh, k), qs->xyz + 3 * j);
+            if (d2 < b2) b2 = d2, best = j;
+        }
+        below |= offer(d, sh, qs, k, best, u2, jj) < L;
+    }
+    return below;
+}
+
 /* The shell's points not yet exact take the sample's nearest point when
  * it is smaller (forward.c's invariants); with the whole of Q sampled
  * they become exact.  The paper's early break first: a point to which a
@@ -303,7 +330,7 @@ static int sample_bounds(hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, hd__mpi_shell
         exact[k] |= 2; /* searched below (a mark, cleared there) */
         m++;
     }
-    if (m == 0 || m > HD__AN_MAX_POINTS) {
+    if (m == 0 || m > HD__AN_MAX_POINTS || (!qs->whole && m >= PILOT_MIN && !pilot(d, sh, qs, L, u2, jj, exact, m))) {
         for (size_t k = 0; k < sh->n; k++) exact[k] &= 1;
         return HD_OK;
     }

@@ -73,8 +73,10 @@
  *     refuse is interior: kept (exact), or never offered, so below h_I or
  *     at it with a larger index than the witness (hd__keep_t), which no
  *     other rank's points can change; the shell is the refused points
- *     alone.  When the filter's list of refused points overflows, or it
- *     keeps none, the engine runs unfiltered and:
+ *     alone.  When the filter's list of refused points overflows, the
+ *     filter keeps every point from then on, and the larger of its answer
+ *     and the listed points' exact u is the unfiltered answer (no second
+ *     pass); when it keeps none, the engine runs unfiltered.  Unfiltered:
  *     When the engine's witness is interior, it is the
  *     interior's maximum; else the interior's maximum is computed (one
  *     more engine call on it, its maximum starting at G, so what cannot
@@ -358,11 +360,9 @@ static int run(hd__mpi_ctx_t *c, const hd_options_t *opt, hd__mpi_input_t *in, v
     } else {
         hd__mpi_spread_t *sp = &cs.sp;
         /* The points that cannot change the answer stay where they are
-         * (prune.c), unless HD_MPI_NO_PRUNE is set (mpi_bench's and the
-         * tests' comparison of what moves). */
+         * (prune.c), unless the options turn it off. */
         hd__mpi_prune_t pr = {0};
-        const char *off = getenv("HD_MPI_NO_PRUNE");
-        if (!(off && *off) && (rc = hd__mpi_prune(c, in, cs.N, corners, both, &pr)) != HD_OK) goto done;
+        if (c->prune && (rc = hd__mpi_prune(c, in, cs.N, corners, both, &pr)) != HD_OK) goto done;
         if ((rc = hd__mpi_spread(c, in, &cs.rg, cs.N, &pr, sp)) != HD_OK) goto done;
         hd__mpi_local_t *loc = &sp->loc;
         /* Both directions: the engine once for both (each of its calls
@@ -410,8 +410,14 @@ done:
     return rc;
 }
 
+void hd_mpi_options_init(hd_mpi_options_t *opt) {
+    hd_options_init(&opt->engine);
+    opt->prune = 1;
+}
+
 int hd__mpi_call(MPI_Comm comm, const hd_mpi_part_t *a, size_t na, const hd_mpi_part_t *b, size_t nb,
-                 const hd_options_t *opt, hd__mpi_body_t body, void *arg, hd_mpi_stats_t *st, hd_error_t *err) {
+                 const hd_mpi_options_t *mopt, hd__mpi_body_t body, void *arg, hd_mpi_stats_t *st, hd_error_t *err) {
+    const hd_options_t *opt = mopt ? &mopt->engine : NULL;
     hd__err_clear(err);
     hd__mpi_ctx_t c;
     memset(&c, 0, sizeof c);
@@ -432,6 +438,7 @@ int hd__mpi_call(MPI_Comm comm, const hd_mpi_part_t *a, size_t na, const hd_mpi_
         MPI_Comm_size(c.comm, &c.K);
         c.first = hd__mpi_first_samples(c.K);
         c.threads = opt ? opt->threads : 0;
+        c.prune = mopt ? mopt->prune : 1;
         if (c.threads < 0) c.threads = 1; /* refused by check_local, on every rank */
         rc = hd__mpi_types_create(&c);
         if ((rc = hd__mpi_agree(&c, rc)) == HD_OK) {
@@ -450,13 +457,13 @@ int hd__mpi_call(MPI_Comm comm, const hd_mpi_part_t *a, size_t na, const hd_mpi_
 }
 
 int hd_mpi_hausdorff(MPI_Comm comm, const hd_mpi_part_t *a, size_t na, const hd_mpi_part_t *b, size_t nb,
-                     const hd_options_t *opt, hd_symmetric_t *out, hd_mpi_stats_t *stats, hd_error_t *err) {
+                     const hd_mpi_options_t *opt, hd_symmetric_t *out, hd_mpi_stats_t *stats, hd_error_t *err) {
     what_t w = {MODE_BOTH, out};
     return hd__mpi_call(comm, a, na, b, nb, opt, run, &w, stats, err);
 }
 
 int hd_mpi_directed(MPI_Comm comm, const hd_mpi_part_t *a, size_t na, const hd_mpi_part_t *b, size_t nb,
-                    const hd_options_t *opt, hd_result_t *out, hd_mpi_stats_t *stats, hd_error_t *err) {
+                    const hd_mpi_options_t *opt, hd_result_t *out, hd_mpi_stats_t *stats, hd_error_t *err) {
     what_t w = {MODE_DIRECTED, out};
     return hd__mpi_call(comm, a, na, b, nb, opt, run, &w, stats, err);
 }

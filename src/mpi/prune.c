@@ -9,9 +9,11 @@
  * Invariants (every bound is one of points.h's computed bounds, evaluated
  * in hd__d2's operation order, so each holds for the computed squared
  * distances the engine compares, not only for the real ones):
- *  - U[s][c] = min over the sample of the other set of hd__box_ub2(cell
- *    box, o): at least the computed d2 of every point of the cell to its
- *    nearest in the other set (the sample's points are points of it).
+ *  - U[s][c] = min over some sample points o of the other set of
+ *    hd__box_ub2(cell box, o) (those of the other set's cells around the
+ *    one nearest the cell's centre: cell_u): at least the computed d2 of
+ *    every point of the cell to its nearest in the other set (the
+ *    sample's points are points of it), whichever points are tried.
  *  - L[s] = max over the sample of s of min over the other set's nonempty
  *    cells of hd__box_lb2(cell box, p): at most the computed d2 of the
  *    sample point p to its nearest, so at most h^2 of the direction s.
@@ -33,26 +35,57 @@
 
 /* Sample points a side in all (each rank its share of its input). */
 #define PRUNE_SAMPLE 1024
+/* Cells a set. */
+enum { NC = HD__MPI_CELLS * HD__MPI_CELLS * HD__MPI_CELLS };
 
-static int by_side(const void *x, const void *y) {
+/* By set, then by cell (the cell in g: prune() puts it there). */
+static int by_side_cell(const void *x, const void *y) {
     const hd__mpi_sample_t *a = x, *b = y;
-    return (a->side > b->side) - (a->side < b->side);
+    if (a->side != b->side) return (a->side > b->side) - (a->side < b->side);
+    return (a->g > b->g) - (a->g < b->g);
 }
 
-/* U of cell k of set s (prune.c's invariants), computed when first
- * asked (U[] < 0 until then): the sample of the other set is
- * all[from[t]..to[t]). */
-static double cell_u(double *U, const hd__box_t *box, const hd__mpi_sample_t *all, const size_t *from, const size_t *to,
-                     int s, size_t k) {
-    enum { NC = HD__MPI_CELLS * HD__MPI_CELLS * HD__MPI_CELLS };
-    double *u = &U[(size_t)s * NC + k];
+/* The sample of each set sorted by set, then by its cell in its own set's
+ * grid: set s's sample points of cell k are all[at[s][k] .. at[s][k + 1]). */
+typedef struct {
+    const hd__mpi_prune_t *pr;
+    const hd__box_t *box;            /* 2 NC global cell boxes */
+    const unsigned char *full;       /* 2 NC: the cell holds a point */
+    const hd__mpi_sample_t *all;
+    size_t (*at)[NC + 1];
+    double *U;                       /* 2 NC, < 0 until computed */
+} cells_t;
+
+/* U of cell k of set s (prune.c's invariants), computed when first asked.
+ * Any sample point of the other set gives an upper bound; the smallest is
+ * sought among the sample points of the other set's cells around the one
+ * nearest the cell's centre, ring by ring (Chebyshev distance in cells),
+ * up to one ring beyond the first that holds a sample point: the points
+ * farther out are farther from every corner too, up to a cell or two, and
+ * a larger U only keeps more cells. */
+static double cell_u(cells_t *cl, int s, size_t k) {
+    enum { M = HD__MPI_CELLS };
+    double *u = &cl->U[(size_t)s * NC + k];
     if (*u >= 0) return *u;
     int t = 1 - s;
+    const hd__box_t *b = &cl->box[(size_t)s * NC + k];
+    double mid[3] = {0.5 * b->lo[0] + 0.5 * b->hi[0], 0.5 * b->lo[1] + 0.5 * b->hi[1], 0.5 * b->lo[2] + 0.5 * b->hi[2]};
+    int c = hd__mpi_cell(cl->pr, t, mid), ci[3] = {c % M, c / M % M, c / (M * M)};
     double m = INFINITY;
-    for (size_t j = from[t]; j < to[t]; j++) {
-        double d = hd__box_ub2(&box[(size_t)s * NC + k], all[j].x);
-        m = d < m ? d : m;
-    }
+    for (int r = 0, last = M; r <= last; r++)
+        for (int z = ci[2] - r; z <= ci[2] + r; z++)
+            for (int y = ci[1] - r; y <= ci[1] + r; y++)
+                for (int x = ci[0] - r; x <= ci[0] + r; x++) {
+                    int dz = abs(z - ci[2]), dy = abs(y - ci[1]), dx = abs(x - ci[0]);
+                    if (x < 0 || y < 0 || z < 0 || x >= M || y >= M || z >= M) continue;
+                    if ((dx > dy ? dx : dy) < r && dz < r) continue; /* an inner ring's */
+                    size_t j = (size_t)x + (size_t)M * ((size_t)y + (size_t)M * (size_t)z);
+                    for (size_t q = cl->at[t][j]; q < cl->at[t][j + 1]; q++) {
+                        double d = hd__box_ub2(b, cl->all[q].x);
+                        m = d < m ? d : m;
+                    }
+                    if (m < INFINITY && last > r + 1) last = r + 1;
+                }
     return *u = m;
 }
 
@@ -67,9 +100,113 @@ static double half_diag2(const hd__box_t *b) {
 
 static size_t share(uint64_t n, uint64_t N) { return N <= PRUNE_SAMPLE ? (size_t)n : (size_t)(n * PRUNE_SAMPLE / N); }
 
+/* This rank's points into the cells' boxes cb (2 NC boxes, hi negated, at
+ * +INFINITY on entry) and its share of the sample into own (mine[s] of
+ * set s, evenly spaced in its own order; a point's g holds its cell). */
+static void take_cells(const hd__mpi_input_t *in, const hd__mpi_prune_t *pr, const size_t mine[2], double *cb,
+                       hd__mpi_sample_t *own) {
+    size_t o = 0;
+    for (int s = 0; s < 2; s++) {
+        size_t t = 0, i = 0, ns = mine[s];
+        uint64_t n = in->n[s], next = 0; /* the share's next position: i n / ns */
+        for (size_t p = 0; p < in->nparts[s]; p++) {
+            const hd_points_t *v = &in->parts[s][p].points;
+            const double *px = hd__mpi_packed(v);
+            for (size_t k = 0; k < v->count; k++, t++) {
+                double xb[3];
+                const double *x = px ? px + 3 * k : (hd_points_get(v, k, xb), xb);
+                int cell = hd__mpi_cell(pr, s, x);
+                double *b = cb + 6 * ((size_t)s * NC + (size_t)cell);
+                for (int a = 0; a < 3; a++) {
+                    b[a] = x[a] < b[a] ? x[a] : b[a];
+                    b[3 + a] = -x[a] < b[3 + a] ? -x[a] : b[3 + a];
+                }
+                /* the share: position i n / ns for i < ns (increasing, ns <= n) */
+                if (i < ns && next == t) {
+                    memcpy(own[o].x, x, sizeof own[o].x);
+                    own[o].g = (uint64_t)cell, own[o].side = (uint64_t)s;
+                    o++, i++;
+                    next = (uint64_t)i * n / ns;
+                }
+            }
+        }
+    }
+}
+
+/* The sample (total points, every rank's) by set (A's first) and cell:
+ * set s's points are all[from[s] .. to[s]), those of its cell k
+ * all[at[s][k] .. at[s][k + 1]). */
+static void sort_sample(hd__mpi_sample_t *all, size_t total, size_t from[2], size_t to[2], size_t (*at)[NC + 1]) {
+    qsort(all, total, sizeof *all, by_side_cell);
+    size_t split = 0;
+    while (split < total && all[split].side == 0) split++;
+    from[0] = 0, to[0] = split, from[1] = split, to[1] = total;
+    for (int s = 0; s < 2; s++) {
+        size_t q = from[s];
+        for (size_t k = 0; k <= NC; k++) {
+            while (q < to[s] && all[q].g < k) q++;
+            at[s][k] = q;
+        }
+    }
+}
+
+/* L of set s (prune.c's invariants) over its sample all[from .. to): a
+ * sample point whose bound is already at most L cannot raise it, and the
+ * other set's cell nearest it is tried first. */
+static double lower_L(const cells_t *cl, int s, size_t from, size_t to) {
+    int t = 1 - s;
+    const hd__box_t *box = cl->box + (size_t)t * NC;
+    const unsigned char *full = cl->full + (size_t)t * NC;
+    double L = -1.0;
+    for (size_t j = from; j < to; j++) {
+        const double *x = cl->all[j].x;
+        size_t near = (size_t)hd__mpi_cell(cl->pr, t, x);
+        if (full[near] && hd__box_lb2(&box[near], x) <= L) continue;
+        double lb = INFINITY;
+        for (size_t k = 0; k < NC && lb > L; k++)
+            if (full[k]) {
+                double d = hd__box_lb2(&box[k], x);
+                lb = d < lb ? d : lb;
+            }
+        L = lb > L ? lb : L;
+    }
+    return L;
+}
+
+/* The cells kept (kp): cell k of s is kept when it may hold the witness of
+ * direction s; then every kept point that is asked for its nearest (both
+ * sets' in the symmetric call, A's in the directed one) keeps every cell
+ * of the other set within its U, ties included, each kept cell once (todo,
+ * 2 NC: the cells still to look from), and not at all once every cell of
+ * the other set is kept: a kept point's nearest among the kept points is
+ * its nearest among all, so a point kept only as a searched one keeps its
+ * d2 <= U < L and cannot win either. */
+static void keep_cells(cells_t *cl, const double L[2], int both, size_t *todo, unsigned char (*kp)[NC]) {
+    const hd__box_t *box = cl->box;
+    const unsigned char *full = cl->full;
+    size_t nq = 0, out[2] = {0, 0}; /* out: the nonempty cells not kept */
+    for (int s = 0; s < 2; s++)
+        for (size_t k = 0; k < NC; k++) {
+            kp[s][k] = full[s * NC + k] && (s == 0 || both) &&
+                       (L[s] < 0.5 * half_diag2(&box[s * NC + k]) || !(cell_u(cl, s, k) < L[s]));
+            if (kp[s][k]) todo[nq++] = (size_t)s * NC + k;
+            out[s] += full[s * NC + k] && !kp[s][k];
+        }
+    while (nq) {
+        size_t sk = todo[--nq];
+        int s = (int)(sk / NC), t = 1 - s;
+        if (!out[t]) continue;
+        double u = cell_u(cl, s, sk % NC);
+        for (size_t j = 0; j < NC; j++)
+            if (!kp[t][j] && full[t * NC + j] && hd__box_box_lb2(&box[sk], &box[t * NC + j]) <= u) {
+                kp[t][j] = 1, out[t]--;
+                if (t == 0 || both) todo[nq++] = (size_t)t * NC + j;
+            }
+    }
+}
+
 int hd__mpi_prune(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const uint64_t N[2], const double corners[2][6], int both,
                   hd__mpi_prune_t *pr) {
-    enum { NC = HD__MPI_CELLS * HD__MPI_CELLS * HD__MPI_CELLS };
     int K = c->K, rc = HD_OK;
     memset(pr, 0, sizeof *pr);
     for (int s = 0; s < 2; s++)
@@ -85,35 +222,13 @@ int hd__mpi_prune(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const uint64_t N[
     int *cnt = hd__mpi_alloc(c, 2 * (size_t)K, sizeof(int));
     hd__mpi_sample_t *all = NULL;
     double *U = hd__mpi_alloc(c, 2 * NC, sizeof(double));
+    size_t (*at)[NC + 1] = hd__mpi_alloc(c, 2, sizeof *at), *todo = hd__mpi_alloc(c, 2 * NC, sizeof(size_t));
     size_t total = 0;
-    if (!cb || !gb || !own || !cnt || !U) rc = hd__mpi_nomem(c, "the cells", NC);
+    if (!cb || !gb || !own || !cnt || !U || !at || !todo) rc = hd__mpi_nomem(c, "the cells", NC);
     if (rc == HD_OK) {
         for (size_t k = 0; k < 2 * NC; k++)
             for (int a = 0; a < 6; a++) cb[6 * k + a] = INFINITY;
-        size_t o = 0;
-        for (int s = 0; s < 2; s++) {
-            size_t t = 0, i = 0, ns = mine[s];
-            uint64_t n = in->n[s];
-            for (size_t p = 0; p < in->nparts[s]; p++) {
-                const hd_points_t *v = &in->parts[s][p].points;
-                const double *px = hd__mpi_packed(v);
-                for (size_t k = 0; k < v->count; k++, t++) {
-                    double xb[3];
-                    const double *x = px ? px + 3 * k : (hd_points_get(v, k, xb), xb);
-                    double *b = cb + 6 * ((size_t)s * NC + (size_t)hd__mpi_cell(pr, s, x));
-                    for (int a = 0; a < 3; a++) {
-                        b[a] = x[a] < b[a] ? x[a] : b[a];
-                        b[3 + a] = -x[a] < b[3 + a] ? -x[a] : b[3 + a];
-                    }
-                    /* the share: position i n / ns for i < ns (increasing, ns <= n) */
-                    if (i < ns && (uint64_t)i * n / ns == t) {
-                        memcpy(own[o].x, x, sizeof own[o].x);
-                        own[o].g = 0, own[o].side = (uint64_t)s;
-                        o++, i++;
-                    }
-                }
-            }
-        }
+        take_cells(in, pr, mine, cb, own);
     }
     if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
     HD__MPI_GO(c, rc, MPI_Allreduce(cb, gb, 2 * NC * 6, MPI_DOUBLE, MPI_MIN, c->comm));
@@ -133,52 +248,14 @@ int hd__mpi_prune(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const uint64_t N[
             box[k] = b;
         }
         for (size_t k = 0; k < 2 * NC; k++) full[k] = box[k].lo[0] <= box[k].hi[0];
-        /* The sample by set (A's first), then L (a sample point whose
-         * bound is already at most L cannot raise it), then U (the
-         * smallest: a larger one would keep more cells). */
-        qsort(all, total, sizeof *all, by_side);
-        size_t split = 0, from[2], to[2];
-        while (split < total && all[split].side == 0) split++;
-        from[0] = 0, to[0] = split, from[1] = split, to[1] = total;
-        double L[2] = {-1.0, -1.0};
-        for (int s = 0; s < 2; s++) {
-            int t = 1 - s;
-            for (size_t j = from[s]; j < to[s]; j++) {
-                double lb = INFINITY;
-                for (size_t k = 0; k < NC && lb > L[s]; k++)
-                    if (full[t * NC + k]) {
-                        double d = hd__box_lb2(&box[t * NC + k], all[j].x);
-                        lb = d < lb ? d : lb;
-                    }
-                L[s] = lb > L[s] ? lb : L[s];
-            }
-        }
+        /* The sample by set and cell, then L, then U as the cells need it
+         * (the smallest found: a larger one would keep more cells). */
+        size_t from[2], to[2];
+        sort_sample(all, total, from, to, at);
         for (size_t k = 0; k < 2 * NC; k++) U[k] = -1.0; /* not computed: cell_u */
-        /* Cell k of s is kept when it may hold the witness of direction s;
-         * then every kept point that is asked for its nearest (both sets'
-         * in the symmetric call, A's in the directed one) keeps every cell
-         * of the other set within its U, ties included, until nothing
-         * changes: a kept point's nearest among the kept points is its
-         * nearest among all, so a point kept only as a searched one keeps
-         * its d2 <= U < L and cannot win either. */
-        unsigned char (*kp)[NC] = pr->keep;
-        for (int s = 0; s < 2; s++)
-            for (size_t k = 0; k < NC; k++)
-                kp[s][k] = full[s * NC + k] && (s == 0 || both) &&
-                           (L[s] < 0.5 * half_diag2(&box[s * NC + k]) || !(cell_u(U, box, all, from, to, s, k) < L[s]));
-        for (int changed = 1; changed;) {
-            changed = 0;
-            for (int s = 0; s < (both ? 2 : 1); s++) {
-                int t = 1 - s;
-                for (size_t k = 0; k < NC; k++) {
-                    if (!kp[s][k]) continue;
-                    for (size_t j = 0; j < NC; j++)
-                        if (!kp[t][j] && full[t * NC + j] &&
-                            hd__box_box_lb2(&box[s * NC + k], &box[t * NC + j]) <= cell_u(U, box, all, from, to, s, k))
-                            kp[t][j] = 1, changed = 1;
-                }
-            }
-        }
+        cells_t cl = {pr, box, full, all, at, U};
+        double L[2] = {lower_L(&cl, 0, from[0], to[0]), lower_L(&cl, 1, from[1], to[1])};
+        keep_cells(&cl, L, both, todo, pr->keep);
     }
     pr->on = 1;
 done:
@@ -188,5 +265,7 @@ done:
     hd__mpi_free(c, cnt, 2 * (size_t)K, sizeof(int));
     hd__mpi_free(c, all, total ? total : 1, sizeof *all);
     hd__mpi_free(c, U, 2 * NC, sizeof(double));
+    hd__mpi_free(c, at, 2, sizeof *at);
+    hd__mpi_free(c, todo, 2 * NC, sizeof(size_t));
     return rc;
 }

@@ -24,7 +24,9 @@
  * slabs' scale) is the larger of h_I and the refused points' largest.  A
  * refused point's nearest point of Q is the engine's own answer (offered
  * with it: the exact distance and the smallest index at it), so the shell
- * needs no search of Q.  Unfiltered, the shell is the points whose faces
+ * needs no search of Q.  When the list overflows, every point from then
+ * on is kept, so the larger of the answer and the listed points' is the
+ * unfiltered answer (overflow_max).  Unfiltered, the shell is the points whose faces
  * are not clear of the engine's answer, the rank's largest u, and they get
  * per-point searches (hd_distances).  The engine prunes the points that cannot be the
  * farthest, which per-point searches cannot (mpi_bench times both on two
@@ -269,10 +271,30 @@ static int pairs_engine(hd__mpi_ctx_t *c, double *P, size_t nP, double *Q, size_
 static int keep_clear(void *ctx, size_t i, double d2, size_t j) {
     hd__mpi_refused_t *r = ctx;
     if (r->overflow || hd__mpi_faces_clear(r->mine, r->P + 3 * i, d2)) return 1;
+    if (r->n == r->cap) {
+        r->overflow = 1;
+        return 1; /* kept, as every point after it: each refused point is listed (overflow_max) */
+    }
     r->d2 = d2 > r->d2 ? d2 : r->d2;
-    if (r->n < r->cap) r->pos[r->n] = (uint32_t)i, r->near[r->n++] = (uint32_t)j;
-    else r->overflow = 1;
+    r->pos[r->n] = (uint32_t)i, r->near[r->n++] = (uint32_t)j;
     return 0;
+}
+
+/* The engine's unfiltered answer from a pass whose list overflowed (e,
+ * its answer over the points kept, a real point): every point offered was
+ * kept (exact) or refused and listed with its exact nearest (keep_clear
+ * keeps every point from the overflow on), and a point never offered has
+ * u below e's or equal to it at a larger index (hd__keep_t), so the rank's
+ * largest u, smallest index on ties, is the larger of e and the listed
+ * points' (local order is index order): what the engine gives without the
+ * filter, without running it again. */
+static hd_result_t overflow_max(const hd__mpi_refused_t *r, const double *Q, hd_result_t e) {
+    for (size_t k = 0; k < r->n; k++) {
+        size_t i = r->pos[k], j = r->near[k];
+        double d2 = hd__d2(r->P + 3 * i, Q + 3 * j);
+        if (d2 > e.distance2 || (d2 == e.distance2 && i < e.i)) e.distance2 = d2, e.distance = sqrt(d2), e.i = i, e.j = j;
+    }
+    return e;
 }
 
 /* Room for the refused points: an engine pass offers a few thousand
@@ -530,18 +552,28 @@ int hd__mpi_shell_of(hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, const hd__box_t *
      * point of P either was refused (its faces not clear of its own u), or
      * has u no larger than the answer, which a kept point attains.  With
      * the refused points' list incomplete, or no point kept, the engine
-     * runs again on the whole local sets, without the filter. */
+     * runs again on the whole local sets, without the filter: the same
+     * filter over the same sets would fail again (it refuses by the same
+     * faces), so it is run here only when it has not run yet. */
     const hd__mpi_refused_t *ref = pre && pre->ref.on ? &pre->ref : NULL;
     hd__mpi_refused_t own = {mine, d->P, 0, -1.0, NULL, 0, 0, 0, NULL}; /* when the engine runs here */
-    if (ref && (ref->overflow || pre->e.i == HD__NONE)) pre = NULL, ref = NULL;
-    if (rc == HD_OK && !done && pre) e = pre->e;
-    if (rc == HD_OK && !done && !pre) {
+    int filter = !ref, have = 0; /* the filter not tried yet; e unfiltered */
+    if (ref && ref->overflow && pre->e.i != HD__NONE) {
+        e = overflow_max(ref, d->Q, pre->e), have = 1;
+        pre = NULL, ref = NULL;
+    } else if (ref && (ref->overflow || pre->e.i == HD__NONE)) {
+        pre = NULL, ref = NULL;
+    } else if (rc == HD_OK && !done && pre) {
+        e = pre->e, have = !ref;
+    }
+    if (rc == HD_OK && !done && !pre && filter) {
         own.cap = REFUSED_ROOM(d->nP);
         hd__keep_t keep = {keep_clear, &own};
         rc = refused_alloc(c, &own, d->nP);
-        if (rc == HD_OK && (rc = hd__mpi_engine_kept(c, &Pv, &Qv, &keep, &e)) == HD_OK && !own.overflow &&
-            e.i != HD__NONE)
-            ref = &own;
+        if (rc == HD_OK && (rc = hd__mpi_engine_kept(c, &Pv, &Qv, &keep, &e)) == HD_OK && e.i != HD__NONE) {
+            if (!own.overflow) ref = &own;
+            else e = overflow_max(&own, d->Q, e), have = 1;
+        }
     }
     /* The shell's positions, when it is the refused points (below). */
     uint32_t *refpos = NULL;
@@ -556,7 +588,7 @@ int hd__mpi_shell_of(hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, const hd__box_t *
          * cannot be the witness on any rank. */
         rc = refused_shell(c, ref, &refpos, &refnear, &nref);
         nI = d->nP - nref;
-    } else if (rc == HD_OK && !done && (pre || (rc = hd__mpi_engine_local(c, &Pv, &Qv, NULL, NULL, &e)) == HD_OK)) {
+    } else if (rc == HD_OK && !done && (have || (rc = hd__mpi_engine_local(c, &Pv, &Qv, NULL, NULL, &e)) == HD_OK)) {
         /* Unfiltered: the engine's answer is the rank's largest u, which
          * only the points whose faces are clear of it may take as global */
         if (!in && !(in = hd__mpi_alloc(c, d->nP, 1))) rc = hd__mpi_nomem(c, "the interior", d->nP);

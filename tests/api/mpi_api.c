@@ -290,10 +290,19 @@ static void open_case(const char *call, int which, int how, uint64_t seed, set_t
     opt->threads = 1;
 }
 
+/* The MPI calls' options around the engine's `opt` (the cells on). */
+static hd_mpi_options_t mpi_opt(const hd_options_t *opt) {
+    hd_mpi_options_t m;
+    hd_mpi_options_init(&m);
+    m.engine = *opt;
+    return m;
+}
+
 static void check_equal(int which, int how, uint64_t seed) {
     set_t s = {"", NULL, NULL, 0, 0};
     hd_options_t opt;
     open_case("hausdorff", which, how, seed, &s, &opt);
+    hd_mpi_options_t mo = mpi_opt(&opt);
     hd_points_t A = hd_points_f64(s.a, s.na), B = hd_points_f64(s.b, s.nb);
     hd_symmetric_t ref, got;
     hd_error_t err;
@@ -307,7 +316,7 @@ static void check_equal(int which, int how, uint64_t seed) {
     MPI_Allreduce(held, all, 2, MPI_UNSIGNED_LONG_LONG, MPI_SUM, MPI_COMM_WORLD);
     CHECK(all[0] == s.na && all[1] == s.nb); /* the layout gave every point out once */
     hd_mpi_stats_t st;
-    rc = hd_mpi_hausdorff(MPI_COMM_WORLD, pa, na, pb, nb, &opt, &got, &st, &err);
+    rc = hd_mpi_hausdorff(MPI_COMM_WORLD, pa, na, pb, nb, &mo, &got, &st, &err);
     CHECK(rc == HD_OK);
     if (rc != HD_OK) fprintf(stderr, "rank %d: %s\n", rank_, err.message);
     CHECK(SAME_BITS(got.distance, ref.distance));
@@ -328,7 +337,7 @@ static void check_equal(int which, int how, uint64_t seed) {
     /* the directed call too (its engine pass is its own: shell.c), on
      * every layout; the overlap on one */
     hd_result_t dr;
-    rc = hd_mpi_directed(MPI_COMM_WORLD, pa, na, pb, nb, &opt, &dr, NULL, &err);
+    rc = hd_mpi_directed(MPI_COMM_WORLD, pa, na, pb, nb, &mo, &dr, NULL, &err);
     CHECK(rc == HD_OK);
     CHECK(SAME_BITS(dr.distance2, ref.ab.distance2) && dr.i == ref.ab.i && dr.j == ref.ab.j);
     if (how == LAY_HOLES) {
@@ -371,6 +380,7 @@ static void check_distances(int which, int how, uint64_t seed) {
     set_t s = {"", NULL, NULL, 0, 0};
     hd_options_t opt;
     open_case("distances", which, how, seed, &s, &opt);
+    hd_mpi_options_t mo = mpi_opt(&opt);
     hd_points_t A = hd_points_f64(s.a, s.na), B = hd_points_f64(s.b, s.nb);
     double *rd_ab = malloc(s.na * sizeof(double)), *rd_ba = malloc(s.nb * sizeof(double));
     size_t *rn_ab = malloc(s.na * sizeof(size_t)), *rn_ba = malloc(s.nb * sizeof(size_t));
@@ -385,7 +395,7 @@ static void check_distances(int which, int how, uint64_t seed) {
     size_t *n_ab = malloc((s.na + 1) * sizeof(size_t)), *n_ba = malloc((s.nb + 1) * sizeof(size_t));
     size_t ma = gather_expected(pa, na, rd_ab, rn_ab, ed_ab, en_ab), mb = gather_expected(pb, nb, rd_ba, rn_ba, ed_ba, en_ba);
     hd_mpi_stats_t st;
-    int rc = hd_mpi_distances(MPI_COMM_WORLD, pa, na, pb, nb, &opt, d_ab, n_ab, d_ba, n_ba, &st, &err);
+    int rc = hd_mpi_distances(MPI_COMM_WORLD, pa, na, pb, nb, &mo, d_ab, n_ab, d_ba, n_ba, &st, &err);
     CHECK(rc == HD_OK);
     if (rc != HD_OK) fprintf(stderr, "rank %d: %s\n", rank_, err.message);
     CHECK(same_answers(d_ab, n_ab, ed_ab, en_ab, ma, "A to B"));
@@ -395,11 +405,11 @@ static void check_distances(int which, int how, uint64_t seed) {
     if (how == LAY_HOLES || how == LAY_CHUNKS) {
         memset(d_ab, 0, (s.na + 1) * sizeof(double));
         memset(n_ba, 0, (s.nb + 1) * sizeof(size_t));
-        CHECK(hd_mpi_distances(MPI_COMM_WORLD, pa, na, pb, nb, &opt, d_ab, NULL, NULL, NULL, &st, &err) == HD_OK);
+        CHECK(hd_mpi_distances(MPI_COMM_WORLD, pa, na, pb, nb, &mo, d_ab, NULL, NULL, NULL, &st, &err) == HD_OK);
         CHECK(st.rounds == (K_ > 1 ? 1 : 0));
         for (size_t k = 0; k < ma; k++) n_ab[k] = en_ab[k];
         CHECK(same_answers(d_ab, n_ab, ed_ab, en_ab, ma, "A to B alone"));
-        CHECK(hd_mpi_distances(MPI_COMM_WORLD, pa, na, pb, nb, &opt, NULL, NULL, NULL, n_ba, &st, &err) == HD_OK);
+        CHECK(hd_mpi_distances(MPI_COMM_WORLD, pa, na, pb, nb, &mo, NULL, NULL, NULL, n_ba, &st, &err) == HD_OK);
         for (size_t k = 0; k < mb; k++) d_ba[k] = ed_ba[k];
         CHECK(same_answers(d_ba, n_ba, ed_ba, en_ba, mb, "B to A alone"));
     }
@@ -408,7 +418,7 @@ static void check_distances(int which, int how, uint64_t seed) {
     if (how == LAY_BLOCKS) {
         memset(n_ba, 0, (s.nb + 1) * sizeof(size_t));
         int r0 = rank_ == 0;
-        CHECK(hd_mpi_distances(MPI_COMM_WORLD, pa, na, pb, nb, &opt, d_ab, n_ab, r0 ? NULL : d_ba, r0 ? NULL : n_ba,
+        CHECK(hd_mpi_distances(MPI_COMM_WORLD, pa, na, pb, nb, &mo, d_ab, n_ab, r0 ? NULL : d_ba, r0 ? NULL : n_ba,
                                &st, &err) == HD_OK);
         CHECK(st.rounds == (K_ > 1 ? 2 : 0));
         CHECK(same_answers(d_ab, n_ab, ed_ab, en_ab, ma, "A to B, B to A asked by some ranks"));
@@ -449,7 +459,8 @@ static void check_errors(void) {
     hd_options_t opt;
     hd_options_init(&opt);
     opt.threads = rank_ == bad ? -1 : 1;
-    check_agreed(hd_mpi_hausdorff(MPI_COMM_WORLD, &pa, 1, &pb, 1, &opt, &r, NULL, &err), HD_EINVAL, &err,
+    hd_mpi_options_t mo = mpi_opt(&opt);
+    check_agreed(hd_mpi_hausdorff(MPI_COMM_WORLD, &pa, 1, &pb, 1, &mo, &r, NULL, &err), HD_EINVAL, &err,
                  "threads");
 
     snprintf(context_, sizeof context_, "B's parts share indices across ranks");
@@ -488,7 +499,7 @@ static void check_errors(void) {
     check_agreed(hd_mpi_distances(MPI_COMM_WORLD, &pa, 1, NULL, 0, NULL, dd, nn, NULL, NULL, NULL, &err), HD_EEMPTY,
                  &err, "point set B is empty");
     snprintf(context_, sizeof context_, "distances: threads = -1 on rank %d only", bad);
-    check_agreed(hd_mpi_distances(MPI_COMM_WORLD, &pa, 1, &pb, 1, &opt, dd, nn, NULL, NULL, NULL, &err), HD_EINVAL,
+    check_agreed(hd_mpi_distances(MPI_COMM_WORLD, &pa, 1, &pb, 1, &mo, dd, nn, NULL, NULL, NULL, &err), HD_EINVAL,
                  &err, "threads");
 
     /* and after all that, a good call still works */
@@ -626,11 +637,12 @@ static void call_big_uniform(const char *what, int how, hd_mpi_stats_t *st) {
     set_t s = {"", NULL, NULL, 0, 0};
     hd_options_t opt;
     open_case(what, DS_BIG_UNIFORM, how, seed, &s, &opt);
+    hd_mpi_options_t mo = mpi_opt(&opt);
     hd_mpi_part_t pa[64], pb[64];
     size_t na = layout(how, 0, s.a, s.na, seed, pa, 64), nb = layout(how, 1, s.b, s.nb, seed, pb, 64);
     hd_symmetric_t got;
     hd_error_t err;
-    CHECK(hd_mpi_hausdorff(MPI_COMM_WORLD, pa, na, pb, nb, &opt, &got, st, &err) == HD_OK);
+    CHECK(hd_mpi_hausdorff(MPI_COMM_WORLD, pa, na, pb, nb, &mo, &got, st, &err) == HD_OK);
     free(s.a);
     free(s.b);
 }

@@ -88,15 +88,39 @@ static void moved_at_most(int shape, const hd_mpi_stats_t *st, unsigned b) {
                 (double)st->bytes_partition / (double)st->points);
 }
 
+/* hd_mpi_options_t's prune = 0 on the cubes 300 apart: the same result,
+ * and every point moves (K > 1), so the partition's bytes exceed twice
+ * those of the call with the cells (`on`, the same sets). */
+static void prune_off(const hd_mpi_part_t *pa, const hd_mpi_part_t *pb, const hd_symmetric_t *ref,
+                      const hd_mpi_stats_t *on) {
+    hd_mpi_options_t mo;
+    hd_mpi_options_init(&mo);
+    mo.engine.threads = 1;
+    mo.prune = 0;
+    hd_symmetric_t got;
+    hd_mpi_stats_t st;
+    hd_error_t err;
+    CHECK(hd_mpi_hausdorff(MPI_COMM_WORLD, pa, 1, pb, 1, &mo, &got, &st, &err) == HD_OK);
+    CHECK(SAME_BITS(got.ab.distance2, ref->ab.distance2) && SAME_BITS(got.ba.distance2, ref->ba.distance2));
+    CHECK(got.ab.i == ref->ab.i && got.ab.j == ref->ab.j && got.ba.i == ref->ba.i && got.ba.j == ref->ba.j);
+    if (K_ == 1) return;
+    CHECK(st.bytes_partition > 2 * on->bytes_partition);
+    if (rank_ == 0)
+        fprintf(stderr, "%s at K = %d, prune = 0: the partition moved %.2f bytes a point (%.2f with the cells)\n",
+                context_, K_, (double)st.bytes_partition / (double)st.points,
+                (double)on->bytes_partition / (double)on->points);
+}
+
 static void run_shape(int shape, uint64_t seed) {
     snprintf(context_, sizeof context_, "%s, seed %llu", shape_name[shape], (unsigned long long)seed);
     double *a, *b;
     size_t na, nb;
     make(shape, seed, &a, &na, &b, &nb);
     hd_points_t A = hd_points_f64(a, na), B = hd_points_f64(b, nb);
-    hd_options_t opt;
-    hd_options_init(&opt);
-    opt.threads = 1;
+    hd_mpi_options_t mo;
+    hd_mpi_options_init(&mo);
+    mo.engine.threads = 1;
+    const hd_options_t opt = mo.engine;
     hd_symmetric_t ref, got;
     hd_result_t dref, dgot;
     hd_error_t err;
@@ -104,7 +128,7 @@ static void run_shape(int shape, uint64_t seed) {
     CHECK(hd_directed(&A, &B, &opt, &dref, &err) == HD_OK);
     hd_mpi_part_t pa = block(a, na, 0), pb = block(b, nb, 1);
     hd_mpi_stats_t st;
-    int rc = hd_mpi_hausdorff(MPI_COMM_WORLD, &pa, 1, &pb, 1, &opt, &got, &st, &err);
+    int rc = hd_mpi_hausdorff(MPI_COMM_WORLD, &pa, 1, &pb, 1, &mo, &got, &st, &err);
     CHECK(rc == HD_OK);
     if (rc != HD_OK) fprintf(stderr, "rank %d: %s\n", rank_, err.message);
     CHECK(SAME_BITS(got.distance, ref.distance));
@@ -118,11 +142,12 @@ static void run_shape(int shape, uint64_t seed) {
     if (rank_ == 0 && 100 * st.forwarded_points > 2 * st.points)
         fprintf(stderr, "%s: %llu of %llu points forwarded\n", context_, (unsigned long long)st.forwarded_points,
                 (unsigned long long)st.points);
-    rc = hd_mpi_directed(MPI_COMM_WORLD, &pa, 1, &pb, 1, &opt, &dgot, &st, &err);
+    rc = hd_mpi_directed(MPI_COMM_WORLD, &pa, 1, &pb, 1, &mo, &dgot, &st, &err);
     CHECK(rc == HD_OK);
     CHECK(SAME_BITS(dgot.distance2, dref.distance2) && dgot.i == dref.i && dgot.j == dref.j);
     CHECK(100 * st.forwarded_points <= 2 * st.points);
     moved_at_most(shape, &st, K_ == 2 ? 8 : 14);
+    if (shape == APART) prune_off(&pa, &pb, &ref, &st);
     free(a);
     free(b);
 }
