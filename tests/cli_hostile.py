@@ -22,10 +22,11 @@ import os
 import resource
 import subprocess
 import sys
-import tempfile
 import threading
 import time
 import unittest
+
+from cli_checks import collector, temp_dir_cases, tool_from_argv
 
 TESTS = []
 TOOL = None  # the hausdorff executable, from the command line
@@ -33,9 +34,7 @@ SANITIZED = False
 NOBODY = 65534
 
 
-def test(fn):
-    TESTS.append(fn)
-    return fn
+test = collector(TESTS)
 
 
 def run(*args, cwd=None, preexec_fn=None, timeout=120):
@@ -226,24 +225,10 @@ def a_file_that_cannot_be_mapped_for_want_of_memory_exits_3(d):
     assert "big.xyz: cannot map its 3221225472 bytes: Cannot allocate memory (out of memory)" in err, err
 
 
-class HostileCli(unittest.TestCase):
-    """Each function above becomes one test, run in a fresh temporary directory."""
-
-    def setUp(self):
-        self.tmp = tempfile.TemporaryDirectory(prefix="hd-cli-hostile-")
-
-    def tearDown(self):
-        for root, dirs, _ in os.walk(self.tmp.name):
-            for x in dirs:
-                os.chmod(os.path.join(root, x), 0o755)
-        self.tmp.cleanup()
-
-
-for _fn in TESTS:
-    setattr(HostileCli, "test_" + _fn.__name__, lambda self, fn=_fn: fn(self.tmp.name))
+HostileCli = temp_dir_cases("HostileCli", TESTS, "hd-cli-hostile-")
 
 if __name__ == "__main__":
-    TOOL = os.path.abspath(sys.argv.pop(1))
+    TOOL = tool_from_argv()
     if len(sys.argv) > 1 and sys.argv[1] == "--sanitized":
         SANITIZED = True
         sys.argv.pop(1)

@@ -18,10 +18,10 @@ import resource
 import signal
 import stat
 import subprocess
-import sys
-import tempfile
 import time
 import unittest
+
+from cli_checks import collector, temp_dir_cases, tool_from_argv
 
 TESTS = []
 TOOL = None  # the hausdorff executable, from the command line
@@ -33,9 +33,7 @@ LARGE = os.path.join(DATA, "armadillo.ply")     # many more points: a CSV of a f
 NOBODY = 65534
 
 
-def test(fn):
-    TESTS.append(fn)
-    return fn
+test = collector(TESTS)
 
 
 def run(*args, stdout=subprocess.PIPE, stdin=None, preexec_fn=None, cwd=None):
@@ -308,22 +306,8 @@ def a_run_that_succeeds_leaves_complete_files_and_no_temporary(d):
         assert not [n for n in os.listdir("/dev") if n.startswith(".null.")]
 
 
-class WritingCli(unittest.TestCase):
-    """Each function above becomes one test, run in a fresh temporary directory."""
-
-    def setUp(self):
-        self.tmp = tempfile.TemporaryDirectory(prefix="hd-cli-output-")
-
-    def tearDown(self):
-        for root, dirs, _ in os.walk(self.tmp.name):
-            for x in dirs:
-                os.chmod(os.path.join(root, x), 0o755)
-        self.tmp.cleanup()
-
-
-for _fn in TESTS:
-    setattr(WritingCli, "test_" + _fn.__name__, lambda self, fn=_fn: fn(self.tmp.name))
+WritingCli = temp_dir_cases("WritingCli", TESTS, "hd-cli-output-")
 
 if __name__ == "__main__":
-    TOOL = os.path.abspath(sys.argv.pop(1))
+    TOOL = tool_from_argv()
     unittest.main(verbosity=2)
