@@ -24,8 +24,8 @@
  * --dtu-cap, --labels, --components, --farther-than / --nearer-than (the
  * distance and the path), and each flag; the two files are the arguments
  * left, each with its FORMAT: prefix split off.  The combinations the
- * parser refuses (--tolerance, --within or --signed without --surface, a
- * write-back path with --surface) never come back as -1.
+ * parser refuses (--tolerance, --within or --signed without --surface)
+ * never come back as -1.
  *
  * The contract covers every option: LLVMFuzzerInitialize reads each
  * "--name" that --help prints and aborts when one is unknown here, so an
@@ -372,9 +372,6 @@ static void check_analysis_rest(const walk_t *w, const cli_args_t *a) {
         CHECK(an->subset[s].on == !!v && an->subset[s].out == out);
         if (v) CHECK(same(an->subset[s].d, num(v)) && an->subset[s].d >= 0 && analysis_writeback_format_known(out));
     }
-    /* a write-back path (A's own format) is not written with --surface */
-    CHECK(!a->surface || (!an->subset[0].on && !an->subset[1].on &&
-                          (!an->distances_out || distances_format_known(an->distances_out))));
     CHECK(an->format[0] == a->format_a && an->format[1] == a->format_b);
     /* the files written back are read as the inputs were */
     CHECK(an->read.format == a->read.format && an->read.dtype == a->read.dtype && an->read.mesh == a->read.mesh);
