@@ -26,12 +26,11 @@ import threading
 import time
 import unittest
 
-from cli_checks import collector, temp_dir_cases, tool_from_argv
+from cli_checks import as_nobody, collector, temp_dir_cases, tool_from_argv
 
 TESTS = []
 TOOL = None  # the hausdorff executable, from the command line
 SANITIZED = False
-NOBODY = 65534
 
 
 test = collector(TESTS)
@@ -160,17 +159,6 @@ def max_distance_takes_a_subnormal_number(d):
     assert rc == 1 and "1e-400 is below the smallest positive double" in err, err
     rc, out, err = run("--max-distance", "-1e-320", a, a)
     assert rc == 1 and "needs a positive number" in err, err
-
-
-def as_nobody():
-    if os.geteuid() != 0:
-        return None
-
-    def drop():
-        os.setgroups([])
-        os.setgid(NOBODY)
-        os.setuid(NOBODY)
-    return drop
 
 
 @test

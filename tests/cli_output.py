@@ -21,7 +21,7 @@ import subprocess
 import time
 import unittest
 
-from cli_checks import collector, temp_dir_cases, tool_from_argv
+from cli_checks import as_nobody, collector, temp_dir_cases, tool_from_argv
 
 TESTS = []
 TOOL = None  # the hausdorff executable, from the command line
@@ -30,7 +30,6 @@ DATA = os.path.join(os.path.dirname(HERE), "data")
 SMALL = os.path.join(DATA, "pinion_gear.ply")   # 650 points: a CSV of about 50 KB
 OTHER = os.path.join(DATA, "teapot_792.ply")    # 792 points
 LARGE = os.path.join(DATA, "armadillo.ply")     # many more points: a CSV of a few MB
-NOBODY = 65534
 
 
 test = collector(TESTS)
@@ -117,17 +116,6 @@ def closed_standard_output_exits_3(d):
                            timeout=300)
         expect(p.returncode, p.stderr.decode(), 3, "standard output: Bad file descriptor")
     assert listing(d) == [], listing(d)
-
-
-def as_nobody():
-    """preexec_fn for a read-only directory to mean something to root."""
-    if os.geteuid() != 0:
-        return None
-    def drop():
-        os.setgroups([])
-        os.setgid(NOBODY)
-        os.setuid(NOBODY)
-    return drop
 
 
 @test
