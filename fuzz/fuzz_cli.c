@@ -265,6 +265,7 @@ static void check_run(const walk_t *w, const cli_args_t *a, const cli_args_t *d)
     CHECK(o->algorithm == alg);
     CHECK(o->threads == (v[THREADS] ? strtol(v[THREADS], NULL, 10) : d->opt.threads));
     CHECK(o->seed == (v[SEED] ? strtoull(v[SEED], NULL, 10) : d->opt.seed) && r->seed == o->seed);
+    CHECK(!v[SEED] || !strchr(v[SEED], '-')); /* no negative number, not even after a blank */
     CHECK(o->depth == (v[DEPTH] ? strtol(v[DEPTH], NULL, 10) : d->opt.depth) && o->depth >= 1 && o->depth <= 21);
     CHECK(same(o->lambda, v[LAMBDA] ? num(v[LAMBDA]) : d->opt.lambda) && o->lambda > 0 && o->lambda <= 1);
     CHECK(same(o->theta, v[THETA] ? num(v[THETA]) : d->opt.theta) && o->theta >= 0 && o->theta <= 1);

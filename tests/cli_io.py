@@ -174,7 +174,7 @@ def a_laz_file_denser_than_the_points_per_byte_limit_is_refused_unless_the_limit
 
 @test
 def usage_errors_exit_1(d):
-    for args in (["--format", "dxf"], ["--sample", "0"], ["--sample", "-5"], ["--sample"]):
+    for args in (["--format", "dxf"], ["--sample", "0"], ["--sample", "-5"], ["--sample"], ["--seed", " -1"]):
         rc, out, err = run(*args, "a.ply", "b.ply")
         assert rc == 1, (args, rc, err)
         assert "hausdorff: " in err, err
