@@ -118,7 +118,7 @@ static int parse_long(const char *s, long lo, long hi, long *out) {
 static int parse_u64(const char *s, uint64_t *out) {
     char *e;
     errno = 0;
-    if (*s == '-') return -1;
+    if (strchr(s, '-')) return -1; /* strtoull negates " -1" to 2^64 - 1 */
     unsigned long long v = strtoull(s, &e, 10);
     if (e == s || *e || errno) return -1;
     *out = v;

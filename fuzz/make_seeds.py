@@ -127,6 +127,17 @@ def cli_seeds():
         "missing_value": ["a", "b", "--seed"],
         "three_files": ["a", "b", "c"],
         "empty_zero_npy": ["--empty=zero", "--distances=d.npy", "--algorithm=ohd", "x.npy", "-"],
+        "surface": ["--surface", "--signed", "--tolerance", "1e-6d", "--within=0.25", "--distances", "d.ply",
+                    "--percentile", "95", "--tau", "0.5,1,,2", "--dtu-cap=inf", "part.stl", "model.obj"],
+        "surface_absolute": ["--surface", "--tolerance=0", "--directed", "--dtu-cap", "20", "ply:a.dat", "b.off"],
+        "labels": ["--labels", "all", "--components", "26", "--csv", "--tau=1", "--tau-rule", "lt",
+                   "--connectivity", "3", "--mask-dims=2", "--empty", "monai", "--units", "mm", "p.nii.gz", "r.nii"],
+        "labels_list": ["--labels=1,2,40", "--components=8", "--mask-dims", "auto", "--tau-rule=le", "p.nii", "r.nii"],
+        "subsets": ["--farther-than", "0.5", "far.laz", "--nearer-than", "1e-3", "near.xyz", "--json",
+                    "--distances", "all.las", "scan.laz", "model.ply"],
+        "streams": ["--max-stream-size", "64K", "--fifo-wait=5", "--laz-points-per-byte", "4096",
+                    "--decimal-comma", "--seed=18446744073709551615", "--sample", "7", "--vertices", "csv:-", "b.pcd"],
+        "streams_bytes": ["--max-stream-size=1g", "--laz-points-per-byte=1", "--fifo-wait", "86400", "a.npy", "b.las"],
     }
     for name, args in lines.items():
         put("cli/" + name, "\0".join(args))

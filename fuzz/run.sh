@@ -17,7 +17,13 @@
 # FUZZ_FRESH=1 empties each growing corpus first (the smoke test, so a run
 # depends on the repository only); FUZZ_JOBS (default 2) build jobs; FUZZ_CC
 # (default clang); FUZZ_ARGS more libFuzzer options (e.g. "-fork=1
-# -ignore_crashes=1" to go on past a finding).  The seed corpus in the repository is only read.
+# -ignore_crashes=1" to go on past a finding; each reproducer written is
+# still a finding).  FUZZ_RUNS=N stops each target after N inputs (or
+# FUZZ_SECONDS, whichever comes first); FUZZ_SEED=S fixes libFuzzer's
+# random seed, so a run draws the same mutations again (the smoke test's 1:
+# a failure there replays; the readers' parsing threads still vary the
+# coverage they report, and so the corpus, a little).  The seed corpus in
+# the repository is only read.
 #
 # A finding (crash, leak, timeout, undefined behaviour, a broken contract)
 # leaves crash-*/leak-*/timeout-*/oom-* in $FUZZ_BUILD/TARGET/, is reported
@@ -73,11 +79,22 @@ for t in $targets; do
   [ -d "$seeds" ] || { echo "fuzz: no seed corpus $seeds" >&2; exit 2; }
   [ "${FUZZ_FRESH:-0}" = 1 ] && rm -rf "$OUT/$t/corpus"
   mkdir -p "$OUT/$t/corpus"
-  echo "== fuzz_$t: $SECONDS_EACH s from $seeds/"
-  if (cd "$OUT/$t" && ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1} "../fuzz_$t" \
+  echo "== fuzz_$t: $SECONDS_EACH s${FUZZ_RUNS:+ or $FUZZ_RUNS inputs}${FUZZ_SEED:+ (seed $FUZZ_SEED)} from $seeds/"
+  touch "$OUT/$t/.started"
+  ok=0
+  (cd "$OUT/$t" && ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1} "../fuzz_$t" \
         -max_total_time="$SECONDS_EACH" -max_len=65536 -rss_limit_mb=2048 -timeout=10 \
-        -print_final_stats=1 ${FUZZ_ARGS:-} corpus "$ROOT/$seeds" > log.txt 2>&1); then
+        -print_final_stats=1 ${FUZZ_RUNS:+-runs=$FUZZ_RUNS} ${FUZZ_SEED:+-seed=$FUZZ_SEED} ${FUZZ_ARGS:-} \
+        corpus "$ROOT/$seeds" > log.txt 2>&1) && ok=1
+  # a finding is a failing exit or a reproducer written during this run
+  # (with -fork=N -ignore_crashes=1 there may be many: each is listed)
+  found=$(find "$OUT/$t" -maxdepth 1 -newer "$OUT/$t/.started" \
+            \( -name 'crash-*' -o -name 'leak-*' -o -name 'timeout-*' -o -name 'oom-*' \) | sort)
+  if [ $ok = 1 ] && [ -z "$found" ]; then
     grep -E "stat::number_of_executed_units|stat::new_units_added" "$OUT/$t/log.txt" | sed "s/^/$t: /"
+    # fork mode prints no final stats: its last progress line has the count
+    grep -q "stat::number_of_executed_units" "$OUT/$t/log.txt" ||
+      grep -E '^#[0-9]+: ' "$OUT/$t/log.txt" | tail -1 | sed "s/^#\([0-9]*\):.*/$t: executed units \1 (fork mode)/"
   else
     status=1
     echo "fuzz_$t FOUND A PROBLEM; see $OUT/$t/log.txt:" >&2
@@ -85,6 +102,7 @@ for t in $targets; do
     awk '/ERROR|SUMMARY|Test unit written|crash-|leak-|timeout-|oom-/ { print; next }
          /^ *#[0-5] / && !done { print; if ($1 == "#5") done = 1 }' "$OUT/$t/log.txt" >&2
     grep -q "ERROR\|SUMMARY" "$OUT/$t/log.txt" || tail -20 "$OUT/$t/log.txt" >&2
+    [ -z "$found" ] || printf '%s\n' "reproducers of this run:" $found >&2
   fi
 done
 [ $status = 0 ] && echo "fuzz: no finding in: $targets"

@@ -22,20 +22,18 @@ import os
 import resource
 import subprocess
 import sys
-import tempfile
 import threading
 import time
 import unittest
 
+from cli_checks import as_nobody, collector, temp_dir_cases, tool_from_argv
+
 TESTS = []
 TOOL = None  # the hausdorff executable, from the command line
 SANITIZED = False
-NOBODY = 65534
 
 
-def test(fn):
-    TESTS.append(fn)
-    return fn
+test = collector(TESTS)
 
 
 def run(*args, cwd=None, preexec_fn=None, timeout=120):
@@ -163,17 +161,6 @@ def max_distance_takes_a_subnormal_number(d):
     assert rc == 1 and "needs a positive number" in err, err
 
 
-def as_nobody():
-    if os.geteuid() != 0:
-        return None
-
-    def drop():
-        os.setgroups([])
-        os.setgid(NOBODY)
-        os.setuid(NOBODY)
-    return drop
-
-
 @test
 def a_writable_file_in_a_read_only_directory_names_the_temporary_and_where(d):
     os.chmod(d, 0o755)
@@ -226,24 +213,10 @@ def a_file_that_cannot_be_mapped_for_want_of_memory_exits_3(d):
     assert "big.xyz: cannot map its 3221225472 bytes: Cannot allocate memory (out of memory)" in err, err
 
 
-class HostileCli(unittest.TestCase):
-    """Each function above becomes one test, run in a fresh temporary directory."""
-
-    def setUp(self):
-        self.tmp = tempfile.TemporaryDirectory(prefix="hd-cli-hostile-")
-
-    def tearDown(self):
-        for root, dirs, _ in os.walk(self.tmp.name):
-            for x in dirs:
-                os.chmod(os.path.join(root, x), 0o755)
-        self.tmp.cleanup()
-
-
-for _fn in TESTS:
-    setattr(HostileCli, "test_" + _fn.__name__, lambda self, fn=_fn: fn(self.tmp.name))
+HostileCli = temp_dir_cases("HostileCli", TESTS, "hd-cli-hostile-")
 
 if __name__ == "__main__":
-    TOOL = os.path.abspath(sys.argv.pop(1))
+    TOOL = tool_from_argv()
     if len(sys.argv) > 1 and sys.argv[1] == "--sanitized":
         SANITIZED = True
         sys.argv.pop(1)

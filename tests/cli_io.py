@@ -11,10 +11,10 @@ import pty
 import select
 import struct
 import subprocess
-import sys
-import tempfile
 import time
 import unittest
+
+from cli_checks import collector, temp_dir_cases, tool_from_argv
 
 TESTS = []
 TOOL = None  # the hausdorff executable, from the command line
@@ -22,9 +22,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 DATA = os.path.join(os.path.dirname(HERE), "data")
 
 
-def test(fn):
-    TESTS.append(fn)
-    return fn
+test = collector(TESTS)
 
 
 def run(*args, stdin=None):
@@ -176,7 +174,7 @@ def a_laz_file_denser_than_the_points_per_byte_limit_is_refused_unless_the_limit
 
 @test
 def usage_errors_exit_1(d):
-    for args in (["--format", "dxf"], ["--sample", "0"], ["--sample", "-5"], ["--sample"]):
+    for args in (["--format", "dxf"], ["--sample", "0"], ["--sample", "-5"], ["--sample"], ["--seed", " -1"]):
         rc, out, err = run(*args, "a.ply", "b.ply")
         assert rc == 1, (args, rc, err)
         assert "hausdorff: " in err, err
@@ -420,19 +418,8 @@ def empty_monai_is_inf_for_one_empty_set_and_nan_for_two(d):
     assert r["hausdorff"] is None and r["empty"]["policy"] == "monai", r
 
 
-class ReadingCli(unittest.TestCase):
-    """Each function above becomes one test, run in a fresh temporary directory."""
-
-    def setUp(self):
-        self.tmp = tempfile.TemporaryDirectory(prefix="hd-cli-io-")
-
-    def tearDown(self):
-        self.tmp.cleanup()
-
-
-for _fn in TESTS:
-    setattr(ReadingCli, "test_" + _fn.__name__, lambda self, fn=_fn: fn(self.tmp.name))
+ReadingCli = temp_dir_cases("ReadingCli", TESTS, "hd-cli-io-")
 
 if __name__ == "__main__":
-    TOOL = sys.argv.pop(1)
+    TOOL = tool_from_argv()
     unittest.main(verbosity=2)

@@ -18,10 +18,10 @@ import resource
 import signal
 import stat
 import subprocess
-import sys
-import tempfile
 import time
 import unittest
+
+from cli_checks import as_nobody, collector, temp_dir_cases, tool_from_argv
 
 TESTS = []
 TOOL = None  # the hausdorff executable, from the command line
@@ -30,12 +30,9 @@ DATA = os.path.join(os.path.dirname(HERE), "data")
 SMALL = os.path.join(DATA, "pinion_gear.ply")   # 650 points: a CSV of about 50 KB
 OTHER = os.path.join(DATA, "teapot_792.ply")    # 792 points
 LARGE = os.path.join(DATA, "armadillo.ply")     # many more points: a CSV of a few MB
-NOBODY = 65534
 
 
-def test(fn):
-    TESTS.append(fn)
-    return fn
+test = collector(TESTS)
 
 
 def run(*args, stdout=subprocess.PIPE, stdin=None, preexec_fn=None, cwd=None):
@@ -119,17 +116,6 @@ def closed_standard_output_exits_3(d):
                            timeout=300)
         expect(p.returncode, p.stderr.decode(), 3, "standard output: Bad file descriptor")
     assert listing(d) == [], listing(d)
-
-
-def as_nobody():
-    """preexec_fn for a read-only directory to mean something to root."""
-    if os.geteuid() != 0:
-        return None
-    def drop():
-        os.setgroups([])
-        os.setgid(NOBODY)
-        os.setuid(NOBODY)
-    return drop
 
 
 @test
@@ -308,22 +294,8 @@ def a_run_that_succeeds_leaves_complete_files_and_no_temporary(d):
         assert not [n for n in os.listdir("/dev") if n.startswith(".null.")]
 
 
-class WritingCli(unittest.TestCase):
-    """Each function above becomes one test, run in a fresh temporary directory."""
-
-    def setUp(self):
-        self.tmp = tempfile.TemporaryDirectory(prefix="hd-cli-output-")
-
-    def tearDown(self):
-        for root, dirs, _ in os.walk(self.tmp.name):
-            for x in dirs:
-                os.chmod(os.path.join(root, x), 0o755)
-        self.tmp.cleanup()
-
-
-for _fn in TESTS:
-    setattr(WritingCli, "test_" + _fn.__name__, lambda self, fn=_fn: fn(self.tmp.name))
+WritingCli = temp_dir_cases("WritingCli", TESTS, "hd-cli-output-")
 
 if __name__ == "__main__":
-    TOOL = os.path.abspath(sys.argv.pop(1))
+    TOOL = tool_from_argv()
     unittest.main(verbosity=2)

@@ -71,9 +71,10 @@ static void chunk(void *ctx, hd__chunk_t *c) {
             return;
         }
         for (uint64_t k = 0; k < n; k++) {
-            if (!next_token(&q, eol, &tb, &te) || !hd__parse_u64(tb, te, &ix[k])) {
+            int found = next_token(&q, eol, &tb, &te);
+            if (!found || !hd__parse_u64(tb, te, &ix[k])) {
                 hd__chunk_fail(c, HD_EFORMAT, line, "face: expected %llu vertex indices, index %llu is %s",
-                               (unsigned long long)n, (unsigned long long)k + 1, q == eol ? "missing" : "not a whole number");
+                               (unsigned long long)n, (unsigned long long)k + 1, found ? "not a whole number" : "missing");
                 if (ix != idx) free(ix);
                 return;
             }

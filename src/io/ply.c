@@ -266,6 +266,10 @@ static int walk_binary(ply_t *p, const elem_t *e, size_t *pos, const int *xyz, i
             if (j == face && r->tris) {
                 if (pr->type == HD__T_F32 || pr->type == HD__T_F64)
                     return hd__io_err_at(r, HD_EFORMAT, (long long)at, "face vertex indices are not integers");
+                if (cnt < 3)
+                    return hd__io_err_at(r, HD_EFORMAT, (long long)(at - csz),
+                                         "face %llu with %lld vertices (at least 3 are needed)", (unsigned long long)k,
+                                         (long long)cnt);
                 uint64_t *ix = (uint64_t)cnt <= 64 ? idx : hd__malloc_array((size_t)cnt, sizeof *ix);
                 if (!ix) return hd__io_err(r, HD_ENOMEM, "out of memory for a face of %lld vertices", (long long)cnt);
                 int rc = HD_OK;
@@ -400,6 +404,10 @@ static void vertex_chunk(void *ctx, hd__chunk_t *c) {
                 return;
             }
             int keep = j == a->face;
+            if (keep && cnt < 3) {
+                hd__chunk_fail(c, HD_EFORMAT, line, "face with %llu vertices (at least 3 are needed)", (unsigned long long)cnt);
+                return;
+            }
             uint64_t *ix = idx;
             if (keep && cnt > 64 && !(ix = hd__malloc_array((size_t)cnt, sizeof *ix))) {
                 hd__chunk_fail(c, HD_ENOMEM, line, "out of memory for a face of %llu vertices", (unsigned long long)cnt);

@@ -478,6 +478,60 @@ TEST(off_face_of_fewer_than_three_vertices_is_refused_when_sampling) {
     CHECK(strstr(e.message, "two.off:7: face with 2 vertices (at least 3 are needed)") != NULL);
 }
 
+/* Reading `path` as HD_MESH_SAMPLE: its return code, the error in *e. */
+static int read_sampled(const char *path, hd_error_t *e) {
+    hd_read_options_t o;
+    hd_read_options_init(&o);
+    o.mesh = HD_MESH_SAMPLE;
+    o.sample = 4;
+    hd_cloud_t *c = NULL;
+    int rc = hd_read_file(path, &o, &c, e);
+    hd_cloud_free(c);
+    return rc;
+}
+
+TEST(off_face_index_that_is_no_whole_number_is_named_so_not_missing) {
+    hd_error_t e;
+    CHECK_RC(read_sampled(tf_printf("neg.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 -1\n"), &e), HD_EFORMAT);
+    CHECK(strstr(e.message, "neg.off:6: face: expected 3 vertex indices, index 3 is not a whole number") != NULL);
+    CHECK_RC(read_sampled(tf_printf("short.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1\n"), &e), HD_EFORMAT);
+    CHECK(strstr(e.message, "short.off:6: face: expected 3 vertex indices, index 3 is missing") != NULL);
+}
+
+/* A PLY face list of 0, 1 or 2 vertices is refused as OBJ's and OFF's are
+ * (it was dropped without a word): ascii with its line, binary with the
+ * offset of its list count. */
+TEST(ply_face_of_fewer_than_three_vertices_is_refused_when_sampling) {
+    const char *head = "ply\nformat %s 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                       "element face 2\nproperty list uchar int vertex_indices\nend_header\n";
+    for (int n = 0; n < 3; n++) {
+        hd_error_t e;
+        const char *faces[] = {"0", "1 0", "2 0 1"};
+        char h[400], want[80];
+        snprintf(h, sizeof h, head, "ascii");
+        const char *p = tf_printf("few.ply", "%s0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n%s\n", h, faces[n]);
+        CHECK_RC(read_sampled(p, &e), HD_EFORMAT);
+        snprintf(want, sizeof want, "few.ply:14: face with %d vertices (at least 3 are needed)", n);
+        if (!strstr(e.message, want)) hdt_fail(__FILE__, __LINE__, "n = %d: '%s' lacks '%s'", n, e.message, want);
+
+        tf_buf_t b = {0};
+        snprintf(h, sizeof h, head, "binary_little_endian");
+        tf_puts(&b, h);
+        for (int k = 0; k < 9; k++) tf_f32(&b, k == 3 || k == 7 ? 1.0f : 0.0f, 0);
+        tf_u8(&b, 3);
+        for (int k = 0; k < 3; k++) tf_u32(&b, (uint32_t)k, 0);
+        size_t at = b.size;
+        tf_u8(&b, (uint8_t)n);
+        for (int k = 0; k < n; k++) tf_u32(&b, (uint32_t)k, 0);
+        p = tf_write("few_bin.ply", b.data, b.size);
+        tf_free(&b);
+        CHECK_RC(read_sampled(p, &e), HD_EFORMAT);
+        CHECK_EQ(e.offset, (long long)at);
+        snprintf(want, sizeof want, "face 1 with %d vertices (at least 3 are needed)", n);
+        if (!strstr(e.message, want)) hdt_fail(__FILE__, __LINE__, "n = %d: '%s' lacks '%s'", n, e.message, want);
+    }
+}
+
 TEST(las_count_lower_than_the_data_is_refused) {
     tf_buf_t b = las_header(2, 0, 20, 1, 227);
     for (int k = 0; k < 3 * 20; k++) tf_u8(&b, 1);
