@@ -26,18 +26,21 @@
  * and the triangles move once.
  *
  * Prepared triangles (hd__tri_prep, 376 bytes each) are made on first use
- * by hd__bvh_prep: ready[k] goes 0 -> 1 for the one thread that claims
- * triangle k (compare and swap), which writes prep[k] and then stores 2
- * with release order; a reader that loads 2 with acquire order reads the
- * finished record.  A reader that finds 1 (another thread is writing)
- * prepares its own copy in a per-thread record: hd__tri_prep is a
- * function of the corners, so every copy has the same bits, and no answer
- * depends on who prepared what.  A query near the surface reaches a few
- * triangles: a tree queried by few points never prepares (nor touches the
- * memory of) the rest.
+ * by hd__bvh_prep, into the next free record of one array (so a search
+ * that reaches a third of the triangles writes a third of the array's
+ * pages, not every page): slot[k] goes 0 -> HD__BVH_BUSY for the one
+ * thread that claims triangle k (compare and swap), which takes the next
+ * record (an atomic counter), writes it and then stores its position + 1
+ * with release order; a reader that loads that with acquire order reads
+ * the finished record.  A reader that finds HD__BVH_BUSY (another thread
+ * is writing) prepares its own copy in a per-thread record: hd__tri_prep
+ * is a function of the corners, so every copy has the same bits, and no
+ * answer depends on who prepared what.  A query near the surface reaches
+ * a few triangles: a tree queried by few points never prepares the rest.
  */
 #include "mesh/mesh.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -79,30 +82,45 @@ static size_t nodes_for(size_t n) {
 
 /* ---- one split ------------------------------------------------------- */
 
-/* Partial sort: k[mid] is the key of that rank on axis a, with no larger
- * one before it and no smaller one after (Hoare's selection, middle
- * pivot). */
-static void select_mid(bkey_t *k, size_t n, size_t mid, int a) {
-    size_t lo = 0, hi = n - 1;
-    while (lo < hi) {
-        double pivot = k[lo + (hi - lo) / 2].c[a];
-        size_t i = lo, j = hi;
-        while (i <= j) {
-            while (k[i].c[a] < pivot) i++;
-            while (k[j].c[a] > pivot) j--;
-            if (i <= j) {
-                bkey_t s = k[i];
-                k[i] = k[j], k[j] = s;
-                i++;
-                if (j == 0) break;
-                j--;
-            }
+HD__INLINE void swap_keys(bkey_t *x, long i, long j) {
+    bkey_t s = x[i];
+    x[i] = x[j], x[j] = s;
+}
+
+/* Partial sort of x[left .. right]: x[k] becomes the key of its rank on
+ * axis a, with no larger one before it and no smaller one after (Floyd and
+ * Rivest's selection: a pivot from a sample about the rank first, so the
+ * partition that follows reads each key about once; the sample's bounds
+ * only steer the work, any values give the same postcondition).  Keys
+ * equal to the pivot stop both scans and are swapped, so ties split
+ * evenly. */
+static void select_rank(bkey_t *x, long left, long right, long k, int a) {
+    while (right > left) {
+        if (right - left > 600) {
+            double n = (double)(right - left + 1), i = (double)(k - left + 1), z = log(n);
+            double s = 0.5 * exp(2 * z / 3), sd = 0.5 * sqrt(z * s * (n - s) / n);
+            sd = i < n / 2 ? -sd : i > n / 2 ? sd : 0;
+            long lo = (long)((double)k - i * s / n + sd), hi = (long)((double)k + (n - i) * s / n + sd);
+            select_rank(x, lo > left ? lo : left, hi < right ? hi : right, k, a);
         }
-        if (mid <= j) hi = j;
-        else if (mid >= i) lo = i;
-        else return;
+        double t = x[k].c[a];
+        long i = left, j = right;
+        swap_keys(x, left, k);
+        if (x[right].c[a] > t) swap_keys(x, right, left);
+        while (i < j) { /* x[left] <= t <= x[right] stop both scans */
+            swap_keys(x, i, j);
+            i++, j--;
+            while (x[i].c[a] < t) i++;
+            while (x[j].c[a] > t) j--;
+        }
+        if (x[left].c[a] == t) swap_keys(x, left, j);
+        else swap_keys(x, ++j, right);
+        if (j <= k) left = j + 1;
+        if (k <= j) right = j - 1;
     }
 }
+
+static void select_mid(bkey_t *k, size_t n, size_t mid, int a) { select_rank(k, 0, (long)n - 1, (long)mid, a); }
 
 /* The axis along which the n keys' centroids spread most. */
 static int longest_axis(const bkey_t *k, size_t n) {
@@ -263,14 +281,15 @@ int hd__bvh_build(hd__bvh_t *t, hd__tri_t *tris, size_t n, int threads) {
     t->nodes = hd__malloc_array(t->n_nodes, sizeof *t->nodes);
     t->boxes = hd__malloc_array(n, sizeof *t->boxes);
     t->prep = hd__malloc_array(n, sizeof *t->prep);
-    t->ready = hd__calloc_array(n, sizeof *t->ready);
+    t->slot = hd__calloc_array(n, sizeof *t->slot);
+    t->used = malloc(sizeof *t->used);
     /* phase 2's levels end below threads * TASKS_PER_THREAD ranges, so a
      * level has fewer than twice that, and the nodes above them too */
     size_t most = 2 * (size_t)threads * TASKS_PER_THREAD;
     bkey_t *keys = hd__malloc_array(n, sizeof *keys);
     range_t *ranges = hd__malloc_array(3 * most, sizeof *ranges);
     size_t *top = hd__malloc_array(most, sizeof *top);
-    if (!t->tris || !t->nodes || !t->boxes || !t->prep || !t->ready || !keys || !ranges || !top) {
+    if (!t->tris || !t->nodes || !t->boxes || !t->prep || !t->slot || !t->used || !keys || !ranges || !top) {
         free(keys), free(ranges), free(top);
         hd__bvh_t failed = *t;
         failed.tris = NULL; /* hd__bvh_free would free it */
@@ -279,6 +298,7 @@ int hd__bvh_build(hd__bvh_t *t, hd__tri_t *tris, size_t n, int threads) {
         memset(t, 0, sizeof *t);
         return HD_ENOMEM; /* the triangles stay the caller's */
     }
+    atomic_init(t->used, 0);
     build_t B = {t, tris, keys, ranges, ranges + most};
     size_t chunks = (n + CHUNK - 1) / CHUNK, n_sub, n_top;
     hd__parallel_for(threads, chunks, make_keys, &B);
@@ -297,7 +317,8 @@ void hd__bvh_free(hd__bvh_t *t) {
     free(t->nodes);
     free(t->boxes);
     free(t->prep);
-    free((void *)t->ready);
+    free((void *)t->slot);
+    free((void *)t->used);
     memset(t, 0, sizeof *t);
 }
 
@@ -306,14 +327,15 @@ void hd__bvh_free(hd__bvh_t *t) {
 const hd__tri_prep_t *hd__bvh_prep_first(const hd__bvh_t *t, size_t k) {
     static _Thread_local hd__tri_prep_t own;
     const hd__tri_t *tr = &t->tris[k];
-    unsigned char idle = 0;
-    if (atomic_compare_exchange_strong_explicit(&t->ready[k], &idle, 1, memory_order_acquire,
+    uint_least32_t s = 0;
+    if (atomic_compare_exchange_strong_explicit(&t->slot[k], &s, HD__BVH_BUSY, memory_order_acquire,
                                                 memory_order_acquire)) {
-        hd__tri_prep(tr->v[0], tr->v[1], tr->v[2], &t->prep[k]);
-        atomic_store_explicit(&t->ready[k], 2, memory_order_release);
-        return &t->prep[k];
+        size_t r = atomic_fetch_add_explicit(t->used, 1, memory_order_relaxed); /* < n: one a triangle */
+        hd__tri_prep(tr->v[0], tr->v[1], tr->v[2], &t->prep[r]);
+        atomic_store_explicit(&t->slot[k], (uint_least32_t)(r + 1), memory_order_release);
+        return &t->prep[r];
     }
-    if (idle == 2) return &t->prep[k]; /* finished since the caller looked */
+    if (s != HD__BVH_BUSY) return &t->prep[s - 1]; /* finished since the caller looked */
     hd__tri_prep(tr->v[0], tr->v[1], tr->v[2], &own);
     return &own;
 }

@@ -116,11 +116,16 @@ typedef struct hd__bvh_node {
 typedef struct hd__bvh {
     hd__tri_t *tris;        /* in leaf order */
     hd__box_t *boxes;       /* each triangle's box, in the same order */
-    hd__tri_prep_t *prep;   /* prep[k]: triangle k prepared once ready[k] is 2 */
-    atomic_uchar *ready;    /* 0 not prepared, 1 being prepared, 2 prepared */
+    /* triangle k prepared: prep[slot[k] - 1] once slot[k] is neither 0
+     * (not prepared) nor HD__BVH_BUSY (being prepared); prep fills from
+     * its start in the order of first use, *used records so far */
+    atomic_uint_least32_t *slot;
+    hd__tri_prep_t *prep;
+    atomic_size_t *used;
     hd__bvh_node_t *nodes;
     size_t n_tris, n_nodes;
 } hd__bvh_t;
+#define HD__BVH_BUSY UINT32_MAX
 
 /* The tree over n triangles given as corner triples (tris[k].index = k's
  * index in the mesh), built on `threads` threads (bvh_build.c); the same
@@ -138,7 +143,8 @@ void hd__bvh_free(hd__bvh_t *t);
  * next call. */
 const hd__tri_prep_t *hd__bvh_prep_first(const hd__bvh_t *t, size_t k);
 HD__INLINE const hd__tri_prep_t *hd__bvh_prep(const hd__bvh_t *t, size_t k) {
-    if (atomic_load_explicit(&t->ready[k], memory_order_acquire) == 2) return &t->prep[k];
+    uint_least32_t s = atomic_load_explicit(&t->slot[k], memory_order_acquire);
+    if (s != 0 && s != HD__BVH_BUSY) return &t->prep[s - 1];
     return hd__bvh_prep_first(t, k);
 }
 
