@@ -26,11 +26,10 @@
  * for the checked inputs (|difference| < 2.1e153, 3 * 2.1e153^2 <
  * 1.4e307).
  *
- * The tree (bvh_build.c): nodes split at the median of the triangles'
- * centroids along the longest axis of their box, down to leaves of at
- * most 4 triangles; each node's box is the exact minimum and maximum of
- * its corners (no rounding), each triangle prepared (hd__tri_prep) when a
- * search first reaches it (hd__bvh_prep).  A
+ * The tree: nodes split at the median of the triangles' centroids along
+ * the longest axis of their box, down to leaves of at most LEAF
+ * triangles; each node's box is the exact minimum and maximum of its
+ * corners (no rounding), each triangle prepared once (hd__tri_prep).  A
  * query starts from a seed triangle (the previous query's nearest) and
  * descends nearest child first, discarding nodes by their boxes.  A leaf's
  * triangles pass three stages, each in increasing order of its lower
@@ -135,6 +134,16 @@ double hd__support_lower(const hd__tri_t *t, size_t n, const double p[3], double
     return r >= TINY ? r * SHRINK : 0.0;
 }
 
+
+void hd__bvh_free(hd__bvh_t *t) {
+    free((void *)t->slot);
+    free((void *)t->used);
+    free(t->tris);
+    free(t->nodes);
+    free(t->boxes);
+    free(t->prep);
+    memset(t, 0, sizeof *t);
+}
 
 /* ---- the query ---------------------------------------------------------- */
 

@@ -312,16 +312,6 @@ int hd__bvh_build(hd__bvh_t *t, hd__tri_t *tris, size_t n, int threads) {
     return HD_OK;
 }
 
-void hd__bvh_free(hd__bvh_t *t) {
-    free(t->tris);
-    free(t->nodes);
-    free(t->boxes);
-    free(t->prep);
-    free((void *)t->slot);
-    free((void *)t->used);
-    memset(t, 0, sizeof *t);
-}
-
 /* ---- prepared on first use ------------------------------------------- */
 
 const hd__tri_prep_t *hd__bvh_prep_first(const hd__bvh_t *t, size_t k) {

@@ -125,16 +125,8 @@ typedef struct hd__bvh {
     hd__bvh_node_t *nodes;
     size_t n_tris, n_nodes;
 } hd__bvh_t;
+
 #define HD__BVH_BUSY UINT32_MAX
-
-/* The tree over n triangles given as corner triples (tris[k].index = k's
- * index in the mesh), built on `threads` threads (bvh_build.c); the same
- * tree at any thread count.  The array is taken over (freed: the tree
- * holds its triangles in leaf order).  HD_OK or HD_ENOMEM / HD_EOVERFLOW
- * (more than 2^31 triangles), and then the array is still the caller's. */
-int hd__bvh_build(hd__bvh_t *t, hd__tri_t *tris, size_t n, int threads);
-void hd__bvh_free(hd__bvh_t *t);
-
 /* Triangle k (a position in t->tris) prepared for hd__tri_bounds_prep:
  * prepared by the first search that asks, then shared.  Any thread may
  * ask at any time; the record has hd__tri_prep's bits whoever made it.
@@ -147,6 +139,14 @@ HD__INLINE const hd__tri_prep_t *hd__bvh_prep(const hd__bvh_t *t, size_t k) {
     if (s != 0 && s != HD__BVH_BUSY) return &t->prep[s - 1];
     return hd__bvh_prep_first(t, k);
 }
+
+/* The tree over n triangles given as corner triples (tris[k].index = k's
+ * index in the mesh), built on `threads` threads (bvh_build.c); the same
+ * tree at any thread count.  The array is taken over (freed: the tree
+ * holds its triangles in leaf order).  HD_OK or HD_ENOMEM / HD_EOVERFLOW
+ * (more than 2^31 triangles), and then the array is still the caller's. */
+int hd__bvh_build(hd__bvh_t *t, hd__tri_t *tris, size_t n, int threads);
+void hd__bvh_free(hd__bvh_t *t);
 
 /* The counters of the queries (summed per thread, then over threads). */
 typedef struct hd__bvh_stats {
