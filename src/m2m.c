@@ -51,7 +51,7 @@ static int side_tree(side_t *s, const char *name, hd_error_t *err) {
     hd__tri_t *copy = hd__malloc_array(s->n, sizeof *copy);
     if (!copy) return hd__err(err, HD_ENOMEM, "%s: out of memory for %zu triangles", name, s->n);
     memcpy(copy, s->tris, s->n * sizeof *copy);
-    int rc = hd__bvh_build(&s->bvh, copy, s->n, 1);
+    int rc = hd__bvh_build(&s->bvh, copy, s->n);
     if (rc) {
         free(copy);
         return hd__err(err, rc, "%s: cannot build the tree of %zu triangles", name, s->n);

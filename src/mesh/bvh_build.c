@@ -270,7 +270,7 @@ static void top_levels(build_t *B, int threads, size_t *n_sub, size_t *top, size
     *n_sub = nc;
 }
 
-int hd__bvh_build(hd__bvh_t *t, hd__tri_t *tris, size_t n, int threads) {
+int hd__bvh_build_threads(hd__bvh_t *t, hd__tri_t *tris, size_t n, int threads) {
     memset(t, 0, sizeof *t);
     if (n == 0 || n > ((size_t)1 << 31)) return HD_EOVERFLOW;
     if (threads < 1) threads = 1;
@@ -311,6 +311,8 @@ int hd__bvh_build(hd__bvh_t *t, hd__tri_t *tris, size_t n, int threads) {
     free(tris); /* taken over: its triangles are now t->tris */
     return HD_OK;
 }
+
+int hd__bvh_build(hd__bvh_t *t, hd__tri_t *tris, size_t n) { return hd__bvh_build_threads(t, tris, n, 1); }
 
 /* ---- prepared on first use ------------------------------------------- */
 

@@ -141,11 +141,13 @@ HD__INLINE const hd__tri_prep_t *hd__bvh_prep(const hd__bvh_t *t, size_t k) {
 }
 
 /* The tree over n triangles given as corner triples (tris[k].index = k's
- * index in the mesh), built on `threads` threads (bvh_build.c); the same
- * tree at any thread count.  The array is taken over (freed: the tree
- * holds its triangles in leaf order).  HD_OK or HD_ENOMEM / HD_EOVERFLOW
- * (more than 2^31 triangles), and then the array is still the caller's. */
-int hd__bvh_build(hd__bvh_t *t, hd__tri_t *tris, size_t n, int threads);
+ * index in the mesh), built on `threads` threads (bvh_build.c), or on the
+ * caller's alone; the same tree at any thread count.  The array is taken
+ * over (freed: the tree holds its triangles in leaf order).  HD_OK or
+ * HD_ENOMEM / HD_EOVERFLOW (more than 2^31 triangles), and then the array
+ * is still the caller's. */
+int hd__bvh_build_threads(hd__bvh_t *t, hd__tri_t *tris, size_t n, int threads);
+int hd__bvh_build(hd__bvh_t *t, hd__tri_t *tris, size_t n);
 void hd__bvh_free(hd__bvh_t *t);
 
 /* The counters of the queries (summed per thread, then over threads). */

@@ -124,12 +124,12 @@ TEST(the_tree_is_valid_and_the_same_on_1_and_several_threads) {
             if (n == 0) continue;
             hd__bvh_t one;
             CONTEXT("seed 5, kind %d (0 random, 1 copies, 2 torus), %zu triangles, 1 thread", kind, n);
-            CHECK_RC(hd__bvh_build(&one, tris_make(5, n, kind), n, 1), HD_OK);
+            CHECK_RC(hd__bvh_build_threads(&one, tris_make(5, n, kind), n, 1), HD_OK);
             check_tree(&one, n);
             for (int k = 0; k < 3 && !hdt_failed(); k++) {
                 hd__bvh_t many;
                 CONTEXT("seed 5, kind %d, %zu triangles, %d threads", kind, n, threads[k]);
-                CHECK_RC(hd__bvh_build(&many, tris_make(5, n, kind), n, threads[k]), HD_OK);
+                CHECK_RC(hd__bvh_build_threads(&many, tris_make(5, n, kind), n, threads[k]), HD_OK);
                 check_tree(&many, n);
                 same_tree(&one, &many);
                 hd__bvh_free(&many);
@@ -147,7 +147,7 @@ TEST(trees_built_on_1_and_3_threads_give_the_brute_force_answers) {
     for (int k = 0; k < 2; k++) {
         hd__tri_t *copy = malloc(n * sizeof *copy);
         memcpy(copy, orig, n * sizeof *copy);
-        CHECK_RC(hd__bvh_build(&tree[k], copy, n, k ? 3 : 1), HD_OK);
+        CHECK_RC(hd__bvh_build_threads(&tree[k], copy, n, k ? 3 : 1), HD_OK);
     }
     gen_rng_t g;
     gen_seed(&g, 9);
@@ -180,7 +180,7 @@ TEST(trees_built_on_1_and_3_threads_give_the_brute_force_answers) {
 TEST(a_query_prepares_only_the_triangles_it_reaches) {
     size_t n = 20000;
     hd__bvh_t t;
-    CHECK_RC(hd__bvh_build(&t, tris_make(3, n, 0), n, 2), HD_OK);
+    CHECK_RC(hd__bvh_build_threads(&t, tris_make(3, n, 0), n, 2), HD_OK);
     double p[3] = {0.5, 0.5, 0.5};
     hd__tri_near_t best;
     size_t index, ready = 0;
@@ -213,7 +213,7 @@ static void ask_all(void *ctx, size_t task, int worker) {
 TEST(prepared_triangles_have_the_same_bits_whichever_thread_prepares_them) {
     size_t n = 5000 / SCALE;
     hd__bvh_t t;
-    CHECK_RC(hd__bvh_build(&t, tris_make(4, n, 1), n, 1), HD_OK);
+    CHECK_RC(hd__bvh_build_threads(&t, tris_make(4, n, 1), n, 1), HD_OK);
     hd__tri_prep_t *want = calloc(n, sizeof *want); /* calloc: padding compares equal */
     for (size_t k = 0; k < n; k++) hd__tri_prep(t.tris[k].v[0], t.tris[k].v[1], t.tris[k].v[2], &want[k]);
     prep_job_t J = {&t, want, 0};
