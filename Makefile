@@ -101,7 +101,7 @@ python:
 # The threaded tests under ThreadSanitizer (clang's: gcc 12's fails to start
 # on this kernel), in build-tsan/; not part of `make test` (a third build).
 TSAN_BUILD ?= build-tsan
-TSAN_TESTS ?= test_index|test_analysis|test_engine|test_algorithms|test_readers|test_io_mesh|test_oom
+TSAN_TESTS ?= test_index|test_analysis|test_engine|test_algorithms|test_readers|test_io_mesh|test_oom|test_bvh|test_c2m
 test-tsan:
 	@scripts/deps.sh fuzz
 	CC=clang cmake -S . -B $(TSAN_BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo \

@@ -370,7 +370,7 @@ int hd_mesh_distances(const hd_points_t *P, const hd_mesh_t *M, const hd_options
     hd__tri_t *tris = NULL;
     if (rc || (rc = hd__mesh_triangles(M, &tris, &res.n_degenerate, err))) return rc;
     hd__bvh_t bvh;
-    if ((rc = hd__bvh_build(&bvh, tris, M->n_triangles))) {
+    if ((rc = hd__bvh_build_threads(&bvh, tris, M->n_triangles, hd__thread_count(opt ? opt->threads : 0, SIZE_MAX)))) {
         free(tris);
         return hd__err(err, rc, "mesh: cannot build the tree of %zu triangles", M->n_triangles);
     }

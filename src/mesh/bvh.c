@@ -47,7 +47,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define LEAF 4
 /* The shrink factor of every bound: exceeds (1 + 2^-53)^16 - 1. */
 #define SHRINK (1.0 - 0x1p-48)
 /* Below this a computed square or quotient may carry underflow's absolute
@@ -136,118 +135,9 @@ double hd__support_lower(const hd__tri_t *t, size_t n, const double p[3], double
 }
 
 
-/* ---- the tree ----------------------------------------------------------- */
-
-static void tri_box(const hd__tri_t *t, hd__box_t *b) {
-    for (int k = 0; k < 3; k++) {
-        double lo = t->v[0][k], hi = lo;
-        for (int j = 1; j < 3; j++) {
-            lo = t->v[j][k] < lo ? t->v[j][k] : lo;
-            hi = t->v[j][k] > hi ? t->v[j][k] : hi;
-        }
-        b->lo[k] = lo, b->hi[k] = hi;
-    }
-}
-
-/* Three times the centroid on axis k (only an order for the split). */
-static double centre3(const hd__tri_t *t, int k) { return t->v[0][k] + t->v[1][k] + t->v[2][k]; }
-
-/* Partial sort: tris[mid] is the element of that rank by centre3 on axis
- * k, with no larger one before it and no smaller one after (Hoare's
- * selection, middle pivot). */
-static void select_mid(hd__tri_t *tris, size_t n, size_t mid, int k) {
-    size_t lo = 0, hi = n - 1;
-    while (lo < hi) {
-        double pivot = centre3(&tris[lo + (hi - lo) / 2], k);
-        size_t i = lo, j = hi;
-        while (i <= j) {
-            while (centre3(&tris[i], k) < pivot) i++;
-            while (centre3(&tris[j], k) > pivot) j--;
-            if (i <= j) {
-                hd__tri_t s = tris[i];
-                tris[i] = tris[j], tris[j] = s;
-                i++;
-                if (j == 0) break;
-                j--;
-            }
-        }
-        if (mid <= j) hi = j;
-        else if (mid >= i) lo = i;
-        else return;
-    }
-}
-
-typedef struct {
-    hd__bvh_t *t;
-    size_t used;
-} builder_t;
-
-/* Node for tris[first, first + n); returns its position. */
-static size_t build_node(builder_t *B, size_t first, size_t n) {
-    size_t me = B->used++;
-    hd__bvh_node_t *node = &B->t->nodes[me];
-    hd__tri_t *tris = B->t->tris + first;
-    hd__box_t box, cbox;
-    tri_box(&tris[0], &box);
-    for (int k = 0; k < 3; k++) cbox.lo[k] = cbox.hi[k] = centre3(&tris[0], k);
-    for (size_t i = 1; i < n; i++) {
-        hd__box_t b;
-        tri_box(&tris[i], &b);
-        hd__box_merge(&box, &b);
-        for (int k = 0; k < 3; k++) {
-            double c = centre3(&tris[i], k);
-            cbox.lo[k] = c < cbox.lo[k] ? c : cbox.lo[k];
-            cbox.hi[k] = c > cbox.hi[k] ? c : cbox.hi[k];
-        }
-    }
-    node->box = box;
-    if (n <= LEAF) {
-        node->first_or_second = (uint32_t)first;
-        node->count = (uint32_t)n;
-        return me;
-    }
-    int axis = 0;
-    for (int k = 1; k < 3; k++)
-        if (cbox.hi[k] - cbox.lo[k] > cbox.hi[axis] - cbox.lo[axis]) axis = k;
-    size_t half = n / 2;
-    select_mid(tris, n, half, axis);
-    node->count = 0;
-    build_node(B, first, half);
-    size_t second = build_node(B, first + half, n - half);
-    B->t->nodes[me].first_or_second = (uint32_t)second; /* nodes did not move */
-    return me;
-}
-
-int hd__bvh_build(hd__bvh_t *t, hd__tri_t *tris, size_t n) {
-    memset(t, 0, sizeof *t);
-    if (n == 0 || n > ((size_t)1 << 31)) return HD_EOVERFLOW;
-    t->tris = tris;
-    t->n_tris = n;
-    t->nodes = hd__malloc_array(2 * n, sizeof *t->nodes);
-    t->boxes = hd__malloc_array(n, sizeof *t->boxes);
-    t->prep = hd__malloc_array(n, sizeof *t->prep);
-    if (!t->nodes || !t->boxes || !t->prep) { /* the triangles stay the caller's */
-        free(t->nodes);
-        free(t->boxes);
-        free(t->prep);
-        memset(t, 0, sizeof *t);
-        return HD_ENOMEM;
-    }
-    builder_t B = {t, 0};
-    build_node(&B, 0, n);
-    t->n_nodes = B.used;
-    /* at most 2n nodes were reserved; give back the rest (a failed
-     * shrink keeps the larger array) */
-    hd__bvh_node_t *nodes = realloc(t->nodes, t->n_nodes * sizeof *t->nodes);
-    if (nodes) t->nodes = nodes;
-    for (size_t k = 0; k < n; k++) {
-        tri_box(&t->tris[k], &t->boxes[k]);
-        hd__tri_prep(t->tris[k].v[0], t->tris[k].v[1], t->tris[k].v[2], &t->prep[k]);
-    }
-    return HD_OK;
-}
-
 void hd__bvh_free(hd__bvh_t *t) {
+    free((void *)t->slot);
+    free((void *)t->used);
     free(t->tris);
     free(t->nodes);
     free(t->boxes);
@@ -330,7 +220,7 @@ static void sort_cands(cand_t *c, size_t n) {
  * decided here: it wins exactly when its index is smaller.  1 when
  * decided. */
 static int corner_tie(const hd__bvh_t *t, const double *p, size_t k, search_t *s) {
-    const hd__tri_prep_t *q = &t->prep[k];
+    const hd__tri_prep_t *q = hd__bvh_prep(t, k);
     if (s->best.feature < HD__TRI_VERTEX_A || !q->direct) return 0;
     if (!(fabs(p[0]) < 0x1p100 && fabs(p[1]) < 0x1p100 && fabs(p[2]) < 0x1p100)) return 0;
     const double *corner[3] = {q->a, q->b, q->c};
@@ -378,7 +268,7 @@ static void flush_prep(const hd__bvh_t *t, const double *p, search_t *s, hd__bvh
 static void consider(const hd__bvh_t *t, const double *p, size_t k, search_t *s, hd__bvh_stats_t *st) {
     double lo2, hi2;
     st->bounded++;
-    hd__tri_bounds_prep(p, &t->prep[k], &lo2, &hi2);
+    hd__tri_bounds_prep(p, hd__bvh_prep(t, k), &lo2, &hi2);
     if (lo2 > s->thr) return;
     double h = thr_from_hi(hi2);
     s->thr = h < s->thr ? h : s->thr;

@@ -116,15 +116,37 @@ typedef struct hd__bvh_node {
 typedef struct hd__bvh {
     hd__tri_t *tris;        /* in leaf order */
     hd__box_t *boxes;       /* each triangle's box, in the same order */
-    hd__tri_prep_t *prep;   /* each triangle prepared (hd__tri_prep), in the same order */
+    /* triangle k prepared: prep[slot[k] - 1] once slot[k] is neither 0
+     * (not prepared) nor HD__BVH_BUSY (being prepared); prep fills from
+     * its start in the order of first use, *used records so far */
+    atomic_uint_least32_t *slot;
+    hd__tri_prep_t *prep;
+    atomic_size_t *used;
     hd__bvh_node_t *nodes;
     size_t n_tris, n_nodes;
 } hd__bvh_t;
 
+#define HD__BVH_BUSY UINT32_MAX
+/* Triangle k (a position in t->tris) prepared for hd__tri_bounds_prep:
+ * prepared by the first search that asks, then shared.  Any thread may
+ * ask at any time; the record has hd__tri_prep's bits whoever made it.
+ * The pointer stays valid while the tree lives, except that a thread that
+ * asked while another was preparing k gets its own copy, valid until its
+ * next call. */
+const hd__tri_prep_t *hd__bvh_prep_first(const hd__bvh_t *t, size_t k);
+HD__INLINE const hd__tri_prep_t *hd__bvh_prep(const hd__bvh_t *t, size_t k) {
+    uint_least32_t s = atomic_load_explicit(&t->slot[k], memory_order_acquire);
+    if (s != 0 && s != HD__BVH_BUSY) return &t->prep[s - 1];
+    return hd__bvh_prep_first(t, k);
+}
+
 /* The tree over n triangles given as corner triples (tris[k].index = k's
- * index in the mesh; the array is taken over and reordered).  HD_OK or
+ * index in the mesh), built on `threads` threads (bvh_build.c), or on the
+ * caller's alone; the same tree at any thread count.  The array is taken
+ * over (freed: the tree holds its triangles in leaf order).  HD_OK or
  * HD_ENOMEM / HD_EOVERFLOW (more than 2^31 triangles), and then the array
  * is still the caller's. */
+int hd__bvh_build_threads(hd__bvh_t *t, hd__tri_t *tris, size_t n, int threads);
 int hd__bvh_build(hd__bvh_t *t, hd__tri_t *tris, size_t n);
 void hd__bvh_free(hd__bvh_t *t);
 

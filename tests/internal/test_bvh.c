@@ -1,0 +1,227 @@
+/*
+ * test_bvh.c -- the triangle tree's build (src/mesh/bvh_build.c): the same
+ * tree on 1 and on several threads, a valid tree (every triangle in
+ * exactly one leaf, the first child over the first half, each box the
+ * exact box of what it holds, so it contains its children and their
+ * corners), the same answers from every tree, and triangles prepared
+ * only when a search reaches them, with hd__tri_prep's bits whoever
+ * prepared them, on every thread.
+ */
+#include "check.h"
+#include "gen.h"
+#include "mesh/mesh.h"
+
+#include <stdlib.h>
+
+#ifdef __SANITIZE_ADDRESS__
+#define SCALE 4 /* the sanitizer build runs fewer cases */
+#else
+#define SCALE 1
+#endif
+
+/* n triangles: random small ones in the unit cube, or (ties) every third
+ * one a copy of the one before, or a torus's. */
+static hd__tri_t *tris_make(uint64_t seed, size_t n, int kind) {
+    gen_rng_t g;
+    gen_seed(&g, seed);
+    hd__tri_t *t = malloc(n * sizeof *t);
+    double *v = NULL;
+    uint64_t *f = NULL;
+    if (kind == 2) gen_torus_mesh(3, 1, (int)(n / 2 / 50), 50, &v, &f);
+    for (size_t k = 0; k < n; k++) {
+        t[k].index = k;
+        if (kind == 2) {
+            for (int j = 0; j < 3; j++) memcpy(t[k].v[j], v + 3 * f[3 * k + j], sizeof t[k].v[j]);
+            continue;
+        }
+        if (kind == 1 && k % 3 == 2) {
+            memcpy(t[k].v, t[k - 1].v, sizeof t[k].v);
+            continue;
+        }
+        double c[3] = {gen_unit(&g), gen_unit(&g), gen_unit(&g)};
+        for (int j = 0; j < 3; j++)
+            for (int i = 0; i < 3; i++) t[k].v[j][i] = c[i] + 0.01 * (gen_unit(&g) - 0.5);
+    }
+    free(v), free(f);
+    return t;
+}
+
+static int box_equal(const hd__box_t *a, const hd__box_t *b) { return memcmp(a, b, sizeof *a) == 0; }
+
+/* Node me over [first, first + n) (positions in t->tris): checks its
+ * children recursively; returns the position after its subtree, or 0
+ * after a failed check.  seen[k] counts the leaves holding k. */
+static size_t check_node(const hd__bvh_t *t, size_t me, size_t first, size_t n, int depth, unsigned char *seen) {
+    if (me >= t->n_nodes || depth > 100) {
+        CHECK(me < t->n_nodes && depth <= 100);
+        return 0;
+    }
+    const hd__bvh_node_t *node = &t->nodes[me];
+    hd__box_t box;
+    if (node->count) {
+        CHECK_EQ(node->first_or_second, first);
+        CHECK_EQ(node->count, n);
+        CHECK(n <= 4);
+        box = t->boxes[first];
+        for (size_t k = first; k < first + n; k++) {
+            hd__box_t b;
+            for (int c = 0; c < 3; c++) { /* the triangle's own box, exact */
+                b.lo[c] = b.hi[c] = t->tris[k].v[0][c];
+                for (int j = 1; j < 3; j++) {
+                    b.lo[c] = t->tris[k].v[j][c] < b.lo[c] ? t->tris[k].v[j][c] : b.lo[c];
+                    b.hi[c] = t->tris[k].v[j][c] > b.hi[c] ? t->tris[k].v[j][c] : b.hi[c];
+                }
+            }
+            CHECK(box_equal(&b, &t->boxes[k]));
+            hd__box_merge(&box, &b);
+            seen[k]++;
+        }
+        CHECK(box_equal(&box, &node->box));
+        return hdt_failed() ? 0 : me + 1;
+    }
+    CHECK(n > 4);
+    size_t second = check_node(t, me + 1, first, n / 2, depth + 1, seen);
+    if (!second) return 0;
+    CHECK_EQ(node->first_or_second, second);
+    size_t end = check_node(t, second, first + n / 2, n - n / 2, depth + 1, seen);
+    if (!end) return 0;
+    box = t->nodes[me + 1].box;
+    hd__box_merge(&box, &t->nodes[second].box);
+    CHECK(box_equal(&box, &node->box)); /* exactly its children's: it contains them */
+    return hdt_failed() ? 0 : end;
+}
+
+/* Every triangle of the input in exactly one leaf, the tree's shape and
+ * boxes as mesh.h states, nothing prepared yet. */
+static void check_tree(const hd__bvh_t *t, size_t n) {
+    unsigned char *seen = calloc(n, 1), *index_seen = calloc(n, 1);
+    CHECK_EQ(t->n_tris, n);
+    CHECK_EQ(check_node(t, 0, 0, n, 0, seen), t->n_nodes);
+    for (size_t k = 0; k < n && !hdt_failed(); k++) {
+        CHECK_EQ(seen[k], 1);
+        CHECK(t->tris[k].index < n && !index_seen[t->tris[k].index]);
+        if (t->tris[k].index < n) index_seen[t->tris[k].index] = 1;
+        CHECK_EQ(atomic_load(&t->slot[k]), 0);
+    }
+    free(seen), free(index_seen);
+}
+
+static void same_tree(const hd__bvh_t *a, const hd__bvh_t *b) {
+    CHECK_EQ(a->n_nodes, b->n_nodes);
+    CHECK_EQ(a->n_tris, b->n_tris);
+    if (hdt_failed()) return;
+    CHECK(memcmp(a->nodes, b->nodes, a->n_nodes * sizeof *a->nodes) == 0);
+    CHECK(memcmp(a->tris, b->tris, a->n_tris * sizeof *a->tris) == 0);
+    CHECK(memcmp(a->boxes, b->boxes, a->n_tris * sizeof *a->boxes) == 0);
+}
+
+TEST(the_tree_is_valid_and_the_same_on_1_and_several_threads) {
+    const size_t sizes[] = {1, 2, 3, 4, 5, 7, 8, 9, 17, 100, 1000, 4097, 9001, 40000 / SCALE};
+    const int threads[] = {2, 3, 8};
+    for (int kind = 0; kind < 3; kind++)
+        for (size_t s = 0; s < sizeof sizes / sizeof *sizes && !hdt_failed(); s++) {
+            size_t n = kind == 2 ? (sizes[s] / 100) * 100 : sizes[s];
+            if (n == 0) continue;
+            hd__bvh_t one;
+            CONTEXT("seed 5, kind %d (0 random, 1 copies, 2 torus), %zu triangles, 1 thread", kind, n);
+            CHECK_RC(hd__bvh_build_threads(&one, tris_make(5, n, kind), n, 1), HD_OK);
+            check_tree(&one, n);
+            for (int k = 0; k < 3 && !hdt_failed(); k++) {
+                hd__bvh_t many;
+                CONTEXT("seed 5, kind %d, %zu triangles, %d threads", kind, n, threads[k]);
+                CHECK_RC(hd__bvh_build_threads(&many, tris_make(5, n, kind), n, threads[k]), HD_OK);
+                check_tree(&many, n);
+                same_tree(&one, &many);
+                hd__bvh_free(&many);
+            }
+            hd__bvh_free(&one);
+        }
+}
+
+/* Points near the triangles and far from them: every tree gives the
+ * brute force's answer (smallest rounded distance, then smallest index). */
+TEST(trees_built_on_1_and_3_threads_give_the_brute_force_answers) {
+    size_t n = 12000 / SCALE, queries = 300 / SCALE;
+    hd__tri_t *orig = tris_make(9, n, 1);
+    hd__bvh_t tree[2];
+    for (int k = 0; k < 2; k++) {
+        hd__tri_t *copy = malloc(n * sizeof *copy);
+        memcpy(copy, orig, n * sizeof *copy);
+        CHECK_RC(hd__bvh_build_threads(&tree[k], copy, n, k ? 3 : 1), HD_OK);
+    }
+    gen_rng_t g;
+    gen_seed(&g, 9);
+    for (size_t q = 0; q < queries && !hdt_failed(); q++) {
+        double p[3];
+        for (int c = 0; c < 3; c++) p[c] = q % 2 ? 3 * gen_unit(&g) - 1 : orig[q * 7 % n].v[0][c] + 1e-4 * gen_unit(&g);
+        hd__tri_near_t want;
+        size_t want_index = SIZE_MAX;
+        for (size_t k = 0; k < n; k++) {
+            hd__tri_near_t r;
+            CHECK_RC(hd__tri_nearest(p, orig[k].v[0], orig[k].v[1], orig[k].v[2], &r), HD_OK);
+            if (want_index == SIZE_MAX || r.d < want.d) want = r, want_index = k;
+        }
+        for (int k = 0; k < 2; k++) {
+            hd__tri_near_t got;
+            size_t index;
+            hd__bvh_stats_t st = {0, 0, 0, 0, 0, 0};
+            hd__bvh_nearest(&tree[k], p, SIZE_MAX, 0, &got, &index, &st);
+            CONTEXT("seed 9, query %zu, tree built on %d threads", q, k ? 3 : 1);
+            CHECK_BITS(got.d, want.d);
+            CHECK_EQ(index, want_index);
+        }
+    }
+    hd__bvh_free(&tree[0]);
+    hd__bvh_free(&tree[1]);
+    free(orig);
+}
+
+/* A search prepares the triangles it bounds and no others. */
+TEST(a_query_prepares_only_the_triangles_it_reaches) {
+    size_t n = 20000;
+    hd__bvh_t t;
+    CHECK_RC(hd__bvh_build_threads(&t, tris_make(3, n, 0), n, 2), HD_OK);
+    double p[3] = {0.5, 0.5, 0.5};
+    hd__tri_near_t best;
+    size_t index, ready = 0;
+    hd__bvh_stats_t st = {0, 0, 0, 0, 0, 0};
+    hd__bvh_nearest(&t, p, SIZE_MAX, 0, &best, &index, &st);
+    for (size_t k = 0; k < n; k++) ready += atomic_load(&t.slot[k]) != 0;
+    CONTEXT("seed 3: %zu of %zu triangles prepared, %llu bounded", ready, n, (unsigned long long)st.bounded);
+    CHECK(ready >= 1 && ready < n / 100);
+    hd__bvh_free(&t);
+}
+
+typedef struct {
+    const hd__bvh_t *t;
+    const hd__tri_prep_t *want;
+    atomic_int differ;
+} prep_job_t;
+
+/* Task k asks for every triangle, from a different start, twice. */
+static void ask_all(void *ctx, size_t task, int worker) {
+    (void)worker;
+    prep_job_t *J = ctx;
+    size_t n = J->t->n_tris;
+    for (size_t i = 0; i < 2 * n; i++) {
+        size_t k = (i + task * 7919) % n;
+        const hd__tri_prep_t *q = hd__bvh_prep(J->t, k);
+        if (memcmp(q, &J->want[k], sizeof *q) != 0) atomic_fetch_add(&J->differ, 1);
+    }
+}
+
+TEST(prepared_triangles_have_the_same_bits_whichever_thread_prepares_them) {
+    size_t n = 5000 / SCALE;
+    hd__bvh_t t;
+    CHECK_RC(hd__bvh_build_threads(&t, tris_make(4, n, 1), n, 1), HD_OK);
+    hd__tri_prep_t *want = calloc(n, sizeof *want); /* calloc: padding compares equal */
+    for (size_t k = 0; k < n; k++) hd__tri_prep(t.tris[k].v[0], t.tris[k].v[1], t.tris[k].v[2], &want[k]);
+    prep_job_t J = {&t, want, 0};
+    hd__parallel_for(4, 8, ask_all, &J);
+    CONTEXT("seed 4: %d prepared records differ from hd__tri_prep's", atomic_load(&J.differ));
+    CHECK_EQ(atomic_load(&J.differ), 0);
+    for (size_t k = 0; k < n; k++) CHECK(atomic_load(&t.slot[k]) - 1 < n); /* prepared, in a record */
+    CHECK_EQ(atomic_load(t.used), n);
+    hd__bvh_free(&t);
+    free(want);
+}
