@@ -128,13 +128,16 @@ static int local_of(hd__mpi_ctx_t *c, const local_t *lc, int s, const uint32_t *
 }
 
 /* The exact global squared distances g[t] of the m local points P[sel[t]]
- * of side s (sel increasing), u[t] their local ones (local_of): g = u
- * where the region's faces are clear of u or no other rank's box of Q is
- * as near (mpi.c's step 4), or where u < skip (the caller needs only
- * that g < skip, and g <= u); the others ask the candidate ranks.
- * Collective (one forwarding round, on every rank). */
+ * of side s (sel increasing), u[t] an actual squared distance from each to
+ * a local point of Q (+inf when none is known), where the caller needs g
+ * only when it is at most cap: g = u where u < skip (the caller needs only
+ * that g < skip, and g <= u), and where the region's faces are clear of
+ * min(u, cap) or no other rank's box of Q is that near (mpi.c's step 4);
+ * the others ask the candidate ranks, and g is the smallest answer (when
+ * u > cap, g <= cap is exact and g > cap only says so).  Collective (one
+ * forwarding round, on every rank). */
 static int exact_of(hd__mpi_ctx_t *c, int rc, const local_t *lc, int s, const uint32_t *sel, size_t m,
-                    const double *u, double skip, double *g) {
+                    const double *u, double skip, double cap, double *g) {
     const hd__mpi_spread_t *sp = lc->sp;
     int K = c->K, qs = 1 - s, none_here = sp->loc.n[qs] == 0;
     const double *P = sp->loc.xyz[s];
@@ -147,11 +150,13 @@ static int exact_of(hd__mpi_ctx_t *c, int rc, const local_t *lc, int s, const ui
     if (rc == HD_OK) hd__mpi_node_boxes(sp->tree, 0, sp->held, qs, nbox);
     for (size_t t = 0; t < m && rc == HD_OK; t++) {
         const double *p = P + 3 * (size_t)sel[t];
+        double bound = u[t] < cap ? u[t] : cap;
         g[t] = u[t], jj[t] = 0;
-        if (u[t] < skip || hd__mpi_faces_clear(mine, p, u[t])) continue;
-        int n = hd__mpi_asked(sp->tree, nbox, sp->held, K, qs, none_here, p, u[t], c->rank, list);
+        if (u[t] < skip || hd__mpi_faces_clear(mine, p, bound)) continue;
+        int n = hd__mpi_asked(sp->tree, nbox, sp->held, K, qs, none_here, p, bound, c->rank, list);
         if (n == 0) continue;
         c->forwarded_points++;
+        c->shell++; /* its exact distance from another rank */
         rc = hd__mpi_pairs_add(c, &pr, t, list, n);
     }
     hd__mpi_free(c, nbox, (size_t)K - 1, sizeof(hd__box_t));
@@ -187,7 +192,8 @@ static int sample_of(hd__mpi_ctx_t *c, int rc, const local_t *lc, int s, uint64_
     if (rc == HD_OK && (!sel || !u || !g || !mn || !cnt)) rc = hd__mpi_nomem(c, "the sample", m);
     for (size_t k = 0; k < m && rc == HD_OK; k++) sel[k] = (uint32_t)((uint64_t)k * n / m);
     if (rc == HD_OK) rc = local_of(c, lc, s, sel, m, u);
-    rc = exact_of(c, rc, lc, s, sel, m, u, 0.0, g);
+    rc = exact_of(c, rc, lc, s, sel, m, u, 0.0, INFINITY, g);
+    c->shell += m;
     if (rc == HD_OK) qsort(g, m, sizeof *g, cmp_double);
     uint64_t mine[2] = {m, n};
     if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
@@ -244,24 +250,29 @@ static size_t remove_sorted(double *from, size_t n, const double *minus, size_t 
     return k;
 }
 
-/* The pass of side s over [L, H] into *pt (step 2 of the essay).
+/* The pass of side s over [L, H] into *pt (step 2 of the essay): the
+ * band's class of every local point (hd__an_band_each), then the exact
+ * global value of those inside or above it that another rank may hold a
+ * nearer point for (exact_of), their class corrected where it is smaller.
  * Collective. */
 static int pass(hd__mpi_ctx_t *c, const local_t *lc, int s, double L, double H, part_t *pt) {
     const hd__mpi_spread_t *sp = lc->sp;
     int qs = 1 - s, rc = HD_OK;
     size_t nP = sp->loc.n[s], nQ = sp->loc.n[qs], m = 0, nb = 0;
-    const double *P = sp->loc.xyz[s];
-    const hd__box_t *mine = &sp->region[c->rank];
     hd__an_band_t b = {0, 0, 0, NULL, 0};
     part_free(c, pt);
     pt->L = L, pt->H = H;
+    double *each = hd__mpi_alloc(c, nQ ? nP : 0, sizeof(double));
+    if (!each) rc = hd__mpi_nomem(c, "the band", nP);
     double t0 = hd__now(), u0 = hd__mpi_cpu();
-    if (nP && nQ) rc = hd__an_band(&lc->an[s], &lc->an[qs], L, H, threads_for(c, nP), &b, &c->e);
+    if (rc == HD_OK && nP && nQ)
+        rc = hd__an_band_each(&lc->an[s], &lc->an[qs], L, H, threads_for(c, nP), &b, each, &c->e);
     c->search += hd__now() - t0;
     c->search_cpu += hd__mpi_cpu() - u0;
     nb = b.n;
-    /* the shell: every point whose faces are not clear of H */
-    for (size_t k = 0; k < nP && rc == HD_OK; k++) m += nQ == 0 || !hd__mpi_faces_clear(mine, P + 3 * k, H);
+    c->shell += nb;
+    /* the points not settled below (every point when no Q is here) */
+    for (size_t k = 0; k < nP && rc == HD_OK; k++) m += nQ == 0 || each[k] >= 0;
     uint32_t *sel = hd__mpi_alloc(c, m, sizeof(uint32_t));
     double *u = hd__mpi_alloc(c, m, sizeof(double)), *g = hd__mpi_alloc(c, m, sizeof(double));
     double *minus = hd__mpi_alloc(c, m, sizeof(double));
@@ -269,10 +280,9 @@ static int pass(hd__mpi_ctx_t *c, const local_t *lc, int s, double L, double H, 
     pt->v = hd__mpi_alloc(c, pt->cap, sizeof(double));
     if (rc == HD_OK && (!sel || !u || !g || !minus || !pt->v)) rc = hd__mpi_nomem(c, "the band", nb + m);
     for (size_t k = 0, t = 0; k < nP && rc == HD_OK; k++)
-        if (nQ == 0 || !hd__mpi_faces_clear(mine, P + 3 * k, H)) sel[t++] = (uint32_t)k;
-    if (rc == HD_OK) rc = local_of(c, lc, s, sel, m, u);
-    rc = exact_of(c, rc, lc, s, sel, m, u, L, g);
-    c->shell += nb + m;
+        if (nQ == 0 || each[k] >= 0) sel[t] = (uint32_t)k, u[t++] = nQ ? each[k] : INFINITY;
+    hd__mpi_free(c, each, nQ ? nP : 0, sizeof(double));
+    rc = exact_of(c, rc, lc, s, sel, m, u, L, H, g);
     size_t nm = 0, np = nb;
     if (rc == HD_OK) {
         pt->below = b.below;

@@ -1563,10 +1563,20 @@ typedef struct {
     double lo2, hi2;
     cands_t *cand;
     band_out_t *out; /* per worker */
+    double *each;    /* NULL, or each point's class by its name (hd__an_band_each) */
 } band_ctx;
 
-/* Settles one value, of `times` points, into o. */
-HD__INLINE void band_settle(const band_ctx *c, band_out_t *o, double d2, size_t times) {
+/* The class of `times` points from position k of q in c->each: -1 below,
+ * +inf above, else d2. */
+HD__INLINE void band_each(const band_ctx *c, size_t k, size_t times, double d2) {
+    if (!c->each) return;
+    double v = d2 < c->lo2 ? -1.0 : d2 > c->hi2 ? INFINITY : d2;
+    for (size_t t = 0; t < times; t++) c->each[c->q->idx[k + t]] = v;
+}
+
+/* Settles one value, of `times` points from position k, into o. */
+HD__INLINE void band_settle(const band_ctx *c, band_out_t *o, double d2, size_t times, size_t k) {
+    band_each(c, k, times, d2);
     if (d2 < c->lo2) {
         o->below += times;
         return;
@@ -1623,6 +1633,7 @@ HD__INLINE void band_points(const band_ctx *c, cands_t *cd, band_out_t *o, size_
     size_t near = nearest_leaf(t, &box, &U);
     if (U < c->lo2) { /* every point of the box has a point of t within U */
         o->below += (end - first) * times;
+        band_each(c, first, (end - first) * times, -1.0);
         return;
     }
     for (size_t k = first; k < end; k++) {
@@ -1632,7 +1643,7 @@ HD__INLINE void band_points(const band_ctx *c, cands_t *cd, band_out_t *o, size_
         window_best(q, t, k, wb, wp, bk, &j);
         if (!(*bk < c->lo2)) scan_bucket(t, near, q->x[k], q->y[k], q->z[k], bk, &j);
         if (*bk < c->lo2) {
-            band_settle(c, o, *bk, times);
+            band_settle(c, o, *bk, times, k);
             *bk = -1; /* settled */
             continue;
         }
@@ -1645,7 +1656,7 @@ HD__INLINE void band_points(const band_ctx *c, cands_t *cd, band_out_t *o, size_
     if (candidates(t, &box, lim, open * BAND_SHARED, cd)) {
         for (size_t k = first; k < end; k++)
             if (best[k - first] >= 0)
-                band_settle(c, o, band_finish(c, cd, q->x[k], q->y[k], q->z[k], best[k - first], near), times);
+                band_settle(c, o, band_finish(c, cd, q->x[k], q->y[k], q->z[k], best[k - first], near), times, k);
         return;
     }
     /* A bucket spread over more of t's buckets than BAND_SHARED per open
@@ -1657,7 +1668,7 @@ HD__INLINE void band_points(const band_ctx *c, cands_t *cd, band_out_t *o, size_
         hd__box_t pb = {{q->x[k], q->y[k], q->z[k]}, {q->x[k], q->y[k], q->z[k]}};
         candidates(t, &pb, bk < c->hi2 ? bk : c->hi2, SIZE_MAX, cd);
         o->solo += times;
-        band_settle(c, o, band_finish(c, cd, q->x[k], q->y[k], q->z[k], bk, near), times);
+        band_settle(c, o, band_finish(c, cd, q->x[k], q->y[k], q->z[k], bk, near), times, k);
     }
 }
 
@@ -1679,10 +1690,15 @@ static HD__HOT void band_task(void *vctx, size_t task, int worker) {
 
 int hd__an_band(const hd__an_t *asking, const hd__an_t *searched, double lo2, double hi2, int threads,
                 hd__an_band_t *out, hd_error_t *err) {
+    return hd__an_band_each(asking, searched, lo2, hi2, threads, out, NULL, err);
+}
+
+int hd__an_band_each(const hd__an_t *asking, const hd__an_t *searched, double lo2, double hi2, int threads,
+                     hd__an_band_t *out, double *each, hd_error_t *err) {
     memset(out, 0, sizeof *out);
     size_t tasks = (asking->nb + BAND_TASK - 1) / BAND_TASK;
     threads = hd__thread_count(threads, tasks);
-    band_ctx c = {asking, searched, lo2, hi2, NULL, NULL};
+    band_ctx c = {asking, searched, lo2, hi2, NULL, NULL, each};
     c.cand = hd__calloc_array((size_t)threads, sizeof *c.cand);
     c.out = hd__calloc_array((size_t)threads, sizeof *c.out);
     int rc = c.cand && c.out ? HD_OK : HD_ENOMEM;

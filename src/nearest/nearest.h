@@ -132,6 +132,13 @@ typedef struct hd__an_band {
 int hd__an_band(const hd__an_t *asking, const hd__an_t *searched, double lo2, double hi2, int threads,
                 hd__an_band_t *out, hd_error_t *err);
 
+/* hd__an_band, and each point's class into each[name] (an array as long
+ * as the asking names go): -1 for a point counted below, +inf above, its
+ * exact d2 inside the band.  The classes are the same at any thread
+ * count.  Returns as hd__an_band. */
+int hd__an_band_each(const hd__an_t *asking, const hd__an_t *searched, double lo2, double hi2, int threads,
+                     hd__an_band_t *out, double *each, hd_error_t *err);
+
 /* Both structures of A and B (validated views of at most
  * HD__AN_MAX_POINTS each) on one key box, built side by side on the
  * threads.  On failure neither is left allocated.  Returns as
