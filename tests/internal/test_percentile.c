@@ -19,6 +19,7 @@
 
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 static int cmp_d(const void *x, const void *y) {
     double a = *(const double *)x, b = *(const double *)y;
@@ -187,6 +188,61 @@ TEST(the_band_pass_counts_and_keeps_what_a_full_classification_does) {
         hd__an_free(&s[1]);
         free(d2);
         free(want);
+        free(a);
+        free(b);
+        if (hdt_failed()) return;
+    }
+}
+
+TEST(the_band_pass_classifies_each_point_as_a_full_classification_does) {
+    /* hd__an_band_each: every point's class by its index (-1 below, +inf
+     * above, else its exact d2), with a run of copies of one point (a
+     * bucket settled once for all of them) and lattice ties on the edges. */
+    for (uint64_t seed = 300; seed < 304; seed++) {
+        double *a, *b;
+        hd_points_t A, B;
+        make_pair(seed, 3000, &a, &b, &A, &B);
+        size_t na = A.count;
+        for (size_t i = na / 2; i < na / 2 + 200 && i < na; i++) memcpy(a + 3 * i, a, 3 * sizeof(double));
+        for (size_t i = 0; i < na / 4; i++) /* lattice points: ties */
+            for (int d = 0; d < 3; d++) a[3 * i + d] = floor(a[3 * i + d] * 8) / 8;
+        double *d2 = malloc(8 * na), *each = malloc(8 * na);
+        for (size_t i = 0; i < na; i++) d2[i] = brute_nearest(a + 3 * i, b, B.count, NULL);
+        hd__box_t ba, bb;
+        CHECK_RC(hd__points_scan(&A, "A", 1, &ba, NULL), HD_OK);
+        CHECK_RC(hd__points_scan(&B, "B", 1, &bb, NULL), HD_OK);
+        hd__box_merge(&ba, &bb);
+        hd__an_t s[2];
+        CHECK_RC(hd__an_build_pair(&A, &B, &ba, 2, s, NULL), HD_OK);
+        gen_rng_t g;
+        gen_seed(&g, seed);
+        double top = 0; /* a band at the largest value: whole buckets below at once */
+        for (size_t i = 0; i < na; i++) top = d2[i] > top ? d2[i] : top;
+        for (int trial = 0; trial < 6; trial++) {
+            double lo2 = trial == 0 ? 0 : trial == 5 ? top : d2[gen_u64(&g) % na];
+            double hi2 = trial == 1 || trial == 5 ? INFINITY : d2[gen_u64(&g) % na];
+            if (lo2 > hi2) {
+                double t = lo2;
+                lo2 = hi2, hi2 = t;
+            }
+            for (int threads = 1; threads <= 3; threads += 2) {
+                CONTEXT("seed=%llu band [%.17g, %.17g] threads=%d", (unsigned long long)seed, lo2, hi2, threads);
+                hd__an_band_t got;
+                for (size_t i = 0; i < na; i++) each[i] = NAN;
+                CHECK_RC(hd__an_band_each(&s[0], &s[1], lo2, hi2, threads, &got, each, NULL), HD_OK);
+                size_t wrong = 0;
+                for (size_t i = 0; i < na; i++) {
+                    double want = d2[i] < lo2 ? -1.0 : d2[i] > hi2 ? INFINITY : d2[i];
+                    wrong += memcmp(&each[i], &want, sizeof want) != 0;
+                }
+                CHECK_EQ(wrong, (size_t)0);
+                free(got.v);
+            }
+        }
+        hd__an_free(&s[0]);
+        hd__an_free(&s[1]);
+        free(d2);
+        free(each);
         free(a);
         free(b);
         if (hdt_failed()) return;
