@@ -286,7 +286,7 @@ static int pass(hd__mpi_ctx_t *c, const local_t *lc, int s, double L, double H, 
     size_t nm = 0, np = nb;
     if (rc == HD_OK) {
         pt->below = b.below;
-        memcpy(pt->v, b.v, nb * sizeof(double));
+        if (nb) memcpy(pt->v, b.v, nb * sizeof(double));
         for (size_t t = 0; t < m; t++) {
             if (nQ && g[t] == u[t]) continue; /* the band's class is g's */
             if (nQ && u[t] <= H) minus[nm++] = u[t]; /* u >= L here: it was kept */
