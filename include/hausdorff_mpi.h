@@ -245,8 +245,8 @@ int hd_mpi_distances(MPI_Comm comm, const hd_mpi_part_t *a, size_t na,
  *   besides the checks).  p: in [0, 100].
  * out: the figures (the same on every rank).
  * stats: NULL, or the figures of hd_mpi_stats_t; here shell_points counts
- *   the points whose exact distance some rank computed (inside a band, in
- *   the sample, or near a region's face: the rest were only bounded), and
+ *   the exact searches the ranks made (a band's values, the sample, the
+ *   points forwarded: the rest were only bounded; 0 on one rank), and
  *   forwarded* the queries sent to other ranks for them.
  * err: NULL, or receives the context of a failure.
  * Memory, per point a rank holds after the partition: the two local
