@@ -48,6 +48,7 @@
 # times (Release, 2 shared cores): mpi_api 1, 3, 2.5-4.5, 3.5 and 6-13 s;
 # mpi_figures 1, 1.5, 4.4, 3.4 and 5.8 s; mpi_cli_3 90-110 s (load 7-8);
 # sanitizers: mpi_api_3 14-25 s, mpi_figures_3 8 s, mpi_cli_3 100-160 s.
+# mpi_percentile 5, 15-33, 15 and 14-26 s at load 12-13.
 if(HD_MPI)
   find_program(HD_MPIEXEC NAMES mpirun mpiexec REQUIRED)
   add_executable(mpi_api ${CMAKE_CURRENT_SOURCE_DIR}/tests/api/mpi_api.c ${CMAKE_CURRENT_SOURCE_DIR}/tests/support/gen.c)
