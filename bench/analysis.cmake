@@ -14,3 +14,10 @@ target_include_directories(field_bench PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/src)
 # field_histogram_bench: histograms from bounds (hd_hausdorff_histogram)
 # against every distance then hd_histogram, on issue 39's cases a-e.
 hd_add_bench(field_histogram_bench ${CMAKE_CURRENT_LIST_DIR}/field_histogram_bench.c ${CMAKE_CURRENT_LIST_DIR}/support/field_cases.c)
+# percentile_mpi_bench (under mpirun): hausdorff-mpi's percentile without
+# every distance (hd_mpi_hausdorff_percentile) against every distance over
+# the ranks then hd_mpi_percentile_of, on issue 39's cases a-e.
+if(HD_MPI)
+  hd_add_bench(percentile_mpi_bench ${CMAKE_CURRENT_LIST_DIR}/percentile_mpi_bench.c ${CMAKE_CURRENT_LIST_DIR}/support/field_cases.c)
+  target_link_libraries(percentile_mpi_bench PRIVATE hausdorff_mpi)
+endif()

@@ -67,8 +67,7 @@ int analysis_active(const analysis_args_t *an) {
            an->render_out || an->histogram_png || an->n_taus || an->dtu_cap > 0 || an->subset[0].on || an->subset[1].on;
 }
 
-/* Only the percentile asked for: no figure needs every distance. */
-static int analysis_percentile_only(const analysis_args_t *an) {
+int analysis_percentile_only(const analysis_args_t *an) {
     return an->percentile_on && !an->mean && !an->chamfer && !an->histogram && !an->distances_out &&
            !an->render_out && !an->histogram_png && !an->subset[0].on && !an->subset[1].on;
 }

@@ -167,6 +167,8 @@ typedef struct analysis_result {
 const char *analysis_units(const analysis_args_t *an);
 /* Does anything need the per-point distances? */
 int analysis_active(const analysis_args_t *an);
+/* Only the percentile asked for: no figure needs every distance. */
+int analysis_percentile_only(const analysis_args_t *an);
 /* When A or B is empty (the counts n_a, n_b), under the --empty policy:
  * every figure asked for is the policy's value (the scores of --tau and
  * --dtu-cap: none within, NaN for no points) into r, and s the distances

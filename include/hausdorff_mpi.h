@@ -253,6 +253,38 @@ int hd_mpi_distances(MPI_Comm comm, const hd_mpi_part_t *a, size_t na,
                      size_t *nearest_ba, hd_mpi_stats_t *stats,
                      hd_error_t *err);
 
+/* hd_hausdorff_percentile() on the union of all ranks' points: numpy's
+ * linear percentile p of the nearest distances A->B, B->A, their maximum
+ * (MONAI's HD95 for p = 95) and both directions pooled (medpy's), to the
+ * bit, on every rank, without every per-point distance: after the
+ * partition each rank classifies its points against a band around the
+ * answer drawn from a sample, searching completely only the points near
+ * the band or near its region's faces, and the ranks select the values
+ * of the two ranks numpy interpolates from the band's values with
+ * MPI_Allreduce counts (src/mpi/select.c has the method and the proof).
+ * Collective over comm.
+ * a, na, b, nb, opt: as hd_mpi_hausdorff (only opt->threads is read
+ *   besides the checks).  p: in [0, 100].
+ * out: the figures (the same on every rank).
+ * stats: NULL, or the figures of hd_mpi_stats_t; here shell_points counts
+ *   the exact searches the ranks made (a band's values, the sample, the
+ *   points forwarded: the rest were only bounded; 0 on one rank), and
+ *   forwarded* the queries sent to other ranks for them.
+ * err: NULL, or receives the context of a failure.
+ * Memory, per point a rank holds after the partition: the two local
+ *   structures of hd_mpi_distances (about 37 bytes a point of each set)
+ *   and 8 bytes a point kept by a band.  On one rank,
+ *   hd_hausdorff_percentile on the caller's points (packed when a set has
+ *   several parts, 24 bytes a point).
+ * Errors: as hd_mpi_hausdorff (HD_EEMPTY when a set has no point on any
+ *   rank), HD_EINVAL for p outside [0, 100].
+ * Thread safety: as hd_mpi_hausdorff. */
+int hd_mpi_hausdorff_percentile(MPI_Comm comm, const hd_mpi_part_t *a, size_t na,
+                                const hd_mpi_part_t *b, size_t nb,
+                                const hd_options_t *opt, double p,
+                                hd_percentile_t *out, hd_mpi_stats_t *stats,
+                                hd_error_t *err);
+
 /* The overlap degree alpha and *disjoint of the bounding boxes of all of A
  * and all of B, as hd_overlap() gives them on the union (hausdorff.h);
  * with hd_mpi_directed it makes what hd_hausdorff's result holds besides

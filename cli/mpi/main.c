@@ -409,6 +409,13 @@ static int compute(run_t *r, hd_error_t *err) {
         rc = hd_mpi_hausdorff(MPI_COMM_WORLD, &part[0], 1, &part[1], 1, &mo, s, &r->st, err);
     }
     if (rc != HD_OK || !analysis_active(&a->an)) return rc;
+    if (!a->directed && analysis_percentile_only(&a->an)) { /* without every distance (src/mpi/select.c) */
+        r->an.active = 1, r->an.n_a = (size_t)r->total[0], r->an.n_b = (size_t)r->total[1];
+        rc = hd_mpi_hausdorff_percentile(MPI_COMM_WORLD, &part[0], 1, &part[1], 1, &a->opt, a->an.percentile,
+                                         &r->an.pct, &r->dst, err);
+        r->an.seconds = rc == HD_OK ? r->dst.seconds_max : 0;
+        return rc;
+    }
     if ((rc = distances_mpi(a, part, r->total, &r->an, &r->dst, err)) == HD_OK)
         rc = mpi_figures(&a->an, r->an.d_ab, part[0].points.count, r->an.d_ba, part[1].points.count, &r->an, err);
     if (rc == HD_OK && (a->an.distances_out || a->an.subset[0].on || a->an.subset[1].on))

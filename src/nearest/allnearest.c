@@ -1563,10 +1563,21 @@ typedef struct {
     double lo2, hi2;
     cands_t *cand;
     band_out_t *out; /* per worker */
+    double *each;    /* NULL, or each point's class by its name (hd__an_band_each) */
 } band_ctx;
 
-/* Settles one value, of `times` points, into o. */
-HD__INLINE void band_settle(const band_ctx *c, band_out_t *o, double d2, size_t times) {
+/* The class of `times` points from position k of q in each (NULL: not
+ * kept; the passes without it are compiled without the stores): -1 below,
+ * +inf above, else d2. */
+HD__INLINE void band_each(const band_ctx *c, double *each, size_t k, size_t times, double d2) {
+    if (!each) return;
+    double v = d2 < c->lo2 ? -1.0 : d2 > c->hi2 ? INFINITY : d2;
+    for (size_t t = 0; t < times; t++) each[c->q->idx[k + t]] = v;
+}
+
+/* Settles one value, of `times` points from position k, into o. */
+HD__INLINE void band_settle(const band_ctx *c, band_out_t *o, double *each, double d2, size_t times, size_t k) {
+    band_each(c, each, k, times, d2);
     if (d2 < c->lo2) {
         o->below += times;
         return;
@@ -1613,8 +1624,8 @@ HD__INLINE double band_finish(const band_ctx *c, cands_t *cd, double qx, double 
  * drawn from the two boxes, and a node holds a point); else the window of
  * each point on t's curve, then, for those it left open, that nearest
  * bucket, then the candidates.  *wb and *wp carry the window's place (window_best). */
-HD__INLINE void band_points(const band_ctx *c, cands_t *cd, band_out_t *o, size_t b, size_t first, size_t end,
-                        size_t times, size_t *wb, size_t *wp) {
+HD__INLINE void band_points(const band_ctx *c, cands_t *cd, band_out_t *o, double *each, size_t b, size_t first,
+                            size_t end, size_t times, size_t *wb, size_t *wp) {
     const hd__an_t *q = c->q, *t = c->t;
     double best[HD__AN_BUCKET], U = INFINITY, V = 0;
     size_t open = 0, node = q->leaf[b];
@@ -1623,6 +1634,7 @@ HD__INLINE void band_points(const band_ctx *c, cands_t *cd, band_out_t *o, size_
     size_t near = nearest_leaf(t, &box, &U);
     if (U < c->lo2) { /* every point of the box has a point of t within U */
         o->below += (end - first) * times;
+        band_each(c, each, first, (end - first) * times, -1.0);
         return;
     }
     for (size_t k = first; k < end; k++) {
@@ -1632,7 +1644,7 @@ HD__INLINE void band_points(const band_ctx *c, cands_t *cd, band_out_t *o, size_
         window_best(q, t, k, wb, wp, bk, &j);
         if (!(*bk < c->lo2)) scan_bucket(t, near, q->x[k], q->y[k], q->z[k], bk, &j);
         if (*bk < c->lo2) {
-            band_settle(c, o, *bk, times);
+            band_settle(c, o, each, *bk, times, k);
             *bk = -1; /* settled */
             continue;
         }
@@ -1645,7 +1657,8 @@ HD__INLINE void band_points(const band_ctx *c, cands_t *cd, band_out_t *o, size_
     if (candidates(t, &box, lim, open * BAND_SHARED, cd)) {
         for (size_t k = first; k < end; k++)
             if (best[k - first] >= 0)
-                band_settle(c, o, band_finish(c, cd, q->x[k], q->y[k], q->z[k], best[k - first], near), times);
+                band_settle(c, o, each, band_finish(c, cd, q->x[k], q->y[k], q->z[k], best[k - first], near), times,
+                            k);
         return;
     }
     /* A bucket spread over more of t's buckets than BAND_SHARED per open
@@ -1657,37 +1670,52 @@ HD__INLINE void band_points(const band_ctx *c, cands_t *cd, band_out_t *o, size_
         hd__box_t pb = {{q->x[k], q->y[k], q->z[k]}, {q->x[k], q->y[k], q->z[k]}};
         candidates(t, &pb, bk < c->hi2 ? bk : c->hi2, SIZE_MAX, cd);
         o->solo += times;
-        band_settle(c, o, band_finish(c, cd, q->x[k], q->y[k], q->z[k], bk, near), times);
+        band_settle(c, o, each, band_finish(c, cd, q->x[k], q->y[k], q->z[k], bk, near), times, k);
     }
 }
 
 /* Asking bucket b, HD__AN_BUCKET points at a time (a bucket of equal keys
  * may hold more). */
-HD__INLINE void band_bucket(const band_ctx *c, cands_t *cd, band_out_t *o, size_t b, size_t *wb, size_t *wp) {
+HD__INLINE void band_bucket(const band_ctx *c, cands_t *cd, band_out_t *o, double *each, size_t b, size_t *wb,
+                            size_t *wp) {
     const hd__an_t *q = c->q;
     size_t first = q->start[b], end = q->stop[b], times = end == first + 1 ? q->start[b + 1] - first : 1;
     for (size_t k = first; k < end; k += HD__AN_BUCKET)
-        band_points(c, cd, o, b, k, end - k < HD__AN_BUCKET ? end : k + HD__AN_BUCKET, times, wb, wp);
+        band_points(c, cd, o, each, b, k, end - k < HD__AN_BUCKET ? end : k + HD__AN_BUCKET, times, wb, wp);
 }
 
-static HD__HOT void band_task(void *vctx, size_t task, int worker) {
-    band_ctx *c = vctx;
+/* One task's asking buckets; each as band_each's (NULL: the stores are
+ * compiled out of band_task). */
+HD__INLINE void band_range(const band_ctx *c, size_t task, int worker, double *each) {
     size_t b0 = task * BAND_TASK, b1 = b0 + BAND_TASK < c->q->nb ? b0 + BAND_TASK : c->q->nb;
     size_t wb = 0, wp = 0;
-    for (size_t b = b0; b < b1; b++) band_bucket(c, &c->cand[worker], &c->out[worker], b, &wb, &wp);
+    for (size_t b = b0; b < b1; b++) band_bucket(c, &c->cand[worker], &c->out[worker], each, b, &wb, &wp);
+}
+
+static HD__HOT void band_task(void *vctx, size_t task, int worker) { band_range(vctx, task, worker, NULL); }
+
+/* band_task keeping each point's class (hd__an_band_each). */
+static HD__HOT void band_task_each(void *vctx, size_t task, int worker) {
+    const band_ctx *c = vctx;
+    band_range(c, task, worker, c->each);
 }
 
 int hd__an_band(const hd__an_t *asking, const hd__an_t *searched, double lo2, double hi2, int threads,
                 hd__an_band_t *out, hd_error_t *err) {
+    return hd__an_band_each(asking, searched, lo2, hi2, threads, out, NULL, err);
+}
+
+int hd__an_band_each(const hd__an_t *asking, const hd__an_t *searched, double lo2, double hi2, int threads,
+                     hd__an_band_t *out, double *each, hd_error_t *err) {
     memset(out, 0, sizeof *out);
     size_t tasks = (asking->nb + BAND_TASK - 1) / BAND_TASK;
     threads = hd__thread_count(threads, tasks);
-    band_ctx c = {asking, searched, lo2, hi2, NULL, NULL};
+    band_ctx c = {asking, searched, lo2, hi2, NULL, NULL, each};
     c.cand = hd__calloc_array((size_t)threads, sizeof *c.cand);
     c.out = hd__calloc_array((size_t)threads, sizeof *c.out);
     int rc = c.cand && c.out ? HD_OK : HD_ENOMEM;
     if (rc == HD_OK) rc = cands_alloc(c.cand, threads, searched->nb);
-    if (rc == HD_OK) hd__parallel_for(threads, tasks, band_task, &c);
+    if (rc == HD_OK) hd__parallel_for(threads, tasks, each ? band_task_each : band_task, &c);
     size_t kept = 0;
     for (int w = 0; c.out && w < threads; w++) {
         out->below += c.out[w].below, out->above += c.out[w].above, kept += c.out[w].n;

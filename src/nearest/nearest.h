@@ -132,6 +132,13 @@ typedef struct hd__an_band {
 int hd__an_band(const hd__an_t *asking, const hd__an_t *searched, double lo2, double hi2, int threads,
                 hd__an_band_t *out, hd_error_t *err);
 
+/* hd__an_band, and each point's class into each[name] (an array as long
+ * as the asking names go): -1 for a point counted below, +inf above, its
+ * exact d2 inside the band.  The classes are the same at any thread
+ * count.  Returns as hd__an_band. */
+int hd__an_band_each(const hd__an_t *asking, const hd__an_t *searched, double lo2, double hi2, int threads,
+                     hd__an_band_t *out, double *each, hd_error_t *err);
+
 /* Both structures of A and B (validated views of at most
  * HD__AN_MAX_POINTS each) on one key box, built side by side on the
  * threads.  On failure neither is left allocated.  Returns as
@@ -146,6 +153,24 @@ int hd__an_build_pair(const hd_points_t *A, const hd_points_t *B, const hd__box_
  * HD_EOVERFLOW. */
 int hd__percentile_points(const hd_points_t *A, const hd_points_t *B, const hd__an_t s[2],
                           const hd__box_t *keybox, int threads, double p, hd_percentile_t *out, hd_error_t *err);
+
+/* A sample of a direction's exact squared distances: m values (sorted
+ * ascending; +inf allowed) standing for n points (n >= m; m = 0 stands
+ * for nothing). */
+typedef struct hd__pct_sample {
+    double *v;
+    size_t m, n;
+} hd__pct_sample_t;
+
+/* The band [*lo2, *hi2] in which ranks r1 <= r2 of the points the ns
+ * samples stand for are expected (percentile.c's step 2): lo2 the largest
+ * sample value whose estimated rank (each value weighing n / m of its
+ * sample) lies SPREAD standard deviations below r1, hi2 the smallest
+ * whose estimated count at most it reaches that far above r2; 0 and +inf
+ * where there is none.  at: ns entries of scratch.  The band decides only
+ * the cost of a selection, never its answer. */
+void hd__percentile_band(const hd__pct_sample_t *s, int ns, size_t *at, size_t r1, size_t r2, double *lo2,
+                         double *hi2);
 
 /* ---- histograms (histogram.c) ------------------------------------------- */
 

@@ -38,12 +38,7 @@
 #define SAMPLE 4096 /* points sampled per direction for the bands */
 #define SPREAD 6.0  /* a band's half-width, in standard deviations of a sample's estimated rank */
 
-/* The exact squared distances of a sample of the points of P (structure
- * of the whole set: not needed) against `searched`, sorted. */
-typedef struct {
-    double *v;
-    size_t m, n; /* m sampled values of n points */
-} sample_t;
+typedef hd__pct_sample_t sample_t;
 
 static int cmp_double(const void *x, const void *y) {
     double a = *(const double *)x, b = *(const double *)y;
@@ -70,22 +65,19 @@ static int sample_of(const hd_points_t *P, const hd__an_t *searched, const hd__b
     return HD_OK;
 }
 
-/* The band [*lo2, *hi2] for ranks r1 <= r2 of the n_0 + ... points the
- * ns samples stand for: lo2 the largest sample value whose estimated rank
- * (weighted count of sample values below it) is at most r1 - delta, hi2
- * the smallest whose weighted count of values at most it reaches
- * r2 + 1 + delta; 0 and +inf where there is none. */
-static void band_of(const sample_t *s, int ns, size_t r1, size_t r2, double *lo2, double *hi2) {
+void hd__percentile_band(const hd__pct_sample_t *s, int ns, size_t *at, size_t r1, size_t r2, double *lo2,
+                         double *hi2) {
     double total = 0, var = 0, slack = 0;
     for (int i = 0; i < ns; i++) total += (double)s[i].n;
     double q = ((double)r1 + 0.5) / total;
     for (int i = 0; i < ns; i++) {
+        at[i] = 0;
+        if (s[i].m == 0) continue;
         double w = (double)s[i].n / (double)s[i].m, f = 1.0 - (double)s[i].m / (double)s[i].n;
         var += w * w * (double)s[i].m * q * (1 - q) * f;
         slack += f > 0 ? w : 0;
     }
     double delta = SPREAD * sqrt(var) + slack, below = 0;
-    size_t at[2] = {0, 0};
     *lo2 = 0, *hi2 = INFINITY;
     for (;;) { /* the samples merged, a value (with its copies) at a time */
         double v = INFINITY;
@@ -100,6 +92,11 @@ static void band_of(const sample_t *s, int ns, size_t r1, size_t r2, double *lo2
             return;
         }
     }
+}
+
+static void band_of(const sample_t *s, int ns, size_t r1, size_t r2, double *lo2, double *hi2) {
+    size_t at[2];
+    hd__percentile_band(s, ns, at, r1, r2, lo2, hi2);
 }
 
 /* One figure: its ranks, its band, and its answer once settled. */

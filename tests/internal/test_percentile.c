@@ -19,6 +19,7 @@
 
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 static int cmp_d(const void *x, const void *y) {
     double a = *(const double *)x, b = *(const double *)y;
@@ -141,29 +142,57 @@ TEST(a_misleading_sample_changes_no_bit) {
     }
 }
 
+/* A band test's sets: A (a) against B (b), every brute-force nearest
+ * squared distance of A's points (d2) and both structures on one key box. */
+typedef struct {
+    double *a, *b, *d2;
+    hd_points_t A, B;
+    hd__an_t s[2];
+} band_sets_t;
+
+static void band_sets_build(band_sets_t *t) {
+    size_t na = t->A.count;
+    t->d2 = malloc(8 * na);
+    for (size_t i = 0; i < na; i++) t->d2[i] = brute_nearest(t->a + 3 * i, t->b, t->B.count, NULL);
+    hd__box_t ba, bb;
+    CHECK_RC(hd__points_scan(&t->A, "A", 1, &ba, NULL), HD_OK);
+    CHECK_RC(hd__points_scan(&t->B, "B", 1, &bb, NULL), HD_OK);
+    hd__box_merge(&ba, &bb);
+    CHECK_RC(hd__an_build_pair(&t->A, &t->B, &ba, 2, t->s, NULL), HD_OK);
+}
+
+static void band_sets_free(band_sets_t *t) {
+    hd__an_free(&t->s[0]);
+    hd__an_free(&t->s[1]);
+    free(t->d2);
+    free(t->a);
+    free(t->b);
+}
+
+/* A band whose edges are actual values (ties sit on them), ordered;
+ * trial 0 opens it below, trial 1 above. */
+static void band_edges(gen_rng_t *g, const double *d2, size_t n, int trial, double *lo2, double *hi2) {
+    *lo2 = trial == 0 ? 0 : d2[gen_u64(g) % n];
+    *hi2 = trial == 1 ? INFINITY : d2[gen_u64(g) % n];
+    if (*lo2 > *hi2) {
+        double t = *lo2;
+        *lo2 = *hi2, *hi2 = t;
+    }
+}
+
 TEST(the_band_pass_counts_and_keeps_what_a_full_classification_does) {
     for (uint64_t seed = 200; seed < 206; seed++) {
-        double *a, *b;
-        hd_points_t A, B;
-        make_pair(seed, 2500, &a, &b, &A, &B);
-        size_t na = A.count;
-        double *d2 = malloc(8 * na), *want = malloc(8 * na);
-        for (size_t i = 0; i < na; i++) d2[i] = brute_nearest(a + 3 * i, b, B.count, NULL);
-        hd__box_t ba, bb;
-        CHECK_RC(hd__points_scan(&A, "A", 1, &ba, NULL), HD_OK);
-        CHECK_RC(hd__points_scan(&B, "B", 1, &bb, NULL), HD_OK);
-        hd__box_merge(&ba, &bb);
-        hd__an_t s[2];
-        CHECK_RC(hd__an_build_pair(&A, &B, &ba, 2, s, NULL), HD_OK);
+        band_sets_t t;
+        make_pair(seed, 2500, &t.a, &t.b, &t.A, &t.B);
+        band_sets_build(&t);
+        size_t na = t.A.count;
+        const double *d2 = t.d2;
+        double *want = malloc(8 * na);
         gen_rng_t g;
         gen_seed(&g, seed);
         for (int trial = 0; trial < 6; trial++) {
-            /* edges on actual values, so that ties sit on them */
-            double lo2 = trial == 0 ? 0 : d2[gen_u64(&g) % na], hi2 = trial == 1 ? INFINITY : d2[gen_u64(&g) % na];
-            if (lo2 > hi2) {
-                double t = lo2;
-                lo2 = hi2, hi2 = t;
-            }
+            double lo2, hi2;
+            band_edges(&g, d2, na, trial, &lo2, &hi2);
             size_t below = 0, above = 0, in = 0;
             for (size_t i = 0; i < na; i++) {
                 below += d2[i] < lo2;
@@ -174,7 +203,7 @@ TEST(the_band_pass_counts_and_keeps_what_a_full_classification_does) {
             for (int threads = 1; threads <= 3; threads += 2) {
                 CONTEXT("seed=%llu band [%.17g, %.17g] threads=%d", (unsigned long long)seed, lo2, hi2, threads);
                 hd__an_band_t got;
-                CHECK_RC(hd__an_band(&s[0], &s[1], lo2, hi2, threads, &got, NULL), HD_OK);
+                CHECK_RC(hd__an_band(&t.s[0], &t.s[1], lo2, hi2, threads, &got, NULL), HD_OK);
                 CHECK_EQ(got.below, below);
                 CHECK_EQ(got.above, above);
                 CHECK_EQ(got.n, in);
@@ -183,12 +212,49 @@ TEST(the_band_pass_counts_and_keeps_what_a_full_classification_does) {
                 free(got.v);
             }
         }
-        hd__an_free(&s[0]);
-        hd__an_free(&s[1]);
-        free(d2);
+        band_sets_free(&t);
         free(want);
-        free(a);
-        free(b);
+        if (hdt_failed()) return;
+    }
+}
+
+TEST(the_band_pass_classifies_each_point_as_a_full_classification_does) {
+    /* hd__an_band_each: every point's class by its index (-1 below, +inf
+     * above, else its exact d2), with a run of copies of one point (a
+     * bucket settled once for all of them), lattice ties on the edges, and
+     * a band at the largest value (whole buckets below at once). */
+    for (uint64_t seed = 300; seed < 304; seed++) {
+        band_sets_t t;
+        make_pair(seed, 3000, &t.a, &t.b, &t.A, &t.B);
+        size_t na = t.A.count;
+        for (size_t i = na / 2; i < na / 2 + 200 && i < na; i++) memcpy(t.a + 3 * i, t.a, 3 * sizeof(double));
+        for (size_t i = 0; i < na / 4; i++) /* lattice points: ties */
+            for (int d = 0; d < 3; d++) t.a[3 * i + d] = floor(t.a[3 * i + d] * 8) / 8;
+        band_sets_build(&t);
+        const double *d2 = t.d2;
+        double *each = malloc(8 * na), top = 0;
+        for (size_t i = 0; i < na; i++) top = d2[i] > top ? d2[i] : top;
+        gen_rng_t g;
+        gen_seed(&g, seed);
+        for (int trial = 0; trial < 6; trial++) {
+            double lo2 = top, hi2 = INFINITY;
+            if (trial < 5) band_edges(&g, d2, na, trial, &lo2, &hi2);
+            for (int threads = 1; threads <= 3; threads += 2) {
+                CONTEXT("seed=%llu band [%.17g, %.17g] threads=%d", (unsigned long long)seed, lo2, hi2, threads);
+                hd__an_band_t got;
+                for (size_t i = 0; i < na; i++) each[i] = NAN;
+                CHECK_RC(hd__an_band_each(&t.s[0], &t.s[1], lo2, hi2, threads, &got, each, NULL), HD_OK);
+                size_t wrong = 0;
+                for (size_t i = 0; i < na; i++) {
+                    double want = d2[i] < lo2 ? -1.0 : d2[i] > hi2 ? INFINITY : d2[i];
+                    wrong += memcmp(&each[i], &want, sizeof want) != 0;
+                }
+                CHECK_EQ(wrong, (size_t)0);
+                free(got.v);
+            }
+        }
+        band_sets_free(&t);
+        free(each);
         if (hdt_failed()) return;
     }
 }
