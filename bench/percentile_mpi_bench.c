@@ -55,9 +55,9 @@ int main(int argc, char **argv) {
     if (runs < 1 || runs > 50) runs = 3;
     double *a = malloc(24 * n), *b = malloc(24 * n), *dab = malloc(8 * n), *dba = malloc(8 * n);
     if (!a || !b || !dab || !dba) return 1;
-    hd_options_t o;
-    hd_options_init(&o);
-    o.threads = threads;
+    hd_mpi_options_t o;
+    hd_mpi_options_init(&o);
+    o.engine.threads = threads;
     hd_error_t err;
     int bad = 0;
     if (rank == 0)

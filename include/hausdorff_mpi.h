@@ -110,8 +110,9 @@ typedef struct hd_mpi_options {
                             0: every point moves to its region's rank.
                             The result is the same bit for bit; only the
                             work and the bytes moved differ (a comparison
-                            for benchmarks).  hd_mpi_distances ignores
-                            it: every point needs its own answer */
+                            for benchmarks).  hd_mpi_distances and
+                            hd_mpi_hausdorff_percentile ignore it: every
+                            point needs its own answer or class */
 } hd_mpi_options_t;
 
 /* Fill `opt` with the defaults: hd_options_init's engine options and
@@ -281,7 +282,7 @@ int hd_mpi_distances(MPI_Comm comm, const hd_mpi_part_t *a, size_t na,
  * Thread safety: as hd_mpi_hausdorff. */
 int hd_mpi_hausdorff_percentile(MPI_Comm comm, const hd_mpi_part_t *a, size_t na,
                                 const hd_mpi_part_t *b, size_t nb,
-                                const hd_options_t *opt, double p,
+                                const hd_mpi_options_t *opt, double p,
                                 hd_percentile_t *out, hd_mpi_stats_t *stats,
                                 hd_error_t *err);
 

@@ -411,7 +411,7 @@ static int compute(run_t *r, hd_error_t *err) {
     if (rc != HD_OK || !analysis_active(&a->an)) return rc;
     if (!a->directed && analysis_percentile_only(&a->an)) { /* without every distance (src/mpi/select.c) */
         r->an.active = 1, r->an.n_a = (size_t)r->total[0], r->an.n_b = (size_t)r->total[1];
-        rc = hd_mpi_hausdorff_percentile(MPI_COMM_WORLD, &part[0], 1, &part[1], 1, &a->opt, a->an.percentile,
+        rc = hd_mpi_hausdorff_percentile(MPI_COMM_WORLD, &part[0], 1, &part[1], 1, &mo, a->an.percentile,
                                          &r->an.pct, &r->dst, err);
         r->an.seconds = rc == HD_OK ? r->dst.seconds_max : 0;
         return rc;

@@ -550,7 +550,7 @@ done:
 }
 
 int hd_mpi_hausdorff_percentile(MPI_Comm comm, const hd_mpi_part_t *a, size_t na, const hd_mpi_part_t *b, size_t nb,
-                                const hd_options_t *opt, double p, hd_percentile_t *out, hd_mpi_stats_t *stats,
+                                const hd_mpi_options_t *opt, double p, hd_percentile_t *out, hd_mpi_stats_t *stats,
                                 hd_error_t *err) {
     pct_arg_t arg = {p, out};
     return hd__mpi_call(comm, a, na, b, nb, opt, percentile_body, &arg, stats, err);

@@ -146,9 +146,9 @@ static void check_set(int which, uint64_t seed, size_t n) {
     for (int lay = 0; lay < LAY_COUNT; lay++)
         for (int threads = 1; threads <= 2; threads++) {
             size_t na = layout(lay, s.a, s.na, pa, 64), nb = layout(lay, s.b, s.nb, pb, 64);
-            hd_options_t opt;
-            hd_options_init(&opt);
-            opt.threads = threads;
+            hd_mpi_options_t opt;
+            hd_mpi_options_init(&opt);
+            opt.engine.threads = threads;
             for (size_t k = 0; k < NP; k++) {
                 if ((lay != LAY_BLOCKS || threads != 1) && P[k] != 95 && P[k] != 37.3) continue; /* the time */
                 snprintf(context_, sizeof context_, "%s, %zu + %zu points, seed %llu, %s, %d threads, p %g",
