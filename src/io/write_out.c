@@ -1,7 +1,8 @@
 /*
- * write_out.c -- what every writer of hd_write_field (write*.c) shares:
+ * write_out.c -- what every writer of hd_write_fields (write*.c) shares:
  * appending bytes with the first failure kept, a double in either byte
- * order, the shortest decimal of a double, and which points are written.
+ * order, the shortest decimal of a double, which points are written, the
+ * fields' bytes of a point and a field by its name.
  * A leaf: it calls no other file of src/io.
  */
 #include "io.h"
@@ -44,3 +45,19 @@ size_t hd__w_kept(const hd__writer_t *w) {
     return m;
 }
 
+
+void hd__w_values_le(const hd__writer_t *w, size_t k, unsigned char *b) {
+    for (size_t j = 0; j < w->nf; j++) {
+        uint64_t u;
+        memcpy(&u, &w->f[j].values[k], 8);
+        for (int i = 0; i < 8; i++) b[8 * j + (size_t)i] = (unsigned char)(u >> (8 * i));
+    }
+}
+
+long hd__w_field_named(const hd__writer_t *w, const char *s, size_t n) {
+    for (size_t j = 0; j < w->nf; j++) {
+        const char *name = w->f[j].name;
+        if (n ? strlen(name) == n && memcmp(name, s, n) == 0 : strncmp(name, s, 32) == 0) return (long)j;
+    }
+    return -1;
+}
