@@ -174,10 +174,8 @@ HD__INLINE int hd__w_keep(const hd__writer_t *w, size_t k) {
 size_t hd__w_kept(const hd__writer_t *w);
 /* Append n bytes (nothing once a write has failed: w->werr). */
 void hd__w_put(hd__writer_t *w, const void *p, size_t n);
-/* Append a double in the given byte order. */
-void hd__w_value(hd__writer_t *w, double v, int big);
-/* Point k's nf values, little endian, into b (8 * nf bytes). */
-void hd__w_values_le(const hd__writer_t *w, size_t k, unsigned char *b);
+/* Point k's nf values, in the given byte order, into b (8 * nf bytes). */
+void hd__w_values(const hd__writer_t *w, size_t k, int big, unsigned char *b);
 /* The index of the first field whose name equals the n bytes at s
  * (n = 0: s is NUL-terminated; at most 32 bytes compared), or -1. */
 long hd__w_field_named(const hd__writer_t *w, const char *s, size_t n);

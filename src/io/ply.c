@@ -638,17 +638,22 @@ static int write_binary(hd__writer_t *w, const ply_t *p, int v, int subset) {
     const unsigned char *d = w->in->data;
     size_t pos = p->data, size = w->in->size;
     int big = p->format == 2;
+    unsigned char *vals = malloc(8 * w->nf + 1); /* a vertex's values, appended at once */
+    if (!vals) return hd__err(w->err, HD_ENOMEM, "out of memory");
     for (int k = 0; k < p->n_el; k++) {
         const elem_t *e = &p->el[k];
         size_t from = pos;
         for (uint64_t i = 0; i < e->count; i++) {
             size_t n = instance_size(e, d, pos, size, big);
-            if (n == 0 && (e->has_list || e->fixed))
+            if (n == 0 && (e->has_list || e->fixed)) {
+                free(vals);
                 return hd__err(w->err, HD_EFORMAT, "%s: byte %zu: element %.*s ends early", w->in->name, pos, (int)e->len,
                                e->name);
+            }
             if (k == v && hd__w_keep(w, (size_t)i)) {
                 hd__w_put(w, d + pos, n);
-                for (size_t j = 0; j < w->nf; j++) hd__w_value(w, w->f[j].values[i], big);
+                hd__w_values(w, (size_t)i, big, vals);
+                hd__w_put(w, vals, 8 * w->nf);
                 w->written++;
             }
             pos += n;
@@ -659,6 +664,7 @@ static int write_binary(hd__writer_t *w, const ply_t *p, int v, int subset) {
         }
         if (k != v && !subset) hd__w_put(w, d + from, pos - from);
     }
+    free(vals);
     return HD_OK;
 }
 

@@ -309,7 +309,7 @@ int hd__write_las(hd__writer_t *w) {
         if (!hd__w_keep(w, k)) continue;
         memcpy(buf + used, d + pl.offset + k * pl.rec, pl.rec);
         used += pl.rec;
-        hd__w_values_le(w, k, buf + used);
+        hd__w_values(w, k, 0, buf + used);
         used += 8 * w->nf;
         if (used >= BLOCK) {
             hd__w_put(w, buf, used);

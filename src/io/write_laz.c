@@ -74,7 +74,7 @@ static int encode_bytes(const hd__writer_t *w, size_t first, size_t n, const uns
     memset(changed, 0, nl * sizeof *changed);
     int rc = HD_OK;
     for (size_t b = 0; b < nl; b++) hd__enc_reset(&enc[b]);
-    hd__w_values_le(w, first, item);
+    hd__w_values(w, first, 0, item);
     unsigned cur = chan[0];
     rc = bctx_start(&cx[cur], item, nl);
     for (size_t i = 1; i < n && rc == HD_OK; i++) {
@@ -91,7 +91,7 @@ static int encode_bytes(const hd__writer_t *w, size_t first, size_t n, const uns
             cur = next;
         }
         bctx_t *c = &cx[cur];
-        hd__w_values_le(w, first + i, item);
+        hd__w_values(w, first + i, 0, item);
         for (size_t b = 0; b < nl; b++) {
             unsigned diff = (unsigned)(item[b] - last[b]) & 255;
             hd__enc_symbol(&enc[b], &c->m[b], diff);
@@ -238,7 +238,7 @@ static void write_chunk(lazw_t *z, size_t k) {
     size_t nl = z->nl;
     unsigned char *s = z->scratch; /* 4 * nl bytes */
     hd__w_put(w, b, rec);
-    hd__w_values_le(w, (size_t)z->c.first[k], s);
+    hd__w_values(w, (size_t)z->c.first[k], 0, s);
     hd__w_put(w, s, nl);
     hd__w_put(w, b + rec, head - rec);
     for (size_t i = 0; i < nl; i++)

@@ -385,7 +385,7 @@ static int write_chunks(pw_t *z, const hd__las_header_t *h, const hd__laz_chunks
             if (!hd__w_keep(w, f + i)) continue;
             unsigned char *o = z->out + z->n_out++ * orec;
             memcpy(o, in + i * rec, rec);
-            hd__w_values_le(w, f + i, o + rec);
+            hd__w_values(w, f + i, 0, o + rec);
             z->by_return[hd__las_return(o, z->pl->fmt)]++;
             hd__las_bound(z->bounds, o, z->scale, z->shift, z->kept++ == 0);
             if (per && z->n_out == per) rc = flush_chunk(z);
@@ -429,7 +429,7 @@ static void batch_task(void *ctx, size_t t, int worker) {
     int rc = hd__laz_chunk_records(&r, B->h, B->c, k, B->in[t]);
     for (size_t i = 0; i < n && rc == HD_OK; i++) {
         memcpy(B->out[t] + i * orec, B->in[t] + i * rec, rec);
-        hd__w_values_le(z->w, f + i, B->out[t] + i * orec + rec);
+        hd__w_values(z->w, f + i, 0, B->out[t] + i * orec + rec);
     }
     if (rc == HD_OK && hd__laz_encode_pointwise(B->out[t], n, orec, z->type, z->size, z->n_items, &B->enc[t]))
         rc = hd__err(&B->err[t], HD_ENOMEM, "out of memory");

@@ -1,8 +1,8 @@
 /*
  * write_out.c -- what every writer of hd_write_fields (write*.c) shares:
- * appending bytes with the first failure kept, a double in either byte
- * order, the shortest decimal of a double, which points are written, the
- * fields' bytes of a point and a field by its name.
+ * appending bytes with the first failure kept, the shortest decimal of a
+ * double, which points are written, the fields' bytes of a point in either
+ * byte order and a field by its name.
  * A leaf: it calls no other file of src/io.
  */
 #include "io.h"
@@ -30,14 +30,6 @@ void hd__w_put(hd__writer_t *w, const void *p, size_t n) {
     if (fwrite(p, 1, n, w->out) != n) w->werr = errno ? errno : EIO;
 }
 
-void hd__w_value(hd__writer_t *w, double v, int big) {
-    uint64_t u;
-    memcpy(&u, &v, 8);
-    unsigned char b[8];
-    for (int i = 0; i < 8; i++) b[big ? 7 - i : i] = (unsigned char)(u >> (8 * i));
-    hd__w_put(w, b, 8);
-}
-
 size_t hd__w_kept(const hd__writer_t *w) {
     if (w->keep == HD_KEEP_ALL) return w->n;
     size_t m = 0;
@@ -46,11 +38,12 @@ size_t hd__w_kept(const hd__writer_t *w) {
 }
 
 
-void hd__w_values_le(const hd__writer_t *w, size_t k, unsigned char *b) {
-    for (size_t j = 0; j < w->nf; j++) {
+void hd__w_values(const hd__writer_t *w, size_t k, int big, unsigned char *b) {
+    const hd_field_t *f = w->f;
+    for (size_t j = 0, nf = w->nf; j < nf; j++) {
         uint64_t u;
-        memcpy(&u, &w->f[j].values[k], 8);
-        for (int i = 0; i < 8; i++) b[8 * j + (size_t)i] = (unsigned char)(u >> (8 * i));
+        memcpy(&u, &f[j].values[k], 8);
+        for (int i = 0; i < 8; i++) b[8 * j + (size_t)(big ? 7 - i : i)] = (unsigned char)(u >> (8 * i));
     }
 }
 
