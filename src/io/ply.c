@@ -634,26 +634,50 @@ static void write_header(hd__writer_t *w, const ply_t *p, int v, int subset, siz
     }
 }
 
+/* Bytes gathered into blocks of BLOCK before they are written. */
+enum { BLOCK = 1 << 16 };
+typedef struct {
+    unsigned char *buf; /* BLOCK bytes */
+    size_t used;
+} staged_t;
+
+static void stage(hd__writer_t *w, staged_t *s, const void *p, size_t n) {
+    if (s->used + n > BLOCK) {
+        hd__w_put(w, s->buf, s->used);
+        s->used = 0;
+    }
+    if (n > BLOCK) {
+        hd__w_put(w, p, n);
+        return;
+    }
+    memcpy(s->buf + s->used, p, n);
+    s->used += n;
+}
+
 static int write_binary(hd__writer_t *w, const ply_t *p, int v, int subset) {
     const unsigned char *d = w->in->data;
     size_t pos = p->data, size = w->in->size;
     int big = p->format == 2;
-    unsigned char *vals = malloc(8 * w->nf + 1); /* a vertex's values, appended at once */
-    if (!vals) return hd__err(w->err, HD_ENOMEM, "out of memory");
+    unsigned char *vals = malloc(8 * w->nf + 1); /* a vertex's values */
+    staged_t st = {malloc(BLOCK), 0};
+    if (!vals || !st.buf) {
+        free(vals), free(st.buf);
+        return hd__err(w->err, HD_ENOMEM, "out of memory");
+    }
     for (int k = 0; k < p->n_el; k++) {
         const elem_t *e = &p->el[k];
         size_t from = pos;
         for (uint64_t i = 0; i < e->count; i++) {
             size_t n = instance_size(e, d, pos, size, big);
             if (n == 0 && (e->has_list || e->fixed)) {
-                free(vals);
+                free(vals), free(st.buf);
                 return hd__err(w->err, HD_EFORMAT, "%s: byte %zu: element %.*s ends early", w->in->name, pos, (int)e->len,
                                e->name);
             }
             if (k == v && hd__w_keep(w, (size_t)i)) {
-                hd__w_put(w, d + pos, n);
+                stage(w, &st, d + pos, n);
                 hd__w_values(w, (size_t)i, big, vals);
-                hd__w_put(w, vals, 8 * w->nf);
+                stage(w, &st, vals, 8 * w->nf);
                 w->written++;
             }
             pos += n;
@@ -662,9 +686,13 @@ static int write_binary(hd__writer_t *w, const ply_t *p, int v, int subset) {
                 break;
             }
         }
+        if (k == v) {
+            hd__w_put(w, st.buf, st.used);
+            st.used = 0;
+        }
         if (k != v && !subset) hd__w_put(w, d + from, pos - from);
     }
-    free(vals);
+    free(vals), free(st.buf);
     return HD_OK;
 }
 
