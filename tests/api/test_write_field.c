@@ -232,6 +232,43 @@ TEST(ply_subset_keeps_the_vertices_past_the_threshold_only) {
     free(d);
 }
 
+TEST(ply_binary_vertices_larger_than_a_block_keep_their_bytes) {
+    /* a vertex with a list of 20000 ints (80 KB, more than the writer
+     * gathers before writing) between small ones */
+    tf_buf_t b = {0};
+    tf_putf(&b, "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                "property float z\nproperty list int int ids\nend_header\n");
+    for (int k = 0; k < 3; k++) {
+        for (int c = 0; c < 3; c++) tf_f32(&b, (float)(k + c), 0);
+        uint32_t m = k == 1 ? 20000 : 2;
+        tf_u32(&b, m, 0);
+        for (uint32_t i = 0; i < m; i++) tf_u32(&b, i * 3 + (uint32_t)k, 0);
+    }
+    const char *in = tf_finish(&b, "biglist.ply");
+    size_t nin;
+    unsigned char *src = tf_read(in, &nin);
+    double v[9];
+    values3(v, 3);
+    hd_error_t err;
+    CHECK_RC(write_fields(in, tf_path("biglist_out.ply"), v, 3, 2, HD_KEEP_ALL, 0, NULL, &err), HD_OK);
+    size_t n;
+    unsigned char *d = tf_read(tf_path("biglist_out.ply"), &n);
+    const char *h = d ? strstr((char *)d, "end_header\n") : NULL;
+    const unsigned char *s = src ? (const unsigned char *)strstr((char *)src, "end_header\n") + 11 : NULL;
+    CHECK(h && s && n == (size_t)((const unsigned char *)h + 11 - d) + (nin - (size_t)(s - src)) + 3 * 16);
+    const unsigned char *p = h ? (const unsigned char *)h + 11 : NULL;
+    for (int k = 0; p && s && k < 3; k++) {
+        size_t rec = 16 + 4 * (k == 1 ? 20000 : 2);
+        CHECK(memcmp(p, s, rec) == 0);
+        CHECK_BITS(le_f64(p + rec), v[k]);
+        CHECK_BITS(le_f64(p + rec + 8), v[3 + k]);
+        p += rec + 16;
+        s += rec;
+    }
+    free(d);
+    free(src);
+}
+
 TEST(ply_with_the_property_already_is_refused) {
     const char *in = tf_printf("has.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
                                           "property float z\nproperty float distance\nend_header\n0 0 0 1\n");
