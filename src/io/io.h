@@ -175,7 +175,17 @@ size_t hd__w_kept(const hd__writer_t *w);
 /* Append n bytes (nothing once a write has failed: w->werr). */
 void hd__w_put(hd__writer_t *w, const void *p, size_t n);
 /* Point k's nf values, in the given byte order, into b (8 * nf bytes). */
-void hd__w_values(const hd__writer_t *w, size_t k, int big, unsigned char *b);
+HD__INLINE void hd__w_values(const hd__writer_t *w, size_t k, int big, unsigned char *b) {
+    const hd_field_t *f = w->f;
+    for (size_t j = 0, nf = w->nf; j < nf; j++, b += 8) {
+        uint64_t u;
+        memcpy(&u, &f[j].values[k], 8);
+        if (big)
+            for (int i = 0; i < 8; i++) b[7 - i] = (unsigned char)(u >> (8 * i));
+        else
+            for (int i = 0; i < 8; i++) b[i] = (unsigned char)(u >> (8 * i));
+    }
+}
 /* The index of the first field whose name equals the n bytes at s
  * (n = 0: s is NUL-terminated; at most 32 bytes compared), or -1. */
 long hd__w_field_named(const hd__writer_t *w, const char *s, size_t n);

@@ -38,15 +38,6 @@ size_t hd__w_kept(const hd__writer_t *w) {
 }
 
 
-void hd__w_values(const hd__writer_t *w, size_t k, int big, unsigned char *b) {
-    const hd_field_t *f = w->f;
-    for (size_t j = 0, nf = w->nf; j < nf; j++) {
-        uint64_t u;
-        memcpy(&u, &f[j].values[k], 8);
-        for (int i = 0; i < 8; i++) b[8 * j + (size_t)(big ? 7 - i : i)] = (unsigned char)(u >> (8 * i));
-    }
-}
-
 long hd__w_field_named(const hd__writer_t *w, const char *s, size_t n) {
     for (size_t j = 0; j < w->nf; j++) {
         const char *name = w->f[j].name;
