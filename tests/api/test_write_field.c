@@ -700,6 +700,8 @@ TEST(fields_without_a_name_or_with_one_twice_are_refused) {
     hd_field_t none[1] = {{"distance", NULL}};
     CHECK_RC(hd_write_fields(in, out, none, 1, 2, &o, NULL, &err), HD_EINVAL);
     CHECK_RC(hd_write_fields(in, out, twice, 0, 2, &o, NULL, &err), HD_EINVAL);
+    CHECK_RC(hd_write_fields(in, out, twice, 8192, 2, &o, NULL, &err), HD_EINVAL); /* checked before any is read */
+    CHECK(strstr(err.message, "8192 fields, at most 8191"));
     CHECK_RC(hd_write_fields(in, out, NULL, 1, 2, &o, NULL, &err), HD_EINVAL);
     hd_field_t had[2] = {{"distance", v}, {"nearest", v}}; /* the second is a property of the file */
     CHECK_RC(hd_write_fields(in, out, had, 2, 2, &o, NULL, &err), HD_EINVAL);
