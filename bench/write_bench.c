@@ -1,8 +1,10 @@
 /*
  * write_bench.c -- hd_write_field's speed: a per-point double written back
- * into a LAS and a LAZ file of POINTS points, against copying the file.
+ * into a LAS and a LAZ file of POINTS points, against copying the file;
+ * with -f FIELDS, hd_write_fields writing FIELDS doubles a point (2:
+ * distance, nearest; 3: and sign) in one pass.
  *
- *   write_bench [-n POINTS] [-r RUNS] [-d DIR] [-k]
+ *   write_bench [-n POINTS] [-r RUNS] [-d DIR] [-f FIELDS] [-k]
  *
  * It writes POINTS points (1 000 000 by default: seeded random walks of the
  * tests' LAZ writer, tests/internal/lazwrite.c) as LAS 1.4 point format 6
@@ -73,7 +75,11 @@ static off_t size_of(const char *path) {
     return stat(path, &st) == 0 ? st.st_size : -1;
 }
 
-static void row(const char *name, const char *in, const char *dir, const double *v, size_t n, int runs) {
+static const char *const field_names[3] = {"distance", "nearest", "sign"};
+
+static void row(const char *name, const char *in, const char *dir, const double *v, size_t n, size_t nf, int runs) {
+    hd_field_t f[3];
+    for (size_t j = 0; j < nf; j++) f[j].name = field_names[j], f[j].values = v + j * n;
     char out[4096], copy[4096], cmd[9000];
     const char *ext = strrchr(in, '.');
     snprintf(out, sizeof out, "%s/write_bench_out_%s%s", dir, name, ext);
@@ -87,7 +93,9 @@ static void row(const char *name, const char *in, const char *dir, const double 
         double c0 = bench_cpu_now();
         t0 = bench_now();
         hd_error_t err;
-        if (hd_write_field(in, out, v, n, NULL, NULL, &err) != HD_OK) {
+        int rc = nf == 1 ? hd_write_field(in, out, v, n, NULL, NULL, &err)
+                         : hd_write_fields(in, out, f, nf, n, NULL, NULL, &err);
+        if (rc != HD_OK) {
             fprintf(stderr, "write_bench: %s\n", err.message);
             exit(1);
         }
@@ -107,6 +115,7 @@ int main(int argc, char **argv) {
     int runs = 5;
     const char *dir = "/tmp";
     int keep = 0;
+    size_t nf = 1;
     for (int i = 1; i < argc; i += 2) {
         if (strcmp(argv[i], "-k") == 0) {
             keep = 1;
@@ -117,13 +126,19 @@ int main(int argc, char **argv) {
         if (strcmp(argv[i], "-n") == 0) n = (size_t)atof(argv[i + 1]);
         else if (strcmp(argv[i], "-r") == 0) runs = atoi(argv[i + 1]);
         else if (strcmp(argv[i], "-d") == 0) dir = argv[i + 1];
+        else if (strcmp(argv[i], "-f") == 0) nf = (size_t)atoi(argv[i + 1]);
+    }
+    if (nf < 1 || nf > 3) {
+        fprintf(stderr, "write_bench: -f takes 1, 2 or 3 fields\n");
+        return 2;
     }
     gen_rng_t g;
     gen_seed(&g, 20261202);
     lazw_point_t *p = malloc(n * sizeof *p);
-    double *v = malloc(n * sizeof *v);
+    double *v = malloc(3 * n * sizeof *v);
     lazw_random(&g, p, n, 6);
     for (size_t k = 0; k < n; k++) v[k] = gen_unit(&g) * 0.05;
+    for (size_t k = 0; k < n; k++) v[n + k] = (double)(k * 7919 % n), v[2 * n + k] = k % 3 ? 1.0 : -1.0;
     char las[4096], laz[4096], laz3[4096];
     snprintf(laz3, sizeof laz3, "%s/write_bench_in3.laz", dir);
     snprintf(las, sizeof las, "%s/write_bench_in.las", dir);
@@ -143,9 +158,9 @@ int main(int argc, char **argv) {
     tf_free(&b);
     free(recs);
     printf("| format | input | output | copy (cp + sync) | hd_write_field | its CPU | Mpoints/s |\n|---|---|---|---|---|---|---|\n");
-    row("las", las, dir, v, n, runs);
-    row("laz", laz, dir, v, n, runs);
-    row("laz3", laz3, dir, v, n, runs);
+    row("las", las, dir, v, n, nf, runs);
+    row("laz", laz, dir, v, n, nf, runs);
+    row("laz3", laz3, dir, v, n, nf, runs);
     if (!keep) {
         remove(las);
         remove(laz);

@@ -1,6 +1,6 @@
 /*
  * writeback.c -- per-point distances written into the inputs' own files
- * (hd_write_field): --distances OUT when OUT names the side's format
+ * (hd_write_fields): --distances OUT when OUT names the side's format
  * (.las, .laz, .ply, text: a `distance` field added to every point,
  * everything else kept), and --farther-than D OUT / --nearer-than D OUT
  * (the points whose distance is > D / <= D, in their file's format, the
@@ -17,10 +17,9 @@
  * (`nearest`, -1 with an empty other side; `face` with --surface), and
  * `sign` with --signed.  Other formats get `distance` (and `sign`) only.
  *
- * More than one field is written by chaining hd_write_field: each call
- * reads the previous one's file and adds one field, the last into the
- * output's temporary; the intermediate files are removed whatever happens.
- * A FIFO or device as OUT (hd_write_field renames its result into place)
+ * Every field of a file is written by one hd_write_fields call, in one pass
+ * over the input, into the output's temporary.
+ * A FIFO or device as OUT (hd_write_fields renames its result into place)
  * gets the bytes of the finished file, made under $TMPDIR and removed.
  */
 #include "cli.h"
@@ -156,9 +155,7 @@ int analysis_check_outputs(const analysis_args_t *an, const char *path_a, const 
 
 enum { MAX_FIELDS = 3 };
 typedef struct {
-    const char *name[MAX_FIELDS];
-    const double *v[MAX_FIELDS]; /* v[0]: the distances, every point; the others the kept points' */
-    size_t n[MAX_FIELDS];
+    hd_field_t f[MAX_FIELDS]; /* f[0]: the distances, which select the points */
     double *owned[MAX_FIELDS];
     int count;
 } fields_t;
@@ -167,37 +164,27 @@ static void fields_free(fields_t *f) {
     for (int i = 0; i < f->count; i++) free(f->owned[i]);
 }
 
-/* Whether point k is kept by o (the library's rule: a NaN is never). */
-static int kept(const hd_write_options_t *o, double d) {
-    return o->keep == HD_KEEP_ALL || (o->keep == HD_KEEP_FARTHER ? d > o->threshold : d <= o->threshold);
-}
-
-/* One more field of the kept points: index (as double, -1 for none) or sign. */
-static int add_field(fields_t *f, const char *name, const writeback_side_t *s, const hd_write_options_t *o,
-                     int is_sign, hd_error_t *err) {
+/* One more field of every point: index (as double, -1 for none) or sign. */
+static int add_field(fields_t *f, const char *name, const writeback_side_t *s, int is_sign, hd_error_t *err) {
     double *v = malloc((s->n ? s->n : 1) * sizeof *v);
     if (!v) {
         snprintf(err->message, sizeof err->message, "out of memory for %zu values of '%s'", s->n, name);
         return err->code = HD_ENOMEM;
     }
-    size_t m = 0;
-    for (size_t k = 0; k < s->n; k++)
-        if (kept(o, s->d[k]))
-            v[m++] = is_sign ? (double)s->sign[k] : s->index ? (double)s->index[k] : -1.0;
-    f->name[f->count] = name, f->v[f->count] = v, f->n[f->count] = m, f->owned[f->count++] = v;
+    for (size_t k = 0; k < s->n; k++) v[k] = is_sign ? (double)s->sign[k] : s->index ? (double)s->index[k] : -1.0;
+    f->f[f->count].name = name, f->f[f->count].values = v, f->owned[f->count++] = v;
     return HD_OK;
 }
 
 /* The fields of kind k's file for side s: distance; in a PLY written by
  * --distances the table's index column; with --signed the sign. */
-static int side_fields(int k, const char *out, const writeback_side_t *s, int surface, const hd_write_options_t *o,
-                       fields_t *f, hd_error_t *err) {
+static int side_fields(int k, const char *out, const writeback_side_t *s, int surface, fields_t *f, hd_error_t *err) {
     memset(f, 0, sizeof *f);
-    f->name[0] = "distance", f->v[0] = s->d, f->n[0] = s->n, f->count = 1;
+    f->f[0].name = "distance", f->f[0].values = s->d, f->count = 1;
     const char *fmt = hd_format_of_path(out);
     int rc = HD_OK;
-    if (k == 0 && fmt && strcmp(fmt, "ply") == 0) rc = add_field(f, surface ? "face" : "nearest", s, o, 0, err);
-    if (rc == HD_OK && s->sign) rc = add_field(f, "sign", s, o, 1, err);
+    if (k == 0 && fmt && strcmp(fmt, "ply") == 0) rc = add_field(f, surface ? "face" : "nearest", s, 0, err);
+    if (rc == HD_OK && s->sign) rc = add_field(f, "sign", s, 1, err);
     return rc;
 }
 
@@ -231,9 +218,7 @@ static char *stage(const char *out, hd_error_t *err) {
 static int as_output(int rc, const char *name, const char *out, hd_error_t *err) {
     if (rc == HD_EIO && strncmp(err->message, name, strlen(name)) == 0) {
         char reason[200];
-        const char *r = err->message + strlen(name);
-        while (*r && *r != ':') r++; /* past an intermediate's suffix */
-        snprintf(reason, sizeof reason, "%s", r);
+        snprintf(reason, sizeof reason, "%s", err->message + strlen(name));
         snprintf(err->message, sizeof err->message, "%.800s%s", out, reason);
         rc = err->code = OUT_EFAIL;
     }
@@ -278,36 +263,16 @@ static int copy_into(const char *from, const char *out, hd_error_t *err) {
     return out_close(f, werr, err);
 }
 
-/* The fields into out: field i from file i (the input, then the
- * intermediates name.1, name.2 beside the last) into file i + 1, the
- * subset taken by the first call.  The last is out's temporary from
- * output.c; for a FIFO or device, a scratch file whose bytes are then
- * copied into it. */
-static int write_chain(const char *in, const char *out, const fields_t *f, const hd_write_options_t *first,
-                       size_t *written, hd_error_t *err) {
+/* The fields into out in one hd_write_fields call, written to out's
+ * temporary from output.c; for a FIFO or device, to a scratch file whose
+ * bytes are then copied into it. */
+static int write_out(const char *in, const char *out, const fields_t *f, const hd_write_options_t *o, size_t n,
+                     size_t *written, hd_error_t *err) {
     int special = is_special(out);
     char *name = special ? scratch(out, err) : stage(out, err);
     if (!name) return err->code;
-    size_t len = strlen(name) + 8;
-    char *file[MAX_FIELDS + 1] = {(char *)in};
-    int rc = HD_OK;
-    for (int i = 1; i < f->count && rc == HD_OK; i++)
-        if (!(file[i] = malloc(len)) || snprintf(file[i], len, "%s.%d", name, i) < 0)
-            rc = err->code = HD_ENOMEM, snprintf(err->message, sizeof err->message, "out of memory");
-    file[f->count] = name;
-    hd_read_options_t ro = *first->read;
-    ro.format = first->format;
-    for (int i = 0; i < f->count && rc == HD_OK; i++) {
-        hd_write_options_t o = *first;
-        o.name = f->name[i];
-        if (i > 0) o.keep = HD_KEEP_ALL, o.read = &ro;
-        rc = hd_write_field(file[i], file[i + 1], f->v[i], f->n[i], &o, i ? NULL : written, err);
-    }
+    int rc = hd_write_fields(in, name, f->f, (size_t)f->count, n, o, written, err);
     rc = as_output(rc, name, out, err);
-    for (int i = 1; i < f->count; i++) {
-        if (file[i]) unlink(file[i]);
-        free(file[i]);
-    }
     if (special) {
         if (rc == HD_OK) rc = copy_into(name, out, err);
         unlink(name);
@@ -337,8 +302,8 @@ int analysis_write_back(const analysis_args_t *an, const char *path_a, const cha
                 o.threshold = an->subset[k - 1].d;
             }
             fields_t f;
-            int rc = side_fields(k, out, &side[w], surface, &o, &f, err);
-            if (rc == HD_OK) rc = write_chain(path[w], out, &f, &o, &r->wb_points[k][w], err);
+            int rc = side_fields(k, out, &side[w], surface, &f, err);
+            if (rc == HD_OK) rc = write_out(path[w], out, &f, &o, side[w].n, &r->wb_points[k][w], err);
             fields_free(&f);
             if (rc) return rc;
             r->wb_sides[k] |= 1 << w;

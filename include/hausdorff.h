@@ -1073,6 +1073,30 @@ HD_EXTERN int hd_write_field(const char *in_path, const char *out_path,
                              const hd_write_options_t *opt, size_t *written,
                              hd_error_t *err);
 
+/* One field of hd_write_fields: its name (as opt->name of hd_write_field,
+ * but not "") and its n values, point k's being values[k]; both borrowed
+ * for the call. */
+typedef struct hd_field {
+    const char *name;
+    const double *values;
+} hd_field_t;
+
+/* hd_write_field with n_fields fields at once, in one pass over the file:
+ * point k gets fields[0].values[k], ..., fields[n_fields - 1].values[k],
+ * in that order (PLY properties, LAS extra-bytes descriptors and bytes,
+ * LAZ BYTE14 layers or BYTE item bytes, text columns); opt->keep and
+ * opt->threshold select on fields[0]'s values; opt->name is not used.
+ * hd_write_field is this call with one field (its "" name: none).
+ * Errors: those of hd_write_field, and HD_EINVAL for n_fields 0 or more
+ *   than 8191 (65535 bytes, LAS's longest record), a NULL fields or
+ *   values, an empty or bad name, two fields of one name; a record or an
+ *   extra-bytes VLR with no room for them is HD_EUNSUPPORTED.
+ * Thread safe (nothing is shared between calls). */
+HD_EXTERN int hd_write_fields(const char *in_path, const char *out_path,
+                              const hd_field_t *fields, size_t n_fields,
+                              size_t n, const hd_write_options_t *opt,
+                              size_t *written, hd_error_t *err);
+
 /* ------------------------------------------------------------------------
  * Surfaces: the distance from every point of a cloud to a triangle mesh.
  *

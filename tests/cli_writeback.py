@@ -334,9 +334,9 @@ def an_unwritable_file_is_exit_3_and_leaves_nothing(tmp):
     rc, out, err = run("--directed", "--distances", tmp + "/w.ply", tmp + "/x.ply", B)
     assert rc == 2, (rc, err)  # A missing: its read fails before anything is written
     assert os.listdir(tmp) == [], os.listdir(tmp)
-    # a file size limit between the file with `distance` (30,172 bytes,
-    # the intermediate) and the one with `nearest` too: exit 3, and neither
-    # the intermediate nor a temporary left
+    # a file size limit above the size of the file with `distance` alone
+    # (30,172 bytes) and below the one with `nearest` too: exit 3, and no
+    # temporary left
     limit = lambda: resource.setrlimit(resource.RLIMIT_FSIZE, (31000, 31000))
     p = subprocess.run([TOOL, "--directed", "--distances", tmp + "/w.ply", A, B], capture_output=True, text=True,
                        timeout=300, preexec_fn=limit)

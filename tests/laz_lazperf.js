@@ -1,19 +1,21 @@
 // laz_lazperf.js -- decode a LAZ file with laz-perf (the npm package: LASzip's
 // format compiled to WebAssembly, an implementation independent of ours) and
 // print its points' integer coordinates, one "X Y Z" line per point in file
-// order, after a first line "count N"; with `field`, each line also gets
-// the record's last eight bytes as a little-endian 64-bit integer in
-// hexadecimal (the value hd_write_field added); with `record`, each line is
-// the whole record in hexadecimal, byte by byte, instead.
+// order, after a first line "count N"; with `field [F]`, each line also
+// gets the record's last 8 * F bytes (F = 1 when not given) as F
+// little-endian 64-bit integers in hexadecimal (the values hd_write_fields
+// added, in order); with `record`, each line is the whole record in
+// hexadecimal, byte by byte, instead.
 //
-//   node laz_lazperf.js NODE_MODULES_DIR FILE.laz [field | record]
+//   node laz_lazperf.js NODE_MODULES_DIR FILE.laz [field [F] | record]
 //
 // tests/laz_lazperf.py runs it on the files the tests' LAZ writer makes and
 // compares with the points the writer was given.
 'use strict';
 const fs = require('fs');
 const path = require('path');
-const [modules, file, field] = process.argv.slice(2);
+const [modules, file, field, nfields] = process.argv.slice(2);
+const nf = nfields ? parseInt(nfields, 10) : 1;
 const { createLazPerf } = require(path.resolve(modules, 'laz-perf'));
 
 (async () => {
@@ -35,9 +37,12 @@ const { createLazPerf } = require(path.resolve(modules, 'laz-perf'));
       for (let b = 0; b < len; b++) line += v.getUint8(b).toString(16).padStart(2, '0');
     }
     if (field === 'field') {
-      let hex = '';
-      for (let b = len - 1; b >= len - 8; b--) hex += v.getUint8(b).toString(16).padStart(2, '0');
-      line += ' ' + hex;
+      for (let j = 0; j < nf; j++) {
+        const end = len - 8 * (nf - j);
+        let hex = '';
+        for (let b = end + 7; b >= end; b--) hex += v.getUint8(b).toString(16).padStart(2, '0');
+        line += ' ' + hex;
+      }
     }
     out.push(line);
   }

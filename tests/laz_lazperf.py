@@ -8,9 +8,9 @@ The reader's own tests (test_io_laz) read the files of the tests' LAZ writer
 (tests/internal/lazwrite.c): a model or context mistake shared by writer and
 reader would pass them.  laz-perf (the npm package: LASzip's format compiled
 to WebAssembly, pinned to one version) decodes the writer's files
-independently.  The cases named field_* are hd_write_field's LAZ output
+independently.  The cases named field_* are hd_write_fields's LAZ output
 (the library's LAZ writer; their lines "X Y Z HEX" carry the value added to
-each point, decoded by laz-perf too); record_* are its pointwise LAZ output
+each point, decoded by laz-perf too; fieldsN_* "X Y Z HEX..." N values); record_* are its pointwise LAZ output
 on files whose every field varies, compared record by record in hexadecimal).  FIXTURES (tests/laz_lazperf/) holds
 the files LAZGEN wrote
 when laz-perf last decoded them, and laz-perf's decoding of each in
@@ -32,6 +32,7 @@ npm      (the extra, where node, npm and the npm registry are reachable):
 """
 import hashlib
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -138,7 +139,9 @@ def lazperf_decode(node, modules, path):
     """laz-perf's points of PATH as "X Y Z" lines, or None after saying why."""
     here = os.path.dirname(os.path.abspath(__file__))
     base = os.path.basename(path)
-    field = ["field"] if base.startswith("field_") else ["record"] if base.startswith("record_") else []
+    fields = re.match(r"fields(\d+)_", base)
+    field = (["field", fields.group(1)] if fields else ["field"] if base.startswith("field_")
+             else ["record"] if base.startswith("record_") else [])
     r = subprocess.run([node, os.path.join(here, "laz_lazperf.js"), modules, path] + field, capture_output=True, text=True)
     if r.returncode != 0:
         print("%s: laz-perf failed: %s" % (path, r.stderr.strip()[-500:]))
@@ -187,7 +190,7 @@ def npm(lazgen, fixtures, work, update):
         with open(os.path.join(fixtures, DIGESTS), "w") as f:
             f.write("# %s's decoding of each file here, written by `tests/laz_lazperf.py npm ... --update`\n"
                     "# once it decoded every one exactly as the writer was given it (tests/laz_lazperf.py).\n"
-                    "# NAME  POINTS  SHA-256 of its \"X Y Z\" lines (integer coordinates, file order; field_*: \"X Y Z HEX\"; record_*: the whole record in hexadecimal)\n" % LAZPERF)
+                    "# NAME  POINTS  SHA-256 of its \"X Y Z\" lines (integer coordinates, file order; field_*: \"X Y Z HEX\", fieldsN_*: N HEX; record_*: the whole record in hexadecimal)\n" % LAZPERF)
             for name in sorted(digests):
                 f.write("%s %d %s\n" % (name, digests[name][0], digests[name][1]))
         print("laz_lazperf: %d fixtures written into %s" % (len(names), fixtures))

@@ -12,19 +12,20 @@
  *
  * writes the fuzz target's seed files (tests/corpus/laz/, committed).
  *
- * The cases named field_* are the output of hd_write_field (the library's
+ * The cases named field_* are the output of hd_write_fields (the library's
  * LAZ writer) on a file of the tests' writer whose points all lie in
  * scanner channel 0, with seeded values: their NAME.txt lines are
  * "X Y Z HEX", HEX the value's eight bytes as a little-endian 64-bit
- * integer in hexadecimal.  (laz-perf 0.0.7 hands its BYTE14 decoder
+ * integer in hexadecimal; fieldsN_* have N fields (distance, nearest,
+ * sign), N HEX on each line.  (laz-perf 0.0.7 hands its BYTE14 decoder
  * channel 0 unless the channel changes at that very point, where LASzip
  * hands the point's channel: on files with other channels it decodes
  * extra bytes wrongly, so they are checked by test_write_laz alone.)
- * The cases named record_* are hd_write_field's output on pointwise LAZ
+ * The cases named record_* are hd_write_fields's output on pointwise LAZ
  * whose every field varies (tests/internal/lazwrite.c's lazw_pointwise),
- * all points or those whose value is > 0.25: their NAME.txt lines are each
- * written record in hexadecimal, byte by byte, the value's eight bytes
- * last.
+ * all points or those whose first value is > 0.25: their NAME.txt lines
+ * are each written record in hexadecimal, byte by byte, the values' eight
+ * bytes each last (_fieldsN: N of them).
  */
 #include "files.h"
 #include "gen.h"
@@ -70,11 +71,22 @@ static void write_case(const char *dir, const char *name, const lazw_opts_t *o, 
     free(p);
 }
 
-/* The input b saved as DIR/NAME-input.laz, hd_write_field of the n values
- * v into DIR/NAME.laz (o: NULL for the defaults), the input removed, and
- * DIR/NAME.txt opened for the expected lines. */
+/* The names of the fields of a case: distance, nearest, sign. */
+static const char *const field_names[3] = {"distance", "nearest", "sign"};
+
+/* Fields 2 and 3 of a case (field j's n values at v + j * n): an index, a
+ * sign. */
+static void more_fields(double *v, size_t n, size_t nf) {
+    for (size_t j = 1; j < nf; j++)
+        for (size_t k = 0; k < n; k++) v[j * n + k] = j == 1 ? (double)(k * 7 % 1000) : k % 3 ? 1.0 : -1.0;
+}
+
+/* The input b saved as DIR/NAME-input.laz, hd_write_fields of the nf
+ * fields of n values v (field j's at v + j * n) into DIR/NAME.laz (o: NULL
+ * for the defaults), the input removed, and DIR/NAME.txt opened for the
+ * expected lines. */
 static FILE *write_field_of(const char *dir, const char *name, const tf_buf_t *b, const double *v, size_t n,
-                            const hd_write_options_t *o) {
+                            size_t nf, const hd_write_options_t *o) {
     char in[4096], out[4096];
     snprintf(in, sizeof in, "%s/%s-input.laz", dir, name);
     snprintf(out, sizeof out, "%s/%s.laz", dir, name);
@@ -84,7 +96,9 @@ static FILE *write_field_of(const char *dir, const char *name, const tf_buf_t *b
         exit(1);
     }
     hd_error_t err;
-    if (hd_write_field(in, out, v, n, o, NULL, &err) != HD_OK) {
+    hd_field_t fields[3];
+    for (size_t j = 0; j < nf; j++) fields[j].name = field_names[j], fields[j].values = v + j * n;
+    if (hd_write_fields(in, out, fields, nf, n, o, NULL, &err) != HD_OK) {
         fprintf(stderr, "lazgen: %s\n", err.message);
         exit(1);
     }
@@ -95,24 +109,29 @@ static FILE *write_field_of(const char *dir, const char *name, const tf_buf_t *b
 }
 
 /* The field case NAME: see the top of the file. */
-static void field_case(const char *dir, const char *name, const lazw_opts_t *o, uint64_t seed, size_t n) {
+static void field_case(const char *dir, const char *name, const lazw_opts_t *o, uint64_t seed, size_t n, size_t nf) {
     gen_rng_t g;
     gen_seed(&g, seed);
     lazw_point_t *p = malloc(n * sizeof *p);
-    double *v = malloc(n * sizeof *v);
+    double *v = malloc(nf * n * sizeof *v);
     if (!p || !v) exit(1);
     lazw_random(&g, p, n, o->format);
     for (size_t k = 0; k < n; k++) {
         p[k].channel = 0;
         v[k] = k % 3 == 0 ? gen_unit(&g) * 100 : k % 3 == 1 ? v[k - 1] : gen_normal(&g);
     }
+    more_fields(v, n, nf);
     tf_buf_t b = {0};
     lazw_encode(&b, o, p, n);
-    FILE *f = write_field_of(dir, name, &b, v, n, NULL);
+    FILE *f = write_field_of(dir, name, &b, v, n, nf, NULL);
     for (size_t k = 0; k < n; k++) {
-        uint64_t u;
-        memcpy(&u, &v[k], 8);
-        fprintf(f, "%d %d %d %016llx\n", (int)p[k].x, (int)p[k].y, (int)p[k].z, (unsigned long long)u);
+        fprintf(f, "%d %d %d", (int)p[k].x, (int)p[k].y, (int)p[k].z);
+        for (size_t j = 0; j < nf; j++) {
+            uint64_t u;
+            memcpy(&u, &v[j * n + k], 8);
+            fprintf(f, " %016llx", (unsigned long long)u);
+        }
+        fputc('\n', f);
     }
     if (fclose(f)) exit(1);
     printf("%s\n", name);
@@ -122,27 +141,31 @@ static void field_case(const char *dir, const char *name, const lazw_opts_t *o, 
 }
 
 /* The record case NAME: see the top of the file. */
-static void record_case(const char *dir, const char *name, int fmt, unsigned extra, int subset, uint64_t seed, size_t n) {
+static void record_case(const char *dir, const char *name, int fmt, unsigned extra, int subset, uint64_t seed, size_t n,
+                        size_t nf) {
     gen_rng_t g;
     gen_seed(&g, seed);
     size_t rec;
     unsigned char *recs = lazw_rich_records(&g, fmt, extra, n, &rec);
-    double *v = malloc(n * sizeof *v);
+    double *v = malloc(nf * n * sizeof *v);
     if (!recs || !v) exit(1);
     for (size_t k = 0; k < n; k++) v[k] = k % 4 ? gen_normal(&g) : 0.5;
+    more_fields(v, n, nf);
     tf_buf_t b = {0};
     lazw_pointwise(&b, fmt, extra, recs, rec, n, 1000);
     hd_write_options_t o;
     hd_write_options_init(&o);
     o.keep = subset ? HD_KEEP_FARTHER : HD_KEEP_ALL;
     o.threshold = 0.25;
-    FILE *f = write_field_of(dir, name, &b, v, n, &o);
+    FILE *f = write_field_of(dir, name, &b, v, n, nf, &o);
     for (size_t k = 0; k < n; k++) {
         if (subset && !(v[k] > 0.25)) continue;
-        unsigned char val[8];
-        memcpy(val, &v[k], 8);
         for (size_t i = 0; i < rec; i++) fprintf(f, "%02x", recs[k * rec + i]);
-        for (int i = 0; i < 8; i++) fprintf(f, "%02x", val[i]);
+        for (size_t j = 0; j < nf; j++) {
+            unsigned char val[8];
+            memcpy(val, &v[j * n + k], 8);
+            for (int i = 0; i < 8; i++) fprintf(f, "%02x", val[i]);
+        }
         fputc('\n', f);
     }
     if (fclose(f)) exit(1);
@@ -272,12 +295,16 @@ int main(int argc, char **argv) {
     v.format = 1;
     write_case(argv[1], "format1_variable_chunks", &v, 301, 4000, 1);
     lazw_opts_t w = {6, 0, 1000, NULL, 0, {0.001, 0.001, 0.001}, {0, 0, 0}, 0};
-    field_case(argv[1], "field_format6_extra0", &w, 400, 2500);
+    field_case(argv[1], "field_format6_extra0", &w, 400, 2500, 1);
+    field_case(argv[1], "fields2_format6_extra0", &w, 410, 2500, 2);
     w.extra = 3, w.chunk_size = 0, w.chunks = sizes, w.n_chunks = 5;
-    field_case(argv[1], "field_format6_extra3_variable_chunks", &w, 401, 4000);
-    record_case(argv[1], "record_format1_extra0", 1, 0, 0, 500, 2500);
-    record_case(argv[1], "record_format2_extra3", 2, 3, 0, 501, 2500);
-    record_case(argv[1], "record_format3_extra1_subset", 3, 1, 1, 502, 3001);
-    record_case(argv[1], "record_format0_extra0_subset", 0, 0, 1, 503, 2500);
+    field_case(argv[1], "field_format6_extra3_variable_chunks", &w, 401, 4000, 1);
+    field_case(argv[1], "fields3_format6_extra3_variable_chunks", &w, 411, 4000, 3);
+    record_case(argv[1], "record_format1_extra0", 1, 0, 0, 500, 2500, 1);
+    record_case(argv[1], "record_format2_extra3", 2, 3, 0, 501, 2500, 1);
+    record_case(argv[1], "record_format3_extra1_subset", 3, 1, 1, 502, 3001, 1);
+    record_case(argv[1], "record_format0_extra0_subset", 0, 0, 1, 503, 2500, 1);
+    record_case(argv[1], "record_format1_extra0_fields3", 1, 0, 0, 510, 2500, 3);
+    record_case(argv[1], "record_format3_extra1_fields2_subset", 3, 1, 1, 511, 3001, 2);
     return 0;
 }

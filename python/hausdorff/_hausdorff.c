@@ -1442,22 +1442,27 @@ static PyObject *py_read(PyObject *self, PyObject *args, PyObject *kw) {
 }
 
 PyDoc_STRVAR(write_field_doc,
-"write_field($module, in_path, out_path, values, *, name='distance',\n"
+"write_field($module, in_path, out_path, values, *, name=None,\n"
 "            farther_than=None, nearer_than=None, format=None,\n"
 "            decimal_comma=False)\n--\n\n"
 "Write out_path: the points of in_path in its own format (PLY ascii or\n"
 "binary, LAS, LAZ, xyz/csv/pts text; OBJ subsets) with\n"
-"values[k] added to point k as the field `name` (a PLY vertex property, a\n"
+"values[k] added to point k as the field `name` ('distance' when not\n"
+"given: a PLY vertex property, a\n"
 "LAS/LAZ extra-bytes dimension, a text column); every other property,\n"
 "element, record and line of the input is kept.  values: one float per\n"
-"point, as read(in_path) numbers them.  With farther_than=D only the\n"
-"points whose value is > D are written, with nearer_than=D those <= D\n"
-"(in the input's format, the field included); name='' writes no field.\n"
+"point, as read(in_path) numbers them; or a dict {name: values} for\n"
+"several fields written in one pass, in the dict's order (then `name` is\n"
+"not given).  With farther_than=D only the\n"
+"points whose value (the first field's) is > D are written, with\n"
+"nearer_than=D those <= D\n"
+"(in the input's format, the fields included); name='' writes no field.\n"
 "out_path's extension must name the input's format.  Returns the number\n"
 "of points written.  The file appears whole or not at all.  Raises\n"
 "ValueError (bad arguments, a name the input already has, a format that\n"
 "cannot hold the field) and OSError (out_path cannot be written).\n"
-"The library's hd_write_field; formats: docs/formats.md.\n\n"
+"The library's hd_write_field and hd_write_fields; formats:\n"
+"docs/formats.md.\n\n"
 ">>> import os, tempfile, hausdorff\n"
 ">>> d = tempfile.mkdtemp()\n"
 ">>> src = os.path.join(d, 'a.xyz')\n"
@@ -1465,14 +1470,65 @@ PyDoc_STRVAR(write_field_doc,
 ">>> hausdorff.write_field(src, os.path.join(d, 'far.xyz'), [0.5, 2.0], farther_than=1.0)\n"
 "1\n"
 ">>> print(open(os.path.join(d, 'far.xyz')).read(), end='')\n"
-"1 0 0 2\n");
+"1 0 0 2\n"
+">>> hausdorff.write_field(src, os.path.join(d, 'two.xyz'), {'distance': [0.5, 2.0], 'nearest': [1, 0]})\n"
+"2\n"
+">>> print(open(os.path.join(d, 'two.xyz')).read(), end='')\n"
+"0 0 0 0.5 1\n"
+"1 0 0 2 0\n");
+
+/* values as a one-dimensional array of doubles (a new reference), or NULL
+ * with the exception set. */
+static PyArrayObject *field_values(PyObject *values, const char *name) {
+    PyArrayObject *v = (PyArrayObject *)PyArray_FROM_OTF(values, NPY_DOUBLE, NPY_ARRAY_IN_ARRAY);
+    if (v && PyArray_NDIM(v) != 1) {
+        PyErr_Format(PyExc_ValueError, "write_field: the values of '%s' must be one-dimensional (one per point), not "
+                                       "of shape with %d dimensions",
+                     name, PyArray_NDIM(v));
+        Py_DECREF(v);
+        return NULL;
+    }
+    return v;
+}
+
+/* The fields of values (a dict: its items in order; else one array named
+ * name) into f[], their arrays (new references) into arr[]; their count,
+ * or -1 with the exception set (the arrays made so far in arr[]). */
+static Py_ssize_t write_fields_of(PyObject *values, const char *name, hd_field_t *f, PyArrayObject **arr,
+                                  Py_ssize_t cap, size_t *n) {
+    if (!PyDict_Check(values)) {
+        if (!(arr[0] = field_values(values, name))) return -1;
+        f[0].name = name, f[0].values = (const double *)PyArray_DATA(arr[0]);
+        *n = (size_t)PyArray_DIM(arr[0], 0);
+        return 1;
+    }
+    PyObject *key, *val;
+    Py_ssize_t pos = 0, k = 0;
+    while (k < cap && PyDict_Next(values, &pos, &key, &val)) {
+        const char *kname = PyUnicode_Check(key) ? PyUnicode_AsUTF8(key) : NULL;
+        if (!kname) {
+            if (!PyErr_Occurred()) PyErr_SetString(PyExc_TypeError, "write_field: the fields' names must be str");
+            return -1;
+        }
+        if (!(arr[k] = field_values(val, kname))) return -1;
+        f[k].name = kname, f[k].values = (const double *)PyArray_DATA(arr[k]);
+        size_t m = (size_t)PyArray_DIM(arr[k], 0);
+        if (k && m != *n) {
+            PyErr_Format(PyExc_ValueError, "write_field: '%s' has %zu values, '%s' %zu", kname, m, f[0].name, *n);
+            return -1;
+        }
+        *n = m;
+        k++;
+    }
+    return k;
+}
 
 static PyObject *py_write_field(PyObject *self, PyObject *args, PyObject *kw) {
     (void)self;
     static char *kwlist[] = {"in_path", "out_path", "values", "name", "farther_than", "nearer_than", "format",
                              "decimal_comma", NULL};
     PyObject *in = NULL, *out = NULL, *values = NULL, *far = Py_None, *near = Py_None;
-    const char *name = "distance", *format = NULL;
+    const char *name = NULL, *format = NULL;
     int decimal_comma = 0;
     if (!PyArg_ParseTupleAndKeywords(args, kw, "O&O&O|$sOOzp:write_field", kwlist, PyUnicode_FSConverter, &in,
                                      PyUnicode_FSConverter, &out, &values, &name, &far, &near, &format, &decimal_comma)) {
@@ -1482,8 +1538,30 @@ static PyObject *py_write_field(PyObject *self, PyObject *args, PyObject *kw) {
     }
     hd_write_options_t wo;
     hd_write_options_init(&wo);
-    wo.name = name;
-    PyArrayObject *v = NULL;
+    int several = PyDict_Check(values);
+    PyObject *own = several ? PyDict_Copy(values) : NULL; /* its keys name the fields while the GIL is released */
+    if (several && !own) {
+        Py_DECREF(in);
+        Py_DECREF(out);
+        return NULL;
+    }
+    if (own) values = own;
+    Py_ssize_t nf = several ? PyDict_Size(values) : 1, made = 0;
+    hd_field_t *f = PyMem_Calloc((size_t)nf + 1, sizeof *f);
+    PyArrayObject **arr = PyMem_Calloc((size_t)nf + 1, sizeof *arr);
+    size_t n = 0;
+    if (!f || !arr) {
+        PyErr_NoMemory();
+        goto fail;
+    }
+    if (several && name) {
+        PyErr_SetString(PyExc_ValueError, "write_field: with a dict of fields their names are its keys, not name=");
+        goto fail;
+    }
+    if (several && nf == 0) {
+        PyErr_SetString(PyExc_ValueError, "write_field: the dict of fields is empty");
+        goto fail;
+    }
     if (far != Py_None && near != Py_None) {
         PyErr_SetString(PyExc_ValueError, "write_field: give farther_than or nearer_than, not both");
         goto fail;
@@ -1493,14 +1571,9 @@ static PyObject *py_write_field(PyObject *self, PyObject *args, PyObject *kw) {
         wo.threshold = PyFloat_AsDouble(far != Py_None ? far : near);
         if (wo.threshold == -1.0 && PyErr_Occurred()) goto fail;
     }
-    v = (PyArrayObject *)PyArray_FROM_OTF(values, NPY_DOUBLE, NPY_ARRAY_IN_ARRAY);
-    if (!v) goto fail;
-    if (PyArray_NDIM(v) != 1) {
-        PyErr_Format(PyExc_ValueError, "write_field: values must be one-dimensional (one per point), not of shape with %d "
-                                       "dimensions",
-                     PyArray_NDIM(v));
-        goto fail;
-    }
+    made = write_fields_of(values, name ? name : "distance", f, arr, nf, &n);
+    if (made < 0) goto fail;
+    wo.name = f[0].name;
     hd_read_options_t ro;
     hd_read_options_init(&ro);
     ro.format = format;
@@ -1510,18 +1583,23 @@ static PyObject *py_write_field(PyObject *self, PyObject *args, PyObject *kw) {
     size_t written = 0;
     int rc;
     const char *ci = PyBytes_AS_STRING(in), *co = PyBytes_AS_STRING(out);
-    const double *vd = (const double *)PyArray_DATA(v);
-    size_t n = (size_t)PyArray_DIM(v, 0);
     Py_BEGIN_ALLOW_THREADS
-    rc = hd_write_field(ci, co, vd, n, &wo, &written, &err);
+    rc = several ? hd_write_fields(ci, co, f, (size_t)made, n, &wo, &written, &err)
+                 : hd_write_field(ci, co, f[0].values, n, &wo, &written, &err);
     Py_END_ALLOW_THREADS
-    Py_DECREF(v);
+    for (Py_ssize_t k = 0; k < nf; k++) Py_XDECREF(arr[k]);
+    PyMem_Free(arr);
+    PyMem_Free(f);
+    Py_XDECREF(own);
     Py_DECREF(in);
     Py_DECREF(out);
     if (rc != HD_OK) return raise_hd(rc, &err);
     return PyLong_FromSize_t(written);
 fail:
-    Py_XDECREF(v);
+    for (Py_ssize_t k = 0; arr && k < nf; k++) Py_XDECREF(arr[k]);
+    PyMem_Free(arr);
+    PyMem_Free(f);
+    Py_XDECREF(own);
     Py_DECREF(in);
     Py_DECREF(out);
     return NULL;

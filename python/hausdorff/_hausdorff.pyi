@@ -1,6 +1,6 @@
 """Type stubs of the hausdorff C extension (see the docstrings for details)."""
 import os
-from typing import Any, Dict, List, Literal, Optional, Sequence, Tuple, Union, overload
+from typing import Any, Dict, List, Literal, Mapping, Optional, Sequence, Tuple, Union, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -192,9 +192,9 @@ def formats() -> Dict[str, str]: ...
 def write_field(
     in_path: Union[str, bytes, os.PathLike[str], os.PathLike[bytes]],
     out_path: Union[str, bytes, os.PathLike[str], os.PathLike[bytes]],
-    values: npt.ArrayLike,
+    values: Union[npt.ArrayLike, Mapping[str, npt.ArrayLike]],
     *,
-    name: str = "distance",
+    name: Optional[str] = None,
     farther_than: Optional[float] = None,
     nearer_than: Optional[float] = None,
     format: Optional[str] = None,

@@ -215,6 +215,46 @@ def test_text_fixtures_keep_their_lines(tmp_path):
     assert n == 2 and np.array_equal(hausdorff.read(tmp_path / "near.obj"), pts[:2])
 
 
+def test_several_fields_in_one_call_every_format(tmp_path):
+    """A dict of fields: each becomes a PLY property, a LAS/LAZ extra-bytes
+    dimension or a text column, in the dict's order, bit for bit; a subset
+    is chosen by the first field."""
+    cases = [os.path.join(CORPUS, "ply", f) for f in ("ascii.ply", "binary_big_endian.ply")] + [
+        os.path.join(CORPUS, "las", f) for f in ("v12_fmt0.las", "v14_fmt6.las")] + [
+        os.path.join(CORPUS, "laz", f) for f in ("fmt6_channels.laz", "fmt3_extra2.laz")] + [
+        os.path.join(CORPUS, "xyz", "header.csv")]
+    for src in cases:
+        name = os.path.basename(src)
+        pts = hausdorff.read(src)
+        rng = np.random.default_rng(len(name))
+        for nf in (2, 3):
+            fields = {"distance": rng.random(len(pts)) * 10, "nearest": np.arange(len(pts), dtype=float),
+                      "sign": np.where(np.arange(len(pts)) % 3, 1.0, -1.0)}
+            fields = dict(list(fields.items())[:nf])
+            for far in (None, 5.0):
+                if far is not None and name.startswith("fmt6"):
+                    continue  # subsets of layered LAZ are refused (test_laz_fixtures_read_back)
+                out = tmp_path / ("%d_%s_%s" % (nf, far, name))
+                n = hausdorff.write_field(src, out, fields, farther_than=far)
+                keep = fields["distance"] > far if far is not None else np.ones(len(pts), bool)
+                assert n == int(keep.sum()), name
+                if src.endswith(".laz"):
+                    if far is None:  # the points as they were (the values: tests/laz_lazperf, test_write_laz)
+                        assert np.array_equal(hausdorff.read(out), pts), name
+                    continue
+                assert np.array_equal(hausdorff.read(out), pts[keep]), name
+                for j, (fname, v) in enumerate(fields.items()):
+                    if src.endswith(".ply"):
+                        got = ply_vertices(out)[0][fname]
+                    elif src.endswith(".las"):
+                        got = las_dimension(parse_las(out), fname)
+                    else:
+                        rows = open(out).read().splitlines()
+                        assert rows[0].split(",")[-nf:] == list(fields), name
+                        got = np.array([float(r.split(",")[j - nf]) for r in rows[1:]])
+                    assert np.array_equal(bits(got), bits(v[keep])), (name, fname, far)
+
+
 def test_refusals_raise_with_the_reason(tmp_path):
     src = os.path.join(CORPUS, "ply", "ascii.ply")
     n = len(hausdorff.read(src))
@@ -232,6 +272,15 @@ def test_refusals_raise_with_the_reason(tmp_path):
     with pytest.raises(ValueError, match="already has a property 'distance'"):
         hausdorff.write_field(tmp_path / "b.ply", tmp_path / "c.ply", np.zeros(n))
     assert hausdorff.write_field(tmp_path / "b.ply", tmp_path / "c.ply", np.ones(n), name="second") == n
+    assert not os.path.exists(tmp_path / "a.ply")
+    with pytest.raises(ValueError, match="names are its keys"):
+        hausdorff.write_field(src, tmp_path / "a.ply", {"distance": np.zeros(n)}, name="x")
+    with pytest.raises(ValueError, match="'nearest' has 1 values"):
+        hausdorff.write_field(src, tmp_path / "a.ply", {"distance": np.zeros(n), "nearest": np.zeros(1)})
+    with pytest.raises(ValueError, match="already has a property 'distance'"):
+        hausdorff.write_field(tmp_path / "b.ply", tmp_path / "a.ply", {"d2": np.zeros(n), "distance": np.zeros(n)})
+    with pytest.raises(ValueError, match="empty"):
+        hausdorff.write_field(src, tmp_path / "a.ply", {})
     assert not os.path.exists(tmp_path / "a.ply")
 
 

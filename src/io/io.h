@@ -145,14 +145,19 @@ int hd__read_laz(hd__read_t *r, const hd__las_header_t *h);
  * lost its compression bit. */
 int hd__laz_vlr_present(const unsigned char *d, const hd__las_header_t *h);
 
-/* ---- writing a field back (write.c, hd_write_field) ---------------------- */
+/* ---- writing fields back (write.c, hd_write_fields) ---------------------- */
+/* The most fields: 8 bytes each in a LAS record of at most 65535 bytes. */
+#define HD__FIELDS_MAX 8191
 typedef struct hd__writer {
     const hd__file_t *in;    /* the input, mapped */
     const char *out_name;    /* for messages */
     FILE *out;               /* the temporary being written */
-    const double *v;         /* n values, point k's is v[k] */
+    const double *v;         /* n values selecting the points (keep,
+                                threshold): point k's is v[k] */
     size_t n;
-    const char *name;        /* the field's name; "": no field */
+    const hd_field_t *f;     /* the fields added, nf of them (0: none),
+                                each of n values */
+    size_t nf;
     hd_keep_t keep;
     double threshold;
     const hd_read_options_t *ropt;
@@ -169,8 +174,21 @@ HD__INLINE int hd__w_keep(const hd__writer_t *w, size_t k) {
 size_t hd__w_kept(const hd__writer_t *w);
 /* Append n bytes (nothing once a write has failed: w->werr). */
 void hd__w_put(hd__writer_t *w, const void *p, size_t n);
-/* Append a double in the given byte order. */
-void hd__w_value(hd__writer_t *w, double v, int big);
+/* Point k's nf values, in the given byte order, into b (8 * nf bytes). */
+HD__INLINE void hd__w_values(const hd__writer_t *w, size_t k, int big, unsigned char *b) {
+    const hd_field_t *f = w->f;
+    for (size_t j = 0, nf = w->nf; j < nf; j++, b += 8) {
+        uint64_t u;
+        memcpy(&u, &f[j].values[k], 8);
+        if (big)
+            for (int i = 0; i < 8; i++) b[7 - i] = (unsigned char)(u >> (8 * i));
+        else
+            for (int i = 0; i < 8; i++) b[i] = (unsigned char)(u >> (8 * i));
+    }
+}
+/* The index of the first field whose name equals the n bytes at s
+ * (n = 0: s is NUL-terminated; at most 32 bytes compared), or -1. */
+long hd__w_field_named(const hd__writer_t *w, const char *s, size_t n);
 /* The shortest decimal text that reads back (strtod) to v; its length. */
 size_t hd__shortest(double v, char buf[32]);
 

@@ -10,13 +10,13 @@
 
 typedef struct hd__las_plan {
     unsigned minor, fmt;
-    size_t header, offset, rec, out_rec; /* out_rec: rec + 8 with the field */
+    size_t header, offset, rec, out_rec; /* out_rec: rec + 8 a field */
     uint32_t n_vlr;
     uint64_t count;
     size_t vlr_end;   /* the end of the last VLR */
     size_t eb_at;     /* the extra-bytes VLR's header, 0: none */
     size_t end;       /* the end of the point data (uncompressed LAS) */
-    int add;          /* the field is added */
+    int add;          /* fields are added */
     size_t gap;       /* extra bytes no descriptor described */
     size_t n_desc;    /* descriptors added */
     size_t vlr_added; /* bytes added before the points */
@@ -27,18 +27,18 @@ typedef struct hd__las_plan {
  * room in the record or the VLR (HD_EUNSUPPORTED). */
 int hd__las_plan(hd__writer_t *w, hd__las_plan_t *pl);
 /* The header (counts, by_return[1..15], bounds: max/min x, y, z, of `kept`
- * points in a subset), the VLRs (the extra-bytes one with the field's
- * descriptor, lo..hi its range; laz_vlr: the LASzip VLR's new data, whose
+ * points in a subset), the VLRs (the extra-bytes one with the fields'
+ * descriptors, each with its kept values' range; laz_vlr: the LASzip VLR's new data, whose
  * data started at laz_vlr_at in the input) and the bytes up to the
  * points; points_bytes is what the points will take. */
 void hd__las_write_head(hd__writer_t *w, const hd__las_plan_t *pl, uint64_t kept, const uint64_t by_return[16],
-                        const double bounds[6], double lo, double hi, uint64_t points_bytes, const unsigned char *laz_vlr,
+                        const double bounds[6], uint64_t points_bytes, const unsigned char *laz_vlr,
                         size_t laz_vlr_at, size_t laz_vlr_len);
 unsigned hd__las_return(const unsigned char *rec, unsigned fmt);
 /* Widen the bounds by record rec's coordinates (first: start them). */
 void hd__las_bound(double bounds[6], const unsigned char *rec, const double scale[3], const double shift[3], int first);
 void hd__las_scale(const unsigned char *d, double scale[3], double shift[3]);
-void hd__w_range(const hd__writer_t *w, double *lo, double *hi);
+void hd__w_range(const hd__writer_t *w, const double *v, double *lo, double *hi);
 void hd__st_u64(unsigned char *p, uint64_t v);
 
 /* For the LAZ writers (write_laz.c, write_lazpw.c). */

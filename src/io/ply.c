@@ -618,15 +618,15 @@ static void put_str(hd__writer_t *w, const char *s) { hd__w_put(w, s, strlen(s))
 /* The header as described above. */
 static void write_header(hd__writer_t *w, const ply_t *p, int v, int subset, size_t kept) {
     const char *s = (const char *)w->in->data, *hend = s + p->data, *q = s, *eol;
-    int k = -1, add = w->name[0] != 0;
+    int k = -1;
     for (const char *line; hd__next_line(&q, hend, &line, &eol);) {
         const char *cur = line, *tb, *te;
         int tok = hd__token(&cur, eol, &tb, &te);
         int is_el = tok && is(tb, (size_t)(te - tb), "element"), is_end = tok && is(tb, (size_t)(te - tb), "end_header");
         const char *nl = line_end(line, eol, hend);
-        if ((is_el || is_end) && k == v && add) {
+        for (size_t j = 0; (is_el || is_end) && k == v && j < w->nf; j++) {
             put_str(w, "property double ");
-            put_str(w, w->name);
+            put_str(w, w->f[j].name);
             put_str(w, nl);
         }
         if (is_el) k++;
@@ -642,21 +642,50 @@ static void write_header(hd__writer_t *w, const ply_t *p, int v, int subset, siz
     }
 }
 
+/* Bytes gathered into blocks of BLOCK before they are written. */
+enum { BLOCK = 1 << 16 };
+typedef struct {
+    unsigned char *buf; /* BLOCK bytes */
+    size_t used;
+} staged_t;
+
+static void stage(hd__writer_t *w, staged_t *s, const void *p, size_t n) {
+    if (s->used + n > BLOCK) {
+        hd__w_put(w, s->buf, s->used);
+        s->used = 0;
+    }
+    if (n > BLOCK) {
+        hd__w_put(w, p, n);
+        return;
+    }
+    memcpy(s->buf + s->used, p, n);
+    s->used += n;
+}
+
 static int write_binary(hd__writer_t *w, const ply_t *p, int v, int subset) {
     const unsigned char *d = w->in->data;
     size_t pos = p->data, size = w->in->size;
-    int big = p->format == 2, add = w->name[0] != 0;
+    int big = p->format == 2;
+    unsigned char *vals = malloc(8 * w->nf + 1); /* a vertex's values */
+    staged_t st = {malloc(BLOCK), 0};
+    if (!vals || !st.buf) {
+        free(vals), free(st.buf);
+        return hd__err(w->err, HD_ENOMEM, "out of memory");
+    }
     for (int k = 0; k < p->n_el; k++) {
         const elem_t *e = &p->el[k];
         size_t from = pos;
         for (uint64_t i = 0; i < e->count; i++) {
             size_t n = instance_size(e, d, pos, size, big);
-            if (n == 0 && (e->has_list || e->fixed))
+            if (n == 0 && (e->has_list || e->fixed)) {
+                free(vals), free(st.buf);
                 return hd__err(w->err, HD_EFORMAT, "%s: byte %zu: element %.*s ends early", w->in->name, pos, (int)e->len,
                                e->name);
+            }
             if (k == v && hd__w_keep(w, (size_t)i)) {
-                hd__w_put(w, d + pos, n);
-                if (add) hd__w_value(w, w->v[i], big);
+                stage(w, &st, d + pos, n);
+                hd__w_values(w, (size_t)i, big, vals);
+                stage(w, &st, vals, 8 * w->nf);
                 w->written++;
             }
             pos += n;
@@ -665,14 +694,18 @@ static int write_binary(hd__writer_t *w, const ply_t *p, int v, int subset) {
                 break;
             }
         }
+        if (k == v) {
+            hd__w_put(w, st.buf, st.used);
+            st.used = 0;
+        }
         if (k != v && !subset) hd__w_put(w, d + from, pos - from);
     }
+    free(vals), free(st.buf);
     return HD_OK;
 }
 
 static int write_ascii(hd__writer_t *w, const ply_t *p, int v, int subset) {
     const char *s = (const char *)w->in->data, *end = s + w->in->size, *q = s + p->data;
-    int add = w->name[0] != 0;
     char num[40];
     num[0] = ' ';
     for (int k = 0; k < p->n_el; k++) {
@@ -692,7 +725,7 @@ static int write_ascii(hd__writer_t *w, const ply_t *p, int v, int subset) {
             const char *c = eol;
             while (c > line && hd__is_blank((unsigned char)c[-1])) c--;
             hd__w_put(w, line, (size_t)(c - line));
-            if (add) hd__w_put(w, num, 1 + hd__shortest(w->v[i], num + 1));
+            for (size_t j = 0; j < w->nf; j++) hd__w_put(w, num, 1 + hd__shortest(w->f[j].values[i], num + 1));
             put_str(w, line_end(line, eol, end));
             w->written++;
         }
@@ -712,10 +745,11 @@ int hd__write_ply(hd__writer_t *w) {
     for (int k = 0; rc == HD_OK && k < p->n_el; k++)
         if (is(p->el[k].name, p->el[k].len, "vertex")) v = k;
     if (rc == HD_OK && v < 0) rc = hd__err(w->err, HD_EFORMAT, "%s: the header declares no element 'vertex'", w->in->name);
-    if (rc == HD_OK && w->name[0] && prop_index(&p->el[v], w->name) >= 0)
-        rc = hd__err(w->err, HD_EINVAL, "%s: element vertex already has a property '%s' (line %lld's element); choose "
-                                        "another name",
-                     w->in->name, w->name, p->el[v].line);
+    for (size_t j = 0; rc == HD_OK && j < w->nf; j++)
+        if (prop_index(&p->el[v], w->f[j].name) >= 0)
+            rc = hd__err(w->err, HD_EINVAL, "%s: element vertex already has a property '%s' (line %lld's element); "
+                                            "choose another name",
+                         w->in->name, w->f[j].name, p->el[v].line);
     if (rc == HD_OK && p->el[v].count != w->n)
         rc = hd__err(w->err, HD_EINVAL, "%s: %zu values for %llu vertices", w->in->name, w->n,
                      (unsigned long long)p->el[v].count);

@@ -1,6 +1,6 @@
 /*
- * write.c -- hd_write_field: a per-point field written back into the
- * input's own format (hausdorff.h has the contract, docs/formats.md the
+ * write.c -- hd_write_fields and hd_write_field: per-point fields written
+ * back into the input's own format (hausdorff.h has the contract, docs/formats.md the
  * formats).
  *
  * The input is read twice: first by hd_read_file, with the caller's read
@@ -154,13 +154,10 @@ static int finish(hd__writer_t *w, const char *tmp, const char *out_path, int rc
     return rc;
 }
 
-static int check_args(const char *in_path, const char *out_path, const double *values, size_t n,
-                      const hd_write_options_t *o, hd_error_t *err) {
-    if (!in_path || !out_path || (!values && n)) return hd__err(err, HD_EINVAL, "hd_write_field: NULL argument");
-    if (!good_name(o->name))
-        return hd__err(err, HD_EINVAL, "field name '%.40s': letters, digits and '_' (not first a digit), at most 31", o->name);
+static int check_args(const char *in_path, const char *out_path, const hd_write_options_t *o, hd_error_t *err) {
+    if (!in_path || !out_path) return hd__err(err, HD_EINVAL, "hd_write_fields: NULL argument");
     if (o->keep != HD_KEEP_ALL && o->keep != HD_KEEP_FARTHER && o->keep != HD_KEEP_NEARER)
-        return hd__err(err, HD_EINVAL, "hd_write_field: keep is %d (HD_KEEP_ALL, _FARTHER or _NEARER)", (int)o->keep);
+        return hd__err(err, HD_EINVAL, "hd_write_fields: keep is %d (HD_KEEP_ALL, _FARTHER or _NEARER)", (int)o->keep);
     if (o->keep != HD_KEEP_ALL && !isfinite(o->threshold))
         return hd__err(err, HD_EINVAL, "the threshold %g is not a finite number", o->threshold);
     const hd_read_options_t *r = o->read;
@@ -168,6 +165,23 @@ static int check_args(const char *in_path, const char *out_path, const double *v
         return hd__err(err, HD_EINVAL, "%s: a field is written for every point of the file: a range read or mesh "
                                        "sampling does not number them",
                        in_path);
+    return HD_OK;
+}
+
+/* The fields: their values given, names good and distinct. */
+static int check_fields(const hd_field_t *f, size_t nf, size_t n, hd_error_t *err) {
+    if (nf > HD__FIELDS_MAX)
+        return hd__err(err, HD_EINVAL, "hd_write_fields: %zu fields, at most %d (8 bytes each in a record of 65535)", nf,
+                       HD__FIELDS_MAX);
+    for (size_t j = 0; j < nf; j++) {
+        if (!f[j].name || (!f[j].values && n)) return hd__err(err, HD_EINVAL, "hd_write_fields: field %zu: NULL", j + 1);
+        if (!f[j].name[0] || !good_name(f[j].name))
+            return hd__err(err, HD_EINVAL, "field name '%.40s': letters, digits and '_' (not first a digit), 1 to 31",
+                           f[j].name);
+        for (size_t i = 0; i < j; i++)
+            if (strcmp(f[i].name, f[j].name) == 0)
+                return hd__err(err, HD_EINVAL, "fields %zu and %zu are both named '%s'", i + 1, j + 1, f[j].name);
+    }
     return HD_OK;
 }
 
@@ -218,18 +232,21 @@ static int check_output(const char *in_path, const char *out_path, const char *o
     return HD_OK;
 }
 
-int hd_write_field(const char *in_path, const char *out_path, const double *values, size_t n,
-                   const hd_write_options_t *opt, size_t *written, hd_error_t *err) {
+/* The write of nf fields (none: the points selected, as they are), the
+ * points selected by `select`'s n values. */
+static int write_fields(const char *in_path, const char *out_path, const double *select, const hd_field_t *fields,
+                        size_t nf, size_t n, const hd_write_options_t *opt, size_t *written, hd_error_t *err) {
     hd_write_options_t o;
     hd_read_options_t ro;
     if (opt) o = *opt;
     else hd_write_options_init(&o);
-    if (!o.name) o.name = "distance";
     if (o.read) ro = *o.read;
     else hd_read_options_init(&ro);
     if (written) *written = 0;
     if (err) hd__err_clear(err);
-    int rc = check_args(in_path, out_path, values, n, &o, err);
+    int rc = check_args(in_path, out_path, &o, err);
+    if (rc == HD_OK && !select && n) rc = hd__err(err, HD_EINVAL, "hd_write_fields: NULL values");
+    if (rc == HD_OK) rc = check_fields(fields, nf, n, err);
     if (rc) return rc;
     hd__file_t f;
     struct stat st;
@@ -246,7 +263,7 @@ int hd_write_field(const char *in_path, const char *out_path, const double *valu
     FILE *out = rc == HD_OK ? open_temp(out_path, &tmp, err) : NULL;
     if (rc == HD_OK && !out) rc = err ? err->code : HD_EIO;
     if (rc == HD_OK) {
-        hd__writer_t w = {&f, out_path, out, values, n, o.name, o.keep, o.threshold, &ro, 0, 0, err};
+        hd__writer_t w = {&f, out_path, out, select, n, fields, nf, o.keep, o.threshold, &ro, 0, 0, err};
         rc = dispatch(&w, fmt);
         rc = finish(&w, tmp, out_path, rc);
         if (rc == HD_OK && written) *written = w.written;
@@ -254,4 +271,26 @@ int hd_write_field(const char *in_path, const char *out_path, const double *valu
     free(tmp);
     if (f.size) munmap((void *)f.data, f.size);
     return rc;
+}
+
+int hd_write_fields(const char *in_path, const char *out_path, const hd_field_t *fields, size_t n_fields, size_t n,
+                    const hd_write_options_t *opt, size_t *written, hd_error_t *err) {
+    if (written) *written = 0;
+    if (!fields || n_fields == 0) {
+        if (err) hd__err_clear(err);
+        return hd__err(err, HD_EINVAL, "hd_write_fields: no fields (hd_write_field with the name \"\" writes none)");
+    }
+    return write_fields(in_path, out_path, fields[0].values, fields, n_fields, n, opt, written, err);
+}
+
+int hd_write_field(const char *in_path, const char *out_path, const double *values, size_t n,
+                   const hd_write_options_t *opt, size_t *written, hd_error_t *err) {
+    hd_field_t f = {opt && opt->name ? opt->name : "distance", values};
+    if (!good_name(f.name)) {
+        if (written) *written = 0;
+        if (err) hd__err_clear(err);
+        return hd__err(err, HD_EINVAL, "field name '%.40s': letters, digits and '_' (not first a digit), at most 31",
+                       f.name);
+    }
+    return write_fields(in_path, out_path, values, &f, f.name[0] ? 1 : 0, n, opt, written, err);
 }

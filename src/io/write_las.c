@@ -1,5 +1,5 @@
 /*
- * write_las.c -- a field written back into LAS (hd_write_field), and the
+ * write_las.c -- fields written back into LAS (hd_write_fields), and the
  * LAS facts the LAZ writer shares with it.
  *
  * Format (ASPRS "LAS Specification 1.4 - R15", 2019): section 2.4 for the
@@ -99,10 +99,10 @@ int hd__las_plan(hd__writer_t *w, hd__las_plan_t *pl) {
     }
     if (pl->fmt > 10 || pl->rec < min_record[pl->fmt])
         return hd__err(w->err, HD_EFORMAT, "%s: point format %u with records of %zu bytes", w->in->name, pl->fmt, pl->rec);
-    pl->add = w->name[0] != 0;
-    if (pl->add && pl->rec + 8 > 65535)
-        return hd__err(w->err, HD_EUNSUPPORTED, "%s: records of %zu bytes leave no room for 8 more (65535 at most)",
-                       w->in->name, pl->rec);
+    pl->add = w->nf != 0;
+    if (pl->add && pl->rec + 8 * w->nf > 65535)
+        return hd__err(w->err, HD_EUNSUPPORTED, "%s: records of %zu bytes leave no room for %zu more (65535 at most)",
+                       w->in->name, pl->rec, 8 * w->nf);
     /* the VLRs: where they end, and the extra-bytes VLR if any */
     size_t p = pl->header, described = 0;
     pl->eb_at = 0;
@@ -115,10 +115,11 @@ int hd__las_plan(hd__writer_t *w, hd__las_plan_t *pl) {
             pl->eb_at = p;
             for (size_t q = p + 54; q + 192 <= p + 54 + len; q += 192) {
                 described += eb_size(d[q + 2], d[q + 3]);
-                if (pl->add && strncmp((const char *)d + q + 4, w->name, 32) == 0)
+                long j = hd__w_field_named(w, (const char *)d + q + 4, 0);
+                if (j >= 0)
                     return hd__err(w->err, HD_EINVAL, "%s: the extra-bytes VLR already describes a dimension '%s'; choose "
                                                       "another name",
-                                   w->in->name, w->name);
+                                   w->in->name, w->f[j].name);
             }
         }
         p += 54 + len;
@@ -131,32 +132,37 @@ int hd__las_plan(hd__writer_t *w, hd__las_plan_t *pl) {
                        w->in->name, described, extra, pl->fmt);
     pl->end = pl->offset + (size_t)pl->count * pl->rec;
     pl->gap = pl->add ? extra - described : 0;
-    pl->n_desc = pl->add ? 1 + (pl->gap + 254) / 255 : 0; /* an undocumented descriptor holds 255 bytes at most */
+    pl->n_desc = pl->add ? w->nf + (pl->gap + 254) / 255 : 0; /* an undocumented descriptor holds 255 bytes at most */
     size_t old_len = pl->eb_at ? hd__ld_u16(d + pl->eb_at + 20, 0) : 0;
     if (pl->add && old_len + 192 * pl->n_desc > 65535)
         return hd__err(w->err, HD_EUNSUPPORTED, "%s: the extra-bytes VLR has no room for another descriptor", w->in->name);
     pl->vlr_added = pl->add ? 192 * pl->n_desc + (pl->eb_at ? 0 : 54) : 0;
-    pl->out_rec = pl->rec + (pl->add ? 8 : 0);
+    pl->out_rec = pl->rec + 8 * w->nf;
     return HD_OK;
 }
 
 /* The extra-bytes VLR's new part: the descriptors (an undocumented one per
- * 255 bytes not described, then the field's), into buf (192 * n_desc). */
-static void new_descriptors(const hd__writer_t *w, const hd__las_plan_t *pl, unsigned char *buf, double lo, double hi) {
+ * 255 bytes not described, then the fields', each with the range of its
+ * kept values), into buf (192 * n_desc). */
+static void new_descriptors(const hd__writer_t *w, const hd__las_plan_t *pl, unsigned char *buf) {
     size_t gap = pl->gap, k = 0;
     for (; gap > 0; k++) {
         size_t g = gap > 255 ? 255 : gap;
         descriptor(buf + 192 * k, 0, (unsigned)g, "", 0, 0);
         gap -= g;
     }
-    descriptor(buf + 192 * k, 10, 6, w->name, lo, hi);
+    for (size_t j = 0; j < w->nf; j++, k++) {
+        double lo, hi;
+        hd__w_range(w, w->f[j].values, &lo, &hi);
+        descriptor(buf + 192 * k, 10, 6, w->f[j].name, lo, hi);
+    }
 }
 
 /* The header, VLRs and the bytes before the points, for `kept` points
  * whose values run from lo to hi; by_return[1..15] and bounds (max x, min
  * x, max y, min y, max z, min z) are used in a subset. */
 void hd__las_write_head(hd__writer_t *w, const hd__las_plan_t *pl, uint64_t kept, const uint64_t by_return[16],
-                        const double bounds[6], double lo, double hi, uint64_t points_bytes, const unsigned char *laz_vlr,
+                        const double bounds[6], uint64_t points_bytes, const unsigned char *laz_vlr,
                         size_t laz_vlr_at, size_t laz_vlr_len) {
     const unsigned char *d = w->in->data;
     unsigned char *h = malloc(pl->header);
@@ -197,7 +203,7 @@ void hd__las_write_head(hd__writer_t *w, const hd__las_plan_t *pl, uint64_t kept
         w->werr = ENOMEM;
         return;
     }
-    if (pl->add) new_descriptors(w, pl, nd, lo, hi);
+    if (pl->add) new_descriptors(w, pl, nd);
     size_t p = pl->header;
     for (uint32_t i = 0; i < pl->n_vlr; i++) {
         size_t len = hd__ld_u16(d + p + 20, 0);
@@ -249,14 +255,14 @@ void hd__las_scale(const unsigned char *d, double scale[3], double shift[3]) {
     }
 }
 
-/* The range of the kept values (0, 0 when none is finite). */
-void hd__w_range(const hd__writer_t *w, double *lo, double *hi) {
+/* The range of the kept points' values v (0, 0 when none is finite). */
+void hd__w_range(const hd__writer_t *w, const double *v, double *lo, double *hi) {
     int any = 0;
     *lo = *hi = 0;
     for (size_t k = 0; k < w->n; k++)
-        if (hd__w_keep(w, k) && isfinite(w->v[k])) {
-            if (!any || w->v[k] < *lo) *lo = w->v[k];
-            if (!any || w->v[k] > *hi) *hi = w->v[k];
+        if (hd__w_keep(w, k) && isfinite(v[k])) {
+            if (!any || v[k] < *lo) *lo = v[k];
+            if (!any || v[k] > *hi) *hi = v[k];
             any = 1;
         }
 }
@@ -285,7 +291,7 @@ int hd__write_las(hd__writer_t *w) {
     if (pl.end > w->in->size) return hd__err(w->err, HD_EFORMAT, "%s: the points run past the file's end", w->in->name);
     const unsigned char *d = w->in->data;
     uint64_t by_return[16] = {0}, kept = 0;
-    double bounds[6] = {0}, scale[3], shift[3], lo, hi;
+    double bounds[6] = {0}, scale[3], shift[3];
     hd__las_scale(d, scale, shift);
     for (size_t k = 0; k < w->n; k++)
         if (hd__w_keep(w, k)) {
@@ -293,8 +299,7 @@ int hd__write_las(hd__writer_t *w) {
             by_return[hd__las_return(r, pl.fmt)]++;
             hd__las_bound(bounds, r, scale, shift, kept++ == 0);
         }
-    hd__w_range(w, &lo, &hi);
-    hd__las_write_head(w, &pl, kept, by_return, bounds, lo, hi, kept * pl.out_rec, NULL, 0, 0);
+    hd__las_write_head(w, &pl, kept, by_return, bounds, kept * pl.out_rec, NULL, 0, 0);
     /* the records, staged a block at a time */
     enum { BLOCK = 1 << 16 };
     unsigned char *buf = malloc(BLOCK + pl.out_rec);
@@ -304,12 +309,8 @@ int hd__write_las(hd__writer_t *w) {
         if (!hd__w_keep(w, k)) continue;
         memcpy(buf + used, d + pl.offset + k * pl.rec, pl.rec);
         used += pl.rec;
-        if (pl.add) {
-            uint64_t u;
-            memcpy(&u, &w->v[k], 8);
-            hd__st_u64(buf + used, u);
-            used += 8;
-        }
+        hd__w_values(w, k, 0, buf + used);
+        used += 8 * w->nf;
         if (used >= BLOCK) {
             hd__w_put(w, buf, used);
             used = 0;

@@ -1,5 +1,5 @@
 /*
- * write_laz.c -- a field written back into LAZ (hd_write_field).
+ * write_laz.c -- fields written back into LAZ (hd_write_fields).
  *
  * Layered LAZ (LAS 1.4 point formats 6-10, LASzip compressor 3) keeps
  * every field of a point in layers of its own: a chunk is its first point
@@ -7,11 +7,12 @@
  * the order of the LASzip VLR's items (POINT14's nine, RGB14's one,
  * RGBNIR14's two, WAVEPACKET14's one, BYTE14's one per extra byte).  The
  * extra bytes are the last bytes of a record and BYTE14 the last item, so
- * eight more extra bytes are eight more layers at the end of every chunk:
- * the chunk's first point gets the value's eight bytes, eight sizes follow
- * the old ones, eight layers the old layers, and every old byte is copied
- * as it is.  The LASzip VLR's BYTE14 item grows by 8 (or a BYTE14 item of
- * 8 is added), the chunk table is encoded again with the new byte sizes.
+ * the 8 bytes of each field added are 8 more layers at the end of every
+ * chunk: with nl = 8 * fields, the chunk's first point gets the values'
+ * nl bytes, nl sizes follow the old ones, nl layers the old layers, and
+ * every old byte is copied as it is.  The LASzip VLR's BYTE14 item grows
+ * by nl (or a BYTE14 item of nl is added), the chunk table is encoded
+ * again with the new byte sizes.
  *
  * BYTE14 (LASzip's LASwriteItemCompressed_BYTE14_v3, from the format's
  * description): per byte one stream; the models depend on the scanner
@@ -36,52 +37,52 @@
 
 #include <stdlib.h>
 
-enum { IT_POINT14 = 10, IT_BYTE14 = 14, NB = 8 };
+enum { IT_POINT14 = 10, IT_BYTE14 = 14 };
 
+/* A channel's models and last bytes, nl = 8 * nf of each. */
 typedef struct {
     int used;
-    unsigned char last[NB];
-    hd__symmodel_t m[NB];
+    unsigned char *last;
+    hd__symmodel_t *m;
 } bctx_t;
 
-/* The eight value bytes of point k. */
-static void value_bytes(const hd__writer_t *w, size_t k, unsigned char b[NB]) {
-    uint64_t u;
-    memcpy(&u, &w->v[k], 8);
-    for (int i = 0; i < NB; i++) b[i] = (unsigned char)(u >> (8 * i));
-}
-
-static int bctx_start(bctx_t *c, const unsigned char last[NB]) {
-    memset(c, 0, sizeof *c);
-    for (int i = 0; i < NB; i++)
-        if (hd__symmodel_new(&c->m[i], 256)) return HD_ENOMEM;
-    memcpy(c->last, last, NB);
+static int bctx_start(bctx_t *c, const unsigned char *last, size_t nl) {
     c->used = 1;
+    c->last = malloc(nl);
+    c->m = calloc(nl, sizeof *c->m);
+    if (!c->last || !c->m) return HD_ENOMEM;
+    for (size_t i = 0; i < nl; i++)
+        if (hd__symmodel_new(&c->m[i], 256)) return HD_ENOMEM;
+    memcpy(c->last, last, nl);
     return HD_OK;
 }
 
-static void bctx_free(bctx_t *c) {
-    for (int i = 0; i < NB; i++) hd__symmodel_free(&c->m[i]);
+static void bctx_free(bctx_t *c, size_t nl) {
+    for (size_t i = 0; c->m && i < nl; i++) hd__symmodel_free(&c->m[i]);
+    free(c->m);
+    free(c->last);
 }
 
-/* The eight BYTE14 layers of the n points from `first` whose channels are
- * chan, into enc[0..7]; size[b] 0 for a byte that never changes. */
+/* The nl BYTE14 layers of the n points from `first` whose channels are
+ * chan, into enc[0..nl-1]; size[b] 0 for a byte that never changes;
+ * item and changed: nl bytes and ints of scratch. */
 static int encode_bytes(const hd__writer_t *w, size_t first, size_t n, const unsigned char *chan, int v4,
-                        hd__enc_t enc[NB], uint32_t size[NB]) {
+                        hd__enc_t *enc, uint32_t *size, unsigned char *item, int *changed) {
+    size_t nl = 8 * w->nf;
     bctx_t cx[4];
     memset(cx, 0, sizeof cx);
-    int changed[NB] = {0}, rc = HD_OK;
-    unsigned char item[NB];
-    for (int b = 0; b < NB; b++) hd__enc_reset(&enc[b]);
-    value_bytes(w, first, item);
+    memset(changed, 0, nl * sizeof *changed);
+    int rc = HD_OK;
+    for (size_t b = 0; b < nl; b++) hd__enc_reset(&enc[b]);
+    hd__w_values(w, first, 0, item);
     unsigned cur = chan[0];
-    rc = bctx_start(&cx[cur], item);
+    rc = bctx_start(&cx[cur], item, nl);
     for (size_t i = 1; i < n && rc == HD_OK; i++) {
         unsigned char *last = cx[cur].last;
         if (chan[i] != cur) {
             unsigned next = chan[i];
             if (!cx[next].used) {
-                if ((rc = bctx_start(&cx[next], last))) break;
+                if ((rc = bctx_start(&cx[next], last, nl))) break;
                 last = cx[next].last;
             } else if (v4) {
                 last = cx[next].last;
@@ -90,8 +91,8 @@ static int encode_bytes(const hd__writer_t *w, size_t first, size_t n, const uns
             cur = next;
         }
         bctx_t *c = &cx[cur];
-        value_bytes(w, first + i, item);
-        for (int b = 0; b < NB; b++) {
+        hd__w_values(w, first + i, 0, item);
+        for (size_t b = 0; b < nl; b++) {
             unsigned diff = (unsigned)(item[b] - last[b]) & 255;
             hd__enc_symbol(&enc[b], &c->m[b], diff);
             if (diff) {
@@ -100,18 +101,19 @@ static int encode_bytes(const hd__writer_t *w, size_t first, size_t n, const uns
             }
         }
     }
-    for (int b = 0; b < NB; b++) {
+    for (size_t b = 0; b < nl; b++) {
         if (changed[b]) hd__enc_done(&enc[b]);
         size[b] = changed[b] ? (uint32_t)enc[b].size : 0;
         if (enc[b].oom) rc = HD_ENOMEM;
     }
-    for (int k = 0; k < 4; k++) bctx_free(&cx[k]);
+    for (int k = 0; k < 4; k++) bctx_free(&cx[k], nl);
     return rc;
 }
 
-/* The LASzip VLR's data with the BYTE14 item grown by 8 or added: into
+/* The LASzip VLR's data with the BYTE14 item grown by nl or added: into
  * *out (malloc'd), its length in *len. */
 static int new_vlr(const hd__writer_t *w, const hd__laz_chunks_t *c, unsigned char **out, size_t *len) {
+    size_t nl = 8 * w->nf;
     const unsigned char *v = w->in->data + c->vlr_at;
     int grow = c->type[c->n_items - 1] == IT_BYTE14;
     *len = c->vlr_len + (grow ? 0 : 6);
@@ -120,7 +122,7 @@ static int new_vlr(const hd__writer_t *w, const hd__laz_chunks_t *c, unsigned ch
     memcpy(p, v, c->vlr_len);
     size_t item = 34 + 6 * (size_t)(c->n_items - 1);
     if (grow) {
-        unsigned sz = c->size[c->n_items - 1] + NB;
+        unsigned sz = c->size[c->n_items - 1] + (unsigned)nl;
         p[item + 2] = (unsigned char)sz;
         p[item + 3] = (unsigned char)(sz >> 8);
     } else {
@@ -130,7 +132,8 @@ static int new_vlr(const hd__writer_t *w, const hd__laz_chunks_t *c, unsigned ch
         /* the items end the VLR's 34 + 6n bytes; anything after them moves */
         size_t at = 34 + 6 * (size_t)c->n_items;
         memmove(p + at + 6, v + at, c->vlr_len - at);
-        unsigned char it[6] = {IT_BYTE14, 0, NB, 0, (unsigned char)version, (unsigned char)(version >> 8)};
+        unsigned char it[6] = {IT_BYTE14, 0, (unsigned char)nl, (unsigned char)(nl >> 8), (unsigned char)version,
+                               (unsigned char)(version >> 8)};
         memcpy(p + at, it, 6);
     }
     *out = p;
@@ -153,9 +156,11 @@ typedef struct {
     hd__laz_chunks_t c;
     hd__read_t r;
     hd__sink_t sink;
+    size_t nl;              /* the new layers: 8 a field */
     unsigned char **layers; /* per chunk: its new layers, back to back */
     size_t *layers_size;
-    uint32_t *sizes;        /* NB per chunk */
+    uint32_t *sizes;        /* nl per chunk */
+    unsigned char *scratch; /* 4 * nl bytes, for write_chunk */
     uint64_t *bytes;        /* each chunk's new byte size */
     int *rc;                /* per chunk: HD_OK or the failure ... */
     hd_error_t *err;        /* ... and its message */
@@ -171,29 +176,35 @@ static void encode_chunk(void *ctx, size_t k, int worker) {
     hd_error_t *err = &z->err[k];
     hd__read_t r = z->r;
     r.err = err;
-    unsigned char *chan = malloc(n + 1);
-    hd__enc_t enc[NB];
-    for (int b = 0; b < NB; b++) hd__enc_init(&enc[b]);
-    int rc = chan ? HD_OK : hd__err(err, HD_ENOMEM, "out of memory");
+    size_t nl = z->nl;
+    unsigned char *chan = malloc(n + 1), *item = malloc(nl);
+    int *changed = hd__malloc_array(nl, sizeof *changed);
+    hd__enc_t *enc = hd__malloc_array(nl, sizeof *enc);
+    for (size_t b = 0; enc && b < nl; b++) hd__enc_init(&enc[b]);
+    int rc = chan && item && changed && enc ? HD_OK : hd__err(err, HD_ENOMEM, "out of memory");
     if (rc == HD_OK) {
         memset(chan, 0, n);
         if (n > 1) rc = hd__laz_chunk_channels(&r, &z->h, &z->c, k, chan);
         else chan[0] = (z->w->in->data[z->c.start[k] + 15] >> 4) & 3;
     }
-    if (rc == HD_OK && encode_bytes(z->w, (size_t)z->c.first[k], n, chan, z->v4, enc, z->sizes + NB * k))
+    if (rc == HD_OK &&
+        encode_bytes(z->w, (size_t)z->c.first[k], n, chan, z->v4, enc, z->sizes + nl * k, item, changed))
         rc = hd__err(err, HD_ENOMEM, "out of memory");
-    size_t add = 0;
-    for (int b = 0; b < NB; b++) add += z->sizes[NB * k + b];
-    if (rc == HD_OK && add && !(z->layers[k] = malloc(add))) rc = hd__err(err, HD_ENOMEM, "out of memory");
-    for (int b = 0, at = 0; b < NB && rc == HD_OK; b++) {
-        if (z->sizes[NB * k + b]) memcpy(z->layers[k] + at, enc[b].buf, z->sizes[NB * k + b]);
-        at += (int)z->sizes[NB * k + b];
-    }
-    z->layers_size[k] = add;
-    z->bytes[k] = z->c.start[k + 1] - z->c.start[k] + NB + 4 * NB + add;
+    uint64_t add = 0;
+    for (size_t b = 0; rc == HD_OK && b < nl; b++) add += z->sizes[nl * k + b];
+    z->bytes[k] = z->c.start[k + 1] - z->c.start[k] + nl + 4 * nl + add;
     if (rc == HD_OK && z->bytes[k] > 0xFFFFFFFFu)
         rc = hd__err(err, HD_EUNSUPPORTED, "%s: chunk %zu would exceed 4 GiB", z->w->in->name, k + 1);
-    for (int b = 0; b < NB; b++) hd__enc_free(&enc[b]);
+    if (rc == HD_OK && add && !(z->layers[k] = malloc((size_t)add))) rc = hd__err(err, HD_ENOMEM, "out of memory");
+    for (size_t b = 0, at = 0; b < nl && rc == HD_OK; b++) {
+        if (z->sizes[nl * k + b]) memcpy(z->layers[k] + at, enc[b].buf, z->sizes[nl * k + b]);
+        at += z->sizes[nl * k + b];
+    }
+    z->layers_size[k] = (size_t)add;
+    for (size_t b = 0; enc && b < nl; b++) hd__enc_free(&enc[b]);
+    free(enc);
+    free(changed);
+    free(item);
     free(chan);
     z->rc[k] = rc;
 }
@@ -205,11 +216,12 @@ static int encode_chunks(lazw_t *z) {
     size_t nc = z->c.n_chunks;
     z->layers = hd__calloc_array(nc + 1, sizeof *z->layers);
     z->layers_size = hd__calloc_array(nc + 1, sizeof *z->layers_size);
-    z->sizes = hd__calloc_array(nc * NB + 1, sizeof *z->sizes);
+    z->sizes = hd__calloc_array(nc + 1, z->nl * sizeof *z->sizes);
     z->bytes = hd__calloc_array(nc + 1, sizeof *z->bytes);
     z->rc = hd__calloc_array(nc + 1, sizeof *z->rc);
+    z->scratch = malloc(4 * z->nl);
     z->err = hd__calloc_array(nc + 1, sizeof *z->err);
-    if (!z->layers || !z->layers_size || !z->sizes || !z->bytes || !z->rc || !z->err)
+    if (!z->layers || !z->layers_size || !z->sizes || !z->bytes || !z->rc || !z->err || !z->scratch)
         return hd__err(z->w->err, HD_ENOMEM, "out of memory");
     hd__parallel_for(hd__thread_count(z->w->ropt->threads, nc), nc, encode_chunk, z);
     for (size_t k = 0; k < nc; k++)
@@ -223,14 +235,15 @@ static void write_chunk(lazw_t *z, size_t k) {
     hd__writer_t *w = z->w;
     const unsigned char *b = w->in->data + z->c.start[k];
     size_t nb = (size_t)(z->c.start[k + 1] - z->c.start[k]), rec = z->pl.rec, head = rec + 4 + 4 * (size_t)z->c.n_layers;
-    unsigned char v[NB], s[4 * NB];
+    size_t nl = z->nl;
+    unsigned char *s = z->scratch; /* 4 * nl bytes */
     hd__w_put(w, b, rec);
-    value_bytes(w, (size_t)z->c.first[k], v);
-    hd__w_put(w, v, NB);
+    hd__w_values(w, (size_t)z->c.first[k], 0, s);
+    hd__w_put(w, s, nl);
     hd__w_put(w, b + rec, head - rec);
-    for (int i = 0; i < NB; i++)
-        for (int q = 0; q < 4; q++) s[4 * i + q] = (unsigned char)(z->sizes[NB * k + i] >> (8 * q));
-    hd__w_put(w, s, sizeof s);
+    for (size_t i = 0; i < nl; i++)
+        for (int q = 0; q < 4; q++) s[4 * i + (size_t)q] = (unsigned char)(z->sizes[nl * k + i] >> (8 * q));
+    hd__w_put(w, s, 4 * nl);
     hd__w_put(w, b + head, nb - head);
     hd__w_put(w, z->layers[k], z->layers_size[k]);
 }
@@ -252,9 +265,7 @@ static int write_layered(lazw_t *z) {
         uint64_t table_bytes = 8 + table.size, points = 8 + chunks + gap + table_bytes;
         z->pl.vlr_added += vlr_len - z->c.vlr_len;
         z->pl.end = z->c.table_end;
-        double lo, hi;
-        hd__w_range(w, &lo, &hi);
-        hd__las_write_head(w, &z->pl, w->n, NULL, NULL, lo, hi, points, vlr, z->c.vlr_at, vlr_len);
+        hd__las_write_head(w, &z->pl, w->n, NULL, NULL, points, vlr, z->c.vlr_at, vlr_len);
         uint64_t new_offset = z->pl.offset + z->pl.vlr_added;
         unsigned char t[8];
         hd__st_u64(t, new_offset + 8 + chunks + gap);
@@ -277,6 +288,7 @@ int hd__write_laz(hd__writer_t *w) {
     lazw_t z;
     memset(&z, 0, sizeof z);
     z.w = w;
+    z.nl = 8 * w->nf;
     int rc = hd__las_plan(w, &z.pl);
     if (rc) return rc;
     if (!z.pl.add && w->keep == HD_KEEP_ALL) { /* no field, every point: the file as it is */
@@ -316,6 +328,7 @@ int hd__write_laz(hd__writer_t *w) {
     free(z.bytes);
     free(z.rc);
     free(z.err);
+    free(z.scratch);
     hd__sink_free(&z.sink);
     return rc;
 }

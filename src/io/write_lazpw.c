@@ -1,11 +1,11 @@
 /*
- * write_lazpw.c -- a field written back into pointwise LAZ (LAS point
+ * write_lazpw.c -- fields written back into pointwise LAZ (LAS point
  * formats 0-3, LASzip compressor 2), or the points past a threshold.
  *
  * Pointwise LAZ codes every field of a point in one stream per chunk, so
- * the field's bytes cannot be added beside the old data: every chunk is
+ * the fields' bytes cannot be added beside the old data: every chunk is
  * decoded to whole records (laz.c, items of version 2) and the records,
- * each with the value's eight bytes after it, are compressed again by this
+ * each with its values' 8 bytes a field after it, are compressed again by this
  * file's encoder: POINT10, GPSTIME11, RGB12 and BYTE, version 2 each, the
  * mirror of laz.c's decoder (the same models, contexts and predictions;
  * lazcoder.h has the coder):
@@ -297,7 +297,7 @@ typedef struct {
 } pw_t;
 
 /* The output's items (every input item of version 2; the BYTE item grown
- * by 8, or added) and its LASzip VLR (the input's, items rewritten;
+ * by 8 a field, or added) and its LASzip VLR (the input's, items rewritten;
  * compressor 2, the chunk size `chunk`). */
 static int plan_items(pw_t *z, const hd__laz_chunks_t *c, uint32_t chunk) {
     hd__writer_t *w = z->w;
@@ -310,9 +310,10 @@ static int plan_items(pw_t *z, const hd__laz_chunks_t *c, uint32_t chunk) {
     z->n_items = c->n_items;
     memcpy(z->type, c->type, sizeof z->type);
     memcpy(z->size, c->size, sizeof z->size);
+    unsigned nb = (unsigned)(8 * w->nf);
     if (z->pl->add) {
-        if (z->type[z->n_items - 1] == IT_BYTE) z->size[z->n_items - 1] += 8;
-        else z->type[z->n_items] = IT_BYTE, z->size[z->n_items++] = 8;
+        if (z->type[z->n_items - 1] == IT_BYTE) z->size[z->n_items - 1] += nb;
+        else z->type[z->n_items] = IT_BYTE, z->size[z->n_items++] = nb;
     }
     const unsigned char *v = w->in->data + c->vlr_at;
     size_t tail = c->vlr_len - (34 + 6 * (size_t)c->n_items); /* bytes after the items, kept */
@@ -384,11 +385,7 @@ static int write_chunks(pw_t *z, const hd__las_header_t *h, const hd__laz_chunks
             if (!hd__w_keep(w, f + i)) continue;
             unsigned char *o = z->out + z->n_out++ * orec;
             memcpy(o, in + i * rec, rec);
-            if (z->pl->add) {
-                uint64_t u;
-                memcpy(&u, &w->v[f + i], 8);
-                hd__st_u64(o + rec, u);
-            }
+            hd__w_values(w, f + i, 0, o + rec);
             z->by_return[hd__las_return(o, z->pl->fmt)]++;
             hd__las_bound(z->bounds, o, z->scale, z->shift, z->kept++ == 0);
             if (per && z->n_out == per) rc = flush_chunk(z);
@@ -432,9 +429,7 @@ static void batch_task(void *ctx, size_t t, int worker) {
     int rc = hd__laz_chunk_records(&r, B->h, B->c, k, B->in[t]);
     for (size_t i = 0; i < n && rc == HD_OK; i++) {
         memcpy(B->out[t] + i * orec, B->in[t] + i * rec, rec);
-        uint64_t u;
-        memcpy(&u, &z->w->v[f + i], 8);
-        hd__st_u64(B->out[t] + i * orec + rec, u);
+        hd__w_values(z->w, f + i, 0, B->out[t] + i * orec + rec);
     }
     if (rc == HD_OK && hd__laz_encode_pointwise(B->out[t], n, orec, z->type, z->size, z->n_items, &B->enc[t]))
         rc = hd__err(&B->err[t], HD_ENOMEM, "out of memory");
@@ -491,15 +486,13 @@ int hd__write_laz_pointwise(hd__writer_t *w, hd__las_plan_t *pl, const hd__las_h
     uint32_t chunk = all ? c->chunk_size : HD__LAZ_CHUNK;
     int variable = chunk == 0 || chunk == 0xFFFFFFFFu;
     int rc = plan_items(&z, c, chunk);
-    double lo, hi;
-    hd__w_range(w, &lo, &hi);
     off_t head_at = 0, table_ptr = 0;
     if (rc == HD_OK) {
         pl->vlr_added += z.vlr_len - c->vlr_len;
         pl->end = c->table_end;
         /* provisional: counts, bounds and the offsets after the points are
          * written again below */
-        hd__las_write_head(w, pl, 0, z.by_return, z.bounds, lo, hi, 0, z.vlr, c->vlr_at, z.vlr_len);
+        hd__las_write_head(w, pl, 0, z.by_return, z.bounds, 0, z.vlr, c->vlr_at, z.vlr_len);
         table_ptr = ftello(w->out);
         unsigned char zero[8] = {0};
         hd__w_put(w, zero, 8);
@@ -515,7 +508,7 @@ int hd__write_laz_pointwise(hd__writer_t *w, hd__las_plan_t *pl, const hd__las_h
         hd__w_put(w, w->in->data + c->table_end, w->in->size - c->table_end); /* extended VLRs */
         uint64_t points = (uint64_t)(ftello(w->out) - table_ptr) - (w->in->size - c->table_end);
         if (rc == HD_OK && !w->werr && fseeko(w->out, head_at, SEEK_SET) != 0) w->werr = errno ? errno : EIO;
-        hd__las_write_head(w, pl, z.kept, z.by_return, z.bounds, lo, hi, points, z.vlr, c->vlr_at, z.vlr_len);
+        hd__las_write_head(w, pl, z.kept, z.by_return, z.bounds, points, z.vlr, c->vlr_at, z.vlr_len);
         unsigned char t[8];
         hd__st_u64(t, (uint64_t)table);
         if (!w->werr && fseeko(w->out, table_ptr, SEEK_SET) != 0) w->werr = errno ? errno : EIO;

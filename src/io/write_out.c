@@ -1,7 +1,8 @@
 /*
- * write_out.c -- what every writer of hd_write_field (write*.c) shares:
- * appending bytes with the first failure kept, a double in either byte
- * order, the shortest decimal of a double, and which points are written.
+ * write_out.c -- what every writer of hd_write_fields (write*.c) shares:
+ * appending bytes with the first failure kept, the shortest decimal of a
+ * double, which points are written, the fields' bytes of a point in either
+ * byte order and a field by its name.
  * A leaf: it calls no other file of src/io.
  */
 #include "io.h"
@@ -29,14 +30,6 @@ void hd__w_put(hd__writer_t *w, const void *p, size_t n) {
     if (fwrite(p, 1, n, w->out) != n) w->werr = errno ? errno : EIO;
 }
 
-void hd__w_value(hd__writer_t *w, double v, int big) {
-    uint64_t u;
-    memcpy(&u, &v, 8);
-    unsigned char b[8];
-    for (int i = 0; i < 8; i++) b[big ? 7 - i : i] = (unsigned char)(u >> (8 * i));
-    hd__w_put(w, b, 8);
-}
-
 size_t hd__w_kept(const hd__writer_t *w) {
     if (w->keep == HD_KEEP_ALL) return w->n;
     size_t m = 0;
@@ -44,3 +37,11 @@ size_t hd__w_kept(const hd__writer_t *w) {
     return m;
 }
 
+
+long hd__w_field_named(const hd__writer_t *w, const char *s, size_t n) {
+    for (size_t j = 0; j < w->nf; j++) {
+        const char *name = w->f[j].name;
+        if (n ? strlen(name) == n && memcmp(name, s, n) == 0 : strncmp(name, s, 32) == 0) return (long)j;
+    }
+    return -1;
+}

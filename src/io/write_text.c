@@ -67,9 +67,36 @@ static void put_with(hd__writer_t *w, const char *line, const char *eol, const c
     hd__w_put(w, nl, strlen(nl));
 }
 
+/* The fields' names, separated by sep, into row; its length. */
+static size_t names_row(const hd__writer_t *w, char sep, char *row) {
+    size_t n = 0;
+    for (size_t j = 0; j < w->nf; j++) {
+        if (j) row[n++] = sep;
+        size_t len = strlen(w->f[j].name);
+        memcpy(row + n, w->f[j].name, len);
+        n += len;
+    }
+    return n;
+}
+
+/* Point k's values as their shortest decimals (a decimal comma with dc),
+ * separated by sep, into row; its length. */
+static size_t values_row(const hd__writer_t *w, size_t k, char sep, int dc, char *row) {
+    size_t n = 0;
+    for (size_t j = 0; j < w->nf; j++) {
+        if (j) row[n++] = sep;
+        char *num = row + n;
+        size_t len = hd__shortest(w->f[j].values[k], num);
+        char *dot = dc ? memchr(num, '.', len) : NULL;
+        if (dot) *dot = ',';
+        n += len;
+    }
+    return n;
+}
+
 static int write_obj(hd__writer_t *w) {
     const char *s = (const char *)w->in->data, *end = s + w->in->size, *p = s, *line, *eol;
-    if (w->keep == HD_KEEP_ALL && w->name[0])
+    if (w->keep == HD_KEEP_ALL && w->nf)
         return hd__err(w->err, HD_EUNSUPPORTED,
                        "%s: OBJ has no place for a per-vertex value (a fourth number is the weight w); write the "
                        "distances as .csv, .ply or .npy, or a subset of the OBJ",
@@ -119,9 +146,9 @@ static int write_xyz(hd__writer_t *w) {
         else if (fields(q, eol) == data_fields) names = line;
     }
     size_t k = 0, kept = hd__w_kept(w);
-    int add = w->name[0] != 0;
+    char num[40], *row = malloc(40 * w->nf + 1); /* the fields' texts, sep between them */
+    if (!row) return hd__err(w->err, HD_ENOMEM, "out of memory");
     hd__w_put(w, s, (size_t)(begin - s));
-    char num[40];
     for (p = begin; hd__next_line(&p, end, &line, &eol);) {
         const char *q = skip_seps(line, eol);
         if (line == count_line && w->keep != HD_KEEP_ALL) {
@@ -132,17 +159,17 @@ static int write_xyz(hd__writer_t *w) {
             continue;
         }
         if (line < data || is_comment(q, eol)) {
-            if (line == names && add) put_with(w, line, eol, end, sep, w->name, strlen(w->name));
+            if (line == names && w->nf) put_with(w, line, eol, end, sep, row, names_row(w, sep, row));
             else hd__w_put(w, line, (size_t)(p - line));
             continue;
         }
-        if (k >= w->n) return hd__err(w->err, HD_EINVAL, "%s: more points than the %zu values", w->in->name, w->n);
+        if (k >= w->n) {
+            free(row);
+            return hd__err(w->err, HD_EINVAL, "%s: more points than the %zu values", w->in->name, w->n);
+        }
         if (hd__w_keep(w, k)) {
-            if (add) {
-                size_t n = hd__shortest(w->v[k], num);
-                char *dot = dc ? memchr(num, '.', n) : NULL;
-                if (dot) *dot = ',';
-                put_with(w, line, eol, end, sep, num, n);
+            if (w->nf) {
+                put_with(w, line, eol, end, sep, row, values_row(w, k, sep, dc, row));
             } else {
                 hd__w_put(w, line, (size_t)(p - line));
             }
@@ -150,6 +177,7 @@ static int write_xyz(hd__writer_t *w) {
         }
         k++;
     }
+    free(row);
     return k == w->n ? HD_OK : hd__err(w->err, HD_EINVAL, "%s: %zu points for %zu values", w->in->name, k, w->n);
 }
 

@@ -1,7 +1,7 @@
 /*
- * test_write_field.c -- hd_write_field: a per-point field written back into
- * the input's own format, every other byte kept; the points past a
- * threshold alone; and the refusals.
+ * test_write_field.c -- hd_write_field and hd_write_fields: per-point
+ * fields written back into the input's own format, every other byte kept;
+ * the points past a threshold alone; and the refusals.
  *
  * The outputs are checked two ways: read back by hd_read_file (the same
  * points), and taken apart here byte by byte, independently of the writer
@@ -75,6 +75,29 @@ static int write_field(const char *in, const char *out, const double *v, size_t 
     o.keep = keep;
     o.threshold = d;
     return hd_write_field(in, out, v, n, &o, written, err);
+}
+
+/* The names and values of up to three fields: distance (values()),
+ * nearest (an index), sign (+-1); field j's n values at v + j * n. */
+static const char *const names3[3] = {"distance", "nearest", "sign"};
+
+static void values3(double *v, size_t n) {
+    values(v, n);
+    for (size_t k = 0; k < n; k++) {
+        v[n + k] = (double)(k * 31 % 17) - 1.0;
+        v[2 * n + k] = k % 3 ? 1.0 : -1.0;
+    }
+}
+
+static int write_fields(const char *in, const char *out, const double *v, size_t n, size_t nf, hd_keep_t keep,
+                        double d, size_t *written, hd_error_t *err) {
+    hd_write_options_t o;
+    hd_write_options_init(&o);
+    o.keep = keep;
+    o.threshold = d;
+    hd_field_t f[3];
+    for (size_t j = 0; j < nf; j++) f[j].name = names3[j], f[j].values = v + j * n;
+    return hd_write_fields(in, out, f, nf, n, &o, written, err);
 }
 
 /* No "*.tmp-*" file is left in the test directory. */
@@ -209,6 +232,43 @@ TEST(ply_subset_keeps_the_vertices_past_the_threshold_only) {
     free(d);
 }
 
+TEST(ply_binary_vertices_larger_than_a_block_keep_their_bytes) {
+    /* a vertex with a list of 20000 ints (80 KB, more than the writer
+     * gathers before writing) between small ones */
+    tf_buf_t b = {0};
+    tf_putf(&b, "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                "property float z\nproperty list int int ids\nend_header\n");
+    for (int k = 0; k < 3; k++) {
+        for (int c = 0; c < 3; c++) tf_f32(&b, (float)(k + c), 0);
+        uint32_t m = k == 1 ? 20000 : 2;
+        tf_u32(&b, m, 0);
+        for (uint32_t i = 0; i < m; i++) tf_u32(&b, i * 3 + (uint32_t)k, 0);
+    }
+    const char *in = tf_finish(&b, "biglist.ply");
+    size_t nin;
+    unsigned char *src = tf_read(in, &nin);
+    double v[9];
+    values3(v, 3);
+    hd_error_t err;
+    CHECK_RC(write_fields(in, tf_path("biglist_out.ply"), v, 3, 2, HD_KEEP_ALL, 0, NULL, &err), HD_OK);
+    size_t n;
+    unsigned char *d = tf_read(tf_path("biglist_out.ply"), &n);
+    const char *h = d ? strstr((char *)d, "end_header\n") : NULL;
+    const unsigned char *s = src ? (const unsigned char *)strstr((char *)src, "end_header\n") + 11 : NULL;
+    CHECK(h && s && n == (size_t)((const unsigned char *)h + 11 - d) + (nin - (size_t)(s - src)) + 3 * 16);
+    const unsigned char *p = h ? (const unsigned char *)h + 11 : NULL;
+    for (int k = 0; p && s && k < 3; k++) {
+        size_t rec = 16 + 4 * (k == 1 ? 20000 : 2);
+        CHECK(memcmp(p, s, rec) == 0);
+        CHECK_BITS(le_f64(p + rec), v[k]);
+        CHECK_BITS(le_f64(p + rec + 8), v[3 + k]);
+        p += rec + 16;
+        s += rec;
+    }
+    free(d);
+    free(src);
+}
+
 TEST(ply_with_the_property_already_is_refused) {
     const char *in = tf_printf("has.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
                                           "property float z\nproperty float distance\nend_header\n0 0 0 1\n");
@@ -217,6 +277,97 @@ TEST(ply_with_the_property_already_is_refused) {
     CHECK_RC(write_field(in, tf_path("has_out.ply"), &v, 1, HD_KEEP_ALL, 0, NULL, &err), HD_EINVAL);
     CHECK(strstr(err.message, "already has a property 'distance'"));
     CHECK(access(tf_path("has_out.ply"), F_OK) != 0);
+}
+
+/* Several fields: one `property double` each, in order, after the
+ * vertex's own; each vertex line or record gets the values in that
+ * order; a subset is chosen by the first field. */
+static void ply_ascii_fields(size_t nf) {
+    CONTEXT("%zu fields", nf);
+    const char *in = tf_printf("af.ply", "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+                                         "property float z\nelement face 1\nproperty list uchar int vertex_indices\n"
+                                         "end_header\n0 0 0\n1 0 0\n0 1 0\n1 1 1\n3 0 1 2\n");
+    double v[12];
+    values3(v, 4);
+    const char *out = tf_path("af_out.ply");
+    hd_error_t err;
+    size_t written = 0;
+    CHECK_RC(write_fields(in, out, v, 4, nf, HD_KEEP_ALL, 0, &written, &err), HD_OK);
+    CHECK_EQ(written, 4);
+    size_t n;
+    char *d = (char *)tf_read(out, &n);
+    char want[256] = "property float z\n";
+    for (size_t j = 0; j < nf; j++) snprintf(want + strlen(want), 64, "property double %s\n", names3[j]);
+    strcat(want, "element face 1\n");
+    CHECK(d && strstr(d, want));
+    const char *p = d ? strstr(d, "end_header\n") + 11 : NULL;
+    for (size_t k = 0; p && k < 4 && !hdt_failed(); k++) {
+        CONTEXT("vertex %zu", k);
+        for (int c = 0; c < 3; c++) strtod(p, (char **)&p); /* x y z */
+        for (size_t j = 0; j < nf; j++) {
+            char *end;
+            CHECK(*p == ' ');
+            CHECK_BITS(strtod(p, &end), v[j * 4 + k]);
+            p = end;
+        }
+        CHECK(*p == '\n');
+        p++;
+    }
+    CHECK(p && strcmp(p, "3 0 1 2\n") == 0);
+    free(d);
+}
+
+static void ply_binary_fields(int big, size_t nf) {
+    CONTEXT("big-endian %d, %zu fields", big, nf);
+    const char *in = binary_ply(big ? "bef.ply" : "lef.ply", big);
+    size_t nin;
+    unsigned char *src = tf_read(in, &nin);
+    double v[9];
+    values3(v, 3);
+    const char *out = tf_path("bf_out.ply");
+    hd_error_t err;
+    for (int subset = 0; subset < 2; subset++) {
+        CONTEXT("subset %d", subset);
+        double d0 = v[0]; /* the first point's first value: the subset keeps the two others */
+        size_t written = 0;
+        CHECK_RC(write_fields(in, out, v, 3, nf, subset ? HD_KEEP_FARTHER : HD_KEEP_ALL, d0, &written, &err), HD_OK);
+        size_t n;
+        unsigned char *d = tf_read(out, &n);
+        const char *hend = d ? strstr((char *)d, "end_header\n") : NULL;
+        CHECK(hend && strstr((char *)d, nf == 2 ? "property uchar quality\nproperty double distance\nproperty double "
+                                                  "nearest\n"
+                                                : "property double distance\nproperty double nearest\nproperty double "
+                                                  "sign\n"));
+        CHECK(hend && strstr((char *)d, subset ? "\nend_header\n" : "\nelement face 1\n"));
+        if (!hend || !src) return;
+        const unsigned char *p = (const unsigned char *)hend + 11;
+        const unsigned char *s = (const unsigned char *)strstr((char *)src, "end_header\n") + 11;
+        size_t kept = 0;
+        for (int k = 0; k < 3; k++, s += 17) {
+            if (subset && !(v[k] > d0)) continue;
+            CHECK(memcmp(p, s, 17) == 0);
+            for (size_t j = 0; j < nf; j++) CHECK_BITS(big ? be_f64(p + 17 + 8 * j) : le_f64(p + 17 + 8 * j), v[j * 3 + k]);
+            p += 17 + 8 * nf;
+            kept++;
+        }
+        CHECK_EQ(written, kept);
+        if (!subset) { /* the face and extra elements, byte for byte */
+            size_t tail = nin - (size_t)(s - src);
+            CHECK(n - (size_t)(p - d) == tail && memcmp(p, s, tail) == 0);
+        } else {
+            CHECK(kept == 2 && p == d + n);
+        }
+        free(d);
+    }
+    free(src);
+}
+
+TEST(ply_takes_two_and_three_fields_in_one_pass) {
+    for (size_t nf = 2; nf <= 3; nf++) {
+        ply_ascii_fields(nf);
+        ply_binary_fields(0, nf);
+        ply_binary_fields(1, nf);
+    }
 }
 
 /* ---- LAS ------------------------------------------------------------------ */
@@ -402,6 +553,83 @@ TEST(las_with_the_dimension_already_is_refused) {
     free(d);
 }
 
+/* Several fields: one descriptor each after the undescribed bytes' one,
+ * named, with its kept values' range; 8 bytes each after every record. */
+static void las_fields_case(unsigned minor, unsigned fmt, size_t nf, int subset) {
+    CONTEXT("LAS 1.%u format %u, %zu fields, subset %d", minor, fmt, nf, subset);
+    size_t n = 40;
+    const char *in = las_file("inf.las", minor, fmt, n, 3);
+    double *v = malloc(3 * n * sizeof *v);
+    values3(v, n);
+    const char *out = tf_path("outf.las");
+    hd_error_t err;
+    size_t written = 0;
+    CHECK_RC(write_fields(in, out, v, n, nf, subset ? HD_KEEP_FARTHER : HD_KEEP_ALL, 100.0, &written, &err), HD_OK);
+    size_t ni, no;
+    unsigned char *s = tf_read(in, &ni), *d = tf_read(out, &no);
+    las_t I, O;
+    las_parse(s, &I);
+    CHECK(las_parse(d, &O));
+    CHECK_EQ(O.rec, I.rec + 8 * nf);
+    CHECK_EQ(O.offset, I.offset + 54 + 192 * (1 + nf));
+    CHECK(O.eb_len == 192 * (1 + nf) && O.eb[2] == 0 && O.eb[3] == 3);
+    for (size_t j = 0; j < nf; j++) {
+        const unsigned char *e = O.eb + 192 * (1 + j);
+        CONTEXT("descriptor of %s", names3[j]);
+        CHECK(e[2] == 10 && e[3] == 6 && strcmp((const char *)e + 4, names3[j]) == 0);
+        double lo = 0, hi = 0;
+        int any = 0;
+        for (size_t k = 0; k < n; k++)
+            if (!subset || v[k] > 100.0) {
+                double x = v[j * n + k];
+                if (!any || x < lo) lo = x;
+                if (!any || x > hi) hi = x;
+                any = 1;
+            }
+        CHECK_BITS(le_f64(e + 64), lo);
+        CHECK_BITS(le_f64(e + 88), hi);
+    }
+    size_t kept = 0;
+    for (size_t k = 0; k < n && !hdt_failed(); k++) {
+        if (subset && !(v[k] > 100.0)) continue;
+        const unsigned char *r = d + O.offset + kept * O.rec;
+        CHECK(memcmp(r, s + I.offset + k * I.rec, I.rec) == 0);
+        for (size_t j = 0; j < nf; j++) CHECK_BITS(le_f64(r + I.rec + 8 * j), v[j * n + k]);
+        kept++;
+    }
+    CHECK(written == kept && O.count == kept);
+    if (minor >= 4) CHECK(le(d + 235, 8) == O.offset + kept * O.rec && memcmp(d + no - 4, "EVLR", 4) == 0);
+    free(s), free(d), free(v);
+}
+
+TEST(las_takes_several_fields_with_a_descriptor_each) {
+    for (size_t nf = 2; nf <= 3; nf++)
+        for (int subset = 0; subset < 2; subset++) {
+            las_fields_case(2, 1, nf, subset);
+            las_fields_case(4, 6, nf, subset);
+            las_fields_case(4, 3, nf, subset);
+        }
+    /* an extra-bytes VLR with one field gets the others' descriptors after it */
+    const char *in = las_file("ebf.las", 2, 0, 4, 0);
+    double v[12];
+    values3(v, 4);
+    hd_error_t err;
+    CHECK_RC(write_field(in, tf_path("ebf1.las"), v, 4, HD_KEEP_ALL, 0, NULL, &err), HD_OK);
+    hd_write_options_t o;
+    hd_write_options_init(&o);
+    hd_field_t f[2] = {{"nearest", v + 4}, {"sign", v + 8}};
+    CHECK_RC(hd_write_fields(tf_path("ebf1.las"), tf_path("ebf2.las"), f, 2, 4, &o, NULL, &err), HD_OK);
+    size_t n;
+    unsigned char *d = tf_read(tf_path("ebf2.las"), &n);
+    las_t L;
+    CHECK(d && las_parse(d, &L) && L.eb_len == 3 * 192 && L.rec == 20 + 24);
+    for (int j = 0; d && j < 3; j++) {
+        CHECK(strcmp((const char *)L.eb + 192 * j + 4, names3[j]) == 0);
+        for (size_t k = 0; k < 4; k++) CHECK_BITS(le_f64(d + L.offset + k * L.rec + 20 + 8 * j), v[4 * j + k]);
+    }
+    free(d);
+}
+
 /* ---- text ----------------------------------------------------------------- */
 TEST(text_lines_kept_with_the_value_as_a_column) {
     const char *in = tf_printf("pts.csv", "X,Y,Z\n# a comment\n1.5,2,3\n\n4,5,6,7\n");
@@ -432,6 +660,54 @@ TEST(text_lines_kept_with_the_value_as_a_column) {
     d = (char *)tf_read(tf_path("dc_out.csv"), &n);
     CHECK(d && strcmp(d, "1,5;2;3;0,25\r\n") == 0);
     free(d);
+    /* two fields: each value with its decimal comma, semicolons between */
+    double u2 = 1.5;
+    hd_field_t f[2] = {{"distance", &u}, {"nearest", &u2}};
+    CHECK_RC(hd_write_fields(in, tf_path("dcf_out.csv"), f, 2, 1, &o, NULL, &err), HD_OK);
+    d = (char *)tf_read(tf_path("dcf_out.csv"), &n);
+    CHECK(d && strcmp(d, "1,5;2;3;0,25;1,5\r\n") == 0);
+    free(d);
+}
+
+TEST(text_takes_several_columns_in_one_pass) {
+    const char *in = tf_printf("pf.csv", "X,Y,Z\n1.5,2,3\n4,5,6\n7,8,9\n");
+    double v[9] = {0.1, 2.0 / 3.0, 0.3, 3, 0, 12, 1, -1, 1};
+    hd_error_t err;
+    CHECK_RC(write_fields(in, tf_path("pf2.csv"), v, 3, 2, HD_KEEP_ALL, 0, NULL, &err), HD_OK);
+    size_t n;
+    char *d = (char *)tf_read(tf_path("pf2.csv"), &n);
+    CHECK(d && strcmp(d, "X,Y,Z,distance,nearest\n1.5,2,3,0.1,3\n4,5,6,0.6666666666666666,0\n7,8,9,0.3,12\n") == 0);
+    free(d);
+    CHECK_RC(write_fields(in, tf_path("pf3.csv"), v, 3, 3, HD_KEEP_FARTHER, 0.2, NULL, &err), HD_OK);
+    d = (char *)tf_read(tf_path("pf3.csv"), &n);
+    CHECK(d && strcmp(d, "X,Y,Z,distance,nearest,sign\n4,5,6,0.6666666666666666,0,-1\n7,8,9,0.3,12,1\n") == 0);
+    free(d);
+}
+
+TEST(fields_without_a_name_or_with_one_twice_are_refused) {
+    const char *in = tf_printf("nf.ply", "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
+                                         "property float z\nproperty float nearest\nend_header\n0 0 0 1\n1 1 1 2\n");
+    double v[2] = {1, 2};
+    const char *out = tf_path("nf_out.ply");
+    hd_write_options_t o;
+    hd_write_options_init(&o);
+    hd_error_t err;
+    hd_field_t twice[2] = {{"distance", v}, {"distance", v}};
+    CHECK_RC(hd_write_fields(in, out, twice, 2, 2, &o, NULL, &err), HD_EINVAL);
+    CHECK(strstr(err.message, "fields 1 and 2 are both named 'distance'"));
+    hd_field_t empty[2] = {{"distance", v}, {"", v}};
+    CHECK_RC(hd_write_fields(in, out, empty, 2, 2, &o, NULL, &err), HD_EINVAL);
+    hd_field_t none[1] = {{"distance", NULL}};
+    CHECK_RC(hd_write_fields(in, out, none, 1, 2, &o, NULL, &err), HD_EINVAL);
+    CHECK_RC(hd_write_fields(in, out, twice, 0, 2, &o, NULL, &err), HD_EINVAL);
+    CHECK_RC(hd_write_fields(in, out, twice, 8192, 2, &o, NULL, &err), HD_EINVAL); /* checked before any is read */
+    CHECK(strstr(err.message, "8192 fields, at most 8191"));
+    CHECK_RC(hd_write_fields(in, out, NULL, 1, 2, &o, NULL, &err), HD_EINVAL);
+    hd_field_t had[2] = {{"distance", v}, {"nearest", v}}; /* the second is a property of the file */
+    CHECK_RC(hd_write_fields(in, out, had, 2, 2, &o, NULL, &err), HD_EINVAL);
+    CHECK(strstr(err.message, "already has a property 'nearest'"));
+    CHECK(access(out, F_OK) != 0);
+    CHECK(no_temporaries());
 }
 
 TEST(obj_subset_keeps_its_lines_without_the_faces) {
@@ -493,21 +769,25 @@ TEST(a_file_size_limit_leaves_no_file) {
     tf_buf_t b = {0};
     for (size_t k = 0; k < n; k++) tf_putf(&b, "%zu 1 2\n", k);
     const char *in = tf_finish(&b, "big.xyz");
-    double *v = malloc(n * sizeof *v);
-    values(v, n);
+    double *v = malloc(3 * n * sizeof *v);
+    values3(v, n);
     struct rlimit old, lim;
     getrlimit(RLIMIT_FSIZE, &old);
     lim = old;
     lim.rlim_cur = 64 * 1024;
     void (*prev)(int) = signal(SIGXFSZ, SIG_IGN);
     CHECK(setrlimit(RLIMIT_FSIZE, &lim) == 0);
-    hd_error_t err;
+    hd_error_t err, err3;
     int rc = write_field(in, tf_path("big_out.xyz"), v, n, HD_KEEP_ALL, 0, NULL, &err);
+    int rc3 = write_fields(in, tf_path("big_out3.xyz"), v, n, 3, HD_KEEP_ALL, 0, NULL, &err3);
     setrlimit(RLIMIT_FSIZE, &old);
     signal(SIGXFSZ, prev);
     CHECK_RC(rc, HD_EIO);
     CHECK(strstr(err.message, "cannot write: File too large"));
     CHECK(access(tf_path("big_out.xyz"), F_OK) != 0);
+    CHECK_RC(rc3, HD_EIO); /* three fields in one pass: the same */
+    CHECK(strstr(err3.message, "cannot write: File too large"));
+    CHECK(access(tf_path("big_out3.xyz"), F_OK) != 0);
     CHECK(no_temporaries());
     free(v);
 }

@@ -1,10 +1,11 @@
 /*
- * test_write_laz.c -- hd_write_field into layered LAZ (src/io/write_laz.c):
+ * test_write_laz.c -- hd_write_field and hd_write_fields into layered LAZ
+ * (src/io/write_laz.c):
  * files of the tests' LAZ writer (random points in every scanner channel,
  * fixed and variable chunks, with and without extra bytes) get a field;
  * the output is taken apart here: its header and LASzip VLR, its chunk
  * table, every chunk's old layers byte for byte as they were, and the
- * eight new BYTE14 layers decoded by this file's own loop over the
+ * new BYTE14 layers (8 a field) decoded by this file's own loop over the
  * coder's primitives with LASzip's v3 rule for the scanner channels (the
  * channel of each point known from the points given to the writer), so
  * every value comes back bit for bit.  Pointwise LAZ (formats 0-3) whose
@@ -68,79 +69,101 @@ static void table(const unsigned char *d, size_t size, uint64_t at, int variable
     hd__intcoder_free(&ic);
 }
 
-/* The eight BYTE14 layers at `layers` (sizes `sz`) of a chunk of n
- * points with channels p[].channel, decoded with LASzip's v3 rule: a
- * channel's models and last bytes start from the last bytes of the
- * channel before it when it first appears; at a switch to a channel seen
- * before, the point is predicted from (and updates) the last bytes of
- * the channel it follows. */
-static void decode_bytes(const unsigned char *first, const unsigned char *layers, const uint32_t sz[8],
-                         const lazw_point_t *p, size_t n, double *out) {
-    hd__dec_t dec[8];
-    hd__symmodel_t m[4][8];
-    unsigned char last[4][8];
+/* The nb BYTE14 layers at `layers` (sizes `sz`) of a chunk of n points
+ * with channels p[].channel, decoded with LASzip's v3 rule into out (nb
+ * bytes a point): a channel's models and last bytes start from the last
+ * bytes of the channel before it when it first appears; at a switch to a
+ * channel seen before, the point is predicted from (and updates) the last
+ * bytes of the channel it follows. */
+static void decode_bytes(const unsigned char *first, const unsigned char *layers, const uint32_t *sz, size_t nb,
+                         const lazw_point_t *p, size_t n, unsigned char *out) {
+    hd__dec_t *dec = calloc(nb, sizeof *dec);
+    hd__symmodel_t(*m)[4] = calloc(nb, sizeof *m);
+    unsigned char *last = calloc(4, nb);
     int used[4] = {0};
     size_t at = 0;
-    for (int b = 0; b < 8; b++) {
+    for (size_t b = 0; b < nb; b++) {
         hd__dec_init(&dec[b], layers + at, sz[b]);
         at += sz[b];
-        for (int c = 0; c < 4; c++) CHECK(hd__symmodel_new(&m[c][b], 256) == HD_OK);
+        for (int c = 0; c < 4; c++) CHECK(hd__symmodel_new(&m[b][c], 256) == HD_OK);
     }
     unsigned cur = p[0].channel;
-    memcpy(last[cur], first, 8);
+    memcpy(last + cur * nb, first, nb);
     used[cur] = 1;
-    memcpy(&out[0], first, 8);
+    memcpy(out, first, nb);
     for (size_t i = 1; i < n; i++) {
-        unsigned char *L = last[cur];
+        unsigned char *L = last + cur * nb;
         if (p[i].channel != cur) {
             cur = p[i].channel;
             if (!used[cur]) {
                 used[cur] = 1;
-                memcpy(last[cur], L, 8);
-                L = last[cur];
+                memcpy(last + cur * nb, L, nb);
+                L = last + cur * nb;
             }
         }
-        for (int b = 0; b < 8; b++)
-            if (sz[b]) L[b] = (unsigned char)(L[b] + hd__dec_symbol(&dec[b], &m[cur][b]));
-        memcpy(&out[i], L, 8);
+        for (size_t b = 0; b < nb; b++)
+            if (sz[b]) L[b] = (unsigned char)(L[b] + hd__dec_symbol(&dec[b], &m[b][cur]));
+        memcpy(out + i * nb, L, nb);
     }
-    for (int b = 0; b < 8; b++) {
+    for (size_t b = 0; b < nb; b++) {
         CHECK(sz[b] == 0 || (dec[b].over == 0 && dec[b].p == dec[b].end)); /* each layer used up exactly */
-        for (int c = 0; c < 4; c++) hd__symmodel_free(&m[c][b]);
+        for (int c = 0; c < 4; c++) hd__symmodel_free(&m[b][c]);
     }
+    free(dec), free(m), free(last);
 }
 
-static void laz_case(const lazw_opts_t *o, size_t n, uint64_t seed) {
-    CONTEXT("format %d extra %u chunk %u seed %llu", o->format, o->extra, o->chunk_size, (unsigned long long)seed);
+/* nf fields of n values (field j's at v + j * n): runs of equal values,
+ * small steps, any double; an index; a sign. */
+static void field_values(gen_rng_t *g, double *v, size_t n, size_t nf) {
+    for (size_t k = 0; k < n; k++)
+        v[k] = k % 5 == 0 ? gen_unit(g) * 1e3 : k % 5 == 1 ? v[k - 1] : k % 5 == 2 ? v[k - 1] + 1e-9 : gen_normal(g);
+    for (size_t j = 1; j < nf; j++)
+        for (size_t k = 0; k < n; k++) v[j * n + k] = j == 1 ? (double)(k * 7 % 1000) : k % 3 ? 1.0 : -1.0;
+}
+
+static const char *const field_names[3] = {"distance", "nearest", "sign"};
+
+/* hd_write_fields of nf fields (values field_values's, names field_names). */
+static int write_fields(const char *in, const char *out, const double *v, size_t n, size_t nf,
+                        const hd_write_options_t *o, size_t *written, hd_error_t *err) {
+    hd_field_t f[3];
+    for (size_t j = 0; j < nf; j++) f[j].name = field_names[j], f[j].values = v + j * n;
+    return hd_write_fields(in, out, f, nf, n, o, written, err);
+}
+
+static void laz_case(const lazw_opts_t *o, size_t n, uint64_t seed, size_t nf) {
+    CONTEXT("format %d extra %u chunk %u seed %llu fields %zu", o->format, o->extra, o->chunk_size,
+            (unsigned long long)seed, nf);
     gen_rng_t g;
     gen_seed(&g, seed);
     lazw_point_t *p = malloc(n * sizeof *p);
     lazw_random(&g, p, n, o->format);
     tf_buf_t b = {0};
     lazw_encode(&b, o, p, n);
-    size_t nin = b.size;
+    size_t nin = b.size, nb = 8 * nf;
     unsigned char *src = malloc(nin);
     memcpy(src, b.data, nin);
     const char *in = tf_finish(&b, "in.laz");
-    double *v = malloc(n * sizeof *v), *got = malloc(n * sizeof *got);
-    for (size_t k = 0; k < n; k++) /* runs of equal values, small steps, any double */
-        v[k] = k % 5 == 0 ? gen_unit(&g) * 1e3 : k % 5 == 1 ? v[k - 1] : k % 5 == 2 ? v[k - 1] + 1e-9 : gen_normal(&g);
+    double *v = malloc(nf * n * sizeof *v);
+    unsigned char *got = malloc(n * nb);
+    field_values(&g, v, n, nf);
     const char *out = tf_path("out.laz");
     hd_error_t err;
     size_t written = 0;
-    CHECK_RC(hd_write_field(in, out, v, n, NULL, &written, &err), HD_OK);
+    if (nf == 1) CHECK_RC(hd_write_field(in, out, v, n, NULL, &written, &err), HD_OK);
+    else CHECK_RC(write_fields(in, out, v, n, nf, NULL, &written, &err), HD_OK);
     CHECK_EQ(written, n);
     size_t no;
     unsigned char *d = tf_read(out, &no);
     laz_t I, O;
     parse(src, &I);
     parse(d, &O);
-    CHECK_EQ(O.rec, I.rec + 8);
+    CHECK_EQ(O.rec, I.rec + nb);
     CHECK_EQ(O.last_type, 14);
-    CHECK_EQ(O.last_size, o->extra + 8);
+    CHECK_EQ(O.last_size, o->extra + nb);
     CHECK_EQ(O.n_items, I.n_items + (o->extra == 0));
     size_t nc = o->chunk_size ? (n + o->chunk_size - 1) / o->chunk_size : o->n_chunks;
-    uint32_t *ib = calloc(nc, 4), *ob = calloc(nc, 4), *ic = calloc(nc, 4), *oc = calloc(nc, 4);
+    uint32_t *ib = calloc(nc, 4), *ob = calloc(nc, 4), *ic = calloc(nc, 4), *oc = calloc(nc, 4), *sz = calloc(nb, 4);
     table(src, nin, I.table, !o->chunk_size, nc, ib, ic);
     table(d, no, O.table, !o->chunk_size, nc, ob, oc);
     CHECK(memcmp(ic, oc, nc * 4) == 0);
@@ -148,20 +171,25 @@ static void laz_case(const lazw_opts_t *o, size_t n, uint64_t seed) {
     for (size_t c = 0; c < nc && !hdt_failed(); c++) {
         size_t k = o->chunk_size ? (n - first < o->chunk_size ? n - first : o->chunk_size) : o->chunks[c];
         const unsigned char *ci = src + at_i, *co = d + at_o;
-        CHECK(memcmp(co, ci, I.rec) == 0);                           /* the first point */
-        CHECK(memcmp(co + I.rec + 8, ci + I.rec, 4 + 4 * layers) == 0); /* count, old sizes */
-        uint32_t sz[8], old = 0, add = 0;
+        CHECK(memcmp(co, ci, I.rec) == 0);                            /* the first point */
+        CHECK(memcmp(co + I.rec + nb, ci + I.rec, 4 + 4 * layers) == 0); /* count, old sizes */
+        uint32_t old = 0, add = 0;
         for (size_t q = 0; q < layers; q++) old += (uint32_t)le(ci + I.rec + 4 + 4 * q, 4);
-        for (int q = 0; q < 8; q++) add += sz[q] = (uint32_t)le(co + I.rec + 8 + 4 + 4 * layers + 4 * q, 4);
-        size_t hi = I.rec + 4 + 4 * layers, ho = hi + 8 + 32;
+        for (size_t q = 0; q < nb; q++) add += sz[q] = (uint32_t)le(co + I.rec + nb + 4 + 4 * layers + 4 * q, 4);
+        size_t hi = I.rec + 4 + 4 * layers, ho = hi + nb + 4 * nb;
         CHECK(memcmp(co + ho, ci + hi, old) == 0); /* the old layers */
-        CHECK_EQ(ob[c], ib[c] + 8 + 32 + add);
-        decode_bytes(co + I.rec, co + ho + old, sz, p + first, k, got + first);
+        CHECK_EQ(ob[c], ib[c] + nb + 4 * nb + add);
+        decode_bytes(co + I.rec, co + ho + old, sz, nb, p + first, k, got + first * nb);
         at_i += ib[c];
         at_o += ob[c];
         first += k;
     }
-    for (size_t k = 0; k < n && !hdt_failed(); k++) CHECK_BITS(got[k], v[k]);
+    for (size_t k = 0; k < n && !hdt_failed(); k++)
+        for (size_t j = 0; j < nf; j++) {
+            double x;
+            memcpy(&x, got + k * nb + 8 * j, 8);
+            CHECK_BITS(x, v[j * n + k]);
+        }
     /* the points read back as before */
     hd_cloud_t *a = NULL, *c = NULL;
     CHECK_RC(hd_read_file(in, NULL, &a, &err), HD_OK);
@@ -169,20 +197,32 @@ static void laz_case(const lazw_opts_t *o, size_t n, uint64_t seed) {
     CHECK(a && c && a->count == c->count && memcmp(a->data, c->data, 3 * n * sizeof(double)) == 0);
     hd_cloud_free(a);
     hd_cloud_free(c);
-    free(ib), free(ob), free(ic), free(oc);
+    free(ib), free(ob), free(ic), free(oc), free(sz);
     free(d), free(src), free(v), free(got), free(p);
 }
 
 TEST(layered_laz_gains_the_field_as_byte14_layers) {
     lazw_opts_t o = {6, 0, 50, NULL, 0, {0.01, 0.01, 0.001}, {1000.5, -20.25, 3}, 0};
-    for (uint64_t seed = 1; seed <= 3; seed++) laz_case(&o, 1000, seed);
+    for (uint64_t seed = 1; seed <= 3; seed++) laz_case(&o, 1000, seed, 1);
     o.extra = 3; /* a BYTE14 item grows */
-    laz_case(&o, 777, 4);
+    laz_case(&o, 777, 4, 1);
     size_t chunks[4] = {1, 300, 2, 197};
     lazw_opts_t v = {6, 2, 0, chunks, 4, {0.01, 0.01, 0.01}, {0, 0, 0}, 0};
-    laz_case(&v, 500, 5);
+    laz_case(&v, 500, 5, 1);
     o.chunk_size = 1; /* one-point chunks: empty layers */
-    laz_case(&o, 5, 6);
+    laz_case(&o, 5, 6, 1);
+}
+
+TEST(layered_laz_gains_several_fields_as_eight_byte14_layers_each) {
+    for (size_t nf = 2; nf <= 3; nf++) {
+        lazw_opts_t o = {6, 0, 50, NULL, 0, {0.01, 0.01, 0.001}, {1000.5, -20.25, 3}, 0};
+        laz_case(&o, 1000, 10 + nf, nf); /* a BYTE14 item of 8 * nf added */
+        o.extra = 3;                      /* a BYTE14 item grows by 8 * nf */
+        laz_case(&o, 777, 20 + nf, nf);
+        size_t chunks[4] = {1, 300, 2, 197};
+        lazw_opts_t v = {6, 2, 0, chunks, 4, {0.01, 0.01, 0.01}, {0, 0, 0}, 0};
+        laz_case(&v, 500, 30 + nf, nf);
+    }
 }
 
 TEST(laz_extended_vlrs_follow_the_points_with_their_offset_moved) {
@@ -280,6 +320,49 @@ TEST(pointwise_laz_is_compressed_again_with_every_field) {
                     CHECK_BITS(got, v[k]);
                     j++;
                 }
+                free(out);
+            }
+            free(v);
+            free(recs);
+        }
+}
+
+TEST(pointwise_laz_takes_several_fields_in_the_byte_item) {
+    for (int fmt = 1; fmt <= 3; fmt += 2)
+        for (size_t nf = 2; nf <= 3; nf++) {
+            unsigned extra = fmt == 3 ? 2 : 0;
+            CONTEXT("format %d extra %u fields %zu", fmt, extra, nf);
+            gen_rng_t g;
+            gen_seed(&g, 177 + (uint64_t)fmt * 10 + nf);
+            size_t n = 2501, rec, m, mrec;
+            unsigned char *recs = lazw_rich_records(&g, fmt, extra, n, &rec);
+            tf_buf_t b = {0};
+            lazw_pointwise(&b, fmt, extra, recs, rec, n, 1000);
+            const char *in = tf_finish(&b, "rich_n.laz");
+            double *v = malloc(nf * n * sizeof *v);
+            field_values(&g, v, n, nf);
+            hd_error_t err;
+            hd_write_options_t o;
+            hd_write_options_init(&o);
+            for (int keep = 0; keep < 2; keep++) {
+                o.keep = keep ? HD_KEEP_FARTHER : HD_KEEP_ALL;
+                o.threshold = 0.25; /* on the first field */
+                size_t written = 0;
+                CHECK_RC(write_fields(in, tf_path("rich_n_out.laz"), v, n, nf, &o, &written, &err), HD_OK);
+                unsigned char *out = records_of(tf_path("rich_n_out.laz"), &m, &mrec);
+                CHECK(mrec == rec + 8 * nf && m == written);
+                size_t j = 0;
+                for (size_t k = 0; k < n && !hdt_failed(); k++) {
+                    if (keep && !(v[k] > 0.25)) continue;
+                    CHECK(memcmp(out + j * mrec, recs + k * rec, rec) == 0);
+                    for (size_t f = 0; f < nf; f++) {
+                        double x;
+                        memcpy(&x, out + j * mrec + rec + 8 * f, 8);
+                        CHECK_BITS(x, v[f * n + k]);
+                    }
+                    j++;
+                }
+                CHECK(keep ? j < n : j == n);
                 free(out);
             }
             free(v);
