@@ -13,6 +13,7 @@
 #include <stdatomic.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <string.h>
 
 #define HD__NONE ((size_t)-1)
 
@@ -149,6 +150,20 @@ HD__INLINE int hd__parts_for(size_t n, int parts) {
  * fewer threads). */
 typedef void (*hd__task_fn)(void *ctx, size_t task, int worker);
 void hd__parallel_for(int threads, size_t n_tasks, hd__task_fn fn, void *ctx);
+
+/* ---- a double's bits ---------------------------------------------------- */
+/* The IEEE 754 binary64 bits of x, and the double with bits u: for an
+ * x >= 0 (or +0), the order of the bits is the order of the values. */
+HD__INLINE uint64_t hd__bits_of(double x) {
+    uint64_t u;
+    memcpy(&u, &x, sizeof u);
+    return u;
+}
+HD__INLINE double hd__double_of(uint64_t u) {
+    double x;
+    memcpy(&x, &u, sizeof x);
+    return x;
+}
 
 /* ---- clocks ------------------------------------------------------------ */
 double hd__now(void); /* seconds, monotonic */

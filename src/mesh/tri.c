@@ -132,19 +132,10 @@ HD__INLINE void two_prod_x(double a, double b, double *p, double *e, int fma) {
 /* ---- powers of two and binades, by their bits -------------------------- */
 
 /* 2^e for a normal result (-1022 <= e <= 1023). */
-HD__INLINE double pow2(int e) {
-    uint64_t bits = (uint64_t)(e + 1023) << 52;
-    double r;
-    memcpy(&r, &bits, sizeof r);
-    return r;
-}
+HD__INLINE double pow2(int e) { return hd__double_of((uint64_t)(e + 1023) << 52); }
 
 /* floor(log2(x)) for a normal x > 0. */
-HD__INLINE int binade(double x) {
-    uint64_t bits;
-    memcpy(&bits, &x, sizeof bits);
-    return (int)((bits >> 52) & 0x7ff) - 1023;
-}
+HD__INLINE int binade(double x) { return (int)((hd__bits_of(x) >> 52) & 0x7ff) - 1023; }
 
 /* ---- double-doubles with an error bound ------------------------------- */
 

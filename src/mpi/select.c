@@ -338,18 +338,6 @@ typedef struct {
     size_t a[2], b[2];
 } sel_t;
 
-static uint64_t bits_of(double x) {
-    uint64_t u;
-    memcpy(&u, &x, sizeof u);
-    return u;
-}
-
-static double double_of(uint64_t u) {
-    double x;
-    memcpy(&x, &u, sizeof x);
-    return x;
-}
-
 /* The values of the ns selections into out[] (step 3's radix selection:
  * non-negative doubles order as their bits).  Collective. */
 static int select_ranks(hd__mpi_ctx_t *c, const part_t pt[2], sel_t *sel, int ns, double *out) {
@@ -364,7 +352,7 @@ static int select_ranks(hd__mpi_ctx_t *c, const part_t pt[2], sel_t *sel, int ns
         for (int s = 0; s < ns; s++)
             for (int d = 0; d < 2; d++) {
                 uint64_t *h = dir + ((size_t)s * 2 + (size_t)d) * BINS;
-                for (size_t i = sel[s].a[d]; i < sel[s].b[d]; i++) h[(bits_of(pt[d].v[i]) >> shift) & (BINS - 1)]++;
+                for (size_t i = sel[s].a[d]; i < sel[s].b[d]; i++) h[(hd__bits_of(pt[d].v[i]) >> shift) & (BINS - 1)]++;
                 for (uint32_t e = 0; e < BINS; e++) mine[(size_t)s * BINS + e] += h[e];
             }
         HD__MPI_GO(c, rc, MPI_Allreduce(mine, all, (int)words, MPI_UINT64_T, MPI_SUM, c->comm));
@@ -381,7 +369,7 @@ static int select_ranks(hd__mpi_ctx_t *c, const part_t pt[2], sel_t *sel, int ns
             }
         }
     }
-    for (int s = 0; s < ns; s++) out[s] = double_of(sel[s].prefix);
+    for (int s = 0; s < ns; s++) out[s] = hd__double_of(sel[s].prefix);
 done:
     hd__mpi_free(c, dir, 4 * words, sizeof(uint64_t));
     return rc;

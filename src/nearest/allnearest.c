@@ -1054,9 +1054,7 @@ HD__INLINE double window_bests(const hd__an_t *q, const hd__an_t *t, qgroup_t *G
     for (size_t k = 0, p = 0, b = 0; k < m; k++) {
         b = b > G->seed[k] ? b : G->seed[k];
         window_best(q, t, first + k, &b, &p, &G->best[k], &G->bj[k]);
-        uint64_t u;
-        __builtin_memcpy(&u, &G->best[k], sizeof u);
-        esum += (int64_t)(u >> 52);
+        esum += (int64_t)(hd__bits_of(G->best[k]) >> 52);
     }
     int64_t ecut = esum / (int64_t)m + 4;
     uint64_t ucut = (uint64_t)(ecut < 2047 ? ecut : 2047) << 52;
