@@ -342,29 +342,59 @@ static void frame_of(const hd__tri_t *tris, size_t n, hd__bvh_frame_t *f) {
     }
 }
 
+/* The frame of node k holding tris[first, first + n), made once: the
+ * thread that moves its state from 0 to 1 makes it and publishes it with
+ * state 2 (release; readers acquire); one that finds it being made uses
+ * the box meanwhile.  NULL when there is no frame (yet). */
+static const hd__bvh_frame_t *frame_get(const hd__bvh_t *t, uint32_t k, uint32_t first, uint32_t n) {
+    hd__bvh_frame_t *f = &t->frames[k];
+    int st = atomic_load_explicit(&f->state, memory_order_acquire);
+    if (st == 0 && n <= FRAME_MAX &&
+        atomic_compare_exchange_strong_explicit(&f->state, &st, 1, memory_order_relaxed, memory_order_relaxed)) {
+        frame_of(t->tris + first, n, f);
+        atomic_store_explicit(&f->state, 2, memory_order_release);
+        st = 2;
+    }
+    return st == 2 && f->ok ? f : NULL;
+}
+
+/* H: a frame's axes have |a_j|_1 <= 1.8, so a computed a_j . v is at
+ * most 1.8 V (1 + 4u) + 2^-1072 in magnitude for the largest coordinate
+ * magnitude V of the corners (the root box's), and its slabs add
+ * E = 2^-48 V + 2^-1000 and one rounding: 2 V + 2^-990 bounds every
+ * |lo_j| and |hi_j|, and the factor 1 + 2^-50 covers the rounding of that
+ * sum and of itself. */
 int hd__bvh_frames(hd__bvh_t *t) {
     free(t->frames);
-    t->frame_h = 0;
+    t->frame_h = t->frame_reach2 = 0;
     t->frames = hd__calloc_array(t->n_nodes, sizeof *t->frames);
     if (!t->frames) return HD_ENOMEM;
-    struct { uint32_t node, first, n; } stack[MAX_DEPTH];
+    for (size_t k = 0; k < t->n_nodes; k++) atomic_init(&t->frames[k].state, 0);
+    const hd__box_t *r = &t->nodes[0].box;
+    for (int k = 0; k < 3; k++) {
+        double m = fabs(r->lo[k]) > fabs(r->hi[k]) ? fabs(r->lo[k]) : fabs(r->hi[k]);
+        t->frame_h = m > t->frame_h ? m : t->frame_h;
+    }
+    t->frame_h = (2 * t->frame_h + 0x1p-990) * (1 + 0x1p-50);
+    /* the mean squared diagonal of the largest framed nodes */
+    struct { uint32_t node, n; } stack[MAX_DEPTH];
     int top = 0;
-    stack[top++].node = 0, stack[0].first = 0, stack[0].n = (uint32_t)t->n_tris;
+    size_t roots = 0;
+    stack[top].node = 0, stack[top++].n = (uint32_t)t->n_tris;
     while (top > 0) {
-        uint32_t me = stack[--top].node, first = stack[top].first, n = stack[top].n;
+        uint32_t me = stack[--top].node, n = stack[top].n;
         const hd__bvh_node_t *node = &t->nodes[me];
         if (n <= FRAME_MAX) {
-            hd__bvh_frame_t *f = &t->frames[me];
-            frame_of(t->tris + first, n, f);
-            for (int j = 0; f->ok && j < 3; j++) {
-                double m = fabs(f->lo[j]) > fabs(f->hi[j]) ? fabs(f->lo[j]) : fabs(f->hi[j]);
-                t->frame_h = m > t->frame_h ? m : t->frame_h;
-            }
+            const hd__box_t *b = &node->box;
+            double x = b->hi[0] - b->lo[0], y = b->hi[1] - b->lo[1], z = b->hi[2] - b->lo[2];
+            t->frame_reach2 += x * x + y * y + z * z;
+            roots++;
+            continue;
         }
-        if (node->count) continue;
-        stack[top].node = me + 1, stack[top].first = first, stack[top++].n = n / 2;
-        stack[top].node = node->first_or_second, stack[top].first = first + n / 2, stack[top++].n = n - n / 2;
+        stack[top].node = me + 1, stack[top++].n = n / 2;
+        stack[top].node = node->first_or_second, stack[top++].n = n - n / 2;
     }
+    t->frame_reach2 /= (double)roots;
     return HD_OK;
 }
 
@@ -610,8 +640,7 @@ static void start(const hd__bvh_t *t, const double *p, size_t seed, int seed_ker
  * relative 2^-170 when it is at least 2^-900; G (1 - 2^-40), rounded, is
  * below every such bound.  Returns that lower bound on the squared
  * distance from p to the node, or 0. */
-static double frame_lo2(const hd__bvh_frame_t *f, const double *p, double E) {
-    if (!f->ok) return 0.0;
+static inline double frame_lo2(const hd__bvh_frame_t *f, const double *p, double E) {
     double G = 0;
     for (int j = 0; j < 3; j++) {
         double d = f->a[j][0] * p[0] + f->a[j][1] * p[1] + f->a[j][2] * p[2];
@@ -629,15 +658,19 @@ static double frame_err(const hd__bvh_t *t, const double *p) {
     return 0x1p-50 * (2 * P + t->frame_h) + 0x1p-1020;
 }
 
-double hd__bvh_frame_lower2(const hd__bvh_t *t, size_t k, const double p[3]) {
-    return t->frames && k < t->n_nodes ? frame_lo2(&t->frames[k], p, frame_err(t, p)) : 0.0;
+double hd__bvh_frame_lower2(const hd__bvh_t *t, size_t k, size_t first, size_t n, const double p[3]) {
+    if (!t->frames || k >= t->n_nodes) return 0.0;
+    const hd__bvh_frame_t *f = frame_get(t, (uint32_t)k, (uint32_t)first, (uint32_t)n);
+    return f ? frame_lo2(f, p, frame_err(t, p)) : 0.0;
 }
 
 /* A lower bound on the squared distance from p to node k: the frame's
- * (frame_lo2) where the node has one, else its box's (hd__box_lb2s times
- * SHRINK: box_beyond's proof). */
-static double node_lo2(const hd__bvh_t *t, uint32_t k, const double *p, double E) {
-    if (t->frames && t->frames[k].ok) return frame_lo2(&t->frames[k], p, E);
+ * (frame_lo2) where the node has one and E >= 0, else its box's
+ * (hd__box_lb2s times SHRINK: box_beyond's proof). */
+static inline double node_lo2(const hd__bvh_t *t, uint32_t k, uint32_t first, uint32_t n, const double *p,
+                              double E) {
+    const hd__bvh_frame_t *f = E >= 0 && n <= FRAME_MAX ? frame_get(t, k, first, n) : NULL;
+    if (f) return frame_lo2(f, p, E);
     return hd__box_lb2s(&t->nodes[k].box, p[0], p[1], p[2]) * SHRINK;
 }
 
@@ -645,14 +678,16 @@ size_t hd__bvh_nearest(const hd__bvh_t *t, const double p[3], size_t seed, int s
                        size_t *index, hd__bvh_stats_t *st) {
     search_t s;
     start(t, p, seed, seed_kernel, &s, st);
-    double E = t->frames ? frame_err(t, p) : 0;
+    /* the frames for a point farther from its seed than the framed nodes
+     * are large (E >= 0); the boxes alone near the surface (E < 0) */
+    double E = t->frames && s.thr > t->frame_reach2 ? frame_err(t, p) : -1.0;
     /* lo2: a lower bound on the squared distance to the node (node_lo2);
      * [first, first + n): the node's triangles (the build gives a node's
      * first child the first n / 2) */
     typedef struct { uint32_t node, first, n; double lo2; } entry_t;
     entry_t stack[MAX_DEPTH], *e;
     int top = 0;
-    stack[0] = (entry_t){0, 0, (uint32_t)t->n_tris, node_lo2(t, 0, p, E)};
+    stack[0] = (entry_t){0, 0, (uint32_t)t->n_tris, node_lo2(t, 0, 0, (uint32_t)t->n_tris, p, E)};
     top = 1;
     while (top > 0) {
         e = &stack[--top];
@@ -665,7 +700,7 @@ size_t hd__bvh_nearest(const hd__bvh_t *t, const double p[3], size_t seed, int s
             continue;
         }
         uint32_t a = e->node + 1, b = node->first_or_second, na = n / 2, fa = first, fb = first + n / 2;
-        double la = node_lo2(t, a, p, E), lb = node_lo2(t, b, p, E);
+        double la = node_lo2(t, a, fa, na, p, E), lb = node_lo2(t, b, fb, n - na, p, E);
         /* the nearer child on top; the median split halves the count at
          * each level, so the stack never holds more than the depth plus one */
         if (la > lb) {

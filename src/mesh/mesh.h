@@ -116,10 +116,13 @@ typedef struct hd__bvh_node {
 /* A node's frame (hd__bvh_frames): three nearly orthonormal axes a[j],
  * the first along the node's area-weighted normal, and for each an
  * interval [lo[j], hi[j]] holding a[j] . x exactly for every point x of
- * the node's triangles.  ok 0: no frame (the box alone bounds the node). */
+ * the node's triangles.  Made by the first search that needs it: state 0
+ * not yet, 1 being made, 2 made (the fields then read-only); ok 0: no
+ * frame (the box alone bounds the node). */
 typedef struct hd__bvh_frame {
     double a[3][3], lo[3], hi[3];
     int ok;
+    atomic_int state;
 } hd__bvh_frame_t;
 
 typedef struct hd__bvh {
@@ -129,7 +132,8 @@ typedef struct hd__bvh {
     hd__bvh_node_t *nodes;
     size_t n_tris, n_nodes;
     hd__bvh_frame_t *frames; /* one per node, or NULL (hd__bvh_frames) */
-    double frame_h;          /* at least every |lo[j]| and |hi[j]| of the frames */
+    double frame_h;          /* at least every |lo[j]| and |hi[j]| a frame can have */
+    double frame_reach2;     /* the mean squared box diagonal of the largest framed nodes */
 } hd__bvh_t;
 
 /* The tree over n triangles given as corner triples (tris[k].index = k's
@@ -139,10 +143,13 @@ typedef struct hd__bvh {
 int hd__bvh_build(hd__bvh_t *t, hd__tri_t *tris, size_t n);
 void hd__bvh_free(hd__bvh_t *t);
 
-/* Frames for the nodes of at most a few hundred triangles of a built
- * tree: a second, oriented lower bound on a node's distance that the
- * searches use where the box bound does not discard the node (tight on
- * the nearly flat patches a far point sees at an angle).  Optional:
+/* Frames for the nodes of at most 64 triangles of a built tree: an
+ * oriented lower bound on a node's distance that hd__bvh_nearest uses in
+ * place of the box's for a point farther from its seed triangle than
+ * those nodes are large (tight on the nearly flat patches a far point
+ * sees at an angle; near the surface the box's is as good and cheaper).
+ * Each frame is made when a search first needs it (so a near cloud pays
+ * for none); searches in several threads may share the tree.  Optional:
  * HD_ENOMEM leaves t->frames NULL and the searches exact without them. */
 int hd__bvh_frames(hd__bvh_t *t);
 
@@ -180,10 +187,11 @@ size_t hd__bvh_nearest_in(const hd__bvh_t *t, const double p[3], const uint32_t 
  * every rounding error counted (bvh.c has the proofs); 0 when no bound
  * is certain.  Exposed for the tests. */
 double hd__box_lower(const hd__box_t *b, const double p[3]);
-/* The frame bound of node k of a tree with frames (hd__bvh_frames): a
- * lower bound on the squared distance from p to the node's triangles, 0
- * when the node has no frame or no bound is certain. */
-double hd__bvh_frame_lower2(const hd__bvh_t *t, size_t k, const double p[3]);
+/* The frame bound of node k, holding t->tris[first, first + n), of a tree
+ * with frames (hd__bvh_frames; the frame is made if it was not): a lower
+ * bound on the squared distance from p to the node's triangles, 0 when
+ * the node has no frame or no bound is certain. */
+double hd__bvh_frame_lower2(const hd__bvh_t *t, size_t k, size_t first, size_t n, const double p[3]);
 /* The support bound: min over the corners v of t[0 .. n) of
  * w . (p - v) / |w|, shrunk; any w (it may be rescaled in place). */
 double hd__support_lower(const hd__tri_t *t, size_t n, const double p[3], double *w);

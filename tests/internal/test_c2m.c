@@ -686,7 +686,8 @@ TEST(the_frame_bound_never_exceeds_a_nodes_distance) {
                 stack[top].node = k + 1, stack[top].first = first, stack[top++].n = n / 2;
                 stack[top].node = node->first_or_second, stack[top].first = first + n / 2, stack[top++].n = n - n / 2;
             }
-            if (!t.frames[k].ok) continue;
+            (void)hd__bvh_frame_lower2(&t, k, first, n, lo); /* makes the frame */
+            if (atomic_load(&t.frames[k].state) != 2 || !t.frames[k].ok) continue;
             framed++;
             for (int i = 0; i < 40 / SCALE; i++) {
                 double p[3], grow = i % 4 == 0 ? 0 : i % 4 == 1 ? 0.01 : i % 4 == 2 ? 3 : 100, least = INFINITY;
@@ -703,7 +704,7 @@ TEST(the_frame_bound_never_exceeds_a_nodes_distance) {
                     CHECK_RC(hd__tri_nearest(p, t.tris[j].v[0], t.tris[j].v[1], t.tris[j].v[2], &r), HD_OK);
                     least = r.d < least ? r.d : least;
                 }
-                double lo2 = hd__bvh_frame_lower2(&t, k, p);
+                double lo2 = hd__bvh_frame_lower2(&t, k, first, n, p);
                 if (c % 4 == 0 && grow >= 3) far_flat++, tight += lo2 >= least * least * (1 - 1e-9);
                 if (!(lo2 <= least * least)) {
                     CONTEXT("case %d (seed %d), node %zu, point %d: nearest %.17g, frame bound %.17g", c, 800 + c, k,
