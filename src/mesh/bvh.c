@@ -342,20 +342,30 @@ static void frame_of(const hd__tri_t *tris, size_t n, hd__bvh_frame_t *f) {
     }
 }
 
-/* The frame of node k holding tris[first, first + n), made once: the
- * thread that moves its state from 0 to 1 makes it and publishes it with
- * state 2 (release; readers acquire); one that finds it being made uses
- * the box meanwhile.  NULL when there is no frame (yet). */
-static const hd__bvh_frame_t *frame_get(const hd__bvh_t *t, uint32_t k, uint32_t first, uint32_t n) {
+/* Make the frame of node k, holding tris[first, first + n), unless another
+ * thread does: the thread that moves its state from 0 to 1 makes it and
+ * publishes it with state 2 (a frame) or 3 (none), release; readers
+ * acquire; one that finds it being made uses the box meanwhile.  Returns
+ * the state seen last. */
+static __attribute__((noinline)) int frame_make(const hd__bvh_t *t, uint32_t k, uint32_t first, uint32_t n) {
     hd__bvh_frame_t *f = &t->frames[k];
+    int st = 0;
+    if (!atomic_compare_exchange_strong_explicit(&f->state, &st, 1, memory_order_acquire, memory_order_acquire))
+        return st;
+    frame_of(t->tris + first, n, f);
+    st = f->ok ? 2 : 3;
+    atomic_store_explicit(&f->state, st, memory_order_release);
+    return st;
+}
+
+/* The frame of node k, made if need be; NULL when there is none (yet).
+ * Nodes of more than FRAME_MAX triangles have state 3 from the start. */
+static inline const hd__bvh_frame_t *frame_get(const hd__bvh_t *t, uint32_t k, uint32_t first, uint32_t n) {
+    const hd__bvh_frame_t *f = &t->frames[k];
     int st = atomic_load_explicit(&f->state, memory_order_acquire);
-    if (st == 0 && n <= FRAME_MAX &&
-        atomic_compare_exchange_strong_explicit(&f->state, &st, 1, memory_order_relaxed, memory_order_relaxed)) {
-        frame_of(t->tris + first, n, f);
-        atomic_store_explicit(&f->state, 2, memory_order_release);
-        st = 2;
-    }
-    return st == 2 && f->ok ? f : NULL;
+    if (st == 2) return f;
+    if (st == 0 && frame_make(t, k, first, n) == 2) return f;
+    return NULL;
 }
 
 /* H: a frame's axes have |a_j|_1 <= 1.8, so a computed a_j . v is at
@@ -370,6 +380,7 @@ int hd__bvh_frames(hd__bvh_t *t) {
     t->frames = hd__calloc_array(t->n_nodes, sizeof *t->frames);
     if (!t->frames) return HD_ENOMEM;
     for (size_t k = 0; k < t->n_nodes; k++) atomic_init(&t->frames[k].state, 0);
+    /* and the nodes above them get no frame (state 3) */
     const hd__box_t *r = &t->nodes[0].box;
     for (int k = 0; k < 3; k++) {
         double m = fabs(r->lo[k]) > fabs(r->hi[k]) ? fabs(r->lo[k]) : fabs(r->hi[k]);
@@ -391,6 +402,7 @@ int hd__bvh_frames(hd__bvh_t *t) {
             roots++;
             continue;
         }
+        atomic_init(&t->frames[me].state, 3);
         stack[top].node = me + 1, stack[top++].n = n / 2;
         stack[top].node = node->first_or_second, stack[top++].n = n - n / 2;
     }
@@ -669,34 +681,32 @@ double hd__bvh_frame_lower2(const hd__bvh_t *t, size_t k, size_t first, size_t n
  * (hd__box_lb2s times SHRINK: box_beyond's proof). */
 static inline double node_lo2(const hd__bvh_t *t, uint32_t k, uint32_t first, uint32_t n, const double *p,
                               double E) {
-    const hd__bvh_frame_t *f = E >= 0 && n <= FRAME_MAX ? frame_get(t, k, first, n) : NULL;
+    const hd__bvh_frame_t *f = E >= 0 ? frame_get(t, k, first, n) : NULL;
     if (f) return frame_lo2(f, p, E);
     return hd__box_lb2s(&t->nodes[k].box, p[0], p[1], p[2]) * SHRINK;
 }
 
-size_t hd__bvh_nearest(const hd__bvh_t *t, const double p[3], size_t seed, int seed_kernel, hd__tri_near_t *best,
-                       size_t *index, hd__bvh_stats_t *st) {
-    search_t s;
-    start(t, p, seed, seed_kernel, &s, st);
-    /* the frames for a point farther from its seed than the framed nodes
-     * are large (E >= 0); the boxes alone near the surface (E < 0) */
-    double E = t->frames && s.thr > t->frame_reach2 ? frame_err(t, p) : -1.0;
+/* The descent from the root, nearest child first; framed: with the
+ * frames (node_lo2 with E), else the boxes alone (written twice by the
+ * compiler, one loop each). */
+HD__INLINE void descend(const hd__bvh_t *t, const double *p, size_t seed, search_t *s, hd__bvh_stats_t *st,
+                        int framed, double E) {
+    E = framed ? E : -1.0;
     /* lo2: a lower bound on the squared distance to the node (node_lo2);
      * [first, first + n): the node's triangles (the build gives a node's
      * first child the first n / 2) */
     typedef struct { uint32_t node, first, n; double lo2; } entry_t;
     entry_t stack[MAX_DEPTH], *e;
     int top = 0;
-    stack[0] = (entry_t){0, 0, (uint32_t)t->n_tris, node_lo2(t, 0, 0, (uint32_t)t->n_tris, p, E)};
-    top = 1;
+    stack[top++] = (entry_t){0, 0, (uint32_t)t->n_tris, node_lo2(t, 0, 0, (uint32_t)t->n_tris, p, E)};
     while (top > 0) {
         e = &stack[--top];
-        if (e->lo2 > s.thr) continue;
+        if (e->lo2 > s->thr) continue;
         const hd__bvh_node_t *node = &t->nodes[e->node];
         uint32_t first = e->first, n = e->n;
         st->nodes++;
         if (node->count) {
-            leaf(t, node, p, seed, &s, st);
+            leaf(t, node, p, seed, s, st);
             continue;
         }
         uint32_t a = e->node + 1, b = node->first_or_second, na = n / 2, fa = first, fb = first + n / 2;
@@ -704,13 +714,23 @@ size_t hd__bvh_nearest(const hd__bvh_t *t, const double p[3], size_t seed, int s
         /* the nearer child on top; the median split halves the count at
          * each level, so the stack never holds more than the depth plus one */
         if (la > lb) {
-            if (!(la > s.thr)) stack[top++] = (entry_t){a, fa, na, la};
-            if (!(lb > s.thr)) stack[top++] = (entry_t){b, fb, n - na, lb};
+            if (!(la > s->thr)) stack[top++] = (entry_t){a, fa, na, la};
+            if (!(lb > s->thr)) stack[top++] = (entry_t){b, fb, n - na, lb};
         } else {
-            if (!(lb > s.thr)) stack[top++] = (entry_t){b, fb, n - na, lb};
-            if (!(la > s.thr)) stack[top++] = (entry_t){a, fa, na, la};
+            if (!(lb > s->thr)) stack[top++] = (entry_t){b, fb, n - na, lb};
+            if (!(la > s->thr)) stack[top++] = (entry_t){a, fa, na, la};
         }
     }
+}
+
+size_t hd__bvh_nearest(const hd__bvh_t *t, const double p[3], size_t seed, int seed_kernel, hd__tri_near_t *best,
+                       size_t *index, hd__bvh_stats_t *st) {
+    search_t s;
+    start(t, p, seed, seed_kernel, &s, st);
+    /* the frames for a point farther from its seed than two diagonals of
+     * the largest framed nodes; the boxes alone nearer */
+    if (t->frames && s.thr > 4 * t->frame_reach2) descend(t, p, seed, &s, st, 1, frame_err(t, p));
+    else descend(t, p, seed, &s, st, 0, -1.0);
     return search_end(t, p, &s, best, index, st);
 }
 

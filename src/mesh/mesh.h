@@ -117,8 +117,8 @@ typedef struct hd__bvh_node {
  * the first along the node's area-weighted normal, and for each an
  * interval [lo[j], hi[j]] holding a[j] . x exactly for every point x of
  * the node's triangles.  Made by the first search that needs it: state 0
- * not yet, 1 being made, 2 made (the fields then read-only); ok 0: no
- * frame (the box alone bounds the node). */
+ * not yet, 1 being made, 2 made (the fields then read-only), 3 none (the
+ * box alone bounds the node; ok 0). */
 typedef struct hd__bvh_frame {
     double a[3][3], lo[3], hi[3];
     int ok;
