@@ -58,6 +58,11 @@
  * error (at most 2^-1074 an operation): bounds there are taken as 0. */
 #define TINY 0x1p-1000
 #define MAX_DEPTH 128
+#if defined(__GNUC__)
+#define NOINLINE __attribute__((noinline)) /* a rare path kept out of a hot loop */
+#else
+#define NOINLINE
+#endif
 
 /* ---- lower bounds ------------------------------------------------------- */
 
@@ -347,7 +352,7 @@ static void frame_of(const hd__tri_t *tris, size_t n, hd__bvh_frame_t *f) {
  * publishes it with state 2 (a frame) or 3 (none), release; readers
  * acquire; one that finds it being made uses the box meanwhile.  Returns
  * the state seen last. */
-static __attribute__((noinline)) int frame_make(const hd__bvh_t *t, uint32_t k, uint32_t first, uint32_t n) {
+static NOINLINE int frame_make(const hd__bvh_t *t, uint32_t k, uint32_t first, uint32_t n) {
     hd__bvh_frame_t *f = &t->frames[k];
     int st = 0;
     if (!atomic_compare_exchange_strong_explicit(&f->state, &st, 1, memory_order_acquire, memory_order_acquire))
