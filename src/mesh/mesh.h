@@ -145,8 +145,8 @@ void hd__bvh_free(hd__bvh_t *t);
 
 /* Frames for the nodes of at most 64 triangles of a built tree: an
  * oriented lower bound on a node's distance that hd__bvh_nearest uses in
- * place of the box's for a point farther from its seed triangle than
- * those nodes are large (tight on the nearly flat patches a far point
+ * place of the box's for a point whose seed triangle is farther than two
+ * diagonals of those nodes (tight on the nearly flat patches a far point
  * sees at an angle; near the surface the box's is as good and cheaper).
  * Each frame is made when a search first needs it (so a near cloud pays
  * for none); searches in several threads may share the tree.  Optional:
