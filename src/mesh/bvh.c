@@ -363,8 +363,8 @@ static NOINLINE int frame_make(const hd__bvh_t *t, uint32_t k, uint32_t first, u
     return st;
 }
 
-/* The frame of node k, made if need be; NULL when there is none (yet).
- * Nodes of more than FRAME_MAX triangles have state 3 from the start. */
+/* The frame of node k (of at most FRAME_MAX triangles), made if need be;
+ * NULL when there is none (yet). */
 static inline const hd__bvh_frame_t *frame_get(const hd__bvh_t *t, uint32_t k, uint32_t first, uint32_t n) {
     const hd__bvh_frame_t *f = &t->frames[k];
     int st = atomic_load_explicit(&f->state, memory_order_acquire);
@@ -384,8 +384,8 @@ int hd__bvh_frames(hd__bvh_t *t) {
     t->frame_h = t->frame_reach2 = 0;
     t->frames = hd__calloc_array(t->n_nodes, sizeof *t->frames);
     if (!t->frames) return HD_ENOMEM;
-    for (size_t k = 0; k < t->n_nodes; k++) atomic_init(&t->frames[k].state, 0);
-    /* and the nodes above them get no frame (state 3) */
+    /* every state 0 as the zeroed memory is (an atomic_int is a lock-free
+     * int on every target of the library): a near cloud writes no frame */
     const hd__box_t *r = &t->nodes[0].box;
     for (int k = 0; k < 3; k++) {
         double m = fabs(r->lo[k]) > fabs(r->hi[k]) ? fabs(r->lo[k]) : fabs(r->hi[k]);
@@ -407,7 +407,6 @@ int hd__bvh_frames(hd__bvh_t *t) {
             roots++;
             continue;
         }
-        atomic_init(&t->frames[me].state, 3);
         stack[top].node = me + 1, stack[top++].n = n / 2;
         stack[top].node = node->first_or_second, stack[top++].n = n - n / 2;
     }
@@ -676,7 +675,7 @@ static double frame_err(const hd__bvh_t *t, const double *p) {
 }
 
 double hd__bvh_frame_lower2(const hd__bvh_t *t, size_t k, size_t first, size_t n, const double p[3]) {
-    if (!t->frames || k >= t->n_nodes) return 0.0;
+    if (!t->frames || k >= t->n_nodes || n > FRAME_MAX) return 0.0;
     const hd__bvh_frame_t *f = frame_get(t, (uint32_t)k, (uint32_t)first, (uint32_t)n);
     return f ? frame_lo2(f, p, frame_err(t, p)) : 0.0;
 }
@@ -686,7 +685,7 @@ double hd__bvh_frame_lower2(const hd__bvh_t *t, size_t k, size_t first, size_t n
  * (hd__box_lb2s times SHRINK: box_beyond's proof). */
 static inline double node_lo2(const hd__bvh_t *t, uint32_t k, uint32_t first, uint32_t n, const double *p,
                               double E) {
-    const hd__bvh_frame_t *f = E >= 0 ? frame_get(t, k, first, n) : NULL;
+    const hd__bvh_frame_t *f = E >= 0 && n <= FRAME_MAX ? frame_get(t, k, first, n) : NULL;
     if (f) return frame_lo2(f, p, E);
     return hd__box_lb2s(&t->nodes[k].box, p[0], p[1], p[2]) * SHRINK;
 }
