@@ -374,6 +374,7 @@ int hd_mesh_distances(const hd_points_t *P, const hd_mesh_t *M, const hd_options
         free(tris);
         return hd__err(err, rc, "mesh: cannot build the tree of %zu triangles", M->n_triangles);
     }
+    (void)hd__bvh_frames(&bvh); /* optional: without frames the search is as exact */
     int threads = hd__thread_count(opt ? opt->threads : 0, (P->count + RUN - 1) / RUN);
     job_t J = {.dist = dist, .closest = closest, .bary = bary, .triangle = triangle};
     rc = answer(P, &bvh, &box, threads, &J, &res, err);

@@ -31,7 +31,11 @@
  * triangles; each node's box is the exact minimum and maximum of its
  * corners (no rounding), each triangle prepared once (hd__tri_prep).  A
  * query starts from a seed triangle (the previous query's nearest) and
- * descends nearest child first, discarding nodes by their boxes.  A leaf's
+ * descends nearest child first, discarding nodes by their boxes, or where
+ * a node has a frame (hd__bvh_frames: nearly orthonormal axes, the first
+ * along the node's normal, and the slabs holding its triangles), by the
+ * distance to the frame's slabs, much tighter on a nearly flat patch seen
+ * at an angle (frame_lo2).  A leaf's
  * triangles pass three stages, each in increasing order of its lower
  * bound and each stopping at the first bound above thr: the cheap bounds
  * (the triangle's box, then the support bound in the direction of its
@@ -53,6 +57,11 @@
  * error (at most 2^-1074 an operation): bounds there are taken as 0. */
 #define TINY 0x1p-1000
 #define MAX_DEPTH 128
+#if defined(__GNUC__)
+#define NOINLINE __attribute__((noinline)) /* a rare path kept out of a hot loop */
+#else
+#define NOINLINE
+#endif
 
 /* ---- lower bounds ------------------------------------------------------- */
 
@@ -142,7 +151,157 @@ void hd__bvh_free(hd__bvh_t *t) {
     free(t->nodes);
     free(t->boxes);
     free(t->prep);
+    free(t->frames);
     memset(t, 0, sizeof *t);
+}
+
+/* ---- the frames --------------------------------------------------------- */
+
+#define FRAME_MAX 64 /* triangles of the largest node given a frame */
+
+/* a x b */
+static void cross3(const double *a, const double *b, double *o) {
+    o[0] = a[1] * b[2] - a[2] * b[1];
+    o[1] = a[2] * b[0] - a[0] * b[2];
+    o[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+static int unit3(double *a) {
+    double l = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+    if (!(l > 0) || !isfinite(l)) return 0;
+    for (int i = 0; i < 3; i++) a[i] /= l;
+    return 1;
+}
+
+/* The axes of a frame: the unit normal n, and n x e_k (e_k the axis
+ * along which n is smallest) and n x that, normalised.  Only their near
+ * orthonormality is used, and it is checked on the computed doubles: each
+ * |a_j|^2 and a_j . a_k is a sum of three products, within 3.01u of the
+ * product of the norms (about 1) of its true value, so computed values
+ * within 2^-45 of 1 and of 0 put the true ones within 2^-44 (eta and c in
+ * frame_lo2's proof), and an L1 norm computed below 1.79 is below 1.8. */
+static int frame_axes(const double *normal, double a[3][3]) {
+    memcpy(a[0], normal, sizeof a[0]);
+    if (!unit3(a[0])) return 0;
+    int k = 0;
+    for (int i = 1; i < 3; i++)
+        if (fabs(a[0][i]) < fabs(a[0][k])) k = i;
+    double e[3] = {0, 0, 0};
+    e[k] = 1;
+    cross3(a[0], e, a[1]);
+    if (!unit3(a[1])) return 0;
+    cross3(a[0], a[1], a[2]);
+    if (!unit3(a[2])) return 0;
+    for (int j = 0; j < 3; j++) {
+        if (!(fabs(a[j][0]) + fabs(a[j][1]) + fabs(a[j][2]) < 1.79)) return 0;
+        for (int m = j; m < 3; m++) {
+            double d = a[j][0] * a[m][0] + a[j][1] * a[m][1] + a[j][2] * a[m][2];
+            if (!(fabs(d - (j == m)) <= 0x1p-45)) return 0;
+        }
+    }
+    return 1;
+}
+
+/* The frame of triangles tris[0 .. n).  The slabs: for a corner v, the
+ * computed a_j . v is within gamma_3 |a_j|_1 |v|_inf + 3 * 2^-1074 <=
+ * 5.5u V + 2^-1072 of the true one (V the largest corner coordinate's
+ * magnitude, |a_j|_1 <= 1.8), and adding or subtracting
+ * E = 2^-48 V + 2^-1000 (32u V, rounded once) covers that error and the
+ * rounding of the sum itself (u of at most 1.81 V + E): so [lo_j, hi_j]
+ * holds every corner's exact a_j . v, and as a slab is convex, every point
+ * of the triangles. */
+static void frame_of(const hd__tri_t *tris, size_t n, hd__bvh_frame_t *f) {
+    double normal[3] = {0, 0, 0}, V = 0;
+    for (size_t i = 0; i < n; i++) {
+        const hd__tri_t *t = &tris[i];
+        double e1[3], e2[3], c[3];
+        for (int k = 0; k < 3; k++) {
+            e1[k] = t->v[1][k] - t->v[0][k], e2[k] = t->v[2][k] - t->v[0][k];
+            for (int j = 0; j < 3; j++) V = fabs(t->v[j][k]) > V ? fabs(t->v[j][k]) : V;
+        }
+        cross3(e1, e2, c);
+        for (int k = 0; k < 3; k++) normal[k] += c[k];
+    }
+    f->ok = frame_axes(normal, f->a);
+    if (!f->ok) return;
+    double E = 0x1p-48 * V + 0x1p-1000;
+    for (int j = 0; j < 3; j++) {
+        double lo = INFINITY, hi = -INFINITY;
+        for (size_t i = 0; i < n; i++)
+            for (int k = 0; k < 3; k++) {
+                const double *v = tris[i].v[k];
+                double d = f->a[j][0] * v[0] + f->a[j][1] * v[1] + f->a[j][2] * v[2];
+                lo = d < lo ? d : lo, hi = d > hi ? d : hi;
+            }
+        f->lo[j] = lo - E, f->hi[j] = hi + E;
+    }
+}
+
+/* Make the frame of node k, holding tris[first, first + n), unless another
+ * thread does: the thread that moves its state from 0 to 1 makes it and
+ * publishes it with state 2 (a frame) or 3 (none), release; readers
+ * acquire; one that finds it being made uses the box meanwhile.  Returns
+ * the state seen last. */
+static NOINLINE int frame_make(const hd__bvh_t *t, uint32_t k, uint32_t first, uint32_t n) {
+    hd__bvh_frame_t *f = &t->frames[k];
+    int st = 0;
+    if (!atomic_compare_exchange_strong_explicit(&f->state, &st, 1, memory_order_acquire, memory_order_acquire))
+        return st;
+    frame_of(t->tris + first, n, f);
+    st = f->ok ? 2 : 3;
+    atomic_store_explicit(&f->state, st, memory_order_release);
+    return st;
+}
+
+/* The frame of node k (of at most FRAME_MAX triangles), made if need be;
+ * NULL when there is none (yet). */
+static inline const hd__bvh_frame_t *frame_get(const hd__bvh_t *t, uint32_t k, uint32_t first, uint32_t n) {
+    const hd__bvh_frame_t *f = &t->frames[k];
+    int st = atomic_load_explicit(&f->state, memory_order_acquire);
+    if (st == 2) return f;
+    if (st == 0 && frame_make(t, k, first, n) == 2) return f;
+    return NULL;
+}
+
+/* H: a frame's axes have |a_j|_1 <= 1.8, so a computed a_j . v is at
+ * most 1.8 V (1 + 4u) + 2^-1072 in magnitude for the largest coordinate
+ * magnitude V of the corners (the root box's), and its slabs add
+ * E = 2^-48 V + 2^-1000 and one rounding: 2 V + 2^-990 bounds every
+ * |lo_j| and |hi_j|, and the factor 1 + 2^-50 covers the rounding of that
+ * sum and of itself. */
+int hd__bvh_frames(hd__bvh_t *t) {
+    free(t->frames);
+    t->frame_h = t->frame_reach2 = 0;
+    t->frames = hd__calloc_array(t->n_nodes, sizeof *t->frames);
+    if (!t->frames) return HD_ENOMEM;
+    /* every state 0 as the zeroed memory is (an atomic_int is a lock-free
+     * int on every target of the library): a near cloud writes no frame */
+    const hd__box_t *r = &t->nodes[0].box;
+    for (int k = 0; k < 3; k++) {
+        double m = fabs(r->lo[k]) > fabs(r->hi[k]) ? fabs(r->lo[k]) : fabs(r->hi[k]);
+        t->frame_h = m > t->frame_h ? m : t->frame_h;
+    }
+    t->frame_h = (2 * t->frame_h + 0x1p-990) * (1 + 0x1p-50);
+    /* the mean squared diagonal of the largest framed nodes */
+    struct { uint32_t node, n; } stack[MAX_DEPTH];
+    int top = 0;
+    size_t roots = 0;
+    stack[top].node = 0, stack[top++].n = (uint32_t)t->n_tris;
+    while (top > 0) {
+        uint32_t me = stack[--top].node, n = stack[top].n;
+        const hd__bvh_node_t *node = &t->nodes[me];
+        if (n <= FRAME_MAX) {
+            const hd__box_t *b = &node->box;
+            double x = b->hi[0] - b->lo[0], y = b->hi[1] - b->lo[1], z = b->hi[2] - b->lo[2];
+            t->frame_reach2 += x * x + y * y + z * z;
+            roots++;
+            continue;
+        }
+        stack[top].node = me + 1, stack[top++].n = n / 2;
+        stack[top].node = node->first_or_second, stack[top++].n = n - n / 2;
+    }
+    t->frame_reach2 /= (double)roots;
+    return HD_OK;
 }
 
 /* ---- the query ---------------------------------------------------------- */
@@ -367,40 +526,105 @@ static void start(const hd__bvh_t *t, const double *p, size_t seed, int seed_ker
     else consider(t, p, seed, s, st);
 }
 
-size_t hd__bvh_nearest(const hd__bvh_t *t, const double p[3], size_t seed, int seed_kernel, hd__tri_near_t *best,
-                       size_t *index, hd__bvh_stats_t *st) {
-    search_t s;
-    start(t, p, seed, seed_kernel, &s, st);
-    /* s: the box's computed hd__box_lb2s; [first, first + n): the node's
-     * triangles (the build gives a node's first child the first n / 2) */
-    typedef struct { uint32_t node, first, n; double s; } entry_t;
+/* The frame bound.  For a node with a frame (hd__bvh_frame_t) and a
+ * point p, g_j is a computed gap of p outside slab j: on the hi side, the
+ * true gap is gamma_j = a_j . p - hi_j, and t_j, the computed a_j . p, is
+ * within gamma_3 |a_j|_1 P + 3 * 2^-1074 <= 5.5u P + 2^-1072 of a_j . p
+ * (P = max |p_i|, |a_j|_1 <= 1.8); D = t_j - hi_j rounds by at most
+ * u (1.81 P + H) (H = frame_h >= |hi_j|), so |D - gamma_j| <= 7.4u P + uH
+ * + 2^-1072, which E = 2^-50 (2P + H) + 2^-1020 (computed, at least
+ * 15.9u P + 7.9u H + 0.99 * 2^-1020) exceeds: g_j = D - E, rounded, is at
+ * most gamma_j (1 + u) when positive (likewise on the lo side, with
+ * gamma_j = lo_j - a_j . p); g_j = 0 elsewhere.  Let s_j = +1 on the hi
+ * side, -1 on the lo side, and w = sum s_j g_j a_j (exact).  For every x
+ * of the node, a_j . x lies in [lo_j, hi_j], so w . (p - x) >=
+ * sum g_j gamma_j >= G / (1 + u) with G = sum g_j^2; and |w|^2 <= G (1 +
+ * eta + 2c) <= G (1 + 3 * 2^-44), where |a_j|^2 <= 1 + eta and
+ * |a_j . a_k| <= c (frame_axes) and 2 g_j g_k <= g_j^2 + g_k^2.  So by
+ * Cauchy-Schwarz |p - x|^2 >= G / ((1 + u)^2 (1 + 3 * 2^-44)).  The
+ * computed G is at most G (1 + u)^3 plus 3 * 2^-1074 of underflow, a
+ * relative 2^-170 when it is at least 2^-900; G (1 - 2^-40), rounded, is
+ * below every such bound.  Returns that lower bound on the squared
+ * distance from p to the node, or 0. */
+static inline double frame_lo2(const hd__bvh_frame_t *f, const double *p, double E) {
+    double G = 0;
+    for (int j = 0; j < 3; j++) {
+        double d = f->a[j][0] * p[0] + f->a[j][1] * p[1] + f->a[j][2] * p[2];
+        double g = (d - f->hi[j]) - E;
+        if (!(g > 0)) g = (f->lo[j] - d) - E;
+        if (g > 0) G += g * g;
+    }
+    return G >= 0x1p-900 ? G * (1 - 0x1p-40) : 0.0;
+}
+
+/* E of frame_lo2 for the point p. */
+static double frame_err(const hd__bvh_t *t, const double *p) {
+    double P = fabs(p[0]) > fabs(p[1]) ? fabs(p[0]) : fabs(p[1]);
+    P = fabs(p[2]) > P ? fabs(p[2]) : P;
+    return 0x1p-50 * (2 * P + t->frame_h) + 0x1p-1020;
+}
+
+double hd__bvh_frame_lower2(const hd__bvh_t *t, size_t k, size_t first, size_t n, const double p[3]) {
+    if (!t->frames || k >= t->n_nodes || n > FRAME_MAX) return 0.0;
+    const hd__bvh_frame_t *f = frame_get(t, (uint32_t)k, (uint32_t)first, (uint32_t)n);
+    return f ? frame_lo2(f, p, frame_err(t, p)) : 0.0;
+}
+
+/* A lower bound on the squared distance from p to node k: the frame's
+ * (frame_lo2) where the node has one and E >= 0, else its box's
+ * (hd__box_lb2s times SHRINK: box_beyond's proof). */
+static inline double node_lo2(const hd__bvh_t *t, uint32_t k, uint32_t first, uint32_t n, const double *p,
+                              double E) {
+    const hd__bvh_frame_t *f = E >= 0 && n <= FRAME_MAX ? frame_get(t, k, first, n) : NULL;
+    if (f) return frame_lo2(f, p, E);
+    return hd__box_lb2s(&t->nodes[k].box, p[0], p[1], p[2]) * SHRINK;
+}
+
+/* The descent from the root, nearest child first; framed: with the
+ * frames (node_lo2 with E), else the boxes alone (written twice by the
+ * compiler, one loop each). */
+HD__INLINE void descend(const hd__bvh_t *t, const double *p, size_t seed, search_t *s, hd__bvh_stats_t *st,
+                        int framed, double E) {
+    E = framed ? E : -1.0;
+    /* lo2: a lower bound on the squared distance to the node (node_lo2);
+     * [first, first + n): the node's triangles (the build gives a node's
+     * first child the first n / 2) */
+    typedef struct { uint32_t node, first, n; double lo2; } entry_t;
     entry_t stack[MAX_DEPTH], *e;
     int top = 0;
-    stack[0] = (entry_t){0, 0, (uint32_t)t->n_tris, hd__box_lb2s(&t->nodes[0].box, p[0], p[1], p[2])};
-    top = 1;
+    stack[top++] = (entry_t){0, 0, (uint32_t)t->n_tris, node_lo2(t, 0, 0, (uint32_t)t->n_tris, p, E)};
     while (top > 0) {
         e = &stack[--top];
-        if (box_beyond(e->s, s.thr)) continue;
+        if (e->lo2 > s->thr) continue;
         const hd__bvh_node_t *node = &t->nodes[e->node];
         uint32_t first = e->first, n = e->n;
         st->nodes++;
         if (node->count) {
-            leaf(t, node, p, seed, &s, st);
+            leaf(t, node, p, seed, s, st);
             continue;
         }
         uint32_t a = e->node + 1, b = node->first_or_second, na = n / 2, fa = first, fb = first + n / 2;
-        double la = hd__box_lb2s(&t->nodes[a].box, p[0], p[1], p[2]);
-        double lb = hd__box_lb2s(&t->nodes[b].box, p[0], p[1], p[2]);
+        double la = node_lo2(t, a, fa, na, p, E), lb = node_lo2(t, b, fb, n - na, p, E);
         /* the nearer child on top; the median split halves the count at
          * each level, so the stack never holds more than the depth plus one */
         if (la > lb) {
-            if (!box_beyond(la, s.thr)) stack[top++] = (entry_t){a, fa, na, la};
-            if (!box_beyond(lb, s.thr)) stack[top++] = (entry_t){b, fb, n - na, lb};
+            if (!(la > s->thr)) stack[top++] = (entry_t){a, fa, na, la};
+            if (!(lb > s->thr)) stack[top++] = (entry_t){b, fb, n - na, lb};
         } else {
-            if (!box_beyond(lb, s.thr)) stack[top++] = (entry_t){b, fb, n - na, lb};
-            if (!box_beyond(la, s.thr)) stack[top++] = (entry_t){a, fa, na, la};
+            if (!(lb > s->thr)) stack[top++] = (entry_t){b, fb, n - na, lb};
+            if (!(la > s->thr)) stack[top++] = (entry_t){a, fa, na, la};
         }
     }
+}
+
+size_t hd__bvh_nearest(const hd__bvh_t *t, const double p[3], size_t seed, int seed_kernel, hd__tri_near_t *best,
+                       size_t *index, hd__bvh_stats_t *st) {
+    search_t s;
+    start(t, p, seed, seed_kernel, &s, st);
+    /* the frames for a point farther from its seed than two diagonals of
+     * the largest framed nodes; the boxes alone nearer */
+    if (t->frames && s.thr > 4 * t->frame_reach2) descend(t, p, seed, &s, st, 1, frame_err(t, p));
+    else descend(t, p, seed, &s, st, 0, -1.0);
     return search_end(t, p, &s, best, index, st);
 }
 

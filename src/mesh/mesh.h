@@ -113,6 +113,18 @@ typedef struct hd__bvh_node {
     uint32_t first_or_second, count;
 } hd__bvh_node_t;
 
+/* A node's frame (hd__bvh_frames): three nearly orthonormal axes a[j],
+ * the first along the node's area-weighted normal, and for each an
+ * interval [lo[j], hi[j]] holding a[j] . x exactly for every point x of
+ * the node's triangles.  Made by the first search that needs it: state 0
+ * not yet, 1 being made, 2 made (the fields then read-only), 3 none (the
+ * box alone bounds the node; ok 0). */
+typedef struct hd__bvh_frame {
+    double a[3][3], lo[3], hi[3];
+    int ok;
+    atomic_int state;
+} hd__bvh_frame_t;
+
 typedef struct hd__bvh {
     hd__tri_t *tris;        /* in leaf order */
     hd__box_t *boxes;       /* each triangle's box, in the same order */
@@ -124,6 +136,9 @@ typedef struct hd__bvh {
     atomic_size_t *used;
     hd__bvh_node_t *nodes;
     size_t n_tris, n_nodes;
+    hd__bvh_frame_t *frames; /* one per node, or NULL (hd__bvh_frames) */
+    double frame_h;          /* at least every |lo[j]| and |hi[j]| a frame can have */
+    double frame_reach2;     /* the mean squared box diagonal of the largest framed nodes */
 } hd__bvh_t;
 
 #define HD__BVH_BUSY UINT32_MAX
@@ -149,6 +164,16 @@ HD__INLINE const hd__tri_prep_t *hd__bvh_prep(const hd__bvh_t *t, size_t k) {
 int hd__bvh_build_threads(hd__bvh_t *t, hd__tri_t *tris, size_t n, int threads);
 int hd__bvh_build(hd__bvh_t *t, hd__tri_t *tris, size_t n);
 void hd__bvh_free(hd__bvh_t *t);
+
+/* Frames for the nodes of at most 64 triangles of a built tree: an
+ * oriented lower bound on a node's distance that hd__bvh_nearest uses in
+ * place of the box's for a point whose seed triangle is farther than two
+ * diagonals of those nodes (tight on the nearly flat patches a far point
+ * sees at an angle; near the surface the box's is as good and cheaper).
+ * Each frame is made when a search first needs it (so a near cloud pays
+ * for none); searches in several threads may share the tree.  Optional:
+ * HD_ENOMEM leaves t->frames NULL and the searches exact without them. */
+int hd__bvh_frames(hd__bvh_t *t);
 
 /* The counters of the queries (summed per thread, then over threads). */
 typedef struct hd__bvh_stats {
@@ -184,6 +209,11 @@ size_t hd__bvh_nearest_in(const hd__bvh_t *t, const double p[3], const uint32_t 
  * every rounding error counted (bvh.c has the proofs); 0 when no bound
  * is certain.  Exposed for the tests. */
 double hd__box_lower(const hd__box_t *b, const double p[3]);
+/* The frame bound of node k, holding t->tris[first, first + n), of a tree
+ * with frames (hd__bvh_frames; the frame is made if it was not): a lower
+ * bound on the squared distance from p to the node's triangles, 0 when
+ * the node has no frame or no bound is certain. */
+double hd__bvh_frame_lower2(const hd__bvh_t *t, size_t k, size_t first, size_t n, const double p[3]);
 /* The support bound: min over the corners v of t[0 .. n) of
  * w . (p - v) / |w|, shrunk; any w (it may be rescaled in place). */
 double hd__support_lower(const hd__tri_t *t, size_t n, const double p[3], double *w);
