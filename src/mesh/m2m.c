@@ -369,6 +369,8 @@ typedef struct ctx {
     found_t *found;        /* by corner */
     size_t n_corners;
     cache_t *caches;       /* one per worker */
+    struct vslot *vslots;  /* the predicate's pass: VSLOTS per worker */
+    size_t task0;          /* ... and the first task of its round */
 } ctx_t;
 
 #define CORNER(J, id) ((J)->from[(id) / 3].v[(id) % 3])
@@ -387,7 +389,7 @@ static void phase0(void *vctx, size_t task, int worker) {
     for (size_t k = lo; k < hi; k++) {
         size_t id = C->order ? (size_t)(C->order[k] & 0xffffffffu) : k;
         found_t *F = &C->found[id];
-        if (J->drop && J->drop[id / 3]) continue;
+        if (C->faces[id / 3].done) continue;
         if (prev != SIZE_MAX && memcmp(CORNER(J, id), CORNER(J, prev), 3 * sizeof(double)) == 0) {
             *F = C->found[prev];
             continue;
@@ -401,29 +403,167 @@ static void phase0(void *vctx, size_t task, int worker) {
     C->faces[lo / 3].kernel += st.kernel; /* counted on the chunk's first face */
 }
 
+/* Face f's level-0 sub-triangle from its corners' nearest triangles x,
+ * its corners offered as lower bounds, its bound (the dearer bounds
+ * skipped once the point bound is at most `enough`). */
+static void face_top(const hd__m2m_job_t *J, face_t *F, size_t f, const found_t *x, double enough, cache_t *cache) {
+    for (int i = 0; i < 3; i++) {
+        corner_t *c = &F->top.c[i];
+        c->k[0] = c->k[1] = c->k[2] = 0;
+        c->k[i] = 1;
+        memcpy(c->p, J->from[f].v[i], sizeof c->p);
+        c->r = c->lower = x[i].r;
+        c->pos = x[i].pos;
+        c->index = x[i].index;
+        memcpy(c->near, x[i].near, sizeof c->near);
+        offer(&F->best, c, 0, 0);
+    }
+    F->top.level = 0;
+    F->top.U = upper_of(J, &F->top, 0, enough, cache, &F->kernel);
+    F->upper = F->top.U;
+}
+
 static void phase1(void *vctx, size_t task, int worker) {
     ctx_t *C = vctx;
     const hd__m2m_job_t *J = C->job;
     size_t lo = task * CHUNK, hi = lo + CHUNK < J->n_from ? lo + CHUNK : J->n_from;
+    for (size_t f = lo; f < hi; f++)
+        if (!C->faces[f].done) face_top(J, &C->faces[f], f, &C->found[3 * f], -INFINITY, &C->caches[worker]);
+}
+
+/* ---- the predicate's pass: screen, then exact corners, in rounds --------- */
+
+/* The screen's search gives up after bounding this many triangles. */
+#define SCREEN_TRIS 24
+/* A worker's exact corners of the current task, direct mapped by the
+ * point's bits (stamped with the task: nothing carries between tasks, so
+ * nothing depends on which worker ran which task). */
+#define VSLOTS 512
+typedef struct vslot {
+    double p[3];
+    found_t x;
+    size_t stamp; /* task + 1; 0: empty */
+} vslot_t;
+
+/* An upper bound on d(p, Y) that is at most target, from prepared bounds
+ * alone: 1 with *ub (and *seed its triangle's position), or 0.  Any
+ * triangle's sqrt_up(hi2) is >= d(p, Y), so which triangles are tried (the
+ * seed, then the tree nearest box first, pruned by plain box distances, at
+ * most SCREEN_TRIS of them) changes the cost only, never the bound's
+ * validity. */
+static int screen_point(const hd__bvh_t *T, const double p[3], double target, size_t *seed, double *ub) {
+    double lo2, hi2, t2 = target * target * (1 + 0x1p-40);
+    if (*seed != SIZE_MAX) {
+        hd__tri_bounds_prep(p, &T->prep[*seed], &lo2, &hi2);
+        if (sqrt_up(hi2) <= target) return *ub = sqrt_up(hi2), 1;
+    }
+    uint32_t stack[128];
+    int top = 0, tried = 0;
+    stack[top++] = 0;
+    while (top > 0) {
+        uint32_t id = stack[--top];
+        const hd__bvh_node_t *node = &T->nodes[id];
+        if (node->count) {
+            for (size_t k = node->first_or_second, end = k + node->count; k < end; k++) {
+                if (k == *seed) continue;
+                hd__tri_bounds_prep(p, &T->prep[k], &lo2, &hi2);
+                if (lo2 > t2) continue;
+                if (sqrt_up(hi2) <= target) return *seed = k, *ub = sqrt_up(hi2), 1;
+                if (++tried >= SCREEN_TRIS) return 0;
+            }
+            continue;
+        }
+        uint32_t a = id + 1, b = node->first_or_second;
+        double la = hd__box_lb2s(&T->nodes[a].box, p[0], p[1], p[2]);
+        double lb = hd__box_lb2s(&T->nodes[b].box, p[0], p[1], p[2]);
+        if (top + 2 > 128) return 0;
+        if (la > lb) { /* the nearer child on top */
+            if (la <= t2) stack[top++] = a;
+            if (lb <= t2) stack[top++] = b;
+        } else {
+            if (lb <= t2) stack[top++] = b;
+            if (la <= t2) stack[top++] = a;
+        }
+    }
+    return 0;
+}
+
+/* Tang's bound with one triangle of Y (position pos): d(., t) is convex,
+ * so over the face it is at most its largest value at a vertex. */
+static int tang_screened(const hd__m2m_job_t *J, const hd__tri_t *t, size_t pos, double *upper) {
+    double m = 0, lo2, hi2;
+    for (int i = 0; i < 3 && m <= J->done_below; i++) {
+        hd__tri_bounds_prep(t->v[i], &J->to->prep[pos], &lo2, &hi2);
+        m = fmax(m, sqrt_up(hi2));
+    }
+    if (!(m <= J->done_below)) return 0;
+    *upper = m;
+    return 1;
+}
+
+/* Face t discarded by the predicate's d without the kernel: the point
+ * bound over its exact corners, d(y, Y) <= max_v ub_v + R for every y of
+ * the face (e = 0 at level 0), is at most d; or else Tang's bound with the
+ * last triangle the screen found.  1 with that bound in *upper. */
+static int screened(const hd__m2m_job_t *J, const hd__tri_t *t, size_t *seed, double *upper) {
+    sub_t s;
+    for (int i = 0; i < 3; i++) memcpy(s.c[i].p, t->v[i], sizeof s.c[i].p);
+    double R = reach(&s), target = J->done_below - R, m = 0, ub;
+    int i = 0;
+    if (target >= 0)
+        for (; i < 3 && screen_point(J->to, t->v[i], target, seed, &ub); i++) m = fmax(m, ub);
+    double U = up(m + R);
+    if (i == 3 && U <= J->done_below) {
+        *upper = U;
+        return 1;
+    }
+    return *seed != SIZE_MAX && tang_screened(J, t, *seed, upper);
+}
+
+/* A corner's nearest triangle, exactly (hd__bvh_nearest), once per task. */
+static void exact_corner(const hd__m2m_job_t *J, vslot_t *V, size_t stamp, const double *p, size_t *seed,
+                         found_t *x, hd__bvh_stats_t *st) {
+    uint64_t h = 0, b;
+    for (int d = 0; d < 3; d++) {
+        memcpy(&b, &p[d], sizeof b);
+        h = (h ^ b) * 0x9e3779b97f4a7c15u;
+    }
+    vslot_t *v = &V[h >> 55 & (VSLOTS - 1)];
+    if (v->stamp == stamp && memcmp(v->p, p, sizeof v->p) == 0) {
+        *x = v->x;
+        return;
+    }
+    hd__tri_near_t near;
+    x->pos = *seed = hd__bvh_nearest(J->to, p, *seed, 0, &near, &x->index, st);
+    x->r = near.d;
+    memcpy(x->near, near.point, sizeof x->near);
+    memcpy(v->p, p, sizeof v->p);
+    v->x = *x;
+    v->stamp = stamp;
+}
+
+/* One task of a round: each face screened, else its corners measured and
+ * its level-0 bound taken (phases 0 and 1 for that face). */
+static void decide_task(void *vctx, size_t task, int worker) {
+    ctx_t *C = vctx;
+    const hd__m2m_job_t *J = C->job;
+    task += C->task0;
+    size_t lo = task * CHUNK, hi = lo + CHUNK < J->n_from ? lo + CHUNK : J->n_from;
+    size_t seed = SIZE_MAX, eseed = SIZE_MAX;
+    vslot_t *V = &C->vslots[(size_t)worker * VSLOTS];
+    hd__bvh_stats_t st = {0};
     for (size_t f = lo; f < hi; f++) {
         face_t *F = &C->faces[f];
         if (F->done) continue;
-        for (int i = 0; i < 3; i++) {
-            corner_t *c = &F->top.c[i];
-            const found_t *x = &C->found[3 * f + (size_t)i];
-            c->k[0] = c->k[1] = c->k[2] = 0;
-            c->k[i] = 1;
-            memcpy(c->p, J->from[f].v[i], sizeof c->p);
-            c->r = c->lower = x->r;
-            c->pos = x->pos;
-            c->index = x->index;
-            memcpy(c->near, x->near, sizeof c->near);
-            offer(&F->best, c, 0, 0);
+        if (screened(J, &J->from[f], &seed, &F->upper)) {
+            F->done = 1;
+            continue;
         }
-        F->top.level = 0;
-        F->top.U = upper_of(J, &F->top, 0, -INFINITY, &C->caches[worker], &F->kernel);
-        F->upper = F->top.U;
+        found_t x[3];
+        for (int i = 0; i < 3; i++) exact_corner(J, V, task + 1, J->from[f].v[i], &eseed, &x[i], &st);
+        face_top(J, F, f, x, J->done_below, &C->caches[worker]);
     }
+    C->faces[lo].kernel += st.kernel;
 }
 
 /* The corners' Morton order (NULL when there are too many to key; any
@@ -650,50 +790,86 @@ static int run_batches(const hd__m2m_job_t *J, ctx_t *C, rank_t *rk, size_t n, h
     return rc;
 }
 
+/* The first pass of a search for h: every face's corners, in Morton
+ * order (phase 0), then every face's level-0 bound (phase 1). */
+static int first_pass(const hd__m2m_job_t *J, ctx_t *C, hd__m2m_result_t *R) {
+    size_t n = J->n_from;
+    uint64_t *order = NULL;
+    C->found = hd__malloc_array(n ? 3 * n : 1, sizeof *C->found);
+    if (!C->found || corner_order(J, J->threads, &order)) {
+        free(C->found);
+        return HD_ENOMEM;
+    }
+    C->order = order;
+    hd__parallel_for(J->threads, (n + CHUNK - 1) / CHUNK, phase0, C);
+    hd__parallel_for(J->threads, (n + CHUNK - 1) / CHUNK, phase1, C);
+    free(order);
+    free(C->found);
+    for (size_t f = 0; f < n; f++) take_best(R, &C->faces[f], f);
+    return HD_OK;
+}
+
+/* The first pass of the predicate: rounds of tasks (doubling from
+ * FIRST_ROUND to MAX_ROUND, whatever the thread count), each face screened
+ * or measured; after each round the faces' lower bounds are taken in face
+ * order, and a lower bound above d stops the pass.  *stopped: 1 when it
+ * stopped before the last face (faces never reached have no bound). */
+#define FIRST_ROUND 2
+#define MAX_ROUND 64
+static int decide_pass(const hd__m2m_job_t *J, ctx_t *C, hd__m2m_result_t *R, int *stopped) {
+    size_t n = J->n_from, tasks = (n + CHUNK - 1) / CHUNK, size = FIRST_ROUND;
+    C->vslots = calloc((size_t)J->threads * VSLOTS, sizeof *C->vslots);
+    if (!C->vslots) return HD_ENOMEM;
+    *stopped = 0;
+    for (C->task0 = 0; C->task0 < tasks; C->task0 += size, size = size < MAX_ROUND ? 2 * size : size) {
+        size_t m = tasks - C->task0 < size ? tasks - C->task0 : size;
+        hd__parallel_for(J->threads, m, decide_task, C);
+        size_t hi = (C->task0 + m) * CHUNK < n ? (C->task0 + m) * CHUNK : n;
+        for (size_t f = C->task0 * CHUNK; f < hi; f++) take_best(R, &C->faces[f], f);
+        if (R->lower > J->stop_above && hi < n) {
+            *stopped = 1;
+            break;
+        }
+    }
+    free(C->vslots);
+    C->vslots = NULL;
+    return HD_OK;
+}
+
 int hd__m2m_run(const hd__m2m_job_t *J, hd__m2m_result_t *R) {
     memset(R, 0, sizeof *R);
     R->face = R->face_b = SIZE_MAX;
     size_t n = J->n_from;
-    ctx_t C = {J, hd__malloc_array(n ? n : 1, sizeof(face_t)), NULL, NULL, 0, NULL};
+    ctx_t C = {J, hd__malloc_array(n ? n : 1, sizeof(face_t)), NULL, NULL, 0, NULL, NULL, 0};
     rank_t *rk = hd__malloc_array(n ? n : 1, sizeof *rk);
-    if (!C.faces || !rk) {
-        free(C.faces);
-        free(rk);
-        return HD_ENOMEM;
-    }
     C.n_corners = 3 * n;
-    C.found = hd__malloc_array(n ? 3 * n : 1, sizeof *C.found);
     C.caches = hd__malloc_array((size_t)J->threads, sizeof *C.caches);
-    uint64_t *order = NULL;
-    if (!C.found || !C.caches || corner_order(J, J->threads, &order)) {
+    if (!C.faces || !rk || !C.caches) {
         free(C.faces);
         free(rk);
-        free(C.found);
         free(C.caches);
         return HD_ENOMEM;
     }
     for (int w = 0; w < J->threads; w++)
         for (size_t k = 0; k < CACHE; k++) C.caches[w].pos[k] = SIZE_MAX;
-    C.order = order;
     for (size_t f = 0; f < n; f++) {
         memset(&C.faces[f], 0, sizeof C.faces[f]);
         C.faces[f].done = J->drop && J->drop[f];
+        R->dropped += C.faces[f].done;
     }
-    hd__parallel_for(J->threads, (n + CHUNK - 1) / CHUNK, phase0, &C);
-    hd__parallel_for(J->threads, (n + CHUNK - 1) / CHUNK, phase1, &C);
-    free(order);
-    free(C.found);
+    /* the predicate (a finite d, faces not asked for one by one) */
+    int decide = isfinite(J->done_below) && !J->per_face, stopped = 0;
+    int rc = decide ? decide_pass(J, &C, R, &stopped) : first_pass(J, &C, R);
     size_t live = 0;
-    for (size_t f = 0; f < n; f++) {
-        take_best(R, &C.faces[f], f);
+    for (size_t f = 0; rc == HD_OK && f < n; f++)
         if (!C.faces[f].done) rk[live++] = (rank_t){C.faces[f].top.U, f};
-        else R->dropped++;
-    }
-    if (R->face == SIZE_MAX) R->lower = 0; /* every face shared: h = 0 */
+    /* no face with a corner measured (every face shared, or screened):
+     * 0 is a lower bound without a witness */
+    if (R->face == SIZE_MAX) R->lower = 0;
     qsort(rk, live, sizeof *rk, by_upper);
-    int rc = run_batches(J, &C, rk, live, R);
+    if (rc == HD_OK && !stopped) rc = run_batches(J, &C, rk, live, R);
     for (size_t f = 0; f < n; f++) finish_face(R, J, &C.faces[f], f);
-    R->upper = fmax(R->upper, R->lower);
+    R->upper = stopped ? INFINITY : fmax(R->upper, R->lower);
     free(C.faces);
     free(C.caches);
     free(rk);

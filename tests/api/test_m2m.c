@@ -370,8 +370,50 @@ TEST(surface_to_points_encloses_and_points_to_surface_is_exact) {
     }
 }
 
+/* The largest dense sample of h(X, Y) over grid n. */
+static double dense_max(const gen_soup_t *X, const gen_soup_t *Y, int n) {
+    double *best = dense(X, Y, n), far = 0;
+    for (size_t k = 0; k < X->nt; k++) far = fmax(far, best[k]);
+    free(best);
+    return far;
+}
+
+/* hd_surface_within(A, B, d) at 1 and 2 threads: the same answer and
+ * enclosures, and the answer what they prove: 1 with every upper bound <= d
+ * (and the dense samples, `far`, too), 0 with a witness's lower bound > d,
+ * -1 with d inside an enclosure no wider than the tolerance.  Returns the
+ * answer. */
+static int predicate(const gen_soup_t *A, const gen_soup_t *B, double d, int directed, double far) {
+    hd_mesh_t a = gen_soup_view(A), b = gen_soup_view(B);
+    hd_surface_options_t o1 = options(1e-9, 1, 1), o2 = options(1e-9, 1, 2);
+    hd_enclosure_t ab, ba, ab2, ba2;
+    int answer, answer2;
+    CONTEXT("d %.17g, directed %d", d, directed);
+    CHECK_RC(hd_surface_within(&a, &b, d, directed, &o1, &answer, &ab, &ba, NULL), HD_OK);
+    CHECK_RC(hd_surface_within(&a, &b, d, directed, &o2, &answer2, &ab2, &ba2, NULL), HD_OK);
+    CHECK_EQ(answer, answer2);
+    same_enclosure(&ab, &ab2);
+    double lower = ab.lower, upper = ab.upper;
+    if (!directed) {
+        same_enclosure(&ba, &ba2);
+        lower = fmax(lower, ba.lower), upper = fmax(upper, ba.upper);
+    }
+    if (answer == 1) {
+        CHECK(upper <= d);
+        CHECK(far <= d);
+    } else if (answer == 0) {
+        CHECK(lower > d);
+        witness_holds(ab.lower > d ? &ab : &ba, ab.lower > d ? A : B, ab.lower > d ? B : A);
+    } else {
+        CHECK_EQ(answer, -1);
+        CHECK(lower <= d && d < upper);
+        CHECK(upper - lower <= ab.tolerance);
+    }
+    return answer;
+}
+
 TEST(predicate_agrees_with_the_enclosure) {
-    for (uint64_t seed = 1; seed <= 6 / SCALE + 1; seed++) {
+    for (uint64_t seed = 1; seed <= 16 / SCALE; seed++) {
         CONTEXT("seed %llu", (unsigned long long)seed);
         gen_rng_t r;
         gen_seed(&r, seed);
@@ -380,19 +422,67 @@ TEST(predicate_agrees_with_the_enclosure) {
         hd_enclosure_t ab, ba;
         hd_surface_options_t o = options(1e-9, 1, 2);
         CHECK_RC(hd_surface_hausdorff(&a, &b, &o, &ab, &ba, NULL), HD_OK);
-        double lo = fmax(ab.lower, ba.lower), hi = fmax(ab.upper, ba.upper);
-        int answer;
-        CHECK_RC(hd_surface_within(&a, &b, hi * (1 + 1e-6), 0, &o, &answer, NULL, NULL, NULL), HD_OK);
-        CHECK_EQ(answer, 1);
-        CHECK_RC(hd_surface_within(&a, &b, lo * (1 - 1e-6), 0, &o, &answer, NULL, NULL, NULL), HD_OK);
-        CHECK_EQ(answer, 0);
-        CHECK_RC(hd_surface_within(&a, &b, ab.upper * (1 + 1e-6), 1, &o, &answer, NULL, NULL, NULL), HD_OK);
-        CHECK_EQ(answer, 1);
-        CHECK_RC(hd_surface_within(&a, &b, ab.lower * (1 - 1e-6), 1, &o, &answer, NULL, NULL, NULL), HD_OK);
-        CHECK_EQ(answer, 0);
+        double far_ab = dense_max(&A, &B, 16), far = fmax(far_ab, dense_max(&B, &A, 16));
+        for (int directed = 0; directed <= 1; directed++) {
+            double lo = directed ? ab.lower : fmax(ab.lower, ba.lower);
+            double hi = directed ? ab.upper : fmax(ab.upper, ba.upper), x = directed ? far_ab : far;
+            CHECK_EQ(predicate(&A, &B, lo * (1 - 1e-6), directed, x), 0);
+            CHECK(predicate(&A, &B, nextafter(lo, 0), directed, x) != 1);
+            predicate(&A, &B, lo / 2 + hi / 2, directed, x);
+            CHECK(predicate(&A, &B, nextafter(hi, INFINITY), directed, x) != 0);
+            CHECK_EQ(predicate(&A, &B, hi * (1 + 1e-6), directed, x), 1);
+            CHECK_EQ(predicate(&A, &B, 2 * hi, directed, x), 1);
+            CHECK_EQ(predicate(&A, &B, lo / 2, directed, x), 0);
+        }
         gen_soup_free(&A), gen_soup_free(&B);
         if (hdt_failed()) break;
     }
+}
+
+/* Two parallel grids of n x n squares (2 n^2 triangles), z = 0 and z = 1:
+ * h = 1 both ways. */
+static gen_soup_t grid(int n, double z) {
+    gen_soup_t s = soup_new((size_t)(n + 1) * (size_t)(n + 1), 2 * (size_t)n * (size_t)n);
+    for (int i = 0; i <= n; i++)
+        for (int j = 0; j <= n; j++) {
+            double *v = s.v + 3 * ((size_t)i * (size_t)(n + 1) + (size_t)j);
+            v[0] = i, v[1] = j, v[2] = z;
+        }
+    for (int i = 0, k = 0; i < n; i++)
+        for (int j = 0; j < n; j++, k += 6) {
+            uint64_t c = (uint64_t)i * (uint64_t)(n + 1) + (uint64_t)j, up_ = c + (uint64_t)(n + 1);
+            uint64_t t[6] = {c, c + 1, up_, c + 1, up_ + 1, up_};
+            memcpy(s.t + k, t, sizeof t);
+        }
+    return s;
+}
+
+TEST(predicate_far_from_the_distance_measures_few_corners) {
+    gen_soup_t A = grid(64, 0), B = grid(64, 1);
+    hd_mesh_t a = gen_soup_view(&A), b = gen_soup_view(&B);
+    hd_surface_options_t o = options(1e-9, 1, 1), o2 = options(1e-9, 1, 2);
+    hd_enclosure_t ab, ba, ab2, ba2;
+    int answer;
+    CHECK_RC(hd_surface_hausdorff(&a, &b, &o, &ab, &ba, NULL), HD_OK);
+    CHECK(ab.lower == 1 && ba.lower == 1);
+    uint64_t full = ab.kernel_calls;
+    CHECK(full >= 65 * 65);
+    /* d = 2: every face is within by bounds on its corners alone */
+    CHECK_RC(hd_surface_within(&a, &b, 2, 0, &o, &answer, &ab, &ba, NULL), HD_OK);
+    CHECK_EQ(answer, 1);
+    CHECK_EQ(ab.kernel_calls, 0);
+    CHECK_EQ(ba.kernel_calls, 0);
+    CHECK(ab.upper <= 2 && ba.upper <= 2);
+    /* d = 1/2: the first corners measured are beyond it, and the search
+     * stops there (the faces never reached leave upper infinite) */
+    CHECK_RC(hd_surface_within(&a, &b, 0.5, 0, &o, &answer, &ab, &ba, NULL), HD_OK);
+    CHECK_RC(hd_surface_within(&a, &b, 0.5, 0, &o2, &answer, &ab2, &ba2, NULL), HD_OK);
+    CHECK_EQ(answer, 0);
+    CHECK(ab.lower == 1 && isinf(ab.upper));
+    CHECK(ab.kernel_calls * 8 <= full);
+    same_enclosure(&ab, &ab2);
+    CHECK(isinf(ba.upper));
+    gen_soup_free(&A), gen_soup_free(&B);
 }
 
 TEST(face_maxima_enclose_each_face) {
