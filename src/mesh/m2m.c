@@ -369,8 +369,7 @@ typedef struct ctx {
     found_t *found;        /* by corner */
     size_t n_corners;
     cache_t *caches;       /* one per worker */
-    struct vslot *vslots;  /* the predicate's pass: VSLOTS per worker */
-    size_t task0;          /* ... and the first task of its round */
+    size_t task0;          /* phase 1's first task (the predicate's rounds) */
 } ctx_t;
 
 #define CORNER(J, id) ((J)->from[(id) / 3].v[(id) % 3])
@@ -426,24 +425,15 @@ static void face_top(const hd__m2m_job_t *J, face_t *F, size_t f, const found_t 
 static void phase1(void *vctx, size_t task, int worker) {
     ctx_t *C = vctx;
     const hd__m2m_job_t *J = C->job;
-    size_t lo = task * CHUNK, hi = lo + CHUNK < J->n_from ? lo + CHUNK : J->n_from;
+    size_t lo = (C->task0 + task) * CHUNK, hi = lo + CHUNK < J->n_from ? lo + CHUNK : J->n_from;
     for (size_t f = lo; f < hi; f++)
-        if (!C->faces[f].done) face_top(J, &C->faces[f], f, &C->found[3 * f], -INFINITY, &C->caches[worker]);
+        if (!C->faces[f].done) face_top(J, &C->faces[f], f, &C->found[3 * f], J->done_below, &C->caches[worker]);
 }
 
 /* ---- the predicate's pass: screen, then exact corners, in rounds --------- */
 
 /* The screen's search gives up after bounding this many triangles. */
 #define SCREEN_TRIS 24
-/* A worker's exact corners of the current task, direct mapped by the
- * point's bits (stamped with the task: nothing carries between tasks, so
- * nothing depends on which worker ran which task). */
-#define VSLOTS 512
-typedef struct vslot {
-    double p[3];
-    found_t x;
-    size_t stamp; /* task + 1; 0: empty */
-} vslot_t;
 
 /* An upper bound on d(p, Y) that is at most target, from prepared bounds
  * alone: 1 with *ub (and *seed its triangle's position), or 0.  Any
@@ -520,50 +510,15 @@ static int screened(const hd__m2m_job_t *J, const hd__tri_t *t, size_t *seed, do
     return *seed != SIZE_MAX && tang_screened(J, t, *seed, upper);
 }
 
-/* A corner's nearest triangle, exactly (hd__bvh_nearest), once per task. */
-static void exact_corner(const hd__m2m_job_t *J, vslot_t *V, size_t stamp, const double *p, size_t *seed,
-                         found_t *x, hd__bvh_stats_t *st) {
-    uint64_t h = 0, b;
-    for (int d = 0; d < 3; d++) {
-        memcpy(&b, &p[d], sizeof b);
-        h = (h ^ b) * 0x9e3779b97f4a7c15u;
-    }
-    vslot_t *v = &V[h >> 55 & (VSLOTS - 1)];
-    if (v->stamp == stamp && memcmp(v->p, p, sizeof v->p) == 0) {
-        *x = v->x;
-        return;
-    }
-    hd__tri_near_t near;
-    x->pos = *seed = hd__bvh_nearest(J->to, p, *seed, 0, &near, &x->index, st);
-    x->r = near.d;
-    memcpy(x->near, near.point, sizeof x->near);
-    memcpy(v->p, p, sizeof v->p);
-    v->x = *x;
-    v->stamp = stamp;
-}
-
-/* One task of a round: each face screened, else its corners measured and
- * its level-0 bound taken (phases 0 and 1 for that face). */
-static void decide_task(void *vctx, size_t task, int worker) {
+/* The predicate's screen over one task of faces of the round. */
+static void screen_task(void *vctx, size_t task, int worker) {
+    (void)worker;
     ctx_t *C = vctx;
     const hd__m2m_job_t *J = C->job;
-    task += C->task0;
-    size_t lo = task * CHUNK, hi = lo + CHUNK < J->n_from ? lo + CHUNK : J->n_from;
-    size_t seed = SIZE_MAX, eseed = SIZE_MAX;
-    vslot_t *V = &C->vslots[(size_t)worker * VSLOTS];
-    hd__bvh_stats_t st = {0};
-    for (size_t f = lo; f < hi; f++) {
-        face_t *F = &C->faces[f];
-        if (F->done) continue;
-        if (screened(J, &J->from[f], &seed, &F->upper)) {
-            F->done = 1;
-            continue;
-        }
-        found_t x[3];
-        for (int i = 0; i < 3; i++) exact_corner(J, V, task + 1, J->from[f].v[i], &eseed, &x[i], &st);
-        face_top(J, F, f, x, J->done_below, &C->caches[worker]);
-    }
-    C->faces[lo].kernel += st.kernel;
+    size_t lo = (C->task0 + task) * CHUNK, hi = lo + CHUNK < J->n_from ? lo + CHUNK : J->n_from;
+    size_t seed = SIZE_MAX;
+    for (size_t f = lo; f < hi; f++)
+        if (!C->faces[f].done && screened(J, &J->from[f], &seed, &C->faces[f].upper)) C->faces[f].done = 1;
 }
 
 /* The corners' Morton order (NULL when there are too many to key; any
@@ -809,30 +764,48 @@ static int first_pass(const hd__m2m_job_t *J, ctx_t *C, hd__m2m_result_t *R) {
     return HD_OK;
 }
 
-/* The first pass of the predicate: rounds of tasks (doubling from
- * FIRST_ROUND to MAX_ROUND, whatever the thread count), each face screened
- * or measured; after each round the faces' lower bounds are taken in face
- * order, and a lower bound above d stops the pass.  *stopped: 1 when it
+/* The first pass of the predicate: rounds of faces (tasks of CHUNK faces,
+ * FIRST_ROUND of them, then 8 times more each round, whatever the thread
+ * count: few rounds, so that each round's corners share searches).  In
+ * a round the faces are screened, the corners of the others measured in
+ * Morton order (phase 0 over the round's part of the order) and their
+ * level-0 bounds taken (phase 1); then the round's lower bounds are taken
+ * in face order, and one above d stops the pass.  *stopped: 1 when it
  * stopped before the last face (faces never reached have no bound). */
 #define FIRST_ROUND 2
-#define MAX_ROUND 64
 static int decide_pass(const hd__m2m_job_t *J, ctx_t *C, hd__m2m_result_t *R, int *stopped) {
     size_t n = J->n_from, tasks = (n + CHUNK - 1) / CHUNK, size = FIRST_ROUND;
-    C->vslots = calloc((size_t)J->threads * VSLOTS, sizeof *C->vslots);
-    if (!C->vslots) return HD_ENOMEM;
+    uint64_t *order = NULL, *part = NULL;
+    C->found = hd__malloc_array(n ? 3 * n : 1, sizeof *C->found);
+    part = hd__malloc_array(n ? 3 * n : 1, sizeof *part);
+    if (!C->found || !part || corner_order(J, J->threads, &order)) {
+        free(C->found);
+        free(part);
+        return HD_ENOMEM;
+    }
     *stopped = 0;
-    for (C->task0 = 0; C->task0 < tasks; C->task0 += size, size = size < MAX_ROUND ? 2 * size : size) {
-        size_t m = tasks - C->task0 < size ? tasks - C->task0 : size;
-        hd__parallel_for(J->threads, m, decide_task, C);
-        size_t hi = (C->task0 + m) * CHUNK < n ? (C->task0 + m) * CHUNK : n;
-        for (size_t f = C->task0 * CHUNK; f < hi; f++) take_best(R, &C->faces[f], f);
-        if (R->lower > J->stop_above && hi < n) {
+    for (size_t t0 = 0; t0 < tasks; t0 += size, size *= 8) {
+        size_t m = tasks - t0 < size ? tasks - t0 : size, f0 = t0 * CHUNK;
+        size_t f1 = (t0 + m) * CHUNK < n ? (t0 + m) * CHUNK : n, k = 0;
+        C->task0 = t0;
+        hd__parallel_for(J->threads, m, screen_task, C);
+        for (size_t i = 0; i < 3 * n; i++) {
+            size_t id = order ? (size_t)(order[i] & 0xffffffffu) : i;
+            if (id / 3 >= f0 && id / 3 < f1 && !C->faces[id / 3].done) part[k++] = id;
+        }
+        C->order = part;
+        C->n_corners = k;
+        hd__parallel_for(J->threads, (k + 3 * CHUNK - 1) / (3 * CHUNK), phase0, C);
+        hd__parallel_for(J->threads, m, phase1, C);
+        for (size_t f = f0; f < f1; f++) take_best(R, &C->faces[f], f);
+        if (R->lower > J->stop_above && f1 < n) {
             *stopped = 1;
             break;
         }
     }
-    free(C->vslots);
-    C->vslots = NULL;
+    free(order);
+    free(part);
+    free(C->found);
     return HD_OK;
 }
 
@@ -840,7 +813,7 @@ int hd__m2m_run(const hd__m2m_job_t *J, hd__m2m_result_t *R) {
     memset(R, 0, sizeof *R);
     R->face = R->face_b = SIZE_MAX;
     size_t n = J->n_from;
-    ctx_t C = {J, hd__malloc_array(n ? n : 1, sizeof(face_t)), NULL, NULL, 0, NULL, NULL, 0};
+    ctx_t C = {J, hd__malloc_array(n ? n : 1, sizeof(face_t)), NULL, NULL, 0, NULL, 0};
     rank_t *rk = hd__malloc_array(n ? n : 1, sizeof *rk);
     C.n_corners = 3 * n;
     C.caches = hd__malloc_array((size_t)J->threads, sizeof *C.caches);
