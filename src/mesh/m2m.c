@@ -126,6 +126,11 @@ typedef struct face {
     uint64_t splits, kernel;
     int capped;         /* stopped by max_splits or MAX_LEVEL */
     int done;
+    /* a face whose visit used up its budget: its sub-triangles still to
+     * refine, in the order the heap gave them, and the largest U discarded */
+    sub_t *saved;
+    size_t n_saved;
+    double cut;
 } face_t;
 
 static double slack(const hd__tri_t *t) {
@@ -617,15 +622,34 @@ static void split(const hd__m2m_job_t *J, const hd__tri_t *t, double e, double L
     }
 }
 
-/* Refine face f against the lower bound L of the batches before it. */
-static void refine(const hd__m2m_job_t *J, face_t *F, size_t f, double L, pool_t *P) {
+/* Keep what is left of a face's heap for its next visit (F->upper: its
+ * bound now).  0, or -1 out of memory. */
+static int save(face_t *F, pool_t *P, double cut) {
+    F->n_saved = hd__heap_size(&P->heap);
+    F->saved = hd__malloc_array(F->n_saved, sizeof *F->saved);
+    if (!F->saved) return P->failed = 1, -1;
+    F->upper = fmax(hd__heap_top(&P->heap)->key, cut);
+    F->cut = cut;
+    for (size_t k = 0; k < F->n_saved; k++) F->saved[k] = P->s[hd__heap_pop(&P->heap).val];
+    return 0;
+}
+
+/* Refine face f against the lower bound L of the batches before it, from
+ * where its last visit stopped, for at most `budget` splits: then the face
+ * is left pending (saved) with its bound so far, else it is done. */
+static void refine(const hd__m2m_job_t *J, face_t *F, size_t f, double L, pool_t *P, uint64_t budget) {
     const hd__tri_t *t = &J->from[f];
-    double e = slack(t), cut = 0; /* cut: the largest U discarded */
+    double e = slack(t), cut = F->cut; /* cut: the largest U discarded */
     hd__bvh_stats_t st = {0};
     hd__heap_clear(&P->heap);
     P->n = P->n_free = 0;
-    if (pool_put(P, &F->top) == SIZE_MAX) return;
-    for (;;) {
+    if (!F->saved && pool_put(P, &F->top) == SIZE_MAX) return;
+    for (size_t k = 0; k < F->n_saved; k++)
+        if (pool_put(P, &F->saved[k]) == SIZE_MAX) return;
+    free(F->saved);
+    F->saved = NULL;
+    F->n_saved = 0;
+    for (uint64_t visit = 0;; visit++) {
         if (hd__heap_size(&P->heap) == 0) {
             F->upper = cut;
             break;
@@ -635,6 +659,11 @@ static void refine(const hd__m2m_job_t *J, face_t *F, size_t f, double L, pool_t
         if (top->key - thr <= J->tol || top->key <= J->done_below || F->best.lower > J->stop_above) {
             F->upper = fmax(top->key, cut);
             break;
+        }
+        if (visit == budget) {
+            F->kernel += st.kernel;
+            save(F, P, cut);
+            return;
         }
         hd__heap_item_t it = hd__heap_pop(&P->heap);
         sub_t s = P->s[it.val];
@@ -666,13 +695,14 @@ typedef struct batch {
     const size_t *order;
     double L;
     pool_t *pools;
+    uint64_t budget;
 } batch_t;
 
 static void phase2(void *vctx, size_t task, int worker) {
     batch_t *B = vctx;
     size_t f = B->order[task];
     pool_t *P = &B->pools[worker];
-    if (!P->failed) refine(B->C->job, &B->C->faces[f], f, B->L, P);
+    if (!P->failed) refine(B->C->job, &B->C->faces[f], f, B->L, P, B->budget);
 }
 
 /* ---- the whole search ---------------------------------------------------- */
@@ -711,29 +741,64 @@ static void finish_face(hd__m2m_result_t *R, const hd__m2m_job_t *J, const face_
     R->capped |= F->capped;
 }
 
+/* One pass over the faces rk[0, n) (by decreasing bound) in batches of
+ * growing size, each face visited for at most B->budget splits. */
+static int pass(const hd__m2m_job_t *J, ctx_t *C, const rank_t *rk, size_t n, batch_t *B, size_t *size,
+                hd__m2m_result_t *R) {
+    size_t next = 0, *order = (size_t *)B->order;
+    while (next < n) {
+        if (R->lower > J->stop_above) break; /* the predicate is answered */
+        size_t m = 0;
+        /* faces whose bound cannot exceed L (or the predicate's d) are finished */
+        for (; next < n && m < *size; next++) {
+            face_t *F = &C->faces[rk[next].f];
+            if (J->per_face || (F->upper - R->lower > J->tol && F->upper > J->done_below)) {
+                order[m++] = rk[next].f;
+            } else { /* finished at its bound so far */
+                free(F->saved);
+                F->saved = NULL;
+            }
+        }
+        B->L = J->per_face ? -INFINITY : R->lower;
+        hd__parallel_for(J->threads, m, phase2, B);
+        for (int w = 0; w < J->threads; w++)
+            if (B->pools[w].failed) return HD_ENOMEM;
+        for (size_t k = 0; k < m; k++) take_best(R, &C->faces[order[k]], order[k]);
+        if (*size < MAX_BATCH) *size *= 2;
+    }
+    return HD_OK;
+}
+
+/* Phase 2: passes over the faces, the first visiting each face for
+ * FIRST_BUDGET splits, each next one the faces left pending, by their
+ * bounds so far, for four times as many.  A face whose maximum lies just
+ * below the lower bound L of its batch needs every sub-triangle along that
+ * maximum refined until its bound drops below L: against a stale L (a
+ * face with a higher maximum still waiting in a later batch) that is
+ * unbounded work, so no face is refined to the end before the faces with
+ * higher bounds have had their turn. */
+#define FIRST_BUDGET 64
 static int run_batches(const hd__m2m_job_t *J, ctx_t *C, rank_t *rk, size_t n, hd__m2m_result_t *R) {
     pool_t *pools = calloc((size_t)J->threads, sizeof *pools);
-    size_t *order = hd__malloc_array(MAX_BATCH, sizeof *order);
+    size_t *order = hd__malloc_array(MAX_BATCH, sizeof *order), size = FIRST_BATCH;
     int rc = pools && order ? HD_OK : HD_ENOMEM;
     for (int w = 0; pools && w < J->threads; w++) {
         hd__heap_init(&pools[w].heap, 1);
         pools[w].cache = &C->caches[w];
     }
-    size_t next = 0, size = FIRST_BATCH;
-    while (rc == HD_OK && next < n) {
-        if (R->lower > J->stop_above) break; /* the predicate is answered */
+    batch_t B = {C, order, 0, pools, FIRST_BUDGET};
+    while (rc == HD_OK && n > 0) {
+        rc = pass(J, C, rk, n, &B, &size, R);
         size_t m = 0;
-        /* faces whose first bound cannot exceed L (or the predicate's d) are finished */
-        for (; next < n && m < size; next++) {
-            face_t *F = &C->faces[rk[next].f];
-            if (J->per_face || (F->top.U - R->lower > J->tol && F->top.U > J->done_below)) order[m++] = rk[next].f;
-        }
-        batch_t B = {C, order, J->per_face ? -INFINITY : R->lower, pools};
-        hd__parallel_for(J->threads, m, phase2, &B);
-        for (int w = 0; w < J->threads; w++)
-            if (pools[w].failed) rc = HD_ENOMEM;
-        for (size_t k = 0; k < m; k++) take_best(R, &C->faces[order[k]], order[k]);
-        if (size < MAX_BATCH) size *= 2;
+        for (size_t k = 0; k < n; k++)
+            if (C->faces[rk[k].f].saved) rk[m++] = (rank_t){C->faces[rk[k].f].upper, rk[k].f};
+        qsort(rk, m, sizeof *rk, by_upper);
+        n = R->lower > J->stop_above ? 0 : m;
+        B.budget = B.budget < ((uint64_t)1 << 40) ? 4 * B.budget : B.budget;
+    }
+    for (size_t f = 0; f < J->n_from; f++) { /* pending faces keep their bound so far */
+        free(C->faces[f].saved);
+        C->faces[f].saved = NULL;
     }
     for (int w = 0; pools && w < J->threads; w++) {
         free(pools[w].s);

@@ -485,6 +485,52 @@ TEST(predicate_far_from_the_distance_measures_few_corners) {
     gen_soup_free(&A), gen_soup_free(&B);
 }
 
+/* B: two strips in z = 0, y in [-3, -1] and [1, 3], x in [-10, 100].
+ * A: eight wide faces across the gap, whose distance has a ridge at
+ * exactly 1 along y = 0, which no edge of their subdivisions follows (y = 0
+ * is 9/17 of the way from their base to their apex); a face at z = 1/2 over
+ * the gap whose largest distance, sqrt(5) / 2 at y = 0, is inside it (its
+ * corners are at sqrt(2) / 2); and a small face at z = 1 + 1e-9 over a
+ * strip, whose corners put the first lower bound just above the ridges.
+ * The wide faces have the largest first bounds, so they come first: a
+ * face refined to the end against that lower bound would need every
+ * sub-triangle along its ridge within 1e-9 of it. */
+TEST(a_ridge_just_below_the_first_lower_bound_waits_for_the_faces_above_it) {
+    double v[3 * 8], va[3 * 30];
+    uint64_t tb[3 * 4], ta[30];
+    const double strip[8][3] = {{-10, -3, 0}, {100, -3, 0}, {100, -1, 0}, {-10, -1, 0},
+                                {-10, 1, 0},  {100, 1, 0},  {100, 3, 0},  {-10, 3, 0}};
+    memcpy(v, strip, sizeof strip);
+    const uint64_t quads[4][3] = {{0, 1, 2}, {0, 2, 3}, {4, 5, 6}, {4, 6, 7}};
+    memcpy(tb, quads, sizeof quads);
+    gen_soup_t B = soup_of(v, 8, tb, 4);
+    size_t n = 0;
+    for (int k = 0; k < 8; k++, n += 3) {
+        double x = 10.0 * k, c[3][3] = {{x, -0.9, 0}, {x + 8, -0.9, 0}, {x + 4, 0.8, 0}};
+        memcpy(va + 3 * n, c, sizeof c);
+    }
+    const double mid[3][3] = {{80, -0.5, 0.5}, {84, -0.5, 0.5}, {82, 0.5, 0.5}};
+    const double z = 1 + 1e-9, top[3][3] = {{90, -2, z}, {90.5, -2, z}, {90, -1.5, z}};
+    memcpy(va + 3 * n, mid, sizeof mid), n += 3;
+    memcpy(va + 3 * n, top, sizeof top), n += 3;
+    for (size_t k = 0; k < n; k++) ta[k] = k;
+    gen_soup_t A = soup_of(va, n, ta, n / 3);
+    hd_mesh_t a = gen_soup_view(&A), b = gen_soup_view(&B);
+    hd_surface_options_t o = options(1e-12, 0, 1), o2 = options(1e-12, 0, 2);
+    o.max_splits = o2.max_splits = 20000;
+    hd_enclosure_t ab, ab2;
+    CHECK_RC(hd_surface_hausdorff(&a, &b, &o, &ab, NULL, NULL), HD_OK);
+    CHECK_RC(hd_surface_hausdorff(&a, &b, &o2, &ab2, NULL, NULL), HD_OK);
+    CONTEXT("[%.17g, %.17g], %llu splits", ab.lower, ab.upper, (unsigned long long)ab.faces_split);
+    CHECK(ab.converged);
+    CHECK(ab.lower <= sqrt(1.25) && sqrt(1.25) <= ab.upper);
+    CHECK_EQ(ab.face_a, 8);
+    CHECK(ab.faces_split < 20000);
+    same_enclosure(&ab, &ab2);
+    encloses(&ab, &A, &B, 16);
+    gen_soup_free(&A), gen_soup_free(&B);
+}
+
 TEST(face_maxima_enclose_each_face) {
     gen_rng_t r;
     gen_seed(&r, 7);
