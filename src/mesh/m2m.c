@@ -27,22 +27,32 @@
  * is a vertex of the face (one weight 2^L) is that vertex, exactly
  * (e = 0).
  *
- * Bounds.  Each corner v gets r = RN(d(v, Y)) from the exact kernel through
- * the tree (hd__bvh_nearest), so d(v, Y) <= next_up(r).
+ * Bounds.  Each corner v gets hi >= d(v, Y) from the prepared bounds alone
+ * (interval(): the smallest hi2 of hd__tri_bounds_prep over the triangles of
+ * Y that the tree cannot exclude), and the triangle giving it.  The exact
+ * r = RN(d(v, Y)) (the kernel through the tree, hd__bvh_nearest) is needed
+ * only where v could change the lower bound: r <= hi (RN is monotone and
+ * hi is a double), so a corner whose lower bound from hi (below) is at most
+ * the bound it would have to beat - its face's best and, unless each
+ * face's own lower bound is asked for, L - cannot beat it (offer() needs
+ * more), and the result is the same as with every r computed.  Phase 0's
+ * bar is max lo over all corners (lo <= d from the smallest lo2 of the
+ * triangles visited): a corner with hi below it is nearer than another.
+ * An exact corner takes hi = next_up(r) when that is smaller.
  *  - Lower: a point of X at distance >= r' from Y with r' = r at a vertex
  *    (the witness is exact), else r' = down(next_down(r) - e): the exact
  *    point of the face at the corner's weights is within e of v, so its
  *    distance is at least d(v, Y) - e >= next_down(r) - e.
  *  - Upper, for the hull T of the three computed corners: every y in T has
  *    d(y, Y) <= d(v, Y) + |y - v| for each corner v, so
- *    d(y, Y) <= max_v next_up(r_v) + R with R >= the largest distance from a
+ *    d(y, Y) <= max_v hi_v + R with R >= the largest distance from a
  *    point of T to its nearest corner (the point bound: R <= the longest
  *    edge over sqrt 3 for every triangle, the circumradius bound of a
  *    non-obtuse triangle, and half the longest edge for an obtuse one).
  *    And for any triangle t of Y, d(., t) is convex, so its maximum over T
  *    is at a corner: d(y, Y) <= min over t of max_v d(v, t) (Tang et al.),
  *    taken over the corners' nearest triangles with d(v, t) <= sqrt_up(hi2)
- *    from hd__tri_bounds (or next_up(r) for v's own nearest).  The exact
+ *    from hd__tri_bounds (or hi for v's own triangle).  The exact
  *    sub-triangle of the face is within e of T point by point (the weights
  *    of a point of the exact sub-triangle applied to the computed corners
  *    give a point of T within e), so U = up(min(both) + e) (e = 0 at level
@@ -50,18 +60,34 @@
  * All upper sums and square roots are rounded to nearest and then moved one
  * double up (next_up), which is at least the exact value.
  *
- * The search.  Phase 1 evaluates every face's corners (fixed chunks, any
- * thread) and sets the lower bound L to the best corner.  Phase 2 takes the
- * faces by decreasing upper bound in batches of fixed sizes; the faces of a
- * batch are refined in parallel, each on its own against L as it was
- * before the batch (and its own corners' lower bounds): a face pops its
- * sub-triangle of largest U, stops when U <= max(L, own lower) + tolerance
- * (or the predicate's bound), else splits it and keeps the children whose
- * U exceeds that threshold.  The batches merge in order, the witness is the
- * first best in face order, so nothing depends on the thread count.  The
- * face's upper bound is the largest U it stopped at or discarded; h's
- * upper bound is the largest over faces (faces skipped because their
- * first U was <= L contribute that U).
+ * The search.  Phase 0 bounds every distinct corner and computes the
+ * exact distances of those that can be the largest; phase 1 evaluates
+ * every face's corners (fixed chunks, any thread) and sets the lower
+ * bound L to the best corner.  Phase 2 takes the faces by decreasing
+ * upper bound in batches of fixed sizes; the faces of a batch are refined
+ * in parallel, each on its own against L as it was before the batch (and
+ * its own corners' lower bounds): a face pops its sub-triangle of largest
+ * U, stops when U <= max(L, own lower) + tolerance (or the predicate's
+ * bound), else splits it and keeps the children whose U exceeds that
+ * threshold.  A visit ends after a budget of splits (growing fourfold from
+ * pass to pass); the faces left pending are taken again, by their bounds
+ * so far, in the next pass, so that no face is refined to the end against
+ * an L that a face with a higher bound would raise.  The batches merge in
+ * order, the witness is the first best in face order, so nothing depends
+ * on the thread count.  The face's upper bound is the largest U it stopped
+ * at or discarded (or, pending when the search stopped, the largest U
+ * left); h's upper bound is the largest over faces (faces skipped because
+ * their first U was <= L contribute that U).
+ *
+ * The predicate (a finite d: done_below = stop_above = d) runs phases 0
+ * and 1 in rounds of faces instead: a face is first screened - the point
+ * bound over its vertices from any triangle of Y whose prepared upper
+ * bound is small enough, or Tang's bound with one such triangle - and
+ * discarded unrefined when that is <= d; only the other faces' corners are
+ * measured, and a lower bound above d after a round ends the search (the
+ * faces not reached then have no bound: upper is infinite).  Refinement
+ * discards every sub-triangle whose U is <= d and stops a face at a lower
+ * bound above d.
  */
 #include "mesh/mesh.h"
 #include "mesh/mesh_int.h"
@@ -96,11 +122,13 @@ static double sqrt_up(double x) { return x <= 0 ? 0 : up(sqrt(x)); }
 typedef struct corner {
     double p[3];
     uint64_t k[3];
-    double r;      /* RN(d(p, Y)) */
-    double lower;  /* a distance a point of X has, from this corner */
-    size_t pos;    /* p's nearest triangle: its position in the tree */
-    size_t index;  /* ... and its index in Y */
-    double near[3];/* the nearest point on it */
+    double hi;     /* d(p, Y) <= hi, and d(p, t) <= hi for t at pos */
+    double r;      /* RN(d(p, Y)), when exact */
+    double lower;  /* a distance a point of X has, from this corner (exact) */
+    size_t pos;    /* a triangle of Y as near as the bounds tell: its position */
+    size_t index;  /* p's nearest triangle's index in Y (exact) */
+    double near[3];/* the nearest point on it (exact) */
+    int exact;     /* r, lower, index, near are set */
 } corner_t;
 
 typedef struct sub {
@@ -162,16 +190,6 @@ static void corner_point(const hd__tri_t *t, corner_t *c, int level) {
 static int is_vertex(const corner_t *c, int level) {
     uint64_t one = (uint64_t)1 << level;
     return c->k[0] == one || c->k[1] == one || c->k[2] == one;
-}
-
-static void evaluate(const hd__m2m_job_t *J, const hd__tri_t *t, double e, corner_t *c, int level, size_t seed,
-                     hd__bvh_stats_t *st) {
-    hd__tri_near_t near;
-    corner_point(t, c, level);
-    c->pos = hd__bvh_nearest(J->to, c->p, seed, 0, &near, &c->index, st);
-    c->r = near.d;
-    memcpy(c->near, near.point, sizeof c->near);
-    c->lower = is_vertex(c, level) ? c->r : fmax(0.0, down(down(c->r) - e));
 }
 
 static void offer(best_t *b, const corner_t *c, int level, double e) {
@@ -294,15 +312,44 @@ static int shared_convex(const hd__tri_t *s, const hd__tri_t *t) {
 }
 
 /* A worker's prepared triangles of Y, by position in the tree (direct
- * mapped): hd__tri_bounds_prep gives hd__tri_bounds's bits. */
-#define CACHE 1024
+ * mapped, a power of two entries up to MAX_CACHE, enough for all of Y
+ * when it is smaller): hd__tri_bounds_prep gives hd__tri_bounds's bits,
+ * so what the cache holds never changes a result. */
+#define MAX_CACHE 2048
 typedef struct cache {
-    size_t pos[CACHE];
-    hd__tri_prep_t prep[CACHE];
+    size_t mask;
+    size_t *pos;
+    hd__tri_prep_t *prep;
 } cache_t;
 
+static void caches_free(cache_t *C, int n) {
+    for (int w = 0; C && w < n; w++) {
+        free(C[w].pos);
+        free(C[w].prep);
+    }
+    free(C);
+}
+
+/* n workers' caches for a tree of n_tris triangles, or NULL. */
+static cache_t *caches_new(int n, size_t n_tris) {
+    size_t size = 64;
+    while (size < n_tris && size < MAX_CACHE) size *= 2;
+    cache_t *C = calloc((size_t)n, sizeof *C);
+    for (int w = 0; C && w < n; w++) {
+        C[w].mask = size - 1;
+        C[w].pos = hd__malloc_array(size, sizeof *C[w].pos);
+        C[w].prep = hd__malloc_array(size, sizeof *C[w].prep);
+        if (!C[w].pos || !C[w].prep) {
+            caches_free(C, n);
+            return NULL;
+        }
+        for (size_t k = 0; k < size; k++) C[w].pos[k] = SIZE_MAX;
+    }
+    return C;
+}
+
 static const hd__tri_prep_t *prepared(cache_t *C, size_t pos, const hd__tri_t *t) {
-    size_t k = pos & (CACHE - 1);
+    size_t k = pos & C->mask;
     if (C->pos[k] != pos) {
         hd__tri_prep(t->v[0], t->v[1], t->v[2], &C->prep[k]);
         C->pos[k] = pos;
@@ -310,9 +357,105 @@ static const hd__tri_prep_t *prepared(cache_t *C, size_t pos, const hd__tri_t *t
     return &C->prep[k];
 }
 
+/* ---- a point's distance to Y, enclosed without the kernel --------------- */
+
+/* Every point of the box is at squared distance above h2 from p (the
+ * computed hd__box_lb2s is within a factor (1 + u)^11 of the exact square
+ * when it is at least 2^-1000, bvh.c's proof). */
+static int far2(double s, double h2) { return s >= 0x1p-1000 && s * (1 - 0x1p-46) > h2; }
+static int beyond(const hd__box_t *b, const double p[3], double h2) { return far2(hd__box_lb2s(b, p[0], p[1], p[2]), h2); }
+
+/* The bounds of p to the triangle at pos.  hd__tri_bounds gives lo2 = 0 for
+ * a point (a point set's triangles): there the computed square, within a
+ * factor 1 + 5.01 u of the exact one (two roundings in each difference
+ * squared, two in the sum), shrunk by 1 - 8 u. */
+static void bounds_at(const hd__bvh_t *T, size_t pos, const double p[3], cache_t *C, double *lo2, double *hi2) {
+    const hd__tri_t *t = &T->tris[pos];
+    hd__tri_bounds_prep(p, prepared(C, pos, t), lo2, hi2);
+    if (*lo2 == 0 && memcmp(t->v[0], t->v[1], sizeof t->v[0]) == 0 && memcmp(t->v[0], t->v[2], sizeof t->v[0]) == 0) {
+        double dx = p[0] - t->v[0][0], dy = p[1] - t->v[0][1], dz = p[2] - t->v[0][2];
+        double d2 = dx * dx + dy * dy + dz * dz;
+        *lo2 = d2 >= 0x1p-1000 ? d2 * (1 - 0x1p-50) : 0;
+    }
+}
+
+#define DEPTH 130
+/* lo <= d(p, Y) <= hi from hd__tri_bounds_prep alone: hi from the triangle
+ * of smallest hi2 (returned: its position in the tree; a triangle whose
+ * box lies beyond the smallest hi2 so far is skipped), lo from the smallest
+ * lo2 over the triangles visited (a skipped one is farther than the
+ * nearest, so the minimum over Y is among them).  The answer depends on p,
+ * the seed and the tree only. */
+static size_t interval(const hd__bvh_t *T, const double p[3], size_t seed, cache_t *C, double *lo, double *hi,
+                       uint64_t *count) {
+    double best = INFINITY, low = INFINITY, lo2, hi2;
+    size_t pos = SIZE_MAX;
+    if (seed < T->n_tris) {
+        bounds_at(T, seed, p, C, &lo2, &hi2);
+        best = hi2, low = lo2, pos = seed;
+        (*count)++;
+    }
+    struct { uint32_t id; double s; } stack[DEPTH]; /* s: the box's hd__box_lb2s */
+    int top = 0;
+    stack[top].id = 0, stack[top++].s = hd__box_lb2s(&T->nodes[0].box, p[0], p[1], p[2]);
+    while (top > 0) {
+        uint32_t id = stack[--top].id;
+        if (far2(stack[top].s, best)) continue;
+        const hd__bvh_node_t *node = &T->nodes[id];
+        if (node->count) {
+            for (size_t k = node->first_or_second; k < (size_t)node->first_or_second + node->count; k++) {
+                if (k == seed || beyond(&T->boxes[k], p, best)) continue;
+                bounds_at(T, k, p, C, &lo2, &hi2);
+                (*count)++;
+                low = fmin(low, lo2);
+                if (pos == SIZE_MAX || hi2 < best) best = hi2, pos = k;
+            }
+            continue;
+        }
+        uint32_t a = id + 1, b = node->first_or_second;
+        double la = hd__box_lb2s(&T->nodes[a].box, p[0], p[1], p[2]);
+        double lb = hd__box_lb2s(&T->nodes[b].box, p[0], p[1], p[2]);
+        if (la < lb) { /* the nearer on top */
+            uint32_t t = a;
+            double u = la;
+            a = b, la = lb, b = t, lb = u;
+        }
+        if (!far2(la, best)) stack[top].id = a, stack[top++].s = la;
+        if (!far2(lb, best)) stack[top].id = b, stack[top++].s = lb;
+    }
+    *lo = low > 0 ? down(sqrt(low)) : 0;
+    *hi = sqrt_up(best);
+    return pos;
+}
+
+/* The largest lower bound the corner could give (its exact distance is at
+ * most hi). */
+static double could(const corner_t *c, int level, double e) {
+    return is_vertex(c, level) ? c->hi : fmax(0.0, down(down(c->hi) - e));
+}
+
+/* The corner's exact distance through the tree (the witness's lower bound). */
+static void make_exact(const hd__m2m_job_t *J, corner_t *c, int level, double e, hd__bvh_stats_t *st) {
+    hd__tri_near_t near;
+    size_t pos = hd__bvh_nearest(J->to, c->p, c->pos, 0, &near, &c->index, st);
+    c->r = near.d;
+    memcpy(c->near, near.point, sizeof c->near);
+    c->lower = is_vertex(c, level) ? c->r : fmax(0.0, down(down(c->r) - e));
+    c->exact = 1;
+    if (up(c->r) < c->hi) c->hi = up(c->r), c->pos = pos;
+}
+
+static void evaluate(const hd__m2m_job_t *J, const hd__tri_t *t, corner_t *c, int level, size_t seed, cache_t *C,
+                     uint64_t *count) {
+    double lo;
+    corner_point(t, c, level);
+    c->pos = interval(J->to, c->p, seed, C, &lo, &c->hi, count);
+    c->exact = 0;
+}
+
 /* d(v, t) <= this (v's own nearest triangle: next_up(r)). */
 static double corner_to(const corner_t *c, size_t pos, const hd__tri_t *t, cache_t *C, uint64_t *kernel) {
-    if (c->pos == pos) return up(c->r);
+    if (c->pos == pos) return c->hi;
     double lo2, hi2;
     hd__tri_bounds_prep(c->p, prepared(C, pos, t), &lo2, &hi2);
     (*kernel)++;
@@ -342,7 +485,7 @@ static double pair_bound(const hd__m2m_job_t *J, const sub_t *s, double U, cache
 static double upper_of(const hd__m2m_job_t *J, const sub_t *s, double e, double enough, cache_t *C,
                        uint64_t *kernel) {
     double rmax = 0;
-    for (int i = 0; i < 3; i++) rmax = fmax(rmax, up(s->c[i].r));
+    for (int i = 0; i < 3; i++) rmax = fmax(rmax, s->c[i].hi);
     double U = up(rmax + reach(s));
     if ((s->level ? up(U + e) : U) <= enough) return s->level ? up(U + e) : U;
     for (int i = 0; i < 3; i++) { /* Tang's bound over the corners' nearest triangles */
@@ -363,8 +506,9 @@ static double upper_of(const hd__m2m_job_t *J, const sub_t *s, double e, double 
 
 /* A corner of a face as phase 0 finds it. */
 typedef struct found {
-    double r, near[3];
+    double lo, hi, r, near[3];
     size_t pos, index;
+    int exact;
 } found_t;
 
 typedef struct ctx {
@@ -375,21 +519,20 @@ typedef struct ctx {
     size_t n_corners;
     cache_t *caches;       /* one per worker */
     size_t task0;          /* phase 1's first task (the predicate's rounds) */
+    double bar;            /* phase 0's exact searches: corners with hi >= bar */
 } ctx_t;
 
 #define CORNER(J, id) ((J)->from[(id) / 3].v[(id) % 3])
 
-/* Phase 0: each corner's nearest triangle, in Morton order so that each
- * search starts from its predecessor's answer; a corner equal to its
- * predecessor copies it (the answer is the brute force's: it depends on
- * the point alone). */
+/* Phase 0: each corner's distance enclosed (interval()), in Morton order
+ * so that each search starts from its predecessor's answer; a corner equal
+ * to its predecessor copies it. */
 static void phase0(void *vctx, size_t task, int worker) {
-    (void)worker;
     ctx_t *C = vctx;
     const hd__m2m_job_t *J = C->job;
     size_t lo = task * CHUNK * 3, hi = lo + CHUNK * 3 < C->n_corners ? lo + CHUNK * 3 : C->n_corners;
     size_t seed = SIZE_MAX, prev = SIZE_MAX;
-    hd__bvh_stats_t st = {0};
+    uint64_t count = 0;
     for (size_t k = lo; k < hi; k++) {
         size_t id = C->order ? (size_t)(C->order[k] & 0xffffffffu) : k;
         found_t *F = &C->found[id];
@@ -398,13 +541,48 @@ static void phase0(void *vctx, size_t task, int worker) {
             *F = C->found[prev];
             continue;
         }
-        hd__tri_near_t near;
-        F->pos = seed = hd__bvh_nearest(J->to, CORNER(J, id), seed, 0, &near, &F->index, &st);
-        F->r = near.d;
-        memcpy(F->near, near.point, sizeof F->near);
+        F->pos = seed = interval(J->to, CORNER(J, id), seed, &C->caches[worker], &F->lo, &F->hi, &count);
+        F->exact = 0;
         prev = id;
     }
-    C->faces[lo / 3].kernel += st.kernel; /* counted on the chunk's first face */
+    C->faces[lo / 3].kernel += count; /* counted on the chunk's first face */
+}
+
+/* The corners (of C->order's first n_corners) that can be the largest:
+ * those whose hi reaches the largest lo (every other one is nearer to Y
+ * than that corner), or all of them when each face's own lower bound is
+ * asked for. */
+static double phase0_bar(const ctx_t *C) {
+    const hd__m2m_job_t *J = C->job;
+    if (J->per_face || J->face_lower) return -INFINITY;
+    double bar = -INFINITY;
+    for (size_t k = 0; k < C->n_corners; k++) {
+        size_t id = C->order ? (size_t)(C->order[k] & 0xffffffffu) : k;
+        if (!C->faces[id / 3].done) bar = fmax(bar, C->found[id].lo);
+    }
+    return bar;
+}
+
+/* Phase 0, second part: those corners' exact distances (through the tree:
+ * the answer is the brute force's, it depends on the point alone). */
+static void phase0_exact(void *vctx, size_t task, int worker) {
+    (void)worker;
+    ctx_t *C = vctx;
+    const hd__m2m_job_t *J = C->job;
+    size_t lo = task * CHUNK * 3, hi = lo + CHUNK * 3 < C->n_corners ? lo + CHUNK * 3 : C->n_corners;
+    hd__bvh_stats_t st = {0};
+    for (size_t k = lo; k < hi; k++) {
+        size_t id = C->order ? (size_t)(C->order[k] & 0xffffffffu) : k;
+        found_t *F = &C->found[id];
+        if (C->faces[id / 3].done || F->hi < C->bar) continue;
+        hd__tri_near_t near;
+        F->pos = hd__bvh_nearest(J->to, CORNER(J, id), F->pos, 0, &near, &F->index, &st);
+        F->r = near.d;
+        F->hi = up(near.d);
+        memcpy(F->near, near.point, sizeof F->near);
+        F->exact = 1;
+    }
+    C->faces[lo / 3].kernel += st.kernel;
 }
 
 /* Face f's level-0 sub-triangle from its corners' nearest triangles x,
@@ -417,10 +595,12 @@ static void face_top(const hd__m2m_job_t *J, face_t *F, size_t f, const found_t 
         c->k[i] = 1;
         memcpy(c->p, J->from[f].v[i], sizeof c->p);
         c->r = c->lower = x[i].r;
+        c->hi = x[i].hi;
+        c->exact = x[i].exact;
         c->pos = x[i].pos;
         c->index = x[i].index;
         memcpy(c->near, x[i].near, sizeof c->near);
-        offer(&F->best, c, 0, 0);
+        if (c->exact) offer(&F->best, c, 0, 0);
     }
     F->top.level = 0;
     F->top.U = upper_of(J, &F->top, 0, enough, cache, &F->kernel);
@@ -432,7 +612,7 @@ static void phase1(void *vctx, size_t task, int worker) {
     const hd__m2m_job_t *J = C->job;
     size_t lo = (C->task0 + task) * CHUNK, hi = lo + CHUNK < J->n_from ? lo + CHUNK : J->n_from;
     for (size_t f = lo; f < hi; f++)
-        if (!C->faces[f].done) face_top(J, &C->faces[f], f, &C->found[3 * f], J->done_below, &C->caches[worker]);
+        if (!C->faces[f].done) face_top(J, &C->faces[f], f, &C->found[3 * f], J->face_upper ? -INFINITY : fmax(C->bar, J->done_below), &C->caches[worker]);
 }
 
 /* ---- the predicate's pass: screen, then exact corners, in rounds --------- */
@@ -598,6 +778,13 @@ static double threshold(const hd__m2m_job_t *J, double L, const face_t *F) {
     return thr;
 }
 
+/* A point whose could() is at most this cannot change the result: the
+ * face's own best, and L unless each face's own lower bound is asked for. */
+static double exact_bar(const hd__m2m_job_t *J, double L, const face_t *F) {
+    double own = F->best.set ? F->best.lower : -INFINITY;
+    return J->per_face || J->face_lower ? own : fmax(L, own);
+}
+
 static void split(const hd__m2m_job_t *J, const hd__tri_t *t, double e, double L, const sub_t *s, sub_t kids[4],
                   face_t *F, pool_t *P, hd__bvh_stats_t *st) {
     int level = s->level + 1;
@@ -609,8 +796,11 @@ static void split(const hd__m2m_job_t *J, const hd__tri_t *t, double e, double L
     for (int i = 0; i < 3; i++) {
         const corner_t *p = &s->c[i], *q = &s->c[(i + 1) % 3];
         for (int j = 0; j < 3; j++) m[i].k[j] = p->k[j] + q->k[j];
-        evaluate(J, t, e, &m[i], level, p->pos, st);
-        offer(&F->best, &m[i], level, e);
+        evaluate(J, t, &m[i], level, p->pos, P->cache, &F->kernel);
+        if (could(&m[i], level, e) > exact_bar(J, L, F)) {
+            make_exact(J, &m[i], level, e, st);
+            offer(&F->best, &m[i], level, e);
+        }
     }
     const corner_t *tri[4][3] = {{&c[0], &m[0], &m[2]}, {&m[0], &c[1], &m[1]}, {&m[2], &m[1], &c[2]},
                                  {&m[0], &m[1], &m[2]}};
@@ -822,6 +1012,8 @@ static int first_pass(const hd__m2m_job_t *J, ctx_t *C, hd__m2m_result_t *R) {
     }
     C->order = order;
     hd__parallel_for(J->threads, (n + CHUNK - 1) / CHUNK, phase0, C);
+    C->bar = phase0_bar(C);
+    hd__parallel_for(J->threads, (n + CHUNK - 1) / CHUNK, phase0_exact, C);
     hd__parallel_for(J->threads, (n + CHUNK - 1) / CHUNK, phase1, C);
     free(order);
     free(C->found);
@@ -861,6 +1053,8 @@ static int decide_pass(const hd__m2m_job_t *J, ctx_t *C, hd__m2m_result_t *R, in
         C->order = part;
         C->n_corners = k;
         hd__parallel_for(J->threads, (k + 3 * CHUNK - 1) / (3 * CHUNK), phase0, C);
+        C->bar = phase0_bar(C);
+        hd__parallel_for(J->threads, (k + 3 * CHUNK - 1) / (3 * CHUNK), phase0_exact, C);
         hd__parallel_for(J->threads, m, phase1, C);
         for (size_t f = f0; f < f1; f++) take_best(R, &C->faces[f], f);
         if (R->lower > J->stop_above && f1 < n) {
@@ -878,18 +1072,16 @@ int hd__m2m_run(const hd__m2m_job_t *J, hd__m2m_result_t *R) {
     memset(R, 0, sizeof *R);
     R->face = R->face_b = SIZE_MAX;
     size_t n = J->n_from;
-    ctx_t C = {J, hd__malloc_array(n ? n : 1, sizeof(face_t)), NULL, NULL, 0, NULL, 0};
+    ctx_t C = {J, hd__malloc_array(n ? n : 1, sizeof(face_t)), NULL, NULL, 0, NULL, 0, 0};
     rank_t *rk = hd__malloc_array(n ? n : 1, sizeof *rk);
     C.n_corners = 3 * n;
-    C.caches = hd__malloc_array((size_t)J->threads, sizeof *C.caches);
+    C.caches = caches_new(J->threads, J->to->n_tris);
     if (!C.faces || !rk || !C.caches) {
         free(C.faces);
         free(rk);
-        free(C.caches);
+        caches_free(C.caches, J->threads);
         return HD_ENOMEM;
     }
-    for (int w = 0; w < J->threads; w++)
-        for (size_t k = 0; k < CACHE; k++) C.caches[w].pos[k] = SIZE_MAX;
     for (size_t f = 0; f < n; f++) {
         memset(&C.faces[f], 0, sizeof C.faces[f]);
         C.faces[f].done = J->drop && J->drop[f];
@@ -909,7 +1101,7 @@ int hd__m2m_run(const hd__m2m_job_t *J, hd__m2m_result_t *R) {
     for (size_t f = 0; f < n; f++) finish_face(R, J, &C.faces[f], f);
     R->upper = stopped ? INFINITY : fmax(R->upper, R->lower);
     free(C.faces);
-    free(C.caches);
+    caches_free(C.caches, J->threads);
     free(rk);
     return rc;
 }
@@ -922,9 +1114,19 @@ typedef struct key {
 
 static int cmp_corner3(const void *x, const void *y) { return memcmp(x, y, 3 * sizeof(double)); }
 
+static void swap_if(double a[3], double b[3]) {
+    if (cmp_corner3(a, b) > 0) {
+        double t[3];
+        memcpy(t, a, sizeof t), memcpy(a, b, sizeof t), memcpy(b, t, sizeof t);
+    }
+}
+
+/* The corners in memcmp order (three compare-exchanges). */
 static void key_of(const hd__tri_t *t, facekey_t *k) {
     memcpy(k->v, t->v, sizeof k->v);
-    qsort(k->v, 3, sizeof k->v[0], cmp_corner3);
+    swap_if(k->v[0], k->v[1]);
+    swap_if(k->v[1], k->v[2]);
+    swap_if(k->v[0], k->v[1]);
 }
 
 static int cmp_key(const void *x, const void *y) { return memcmp(x, y, sizeof(facekey_t)); }
