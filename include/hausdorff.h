@@ -1310,14 +1310,22 @@ HD_EXTERN int hd_surface_points_hausdorff(const hd_mesh_t *A,
                                           hd_error_t *err);
 
 /* The predicate "H(A, B) <= d?" (h(A, B) <= d when `directed` is 1),
- * with early exit: the search stops as soon as one face of A (or B) is
- * proven farther than d, or every face is proven within d.  *answer: 1
- * (proven <= d), 0 (proven > d), or -1 when the distance lies within the
- * tolerance of d and the enclosure cannot decide (the enclosures say how
- * close).  ab, ba: NULL, or the enclosures as far as the search went (their
- * width is then not bounded by the tolerance; ba has lower 0 and upper
- * infinity when h(A, B) alone proved the answer 0).  Errors: as
- * hd_surface_hausdorff, and HD_EINVAL for d negative or NaN. */
+ * with early exit, refining only what decides d: a face whose rigorous
+ * upper bound is <= d is discarded unrefined (first from bounds on its
+ * corners without the exact kernel), and the search stops at the first
+ * witness whose correctly rounded distance exceeds d.  *answer: 1 (proven
+ * <= d: every upper bound <= d), 0 (proven > d: a witness's lower bound
+ * > d), or -1 when d lies within the tolerance of the distance: then lower
+ * <= d < upper and upper - lower <= tolerance (lower and upper the largest
+ * of the directions'), so that a tolerance of 0 decides every d but those
+ * within about 2^-48 of the coordinates of the distance.  ab, ba: NULL, or
+ * the enclosures as far as the search went: a face discarded by its bound
+ * gives no lower bound (lower may be 0 with no witness, face_a SIZE_MAX),
+ * and upper is infinity when the search stopped before every face had a
+ * bound; ba has lower 0 and upper infinity when h(A, B) alone proved the
+ * answer 0.  The answer, enclosures and counters do not depend on the
+ * thread count.  Errors: as hd_surface_hausdorff, and HD_EINVAL for d
+ * negative or NaN. */
 HD_EXTERN int hd_surface_within(const hd_mesh_t *A, const hd_mesh_t *B,
                                 double d, int directed,
                                 const hd_surface_options_t *opt,

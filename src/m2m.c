@@ -142,7 +142,6 @@ static int directed(const side_t *x, side_t *y, const ask_t *q, hd_enclosure_t *
     unsigned char *drop = NULL;
     size_t dropped = 0;
     int rc = HD_OK;
-    if (!y->built && (rc = side_tree(y, y->points ? "points" : "mesh", err))) return rc;
     if (!x->points && !y->points) {
         drop = malloc(x->n ? x->n : 1);
         if (!drop || hd__m2m_shared(x->tris, x->n, y->tris, y->n, drop, &dropped)) {
@@ -150,6 +149,20 @@ static int directed(const side_t *x, side_t *y, const ask_t *q, hd_enclosure_t *
             return hd__err(err, HD_ENOMEM, "out of memory comparing the faces of the meshes");
         }
     }
+    if (dropped == x->n) { /* every face of X is a face of Y: h = 0, no tree needed */
+        free(drop);
+        for (size_t k = 0; k < x->n; k++) {
+            if (q->face_lower) q->face_lower[k] = 0;
+            if (q->face_upper) q->face_upper[k] = 0;
+        }
+        enclosure_init(out);
+        out->tolerance = q->tol;
+        out->converged = 1;
+        out->faces_dropped = dropped;
+        out->seconds = hd__now() - t0;
+        return HD_OK;
+    }
+    if (!y->built && (rc = side_tree(y, y->points ? "points" : "mesh", err))) return rc;
     hd__m2m_job_t J = {.from = x->tris, .n_from = x->n, .to = &y->bvh, .drop = drop, .tol = q->tol,
                        .done_below = q->done_below, .stop_above = q->stop_above, .per_face = q->per_face,
                        .max_splits = q->max_splits, .face_lower = q->face_lower, .face_upper = q->face_upper};

@@ -10,6 +10,10 @@
 //       bounded_error_symmetric_Hausdorff_distance (sym) at the absolute
 //       tolerance, on Exact_predicates_inexact_constructions_kernel (as in
 //       CGAL's own example), match_faces left on (its default).
+//   m2m_cgal larger A.off B.off D TOLERANCE ab|sym
+//       is_Hausdorff_distance_larger(A, B, D, TOLERANCE), one-sided (ab) or
+//       symmetric (sym): prints its answer as "within" (1 when it says the
+//       distance is not larger than D).
 //   m2m_cgal sampled A.off B.off SAMPLES SEED
 //       approximate_Hausdorff_distance both ways: SAMPLES points drawn
 //       uniformly on the faces, plus the vertices and one point per vertex
@@ -121,6 +125,18 @@ static int bounded(const Mesh &a, const Mesh &b, double tol, const char *which) 
     return 0;
 }
 
+static int larger(const Mesh &a, const Mesh &b, double d, double tol, const char *which) {
+    if (std::strcmp(which, "ab") && std::strcmp(which, "sym")) return 2;
+    Clock t;
+    bool beyond = PMP::is_Hausdorff_distance_larger<CGAL::Sequential_tag>(
+        a, b, d, tol, PMP::parameters::use_one_sided_hausdorff(!std::strcmp(which, "ab")));
+    double wall = t.wall(), cpu = t.cpu();
+    std::printf("{\"which\": \"%s\", \"d\": %.17g, \"tolerance\": %.17g, \"within\": %d, \"seconds\": %.6g, "
+                "\"cpu\": %.6g}\n",
+                which, d, tol, beyond ? 0 : 1, wall, cpu);
+    return 0;
+}
+
 // Metro-style: float32 everywhere a stock MeshLab build has it.
 static double metro(const Soup &a, const Soup &b, size_t samples, unsigned seed) {
     typedef CGAL::Simple_cartesian<double> KD;
@@ -190,8 +206,10 @@ static int sampled(const Soup &sa, const Soup &sb, const Mesh &a, const Mesh &b,
 }
 
 int main(int argc, char **argv) {
-    if (argc != 6 || (std::strcmp(argv[1], "bounded") && std::strcmp(argv[1], "sampled"))) {
+    int is_larger = argc == 7 && !std::strcmp(argv[1], "larger");
+    if (!is_larger && (argc != 6 || (std::strcmp(argv[1], "bounded") && std::strcmp(argv[1], "sampled")))) {
         std::fprintf(stderr, "usage: m2m_cgal bounded A.off B.off TOLERANCE ab|ba|sym\n"
+                             "       m2m_cgal larger A.off B.off D TOLERANCE ab|sym\n"
                              "       m2m_cgal sampled A.off B.off SAMPLES SEED\n");
         return 2;
     }
@@ -199,6 +217,7 @@ int main(int argc, char **argv) {
     size_t da, db;
     Mesh a = to_mesh(sa, &da), b = to_mesh(sb, &db);
     std::fprintf(stderr, "m2m_cgal: %zu and %zu faces detached\n", da, db);
+    if (is_larger) return larger(a, b, std::atof(argv[4]), std::atof(argv[5]), argv[6]);
     if (!std::strcmp(argv[1], "bounded")) return bounded(a, b, std::atof(argv[4]), argv[5]);
     return sampled(sa, sb, a, b, (size_t)std::atof(argv[4]), (unsigned)std::atoi(argv[5]));
 }

@@ -27,22 +27,32 @@
  * is a vertex of the face (one weight 2^L) is that vertex, exactly
  * (e = 0).
  *
- * Bounds.  Each corner v gets r = RN(d(v, Y)) from the exact kernel through
- * the tree (hd__bvh_nearest), so d(v, Y) <= next_up(r).
+ * Bounds.  Each corner v gets hi >= d(v, Y) from the prepared bounds alone
+ * (interval(): the smallest hi2 of hd__tri_bounds_prep over the triangles of
+ * Y that the tree cannot exclude), and the triangle giving it.  The exact
+ * r = RN(d(v, Y)) (the kernel through the tree, hd__bvh_nearest) is needed
+ * only where v could change the lower bound: r <= hi (RN is monotone and
+ * hi is a double), so a corner whose lower bound from hi (below) is at most
+ * the bound it would have to beat - its face's best and, unless each
+ * face's own lower bound is asked for, L - cannot beat it (offer() needs
+ * more), and the result is the same as with every r computed.  Phase 0's
+ * bar is max lo over all corners (lo <= d from the smallest lo2 of the
+ * triangles visited): a corner with hi below it is nearer than another.
+ * An exact corner takes hi = next_up(r) when that is smaller.
  *  - Lower: a point of X at distance >= r' from Y with r' = r at a vertex
  *    (the witness is exact), else r' = down(next_down(r) - e): the exact
  *    point of the face at the corner's weights is within e of v, so its
  *    distance is at least d(v, Y) - e >= next_down(r) - e.
  *  - Upper, for the hull T of the three computed corners: every y in T has
  *    d(y, Y) <= d(v, Y) + |y - v| for each corner v, so
- *    d(y, Y) <= max_v next_up(r_v) + R with R >= the largest distance from a
+ *    d(y, Y) <= max_v hi_v + R with R >= the largest distance from a
  *    point of T to its nearest corner (the point bound: R <= the longest
  *    edge over sqrt 3 for every triangle, the circumradius bound of a
  *    non-obtuse triangle, and half the longest edge for an obtuse one).
  *    And for any triangle t of Y, d(., t) is convex, so its maximum over T
  *    is at a corner: d(y, Y) <= min over t of max_v d(v, t) (Tang et al.),
  *    taken over the corners' nearest triangles with d(v, t) <= sqrt_up(hi2)
- *    from hd__tri_bounds (or next_up(r) for v's own nearest).  The exact
+ *    from hd__tri_bounds (or hi for v's own triangle).  The exact
  *    sub-triangle of the face is within e of T point by point (the weights
  *    of a point of the exact sub-triangle applied to the computed corners
  *    give a point of T within e), so U = up(min(both) + e) (e = 0 at level
@@ -50,18 +60,34 @@
  * All upper sums and square roots are rounded to nearest and then moved one
  * double up (next_up), which is at least the exact value.
  *
- * The search.  Phase 1 evaluates every face's corners (fixed chunks, any
- * thread) and sets the lower bound L to the best corner.  Phase 2 takes the
- * faces by decreasing upper bound in batches of fixed sizes; the faces of a
- * batch are refined in parallel, each on its own against L as it was
- * before the batch (and its own corners' lower bounds): a face pops its
- * sub-triangle of largest U, stops when U <= max(L, own lower) + tolerance
- * (or the predicate's bound), else splits it and keeps the children whose
- * U exceeds that threshold.  The batches merge in order, the witness is the
- * first best in face order, so nothing depends on the thread count.  The
- * face's upper bound is the largest U it stopped at or discarded; h's
- * upper bound is the largest over faces (faces skipped because their
- * first U was <= L contribute that U).
+ * The search.  Phase 0 bounds every distinct corner and computes the
+ * exact distances of those that can be the largest; phase 1 evaluates
+ * every face's corners (fixed chunks, any thread) and sets the lower
+ * bound L to the best corner.  Phase 2 takes the faces by decreasing
+ * upper bound in batches of fixed sizes; the faces of a batch are refined
+ * in parallel, each on its own against L as it was before the batch (and
+ * its own corners' lower bounds): a face pops its sub-triangle of largest
+ * U, stops when U <= max(L, own lower) + tolerance (or the predicate's
+ * bound), else splits it and keeps the children whose U exceeds that
+ * threshold.  A visit ends after a budget of splits (growing fourfold from
+ * pass to pass); the faces left pending are taken again, by their bounds
+ * so far, in the next pass, so that no face is refined to the end against
+ * an L that a face with a higher bound would raise.  The batches merge in
+ * order, the witness is the first best in face order, so nothing depends
+ * on the thread count.  The face's upper bound is the largest U it stopped
+ * at or discarded (or, pending when the search stopped, the largest U
+ * left); h's upper bound is the largest over faces (faces skipped because
+ * their first U was <= L contribute that U).
+ *
+ * The predicate (a finite d: done_below = stop_above = d) runs phases 0
+ * and 1 in rounds of faces instead: a face is first screened - the point
+ * bound over its vertices from any triangle of Y whose prepared upper
+ * bound is small enough, or Tang's bound with one such triangle - and
+ * discarded unrefined when that is <= d; only the other faces' corners are
+ * measured, and a lower bound above d after a round ends the search (the
+ * faces not reached then have no bound: upper is infinite).  Refinement
+ * discards every sub-triangle whose U is <= d and stops a face at a lower
+ * bound above d.
  */
 #include "mesh/mesh.h"
 #include "mesh/mesh_int.h"
@@ -96,11 +122,13 @@ static double sqrt_up(double x) { return x <= 0 ? 0 : up(sqrt(x)); }
 typedef struct corner {
     double p[3];
     uint64_t k[3];
-    double r;      /* RN(d(p, Y)) */
-    double lower;  /* a distance a point of X has, from this corner */
-    size_t pos;    /* p's nearest triangle: its position in the tree */
-    size_t index;  /* ... and its index in Y */
-    double near[3];/* the nearest point on it */
+    double hi;     /* d(p, Y) <= hi, and d(p, t) <= hi for t at pos */
+    double r;      /* RN(d(p, Y)), when exact */
+    double lower;  /* a distance a point of X has, from this corner (exact) */
+    size_t pos;    /* a triangle of Y as near as the bounds tell: its position */
+    size_t index;  /* p's nearest triangle's index in Y (exact) */
+    double near[3];/* the nearest point on it (exact) */
+    int exact;     /* r, lower, index, near are set */
 } corner_t;
 
 typedef struct sub {
@@ -126,6 +154,11 @@ typedef struct face {
     uint64_t splits, kernel;
     int capped;         /* stopped by max_splits or MAX_LEVEL */
     int done;
+    /* a face whose visit used up its budget: its sub-triangles still to
+     * refine, in the order the heap gave them, and the largest U discarded */
+    sub_t *saved;
+    size_t n_saved;
+    double cut;
 } face_t;
 
 static double slack(const hd__tri_t *t) {
@@ -157,16 +190,6 @@ static void corner_point(const hd__tri_t *t, corner_t *c, int level) {
 static int is_vertex(const corner_t *c, int level) {
     uint64_t one = (uint64_t)1 << level;
     return c->k[0] == one || c->k[1] == one || c->k[2] == one;
-}
-
-static void evaluate(const hd__m2m_job_t *J, const hd__tri_t *t, double e, corner_t *c, int level, size_t seed,
-                     hd__bvh_stats_t *st) {
-    hd__tri_near_t near;
-    corner_point(t, c, level);
-    c->pos = hd__bvh_nearest(J->to, c->p, seed, 0, &near, &c->index, st);
-    c->r = near.d;
-    memcpy(c->near, near.point, sizeof c->near);
-    c->lower = is_vertex(c, level) ? c->r : fmax(0.0, down(down(c->r) - e));
 }
 
 static void offer(best_t *b, const corner_t *c, int level, double e) {
@@ -289,15 +312,44 @@ static int shared_convex(const hd__tri_t *s, const hd__tri_t *t) {
 }
 
 /* A worker's prepared triangles of Y, by position in the tree (direct
- * mapped): hd__tri_bounds_prep gives hd__tri_bounds's bits. */
-#define CACHE 1024
+ * mapped, a power of two entries up to MAX_CACHE, enough for all of Y
+ * when it is smaller): hd__tri_bounds_prep gives hd__tri_bounds's bits,
+ * so what the cache holds never changes a result. */
+#define MAX_CACHE 2048
 typedef struct cache {
-    size_t pos[CACHE];
-    hd__tri_prep_t prep[CACHE];
+    size_t mask;
+    size_t *pos;
+    hd__tri_prep_t *prep;
 } cache_t;
 
+static void caches_free(cache_t *C, int n) {
+    for (int w = 0; C && w < n; w++) {
+        free(C[w].pos);
+        free(C[w].prep);
+    }
+    free(C);
+}
+
+/* n workers' caches for a tree of n_tris triangles, or NULL. */
+static cache_t *caches_new(int n, size_t n_tris) {
+    size_t size = 64;
+    while (size < n_tris && size < MAX_CACHE) size *= 2;
+    cache_t *C = calloc((size_t)n, sizeof *C);
+    for (int w = 0; C && w < n; w++) {
+        C[w].mask = size - 1;
+        C[w].pos = hd__malloc_array(size, sizeof *C[w].pos);
+        C[w].prep = hd__malloc_array(size, sizeof *C[w].prep);
+        if (!C[w].pos || !C[w].prep) {
+            caches_free(C, n);
+            return NULL;
+        }
+        for (size_t k = 0; k < size; k++) C[w].pos[k] = SIZE_MAX;
+    }
+    return C;
+}
+
 static const hd__tri_prep_t *prepared(cache_t *C, size_t pos, const hd__tri_t *t) {
-    size_t k = pos & (CACHE - 1);
+    size_t k = pos & C->mask;
     if (C->pos[k] != pos) {
         hd__tri_prep(t->v[0], t->v[1], t->v[2], &C->prep[k]);
         C->pos[k] = pos;
@@ -305,9 +357,105 @@ static const hd__tri_prep_t *prepared(cache_t *C, size_t pos, const hd__tri_t *t
     return &C->prep[k];
 }
 
+/* ---- a point's distance to Y, enclosed without the kernel --------------- */
+
+/* Every point of the box is at squared distance above h2 from p (the
+ * computed hd__box_lb2s is within a factor (1 + u)^11 of the exact square
+ * when it is at least 2^-1000, bvh.c's proof). */
+static int far2(double s, double h2) { return s >= 0x1p-1000 && s * (1 - 0x1p-46) > h2; }
+static int beyond(const hd__box_t *b, const double p[3], double h2) { return far2(hd__box_lb2s(b, p[0], p[1], p[2]), h2); }
+
+/* The bounds of p to the triangle at pos.  hd__tri_bounds gives lo2 = 0 for
+ * a point (a point set's triangles): there the computed square, within a
+ * factor 1 + 5.01 u of the exact one (two roundings in each difference
+ * squared, two in the sum), shrunk by 1 - 8 u. */
+static void bounds_at(const hd__bvh_t *T, size_t pos, const double p[3], cache_t *C, double *lo2, double *hi2) {
+    const hd__tri_t *t = &T->tris[pos];
+    hd__tri_bounds_prep(p, prepared(C, pos, t), lo2, hi2);
+    if (*lo2 == 0 && memcmp(t->v[0], t->v[1], sizeof t->v[0]) == 0 && memcmp(t->v[0], t->v[2], sizeof t->v[0]) == 0) {
+        double dx = p[0] - t->v[0][0], dy = p[1] - t->v[0][1], dz = p[2] - t->v[0][2];
+        double d2 = dx * dx + dy * dy + dz * dz;
+        *lo2 = d2 >= 0x1p-1000 ? d2 * (1 - 0x1p-50) : 0;
+    }
+}
+
+#define DEPTH 130
+/* lo <= d(p, Y) <= hi from hd__tri_bounds_prep alone: hi from the triangle
+ * of smallest hi2 (returned: its position in the tree; a triangle whose
+ * box lies beyond the smallest hi2 so far is skipped), lo from the smallest
+ * lo2 over the triangles visited (a skipped one is farther than the
+ * nearest, so the minimum over Y is among them).  The answer depends on p,
+ * the seed and the tree only. */
+static size_t interval(const hd__bvh_t *T, const double p[3], size_t seed, cache_t *C, double *lo, double *hi,
+                       uint64_t *count) {
+    double best = INFINITY, low = INFINITY, lo2, hi2;
+    size_t pos = SIZE_MAX;
+    if (seed < T->n_tris) {
+        bounds_at(T, seed, p, C, &lo2, &hi2);
+        best = hi2, low = lo2, pos = seed;
+        (*count)++;
+    }
+    struct { uint32_t id; double s; } stack[DEPTH]; /* s: the box's hd__box_lb2s */
+    int top = 0;
+    stack[top].id = 0, stack[top++].s = hd__box_lb2s(&T->nodes[0].box, p[0], p[1], p[2]);
+    while (top > 0) {
+        uint32_t id = stack[--top].id;
+        if (far2(stack[top].s, best)) continue;
+        const hd__bvh_node_t *node = &T->nodes[id];
+        if (node->count) {
+            for (size_t k = node->first_or_second; k < (size_t)node->first_or_second + node->count; k++) {
+                if (k == seed || beyond(&T->boxes[k], p, best)) continue;
+                bounds_at(T, k, p, C, &lo2, &hi2);
+                (*count)++;
+                low = fmin(low, lo2);
+                if (pos == SIZE_MAX || hi2 < best) best = hi2, pos = k;
+            }
+            continue;
+        }
+        uint32_t a = id + 1, b = node->first_or_second;
+        double la = hd__box_lb2s(&T->nodes[a].box, p[0], p[1], p[2]);
+        double lb = hd__box_lb2s(&T->nodes[b].box, p[0], p[1], p[2]);
+        if (la < lb) { /* the nearer on top */
+            uint32_t t = a;
+            double u = la;
+            a = b, la = lb, b = t, lb = u;
+        }
+        if (!far2(la, best)) stack[top].id = a, stack[top++].s = la;
+        if (!far2(lb, best)) stack[top].id = b, stack[top++].s = lb;
+    }
+    *lo = low > 0 ? down(sqrt(low)) : 0;
+    *hi = sqrt_up(best);
+    return pos;
+}
+
+/* The largest lower bound the corner could give (its exact distance is at
+ * most hi). */
+static double could(const corner_t *c, int level, double e) {
+    return is_vertex(c, level) ? c->hi : fmax(0.0, down(down(c->hi) - e));
+}
+
+/* The corner's exact distance through the tree (the witness's lower bound). */
+static void make_exact(const hd__m2m_job_t *J, corner_t *c, int level, double e, hd__bvh_stats_t *st) {
+    hd__tri_near_t near;
+    size_t pos = hd__bvh_nearest(J->to, c->p, c->pos, 0, &near, &c->index, st);
+    c->r = near.d;
+    memcpy(c->near, near.point, sizeof c->near);
+    c->lower = is_vertex(c, level) ? c->r : fmax(0.0, down(down(c->r) - e));
+    c->exact = 1;
+    if (up(c->r) < c->hi) c->hi = up(c->r), c->pos = pos;
+}
+
+static void evaluate(const hd__m2m_job_t *J, const hd__tri_t *t, corner_t *c, int level, size_t seed, cache_t *C,
+                     uint64_t *count) {
+    double lo;
+    corner_point(t, c, level);
+    c->pos = interval(J->to, c->p, seed, C, &lo, &c->hi, count);
+    c->exact = 0;
+}
+
 /* d(v, t) <= this (v's own nearest triangle: next_up(r)). */
 static double corner_to(const corner_t *c, size_t pos, const hd__tri_t *t, cache_t *C, uint64_t *kernel) {
-    if (c->pos == pos) return up(c->r);
+    if (c->pos == pos) return c->hi;
     double lo2, hi2;
     hd__tri_bounds_prep(c->p, prepared(C, pos, t), &lo2, &hi2);
     (*kernel)++;
@@ -337,7 +485,7 @@ static double pair_bound(const hd__m2m_job_t *J, const sub_t *s, double U, cache
 static double upper_of(const hd__m2m_job_t *J, const sub_t *s, double e, double enough, cache_t *C,
                        uint64_t *kernel) {
     double rmax = 0;
-    for (int i = 0; i < 3; i++) rmax = fmax(rmax, up(s->c[i].r));
+    for (int i = 0; i < 3; i++) rmax = fmax(rmax, s->c[i].hi);
     double U = up(rmax + reach(s));
     if ((s->level ? up(U + e) : U) <= enough) return s->level ? up(U + e) : U;
     for (int i = 0; i < 3; i++) { /* Tang's bound over the corners' nearest triangles */
@@ -358,8 +506,9 @@ static double upper_of(const hd__m2m_job_t *J, const sub_t *s, double e, double 
 
 /* A corner of a face as phase 0 finds it. */
 typedef struct found {
-    double r, near[3];
+    double lo, hi, r, near[3];
     size_t pos, index;
+    int exact;
 } found_t;
 
 typedef struct ctx {
@@ -369,61 +518,192 @@ typedef struct ctx {
     found_t *found;        /* by corner */
     size_t n_corners;
     cache_t *caches;       /* one per worker */
+    size_t task0;          /* phase 1's first task (the predicate's rounds) */
+    double bar;            /* phase 0's exact searches: corners with hi >= bar */
 } ctx_t;
 
 #define CORNER(J, id) ((J)->from[(id) / 3].v[(id) % 3])
 
-/* Phase 0: each corner's nearest triangle, in Morton order so that each
- * search starts from its predecessor's answer; a corner equal to its
- * predecessor copies it (the answer is the brute force's: it depends on
- * the point alone). */
+/* Phase 0: each corner's distance enclosed (interval()), in Morton order
+ * so that each search starts from its predecessor's answer; a corner equal
+ * to its predecessor copies it. */
 static void phase0(void *vctx, size_t task, int worker) {
-    (void)worker;
     ctx_t *C = vctx;
     const hd__m2m_job_t *J = C->job;
     size_t lo = task * CHUNK * 3, hi = lo + CHUNK * 3 < C->n_corners ? lo + CHUNK * 3 : C->n_corners;
     size_t seed = SIZE_MAX, prev = SIZE_MAX;
-    hd__bvh_stats_t st = {0};
+    uint64_t count = 0;
     for (size_t k = lo; k < hi; k++) {
         size_t id = C->order ? (size_t)(C->order[k] & 0xffffffffu) : k;
         found_t *F = &C->found[id];
-        if (J->drop && J->drop[id / 3]) continue;
+        if (C->faces[id / 3].done) continue;
         if (prev != SIZE_MAX && memcmp(CORNER(J, id), CORNER(J, prev), 3 * sizeof(double)) == 0) {
             *F = C->found[prev];
             continue;
         }
-        hd__tri_near_t near;
-        F->pos = seed = hd__bvh_nearest(J->to, CORNER(J, id), seed, 0, &near, &F->index, &st);
-        F->r = near.d;
-        memcpy(F->near, near.point, sizeof F->near);
+        F->pos = seed = interval(J->to, CORNER(J, id), seed, &C->caches[worker], &F->lo, &F->hi, &count);
+        F->exact = 0;
         prev = id;
     }
-    C->faces[lo / 3].kernel += st.kernel; /* counted on the chunk's first face */
+    C->faces[lo / 3].kernel += count; /* counted on the chunk's first face */
+}
+
+/* The corners (of C->order's first n_corners) that can be the largest:
+ * those whose hi reaches the largest lo (every other one is nearer to Y
+ * than that corner), or all of them when each face's own lower bound is
+ * asked for. */
+static double phase0_bar(const ctx_t *C) {
+    const hd__m2m_job_t *J = C->job;
+    if (J->per_face || J->face_lower) return -INFINITY;
+    double bar = -INFINITY;
+    for (size_t k = 0; k < C->n_corners; k++) {
+        size_t id = C->order ? (size_t)(C->order[k] & 0xffffffffu) : k;
+        if (!C->faces[id / 3].done) bar = fmax(bar, C->found[id].lo);
+    }
+    return bar;
+}
+
+/* Phase 0, second part: those corners' exact distances (through the tree:
+ * the answer is the brute force's, it depends on the point alone). */
+static void phase0_exact(void *vctx, size_t task, int worker) {
+    (void)worker;
+    ctx_t *C = vctx;
+    const hd__m2m_job_t *J = C->job;
+    size_t lo = task * CHUNK * 3, hi = lo + CHUNK * 3 < C->n_corners ? lo + CHUNK * 3 : C->n_corners;
+    hd__bvh_stats_t st = {0};
+    for (size_t k = lo; k < hi; k++) {
+        size_t id = C->order ? (size_t)(C->order[k] & 0xffffffffu) : k;
+        found_t *F = &C->found[id];
+        if (C->faces[id / 3].done || F->hi < C->bar) continue;
+        hd__tri_near_t near;
+        F->pos = hd__bvh_nearest(J->to, CORNER(J, id), F->pos, 0, &near, &F->index, &st);
+        F->r = near.d;
+        F->hi = up(near.d);
+        memcpy(F->near, near.point, sizeof F->near);
+        F->exact = 1;
+    }
+    C->faces[lo / 3].kernel += st.kernel;
+}
+
+/* Face f's level-0 sub-triangle from its corners' nearest triangles x,
+ * its corners offered as lower bounds, its bound (the dearer bounds
+ * skipped once the point bound is at most `enough`). */
+static void face_top(const hd__m2m_job_t *J, face_t *F, size_t f, const found_t *x, double enough, cache_t *cache) {
+    for (int i = 0; i < 3; i++) {
+        corner_t *c = &F->top.c[i];
+        c->k[0] = c->k[1] = c->k[2] = 0;
+        c->k[i] = 1;
+        memcpy(c->p, J->from[f].v[i], sizeof c->p);
+        c->r = c->lower = x[i].r;
+        c->hi = x[i].hi;
+        c->exact = x[i].exact;
+        c->pos = x[i].pos;
+        c->index = x[i].index;
+        memcpy(c->near, x[i].near, sizeof c->near);
+        if (c->exact) offer(&F->best, c, 0, 0);
+    }
+    F->top.level = 0;
+    F->top.U = upper_of(J, &F->top, 0, enough, cache, &F->kernel);
+    F->upper = F->top.U;
 }
 
 static void phase1(void *vctx, size_t task, int worker) {
     ctx_t *C = vctx;
     const hd__m2m_job_t *J = C->job;
-    size_t lo = task * CHUNK, hi = lo + CHUNK < J->n_from ? lo + CHUNK : J->n_from;
-    for (size_t f = lo; f < hi; f++) {
-        face_t *F = &C->faces[f];
-        if (F->done) continue;
-        for (int i = 0; i < 3; i++) {
-            corner_t *c = &F->top.c[i];
-            const found_t *x = &C->found[3 * f + (size_t)i];
-            c->k[0] = c->k[1] = c->k[2] = 0;
-            c->k[i] = 1;
-            memcpy(c->p, J->from[f].v[i], sizeof c->p);
-            c->r = c->lower = x->r;
-            c->pos = x->pos;
-            c->index = x->index;
-            memcpy(c->near, x->near, sizeof c->near);
-            offer(&F->best, c, 0, 0);
-        }
-        F->top.level = 0;
-        F->top.U = upper_of(J, &F->top, 0, -INFINITY, &C->caches[worker], &F->kernel);
-        F->upper = F->top.U;
+    size_t lo = (C->task0 + task) * CHUNK, hi = lo + CHUNK < J->n_from ? lo + CHUNK : J->n_from;
+    for (size_t f = lo; f < hi; f++)
+        if (!C->faces[f].done) face_top(J, &C->faces[f], f, &C->found[3 * f], J->face_upper ? -INFINITY : fmax(C->bar, J->done_below), &C->caches[worker]);
+}
+
+/* ---- the predicate's pass: screen, then exact corners, in rounds --------- */
+
+/* The screen's search gives up after bounding this many triangles. */
+#define SCREEN_TRIS 24
+
+/* An upper bound on d(p, Y) that is at most target, from prepared bounds
+ * alone: 1 with *ub (and *seed its triangle's position), or 0.  Any
+ * triangle's sqrt_up(hi2) is >= d(p, Y), so which triangles are tried (the
+ * seed, then the tree nearest box first, pruned by plain box distances, at
+ * most SCREEN_TRIS of them) changes the cost only, never the bound's
+ * validity. */
+static int screen_point(const hd__bvh_t *T, const double p[3], double target, size_t *seed, double *ub) {
+    double lo2, hi2, t2 = target * target * (1 + 0x1p-40);
+    if (*seed != SIZE_MAX) {
+        hd__tri_bounds_prep(p, &T->prep[*seed], &lo2, &hi2);
+        if (sqrt_up(hi2) <= target) return *ub = sqrt_up(hi2), 1;
     }
+    uint32_t stack[128];
+    int top = 0, tried = 0;
+    stack[top++] = 0;
+    while (top > 0) {
+        uint32_t id = stack[--top];
+        const hd__bvh_node_t *node = &T->nodes[id];
+        if (node->count) {
+            for (size_t k = node->first_or_second, end = k + node->count; k < end; k++) {
+                if (k == *seed) continue;
+                hd__tri_bounds_prep(p, &T->prep[k], &lo2, &hi2);
+                if (lo2 > t2) continue;
+                if (sqrt_up(hi2) <= target) return *seed = k, *ub = sqrt_up(hi2), 1;
+                if (++tried >= SCREEN_TRIS) return 0;
+            }
+            continue;
+        }
+        uint32_t a = id + 1, b = node->first_or_second;
+        double la = hd__box_lb2s(&T->nodes[a].box, p[0], p[1], p[2]);
+        double lb = hd__box_lb2s(&T->nodes[b].box, p[0], p[1], p[2]);
+        if (top + 2 > 128) return 0;
+        if (la > lb) { /* the nearer child on top */
+            if (la <= t2) stack[top++] = a;
+            if (lb <= t2) stack[top++] = b;
+        } else {
+            if (lb <= t2) stack[top++] = b;
+            if (la <= t2) stack[top++] = a;
+        }
+    }
+    return 0;
+}
+
+/* Tang's bound with one triangle of Y (position pos): d(., t) is convex,
+ * so over the face it is at most its largest value at a vertex. */
+static int tang_screened(const hd__m2m_job_t *J, const hd__tri_t *t, size_t pos, double *upper) {
+    double m = 0, lo2, hi2;
+    for (int i = 0; i < 3 && m <= J->done_below; i++) {
+        hd__tri_bounds_prep(t->v[i], &J->to->prep[pos], &lo2, &hi2);
+        m = fmax(m, sqrt_up(hi2));
+    }
+    if (!(m <= J->done_below)) return 0;
+    *upper = m;
+    return 1;
+}
+
+/* Face t discarded by the predicate's d without the kernel: the point
+ * bound over its exact corners, d(y, Y) <= max_v ub_v + R for every y of
+ * the face (e = 0 at level 0), is at most d; or else Tang's bound with the
+ * last triangle the screen found.  1 with that bound in *upper. */
+static int screened(const hd__m2m_job_t *J, const hd__tri_t *t, size_t *seed, double *upper) {
+    sub_t s;
+    for (int i = 0; i < 3; i++) memcpy(s.c[i].p, t->v[i], sizeof s.c[i].p);
+    double R = reach(&s), target = J->done_below - R, m = 0, ub;
+    int i = 0;
+    if (target >= 0)
+        for (; i < 3 && screen_point(J->to, t->v[i], target, seed, &ub); i++) m = fmax(m, ub);
+    double U = up(m + R);
+    if (i == 3 && U <= J->done_below) {
+        *upper = U;
+        return 1;
+    }
+    return *seed != SIZE_MAX && tang_screened(J, t, *seed, upper);
+}
+
+/* The predicate's screen over one task of faces of the round. */
+static void screen_task(void *vctx, size_t task, int worker) {
+    (void)worker;
+    ctx_t *C = vctx;
+    const hd__m2m_job_t *J = C->job;
+    size_t lo = (C->task0 + task) * CHUNK, hi = lo + CHUNK < J->n_from ? lo + CHUNK : J->n_from;
+    size_t seed = SIZE_MAX;
+    for (size_t f = lo; f < hi; f++)
+        if (!C->faces[f].done && screened(J, &J->from[f], &seed, &C->faces[f].upper)) C->faces[f].done = 1;
 }
 
 /* The corners' Morton order (NULL when there are too many to key; any
@@ -498,6 +778,13 @@ static double threshold(const hd__m2m_job_t *J, double L, const face_t *F) {
     return thr;
 }
 
+/* A point whose could() is at most this cannot change the result: the
+ * face's own best, and L unless each face's own lower bound is asked for. */
+static double exact_bar(const hd__m2m_job_t *J, double L, const face_t *F) {
+    double own = F->best.set ? F->best.lower : -INFINITY;
+    return J->per_face || J->face_lower ? own : fmax(L, own);
+}
+
 static void split(const hd__m2m_job_t *J, const hd__tri_t *t, double e, double L, const sub_t *s, sub_t kids[4],
                   face_t *F, pool_t *P, hd__bvh_stats_t *st) {
     int level = s->level + 1;
@@ -509,8 +796,11 @@ static void split(const hd__m2m_job_t *J, const hd__tri_t *t, double e, double L
     for (int i = 0; i < 3; i++) {
         const corner_t *p = &s->c[i], *q = &s->c[(i + 1) % 3];
         for (int j = 0; j < 3; j++) m[i].k[j] = p->k[j] + q->k[j];
-        evaluate(J, t, e, &m[i], level, p->pos, st);
-        offer(&F->best, &m[i], level, e);
+        evaluate(J, t, &m[i], level, p->pos, P->cache, &F->kernel);
+        if (could(&m[i], level, e) > exact_bar(J, L, F)) {
+            make_exact(J, &m[i], level, e, st);
+            offer(&F->best, &m[i], level, e);
+        }
     }
     const corner_t *tri[4][3] = {{&c[0], &m[0], &m[2]}, {&m[0], &c[1], &m[1]}, {&m[2], &m[1], &c[2]},
                                  {&m[0], &m[1], &m[2]}};
@@ -522,15 +812,34 @@ static void split(const hd__m2m_job_t *J, const hd__tri_t *t, double e, double L
     }
 }
 
-/* Refine face f against the lower bound L of the batches before it. */
-static void refine(const hd__m2m_job_t *J, face_t *F, size_t f, double L, pool_t *P) {
+/* Keep what is left of a face's heap for its next visit (F->upper: its
+ * bound now).  0, or -1 out of memory. */
+static int save(face_t *F, pool_t *P, double cut) {
+    F->n_saved = hd__heap_size(&P->heap);
+    F->saved = hd__malloc_array(F->n_saved, sizeof *F->saved);
+    if (!F->saved) return P->failed = 1, -1;
+    F->upper = fmax(hd__heap_top(&P->heap)->key, cut);
+    F->cut = cut;
+    for (size_t k = 0; k < F->n_saved; k++) F->saved[k] = P->s[hd__heap_pop(&P->heap).val];
+    return 0;
+}
+
+/* Refine face f against the lower bound L of the batches before it, from
+ * where its last visit stopped, for at most `budget` splits: then the face
+ * is left pending (saved) with its bound so far, else it is done. */
+static void refine(const hd__m2m_job_t *J, face_t *F, size_t f, double L, pool_t *P, uint64_t budget) {
     const hd__tri_t *t = &J->from[f];
-    double e = slack(t), cut = 0; /* cut: the largest U discarded */
+    double e = slack(t), cut = F->cut; /* cut: the largest U discarded */
     hd__bvh_stats_t st = {0};
     hd__heap_clear(&P->heap);
     P->n = P->n_free = 0;
-    if (pool_put(P, &F->top) == SIZE_MAX) return;
-    for (;;) {
+    if (!F->saved && pool_put(P, &F->top) == SIZE_MAX) return;
+    for (size_t k = 0; k < F->n_saved; k++)
+        if (pool_put(P, &F->saved[k]) == SIZE_MAX) return;
+    free(F->saved);
+    F->saved = NULL;
+    F->n_saved = 0;
+    for (uint64_t visit = 0;; visit++) {
         if (hd__heap_size(&P->heap) == 0) {
             F->upper = cut;
             break;
@@ -540,6 +849,11 @@ static void refine(const hd__m2m_job_t *J, face_t *F, size_t f, double L, pool_t
         if (top->key - thr <= J->tol || top->key <= J->done_below || F->best.lower > J->stop_above) {
             F->upper = fmax(top->key, cut);
             break;
+        }
+        if (visit == budget) {
+            F->kernel += st.kernel;
+            save(F, P, cut);
+            return;
         }
         hd__heap_item_t it = hd__heap_pop(&P->heap);
         sub_t s = P->s[it.val];
@@ -571,13 +885,14 @@ typedef struct batch {
     const size_t *order;
     double L;
     pool_t *pools;
+    uint64_t budget;
 } batch_t;
 
 static void phase2(void *vctx, size_t task, int worker) {
     batch_t *B = vctx;
     size_t f = B->order[task];
     pool_t *P = &B->pools[worker];
-    if (!P->failed) refine(B->C->job, &B->C->faces[f], f, B->L, P);
+    if (!P->failed) refine(B->C->job, &B->C->faces[f], f, B->L, P, B->budget);
 }
 
 /* ---- the whole search ---------------------------------------------------- */
@@ -616,29 +931,64 @@ static void finish_face(hd__m2m_result_t *R, const hd__m2m_job_t *J, const face_
     R->capped |= F->capped;
 }
 
+/* One pass over the faces rk[0, n) (by decreasing bound) in batches of
+ * growing size, each face visited for at most B->budget splits. */
+static int pass(const hd__m2m_job_t *J, ctx_t *C, const rank_t *rk, size_t n, batch_t *B, size_t *size,
+                hd__m2m_result_t *R) {
+    size_t next = 0, *order = (size_t *)B->order;
+    while (next < n) {
+        if (R->lower > J->stop_above) break; /* the predicate is answered */
+        size_t m = 0;
+        /* faces whose bound cannot exceed L (or the predicate's d) are finished */
+        for (; next < n && m < *size; next++) {
+            face_t *F = &C->faces[rk[next].f];
+            if (J->per_face || (F->upper - R->lower > J->tol && F->upper > J->done_below)) {
+                order[m++] = rk[next].f;
+            } else { /* finished at its bound so far */
+                free(F->saved);
+                F->saved = NULL;
+            }
+        }
+        B->L = J->per_face ? -INFINITY : R->lower;
+        hd__parallel_for(J->threads, m, phase2, B);
+        for (int w = 0; w < J->threads; w++)
+            if (B->pools[w].failed) return HD_ENOMEM;
+        for (size_t k = 0; k < m; k++) take_best(R, &C->faces[order[k]], order[k]);
+        if (*size < MAX_BATCH) *size *= 2;
+    }
+    return HD_OK;
+}
+
+/* Phase 2: passes over the faces, the first visiting each face for
+ * FIRST_BUDGET splits, each next one the faces left pending, by their
+ * bounds so far, for four times as many.  A face whose maximum lies just
+ * below the lower bound L of its batch needs every sub-triangle along that
+ * maximum refined until its bound drops below L: against a stale L (a
+ * face with a higher maximum still waiting in a later batch) that is
+ * unbounded work, so no face is refined to the end before the faces with
+ * higher bounds have had their turn. */
+#define FIRST_BUDGET 64
 static int run_batches(const hd__m2m_job_t *J, ctx_t *C, rank_t *rk, size_t n, hd__m2m_result_t *R) {
     pool_t *pools = calloc((size_t)J->threads, sizeof *pools);
-    size_t *order = hd__malloc_array(MAX_BATCH, sizeof *order);
+    size_t *order = hd__malloc_array(MAX_BATCH, sizeof *order), size = FIRST_BATCH;
     int rc = pools && order ? HD_OK : HD_ENOMEM;
     for (int w = 0; pools && w < J->threads; w++) {
         hd__heap_init(&pools[w].heap, 1);
         pools[w].cache = &C->caches[w];
     }
-    size_t next = 0, size = FIRST_BATCH;
-    while (rc == HD_OK && next < n) {
-        if (R->lower > J->stop_above) break; /* the predicate is answered */
+    batch_t B = {C, order, 0, pools, FIRST_BUDGET};
+    while (rc == HD_OK && n > 0) {
+        rc = pass(J, C, rk, n, &B, &size, R);
         size_t m = 0;
-        /* faces whose first bound cannot exceed L (or the predicate's d) are finished */
-        for (; next < n && m < size; next++) {
-            face_t *F = &C->faces[rk[next].f];
-            if (J->per_face || (F->top.U - R->lower > J->tol && F->top.U > J->done_below)) order[m++] = rk[next].f;
-        }
-        batch_t B = {C, order, J->per_face ? -INFINITY : R->lower, pools};
-        hd__parallel_for(J->threads, m, phase2, &B);
-        for (int w = 0; w < J->threads; w++)
-            if (pools[w].failed) rc = HD_ENOMEM;
-        for (size_t k = 0; k < m; k++) take_best(R, &C->faces[order[k]], order[k]);
-        if (size < MAX_BATCH) size *= 2;
+        for (size_t k = 0; k < n; k++)
+            if (C->faces[rk[k].f].saved) rk[m++] = (rank_t){C->faces[rk[k].f].upper, rk[k].f};
+        qsort(rk, m, sizeof *rk, by_upper);
+        n = R->lower > J->stop_above ? 0 : m;
+        B.budget = B.budget < ((uint64_t)1 << 40) ? 4 * B.budget : B.budget;
+    }
+    for (size_t f = 0; f < J->n_from; f++) { /* pending faces keep their bound so far */
+        free(C->faces[f].saved);
+        C->faces[f].saved = NULL;
     }
     for (int w = 0; pools && w < J->threads; w++) {
         free(pools[w].s);
@@ -650,52 +1000,108 @@ static int run_batches(const hd__m2m_job_t *J, ctx_t *C, rank_t *rk, size_t n, h
     return rc;
 }
 
+/* The first pass of a search for h: every face's corners, in Morton
+ * order (phase 0), then every face's level-0 bound (phase 1). */
+static int first_pass(const hd__m2m_job_t *J, ctx_t *C, hd__m2m_result_t *R) {
+    size_t n = J->n_from;
+    uint64_t *order = NULL;
+    C->found = hd__malloc_array(n ? 3 * n : 1, sizeof *C->found);
+    if (!C->found || corner_order(J, J->threads, &order)) {
+        free(C->found);
+        return HD_ENOMEM;
+    }
+    C->order = order;
+    hd__parallel_for(J->threads, (n + CHUNK - 1) / CHUNK, phase0, C);
+    C->bar = phase0_bar(C);
+    hd__parallel_for(J->threads, (n + CHUNK - 1) / CHUNK, phase0_exact, C);
+    hd__parallel_for(J->threads, (n + CHUNK - 1) / CHUNK, phase1, C);
+    free(order);
+    free(C->found);
+    for (size_t f = 0; f < n; f++) take_best(R, &C->faces[f], f);
+    return HD_OK;
+}
+
+/* The first pass of the predicate: rounds of faces (tasks of CHUNK faces,
+ * FIRST_ROUND of them, then 8 times more each round, whatever the thread
+ * count: few rounds, so that each round's corners share searches).  In
+ * a round the faces are screened, the corners of the others measured in
+ * Morton order (phase 0 over the round's part of the order) and their
+ * level-0 bounds taken (phase 1); then the round's lower bounds are taken
+ * in face order, and one above d stops the pass.  *stopped: 1 when it
+ * stopped before the last face (faces never reached have no bound). */
+#define FIRST_ROUND 2
+static int decide_pass(const hd__m2m_job_t *J, ctx_t *C, hd__m2m_result_t *R, int *stopped) {
+    size_t n = J->n_from, tasks = (n + CHUNK - 1) / CHUNK, size = FIRST_ROUND;
+    uint64_t *order = NULL, *part = NULL;
+    C->found = hd__malloc_array(n ? 3 * n : 1, sizeof *C->found);
+    part = hd__malloc_array(n ? 3 * n : 1, sizeof *part);
+    if (!C->found || !part || corner_order(J, J->threads, &order)) {
+        free(C->found);
+        free(part);
+        return HD_ENOMEM;
+    }
+    *stopped = 0;
+    for (size_t t0 = 0; t0 < tasks; t0 += size, size *= 8) {
+        size_t m = tasks - t0 < size ? tasks - t0 : size, f0 = t0 * CHUNK;
+        size_t f1 = (t0 + m) * CHUNK < n ? (t0 + m) * CHUNK : n, k = 0;
+        C->task0 = t0;
+        hd__parallel_for(J->threads, m, screen_task, C);
+        for (size_t i = 0; i < 3 * n; i++) {
+            size_t id = order ? (size_t)(order[i] & 0xffffffffu) : i;
+            if (id / 3 >= f0 && id / 3 < f1 && !C->faces[id / 3].done) part[k++] = id;
+        }
+        C->order = part;
+        C->n_corners = k;
+        hd__parallel_for(J->threads, (k + 3 * CHUNK - 1) / (3 * CHUNK), phase0, C);
+        C->bar = phase0_bar(C);
+        hd__parallel_for(J->threads, (k + 3 * CHUNK - 1) / (3 * CHUNK), phase0_exact, C);
+        hd__parallel_for(J->threads, m, phase1, C);
+        for (size_t f = f0; f < f1; f++) take_best(R, &C->faces[f], f);
+        if (R->lower > J->stop_above && f1 < n) {
+            *stopped = 1;
+            break;
+        }
+    }
+    free(order);
+    free(part);
+    free(C->found);
+    return HD_OK;
+}
+
 int hd__m2m_run(const hd__m2m_job_t *J, hd__m2m_result_t *R) {
     memset(R, 0, sizeof *R);
     R->face = R->face_b = SIZE_MAX;
     size_t n = J->n_from;
-    ctx_t C = {J, hd__malloc_array(n ? n : 1, sizeof(face_t)), NULL, NULL, 0, NULL};
+    ctx_t C = {J, hd__malloc_array(n ? n : 1, sizeof(face_t)), NULL, NULL, 0, NULL, 0, 0};
     rank_t *rk = hd__malloc_array(n ? n : 1, sizeof *rk);
-    if (!C.faces || !rk) {
-        free(C.faces);
-        free(rk);
-        return HD_ENOMEM;
-    }
     C.n_corners = 3 * n;
-    C.found = hd__malloc_array(n ? 3 * n : 1, sizeof *C.found);
-    C.caches = hd__malloc_array((size_t)J->threads, sizeof *C.caches);
-    uint64_t *order = NULL;
-    if (!C.found || !C.caches || corner_order(J, J->threads, &order)) {
+    C.caches = caches_new(J->threads, J->to->n_tris);
+    if (!C.faces || !rk || !C.caches) {
         free(C.faces);
         free(rk);
-        free(C.found);
-        free(C.caches);
+        caches_free(C.caches, J->threads);
         return HD_ENOMEM;
     }
-    for (int w = 0; w < J->threads; w++)
-        for (size_t k = 0; k < CACHE; k++) C.caches[w].pos[k] = SIZE_MAX;
-    C.order = order;
     for (size_t f = 0; f < n; f++) {
         memset(&C.faces[f], 0, sizeof C.faces[f]);
         C.faces[f].done = J->drop && J->drop[f];
+        R->dropped += C.faces[f].done;
     }
-    hd__parallel_for(J->threads, (n + CHUNK - 1) / CHUNK, phase0, &C);
-    hd__parallel_for(J->threads, (n + CHUNK - 1) / CHUNK, phase1, &C);
-    free(order);
-    free(C.found);
+    /* the predicate (a finite d, faces not asked for one by one) */
+    int decide = isfinite(J->done_below) && !J->per_face, stopped = 0;
+    int rc = decide ? decide_pass(J, &C, R, &stopped) : first_pass(J, &C, R);
     size_t live = 0;
-    for (size_t f = 0; f < n; f++) {
-        take_best(R, &C.faces[f], f);
+    for (size_t f = 0; rc == HD_OK && f < n; f++)
         if (!C.faces[f].done) rk[live++] = (rank_t){C.faces[f].top.U, f};
-        else R->dropped++;
-    }
-    if (R->face == SIZE_MAX) R->lower = 0; /* every face shared: h = 0 */
+    /* no face with a corner measured (every face shared, or screened):
+     * 0 is a lower bound without a witness */
+    if (R->face == SIZE_MAX) R->lower = 0;
     qsort(rk, live, sizeof *rk, by_upper);
-    int rc = run_batches(J, &C, rk, live, R);
+    if (rc == HD_OK && !stopped) rc = run_batches(J, &C, rk, live, R);
     for (size_t f = 0; f < n; f++) finish_face(R, J, &C.faces[f], f);
-    R->upper = fmax(R->upper, R->lower);
+    R->upper = stopped ? INFINITY : fmax(R->upper, R->lower);
     free(C.faces);
-    free(C.caches);
+    caches_free(C.caches, J->threads);
     free(rk);
     return rc;
 }
@@ -708,9 +1114,19 @@ typedef struct key {
 
 static int cmp_corner3(const void *x, const void *y) { return memcmp(x, y, 3 * sizeof(double)); }
 
+static void swap_if(double a[3], double b[3]) {
+    if (cmp_corner3(a, b) > 0) {
+        double t[3];
+        memcpy(t, a, sizeof t), memcpy(a, b, sizeof t), memcpy(b, t, sizeof t);
+    }
+}
+
+/* The corners in memcmp order (three compare-exchanges). */
 static void key_of(const hd__tri_t *t, facekey_t *k) {
     memcpy(k->v, t->v, sizeof k->v);
-    qsort(k->v, 3, sizeof k->v[0], cmp_corner3);
+    swap_if(k->v[0], k->v[1]);
+    swap_if(k->v[1], k->v[2]);
+    swap_if(k->v[0], k->v[1]);
 }
 
 static int cmp_key(const void *x, const void *y) { return memcmp(x, y, sizeof(facekey_t)); }

@@ -370,8 +370,50 @@ TEST(surface_to_points_encloses_and_points_to_surface_is_exact) {
     }
 }
 
+/* The largest dense sample of h(X, Y) over grid n. */
+static double dense_max(const gen_soup_t *X, const gen_soup_t *Y, int n) {
+    double *best = dense(X, Y, n), far = 0;
+    for (size_t k = 0; k < X->nt; k++) far = fmax(far, best[k]);
+    free(best);
+    return far;
+}
+
+/* hd_surface_within(A, B, d) at 1 and 2 threads: the same answer and
+ * enclosures, and the answer what they prove: 1 with every upper bound <= d
+ * (and the dense samples, `far`, too), 0 with a witness's lower bound > d,
+ * -1 with d inside an enclosure no wider than the tolerance.  Returns the
+ * answer. */
+static int predicate(const gen_soup_t *A, const gen_soup_t *B, double d, int directed, double far) {
+    hd_mesh_t a = gen_soup_view(A), b = gen_soup_view(B);
+    hd_surface_options_t o1 = options(1e-9, 1, 1), o2 = options(1e-9, 1, 2);
+    hd_enclosure_t ab, ba, ab2, ba2;
+    int answer, answer2;
+    CONTEXT("d %.17g, directed %d", d, directed);
+    CHECK_RC(hd_surface_within(&a, &b, d, directed, &o1, &answer, &ab, &ba, NULL), HD_OK);
+    CHECK_RC(hd_surface_within(&a, &b, d, directed, &o2, &answer2, &ab2, &ba2, NULL), HD_OK);
+    CHECK_EQ(answer, answer2);
+    same_enclosure(&ab, &ab2);
+    double lower = ab.lower, upper = ab.upper;
+    if (!directed) {
+        same_enclosure(&ba, &ba2);
+        lower = fmax(lower, ba.lower), upper = fmax(upper, ba.upper);
+    }
+    if (answer == 1) {
+        CHECK(upper <= d);
+        CHECK(far <= d);
+    } else if (answer == 0) {
+        CHECK(lower > d);
+        witness_holds(ab.lower > d ? &ab : &ba, ab.lower > d ? A : B, ab.lower > d ? B : A);
+    } else {
+        CHECK_EQ(answer, -1);
+        CHECK(lower <= d && d < upper);
+        CHECK(upper - lower <= ab.tolerance);
+    }
+    return answer;
+}
+
 TEST(predicate_agrees_with_the_enclosure) {
-    for (uint64_t seed = 1; seed <= 6 / SCALE + 1; seed++) {
+    for (uint64_t seed = 1; seed <= 16 / SCALE; seed++) {
         CONTEXT("seed %llu", (unsigned long long)seed);
         gen_rng_t r;
         gen_seed(&r, seed);
@@ -380,19 +422,113 @@ TEST(predicate_agrees_with_the_enclosure) {
         hd_enclosure_t ab, ba;
         hd_surface_options_t o = options(1e-9, 1, 2);
         CHECK_RC(hd_surface_hausdorff(&a, &b, &o, &ab, &ba, NULL), HD_OK);
-        double lo = fmax(ab.lower, ba.lower), hi = fmax(ab.upper, ba.upper);
-        int answer;
-        CHECK_RC(hd_surface_within(&a, &b, hi * (1 + 1e-6), 0, &o, &answer, NULL, NULL, NULL), HD_OK);
-        CHECK_EQ(answer, 1);
-        CHECK_RC(hd_surface_within(&a, &b, lo * (1 - 1e-6), 0, &o, &answer, NULL, NULL, NULL), HD_OK);
-        CHECK_EQ(answer, 0);
-        CHECK_RC(hd_surface_within(&a, &b, ab.upper * (1 + 1e-6), 1, &o, &answer, NULL, NULL, NULL), HD_OK);
-        CHECK_EQ(answer, 1);
-        CHECK_RC(hd_surface_within(&a, &b, ab.lower * (1 - 1e-6), 1, &o, &answer, NULL, NULL, NULL), HD_OK);
-        CHECK_EQ(answer, 0);
+        double far_ab = dense_max(&A, &B, 16), far = fmax(far_ab, dense_max(&B, &A, 16));
+        for (int directed = 0; directed <= 1; directed++) {
+            double lo = directed ? ab.lower : fmax(ab.lower, ba.lower);
+            double hi = directed ? ab.upper : fmax(ab.upper, ba.upper), x = directed ? far_ab : far;
+            CHECK_EQ(predicate(&A, &B, lo * (1 - 1e-6), directed, x), 0);
+            CHECK(predicate(&A, &B, nextafter(lo, 0), directed, x) != 1);
+            predicate(&A, &B, lo / 2 + hi / 2, directed, x);
+            CHECK(predicate(&A, &B, nextafter(hi, INFINITY), directed, x) != 0);
+            CHECK_EQ(predicate(&A, &B, hi * (1 + 1e-6), directed, x), 1);
+            CHECK_EQ(predicate(&A, &B, 2 * hi, directed, x), 1);
+            CHECK_EQ(predicate(&A, &B, lo / 2, directed, x), 0);
+        }
         gen_soup_free(&A), gen_soup_free(&B);
         if (hdt_failed()) break;
     }
+}
+
+/* Two parallel grids of n x n squares (2 n^2 triangles), z = 0 and z = 1:
+ * h = 1 both ways. */
+static gen_soup_t grid(int n, double z) {
+    gen_soup_t s = soup_new((size_t)(n + 1) * (size_t)(n + 1), 2 * (size_t)n * (size_t)n);
+    for (int i = 0; i <= n; i++)
+        for (int j = 0; j <= n; j++) {
+            double *v = s.v + 3 * ((size_t)i * (size_t)(n + 1) + (size_t)j);
+            v[0] = i, v[1] = j, v[2] = z;
+        }
+    for (int i = 0, k = 0; i < n; i++)
+        for (int j = 0; j < n; j++, k += 6) {
+            uint64_t c = (uint64_t)i * (uint64_t)(n + 1) + (uint64_t)j, up_ = c + (uint64_t)(n + 1);
+            uint64_t t[6] = {c, c + 1, up_, c + 1, up_ + 1, up_};
+            memcpy(s.t + k, t, sizeof t);
+        }
+    return s;
+}
+
+TEST(predicate_far_from_the_distance_measures_few_corners) {
+    gen_soup_t A = grid(64, 0), B = grid(64, 1);
+    hd_mesh_t a = gen_soup_view(&A), b = gen_soup_view(&B);
+    hd_surface_options_t o = options(1e-9, 1, 1), o2 = options(1e-9, 1, 2);
+    hd_enclosure_t ab, ba, ab2, ba2;
+    int answer;
+    CHECK_RC(hd_surface_hausdorff(&a, &b, &o, &ab, &ba, NULL), HD_OK);
+    CHECK(ab.lower == 1 && ba.lower == 1);
+    uint64_t full = ab.kernel_calls;
+    CHECK(full >= 65 * 65);
+    /* d = 2: every face is within by bounds on its corners alone */
+    CHECK_RC(hd_surface_within(&a, &b, 2, 0, &o, &answer, &ab, &ba, NULL), HD_OK);
+    CHECK_EQ(answer, 1);
+    CHECK_EQ(ab.kernel_calls, 0);
+    CHECK_EQ(ba.kernel_calls, 0);
+    CHECK(ab.upper <= 2 && ba.upper <= 2);
+    /* d = 1/2: the first corners measured are beyond it, and the search
+     * stops there (the faces never reached leave upper infinite) */
+    CHECK_RC(hd_surface_within(&a, &b, 0.5, 0, &o, &answer, &ab, &ba, NULL), HD_OK);
+    CHECK_RC(hd_surface_within(&a, &b, 0.5, 0, &o2, &answer, &ab2, &ba2, NULL), HD_OK);
+    CHECK_EQ(answer, 0);
+    CHECK(ab.lower == 1 && isinf(ab.upper));
+    CHECK(ab.kernel_calls * 8 <= full);
+    same_enclosure(&ab, &ab2);
+    CHECK(isinf(ba.upper));
+    gen_soup_free(&A), gen_soup_free(&B);
+}
+
+/* B: two strips in z = 0, y in [-3, -1] and [1, 3], x in [-10, 100].
+ * A: eight wide faces across the gap, whose distance has a ridge at
+ * exactly 1 along y = 0, which no edge of their subdivisions follows (y = 0
+ * is 9/17 of the way from their base to their apex); a face at z = 1/2 over
+ * the gap whose largest distance, sqrt(5) / 2 at y = 0, is inside it (its
+ * corners are at sqrt(2) / 2); and a small face at z = 1 + 1e-9 over a
+ * strip, whose corners put the first lower bound just above the ridges.
+ * The wide faces have the largest first bounds, so they come first: a
+ * face refined to the end against that lower bound would need every
+ * sub-triangle along its ridge within 1e-9 of it. */
+TEST(a_ridge_just_below_the_first_lower_bound_waits_for_the_faces_above_it) {
+    double v[3 * 8], va[3 * 30];
+    uint64_t tb[3 * 4], ta[30];
+    const double strip[8][3] = {{-10, -3, 0}, {100, -3, 0}, {100, -1, 0}, {-10, -1, 0},
+                                {-10, 1, 0},  {100, 1, 0},  {100, 3, 0},  {-10, 3, 0}};
+    memcpy(v, strip, sizeof strip);
+    const uint64_t quads[4][3] = {{0, 1, 2}, {0, 2, 3}, {4, 5, 6}, {4, 6, 7}};
+    memcpy(tb, quads, sizeof quads);
+    gen_soup_t B = soup_of(v, 8, tb, 4);
+    size_t n = 0;
+    for (int k = 0; k < 8; k++, n += 3) {
+        double x = 10.0 * k, c[3][3] = {{x, -0.9, 0}, {x + 8, -0.9, 0}, {x + 4, 0.8, 0}};
+        memcpy(va + 3 * n, c, sizeof c);
+    }
+    const double mid[3][3] = {{80, -0.5, 0.5}, {84, -0.5, 0.5}, {82, 0.5, 0.5}};
+    const double z = 1 + 1e-9, top[3][3] = {{90, -2, z}, {90.5, -2, z}, {90, -1.5, z}};
+    memcpy(va + 3 * n, mid, sizeof mid), n += 3;
+    memcpy(va + 3 * n, top, sizeof top), n += 3;
+    for (size_t k = 0; k < n; k++) ta[k] = k;
+    gen_soup_t A = soup_of(va, n, ta, n / 3);
+    hd_mesh_t a = gen_soup_view(&A), b = gen_soup_view(&B);
+    hd_surface_options_t o = options(1e-12, 0, 1), o2 = options(1e-12, 0, 2);
+    o.max_splits = o2.max_splits = 20000;
+    hd_enclosure_t ab, ab2;
+    CHECK_RC(hd_surface_hausdorff(&a, &b, &o, &ab, NULL, NULL), HD_OK);
+    CHECK_RC(hd_surface_hausdorff(&a, &b, &o2, &ab2, NULL, NULL), HD_OK);
+    CONTEXT("[%.17g, %.17g], %llu splits", ab.lower, ab.upper, (unsigned long long)ab.faces_split);
+    CHECK(ab.converged);
+    CHECK(ab.lower <= sqrt(1.25) && sqrt(1.25) <= ab.upper);
+    CHECK_EQ(ab.face_a, 8);
+    CHECK(ab.faces_split < 20000);
+    same_enclosure(&ab, &ab2);
+    encloses(&ab, &A, &B, 16);
+    gen_soup_free(&A), gen_soup_free(&B);
 }
 
 TEST(face_maxima_enclose_each_face) {
