@@ -150,7 +150,7 @@ void hd__bvh_free(hd__bvh_t *t) {
     free(t->tris);
     free(t->nodes);
     free(t->boxes);
-    free(t->prep);
+    free(t->prep_pool);
     free(t->frames);
     memset(t, 0, sizeof *t);
 }

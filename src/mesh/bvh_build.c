@@ -280,7 +280,7 @@ int hd__bvh_build_threads(hd__bvh_t *t, hd__tri_t *tris, size_t n, int threads) 
     t->tris = hd__malloc_array(n, sizeof *t->tris);
     t->nodes = hd__malloc_array(t->n_nodes, sizeof *t->nodes);
     t->boxes = hd__malloc_array(n, sizeof *t->boxes);
-    t->prep = hd__malloc_array(n, sizeof *t->prep);
+    t->prep_pool = hd__malloc_array(n, sizeof *t->prep_pool);
     t->slot = hd__calloc_array(n, sizeof *t->slot);
     t->used = malloc(sizeof *t->used);
     /* phase 2's levels end below threads * TASKS_PER_THREAD ranges, so a
@@ -289,7 +289,7 @@ int hd__bvh_build_threads(hd__bvh_t *t, hd__tri_t *tris, size_t n, int threads) 
     bkey_t *keys = hd__malloc_array(n, sizeof *keys);
     range_t *ranges = hd__malloc_array(3 * most, sizeof *ranges);
     size_t *top = hd__malloc_array(most, sizeof *top);
-    if (!t->tris || !t->nodes || !t->boxes || !t->prep || !t->slot || !t->used || !keys || !ranges || !top) {
+    if (!t->tris || !t->nodes || !t->boxes || !t->prep_pool || !t->slot || !t->used || !keys || !ranges || !top) {
         free(keys), free(ranges), free(top);
         hd__bvh_t failed = *t;
         failed.tris = NULL; /* hd__bvh_free would free it */
@@ -323,11 +323,11 @@ const hd__tri_prep_t *hd__bvh_prep_first(const hd__bvh_t *t, size_t k) {
     if (atomic_compare_exchange_strong_explicit(&t->slot[k], &s, HD__BVH_BUSY, memory_order_acquire,
                                                 memory_order_acquire)) {
         size_t r = atomic_fetch_add_explicit(t->used, 1, memory_order_relaxed); /* < n: one a triangle */
-        hd__tri_prep(tr->v[0], tr->v[1], tr->v[2], &t->prep[r]);
+        hd__tri_prep(tr->v[0], tr->v[1], tr->v[2], &t->prep_pool[r]);
         atomic_store_explicit(&t->slot[k], (uint_least32_t)(r + 1), memory_order_release);
-        return &t->prep[r];
+        return &t->prep_pool[r];
     }
-    if (s != HD__BVH_BUSY) return &t->prep[s - 1]; /* finished since the caller looked */
+    if (s != HD__BVH_BUSY) return &t->prep_pool[s - 1]; /* finished since the caller looked */
     hd__tri_prep(tr->v[0], tr->v[1], tr->v[2], &own);
     return &own;
 }

@@ -629,7 +629,7 @@ static void phase1(void *vctx, size_t task, int worker) {
 static int screen_point(const hd__bvh_t *T, const double p[3], double target, size_t *seed, double *ub) {
     double lo2, hi2, t2 = target * target * (1 + 0x1p-40);
     if (*seed != SIZE_MAX) {
-        hd__tri_bounds_prep(p, &T->prep[*seed], &lo2, &hi2);
+        hd__tri_bounds_prep(p, hd__bvh_prep(T, *seed), &lo2, &hi2);
         if (sqrt_up(hi2) <= target) return *ub = sqrt_up(hi2), 1;
     }
     uint32_t stack[128];
@@ -641,7 +641,7 @@ static int screen_point(const hd__bvh_t *T, const double p[3], double target, si
         if (node->count) {
             for (size_t k = node->first_or_second, end = k + node->count; k < end; k++) {
                 if (k == *seed) continue;
-                hd__tri_bounds_prep(p, &T->prep[k], &lo2, &hi2);
+                hd__tri_bounds_prep(p, hd__bvh_prep(T, k), &lo2, &hi2);
                 if (lo2 > t2) continue;
                 if (sqrt_up(hi2) <= target) return *seed = k, *ub = sqrt_up(hi2), 1;
                 if (++tried >= SCREEN_TRIS) return 0;
@@ -668,7 +668,7 @@ static int screen_point(const hd__bvh_t *T, const double p[3], double target, si
 static int tang_screened(const hd__m2m_job_t *J, const hd__tri_t *t, size_t pos, double *upper) {
     double m = 0, lo2, hi2;
     for (int i = 0; i < 3 && m <= J->done_below; i++) {
-        hd__tri_bounds_prep(t->v[i], &J->to->prep[pos], &lo2, &hi2);
+        hd__tri_bounds_prep(t->v[i], hd__bvh_prep(J->to, pos), &lo2, &hi2);
         m = fmax(m, sqrt_up(hi2));
     }
     if (!(m <= J->done_below)) return 0;

@@ -128,11 +128,13 @@ typedef struct hd__bvh_frame {
 typedef struct hd__bvh {
     hd__tri_t *tris;        /* in leaf order */
     hd__box_t *boxes;       /* each triangle's box, in the same order */
-    /* triangle k prepared: prep[slot[k] - 1] once slot[k] is neither 0
-     * (not prepared) nor HD__BVH_BUSY (being prepared); prep fills from
-     * its start in the order of first use, *used records so far */
+    /* triangle k prepared: prep_pool[slot[k] - 1] once slot[k] is neither
+     * 0 (not prepared) nor HD__BVH_BUSY (being prepared); the pool fills
+     * from its start in the order of first use, *used records so far.
+     * Read it through hd__bvh_prep only: position k is not an index of
+     * the pool. */
     atomic_uint_least32_t *slot;
-    hd__tri_prep_t *prep;
+    hd__tri_prep_t *prep_pool;
     atomic_size_t *used;
     hd__bvh_node_t *nodes;
     size_t n_tris, n_nodes;
@@ -151,7 +153,7 @@ typedef struct hd__bvh {
 const hd__tri_prep_t *hd__bvh_prep_first(const hd__bvh_t *t, size_t k);
 HD__INLINE const hd__tri_prep_t *hd__bvh_prep(const hd__bvh_t *t, size_t k) {
     uint_least32_t s = atomic_load_explicit(&t->slot[k], memory_order_acquire);
-    if (s != 0 && s != HD__BVH_BUSY) return &t->prep[s - 1];
+    if (s != 0 && s != HD__BVH_BUSY) return &t->prep_pool[s - 1];
     return hd__bvh_prep_first(t, k);
 }
 
