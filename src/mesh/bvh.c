@@ -144,17 +144,6 @@ double hd__support_lower(const hd__tri_t *t, size_t n, const double p[3], double
 }
 
 
-void hd__bvh_free(hd__bvh_t *t) {
-    free((void *)t->slot);
-    free((void *)t->used);
-    free(t->tris);
-    free(t->nodes);
-    free(t->boxes);
-    free(t->prep_pool);
-    free(t->frames);
-    memset(t, 0, sizeof *t);
-}
-
 /* ---- the frames --------------------------------------------------------- */
 
 #define FRAME_MAX 64 /* triangles of the largest node given a frame */

@@ -270,6 +270,19 @@ static void top_levels(build_t *B, int threads, size_t *n_sub, size_t *top, size
     *n_sub = nc;
 }
 
+/* Everything the build allocated, and the frames (hd__bvh_frames); the
+ * tree is left zeroed, so freeing it twice is harmless. */
+void hd__bvh_free(hd__bvh_t *t) {
+    free((void *)t->slot);
+    free((void *)t->used);
+    free(t->tris);
+    free(t->nodes);
+    free(t->boxes);
+    free(t->prep_pool);
+    free(t->frames);
+    memset(t, 0, sizeof *t);
+}
+
 int hd__bvh_build_threads(hd__bvh_t *t, hd__tri_t *tris, size_t n, int threads) {
     memset(t, 0, sizeof *t);
     if (n == 0 || n > ((size_t)1 << 31)) return HD_EOVERFLOW;
