@@ -264,7 +264,7 @@ int hd_mpi_distances(MPI_Comm comm, const hd_mpi_part_t *a, size_t na,
  * of the two ranks numpy interpolates from the band's values with
  * MPI_Allreduce counts (src/mpi/select.c has the method and the proof).
  * Collective over comm.
- * a, na, b, nb, opt: as hd_mpi_hausdorff (only opt->threads is read
+ * a, na, b, nb, opt: as hd_mpi_hausdorff (only opt->engine.threads is read
  *   besides the checks).  p: in [0, 100].
  * out: the figures (the same on every rank).
  * stats: NULL, or the figures of hd_mpi_stats_t; here shell_points counts
