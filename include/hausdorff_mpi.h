@@ -8,8 +8,10 @@
  * bit for bit the one hd_hausdorff() returns on all the points in one
  * process, witness included (hd_mpi_hausdorff); or each rank receives, for
  * its own points, what hd_distances() returns for them on all the points
- * (hd_mpi_distances).  docs/scale-out.md explains the algorithm and its
- * costs.
+ * (hd_mpi_distances); or every rank receives hd_hausdorff_percentile()'s
+ * figures on all the points (hd_mpi_hausdorff_percentile).  The options
+ * are an hd_mpi_options_t (NULL: the defaults).  docs/scale-out.md
+ * explains the algorithm and its costs.
  *
  * A first program:
  *
