@@ -298,10 +298,10 @@ static const option_entry_t options[] = {
      "write A's points with distance and nearest index in B\n"
      "(.csv: x,y,z,distance,nearest; .ply: also a viridis\n"
      "colour; .npy: (N, 5) float64); B's go to OUT_b.EXT.\n"
-     "OUT of A's own format (.las, .laz, .xyz/.txt/.pts, .ply\n"
-     "when A is a PLY file): A's file with a field `distance`\n"
-     "added to every point, everything else kept (a PLY\n"
-     "property, with `nearest` too; a LAS/LAZ extra-bytes\n"
+     "OUT of A's own format (.las, .laz, .xyz/.txt/.pts/.asc,\n"
+     ".ply when A is a PLY file): A's file with a field\n"
+     "`distance` added to every point, everything else kept (a\n"
+     "PLY property, with `nearest` too; a LAS/LAZ extra-bytes\n"
      "dimension; a column)"},
     {OPT_FARTHER_THAN, "--farther-than", NULL, "D OUT", 0,
      "write the points of A farther than D from B (d > D),\n"
@@ -710,6 +710,8 @@ int cli_parse(int argc, char **argv, cli_args_t *a) {
                    a->within_set ? "--within" : "--tolerance");
     if (a->signed_distance && !a->surface)
         return bad("--signed needs --surface: a sign is taken from the surface of the mesh B%s", "");
+    if (a->surface && mpi_tool) /* a mesh there is its vertices: measuring them would answer another question */
+        return bad("--surface is computed by hausdorff only; hausdorff-mpi measures point sets%s", "");
     if (nfiles != 2) {
         /* one line and a pointer, not the whole help */
         fprintf(stderr, "%s: expected two files, A and B, not %d\n"

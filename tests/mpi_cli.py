@@ -99,6 +99,14 @@ def main():
     check(rc == 0 and out.startswith("hausdorff-mpi ") and "(MPI " in out and out.count("\n") == 1,
           "--version: exit %d: %r %r" % (rc, out, err))
 
+    # what only hausdorff computes is refused, never answered as another question
+    surface_args = ("--surface", "--surface --signed", "--surface --within 0.01", "--surface --tolerance 1d")
+    for extra in surface_args:
+        rc, out, err = ranks(mpirun, k, tool, *extra.split(), os.path.join(DATA, "cgal_lion_head.ply"),
+                             os.path.join(DATA, "cgal_lion.ply"))
+        check(rc == 1 and out == "" and "--surface is computed by hausdorff only" in err,
+              "%s: exit %d, expected 1 and the refusal: %r %r" % (extra, rc, out, err))
+
     def same_json(args, keys=SAME_KEYS):
         """The members `keys` equal (None: every member but the times, the
         engine's counters and "mpi"); None if a run failed, else both."""
