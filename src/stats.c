@@ -25,7 +25,7 @@
  * whose median splits cost far more to build, and copes with massively
  * repeated points, which made every kd-tree search visit every node (a
  * kd-tree prunes only on strictly larger bounds); the times are in
- * docs/benchmarks.md, "Analysis".  The kd-trees
+ * docs/journal/benchmarks.md, "Analysis".  The kd-trees
  * remain for sets beyond HD__AN_MAX_POINTS points, whose indices do not fit
  * the structure's 32-bit fields.
  *

@@ -192,7 +192,7 @@
  * for the worst case, one point a bucket, they took 24 bytes a point
  * more); the build's account of it is hd__an_t.peak.  What each
  * of these choices was measured to save, and the times, are in
- * docs/benchmarks.md, "Analysis".  Sets of more than HD__AN_MAX_POINTS
+ * docs/journal/benchmarks.md, "Analysis".  Sets of more than HD__AN_MAX_POINTS
  * points are refused with HD_EOVERFLOW (stats.c then uses the kd-trees).
  */
 #include "nearest/nearest.h"

@@ -19,7 +19,7 @@
 
 /* Points per bucket and per group, at most (unless their keys are equal);
  * the sizes around these were within noise of each other
- * (docs/benchmarks.md, "Analysis", "Earlier measurements"). */
+ * (docs/journal/benchmarks.md, "Analysis", "Earlier measurements"). */
 #define HD__AN_BUCKET 64
 #define HD__AN_GROUP 128
 
