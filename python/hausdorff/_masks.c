@@ -26,6 +26,18 @@ static PyObject *raise_hd(int rc, const hd_error_t *err) {
     return NULL;
 }
 
+/* The mask over the buffer `vox` of shape n and spacing sp, or -1 with
+ * ValueError (and the buffer released) when its length is not the shape's. */
+static int mask_view(Py_buffer *vox, const Py_ssize_t n[3], const double sp[3], hd_mask_t *mk) {
+    if (n[0] < 1 || n[1] < 1 || n[2] < 1 || vox->len != n[0] * n[1] * n[2]) {
+        PyBuffer_Release(vox);
+        PyErr_SetString(PyExc_ValueError, "the mask's buffer does not hold its shape");
+        return -1;
+    }
+    hd_mask_init(mk, vox->buf, (size_t)n[0], (size_t)n[1], (size_t)n[2], sp);
+    return 0;
+}
+
 /* _mask_points(voxels, n0, n1, n2, s0, s1, s2, connectivity, dims, all)
  * -> (bytes of n * 3 float64, foreground, surface_dims, connectivity) */
 static PyObject *py_mask_points(PyObject *self, PyObject *args) {
@@ -37,13 +49,8 @@ static PyObject *py_mask_points(PyObject *self, PyObject *args) {
     if (!PyArg_ParseTuple(args, "y*nnndddiip", &vox, &n[0], &n[1], &n[2], &sp[0], &sp[1], &sp[2],
                           &connectivity, &dims, &all))
         return NULL;
-    if (n[0] < 1 || n[1] < 1 || n[2] < 1 || vox.len != n[0] * n[1] * n[2]) {
-        PyBuffer_Release(&vox);
-        PyErr_SetString(PyExc_ValueError, "the mask's buffer does not hold its shape");
-        return NULL;
-    }
     hd_mask_t mk;
-    hd_mask_init(&mk, vox.buf, (size_t)n[0], (size_t)n[1], (size_t)n[2], sp);
+    if (mask_view(&vox, n, sp, &mk) < 0) return NULL;
     hd_mask_options_t mo;
     hd_mask_options_init(&mo);
     mo.points = all ? HD_MASK_ALL : HD_MASK_SURFACE;
@@ -263,13 +270,8 @@ static PyObject *py_mask_surfels(PyObject *self, PyObject *args) {
     double sp[3];
     int dims;
     if (!PyArg_ParseTuple(args, "y*nnndddi", &vox, &n[0], &n[1], &n[2], &sp[0], &sp[1], &sp[2], &dims)) return NULL;
-    if (n[0] < 1 || n[1] < 1 || n[2] < 1 || vox.len != n[0] * n[1] * n[2]) {
-        PyBuffer_Release(&vox);
-        PyErr_SetString(PyExc_ValueError, "the mask's buffer does not hold its shape");
-        return NULL;
-    }
     hd_mask_t mk;
-    hd_mask_init(&mk, vox.buf, (size_t)n[0], (size_t)n[1], (size_t)n[2], sp);
+    if (mask_view(&vox, n, sp, &mk) < 0) return NULL;
     hd_cloud_t *c = NULL;
     double *areas = NULL;
     hd_error_t err;
