@@ -9,6 +9,7 @@ numpy's own (np.percentile, np.histogram), the reference for bit-exactness.
 """
 import gzip
 import json
+import math
 import os
 import struct
 import subprocess
@@ -84,6 +85,11 @@ def nearest(q, b):
         j[s:s + 256] = jj
         d[s:s + 256] = np.sqrt(d2[np.arange(len(jj)), jj])
     return d, j
+
+
+def value(x):
+    """A JSON number as a double: null stands for NaN."""
+    return math.nan if x is None else x
 
 
 def same(a, b, what=""):

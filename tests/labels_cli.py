@@ -22,11 +22,7 @@ import numpy as np
 from scipy import ndimage
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from cli_analysis_support import main, run, run_json, test, write_nifti  # noqa: E402
-
-
-def value(x):
-    return math.nan if x is None else x
+from cli_analysis_support import main, run, run_json, test, value, write_nifti  # noqa: E402
 
 
 def surface(m):

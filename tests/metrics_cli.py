@@ -25,12 +25,8 @@ import numpy as np
 from scipy import ndimage
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from cli_analysis_support import main, nearest, run, run_json, same, test, write_nifti, write_xyz  # noqa: E402
+from cli_analysis_support import main, nearest, run, run_json, same, test, value, write_nifti, write_xyz  # noqa: E402
 from metrics_support import MONAI_FILE, close, dtu, monai_cases, monai_nsd, monai_orderings, tanks_and_temples  # noqa: E402,E501
-
-
-def value(x):
-    return math.nan if x is None else x
 
 
 def clouds(seed, na=700, nb=500):
