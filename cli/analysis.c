@@ -287,14 +287,10 @@ int analysis_figures(const analysis_args_t *an, const analysis_ops_t *ops, const
                      const double *d_ba, size_t n_b, analysis_result_t *r, hd_error_t *err) {
     int rc;
     if ((rc = ops->summarize(d_ab, n_a, r->directed ? NULL : d_ba, n_b, &r->sum, err))) return rc;
-    if (an->n_taus || an->dtu_cap > 0) {
-        if (ops->summarize != hd_summarize) {
-            snprintf(err->message, sizeof err->message, "--tau and --dtu-cap are computed by hausdorff only, "
-                                                        "not over the ranks of hausdorff-mpi");
-            return err->code = HD_EUNSUPPORTED;
-        }
-        if ((rc = scores_figures(an, d_ab, n_a, r->directed ? NULL : d_ba, n_b, r, err))) return rc;
-    }
+    /* one process's distances only: hausdorff-mpi refuses --tau and --dtu-cap when parsing (options.c) */
+    if ((an->n_taus || an->dtu_cap > 0) &&
+        (rc = scores_figures(an, d_ab, n_a, r->directed ? NULL : d_ba, n_b, r, err)))
+        return rc;
     if (an->percentile_on &&
         (rc = ops->percentile_of(d_ab, n_a, r->directed ? NULL : d_ba, n_b, an->percentile, &r->pct, err)))
         return rc;

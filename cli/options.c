@@ -47,13 +47,17 @@ static void usage_head(FILE *out) {
 "Distances are bit-identical to a brute force in double precision.\n");
 }
 
+static void usage_one_process(FILE *out); /* from the option table, below */
+
 static void usage_examples(FILE *out) {
     if (mpi_tool) {
         fprintf(out,
 "\n"
 "hausdorff-mpi computes with its own distributed algorithm: --algorithm,\n"
 "--depth, --lambda, --theta, --no-early-break and --no-culling are checked\n"
-"and have no effect; --threads is per process.\n"
+"and have no effect; --threads is per process.\n");
+        usage_one_process(out);
+        fprintf(out,
 "\n"
 "Examples:\n"
 "  mpirun -n 64 hausdorff-mpi --json tiles2019/ @tiles2024.txt\n"
@@ -174,127 +178,130 @@ typedef enum {
 
 /* The one table of options, in the order --help lists them: the name, a
  * short alias, the argument's name (NULL for a flag), what it needs ('p'
- * libpng, 'n' libnifti2: the %s in the help says when it is unavailable)
- * and the help text (continuation lines are indented to the help column;
- * options without help share one line).  OPT_NONE entries are the help's
- * headings and notes.  An option missing here is unknown to the parser:
- * every one has its entry and its help. */
+ * libpng, 'n' libnifti2: the %s in the help says when it is unavailable),
+ * 1 for what only one process computes (surfaces, scores, label maps:
+ * hausdorff-mpi refuses those when parsing, before reading anything, never
+ * answering another question) and the help text (continuation lines are
+ * indented to the help column; options without help share one line).
+ * OPT_NONE entries are the help's headings and notes.  An option missing
+ * here is unknown to the parser: every one has its entry and its help. */
 typedef struct {
     int id;
     const char *name, *alias, *arg;
     char needs;
+    char one_process; /* 1: computed by hausdorff only; hausdorff-mpi refuses it when parsing */
     const char *help;
 } option_entry_t;
 
 static const option_entry_t options[] = {
-    {OPT_NONE, NULL, NULL, NULL, 0,
+    {OPT_NONE, NULL, NULL, NULL, 0, 0,
      "\n"
      "Options:\n"},
-    {OPT_ALGORITHM, "--algorithm", NULL, "NAME", 0,
+    {OPT_ALGORITHM, "--algorithm", NULL, "NAME", 0, 0,
      "auto (default), naive, earlybreak, inc, nohd, ohd,\n"
      "framework, kdtree"},
-    {OPT_DIRECTED, "--directed", NULL, NULL, 0,
+    {OPT_DIRECTED, "--directed", NULL, NULL, 0, 0,
      "compute only h(A,B)"},
-    {OPT_THREADS, "--threads", NULL, "N", 0,
+    {OPT_THREADS, "--threads", NULL, "N", 0, 0,
      "threads to use (default: every core; 1 = serial)"},
-    {OPT_SEED, "--seed", NULL, "N", 0,
+    {OPT_SEED, "--seed", NULL, "N", 0, 0,
      "seed for randomised steps (default 0)"},
-    {OPT_DEPTH, "--depth", NULL, "N", 0,
+    {OPT_DEPTH, "--depth", NULL, "N", 0, 0,
      "NOHD octree depth (default 6)"},
-    {OPT_LAMBDA, "--lambda", NULL, "X", 0,
+    {OPT_LAMBDA, "--lambda", NULL, "X", 0, 0,
      "OHD sample fraction of |A| (default 0.01)"},
-    {OPT_THETA, "--theta", NULL, "X", 0,
+    {OPT_THETA, "--theta", NULL, "X", 0, 0,
      "framework overlap threshold (default 0.33)"},
-    {OPT_NO_EARLY_BREAK, "--no-early-break", NULL, NULL, 0,
+    {OPT_NO_EARLY_BREAK, "--no-early-break", NULL, NULL, 0, 0,
      "NOHD without early breaking (the paper's nNOHD)"},
-    {OPT_NO_CULLING, "--no-culling", NULL, NULL, 0,
+    {OPT_NO_CULLING, "--no-culling", NULL, NULL, 0, 0,
      "OHD without point culling (the paper's nOHD)"},
-    {OPT_FORMAT, "--format", NULL, "NAME", 0,
+    {OPT_FORMAT, "--format", NULL, "NAME", 0, 0,
      "read both files as NAME instead of by extension\n"
      "(a file named - is standard input: its format is\n"
      "--format's, else told from its content); one file's\n"
      "format: FORMAT:PATH, e.g. xyz:- or ply:scan.dat\n"
      "(./ply:x for a file whose name holds a colon)"},
-    {OPT_FORMATS, "--formats", NULL, NULL, 0,
+    {OPT_FORMATS, "--formats", NULL, NULL, 0, 0,
      "list the file formats and exit"},
-    {OPT_NONE, "A or B as tiles:", NULL, NULL, 0,
+    {OPT_NONE, "A or B as tiles:", NULL, NULL, 0, 0,
      "a directory (its point files by extension, sorted by\n"
      "name in byte order, not recursed) or @LIST (a file of\n"
      "paths, one a line, relative to the list's folder; '#'\n"
      "comments; a line may be FORMAT:PATH): their points in\n"
      "that order; the witness is named by file and index\n"
      "(./@x for a file whose name starts with @)"},
-    {OPT_VERTICES, "--vertices", NULL, NULL, 0,
+    {OPT_VERTICES, "--vertices", NULL, NULL, 0, 0,
      "read a mesh (ply, obj, off, stl) as its vertices (default)"},
-    {OPT_SURFACE, "--surface", NULL, NULL, 0,
+    {OPT_SURFACE, "--surface", NULL, NULL, 0, 1,
      "measure meshes as surfaces: each point of A to B's\n"
      "nearest triangle, correctly rounded (the analysis\n"
      "options below work on these distances); with a mesh\n"
      "as A, every point of A's surface against B (a mesh or\n"
      "points): the distance enclosed in [lower, upper] with\n"
      "a witness"},
-    {OPT_SIGNED, "--signed", NULL, NULL, 0,
+    {OPT_SIGNED, "--signed", NULL, NULL, 0, 1,
      "with --surface: each distance's sign, -1 inside B, +1\n"
      "outside, 0 on it, from B's winding number (exact); B must\n"
      "be closed and consistently oriented, else it is refused\n"
      "naming an edge"},
-    {OPT_TOLERANCE, "--tolerance", NULL, "T", 0,
+    {OPT_TOLERANCE, "--tolerance", NULL, "T", 0, 1,
      "with --surface and a mesh as A: upper - lower <= T,\n"
      "absolute, or with a d suffix a fraction of the\n"
      "bounding-box diagonal (default 1e-9d; 0: as tight\n"
      "as doubles allow)"},
-    {OPT_WITHIN, "--within", NULL, "D", 0,
+    {OPT_WITHIN, "--within", NULL, "D", 0, 1,
      "with --surface and two meshes: only answer whether\n"
      "H(A,B) <= D (h(A,B) with --directed), stopping early"},
-    {OPT_SAMPLE, "--sample", NULL, "N", 0,
+    {OPT_SAMPLE, "--sample", NULL, "N", 0, 0,
      "read a mesh as N points drawn uniformly by area on its\n"
      "faces, reproducibly for a given --seed; a point format\n"
      "(las, laz, xyz, pcd, npy) is read as its points"},
-    {OPT_FLOAT32, "--float32", NULL, NULL, 0,
+    {OPT_FLOAT32, "--float32", NULL, NULL, 0, 0,
      "store coordinates as float (half the memory)"},
-    {OPT_DECIMAL_COMMA, "--decimal-comma", NULL, NULL, 0,
+    {OPT_DECIMAL_COMMA, "--decimal-comma", NULL, NULL, 0, 0,
      "text files write 1,5 for 1.5: commas are decimal points\n"
      "and fields are separated by ';' or blanks (without it\n"
      "a decimal comma is refused with its line)"},
-    {OPT_MAX_STREAM_SIZE, "--max-stream-size", NULL, "SIZE", 0,
+    {OPT_MAX_STREAM_SIZE, "--max-stream-size", NULL, "SIZE", 0, 0,
      "most bytes read from an input that is not a\n"
      "regular file (standard input, a pipe, a FIFO), with an\n"
      "optional K, M or G suffix (default 2G)"},
-    {OPT_FIFO_WAIT, "--fifo-wait", NULL, "SECONDS", 0,
+    {OPT_FIFO_WAIT, "--fifo-wait", NULL, "SECONDS", 0, 0,
      "how long a FIFO's writer (input) or reader (output)\n"
      "is awaited (default 30)"},
-    {OPT_LAZ_POINTS_PER_BYTE, "--laz-points-per-byte", NULL, "N", 0,
+    {OPT_LAZ_POINTS_PER_BYTE, "--laz-points-per-byte", NULL, "N", 0, 0,
      "the most points a LAZ chunk may hold per byte,\n"
      "bounding a small file's memory (default 256, up to 4096)"},
-    {OPT_JSON, "--json", NULL, NULL, 0,
+    {OPT_JSON, "--json", NULL, NULL, 0, 0,
      "print one JSON object"},
-    {OPT_QUIET, "--quiet", "-q", NULL, 0,
+    {OPT_QUIET, "--quiet", "-q", NULL, 0, 0,
      "no progress bar on stderr (there is none when stderr\n"
      "is not a terminal, nor with --json)"},
-    {OPT_HELP, "--help", "-h", NULL, 0, NULL},
-    {OPT_VERSION, "--version", NULL, NULL, 0, NULL},
-    {OPT_NONE, NULL, NULL, NULL, 0,
+    {OPT_HELP, "--help", "-h", NULL, 0, 0, NULL},
+    {OPT_VERSION, "--version", NULL, NULL, 0, 0, NULL},
+    {OPT_NONE, NULL, NULL, NULL, 0, 0,
      "\n"
      "Where the deviation is (per-point nearest-neighbour distances):\n"},
-    {OPT_PERCENTILE, "--percentile", NULL, "P", 0,
+    {OPT_PERCENTILE, "--percentile", NULL, "P", 0, 0,
      "percentile Hausdorff, e.g. 95 for HD95: the P-th\n"
      "percentile (numpy's linear interpolation) of the\n"
      "distances of A's points to B (ab), of B's to A (ba),\n"
      "symmetric = max(ab, ba) as MONAI, pooled = both\n"
      "directions together as medpy; P = 100 is H(A,B)"},
-    {OPT_MEAN, "--mean", NULL, NULL, 0,
+    {OPT_MEAN, "--mean", NULL, NULL, 0, 0,
      "mean distances: A->B, B->A, their max (the average\n"
      "Hausdorff distance), their average, and pooled"},
-    {OPT_CHAMFER, "--chamfer", NULL, NULL, 0,
+    {OPT_CHAMFER, "--chamfer", NULL, NULL, 0, 0,
      "Chamfer distance = mean squared distance A->B + mean\n"
      "squared distance B->A (as PyTorch3D); the JSON also\n"
      "has the summed and the unsquared variants"},
-    {OPT_HISTOGRAM, "--histogram", NULL, NULL, 0,
+    {OPT_HISTOGRAM, "--histogram", NULL, NULL, 0, 0,
      "histogram of the distances (--bins N, default 20) on\n"
      "[0, largest distance] or [0, --max-distance]"},
-    {OPT_BINS, "--bins", NULL, "N", 0,
+    {OPT_BINS, "--bins", NULL, "N", 0, 0,
      "the histogram's number of bins, 1 to 100000 (default 20)"},
-    {OPT_DISTANCES, "--distances", NULL, "OUT", 0,
+    {OPT_DISTANCES, "--distances", NULL, "OUT", 0, 0,
      "write A's points with distance and nearest index in B\n"
      "(.csv: x,y,z,distance,nearest; .ply: also a viridis\n"
      "colour; .npy: (N, 5) float64); B's go to OUT_b.EXT.\n"
@@ -303,73 +310,73 @@ static const option_entry_t options[] = {
      "`distance` added to every point, everything else kept (a\n"
      "PLY property, with `nearest` too; a LAS/LAZ extra-bytes\n"
      "dimension; a column)"},
-    {OPT_FARTHER_THAN, "--farther-than", NULL, "D OUT", 0,
+    {OPT_FARTHER_THAN, "--farther-than", NULL, "D OUT", 0, 0,
      "write the points of A farther than D from B (d > D),\n"
      "with their distance, as a file of A's own format (PLY,\n"
      "LAS, LAZ, text, OBJ); B's farther than D from A to\n"
      "OUT_b.EXT"},
-    {OPT_NEARER_THAN, "--nearer-than", NULL, "D OUT", 0,
+    {OPT_NEARER_THAN, "--nearer-than", NULL, "D OUT", 0, 0,
      "the same for the points within D (d <= D)"},
-    {OPT_MAX_DISTANCE, "--max-distance", NULL, "D", 0,
+    {OPT_MAX_DISTANCE, "--max-distance", NULL, "D", 0, 0,
      "top of the colour and histogram scale (default: the\n"
      "Hausdorff distance)"},
-    {OPT_RENDER, "--render", NULL, "OUT.png", 'p',
+    {OPT_RENDER, "--render", NULL, "OUT.png", 'p', 0,
      "picture of A coloured by distance to B: front, side\n"
      "and top views, colour bar, the Hausdorff witness pair\n"
      "marked, the --percentile figure on the bar%s"},
-    {OPT_HISTOGRAM_PNG, "--histogram-png", NULL, "OUT.png", 'p',
+    {OPT_HISTOGRAM_PNG, "--histogram-png", NULL, "OUT.png", 'p', 0,
      "the histogram as a picture%s\n"
      "(pictures are PNG: OUT must end in .png)"},
-    {OPT_UNITS, "--units", NULL, "TEXT", 0,
+    {OPT_UNITS, "--units", NULL, "TEXT", 0, 0,
      "the distances' unit, shown in the report, the JSON and\n"
      "the pictures (a label: nothing is scaled); masks whose\n"
      "header names mm, um or m are in mm without it"},
-    {OPT_NONE, NULL, NULL, NULL, 0,
+    {OPT_NONE, NULL, NULL, NULL, 0, 0,
      "\n"
      "Scores at a tolerance (A: the prediction or reconstruction, B: the reference):\n"},
-    {OPT_TAU, "--tau", NULL, "T[,T...]", 0,
+    {OPT_TAU, "--tau", NULL, "T[,T...]", 0, 1,
      "at each tolerance T (up to 64): precision (share of A\n"
      "within T of B), recall (of B within T of A), F-score,\n"
      "and NSD, the normalized surface Dice counted per point\n"
      "(MONAI's compute_surface_dice on masks' surfaces)"},
-    {OPT_TAU_RULE, "--tau-rule", NULL, "le|lt", 0,
+    {OPT_TAU_RULE, "--tau-rule", NULL, "le|lt", 0, 1,
      "within means d <= T (le, default: MONAI, DeepMind) or\n"
      "d < T (lt: the Tanks and Temples evaluation)"},
-    {OPT_DTU_CAP, "--dtu-cap", NULL, "D", 0,
+    {OPT_DTU_CAP, "--dtu-cap", NULL, "D", 0, 1,
      "DTU accuracy (mean A->B distance) and completeness\n"
      "(mean B->A) over the distances below D, and overall =\n"
      "their average, as the DTU MVS evaluation (D = 20 there)"},
-    {OPT_NONE, NULL, NULL, NULL, 'n',
+    {OPT_NONE, NULL, NULL, NULL, 'n', 0,
      "\n"
      "Medical masks: A or B may be a NIfTI-1/2 mask (.nii, .nii.gz)%s.\n"
      "  Voxels with a nonzero value are foreground; each becomes the world\n"
      "  coordinate of its centre (sform when sform_code > 0, else qform, else\n"
      "  pixdim), in millimetres (m and um are converted).  Distances are in mm.\n"},
-    {OPT_MASK_POINTS, "--mask-points", NULL, "surface|all", 0,
+    {OPT_MASK_POINTS, "--mask-points", NULL, "surface|all", 0, 0,
      "surface (default): the foreground voxels that\n"
      "binary erosion removes, outside the image counting as\n"
      "background (as medpy and MONAI); all: every foreground\n"
      "voxel"},
-    {OPT_CONNECTIVITY, "--connectivity", NULL, "1|2|3", 0,
+    {OPT_CONNECTIVITY, "--connectivity", NULL, "1|2|3", 0, 0,
      "the surface's neighbourhood, as medpy's connectivity:\n"
      "1 (default) 6-neighbour in 3-D, 4 in 2-D; 2: 18 (8 in\n"
      "2-D); 3: 26"},
-    {OPT_MASK_DIMS, "--mask-dims", NULL, "auto|2|3", 0,
+    {OPT_MASK_DIMS, "--mask-dims", NULL, "auto|2|3", 0, 0,
      "the axes of that neighbourhood: auto (default) those\n"
      "of more than one voxel (a single slice is a 2-D mask);\n"
      "2: each slice (constant k) on its own, a stack of\n"
      "in-plane contours; 3: all three, a one-voxel axis too"},
-    {OPT_EMPTY, "--empty", NULL, "inf|nan|zero|monai", 0,
+    {OPT_EMPTY, "--empty", NULL, "inf|nan|zero|monai", 0, 0,
      "an empty mask or file is an error by default;\n"
      "with this option every distance is reported as inf, NaN\n"
      "or 0 instead; monai: inf when one set is empty, NaN when\n"
      "both are, as MONAI (JSON: null for inf and NaN, and an\n"
      "\"empty\" member)"},
-    {OPT_NONE, NULL, NULL, NULL, 'n',
+    {OPT_NONE, NULL, NULL, NULL, 'n', 0,
      "\n"
      "Label maps: A (the prediction) and B (the reference) are NIfTI label maps%s\n"
      "  of one size, one integer label a voxel (0: background).\n"},
-    {OPT_LABELS, "--labels", NULL, "all|L[,L...]", 0,
+    {OPT_LABELS, "--labels", NULL, "all|L[,L...]", 0, 1,
      "every nonzero label in A or B (all), or these: per\n"
      "label Dice, HD, HD_P (--percentile, default 95: max of\n"
      "the directed ones as MONAI, and pooled as medpy), ASSD,\n"
@@ -377,12 +384,12 @@ static const option_entry_t options[] = {
      "(MONAI) and weighted by surfel area (DeepMind), and\n"
      "DeepMind's HD_P; a table, --csv or --json; a label\n"
      "absent from a side follows --empty (else an error)"},
-    {OPT_COMPONENTS, "--components", NULL, "CONN", 0,
+    {OPT_COMPONENTS, "--components", NULL, "CONN", 0, 1,
      "with --labels, also each connected component (CONN\n"
      "6, 18 or 26; 4 or 8 in 2-D) of each side: its directed\n"
      "HD, HD_P and nearest distance to the other side, and\n"
      "whether it overlaps or comes within --tau (detected)"},
-    {OPT_CSV, "--csv", NULL, NULL, 0,
+    {OPT_CSV, "--csv", NULL, NULL, 0, 1,
      "with --labels, print the table as CSV"},
 };
 enum { N_OPTIONS = sizeof options / sizeof options[0], HELP_COLUMN = 21 };
@@ -426,6 +433,18 @@ static void usage_options(FILE *out) {
     }
 }
 
+/* hausdorff-mpi's help: the options it refuses, from the table. */
+static void usage_one_process(FILE *out) {
+    int n = fprintf(out, "Computed by hausdorff only, and refused here:");
+    for (size_t k = 0; k < N_OPTIONS; k++) {
+        if (!options[k].one_process) continue;
+        int w = (int)strlen(options[k].name) + 1;
+        if (n + w > 78) n = fprintf(out, "\n ") - 1;
+        n += fprintf(out, " %s", options[k].name);
+    }
+    fprintf(out, ".\n");
+}
+
 /* The option that s names: "--name", its alias, or "--name=VALUE" for an
  * option that takes a value; -1 for none. */
 static int option_named(const char *s) {
@@ -440,12 +459,15 @@ static int option_named(const char *s) {
     return -1;
 }
 
-/* An option's name ("--tau") for messages. */
-static const char *option_name(int id) {
-    for (size_t k = 0; k < N_OPTIONS; k++)
-        if (options[k].id == id) return options[k].name;
-    return "?";
+/* The table's entry of option id (not OPT_NONE). */
+static const option_entry_t *option_entry(int id) {
+    size_t k = 0;
+    while (k + 1 < N_OPTIONS && options[k].id != id) k++;
+    return &options[k];
 }
+
+/* An option's name ("--tau") for messages. */
+static const char *option_name(int id) { return option_entry(id)->name; }
 
 /* A flag: 1 when the run ends here (--help, --version, --formats: printed), else 0. */
 static int set_flag(cli_args_t *a, int which) {
@@ -687,6 +709,8 @@ int cli_parse(int argc, char **argv, cli_args_t *a) {
         if (strcmp(s, "--") == 0) { only_files = 1; continue; }
         int which = option_named(s);
         if (which < 0) return bad("unknown option '%s'", s);
+        if (mpi_tool && option_entry(which)->one_process)
+            return bad("%s is computed by hausdorff only; hausdorff-mpi measures point sets", option_name(which));
         if (which >= OPT_FLAGS) {
             if (set_flag(a, which)) return EXIT_OK;
             continue;
@@ -710,8 +734,6 @@ int cli_parse(int argc, char **argv, cli_args_t *a) {
                    a->within_set ? "--within" : "--tolerance");
     if (a->signed_distance && !a->surface)
         return bad("--signed needs --surface: a sign is taken from the surface of the mesh B%s", "");
-    if (a->surface && mpi_tool) /* a mesh there is its vertices: measuring them would answer another question */
-        return bad("--surface is computed by hausdorff only; hausdorff-mpi measures point sets%s", "");
     if (nfiles != 2) {
         /* one line and a pointer, not the whole help */
         fprintf(stderr, "%s: expected two files, A and B, not %d\n"

@@ -9,6 +9,7 @@ Random points come from random.Random(SEED); a failure prints the seed.
 import json
 import math
 import os
+import re
 import random
 import struct
 import subprocess
@@ -99,12 +100,22 @@ def main():
     check(rc == 0 and out.startswith("hausdorff-mpi ") and "(MPI " in out and out.count("\n") == 1,
           "--version: exit %d: %r %r" % (rc, out, err))
 
-    # what only hausdorff computes is refused, never answered as another question
-    surface_args = ("--surface", "--surface --signed", "--surface --within 0.01", "--surface --tolerance 1d")
-    for extra in surface_args:
-        rc, out, err = ranks(mpirun, k, tool, *extra.split(), os.path.join(DATA, "cgal_lion_head.ply"),
+    # what only hausdorff computes is refused when parsing, never answered as another question: every option
+    # that hausdorff-mpi's --help names as refused, the first one given named in the message
+    rc, out, err = ranks(mpirun, k, tool, "--help")
+    refused = re.search(r"Computed by hausdorff only, and refused here:(.*?)\.\n", out, re.S)
+    names = refused.group(1).split() if refused else []
+    check(rc == 0 and {"--surface", "--labels", "--tau", "--dtu-cap"} <= set(names),
+          "--help names the refused options: %r" % names)
+    values = {"--tolerance": "1d", "--within": "0.01", "--tau": "1", "--tau-rule": "lt", "--dtu-cap": "20",
+              "--labels": "all", "--components": "26"}
+    refusals = [[n] + ([values[n]] if n in values else []) for n in names]
+    refusals += [["--surface", "--signed"], ["--percentile", "95", "--tau", "1,2"]]
+    for extra in refusals:
+        first = next(a for a in extra if a in names)
+        rc, out, err = ranks(mpirun, k, tool, *extra, os.path.join(DATA, "cgal_lion_head.ply"),
                              os.path.join(DATA, "cgal_lion.ply"))
-        check(rc == 1 and out == "" and "--surface is computed by hausdorff only" in err,
+        check(rc == 1 and out == "" and "%s is computed by hausdorff only" % first in err,
               "%s: exit %d, expected 1 and the refusal: %r %r" % (extra, rc, out, err))
 
     def same_json(args, keys=SAME_KEYS):

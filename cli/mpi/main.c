@@ -526,10 +526,6 @@ int main(int argc, char **argv) {
     cli_set_mpi(print_version);
     int rc = cli_parse(argc, argv, &r.a); /* the same verdict on every rank */
     if (rc >= 0) return finish(rc == EXIT_OK ? out_finish() : rc);
-    if (r.a.an.labels) { /* label maps are one process's work (hausdorff --labels) */
-        fprintf(stderr, "%s: --labels is computed by hausdorff only\n", cli_prog());
-        return finish(EXIT_USAGE);
-    }
     rc = run(&r);
     analysis_free(&r.an);
     for (int w = 0; w < 2; w++) {
