@@ -778,3 +778,33 @@ TEST(far_points_and_ties_over_a_tilted_grid_equal_the_brute_force) {
     free(p);
     gen_soup_free(&s);
 }
+
+/* The list a group of points shares (hd__bvh_collect with group_r2) must
+ * keep every triangle that is nearest to some point of the group, however
+ * far that point is from the group's first one.  Two parallel triangles,
+ * in the planes x = 0 and x = X1, and points on the x axis: p0 = (1, 0, 0)
+ * is nearest the plane x = 0 (at 1) and q = (4, 0, 0) the plane x = X1,
+ * at X1 - 4 = 4 (1 - eps), just below its distance 4 to the first plane:
+ * the group's radius (p0's distance plus the group's diagonal, 1 + 3) is
+ * then tight, so a radius even slightly short of it drops q's triangle.
+ * eps = 0 is a tie, which the first triangle (the far one, index 0)
+ * wins.  The same mirrored (the other point first in the Morton order)
+ * and scaled by 2^-600 and 2^400 (exact); 1 and 3 threads. */
+TEST(a_group_keeps_the_triangle_nearest_to_its_far_point) {
+    const double eps[] = {0x1p-3, 0x1p-20, 0x1p-52, 0}, scale[] = {1, 0x1p-600, 0x1p400};
+    for (size_t e = 0; e < 4; e++)
+        for (size_t k = 0; k < 3; k++)
+            for (int mirror = 0; mirror < 2; mirror++) {
+                double m = mirror ? -scale[k] : scale[k], x1 = 8 - 4 * eps[e];
+                double v[] = {x1, -1, -1, x1, 1, -1, x1, 0, 1, 0, -1, -1, 0, 1, -1, 0, 0, 1};
+                double p[] = {1, 0, 0, 4, 0, 0, 2.5, 0, 0};
+                for (int i = 0; i < 18; i++) v[i] *= i % 3 == 0 ? m : scale[k];
+                for (int i = 0; i < 9; i += 3) p[i] *= m;
+                uint64_t t[] = {0, 1, 2, 3, 4, 5};
+                gen_soup_t s = {v, 6, t, 2};
+                char what[96];
+                snprintf(what, sizeof what, "planes 0 and %.17g, scale %g%s", x1, scale[k], mirror ? ", mirrored" : "");
+                same_as_brute(&s, p, 2, what);
+                same_as_brute(&s, p, 3, what);
+            }
+}
