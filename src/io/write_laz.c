@@ -33,6 +33,7 @@
  */
 #include "io.h"
 #include "lasfield.h"
+#include "laz14.h"
 #include "lazcoder.h"
 
 #include <stdlib.h>
@@ -301,17 +302,19 @@ int hd__write_laz(hd__writer_t *w) {
     hd__read_t r = {w->in, w->ropt, 1, &z.sink, NULL, 0, w->err, 0, 0, 0};
     z.r = r;
     rc = hd__laz_chunks(&z.r, &z.h, &z.c);
-    if (rc == HD_OK && !z.c.layered) {
+    if (rc == HD_OK && z.c.layered && w->keep != HD_KEEP_ALL) { /* a subset: every point encoded again (laz14.c) */
+        hd__laz14_items_t it = {z.c.n_items, {0}, {0}, {0}};
+        memcpy(it.type, z.c.type, sizeof it.type);
+        char msg[256];
+        if (hd__laz14_supported(&it, msg, sizeof msg))
+            rc = hd__err(w->err, HD_EUNSUPPORTED, "%s: point format %u: %s", w->in->name, z.pl.fmt, msg);
+    }
+    if (rc == HD_OK && (!z.c.layered || w->keep != HD_KEEP_ALL)) {
         rc = hd__write_laz_pointwise(w, &z.pl, &z.h, &z.c, &z.r);
         hd__laz_chunks_free(&z.c);
         hd__sink_free(&z.sink);
         return rc;
     }
-    if (rc == HD_OK && w->keep != HD_KEEP_ALL)
-        rc = hd__err(w->err, HD_EUNSUPPORTED,
-                     "%s: a subset of a layered LAZ file (point format %u) is not written: its points would be compressed "
-                     "again, every field, and the layered encoder compresses only the added field",
-                     w->in->name, z.pl.fmt);
     if (rc == HD_OK) /* the BYTE14 item's version: the existing one's, or POINT14's for a new one */
         z.v4 = hd__ld_u16(w->in->data + z.c.vlr_at + 34 + 6 * (size_t)(z.c.type[z.c.n_items - 1] == IT_BYTE14 ? z.c.n_items - 1 : 0) + 4,
                           0) == 4;

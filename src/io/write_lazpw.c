@@ -39,6 +39,7 @@
  */
 #include "io.h"
 #include "lasfield.h"
+#include "laz14.h"
 #include "lazcoder.h"
 
 #include <errno.h>
@@ -283,7 +284,8 @@ int hd__laz_table_encode(int variable, size_t nc, const uint32_t *counts, const 
 typedef struct {
     hd__writer_t *w;
     hd__las_plan_t *pl;
-    unsigned type[32], size[32], n_items;
+    unsigned type[32], size[32], version[32], n_items;
+    int layered; /* LASzip compressor 3 (laz14.c encodes the chunks) */
     unsigned char *vlr;  /* the output's LASzip VLR data */
     size_t vlr_len;
     unsigned char *out;  /* the output chunk being gathered */
@@ -301,32 +303,34 @@ typedef struct {
  * compressor 2, the chunk size `chunk`). */
 static int plan_items(pw_t *z, const hd__laz_chunks_t *c, uint32_t chunk) {
     hd__writer_t *w = z->w;
-    for (unsigned i = 0; i < c->n_items; i++)
+    for (unsigned i = 0; i < c->n_items && !c->layered; i++)
         if (c->version[i] != 2)
             return hd__err(w->err, HD_EUNSUPPORTED,
                            "%s: LASzip item %u is of version %u: a field is written into pointwise LAZ of version 2 "
                            "items (LASzip 2 and later) only",
                            w->in->name, i + 1, c->version[i]);
     z->n_items = c->n_items;
+    z->layered = c->layered;
     memcpy(z->type, c->type, sizeof z->type);
     memcpy(z->size, c->size, sizeof z->size);
-    unsigned nb = (unsigned)(8 * w->nf);
-    if (z->pl->add) {
-        if (z->type[z->n_items - 1] == IT_BYTE) z->size[z->n_items - 1] += nb;
-        else z->type[z->n_items] = IT_BYTE, z->size[z->n_items++] = nb;
+    for (unsigned i = 0; i < c->n_items; i++) z->version[i] = c->layered ? c->version[i] : 2;
+    unsigned nb = (unsigned)(8 * w->nf), bytes = c->layered ? HD__LAZ_IT_BYTE14 : IT_BYTE;
+    if (z->pl->add) { /* a new BYTE14 item takes POINT14's version */
+        if (z->type[z->n_items - 1] == bytes) z->size[z->n_items - 1] += nb;
+        else z->type[z->n_items] = bytes, z->version[z->n_items] = z->version[0], z->size[z->n_items++] = nb;
     }
     const unsigned char *v = w->in->data + c->vlr_at;
     size_t tail = c->vlr_len - (34 + 6 * (size_t)c->n_items); /* bytes after the items, kept */
     z->vlr_len = 34 + 6 * (size_t)z->n_items + tail;
     if (!(z->vlr = malloc(z->vlr_len))) return hd__err(w->err, HD_ENOMEM, "out of memory");
     memcpy(z->vlr, v, 34);
-    z->vlr[0] = 2, z->vlr[1] = 0; /* pointwise chunked */
+    z->vlr[0] = c->layered ? 3 : 2, z->vlr[1] = 0; /* layered or pointwise chunked */
     for (int b = 0; b < 4; b++) z->vlr[12 + b] = (unsigned char)(chunk >> (8 * b));
     z->vlr[32] = (unsigned char)z->n_items, z->vlr[33] = 0;
     for (unsigned i = 0; i < z->n_items; i++) {
         unsigned char *q = z->vlr + 34 + 6 * i;
         q[0] = (unsigned char)z->type[i], q[1] = 0, q[2] = (unsigned char)z->size[i], q[3] = (unsigned char)(z->size[i] >> 8);
-        q[4] = 2, q[5] = 0;
+        q[4] = (unsigned char)z->version[i], q[5] = 0;
     }
     memcpy(z->vlr + 34 + 6 * z->n_items, v + 34 + 6 * c->n_items, tail);
     return HD_OK;
@@ -356,8 +360,20 @@ static int flush_chunk(pw_t *z) {
     if (z->n_out == 0) return HD_OK;
     hd__writer_t *w = z->w;
     size_t rec = z->pl->out_rec;
-    if (hd__laz_encode_pointwise(z->out, z->n_out, rec, z->type, z->size, z->n_items, &z->enc))
-        return hd__err(w->err, HD_ENOMEM, "out of memory");
+    int rc;
+    if (z->layered) {
+        hd__laz14_items_t it = {z->n_items, {0}, {0}, {0}};
+        memcpy(it.type, z->type, sizeof it.type);
+        memcpy(it.size, z->size, sizeof it.size);
+        memcpy(it.version, z->version, sizeof it.version);
+        rc = hd__laz14_encode(z->out, z->n_out, rec, &it, &z->enc);
+    } else {
+        rc = hd__laz_encode_pointwise(z->out, z->n_out, rec, z->type, z->size, z->n_items, &z->enc);
+    }
+    if (rc == HD_EINVAL)
+        return hd__err(w->err, rc, "%s: internal: a record of the chunk ending at point %llu would not decode back to itself",
+                       w->in->name, (unsigned long long)z->kept);
+    if (rc) return hd__err(w->err, rc, "%s: %s", w->in->name, hd_strerror(rc));
     if (put_chunk(z, z->n_out, z->out, &z->enc)) return hd__err(w->err, HD_ENOMEM, "out of memory");
     z->n_out = 0;
     return HD_OK;

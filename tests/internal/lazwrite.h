@@ -71,4 +71,14 @@ unsigned char *lazw_rich_records(gen_rng_t *g, int fmt, unsigned extra, size_t n
 void lazw_pointwise(tf_buf_t *b, int fmt, unsigned extra, const unsigned char *recs, size_t rec, size_t n,
                     size_t chunk);
 
+/* n random whole records of LAS 1.4 point format fmt (6, 7, 8) with
+ * `extra` extra bytes, every field varying; scanner channels switching
+ * when `channels`, else all 0; malloc'd, *rec bytes each. */
+unsigned char *lazw_rich_records14(gen_rng_t *g, int fmt, unsigned extra, size_t n, size_t *rec, int channels);
+/* The layered LAZ file (LAS 1.4, items of `version` 3 or 4, chunks of
+ * `chunk` points) of those records, compressed by the library's layered
+ * encoder (hd__laz14_encode, src/io/laz14.c), appended to b. */
+void lazw_layered(tf_buf_t *b, int fmt, unsigned extra, const unsigned char *recs, size_t rec, size_t n, size_t chunk,
+                  unsigned version);
+
 #endif
