@@ -25,7 +25,12 @@
  * whose every field varies (tests/internal/lazwrite.c's lazw_pointwise),
  * all points or those whose first value is > 0.25: their NAME.txt lines
  * are each written record in hexadecimal, byte by byte, the values' eight
- * bytes each last (_fieldsN: N of them).
+ * bytes each last (_fieldsN: N of them).  The cases named record_formatK_*
+ * with K of 6-8 are layered LAZ whose every field varies
+ * (lazwrite.c's lazw_rich_records14), compressed by the library's layered
+ * encoder (src/io/laz14.c), or hd_write_fields's output on such a file
+ * (_subset: the points whose first value is > 0.25, encoded again); their
+ * NAME.txt lines are whole records as above.
  */
 #include "files.h"
 #include "gen.h"
@@ -175,6 +180,55 @@ static void record_case(const char *dir, const char *name, int fmt, unsigned ext
     free(v);
 }
 
+static int save(const char *dir, const char *name, const tf_buf_t *b);
+
+/* The layered record case NAME: records of LAS 1.4 format fmt whose every
+ * field varies (channels switching when `channels`), compressed by the
+ * library's layered encoder with items of `version`; with nf = 0 that file
+ * is the case, else hd_write_fields's output on it (all points, or those
+ * whose first value is > 0.25 when `subset`). */
+static void record14_case(const char *dir, const char *name, int fmt, unsigned extra, int channels, unsigned version,
+                          int subset, uint64_t seed, size_t n, size_t nf) {
+    gen_rng_t g;
+    gen_seed(&g, seed);
+    size_t rec;
+    unsigned char *recs = lazw_rich_records14(&g, fmt, extra, n, &rec, channels);
+    double *v = malloc((nf ? nf : 1) * n * sizeof *v);
+    if (!recs || !v) exit(1);
+    for (size_t k = 0; k < n; k++) v[k] = k % 4 ? gen_normal(&g) : 0.5;
+    more_fields(v, n, nf);
+    tf_buf_t b = {0};
+    lazw_layered(&b, fmt, extra, recs, rec, n, 1000, version);
+    FILE *f;
+    if (nf) {
+        hd_write_options_t o;
+        hd_write_options_init(&o);
+        o.keep = subset ? HD_KEEP_FARTHER : HD_KEEP_ALL;
+        o.threshold = 0.25;
+        f = write_field_of(dir, name, &b, v, n, nf, &o);
+    } else {
+        if (save(dir, name, &b)) exit(1);
+        char path[4096];
+        snprintf(path, sizeof path, "%s/%s.txt", dir, name);
+        if (!(f = fopen(path, "w"))) exit(1);
+    }
+    for (size_t k = 0; k < n; k++) {
+        if (subset && !(v[k] > 0.25)) continue;
+        for (size_t i = 0; i < rec; i++) fprintf(f, "%02x", recs[k * rec + i]);
+        for (size_t j = 0; j < nf; j++) {
+            unsigned char val[8];
+            memcpy(val, &v[j * n + k], 8);
+            for (int i = 0; i < 8; i++) fprintf(f, "%02x", val[i]);
+        }
+        fputc('\n', f);
+    }
+    if (fclose(f)) exit(1);
+    printf("%s\n", name);
+    tf_free(&b);
+    free(recs);
+    free(v);
+}
+
 static int save(const char *dir, const char *name, const tf_buf_t *b) {
     char path[4096];
     snprintf(path, sizeof path, "%s/%s.laz", dir, name);
@@ -306,5 +360,16 @@ int main(int argc, char **argv) {
     record_case(argv[1], "record_format0_extra0_subset", 0, 0, 1, 503, 2500, 1);
     record_case(argv[1], "record_format1_extra0_fields3", 1, 0, 0, 510, 2500, 3);
     record_case(argv[1], "record_format3_extra1_fields2_subset", 3, 1, 1, 511, 3001, 2);
+    /* layered, every layer.  laz-perf 0.0.7 hands the RGB14, RGBNIR14 and
+     * BYTE14 decoders channel 0 except at a point where the channel
+     * changes, so colours, extra bytes and fields go with channel 0; the
+     * nine POINT14 layers switch channels */
+    record14_case(argv[1], "record_format6_channels_v3", 6, 0, 1, 3, 0, 600, 3001, 0);
+    record14_case(argv[1], "record_format6_channels_v4", 6, 0, 1, 4, 0, 604, 3001, 0);
+    record14_case(argv[1], "record_format7_v4", 7, 0, 0, 4, 0, 601, 3001, 0);
+    record14_case(argv[1], "record_format8_v3", 8, 0, 0, 3, 0, 602, 3001, 0);
+    record14_case(argv[1], "record_format8_extra2_v4", 8, 2, 0, 4, 0, 603, 2500, 0);
+    record14_case(argv[1], "record_format6_extra1_subset", 6, 1, 0, 3, 1, 610, 3001, 1);
+    record14_case(argv[1], "record_format7_fields2_subset", 7, 0, 0, 4, 1, 611, 3001, 2);
     return 0;
 }
