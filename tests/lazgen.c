@@ -12,6 +12,11 @@
  *
  * writes the fuzz target's seed files (tests/corpus/laz/, committed).
  *
+ *   lazgen --records FILE
+ *
+ * prints every whole record of a LAZ file as the library decodes it (every
+ * field of every item, every layer), one line of hexadecimal each.
+ *
  * The cases named field_* are the output of hd_write_fields (the library's
  * LAZ writer) on a file of the tests' writer whose points all lie in
  * scanner channel 0, with seeded values: their NAME.txt lines are
@@ -324,8 +329,31 @@ static int seeds(const char *dir) {
     return rc | lies(dir);
 }
 
+/* lazgen --records FILE: every whole record of the LAZ file as the
+ * library decodes it (every field, every layer), one line of hexadecimal
+ * each; 1 with the error when it is refused. */
+static int records(const char *path) {
+    size_t size, n, rec;
+    unsigned char *d = tf_read(path, &size);
+    hd_error_t err;
+    unsigned char *r = d ? lazw_decode_records(path, d, size, &n, &rec, &err) : NULL;
+    if (!r) {
+        fprintf(stderr, "lazgen: %s: %s\n", path, d ? err.message : "cannot read");
+        free(d);
+        return 1;
+    }
+    for (size_t k = 0; k < n; k++) {
+        for (size_t i = 0; i < rec; i++) printf("%02x", r[k * rec + i]);
+        putchar('\n');
+    }
+    free(r);
+    free(d);
+    return 0;
+}
+
 int main(int argc, char **argv) {
     if (argc == 3 && strcmp(argv[1], "--seeds") == 0) return seeds(argv[2]);
+    if (argc == 3 && strcmp(argv[1], "--records") == 0) return records(argv[2]);
     if (argc != 2) {
         fprintf(stderr, "usage: lazgen DIR | lazgen --seeds DIR\n");
         return 2;

@@ -590,3 +590,35 @@ void lazw_layered(tf_buf_t *b, int fmt, unsigned extra, const unsigned char *rec
     hd__enc_free(&e);
     free(bytes);
 }
+
+static uint64_t le_of(const unsigned char *p, int n) {
+    uint64_t v = 0;
+    for (int i = n - 1; i >= 0; i--) v = v << 8 | p[i];
+    return v;
+}
+
+unsigned char *lazw_decode_records(const char *path, const unsigned char *d, size_t size, size_t *n, size_t *rec,
+                                   hd_error_t *err) {
+    hd__file_t f = {path, d, size};
+    hd_read_options_t o;
+    hd_read_options_init(&o);
+    hd__sink_t sink;
+    hd__sink_init(&sink, HD_FLOAT64);
+    hd__read_t r = {&f, &o, 1, &sink, NULL, 0, err, 0, 0, 0};
+    hd__las_header_t h;
+    memset(&h, 0, sizeof h);
+    h.minor = d[25], h.fmt = d[104] & 63, h.header = le_of(d + 94, 2), h.offset = le_of(d + 96, 4), h.rec = le_of(d + 105, 2);
+    h.count = d[25] >= 4 ? le_of(d + 247, 8) : le_of(d + 107, 4), h.n_vlr = (uint32_t)le_of(d + 100, 4);
+    hd__laz_chunks_t c;
+    if (hd__laz_chunks(&r, &h, &c)) return NULL;
+    unsigned char *out = calloc(h.count + 1, h.rec);
+    for (size_t k = 0; out && k < c.n_chunks; k++)
+        if (hd__laz_chunk_records(&r, &h, &c, k, out + c.first[k] * h.rec)) {
+            free(out);
+            out = NULL;
+        }
+    hd__laz_chunks_free(&c);
+    hd__sink_free(&sink);
+    *n = h.count, *rec = h.rec;
+    return out;
+}

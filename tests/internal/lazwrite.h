@@ -19,6 +19,8 @@
 #include "files.h"
 #include "gen.h"
 
+#include <hausdorff.h>
+
 #include <stddef.h>
 #include <stdint.h>
 
@@ -80,5 +82,12 @@ unsigned char *lazw_rich_records14(gen_rng_t *g, int fmt, unsigned extra, size_t
  * encoder (hd__laz14_encode, src/io/laz14.c), appended to b. */
 void lazw_layered(tf_buf_t *b, int fmt, unsigned extra, const unsigned char *recs, size_t rec, size_t n, size_t chunk,
                   unsigned version);
+
+/* Every whole record of the LAZ file d[0..size) (named path), decoded by
+ * the library (hd__laz_chunk_records: pointwise items of version 2, or
+ * every layer); malloc'd, *n records of *rec bytes; NULL with err set when
+ * the file is refused. */
+unsigned char *lazw_decode_records(const char *path, const unsigned char *d, size_t size, size_t *n, size_t *rec,
+                                   hd_error_t *err);
 
 #endif

@@ -260,27 +260,10 @@ TEST(laz_extended_vlrs_follow_the_points_with_their_offset_moved) {
 static unsigned char *records_of(const char *path, size_t *n, size_t *rec) {
     size_t size;
     unsigned char *d = tf_read(path, &size);
-    hd__file_t f = {path, d, size};
-    hd_read_options_t o;
-    hd_read_options_init(&o);
-    hd__sink_t sink;
-    hd__sink_init(&sink, HD_FLOAT64);
     hd_error_t err;
-    hd__read_t r = {&f, &o, 1, &sink, NULL, 0, &err, 0, 0, 0};
-    hd__las_header_t h;
-    memset(&h, 0, sizeof h);
-    h.minor = d[25], h.fmt = d[104] & 63, h.header = le(d + 94, 2), h.offset = le(d + 96, 4), h.rec = le(d + 105, 2);
-    h.count = d[25] >= 4 ? le(d + 247, 8) : le(d + 107, 4), h.n_vlr = (uint32_t)le(d + 100, 4);
-    hd__laz_chunks_t c;
-    CHECK_RC(hd__laz_chunks(&r, &h, &c), HD_OK);
-    unsigned char *out = calloc(h.count + 1, h.rec);
-    for (size_t k = 0; k < c.n_chunks && !hdt_failed(); k++) {
-        int rc = hd__laz_chunk_records(&r, &h, &c, k, out + c.first[k] * h.rec);
-        if (rc) CONTEXT("%s", err.message);
-        CHECK_RC(rc, HD_OK);
-    }
-    hd__laz_chunks_free(&c);
-    *n = h.count, *rec = h.rec;
+    unsigned char *out = lazw_decode_records(path, d, size, n, rec, &err);
+    if (!out) CONTEXT("%s", err.message);
+    CHECK(out != NULL);
     free(d);
     return out;
 }
