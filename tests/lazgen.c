@@ -310,13 +310,24 @@ static int seeds(const char *dir) {
     write_case(dir, "fmt1_variable", &o, 5, 30, 0);
     o.format = 3, o.extra = 1, o.v1 = 1;
     write_case(dir, "fmt3_laszip1_extra1", &o, 6, 30, 0);
+    /* layered, every field varying in all four channels: colour, NIR and
+     * extra bytes, items of version 3 (the writers' whole-record decoder) */
+    gen_rng_t g;
+    gen_seed(&g, 7);
+    size_t rec;
+    unsigned char *recs = lazw_rich_records14(&g, 8, 2, 50, &rec, 1);
+    tf_buf_t rb = {0};
+    lazw_layered(&rb, 8, 2, recs, rec, 50, 20, 3);
+    int rc0 = save(dir, "fmt8_every_field_extra2", &rb);
+    tf_free(&rb);
+    free(recs);
     /* one point repeated: over 64 points per byte, the reader's growing path */
     static lazw_point_t same[40000];
     for (size_t k = 0; k < 40000; k++) same[k] = (lazw_point_t){1, 2, 3, 1, 1, 0};
     lazw_opts_t r = {0, 0, 40000, NULL, 0, {0.5, 0.5, 0.5}, {0, 0, 0}, 0};
     tf_buf_t b = {0};
     lazw_encode(&b, &r, same, 40000);
-    int rc = save(dir, "fmt0_repeated_point", &b);
+    int rc = rc0 | save(dir, "fmt0_repeated_point", &b);
     tf_free(&b);
     /* a million copies of one point in one chunk, about 500 a byte: denser
      * than the reader's default limit (--laz-points-per-byte raises it) */
