@@ -27,9 +27,13 @@
  * gets an empty layer (size 0), which a decoder reads as "unchanged".  The
  * channels come from decoding each chunk's x/y layer (laz.c).
  *
- * Pointwise LAZ (point formats 0-5) interleaves every field of a point in
- * one stream, so adding bytes means compressing every field again; that is
- * not done: HD_EUNSUPPORTED, and so is a subset of any LAZ file.
+ * A subset of a layered file changes every prediction in a chunk, so it is
+ * decoded to whole records and its kept points compressed again, every
+ * layer (laz14.c), by the writer of pointwise LAZ (write_lazpw.c), which
+ * does the same for pointwise files (formats 0-5 interleave every field of
+ * a point in one stream, so adding bytes there means compressing every
+ * field again).  Waveform packets (WAVEPACKET14) are not coded: a subset of
+ * formats 9 and 10 is HD_EUNSUPPORTED.
  */
 #include "io.h"
 #include "lasfield.h"
