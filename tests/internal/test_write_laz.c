@@ -452,6 +452,38 @@ TEST(layered_laz_subsets_are_compressed_again_every_field) {
         }
 }
 
+TEST(layered_laz_subsets_of_one_point_and_of_none) {
+    gen_rng_t g;
+    gen_seed(&g, 43);
+    size_t n = 120, rec, m, mrec;
+    unsigned char *recs = lazw_rich_records14(&g, 8, 1, n, &rec, 1);
+    tf_buf_t b = {0};
+    lazw_layered(&b, 8, 1, recs, rec, n, 50, 4);
+    const char *in = tf_finish(&b, "rich14_one.laz");
+    double *v = calloc(n, sizeof *v);
+    v[77] = 1; /* the one point farther than 0.5: a chunk of one point, its layers those of an empty stream */
+    hd_write_options_t o;
+    hd_write_options_init(&o);
+    o.keep = HD_KEEP_FARTHER;
+    o.threshold = 0.5;
+    hd_error_t err;
+    size_t written = 9;
+    CHECK_RC(hd_write_field(in, tf_path("rich14_one_out.laz"), v, n, &o, &written, &err), HD_OK);
+    unsigned char *out = records_of(tf_path("rich14_one_out.laz"), &m, &mrec);
+    CHECK(written == 1 && m == 1 && mrec == rec + 8);
+    CHECK(out && memcmp(out, recs + 77 * rec, rec) == 0);
+    free(out);
+    o.threshold = 2; /* none */
+    CHECK_RC(hd_write_field(in, tf_path("rich14_none_out.laz"), v, n, &o, &written, &err), HD_OK);
+    hd_cloud_t *c = NULL;
+    CHECK(written == 0);
+    int rc = hd_read_file(tf_path("rich14_none_out.laz"), NULL, &c, &err);
+    CHECK(rc == HD_OK ? c->count == 0 : rc == HD_EEMPTY);
+    hd_cloud_free(c);
+    free(v);
+    free(recs);
+}
+
 TEST(layered_laz_damaged_layers_are_errors_with_offsets) {
     gen_rng_t g;
     gen_seed(&g, 41);
