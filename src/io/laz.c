@@ -26,7 +26,9 @@
  * extra byte), then the layers, each its own stream; x and y are in the
  * first layer (with the return counts and scanner channel that choose
  * their contexts), z in the second, and every other layer is skipped by
- * its size.  COPC files are layered LAZ with variable chunk sizes.
+ * its size (the writers of subsets decode every layer of a chunk through
+ * hd__laz_chunk_records, in laz14.c; a read never does).  COPC files are
+ * layered LAZ with variable chunk sizes.
  *
  * POINT10 v2, per point: a symbol of 64 says which of the return byte,
  * intensity, classification, scan angle, user data, point source changed;
