@@ -321,6 +321,11 @@ static int seeds(const char *dir) {
     int rc0 = save(dir, "fmt8_every_field_extra2", &rb);
     tf_free(&rb);
     free(recs);
+    recs = lazw_rich_records14(&g, 10, 0, 40, &rec, 1); /* and wave packets (WAVEPACKET14), version 4 */
+    lazw_layered(&rb, 10, 0, recs, rec, 40, 20, 4);
+    rc0 |= save(dir, "fmt10_every_field", &rb);
+    tf_free(&rb);
+    free(recs);
     /* one point repeated: over 64 points per byte, the reader's growing path */
     static lazw_point_t same[40000];
     for (size_t k = 0; k < 40000; k++) same[k] = (lazw_point_t){1, 2, 3, 1, 1, 0};

@@ -1,6 +1,6 @@
 /*
- * laz14.c -- layered LAZ (LASzip compressor 3: POINT14, RGB14, RGBNIR14
- * and BYTE14 items, versions 3 and 4), every field, decoded and encoded
+ * laz14.c -- layered LAZ (LASzip compressor 3: POINT14, RGB14, RGBNIR14,
+ * WAVEPACKET14 and BYTE14 items, versions 3 and 4), every field, decoded and encoded
  * by one description of the format (written from LASzip's published
  * description of its v3/v4 item coders: facts, not code).
  *
@@ -18,7 +18,7 @@
  * symbol, scanner channel, return counts, x and y; (1) z; (2)
  * classification; (3) flags; (4) intensity; (5) scan angle; (6) user data;
  * (7) point source; (8) GPS time.  RGB14 has one, RGBNIR14 two (RGB, NIR),
- * BYTE14 one per byte.  A layer of size 0 means its field never changes
+ * WAVEPACKET14 one, BYTE14 one per byte.  A layer of size 0 means its field never changes
  * within the chunk: the decoder keeps the last value.  The encoder always
  * writes layers 0 and 1 and drops any other whose values never change.
  *
@@ -48,7 +48,8 @@
  *    (below).
  * RGB14 and RGBNIR14 code colours as RGB12 v2 does (which bytes changed,
  * green and blue from red's change), NIR's two bytes by their change;
- * BYTE14 each byte as its difference to the last.  Version 3 of these
+ * WAVEPACKET14 as wave14() says; BYTE14 each byte as its difference to the
+ * last.  Version 3 of these
  * items, at a switch to a channel already seen in the chunk, predicts the
  * switching point from (and updates) the last values of the channel it
  * comes from; version 4 uses the channel's own.
@@ -101,6 +102,16 @@ typedef struct {
     hd__symmodel_t **m;
 } bytc_t;
 
+/* WAVEPACKET14, one channel. */
+typedef struct {
+    int used;
+    unsigned char last[29];
+    hd__symmodel_t index, odiff[4];
+    hd__intcoder_t ioff, isize, iret, ixyz;
+    unsigned sym_last;
+    int32_t last_diff;
+} wavec_t;
+
 typedef struct {
     int enc, oom;
     const hd__laz14_items_t *it;
@@ -113,6 +124,11 @@ typedef struct {
     size_t rgb_off;
     unsigned rgb_layer, rgb_cur;
     rgbc_t rgb[4];
+    /* WAVEPACKET14 */
+    int has_wave, wave_v4;
+    size_t wave_off;
+    unsigned wave_layer, wave_cur;
+    wavec_t wave[4];
     /* BYTE14 */
     int has_bytes, byt_v4;
     size_t byt_off, nb;
@@ -538,6 +554,93 @@ static int rgb14(c14_t *s, unsigned char *item) {
     return HD_OK;
 }
 
+/* ---- WAVEPACKET14 ---------------------------------------------------------- */
+static int wavec_start(wavec_t *c, const unsigned char *from) {
+    int rc = hd__symmodel_new(&c->index, 256);
+    for (int i = 0; i < 4 && rc == HD_OK; i++) rc = hd__symmodel_new(&c->odiff[i], 4);
+    rc = rc ? rc : hd__intcoder_new(&c->ioff, 32, 1);
+    rc = rc ? rc : hd__intcoder_new(&c->isize, 32, 1);
+    rc = rc ? rc : hd__intcoder_new(&c->iret, 32, 1);
+    rc = rc ? rc : hd__intcoder_new(&c->ixyz, 32, 3);
+    c->used = 1;
+    c->sym_last = 0;
+    c->last_diff = 0;
+    memcpy(c->last, from, 29);
+    return rc;
+}
+static void wavec_free(wavec_t *c) {
+    hd__symmodel_t *m[] = {&c->index, &c->odiff[0], &c->odiff[1], &c->odiff[2], &c->odiff[3]};
+    hd__symmodels_free(m, 5);
+    hd__intcoder_t *ic[] = {&c->ioff, &c->isize, &c->iret, &c->ixyz};
+    for (int i = 0; i < 4; i++) hd__intcoder_free(ic[i]);
+}
+
+/* A wave packet descriptor (29 bytes: index, u64 offset, u32 size, f32
+ * return point, f32 x, y, z, the floats coded as their 32 bits): the
+ * index by a symbol of 256; the offset as the last (0), the last plus the
+ * last size (1), the last plus a 32-bit difference predicted by the last
+ * such difference (2), or its 64 raw bits (3), that choice by a model of
+ * the previous choice; the others against the last values. */
+static int wave14(c14_t *s, unsigned char *item) {
+    unsigned char *lp = s->wave[s->wave_cur].last;
+    if (s->cur != s->wave_cur) {
+        s->wave_cur = s->cur;
+        if (!s->wave[s->cur].used) {
+            if (wavec_start(&s->wave[s->cur], lp)) return HD_ENOMEM;
+            lp = s->wave[s->cur].last;
+        } else if (s->wave_v4) {
+            lp = s->wave[s->cur].last;
+        }
+    }
+    wavec_t *c = &s->wave[s->cur];
+    layer_t *L = &s->L[s->wave_layer];
+    unsigned char out[29];
+    if (!L->on) { /* never changes in the chunk */
+        if (!s->enc) memcpy(item, lp, 29);
+        return HD_OK;
+    }
+    if (s->enc) L->changed |= memcmp(item, lp, 29) != 0;
+    out[0] = (unsigned char)csym(s, L, &c->index, E(item[0]));
+    uint64_t loff = u64(lp + 1), off = loff;
+    uint32_t lsize = hd__ld_u32(lp + 9, 0);
+    uint32_t sym = 0;
+    int32_t d32 = 0;
+    if (s->enc) {
+        uint64_t now = u64(item + 1);
+        int64_t d = (int64_t)(now - loff);
+        d32 = (int32_t)d;
+        sym = d != d32 ? 3u : d32 == 0 ? 0u : now == loff + lsize ? 1u : 2u;
+    }
+    sym = csym(s, L, &c->odiff[c->sym_last], sym);
+    c->sym_last = sym;
+    if (sym == 1) {
+        off = loff + lsize;
+    } else if (sym == 2) {
+        c->last_diff = cint(s, L, &c->ioff, c->last_diff, d32, 0);
+        off = loff + (uint64_t)(int64_t)c->last_diff;
+    } else if (sym == 3) {
+        uint32_t lo, hi;
+        if (s->enc) {
+            off = u64(item + 1);
+            hd__enc_raw(&L->e, 32, (uint32_t)off);
+            hd__enc_raw(&L->e, 32, (uint32_t)(off >> 32));
+        } else {
+            lo = hd__dec_raw(&L->d, 32);
+            hi = hd__dec_raw(&L->d, 32);
+            off = (uint64_t)hi << 32 | lo;
+        }
+    }
+    st64(out + 1, off);
+    st32(out + 9, (uint32_t)cint(s, L, &c->isize, (int32_t)lsize, E(i32(item + 9)), 0));
+    st32(out + 13, (uint32_t)cint(s, L, &c->iret, i32(lp + 13), E(i32(item + 13)), 0));
+    for (int k = 0; k < 3; k++)
+        st32(out + 17 + 4 * k, (uint32_t)cint(s, L, &c->ixyz, i32(lp + 17 + 4 * k), E(i32(item + 17 + 4 * k)), (uint32_t)k));
+    memcpy(lp, out, 29);
+    if (!s->enc) memcpy(item, out, 29);
+    else if (memcmp(item, out, 29) != 0) return HD_EINVAL;
+    return HD_OK;
+}
+
 /* ---- BYTE14 --------------------------------------------------------------- */
 static int bytc_start(bytc_t *c, const unsigned char *from, size_t nb) {
     c->used = 1;
@@ -582,16 +685,6 @@ static int byte14(c14_t *s, unsigned char *item) {
 }
 
 /* ---- a chunk -------------------------------------------------------------- */
-int hd__laz14_supported(const hd__laz14_items_t *it, char *msg, size_t len) {
-    for (unsigned i = 0; i < it->n; i++)
-        if (it->type[i] == HD__LAZ_IT_WAVE14) {
-            snprintf(msg, len,
-                     "its points carry waveform packets (LASzip item WAVEPACKET14, point formats 9 and 10), whose "
-                     "compression is not coded here, so a subset of them is not written");
-            return HD_EUNSUPPORTED;
-        }
-    return HD_OK;
-}
 
 /* The state for items `it`, records of `rec` bytes, first record `first`:
  * offsets, layer numbers, the first channel's models. */
@@ -620,7 +713,12 @@ static int c14_start(c14_t *s, const hd__laz14_items_t *it, const unsigned char 
             s->byt_layer = nl;
             nl += it->size[i];
         }
-        if (t == HD__LAZ_IT_WAVE14) return HD_EUNSUPPORTED;
+        if (t == HD__LAZ_IT_WAVE14) {
+            s->has_wave = 1;
+            s->wave_v4 = it->version[i] == 4;
+            s->wave_off = off;
+            s->wave_layer = nl++;
+        }
         off += it->size[i];
     }
     s->nl = nl;
@@ -628,13 +726,14 @@ static int c14_start(c14_t *s, const hd__laz14_items_t *it, const unsigned char 
     s->ch = calloc(4, sizeof *s->ch);
     if (!s->L || !s->ch) return HD_ENOMEM;
     for (unsigned k = 0; k < nl; k++) hd__enc_init(&s->L[k].e);
-    s->cur = s->rgb_cur = s->byt_cur = (first[15] >> 4) & 3;
+    s->cur = s->rgb_cur = s->wave_cur = s->byt_cur = (first[15] >> 4) & 3;
     int rc = ch_start(&s->ch[s->cur], first);
     unsigned char rgb[8] = {0};
     if (rc == HD_OK && s->has_rgb) {
         memcpy(rgb, first + s->rgb_off, s->nir ? 8 : 6);
         rc = rgbc_start(&s->rgb[s->cur], rgb);
     }
+    if (rc == HD_OK && s->has_wave) rc = wavec_start(&s->wave[s->cur], first + s->wave_off);
     if (rc == HD_OK && s->has_bytes) rc = bytc_start(&s->byt[s->cur], first + s->byt_off, s->nb);
     return rc;
 }
@@ -644,6 +743,7 @@ static void c14_free(c14_t *s) {
         if (s->ch[c].used) ch_free(&s->ch[c]);
     for (int c = 0; c < 4; c++) {
         if (s->rgb[c].used) rgbc_free(&s->rgb[c]);
+        if (s->wave[c].used) wavec_free(&s->wave[c]);
         if (s->byt[c].used) bytc_free(&s->byt[c], s->nb);
     }
     for (unsigned k = 0; s->L && k < s->nl; k++) hd__enc_free(&s->L[k].e);
@@ -655,6 +755,7 @@ static void c14_free(c14_t *s) {
 static int c14_point(c14_t *s, unsigned char *rec) {
     int rc = point14(s, rec);
     if (rc == HD_OK && s->has_rgb) rc = rgb14(s, rec + s->rgb_off);
+    if (rc == HD_OK && s->has_wave) rc = wave14(s, rec + s->wave_off);
     if (rc == HD_OK && s->has_bytes) rc = byte14(s, rec + s->byt_off);
     if (s->oom) rc = HD_ENOMEM;
     return rc;
@@ -666,6 +767,7 @@ static const char *layer_name(const c14_t *s, unsigned k, char buf[32]) {
     if (k < 9) return p14[k];
     if (s->has_rgb && k == s->rgb_layer) return "RGB";
     if (s->has_rgb && s->nir && k == s->rgb_layer + 1) return "NIR";
+    if (s->has_wave && k == s->wave_layer) return "wave packet";
     snprintf(buf, 32, "extra byte %u", k - s->byt_layer + 1);
     return buf;
 }
@@ -674,8 +776,7 @@ int hd__laz14_decode(const unsigned char *b, size_t nb, size_t n, size_t rec, co
                      unsigned char *recs, char *msg, size_t len, size_t *at) {
     c14_t s;
     *at = 0;
-    int rc = hd__laz14_supported(it, msg, len);
-    if (rc) return rc;
+    int rc;
     if (nb < rec) {
         snprintf(msg, len, "chunk of %zu bytes is shorter than its first point's %zu bytes", nb, rec);
         return HD_EFORMAT;

@@ -32,8 +32,7 @@
  * layer (laz14.c), by the writer of pointwise LAZ (write_lazpw.c), which
  * does the same for pointwise files (formats 0-5 interleave every field of
  * a point in one stream, so adding bytes there means compressing every
- * field again).  Waveform packets (WAVEPACKET14) are not coded: a subset of
- * formats 9 and 10 is HD_EUNSUPPORTED.
+ * field again).
  */
 #include "io.h"
 #include "lasfield.h"
@@ -306,14 +305,7 @@ int hd__write_laz(hd__writer_t *w) {
     hd__read_t r = {w->in, w->ropt, 1, &z.sink, NULL, 0, w->err, 0, 0, 0};
     z.r = r;
     rc = hd__laz_chunks(&z.r, &z.h, &z.c);
-    if (rc == HD_OK && z.c.layered && w->keep != HD_KEEP_ALL) { /* a subset: every point encoded again (laz14.c) */
-        hd__laz14_items_t it = {z.c.n_items, {0}, {0}, {0}};
-        memcpy(it.type, z.c.type, sizeof it.type);
-        char msg[256];
-        if (hd__laz14_supported(&it, msg, sizeof msg))
-            rc = hd__err(w->err, HD_EUNSUPPORTED, "%s: point format %u: %s", w->in->name, z.pl.fmt, msg);
-    }
-    if (rc == HD_OK && (!z.c.layered || w->keep != HD_KEEP_ALL)) {
+    if (rc == HD_OK && (!z.c.layered || w->keep != HD_KEEP_ALL)) { /* a layered subset: every point encoded again (laz14.c) */
         rc = hd__write_laz_pointwise(w, &z.pl, &z.h, &z.c, &z.r);
         hd__laz_chunks_free(&z.c);
         hd__sink_free(&z.sink);

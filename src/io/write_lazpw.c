@@ -1,7 +1,7 @@
 /*
  * write_lazpw.c -- fields written back into pointwise LAZ (LAS point
  * formats 0-3, LASzip compressor 2), or the points past a threshold; and
- * the points past a threshold of layered LAZ (formats 6-8, compressor 3),
+ * the points past a threshold of layered LAZ (formats 6-10, compressor 3),
  * whose chunks are decoded to whole records and encoded again, every
  * layer, by laz14.c, the rest as below (the items' versions kept, a BYTE14
  * item grown or added for the fields).

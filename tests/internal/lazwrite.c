@@ -492,12 +492,15 @@ void lazw_pointwise(tf_buf_t *b, int fmt, unsigned extra, const unsigned char *r
 
 /* LAS 1.4 records (formats 6, 7, 8) with every field varying. */
 unsigned char *lazw_rich_records14(gen_rng_t *g, int fmt, unsigned extra, size_t n, size_t *rec, int channels) {
-    *rec = (fmt == 6 ? 30 : fmt == 7 ? 36 : 38) + extra;
+    *rec = (fmt == 6 || fmt == 9 ? 30 : fmt == 7 ? 36 : 38) + (fmt >= 9 ? 29 : 0) + extra;
     unsigned char *r = calloc(n, *rec);
     int32_t x = 0, y = 0, z = 0;
     uint64_t t = 0x41C0000000000000ull;
     uint16_t rgb[4] = {100, 200, 300, 400}, scan = 0, inten = 900, psid = 3;
     unsigned chan = 0, cls = 2, ud = 7, flags = 0;
+    unsigned char wave[1] = {1};
+    uint64_t wave_off = 1000;
+    uint32_t wave_size = 256, wave_ret = 0x3f800000, wave_xyz[3] = {0, 0, 0x3f000000};
     for (size_t k = 0; k < n; k++) {
         unsigned char *p = r + k * *rec;
         uint64_t u = gen_u64(g), v = gen_u64(g);
@@ -527,14 +530,30 @@ unsigned char *lazw_rich_records14(gen_rng_t *g, int fmt, unsigned extra, size_t
         t = w % 4 == 0 ? t : w % 4 == 1 ? t + 1000 : w % 4 == 2 ? t + (w >> 8 & 0xFFFFF) : w % 16 == 3 ? t + (w << 30) : t - 5;
         for (int b = 0; b < 8; b++) p[22 + b] = (unsigned char)(t >> 8 * b);
         size_t off = 30;
-        if (fmt >= 7) {
+        if (fmt == 7 || fmt == 8 || fmt == 10) {
             uint64_t c = gen_u64(g);
             if (c % 3 == 0) rgb[0] = rgb[1] = rgb[2] = (uint16_t)(c >> 8); /* grey */
             else if (c % 3 == 1) rgb[0] = (uint16_t)(rgb[0] + (c >> 8 & 15)), rgb[2] = (uint16_t)(c >> 24);
             if (c % 5 == 0) rgb[1] = (uint16_t)(c >> 40);
             if (c % 7 == 0) rgb[3] = (uint16_t)(c >> 44);
-            for (int q = 0; q < (fmt == 8 ? 4 : 3); q++) p[off + 2 * q] = (unsigned char)rgb[q], p[off + 2 * q + 1] = (unsigned char)(rgb[q] >> 8);
-            off += fmt == 8 ? 8 : 6;
+            for (int q = 0; q < (fmt == 7 ? 3 : 4); q++) p[off + 2 * q] = (unsigned char)rgb[q], p[off + 2 * q + 1] = (unsigned char)(rgb[q] >> 8);
+            off += fmt == 7 ? 6 : 8;
+        }
+        if (fmt >= 9) { /* a wave packet descriptor: index, offset, size, return point, x, y, z */
+            uint64_t c = gen_u64(g);
+            if (c % 5 == 0) wave[0] = (unsigned char)(c >> 8);
+            wave_off = c % 4 == 0 ? wave_off : c % 4 == 1 ? wave_off + wave_size : c % 8 == 2 ? wave_off + (c >> 20 & 0xFFFF) : c % 8 == 3 ? wave_off - 7 : c % 8 == 6 ? gen_u64(g) : wave_off + (c << 33);
+            if (c % 3 == 0) wave_size = (uint32_t)(c >> 40 & 1023);
+            if (c % 7 == 0) wave_ret = (uint32_t)gen_u64(g);
+            for (int q = 0; q < 3; q++)
+                if (c >> (50 + q) & 1) wave_xyz[q] = (uint32_t)gen_u64(g);
+            p[off] = wave[0];
+            for (int b = 0; b < 8; b++) p[off + 1 + b] = (unsigned char)(wave_off >> 8 * b);
+            for (int b = 0; b < 4; b++) {
+                p[off + 9 + b] = (unsigned char)(wave_size >> 8 * b), p[off + 13 + b] = (unsigned char)(wave_ret >> 8 * b);
+                for (int q = 0; q < 3; q++) p[off + 17 + 4 * q + b] = (unsigned char)(wave_xyz[q] >> 8 * b);
+            }
+            off += 29;
         }
         for (unsigned e = 0; e < extra; e++) p[off + e] = (unsigned char)(k % 7 ? 40 + e : gen_u64(g));
         if (extra > 1 && k % 11 != 0) p[off + 1] = 9; /* a byte that changes rarely */
@@ -550,7 +569,8 @@ void lazw_layered(tf_buf_t *b, int fmt, unsigned extra, const unsigned char *rec
     hd__laz14_items_t it = {0, {0}, {0}, {0}};
     it.type[it.n] = 10, it.size[it.n] = 30, it.version[it.n++] = version;
     if (fmt == 7) it.type[it.n] = 11, it.size[it.n] = 6, it.version[it.n++] = version;
-    if (fmt == 8) it.type[it.n] = 12, it.size[it.n] = 8, it.version[it.n++] = version;
+    if (fmt == 8 || fmt == 10) it.type[it.n] = 12, it.size[it.n] = 8, it.version[it.n++] = version;
+    if (fmt >= 9) it.type[it.n] = 13, it.size[it.n] = 29, it.version[it.n++] = version;
     if (extra) it.type[it.n] = 14, it.size[it.n] = extra, it.version[it.n++] = version;
     size_t vlr = 34 + 6 * it.n, offset = 375 + 54 + vlr;
     tf_put(b, "LASF", 4);

@@ -73,7 +73,7 @@ unsigned char *lazw_rich_records(gen_rng_t *g, int fmt, unsigned extra, size_t n
 void lazw_pointwise(tf_buf_t *b, int fmt, unsigned extra, const unsigned char *recs, size_t rec, size_t n,
                     size_t chunk);
 
-/* n random whole records of LAS 1.4 point format fmt (6, 7, 8) with
+/* n random whole records of LAS 1.4 point format fmt (6-10) with
  * `extra` extra bytes, every field varying; scanner channels switching
  * when `channels`, else all 0; malloc'd, *rec bytes each. */
 unsigned char *lazw_rich_records14(gen_rng_t *g, int fmt, unsigned extra, size_t n, size_t *rec, int channels);
