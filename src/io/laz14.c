@@ -341,12 +341,12 @@ static int gps_code(c14_t *s, ch_t *c, layer_t *L, uint64_t T) {
     return -1;
 }
 
-/* The POINT14 record of the next point into rec (decoding) or from it
- * (encoding).  HD_OK, HD_ENOMEM, HD_EFORMAT (GPS sequences). */
-static int point14(c14_t *s, unsigned char *rec) {
+/* The changed-values symbol (and a new scanner channel): the encoder's
+ * from rec against the last record of rec's channel; s->cur is then the
+ * point's channel.  HD_OK or HD_ENOMEM. */
+static int p14_changed(c14_t *s, const unsigned char *rec, uint32_t *out) {
     ch_t *c = &s->ch[s->cur];
-    unsigned char *last = c->last;
-    layer_t *L = s->L;
+    const unsigned char *last = c->last;
     unsigned lr = last[14] & 15, ln = last[14] >> 4;
     unsigned lpr = (lr == 1) + 2 * (lr >= ln) + 4 * (unsigned)c->gps_change;
     uint32_t cv = 0;
@@ -360,100 +360,121 @@ static int point14(c14_t *s, unsigned char *rec) {
              (uint32_t)(n != rn) << 2;
         if (r != rr) cv |= r == ((rr + 1) & 15) ? 1u : r == ((rr + 15) & 15) ? 2u : 3u;
     }
-    cv = csym(s, &L[0], &c->changed[lpr], cv);
-    if (cv & 64) {
-        unsigned d = csym(s, &L[0], &c->scanner, E((chan - s->cur + 3) & 3));
-        chan = (s->cur + d + 1) & 3;
-        if (!s->ch[chan].used && ch_start(&s->ch[chan], last)) return HD_ENOMEM;
-        s->cur = chan;
-        c = &s->ch[chan];
-        last = c->last;
-        last[15] = (unsigned char)((last[15] & 0xCF) | chan << 4);
-    }
-    unsigned gps = (cv >> 4) & 1;
-    ln = last[14] >> 4;
-    lr = last[14] & 15;
-    unsigned n = ln, r = lr;
+    *out = cv = csym(s, &s->L[0], &c->changed[lpr], cv);
+    if (!(cv & 64)) return HD_OK;
+    unsigned d = csym(s, &s->L[0], &c->scanner, E((chan - s->cur + 3) & 3));
+    chan = (s->cur + d + 1) & 3;
+    if (!s->ch[chan].used && ch_start(&s->ch[chan], last)) return HD_ENOMEM;
+    s->cur = chan;
+    s->ch[chan].last[15] = (unsigned char)((s->ch[chan].last[15] & 0xCF) | chan << 4);
+    return HD_OK;
+}
+
+/* The number of returns and the return number into c->last.  HD_OK or
+ * HD_ENOMEM. */
+static int p14_returns(c14_t *s, ch_t *c, const unsigned char *rec, uint32_t cv) {
+    unsigned char *last = c->last;
+    unsigned ln = last[14] >> 4, lr = last[14] & 15, n = ln, r = lr;
     hd__symmodel_t *m;
     if (cv & 4) {
         if (!(m = lazy(s, &c->nret[ln], 16))) return HD_ENOMEM;
-        n = csym(s, &L[0], m, E(rec[14] >> 4));
+        n = csym(s, &s->L[0], m, E(rec[14] >> 4));
     }
-    switch (cv & 3) {
-    case 1: r = (lr + 1) & 15; break;
-    case 2: r = (lr + 15) & 15; break;
-    case 3:
-        if (gps) {
-            if (!(m = lazy(s, &c->rnum[lr], 16))) return HD_ENOMEM;
-            r = csym(s, &L[0], m, E(rec[14] & 15));
-        } else {
-            r = (lr + csym(s, &L[0], &c->rn_same, E(((rec[14] & 15) - lr - 2) & 15)) + 2) & 15;
-        }
-        break;
-    default: break;
+    if ((cv & 3) == 1) r = (lr + 1) & 15;
+    if ((cv & 3) == 2) r = (lr + 15) & 15;
+    if ((cv & 3) == 3 && (cv & 16)) {
+        if (!(m = lazy(s, &c->rnum[lr], 16))) return HD_ENOMEM;
+        r = csym(s, &s->L[0], m, E(rec[14] & 15));
+    } else if ((cv & 3) == 3) {
+        r = (lr + csym(s, &s->L[0], &c->rn_same, E(((rec[14] & 15) - lr - 2) & 15)) + 2) & 15;
     }
-    unsigned mi = (unsigned)hd__laz_rmap14[n][r] << 1 | gps, l = hd__laz_level(n, r), cpr = (r == 1) + 2 * (r >= n);
-    int32_t X = i32(last), Y = i32(last + 4), Z = i32(last + 8);
-    int32_t dx = cint(s, &L[0], &c->dx, c->mx[mi].v[2], E((int32_t)((uint32_t)i32(rec) - (uint32_t)X)), n == 1);
+    last[14] = (unsigned char)(r | n << 4);
+    return HD_OK;
+}
+
+/* x and y (layer 0), z (layer 1, when it has bytes) into c->last. */
+static void p14_xyz(c14_t *s, ch_t *c, const unsigned char *rec, unsigned gps) {
+    unsigned char *last = c->last;
+    unsigned n = last[14] >> 4, r = last[14] & 15;
+    unsigned mi = (unsigned)hd__laz_rmap14[n][r] << 1 | gps, l = hd__laz_level(n, r);
+    uint32_t X = hd__ld_u32(last, 0), Y = hd__ld_u32(last + 4, 0);
+    int32_t dx = cint(s, &s->L[0], &c->dx, c->mx[mi].v[2], E((int32_t)(hd__ld_u32(rec, 0) - X)), n == 1);
     hd__median5_add(&c->mx[mi], dx);
-    int32_t dy = cint(s, &L[0], &c->dy, c->my[mi].v[2], E((int32_t)((uint32_t)i32(rec + 4) - (uint32_t)Y)),
+    int32_t dy = cint(s, &s->L[0], &c->dy, c->my[mi].v[2], E((int32_t)(hd__ld_u32(rec + 4, 0) - Y)),
                       (n == 1) + hd__laz_kctx(c->dx.k, 20));
     hd__median5_add(&c->my[mi], dy);
-    X = (int32_t)((uint32_t)X + (uint32_t)dx);
-    Y = (int32_t)((uint32_t)Y + (uint32_t)dy);
-    if (L[1].on) {
-        Z = cint(s, &L[1], &c->dz, c->last_z[l], E(i32(rec + 8)), (n == 1) + hd__laz_kctx((c->dx.k + c->dy.k) / 2, 18));
+    st32(last, X + (uint32_t)dx);
+    st32(last + 4, Y + (uint32_t)dy);
+    if (s->L[1].on) {
+        int32_t Z = cint(s, &s->L[1], &c->dz, c->last_z[l], E(i32(rec + 8)), (n == 1) + hd__laz_kctx((c->dx.k + c->dy.k) / 2, 18));
         c->last_z[l] = Z;
+        st32(last + 8, (uint32_t)Z);
     }
-    unsigned cls = last[16], lf = ((last[15] >> 2) & 0x30) | (last[15] & 15), f = lf, ud = last[17];
-    if (L[2].on) {
-        if (!(m = lazy(s, &c->cls[((last[16] & 31) << 1) + (cpr == 3)], 256))) return HD_ENOMEM;
-        cls = csym(s, &L[2], m, E(rec[16]));
-        L[2].changed |= cls != last[16];
-    }
-    if (L[3].on) {
-        if (!(m = lazy(s, &c->flags[lf], 64))) return HD_ENOMEM;
-        f = csym(s, &L[3], m, E(((rec[15] >> 2) & 0x30u) | (rec[15] & 15u)));
-        L[3].changed |= f != lf;
-    }
-    unsigned inten = u16(last + 12), scan = u16(last + 18), ps = u16(last + 20);
-    if (L[4].on) {
-        unsigned q = cpr << 1 | gps;
-        inten = (uint16_t)cint(s, &L[4], &c->inten, c->last_int[q], E(u16(rec + 12)), cpr);
-        c->last_int[q] = (uint16_t)inten;
-        L[4].changed |= inten != u16(last + 12);
-    }
-    if (L[5].on && (cv & 8)) {
-        scan = (uint16_t)cint(s, &L[5], &c->scan, (int32_t)scan, E(u16(rec + 18)), gps);
-        L[5].changed = 1;
-    }
-    if (L[6].on) {
-        if (!(m = lazy(s, &c->user[last[17] / 4], 256))) return HD_ENOMEM;
-        ud = csym(s, &L[6], m, E(rec[17]));
-        L[6].changed |= ud != last[17];
-    }
-    if (L[7].on && (cv & 32)) {
-        ps = (uint16_t)cint(s, &L[7], &c->psid, (int32_t)ps, E(u16(rec + 20)), 0);
-        L[7].changed = 1;
-    }
-    if (L[8].on && gps) {
-        if (gps_code(s, c, &L[8], E(u64(rec + 22)))) return HD_EFORMAT;
-        st64(last + 22, c->gt[c->glast]);
-        L[8].changed = 1;
-    }
-    st32(last, (uint32_t)X);
-    st32(last + 4, (uint32_t)Y);
-    st32(last + 8, (uint32_t)Z);
-    st16(last + 12, inten);
-    last[14] = (unsigned char)(r | n << 4);
+}
+
+/* A byte field of layer k by a model of slots[ctx] (n symbols) into *v;
+ * `now` the encoder's value.  HD_OK or HD_ENOMEM. */
+static int p14_byte(c14_t *s, unsigned k, hd__symmodel_t **slots, unsigned ctx, uint32_t n, unsigned now, unsigned *v) {
+    hd__symmodel_t *m;
+    if (!s->L[k].on) return HD_OK;
+    if (!(m = lazy(s, &slots[ctx], n))) return HD_ENOMEM;
+    unsigned was = *v;
+    *v = csym(s, &s->L[k], m, now);
+    s->L[k].changed |= *v != was;
+    return HD_OK;
+}
+
+/* Classification, flags, intensity, scan angle, user data, point source
+ * into c->last (layers 2-7, those with bytes).  HD_OK or HD_ENOMEM. */
+static int p14_attributes(c14_t *s, ch_t *c, const unsigned char *rec, uint32_t cv) {
+    unsigned char *last = c->last;
+    unsigned n = last[14] >> 4, r = last[14] & 15, gps = (cv >> 4) & 1, cpr = (r == 1) + 2 * (r >= n);
+    unsigned cls = last[16], f = ((last[15] >> 2) & 0x30) | (last[15] & 15), ud = last[17];
+    int rc = p14_byte(s, 2, c->cls, ((cls & 31) << 1) + (cpr == 3), 256, E(rec[16]), &cls);
+    rc = rc ? rc : p14_byte(s, 3, c->flags, f, 64, E(((rec[15] >> 2) & 0x30u) | (rec[15] & 15u)), &f);
+    rc = rc ? rc : p14_byte(s, 6, c->user, ud / 4, 256, E(rec[17]), &ud);
+    if (rc) return rc;
     last[15] = (unsigned char)((f & 15) | (f & 0x30) << 2 | s->cur << 4);
     last[16] = (unsigned char)cls;
     last[17] = (unsigned char)ud;
-    st16(last + 18, scan);
-    st16(last + 20, ps);
-    c->gps_change = (int)gps;
-    if (!s->enc) memcpy(rec, last, 30);
-    else if (memcmp(rec, last, 30) != 0) return HD_EINVAL;
+    if (s->L[4].on) {
+        unsigned q = cpr << 1 | gps, inten = (uint16_t)cint(s, &s->L[4], &c->inten, c->last_int[q], E(u16(rec + 12)), cpr);
+        c->last_int[q] = (uint16_t)inten;
+        s->L[4].changed |= inten != u16(last + 12);
+        st16(last + 12, inten);
+    }
+    if (s->L[5].on && (cv & 8)) {
+        st16(last + 18, (uint16_t)cint(s, &s->L[5], &c->scan, u16(last + 18), E(u16(rec + 18)), gps));
+        s->L[5].changed = 1;
+    }
+    if (s->L[7].on && (cv & 32)) {
+        st16(last + 20, (uint16_t)cint(s, &s->L[7], &c->psid, u16(last + 20), E(u16(rec + 20)), 0));
+        s->L[7].changed = 1;
+    }
+    return HD_OK;
+}
+
+/* The POINT14 record of the next point into rec (decoding) or from it
+ * (encoding), its channel's last record updated field by field (each
+ * field's context depends on its own last value and the point's returns
+ * and GPS change only).  HD_OK, HD_ENOMEM, HD_EFORMAT (GPS sequences),
+ * HD_EINVAL (encoding: the record would not decode back to itself). */
+static int point14(c14_t *s, unsigned char *rec) {
+    uint32_t cv;
+    int rc = p14_changed(s, rec, &cv);
+    ch_t *c = &s->ch[s->cur];
+    rc = rc ? rc : p14_returns(s, c, rec, cv);
+    if (rc) return rc;
+    p14_xyz(s, c, rec, (cv >> 4) & 1);
+    if ((rc = p14_attributes(s, c, rec, cv))) return rc;
+    if (s->L[8].on && (cv & 16)) {
+        if (gps_code(s, c, &s->L[8], E(u64(rec + 22)))) return HD_EFORMAT;
+        st64(c->last + 22, c->gt[c->glast]);
+        s->L[8].changed = 1;
+    }
+    c->gps_change = (cv >> 4) & 1;
+    if (!s->enc) memcpy(rec, c->last, 30);
+    else if (memcmp(rec, c->last, 30) != 0) return HD_EINVAL;
     return HD_OK;
 }
 
