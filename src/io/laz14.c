@@ -793,72 +793,78 @@ static const char *layer_name(const c14_t *s, unsigned k, char buf[32]) {
     return buf;
 }
 
+/* A chunk's header after its first record: its point count (the table's
+ * n), its layer sizes, which fill the chunk exactly; each layer's decoder
+ * started.  HD_OK or HD_EFORMAT with msg and *at. */
+static int layers_start(c14_t *s, const unsigned char *b, size_t nb, size_t n, size_t rec, char *msg, size_t len,
+                        size_t *at) {
+    size_t head = rec + 4 + 4 * (size_t)s->nl, pos = head;
+    if (nb < head) {
+        snprintf(msg, len, "chunk of %zu bytes is shorter than its first point and layer sizes (%zu bytes)", nb, head);
+        return HD_EFORMAT;
+    }
+    if (hd__ld_u32(b + rec, 0) != n) {
+        *at = rec;
+        snprintf(msg, len, "the chunk says it holds %u points, the chunk table %zu", hd__ld_u32(b + rec, 0), n);
+        return HD_EFORMAT;
+    }
+    for (unsigned k = 0; k < s->nl; k++) {
+        size_t sz = hd__ld_u32(b + rec + 4 + 4 * (size_t)k, 0);
+        if (sz > nb - pos) {
+            *at = rec + 4 + 4 * (size_t)k;
+            snprintf(msg, len, "the chunk's layer %u of %u runs past its end", k + 1, s->nl);
+            return HD_EFORMAT;
+        }
+        s->L[k].on = sz > 0 || k == 0; /* x/y is always decoded */
+        s->L[k].size = sz;
+        hd__dec_init(&s->L[k].d, b + pos, sz);
+        pos += sz;
+    }
+    if (pos != nb) {
+        *at = rec + 4;
+        snprintf(msg, len, "the chunk's layers fill only %zu of the %zu bytes after its header", pos - head, nb - head);
+        return HD_EFORMAT;
+    }
+    return HD_OK;
+}
+
+/* Layer k's decoder ran past its bytes (ends: at the end, too, it must
+ * stop exactly at its last byte; see laz.c's stream_end).  HD_OK or
+ * HD_EFORMAT with msg and *at. */
+static int layer_check(c14_t *s, unsigned k, const unsigned char *b, size_t n, int ends, char *msg, size_t len,
+                       size_t *at) {
+    const hd__dec_t *d = &s->L[k].d;
+    char buf[32];
+    if (!ends && d->over <= 4) return HD_OK;
+    if (ends && !d->over && d->p == d->end) return HD_OK;
+    *at = (size_t)(d->end - b);
+    snprintf(msg, len, "the chunk's %s layer %s after its %zu point%s", layer_name(s, k, buf),
+             d->over ? "ends before the decoder stops" : "has bytes left", n, n == 1 ? "" : "s");
+    return HD_EFORMAT;
+}
+
 int hd__laz14_decode(const unsigned char *b, size_t nb, size_t n, size_t rec, const hd__laz14_items_t *it,
                      unsigned char *recs, char *msg, size_t len, size_t *at) {
     c14_t s;
     *at = 0;
-    int rc;
     if (nb < rec) {
         snprintf(msg, len, "chunk of %zu bytes is shorter than its first point's %zu bytes", nb, rec);
         return HD_EFORMAT;
     }
     memcpy(recs, b, rec);
-    rc = c14_start(&s, it, b, 0);
+    int rc = c14_start(&s, it, b, 0);
     if (rc) snprintf(msg, len, "out of memory");
-    size_t head = rec + 4 + 4 * (size_t)s.nl;
-    if (rc == HD_OK && nb < head) {
-        snprintf(msg, len, "chunk of %zu bytes is shorter than its first point and layer sizes (%zu bytes)", nb, head);
-        rc = HD_EFORMAT;
-    }
-    if (rc == HD_OK && hd__ld_u32(b + rec, 0) != n) {
-        *at = rec;
-        snprintf(msg, len, "the chunk says it holds %u points, the chunk table %zu", hd__ld_u32(b + rec, 0), n);
-        rc = HD_EFORMAT;
-    }
-    size_t pos = head;
-    for (unsigned k = 0; rc == HD_OK && k < s.nl; k++) {
-        size_t sz = hd__ld_u32(b + rec + 4 + 4 * (size_t)k, 0);
-        if (sz > nb - pos) {
-            *at = rec + 4 + 4 * (size_t)k;
-            snprintf(msg, len, "the chunk's layer %u of %u runs past its end", k + 1, s.nl);
-            rc = HD_EFORMAT;
-            break;
-        }
-        s.L[k].on = sz > 0 || k == 0;
-        s.L[k].size = sz;
-        hd__dec_init(&s.L[k].d, b + pos, sz);
-        pos += sz;
-    }
-    if (rc == HD_OK && pos != nb) {
-        *at = rec + 4;
-        snprintf(msg, len, "the chunk's layers fill only %zu of the %zu bytes after its header", pos - head, nb - head);
-        rc = HD_EFORMAT;
-    }
+    else rc = layers_start(&s, b, nb, n, rec, msg, len, at);
     for (size_t i = 1; rc == HD_OK && i < n; i++) {
         rc = c14_point(&s, recs + i * rec);
         if (rc == HD_EFORMAT) snprintf(msg, len, "point %zu: the GPS time switches sequence more than three times", i + 1);
         if (rc == HD_ENOMEM) snprintf(msg, len, "out of memory");
-        for (unsigned k = 0; rc == HD_OK && k < s.nl; k++)
-            if (s.L[k].d.over > 4) {
-                char buf[32];
-                *at = (size_t)(s.L[k].d.end - b);
-                snprintf(msg, len, "the chunk's %s layer ends before its %zu points", layer_name(&s, k, buf), n);
-                rc = HD_EFORMAT;
-            }
+        for (unsigned k = 0; rc == HD_OK && k < s.nl; k++) rc = layer_check(&s, k, b, n, 0, msg, len, at);
     }
-    /* every layer with bytes is used up exactly (see laz.c's stream_end);
-     * so is the x/y layer of a chunk of more than one point */
-    for (unsigned k = 0; rc == HD_OK && k < s.nl; k++) {
-        const hd__dec_t *d = &s.L[k].d;
-        char buf[32];
-        if (s.L[k].size == 0 && !(k == 0 && n > 1)) continue;
-        if (d->over || d->p != d->end) {
-            *at = (size_t)(d->end - b);
-            snprintf(msg, len, "the chunk's %s layer %s after its %zu point%s", layer_name(&s, k, buf),
-                     d->over ? "ends before the decoder stops" : "has bytes left", n, n == 1 ? "" : "s");
-            rc = HD_EFORMAT;
-        }
-    }
+    /* every layer with bytes is used up exactly, and so is the x/y layer of
+     * a chunk of more than one point */
+    for (unsigned k = 0; rc == HD_OK && k < s.nl; k++)
+        if (s.L[k].size || (k == 0 && n > 1)) rc = layer_check(&s, k, b, n, 1, msg, len, at);
     c14_free(&s);
     return rc;
 }
