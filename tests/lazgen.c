@@ -34,7 +34,8 @@
  * with K of 6-8 are layered LAZ whose every field varies
  * (lazwrite.c's lazw_rich_records14), compressed by the library's layered
  * encoder (src/io/laz14.c), or hd_write_fields's output on such a file
- * (_subset: the points whose first value is > 0.25, encoded again); their
+ * (_subset: the points whose first value is > 0.25, encoded again; without
+ * a field, its points may use every scanner channel); their
  * NAME.txt lines are whole records as above.
  */
 #include "files.h"
@@ -92,7 +93,8 @@ static void more_fields(double *v, size_t n, size_t nf) {
 }
 
 /* The input b saved as DIR/NAME-input.laz, hd_write_fields of the nf
- * fields of n values v (field j's at v + j * n) into DIR/NAME.laz (o: NULL
+ * fields of n values v (field j's at v + j * n; nf = 0: hd_write_field of
+ * v with o's name, "" for none) into DIR/NAME.laz (o: NULL
  * for the defaults), the input removed, and DIR/NAME.txt opened for the
  * expected lines. */
 static FILE *write_field_of(const char *dir, const char *name, const tf_buf_t *b, const double *v, size_t n,
@@ -108,7 +110,7 @@ static FILE *write_field_of(const char *dir, const char *name, const tf_buf_t *b
     hd_error_t err;
     hd_field_t fields[3];
     for (size_t j = 0; j < nf; j++) fields[j].name = field_names[j], fields[j].values = v + j * n;
-    if (hd_write_fields(in, out, fields, nf, n, o, NULL, &err) != HD_OK) {
+    if ((nf ? hd_write_fields(in, out, fields, nf, n, o, NULL, &err) : hd_write_field(in, out, v, n, o, NULL, &err)) != HD_OK) {
         fprintf(stderr, "lazgen: %s\n", err.message);
         exit(1);
     }
@@ -205,11 +207,12 @@ static void record14_case(const char *dir, const char *name, int fmt, unsigned e
     tf_buf_t b = {0};
     lazw_layered(&b, fmt, extra, recs, rec, n, 1000, version);
     FILE *f;
-    if (nf) {
+    if (nf || subset) { /* nf = 0: the subset alone, no field added (write option name "") */
         hd_write_options_t o;
         hd_write_options_init(&o);
         o.keep = subset ? HD_KEEP_FARTHER : HD_KEEP_ALL;
         o.threshold = 0.25;
+        if (!nf) o.name = "";
         f = write_field_of(dir, name, &b, v, n, nf, &o);
     } else {
         if (save(dir, name, &b)) exit(1);
@@ -414,6 +417,7 @@ int main(int argc, char **argv) {
     record14_case(argv[1], "record_format8_v3", 8, 0, 0, 3, 0, 602, 3001, 0);
     record14_case(argv[1], "record_format8_extra2_v4", 8, 2, 0, 4, 0, 603, 2500, 0);
     record14_case(argv[1], "record_format6_extra1_subset", 6, 1, 0, 3, 1, 610, 3001, 1);
+    record14_case(argv[1], "record_format6_channels_subset", 6, 0, 1, 4, 1, 612, 3001, 0);
     record14_case(argv[1], "record_format7_fields2_subset", 7, 0, 0, 4, 1, 611, 3001, 2);
     return 0;
 }
