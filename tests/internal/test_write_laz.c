@@ -484,6 +484,44 @@ TEST(layered_laz_subsets_of_one_point_and_of_none) {
     free(recs);
 }
 
+TEST(layered_laz_subsets_are_the_same_file_on_any_thread_count) {
+    gen_rng_t g;
+    gen_seed(&g, 47);
+    size_t n = 9001, rec;
+    unsigned char *recs = lazw_rich_records14(&g, 7, 1, n, &rec, 1);
+    tf_buf_t b = {0};
+    lazw_layered(&b, 7, 1, recs, rec, n, 400, 3); /* 23 chunks: several batches of any thread count */
+    const char *in = tf_finish(&b, "rich14_threads.laz");
+    double *v = malloc(n * sizeof *v);
+    for (size_t k = 0; k < n; k++) v[k] = gen_normal(&g);
+    hd_read_options_t r;
+    hd_read_options_init(&r);
+    hd_write_options_t o;
+    hd_write_options_init(&o);
+    o.keep = HD_KEEP_FARTHER;
+    o.read = &r;
+    hd_error_t err;
+    unsigned char *first = NULL;
+    size_t first_size = 0;
+    static const int threads[] = {1, 2, 3, 8};
+    for (int t = 0; t < 4; t++) {
+        CONTEXT("threads %d", threads[t]);
+        r.threads = threads[t];
+        CHECK_RC(hd_write_field(in, tf_path("rich14_threads_out.laz"), v, n, &o, NULL, &err), HD_OK);
+        size_t size;
+        unsigned char *d = tf_read(tf_path("rich14_threads_out.laz"), &size);
+        if (!first) {
+            first = d, first_size = size;
+            continue;
+        }
+        CHECK(size == first_size && memcmp(d, first, size) == 0);
+        free(d);
+    }
+    free(first);
+    free(v);
+    free(recs);
+}
+
 TEST(layered_laz_damaged_layers_are_errors_with_offsets) {
     gen_rng_t g;
     gen_seed(&g, 41);
