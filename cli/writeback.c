@@ -92,19 +92,6 @@ static const char *output(const analysis_args_t *an, int k, int w, const char *p
     return out;
 }
 
-/* The point format of a LAZ file whose point records are layered (6-10),
- * from its header; -1 for any other or an unreadable file (its read says
- * why). */
-static int layered_laz_format(const char *path) {
-    unsigned char h[105];
-    FILE *f = fopen(path, "rb");
-    size_t got = f ? fread(h, 1, sizeof h, f) : 0;
-    if (f) fclose(f);
-    if (got < sizeof h || memcmp(h, "LASF", 4) != 0) return -1;
-    int fmt = h[104] & 0x3f;
-    return fmt >= 6 && fmt <= 10 ? fmt : -1;
-}
-
 static int check_side(const analysis_args_t *an, int k, const char *out, const char *path, int w, hd_error_t *err) {
     const char *in = side_format(path, an->format[w], &an->read), *of = hd_format_of_path(out);
     const char *side = w ? "B" : "A";
@@ -125,12 +112,6 @@ static int check_side(const analysis_args_t *an, int k, const char *out, const c
                  "%s's extension%s",
                  what[k], out, side, path, in ? in : "no single file of a known format", out,
                  of ? of : "no format", side, k == 0 ? " (or .csv, .ply, .npy for the coordinates with their distances)" : "");
-    else if (k && strcmp(in, "laz") == 0 && layered_laz_format(path) >= 0)
-        snprintf(err->message, sizeof err->message,
-                 "%s %s: %s (%s) is a layered LAZ file (point format %d), whose subsets are not written (every field "
-                 "of every point would be compressed again); write it back whole with --distances OUT.laz, or the "
-                 "distances as .csv, .ply or .npy",
-                 what[k], out, side, path, layered_laz_format(path));
     else
         code = HD_OK;
     if (code) err->code = code;

@@ -20,6 +20,8 @@
  * vertices never more points than the input has bytes (no reader may
  * allocate more than the file can hold; a LAZ
  * chunk up to HD_LAZ_POINTS_PER_BYTE points per byte), sampled exactly the sample size.
+ * A LAZ file read also has its chunks decoded again to whole records
+ * (every field, every layer), which must agree with the points read.
  * After a success two more reads check the range contract: where the
  * header count answers it equals the count read, and a range read of the
  * middle third gives exactly that slice of the whole read, bit for bit.
@@ -37,6 +39,47 @@
 #define NAME "fuzz." HD_FUZZ_FORMAT
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
+
+#ifndef HD_FUZZ_SAMPLE
+/* A LAZ file read as points: its chunks decoded again to whole records,
+ * every field of every item (laz.c's hd__laz_chunk_records; every layer of
+ * layered LAZ, laz14.c), as the writers of subsets do.  Each chunk decodes
+ * or fails with a message; one that decodes gives, as doubles
+ * X * scale + offset, exactly the points the read gave. */
+static void laz_records(const uint8_t *data, size_t size, const hd_cloud_t *c) {
+    hd_read_options_t o;
+    hd_read_options_init(&o);
+    hd__file_t f = {NAME, data, size};
+    hd__sink_t sink;
+    hd__sink_init(&sink, HD_FLOAT64);
+    hd_error_t e;
+    hd__read_t r = {&f, &o, 1, &sink, NULL, 0, &e, 0, 0, 0};
+    hd__las_header_t h;
+    memset(&h, 0, sizeof h);
+    h.minor = data[25], h.fmt = data[104] & 63, h.header = hd__ld_u16(data + 94, 0), h.offset = hd__ld_u32(data + 96, 0);
+    h.n_vlr = hd__ld_u32(data + 100, 0), h.rec = hd__ld_u16(data + 105, 0), h.count = c->count;
+    hd__laz_chunks_t cs;
+    if (hd__laz_chunks(&r, &h, &cs) != HD_OK) return;
+    for (size_t k = 0; k < cs.n_chunks; k++) {
+        size_t n = (size_t)(cs.first[k + 1] - cs.first[k]);
+        unsigned char *recs = malloc((n + 1) * h.rec);
+        if (!recs) abort();
+        e.message[0] = 0;
+        int rc = hd__laz_chunk_records(&r, &h, &cs, k, recs);
+        if (rc != HD_OK && (rc == HD_EOVERFLOW || strncmp(e.message, NAME, strlen(NAME)) != 0)) abort();
+        for (size_t i = 0; rc == HD_OK && c->dtype == HD_FLOAT64 && i < n; i++)
+            for (int d = 0; d < 3; d++) {
+                double scale, shift, got = ((const double *)c->data)[3 * (cs.first[k] + i) + (size_t)d];
+                memcpy(&scale, data + 131 + 8 * d, 8);
+                memcpy(&shift, data + 155 + 8 * d, 8);
+                if ((double)(int32_t)hd__ld_u32(recs + i * h.rec + 4 * (size_t)d, 0) * scale + shift != got) abort();
+            }
+        free(recs);
+    }
+    hd__laz_chunks_free(&cs);
+    hd__sink_free(&sink);
+}
+#endif
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     hd_read_options_t o;
@@ -78,6 +121,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
         for (int d = 0; d < 3; d++)
             if (!isfinite(q[d]) || fabs(q[d]) > HD_MAX_COORD) abort();
     }
+#ifndef HD_FUZZ_SAMPLE
+    if (laz && size >= 227) laz_records(data, size, c);
+#endif
     uint64_t total;
     rc = hd__count_buffer(data, size, NAME, &o, &total, &e);
     if (rc == HD_OK ? total != c->count : rc != HD_EUNSUPPORTED) abort();

@@ -37,7 +37,8 @@ add_test(NAME cli_output
   COMMAND ${HD_CLI_IO_PYTHON} ${CMAKE_CURRENT_SOURCE_DIR}/tests/cli_output.py $<TARGET_FILE:hausdorff_cli>)
 set_tests_properties(cli_output PROPERTIES TIMEOUT 300)
 add_test(NAME cli_writeback
-  COMMAND ${HD_CLI_IO_PYTHON} ${CMAKE_CURRENT_SOURCE_DIR}/tests/cli_writeback.py $<TARGET_FILE:hausdorff_cli>)
+  COMMAND ${HD_CLI_IO_PYTHON} ${CMAKE_CURRENT_SOURCE_DIR}/tests/cli_writeback.py $<TARGET_FILE:hausdorff_cli>
+  $<TARGET_FILE:lazgen>)
 set_tests_properties(cli_writeback PROPERTIES TIMEOUT 300)
 add_test(NAME cli_tiles
   COMMAND ${HD_CLI_IO_PYTHON} ${CMAKE_CURRENT_SOURCE_DIR}/tests/cli_tiles.py $<TARGET_FILE:hausdorff_cli>)

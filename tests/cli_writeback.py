@@ -11,8 +11,13 @@ back equals it bit for bit (checked by parsers written here: text and PLY
 ascii lines, LAS extra bytes).  Mismatched formats, --sample, masks,
 are usage errors (exit 1) before
 anything is read; a file that cannot be written is exit 3 and leaves none.
-Standard library only; run as:  cli_writeback.py PATH/TO/hausdorff
+Layered LAZ subsets (formats 6-8) keep every record: the library's decoder
+of whole records (lazgen --records) gives the input fixture's records as
+laz-perf decoded them (tests/laz_lazperf/lazperf.txt) and the subset's as
+those records with their distances.
+Standard library only; run as:  cli_writeback.py PATH/TO/hausdorff PATH/TO/lazgen
 """
+import hashlib
 import json
 import os
 import resource
@@ -33,6 +38,8 @@ B = os.path.join(ROOT, "data", "teapot_792.ply")
 LAS = os.path.join(ROOT, "data", "orig", "Haystack_Rock.las")
 LAS_B = os.path.join(ROOT, "tests", "corpus", "las", "v14_fmt6.las")
 LAZ = os.path.join(ROOT, "tests", "corpus", "laz", "fmt6_channels.laz")
+LAZPERF_FIXTURES = os.path.join(ROOT, "tests", "laz_lazperf")
+LAZGEN = None
 TESTS = []
 
 
@@ -304,6 +311,56 @@ def laz_written_back_reads_back(tmp):
     assert rc2 == 0 and out2.splitlines()[2] == out3.splitlines()[2], (err2, out2, out3)  # h(A,B)
 
 
+def laz_records(path):
+    """Every whole record of a LAZ file as the library decodes it (every
+    field, every layer: lazgen --records)."""
+    p = subprocess.run([LAZGEN, "--records", path], capture_output=True, text=True, timeout=300)
+    assert p.returncode == 0, p.stderr
+    return [bytes.fromhex(l) for l in p.stdout.split()]
+
+
+def lazperf_digest(name):
+    """laz-perf's decoding of fixture NAME (tests/laz_lazperf/lazperf.txt):
+    its count and the SHA-256 of its records' hexadecimal lines."""
+    for line in open(os.path.join(LAZPERF_FIXTURES, "lazperf.txt")):
+        w = line.split()
+        if w and w[0] == name:
+            return int(w[1]), w[2]
+    raise AssertionError("no fixture " + name)
+
+
+@test
+def layered_laz_subsets_keep_every_record(tmp):
+    # inputs whose every field varies (POINT14's nine layers in four scanner
+    # channels; RGB14), as laz-perf decoded them
+    for name in ("record_format6_channels_v3", "record_format7_v4"):
+        a = os.path.join(LAZPERF_FIXTURES, name + ".laz")
+        recs = laz_records(a)
+        lines = "".join(r.hex() + "\n" for r in recs).encode()
+        assert (len(recs), hashlib.sha256(lines).hexdigest()) == lazperf_digest(name), name
+        rc, out, err = run("--directed", "--distances", tmp + "/t.csv", a, LAS_B)
+        assert rc == 0, err
+        d = table(tmp + "/t.csv")
+        D = sorted(d)[len(d) // 2]
+        rc, out, err = run("--directed", "--json", "--farther-than", str(D), tmp + "/far.laz", "--nearer-than", str(D),
+                           tmp + "/near.laz", a, LAS_B)
+        assert rc == 0, err
+        j = json.loads(out)
+        for part, keep in (("far", lambda x: x > D), ("near", lambda x: x <= D)):
+            path = tmp + "/" + part + ".laz"
+            want = [recs[k] + struct.pack("<d", d[k]) for k in range(len(d)) if keep(d[k])]
+            got = laz_records(path)
+            assert got == want, (name, part, len(got), len(want))
+            data = open(path, "rb").read()
+            assert struct.unpack_from("<Q", data, 247)[0] == len(want), (name, part)
+            key = "farther_than" if part == "far" else "nearer_than"
+            assert j[key]["a"]["points"] == len(want), (name, j[key])
+            # the project's reader (the x/y and z layers) reads the subset back
+            rc, out, err = run("--directed", "--distances", tmp + "/" + part + ".csv", path, LAS_B)
+            assert rc == 0, err
+            assert table(tmp + "/" + part + ".csv") == [x for x in d if keep(x)], (name, part)
+
+
 @test
 def mismatches_are_usage_errors_before_reading(tmp):
     cases = [
@@ -315,8 +372,6 @@ def mismatches_are_usage_errors_before_reading(tmp):
         (["--farther-than", "x", tmp + "/o.ply", A, B], "needs a distance >= 0"),
         (["--farther-than", "1", tmp + "/o.dat", A, B], "cannot tell the format of"),
         (["--farther-than", "1"], "needs a distance and a file"),
-        (["--directed", "--nearer-than", "1", tmp + "/o.laz", LAZ, B],
-         "is a layered LAZ file (point format 6), whose subsets are not written"),
         (["--surface", "--farther-than", "1", tmp + "/o.las", A, B], "A (%s) is ply, %s/o.las is las" % (A, tmp)),
     ]
     for args, needle in cases:
@@ -354,8 +409,9 @@ def a_field_already_there_is_refused(tmp):
 
 
 def main():
-    global TOOL
+    global TOOL, LAZGEN
     TOOL = os.path.abspath(sys.argv[1])
+    LAZGEN = os.path.abspath(sys.argv[2])
     passed = failed = 0
     for fn in TESTS:
         tmp = tempfile.mkdtemp(prefix="hd-writeback-")

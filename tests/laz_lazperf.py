@@ -19,7 +19,10 @@ lazperf.txt: the number of points and the SHA-256 of their "X Y Z" lines.
 offline  (make test; no network): LAZGEN writes its cases into WORKDIR; each
          must be byte for byte the fixture laz-perf decoded, and the points
          the writer was given must be laz-perf's decoding of it.  So the
-         cross-check still holds for the writer as it is now.  A change to
+         cross-check still holds for the writer as it is now.  And the
+         library's decoder of whole records (LAZGEN --records: every field
+         of every item, every layer of layered LAZ) must give each
+         fixture's records as laz-perf decoded them.  A change to
          the writer's output fails here until `npm ... --update` has had
          laz-perf decode the new files.
 npm      (the extra, where node, npm and the npm registry are reachable):
@@ -115,6 +118,39 @@ def offline(lazgen, fixtures, work):
              "`tests/laz_lazperf.py npm LAZGEN tests/laz_lazperf WORKDIR --update` where npm is reachable"
              % (bad, len(names)))
     print("laz_lazperf: %d files as laz-perf (%s) decoded them" % (len(names), LAZPERF))
+    # The library's own decoder of whole records (every field, every layer)
+    # gives each fixture's records as laz-perf decoded them.
+    for name in names:
+        got = library_lines(lazgen, os.path.join(fixtures, name + ".laz"), name)
+        if got is None or digest(got) != want[name]:
+            print("%s: the library decodes %s, laz-perf decoded %d points (sha256 %s)"
+                  % (name, "nothing" if got is None else "%d points (sha256 %s)" % digest(got), want[name][0], want[name][1]))
+            bad += 1
+    if bad:
+        fail("%d of %d fixtures are decoded by the library otherwise than by laz-perf" % (bad, len(names)))
+    print("laz_lazperf: %d fixtures' whole records decoded by the library as by laz-perf" % len(names))
+
+
+def library_lines(lazgen, path, name):
+    """The library's decoding of PATH's whole records (lazgen --records) as
+    the lines of case NAME (see lazperf.txt), or None after saying why."""
+    r = subprocess.run([lazgen, "--records", path], capture_output=True, text=True)
+    if r.returncode != 0:
+        print("%s: %s" % (path, r.stderr.strip()[-500:]))
+        return None
+    recs = [bytes.fromhex(l) for l in r.stdout.split()]
+    if name.startswith("record_"):
+        return [b.hex() for b in recs]
+    fields = re.match(r"fields(\d+)_", name)
+    nf = int(fields.group(1)) if fields else 1 if name.startswith("field_") else 0
+    out = []
+    for b in recs:
+        line = "%d %d %d" % tuple(int.from_bytes(b[4 * c:4 * c + 4], "little", signed=True) for c in range(3))
+        for j in range(nf):
+            end = len(b) - 8 * (nf - j)
+            line += " %016x" % int.from_bytes(b[end:end + 8], "little")
+        out.append(line)
+    return out
 
 
 def install_lazperf(work):

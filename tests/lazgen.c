@@ -12,6 +12,11 @@
  *
  * writes the fuzz target's seed files (tests/corpus/laz/, committed).
  *
+ *   lazgen --records FILE
+ *
+ * prints every whole record of a LAZ file as the library decodes it (every
+ * field of every item, every layer), one line of hexadecimal each.
+ *
  * The cases named field_* are the output of hd_write_fields (the library's
  * LAZ writer) on a file of the tests' writer whose points all lie in
  * scanner channel 0, with seeded values: their NAME.txt lines are
@@ -25,7 +30,13 @@
  * whose every field varies (tests/internal/lazwrite.c's lazw_pointwise),
  * all points or those whose first value is > 0.25: their NAME.txt lines
  * are each written record in hexadecimal, byte by byte, the values' eight
- * bytes each last (_fieldsN: N of them).
+ * bytes each last (_fieldsN: N of them).  The cases named record_formatK_*
+ * with K of 6-8 are layered LAZ whose every field varies
+ * (lazwrite.c's lazw_rich_records14), compressed by the library's layered
+ * encoder (src/io/laz14.c), or hd_write_fields's output on such a file
+ * (_subset: the points whose first value is > 0.25, encoded again; without
+ * a field, its points may use every scanner channel); their
+ * NAME.txt lines are whole records as above.
  */
 #include "files.h"
 #include "gen.h"
@@ -82,7 +93,8 @@ static void more_fields(double *v, size_t n, size_t nf) {
 }
 
 /* The input b saved as DIR/NAME-input.laz, hd_write_fields of the nf
- * fields of n values v (field j's at v + j * n) into DIR/NAME.laz (o: NULL
+ * fields of n values v (field j's at v + j * n; nf = 0: hd_write_field of
+ * v with o's name, "" for none) into DIR/NAME.laz (o: NULL
  * for the defaults), the input removed, and DIR/NAME.txt opened for the
  * expected lines. */
 static FILE *write_field_of(const char *dir, const char *name, const tf_buf_t *b, const double *v, size_t n,
@@ -98,7 +110,7 @@ static FILE *write_field_of(const char *dir, const char *name, const tf_buf_t *b
     hd_error_t err;
     hd_field_t fields[3];
     for (size_t j = 0; j < nf; j++) fields[j].name = field_names[j], fields[j].values = v + j * n;
-    if (hd_write_fields(in, out, fields, nf, n, o, NULL, &err) != HD_OK) {
+    if ((nf ? hd_write_fields(in, out, fields, nf, n, o, NULL, &err) : hd_write_field(in, out, v, n, o, NULL, &err)) != HD_OK) {
         fprintf(stderr, "lazgen: %s\n", err.message);
         exit(1);
     }
@@ -158,6 +170,56 @@ static void record_case(const char *dir, const char *name, int fmt, unsigned ext
     o.keep = subset ? HD_KEEP_FARTHER : HD_KEEP_ALL;
     o.threshold = 0.25;
     FILE *f = write_field_of(dir, name, &b, v, n, nf, &o);
+    for (size_t k = 0; k < n; k++) {
+        if (subset && !(v[k] > 0.25)) continue;
+        for (size_t i = 0; i < rec; i++) fprintf(f, "%02x", recs[k * rec + i]);
+        for (size_t j = 0; j < nf; j++) {
+            unsigned char val[8];
+            memcpy(val, &v[j * n + k], 8);
+            for (int i = 0; i < 8; i++) fprintf(f, "%02x", val[i]);
+        }
+        fputc('\n', f);
+    }
+    if (fclose(f)) exit(1);
+    printf("%s\n", name);
+    tf_free(&b);
+    free(recs);
+    free(v);
+}
+
+static int save(const char *dir, const char *name, const tf_buf_t *b);
+
+/* The layered record case NAME: records of LAS 1.4 format fmt whose every
+ * field varies (channels switching when `channels`), compressed by the
+ * library's layered encoder with items of `version`; with nf = 0 that file
+ * is the case, else hd_write_fields's output on it (all points, or those
+ * whose first value is > 0.25 when `subset`). */
+static void record14_case(const char *dir, const char *name, int fmt, unsigned extra, int channels, unsigned version,
+                          int subset, uint64_t seed, size_t n, size_t nf) {
+    gen_rng_t g;
+    gen_seed(&g, seed);
+    size_t rec;
+    unsigned char *recs = lazw_rich_records14(&g, fmt, extra, n, &rec, channels);
+    double *v = malloc((nf ? nf : 1) * n * sizeof *v);
+    if (!recs || !v) exit(1);
+    for (size_t k = 0; k < n; k++) v[k] = k % 4 ? gen_normal(&g) : 0.5;
+    more_fields(v, n, nf);
+    tf_buf_t b = {0};
+    lazw_layered(&b, fmt, extra, recs, rec, n, 1000, version);
+    FILE *f;
+    if (nf || subset) { /* nf = 0: the subset alone, no field added (write option name "") */
+        hd_write_options_t o;
+        hd_write_options_init(&o);
+        o.keep = subset ? HD_KEEP_FARTHER : HD_KEEP_ALL;
+        o.threshold = 0.25;
+        if (!nf) o.name = "";
+        f = write_field_of(dir, name, &b, v, n, nf, &o);
+    } else {
+        if (save(dir, name, &b)) exit(1);
+        char path[4096];
+        snprintf(path, sizeof path, "%s/%s.txt", dir, name);
+        if (!(f = fopen(path, "w"))) exit(1);
+    }
     for (size_t k = 0; k < n; k++) {
         if (subset && !(v[k] > 0.25)) continue;
         for (size_t i = 0; i < rec; i++) fprintf(f, "%02x", recs[k * rec + i]);
@@ -251,13 +313,29 @@ static int seeds(const char *dir) {
     write_case(dir, "fmt1_variable", &o, 5, 30, 0);
     o.format = 3, o.extra = 1, o.v1 = 1;
     write_case(dir, "fmt3_laszip1_extra1", &o, 6, 30, 0);
+    /* layered, every field varying in all four channels: colour, NIR and
+     * extra bytes, items of version 3 (the writers' whole-record decoder) */
+    gen_rng_t g;
+    gen_seed(&g, 7);
+    size_t rec;
+    unsigned char *recs = lazw_rich_records14(&g, 8, 2, 50, &rec, 1);
+    tf_buf_t rb = {0};
+    lazw_layered(&rb, 8, 2, recs, rec, 50, 20, 3);
+    int rc0 = save(dir, "fmt8_every_field_extra2", &rb);
+    tf_free(&rb);
+    free(recs);
+    recs = lazw_rich_records14(&g, 10, 0, 40, &rec, 1); /* and wave packets (WAVEPACKET14), version 4 */
+    lazw_layered(&rb, 10, 0, recs, rec, 40, 20, 4);
+    rc0 |= save(dir, "fmt10_every_field", &rb);
+    tf_free(&rb);
+    free(recs);
     /* one point repeated: over 64 points per byte, the reader's growing path */
     static lazw_point_t same[40000];
     for (size_t k = 0; k < 40000; k++) same[k] = (lazw_point_t){1, 2, 3, 1, 1, 0};
     lazw_opts_t r = {0, 0, 40000, NULL, 0, {0.5, 0.5, 0.5}, {0, 0, 0}, 0};
     tf_buf_t b = {0};
     lazw_encode(&b, &r, same, 40000);
-    int rc = save(dir, "fmt0_repeated_point", &b);
+    int rc = rc0 | save(dir, "fmt0_repeated_point", &b);
     tf_free(&b);
     /* a million copies of one point in one chunk, about 500 a byte: denser
      * than the reader's default limit (--laz-points-per-byte raises it) */
@@ -270,8 +348,31 @@ static int seeds(const char *dir) {
     return rc | lies(dir);
 }
 
+/* lazgen --records FILE: every whole record of the LAZ file as the
+ * library decodes it (every field, every layer), one line of hexadecimal
+ * each; 1 with the error when it is refused. */
+static int records(const char *path) {
+    size_t size, n, rec;
+    unsigned char *d = tf_read(path, &size);
+    hd_error_t err;
+    unsigned char *r = d ? lazw_decode_records(path, d, size, &n, &rec, &err) : NULL;
+    if (!r) {
+        fprintf(stderr, "lazgen: %s: %s\n", path, d ? err.message : "cannot read");
+        free(d);
+        return 1;
+    }
+    for (size_t k = 0; k < n; k++) {
+        for (size_t i = 0; i < rec; i++) printf("%02x", r[k * rec + i]);
+        putchar('\n');
+    }
+    free(r);
+    free(d);
+    return 0;
+}
+
 int main(int argc, char **argv) {
     if (argc == 3 && strcmp(argv[1], "--seeds") == 0) return seeds(argv[2]);
+    if (argc == 3 && strcmp(argv[1], "--records") == 0) return records(argv[2]);
     if (argc != 2) {
         fprintf(stderr, "usage: lazgen DIR | lazgen --seeds DIR\n");
         return 2;
@@ -306,5 +407,17 @@ int main(int argc, char **argv) {
     record_case(argv[1], "record_format0_extra0_subset", 0, 0, 1, 503, 2500, 1);
     record_case(argv[1], "record_format1_extra0_fields3", 1, 0, 0, 510, 2500, 3);
     record_case(argv[1], "record_format3_extra1_fields2_subset", 3, 1, 1, 511, 3001, 2);
+    /* layered, every layer.  laz-perf 0.0.7 hands the RGB14, RGBNIR14 and
+     * BYTE14 decoders channel 0 except at a point where the channel
+     * changes, so colours, extra bytes and fields go with channel 0; the
+     * nine POINT14 layers switch channels */
+    record14_case(argv[1], "record_format6_channels_v3", 6, 0, 1, 3, 0, 600, 3001, 0);
+    record14_case(argv[1], "record_format6_channels_v4", 6, 0, 1, 4, 0, 604, 3001, 0);
+    record14_case(argv[1], "record_format7_v4", 7, 0, 0, 4, 0, 601, 3001, 0);
+    record14_case(argv[1], "record_format8_v3", 8, 0, 0, 3, 0, 602, 3001, 0);
+    record14_case(argv[1], "record_format8_extra2_v4", 8, 2, 0, 4, 0, 603, 2500, 0);
+    record14_case(argv[1], "record_format6_extra1_subset", 6, 1, 0, 3, 1, 610, 3001, 1);
+    record14_case(argv[1], "record_format6_channels_subset", 6, 0, 1, 4, 1, 612, 3001, 0);
+    record14_case(argv[1], "record_format7_fields2_subset", 7, 0, 0, 4, 1, 611, 3001, 2);
     return 0;
 }

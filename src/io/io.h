@@ -225,8 +225,9 @@ void hd__laz_chunks_free(hd__laz_chunks_t *c);
  * (its point count of them), from decoding its x/y layer. */
 int hd__laz_chunk_channels(hd__read_t *r, const hd__las_header_t *h, const hd__laz_chunks_t *c, size_t chunk,
                            unsigned char *chan);
-/* Every whole record of pointwise chunk `chunk` (items of version 2) into
- * recs (its point count times the record length). */
+/* Every whole record of chunk `chunk` (pointwise: items of version 2;
+ * layered: every layer, laz14.c) into recs (its point count times the
+ * record length). */
 int hd__laz_chunk_records(hd__read_t *r, const hd__las_header_t *h, const hd__laz_chunks_t *c, size_t chunk,
                           unsigned char *recs);
 

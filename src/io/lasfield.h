@@ -53,6 +53,9 @@ int hd__laz_table_encode(int variable, size_t nc, const uint32_t *counts, const 
  * HD_OK or HD_ENOMEM. */
 int hd__laz_encode_pointwise(const unsigned char *recs, size_t n, size_t rec, const unsigned *type, const unsigned *sz,
                              unsigned n_items, hd__enc_t *e);
+/* hd__write_laz_pointwise: every chunk decoded to whole records and the
+ * kept ones (with the fields' values) compressed again: pointwise LAZ, and
+ * subsets of layered LAZ (laz14.c encodes their chunks). */
 int hd__write_laz_pointwise(hd__writer_t *w, hd__las_plan_t *pl, const hd__las_header_t *h, const hd__laz_chunks_t *c,
                             hd__read_t *r);
 

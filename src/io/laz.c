@@ -26,7 +26,9 @@
  * extra byte), then the layers, each its own stream; x and y are in the
  * first layer (with the return counts and scanner channel that choose
  * their contexts), z in the second, and every other layer is skipped by
- * its size.  COPC files are layered LAZ with variable chunk sizes.
+ * its size (the writers of subsets decode every layer of a chunk through
+ * hd__laz_chunk_records, in laz14.c; a read never does).  COPC files are
+ * layered LAZ with variable chunk sizes.
  *
  * POINT10 v2, per point: a symbol of 64 says which of the return byte,
  * intensity, classification, scan angle, user data, point source changed;
@@ -69,6 +71,7 @@
  * double, as for LAS.
  */
 #include "io.h"
+#include "laz14.h"
 #include "lazcoder.h"
 
 #include <assert.h>
@@ -1281,6 +1284,21 @@ int hd__laz_chunk_channels(hd__read_t *r, const hd__las_header_t *h, const hd__l
 
 int hd__laz_chunk_records(hd__read_t *r, const hd__las_header_t *h, const hd__laz_chunks_t *c, size_t chunk,
                           unsigned char *recs) {
+    const unsigned char *b = r->f->data + c->start[chunk];
+    size_t nb = (size_t)(c->start[chunk + 1] - c->start[chunk]), n = (size_t)(c->first[chunk + 1] - c->first[chunk]);
+    if (c->layered) { /* every layer (laz14.c) */
+        hd__laz14_items_t it = {c->n_items, {0}, {0}, {0}};
+        for (unsigned i = 0; i < c->n_items; i++) {
+            it.type[i] = c->type[i];
+            it.size[i] = c->size[i];
+            it.version[i] = c->version[i];
+        }
+        char msg[320];
+        size_t at = 0;
+        int rc = hd__laz14_decode(b, nb, n, h->rec, &it, recs, msg, sizeof msg, &at);
+        if (rc) return hd__io_err_at(r, rc, (long long)(c->start[chunk] + at), "chunk %zu of %zu: %s", chunk + 1, c->n_chunks, msg);
+        return HD_OK;
+    }
     laz_t z;
     laz_over(&z, r, h, c);
     job_t j = {&z, chunk, r->sink, HD_MAX_COORD, (size_t)c->first[chunk], 0, -1, "", NULL, recs};

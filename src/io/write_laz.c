@@ -27,12 +27,16 @@
  * gets an empty layer (size 0), which a decoder reads as "unchanged".  The
  * channels come from decoding each chunk's x/y layer (laz.c).
  *
- * Pointwise LAZ (point formats 0-5) interleaves every field of a point in
- * one stream, so adding bytes means compressing every field again; that is
- * not done: HD_EUNSUPPORTED, and so is a subset of any LAZ file.
+ * A subset of a layered file changes every prediction in a chunk, so it is
+ * decoded to whole records and its kept points compressed again, every
+ * layer (laz14.c), by the writer of pointwise LAZ (write_lazpw.c), which
+ * does the same for pointwise files (formats 0-5 interleave every field of
+ * a point in one stream, so adding bytes there means compressing every
+ * field again).
  */
 #include "io.h"
 #include "lasfield.h"
+#include "laz14.h"
 #include "lazcoder.h"
 
 #include <stdlib.h>
@@ -301,17 +305,12 @@ int hd__write_laz(hd__writer_t *w) {
     hd__read_t r = {w->in, w->ropt, 1, &z.sink, NULL, 0, w->err, 0, 0, 0};
     z.r = r;
     rc = hd__laz_chunks(&z.r, &z.h, &z.c);
-    if (rc == HD_OK && !z.c.layered) {
+    if (rc == HD_OK && (!z.c.layered || w->keep != HD_KEEP_ALL)) { /* a layered subset: every point encoded again (laz14.c) */
         rc = hd__write_laz_pointwise(w, &z.pl, &z.h, &z.c, &z.r);
         hd__laz_chunks_free(&z.c);
         hd__sink_free(&z.sink);
         return rc;
     }
-    if (rc == HD_OK && w->keep != HD_KEEP_ALL)
-        rc = hd__err(w->err, HD_EUNSUPPORTED,
-                     "%s: a subset of a layered LAZ file (point format %u) is not written: its points would be compressed "
-                     "again, every field, and the layered encoder compresses only the added field",
-                     w->in->name, z.pl.fmt);
     if (rc == HD_OK) /* the BYTE14 item's version: the existing one's, or POINT14's for a new one */
         z.v4 = hd__ld_u16(w->in->data + z.c.vlr_at + 34 + 6 * (size_t)(z.c.type[z.c.n_items - 1] == IT_BYTE14 ? z.c.n_items - 1 : 0) + 4,
                           0) == 4;

@@ -1,6 +1,10 @@
 /*
  * write_lazpw.c -- fields written back into pointwise LAZ (LAS point
- * formats 0-3, LASzip compressor 2), or the points past a threshold.
+ * formats 0-3, LASzip compressor 2), or the points past a threshold; and
+ * the points past a threshold of layered LAZ (formats 6-10, compressor 3),
+ * whose chunks are decoded to whole records and encoded again, every
+ * layer, by laz14.c, the rest as below (the items' versions kept, a BYTE14
+ * item grown or added for the fields).
  *
  * Pointwise LAZ codes every field of a point in one stream per chunk, so
  * the fields' bytes cannot be added beside the old data: every chunk is
@@ -39,6 +43,7 @@
  */
 #include "io.h"
 #include "lasfield.h"
+#include "laz14.h"
 #include "lazcoder.h"
 
 #include <errno.h>
@@ -283,11 +288,10 @@ int hd__laz_table_encode(int variable, size_t nc, const uint32_t *counts, const 
 typedef struct {
     hd__writer_t *w;
     hd__las_plan_t *pl;
-    unsigned type[32], size[32], n_items;
+    unsigned type[32], size[32], version[32], n_items;
+    int layered; /* LASzip compressor 3 (laz14.c encodes the chunks) */
     unsigned char *vlr;  /* the output's LASzip VLR data */
     size_t vlr_len;
-    unsigned char *out;  /* the output chunk being gathered */
-    size_t n_out, cap_out;
     uint32_t *counts;    /* per output chunk */
     uint64_t *bytes;
     size_t n_chunks, cap_chunks;
@@ -301,32 +305,34 @@ typedef struct {
  * compressor 2, the chunk size `chunk`). */
 static int plan_items(pw_t *z, const hd__laz_chunks_t *c, uint32_t chunk) {
     hd__writer_t *w = z->w;
-    for (unsigned i = 0; i < c->n_items; i++)
+    for (unsigned i = 0; i < c->n_items && !c->layered; i++)
         if (c->version[i] != 2)
             return hd__err(w->err, HD_EUNSUPPORTED,
                            "%s: LASzip item %u is of version %u: a field is written into pointwise LAZ of version 2 "
                            "items (LASzip 2 and later) only",
                            w->in->name, i + 1, c->version[i]);
     z->n_items = c->n_items;
+    z->layered = c->layered;
     memcpy(z->type, c->type, sizeof z->type);
     memcpy(z->size, c->size, sizeof z->size);
-    unsigned nb = (unsigned)(8 * w->nf);
-    if (z->pl->add) {
-        if (z->type[z->n_items - 1] == IT_BYTE) z->size[z->n_items - 1] += nb;
-        else z->type[z->n_items] = IT_BYTE, z->size[z->n_items++] = nb;
+    for (unsigned i = 0; i < c->n_items; i++) z->version[i] = c->layered ? c->version[i] : 2;
+    unsigned nb = (unsigned)(8 * w->nf), bytes = c->layered ? HD__LAZ_IT_BYTE14 : IT_BYTE;
+    if (z->pl->add) { /* a new BYTE14 item takes POINT14's version */
+        if (z->type[z->n_items - 1] == bytes) z->size[z->n_items - 1] += nb;
+        else z->type[z->n_items] = bytes, z->version[z->n_items] = z->version[0], z->size[z->n_items++] = nb;
     }
     const unsigned char *v = w->in->data + c->vlr_at;
     size_t tail = c->vlr_len - (34 + 6 * (size_t)c->n_items); /* bytes after the items, kept */
     z->vlr_len = 34 + 6 * (size_t)z->n_items + tail;
     if (!(z->vlr = malloc(z->vlr_len))) return hd__err(w->err, HD_ENOMEM, "out of memory");
     memcpy(z->vlr, v, 34);
-    z->vlr[0] = 2, z->vlr[1] = 0; /* pointwise chunked */
+    z->vlr[0] = c->layered ? 3 : 2, z->vlr[1] = 0; /* layered or pointwise chunked */
     for (int b = 0; b < 4; b++) z->vlr[12 + b] = (unsigned char)(chunk >> (8 * b));
     z->vlr[32] = (unsigned char)z->n_items, z->vlr[33] = 0;
     for (unsigned i = 0; i < z->n_items; i++) {
         unsigned char *q = z->vlr + 34 + 6 * i;
         q[0] = (unsigned char)z->type[i], q[1] = 0, q[2] = (unsigned char)z->size[i], q[3] = (unsigned char)(z->size[i] >> 8);
-        q[4] = 2, q[5] = 0;
+        q[4] = (unsigned char)z->version[i], q[5] = 0;
     }
     memcpy(z->vlr + 34 + 6 * z->n_items, v + 34 + 6 * c->n_items, tail);
     return HD_OK;
@@ -351,49 +357,137 @@ static int put_chunk(pw_t *z, size_t n, const unsigned char *first, const hd__en
     return HD_OK;
 }
 
-/* Encode and write the gathered output chunk. */
-static int flush_chunk(pw_t *z) {
-    if (z->n_out == 0) return HD_OK;
-    hd__writer_t *w = z->w;
-    size_t rec = z->pl->out_rec;
-    if (hd__laz_encode_pointwise(z->out, z->n_out, rec, z->type, z->size, z->n_items, &z->enc))
-        return hd__err(w->err, HD_ENOMEM, "out of memory");
-    if (put_chunk(z, z->n_out, z->out, &z->enc)) return hd__err(w->err, HD_ENOMEM, "out of memory");
-    z->n_out = 0;
+/* The stream of the output chunk of n records recs (after its raw first
+ * one) into e: HD_OK or the encoder's error code. */
+static int encode_records(const pw_t *z, const unsigned char *recs, size_t n, hd__enc_t *e) {
+    if (!z->layered) return hd__laz_encode_pointwise(recs, n, z->pl->out_rec, z->type, z->size, z->n_items, e);
+    hd__laz14_items_t it = {z->n_items, {0}, {0}, {0}};
+    memcpy(it.type, z->type, sizeof it.type);
+    memcpy(it.size, z->size, sizeof it.size);
+    memcpy(it.version, z->version, sizeof it.version);
+    return hd__laz14_encode(recs, n, z->pl->out_rec, &it, e);
+}
+
+/* A subset, a batch of input chunks at a time: the chunks decoded to
+ * records and filtered in parallel (a task each, with its own buffers and
+ * error), the kept records gathered in file order into output chunks of
+ * `cap` points (per input chunk when per = 0), and a batch of full output
+ * chunks encoded in parallel and written in order.  The file is the one a
+ * sequential pass would write. */
+typedef struct {
+    pw_t *z;
+    const hd__las_header_t *h;
+    const hd__laz_chunks_t *c;
+    hd__read_t *r;
+    size_t base, most, cap;
+    unsigned char **in, **kept; /* per task: its chunk's records, the kept ones with their values */
+    size_t *n_kept;
+    unsigned char **out; /* per output chunk of the batch: its records */
+    size_t *n_out;
+    hd__enc_t *enc;
+    int *rc;
+    hd_error_t *err;
+} sub_t;
+
+static void decode_task(void *ctx, size_t t, int worker) {
+    (void)worker;
+    sub_t *S = ctx;
+    hd__writer_t *w = S->z->w;
+    size_t k = S->base + t, n = (size_t)(S->c->first[k + 1] - S->c->first[k]), f = (size_t)S->c->first[k];
+    size_t rec = S->z->pl->rec, orec = S->z->pl->out_rec;
+    hd__read_t r = *S->r;
+    r.err = &S->err[t];
+    if (!S->in[t]) S->in[t] = hd__malloc_array(S->most + 1, rec);
+    if (!S->kept[t]) S->kept[t] = hd__malloc_array(S->most + 1, orec);
+    if (!S->in[t] || !S->kept[t]) {
+        S->rc[t] = hd__err(&S->err[t], HD_ENOMEM, "out of memory for chunks of %zu points", S->most);
+        return;
+    }
+    int rc = hd__laz_chunk_records(&r, S->h, S->c, k, S->in[t]);
+    size_t m = 0;
+    for (size_t i = 0; i < n && rc == HD_OK; i++) {
+        if (!hd__w_keep(w, f + i)) continue;
+        unsigned char *o = S->kept[t] + m++ * orec;
+        memcpy(o, S->in[t] + i * rec, rec);
+        hd__w_values(w, f + i, 0, o + rec);
+    }
+    S->n_kept[t] = m;
+    S->rc[t] = rc;
+}
+
+static void encode_task(void *ctx, size_t t, int worker) {
+    (void)worker;
+    sub_t *S = ctx;
+    S->rc[t] = encode_records(S->z, S->out[t], S->n_out[t], &S->enc[t]);
+}
+
+/* Encode the batch's first m output chunks and write them in order. */
+static int flush_outs(sub_t *S, size_t m, int threads) {
+    hd__writer_t *w = S->z->w;
+    hd__parallel_for(threads, m, encode_task, S);
+    for (size_t t = 0; t < m; t++) {
+        if (S->rc[t] == HD_EINVAL)
+            return hd__err(w->err, HD_EINVAL, "%s: internal: a record would not decode back to itself", w->in->name);
+        if (S->rc[t]) return hd__err(w->err, S->rc[t], "%s: %s", w->in->name, hd_strerror(S->rc[t]));
+        if (put_chunk(S->z, S->n_out[t], S->out[t], &S->enc[t])) return hd__err(w->err, HD_ENOMEM, "out of memory");
+        S->n_out[t] = 0;
+    }
     return HD_OK;
 }
 
-/* Every input chunk decoded to records; the kept ones, with their values,
- * gathered into output chunks of `per` points (0: the input's chunks). */
+/* Record o (kept, with its values) into the output chunk being gathered,
+ * *full; a batch of P full ones is encoded and written.  HD_OK or the error. */
+static int gather(sub_t *S, const unsigned char *o, size_t *full, size_t P, int threads) {
+    pw_t *z = S->z;
+    size_t orec = z->pl->out_rec;
+    z->by_return[hd__las_return(o, z->pl->fmt)]++;
+    hd__las_bound(z->bounds, o, z->scale, z->shift, z->kept++ == 0);
+    if (!S->out[*full] && !(S->out[*full] = hd__malloc_array(S->cap + 1, orec)))
+        return hd__err(z->w->err, HD_ENOMEM, "out of memory for chunks of %zu points", S->cap);
+    memcpy(S->out[*full] + S->n_out[*full]++ * orec, o, orec);
+    if (S->n_out[*full] < S->cap) return HD_OK;
+    if (++*full < P) return HD_OK;
+    *full = 0;
+    return flush_outs(S, P, threads);
+}
+
 static int write_chunks(pw_t *z, const hd__las_header_t *h, const hd__laz_chunks_t *c, hd__read_t *r, size_t per) {
     hd__writer_t *w = z->w;
-    size_t most = 0, rec = z->pl->rec, orec = z->pl->out_rec;
+    size_t most = 0, orec = z->pl->out_rec;
     for (size_t k = 0; k < c->n_chunks; k++)
         if (c->first[k + 1] - c->first[k] > most) most = (size_t)(c->first[k + 1] - c->first[k]);
-    size_t cap = per ? per : most;
-    unsigned char *in = hd__malloc_array(most + 1, rec);
-    z->out = hd__malloc_array(cap + 1, orec);
-    if (!in || !z->out) {
-        free(in);
-        return hd__err(w->err, HD_ENOMEM, "out of memory for chunks of %zu points", most);
-    }
-    int rc = HD_OK;
-    for (size_t k = 0; k < c->n_chunks && rc == HD_OK && !w->werr; k++) {
-        size_t n = (size_t)(c->first[k + 1] - c->first[k]), f = (size_t)c->first[k];
-        if ((rc = hd__laz_chunk_records(r, h, c, k, in))) break;
-        for (size_t i = 0; i < n && rc == HD_OK; i++) {
-            if (!hd__w_keep(w, f + i)) continue;
-            unsigned char *o = z->out + z->n_out++ * orec;
-            memcpy(o, in + i * rec, rec);
-            hd__w_values(w, f + i, 0, o + rec);
-            z->by_return[hd__las_return(o, z->pl->fmt)]++;
-            hd__las_bound(z->bounds, o, z->scale, z->shift, z->kept++ == 0);
-            if (per && z->n_out == per) rc = flush_chunk(z);
+    int threads = hd__thread_count(w->ropt->threads, c->n_chunks);
+    size_t P = 2 * (size_t)threads, full = 0;
+    sub_t S = {z, h, c, r, 0, most, per ? per : most, calloc(P, sizeof(void *)), calloc(P, sizeof(void *)),
+               calloc(P, sizeof(size_t)), calloc(P, sizeof(void *)), calloc(P, sizeof(size_t)), calloc(P, sizeof(hd__enc_t)),
+               calloc(P, sizeof(int)), calloc(P, sizeof(hd_error_t))};
+    int rc = S.in && S.kept && S.n_kept && S.out && S.n_out && S.enc && S.rc && S.err ? HD_OK
+                                                                                     : hd__err(w->err, HD_ENOMEM, "out of memory");
+    for (size_t t = 0; rc == HD_OK && t < P; t++) hd__enc_init(&S.enc[t]);
+    for (S.base = 0; rc == HD_OK && S.base < c->n_chunks && !w->werr; S.base += P) {
+        size_t m = c->n_chunks - S.base < P ? c->n_chunks - S.base : P;
+        hd__parallel_for(threads, m, decode_task, &S);
+        for (size_t t = 0; t < m && rc == HD_OK; t++) {
+            if (S.rc[t]) { /* the chunk's error, its byte offset included */
+                rc = S.rc[t];
+                if (w->err) *w->err = S.err[t];
+                break;
+            }
+            for (size_t j = 0; j < S.n_kept[t] && rc == HD_OK; j++) rc = gather(&S, S.kept[t] + j * orec, &full, P, threads);
+            if (rc == HD_OK && !per && S.n_out[full] && ++full == P) { /* the input's chunks: one ends here */
+                full = 0;
+                rc = flush_outs(&S, P, threads);
+            }
         }
-        if (!per && rc == HD_OK) rc = flush_chunk(z);
     }
-    if (rc == HD_OK) rc = flush_chunk(z);
-    free(in);
+    if (rc == HD_OK && !w->werr) rc = flush_outs(&S, full + (S.n_out[full] > 0), threads);
+    for (size_t t = 0; t < P; t++) {
+        if (S.in) free(S.in[t]);
+        if (S.kept) free(S.kept[t]);
+        if (S.out) free(S.out[t]);
+        if (S.enc) hd__enc_free(&S.enc[t]);
+    }
+    free(S.in), free(S.kept), free(S.n_kept), free(S.out), free(S.n_out), free(S.enc), free(S.rc), free(S.err);
     return rc;
 }
 
@@ -517,7 +611,6 @@ int hd__write_laz_pointwise(hd__writer_t *w, hd__las_plan_t *pl, const hd__las_h
         w->written = (size_t)z.kept;
     }
     free(z.vlr);
-    free(z.out);
     free(z.counts);
     free(z.bytes);
     hd__enc_free(&z.enc);

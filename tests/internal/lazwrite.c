@@ -5,6 +5,7 @@
 #include "lazwrite.h"
 
 #include "io/lasfield.h"
+#include "io/laz14.h"
 #include "io/lazcoder.h"
 
 #include <assert.h>
@@ -488,3 +489,156 @@ void lazw_pointwise(tf_buf_t *b, int fmt, unsigned extra, const unsigned char *r
     free(bytes);
 }
 
+
+/* LAS 1.4 records (formats 6, 7, 8) with every field varying. */
+unsigned char *lazw_rich_records14(gen_rng_t *g, int fmt, unsigned extra, size_t n, size_t *rec, int channels) {
+    *rec = (fmt == 6 || fmt == 9 ? 30 : fmt == 7 ? 36 : 38) + (fmt >= 9 ? 29 : 0) + extra;
+    unsigned char *r = calloc(n, *rec);
+    int32_t x = 0, y = 0, z = 0;
+    uint64_t t = 0x41C0000000000000ull;
+    uint16_t rgb[4] = {100, 200, 300, 400}, scan = 0, inten = 900, psid = 3;
+    unsigned chan = 0, cls = 2, ud = 7, flags = 0;
+    unsigned char wave[1] = {1};
+    uint64_t wave_off = 1000;
+    uint32_t wave_size = 256, wave_ret = 0x3f800000, wave_xyz[3] = {0, 0, 0x3f000000};
+    for (size_t k = 0; k < n; k++) {
+        unsigned char *p = r + k * *rec;
+        uint64_t u = gen_u64(g), v = gen_u64(g);
+        x += (int32_t)(u % 2001) - 1000, y += (int32_t)(u >> 16 & 255) - 128, z += (int32_t)(u >> 24 & 15) - 7;
+        if (u % 97 == 0) x = (int32_t)gen_u64(g);
+        if (u % 89 == 0) z = (int32_t)gen_u64(g);
+        for (int b = 0; b < 4; b++) p[b] = (unsigned char)(x >> 8 * b), p[4 + b] = (unsigned char)(y >> 8 * b), p[8 + b] = (unsigned char)(z >> 8 * b);
+        if (v % 5 == 0) inten = (uint16_t)(v >> 8);
+        else if (v % 5 == 1) inten = (uint16_t)(inten + (v >> 8 & 15));
+        p[12] = (unsigned char)inten, p[13] = (unsigned char)(inten >> 8);
+        unsigned nr = u >> 32 & 15 ? 1 + (unsigned)(u >> 36) % 5 : (unsigned)(u >> 40) & 15;
+        unsigned ret = u >> 44 & 7 ? 1 + (unsigned)(u >> 47) % (nr ? nr : 1) : (unsigned)(u >> 50) & 15;
+        p[14] = (unsigned char)(ret | nr << 4);
+        if (channels && v % 11 == 0) chan = (unsigned)(v >> 12) & 3;
+        if (v % 13 == 0) flags = (unsigned)(v >> 16) & 15;
+        p[15] = (unsigned char)(flags | chan << 4 | (u >> 53 & 1) << 6 | (v % 31 == 0) << 7);
+        if (v % 7 == 0) cls = (unsigned)(v >> 20) & 255;
+        p[16] = (unsigned char)cls;
+        if (v % 17 == 0) ud = (unsigned)(v >> 28) & 255;
+        p[17] = (unsigned char)ud;
+        if (v % 3 == 0) scan = (uint16_t)(scan + (int)(v >> 36 & 31) - 15);
+        else if (v % 19 == 1) scan = (uint16_t)(v >> 40);
+        p[18] = (unsigned char)scan, p[19] = (unsigned char)(scan >> 8);
+        if (v % 23 == 0) psid = (uint16_t)(v >> 44);
+        p[20] = (unsigned char)psid, p[21] = (unsigned char)(psid >> 8);
+        uint64_t w = gen_u64(g);
+        t = w % 4 == 0 ? t : w % 4 == 1 ? t + 1000 : w % 4 == 2 ? t + (w >> 8 & 0xFFFFF) : w % 16 == 3 ? t + (w << 30) : t - 5;
+        for (int b = 0; b < 8; b++) p[22 + b] = (unsigned char)(t >> 8 * b);
+        size_t off = 30;
+        if (fmt == 7 || fmt == 8 || fmt == 10) {
+            uint64_t c = gen_u64(g);
+            if (c % 3 == 0) rgb[0] = rgb[1] = rgb[2] = (uint16_t)(c >> 8); /* grey */
+            else if (c % 3 == 1) rgb[0] = (uint16_t)(rgb[0] + (c >> 8 & 15)), rgb[2] = (uint16_t)(c >> 24);
+            if (c % 5 == 0) rgb[1] = (uint16_t)(c >> 40);
+            if (c % 7 == 0) rgb[3] = (uint16_t)(c >> 44);
+            for (int q = 0; q < (fmt == 7 ? 3 : 4); q++) p[off + 2 * q] = (unsigned char)rgb[q], p[off + 2 * q + 1] = (unsigned char)(rgb[q] >> 8);
+            off += fmt == 7 ? 6 : 8;
+        }
+        if (fmt >= 9) { /* a wave packet descriptor: index, offset, size, return point, x, y, z */
+            uint64_t c = gen_u64(g);
+            if (c % 5 == 0) wave[0] = (unsigned char)(c >> 8);
+            wave_off = c % 4 == 0 ? wave_off : c % 4 == 1 ? wave_off + wave_size : c % 8 == 2 ? wave_off + (c >> 20 & 0xFFFF) : c % 8 == 3 ? wave_off - 7 : c % 8 == 6 ? gen_u64(g) : wave_off + (c << 33);
+            if (c % 3 == 0) wave_size = (uint32_t)(c >> 40 & 1023);
+            if (c % 7 == 0) wave_ret = (uint32_t)gen_u64(g);
+            for (int q = 0; q < 3; q++)
+                if (c >> (50 + q) & 1) wave_xyz[q] = (uint32_t)gen_u64(g);
+            p[off] = wave[0];
+            for (int b = 0; b < 8; b++) p[off + 1 + b] = (unsigned char)(wave_off >> 8 * b);
+            for (int b = 0; b < 4; b++) {
+                p[off + 9 + b] = (unsigned char)(wave_size >> 8 * b), p[off + 13 + b] = (unsigned char)(wave_ret >> 8 * b);
+                for (int q = 0; q < 3; q++) p[off + 17 + 4 * q + b] = (unsigned char)(wave_xyz[q] >> 8 * b);
+            }
+            off += 29;
+        }
+        for (unsigned e = 0; e < extra; e++) p[off + e] = (unsigned char)(k % 7 ? 40 + e : gen_u64(g));
+        if (extra > 1 && k % 11 != 0) p[off + 1] = 9; /* a byte that changes rarely */
+    }
+    return r;
+}
+
+/* A layered LAZ file (LAS 1.4, LASzip compressor 3, items of `version`,
+ * chunks of `chunk` points) of the records, compressed by the library's
+ * layered encoder (hd__laz14_encode, src/io/laz14.c). */
+void lazw_layered(tf_buf_t *b, int fmt, unsigned extra, const unsigned char *recs, size_t rec, size_t n, size_t chunk,
+                  unsigned version) {
+    hd__laz14_items_t it = {0, {0}, {0}, {0}};
+    it.type[it.n] = 10, it.size[it.n] = 30, it.version[it.n++] = version;
+    if (fmt == 7) it.type[it.n] = 11, it.size[it.n] = 6, it.version[it.n++] = version;
+    if (fmt == 8 || fmt == 10) it.type[it.n] = 12, it.size[it.n] = 8, it.version[it.n++] = version;
+    if (fmt >= 9) it.type[it.n] = 13, it.size[it.n] = 29, it.version[it.n++] = version;
+    if (extra) it.type[it.n] = 14, it.size[it.n] = extra, it.version[it.n++] = version;
+    size_t vlr = 34 + 6 * it.n, offset = 375 + 54 + vlr;
+    tf_put(b, "LASF", 4);
+    while (b->size < 24) tf_u8(b, 0);
+    tf_u8(b, 1), tf_u8(b, 4);
+    while (b->size < 94) tf_u8(b, 0);
+    tf_u16(b, 375, 0), tf_u32(b, (uint32_t)offset, 0), tf_u32(b, 1, 0);
+    tf_u8(b, (unsigned)fmt | 0x80), tf_u16(b, (unsigned)rec, 0), tf_u32(b, 0, 0);
+    while (b->size < 131) tf_u8(b, 0);
+    for (int c = 0; c < 3; c++) tf_f64(b, 0.01, 0);
+    for (int c = 0; c < 3; c++) tf_f64(b, 0, 0);
+    while (b->size < 247) tf_u8(b, 0);
+    tf_u64(b, n, 0);
+    while (b->size < 375) tf_u8(b, 0);
+    char user[16] = "laszip encoded", desc[32] = "";
+    tf_u16(b, 0, 0), tf_put(b, user, 16), tf_u16(b, 22204, 0), tf_u16(b, (unsigned)vlr, 0), tf_put(b, desc, 32);
+    tf_u16(b, 3, 0), tf_u16(b, 0, 0), tf_u8(b, 3), tf_u8(b, 4), tf_u16(b, 0, 0), tf_u32(b, 0, 0);
+    tf_u32(b, (uint32_t)chunk, 0), tf_u64(b, (uint64_t)-1, 0), tf_u64(b, (uint64_t)-1, 0), tf_u16(b, it.n, 0);
+    for (unsigned i = 0; i < it.n; i++) tf_u16(b, it.type[i], 0), tf_u16(b, it.size[i], 0), tf_u16(b, it.version[i], 0);
+    size_t ptr = b->size, nc = (n + chunk - 1) / chunk;
+    tf_u64(b, 0, 0);
+    uint64_t *bytes = calloc(nc + 1, sizeof *bytes);
+    hd__enc_t e;
+    hd__enc_init(&e);
+    for (size_t c = 0; c < nc; c++) {
+        size_t k = n - c * chunk < chunk ? n - c * chunk : chunk;
+        if (hd__laz14_encode(recs + c * chunk * rec, k, rec, &it, &e)) abort();
+        tf_put(b, recs + c * chunk * rec, rec);
+        tf_put(b, e.buf, e.size);
+        bytes[c] = rec + e.size;
+    }
+    uint64_t tab = b->size;
+    for (int i = 0; i < 8; i++) b->data[ptr + i] = (unsigned char)(tab >> 8 * i);
+    tf_u32(b, 0, 0), tf_u32(b, (uint32_t)nc, 0);
+    if (hd__laz_table_encode(0, nc, NULL, bytes, &e)) abort();
+    tf_put(b, e.buf, e.size);
+    hd__enc_free(&e);
+    free(bytes);
+}
+
+static uint64_t le_of(const unsigned char *p, int n) {
+    uint64_t v = 0;
+    for (int i = n - 1; i >= 0; i--) v = v << 8 | p[i];
+    return v;
+}
+
+unsigned char *lazw_decode_records(const char *path, const unsigned char *d, size_t size, size_t *n, size_t *rec,
+                                   hd_error_t *err) {
+    hd__file_t f = {path, d, size};
+    hd_read_options_t o;
+    hd_read_options_init(&o);
+    hd__sink_t sink;
+    hd__sink_init(&sink, HD_FLOAT64);
+    hd__read_t r = {&f, &o, 1, &sink, NULL, 0, err, 0, 0, 0};
+    hd__las_header_t h;
+    memset(&h, 0, sizeof h);
+    h.minor = d[25], h.fmt = d[104] & 63, h.header = le_of(d + 94, 2), h.offset = le_of(d + 96, 4), h.rec = le_of(d + 105, 2);
+    h.count = d[25] >= 4 ? le_of(d + 247, 8) : le_of(d + 107, 4), h.n_vlr = (uint32_t)le_of(d + 100, 4);
+    hd__laz_chunks_t c;
+    if (hd__laz_chunks(&r, &h, &c)) return NULL;
+    unsigned char *out = calloc(h.count + 1, h.rec);
+    for (size_t k = 0; out && k < c.n_chunks; k++)
+        if (hd__laz_chunk_records(&r, &h, &c, k, out + c.first[k] * h.rec)) {
+            free(out);
+            out = NULL;
+        }
+    hd__laz_chunks_free(&c);
+    hd__sink_free(&sink);
+    *n = h.count, *rec = h.rec;
+    return out;
+}

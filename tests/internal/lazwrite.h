@@ -19,6 +19,8 @@
 #include "files.h"
 #include "gen.h"
 
+#include <hausdorff.h>
+
 #include <stddef.h>
 #include <stdint.h>
 
@@ -70,5 +72,22 @@ unsigned char *lazw_rich_records(gen_rng_t *g, int fmt, unsigned extra, size_t n
  * encoder (hd__laz_encode_pointwise, src/io/write_lazpw.c), appended to b. */
 void lazw_pointwise(tf_buf_t *b, int fmt, unsigned extra, const unsigned char *recs, size_t rec, size_t n,
                     size_t chunk);
+
+/* n random whole records of LAS 1.4 point format fmt (6-10) with
+ * `extra` extra bytes, every field varying; scanner channels switching
+ * when `channels`, else all 0; malloc'd, *rec bytes each. */
+unsigned char *lazw_rich_records14(gen_rng_t *g, int fmt, unsigned extra, size_t n, size_t *rec, int channels);
+/* The layered LAZ file (LAS 1.4, items of `version` 3 or 4, chunks of
+ * `chunk` points) of those records, compressed by the library's layered
+ * encoder (hd__laz14_encode, src/io/laz14.c), appended to b. */
+void lazw_layered(tf_buf_t *b, int fmt, unsigned extra, const unsigned char *recs, size_t rec, size_t n, size_t chunk,
+                  unsigned version);
+
+/* Every whole record of the LAZ file d[0..size) (named path), decoded by
+ * the library (hd__laz_chunk_records: pointwise items of version 2, or
+ * every layer); malloc'd, *n records of *rec bytes; NULL with err set when
+ * the file is refused. */
+unsigned char *lazw_decode_records(const char *path, const unsigned char *d, size_t size, size_t *n, size_t *rec,
+                                   hd_error_t *err);
 
 #endif
