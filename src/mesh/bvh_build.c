@@ -103,6 +103,11 @@ static void select_rank(bkey_t *x, long left, long right, long k, int a) {
             long lo = (long)((double)k - i * s / n + sd), hi = (long)((double)k + (n - i) * s / n + sd);
             select_rank(x, lo > left ? lo : left, hi < right ? hi : right, k, a);
         }
+        else if (right - left > 2) { /* the pivot: the median of the ends and x[k] */
+            if (x[k].c[a] < x[left].c[a]) swap_keys(x, k, left);
+            if (x[right].c[a] < x[k].c[a]) swap_keys(x, right, k);
+            if (x[k].c[a] < x[left].c[a]) swap_keys(x, k, left);
+        }
         double t = x[k].c[a];
         long i = left, j = right;
         swap_keys(x, left, k);
@@ -122,11 +127,18 @@ static void select_rank(bkey_t *x, long left, long right, long k, int a) {
 
 static void select_mid(bkey_t *k, size_t n, size_t mid, int a) { select_rank(k, 0, (long)n - 1, (long)mid, a); }
 
-/* The axis along which the n keys' centroids spread most. */
+/* The axis along which the n keys' centroids spread most: over every
+ * key of a small node, over every step-th key of a large one (at least
+ * AXIS_SAMPLE keys: the extents then differ from the whole node's only
+ * where two axes nearly tie, and the key order within a node's range
+ * depends on the range alone, so the choice is the same at any thread
+ * count). */
+#define AXIS_SAMPLE 512
 static int longest_axis(const bkey_t *k, size_t n) {
     double lo[3], hi[3];
+    size_t step = n / AXIS_SAMPLE > 1 ? n / AXIS_SAMPLE : 1;
     for (int a = 0; a < 3; a++) lo[a] = hi[a] = k[0].c[a];
-    for (size_t i = 1; i < n; i++)
+    for (size_t i = step; i < n; i += step)
         for (int a = 0; a < 3; a++) {
             double c = k[i].c[a];
             lo[a] = lo[a] < c ? lo[a] : c; /* this order: one minsd, no copies */

@@ -269,3 +269,28 @@ TEST(a_near_point_from_a_far_seed_opens_few_nodes) {
     hd__bvh_free(&t);
     free(orig);
 }
+
+/* A node of 1024 triangles or more chooses its axis from every
+ * (n / 512)-th centroid of its range (bvh_build.c): here every fourth
+ * triangle of 2048 lies along y over [0, 1], the others along x over
+ * [0, 4], so the sample's longest axis is y and the whole set's x.  The
+ * root splits along y: its first child holds the 1024 lowest centroids in
+ * y, and both children span x. */
+TEST(a_large_node_splits_along_the_longest_axis_of_its_sampled_centroids) {
+    size_t n = 2048;
+    hd__tri_t *t = malloc(n * sizeof *t);
+    for (size_t k = 0; k < n; k++) {
+        double x = k % 4 ? 4.0 * (double)k / (double)n : 0.5, y = k % 4 ? 0.5 : (double)k / (double)n;
+        double c[3][3] = {{x, y, 0}, {x + 1e-3, y, 0}, {x, y + 1e-3, 1e-3}};
+        memcpy(t[k].v, c, sizeof c);
+        t[k].index = k;
+    }
+    hd__bvh_t tree;
+    CHECK_RC(hd__bvh_build_threads(&tree, t, n, 1), HD_OK);
+    const hd__box_t *a = &tree.nodes[1].box, *b = &tree.nodes[tree.nodes[0].first_or_second].box;
+    CONTEXT("first child y [%g, %g] x [%g, %g]; second y [%g, %g]", a->lo[1], a->hi[1], a->lo[0], a->hi[0],
+            b->lo[1], b->hi[1]);
+    CHECK(a->hi[1] <= 0.5 + 1e-3 && b->hi[1] > 0.9); /* split along y: x spans the whole range in both */
+    CHECK(a->hi[0] - a->lo[0] > 3);
+    hd__bvh_free(&tree);
+}
