@@ -417,7 +417,7 @@ static void flush_prep(const hd__bvh_t *t, const double *p, search_t *s, hd__bvh
 static void consider(const hd__bvh_t *t, const double *p, size_t k, search_t *s, hd__bvh_stats_t *st) {
     double lo2, hi2;
     st->bounded++;
-    hd__tri_bounds_prep(p, hd__bvh_prep(t, k), &lo2, &hi2);
+    hd__tri_bounds_below(p, hd__bvh_prep(t, k), s->thr, &lo2, &hi2);
     if (lo2 > s->thr) return;
     double h = thr_from_hi(hi2);
     s->thr = h < s->thr ? h : s->thr;
