@@ -129,11 +129,12 @@ static void select_mid(bkey_t *k, size_t n, size_t mid, int a) { select_rank(k, 
 
 /* The axis along which the n keys' centroids spread most: over every
  * key of a small node, over every step-th key of a large one (at least
- * AXIS_SAMPLE keys: the extents then differ from the whole node's only
- * where two axes nearly tie, and the key order within a node's range
- * depends on the range alone, so the choice is the same at any thread
- * count). */
-#define AXIS_SAMPLE 512
+ * AXIS_SAMPLE keys).  The sample's choice can differ from the whole
+ * node's where two axes' extents are close or a few outlying centroids
+ * decide an extent; any axis gives a valid tree, and the key order within
+ * a node's range depends on the range alone, so the choice is the same at
+ * any thread count. */
+#define AXIS_SAMPLE 64
 static int longest_axis(const bkey_t *k, size_t n) {
     double lo[3], hi[3];
     size_t step = n / AXIS_SAMPLE > 1 ? n / AXIS_SAMPLE : 1;

@@ -270,12 +270,12 @@ TEST(a_near_point_from_a_far_seed_opens_few_nodes) {
     free(orig);
 }
 
-/* A node of 1024 triangles or more chooses its axis from every
- * (n / 512)-th centroid of its range (bvh_build.c): here every fourth
+/* A node of 128 triangles or more chooses its axis from every
+ * (n / 64)-th centroid of its range (bvh_build.c): here every fourth
  * triangle of 2048 lies along y over [0, 1], the others along x over
- * [0, 4], so the sample's longest axis is y and the whole set's x.  The
- * root splits along y: its first child holds the 1024 lowest centroids in
- * y, and both children span x. */
+ * [0, 4], so the sample's longest axis (every 32nd centroid) is y and the
+ * whole set's x.  The root splits along y: its first child holds the 1024
+ * lowest centroids in y, and both children span x. */
 TEST(a_large_node_splits_along_the_longest_axis_of_its_sampled_centroids) {
     size_t n = 2048;
     hd__tri_t *t = malloc(n * sizeof *t);
