@@ -178,15 +178,19 @@ static double corner_lo2(const double *xp, const double *xy, const double *xz) {
     return e1 <= 0 && e2 <= 0 ? dot3(xp, xp) * (1 - 6 * U) : 0;
 }
 
-/* Beyond the edges it may lie beyond: the least foot and the corners. */
+/* The lower bound as returned, from the lo accumulated. */
+HD__INLINE double lo_final(double lo) {
+    lo = lo * OUT_LO - 0x1p-1060;
+    return lo > 0 ? lo : 0;
+}
+
+/* Beyond the edges it may lie beyond: the corners, and unless their lower
+ * bound already exceeds `skip`, the least foot (else hi stays infinite). */
 static void outside(const double *p, const hd__tri_prep_t *t, const v3_t *ap, const int *sure,
-                    double *lo, double *hi) {
+                    double skip, double *lo, double *hi) {
     int all = t->flat;
     v3_t bp = v3_diff(p, t->b);
-    double h = INFINITY, q;
-    if (all || !sure[2]) h = fmin(h, foot_hi2(ap->v, t->ab, t->rd[2]));
-    if (all || !sure[1]) h = fmin(h, foot_hi2(ap->v, t->ac, t->rd[1]));
-    if (all || !sure[0]) h = fmin(h, foot_hi2(bp.v, t->bc, t->rd[0]));
+    double q;
     /* A corner's region lies beyond one of its edges' lines at least. */
     if (all || !(sure[1] && sure[2])) {
         q = corner_lo2(ap->v, t->ab, t->ac);
@@ -202,11 +206,20 @@ static void outside(const double *p, const hd__tri_prep_t *t, const v3_t *ap, co
         q = corner_lo2(cp.v, ca.v, cb.v);
         *lo = dmax(*lo, q);
     }
+    double h = INFINITY;
+    if (lo_final(*lo) > skip) {
+        *hi = h;
+        return;
+    }
+    if (all || !sure[2]) h = fmin(h, foot_hi2(ap->v, t->ab, t->rd[2]));
+    if (all || !sure[1]) h = fmin(h, foot_hi2(ap->v, t->ac, t->rd[1]));
+    if (all || !sure[0]) h = fmin(h, foot_hi2(bp.v, t->bc, t->rd[0]));
     *hi = h;
 }
 
-/* The bounds for a prepared triangle and a point below 2^100. */
-static void bounds_core(const double *p, const hd__tri_prep_t *t, double *lo2, double *hi2) {
+/* The bounds for a prepared triangle and a point below 2^100; hi2 left
+ * infinite when lo2 > skip. */
+static void bounds_core(const double *p, const hd__tri_prep_t *t, double skip, double *lo2, double *hi2) {
     v3_t ap = v3_diff(p, t->a);
     double g = dot3(t->n, ap.v), eg = pdot3(t->wn, ap.v) + TB;
     double L[3], eL[3], lo = 0, hi;
@@ -232,10 +245,9 @@ static void bounds_core(const double *p, const hd__tri_prep_t *t, double *lo2, d
         double gh = fabs(g) + eg;
         hi = (gh * t->rMl + 0x1p-1000) * gh * OUT_HI + 0x1p-1060;
     } else {
-        outside(p, t, &ap, sure, &lo, &hi);
+        outside(p, t, &ap, sure, skip, &lo, &hi);
     }
-    lo = lo * OUT_LO - 0x1p-1060;
-    *lo2 = lo > 0 ? lo : 0;
+    *lo2 = lo_final(lo);
     *hi2 = hi;
 }
 
@@ -253,7 +265,7 @@ static void bounds_scaled(const double *p, const double *a, const double *b, con
     memcpy(t.a, sc[1], sizeof t.a);
     memcpy(t.b, sc[2], sizeof t.b);
     memcpy(t.c, sc[3], sizeof t.c);
-    bounds_core(sc[0], &t, &lo, &hi);
+    bounds_core(sc[0], &t, INFINITY, &lo, &hi);
     /* Unscaling multiplies by a power of four: exact unless it overflows
      * (the lower bound then exceeds every double) or underflows (s > 0:
      * a result below 2^-900 becomes 0 and 2^-900). */
@@ -264,11 +276,15 @@ static void bounds_scaled(const double *p, const double *a, const double *b, con
     *hi2 = hi < 0x1p-900 ? 0x1p-900 : hi;
 }
 
-void hd__tri_bounds_prep(const double p[3], const hd__tri_prep_t *t, double *lo2, double *hi2) {
+void hd__tri_bounds_below(const double p[3], const hd__tri_prep_t *t, double skip, double *lo2, double *hi2) {
     if (t->direct && fabs(p[0]) < SAFE && fabs(p[1]) < SAFE && fabs(p[2]) < SAFE)
-        bounds_core(p, t, lo2, hi2);
+        bounds_core(p, t, skip, lo2, hi2);
     else
         bounds_scaled(p, t->a, t->b, t->c, lo2, hi2);
+}
+
+void hd__tri_bounds_prep(const double p[3], const hd__tri_prep_t *t, double *lo2, double *hi2) {
+    hd__tri_bounds_below(p, t, INFINITY, lo2, hi2);
 }
 
 void hd__tri_bounds(const double p[3], const double a[3], const double b[3], const double c[3],

@@ -40,7 +40,8 @@
  * bound and each stopping at the first bound above thr: the cheap bounds
  * (the triangle's box, then the support bound in the direction of its
  * box's centre), the prepared bounds (hd__tri_bounds_prep: lo2 discards,
- * hi2 lowers thr), and the kernel.  Triangles that share the best one's
+ * hi2 lowers thr) as soon as the leaf is screened, and the kernel, on
+ * the candidates left at the end.  Triangles that share the best one's
  * nearest corner and certainly have it as theirs are decided without the
  * kernel (corner_tie).  hd__bvh_collect and hd__bvh_nearest_in let a
  * group of neighbouring points share one list of triangles.
@@ -416,7 +417,7 @@ static void flush_prep(const hd__bvh_t *t, const double *p, search_t *s, hd__bvh
 static void consider(const hd__bvh_t *t, const double *p, size_t k, search_t *s, hd__bvh_stats_t *st) {
     double lo2, hi2;
     st->bounded++;
-    hd__tri_bounds_prep(p, hd__bvh_prep(t, k), &lo2, &hi2);
+    hd__tri_bounds_below(p, hd__bvh_prep(t, k), s->thr, &lo2, &hi2);
     if (lo2 > s->thr) return;
     double h = thr_from_hi(hi2);
     s->thr = h < s->thr ? h : s->thr;
@@ -484,10 +485,14 @@ static void screen(const hd__bvh_t *t, const double *p, size_t k, search_t *s, h
     s->cheap[s->n_cheap++] = (cand_t){b * SHRINK, k};
 }
 
+/* A leaf's triangles screened, and those left bounded at once: their hi2
+ * lowers thr before the descent opens another node (the seed's alone is
+ * often loose by orders of magnitude). */
 static void leaf(const hd__bvh_t *t, const hd__bvh_node_t *node, const double *p, size_t seed, search_t *s,
                  hd__bvh_stats_t *st) {
     for (size_t k = node->first_or_second, end = k + node->count; k < end; k++)
         if (k != seed) screen(t, p, k, s, st);
+    flush_cheap(t, p, s, st);
 }
 
 static void search_init(search_t *s) {

@@ -103,6 +103,11 @@ static void select_rank(bkey_t *x, long left, long right, long k, int a) {
             long lo = (long)((double)k - i * s / n + sd), hi = (long)((double)k + (n - i) * s / n + sd);
             select_rank(x, lo > left ? lo : left, hi < right ? hi : right, k, a);
         }
+        else if (right - left > 2) { /* the pivot: the median of the ends and x[k] */
+            if (x[k].c[a] < x[left].c[a]) swap_keys(x, k, left);
+            if (x[right].c[a] < x[k].c[a]) swap_keys(x, right, k);
+            if (x[k].c[a] < x[left].c[a]) swap_keys(x, k, left);
+        }
         double t = x[k].c[a];
         long i = left, j = right;
         swap_keys(x, left, k);
@@ -122,11 +127,19 @@ static void select_rank(bkey_t *x, long left, long right, long k, int a) {
 
 static void select_mid(bkey_t *k, size_t n, size_t mid, int a) { select_rank(k, 0, (long)n - 1, (long)mid, a); }
 
-/* The axis along which the n keys' centroids spread most. */
+/* The axis along which the n keys' centroids spread most: over every
+ * key of a small node, over every step-th key of a large one (at least
+ * AXIS_SAMPLE keys).  The sample's choice can differ from the whole
+ * node's where two axes' extents are close or a few outlying centroids
+ * decide an extent; any axis gives a valid tree, and the key order within
+ * a node's range depends on the range alone, so the choice is the same at
+ * any thread count. */
+#define AXIS_SAMPLE 64
 static int longest_axis(const bkey_t *k, size_t n) {
     double lo[3], hi[3];
+    size_t step = n / AXIS_SAMPLE > 1 ? n / AXIS_SAMPLE : 1;
     for (int a = 0; a < 3; a++) lo[a] = hi[a] = k[0].c[a];
-    for (size_t i = 1; i < n; i++)
+    for (size_t i = step; i < n; i += step)
         for (int a = 0; a < 3; a++) {
             double c = k[i].c[a];
             lo[a] = lo[a] < c ? lo[a] : c; /* this order: one minsd, no copies */
@@ -275,9 +288,9 @@ static void top_levels(build_t *B, int threads, size_t *n_sub, size_t *top, size
 void hd__bvh_free(hd__bvh_t *t) {
     free((void *)t->slot);
     free((void *)t->used);
-    free(t->tris);
-    free(t->nodes);
-    free(t->boxes);
+    hd__reuse_put(NULL, t->tris);
+    hd__reuse_put(NULL, t->nodes);
+    hd__reuse_put(NULL, t->boxes);
     free(t->prep_pool);
     free(t->frames);
     memset(t, 0, sizeof *t);
@@ -290,23 +303,26 @@ int hd__bvh_build_threads(hd__bvh_t *t, hd__tri_t *tris, size_t n, int threads) 
     if (threads > 256) threads = 256;
     t->n_tris = n;
     t->n_nodes = nodes_for(n);
-    t->tris = hd__malloc_array(n, sizeof *t->tris);
-    t->nodes = hd__malloc_array(t->n_nodes, sizeof *t->nodes);
-    t->boxes = hd__malloc_array(n, sizeof *t->boxes);
+    /* written whole: mapped at once, in 2 MiB pages where the kernel
+     * gives them (hd__reuse_get); the prepared records only as they are
+     * first written (a search reaches a part of them) */
+    t->tris = hd__reuse_get(NULL, n, sizeof *t->tris);
+    t->nodes = hd__reuse_get(NULL, t->n_nodes, sizeof *t->nodes);
+    t->boxes = hd__reuse_get(NULL, n, sizeof *t->boxes);
     t->prep_pool = hd__malloc_array(n, sizeof *t->prep_pool);
     t->slot = hd__calloc_array(n, sizeof *t->slot);
     t->used = malloc(sizeof *t->used);
     /* phase 2's levels end below threads * TASKS_PER_THREAD ranges, so a
      * level has fewer than twice that, and the nodes above them too */
     size_t most = 2 * (size_t)threads * TASKS_PER_THREAD;
-    bkey_t *keys = hd__malloc_array(n, sizeof *keys);
+    bkey_t *keys = hd__reuse_get(NULL, n, sizeof *keys);
     range_t *ranges = hd__malloc_array(3 * most, sizeof *ranges);
     size_t *top = hd__malloc_array(most, sizeof *top);
     if (!t->tris || !t->nodes || !t->boxes || !t->prep_pool || !t->slot || !t->used || !keys || !ranges || !top) {
-        free(keys), free(ranges), free(top);
+        hd__reuse_put(NULL, keys), free(ranges), free(top);
         hd__bvh_t failed = *t;
         failed.tris = NULL; /* hd__bvh_free would free it */
-        free(t->tris);
+        hd__reuse_put(NULL, t->tris);
         hd__bvh_free(&failed);
         memset(t, 0, sizeof *t);
         return HD_ENOMEM; /* the triangles stay the caller's */
@@ -320,7 +336,7 @@ int hd__bvh_build_threads(hd__bvh_t *t, hd__tri_t *tris, size_t n, int threads) 
     hd__parallel_for(threads, chunks, gather, &B);
     hd__parallel_for(threads, n_sub, subtree_boxes, &B);
     for (size_t i = n_top; i-- > 0;) node_box(t, top[i]); /* deeper levels listed later */
-    free(keys), free(ranges), free(top);
+    hd__reuse_put(NULL, keys), free(ranges), free(top);
     free(tris); /* taken over: its triangles are now t->tris */
     return HD_OK;
 }

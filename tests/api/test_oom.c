@@ -541,6 +541,54 @@ TEST(every_allocation_of_sampling_a_mesh_can_fail_cleanly) {
     exhaust_read(&c, "hd_read_file data/orig/lion-head.off, 5000 points sampled, seed=7");
 }
 
+/* ---- cloud to mesh ------------------------------------------------------------------ */
+
+typedef struct {
+    hd_mesh_file_t *mesh;
+    double *p, *want, *got;
+    size_t n;
+    hd_options_t opt;
+} c2m_ctx;
+
+static int run_c2m(op_t *op, hd_error_t *err) {
+    c2m_ctx *c = op->ctx;
+    hd_points_t P = hd_points_f64(c->p, c->n);
+    hd_mesh_t M = hd_mesh_file_view(c->mesh);
+    return hd_mesh_distances(&P, &M, &c->opt, c->got, NULL, NULL, NULL, NULL, err);
+}
+
+static void check_c2m(op_t *op) {
+    c2m_ctx *c = op->ctx;
+    CHECK(memcmp(c->got, c->want, c->n * sizeof *c->got) == 0);
+}
+
+TEST(every_allocation_of_a_cloud_to_mesh_call_can_fail_cleanly) {
+    /* The triangles' copy, the tree (keys, nodes, boxes, prepared records,
+     * frames: optional), the points' order, the runs' results; 2 threads.
+     * Points near the cow's vertices (seed 37). */
+    c2m_ctx c;
+    memset(&c, 0, sizeof c);
+    CHECK_RC(hd_read_mesh("data/orig/cow.off", NULL, &c.mesh, NULL), HD_OK);
+    if (!c.mesh) return;
+    gen_rng_t g;
+    gen_seed(&g, 37);
+    c.n = 2000;
+    c.p = malloc(3 * c.n * sizeof *c.p), c.want = malloc(c.n * sizeof *c.want), c.got = malloc(c.n * sizeof *c.got);
+    for (size_t i = 0; i < c.n; i++)
+        for (int k = 0; k < 3; k++)
+            c.p[3 * i + k] = c.mesh->vertices[3 * (gen_u64(&g) % c.mesh->n_vertices) + k] + 0.01 * (gen_unit(&g) - 0.5);
+    hd_options_init(&c.opt);
+    c.opt.threads = 2;
+    op_t op = {"hd_mesh_distances data/orig/cow.off, 2000 points, seed=37 threads=2", run_c2m, check_c2m, &c};
+    double *keep = c.got;
+    c.got = c.want;
+    CHECK_RC(run_c2m(&op, NULL), HD_OK);
+    c.got = keep;
+    exhaust(&op);
+    free(c.p), free(c.want), free(c.got);
+    hd_mesh_file_free(c.mesh);
+}
+
 TEST(a_file_that_cannot_be_mapped_for_want_of_memory_is_out_of_memory_not_bad_input) {
     /* ENOMEM (address space) and EAGAIN (locked memory) are a lack of
      * memory: HD_ENOMEM, which the tools exit 3 for; another failure of

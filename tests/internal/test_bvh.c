@@ -11,6 +11,7 @@
 #include "gen.h"
 #include "mesh/mesh.h"
 
+#include <math.h>
 #include <stdlib.h>
 
 #ifdef __SANITIZE_ADDRESS__
@@ -224,4 +225,72 @@ TEST(prepared_triangles_have_the_same_bits_whichever_thread_prepares_them) {
     CHECK_EQ(atomic_load(t.used), n);
     hd__bvh_free(&t);
     free(want);
+}
+
+/* A near point searched from a seed on the far side of a torus: a leaf's
+ * triangles are bounded as soon as it is screened, so the threshold drops
+ * to about the point's distance at the first leaf reached and the descent
+ * opens few nodes more than from the best seed (not the seed's loose
+ * bound all the way down); the answers stay the brute force's. */
+TEST(a_near_point_from_a_far_seed_opens_few_nodes) {
+    size_t n = 20000, queries = 200 / SCALE;
+    hd__tri_t *orig = tris_make(11, n, 2);
+    hd__tri_t *copy = malloc(n * sizeof *copy);
+    memcpy(copy, orig, n * sizeof *copy);
+    hd__bvh_t t;
+    CHECK_RC(hd__bvh_build_threads(&t, copy, n, 1), HD_OK);
+    gen_rng_t g;
+    gen_seed(&g, 11);
+    hd__bvh_stats_t st = {0, 0, 0, 0, 0, 0};
+    for (size_t q = 0; q < queries && !hdt_failed(); q++) {
+        const hd__tri_t *on = &orig[gen_u64(&g) % n];
+        double p[3], lo = INFINITY;
+        size_t seed = 0;
+        for (int c = 0; c < 3; c++) p[c] = (on->v[0][c] + on->v[1][c] + on->v[2][c]) / 3 + 1e-3 * (gen_unit(&g) - 0.5);
+        for (size_t k = 0; k < n; k++) { /* the seed: a triangle about opposite p */
+            double s = t.tris[k].v[0][0] * p[0] + t.tris[k].v[0][1] * p[1];
+            if (s < lo) lo = s, seed = k;
+        }
+        hd__tri_near_t want, got;
+        size_t want_index = SIZE_MAX, index;
+        for (size_t k = 0; k < n; k++) {
+            hd__tri_near_t r;
+            CHECK_RC(hd__tri_nearest(p, orig[k].v[0], orig[k].v[1], orig[k].v[2], &r), HD_OK);
+            if (want_index == SIZE_MAX || r.d < want.d) want = r, want_index = k;
+        }
+        hd__bvh_nearest(&t, p, seed, 0, &got, &index, &st);
+        CONTEXT("seed 11, query %zu", q);
+        CHECK_BITS(got.d, want.d);
+        CHECK_EQ(index, want_index);
+    }
+    double nodes = (double)st.nodes / (double)queries;
+    CONTEXT("seed 11: %.1f nodes opened a query", nodes);
+    CHECK(nodes < 40);
+    hd__bvh_free(&t);
+    free(orig);
+}
+
+/* A node of 128 triangles or more chooses its axis from every
+ * (n / 64)-th centroid of its range (bvh_build.c): here every fourth
+ * triangle of 2048 lies along y over [0, 1], the others along x over
+ * [0, 4], so the sample's longest axis (every 32nd centroid) is y and the
+ * whole set's x.  The root splits along y: its first child holds the 1024
+ * lowest centroids in y, and both children span x. */
+TEST(a_large_node_splits_along_the_longest_axis_of_its_sampled_centroids) {
+    size_t n = 2048;
+    hd__tri_t *t = malloc(n * sizeof *t);
+    for (size_t k = 0; k < n; k++) {
+        double x = k % 4 ? 4.0 * (double)k / (double)n : 0.5, y = k % 4 ? 0.5 : (double)k / (double)n;
+        double c[3][3] = {{x, y, 0}, {x + 1e-3, y, 0}, {x, y + 1e-3, 1e-3}};
+        memcpy(t[k].v, c, sizeof c);
+        t[k].index = k;
+    }
+    hd__bvh_t tree;
+    CHECK_RC(hd__bvh_build_threads(&tree, t, n, 1), HD_OK);
+    const hd__box_t *a = &tree.nodes[1].box, *b = &tree.nodes[tree.nodes[0].first_or_second].box;
+    CONTEXT("first child y [%g, %g] x [%g, %g]; second y [%g, %g]", a->lo[1], a->hi[1], a->lo[0], a->hi[0],
+            b->lo[1], b->hi[1]);
+    CHECK(a->hi[1] <= 0.5 + 1e-3 && b->hi[1] > 0.9); /* split along y: x spans the whole range in both */
+    CHECK(a->hi[0] - a->lo[0] > 3);
+    hd__bvh_free(&tree);
 }

@@ -376,6 +376,45 @@ TEST(a_prepared_triangle_gives_the_same_bounds) {
     }
 }
 
+/* hd__tri_bounds_below: hd__tri_bounds_prep's lo2 at any skip, its hi2
+ * whenever lo2 <= skip; above skip the upper bound may be left infinite,
+ * and is for a point in a corner's region (the corners' lower bound alone
+ * exceeds skip, the feet on the edges are not formed). */
+TEST(bounds_below_a_threshold_keep_the_lower_bound) {
+    for (int f = 0; f < F_COUNT; f++) {
+        gen_rng_t g;
+        uint64_t seed = 4500 + (uint64_t)f;
+        gen_seed(&g, seed);
+        for (long i = 0; i < 2000 && !hdt_failed(); i++) {
+            tri_case_t t;
+            hd__tri_prep_t tp;
+            double lo2, hi2, blo2, bhi2;
+            make_case(&g, f, &t);
+            hd__tri_prep(t.a, t.b, t.c, &tp);
+            hd__tri_bounds_prep(t.p, &tp, &lo2, &hi2);
+            const double skips[] = {0, lo2 / 2, lo2, nextafter(lo2, INFINITY), hi2, INFINITY};
+            for (int k = 0; k < 6; k++) {
+                CONTEXT("family %s, seed %llu, case %ld, skip %d", family_name[f], (unsigned long long)seed, i, k);
+                hd__tri_bounds_below(t.p, &tp, skips[k], &blo2, &bhi2);
+                CHECK_BITS(blo2, lo2);
+                if (lo2 <= skips[k]) CHECK_BITS(bhi2, hi2);
+                else CHECK(bhi2 >= hi2);
+            }
+        }
+    }
+    tri_case_t t;
+    hd__tri_prep_t tp;
+    double lo2, hi2;
+    set3(t.a, 0, 0, 0); set3(t.b, 4, 0, 0); set3(t.c, 0, 4, 0);
+    set3(t.p, -3, -4, 0);                          /* beyond A: 25 */
+    hd__tri_prep(t.a, t.b, t.c, &tp);
+    hd__tri_bounds_below(t.p, &tp, 20, &lo2, &hi2);
+    CHECK(lo2 > 20 && lo2 <= 25);
+    CHECK(hi2 == INFINITY);
+    hd__tri_bounds_below(t.p, &tp, 30, &lo2, &hi2);
+    CHECK(lo2 <= 25 && hi2 >= 25 && hi2 < 26);
+}
+
 TEST(the_bounds_of_hand_cases) {
     tri_case_t t;
     double lo2, hi2;
