@@ -115,10 +115,20 @@ typedef struct hd_mpi_options {
                             for benchmarks).  hd_mpi_distances and
                             hd_mpi_hausdorff_percentile ignore it: every
                             point needs its own answer or class */
+    int replicate;       /* 1 (default): a tiny side (at most 4096 points,
+                            and the other side at least 16 K times as
+                            large, K the ranks) is copied to every rank
+                            and the other side's points stay where they
+                            are: no partition, no exchange
+                            (docs/scale-out.md, "A tiny side"); 0: the
+                            partition's course, as for any sets.  The
+                            result is the same bit for bit.
+                            hd_mpi_distances and
+                            hd_mpi_hausdorff_percentile ignore it */
 } hd_mpi_options_t;
 
-/* Fill `opt` with the defaults: hd_options_init's engine options and
- * prune = 1. */
+/* Fill `opt` with the defaults: hd_options_init's engine options,
+ * prune = 1 and replicate = 1. */
 void hd_mpi_options_init(hd_mpi_options_t *opt);
 
 /* What the exchange cost, the same on every rank (sums and maxima over the

@@ -60,4 +60,19 @@ void hd__mpi_spread_free(hd__mpi_ctx_t *c, hd__mpi_spread_t *sp);
 int hd__mpi_views(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, hd__mpi_views_t *vw);
 void hd__mpi_views_free(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, hd__mpi_views_t *vw);
 
+/* ---- a tiny side replicated (tiny.c) -------------------------------------- */
+
+/* Side s is tiny when N[s] <= HD__MPI_TINY_MAX and N[1 - s] >=
+ * HD__MPI_TINY_RATIO K N[s] (docs/scale-out.md, "A tiny side"). */
+#define HD__MPI_TINY_MAX 4096
+#define HD__MPI_TINY_RATIO 16
+/* The tiny side (0: A, 1: B), or -1: none, or K = 1, or the options'
+ * replicate is 0.  From the global counts alone: every rank decides the same. */
+int hd__mpi_tiny_side(const hd__mpi_ctx_t *c, const uint64_t N[2]);
+/* The Hausdorff distance with side ts replicated on every rank
+ * (collective): f[0] = h(A, B) and, when both, f[1] = h(B, A), with global
+ * witnesses. */
+int hd__mpi_tiny(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const hd__mpi_ranges_t *rg, const uint64_t N[2], int ts,
+                 int both, hd__mpi_far_t f[2]);
+
 #endif /* HD_MPI_COURSE_H */

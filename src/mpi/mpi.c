@@ -354,8 +354,12 @@ static int run(hd__mpi_ctx_t *c, const hd_options_t *opt, hd__mpi_input_t *in, v
 
     hd__mpi_far_t f[2];
     uint64_t pts;
+    int ts = hd__mpi_tiny_side(c, cs.N);
     if (K == 1) {
         if ((rc = single(c, in, &cs.rg, both, f)) != HD_OK) goto done;
+        pts = in->n[0] + in->n[1];
+    } else if (ts >= 0) { /* replicated, nothing partitioned (tiny.c) */
+        if ((rc = hd__mpi_tiny(c, in, &cs.rg, cs.N, ts, both, f)) != HD_OK) goto done;
         pts = in->n[0] + in->n[1];
     } else {
         hd__mpi_spread_t *sp = &cs.sp;
@@ -413,6 +417,7 @@ done:
 void hd_mpi_options_init(hd_mpi_options_t *opt) {
     hd_options_init(&opt->engine);
     opt->prune = 1;
+    opt->replicate = 1;
 }
 
 int hd__mpi_call(MPI_Comm comm, const hd_mpi_part_t *a, size_t na, const hd_mpi_part_t *b, size_t nb,
@@ -422,7 +427,7 @@ int hd__mpi_call(MPI_Comm comm, const hd_mpi_part_t *a, size_t na, const hd_mpi_
     hd__mpi_ctx_t c;
     memset(&c, 0, sizeof c);
     c.ans_type = c.q_type = c.far_type = c.sample_type = c.node_type = MPI_DATATYPE_NULL;
-    c.far_op = MPI_OP_NULL;
+    c.far_op = c.near_op = MPI_OP_NULL;
     c.comm = MPI_COMM_NULL;
     hd__err_clear(&c.e);
     int init = 0, fin = 0;
@@ -439,6 +444,7 @@ int hd__mpi_call(MPI_Comm comm, const hd_mpi_part_t *a, size_t na, const hd_mpi_
         c.first = hd__mpi_first_samples(c.K);
         c.threads = opt ? opt->threads : 0;
         c.prune = mopt ? mopt->prune : 1;
+        c.replicate = mopt ? mopt->replicate : 1;
         if (c.threads < 0) c.threads = 1; /* refused by check_local, on every rank */
         rc = hd__mpi_types_create(&c);
         if ((rc = hd__mpi_agree(&c, rc)) == HD_OK) {
