@@ -239,10 +239,10 @@ static int give_back(hd__mpi_ctx_t *c, const hd__mpi_spread_t *sp, const hd__mpi
     int *scount = cnt, *sdispl = cnt + K, *rcount = cnt + 2 * K, *rdispl = cnt + 3 * K, *cur = cnt + 4 * K;
     for (size_t k = 0; k < n && rc == HD_OK; k++) d2[k] = sqrt(d2[k]); /* one sqrt, as hd_distances */
     if (rc == HD_OK && !loc->merged[s]) {
-        /* Runs as received: sender r's points are positions [start[r], start[r + 1]). */
+        /* Runs as received: sender r's points are positions [start[r], start[r] + start[K + r]). */
         for (int r = 0; r < K; r++) {
             sdispl[r] = (int)loc->start[s][r];
-            scount[r] = (int)(loc->start[s][r + 1] - loc->start[s][r]);
+            scount[r] = (int)loc->start[s][K + r];
         }
     } else if (rc == HD_OK) {
         /* Merged: each position's sender is the owner of its index (the

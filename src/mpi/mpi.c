@@ -257,7 +257,7 @@ void hd__mpi_spread_free(hd__mpi_ctx_t *c, hd__mpi_spread_t *sp) {
     for (int s = 0; s < 2; s++) {
         hd__mpi_free(c, sp->loc.xyz[s], sp->loc.n[s], 3 * sizeof(double));
         hd__mpi_gidx_free(c, &sp->loc.gi[s]);
-        if (sp->loc.start[s]) hd__mpi_free(c, sp->loc.start[s], (size_t)K + 1, sizeof(size_t));
+        if (sp->loc.start[s]) hd__mpi_free(c, sp->loc.start[s], 2 * (size_t)K, sizeof(size_t));
     }
     hd__mpi_free(c, sp->tree, (size_t)K - 1, sizeof(hd__mpi_node_t));
     hd__mpi_free(c, sp->region, (size_t)K, sizeof(hd__box_t));
