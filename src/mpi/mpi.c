@@ -12,7 +12,8 @@
  * types), ranges.c the validation and the index runs, rcb.c the partition
  * (step 1), exchange.c the exchange (2), shell.c the engine's pass (3),
  * slab.c the per-point searches, forward.c the forwarding and reduction
- * (4 to 6); gidx.c the local sets' indices, distances.c and analysis.c
+ * (4 to 6), tiny.c the course without a partition when one side is tiny
+ * (replicated on every rank); gidx.c the local sets' indices, distances.c and analysis.c
  * the per-point distances and their figures.  What they share is in
  * private headers by concern: context.h, ranges.h, partition.h,
  * search.h and course.h.  Each file opens with its invariants.
