@@ -122,9 +122,9 @@ typedef struct hd_mpi_options {
                             are: no partition, no exchange
                             (docs/scale-out.md, "A tiny side"); 0: the
                             partition's course, as for any sets.  The
-                            result is the same bit for bit.
-                            hd_mpi_distances and
-                            hd_mpi_hausdorff_percentile ignore it */
+                            result is the same bit for bit (hd_mpi_distances
+                            too: every point's answer).
+                            hd_mpi_hausdorff_percentile ignores it */
 } hd_mpi_options_t;
 
 /* Fill `opt` with the defaults: hd_options_init's engine options,

@@ -50,14 +50,7 @@ int hd__mpi_tiny_side(const hd__mpi_ctx_t *c, const uint64_t N[2]) {
     return -1;
 }
 
-/* All of T on every rank, in global index order. */
-typedef struct {
-    double *xyz;
-    uint64_t *g;
-    size_t n;
-} tiny_t;
-
-static void tiny_free(hd__mpi_ctx_t *c, tiny_t *t) {
+void hd__mpi_tiny_free(hd__mpi_ctx_t *c, hd__mpi_tiny_t *t) {
     hd__mpi_free(c, t->xyz, t->n, 3 * sizeof(double));
     hd__mpi_free(c, t->g, t->n, sizeof(uint64_t));
     memset(t, 0, sizeof *t);
@@ -69,9 +62,8 @@ static int by_g(const void *x, const void *y) {
     return a->g < b->g ? -1 : a->g > b->g;
 }
 
-/* Gathers side s (rc: the caller's status, agreed first). */
-static int gather(hd__mpi_ctx_t *c, int rc, const hd_points_t *own, const hd__mpi_ranges_t *rg, int s, uint64_t NT,
-                  tiny_t *t) {
+int hd__mpi_tiny_gather(hd__mpi_ctx_t *c, int rc, const hd_points_t *own, const hd__mpi_ranges_t *rg, int s, uint64_t NT,
+                  hd__mpi_tiny_t *t) {
     int K = c->K, nmine = (int)own->count;
     int *cnt = hd__mpi_alloc(c, 2 * (size_t)K, sizeof(int));
     double *send = hd__mpi_alloc(c, own->count ? own->count : 1, 3 * sizeof(double));
@@ -109,7 +101,7 @@ done:
 /* h(L, T) over all ranks (collective; rc agreed first): the engine on the
  * rank's L, then the witness reduction. */
 static int large_to_tiny(hd__mpi_ctx_t *c, int rc, const hd_points_t *L, const hd__mpi_ranges_t *rg, int ls,
-                         const tiny_t *t, hd__mpi_far_t *out) {
+                         const hd__mpi_tiny_t *t, hd__mpi_far_t *out) {
     hd__mpi_far_t mine = {-1.0, UINT64_MAX, UINT64_MAX};
     if (rc == HD_OK && L->count) {
         hd_points_t Tv = hd_points_f64(t->xyz, t->n);
@@ -143,7 +135,7 @@ static hd_points_t sub_view(const hd_points_t *v, size_t j0, size_t n) {
 /* For each point of T, its exact nearest among the rank's L (smallest
  * position on ties) into near[k] as (d2, position); (inf, UINT64_MAX)
  * when L is empty. */
-static int nearest_in_l(hd__mpi_ctx_t *c, const hd_points_t *L, const hd__box_t *lbox, const tiny_t *t,
+static int nearest_in_l(hd__mpi_ctx_t *c, const hd_points_t *L, const hd__box_t *lbox, const hd__mpi_tiny_t *t,
                         hd__mpi_ans_t *near) {
     for (size_t k = 0; k < t->n; k++) near[k] = (hd__mpi_ans_t){INFINITY, UINT64_MAX};
     size_t nL = L->count, ch = nL / 4 > CHUNK_MIN ? nL / 4 : CHUNK_MIN;
@@ -173,11 +165,8 @@ static int nearest_in_l(hd__mpi_ctx_t *c, const hd_points_t *L, const hd__box_t 
     return rc;
 }
 
-/* h(T, L) over all ranks (collective; rc agreed first). */
-static int tiny_to_large(hd__mpi_ctx_t *c, int rc, const hd_points_t *L, const hd__box_t *lbox,
-                         const hd__mpi_ranges_t *rg, int ls, const tiny_t *t, hd__mpi_far_t *out) {
-    hd__mpi_ans_t *near = hd__mpi_alloc(c, t->n, sizeof *near);
-    if (rc == HD_OK && !near) rc = hd__mpi_nomem(c, "the tiny side's answers", t->n);
+int hd__mpi_tiny_answers(hd__mpi_ctx_t *c, int rc, const hd_points_t *L, const hd__box_t *lbox,
+                         const hd__mpi_ranges_t *rg, int ls, const hd__mpi_tiny_t *t, hd__mpi_ans_t *near) {
     if (rc == HD_OK) {
         double t0 = hd__now(), u0 = hd__mpi_cpu();
         rc = nearest_in_l(c, L, lbox, t, near);
@@ -186,16 +175,25 @@ static int tiny_to_large(hd__mpi_ctx_t *c, int rc, const hd_points_t *L, const h
     }
     for (size_t k = 0; rc == HD_OK && k < t->n; k++)
         if (near[k].g != UINT64_MAX) near[k].g = hd__mpi_ranges_global(rg, ls, c->rank, near[k].g);
-    if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
-    HD__MPI_GO(c, rc, MPI_Allreduce(MPI_IN_PLACE, near, (int)t->n, c->ans_type, c->near_op, c->comm));
+    if ((rc = hd__mpi_agree(c, rc)) != HD_OK) return rc;
+    HD__MPI_TRY(c, MPI_Allreduce(MPI_IN_PLACE, near, (int)t->n, c->ans_type, c->near_op, c->comm));
     /* a reduction's bytes, counted as a ring's: each rank sends each answer
      * twice less a K-th */
     c->bytes_part += 2 * (uint64_t)t->n * sizeof *near * (uint64_t)(c->K - 1) / (uint64_t)c->K;
-    size_t w = 0;
-    for (size_t k = 1; k < t->n; k++)
-        if (near[k].d2 > near[w].d2) w = k; /* the first at the largest: the smallest index */
-    *out = (hd__mpi_far_t){near[w].d2, t->g[w], near[w].g};
-done:
+    return HD_OK;
+}
+
+/* h(T, L) over all ranks (collective; rc agreed first). */
+static int tiny_to_large(hd__mpi_ctx_t *c, int rc, const hd_points_t *L, const hd__box_t *lbox,
+                         const hd__mpi_ranges_t *rg, int ls, const hd__mpi_tiny_t *t, hd__mpi_far_t *out) {
+    hd__mpi_ans_t *near = hd__mpi_alloc(c, t->n, sizeof *near);
+    if (rc == HD_OK && !near) rc = hd__mpi_nomem(c, "the tiny side's answers", t->n);
+    if ((rc = hd__mpi_tiny_answers(c, rc, L, lbox, rg, ls, t, near)) == HD_OK) {
+        size_t w = 0;
+        for (size_t k = 1; k < t->n; k++)
+            if (near[k].d2 > near[w].d2) w = k; /* the first at the largest: the smallest index */
+        *out = (hd__mpi_far_t){near[w].d2, t->g[w], near[w].g};
+    }
     hd__mpi_free(c, near, t->n, sizeof *near);
     return rc;
 }
@@ -204,14 +202,14 @@ int hd__mpi_tiny(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const hd__mpi_rang
                  int both, hd__mpi_far_t f[2]) {
     int ls = 1 - ts;
     hd__mpi_views_t vw;
-    tiny_t t;
+    hd__mpi_tiny_t t;
     memset(&t, 0, sizeof t);
     int rc = hd__mpi_views(c, in, &vw);
-    rc = gather(c, rc, &vw.v[ts], rg, ts, N[ts], &t);
+    rc = hd__mpi_tiny_gather(c, rc, &vw.v[ts], rg, ts, N[ts], &t);
     /* A -> B is f[0]: L -> T when T is B, T -> L when T is A. */
     if (both || ts == 1) rc = large_to_tiny(c, rc, &vw.v[ls], rg, ls, &t, &f[ls]);
     if (both || ts == 0) rc = tiny_to_large(c, rc, &vw.v[ls], &in->box[ls], rg, ls, &t, &f[ts]);
-    tiny_free(c, &t);
+    hd__mpi_tiny_free(c, &t);
     hd__mpi_views_free(c, in, &vw);
     return rc;
 }

@@ -17,7 +17,8 @@
  *    searched one by one or forwarded;
  *  - hd_mpi_options_t.replicate = 0 gives the same result;
  *  - hd_mpi_distances gives every rank's points what hd_distances gives
- *    them (the per-point files of hausdorff-mpi --distances).
+ *    them (the per-point files of hausdorff-mpi --distances), both
+ *    directions and each alone, by the replicated course too.
  * Seeds are fixed and printed with every failure.
  */
 #include <hausdorff_mpi.h>
@@ -126,6 +127,15 @@ static void distances(const hd_points_t *A, const hd_points_t *B, const hd_mpi_p
     CHECK(hd_mpi_distances(MPI_COMM_WORLD, pa, na, pb, nb, mo, d[0], n[0], d[1], n[1], &st, &err) == HD_OK);
     same_distances(pa, na, d[0], n[0], rd[0], rn[0], "A to B");
     same_distances(pb, nb, d[1], n[1], rd[1], rn[1], "B to A");
+    replicated(&st, NA < NB ? NA : NB);
+    CHECK(st.bytes_returned == 0);
+    /* each direction alone: the other's outputs NULL on every rank */
+    memset(d[0], 0, NA * sizeof(double));
+    CHECK(hd_mpi_distances(MPI_COMM_WORLD, pa, na, pb, nb, mo, d[0], n[0], NULL, NULL, &st, &err) == HD_OK);
+    same_distances(pa, na, d[0], n[0], rd[0], rn[0], "A to B alone");
+    memset(n[1], 0, NB * sizeof(size_t));
+    CHECK(hd_mpi_distances(MPI_COMM_WORLD, pa, na, pb, nb, mo, NULL, NULL, d[1], n[1], &st, &err) == HD_OK);
+    same_distances(pb, nb, d[1], n[1], rd[1], rn[1], "B to A alone");
     for (int s = 0; s < 2; s++) free(rd[s]), free(d[s]), free(rn[s]), free(n[s]);
 }
 
@@ -167,7 +177,7 @@ static void run(int set, int tiny_b, int how, uint64_t seed) {
         CHECK(K_ == 1 || st.bytes_partition > 56 * (uint64_t)(K_ - 1) * nt);
         mo.replicate = 1;
     }
-    if (how == LAY_CHUNKS) distances(&A, &B, pa, na, pb, nb, &mo);
+    if (how != LAY_BLOCKS) distances(&A, &B, pa, na, pb, nb, &mo);
     free(L);
     free(T);
 }
