@@ -13,7 +13,8 @@
  * (step 1), exchange.c the exchange (2), shell.c the engine's pass (3),
  * slab.c the per-point searches, forward.c the forwarding and reduction
  * (4 to 6), tiny.c the course without a partition when one side is tiny
- * (replicated on every rank); gidx.c the local sets' indices, distances.c and analysis.c
+ * (replicated on every rank), views.c the caller's points as views in index
+ * order; gidx.c the local sets' indices, distances.c and analysis.c
  * the per-point distances and their figures.  What they share is in
  * private headers by concern: context.h, ranges.h, partition.h,
  * search.h and course.h.  Each file opens with its invariants.
@@ -154,44 +155,6 @@
 #include <assert.h>
 #include <stdlib.h>
 #include <string.h>
-
-/* K = 1: no partition, no exchange and no copy: a set given as one part
- * (or one nonempty part) is the caller's view, of any layout; else its
- * parts are packed into one array in index order (24 bytes a point).  Its
- * local indices become global ones (ranges_global): local order is index
- * order, so a smallest index on ties is the global one. */
-int hd__mpi_views(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, hd__mpi_views_t *vw) {
-    memset(vw, 0, sizeof *vw);
-    for (int s = 0; s < 2; s++) {
-        size_t nonempty = 0, last = 0;
-        for (size_t p = 0; p < in->nparts[s]; p++)
-            if (in->parts[s][p].points.count) nonempty++, last = p;
-        if (nonempty == 1) {
-            vw->v[s] = in->parts[s][last].points;
-            continue;
-        }
-        vw->own[s] = hd__mpi_alloc(c, in->n[s], 3 * sizeof(double));
-        vw->order[s] = hd__mpi_alloc(c, in->nparts[s], sizeof *vw->order[s]);
-        if (!vw->own[s] || !vw->order[s]) return hd__mpi_nomem(c, "the parts", in->n[s]);
-        const hd_mpi_part_t **order = vw->order[s];
-        for (size_t p = 0; p < in->nparts[s]; p++) order[p] = &in->parts[s][p];
-        qsort(order, in->nparts[s], sizeof *order, hd__mpi_by_offset);
-        size_t t = 0;
-        for (size_t p = 0; p < in->nparts[s]; p++)
-            for (size_t k = 0; k < order[p]->points.count; k++)
-                hd__mpi_get_point(&order[p]->points, k, vw->own[s] + 3 * t++);
-        vw->v[s] = hd_points_f64(vw->own[s], in->n[s]);
-    }
-    return HD_OK;
-}
-
-void hd__mpi_views_free(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, hd__mpi_views_t *vw) {
-    for (int s = 0; s < 2; s++) {
-        hd__mpi_free(c, vw->own[s], in->n[s], 3 * sizeof(double));
-        hd__mpi_free(c, vw->order[s], in->nparts[s], sizeof *vw->order[s]);
-        vw->own[s] = NULL, vw->order[s] = NULL;
-    }
-}
 
 /* K = 1: the engine on the views. */
 static int single(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const hd__mpi_ranges_t *rg, int both, hd__mpi_far_t *f) {
