@@ -139,7 +139,10 @@ typedef struct hd_mpi_stats {
     uint64_t bytes_partition;   /* bytes sent to other ranks to move the
                                    points (28 a point moved) and choose the
                                    regions (the samples, and the counts
-                                   that refine the splits) */
+                                   that refine the splits); with a tiny
+                                   side replicated, its points (24 each to
+                                   each other rank) and its answers'
+                                   reduction (counted as a ring's) */
     uint64_t bytes_forwarding;  /* bytes of forwarded queries (24 each) and
                                    their answers (16 each) */
     uint64_t bytes_returned;    /* hd_mpi_distances: bytes of per-point
