@@ -3,7 +3,7 @@
  *     mpirun -n K build/bench/mpi_bench [--points N] [--per-rank] [--cases LIST]
  *                                       [--layout random|tiles] [--threads T]
  *                                       [--check] [--repeat R] [--distances]
- *                                       [--rank-cpu] [--no-prune]
+ *                                       [--rank-cpu] [--no-prune] [--no-replicate]
  * For each case, every rank generates its share of A and B (N points per
  * side in total, or per rank with --per-rank: weak scaling), and one call
  * of hd_mpi_hausdorff is timed; rank 0 prints one line per case with the
@@ -40,6 +40,8 @@
  * docs/scale-out.md one core ran 1.4 times slower than the other for an
  * hour on 2026-11-29).  --no-prune sets hd_mpi_options_t's prune to 0:
  * every point moves, the comparison for what the cells keep home.
+ * --no-replicate sets its replicate to 0: a tiny side (tinya, tinyb) takes
+ * the partition's course instead of being copied to every rank.
  *
  * --distances times hd_mpi_distances (both directions, every point's nearest
  * neighbour; the faster of two calls) instead, and prints per case: bytes moved per input point by
@@ -287,7 +289,7 @@ int main(int argc, char **argv) {
     MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
     MPI_Comm_size(MPI_COMM_WORLD, &K_);
     size_t N = 1000000;
-    int per_rank = 0, tiles = 0, threads = 1, check = 0, repeat = 1, dist = 0, rank_cpu = 0, prune = 1;
+    int per_rank = 0, tiles = 0, threads = 1, check = 0, repeat = 1, dist = 0, rank_cpu = 0, prune = 1, replicate = 1;
     const char *cases = "uniform,lidar,copy";
     for (int k = 1; k < argc; k++) {
         if (!strcmp(argv[k], "--points") && k + 1 < argc) N = (size_t)atof(argv[++k]);
@@ -300,6 +302,7 @@ int main(int argc, char **argv) {
         else if (!strcmp(argv[k], "--distances")) dist = 1;
         else if (!strcmp(argv[k], "--rank-cpu")) rank_cpu = 1;
         else if (!strcmp(argv[k], "--no-prune")) prune = 0;
+        else if (!strcmp(argv[k], "--no-replicate")) replicate = 0;
         else {
             if (rank_ == 0) fprintf(stderr, "mpi_bench: unknown argument %s\n", argv[k]);
             MPI_Finalize();
@@ -349,6 +352,7 @@ int main(int argc, char **argv) {
         hd_mpi_options_init(&opt);
         opt.engine.threads = threads;
         opt.prune = prune;
+        opt.replicate = replicate;
         hd_symmetric_t r;
         hd_mpi_stats_t st;
         hd_error_t err;

@@ -115,10 +115,20 @@ typedef struct hd_mpi_options {
                             for benchmarks).  hd_mpi_distances and
                             hd_mpi_hausdorff_percentile ignore it: every
                             point needs its own answer or class */
+    int replicate;       /* 1 (default): a tiny side (at most 4096 points,
+                            and the other side at least 16 K times as
+                            large, K the ranks) is copied to every rank
+                            and the other side's points stay where they
+                            are: no partition, no exchange
+                            (docs/scale-out.md, "A tiny side"); 0: the
+                            partition's course, as for any sets.  The
+                            result is the same bit for bit (hd_mpi_distances
+                            too: every point's answer).
+                            hd_mpi_hausdorff_percentile ignores it */
 } hd_mpi_options_t;
 
-/* Fill `opt` with the defaults: hd_options_init's engine options and
- * prune = 1. */
+/* Fill `opt` with the defaults: hd_options_init's engine options,
+ * prune = 1 and replicate = 1. */
 void hd_mpi_options_init(hd_mpi_options_t *opt);
 
 /* What the exchange cost, the same on every rank (sums and maxima over the
@@ -129,7 +139,10 @@ typedef struct hd_mpi_stats {
     uint64_t bytes_partition;   /* bytes sent to other ranks to move the
                                    points (28 a point moved) and choose the
                                    regions (the samples, and the counts
-                                   that refine the splits) */
+                                   that refine the splits); with a tiny
+                                   side replicated, its points (24 each to
+                                   each other rank) and its answers'
+                                   reduction (counted as a ring's) */
     uint64_t bytes_forwarding;  /* bytes of forwarded queries (24 each) and
                                    their answers (16 each) */
     uint64_t bytes_returned;    /* hd_mpi_distances: bytes of per-point

@@ -25,6 +25,10 @@
 #    tower in one epoch, a lattice against its half-step shift) give
 #    hd_hausdorff's and hd_directed's answers bit for bit, and at most 2 %
 #    of the points are forwarded.  The same K as mpi_api.
+#  - mpi_tiny_K: tests/api/mpi_tiny.c under `mpirun -n K`: a tiny side
+#    replicated on every rank (src/mpi/tiny.c), both ways, with ties
+#    across ranks: results and per-point answers bit for bit, and only the
+#    tiny side moved.  The same K as mpi_api.
 #  - mpi_gidx: tests/internal/mpi_gidx.c, the encoded global indices of
 #    the local sets (src/mpi/gidx.c) read back by position and by cursor.
 #  - mpi_memory: tests/internal/mpi_memory.c, the call's buffers charged at
@@ -69,6 +73,10 @@ if(HD_MPI)
   target_include_directories(mpi_shapes PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/tests/support)
   target_link_libraries(mpi_shapes PRIVATE hausdorff_mpi)
   set_target_properties(mpi_shapes PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/tests)
+  add_executable(mpi_tiny ${CMAKE_CURRENT_SOURCE_DIR}/tests/api/mpi_tiny.c ${CMAKE_CURRENT_SOURCE_DIR}/tests/support/gen.c)
+  target_include_directories(mpi_tiny PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/tests/support)
+  target_link_libraries(mpi_tiny PRIVATE hausdorff_mpi)
+  set_target_properties(mpi_tiny PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/tests)
   add_executable(mpi_partition ${CMAKE_CURRENT_SOURCE_DIR}/tests/internal/mpi_partition.c ${CMAKE_CURRENT_SOURCE_DIR}/tests/support/gen.c)
   target_include_directories(mpi_partition PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/tests/support ${CMAKE_CURRENT_SOURCE_DIR}/src)
   target_link_libraries(mpi_partition PRIVATE hausdorff_mpi)
@@ -88,6 +96,8 @@ if(HD_MPI)
     set_tests_properties(mpi_figures_${k} PROPERTIES TIMEOUT 300 ENVIRONMENT "${HD_MPI_ENV}" PROCESSORS 2)
     add_test(NAME mpi_shapes_${k} COMMAND ${HD_MPIRUN} -n ${k} $<TARGET_FILE:mpi_shapes>)
     set_tests_properties(mpi_shapes_${k} PROPERTIES TIMEOUT 300 ENVIRONMENT "${HD_MPI_ENV}" PROCESSORS 2)
+    add_test(NAME mpi_tiny_${k} COMMAND ${HD_MPIRUN} -n ${k} $<TARGET_FILE:mpi_tiny>)
+    set_tests_properties(mpi_tiny_${k} PROPERTIES TIMEOUT 300 ENVIRONMENT "${HD_MPI_ENV}" PROCESSORS 2)
     if(NOT k EQUAL 7)
       add_test(NAME mpi_percentile_${k} COMMAND ${HD_MPIRUN} -n ${k} $<TARGET_FILE:mpi_percentile>)
       set_tests_properties(mpi_percentile_${k} PROPERTIES TIMEOUT 300 ENVIRONMENT "${HD_MPI_ENV}" PROCESSORS 2)

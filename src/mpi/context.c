@@ -221,7 +221,7 @@ int hd__mpi_agree(hd__mpi_ctx_t *c, int rc) {
     return e.code;
 }
 
-/* ---- the witness reduction ---------------------------------------------- */
+/* ---- the witness and nearest reductions ---------------------------------- */
 
 static void far_reduce(void *in, void *inout, int *len, MPI_Datatype *type) {
     (void)type;
@@ -231,6 +231,13 @@ static void far_reduce(void *in, void *inout, int *len, MPI_Datatype *type) {
         if (hd__mpi_far_better(&x[k], &y[k])) y[k] = x[k];
 }
 
+static void near_reduce(void *in, void *inout, int *len, MPI_Datatype *type) {
+    (void)type;
+    const hd__mpi_ans_t *x = in;
+    hd__mpi_ans_t *y = inout;
+    for (int k = 0; k < *len; k++)
+        if (hd__mpi_ans_better(&x[k], &y[k])) y[k] = x[k];
+}
 int hd__mpi_types_create(hd__mpi_ctx_t *c) {
     HD__MPI_TRY(c, MPI_Type_contiguous((int)sizeof(hd__mpi_ans_t), MPI_BYTE, &c->ans_type));
     HD__MPI_TRY(c, MPI_Type_contiguous(3, MPI_DOUBLE, &c->q_type));
@@ -240,6 +247,7 @@ int hd__mpi_types_create(hd__mpi_ctx_t *c) {
     MPI_Datatype *all[] = {&c->ans_type, &c->q_type, &c->far_type, &c->sample_type, &c->node_type};
     for (size_t k = 0; k < sizeof all / sizeof *all; k++) HD__MPI_TRY(c, MPI_Type_commit(all[k]));
     HD__MPI_TRY(c, MPI_Op_create(far_reduce, 1, &c->far_op));
+    HD__MPI_TRY(c, MPI_Op_create(near_reduce, 1, &c->near_op));
     return HD_OK;
 }
 
@@ -248,4 +256,5 @@ void hd__mpi_types_free(hd__mpi_ctx_t *c) {
     for (size_t k = 0; k < sizeof all / sizeof *all; k++)
         if (*all[k] != MPI_DATATYPE_NULL) MPI_Type_free(all[k]);
     if (c->far_op != MPI_OP_NULL) MPI_Op_free(&c->far_op);
+    if (c->near_op != MPI_OP_NULL) MPI_Op_free(&c->near_op);
 }

@@ -57,8 +57,10 @@ typedef struct hd__mpi_ctx {
     int rounds;
     int first;                 /* the partition's first samples a rank (rcb.c) */
     int prune;                 /* hd_mpi_options_t's: cells that cannot matter stay (prune.c) */
+    int replicate;             /* hd_mpi_options_t's: a tiny side on every rank (tiny.c) */
     MPI_Datatype ans_type, q_type, far_type, sample_type, node_type;
-    MPI_Op far_op;
+    MPI_Op far_op;             /* hd__mpi_far_t: the larger d2, then the smaller i */
+    MPI_Op near_op;            /* hd__mpi_ans_t: the smaller d2, then the smaller g */
 } hd__mpi_ctx_t;
 
 
@@ -89,6 +91,11 @@ void hd__mpi_types_free(hd__mpi_ctx_t *c);
 /* The witness order: larger d2 first, then the smaller index i. */
 static inline int hd__mpi_far_better(const hd__mpi_far_t *x, const hd__mpi_far_t *y) {
     return x->d2 > y->d2 || (x->d2 == y->d2 && x->i < y->i);
+}
+
+/* The answer order: smaller d2 first, then the smaller global index. */
+static inline int hd__mpi_ans_better(const hd__mpi_ans_t *x, const hd__mpi_ans_t *y) {
+    return x->d2 < y->d2 || (x->d2 == y->d2 && x->g < y->g);
 }
 
 /* Every MPI call is timed (thread CPU): what is left of the call's CPU

@@ -60,4 +60,36 @@ void hd__mpi_spread_free(hd__mpi_ctx_t *c, hd__mpi_spread_t *sp);
 int hd__mpi_views(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, hd__mpi_views_t *vw);
 void hd__mpi_views_free(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, hd__mpi_views_t *vw);
 
+/* ---- a tiny side replicated (tiny.c) -------------------------------------- */
+
+/* Side s is tiny when N[s] <= HD__MPI_TINY_MAX and N[1 - s] >=
+ * HD__MPI_TINY_RATIO K N[s] (docs/scale-out.md, "A tiny side"). */
+#define HD__MPI_TINY_MAX 4096
+#define HD__MPI_TINY_RATIO 16
+/* The tiny side (0: A, 1: B), or -1: none, or K = 1, or the options'
+ * replicate is 0.  From the global counts alone: every rank decides the same. */
+int hd__mpi_tiny_side(const hd__mpi_ctx_t *c, const uint64_t N[2]);
+/* All of a tiny side T on every rank, in global index order. */
+typedef struct {
+    double *xyz;             /* n points, packed */
+    uint64_t *g;             /* their global indices, increasing */
+    size_t n;
+} hd__mpi_tiny_t;
+/* Gathers side s (N_T points over all ranks; own: this rank's, in its
+ * index order) on every rank (collective; rc: the caller's status, agreed
+ * first). */
+int hd__mpi_tiny_gather(hd__mpi_ctx_t *c, int rc, const hd_points_t *own, const hd__mpi_ranges_t *rg, int s,
+                        uint64_t NT, hd__mpi_tiny_t *t);
+void hd__mpi_tiny_free(hd__mpi_ctx_t *c, hd__mpi_tiny_t *t);
+/* Every point k of T's nearest over all ranks' L into near[k] (exact d2,
+ * the smallest global index on ties), on every rank (collective; rc agreed
+ * first).  L: this rank's side ls (its view in index order), lbox its box. */
+int hd__mpi_tiny_answers(hd__mpi_ctx_t *c, int rc, const hd_points_t *L, const hd__box_t *lbox,
+                         const hd__mpi_ranges_t *rg, int ls, const hd__mpi_tiny_t *t, hd__mpi_ans_t *near);
+/* The Hausdorff distance with side ts replicated on every rank
+ * (collective): f[0] = h(A, B) and, when both, f[1] = h(B, A), with global
+ * witnesses. */
+int hd__mpi_tiny(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const hd__mpi_ranges_t *rg, const uint64_t N[2], int ts,
+                 int both, hd__mpi_far_t f[2]);
+
 #endif /* HD_MPI_COURSE_H */

@@ -161,60 +161,134 @@ static void walk_order_free(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, int s, 
 
 /* ---- one rank ------------------------------------------------------------ */
 
-/* hd_distances on the views; its positions (index order) become global
- * indices, and the answers go to the outputs in part order (directly when
- * the nonempty parts are given in offset order, else through a copy). */
-static int single(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const hd__mpi_ranges_t *rg, const int want[2], outs_t *o) {
-    hd__mpi_views_t vw;
-    double *td[2] = {NULL, NULL};
-    size_t *tn[2] = {NULL, NULL};
-    const hd_mpi_part_t **order[2] = {NULL, NULL};
-    size_t *base[2] = {NULL, NULL};
-    int rc = hd__mpi_views(c, in, &vw);
+/* Answers in index order (the views' order) on their way to the outputs in
+ * part order: td/tn are the outputs themselves when the nonempty parts are
+ * given in offset order, else arrays of their own, copied by unstage. */
+typedef struct {
+    double *td[2];
+    size_t *tn[2];
+    const hd_mpi_part_t **order[2];
+    size_t *base[2];
+} staged_t;
+
+static int stage(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const int want[2], const outs_t *o, staged_t *sg) {
+    memset(sg, 0, sizeof *sg);
+    int rc = HD_OK;
     for (int s = 0; s < 2 && rc == HD_OK; s++) {
-        if (!want[s] || (rc = walk_order(c, in, s, &order[s], &base[s])) != HD_OK) continue;
+        if (!want[s] || (rc = walk_order(c, in, s, &sg->order[s], &sg->base[s])) != HD_OK) continue;
         int direct = 1;
         for (size_t p = 0, at = 0; p < in->nparts[s]; p++) {
-            direct &= base[s][p] == at;
-            at += order[s][p]->points.count;
+            direct &= sg->base[s][p] == at;
+            at += sg->order[s][p]->points.count;
         }
-        td[s] = o->dist[s];
-        tn[s] = o->nearest[s];
+        sg->td[s] = o->dist[s];
+        sg->tn[s] = o->nearest[s];
         if (direct) continue;
-        if (o->dist[s] && !(td[s] = hd__mpi_alloc(c, in->n[s], sizeof(double))))
+        if (o->dist[s] && !(sg->td[s] = hd__mpi_alloc(c, in->n[s], sizeof(double))))
             rc = hd__mpi_nomem(c, "the distances", in->n[s]);
-        if (rc == HD_OK && o->nearest[s] && !(tn[s] = hd__mpi_alloc(c, in->n[s], sizeof(size_t))))
+        if (rc == HD_OK && o->nearest[s] && !(sg->tn[s] = hd__mpi_alloc(c, in->n[s], sizeof(size_t))))
             rc = hd__mpi_nomem(c, "the distances", in->n[s]);
     }
-    if (rc == HD_OK) {
-        /* hd_distances' bound: 60 bytes a point of each set while built */
-        size_t bytes = 60 * (size_t)(in->n[0] + in->n[1]);
-        hd_options_t opt;
-        hd_options_init(&opt);
-        opt.threads = c->threads;
-        hd__mpi_charge(c, bytes);
-        double t0 = hd__now(), u0 = hd__mpi_cpu();
-        rc = hd_distances(&vw.v[0], &vw.v[1], &opt, td[0], tn[0], td[1], tn[1], &c->e);
-        c->search += hd__now() - t0;
-        c->search_cpu += hd__mpi_cpu() - u0;
-        c->cur -= bytes;
-    }
+    return rc;
+}
+
+/* The staged answers to the outputs (when rc is HD_OK), and the stage freed. */
+static void unstage(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const int want[2], outs_t *o, staged_t *sg, int rc) {
     for (int s = 0; s < 2 && rc == HD_OK; s++) {
-        if (!want[s]) continue;
-        if (tn[s])
-            for (size_t k = 0; k < in->n[s]; k++) tn[s][k] = (size_t)hd__mpi_ranges_global(rg, 1 - s, 0, tn[s][k]);
-        if (td[s] == o->dist[s] && tn[s] == o->nearest[s]) continue;
+        if (!want[s] || (sg->td[s] == o->dist[s] && sg->tn[s] == o->nearest[s])) continue;
         for (size_t p = 0, t = 0; p < in->nparts[s]; p++)
-            for (size_t k = 0; k < order[s][p]->points.count; k++, t++) {
-                if (o->dist[s]) o->dist[s][base[s][p] + k] = td[s][t];
-                if (o->nearest[s]) o->nearest[s][base[s][p] + k] = tn[s][t];
+            for (size_t k = 0; k < sg->order[s][p]->points.count; k++, t++) {
+                if (o->dist[s]) o->dist[s][sg->base[s][p] + k] = sg->td[s][t];
+                if (o->nearest[s]) o->nearest[s][sg->base[s][p] + k] = sg->tn[s][t];
             }
     }
     for (int s = 0; s < 2; s++) {
-        if (td[s] != o->dist[s]) hd__mpi_free(c, td[s], in->n[s], sizeof(double));
-        if (tn[s] != o->nearest[s]) hd__mpi_free(c, tn[s], in->n[s], sizeof(size_t));
-        if (order[s]) walk_order_free(c, in, s, order[s], base[s]);
+        if (sg->td[s] != o->dist[s]) hd__mpi_free(c, sg->td[s], in->n[s], sizeof(double));
+        if (sg->tn[s] != o->nearest[s]) hd__mpi_free(c, sg->tn[s], in->n[s], sizeof(size_t));
+        if (sg->order[s]) walk_order_free(c, in, s, sg->order[s], sg->base[s]);
     }
+}
+
+/* hd_distances(P, Q) into P's answers and Q's (dist, nearest: positions in
+ * the other set; any NULL), charged at its bound (60 bytes a point of each
+ * set while built). */
+static int local_distances(hd__mpi_ctx_t *c, const hd_points_t *P, const hd_points_t *Q, double *dp, size_t *np,
+                           double *dq, size_t *nq) {
+    size_t bytes = 60 * (P->count + Q->count);
+    hd_options_t opt;
+    hd_options_init(&opt);
+    opt.threads = c->threads;
+    hd__mpi_charge(c, bytes);
+    double t0 = hd__now(), u0 = hd__mpi_cpu();
+    int rc = hd_distances(P, Q, &opt, dp, np, dq, nq, &c->e);
+    c->search += hd__now() - t0;
+    c->search_cpu += hd__mpi_cpu() - u0;
+    c->cur -= bytes;
+    return rc;
+}
+
+/* hd_distances on the views; its positions (index order) become global
+ * indices, and the answers go to the outputs in part order. */
+static int single(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const hd__mpi_ranges_t *rg, const int want[2], outs_t *o) {
+    hd__mpi_views_t vw;
+    staged_t sg;
+    memset(&sg, 0, sizeof sg);
+    int rc = hd__mpi_views(c, in, &vw);
+    if (rc == HD_OK) rc = stage(c, in, want, o, &sg);
+    if (rc == HD_OK) rc = local_distances(c, &vw.v[0], &vw.v[1], sg.td[0], sg.tn[0], sg.td[1], sg.tn[1]);
+    for (int s = 0; s < 2 && rc == HD_OK; s++)
+        if (want[s] && sg.tn[s])
+            for (size_t k = 0; k < in->n[s]; k++) sg.tn[s][k] = (size_t)hd__mpi_ranges_global(rg, 1 - s, 0, sg.tn[s][k]);
+    unstage(c, in, want, o, &sg, rc);
+    hd__mpi_views_free(c, in, &vw);
+    return rc;
+}
+
+/* ---- a tiny side replicated (tiny.c) --------------------------------------- */
+
+/* Side ts replicated on every rank, nothing partitioned (collective): each
+ * rank's points of L take their nearest in all of T from hd_distances (a
+ * position of T, whose global index the gather gives), and T's points their
+ * nearest over all ranks' L from the reduction of hd__mpi_tiny_answers,
+ * each rank writing its own points' (T in index order: a binary search of
+ * its indices).  One sqrt of the exact d2, as hd_distances. */
+static int tiny(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const hd__mpi_ranges_t *rg, const uint64_t N[2], int ts,
+                const int want[2], outs_t *o) {
+    int ls = 1 - ts;
+    hd__mpi_views_t vw;
+    staged_t sg;
+    hd__mpi_tiny_t t;
+    memset(&t, 0, sizeof t);
+    memset(&sg, 0, sizeof sg);
+    hd__mpi_ans_t *near = NULL;
+    int rc = hd__mpi_views(c, in, &vw);
+    if (rc == HD_OK) rc = stage(c, in, want, o, &sg);
+    rc = hd__mpi_tiny_gather(c, rc, &vw.v[ts], rg, ts, N[ts], &t);
+    if (want[ts]) {
+        near = hd__mpi_alloc(c, t.n, sizeof *near);
+        if (rc == HD_OK && !near) rc = hd__mpi_nomem(c, "the tiny side's answers", t.n);
+        rc = hd__mpi_tiny_answers(c, rc, &vw.v[ls], &in->box[ls], rg, ls, &t, near);
+        for (size_t m = 0; rc == HD_OK && m < in->n[ts]; m++) {
+            uint64_t g = hd__mpi_ranges_global(rg, ts, c->rank, m);
+            size_t lo = 0, hi = t.n;
+            while (lo < hi) { /* T's position of index g */
+                size_t mid = lo + (hi - lo) / 2;
+                if (t.g[mid] < g) lo = mid + 1;
+                else hi = mid;
+            }
+            if (sg.td[ts]) sg.td[ts][m] = sqrt(near[lo].d2);
+            if (sg.tn[ts]) sg.tn[ts][m] = (size_t)near[lo].g;
+        }
+    }
+    if (rc == HD_OK && want[ls] && in->n[ls]) {
+        hd_points_t Tv = hd_points_f64(t.xyz, t.n);
+        rc = local_distances(c, &vw.v[ls], &Tv, sg.td[ls], sg.tn[ls], NULL, NULL);
+        for (size_t k = 0; rc == HD_OK && sg.tn[ls] && k < in->n[ls]; k++) sg.tn[ls][k] = (size_t)t.g[sg.tn[ls][k]];
+    }
+    rc = hd__mpi_agree(c, rc);
+    unstage(c, in, want, o, &sg, rc);
+    hd__mpi_free(c, near, t.n, sizeof *near);
+    hd__mpi_tiny_free(c, &t);
     hd__mpi_views_free(c, in, &vw);
     return rc;
 }
@@ -239,10 +313,10 @@ static int give_back(hd__mpi_ctx_t *c, const hd__mpi_spread_t *sp, const hd__mpi
     int *scount = cnt, *sdispl = cnt + K, *rcount = cnt + 2 * K, *rdispl = cnt + 3 * K, *cur = cnt + 4 * K;
     for (size_t k = 0; k < n && rc == HD_OK; k++) d2[k] = sqrt(d2[k]); /* one sqrt, as hd_distances */
     if (rc == HD_OK && !loc->merged[s]) {
-        /* Runs as received: sender r's points are positions [start[r], start[r + 1]). */
+        /* Runs as received: sender r's points are positions [start[r], start[r] + start[K + r]). */
         for (int r = 0; r < K; r++) {
             sdispl[r] = (int)loc->start[s][r];
-            scount[r] = (int)(loc->start[s][r + 1] - loc->start[s][r]);
+            scount[r] = (int)loc->start[s][K + r];
         }
     } else if (rc == HD_OK) {
         /* Merged: each position's sender is the owner of its index (the
@@ -549,8 +623,11 @@ static int distances(hd__mpi_ctx_t *c, const hd_options_t *opt, hd__mpi_input_t 
     /* A direction runs when some rank asks for it. */
     int asks[2] = {o->dist[0] || o->nearest[0], o->dist[1] || o->nearest[1]}, want[2];
     HD__MPI_GO(c, rc, MPI_Allreduce(asks, want, 2, MPI_INT, MPI_MAX, c->comm));
+    int ts = hd__mpi_tiny_side(c, cs.N);
     if (c->K == 1) {
         if ((rc = single(c, in, &cs.rg, want, o)) != HD_OK) goto done;
+    } else if (ts >= 0 && (want[0] || want[1])) {
+        if ((rc = tiny(c, in, &cs.rg, cs.N, ts, want, o)) != HD_OK) goto done;
     } else if (want[0] || want[1]) {
         if ((rc = hd__mpi_spread(c, in, &cs.rg, cs.N, NULL, sp)) != HD_OK) goto done;
         pts = sp->loc.n[0] + sp->loc.n[1];

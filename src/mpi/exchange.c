@@ -17,7 +17,9 @@
  *    every rank runs the same number of rounds (the allreduced maximum),
  *    each three collectives.
  *  - After the rounds, local order is global index order: as received when
- *    the runs follow each other in index order, else after a K-way merge
+ *    the runs follow each other in index order (they land in the order of
+ *    their senders' smallest indices, so they do whenever no two ranks'
+ *    indices interleave), else after a K-way merge
  *    applied in place (the numbers become 8-byte indices first).  The
  *    indices are then held encoded (hd__mpi_gidx_t, gidx.c): each round's numbers
  *    are encoded as they arrive (still in the cache), as if the runs were
@@ -216,6 +218,7 @@ typedef struct {
     uint32_t *so;
     size_t sendcap;
     uint32_t *off[2];               /* each local point's number at its sender (scratch) */
+    int *sorder;                    /* 2K: side s's senders in the order their runs land (s K + q) */
 } xch_t;
 
 /* The arrays of K or 2K counts, each its own allocation. */
@@ -240,6 +243,8 @@ static int xch_alloc(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, xch_t *x) {
     for (int s = 0; s < 2; s++) ok &= (x->order[s] = hd__mpi_alloc(c, in->nparts[s], sizeof *x->order[s])) != NULL;
     x->dest = hd__mpi_scratch(c, x->nloc, (size_t)x->w);
     if (!ok || !x->dest) return hd__mpi_nomem(c, "the exchange", x->nloc);
+    x->sorder = hd__mpi_alloc(c, 2 * (size_t)x->K, sizeof(int));
+    if (!x->sorder) return hd__mpi_nomem(c, "the exchange", (size_t)x->K);
     x->tb = hd__mpi_alloc(c, x->maxr + 1, sizeof(size_t));
     x->rcnt = hd__mpi_alloc(c, x->maxr * 2 * (size_t)x->K, sizeof(int));
     if (!x->tb || !x->rcnt) return hd__mpi_nomem(c, "the exchange's rounds", x->maxr);
@@ -259,6 +264,7 @@ static void xch_free(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, xch_t *x, cons
     for (int k = 0; k < (int)(sizeof ints / sizeof *ints); k++)
         hd__mpi_free(c, *ints[k], (k < XCH_INTS_2K ? 2 : 1) * (size_t)x->K, sizeof(int));
     for (int k = 0; k < (int)(sizeof sizes / sizeof *sizes); k++) hd__mpi_free(c, *sizes[k], 2 * (size_t)x->K, sizeof(size_t));
+    hd__mpi_free(c, x->sorder, 2 * (size_t)x->K, sizeof(int));
     hd__mpi_free(c, x->tb, x->maxr + 1, sizeof(size_t));
     hd__mpi_free(c, x->rcnt, x->maxr * 2 * (size_t)x->K, sizeof(int));
     for (int s = 0; s < 2; s++) {
@@ -324,13 +330,41 @@ static int xch_plan(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const hd__mpi_n
     return HD_OK;
 }
 
+typedef struct { uint64_t lo; int r; } sender_t;
+static int by_lo(const void *p, const void *q) {
+    const sender_t *a = p, *b = q;
+    return a->lo != b->lo ? (a->lo < b->lo ? -1 : 1) : (a->r > b->r) - (a->r < b->r);
+}
+
+/* The senders of side s in the order of the smallest index each holds
+ * (from the index runs; a rank without one last): their runs land in that
+ * order, so when no two ranks' indices interleave (each rank's parts one
+ * block, whatever the ranks' order, as hausdorff-mpi's B rotated by K/2)
+ * the local arrays are in index order as received, without a merge. */
+static void senders_by_index(hd__mpi_ctx_t *c, const hd__mpi_ranges_t *rg, int s, int K, int *order) {
+    sender_t *t = hd__mpi_alloc(c, (size_t)K, sizeof *t);
+    if (!t) { /* rank order: still correct, the merge sorts */
+        for (int r = 0; r < K; r++) order[r] = r;
+        return;
+    }
+    for (int r = 0; r < K; r++) {
+        size_t a = rg->seg[(size_t)s * ((size_t)K + 1) + (size_t)r], b = rg->seg[(size_t)s * ((size_t)K + 1) + (size_t)r + 1];
+        t[r] = (sender_t){a < b ? rg->all[a].lo : UINT64_MAX, r};
+    }
+    qsort(t, (size_t)K, sizeof *t, by_lo);
+    for (int q = 0; q < K; q++) order[q] = t[q].r;
+    hd__mpi_free(c, t, (size_t)K, sizeof *t);
+}
+
 /* From the totals received (rtot): where each sender's run lands (base),
  * the local arrays, their indices' code, and the send buffer. */
 static int xch_local(hd__mpi_ctx_t *c, const hd__mpi_ranges_t *rg, xch_t *x, hd__mpi_local_t *loc) {
     int K = x->K, rc = HD_OK;
     for (int s = 0; s < 2 && rc == HD_OK; s++) {
         size_t m = 0;
-        for (int r = 0; r < K; r++) {
+        senders_by_index(c, rg, s, K, x->sorder + (size_t)s * (size_t)K);
+        for (int q = 0; q < K; q++) {
+            int r = x->sorder[(size_t)s * (size_t)K + (size_t)q];
             x->base[s * K + r] = m;
             x->got[s * K + r] = 0;
             m += (size_t)x->rtot[2 * r + s];
@@ -446,19 +480,20 @@ static int xch_rounds(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const hd__mpi
 static int xch_order(hd__mpi_ctx_t *c, const hd__mpi_ranges_t *rg, xch_t *x, hd__mpi_local_t *loc, int s) {
     int K = x->K;
     size_t n = loc->n[s];
-    loc->start[s] = hd__mpi_alloc(c, (size_t)K + 1, sizeof(size_t));
+    loc->start[s] = hd__mpi_alloc(c, 2 * (size_t)K, sizeof(size_t));
     if (!loc->start[s]) return hd__mpi_nomem(c, "the local indices", (size_t)K);
     int sorted = 1;
     uint64_t last = 0;
-    for (int r = 0; r < K; r++) {
+    for (int q = 0; q < K; q++) { /* the runs in the order they land */
+        int r = x->sorder[(size_t)s * (size_t)K + (size_t)q];
         size_t lo = x->base[s * K + r], hi = lo + (size_t)x->rtot[2 * r + s];
         loc->start[s][r] = lo;
+        loc->start[s][K + r] = hi - lo;
         if (hi > lo) {
             if (lo > 0 && hd__mpi_ranges_global(rg, s, r, x->off[s][lo]) < last) sorted = 0;
             last = hd__mpi_ranges_global(rg, s, r, x->off[s][hi - 1]);
         }
     }
-    loc->start[s][K] = n;
     if (!sorted) {
         loc->merged[s] = 1;
         uint64_t *g = hd__mpi_alloc(c, n, sizeof(uint64_t));

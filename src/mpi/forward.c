@@ -436,10 +436,12 @@ static hd__mpi_far_t bounds_below(const hd__mpi_ctx_t *c, const hd__mpi_dir_t *d
     hd__mpi_gcur_t cp;
     hd__mpi_gcur_init(&cp, d->gP);
     for (size_t k = 0; k < sh->n; k++) {
-        hd__mpi_far_t f = {u2[k], hd__mpi_shell_g(&cp, sh, k), jj[k]};
-        if (!exact[k] && (!held || (sh->unproven && sh->unproven[k]))) continue;
-        if (!exact[k])
-            f = (hd__mpi_far_t){lower_bound(c, held, d->qside, hd__mpi_shell_pt(d, sh, k), u2[k]), UINT64_MAX, UINT64_MAX};
+        /* below L's d2, neither (u2[k], its index) nor a lower bound (at
+         * most u2[k]) beats L: the index is decoded only when one may */
+        if (u2[k] < L.d2 || (!exact[k] && (!held || (sh->unproven && sh->unproven[k])))) continue;
+        hd__mpi_far_t f = exact[k] ? (hd__mpi_far_t){u2[k], hd__mpi_shell_g(&cp, sh, k), jj[k]}
+                                   : (hd__mpi_far_t){lower_bound(c, held, d->qside, hd__mpi_shell_pt(d, sh, k), u2[k]),
+                                                     UINT64_MAX, UINT64_MAX};
         if (hd__mpi_far_better(&f, &L)) L = f;
     }
     return L;

@@ -12,7 +12,9 @@
  * types), ranges.c the validation and the index runs, rcb.c the partition
  * (step 1), exchange.c the exchange (2), shell.c the engine's pass (3),
  * slab.c the per-point searches, forward.c the forwarding and reduction
- * (4 to 6); gidx.c the local sets' indices, distances.c and analysis.c
+ * (4 to 6), tiny.c the course without a partition when one side is tiny
+ * (replicated on every rank), views.c the caller's points as views in index
+ * order; gidx.c the local sets' indices, distances.c and analysis.c
  * the per-point distances and their figures.  What they share is in
  * private headers by concern: context.h, ranges.h, partition.h,
  * search.h and course.h.  Each file opens with its invariants.
@@ -154,44 +156,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* K = 1: no partition, no exchange and no copy: a set given as one part
- * (or one nonempty part) is the caller's view, of any layout; else its
- * parts are packed into one array in index order (24 bytes a point).  Its
- * local indices become global ones (ranges_global): local order is index
- * order, so a smallest index on ties is the global one. */
-int hd__mpi_views(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, hd__mpi_views_t *vw) {
-    memset(vw, 0, sizeof *vw);
-    for (int s = 0; s < 2; s++) {
-        size_t nonempty = 0, last = 0;
-        for (size_t p = 0; p < in->nparts[s]; p++)
-            if (in->parts[s][p].points.count) nonempty++, last = p;
-        if (nonempty == 1) {
-            vw->v[s] = in->parts[s][last].points;
-            continue;
-        }
-        vw->own[s] = hd__mpi_alloc(c, in->n[s], 3 * sizeof(double));
-        vw->order[s] = hd__mpi_alloc(c, in->nparts[s], sizeof *vw->order[s]);
-        if (!vw->own[s] || !vw->order[s]) return hd__mpi_nomem(c, "the parts", in->n[s]);
-        const hd_mpi_part_t **order = vw->order[s];
-        for (size_t p = 0; p < in->nparts[s]; p++) order[p] = &in->parts[s][p];
-        qsort(order, in->nparts[s], sizeof *order, hd__mpi_by_offset);
-        size_t t = 0;
-        for (size_t p = 0; p < in->nparts[s]; p++)
-            for (size_t k = 0; k < order[p]->points.count; k++)
-                hd__mpi_get_point(&order[p]->points, k, vw->own[s] + 3 * t++);
-        vw->v[s] = hd_points_f64(vw->own[s], in->n[s]);
-    }
-    return HD_OK;
-}
-
-void hd__mpi_views_free(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, hd__mpi_views_t *vw) {
-    for (int s = 0; s < 2; s++) {
-        hd__mpi_free(c, vw->own[s], in->n[s], 3 * sizeof(double));
-        hd__mpi_free(c, vw->order[s], in->nparts[s], sizeof *vw->order[s]);
-        vw->own[s] = NULL, vw->order[s] = NULL;
-    }
-}
-
 /* K = 1: the engine on the views. */
 static int single(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const hd__mpi_ranges_t *rg, int both, hd__mpi_far_t *f) {
     hd__mpi_views_t vw;
@@ -257,7 +221,7 @@ void hd__mpi_spread_free(hd__mpi_ctx_t *c, hd__mpi_spread_t *sp) {
     for (int s = 0; s < 2; s++) {
         hd__mpi_free(c, sp->loc.xyz[s], sp->loc.n[s], 3 * sizeof(double));
         hd__mpi_gidx_free(c, &sp->loc.gi[s]);
-        if (sp->loc.start[s]) hd__mpi_free(c, sp->loc.start[s], (size_t)K + 1, sizeof(size_t));
+        if (sp->loc.start[s]) hd__mpi_free(c, sp->loc.start[s], 2 * (size_t)K, sizeof(size_t));
     }
     hd__mpi_free(c, sp->tree, (size_t)K - 1, sizeof(hd__mpi_node_t));
     hd__mpi_free(c, sp->region, (size_t)K, sizeof(hd__box_t));
@@ -354,8 +318,12 @@ static int run(hd__mpi_ctx_t *c, const hd_options_t *opt, hd__mpi_input_t *in, v
 
     hd__mpi_far_t f[2];
     uint64_t pts;
+    int ts = hd__mpi_tiny_side(c, cs.N);
     if (K == 1) {
         if ((rc = single(c, in, &cs.rg, both, f)) != HD_OK) goto done;
+        pts = in->n[0] + in->n[1];
+    } else if (ts >= 0) { /* replicated, nothing partitioned (tiny.c) */
+        if ((rc = hd__mpi_tiny(c, in, &cs.rg, cs.N, ts, both, f)) != HD_OK) goto done;
         pts = in->n[0] + in->n[1];
     } else {
         hd__mpi_spread_t *sp = &cs.sp;
@@ -413,6 +381,7 @@ done:
 void hd_mpi_options_init(hd_mpi_options_t *opt) {
     hd_options_init(&opt->engine);
     opt->prune = 1;
+    opt->replicate = 1;
 }
 
 int hd__mpi_call(MPI_Comm comm, const hd_mpi_part_t *a, size_t na, const hd_mpi_part_t *b, size_t nb,
@@ -422,7 +391,7 @@ int hd__mpi_call(MPI_Comm comm, const hd_mpi_part_t *a, size_t na, const hd_mpi_
     hd__mpi_ctx_t c;
     memset(&c, 0, sizeof c);
     c.ans_type = c.q_type = c.far_type = c.sample_type = c.node_type = MPI_DATATYPE_NULL;
-    c.far_op = MPI_OP_NULL;
+    c.far_op = c.near_op = MPI_OP_NULL;
     c.comm = MPI_COMM_NULL;
     hd__err_clear(&c.e);
     int init = 0, fin = 0;
@@ -439,6 +408,7 @@ int hd__mpi_call(MPI_Comm comm, const hd_mpi_part_t *a, size_t na, const hd_mpi_
         c.first = hd__mpi_first_samples(c.K);
         c.threads = opt ? opt->threads : 0;
         c.prune = mopt ? mopt->prune : 1;
+        c.replicate = mopt ? mopt->replicate : 1;
         if (c.threads < 0) c.threads = 1; /* refused by check_local, on every rank */
         rc = hd__mpi_types_create(&c);
         if ((rc = hd__mpi_agree(&c, rc)) == HD_OK) {

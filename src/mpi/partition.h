@@ -102,7 +102,10 @@ typedef struct {
     hd__box_t box[2];        /* the exact box of each side's points (empty: lo > hi) */
     hd__mpi_gidx_t gi[2];            /* their global indices */
     int merged[2];           /* the senders' runs were merged, */
-    size_t *start[2];        /* else K + 1 a side: each sender's run */
+    size_t *start[2];        /* else 2K a side: where sender r's run starts
+                                (start[s][r]) and its length (start[s][K + r]);
+                                the runs lie in the order of the senders'
+                                smallest indices (exchange.c) */
     size_t n[2];
 } hd__mpi_local_t;
 

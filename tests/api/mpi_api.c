@@ -290,11 +290,15 @@ static void open_case(const char *call, int which, int how, uint64_t seed, set_t
     opt->threads = 1;
 }
 
-/* The MPI calls' options around the engine's `opt` (the cells on). */
+/* The MPI calls' options around the engine's `opt` (the cells on).  A
+ * tiny side is not replicated: these sets test the partition's course
+ * (a small cluster far away would be replicated by default);
+ * tests/api/mpi_tiny.c tests the replicated one. */
 static hd_mpi_options_t mpi_opt(const hd_options_t *opt) {
     hd_mpi_options_t m;
     hd_mpi_options_init(&m);
     m.engine = *opt;
+    m.replicate = 0;
     return m;
 }
 
