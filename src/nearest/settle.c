@@ -23,17 +23,20 @@
  *    exceeds hi2: by the same monotonicity, hd__d2s(x, p) is at least
  *    either bound, so every point of q has its nearest squared distance
  *    above hi2.
- * A point is counted once, at the first node of its path that a bound
- * settles, or classified exactly when its bucket stays open, so the counts
- * and the kept values (as a multiset) are hd__an_band's whatever the
- * threads (which only decide where the walk starts).
+ * A point is counted once, at the first node of its path (from where the
+ * walk starts) that a bound settles, or classified exactly when its bucket
+ * stays open, so the counts and the kept values (as a multiset) are
+ * hd__an_band's whatever the threads (which only decide where the walk
+ * starts).
  *
  * The walk pays off only when bounds settle most points: where a bucket's
  * box is wide next to the distances that decide the band (overlapping
  * sets of similar density) it settles little, and hd__an_band alone is
  * cheaper.  A probe of one asking bucket in SETTLE_PROBE decides: the walk
- * runs when the probed buckets' bounds settle at least half of their
- * points.  Only the cost depends on it.
+ * runs when the probed buckets' bounds settle at least SETTLE_WORTH of
+ * their points; and when the walk leaves most points open, hd__an_band
+ * classifies them all, as a structure of the open points would cost more
+ * than it spares.  Only the cost depends on either choice.
  */
 #include "nearest/nearest.h"
 

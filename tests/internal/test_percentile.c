@@ -148,6 +148,7 @@ TEST(a_misleading_sample_changes_no_bit) {
 typedef struct {
     double *a, *b, *d2;
     hd_points_t A, B;
+    hd__box_t keybox;
     hd__an_t s[2];
 } band_sets_t;
 
@@ -159,7 +160,28 @@ static void band_sets_build(band_sets_t *t) {
     CHECK_RC(hd__points_scan(&t->A, "A", 1, &ba, NULL), HD_OK);
     CHECK_RC(hd__points_scan(&t->B, "B", 1, &bb, NULL), HD_OK);
     hd__box_merge(&ba, &bb);
+    t->keybox = ba;
     CHECK_RC(hd__an_build_pair(&t->A, &t->B, &ba, 2, t->s, NULL), HD_OK);
+}
+
+/* A band pass's answer `got` (freed here) against the brute classification
+ * of the n squared distances d2 by [lo2, hi2]. */
+static void check_band(const double *d2, size_t n, double lo2, double hi2, hd__an_band_t *got) {
+    double *want = malloc(8 * (n ? n : 1));
+    size_t below = 0, above = 0, in = 0;
+    for (size_t i = 0; i < n; i++) {
+        below += d2[i] < lo2;
+        above += d2[i] > hi2;
+        if (d2[i] >= lo2 && d2[i] <= hi2) want[in++] = d2[i];
+    }
+    qsort(want, in, 8, cmp_d);
+    CHECK_EQ(got->below, below);
+    CHECK_EQ(got->above, above);
+    CHECK_EQ(got->n, in);
+    qsort(got->v, got->n, 8, cmp_d);
+    for (size_t k = 0; k < in && k < got->n; k++) CHECK_BITS(got->v[k], want[k]);
+    free(got->v);
+    free(want);
 }
 
 static void band_sets_free(band_sets_t *t) {
@@ -187,34 +209,19 @@ TEST(the_band_pass_counts_and_keeps_what_a_full_classification_does) {
         make_pair(seed, 2500, &t.a, &t.b, &t.A, &t.B);
         band_sets_build(&t);
         size_t na = t.A.count;
-        const double *d2 = t.d2;
-        double *want = malloc(8 * na);
         gen_rng_t g;
         gen_seed(&g, seed);
         for (int trial = 0; trial < 6; trial++) {
             double lo2, hi2;
-            band_edges(&g, d2, na, trial, &lo2, &hi2);
-            size_t below = 0, above = 0, in = 0;
-            for (size_t i = 0; i < na; i++) {
-                below += d2[i] < lo2;
-                above += d2[i] > hi2;
-                if (d2[i] >= lo2 && d2[i] <= hi2) want[in++] = d2[i];
-            }
-            qsort(want, in, 8, cmp_d);
+            band_edges(&g, t.d2, na, trial, &lo2, &hi2);
             for (int threads = 1; threads <= 3; threads += 2) {
                 CONTEXT("seed=%llu band [%.17g, %.17g] threads=%d", (unsigned long long)seed, lo2, hi2, threads);
                 hd__an_band_t got;
                 CHECK_RC(hd__an_band(&t.s[0], &t.s[1], lo2, hi2, threads, &got, NULL), HD_OK);
-                CHECK_EQ(got.below, below);
-                CHECK_EQ(got.above, above);
-                CHECK_EQ(got.n, in);
-                qsort(got.v, got.n, 8, cmp_d);
-                for (size_t k = 0; k < in && k < got.n; k++) CHECK_BITS(got.v[k], want[k]);
-                free(got.v);
+                check_band(t.d2, na, lo2, hi2, &got);
             }
         }
         band_sets_free(&t);
-        free(want);
         if (hdt_failed()) return;
     }
 }
@@ -276,7 +283,7 @@ TEST(a_sparse_set_classified_against_a_dense_one_counts_and_keeps_what_a_full_cl
         for (size_t k = 0; seed % 2 && k < 3 * nb; k++) b[k] = 0.0625 * floor(b[k] * 16);
         for (size_t k = 0; seed % 2 && k < 3 * na; k++) a[k] = 0.0625 * floor(a[k] * 16) + 0.03125;
         hd_points_t A = hd_points_f64(a, na), B = hd_points_f64(b, nb);
-        double *d2 = malloc(8 * na), *want = malloc(8 * na);
+        double *d2 = malloc(8 * na);
         for (size_t i = 0; i < na; i++) d2[i] = brute_nearest(a + 3 * i, b, nb, NULL);
         hd__box_t ba, bb;
         CHECK_RC(hd__points_scan(&A, "A", 1, &ba, NULL), HD_OK);
@@ -290,30 +297,18 @@ TEST(a_sparse_set_classified_against_a_dense_one_counts_and_keeps_what_a_full_cl
                 double t = lo2;
                 lo2 = hi2, hi2 = t;
             }
-            size_t below = 0, above = 0, in = 0;
-            for (size_t i = 0; i < na; i++) {
-                below += d2[i] < lo2;
-                above += d2[i] > hi2;
-                if (d2[i] >= lo2 && d2[i] <= hi2) want[in++] = d2[i];
-            }
-            qsort(want, in, 8, cmp_d);
             for (int threads = 1; threads <= 3; threads += 2) {
                 CONTEXT("seed=%llu |A|=%zu |B|=%zu band [%.17g, %.17g] threads=%d", (unsigned long long)seed, na, nb,
                         lo2, hi2, threads);
                 hd__an_band_t got;
                 CHECK_RC(hd__an_band(&s[0], &s[1], lo2, hi2, threads, &got, NULL), HD_OK);
-                CHECK_EQ(got.below, below);
-                CHECK_EQ(got.above, above);
-                CHECK_EQ(got.n, in);
-                qsort(got.v, got.n, 8, cmp_d);
-                for (size_t k = 0; k < in && k < got.n; k++) CHECK_BITS(got.v[k], want[k]);
                 solo += got.solo;
-                free(got.v);
+                check_band(d2, na, lo2, hi2, &got);
             }
         }
         hd__an_free(&s[0]);
         hd__an_free(&s[1]);
-        free(a), free(b), free(d2), free(want);
+        free(a), free(b), free(d2);
     }
     CONTEXT("points that listed their own candidates: %zu", solo);
     CHECK(solo > 0);
@@ -354,44 +349,25 @@ TEST(the_settled_band_pass_counts_and_keeps_what_a_full_classification_does) {
             band_sets_t t;
             settled_sets(seed, shape, &t);
             size_t na = t.A.count;
-            const double *d2 = t.d2;
-            double *want = malloc(8 * na);
             gen_rng_t g;
             gen_seed(&g, seed);
             for (int trial = 0; trial < 7; trial++) {
                 double lo2, hi2;
-                band_edges(&g, d2, na, trial, &lo2, &hi2);
+                band_edges(&g, t.d2, na, trial, &lo2, &hi2);
                 if (trial == 6) lo2 = hi2; /* a band of one value */
-                size_t below = 0, above = 0, in = 0;
-                for (size_t i = 0; i < na; i++) {
-                    below += d2[i] < lo2;
-                    above += d2[i] > hi2;
-                    if (d2[i] >= lo2 && d2[i] <= hi2) want[in++] = d2[i];
-                }
-                qsort(want, in, 8, cmp_d);
                 for (int threads = 1; threads <= 3; threads += 2) {
                     CONTEXT("seed=%llu shape=%d |A|=%zu band [%.17g, %.17g] threads=%d", (unsigned long long)seed,
                             shape, na, lo2, hi2, threads);
-                    hd__box_t keybox;
-                    CHECK_RC(hd__points_scan(&t.A, "A", 1, &keybox, NULL), HD_OK);
-                    hd__box_t bb;
-                    CHECK_RC(hd__points_scan(&t.B, "B", 1, &bb, NULL), HD_OK);
-                    hd__box_merge(&keybox, &bb);
                     hd__an_band_t got;
                     size_t s = 0;
-                    CHECK_RC(hd__an_band_settled(&t.s[0], &t.s[1], &t.A, &keybox, lo2, hi2, threads, &got, &s, NULL),
+                    CHECK_RC(hd__an_band_settled(&t.s[0], &t.s[1], &t.A, &t.keybox, lo2, hi2, threads, &got, &s,
+                                                 NULL),
                              HD_OK);
                     settled += s;
-                    CHECK_EQ(got.below, below);
-                    CHECK_EQ(got.above, above);
-                    CHECK_EQ(got.n, in);
-                    qsort(got.v, got.n, 8, cmp_d);
-                    for (size_t k = 0; k < in && k < got.n; k++) CHECK_BITS(got.v[k], want[k]);
-                    free(got.v);
+                    check_band(t.d2, na, lo2, hi2, &got);
                 }
             }
             band_sets_free(&t);
-            free(want);
         }
     CONTEXT("points settled from bounds: %zu", settled);
     CHECK(settled > 0);
