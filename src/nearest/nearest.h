@@ -139,6 +139,20 @@ int hd__an_band(const hd__an_t *asking, const hd__an_t *searched, double lo2, do
 int hd__an_band_each(const hd__an_t *asking, const hd__an_t *searched, double lo2, double hi2, int threads,
                      hd__an_band_t *out, double *each, hd_error_t *err);
 
+/* hd__an_band with whole nodes of asking settled from bounds (settle.c):
+ * an asking node whose box is proven below or above the band is counted
+ * without its points, and the points of the buckets left open are
+ * classified by hd__an_band on a structure of them alone (P is the view
+ * asking was built from, on keybox).  The same counts and kept values (as
+ * a multiset) as hd__an_band, at any thread count; it runs hd__an_band
+ * itself when a probe of the bounds says they would settle too little.
+ * out->solo counts the open points' only; *settled (when not NULL)
+ * receives how many points bounds counted without their distance (for
+ * tests).  Returns HD_OK or HD_ENOMEM (out zeroed, err filled). */
+int hd__an_band_settled(const hd__an_t *asking, const hd__an_t *searched, const hd_points_t *P,
+                        const hd__box_t *keybox, double lo2, double hi2, int threads, hd__an_band_t *out,
+                        size_t *settled, hd_error_t *err);
+
 /* Both structures of A and B (validated views of at most
  * HD__AN_MAX_POINTS each) on one key box, built side by side on the
  * threads.  On failure neither is left allocated.  Returns as

@@ -152,6 +152,8 @@ static double figure_value(const figure_t *f) {
  * union changed. */
 typedef struct {
     const hd__an_t *s;   /* the two structures */
+    const hd_points_t *set[2]; /* the views they were built from */
+    const hd__box_t *keybox;
     int threads;
     hd__an_band_t part[2];
     double lo2[2], hi2[2]; /* the union each part was made with */
@@ -164,7 +166,8 @@ static int passes_update(passes_t *ps, const figure_t *dir, const figure_t *pool
         if (ps->part[d].v && lo2 == ps->lo2[d] && hi2 == ps->hi2[d]) continue;
         free(ps->part[d].v);
         ps->part[d].v = NULL;
-        int rc = hd__an_band(&ps->s[d], &ps->s[1 - d], lo2, hi2, ps->threads, &ps->part[d], err);
+        int rc = hd__an_band_settled(&ps->s[d], &ps->s[1 - d], ps->set[d], ps->keybox, lo2, hi2, ps->threads,
+                                     &ps->part[d], NULL, err);
         if (rc) return rc;
         ps->lo2[d] = lo2, ps->hi2[d] = hi2;
     }
@@ -176,7 +179,7 @@ int hd__percentile_points(const hd_points_t *A, const hd_points_t *B, const hd__
     const hd_points_t *set[2] = {A, B};
     sample_t smp[2] = {{0}, {0}};
     figure_t dir[2], pooled;
-    passes_t ps = {s, threads, {{0}, {0}}, {0, 0}, {0, 0}};
+    passes_t ps = {s, {A, B}, keybox, threads, {{0}, {0}}, {0, 0}, {0, 0}};
     int rc = HD_OK;
     for (int d = 0; d < 2 && rc == HD_OK; d++) rc = sample_of(set[d], &s[1 - d], keybox, threads, &smp[d], err);
     for (int d = 0; d < 2 && rc == HD_OK; d++) {

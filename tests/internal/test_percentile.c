@@ -7,7 +7,8 @@
  * whole and large enough to be sampled, with ties (lattices, where many
  * distances equal the percentile), duplicates, very unequal sizes and
  * P = 0, 95, 99.9, 100 and others; a sample that misleads the bands on
- * either side still gives the same bits; the band pass counts and keeps
+ * either side still gives the same bits; the band pass, and the one that
+ * settles whole nodes from bounds (hd__an_band_settled), count and keep
  * exactly what a brute classification does.  The exact distances of the
  * reference are hd_distances' (test_analysis.c checks them against a brute
  * force).
@@ -147,6 +148,7 @@ TEST(a_misleading_sample_changes_no_bit) {
 typedef struct {
     double *a, *b, *d2;
     hd_points_t A, B;
+    hd__box_t keybox;
     hd__an_t s[2];
 } band_sets_t;
 
@@ -158,7 +160,28 @@ static void band_sets_build(band_sets_t *t) {
     CHECK_RC(hd__points_scan(&t->A, "A", 1, &ba, NULL), HD_OK);
     CHECK_RC(hd__points_scan(&t->B, "B", 1, &bb, NULL), HD_OK);
     hd__box_merge(&ba, &bb);
+    t->keybox = ba;
     CHECK_RC(hd__an_build_pair(&t->A, &t->B, &ba, 2, t->s, NULL), HD_OK);
+}
+
+/* A band pass's answer `got` (freed here) against the brute classification
+ * of the n squared distances d2 by [lo2, hi2]. */
+static void check_band(const double *d2, size_t n, double lo2, double hi2, hd__an_band_t *got) {
+    double *want = malloc(8 * (n ? n : 1));
+    size_t below = 0, above = 0, in = 0;
+    for (size_t i = 0; i < n; i++) {
+        below += d2[i] < lo2;
+        above += d2[i] > hi2;
+        if (d2[i] >= lo2 && d2[i] <= hi2) want[in++] = d2[i];
+    }
+    qsort(want, in, 8, cmp_d);
+    CHECK_EQ(got->below, below);
+    CHECK_EQ(got->above, above);
+    CHECK_EQ(got->n, in);
+    qsort(got->v, got->n, 8, cmp_d);
+    for (size_t k = 0; k < in && k < got->n; k++) CHECK_BITS(got->v[k], want[k]);
+    free(got->v);
+    free(want);
 }
 
 static void band_sets_free(band_sets_t *t) {
@@ -186,34 +209,19 @@ TEST(the_band_pass_counts_and_keeps_what_a_full_classification_does) {
         make_pair(seed, 2500, &t.a, &t.b, &t.A, &t.B);
         band_sets_build(&t);
         size_t na = t.A.count;
-        const double *d2 = t.d2;
-        double *want = malloc(8 * na);
         gen_rng_t g;
         gen_seed(&g, seed);
         for (int trial = 0; trial < 6; trial++) {
             double lo2, hi2;
-            band_edges(&g, d2, na, trial, &lo2, &hi2);
-            size_t below = 0, above = 0, in = 0;
-            for (size_t i = 0; i < na; i++) {
-                below += d2[i] < lo2;
-                above += d2[i] > hi2;
-                if (d2[i] >= lo2 && d2[i] <= hi2) want[in++] = d2[i];
-            }
-            qsort(want, in, 8, cmp_d);
+            band_edges(&g, t.d2, na, trial, &lo2, &hi2);
             for (int threads = 1; threads <= 3; threads += 2) {
                 CONTEXT("seed=%llu band [%.17g, %.17g] threads=%d", (unsigned long long)seed, lo2, hi2, threads);
                 hd__an_band_t got;
                 CHECK_RC(hd__an_band(&t.s[0], &t.s[1], lo2, hi2, threads, &got, NULL), HD_OK);
-                CHECK_EQ(got.below, below);
-                CHECK_EQ(got.above, above);
-                CHECK_EQ(got.n, in);
-                qsort(got.v, got.n, 8, cmp_d);
-                for (size_t k = 0; k < in && k < got.n; k++) CHECK_BITS(got.v[k], want[k]);
-                free(got.v);
+                check_band(t.d2, na, lo2, hi2, &got);
             }
         }
         band_sets_free(&t);
-        free(want);
         if (hdt_failed()) return;
     }
 }
@@ -275,7 +283,7 @@ TEST(a_sparse_set_classified_against_a_dense_one_counts_and_keeps_what_a_full_cl
         for (size_t k = 0; seed % 2 && k < 3 * nb; k++) b[k] = 0.0625 * floor(b[k] * 16);
         for (size_t k = 0; seed % 2 && k < 3 * na; k++) a[k] = 0.0625 * floor(a[k] * 16) + 0.03125;
         hd_points_t A = hd_points_f64(a, na), B = hd_points_f64(b, nb);
-        double *d2 = malloc(8 * na), *want = malloc(8 * na);
+        double *d2 = malloc(8 * na);
         for (size_t i = 0; i < na; i++) d2[i] = brute_nearest(a + 3 * i, b, nb, NULL);
         hd__box_t ba, bb;
         CHECK_RC(hd__points_scan(&A, "A", 1, &ba, NULL), HD_OK);
@@ -289,33 +297,93 @@ TEST(a_sparse_set_classified_against_a_dense_one_counts_and_keeps_what_a_full_cl
                 double t = lo2;
                 lo2 = hi2, hi2 = t;
             }
-            size_t below = 0, above = 0, in = 0;
-            for (size_t i = 0; i < na; i++) {
-                below += d2[i] < lo2;
-                above += d2[i] > hi2;
-                if (d2[i] >= lo2 && d2[i] <= hi2) want[in++] = d2[i];
-            }
-            qsort(want, in, 8, cmp_d);
             for (int threads = 1; threads <= 3; threads += 2) {
                 CONTEXT("seed=%llu |A|=%zu |B|=%zu band [%.17g, %.17g] threads=%d", (unsigned long long)seed, na, nb,
                         lo2, hi2, threads);
                 hd__an_band_t got;
                 CHECK_RC(hd__an_band(&s[0], &s[1], lo2, hi2, threads, &got, NULL), HD_OK);
-                CHECK_EQ(got.below, below);
-                CHECK_EQ(got.above, above);
-                CHECK_EQ(got.n, in);
-                qsort(got.v, got.n, 8, cmp_d);
-                for (size_t k = 0; k < in && k < got.n; k++) CHECK_BITS(got.v[k], want[k]);
                 solo += got.solo;
-                free(got.v);
+                check_band(d2, na, lo2, hi2, &got);
             }
         }
         hd__an_free(&s[0]);
         hd__an_free(&s[1]);
-        free(a), free(b), free(d2), free(want);
+        free(a), free(b), free(d2);
     }
     CONTEXT("points that listed their own candidates: %zu", solo);
     CHECK(solo > 0);
+}
+
+/* Sets where node bounds settle most points (shape 0: disjoint Gaussians,
+ * B 20 sigma away; 1: B a hundredth the size; 2: a lattice against the
+ * same lattice 40 steps away, every distance one of a few values, so ties
+ * sit on the band's edges; 3: as 2 with A's points each copied 70 times,
+ * so that a bucket is one point and its upper bound is a distance). */
+static void settled_sets(uint64_t seed, int shape, band_sets_t *t) {
+    gen_rng_t g;
+    gen_seed(&g, seed);
+    size_t na = shape >= 2 ? 8400 : 6000 + gen_u64(&g) % 3000, nb = shape == 1 ? na / 100 : na;
+    double m0[3] = {0, 0, 0}, m1[3] = {20, 0, 0};
+    t->a = malloc(24 * na), t->b = malloc(24 * nb);
+    if (shape >= 2) {
+        gen_lattice(&g, t->a, na, 20);
+        gen_lattice(&g, t->b, nb, 20);
+        for (size_t i = 0; i < nb; i++) t->b[3 * i] += 40;
+        for (size_t i = 0; shape == 3 && i < na; i++) memcpy(t->a + 3 * i, t->a + 3 * (i / 70), 24);
+    } else {
+        gen_gauss(&g, t->a, na, m0, 1.0);
+        gen_gauss(&g, t->b, nb, shape == 0 ? m1 : m0, 1.0);
+    }
+    t->A = hd_points_f64(t->a, na), t->B = hd_points_f64(t->b, nb);
+    band_sets_build(t);
+}
+
+TEST(the_settled_band_pass_counts_and_keeps_what_a_full_classification_does) {
+    /* hd__an_band_settled against a brute classification: nodes counted
+     * from their bounds, the open buckets' points classified exactly.  A
+     * bound made too tight (an upper bound below a point's distance, a
+     * lower bound above it) miscounts the points on the band's edges. */
+    size_t settled = 0;
+    for (int shape = 0; shape < 4; shape++)
+        for (uint64_t seed = 400; seed < 403 && !hdt_failed(); seed++) {
+            band_sets_t t;
+            settled_sets(seed, shape, &t);
+            size_t na = t.A.count;
+            gen_rng_t g;
+            gen_seed(&g, seed);
+            for (int trial = 0; trial < 7; trial++) {
+                double lo2, hi2;
+                band_edges(&g, t.d2, na, trial, &lo2, &hi2);
+                if (trial == 6) lo2 = hi2; /* a band of one value */
+                for (int threads = 1; threads <= 3; threads += 2) {
+                    CONTEXT("seed=%llu shape=%d |A|=%zu band [%.17g, %.17g] threads=%d", (unsigned long long)seed,
+                            shape, na, lo2, hi2, threads);
+                    hd__an_band_t got;
+                    size_t s = 0;
+                    CHECK_RC(hd__an_band_settled(&t.s[0], &t.s[1], &t.A, &t.keybox, lo2, hi2, threads, &got, &s,
+                                                 NULL),
+                             HD_OK);
+                    settled += s;
+                    check_band(t.d2, na, lo2, hi2, &got);
+                }
+            }
+            band_sets_free(&t);
+        }
+    CONTEXT("points settled from bounds: %zu", settled);
+    CHECK(settled > 0);
+}
+
+TEST(percentiles_equal_a_full_sort_where_bounds_settle_most_points) {
+    /* The same four shapes through hd_hausdorff_percentile: disjoint
+     * sets, very unequal sizes, ties at the percentile, copies. */
+    static const double ps[] = {95, 50, 99.9, 0, 100};
+    for (int shape = 0; shape < 4 && !hdt_failed(); shape++) {
+        band_sets_t t;
+        settled_sets(500 + (uint64_t)shape, shape, &t);
+        CONTEXT("shape=%d |A|=%zu |B|=%zu", shape, t.A.count, t.B.count);
+        for (size_t k = 0; k < sizeof ps / sizeof ps[0]; k++) check_figures(&t.A, &t.B, ps[k]);
+        band_sets_free(&t);
+    }
 }
 
 TEST(an_empty_side_is_refused_as_before) {
