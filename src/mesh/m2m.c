@@ -102,6 +102,8 @@
 #define MAX_BATCH 1024
 /* Faces per task in phase 1. */
 #define CHUNK 256
+/* Phase 0's sample: every SAMPLE_STRIDE-th corner in Morton order. */
+#define SAMPLE_STRIDE 32
 /* Below this a squared edge may have underflowed: R from |dx|+|dy|+|dz|. */
 #define TINY2 0x1p-960
 
@@ -384,16 +386,21 @@ static void bounds_at(const hd__bvh_t *T, size_t pos, const double p[3], cache_t
  * of smallest hi2 (returned: its position in the tree; a triangle whose
  * box lies beyond the smallest hi2 so far is skipped), lo from the smallest
  * lo2 over the triangles visited (a skipped one is farther than the
- * nearest, so the minimum over Y is among them).  The answer depends on p,
- * the seed and the tree only. */
-static size_t interval(const hd__bvh_t *T, const double p[3], size_t seed, cache_t *C, double *lo, double *hi,
-                       uint64_t *count) {
+ * nearest, so the minimum over Y is among them).  With enough2 >= 0 the
+ * search stops at the first triangle whose hi2 is at most enough2 (the
+ * caller needs no smaller upper bound): hi is then that triangle's bound,
+ * still >= d(p, Y), and lo is 0 (the triangles not visited were not
+ * excluded).  The answer depends on p, the seed, enough2 and the tree
+ * only. */
+static size_t interval(const hd__bvh_t *T, const double p[3], size_t seed, cache_t *C, double enough2, double *lo,
+                       double *hi, uint64_t *count) {
     double best = INFINITY, low = INFINITY, lo2, hi2;
     size_t pos = SIZE_MAX;
     if (seed < T->n_tris) {
         bounds_at(T, seed, p, C, &lo2, &hi2);
         best = hi2, low = lo2, pos = seed;
         (*count)++;
+        if (best <= enough2) goto early;
     }
     struct { uint32_t id; double s; } stack[DEPTH]; /* s: the box's hd__box_lb2s */
     int top = 0;
@@ -409,6 +416,7 @@ static size_t interval(const hd__bvh_t *T, const double p[3], size_t seed, cache
                 (*count)++;
                 low = fmin(low, lo2);
                 if (pos == SIZE_MAX || hi2 < best) best = hi2, pos = k;
+                if (best <= enough2) goto early;
             }
             continue;
         }
@@ -426,7 +434,15 @@ static size_t interval(const hd__bvh_t *T, const double p[3], size_t seed, cache
     *lo = low > 0 ? down(sqrt(low)) : 0;
     *hi = sqrt_up(best);
     return pos;
+early:
+    *lo = 0;
+    *hi = sqrt_up(best);
+    return pos;
 }
+
+/* The squared distance below which an upper bound needs no search: a
+ * corner whose hi is at most `target` (when target > 0; else none). */
+static double enough_of(double target) { return target > 0 ? target * target * (1 - 0x1p-40) : -1; }
 
 /* The largest lower bound the corner could give (its exact distance is at
  * most hi). */
@@ -445,11 +461,13 @@ static void make_exact(const hd__m2m_job_t *J, corner_t *c, int level, double e,
     if (up(c->r) < c->hi) c->hi = up(c->r), c->pos = pos;
 }
 
-static void evaluate(const hd__m2m_job_t *J, const hd__tri_t *t, corner_t *c, int level, size_t seed, cache_t *C,
-                     uint64_t *count) {
+/* The corner's point and its upper bound; the search stops at a bound of
+ * `target` or less (see enough_of). */
+static void evaluate(const hd__m2m_job_t *J, const hd__tri_t *t, corner_t *c, int level, size_t seed, double target,
+                     cache_t *C, uint64_t *count) {
     double lo;
     corner_point(t, c, level);
-    c->pos = interval(J->to, c->p, seed, C, &lo, &c->hi, count);
+    c->pos = interval(J->to, c->p, seed, C, enough_of(target), &lo, &c->hi, count);
     c->exact = 0;
 }
 
@@ -509,6 +527,7 @@ typedef struct found {
     double lo, hi, r, near[3];
     size_t pos, index;
     int exact;
+    int complete; /* hi is the smallest the bounds give (no early stop) */
 } found_t;
 
 typedef struct ctx {
@@ -520,13 +539,51 @@ typedef struct ctx {
     cache_t *caches;       /* one per worker */
     size_t task0;          /* phase 1's first task (the predicate's rounds) */
     double bar;            /* phase 0's exact searches: corners with hi >= bar */
+    /* Phase 0 in stages: 0 every corner searched in full; 1 the sample
+     * (every stride-th corner of the order) in full; 2 the others, each
+     * search stopping at a bound below L0 (the sample's best exact
+     * distance) minus its face's reach, plus the tolerance */
+    int stage;
+    size_t stride;
+    double L0;
 } ctx_t;
 
 #define CORNER(J, id) ((J)->from[(id) / 3].v[(id) % 3])
 
+/* About the farthest a point of face t is from its nearest corner (the
+ * longest edge over sqrt 3, unrounded: it only sets a target). */
+static double face_reach(const hd__tri_t *t) {
+    double a2 = 0;
+    for (int i = 0; i < 3; i++) {
+        const double *p = t->v[i], *q = t->v[(i + 1) % 3];
+        double dx = p[0] - q[0], dy = p[1] - q[1], dz = p[2] - q[2];
+        a2 = fmax(a2, dx * dx + dy * dy + dz * dz);
+    }
+    return sqrt(a2) * 0.5774;
+}
+
+/* Corner k of the order is in stage 1's sample: every stride-th position
+ * that starts a run of equal corners (a vertex of X and its copies). */
+static int is_sample(const ctx_t *C, size_t k) {
+    if (k % C->stride) return 0;
+    if (k == 0) return 1;
+    size_t id = C->order ? (size_t)(C->order[k] & 0xffffffffu) : k;
+    size_t pr = C->order ? (size_t)(C->order[k - 1] & 0xffffffffu) : k - 1;
+    return memcmp(CORNER(C->job, id), CORNER(C->job, pr), 3 * sizeof(double)) != 0;
+}
+
+/* Stage 2's target for corner id: a bound at most this puts the corner
+ * below L0, so it needs no exact distance, and with its face's other
+ * corners as low the face's point bound is within the tolerance of L0. */
+static double corner_target(const ctx_t *C, size_t id) {
+    const hd__m2m_job_t *J = C->job;
+    return fmin(C->L0 + J->tol - face_reach(&J->from[id / 3]), down(C->L0));
+}
+
 /* Phase 0: each corner's distance enclosed (interval()), in Morton order
  * so that each search starts from its predecessor's answer; a corner equal
- * to its predecessor copies it. */
+ * to its predecessor copies it (at stage 2 when that answer is complete or
+ * meets the corner's own target). */
 static void phase0(void *vctx, size_t task, int worker) {
     ctx_t *C = vctx;
     const hd__m2m_job_t *J = C->job;
@@ -537,12 +594,21 @@ static void phase0(void *vctx, size_t task, int worker) {
         size_t id = C->order ? (size_t)(C->order[k] & 0xffffffffu) : k;
         found_t *F = &C->found[id];
         if (C->faces[id / 3].done) continue;
-        if (prev != SIZE_MAX && memcmp(CORNER(J, id), CORNER(J, prev), 3 * sizeof(double)) == 0) {
+        int sampled = C->stage && is_sample(C, k);
+        if (C->stage == 1 && !sampled) continue;
+        if (C->stage == 2 && sampled) { /* done at stage 1 */
+            seed = F->pos, prev = id;
+            continue;
+        }
+        double target = C->stage == 2 ? corner_target(C, id) : -INFINITY;
+        if (prev != SIZE_MAX && memcmp(CORNER(J, id), CORNER(J, prev), 3 * sizeof(double)) == 0 &&
+            (C->found[prev].complete || C->found[prev].hi <= target)) {
             *F = C->found[prev];
             continue;
         }
-        F->pos = seed = interval(J->to, CORNER(J, id), seed, &C->caches[worker], &F->lo, &F->hi, &count);
+        F->pos = seed = interval(J->to, CORNER(J, id), seed, &C->caches[worker], enough_of(target), &F->lo, &F->hi, &count);
         F->exact = 0;
+        F->complete = !(F->hi <= target);
         prev = id;
     }
     C->faces[lo / 3].kernel += count; /* counted on the chunk's first face */
@@ -555,10 +621,10 @@ static void phase0(void *vctx, size_t task, int worker) {
 static double phase0_bar(const ctx_t *C) {
     const hd__m2m_job_t *J = C->job;
     if (J->per_face || J->face_lower) return -INFINITY;
-    double bar = -INFINITY;
-    for (size_t k = 0; k < C->n_corners; k++) {
+    double bar = C->stage == 2 ? C->L0 : -INFINITY;
+    for (size_t k = 0; k < C->n_corners; k += C->stage == 1 ? C->stride : 1) {
         size_t id = C->order ? (size_t)(C->order[k] & 0xffffffffu) : k;
-        if (!C->faces[id / 3].done) bar = fmax(bar, C->found[id].lo);
+        if (!C->faces[id / 3].done && (C->stage != 1 || is_sample(C, k))) bar = fmax(bar, C->found[id].lo);
     }
     return bar;
 }
@@ -574,7 +640,8 @@ static void phase0_exact(void *vctx, size_t task, int worker) {
     for (size_t k = lo; k < hi; k++) {
         size_t id = C->order ? (size_t)(C->order[k] & 0xffffffffu) : k;
         found_t *F = &C->found[id];
-        if (C->faces[id / 3].done || F->hi < C->bar) continue;
+        if (C->faces[id / 3].done || (C->stage == 1 && !is_sample(C, k)) || F->hi < C->bar) continue;
+        if (C->stage == 2 && F->exact) continue; /* the sample's, at stage 1 */
         hd__tri_near_t near;
         F->pos = hd__bvh_nearest(J->to, CORNER(J, id), F->pos, 0, &near, &F->index, &st);
         F->r = near.d;
@@ -793,10 +860,16 @@ static void split(const hd__m2m_job_t *J, const hd__tri_t *t, double e, double L
         c[i] = s->c[i];
         for (int j = 0; j < 3; j++) c[i].k[j] = 2 * s->c[i].k[j];
     }
+    /* A midpoint bounded by at most `target` needs no tighter bound: each
+     * child's point bound is then at most max(the threshold + tolerance,
+     * d) (a child's reach is at most its parent's, up to rounding), where
+     * a sub-triangle is never split, and the midpoint cannot raise a lower
+     * bound (target <= exact_bar). */
+    double target = fmin(fmax(threshold(J, L, F) + J->tol, J->done_below) - reach(s) - 2 * e, exact_bar(J, L, F));
     for (int i = 0; i < 3; i++) {
         const corner_t *p = &s->c[i], *q = &s->c[(i + 1) % 3];
         for (int j = 0; j < 3; j++) m[i].k[j] = p->k[j] + q->k[j];
-        evaluate(J, t, &m[i], level, p->pos, P->cache, &F->kernel);
+        evaluate(J, t, &m[i], level, p->pos, target, P->cache, &F->kernel);
         if (could(&m[i], level, e) > exact_bar(J, L, F)) {
             make_exact(J, &m[i], level, e, st);
             offer(&F->best, &m[i], level, e);
@@ -1000,6 +1073,17 @@ static int run_batches(const hd__m2m_job_t *J, ctx_t *C, rank_t *rk, size_t n, h
     return rc;
 }
 
+/* The sample's largest exact distance (its corners are vertices of X, so
+ * a lower bound with a witness), or -infinity. */
+static double sample_best(const ctx_t *C) {
+    double best = -INFINITY;
+    for (size_t k = 0; k < C->n_corners; k += C->stride) {
+        size_t id = C->order ? (size_t)(C->order[k] & 0xffffffffu) : k;
+        if (!C->faces[id / 3].done && is_sample(C, k) && C->found[id].exact) best = fmax(best, C->found[id].r);
+    }
+    return best;
+}
+
 /* The first pass of a search for h: every face's corners, in Morton
  * order (phase 0), then every face's level-0 bound (phase 1). */
 static int first_pass(const hd__m2m_job_t *J, ctx_t *C, hd__m2m_result_t *R) {
@@ -1011,10 +1095,19 @@ static int first_pass(const hd__m2m_job_t *J, ctx_t *C, hd__m2m_result_t *R) {
         return HD_ENOMEM;
     }
     C->order = order;
-    hd__parallel_for(J->threads, (n + CHUNK - 1) / CHUNK, phase0, C);
+    size_t tasks = (n + CHUNK - 1) / CHUNK;
+    if (!J->per_face && !J->face_lower) { /* the sample first: L0 */
+        C->stage = 1;
+        hd__parallel_for(J->threads, tasks, phase0, C);
+        C->bar = phase0_bar(C);
+        hd__parallel_for(J->threads, tasks, phase0_exact, C);
+        C->L0 = sample_best(C);
+        C->stage = isfinite(C->L0) ? 2 : 0;
+    }
+    hd__parallel_for(J->threads, tasks, phase0, C);
     C->bar = phase0_bar(C);
-    hd__parallel_for(J->threads, (n + CHUNK - 1) / CHUNK, phase0_exact, C);
-    hd__parallel_for(J->threads, (n + CHUNK - 1) / CHUNK, phase1, C);
+    hd__parallel_for(J->threads, tasks, phase0_exact, C);
+    hd__parallel_for(J->threads, tasks, phase1, C);
     free(order);
     free(C->found);
     for (size_t f = 0; f < n; f++) take_best(R, &C->faces[f], f);
@@ -1072,7 +1165,7 @@ int hd__m2m_run(const hd__m2m_job_t *J, hd__m2m_result_t *R) {
     memset(R, 0, sizeof *R);
     R->face = R->face_b = SIZE_MAX;
     size_t n = J->n_from;
-    ctx_t C = {J, hd__malloc_array(n ? n : 1, sizeof(face_t)), NULL, NULL, 0, NULL, 0, 0};
+    ctx_t C = {J, hd__malloc_array(n ? n : 1, sizeof(face_t)), NULL, NULL, 0, NULL, 0, 0, 0, SAMPLE_STRIDE, 0};
     rank_t *rk = hd__malloc_array(n ? n : 1, sizeof *rk);
     C.n_corners = 3 * n;
     C.caches = caches_new(J->threads, J->to->n_tris);
