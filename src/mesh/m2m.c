@@ -1222,21 +1222,47 @@ static void key_of(const hd__tri_t *t, facekey_t *k) {
     swap_if(k->v[0], k->v[1]);
 }
 
-static int cmp_key(const void *x, const void *y) { return memcmp(x, y, sizeof(facekey_t)); }
+/* A key's hash: its 72 bytes mixed (any function would do: equal keys
+ * have equal hashes, and the table compares keys in full). */
+static uint64_t key_hash(const facekey_t *k) {
+    uint64_t h = 0x9e3779b97f4a7c15u, w;
+    for (int i = 0; i < 9; i++) {
+        memcpy(&w, &k->v[i / 3][i % 3], sizeof w);
+        h = (h ^ w) * 0xff51afd7ed558ccdu;
+        h ^= h >> 32;
+    }
+    return h;
+}
 
 int hd__m2m_shared(const hd__tri_t *x, size_t nx, const hd__tri_t *y, size_t ny, unsigned char *drop,
                    size_t *count) {
     *count = 0;
+    size_t size = 16;
+    while (size < 2 * ny) size *= 2;
     facekey_t *ky = hd__malloc_array(ny ? ny : 1, sizeof *ky);
-    if (!ky) return HD_ENOMEM;
-    for (size_t k = 0; k < ny; k++) key_of(&y[k], &ky[k]);
-    qsort(ky, ny, sizeof *ky, cmp_key);
+    size_t *slot = hd__malloc_array(size, sizeof *slot);
+    if (!ky || !slot) {
+        free(ky);
+        free(slot);
+        return HD_ENOMEM;
+    }
+    /* Y's keys in a table with linear probing (SIZE_MAX: empty) */
+    for (size_t k = 0; k < size; k++) slot[k] = SIZE_MAX;
+    for (size_t k = 0; k < ny; k++) {
+        key_of(&y[k], &ky[k]);
+        size_t h = (size_t)key_hash(&ky[k]) & (size - 1);
+        while (slot[h] != SIZE_MAX && memcmp(&ky[slot[h]], &ky[k], sizeof ky[k])) h = (h + 1) & (size - 1);
+        if (slot[h] == SIZE_MAX) slot[h] = k; /* an equal key is there already */
+    }
     for (size_t k = 0; k < nx; k++) {
         facekey_t kx;
         key_of(&x[k], &kx);
-        drop[k] = bsearch(&kx, ky, ny, sizeof *ky, cmp_key) != NULL;
+        size_t h = (size_t)key_hash(&kx) & (size - 1);
+        while (slot[h] != SIZE_MAX && memcmp(&ky[slot[h]], &kx, sizeof kx)) h = (h + 1) & (size - 1);
+        drop[k] = slot[h] != SIZE_MAX;
         *count += drop[k];
     }
     free(ky);
+    free(slot);
     return HD_OK;
 }
