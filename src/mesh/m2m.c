@@ -981,6 +981,40 @@ static int by_upper(const void *x, const void *y) {
     return (a->f > b->f) - (a->f < b->f);
 }
 
+/* rk sorted as by_upper sorts it (by decreasing U, then increasing f):
+ * a stable radix sort, by f and then by U's bits (for U >= 0 their order
+ * as unsigned integers is U's), eight bits a pass, passes whose digit is
+ * the same for every entry skipped; qsort when no scratch is free. */
+static void sort_ranks(rank_t *rk, size_t n) {
+    rank_t *tmp = n > 1 ? hd__malloc_array(n, sizeof *tmp) : NULL;
+    if (!tmp) {
+        qsort(rk, n, sizeof *rk, by_upper);
+        return;
+    }
+    rank_t *src = rk, *dst = tmp;
+    for (int pass = 0; pass < 16; pass++) {
+        size_t count[256] = {0};
+        uint64_t key;
+        for (size_t k = 0; k < n; k++) {
+            if (pass < 8) key = (uint64_t)src[k].f >> (8 * pass);
+            else memcpy(&key, &src[k].U, sizeof key), key = src[k].U > 0 ? ~key >> (8 * (pass - 8)) : ~(uint64_t)0;
+            count[key & 255]++;
+        }
+        size_t at = 0, same = 0;
+        for (int d = 0; d < 256; d++) same |= count[d] == n, at += count[d], count[d] = at - count[d];
+        if (same) continue;
+        for (size_t k = 0; k < n; k++) {
+            if (pass < 8) key = (uint64_t)src[k].f >> (8 * pass);
+            else memcpy(&key, &src[k].U, sizeof key), key = src[k].U > 0 ? ~key >> (8 * (pass - 8)) : ~(uint64_t)0;
+            dst[count[key & 255]++] = src[k];
+        }
+        rank_t *t = src;
+        src = dst, dst = t;
+    }
+    if (src != rk) memcpy(rk, src, n * sizeof *rk);
+    free(tmp);
+}
+
 static void take_best(hd__m2m_result_t *R, const face_t *F, size_t f) {
     if (!F->best.set) return;
     if (R->face != SIZE_MAX && !(F->best.lower > R->lower)) return;
@@ -1055,7 +1089,7 @@ static int run_batches(const hd__m2m_job_t *J, ctx_t *C, rank_t *rk, size_t n, h
         size_t m = 0;
         for (size_t k = 0; k < n; k++)
             if (C->faces[rk[k].f].saved) rk[m++] = (rank_t){C->faces[rk[k].f].upper, rk[k].f};
-        qsort(rk, m, sizeof *rk, by_upper);
+        sort_ranks(rk, m);
         n = R->lower > J->stop_above ? 0 : m;
         B.budget = B.budget < ((uint64_t)1 << 40) ? 4 * B.budget : B.budget;
     }
@@ -1189,7 +1223,7 @@ int hd__m2m_run(const hd__m2m_job_t *J, hd__m2m_result_t *R) {
     /* no face with a corner measured (every face shared, or screened):
      * 0 is a lower bound without a witness */
     if (R->face == SIZE_MAX) R->lower = 0;
-    qsort(rk, live, sizeof *rk, by_upper);
+    sort_ranks(rk, live);
     if (rc == HD_OK && !stopped) rc = run_batches(J, &C, rk, live, R);
     for (size_t f = 0; f < n; f++) finish_face(R, J, &C.faces[f], f);
     R->upper = stopped ? INFINITY : fmax(R->upper, R->lower);
