@@ -520,6 +520,15 @@ static double upper_of(const hd__m2m_job_t *J, const sub_t *s, double e, double 
     return s->level ? up(U + e) : U;
 }
 
+/* The bound at or below which a (sub-)triangle's point bound makes the
+ * dearer bounds useless, for a lower bound `bar` that the search's lower
+ * bound already reaches: the predicate's d, or else bar plus the
+ * tolerance (a face or sub-triangle whose bound is within the tolerance
+ * of the lower bound is never split). */
+static double enough_for(const hd__m2m_job_t *J, double bar) {
+    return isfinite(J->done_below) ? fmax(bar, J->done_below) : bar + J->tol;
+}
+
 /* ---- phase 1: every face's corners -------------------------------------- */
 
 /* A corner of a face as phase 0 finds it. */
@@ -679,7 +688,7 @@ static void phase1(void *vctx, size_t task, int worker) {
     const hd__m2m_job_t *J = C->job;
     size_t lo = (C->task0 + task) * CHUNK, hi = lo + CHUNK < J->n_from ? lo + CHUNK : J->n_from;
     for (size_t f = lo; f < hi; f++)
-        if (!C->faces[f].done) face_top(J, &C->faces[f], f, &C->found[3 * f], J->face_upper ? -INFINITY : fmax(C->bar, J->done_below), &C->caches[worker]);
+        if (!C->faces[f].done) face_top(J, &C->faces[f], f, &C->found[3 * f], J->face_upper ? -INFINITY : enough_for(J, C->bar), &C->caches[worker]);
 }
 
 /* ---- the predicate's pass: screen, then exact corners, in rounds --------- */
@@ -877,7 +886,7 @@ static void split(const hd__m2m_job_t *J, const hd__tri_t *t, double e, double L
     }
     const corner_t *tri[4][3] = {{&c[0], &m[0], &m[2]}, {&m[0], &c[1], &m[1]}, {&m[2], &m[1], &c[2]},
                                  {&m[0], &m[1], &m[2]}};
-    double enough = fmax(threshold(J, L, F), J->done_below);
+    double enough = enough_for(J, threshold(J, L, F));
     for (int q = 0; q < 4; q++) {
         for (int i = 0; i < 3; i++) kids[q].c[i] = *tri[q][i];
         kids[q].level = level;
