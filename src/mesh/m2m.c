@@ -60,8 +60,17 @@
  * All upper sums and square roots are rounded to nearest and then moved one
  * double up (next_up), which is at least the exact value.
  *
- * The search.  Phase 0 bounds every distinct corner and computes the
- * exact distances of those that can be the largest; phase 1 evaluates
+ * The search.  Phase 0 bounds a sample of the corners in full and
+ * computes the exact distances of those that can be the largest; the best,
+ * L0, is the distance of a vertex of X.  It then bounds every other
+ * distinct corner, each search stopping at the first triangle whose hi is
+ * at most a target below L0 (any triangle's hi is >= d(v, Y), so hi stays
+ * an upper bound; such a corner cannot beat L0 and needs no exact
+ * distance; its lo is then 0, since the triangles not visited were not
+ * excluded), and computes the exact distances of the corners whose hi
+ * reaches L0 and every complete search's lo.  A midpoint's search stops
+ * the same way at a bound that keeps its children's point bound within
+ * the tolerance and below the bar of exact corners.  Phase 1 evaluates
  * every face's corners (fixed chunks, any thread) and sets the lower
  * bound L to the best corner.  Phase 2 takes the faces by decreasing
  * upper bound in batches of fixed sizes; the faces of a batch are refined
