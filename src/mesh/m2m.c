@@ -1286,35 +1286,42 @@ static uint64_t key_hash(const facekey_t *k) {
     return h;
 }
 
-int hd__m2m_shared(const hd__tri_t *x, size_t nx, const hd__tri_t *y, size_t ny, unsigned char *drop,
-                   size_t *count) {
-    *count = 0;
+int hd__m2m_shared(const hd__tri_t *x, size_t nx, const hd__tri_t *y, size_t ny, unsigned char *drop_x,
+                   unsigned char *drop_y, size_t *count_x, size_t *count_y) {
+    *count_x = *count_y = 0;
     size_t size = 16;
     while (size < 2 * ny) size *= 2;
     facekey_t *ky = hd__malloc_array(ny ? ny : 1, sizeof *ky);
-    size_t *slot = hd__malloc_array(size, sizeof *slot);
-    if (!ky || !slot) {
-        free(ky);
-        free(slot);
+    size_t *slot = hd__malloc_array(size, sizeof *slot), *at = hd__malloc_array(ny ? ny : 1, sizeof *at);
+    unsigned char *hit = calloc(size, 1);
+    if (!ky || !slot || !at || !hit) {
+        free(ky), free(slot), free(at), free(hit);
         return HD_ENOMEM;
     }
-    /* Y's keys in a table with linear probing (SIZE_MAX: empty) */
+    /* Y's keys in a table with linear probing (SIZE_MAX: empty); at[k]:
+     * the slot of face k's key (equal keys share the first one's) */
     for (size_t k = 0; k < size; k++) slot[k] = SIZE_MAX;
     for (size_t k = 0; k < ny; k++) {
         key_of(&y[k], &ky[k]);
         size_t h = (size_t)key_hash(&ky[k]) & (size - 1);
         while (slot[h] != SIZE_MAX && memcmp(&ky[slot[h]], &ky[k], sizeof ky[k])) h = (h + 1) & (size - 1);
-        if (slot[h] == SIZE_MAX) slot[h] = k; /* an equal key is there already */
+        if (slot[h] == SIZE_MAX) slot[h] = k;
+        at[k] = h;
     }
+    /* X's faces looked up; the keys they meet are Y's shared faces */
     for (size_t k = 0; k < nx; k++) {
         facekey_t kx;
         key_of(&x[k], &kx);
         size_t h = (size_t)key_hash(&kx) & (size - 1);
         while (slot[h] != SIZE_MAX && memcmp(&ky[slot[h]], &kx, sizeof kx)) h = (h + 1) & (size - 1);
-        drop[k] = slot[h] != SIZE_MAX;
-        *count += drop[k];
+        drop_x[k] = slot[h] != SIZE_MAX;
+        hit[h] |= drop_x[k];
+        *count_x += drop_x[k];
     }
-    free(ky);
-    free(slot);
+    for (size_t k = 0; drop_y && k < ny; k++) {
+        drop_y[k] = hit[at[k]];
+        *count_y += drop_y[k];
+    }
+    free(ky), free(slot), free(at), free(hit);
     return HD_OK;
 }

@@ -168,6 +168,26 @@ TEST(identical_meshes_are_zero) {
     gen_soup_free(&A);
 }
 
+/* Shared faces are found for both directions at once: B holds one of A's
+ * faces twice (corners in another order) and a face of its own; A's other
+ * face is not in B.  h(A, B) drops one face, h(B, A) both copies. */
+TEST(shared_faces_are_dropped_both_ways_with_copies) {
+    const double va[] = {0, 0, 0, 8, 0, 0, 0, 8, 0, 8, 8, 4};
+    const uint64_t ta[] = {0, 1, 2, 1, 3, 2};
+    const double vb[] = {0, 0, 0, 8, 0, 0, 0, 8, 0, 0, 0, 8};
+    const uint64_t tb[] = {0, 1, 2, 2, 0, 1, 0, 1, 3};
+    gen_soup_t A = soup_of(va, 4, ta, 2), B = soup_of(vb, 4, tb, 3);
+    hd_mesh_t a = gen_soup_view(&A), b = gen_soup_view(&B);
+    hd_surface_options_t o = options(1e-9, 1, 1);
+    hd_enclosure_t ab, ba;
+    CHECK_RC(hd_surface_hausdorff(&a, &b, &o, &ab, &ba, NULL), HD_OK);
+    CHECK_EQ(ab.faces_dropped, 1);
+    CHECK_EQ(ba.faces_dropped, 2);
+    encloses(&ab, &A, &B, 16);
+    encloses(&ba, &B, &A, 16);
+    gen_soup_free(&A), gen_soup_free(&B);
+}
+
 TEST(parallel_shifted_triangle_is_its_shift) {
     const double v[] = {0, 0, 0, 8, 0, 0, 0, 8, 0, 0, 0, 3, 8, 0, 3, 0, 8, 3};
     const uint64_t ta[] = {0, 1, 2}, tb[] = {3, 4, 5};
