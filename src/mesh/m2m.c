@@ -618,9 +618,13 @@ static void phase0(void *vctx, size_t task, int worker) {
             seed = F->pos, prev = id;
             continue;
         }
+        int same = prev != SIZE_MAX && memcmp(CORNER(J, id), CORNER(J, prev), 3 * sizeof(double)) == 0;
+        if (same && C->found[prev].complete) {
+            *F = C->found[prev];
+            continue;
+        }
         double target = C->stage == 2 ? corner_target(C, id) : -INFINITY;
-        if (prev != SIZE_MAX && memcmp(CORNER(J, id), CORNER(J, prev), 3 * sizeof(double)) == 0 &&
-            (C->found[prev].complete || C->found[prev].hi <= target)) {
+        if (same && C->found[prev].hi <= target) {
             *F = C->found[prev];
             continue;
         }
@@ -999,6 +1003,16 @@ static int by_upper(const void *x, const void *y) {
     return (a->f > b->f) - (a->f < b->f);
 }
 
+/* Digit `pass` of a rank's sort key: passes 0-7 the bytes of f, 8-15
+ * those of the complement of U's bits (U > 0; else the largest key). */
+static unsigned rank_digit(const rank_t *r, int pass) {
+    uint64_t key;
+    if (pass < 8) return (unsigned)(((uint64_t)r->f >> (8 * pass)) & 255);
+    memcpy(&key, &r->U, sizeof key);
+    key = r->U > 0 ? ~key : ~(uint64_t)0;
+    return (unsigned)((key >> (8 * (pass - 8))) & 255);
+}
+
 /* rk sorted as by_upper sorts it (by decreasing U, then increasing f):
  * a stable radix sort, by f and then by U's bits (for U >= 0 their order
  * as unsigned integers is U's), eight bits a pass, passes whose digit is
@@ -1010,27 +1024,29 @@ static void sort_ranks(rank_t *rk, size_t n) {
         return;
     }
     rank_t *src = rk, *dst = tmp;
+    size_t (*count)[256] = calloc(16, sizeof *count); /* every digit's histogram, in one read */
+    if (!count) {
+        free(tmp);
+        qsort(rk, n, sizeof *rk, by_upper);
+        return;
+    }
+    for (size_t k = 0; k < n; k++)
+        for (int pass = 0; pass < 16; pass++) count[pass][rank_digit(&rk[k], pass)]++;
     for (int pass = 0; pass < 16; pass++) {
-        size_t count[256] = {0};
-        uint64_t key;
-        for (size_t k = 0; k < n; k++) {
-            if (pass < 8) key = (uint64_t)src[k].f >> (8 * pass);
-            else memcpy(&key, &src[k].U, sizeof key), key = src[k].U > 0 ? ~key >> (8 * (pass - 8)) : ~(uint64_t)0;
-            count[key & 255]++;
-        }
         size_t at = 0, same = 0;
-        for (int d = 0; d < 256; d++) same |= count[d] == n, at += count[d], count[d] = at - count[d];
-        if (same) continue;
-        for (size_t k = 0; k < n; k++) {
-            if (pass < 8) key = (uint64_t)src[k].f >> (8 * pass);
-            else memcpy(&key, &src[k].U, sizeof key), key = src[k].U > 0 ? ~key >> (8 * (pass - 8)) : ~(uint64_t)0;
-            dst[count[key & 255]++] = src[k];
+        for (int d = 0; d < 256; d++) {
+            same |= count[pass][d] == n;
+            at += count[pass][d];
+            count[pass][d] = at - count[pass][d];
         }
+        if (same) continue;
+        for (size_t k = 0; k < n; k++) dst[count[pass][rank_digit(&src[k], pass)]++] = src[k];
         rank_t *t = src;
         src = dst, dst = t;
     }
     if (src != rk) memcpy(rk, src, n * sizeof *rk);
     free(tmp);
+    free(count);
 }
 
 static void take_best(hd__m2m_result_t *R, const face_t *F, size_t f) {
