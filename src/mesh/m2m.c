@@ -628,7 +628,8 @@ static void phase0(void *vctx, size_t task, int worker) {
             *F = C->found[prev];
             continue;
         }
-        F->pos = seed = interval(J->to, CORNER(J, id), seed, &C->caches[worker], enough_of(target), &F->lo, &F->hi, &count);
+        F->pos = seed =
+            interval(J->to, CORNER(J, id), seed, &C->caches[worker], enough_of(target), &F->lo, &F->hi, &count);
         F->exact = 0;
         F->complete = !(F->hi <= target);
         prev = id;
@@ -700,8 +701,9 @@ static void phase1(void *vctx, size_t task, int worker) {
     ctx_t *C = vctx;
     const hd__m2m_job_t *J = C->job;
     size_t lo = (C->task0 + task) * CHUNK, hi = lo + CHUNK < J->n_from ? lo + CHUNK : J->n_from;
+    double enough = J->face_upper ? -INFINITY : enough_for(J, C->bar);
     for (size_t f = lo; f < hi; f++)
-        if (!C->faces[f].done) face_top(J, &C->faces[f], f, &C->found[3 * f], J->face_upper ? -INFINITY : enough_for(J, C->bar), &C->caches[worker]);
+        if (!C->faces[f].done) face_top(J, &C->faces[f], f, &C->found[3 * f], enough, &C->caches[worker]);
 }
 
 /* ---- the predicate's pass: screen, then exact corners, in rounds --------- */
