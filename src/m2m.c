@@ -39,10 +39,13 @@ typedef struct side {
     hd__bvh_t bvh;
     int built;
     int points;      /* a point set */
+    unsigned char *drop; /* faces shared with the other side (shared()) */
+    size_t dropped;
 } side_t;
 
 static void side_free(side_t *s) {
     free(s->tris);
+    free(s->drop);
     if (s->built) hd__bvh_free(&s->bvh);
     memset(s, 0, sizeof *s);
 }
@@ -137,20 +140,28 @@ typedef struct ask {
     double *face_lower, *face_upper;
 } ask_t;
 
-static int directed(const side_t *x, side_t *y, const ask_t *q, hd_enclosure_t *out, hd_error_t *err) {
-    double t0 = hd__now();
-    unsigned char *drop = NULL;
-    size_t dropped = 0;
-    int rc = HD_OK;
-    if (!x->points && !y->points) {
-        drop = malloc(x->n ? x->n : 1);
-        if (!drop || hd__m2m_shared(x->tris, x->n, y->tris, y->n, drop, &dropped)) {
-            free(drop);
-            return hd__err(err, HD_ENOMEM, "out of memory comparing the faces of the meshes");
-        }
+/* Both meshes' shared faces at once (a table of y's faces, x's looked up
+ * in it), unless already known or a side is a point set. */
+static int shared(side_t *x, side_t *y, hd_error_t *err) {
+    if (x->drop || x->points || y->points) return HD_OK;
+    x->drop = malloc(x->n ? x->n : 1);
+    y->drop = malloc(y->n ? y->n : 1);
+    if (!x->drop || !y->drop ||
+        hd__m2m_shared(x->tris, x->n, y->tris, y->n, x->drop, y->drop, &x->dropped, &y->dropped)) {
+        free(x->drop), free(y->drop);
+        x->drop = y->drop = NULL;
+        return hd__err(err, HD_ENOMEM, "out of memory comparing the faces of the meshes");
     }
+    return HD_OK;
+}
+
+static int directed(side_t *x, side_t *y, const ask_t *q, hd_enclosure_t *out, hd_error_t *err) {
+    double t0 = hd__now();
+    int rc = shared(x, y, err);
+    if (rc) return rc;
+    const unsigned char *drop = x->drop;
+    size_t dropped = x->dropped;
     if (dropped == x->n) { /* every face of X is a face of Y: h = 0, no tree needed */
-        free(drop);
         for (size_t k = 0; k < x->n; k++) {
             if (q->face_lower) q->face_lower[k] = 0;
             if (q->face_upper) q->face_upper[k] = 0;
@@ -169,7 +180,6 @@ static int directed(const side_t *x, side_t *y, const ask_t *q, hd_enclosure_t *
     J.threads = hd__thread_count(q->threads, x->n);
     hd__m2m_result_t R;
     rc = hd__m2m_run(&J, &R);
-    free(drop);
     if (rc) return hd__err(err, rc, "out of memory refining %zu triangles", x->n);
     enclosure_init(out);
     out->lower = R.lower;

@@ -60,8 +60,17 @@
  * All upper sums and square roots are rounded to nearest and then moved one
  * double up (next_up), which is at least the exact value.
  *
- * The search.  Phase 0 bounds every distinct corner and computes the
- * exact distances of those that can be the largest; phase 1 evaluates
+ * The search.  Phase 0 bounds a sample of the corners in full and
+ * computes the exact distances of those that can be the largest; the best,
+ * L0, is the distance of a vertex of X.  It then bounds every other
+ * distinct corner, each search stopping at the first triangle whose hi is
+ * at most a target below L0 (any triangle's hi is >= d(v, Y), so hi stays
+ * an upper bound; such a corner cannot beat L0 and needs no exact
+ * distance; its lo is then 0, since the triangles not visited were not
+ * excluded), and computes the exact distances of the corners whose hi
+ * reaches L0 and every complete search's lo.  A midpoint's search stops
+ * the same way at a bound that keeps its children's point bound within
+ * the tolerance and below the bar of exact corners.  Phase 1 evaluates
  * every face's corners (fixed chunks, any thread) and sets the lower
  * bound L to the best corner.  Phase 2 takes the faces by decreasing
  * upper bound in batches of fixed sizes; the faces of a batch are refined
@@ -102,6 +111,8 @@
 #define MAX_BATCH 1024
 /* Faces per task in phase 1. */
 #define CHUNK 256
+/* Phase 0's sample: every SAMPLE_STRIDE-th corner in Morton order. */
+#define SAMPLE_STRIDE 32
 /* Below this a squared edge may have underflowed: R from |dx|+|dy|+|dz|. */
 #define TINY2 0x1p-960
 
@@ -384,16 +395,21 @@ static void bounds_at(const hd__bvh_t *T, size_t pos, const double p[3], cache_t
  * of smallest hi2 (returned: its position in the tree; a triangle whose
  * box lies beyond the smallest hi2 so far is skipped), lo from the smallest
  * lo2 over the triangles visited (a skipped one is farther than the
- * nearest, so the minimum over Y is among them).  The answer depends on p,
- * the seed and the tree only. */
-static size_t interval(const hd__bvh_t *T, const double p[3], size_t seed, cache_t *C, double *lo, double *hi,
-                       uint64_t *count) {
+ * nearest, so the minimum over Y is among them).  With enough2 >= 0 the
+ * search stops at the first triangle whose hi2 is at most enough2 (the
+ * caller needs no smaller upper bound): hi is then that triangle's bound,
+ * still >= d(p, Y), and lo is 0 (the triangles not visited were not
+ * excluded).  The answer depends on p, the seed, enough2 and the tree
+ * only. */
+static size_t interval(const hd__bvh_t *T, const double p[3], size_t seed, cache_t *C, double enough2, double *lo,
+                       double *hi, uint64_t *count) {
     double best = INFINITY, low = INFINITY, lo2, hi2;
     size_t pos = SIZE_MAX;
     if (seed < T->n_tris) {
         bounds_at(T, seed, p, C, &lo2, &hi2);
         best = hi2, low = lo2, pos = seed;
         (*count)++;
+        if (best <= enough2) goto early;
     }
     struct { uint32_t id; double s; } stack[DEPTH]; /* s: the box's hd__box_lb2s */
     int top = 0;
@@ -409,6 +425,7 @@ static size_t interval(const hd__bvh_t *T, const double p[3], size_t seed, cache
                 (*count)++;
                 low = fmin(low, lo2);
                 if (pos == SIZE_MAX || hi2 < best) best = hi2, pos = k;
+                if (best <= enough2) goto early;
             }
             continue;
         }
@@ -426,7 +443,15 @@ static size_t interval(const hd__bvh_t *T, const double p[3], size_t seed, cache
     *lo = low > 0 ? down(sqrt(low)) : 0;
     *hi = sqrt_up(best);
     return pos;
+early:
+    *lo = 0;
+    *hi = sqrt_up(best);
+    return pos;
 }
+
+/* The squared distance below which an upper bound needs no search: a
+ * corner whose hi is at most `target` (when target > 0; else none). */
+static double enough_of(double target) { return target > 0 ? target * target * (1 - 0x1p-40) : -1; }
 
 /* The largest lower bound the corner could give (its exact distance is at
  * most hi). */
@@ -445,11 +470,13 @@ static void make_exact(const hd__m2m_job_t *J, corner_t *c, int level, double e,
     if (up(c->r) < c->hi) c->hi = up(c->r), c->pos = pos;
 }
 
-static void evaluate(const hd__m2m_job_t *J, const hd__tri_t *t, corner_t *c, int level, size_t seed, cache_t *C,
-                     uint64_t *count) {
+/* The corner's point and its upper bound; the search stops at a bound of
+ * `target` or less (see enough_of). */
+static void evaluate(const hd__m2m_job_t *J, const hd__tri_t *t, corner_t *c, int level, size_t seed, double target,
+                     cache_t *C, uint64_t *count) {
     double lo;
     corner_point(t, c, level);
-    c->pos = interval(J->to, c->p, seed, C, &lo, &c->hi, count);
+    c->pos = interval(J->to, c->p, seed, C, enough_of(target), &lo, &c->hi, count);
     c->exact = 0;
 }
 
@@ -502,6 +529,15 @@ static double upper_of(const hd__m2m_job_t *J, const sub_t *s, double e, double 
     return s->level ? up(U + e) : U;
 }
 
+/* The bound at or below which a (sub-)triangle's point bound makes the
+ * dearer bounds useless, for a lower bound `bar` that the search's lower
+ * bound already reaches: the predicate's d, or else bar plus the
+ * tolerance (a face or sub-triangle whose bound is within the tolerance
+ * of the lower bound is never split). */
+static double enough_for(const hd__m2m_job_t *J, double bar) {
+    return isfinite(J->done_below) ? fmax(bar, J->done_below) : bar + J->tol;
+}
+
 /* ---- phase 1: every face's corners -------------------------------------- */
 
 /* A corner of a face as phase 0 finds it. */
@@ -509,6 +545,7 @@ typedef struct found {
     double lo, hi, r, near[3];
     size_t pos, index;
     int exact;
+    int complete; /* hi is the smallest the bounds give (no early stop) */
 } found_t;
 
 typedef struct ctx {
@@ -520,13 +557,51 @@ typedef struct ctx {
     cache_t *caches;       /* one per worker */
     size_t task0;          /* phase 1's first task (the predicate's rounds) */
     double bar;            /* phase 0's exact searches: corners with hi >= bar */
+    /* Phase 0 in stages: 0 every corner searched in full; 1 the sample
+     * (every stride-th corner of the order) in full; 2 the others, each
+     * search stopping at a bound below L0 (the sample's best exact
+     * distance) minus its face's reach, plus the tolerance */
+    int stage;
+    size_t stride;
+    double L0;
 } ctx_t;
 
 #define CORNER(J, id) ((J)->from[(id) / 3].v[(id) % 3])
 
+/* About the farthest a point of face t is from its nearest corner (the
+ * longest edge over sqrt 3, unrounded: it only sets a target). */
+static double face_reach(const hd__tri_t *t) {
+    double a2 = 0;
+    for (int i = 0; i < 3; i++) {
+        const double *p = t->v[i], *q = t->v[(i + 1) % 3];
+        double dx = p[0] - q[0], dy = p[1] - q[1], dz = p[2] - q[2];
+        a2 = fmax(a2, dx * dx + dy * dy + dz * dz);
+    }
+    return sqrt(a2) * 0.5774;
+}
+
+/* Corner k of the order is in stage 1's sample: every stride-th position
+ * that starts a run of equal corners (a vertex of X and its copies). */
+static int is_sample(const ctx_t *C, size_t k) {
+    if (k % C->stride) return 0;
+    if (k == 0) return 1;
+    size_t id = C->order ? (size_t)(C->order[k] & 0xffffffffu) : k;
+    size_t pr = C->order ? (size_t)(C->order[k - 1] & 0xffffffffu) : k - 1;
+    return memcmp(CORNER(C->job, id), CORNER(C->job, pr), 3 * sizeof(double)) != 0;
+}
+
+/* Stage 2's target for corner id: a bound at most this puts the corner
+ * below L0, so it needs no exact distance, and with its face's other
+ * corners as low the face's point bound is within the tolerance of L0. */
+static double corner_target(const ctx_t *C, size_t id) {
+    const hd__m2m_job_t *J = C->job;
+    return fmin(C->L0 + J->tol - face_reach(&J->from[id / 3]), down(C->L0));
+}
+
 /* Phase 0: each corner's distance enclosed (interval()), in Morton order
  * so that each search starts from its predecessor's answer; a corner equal
- * to its predecessor copies it. */
+ * to its predecessor copies it (at stage 2 when that answer is complete or
+ * meets the corner's own target). */
 static void phase0(void *vctx, size_t task, int worker) {
     ctx_t *C = vctx;
     const hd__m2m_job_t *J = C->job;
@@ -537,12 +612,26 @@ static void phase0(void *vctx, size_t task, int worker) {
         size_t id = C->order ? (size_t)(C->order[k] & 0xffffffffu) : k;
         found_t *F = &C->found[id];
         if (C->faces[id / 3].done) continue;
-        if (prev != SIZE_MAX && memcmp(CORNER(J, id), CORNER(J, prev), 3 * sizeof(double)) == 0) {
+        int sampled = C->stage && is_sample(C, k);
+        if (C->stage == 1 && !sampled) continue;
+        if (C->stage == 2 && sampled) { /* done at stage 1 */
+            seed = F->pos, prev = id;
+            continue;
+        }
+        int same = prev != SIZE_MAX && memcmp(CORNER(J, id), CORNER(J, prev), 3 * sizeof(double)) == 0;
+        if (same && C->found[prev].complete) {
             *F = C->found[prev];
             continue;
         }
-        F->pos = seed = interval(J->to, CORNER(J, id), seed, &C->caches[worker], &F->lo, &F->hi, &count);
+        double target = C->stage == 2 ? corner_target(C, id) : -INFINITY;
+        if (same && C->found[prev].hi <= target) {
+            *F = C->found[prev];
+            continue;
+        }
+        F->pos = seed =
+            interval(J->to, CORNER(J, id), seed, &C->caches[worker], enough_of(target), &F->lo, &F->hi, &count);
         F->exact = 0;
+        F->complete = !(F->hi <= target);
         prev = id;
     }
     C->faces[lo / 3].kernel += count; /* counted on the chunk's first face */
@@ -555,10 +644,10 @@ static void phase0(void *vctx, size_t task, int worker) {
 static double phase0_bar(const ctx_t *C) {
     const hd__m2m_job_t *J = C->job;
     if (J->per_face || J->face_lower) return -INFINITY;
-    double bar = -INFINITY;
-    for (size_t k = 0; k < C->n_corners; k++) {
+    double bar = C->stage == 2 ? C->L0 : -INFINITY;
+    for (size_t k = 0; k < C->n_corners; k += C->stage == 1 ? C->stride : 1) {
         size_t id = C->order ? (size_t)(C->order[k] & 0xffffffffu) : k;
-        if (!C->faces[id / 3].done) bar = fmax(bar, C->found[id].lo);
+        if (!C->faces[id / 3].done && (C->stage != 1 || is_sample(C, k))) bar = fmax(bar, C->found[id].lo);
     }
     return bar;
 }
@@ -574,7 +663,8 @@ static void phase0_exact(void *vctx, size_t task, int worker) {
     for (size_t k = lo; k < hi; k++) {
         size_t id = C->order ? (size_t)(C->order[k] & 0xffffffffu) : k;
         found_t *F = &C->found[id];
-        if (C->faces[id / 3].done || F->hi < C->bar) continue;
+        if (C->faces[id / 3].done || (C->stage == 1 && !is_sample(C, k)) || F->hi < C->bar) continue;
+        if (C->stage == 2 && F->exact) continue; /* the sample's, at stage 1 */
         hd__tri_near_t near;
         F->pos = hd__bvh_nearest(J->to, CORNER(J, id), F->pos, 0, &near, &F->index, &st);
         F->r = near.d;
@@ -611,8 +701,9 @@ static void phase1(void *vctx, size_t task, int worker) {
     ctx_t *C = vctx;
     const hd__m2m_job_t *J = C->job;
     size_t lo = (C->task0 + task) * CHUNK, hi = lo + CHUNK < J->n_from ? lo + CHUNK : J->n_from;
+    double enough = J->face_upper ? -INFINITY : enough_for(J, C->bar);
     for (size_t f = lo; f < hi; f++)
-        if (!C->faces[f].done) face_top(J, &C->faces[f], f, &C->found[3 * f], J->face_upper ? -INFINITY : fmax(C->bar, J->done_below), &C->caches[worker]);
+        if (!C->faces[f].done) face_top(J, &C->faces[f], f, &C->found[3 * f], enough, &C->caches[worker]);
 }
 
 /* ---- the predicate's pass: screen, then exact corners, in rounds --------- */
@@ -793,10 +884,16 @@ static void split(const hd__m2m_job_t *J, const hd__tri_t *t, double e, double L
         c[i] = s->c[i];
         for (int j = 0; j < 3; j++) c[i].k[j] = 2 * s->c[i].k[j];
     }
+    /* A midpoint bounded by at most `target` needs no tighter bound: each
+     * child's point bound is then at most max(the threshold + tolerance,
+     * d) (a child's reach is at most its parent's, up to rounding), where
+     * a sub-triangle is never split, and the midpoint cannot raise a lower
+     * bound (target <= exact_bar). */
+    double target = fmin(fmax(threshold(J, L, F) + J->tol, J->done_below) - reach(s) - 2 * e, exact_bar(J, L, F));
     for (int i = 0; i < 3; i++) {
         const corner_t *p = &s->c[i], *q = &s->c[(i + 1) % 3];
         for (int j = 0; j < 3; j++) m[i].k[j] = p->k[j] + q->k[j];
-        evaluate(J, t, &m[i], level, p->pos, P->cache, &F->kernel);
+        evaluate(J, t, &m[i], level, p->pos, target, P->cache, &F->kernel);
         if (could(&m[i], level, e) > exact_bar(J, L, F)) {
             make_exact(J, &m[i], level, e, st);
             offer(&F->best, &m[i], level, e);
@@ -804,7 +901,7 @@ static void split(const hd__m2m_job_t *J, const hd__tri_t *t, double e, double L
     }
     const corner_t *tri[4][3] = {{&c[0], &m[0], &m[2]}, {&m[0], &c[1], &m[1]}, {&m[2], &m[1], &c[2]},
                                  {&m[0], &m[1], &m[2]}};
-    double enough = fmax(threshold(J, L, F), J->done_below);
+    double enough = enough_for(J, threshold(J, L, F));
     for (int q = 0; q < 4; q++) {
         for (int i = 0; i < 3; i++) kids[q].c[i] = *tri[q][i];
         kids[q].level = level;
@@ -908,6 +1005,52 @@ static int by_upper(const void *x, const void *y) {
     return (a->f > b->f) - (a->f < b->f);
 }
 
+/* Digit `pass` of a rank's sort key: passes 0-7 the bytes of f, 8-15
+ * those of the complement of U's bits (U > 0; else the largest key). */
+static unsigned rank_digit(const rank_t *r, int pass) {
+    uint64_t key;
+    if (pass < 8) return (unsigned)(((uint64_t)r->f >> (8 * pass)) & 255);
+    memcpy(&key, &r->U, sizeof key);
+    key = r->U > 0 ? ~key : ~(uint64_t)0;
+    return (unsigned)((key >> (8 * (pass - 8))) & 255);
+}
+
+/* rk sorted as by_upper sorts it (by decreasing U, then increasing f):
+ * a stable radix sort, by f and then by U's bits (for U >= 0 their order
+ * as unsigned integers is U's), eight bits a pass, passes whose digit is
+ * the same for every entry skipped; qsort when no scratch is free. */
+static void sort_ranks(rank_t *rk, size_t n) {
+    rank_t *tmp = n > 1 ? hd__malloc_array(n, sizeof *tmp) : NULL;
+    if (!tmp) {
+        qsort(rk, n, sizeof *rk, by_upper);
+        return;
+    }
+    rank_t *src = rk, *dst = tmp;
+    size_t (*count)[256] = calloc(16, sizeof *count); /* every digit's histogram, in one read */
+    if (!count) {
+        free(tmp);
+        qsort(rk, n, sizeof *rk, by_upper);
+        return;
+    }
+    for (size_t k = 0; k < n; k++)
+        for (int pass = 0; pass < 16; pass++) count[pass][rank_digit(&rk[k], pass)]++;
+    for (int pass = 0; pass < 16; pass++) {
+        size_t at = 0, same = 0;
+        for (int d = 0; d < 256; d++) {
+            same |= count[pass][d] == n;
+            at += count[pass][d];
+            count[pass][d] = at - count[pass][d];
+        }
+        if (same) continue;
+        for (size_t k = 0; k < n; k++) dst[count[pass][rank_digit(&src[k], pass)]++] = src[k];
+        rank_t *t = src;
+        src = dst, dst = t;
+    }
+    if (src != rk) memcpy(rk, src, n * sizeof *rk);
+    free(tmp);
+    free(count);
+}
+
 static void take_best(hd__m2m_result_t *R, const face_t *F, size_t f) {
     if (!F->best.set) return;
     if (R->face != SIZE_MAX && !(F->best.lower > R->lower)) return;
@@ -982,7 +1125,7 @@ static int run_batches(const hd__m2m_job_t *J, ctx_t *C, rank_t *rk, size_t n, h
         size_t m = 0;
         for (size_t k = 0; k < n; k++)
             if (C->faces[rk[k].f].saved) rk[m++] = (rank_t){C->faces[rk[k].f].upper, rk[k].f};
-        qsort(rk, m, sizeof *rk, by_upper);
+        sort_ranks(rk, m);
         n = R->lower > J->stop_above ? 0 : m;
         B.budget = B.budget < ((uint64_t)1 << 40) ? 4 * B.budget : B.budget;
     }
@@ -1000,6 +1143,17 @@ static int run_batches(const hd__m2m_job_t *J, ctx_t *C, rank_t *rk, size_t n, h
     return rc;
 }
 
+/* The sample's largest exact distance (its corners are vertices of X, so
+ * a lower bound with a witness), or -infinity. */
+static double sample_best(const ctx_t *C) {
+    double best = -INFINITY;
+    for (size_t k = 0; k < C->n_corners; k += C->stride) {
+        size_t id = C->order ? (size_t)(C->order[k] & 0xffffffffu) : k;
+        if (!C->faces[id / 3].done && is_sample(C, k) && C->found[id].exact) best = fmax(best, C->found[id].r);
+    }
+    return best;
+}
+
 /* The first pass of a search for h: every face's corners, in Morton
  * order (phase 0), then every face's level-0 bound (phase 1). */
 static int first_pass(const hd__m2m_job_t *J, ctx_t *C, hd__m2m_result_t *R) {
@@ -1011,10 +1165,19 @@ static int first_pass(const hd__m2m_job_t *J, ctx_t *C, hd__m2m_result_t *R) {
         return HD_ENOMEM;
     }
     C->order = order;
-    hd__parallel_for(J->threads, (n + CHUNK - 1) / CHUNK, phase0, C);
+    size_t tasks = (n + CHUNK - 1) / CHUNK;
+    if (!J->per_face && !J->face_lower) { /* the sample first: L0 */
+        C->stage = 1;
+        hd__parallel_for(J->threads, tasks, phase0, C);
+        C->bar = phase0_bar(C);
+        hd__parallel_for(J->threads, tasks, phase0_exact, C);
+        C->L0 = sample_best(C);
+        C->stage = isfinite(C->L0) ? 2 : 0;
+    }
+    hd__parallel_for(J->threads, tasks, phase0, C);
     C->bar = phase0_bar(C);
-    hd__parallel_for(J->threads, (n + CHUNK - 1) / CHUNK, phase0_exact, C);
-    hd__parallel_for(J->threads, (n + CHUNK - 1) / CHUNK, phase1, C);
+    hd__parallel_for(J->threads, tasks, phase0_exact, C);
+    hd__parallel_for(J->threads, tasks, phase1, C);
     free(order);
     free(C->found);
     for (size_t f = 0; f < n; f++) take_best(R, &C->faces[f], f);
@@ -1072,7 +1235,7 @@ int hd__m2m_run(const hd__m2m_job_t *J, hd__m2m_result_t *R) {
     memset(R, 0, sizeof *R);
     R->face = R->face_b = SIZE_MAX;
     size_t n = J->n_from;
-    ctx_t C = {J, hd__malloc_array(n ? n : 1, sizeof(face_t)), NULL, NULL, 0, NULL, 0, 0};
+    ctx_t C = {J, hd__malloc_array(n ? n : 1, sizeof(face_t)), NULL, NULL, 0, NULL, 0, 0, 0, SAMPLE_STRIDE, 0};
     rank_t *rk = hd__malloc_array(n ? n : 1, sizeof *rk);
     C.n_corners = 3 * n;
     C.caches = caches_new(J->threads, J->to->n_tris);
@@ -1096,7 +1259,7 @@ int hd__m2m_run(const hd__m2m_job_t *J, hd__m2m_result_t *R) {
     /* no face with a corner measured (every face shared, or screened):
      * 0 is a lower bound without a witness */
     if (R->face == SIZE_MAX) R->lower = 0;
-    qsort(rk, live, sizeof *rk, by_upper);
+    sort_ranks(rk, live);
     if (rc == HD_OK && !stopped) rc = run_batches(J, &C, rk, live, R);
     for (size_t f = 0; f < n; f++) finish_face(R, J, &C.faces[f], f);
     R->upper = stopped ? INFINITY : fmax(R->upper, R->lower);
@@ -1129,21 +1292,54 @@ static void key_of(const hd__tri_t *t, facekey_t *k) {
     swap_if(k->v[0], k->v[1]);
 }
 
-static int cmp_key(const void *x, const void *y) { return memcmp(x, y, sizeof(facekey_t)); }
+/* A key's hash: its 72 bytes mixed (any function would do: equal keys
+ * have equal hashes, and the table compares keys in full). */
+static uint64_t key_hash(const facekey_t *k) {
+    uint64_t h = 0x9e3779b97f4a7c15u, w;
+    for (int i = 0; i < 9; i++) {
+        memcpy(&w, &k->v[i / 3][i % 3], sizeof w);
+        h = (h ^ w) * 0xff51afd7ed558ccdu;
+        h ^= h >> 32;
+    }
+    return h;
+}
 
-int hd__m2m_shared(const hd__tri_t *x, size_t nx, const hd__tri_t *y, size_t ny, unsigned char *drop,
-                   size_t *count) {
-    *count = 0;
+int hd__m2m_shared(const hd__tri_t *x, size_t nx, const hd__tri_t *y, size_t ny, unsigned char *drop_x,
+                   unsigned char *drop_y, size_t *count_x, size_t *count_y) {
+    *count_x = *count_y = 0;
+    size_t size = 16;
+    while (size < 2 * ny) size *= 2;
     facekey_t *ky = hd__malloc_array(ny ? ny : 1, sizeof *ky);
-    if (!ky) return HD_ENOMEM;
-    for (size_t k = 0; k < ny; k++) key_of(&y[k], &ky[k]);
-    qsort(ky, ny, sizeof *ky, cmp_key);
+    size_t *slot = hd__malloc_array(size, sizeof *slot), *at = hd__malloc_array(ny ? ny : 1, sizeof *at);
+    unsigned char *hit = calloc(size, 1);
+    if (!ky || !slot || !at || !hit) {
+        free(ky), free(slot), free(at), free(hit);
+        return HD_ENOMEM;
+    }
+    /* Y's keys in a table with linear probing (SIZE_MAX: empty); at[k]:
+     * the slot of face k's key (equal keys share the first one's) */
+    for (size_t k = 0; k < size; k++) slot[k] = SIZE_MAX;
+    for (size_t k = 0; k < ny; k++) {
+        key_of(&y[k], &ky[k]);
+        size_t h = (size_t)key_hash(&ky[k]) & (size - 1);
+        while (slot[h] != SIZE_MAX && memcmp(&ky[slot[h]], &ky[k], sizeof ky[k])) h = (h + 1) & (size - 1);
+        if (slot[h] == SIZE_MAX) slot[h] = k;
+        at[k] = h;
+    }
+    /* X's faces looked up; the keys they meet are Y's shared faces */
     for (size_t k = 0; k < nx; k++) {
         facekey_t kx;
         key_of(&x[k], &kx);
-        drop[k] = bsearch(&kx, ky, ny, sizeof *ky, cmp_key) != NULL;
-        *count += drop[k];
+        size_t h = (size_t)key_hash(&kx) & (size - 1);
+        while (slot[h] != SIZE_MAX && memcmp(&ky[slot[h]], &kx, sizeof kx)) h = (h + 1) & (size - 1);
+        drop_x[k] = slot[h] != SIZE_MAX;
+        hit[h] |= drop_x[k];
+        *count_x += drop_x[k];
     }
-    free(ky);
+    for (size_t k = 0; drop_y && k < ny; k++) {
+        drop_y[k] = hit[at[k]];
+        *count_y += drop_y[k];
+    }
+    free(ky), free(slot), free(at), free(hit);
     return HD_OK;
 }

@@ -263,11 +263,12 @@ typedef struct hd__m2m_result {
  * The result does not depend on job->threads.  HD_OK or HD_ENOMEM. */
 int hd__m2m_run(const hd__m2m_job_t *job, hd__m2m_result_t *out);
 
-/* drop[k] = 1 for each triangle of x whose three corners are, as a set,
- * bit-identical to those of a triangle of y; *count of them.  HD_OK or
+/* drop_x[k] = 1 for each triangle of x whose three corners are, as a set,
+ * bit-identical to those of a triangle of y, *count_x of them; and the
+ * same for y against x in drop_y (unless NULL), *count_y.  HD_OK or
  * HD_ENOMEM. */
-int hd__m2m_shared(const hd__tri_t *x, size_t nx, const hd__tri_t *y, size_t ny, unsigned char *drop,
-                   size_t *count);
+int hd__m2m_shared(const hd__tri_t *x, size_t nx, const hd__tri_t *y, size_t ny, unsigned char *drop_x,
+                   unsigned char *drop_y, size_t *count_x, size_t *count_y);
 /* ---- the sign: the winding number of a closed mesh (winding.c) --------- */
 
 /* One triangle to sign against: its corners and the caller's indices of

@@ -168,6 +168,26 @@ TEST(identical_meshes_are_zero) {
     gen_soup_free(&A);
 }
 
+/* Shared faces are found for both directions at once: B holds one of A's
+ * faces twice (corners in another order) and a face of its own; A's other
+ * face is not in B.  h(A, B) drops one face, h(B, A) both copies. */
+TEST(shared_faces_are_dropped_both_ways_with_copies) {
+    const double va[] = {0, 0, 0, 8, 0, 0, 0, 8, 0, 8, 8, 4};
+    const uint64_t ta[] = {0, 1, 2, 1, 3, 2};
+    const double vb[] = {0, 0, 0, 8, 0, 0, 0, 8, 0, 0, 0, 8};
+    const uint64_t tb[] = {0, 1, 2, 2, 0, 1, 0, 1, 3};
+    gen_soup_t A = soup_of(va, 4, ta, 2), B = soup_of(vb, 4, tb, 3);
+    hd_mesh_t a = gen_soup_view(&A), b = gen_soup_view(&B);
+    hd_surface_options_t o = options(1e-9, 1, 1);
+    hd_enclosure_t ab, ba;
+    CHECK_RC(hd_surface_hausdorff(&a, &b, &o, &ab, &ba, NULL), HD_OK);
+    CHECK_EQ(ab.faces_dropped, 1);
+    CHECK_EQ(ba.faces_dropped, 2);
+    encloses(&ab, &A, &B, 16);
+    encloses(&ba, &B, &A, 16);
+    gen_soup_free(&A), gen_soup_free(&B);
+}
+
 TEST(parallel_shifted_triangle_is_its_shift) {
     const double v[] = {0, 0, 0, 8, 0, 0, 0, 8, 0, 0, 0, 3, 8, 0, 3, 0, 8, 3};
     const uint64_t ta[] = {0, 1, 2}, tb[] = {3, 4, 5};
@@ -554,6 +574,60 @@ TEST(face_maxima_enclose_each_face) {
     }
     CHECK(top >= all.lower);
     free(best);
+    gen_soup_free(&A), gen_soup_free(&B);
+}
+
+/* A UV sphere of radius r about c: m rings of 2 m segments (poles single
+ * vertices), 4 m (m - 1) triangles. */
+static gen_soup_t sphere(int m, double r, const double c[3]) {
+    size_t nv = 2 + (size_t)(m - 1) * (size_t)(2 * m), nt = 4 * (size_t)m * (size_t)(m - 1);
+    gen_soup_t s = soup_new(nv, nt);
+    const double pi = 3.14159265358979323846;
+    for (int d = 0; d < 3; d++) s.v[d] = c[d], s.v[3 + d] = c[d];
+    s.v[2] += r, s.v[5] -= r;
+    for (int i = 1; i < m; i++)
+        for (int j = 0; j < 2 * m; j++) {
+            double th = pi * i / m, ph = pi * j / m, *v = s.v + 3 * (2 + (size_t)(i - 1) * (size_t)(2 * m) + (size_t)j);
+            v[0] = c[0] + r * sin(th) * cos(ph), v[1] = c[1] + r * sin(th) * sin(ph), v[2] = c[2] + r * cos(th);
+        }
+    size_t k = 0;
+#define RING(i, j) (2 + (uint64_t)((i) - 1) * (uint64_t)(2 * m) + (uint64_t)((j) % (2 * m)))
+    for (int j = 0; j < 2 * m; j++) {
+        uint64_t t0[3] = {0, RING(1, j), RING(1, j + 1)}, t1[3] = {1, RING(m - 1, j + 1), RING(m - 1, j)};
+        memcpy(s.t + 3 * k++, t0, sizeof t0);
+        memcpy(s.t + 3 * k++, t1, sizeof t1);
+    }
+    for (int i = 1; i < m - 1; i++)
+        for (int j = 0; j < 2 * m; j++) {
+            uint64_t t0[3] = {RING(i, j), RING(i + 1, j), RING(i + 1, j + 1)};
+            uint64_t t1[3] = {RING(i, j), RING(i + 1, j + 1), RING(i, j + 1)};
+            memcpy(s.t + 3 * k++, t0, sizeof t0);
+            memcpy(s.t + 3 * k++, t1, sizeof t1);
+        }
+#undef RING
+    s.nt = k;
+    return s;
+}
+
+/* A grid near the centre of a sphere: every point of it is nearly as far
+ * from every triangle of the sphere, so a search for a corner's nearest
+ * triangle visits most of them.  Only the corners near the centre can be
+ * the farthest; the others need an upper bound below the sample's lower
+ * bound, not their nearest triangle, so the corners cost far fewer than
+ * (corners x triangles) bounds - and the enclosure still holds. */
+TEST(corners_far_below_the_maximum_stop_at_a_sufficient_bound) {
+    const double c[3] = {8, 8, 0};
+    gen_soup_t A = grid(16, 0), B = sphere(24, 100, c);
+    hd_mesh_t a = gen_soup_view(&A), b = gen_soup_view(&B);
+    hd_surface_options_t o = options(1e-9, 1, 1), o3 = options(1e-9, 1, 3);
+    hd_enclosure_t ab, ab3;
+    CHECK_RC(hd_surface_hausdorff(&a, &b, &o, &ab, NULL, NULL), HD_OK);
+    CHECK_RC(hd_surface_hausdorff(&a, &b, &o3, &ab3, NULL, NULL), HD_OK);
+    encloses(&ab, &A, &B, 4);
+    same_enclosure(&ab, &ab3);
+    uint64_t all = (uint64_t)(17 * 17) * (uint64_t)B.nt;
+    CONTEXT("%llu bounds for %llu corners x triangles", (unsigned long long)ab.kernel_calls, (unsigned long long)all);
+    CHECK(ab.kernel_calls * 8 < all);
     gen_soup_free(&A), gen_soup_free(&B);
 }
 
