@@ -599,8 +599,8 @@ int hd__write_laz_pointwise(hd__writer_t *w, hd__las_plan_t *pl, const hd__las_h
         hd__w_put(w, head, 8);
         if (hd__laz_table_encode(variable, z.n_chunks, z.counts, z.bytes, &z.enc)) rc = hd__err(w->err, HD_ENOMEM, "out of memory");
         hd__w_put(w, z.enc.buf, z.enc.size);
-        hd__w_put(w, w->in->data + c->table_end, w->in->size - c->table_end); /* extended VLRs */
-        uint64_t points = (uint64_t)(ftello(w->out) - table_ptr) - (w->in->size - c->table_end);
+        uint64_t tail = hd__las_put_tail(w, pl, c->table_end); /* extended VLRs (COPC's hierarchy dropped) */
+        uint64_t points = (uint64_t)(ftello(w->out) - table_ptr) - tail;
         if (rc == HD_OK && !w->werr && fseeko(w->out, head_at, SEEK_SET) != 0) w->werr = errno ? errno : EIO;
         hd__las_write_head(w, pl, z.kept, z.by_return, z.bounds, points, z.vlr, c->vlr_at, z.vlr_len);
         unsigned char t[8];
