@@ -107,6 +107,10 @@ static int move_entry(hd__writer_t *w, const hd__las_plan_t *pl, const hd__laz_c
         return hd__err(w->err, HD_EFORMAT, "%s: COPC hierarchy %s: %" PRIu32 " bytes and %" PRId32
                                            " points, chunk %zu has %" PRIu64 " and %" PRIu64,
                        w->in->name, key, size, count, k + 1, c->start[k + 1] - c->start[k], c->first[k + 1] - c->first[k]);
+    if (bytes[k] > INT32_MAX)
+        return hd__err(w->err, HD_EUNSUPPORTED, "%s: COPC hierarchy %s: its chunk would grow past 2 GiB, more than an "
+                                                "entry's byte size holds",
+                       w->in->name, key);
     hd__st_u64(e + 16, new_start[k]);
     for (int q = 0; q < 4; q++) e[24 + q] = (unsigned char)(bytes[k] >> (8 * q));
     return HD_OK;
