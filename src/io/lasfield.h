@@ -70,20 +70,22 @@ int hd__laz_encode_pointwise(const unsigned char *recs, size_t n, size_t rec, co
 int hd__write_laz_pointwise(hd__writer_t *w, hd__las_plan_t *pl, const hd__las_header_t *h, const hd__laz_chunks_t *c,
                             hd__read_t *r);
 
-/* COPC (write_copc.c).  hd__copc_plan: the hierarchy EVLR of a file
- * whose info VLR hd__las_plan found, which must follow the chunk table
- * (table_end); HD_OK or HD_EFORMAT. */
-int hd__copc_plan(hd__writer_t *w, hd__las_plan_t *pl, size_t table_end);
+/* COPC (write_copc.c).  hd__copc_plan: for a file whose info VLR
+ * hd__las_plan found, its hierarchy EVLR (which must follow the chunk
+ * table) and every entry checked: a node with points is exactly one chunk
+ * of c (offset, byte size, point count), a page pointer and the root page
+ * lie inside the hierarchy EVLR; HD_OK, or HD_EFORMAT naming the entry. */
+int hd__copc_plan(hd__writer_t *w, hd__las_plan_t *pl, const hd__laz_chunks_t *c);
 /* hd__copc_drop: neither the info VLR nor the hierarchy is written (the
- * output is plain LAZ: a subset's chunks are not the nodes'). */
+ * output is plain LAZ). */
 void hd__copc_drop(hd__las_plan_t *pl);
-/* hd__copc_move: every point written back, chunk k moved to new_start[k]
- * and now bytes[k] long, every byte after the chunk table moved by shift:
- * the info VLR's root page offset and every hierarchy entry moved with
- * what it points at, into *info and *hier (malloc'd; set into pl).  An
- * entry that is not exactly a chunk of the table (offset, byte size and
- * point count) or a page of the hierarchy is HD_EFORMAT naming it. */
+/* hd__copc_move: input chunk k now starts at new_start[k], is bytes[k]
+ * long and holds count[k] points (0: a node emptied, its entry offset 0,
+ * byte size 0, point count 0; count NULL: every point kept), and every byte after the chunk table moved
+ * by shift: the info VLR's root page offset and every entry moved with
+ * what it points at, into *info and *hier (malloc'd; set into pl).  HD_OK,
+ * or HD_EUNSUPPORTED for a chunk too large for an entry. */
 int hd__copc_move(hd__writer_t *w, hd__las_plan_t *pl, const hd__laz_chunks_t *c, const uint64_t *new_start,
-                  const uint64_t *bytes, uint64_t shift, unsigned char **info, unsigned char **hier);
+                  const uint64_t *bytes, const uint64_t *count, uint64_t shift, unsigned char **info, unsigned char **hier);
 
 #endif

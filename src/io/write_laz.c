@@ -273,7 +273,8 @@ static int write_layered(lazw_t *z) {
             chunks += z->bytes[k];
         }
         uint64_t table_end = new_offset + 8 + chunks + gap + 8 + table.size; /* the EVLRs move with it */
-        rc = hd__copc_move(w, &z->pl, &z->c, new_start, z->bytes, table_end - z->c.table_end, &copc_info, &copc_hier);
+        rc = hd__copc_move(w, &z->pl, &z->c, new_start, z->bytes, NULL, table_end - z->c.table_end, &copc_info,
+                           &copc_hier);
     }
     if (rc == HD_OK) {
         uint64_t table_bytes = 8 + table.size, points = 8 + chunks + gap + table_bytes;
@@ -316,9 +317,9 @@ int hd__write_laz(hd__writer_t *w) {
     hd__read_t r = {w->in, w->ropt, 1, &z.sink, NULL, 0, w->err, 0, 0, 0};
     z.r = r;
     rc = hd__laz_chunks(&z.r, &z.h, &z.c);
-    if (rc == HD_OK) rc = hd__copc_plan(w, &z.pl, z.c.table_end);
+    if (rc == HD_OK && z.c.layered) rc = hd__copc_plan(w, &z.pl, &z.c);
     if (rc == HD_OK && (!z.c.layered || w->keep != HD_KEEP_ALL)) { /* a layered subset: every point encoded again (laz14.c) */
-        hd__copc_drop(&z.pl); /* its chunks are not COPC's nodes: plain LAZ (write_copc.c) */
+        if (!z.c.layered) hd__copc_drop(&z.pl); /* COPC is layered: plain LAZ (write_copc.c) */
         rc = hd__write_laz_pointwise(w, &z.pl, &z.h, &z.c, &z.r);
         hd__laz_chunks_free(&z.c);
         hd__sink_free(&z.sink);

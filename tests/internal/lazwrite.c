@@ -728,7 +728,12 @@ static int copc_page(copc_walk_t *W, uint64_t at, uint64_t size, int depth) {
             if (copc_page(W, off, bytes, depth + 1)) return -1;
             continue;
         }
-        if (count == 0) continue;
+        if (count == 0) {
+            if (off != 0 || bytes != 0)
+                return fail(W, "entry at byte %llu: no points, offset %llu and %u bytes (0 and 0 expected)",
+                            (unsigned long long)q, (unsigned long long)off, bytes);
+            continue;
+        }
         size_t k = 0;
         while (k < W->nc && W->start[k] != off) k++;
         if (k == W->nc) return fail(W, "entry at byte %llu: offset %llu is no chunk's start", (unsigned long long)q,

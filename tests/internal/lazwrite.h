@@ -112,6 +112,7 @@ typedef struct lazw_node {
  * lies inside the EVLR of user "copc", record 1000; every page reached
  * from it (pointers: point count -1) does too; every node with points is
  * exactly one chunk of the chunk table (offset, byte size, point count),
+ * a node without points has offset 0 and byte size 0,
  * no chunk twice, every chunk once, and the counts add up to the header's.
  * Returns 0, or -1 with why (a sentence) filled. */
 int lazw_copc_nodes(const unsigned char *d, size_t size, lazw_node_t *nodes, size_t max, size_t *n, char *why,

@@ -596,34 +596,50 @@ static lazw_node_t *copc_nodes(const unsigned char *d, size_t size, size_t *n) {
     return nodes;
 }
 
-/* Output node by node as the input's: same keys and counts, each point's
- * record the input's with the nf values appended. */
-static void copc_same_nodes(const char *in, const unsigned char *din, size_t nin, const char *out, const double *v,
-                            size_t n, size_t nf) {
-    size_t no, ni = 0, nn = 0, mi, mo, ri, ro;
+/* Whether point k is kept (keep: 0 every point, 1 value > 0.25, 2 <= 0.25). */
+static int kept_at(const double *v, size_t k, int keep) {
+    return keep == 1 ? v[k] > 0.25 : keep == 2 ? v[k] <= 0.25 : 1;
+}
+
+/* Output node by node as the input's (out valid COPC): the same keys, each
+ * node's kept points, each point's record the input's with the nf values
+ * appended; returns the nodes emptied (absent from out's nodes). */
+static size_t copc_same_nodes(const char *in, const unsigned char *din, size_t nin, const char *out, const double *v,
+                              size_t n, size_t nf, int keep) {
+    size_t no, ni = 0, nn = 0, mi, mo, ri, ro, emptied = 0;
     unsigned char *dout = tf_read(out, &no);
     lazw_node_t *a = copc_nodes(din, nin, &ni), *b = copc_nodes(dout, no, &nn);
     hd_error_t err;
     unsigned char *ra = lazw_decode_records(in, din, nin, &mi, &ri, &err);
     unsigned char *rb = lazw_decode_records(out, dout, no, &mo, &ro, &err);
-    CHECK(ra && rb && mi == n && mo == n && ro == ri + 8 * nf);
-    CHECK_EQ(ni, nn);
+    CHECK(ra && rb && mi == n && ro == ri + 8 * nf);
     for (size_t k = 0; k < ni && ra && rb && !hdt_failed(); k++) {
-        CONTEXT("node %zu (level %d, x %d)", k, a[k].key[0], a[k].key[1]);
-        CHECK(memcmp(a[k].key, b[k].key, sizeof a[k].key) == 0 && a[k].count == b[k].count);
-        for (uint64_t i = 0; i < a[k].count && !hdt_failed(); i++) {
-            const unsigned char *x = ra + (a[k].first + i) * ri, *y = rb + (b[k].first + i) * ro;
+        CONTEXT("node %zu (level %d, x %d), keep %d", k, a[k].key[0], a[k].key[1], keep);
+        size_t j = 0, want = 0;
+        while (j < nn && memcmp(a[k].key, b[j].key, sizeof a[k].key) != 0) j++;
+        for (uint64_t i = 0; i < a[k].count; i++) want += (size_t)kept_at(v, (size_t)(a[k].first + i), keep);
+        if (want == 0) {
+            CHECK(j == nn); /* emptied: no node with points */
+            emptied++;
+            continue;
+        }
+        CHECK(j < nn && b[j].count == want);
+        for (uint64_t i = 0, o = 0; j < nn && i < a[k].count && !hdt_failed(); i++) {
+            size_t p = (size_t)(a[k].first + i);
+            if (!kept_at(v, p, keep)) continue;
+            const unsigned char *x = ra + p * ri, *y = rb + (b[j].first + o++) * ro;
             CHECK(memcmp(x, y, ri) == 0);
             for (size_t f = 0; f < nf; f++) {
                 double val;
                 memcpy(&val, y + ri + 8 * f, 8);
-                CHECK_BITS(val, v[f * n + a[k].first + i]);
+                CHECK_BITS(val, v[f * n + p]);
             }
         }
     }
     /* the EVLR after the hierarchy is still the file's last, where the header says */
     CHECK(no > 64 && memcmp(dout + no - 4, "EVLR", 4) == 0 && le(dout + 243, 4) == 2);
     free(a), free(b), free(ra), free(rb), free(dout);
+    return emptied;
 }
 
 TEST(copc_written_back_has_its_hierarchy_on_the_grown_chunks) {
@@ -644,30 +660,19 @@ TEST(copc_written_back_has_its_hierarchy_on_the_grown_chunks) {
         size_t written = 0;
         CHECK_RC(write_fields(in, tf_path("out.copc.laz"), v, n, nf, NULL, &written, &err), HD_OK);
         CHECK_EQ(written, n);
-        copc_same_nodes(in, din, nin, tf_path("out.copc.laz"), v, n, nf);
+        CHECK_EQ(copc_same_nodes(in, din, nin, tf_path("out.copc.laz"), v, n, nf, 0), 0);
         free(v), free(din);
     }
 }
 
-/* Whether d has a VLR (record) or an EVLR (erecord) of user "copc". */
-static int has_copc(const unsigned char *d, size_t size, unsigned record, unsigned erecord) {
-    size_t p = le(d + 94, 2);
-    for (uint64_t i = 0; i < le(d + 100, 4); i++, p += 54 + le(d + p + 20, 2))
-        if (memcmp(d + p + 2, "copc\0", 5) == 0 && le(d + p + 18, 2) == record) return 1;
-    uint64_t e = le(d + 235, 8);
-    for (uint64_t i = 0; i < le(d + 243, 4) && e + 60 <= size; i++, e += 60 + le(d + e + 20, 8))
-        if (memcmp(d + e + 2, "copc\0", 5) == 0 && le(d + e + 18, 2) == erecord) return 1;
-    return 0;
-}
-
-TEST(copc_subsets_are_plain_laz_without_copc_vlrs) {
+TEST(copc_subsets_keep_each_nodes_points_as_its_chunk) {
     gen_rng_t g;
     gen_seed(&g, 711);
-    size_t chunks[5] = {300, 1, 199, 250, 250}, n = 1000, nin;
+    size_t chunks[6] = {1, 300, 2, 197, 250, 250}, n = 1000, nin, emptied = 0;
     unsigned char *din;
-    const char *in = copc_file(&g, chunks, 5, n, "sub.copc.laz", &din, &nin);
-    double *v = malloc(n * sizeof *v);
-    field_values(&g, v, n, 1);
+    const char *in = copc_file(&g, chunks, 6, n, "sub.copc.laz", &din, &nin);
+    double *v = malloc(2 * n * sizeof *v);
+    field_values(&g, v, n, 2);
     hd_write_options_t o;
     hd_write_options_init(&o);
     o.threshold = 0.25;
@@ -675,30 +680,12 @@ TEST(copc_subsets_are_plain_laz_without_copc_vlrs) {
         CONTEXT("keep %s (seed 711)", keep == 1 ? "farther" : "nearer");
         o.keep = keep == 1 ? HD_KEEP_FARTHER : HD_KEEP_NEARER;
         hd_error_t err;
-        size_t written = 0, no, m, rec, ri, mi;
-        CHECK_RC(hd_write_field(in, tf_path("sub_out.laz"), v, n, &o, &written, &err), HD_OK);
-        unsigned char *d = tf_read(tf_path("sub_out.laz"), &no);
-        CHECK(!has_copc(d, no, 1, 1000));
-        CHECK(has_copc(din, nin, 1, 1000));
-        /* the VLRs end where the points start; the other EVLR is the only one, where the header says */
-        size_t p = le(d + 94, 2);
-        for (uint64_t i = 0; i < le(d + 100, 4); i++) p += 54 + le(d + p + 20, 2);
-        CHECK_EQ(p, le(d + 96, 4));
-        CHECK_EQ(le(d + 243, 4), 1);
-        CHECK_EQ(le(d + 235, 8), no - 64);
-        CHECK(memcmp(d + no - 4, "EVLR", 4) == 0);
-        unsigned char *ra = lazw_decode_records(in, din, nin, &mi, &ri, &err);
-        unsigned char *rb = lazw_decode_records(tf_path("sub_out.laz"), d, no, &m, &rec, &err);
-        CHECK(ra && rb && m == written && rec == ri + 8);
-        for (size_t k = 0, j = 0; ra && rb && k < n && !hdt_failed(); k++) {
-            if (keep == 1 ? !(v[k] > 0.25) : !(v[k] <= 0.25)) continue;
-            CHECK(memcmp(rb + j * rec, ra + k * ri, ri) == 0);
-            double x;
-            memcpy(&x, rb + j++ * rec + ri, 8);
-            CHECK_BITS(x, v[k]);
-        }
-        free(ra), free(rb), free(d);
+        size_t written = 0;
+        CHECK_RC(write_fields(in, tf_path("sub_out.copc.laz"), v, n, 2, &o, &written, &err), HD_OK);
+        CHECK(written > 0 && written < n);
+        emptied += copc_same_nodes(in, din, nin, tf_path("sub_out.copc.laz"), v, n, 2, keep);
     }
+    CHECK(emptied > 0); /* a node lost every point: its entry is 0, 0, 0 */
     free(v), free(din);
 }
 
@@ -720,10 +707,15 @@ TEST(copc_hierarchy_entries_that_are_no_chunk_are_refused_by_name) {
         memcpy(d, din, nin);
         d[root + cases[c].at] = (unsigned char)(d[root + cases[c].at] + cases[c].delta);
         const char *bad = tf_write("bad_entry.copc.laz", d, nin);
-        hd_error_t err;
-        CHECK_RC(hd_write_field(bad, tf_path("bad_out.laz"), v, n, NULL, NULL, &err), HD_EFORMAT);
-        CHECK(strstr(err.message, "bad_entry.copc.laz") && strstr(err.message, "COPC hierarchy entry") &&
-              strstr(err.message, cases[c].says));
+        hd_write_options_t o;
+        hd_write_options_init(&o);
+        for (int keep = 0; keep <= 1; keep++) { /* every point, and a subset */
+            o.keep = keep ? HD_KEEP_NEARER : HD_KEEP_ALL;
+            hd_error_t err;
+            CHECK_RC(hd_write_field(bad, tf_path("bad_out.laz"), v, n, &o, NULL, &err), HD_EFORMAT);
+            CHECK(strstr(err.message, "bad_entry.copc.laz") && strstr(err.message, "COPC hierarchy entry") &&
+                  strstr(err.message, cases[c].says));
+        }
         free(d);
     }
     free(v), free(din);
