@@ -686,6 +686,20 @@ TEST(copc_subsets_keep_each_nodes_points_as_its_chunk) {
         emptied += copc_same_nodes(in, din, nin, tf_path("sub_out.copc.laz"), v, n, 2, keep);
     }
     CHECK(emptied > 0); /* a node lost every point: its entry is 0, 0, 0 */
+    /* the same file on 1 and 2 threads (2: batches of 4 chunks, 6 nodes) */
+    hd_read_options_t r;
+    hd_read_options_init(&r);
+    o.read = &r;
+    unsigned char *f[2];
+    size_t size[2];
+    for (int t = 0; t < 2; t++) {
+        r.threads = t + 1;
+        hd_error_t err;
+        CHECK_RC(write_fields(in, tf_path("sub_threads.copc.laz"), v, n, 2, &o, NULL, &err), HD_OK);
+        f[t] = tf_read(tf_path("sub_threads.copc.laz"), &size[t]);
+    }
+    CHECK(f[0] && f[1] && size[0] == size[1] && memcmp(f[0], f[1], size[0]) == 0);
+    free(f[0]), free(f[1]);
     free(v), free(din);
 }
 
