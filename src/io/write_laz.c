@@ -32,7 +32,8 @@
  * layer (laz14.c), by the writer of pointwise LAZ (write_lazpw.c), which
  * does the same for pointwise files (formats 0-5 interleave every field of
  * a point in one stream, so adding bytes there means compressing every
- * field again).
+ * field again).  COPC files keep their hierarchy, moved with the chunks
+ * (write_copc.c).
  */
 #include "io.h"
 #include "lasfield.h"

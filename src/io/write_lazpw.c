@@ -630,7 +630,7 @@ int hd__write_laz_pointwise(hd__writer_t *w, hd__las_plan_t *pl, const hd__las_h
         if (hd__laz_table_encode(variable, z.n_chunks, z.counts, z.bytes, &z.enc)) rc = hd__err(w->err, HD_ENOMEM, "out of memory");
         hd__w_put(w, z.enc.buf, z.enc.size);
         if (rc == HD_OK && copc) rc = copc_nodes(&z, c, (uint64_t)table + 8 + z.enc.size, &copc_info, &copc_hier);
-        uint64_t tail = hd__las_put_tail(w, pl, c->table_end); /* extended VLRs (COPC's hierarchy dropped) */
+        uint64_t tail = hd__las_put_tail(w, pl, c->table_end); /* extended VLRs (COPC: the hierarchy moved) */
         uint64_t points = (uint64_t)(ftello(w->out) - table_ptr) - tail;
         if (rc == HD_OK && !w->werr && fseeko(w->out, head_at, SEEK_SET) != 0) w->werr = errno ? errno : EIO;
         hd__las_write_head(w, pl, z.kept, z.by_return, z.bounds, points, z.vlr, c->vlr_at, z.vlr_len);
