@@ -17,6 +17,12 @@
  * prints every whole record of a LAZ file as the library decodes it (every
  * field of every item, every layer), one line of hexadecimal each.
  *
+ *   lazgen --copc FILE
+ *
+ * checks that FILE is a valid COPC file (lazwrite.h's lazw_copc_nodes:
+ * the info VLR, the hierarchy pages, every node exactly a chunk) and
+ * prints its node and point counts, or why not (exit 1).
+ *
  * The cases named field_* are the output of hd_write_fields (the library's
  * LAZ writer) on a file of the tests' writer whose points all lie in
  * scanner channel 0, with seeded values: their NAME.txt lines are
@@ -370,11 +376,31 @@ static int records(const char *path) {
     return 0;
 }
 
+static int copc(const char *path) {
+    size_t size, n = 0, cap = 1 << 20;
+    unsigned char *d = tf_read(path, &size);
+    lazw_node_t *nodes = malloc(cap * sizeof *nodes);
+    char why[256];
+    if (!d || !nodes) {
+        fprintf(stderr, "lazgen: %s: cannot read\n", path);
+        return 1;
+    }
+    int rc = lazw_copc_nodes(d, size, nodes, cap, &n, why, sizeof why);
+    uint64_t points = 0;
+    for (size_t k = 0; k < n; k++) points += nodes[k].count;
+    if (rc) fprintf(stderr, "%s: not valid COPC: %s\n", path, why);
+    else printf("%s: valid COPC: %zu nodes, %llu points\n", path, n, (unsigned long long)points);
+    free(nodes);
+    free(d);
+    return rc ? 1 : 0;
+}
+
 int main(int argc, char **argv) {
     if (argc == 3 && strcmp(argv[1], "--seeds") == 0) return seeds(argv[2]);
+    if (argc == 3 && strcmp(argv[1], "--copc") == 0) return copc(argv[2]);
     if (argc == 3 && strcmp(argv[1], "--records") == 0) return records(argv[2]);
     if (argc != 2) {
-        fprintf(stderr, "usage: lazgen DIR | lazgen --seeds DIR\n");
+        fprintf(stderr, "usage: lazgen DIR | lazgen --seeds DIR | lazgen --records FILE | lazgen --copc FILE\n");
         return 2;
     }
     static const size_t sizes[] = {1, 700, 33, 2000, 1266};

@@ -20,6 +20,13 @@ typedef struct hd__las_plan {
     size_t gap;       /* extra bytes no descriptor described */
     size_t n_desc;    /* descriptors added */
     size_t vlr_added; /* bytes added before the points */
+    /* COPC (write_copc.c): the info VLR's header (0: none) and length, the
+     * hierarchy EVLR's header (0: none) and data length; the info VLR's and
+     * the hierarchy's new data (NULL: copied), or both dropped */
+    size_t copc_at, copc_len;
+    uint64_t hier_at, hier_len;
+    const unsigned char *copc_info, *copc_hier;
+    int copc_drop;
 } hd__las_plan_t;
 
 /* The plan for w's LAS input (header checked by the reader before):
@@ -40,6 +47,10 @@ void hd__las_bound(double bounds[6], const unsigned char *rec, const double scal
 void hd__las_scale(const unsigned char *d, double scale[3], double shift[3]);
 void hd__w_range(const hd__writer_t *w, const double *v, double *lo, double *hi);
 void hd__st_u64(unsigned char *p, uint64_t v);
+/* The input's bytes from `from` (after the points: the extended VLRs) to
+ * its end, the COPC hierarchy EVLR's data replaced by pl->copc_hier or the
+ * EVLR dropped (pl->copc_drop); returns the bytes written. */
+uint64_t hd__las_put_tail(hd__writer_t *w, const hd__las_plan_t *pl, size_t from);
 
 /* For the LAZ writers (write_laz.c, write_lazpw.c). */
 typedef struct hd__enc hd__enc_t;
@@ -58,5 +69,23 @@ int hd__laz_encode_pointwise(const unsigned char *recs, size_t n, size_t rec, co
  * subsets of layered LAZ (laz14.c encodes their chunks). */
 int hd__write_laz_pointwise(hd__writer_t *w, hd__las_plan_t *pl, const hd__las_header_t *h, const hd__laz_chunks_t *c,
                             hd__read_t *r);
+
+/* COPC (write_copc.c).  hd__copc_plan: for a file whose info VLR
+ * hd__las_plan found, its hierarchy EVLR (which must follow the chunk
+ * table) and every entry checked: a node with points is exactly one chunk
+ * of c (offset, byte size, point count), a page pointer and the root page
+ * lie inside the hierarchy EVLR; HD_OK, or HD_EFORMAT naming the entry. */
+int hd__copc_plan(hd__writer_t *w, hd__las_plan_t *pl, const hd__laz_chunks_t *c);
+/* hd__copc_drop: neither the info VLR nor the hierarchy is written (the
+ * output is plain LAZ). */
+void hd__copc_drop(hd__las_plan_t *pl);
+/* hd__copc_move: input chunk k now starts at new_start[k], is bytes[k]
+ * long and holds count[k] points (0: a node emptied, its entry offset 0,
+ * byte size 0, point count 0; count NULL: every point kept), and every byte after the chunk table moved
+ * by shift: the info VLR's root page offset and every entry moved with
+ * what it points at, into *info and *hier (malloc'd; set into pl).  HD_OK,
+ * or HD_EUNSUPPORTED for a chunk too large for an entry. */
+int hd__copc_move(hd__writer_t *w, hd__las_plan_t *pl, const hd__laz_chunks_t *c, const uint64_t *new_start,
+                  const uint64_t *bytes, const uint64_t *count, uint64_t shift, unsigned char **info, unsigned char **hier);
 
 #endif

@@ -111,6 +111,10 @@ int hd__las_plan(hd__writer_t *w, hd__las_plan_t *pl) {
             return hd__err(w->err, HD_EFORMAT, "%s: byte %zu: VLR %u of %u runs past the point data", w->in->name, p, i + 1,
                            pl->n_vlr);
         size_t len = hd__ld_u16(d + p + 20, 0);
+        if (memcmp(d + p + 2, "copc\0", 5) == 0 && hd__ld_u16(d + p + 18, 0) == 1 && !pl->copc_at) {
+            pl->copc_at = p;
+            pl->copc_len = len;
+        }
         if (memcmp(d + p + 2, "LASF_Spec\0", 10) == 0 && hd__ld_u16(d + p + 18, 0) == 4) {
             pl->eb_at = p;
             for (size_t q = p + 54; q + 192 <= p + 54 + len; q += 192) {
@@ -173,7 +177,7 @@ void hd__las_write_head(hd__writer_t *w, const hd__las_plan_t *pl, uint64_t kept
     memcpy(h, d, pl->header);
     size_t new_offset = pl->offset + pl->vlr_added;
     st_u32(h + 96, (uint32_t)new_offset);
-    st_u32(h + 100, pl->n_vlr + (pl->add && !pl->eb_at));
+    st_u32(h + 100, pl->n_vlr + (pl->add && !pl->eb_at) - (pl->copc_drop && pl->copc_at));
     st_u16(h + 105, (unsigned)pl->out_rec);
     if (w->keep != HD_KEEP_ALL) {
         int legacy = pl->fmt < 6 && kept <= 0xFFFFFFFFu;
@@ -193,6 +197,11 @@ void hd__las_write_head(hd__writer_t *w, const hd__las_plan_t *pl, uint64_t kept
     if (pl->minor >= 4 && pl->header >= 247 && hd__ld_u32(d + 243, 0) > 0) {
         uint64_t evlr = hd__ld_u64(d + 235, 0);
         if (evlr >= old_end) hd__st_u64(h + 235, evlr - old_end + new_end);
+        if (pl->copc_drop && pl->hier_at) { /* the hierarchy EVLR dropped: the next takes its place */
+            uint32_t left = hd__ld_u32(d + 243, 0) - 1;
+            st_u32(h + 243, left);
+            if (left == 0) hd__st_u64(h + 235, 0);
+        }
     }
     hd__w_put(w, h, pl->header);
     free(h);
@@ -207,7 +216,12 @@ void hd__las_write_head(hd__writer_t *w, const hd__las_plan_t *pl, uint64_t kept
     size_t p = pl->header;
     for (uint32_t i = 0; i < pl->n_vlr; i++) {
         size_t len = hd__ld_u16(d + p + 20, 0);
-        if (laz_vlr && p + 54 == laz_vlr_at) { /* the LASzip VLR, rewritten by the LAZ writer */
+        if (pl->copc_at && p == pl->copc_at && (pl->copc_drop || pl->copc_info)) { /* COPC's info VLR */
+            if (!pl->copc_drop) {
+                hd__w_put(w, d + p, 54);
+                hd__w_put(w, pl->copc_info, len);
+            }
+        } else if (laz_vlr && p + 54 == laz_vlr_at) { /* the LASzip VLR, rewritten by the LAZ writer */
             memcpy(desc, d + p, 54);
             st_u16(desc + 20, (unsigned)laz_vlr_len);
             hd__w_put(w, desc, 54);
@@ -234,6 +248,23 @@ void hd__las_write_head(hd__writer_t *w, const hd__las_plan_t *pl, uint64_t kept
     }
     free(nd);
     hd__w_put(w, d + pl->vlr_end, pl->offset - pl->vlr_end);
+}
+
+uint64_t hd__las_put_tail(hd__writer_t *w, const hd__las_plan_t *pl, size_t from) {
+    const unsigned char *d = w->in->data;
+    size_t end = w->in->size;
+    if (!pl->hier_at || pl->hier_at < from || (!pl->copc_drop && !pl->copc_hier)) {
+        hd__w_put(w, d + from, end - from);
+        return end - from;
+    }
+    size_t at = (size_t)pl->hier_at, data_end = at + 60 + (size_t)pl->hier_len;
+    hd__w_put(w, d + from, at - from);
+    if (!pl->copc_drop) {
+        hd__w_put(w, d + at, 60);
+        hd__w_put(w, pl->copc_hier, (size_t)pl->hier_len);
+    }
+    hd__w_put(w, d + data_end, end - data_end);
+    return pl->copc_drop ? end - from - (data_end - at) : end - from;
 }
 
 /* The return number of a record (formats 0-5: bits 0-2 of byte 14;
@@ -319,6 +350,6 @@ int hd__write_las(hd__writer_t *w) {
     }
     hd__w_put(w, buf, used);
     free(buf);
-    hd__w_put(w, d + pl.end, w->in->size - pl.end); /* waveform data, extended VLRs */
+    hd__las_put_tail(w, &pl, pl.end); /* waveform data, extended VLRs */
     return HD_OK;
 }

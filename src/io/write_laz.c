@@ -32,7 +32,8 @@
  * layer (laz14.c), by the writer of pointwise LAZ (write_lazpw.c), which
  * does the same for pointwise files (formats 0-5 interleave every field of
  * a point in one stream, so adding bytes there means compressing every
- * field again).
+ * field again).  COPC files keep their hierarchy, moved with the chunks
+ * (write_copc.c).
  */
 #include "io.h"
 #include "lasfield.h"
@@ -261,16 +262,25 @@ static int write_layered(lazw_t *z) {
     int rc = encode_chunks(z);
     if (rc == HD_OK) rc = new_vlr(w, &z->c, &vlr, &vlr_len);
     if (rc == HD_OK && (rc = encode_table(&z->c, z->bytes, &table))) rc = hd__err(w->err, rc, "out of memory");
+    size_t nc = z->c.n_chunks, gap = z->c.table - (size_t)z->c.start[nc]; /* bytes between the last chunk and the table */
+    uint64_t chunks = 0, new_offset = 0, *new_start = hd__malloc_array(nc + 1, sizeof *new_start);
+    unsigned char *copc_info = NULL, *copc_hier = NULL;
+    if (rc == HD_OK && !new_start) rc = hd__err(w->err, HD_ENOMEM, "out of memory");
     if (rc == HD_OK) {
-        size_t nc = z->c.n_chunks;
-        uint64_t chunks = 0;
-        for (size_t k = 0; k < nc; k++) chunks += z->bytes[k];
-        size_t gap = z->c.table - (size_t)z->c.start[nc]; /* bytes between the last chunk and the table */
-        uint64_t table_bytes = 8 + table.size, points = 8 + chunks + gap + table_bytes;
         z->pl.vlr_added += vlr_len - z->c.vlr_len;
+        new_offset = z->pl.offset + z->pl.vlr_added;
+        for (size_t k = 0; k < nc; k++) {
+            new_start[k] = new_offset + 8 + chunks;
+            chunks += z->bytes[k];
+        }
+        uint64_t table_end = new_offset + 8 + chunks + gap + 8 + table.size; /* the EVLRs move with it */
+        rc = hd__copc_move(w, &z->pl, &z->c, new_start, z->bytes, NULL, table_end - z->c.table_end, &copc_info,
+                           &copc_hier);
+    }
+    if (rc == HD_OK) {
+        uint64_t table_bytes = 8 + table.size, points = 8 + chunks + gap + table_bytes;
         z->pl.end = z->c.table_end;
         hd__las_write_head(w, &z->pl, w->n, NULL, NULL, points, vlr, z->c.vlr_at, vlr_len);
-        uint64_t new_offset = z->pl.offset + z->pl.vlr_added;
         unsigned char t[8];
         hd__st_u64(t, new_offset + 8 + chunks + gap);
         hd__w_put(w, t, 8);
@@ -280,9 +290,12 @@ static int write_layered(lazw_t *z) {
                                  (unsigned char)(nc >> 24)};
         hd__w_put(w, head, 8);
         hd__w_put(w, table.buf, table.size);
-        hd__w_put(w, w->in->data + z->c.table_end, w->in->size - z->c.table_end); /* extended VLRs */
+        hd__las_put_tail(w, &z->pl, z->c.table_end); /* extended VLRs (COPC's hierarchy moved) */
         w->written = w->n;
     }
+    free(new_start);
+    free(copc_info);
+    free(copc_hier);
     hd__enc_free(&table);
     free(vlr);
     return rc;
@@ -305,7 +318,9 @@ int hd__write_laz(hd__writer_t *w) {
     hd__read_t r = {w->in, w->ropt, 1, &z.sink, NULL, 0, w->err, 0, 0, 0};
     z.r = r;
     rc = hd__laz_chunks(&z.r, &z.h, &z.c);
+    if (rc == HD_OK && z.c.layered) rc = hd__copc_plan(w, &z.pl, &z.c);
     if (rc == HD_OK && (!z.c.layered || w->keep != HD_KEEP_ALL)) { /* a layered subset: every point encoded again (laz14.c) */
+        if (!z.c.layered) hd__copc_drop(&z.pl); /* COPC is layered: plain LAZ (write_copc.c) */
         rc = hd__write_laz_pointwise(w, &z.pl, &z.h, &z.c, &z.r);
         hd__laz_chunks_free(&z.c);
         hd__sink_free(&z.sink);

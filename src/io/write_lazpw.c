@@ -297,6 +297,7 @@ typedef struct {
     size_t n_chunks, cap_chunks;
     hd__enc_t enc;
     uint64_t kept, by_return[16];
+    uint64_t *kept_in;   /* per input chunk: its points kept (COPC subsets) */
     double bounds[6], scale[3], shift[3];
 } pw_t;
 
@@ -473,6 +474,7 @@ static int write_chunks(pw_t *z, const hd__las_header_t *h, const hd__laz_chunks
                 if (w->err) *w->err = S.err[t];
                 break;
             }
+            if (z->kept_in) z->kept_in[S.base + t] = S.n_kept[t];
             for (size_t j = 0; j < S.n_kept[t] && rc == HD_OK; j++) rc = gather(&S, S.kept[t] + j * orec, &full, P, threads);
             if (rc == HD_OK && !per && S.n_out[full] && ++full == P) { /* the input's chunks: one ends here */
                 full = 0;
@@ -563,6 +565,30 @@ static int write_all_parallel(pw_t *z, const hd__las_header_t *h, const hd__laz_
     return rc;
 }
 
+/* A COPC subset's hierarchy: input chunk k's kept points are output
+ * chunk j, the j-th chunk keeping a point; the EVLRs follow the table
+ * ending at table_end (write_copc.c moves the entries). */
+static int copc_nodes(pw_t *z, const hd__laz_chunks_t *c, uint64_t table_end, unsigned char **info, unsigned char **hier) {
+    hd__writer_t *w = z->w;
+    size_t nc = c->n_chunks;
+    uint64_t *start = hd__calloc_array(nc + 1, sizeof *start), *bytes = hd__calloc_array(nc + 1, sizeof *bytes);
+    int rc = start && bytes ? HD_OK : hd__err(w->err, HD_ENOMEM, "out of memory");
+    uint64_t at = z->pl->offset + z->pl->vlr_added + 8;
+    for (size_t k = 0, j = 0; rc == HD_OK && k < nc; k++) {
+        if (!z->kept_in[k]) continue;
+        if (j == z->n_chunks || z->counts[j] != z->kept_in[k]) {
+            rc = hd__err(w->err, HD_EINVAL, "%s: internal: COPC node %zu's points are not one chunk", w->in->name, k + 1);
+            break;
+        }
+        start[k] = at;
+        at += bytes[k] = z->bytes[j++];
+    }
+    if (rc == HD_OK) rc = hd__copc_move(w, z->pl, c, start, bytes, z->kept_in, table_end - c->table_end, info, hier);
+    free(start);
+    free(bytes);
+    return rc;
+}
+
 int hd__write_laz_pointwise(hd__writer_t *w, hd__las_plan_t *pl, const hd__las_header_t *h, const hd__laz_chunks_t *c,
                             hd__read_t *r) {
     if (!c->chunked)
@@ -577,7 +603,11 @@ int hd__write_laz_pointwise(hd__writer_t *w, hd__las_plan_t *pl, const hd__las_h
     hd__enc_init(&z.enc);
     hd__las_scale(w->in->data, z.scale, z.shift);
     int all = w->keep == HD_KEEP_ALL;
-    uint32_t chunk = all ? c->chunk_size : HD__LAZ_CHUNK;
+    int copc = !all && pl->copc_at && !pl->copc_drop; /* a COPC subset: a chunk per node (write_copc.c) */
+    uint32_t chunk = all || copc ? c->chunk_size : HD__LAZ_CHUNK;
+    unsigned char *copc_info = NULL, *copc_hier = NULL;
+    if (copc && !(z.kept_in = hd__calloc_array(c->n_chunks + 1, sizeof *z.kept_in)))
+        return hd__err(w->err, HD_ENOMEM, "out of memory");
     int variable = chunk == 0 || chunk == 0xFFFFFFFFu;
     int rc = plan_items(&z, c, chunk);
     off_t head_at = 0, table_ptr = 0;
@@ -590,7 +620,7 @@ int hd__write_laz_pointwise(hd__writer_t *w, hd__las_plan_t *pl, const hd__las_h
         table_ptr = ftello(w->out);
         unsigned char zero[8] = {0};
         hd__w_put(w, zero, 8);
-        rc = all && pl->add ? write_all_parallel(&z, h, c, r) : write_chunks(&z, h, c, r, all ? 0 : HD__LAZ_CHUNK);
+        rc = all && pl->add ? write_all_parallel(&z, h, c, r) : write_chunks(&z, h, c, r, all || copc ? 0 : HD__LAZ_CHUNK);
     }
     if (rc == HD_OK && !w->werr) {
         off_t table = ftello(w->out);
@@ -599,8 +629,9 @@ int hd__write_laz_pointwise(hd__writer_t *w, hd__las_plan_t *pl, const hd__las_h
         hd__w_put(w, head, 8);
         if (hd__laz_table_encode(variable, z.n_chunks, z.counts, z.bytes, &z.enc)) rc = hd__err(w->err, HD_ENOMEM, "out of memory");
         hd__w_put(w, z.enc.buf, z.enc.size);
-        hd__w_put(w, w->in->data + c->table_end, w->in->size - c->table_end); /* extended VLRs */
-        uint64_t points = (uint64_t)(ftello(w->out) - table_ptr) - (w->in->size - c->table_end);
+        if (rc == HD_OK && copc) rc = copc_nodes(&z, c, (uint64_t)table + 8 + z.enc.size, &copc_info, &copc_hier);
+        uint64_t tail = hd__las_put_tail(w, pl, c->table_end); /* extended VLRs (COPC: the hierarchy moved) */
+        uint64_t points = (uint64_t)(ftello(w->out) - table_ptr) - tail;
         if (rc == HD_OK && !w->werr && fseeko(w->out, head_at, SEEK_SET) != 0) w->werr = errno ? errno : EIO;
         hd__las_write_head(w, pl, z.kept, z.by_return, z.bounds, points, z.vlr, c->vlr_at, z.vlr_len);
         unsigned char t[8];
@@ -610,6 +641,9 @@ int hd__write_laz_pointwise(hd__writer_t *w, hd__las_plan_t *pl, const hd__las_h
         if (!w->werr && fseeko(w->out, 0, SEEK_END) != 0) w->werr = errno ? errno : EIO;
         w->written = (size_t)z.kept;
     }
+    free(copc_info);
+    free(copc_hier);
+    free(z.kept_in);
     free(z.vlr);
     free(z.counts);
     free(z.bytes);

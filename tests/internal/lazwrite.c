@@ -9,6 +9,8 @@
 #include "io/lazcoder.h"
 
 #include <assert.h>
+#include <stdarg.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -641,4 +643,163 @@ unsigned char *lazw_decode_records(const char *path, const unsigned char *d, siz
     hd__sink_free(&sink);
     *n = h.count, *rec = h.rec;
     return out;
+}
+
+/* ---- COPC ---------------------------------------------------------------- */
+static void put_at(unsigned char *p, uint64_t v, int n) {
+    for (int i = 0; i < n; i++) p[i] = (unsigned char)(v >> 8 * i);
+}
+
+static void copc_entry(tf_buf_t *b, int32_t level, int32_t x, uint64_t offset, int32_t bytes, int32_t count) {
+    tf_u32(b, (uint32_t)level, 0), tf_u32(b, (uint32_t)x, 0), tf_u32(b, 0, 0), tf_u32(b, 0, 0);
+    tf_u64(b, offset, 0), tf_u32(b, (uint32_t)bytes, 0), tf_u32(b, (uint32_t)count, 0);
+}
+
+void lazw_copc(tf_buf_t *out, const unsigned char *laz, size_t size, const size_t *chunk, const size_t *counts, size_t nc) {
+    enum { INFO = 54 + 160 };
+    assert(nc >= 3 && laz[25] == 4 && le_of(laz + 94, 2) == 375);
+    size_t base = out->size, offset = (size_t)le_of(laz + 96, 4), table = (size_t)le_of(laz + offset, 8);
+    tf_put(out, laz, 375);
+    unsigned char *h = out->data + base;
+    put_at(h + 96, offset + INFO, 4);
+    put_at(h + 100, le_of(laz + 100, 4) + 1, 4);
+    /* the info VLR: centre, halfsize, spacing, root page, GPS times */
+    char user[16] = "copc", desc[32] = "COPC info (tests)";
+    tf_u16(out, 0, 0), tf_put(out, user, 16), tf_u16(out, 1, 0), tf_u16(out, 160, 0), tf_put(out, desc, 32);
+    size_t info = out->size - base;
+    for (int i = 0; i < 5; i++) tf_f64(out, i < 3 ? 0.0 : i == 3 ? 1000.0 : 10.0, 0);
+    tf_u64(out, 0, 0), tf_u64(out, 0, 0); /* the root page, below */
+    for (int i = 0; i < 2 + 11; i++) tf_u64(out, 0, 0);
+    tf_put(out, laz + 375, size - 375);
+    put_at(out->data + base + offset + INFO, table + INFO, 8);
+    /* the hierarchy EVLR: the child page, then the root page */
+    uint64_t evlr = out->size - base, child = evlr + 60, child_size = 32 * (nc - 2), root = child + child_size;
+    put_at(out->data + base + 235, evlr, 8);
+    put_at(out->data + base + 243, 2, 4);
+    char huser[16] = "copc", hdesc[32] = "COPC hierarchy (tests)";
+    tf_u16(out, 0, 0), tf_put(out, huser, 16), tf_u16(out, 1000, 0), tf_u64(out, child_size + 4 * 32, 0);
+    tf_put(out, hdesc, 32);
+    for (size_t k = 2; k < nc; k++)
+        copc_entry(out, 2, (int32_t)k, chunk[k] + INFO, (int32_t)((k + 1 < nc ? chunk[k + 1] : table) - chunk[k]),
+                   (int32_t)counts[k]);
+    copc_entry(out, 0, 0, chunk[0] + INFO, (int32_t)(chunk[1] - chunk[0]), (int32_t)counts[0]);
+    copc_entry(out, 1, 0, chunk[1] + INFO, (int32_t)(chunk[2] - chunk[1]), (int32_t)counts[1]);
+    copc_entry(out, 1, 1, 0, 0, 0);                           /* an empty node */
+    copc_entry(out, 1, 2, child, (int32_t)child_size, -1); /* the child page */
+    put_at(out->data + base + info + 40, root, 8);
+    put_at(out->data + base + info + 48, 4 * 32, 8);
+    char ouser[16] = "someone", odesc[32] = "kept";
+    tf_u16(out, 0, 0), tf_put(out, ouser, 16), tf_u16(out, 9, 0), tf_u64(out, 4, 0), tf_put(out, odesc, 32);
+    tf_put(out, "EVLR", 4);
+}
+
+typedef struct {
+    const unsigned char *d;
+    uint64_t data, end;       /* the hierarchy EVLR's data */
+    size_t nc;
+    uint64_t *start, *first;  /* per chunk (nc + 1) */
+    uint32_t *counts;
+    unsigned char *seen;
+    lazw_node_t *nodes;
+    size_t max, n;
+    char *why;
+    size_t why_len;
+} copc_walk_t;
+
+static int fail(copc_walk_t *W, const char *fmt, ...) {
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(W->why, W->why_len, fmt, ap);
+    va_end(ap);
+    return -1;
+}
+
+static int copc_page(copc_walk_t *W, uint64_t at, uint64_t size, int depth) {
+    if (at < W->data || at > W->end || size > W->end - at || size % 32)
+        return fail(W, "page at %llu (%llu bytes) is not inside the hierarchy EVLR", (unsigned long long)at,
+                    (unsigned long long)size);
+    if (depth > 64) return fail(W, "pages nest deeper than 64");
+    for (uint64_t q = at; q < at + size; q += 32) {
+        const unsigned char *e = W->d + q;
+        uint64_t off = le_of(e + 16, 8);
+        uint32_t bytes = (uint32_t)le_of(e + 24, 4);
+        int32_t count = (int32_t)le_of(e + 28, 4);
+        if (count == -1) {
+            if (copc_page(W, off, bytes, depth + 1)) return -1;
+            continue;
+        }
+        if (count == 0) {
+            if (off != 0 || bytes != 0)
+                return fail(W, "entry at byte %llu: no points, offset %llu and %u bytes (0 and 0 expected)",
+                            (unsigned long long)q, (unsigned long long)off, bytes);
+            continue;
+        }
+        size_t k = 0;
+        while (k < W->nc && W->start[k] != off) k++;
+        if (k == W->nc) return fail(W, "entry at byte %llu: offset %llu is no chunk's start", (unsigned long long)q,
+                                    (unsigned long long)off);
+        if (bytes != W->start[k + 1] - W->start[k] || count < 0 || (uint32_t)count != W->counts[k])
+            return fail(W, "entry at byte %llu: %u bytes, %d points; chunk %zu has %llu bytes, %u points",
+                        (unsigned long long)q, bytes, count, k, (unsigned long long)(W->start[k + 1] - W->start[k]),
+                        W->counts[k]);
+        if (W->seen[k]++) return fail(W, "chunk %zu is two nodes", k);
+        if (W->n == W->max) return fail(W, "more than %zu nodes", W->max);
+        lazw_node_t *nd = &W->nodes[W->n++];
+        for (int i = 0; i < 4; i++) nd->key[i] = (int32_t)le_of(e + 4 * i, 4);
+        nd->first = W->first[k], nd->count = (uint64_t)count;
+    }
+    return 0;
+}
+
+/* The chunk table at `table` (variable sizes: counts and bytes). */
+static int copc_table(copc_walk_t *W, size_t size, uint64_t offset, uint64_t table) {
+    if (table + 8 > size || le_of(W->d + table, 4) != 0) return fail(W, "no chunk table at %llu", (unsigned long long)table);
+    W->nc = (size_t)le_of(W->d + table + 4, 4);
+    W->start = calloc(W->nc + 1, 8), W->first = calloc(W->nc + 1, 8), W->counts = calloc(W->nc + 1, 4);
+    W->seen = calloc(W->nc + 1, 1);
+    hd__intcoder_t ic;
+    icnew(&ic, 32, 2);
+    hd__dec_t dec;
+    hd__dec_init(&dec, W->d + table + 8, size - table - 8);
+    uint32_t pc = 0, pb = 0;
+    W->start[0] = offset + 8;
+    for (size_t k = 0; k < W->nc; k++) {
+        pc = W->counts[k] = (uint32_t)hd__ic_decode(&ic, &dec, (int32_t)pc, 0);
+        pb = (uint32_t)hd__ic_decode(&ic, &dec, (int32_t)pb, 1);
+        W->start[k + 1] = W->start[k] + pb;
+        W->first[k + 1] = W->first[k] + pc;
+    }
+    hd__intcoder_free(&ic);
+    if (W->start[W->nc] != table) return fail(W, "the chunks end at %llu, the table starts at %llu",
+                                              (unsigned long long)W->start[W->nc], (unsigned long long)table);
+    return 0;
+}
+
+int lazw_copc_nodes(const unsigned char *d, size_t size, lazw_node_t *nodes, size_t max, size_t *n, char *why,
+                    size_t why_len) {
+    copc_walk_t W = {d, 0, 0, 0, NULL, NULL, NULL, NULL, nodes, max, 0, why, why_len};
+    int rc = 0;
+    uint64_t header = le_of(d + 94, 2), offset = le_of(d + 96, 4);
+    if (size < 375 || d[25] != 4 || header < 375 || header + 54 + 160 > size || memcmp(d + header + 2, "copc\0", 5) != 0 ||
+        le_of(d + header + 18, 2) != 1 || le_of(d + header + 20, 2) != 160)
+        rc = fail(&W, "the first VLR is not COPC's info VLR (user copc, record 1, 160 bytes)");
+    uint64_t evlr = le_of(d + 235, 8), n_evlr = le_of(d + 243, 4);
+    for (uint64_t i = 0; rc == 0 && i < n_evlr; i++) {
+        if (evlr + 60 > size || le_of(d + evlr + 20, 8) > size - evlr - 60) rc = fail(&W, "EVLR %llu runs past the end",
+                                                                                     (unsigned long long)i + 1);
+        else if (memcmp(d + evlr + 2, "copc\0", 5) == 0 && le_of(d + evlr + 18, 2) == 1000)
+            W.data = evlr + 60, W.end = evlr + 60 + le_of(d + evlr + 20, 8);
+        if (rc == 0) evlr += 60 + le_of(d + evlr + 20, 8);
+    }
+    if (rc == 0 && !W.data) rc = fail(&W, "no EVLR of user copc, record 1000");
+    if (rc == 0 && offset + 8 <= size) rc = copc_table(&W, size, offset, le_of(d + offset, 8));
+    if (rc == 0) rc = copc_page(&W, le_of(d + header + 54 + 40, 8), le_of(d + header + 54 + 48, 8), 0);
+    for (size_t k = 0; rc == 0 && k < W.nc; k++)
+        if (!W.seen[k]) rc = fail(&W, "chunk %zu is no node", k);
+    if (rc == 0 && W.first[W.nc] != le_of(d + 247, 8))
+        rc = fail(&W, "the nodes hold %llu points, the header says %llu", (unsigned long long)W.first[W.nc],
+                  (unsigned long long)le_of(d + 247, 8));
+    free(W.start), free(W.first), free(W.counts), free(W.seen);
+    *n = W.n;
+    return rc;
 }

@@ -90,4 +90,32 @@ void lazw_layered(tf_buf_t *b, int fmt, unsigned extra, const unsigned char *rec
 unsigned char *lazw_decode_records(const char *path, const unsigned char *d, size_t size, size_t *n, size_t *rec,
                                    hd_error_t *err);
 
+/* ---- COPC ------------------------------------------------------------------ */
+/* The COPC file of the layered LAZ file laz[0..size) (LAS 1.4, no EVLRs;
+ * its nc chunks start at chunk[k] and hold counts[k] points, the last
+ * ending at the chunk table) appended to out: the COPC info VLR first,
+ * then the LAZ VLR; after the chunk table the hierarchy EVLR (user
+ * "copc", record 1000) of two pages, the child page first: the root page
+ * holds chunk 0 (level 0), chunk 1 (level 1), an empty node and a pointer
+ * to the child page, which holds every other chunk (level 2); then an EVLR
+ * of another user ("someone", record 9, the 4 bytes "EVLR"). */
+void lazw_copc(tf_buf_t *out, const unsigned char *laz, size_t size, const size_t *chunk, const size_t *counts, size_t nc);
+
+/* A COPC node as lazw_copc_nodes found it: its key, and its points: the
+ * first's number in file order and how many. */
+typedef struct lazw_node {
+    int32_t key[4];
+    uint64_t first, count;
+} lazw_node_t;
+/* The nodes (at most max) of COPC file d[0..size), checked independently
+ * of the library's writer: the info VLR is the first VLR; its root page
+ * lies inside the EVLR of user "copc", record 1000; every page reached
+ * from it (pointers: point count -1) does too; every node with points is
+ * exactly one chunk of the chunk table (offset, byte size, point count),
+ * a node without points has offset 0 and byte size 0,
+ * no chunk twice, every chunk once, and the counts add up to the header's.
+ * Returns 0, or -1 with why (a sentence) filled. */
+int lazw_copc_nodes(const unsigned char *d, size_t size, lazw_node_t *nodes, size_t max, size_t *n, char *why,
+                    size_t why_len);
+
 #endif

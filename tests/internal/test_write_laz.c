@@ -564,3 +564,173 @@ TEST(laszip1_streams_are_refused_by_name) {
     CHECK_RC(hd_write_field(in, tf_path("v1_out.laz"), v, 20, NULL, NULL, &err), HD_EUNSUPPORTED);
     CHECK(strstr(err.message, "LASzip 1.x compression"));
 }
+
+/* ---- COPC: the hierarchy follows the chunks --------------------------------- */
+/* A COPC file of n points in the variable chunks `chunks` (lazw_copc:
+ * two hierarchy pages, an empty node, an EVLR after the hierarchy). */
+static const char *copc_file(gen_rng_t *g, const size_t *chunks, size_t nc, size_t n, const char *name,
+                             unsigned char **d, size_t *size) {
+    lazw_point_t *p = malloc(n * sizeof *p);
+    lazw_random(g, p, n, 6);
+    lazw_opts_t o = {6, 2, 0, chunks, nc, {0.01, 0.01, 0.01}, {0, 0, 0}, 0};
+    tf_buf_t laz = {0}, b = {0};
+    lazw_encode(&laz, &o, p, n);
+    size_t start[64];
+    memcpy(start, lazw_last.chunk, sizeof start);
+    lazw_copc(&b, laz.data, laz.size, start, chunks, nc);
+    *size = b.size;
+    *d = malloc(b.size);
+    memcpy(*d, b.data, b.size);
+    tf_free(&laz);
+    free(p);
+    return tf_finish(&b, name);
+}
+
+/* The nodes of a COPC file, checked (lazw_copc_nodes); *n of them. */
+static lazw_node_t *copc_nodes(const unsigned char *d, size_t size, size_t *n) {
+    lazw_node_t *nodes = calloc(64, sizeof *nodes);
+    char why[256] = "";
+    int rc = lazw_copc_nodes(d, size, nodes, 64, n, why, sizeof why);
+    CONTEXT("%s", why);
+    CHECK(rc == 0);
+    return nodes;
+}
+
+/* Whether point k is kept (keep: 0 every point, 1 value > 0.25, 2 <= 0.25). */
+static int kept_at(const double *v, size_t k, int keep) {
+    return keep == 1 ? v[k] > 0.25 : keep == 2 ? v[k] <= 0.25 : 1;
+}
+
+/* Output node by node as the input's (out valid COPC): the same keys, each
+ * node's kept points, each point's record the input's with the nf values
+ * appended; returns the nodes emptied (absent from out's nodes). */
+static size_t copc_same_nodes(const char *in, const unsigned char *din, size_t nin, const char *out, const double *v,
+                              size_t n, size_t nf, int keep) {
+    size_t no, ni = 0, nn = 0, mi, mo, ri, ro, emptied = 0;
+    unsigned char *dout = tf_read(out, &no);
+    lazw_node_t *a = copc_nodes(din, nin, &ni), *b = copc_nodes(dout, no, &nn);
+    hd_error_t err;
+    unsigned char *ra = lazw_decode_records(in, din, nin, &mi, &ri, &err);
+    unsigned char *rb = lazw_decode_records(out, dout, no, &mo, &ro, &err);
+    CHECK(ra && rb && mi == n && ro == ri + 8 * nf);
+    for (size_t k = 0; k < ni && ra && rb && !hdt_failed(); k++) {
+        CONTEXT("node %zu (level %d, x %d), keep %d", k, a[k].key[0], a[k].key[1], keep);
+        size_t j = 0, want = 0;
+        while (j < nn && memcmp(a[k].key, b[j].key, sizeof a[k].key) != 0) j++;
+        for (uint64_t i = 0; i < a[k].count; i++) want += (size_t)kept_at(v, (size_t)(a[k].first + i), keep);
+        if (want == 0) {
+            CHECK(j == nn); /* emptied: no node with points */
+            emptied++;
+            continue;
+        }
+        CHECK(j < nn && b[j].count == want);
+        for (uint64_t i = 0, o = 0; j < nn && i < a[k].count && !hdt_failed(); i++) {
+            size_t p = (size_t)(a[k].first + i);
+            if (!kept_at(v, p, keep)) continue;
+            const unsigned char *x = ra + p * ri, *y = rb + (b[j].first + o++) * ro;
+            CHECK(memcmp(x, y, ri) == 0);
+            for (size_t f = 0; f < nf; f++) {
+                double val;
+                memcpy(&val, y + ri + 8 * f, 8);
+                CHECK_BITS(val, v[f * n + p]);
+            }
+        }
+    }
+    /* the EVLR after the hierarchy is still the file's last, where the header says */
+    CHECK(no > 64 && memcmp(dout + no - 4, "EVLR", 4) == 0 && le(dout + 243, 4) == 2);
+    free(a), free(b), free(ra), free(rb), free(dout);
+    return emptied;
+}
+
+TEST(copc_written_back_has_its_hierarchy_on_the_grown_chunks) {
+    for (size_t nf = 1; nf <= 2; nf++) {
+        uint64_t seed = 700 + nf;
+        CONTEXT("fields %zu seed %llu", nf, (unsigned long long)seed);
+        gen_rng_t g;
+        gen_seed(&g, seed);
+        size_t chunks[6] = {1, 300, 2, 197, 250, 250}, n = 1000, nin;
+        unsigned char *din;
+        const char *in = copc_file(&g, chunks, 6, n, "in.copc.laz", &din, &nin);
+        size_t ni = 0;
+        free(copc_nodes(din, nin, &ni)); /* the fixture is valid COPC */
+        CHECK_EQ(ni, 6);
+        double *v = malloc(nf * n * sizeof *v);
+        field_values(&g, v, n, nf);
+        hd_error_t err;
+        size_t written = 0;
+        CHECK_RC(write_fields(in, tf_path("out.copc.laz"), v, n, nf, NULL, &written, &err), HD_OK);
+        CHECK_EQ(written, n);
+        CHECK_EQ(copc_same_nodes(in, din, nin, tf_path("out.copc.laz"), v, n, nf, 0), 0);
+        free(v), free(din);
+    }
+}
+
+TEST(copc_subsets_keep_each_nodes_points_as_its_chunk) {
+    gen_rng_t g;
+    gen_seed(&g, 711);
+    size_t chunks[6] = {1, 300, 2, 197, 250, 250}, n = 1000, nin, emptied = 0;
+    unsigned char *din;
+    const char *in = copc_file(&g, chunks, 6, n, "sub.copc.laz", &din, &nin);
+    double *v = malloc(2 * n * sizeof *v);
+    field_values(&g, v, n, 2);
+    hd_write_options_t o;
+    hd_write_options_init(&o);
+    o.threshold = 0.25;
+    for (int keep = 1; keep <= 2; keep++) {
+        CONTEXT("keep %s (seed 711)", keep == 1 ? "farther" : "nearer");
+        o.keep = keep == 1 ? HD_KEEP_FARTHER : HD_KEEP_NEARER;
+        hd_error_t err;
+        size_t written = 0;
+        CHECK_RC(write_fields(in, tf_path("sub_out.copc.laz"), v, n, 2, &o, &written, &err), HD_OK);
+        CHECK(written > 0 && written < n);
+        emptied += copc_same_nodes(in, din, nin, tf_path("sub_out.copc.laz"), v, n, 2, keep);
+    }
+    CHECK(emptied > 0); /* a node lost every point: its entry is 0, 0, 0 */
+    /* the same file on 1 and 2 threads (2: batches of 4 chunks, 6 nodes) */
+    hd_read_options_t r;
+    hd_read_options_init(&r);
+    o.read = &r;
+    unsigned char *f[2];
+    size_t size[2];
+    for (int t = 0; t < 2; t++) {
+        r.threads = t + 1;
+        hd_error_t err;
+        CHECK_RC(write_fields(in, tf_path("sub_threads.copc.laz"), v, n, 2, &o, NULL, &err), HD_OK);
+        f[t] = tf_read(tf_path("sub_threads.copc.laz"), &size[t]);
+    }
+    CHECK(f[0] && f[1] && size[0] == size[1] && memcmp(f[0], f[1], size[0]) == 0);
+    free(f[0]), free(f[1]);
+    free(v), free(din);
+}
+
+TEST(copc_hierarchy_entries_that_are_no_chunk_are_refused_by_name) {
+    gen_rng_t g;
+    gen_seed(&g, 721);
+    size_t chunks[4] = {100, 200, 300, 400}, n = 1000, nin;
+    unsigned char *din;
+    copc_file(&g, chunks, 4, n, "bad.copc.laz", &din, &nin);
+    double *v = calloc(n, sizeof *v);
+    uint64_t root = le(din + 375 + 54 + 40, 8);
+    /* the root page's first entry (chunk 0): its offset, its byte size, its count; then the child page pointer */
+    static const struct { size_t at; int delta; const char *says; } cases[] = {
+        {16, 1, "is not the start of a chunk"}, {24, 1, "bytes and"}, {28, 1, "points, chunk"},
+        {3 * 32 + 16, -64, "is not inside the hierarchy EVLR"}};
+    for (size_t c = 0; c < sizeof cases / sizeof *cases; c++) {
+        CONTEXT("case %zu (seed 721)", c);
+        unsigned char *d = malloc(nin);
+        memcpy(d, din, nin);
+        d[root + cases[c].at] = (unsigned char)(d[root + cases[c].at] + cases[c].delta);
+        const char *bad = tf_write("bad_entry.copc.laz", d, nin);
+        hd_write_options_t o;
+        hd_write_options_init(&o);
+        for (int keep = 0; keep <= 1; keep++) { /* every point, and a subset */
+            o.keep = keep ? HD_KEEP_NEARER : HD_KEEP_ALL;
+            hd_error_t err;
+            CHECK_RC(hd_write_field(bad, tf_path("bad_out.laz"), v, n, &o, NULL, &err), HD_EFORMAT);
+            CHECK(strstr(err.message, "bad_entry.copc.laz") && strstr(err.message, "COPC hierarchy entry") &&
+                  strstr(err.message, cases[c].says));
+        }
+        free(d);
+    }
+    free(v), free(din);
+}
