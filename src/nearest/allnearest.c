@@ -113,6 +113,16 @@
  *    of them; each chunk keeps, the same way, those that can be any of its
  *    answers, and while that stays at most 2 CHUNK points its queries scan
  *    just them (no bucket bounds, no per-query lists).
+ *  - Far groups.  A group whose box lies outside the searched set's box
+ *    by more than its own diagonal (disjoint sets: the window and the
+ *    seeds are far from its answers, and every query scanned the nearest
+ *    bucket only to set a bound) takes the nearest leaf's bound Ub, which
+ *    bounds every answer of the group, as U; when at most FAR_CANDIDATES
+ *    buckets lie within it, holding at most POINT_LIST points, they are
+ *    its candidates, no bucket is scanned first, and its queries are
+ *    answered from point lists (the group is small next to Ub).  A group
+ *    of the seed path whose box is as far from the nearest leaf is
+ *    settled the same way.
  *  - Scans.  A bucket is scanned four points at a time with GCC's vector
  *    extension (each lane evaluates hd__d2s's expression: no fused
  *    multiply-add, -ffp-contract=off), each lane keeping its smallest
