@@ -740,19 +740,21 @@ HD__INLINE double node_ub2(const hd__box_t *q, const hd__an_t *t, size_t k) {
     return g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
 }
 
-/* node_lb2 from box q of the nc consecutive nodes f, ..., f + nc - 1 (a
- * node's children) into lb: the same expression over the box arrays,
- * without branches, so that it vectorises. */
-HD__INLINE void children_lb2(const hd__box_t *q, const hd__an_t *t, size_t f, int nc, double *restrict lb) {
-    const double *restrict lx = t->lo[0] + f, *restrict ly = t->lo[1] + f, *restrict lz = t->lo[2] + f;
-    const double *restrict hx = t->hi[0] + f, *restrict hy = t->hi[1] + f, *restrict hz = t->hi[2] + f;
+/* node_lb2's expression from box q to each of the boxes f, ..., f + n - 1
+ * of the arrays lo[], hi[] (a node's children, or a candidate list, q
+ * then a query's point) into out: without branches, so that it
+ * vectorises. */
+HD__INLINE void boxes_lb2(double *const lo[3], double *const hi[3], size_t f, size_t n, const hd__box_t *q,
+                          double *restrict out) {
+    const double *restrict lx = lo[0] + f, *restrict ly = lo[1] + f, *restrict lz = lo[2] + f;
+    const double *restrict hx = hi[0] + f, *restrict hy = hi[1] + f, *restrict hz = hi[2] + f;
     double ax = q->lo[0], ay = q->lo[1], az = q->lo[2], bx = q->hi[0], by = q->hi[1], bz = q->hi[2];
-    for (int i = 0; i < nc; i++) {
+    for (size_t i = 0; i < n; i++) {
         double u, v, gx, gy, gz;
         u = lx[i] - bx, v = ax - hx[i], gx = u > v ? u : v, gx = gx > 0 ? gx : 0;
         u = ly[i] - by, v = ay - hy[i], gy = u > v ? u : v, gy = gy > 0 ? gy : 0;
         u = lz[i] - bz, v = az - hz[i], gz = u > v ? u : v, gz = gz > 0 ? gz : 0;
-        lb[i] = gx * gx + gy * gy + gz * gz;
+        out[i] = gx * gx + gy * gy + gz * gz;
     }
 }
 
@@ -769,7 +771,7 @@ static size_t nearest_leaf(const hd__an_t *t, const hd__box_t *q, double *U) {
         size_t f = t->first[k], near = f;
         int nc = t->count[k];
         double best = INFINITY, lb[8];
-        children_lb2(q, t, f, nc, lb);
+        boxes_lb2(t->lo, t->hi, f, (size_t)nc, q, lb);
         for (int i = 0; i < nc; i++)
             if (lb[i] < best) best = lb[i], near = f + (size_t)i;
         k = near;
@@ -800,7 +802,7 @@ static int candidates(const hd__an_t *t, const hd__box_t *q, double U, size_t li
         size_t f = t->first[k];
         int nc = t->count[k];
         double lb[8];
-        children_lb2(q, t, f, nc, lb);
+        boxes_lb2(t->lo, t->hi, f, (size_t)nc, q, lb);
         for (int i = nc - 1; i >= 0; i--)
             if (lb[i] <= U) stack[sp] = (uint32_t)(f + (size_t)i), slb[sp] = lb[i], sp++;
     }
@@ -811,16 +813,8 @@ static int candidates(const hd__an_t *t, const hd__box_t *q, double U, size_t li
 /* The bound hd__box_lb2s of every candidate for the query (qx, qy, qz)
  * into c->lb2 (branch-free, so that it vectorises). */
 HD__INLINE void candidate_bounds(cands_t *c, size_t nc, double qx, double qy, double qz) {
-    const double *restrict lx = c->lo[0], *restrict ly = c->lo[1], *restrict lz = c->lo[2];
-    const double *restrict hx = c->hi[0], *restrict hy = c->hi[1], *restrict hz = c->hi[2];
-    double *restrict out = c->lb2;
-    for (size_t r = 0; r < nc; r++) {
-        double u, v, gx, gy, gz;
-        u = lx[r] - qx, v = qx - hx[r], gx = u > v ? u : v, gx = gx > 0 ? gx : 0;
-        u = ly[r] - qy, v = qy - hy[r], gy = u > v ? u : v, gy = gy > 0 ? gy : 0;
-        u = lz[r] - qz, v = qz - hz[r], gz = u > v ? u : v, gz = gz > 0 ? gz : 0;
-        out[r] = gx * gx + gy * gy + gz * gz;
-    }
+    hd__box_t p = {{qx, qy, qz}, {qx, qy, qz}};
+    boxes_lb2(c->lo, c->hi, 0, nc, &p, c->lb2);
 }
 
 /* One query against one bucket: the squared distances four lanes at a time
