@@ -60,13 +60,15 @@
  *    its partner's distance (an actual point's, so the largest over the
  *    group bounds every answer, as U does), and when at most
  *    PAIR_CANDIDATES buckets lie within that bound they are the candidates
- *    and no seed is scanned; otherwise the seeds go on from the partners.
+ *    and no seed is scanned; otherwise the window path (while it pays)
+ *    or the seeds go on from the partners.
  *    The partners are read from the caller's view in its order (a random
  *    access, prefetched a group ahead), or, given by position
  *    (hd__an_nearest_paired: the MPI layer's local parts, of different
  *    sizes, where some partners are on other ranks), from the searched
  *    structure itself; a query without a partner leaves the group's bound
- *    infinite, and the group goes on to the seeds.  A group counts as a success when
+ *    infinite, and the group goes on to the window or the seeds.  A group
+ *    counts as a success when
  *    at least half of its answers are the partners themselves; a task stops
  *    trying once most of the groups it tried, PAIR_TRIAL at least, failed,
  *    so unrelated sets pay for eight groups a task.  (Sets of a few
@@ -1400,8 +1402,8 @@ HD__INLINE void solo_query(query_ctx *c, cands_t *cd, size_t k, size_t *b, size_
  * index) is usually at or next to its answer.  Its distance is a real
  * point's, so the largest over the group bounds every answer; if few
  * buckets lie within it, they are the candidates and no seed is scanned.
- * Otherwise the partners still stand as first answers for the seeds to
- * improve on.
+ * Otherwise the partners still stand as first answers for the window (or
+ * the seeds) to improve on.
  *
  * The window path: a near-copy in another order (or two sets sampled
  * alike) puts each query's answer at about its own place on t's curve,
@@ -1452,7 +1454,10 @@ HD__HOT static void query_task(void *vctx, size_t task, int worker) {
                 paired = candidates(t, &G.box, U, PAIR_CANDIDATES, cd);
                 tried++;
                 cd->counts.paired += (size_t)paired;
-            } else if (scanned && (wtried < PAIR_TRIAL || 2 * wkept >= wtried)) {
+            }
+            /* The partners' distances are real points': the window improves
+             * on them when they listed too many candidates. */
+            if (scanned && !paired && (wtried < PAIR_TRIAL || 2 * wkept >= wtried)) {
                 qgroup_seeds(q, t, &G, &h, &s0);
                 seeded = 1;
                 size_t apart;
