@@ -60,13 +60,15 @@
  *    its partner's distance (an actual point's, so the largest over the
  *    group bounds every answer, as U does), and when at most
  *    PAIR_CANDIDATES buckets lie within that bound they are the candidates
- *    and no seed is scanned; otherwise the seeds go on from the partners.
+ *    and no seed is scanned; otherwise the window path (while it pays)
+ *    or the seeds go on from the partners.
  *    The partners are read from the caller's view in its order (a random
  *    access, prefetched a group ahead), or, given by position
  *    (hd__an_nearest_paired: the MPI layer's local parts, of different
  *    sizes, where some partners are on other ranks), from the searched
  *    structure itself; a query without a partner leaves the group's bound
- *    infinite, and the group goes on to the seeds.  A group counts as a success when
+ *    infinite, and the group goes on to the window or the seeds.  A group
+ *    counts as a success when
  *    at least half of its answers are the partners themselves; a task stops
  *    trying once most of the groups it tried, PAIR_TRIAL at least, failed,
  *    so unrelated sets pay for eight groups a task.  (Sets of a few
@@ -90,7 +92,7 @@
  *    the others, and each query set apart scans its two seed buckets,
  *    then either falls within U (and uses the group's list) or lists its
  *    own candidates around its own point.  A group fails when more than
- *    an eighth of its queries are set apart or more than PAIR_CANDIDATES
+ *    an eighth of its queries are set apart or more than WINDOW_CANDIDATES
  *    buckets are listed; a task drops the path as it drops the partners.
  *    How often each route runs is in docs/benchmarks.md, "Issue 15".
  *  - Chunks.  A group's list serves its queries CHUNK at a time: the
@@ -113,6 +115,16 @@
  *    of them; each chunk keeps, the same way, those that can be any of its
  *    answers, and while that stays at most 2 CHUNK points its queries scan
  *    just them (no bucket bounds, no per-query lists).
+ *  - Far groups.  A group whose box lies outside the searched set's box
+ *    by more than its own diagonal (disjoint sets: the window and the
+ *    seeds are far from its answers, and every query scanned the nearest
+ *    bucket only to set a bound) takes the nearest leaf's bound Ub, which
+ *    bounds every answer of the group, as U; when at most FAR_CANDIDATES
+ *    buckets lie within it, holding at most POINT_LIST points, they are
+ *    its candidates, no bucket is scanned first, and its queries are
+ *    answered from point lists (the group is small next to Ub).  A group
+ *    of the seed path whose box is as far from the nearest leaf is
+ *    settled the same way.
  *  - Scans.  A bucket is scanned four points at a time with GCC's vector
  *    extension (each lane evaluates hd__d2s's expression: no fused
  *    multiply-add, -ffp-contract=off), each lane keeping its smallest
@@ -730,6 +742,24 @@ HD__INLINE double node_ub2(const hd__box_t *q, const hd__an_t *t, size_t k) {
     return g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
 }
 
+/* node_lb2's expression from box q to each of the boxes f, ..., f + n - 1
+ * of the arrays lo[], hi[] (a node's children, or a candidate list, q
+ * then a query's point) into out: without branches, so that it
+ * vectorises. */
+HD__INLINE void boxes_lb2(double *const lo[3], double *const hi[3], size_t f, size_t n, const hd__box_t *q,
+                          double *restrict out) {
+    const double *restrict lx = lo[0] + f, *restrict ly = lo[1] + f, *restrict lz = lo[2] + f;
+    const double *restrict hx = hi[0] + f, *restrict hy = hi[1] + f, *restrict hz = hi[2] + f;
+    double ax = q->lo[0], ay = q->lo[1], az = q->lo[2], bx = q->hi[0], by = q->hi[1], bz = q->hi[2];
+    for (size_t i = 0; i < n; i++) {
+        double u, v, gx, gy, gz;
+        u = lx[i] - bx, v = ax - hx[i], gx = u > v ? u : v, gx = gx > 0 ? gx : 0;
+        u = ly[i] - by, v = ay - hy[i], gy = u > v ? u : v, gy = gy > 0 ? gy : 0;
+        u = lz[i] - bz, v = az - hz[i], gz = u > v ? u : v, gz = gz > 0 ? gz : 0;
+        out[i] = gx * gx + gy * gy + gz * gz;
+    }
+}
+
 /* The bucket reached from the root by always taking the child whose box
  * is nearest to the box q; *U is lowered to the upper bounds of the nodes
  * on the way (each holds a point, so every query in q has a point within
@@ -741,11 +771,11 @@ static size_t nearest_leaf(const hd__an_t *t, const hd__box_t *q, double *U) {
         *U = u < *U ? u : *U;
         if (!t->count[k]) return t->first[k];
         size_t f = t->first[k], near = f;
-        double best = INFINITY;
-        for (size_t i = f; i < f + t->count[k]; i++) {
-            double lb = node_lb2(q, t, i);
-            if (lb < best) best = lb, near = i;
-        }
+        int nc = t->count[k];
+        double best = INFINITY, lb[8];
+        boxes_lb2(t->lo, t->hi, f, (size_t)nc, q, lb);
+        for (int i = 0; i < nc; i++)
+            if (lb[i] < best) best = lb[i], near = f + (size_t)i;
         k = near;
     }
 }
@@ -774,7 +804,7 @@ static int candidates(const hd__an_t *t, const hd__box_t *q, double U, size_t li
         size_t f = t->first[k];
         int nc = t->count[k];
         double lb[8];
-        for (int i = 0; i < nc; i++) lb[i] = node_lb2(q, t, f + (size_t)i);
+        boxes_lb2(t->lo, t->hi, f, (size_t)nc, q, lb);
         for (int i = nc - 1; i >= 0; i--)
             if (lb[i] <= U) stack[sp] = (uint32_t)(f + (size_t)i), slb[sp] = lb[i], sp++;
     }
@@ -785,16 +815,8 @@ static int candidates(const hd__an_t *t, const hd__box_t *q, double U, size_t li
 /* The bound hd__box_lb2s of every candidate for the query (qx, qy, qz)
  * into c->lb2 (branch-free, so that it vectorises). */
 HD__INLINE void candidate_bounds(cands_t *c, size_t nc, double qx, double qy, double qz) {
-    const double *restrict lx = c->lo[0], *restrict ly = c->lo[1], *restrict lz = c->lo[2];
-    const double *restrict hx = c->hi[0], *restrict hy = c->hi[1], *restrict hz = c->hi[2];
-    double *restrict out = c->lb2;
-    for (size_t r = 0; r < nc; r++) {
-        double u, v, gx, gy, gz;
-        u = lx[r] - qx, v = qx - hx[r], gx = u > v ? u : v, gx = gx > 0 ? gx : 0;
-        u = ly[r] - qy, v = qy - hy[r], gy = u > v ? u : v, gy = gy > 0 ? gy : 0;
-        u = lz[r] - qz, v = qz - hz[r], gz = u > v ? u : v, gz = gz > 0 ? gz : 0;
-        out[r] = gx * gx + gy * gy + gz * gz;
-    }
+    hd__box_t p = {{qx, qy, qz}, {qx, qy, qz}};
+    boxes_lb2(c->lo, c->hi, 0, nc, &p, c->lb2);
 }
 
 /* One query against one bucket: the squared distances four lanes at a time
@@ -888,10 +910,12 @@ static size_t bucket_at(const hd__an_t *t, uint32_t key, size_t from) {
 
 #define PAIR_CANDIDATES 32 /* most candidates of a group for the partner path */
 #define PAIR_TRIAL 8        /* groups of a task tried before the partner path may be dropped */
+#define WINDOW_CANDIDATES 64 /* most candidates of a group for the window path */
 #define WINDOW 8            /* points of t scanned around a query's key (a multiple of 8) */
 #define CHUNK 16            /* queries answered from one chunk list */
 #define CHUNK_LIST 256      /* a group list longer than this is not filtered but listed again per chunk */
 #define POINT_LIST 512      /* most points of a group's candidate buckets for a point list */
+#define FAR_CANDIDATES 64   /* most candidates of a far group answered without seeds */
 
 /* The rest of one query's search, on the candidate list cd (the buckets
  * within U of a box holding the query, U at least its answer): every
@@ -1069,15 +1093,47 @@ HD__INLINE double window_bests(const hd__an_t *q, const hd__an_t *t, qgroup_t *G
     return U;
 }
 
+/* The points of t in the buckets listed in cd. */
+HD__INLINE size_t listed_points(const hd__an_t *t, const cands_t *cd) {
+    size_t total = 0;
+    for (size_t r = 0; r < cd->n; r++) total += t->stop[cd->bucket[r]] - t->start[cd->bucket[r]];
+    return total;
+}
+
+/* The squared diagonal of a group's box. */
+HD__INLINE double qgroup_diag2(const qgroup_t *G) {
+    double diag2 = 0;
+    for (int d = 0; d < 3; d++) diag2 += (G->box.hi[d] - G->box.lo[d]) * (G->box.hi[d] - G->box.lo[d]);
+    return diag2;
+}
+
+/* A far group: its box's squared diagonal at most lb2, a bound from its
+ * box to every point of t (disjoint sets, where the curve's seeds and the
+ * window are far), and, Ub bounding every answer of the group (a bound
+ * from the nearest leaf's path, which holds a point within Ub of each
+ * query), at most FAR_CANDIDATES buckets within Ub holding at most
+ * POINT_LIST points: they are listed into cd and returns 1.  Such a group
+ * scans nothing first: U = Ub, no query has a best yet, and qgroup_finish
+ * answers it from point lists (it is small next to Ub). */
+HD__INLINE int far_group(const hd__an_t *t, const qgroup_t *G, double lb2, double Ub, cands_t *cd) {
+    return G->m >= 2 * CHUNK && qgroup_diag2(G) <= lb2 && candidates(t, &G->box, Ub, FAR_CANDIDATES, cd) &&
+           listed_points(t, cd) <= POINT_LIST;
+}
+
 /* The seeds' answers, when no path listed the candidates: the searched
  * buckets at each query's place on the curve (the seeds must be set), and
  * the bucket nearest to the group's box, give every query a real point;
  * U, the largest of these distances (or the nearest bucket's bound Ub,
  * when smaller), bounds every answer of the group and lists its
- * candidates into cd.  Returns the nearest bucket. */
-HD__INLINE size_t seed_bests(const hd__an_t *q, const hd__an_t *t, qgroup_t *G, cands_t *cd, double *U) {
+ * candidates into cd.  Returns the nearest bucket, and *scanned = 1;
+ * for a far group (far_group) *scanned = 0 and U = Ub. */
+HD__INLINE size_t seed_bests(const hd__an_t *q, const hd__an_t *t, qgroup_t *G, cands_t *cd, double *U,
+                             int *scanned) {
     double Ub = INFINITY;
     size_t near = nearest_leaf(t, &G->box, &Ub);
+    *U = Ub;
+    *scanned = !far_group(t, G, node_lb2(&G->box, t, t->leaf[near]), Ub, cd);
+    if (!*scanned) return near;
     *U = 0;
     /* A seed bucket whose box is farther from the group's than Ub holds no
      * answer of the group and is not listed (U <= Ub below): it is not
@@ -1139,25 +1195,31 @@ typedef struct {
     uint32_t idx[POINT_LIST + 4];
 } plist_t;
 
-/* The smallest and the largest computed squared distance between the
- * point (px, py, pz) and a point of box q (node_lb2's and node_ub2's
- * expressions with a box of one point; see the essay). */
-HD__INLINE void point_bounds(const hd__box_t *q, double px, double py, double pz, double *lb, double *ub) {
-    double p[3] = {px, py, pz}, g[3], h[3];
-    for (int d = 0; d < 3; d++) {
-        double u = p[d] - q->hi[d], v = q->lo[d] - p[d];
-        g[d] = u > v ? u : v;
-        g[d] = g[d] > 0 ? g[d] : 0;
-        u = q->hi[d] - p[d], v = p[d] - q->lo[d];
-        h[d] = u > v ? u : v;
-    }
-    *lb = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
-    *ub = h[0] * h[0] + h[1] * h[1] + h[2] * h[2];
-}
-
 HD__INLINE void plist_pad(plist_t *l) {
     for (size_t k = l->n; l->n && k < ((l->n + 3) & ~(size_t)3); k++)
         l->x[k] = l->x[l->n - 1], l->y[k] = l->y[l->n - 1], l->z[k] = l->z[l->n - 1], l->idx[k] = l->idx[l->n - 1];
+}
+
+/* The smallest and the largest computed squared distance between each of
+ * the n points (x[k], y[k], z[k]) and a point of box q (node_lb2's and
+ * node_ub2's expressions with a box of one point; see the essay; the
+ * span's max(hi - p, p - lo) is the larger of the negated gaps, as IEEE
+ * subtraction is exact under negation): the smallest into lb[k], and
+ * returns the least of the largest, or V when smaller.  (The bounds only,
+ * no copies, so that it vectorises.) */
+HD__INLINE double span_bounds(const hd__box_t *q, const double *restrict x, const double *restrict y,
+                              const double *restrict z, size_t n, double *restrict lb, double V) {
+    double l0 = q->lo[0], l1 = q->lo[1], l2 = q->lo[2], h0 = q->hi[0], h1 = q->hi[1], h2 = q->hi[2];
+    for (size_t k = 0; k < n; k++) {
+        double u, v, gx, gy, gz, ex, ey, ez;
+        u = x[k] - h0, v = l0 - x[k], gx = u > v ? u : v, gx = gx > 0 ? gx : 0, ex = u > v ? -v : -u;
+        u = y[k] - h1, v = l1 - y[k], gy = u > v ? u : v, gy = gy > 0 ? gy : 0, ey = u > v ? -v : -u;
+        u = z[k] - h2, v = l2 - z[k], gz = u > v ? u : v, gz = gz > 0 ? gz : 0, ez = u > v ? -v : -u;
+        lb[k] = gx * gx + gy * gy + gz * gz;
+        double ub = ex * ex + ey * ey + ez * ez;
+        V = ub < V ? ub : V;
+    }
+    return V;
 }
 
 /* The points of the buckets listed in cd that can be the answer of a
@@ -1165,25 +1227,25 @@ HD__INLINE void plist_pad(plist_t *l) {
  * node_ub2 of a listed point from the box, bounds every such answer too
  * (the point is within V of each query), and a point whose bound from
  * the box is above min(U, V) is farther than that answer.  Returns 0 when
- * the buckets hold more than POINT_LIST points (then nothing is listed). */
+ * the buckets hold more than POINT_LIST points (then nothing is listed).
+ * The bounds are taken first, over each bucket's points where t stores
+ * them, and only the points kept are copied. */
 static int group_points(const hd__an_t *t, const cands_t *cd, const hd__box_t *q, double U, plist_t *out) {
-    size_t total = 0;
-    for (size_t r = 0; r < cd->n; r++) total += t->stop[cd->bucket[r]] - t->start[cd->bucket[r]];
-    if (total > POINT_LIST) return 0;
+    if (listed_points(t, cd) > POINT_LIST) return 0;
     double lb[POINT_LIST], V = U;
     size_t m = 0;
+    for (size_t r = 0; r < cd->n; r++) {
+        size_t k0 = t->start[cd->bucket[r]], e = t->stop[cd->bucket[r]];
+        V = span_bounds(q, t->x + k0, t->y + k0, t->z + k0, e - k0, lb + m, V);
+        m += e - k0;
+    }
+    size_t n = 0;
+    m = 0;
     for (size_t r = 0; r < cd->n; r++)
         for (size_t k = t->start[cd->bucket[r]]; k < t->stop[cd->bucket[r]]; k++, m++) {
-            double ub;
-            point_bounds(q, t->x[k], t->y[k], t->z[k], &lb[m], &ub);
-            V = ub < V ? ub : V;
-            out->x[m] = t->x[k], out->y[m] = t->y[k], out->z[m] = t->z[k], out->idx[m] = t->idx[k];
+            out->x[n] = t->x[k], out->y[n] = t->y[k], out->z[n] = t->z[k], out->idx[n] = t->idx[k];
+            n += lb[m] <= V;
         }
-    size_t n = 0;
-    for (size_t k = 0; k < m; k++) {
-        out->x[n] = out->x[k], out->y[n] = out->y[k], out->z[n] = out->z[k], out->idx[n] = out->idx[k];
-        n += lb[k] <= V;
-    }
     out->n = n;
     return 1;
 }
@@ -1191,12 +1253,8 @@ static int group_points(const hd__an_t *t, const cands_t *cd, const hd__box_t *q
 /* The points of `from` that can be the answer of a query in the box q
  * (a chunk of the group's, answers at most U), the same way, into out. */
 static void chunk_points(const plist_t *from, const hd__box_t *q, double U, plist_t *out) {
-    double lb[POINT_LIST], V = U;
-    for (size_t k = 0; k < from->n; k++) {
-        double ub;
-        point_bounds(q, from->x[k], from->y[k], from->z[k], &lb[k], &ub);
-        V = ub < V ? ub : V;
-    }
+    double lb[POINT_LIST];
+    double V = span_bounds(q, from->x, from->y, from->z, from->n, lb, U);
     size_t n = 0;
     for (size_t k = 0; k < from->n; k++) {
         out->x[n] = from->x[k], out->y[n] = from->y[k], out->z[n] = from->z[k], out->idx[n] = from->idx[k];
@@ -1220,10 +1278,12 @@ HD__INLINE void scan_points(const plist_t *l, double qx, double qy, double qz, d
  * chunk's own list holds the group's candidates within Uc of the chunk's
  * box, Uc = min(U, the chunk's largest best), which bounds the answer of
  * each of its queries (each answer is at most U and at most its best);
- * a short group list is used as it is.  Returns how many answers were
- * the partners (for the partner path's upkeep). */
+ * a short group list is used as it is.  `scanned` says whether the
+ * seed buckets and `near` were scanned for every query (the seed path;
+ * not for a far group, seed_bests).  Returns how many answers were the
+ * partners (for the partner path's upkeep). */
 HD__INLINE size_t qgroup_finish(query_ctx *c, cands_t *cd, cands_t *ck, qgroup_t *G, double U, int paired,
-                                int windowed, size_t near) {
+                                int windowed, size_t near, int scanned) {
     const hd__an_t *q = c->q, *t = c->t;
     size_t first = G->first, kept = 0, napart = 0, nlisted = 0;
     uint32_t apart[HD__AN_GROUP], listed[HD__AN_GROUP];
@@ -1249,9 +1309,7 @@ HD__INLINE size_t qgroup_finish(query_ctx *c, cands_t *cd, cands_t *ck, qgroup_t
      * chunk by chunk, while the chunks' lists stay short.  (Which groups
      * try decides only the cost.) */
     plist_t gp, cp;
-    double diag2 = 0;
-    for (int d = 0; d < 3; d++) diag2 += (G->box.hi[d] - G->box.lo[d]) * (G->box.hi[d] - G->box.lo[d]);
-    int points = nlisted >= 2 * CHUNK && diag2 <= 4 * U && group_points(t, cd, &G->box, U, &gp);
+    int points = nlisted >= 2 * CHUNK && qgroup_diag2(G) <= 4 * U && group_points(t, cd, &G->box, U, &gp);
     for (size_t r0 = 0; r0 < nlisted; r0 += CHUNK) {
         size_t r1 = r0 + CHUNK < nlisted ? r0 + CHUNK : nlisted;
         const cands_t *list = cd;
@@ -1291,7 +1349,7 @@ HD__INLINE size_t qgroup_finish(query_ctx *c, cands_t *cd, cands_t *ck, qgroup_t
             double qx = q->x[first + k], qy = q->y[first + k], qz = q->z[first + k];
             cands_t *l = (cands_t *)list;
             if (seeded[k]) finish_query(t, l, qx, qy, qz, U, G->seed[k], G->seed[k] + SEEDS, SIZE_MAX, &G->best[k], &G->bj[k]);
-            else if (paired) finish_query(t, l, qx, qy, qz, U, 0, 0, SIZE_MAX, &G->best[k], &G->bj[k]);
+            else if (paired || !scanned) finish_query(t, l, qx, qy, qz, U, 0, 0, SIZE_MAX, &G->best[k], &G->bj[k]);
             else finish_query(t, l, qx, qy, qz, U, G->seed[k], G->seed[k] + SEEDS, near, &G->best[k], &G->bj[k]);
             c->sd[first + k] = G->best[k];
             c->sj[first + k] = G->bj[k];
@@ -1344,8 +1402,8 @@ HD__INLINE void solo_query(query_ctx *c, cands_t *cd, size_t k, size_t *b, size_
  * index) is usually at or next to its answer.  Its distance is a real
  * point's, so the largest over the group bounds every answer; if few
  * buckets lie within it, they are the candidates and no seed is scanned.
- * Otherwise the partners still stand as first answers for the seeds to
- * improve on.
+ * Otherwise the partners still stand as first answers for the window (or
+ * the seeds) to improve on.
  *
  * The window path: a near-copy in another order (or two sets sampled
  * alike) puts each query's answer at about its own place on t's curve,
@@ -1381,37 +1439,47 @@ HD__HOT static void query_task(void *vctx, size_t task, int worker) {
             G.first = first;
             G.m = q->gstart[g + 1] - first < HD__AN_GROUP ? q->gstart[g + 1] - first : HD__AN_GROUP;
             qgroup_box(q, &G);
-            double U = 0;
-            int paired = 0, windowed = 0, seeded = 0;
+            double U = 0, lb0 = node_lb2(&G.box, t, 0);
+            int paired = 0, windowed = 0, seeded = 0, scanned = 1;
+            size_t near = SIZE_MAX;
             for (size_t k = 0; k < G.m; k++) G.best[k] = INFINITY, G.bj[k] = UINT32_MAX;
-            if ((c->partner || c->pair_at) && (tried < PAIR_TRIAL || 2 * kept_groups >= tried)) {
+            if (lb0 >= qgroup_diag2(&G)) {
+                /* Outside t's box by its own diagonal: maybe a far group. */
+                U = INFINITY;
+                near = nearest_leaf(t, &G.box, &U);
+                scanned = !far_group(t, &G, lb0, U, cd);
+            }
+            if (scanned && (c->partner || c->pair_at) && (tried < PAIR_TRIAL || 2 * kept_groups >= tried)) {
                 U = partner_bests(c, &psrc, &G);
                 paired = candidates(t, &G.box, U, PAIR_CANDIDATES, cd);
                 tried++;
                 cd->counts.paired += (size_t)paired;
-            } else if (wtried < PAIR_TRIAL || 2 * wkept >= wtried) {
+            }
+            /* The partners' distances are real points': the window improves
+             * on them when they listed too many candidates. */
+            if (scanned && !paired && (wtried < PAIR_TRIAL || 2 * wkept >= wtried)) {
                 qgroup_seeds(q, t, &G, &h, &s0);
                 seeded = 1;
                 size_t apart;
                 U = window_bests(q, t, &G, &apart);
-                if (8 * apart <= G.m) paired = candidates(t, &G.box, U, PAIR_CANDIDATES, cd);
+                if (8 * apart <= G.m) paired = candidates(t, &G.box, U, WINDOW_CANDIDATES, cd);
                 windowed = paired;
                 wtried++;
                 wkept += (size_t)paired;
                 cd->counts.windowed += (size_t)paired;
             }
-            size_t near = SIZE_MAX;
-            if (!paired && !candidates(t, &G.box, 0, G.m, cd)) {
+            if (!paired && scanned && !candidates(t, &G.box, 0, G.m, cd)) {
                 /* Spread over more of t's buckets than it has queries. */
                 for (size_t k = first, wb = 0, wp = 0; k < first + G.m; k++) solo_query(c, cd, k, &wb, &wp);
                 cd->counts.solo += G.m;
                 continue;
             }
-            if (!paired) {
+            if (!paired && scanned) {
                 if (!seeded) qgroup_seeds(q, t, &G, &h, &s0);
-                near = seed_bests(q, t, &G, cd, &U);
+                near = seed_bests(q, t, &G, cd, &U, &scanned);
             }
-            size_t kept = qgroup_finish(c, cd, ck, &G, U, paired, windowed, near);
+            cd->counts.far += (size_t)!scanned;
+            size_t kept = qgroup_finish(c, cd, ck, &G, U, paired, windowed, near, scanned);
             /* The path pays when the partners are the answers (a copy), not
              * merely near enough to list few candidates (a few buckets of
              * repeated points): it is kept on while at least half of the
@@ -1493,6 +1561,7 @@ static int nearest_run(const hd__an_t *asking, const hd__an_t *searched, const h
         counts->apart += c.cand[w].counts.apart;
         counts->solo += c.cand[w].counts.solo;
         counts->pointed += c.cand[w].counts.pointed;
+        counts->far += c.cand[w].counts.far;
     }
     cands_free(c.cand, 2 * threads);
     free(c.sd);

@@ -86,6 +86,8 @@ typedef struct hd__an_counts {
     size_t apart;    /* queries of those searched on their own */
     size_t solo;     /* queries of sparse groups, each searched on its own */
     size_t pointed;  /* queries answered from a chunk's list of candidate points */
+    size_t far;      /* far groups: candidates within a bound from boxes alone, no
+                      * seed scanned (allnearest.c, "Far groups") */
 } hd__an_counts_t;
 
 /* For every point of `asking`, the exact nearest distance to `searched`

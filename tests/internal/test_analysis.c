@@ -632,6 +632,65 @@ TEST(the_window_gives_up_on_disjoint_sets_and_stays_exact) {
     }
 }
 
+TEST(far_groups_are_answered_from_boxes_alone_and_stay_exact) {
+    /* A group of queries far from the searched set (its box outside the
+     * set's box by more than its own diagonal) lists the buckets within
+     * the nearest leaf's bound and scans no seed: a lattice with copies
+     * asking a small lattice cluster 40 away whose coordinates sit half
+     * way between A's (so A's points at y or z = 1, 2 have two nearest
+     * points: the smaller index must win), and Gaussians 20 sigma apart.
+     * Both directions, every answer against the brute force, at 1 and 3
+     * threads. */
+    size_t far = 0;
+    for (uint64_t seed = 39000; seed < 39008 && !hdt_failed(); seed++) {
+        gen_rng_t g;
+        gen_seed(&g, seed);
+        int threads = seed % 2 ? 1 : 3, lattice = seed % 4 < 2;
+        size_t na = 3000 + gen_u64(&g) % 3000, nb = lattice ? 100 + gen_u64(&g) % 300 : na;
+        CONTEXT("seed=%llu na=%zu nb=%zu threads=%d lattice=%d", (unsigned long long)seed, na, nb, threads, lattice);
+        double *a = malloc(24 * na), *b = malloc(24 * nb), m0[3] = {0, 0, 0}, m1[3] = {20, 0, 0};
+        if (lattice) {
+            gen_lattice(&g, a, na, 16);
+            gen_lattice(&g, b, nb, 3);
+            for (size_t k = 0; k < nb; k++) b[3 * k] += 40, b[3 * k + 1] += 0.5, b[3 * k + 2] += 0.5;
+        } else {
+            gen_gauss(&g, a, na, m0, 1.0);
+            gen_gauss(&g, b, nb, m1, 1.0);
+        }
+        double *both = malloc(24 * (na + nb));
+        memcpy(both, a, 24 * na), memcpy(both + 3 * na, b, 24 * nb);
+        hd__box_t box;
+        hd__box_of(both, na + nb, &box);
+        hd_points_t A = hd_points_f64(a, na), B = hd_points_f64(b, nb);
+        hd__an_t s[2];
+        CHECK_RC(hd__an_build(&s[0], &A, NULL, &box, threads, NULL), HD_OK);
+        CHECK_RC(hd__an_build(&s[1], &B, NULL, &box, threads, NULL), HD_OK);
+        for (int dir = 0; dir < 2 && !hdt_failed(); dir++) {
+            const double *p = dir ? b : a, *o = dir ? a : b;
+            size_t np = dir ? nb : na, no = dir ? na : nb;
+            double *d = malloc(8 * np);
+            size_t *j = malloc(sizeof(size_t) * np);
+            hd__an_counts_t c = {0};
+            CHECK_RC(hd__an_nearest(&s[dir], &s[1 - dir], NULL, threads, d, j, &c, NULL), HD_OK);
+            far += c.far;
+            for (size_t i = 0; i < np && !hdt_failed(); i++) {
+                size_t jo;
+                double d2 = brute_nearest(p + 3 * i, o, no, &jo);
+                CONTEXT("seed=%llu %s query %zu (far groups %zu)", (unsigned long long)seed, dir ? "B->A" : "A->B", i,
+                        c.far);
+                CHECK_BITS(d[i], sqrt(d2));
+                CHECK_EQ(j[i], jo);
+            }
+            free(d), free(j);
+        }
+        hd__an_free(&s[0]);
+        hd__an_free(&s[1]);
+        free(a), free(b), free(both);
+    }
+    CONTEXT("far groups: %zu", far);
+    CHECK(far > 0);
+}
+
 TEST(same_order_copies_in_strided_and_float32_views_read_the_right_partners) {
     /* The partners are read from the caller's views: here a float32 view
      * with a 20-byte stride and a double view with a coordinate stride.  A
