@@ -158,6 +158,24 @@ static void field_case(const char *dir, const char *name, const lazw_opts_t *o, 
     free(v);
 }
 
+
+/* The expected lines of a case: each kept record in hexadecimal, then its
+ * nf values' bytes (kept: all, or those whose first value is > 0.25 when
+ * `subset`); f is closed. */
+static void expected_records(FILE *f, const unsigned char *recs, size_t rec, const double *v, size_t n, size_t nf,
+                             int subset) {
+    for (size_t k = 0; k < n; k++) {
+        if (subset && !(v[k] > 0.25)) continue;
+        for (size_t i = 0; i < rec; i++) fprintf(f, "%02x", recs[k * rec + i]);
+        for (size_t j = 0; j < nf; j++) {
+            unsigned char val[8];
+            memcpy(val, &v[j * n + k], 8);
+            for (int i = 0; i < 8; i++) fprintf(f, "%02x", val[i]);
+        }
+        fputc('\n', f);
+    }
+    if (fclose(f)) exit(1);
+}
 /* The record case NAME: see the top of the file. */
 static void record_case(const char *dir, const char *name, int fmt, unsigned extra, int subset, uint64_t seed, size_t n,
                         size_t nf) {
@@ -176,17 +194,7 @@ static void record_case(const char *dir, const char *name, int fmt, unsigned ext
     o.keep = subset ? HD_KEEP_FARTHER : HD_KEEP_ALL;
     o.threshold = 0.25;
     FILE *f = write_field_of(dir, name, &b, v, n, nf, &o);
-    for (size_t k = 0; k < n; k++) {
-        if (subset && !(v[k] > 0.25)) continue;
-        for (size_t i = 0; i < rec; i++) fprintf(f, "%02x", recs[k * rec + i]);
-        for (size_t j = 0; j < nf; j++) {
-            unsigned char val[8];
-            memcpy(val, &v[j * n + k], 8);
-            for (int i = 0; i < 8; i++) fprintf(f, "%02x", val[i]);
-        }
-        fputc('\n', f);
-    }
-    if (fclose(f)) exit(1);
+    expected_records(f, recs, rec, v, n, nf, subset);
     printf("%s\n", name);
     tf_free(&b);
     free(recs);
@@ -226,17 +234,7 @@ static void record14_case(const char *dir, const char *name, int fmt, unsigned e
         snprintf(path, sizeof path, "%s/%s.txt", dir, name);
         if (!(f = fopen(path, "w"))) exit(1);
     }
-    for (size_t k = 0; k < n; k++) {
-        if (subset && !(v[k] > 0.25)) continue;
-        for (size_t i = 0; i < rec; i++) fprintf(f, "%02x", recs[k * rec + i]);
-        for (size_t j = 0; j < nf; j++) {
-            unsigned char val[8];
-            memcpy(val, &v[j * n + k], 8);
-            for (int i = 0; i < 8; i++) fprintf(f, "%02x", val[i]);
-        }
-        fputc('\n', f);
-    }
-    if (fclose(f)) exit(1);
+    expected_records(f, recs, rec, v, n, nf, subset);
     printf("%s\n", name);
     tf_free(&b);
     free(recs);
