@@ -158,7 +158,6 @@ static void field_case(const char *dir, const char *name, const lazw_opts_t *o, 
     free(v);
 }
 
-
 /* The expected lines of a case: each kept record in hexadecimal, then its
  * nf values' bytes (kept: all, or those whose first value is > 0.25 when
  * `subset`); f is closed. */
