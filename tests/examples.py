@@ -159,6 +159,9 @@ def make_fixtures(d, tool, mpi_tool):
             f.write("tiles2024/t%d.xyz\n" % t)
     shutil.copy(os.path.join(DATA, "orig", "Wuson.stl"), os.path.join(d, "part.stl"))
     shutil.copy(os.path.join(DATA, "orig", "Haystack_Rock.las"), os.path.join(d, "scan.las"))
+    lazperf = os.path.join(ROOT, "tests", "laz_lazperf")  # layered LAZ 1.4 whose every field varies
+    shutil.copy(os.path.join(lazperf, "record_format6_channels_v4.laz"), os.path.join(d, "epoch1.laz"))
+    shutil.copy(os.path.join(lazperf, "record_format7_v4.laz"), os.path.join(d, "epoch2.laz"))
     sp = (0.8, 0.8, 0.8)
     write_nifti(os.path.join(d, "seg.nii.gz"), ball((40, 40, 30), (20, 20, 15), 9), pixdim=sp)
     write_nifti(os.path.join(d, "truth.nii.gz"), ball((40, 40, 30), (21, 19, 15), 10), pixdim=sp)
