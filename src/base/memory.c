@@ -179,14 +179,14 @@ static void reuse_release(hd__reuse_t *pool, void *p) {
  * - the request is at most half a chunk, so the chunk it opens can take a
  *   second array of its size; a larger one, which would leave a tail no
  *   array of its kind fits, gets a block of its own at its bytes;
- * - the pool already holds at least a chunk and a half in other blocks,
- *   so a chunk, however little of it is cut, is at most two fifths of what
- *   the pool holds once it is mapped.  Calls on a few hundred thousand
- *   points a set thus hold their middle-sized arrays at their bytes; larger
- *   ones, whose middle-sized arrays come after their large ones, keep the
- *   one fault a 2 MiB chunk costs. */
+ * - and either the request fills at least a quarter of the chunk, or the
+ *   pool already holds at least a chunk and a half in other blocks, so
+ *   that a chunk, however little of it is cut, is at most two fifths of
+ *   what the pool holds once it is mapped.  A small array that comes first
+ *   in a small call (under a quarter chunk, with little held) thus gets a
+ *   block at its bytes instead of a chunk it would barely use. */
 static int chunk_opens(size_t held, size_t need) {
-    return need <= HUGE_ALIGN / 2 && held >= HUGE_ALIGN + HUGE_ALIGN / 2;
+    return need <= HUGE_ALIGN / 2 && (need >= HUGE_ALIGN / 4 || held >= HUGE_ALIGN + HUGE_ALIGN / 2);
 }
 
 /* Middle-sized blocks (REUSE_SMALL up to HUGE_MIN bytes: a grid's cell

@@ -102,8 +102,10 @@ TEST(blocks_mapped_whole_or_cut_from_chunks_never_overlap) {
  * pool that holds less than a chunk and a half (a call on a few hundred
  * thousand points), never for an array of more than half a chunk (it would
  * leave a tail that no array of its kind fits); those get blocks of their
- * own, held at their bytes.  A pool that holds more cuts its small arrays
- * from a chunk as before (one fault for the lot). */
+ * own, held at their bytes.  An array of a quarter to a half of a chunk,
+ * which fills that much of it, opens one in any pool; a pool that holds a
+ * chunk and a half cuts its small arrays from a chunk as before (one fault
+ * for the lot). */
 TEST(a_chunk_is_mapped_only_where_the_call_needs_what_it_holds) {
     hd__reuse_t r;
     hd__reuse_init(&r);
@@ -127,6 +129,14 @@ TEST(a_chunk_is_mapped_only_where_the_call_needs_what_it_holds) {
     hd__reuse_put(&r, w);
     hd__reuse_put(&r, c);
     hd__reuse_put(&r, a);
+    hd__reuse_free(&r);
+    CHECK(r.held == 0 && r.n_chunks == 0);
+    hd__reuse_init(&r);
+    size_t quarter = 600000;
+    unsigned char *q = hd__reuse_get(&r, quarter, 1);
+    CHECK(q != NULL && r.n_chunks == 1 && r.cut_out == 1);
+    memset(q, 4, quarter);
+    hd__reuse_put(&r, q);
     hd__reuse_free(&r);
     CHECK(r.held == 0 && r.n_chunks == 0);
 }
