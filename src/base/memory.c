@@ -29,7 +29,8 @@
  *
  * Fresh blocks of the reuse set are mapped in transparent huge pages where
  * the kernel gives them: large blocks each on their own (huge_map), middle-
- * sized ones cut from the set's 2 MiB chunks (chunk_get).  A block's pages
+ * sized ones cut from the set's 2 MiB chunks (chunk_get) where the chunks
+ * are not more than the call needs (chunk_opens), else from malloc.  A block's pages
  * are then 2 MiB, one fault each instead of 512.  Every block, however it
  * was made, starts REUSE_HEADER bytes after its header and is released by
  * reuse_release, which knows from the header how.
@@ -171,17 +172,35 @@ static void reuse_release(hd__reuse_t *pool, void *p) {
     else free(h);
 }
 
+/* Whether a request of `need` bytes (header included) that the open chunk
+ * cannot take maps a fresh 2 MiB chunk, while the pool holds `held` bytes.
+ * A chunk is held and charged whole (its huge page is resident whole), so
+ * it is mapped only where the arrays cut from it are what the call needs:
+ * - the request is at most half a chunk, so the chunk it opens can take a
+ *   second array of its size; a larger one, which would leave a tail no
+ *   array of its kind fits, gets a block of its own at its bytes;
+ * - and either the request fills at least a quarter of the chunk, or the
+ *   pool already holds at least a chunk and a half in other blocks, so
+ *   that a chunk, however little of it is cut, is at most two fifths of
+ *   what the pool holds once it is mapped.  A small array that comes first
+ *   in a small call (under a quarter chunk, with little held) thus gets a
+ *   block at its bytes instead of a chunk it would barely use. */
+static int chunk_opens(size_t held, size_t need) {
+    return need <= HUGE_ALIGN / 2 && (need >= HUGE_ALIGN / 4 || held >= HUGE_ALIGN + HUGE_ALIGN / 2);
+}
+
 /* Middle-sized blocks (REUSE_SMALL up to HUGE_MIN bytes: a grid's cell
  * tables, the counting sorts' counts) are cut one after another from 2 MiB
  * chunks of the pool, mapped as huge pages by huge_map: one fault for the
  * lot instead of one per 4 KiB page.  They go back to the pool's list like
  * any block, and their memory is unmapped with the pool.  NULL when the
  * pool has no chunk left or none can be mapped (the caller then uses
- * malloc). */
+ * malloc), and when a chunk would hold more than the call needs
+ * (chunk_opens). */
 static void *chunk_get(hd__reuse_t *pool, size_t bytes) {
     size_t need = REUSE_HEADER + ((bytes + REUSE_HEADER - 1) & ~(size_t)(REUSE_HEADER - 1));
     if (!pool->n_chunks || HUGE_ALIGN - pool->chunk_used < need) {
-        if (pool->n_chunks == HD__REUSE_CHUNKS) return NULL;
+        if (pool->n_chunks == HD__REUSE_CHUNKS || !chunk_opens(pool->held, need)) return NULL;
         /* Not prefaulted when the kernel gives small pages: only the
          * pieces cut from it are touched, each on first write. */
         void *c = huge_map(HUGE_ALIGN, 0);

@@ -97,13 +97,59 @@ TEST(blocks_mapped_whole_or_cut_from_chunks_never_overlap) {
  * 2 MiB pages only, where it has them) and stays writable up to it; blocks given back stay held until the set is trimmed;
  * a trim gives the chunks back too once no block cut from them is in use;
  * the peak survives hd__reuse_free. */
+/* A 2 MiB chunk is held and charged whole, so middle-sized arrays are cut
+ * from one only where the chunk is not more than the call needs: never in a
+ * pool that holds less than a chunk and a half (a call on a few hundred
+ * thousand points), never for an array of more than half a chunk (it would
+ * leave a tail that no array of its kind fits); those get blocks of their
+ * own, held at their bytes.  An array of a quarter to a half of a chunk,
+ * which fills that much of it, opens one in any pool; a pool that holds a
+ * chunk and a half cuts its small arrays from a chunk as before (one fault
+ * for the lot). */
+TEST(a_chunk_is_mapped_only_where_the_call_needs_what_it_holds) {
+    hd__reuse_t r;
+    hd__reuse_init(&r);
+    size_t mid = 100000, wide = 1600000, big = (size_t)4 << 20;
+    unsigned char *m = hd__reuse_get(&r, mid, 1);
+    CHECK(m != NULL && r.n_chunks == 0);
+    CHECK(r.held >= mid && r.held <= mid + 4096); /* its bytes and a header */
+    memset(m, 1, mid);
+    unsigned char *a = hd__reuse_get(&r, big, 1);
+    CHECK(a != NULL);
+    size_t held = r.held;
+    unsigned char *w = hd__reuse_get(&r, wide, 1);
+    CHECK(w != NULL && r.n_chunks == 0);
+    CHECK(r.held - held >= wide && r.held - held <= wide + 4096);
+    memset(w, 2, wide);
+    unsigned char *c = hd__reuse_get(&r, mid, 1);
+    CHECK(c != NULL && r.n_chunks == 1 && r.cut_out == 1);
+    memset(c, 3, mid);
+    CHECK(m[mid - 1] == 1 && w[wide - 1] == 2 && c[mid - 1] == 3);
+    hd__reuse_put(&r, m);
+    hd__reuse_put(&r, w);
+    hd__reuse_put(&r, c);
+    hd__reuse_put(&r, a);
+    hd__reuse_free(&r);
+    CHECK(r.held == 0 && r.n_chunks == 0);
+    hd__reuse_init(&r);
+    size_t quarter = 600000;
+    unsigned char *q = hd__reuse_get(&r, quarter, 1);
+    CHECK(q != NULL && r.n_chunks == 1 && r.cut_out == 1);
+    memset(q, 4, quarter);
+    hd__reuse_put(&r, q);
+    hd__reuse_free(&r);
+    CHECK(r.held == 0 && r.n_chunks == 0);
+}
+
 /* hd__reuse_take trims every kept block but the one that serves the
  * request; when that one was cut from a chunk, the chunk must stay mapped
  * (it once was unmapped under it: a crash in the engine's build). */
 TEST(taking_a_kept_block_cut_from_a_chunk_keeps_its_chunk) {
     hd__reuse_t r;
     hd__reuse_init(&r);
-    size_t mid = 200000;
+    size_t mid = 200000, big = (size_t)4 << 20;
+    unsigned char *a = hd__reuse_get(&r, big, 1); /* a pool large enough for chunks */
+    CHECK(a != NULL);
     unsigned char *m = hd__reuse_get(&r, mid, 1); /* cut from a chunk */
     CHECK(m != NULL && r.n_chunks == 1);
     memset(m, 6, mid);
@@ -114,6 +160,7 @@ TEST(taking_a_kept_block_cut_from_a_chunk_keeps_its_chunk) {
     memset(t, 7, mid - 1000); /* mapped: ASan or a fault says otherwise */
     CHECK_EQ(t[mid - 1001], 7);
     hd__reuse_put(&r, t);
+    hd__reuse_put(&r, a);
     hd__reuse_free(&r);
     CHECK(r.held == 0);
 }
@@ -126,6 +173,9 @@ TEST(a_set_counts_what_it_holds_and_gives_back_shrunk_tails_and_trimmed_blocks) 
     CHECK(a != NULL);
     memset(a, 3, big);
     CHECK(r.held >= big && r.peak == r.held);
+    unsigned char *m = hd__reuse_get(&r, mid, 1); /* cut from a chunk */
+    CHECK(m != NULL && r.n_chunks == 1);
+    memset(m, 5, mid);
     size_t before = r.held;
     hd__reuse_shrink(&r, a, small);
     /* Mapped on its own: the pages past `small` go back, those in 2 MiB
@@ -133,9 +183,6 @@ TEST(a_set_counts_what_it_holds_and_gives_back_shrunk_tails_and_trimmed_blocks) 
     CHECK(r.held + (big - ((size_t)2 << 20)) <= before && r.held >= small);
     memset(a, 4, small);
     CHECK_EQ(a[small - 1], 4);
-    unsigned char *m = hd__reuse_get(&r, mid, 1); /* cut from a chunk */
-    CHECK(m != NULL && r.n_chunks == 1);
-    memset(m, 5, mid);
     hd__reuse_put(&r, a);
     size_t kept = r.held;
     CHECK(kept >= small + ((size_t)2 << 20) && r.n == 1);
