@@ -35,8 +35,10 @@
 
 /* Sample points a side in all (each rank its share of its input). */
 #define PRUNE_SAMPLE 1024
-/* The points a cell's box is first taken over: one in PRUNE_STRIDE. */
+/* The points a cell's box is first taken over: one in at most
+ * PRUNE_STRIDE, at least PRUNE_FIRST a cell on average (stride_of). */
 #define PRUNE_STRIDE 16
+#define PRUNE_FIRST 32
 /* Cells a set. */
 enum { NC = HD__MPI_CELLS * HD__MPI_CELLS * HD__MPI_CELLS };
 
@@ -125,12 +127,19 @@ static void take_sample(const hd__mpi_input_t *in, const hd__mpi_prune_t *pr, co
     }
 }
 
+/* The stride of set s's first boxes (N: the sets' global sizes). */
+static size_t stride_of(const uint64_t N[2], int s) {
+    uint64_t st = N[s] / ((uint64_t)NC * PRUNE_FIRST);
+    return st < 1 ? 1 : st > PRUNE_STRIDE ? PRUNE_STRIDE : (size_t)st;
+}
+
 /* The boxes cb (2 NC boxes, hi negated, at +INFINITY on entry) of this
  * rank's points of each cell at positions of its own order that are
- * multiples of stride (1: every point; above, boxes inside the cells'). */
-static void take_boxes(const hd__mpi_input_t *in, const hd__mpi_prune_t *pr, size_t stride, double *cb) {
+ * multiples of set s's stride[s] (1: every point; above, boxes inside the
+ * cells'). */
+static void take_boxes(const hd__mpi_input_t *in, const hd__mpi_prune_t *pr, const size_t stride_[2], double *cb) {
     for (int s = 0; s < 2; s++) {
-        size_t t0 = 0;
+        size_t t0 = 0, stride = stride_[s];
         for (size_t p = 0; p < in->nparts[s]; p++) {
             const hd_points_t *v = &in->parts[s][p].points;
             const double *px = hd__mpi_packed(v);
@@ -178,13 +187,15 @@ static void sort_sample(hd__mpi_sample_t *all, size_t total, size_t from[2], siz
 
 /* L of set s (prune.c's invariants) over its sample all[from .. to): a
  * sample point whose bound is already at most L cannot raise it, and the
- * other set's cell nearest it is tried first. */
-static double lower_L(const cells_t *cl, int s, size_t from, size_t to) {
+ * other set's cell nearest it is tried first.  Once L reaches cap the
+ * rest is not looked at (the value returned is then at least cap, at most
+ * L: cap INFINITY for L itself). */
+static double lower_L(const cells_t *cl, int s, size_t from, size_t to, double cap) {
     int t = 1 - s;
     const hd__box_t *box = cl->box + (size_t)t * NC;
     const unsigned char *full = cl->full + (size_t)t * NC;
     double L = -1.0;
-    for (size_t j = from; j < to; j++) {
+    for (size_t j = from; j < to && !(L >= cap); j++) {
         const double *x = cl->all[j].x;
         size_t near = (size_t)hd__mpi_cell(cl->pr, t, x);
         if (full[near] && hd__box_lb2(&box[near], x) <= L) continue;
@@ -231,18 +242,26 @@ static void keep_cells(cells_t *cl, const double L[2], int both, size_t *todo, u
     }
 }
 
-/* Whether no asked cell can pass, from boxes inside the cells' (every
- * STRIDE-th point's) and their L' (lower_L over them): each box holds a
- * cell's true box's points only, so L' >= L and a nonempty one's half
- * diagonal is at most the true box's; a cell whose box here has L' below
- * half its squared half diagonal is kept by keep_cells whatever its U.
- * A cell empty here is not proved (it holds points between the strided
- * ones only); its points then move, as without the cells. */
-static int none_can_pass(const hd__box_t *box, const unsigned char *full, const double L[2], int both) {
-    for (int s = 0; s < (both ? 2 : 1); s++)
+/* Whether no asked cell can pass (both: the symmetric call; the directed
+ * one is not tried), from boxes inside the cells' (every stride_of-th
+ * point's) and their L' (lower_L over them): each box holds a cell's true
+ * box's points only, so L' >= L and a nonempty one's half diagonal is at
+ * most the true box's; a cell whose box here has L' below half its
+ * squared half diagonal is kept by keep_cells whatever its U.  So L' is
+ * sought only up to the smallest such half (cap).  A cell empty here is
+ * not proved (it holds points between the strided ones only); its points
+ * then move, as without the cells. */
+static int none_can_pass(const cells_t *cl, const size_t from[2], const size_t to[2], int both) {
+    for (int s = 0; s < (both ? 2 : 0); s++) {
+        double cap = INFINITY;
         for (size_t k = 0; k < NC; k++)
-            if (full[s * NC + k] && !(L[s] < 0.5 * half_diag2(&box[s * NC + k]))) return 0;
-    return 1;
+            if (cl->full[s * NC + k]) {
+                double h = 0.5 * half_diag2(&cl->box[s * NC + k]);
+                cap = h < cap ? h : cap;
+            }
+        if (!(lower_L(cl, s, from[s], to[s], cap) < cap)) return 0;
+    }
+    return both;
 }
 
 int hd__mpi_prune(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const uint64_t N[2], const double corners[2][6], int both,
@@ -263,7 +282,8 @@ int hd__mpi_prune(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const uint64_t N[
     hd__mpi_sample_t *all = NULL;
     double *U = hd__mpi_alloc(c, 2 * NC, sizeof(double));
     size_t (*at)[NC + 1] = hd__mpi_alloc(c, 2, sizeof *at), *todo = hd__mpi_alloc(c, 2 * NC, sizeof(size_t));
-    size_t total = 0;
+    /* the directed call takes the true boxes at once (none_can_pass) */
+    size_t total = 0, stride[2] = {both ? stride_of(N, 0) : 1, both ? stride_of(N, 1) : 1}, every[2] = {1, 1};
     hd__box_t *box = (hd__box_t *)(void *)cb;          /* the global cell boxes, read from gb */
     unsigned char *full = (unsigned char *)(void *)gb; /* gb read into box first */
     if (!cb || !gb || !own || !cnt || !U || !at || !todo) rc = hd__mpi_nomem(c, "the cells", NC);
@@ -271,7 +291,7 @@ int hd__mpi_prune(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const uint64_t N[
         for (size_t k = 0; k < 2 * NC; k++)
             for (int a = 0; a < 6; a++) cb[6 * k + a] = INFINITY;
         take_sample(in, pr, mine, own);
-        take_boxes(in, pr, PRUNE_STRIDE, cb);
+        take_boxes(in, pr, stride, cb);
     }
     if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
     HD__MPI_GO(c, rc, MPI_Allreduce(cb, gb, 2 * NC * 6, MPI_DOUBLE, MPI_MIN, c->comm));
@@ -289,16 +309,17 @@ int hd__mpi_prune(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const uint64_t N[
     for (size_t k = 0; k < 2 * NC; k++) U[k] = -1.0; /* not computed: cell_u */
     cells_t cl = {pr, box, full, all, at, U};
     read_boxes(gb, box, full);
-    double L[2] = {lower_L(&cl, 0, from[0], to[0]), lower_L(&cl, 1, from[1], to[1])};
-    if (both && none_can_pass(box, full, L, both)) goto done; /* pr->on 0: every point moves */
-    for (size_t k = 0; k < 2 * NC; k++)
-        for (int a = 0; a < 6; a++) cb[6 * k + a] = INFINITY;
-    take_boxes(in, pr, 1, cb);
-    HD__MPI_GO(c, rc, MPI_Allreduce(cb, gb, 2 * NC * 6, MPI_DOUBLE, MPI_MIN, c->comm));
-    /* Then L over the true boxes, U as the cells need it (the smallest
-     * found: a larger one would keep more cells). */
-    read_boxes(gb, box, full);
-    L[0] = lower_L(&cl, 0, from[0], to[0]), L[1] = lower_L(&cl, 1, from[1], to[1]);
+    if (none_can_pass(&cl, from, to, both)) goto done; /* pr->on 0: every point moves */
+    if (stride[0] > 1 || stride[1] > 1) { /* else the boxes are the true ones already */
+        for (size_t k = 0; k < 2 * NC; k++)
+            for (int a = 0; a < 6; a++) cb[6 * k + a] = INFINITY;
+        take_boxes(in, pr, every, cb);
+        HD__MPI_GO(c, rc, MPI_Allreduce(cb, gb, 2 * NC * 6, MPI_DOUBLE, MPI_MIN, c->comm));
+        read_boxes(gb, box, full);
+    }
+    double L[2] = {lower_L(&cl, 0, from[0], to[0], INFINITY), lower_L(&cl, 1, from[1], to[1], INFINITY)};
+    /* Then U as the cells need it (the smallest found: a larger one would
+     * keep more cells). */
     keep_cells(&cl, L, both, todo, pr->keep);
     pr->on = 1;
 done:
