@@ -22,9 +22,10 @@
 #    samples bounded.  The same K as mpi_api.
 #  - mpi_shapes_K: tests/api/mpi_shapes.c under `mpirun -n K`: the shapes
 #    of issue 41 (cubes far apart and 2 apart, a tiny side both ways, a
-#    tower in one epoch, a lattice against its half-step shift) give
-#    hd_hausdorff's and hd_directed's answers bit for bit, and at most 2 %
-#    of the points are forwarded.  The same K as mpi_api.
+#    tower in one epoch, a lattice against its half-step shift, cubes
+#    overlapping by half) give hd_hausdorff's and hd_directed's answers bit
+#    for bit, at most 2 % of the points are forwarded, and the cells
+#    (src/mpi/prune.c) save bytes where some can pass.  The same K as mpi_api.
 #  - mpi_tiny_K: tests/api/mpi_tiny.c under `mpirun -n K`: a tiny side
 #    replicated on every rank (src/mpi/tiny.c), both ways, with ties
 #    across ranks: results and per-point answers bit for bit, and only the

@@ -35,6 +35,10 @@
 
 /* Sample points a side in all (each rank its share of its input). */
 #define PRUNE_SAMPLE 1024
+/* The points a cell's box is first taken over: one in at most
+ * PRUNE_STRIDE, at least PRUNE_FIRST a cell on average (stride_of). */
+#define PRUNE_STRIDE 16
+#define PRUNE_FIRST 32
 /* Cells a set. */
 enum { NC = HD__MPI_CELLS * HD__MPI_CELLS * HD__MPI_CELLS };
 
@@ -100,37 +104,68 @@ static double half_diag2(const hd__box_t *b) {
 
 static size_t share(uint64_t n, uint64_t N) { return N <= PRUNE_SAMPLE ? (size_t)n : (size_t)(n * PRUNE_SAMPLE / N); }
 
-/* This rank's points into the cells' boxes cb (2 NC boxes, hi negated, at
- * +INFINITY on entry) and its share of the sample into own (mine[s] of
- * set s, evenly spaced in its own order; a point's g holds its cell). */
-static void take_cells(const hd__mpi_input_t *in, const hd__mpi_prune_t *pr, const size_t mine[2], double *cb,
-                       hd__mpi_sample_t *own) {
+/* This rank's share of each set's sample into own (mine[s] of set s, at
+ * positions i n / ns of its own order; a point's g holds its cell). */
+static void take_sample(const hd__mpi_input_t *in, const hd__mpi_prune_t *pr, const size_t mine[2],
+                        hd__mpi_sample_t *own) {
     size_t o = 0;
     for (int s = 0; s < 2; s++) {
-        size_t t = 0, i = 0, ns = mine[s];
-        uint64_t n = in->n[s], next = 0; /* the share's next position: i n / ns */
+        size_t i = 0, ns = mine[s];
+        uint64_t n = in->n[s], t0 = 0;
+        for (size_t p = 0; p < in->nparts[s] && i < ns; p++) {
+            const hd_points_t *v = &in->parts[s][p].points;
+            const double *px = hd__mpi_packed(v);
+            for (uint64_t next = (uint64_t)i * n / ns; i < ns && next < t0 + v->count; next = (uint64_t)i * n / ns) {
+                size_t k = (size_t)(next - t0);
+                if (px) memcpy(own[o].x, px + 3 * k, sizeof own[o].x);
+                else hd_points_get(v, k, own[o].x);
+                own[o].g = (uint64_t)hd__mpi_cell(pr, s, own[o].x), own[o].side = (uint64_t)s;
+                o++, i++;
+            }
+            t0 += v->count;
+        }
+    }
+}
+
+/* The stride of set s's first boxes (N: the sets' global sizes). */
+static size_t stride_of(const uint64_t N[2], int s) {
+    uint64_t st = N[s] / ((uint64_t)NC * PRUNE_FIRST);
+    return st < 1 ? 1 : st > PRUNE_STRIDE ? PRUNE_STRIDE : (size_t)st;
+}
+
+/* The boxes cb (2 NC boxes, hi negated, at +INFINITY on entry) of this
+ * rank's points of each cell at positions of its own order that are
+ * multiples of set s's stride[s] (1: every point; above, boxes inside the
+ * cells'). */
+static void take_boxes(const hd__mpi_input_t *in, const hd__mpi_prune_t *pr, const size_t stride_[2], double *cb) {
+    for (int s = 0; s < 2; s++) {
+        size_t t0 = 0, stride = stride_[s];
         for (size_t p = 0; p < in->nparts[s]; p++) {
             const hd_points_t *v = &in->parts[s][p].points;
             const double *px = hd__mpi_packed(v);
-            for (size_t k = 0; k < v->count; k++, t++) {
+            for (size_t k = (stride - t0 % stride) % stride; k < v->count; k += stride) {
                 double xb[3];
                 const double *x = px ? px + 3 * k : (hd_points_get(v, k, xb), xb);
-                int cell = hd__mpi_cell(pr, s, x);
-                double *b = cb + 6 * ((size_t)s * NC + (size_t)cell);
+                double *b = cb + 6 * ((size_t)s * NC + (size_t)hd__mpi_cell(pr, s, x));
                 for (int a = 0; a < 3; a++) {
                     b[a] = x[a] < b[a] ? x[a] : b[a];
                     b[3 + a] = -x[a] < b[3 + a] ? -x[a] : b[3 + a];
                 }
-                /* the share: position i n / ns for i < ns (increasing, ns <= n) */
-                if (i < ns && next == t) {
-                    memcpy(own[o].x, x, sizeof own[o].x);
-                    own[o].g = (uint64_t)cell, own[o].side = (uint64_t)s;
-                    o++, i++;
-                    next = (uint64_t)i * n / ns;
-                }
             }
+            t0 += v->count;
         }
     }
+}
+
+/* The all-reduced boxes gb (hi negated) as boxes and whether each holds a
+ * point (into box and full, which may alias cb and gb as prune() does). */
+static void read_boxes(const double *gb, hd__box_t *box, unsigned char *full) {
+    for (size_t k = 0; k < 2 * NC; k++) {
+        hd__box_t b;
+        for (int a = 0; a < 3; a++) b.lo[a] = gb[6 * k + a], b.hi[a] = -gb[6 * k + 3 + a];
+        box[k] = b;
+    }
+    for (size_t k = 0; k < 2 * NC; k++) full[k] = box[k].lo[0] <= box[k].hi[0];
 }
 
 /* The sample (total points, every rank's) by set (A's first) and cell:
@@ -152,13 +187,15 @@ static void sort_sample(hd__mpi_sample_t *all, size_t total, size_t from[2], siz
 
 /* L of set s (prune.c's invariants) over its sample all[from .. to): a
  * sample point whose bound is already at most L cannot raise it, and the
- * other set's cell nearest it is tried first. */
-static double lower_L(const cells_t *cl, int s, size_t from, size_t to) {
+ * other set's cell nearest it is tried first.  Once L reaches cap the
+ * rest is not looked at (the value returned is then at least cap, at most
+ * L: cap INFINITY for L itself). */
+static double lower_L(const cells_t *cl, int s, size_t from, size_t to, double cap) {
     int t = 1 - s;
     const hd__box_t *box = cl->box + (size_t)t * NC;
     const unsigned char *full = cl->full + (size_t)t * NC;
     double L = -1.0;
-    for (size_t j = from; j < to; j++) {
+    for (size_t j = from; j < to && !(L >= cap); j++) {
         const double *x = cl->all[j].x;
         size_t near = (size_t)hd__mpi_cell(cl->pr, t, x);
         if (full[near] && hd__box_lb2(&box[near], x) <= L) continue;
@@ -205,6 +242,28 @@ static void keep_cells(cells_t *cl, const double L[2], int both, size_t *todo, u
     }
 }
 
+/* Whether no asked cell can pass (both: the symmetric call; the directed
+ * one is not tried), from boxes inside the cells' (every stride_of-th
+ * point's) and their L' (lower_L over them): each box holds a cell's true
+ * box's points only, so L' >= L and a nonempty one's half diagonal is at
+ * most the true box's; a cell whose box here has L' below half its
+ * squared half diagonal is kept by keep_cells whatever its U.  So L' is
+ * sought only up to the smallest such half (cap).  A cell empty here is
+ * not proved (it holds points between the strided ones only); its points
+ * then move, as without the cells. */
+static int none_can_pass(const cells_t *cl, const size_t from[2], const size_t to[2], int both) {
+    for (int s = 0; s < (both ? 2 : 0); s++) {
+        double cap = INFINITY;
+        for (size_t k = 0; k < NC; k++)
+            if (cl->full[s * NC + k]) {
+                double h = 0.5 * half_diag2(&cl->box[s * NC + k]);
+                cap = h < cap ? h : cap;
+            }
+        if (!(lower_L(cl, s, from[s], to[s], cap) < cap)) return 0;
+    }
+    return both;
+}
+
 int hd__mpi_prune(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const uint64_t N[2], const double corners[2][6], int both,
                   hd__mpi_prune_t *pr) {
     int K = c->K, rc = HD_OK;
@@ -223,12 +282,16 @@ int hd__mpi_prune(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const uint64_t N[
     hd__mpi_sample_t *all = NULL;
     double *U = hd__mpi_alloc(c, 2 * NC, sizeof(double));
     size_t (*at)[NC + 1] = hd__mpi_alloc(c, 2, sizeof *at), *todo = hd__mpi_alloc(c, 2 * NC, sizeof(size_t));
-    size_t total = 0;
+    /* the directed call takes the true boxes at once (none_can_pass) */
+    size_t total = 0, stride[2] = {both ? stride_of(N, 0) : 1, both ? stride_of(N, 1) : 1}, every[2] = {1, 1};
+    hd__box_t *box = (hd__box_t *)(void *)cb;          /* the global cell boxes, read from gb */
+    unsigned char *full = (unsigned char *)(void *)gb; /* gb read into box first */
     if (!cb || !gb || !own || !cnt || !U || !at || !todo) rc = hd__mpi_nomem(c, "the cells", NC);
     if (rc == HD_OK) {
         for (size_t k = 0; k < 2 * NC; k++)
             for (int a = 0; a < 6; a++) cb[6 * k + a] = INFINITY;
-        take_cells(in, pr, mine, cb, own);
+        take_sample(in, pr, mine, own);
+        take_boxes(in, pr, stride, cb);
     }
     if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
     HD__MPI_GO(c, rc, MPI_Allreduce(cb, gb, 2 * NC * 6, MPI_DOUBLE, MPI_MIN, c->comm));
@@ -239,24 +302,25 @@ int hd__mpi_prune(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const uint64_t N[
     if (!all) rc = hd__mpi_nomem(c, "the sample", total);
     if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
     HD__MPI_GO(c, rc, MPI_Allgatherv(own, m, c->sample_type, all, cnt, cnt + K, c->sample_type, c->comm));
-    {
-        hd__box_t *box = (hd__box_t *)(void *)cb; /* the global cell boxes, reused */
-        unsigned char *full = (unsigned char *)(void *)gb; /* gb read into box first */
-        for (size_t k = 0; k < 2 * NC; k++) {
-            hd__box_t b;
-            for (int a = 0; a < 3; a++) b.lo[a] = gb[6 * k + a], b.hi[a] = -gb[6 * k + 3 + a];
-            box[k] = b;
-        }
-        for (size_t k = 0; k < 2 * NC; k++) full[k] = box[k].lo[0] <= box[k].hi[0];
-        /* The sample by set and cell, then L, then U as the cells need it
-         * (the smallest found: a larger one would keep more cells). */
-        size_t from[2], to[2];
-        sort_sample(all, total, from, to, at);
-        for (size_t k = 0; k < 2 * NC; k++) U[k] = -1.0; /* not computed: cell_u */
-        cells_t cl = {pr, box, full, all, at, U};
-        double L[2] = {lower_L(&cl, 0, from[0], to[0]), lower_L(&cl, 1, from[1], to[1])};
-        keep_cells(&cl, L, both, todo, pr->keep);
+    /* The sample by set and cell; first the strided boxes decide whether
+     * any cell may pass (every rank the same: the same reduced values). */
+    size_t from[2], to[2];
+    sort_sample(all, total, from, to, at);
+    for (size_t k = 0; k < 2 * NC; k++) U[k] = -1.0; /* not computed: cell_u */
+    cells_t cl = {pr, box, full, all, at, U};
+    read_boxes(gb, box, full);
+    if (none_can_pass(&cl, from, to, both)) goto done; /* pr->on 0: every point moves */
+    if (stride[0] > 1 || stride[1] > 1) { /* else the boxes are the true ones already */
+        for (size_t k = 0; k < 2 * NC; k++)
+            for (int a = 0; a < 6; a++) cb[6 * k + a] = INFINITY;
+        take_boxes(in, pr, every, cb);
+        HD__MPI_GO(c, rc, MPI_Allreduce(cb, gb, 2 * NC * 6, MPI_DOUBLE, MPI_MIN, c->comm));
+        read_boxes(gb, box, full);
     }
+    double L[2] = {lower_L(&cl, 0, from[0], to[0], INFINITY), lower_L(&cl, 1, from[1], to[1], INFINITY)};
+    /* Then U as the cells need it (the smallest found: a larger one would
+     * keep more cells). */
+    keep_cells(&cl, L, both, todo, pr->keep);
     pr->on = 1;
 done:
     hd__mpi_free(c, cb, 2 * NC * 6, sizeof(double));
