@@ -913,6 +913,7 @@ static size_t bucket_at(const hd__an_t *t, uint32_t key, size_t from) {
 #define WINDOW_CANDIDATES 64 /* most candidates of a group for the window path */
 #define WINDOW 8            /* points of t scanned around a query's key (a multiple of 8) */
 #define CHUNK 16            /* queries answered from one chunk list */
+#define WINDOW_CHUNK 12     /* the same on the window path */
 #define CHUNK_LIST 256      /* a group list longer than this is not filtered but listed again per chunk */
 #define POINT_LIST 512      /* most points of a group's candidate buckets for a point list */
 #define FAR_CANDIDATES 64   /* most candidates of a far group answered without seeds */
@@ -1310,8 +1311,9 @@ HD__INLINE size_t qgroup_finish(query_ctx *c, cands_t *cd, cands_t *ck, qgroup_t
      * try decides only the cost.) */
     plist_t gp, cp;
     int points = nlisted >= 2 * CHUNK && qgroup_diag2(G) <= 4 * U && group_points(t, cd, &G->box, U, &gp);
-    for (size_t r0 = 0; r0 < nlisted; r0 += CHUNK) {
-        size_t r1 = r0 + CHUNK < nlisted ? r0 + CHUNK : nlisted;
+    size_t chunk = windowed ? WINDOW_CHUNK : CHUNK;
+    for (size_t r0 = 0; r0 < nlisted; r0 += chunk) {
+        size_t r1 = r0 + chunk < nlisted ? r0 + chunk : nlisted;
         const cands_t *list = cd;
         hd__box_t box;
         double Uc = 0;
