@@ -1290,19 +1290,9 @@ HD__INLINE size_t qgroup_finish(query_ctx *c, cands_t *cd, cands_t *ck, qgroup_t
     uint32_t apart[HD__AN_GROUP], listed[HD__AN_GROUP];
     uint8_t seeded[HD__AN_GROUP];
     for (size_t k = 0; k < G->m; k++) {
+        /* Set apart: the list within U holds its answer when that is at
+         * most U; a best still above U after the list says it is not. */
         seeded[k] = windowed && G->best[k] > U;
-        if (seeded[k]) {
-            /* Set apart: its seed buckets usually bring it within U, and
-             * then the list holds its answer; if not: later. */
-            double qx = q->x[first + k], qy = q->y[first + k], qz = q->z[first + k];
-            for (size_t b = G->seed[k]; b < G->seed[k] + SEEDS && b < t->nb; b++)
-                scan_bucket(t, b, qx, qy, qz, &G->best[k], &G->bj[k]);
-            if (G->best[k] > U) {
-                apart[napart++] = (uint32_t)k;
-                cd->counts.apart++;
-                continue;
-            }
-        }
         listed[nlisted++] = (uint32_t)k;
     }
     /* A group small next to its answers' distances (its box's diagonal
@@ -1335,6 +1325,7 @@ HD__INLINE size_t qgroup_finish(query_ctx *c, cands_t *cd, cands_t *ck, qgroup_t
             for (size_t r = r0; r < r1; r++) {
                 size_t k = listed[r];
                 scan_points(&cp, q->x[first + k], q->y[first + k], q->z[first + k], &G->best[k], &G->bj[k]);
+                if (seeded[k] && G->best[k] > U) apart[napart++] = (uint32_t)k;
                 c->sd[first + k] = G->best[k];
                 c->sj[first + k] = G->bj[k];
                 kept += paired && !windowed && G->bj[k] == G->pj[k];
@@ -1350,9 +1341,9 @@ HD__INLINE size_t qgroup_finish(query_ctx *c, cands_t *cd, cands_t *ck, qgroup_t
             size_t k = listed[r];
             double qx = q->x[first + k], qy = q->y[first + k], qz = q->z[first + k];
             cands_t *l = (cands_t *)list;
-            if (seeded[k]) finish_query(t, l, qx, qy, qz, U, G->seed[k], G->seed[k] + SEEDS, SIZE_MAX, &G->best[k], &G->bj[k]);
-            else if (paired || !scanned) finish_query(t, l, qx, qy, qz, U, 0, 0, SIZE_MAX, &G->best[k], &G->bj[k]);
+            if (paired || !scanned) finish_query(t, l, qx, qy, qz, U, 0, 0, SIZE_MAX, &G->best[k], &G->bj[k]);
             else finish_query(t, l, qx, qy, qz, U, G->seed[k], G->seed[k] + SEEDS, near, &G->best[k], &G->bj[k]);
+            if (seeded[k] && G->best[k] > U) apart[napart++] = (uint32_t)k;
             c->sd[first + k] = G->best[k];
             c->sj[first + k] = G->bj[k];
             kept += paired && !windowed && G->bj[k] == G->pj[k];
@@ -1361,6 +1352,7 @@ HD__INLINE size_t qgroup_finish(query_ctx *c, cands_t *cd, cands_t *ck, qgroup_t
     /* The queries set apart: each one's own candidates, the buckets within
      * its best so far (a real point's distance, so at least its answer) of
      * the query itself. */
+    cd->counts.apart += napart;
     for (size_t r = 0; r < napart; r++) {
         size_t k = apart[r];
         double qx = q->x[first + k], qy = q->y[first + k], qz = q->z[first + k];
