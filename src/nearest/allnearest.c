@@ -89,9 +89,11 @@
  *    bests, and one of them would set a bound for the whole group: they
  *    are set apart (best above 16 times, in squares, the geometric mean of
  *    the group's bests, read from the exponents), U is the largest best of
- *    the others, and each query set apart scans its two seed buckets,
- *    then either falls within U (and uses the group's list) or lists its
- *    own candidates around its own point.  A group fails when more than
+ *    the others, and each query set apart is answered from the group's list
+ *    like the others (its answer is usually within U, only its window
+ *    was not); when its best is still above U after the list, its answer
+ *    is above U, and it lists its own candidates around its own point.
+ *    A group fails when more than
  *    an eighth of its queries are set apart or more than WINDOW_CANDIDATES
  *    buckets are listed; a task drops the path as it drops the partners.
  *    How often each route runs is in docs/benchmarks.md, "Issue 15".
@@ -153,10 +155,14 @@
  *    a window) or a node's upper bound (every node holds a point), so each
  *    query of the group has a point within U, and its answer is at most
  *    U; on the window path U is the largest best of the queries not set
- *    apart, so it bounds their answers only, and a query set apart uses
- *    the group's list only once its best is at most U, else lists its own
- *    candidates within its best (an actual point's distance, so at least
- *    its answer) of its own point.
+ *    apart, so it bounds their answers only.  A query set apart is searched
+ *    on the group's list (every bucket within U of a box holding it) with
+ *    its bests limited to U: if its answer is at most U, the answer's
+ *    bucket has a bound at most the answer, is listed and scanned, and
+ *    its best ends at most U; so a best still above U says the answer is
+ *    above U, and the query then lists its own candidates within its best
+ *    (an actual point's distance, so at least its answer) of its own
+ *    point.
  *  - A seed bucket is scanned only when node_lb2 from the group's box to
  *    its box is at most Ub, the nearest leaf's bound; U <= Ub, so a seed
  *    left unscanned is not listed either (the list holds the buckets with
@@ -1272,10 +1278,11 @@ HD__INLINE void scan_points(const plist_t *l, double qx, double qy, double qz, d
 }
 
 /* Every query of the group answered exactly from the candidates listed
- * within U, into c->sd and c->sj.  A windowed query whose best is still
- * above U after its seed buckets may have its answer outside the list:
- * it gets candidates of its own, within its best.  The others are
- * answered CHUNK at a time (consecutive on the curve, so close): the
+ * within U, into c->sd and c->sj.  A windowed query set apart (best above
+ * U) goes through the list with the others; if its best is still above U
+ * then, its answer is above U (an answer within U is listed) and it gets
+ * candidates of its own, within its best.  The queries are answered CHUNK
+ * (on the window path WINDOW_CHUNK) at a time (consecutive on the curve, so close): the
  * chunk's own list holds the group's candidates within Uc of the chunk's
  * box, Uc = min(U, the chunk's largest best), which bounds the answer of
  * each of its queries (each answer is at most U and at most its best);
