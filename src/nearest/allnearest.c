@@ -94,7 +94,7 @@
  *    was not); when its best is still above U after the list, its answer
  *    is above U, and it lists its own candidates around its own point.
  *    A group fails when more than
- *    an eighth of its queries are set apart or more than WINDOW_CANDIDATES
+ *    a quarter of its queries are set apart or more than WINDOW_CANDIDATES
  *    buckets are listed; a task drops the path as it drops the partners.
  *    How often each route runs is in docs/benchmarks.md, "Issue 15".
  *  - Chunks.  A group's list serves its queries CHUNK at a time: the
@@ -1419,7 +1419,7 @@ HD__INLINE void solo_query(query_ctx *c, cands_t *cd, size_t k, size_t *b, size_
  *
  * A task drops either path once most of the groups it tried, PAIR_TRIAL
  * at least, failed (for the partners: did not find most answers at the
- * partners; for the window: more than an eighth of the queries apart, or
+ * partners; for the window: more than a quarter of the queries apart, or
  * too many candidates); no answer depends on any of this. */
 HD__HOT static void query_task(void *vctx, size_t task, int worker) {
     query_ctx *c = vctx;
@@ -1463,7 +1463,7 @@ HD__HOT static void query_task(void *vctx, size_t task, int worker) {
                 seeded = 1;
                 size_t apart;
                 U = window_bests(q, t, &G, &apart);
-                if (8 * apart <= G.m) paired = candidates(t, &G.box, U, WINDOW_CANDIDATES, cd);
+                if (4 * apart <= G.m) paired = candidates(t, &G.box, U, WINDOW_CANDIDATES, cd);
                 windowed = paired;
                 wtried++;
                 wkept += (size_t)paired;
