@@ -89,10 +89,12 @@
  *    bests, and one of them would set a bound for the whole group: they
  *    are set apart (best above 16 times, in squares, the geometric mean of
  *    the group's bests, read from the exponents), U is the largest best of
- *    the others, and each query set apart scans its two seed buckets,
- *    then either falls within U (and uses the group's list) or lists its
- *    own candidates around its own point.  A group fails when more than
- *    an eighth of its queries are set apart or more than WINDOW_CANDIDATES
+ *    the others, and each query set apart is answered from the group's list
+ *    like the others (its answer is usually within U, only its window
+ *    was not); when its best is still above U after the list, its answer
+ *    is above U, and it lists its own candidates around its own point.
+ *    A group fails when more than
+ *    a quarter of its queries are set apart or more than WINDOW_CANDIDATES
  *    buckets are listed; a task drops the path as it drops the partners.
  *    How often each route runs is in docs/benchmarks.md, "Issue 15".
  *  - Chunks.  A group's list serves its queries CHUNK at a time: the
@@ -153,10 +155,14 @@
  *    a window) or a node's upper bound (every node holds a point), so each
  *    query of the group has a point within U, and its answer is at most
  *    U; on the window path U is the largest best of the queries not set
- *    apart, so it bounds their answers only, and a query set apart uses
- *    the group's list only once its best is at most U, else lists its own
- *    candidates within its best (an actual point's distance, so at least
- *    its answer) of its own point.
+ *    apart, so it bounds their answers only.  A query set apart is searched
+ *    on the group's list (every bucket within U of a box holding it) with
+ *    its bests limited to U: if its answer is at most U, the answer's
+ *    bucket has a bound at most the answer, is listed and scanned, and
+ *    its best ends at most U; so a best still above U says the answer is
+ *    above U, and the query then lists its own candidates within its best
+ *    (an actual point's distance, so at least its answer) of its own
+ *    point.
  *  - A seed bucket is scanned only when node_lb2 from the group's box to
  *    its box is at most Ub, the nearest leaf's bound; U <= Ub, so a seed
  *    left unscanned is not listed either (the list holds the buckets with
@@ -913,6 +919,7 @@ static size_t bucket_at(const hd__an_t *t, uint32_t key, size_t from) {
 #define WINDOW_CANDIDATES 64 /* most candidates of a group for the window path */
 #define WINDOW 8            /* points of t scanned around a query's key (a multiple of 8) */
 #define CHUNK 16            /* queries answered from one chunk list */
+#define WINDOW_CHUNK 12     /* the same on the window path */
 #define CHUNK_LIST 256      /* a group list longer than this is not filtered but listed again per chunk */
 #define POINT_LIST 512      /* most points of a group's candidate buckets for a point list */
 #define FAR_CANDIDATES 64   /* most candidates of a far group answered without seeds */
@@ -1271,10 +1278,11 @@ HD__INLINE void scan_points(const plist_t *l, double qx, double qy, double qz, d
 }
 
 /* Every query of the group answered exactly from the candidates listed
- * within U, into c->sd and c->sj.  A windowed query whose best is still
- * above U after its seed buckets may have its answer outside the list:
- * it gets candidates of its own, within its best.  The others are
- * answered CHUNK at a time (consecutive on the curve, so close): the
+ * within U, into c->sd and c->sj.  A windowed query set apart (best above
+ * U) goes through the list with the others; if its best is still above U
+ * then, its answer is above U (an answer within U is listed) and it gets
+ * candidates of its own, within its best.  The queries are answered CHUNK
+ * (on the window path WINDOW_CHUNK) at a time (consecutive on the curve, so close): the
  * chunk's own list holds the group's candidates within Uc of the chunk's
  * box, Uc = min(U, the chunk's largest best), which bounds the answer of
  * each of its queries (each answer is at most U and at most its best);
@@ -1289,19 +1297,9 @@ HD__INLINE size_t qgroup_finish(query_ctx *c, cands_t *cd, cands_t *ck, qgroup_t
     uint32_t apart[HD__AN_GROUP], listed[HD__AN_GROUP];
     uint8_t seeded[HD__AN_GROUP];
     for (size_t k = 0; k < G->m; k++) {
+        /* Set apart: the list within U holds its answer when that is at
+         * most U; a best still above U after the list says it is not. */
         seeded[k] = windowed && G->best[k] > U;
-        if (seeded[k]) {
-            /* Set apart: its seed buckets usually bring it within U, and
-             * then the list holds its answer; if not: later. */
-            double qx = q->x[first + k], qy = q->y[first + k], qz = q->z[first + k];
-            for (size_t b = G->seed[k]; b < G->seed[k] + SEEDS && b < t->nb; b++)
-                scan_bucket(t, b, qx, qy, qz, &G->best[k], &G->bj[k]);
-            if (G->best[k] > U) {
-                apart[napart++] = (uint32_t)k;
-                cd->counts.apart++;
-                continue;
-            }
-        }
         listed[nlisted++] = (uint32_t)k;
     }
     /* A group small next to its answers' distances (its box's diagonal
@@ -1310,8 +1308,9 @@ HD__INLINE size_t qgroup_finish(query_ctx *c, cands_t *cd, cands_t *ck, qgroup_t
      * try decides only the cost.) */
     plist_t gp, cp;
     int points = nlisted >= 2 * CHUNK && qgroup_diag2(G) <= 4 * U && group_points(t, cd, &G->box, U, &gp);
-    for (size_t r0 = 0; r0 < nlisted; r0 += CHUNK) {
-        size_t r1 = r0 + CHUNK < nlisted ? r0 + CHUNK : nlisted;
+    size_t chunk = windowed ? WINDOW_CHUNK : CHUNK;
+    for (size_t r0 = 0; r0 < nlisted; r0 += chunk) {
+        size_t r1 = r0 + chunk < nlisted ? r0 + chunk : nlisted;
         const cands_t *list = cd;
         hd__box_t box;
         double Uc = 0;
@@ -1333,6 +1332,7 @@ HD__INLINE size_t qgroup_finish(query_ctx *c, cands_t *cd, cands_t *ck, qgroup_t
             for (size_t r = r0; r < r1; r++) {
                 size_t k = listed[r];
                 scan_points(&cp, q->x[first + k], q->y[first + k], q->z[first + k], &G->best[k], &G->bj[k]);
+                if (seeded[k] && G->best[k] > U) apart[napart++] = (uint32_t)k;
                 c->sd[first + k] = G->best[k];
                 c->sj[first + k] = G->bj[k];
                 kept += paired && !windowed && G->bj[k] == G->pj[k];
@@ -1348,9 +1348,9 @@ HD__INLINE size_t qgroup_finish(query_ctx *c, cands_t *cd, cands_t *ck, qgroup_t
             size_t k = listed[r];
             double qx = q->x[first + k], qy = q->y[first + k], qz = q->z[first + k];
             cands_t *l = (cands_t *)list;
-            if (seeded[k]) finish_query(t, l, qx, qy, qz, U, G->seed[k], G->seed[k] + SEEDS, SIZE_MAX, &G->best[k], &G->bj[k]);
-            else if (paired || !scanned) finish_query(t, l, qx, qy, qz, U, 0, 0, SIZE_MAX, &G->best[k], &G->bj[k]);
+            if (paired || !scanned) finish_query(t, l, qx, qy, qz, U, 0, 0, SIZE_MAX, &G->best[k], &G->bj[k]);
             else finish_query(t, l, qx, qy, qz, U, G->seed[k], G->seed[k] + SEEDS, near, &G->best[k], &G->bj[k]);
+            if (seeded[k] && G->best[k] > U) apart[napart++] = (uint32_t)k;
             c->sd[first + k] = G->best[k];
             c->sj[first + k] = G->bj[k];
             kept += paired && !windowed && G->bj[k] == G->pj[k];
@@ -1359,6 +1359,7 @@ HD__INLINE size_t qgroup_finish(query_ctx *c, cands_t *cd, cands_t *ck, qgroup_t
     /* The queries set apart: each one's own candidates, the buckets within
      * its best so far (a real point's distance, so at least its answer) of
      * the query itself. */
+    cd->counts.apart += napart;
     for (size_t r = 0; r < napart; r++) {
         size_t k = apart[r];
         double qx = q->x[first + k], qy = q->y[first + k], qz = q->z[first + k];
@@ -1418,7 +1419,7 @@ HD__INLINE void solo_query(query_ctx *c, cands_t *cd, size_t k, size_t *b, size_
  *
  * A task drops either path once most of the groups it tried, PAIR_TRIAL
  * at least, failed (for the partners: did not find most answers at the
- * partners; for the window: more than an eighth of the queries apart, or
+ * partners; for the window: more than a quarter of the queries apart, or
  * too many candidates); no answer depends on any of this. */
 HD__HOT static void query_task(void *vctx, size_t task, int worker) {
     query_ctx *c = vctx;
@@ -1462,7 +1463,7 @@ HD__HOT static void query_task(void *vctx, size_t task, int worker) {
                 seeded = 1;
                 size_t apart;
                 U = window_bests(q, t, &G, &apart);
-                if (8 * apart <= G.m) paired = candidates(t, &G.box, U, WINDOW_CANDIDATES, cd);
+                if (4 * apart <= G.m) paired = candidates(t, &G.box, U, WINDOW_CANDIDATES, cd);
                 windowed = paired;
                 wtried++;
                 wkept += (size_t)paired;

@@ -424,6 +424,50 @@ TEST(shuffled_copies_are_exact_and_mostly_settled_by_the_window) {
     CHECK(apart >= 4);
 }
 
+TEST(queries_set_apart_by_the_window_find_their_answers_within_and_beyond_the_group_bound) {
+    /* B is a copy of A (a Gaussian of sigma 1, noise 1e-3) in a random
+     * order with one point in 40 moved 0.2 away (a few spacings between
+     * neighbours).  A query whose
+     * window lies across a jump of B's curve is set apart; when its answer
+     * is within the group's bound U the group's list holds it, and when
+     * its copy moved away its answer may be above U: then the best it
+     * reaches on the list is above U too, and it lists its own
+     * candidates.  And two samples of one cube, and small Gaussians one
+     * sigma apart, where the answers of the queries set apart lie near U,
+     * on either side.  Both directions,
+     * every answer against the brute force, at 1 and 3 threads. */
+    size_t apart = 0, windowed = 0;
+    for (uint64_t seed = 39500; seed < 39530 && !hdt_failed(); seed++) {
+        gen_rng_t g;
+        gen_seed(&g, seed);
+        size_t n = seed % 3 == 2 ? 50 + gen_u64(&g) % 350 : 4000 + gen_u64(&g) % 4000;
+        int threads = seed % 2 ? 1 : 3;
+        CONTEXT("seed=%llu n=%zu threads=%d", (unsigned long long)seed, n, threads);
+        double *a = malloc(24 * n), *b = malloc(24 * n);
+        if (seed % 3 == 2) {
+            double m0[3] = {0, 0, 0}, m1[3] = {1, 0, 0};
+            gen_gauss(&g, a, n, m0, 1.0);
+            gen_gauss(&g, b, n, m1, 1.0);
+        } else if (seed % 3 == 1) {
+            gen_cube(&g, a, n, -1.0, 1.0);
+            gen_cube(&g, b, n, -1.0, 1.0);
+        } else {
+            gen_copy(&g, GEN_COPY_NOISE, a, b, n);
+            for (size_t k = n; k > 1; k--) gen_swap(b, k - 1, gen_u64(&g) % k);
+            for (size_t k = 0; k < n; k += 40) b[3 * k + (k / 40) % 3] += 0.2;
+        }
+        hd__an_counts_t c = {0};
+        check_window(a, b, n, threads, &c);
+        check_window(b, a, n, threads, &c);
+        apart += c.apart;
+        windowed += c.windowed;
+        free(a), free(b);
+    }
+    CONTEXT("groups windowed %zu, queries listing their own candidates %zu", windowed, apart);
+    CHECK(windowed > 0);
+    CHECK(apart > 0);
+}
+
 TEST(a_sparse_set_asking_a_dense_one_is_searched_point_by_point_and_stays_exact) {
     /* A few points asking many: each group of queries spreads over far
      * more searched buckets than it has queries, so its queries are
