@@ -656,9 +656,10 @@ size_t hd__bvh_nearest(const hd__bvh_t *t, const double p[3], size_t seed, int s
     search_t s;
     start(t, p, seed, seed_kernel, &s, st);
     /* the frames for a point farther from its seed than two diagonals of
-     * the largest framed nodes; the boxes alone nearer */
+     * the largest framed nodes; the boxes alone nearer, and without a
+     * seed (a run's first point: the first leaf reached bounds it) */
     uint32_t n = (uint32_t)t->n_tris;
-    if (t->frames && s.thr > 4 * t->frame_reach2) descend(t, p, seed, &s, st, 1, frame_err(t, p), 0, 0, n);
+    if (t->frames && seed < t->n_tris && s.thr > 4 * t->frame_reach2) descend(t, p, seed, &s, st, 1, frame_err(t, p), 0, 0, n);
     else if (seed >= t->n_tris || !climb(t, p, seed, &s, st)) descend(t, p, seed, &s, st, 0, -1.0, 0, 0, n);
     return search_end(t, p, &s, best, index, st);
 }
