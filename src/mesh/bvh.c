@@ -615,8 +615,10 @@ HD__INLINE void descend(const hd__bvh_t *t, const double *p, size_t seed, search
 /* The search from the seed's leaf up.  The leaf holding position seed is
  * found from the positions alone (a node's first child holds its first
  * n / 2 triangles), and its ancestors' other children, the siblings, are
- * kept on the way down.  When the seed's threshold is within CLIMB_REACH
- * squared diagonals of that leaf's box, the leaf is searched first and
+ * kept on the way down.  When the seed's threshold is at most CLIMB_REACH
+ * times the squared diagonal of that leaf's box (the point within half
+ * the leaf's diagonal of the seed, as a point of a dense scan is of the
+ * previous point's nearest triangle), the leaf is searched first and
  * then each sibling's subtree, deepest first (descend, with the boxes):
  * the leaf and the siblings partition the tree, and the file's rule makes
  * the answer independent of the order of visits, so the result is the
@@ -624,7 +626,7 @@ HD__INLINE void descend(const hd__bvh_t *t, const double *p, size_t seed, search
  * near its seed, and its box alone discards it: the path from the root is
  * walked without a bound, and the nodes a near point opens are those
  * around its leaf.  0 (nothing searched) when the seed is too far. */
-#define CLIMB_REACH 16.0
+#define CLIMB_REACH 0.25
 static int climb(const hd__bvh_t *t, const double *p, size_t seed, search_t *s, hd__bvh_stats_t *st) {
     struct { uint32_t node, first, n; } sib[MAX_DEPTH];
     int depth = 0;
