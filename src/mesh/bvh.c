@@ -30,8 +30,9 @@
  * the longest axis of their box, down to leaves of at most LEAF
  * triangles; each node's box is the exact minimum and maximum of its
  * corners (no rounding), each triangle prepared once (hd__tri_prep).  A
- * query starts from a seed triangle (the previous query's nearest) and
- * descends nearest child first, discarding nodes by their boxes, or where
+ * query starts from a seed triangle (the previous query's nearest); near
+ * its seed it searches the seed's leaf and then its ancestors' siblings
+ * (climb), else it descends from the root; either way nearest child first, discarding nodes by their boxes, or where
  * a node has a frame (hd__bvh_frames: nearly orthonormal axes, the first
  * along the node's normal, and the slabs holding its triangles), by the
  * distance to the frame's slabs, much tighter on a nearly flat patch seen
