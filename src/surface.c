@@ -157,6 +157,65 @@ hd_mesh_t hd_mesh_file_view(const hd_mesh_file_t *mesh) {
 
 /* ---- distances ---------------------------------------------------------- */
 
+/* The triangles copied corner by corner, each index and coordinate checked
+ * where it is read, so that the error names the first triangle and corner
+ * at fault (a vertex no triangle uses is never an error). */
+static int copy_checked(const hd_mesh_t *M, const hd__src_t *src, hd__tri_t *t, hd_error_t *err) {
+    const hd_points_t *V = &M->vertices;
+    for (size_t k = 0; k < M->n_triangles; k++)
+        for (int j = 0; j < 3; j++) {
+            uint64_t v = M->index_type == HD_INDEX_U32 ? ((const uint32_t *)M->triangles)[3 * k + j]
+                                                       : ((const uint64_t *)M->triangles)[3 * k + j];
+            if (v >= V->count)
+                return hd__err(err, HD_EINVAL, "mesh: triangle %zu refers to vertex %llu, but there are %zu vertices",
+                               k, (unsigned long long)v, V->count);
+            hd__src_get(src, (size_t)v, t[k].v[j]);
+            for (int c = 0; c < 3; c++)
+                if (!(fabs(t[k].v[j][c]) <= HD_MAX_COORD)) {
+                    int nonfinite = !isfinite(t[k].v[j][c]);
+                    return hd__err(err, nonfinite ? HD_ENONFINITE : HD_ERANGE,
+                                   "mesh: triangle %zu, corner %d (vertex %llu): a coordinate is %s", k, j,
+                                   (unsigned long long)v, nonfinite ? "NaN or infinite" : "beyond the limit 1e153");
+                }
+        }
+    return HD_OK;
+}
+
+/* Whether every vertex is within the checked range (finite, at most
+ * HD_MAX_COORD): then a corner needs no check of its own. */
+static int vertices_in_range(const hd_points_t *V, const hd__src_t *src) {
+    for (size_t i = 0; i < V->count; i++) {
+        double q[3];
+        hd__src_get(src, i, q);
+        if (!(fabs(q[0]) <= HD_MAX_COORD && fabs(q[1]) <= HD_MAX_COORD && fabs(q[2]) <= HD_MAX_COORD)) return 0;
+    }
+    return 1;
+}
+
+/* The triangles copied with their indices checked alone (every vertex in
+ * range); 0 at the first index out of range, which copy_checked then
+ * reports.  u32: the index type (a constant where inlined, so that each
+ * index type and the plain array of doubles get a loop of their own). */
+HD__INLINE int copy_fast_as(const hd_mesh_t *M, const hd__src_t *src, hd__tri_t *t, int u32, int f64) {
+    size_t n = M->vertices.count;
+    const uint32_t *i32 = M->triangles;
+    const uint64_t *i64 = M->triangles;
+    for (size_t k = 0; k < M->n_triangles; k++)
+        for (int j = 0; j < 3; j++) {
+            uint64_t v = u32 ? i32[3 * k + j] : i64[3 * k + j];
+            if (v >= n) return 0;
+            if (f64) memcpy(t[k].v[j], src->base + (ptrdiff_t)v * 24, sizeof t[k].v[j]);
+            else hd__src_get(src, (size_t)v, t[k].v[j]);
+        }
+    return 1;
+}
+
+static int copy_fast(const hd_mesh_t *M, const hd__src_t *src, hd__tri_t *t) {
+    int u32 = M->index_type == HD_INDEX_U32, f64 = src->kind == HD__SRC_F64 && !src->T;
+    if (u32) return f64 ? copy_fast_as(M, src, t, 1, 1) : copy_fast_as(M, src, t, 1, 0);
+    return f64 ? copy_fast_as(M, src, t, 0, 1) : copy_fast_as(M, src, t, 0, 0);
+}
+
 /* The mesh's triangles as the tree stores them, every index and corner
  * checked; *n_degenerate counted. */
 int hd__mesh_triangles(const hd_mesh_t *M, hd__tri_t **out, size_t *n_degenerate, hd_error_t *err) {
@@ -177,26 +236,12 @@ int hd__mesh_triangles(const hd_mesh_t *M, hd__tri_t **out, size_t *n_degenerate
     if (!t) return hd__err(err, HD_ENOMEM, "mesh: out of memory for %zu triangles", M->n_triangles);
     hd__src_t src;
     hd__src_init(&src, V, NULL);
+    if (!(vertices_in_range(V, &src) && copy_fast(M, &src, t)) && (rc = copy_checked(M, &src, t, err))) {
+        free(t);
+        return rc;
+    }
     *n_degenerate = 0;
     for (size_t k = 0; k < M->n_triangles; k++) {
-        for (int j = 0; j < 3; j++) {
-            uint64_t v = M->index_type == HD_INDEX_U32 ? ((const uint32_t *)M->triangles)[3 * k + j]
-                                                       : ((const uint64_t *)M->triangles)[3 * k + j];
-            if (v >= V->count) {
-                free(t);
-                return hd__err(err, HD_EINVAL, "mesh: triangle %zu refers to vertex %llu, but there are %zu vertices",
-                               k, (unsigned long long)v, V->count);
-            }
-            hd__src_get(&src, (size_t)v, t[k].v[j]);
-            for (int c = 0; c < 3; c++)
-                if (!(fabs(t[k].v[j][c]) <= HD_MAX_COORD)) {
-                    int nonfinite = !isfinite(t[k].v[j][c]);
-                    free(t);
-                    return hd__err(err, nonfinite ? HD_ENONFINITE : HD_ERANGE,
-                                   "mesh: triangle %zu, corner %d (vertex %llu): a coordinate is %s", k, j,
-                                   (unsigned long long)v, nonfinite ? "NaN or infinite" : "beyond the limit 1e153");
-                }
-        }
         t[k].index = k;
         *n_degenerate += (size_t)hd__tri_degenerate(t[k].v[0], t[k].v[1], t[k].v[2]);
     }

@@ -30,8 +30,9 @@
  * the longest axis of their box, down to leaves of at most LEAF
  * triangles; each node's box is the exact minimum and maximum of its
  * corners (no rounding), each triangle prepared once (hd__tri_prep).  A
- * query starts from a seed triangle (the previous query's nearest) and
- * descends nearest child first, discarding nodes by their boxes, or where
+ * query starts from a seed triangle (the previous query's nearest); near
+ * its seed it searches the seed's leaf and then its ancestors' siblings
+ * (climb), else it descends from the root; either way nearest child first, discarding nodes by their boxes, or where
  * a node has a frame (hd__bvh_frames: nearly orthonormal axes, the first
  * along the node's normal, and the slabs holding its triangles), by the
  * distance to the frame's slabs, much tighter on a nearly flat patch seen
@@ -574,11 +575,12 @@ static inline double node_lo2(const hd__bvh_t *t, uint32_t k, uint32_t first, ui
     return hd__box_lb2s(&t->nodes[k].box, p[0], p[1], p[2]) * SHRINK;
 }
 
-/* The descent from the root, nearest child first; framed: with the
- * frames (node_lo2 with E), else the boxes alone (written twice by the
- * compiler, one loop each). */
+/* The descent of the subtree of node root (holding the triangles
+ * [root_first, root_first + root_n)), nearest child first; framed: with
+ * the frames (node_lo2 with E), else the boxes alone (written twice by
+ * the compiler, one loop each). */
 HD__INLINE void descend(const hd__bvh_t *t, const double *p, size_t seed, search_t *s, hd__bvh_stats_t *st,
-                        int framed, double E) {
+                        int framed, double E, uint32_t root, uint32_t root_first, uint32_t root_n) {
     E = framed ? E : -1.0;
     /* lo2: a lower bound on the squared distance to the node (node_lo2);
      * [first, first + n): the node's triangles (the build gives a node's
@@ -586,7 +588,7 @@ HD__INLINE void descend(const hd__bvh_t *t, const double *p, size_t seed, search
     typedef struct { uint32_t node, first, n; double lo2; } entry_t;
     entry_t stack[MAX_DEPTH], *e;
     int top = 0;
-    stack[top++] = (entry_t){0, 0, (uint32_t)t->n_tris, node_lo2(t, 0, 0, (uint32_t)t->n_tris, p, E)};
+    stack[top++] = (entry_t){root, root_first, root_n, node_lo2(t, root, root_first, root_n, p, E)};
     while (top > 0) {
         e = &stack[--top];
         if (e->lo2 > s->thr) continue;
@@ -611,14 +613,57 @@ HD__INLINE void descend(const hd__bvh_t *t, const double *p, size_t seed, search
     }
 }
 
+/* The search from the seed's leaf up.  The leaf holding position seed is
+ * found from the positions alone (a node's first child holds its first
+ * n / 2 triangles), and its ancestors' other children, the siblings, are
+ * kept on the way down.  When the seed's threshold is at most CLIMB_REACH
+ * times the squared diagonal of that leaf's box (the point within half
+ * the leaf's diagonal of the seed, as a point of a dense scan is of the
+ * previous point's nearest triangle), the leaf is searched first and
+ * then each sibling's subtree, deepest first (descend, with the boxes):
+ * the leaf and the siblings partition the tree, and the file's rule makes
+ * the answer independent of the order of visits, so the result is the
+ * descent's from the root.  A sibling near the root is far from a point
+ * near its seed, and its box alone discards it: the path from the root is
+ * walked without a bound, and the nodes a near point opens are those
+ * around its leaf.  0 (nothing searched) when the seed is too far. */
+#define CLIMB_REACH 0.25
+static int climb(const hd__bvh_t *t, const double *p, size_t seed, search_t *s, hd__bvh_stats_t *st) {
+    struct { uint32_t node, first, n; } sib[MAX_DEPTH];
+    int depth = 0;
+    uint32_t k = 0, first = 0, n = (uint32_t)t->n_tris;
+    while (!t->nodes[k].count) {
+        uint32_t na = n / 2;
+        if (seed < (size_t)first + na) {
+            sib[depth].node = t->nodes[k].first_or_second, sib[depth].first = first + na, sib[depth++].n = n - na;
+            k = k + 1, n = na;
+        } else {
+            sib[depth].node = k + 1, sib[depth].first = first, sib[depth++].n = na;
+            k = t->nodes[k].first_or_second, first += na, n -= na;
+        }
+    }
+    const hd__box_t *b = &t->nodes[k].box;
+    double x = b->hi[0] - b->lo[0], y = b->hi[1] - b->lo[1], z = b->hi[2] - b->lo[2];
+    if (!(s->thr <= CLIMB_REACH * (x * x + y * y + z * z))) return 0;
+    st->nodes++;
+    leaf(t, &t->nodes[k], p, seed, s, st);
+    while (depth > 0) {
+        depth--;
+        descend(t, p, seed, s, st, 0, -1.0, sib[depth].node, sib[depth].first, sib[depth].n);
+    }
+    return 1;
+}
+
 size_t hd__bvh_nearest(const hd__bvh_t *t, const double p[3], size_t seed, int seed_kernel, hd__tri_near_t *best,
                        size_t *index, hd__bvh_stats_t *st) {
     search_t s;
     start(t, p, seed, seed_kernel, &s, st);
     /* the frames for a point farther from its seed than two diagonals of
-     * the largest framed nodes; the boxes alone nearer */
-    if (t->frames && s.thr > 4 * t->frame_reach2) descend(t, p, seed, &s, st, 1, frame_err(t, p));
-    else descend(t, p, seed, &s, st, 0, -1.0);
+     * the largest framed nodes; the boxes alone nearer, and without a
+     * seed (a run's first point: the first leaf reached bounds it) */
+    uint32_t n = (uint32_t)t->n_tris;
+    if (t->frames && seed < t->n_tris && s.thr > 4 * t->frame_reach2) descend(t, p, seed, &s, st, 1, frame_err(t, p), 0, 0, n);
+    else if (seed >= t->n_tris || !climb(t, p, seed, &s, st)) descend(t, p, seed, &s, st, 0, -1.0, 0, 0, n);
     return search_end(t, p, &s, best, index, st);
 }
 

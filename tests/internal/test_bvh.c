@@ -294,3 +294,68 @@ TEST(a_large_node_splits_along_the_longest_axis_of_its_sampled_centroids) {
     CHECK(a->hi[0] - a->lo[0] > 3);
     hd__bvh_free(&tree);
 }
+
+/* Near points searched from a seed close by (hd__bvh_nearest's climb from
+ * the seed's leaf): half of the points lie near a triangle B of the root's
+ * second child and are seeded with the triangle A of its first child
+ * nearest to B, so the answer is found only in the sibling next to the
+ * root, the last subtree the climb reaches; the others are seeded with
+ * the answer of a point 0.1 away.  The answers are the brute force's, and
+ * the search opens few nodes (the climb starts at the seed's leaf, not at
+ * the root). */
+TEST(a_near_seed_climbs_from_its_leaf_through_every_sibling) {
+    size_t n = 20000, queries = 400 / SCALE, across = 0;
+    hd__tri_t *orig = tris_make(12, n, 2);
+    hd__tri_t *copy = malloc(n * sizeof *copy);
+    memcpy(copy, orig, n * sizeof *copy);
+    hd__bvh_t t;
+    CHECK_RC(hd__bvh_build_threads(&t, copy, n, 1), HD_OK);
+    size_t *pos = malloc(n * sizeof *pos);
+    for (size_t k = 0; k < n; k++) pos[t.tris[k].index] = k;
+    gen_rng_t g;
+    gen_seed(&g, 12);
+    hd__bvh_stats_t st = {0, 0, 0, 0, 0, 0};
+    for (size_t q = 0; q < queries && !hdt_failed(); q++) {
+        double p[3], c[3], o[3];
+        size_t a = gen_u64(&g) % (n / 2), seed = a, b = a;
+        for (int i = 0; i < 3; i++) c[i] = (t.tris[a].v[0][i] + t.tris[a].v[1][i] + t.tris[a].v[2][i]) / 3;
+        if (q % 2 == 0) { /* B: the triangle of the second child nearest to A */
+            double lo = INFINITY;
+            for (size_t k = n / 2; k < n; k++) {
+                double d = 0;
+                for (int i = 0; i < 3; i++) {
+                    double x = (t.tris[k].v[0][i] + t.tris[k].v[1][i] + t.tris[k].v[2][i]) / 3 - c[i];
+                    d += x * x;
+                }
+                if (d < lo) lo = d, b = k;
+            }
+        }
+        for (int i = 0; i < 3; i++) {
+            p[i] = (t.tris[b].v[0][i] + t.tris[b].v[1][i] + t.tris[b].v[2][i]) / 3 + 1e-3 * (gen_unit(&g) - 0.5);
+            o[i] = p[i] + 0.1 * (gen_unit(&g) - 0.5);
+        }
+        hd__tri_near_t want, got;
+        size_t want_index = SIZE_MAX, index;
+        for (size_t k = 0; k < n; k++) {
+            hd__tri_near_t r;
+            CHECK_RC(hd__tri_nearest(p, orig[k].v[0], orig[k].v[1], orig[k].v[2], &r), HD_OK);
+            if (want_index == SIZE_MAX || r.d < want.d) want = r, want_index = k;
+        }
+        if (q % 2) { /* the answer of a point 0.1 away */
+            hd__bvh_stats_t other = {0, 0, 0, 0, 0, 0};
+            seed = hd__bvh_nearest(&t, o, SIZE_MAX, 0, &got, &index, &other);
+        }
+        across += (seed < n / 2) != (pos[want_index] < n / 2);
+        hd__bvh_nearest(&t, p, seed, 0, &got, &index, &st);
+        CONTEXT("seed 12, query %zu", q);
+        CHECK_BITS(got.d, want.d);
+        CHECK_EQ(index, want_index);
+    }
+    double nodes = (double)st.nodes / (double)queries;
+    CONTEXT("seed 12: %.1f nodes opened a query, %zu answers across the root's split", nodes, across);
+    CHECK(across >= queries / 4);
+    CHECK(nodes < 15);
+    hd__bvh_free(&t);
+    free(pos);
+    free(orig);
+}

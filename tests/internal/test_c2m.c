@@ -472,6 +472,33 @@ TEST(bad_meshes_get_an_error_naming_the_triangle) {
     CHECK_RC(hd_mesh_distances(&P, &M, NULL, NULL, NULL, NULL, NULL, NULL, &err), HD_ENONFINITE);
 }
 
+/* Every vertex in range: the triangles are copied without a check per
+ * corner, and an index out of range is still reported by its triangle;
+ * the two index types and float32 vertices read the same corners. */
+TEST(a_mesh_of_vertices_in_range_reads_every_index_type_alike) {
+    double v[] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+    float vf[] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+    uint32_t t32[] = {0, 1, 2, 1, 2, 3};
+    uint64_t t64[] = {0, 1, 2, 1, 2, 3};
+    double q[6] = {0.2, 0.2, 1, 1, 1, 1}, d[3][2];
+    size_t f[3][2];
+    hd_points_t P = hd_points_f64(q, 2);
+    hd_error_t err;
+    hd_mesh_t M[3] = {{hd_points_f64(v, 4), t32, 2, HD_INDEX_U32},
+                      {hd_points_f64(v, 4), t64, 2, HD_INDEX_U64},
+                      {hd_points_f32(vf, 4), t64, 2, HD_INDEX_U64}};
+    for (int m = 0; m < 3; m++) {
+        CONTEXT("mesh %d", m);
+        CHECK_RC(hd_mesh_distances(&P, &M[m], NULL, d[m], f[m], NULL, NULL, NULL, &err), HD_OK);
+        CHECK_BITS(d[m][0], d[0][0]);
+        CHECK_BITS(d[m][1], d[0][1]);
+        CHECK_EQ(f[m][1], (size_t)1);
+    }
+    t32[4] = 9;
+    CHECK_RC(hd_mesh_distances(&P, &M[0], NULL, NULL, NULL, NULL, NULL, NULL, &err), HD_EINVAL);
+    CHECK(strstr(err.message, "triangle 1 refers to vertex 9, but there are 4 vertices") != NULL);
+}
+
 /* ---- the discards of the search: far, clustered, tied, scaled ---------- */
 
 /* The corners' box of a soup. */
