@@ -52,7 +52,19 @@
  *    And for any triangle t of Y, d(., t) is convex, so its maximum over T
  *    is at a corner: d(y, Y) <= min over t of max_v d(v, t) (Tang et al.),
  *    taken over the corners' nearest triangles with d(v, t) <= sqrt_up(hi2)
- *    from hd__tri_bounds (or hi for v's own triangle).  The exact
+ *    from hd__tri_bounds (or hi for v's own triangle).  Two triangles t1,
+ *    t2 at once (bent pairs, whose corners are nearest to different
+ *    triangles): with a_k >= d(v_k, t1), b_k >= d(v_k, t2) and y =
+ *    sum w_k v_k in T, convexity gives d(y, ti) <= sum w_k a_k (resp.
+ *    b_k), and for any lam in [0, 1] and mu >= 1 - lam, min(x, z) <=
+ *    lam x + mu z for x, z >= 0, so d(y, Y) <= sum w_k (lam a_k + mu b_k)
+ *    <= max_k (lam a_k + mu b_k): a bound for every lam (no face region,
+ *    sign or rounding of lam matters; mu = next_up(1 - lam) and each
+ *    product and sum is moved one double up).  The smallest over lam of
+ *    this convex piecewise linear function is at lam = 0, 1 (Tang's) or
+ *    where two corners' lines cross, and equals the largest over T of
+ *    min(sum w_k a_k, sum w_k b_k) (minimax over two simplices), so those
+ *    lam are the ones tried.  The exact
  *    sub-triangle of the face is within e of T point by point (the weights
  *    of a point of the exact sub-triangle applied to the computed corners
  *    give a point of T within e), so U = up(min(both) + e) (e = 0 at level
