@@ -52,7 +52,19 @@
  *    And for any triangle t of Y, d(., t) is convex, so its maximum over T
  *    is at a corner: d(y, Y) <= min over t of max_v d(v, t) (Tang et al.),
  *    taken over the corners' nearest triangles with d(v, t) <= sqrt_up(hi2)
- *    from hd__tri_bounds (or hi for v's own triangle).  The exact
+ *    from hd__tri_bounds (or hi for v's own triangle).  Two triangles t1,
+ *    t2 at once (bent pairs, whose corners are nearest to different
+ *    triangles): with a_k >= d(v_k, t1), b_k >= d(v_k, t2) and y =
+ *    sum w_k v_k in T, convexity gives d(y, ti) <= sum w_k a_k (resp.
+ *    b_k), and for any lam in [0, 1] and mu >= 1 - lam, min(x, z) <=
+ *    lam x + mu z for x, z >= 0, so d(y, Y) <= sum w_k (lam a_k + mu b_k)
+ *    <= max_k (lam a_k + mu b_k): a bound for every lam (no face region,
+ *    sign or rounding of lam matters; mu = next_up(1 - lam) and each
+ *    product and sum is moved one double up).  The smallest over lam of
+ *    this convex piecewise linear function is at lam = 0, 1 (Tang's) or
+ *    where two corners' lines cross, and equals the largest over T of
+ *    min(sum w_k a_k, sum w_k b_k) (minimax over two simplices), so those
+ *    lam are the ones tried.  The exact
  *    sub-triangle of the face is within e of T point by point (the weights
  *    of a point of the exact sub-triangle applied to the computed corners
  *    give a point of T within e), so U = up(min(both) + e) (e = 0 at level
@@ -506,6 +518,43 @@ static double pair_bound(const hd__m2m_job_t *J, const sub_t *s, double U, cache
     return U;
 }
 
+/* The corners' bounds to up to three triangles of Y (the corners' own
+ * nearest as the bounds tell, each once), filled as needed: h[i][k] >=
+ * d(corner k, triangle i), NAN while not computed. */
+typedef struct cands {
+    size_t pos[3];
+    int n;
+    double h[3][3];
+} cands_t;
+
+static double cand_h(const hd__m2m_job_t *J, const sub_t *s, cands_t *K, int i, int k, cache_t *C, uint64_t *kernel) {
+    if (isnan(K->h[i][k])) K->h[i][k] = corner_to(&s->c[k], K->pos[i], &J->to->tris[K->pos[i]], C, kernel);
+    return K->h[i][k];
+}
+
+/* The largest over the corners of lam a_k + mu b_k, rounded up, with
+ * mu >= 1 - lam (a, b >= 0 and finite). */
+static double mixed(const double *a, const double *b, double lam) {
+    double mu = up(1 - lam), m = 0;
+    for (int k = 0; k < 3; k++) m = fmax(m, up(up(lam * a[k]) + up(mu * b[k])));
+    return m;
+}
+
+/* The bent-pair bound (mesh.h; the proof is at the top): lam is tried at
+ * the crossings of the corners' lines lam a_k + (1 - lam) b_k, where the
+ * smallest of their maxima lies; any lam in [0, 1] gives a bound. */
+double hd__m2m_bent_bound(const double a[3], const double b[3], double U) {
+    for (int k = 0; k < 3; k++)
+        if (!isfinite(a[k]) || !isfinite(b[k])) return U;
+    U = fmin(U, fmin(fmax(a[0], fmax(a[1], a[2])), fmax(b[0], fmax(b[1], b[2])))); /* lam = 1, 0 */
+    for (int k = 0; k < 3; k++) {
+        int l = (k + 1) % 3;
+        double lam = (b[l] - b[k]) / ((a[k] - b[k]) - (a[l] - b[l]));
+        if (lam > 0 && lam < 1) U = fmin(U, mixed(a, b, lam));
+    }
+    return U;
+}
+
 /* The sub-triangle's upper bound; once the point bound alone is at most
  * `enough` (the sub-triangle will be discarded whatever its bound) the
  * dearer bounds are skipped. */
@@ -515,17 +564,28 @@ static double upper_of(const hd__m2m_job_t *J, const sub_t *s, double e, double 
     for (int i = 0; i < 3; i++) rmax = fmax(rmax, s->c[i].hi);
     double U = up(rmax + reach(s));
     if ((s->level ? up(U + e) : U) <= enough) return s->level ? up(U + e) : U;
-    for (int i = 0; i < 3; i++) { /* Tang's bound over the corners' nearest triangles */
-        size_t cand = s->c[i].pos;
+    cands_t K = {.n = 0};
+    for (int i = 0; i < 3; i++) {
         int seen = 0;
-        for (int j = 0; j < i; j++) seen |= s->c[j].pos == cand;
-        if (seen) continue;
-        const hd__tri_t *t = &J->to->tris[cand];
+        for (int j = 0; j < K.n; j++) seen |= K.pos[j] == s->c[i].pos;
+        if (!seen) {
+            K.pos[K.n] = s->c[i].pos;
+            for (int k = 0; k < 3; k++) K.h[K.n][k] = NAN;
+            K.n++;
+        }
+    }
+    for (int i = 0; i < K.n; i++) { /* Tang's bound over the corners' nearest triangles */
         double m = 0;
-        for (int j = 0; j < 3 && m < U; j++) m = fmax(m, corner_to(&s->c[j], cand, t, C, kernel));
+        for (int k = 0; k < 3 && m < U; k++) m = fmax(m, cand_h(J, s, &K, i, k, C, kernel));
         U = fmin(U, m);
     }
-    if (s->c[0].pos != s->c[1].pos || s->c[1].pos != s->c[2].pos) U = pair_bound(J, s, U, C, kernel);
+    if (K.n > 1) U = pair_bound(J, s, U, C, kernel);
+    double E = s->level ? e : 0;
+    for (int i = 0; i < K.n && up(U + E) > enough; i++) /* bent pairs */
+        for (int j = i + 1; j < K.n; j++) {
+            for (int k = 0; k < 3; k++) cand_h(J, s, &K, i, k, C, kernel), cand_h(J, s, &K, j, k, C, kernel);
+            U = hd__m2m_bent_bound(K.h[i], K.h[j], U);
+        }
     return s->level ? up(U + e) : U;
 }
 

@@ -263,6 +263,13 @@ typedef struct hd__m2m_result {
  * The result does not depend on job->threads.  HD_OK or HD_ENOMEM. */
 int hd__m2m_run(const hd__m2m_job_t *job, hd__m2m_result_t *out);
 
+/* A bound for a sub-triangle T whose corners are nearest to different
+ * triangles t1, t2 of Y: given a[k] >= d(corner k, t1) and b[k] >=
+ * d(corner k, t2), min(U, a bound >= max over y in T of min(d(y, t1),
+ * d(y, t2))), rounded up (m2m.c has the proof).  U when a value is not
+ * finite.  Thread safety: none needed. */
+double hd__m2m_bent_bound(const double a[3], const double b[3], double U);
+
 /* drop_x[k] = 1 for each triangle of x whose three corners are, as a set,
  * bit-identical to those of a triangle of y, *count_x of them; and the
  * same for y against x in drop_y (unless NULL), *count_y.  HD_OK or

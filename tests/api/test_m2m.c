@@ -654,3 +654,26 @@ TEST(bad_input_is_refused) {
     CHECK_RC(hd_surface_points_hausdorff(&a, &none, NULL, &ab, NULL, &err), HD_EEMPTY);
     gen_soup_free(&A), gen_soup_free(&N), gen_soup_free(&F);
 }
+
+/* A flat grid over a copy split finer whose vertices are raised by seeded
+ * amounts (bent at every edge): a sub-triangle over two of B's triangles
+ * is bounded by both at once (the bent-pair bound), so the refinement
+ * splits fewer times than with one triangle at a time along B's edges
+ * - and the enclosure holds both ways. */
+TEST(sub_triangles_over_bent_pairs_split_fewer_times) {
+    gen_rng_t r;
+    gen_seed(&r, 3838);
+    gen_soup_t A = grid(4, 0), B = grid(8, 0);
+    for (size_t k = 0; k < B.nv; k++) {
+        B.v[3 * k] *= 0.5, B.v[3 * k + 1] *= 0.5;
+        B.v[3 * k + 2] = ldexp((double)(gen_u64(&r) % 64), -8);
+    }
+    hd_mesh_t a = gen_soup_view(&A), b = gen_soup_view(&B);
+    hd_surface_options_t o = options(1e-9, 1, 1);
+    hd_enclosure_t ab, ba;
+    CHECK_RC(hd_surface_hausdorff(&a, &b, &o, &ab, &ba, NULL), HD_OK);
+    CONTEXT("seed 3838: %llu and %llu splits", (unsigned long long)ab.faces_split, (unsigned long long)ba.faces_split);
+    CHECK(ab.faces_split + ba.faces_split < 270);
+    both_ways(&A, &B, 1e-9, 8);
+    gen_soup_free(&A), gen_soup_free(&B);
+}
