@@ -122,7 +122,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
             if (!isfinite(q[d]) || fabs(q[d]) > HD_MAX_COORD) abort();
     }
 #ifndef HD_FUZZ_SAMPLE
-    if (laz && size >= 227) laz_records(data, size, c);
+    /* only what was read as LAS: another reader's file may merely start with "LASF" */
+    if (laz && size >= 227 && (strcmp(HD_FUZZ_FORMAT, "las") == 0 || strcmp(HD_FUZZ_FORMAT, "laz") == 0))
+        laz_records(data, size, c);
 #endif
     uint64_t total;
     rc = hd__count_buffer(data, size, NAME, &o, &total, &e);
