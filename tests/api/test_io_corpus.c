@@ -42,6 +42,7 @@ static outcome_t regress[] = {
     {"tests/corpus/obj/regress-utf32.obj", HD_EFORMAT, 0, HD_EFORMAT, 0, 0},
     {"tests/corpus/obj/regress-mac-line-ends.obj", HD_EFORMAT, 0, HD_EFORMAT, 0, 0},
     {"tests/corpus/obj/regress-two-statements-a-line.obj", HD_EFORMAT, 0, HD_EFORMAT, 0, 0},
+    {"tests/corpus/obj/regress-obj-that-starts-with-lasf", HD_OK, 1, HD_EFORMAT, 0, 0},
     {"tests/corpus/off/regress-empty-window", HD_EFORMAT, 0, HD_EFORMAT, 0, 0},
     {"tests/corpus/off/regress-bom.off", HD_OK, 3, HD_OK, 8, 0},
     {"tests/corpus/stl/regress-binary-solid-header", HD_OK, 6, HD_OK, 8, 0},
