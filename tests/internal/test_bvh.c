@@ -116,6 +116,18 @@ static void same_tree(const hd__bvh_t *a, const hd__bvh_t *b) {
     CHECK(memcmp(a->boxes, b->boxes, a->n_tris * sizeof *a->boxes) == 0);
 }
 
+/* The brute force: the nearest of n triangles to p (ties: the smallest
+ * index), its index and its answer in *want. */
+static size_t brute_nearest(const double p[3], const hd__tri_t *orig, size_t n, hd__tri_near_t *want) {
+    size_t at = SIZE_MAX;
+    for (size_t k = 0; k < n; k++) {
+        hd__tri_near_t r;
+        CHECK_RC(hd__tri_nearest(p, orig[k].v[0], orig[k].v[1], orig[k].v[2], &r), HD_OK);
+        if (at == SIZE_MAX || r.d < want->d) *want = r, at = k;
+    }
+    return at;
+}
+
 TEST(the_tree_is_valid_and_the_same_on_1_and_several_threads) {
     const size_t sizes[] = {1, 2, 3, 4, 5, 7, 8, 9, 17, 100, 1000, 4097, 9001, 40000 / SCALE};
     const int threads[] = {2, 3, 8};
@@ -157,11 +169,7 @@ TEST(trees_built_on_1_and_3_threads_give_the_brute_force_answers) {
         for (int c = 0; c < 3; c++) p[c] = q % 2 ? 3 * gen_unit(&g) - 1 : orig[q * 7 % n].v[0][c] + 1e-4 * gen_unit(&g);
         hd__tri_near_t want;
         size_t want_index = SIZE_MAX;
-        for (size_t k = 0; k < n; k++) {
-            hd__tri_near_t r;
-            CHECK_RC(hd__tri_nearest(p, orig[k].v[0], orig[k].v[1], orig[k].v[2], &r), HD_OK);
-            if (want_index == SIZE_MAX || r.d < want.d) want = r, want_index = k;
-        }
+        want_index = brute_nearest(p, orig, n, &want);
         for (int k = 0; k < 2; k++) {
             hd__tri_near_t got;
             size_t index;
@@ -253,11 +261,7 @@ TEST(a_near_point_from_a_far_seed_opens_few_nodes) {
         }
         hd__tri_near_t want, got;
         size_t want_index = SIZE_MAX, index;
-        for (size_t k = 0; k < n; k++) {
-            hd__tri_near_t r;
-            CHECK_RC(hd__tri_nearest(p, orig[k].v[0], orig[k].v[1], orig[k].v[2], &r), HD_OK);
-            if (want_index == SIZE_MAX || r.d < want.d) want = r, want_index = k;
-        }
+        want_index = brute_nearest(p, orig, n, &want);
         hd__bvh_nearest(&t, p, seed, 0, &got, &index, &st);
         CONTEXT("seed 11, query %zu", q);
         CHECK_BITS(got.d, want.d);
@@ -336,11 +340,7 @@ TEST(a_near_seed_climbs_from_its_leaf_through_every_sibling) {
         }
         hd__tri_near_t want, got;
         size_t want_index = SIZE_MAX, index;
-        for (size_t k = 0; k < n; k++) {
-            hd__tri_near_t r;
-            CHECK_RC(hd__tri_nearest(p, orig[k].v[0], orig[k].v[1], orig[k].v[2], &r), HD_OK);
-            if (want_index == SIZE_MAX || r.d < want.d) want = r, want_index = k;
-        }
+        want_index = brute_nearest(p, orig, n, &want);
         if (q % 2) { /* the answer of a point 0.1 away */
             hd__bvh_stats_t other = {0, 0, 0, 0, 0, 0};
             seed = hd__bvh_nearest(&t, o, SIZE_MAX, 0, &got, &index, &other);
