@@ -191,6 +191,10 @@ static void outside(const double *p, const hd__tri_prep_t *t, const v3_t *ap, co
     int all = t->flat;
     v3_t bp = v3_diff(p, t->b);
     double q;
+    if (lo_final(*lo) > skip) { /* the plane's and the edges' terms suffice */
+        *hi = INFINITY;
+        return;
+    }
     /* A corner's region lies beyond one of its edges' lines at least. */
     if (all || !(sure[1] && sure[2])) {
         q = corner_lo2(ap->v, t->ab, t->ac);
@@ -224,6 +228,15 @@ static void bounds_core(const double *p, const hd__tri_prep_t *t, double skip, d
     double g = dot3(t->n, ap.v), eg = pdot3(t->wn, ap.v) + TB;
     double L[3], eL[3], lo = 0, hi;
     int sure[3] = {0, 0, 0}, inside = !t->flat;
+    if (inside) { /* the plane's term alone, a part of lo below: done when it exceeds skip */
+        double gl = fabs(g) - eg;
+        lo = lower_product(gl, gl * t->rMu);
+        if (lo_final(lo) > skip) {
+            *lo2 = lo_final(lo);
+            *hi2 = INFINITY;
+            return;
+        }
+    }
     L[2] = dot3(t->mc, ap.v);
     L[1] = dot3(t->mb, ap.v);
     eL[2] = pdot3(t->wc, ap.v) + TB;
@@ -231,8 +244,7 @@ static void bounds_core(const double *p, const hd__tri_prep_t *t, double skip, d
     L[0] = (t->M - L[1]) - L[2];
     eL[0] = (t->eM + eL[1] + eL[2] + 2 * U * (t->M + fabs(L[1]) + fabs(L[2]))) * SLACK;
     if (inside) {
-        double gl = fabs(g) - eg, out = 0;
-        lo = lower_product(gl, gl * t->rMu);
+        double out = 0;
         for (int i = 0; i < 3; i++) {
             double o = -L[i] - eL[i];
             sure[i] = L[i] - eL[i] >= 0;

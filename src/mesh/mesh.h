@@ -91,9 +91,12 @@ typedef struct hd__tri_prep {
 
 void hd__tri_prep(const double a[3], const double b[3], const double c[3], hd__tri_prep_t *t);
 void hd__tri_bounds_prep(const double p[3], const hd__tri_prep_t *t, double *lo2, double *hi2);
-/* The same lo2, and hi2 only when lo2 <= skip (else possibly +infinity):
- * for a search that discards the triangle when lo2 exceeds its threshold
- * skip, the upper bound's work is saved. */
+/* For a search that discards the triangle when lo2 exceeds its threshold
+ * skip: when hd__tri_bounds_prep's lo2 is at most skip, the same lo2 and
+ * hi2; else a lower bound lo2 > skip, at most hd__tri_bounds_prep's, from
+ * the first of its terms that exceeds skip (the plane's, then the
+ * edges', then the corners'), and hi2 possibly +infinity: the terms and
+ * the upper bound's work past that are saved. */
 void hd__tri_bounds_below(const double p[3], const hd__tri_prep_t *t, double skip, double *lo2, double *hi2);
 
 /* The same answer from exact arithmetic alone (tests compare the two). */

@@ -376,10 +376,12 @@ TEST(a_prepared_triangle_gives_the_same_bounds) {
     }
 }
 
-/* hd__tri_bounds_below: hd__tri_bounds_prep's lo2 at any skip, its hi2
- * whenever lo2 <= skip; above skip the upper bound may be left infinite,
- * and is for a point in a corner's region (the corners' lower bound alone
- * exceeds skip, the feet on the edges are not formed). */
+/* hd__tri_bounds_below: hd__tri_bounds_prep's lo2 and hi2 whenever its
+ * lo2 <= skip; above skip a lower bound still above skip and at most
+ * hd__tri_bounds_prep's, the upper bound possibly left infinite, as it is
+ * for a point in a corner's region (the corners' lower bound alone
+ * exceeds skip, the feet on the edges are not formed) and for a point
+ * whose distance to the plane alone exceeds skip (nothing else formed). */
 TEST(bounds_below_a_threshold_keep_the_lower_bound) {
     for (int f = 0; f < F_COUNT; f++) {
         gen_rng_t g;
@@ -396,9 +398,13 @@ TEST(bounds_below_a_threshold_keep_the_lower_bound) {
             for (int k = 0; k < 6; k++) {
                 CONTEXT("family %s, seed %llu, case %ld, skip %d", family_name[f], (unsigned long long)seed, i, k);
                 hd__tri_bounds_below(t.p, &tp, skips[k], &blo2, &bhi2);
-                CHECK_BITS(blo2, lo2);
-                if (lo2 <= skips[k]) CHECK_BITS(bhi2, hi2);
-                else CHECK(bhi2 >= hi2);
+                if (lo2 <= skips[k]) {
+                    CHECK_BITS(blo2, lo2);
+                    CHECK_BITS(bhi2, hi2);
+                } else {
+                    CHECK(blo2 > skips[k] && blo2 <= lo2);
+                    CHECK(bhi2 >= hi2);
+                }
             }
         }
     }
@@ -413,6 +419,14 @@ TEST(bounds_below_a_threshold_keep_the_lower_bound) {
     CHECK(hi2 == INFINITY);
     hd__tri_bounds_below(t.p, &tp, 30, &lo2, &hi2);
     CHECK(lo2 <= 25 && hi2 >= 25 && hi2 < 26);
+    set3(t.p, 1, 1, 5);                            /* above the face: 25 */
+    hd__tri_bounds_below(t.p, &tp, 20, &lo2, &hi2);
+    CHECK(lo2 > 20 && lo2 <= 25);
+    CHECK(hi2 == INFINITY);                        /* the plane's term decided */
+    set3(t.p, 3, 3, 3);                            /* beyond BC: 9 from the plane, 11 in all */
+    hd__tri_bounds_below(t.p, &tp, 10, &lo2, &hi2);
+    CHECK(lo2 > 10 && lo2 <= 11);
+    CHECK(hi2 == INFINITY);                        /* the edges' term decided */
 }
 
 TEST(the_bounds_of_hand_cases) {
