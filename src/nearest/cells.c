@@ -31,9 +31,10 @@
  *
  * It pays only when most points lie in cells whose range of distances is
  * narrow next to the distances themselves (sets far apart, as issue 39's
- * case b; docs/benchmarks.md, "Cell bounds"): a gate on the share of such
- * points (CELLS_NARROW, CELLS_WORTH) decides before anything but the
- * cells is computed.  Only the cost depends on the gate.
+ * case b; docs/benchmarks.md, "Sets far apart"): it runs only when the two
+ * sets' boxes lie apart, and then only when the probed cells (one in
+ * CELLS_PROBE) with U - L at most CELLS_NARROW L hold CELLS_WORTH of the
+ * probed points, in both directions.  Only the cost depends on the gate.
  */
 #include "nearest/nearest.h"
 
@@ -58,7 +59,7 @@ typedef struct {
 } cells_t;
 
 typedef struct {
-    double lo[3], inv;
+    double lo[3], inv, top[3]; /* top[k] = dim[k] - 1 */
     int dim[3];
 } geom_t;
 
@@ -67,11 +68,14 @@ static void cells_free(cells_t *c) {
     memset(c, 0, sizeof *c);
 }
 
-/* The cell along axis k of a coordinate v of the key box (v >= lo, so
- * the rounded difference is not negative; the top cell takes the rest). */
+/* The cell along axis k of a coordinate v, clamped to the grid (the
+ * points lie in the key box; the clamp keeps the conversion defined
+ * whatever the rounding). */
 static inline uint32_t axis_cell(const geom_t *g, int k, double v) {
-    uint32_t c = (uint32_t)((v - g->lo[k]) * g->inv), top = (uint32_t)g->dim[k] - 1u;
-    return c < top ? c : top;
+    double f = (v - g->lo[k]) * g->inv;
+    f = f > 0 ? f : 0;
+    f = f < g->top[k] ? f : g->top[k];
+    return (uint32_t)f;
 }
 
 /* The cells of P on g: numbered by first occupation, boxes exact. */
@@ -289,7 +293,7 @@ int hd__percentile_cells(const hd_points_t *A, const hd_points_t *B, const hd__b
     for (int k = 0; k < 3; k++) {
         double n = floor((keybox->hi[k] - keybox->lo[k]) * g.inv) + 1;
         g.dim[k] = n < CELLS_AXIS ? (int)n : CELLS_AXIS;
-        g.lo[k] = keybox->lo[k];
+        g.lo[k] = keybox->lo[k], g.top[k] = (double)(g.dim[k] - 1);
     }
     cells_t ca, cb;
     int rc = cells_build(&ca, A, &g, err);
