@@ -220,6 +220,8 @@ int hd_hausdorff_percentile(const hd_points_t *A, const hd_points_t *B,
      * percentile are searched completely (nearest/percentile.c). */
     hd__box_t keybox = box_a;
     hd__box_merge(&keybox, &box_b);
+    int done = 0; /* sets far apart: from a grid's cell bounds, without the structures */
+    if ((rc = hd__percentile_cells(A, B, &box_a, &box_b, &keybox, threads, p, out, &done, err)) || done) return rc;
     hd__an_t s[2];
     if ((rc = hd__an_build_pair(A, B, &keybox, threads, s, err))) return rc;
     rc = hd__percentile_points(A, B, s, &keybox, threads, p, out, err);

@@ -188,6 +188,33 @@ typedef struct hd__pct_sample {
 void hd__percentile_band(const hd__pct_sample_t *s, int ns, size_t *at, size_t r1, size_t r2, double *lo2,
                          double *hi2);
 
+/* Where a percentile's exact squared distances come from (percentile.c
+ * runs the same selection on either): sample(ctx, d, sel, m, out, err)
+ * classifies the points sel[0..m) (increasing) of direction d's asking set
+ * (0: A -> B, 1: B -> A) against the band [0, +inf], band(ctx, d, lo2,
+ * hi2, out, err) every point of direction d against [lo2, hi2], each as
+ * hd__an_band does.  Both return HD_OK or an error with out zeroed. */
+typedef struct hd__pct_src {
+    int (*sample)(void *ctx, int d, const uint32_t *sel, size_t m, hd__an_band_t *out, hd_error_t *err);
+    int (*band)(void *ctx, int d, double lo2, double hi2, hd__an_band_t *out, hd_error_t *err);
+    void *ctx;
+} hd__pct_src_t;
+
+/* The percentile figures of sets of na and nb points (both at least 1)
+ * from src: the same bits as hd_percentile_of on every exact distance
+ * whatever src's passes cost.  Returns HD_OK or src's error. */
+int hd__percentile_run(const hd__pct_src_t *src, size_t na, size_t nb, double p, hd_percentile_t *out,
+                       hd_error_t *err);
+
+/* The percentile figures from a uniform grid's cell bounds (cells.c), for
+ * sets whose boxes box_a and box_b lie apart and whose cells' bounds are
+ * narrow next to their distances: *done = 1 and out filled, the same bits
+ * as hd__percentile_points; else *done = 0 (out untouched) and nothing
+ * but the gate's cost spent.  Returns HD_OK, HD_ENOMEM or HD_EOVERFLOW. */
+int hd__percentile_cells(const hd_points_t *A, const hd_points_t *B, const hd__box_t *box_a, const hd__box_t *box_b,
+                         const hd__box_t *keybox, int threads, double p, hd_percentile_t *out, int *done,
+                         hd_error_t *err);
+
 /* ---- histograms (histogram.c) ------------------------------------------- */
 
 /* numpy.histogram's bins on [lo, hi]: the range (widened by half a unit on

@@ -45,20 +45,17 @@ static int cmp_double(const void *x, const void *y) {
     return (a > b) - (a < b);
 }
 
-static int sample_of(const hd_points_t *P, const hd__an_t *searched, const hd__box_t *keybox, int threads,
-                     sample_t *s, hd_error_t *err) {
-    size_t n = P->count, m = n < SAMPLE ? n : SAMPLE;
+/* The sample of direction d: its SAMPLE points spread evenly over the
+ * file order, their exact squared distances sorted. */
+static int sample_of(const hd__pct_src_t *src, int d, size_t n, sample_t *s, hd_error_t *err) {
+    size_t m = n < SAMPLE ? n : SAMPLE;
     s->v = NULL, s->m = m, s->n = n;
     uint32_t *sel = hd__malloc_array(m, sizeof *sel);
     if (!sel) return hd__err(err, HD_ENOMEM, "cannot allocate a sample of %zu points", m);
     for (size_t k = 0; k < m; k++) sel[k] = (uint32_t)((uint64_t)k * n / m); /* increasing: n >= m */
-    hd__an_t one;
-    int rc = hd__an_build_sel(&one, P, sel, NULL, m, keybox, threads, err);
-    free(sel);
-    if (rc) return rc;
     hd__an_band_t b;
-    rc = hd__an_band(&one, searched, 0.0, INFINITY, threads, &b, err);
-    hd__an_free(&one);
+    int rc = src->sample(src->ctx, d, sel, m, &b, err);
+    free(sel);
     if (rc) return rc;
     qsort(b.v, b.n, sizeof *b.v, cmp_double);
     s->v = b.v;
@@ -151,10 +148,7 @@ static double figure_value(const figure_t *f) {
  * bands of its figure and the pooled one; a pass runs again only when that
  * union changed. */
 typedef struct {
-    const hd__an_t *s;   /* the two structures */
-    const hd_points_t *set[2]; /* the views they were built from */
-    const hd__box_t *keybox;
-    int threads;
+    const hd__pct_src_t *src;
     hd__an_band_t part[2];
     double lo2[2], hi2[2]; /* the union each part was made with */
 } passes_t;
@@ -166,28 +160,27 @@ static int passes_update(passes_t *ps, const figure_t *dir, const figure_t *pool
         if (ps->part[d].v && lo2 == ps->lo2[d] && hi2 == ps->hi2[d]) continue;
         free(ps->part[d].v);
         ps->part[d].v = NULL;
-        int rc = hd__an_band_settled(&ps->s[d], &ps->s[1 - d], ps->set[d], ps->keybox, lo2, hi2, ps->threads,
-                                     &ps->part[d], NULL, err);
+        int rc = ps->src->band(ps->src->ctx, d, lo2, hi2, &ps->part[d], err);
         if (rc) return rc;
         ps->lo2[d] = lo2, ps->hi2[d] = hi2;
     }
     return HD_OK;
 }
 
-int hd__percentile_points(const hd_points_t *A, const hd_points_t *B, const hd__an_t s[2],
-                          const hd__box_t *keybox, int threads, double p, hd_percentile_t *out, hd_error_t *err) {
-    const hd_points_t *set[2] = {A, B};
+int hd__percentile_run(const hd__pct_src_t *src, size_t na, size_t nb, double p, hd_percentile_t *out,
+                       hd_error_t *err) {
+    size_t n[2] = {na, nb};
     sample_t smp[2] = {{0}, {0}};
     figure_t dir[2], pooled;
-    passes_t ps = {s, {A, B}, keybox, threads, {{0}, {0}}, {0, 0}, {0, 0}};
+    passes_t ps = {src, {{0}, {0}}, {0, 0}, {0, 0}};
     int rc = HD_OK;
-    for (int d = 0; d < 2 && rc == HD_OK; d++) rc = sample_of(set[d], &s[1 - d], keybox, threads, &smp[d], err);
+    for (int d = 0; d < 2 && rc == HD_OK; d++) rc = sample_of(src, d, n[d], &smp[d], err);
     for (int d = 0; d < 2 && rc == HD_OK; d++) {
-        figure_init(&dir[d], set[d]->count, p);
+        figure_init(&dir[d], n[d], p);
         band_of(&smp[d], 1, dir[d].r1, dir[d].r2, &dir[d].lo2, &dir[d].hi2);
     }
     if (rc == HD_OK) {
-        figure_init(&pooled, A->count + B->count, p);
+        figure_init(&pooled, na + nb, p);
         band_of(smp, 2, pooled.r1, pooled.r2, &pooled.lo2, &pooled.hi2);
     }
     while (rc == HD_OK && !(dir[0].settled && dir[1].settled && pooled.settled)) {
@@ -205,4 +198,37 @@ int hd__percentile_points(const hd_points_t *A, const hd_points_t *B, const hd__
     }
     for (int d = 0; d < 2; d++) free(smp[d].v), free(ps.part[d].v);
     return rc;
+}
+
+/* The structures' source: the samples on a structure of the sampled
+ * points searching the other set's whole structure, the passes by
+ * hd__an_band_settled. */
+typedef struct {
+    const hd__an_t *s;
+    const hd_points_t *set[2];
+    const hd__box_t *keybox;
+    int threads;
+} an_src_t;
+
+static int an_sample(void *ctx, int d, const uint32_t *sel, size_t m, hd__an_band_t *out, hd_error_t *err) {
+    const an_src_t *c = ctx;
+    hd__an_t one;
+    int rc = hd__an_build_sel(&one, c->set[d], sel, NULL, m, c->keybox, c->threads, err);
+    if (rc) return rc;
+    rc = hd__an_band(&one, &c->s[1 - d], 0.0, INFINITY, c->threads, out, err);
+    hd__an_free(&one);
+    return rc;
+}
+
+static int an_band(void *ctx, int d, double lo2, double hi2, hd__an_band_t *out, hd_error_t *err) {
+    const an_src_t *c = ctx;
+    return hd__an_band_settled(&c->s[d], &c->s[1 - d], c->set[d], c->keybox, lo2, hi2, c->threads, out, NULL,
+                               err);
+}
+
+int hd__percentile_points(const hd_points_t *A, const hd_points_t *B, const hd__an_t s[2],
+                          const hd__box_t *keybox, int threads, double p, hd_percentile_t *out, hd_error_t *err) {
+    an_src_t c = {s, {A, B}, keybox, threads};
+    hd__pct_src_t src = {an_sample, an_band, &c};
+    return hd__percentile_run(&src, A->count, B->count, p, out, err);
 }

@@ -386,6 +386,58 @@ TEST(percentiles_equal_a_full_sort_where_bounds_settle_most_points) {
     }
 }
 
+TEST(percentiles_from_cell_bounds_equal_a_full_sort_on_sets_far_apart) {
+    /* hd__percentile_cells on disjoint shapes (Gaussians 20 sigma apart,
+     * lattices 40 steps apart with ties at the percentile and copies): it
+     * must take its path (cells counted from bounds, the open points
+     * classified against the part of the other set within their cells'
+     * upper bounds), and give the bits of a full sort.  A bound too tight,
+     * or a part of the other set missing a nearest point, moves a rank. */
+    static const double ps[] = {95, 50, 99.9, 0, 100, 5};
+    static const int shapes[] = {0, 2, 3};
+    for (size_t k = 0; k < 3 && !hdt_failed(); k++) {
+        band_sets_t t;
+        settled_sets(600 + (uint64_t)k, shapes[k], &t);
+        hd__box_t box_a, box_b;
+        hd__box_of(t.a, t.A.count, &box_a);
+        hd__box_of(t.b, t.B.count, &box_b);
+        for (size_t j = 0; j < sizeof ps / sizeof ps[0]; j++) {
+            hd_percentile_t want = reference(&t.A, &t.B, ps[j]);
+            for (int threads = 1; threads <= 3; threads += 2) {
+                CONTEXT("shape=%d |A|=%zu |B|=%zu p=%g threads=%d", shapes[k], t.A.count, t.B.count, ps[j],
+                        threads);
+                hd_percentile_t got;
+                int done = 0;
+                CHECK_RC(hd__percentile_cells(&t.A, &t.B, &box_a, &box_b, &t.keybox, threads, ps[j], &got, &done,
+                                              NULL),
+                         HD_OK);
+                CHECK(done == 1);
+                if (!done) continue;
+                CHECK_BITS(got.ab, want.ab);
+                CHECK_BITS(got.ba, want.ba);
+                CHECK_BITS(got.symmetric, want.symmetric);
+                CHECK_BITS(got.pooled, want.pooled);
+            }
+        }
+        band_sets_free(&t);
+    }
+}
+
+TEST(percentiles_from_cell_bounds_decline_sets_whose_boxes_overlap) {
+    /* B a hundredth of A around the same centre: the cells path declines
+     * (done = 0) and leaves the figures to the structures. */
+    band_sets_t t;
+    settled_sets(610, 1, &t);
+    hd__box_t box_a, box_b;
+    hd__box_of(t.a, t.A.count, &box_a);
+    hd__box_of(t.b, t.B.count, &box_b);
+    hd_percentile_t got;
+    int done = 1;
+    CHECK_RC(hd__percentile_cells(&t.A, &t.B, &box_a, &box_b, &t.keybox, 1, 95, &got, &done, NULL), HD_OK);
+    CHECK(done == 0);
+    band_sets_free(&t);
+}
+
 TEST(an_empty_side_is_refused_as_before) {
     double p[3] = {0, 0, 0};
     hd_points_t A = hd_points_f64(p, 1), E = hd_points_f64(p, 0);
