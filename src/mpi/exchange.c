@@ -282,6 +282,7 @@ static int xch_plan(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const hd__mpi_n
     memset(x->rcnt, 0, x->maxr * 2 * (size_t)K * sizeof(int));
     size_t t = 0, out = 0, q = 0, cut = x->C; /* cut: where round q ends, (q + 1) C points sent */
     int prev = -1, *row = x->rcnt;            /* row: round q's counts */
+    const hd__mpi_prune_t *cells = x->pr && x->pr->on ? x->pr : NULL; /* NULL: every point moves */
     x->tb[0] = 0;
     for (int s = 0; s < 2; s++) {
         for (size_t p = 0; p < in->nparts[s]; p++) x->order[s][p] = &in->parts[s][p];
@@ -293,7 +294,7 @@ static int xch_plan(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const hd__mpi_n
             for (size_t k = 0; k < v->count; k++, t++) {
                 double xb[3];
                 const double *pt = px ? px + 3 * k : (hd_points_get(v, k, xb), xb);
-                if (!hd__mpi_moves(x->pr, s, pt)) {
+                if (cells && !hd__mpi_moves(cells, s, pt)) {
                     dest_set(x->dest, x->w, t, K);
                     continue;
                 }

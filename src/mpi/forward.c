@@ -201,6 +201,46 @@ static int by_g(const void *x, const void *y) {
     return (a->g > b->g) - (a->g < b->g);
 }
 
+/* The gathered sample in global index order: each rank's share is sorted
+ * already (its positions increase, and local order is index order), at
+ * cnt[K + r] with cnt[r] points, so the K runs are merged pairwise,
+ * log2(K) passes over n, instead of sorted (indices are distinct: the
+ * order is the same).  Returns the merged array (n, charged; `all` itself
+ * when it is one run), or NULL when there is no room. */
+static hd__mpi_sample_t *merge_runs(hd__mpi_ctx_t *c, hd__mpi_sample_t *all, size_t n, const int *cnt, int K) {
+    size_t *b = hd__mpi_alloc(c, (size_t)K + 1, sizeof(size_t));
+    hd__mpi_sample_t *tmp = hd__mpi_alloc(c, n ? n : 1, sizeof *tmp), *src = all, *dst = tmp;
+    if (!b || !tmp) {
+        hd__mpi_free(c, b, (size_t)K + 1, sizeof(size_t));
+        hd__mpi_free(c, tmp, n ? n : 1, sizeof *tmp);
+        return NULL;
+    }
+    size_t nb = 0; /* run t is [b[t], b[t + 1]) */
+    for (int r = 0; r < K; r++)
+        if (cnt[r]) b[nb++] = (size_t)cnt[K + r];
+    b[nb] = n;
+    while (nb > 1) {
+        size_t m = 0;
+        for (size_t t = 0; t < nb; t += 2) {
+            size_t i = b[t], ie = b[t + 1], j = t + 1 < nb ? b[t + 1] : ie, je = t + 1 < nb ? b[t + 2] : ie, o = b[t];
+            while (i < ie && j < je) dst[o++] = src[i].g < src[j].g ? src[i++] : src[j++];
+            while (i < ie) dst[o++] = src[i++];
+            while (j < je) dst[o++] = src[j++];
+            b[m++] = b[t];
+        }
+        b[m] = n;
+        nb = m;
+        hd__mpi_sample_t *sw = src;
+        src = dst, dst = sw;
+    }
+    hd__mpi_free(c, b, (size_t)K + 1, sizeof(size_t));
+    if (src == all) { /* the runs merged back into all (or one run) */
+        hd__mpi_free(c, tmp, n ? n : 1, sizeof *tmp);
+        return all;
+    }
+    return tmp;
+}
+
 /* Each rank's share of the sample: all its points when Q has at most
  * SAMPLE_TOTAL, else n_r SAMPLE_TOTAL / N_Q of them (every rank computes
  * every share from held[]). */
@@ -232,22 +272,45 @@ static int sample_q(hd__mpi_ctx_t *c, int rc, const hd__mpi_dir_t *d, const hd__
     if (rc == HD_OK) {
         int t = 0;
         for (int r = 0; r < K; r++) cnt[r] = (int)sample_share(held, r, d->qside, NQ), cnt[K + r] = t, t += cnt[r];
+        hd__mpi_gcur_t cq; /* the positions increase */
+        hd__mpi_gcur_init(&cq, d->gQ);
         for (size_t k = 0; k < mine; k++) {
             size_t j = (size_t)((uint64_t)k * d->nQ / mine);
             memcpy(own[k].x, d->Q + 3 * j, sizeof own[k].x);
-            own[k].g = hd__mpi_gidx(d->gQ, j);
+            own[k].g = hd__mpi_gcur_at(&cq, j);
             own[k].side = (uint64_t)d->qside;
         }
     }
     if ((rc = hd__mpi_agree(c, rc)) != HD_OK) goto done;
     HD__MPI_GO(c, rc, MPI_Allgatherv(own, (int)mine, c->sample_type, all, cnt, cnt + K, c->sample_type, c->comm));
-    qsort(all, total, sizeof *all, by_g);
-    for (size_t k = 0; k < total; k++) memcpy(qs->xyz + 3 * k, all[k].x, sizeof all[k].x), qs->g[k] = all[k].g;
+    hd__mpi_sample_t *sorted = merge_runs(c, all, total, cnt, K);
+    if (!sorted) qsort(all, total, sizeof *all, by_g), sorted = all; /* no room for the merge: the same order */
+    for (size_t k = 0; k < total; k++) memcpy(qs->xyz + 3 * k, sorted[k].x, sizeof sorted[k].x), qs->g[k] = sorted[k].g;
+    if (sorted != all) hd__mpi_free(c, sorted, total, sizeof *sorted);
 done:
     hd__mpi_free(c, cnt, 2 * (size_t)K, sizeof(int));
     hd__mpi_free(c, own, mine ? mine : 1, sizeof *own);
     hd__mpi_free(c, all, total ? total : 1, sizeof *all);
     return rc;
+}
+
+/* Whether the shell's point k, at u2, is below (L, i_L) in the witness
+ * order, so that it cannot be the witness (cu: a cursor on P's indices,
+ * asked in increasing k). */
+static int loses(hd__mpi_gcur_t *cu, const hd__mpi_shell_t *sh, size_t k, double u2, double L, uint64_t iL) {
+    return u2 < L || (u2 == L && hd__mpi_shell_g(cu, sh, k) > iL);
+}
+
+/* loses(), remembered in exact[] (LOST): a point below (L, i_L) stays
+ * below at every later step, since L only grows in the witness order and
+ * an upper bound only falls, so its index is decoded once. */
+#define LOST 4
+static int lost(hd__mpi_gcur_t *cu, const hd__mpi_shell_t *sh, size_t k, double u2, double L, uint64_t iL,
+                unsigned char *exact) {
+    if (exact[k] & LOST) return 1;
+    if (!loses(cu, sh, k, u2, L, iL)) return 0;
+    exact[k] |= LOST;
+    return 1;
 }
 
 /* Takes sample point j as point k's answer when smaller (d2 first, then
@@ -312,13 +375,15 @@ static int pilot(const hd__mpi_dir_t *d, const hd__mpi_shell_t *sh, const qsampl
  * was) cannot be the witness, and takes that point, which keeps it below
  * L, without a search. */
 static int sample_bounds(hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, hd__mpi_shell_t *sh, const qsample_t *qs, double L,
-                         double *u2, uint64_t *jj, unsigned char *exact) {
+                         uint64_t iL, double *u2, uint64_t *jj, unsigned char *exact) {
     size_t m = 0;
     if (qs->n == 0) return HD_OK;
     size_t guess[2] = {central(d, sh, qs), 0};
     guess[1] = guess[0];
+    hd__mpi_gcur_t cp;
+    hd__mpi_gcur_init(&cp, d->gP);
     for (size_t k = 0; k < sh->n; k++) {
-        if (exact[k]) continue;
+        if (exact[k] || lost(&cp, sh, k, u2[k], L, iL, exact)) continue; /* a point that lost needs no bound */
         if (!qs->whole) {
             int t = 0;
             while (t < 2 && !(offer(d, sh, qs, k, guess[t], u2, jj) < L)) t++;
@@ -331,7 +396,7 @@ static int sample_bounds(hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, hd__mpi_shell
         m++;
     }
     if (m == 0 || m > HD__AN_MAX_POINTS || (!qs->whole && m >= PILOT_MIN && !pilot(d, sh, qs, L, u2, jj, exact, m))) {
-        for (size_t k = 0; k < sh->n; k++) exact[k] &= 1;
+        for (size_t k = 0; k < sh->n; k++) exact[k] &= (unsigned char)~2;
         return HD_OK;
     }
     /* The marked points in chunks of one batch: their positions, shell
@@ -377,12 +442,6 @@ static double lower_bound(const hd__mpi_ctx_t *c, const hd__mpi_held_t *held, in
     return lb;
 }
 
-/* Whether the shell's point k, at u2, is below (L, i_L) in the witness
- * order, so that it cannot be the witness (cu: a cursor on P's indices,
- * asked in increasing k). */
-static int loses(hd__mpi_gcur_t *cu, const hd__mpi_shell_t *sh, size_t k, double u2, double L, uint64_t iL) {
-    return u2 < L || (u2 == L && hd__mpi_shell_g(cu, sh, k) > iL);
-}
 
 /* The shell's points the first slab answered without proof
  * (sh->unproven) and that can still win: the answer each has now, the
@@ -390,17 +449,18 @@ static int loses(hd__mpi_gcur_t *cu, const hd__mpi_shell_t *sh, size_t k, double
  * slab's proof holds for it (every point of Q outside the slab is then
  * farther; inside, the slab's answer was the nearest); the others ask all
  * of Q (hd__mpi_nearest_in_q again), and the smaller answer is kept (d2
- * first, then the index).  The flags of the points settled without a
- * search are cleared on the way. */
+ * first, then the index).  A point whose answer is its partner, from no
+ * search (HD__MPI_UNSEARCHED), is settled only by losing.  The flags of
+ * the points settled without a search are cleared on the way. */
 static int resolve(hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, const hd__box_t *mine, hd__mpi_qtree_t *q, const hd__mpi_shell_t *sh, double *u2,
-                   uint64_t *jj, double L, uint64_t iL) {
+                   uint64_t *jj, unsigned char *exact, double L, uint64_t iL) {
     hd__mpi_gcur_t cp;
     size_t m = 0;
     hd__mpi_gcur_init(&cp, d->gP);
     for (size_t k = 0; k < sh->n; k++) {
         if (!sh->unproven[k]) continue;
-        int settled = loses(&cp, sh, k, u2[k], L, iL) ||
-                      hd__mpi_slab_proves(mine, q->M0, hd__mpi_shell_pt(d, sh, k), u2[k]);
+        int settled = lost(&cp, sh, k, u2[k], L, iL, exact) ||
+                      (sh->unproven[k] == 1 && hd__mpi_slab_proves(mine, q->M0, hd__mpi_shell_pt(d, sh, k), u2[k]));
         sh->unproven[k] = (unsigned char)!settled;
         m += !settled;
     }
@@ -438,8 +498,8 @@ static hd__mpi_far_t bounds_below(const hd__mpi_ctx_t *c, const hd__mpi_dir_t *d
     for (size_t k = 0; k < sh->n; k++) {
         /* below L's d2, neither (u2[k], its index) nor a lower bound (at
          * most u2[k]) beats L: the index is decoded only when one may */
-        if (u2[k] < L.d2 || (!exact[k] && (!held || (sh->unproven && sh->unproven[k])))) continue;
-        hd__mpi_far_t f = exact[k] ? (hd__mpi_far_t){u2[k], hd__mpi_shell_g(&cp, sh, k), jj[k]}
+        if (u2[k] < L.d2 || (!(exact[k] & 1) && (!held || (sh->unproven && sh->unproven[k])))) continue;
+        hd__mpi_far_t f = exact[k] & 1 ? (hd__mpi_far_t){u2[k], hd__mpi_shell_g(&cp, sh, k), jj[k]}
                                    : (hd__mpi_far_t){lower_bound(c, held, d->qside, hd__mpi_shell_pt(d, sh, k), u2[k]),
                                                      UINT64_MAX, UINT64_MAX};
         if (hd__mpi_far_better(&f, &L)) L = f;
@@ -460,7 +520,7 @@ static int forward(hd__mpi_ctx_t *c, int rc, const hd__mpi_dir_t *d, const hd__m
     hd__mpi_gcur_t cp;
     hd__mpi_gcur_init(&cp, d->gP);
     for (size_t k = 0; k < sh->n && rc == HD_OK; k++) {
-        if (exact[k] || (pick && !pick[k]) || loses(&cp, sh, k, u2[k], L, iL)) continue;
+        if (exact[k] || (pick && !pick[k]) || lost(&cp, sh, k, u2[k], L, iL, exact)) continue;
         int n = hd__mpi_asked(tree, nbox, held, c->K, d->qside, d->nQ == 0, hd__mpi_shell_pt(d, sh, k), u2[k],
                               c->rank, list);
         if (n == 0) {
@@ -478,14 +538,14 @@ static int forward(hd__mpi_ctx_t *c, int rc, const hd__mpi_dir_t *d, const hd__m
 
 /* Picks (pick[k] = 1) the CULL_FIRST shell points with the largest u2
  * that are not exact, not unproven and may still win over (L, i_L). */
-static void cull_pick(const hd__mpi_dir_t *d, const hd__mpi_shell_t *sh, const double *u2, const unsigned char *exact,
+static void cull_pick(const hd__mpi_dir_t *d, const hd__mpi_shell_t *sh, const double *u2, unsigned char *exact,
                       double L, uint64_t iL, unsigned char *pick) {
     size_t top[CULL_FIRST], nt = 0;
     hd__mpi_gcur_t cp;
     hd__mpi_gcur_init(&cp, d->gP);
     memset(pick, 0, sh->n);
     for (size_t k = 0; k < sh->n; k++) {
-        if (exact[k] || (sh->unproven && sh->unproven[k]) || loses(&cp, sh, k, u2[k], L, iL)) continue;
+        if (exact[k] || (sh->unproven && sh->unproven[k]) || lost(&cp, sh, k, u2[k], L, iL, exact)) continue;
         if (nt == CULL_FIRST && !(u2[k] > u2[top[nt - 1]])) continue;
         size_t t = nt < CULL_FIRST ? nt++ : nt - 1; /* insertion, largest first */
         for (; t > 0 && u2[top[t - 1]] < u2[k]; t--) top[t] = top[t - 1];
@@ -525,7 +585,7 @@ static int one_sided_bounds(hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, const qsam
     part.n = n;
     part.own_pos = pos;
     for (size_t k = 0; k < n; k++) u2[k] = INFINITY, jj[k] = UINT64_MAX, exact[k] = 0;
-    return sample_bounds(c, d, &part, qs, L.d2, u2, jj, exact);
+    return sample_bounds(c, d, &part, qs, L.d2, L.i, u2, jj, exact);
 }
 
 static int one_sided_loses(const hd__mpi_dir_t *d, uint32_t pos, double u2, hd__mpi_far_t L) {
@@ -617,7 +677,7 @@ static int deferred_answers(hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, const hd__
             uint64_t g = hd__mpi_gcur_at(&cq, near[k]);
             if (d2 < u2[k] || (d2 == u2[k] && g < jj[k])) u2[k] = d2, jj[k] = g;
         }
-        if (exact[k]) sh->unproven[k] = 0; /* the sample was all of Q */
+        if (exact[k] & 1) sh->unproven[k] = 0; /* the sample was all of Q */
         else exact[k] = (unsigned char)(!sh->unproven[k] && hd__mpi_faces_clear(mine, p, u2[k]));
     }
     hd__mpi_free(c, near, n, sizeof(size_t));
@@ -711,7 +771,7 @@ int hd__mpi_direction(hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, const hd__mpi_no
         if (rc == HD_OK && !(pick = hd__mpi_alloc(c, nP, 1))) rc = hd__mpi_nomem(c, "per-point bounds", nP);
         if (rc == HD_OK && d->nQ) rc = deferred_answers(c, d, mine, &q, &sh, u2, jj, exact);
     } else {
-        rc = sample_bounds(c, d, &sh, &qs, Lall.d2, u2, jj, exact);
+        rc = sample_bounds(c, d, &sh, &qs, Lall.d2, Lall.i, u2, jj, exact);
     }
     c->search += hd__now() - t0;
     c->search_cpu += hd__mpi_cpu() - u0;
@@ -728,13 +788,13 @@ int hd__mpi_direction(hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, const hd__mpi_no
     /* The second round: every other point that may still win. */
     if ((rc = forward(c, rc, d, &sh, tree, nbox, held, NULL, L, iL, list, &an, u2, jj, exact)) != HD_OK) goto done;
     /* local: a failure goes on to the agreement below, as the interior's */
-    if (nP && d->nQ) rc = resolve(c, d, mine, &q, &sh, u2, jj, L, iL);
+    if (nP && d->nQ) rc = resolve(c, d, mine, &q, &sh, u2, jj, exact, L, iL);
     /* Every point that could win is now exact; the others cannot win (a
      * point at L with a larger index than i_L loses to i_L). */
     hd__mpi_far_t best = sh.inner;
     hd__mpi_gcur_init(&cp, d->gP);
     for (size_t k = 0; k < nP; k++) {
-        if (loses(&cp, &sh, k, u2[k], L, iL)) continue;
+        if (lost(&cp, &sh, k, u2[k], L, iL, exact)) continue;
         hd__mpi_far_t f = {u2[k], hd__mpi_shell_g(&cp, &sh, k), jj[k]};
         if (hd__mpi_far_better(&f, &best)) best = f;
     }

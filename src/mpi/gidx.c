@@ -165,25 +165,39 @@ static void seq_begin(seq_t *q, hd__mpi_gidx_t *x, size_t k) {
     q->hw = SIZE_MAX, q->hacc = 0;
 }
 
-static inline void seq_put(seq_t *q, size_t k, uint64_t o) {
-    uint64_t h = (o >> q->l) + k;
-    if ((size_t)(h >> 6) != q->hw) {
-        if (q->hw != SIZE_MAX) q->high[q->hw] |= q->hacc;
-        q->hw = (size_t)(h >> 6), q->hacc = 0;
-    }
-    q->hacc |= UINT64_C(1) << (h & 63);
-    if ((k & 63) == 0) q->samp[k >> 6] = h;
-    if (q->l) {
-        uint64_t v = o & ((UINT64_C(1) << q->l) - 1);
-        unsigned s = (unsigned)(q->lbit & 63);
-        q->lacc |= v << s;
-        if (s + (unsigned)q->l >= 64) {
-            q->low[q->lbit >> 6] |= q->lacc;
-            q->lacc = s + (unsigned)q->l > 64 ? v >> (64 - s) : 0;
+/* Ordinals o[0 .. m - 1] at positions k .. k + m - 1, the state in
+ * locals for the loop (through q, every store to the code's words would
+ * make the compiler load q's fields again: they may alias). */
+static void seq_puts(seq_t *q, size_t k, const uint64_t *o, size_t m) {
+    uint64_t *const high = q->high, *const low = q->low, *const samp = q->samp;
+    const int l = q->l;
+    const uint64_t lmask = l ? (UINT64_C(1) << l) - 1 : 0;
+    uint64_t lbit = q->lbit, lacc = q->lacc, hacc = q->hacc;
+    size_t hw = q->hw;
+    for (size_t t = 0; t < m; t++, k++) {
+        uint64_t h = (o[t] >> l) + k;
+        if ((size_t)(h >> 6) != hw) {
+            if (hw != SIZE_MAX) high[hw] |= hacc;
+            hw = (size_t)(h >> 6), hacc = 0;
         }
-        q->lbit += (uint64_t)q->l;
+        hacc |= UINT64_C(1) << (h & 63);
+        if ((k & 63) == 0) samp[k >> 6] = h;
+        if (l) {
+            uint64_t v = o[t] & lmask;
+            unsigned s = (unsigned)(lbit & 63);
+            lacc |= v << s;
+            if (s + (unsigned)l >= 64) {
+                low[lbit >> 6] |= lacc;
+                lacc = s + (unsigned)l > 64 ? v >> (64 - s) : 0;
+            }
+            lbit += (uint64_t)l;
+        }
     }
+    q->lbit = lbit, q->lacc = lacc, q->hacc = hacc, q->hw = hw;
 }
+
+/* Ordinals go to seq_puts through a buffer of this many on the stack. */
+#define SEQ_BUF 256
 
 static void seq_end(seq_t *q) {
     if (q->hw != SIZE_MAX) q->high[q->hw] |= q->hacc;
@@ -197,14 +211,19 @@ void hd__mpi_gidx_put_numbers(hd__mpi_gidx_t *x, const hd__mpi_ranges_t *rg, int
     size_t i = rg->seg[(size_t)x->side * ((size_t)rg->K + 1) + (size_t)r];
     /* rank r's run i: numbers first .. first + span, ordinals from ob */
     uint64_t first = UINT64_MAX, span = 0, ob = 0; /* m - first > span: no run yet */
-    for (size_t t = 0; t < n; t++) {
-        uint64_t m = num[t];
-        if (m - first > span) {
-            hd__mpi_ranges_seek(rg, x->side, r, &i, m);
-            first = rg->first[i], span = rg->all[i].hi - rg->all[i].lo;
-            ob = x->rord[run_at(x, rg->all[i].lo)];
+    uint64_t o[SEQ_BUF];
+    for (size_t t0 = 0; t0 < n; t0 += SEQ_BUF) {
+        size_t b = n - t0 < SEQ_BUF ? n - t0 : SEQ_BUF;
+        for (size_t t = 0; t < b; t++) {
+            uint64_t m = num[t0 + t];
+            if (m - first > span) {
+                hd__mpi_ranges_seek(rg, x->side, r, &i, m);
+                first = rg->first[i], span = rg->all[i].hi - rg->all[i].lo;
+                ob = x->rord[run_at(x, rg->all[i].lo)];
+            }
+            o[t] = ob + (m - first);
         }
-        seq_put(&q, k + t, ob + (m - first));
+        seq_puts(&q, k + t0, o, b);
     }
     seq_end(&q);
 }
@@ -214,10 +233,16 @@ void hd__mpi_gidx_put_indices(hd__mpi_gidx_t *x, size_t k, const uint64_t *g, si
     seq_t q;
     seq_begin(&q, x, k);
     size_t i = run_at(x, g[0]);
-    for (size_t t = 0; t < n; t++) {
-        while (g[t] > x->run[i].hi) i++;
-        assert(i < x->nrun && g[t] >= x->run[i].lo);
-        seq_put(&q, k + t, x->rord[i] + (g[t] - x->run[i].lo));
+    uint64_t o[SEQ_BUF];
+    for (size_t t0 = 0; t0 < n; t0 += SEQ_BUF) {
+        size_t b = n - t0 < SEQ_BUF ? n - t0 : SEQ_BUF;
+        for (size_t t = 0; t < b; t++) {
+            uint64_t gt = g[t0 + t];
+            while (gt > x->run[i].hi) i++;
+            assert(i < x->nrun && gt >= x->run[i].lo);
+            o[t] = x->rord[i] + (gt - x->run[i].lo);
+        }
+        seq_puts(&q, k + t0, o, b);
     }
     seq_end(&q);
 }
@@ -255,6 +280,94 @@ void hd__mpi_gidx_decode(const hd__mpi_gidx_t *x, size_t k, size_t m, uint64_t *
         at = ((uint64_t)wi << 6) | (uint64_t)__builtin_ctzll(w);
         w &= w - 1;
     }
+}
+
+/* A walk over every position in order, for hd__mpi_gidx_common: the next
+ * 1 of the high bits, the low bits read from the bit after the last's, and
+ * the run only forward (ordinals grow).  Everything it reads is held here,
+ * not read through the code's struct: the caller's byte stores may alias
+ * any memory, and the compiler would load each field again after each. */
+typedef struct {
+    const uint64_t *high, *low, *rord;
+    const hd__mpi_range_t *run;
+    size_t nrun, wi, r;
+    uint64_t w, lbit, mask, next, delta; /* next: the next run's first ordinal; delta: index - ordinal in run r */
+    int l;
+} walk_t;
+
+static void walk_run(walk_t *v) {
+    v->next = v->r + 1 < v->nrun ? v->rord[v->r + 1] : UINT64_MAX;
+    v->delta = v->run[v->r].lo - v->rord[v->r]; /* modulo 2^64: o + delta is the index */
+}
+
+static void walk_init(walk_t *v, const hd__mpi_gidx_t *x) {
+    *v = (walk_t){x->high, x->low, x->rord, x->run, x->nrun, 0, 0, x->n ? x->high[0] : 0, 0, 0, 0, 0, x->l};
+    v->mask = x->l ? (UINT64_C(1) << x->l) - 1 : 0;
+    walk_run(v);
+}
+
+/* Positions k .. k + m - 1's indices into g[0 .. m - 1] (k: the walk's
+ * count so far), with the walk's state in locals for the loop. */
+static void walk_block(walk_t *v, size_t k, size_t m, uint64_t *g) {
+    const uint64_t *high = v->high, *low = v->low, mask = v->mask;
+    const int l = v->l;
+    size_t wi = v->wi;
+    uint64_t w = v->w, lbit = v->lbit, next = v->next, delta = v->delta;
+    for (size_t t = 0; t < m; t++) {
+        while (!w) w = high[++wi];
+        uint64_t o = (((uint64_t)wi << 6) | (uint64_t)__builtin_ctzll(w)) - (k + t);
+        w &= w - 1;
+        if (l) {
+            size_t wd = (size_t)(lbit >> 6);
+            unsigned b = (unsigned)(lbit & 63);
+            uint64_t lo = low[wd] >> b;
+            if (b + (unsigned)l > 64) lo |= low[wd + 1] << (64 - b);
+            o = (o << l) | (lo & mask);
+            lbit += (uint64_t)l;
+        }
+        if (o >= next) {
+            while (o >= v->next) v->r++, walk_run(v);
+            next = v->next, delta = v->delta;
+        }
+        g[t] = o + delta;
+    }
+    v->wi = wi, v->w = w, v->lbit = lbit;
+}
+
+/* Decoded a block at a time (WALK_BLOCK indices a side, on the stack). */
+#define WALK_BLOCK 256
+
+size_t hd__mpi_gidx_common(const hd__mpi_gidx_t *p, const hd__mpi_gidx_t *q, unsigned char *mp, unsigned char *mq) {
+    size_t np = p->n, nq = q->n, nc = 0;
+    if (np == 0 || nq == 0) return 0;
+    walk_t a, b;
+    walk_init(&a, p);
+    walk_init(&b, q);
+    uint64_t ga[WALK_BLOCK], gb[WALK_BLOCK];
+    size_t i0 = 0, j0 = 0, ma = 0, mb = 0, i = 0, j = 0; /* blocks [i0, i0 + ma), [j0, j0 + mb); i, j in them */
+    for (;;) {
+        if (i == ma) {
+            i0 += ma, i = 0, ma = np - i0 < WALK_BLOCK ? np - i0 : WALK_BLOCK;
+            if (ma == 0) break;
+            walk_block(&a, i0, ma, ga);
+        }
+        if (j == mb) {
+            j0 += mb, j = 0, mb = nq - j0 < WALK_BLOCK ? nq - j0 : WALK_BLOCK;
+            if (mb == 0) break;
+            walk_block(&b, j0, mb, gb);
+        }
+        while (i < ma && j < mb) {
+            uint64_t gi = ga[i], gj = gb[j];
+            if (gi == gj) {
+                if (mp) mp[i0 + i] = mq[j0 + j] = 1;
+                nc++, i++, j++;
+            } else {
+                i += gi < gj;
+                j += gj < gi;
+            }
+        }
+    }
+    return nc;
 }
 
 void hd__mpi_gcur_init(hd__mpi_gcur_t *cu, const hd__mpi_gidx_t *x) {

@@ -109,6 +109,12 @@ uint64_t hd__mpi_gidx(const hd__mpi_gidx_t *x, size_t k);
  * first, then the 1s of the high bits in order and the runs only forward
  * (a fraction of a cursor's cost a position, when all are wanted). */
 void hd__mpi_gidx_decode(const hd__mpi_gidx_t *x, size_t k, size_t m, uint64_t *g);
+/* The global indices two local sets share (each in index order): their
+ * number, and, when mp is not NULL, mp[i] = mq[j] = 1 at each pair of
+ * positions holding the same index (the other bytes untouched).  One
+ * merge walk over both codes in order (the 1s of the high bits and the
+ * low bits as they come: no select, no cursor). */
+size_t hd__mpi_gidx_common(const hd__mpi_gidx_t *p, const hd__mpi_gidx_t *q, unsigned char *mp, unsigned char *mq);
 
 /* The low l bits of position k's ordinal. */
 static inline uint64_t hd__mpi_gidx_low(const hd__mpi_gidx_t *x, size_t k) {

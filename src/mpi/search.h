@@ -49,6 +49,31 @@ static inline int hd__mpi_faces_clear(const hd__box_t *r, const double *p, doubl
     return 1;
 }
 
+/* hd__mpi_faces_clear for many points: the region's finite faces listed
+ * once (axis and coordinate), so a point tests only those (one at K = 2).
+ * The gap's sign does not matter: fl(s - p) = -fl(p - s), and the square
+ * is the same. */
+typedef struct {
+    int n, ax[6];
+    double at[6];
+} hd__mpi_faces_t;
+
+static inline void hd__mpi_faces_of(const hd__box_t *r, hd__mpi_faces_t *f) {
+    f->n = 0;
+    for (int a = 0; a < 3; a++) {
+        if (isfinite(r->lo[a])) f->ax[f->n] = a, f->at[f->n++] = r->lo[a];
+        if (isfinite(r->hi[a])) f->ax[f->n] = a, f->at[f->n++] = r->hi[a];
+    }
+}
+
+static inline int hd__mpi_faces_clear_of(const hd__mpi_faces_t *f, const double *p, double u2) {
+    for (int t = 0; t < f->n; t++) {
+        double g = p[f->ax[t]] - f->at[t];
+        if (!(g * g > u2)) return 0;
+    }
+    return 1;
+}
+
 /* The slabs of the searched local set Q (slab.c has the proof). */
 typedef struct {
     hd__an_t s;
@@ -105,8 +130,11 @@ typedef struct {
     size_t n;                /* the shell's points, read in P (hd__mpi_shell_pt) */
     size_t *nearest;         /* each one's nearest in Q (NULL if Q is empty) */
     uint32_t *own_pos;       /* each one's position in P (NULL: all of P) */
-    unsigned char *unproven; /* each one's: nearest[] only a point of the first slab
-                                (hd__mpi_nearest_in_q), or NULL */
+    unsigned char *unproven; /* each one's: 0, nearest[] exact over the local Q;
+                                1, only a point of the first slab
+                                (hd__mpi_nearest_in_q); HD__MPI_UNSEARCHED,
+                                its partner (shell.c, paired_shell);
+                                or NULL: all exact */
     hd__mpi_far_t inner;             /* exact over the interior; d2 = -1 if none
                                 or not known (lazy) */
     int lazy;                /* the interior's maximum was not computed */
@@ -116,6 +144,10 @@ typedef struct {
     hd__mpi_far_t h;                 /* then: the engine's answer, whose witness
                                 is in the shell and bounds the interior */
 } hd__mpi_shell_t;
+
+/* A shell point's answer that is a bound only, from no search (its
+ * partner): never proven by the first slab's test (forward.c, resolve). */
+#define HD__MPI_UNSEARCHED 2
 
 /* The shell's point k: its coordinates are P's, not a copy. */
 static inline const double *hd__mpi_shell_pt(const hd__mpi_dir_t *d, const hd__mpi_shell_t *sh, size_t k) {

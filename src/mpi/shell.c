@@ -84,7 +84,7 @@ HD__INLINE void swap3(double *xyz, size_t i, size_t k) {
 }
 
 static double *aside_for(hd__mpi_ctx_t *c, size_t n, size_t dropped) {
-    return dropped <= n / 64 ? hd__mpi_alloc(c, dropped, 3 * sizeof(double)) : NULL;
+    return dropped <= n / 16 ? hd__mpi_alloc(c, dropped, 3 * sizeof(double)) : NULL;
 }
 
 /* Whether position k is dropped, walking forwards (o: the next listed
@@ -167,28 +167,9 @@ static size_t kept_at(keep_t kp, size_t n, size_t m) {
  * orders. */
 static size_t mark_pairs(const hd__mpi_gidx_t *gP, size_t nP, const hd__mpi_gidx_t *gQ, size_t nQ, unsigned char *inp,
                          unsigned char *inq) {
-    if (nP == 0 || nQ == 0) return 0;
-    hd__mpi_gcur_t cp, cq;
-    hd__mpi_gcur_init(&cp, gP);
-    hd__mpi_gcur_init(&cq, gQ);
-    size_t i = 0, j = 0, nc = 0;
-    uint64_t gi = hd__mpi_gcur_at(&cp, 0), gj = hd__mpi_gcur_at(&cq, 0);
-    for (;;) {
-        if (gi == gj) {
-            if (inp) inp[i] = inq[j] = 1;
-            nc++;
-            if (++i == nP || ++j == nQ) break;
-            gi = hd__mpi_gcur_at(&cp, i);
-            gj = hd__mpi_gcur_at(&cq, j);
-        } else if (gi < gj) {
-            if (++i == nP) break;
-            gi = hd__mpi_gcur_at(&cp, i);
-        } else {
-            if (++j == nQ) break;
-            gj = hd__mpi_gcur_at(&cq, j);
-        }
-    }
-    return nc;
+    assert(gP->n == nP && gQ->n == nQ);
+    (void)nP, (void)nQ;
+    return hd__mpi_gidx_common(gP, gQ, inp, inq);
 }
 
 /* Whether the merge walk of mark_pairs is worth it: at least three
@@ -385,13 +366,23 @@ int hd__mpi_engine_both(hd__mpi_ctx_t *c, double *xyz[2], const hd__mpi_gidx_t *
  * of P_c with u^2 = h_c has u_c^2 = h_c too, so an index no smaller than
  * a*'s (the engine's tie rule).  The witness's j is the engine's, or the
  * smallest index of Q_x at exactly h_c.  Otherwise (*done = 0) the caller
- * runs the engine on the whole local sets (or takes d->pre's answer). */
+ * runs the engine on the whole local sets (or takes d->pre's answer).
+ * Done, *inq_out is Q's pairs' mask for paired_shell (*ownq_out: the
+ * caller frees it, when it is this pass's own). */
+/* paired_pass's mask of P: a pair whose faces are clear of h_c (the
+ * interior), a pair that is not (the shell), or 0: no partner here (the
+ * shell too). */
+#define INTERIOR 1
+#define PAIRED_SHELL 2
+
 static int paired_pass(hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, const hd__box_t *mine, unsigned char **inp, size_t *nI,
-                       hd__mpi_far_t *inner, int *done) {
+                       hd__mpi_far_t *inner, int *done, unsigned char **ownq_out, const unsigned char **inq_out) {
     size_t nP = d->nP, nQ = d->nQ, nc;
     const hd__mpi_pre_t *pre = d->pre && d->pre->have ? d->pre : NULL;
     *done = 0;
     *inp = NULL;
+    *ownq_out = NULL;
+    *inq_out = NULL;
     if (pre && !pre->paired) return HD_OK;
     if (!pre && (!pairs_likely(d->P, d->gP, nP, d->Q, d->gQ, nQ) ||
                  !is_paired(nc = mark_pairs(d->gP, nP, d->gQ, nQ, NULL, NULL), nP, nQ)))
@@ -420,22 +411,34 @@ static int paired_pass(hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, const hd__box_t
         keep_t kp = {in, NULL, 0};
         size_t astar = kept_at(kp, nP, e[0].i);
         uint64_t gi = hd__mpi_gidx(d->gP, astar), jc = hd__mpi_gidx(d->gP, kept_at(kp, nP, e[0].j));
+        /* in[i]: INTERIOR, PAIRED_SHELL (a pair, faces not clear), or 0
+         * (no partner here: shell too) */
+        hd__mpi_faces_t fc;
+        hd__mpi_faces_of(mine, &fc);
         *nI = 0;
-        for (size_t i = 0; i < nP; i++)
-            *nI += in[i] = (unsigned char)(in[i] && hd__mpi_faces_clear(mine, d->P + 3 * i, e[0].distance2));
+        for (size_t i = 0; i < nP; i++) {
+            int clear = in[i] && hd__mpi_faces_clear_of(&fc, d->P + 3 * i, e[0].distance2);
+            *nI += (size_t)clear;
+            in[i] = clear ? INTERIOR : in[i] ? PAIRED_SHELL : 0;
+        }
         /* The nearest point of Q_x to a* (position order is index order:
          * the first at the minimum is the smallest index). */
         double v = INFINITY;
         size_t jx = SIZE_MAX;
-        for (size_t j = 0; j < nQ && in[astar]; j++) {
-            if (inq[j]) continue;
+        for (size_t j = 0; j < nQ && in[astar] == INTERIOR; j++) {
+            const unsigned char *z = memchr(inq + j, 0, nQ - j); /* the next of Q_x */
+            if (!z) break;
+            j = (size_t)(z - inq);
             double d2 = hd__d2(d->P + 3 * astar, d->Q + 3 * j);
             if (d2 < v) v = d2, jx = j;
         }
         uint64_t jv = jx == SIZE_MAX ? UINT64_MAX : hd__mpi_gidx(d->gQ, jx);
-        if (in[astar] && v >= e[0].distance2) {
+        if (in[astar] == INTERIOR && v >= e[0].distance2) {
             *inner = (hd__mpi_far_t){e[0].distance2, gi, v == e[0].distance2 && jv < jc ? jv : jc};
             *done = 1;
+            *inq_out = inq; /* the shell's partners (paired_shell) */
+            *ownq_out = ownq;
+            return rc;
         }
     }
 done:
@@ -530,6 +533,66 @@ static int refused_shell(hd__mpi_ctx_t *c, const hd__mpi_refused_t *ref, uint32_
     return HD_OK;
 }
 
+/* The shell of a paired pass that is done (in[k] != INTERIOR, nS points):
+ * a point whose partner is here takes it as its answer, a point of Q and
+ * so an upper bound of its nearest distance, not searched
+ * (HD__MPI_UNSEARCHED): forward.c searches it only when that bound may
+ * still win over (L, i_L) (resolve), and on a copy, or a lattice against
+ * its shift, almost every shell point's partner distance is below the
+ * interior's answer or ties it at a larger index, so none is.  A point
+ * without its partner here is searched now (hd__mpi_nearest_in_q), as
+ * every shell point is otherwise.  P_c's m-th point's partner is Q_c's
+ * m-th (both in index order). */
+/* Whether the 8 bytes at p are all 1 (INTERIOR, or a pair in Q's mask):
+ * paired_shell steps over those 8 at a time. */
+HD__INLINE int all_ones(const unsigned char *p) {
+    uint64_t w;
+    memcpy(&w, p, sizeof w);
+    return w == UINT64_C(0x0101010101010101);
+}
+
+static int paired_shell(hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, const hd__box_t *mine, hd__mpi_qtree_t *q,
+                        const unsigned char *in, const unsigned char *inq, size_t nS, hd__mpi_shell_t *sh) {
+    sh->own_pos = hd__mpi_alloc(c, nS, sizeof(uint32_t));
+    sh->nearest = hd__mpi_alloc(c, nS, sizeof(size_t));
+    sh->unproven = hd__mpi_alloc(c, nS, 1);
+    if (!sh->own_pos || !sh->nearest || !sh->unproven) return hd__mpi_nomem(c, "the shell", nS);
+    size_t t = 0, m = 0;
+    for (size_t k = 0, j = 0; k < d->nP; k++) {
+        while (k + 8 <= d->nP && j + 8 <= d->nQ && all_ones(in + k) && all_ones(inq + j)) k += 8, j += 8;
+        if (k == d->nP) break;
+        if (in[k] == INTERIOR) {
+            while (!inq[j]) j++;
+            j++;
+            continue;
+        }
+        sh->own_pos[t] = (uint32_t)k;
+        sh->unproven[t] = in[k] ? HD__MPI_UNSEARCHED : 0;
+        if (in[k]) {
+            while (!inq[j]) j++;
+            sh->nearest[t] = j++;
+        }
+        m += !in[k];
+        t++;
+    }
+    assert(t == nS);
+    if (m == 0) return HD_OK;
+    /* the points without a partner here, searched now */
+    uint32_t *pos = hd__mpi_alloc(c, m, sizeof(uint32_t));
+    size_t *near = hd__mpi_alloc(c, m, sizeof(size_t));
+    unsigned char *unp = hd__mpi_alloc(c, m, 1);
+    int rc = pos && near && unp ? HD_OK : hd__mpi_nomem(c, "nearest neighbours", m);
+    for (size_t k = 0, u = 0; k < nS && rc == HD_OK; k++)
+        if (!sh->unproven[k]) pos[u++] = sh->own_pos[k];
+    if (rc == HD_OK) memset(unp, 0, m), rc = hd__mpi_nearest_in_q(c, d, mine, q, d->P, pos, m, near, unp);
+    for (size_t k = 0, u = 0; k < nS && rc == HD_OK; k++)
+        if (!sh->unproven[k]) sh->nearest[k] = near[u], sh->unproven[k] = unp[u++];
+    hd__mpi_free(c, pos, m, sizeof(uint32_t));
+    hd__mpi_free(c, near, m, sizeof(size_t));
+    hd__mpi_free(c, unp, m, 1);
+    return rc;
+}
+
 /* The smallest shell searched after the sample's bounds rather than one by
  * one (below), when it is also at least half of P: a shell of a few
  * points is searched at once, and on two epochs of one scene the shell is
@@ -546,7 +609,9 @@ int hd__mpi_shell_of(hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, const hd__box_t *
     unsigned char *in = NULL; /* allocated after the engine's pass, the peak */
     size_t nI = 0;
     int done = 0;
-    int rc = paired_pass(c, d, mine, &in, &nI, &sh->inner, &done);
+    unsigned char *ownq = NULL; /* Q's pairs' mask, when the paired pass made it */
+    const unsigned char *inq = NULL;
+    int rc = paired_pass(c, d, mine, &in, &nI, &sh->inner, &done, &ownq, &inq);
     const hd__mpi_pre_t *pre = d->pre && d->pre->have && !d->pre->paired ? d->pre : NULL;
     /* The engine's answer over the points kept (hd__mpi_engine_both): every
      * point of P either was refused (its faces not clear of its own u), or
@@ -592,12 +657,15 @@ int hd__mpi_shell_of(hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, const hd__box_t *
         /* Unfiltered: the engine's answer is the rank's largest u, which
          * only the points whose faces are clear of it may take as global */
         if (!in && !(in = hd__mpi_alloc(c, d->nP, 1))) rc = hd__mpi_nomem(c, "the interior", d->nP);
+        hd__mpi_faces_t fc;
+        hd__mpi_faces_of(mine, &fc);
         nI = 0;
         for (size_t k = 0; k < d->nP && rc == HD_OK; k++)
-            nI += in[k] = (unsigned char)hd__mpi_faces_clear(mine, d->P + 3 * k, e.distance2);
+            nI += in[k] = (unsigned char)hd__mpi_faces_clear_of(&fc, d->P + 3 * k, e.distance2);
     }
     if (rc != HD_OK) {
         hd__mpi_free(c, in, d->nP, 1);
+        hd__mpi_free(c, ownq, d->nQ, 1);
         hd__mpi_free(c, refpos, nref, sizeof(uint32_t));
         hd__mpi_free(c, refnear, nref, sizeof(size_t));
         refused_free(c, &own);
@@ -633,6 +701,9 @@ int hd__mpi_shell_of(hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, const hd__box_t *
         assert(nI > 0);
         sh->own_pos = refpos;
         sh->nearest = refnear; /* exact over all of Q: nothing unproven */
+    } else if (rc == HD_OK && done && nS) { /* the paired pass's shell, with its partners */
+        sh->n = nS;
+        rc = paired_shell(c, d, mine, q, in, inq, nS, sh);
     } else if (rc == HD_OK && nS && nI) { /* a proper subset: its positions */
         sh->n = nS;
         if (!(sh->own_pos = hd__mpi_alloc(c, nS, sizeof(uint32_t)))) rc = hd__mpi_nomem(c, "the shell", nS);
@@ -641,6 +712,8 @@ int hd__mpi_shell_of(hd__mpi_ctx_t *c, const hd__mpi_dir_t *d, const hd__box_t *
     }
     sh->n = nS;
     hd__mpi_free(c, in, d->nP, 1);
+    hd__mpi_free(c, ownq, d->nQ, 1);
+    if (done) return rc; /* every shell point has its answer or bound (paired_shell) */
     /* A shell of most of P (sets far apart: every point within h of a
      * face) is not searched one by one here: the sample's bounds come
      * first and only the points that may still win are searched

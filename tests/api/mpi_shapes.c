@@ -4,7 +4,12 @@
  * (every point of A in regions without B), two cubes 2 apart, a large set
  * against a tiny one both ways, a terrain with a tower in A only (a local
  * change), a lattice against its half-step shift (ties everywhere) and
- * two cubes overlapping by half.
+ * two cubes overlapping by half, and a copy (B = A and up to 0.5 of noise)
+ * of a box twice as long in x with a hole at its middle, where the
+ * farthest point of A lies within a spacing of the split plane, its
+ * partner moved far off on its own side and another pair nearer to it
+ * than any point across the plane (a partner's distance is only a bound:
+ * shell.c, paired_shell).
  * On each, at the K of tests/mpi.cmake:
  *  - the result equals hd_hausdorff's (and hd_directed's) on the whole
  *    sets bit for bit, witnesses included;
@@ -36,10 +41,11 @@
 #include "gen.h"
 #include "mpicheck.h"
 
-enum { APART, NEAR, TINY_B, TINY_A, TOWER, LATTICE, HALF, SHAPES };
+enum { APART, NEAR, TINY_B, TINY_A, TOWER, LATTICE, HALF, HOLE, SHAPES };
 static const char *const shape_name[SHAPES] = {"cubes 300 apart", "cubes 2 apart", "large A, 40 points of B",
                                                "40 points of A, large B", "terrain with a tower in A",
-                                               "lattice against its half-step shift", "cubes overlapping by half"};
+                                               "lattice against its half-step shift", "cubes overlapping by half",
+                                               "a copy with its farthest point at the middle plane"};
 
 /* A terrain of n points over [0, 400]^2 with, when tower, a tower 60 high
  * on a square of 12 (a tenth of the points on its roof and walls). */
@@ -52,11 +58,44 @@ static void terrain(gen_rng_t *g, double *p, size_t n, int tower) {
     }
 }
 
+/* A copy whose shell holds a point that its partner's distance would
+ * make the farthest: n points uniform in [0, 200] x [0, 100]^2 but none
+ * within 10 of c0 = (103, 50, 50) nor within 12 of c1 = (30, 50, 50) and
+ * c2 = (170, 50, 50), B each point moved by up to 0.5 on each axis (point k of B is
+ * point k of A moved).  Point 0 of A at c0, its partner at (190, 90, 90),
+ * point 1 of A and B at 8 above c0: point 0's nearest in B is point 1, at
+ * 8, whatever the split near x = 100 (every point across it is more than
+ * 9 away; the noise makes some pairs straddle the split, so that the
+ * ranks' sets are not whole copies and the pairs pass runs).  Points 2 and 4 of A at c1 and c2, each with its partner 9
+ * below it and the next point of A and B 9 above: the farthest points of
+ * A, at 9, far from every face at K = 2, one on each side of the split,
+ * so that each rank's pairs pass is settled by its interior.  Taking
+ * point 0's partner (about 100 off) as its answer instead of searching it
+ * makes point 0 the farthest, at about 10 (the nearest point across the
+ * plane). */
+static void copy_with_hole(gen_rng_t *g, double *a, double *b, size_t n) {
+    const double c[3][3] = {{103, 50, 50}, {30, 50, 50}, {170, 50, 50}}, r2[3] = {100, 144, 144};
+    for (size_t k = 0; k < n; k++) {
+        double *p = a + 3 * k;
+        for (int in = 1; in;) {
+            p[0] = 200 * gen_unit(g), p[1] = 100 * gen_unit(g), p[2] = 100 * gen_unit(g), in = 0;
+            for (int h = 0; h < 3; h++)
+                in |= (p[0] - c[h][0]) * (p[0] - c[h][0]) + (p[1] - c[h][1]) * (p[1] - c[h][1]) +
+                          (p[2] - c[h][2]) * (p[2] - c[h][2]) < r2[h];
+        }
+        for (int t = 0; t < 3; t++) b[3 * k + t] = p[t] + 0.5 * (2 * gen_unit(g) - 1);
+    }
+    const double pts[6][2][3] = {{{103, 50, 50}, {190, 90, 90}}, {{103, 50, 58}, {103, 50, 58}},
+                                 {{30, 50, 50}, {30, 50, 41}},   {{30, 50, 59}, {30, 50, 59}},
+                                 {{170, 50, 50}, {170, 50, 41}}, {{170, 50, 59}, {170, 50, 59}}};
+    for (int k = 0; k < 6; k++) memcpy(a + 3 * k, pts[k][0], sizeof pts[k][0]), memcpy(b + 3 * k, pts[k][1], sizeof pts[k][1]);
+}
+
 /* The shape's two sets (malloc'd, packed xyz) from the seed. */
 static void make(int shape, uint64_t seed, double **a, size_t *na, double **b, size_t *nb) {
     gen_rng_t g;
     gen_seed(&g, seed);
-    size_t sizes[SHAPES][2] = {{30000, 30000}, {20000, 25000}, {60000, 40}, {40, 60000}, {40000, 40000}, {27000, 27000}, {30000, 30000}};
+    size_t sizes[SHAPES][2] = {{30000, 30000}, {20000, 25000}, {60000, 40}, {40, 60000}, {40000, 40000}, {27000, 27000}, {30000, 30000}, {30000, 30000}};
     *na = sizes[shape][0], *nb = sizes[shape][1];
     *a = malloc(3 * *na * sizeof(double));
     *b = malloc(3 * *nb * sizeof(double));
@@ -66,6 +105,8 @@ static void make(int shape, uint64_t seed, double **a, size_t *na, double **b, s
                 double *p = (s ? *b : *a) + 3 * k;
                 p[0] = (double)(k % 30) + 0.5 * s, p[1] = (double)(k / 30 % 30) + 0.5 * s, p[2] = (double)(k / 900) + 0.5 * s;
             }
+    } else if (shape == HOLE) {
+        copy_with_hole(&g, *a, *b, *na);
     } else if (shape == TOWER) {
         terrain(&g, *a, *na, 1);
         terrain(&g, *b, *nb, 0);

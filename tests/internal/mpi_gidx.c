@@ -4,7 +4,9 @@
  * encoded in increasing order over the side's index runs, gives back every
  * index by position (hd__mpi_gidx), through a cursor (hd__mpi_gcur_at)
  * walked in order, with jumps, and backwards, with the rank whose run holds
- * it, and in bulk from any position (hd__mpi_gidx_decode); in less than
+ * it, and in bulk from any position (hd__mpi_gidx_decode); two sides'
+ * shared indices are found by one walk over both codes (hd__mpi_gidx_common,
+ * the pairs of a copy); in less than
  * 4 + log2(U / n) bits a point and a few words, charged to the call while
  * held.  No MPI call is made (the context only counts
  * bytes), so this runs without mpirun; built with the MPI library
@@ -120,6 +122,36 @@ static void check_side(scene_t *sc, int s, gen_rng_t *rng) {
     CHECK_EQ(sc->c.cur, before);
 }
 
+/* Both sides encoded: hd__mpi_gidx_common marks exactly the positions
+ * whose indices the other side holds too (a merge of the plain indices
+ * says which), counts them, and, without masks, counts the same. */
+static void check_common(scene_t *sc) {
+    hd__mpi_gidx_t x[2];
+    for (int s = 0; s < 2; s++) {
+        CHECK_RC(hd__mpi_gidx_init(&sc->c, &x[s], &sc->rg, s, sc->n[s]), HD_OK);
+        hd__mpi_gidx_put_indices(&x[s], 0, sc->g[s], sc->n[s]);
+    }
+    unsigned char *m[2], *want[2];
+    size_t nc = 0;
+    for (int s = 0; s < 2; s++) {
+        m[s] = calloc(sc->n[s] + 1, 1);
+        want[s] = calloc(sc->n[s] + 1, 1);
+    }
+    for (size_t i = 0, j = 0; i < sc->n[0] && j < sc->n[1];) {
+        if (sc->g[0][i] == sc->g[1][j]) want[0][i++] = want[1][j++] = 1, nc++;
+        else if (sc->g[0][i] < sc->g[1][j]) i++;
+        else j++;
+    }
+    CHECK_EQ(hd__mpi_gidx_common(&x[0], &x[1], m[0], m[1]), nc);
+    CHECK_EQ(hd__mpi_gidx_common(&x[0], &x[1], NULL, NULL), nc);
+    for (int s = 0; s < 2; s++) {
+        CHECK(memcmp(m[s], want[s], sc->n[s]) == 0);
+        free(m[s]);
+        free(want[s]);
+        hd__mpi_gidx_free(&sc->c, &x[s]);
+    }
+}
+
 static void check_scene(int K, const hd__mpi_range_t *runs, size_t nruns, double keep, uint64_t seed) {
     gen_rng_t rng;
     gen_seed(&rng, seed);
@@ -130,7 +162,34 @@ static void check_scene(int K, const hd__mpi_range_t *runs, size_t nruns, double
                 sc.n[s]);
         check_side(&sc, s, &rng);
     }
+    if (!hdt_failed()) {
+        CONTEXT("seed=%llu K=%d runs=%zu keep=%g: the indices both sides hold", (unsigned long long)seed, K, nruns,
+                keep);
+        check_common(&sc);
+    }
     scene_free(&sc);
+}
+
+/* A copy's two sides: the same runs (each side's index runs the other's),
+ * each rank's set a random part, as after a partition. */
+TEST(the_indices_both_sides_hold_are_found_in_one_walk) {
+    for (uint64_t seed = 200; seed < 230 && !hdt_failed(); seed++) {
+        gen_rng_t rng;
+        gen_seed(&rng, seed);
+        int K = 1 + (int)(gen_u64(&rng) % 7);
+        size_t nruns = 1 + gen_u64(&rng) % 6;
+        hd__mpi_range_t runs[12];
+        uint64_t at = gen_u64(&rng) % 2 ? 0 : gen_u64(&rng) >> 4;
+        for (size_t i = 0; i < nruns; i++) {
+            uint64_t len = 1 + gen_u64(&rng) % 5000, gap = gen_u64(&rng) % 2 ? 0 : gen_u64(&rng) % 100000;
+            int r = (int)(gen_u64(&rng) % (uint64_t)K);
+            runs[2 * i] = (hd__mpi_range_t){at, at + len - 1, 0, r};
+            runs[2 * i + 1] = (hd__mpi_range_t){at, at + len - 1, 1, (r + K / 2) % K};
+            at += len + gap;
+        }
+        double keep = seed % 3 == 0 ? 1.0 : 0.3 + 0.7 * gen_unit(&rng);
+        check_scene(K, runs, 2 * nruns, keep, seed);
+    }
 }
 
 TEST(an_empty_set_holds_nothing_and_frees_cleanly) {
