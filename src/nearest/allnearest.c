@@ -366,7 +366,7 @@ static void points_box(hd__an_t *s, size_t b, size_t e, size_t k) {
 }
 
 /* The exact boxes of the leaves of buckets [task * BOX_TASK, ...). */
-static void box_task(void *vctx, size_t task, int worker) {
+HD__HOT static void box_task(void *vctx, size_t task, int worker) {
     (void)worker;
     build_ctx *c = vctx;
     hd__an_t *s = c->s;
@@ -808,7 +808,7 @@ HD__INLINE void boxes_lb2(double *const lo[3], double *const hi[3], size_t f, si
  * on the way (each holds a point, so every query in q has a point within
  * them).  When the group is far from t, or the curve's order says little
  * (refined cells), this is a better first bucket than the seeds. */
-static size_t nearest_leaf(const hd__an_t *t, const hd__box_t *q, double *U) {
+HD__HOT static size_t nearest_leaf(const hd__an_t *t, const hd__box_t *q, double *U) {
     for (size_t k = 0;;) {
         double u = node_ub2(q, t, k);
         *U = u < *U ? u : *U;
@@ -827,7 +827,7 @@ static size_t nearest_leaf(const hd__an_t *t, const hd__box_t *q, double *U) {
  * bound <= U), U bounding the answer of every query in q: the buckets left
  * out hold no point that any of them could have as its nearest.  Returns 0,
  * with the list unfinished, as soon as it would hold more than `limit`. */
-static int candidates(const hd__an_t *t, const hd__box_t *q, double U, size_t limit, cands_t *c) {
+HD__HOT static int candidates(const hd__an_t *t, const hd__box_t *q, double U, size_t limit, cands_t *c) {
     uint32_t stack[8 * 11 + 8];
     double slb[8 * 11 + 8];
     int sp = 0;
@@ -1274,7 +1274,7 @@ HD__INLINE double span_bounds(const hd__box_t *q, const double *restrict x, cons
  * the buckets hold more than POINT_LIST points (then nothing is listed).
  * The bounds are taken first, over each bucket's points where t stores
  * them, and only the points kept are copied. */
-static int group_points(const hd__an_t *t, const cands_t *cd, const hd__box_t *q, double U, plist_t *out) {
+HD__HOT static int group_points(const hd__an_t *t, const cands_t *cd, const hd__box_t *q, double U, plist_t *out) {
     if (listed_points(t, cd) > POINT_LIST) return 0;
     double lb[POINT_LIST], V = U;
     size_t m = 0;
@@ -1296,7 +1296,7 @@ static int group_points(const hd__an_t *t, const cands_t *cd, const hd__box_t *q
 
 /* The points of `from` that can be the answer of a query in the box q
  * (a chunk of the group's, answers at most U), the same way, into out. */
-static void chunk_points(const plist_t *from, const hd__box_t *q, double U, plist_t *out) {
+HD__HOT static void chunk_points(const plist_t *from, const hd__box_t *q, double U, plist_t *out) {
     double lb[POINT_LIST];
     double V = span_bounds(q, from->x, from->y, from->z, from->n, lb, U);
     size_t n = 0;
