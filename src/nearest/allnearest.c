@@ -1160,7 +1160,7 @@ HD__INLINE double qgroup_diag2(const qgroup_t *G) {
  * scans nothing first: U = Ub, no query has a best yet, and qgroup_finish
  * answers it from point lists (it is small next to Ub). */
 HD__INLINE int far_group(const hd__an_t *t, const qgroup_t *G, double lb2, double Ub, cands_t *cd) {
-    return G->m >= 2 * CHUNK && qgroup_diag2(G) <= lb2 && candidates(t, &G->box, Ub, FAR_CANDIDATES, cd) &&
+    return qgroup_diag2(G) <= lb2 && candidates(t, &G->box, Ub, FAR_CANDIDATES, cd) &&
            listed_points(t, cd) <= POINT_LIST;
 }
 
@@ -1341,10 +1341,13 @@ HD__INLINE size_t qgroup_finish(query_ctx *c, cands_t *cd, cands_t *ck, qgroup_t
     }
     /* A group small next to its answers' distances (its box's diagonal
      * at most twice the bound U on them) shares its candidate points,
-     * chunk by chunk, while the chunks' lists stay short.  (Which groups
-     * try decides only the cost.) */
+     * chunk by chunk, while the chunks' lists stay short: a far group
+     * (nothing scanned yet, seed_bests) at any size, another when it has
+     * two chunks of queries or more.  (Which groups try decides only the
+     * cost.) */
     plist_t gp, cp;
-    int points = nlisted >= 2 * CHUNK && qgroup_diag2(G) <= 4 * U && group_points(t, cd, &G->box, U, &gp);
+    int points = (nlisted >= 2 * CHUNK || !scanned) && qgroup_diag2(G) <= 4 * U &&
+                 group_points(t, cd, &G->box, U, &gp);
     size_t chunk = windowed ? WINDOW_CHUNK : CHUNK;
     for (size_t r0 = 0; r0 < nlisted; r0 += chunk) {
         size_t r1 = r0 + chunk < nlisted ? r0 + chunk : nlisted;

@@ -709,6 +709,40 @@ TEST(the_window_gives_up_on_disjoint_sets_and_stays_exact) {
     }
 }
 
+/* A's points (na) and B's (nb) on one key box, each asking the other at
+ * `threads` threads: every answer against the brute force; what the
+ * searches took added to c[0] (A->B) and c[1] (B->A). */
+static void check_both_ways(const double *a, size_t na, const double *b, size_t nb, int threads, uint64_t seed,
+                            hd__an_counts_t c[2]) {
+    double *both = malloc(24 * (na + nb));
+    memcpy(both, a, 24 * na), memcpy(both + 3 * na, b, 24 * nb);
+    hd__box_t box;
+    hd__box_of(both, na + nb, &box);
+    hd_points_t A = hd_points_f64(a, na), B = hd_points_f64(b, nb);
+    hd__an_t s[2];
+    CHECK_RC(hd__an_build(&s[0], &A, NULL, &box, threads, NULL), HD_OK);
+    CHECK_RC(hd__an_build(&s[1], &B, NULL, &box, threads, NULL), HD_OK);
+    for (int dir = 0; dir < 2 && !hdt_failed(); dir++) {
+        const double *p = dir ? b : a, *o = dir ? a : b;
+        size_t np = dir ? nb : na, no = dir ? na : nb;
+        double *d = malloc(8 * np);
+        size_t *j = malloc(sizeof(size_t) * np);
+        CHECK_RC(hd__an_nearest(&s[dir], &s[1 - dir], NULL, threads, d, j, &c[dir], NULL), HD_OK);
+        for (size_t i = 0; i < np && !hdt_failed(); i++) {
+            size_t jo;
+            double d2 = brute_nearest(p + 3 * i, o, no, &jo);
+            CONTEXT("seed=%llu %s query %zu (far groups %zu)", (unsigned long long)seed, dir ? "B->A" : "A->B", i,
+                    c[dir].far);
+            CHECK_BITS(d[i], sqrt(d2));
+            CHECK_EQ(j[i], jo);
+        }
+        free(d), free(j);
+    }
+    hd__an_free(&s[0]);
+    hd__an_free(&s[1]);
+    free(both);
+}
+
 TEST(far_groups_are_answered_from_boxes_alone_and_stay_exact) {
     /* A group of queries far from the searched set (its box outside the
      * set's box by more than its own diagonal) lists the buckets within
@@ -734,38 +768,40 @@ TEST(far_groups_are_answered_from_boxes_alone_and_stay_exact) {
             gen_gauss(&g, a, na, m0, 1.0);
             gen_gauss(&g, b, nb, m1, 1.0);
         }
-        double *both = malloc(24 * (na + nb));
-        memcpy(both, a, 24 * na), memcpy(both + 3 * na, b, 24 * nb);
-        hd__box_t box;
-        hd__box_of(both, na + nb, &box);
-        hd_points_t A = hd_points_f64(a, na), B = hd_points_f64(b, nb);
-        hd__an_t s[2];
-        CHECK_RC(hd__an_build(&s[0], &A, NULL, &box, threads, NULL), HD_OK);
-        CHECK_RC(hd__an_build(&s[1], &B, NULL, &box, threads, NULL), HD_OK);
-        for (int dir = 0; dir < 2 && !hdt_failed(); dir++) {
-            const double *p = dir ? b : a, *o = dir ? a : b;
-            size_t np = dir ? nb : na, no = dir ? na : nb;
-            double *d = malloc(8 * np);
-            size_t *j = malloc(sizeof(size_t) * np);
-            hd__an_counts_t c = {0};
-            CHECK_RC(hd__an_nearest(&s[dir], &s[1 - dir], NULL, threads, d, j, &c, NULL), HD_OK);
-            far += c.far;
-            for (size_t i = 0; i < np && !hdt_failed(); i++) {
-                size_t jo;
-                double d2 = brute_nearest(p + 3 * i, o, no, &jo);
-                CONTEXT("seed=%llu %s query %zu (far groups %zu)", (unsigned long long)seed, dir ? "B->A" : "A->B", i,
-                        c.far);
-                CHECK_BITS(d[i], sqrt(d2));
-                CHECK_EQ(j[i], jo);
-            }
-            free(d), free(j);
-        }
-        hd__an_free(&s[0]);
-        hd__an_free(&s[1]);
-        free(a), free(b), free(both);
+        hd__an_counts_t c[2] = {{0}, {0}};
+        check_both_ways(a, na, b, nb, threads, seed, c);
+        far += c[0].far + c[1].far;
+        free(a), free(b);
     }
     CONTEXT("far groups: %zu", far);
     CHECK(far > 0);
+}
+
+TEST(small_far_groups_share_their_candidate_points) {
+    /* A group far from the searched set with fewer queries than two
+     * chunks is answered like a large one, from its candidate points (no
+     * seed scanned): here a whole set of a few points, a small lattice
+     * with copies, asking a lattice 40 away whose points at y or z = 0
+     * have two nearest points (ties: the smaller index must win); every
+     * answer against the brute force. */
+    for (uint64_t seed = 39100; seed < 39106 && !hdt_failed(); seed++) {
+        gen_rng_t g;
+        gen_seed(&g, seed);
+        int threads = seed % 2 ? 1 : 2;
+        size_t na = 8 + gen_u64(&g) % 24, nb = 20 + gen_u64(&g) % 20;
+        CONTEXT("seed=%llu na=%zu nb=%zu threads=%d", (unsigned long long)seed, na, nb, threads);
+        double *a = malloc(24 * na), *b = malloc(24 * nb);
+        gen_lattice(&g, a, na, 3);
+        gen_affine(a, na, 0.25, 0.0);
+        gen_lattice(&g, b, nb, 3);
+        for (size_t k = 0; k < nb; k++) b[3 * k] += 40, b[3 * k + 1] -= 0.5, b[3 * k + 2] -= 0.5;
+        hd__an_counts_t c[2] = {{0}, {0}};
+        check_both_ways(a, na, b, nb, threads, seed, c);
+        CONTEXT("seed=%llu na=%zu far groups %zu, from point lists %zu", (unsigned long long)seed, na, c[0].far,
+                c[0].pointed);
+        CHECK(c[0].far == 1 && c[0].pointed == na);
+        free(a), free(b);
+    }
 }
 
 TEST(same_order_copies_in_strided_and_float32_views_read_the_right_partners) {
