@@ -959,6 +959,7 @@ static size_t bucket_at(const hd__an_t *t, uint32_t key, size_t from) {
 #define WINDOW_CHUNK 12     /* the same on the window path */
 #define CHUNK_LIST 256      /* a group list longer than this is not filtered but listed again per chunk */
 #define POINT_LIST 512      /* most points of a group's candidate buckets for a point list */
+#define DENSE 8             /* a set this many times as large as t tries point lists in every group */
 #define FAR_CANDIDATES 64   /* most candidates of a far group answered without seeds */
 
 /* The rest of one query's search, on the candidate list cd (the buckets
@@ -1342,11 +1343,12 @@ HD__INLINE size_t qgroup_finish(query_ctx *c, cands_t *cd, cands_t *ck, qgroup_t
     /* A group small next to its answers' distances (its box's diagonal
      * at most twice the bound U on them) shares its candidate points,
      * chunk by chunk, while the chunks' lists stay short: a far group
-     * (nothing scanned yet, seed_bests) at any size, another when it has
-     * two chunks of queries or more.  (Which groups try decides only the
-     * cost.) */
+     * (nothing scanned yet, seed_bests) or a group of a set DENSE times
+     * as large as t or more (few points of t per group) at any size,
+     * another when it has two chunks of queries or more.  (Which groups
+     * try decides only the cost.) */
     plist_t gp, cp;
-    int points = (nlisted >= 2 * CHUNK || !scanned) && qgroup_diag2(G) <= 4 * U &&
+    int points = (nlisted >= 2 * CHUNK || !scanned || q->n / DENSE >= t->n) && qgroup_diag2(G) <= 4 * U &&
                  group_points(t, cd, &G->box, U, &gp);
     size_t chunk = windowed ? WINDOW_CHUNK : CHUNK;
     for (size_t r0 = 0; r0 < nlisted; r0 += chunk) {
