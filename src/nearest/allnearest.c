@@ -220,6 +220,12 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* Four lanes of doubles, of 64-bit and of 32-bit integers (GCC's vector
+ * extension: the bucket scans, the boxes). */
+typedef double v4d __attribute__((vector_size(32)));
+typedef int64_t v4l __attribute__((vector_size(32)));
+typedef uint32_t v4u __attribute__((vector_size(16)));
+
 /* ---- building ---------------------------------------------------------------- */
 
 #define MAX_PARTS 16
@@ -351,18 +357,38 @@ static void gather_task(void *vctx, size_t task, int worker) {
     }
 }
 
-/* The exact box of the points [b, e) into node k's box. */
-static void points_box(hd__an_t *s, size_t b, size_t e, size_t k) {
-    const double *v[3] = {s->x, s->y, s->z};
-    for (int d = 0; d < 3; d++) {
-        double lo = v[d][b], hi = lo;
-        for (size_t i = b + 1; i < e; i++) {
-            lo = v[d][i] < lo ? v[d][i] : lo;
-            hi = v[d][i] > hi ? v[d][i] : hi;
+/* The smallest and the largest of v[b], ..., v[e - 1] (b < e) into *lo
+ * and *hi: four lanes at a time, then the lanes' (each lane's, and so
+ * the whole set's, are values of v: the box is exact). */
+HD__INLINE void span_minmax(const double *v, size_t b, size_t e, double *lo, double *hi) {
+    double l = v[b], h = l;
+    size_t i = b + 1;
+    if (e - b >= 8) {
+        v4d l4, h4, w;
+        __builtin_memcpy(&l4, v + b, sizeof l4);
+        h4 = l4;
+        for (i = b + 4; i + 4 <= e; i += 4) {
+            __builtin_memcpy(&w, v + i, sizeof w);
+            v4l lt = w < l4, gt = w > h4;
+            l4 = (v4d)(((v4l)w & lt) | ((v4l)l4 & ~lt));
+            h4 = (v4d)(((v4l)w & gt) | ((v4l)h4 & ~gt));
         }
-        s->lo[d][k] = lo;
-        s->hi[d][k] = hi;
+        for (int k = 0; k < 4; k++) {
+            l = l4[k] < l ? l4[k] : l;
+            h = h4[k] > h ? h4[k] : h;
+        }
     }
+    for (; i < e; i++) {
+        l = v[i] < l ? v[i] : l;
+        h = v[i] > h ? v[i] : h;
+    }
+    *lo = l, *hi = h;
+}
+
+/* The exact box of the points [b, e) into node k's box. */
+HD__INLINE void points_box(hd__an_t *s, size_t b, size_t e, size_t k) {
+    const double *v[3] = {s->x, s->y, s->z};
+    for (int d = 0; d < 3; d++) span_minmax(v[d], b, e, &s->lo[d][k], &s->hi[d][k]);
 }
 
 /* The exact boxes of the leaves of buckets [task * BOX_TASK, ...). */
@@ -865,9 +891,6 @@ HD__INLINE void candidate_bounds(cands_t *c, size_t nc, double qx, double qy, do
 /* One query against one bucket: the squared distances four lanes at a time
  * (GCC's vector extension; each lane evaluates the expression of hd__d2s),
  * their minimum, and the smallest original index at the minimum. */
-typedef double v4d __attribute__((vector_size(32)));
-typedef int64_t v4l __attribute__((vector_size(32)));
-typedef uint32_t v4u __attribute__((vector_size(16)));
 
 /* The distances of (vx, vy, vz) to the four points from position k of
  * the arrays x, y, z. */
