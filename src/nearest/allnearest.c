@@ -623,6 +623,25 @@ void hd__an_free(hd__an_t *s) {
     memset(s, 0, sizeof *s);
 }
 
+/* The upper halves of keys[0, n) moved down to the first 4 n bytes of
+ * the same memory, in order: four keys read, then their halves written
+ * over bytes of keys read already. */
+HD__HOT static void keys_upper(uint64_t *keys, size_t n) {
+    unsigned char *k32 = (unsigned char *)keys;
+    size_t i = 0;
+    for (; i + 4 <= n; i += 4) {
+        uint64_t w[4];
+        uint32_t k[4];
+        memcpy(w, keys + i, sizeof w);
+        for (int j = 0; j < 4; j++) k[j] = (uint32_t)(w[j] >> 32);
+        memcpy(k32 + 4 * i, k, sizeof k);
+    }
+    for (; i < n; i++) {
+        uint32_t k = (uint32_t)(keys[i] >> 32);
+        memcpy(k32 + 4 * i, &k, sizeof k);
+    }
+}
+
 /* The structure of the points p[sel[i]], i < n (sel NULL: p's first n),
  * each named names[i] (names NULL: by its number in p). */
 static int build(hd__an_t *s, const hd_points_t *p, const uint32_t *sel, const uint32_t *names, size_t n,
@@ -699,11 +718,7 @@ static int build(hd__an_t *s, const hd_points_t *p, const uint32_t *sel, const u
          * fault per 4 KiB); the rest is given back before the boxes.  In
          * a refined cell they are the keys on the cell's own grid: the
          * window there is a guess like any other. */
-        unsigned char *k32 = (unsigned char *)c.b;
-        for (size_t i = 0; k32 && i < n; i++) {
-            uint32_t k = (uint32_t)(c.b[i] >> 32);
-            memcpy(k32 + 4 * i, &k, sizeof k); /* bytes of keys read already */
-        }
+        if (c.b) keys_upper(c.b, n);
         s->key32 = (uint32_t *)(void *)c.b;
         shrink((void **)&s->key32, n ? n : 1, sizeof *s->key32);
         c.a = c.b = NULL;
