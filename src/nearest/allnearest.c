@@ -311,6 +311,13 @@ static void key_task(void *vctx, size_t part, int worker) {
     }
 }
 
+/* Packed point i of base to position `at` of s. */
+HD__INLINE void gather_f64(hd__an_t *s, const double *base, size_t at, uint32_t i) {
+    const double *q = base + 3 * (size_t)i;
+    s->x[at] = q[0], s->y[at] = q[1], s->z[at] = q[2];
+    s->idx[at] = i;
+}
+
 /* Gather the points [task * GATHER_TASK, ...) in sorted order (positions
  * n .. n + 3 repeat the last point, so that scans may read whole groups of
  * four). */
@@ -337,13 +344,13 @@ static void gather_task(void *vctx, size_t task, int worker) {
         /* Packed doubles, the layout most callers pass: the same reads as
          * hd__src_get's, without its tests per point. */
         const double *base = (const double *)(const void *)c->src.base;
-        for (size_t at = lo; at < hi; at++) {
-            if (at + 16 < s->n) __builtin_prefetch(base + 3 * (size_t)(uint32_t)c->b[at + 16]);
-            uint32_t i = (uint32_t)c->b[at < s->n ? at : s->n - 1];
-            const double *q = base + 3 * (size_t)i;
-            s->x[at] = q[0], s->y[at] = q[1], s->z[at] = q[2];
-            s->idx[at] = i;
+        size_t mid = s->n > 16 ? s->n - 16 : 0; /* below it, a point 16 ahead exists */
+        mid = mid < lo ? lo : mid > hi ? hi : mid;
+        for (size_t at = lo; at < mid; at++) {
+            __builtin_prefetch(base + 3 * (size_t)(uint32_t)c->b[at + 16]);
+            gather_f64(s, base, at, (uint32_t)c->b[at]);
         }
+        for (size_t at = mid; at < hi; at++) gather_f64(s, base, at, (uint32_t)c->b[at < s->n ? at : s->n - 1]);
         return;
     }
     for (size_t at = lo; at < hi; at++) {
