@@ -1411,14 +1411,20 @@ HD__INLINE size_t qgroup_finish(query_ctx *c, cands_t *cd, cands_t *ck, qgroup_t
             Uc = G->best[listed[r]] > Uc ? G->best[listed[r]] : Uc;
         }
         Uc = Uc < U ? Uc : U;
-        if (points) {
+        /* A far group of one chunk: its box and bound are the group's
+         * (no query has a best yet), so its list is the group's. */
+        const plist_t *pl = &cp;
+        if (points && !scanned && nlisted <= chunk) {
+            plist_pad(&gp);
+            pl = &gp;
+        } else if (points) {
             chunk_points(&gp, &box, Uc, &cp);
-            points = cp.n <= 2 * CHUNK;
         }
+        points = points && pl->n <= 2 * CHUNK;
         if (points) {
             for (size_t r = r0; r < r1; r++) {
                 size_t k = listed[r];
-                scan_points(&cp, q->x[first + k], q->y[first + k], q->z[first + k], &G->best[k], &G->bj[k]);
+                scan_points(pl, q->x[first + k], q->y[first + k], q->z[first + k], &G->best[k], &G->bj[k]);
                 if (seeded[k] && G->best[k] > U) apart[napart++] = (uint32_t)k;
                 c->sd[first + k] = G->best[k];
                 c->sj[first + k] = G->bj[k];
