@@ -120,8 +120,10 @@
  *  - Far groups.  A group whose box lies outside the searched set's box
  *    by more than its own diagonal (disjoint sets: the window and the
  *    seeds are far from its answers, and every query scanned the nearest
- *    bucket only to set a bound) takes the nearest leaf's bound Ub, which
- *    bounds every answer of the group, as U; when at most FAR_CANDIDATES
+ *    bucket only to set a bound) takes the nearest leaf's bound Ub (the
+ *    least upper bound from its box to one of the leaf's points, far
+ *    tighter than the leaf's box's: fewer candidates), which bounds every
+ *    answer of the group, as U; when at most FAR_CANDIDATES
  *    buckets lie within it, holding at most POINT_LIST points, they are
  *    its candidates, no bucket is scanned first, and its queries are
  *    answered from point lists (the group is small next to Ub).  A group
@@ -851,16 +853,40 @@ HD__INLINE void boxes_lb2(double *const lo[3], double *const hi[3], size_t f, si
     }
 }
 
+/* The least of V and the largest computed squared distance between a
+ * point of box q and each of the points [b, e) of the arrays x, y, z
+ * (node_ub2's expression with a box of one point: each of those points
+ * is within it of every point of q). */
+HD__INLINE double points_ub2(const hd__box_t *q, const double *restrict x, const double *restrict y,
+                             const double *restrict z, size_t b, size_t e, double V) {
+    double l0 = q->lo[0], l1 = q->lo[1], l2 = q->lo[2], h0 = q->hi[0], h1 = q->hi[1], h2 = q->hi[2];
+    for (size_t k = b; k < e; k++) {
+        double u, v, ex, ey, ez;
+        u = h0 - x[k], v = x[k] - l0, ex = u > v ? u : v;
+        u = h1 - y[k], v = y[k] - l1, ey = u > v ? u : v;
+        u = h2 - z[k], v = z[k] - l2, ez = u > v ? u : v;
+        double ub = ex * ex + ey * ey + ez * ez;
+        V = ub < V ? ub : V;
+    }
+    return V;
+}
+
 /* The bucket reached from the root by always taking the child whose box
  * is nearest to the box q; *U is lowered to the upper bounds of the nodes
  * on the way (each holds a point, so every query in q has a point within
- * them).  When the group is far from t, or the curve's order says little
- * (refined cells), this is a better first bucket than the seeds. */
+ * them), and at the leaf to each of its points' upper bounds (each is
+ * within it of every query in q).  When the group is far from t, or the
+ * curve's order says little (refined cells), this is a better first
+ * bucket than the seeds. */
 HD__HOT static size_t nearest_leaf(const hd__an_t *t, const hd__box_t *q, double *U) {
     for (size_t k = 0;;) {
         double u = node_ub2(q, t, k);
         *U = u < *U ? u : *U;
-        if (!t->count[k]) return t->first[k];
+        if (!t->count[k]) {
+            size_t b = t->first[k];
+            *U = points_ub2(q, t->x, t->y, t->z, t->start[b], t->stop[b], *U);
+            return b;
+        }
         size_t f = t->first[k], near = f;
         int nc = t->count[k];
         double best = INFINITY, lb[8];
