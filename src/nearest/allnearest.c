@@ -121,9 +121,9 @@
  *    by more than its own diagonal (disjoint sets: the window and the
  *    seeds are far from its answers, and every query scanned the nearest
  *    bucket only to set a bound) takes the nearest leaf's bound Ub (the
- *    least upper bound from its box to one of the leaf's points, far
- *    tighter than the leaf's box's: fewer candidates), which bounds every
- *    answer of the group, as U; when at most FAR_CANDIDATES
+ *    least upper bound from the group's box to one of the leaf's points,
+ *    far tighter than the bound to the leaf's box: fewer candidates),
+ *    which bounds every answer of the group, as U; when at most FAR_CANDIDATES
  *    buckets lie within it, holding at most POINT_LIST points, they are
  *    its candidates, no bucket is scanned first, and its queries are
  *    answered from point lists (the group is small next to Ub).  A group

@@ -661,10 +661,10 @@ TEST(the_keys_of_packed_doubles_are_the_keys_of_any_view) {
         gen_rng_t g;
         gen_seed(&g, seed);
         size_t n = 1000 + gen_u64(&g) % 3000;
-        CONTEXT("seed=%llu n=%zu", (unsigned long long)seed, n);
         double *a = malloc(24 * n), *w = malloc(32 * n);
         gen_cube(&g, a, n, -1.0, 1.0);
         for (size_t k = 0; k < n; k++) memcpy(w + 4 * k, a + 3 * k, 24);
+        CONTEXT("seed=%llu n=%zu (a key box smaller than the set: %d)", (unsigned long long)seed, n, (int)(seed % 2));
         hd_points_t A = hd_points_f64(a, n), W = A;
         W.data = w, W.stride = 32;
         hd__box_t box = union_box(a, a, n);
@@ -788,10 +788,10 @@ TEST(small_far_groups_share_their_candidate_points) {
     for (uint64_t seed = 39100; seed < 39106 && !hdt_failed(); seed++) {
         gen_rng_t g;
         gen_seed(&g, seed);
-        int threads = seed % 2 ? 1 : 2;
         size_t na = 8 + gen_u64(&g) % 24, nb = 20 + gen_u64(&g) % 20;
-        CONTEXT("seed=%llu na=%zu nb=%zu threads=%d", (unsigned long long)seed, na, nb, threads);
         double *a = malloc(24 * na), *b = malloc(24 * nb);
+        int threads = seed % 2 ? 1 : 2;
+        CONTEXT("seed=%llu na=%zu nb=%zu threads=%d", (unsigned long long)seed, na, nb, threads);
         gen_lattice(&g, a, na, 3);
         gen_affine(a, na, 0.25, 0.0);
         gen_lattice(&g, b, nb, 3);
