@@ -120,8 +120,10 @@
  *  - Far groups.  A group whose box lies outside the searched set's box
  *    by more than its own diagonal (disjoint sets: the window and the
  *    seeds are far from its answers, and every query scanned the nearest
- *    bucket only to set a bound) takes the nearest leaf's bound Ub, which
- *    bounds every answer of the group, as U; when at most FAR_CANDIDATES
+ *    bucket only to set a bound) takes the nearest leaf's bound Ub (the
+ *    least upper bound from the group's box to one of the leaf's points,
+ *    far tighter than the bound to the leaf's box: fewer candidates),
+ *    which bounds every answer of the group, as U; when at most FAR_CANDIDATES
  *    buckets lie within it, holding at most POINT_LIST points, they are
  *    its candidates, no bucket is scanned first, and its queries are
  *    answered from point lists (the group is small next to Ub).  A group
@@ -220,6 +222,12 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* Four lanes of doubles, of 64-bit and of 32-bit integers (GCC's vector
+ * extension: the bucket scans, the boxes). */
+typedef double v4d __attribute__((vector_size(32)));
+typedef int64_t v4l __attribute__((vector_size(32)));
+typedef uint32_t v4u __attribute__((vector_size(16)));
+
 /* ---- building ---------------------------------------------------------------- */
 
 #define MAX_PARTS 16
@@ -251,12 +259,49 @@ static void part_range(const build_ctx *c, size_t part, size_t *lo, size_t *hi) 
     *hi = c->n * (part + 1) / (size_t)c->parts;
 }
 
+/* hd__key30's cell on one axis, the same value: u lies in [0, 1023]
+ * after the clamps, where the signed conversion (one instruction, which
+ * vectorises) equals the unsigned one (a sequence of a dozen). */
+HD__INLINE uint32_t key_cell(double v, double lo, double scale) {
+    double u = (v - lo) * scale;
+    u = u < 1023.0 ? u : 1023.0;
+    u = u > 0 ? u : 0;
+    return (uint32_t)(int32_t)u;
+}
+
+/* hd__spread10's value by shifts and masks (which vectorise; the table's
+ * reads do not). */
+HD__INLINE uint32_t spread10(uint32_t v) {
+    v = (v | v << 16) & 0x030000ffu;
+    v = (v | v << 8) & 0x0300f00fu;
+    v = (v | v << 4) & 0x030c30c3u;
+    return (v | v << 2) & 0x09249249u;
+}
+
+/* hd__src_keys for packed doubles without a transform (the layout most
+ * callers pass), the same keys; compiled for AVX2 where there is one
+ * (field_bench's build phase). */
+HD__HOT static void keys_f64(const double *base, const hd__keygrid_t *grid, size_t lo, size_t hi,
+                             uint64_t *restrict keys) {
+    double l0 = grid->lo[0], l1 = grid->lo[1], l2 = grid->lo[2], sc = grid->scale;
+    for (size_t i = lo; i < hi; i++) {
+        const double *q = base + 3 * i;
+        uint32_t k = spread10(key_cell(q[0], l0, sc)) | spread10(key_cell(q[1], l1, sc)) << 1 |
+                     spread10(key_cell(q[2], l2, sc)) << 2;
+        keys[i] = (uint64_t)k << 32 | (uint64_t)i;
+    }
+}
+
 /* Keys of one part. */
 static void key_task(void *vctx, size_t part, int worker) {
     (void)worker;
     build_ctx *c = vctx;
     size_t lo, hi;
     part_range(c, part, &lo, &hi);
+    if (!c->sel && c->src.kind == HD__SRC_F64 && !c->src.T) {
+        keys_f64((const double *)(const void *)c->src.base, &c->grid, lo, hi, c->a);
+        return;
+    }
     if (!c->sel) {
         hd__src_keys(&c->src, &c->grid, lo, hi, c->a);
         return;
@@ -266,6 +311,13 @@ static void key_task(void *vctx, size_t part, int worker) {
         hd__src_get(&c->src, c->sel[i], p);
         c->a[i] = (uint64_t)hd__key30(&c->grid, p) << 32 | (uint64_t)i;
     }
+}
+
+/* Packed point i of base to position `at` of s. */
+HD__INLINE void gather_f64(hd__an_t *s, const double *base, size_t at, uint32_t i) {
+    const double *q = base + 3 * (size_t)i;
+    s->x[at] = q[0], s->y[at] = q[1], s->z[at] = q[2];
+    s->idx[at] = i;
 }
 
 /* Gather the points [task * GATHER_TASK, ...) in sorted order (positions
@@ -294,13 +346,13 @@ static void gather_task(void *vctx, size_t task, int worker) {
         /* Packed doubles, the layout most callers pass: the same reads as
          * hd__src_get's, without its tests per point. */
         const double *base = (const double *)(const void *)c->src.base;
-        for (size_t at = lo; at < hi; at++) {
-            if (at + 16 < s->n) __builtin_prefetch(base + 3 * (size_t)(uint32_t)c->b[at + 16]);
-            uint32_t i = (uint32_t)c->b[at < s->n ? at : s->n - 1];
-            const double *q = base + 3 * (size_t)i;
-            s->x[at] = q[0], s->y[at] = q[1], s->z[at] = q[2];
-            s->idx[at] = i;
+        size_t mid = s->n > 16 ? s->n - 16 : 0; /* below it, a point 16 ahead exists */
+        mid = mid < lo ? lo : mid > hi ? hi : mid;
+        for (size_t at = lo; at < mid; at++) {
+            __builtin_prefetch(base + 3 * (size_t)(uint32_t)c->b[at + 16]);
+            gather_f64(s, base, at, (uint32_t)c->b[at]);
         }
+        for (size_t at = mid; at < hi; at++) gather_f64(s, base, at, (uint32_t)c->b[at < s->n ? at : s->n - 1]);
         return;
     }
     for (size_t at = lo; at < hi; at++) {
@@ -314,22 +366,42 @@ static void gather_task(void *vctx, size_t task, int worker) {
     }
 }
 
-/* The exact box of the points [b, e) into node k's box. */
-static void points_box(hd__an_t *s, size_t b, size_t e, size_t k) {
-    const double *v[3] = {s->x, s->y, s->z};
-    for (int d = 0; d < 3; d++) {
-        double lo = v[d][b], hi = lo;
-        for (size_t i = b + 1; i < e; i++) {
-            lo = v[d][i] < lo ? v[d][i] : lo;
-            hi = v[d][i] > hi ? v[d][i] : hi;
+/* The smallest and the largest of v[b], ..., v[e - 1] (b < e) into *lo
+ * and *hi: four lanes at a time, then the lanes' (each lane's, and so
+ * the whole set's, are values of v: the box is exact). */
+HD__INLINE void span_minmax(const double *v, size_t b, size_t e, double *lo, double *hi) {
+    double l = v[b], h = l;
+    size_t i = b + 1;
+    if (e - b >= 8) {
+        v4d l4, h4, w;
+        __builtin_memcpy(&l4, v + b, sizeof l4);
+        h4 = l4;
+        for (i = b + 4; i + 4 <= e; i += 4) {
+            __builtin_memcpy(&w, v + i, sizeof w);
+            v4l lt = w < l4, gt = w > h4;
+            l4 = (v4d)(((v4l)w & lt) | ((v4l)l4 & ~lt));
+            h4 = (v4d)(((v4l)w & gt) | ((v4l)h4 & ~gt));
         }
-        s->lo[d][k] = lo;
-        s->hi[d][k] = hi;
+        for (int k = 0; k < 4; k++) {
+            l = l4[k] < l ? l4[k] : l;
+            h = h4[k] > h ? h4[k] : h;
+        }
     }
+    for (; i < e; i++) {
+        l = v[i] < l ? v[i] : l;
+        h = v[i] > h ? v[i] : h;
+    }
+    *lo = l, *hi = h;
+}
+
+/* The exact box of the points [b, e) into node k's box. */
+HD__INLINE void points_box(hd__an_t *s, size_t b, size_t e, size_t k) {
+    const double *v[3] = {s->x, s->y, s->z};
+    for (int d = 0; d < 3; d++) span_minmax(v[d], b, e, &s->lo[d][k], &s->hi[d][k]);
 }
 
 /* The exact boxes of the leaves of buckets [task * BOX_TASK, ...). */
-static void box_task(void *vctx, size_t task, int worker) {
+HD__HOT static void box_task(void *vctx, size_t task, int worker) {
     (void)worker;
     build_ctx *c = vctx;
     hd__an_t *s = c->s;
@@ -560,6 +632,25 @@ void hd__an_free(hd__an_t *s) {
     memset(s, 0, sizeof *s);
 }
 
+/* The upper halves of keys[0, n) moved down to the first 4 n bytes of
+ * the same memory, in order: four keys read, then their halves written
+ * over bytes of keys read already. */
+HD__HOT static void keys_upper(uint64_t *keys, size_t n) {
+    unsigned char *k32 = (unsigned char *)keys;
+    size_t i = 0;
+    for (; i + 4 <= n; i += 4) {
+        uint64_t w[4];
+        uint32_t k[4];
+        memcpy(w, keys + i, sizeof w);
+        for (int j = 0; j < 4; j++) k[j] = (uint32_t)(w[j] >> 32);
+        memcpy(k32 + 4 * i, k, sizeof k);
+    }
+    for (; i < n; i++) {
+        uint32_t k = (uint32_t)(keys[i] >> 32);
+        memcpy(k32 + 4 * i, &k, sizeof k);
+    }
+}
+
 /* The structure of the points p[sel[i]], i < n (sel NULL: p's first n),
  * each named names[i] (names NULL: by its number in p). */
 static int build(hd__an_t *s, const hd_points_t *p, const uint32_t *sel, const uint32_t *names, size_t n,
@@ -636,11 +727,7 @@ static int build(hd__an_t *s, const hd_points_t *p, const uint32_t *sel, const u
          * fault per 4 KiB); the rest is given back before the boxes.  In
          * a refined cell they are the keys on the cell's own grid: the
          * window there is a guess like any other. */
-        unsigned char *k32 = (unsigned char *)c.b;
-        for (size_t i = 0; k32 && i < n; i++) {
-            uint32_t k = (uint32_t)(c.b[i] >> 32);
-            memcpy(k32 + 4 * i, &k, sizeof k); /* bytes of keys read already */
-        }
+        if (c.b) keys_upper(c.b, n);
         s->key32 = (uint32_t *)(void *)c.b;
         shrink((void **)&s->key32, n ? n : 1, sizeof *s->key32);
         c.a = c.b = NULL;
@@ -766,16 +853,40 @@ HD__INLINE void boxes_lb2(double *const lo[3], double *const hi[3], size_t f, si
     }
 }
 
+/* The least of V and the largest computed squared distance between a
+ * point of box q and each of the points [b, e) of the arrays x, y, z
+ * (node_ub2's expression with a box of one point: each of those points
+ * is within it of every point of q). */
+HD__INLINE double points_ub2(const hd__box_t *q, const double *restrict x, const double *restrict y,
+                             const double *restrict z, size_t b, size_t e, double V) {
+    double l0 = q->lo[0], l1 = q->lo[1], l2 = q->lo[2], h0 = q->hi[0], h1 = q->hi[1], h2 = q->hi[2];
+    for (size_t k = b; k < e; k++) {
+        double u, v, ex, ey, ez;
+        u = h0 - x[k], v = x[k] - l0, ex = u > v ? u : v;
+        u = h1 - y[k], v = y[k] - l1, ey = u > v ? u : v;
+        u = h2 - z[k], v = z[k] - l2, ez = u > v ? u : v;
+        double ub = ex * ex + ey * ey + ez * ez;
+        V = ub < V ? ub : V;
+    }
+    return V;
+}
+
 /* The bucket reached from the root by always taking the child whose box
  * is nearest to the box q; *U is lowered to the upper bounds of the nodes
  * on the way (each holds a point, so every query in q has a point within
- * them).  When the group is far from t, or the curve's order says little
- * (refined cells), this is a better first bucket than the seeds. */
-static size_t nearest_leaf(const hd__an_t *t, const hd__box_t *q, double *U) {
+ * them), and at the leaf to each of its points' upper bounds (each is
+ * within it of every query in q).  When the group is far from t, or the
+ * curve's order says little (refined cells), this is a better first
+ * bucket than the seeds. */
+HD__HOT static size_t nearest_leaf(const hd__an_t *t, const hd__box_t *q, double *U) {
     for (size_t k = 0;;) {
         double u = node_ub2(q, t, k);
         *U = u < *U ? u : *U;
-        if (!t->count[k]) return t->first[k];
+        if (!t->count[k]) {
+            size_t b = t->first[k];
+            *U = points_ub2(q, t->x, t->y, t->z, t->start[b], t->stop[b], *U);
+            return b;
+        }
         size_t f = t->first[k], near = f;
         int nc = t->count[k];
         double best = INFINITY, lb[8];
@@ -790,7 +901,7 @@ static size_t nearest_leaf(const hd__an_t *t, const hd__box_t *q, double *U) {
  * bound <= U), U bounding the answer of every query in q: the buckets left
  * out hold no point that any of them could have as its nearest.  Returns 0,
  * with the list unfinished, as soon as it would hold more than `limit`. */
-static int candidates(const hd__an_t *t, const hd__box_t *q, double U, size_t limit, cands_t *c) {
+HD__HOT static int candidates(const hd__an_t *t, const hd__box_t *q, double U, size_t limit, cands_t *c) {
     uint32_t stack[8 * 11 + 8];
     double slb[8 * 11 + 8];
     int sp = 0;
@@ -828,9 +939,6 @@ HD__INLINE void candidate_bounds(cands_t *c, size_t nc, double qx, double qy, do
 /* One query against one bucket: the squared distances four lanes at a time
  * (GCC's vector extension; each lane evaluates the expression of hd__d2s),
  * their minimum, and the smallest original index at the minimum. */
-typedef double v4d __attribute__((vector_size(32)));
-typedef int64_t v4l __attribute__((vector_size(32)));
-typedef uint32_t v4u __attribute__((vector_size(16)));
 
 /* The distances of (vx, vy, vz) to the four points from position k of
  * the arrays x, y, z. */
@@ -922,6 +1030,7 @@ static size_t bucket_at(const hd__an_t *t, uint32_t key, size_t from) {
 #define WINDOW_CHUNK 12     /* the same on the window path */
 #define CHUNK_LIST 256      /* a group list longer than this is not filtered but listed again per chunk */
 #define POINT_LIST 512      /* most points of a group's candidate buckets for a point list */
+#define DENSE 8             /* a set this many times as large as t tries point lists in every group */
 #define FAR_CANDIDATES 64   /* most candidates of a far group answered without seeds */
 
 /* The rest of one query's search, on the candidate list cd (the buckets
@@ -1123,7 +1232,7 @@ HD__INLINE double qgroup_diag2(const qgroup_t *G) {
  * scans nothing first: U = Ub, no query has a best yet, and qgroup_finish
  * answers it from point lists (it is small next to Ub). */
 HD__INLINE int far_group(const hd__an_t *t, const qgroup_t *G, double lb2, double Ub, cands_t *cd) {
-    return G->m >= 2 * CHUNK && qgroup_diag2(G) <= lb2 && candidates(t, &G->box, Ub, FAR_CANDIDATES, cd) &&
+    return qgroup_diag2(G) <= lb2 && candidates(t, &G->box, Ub, FAR_CANDIDATES, cd) &&
            listed_points(t, cd) <= POINT_LIST;
 }
 
@@ -1237,7 +1346,7 @@ HD__INLINE double span_bounds(const hd__box_t *q, const double *restrict x, cons
  * the buckets hold more than POINT_LIST points (then nothing is listed).
  * The bounds are taken first, over each bucket's points where t stores
  * them, and only the points kept are copied. */
-static int group_points(const hd__an_t *t, const cands_t *cd, const hd__box_t *q, double U, plist_t *out) {
+HD__HOT static int group_points(const hd__an_t *t, const cands_t *cd, const hd__box_t *q, double U, plist_t *out) {
     if (listed_points(t, cd) > POINT_LIST) return 0;
     double lb[POINT_LIST], V = U;
     size_t m = 0;
@@ -1259,7 +1368,7 @@ static int group_points(const hd__an_t *t, const cands_t *cd, const hd__box_t *q
 
 /* The points of `from` that can be the answer of a query in the box q
  * (a chunk of the group's, answers at most U), the same way, into out. */
-static void chunk_points(const plist_t *from, const hd__box_t *q, double U, plist_t *out) {
+HD__HOT static void chunk_points(const plist_t *from, const hd__box_t *q, double U, plist_t *out) {
     double lb[POINT_LIST];
     double V = span_bounds(q, from->x, from->y, from->z, from->n, lb, U);
     size_t n = 0;
@@ -1304,10 +1413,14 @@ HD__INLINE size_t qgroup_finish(query_ctx *c, cands_t *cd, cands_t *ck, qgroup_t
     }
     /* A group small next to its answers' distances (its box's diagonal
      * at most twice the bound U on them) shares its candidate points,
-     * chunk by chunk, while the chunks' lists stay short.  (Which groups
+     * chunk by chunk, while the chunks' lists stay short: a far group
+     * (nothing scanned yet, seed_bests) or a group of a set DENSE times
+     * as large as t or more (few points of t per group) at any size,
+     * another when it has two chunks of queries or more.  (Which groups
      * try decides only the cost.) */
     plist_t gp, cp;
-    int points = nlisted >= 2 * CHUNK && qgroup_diag2(G) <= 4 * U && group_points(t, cd, &G->box, U, &gp);
+    int points = (nlisted >= 2 * CHUNK || !scanned || q->n / DENSE >= t->n) && qgroup_diag2(G) <= 4 * U &&
+                 group_points(t, cd, &G->box, U, &gp);
     size_t chunk = windowed ? WINDOW_CHUNK : CHUNK;
     for (size_t r0 = 0; r0 < nlisted; r0 += chunk) {
         size_t r1 = r0 + chunk < nlisted ? r0 + chunk : nlisted;
@@ -1324,14 +1437,20 @@ HD__INLINE size_t qgroup_finish(query_ctx *c, cands_t *cd, cands_t *ck, qgroup_t
             Uc = G->best[listed[r]] > Uc ? G->best[listed[r]] : Uc;
         }
         Uc = Uc < U ? Uc : U;
-        if (points) {
+        /* A far group of one chunk: its box and bound are the group's
+         * (no query has a best yet), so its list is the group's. */
+        const plist_t *pl = &cp;
+        if (points && !scanned && nlisted <= chunk) {
+            plist_pad(&gp);
+            pl = &gp;
+        } else if (points) {
             chunk_points(&gp, &box, Uc, &cp);
-            points = cp.n <= 2 * CHUNK;
         }
+        points = points && pl->n <= 2 * CHUNK;
         if (points) {
             for (size_t r = r0; r < r1; r++) {
                 size_t k = listed[r];
-                scan_points(&cp, q->x[first + k], q->y[first + k], q->z[first + k], &G->best[k], &G->bj[k]);
+                scan_points(pl, q->x[first + k], q->y[first + k], q->z[first + k], &G->best[k], &G->bj[k]);
                 if (seeded[k] && G->best[k] > U) apart[napart++] = (uint32_t)k;
                 c->sd[first + k] = G->best[k];
                 c->sj[first + k] = G->bj[k];
