@@ -142,6 +142,9 @@ static double up(double x) {
 static double down(double x) { return -up(-x); }
 static double sqrt_up(double x) { return x <= 0 ? 0 : up(sqrt(x)); }
 
+/* Bounds to triangles of Y that a corner remembers (corner_to). */
+#define MEMO 4
+
 typedef struct corner {
     double p[3];
     uint64_t k[3];
@@ -152,13 +155,24 @@ typedef struct corner {
     size_t index;  /* p's nearest triangle's index in Y (exact) */
     double near[3];/* the nearest point on it (exact) */
     int exact;     /* r, lower, index, near are set */
+    /* bounds already computed: d(p, triangle at mpos[i]) <= mh[i]
+     * (corner_to's value, a function of p and the triangle alone) */
+    uint32_t mpos[MEMO];
+    double mh[MEMO];
+    int nm;
 } corner_t;
 
 typedef struct sub {
     corner_t c[3];
     double U;
     int level;
+    /* candidates: list[off, off + n) of the worker's arena holds every
+     * triangle of Y that can be nearest to a point of the sub-triangle's
+     * descendants (inherited from the parent, or its own once split;
+     * n == NO_LIST: none, the tree is searched) */
+    uint32_t off, n;
 } sub_t;
+#define NO_LIST UINT32_MAX
 
 /* The best lower bound of a face and its witness. */
 typedef struct best {
@@ -492,18 +506,60 @@ static void evaluate(const hd__m2m_job_t *J, const hd__tri_t *t, corner_t *c, in
     c->exact = 0;
 }
 
+/* evaluate()'s upper bound from a list of candidates instead of the tree:
+ * hi from the smallest hi2 over the seed and the list's triangles whose
+ * box is not beyond the best so far (any triangle's sqrt_up(hi2) is
+ * >= d(p, Y), so the bound holds whatever the list; a list that holds
+ * p's nearest triangle gives the tree's smallest hi2), the search
+ * stopping at a bound of target or less as in interval().  The answer
+ * depends on p, the seed, the list and target only. */
+static void evaluate_in(const hd__m2m_job_t *J, const hd__tri_t *t, corner_t *c, int level, size_t seed,
+                        double target, const uint32_t *list, size_t n, cache_t *C, uint64_t *count) {
+    const hd__bvh_t *T = J->to;
+    double best = INFINITY, enough2 = enough_of(target), lo2, hi2;
+    size_t pos = SIZE_MAX;
+    corner_point(t, c, level);
+    c->exact = 0;
+    if (seed < T->n_tris) {
+        bounds_at(T, seed, c->p, C, &lo2, &hi2);
+        best = hi2, pos = seed;
+        (*count)++;
+    }
+    for (size_t i = 0; i < n && !(best <= enough2); i++) {
+        size_t k = list[i];
+        if (k == seed || beyond(&T->boxes[k], c->p, best)) continue;
+        bounds_at(T, k, c->p, C, &lo2, &hi2);
+        (*count)++;
+        if (pos == SIZE_MAX || hi2 < best) best = hi2, pos = k;
+    }
+    if (pos == SIZE_MAX) { /* no seed, an empty list: the tree */
+        evaluate(J, t, c, level, seed, target, C, count);
+        return;
+    }
+    c->pos = pos;
+    c->hi = sqrt_up(best);
+}
+
 /* d(v, t) <= this (v's own nearest triangle: next_up(r)). */
-static double corner_to(const corner_t *c, size_t pos, const hd__tri_t *t, cache_t *C, uint64_t *kernel) {
+static double corner_to(corner_t *c, size_t pos, const hd__tri_t *t, cache_t *C, uint64_t *kernel) {
     if (c->pos == pos) return c->hi;
+    int n = c->nm < MEMO ? c->nm : MEMO;
+    for (int i = 0; i < n; i++)
+        if (c->mpos[i] == pos) return c->mh[i];
     double lo2, hi2;
     hd__tri_bounds_prep(c->p, prepared(C, pos, t), &lo2, &hi2);
     (*kernel)++;
-    return sqrt_up(hi2);
+    double h = sqrt_up(hi2);
+    if (pos < UINT32_MAX) {
+        c->mpos[c->nm % MEMO] = (uint32_t)pos, c->mh[c->nm % MEMO] = h;
+        c->nm = c->nm < MEMO ? c->nm + 1 : MEMO + (c->nm + 1) % MEMO; /* once full: the oldest next */
+    }
+    return h;
 }
 
 /* Over a convex union W of two triangles of Y, the distance to W is convex
  * too: its largest value over the sub-triangle is at a corner. */
-static double pair_bound(const hd__m2m_job_t *J, const sub_t *s, double U, cache_t *C, uint64_t *kernel) {
+static double pair_bound(const hd__m2m_job_t *J, sub_t *s, double U, cache_t *C, uint64_t *kernel) {
     for (int i = 0; i < 3; i++)
         for (int j = i + 1; j < 3; j++) {
             size_t p1 = s->c[i].pos, p2 = s->c[j].pos;
@@ -527,7 +583,7 @@ typedef struct cands {
     double h[3][3];
 } cands_t;
 
-static double cand_h(const hd__m2m_job_t *J, const sub_t *s, cands_t *K, int i, int k, cache_t *C, uint64_t *kernel) {
+static double cand_h(const hd__m2m_job_t *J, sub_t *s, cands_t *K, int i, int k, cache_t *C, uint64_t *kernel) {
     if (isnan(K->h[i][k])) K->h[i][k] = corner_to(&s->c[k], K->pos[i], &J->to->tris[K->pos[i]], C, kernel);
     return K->h[i][k];
 }
@@ -558,7 +614,7 @@ double hd__m2m_bent_bound(const double a[3], const double b[3], double U) {
 /* The sub-triangle's upper bound; once the point bound alone is at most
  * `enough` (the sub-triangle will be discarded whatever its bound) the
  * dearer bounds are skipped. */
-static double upper_of(const hd__m2m_job_t *J, const sub_t *s, double e, double enough, cache_t *C,
+static double upper_of(const hd__m2m_job_t *J, sub_t *s, double e, double enough, cache_t *C,
                        uint64_t *kernel) {
     double rmax = 0;
     for (int i = 0; i < 3; i++) rmax = fmax(rmax, s->c[i].hi);
@@ -747,12 +803,15 @@ static void face_top(const hd__m2m_job_t *J, face_t *F, size_t f, const found_t 
         c->r = c->lower = x[i].r;
         c->hi = x[i].hi;
         c->exact = x[i].exact;
+        c->nm = 0;
         c->pos = x[i].pos;
         c->index = x[i].index;
         memcpy(c->near, x[i].near, sizeof c->near);
         if (c->exact) offer(&F->best, c, 0, 0);
     }
     F->top.level = 0;
+    F->top.n = NO_LIST;
+    F->top.off = 0;
     F->top.U = upper_of(J, &F->top, 0, enough, cache, &F->kernel);
     F->upper = F->top.U;
 }
@@ -894,6 +953,10 @@ typedef struct pool {
     hd__heap_t heap;
     cache_t *cache;
     int failed;
+    /* the candidate lists of the sub-triangles of the face being refined
+     * (sub_t.off, n index it; emptied at each visit) */
+    uint32_t *arena;
+    size_t a_n, a_cap;
 } pool_t;
 
 static size_t pool_put(pool_t *P, const sub_t *s) {
@@ -936,6 +999,130 @@ static double exact_bar(const hd__m2m_job_t *J, double L, const face_t *F) {
     return J->per_face || J->face_lower ? own : fmax(L, own);
 }
 
+/* ---- candidate lists ---------------------------------------------------- */
+
+/* Box b certainly farther than sqrt(r2) from box a: the computed
+ * hd__box_box_lb2 is at most the exact squared gap times (1 + u)^5 (one
+ * rounding a difference, exact when not normal, one a square, two sums)
+ * when it is at least 2^-1000, where underflow's 2^-1074 an operation is
+ * below a relative 2^-70; s (1 - 2^-46), rounded, is then below the exact
+ * square. */
+static int box_far(const hd__box_t *a, const hd__box_t *b, double r2) {
+    double s = hd__box_box_lb2(a, b);
+    return s >= 0x1p-1000 && s * (1 - 0x1p-46) > r2;
+}
+
+/* The box of the computed corners c widened by 2e on each side, rounded
+ * outward, and r2 >= H^2 with H = up(U + 2e) (hd__m2m_candidates). */
+static void cand_region(const double c[3][3], double U, double e, hd__box_t *B, double *r2) {
+    double w = up(2 * e);
+    for (int k = 0; k < 3; k++) {
+        double lo = fmin(c[0][k], fmin(c[1][k], c[2][k])), hi = fmax(c[0][k], fmax(c[1][k], c[2][k]));
+        B->lo[k] = down(lo - w);
+        B->hi[k] = up(hi + w);
+    }
+    double H = up(U + w);
+    *r2 = up(H * H);
+}
+
+/* The positions of the triangles of T whose box is not box_far from B,
+ * in leaf order, or SIZE_MAX when there are more than cap (the boxes
+ * alone: cheaper than hd__bvh_collect's support bound per triangle, for
+ * the short lists wanted here). */
+static size_t collect(const hd__bvh_t *T, const hd__box_t *B, double r2, uint32_t *out, size_t cap) {
+    uint32_t stack[DEPTH];
+    int top = 0;
+    size_t n = 0;
+    if (box_far(&T->nodes[0].box, B, r2)) return 0;
+    stack[top++] = 0;
+    while (top > 0) {
+        const hd__bvh_node_t *node = &T->nodes[stack[--top]];
+        if (node->count) {
+            for (size_t k = node->first_or_second, end = k + node->count; k < end; k++) {
+                if (box_far(&T->boxes[k], B, r2)) continue;
+                if (n == cap) return SIZE_MAX;
+                out[n++] = (uint32_t)k;
+            }
+            continue;
+        }
+        uint32_t a = (uint32_t)(node - T->nodes) + 1, b = node->first_or_second;
+        if (top + 2 > DEPTH) return SIZE_MAX;
+        if (!box_far(&T->nodes[b].box, B, r2)) stack[top++] = b;
+        if (!box_far(&T->nodes[a].box, B, r2)) stack[top++] = a;
+    }
+    return n;
+}
+
+size_t hd__m2m_candidates(const hd__bvh_t *T, const double c[3][3], double U, double e, const uint32_t *from,
+                          size_t n_from, uint32_t *out, size_t cap) {
+    hd__box_t B;
+    double r2;
+    cand_region(c, U, e, &B, &r2);
+    if (!from) return collect(T, &B, r2, out, cap);
+    size_t n = 0;
+    for (size_t i = 0; i < n_from; i++) {
+        if (box_far(&T->boxes[from[i]], &B, r2)) continue;
+        if (n == cap) return SIZE_MAX;
+        out[n++] = from[i];
+    }
+    return n;
+}
+
+/* Most entries a worker's arena holds, and most a list collected from the
+ * tree may have (beyond them the tree is searched instead). */
+#define ARENA_MAX ((size_t)1 << 24)
+#define LIST_MAX 48
+/* A sub-triangle without a list whose collection failed (too many
+ * candidates) lets its descendants try again RETRY levels down. */
+#define RETRY 2
+#define LIST_RATIO 1.0
+
+/* A list is collected from the tree only for a sub-triangle whose bound
+ * is small against its size (its candidates are then the few triangles
+ * under it; where the bound is larger a box query meets more triangles
+ * than the point searches it replaces: bench/m2m_bench.py's cases). */
+static int small_reach(const sub_t *s, double e) {
+    double ext = 0;
+    for (int k = 0; k < 3; k++) {
+        double lo = fmin(s->c[0].p[k], fmin(s->c[1].p[k], s->c[2].p[k]));
+        double hi = fmax(s->c[0].p[k], fmax(s->c[1].p[k], s->c[2].p[k]));
+        ext = fmax(ext, hi - lo);
+    }
+    return s->U + 2 * e < LIST_RATIO * ext;
+}
+
+/* s's own candidate list in P's arena (s->off, s->n), from the one it
+ * inherited or else from the tree; s->n = NO_LIST when there is none
+ * (then s->off is the level from which its descendants try again). */
+static void own_list(const hd__m2m_job_t *J, double e, sub_t *s, pool_t *P) {
+    size_t need = s->n != NO_LIST ? s->n : LIST_MAX;
+    if (s->n == NO_LIST && ((uint32_t)s->level < s->off || !small_reach(s, e))) return;
+    if (P->a_n + need > ARENA_MAX) {
+        s->n = NO_LIST, s->off = UINT32_MAX;
+        return;
+    }
+    if (P->a_n + need > P->a_cap) {
+        size_t cap = P->a_cap ? P->a_cap : 4096;
+        while (cap < P->a_n + need) cap *= 2;
+        uint32_t *na = realloc(P->arena, cap * sizeof *na);
+        if (!na) {
+            s->n = NO_LIST, s->off = UINT32_MAX;
+            return;
+        }
+        P->arena = na, P->a_cap = cap;
+    }
+    double c[3][3];
+    for (int i = 0; i < 3; i++) memcpy(c[i], s->c[i].p, sizeof c[i]);
+    const uint32_t *from = s->n != NO_LIST ? P->arena + s->off : NULL;
+    size_t n = hd__m2m_candidates(J->to, c, s->U, e, from, s->n != NO_LIST ? s->n : 0, P->arena + P->a_n, need);
+    if (n == SIZE_MAX) {
+        s->n = NO_LIST, s->off = (uint32_t)s->level + RETRY;
+        return;
+    }
+    s->off = (uint32_t)P->a_n, s->n = (uint32_t)n;
+    P->a_n += n;
+}
+
 static void split(const hd__m2m_job_t *J, const hd__tri_t *t, double e, double L, const sub_t *s, sub_t kids[4],
                   face_t *F, pool_t *P, hd__bvh_stats_t *st) {
     int level = s->level + 1;
@@ -953,20 +1140,31 @@ static void split(const hd__m2m_job_t *J, const hd__tri_t *t, double e, double L
     for (int i = 0; i < 3; i++) {
         const corner_t *p = &s->c[i], *q = &s->c[(i + 1) % 3];
         for (int j = 0; j < 3; j++) m[i].k[j] = p->k[j] + q->k[j];
-        evaluate(J, t, &m[i], level, p->pos, target, P->cache, &F->kernel);
+        m[i].nm = 0;
+        if (s->n != NO_LIST)
+            evaluate_in(J, t, &m[i], level, p->pos, target, P->arena + s->off, s->n, P->cache, &F->kernel);
+        else
+            evaluate(J, t, &m[i], level, p->pos, target, P->cache, &F->kernel);
         if (could(&m[i], level, e) > exact_bar(J, L, F)) {
             make_exact(J, &m[i], level, e, st);
             offer(&F->best, &m[i], level, e);
         }
     }
-    const corner_t *tri[4][3] = {{&c[0], &m[0], &m[2]}, {&m[0], &c[1], &m[1]}, {&m[2], &m[1], &c[2]},
-                                 {&m[0], &m[1], &m[2]}};
+    corner_t *tri[4][3] = {{&c[0], &m[0], &m[2]}, {&m[0], &c[1], &m[1]}, {&m[2], &m[1], &c[2]},
+                           {&m[0], &m[1], &m[2]}};
     double enough = enough_for(J, threshold(J, L, F));
+    /* the corners' remembered bounds go back to c and m after each child,
+     * so that its siblings (and, copied again below, its descendants)
+     * reuse them */
     for (int q = 0; q < 4; q++) {
         for (int i = 0; i < 3; i++) kids[q].c[i] = *tri[q][i];
         kids[q].level = level;
+        kids[q].off = s->off, kids[q].n = s->n;
         kids[q].U = upper_of(J, &kids[q], e, enough, P->cache, &F->kernel);
+        for (int i = 0; i < 3; i++) *tri[q][i] = kids[q].c[i];
     }
+    for (int q = 0; q < 3; q++)
+        for (int i = 0; i < 3; i++) kids[q].c[i] = *tri[q][i];
 }
 
 /* Keep what is left of a face's heap for its next visit (F->upper: its
@@ -977,7 +1175,11 @@ static int save(face_t *F, pool_t *P, double cut) {
     if (!F->saved) return P->failed = 1, -1;
     F->upper = fmax(hd__heap_top(&P->heap)->key, cut);
     F->cut = cut;
-    for (size_t k = 0; k < F->n_saved; k++) F->saved[k] = P->s[hd__heap_pop(&P->heap).val];
+    for (size_t k = 0; k < F->n_saved; k++) {
+        F->saved[k] = P->s[hd__heap_pop(&P->heap).val];
+        F->saved[k].n = NO_LIST; /* the arena is emptied at the next visit */
+        F->saved[k].off = 0;
+    }
     return 0;
 }
 
@@ -990,6 +1192,7 @@ static void refine(const hd__m2m_job_t *J, face_t *F, size_t f, double L, pool_t
     hd__bvh_stats_t st = {0};
     hd__heap_clear(&P->heap);
     P->n = P->n_free = 0;
+    P->a_n = 0;
     if (!F->saved && pool_put(P, &F->top) == SIZE_MAX) return;
     for (size_t k = 0; k < F->n_saved; k++)
         if (pool_put(P, &F->saved[k]) == SIZE_MAX) return;
@@ -1025,6 +1228,7 @@ static void refine(const hd__m2m_job_t *J, face_t *F, size_t f, double L, pool_t
             break;
         }
         sub_t kids[4];
+        own_list(J, e, &s, P);
         split(J, t, e, L, &s, kids, F, P, &st);
         F->splits++;
         thr = threshold(J, L, F);
@@ -1196,6 +1400,7 @@ static int run_batches(const hd__m2m_job_t *J, ctx_t *C, rank_t *rk, size_t n, h
     for (int w = 0; pools && w < J->threads; w++) {
         free(pools[w].s);
         free(pools[w].free_);
+        free(pools[w].arena);
         hd__heap_free(&pools[w].heap);
     }
     free(pools);
