@@ -140,6 +140,9 @@ static double up(double x) {
     return x;
 }
 static double down(double x) { return -up(-x); }
+/* fmax and fmin (a NaN argument gives the other), inline: libm's are calls. */
+static inline double dmax(double a, double b) { return a > b ? a : b == b ? b : a; }
+static inline double dmin(double a, double b) { return a < b ? a : b == b ? b : a; }
 static double sqrt_up(double x) { return x <= 0 ? 0 : up(sqrt(x)); }
 
 /* Bounds to triangles of Y that a corner remembers (corner_to). */
@@ -201,8 +204,8 @@ typedef struct face {
 static double slack(const hd__tri_t *t) {
     double m = 0, d = 0;
     for (int k = 0; k < 3; k++) {
-        double mk = fmax(fabs(t->v[0][k]), fmax(fabs(t->v[1][k]), fabs(t->v[2][k])));
-        double dk = fmax(fabs(t->v[1][k] - t->v[0][k]), fabs(t->v[2][k] - t->v[0][k]));
+        double mk = dmax(fabs(t->v[0][k]), dmax(fabs(t->v[1][k]), fabs(t->v[2][k])));
+        double dk = dmax(fabs(t->v[1][k] - t->v[0][k]), fabs(t->v[2][k] - t->v[0][k]));
         m = up(m + mk);
         d = up(d + dk);
     }
@@ -249,7 +252,7 @@ static double reach(const sub_t *s) {
         l2[i] = dx * dx + dy * dy + dz * dz;
         l1 = up(l1 + up(up(fabs(dx) + fabs(dy)) + fabs(dz)));
     }
-    double a2 = fmax(l2[0], fmax(l2[1], l2[2]));
+    double a2 = dmax(l2[0], dmax(l2[1], l2[2]));
     if (a2 < TINY2) return up(l1 * (1 + 0x1p-40));
     double rest = l2[0] + l2[1] + l2[2] - a2;
     /* a2 > rest by a margin far above the rounding of the squares: obtuse */
@@ -449,7 +452,7 @@ static size_t interval(const hd__bvh_t *T, const double p[3], size_t seed, cache
                 if (k == seed || beyond(&T->boxes[k], p, best)) continue;
                 bounds_at(T, k, p, C, &lo2, &hi2);
                 (*count)++;
-                low = fmin(low, lo2);
+                low = dmin(low, lo2);
                 if (pos == SIZE_MAX || hi2 < best) best = hi2, pos = k;
                 if (best <= enough2) goto early;
             }
@@ -482,7 +485,7 @@ static double enough_of(double target) { return target > 0 ? target * target * (
 /* The largest lower bound the corner could give (its exact distance is at
  * most hi). */
 static double could(const corner_t *c, int level, double e) {
-    return is_vertex(c, level) ? c->hi : fmax(0.0, down(down(c->hi) - e));
+    return is_vertex(c, level) ? c->hi : dmax(0.0, down(down(c->hi) - e));
 }
 
 /* The corner's exact distance through the tree (the witness's lower bound). */
@@ -491,7 +494,7 @@ static void make_exact(const hd__m2m_job_t *J, corner_t *c, int level, double e,
     size_t pos = hd__bvh_nearest(J->to, c->p, c->pos, 0, &near, &c->index, st);
     c->r = near.d;
     memcpy(c->near, near.point, sizeof c->near);
-    c->lower = is_vertex(c, level) ? c->r : fmax(0.0, down(down(c->r) - e));
+    c->lower = is_vertex(c, level) ? c->r : dmax(0.0, down(down(c->r) - e));
     c->exact = 1;
     if (up(c->r) < c->hi) c->hi = up(c->r), c->pos = pos;
 }
@@ -568,8 +571,8 @@ static double pair_bound(const hd__m2m_job_t *J, sub_t *s, double U, cache_t *C,
             if (!shared_convex(t1, t2)) continue;
             double m = 0;
             for (int k = 0; k < 3 && m < U; k++)
-                m = fmax(m, fmin(corner_to(&s->c[k], p1, t1, C, kernel), corner_to(&s->c[k], p2, t2, C, kernel)));
-            U = fmin(U, m);
+                m = dmax(m, dmin(corner_to(&s->c[k], p1, t1, C, kernel), corner_to(&s->c[k], p2, t2, C, kernel)));
+            U = dmin(U, m);
         }
     return U;
 }
@@ -592,7 +595,7 @@ static double cand_h(const hd__m2m_job_t *J, sub_t *s, cands_t *K, int i, int k,
  * mu >= 1 - lam (a, b >= 0 and finite). */
 static double mixed(const double *a, const double *b, double lam) {
     double mu = up(1 - lam), m = 0;
-    for (int k = 0; k < 3; k++) m = fmax(m, up(up(lam * a[k]) + up(mu * b[k])));
+    for (int k = 0; k < 3; k++) m = dmax(m, up(up(lam * a[k]) + up(mu * b[k])));
     return m;
 }
 
@@ -602,11 +605,11 @@ static double mixed(const double *a, const double *b, double lam) {
 double hd__m2m_bent_bound(const double a[3], const double b[3], double U) {
     for (int k = 0; k < 3; k++)
         if (!isfinite(a[k]) || !isfinite(b[k])) return U;
-    U = fmin(U, fmin(fmax(a[0], fmax(a[1], a[2])), fmax(b[0], fmax(b[1], b[2])))); /* lam = 1, 0 */
+    U = dmin(U, dmin(dmax(a[0], dmax(a[1], a[2])), dmax(b[0], dmax(b[1], b[2])))); /* lam = 1, 0 */
     for (int k = 0; k < 3; k++) {
         int l = (k + 1) % 3;
         double lam = (b[l] - b[k]) / ((a[k] - b[k]) - (a[l] - b[l]));
-        if (lam > 0 && lam < 1) U = fmin(U, mixed(a, b, lam));
+        if (lam > 0 && lam < 1) U = dmin(U, mixed(a, b, lam));
     }
     return U;
 }
@@ -617,7 +620,7 @@ double hd__m2m_bent_bound(const double a[3], const double b[3], double U) {
 static double upper_of(const hd__m2m_job_t *J, sub_t *s, double e, double enough, cache_t *C,
                        uint64_t *kernel) {
     double rmax = 0;
-    for (int i = 0; i < 3; i++) rmax = fmax(rmax, s->c[i].hi);
+    for (int i = 0; i < 3; i++) rmax = dmax(rmax, s->c[i].hi);
     double U = up(rmax + reach(s));
     if ((s->level ? up(U + e) : U) <= enough) return s->level ? up(U + e) : U;
     cands_t K = {.n = 0};
@@ -632,8 +635,8 @@ static double upper_of(const hd__m2m_job_t *J, sub_t *s, double e, double enough
     }
     for (int i = 0; i < K.n; i++) { /* Tang's bound over the corners' nearest triangles */
         double m = 0;
-        for (int k = 0; k < 3 && m < U; k++) m = fmax(m, cand_h(J, s, &K, i, k, C, kernel));
-        U = fmin(U, m);
+        for (int k = 0; k < 3 && m < U; k++) m = dmax(m, cand_h(J, s, &K, i, k, C, kernel));
+        U = dmin(U, m);
     }
     if (K.n > 1) U = pair_bound(J, s, U, C, kernel);
     double E = s->level ? e : 0;
@@ -651,7 +654,7 @@ static double upper_of(const hd__m2m_job_t *J, sub_t *s, double e, double enough
  * tolerance (a face or sub-triangle whose bound is within the tolerance
  * of the lower bound is never split). */
 static double enough_for(const hd__m2m_job_t *J, double bar) {
-    return isfinite(J->done_below) ? fmax(bar, J->done_below) : bar + J->tol;
+    return isfinite(J->done_below) ? dmax(bar, J->done_below) : bar + J->tol;
 }
 
 /* ---- phase 1: every face's corners -------------------------------------- */
@@ -691,7 +694,7 @@ static double face_reach(const hd__tri_t *t) {
     for (int i = 0; i < 3; i++) {
         const double *p = t->v[i], *q = t->v[(i + 1) % 3];
         double dx = p[0] - q[0], dy = p[1] - q[1], dz = p[2] - q[2];
-        a2 = fmax(a2, dx * dx + dy * dy + dz * dz);
+        a2 = dmax(a2, dx * dx + dy * dy + dz * dz);
     }
     return sqrt(a2) * 0.5774;
 }
@@ -711,7 +714,7 @@ static int is_sample(const ctx_t *C, size_t k) {
  * corners as low the face's point bound is within the tolerance of L0. */
 static double corner_target(const ctx_t *C, size_t id) {
     const hd__m2m_job_t *J = C->job;
-    return fmin(C->L0 + J->tol - face_reach(&J->from[id / 3]), down(C->L0));
+    return dmin(C->L0 + J->tol - face_reach(&J->from[id / 3]), down(C->L0));
 }
 
 /* Phase 0: each corner's distance enclosed (interval()), in Morton order
@@ -763,7 +766,7 @@ static double phase0_bar(const ctx_t *C) {
     double bar = C->stage == 2 ? C->L0 : -INFINITY;
     for (size_t k = 0; k < C->n_corners; k += C->stage == 1 ? C->stride : 1) {
         size_t id = C->order ? (size_t)(C->order[k] & 0xffffffffu) : k;
-        if (!C->faces[id / 3].done && (C->stage != 1 || is_sample(C, k))) bar = fmax(bar, C->found[id].lo);
+        if (!C->faces[id / 3].done && (C->stage != 1 || is_sample(C, k))) bar = dmax(bar, C->found[id].lo);
     }
     return bar;
 }
@@ -879,7 +882,7 @@ static int tang_screened(const hd__m2m_job_t *J, const hd__tri_t *t, size_t pos,
     double m = 0, lo2, hi2;
     for (int i = 0; i < 3 && m <= J->done_below; i++) {
         hd__tri_bounds_prep(t->v[i], hd__bvh_prep(J->to, pos), &lo2, &hi2);
-        m = fmax(m, sqrt_up(hi2));
+        m = dmax(m, sqrt_up(hi2));
     }
     if (!(m <= J->done_below)) return 0;
     *upper = m;
@@ -896,7 +899,7 @@ static int screened(const hd__m2m_job_t *J, const hd__tri_t *t, size_t *seed, do
     double R = reach(&s), target = J->done_below - R, m = 0, ub;
     int i = 0;
     if (target >= 0)
-        for (; i < 3 && screen_point(J->to, t->v[i], target, seed, &ub); i++) m = fmax(m, ub);
+        for (; i < 3 && screen_point(J->to, t->v[i], target, seed, &ub); i++) m = dmax(m, ub);
     double U = up(m + R);
     if (i == 3 && U <= J->done_below) {
         *upper = U;
@@ -931,7 +934,7 @@ static int corner_order(const hd__m2m_job_t *J, int threads, uint64_t **out) {
     hd__box_t box = {{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
     for (size_t id = 0; id < n; id++)
         for (int d = 0; d < 3; d++)
-            box.lo[d] = fmin(box.lo[d], CORNER(J, id)[d]), box.hi[d] = fmax(box.hi[d], CORNER(J, id)[d]);
+            box.lo[d] = dmin(box.lo[d], CORNER(J, id)[d]), box.hi[d] = dmax(box.hi[d], CORNER(J, id)[d]);
     hd__keygrid_t g;
     hd__keygrid_init(&g, &box);
     for (size_t id = 0; id < n; id++) keys[id] = (uint64_t)hd__key30(&g, CORNER(J, id)) << 32 | (uint64_t)id;
@@ -988,7 +991,7 @@ static size_t pool_put(pool_t *P, const sub_t *s) {
 
 /* The four children of s (corners 0, 1, 2; midpoints m01, m12, m20). */
 static double threshold(const hd__m2m_job_t *J, double L, const face_t *F) {
-    double thr = J->per_face ? F->best.lower : fmax(L, F->best.lower);
+    double thr = J->per_face ? F->best.lower : dmax(L, F->best.lower);
     return thr;
 }
 
@@ -996,7 +999,7 @@ static double threshold(const hd__m2m_job_t *J, double L, const face_t *F) {
  * face's own best, and L unless each face's own lower bound is asked for. */
 static double exact_bar(const hd__m2m_job_t *J, double L, const face_t *F) {
     double own = F->best.set ? F->best.lower : -INFINITY;
-    return J->per_face || J->face_lower ? own : fmax(L, own);
+    return J->per_face || J->face_lower ? own : dmax(L, own);
 }
 
 /* ---- candidate lists ---------------------------------------------------- */
@@ -1017,7 +1020,7 @@ static int box_far(const hd__box_t *a, const hd__box_t *b, double r2) {
 static void cand_region(const double c[3][3], double U, double e, hd__box_t *B, double *r2) {
     double w = up(2 * e);
     for (int k = 0; k < 3; k++) {
-        double lo = fmin(c[0][k], fmin(c[1][k], c[2][k])), hi = fmax(c[0][k], fmax(c[1][k], c[2][k]));
+        double lo = dmin(c[0][k], dmin(c[1][k], c[2][k])), hi = dmax(c[0][k], dmax(c[1][k], c[2][k]));
         B->lo[k] = down(lo - w);
         B->hi[k] = up(hi + w);
     }
@@ -1075,7 +1078,7 @@ size_t hd__m2m_candidates(const hd__bvh_t *T, const double c[3][3], double U, do
 /* A sub-triangle without a list whose collection failed (too many
  * candidates) lets its descendants try again RETRY levels down. */
 #define RETRY 2
-#define LIST_RATIO 1.0
+#define LIST_RATIO 0.35
 
 /* A list is collected from the tree only for a sub-triangle whose bound
  * is small against its size (its candidates are then the few triangles
@@ -1084,9 +1087,9 @@ size_t hd__m2m_candidates(const hd__bvh_t *T, const double c[3][3], double U, do
 static int small_reach(const sub_t *s, double e) {
     double ext = 0;
     for (int k = 0; k < 3; k++) {
-        double lo = fmin(s->c[0].p[k], fmin(s->c[1].p[k], s->c[2].p[k]));
-        double hi = fmax(s->c[0].p[k], fmax(s->c[1].p[k], s->c[2].p[k]));
-        ext = fmax(ext, hi - lo);
+        double lo = dmin(s->c[0].p[k], dmin(s->c[1].p[k], s->c[2].p[k]));
+        double hi = dmax(s->c[0].p[k], dmax(s->c[1].p[k], s->c[2].p[k]));
+        ext = dmax(ext, hi - lo);
     }
     return s->U + 2 * e < LIST_RATIO * ext;
 }
@@ -1136,7 +1139,7 @@ static void split(const hd__m2m_job_t *J, const hd__tri_t *t, double e, double L
      * d) (a child's reach is at most its parent's, up to rounding), where
      * a sub-triangle is never split, and the midpoint cannot raise a lower
      * bound (target <= exact_bar). */
-    double target = fmin(fmax(threshold(J, L, F) + J->tol, J->done_below) - reach(s) - 2 * e, exact_bar(J, L, F));
+    double target = dmin(dmax(threshold(J, L, F) + J->tol, J->done_below) - reach(s) - 2 * e, exact_bar(J, L, F));
     for (int i = 0; i < 3; i++) {
         const corner_t *p = &s->c[i], *q = &s->c[(i + 1) % 3];
         for (int j = 0; j < 3; j++) m[i].k[j] = p->k[j] + q->k[j];
@@ -1173,7 +1176,7 @@ static int save(face_t *F, pool_t *P, double cut) {
     F->n_saved = hd__heap_size(&P->heap);
     F->saved = hd__malloc_array(F->n_saved, sizeof *F->saved);
     if (!F->saved) return P->failed = 1, -1;
-    F->upper = fmax(hd__heap_top(&P->heap)->key, cut);
+    F->upper = dmax(hd__heap_top(&P->heap)->key, cut);
     F->cut = cut;
     for (size_t k = 0; k < F->n_saved; k++) {
         F->saved[k] = P->s[hd__heap_pop(&P->heap).val];
@@ -1207,7 +1210,7 @@ static void refine(const hd__m2m_job_t *J, face_t *F, size_t f, double L, pool_t
         const hd__heap_item_t *top = hd__heap_top(&P->heap);
         double thr = threshold(J, L, F);
         if (top->key - thr <= J->tol || top->key <= J->done_below || F->best.lower > J->stop_above) {
-            F->upper = fmax(top->key, cut);
+            F->upper = dmax(top->key, cut);
             break;
         }
         if (visit == budget) {
@@ -1221,10 +1224,10 @@ static void refine(const hd__m2m_job_t *J, face_t *F, size_t f, double L, pool_t
         if (s.level >= MAX_LEVEL || (J->max_splits && F->splits >= J->max_splits)) {
             F->capped = 1;
             if (s.level >= MAX_LEVEL) {
-                cut = fmax(cut, s.U);
+                cut = dmax(cut, s.U);
                 continue;
             }
-            F->upper = fmax(s.U, cut);
+            F->upper = dmax(s.U, cut);
             break;
         }
         sub_t kids[4];
@@ -1233,7 +1236,7 @@ static void refine(const hd__m2m_job_t *J, face_t *F, size_t f, double L, pool_t
         F->splits++;
         thr = threshold(J, L, F);
         for (int q = 0; q < 4; q++) {
-            if (kids[q].U <= fmax(thr, J->done_below)) cut = fmax(cut, kids[q].U);
+            if (kids[q].U <= dmax(thr, J->done_below)) cut = dmax(cut, kids[q].U);
             else if (pool_put(P, &kids[q]) == SIZE_MAX) return;
         }
     }
@@ -1332,7 +1335,7 @@ static void take_best(hd__m2m_result_t *R, const face_t *F, size_t f) {
 static void finish_face(hd__m2m_result_t *R, const hd__m2m_job_t *J, const face_t *F, size_t f) {
     if (J->face_lower) J->face_lower[f] = F->best.set ? F->best.lower : 0;
     if (J->face_upper) J->face_upper[f] = F->upper;
-    R->upper = fmax(R->upper, F->upper);
+    R->upper = dmax(R->upper, F->upper);
     R->splits += F->splits;
     R->kernel_calls += F->kernel;
     R->capped |= F->capped;
@@ -1414,7 +1417,7 @@ static double sample_best(const ctx_t *C) {
     double best = -INFINITY;
     for (size_t k = 0; k < C->n_corners; k += C->stride) {
         size_t id = C->order ? (size_t)(C->order[k] & 0xffffffffu) : k;
-        if (!C->faces[id / 3].done && is_sample(C, k) && C->found[id].exact) best = fmax(best, C->found[id].r);
+        if (!C->faces[id / 3].done && is_sample(C, k) && C->found[id].exact) best = dmax(best, C->found[id].r);
     }
     return best;
 }
@@ -1527,7 +1530,7 @@ int hd__m2m_run(const hd__m2m_job_t *J, hd__m2m_result_t *R) {
     sort_ranks(rk, live);
     if (rc == HD_OK && !stopped) rc = run_batches(J, &C, rk, live, R);
     for (size_t f = 0; f < n; f++) finish_face(R, J, &C.faces[f], f);
-    R->upper = stopped ? INFINITY : fmax(R->upper, R->lower);
+    R->upper = stopped ? INFINITY : dmax(R->upper, R->lower);
     free(C.faces);
     caches_free(C.caches, J->threads);
     free(rk);
