@@ -1078,28 +1078,19 @@ size_t hd__m2m_candidates(const hd__bvh_t *T, const double c[3][3], double U, do
 /* A sub-triangle without a list whose collection failed (too many
  * candidates) lets its descendants try again RETRY levels down. */
 #define RETRY 2
-#define LIST_RATIO 0.35
-
-/* A list is collected from the tree only for a sub-triangle whose bound
- * is small against its size (its candidates are then the few triangles
- * under it; where the bound is larger a box query meets more triangles
- * than the point searches it replaces: bench/m2m_bench.py's cases). */
-static int small_reach(const sub_t *s, double e) {
-    double ext = 0;
-    for (int k = 0; k < 3; k++) {
-        double lo = dmin(s->c[0].p[k], dmin(s->c[1].p[k], s->c[2].p[k]));
-        double hi = dmax(s->c[0].p[k], dmax(s->c[1].p[k], s->c[2].p[k]));
-        ext = dmax(ext, hi - lo);
-    }
-    return s->U + 2 * e < LIST_RATIO * ext;
-}
+/* Lists are collected from the tree from this level on: a shallower
+ * sub-triangle is often split once only (each face of a finer X over a
+ * coarser Y), and one box query then costs as much as the point searches
+ * it would replace (bench/m2m_bench.py's `subdivided` and `decimated`;
+ * `nearzero` splits deep, where inherited lists pay). */
+#define LIST_LEVEL 2
 
 /* s's own candidate list in P's arena (s->off, s->n), from the one it
  * inherited or else from the tree; s->n = NO_LIST when there is none
  * (then s->off is the level from which its descendants try again). */
 static void own_list(const hd__m2m_job_t *J, double e, sub_t *s, pool_t *P) {
     size_t need = s->n != NO_LIST ? s->n : LIST_MAX;
-    if (s->n == NO_LIST && ((uint32_t)s->level < s->off || !small_reach(s, e))) return;
+    if (s->n == NO_LIST && ((uint32_t)s->level < s->off || s->level < LIST_LEVEL)) return;
     if (P->a_n + need > ARENA_MAX) {
         s->n = NO_LIST, s->off = UINT32_MAX;
         return;
