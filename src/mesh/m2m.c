@@ -100,6 +100,34 @@
  * left); h's upper bound is the largest over faces (faces skipped because
  * their first U was <= L contribute that U).
  *
+ * Candidate lists.  A sub-triangle split at level LIST_LEVEL or deeper
+ * bounds its midpoints from a list of Y's triangles instead of the tree
+ * (evaluate_in; any triangle's bound is an upper bound, so the list only
+ * decides how tight hi is, never whether it holds).  The list holds
+ * every triangle that can be nearest to a point q computed below the
+ * sub-triangle s (a corner of a descendant): q is within e of the exact
+ * point of the face at its weights, which lies in the exact sub-triangle,
+ * itself within e of the hull T of s's computed corners point by point
+ * (above), so |q - y| <= 2e for some y in T and d(q, Y) <= d(y, Y) + 2e
+ * <= U + 2e <= H = up(U + 2e), U = s's bound; and q lies in the corners'
+ * box widened by 2e (rounded outward), Bx.  q's nearest triangle t* has
+ * dist(Bx, box(t*)) <= d(q, t*) = d(q, Y) <= H, so t* is not among the
+ * triangles whose box is proven farther than sqrt(r2) from Bx, r2 =
+ * up(H * H) >= H^2 (box_far: the computed box-to-box square is within
+ * (1 + u)^5 of the exact one above 2^-1000, and is shrunk by 1 - 2^-46).
+ * The children's points are their parent's, so they inherit its list as
+ * it stands; a sub-triangle being split filters its inherited list with
+ * its own Bx and H (the same argument), or, without one, collects it from
+ * the tree (collect(), up to LIST_MAX triangles).  Lists live in the
+ * worker's arena for one visit of the face; a sub-triangle saved for a
+ * later pass loses its list.  So hi is the tree's smallest hi2, up to
+ * ties, and every list depends on the face's refinement alone.
+ *
+ * Corners remember (MEMO) the bounds to triangles of Y that upper_of
+ * computed for them (corner_to: a function of the point and the triangle
+ * only), so a corner shared by siblings, or kept by the children of a
+ * split, is bounded once per triangle; the results are the same.
+ *
  * The predicate (a finite d: done_below = stop_above = d) runs phases 0
  * and 1 in rounds of faces instead: a face is first screened - the point
  * bound over its vertices from any triangle of Y whose prepared upper

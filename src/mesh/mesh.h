@@ -272,13 +272,14 @@ double hd__m2m_bent_bound(const double a[3], const double b[3], double U);
 
 /* The candidate list of a sub-triangle whose computed corners are c, with
  * U >= d(y, Y) for every y of their hull and e the face's slack (m2m.c):
- * writes to out every triangle of T (positions; from the tree, or those
- * of from[0 .. n_from) when from is not NULL) whose box is not proven
- * farther than up(U + 2e) from the corners' box widened by 2e, and
- * returns their number, or SIZE_MAX when there are more than cap.  Every
- * point computed within 2e of the hull (a corner of a descendant
- * sub-triangle) has its nearest triangle of T in the list when it is in
- * from (m2m.c has the proof).  Thread safety: as hd__bvh_collect. */
+ * writes to out every triangle of T (positions, from the tree in leaf
+ * order, or from from[0 .. n_from) in its order when from is not NULL)
+ * whose box is not proven farther than up(U + 2e) from the corners' box
+ * widened by 2e, and returns their number, or SIZE_MAX when there are
+ * more than cap.  Every point within 2e of the hull (a corner of a
+ * descendant sub-triangle) then has a nearest triangle of T in the list,
+ * if from (when given) had one (m2m.c has the proof).  Thread safety:
+ * reads T only. */
 size_t hd__m2m_candidates(const hd__bvh_t *T, const double c[3][3], double U, double e, const uint32_t *from,
                           size_t n_from, uint32_t *out, size_t cap);
 
