@@ -1064,22 +1064,21 @@ static size_t collect(const hd__bvh_t *T, const hd__box_t *B, double r2, uint32_
     uint32_t stack[DEPTH];
     int top = 0;
     size_t n = 0;
-    if (box_far(&T->nodes[0].box, B, r2)) return 0;
     stack[top++] = 0;
-    while (top > 0) {
-        const hd__bvh_node_t *node = &T->nodes[stack[--top]];
-        if (node->count) {
-            for (size_t k = node->first_or_second, end = k + node->count; k < end; k++) {
-                if (box_far(&T->boxes[k], B, r2)) continue;
+    while (top > 0) { /* a node's box is tested when it is popped */
+        uint32_t id = stack[--top];
+        const hd__bvh_node_t *node = &T->nodes[id];
+        if (box_far(&node->box, B, r2)) continue;
+        if (!node->count) {
+            if (top + 2 > DEPTH) return SIZE_MAX;
+            stack[top++] = node->first_or_second, stack[top++] = id + 1; /* the first child first */
+            continue;
+        }
+        for (size_t k = node->first_or_second; k < (size_t)node->first_or_second + node->count; k++)
+            if (!box_far(&T->boxes[k], B, r2)) {
                 if (n == cap) return SIZE_MAX;
                 out[n++] = (uint32_t)k;
             }
-            continue;
-        }
-        uint32_t a = (uint32_t)(node - T->nodes) + 1, b = node->first_or_second;
-        if (top + 2 > DEPTH) return SIZE_MAX;
-        if (!box_far(&T->nodes[b].box, B, r2)) stack[top++] = b;
-        if (!box_far(&T->nodes[a].box, B, r2)) stack[top++] = a;
     }
     return n;
 }
