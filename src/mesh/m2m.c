@@ -100,6 +100,34 @@
  * left); h's upper bound is the largest over faces (faces skipped because
  * their first U was <= L contribute that U).
  *
+ * Candidate lists.  A sub-triangle split at level LIST_LEVEL or deeper
+ * bounds its midpoints from a list of Y's triangles instead of the tree
+ * (evaluate_in; any triangle's bound is an upper bound, so the list only
+ * decides how tight hi is, never whether it holds).  The list holds
+ * every triangle that can be nearest to a point q computed below the
+ * sub-triangle s (a corner of a descendant): q is within e of the exact
+ * point of the face at its weights, which lies in the exact sub-triangle,
+ * itself within e of the hull T of s's computed corners point by point
+ * (above), so |q - y| <= 2e for some y in T and d(q, Y) <= d(y, Y) + 2e
+ * <= U + 2e <= H = up(U + 2e), U = s's bound; and q lies in the corners'
+ * box widened by 2e (rounded outward), Bx.  q's nearest triangle t* has
+ * dist(Bx, box(t*)) <= d(q, t*) = d(q, Y) <= H, so t* is not among the
+ * triangles whose box is proven farther than sqrt(r2) from Bx, r2 =
+ * up(H * H) >= H^2 (box_far: the computed box-to-box square is within
+ * (1 + u)^5 of the exact one above 2^-1000, and is shrunk by 1 - 2^-46).
+ * The children's points are their parent's, so they inherit its list as
+ * it stands; a sub-triangle being split filters its inherited list with
+ * its own Bx and H (the same argument), or, without one, collects it from
+ * the tree (collect(), up to LIST_MAX triangles).  Lists live in the
+ * worker's arena for one visit of the face; a sub-triangle saved for a
+ * later pass loses its list.  So hi is the tree's smallest hi2, up to
+ * ties, and every list depends on the face's refinement alone.
+ *
+ * Corners remember (MEMO) the bounds to triangles of Y that upper_of
+ * computed for them (corner_to: a function of the point and the triangle
+ * only), so a corner shared by siblings, or kept by the children of a
+ * split, is bounded once per triangle; the results are the same.
+ *
  * The predicate (a finite d: done_below = stop_above = d) runs phases 0
  * and 1 in rounds of faces instead: a face is first screened - the point
  * bound over its vertices from any triangle of Y whose prepared upper
@@ -140,7 +168,13 @@ static double up(double x) {
     return x;
 }
 static double down(double x) { return -up(-x); }
+/* fmax and fmin (a NaN argument gives the other), inline: libm's are calls. */
+static inline double dmax(double a, double b) { return a > b ? a : b == b ? b : a; }
+static inline double dmin(double a, double b) { return a < b ? a : b == b ? b : a; }
 static double sqrt_up(double x) { return x <= 0 ? 0 : up(sqrt(x)); }
+
+/* Bounds to triangles of Y that a corner remembers (corner_to). */
+#define MEMO 4
 
 typedef struct corner {
     double p[3];
@@ -152,13 +186,24 @@ typedef struct corner {
     size_t index;  /* p's nearest triangle's index in Y (exact) */
     double near[3];/* the nearest point on it (exact) */
     int exact;     /* r, lower, index, near are set */
+    /* bounds already computed: d(p, triangle at mpos[i]) <= mh[i]
+     * (corner_to's value, a function of p and the triangle alone) */
+    uint32_t mpos[MEMO];
+    double mh[MEMO];
+    int nm;
 } corner_t;
 
 typedef struct sub {
     corner_t c[3];
     double U;
     int level;
+    /* candidates: list[off, off + n) of the worker's arena holds every
+     * triangle of Y that can be nearest to a point of the sub-triangle's
+     * descendants (inherited from the parent, or its own once split;
+     * n == NO_LIST: none, the tree is searched) */
+    uint32_t off, n;
 } sub_t;
+#define NO_LIST UINT32_MAX
 
 /* The best lower bound of a face and its witness. */
 typedef struct best {
@@ -187,8 +232,8 @@ typedef struct face {
 static double slack(const hd__tri_t *t) {
     double m = 0, d = 0;
     for (int k = 0; k < 3; k++) {
-        double mk = fmax(fabs(t->v[0][k]), fmax(fabs(t->v[1][k]), fabs(t->v[2][k])));
-        double dk = fmax(fabs(t->v[1][k] - t->v[0][k]), fabs(t->v[2][k] - t->v[0][k]));
+        double mk = dmax(fabs(t->v[0][k]), dmax(fabs(t->v[1][k]), fabs(t->v[2][k])));
+        double dk = dmax(fabs(t->v[1][k] - t->v[0][k]), fabs(t->v[2][k] - t->v[0][k]));
         m = up(m + mk);
         d = up(d + dk);
     }
@@ -235,7 +280,7 @@ static double reach(const sub_t *s) {
         l2[i] = dx * dx + dy * dy + dz * dz;
         l1 = up(l1 + up(up(fabs(dx) + fabs(dy)) + fabs(dz)));
     }
-    double a2 = fmax(l2[0], fmax(l2[1], l2[2]));
+    double a2 = dmax(l2[0], dmax(l2[1], l2[2]));
     if (a2 < TINY2) return up(l1 * (1 + 0x1p-40));
     double rest = l2[0] + l2[1] + l2[2] - a2;
     /* a2 > rest by a margin far above the rounding of the squares: obtuse */
@@ -435,7 +480,7 @@ static size_t interval(const hd__bvh_t *T, const double p[3], size_t seed, cache
                 if (k == seed || beyond(&T->boxes[k], p, best)) continue;
                 bounds_at(T, k, p, C, &lo2, &hi2);
                 (*count)++;
-                low = fmin(low, lo2);
+                low = dmin(low, lo2);
                 if (pos == SIZE_MAX || hi2 < best) best = hi2, pos = k;
                 if (best <= enough2) goto early;
             }
@@ -468,7 +513,7 @@ static double enough_of(double target) { return target > 0 ? target * target * (
 /* The largest lower bound the corner could give (its exact distance is at
  * most hi). */
 static double could(const corner_t *c, int level, double e) {
-    return is_vertex(c, level) ? c->hi : fmax(0.0, down(down(c->hi) - e));
+    return is_vertex(c, level) ? c->hi : dmax(0.0, down(down(c->hi) - e));
 }
 
 /* The corner's exact distance through the tree (the witness's lower bound). */
@@ -477,7 +522,7 @@ static void make_exact(const hd__m2m_job_t *J, corner_t *c, int level, double e,
     size_t pos = hd__bvh_nearest(J->to, c->p, c->pos, 0, &near, &c->index, st);
     c->r = near.d;
     memcpy(c->near, near.point, sizeof c->near);
-    c->lower = is_vertex(c, level) ? c->r : fmax(0.0, down(down(c->r) - e));
+    c->lower = is_vertex(c, level) ? c->r : dmax(0.0, down(down(c->r) - e));
     c->exact = 1;
     if (up(c->r) < c->hi) c->hi = up(c->r), c->pos = pos;
 }
@@ -492,18 +537,60 @@ static void evaluate(const hd__m2m_job_t *J, const hd__tri_t *t, corner_t *c, in
     c->exact = 0;
 }
 
+/* evaluate()'s upper bound from a list of candidates instead of the tree:
+ * hi from the smallest hi2 over the seed and the list's triangles whose
+ * box is not beyond the best so far (any triangle's sqrt_up(hi2) is
+ * >= d(p, Y), so the bound holds whatever the list; a list that holds
+ * p's nearest triangle gives the tree's smallest hi2), the search
+ * stopping at a bound of target or less as in interval().  The answer
+ * depends on p, the seed, the list and target only. */
+static void evaluate_in(const hd__m2m_job_t *J, const hd__tri_t *t, corner_t *c, int level, size_t seed,
+                        double target, const uint32_t *list, size_t n, cache_t *C, uint64_t *count) {
+    const hd__bvh_t *T = J->to;
+    double best = INFINITY, enough2 = enough_of(target), lo2, hi2;
+    size_t pos = SIZE_MAX;
+    corner_point(t, c, level);
+    c->exact = 0;
+    if (seed < T->n_tris) {
+        bounds_at(T, seed, c->p, C, &lo2, &hi2);
+        best = hi2, pos = seed;
+        (*count)++;
+    }
+    for (size_t i = 0; i < n && !(best <= enough2); i++) {
+        size_t k = list[i];
+        if (k == seed || beyond(&T->boxes[k], c->p, best)) continue;
+        bounds_at(T, k, c->p, C, &lo2, &hi2);
+        (*count)++;
+        if (pos == SIZE_MAX || hi2 < best) best = hi2, pos = k;
+    }
+    if (pos == SIZE_MAX) { /* no seed, an empty list: the tree */
+        evaluate(J, t, c, level, seed, target, C, count);
+        return;
+    }
+    c->pos = pos;
+    c->hi = sqrt_up(best);
+}
+
 /* d(v, t) <= this (v's own nearest triangle: next_up(r)). */
-static double corner_to(const corner_t *c, size_t pos, const hd__tri_t *t, cache_t *C, uint64_t *kernel) {
+static double corner_to(corner_t *c, size_t pos, const hd__tri_t *t, cache_t *C, uint64_t *kernel) {
     if (c->pos == pos) return c->hi;
+    int n = c->nm < MEMO ? c->nm : MEMO;
+    for (int i = 0; i < n; i++)
+        if (c->mpos[i] == pos) return c->mh[i];
     double lo2, hi2;
     hd__tri_bounds_prep(c->p, prepared(C, pos, t), &lo2, &hi2);
     (*kernel)++;
-    return sqrt_up(hi2);
+    double h = sqrt_up(hi2);
+    if (pos < UINT32_MAX) {
+        c->mpos[c->nm % MEMO] = (uint32_t)pos, c->mh[c->nm % MEMO] = h;
+        c->nm = c->nm < MEMO ? c->nm + 1 : MEMO + (c->nm + 1) % MEMO; /* once full: the oldest next */
+    }
+    return h;
 }
 
 /* Over a convex union W of two triangles of Y, the distance to W is convex
  * too: its largest value over the sub-triangle is at a corner. */
-static double pair_bound(const hd__m2m_job_t *J, const sub_t *s, double U, cache_t *C, uint64_t *kernel) {
+static double pair_bound(const hd__m2m_job_t *J, sub_t *s, double U, cache_t *C, uint64_t *kernel) {
     for (int i = 0; i < 3; i++)
         for (int j = i + 1; j < 3; j++) {
             size_t p1 = s->c[i].pos, p2 = s->c[j].pos;
@@ -512,8 +599,8 @@ static double pair_bound(const hd__m2m_job_t *J, const sub_t *s, double U, cache
             if (!shared_convex(t1, t2)) continue;
             double m = 0;
             for (int k = 0; k < 3 && m < U; k++)
-                m = fmax(m, fmin(corner_to(&s->c[k], p1, t1, C, kernel), corner_to(&s->c[k], p2, t2, C, kernel)));
-            U = fmin(U, m);
+                m = dmax(m, dmin(corner_to(&s->c[k], p1, t1, C, kernel), corner_to(&s->c[k], p2, t2, C, kernel)));
+            U = dmin(U, m);
         }
     return U;
 }
@@ -527,7 +614,7 @@ typedef struct cands {
     double h[3][3];
 } cands_t;
 
-static double cand_h(const hd__m2m_job_t *J, const sub_t *s, cands_t *K, int i, int k, cache_t *C, uint64_t *kernel) {
+static double cand_h(const hd__m2m_job_t *J, sub_t *s, cands_t *K, int i, int k, cache_t *C, uint64_t *kernel) {
     if (isnan(K->h[i][k])) K->h[i][k] = corner_to(&s->c[k], K->pos[i], &J->to->tris[K->pos[i]], C, kernel);
     return K->h[i][k];
 }
@@ -536,7 +623,7 @@ static double cand_h(const hd__m2m_job_t *J, const sub_t *s, cands_t *K, int i, 
  * mu >= 1 - lam (a, b >= 0 and finite). */
 static double mixed(const double *a, const double *b, double lam) {
     double mu = up(1 - lam), m = 0;
-    for (int k = 0; k < 3; k++) m = fmax(m, up(up(lam * a[k]) + up(mu * b[k])));
+    for (int k = 0; k < 3; k++) m = dmax(m, up(up(lam * a[k]) + up(mu * b[k])));
     return m;
 }
 
@@ -546,11 +633,11 @@ static double mixed(const double *a, const double *b, double lam) {
 double hd__m2m_bent_bound(const double a[3], const double b[3], double U) {
     for (int k = 0; k < 3; k++)
         if (!isfinite(a[k]) || !isfinite(b[k])) return U;
-    U = fmin(U, fmin(fmax(a[0], fmax(a[1], a[2])), fmax(b[0], fmax(b[1], b[2])))); /* lam = 1, 0 */
+    U = dmin(U, dmin(dmax(a[0], dmax(a[1], a[2])), dmax(b[0], dmax(b[1], b[2])))); /* lam = 1, 0 */
     for (int k = 0; k < 3; k++) {
         int l = (k + 1) % 3;
         double lam = (b[l] - b[k]) / ((a[k] - b[k]) - (a[l] - b[l]));
-        if (lam > 0 && lam < 1) U = fmin(U, mixed(a, b, lam));
+        if (lam > 0 && lam < 1) U = dmin(U, mixed(a, b, lam));
     }
     return U;
 }
@@ -558,10 +645,10 @@ double hd__m2m_bent_bound(const double a[3], const double b[3], double U) {
 /* The sub-triangle's upper bound; once the point bound alone is at most
  * `enough` (the sub-triangle will be discarded whatever its bound) the
  * dearer bounds are skipped. */
-static double upper_of(const hd__m2m_job_t *J, const sub_t *s, double e, double enough, cache_t *C,
+static double upper_of(const hd__m2m_job_t *J, sub_t *s, double e, double enough, cache_t *C,
                        uint64_t *kernel) {
     double rmax = 0;
-    for (int i = 0; i < 3; i++) rmax = fmax(rmax, s->c[i].hi);
+    for (int i = 0; i < 3; i++) rmax = dmax(rmax, s->c[i].hi);
     double U = up(rmax + reach(s));
     if ((s->level ? up(U + e) : U) <= enough) return s->level ? up(U + e) : U;
     cands_t K = {.n = 0};
@@ -576,8 +663,8 @@ static double upper_of(const hd__m2m_job_t *J, const sub_t *s, double e, double 
     }
     for (int i = 0; i < K.n; i++) { /* Tang's bound over the corners' nearest triangles */
         double m = 0;
-        for (int k = 0; k < 3 && m < U; k++) m = fmax(m, cand_h(J, s, &K, i, k, C, kernel));
-        U = fmin(U, m);
+        for (int k = 0; k < 3 && m < U; k++) m = dmax(m, cand_h(J, s, &K, i, k, C, kernel));
+        U = dmin(U, m);
     }
     if (K.n > 1) U = pair_bound(J, s, U, C, kernel);
     double E = s->level ? e : 0;
@@ -595,7 +682,7 @@ static double upper_of(const hd__m2m_job_t *J, const sub_t *s, double e, double 
  * tolerance (a face or sub-triangle whose bound is within the tolerance
  * of the lower bound is never split). */
 static double enough_for(const hd__m2m_job_t *J, double bar) {
-    return isfinite(J->done_below) ? fmax(bar, J->done_below) : bar + J->tol;
+    return isfinite(J->done_below) ? dmax(bar, J->done_below) : bar + J->tol;
 }
 
 /* ---- phase 1: every face's corners -------------------------------------- */
@@ -635,7 +722,7 @@ static double face_reach(const hd__tri_t *t) {
     for (int i = 0; i < 3; i++) {
         const double *p = t->v[i], *q = t->v[(i + 1) % 3];
         double dx = p[0] - q[0], dy = p[1] - q[1], dz = p[2] - q[2];
-        a2 = fmax(a2, dx * dx + dy * dy + dz * dz);
+        a2 = dmax(a2, dx * dx + dy * dy + dz * dz);
     }
     return sqrt(a2) * 0.5774;
 }
@@ -655,7 +742,7 @@ static int is_sample(const ctx_t *C, size_t k) {
  * corners as low the face's point bound is within the tolerance of L0. */
 static double corner_target(const ctx_t *C, size_t id) {
     const hd__m2m_job_t *J = C->job;
-    return fmin(C->L0 + J->tol - face_reach(&J->from[id / 3]), down(C->L0));
+    return dmin(C->L0 + J->tol - face_reach(&J->from[id / 3]), down(C->L0));
 }
 
 /* Phase 0: each corner's distance enclosed (interval()), in Morton order
@@ -707,7 +794,7 @@ static double phase0_bar(const ctx_t *C) {
     double bar = C->stage == 2 ? C->L0 : -INFINITY;
     for (size_t k = 0; k < C->n_corners; k += C->stage == 1 ? C->stride : 1) {
         size_t id = C->order ? (size_t)(C->order[k] & 0xffffffffu) : k;
-        if (!C->faces[id / 3].done && (C->stage != 1 || is_sample(C, k))) bar = fmax(bar, C->found[id].lo);
+        if (!C->faces[id / 3].done && (C->stage != 1 || is_sample(C, k))) bar = dmax(bar, C->found[id].lo);
     }
     return bar;
 }
@@ -747,12 +834,15 @@ static void face_top(const hd__m2m_job_t *J, face_t *F, size_t f, const found_t 
         c->r = c->lower = x[i].r;
         c->hi = x[i].hi;
         c->exact = x[i].exact;
+        c->nm = 0;
         c->pos = x[i].pos;
         c->index = x[i].index;
         memcpy(c->near, x[i].near, sizeof c->near);
         if (c->exact) offer(&F->best, c, 0, 0);
     }
     F->top.level = 0;
+    F->top.n = NO_LIST;
+    F->top.off = 0;
     F->top.U = upper_of(J, &F->top, 0, enough, cache, &F->kernel);
     F->upper = F->top.U;
 }
@@ -820,7 +910,7 @@ static int tang_screened(const hd__m2m_job_t *J, const hd__tri_t *t, size_t pos,
     double m = 0, lo2, hi2;
     for (int i = 0; i < 3 && m <= J->done_below; i++) {
         hd__tri_bounds_prep(t->v[i], hd__bvh_prep(J->to, pos), &lo2, &hi2);
-        m = fmax(m, sqrt_up(hi2));
+        m = dmax(m, sqrt_up(hi2));
     }
     if (!(m <= J->done_below)) return 0;
     *upper = m;
@@ -837,7 +927,7 @@ static int screened(const hd__m2m_job_t *J, const hd__tri_t *t, size_t *seed, do
     double R = reach(&s), target = J->done_below - R, m = 0, ub;
     int i = 0;
     if (target >= 0)
-        for (; i < 3 && screen_point(J->to, t->v[i], target, seed, &ub); i++) m = fmax(m, ub);
+        for (; i < 3 && screen_point(J->to, t->v[i], target, seed, &ub); i++) m = dmax(m, ub);
     double U = up(m + R);
     if (i == 3 && U <= J->done_below) {
         *upper = U;
@@ -872,7 +962,7 @@ static int corner_order(const hd__m2m_job_t *J, int threads, uint64_t **out) {
     hd__box_t box = {{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
     for (size_t id = 0; id < n; id++)
         for (int d = 0; d < 3; d++)
-            box.lo[d] = fmin(box.lo[d], CORNER(J, id)[d]), box.hi[d] = fmax(box.hi[d], CORNER(J, id)[d]);
+            box.lo[d] = dmin(box.lo[d], CORNER(J, id)[d]), box.hi[d] = dmax(box.hi[d], CORNER(J, id)[d]);
     hd__keygrid_t g;
     hd__keygrid_init(&g, &box);
     for (size_t id = 0; id < n; id++) keys[id] = (uint64_t)hd__key30(&g, CORNER(J, id)) << 32 | (uint64_t)id;
@@ -894,6 +984,10 @@ typedef struct pool {
     hd__heap_t heap;
     cache_t *cache;
     int failed;
+    /* the candidate lists of the sub-triangles of the face being refined
+     * (sub_t.off, n index it; emptied at each visit) */
+    uint32_t *arena;
+    size_t a_n, a_cap;
 } pool_t;
 
 static size_t pool_put(pool_t *P, const sub_t *s) {
@@ -925,7 +1019,7 @@ static size_t pool_put(pool_t *P, const sub_t *s) {
 
 /* The four children of s (corners 0, 1, 2; midpoints m01, m12, m20). */
 static double threshold(const hd__m2m_job_t *J, double L, const face_t *F) {
-    double thr = J->per_face ? F->best.lower : fmax(L, F->best.lower);
+    double thr = J->per_face ? F->best.lower : dmax(L, F->best.lower);
     return thr;
 }
 
@@ -933,7 +1027,121 @@ static double threshold(const hd__m2m_job_t *J, double L, const face_t *F) {
  * face's own best, and L unless each face's own lower bound is asked for. */
 static double exact_bar(const hd__m2m_job_t *J, double L, const face_t *F) {
     double own = F->best.set ? F->best.lower : -INFINITY;
-    return J->per_face || J->face_lower ? own : fmax(L, own);
+    return J->per_face || J->face_lower ? own : dmax(L, own);
+}
+
+/* ---- candidate lists ---------------------------------------------------- */
+
+/* Box b certainly farther than sqrt(r2) from box a: the computed
+ * hd__box_box_lb2 is at most the exact squared gap times (1 + u)^5 (one
+ * rounding a difference, exact when not normal, one a square, two sums)
+ * when it is at least 2^-1000, where underflow's 2^-1074 an operation is
+ * below a relative 2^-70; s (1 - 2^-46), rounded, is then below the exact
+ * square. */
+static int box_far(const hd__box_t *a, const hd__box_t *b, double r2) {
+    double s = hd__box_box_lb2(a, b);
+    return s >= 0x1p-1000 && s * (1 - 0x1p-46) > r2;
+}
+
+/* The box of the computed corners c widened by 2e on each side, rounded
+ * outward, and r2 >= H^2 with H = up(U + 2e) (hd__m2m_candidates). */
+static void cand_region(const double c[3][3], double U, double e, hd__box_t *B, double *r2) {
+    double w = up(2 * e);
+    for (int k = 0; k < 3; k++) {
+        double lo = dmin(c[0][k], dmin(c[1][k], c[2][k])), hi = dmax(c[0][k], dmax(c[1][k], c[2][k]));
+        B->lo[k] = down(lo - w);
+        B->hi[k] = up(hi + w);
+    }
+    double H = up(U + w);
+    *r2 = up(H * H);
+}
+
+/* The positions of the triangles of T whose box is not box_far from B,
+ * in leaf order, or SIZE_MAX when there are more than cap (the boxes
+ * alone: cheaper than hd__bvh_collect's support bound per triangle, for
+ * the short lists wanted here). */
+static size_t collect(const hd__bvh_t *T, const hd__box_t *B, double r2, uint32_t *out, size_t cap) {
+    uint32_t stack[DEPTH];
+    int top = 0;
+    size_t n = 0;
+    stack[top++] = 0;
+    while (top > 0) { /* a node's box is tested when it is popped */
+        uint32_t id = stack[--top];
+        const hd__bvh_node_t *node = &T->nodes[id];
+        if (box_far(&node->box, B, r2)) continue;
+        if (!node->count) {
+            if (top + 2 > DEPTH) return SIZE_MAX;
+            stack[top++] = node->first_or_second, stack[top++] = id + 1; /* the first child first */
+            continue;
+        }
+        for (size_t k = node->first_or_second; k < (size_t)node->first_or_second + node->count; k++)
+            if (!box_far(&T->boxes[k], B, r2)) {
+                if (n == cap) return SIZE_MAX;
+                out[n++] = (uint32_t)k;
+            }
+    }
+    return n;
+}
+
+size_t hd__m2m_candidates(const hd__bvh_t *T, const double c[3][3], double U, double e, const uint32_t *from,
+                          size_t n_from, uint32_t *out, size_t cap) {
+    hd__box_t B;
+    double r2;
+    cand_region(c, U, e, &B, &r2);
+    if (!from) return collect(T, &B, r2, out, cap);
+    size_t n = 0;
+    for (size_t i = 0; i < n_from; i++) {
+        if (box_far(&T->boxes[from[i]], &B, r2)) continue;
+        if (n == cap) return SIZE_MAX;
+        out[n++] = from[i];
+    }
+    return n;
+}
+
+/* Most entries a worker's arena holds, and most a list collected from the
+ * tree may have (beyond them the tree is searched instead). */
+#define ARENA_MAX ((size_t)1 << 24)
+#define LIST_MAX 48
+/* A sub-triangle without a list whose collection failed (too many
+ * candidates) lets its descendants try again RETRY levels down. */
+#define RETRY 2
+/* Lists are collected from the tree from this level on: a shallower
+ * sub-triangle is often split once only (each face of a finer X over a
+ * coarser Y), and one box query then costs as much as the point searches
+ * it would replace (bench/m2m_bench.py's `subdivided` and `decimated`;
+ * `nearzero` splits deep, where inherited lists pay). */
+#define LIST_LEVEL 2
+
+/* s's own candidate list in P's arena (s->off, s->n), from the one it
+ * inherited or else from the tree; s->n = NO_LIST when there is none
+ * (then s->off is the level from which its descendants try again). */
+static void own_list(const hd__m2m_job_t *J, double e, sub_t *s, pool_t *P) {
+    size_t need = s->n != NO_LIST ? s->n : LIST_MAX;
+    if (s->n == NO_LIST && ((uint32_t)s->level < s->off || s->level < LIST_LEVEL)) return;
+    if (P->a_n + need > ARENA_MAX) {
+        s->n = NO_LIST, s->off = UINT32_MAX;
+        return;
+    }
+    if (P->a_n + need > P->a_cap) {
+        size_t cap = P->a_cap ? P->a_cap : 4096;
+        while (cap < P->a_n + need) cap *= 2;
+        uint32_t *na = realloc(P->arena, cap * sizeof *na);
+        if (!na) {
+            s->n = NO_LIST, s->off = UINT32_MAX;
+            return;
+        }
+        P->arena = na, P->a_cap = cap;
+    }
+    double c[3][3];
+    for (int i = 0; i < 3; i++) memcpy(c[i], s->c[i].p, sizeof c[i]);
+    const uint32_t *from = s->n != NO_LIST ? P->arena + s->off : NULL;
+    size_t n = hd__m2m_candidates(J->to, c, s->U, e, from, s->n != NO_LIST ? s->n : 0, P->arena + P->a_n, need);
+    if (n == SIZE_MAX) {
+        s->n = NO_LIST, s->off = (uint32_t)s->level + RETRY;
+        return;
+    }
+    s->off = (uint32_t)P->a_n, s->n = (uint32_t)n;
+    P->a_n += n;
 }
 
 static void split(const hd__m2m_job_t *J, const hd__tri_t *t, double e, double L, const sub_t *s, sub_t kids[4],
@@ -949,24 +1157,35 @@ static void split(const hd__m2m_job_t *J, const hd__tri_t *t, double e, double L
      * d) (a child's reach is at most its parent's, up to rounding), where
      * a sub-triangle is never split, and the midpoint cannot raise a lower
      * bound (target <= exact_bar). */
-    double target = fmin(fmax(threshold(J, L, F) + J->tol, J->done_below) - reach(s) - 2 * e, exact_bar(J, L, F));
+    double target = dmin(dmax(threshold(J, L, F) + J->tol, J->done_below) - reach(s) - 2 * e, exact_bar(J, L, F));
     for (int i = 0; i < 3; i++) {
         const corner_t *p = &s->c[i], *q = &s->c[(i + 1) % 3];
         for (int j = 0; j < 3; j++) m[i].k[j] = p->k[j] + q->k[j];
-        evaluate(J, t, &m[i], level, p->pos, target, P->cache, &F->kernel);
+        m[i].nm = 0;
+        if (s->n != NO_LIST)
+            evaluate_in(J, t, &m[i], level, p->pos, target, P->arena + s->off, s->n, P->cache, &F->kernel);
+        else
+            evaluate(J, t, &m[i], level, p->pos, target, P->cache, &F->kernel);
         if (could(&m[i], level, e) > exact_bar(J, L, F)) {
             make_exact(J, &m[i], level, e, st);
             offer(&F->best, &m[i], level, e);
         }
     }
-    const corner_t *tri[4][3] = {{&c[0], &m[0], &m[2]}, {&m[0], &c[1], &m[1]}, {&m[2], &m[1], &c[2]},
-                                 {&m[0], &m[1], &m[2]}};
+    corner_t *tri[4][3] = {{&c[0], &m[0], &m[2]}, {&m[0], &c[1], &m[1]}, {&m[2], &m[1], &c[2]},
+                           {&m[0], &m[1], &m[2]}};
     double enough = enough_for(J, threshold(J, L, F));
+    /* the corners' remembered bounds go back to c and m after each child,
+     * so that its siblings (and, copied again below, its descendants)
+     * reuse them */
     for (int q = 0; q < 4; q++) {
         for (int i = 0; i < 3; i++) kids[q].c[i] = *tri[q][i];
         kids[q].level = level;
+        kids[q].off = s->off, kids[q].n = s->n;
         kids[q].U = upper_of(J, &kids[q], e, enough, P->cache, &F->kernel);
+        for (int i = 0; i < 3; i++) *tri[q][i] = kids[q].c[i];
     }
+    for (int q = 0; q < 3; q++)
+        for (int i = 0; i < 3; i++) kids[q].c[i] = *tri[q][i];
 }
 
 /* Keep what is left of a face's heap for its next visit (F->upper: its
@@ -975,9 +1194,13 @@ static int save(face_t *F, pool_t *P, double cut) {
     F->n_saved = hd__heap_size(&P->heap);
     F->saved = hd__malloc_array(F->n_saved, sizeof *F->saved);
     if (!F->saved) return P->failed = 1, -1;
-    F->upper = fmax(hd__heap_top(&P->heap)->key, cut);
+    F->upper = dmax(hd__heap_top(&P->heap)->key, cut);
     F->cut = cut;
-    for (size_t k = 0; k < F->n_saved; k++) F->saved[k] = P->s[hd__heap_pop(&P->heap).val];
+    for (size_t k = 0; k < F->n_saved; k++) {
+        F->saved[k] = P->s[hd__heap_pop(&P->heap).val];
+        F->saved[k].n = NO_LIST; /* the arena is emptied at the next visit */
+        F->saved[k].off = 0;
+    }
     return 0;
 }
 
@@ -990,6 +1213,7 @@ static void refine(const hd__m2m_job_t *J, face_t *F, size_t f, double L, pool_t
     hd__bvh_stats_t st = {0};
     hd__heap_clear(&P->heap);
     P->n = P->n_free = 0;
+    P->a_n = 0;
     if (!F->saved && pool_put(P, &F->top) == SIZE_MAX) return;
     for (size_t k = 0; k < F->n_saved; k++)
         if (pool_put(P, &F->saved[k]) == SIZE_MAX) return;
@@ -1004,7 +1228,7 @@ static void refine(const hd__m2m_job_t *J, face_t *F, size_t f, double L, pool_t
         const hd__heap_item_t *top = hd__heap_top(&P->heap);
         double thr = threshold(J, L, F);
         if (top->key - thr <= J->tol || top->key <= J->done_below || F->best.lower > J->stop_above) {
-            F->upper = fmax(top->key, cut);
+            F->upper = dmax(top->key, cut);
             break;
         }
         if (visit == budget) {
@@ -1018,18 +1242,19 @@ static void refine(const hd__m2m_job_t *J, face_t *F, size_t f, double L, pool_t
         if (s.level >= MAX_LEVEL || (J->max_splits && F->splits >= J->max_splits)) {
             F->capped = 1;
             if (s.level >= MAX_LEVEL) {
-                cut = fmax(cut, s.U);
+                cut = dmax(cut, s.U);
                 continue;
             }
-            F->upper = fmax(s.U, cut);
+            F->upper = dmax(s.U, cut);
             break;
         }
         sub_t kids[4];
+        own_list(J, e, &s, P);
         split(J, t, e, L, &s, kids, F, P, &st);
         F->splits++;
         thr = threshold(J, L, F);
         for (int q = 0; q < 4; q++) {
-            if (kids[q].U <= fmax(thr, J->done_below)) cut = fmax(cut, kids[q].U);
+            if (kids[q].U <= dmax(thr, J->done_below)) cut = dmax(cut, kids[q].U);
             else if (pool_put(P, &kids[q]) == SIZE_MAX) return;
         }
     }
@@ -1128,7 +1353,7 @@ static void take_best(hd__m2m_result_t *R, const face_t *F, size_t f) {
 static void finish_face(hd__m2m_result_t *R, const hd__m2m_job_t *J, const face_t *F, size_t f) {
     if (J->face_lower) J->face_lower[f] = F->best.set ? F->best.lower : 0;
     if (J->face_upper) J->face_upper[f] = F->upper;
-    R->upper = fmax(R->upper, F->upper);
+    R->upper = dmax(R->upper, F->upper);
     R->splits += F->splits;
     R->kernel_calls += F->kernel;
     R->capped |= F->capped;
@@ -1196,6 +1421,7 @@ static int run_batches(const hd__m2m_job_t *J, ctx_t *C, rank_t *rk, size_t n, h
     for (int w = 0; pools && w < J->threads; w++) {
         free(pools[w].s);
         free(pools[w].free_);
+        free(pools[w].arena);
         hd__heap_free(&pools[w].heap);
     }
     free(pools);
@@ -1209,7 +1435,7 @@ static double sample_best(const ctx_t *C) {
     double best = -INFINITY;
     for (size_t k = 0; k < C->n_corners; k += C->stride) {
         size_t id = C->order ? (size_t)(C->order[k] & 0xffffffffu) : k;
-        if (!C->faces[id / 3].done && is_sample(C, k) && C->found[id].exact) best = fmax(best, C->found[id].r);
+        if (!C->faces[id / 3].done && is_sample(C, k) && C->found[id].exact) best = dmax(best, C->found[id].r);
     }
     return best;
 }
@@ -1322,7 +1548,7 @@ int hd__m2m_run(const hd__m2m_job_t *J, hd__m2m_result_t *R) {
     sort_ranks(rk, live);
     if (rc == HD_OK && !stopped) rc = run_batches(J, &C, rk, live, R);
     for (size_t f = 0; f < n; f++) finish_face(R, J, &C.faces[f], f);
-    R->upper = stopped ? INFINITY : fmax(R->upper, R->lower);
+    R->upper = stopped ? INFINITY : dmax(R->upper, R->lower);
     free(C.faces);
     caches_free(C.caches, J->threads);
     free(rk);

@@ -273,6 +273,19 @@ int hd__m2m_run(const hd__m2m_job_t *job, hd__m2m_result_t *out);
  * finite.  Thread safety: none needed. */
 double hd__m2m_bent_bound(const double a[3], const double b[3], double U);
 
+/* The candidate list of a sub-triangle whose computed corners are c, with
+ * U >= d(y, Y) for every y of their hull and e the face's slack (m2m.c):
+ * writes to out every triangle of T (positions, from the tree in leaf
+ * order, or from from[0 .. n_from) in its order when from is not NULL)
+ * whose box is not proven farther than up(U + 2e) from the corners' box
+ * widened by 2e, and returns their number, or SIZE_MAX when there are
+ * more than cap.  Every point within 2e of the hull (a corner of a
+ * descendant sub-triangle) then has a nearest triangle of T in the list,
+ * if from (when given) had one (m2m.c has the proof).  Thread safety:
+ * reads T only. */
+size_t hd__m2m_candidates(const hd__bvh_t *T, const double c[3][3], double U, double e, const uint32_t *from,
+                          size_t n_from, uint32_t *out, size_t cap);
+
 /* drop_x[k] = 1 for each triangle of x whose three corners are, as a set,
  * bit-identical to those of a triangle of y, *count_x of them; and the
  * same for y against x in drop_y (unless NULL), *count_y.  HD_OK or
