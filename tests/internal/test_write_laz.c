@@ -558,6 +558,33 @@ TEST(layered_laz_damaged_layers_are_errors_with_offsets) {
     free(recs);
 }
 
+TEST(pointwise_laz_damaged_chunks_are_errors_with_offsets_whatever_is_kept) {
+    gen_rng_t g;
+    size_t n = 2500, rec;
+    tf_buf_t b = {0};
+    unsigned char *recs = pointwise_file(&g, 53, 3, 2, n, 1000, &b, &rec);
+    size_t chunk = le(b.data + 96, 4) + 8; /* the first chunk: its raw record, then its stream */
+    for (size_t i = 0; i < 64; i++) b.data[chunk + rec + 200 + i] ^= 0x5A;
+    const char *in = tf_finish(&b, "rich_bad.laz");
+    double *v = calloc(n, sizeof *v);
+    v[3] = 1;
+    hd_write_options_t o;
+    hd_write_options_init(&o);
+    /* every point (each chunk decoded and encoded by one task), and a
+     * subset (the kept points gathered into new chunks) */
+    for (int keep = 0; keep < 2; keep++) {
+        CONTEXT("keep %s", keep ? "farther" : "all");
+        o.keep = keep ? HD_KEEP_FARTHER : HD_KEEP_ALL;
+        hd_error_t err;
+        CHECK_RC(hd_write_field(in, tf_path("rich_bad_out.laz"), v, n, &o, NULL, &err), HD_EFORMAT);
+        CONTEXT("%s (offset %lld)", err.message, err.offset);
+        CHECK(strstr(err.message, "chunk 1 of 3"));
+        CHECK(err.offset > (long long)chunk && err.offset <= (long long)(chunk + 1000 * rec));
+    }
+    free(v);
+    free(recs);
+}
+
 TEST(laszip1_streams_are_refused_by_name) {
     gen_rng_t g;
     gen_seed(&g, 9);
