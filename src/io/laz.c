@@ -680,45 +680,21 @@ static void pointwise_chunk(job_t *j, const unsigned char *b, size_t nb, size_t 
 /* ---- POINT14 v3/v4, layered: x and y from layer 0, z from layer 1 -------- */
 typedef struct {
     int used;
-    hd__symmodel_t changed[8], scanner, rn_same;
-    hd__symmodel_t *nret[16], *rnum[16];
-    hd__intcoder_t dx, dy, dz;
-    hd__median5_t mx[12], my[12];
+    hd__p14_models_t m;
     int32_t last_z[8];
     int32_t X, Y, Z;
     unsigned r, n, gps_change;
 } ctx14_t;
 
-static void ctx14_free(ctx14_t *c) {
-    for (int i = 0; i < 8; i++) hd__symmodel_free(&c->changed[i]);
-    hd__symmodel_free(&c->scanner);
-    hd__symmodel_free(&c->rn_same);
-    for (int i = 0; i < 16; i++) {
-        if (c->nret[i]) hd__symmodel_free(c->nret[i]);
-        if (c->rnum[i]) hd__symmodel_free(c->rnum[i]);
-        free(c->nret[i]);
-        free(c->rnum[i]);
-    }
-    hd__intcoder_free(&c->dx);
-    hd__intcoder_free(&c->dy);
-    hd__intcoder_free(&c->dz);
-}
+static void ctx14_free(ctx14_t *c) { hd__p14_models_free(&c->m); }
 
 /* Create channel c's models and start it from a point (the chunk's first
- * point, or the previous channel's last). */
-static int ctx14_start(ctx14_t *c, const ctx14_t *from) {
-    int rc = HD_OK;
-    for (int i = 0; i < 8 && rc == HD_OK; i++) rc = hd__symmodel_new(&c->changed[i], 128);
-    rc = rc ? rc : hd__symmodel_new(&c->scanner, 3);
-    rc = rc ? rc : hd__symmodel_new(&c->rn_same, 13);
-    rc = rc ? rc : hd__intcoder_new(&c->dx, 32, 2);
-    rc = rc ? rc : hd__intcoder_new(&c->dy, 32, 22);
-    rc = rc ? rc : hd__intcoder_new(&c->dz, 32, 20);
+ * point, or the previous channel's last).  Kept out of layered_points: a
+ * rare step whose inlining changes the decoding loop's code (measured by
+ * bench/read_bench under callgrind). */
+HD__NOINLINE static int ctx14_start(ctx14_t *c, const ctx14_t *from) {
+    int rc = hd__p14_models_new(&c->m);
     if (rc) return rc;
-    for (int i = 0; i < 12; i++) {
-        hd__median5_init(&c->mx[i]);
-        hd__median5_init(&c->my[i]);
-    }
     c->X = from->X;
     c->Y = from->Y;
     c->Z = from->Z;
@@ -736,9 +712,9 @@ static void layered_loop(job_t *j, ctx14_t *cx, unsigned cur, hd__dec_t *dxy, hd
     for (size_t i = 1; i < n; i++) {
         ctx14_t *c = &cx[cur];
         unsigned lpr = (c->r == 1) + 2 * (c->r >= c->n) + 4 * c->gps_change;
-        uint32_t changed = hd__dec_symbol(dxy, &c->changed[lpr]);
+        uint32_t changed = hd__dec_symbol(dxy, &c->m.changed[lpr]);
         if (changed & 64) {
-            unsigned next = (cur + hd__dec_symbol(dxy, &c->scanner) + 1) & 3;
+            unsigned next = (cur + hd__dec_symbol(dxy, &c->m.scanner) + 1) & 3;
             if (!cx[next].used && ctx14_start(&cx[next], c)) {
                 fail(j, HD_ENOMEM, at, "out of memory");
                 return;
@@ -750,7 +726,7 @@ static void layered_loop(job_t *j, ctx14_t *cx, unsigned cur, hd__dec_t *dxy, hd
         unsigned gps = (changed >> 4) & 1;
         unsigned last_n = c->n, last_r = c->r, nn = last_n, r = last_r;
         if (changed & 4) {
-            hd__symmodel_t *m = lazy(&c->nret[last_n], 16);
+            hd__symmodel_t *m = lazy(&c->m.nret[last_n], 16);
             if (!m) {
                 fail(j, HD_ENOMEM, at, "out of memory");
                 return;
@@ -762,14 +738,14 @@ static void layered_loop(job_t *j, ctx14_t *cx, unsigned cur, hd__dec_t *dxy, hd
         case 2: r = (last_r + 15) & 15; break;
         case 3:
             if (gps) {
-                hd__symmodel_t *m = lazy(&c->rnum[last_r], 16);
+                hd__symmodel_t *m = lazy(&c->m.rnum[last_r], 16);
                 if (!m) {
                     fail(j, HD_ENOMEM, at, "out of memory");
                     return;
                 }
                 r = hd__dec_symbol(dxy, m);
             } else {
-                r = (last_r + hd__dec_symbol(dxy, &c->rn_same) + 2) & 15;
+                r = (last_r + hd__dec_symbol(dxy, &c->m.rn_same) + 2) & 15;
             }
             break;
         default: break;
@@ -777,14 +753,14 @@ static void layered_loop(job_t *j, ctx14_t *cx, unsigned cur, hd__dec_t *dxy, hd
         c->n = nn;
         c->r = r;
         unsigned m = hd__laz_rmap14[nn][r], l = hd__laz_level(nn, r), mi = m << 1 | gps;
-        int32_t dx = hd__ic_decode(&c->dx, dxy, c->mx[mi].v[2], nn == 1);
+        int32_t dx = hd__ic_decode(&c->m.dx, dxy, c->m.mx[mi].v[2], nn == 1);
         c->X = (int32_t)((uint32_t)c->X + (uint32_t)dx);
-        hd__median5_add(&c->mx[mi], dx);
-        int32_t dy = hd__ic_decode(&c->dy, dxy, c->my[mi].v[2], (nn == 1) + hd__laz_kctx(c->dx.k, 20));
+        hd__median5_add(&c->m.mx[mi], dx);
+        int32_t dy = hd__ic_decode(&c->m.dy, dxy, c->m.my[mi].v[2], (nn == 1) + hd__laz_kctx(c->m.dx.k, 20));
         c->Y = (int32_t)((uint32_t)c->Y + (uint32_t)dy);
-        hd__median5_add(&c->my[mi], dy);
+        hd__median5_add(&c->m.my[mi], dy);
         if (has_z) {
-            c->Z = hd__ic_decode(&c->dz, dz, c->last_z[l], (nn == 1) + hd__laz_kctx((c->dx.k + c->dy.k) / 2, 18));
+            c->Z = hd__ic_decode(&c->m.dz, dz, c->last_z[l], (nn == 1) + hd__laz_kctx((c->m.dx.k + c->m.dy.k) / 2, 18));
             c->last_z[l] = c->Z;
         }
         c->gps_change = gps;
