@@ -881,23 +881,6 @@ int hd__laz14_decode(const unsigned char *b, size_t nb, size_t n, size_t rec, co
     return rc;
 }
 
-/* Append n bytes to e (its oom flag set on failure). */
-static void put(hd__enc_t *e, const void *p, size_t n) {
-    if (e->size + n > e->cap) {
-        size_t cap = e->cap ? e->cap : 4096;
-        while (cap < e->size + n) cap *= 2;
-        unsigned char *q = realloc(e->buf, cap);
-        if (!q) {
-            e->oom = 1;
-            return;
-        }
-        e->buf = q;
-        e->cap = cap;
-    }
-    memcpy(e->buf + e->size, p, n);
-    e->size += n;
-}
-
 int hd__laz14_encode(const unsigned char *recs, size_t n, size_t rec, const hd__laz14_items_t *it, hd__enc_t *out) {
     c14_t s;
     int rc = c14_start(&s, it, recs, 1);
@@ -913,17 +896,17 @@ int hd__laz14_encode(const unsigned char *recs, size_t n, size_t rec, const hd__
     if (rc == HD_OK) {
         unsigned char u[4];
         st32(u, (uint32_t)n);
-        put(out, u, 4);
+        hd__enc_put(out, u, 4);
         for (unsigned k = 0; k < s.nl; k++) {
             layer_t *L = &s.L[k];
             int keep = k < 2 || L->changed; /* x/y and z always; others only when they change */
             if (keep) hd__enc_done(&L->e);
             if (L->e.oom) rc = HD_ENOMEM;
             st32(u, keep ? (uint32_t)L->e.size : 0);
-            put(out, u, 4);
+            hd__enc_put(out, u, 4);
         }
         for (unsigned k = 0; k < s.nl; k++)
-            if (k < 2 || s.L[k].changed) put(out, s.L[k].e.buf, s.L[k].e.size);
+            if (k < 2 || s.L[k].changed) hd__enc_put(out, s.L[k].e.buf, s.L[k].e.size);
         if (out->oom) rc = HD_ENOMEM;
     }
     c14_free(&s);

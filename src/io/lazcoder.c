@@ -238,17 +238,28 @@ void hd__enc_free(hd__enc_t *e) {
     e->buf = NULL;
     e->size = e->cap = 0;
 }
-static void enc_byte(hd__enc_t *e, unsigned char b) {
-    if (e->size == e->cap) {
-        size_t cap = e->cap ? 2 * e->cap : 4096;
-        unsigned char *p = realloc(e->buf, cap);
-        if (!p) {
-            e->oom = 1;
-            return;
-        }
-        e->buf = p;
-        e->cap = cap;
+/* Room for n more bytes in e's buffer (doubled as needed): 0, or -1 with
+ * e's oom flag set. */
+static int enc_room(hd__enc_t *e, size_t n) {
+    if (n <= e->cap - e->size) return 0;
+    size_t cap = e->cap ? e->cap : 4096;
+    while (cap - e->size < n && cap <= SIZE_MAX / 2) cap *= 2;
+    unsigned char *p = cap - e->size >= n ? realloc(e->buf, cap) : NULL;
+    if (!p) {
+        e->oom = 1;
+        return -1;
     }
+    e->buf = p;
+    e->cap = cap;
+    return 0;
+}
+void hd__enc_put(hd__enc_t *e, const void *p, size_t n) {
+    if (n == 0 || enc_room(e, n)) return;
+    memcpy(e->buf + e->size, p, n);
+    e->size += n;
+}
+static void enc_byte(hd__enc_t *e, unsigned char b) {
+    if (e->size == e->cap && enc_room(e, 1)) return;
     e->buf[e->size++] = b;
 }
 static void enc_carry(hd__enc_t *e) {

@@ -234,6 +234,9 @@ typedef struct hd__enc {
 void hd__enc_init(hd__enc_t *e);   /* empty, no memory yet */
 void hd__enc_reset(hd__enc_t *e);  /* a new stream, keeping the memory */
 void hd__enc_free(hd__enc_t *e);
+/* Append n raw bytes to e's buffer (nothing, with e's oom flag set, when
+ * it cannot grow). */
+void hd__enc_put(hd__enc_t *e, const void *p, size_t n);
 void hd__enc_bit(hd__enc_t *e, hd__bitmodel_t *m, uint32_t sym);
 void hd__enc_symbol(hd__enc_t *e, hd__symmodel_t *m, uint32_t sym);
 /* `bits` raw bits of sym, 1 <= bits <= 32. */
