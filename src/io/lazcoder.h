@@ -266,4 +266,27 @@ HD__INLINE unsigned hd__laz_level(unsigned n, unsigned r) {
 /* The context of dy from dx's k (cap 20), of z from the mean k (cap 18). */
 HD__INLINE unsigned hd__laz_kctx(unsigned k, unsigned cap) { return k < cap ? (k & ~1u) : cap; }
 
+/* ---- the models of pointwise LAZ's items ---------------------------------
+ * POINT10, GPSTIME11 and RGB12 in version 1 or 2, one set for the reader
+ * (laz.c) and the pointwise encoder (write_lazpw.c).  Each hd__pw_*_new
+ * creates one item's models (HD_OK or HD_ENOMEM) in m zeroed first;
+ * hd__pw_models_free frees whatever was created, after a failure too. */
+typedef struct hd__pw_models {
+    /* POINT10 */
+    hd__symmodel_t changed, scan[2];                     /* scan: v2 only */
+    hd__symmodel_t *bitbyte[256], *cls[256], *user[256]; /* created at first use */
+    hd__intcoder_t intensity, psid, dx, dy, dz, scan1;   /* scan1: v1 only */
+    hd__median5_t mx[16], my[16];                        /* v2 */
+    /* GPSTIME11 */
+    hd__symmodel_t gmulti, gzero;
+    hd__intcoder_t gic;
+    /* RGB12 */
+    hd__symmodel_t used, cdiff[6]; /* cdiff: v2 */
+    hd__intcoder_t cic;            /* v1 */
+} hd__pw_models_t;
+int hd__pw_point10_new(hd__pw_models_t *m, int v2);
+int hd__pw_gps11_new(hd__pw_models_t *m, int v2);
+int hd__pw_rgb12_new(hd__pw_models_t *m, int v2);
+void hd__pw_models_free(hd__pw_models_t *m);
+
 #endif

@@ -54,18 +54,13 @@ enum { IT_BYTE = 0, IT_POINT10 = 6, IT_GPSTIME11 = 7, IT_RGB12 = 8 };
 #define HD__LAZ_CHUNK 50000 /* LASzip's default chunk size */
 
 typedef struct {
-    hd__symmodel_t changed, scan[2], *bitbyte[256], *cls[256], *user[256];
-    hd__intcoder_t intensity, psid, dx, dy, dz;
-    hd__median5_t mx[16], my[16];
+    hd__pw_models_t m; /* the items' models, version 2 (lazcoder.h) */
     uint16_t last_int[16];
     int32_t last_h[8];
     unsigned char last[20];
-    hd__symmodel_t gmulti, gzero;
-    hd__intcoder_t gic;
     int64_t t[4];
     int32_t gdiff[4];
     unsigned glast, gnext;
-    hd__symmodel_t used, cdiff[6];
     uint16_t rgb[3];
     unsigned nb;
     hd__symmodel_t *bm;
@@ -74,14 +69,7 @@ typedef struct {
 } pwe_t;
 
 static void pwe_free(pwe_t *p) {
-    hd__symmodel_t *m[] = {&p->changed, &p->scan[0], &p->scan[1], &p->gmulti, &p->gzero, &p->used,
-                           &p->cdiff[0], &p->cdiff[1], &p->cdiff[2], &p->cdiff[3], &p->cdiff[4], &p->cdiff[5]};
-    hd__symmodels_free(m, sizeof m / sizeof m[0]);
-    hd__lazy_models_free(p->bitbyte, 256);
-    hd__lazy_models_free(p->cls, 256);
-    hd__lazy_models_free(p->user, 256);
-    hd__intcoder_t *ic[] = {&p->intensity, &p->psid, &p->dx, &p->dy, &p->dz, &p->gic};
-    for (size_t i = 0; i < sizeof ic / sizeof ic[0]; i++) hd__intcoder_free(ic[i]);
+    hd__pw_models_free(&p->m);
     for (unsigned i = 0; p->bm && i < p->nb; i++) hd__symmodel_free(&p->bm[i]);
     free(p->bm);
     free(p->blast);
@@ -91,20 +79,9 @@ static void pwe_free(pwe_t *p) {
  * output's, sizes sz). */
 static int pwe_start(pwe_t *p, const unsigned char *r, const unsigned *type, const unsigned *sz, unsigned n_items) {
     memset(p, 0, sizeof *p);
-    int rc = hd__symmodel_new(&p->changed, 64);
-    rc = rc ? rc : hd__symmodel_new(&p->scan[0], 256);
-    rc = rc ? rc : hd__symmodel_new(&p->scan[1], 256);
-    rc = rc ? rc : hd__intcoder_new(&p->intensity, 16, 4);
-    rc = rc ? rc : hd__intcoder_new(&p->psid, 16, 1);
-    rc = rc ? rc : hd__intcoder_new(&p->dx, 32, 2);
-    rc = rc ? rc : hd__intcoder_new(&p->dy, 32, 22);
-    rc = rc ? rc : hd__intcoder_new(&p->dz, 32, 20);
-    rc = rc ? rc : hd__symmodel_new(&p->gmulti, 516);
-    rc = rc ? rc : hd__symmodel_new(&p->gzero, 6);
-    rc = rc ? rc : hd__intcoder_new(&p->gic, 32, 9);
-    rc = rc ? rc : hd__symmodel_new(&p->used, 128);
-    for (int i = 0; i < 6 && rc == HD_OK; i++) rc = hd__symmodel_new(&p->cdiff[i], 256);
-    for (int i = 0; i < 16; i++) hd__median5_init(&p->mx[i]), hd__median5_init(&p->my[i]);
+    int rc = hd__pw_point10_new(&p->m, 1);
+    rc = rc ? rc : hd__pw_gps11_new(&p->m, 1);
+    rc = rc ? rc : hd__pw_rgb12_new(&p->m, 1);
     memcpy(p->last, r, 20);
     size_t off = 20;
     for (unsigned i = 1; i < n_items && rc == HD_OK; i++) {
@@ -150,29 +127,29 @@ static void point10(pwe_t *p, hd__enc_t *e, const unsigned char *r) {
     uint16_t inten = hd__ld_u16(r + 12, 0);
     unsigned changed = (r[14] != L[14]) << 5 | (inten != p->last_int[m]) << 4 | (r[15] != L[15]) << 3 |
                        (r[16] != L[16]) << 2 | (r[17] != L[17]) << 1 | (hd__ld_u16(r + 18, 0) != hd__ld_u16(L + 18, 0));
-    hd__enc_symbol(e, &p->changed, changed);
-    if (changed & 32) byte_by_last(p, e, p->bitbyte, &L[14], r[14]);
+    hd__enc_symbol(e, &p->m.changed, changed);
+    if (changed & 32) byte_by_last(p, e, p->m.bitbyte, &L[14], r[14]);
     if (changed & 16) {
-        hd__ic_encode(&p->intensity, e, p->last_int[m], inten, m < 3 ? m : 3);
+        hd__ic_encode(&p->m.intensity, e, p->last_int[m], inten, m < 3 ? m : 3);
         p->last_int[m] = inten;
     }
-    if (changed & 8) byte_by_last(p, e, p->cls, &L[15], r[15]);
+    if (changed & 8) byte_by_last(p, e, p->m.cls, &L[15], r[15]);
     if (changed & 4) {
-        hd__enc_symbol(e, &p->scan[(r[14] >> 6) & 1], (unsigned)(r[16] - L[16]) & 255);
+        hd__enc_symbol(e, &p->m.scan[(r[14] >> 6) & 1], (unsigned)(r[16] - L[16]) & 255);
         L[16] = r[16];
     }
-    if (changed & 2) byte_by_last(p, e, p->user, &L[17], r[17]);
+    if (changed & 2) byte_by_last(p, e, p->m.user, &L[17], r[17]);
     if (changed & 1) {
-        hd__ic_encode(&p->psid, e, hd__ld_u16(L + 18, 0), hd__ld_u16(r + 18, 0), 0);
+        hd__ic_encode(&p->m.psid, e, hd__ld_u16(L + 18, 0), hd__ld_u16(r + 18, 0), 0);
         L[18] = r[18], L[19] = r[19];
     }
     int32_t X = (int32_t)hd__ld_u32(r, 0), Y = (int32_t)hd__ld_u32(r + 4, 0), Z = (int32_t)hd__ld_u32(r + 8, 0);
     int32_t dx = (int32_t)((uint32_t)X - hd__ld_u32(L, 0)), dy = (int32_t)((uint32_t)Y - hd__ld_u32(L + 4, 0));
-    hd__ic_encode(&p->dx, e, p->mx[m].v[2], dx, n == 1);
-    hd__median5_add(&p->mx[m], dx);
-    hd__ic_encode(&p->dy, e, p->my[m].v[2], dy, (n == 1) + hd__laz_kctx(p->dx.k, 20));
-    hd__median5_add(&p->my[m], dy);
-    hd__ic_encode(&p->dz, e, p->last_h[l], Z, (n == 1) + hd__laz_kctx((p->dx.k + p->dy.k) / 2, 18));
+    hd__ic_encode(&p->m.dx, e, p->m.mx[m].v[2], dx, n == 1);
+    hd__median5_add(&p->m.mx[m], dx);
+    hd__ic_encode(&p->m.dy, e, p->m.my[m].v[2], dy, (n == 1) + hd__laz_kctx(p->m.dx.k, 20));
+    hd__median5_add(&p->m.my[m], dy);
+    hd__ic_encode(&p->m.dz, e, p->last_h[l], Z, (n == 1) + hd__laz_kctx((p->m.dx.k + p->m.dy.k) / 2, 18));
     p->last_h[l] = Z;
     memcpy(L, r, 12);
 }
@@ -183,26 +160,26 @@ static void gpstime(pwe_t *p, hd__enc_t *e, int64_t T) {
     int64_t diff = (int64_t)((uint64_t)T - (uint64_t)p->t[L]);
     int fits = diff >= INT32_MIN && diff <= INT32_MAX;
     if (p->gdiff[L] == 0) {
-        hd__enc_symbol(e, &p->gzero, T == p->t[L] ? 0 : fits ? 1 : 2);
+        hd__enc_symbol(e, &p->m.gzero, T == p->t[L] ? 0 : fits ? 1 : 2);
         if (T == p->t[L]) return;
         if (fits) {
-            hd__ic_encode(&p->gic, e, 0, (int32_t)diff, 0);
+            hd__ic_encode(&p->m.gic, e, 0, (int32_t)diff, 0);
             p->gdiff[L] = (int32_t)diff;
             p->t[L] = T;
             return;
         }
     } else {
-        hd__enc_symbol(e, &p->gmulti, T == p->t[L] ? 511 : fits ? 1 : 512);
+        hd__enc_symbol(e, &p->m.gmulti, T == p->t[L] ? 511 : fits ? 1 : 512);
         if (T == p->t[L]) return;
         if (fits) {
-            hd__ic_encode(&p->gic, e, p->gdiff[L], (int32_t)diff, 1);
+            hd__ic_encode(&p->m.gic, e, p->gdiff[L], (int32_t)diff, 1);
             p->t[L] = T;
             return;
         }
     }
     /* the whole value, as a new sequence */
     p->gnext = (p->gnext + 1) & 3;
-    hd__ic_encode(&p->gic, e, (int32_t)((uint64_t)p->t[L] >> 32), (int32_t)((uint64_t)T >> 32), 8);
+    hd__ic_encode(&p->m.gic, e, (int32_t)((uint64_t)p->t[L] >> 32), (int32_t)((uint64_t)T >> 32), 8);
     hd__enc_raw(e, 16, (uint32_t)T & 0xFFFF);
     hd__enc_raw(e, 16, ((uint32_t)T >> 16) & 0xFFFF);
     p->t[p->gnext] = T;
@@ -219,20 +196,20 @@ static void rgb12(pwe_t *p, hd__enc_t *e, const unsigned char *r) {
                    ((last[1] & 255) != (it[1] & 255)) << 2 | ((last[1] >> 8) != (it[1] >> 8)) << 3 |
                    ((last[2] & 255) != (it[2] & 255)) << 4 | ((last[2] >> 8) != (it[2] >> 8)) << 5 |
                    (it[0] != it[1] || it[0] != it[2]) << 6;
-    hd__enc_symbol(e, &p->used, sym);
+    hd__enc_symbol(e, &p->m.used, sym);
     int dl = (int)(it[0] & 255) - (int)(last[0] & 255), dh = (int)(it[0] >> 8) - (int)(last[0] >> 8);
-    if (sym & 1) hd__enc_symbol(e, &p->cdiff[0], (unsigned)dl & 255);
-    if (sym & 2) hd__enc_symbol(e, &p->cdiff[1], (unsigned)dh & 255);
+    if (sym & 1) hd__enc_symbol(e, &p->m.cdiff[0], (unsigned)dl & 255);
+    if (sym & 2) hd__enc_symbol(e, &p->m.cdiff[1], (unsigned)dh & 255);
     if (sym & 64) {
-        if (sym & 4) hd__enc_symbol(e, &p->cdiff[2], (unsigned)((int)(it[1] & 255) - (int)clamp8(dl + (last[1] & 255))) & 255);
+        if (sym & 4) hd__enc_symbol(e, &p->m.cdiff[2], (unsigned)((int)(it[1] & 255) - (int)clamp8(dl + (last[1] & 255))) & 255);
         if (sym & 16) {
             int d = (dl + ((int)(it[1] & 255) - (int)(last[1] & 255))) / 2;
-            hd__enc_symbol(e, &p->cdiff[4], (unsigned)((int)(it[2] & 255) - (int)clamp8(d + (last[2] & 255))) & 255);
+            hd__enc_symbol(e, &p->m.cdiff[4], (unsigned)((int)(it[2] & 255) - (int)clamp8(d + (last[2] & 255))) & 255);
         }
-        if (sym & 8) hd__enc_symbol(e, &p->cdiff[3], (unsigned)((int)(it[1] >> 8) - (int)clamp8(dh + (last[1] >> 8))) & 255);
+        if (sym & 8) hd__enc_symbol(e, &p->m.cdiff[3], (unsigned)((int)(it[1] >> 8) - (int)clamp8(dh + (last[1] >> 8))) & 255);
         if (sym & 32) {
             int d = (dh + ((int)(it[1] >> 8) - (int)(last[1] >> 8))) / 2;
-            hd__enc_symbol(e, &p->cdiff[5], (unsigned)((int)(it[2] >> 8) - (int)clamp8(d + (last[2] >> 8))) & 255);
+            hd__enc_symbol(e, &p->m.cdiff[5], (unsigned)((int)(it[2] >> 8) - (int)clamp8(d + (last[2] >> 8))) & 255);
         }
     }
     memcpy(last, it, sizeof it);
