@@ -204,7 +204,7 @@ void hd__p14_models_free(hd__p14_models_t *m) {
     hd__lazy_models_free(m->nret, 16);
     hd__lazy_models_free(m->rnum, 16);
     hd__intcoder_t *ic[] = {&m->dx, &m->dy, &m->dz};
-    for (int i = 0; i < 3; i++) hd__intcoder_free(ic[i]);
+    hd__intcoders_free(ic, 3);
 }
 
 static void ch_free(ch_t *c) {
@@ -215,7 +215,7 @@ static void ch_free(ch_t *c) {
     hd__lazy_models_free(c->flags, 64);
     hd__lazy_models_free(c->user, 64);
     hd__intcoder_t *ic[] = {&c->inten, &c->scan, &c->psid, &c->gic};
-    for (int i = 0; i < 4; i++) hd__intcoder_free(ic[i]);
+    hd__intcoders_free(ic, 4);
 }
 
 /* Channel c's models, started from the record `from` (the chunk's first,
@@ -605,7 +605,7 @@ static void wavec_free(wavec_t *c) {
     hd__symmodel_t *m[] = {&c->index, &c->odiff[0], &c->odiff[1], &c->odiff[2], &c->odiff[3]};
     hd__symmodels_free(m, 5);
     hd__intcoder_t *ic[] = {&c->ioff, &c->isize, &c->iret, &c->ixyz};
-    for (int i = 0; i < 4; i++) hd__intcoder_free(ic[i]);
+    hd__intcoders_free(ic, 4);
 }
 
 /* A wave packet descriptor (29 bytes: index, u64 offset, u32 size, f32

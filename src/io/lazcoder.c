@@ -150,6 +150,10 @@ void hd__intcoder_free(hd__intcoder_t *ic) {
     for (uint32_t i = 1; i <= 32; i++) hd__symmodel_free(&ic->corr[i]);
 }
 
+void hd__intcoders_free(hd__intcoder_t *const *ic, size_t n) {
+    for (size_t i = 0; i < n; i++) hd__intcoder_free(ic[i]);
+}
+
 void hd__median5_init(hd__median5_t *m) {
     memset(m->v, 0, sizeof m->v);
     m->high = 1;
@@ -405,5 +409,5 @@ void hd__pw_models_free(hd__pw_models_t *m) {
     hd__lazy_models_free(m->cls, 256);
     hd__lazy_models_free(m->user, 256);
     hd__intcoder_t *ic[] = {&m->intensity, &m->psid, &m->dx, &m->dy, &m->dz, &m->scan1, &m->gic, &m->cic};
-    for (size_t i = 0; i < sizeof ic / sizeof ic[0]; i++) hd__intcoder_free(ic[i]);
+    hd__intcoders_free(ic, sizeof ic / sizeof ic[0]);
 }

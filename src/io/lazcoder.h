@@ -182,6 +182,8 @@ typedef struct hd__intcoder {
 /* bits: 1 to 32 (LAZ uses 8, 16, 32); HD_OK or HD_ENOMEM. */
 int hd__intcoder_new(hd__intcoder_t *ic, uint32_t bits, uint32_t contexts);
 void hd__intcoder_free(hd__intcoder_t *ic);
+/* Free the n integer coders whose addresses are in ic. */
+void hd__intcoders_free(hd__intcoder_t *const *ic, size_t n);
 
 /* The model m, initialised at its first use. */
 HD__INLINE hd__symmodel_t *hd__ic_model(hd__symmodel_t *m) {

@@ -172,7 +172,7 @@ static void chunk10v1(tf_buf_t *b, const lazw_opts_t *o, const lazw_point_t *p, 
     for (int i = 0; i < 256; i++)
         if (made[i]) hd__symmodel_free(&bitbyte[i]);
     hd__intcoder_t *ics[] = {&dx, &dy, &dz, &bic};
-    for (int i = 0; i < 4; i++) hd__intcoder_free(ics[i]);
+    hd__intcoders_free(ics, 4);
 }
 
 /* ---- POINT14 v3 layered chunks -------------------------------------------- */
