@@ -73,6 +73,18 @@ def write_xyz(path, pts):
             f.write("%r %r %r\n" % (float(p[0]), float(p[1]), float(p[2])))
 
 
+def write_pair(tmp, a, b, names=("a.xyz", "b.xyz"), **kw):
+    """A and B written into tmp under the two names: XYZ, or NIfTI masks
+    (write_nifti, with kw) for .nii names; their two paths."""
+    paths = tuple(os.path.join(tmp, name) for name in names)
+    for path, v in zip(paths, (a, b)):
+        if path.endswith((".nii", ".nii.gz")):
+            write_nifti(path, v, **kw)
+        else:
+            write_xyz(path, v)
+    return paths
+
+
 def nearest(q, b):
     """(distance, nearest index) of every point of q to b, brute force."""
     d = np.empty(len(q))
