@@ -21,6 +21,8 @@ import struct
 import sys
 
 ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests", "corpus")
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests"))
+from nifti_header import nifti_header  # noqa: E402  (tests/nifti_header.py)
 
 
 def put(rel, data):
@@ -45,38 +47,11 @@ def nifti(version, dims, dtype, voxels, pixdim=(1, 1, 1), sform=None, quatern=No
     code, bitpix, fmt = DT[dtype]
     dim = [ndim if ndim is not None else len(dims)] + list(dims)
     dim += [1] * (8 - len(dim))
-    qcode = 1 if quatern else 0
-    scode = 1 if sform else 0
-    qb, qc, qd, qx, qy, qz, qfac = quatern if quatern else (0, 0, 0, 0, 0, 0, 1)
+    qfac = quatern[6] if quatern else 1
     pd = [qfac] + list(pixdim) + [1] * (7 - len(pixdim))
-    rows = sform if sform else [[0] * 4] * 3
-    if version == 1:
-        h = bytearray(348)
-        struct.pack_into("<i", h, 0, 348)
-        struct.pack_into("<8h", h, 40, *dim)
-        struct.pack_into("<hh", h, 70, code, bitpix)
-        struct.pack_into("<8f", h, 76, *pd)
-        struct.pack_into("<f", h, 108, 352.0)
-        struct.pack_into("<B", h, 123, units)
-        struct.pack_into("<hh", h, 252, qcode, scode)
-        struct.pack_into("<6f", h, 256, qb, qc, qd, qx, qy, qz)
-        for r in range(3):
-            struct.pack_into("<4f", h, 280 + 16 * r, *rows[r])
-        h[344:348] = b"n+1\0"
-    else:
-        h = bytearray(540)
-        struct.pack_into("<i", h, 0, 540)
-        h[4:12] = b"n+2\0\r\n\x1a\n"
-        struct.pack_into("<hh", h, 12, code, bitpix)
-        struct.pack_into("<8q", h, 16, *dim)
-        struct.pack_into("<8d", h, 104, *pd)
-        struct.pack_into("<q", h, 168, 544)
-        struct.pack_into("<ii", h, 344, qcode, scode)
-        struct.pack_into("<6d", h, 352, qb, qc, qd, qx, qy, qz)
-        for r in range(3):
-            struct.pack_into("<4d", h, 400 + 32 * r, *rows[r])
-        struct.pack_into("<i", h, 500, units)
-    return bytes(h) + b"\0\0\0\0" + struct.pack("<%d%s" % (len(voxels), fmt), *voxels)
+    head = nifti_header(version, dim, code, bitpix, pd, quatern=quatern[:6] if quatern else None,
+                        sform=sform if sform else None, units=units)
+    return head + struct.pack("<%d%s" % (len(voxels), fmt), *voxels)
 
 
 def block(nx, ny, nz, lo, hi, value=1):

@@ -20,7 +20,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from cli_analysis_support import (lattice_clouds, main, nearest, read_png, run, run_json, same,  # noqa: E402
-                                  test, tool, write_xyz)
+                                  test, tool, write_pair, write_xyz)
 
 
 def pictures_built():
@@ -39,13 +39,6 @@ def gauss_clouds(seed, na, nb):
     return r.standard_normal((na, 3)), r.standard_normal((nb, 3)) + [0.4, 0, 0]
 
 
-def files(tmp, a, b):
-    pa, pb = os.path.join(tmp, "a.xyz"), os.path.join(tmp, "b.xyz")
-    write_xyz(pa, a)
-    write_xyz(pb, b)
-    return pa, pb
-
-
 def cases():
     """(name, A, B): ties on lattices, duplicates, Gaussians, unequal sizes."""
     yield ("lattice", *lattice_clouds(1, 700, 500))
@@ -57,7 +50,7 @@ def cases():
 def cases_with_files(tmp):
     """(name, file A, file B, distances A->B, distances B->A) per case."""
     for name, a, b in cases():
-        pa, pb = files(tmp, a, b)
+        pa, pb = write_pair(tmp, a, b)
         yield name, pa, pb, nearest(a, b)[0], nearest(b, a)[0]
 
 
@@ -81,7 +74,7 @@ def percentile_json_is_numpy_percentile_monai_and_medpy(tmp):
 @test
 def directed_percentile_has_only_the_ab_figure(tmp):
     a, b = lattice_clouds(5, 200, 150)
-    pa, pb = files(tmp, a, b)
+    pa, pb = write_pair(tmp, a, b)
     r = run_json(["--directed", "--percentile", "95", "--mean", pa, pb])
     same(r["percentile"]["ab"], np.percentile(nearest(a, b)[0], 95))
     assert r["percentile"]["ba"] is None and r["percentile"]["pooled"] is None
@@ -115,7 +108,7 @@ def mean_and_chamfer_follow_their_stated_definitions(tmp):
 @test
 def histogram_counts_are_numpys(tmp):
     a, b = lattice_clouds(6, 600, 400)  # many distances exactly on bin edges
-    pa, pb = files(tmp, a, b)
+    pa, pb = write_pair(tmp, a, b)
     dab, _ = nearest(a, b)
     dba, _ = nearest(b, a)
     top = max(dab.max(), dba.max())
@@ -159,7 +152,7 @@ def check_rows(rows, pts, d, j, what):
 @test
 def distances_csv_has_the_contract_columns_and_reads_back(tmp):
     a, b = gauss_clouds(7, 500, 400)
-    pa, pb = files(tmp, a, b)
+    pa, pb = write_pair(tmp, a, b)
     out = os.path.join(tmp, "dev.csv")
     r = run_json(["--distances", out, pa, pb])
     assert r["distances_file"] == {"a": out, "b": os.path.join(tmp, "dev_b.csv")}
@@ -187,7 +180,7 @@ def read_ply(path):
 def distances_ply_carries_distance_nearest_and_viridis_colour(tmp):
     a, b = lattice_clouds(8, 400, 300)
     b[0] = a[5]  # one distance 0
-    pa, pb = files(tmp, a, b)
+    pa, pb = write_pair(tmp, a, b)
     out = os.path.join(tmp, "dev.ply")
     run(["--distances", out, pa, pb])
     v = read_ply(out)
@@ -208,7 +201,7 @@ def distances_ply_carries_distance_nearest_and_viridis_colour(tmp):
 @test
 def distances_npy_is_an_n_by_5_float64_array(tmp):
     a, b = gauss_clouds(9, 300, 350)
-    pa, pb = files(tmp, a, b)
+    pa, pb = write_pair(tmp, a, b)
     out = os.path.join(tmp, "dev.npy")
     run(["--distances", out, pa, pb])
     m = np.load(out)
@@ -221,7 +214,7 @@ def distances_npy_is_an_n_by_5_float64_array(tmp):
 def render_is_a_picture_with_the_witness_pair_marked(tmp):
     a, b = gauss_clouds(10, 3000, 2500)
     b[7] = [6.0, 5.0, -4.0]  # a far point of B: h(B,A) wins, witness B[7]
-    pa, pb = files(tmp, a, b)
+    pa, pb = write_pair(tmp, a, b)
     png = os.path.join(tmp, "r.png")
     if not pictures_built():
         return refuses_pictures(["--render", png, pa, pb])
@@ -247,7 +240,7 @@ def histogram_picture(tmp):
     """The JSON and the pixels of --histogram-png with --percentile 95 on two
     Gaussian clouds; None (after checking the refusal) without libpng."""
     a, b = gauss_clouds(11, 800, 700)
-    pa, pb = files(tmp, a, b)
+    pa, pb = write_pair(tmp, a, b)
     png = os.path.join(tmp, "h.png")
     if not pictures_built():
         refuses_pictures(["--histogram-png", png, pa, pb])
@@ -297,7 +290,7 @@ def render_marks_the_percentile_on_the_colour_bar_and_says_the_unit(tmp):
     P95, and the caption gives all three figures; --units names the unit of
     the bar and the caption; without either, neither appears."""
     a, b = gauss_clouds(15, 1500, 1400)
-    pa, pb = files(tmp, a, b)
+    pa, pb = write_pair(tmp, a, b)
     png = os.path.join(tmp, "p.png")
     if not pictures_built():
         return refuses_pictures(["--render", png, "--percentile", "95", pa, pb])
@@ -328,7 +321,7 @@ def pictures_refuse_a_name_that_is_not_png(tmp):
     extension is a usage error (nothing written); .png in any case and a
     name without an extension (/dev/stdout) are fine."""
     a, b = gauss_clouds(16, 50, 40)
-    pa, pb = files(tmp, a, b)
+    pa, pb = write_pair(tmp, a, b)
     for opt in ("--render", "--histogram-png"):
         for name in ("x.jpg", "x.jpeg", "x.png.gif", "x.tif"):
             _, err = run([opt, os.path.join(tmp, name), pa, pb], expect=1)
@@ -343,7 +336,7 @@ def pictures_refuse_a_name_that_is_not_png(tmp):
 @test
 def answers_do_not_depend_on_the_thread_count(tmp):
     a, b = lattice_clouds(12, 2000, 1800, side=9)
-    pa, pb = files(tmp, a, b)
+    pa, pb = write_pair(tmp, a, b)
     keys = ("percentile", "mean", "chamfer", "histogram", "hausdorff", "witness_ab", "witness_ba")
     args = ["--percentile", "90", "--mean", "--chamfer", "--histogram", pa, pb]
     one = run_json(["--threads", "1"] + args)
@@ -410,7 +403,7 @@ def every_option_the_help_lists_is_one_the_parser_knows(tmp):
 @test
 def bad_analysis_options_are_usage_errors(tmp):
     a, b = gauss_clouds(14, 5, 5)
-    pa, pb = files(tmp, a, b)
+    pa, pb = write_pair(tmp, a, b)
     for args, words in ((["--percentile", "101"], "[0, 100]"), (["--percentile", "x"], "percentile"),
                         (["--distances", "out.dat"], ".csv, .ply or .npy"),
                         (["--bins", "0"], "--bins"), (["--max-distance", "-1"], "positive"),

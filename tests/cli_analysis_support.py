@@ -20,6 +20,8 @@ import zlib
 
 import numpy as np
 
+from nifti_header import nifti_header  # tests/nifti_header.py
+
 TESTS = []
 
 
@@ -69,6 +71,18 @@ def write_xyz(path, pts):
     with open(path, "w") as f:
         for p in pts:
             f.write("%r %r %r\n" % (float(p[0]), float(p[1]), float(p[2])))
+
+
+def write_pair(tmp, a, b, names=("a.xyz", "b.xyz"), **kw):
+    """A and B written into tmp under the two names: XYZ, or NIfTI masks
+    (write_nifti, with kw) for .nii names; their two paths."""
+    paths = tuple(os.path.join(tmp, name) for name in names)
+    for path, v in zip(paths, (a, b)):
+        if path.endswith((".nii", ".nii.gz")):
+            write_nifti(path, v, **kw)
+        else:
+            write_xyz(path, v)
+    return paths
 
 
 def nearest(q, b):
@@ -167,38 +181,9 @@ def write_nifti(path, vol, pixdim=(1, 1, 1), sform=None, qform=None, version=1, 
     dims = [3, vol.shape[0], vol.shape[1], vol.shape[2], 1, 1, 1, 1]
     qfac = qform["qfac"] if qform else 1.0
     pd = [qfac, pixdim[0], pixdim[1], pixdim[2], 1, 1, 1, 1]
-    qcode, scode = (1 if qform else 0), (1 if sform is not None else 0)
-    qb, qc, qd = (qform["b"], qform["c"], qform["d"]) if qform else (0, 0, 0)
-    qo = qform["offset"] if qform else (0, 0, 0)
-    rows = np.asarray(sform if sform is not None else np.zeros((3, 4)), dtype=np.float64)
-    if version == 1:
-        h = bytearray(348)
-        struct.pack_into("<i", h, 0, 348)
-        struct.pack_into("<8h", h, 40, *dims)
-        struct.pack_into("<hh", h, 70, code, bitpix)
-        struct.pack_into("<8f", h, 76, *pd)
-        struct.pack_into("<f", h, 108, 352.0)
-        struct.pack_into("<B", h, 123, units)
-        struct.pack_into("<hh", h, 252, qcode, scode)
-        struct.pack_into("<6f", h, 256, qb, qc, qd, *qo)
-        for r in range(3):
-            struct.pack_into("<4f", h, 280 + 16 * r, *rows[r])
-        h[344:348] = b"n+1\0"
-        head = bytes(h) + b"\0\0\0\0"
-    else:
-        h = bytearray(540)
-        struct.pack_into("<i", h, 0, 540)
-        h[4:12] = b"n+2\0\r\n\x1a\n"
-        struct.pack_into("<hh", h, 12, code, bitpix)
-        struct.pack_into("<8q", h, 16, *dims)
-        struct.pack_into("<8d", h, 104, *pd)
-        struct.pack_into("<q", h, 168, 544)
-        struct.pack_into("<ii", h, 344, qcode, scode)
-        struct.pack_into("<6d", h, 352, qb, qc, qd, *qo)
-        for r in range(3):
-            struct.pack_into("<4d", h, 400 + 32 * r, *rows[r])
-        struct.pack_into("<i", h, 500, units)
-        head = bytes(h) + b"\0\0\0\0"
+    quatern = (qform["b"], qform["c"], qform["d"], *qform["offset"]) if qform else None
+    rows = np.asarray(sform, dtype=np.float64) if sform is not None else None
+    head = nifti_header(version, dims, code, bitpix, pd, quatern=quatern, sform=rows, units=units)
     data = head + np.asarray(vol, dtype=vol.dtype.newbyteorder("<")).tobytes(order="F")
     if path.endswith(".gz"):
         with gzip.open(path, "wb") as f:

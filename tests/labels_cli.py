@@ -22,7 +22,7 @@ import numpy as np
 from scipy import ndimage
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from cli_analysis_support import main, run, run_json, test, value, write_nifti  # noqa: E402
+from cli_analysis_support import main, run, run_json, test, value, write_nifti, write_pair  # noqa: E402
 
 
 def surface(m):
@@ -93,9 +93,7 @@ def labels_match_a_brute_force_reference_seed_1_to_3(tmp):
 @test
 def components_are_scipy_labels_seed_4(tmp):
     p, g = maps(4)
-    pa, pb = os.path.join(tmp, "p.nii"), os.path.join(tmp, "g.nii")
-    write_nifti(pa, p)
-    write_nifti(pb, g)
+    pa, pb = write_pair(tmp, p, g, ("p.nii", "g.nii"))
     for conn, rank in ((6, 1), (18, 2), (26, 3)):
         j = run_json(["--labels", "all", "--components", str(conn), pa, pb])
         st = ndimage.generate_binary_structure(3, rank)
@@ -113,9 +111,7 @@ def components_are_scipy_labels_seed_4(tmp):
 @test
 def csv_and_text_carry_the_json_figures_seed_5(tmp):
     p, g = maps(5)
-    pa, pb = os.path.join(tmp, "p.nii"), os.path.join(tmp, "g.nii")
-    write_nifti(pa, p, pixdim=(0.8, 0.8, 2.5))
-    write_nifti(pb, g, pixdim=(0.8, 0.8, 2.5))
+    pa, pb = write_pair(tmp, p, g, ("p.nii", "g.nii"), pixdim=(0.8, 0.8, 2.5))
     j = run_json(["--labels", "all", pa, pb])
     out, _ = run(["--labels", "all", "--csv", pa, pb])
     rows = list(csv.DictReader(io.StringIO(out)))
@@ -133,9 +129,7 @@ def csv_and_text_carry_the_json_figures_seed_5(tmp):
 def absent_labels_follow_empty(tmp):
     p, g = maps(6)
     g[g == 3] = 1  # label 3 only in the prediction
-    pa, pb = os.path.join(tmp, "p.nii"), os.path.join(tmp, "g.nii")
-    write_nifti(pa, p)
-    write_nifti(pb, g)
+    pa, pb = write_pair(tmp, p, g, ("p.nii", "g.nii"))
     _, err = run(["--labels", "all", pa, pb], expect=2)
     assert "label 3 is absent from B" in err, err
     j = run_json(["--labels", "3,7", "--empty", "monai", pa, pb])
@@ -165,9 +159,7 @@ def float_label_maps_hold_whole_numbers(tmp):
 @test
 def bad_label_options_are_usage_errors(tmp):
     p, g = maps(8)
-    pa, pb = os.path.join(tmp, "p.nii"), os.path.join(tmp, "g.nii")
-    write_nifti(pa, p)
-    write_nifti(pb, g)
+    pa, pb = write_pair(tmp, p, g, ("p.nii", "g.nii"))
     for args in (["--labels", "1,x"], ["--labels", ""], ["--labels", "all", "--components", "5"],
                  ["--labels", "all", "--csv", "--json"], ["--labels", "all", "--mean"],
                  ["--labels", "all", "--tau", "1,2"], ["--labels", "all", "--directed"]):

@@ -25,7 +25,7 @@ import numpy as np
 from scipy import ndimage
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from cli_analysis_support import main, nearest, run, run_json, same, test, value, write_nifti, write_xyz  # noqa: E402
+from cli_analysis_support import main, nearest, run, run_json, same, test, value, write_nifti, write_pair, write_xyz  # noqa: E402
 from metrics_support import MONAI_FILE, close, dtu, monai_cases, monai_nsd, monai_orderings, tanks_and_temples  # noqa: E402,E501
 
 
@@ -41,9 +41,7 @@ def clouds(seed, na=700, nb=500):
 @test
 def scores_at_each_tolerance_follow_their_definition_seed_7(tmp):
     a, b = clouds(7)
-    pa, pb = os.path.join(tmp, "a.xyz"), os.path.join(tmp, "b.xyz")
-    write_xyz(pa, a)
-    write_xyz(pb, b)
+    pa, pb = write_pair(tmp, a, b)
     d_ab, _ = nearest(a, b)
     d_ba, _ = nearest(b, a)
     taus = [0.25, 0.1, 0.5, 0.0, 2.0]
@@ -67,9 +65,7 @@ def scores_at_each_tolerance_follow_their_definition_seed_7(tmp):
 
 @test
 def a_point_exactly_at_tau_is_within_by_le_and_not_by_lt(tmp):
-    pa, pb = os.path.join(tmp, "a.xyz"), os.path.join(tmp, "b.xyz")
-    write_xyz(pa, [[0, 0, 0], [3, 0, 0]])
-    write_xyz(pb, [[0.25, 0, 0]])
+    pa, pb = write_pair(tmp, [[0, 0, 0], [3, 0, 0]], [[0.25, 0, 0]])
     le = run_json([pa, pb, "--tau", "0.25"])["tolerance"]["scores"][0]
     lt = run_json([pa, pb, "--tau", "0.25", "--tau-rule", "lt"])["tolerance"]["scores"][0]
     assert (le["within_ab"], lt["within_ab"]) == (1, 0), (le, lt)
@@ -78,9 +74,7 @@ def a_point_exactly_at_tau_is_within_by_le_and_not_by_lt(tmp):
 @test
 def dtu_means_are_the_capped_means_seed_11(tmp):
     a, b = clouds(11)
-    pa, pb = os.path.join(tmp, "a.xyz"), os.path.join(tmp, "b.xyz")
-    write_xyz(pa, a)
-    write_xyz(pb, b)
+    pa, pb = write_pair(tmp, a, b)
     d_ab, _ = nearest(a, b)
     d_ba, _ = nearest(b, a)
     for cap in (0.3, 1.0, float("inf")):
@@ -100,9 +94,7 @@ def open3d_distances_give_the_same_scores_seed_5(tmp):
         print("     (python3-open3d is not installed: the comparison with Open3D is skipped)")
         return
     a, b = clouds(5, 3000, 2000)
-    pa, pb = os.path.join(tmp, "a.xyz"), os.path.join(tmp, "b.xyz")
-    write_xyz(pa, a)
-    write_xyz(pb, b)
+    pa, pb = write_pair(tmp, a, b)
     ca, cb = o3d.geometry.PointCloud(), o3d.geometry.PointCloud()
     ca.points = o3d.utility.Vector3dVector(a)
     cb.points = o3d.utility.Vector3dVector(b)

@@ -18,7 +18,7 @@ import pytest
 from scipy import ndimage
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from cli_analysis_support import nearest, write_nifti, write_xyz  # noqa: E402
+from cli_analysis_support import nearest, write_nifti, write_pair  # noqa: E402
 from metrics_support import (MONAI_FILE, close, dtu, edges, monai_cases, monai_nsd,  # noqa: E402
                              monai_orderings, surface_distances, tanks_and_temples)
 
@@ -170,9 +170,7 @@ def test_point_set_scores_equal_the_command_line():
     r = np.random.default_rng(31)
     a, b = r.normal(size=(300, 3)), r.normal(size=(200, 3))
     with tempfile.TemporaryDirectory() as tmp:
-        pa, pb = os.path.join(tmp, "a.xyz"), os.path.join(tmp, "b.xyz")
-        write_xyz(pa, a)
-        write_xyz(pb, b)
+        pa, pb = write_pair(tmp, a, b)
         j = json.loads(subprocess.run([CLI, pa, pb, "--json", "--tau", "0.1,0.3", "--dtu-cap", "0.5"],
                                       capture_output=True, text=True, check=True).stdout)
     for s, t in zip(j["tolerance"]["scores"], scores.tolerance(a, b, [0.1, 0.3])):

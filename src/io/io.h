@@ -11,6 +11,14 @@
 #include <stdio.h>
 #include <string.h>
 
+/* A function kept out of its callers: a rare step (a model set's creation)
+ * that, inlined, would change a hot loop's code around it. */
+#if defined(__GNUC__)
+#define HD__NOINLINE __attribute__((noinline))
+#else
+#define HD__NOINLINE
+#endif
+
 /* A whole input file in memory (mapped when it is a regular file). */
 typedef struct hd__file {
     const char *name;          /* as given by the caller, for messages */

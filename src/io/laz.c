@@ -172,26 +172,18 @@ static int32_t i32_at(const unsigned char *p) { return (int32_t)hd__ld_u32(p, 0)
 /* Every model of a pointwise chunk, zeroed first so that freeing is always
  * safe; each item uses the fields of its version. */
 typedef struct {
+    hd__pw_models_t m; /* POINT10, GPSTIME11, RGB12 (lazcoder.h) */
     /* POINT10 */
-    hd__symmodel_t changed, scan[2]; /* scan: v2 only */
-    hd__symmodel_t *bitbyte[256], *cls[256], *user[256];
-    hd__intcoder_t intensity, psid, dx, dy, dz, scan1; /* scan1: v1 only */
-    hd__median5_t mx[16], my[16];                     /* v2 */
-    int32_t diff1[2][3];                              /* v1: the last three dx, dy */
+    int32_t diff1[2][3]; /* v1: the last three dx, dy */
     unsigned incr1;
     uint16_t last_int[16];
     int32_t last_h[8];
     unsigned char last[20];
     /* GPSTIME11 */
-    hd__symmodel_t gmulti, gzero;
-    hd__intcoder_t gic;
     int64_t t[4];
     int32_t gdiff[4];
     int extreme[4];
     unsigned glast, gnext;
-    /* RGB12 */
-    hd__symmodel_t used, cdiff[6]; /* cdiff: v2 */
-    hd__intcoder_t cic;            /* v1 */
     /* BYTE */
     unsigned nb;
     hd__symmodel_t **bm; /* v2: nb models, each created at its first symbol
@@ -205,14 +197,8 @@ typedef struct {
 } pw_t;
 
 static void pw_free(pw_t *w) {
-    hd__symmodel_t *models[] = {&w->changed, &w->scan[0], &w->scan[1], &w->gmulti, &w->gzero, &w->used};
-    hd__symmodels_free(models, sizeof models / sizeof models[0]);
-    for (int i = 0; i < 6; i++) hd__symmodel_free(&w->cdiff[i]);
-    hd__lazy_models_free(w->bitbyte, 256);
-    hd__lazy_models_free(w->cls, 256);
-    hd__lazy_models_free(w->user, 256);
-    hd__intcoder_t *ics[] = {&w->intensity, &w->psid, &w->dx, &w->dy, &w->dz, &w->scan1, &w->gic, &w->cic, &w->bic};
-    for (size_t i = 0; i < sizeof ics / sizeof ics[0]; i++) hd__intcoder_free(ics[i]);
+    hd__pw_models_free(&w->m);
+    hd__intcoder_free(&w->bic);
     if (w->bm)
         for (unsigned i = 0; i < w->nb; i++)
             if (w->bm[i]) {
@@ -226,31 +212,13 @@ static void pw_free(pw_t *w) {
 /* Create the models of every item, in the version the VLR gives it. */
 static int pw_new(pw_t *w, const laz_t *z) {
     memset(w, 0, sizeof *w);
-    int v2 = z->items[0].version == 2, rc = hd__symmodel_new(&w->changed, 64);
-    if (v2) {
-        rc = rc ? rc : hd__symmodel_new(&w->scan[0], 256);
-        rc = rc ? rc : hd__symmodel_new(&w->scan[1], 256);
-        rc = rc ? rc : hd__intcoder_new(&w->intensity, 16, 4);
-        rc = rc ? rc : hd__intcoder_new(&w->dx, 32, 2);
-        rc = rc ? rc : hd__intcoder_new(&w->dy, 32, 22);
-    } else {
-        rc = rc ? rc : hd__intcoder_new(&w->scan1, 8, 2);
-        rc = rc ? rc : hd__intcoder_new(&w->intensity, 16, 1);
-        rc = rc ? rc : hd__intcoder_new(&w->dx, 32, 1);
-        rc = rc ? rc : hd__intcoder_new(&w->dy, 32, 20);
-    }
-    rc = rc ? rc : hd__intcoder_new(&w->psid, 16, 1);
-    rc = rc ? rc : hd__intcoder_new(&w->dz, 32, 20);
+    int rc = hd__pw_point10_new(&w->m, z->items[0].version == 2);
     for (unsigned i = 1; i < z->n_items && rc == HD_OK; i++) {
         unsigned t = z->items[i].type, iv2 = z->items[i].version == 2;
         if (t == IT_GPSTIME11) {
-            rc = hd__symmodel_new(&w->gmulti, iv2 ? 516 : 512);
-            rc = rc ? rc : hd__symmodel_new(&w->gzero, iv2 ? 6 : 3);
-            rc = rc ? rc : hd__intcoder_new(&w->gic, 32, iv2 ? 9 : 6);
+            rc = hd__pw_gps11_new(&w->m, iv2);
         } else if (t == IT_RGB12) {
-            rc = hd__symmodel_new(&w->used, iv2 ? 128 : 64);
-            for (int k = 0; k < 6 && rc == HD_OK && iv2; k++) rc = hd__symmodel_new(&w->cdiff[k], 256);
-            if (!iv2 && rc == HD_OK) rc = hd__intcoder_new(&w->cic, 8, 6);
+            rc = hd__pw_rgb12_new(&w->m, iv2);
         } else if (t == IT_BYTE) {
             w->nb = z->items[i].size;
             if (!iv2) {
@@ -304,27 +272,27 @@ static uint16_t ic16(hd__intcoder_t *ic, hd__dec_t *d, uint16_t pred, uint32_t c
  * when a lazily created model could not be allocated. */
 static int p10_read(pw_t *p, hd__dec_t *d) {
     unsigned char *L = p->last;
-    uint32_t changed = hd__dec_symbol(d, &p->changed);
+    uint32_t changed = hd__dec_symbol(d, &p->m.changed);
     if (changed) {
-        if ((changed & 32) && lazy_byte(p->bitbyte, &L[14], d)) return -1;
+        if ((changed & 32) && lazy_byte(p->m.bitbyte, &L[14], d)) return -1;
         unsigned m = hd__laz_rmap10[(L[14] >> 3) & 7][L[14] & 7];
-        if (changed & 16) p->last_int[m] = ic16(&p->intensity, d, p->last_int[m], m < 3 ? m : 3);
-        if ((changed & 8) && lazy_byte(p->cls, &L[15], d)) return -1;
-        if (changed & 4) L[16] = (unsigned char)(hd__dec_symbol(d, &p->scan[(L[14] >> 6) & 1]) + L[16]);
-        if ((changed & 2) && lazy_byte(p->user, &L[17], d)) return -1;
+        if (changed & 16) p->last_int[m] = ic16(&p->m.intensity, d, p->last_int[m], m < 3 ? m : 3);
+        if ((changed & 8) && lazy_byte(p->m.cls, &L[15], d)) return -1;
+        if (changed & 4) L[16] = (unsigned char)(hd__dec_symbol(d, &p->m.scan[(L[14] >> 6) & 1]) + L[16]);
+        if ((changed & 2) && lazy_byte(p->m.user, &L[17], d)) return -1;
         if (changed & 1) {
-            uint16_t ps = ic16(&p->psid, d, hd__ld_u16(L + 18, 0), 0);
+            uint16_t ps = ic16(&p->m.psid, d, hd__ld_u16(L + 18, 0), 0);
             L[18] = (unsigned char)ps;
             L[19] = (unsigned char)(ps >> 8);
         }
     }
     unsigned r = L[14] & 7, n = (L[14] >> 3) & 7;
     unsigned m = hd__laz_rmap10[n][r], l = hd__laz_level(n, r);
-    int32_t dx = hd__ic_decode(&p->dx, d, p->mx[m].v[2], n == 1);
-    hd__median5_add(&p->mx[m], dx);
-    int32_t dy = hd__ic_decode(&p->dy, d, p->my[m].v[2], (n == 1) + hd__laz_kctx(p->dx.k, 20));
-    hd__median5_add(&p->my[m], dy);
-    int32_t Z = hd__ic_decode(&p->dz, d, p->last_h[l], (n == 1) + hd__laz_kctx((p->dx.k + p->dy.k) / 2, 18));
+    int32_t dx = hd__ic_decode(&p->m.dx, d, p->m.mx[m].v[2], n == 1);
+    hd__median5_add(&p->m.mx[m], dx);
+    int32_t dy = hd__ic_decode(&p->m.dy, d, p->m.my[m].v[2], (n == 1) + hd__laz_kctx(p->m.dx.k, 20));
+    hd__median5_add(&p->m.my[m], dy);
+    int32_t Z = hd__ic_decode(&p->m.dz, d, p->last_h[l], (n == 1) + hd__laz_kctx((p->m.dx.k + p->m.dy.k) / 2, 18));
     p->last_h[l] = Z;
     set_xyz(L, (int32_t)((uint32_t)i32_at(L) + (uint32_t)dx), (int32_t)((uint32_t)i32_at(L + 4) + (uint32_t)dy), Z);
     return 0;
@@ -339,25 +307,25 @@ static int32_t median3(const int32_t v[3]) {
  * last three differences; contexts from k), then the changed fields. */
 static int p10v1_read(pw_t *p, hd__dec_t *d) {
     unsigned char *L = p->last;
-    int32_t dx = hd__ic_decode(&p->dx, d, median3(p->diff1[0]), 0);
-    unsigned k = p->dx.k;
-    int32_t dy = hd__ic_decode(&p->dy, d, median3(p->diff1[1]), k < 19 ? k : 19);
-    k = (k + p->dy.k) / 2;
-    int32_t Z = hd__ic_decode(&p->dz, d, i32_at(L + 8), k < 19 ? k : 19);
+    int32_t dx = hd__ic_decode(&p->m.dx, d, median3(p->diff1[0]), 0);
+    unsigned k = p->m.dx.k;
+    int32_t dy = hd__ic_decode(&p->m.dy, d, median3(p->diff1[1]), k < 19 ? k : 19);
+    k = (k + p->m.dy.k) / 2;
+    int32_t Z = hd__ic_decode(&p->m.dz, d, i32_at(L + 8), k < 19 ? k : 19);
     set_xyz(L, (int32_t)((uint32_t)i32_at(L) + (uint32_t)dx), (int32_t)((uint32_t)i32_at(L + 4) + (uint32_t)dy), Z);
-    uint32_t changed = hd__dec_symbol(d, &p->changed);
+    uint32_t changed = hd__dec_symbol(d, &p->m.changed);
     if (changed) {
         if (changed & 32) {
-            uint16_t v = ic16(&p->intensity, d, hd__ld_u16(L + 12, 0), 0);
+            uint16_t v = ic16(&p->m.intensity, d, hd__ld_u16(L + 12, 0), 0);
             L[12] = (unsigned char)v;
             L[13] = (unsigned char)(v >> 8);
         }
-        if ((changed & 16) && lazy_byte(p->bitbyte, &L[14], d)) return -1;
-        if ((changed & 8) && lazy_byte(p->cls, &L[15], d)) return -1;
-        if (changed & 4) L[16] = (unsigned char)hd__ic_decode(&p->scan1, d, L[16], k < 3);
-        if ((changed & 2) && lazy_byte(p->user, &L[17], d)) return -1;
+        if ((changed & 16) && lazy_byte(p->m.bitbyte, &L[14], d)) return -1;
+        if ((changed & 8) && lazy_byte(p->m.cls, &L[15], d)) return -1;
+        if (changed & 4) L[16] = (unsigned char)hd__ic_decode(&p->m.scan1, d, L[16], k < 3);
+        if ((changed & 2) && lazy_byte(p->m.user, &L[17], d)) return -1;
         if (changed & 1) {
-            uint16_t ps = ic16(&p->psid, d, hd__ld_u16(L + 18, 0), 0);
+            uint16_t ps = ic16(&p->m.psid, d, hd__ld_u16(L + 18, 0), 0);
             L[18] = (unsigned char)ps;
             L[19] = (unsigned char)(ps >> 8);
         }
@@ -383,26 +351,26 @@ static int32_t times(int32_t m, int32_t v) { return (int32_t)((uint32_t)m * (uin
 static void gps1_read(pw_t *g, hd__dec_t *d) {
     int32_t *last = &g->gdiff[0];
     if (*last == 0) {
-        uint32_t multi = hd__dec_symbol(d, &g->gzero);
+        uint32_t multi = hd__dec_symbol(d, &g->m.gzero);
         if (multi == 1) {
-            *last = hd__ic_decode(&g->gic, d, 0, 0);
+            *last = hd__ic_decode(&g->m.gic, d, 0, 0);
             gps_add(g, 0, *last);
         } else if (multi == 2) {
             g->t[0] = (int64_t)raw64(d);
         }
         return;
     }
-    uint32_t multi = hd__dec_symbol(d, &g->gmulti);
+    uint32_t multi = hd__dec_symbol(d, &g->m.gmulti);
     if (multi < 510) {
         int32_t diff;
         if (multi == 1) {
-            diff = *last = hd__ic_decode(&g->gic, d, *last, 1);
+            diff = *last = hd__ic_decode(&g->m.gic, d, *last, 1);
             g->extreme[0] = 0;
         } else if (multi == 0) {
-            diff = hd__ic_decode(&g->gic, d, *last / 4, 2);
+            diff = hd__ic_decode(&g->m.gic, d, *last / 4, 2);
             if (++g->extreme[0] > 3) *last = diff, g->extreme[0] = 0;
         } else {
-            diff = hd__ic_decode(&g->gic, d, times((int32_t)multi, *last), multi < 10 ? 3 : multi < 50 ? 4 : 5);
+            diff = hd__ic_decode(&g->m.gic, d, times((int32_t)multi, *last), multi < 10 ? 3 : multi < 50 ? 4 : 5);
             if (multi == 509 && ++g->extreme[0] > 3) *last = diff, g->extreme[0] = 0;
         }
         gps_add(g, 0, diff);
@@ -420,9 +388,9 @@ static int gps_read(pw_t *g, hd__dec_t *d) {
         unsigned L = g->glast;
         uint32_t multi;
         if (g->gdiff[L] == 0) {
-            multi = hd__dec_symbol(d, &g->gzero);
+            multi = hd__dec_symbol(d, &g->m.gzero);
             if (multi == 1) {
-                g->gdiff[L] = hd__ic_decode(&g->gic, d, 0, 0);
+                g->gdiff[L] = hd__ic_decode(&g->m.gic, d, 0, 0);
                 gps_add(g, L, g->gdiff[L]);
                 g->extreme[L] = 0;
                 return 0;
@@ -433,9 +401,9 @@ static int gps_read(pw_t *g, hd__dec_t *d) {
             }
             if (multi == 0) return 0;
         } else {
-            multi = hd__dec_symbol(d, &g->gmulti);
+            multi = hd__dec_symbol(d, &g->m.gmulti);
             if (multi == 1) {
-                gps_add(g, L, hd__ic_decode(&g->gic, d, g->gdiff[L], 1));
+                gps_add(g, L, hd__ic_decode(&g->m.gic, d, g->gdiff[L], 1));
                 g->extreme[L] = 0;
                 return 0;
             }
@@ -443,17 +411,17 @@ static int gps_read(pw_t *g, hd__dec_t *d) {
                 int32_t diff;
                 int extreme = 0;
                 if (multi == 0) {
-                    diff = hd__ic_decode(&g->gic, d, 0, 7);
+                    diff = hd__ic_decode(&g->m.gic, d, 0, 7);
                     extreme = 1;
                 } else if (multi < 500) {
-                    diff = hd__ic_decode(&g->gic, d, times((int32_t)multi, g->gdiff[L]), multi < 10 ? 2 : 3);
+                    diff = hd__ic_decode(&g->m.gic, d, times((int32_t)multi, g->gdiff[L]), multi < 10 ? 2 : 3);
                 } else if (multi == 500) {
-                    diff = hd__ic_decode(&g->gic, d, times(500, g->gdiff[L]), 4);
+                    diff = hd__ic_decode(&g->m.gic, d, times(500, g->gdiff[L]), 4);
                     extreme = 1;
                 } else {
                     int32_t mm = 500 - (int32_t)multi;
                     extreme = mm <= -10;
-                    diff = hd__ic_decode(&g->gic, d, times(extreme ? -10 : mm, g->gdiff[L]), extreme ? 6 : 5);
+                    diff = hd__ic_decode(&g->m.gic, d, times(extreme ? -10 : mm, g->gdiff[L]), extreme ? 6 : 5);
                 }
                 if (extreme && ++g->extreme[L] > 3) {
                     g->gdiff[L] = diff;
@@ -470,7 +438,7 @@ static int gps_read(pw_t *g, hd__dec_t *d) {
         }
         /* a full value (0diff symbol 2, multi symbol 512): a new sequence */
         g->gnext = (g->gnext + 1) & 3;
-        uint32_t hi = (uint32_t)hd__ic_decode(&g->gic, d, (int32_t)((uint64_t)g->t[L] >> 32), 8);
+        uint32_t hi = (uint32_t)hd__ic_decode(&g->m.gic, d, (int32_t)((uint64_t)g->t[L] >> 32), 8);
         uint32_t lo = hd__dec_raw(d, 16);
         lo |= hd__dec_raw(d, 16) << 16;
         g->t[g->gnext] = (int64_t)((uint64_t)hi << 32 | lo);
@@ -489,23 +457,23 @@ static unsigned clamp8(int v) { return v < 0 ? 0u : v > 255 ? 255u : (unsigned)v
 static void rgb12_values(pw_t *c, hd__dec_t *d, uint32_t sym) {
     const uint16_t *last = c->rgb;
     uint16_t it[3];
-    unsigned lo = sym & 1 ? (hd__dec_symbol(d, &c->cdiff[0]) + (last[0] & 255)) & 255 : last[0] & 255;
-    unsigned hi = sym & 2 ? (hd__dec_symbol(d, &c->cdiff[1]) + (last[0] >> 8)) & 255 : last[0] >> 8;
+    unsigned lo = sym & 1 ? (hd__dec_symbol(d, &c->m.cdiff[0]) + (last[0] & 255)) & 255 : last[0] & 255;
+    unsigned hi = sym & 2 ? (hd__dec_symbol(d, &c->m.cdiff[1]) + (last[0] >> 8)) & 255 : last[0] >> 8;
     it[0] = (uint16_t)(hi << 8 | lo);
     if (sym & 64) {
         int diff = (int)(it[0] & 255) - (int)(last[0] & 255);
-        unsigned g = sym & 4 ? (hd__dec_symbol(d, &c->cdiff[2]) + clamp8(diff + (last[1] & 255))) & 255 : last[1] & 255;
+        unsigned g = sym & 4 ? (hd__dec_symbol(d, &c->m.cdiff[2]) + clamp8(diff + (last[1] & 255))) & 255 : last[1] & 255;
         unsigned b = last[2] & 255;
         if (sym & 16) {
             diff = (diff + ((int)g - (int)(last[1] & 255))) / 2;
-            b = (hd__dec_symbol(d, &c->cdiff[4]) + clamp8(diff + (last[2] & 255))) & 255;
+            b = (hd__dec_symbol(d, &c->m.cdiff[4]) + clamp8(diff + (last[2] & 255))) & 255;
         }
         diff = (int)(it[0] >> 8) - (int)(last[0] >> 8);
-        unsigned gh = sym & 8 ? (hd__dec_symbol(d, &c->cdiff[3]) + clamp8(diff + (last[1] >> 8))) & 255 : last[1] >> 8;
+        unsigned gh = sym & 8 ? (hd__dec_symbol(d, &c->m.cdiff[3]) + clamp8(diff + (last[1] >> 8))) & 255 : last[1] >> 8;
         unsigned bh = last[2] >> 8;
         if (sym & 32) {
             diff = (diff + ((int)gh - (int)(last[1] >> 8))) / 2;
-            bh = (hd__dec_symbol(d, &c->cdiff[5]) + clamp8(diff + (last[2] >> 8))) & 255;
+            bh = (hd__dec_symbol(d, &c->m.cdiff[5]) + clamp8(diff + (last[2] >> 8))) & 255;
         }
         it[1] = (uint16_t)(gh << 8 | g);
         it[2] = (uint16_t)(bh << 8 | b);
@@ -518,10 +486,10 @@ static void rgb12_values(pw_t *c, hd__dec_t *d, uint32_t sym) {
 /* RGB12 v2 and v1, BYTE v2 and v1: their values never steer the stream,
  * so only their symbols are decoded. */
 static void rgb_read(pw_t *c, hd__dec_t *d, int v2) {
-    uint32_t sym = hd__dec_symbol(d, &c->used);
+    uint32_t sym = hd__dec_symbol(d, &c->m.used);
     if (!v2) {
         for (unsigned k = 0; k < 6; k++)
-            if (sym & (1u << k)) hd__ic_decode(&c->cic, d, 0, k);
+            if (sym & (1u << k)) hd__ic_decode(&c->m.cic, d, 0, k);
         return;
     }
     if (c->values) {
@@ -531,7 +499,7 @@ static void rgb_read(pw_t *c, hd__dec_t *d, int v2) {
     static const unsigned char order[6] = {0, 1, 2, 4, 3, 5};
     for (int i = 0; i < 6; i++) {
         unsigned k = order[i];
-        if ((sym & (1u << k)) && (k < 2 || (sym & 64))) hd__dec_symbol(d, &c->cdiff[k]);
+        if ((sym & (1u << k)) && (k < 2 || (sym & 64))) hd__dec_symbol(d, &c->m.cdiff[k]);
     }
 }
 /* BYTE v2 gives each extra byte a model of 256 symbols, created here at its
@@ -581,10 +549,6 @@ static int pointwise_start(pw_t *w, const laz_t *z, const unsigned char *b, int 
     int rc = pw_new(w, z);
     w->values = values;
     if (rc) return rc;
-    for (int i = 0; i < 16; i++) {
-        hd__median5_init(&w->mx[i]);
-        hd__median5_init(&w->my[i]);
-    }
     memcpy(w->last, b, 20);
     if (z->items[0].version == 2) w->last[12] = w->last[13] = 0; /* v2: intensity starts at 0 */
     size_t off = 20;
@@ -680,45 +644,21 @@ static void pointwise_chunk(job_t *j, const unsigned char *b, size_t nb, size_t 
 /* ---- POINT14 v3/v4, layered: x and y from layer 0, z from layer 1 -------- */
 typedef struct {
     int used;
-    hd__symmodel_t changed[8], scanner, rn_same;
-    hd__symmodel_t *nret[16], *rnum[16];
-    hd__intcoder_t dx, dy, dz;
-    hd__median5_t mx[12], my[12];
+    hd__p14_models_t m;
     int32_t last_z[8];
     int32_t X, Y, Z;
     unsigned r, n, gps_change;
 } ctx14_t;
 
-static void ctx14_free(ctx14_t *c) {
-    for (int i = 0; i < 8; i++) hd__symmodel_free(&c->changed[i]);
-    hd__symmodel_free(&c->scanner);
-    hd__symmodel_free(&c->rn_same);
-    for (int i = 0; i < 16; i++) {
-        if (c->nret[i]) hd__symmodel_free(c->nret[i]);
-        if (c->rnum[i]) hd__symmodel_free(c->rnum[i]);
-        free(c->nret[i]);
-        free(c->rnum[i]);
-    }
-    hd__intcoder_free(&c->dx);
-    hd__intcoder_free(&c->dy);
-    hd__intcoder_free(&c->dz);
-}
+static void ctx14_free(ctx14_t *c) { hd__p14_models_free(&c->m); }
 
 /* Create channel c's models and start it from a point (the chunk's first
- * point, or the previous channel's last). */
-static int ctx14_start(ctx14_t *c, const ctx14_t *from) {
-    int rc = HD_OK;
-    for (int i = 0; i < 8 && rc == HD_OK; i++) rc = hd__symmodel_new(&c->changed[i], 128);
-    rc = rc ? rc : hd__symmodel_new(&c->scanner, 3);
-    rc = rc ? rc : hd__symmodel_new(&c->rn_same, 13);
-    rc = rc ? rc : hd__intcoder_new(&c->dx, 32, 2);
-    rc = rc ? rc : hd__intcoder_new(&c->dy, 32, 22);
-    rc = rc ? rc : hd__intcoder_new(&c->dz, 32, 20);
+ * point, or the previous channel's last).  Kept out of layered_points: a
+ * rare step whose inlining changes the decoding loop's code (measured by
+ * bench/read_bench under callgrind). */
+HD__NOINLINE static int ctx14_start(ctx14_t *c, const ctx14_t *from) {
+    int rc = hd__p14_models_new(&c->m);
     if (rc) return rc;
-    for (int i = 0; i < 12; i++) {
-        hd__median5_init(&c->mx[i]);
-        hd__median5_init(&c->my[i]);
-    }
     c->X = from->X;
     c->Y = from->Y;
     c->Z = from->Z;
@@ -736,9 +676,9 @@ static void layered_loop(job_t *j, ctx14_t *cx, unsigned cur, hd__dec_t *dxy, hd
     for (size_t i = 1; i < n; i++) {
         ctx14_t *c = &cx[cur];
         unsigned lpr = (c->r == 1) + 2 * (c->r >= c->n) + 4 * c->gps_change;
-        uint32_t changed = hd__dec_symbol(dxy, &c->changed[lpr]);
+        uint32_t changed = hd__dec_symbol(dxy, &c->m.changed[lpr]);
         if (changed & 64) {
-            unsigned next = (cur + hd__dec_symbol(dxy, &c->scanner) + 1) & 3;
+            unsigned next = (cur + hd__dec_symbol(dxy, &c->m.scanner) + 1) & 3;
             if (!cx[next].used && ctx14_start(&cx[next], c)) {
                 fail(j, HD_ENOMEM, at, "out of memory");
                 return;
@@ -750,7 +690,7 @@ static void layered_loop(job_t *j, ctx14_t *cx, unsigned cur, hd__dec_t *dxy, hd
         unsigned gps = (changed >> 4) & 1;
         unsigned last_n = c->n, last_r = c->r, nn = last_n, r = last_r;
         if (changed & 4) {
-            hd__symmodel_t *m = lazy(&c->nret[last_n], 16);
+            hd__symmodel_t *m = lazy(&c->m.nret[last_n], 16);
             if (!m) {
                 fail(j, HD_ENOMEM, at, "out of memory");
                 return;
@@ -762,14 +702,14 @@ static void layered_loop(job_t *j, ctx14_t *cx, unsigned cur, hd__dec_t *dxy, hd
         case 2: r = (last_r + 15) & 15; break;
         case 3:
             if (gps) {
-                hd__symmodel_t *m = lazy(&c->rnum[last_r], 16);
+                hd__symmodel_t *m = lazy(&c->m.rnum[last_r], 16);
                 if (!m) {
                     fail(j, HD_ENOMEM, at, "out of memory");
                     return;
                 }
                 r = hd__dec_symbol(dxy, m);
             } else {
-                r = (last_r + hd__dec_symbol(dxy, &c->rn_same) + 2) & 15;
+                r = (last_r + hd__dec_symbol(dxy, &c->m.rn_same) + 2) & 15;
             }
             break;
         default: break;
@@ -777,14 +717,14 @@ static void layered_loop(job_t *j, ctx14_t *cx, unsigned cur, hd__dec_t *dxy, hd
         c->n = nn;
         c->r = r;
         unsigned m = hd__laz_rmap14[nn][r], l = hd__laz_level(nn, r), mi = m << 1 | gps;
-        int32_t dx = hd__ic_decode(&c->dx, dxy, c->mx[mi].v[2], nn == 1);
+        int32_t dx = hd__ic_decode(&c->m.dx, dxy, c->m.mx[mi].v[2], nn == 1);
         c->X = (int32_t)((uint32_t)c->X + (uint32_t)dx);
-        hd__median5_add(&c->mx[mi], dx);
-        int32_t dy = hd__ic_decode(&c->dy, dxy, c->my[mi].v[2], (nn == 1) + hd__laz_kctx(c->dx.k, 20));
+        hd__median5_add(&c->m.mx[mi], dx);
+        int32_t dy = hd__ic_decode(&c->m.dy, dxy, c->m.my[mi].v[2], (nn == 1) + hd__laz_kctx(c->m.dx.k, 20));
         c->Y = (int32_t)((uint32_t)c->Y + (uint32_t)dy);
-        hd__median5_add(&c->my[mi], dy);
+        hd__median5_add(&c->m.my[mi], dy);
         if (has_z) {
-            c->Z = hd__ic_decode(&c->dz, dz, c->last_z[l], (nn == 1) + hd__laz_kctx((c->dx.k + c->dy.k) / 2, 18));
+            c->Z = hd__ic_decode(&c->m.dz, dz, c->last_z[l], (nn == 1) + hd__laz_kctx((c->m.dx.k + c->m.dy.k) / 2, 18));
             c->last_z[l] = c->Z;
         }
         c->gps_change = gps;

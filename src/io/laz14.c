@@ -75,10 +75,10 @@ typedef struct {
 typedef struct {
     int used, gps_change;
     unsigned char last[30];
-    hd__symmodel_t changed[8], scanner, rn_same, gmulti, gzero;
-    hd__symmodel_t *nret[16], *rnum[16], *cls[64], *flags[64], *user[64];
-    hd__intcoder_t dx, dy, dz, inten, scan, psid, gic;
-    hd__median5_t mx[12], my[12];
+    hd__p14_models_t m; /* what the ordinary reader decodes too */
+    hd__symmodel_t gmulti, gzero;
+    hd__symmodel_t *cls[64], *flags[64], *user[64];
+    hd__intcoder_t inten, scan, psid, gic;
     int32_t last_z[8];
     uint16_t last_int[8];
     uint64_t gt[4];
@@ -183,41 +183,53 @@ static void st64(unsigned char *p, uint64_t v) {
 }
 
 /* ---- POINT14 -------------------------------------------------------------- */
+int hd__p14_models_new(hd__p14_models_t *m) {
+    int rc = HD_OK;
+    for (int i = 0; i < 8 && rc == HD_OK; i++) rc = hd__symmodel_new(&m->changed[i], 128);
+    rc = rc ? rc : hd__symmodel_new(&m->scanner, 3);
+    rc = rc ? rc : hd__symmodel_new(&m->rn_same, 13);
+    rc = rc ? rc : hd__intcoder_new(&m->dx, 32, 2);
+    rc = rc ? rc : hd__intcoder_new(&m->dy, 32, 22);
+    rc = rc ? rc : hd__intcoder_new(&m->dz, 32, 20);
+    for (int i = 0; i < 12; i++) {
+        hd__median5_init(&m->mx[i]);
+        hd__median5_init(&m->my[i]);
+    }
+    return rc;
+}
+void hd__p14_models_free(hd__p14_models_t *m) {
+    hd__symmodel_t *s[] = {&m->scanner, &m->rn_same};
+    hd__symmodels_free(s, 2);
+    for (int i = 0; i < 8; i++) hd__symmodel_free(&m->changed[i]);
+    hd__lazy_models_free(m->nret, 16);
+    hd__lazy_models_free(m->rnum, 16);
+    hd__intcoder_t *ic[] = {&m->dx, &m->dy, &m->dz};
+    hd__intcoders_free(ic, 3);
+}
+
 static void ch_free(ch_t *c) {
-    hd__symmodel_t *m[] = {&c->scanner, &c->rn_same, &c->gmulti, &c->gzero};
-    hd__symmodels_free(m, 4);
-    for (int i = 0; i < 8; i++) hd__symmodel_free(&c->changed[i]);
-    hd__lazy_models_free(c->nret, 16);
-    hd__lazy_models_free(c->rnum, 16);
+    hd__p14_models_free(&c->m);
+    hd__symmodel_t *m[] = {&c->gmulti, &c->gzero};
+    hd__symmodels_free(m, 2);
     hd__lazy_models_free(c->cls, 64);
     hd__lazy_models_free(c->flags, 64);
     hd__lazy_models_free(c->user, 64);
-    hd__intcoder_t *ic[] = {&c->dx, &c->dy, &c->dz, &c->inten, &c->scan, &c->psid, &c->gic};
-    for (int i = 0; i < 7; i++) hd__intcoder_free(ic[i]);
+    hd__intcoder_t *ic[] = {&c->inten, &c->scan, &c->psid, &c->gic};
+    hd__intcoders_free(ic, 4);
 }
 
 /* Channel c's models, started from the record `from` (the chunk's first,
  * or the last of the channel the stream was in). */
 static int ch_start(ch_t *c, const unsigned char *from) {
-    int rc = HD_OK;
-    for (int i = 0; i < 8 && rc == HD_OK; i++) rc = hd__symmodel_new(&c->changed[i], 128);
-    rc = rc ? rc : hd__symmodel_new(&c->scanner, 3);
-    rc = rc ? rc : hd__symmodel_new(&c->rn_same, 13);
+    int rc = hd__p14_models_new(&c->m);
     rc = rc ? rc : hd__symmodel_new(&c->gmulti, 515);
     rc = rc ? rc : hd__symmodel_new(&c->gzero, 5);
-    rc = rc ? rc : hd__intcoder_new(&c->dx, 32, 2);
-    rc = rc ? rc : hd__intcoder_new(&c->dy, 32, 22);
-    rc = rc ? rc : hd__intcoder_new(&c->dz, 32, 20);
     rc = rc ? rc : hd__intcoder_new(&c->inten, 16, 4);
     rc = rc ? rc : hd__intcoder_new(&c->scan, 16, 2);
     rc = rc ? rc : hd__intcoder_new(&c->psid, 16, 1);
     rc = rc ? rc : hd__intcoder_new(&c->gic, 32, 9);
     c->used = 1; /* freed by ch_free even when a step failed */
     if (rc) return rc;
-    for (int i = 0; i < 12; i++) {
-        hd__median5_init(&c->mx[i]);
-        hd__median5_init(&c->my[i]);
-    }
     memcpy(c->last, from, 30);
     c->gps_change = 0;
     for (int i = 0; i < 8; i++) {
@@ -360,9 +372,9 @@ static int p14_changed(c14_t *s, const unsigned char *rec, uint32_t *out) {
              (uint32_t)(n != rn) << 2;
         if (r != rr) cv |= r == ((rr + 1) & 15) ? 1u : r == ((rr + 15) & 15) ? 2u : 3u;
     }
-    *out = cv = csym(s, &s->L[0], &c->changed[lpr], cv);
+    *out = cv = csym(s, &s->L[0], &c->m.changed[lpr], cv);
     if (!(cv & 64)) return HD_OK;
-    unsigned d = csym(s, &s->L[0], &c->scanner, E((chan - s->cur + 3) & 3));
+    unsigned d = csym(s, &s->L[0], &c->m.scanner, E((chan - s->cur + 3) & 3));
     chan = (s->cur + d + 1) & 3;
     if (!s->ch[chan].used && ch_start(&s->ch[chan], last)) return HD_ENOMEM;
     s->cur = chan;
@@ -377,16 +389,16 @@ static int p14_returns(c14_t *s, ch_t *c, const unsigned char *rec, uint32_t cv)
     unsigned ln = last[14] >> 4, lr = last[14] & 15, n = ln, r = lr;
     hd__symmodel_t *m;
     if (cv & 4) {
-        if (!(m = lazy(s, &c->nret[ln], 16))) return HD_ENOMEM;
+        if (!(m = lazy(s, &c->m.nret[ln], 16))) return HD_ENOMEM;
         n = csym(s, &s->L[0], m, E(rec[14] >> 4));
     }
     if ((cv & 3) == 1) r = (lr + 1) & 15;
     if ((cv & 3) == 2) r = (lr + 15) & 15;
     if ((cv & 3) == 3 && (cv & 16)) {
-        if (!(m = lazy(s, &c->rnum[lr], 16))) return HD_ENOMEM;
+        if (!(m = lazy(s, &c->m.rnum[lr], 16))) return HD_ENOMEM;
         r = csym(s, &s->L[0], m, E(rec[14] & 15));
     } else if ((cv & 3) == 3) {
-        r = (lr + csym(s, &s->L[0], &c->rn_same, E(((rec[14] & 15) - lr - 2) & 15)) + 2) & 15;
+        r = (lr + csym(s, &s->L[0], &c->m.rn_same, E(((rec[14] & 15) - lr - 2) & 15)) + 2) & 15;
     }
     last[14] = (unsigned char)(r | n << 4);
     return HD_OK;
@@ -398,15 +410,15 @@ static void p14_xyz(c14_t *s, ch_t *c, const unsigned char *rec, unsigned gps) {
     unsigned n = last[14] >> 4, r = last[14] & 15;
     unsigned mi = (unsigned)hd__laz_rmap14[n][r] << 1 | gps, l = hd__laz_level(n, r);
     uint32_t X = hd__ld_u32(last, 0), Y = hd__ld_u32(last + 4, 0);
-    int32_t dx = cint(s, &s->L[0], &c->dx, c->mx[mi].v[2], E((int32_t)(hd__ld_u32(rec, 0) - X)), n == 1);
-    hd__median5_add(&c->mx[mi], dx);
-    int32_t dy = cint(s, &s->L[0], &c->dy, c->my[mi].v[2], E((int32_t)(hd__ld_u32(rec + 4, 0) - Y)),
-                      (n == 1) + hd__laz_kctx(c->dx.k, 20));
-    hd__median5_add(&c->my[mi], dy);
+    int32_t dx = cint(s, &s->L[0], &c->m.dx, c->m.mx[mi].v[2], E((int32_t)(hd__ld_u32(rec, 0) - X)), n == 1);
+    hd__median5_add(&c->m.mx[mi], dx);
+    int32_t dy = cint(s, &s->L[0], &c->m.dy, c->m.my[mi].v[2], E((int32_t)(hd__ld_u32(rec + 4, 0) - Y)),
+                      (n == 1) + hd__laz_kctx(c->m.dx.k, 20));
+    hd__median5_add(&c->m.my[mi], dy);
     st32(last, X + (uint32_t)dx);
     st32(last + 4, Y + (uint32_t)dy);
     if (s->L[1].on) {
-        int32_t Z = cint(s, &s->L[1], &c->dz, c->last_z[l], E(i32(rec + 8)), (n == 1) + hd__laz_kctx((c->dx.k + c->dy.k) / 2, 18));
+        int32_t Z = cint(s, &s->L[1], &c->m.dz, c->last_z[l], E(i32(rec + 8)), (n == 1) + hd__laz_kctx((c->m.dx.k + c->m.dy.k) / 2, 18));
         c->last_z[l] = Z;
         st32(last + 8, (uint32_t)Z);
     }
@@ -593,7 +605,7 @@ static void wavec_free(wavec_t *c) {
     hd__symmodel_t *m[] = {&c->index, &c->odiff[0], &c->odiff[1], &c->odiff[2], &c->odiff[3]};
     hd__symmodels_free(m, 5);
     hd__intcoder_t *ic[] = {&c->ioff, &c->isize, &c->iret, &c->ixyz};
-    for (int i = 0; i < 4; i++) hd__intcoder_free(ic[i]);
+    hd__intcoders_free(ic, 4);
 }
 
 /* A wave packet descriptor (29 bytes: index, u64 offset, u32 size, f32
@@ -869,23 +881,6 @@ int hd__laz14_decode(const unsigned char *b, size_t nb, size_t n, size_t rec, co
     return rc;
 }
 
-/* Append n bytes to e (its oom flag set on failure). */
-static void put(hd__enc_t *e, const void *p, size_t n) {
-    if (e->size + n > e->cap) {
-        size_t cap = e->cap ? e->cap : 4096;
-        while (cap < e->size + n) cap *= 2;
-        unsigned char *q = realloc(e->buf, cap);
-        if (!q) {
-            e->oom = 1;
-            return;
-        }
-        e->buf = q;
-        e->cap = cap;
-    }
-    memcpy(e->buf + e->size, p, n);
-    e->size += n;
-}
-
 int hd__laz14_encode(const unsigned char *recs, size_t n, size_t rec, const hd__laz14_items_t *it, hd__enc_t *out) {
     c14_t s;
     int rc = c14_start(&s, it, recs, 1);
@@ -901,17 +896,17 @@ int hd__laz14_encode(const unsigned char *recs, size_t n, size_t rec, const hd__
     if (rc == HD_OK) {
         unsigned char u[4];
         st32(u, (uint32_t)n);
-        put(out, u, 4);
+        hd__enc_put(out, u, 4);
         for (unsigned k = 0; k < s.nl; k++) {
             layer_t *L = &s.L[k];
             int keep = k < 2 || L->changed; /* x/y and z always; others only when they change */
             if (keep) hd__enc_done(&L->e);
             if (L->e.oom) rc = HD_ENOMEM;
             st32(u, keep ? (uint32_t)L->e.size : 0);
-            put(out, u, 4);
+            hd__enc_put(out, u, 4);
         }
         for (unsigned k = 0; k < s.nl; k++)
-            if (k < 2 || s.L[k].changed) put(out, s.L[k].e.buf, s.L[k].e.size);
+            if (k < 2 || s.L[k].changed) hd__enc_put(out, s.L[k].e.buf, s.L[k].e.size);
         if (out->oom) rc = HD_ENOMEM;
     }
     c14_free(&s);

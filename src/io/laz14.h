@@ -20,6 +20,21 @@ typedef struct hd__laz14_items {
 enum { HD__LAZ_IT_POINT14 = 10, HD__LAZ_IT_RGB14 = 11, HD__LAZ_IT_RGBNIR14 = 12, HD__LAZ_IT_WAVE14 = 13,
        HD__LAZ_IT_BYTE14 = 14 };
 
+/* The models of POINT14's return numbers and x, y, z in one scanner
+ * channel (with the medians of the last five dx, dy): the ones the
+ * reader's ordinary path (laz.c) decodes, and part of the ones the
+ * layered codec (laz14.c) codes.  nret and rnum are created at their first
+ * use.  hd__p14_models_new: HD_OK or HD_ENOMEM; hd__p14_models_free frees
+ * them after a failure too (m zeroed before the first call). */
+typedef struct hd__p14_models {
+    hd__symmodel_t changed[8], scanner, rn_same;
+    hd__symmodel_t *nret[16], *rnum[16];
+    hd__intcoder_t dx, dy, dz;
+    hd__median5_t mx[12], my[12];
+} hd__p14_models_t;
+int hd__p14_models_new(hd__p14_models_t *m);
+void hd__p14_models_free(hd__p14_models_t *m);
+
 /* The n records (rec bytes each) of the layered chunk b[0..nb) into recs.
  * HD_OK, or HD_EFORMAT / HD_ENOMEM with msg and *at (the byte offset in
  * the chunk the problem is at). */

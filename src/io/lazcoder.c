@@ -150,6 +150,10 @@ void hd__intcoder_free(hd__intcoder_t *ic) {
     for (uint32_t i = 1; i <= 32; i++) hd__symmodel_free(&ic->corr[i]);
 }
 
+void hd__intcoders_free(hd__intcoder_t *const *ic, size_t n) {
+    for (size_t i = 0; i < n; i++) hd__intcoder_free(ic[i]);
+}
+
 void hd__median5_init(hd__median5_t *m) {
     memset(m->v, 0, sizeof m->v);
     m->high = 1;
@@ -238,17 +242,28 @@ void hd__enc_free(hd__enc_t *e) {
     e->buf = NULL;
     e->size = e->cap = 0;
 }
-static void enc_byte(hd__enc_t *e, unsigned char b) {
-    if (e->size == e->cap) {
-        size_t cap = e->cap ? 2 * e->cap : 4096;
-        unsigned char *p = realloc(e->buf, cap);
-        if (!p) {
-            e->oom = 1;
-            return;
-        }
-        e->buf = p;
-        e->cap = cap;
+/* Room for n more bytes in e's buffer (doubled as needed): 0, or -1 with
+ * e's oom flag set. */
+static int enc_room(hd__enc_t *e, size_t n) {
+    if (n <= e->cap - e->size) return 0;
+    size_t cap = e->cap ? e->cap : 4096;
+    while (cap - e->size < n && cap <= SIZE_MAX / 2) cap *= 2;
+    unsigned char *p = cap - e->size >= n ? realloc(e->buf, cap) : NULL;
+    if (!p) {
+        e->oom = 1;
+        return -1;
     }
+    e->buf = p;
+    e->cap = cap;
+    return 0;
+}
+void hd__enc_put(hd__enc_t *e, const void *p, size_t n) {
+    if (n == 0 || enc_room(e, n)) return;
+    memcpy(e->buf + e->size, p, n);
+    e->size += n;
+}
+static void enc_byte(hd__enc_t *e, unsigned char b) {
+    if (e->size == e->cap && enc_room(e, 1)) return;
     e->buf[e->size++] = b;
 }
 static void enc_carry(hd__enc_t *e) {
@@ -348,4 +363,51 @@ void hd__ic_encode(hd__intcoder_t *ic, hd__enc_t *e, int32_t pred, int32_t real,
     } else {
         hd__enc_bit(e, &ic->corr0, (uint32_t)c);
     }
+}
+
+/* ---- the models of pointwise LAZ's items --------------------------------- */
+int hd__pw_point10_new(hd__pw_models_t *m, int v2) {
+    int rc = hd__symmodel_new(&m->changed, 64);
+    if (v2) {
+        rc = rc ? rc : hd__symmodel_new(&m->scan[0], 256);
+        rc = rc ? rc : hd__symmodel_new(&m->scan[1], 256);
+        rc = rc ? rc : hd__intcoder_new(&m->intensity, 16, 4);
+        rc = rc ? rc : hd__intcoder_new(&m->dx, 32, 2);
+        rc = rc ? rc : hd__intcoder_new(&m->dy, 32, 22);
+    } else {
+        rc = rc ? rc : hd__intcoder_new(&m->scan1, 8, 2);
+        rc = rc ? rc : hd__intcoder_new(&m->intensity, 16, 1);
+        rc = rc ? rc : hd__intcoder_new(&m->dx, 32, 1);
+        rc = rc ? rc : hd__intcoder_new(&m->dy, 32, 20);
+    }
+    rc = rc ? rc : hd__intcoder_new(&m->psid, 16, 1);
+    rc = rc ? rc : hd__intcoder_new(&m->dz, 32, 20);
+    for (int i = 0; i < 16; i++) {
+        hd__median5_init(&m->mx[i]);
+        hd__median5_init(&m->my[i]);
+    }
+    return rc;
+}
+
+int hd__pw_gps11_new(hd__pw_models_t *m, int v2) {
+    int rc = hd__symmodel_new(&m->gmulti, v2 ? 516 : 512);
+    rc = rc ? rc : hd__symmodel_new(&m->gzero, v2 ? 6 : 3);
+    return rc ? rc : hd__intcoder_new(&m->gic, 32, v2 ? 9 : 6);
+}
+
+int hd__pw_rgb12_new(hd__pw_models_t *m, int v2) {
+    int rc = hd__symmodel_new(&m->used, v2 ? 128 : 64);
+    for (int k = 0; k < 6 && rc == HD_OK && v2; k++) rc = hd__symmodel_new(&m->cdiff[k], 256);
+    return rc || v2 ? rc : hd__intcoder_new(&m->cic, 8, 6);
+}
+
+void hd__pw_models_free(hd__pw_models_t *m) {
+    hd__symmodel_t *s[] = {&m->changed, &m->scan[0], &m->scan[1], &m->gmulti, &m->gzero, &m->used};
+    hd__symmodels_free(s, sizeof s / sizeof s[0]);
+    for (int i = 0; i < 6; i++) hd__symmodel_free(&m->cdiff[i]);
+    hd__lazy_models_free(m->bitbyte, 256);
+    hd__lazy_models_free(m->cls, 256);
+    hd__lazy_models_free(m->user, 256);
+    hd__intcoder_t *ic[] = {&m->intensity, &m->psid, &m->dx, &m->dy, &m->dz, &m->scan1, &m->gic, &m->cic};
+    hd__intcoders_free(ic, sizeof ic / sizeof ic[0]);
 }

@@ -182,6 +182,8 @@ typedef struct hd__intcoder {
 /* bits: 1 to 32 (LAZ uses 8, 16, 32); HD_OK or HD_ENOMEM. */
 int hd__intcoder_new(hd__intcoder_t *ic, uint32_t bits, uint32_t contexts);
 void hd__intcoder_free(hd__intcoder_t *ic);
+/* Free the n integer coders whose addresses are in ic. */
+void hd__intcoders_free(hd__intcoder_t *const *ic, size_t n);
 
 /* The model m, initialised at its first use. */
 HD__INLINE hd__symmodel_t *hd__ic_model(hd__symmodel_t *m) {
@@ -234,6 +236,9 @@ typedef struct hd__enc {
 void hd__enc_init(hd__enc_t *e);   /* empty, no memory yet */
 void hd__enc_reset(hd__enc_t *e);  /* a new stream, keeping the memory */
 void hd__enc_free(hd__enc_t *e);
+/* Append n raw bytes to e's buffer (nothing, with e's oom flag set, when
+ * it cannot grow). */
+void hd__enc_put(hd__enc_t *e, const void *p, size_t n);
 void hd__enc_bit(hd__enc_t *e, hd__bitmodel_t *m, uint32_t sym);
 void hd__enc_symbol(hd__enc_t *e, hd__symmodel_t *m, uint32_t sym);
 /* `bits` raw bits of sym, 1 <= bits <= 32. */
@@ -262,5 +267,28 @@ HD__INLINE unsigned hd__laz_level(unsigned n, unsigned r) {
 }
 /* The context of dy from dx's k (cap 20), of z from the mean k (cap 18). */
 HD__INLINE unsigned hd__laz_kctx(unsigned k, unsigned cap) { return k < cap ? (k & ~1u) : cap; }
+
+/* ---- the models of pointwise LAZ's items ---------------------------------
+ * POINT10, GPSTIME11 and RGB12 in version 1 or 2, one set for the reader
+ * (laz.c) and the pointwise encoder (write_lazpw.c).  Each hd__pw_*_new
+ * creates one item's models (HD_OK or HD_ENOMEM) in m zeroed first;
+ * hd__pw_models_free frees whatever was created, after a failure too. */
+typedef struct hd__pw_models {
+    /* POINT10 */
+    hd__symmodel_t changed, scan[2];                     /* scan: v2 only */
+    hd__symmodel_t *bitbyte[256], *cls[256], *user[256]; /* created at first use */
+    hd__intcoder_t intensity, psid, dx, dy, dz, scan1;   /* scan1: v1 only */
+    hd__median5_t mx[16], my[16];                        /* v2 */
+    /* GPSTIME11 */
+    hd__symmodel_t gmulti, gzero;
+    hd__intcoder_t gic;
+    /* RGB12 */
+    hd__symmodel_t used, cdiff[6]; /* cdiff: v2 */
+    hd__intcoder_t cic;            /* v1 */
+} hd__pw_models_t;
+int hd__pw_point10_new(hd__pw_models_t *m, int v2);
+int hd__pw_gps11_new(hd__pw_models_t *m, int v2);
+int hd__pw_rgb12_new(hd__pw_models_t *m, int v2);
+void hd__pw_models_free(hd__pw_models_t *m);
 
 #endif

@@ -27,42 +27,41 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-static int vplace(hd__read_t *r, int code, const char *place, const char *fmt,
-                  va_list ap) {
+/* The message "NAME[:LINE | : byte OFFSET]: what" into r's error, its
+ * line and offset set (-1: none; a line wins over an offset). */
+static int vplace(hd__read_t *r, int code, long long line, long long offset, const char *fmt, va_list ap) {
     hd_error_t *err = r->err;
     if (!err) return code;
-    char what[768];
+    char place[40] = "", what[768];
+    if (line >= 0) snprintf(place, sizeof place, ":%lld", line);
+    else if (offset >= 0) snprintf(place, sizeof place, ": byte %lld", offset);
     vsnprintf(what, sizeof what, fmt, ap);
     hd__err(err, code, "%s%s: %s", r->f->name, place, what);
+    err->line = line;
+    err->offset = offset;
     return code;
 }
 
 int hd__io_err_line(hd__read_t *r, int code, long long line, const char *fmt, ...) {
-    char place[32];
-    snprintf(place, sizeof place, ":%lld", line);
     va_list ap;
     va_start(ap, fmt);
-    vplace(r, code, place, fmt, ap);
+    vplace(r, code, line, -1, fmt, ap);
     va_end(ap);
-    if (r->err) r->err->line = line;
     return code;
 }
 
 int hd__io_err_at(hd__read_t *r, int code, long long offset, const char *fmt, ...) {
-    char place[40];
-    snprintf(place, sizeof place, ": byte %lld", offset);
     va_list ap;
     va_start(ap, fmt);
-    vplace(r, code, place, fmt, ap);
+    vplace(r, code, -1, offset, fmt, ap);
     va_end(ap);
-    if (r->err) r->err->offset = offset;
     return code;
 }
 
 int hd__io_err(hd__read_t *r, int code, const char *fmt, ...) {
     va_list ap;
     va_start(ap, fmt);
-    vplace(r, code, "", fmt, ap);
+    vplace(r, code, -1, -1, fmt, ap);
     va_end(ap);
     return code;
 }

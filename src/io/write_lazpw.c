@@ -54,18 +54,13 @@ enum { IT_BYTE = 0, IT_POINT10 = 6, IT_GPSTIME11 = 7, IT_RGB12 = 8 };
 #define HD__LAZ_CHUNK 50000 /* LASzip's default chunk size */
 
 typedef struct {
-    hd__symmodel_t changed, scan[2], *bitbyte[256], *cls[256], *user[256];
-    hd__intcoder_t intensity, psid, dx, dy, dz;
-    hd__median5_t mx[16], my[16];
+    hd__pw_models_t m; /* the items' models, version 2 (lazcoder.h) */
     uint16_t last_int[16];
     int32_t last_h[8];
     unsigned char last[20];
-    hd__symmodel_t gmulti, gzero;
-    hd__intcoder_t gic;
     int64_t t[4];
     int32_t gdiff[4];
     unsigned glast, gnext;
-    hd__symmodel_t used, cdiff[6];
     uint16_t rgb[3];
     unsigned nb;
     hd__symmodel_t *bm;
@@ -74,14 +69,7 @@ typedef struct {
 } pwe_t;
 
 static void pwe_free(pwe_t *p) {
-    hd__symmodel_t *m[] = {&p->changed, &p->scan[0], &p->scan[1], &p->gmulti, &p->gzero, &p->used,
-                           &p->cdiff[0], &p->cdiff[1], &p->cdiff[2], &p->cdiff[3], &p->cdiff[4], &p->cdiff[5]};
-    hd__symmodels_free(m, sizeof m / sizeof m[0]);
-    hd__lazy_models_free(p->bitbyte, 256);
-    hd__lazy_models_free(p->cls, 256);
-    hd__lazy_models_free(p->user, 256);
-    hd__intcoder_t *ic[] = {&p->intensity, &p->psid, &p->dx, &p->dy, &p->dz, &p->gic};
-    for (size_t i = 0; i < sizeof ic / sizeof ic[0]; i++) hd__intcoder_free(ic[i]);
+    hd__pw_models_free(&p->m);
     for (unsigned i = 0; p->bm && i < p->nb; i++) hd__symmodel_free(&p->bm[i]);
     free(p->bm);
     free(p->blast);
@@ -91,20 +79,9 @@ static void pwe_free(pwe_t *p) {
  * output's, sizes sz). */
 static int pwe_start(pwe_t *p, const unsigned char *r, const unsigned *type, const unsigned *sz, unsigned n_items) {
     memset(p, 0, sizeof *p);
-    int rc = hd__symmodel_new(&p->changed, 64);
-    rc = rc ? rc : hd__symmodel_new(&p->scan[0], 256);
-    rc = rc ? rc : hd__symmodel_new(&p->scan[1], 256);
-    rc = rc ? rc : hd__intcoder_new(&p->intensity, 16, 4);
-    rc = rc ? rc : hd__intcoder_new(&p->psid, 16, 1);
-    rc = rc ? rc : hd__intcoder_new(&p->dx, 32, 2);
-    rc = rc ? rc : hd__intcoder_new(&p->dy, 32, 22);
-    rc = rc ? rc : hd__intcoder_new(&p->dz, 32, 20);
-    rc = rc ? rc : hd__symmodel_new(&p->gmulti, 516);
-    rc = rc ? rc : hd__symmodel_new(&p->gzero, 6);
-    rc = rc ? rc : hd__intcoder_new(&p->gic, 32, 9);
-    rc = rc ? rc : hd__symmodel_new(&p->used, 128);
-    for (int i = 0; i < 6 && rc == HD_OK; i++) rc = hd__symmodel_new(&p->cdiff[i], 256);
-    for (int i = 0; i < 16; i++) hd__median5_init(&p->mx[i]), hd__median5_init(&p->my[i]);
+    int rc = hd__pw_point10_new(&p->m, 1);
+    rc = rc ? rc : hd__pw_gps11_new(&p->m, 1);
+    rc = rc ? rc : hd__pw_rgb12_new(&p->m, 1);
     memcpy(p->last, r, 20);
     size_t off = 20;
     for (unsigned i = 1; i < n_items && rc == HD_OK; i++) {
@@ -150,29 +127,29 @@ static void point10(pwe_t *p, hd__enc_t *e, const unsigned char *r) {
     uint16_t inten = hd__ld_u16(r + 12, 0);
     unsigned changed = (r[14] != L[14]) << 5 | (inten != p->last_int[m]) << 4 | (r[15] != L[15]) << 3 |
                        (r[16] != L[16]) << 2 | (r[17] != L[17]) << 1 | (hd__ld_u16(r + 18, 0) != hd__ld_u16(L + 18, 0));
-    hd__enc_symbol(e, &p->changed, changed);
-    if (changed & 32) byte_by_last(p, e, p->bitbyte, &L[14], r[14]);
+    hd__enc_symbol(e, &p->m.changed, changed);
+    if (changed & 32) byte_by_last(p, e, p->m.bitbyte, &L[14], r[14]);
     if (changed & 16) {
-        hd__ic_encode(&p->intensity, e, p->last_int[m], inten, m < 3 ? m : 3);
+        hd__ic_encode(&p->m.intensity, e, p->last_int[m], inten, m < 3 ? m : 3);
         p->last_int[m] = inten;
     }
-    if (changed & 8) byte_by_last(p, e, p->cls, &L[15], r[15]);
+    if (changed & 8) byte_by_last(p, e, p->m.cls, &L[15], r[15]);
     if (changed & 4) {
-        hd__enc_symbol(e, &p->scan[(r[14] >> 6) & 1], (unsigned)(r[16] - L[16]) & 255);
+        hd__enc_symbol(e, &p->m.scan[(r[14] >> 6) & 1], (unsigned)(r[16] - L[16]) & 255);
         L[16] = r[16];
     }
-    if (changed & 2) byte_by_last(p, e, p->user, &L[17], r[17]);
+    if (changed & 2) byte_by_last(p, e, p->m.user, &L[17], r[17]);
     if (changed & 1) {
-        hd__ic_encode(&p->psid, e, hd__ld_u16(L + 18, 0), hd__ld_u16(r + 18, 0), 0);
+        hd__ic_encode(&p->m.psid, e, hd__ld_u16(L + 18, 0), hd__ld_u16(r + 18, 0), 0);
         L[18] = r[18], L[19] = r[19];
     }
     int32_t X = (int32_t)hd__ld_u32(r, 0), Y = (int32_t)hd__ld_u32(r + 4, 0), Z = (int32_t)hd__ld_u32(r + 8, 0);
     int32_t dx = (int32_t)((uint32_t)X - hd__ld_u32(L, 0)), dy = (int32_t)((uint32_t)Y - hd__ld_u32(L + 4, 0));
-    hd__ic_encode(&p->dx, e, p->mx[m].v[2], dx, n == 1);
-    hd__median5_add(&p->mx[m], dx);
-    hd__ic_encode(&p->dy, e, p->my[m].v[2], dy, (n == 1) + hd__laz_kctx(p->dx.k, 20));
-    hd__median5_add(&p->my[m], dy);
-    hd__ic_encode(&p->dz, e, p->last_h[l], Z, (n == 1) + hd__laz_kctx((p->dx.k + p->dy.k) / 2, 18));
+    hd__ic_encode(&p->m.dx, e, p->m.mx[m].v[2], dx, n == 1);
+    hd__median5_add(&p->m.mx[m], dx);
+    hd__ic_encode(&p->m.dy, e, p->m.my[m].v[2], dy, (n == 1) + hd__laz_kctx(p->m.dx.k, 20));
+    hd__median5_add(&p->m.my[m], dy);
+    hd__ic_encode(&p->m.dz, e, p->last_h[l], Z, (n == 1) + hd__laz_kctx((p->m.dx.k + p->m.dy.k) / 2, 18));
     p->last_h[l] = Z;
     memcpy(L, r, 12);
 }
@@ -183,26 +160,26 @@ static void gpstime(pwe_t *p, hd__enc_t *e, int64_t T) {
     int64_t diff = (int64_t)((uint64_t)T - (uint64_t)p->t[L]);
     int fits = diff >= INT32_MIN && diff <= INT32_MAX;
     if (p->gdiff[L] == 0) {
-        hd__enc_symbol(e, &p->gzero, T == p->t[L] ? 0 : fits ? 1 : 2);
+        hd__enc_symbol(e, &p->m.gzero, T == p->t[L] ? 0 : fits ? 1 : 2);
         if (T == p->t[L]) return;
         if (fits) {
-            hd__ic_encode(&p->gic, e, 0, (int32_t)diff, 0);
+            hd__ic_encode(&p->m.gic, e, 0, (int32_t)diff, 0);
             p->gdiff[L] = (int32_t)diff;
             p->t[L] = T;
             return;
         }
     } else {
-        hd__enc_symbol(e, &p->gmulti, T == p->t[L] ? 511 : fits ? 1 : 512);
+        hd__enc_symbol(e, &p->m.gmulti, T == p->t[L] ? 511 : fits ? 1 : 512);
         if (T == p->t[L]) return;
         if (fits) {
-            hd__ic_encode(&p->gic, e, p->gdiff[L], (int32_t)diff, 1);
+            hd__ic_encode(&p->m.gic, e, p->gdiff[L], (int32_t)diff, 1);
             p->t[L] = T;
             return;
         }
     }
     /* the whole value, as a new sequence */
     p->gnext = (p->gnext + 1) & 3;
-    hd__ic_encode(&p->gic, e, (int32_t)((uint64_t)p->t[L] >> 32), (int32_t)((uint64_t)T >> 32), 8);
+    hd__ic_encode(&p->m.gic, e, (int32_t)((uint64_t)p->t[L] >> 32), (int32_t)((uint64_t)T >> 32), 8);
     hd__enc_raw(e, 16, (uint32_t)T & 0xFFFF);
     hd__enc_raw(e, 16, ((uint32_t)T >> 16) & 0xFFFF);
     p->t[p->gnext] = T;
@@ -219,20 +196,20 @@ static void rgb12(pwe_t *p, hd__enc_t *e, const unsigned char *r) {
                    ((last[1] & 255) != (it[1] & 255)) << 2 | ((last[1] >> 8) != (it[1] >> 8)) << 3 |
                    ((last[2] & 255) != (it[2] & 255)) << 4 | ((last[2] >> 8) != (it[2] >> 8)) << 5 |
                    (it[0] != it[1] || it[0] != it[2]) << 6;
-    hd__enc_symbol(e, &p->used, sym);
+    hd__enc_symbol(e, &p->m.used, sym);
     int dl = (int)(it[0] & 255) - (int)(last[0] & 255), dh = (int)(it[0] >> 8) - (int)(last[0] >> 8);
-    if (sym & 1) hd__enc_symbol(e, &p->cdiff[0], (unsigned)dl & 255);
-    if (sym & 2) hd__enc_symbol(e, &p->cdiff[1], (unsigned)dh & 255);
+    if (sym & 1) hd__enc_symbol(e, &p->m.cdiff[0], (unsigned)dl & 255);
+    if (sym & 2) hd__enc_symbol(e, &p->m.cdiff[1], (unsigned)dh & 255);
     if (sym & 64) {
-        if (sym & 4) hd__enc_symbol(e, &p->cdiff[2], (unsigned)((int)(it[1] & 255) - (int)clamp8(dl + (last[1] & 255))) & 255);
+        if (sym & 4) hd__enc_symbol(e, &p->m.cdiff[2], (unsigned)((int)(it[1] & 255) - (int)clamp8(dl + (last[1] & 255))) & 255);
         if (sym & 16) {
             int d = (dl + ((int)(it[1] & 255) - (int)(last[1] & 255))) / 2;
-            hd__enc_symbol(e, &p->cdiff[4], (unsigned)((int)(it[2] & 255) - (int)clamp8(d + (last[2] & 255))) & 255);
+            hd__enc_symbol(e, &p->m.cdiff[4], (unsigned)((int)(it[2] & 255) - (int)clamp8(d + (last[2] & 255))) & 255);
         }
-        if (sym & 8) hd__enc_symbol(e, &p->cdiff[3], (unsigned)((int)(it[1] >> 8) - (int)clamp8(dh + (last[1] >> 8))) & 255);
+        if (sym & 8) hd__enc_symbol(e, &p->m.cdiff[3], (unsigned)((int)(it[1] >> 8) - (int)clamp8(dh + (last[1] >> 8))) & 255);
         if (sym & 32) {
             int d = (dh + ((int)(it[1] >> 8) - (int)(last[1] >> 8))) / 2;
-            hd__enc_symbol(e, &p->cdiff[5], (unsigned)((int)(it[2] >> 8) - (int)clamp8(d + (last[2] >> 8))) & 255);
+            hd__enc_symbol(e, &p->m.cdiff[5], (unsigned)((int)(it[2] >> 8) - (int)clamp8(d + (last[2] >> 8))) & 255);
         }
     }
     memcpy(last, it, sizeof it);
@@ -369,18 +346,22 @@ static int encode_records(const pw_t *z, const unsigned char *recs, size_t n, hd
     return hd__laz14_encode(recs, n, z->pl->out_rec, &it, e);
 }
 
-/* A subset, a batch of input chunks at a time: the chunks decoded to
- * records and filtered in parallel (a task each, with its own buffers and
- * error), the kept records gathered in file order into output chunks of
- * `cap` points (per input chunk when per = 0), and a batch of full output
- * chunks encoded in parallel and written in order.  The file is the one a
- * sequential pass would write. */
+/* The chunks are decoded a batch of P at a time, in parallel: task t
+ * decodes input chunk base + t to records and keeps the kept ones with
+ * their values (kept[t], n_kept[t] of them), each task with its own
+ * buffers and error; with `encode` (every point kept, the input's chunks
+ * kept) the task also compresses them (enc[t]).  Without it the kept
+ * records are gathered in file order into output chunks of `cap` points
+ * (out, n_out: per input chunk when per = 0), and a batch of full output
+ * chunks is encoded in parallel (enc) and written in order.  Either way
+ * the file is the one a sequential pass would write. */
 typedef struct {
     pw_t *z;
     const hd__las_header_t *h;
     const hd__laz_chunks_t *c;
     hd__read_t *r;
-    size_t base, most, cap;
+    size_t P, base, most, cap;
+    int threads, encode;
     unsigned char **in, **kept; /* per task: its chunk's records, the kept ones with their values */
     size_t *n_kept;
     unsigned char **out; /* per output chunk of the batch: its records */
@@ -389,6 +370,34 @@ typedef struct {
     int *rc;
     hd_error_t *err;
 } sub_t;
+
+/* S's buffers for a batch of 2 per thread; HD_OK or HD_ENOMEM (with
+ * w->err).  sub_free frees them, after a failure too. */
+static int sub_new(sub_t *S, pw_t *z, const hd__las_header_t *h, const hd__laz_chunks_t *c, hd__read_t *r) {
+    memset(S, 0, sizeof *S);
+    S->z = z, S->h = h, S->c = c, S->r = r;
+    for (size_t k = 0; k < c->n_chunks; k++)
+        if (c->first[k + 1] - c->first[k] > S->most) S->most = (size_t)(c->first[k + 1] - c->first[k]);
+    S->threads = hd__thread_count(z->w->ropt->threads, c->n_chunks);
+    size_t P = S->P = 2 * (size_t)S->threads;
+    S->in = calloc(P, sizeof(void *)), S->kept = calloc(P, sizeof(void *)), S->n_kept = calloc(P, sizeof(size_t));
+    S->out = calloc(P, sizeof(void *)), S->n_out = calloc(P, sizeof(size_t)), S->enc = calloc(P, sizeof(hd__enc_t));
+    S->rc = calloc(P, sizeof(int)), S->err = calloc(P, sizeof(hd_error_t));
+    if (!S->in || !S->kept || !S->n_kept || !S->out || !S->n_out || !S->enc || !S->rc || !S->err)
+        return hd__err(z->w->err, HD_ENOMEM, "out of memory");
+    for (size_t t = 0; t < P; t++) hd__enc_init(&S->enc[t]);
+    return HD_OK;
+}
+
+static void sub_free(sub_t *S) {
+    for (size_t t = 0; t < S->P; t++) {
+        if (S->in) free(S->in[t]);
+        if (S->kept) free(S->kept[t]);
+        if (S->out) free(S->out[t]);
+        if (S->enc) hd__enc_free(&S->enc[t]);
+    }
+    free(S->in), free(S->kept), free(S->n_kept), free(S->out), free(S->n_out), free(S->enc), free(S->rc), free(S->err);
+}
 
 static void decode_task(void *ctx, size_t t, int worker) {
     (void)worker;
@@ -413,7 +422,23 @@ static void decode_task(void *ctx, size_t t, int worker) {
         hd__w_values(w, f + i, 0, o + rec);
     }
     S->n_kept[t] = m;
+    if (rc == HD_OK && S->encode && encode_records(S->z, S->kept[t], m, &S->enc[t]))
+        rc = hd__err(&S->err[t], HD_ENOMEM, "out of memory");
     S->rc[t] = rc;
+}
+
+/* Decode the batch of input chunks from S->base (*m of them); HD_OK, or
+ * the error of the first chunk that failed (its byte offset included). */
+static int decode_batch(sub_t *S, size_t *m) {
+    size_t left = S->c->n_chunks - S->base;
+    *m = left < S->P ? left : S->P;
+    hd__parallel_for(S->threads, *m, decode_task, S);
+    for (size_t t = 0; t < *m; t++)
+        if (S->rc[t]) {
+            if (S->z->w->err) *S->z->w->err = S->err[t];
+            return S->rc[t];
+        }
+    return HD_OK;
 }
 
 static void encode_task(void *ctx, size_t t, int worker) {
@@ -423,9 +448,9 @@ static void encode_task(void *ctx, size_t t, int worker) {
 }
 
 /* Encode the batch's first m output chunks and write them in order. */
-static int flush_outs(sub_t *S, size_t m, int threads) {
+static int flush_outs(sub_t *S, size_t m) {
     hd__writer_t *w = S->z->w;
-    hd__parallel_for(threads, m, encode_task, S);
+    hd__parallel_for(S->threads, m, encode_task, S);
     for (size_t t = 0; t < m; t++) {
         if (S->rc[t] == HD_EINVAL)
             return hd__err(w->err, HD_EINVAL, "%s: internal: a record would not decode back to itself", w->in->name);
@@ -438,7 +463,7 @@ static int flush_outs(sub_t *S, size_t m, int threads) {
 
 /* Record o (kept, with its values) into the output chunk being gathered,
  * *full; a batch of P full ones is encoded and written.  HD_OK or the error. */
-static int gather(sub_t *S, const unsigned char *o, size_t *full, size_t P, int threads) {
+static int gather(sub_t *S, const unsigned char *o, size_t *full) {
     pw_t *z = S->z;
     size_t orec = z->pl->out_rec;
     z->by_return[hd__las_return(o, z->pl->fmt)]++;
@@ -447,121 +472,50 @@ static int gather(sub_t *S, const unsigned char *o, size_t *full, size_t P, int 
         return hd__err(z->w->err, HD_ENOMEM, "out of memory for chunks of %zu points", S->cap);
     memcpy(S->out[*full] + S->n_out[*full]++ * orec, o, orec);
     if (S->n_out[*full] < S->cap) return HD_OK;
-    if (++*full < P) return HD_OK;
+    if (++*full < S->P) return HD_OK;
     *full = 0;
-    return flush_outs(S, P, threads);
+    return flush_outs(S, S->P);
 }
 
+/* A subset (or every point into chunks of `per` points): the kept records
+ * gathered into new chunks. */
 static int write_chunks(pw_t *z, const hd__las_header_t *h, const hd__laz_chunks_t *c, hd__read_t *r, size_t per) {
     hd__writer_t *w = z->w;
-    size_t most = 0, orec = z->pl->out_rec;
-    for (size_t k = 0; k < c->n_chunks; k++)
-        if (c->first[k + 1] - c->first[k] > most) most = (size_t)(c->first[k + 1] - c->first[k]);
-    int threads = hd__thread_count(w->ropt->threads, c->n_chunks);
-    size_t P = 2 * (size_t)threads, full = 0;
-    sub_t S = {z, h, c, r, 0, most, per ? per : most, calloc(P, sizeof(void *)), calloc(P, sizeof(void *)),
-               calloc(P, sizeof(size_t)), calloc(P, sizeof(void *)), calloc(P, sizeof(size_t)), calloc(P, sizeof(hd__enc_t)),
-               calloc(P, sizeof(int)), calloc(P, sizeof(hd_error_t))};
-    int rc = S.in && S.kept && S.n_kept && S.out && S.n_out && S.enc && S.rc && S.err ? HD_OK
-                                                                                     : hd__err(w->err, HD_ENOMEM, "out of memory");
-    for (size_t t = 0; rc == HD_OK && t < P; t++) hd__enc_init(&S.enc[t]);
-    for (S.base = 0; rc == HD_OK && S.base < c->n_chunks && !w->werr; S.base += P) {
-        size_t m = c->n_chunks - S.base < P ? c->n_chunks - S.base : P;
-        hd__parallel_for(threads, m, decode_task, &S);
+    sub_t S;
+    int rc = sub_new(&S, z, h, c, r);
+    size_t full = 0, orec = z->pl->out_rec, m = 0;
+    S.cap = per ? per : S.most;
+    for (S.base = 0; rc == HD_OK && S.base < c->n_chunks && !w->werr; S.base += S.P) {
+        rc = decode_batch(&S, &m);
         for (size_t t = 0; t < m && rc == HD_OK; t++) {
-            if (S.rc[t]) { /* the chunk's error, its byte offset included */
-                rc = S.rc[t];
-                if (w->err) *w->err = S.err[t];
-                break;
-            }
             if (z->kept_in) z->kept_in[S.base + t] = S.n_kept[t];
-            for (size_t j = 0; j < S.n_kept[t] && rc == HD_OK; j++) rc = gather(&S, S.kept[t] + j * orec, &full, P, threads);
-            if (rc == HD_OK && !per && S.n_out[full] && ++full == P) { /* the input's chunks: one ends here */
+            for (size_t j = 0; j < S.n_kept[t] && rc == HD_OK; j++) rc = gather(&S, S.kept[t] + j * orec, &full);
+            if (rc == HD_OK && !per && S.n_out[full] && ++full == S.P) { /* the input's chunks: one ends here */
                 full = 0;
-                rc = flush_outs(&S, P, threads);
+                rc = flush_outs(&S, S.P);
             }
         }
     }
-    if (rc == HD_OK && !w->werr) rc = flush_outs(&S, full + (S.n_out[full] > 0), threads);
-    for (size_t t = 0; t < P; t++) {
-        if (S.in) free(S.in[t]);
-        if (S.kept) free(S.kept[t]);
-        if (S.out) free(S.out[t]);
-        if (S.enc) hd__enc_free(&S.enc[t]);
-    }
-    free(S.in), free(S.kept), free(S.n_kept), free(S.out), free(S.n_out), free(S.enc), free(S.rc), free(S.err);
+    if (rc == HD_OK && !w->werr) rc = flush_outs(&S, full + (S.n_out[full] > 0));
+    sub_free(&S);
     return rc;
 }
 
-/* Every point kept, the input's chunks kept: the chunks are decoded and
- * encoded in parallel, a batch of a few per thread at a time (each task
- * with its own buffers, encoder and error), and written in order. */
-typedef struct {
-    pw_t *z;
-    const hd__las_header_t *h;
-    const hd__laz_chunks_t *c;
-    hd__read_t *r;
-    size_t base, most;
-    unsigned char **in, **out;
-    hd__enc_t *enc;
-    int *rc;
-    hd_error_t *err;
-} batch_t;
-
-static void batch_task(void *ctx, size_t t, int worker) {
-    (void)worker;
-    batch_t *B = ctx;
-    pw_t *z = B->z;
-    size_t k = B->base + t, n = (size_t)(B->c->first[k + 1] - B->c->first[k]), f = (size_t)B->c->first[k];
-    size_t rec = z->pl->rec, orec = z->pl->out_rec;
-    hd__read_t r = *B->r;
-    r.err = &B->err[t];
-    if (!B->in[t]) B->in[t] = hd__malloc_array(B->most + 1, rec);
-    if (!B->out[t]) B->out[t] = hd__malloc_array(B->most + 1, orec);
-    if (!B->in[t] || !B->out[t]) {
-        B->rc[t] = hd__err(&B->err[t], HD_ENOMEM, "out of memory for chunks of %zu points", B->most);
-        return;
-    }
-    int rc = hd__laz_chunk_records(&r, B->h, B->c, k, B->in[t]);
-    for (size_t i = 0; i < n && rc == HD_OK; i++) {
-        memcpy(B->out[t] + i * orec, B->in[t] + i * rec, rec);
-        hd__w_values(z->w, f + i, 0, B->out[t] + i * orec + rec);
-    }
-    if (rc == HD_OK && hd__laz_encode_pointwise(B->out[t], n, orec, z->type, z->size, z->n_items, &B->enc[t]))
-        rc = hd__err(&B->err[t], HD_ENOMEM, "out of memory");
-    B->rc[t] = rc;
-}
-
+/* Every point kept, the input's chunks kept: each task encodes its chunk
+ * too, and the batch's chunks are written in order. */
 static int write_all_parallel(pw_t *z, const hd__las_header_t *h, const hd__laz_chunks_t *c, hd__read_t *r) {
     hd__writer_t *w = z->w;
-    int threads = hd__thread_count(w->ropt->threads, c->n_chunks);
-    size_t per = 2 * (size_t)threads, most = 0;
-    for (size_t k = 0; k < c->n_chunks; k++)
-        if (c->first[k + 1] - c->first[k] > most) most = (size_t)(c->first[k + 1] - c->first[k]);
-    batch_t B = {z, h, c, r, 0, most, calloc(per, sizeof(void *)), calloc(per, sizeof(void *)),
-                 calloc(per, sizeof(hd__enc_t)), calloc(per, sizeof(int)), calloc(per, sizeof(hd_error_t))};
-    int rc = B.in && B.out && B.enc && B.rc && B.err ? HD_OK : hd__err(w->err, HD_ENOMEM, "out of memory");
-    for (size_t t = 0; rc == HD_OK && t < per; t++) hd__enc_init(&B.enc[t]);
-    for (B.base = 0; rc == HD_OK && B.base < c->n_chunks && !w->werr; B.base += per) {
-        size_t m = c->n_chunks - B.base < per ? c->n_chunks - B.base : per;
-        hd__parallel_for(threads, m, batch_task, &B);
-        for (size_t t = 0; t < m && rc == HD_OK; t++) {
-            if (B.rc[t]) {
-                rc = hd__err(w->err, B.rc[t], "%s", B.err[t].message);
-                break;
-            }
-            size_t k = B.base + t;
-            if (put_chunk(z, (size_t)(c->first[k + 1] - c->first[k]), B.out[t], &B.enc[t]))
-                rc = hd__err(w->err, HD_ENOMEM, "out of memory");
-        }
+    sub_t S;
+    int rc = sub_new(&S, z, h, c, r);
+    size_t m = 0;
+    S.encode = 1;
+    for (S.base = 0; rc == HD_OK && S.base < c->n_chunks && !w->werr; S.base += S.P) {
+        rc = decode_batch(&S, &m);
+        for (size_t t = 0; t < m && rc == HD_OK; t++)
+            if (put_chunk(z, S.n_kept[t], S.kept[t], &S.enc[t])) rc = hd__err(w->err, HD_ENOMEM, "out of memory");
     }
     z->kept = w->n;
-    for (size_t t = 0; t < per; t++) {
-        if (B.in) free(B.in[t]);
-        if (B.out) free(B.out[t]);
-        if (B.enc) hd__enc_free(&B.enc[t]);
-    }
-    free(B.in), free(B.out), free(B.enc), free(B.rc), free(B.err);
+    sub_free(&S);
     return rc;
 }
 

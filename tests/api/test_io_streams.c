@@ -81,17 +81,26 @@ static void *write_fifo(void *arg) {
     return NULL;
 }
 
+/* hd_read_file of the FIFO w->path while a thread writes it (write_fifo). */
+static int read_fifo(const writer_t *w, const hd_read_options_t *o, hd_cloud_t **c, hd_error_t *e) {
+    pthread_t t;
+    if (pthread_create(&t, NULL, write_fifo, (void *)w) != 0) {
+        hdt_fail(__FILE__, __LINE__, "pthread_create failed");
+        return HD_EIO;
+    }
+    int rc = hd_read_file(w->path, o, c, e);
+    pthread_join(t, NULL);
+    return rc;
+}
+
 TEST(a_fifo_is_read_whole_when_its_writer_comes_late) {
     hd_read_options_t o;
     hd_read_options_init(&o);
     o.fifo_wait_ms = 20000;
     writer_t w = {fifo_path("late.xyz"), 300, 50000};
-    pthread_t t;
-    CHECK(pthread_create(&t, NULL, write_fifo, &w) == 0);
     hd_cloud_t *c = NULL;
     hd_error_t e;
-    int rc = hd_read_file(w.path, &o, &c, &e);
-    pthread_join(t, NULL);
+    int rc = read_fifo(&w, &o, &c, &e);
     if (rc) hdt_fail(__FILE__, __LINE__, "refused: %s", e.message);
     CHECK_EQ(c->count, 50000);
     CHECK_BITS(((const double *)c->data)[3 * 49999], 49999.0);
@@ -104,14 +113,11 @@ TEST(a_fifo_longer_than_the_stream_limit_is_refused) {
     hd_read_options_init(&o);
     o.stream_limit = 1000;
     writer_t w = {fifo_path("long.xyz"), 0, 1000};
-    pthread_t t;
-    CHECK(pthread_create(&t, NULL, write_fifo, &w) == 0);
     hd_cloud_t *c = NULL;
     hd_error_t e;
     /* the reader stops early: the writer's next write fails with EPIPE */
     signal(SIGPIPE, SIG_IGN);
-    CHECK_RC(hd_read_file(w.path, &o, &c, &e), HD_EFORMAT);
-    pthread_join(t, NULL);
+    CHECK_RC(read_fifo(&w, &o, &c, &e), HD_EFORMAT);
     CHECK(strstr(e.message, "more than 1000 bytes from a stream") != NULL);
     unlink(w.path);
 }

@@ -172,7 +172,7 @@ static void chunk10v1(tf_buf_t *b, const lazw_opts_t *o, const lazw_point_t *p, 
     for (int i = 0; i < 256; i++)
         if (made[i]) hd__symmodel_free(&bitbyte[i]);
     hd__intcoder_t *ics[] = {&dx, &dy, &dz, &bic};
-    for (int i = 0; i < 4; i++) hd__intcoder_free(ics[i]);
+    hd__intcoders_free(ics, 4);
 }
 
 /* ---- POINT14 v3 layered chunks -------------------------------------------- */
@@ -445,31 +445,34 @@ unsigned char *lazw_rich_records(gen_rng_t *g, int fmt, unsigned extra, size_t n
     return r;
 }
 
-/* A pointwise LAZ file (LAS 1.2, chunks of `chunk` points) of the records,
- * compressed by the library's pointwise encoder. */
-void lazw_pointwise(tf_buf_t *b, int fmt, unsigned extra, const unsigned char *recs, size_t rec, size_t n,
-                           size_t chunk) {
-    unsigned type[4], size[4], ni = 0;
-    type[ni] = 6, size[ni++] = 20;
-    if (fmt == 1 || fmt == 3) type[ni] = 7, size[ni++] = 8;
-    if (fmt >= 2) type[ni] = 8, size[ni++] = 6;
-    if (extra) type[ni] = 0, size[ni++] = extra;
-    size_t vlr = 34 + 6 * ni, offset = 227 + 54 + vlr;
+/* A LAZ file of the n records (rec bytes each, point format fmt) in chunks
+ * of `chunk` points: LAS 1.2 with the LASzip VLR of compressor 2, each
+ * chunk compressed by the library's pointwise encoder, or (layered) LAS 1.4
+ * with compressor 3 and the layered encoder; the items `it`; the chunk
+ * table last. */
+static void laz_file(tf_buf_t *b, int fmt, const hd__laz14_items_t *it, const unsigned char *recs, size_t rec,
+                     size_t n, size_t chunk, int layered) {
+    size_t header = layered ? 375 : 227, vlr = 34 + 6 * it->n, offset = header + 54 + vlr;
     tf_put(b, "LASF", 4);
     while (b->size < 24) tf_u8(b, 0);
-    tf_u8(b, 1), tf_u8(b, 2);
+    tf_u8(b, 1), tf_u8(b, layered ? 4 : 2);
     while (b->size < 94) tf_u8(b, 0);
-    tf_u16(b, 227, 0), tf_u32(b, (uint32_t)offset, 0), tf_u32(b, 1, 0);
-    tf_u8(b, (unsigned)fmt | 0x80), tf_u16(b, (unsigned)rec, 0), tf_u32(b, (uint32_t)n, 0);
+    tf_u16(b, (unsigned)header, 0), tf_u32(b, (uint32_t)offset, 0), tf_u32(b, 1, 0);
+    tf_u8(b, (unsigned)fmt | 0x80), tf_u16(b, (unsigned)rec, 0), tf_u32(b, layered ? 0 : (uint32_t)n, 0);
     while (b->size < 131) tf_u8(b, 0);
     for (int c = 0; c < 3; c++) tf_f64(b, 0.01, 0);
     for (int c = 0; c < 3; c++) tf_f64(b, 0, 0);
-    while (b->size < 227) tf_u8(b, 0);
+    if (layered) {
+        while (b->size < 247) tf_u8(b, 0);
+        tf_u64(b, n, 0);
+    }
+    while (b->size < header) tf_u8(b, 0);
     char user[16] = "laszip encoded", desc[32] = "";
     tf_u16(b, 0, 0), tf_put(b, user, 16), tf_u16(b, 22204, 0), tf_u16(b, (unsigned)vlr, 0), tf_put(b, desc, 32);
-    tf_u16(b, 2, 0), tf_u16(b, 0, 0), tf_u8(b, 2), tf_u8(b, 2), tf_u16(b, 0, 0), tf_u32(b, 0, 0);
-    tf_u32(b, (uint32_t)chunk, 0), tf_u64(b, (uint64_t)-1, 0), tf_u64(b, (uint64_t)-1, 0), tf_u16(b, ni, 0);
-    for (unsigned i = 0; i < ni; i++) tf_u16(b, type[i], 0), tf_u16(b, size[i], 0), tf_u16(b, 2, 0);
+    unsigned compressor = layered ? 3 : 2;
+    tf_u16(b, compressor, 0), tf_u16(b, 0, 0), tf_u8(b, compressor), tf_u8(b, layered ? 4 : 2), tf_u16(b, 0, 0), tf_u32(b, 0, 0);
+    tf_u32(b, (uint32_t)chunk, 0), tf_u64(b, (uint64_t)-1, 0), tf_u64(b, (uint64_t)-1, 0), tf_u16(b, it->n, 0);
+    for (unsigned i = 0; i < it->n; i++) tf_u16(b, it->type[i], 0), tf_u16(b, it->size[i], 0), tf_u16(b, it->version[i], 0);
     size_t ptr = b->size, nc = (n + chunk - 1) / chunk;
     tf_u64(b, 0, 0);
     uint64_t *bytes = calloc(nc + 1, sizeof *bytes);
@@ -477,8 +480,11 @@ void lazw_pointwise(tf_buf_t *b, int fmt, unsigned extra, const unsigned char *r
     hd__enc_init(&e);
     for (size_t c = 0; c < nc; c++) {
         size_t k = n - c * chunk < chunk ? n - c * chunk : chunk;
-        if (hd__laz_encode_pointwise(recs + c * chunk * rec, k, rec, type, size, ni, &e)) abort();
-        tf_put(b, recs + c * chunk * rec, rec);
+        const unsigned char *first = recs + c * chunk * rec;
+        if (layered ? hd__laz14_encode(first, k, rec, it, &e)
+                    : hd__laz_encode_pointwise(first, k, rec, it->type, it->size, it->n, &e))
+            abort();
+        tf_put(b, first, rec);
         tf_put(b, e.buf, e.size);
         bytes[c] = rec + e.size;
     }
@@ -489,6 +495,23 @@ void lazw_pointwise(tf_buf_t *b, int fmt, unsigned extra, const unsigned char *r
     tf_put(b, e.buf, e.size);
     hd__enc_free(&e);
     free(bytes);
+}
+
+/* One more item of the file's list. */
+static void add_item(hd__laz14_items_t *it, unsigned type, unsigned size, unsigned version) {
+    it->type[it->n] = type, it->size[it->n] = size, it->version[it->n++] = version;
+}
+
+/* A pointwise LAZ file (LAS 1.2, chunks of `chunk` points) of the records,
+ * compressed by the library's pointwise encoder. */
+void lazw_pointwise(tf_buf_t *b, int fmt, unsigned extra, const unsigned char *recs, size_t rec, size_t n,
+                           size_t chunk) {
+    hd__laz14_items_t it = {0, {0}, {0}, {0}};
+    add_item(&it, 6, 20, 2);
+    if (fmt == 1 || fmt == 3) add_item(&it, 7, 8, 2);
+    if (fmt >= 2) add_item(&it, 8, 6, 2);
+    if (extra) add_item(&it, 0, extra, 2);
+    laz_file(b, fmt, &it, recs, rec, n, chunk, 0);
 }
 
 
@@ -569,48 +592,12 @@ unsigned char *lazw_rich_records14(gen_rng_t *g, int fmt, unsigned extra, size_t
 void lazw_layered(tf_buf_t *b, int fmt, unsigned extra, const unsigned char *recs, size_t rec, size_t n, size_t chunk,
                   unsigned version) {
     hd__laz14_items_t it = {0, {0}, {0}, {0}};
-    it.type[it.n] = 10, it.size[it.n] = 30, it.version[it.n++] = version;
-    if (fmt == 7) it.type[it.n] = 11, it.size[it.n] = 6, it.version[it.n++] = version;
-    if (fmt == 8 || fmt == 10) it.type[it.n] = 12, it.size[it.n] = 8, it.version[it.n++] = version;
-    if (fmt >= 9) it.type[it.n] = 13, it.size[it.n] = 29, it.version[it.n++] = version;
-    if (extra) it.type[it.n] = 14, it.size[it.n] = extra, it.version[it.n++] = version;
-    size_t vlr = 34 + 6 * it.n, offset = 375 + 54 + vlr;
-    tf_put(b, "LASF", 4);
-    while (b->size < 24) tf_u8(b, 0);
-    tf_u8(b, 1), tf_u8(b, 4);
-    while (b->size < 94) tf_u8(b, 0);
-    tf_u16(b, 375, 0), tf_u32(b, (uint32_t)offset, 0), tf_u32(b, 1, 0);
-    tf_u8(b, (unsigned)fmt | 0x80), tf_u16(b, (unsigned)rec, 0), tf_u32(b, 0, 0);
-    while (b->size < 131) tf_u8(b, 0);
-    for (int c = 0; c < 3; c++) tf_f64(b, 0.01, 0);
-    for (int c = 0; c < 3; c++) tf_f64(b, 0, 0);
-    while (b->size < 247) tf_u8(b, 0);
-    tf_u64(b, n, 0);
-    while (b->size < 375) tf_u8(b, 0);
-    char user[16] = "laszip encoded", desc[32] = "";
-    tf_u16(b, 0, 0), tf_put(b, user, 16), tf_u16(b, 22204, 0), tf_u16(b, (unsigned)vlr, 0), tf_put(b, desc, 32);
-    tf_u16(b, 3, 0), tf_u16(b, 0, 0), tf_u8(b, 3), tf_u8(b, 4), tf_u16(b, 0, 0), tf_u32(b, 0, 0);
-    tf_u32(b, (uint32_t)chunk, 0), tf_u64(b, (uint64_t)-1, 0), tf_u64(b, (uint64_t)-1, 0), tf_u16(b, it.n, 0);
-    for (unsigned i = 0; i < it.n; i++) tf_u16(b, it.type[i], 0), tf_u16(b, it.size[i], 0), tf_u16(b, it.version[i], 0);
-    size_t ptr = b->size, nc = (n + chunk - 1) / chunk;
-    tf_u64(b, 0, 0);
-    uint64_t *bytes = calloc(nc + 1, sizeof *bytes);
-    hd__enc_t e;
-    hd__enc_init(&e);
-    for (size_t c = 0; c < nc; c++) {
-        size_t k = n - c * chunk < chunk ? n - c * chunk : chunk;
-        if (hd__laz14_encode(recs + c * chunk * rec, k, rec, &it, &e)) abort();
-        tf_put(b, recs + c * chunk * rec, rec);
-        tf_put(b, e.buf, e.size);
-        bytes[c] = rec + e.size;
-    }
-    uint64_t tab = b->size;
-    for (int i = 0; i < 8; i++) b->data[ptr + i] = (unsigned char)(tab >> 8 * i);
-    tf_u32(b, 0, 0), tf_u32(b, (uint32_t)nc, 0);
-    if (hd__laz_table_encode(0, nc, NULL, bytes, &e)) abort();
-    tf_put(b, e.buf, e.size);
-    hd__enc_free(&e);
-    free(bytes);
+    add_item(&it, 10, 30, version);
+    if (fmt == 7) add_item(&it, 11, 6, version);
+    if (fmt == 8 || fmt == 10) add_item(&it, 12, 8, version);
+    if (fmt >= 9) add_item(&it, 13, 29, version);
+    if (extra) add_item(&it, 14, extra, version);
+    laz_file(b, fmt, &it, recs, rec, n, chunk, 1);
 }
 
 static uint64_t le_of(const unsigned char *p, int n) {

@@ -268,16 +268,36 @@ static unsigned char *records_of(const char *path, size_t *n, size_t *rec) {
     return out;
 }
 
+/* A pointwise LAZ file in b (lazw_pointwise, chunks of `chunk` points) of
+ * n random records of format fmt with `extra` bytes (lazw_rich_records),
+ * drawn from g seeded with `seed` (g goes on from there); the records
+ * returned (malloc'd), *rec bytes each. */
+static unsigned char *pointwise_file(gen_rng_t *g, uint64_t seed, int fmt, unsigned extra, size_t n, size_t chunk,
+                                     tf_buf_t *b, size_t *rec) {
+    gen_seed(g, seed);
+    unsigned char *recs = lazw_rich_records(g, fmt, extra, n, rec);
+    lazw_pointwise(b, fmt, extra, recs, *rec, n, chunk);
+    return recs;
+}
+
+/* The same, layered (lazw_layered: LAS 1.4 format fmt, items of
+ * `version`; scanner channels switching when `channels`). */
+static unsigned char *layered_file(gen_rng_t *g, uint64_t seed, int fmt, unsigned extra, int channels, size_t n,
+                                   size_t chunk, unsigned version, tf_buf_t *b, size_t *rec) {
+    gen_seed(g, seed);
+    unsigned char *recs = lazw_rich_records14(g, fmt, extra, n, rec, channels);
+    lazw_layered(b, fmt, extra, recs, *rec, n, chunk, version);
+    return recs;
+}
+
 TEST(pointwise_laz_is_compressed_again_with_every_field) {
     for (int fmt = 0; fmt <= 3; fmt++)
         for (unsigned extra = 0; extra <= 3; extra += 3) {
             CONTEXT("format %d extra %u", fmt, extra);
             gen_rng_t g;
-            gen_seed(&g, 77 + (uint64_t)fmt * 10 + extra);
             size_t n = 3001, rec;
-            unsigned char *recs = lazw_rich_records(&g, fmt, extra, n, &rec);
             tf_buf_t b = {0};
-            lazw_pointwise(&b, fmt, extra, recs, rec, n, 1000);
+            unsigned char *recs = pointwise_file(&g, 77 + (uint64_t)fmt * 10 + extra, fmt, extra, n, 1000, &b, &rec);
             const char *in = tf_finish(&b, "rich.laz");
             size_t m, mrec;
             unsigned char *back = records_of(in, &m, &mrec); /* the encoder's file decodes to its records */
@@ -316,11 +336,9 @@ TEST(pointwise_laz_takes_several_fields_in_the_byte_item) {
             unsigned extra = fmt == 3 ? 2 : 0;
             CONTEXT("format %d extra %u fields %zu", fmt, extra, nf);
             gen_rng_t g;
-            gen_seed(&g, 177 + (uint64_t)fmt * 10 + nf);
             size_t n = 2501, rec, m, mrec;
-            unsigned char *recs = lazw_rich_records(&g, fmt, extra, n, &rec);
             tf_buf_t b = {0};
-            lazw_pointwise(&b, fmt, extra, recs, rec, n, 1000);
+            unsigned char *recs = pointwise_file(&g, 177 + (uint64_t)fmt * 10 + nf, fmt, extra, n, 1000, &b, &rec);
             const char *in = tf_finish(&b, "rich_n.laz");
             double *v = malloc(nf * n * sizeof *v);
             field_values(&g, v, n, nf);
@@ -376,11 +394,9 @@ TEST(layered_laz_every_field_decodes_back_to_its_records) {
                     CONTEXT("format %d extra %u version %u channels %d seed %llu", fmt, extra, version, channels,
                             (unsigned long long)seed);
                     gen_rng_t g;
-                    gen_seed(&g, seed);
                     size_t n = 3001, rec, m, mrec;
-                    unsigned char *recs = lazw_rich_records14(&g, fmt, extra, n, &rec, channels);
                     tf_buf_t b = {0};
-                    lazw_layered(&b, fmt, extra, recs, rec, n, 1000, version);
+                    unsigned char *recs = layered_file(&g, seed, fmt, extra, channels, n, 1000, version, &b, &rec);
                     const char *in = tf_finish(&b, "rich14.laz");
                     unsigned char *back = records_of(in, &m, &mrec);
                     CHECK(m == n && mrec == rec);
@@ -408,11 +424,9 @@ TEST(layered_laz_subsets_are_compressed_again_every_field) {
             unsigned extra = fmt == 7 || fmt == 9 ? 2 : 0, version = fmt == 8 || fmt == 9 ? 3 : 4;
             CONTEXT("format %d extra %u fields %zu version %u", fmt, extra, nf, version);
             gen_rng_t g;
-            gen_seed(&g, 577 + (uint64_t)fmt * 10 + nf);
             size_t n = 2501, rec, m, mrec;
-            unsigned char *recs = lazw_rich_records14(&g, fmt, extra, n, &rec, 1);
             tf_buf_t b = {0};
-            lazw_layered(&b, fmt, extra, recs, rec, n, 700, version);
+            unsigned char *recs = layered_file(&g, 577 + (uint64_t)fmt * 10 + nf, fmt, extra, 1, n, 700, version, &b, &rec);
             const char *in = tf_finish(&b, "rich14_sub.laz");
             double *v = malloc(nf * n * sizeof *v);
             field_values(&g, v, n, nf);
@@ -454,11 +468,9 @@ TEST(layered_laz_subsets_are_compressed_again_every_field) {
 
 TEST(layered_laz_subsets_of_one_point_and_of_none) {
     gen_rng_t g;
-    gen_seed(&g, 43);
     size_t n = 120, rec, m, mrec;
-    unsigned char *recs = lazw_rich_records14(&g, 8, 1, n, &rec, 1);
     tf_buf_t b = {0};
-    lazw_layered(&b, 8, 1, recs, rec, n, 50, 4);
+    unsigned char *recs = layered_file(&g, 43, 8, 1, 1, n, 50, 4, &b, &rec);
     const char *in = tf_finish(&b, "rich14_one.laz");
     double *v = calloc(n, sizeof *v);
     v[77] = 1; /* the one point farther than 0.5: a chunk of one point, its layers those of an empty stream */
@@ -486,11 +498,9 @@ TEST(layered_laz_subsets_of_one_point_and_of_none) {
 
 TEST(layered_laz_subsets_are_the_same_file_on_any_thread_count) {
     gen_rng_t g;
-    gen_seed(&g, 47);
     size_t n = 9001, rec;
-    unsigned char *recs = lazw_rich_records14(&g, 7, 1, n, &rec, 1);
     tf_buf_t b = {0};
-    lazw_layered(&b, 7, 1, recs, rec, n, 400, 3); /* 23 chunks: several batches of any thread count */
+    unsigned char *recs = layered_file(&g, 47, 7, 1, 1, n, 400, 3, &b, &rec); /* 23 chunks: several batches of any thread count */
     const char *in = tf_finish(&b, "rich14_threads.laz");
     double *v = malloc(n * sizeof *v);
     for (size_t k = 0; k < n; k++) v[k] = gen_normal(&g);
@@ -524,11 +534,9 @@ TEST(layered_laz_subsets_are_the_same_file_on_any_thread_count) {
 
 TEST(layered_laz_damaged_layers_are_errors_with_offsets) {
     gen_rng_t g;
-    gen_seed(&g, 41);
     size_t n = 300, rec, m, mrec;
-    unsigned char *recs = lazw_rich_records14(&g, 7, 2, n, &rec, 1);
     tf_buf_t b = {0};
-    lazw_layered(&b, 7, 2, recs, rec, n, 300, 4);
+    unsigned char *recs = layered_file(&g, 41, 7, 2, 1, n, 300, 4, &b, &rec);
     unsigned char *d = b.data;
     size_t offset = le(d + 96, 4), chunk = offset + 8, sizes = chunk + rec + 4;
     /* the classification layer (the third) one byte shorter, the flags layer one longer */
@@ -546,6 +554,33 @@ TEST(layered_laz_damaged_layers_are_errors_with_offsets) {
     CHECK(strstr(err.message, "chunk 1 of 1") && strstr(err.message, "classification layer"));
     CHECK(err.offset > (long long)sizes);
     (void)m, (void)mrec;
+    free(v);
+    free(recs);
+}
+
+TEST(pointwise_laz_damaged_chunks_are_errors_with_offsets_whatever_is_kept) {
+    gen_rng_t g;
+    size_t n = 2500, rec;
+    tf_buf_t b = {0};
+    unsigned char *recs = pointwise_file(&g, 53, 3, 2, n, 1000, &b, &rec);
+    size_t chunk = le(b.data + 96, 4) + 8; /* the first chunk: its raw record, then its stream */
+    for (size_t i = 0; i < 64; i++) b.data[chunk + rec + 200 + i] ^= 0x5A;
+    const char *in = tf_finish(&b, "rich_bad.laz");
+    double *v = calloc(n, sizeof *v);
+    v[3] = 1;
+    hd_write_options_t o;
+    hd_write_options_init(&o);
+    /* every point (each chunk decoded and encoded by one task), and a
+     * subset (the kept points gathered into new chunks) */
+    for (int keep = 0; keep < 2; keep++) {
+        CONTEXT("keep %s", keep ? "farther" : "all");
+        o.keep = keep ? HD_KEEP_FARTHER : HD_KEEP_ALL;
+        hd_error_t err;
+        CHECK_RC(hd_write_field(in, tf_path("rich_bad_out.laz"), v, n, &o, NULL, &err), HD_EFORMAT);
+        CONTEXT("%s (offset %lld)", err.message, err.offset);
+        CHECK(strstr(err.message, "chunk 1 of 3"));
+        CHECK(err.offset > (long long)chunk && err.offset <= (long long)(chunk + 1000 * rec));
+    }
     free(v);
     free(recs);
 }
