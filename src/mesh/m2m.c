@@ -80,7 +80,12 @@
  * an upper bound; such a corner cannot beat L0 and needs no exact
  * distance; its lo is then 0, since the triangles not visited were not
  * excluded), and computes the exact distances of the corners whose hi
- * reaches L0 and every complete search's lo.  A midpoint's search stops
+ * reaches L0 and every complete search's lo.  A corner whose bound carried
+ * from the last corner searched in its chunk (the anchor a, with hi_a >=
+ * d(a, t) for t the triangle at its pos) meets that target is not searched:
+ * d(v, t) <= hi_a + |v - a| (hd__m2m_carried_bound, rounded up) is an
+ * upper bound with the anchor's triangle, which is all phases 1 and 2 ask
+ * of a corner's hi and pos (bench/m2m_run, `through`).  A midpoint's search stops
  * the same way at a bound that keeps its children's point bound within
  * the tolerance and below the bar of exact corners.  Phase 1 evaluates
  * every face's corners (fixed chunks, any thread) and sets the lower
@@ -642,6 +647,19 @@ double hd__m2m_bent_bound(const double a[3], const double b[3], double U) {
     return U;
 }
 
+/* |p - a| <= sqrt(d2 (1 + 2^-50) + 2^-1070), d2 the computed square: each
+ * difference is within a factor 1 + u of the exact one (exact when
+ * subnormal), each square and the two additions add a factor 1 + u and
+ * at most 2^-1075 each, (1 + u)^5 < 1 + 2^-50; every step rounded up.
+ * Then d(p, t) <= d(a, t) + |p - a| <= hi + |p - a| (the triangle
+ * inequality), the sum rounded up. */
+double hd__m2m_carried_bound(double hi, const double a[3], const double p[3]) {
+    double dx = p[0] - a[0], dy = p[1] - a[1], dz = p[2] - a[2];
+    double d2 = dx * dx + dy * dy + dz * dz;
+    if (!(d2 < INFINITY) || !(hi < INFINITY)) return INFINITY;
+    return up(hi + sqrt_up(up(up(d2 * (1 + 0x1p-50)) + 0x1p-1070)));
+}
+
 /* The sub-triangle's upper bound; once the point bound alone is at most
  * `enough` (the sub-triangle will be discarded whatever its bound) the
  * dearer bounds are skipped. */
@@ -745,6 +763,25 @@ static double corner_target(const ctx_t *C, size_t id) {
     return dmin(C->L0 + J->tol - face_reach(&J->from[id / 3]), down(C->L0));
 }
 
+/* Stage 2 without a search: the bound of corner id carried from an anchor
+ * (the last corner of the chunk whose hi came from a search or the sample,
+ * never a carried one, so that errors do not add up; d(anchor, triangle at
+ * pos) <= hi) when it meets the corner's target: then hi >= d(corner,
+ * triangle at pos) too (hd__m2m_carried_bound), which is all that phases 1
+ * and 2 ask of a corner's hi and pos, and lo is 0.  1 when it does. */
+static int carried(ctx_t *C, size_t anchor, size_t id, double target) {
+    const found_t *A = &C->found[anchor];
+    if (!(A->hi <= target)) return 0;
+    const double *a = CORNER(C->job, anchor), *p = CORNER(C->job, id);
+    double m = target - A->hi, dx = p[0] - a[0], dy = p[1] - a[1], dz = p[2] - a[2];
+    if (dx * dx + dy * dy + dz * dz > m * m) return 0; /* a filter: the bound decides */
+    double g = hd__m2m_carried_bound(A->hi, a, p);
+    if (!(g <= target)) return 0;
+    found_t *F = &C->found[id];
+    F->lo = 0, F->hi = g, F->pos = A->pos, F->exact = 0, F->complete = 0;
+    return 1;
+}
+
 /* Phase 0: each corner's distance enclosed (interval()), in Morton order
  * so that each search starts from its predecessor's answer; a corner equal
  * to its predecessor copies it (at stage 2 when that answer is complete or
@@ -753,7 +790,7 @@ static void phase0(void *vctx, size_t task, int worker) {
     ctx_t *C = vctx;
     const hd__m2m_job_t *J = C->job;
     size_t lo = task * CHUNK * 3, hi = lo + CHUNK * 3 < C->n_corners ? lo + CHUNK * 3 : C->n_corners;
-    size_t seed = SIZE_MAX, prev = SIZE_MAX;
+    size_t seed = SIZE_MAX, prev = SIZE_MAX, anchor = SIZE_MAX;
     uint64_t count = 0;
     for (size_t k = lo; k < hi; k++) {
         size_t id = C->order ? (size_t)(C->order[k] & 0xffffffffu) : k;
@@ -762,7 +799,7 @@ static void phase0(void *vctx, size_t task, int worker) {
         int sampled = C->stage && is_sample(C, k);
         if (C->stage == 1 && !sampled) continue;
         if (C->stage == 2 && sampled) { /* done at stage 1 */
-            seed = F->pos, prev = id;
+            seed = F->pos, prev = anchor = id;
             continue;
         }
         int same = prev != SIZE_MAX && memcmp(CORNER(J, id), CORNER(J, prev), 3 * sizeof(double)) == 0;
@@ -775,11 +812,16 @@ static void phase0(void *vctx, size_t task, int worker) {
             *F = C->found[prev];
             continue;
         }
+        if (C->stage == 2 && anchor != SIZE_MAX && carried(C, anchor, id, target)) {
+            prev = id;
+            continue;
+        }
         F->pos = seed =
             interval(J->to, CORNER(J, id), seed, &C->caches[worker], enough_of(target), &F->lo, &F->hi, &count);
         F->exact = 0;
         F->complete = !(F->hi <= target);
         prev = id;
+        anchor = id;
     }
     C->faces[lo / 3].kernel += count; /* counted on the chunk's first face */
 }

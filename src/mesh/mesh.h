@@ -273,6 +273,12 @@ int hd__m2m_run(const hd__m2m_job_t *job, hd__m2m_result_t *out);
  * finite.  Thread safety: none needed. */
 double hd__m2m_bent_bound(const double a[3], const double b[3], double U);
 
+/* A bound carried from an anchor point a to a point p: given hi >= d(a, t)
+ * for a set t (a triangle of Y, or Y), d(p, t) <= d(a, t) + |p - a| <=
+ * the result, the distance and the sum rounded up (m2m.c).  Infinite when
+ * hi or a coordinate is not finite.  Thread safety: none needed. */
+double hd__m2m_carried_bound(double hi, const double a[3], const double p[3]);
+
 /* The candidate list of a sub-triangle whose computed corners are c, with
  * U >= d(y, Y) for every y of their hull and e the face's slack (m2m.c):
  * writes to out every triangle of T (positions, from the tree in leaf
