@@ -144,48 +144,70 @@ static void box_run(hd__box_t *b, const double *xyz, size_t n) {
  * coordinates and number to its slot in the local arrays (lx, lo at
  * *own, when it stays) or in the send buffer (sx, so at sfill[2 r + s]).
  * Two ways, one result, chosen by the caller from how often consecutive
- * points change destination (the first pass counts it):
- *  - a branch on whether the point stays, for destinations in long runs
- *    (an input in space's order, as a rank reading its tiles has), where
- *    it is predicted;
- *  - tables indexed by it, with no branch, for destinations at random (an
- *    input in no spatial order: half the points stay at K = 2, and the
- *    branch was mispredicted as often, by callgrind's branch simulation;
- *    GCC turned plain ternaries back into the branch).  A rank's own
- *    block of the send buffer is empty, so its cursor, written back
- *    unchanged when a point stays, is never used.
- * Inlined with a constant `branchless`, so each way is its own loop. */
-HD__INLINE void pack_run(const hd_points_t *v, const double *px, size_t k0, size_t m, const void *dest, int w,
-                         size_t t, int me, int s, uint32_t num, double *lx, uint32_t *lo, size_t *own, double *sx,
-                         uint32_t *so, int *sfill, int branchless, int drop) {
+ * points change destination (the plan counts it):
+ *  - pack_runs, for destinations in long runs (an input in space's order,
+ *    as a rank reading its tiles has): a run of one destination is found
+ *    eight bytes at a time and copied at once, its numbers written in a
+ *    loop without a branch;
+ *  - pack_scattered, tables indexed by the destination, with no branch,
+ *    for destinations at random (an input in no spatial order: half the
+ *    points stay at K = 2, and a branch on it was mispredicted as often,
+ *    by callgrind's branch simulation; GCC turned plain ternaries back
+ *    into the branch).  A rank's own block of the send buffer is empty,
+ *    so its cursor, written back unchanged when a point stays, is never
+ *    used. */
+static void pack_scattered(const hd_points_t *v, const double *px, size_t k0, size_t m, const void *dest, int w,
+                           size_t t, int me, int s, uint32_t num, double *lx, uint32_t *lo, size_t *own, double *sx,
+                           uint32_t *so, int *sfill, int drop) {
     double *const xto[2] = {sx, lx};
     uint32_t *const oto[2] = {so, lo};
     size_t cur[2] = {0, *own};
     for (size_t i = 0; i < m; i++, t++, num++) {
         int r = dest_get(dest, w, t);
-        double *x;
         if (r == drop) continue; /* it stays, out of the course (prune.c) */
-        if (branchless) {
-            int mine = r == me;
-            cur[0] = (size_t)sfill[2 * r + s];
-            size_t to = cur[mine];
-            sfill[2 * r + s] = (int)cur[0] + !mine;
-            cur[1] += (size_t)mine;
-            x = xto[mine] + 3 * to;
-            oto[mine][to] = num;
-        } else if (r == me) {
-            size_t to = cur[1]++;
-            x = lx + 3 * to;
-            lo[to] = num;
-        } else {
-            size_t to = (size_t)sfill[2 * r + s]++;
-            x = sx + 3 * to;
-            so[to] = num;
-        }
+        int mine = r == me;
+        cur[0] = (size_t)sfill[2 * r + s];
+        size_t to = cur[mine];
+        sfill[2 * r + s] = (int)cur[0] + !mine;
+        cur[1] += (size_t)mine;
+        double *x = xto[mine] + 3 * to;
+        oto[mine][to] = num;
         if (px) memcpy(x, px + 3 * (k0 + i), 3 * sizeof(double));
         else hd_points_get(v, k0 + i, x);
     }
     *own = cur[1];
+}
+
+/* The positions from t on (at most m, at least 1) whose rank is r. */
+static inline size_t run_length(const void *dest, int w, size_t t, size_t m, int r) {
+    size_t j = 1;
+    if (w == 1) {
+        const uint8_t *d = (const uint8_t *)dest + t;
+        uint64_t all = (uint64_t)(uint8_t)r * UINT64_C(0x0101010101010101), wd;
+        while (j + 8 <= m && (memcpy(&wd, d + j, 8), wd == all)) j += 8;
+    }
+    while (j < m && dest_get(dest, w, t + j) == r) j++;
+    return j;
+}
+
+static void pack_runs(const hd_points_t *v, const double *px, size_t k0, size_t m, const void *dest, int w, size_t t,
+                      int me, int s, uint32_t num, double *lx, uint32_t *lo, size_t *own, double *sx, uint32_t *so,
+                      int *sfill, int drop) {
+    for (size_t i = 0, n; i < m; i += n) {
+        int r = dest_get(dest, w, t + i);
+        n = run_length(dest, w, t + i, m - i, r);
+        if (r == drop) continue; /* they stay, out of the course (prune.c) */
+        size_t to;
+        double *x;
+        uint32_t *o;
+        if (r == me) to = *own, *own += n, x = lx, o = lo;
+        else to = (size_t)sfill[2 * r + s], sfill[2 * r + s] += (int)n, x = sx, o = so;
+        x += 3 * to, o += to;
+        if (px) memcpy(x, px + 3 * (k0 + i), n * 3 * sizeof(double));
+        else
+            for (size_t u = 0; u < n; u++) hd_points_get(v, k0 + i + u, x + 3 * u);
+        for (size_t u = 0; u < n; u++) o[u] = num + (uint32_t)(i + u);
+    }
 }
 
 /* Points sent per round by a rank: an eighth of its points (at least
@@ -274,49 +296,134 @@ static void xch_free(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, xch_t *x, cons
     xch_free_sends(c, x);
 }
 
+/* The ranks of one part's n points (side s, first global index g0) into
+ * dest from position t, K for a point that stays out (prune.c).  The
+ * tree's root is copied into a local: the byte stores may alias anything,
+ * and would make the compiler load the root again for every point (at
+ * K = 2 the root is the whole walk). */
+static void route_run(const hd__mpi_node_t *tree, int K, const hd__mpi_prune_t *cells, int s, const hd_points_t *v,
+                      uint64_t g0, void *dest, int w, size_t t) {
+    const double *px = hd__mpi_packed(v);
+    hd__mpi_node_t root = K > 1 ? tree[0] : (hd__mpi_node_t){0};
+    if (K == 2 && px && !cells && w == 1) { /* the root's two leaves: its coordinate decides but at a tie */
+        uint8_t *d = (uint8_t *)dest + t, lr = (uint8_t)(-root.left - 1), rr = (uint8_t)(-root.right - 1);
+        for (size_t k = 0; k < v->count; k++) {
+            double c = px[3 * k + (size_t)root.axis];
+            d[k] = c < root.s ? lr : c > root.s ? rr : hd__mpi_goes_left(&root, px + 3 * k, (uint64_t)s, g0 + k) ? lr : rr;
+        }
+        return;
+    }
+    for (size_t k = 0; k < v->count; k++, t++) {
+        double xb[3];
+        const double *pt = px ? px + 3 * k : (hd_points_get(v, k, xb), xb);
+        int r = 0;
+        if (cells && !hd__mpi_moves(cells, s, pt)) r = K;
+        else if (K > 1) {
+            int next = hd__mpi_goes_left(&root, pt, (uint64_t)s, g0 + k) ? root.left : root.right;
+            while (next >= 0)
+                next = hd__mpi_goes_left(&tree[next], pt, (uint64_t)s, g0 + k) ? tree[next].left : tree[next].right;
+            r = -next - 1;
+        }
+        dest_set(dest, w, t, r);
+    }
+}
+
+/* Positions [t0, t1)'s points for a rank other than me (neither me nor K,
+ * out of the course): a count without a branch, which the compiler
+ * vectorizes for one-byte destinations. */
+static size_t others_in(const void *dest, int w, size_t t0, size_t t1, int me, int K) {
+    size_t n = 0;
+    if (w == 1) {
+        const uint8_t *d = dest, m8 = (uint8_t)me, k8 = (uint8_t)K;
+        for (size_t t = t0; t < t1; t++) n += (size_t)((d[t] != m8) & (d[t] != k8));
+    } else {
+        for (size_t t = t0; t < t1; t++) {
+            int r = dest_get(dest, w, t);
+            n += (size_t)((r != me) & (r != K));
+        }
+    }
+    return n;
+}
+
+/* Positions counted between checks of the rounds' cuts (at most
+ * ROUND_MIN, so a block holds at most one cut). */
+#define PLAN_BLOCK 1024
+
+/* The rounds' cuts (tb, nr): round q ends before the position of the
+ * ((q + 1) C + 1)-th point for another rank.  Blocks are counted without a
+ * branch; only a block that holds a cut is walked point by point. */
+static void plan_cuts(xch_t *x) {
+    size_t out = 0, q = 0, cut = x->C;
+    x->tb[0] = 0;
+    for (size_t b = 0; b < x->nloc; b += PLAN_BLOCK) {
+        size_t e = x->nloc - b < PLAN_BLOCK ? x->nloc : b + PLAN_BLOCK, o = others_in(x->dest, x->w, b, e, x->me, x->K);
+        if (out + o <= cut) {
+            out += o;
+            continue;
+        }
+        for (size_t t = b; t < e; t++) {
+            int r = dest_get(x->dest, x->w, t);
+            if (r == x->me || r == x->K) continue;
+            if (out == cut) x->tb[++q] = t, cut += x->C;
+            assert(q < x->maxr);
+            out++;
+        }
+    }
+    x->nr = q + 1;
+    x->tb[x->nr] = x->nloc;
+}
+
+/* Each round's counts by (rank, side) for the other ranks (rcnt), the
+ * totals to every rank (big) and the positions whose rank differs from the
+ * previous position's (switches): a histogram of each round's positions of
+ * each side (A's positions come first: n[0] of them). */
+static void plan_counts(xch_t *x, size_t nA, size_t *hist) {
+    int K = x->K, w = x->w;
+    const uint8_t *d8 = x->dest;
+    for (size_t t = 1; t < x->nloc; t++)
+        x->switches += w == 1 ? (size_t)(d8[t] != d8[t - 1]) : (size_t)(dest_get(x->dest, w, t) != dest_get(x->dest, w, t - 1));
+    for (size_t q = 0; q < x->nr; q++) {
+        int *row = x->rcnt + q * 2 * (size_t)K;
+        for (int s = 0; s < 2; s++) {
+            size_t a = s ? nA : 0, e = s ? x->nloc : nA;
+            a = a > x->tb[q] ? a : x->tb[q], e = e < x->tb[q + 1] ? e : x->tb[q + 1];
+            if (a >= e) continue;
+            memset(hist, 0, ((size_t)K + 1) * sizeof *hist);
+            if (w == 1 && K <= 4) /* a count a rank without a branch, vectorized, for the few */
+                for (int r = 0; r < K; r++) hist[r] = (e - a) - others_in(x->dest, 1, a, e, r, r);
+            else if (w == 1)
+                for (size_t t = a; t < e; t++) hist[d8[t]]++;
+            else
+                for (size_t t = a; t < e; t++) hist[dest_get(x->dest, w, t)]++;
+            for (int r = 0; r < K; r++) {
+                x->big[2 * r + s] += hist[r];
+                if (r != x->me) row[2 * r + s] += (int)hist[r];
+            }
+        }
+    }
+}
+
 /* The first pass: each input position's rank (dest), the totals to each
  * rank (tot), and the rounds' cuts and counts (tb, rcnt). */
 static int xch_plan(hd__mpi_ctx_t *c, const hd__mpi_input_t *in, const hd__mpi_node_t *tree, xch_t *x) {
     int K = x->K, me = x->me, rc = HD_OK;
     memset(x->big, 0, 2 * (size_t)K * sizeof(size_t));
     memset(x->rcnt, 0, x->maxr * 2 * (size_t)K * sizeof(int));
-    size_t t = 0, out = 0, q = 0, cut = x->C; /* cut: where round q ends, (q + 1) C points sent */
-    int prev = -1, *row = x->rcnt;            /* row: round q's counts */
     const hd__mpi_prune_t *cells = x->pr && x->pr->on ? x->pr : NULL; /* NULL: every point moves */
-    x->tb[0] = 0;
+    size_t t = 0;
     for (int s = 0; s < 2; s++) {
         for (size_t p = 0; p < in->nparts[s]; p++) x->order[s][p] = &in->parts[s][p];
         qsort(x->order[s], in->nparts[s], sizeof *x->order[s], hd__mpi_by_offset);
         for (size_t p = 0; p < in->nparts[s]; p++) {
-            const hd_points_t *v = &x->order[s][p]->points;
-            const double *px = hd__mpi_packed(v);
-            uint64_t g0 = x->order[s][p]->offset;
-            for (size_t k = 0; k < v->count; k++, t++) {
-                double xb[3];
-                const double *pt = px ? px + 3 * k : (hd_points_get(v, k, xb), xb);
-                if (cells && !hd__mpi_moves(cells, s, pt)) {
-                    dest_set(x->dest, x->w, t, K);
-                    continue;
-                }
-                int r = hd__mpi_rank_of(tree, K, pt, (uint64_t)s, g0 + k);
-                dest_set(x->dest, x->w, t, r);
-                x->switches += (size_t)(r != prev);
-                prev = r;
-                x->big[2 * r + s]++;
-                /* No branch on whether the point stays: in an input
-                 * that is not in space's order it does at random (half
-                 * the points at K = 2), and the branch was mispredicted
-                 * as often (callgrind's branch simulation). */
-                int other = r != me;
-                if (out == cut && other) x->tb[++q] = t, row += 2 * (size_t)K, cut += x->C;
-                assert(q < x->maxr && cut == (q + 1) * x->C && row == x->rcnt + q * 2 * (size_t)K);
-                row[2 * r + s] += other;
-                out += (size_t)other;
-            }
+            route_run(tree, K, cells, s, &x->order[s][p]->points, x->order[s][p]->offset, x->dest, x->w, t);
+            t += x->order[s][p]->points.count;
         }
     }
-    x->nr = q + 1;
-    x->tb[x->nr] = x->nloc;
+    size_t *hist = hd__mpi_alloc(c, (size_t)K + 1, sizeof *hist);
+    if (!hist) return hd__mpi_nomem(c, "the exchange's counts", (size_t)K);
+    plan_cuts(x);
+    plan_counts(x, (size_t)in->n[0], hist);
+    hd__mpi_free(c, hist, (size_t)K + 1, sizeof *hist);
     for (int k = 0; k < 2 * K; k++) {
         if (x->big[k] > INT_MAX) rc = HD_EOVERFLOW;
         x->tot[k] = x->big[k] > INT_MAX ? INT_MAX : (int)x->big[k];
@@ -408,9 +515,9 @@ static void xch_pack(const hd__mpi_input_t *in, const hd__mpi_ranges_t *rg, xch_
             pos += x->per[2 * r + s];
         }
     /* Destinations that change at more than a quarter of the points are
-     * packed without a branch on them (pack_run): a branch mispredicted at
-     * random costs more than the tables' few instructions a point, and an
-     * input in space's order (tiles) keeps the branch, which is predicted
+     * packed without a branch on them (pack_scattered): a branch mispredicted
+     * at random costs more than the tables' few instructions a point, and
+     * an input in space's order (tiles) is copied a run at a time
      * (mpi_bench times both orders; the figures are in docs/scale-out.md). */
     int scattered = x->switches > x->nloc / 4;
     size_t own0[2] = {ownat[0], ownat[1]};
@@ -422,11 +529,11 @@ static void xch_pack(const hd__mpi_input_t *in, const hd__mpi_ranges_t *rg, xch_
         const double *px = hd__mpi_packed(v);
         uint32_t num = (uint32_t)at->num[s];
         if (scattered)
-            pack_run(v, px, at->k, m, x->dest, x->w, t, me, s, num, loc->xyz[s], x->off[s], &ownat[s], x->sx, x->so,
-                     x->sfill, 1, K);
+            pack_scattered(v, px, at->k, m, x->dest, x->w, t, me, s, num, loc->xyz[s], x->off[s], &ownat[s], x->sx,
+                           x->so, x->sfill, K);
         else
-            pack_run(v, px, at->k, m, x->dest, x->w, t, me, s, num, loc->xyz[s], x->off[s], &ownat[s], x->sx, x->so,
-                     x->sfill, 0, K);
+            pack_runs(v, px, at->k, m, x->dest, x->w, t, me, s, num, loc->xyz[s], x->off[s], &ownat[s], x->sx, x->so,
+                      x->sfill, K);
         t += m;
         at->k += m;
         at->num[s] += m;
