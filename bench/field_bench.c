@@ -122,8 +122,9 @@ int main(int argc, char **argv) {
         printf("| %s | %zu | %zu | %.4f s | %.4f s | %.4f s | %.4f s | %.4f s | %.1fx |\n", field_case_names[c], n, nb,
                mh, mf, bench_median(tp[0], runs), bench_median(tp[1], runs), bench_median(tp[2], runs), mf / mh);
         for (int d = 0; d < 2 && routes; d++)
-            printf("|   %s: groups paired %zu, windowed %zu, far %zu; queries apart %zu, solo %zu, from point lists %zu |\n",
-                   d ? "B->A" : "A->B", counts[d].paired, counts[d].windowed, counts[d].far, counts[d].apart,
+            printf("|   %s: groups paired %zu, windowed %zu, far %zu, shared %zu; queries apart %zu, solo %zu, "
+                   "from point lists %zu |\n",
+                   d ? "B->A" : "A->B", counts[d].paired, counts[d].windowed, counts[d].far, counts[d].shared, counts[d].apart,
                    counts[d].solo, counts[d].pointed);
         fflush(stdout);
     }

@@ -117,6 +117,14 @@
  *    of them; each chunk keeps, the same way, those that can be any of its
  *    answers, and while that stays at most 2 CHUNK points its queries scan
  *    just them (no bucket bounds, no per-query lists).
+ *  - Shared point lists.  When the asking set is DENSE times as large as
+ *    t or more, neighbouring groups have nearly the same candidate points:
+ *    RUN consecutive groups list them once, for the run's box, within the
+ *    nearest leaf's bound Ub of it (as a far group does, with no window
+ *    and no seed), and each group keeps from that list the points that
+ *    can be its answers, as a chunk does from its group's.  A run whose box
+ *    is not small next to Ub, or whose buckets are too many, leaves its
+ *    groups to the paths above.
  *  - Far groups.  A group whose box lies outside the searched set's box
  *    by more than its own diagonal (disjoint sets: the window and the
  *    seeds are far from its answers, and every query scanned the nearest
@@ -181,6 +189,10 @@
  *    exceeds min(U, V): V is node_ub2's expression from the box to a kept
  *    point, never below that point's computed distance to a query in the
  *    box, so the answer is at most V, and the dropped point is farther.
+ *    A run's shared list is such a list for the run's box, within
+ *    min(Ub, V): it holds every answer of every query in the box, and
+ *    min(Ub, V) bounds each of them, so a group's list taken from it (a
+ *    box inside the run's) is one again.
  *    Its scans are the buckets' scans (scan_arrays), over copies of points
  *    of the set only.
  *  - A point replaces the best on a smaller squared distance, or on an
@@ -205,7 +217,7 @@
  * which there are far fewer than points), 12 bytes
  * per asking point for the answers in its order, and, per thread, 128
  * bytes per searched bucket for the candidates (the group's list and a
- * chunk's), with about 40 KB of stack for the point lists.  While a set is built it
+ * chunk's), with about 60 KB of stack for the point lists.  While a set is built it
  * holds up to about 38 bytes per point: 8 of sort keys beside the
  * coordinates and indices (the sort's other buffer is x[]'s memory), and
  * the node and per-bucket arrays, which grow as the octree is cut (sized
@@ -1032,6 +1044,7 @@ static size_t bucket_at(const hd__an_t *t, uint32_t key, size_t from) {
 #define POINT_LIST 512      /* most points of a group's candidate buckets for a point list */
 #define DENSE 8             /* a set this many times as large as t tries point lists in every group */
 #define FAR_CANDIDATES 64   /* most candidates of a far group answered without seeds */
+#define RUN 3               /* groups of a dense set sharing one point list */
 
 /* The rest of one query's search, on the candidate list cd (the buckets
  * within U of a box holding the query, U at least its answer): every
@@ -1103,16 +1116,19 @@ typedef struct {
     size_t seed[HD__AN_GROUP];
 } qgroup_t;
 
-HD__INLINE void qgroup_box(const hd__an_t *q, qgroup_t *G) {
+/* The box of q's points [first, first + m), m > 0. */
+HD__INLINE void span_box(const hd__an_t *q, size_t first, size_t m, hd__box_t *box) {
     const double *v[3] = {q->x, q->y, q->z};
     for (int d = 0; d < 3; d++) {
-        G->box.lo[d] = G->box.hi[d] = v[d][G->first];
-        for (size_t k = G->first + 1; k < G->first + G->m; k++) {
-            G->box.lo[d] = v[d][k] < G->box.lo[d] ? v[d][k] : G->box.lo[d];
-            G->box.hi[d] = v[d][k] > G->box.hi[d] ? v[d][k] : G->box.hi[d];
+        box->lo[d] = box->hi[d] = v[d][first];
+        for (size_t k = first + 1; k < first + m; k++) {
+            box->lo[d] = v[d][k] < box->lo[d] ? v[d][k] : box->lo[d];
+            box->hi[d] = v[d][k] > box->hi[d] ? v[d][k] : box->hi[d];
         }
     }
 }
+
+HD__INLINE void qgroup_box(const hd__an_t *q, qgroup_t *G) { span_box(q, G->first, G->m, &G->box); }
 
 /* Each query's place on t's curve: the searched bucket at its own
  * bucket's key (h: the query's bucket, s0: the last seed, both carried
@@ -1316,17 +1332,57 @@ HD__INLINE void plist_pad(plist_t *l) {
         l->x[k] = l->x[l->n - 1], l->y[k] = l->y[l->n - 1], l->z[k] = l->z[l->n - 1], l->idx[k] = l->idx[l->n - 1];
 }
 
+/* span_bounds's gap g (at least 0) and span e on one axis for the four
+ * coordinates from p, the box's side [lo, hi]. */
+HD__INLINE void gap_span4(const double *p, v4d lo, v4d hi, v4d *g, v4d *e) {
+    v4d c_, zero = {0, 0, 0, 0};
+    __builtin_memcpy(&c_, p, sizeof c_);
+    v4d u = c_ - hi, v = lo - c_;
+    v4l c = u > v;
+    *g = (v4d)(((v4l)u & c) | ((v4l)v & ~c));
+    *g = (v4d)((v4l)*g & (*g > zero));
+    *e = (v4d)(((v4l)-v & c) | ((v4l)-u & ~c));
+}
+
+/* The n points at positions at[] of the arrays x, y, z, idx into l
+ * (the positions of the points kept are listed first, without a branch
+ * per point, and only those are copied). */
+HD__INLINE void plist_take(plist_t *l, const double *x, const double *y, const double *z, const uint32_t *idx,
+                           const uint32_t *at, size_t n) {
+    for (size_t k = 0; k < n; k++) l->x[k] = x[at[k]], l->y[k] = y[at[k]], l->z[k] = z[at[k]], l->idx[k] = idx[at[k]];
+    l->n = n;
+}
+
 /* The smallest and the largest computed squared distance between each of
  * the n points (x[k], y[k], z[k]) and a point of box q (node_lb2's and
  * node_ub2's expressions with a box of one point; see the essay; the
  * span's max(hi - p, p - lo) is the larger of the negated gaps, as IEEE
  * subtraction is exact under negation): the smallest into lb[k], and
- * returns the least of the largest, or V when smaller.  (The bounds only,
- * no copies, so that it vectorises.) */
+ * returns the least of the largest, or V when smaller.  Four points at a
+ * time with GCC's vector extension (each lane evaluates the scalar
+ * expressions, selections by masks: GCC left the scalar loop unvectorised),
+ * the rest one by one; the least of the lanes is the same minimum in any
+ * order (the bounds are sums of squares, never -0 nor NaN). */
 HD__INLINE double span_bounds(const hd__box_t *q, const double *restrict x, const double *restrict y,
                               const double *restrict z, size_t n, double *restrict lb, double V) {
     double l0 = q->lo[0], l1 = q->lo[1], l2 = q->lo[2], h0 = q->hi[0], h1 = q->hi[1], h2 = q->hi[2];
-    for (size_t k = 0; k < n; k++) {
+    v4d L0 = {l0, l0, l0, l0}, L1 = {l1, l1, l1, l1}, L2 = {l2, l2, l2, l2};
+    v4d H0 = {h0, h0, h0, h0}, H1 = {h1, h1, h1, h1}, H2 = {h2, h2, h2, h2};
+    v4d Vv = {V, V, V, V};
+    size_t k = 0;
+    for (; k + 4 <= n; k += 4) {
+        v4d gx, gy, gz, ex, ey, ez;
+        gap_span4(x + k, L0, H0, &gx, &ex);
+        gap_span4(y + k, L1, H1, &gy, &ey);
+        gap_span4(z + k, L2, H2, &gz, &ez);
+        v4d l = gx * gx + gy * gy + gz * gz, ub = ex * ex + ey * ey + ez * ez;
+        __builtin_memcpy(lb + k, &l, sizeof l);
+        v4l c = ub < Vv;
+        Vv = (v4d)(((v4l)ub & c) | ((v4l)Vv & ~c));
+    }
+    double m = Vv[0] < Vv[1] ? Vv[0] : Vv[1], m2 = Vv[2] < Vv[3] ? Vv[2] : Vv[3];
+    V = m < m2 ? m : m2;
+    for (; k < n; k++) {
         double u, v, gx, gy, gz, ex, ey, ez;
         u = x[k] - h0, v = l0 - x[k], gx = u > v ? u : v, gx = gx > 0 ? gx : 0, ex = u > v ? -v : -u;
         u = y[k] - h1, v = l1 - y[k], gy = u > v ? u : v, gy = gy > 0 ? gy : 0, ey = u > v ? -v : -u;
@@ -1346,7 +1402,8 @@ HD__INLINE double span_bounds(const hd__box_t *q, const double *restrict x, cons
  * the buckets hold more than POINT_LIST points (then nothing is listed).
  * The bounds are taken first, over each bucket's points where t stores
  * them, and only the points kept are copied. */
-HD__HOT static int group_points(const hd__an_t *t, const cands_t *cd, const hd__box_t *q, double U, plist_t *out) {
+HD__HOT static int group_points(const hd__an_t *t, const cands_t *cd, const hd__box_t *q, double U, plist_t *out,
+                                double *Vout) {
     if (listed_points(t, cd) > POINT_LIST) return 0;
     double lb[POINT_LIST], V = U;
     size_t m = 0;
@@ -1355,14 +1412,16 @@ HD__HOT static int group_points(const hd__an_t *t, const cands_t *cd, const hd__
         V = span_bounds(q, t->x + k0, t->y + k0, t->z + k0, e - k0, lb + m, V);
         m += e - k0;
     }
+    uint32_t at[POINT_LIST];
     size_t n = 0;
     m = 0;
     for (size_t r = 0; r < cd->n; r++)
         for (size_t k = t->start[cd->bucket[r]]; k < t->stop[cd->bucket[r]]; k++, m++) {
-            out->x[n] = t->x[k], out->y[n] = t->y[k], out->z[n] = t->z[k], out->idx[n] = t->idx[k];
+            at[n] = (uint32_t)k;
             n += lb[m] <= V;
         }
-    out->n = n;
+    plist_take(out, t->x, t->y, t->z, t->idx, at, n);
+    *Vout = V;
     return 1;
 }
 
@@ -1371,12 +1430,13 @@ HD__HOT static int group_points(const hd__an_t *t, const cands_t *cd, const hd__
 HD__HOT static void chunk_points(const plist_t *from, const hd__box_t *q, double U, plist_t *out) {
     double lb[POINT_LIST];
     double V = span_bounds(q, from->x, from->y, from->z, from->n, lb, U);
+    uint32_t at[POINT_LIST];
     size_t n = 0;
     for (size_t k = 0; k < from->n; k++) {
-        out->x[n] = from->x[k], out->y[n] = from->y[k], out->z[n] = from->z[k], out->idx[n] = from->idx[k];
+        at[n] = (uint32_t)k;
         n += lb[k] <= V;
     }
-    out->n = n;
+    plist_take(out, from->x, from->y, from->z, from->idx, at, n);
     plist_pad(out);
 }
 
@@ -1400,7 +1460,7 @@ HD__INLINE void scan_points(const plist_t *l, double qx, double qy, double qz, d
  * not for a far group, seed_bests).  Returns how many answers were the
  * partners (for the partner path's upkeep). */
 HD__INLINE size_t qgroup_finish(query_ctx *c, cands_t *cd, cands_t *ck, qgroup_t *G, double U, int paired,
-                                int windowed, size_t near, int scanned) {
+                                int windowed, size_t near, int scanned, const plist_t *shared) {
     const hd__an_t *q = c->q, *t = c->t;
     size_t first = G->first, kept = 0, napart = 0, nlisted = 0;
     uint32_t apart[HD__AN_GROUP], listed[HD__AN_GROUP];
@@ -1419,8 +1479,9 @@ HD__INLINE size_t qgroup_finish(query_ctx *c, cands_t *cd, cands_t *ck, qgroup_t
      * another when it has two chunks of queries or more.  (Which groups
      * try decides only the cost.) */
     plist_t gp, cp;
+    double V;
     int points = (nlisted >= 2 * CHUNK || !scanned || q->n / DENSE >= t->n) && qgroup_diag2(G) <= 4 * U &&
-                 group_points(t, cd, &G->box, U, &gp);
+                 (shared ? (chunk_points(shared, &G->box, U, &gp), 1) : group_points(t, cd, &G->box, U, &gp, &V));
     size_t chunk = windowed ? WINDOW_CHUNK : CHUNK;
     for (size_t r0 = 0; r0 < nlisted; r0 += chunk) {
         size_t r1 = r0 + chunk < nlisted ? r0 + chunk : nlisted;
@@ -1510,6 +1571,30 @@ HD__INLINE void solo_query(query_ctx *c, cands_t *cd, size_t k, size_t *b, size_
     c->sj[k] = j;
 }
 
+/* Runs of RUN consecutive groups of a set DENSE times as large as t or
+ * more (a dense set asking a sparse one: the run's box is small next to
+ * the distances to its answers, and its groups have nearly the same
+ * candidates) share one point list, listed once for the run's box Q: the
+ * nearest leaf's bound Ub bounds every answer in Q (nearest_leaf), the
+ * buckets within Ub of Q (at most FAR_CANDIDATES, holding at most
+ * POINT_LIST points) hold them all, and their points within min(Ub, V)
+ * of Q (group_points) still do; *U = min(Ub, V) bounds every answer in Q.
+ * Each group of the run then keeps from that list the points that can be
+ * its answers (chunk_points, within U of its own box) and goes on as a
+ * far group does.  Returns 0 (the groups go their own ways) when Q is not
+ * small next to Ub, or the buckets are too many.  The groups g, ..., g +
+ * ng - 1 of q; cd is left holding the run's candidates (within Ub of Q,
+ * so of each group's box: the groups' bucket lists may use it). */
+static int run_points(const hd__an_t *q, const hd__an_t *t, size_t g, size_t ng, cands_t *cd, plist_t *S,
+                      double *U) {
+    hd__box_t box;
+    span_box(q, q->gstart[g], q->gstart[g + ng] - q->gstart[g], &box);
+    double Ub = INFINITY, diag2 = 0;
+    nearest_leaf(t, &box, &Ub);
+    for (int d = 0; d < 3; d++) diag2 += (box.hi[d] - box.lo[d]) * (box.hi[d] - box.lo[d]);
+    return diag2 <= 4 * Ub && candidates(t, &box, Ub, FAR_CANDIDATES, cd) && group_points(t, cd, &box, Ub, S, U);
+}
+
 /* The groups of a task, each answered in phases: its box; first answers
  * by the partner path or the window path while they pay, each listing the
  * group's candidates when its bound lists few; else, when the group's box
@@ -1550,7 +1635,11 @@ HD__HOT static void query_task(void *vctx, size_t task, int worker) {
     hd__src_t psrc;
     if (c->partner) hd__src_init(&psrc, c->partner, NULL);
     size_t tried = 0, kept_groups = 0, wtried = 0, wkept = 0;
+    int dense = q->n / DENSE >= t->n, shared = 0;
+    plist_t S;
+    double US = 0;
     for (size_t g = g0; g < g1; g++) {
+        if (dense && (g - g0) % RUN == 0) shared = run_points(q, t, g, g1 - g < RUN ? g1 - g : RUN, cd, &S, &US);
         /* A group of equal keys may hold more than HD__AN_GROUP points:
          * its queries are then taken HD__AN_GROUP at a time. */
         size_t h = q->glead[g], s0 = at0;
@@ -1563,7 +1652,12 @@ HD__HOT static void query_task(void *vctx, size_t task, int worker) {
             int paired = 0, windowed = 0, seeded = 0, scanned = 1;
             size_t near = SIZE_MAX;
             for (size_t k = 0; k < G.m; k++) G.best[k] = INFINITY, G.bj[k] = UINT32_MAX;
-            if (lb0 >= qgroup_diag2(&G)) {
+            if (shared) {
+                /* Its run's list holds every answer of the group, within
+                 * US: no path below runs (nothing scanned). */
+                U = US, scanned = 0;
+                cd->counts.shared++;
+            } else if (lb0 >= qgroup_diag2(&G)) {
                 /* Outside t's box by its own diagonal: maybe a far group. */
                 U = INFINITY;
                 near = nearest_leaf(t, &G.box, &U);
@@ -1598,8 +1692,8 @@ HD__HOT static void query_task(void *vctx, size_t task, int worker) {
                 if (!seeded) qgroup_seeds(q, t, &G, &h, &s0);
                 near = seed_bests(q, t, &G, cd, &U, &scanned);
             }
-            cd->counts.far += (size_t)!scanned;
-            size_t kept = qgroup_finish(c, cd, ck, &G, U, paired, windowed, near, scanned);
+            cd->counts.far += (size_t)(!scanned && !shared);
+            size_t kept = qgroup_finish(c, cd, ck, &G, U, paired, windowed, near, scanned, shared ? &S : NULL);
             /* The path pays when the partners are the answers (a copy), not
              * merely near enough to list few candidates (a few buckets of
              * repeated points): it is kept on while at least half of the
@@ -1682,6 +1776,7 @@ static int nearest_run(const hd__an_t *asking, const hd__an_t *searched, const h
         counts->solo += c.cand[w].counts.solo;
         counts->pointed += c.cand[w].counts.pointed;
         counts->far += c.cand[w].counts.far;
+        counts->shared += c.cand[w].counts.shared;
     }
     cands_free(c.cand, 2 * threads);
     free(c.sd);

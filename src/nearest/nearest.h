@@ -88,6 +88,8 @@ typedef struct hd__an_counts {
     size_t pointed;  /* queries answered from a chunk's list of candidate points */
     size_t far;      /* far groups: candidates within a bound from boxes alone, no
                       * seed scanned (allnearest.c, "Far groups") */
+    size_t shared;   /* groups answered from their run's shared point list (allnearest.c,
+                      * "Shared point lists") */
 } hd__an_counts_t;
 
 /* For every point of `asking`, the exact nearest distance to `searched`

@@ -778,6 +778,38 @@ TEST(far_groups_are_answered_from_boxes_alone_and_stay_exact) {
     CHECK(far > 0);
 }
 
+TEST(runs_of_a_dense_sets_groups_share_one_point_list_and_stay_exact) {
+    /* A set many times as large as the other (here 40 to 80 times) asks
+     * it in runs of consecutive groups that share one list of candidate
+     * points: A on a grid of 1/64 and B on a grid of 1/8 (so that many of
+     * A's points have several nearest points: the smaller index must
+     * win), with copies in both sets; every answer of both directions
+     * against the brute force, at 1 and 3 threads, and most of A's groups
+     * answered from their run's list. */
+    size_t shared = 0, groups = 0;
+    for (uint64_t seed = 39200; seed < 39206 && !hdt_failed(); seed++) {
+        gen_rng_t g;
+        gen_seed(&g, seed);
+        int threads = seed % 2 ? 1 : 3;
+        size_t na = 20000 + gen_u64(&g) % 20000, nb = na / (40 + gen_u64(&g) % 40);
+        CONTEXT("seed=%llu na=%zu nb=%zu threads=%d", (unsigned long long)seed, na, nb, threads);
+        double *a = malloc(24 * na), *b = malloc(24 * nb), m0[3] = {0, 0, 0}, m1[3] = {seed % 3 ? 0.0 : 0.5, 0, 0};
+        gen_gauss(&g, a, na, m0, 1.0);
+        gen_gauss(&g, b, nb, m1, 1.0);
+        for (size_t k = 0; k < 3 * na; k++) a[k] = (double)(long)(a[k] * 64) / 64;
+        for (size_t k = 0; k < 3 * nb; k++) b[k] = (double)(long)(b[k] * 8) / 8;
+        for (size_t k = 0; k + 1 < nb; k += 7) memcpy(b + 3 * (k + 1), b + 3 * k, 24);
+        for (size_t k = 0; k + 1 < na; k += 5) memcpy(a + 3 * (k + 1), a + 3 * k, 24);
+        hd__an_counts_t c[2] = {{0}, {0}};
+        check_both_ways(a, na, b, nb, threads, seed, c);
+        shared += c[0].shared;
+        groups += c[0].shared + c[0].windowed + c[0].far + c[0].paired;
+        free(a), free(b);
+    }
+    CONTEXT("groups answered from their run's list: %zu of %zu", shared, groups);
+    CHECK(2 * shared >= groups);
+}
+
 TEST(small_far_groups_share_their_candidate_points) {
     /* A group far from the searched set with fewer queries than two
      * chunks is answered like a large one, from its candidate points (no
