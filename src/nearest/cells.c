@@ -88,12 +88,13 @@ static int cells_build(cells_t *c, const hd_points_t *P, const geom_t *g, hd_err
     size_t sdense = (size_t)sd[0] * (size_t)sd[1] * (size_t)sd[2];
     memset(c, 0, sizeof *c);
     c->n = P->count;
+    size_t cap = P->count < dense ? P->count : dense; /* occupied cells at most */
     uint32_t *map = hd__malloc_array(dense, sizeof *map), *smap = hd__malloc_array(sdense, sizeof *smap);
-    uint32_t *csb = hd__malloc_array(P->count, sizeof *csb);
+    uint32_t *csb = hd__malloc_array(cap, sizeof *csb);
     c->of = hd__malloc_array(P->count, sizeof *c->of);
-    c->box = hd__malloc_array(P->count, sizeof *c->box);
-    c->cnt = hd__calloc_array(P->count, sizeof *c->cnt);
-    c->sbox = hd__malloc_array(P->count < sdense ? P->count : sdense, sizeof *c->sbox);
+    c->box = hd__malloc_array(cap, sizeof *c->box);
+    c->cnt = hd__calloc_array(cap, sizeof *c->cnt);
+    c->sbox = hd__malloc_array(cap < sdense ? cap : sdense, sizeof *c->sbox);
     int rc = map && smap && csb && c->of && c->box && c->cnt && c->sbox ? HD_OK : HD_ENOMEM;
     if (rc == HD_OK) {
         memset(map, 0xff, dense * sizeof *map);
@@ -151,12 +152,10 @@ static int cells_build(cells_t *c, const hd_points_t *P, const geom_t *g, hd_err
     return HD_OK;
 }
 
-typedef double sbound_t;
-
 /* U and L of the essay for the box q against the searched cells t; sb:
  * t->nsb entries of scratch.  The superblocks are taken by increasing
  * bound, the smallest left each time (they are few). */
-static void cell_bounds(const cells_t *t, const hd__box_t *q, sbound_t *sb, double *U, double *L) {
+static void cell_bounds(const cells_t *t, const hd__box_t *q, double *sb, double *U, double *L) {
     for (size_t s = 0; s < t->nsb; s++) sb[s] = hd__box_box_lb2(q, &t->sbox[s]);
     double u = INFINITY, l = INFINITY;
     for (;;) {
@@ -192,7 +191,7 @@ typedef struct {
 static int dir_bounds(dir_t *d, hd_error_t *err) {
     d->U = hd__malloc_array(d->q->nc ? d->q->nc : 1, sizeof *d->U);
     d->L = hd__malloc_array(d->q->nc ? d->q->nc : 1, sizeof *d->L);
-    sbound_t *sb = hd__malloc_array(d->t->nsb ? d->t->nsb : 1, sizeof *sb);
+    double *sb = hd__malloc_array(d->t->nsb ? d->t->nsb : 1, sizeof *sb);
     if (!d->U || !d->L || !sb) {
         free(sb);
         return hd__err(err, HD_ENOMEM, "cannot allocate the bounds of %zu cells", d->q->nc);
@@ -205,7 +204,7 @@ static int dir_bounds(dir_t *d, hd_error_t *err) {
 /* 1 when the probed cells (one in CELLS_PROBE) that are narrow (U - L at
  * most CELLS_NARROW L) hold CELLS_WORTH of the probed points. */
 static int narrow_enough(const cells_t *q, const cells_t *t) {
-    sbound_t *sb = hd__malloc_array(t->nsb ? t->nsb : 1, sizeof *sb);
+    double *sb = hd__malloc_array(t->nsb ? t->nsb : 1, sizeof *sb);
     if (!sb) return 0;
     size_t seen = 0, narrow = 0;
     for (size_t k = 0; k < q->nc; k += CELLS_PROBE) {
