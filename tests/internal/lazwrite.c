@@ -484,11 +484,13 @@ static void laz_file(tf_buf_t *b, int fmt, const hd__laz14_items_t *it, const un
         if (layered ? hd__laz14_encode(first, k, rec, it, &e)
                     : hd__laz_encode_pointwise(first, k, rec, it->type, it->size, it->n, &e))
             abort();
+        if (c < 64) lazw_last.chunk[c] = b->size;
         tf_put(b, first, rec);
         tf_put(b, e.buf, e.size);
         bytes[c] = rec + e.size;
     }
     uint64_t tab = b->size;
+    lazw_last.vlr = header + 54, lazw_last.points = offset, lazw_last.table = (size_t)tab;
     for (int i = 0; i < 8; i++) b->data[ptr + i] = (unsigned char)(tab >> 8 * i);
     tf_u32(b, 0, 0), tf_u32(b, (uint32_t)nc, 0);
     if (hd__laz_table_encode(0, nc, NULL, bytes, &e)) abort();

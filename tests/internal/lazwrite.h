@@ -54,8 +54,8 @@ void lazw_table(tf_buf_t *out, const uint32_t *counts, const uint32_t *bytes, si
  * sometimes; scanner channels switching now and then (format 6). */
 void lazw_random(gen_rng_t *g, lazw_point_t *p, size_t n, int format);
 
-/* Byte offsets of the parts of the last file lazw_encode wrote (for
- * hostile tests that damage one of them). */
+/* Byte offsets of the parts of the last file lazw_encode, lazw_pointwise
+ * or lazw_layered wrote (for hostile tests that damage one of them). */
 typedef struct lazw_layout {
     size_t vlr, points, table; /* the LASzip VLR's data, the point data, the chunk table */
     size_t chunk[64];          /* the first 64 chunks' starts */

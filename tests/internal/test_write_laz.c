@@ -534,7 +534,7 @@ TEST(layered_laz_subsets_are_the_same_file_on_any_thread_count) {
 
 TEST(layered_laz_damaged_layers_are_errors_with_offsets) {
     gen_rng_t g;
-    size_t n = 300, rec, m, mrec;
+    size_t n = 300, rec;
     tf_buf_t b = {0};
     unsigned char *recs = layered_file(&g, 41, 7, 2, 1, n, 300, 4, &b, &rec);
     unsigned char *d = b.data;
@@ -553,34 +553,67 @@ TEST(layered_laz_damaged_layers_are_errors_with_offsets) {
     CHECK_RC(hd_write_field(in, tf_path("rich14_bad_out.laz"), v, n, &o, NULL, &err), HD_EFORMAT);
     CHECK(strstr(err.message, "chunk 1 of 1") && strstr(err.message, "classification layer"));
     CHECK(err.offset > (long long)sizes);
-    (void)m, (void)mrec;
     free(v);
     free(recs);
 }
 
-TEST(pointwise_laz_damaged_chunks_are_errors_with_offsets_whatever_is_kept) {
+/* hd__write_laz on the n points of the LAZ bytes d (named `name`), keeping
+ * `keep` of them (v > 0.5 farther), on `threads` threads, into a temporary
+ * stream: what hd_write_field does once its read of the input has passed.
+ * A chunk that does not decode fails that read first, so only a call
+ * without it reaches the writer's own decoding. */
+static int write_laz_unread(const char *name, const unsigned char *d, size_t size, const double *v, size_t n,
+                            hd_keep_t keep, int threads, hd_error_t *err) {
+    hd__file_t f = {name, d, size};
+    hd_read_options_t r;
+    hd_read_options_init(&r);
+    r.threads = threads;
+    hd_field_t field = {"distance", v};
+    FILE *out = tmpfile();
+    CHECK(out != NULL);
+    hd__writer_t w = {.in = &f, .out_name = "unread_out.laz", .out = out, .v = v, .n = n, .f = &field, .nf = 1,
+                      .keep = keep, .threshold = 0.5, .ropt = &r, .err = err};
+    hd__err_clear(err);
+    int rc = hd__write_laz(&w);
+    fclose(out);
+    return rc;
+}
+
+TEST(pointwise_laz_chunks_that_do_not_decode_are_the_writers_errors_with_the_first_ones_offset) {
     gen_rng_t g;
     size_t n = 2500, rec;
     tf_buf_t b = {0};
     unsigned char *recs = pointwise_file(&g, 53, 3, 2, n, 1000, &b, &rec);
-    size_t chunk = le(b.data + 96, 4) + 8; /* the first chunk: its raw record, then its stream */
-    for (size_t i = 0; i < 64; i++) b.data[chunk + rec + 200 + i] ^= 0x5A;
-    const char *in = tf_finish(&b, "rich_bad.laz");
+    size_t start[4] = {lazw_last.chunk[0], lazw_last.chunk[1], lazw_last.chunk[2], lazw_last.table};
     double *v = calloc(n, sizeof *v);
-    v[3] = 1;
-    hd_write_options_t o;
-    hd_write_options_init(&o);
-    /* every point (each chunk decoded and encoded by one task), and a
-     * subset (the kept points gathered into new chunks) */
-    for (int keep = 0; keep < 2; keep++) {
-        CONTEXT("keep %s", keep ? "farther" : "all");
-        o.keep = keep ? HD_KEEP_FARTHER : HD_KEEP_ALL;
-        hd_error_t err;
-        CHECK_RC(hd_write_field(in, tf_path("rich_bad_out.laz"), v, n, &o, NULL, &err), HD_EFORMAT);
-        CONTEXT("%s (offset %lld)", err.message, err.offset);
-        CHECK(strstr(err.message, "chunk 1 of 3"));
-        CHECK(err.offset > (long long)chunk && err.offset <= (long long)(chunk + 1000 * rec));
+    v[3] = v[1500] = 1;
+    /* chunk 3 damaged, then chunks 2 and 3: the first that fails is named,
+     * with an offset inside it, every point kept (each chunk decoded and
+     * encoded by one task) or a subset (the kept points gathered into new
+     * chunks), whether its batch holds the chunk after it or not */
+    for (int first = 2; first >= 1; first--) {
+        unsigned char *d = malloc(b.size);
+        memcpy(d, b.data, b.size);
+        for (size_t c = (size_t)first; c < 3; c++)
+            for (size_t i = 0; i < 64; i++) d[start[c] + rec + 200 + i] ^= 0x5A;
+        char says[32];
+        snprintf(says, sizeof says, "chunk %d of 3: ", first + 1);
+        static const int threads[] = {1, 3};
+        for (int keep = 0; keep < 2; keep++)
+            for (int t = 0; t < 2; t++) {
+                CONTEXT("chunks %d to 3 damaged, keep %s, threads %d (seed 53)", first + 1, keep ? "farther" : "all",
+                        threads[t]);
+                hd_error_t err;
+                CHECK_RC(write_laz_unread("rich_bad.laz", d, b.size, v, n, keep ? HD_KEEP_FARTHER : HD_KEEP_ALL,
+                                          threads[t], &err),
+                         HD_EFORMAT);
+                CONTEXT("%s (offset %lld)", err.message, err.offset);
+                CHECK(strstr(err.message, "rich_bad.laz") && strstr(err.message, says));
+                CHECK(err.offset > (long long)start[first] && err.offset <= (long long)start[first + 1]);
+            }
+        free(d);
     }
+    tf_free(&b);
     free(v);
     free(recs);
 }
