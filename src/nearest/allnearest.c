@@ -271,49 +271,12 @@ static void part_range(const build_ctx *c, size_t part, size_t *lo, size_t *hi) 
     *hi = c->n * (part + 1) / (size_t)c->parts;
 }
 
-/* hd__key30's cell on one axis, the same value: u lies in [0, 1023]
- * after the clamps, where the signed conversion (one instruction, which
- * vectorises) equals the unsigned one (a sequence of a dozen). */
-HD__INLINE uint32_t key_cell(double v, double lo, double scale) {
-    double u = (v - lo) * scale;
-    u = u < 1023.0 ? u : 1023.0;
-    u = u > 0 ? u : 0;
-    return (uint32_t)(int32_t)u;
-}
-
-/* hd__spread10's value by shifts and masks (which vectorise; the table's
- * reads do not). */
-HD__INLINE uint32_t spread10(uint32_t v) {
-    v = (v | v << 16) & 0x030000ffu;
-    v = (v | v << 8) & 0x0300f00fu;
-    v = (v | v << 4) & 0x030c30c3u;
-    return (v | v << 2) & 0x09249249u;
-}
-
-/* hd__src_keys for packed doubles without a transform (the layout most
- * callers pass), the same keys; compiled for AVX2 where there is one
- * (field_bench's build phase). */
-HD__HOT static void keys_f64(const double *base, const hd__keygrid_t *grid, size_t lo, size_t hi,
-                             uint64_t *restrict keys) {
-    double l0 = grid->lo[0], l1 = grid->lo[1], l2 = grid->lo[2], sc = grid->scale;
-    for (size_t i = lo; i < hi; i++) {
-        const double *q = base + 3 * i;
-        uint32_t k = spread10(key_cell(q[0], l0, sc)) | spread10(key_cell(q[1], l1, sc)) << 1 |
-                     spread10(key_cell(q[2], l2, sc)) << 2;
-        keys[i] = (uint64_t)k << 32 | (uint64_t)i;
-    }
-}
-
 /* Keys of one part. */
 static void key_task(void *vctx, size_t part, int worker) {
     (void)worker;
     build_ctx *c = vctx;
     size_t lo, hi;
     part_range(c, part, &lo, &hi);
-    if (!c->sel && c->src.kind == HD__SRC_F64 && !c->src.T) {
-        keys_f64((const double *)(const void *)c->src.base, &c->grid, lo, hi, c->a);
-        return;
-    }
     if (!c->sel) {
         hd__src_keys(&c->src, &c->grid, lo, hi, c->a);
         return;

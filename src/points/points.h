@@ -283,34 +283,29 @@ HD__INLINE void hd__src_get(const hd__src_t *s, size_t k, double out[3]) {
     else out[0] = p[0], out[1] = p[1], out[2] = p[2];
 }
 
+/* The Morton keys on grid of the packed doubles xyz's points [lo, hi),
+ * above their indices (keys[i] = key << 32 | i): hd__key30's keys, by a
+ * loop that vectorises, compiled for AVX2 where there is one (source.c).
+ * The layout the engine's callers mostly pass; field_bench's build phase
+ * and the engine's build measure it. */
+void hd__keys_f64(const double *xyz, const hd__keygrid_t *grid, size_t lo, size_t hi, uint64_t *restrict keys);
+
 /* The Morton keys on grid of points [lo, hi) of src, above their indices
  * (keys[i] = key << 32 | i), as the builds and the index's queries sort
- * them.  Inline: an out-of-line call made hd_hausdorff measurably slower
- * (docs/benchmarks.md, "Measurements once quoted in the source"). */
-HD__INLINE void hd__src_keys_of(const hd__src_t *src, hd__src_kind_t kind, hd__keygrid_t g, size_t lo,
-                                size_t hi, uint64_t *keys) {
-    for (size_t i = lo; i < hi; i++) {
-        double p[3];
-        if (kind == HD__SRC_F64) {
-            const double *q = (const double *)(const void *)src->base + 3 * i;
-            p[0] = q[0], p[1] = q[1], p[2] = q[2];
-        } else {
-            hd__src_get(src, i, p);
-        }
-        keys[i] = (uint64_t)hd__key30(&g, p) << 32 | (uint64_t)i;
-    }
-}
-
-/* The loop specialised for packed doubles without a transform (the
- * layout the engine's callers mostly pass), with the grid in locals so
- * that the stores cannot be taken to change it: fewer instructions than
- * the general loop (callgrind; the counts are in docs/benchmarks.md). */
+ * them: hd__keys_f64 for packed doubles without a transform, else point
+ * by point through hd__src_get. */
 HD__INLINE void hd__src_keys(const hd__src_t *src, const hd__keygrid_t *grid, size_t lo, size_t hi,
                              uint64_t *keys) {
-    if (src->kind == HD__SRC_F64 && !src->T) hd__src_keys_of(src, HD__SRC_F64, *grid, lo, hi, keys);
-    else hd__src_keys_of(src, HD__SRC_ANY, *grid, lo, hi, keys);
+    if (src->kind == HD__SRC_F64 && !src->T) {
+        hd__keys_f64((const double *)(const void *)src->base, grid, lo, hi, keys);
+        return;
+    }
+    for (size_t i = lo; i < hi; i++) {
+        double p[3];
+        hd__src_get(src, i, p);
+        keys[i] = (uint64_t)hd__key30(grid, p) << 32 | (uint64_t)i;
+    }
 }
-
 
 /* Sort a[0..n) of 64-bit words by bits 32..61 (a Morton key above a 32-bit
  * index), stable, in three counting passes of 10 bits over `threads`

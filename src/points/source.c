@@ -37,6 +37,37 @@ const uint32_t hd__spread_table[1024] = {R256(0u), R256(256u), R256(512u), R256(
 #undef S3
 #undef S1
 
+/* hd__key_cell's value: u lies in [0, 1023] after the clamps, where the
+ * signed conversion (one instruction, which vectorises) equals the
+ * unsigned one (a sequence of a dozen). */
+HD__INLINE uint32_t key_cell(double v, double lo, double scale) {
+    double u = (v - lo) * scale;
+    u = u < 1023.0 ? u : 1023.0;
+    u = u > 0 ? u : 0;
+    return (uint32_t)(int32_t)u;
+}
+
+/* hd__spread10's value by shifts and masks (which vectorise; the table's
+ * reads do not). */
+HD__INLINE uint32_t spread10(uint32_t v) {
+    v = (v | v << 16) & 0x030000ffu;
+    v = (v | v << 8) & 0x0300f00fu;
+    v = (v | v << 4) & 0x030c30c3u;
+    return (v | v << 2) & 0x09249249u;
+}
+
+/* The grid in locals, so that the stores cannot be taken to change it. */
+HD__HOT void hd__keys_f64(const double *xyz, const hd__keygrid_t *grid, size_t lo, size_t hi,
+                          uint64_t *restrict keys) {
+    double l0 = grid->lo[0], l1 = grid->lo[1], l2 = grid->lo[2], sc = grid->scale;
+    for (size_t i = lo; i < hi; i++) {
+        const double *q = xyz + 3 * i;
+        uint32_t k = spread10(key_cell(q[0], l0, sc)) | spread10(key_cell(q[1], l1, sc)) << 1 |
+                     spread10(key_cell(q[2], l2, sc)) << 2;
+        keys[i] = (uint64_t)k << 32 | (uint64_t)i;
+    }
+}
+
 void hd__src_init(hd__src_t *s, const hd_points_t *p, const hd_transform_t *T) {
     ptrdiff_t el = p->dtype == HD_FLOAT32 ? (ptrdiff_t)sizeof(float) : (ptrdiff_t)sizeof(double);
     s->base = p->data;

@@ -652,8 +652,8 @@ TEST(a_structure_build_holds_at_most_39_bytes_a_point) {
 }
 
 TEST(the_keys_of_packed_doubles_are_the_keys_of_any_view) {
-    /* The build computes packed doubles' keys by a loop of its own; the
-     * same points read through a strided view take hd__src_keys: both
+    /* The build computes packed doubles' keys by hd__keys_f64's loop; the
+     * same points read through a strided view take hd__src_get: both
      * structures hold the same keys, point for point, hd__key30's when the
      * key box holds the set, and also where it is smaller (clamped cells
      * at both ends, the fullest corners refined alike). */
