@@ -183,51 +183,41 @@ static void st64(unsigned char *p, uint64_t v) {
 }
 
 /* ---- POINT14 -------------------------------------------------------------- */
+typedef hd__p14_models_t p14_t;
+static const hd__model_spec_t p14_models[] = {
+    HD__SYMS(p14_t, changed, 8, 128), HD__SYM(p14_t, scanner, 3), HD__SYM(p14_t, rn_same, 13),
+    HD__IC(p14_t, dx, 32, 2),         HD__IC(p14_t, dy, 32, 22),  HD__IC(p14_t, dz, 32, 20)};
+/* A channel's models besides POINT14's x, y, z (p14_models). */
+static const hd__model_spec_t ch_models[] = {
+    HD__SYM(ch_t, gmulti, 515), HD__SYM(ch_t, gzero, 5),   HD__IC(ch_t, inten, 16, 4),
+    HD__IC(ch_t, scan, 16, 2),  HD__IC(ch_t, psid, 16, 1), HD__IC(ch_t, gic, 32, 9)};
+
 int hd__p14_models_new(hd__p14_models_t *m) {
-    int rc = HD_OK;
-    for (int i = 0; i < 8 && rc == HD_OK; i++) rc = hd__symmodel_new(&m->changed[i], 128);
-    rc = rc ? rc : hd__symmodel_new(&m->scanner, 3);
-    rc = rc ? rc : hd__symmodel_new(&m->rn_same, 13);
-    rc = rc ? rc : hd__intcoder_new(&m->dx, 32, 2);
-    rc = rc ? rc : hd__intcoder_new(&m->dy, 32, 22);
-    rc = rc ? rc : hd__intcoder_new(&m->dz, 32, 20);
     for (int i = 0; i < 12; i++) {
         hd__median5_init(&m->mx[i]);
         hd__median5_init(&m->my[i]);
     }
-    return rc;
+    return HD__MODELS_NEW(m, p14_models);
 }
 void hd__p14_models_free(hd__p14_models_t *m) {
-    hd__symmodel_t *s[] = {&m->scanner, &m->rn_same};
-    hd__symmodels_free(s, 2);
-    for (int i = 0; i < 8; i++) hd__symmodel_free(&m->changed[i]);
+    HD__MODELS_FREE(m, p14_models);
     hd__lazy_models_free(m->nret, 16);
     hd__lazy_models_free(m->rnum, 16);
-    hd__intcoder_t *ic[] = {&m->dx, &m->dy, &m->dz};
-    hd__intcoders_free(ic, 3);
 }
 
 static void ch_free(ch_t *c) {
     hd__p14_models_free(&c->m);
-    hd__symmodel_t *m[] = {&c->gmulti, &c->gzero};
-    hd__symmodels_free(m, 2);
+    HD__MODELS_FREE(c, ch_models);
     hd__lazy_models_free(c->cls, 64);
     hd__lazy_models_free(c->flags, 64);
     hd__lazy_models_free(c->user, 64);
-    hd__intcoder_t *ic[] = {&c->inten, &c->scan, &c->psid, &c->gic};
-    hd__intcoders_free(ic, 4);
 }
 
 /* Channel c's models, started from the record `from` (the chunk's first,
  * or the last of the channel the stream was in). */
 static int ch_start(ch_t *c, const unsigned char *from) {
     int rc = hd__p14_models_new(&c->m);
-    rc = rc ? rc : hd__symmodel_new(&c->gmulti, 515);
-    rc = rc ? rc : hd__symmodel_new(&c->gzero, 5);
-    rc = rc ? rc : hd__intcoder_new(&c->inten, 16, 4);
-    rc = rc ? rc : hd__intcoder_new(&c->scan, 16, 2);
-    rc = rc ? rc : hd__intcoder_new(&c->psid, 16, 1);
-    rc = rc ? rc : hd__intcoder_new(&c->gic, 32, 9);
+    rc = rc ? rc : HD__MODELS_NEW(c, ch_models);
     c->used = 1; /* freed by ch_free even when a step failed */
     if (rc) return rc;
     memcpy(c->last, from, 30);
@@ -491,21 +481,15 @@ static int point14(c14_t *s, unsigned char *rec) {
 }
 
 /* ---- RGB14, RGBNIR14 ------------------------------------------------------ */
+static const hd__model_spec_t rgbc_models[] = {
+    HD__SYM(rgbc_t, sym, 128), HD__SYMS(rgbc_t, diff, 6, 256), HD__SYM(rgbc_t, nsym, 4), HD__SYMS(rgbc_t, ndiff, 2, 256)};
 static int rgbc_start(rgbc_t *c, const unsigned char *from) {
-    int rc = hd__symmodel_new(&c->sym, 128);
-    for (int i = 0; i < 6 && rc == HD_OK; i++) rc = hd__symmodel_new(&c->diff[i], 256);
-    rc = rc ? rc : hd__symmodel_new(&c->nsym, 4);
-    rc = rc ? rc : hd__symmodel_new(&c->ndiff[0], 256);
-    rc = rc ? rc : hd__symmodel_new(&c->ndiff[1], 256);
+    int rc = HD__MODELS_NEW(c, rgbc_models);
     c->used = 1;
     memcpy(c->last, from, 8);
     return rc;
 }
-static void rgbc_free(rgbc_t *c) {
-    hd__symmodel_t *m[] = {&c->sym, &c->diff[0], &c->diff[1], &c->diff[2], &c->diff[3], &c->diff[4], &c->diff[5],
-                           &c->nsym, &c->ndiff[0], &c->ndiff[1]};
-    hd__symmodels_free(m, 10);
-}
+static void rgbc_free(rgbc_t *c) { HD__MODELS_FREE(c, rgbc_models); }
 
 static unsigned clamp8(int v) { return v < 0 ? 0u : v > 255 ? 255u : (unsigned)v; }
 
@@ -588,25 +572,18 @@ static int rgb14(c14_t *s, unsigned char *item) {
 }
 
 /* ---- WAVEPACKET14 ---------------------------------------------------------- */
+static const hd__model_spec_t wavec_models[] = {
+    HD__SYM(wavec_t, index, 256),  HD__SYMS(wavec_t, odiff, 4, 4), HD__IC(wavec_t, ioff, 32, 1),
+    HD__IC(wavec_t, isize, 32, 1), HD__IC(wavec_t, iret, 32, 1),   HD__IC(wavec_t, ixyz, 32, 3)};
 static int wavec_start(wavec_t *c, const unsigned char *from) {
-    int rc = hd__symmodel_new(&c->index, 256);
-    for (int i = 0; i < 4 && rc == HD_OK; i++) rc = hd__symmodel_new(&c->odiff[i], 4);
-    rc = rc ? rc : hd__intcoder_new(&c->ioff, 32, 1);
-    rc = rc ? rc : hd__intcoder_new(&c->isize, 32, 1);
-    rc = rc ? rc : hd__intcoder_new(&c->iret, 32, 1);
-    rc = rc ? rc : hd__intcoder_new(&c->ixyz, 32, 3);
+    int rc = HD__MODELS_NEW(c, wavec_models);
     c->used = 1;
     c->sym_last = 0;
     c->last_diff = 0;
     memcpy(c->last, from, 29);
     return rc;
 }
-static void wavec_free(wavec_t *c) {
-    hd__symmodel_t *m[] = {&c->index, &c->odiff[0], &c->odiff[1], &c->odiff[2], &c->odiff[3]};
-    hd__symmodels_free(m, 5);
-    hd__intcoder_t *ic[] = {&c->ioff, &c->isize, &c->iret, &c->ixyz};
-    hd__intcoders_free(ic, 4);
-}
+static void wavec_free(wavec_t *c) { HD__MODELS_FREE(c, wavec_models); }
 
 /* A wave packet descriptor (29 bytes: index, u64 offset, u32 size, f32
  * return point, f32 x, y, z, the floats coded as their 32 bits): the

@@ -100,10 +100,6 @@ void hd__symmodel_free(hd__symmodel_t *m) {
     m->dist = m->count = m->table = NULL;
 }
 
-void hd__symmodels_free(hd__symmodel_t *const *m, size_t n) {
-    for (size_t i = 0; i < n; i++) hd__symmodel_free(m[i]);
-}
-
 void hd__lazy_models_free(hd__symmodel_t **slots, size_t n) {
     for (size_t i = 0; i < n; i++)
         if (slots[i]) {
@@ -152,6 +148,26 @@ void hd__intcoder_free(hd__intcoder_t *ic) {
 
 void hd__intcoders_free(hd__intcoder_t *const *ic, size_t n) {
     for (size_t i = 0; i < n; i++) hd__intcoder_free(ic[i]);
+}
+
+int hd__models_new(void *set, const hd__model_spec_t *list, size_t n) {
+    for (size_t i = 0; i < n; i++)
+        for (unsigned k = 0; k < list[i].count; k++) {
+            char *at = (char *)set + list[i].at;
+            int rc = list[i].ic ? hd__intcoder_new((hd__intcoder_t *)(void *)at + k, list[i].n, list[i].ctx)
+                                : hd__symmodel_new((hd__symmodel_t *)(void *)at + k, list[i].n);
+            if (rc) return rc;
+        }
+    return HD_OK;
+}
+
+void hd__models_free(void *set, const hd__model_spec_t *list, size_t n) {
+    for (size_t i = 0; i < n; i++)
+        for (unsigned k = 0; k < list[i].count; k++) {
+            char *at = (char *)set + list[i].at;
+            if (list[i].ic) hd__intcoder_free((hd__intcoder_t *)(void *)at + k);
+            else hd__symmodel_free((hd__symmodel_t *)(void *)at + k);
+        }
 }
 
 void hd__median5_init(hd__median5_t *m) {
@@ -366,48 +382,43 @@ void hd__ic_encode(hd__intcoder_t *ic, hd__enc_t *e, int32_t pred, int32_t real,
 }
 
 /* ---- the models of pointwise LAZ's items --------------------------------- */
+/* Each item's models in version 2 and in version 1 (hd__model_spec_t). */
+typedef hd__pw_models_t pw_t;
+static const hd__model_spec_t point10_v2[] = {
+    HD__SYM(pw_t, changed, 64), HD__SYMS(pw_t, scan, 2, 256), HD__IC(pw_t, intensity, 16, 4), HD__IC(pw_t, dx, 32, 2),
+    HD__IC(pw_t, dy, 32, 22),   HD__IC(pw_t, psid, 16, 1),    HD__IC(pw_t, dz, 32, 20)};
+static const hd__model_spec_t point10_v1[] = {
+    HD__SYM(pw_t, changed, 64), HD__IC(pw_t, scan1, 8, 2), HD__IC(pw_t, intensity, 16, 1), HD__IC(pw_t, dx, 32, 1),
+    HD__IC(pw_t, dy, 32, 20),   HD__IC(pw_t, psid, 16, 1), HD__IC(pw_t, dz, 32, 20)};
+static const hd__model_spec_t gps11_v2[] = {
+    HD__SYM(pw_t, gmulti, 516), HD__SYM(pw_t, gzero, 6), HD__IC(pw_t, gic, 32, 9)};
+static const hd__model_spec_t gps11_v1[] = {
+    HD__SYM(pw_t, gmulti, 512), HD__SYM(pw_t, gzero, 3), HD__IC(pw_t, gic, 32, 6)};
+static const hd__model_spec_t rgb12_v2[] = {HD__SYM(pw_t, used, 128), HD__SYMS(pw_t, cdiff, 6, 256)};
+static const hd__model_spec_t rgb12_v1[] = {HD__SYM(pw_t, used, 64), HD__IC(pw_t, cic, 8, 6)};
+
 int hd__pw_point10_new(hd__pw_models_t *m, int v2) {
-    int rc = hd__symmodel_new(&m->changed, 64);
-    if (v2) {
-        rc = rc ? rc : hd__symmodel_new(&m->scan[0], 256);
-        rc = rc ? rc : hd__symmodel_new(&m->scan[1], 256);
-        rc = rc ? rc : hd__intcoder_new(&m->intensity, 16, 4);
-        rc = rc ? rc : hd__intcoder_new(&m->dx, 32, 2);
-        rc = rc ? rc : hd__intcoder_new(&m->dy, 32, 22);
-    } else {
-        rc = rc ? rc : hd__intcoder_new(&m->scan1, 8, 2);
-        rc = rc ? rc : hd__intcoder_new(&m->intensity, 16, 1);
-        rc = rc ? rc : hd__intcoder_new(&m->dx, 32, 1);
-        rc = rc ? rc : hd__intcoder_new(&m->dy, 32, 20);
-    }
-    rc = rc ? rc : hd__intcoder_new(&m->psid, 16, 1);
-    rc = rc ? rc : hd__intcoder_new(&m->dz, 32, 20);
     for (int i = 0; i < 16; i++) {
         hd__median5_init(&m->mx[i]);
         hd__median5_init(&m->my[i]);
     }
-    return rc;
+    return v2 ? HD__MODELS_NEW(m, point10_v2) : HD__MODELS_NEW(m, point10_v1);
 }
 
 int hd__pw_gps11_new(hd__pw_models_t *m, int v2) {
-    int rc = hd__symmodel_new(&m->gmulti, v2 ? 516 : 512);
-    rc = rc ? rc : hd__symmodel_new(&m->gzero, v2 ? 6 : 3);
-    return rc ? rc : hd__intcoder_new(&m->gic, 32, v2 ? 9 : 6);
+    return v2 ? HD__MODELS_NEW(m, gps11_v2) : HD__MODELS_NEW(m, gps11_v1);
 }
 
 int hd__pw_rgb12_new(hd__pw_models_t *m, int v2) {
-    int rc = hd__symmodel_new(&m->used, v2 ? 128 : 64);
-    for (int k = 0; k < 6 && rc == HD_OK && v2; k++) rc = hd__symmodel_new(&m->cdiff[k], 256);
-    return rc || v2 ? rc : hd__intcoder_new(&m->cic, 8, 6);
+    return v2 ? HD__MODELS_NEW(m, rgb12_v2) : HD__MODELS_NEW(m, rgb12_v1);
 }
 
+/* Every field of the set is in one of the lists freed (gps11_v1's are
+ * gps11_v2's fields). */
 void hd__pw_models_free(hd__pw_models_t *m) {
-    hd__symmodel_t *s[] = {&m->changed, &m->scan[0], &m->scan[1], &m->gmulti, &m->gzero, &m->used};
-    hd__symmodels_free(s, sizeof s / sizeof s[0]);
-    for (int i = 0; i < 6; i++) hd__symmodel_free(&m->cdiff[i]);
+    HD__MODELS_FREE(m, point10_v2), HD__MODELS_FREE(m, point10_v1);
+    HD__MODELS_FREE(m, gps11_v2), HD__MODELS_FREE(m, rgb12_v2), HD__MODELS_FREE(m, rgb12_v1);
     hd__lazy_models_free(m->bitbyte, 256);
     hd__lazy_models_free(m->cls, 256);
     hd__lazy_models_free(m->user, 256);
-    hd__intcoder_t *ic[] = {&m->intensity, &m->psid, &m->dx, &m->dy, &m->dz, &m->scan1, &m->gic, &m->cic};
-    hd__intcoders_free(ic, sizeof ic / sizeof ic[0]);
 }

@@ -34,6 +34,7 @@
 
 #include "base/base.h"
 
+#include <stddef.h>
 #include <stdint.h>
 #include <string.h>
 
@@ -70,8 +71,6 @@ int hd__symmodel_new(hd__symmodel_t *m, uint32_t n);
 void hd__symmodel_init(hd__symmodel_t *m);
 void hd__symmodel_update(hd__symmodel_t *m);
 void hd__symmodel_free(hd__symmodel_t *m);
-/* Free the n models whose addresses are in m. */
-void hd__symmodels_free(hd__symmodel_t *const *m, size_t n);
 /* Free the models created on first use in slots[0..n) (NULL: never used),
  * and their memory. */
 void hd__lazy_models_free(hd__symmodel_t **slots, size_t n);
@@ -184,6 +183,30 @@ int hd__intcoder_new(hd__intcoder_t *ic, uint32_t bits, uint32_t contexts);
 void hd__intcoder_free(hd__intcoder_t *ic);
 /* Free the n integer coders whose addresses are in ic. */
 void hd__intcoders_free(hd__intcoder_t *const *ic, size_t n);
+
+/* ---- a set of models, as a list of its fields ---------------------------
+ * An item's coder keeps its models as fields of a struct (a "set"); one
+ * list of those fields, in the order LASzip's coder creates them, makes
+ * them (hd__models_new) and frees them (hd__models_free).  An entry is a
+ * field's offset, whether it is an integer coder, how many lie in a row
+ * (an array field), and a symbol model's symbols or an integer coder's bits
+ * and contexts. */
+typedef struct hd__model_spec {
+    size_t at;
+    unsigned char ic, count;
+    uint32_t n, ctx;
+} hd__model_spec_t;
+#define HD__SYMS(T, field, count, n) {offsetof(T, field), 0, (count), (n), 0}
+#define HD__SYM(T, field, n) HD__SYMS(T, field, 1, n)
+#define HD__IC(T, field, bits, contexts) {offsetof(T, field), 1, 1, (bits), (contexts)}
+/* The models of list[0..n) in the set at `set`, in order: HD_OK, or
+ * HD_ENOMEM at the first that cannot be made (those before it are made). */
+int hd__models_new(void *set, const hd__model_spec_t *list, size_t n);
+/* Free the models of list[0..n) in the set at `set`, each made or zeroed
+ * (a freed model is zeroed again, so a field in two lists is harmless). */
+void hd__models_free(void *set, const hd__model_spec_t *list, size_t n);
+#define HD__MODELS_NEW(set, list) hd__models_new(set, list, sizeof(list) / sizeof *(list))
+#define HD__MODELS_FREE(set, list) hd__models_free(set, list, sizeof(list) / sizeof *(list))
 
 /* The model m, initialised at its first use. */
 HD__INLINE hd__symmodel_t *hd__ic_model(hd__symmodel_t *m) {
