@@ -500,21 +500,25 @@ static unsigned cbyte(const c14_t *s, layer_t *L, hd__symmodel_t *m, int bit, un
     return (csym(s, L, m, E((now - pred) & 255)) + pred) & 255;
 }
 
-/* The last values to predict from after a switch of the item's channel to
- * the point's (see the top); NULL when a channel's models could not be
- * made. */
+/* What an item (RGB14, RGBNIR14, WAVEPACKET14, BYTE14) predicts the point
+ * from when the point's channel is not the item's (*item_cur, moved to
+ * it; see the top): the last values of the channel it comes from (CH_SAME),
+ * the point's channel's own (CH_OWN), or these started from those (CH_FIRST:
+ * the channel is not `used` yet).  v4: the item's version is 4. */
+typedef enum { CH_SAME, CH_FIRST, CH_OWN } item_switch_t;
+static item_switch_t item_switch(const c14_t *s, unsigned *item_cur, int used, int v4) {
+    if (s->cur == *item_cur) return CH_SAME;
+    *item_cur = s->cur;
+    return !used ? CH_FIRST : v4 ? CH_OWN : CH_SAME;
+}
+
+/* The last values to predict from (item_switch); NULL when a channel's
+ * models could not be made. */
 static unsigned char *rgb_last(c14_t *s) {
     unsigned char *lp = s->rgb[s->rgb_cur].last;
-    if (s->cur != s->rgb_cur) {
-        s->rgb_cur = s->cur;
-        if (!s->rgb[s->cur].used) {
-            if (rgbc_start(&s->rgb[s->cur], lp)) return NULL;
-            lp = s->rgb[s->cur].last;
-        } else if (s->rgb_v4) {
-            lp = s->rgb[s->cur].last;
-        }
-    }
-    return lp;
+    item_switch_t w = item_switch(s, &s->rgb_cur, s->rgb[s->cur].used, s->rgb_v4);
+    if (w == CH_FIRST && rgbc_start(&s->rgb[s->cur], lp)) return NULL;
+    return w == CH_SAME ? lp : s->rgb[s->cur].last;
 }
 
 static int rgb14(c14_t *s, unsigned char *item) {
@@ -593,15 +597,9 @@ static void wavec_free(wavec_t *c) { HD__MODELS_FREE(c, wavec_models); }
  * the previous choice; the others against the last values. */
 static int wave14(c14_t *s, unsigned char *item) {
     unsigned char *lp = s->wave[s->wave_cur].last;
-    if (s->cur != s->wave_cur) {
-        s->wave_cur = s->cur;
-        if (!s->wave[s->cur].used) {
-            if (wavec_start(&s->wave[s->cur], lp)) return HD_ENOMEM;
-            lp = s->wave[s->cur].last;
-        } else if (s->wave_v4) {
-            lp = s->wave[s->cur].last;
-        }
-    }
+    item_switch_t w = item_switch(s, &s->wave_cur, s->wave[s->cur].used, s->wave_v4);
+    if (w == CH_FIRST && wavec_start(&s->wave[s->cur], lp)) return HD_ENOMEM;
+    if (w != CH_SAME) lp = s->wave[s->cur].last;
     wavec_t *c = &s->wave[s->cur];
     layer_t *L = &s->L[s->wave_layer];
     unsigned char out[29];
@@ -668,15 +666,9 @@ static void bytc_free(bytc_t *c, size_t nb) {
 
 static int byte14(c14_t *s, unsigned char *item) {
     unsigned char *lp = s->byt[s->byt_cur].last;
-    if (s->cur != s->byt_cur) {
-        s->byt_cur = s->cur;
-        if (!s->byt[s->cur].used) {
-            if (bytc_start(&s->byt[s->cur], lp, s->nb)) return HD_ENOMEM;
-            lp = s->byt[s->cur].last;
-        } else if (s->byt_v4) {
-            lp = s->byt[s->cur].last;
-        }
-    }
+    item_switch_t w = item_switch(s, &s->byt_cur, s->byt[s->cur].used, s->byt_v4);
+    if (w == CH_FIRST && bytc_start(&s->byt[s->cur], lp, s->nb)) return HD_ENOMEM;
+    if (w != CH_SAME) lp = s->byt[s->cur].last;
     bytc_t *c = &s->byt[s->cur];
     for (size_t k = 0; k < s->nb; k++) {
         layer_t *L = &s->L[s->byt_layer + k];
