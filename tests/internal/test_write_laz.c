@@ -225,14 +225,21 @@ TEST(layered_laz_gains_several_fields_as_eight_byte14_layers_each) {
     }
 }
 
-TEST(laz_extended_vlrs_follow_the_points_with_their_offset_moved) {
+/* The LAZ file (options o) of n random points of o's format drawn from
+ * seed (lazw_random), in b. */
+static void random_laz(tf_buf_t *b, const lazw_opts_t *o, size_t n, uint64_t seed) {
     gen_rng_t g;
-    gen_seed(&g, 31);
-    lazw_point_t p[300];
-    lazw_random(&g, p, 300, 6);
+    gen_seed(&g, seed);
+    lazw_point_t *p = malloc(n * sizeof *p);
+    lazw_random(&g, p, n, o->format);
+    lazw_encode(b, o, p, n);
+    free(p);
+}
+
+TEST(laz_extended_vlrs_follow_the_points_with_their_offset_moved) {
     lazw_opts_t o = {6, 0, 100, NULL, 0, {0.01, 0.01, 0.01}, {0, 0, 0}, 0};
     tf_buf_t b = {0};
-    lazw_encode(&b, &o, p, 300);
+    random_laz(&b, &o, 300, 31);
     uint64_t at = b.size; /* an extended VLR after the chunk table */
     for (int i = 0; i < 8; i++) b.data[235 + i] = (unsigned char)(at >> 8 * i);
     b.data[243] = 1;
@@ -619,13 +626,9 @@ TEST(pointwise_laz_chunks_that_do_not_decode_are_the_writers_errors_with_the_fir
 }
 
 TEST(laszip1_streams_are_refused_by_name) {
-    gen_rng_t g;
-    gen_seed(&g, 9);
-    lazw_point_t p[20];
-    lazw_random(&g, p, 20, 1);
     lazw_opts_t o = {1, 0, 10, NULL, 0, {0.01, 0.01, 0.01}, {0, 0, 0}, 1};
     tf_buf_t b = {0};
-    lazw_encode(&b, &o, p, 20);
+    random_laz(&b, &o, 20, 9);
     const char *in = tf_finish(&b, "v1.laz");
     double v[20] = {0};
     hd_error_t err;
