@@ -216,7 +216,7 @@ static void encode_chunk(void *ctx, size_t k, int worker) {
 
 /* Encode every chunk's new layers, in parallel (first pass: the sizes are
  * needed before anything after the header is written); the first failing
- * chunk in file order is the error. */
+ * chunk in file order is the error, kept whole (its offset too). */
 static int encode_chunks(lazw_t *z) {
     size_t nc = z->c.n_chunks;
     z->layers = hd__calloc_array(nc + 1, sizeof *z->layers);
@@ -230,7 +230,10 @@ static int encode_chunks(lazw_t *z) {
         return hd__err(z->w->err, HD_ENOMEM, "out of memory");
     hd__parallel_for(hd__thread_count(z->w->ropt->threads, nc), nc, encode_chunk, z);
     for (size_t k = 0; k < nc; k++)
-        if (z->rc[k]) return hd__err(z->w->err, z->rc[k], "%s", z->err[k].message);
+        if (z->rc[k]) {
+            if (z->w->err) *z->w->err = z->err[k];
+            return z->rc[k];
+        }
     return HD_OK;
 }
 

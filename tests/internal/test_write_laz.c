@@ -586,43 +586,54 @@ static int write_laz_unread(const char *name, const unsigned char *d, size_t siz
     return rc;
 }
 
-TEST(pointwise_laz_chunks_that_do_not_decode_are_the_writers_errors_with_the_first_ones_offset) {
-    gen_rng_t g;
-    size_t n = 2500, rec;
-    tf_buf_t b = {0};
-    unsigned char *recs = pointwise_file(&g, 53, 3, 2, n, 1000, &b, &rec);
+/* The LAZ file b (n points of rec bytes, three chunks: lazw_last) with
+ * chunk 3 damaged, then chunks 2 and 3: the first that fails is named by
+ * the writer, with an offset inside it, every point kept or a subset,
+ * whether its batch of tasks holds the chunk after it or not (1 and 3
+ * threads). */
+static void damaged_chunks_name_the_first(const tf_buf_t *b, size_t n, size_t rec, const char *what) {
     size_t start[4] = {lazw_last.chunk[0], lazw_last.chunk[1], lazw_last.chunk[2], lazw_last.table};
     double *v = calloc(n, sizeof *v);
     v[3] = v[1500] = 1;
-    /* chunk 3 damaged, then chunks 2 and 3: the first that fails is named,
-     * with an offset inside it, every point kept (each chunk decoded and
-     * encoded by one task) or a subset (the kept points gathered into new
-     * chunks), whether its batch holds the chunk after it or not */
     for (int first = 2; first >= 1; first--) {
-        unsigned char *d = malloc(b.size);
-        memcpy(d, b.data, b.size);
+        unsigned char *d = malloc(b->size);
+        memcpy(d, b->data, b->size);
         for (size_t c = (size_t)first; c < 3; c++)
-            for (size_t i = 0; i < 64; i++) d[start[c] + rec + 200 + i] ^= 0x5A;
+            for (size_t i = 0; i < 64; i++) d[start[c] + rec + 200 + i] ^= 0x5A; /* the stream (layer 0) */
         char says[32];
         snprintf(says, sizeof says, "chunk %d of 3: ", first + 1);
         static const int threads[] = {1, 3};
         for (int keep = 0; keep < 2; keep++)
             for (int t = 0; t < 2; t++) {
-                CONTEXT("chunks %d to 3 damaged, keep %s, threads %d (seed 53)", first + 1, keep ? "farther" : "all",
+                CONTEXT("%s: chunks %d to 3 damaged, keep %s, threads %d", what, first + 1, keep ? "farther" : "all",
                         threads[t]);
                 hd_error_t err;
-                CHECK_RC(write_laz_unread("rich_bad.laz", d, b.size, v, n, keep ? HD_KEEP_FARTHER : HD_KEEP_ALL,
+                CHECK_RC(write_laz_unread("bad.laz", d, b->size, v, n, keep ? HD_KEEP_FARTHER : HD_KEEP_ALL,
                                           threads[t], &err),
                          HD_EFORMAT);
                 CONTEXT("%s (offset %lld)", err.message, err.offset);
-                CHECK(strstr(err.message, "rich_bad.laz") && strstr(err.message, says));
+                CHECK(strstr(err.message, "bad.laz") && strstr(err.message, says));
                 CHECK(err.offset > (long long)start[first] && err.offset <= (long long)start[first + 1]);
             }
         free(d);
     }
-    tf_free(&b);
     free(v);
-    free(recs);
+}
+
+/* Pointwise: each chunk decoded to records (and, every point kept, encoded
+ * by the same task); layered: every point kept, each chunk's channels
+ * decoded from its first layer (write_laz.c), a subset every layer. */
+TEST(laz_chunks_that_do_not_decode_are_the_writers_errors_with_the_first_ones_offset) {
+    for (int layered = 0; layered < 2; layered++) {
+        gen_rng_t g;
+        size_t n = 2500, rec;
+        tf_buf_t b = {0};
+        unsigned char *recs = layered ? layered_file(&g, 59, 7, 1, 1, n, 1000, 3, &b, &rec)
+                                      : pointwise_file(&g, 53, 3, 2, n, 1000, &b, &rec);
+        damaged_chunks_name_the_first(&b, n, rec, layered ? "layered, seed 59" : "pointwise, seed 53");
+        tf_free(&b);
+        free(recs);
+    }
 }
 
 TEST(laszip1_streams_are_refused_by_name) {
