@@ -374,6 +374,10 @@ int hd__chunk_vertex(hd__chunk_t *c, const char **q, const char *eol, long long 
                      const char *prefix, const char *expected, int comment_ends);
 void hd__chunk_fail(hd__chunk_t *c, int code, long long line, const char *fmt,
                     ...) HD__PRINTF(4, 5);
+/* Add the face of n vertex indices ix to the chunk's triangles and count
+ * it (c->aux); ix is freed unless it is the caller's buffer idx.  1, or 0
+ * with the chunk failed at `line` (out of memory). */
+int hd__chunk_face(hd__chunk_t *c, uint64_t *ix, const uint64_t *idx, size_t n, long long line);
 /* Append the point v to the chunk's window (hd__sink_push): 1, or 0 with the
  * point's problem recorded through hd__chunk_fail. */
 HD__INLINE int hd__chunk_push(hd__chunk_t *c, long long line, const double v[3]) {

@@ -85,13 +85,7 @@ static void chunk(void *ctx, hd__chunk_t *c) {
                 return;
             }
         }
-        int rc = hd__tris_add(&c->tris, ix, (size_t)n);
-        if (ix != idx) free(ix);
-        if (rc) {
-            hd__chunk_fail(c, rc, line, "out of memory for faces");
-            return;
-        }
-        c->aux++;
+        if (!hd__chunk_face(c, ix, idx, (size_t)n, line)) return;
     }
     c->lines = line;
 }

@@ -439,15 +439,7 @@ static void vertex_chunk(void *ctx, hd__chunk_t *c) {
                     return;
                 }
             }
-            if (keep) {
-                int rc = hd__tris_add(&c->tris, ix, (size_t)cnt);
-                if (ix != idx) free(ix);
-                if (rc) {
-                    hd__chunk_fail(c, rc, line, "out of memory for faces");
-                    return;
-                }
-                c->aux++;
-            }
+            if (keep && !hd__chunk_face(c, ix, idx, (size_t)cnt, line)) return;
         }
         if (hd__token(&q, eol, &tb, &te)) {
             hd__chunk_fail(c, HD_EFORMAT, line, "element %.*s: more values than its %d properties ('%.*s')",

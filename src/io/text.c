@@ -154,6 +154,17 @@ void hd__chunk_fail(hd__chunk_t *c, int code, long long line, const char *fmt, .
     va_end(ap);
 }
 
+int hd__chunk_face(hd__chunk_t *c, uint64_t *ix, const uint64_t *idx, size_t n, long long line) {
+    int rc = hd__tris_add(&c->tris, ix, n);
+    if (ix != idx) free(ix);
+    if (rc) {
+        hd__chunk_fail(c, rc, line, "out of memory for faces");
+        return 0;
+    }
+    c->aux++;
+    return 1;
+}
+
 typedef struct {
     hd__chunk_t *chunks;
     const hd__text_job_t *job;
