@@ -13,7 +13,9 @@
  * decoded back to its records, and hd_write_field's output (all points, a
  * subset) to the same records with the values after them.  laz-perf
  * checks these outputs too where it can (tests/laz_lazperf.py, field_*
- * cases).  And the LAZ refusals.
+ * cases).  And the LAZ refusals, the writer's own among them: chunks that
+ * do not decode, given to hd__write_laz without the read of the input
+ * that hd_write_field makes first and that refuses them before.
  */
 #include "check.h"
 #include "files.h"
