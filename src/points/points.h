@@ -286,24 +286,26 @@ HD__INLINE void hd__src_get(const hd__src_t *s, size_t k, double out[3]) {
 /* The Morton keys on grid of the packed doubles xyz's points [lo, hi),
  * above their indices (keys[i] = key << 32 | i): hd__key30's keys, by a
  * loop that vectorises, compiled for AVX2 where there is one (source.c).
- * The layout the engine's callers mostly pass; field_bench's build phase
- * and the engine's build measure it. */
+ * The layout the engine's callers mostly pass (field_bench's build phase
+ * and keys_bench measure it). */
 void hd__keys_f64(const double *xyz, const hd__keygrid_t *grid, size_t lo, size_t hi, uint64_t *restrict keys);
 
 /* The Morton keys on grid of points [lo, hi) of src, above their indices
  * (keys[i] = key << 32 | i), as the builds and the index's queries sort
  * them: hd__keys_f64 for packed doubles without a transform, else point
- * by point through hd__src_get. */
+ * by point through hd__src_get (the grid in a local, so that the stores
+ * cannot be taken to change it). */
 HD__INLINE void hd__src_keys(const hd__src_t *src, const hd__keygrid_t *grid, size_t lo, size_t hi,
                              uint64_t *keys) {
     if (src->kind == HD__SRC_F64 && !src->T) {
         hd__keys_f64((const double *)(const void *)src->base, grid, lo, hi, keys);
         return;
     }
+    hd__keygrid_t g = *grid;
     for (size_t i = lo; i < hi; i++) {
         double p[3];
         hd__src_get(src, i, p);
-        keys[i] = (uint64_t)hd__key30(grid, p) << 32 | (uint64_t)i;
+        keys[i] = (uint64_t)hd__key30(&g, p) << 32 | (uint64_t)i;
     }
 }
 
