@@ -11,7 +11,12 @@
  *    so the rounding of the distance is the same in both scales as long as
  *    the result is a normal double.
  *
- * 2. The feature.  Ericson's tests (Real-Time Collision Detection, 5.1.5)
+ * 2. The feature.  First the face alone (face_first): the three weights
+ *    of p's projection, as signs of plain-double products each with an
+ *    error bound; when all three are certainly positive the feature is the
+ *    face and step 3 goes straight to its N / M (a near point's common
+ *    case: the classification's twelve dot products are not formed).
+ *    Otherwise Ericson's tests (Real-Time Collision Detection, 5.1.5)
  *    name the Voronoi region of p exactly when they are evaluated exactly on
  *    a non-degenerate triangle.  Each is evaluated in doubles from rounded
  *    differences, and its sign is accepted only when |value| exceeds
