@@ -356,6 +356,11 @@ typedef struct {
     cand_t cheap[CANDS], prep[CANDS];
 } search_t;
 
+/* The double after d, for a distance (finite, d >= +0): its bits plus one,
+ * as nextafter(d, INFINITY) gives, without the call (a -0 would give -2^-1074,
+ * which square_up takes to its floor, as it takes nextafter's 2^-1074). */
+static inline double next_up(double d) { return hd__double_of(hd__bits_of(d) + 1); }
+
 static void evaluate(const hd__bvh_t *t, const double *p, size_t pos, search_t *s, hd__bvh_stats_t *st) {
     const hd__tri_t *tr = &t->tris[pos];
     hd__tri_near_t r;
@@ -366,7 +371,7 @@ static void evaluate(const hd__bvh_t *t, const double *p, size_t pos, search_t *
         s->best = r;
         s->index = tr->index;
         s->pos = pos;
-        double t2 = square_up(nextafter(r.d, INFINITY));
+        double t2 = square_up(next_up(r.d));
         s->thr = t2 < s->thr ? t2 : s->thr;
     }
 }
