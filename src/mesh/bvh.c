@@ -442,7 +442,7 @@ static void flush_prep(const hd__bvh_t *t, const double *p, search_t *s, hd__bvh
 
 /* Triangle k's prepared bounds: discarded when lo2 > thr, else a
  * candidate of the kernel, and its hi2 may lower thr. */
-static void consider(const hd__bvh_t *t, const double *p, size_t k, search_t *s, hd__bvh_stats_t *st) {
+HD__INLINE void consider(const hd__bvh_t *t, const double *p, size_t k, search_t *s, hd__bvh_stats_t *st) {
     double lo2, hi2;
     st->bounded++;
     hd__tri_bounds_below(p, hd__bvh_prep(t, k), s->thr, &lo2, &hi2);
@@ -503,7 +503,7 @@ static int support_beyond(const hd__tri_t *t, const double *c, const double *p, 
 /* Triangle k's cheap bounds: its box's (hd__box_lb2s shrunk, below d^2
  * by box_beyond's proof) and the support bound; a triangle left is a
  * candidate of the prepared stage with the box's bound as its key. */
-static void screen(const hd__bvh_t *t, const double *p, size_t k, search_t *s, hd__bvh_stats_t *st) {
+HD__INLINE void screen(const hd__bvh_t *t, const double *p, size_t k, search_t *s, hd__bvh_stats_t *st) {
     const hd__box_t *bx = &t->boxes[k];
     double b = box_lb2s(bx, p);
     if (box_beyond(b, s->thr)) return;
