@@ -95,7 +95,7 @@ HD__INLINE double lower_product(double x, double y) {
 /* x y for x within ex (per component) and y a rounded difference: the
  * cross product, its error bound, and the weights of a later dot product
  * with a point's rounded difference. */
-static void cross_weights(const double *x, const double *ex, const double *y, double *r,
+HD__INLINE void cross_weights(const double *x, const double *ex, const double *y, double *r,
                           double *w) {
     for (int i = 0; i < 3; i++) {
         int j = (i + 1) % 3, k = (i + 2) % 3;
@@ -158,7 +158,7 @@ void hd__tri_prep(const double a[3], const double b[3], const double c[3], hd__t
 
 /* An upper bound on |XP - tau XY|^2 for tau = (XP . XY) rd clamped to
  * [0, 1]: X + tau XY is a point of the edge for any tau there. */
-static double foot_hi2(const double *xp, const double *xy, double rd) {
+HD__INLINE double foot_hi2(const double *xp, const double *xy, double rd) {
     double tau = dot3(xp, xy) * rd, s = 0;
     tau = tau > 0 ? (tau < 1 ? tau : 1) : 0;
     for (int i = 0; i < 3; i++) {
@@ -171,7 +171,7 @@ static double foot_hi2(const double *xp, const double *xy, double rd) {
 
 /* |XP|^2 (less its rounding) when p is certainly in the corner X's region,
  * else 0: a lower bound either way. */
-static double corner_lo2(const double *xp, const double *xy, const double *xz) {
+HD__INLINE double corner_lo2(const double *xp, const double *xy, const double *xz) {
     double m[3] = {fabs(xp[0]), fabs(xp[1]), fabs(xp[2])};
     double e1 = dot3(xy, xp) + (6 * U * pdot3(m, xy) + TB);
     double e2 = dot3(xz, xp) + (6 * U * pdot3(m, xz) + TB);

@@ -52,6 +52,9 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 /* The shrink factor of every bound: exceeds (1 + 2^-53)^16 - 1. */
 #define SHRINK (1.0 - 0x1p-48)
@@ -67,6 +70,25 @@
 
 /* ---- lower bounds ------------------------------------------------------- */
 
+/* hd__box_lb2s(b, p[0], p[1], p[2]), bit for bit: the same operations in
+ * the same order, x and y in one SSE2 register where there is one (its
+ * maximum is u > v ? u : v, as the scalar one, zeros and NaN included),
+ * and (gx^2 + gy^2) + gz^2.  The descent's and the screens' box tests
+ * (c2m_bench's near and far rows measure it). */
+HD__INLINE double box_lb2s(const hd__box_t *b, const double *p) {
+#if defined(__SSE2__)
+    __m128d q = _mm_loadu_pd(p), lo = _mm_loadu_pd(b->lo), hi = _mm_loadu_pd(b->hi);
+    __m128d g = _mm_max_pd(_mm_sub_pd(lo, q), _mm_sub_pd(q, hi));
+    g = _mm_max_pd(g, _mm_setzero_pd());
+    g = _mm_mul_pd(g, g);
+    double u = b->lo[2] - p[2], v = p[2] - b->hi[2], gz = u > v ? u : v;
+    gz = gz > 0 ? gz : 0;
+    return (_mm_cvtsd_f64(g) + _mm_cvtsd_f64(_mm_unpackhi_pd(g, g))) + gz * gz;
+#else
+    return hd__box_lb2s(b, p[0], p[1], p[2]);
+#endif
+}
+
 /* Box: the gap g on each axis is a difference of doubles rounded once
  * (relative error <= u = 2^-53, and exact when it is not normal), its
  * square adds one rounding, the two sums two more, the square root half a
@@ -76,7 +98,7 @@
  * (1 + u)^6.5 * SHRINK < 1, so the result never exceeds the true
  * distance from p to the box. */
 double hd__box_lower(const hd__box_t *b, const double p[3]) {
-    double s = hd__box_lb2s(b, p[0], p[1], p[2]);
+    double s = box_lb2s(b, p);
     if (!(s >= TINY)) return 0.0;
     return sqrt(s) * SHRINK;
 }
@@ -334,6 +356,11 @@ typedef struct {
     cand_t cheap[CANDS], prep[CANDS];
 } search_t;
 
+/* The double after d, for a distance (finite, d >= +0): its bits plus one,
+ * as nextafter(d, INFINITY) gives, without the call (a -0 would give -2^-1074,
+ * which square_up takes to its floor, as it takes nextafter's 2^-1074). */
+static inline double next_up(double d) { return hd__double_of(hd__bits_of(d) + 1); }
+
 static void evaluate(const hd__bvh_t *t, const double *p, size_t pos, search_t *s, hd__bvh_stats_t *st) {
     const hd__tri_t *tr = &t->tris[pos];
     hd__tri_near_t r;
@@ -344,7 +371,7 @@ static void evaluate(const hd__bvh_t *t, const double *p, size_t pos, search_t *
         s->best = r;
         s->index = tr->index;
         s->pos = pos;
-        double t2 = square_up(nextafter(r.d, INFINITY));
+        double t2 = square_up(next_up(r.d));
         s->thr = t2 < s->thr ? t2 : s->thr;
     }
 }
@@ -415,7 +442,7 @@ static void flush_prep(const hd__bvh_t *t, const double *p, search_t *s, hd__bvh
 
 /* Triangle k's prepared bounds: discarded when lo2 > thr, else a
  * candidate of the kernel, and its hi2 may lower thr. */
-static void consider(const hd__bvh_t *t, const double *p, size_t k, search_t *s, hd__bvh_stats_t *st) {
+HD__INLINE void consider(const hd__bvh_t *t, const double *p, size_t k, search_t *s, hd__bvh_stats_t *st) {
     double lo2, hi2;
     st->bounded++;
     hd__tri_bounds_below(p, hd__bvh_prep(t, k), s->thr, &lo2, &hi2);
@@ -476,9 +503,9 @@ static int support_beyond(const hd__tri_t *t, const double *c, const double *p, 
 /* Triangle k's cheap bounds: its box's (hd__box_lb2s shrunk, below d^2
  * by box_beyond's proof) and the support bound; a triangle left is a
  * candidate of the prepared stage with the box's bound as its key. */
-static void screen(const hd__bvh_t *t, const double *p, size_t k, search_t *s, hd__bvh_stats_t *st) {
+HD__INLINE void screen(const hd__bvh_t *t, const double *p, size_t k, search_t *s, hd__bvh_stats_t *st) {
     const hd__box_t *bx = &t->boxes[k];
-    double b = hd__box_lb2s(bx, p[0], p[1], p[2]);
+    double b = box_lb2s(bx, p);
     if (box_beyond(b, s->thr)) return;
     double c[3] = {bx->lo[0] / 2 + bx->hi[0] / 2, bx->lo[1] / 2 + bx->hi[1] / 2, bx->lo[2] / 2 + bx->hi[2] / 2};
     if (support_beyond(&t->tris[k], c, p, s->thr)) return;
@@ -572,7 +599,7 @@ static inline double node_lo2(const hd__bvh_t *t, uint32_t k, uint32_t first, ui
                               double E) {
     const hd__bvh_frame_t *f = E >= 0 && n <= FRAME_MAX ? frame_get(t, k, first, n) : NULL;
     if (f) return frame_lo2(f, p, E);
-    return hd__box_lb2s(&t->nodes[k].box, p[0], p[1], p[2]) * SHRINK;
+    return box_lb2s(&t->nodes[k].box, p) * SHRINK;
 }
 
 /* The descent of the subtree of node root (holding the triangles

@@ -14,8 +14,9 @@
  * triangles.
  *
  * How (tri.c has the proofs): the nearest feature (a corner, an edge or the
- * face) is chosen by Ericson's Voronoi-region tests evaluated in doubles,
- * each accepted only when its computed sign exceeds a proven bound on its
+ * face) is the face when the projection's three weights are certainly
+ * positive, else chosen by Ericson's Voronoi-region tests evaluated in
+ * doubles, each sign accepted only when it exceeds a proven bound on its
  * rounding error; the squared distance N/M of that feature is evaluated as
  * compensated sums of products (double-double accuracy) with one a-priori
  * error bound per quantity; and the rounding of sqrt(N/M) is decided by one

@@ -128,6 +128,31 @@ static size_t brute_nearest(const double p[3], const hd__tri_t *orig, size_t n, 
     return at;
 }
 
+/* The search's box test (bvh.c's box_lb2s, through hd__box_lower) has
+ * the bits of the scalar hd__box_lb2s: points inside, on a face, beyond
+ * one, two or three slabs, signed zeros and flat boxes. */
+TEST(the_box_bound_has_the_scalar_bounds_bits) {
+    gen_rng_t g;
+    uint64_t seed = 77;
+    gen_seed(&g, seed);
+    const double pick[4] = {0.0, -0.0, 0.25, -0.25};
+    for (long i = 0; i < 200000 && !hdt_failed(); i++) {
+        hd__box_t b;
+        double p[3];
+        for (int k = 0; k < 3; k++) {
+            double x = gen_unit(&g) * 2 - 1, y = gen_unit(&g) * 2 - 1;
+            if (i % 7 == 0) y = x;                      /* flat */
+            b.lo[k] = x < y ? x : y, b.hi[k] = x < y ? y : x;
+            uint64_t r = gen_u64(&g) % 6;
+            p[k] = r < 4 ? pick[r] : r == 4 ? b.lo[k] : gen_unit(&g) * 4 - 2;
+        }
+        double s = hd__box_lb2s(&b, p[0], p[1], p[2]);
+        double want = s >= 0x1p-1000 ? sqrt(s) * (1.0 - 0x1p-48) : 0.0;
+        CONTEXT("seed %llu, case %ld", (unsigned long long)seed, i);
+        CHECK_BITS(hd__box_lower(&b, p), want);
+    }
+}
+
 TEST(the_tree_is_valid_and_the_same_on_1_and_several_threads) {
     const size_t sizes[] = {1, 2, 3, 4, 5, 7, 8, 9, 17, 100, 1000, 4097, 9001, 40000 / SCALE};
     const int threads[] = {2, 3, 8};

@@ -292,6 +292,37 @@ TEST(every_feature_is_reached_and_sums_its_weights_to_one) {
     }
 }
 
+/* The face is decided first only when the projection is certainly inside
+ * (tri.c, face_first): a point whose projection lies within rounding of an
+ * edge, on either side, and whose height above the plane is as small as
+ * its offset, has a distance that differs from the height alone when it
+ * is beyond the edge; every such point gets the exact path's distance. */
+TEST(a_point_within_rounding_of_an_edge_is_not_taken_for_the_face) {
+    gen_rng_t g;
+    uint64_t seed = 9100;
+    gen_seed(&g, seed);
+    long face = 0;
+    for (long i = 0; i < 20000 && !hdt_failed(); i++) {
+        tri_case_t t;
+        hd__tri_near_t fast, ref;
+        double ab[3], out[3], w = gen_unit(&g), off = ldexp(gen_unit(&g) - 0.5, -52);
+        set3(t.a, gen_unit(&g), gen_unit(&g), 0);
+        set3(t.b, gen_unit(&g), gen_unit(&g), 0);
+        set3(t.c, gen_unit(&g), gen_unit(&g), 0);
+        for (int k = 0; k < 3; k++) ab[k] = t.b[k] - t.a[k];
+        set3(out, ab[1], -ab[0], 0);   /* in the plane, across AB */
+        axpy(t.p, t.a, w, ab);
+        axpy(t.p, t.p, off, out);
+        t.p[2] = ldexp(gen_unit(&g), -54);
+        CONTEXT("seed %llu, case %ld", (unsigned long long)seed, i);
+        CHECK_RC(hd__tri_nearest(t.p, t.a, t.b, t.c, &fast), HD_OK);
+        CHECK_RC(hd__tri_nearest_exact(t.p, t.a, t.b, t.c, &ref), HD_OK);
+        CHECK_BITS(fast.d, ref.d);
+        face += fast.feature == HD__TRI_FACE;
+    }
+    printf("  the face decided for %ld of 20000 points at an edge\n", face);
+}
+
 /* ---- bounds from plain doubles -------------------------------------------- */
 
 /* lo2 <= t^2 <= hi2 for the true distance t, seen through the correctly
