@@ -111,15 +111,16 @@ static int check_options(const hd_surface_options_t *opt, hd_surface_options_t *
 /* The absolute tolerance: the option made absolute (relative: times the
  * diagonal of both sides' box), and never below the floor. */
 static double tolerance_of(const hd_surface_options_t *o, const side_t *x, const side_t *y) {
-    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY}, big = 0;
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY}, big;
     const side_t *s2[2] = {x, y};
-    for (int s = 0; s < 2; s++)
+    for (int s = 0; s < 2; s++) /* the corners are finite (checked): plain comparisons */
         for (size_t k = 0; k < s2[s]->n; k++)
             for (int j = 0; j < 3; j++)
                 for (int d = 0; d < 3; d++) {
                     double v = s2[s]->tris[k].v[j][d];
-                    lo[d] = fmin(lo[d], v), hi[d] = fmax(hi[d], v), big = fmax(big, fabs(v));
+                    lo[d] = v < lo[d] ? v : lo[d], hi[d] = v > hi[d] ? v : hi[d];
                 }
+    big = fmax(fmax(fmax(-lo[0], hi[0]), fmax(-lo[1], hi[1])), fmax(-lo[2], hi[2]));
     double dx = hi[0] - lo[0], dy = hi[1] - lo[1], dz = hi[2] - lo[2];
     double diag = sqrt(dx * dx + dy * dy + dz * dz);
     double floor_ = big * FLOOR_COORD + diag * FLOOR_DIAG + 0x1p-1000;

@@ -989,29 +989,40 @@ static void screen_task(void *vctx, size_t task, int worker) {
         if (!C->faces[f].done && screened(J, &J->from[f], &seed, &C->faces[f].upper)) C->faces[f].done = 1;
 }
 
-/* The corners' Morton order (NULL when there are too many to key; any
- * order is correct). */
-static int corner_order(const hd__m2m_job_t *J, int threads, uint64_t **out) {
+/* The corners of the faces not dropped (J->drop), in Morton order, in
+ * *out (NULL when there are too many to key: then every corner in index
+ * order; any order is correct) and their number in *count.  A dropped
+ * face's corners are never searched, so they take no place in the order
+ * and no part in its grid (bench/m2m_run, `shared`). */
+static int corner_order(const hd__m2m_job_t *J, int threads, uint64_t **out, size_t *count) {
     *out = NULL;
-    size_t n = 3 * J->n_from;
+    size_t n = 3 * J->n_from, m = 0;
+    *count = n;
     if (n > UINT32_MAX) return HD_OK;
-    uint64_t *keys = hd__malloc_array(n, sizeof *keys), *tmp = hd__malloc_array(n, sizeof *tmp);
+    uint64_t *keys = hd__malloc_array(n ? n : 1, sizeof *keys), *tmp = hd__malloc_array(n ? n : 1, sizeof *tmp);
     if (!keys || !tmp) {
         free(keys);
         free(tmp);
         return HD_ENOMEM;
     }
     hd__box_t box = {{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
-    for (size_t id = 0; id < n; id++)
-        for (int d = 0; d < 3; d++)
-            box.lo[d] = dmin(box.lo[d], CORNER(J, id)[d]), box.hi[d] = dmax(box.hi[d], CORNER(J, id)[d]);
+    for (size_t f = 0; f < J->n_from; f++) {
+        if (J->drop && J->drop[f]) continue;
+        for (int j = 0; j < 3; j++) {
+            const double *p = J->from[f].v[j];
+            for (int d = 0; d < 3; d++) box.lo[d] = dmin(box.lo[d], p[d]), box.hi[d] = dmax(box.hi[d], p[d]);
+        }
+    }
     hd__keygrid_t g;
     hd__keygrid_init(&g, &box);
-    for (size_t id = 0; id < n; id++) keys[id] = (uint64_t)hd__key30(&g, CORNER(J, id)) << 32 | (uint64_t)id;
-    int rc = hd__radix_sort(&keys, &tmp, n, threads);
+    for (size_t f = 0; f < J->n_from; f++)
+        if (!(J->drop && J->drop[f]))
+            for (int j = 0; j < 3; j++)
+                keys[m++] = (uint64_t)hd__key30(&g, J->from[f].v[j]) << 32 | (uint64_t)(3 * f + j);
+    int rc = hd__radix_sort(&keys, &tmp, m, threads);
     free(tmp);
     if (rc) free(keys);
-    else *out = keys;
+    else *out = keys, *count = m;
     return rc;
 }
 
@@ -1359,9 +1370,13 @@ static void sort_ranks(rank_t *rk, size_t n) {
         qsort(rk, n, sizeof *rk, by_upper);
         return;
     }
+    /* entries already in increasing f (phase 1's ranks) need only the
+     * passes by U: a stable sort keeps that order among equal U */
+    int first = 8;
+    for (size_t k = 1; k < n && first == 8; k++) first = rk[k - 1].f < rk[k].f ? 8 : 0;
     for (size_t k = 0; k < n; k++)
-        for (int pass = 0; pass < 16; pass++) count[pass][rank_digit(&rk[k], pass)]++;
-    for (int pass = 0; pass < 16; pass++) {
+        for (int pass = first; pass < 16; pass++) count[pass][rank_digit(&rk[k], pass)]++;
+    for (int pass = first; pass < 16; pass++) {
         size_t at = 0, same = 0;
         for (int d = 0; d < 256; d++) {
             same |= count[pass][d] == n;
@@ -1488,23 +1503,23 @@ static int first_pass(const hd__m2m_job_t *J, ctx_t *C, hd__m2m_result_t *R) {
     size_t n = J->n_from;
     uint64_t *order = NULL;
     C->found = hd__malloc_array(n ? 3 * n : 1, sizeof *C->found);
-    if (!C->found || corner_order(J, J->threads, &order)) {
+    if (!C->found || corner_order(J, J->threads, &order, &C->n_corners)) {
         free(C->found);
         return HD_ENOMEM;
     }
     C->order = order;
-    size_t tasks = (n + CHUNK - 1) / CHUNK;
+    size_t tasks = (n + CHUNK - 1) / CHUNK, corner_tasks = (C->n_corners + 3 * CHUNK - 1) / (3 * CHUNK);
     if (!J->per_face && !J->face_lower) { /* the sample first: L0 */
         C->stage = 1;
-        hd__parallel_for(J->threads, tasks, phase0, C);
+        hd__parallel_for(J->threads, corner_tasks, phase0, C);
         C->bar = phase0_bar(C);
-        hd__parallel_for(J->threads, tasks, phase0_exact, C);
+        hd__parallel_for(J->threads, corner_tasks, phase0_exact, C);
         C->L0 = sample_best(C);
         C->stage = isfinite(C->L0) ? 2 : 0;
     }
-    hd__parallel_for(J->threads, tasks, phase0, C);
+    hd__parallel_for(J->threads, corner_tasks, phase0, C);
     C->bar = phase0_bar(C);
-    hd__parallel_for(J->threads, tasks, phase0_exact, C);
+    hd__parallel_for(J->threads, corner_tasks, phase0_exact, C);
     hd__parallel_for(J->threads, tasks, phase1, C);
     free(order);
     free(C->found);
@@ -1526,7 +1541,8 @@ static int decide_pass(const hd__m2m_job_t *J, ctx_t *C, hd__m2m_result_t *R, in
     uint64_t *order = NULL, *part = NULL;
     C->found = hd__malloc_array(n ? 3 * n : 1, sizeof *C->found);
     part = hd__malloc_array(n ? 3 * n : 1, sizeof *part);
-    if (!C->found || !part || corner_order(J, J->threads, &order)) {
+    size_t live = 0;
+    if (!C->found || !part || corner_order(J, J->threads, &order, &live)) {
         free(C->found);
         free(part);
         return HD_ENOMEM;
@@ -1537,7 +1553,7 @@ static int decide_pass(const hd__m2m_job_t *J, ctx_t *C, hd__m2m_result_t *R, in
         size_t f1 = (t0 + m) * CHUNK < n ? (t0 + m) * CHUNK : n, k = 0;
         C->task0 = t0;
         hd__parallel_for(J->threads, m, screen_task, C);
-        for (size_t i = 0; i < 3 * n; i++) {
+        for (size_t i = 0; i < live; i++) {
             size_t id = order ? (size_t)(order[i] & 0xffffffffu) : i;
             if (id / 3 >= f0 && id / 3 < f1 && !C->faces[id / 3].done) part[k++] = id;
         }
@@ -1595,79 +1611,4 @@ int hd__m2m_run(const hd__m2m_job_t *J, hd__m2m_result_t *R) {
     caches_free(C.caches, J->threads);
     free(rk);
     return rc;
-}
-
-/* ---- shared faces -------------------------------------------------------- */
-
-typedef struct key {
-    double v[3][3];
-} facekey_t;
-
-static int cmp_corner3(const void *x, const void *y) { return memcmp(x, y, 3 * sizeof(double)); }
-
-static void swap_if(double a[3], double b[3]) {
-    if (cmp_corner3(a, b) > 0) {
-        double t[3];
-        memcpy(t, a, sizeof t), memcpy(a, b, sizeof t), memcpy(b, t, sizeof t);
-    }
-}
-
-/* The corners in memcmp order (three compare-exchanges). */
-static void key_of(const hd__tri_t *t, facekey_t *k) {
-    memcpy(k->v, t->v, sizeof k->v);
-    swap_if(k->v[0], k->v[1]);
-    swap_if(k->v[1], k->v[2]);
-    swap_if(k->v[0], k->v[1]);
-}
-
-/* A key's hash: its 72 bytes mixed (any function would do: equal keys
- * have equal hashes, and the table compares keys in full). */
-static uint64_t key_hash(const facekey_t *k) {
-    uint64_t h = 0x9e3779b97f4a7c15u, w;
-    for (int i = 0; i < 9; i++) {
-        memcpy(&w, &k->v[i / 3][i % 3], sizeof w);
-        h = (h ^ w) * 0xff51afd7ed558ccdu;
-        h ^= h >> 32;
-    }
-    return h;
-}
-
-int hd__m2m_shared(const hd__tri_t *x, size_t nx, const hd__tri_t *y, size_t ny, unsigned char *drop_x,
-                   unsigned char *drop_y, size_t *count_x, size_t *count_y) {
-    *count_x = *count_y = 0;
-    size_t size = 16;
-    while (size < 2 * ny) size *= 2;
-    facekey_t *ky = hd__malloc_array(ny ? ny : 1, sizeof *ky);
-    size_t *slot = hd__malloc_array(size, sizeof *slot), *at = hd__malloc_array(ny ? ny : 1, sizeof *at);
-    unsigned char *hit = calloc(size, 1);
-    if (!ky || !slot || !at || !hit) {
-        free(ky), free(slot), free(at), free(hit);
-        return HD_ENOMEM;
-    }
-    /* Y's keys in a table with linear probing (SIZE_MAX: empty); at[k]:
-     * the slot of face k's key (equal keys share the first one's) */
-    for (size_t k = 0; k < size; k++) slot[k] = SIZE_MAX;
-    for (size_t k = 0; k < ny; k++) {
-        key_of(&y[k], &ky[k]);
-        size_t h = (size_t)key_hash(&ky[k]) & (size - 1);
-        while (slot[h] != SIZE_MAX && memcmp(&ky[slot[h]], &ky[k], sizeof ky[k])) h = (h + 1) & (size - 1);
-        if (slot[h] == SIZE_MAX) slot[h] = k;
-        at[k] = h;
-    }
-    /* X's faces looked up; the keys they meet are Y's shared faces */
-    for (size_t k = 0; k < nx; k++) {
-        facekey_t kx;
-        key_of(&x[k], &kx);
-        size_t h = (size_t)key_hash(&kx) & (size - 1);
-        while (slot[h] != SIZE_MAX && memcmp(&ky[slot[h]], &kx, sizeof kx)) h = (h + 1) & (size - 1);
-        drop_x[k] = slot[h] != SIZE_MAX;
-        hit[h] |= drop_x[k];
-        *count_x += drop_x[k];
-    }
-    for (size_t k = 0; drop_y && k < ny; k++) {
-        drop_y[k] = hit[at[k]];
-        *count_y += drop_y[k];
-    }
-    free(ky), free(slot), free(at), free(hit);
-    return HD_OK;
 }
