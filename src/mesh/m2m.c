@@ -729,6 +729,7 @@ typedef struct ctx {
     int stage;
     size_t stride;
     double L0;
+    double *target;        /* stage 2: each face's corner_target (or NULL) */
 } ctx_t;
 
 #define CORNER(J, id) ((J)->from[(id) / 3].v[(id) % 3])
@@ -745,6 +746,14 @@ static double face_reach(const hd__tri_t *t) {
     return sqrt(a2) * 0.5774;
 }
 
+/* The same corner, bit for bit (inline: phase 0 asks at every corner). */
+static int same_point(const double *p, const double *q) {
+    uint64_t a[3], b[3];
+    memcpy(a, p, sizeof a);
+    memcpy(b, q, sizeof b);
+    return ((a[0] ^ b[0]) | (a[1] ^ b[1]) | (a[2] ^ b[2])) == 0;
+}
+
 /* Corner k of the order is in stage 1's sample: every stride-th position
  * that starts a run of equal corners (a vertex of X and its copies). */
 static int is_sample(const ctx_t *C, size_t k) {
@@ -752,15 +761,28 @@ static int is_sample(const ctx_t *C, size_t k) {
     if (k == 0) return 1;
     size_t id = C->order ? (size_t)(C->order[k] & 0xffffffffu) : k;
     size_t pr = C->order ? (size_t)(C->order[k - 1] & 0xffffffffu) : k - 1;
-    return memcmp(CORNER(C->job, id), CORNER(C->job, pr), 3 * sizeof(double)) != 0;
+    return !same_point(CORNER(C->job, id), CORNER(C->job, pr));
 }
 
 /* Stage 2's target for corner id: a bound at most this puts the corner
  * below L0, so it needs no exact distance, and with its face's other
  * corners as low the face's point bound is within the tolerance of L0. */
 static double corner_target(const ctx_t *C, size_t id) {
+    if (C->target) return C->target[id / 3];
     const hd__m2m_job_t *J = C->job;
     return dmin(C->L0 + J->tol - face_reach(&J->from[id / 3]), down(C->L0));
+}
+
+/* Every face's stage-2 target at once (each face has three corners), in
+ * C->target; left NULL without memory (then each corner computes it). */
+static void corner_targets(ctx_t *C) {
+    const hd__m2m_job_t *J = C->job;
+    C->target = hd__malloc_array(J->n_from ? J->n_from : 1, sizeof *C->target);
+    if (!C->target) return;
+    double *t = C->target;
+    C->target = NULL;
+    for (size_t f = 0; f < J->n_from; f++) t[f] = C->faces[f].done ? 0 : corner_target(C, 3 * f);
+    C->target = t;
 }
 
 /* Stage 2 without a search: the bound of corner id carried from an anchor
@@ -802,7 +824,7 @@ static void phase0(void *vctx, size_t task, int worker) {
             seed = F->pos, prev = anchor = id;
             continue;
         }
-        int same = prev != SIZE_MAX && memcmp(CORNER(J, id), CORNER(J, prev), 3 * sizeof(double)) == 0;
+        int same = prev != SIZE_MAX && same_point(CORNER(J, id), CORNER(J, prev));
         if (same && C->found[prev].complete) {
             *F = C->found[prev];
             continue;
@@ -1345,12 +1367,15 @@ static int by_upper(const void *x, const void *y) {
 
 /* Digit `pass` of a rank's sort key: passes 0-7 the bytes of f, 8-15
  * those of the complement of U's bits (U > 0; else the largest key). */
-static unsigned rank_digit(const rank_t *r, int pass) {
+static uint64_t u_key(const rank_t *r) {
     uint64_t key;
-    if (pass < 8) return (unsigned)(((uint64_t)r->f >> (8 * pass)) & 255);
     memcpy(&key, &r->U, sizeof key);
-    key = r->U > 0 ? ~key : ~(uint64_t)0;
-    return (unsigned)((key >> (8 * (pass - 8))) & 255);
+    return r->U > 0 ? ~key : ~(uint64_t)0;
+}
+
+static unsigned rank_digit(const rank_t *r, int pass) {
+    if (pass < 8) return (unsigned)(((uint64_t)r->f >> (8 * pass)) & 255);
+    return (unsigned)((u_key(r) >> (8 * (pass - 8))) & 255);
 }
 
 /* rk sorted as by_upper sorts it (by decreasing U, then increasing f):
@@ -1374,8 +1399,12 @@ static void sort_ranks(rank_t *rk, size_t n) {
      * passes by U: a stable sort keeps that order among equal U */
     int first = 8;
     for (size_t k = 1; k < n && first == 8; k++) first = rk[k - 1].f < rk[k].f ? 8 : 0;
-    for (size_t k = 0; k < n; k++)
-        for (int pass = first; pass < 16; pass++) count[pass][rank_digit(&rk[k], pass)]++;
+    for (size_t k = 0; k < n; k++) {
+        uint64_t f = (uint64_t)rk[k].f, u = u_key(&rk[k]);
+        for (int b = 0; b < 8; b++) count[8 + b][(u >> (8 * b)) & 255]++;
+        if (!first)
+            for (int b = 0; b < 8; b++) count[b][(f >> (8 * b)) & 255]++;
+    }
     for (int pass = first; pass < 16; pass++) {
         size_t at = 0, same = 0;
         for (int d = 0; d < 256; d++) {
@@ -1516,11 +1545,14 @@ static int first_pass(const hd__m2m_job_t *J, ctx_t *C, hd__m2m_result_t *R) {
         hd__parallel_for(J->threads, corner_tasks, phase0_exact, C);
         C->L0 = sample_best(C);
         C->stage = isfinite(C->L0) ? 2 : 0;
+        if (C->stage == 2) corner_targets(C);
     }
     hd__parallel_for(J->threads, corner_tasks, phase0, C);
     C->bar = phase0_bar(C);
     hd__parallel_for(J->threads, corner_tasks, phase0_exact, C);
     hd__parallel_for(J->threads, tasks, phase1, C);
+    free(C->target);
+    C->target = NULL;
     free(order);
     free(C->found);
     for (size_t f = 0; f < n; f++) take_best(R, &C->faces[f], f);
@@ -1579,7 +1611,7 @@ int hd__m2m_run(const hd__m2m_job_t *J, hd__m2m_result_t *R) {
     memset(R, 0, sizeof *R);
     R->face = R->face_b = SIZE_MAX;
     size_t n = J->n_from;
-    ctx_t C = {J, hd__malloc_array(n ? n : 1, sizeof(face_t)), NULL, NULL, 0, NULL, 0, 0, 0, SAMPLE_STRIDE, 0};
+    ctx_t C = {J, hd__malloc_array(n ? n : 1, sizeof(face_t)), NULL, NULL, 0, NULL, 0, 0, 0, SAMPLE_STRIDE, 0, NULL};
     rank_t *rk = hd__malloc_array(n ? n : 1, sizeof *rk);
     C.n_corners = 3 * n;
     C.caches = caches_new(J->threads, J->to->n_tris);
