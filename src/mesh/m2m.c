@@ -156,8 +156,14 @@
 #define MAX_BATCH 1024
 /* Faces per task in phase 1. */
 #define CHUNK 256
-/* Phase 0's sample: every SAMPLE_STRIDE-th corner in Morton order. */
+/* Phase 0's sample: every stride-th corner in Morton order, the stride
+ * SAMPLE_STRIDE doubled while the sample would exceed SAMPLE_SIZE corners,
+ * up to MAX_STRIDE (each sample corner is searched in full; a larger
+ * sample only sharpens L0 a little: bench/m2m_run, `through` and
+ * `decimated` against `shared`). */
 #define SAMPLE_STRIDE 32
+#define SAMPLE_SIZE 512
+#define MAX_STRIDE 256
 /* Below this a squared edge may have underflowed: R from |dx|+|dy|+|dz|. */
 #define TINY2 0x1p-960
 
@@ -1537,6 +1543,7 @@ static int first_pass(const hd__m2m_job_t *J, ctx_t *C, hd__m2m_result_t *R) {
         return HD_ENOMEM;
     }
     C->order = order;
+    while (C->stride < MAX_STRIDE && C->n_corners / C->stride > SAMPLE_SIZE) C->stride *= 2;
     size_t tasks = (n + CHUNK - 1) / CHUNK, corner_tasks = (C->n_corners + 3 * CHUNK - 1) / (3 * CHUNK);
     if (!J->per_face && !J->face_lower) { /* the sample first: L0 */
         C->stage = 1;
