@@ -123,7 +123,9 @@
  * The children's points are their parent's, so they inherit its list as
  * it stands; a sub-triangle being split filters its inherited list with
  * its own Bx and H (the same argument), or, without one, collects it from
- * the tree (collect(), up to LIST_MAX triangles).  Lists live in the
+ * the tree (hd__bvh_collect, up to LIST_MAX triangles: it leaves out only
+ * triangles proven farther than sqrt(r2) from Bx, by their boxes or by
+ * the support bound, proofs in bvh.c).  Lists live in the
  * worker's arena for one visit of the face; a sub-triangle saved for a
  * later pass loses its list.  So hi is the tree's smallest hi2, up to
  * ties, and every list depends on the face's refinement alone.
@@ -1137,39 +1139,12 @@ static void cand_region(const double c[3][3], double U, double e, hd__box_t *B, 
     *r2 = up(H * H);
 }
 
-/* The positions of the triangles of T whose box is not box_far from B,
- * in leaf order, or SIZE_MAX when there are more than cap (the boxes
- * alone: cheaper than hd__bvh_collect's support bound per triangle, for
- * the short lists wanted here). */
-static size_t collect(const hd__bvh_t *T, const hd__box_t *B, double r2, uint32_t *out, size_t cap) {
-    uint32_t stack[DEPTH];
-    int top = 0;
-    size_t n = 0;
-    stack[top++] = 0;
-    while (top > 0) { /* a node's box is tested when it is popped */
-        uint32_t id = stack[--top];
-        const hd__bvh_node_t *node = &T->nodes[id];
-        if (box_far(&node->box, B, r2)) continue;
-        if (!node->count) {
-            if (top + 2 > DEPTH) return SIZE_MAX;
-            stack[top++] = node->first_or_second, stack[top++] = id + 1; /* the first child first */
-            continue;
-        }
-        for (size_t k = node->first_or_second; k < (size_t)node->first_or_second + node->count; k++)
-            if (!box_far(&T->boxes[k], B, r2)) {
-                if (n == cap) return SIZE_MAX;
-                out[n++] = (uint32_t)k;
-            }
-    }
-    return n;
-}
-
 size_t hd__m2m_candidates(const hd__bvh_t *T, const double c[3][3], double U, double e, const uint32_t *from,
                           size_t n_from, uint32_t *out, size_t cap) {
     hd__box_t B;
     double r2;
     cand_region(c, U, e, &B, &r2);
-    if (!from) return collect(T, &B, r2, out, cap);
+    if (!from) return hd__bvh_collect(T, &B, r2, out, cap);
     size_t n = 0;
     for (size_t i = 0; i < n_from; i++) {
         if (box_far(&T->boxes[from[i]], &B, r2)) continue;
