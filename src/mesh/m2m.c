@@ -822,7 +822,9 @@ static void phase0(void *vctx, size_t task, int worker) {
     size_t lo = task * CHUNK * 3, hi = lo + CHUNK * 3 < C->n_corners ? lo + CHUNK * 3 : C->n_corners;
     size_t seed = SIZE_MAX, prev = SIZE_MAX, anchor = SIZE_MAX;
     uint64_t count = 0;
-    for (size_t k = lo; k < hi; k++) {
+    /* stage 1 visits the sample's positions alone (multiples of the stride) */
+    size_t step = C->stage == 1 ? C->stride : 1;
+    for (size_t k = C->stage == 1 ? (lo + step - 1) / step * step : lo; k < hi; k += step) {
         size_t id = C->order ? (size_t)(C->order[k] & 0xffffffffu) : k;
         found_t *F = &C->found[id];
         if (C->faces[id / 3].done) continue;
@@ -879,7 +881,9 @@ static void phase0_exact(void *vctx, size_t task, int worker) {
     const hd__m2m_job_t *J = C->job;
     size_t lo = task * CHUNK * 3, hi = lo + CHUNK * 3 < C->n_corners ? lo + CHUNK * 3 : C->n_corners;
     hd__bvh_stats_t st = {0};
-    for (size_t k = lo; k < hi; k++) {
+    /* stage 1 visits the sample's positions alone (multiples of the stride) */
+    size_t step = C->stage == 1 ? C->stride : 1;
+    for (size_t k = C->stage == 1 ? (lo + step - 1) / step * step : lo; k < hi; k += step) {
         size_t id = C->order ? (size_t)(C->order[k] & 0xffffffffu) : k;
         found_t *F = &C->found[id];
         if (C->faces[id / 3].done || (C->stage == 1 && !is_sample(C, k)) || F->hi < C->bar) continue;
