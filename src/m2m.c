@@ -41,11 +41,15 @@ typedef struct side {
     int points;      /* a point set */
     unsigned char *drop; /* faces shared with the other side (shared()) */
     size_t dropped;
+    uint32_t *vert;      /* each corner's vertex index (a mesh of fewer than
+                          * 2^32 vertices; else NULL) */
+    size_t n_vert;
 } side_t;
 
 static void side_free(side_t *s) {
     free(s->tris);
     free(s->drop);
+    free(s->vert);
     if (s->built) hd__bvh_free(&s->bvh);
     memset(s, 0, sizeof *s);
 }
@@ -63,6 +67,25 @@ static int side_tree(side_t *s, const char *name, hd_error_t *err) {
     return HD_OK;
 }
 
+/* Each corner's vertex index (the indices are checked by then), so that
+ * the search orders vertices rather than corners (mesh/m2m.c,
+ * corner_order); none for 2^32 vertices or more. */
+static int side_vertices(const hd_mesh_t *M, side_t *s, hd_error_t *err) {
+    if (M->vertices.count > UINT32_MAX || s->n > SIZE_MAX / 3) return HD_OK;
+    s->vert = hd__malloc_array(3 * s->n, sizeof *s->vert);
+    if (!s->vert) {
+        free(s->tris);
+        s->tris = NULL;
+        return hd__err(err, HD_ENOMEM, "out of memory for %zu triangles", s->n);
+    }
+    const uint32_t *i32 = M->triangles;
+    const uint64_t *i64 = M->triangles;
+    for (size_t k = 0; k < 3 * s->n; k++)
+        s->vert[k] = M->index_type == HD_INDEX_U32 ? i32[k] : (uint32_t)i64[k];
+    s->n_vert = M->vertices.count;
+    return HD_OK;
+}
+
 static int side_mesh(const hd_mesh_t *M, const char *name, side_t *s, hd_error_t *err) {
     memset(s, 0, sizeof *s);
     if (!M) return hd__err(err, HD_EINVAL, "mesh %s is NULL", name);
@@ -77,7 +100,7 @@ static int side_mesh(const hd_mesh_t *M, const char *name, side_t *s, hd_error_t
         return rc;
     }
     s->n = M->n_triangles;
-    return HD_OK;
+    return side_vertices(M, s, err);
 }
 
 static int side_points(const hd_points_t *P, side_t *s, hd_error_t *err) {
@@ -175,7 +198,8 @@ static int directed(side_t *x, side_t *y, const ask_t *q, hd_enclosure_t *out, h
         return HD_OK;
     }
     if (!y->built && (rc = side_tree(y, y->points ? "points" : "mesh", err))) return rc;
-    hd__m2m_job_t J = {.from = x->tris, .n_from = x->n, .to = &y->bvh, .drop = drop, .tol = q->tol,
+    hd__m2m_job_t J = {.from = x->tris, .n_from = x->n, .to = &y->bvh, .drop = drop, .vertex = x->vert,
+                       .n_vertices = x->n_vert, .tol = q->tol,
                        .done_below = q->done_below, .stop_above = q->stop_above, .per_face = q->per_face,
                        .max_splits = q->max_splits, .face_lower = q->face_lower, .face_upper = q->face_upper};
     J.threads = hd__thread_count(q->threads, x->n);

@@ -1023,40 +1023,54 @@ static void screen_task(void *vctx, size_t task, int worker) {
         if (!C->faces[f].done && screened(J, &J->from[f], &seed, &C->faces[f].upper)) C->faces[f].done = 1;
 }
 
-/* The corners of the faces not dropped (J->drop), in Morton order, in
- * *out (NULL when there are too many to key: then every corner in index
- * order; any order is correct) and their number in *count.  A dropped
- * face's corners are never searched, so they take no place in the order
- * and no part in its grid (bench/m2m_run, `shared`). */
+/* The corners of the faces not dropped (J->drop), in *out (their ids in
+ * the low 32 bits) and their number in *count: the vertices of X those
+ * corners use in Morton order (a key per vertex, not per corner), each
+ * vertex's corners together in increasing id, so that equal corners
+ * follow each other; NULL when there are too many corners or no vertex
+ * indices (then every corner in index order; any order is correct).  A
+ * dropped face's corners are never searched, so they take no place in
+ * the order and no part in its grid (bench/m2m_run, `shared`). */
 static int corner_order(const hd__m2m_job_t *J, int threads, uint64_t **out, size_t *count) {
     *out = NULL;
-    size_t n = 3 * J->n_from, m = 0;
+    size_t n = 3 * J->n_from, nv = J->n_vertices, m = 0, live = 0;
     *count = n;
-    if (n > UINT32_MAX) return HD_OK;
-    uint64_t *keys = hd__malloc_array(n ? n : 1, sizeof *keys), *tmp = hd__malloc_array(n ? n : 1, sizeof *tmp);
-    if (!keys || !tmp) {
-        free(keys);
-        free(tmp);
-        return HD_ENOMEM;
-    }
+    if (n > UINT32_MAX || !J->vertex) return HD_OK;
+    uint32_t *first = hd__malloc_array(nv ? nv : 1, sizeof *first); /* a corner of each vertex used */
+    size_t *at = hd__malloc_array(nv ? nv : 1, sizeof *at);
+    uint64_t *keys = hd__malloc_array(nv ? nv : 1, sizeof *keys), *tmp = hd__malloc_array(nv ? nv : 1, sizeof *tmp);
+    uint64_t *order = hd__malloc_array(n ? n : 1, sizeof *order);
+    int rc = first && at && keys && tmp && order ? HD_OK : HD_ENOMEM;
     hd__box_t box = {{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
-    for (size_t f = 0; f < J->n_from; f++) {
-        if (J->drop && J->drop[f]) continue;
-        for (int j = 0; j < 3; j++) {
-            const double *p = J->from[f].v[j];
-            for (int d = 0; d < 3; d++) box.lo[d] = dmin(box.lo[d], p[d]), box.hi[d] = dmax(box.hi[d], p[d]);
-        }
+    for (size_t v = 0; rc == HD_OK && v < nv; v++) first[v] = UINT32_MAX, at[v] = 0;
+    for (size_t id = 0; rc == HD_OK && id < n; id++) {
+        if (J->drop && J->drop[id / 3]) continue;
+        uint32_t v = J->vertex[id];
+        at[v]++, live++;
+        if (first[v] != UINT32_MAX) continue;
+        first[v] = (uint32_t)id;
+        const double *p = CORNER(J, id);
+        for (int d = 0; d < 3; d++) box.lo[d] = dmin(box.lo[d], p[d]), box.hi[d] = dmax(box.hi[d], p[d]);
     }
-    hd__keygrid_t g;
-    hd__keygrid_init(&g, &box);
-    for (size_t f = 0; f < J->n_from; f++)
-        if (!(J->drop && J->drop[f]))
-            for (int j = 0; j < 3; j++)
-                keys[m++] = (uint64_t)hd__key30(&g, J->from[f].v[j]) << 32 | (uint64_t)(3 * f + j);
-    int rc = hd__radix_sort(&keys, &tmp, m, threads);
-    free(tmp);
-    if (rc) free(keys);
-    else *out = keys, *count = m;
+    if (rc == HD_OK) {
+        hd__keygrid_t g;
+        hd__keygrid_init(&g, &box);
+        for (size_t v = 0; v < nv; v++)
+            if (first[v] != UINT32_MAX) keys[m++] = (uint64_t)hd__key30(&g, CORNER(J, first[v])) << 32 | (uint64_t)v;
+        rc = hd__radix_sort(&keys, &tmp, m, threads);
+    }
+    if (rc == HD_OK) {
+        size_t next = 0; /* each vertex's first place in the order */
+        for (size_t i = 0; i < m; i++) {
+            size_t v = (size_t)(keys[i] & 0xffffffffu), c = at[v];
+            at[v] = next, next += c;
+        }
+        for (size_t id = 0; id < n; id++)
+            if (!(J->drop && J->drop[id / 3])) order[at[J->vertex[id]]++] = (uint64_t)id;
+        *out = order, *count = live;
+    }
+    free(first), free(at), free(keys), free(tmp);
+    if (rc) free(order);
     return rc;
 }
 

@@ -239,6 +239,9 @@ typedef struct hd__m2m_job {
     size_t n_from;
     const hd__bvh_t *to;
     const unsigned char *drop; /* 1 for a face of X to skip (shared), or NULL */
+    const uint32_t *vertex;    /* corner 3 f + j's vertex index in X, < n_vertices
+                                  (equal indices: equal corners), or NULL */
+    size_t n_vertices;
     double tol;                /* absolute, > 0 */
     double done_below;         /* a face is finished once its bound is <= this
                                   (the predicate's d; -infinity otherwise) */
