@@ -834,7 +834,8 @@ static void phase0(void *vctx, size_t task, int worker) {
             seed = F->pos, prev = anchor = id;
             continue;
         }
-        int same = prev != SIZE_MAX && same_point(CORNER(J, id), CORNER(J, prev));
+        int same = prev != SIZE_MAX && ((J->vertex && J->vertex[id] == J->vertex[prev]) ||
+                                        same_point(CORNER(J, id), CORNER(J, prev)));
         if (same && C->found[prev].complete) {
             *F = C->found[prev];
             continue;
