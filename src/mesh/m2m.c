@@ -1058,7 +1058,7 @@ static int corner_order(const hd__m2m_job_t *J, int threads, uint64_t **out, siz
         hd__keygrid_init(&g, &box);
         for (size_t v = 0; v < nv; v++)
             if (first[v] != UINT32_MAX) keys[m++] = (uint64_t)hd__key30(&g, CORNER(J, first[v])) << 32 | (uint64_t)v;
-        rc = hd__radix_sort(&keys, &tmp, m, threads);
+        rc = m ? hd__radix_sort(&keys, &tmp, m, threads) : HD_OK;
     }
     if (rc == HD_OK) {
         size_t next = 0; /* each vertex's first place in the order */
@@ -1365,14 +1365,16 @@ static int by_upper(const void *x, const void *y) {
     return (a->f > b->f) - (a->f < b->f);
 }
 
-/* Digit `pass` of a rank's sort key: passes 0-7 the bytes of f, 8-15
- * those of the complement of U's bits (U > 0; else the largest key). */
+/* U's part of a rank's sort key: the complement of U's bits (U > 0;
+ * else the largest key). */
 static uint64_t u_key(const rank_t *r) {
     uint64_t key;
     memcpy(&key, &r->U, sizeof key);
     return r->U > 0 ? ~key : ~(uint64_t)0;
 }
 
+/* Digit `pass` of a rank's sort key: passes 0-7 the bytes of f, 8-15
+ * those of u_key. */
 static unsigned rank_digit(const rank_t *r, int pass) {
     if (pass < 8) return (unsigned)(((uint64_t)r->f >> (8 * pass)) & 255);
     return (unsigned)((u_key(r) >> (8 * (pass - 8))) & 255);
