@@ -41,8 +41,9 @@ typedef struct side {
     int points;      /* a point set */
     unsigned char *drop; /* faces shared with the other side (shared()) */
     size_t dropped;
-    uint32_t *vert;      /* each corner's vertex index (a mesh of fewer than
-                          * 2^32 vertices; else NULL) */
+    const hd_mesh_t *mesh; /* the mesh the triangles come from (NULL: points) */
+    uint32_t *vert;      /* each corner's vertex index, once a search from
+                          * this side needs it (side_vertices) */
     size_t n_vert;
 } side_t;
 
@@ -67,17 +68,15 @@ static int side_tree(side_t *s, const char *name, hd_error_t *err) {
     return HD_OK;
 }
 
-/* Each corner's vertex index (the indices are checked by then), so that
- * the search orders vertices rather than corners (mesh/m2m.c,
- * corner_order); none for 2^32 vertices or more. */
-static int side_vertices(const hd_mesh_t *M, side_t *s, hd_error_t *err) {
-    if (M->vertices.count > UINT32_MAX || s->n > SIZE_MAX / 3) return HD_OK;
+/* Each corner's vertex index (the indices were checked with the
+ * triangles), so that the search orders vertices rather than corners
+ * (mesh/m2m.c, corner_order); none for a point set or for 2^32 vertices
+ * or more. */
+static int side_vertices(side_t *s, hd_error_t *err) {
+    const hd_mesh_t *M = s->mesh;
+    if (s->vert || !M || M->vertices.count > UINT32_MAX || s->n > SIZE_MAX / 3) return HD_OK;
     s->vert = hd__malloc_array(3 * s->n, sizeof *s->vert);
-    if (!s->vert) {
-        free(s->tris);
-        s->tris = NULL;
-        return hd__err(err, HD_ENOMEM, "out of memory for %zu triangles", s->n);
-    }
+    if (!s->vert) return hd__err(err, HD_ENOMEM, "out of memory for %zu triangles", s->n);
     const uint32_t *i32 = M->triangles;
     const uint64_t *i64 = M->triangles;
     for (size_t k = 0; k < 3 * s->n; k++)
@@ -100,7 +99,8 @@ static int side_mesh(const hd_mesh_t *M, const char *name, side_t *s, hd_error_t
         return rc;
     }
     s->n = M->n_triangles;
-    return side_vertices(M, s, err);
+    s->mesh = M;
+    return HD_OK;
 }
 
 static int side_points(const hd_points_t *P, side_t *s, hd_error_t *err) {
@@ -198,6 +198,7 @@ static int directed(side_t *x, side_t *y, const ask_t *q, hd_enclosure_t *out, h
         return HD_OK;
     }
     if (!y->built && (rc = side_tree(y, y->points ? "points" : "mesh", err))) return rc;
+    if ((rc = side_vertices(x, err))) return rc;
     hd__m2m_job_t J = {.from = x->tris, .n_from = x->n, .to = &y->bvh, .drop = drop, .vertex = x->vert,
                        .n_vertices = x->n_vert, .tol = q->tol,
                        .done_below = q->done_below, .stop_above = q->stop_above, .per_face = q->per_face,
