@@ -41,11 +41,16 @@ typedef struct side {
     int points;      /* a point set */
     unsigned char *drop; /* faces shared with the other side (shared()) */
     size_t dropped;
+    const hd_mesh_t *mesh; /* the mesh the triangles come from (NULL: points) */
+    uint32_t *vert;      /* each corner's vertex index, once a search from
+                          * this side needs it (side_vertices) */
+    size_t n_vert;
 } side_t;
 
 static void side_free(side_t *s) {
     free(s->tris);
     free(s->drop);
+    free(s->vert);
     if (s->built) hd__bvh_free(&s->bvh);
     memset(s, 0, sizeof *s);
 }
@@ -63,6 +68,23 @@ static int side_tree(side_t *s, const char *name, hd_error_t *err) {
     return HD_OK;
 }
 
+/* Each corner's vertex index (the indices were checked with the
+ * triangles), so that the search orders vertices rather than corners
+ * (mesh/m2m.c, corner_order); none for a point set or for 2^32 vertices
+ * or more. */
+static int side_vertices(side_t *s, hd_error_t *err) {
+    const hd_mesh_t *M = s->mesh;
+    if (s->vert || !M || M->vertices.count > UINT32_MAX || s->n > SIZE_MAX / 3) return HD_OK;
+    s->vert = hd__malloc_array(3 * s->n, sizeof *s->vert);
+    if (!s->vert) return hd__err(err, HD_ENOMEM, "out of memory for %zu triangles", s->n);
+    const uint32_t *i32 = M->triangles;
+    const uint64_t *i64 = M->triangles;
+    for (size_t k = 0; k < 3 * s->n; k++)
+        s->vert[k] = M->index_type == HD_INDEX_U32 ? i32[k] : (uint32_t)i64[k];
+    s->n_vert = M->vertices.count;
+    return HD_OK;
+}
+
 static int side_mesh(const hd_mesh_t *M, const char *name, side_t *s, hd_error_t *err) {
     memset(s, 0, sizeof *s);
     if (!M) return hd__err(err, HD_EINVAL, "mesh %s is NULL", name);
@@ -77,6 +99,7 @@ static int side_mesh(const hd_mesh_t *M, const char *name, side_t *s, hd_error_t
         return rc;
     }
     s->n = M->n_triangles;
+    s->mesh = M;
     return HD_OK;
 }
 
@@ -111,15 +134,16 @@ static int check_options(const hd_surface_options_t *opt, hd_surface_options_t *
 /* The absolute tolerance: the option made absolute (relative: times the
  * diagonal of both sides' box), and never below the floor. */
 static double tolerance_of(const hd_surface_options_t *o, const side_t *x, const side_t *y) {
-    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY}, big = 0;
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY}, big;
     const side_t *s2[2] = {x, y};
-    for (int s = 0; s < 2; s++)
+    for (int s = 0; s < 2; s++) /* the corners are finite (checked): plain comparisons */
         for (size_t k = 0; k < s2[s]->n; k++)
             for (int j = 0; j < 3; j++)
                 for (int d = 0; d < 3; d++) {
                     double v = s2[s]->tris[k].v[j][d];
-                    lo[d] = fmin(lo[d], v), hi[d] = fmax(hi[d], v), big = fmax(big, fabs(v));
+                    lo[d] = v < lo[d] ? v : lo[d], hi[d] = v > hi[d] ? v : hi[d];
                 }
+    big = fmax(fmax(fmax(-lo[0], hi[0]), fmax(-lo[1], hi[1])), fmax(-lo[2], hi[2]));
     double dx = hi[0] - lo[0], dy = hi[1] - lo[1], dz = hi[2] - lo[2];
     double diag = sqrt(dx * dx + dy * dy + dz * dz);
     double floor_ = big * FLOOR_COORD + diag * FLOOR_DIAG + 0x1p-1000;
@@ -174,7 +198,9 @@ static int directed(side_t *x, side_t *y, const ask_t *q, hd_enclosure_t *out, h
         return HD_OK;
     }
     if (!y->built && (rc = side_tree(y, y->points ? "points" : "mesh", err))) return rc;
-    hd__m2m_job_t J = {.from = x->tris, .n_from = x->n, .to = &y->bvh, .drop = drop, .tol = q->tol,
+    if ((rc = side_vertices(x, err))) return rc;
+    hd__m2m_job_t J = {.from = x->tris, .n_from = x->n, .to = &y->bvh, .drop = drop, .vertex = x->vert,
+                       .n_vertices = x->n_vert, .tol = q->tol,
                        .done_below = q->done_below, .stop_above = q->stop_above, .per_face = q->per_face,
                        .max_splits = q->max_splits, .face_lower = q->face_lower, .face_upper = q->face_upper};
     J.threads = hd__thread_count(q->threads, x->n);

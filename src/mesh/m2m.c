@@ -123,7 +123,9 @@
  * The children's points are their parent's, so they inherit its list as
  * it stands; a sub-triangle being split filters its inherited list with
  * its own Bx and H (the same argument), or, without one, collects it from
- * the tree (collect(), up to LIST_MAX triangles).  Lists live in the
+ * the tree (hd__bvh_collect, up to LIST_MAX triangles: it leaves out only
+ * triangles proven farther than sqrt(r2) from Bx, by their boxes or by
+ * the support bound, proofs in bvh.c).  Lists live in the
  * worker's arena for one visit of the face; a sub-triangle saved for a
  * later pass loses its list.  So hi is the tree's smallest hi2, up to
  * ties, and every list depends on the face's refinement alone.
@@ -156,8 +158,14 @@
 #define MAX_BATCH 1024
 /* Faces per task in phase 1. */
 #define CHUNK 256
-/* Phase 0's sample: every SAMPLE_STRIDE-th corner in Morton order. */
+/* Phase 0's sample: every stride-th corner in Morton order, the stride
+ * SAMPLE_STRIDE doubled while the sample would exceed SAMPLE_SIZE corners,
+ * up to MAX_STRIDE (each sample corner is searched in full; a larger
+ * sample only sharpens L0 a little: bench/m2m_run, `through` and
+ * `decimated` against `shared`). */
 #define SAMPLE_STRIDE 32
+#define SAMPLE_SIZE 512
+#define MAX_STRIDE 256
 /* Below this a squared edge may have underflowed: R from |dx|+|dy|+|dz|. */
 #define TINY2 0x1p-960
 
@@ -729,6 +737,7 @@ typedef struct ctx {
     int stage;
     size_t stride;
     double L0;
+    double *target;        /* stage 2: each face's corner_target (or NULL) */
 } ctx_t;
 
 #define CORNER(J, id) ((J)->from[(id) / 3].v[(id) % 3])
@@ -745,6 +754,14 @@ static double face_reach(const hd__tri_t *t) {
     return sqrt(a2) * 0.5774;
 }
 
+/* The same corner, bit for bit (inline: phase 0 asks at every corner). */
+static int same_point(const double *p, const double *q) {
+    uint64_t a[3], b[3];
+    memcpy(a, p, sizeof a);
+    memcpy(b, q, sizeof b);
+    return ((a[0] ^ b[0]) | (a[1] ^ b[1]) | (a[2] ^ b[2])) == 0;
+}
+
 /* Corner k of the order is in stage 1's sample: every stride-th position
  * that starts a run of equal corners (a vertex of X and its copies). */
 static int is_sample(const ctx_t *C, size_t k) {
@@ -752,15 +769,28 @@ static int is_sample(const ctx_t *C, size_t k) {
     if (k == 0) return 1;
     size_t id = C->order ? (size_t)(C->order[k] & 0xffffffffu) : k;
     size_t pr = C->order ? (size_t)(C->order[k - 1] & 0xffffffffu) : k - 1;
-    return memcmp(CORNER(C->job, id), CORNER(C->job, pr), 3 * sizeof(double)) != 0;
+    return !same_point(CORNER(C->job, id), CORNER(C->job, pr));
 }
 
 /* Stage 2's target for corner id: a bound at most this puts the corner
  * below L0, so it needs no exact distance, and with its face's other
  * corners as low the face's point bound is within the tolerance of L0. */
 static double corner_target(const ctx_t *C, size_t id) {
+    if (C->target) return C->target[id / 3];
     const hd__m2m_job_t *J = C->job;
     return dmin(C->L0 + J->tol - face_reach(&J->from[id / 3]), down(C->L0));
+}
+
+/* Every face's stage-2 target at once (each face has three corners), in
+ * C->target; left NULL without memory (then each corner computes it). */
+static void corner_targets(ctx_t *C) {
+    const hd__m2m_job_t *J = C->job;
+    C->target = hd__malloc_array(J->n_from ? J->n_from : 1, sizeof *C->target);
+    if (!C->target) return;
+    double *t = C->target;
+    C->target = NULL;
+    for (size_t f = 0; f < J->n_from; f++) t[f] = C->faces[f].done ? 0 : corner_target(C, 3 * f);
+    C->target = t;
 }
 
 /* Stage 2 without a search: the bound of corner id carried from an anchor
@@ -792,7 +822,9 @@ static void phase0(void *vctx, size_t task, int worker) {
     size_t lo = task * CHUNK * 3, hi = lo + CHUNK * 3 < C->n_corners ? lo + CHUNK * 3 : C->n_corners;
     size_t seed = SIZE_MAX, prev = SIZE_MAX, anchor = SIZE_MAX;
     uint64_t count = 0;
-    for (size_t k = lo; k < hi; k++) {
+    /* stage 1 visits the sample's positions alone (multiples of the stride) */
+    size_t step = C->stage == 1 ? C->stride : 1;
+    for (size_t k = C->stage == 1 ? (lo + step - 1) / step * step : lo; k < hi; k += step) {
         size_t id = C->order ? (size_t)(C->order[k] & 0xffffffffu) : k;
         found_t *F = &C->found[id];
         if (C->faces[id / 3].done) continue;
@@ -802,7 +834,8 @@ static void phase0(void *vctx, size_t task, int worker) {
             seed = F->pos, prev = anchor = id;
             continue;
         }
-        int same = prev != SIZE_MAX && memcmp(CORNER(J, id), CORNER(J, prev), 3 * sizeof(double)) == 0;
+        int same = prev != SIZE_MAX && ((J->vertex && J->vertex[id] == J->vertex[prev]) ||
+                                        same_point(CORNER(J, id), CORNER(J, prev)));
         if (same && C->found[prev].complete) {
             *F = C->found[prev];
             continue;
@@ -849,7 +882,9 @@ static void phase0_exact(void *vctx, size_t task, int worker) {
     const hd__m2m_job_t *J = C->job;
     size_t lo = task * CHUNK * 3, hi = lo + CHUNK * 3 < C->n_corners ? lo + CHUNK * 3 : C->n_corners;
     hd__bvh_stats_t st = {0};
-    for (size_t k = lo; k < hi; k++) {
+    /* stage 1 visits the sample's positions alone (multiples of the stride) */
+    size_t step = C->stage == 1 ? C->stride : 1;
+    for (size_t k = C->stage == 1 ? (lo + step - 1) / step * step : lo; k < hi; k += step) {
         size_t id = C->order ? (size_t)(C->order[k] & 0xffffffffu) : k;
         found_t *F = &C->found[id];
         if (C->faces[id / 3].done || (C->stage == 1 && !is_sample(C, k)) || F->hi < C->bar) continue;
@@ -989,29 +1024,54 @@ static void screen_task(void *vctx, size_t task, int worker) {
         if (!C->faces[f].done && screened(J, &J->from[f], &seed, &C->faces[f].upper)) C->faces[f].done = 1;
 }
 
-/* The corners' Morton order (NULL when there are too many to key; any
- * order is correct). */
-static int corner_order(const hd__m2m_job_t *J, int threads, uint64_t **out) {
+/* The corners of the faces not dropped (J->drop), in *out (their ids in
+ * the low 32 bits) and their number in *count: the vertices of X those
+ * corners use in Morton order (a key per vertex, not per corner), each
+ * vertex's corners together in increasing id, so that equal corners
+ * follow each other; NULL when there are too many corners or no vertex
+ * indices (then every corner in index order; any order is correct).  A
+ * dropped face's corners are never searched, so they take no place in
+ * the order and no part in its grid (bench/m2m_run, `shared`). */
+static int corner_order(const hd__m2m_job_t *J, int threads, uint64_t **out, size_t *count) {
     *out = NULL;
-    size_t n = 3 * J->n_from;
-    if (n > UINT32_MAX) return HD_OK;
-    uint64_t *keys = hd__malloc_array(n, sizeof *keys), *tmp = hd__malloc_array(n, sizeof *tmp);
-    if (!keys || !tmp) {
-        free(keys);
-        free(tmp);
-        return HD_ENOMEM;
-    }
+    size_t n = 3 * J->n_from, nv = J->n_vertices, m = 0, live = 0;
+    *count = n;
+    if (n > UINT32_MAX || !J->vertex) return HD_OK;
+    uint32_t *first = hd__malloc_array(nv ? nv : 1, sizeof *first); /* a corner of each vertex used */
+    size_t *at = hd__malloc_array(nv ? nv : 1, sizeof *at);
+    uint64_t *keys = hd__malloc_array(nv ? nv : 1, sizeof *keys), *tmp = hd__malloc_array(nv ? nv : 1, sizeof *tmp);
+    uint64_t *order = hd__malloc_array(n ? n : 1, sizeof *order);
+    int rc = first && at && keys && tmp && order ? HD_OK : HD_ENOMEM;
     hd__box_t box = {{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
-    for (size_t id = 0; id < n; id++)
-        for (int d = 0; d < 3; d++)
-            box.lo[d] = dmin(box.lo[d], CORNER(J, id)[d]), box.hi[d] = dmax(box.hi[d], CORNER(J, id)[d]);
-    hd__keygrid_t g;
-    hd__keygrid_init(&g, &box);
-    for (size_t id = 0; id < n; id++) keys[id] = (uint64_t)hd__key30(&g, CORNER(J, id)) << 32 | (uint64_t)id;
-    int rc = hd__radix_sort(&keys, &tmp, n, threads);
-    free(tmp);
-    if (rc) free(keys);
-    else *out = keys;
+    for (size_t v = 0; rc == HD_OK && v < nv; v++) first[v] = UINT32_MAX, at[v] = 0;
+    for (size_t id = 0; rc == HD_OK && id < n; id++) {
+        if (J->drop && J->drop[id / 3]) continue;
+        uint32_t v = J->vertex[id];
+        at[v]++, live++;
+        if (first[v] != UINT32_MAX) continue;
+        first[v] = (uint32_t)id;
+        const double *p = CORNER(J, id);
+        for (int d = 0; d < 3; d++) box.lo[d] = dmin(box.lo[d], p[d]), box.hi[d] = dmax(box.hi[d], p[d]);
+    }
+    if (rc == HD_OK) {
+        hd__keygrid_t g;
+        hd__keygrid_init(&g, &box);
+        for (size_t v = 0; v < nv; v++)
+            if (first[v] != UINT32_MAX) keys[m++] = (uint64_t)hd__key30(&g, CORNER(J, first[v])) << 32 | (uint64_t)v;
+        rc = m ? hd__radix_sort(&keys, &tmp, m, threads) : HD_OK;
+    }
+    if (rc == HD_OK) {
+        size_t next = 0; /* each vertex's first place in the order */
+        for (size_t i = 0; i < m; i++) {
+            size_t v = (size_t)(keys[i] & 0xffffffffu), c = at[v];
+            at[v] = next, next += c;
+        }
+        for (size_t id = 0; id < n; id++)
+            if (!(J->drop && J->drop[id / 3])) order[at[J->vertex[id]]++] = (uint64_t)id;
+        *out = order, *count = live;
+    }
+    free(first), free(at), free(keys), free(tmp);
+    if (rc) free(order);
     return rc;
 }
 
@@ -1098,39 +1158,12 @@ static void cand_region(const double c[3][3], double U, double e, hd__box_t *B, 
     *r2 = up(H * H);
 }
 
-/* The positions of the triangles of T whose box is not box_far from B,
- * in leaf order, or SIZE_MAX when there are more than cap (the boxes
- * alone: cheaper than hd__bvh_collect's support bound per triangle, for
- * the short lists wanted here). */
-static size_t collect(const hd__bvh_t *T, const hd__box_t *B, double r2, uint32_t *out, size_t cap) {
-    uint32_t stack[DEPTH];
-    int top = 0;
-    size_t n = 0;
-    stack[top++] = 0;
-    while (top > 0) { /* a node's box is tested when it is popped */
-        uint32_t id = stack[--top];
-        const hd__bvh_node_t *node = &T->nodes[id];
-        if (box_far(&node->box, B, r2)) continue;
-        if (!node->count) {
-            if (top + 2 > DEPTH) return SIZE_MAX;
-            stack[top++] = node->first_or_second, stack[top++] = id + 1; /* the first child first */
-            continue;
-        }
-        for (size_t k = node->first_or_second; k < (size_t)node->first_or_second + node->count; k++)
-            if (!box_far(&T->boxes[k], B, r2)) {
-                if (n == cap) return SIZE_MAX;
-                out[n++] = (uint32_t)k;
-            }
-    }
-    return n;
-}
-
 size_t hd__m2m_candidates(const hd__bvh_t *T, const double c[3][3], double U, double e, const uint32_t *from,
                           size_t n_from, uint32_t *out, size_t cap) {
     hd__box_t B;
     double r2;
     cand_region(c, U, e, &B, &r2);
-    if (!from) return collect(T, &B, r2, out, cap);
+    if (!from) return hd__bvh_collect(T, &B, r2, out, cap);
     size_t n = 0;
     for (size_t i = 0; i < n_from; i++) {
         if (box_far(&T->boxes[from[i]], &B, r2)) continue;
@@ -1332,14 +1365,19 @@ static int by_upper(const void *x, const void *y) {
     return (a->f > b->f) - (a->f < b->f);
 }
 
-/* Digit `pass` of a rank's sort key: passes 0-7 the bytes of f, 8-15
- * those of the complement of U's bits (U > 0; else the largest key). */
-static unsigned rank_digit(const rank_t *r, int pass) {
+/* U's part of a rank's sort key: the complement of U's bits (U > 0;
+ * else the largest key). */
+static uint64_t u_key(const rank_t *r) {
     uint64_t key;
-    if (pass < 8) return (unsigned)(((uint64_t)r->f >> (8 * pass)) & 255);
     memcpy(&key, &r->U, sizeof key);
-    key = r->U > 0 ? ~key : ~(uint64_t)0;
-    return (unsigned)((key >> (8 * (pass - 8))) & 255);
+    return r->U > 0 ? ~key : ~(uint64_t)0;
+}
+
+/* Digit `pass` of a rank's sort key: passes 0-7 the bytes of f, 8-15
+ * those of u_key. */
+static unsigned rank_digit(const rank_t *r, int pass) {
+    if (pass < 8) return (unsigned)(((uint64_t)r->f >> (8 * pass)) & 255);
+    return (unsigned)((u_key(r) >> (8 * (pass - 8))) & 255);
 }
 
 /* rk sorted as by_upper sorts it (by decreasing U, then increasing f):
@@ -1359,9 +1397,17 @@ static void sort_ranks(rank_t *rk, size_t n) {
         qsort(rk, n, sizeof *rk, by_upper);
         return;
     }
-    for (size_t k = 0; k < n; k++)
-        for (int pass = 0; pass < 16; pass++) count[pass][rank_digit(&rk[k], pass)]++;
-    for (int pass = 0; pass < 16; pass++) {
+    /* entries already in increasing f (phase 1's ranks) need only the
+     * passes by U: a stable sort keeps that order among equal U */
+    int first = 8;
+    for (size_t k = 1; k < n && first == 8; k++) first = rk[k - 1].f < rk[k].f ? 8 : 0;
+    for (size_t k = 0; k < n; k++) {
+        uint64_t f = (uint64_t)rk[k].f, u = u_key(&rk[k]);
+        for (int b = 0; b < 8; b++) count[8 + b][(u >> (8 * b)) & 255]++;
+        if (!first)
+            for (int b = 0; b < 8; b++) count[b][(f >> (8 * b)) & 255]++;
+    }
+    for (int pass = first; pass < 16; pass++) {
         size_t at = 0, same = 0;
         for (int d = 0; d < 256; d++) {
             same |= count[pass][d] == n;
@@ -1488,24 +1534,28 @@ static int first_pass(const hd__m2m_job_t *J, ctx_t *C, hd__m2m_result_t *R) {
     size_t n = J->n_from;
     uint64_t *order = NULL;
     C->found = hd__malloc_array(n ? 3 * n : 1, sizeof *C->found);
-    if (!C->found || corner_order(J, J->threads, &order)) {
+    if (!C->found || corner_order(J, J->threads, &order, &C->n_corners)) {
         free(C->found);
         return HD_ENOMEM;
     }
     C->order = order;
-    size_t tasks = (n + CHUNK - 1) / CHUNK;
+    while (C->stride < MAX_STRIDE && C->n_corners / C->stride > SAMPLE_SIZE) C->stride *= 2;
+    size_t tasks = (n + CHUNK - 1) / CHUNK, corner_tasks = (C->n_corners + 3 * CHUNK - 1) / (3 * CHUNK);
     if (!J->per_face && !J->face_lower) { /* the sample first: L0 */
         C->stage = 1;
-        hd__parallel_for(J->threads, tasks, phase0, C);
+        hd__parallel_for(J->threads, corner_tasks, phase0, C);
         C->bar = phase0_bar(C);
-        hd__parallel_for(J->threads, tasks, phase0_exact, C);
+        hd__parallel_for(J->threads, corner_tasks, phase0_exact, C);
         C->L0 = sample_best(C);
         C->stage = isfinite(C->L0) ? 2 : 0;
+        if (C->stage == 2) corner_targets(C);
     }
-    hd__parallel_for(J->threads, tasks, phase0, C);
+    hd__parallel_for(J->threads, corner_tasks, phase0, C);
     C->bar = phase0_bar(C);
-    hd__parallel_for(J->threads, tasks, phase0_exact, C);
+    hd__parallel_for(J->threads, corner_tasks, phase0_exact, C);
     hd__parallel_for(J->threads, tasks, phase1, C);
+    free(C->target);
+    C->target = NULL;
     free(order);
     free(C->found);
     for (size_t f = 0; f < n; f++) take_best(R, &C->faces[f], f);
@@ -1526,7 +1576,8 @@ static int decide_pass(const hd__m2m_job_t *J, ctx_t *C, hd__m2m_result_t *R, in
     uint64_t *order = NULL, *part = NULL;
     C->found = hd__malloc_array(n ? 3 * n : 1, sizeof *C->found);
     part = hd__malloc_array(n ? 3 * n : 1, sizeof *part);
-    if (!C->found || !part || corner_order(J, J->threads, &order)) {
+    size_t live = 0;
+    if (!C->found || !part || corner_order(J, J->threads, &order, &live)) {
         free(C->found);
         free(part);
         return HD_ENOMEM;
@@ -1537,7 +1588,7 @@ static int decide_pass(const hd__m2m_job_t *J, ctx_t *C, hd__m2m_result_t *R, in
         size_t f1 = (t0 + m) * CHUNK < n ? (t0 + m) * CHUNK : n, k = 0;
         C->task0 = t0;
         hd__parallel_for(J->threads, m, screen_task, C);
-        for (size_t i = 0; i < 3 * n; i++) {
+        for (size_t i = 0; i < live; i++) {
             size_t id = order ? (size_t)(order[i] & 0xffffffffu) : i;
             if (id / 3 >= f0 && id / 3 < f1 && !C->faces[id / 3].done) part[k++] = id;
         }
@@ -1563,7 +1614,7 @@ int hd__m2m_run(const hd__m2m_job_t *J, hd__m2m_result_t *R) {
     memset(R, 0, sizeof *R);
     R->face = R->face_b = SIZE_MAX;
     size_t n = J->n_from;
-    ctx_t C = {J, hd__malloc_array(n ? n : 1, sizeof(face_t)), NULL, NULL, 0, NULL, 0, 0, 0, SAMPLE_STRIDE, 0};
+    ctx_t C = {J, hd__malloc_array(n ? n : 1, sizeof(face_t)), NULL, NULL, 0, NULL, 0, 0, 0, SAMPLE_STRIDE, 0, NULL};
     rank_t *rk = hd__malloc_array(n ? n : 1, sizeof *rk);
     C.n_corners = 3 * n;
     C.caches = caches_new(J->threads, J->to->n_tris);
@@ -1595,79 +1646,4 @@ int hd__m2m_run(const hd__m2m_job_t *J, hd__m2m_result_t *R) {
     caches_free(C.caches, J->threads);
     free(rk);
     return rc;
-}
-
-/* ---- shared faces -------------------------------------------------------- */
-
-typedef struct key {
-    double v[3][3];
-} facekey_t;
-
-static int cmp_corner3(const void *x, const void *y) { return memcmp(x, y, 3 * sizeof(double)); }
-
-static void swap_if(double a[3], double b[3]) {
-    if (cmp_corner3(a, b) > 0) {
-        double t[3];
-        memcpy(t, a, sizeof t), memcpy(a, b, sizeof t), memcpy(b, t, sizeof t);
-    }
-}
-
-/* The corners in memcmp order (three compare-exchanges). */
-static void key_of(const hd__tri_t *t, facekey_t *k) {
-    memcpy(k->v, t->v, sizeof k->v);
-    swap_if(k->v[0], k->v[1]);
-    swap_if(k->v[1], k->v[2]);
-    swap_if(k->v[0], k->v[1]);
-}
-
-/* A key's hash: its 72 bytes mixed (any function would do: equal keys
- * have equal hashes, and the table compares keys in full). */
-static uint64_t key_hash(const facekey_t *k) {
-    uint64_t h = 0x9e3779b97f4a7c15u, w;
-    for (int i = 0; i < 9; i++) {
-        memcpy(&w, &k->v[i / 3][i % 3], sizeof w);
-        h = (h ^ w) * 0xff51afd7ed558ccdu;
-        h ^= h >> 32;
-    }
-    return h;
-}
-
-int hd__m2m_shared(const hd__tri_t *x, size_t nx, const hd__tri_t *y, size_t ny, unsigned char *drop_x,
-                   unsigned char *drop_y, size_t *count_x, size_t *count_y) {
-    *count_x = *count_y = 0;
-    size_t size = 16;
-    while (size < 2 * ny) size *= 2;
-    facekey_t *ky = hd__malloc_array(ny ? ny : 1, sizeof *ky);
-    size_t *slot = hd__malloc_array(size, sizeof *slot), *at = hd__malloc_array(ny ? ny : 1, sizeof *at);
-    unsigned char *hit = calloc(size, 1);
-    if (!ky || !slot || !at || !hit) {
-        free(ky), free(slot), free(at), free(hit);
-        return HD_ENOMEM;
-    }
-    /* Y's keys in a table with linear probing (SIZE_MAX: empty); at[k]:
-     * the slot of face k's key (equal keys share the first one's) */
-    for (size_t k = 0; k < size; k++) slot[k] = SIZE_MAX;
-    for (size_t k = 0; k < ny; k++) {
-        key_of(&y[k], &ky[k]);
-        size_t h = (size_t)key_hash(&ky[k]) & (size - 1);
-        while (slot[h] != SIZE_MAX && memcmp(&ky[slot[h]], &ky[k], sizeof ky[k])) h = (h + 1) & (size - 1);
-        if (slot[h] == SIZE_MAX) slot[h] = k;
-        at[k] = h;
-    }
-    /* X's faces looked up; the keys they meet are Y's shared faces */
-    for (size_t k = 0; k < nx; k++) {
-        facekey_t kx;
-        key_of(&x[k], &kx);
-        size_t h = (size_t)key_hash(&kx) & (size - 1);
-        while (slot[h] != SIZE_MAX && memcmp(&ky[slot[h]], &kx, sizeof kx)) h = (h + 1) & (size - 1);
-        drop_x[k] = slot[h] != SIZE_MAX;
-        hit[h] |= drop_x[k];
-        *count_x += drop_x[k];
-    }
-    for (size_t k = 0; drop_y && k < ny; k++) {
-        drop_y[k] = hit[at[k]];
-        *count_y += drop_y[k];
-    }
-    free(ky), free(slot), free(at), free(hit);
-    return HD_OK;
 }

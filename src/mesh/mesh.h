@@ -240,6 +240,9 @@ typedef struct hd__m2m_job {
     size_t n_from;
     const hd__bvh_t *to;
     const unsigned char *drop; /* 1 for a face of X to skip (shared), or NULL */
+    const uint32_t *vertex;    /* corner 3 f + j's vertex index in X, < n_vertices
+                                  (equal indices: equal corners), or NULL */
+    size_t n_vertices;
     double tol;                /* absolute, > 0 */
     double done_below;         /* a face is finished once its bound is <= this
                                   (the predicate's d; -infinity otherwise) */
@@ -293,7 +296,7 @@ double hd__m2m_carried_bound(double hi, const double a[3], const double p[3]);
 size_t hd__m2m_candidates(const hd__bvh_t *T, const double c[3][3], double U, double e, const uint32_t *from,
                           size_t n_from, uint32_t *out, size_t cap);
 
-/* drop_x[k] = 1 for each triangle of x whose three corners are, as a set,
+/* drop_x[k] = 1 for each triangle of x whose three corners are, as a multiset,
  * bit-identical to those of a triangle of y, *count_x of them; and the
  * same for y against x in drop_y (unless NULL), *count_y.  HD_OK or
  * HD_ENOMEM. */
