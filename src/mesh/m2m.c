@@ -1186,6 +1186,37 @@ static void own_list(const hd__m2m_job_t *J, double e, sub_t *s, pool_t *P) {
     P->a_n += n;
 }
 
+/* Tang's bound with the triangle nearest (as the bounds tell) to the
+ * centroid of s's computed corners, from s's list or else the tree, when
+ * it is none of the corners' own: U if not smaller.  Any triangle of Y
+ * gives a bound (the top); where the corners lie at vertices of Y, each
+ * nearest to one of the triangles around it, the one under the whole
+ * sub-triangle need not be any corner's. */
+static double centre_bound(const hd__m2m_job_t *J, sub_t *s, double e, double U, const uint32_t *arena, cache_t *C,
+                           uint64_t *kernel) {
+    const hd__bvh_t *T = J->to;
+    double g[3], lo2, hi2, best = INFINITY;
+    for (int d = 0; d < 3; d++) g[d] = (s->c[0].p[d] + s->c[1].p[d] + s->c[2].p[d]) / 3;
+    size_t pos = SIZE_MAX;
+    if (s->n != NO_LIST) {
+        for (size_t i = 0; i < s->n; i++) {
+            size_t k = arena[s->off + i];
+            if (beyond(&T->boxes[k], g, best)) continue;
+            bounds_at(T, k, g, C, &lo2, &hi2);
+            (*kernel)++;
+            if (pos == SIZE_MAX || hi2 < best) best = hi2, pos = k;
+        }
+    }
+    if (pos == SIZE_MAX) {
+        double lo, hi;
+        pos = interval(T, g, s->c[0].pos, C, -1, &lo, &hi, kernel);
+    }
+    if (pos == SIZE_MAX || pos == s->c[0].pos || pos == s->c[1].pos || pos == s->c[2].pos) return U;
+    double m = 0, E = s->level ? e : 0;
+    for (int k = 0; k < 3 && up(m + E) < U; k++) m = dmax(m, corner_to(&s->c[k], pos, &T->tris[pos], C, kernel));
+    return dmin(U, up(m + E));
+}
+
 static void split(const hd__m2m_job_t *J, const hd__tri_t *t, double e, double L, const sub_t *s, sub_t kids[4],
                   face_t *F, pool_t *P, hd__bvh_stats_t *st) {
     int level = s->level + 1;
@@ -1224,6 +1255,7 @@ static void split(const hd__m2m_job_t *J, const hd__tri_t *t, double e, double L
         kids[q].level = level;
         kids[q].off = s->off, kids[q].n = s->n;
         kids[q].U = upper_of(J, &kids[q], e, enough, P->cache, &F->kernel);
+        if (kids[q].U > enough) kids[q].U = centre_bound(J, &kids[q], e, kids[q].U, P->arena, P->cache, &F->kernel);
         for (int i = 0; i < 3; i++) *tri[q][i] = kids[q].c[i];
     }
     for (int q = 0; q < 3; q++)
