@@ -1191,7 +1191,10 @@ static void own_list(const hd__m2m_job_t *J, double e, sub_t *s, pool_t *P) {
  * it is none of the corners' own: U if not smaller.  Any triangle of Y
  * gives a bound (the top); where the corners lie at vertices of Y, each
  * nearest to one of the triangles around it, the one under the whole
- * sub-triangle need not be any corner's. */
+ * sub-triangle need not be any corner's.  Tried from the tree at the
+ * levels without lists only: deeper, a sub-triangle whose list could not
+ * be collected has too many triangles near it for one to settle it
+ * (bench/m2m_run, `shared`: its maximum lies on Y's medial axis). */
 static double centre_bound(const hd__m2m_job_t *J, sub_t *s, double e, double U, const uint32_t *arena, cache_t *C,
                            uint64_t *kernel) {
     const hd__bvh_t *T = J->to;
@@ -1255,7 +1258,7 @@ static void split(const hd__m2m_job_t *J, const hd__tri_t *t, double e, double L
         kids[q].level = level;
         kids[q].off = s->off, kids[q].n = s->n;
         kids[q].U = upper_of(J, &kids[q], e, enough, P->cache, &F->kernel);
-        if (kids[q].U > enough) kids[q].U = centre_bound(J, &kids[q], e, kids[q].U, P->arena, P->cache, &F->kernel);
+        if (kids[q].U > enough && (kids[q].n != NO_LIST || level < LIST_LEVEL)) kids[q].U = centre_bound(J, &kids[q], e, kids[q].U, P->arena, P->cache, &F->kernel);
         for (int i = 0; i < 3; i++) *tri[q][i] = kids[q].c[i];
     }
     for (int q = 0; q < 3; q++)
