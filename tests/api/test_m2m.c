@@ -677,3 +677,28 @@ TEST(sub_triangles_over_bent_pairs_split_fewer_times) {
     both_ways(&A, &B, 1e-9, 8);
     gen_soup_free(&A), gen_soup_free(&B);
 }
+
+/* A flat grid against a copy split in four whose vertices are raised by
+ * seeded amounts far below the tolerance (nearzero's case): each child of
+ * a face's first split lies over one triangle of B, but its corners sit at
+ * B's vertices, each nearest to any triangle around it; Tang's bound with
+ * the triangle under the child's centroid settles it, so a face splits
+ * about once - and the enclosure holds both ways. */
+TEST(sub_triangles_over_one_triangle_of_a_finer_copy_settle_at_once) {
+    gen_rng_t r;
+    gen_seed(&r, 3839);
+    gen_soup_t A = grid(8, 0), B = grid(16, 0);
+    for (size_t k = 0; k < B.nv; k++) {
+        B.v[3 * k] *= 0.5, B.v[3 * k + 1] *= 0.5;
+        B.v[3 * k + 2] = ldexp((double)(gen_u64(&r) % 64), -30);
+    }
+    hd_mesh_t a = gen_soup_view(&A), b = gen_soup_view(&B);
+    hd_surface_options_t o = options(1e-4, 1, 1);
+    hd_enclosure_t ab, ba;
+    CHECK_RC(hd_surface_hausdorff(&a, &b, &o, &ab, &ba, NULL), HD_OK);
+    CONTEXT("seed 3839: %llu and %llu splits of %zu and %zu faces", (unsigned long long)ab.faces_split,
+            (unsigned long long)ba.faces_split, A.nt, B.nt);
+    CHECK(ab.faces_split <= 2 * A.nt);
+    both_ways(&A, &B, 1e-4, 8);
+    gen_soup_free(&A), gen_soup_free(&B);
+}
