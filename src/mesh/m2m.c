@@ -1228,12 +1228,16 @@ static void split(const hd__m2m_job_t *J, const hd__tri_t *t, double e, double L
         c[i] = s->c[i];
         for (int j = 0; j < 3; j++) c[i].k[j] = 2 * s->c[i].k[j];
     }
-    /* A midpoint bounded by at most `target` needs no tighter bound: each
-     * child's point bound is then at most max(the threshold + tolerance,
-     * d) (a child's reach is at most its parent's, up to rounding), where
-     * a sub-triangle is never split, and the midpoint cannot raise a lower
-     * bound (target <= exact_bar). */
-    double target = dmin(dmax(threshold(J, L, F) + J->tol, J->done_below) - reach(s) - 2 * e, exact_bar(J, L, F));
+    /* A midpoint bounded by at most `target` needs no tighter bound: it
+     * cannot raise a lower bound (target <= exact_bar), and its own bound,
+     * plus e, is at most max(the threshold + tolerance, d), where a
+     * sub-triangle is never split, so it raises none of its children's
+     * bounds above that (their bounds with other triangles take its
+     * distance to each afresh, corner_to); the triangle it names may be a
+     * poorer candidate for their Tang bounds than its nearest, which
+     * centre_bound makes up for (bench/m2m_run, `nearzero`,
+     * `subdivided`). */
+    double target = dmin(dmax(threshold(J, L, F) + J->tol, J->done_below) - 2 * e, exact_bar(J, L, F));
     for (int i = 0; i < 3; i++) {
         const corner_t *p = &s->c[i], *q = &s->c[(i + 1) % 3];
         for (int j = 0; j < 3; j++) m[i].k[j] = p->k[j] + q->k[j];
