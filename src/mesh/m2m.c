@@ -1232,8 +1232,8 @@ static void split(const hd__m2m_job_t *J, const hd__tri_t *t, double e, double L
      * cannot raise a lower bound (target <= exact_bar), and its own bound,
      * plus e, is at most max(the threshold + tolerance, d), where a
      * sub-triangle is never split, so it raises none of its children's
-     * bounds above that (their bounds with other triangles take its
-     * distance to each afresh, corner_to); the triangle it names may be a
+     * Tang bounds above that (those with other triangles take its distance
+     * to each afresh, corner_to); the triangle it names may be a
      * poorer candidate for their Tang bounds than its nearest, which
      * centre_bound makes up for (bench/m2m_run, `nearzero`,
      * `subdivided`). */
