@@ -52,7 +52,10 @@
  *    And for any triangle t of Y, d(., t) is convex, so its maximum over T
  *    is at a corner: d(y, Y) <= min over t of max_v d(v, t) (Tang et al.),
  *    taken over the corners' nearest triangles with d(v, t) <= sqrt_up(hi2)
- *    from hd__tri_bounds (or hi for v's own triangle).  Two triangles t1,
+ *    from hd__tri_bounds (or hi for v's own triangle), and, for a child
+ *    those leave above the threshold, the triangle nearest (as the bounds
+ *    tell) to its corners' centroid computed in doubles (any triangle
+ *    gives a bound; where does not matter for rigor).  Two triangles t1,
  *    t2 at once (bent pairs, whose corners are nearest to different
  *    triangles): with a_k >= d(v_k, t1), b_k >= d(v_k, t2) and y =
  *    sum w_k v_k in T, convexity gives d(y, ti) <= sum w_k a_k (resp.
@@ -86,8 +89,8 @@
  * d(v, t) <= hi_a + |v - a| (hd__m2m_carried_bound, rounded up) is an
  * upper bound with the anchor's triangle, which is all phases 1 and 2 ask
  * of a corner's hi and pos (bench/m2m_run, `through`).  A midpoint's search stops
- * the same way at a bound that keeps its children's point bound within
- * the tolerance and below the bar of exact corners.  Phase 1 evaluates
+ * the same way at a bound within the tolerance of the threshold (less the
+ * slack) and below the bar of exact corners (split()).  Phase 1 evaluates
  * every face's corners (fixed chunks, any thread) and sets the lower
  * bound L to the best corner.  Phase 2 takes the faces by decreasing
  * upper bound in batches of fixed sizes; the faces of a batch are refined
