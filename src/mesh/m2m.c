@@ -663,11 +663,46 @@ double hd__m2m_carried_bound(double hi, const double a[3], const double p[3]) {
     return up(hi + sqrt_up(up(up(d2 * (1 + 0x1p-50)) + 0x1p-1070)));
 }
 
+/* Tang's bound with the triangle nearest (as the bounds tell) to the
+ * centroid of s's computed corners (before the slack e), from s's list
+ * or else the tree, when it is none of the corners' own: U if not
+ * smaller.  Any triangle of Y
+ * gives a bound (the top); where the corners lie at vertices of Y, each
+ * nearest to one of the triangles around it, the one under the whole
+ * sub-triangle need not be any corner's.  Tried from the tree at the
+ * levels without lists only: deeper, a sub-triangle whose list could not
+ * be collected has too many triangles near it for one to settle it
+ * (bench/m2m_run, `shared`: its maximum lies on Y's medial axis). */
+static double centre_bound(const hd__m2m_job_t *J, sub_t *s, double U, const uint32_t *arena, cache_t *C,
+                           uint64_t *kernel) {
+    const hd__bvh_t *T = J->to;
+    double g[3], lo2, hi2, best = INFINITY;
+    for (int d = 0; d < 3; d++) g[d] = (s->c[0].p[d] + s->c[1].p[d] + s->c[2].p[d]) / 3;
+    size_t pos = SIZE_MAX;
+    if (s->n != NO_LIST) {
+        for (size_t i = 0; i < s->n; i++) {
+            size_t k = arena[s->off + i];
+            if (beyond(&T->boxes[k], g, best)) continue;
+            bounds_at(T, k, g, C, &lo2, &hi2);
+            (*kernel)++;
+            if (pos == SIZE_MAX || hi2 < best) best = hi2, pos = k;
+        }
+    }
+    if (pos == SIZE_MAX) {
+        double lo, hi;
+        pos = interval(T, g, s->c[0].pos, C, -1, &lo, &hi, kernel);
+    }
+    if (pos == SIZE_MAX || pos == s->c[0].pos || pos == s->c[1].pos || pos == s->c[2].pos) return U;
+    double m = 0;
+    for (int k = 0; k < 3 && m < U; k++) m = dmax(m, corner_to(&s->c[k], pos, &T->tris[pos], C, kernel));
+    return dmin(U, m);
+}
+
 /* The sub-triangle's upper bound; once the point bound alone is at most
  * `enough` (the sub-triangle will be discarded whatever its bound) the
  * dearer bounds are skipped. */
-static double upper_of(const hd__m2m_job_t *J, sub_t *s, double e, double enough, cache_t *C,
-                       uint64_t *kernel) {
+static double upper_core(const hd__m2m_job_t *J, sub_t *s, double e, double enough, cache_t *C, uint64_t *kernel,
+                         int centre, const uint32_t *arena) {
     double rmax = 0;
     for (int i = 0; i < 3; i++) rmax = dmax(rmax, s->c[i].hi);
     double U = up(rmax + reach(s));
@@ -687,14 +722,23 @@ static double upper_of(const hd__m2m_job_t *J, sub_t *s, double e, double enough
         for (int k = 0; k < 3 && m < U; k++) m = dmax(m, cand_h(J, s, &K, i, k, C, kernel));
         U = dmin(U, m);
     }
-    if (K.n > 1) U = pair_bound(J, s, U, C, kernel);
     double E = s->level ? e : 0;
+    /* three triangles (corners at vertices of Y): the centroid's first */
+    if (centre && K.n == 3 && up(U + E) > enough) U = centre_bound(J, s, U, arena, C, kernel), centre = 0;
+    if (K.n > 1 && up(U + E) > enough) U = pair_bound(J, s, U, C, kernel);
     for (int i = 0; i < K.n && up(U + E) > enough; i++) /* bent pairs */
         for (int j = i + 1; j < K.n; j++) {
             for (int k = 0; k < 3; k++) cand_h(J, s, &K, i, k, C, kernel), cand_h(J, s, &K, j, k, C, kernel);
             U = hd__m2m_bent_bound(K.h[i], K.h[j], U);
         }
+    if (centre && up(U + E) > enough) U = centre_bound(J, s, U, arena, C, kernel);
     return s->level ? up(U + e) : U;
+}
+
+/* upper_core without the centroid's triangle (a face's first bound). */
+static double upper_of(const hd__m2m_job_t *J, sub_t *s, double e, double enough, cache_t *C,
+                       uint64_t *kernel) {
+    return upper_core(J, s, e, enough, C, kernel, 0, NULL);
 }
 
 /* The bound at or below which a (sub-)triangle's point bound makes the
@@ -1189,40 +1233,6 @@ static void own_list(const hd__m2m_job_t *J, double e, sub_t *s, pool_t *P) {
     P->a_n += n;
 }
 
-/* Tang's bound with the triangle nearest (as the bounds tell) to the
- * centroid of s's computed corners, from s's list or else the tree, when
- * it is none of the corners' own: U if not smaller.  Any triangle of Y
- * gives a bound (the top); where the corners lie at vertices of Y, each
- * nearest to one of the triangles around it, the one under the whole
- * sub-triangle need not be any corner's.  Tried from the tree at the
- * levels without lists only: deeper, a sub-triangle whose list could not
- * be collected has too many triangles near it for one to settle it
- * (bench/m2m_run, `shared`: its maximum lies on Y's medial axis). */
-static double centre_bound(const hd__m2m_job_t *J, sub_t *s, double e, double U, const uint32_t *arena, cache_t *C,
-                           uint64_t *kernel) {
-    const hd__bvh_t *T = J->to;
-    double g[3], lo2, hi2, best = INFINITY;
-    for (int d = 0; d < 3; d++) g[d] = (s->c[0].p[d] + s->c[1].p[d] + s->c[2].p[d]) / 3;
-    size_t pos = SIZE_MAX;
-    if (s->n != NO_LIST) {
-        for (size_t i = 0; i < s->n; i++) {
-            size_t k = arena[s->off + i];
-            if (beyond(&T->boxes[k], g, best)) continue;
-            bounds_at(T, k, g, C, &lo2, &hi2);
-            (*kernel)++;
-            if (pos == SIZE_MAX || hi2 < best) best = hi2, pos = k;
-        }
-    }
-    if (pos == SIZE_MAX) {
-        double lo, hi;
-        pos = interval(T, g, s->c[0].pos, C, -1, &lo, &hi, kernel);
-    }
-    if (pos == SIZE_MAX || pos == s->c[0].pos || pos == s->c[1].pos || pos == s->c[2].pos) return U;
-    double m = 0, E = s->level ? e : 0;
-    for (int k = 0; k < 3 && up(m + E) < U; k++) m = dmax(m, corner_to(&s->c[k], pos, &T->tris[pos], C, kernel));
-    return dmin(U, up(m + E));
-}
-
 static void split(const hd__m2m_job_t *J, const hd__tri_t *t, double e, double L, const sub_t *s, sub_t kids[4],
                   face_t *F, pool_t *P, hd__bvh_stats_t *st) {
     int level = s->level + 1;
@@ -1264,8 +1274,8 @@ static void split(const hd__m2m_job_t *J, const hd__tri_t *t, double e, double L
         for (int i = 0; i < 3; i++) kids[q].c[i] = *tri[q][i];
         kids[q].level = level;
         kids[q].off = s->off, kids[q].n = s->n;
-        kids[q].U = upper_of(J, &kids[q], e, enough, P->cache, &F->kernel);
-        if (kids[q].U > enough && (kids[q].n != NO_LIST || level < LIST_LEVEL)) kids[q].U = centre_bound(J, &kids[q], e, kids[q].U, P->arena, P->cache, &F->kernel);
+        int centre = kids[q].n != NO_LIST || level < LIST_LEVEL;
+        kids[q].U = upper_core(J, &kids[q], e, enough, P->cache, &F->kernel, centre, P->arena);
         for (int i = 0; i < 3; i++) *tri[q][i] = kids[q].c[i];
     }
     for (int q = 0; q < 3; q++)
