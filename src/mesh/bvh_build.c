@@ -94,6 +94,9 @@ HD__INLINE void swap_keys(bkey_t *x, long i, long j) {
  * step still narrows).  Measured by `c2m_bench ... 2 1 near 1 1`
  * (docs/benchmarks.md, "The tree's build"). */
 #define BAND_MIN 1024
+/* Ranges of at most SORT_MAX + 1 keys are sorted by insertion (fewer
+ * instructions than a partition of so few; `c2m_bench ... 2 1 near 1 1`). */
+#define SORT_MAX 5
 #define BAND_SAMPLE 0.5
 #define BAND_WIDTH 1.25
 
@@ -102,7 +105,7 @@ HD__INLINE void swap_keys(bkey_t *x, long i, long j) {
  * range first narrows to a band of values about the rank (narrow: two
  * partitions by values from a strided sample, the second over the keys
  * above the first's value only); then Hoare's selection, the pivot the
- * median of the ends and x[k].  The sample and the band only steer the
+ * median of the ends and x[k], down to a few keys, sorted.  The sample and the band only steer the
  * work: any values give the same postcondition.  Keys equal to the pivot
  * stop both scans and are swapped, so ties split evenly. */
 static void select_rank(bkey_t *x, long left, long right, long k, int a);
@@ -161,12 +164,11 @@ static int narrow(bkey_t *x, long *left, long *right, long k, int a) {
 static void select_rank(bkey_t *x, long left, long right, long k, int a) {
     while (right - left > BAND_MIN && narrow(x, &left, &right, k, a)) {
     }
-    while (right > left) {
-        if (right - left > 2) { /* the pivot: the median of the ends and x[k] */
-            if (x[k].c[a] < x[left].c[a]) swap_keys(x, k, left);
-            if (x[right].c[a] < x[k].c[a]) swap_keys(x, right, k);
-            if (x[k].c[a] < x[left].c[a]) swap_keys(x, k, left);
-        }
+    while (right - left > SORT_MAX) {
+        /* the pivot: the median of the ends and x[k] */
+        if (x[k].c[a] < x[left].c[a]) swap_keys(x, k, left);
+        if (x[right].c[a] < x[k].c[a]) swap_keys(x, right, k);
+        if (x[k].c[a] < x[left].c[a]) swap_keys(x, k, left);
         double t = x[k].c[a];
         long i = left, j = right;
         swap_keys(x, left, k);
@@ -182,6 +184,8 @@ static void select_rank(bkey_t *x, long left, long right, long k, int a) {
         if (j <= k) left = j + 1;
         if (k <= j) right = j - 1;
     }
+    for (long i = left + 1; i <= right; i++) /* a few keys: sorted by insertion */
+        for (long j = i; j > left && x[j].c[a] < x[j - 1].c[a]; j--) swap_keys(x, j, j - 1);
 }
 
 static void select_mid(bkey_t *k, size_t n, size_t mid, int a) { select_rank(k, 0, (long)n - 1, (long)mid, a); }
