@@ -94,11 +94,11 @@ HD__INLINE void swap_keys(bkey_t *x, long i, long j) {
  * step still narrows).  Measured by `c2m_bench ... 2 1 near 1 1`
  * (docs/benchmarks.md, "The tree's build"). */
 #define BAND_MIN 1024
+#define BAND_SAMPLE 0.5
+#define BAND_WIDTH 1.25
 /* Ranges of at most SORT_MAX + 1 keys are sorted by insertion (fewer
  * instructions than a partition of so few; `c2m_bench ... 2 1 near 1 1`). */
 #define SORT_MAX 5
-#define BAND_SAMPLE 0.5
-#define BAND_WIDTH 1.25
 
 /* Partial sort of x[left .. right]: x[k] becomes the key of its rank on
  * axis a, with no larger one before it and no smaller one after.  A large
@@ -192,12 +192,12 @@ static void select_mid(bkey_t *k, size_t n, size_t mid, int a) { select_rank(k, 
 
 /* The axis along which the n keys' centroids spread most, over every
  * step-th key: at least AXIS_SAMPLE keys of a node, AXIS_SAMPLE_LARGE of
- * one of AXIS_LARGE keys or more (a small sample suffices for the
- * small nodes, which are most of the tree and where reading every key
- * cost the build a tenth of its work; the large nodes' axes decide the
- * most).  The sample's choice can differ from the whole node's where two
- * axes' extents are close or a few outlying centroids decide an extent;
- * any axis gives a valid tree, and the key order within a node's range
+ * one of AXIS_LARGE keys or more (the small nodes are most of the tree,
+ * and a small sample leaves their searches as fast: docs/benchmarks.md,
+ * "The tree's build"; the large nodes' axes cost little to sample).  The
+ * sample's choice can differ from the whole node's where two axes'
+ * extents are close or a few outlying centroids decide an extent; any
+ * axis gives a valid tree, and the key order within a node's range
  * depends on the range alone, so the choice is the same at any thread
  * count. */
 #define AXIS_SAMPLE 8
