@@ -89,13 +89,13 @@ HD__INLINE void swap_keys(bkey_t *x, long i, long j) {
 
 /* Ranges of more than BAND_MIN keys narrow by a band (narrow): a sample
  * of BAND_SAMPLE n^(2/3) keys, the band BAND_WIDTH sqrt(sample) sample
- * ranks either side of the rank (about 2.5 standard deviations of the
+ * ranks either side of the rank (about 2 standard deviations of the
  * rank's place in the sample: the band misses it rarely, and then the
- * step still narrows).  Measured by `c2m_bench ... 2 1 near 1 1`
+ * step still narrows; wider bands cost more than the misses they save).  Measured by `c2m_bench ... 2 1 near 1 1`
  * (docs/benchmarks.md, "The tree's build"). */
 #define BAND_MIN 1024
 #define BAND_SAMPLE 0.5
-#define BAND_WIDTH 1.25
+#define BAND_WIDTH 1.0
 /* Ranges of at most SORT_MAX + 1 keys are sorted by insertion (fewer
  * instructions than a partition of so few; `c2m_bench ... 2 1 near 1 1`). */
 #define SORT_MAX 5
