@@ -91,8 +91,9 @@ HD__INLINE void swap_keys(bkey_t *x, long i, long j) {
  * of BAND_SAMPLE n^(2/3) keys, the band BAND_WIDTH sqrt(sample) sample
  * ranks either side of the rank (about 2 standard deviations of the
  * rank's place in the sample: the band misses it rarely, and then the
- * step still narrows; wider bands cost more than the misses they save).  Measured by `c2m_bench ... 2 1 near 1 1`
- * (docs/benchmarks.md, "The tree's build"). */
+ * step still narrows; wider bands cost more than the misses they save).
+ * Measured by `c2m_bench ... 2 1 near 1 1` (docs/benchmarks.md, "The
+ * tree's build"). */
 #define BAND_MIN 1024
 #define BAND_SAMPLE 0.5
 #define BAND_WIDTH 1.0
@@ -105,9 +106,10 @@ HD__INLINE void swap_keys(bkey_t *x, long i, long j) {
  * range first narrows to a band of values about the rank (narrow: two
  * partitions by values from a strided sample, the second over the keys
  * above the first's value only); then Hoare's selection, the pivot the
- * median of the ends and x[k], down to a few keys, sorted.  The sample and the band only steer the
- * work: any values give the same postcondition.  Keys equal to the pivot
- * stop both scans and are swapped, so ties split evenly. */
+ * median of the ends and x[k], down to a few keys, sorted.  The sample
+ * and the band only steer the work: any values give the same
+ * postcondition.  Keys equal to the pivot stop both scans and are
+ * swapped, so ties split evenly. */
 static void select_rank(bkey_t *x, long left, long right, long k, int a);
 
 /* The keys of x[lo .. hi] whose c[a] is below t (strict) or at most t
