@@ -110,28 +110,72 @@ static void check_directed(const hd_result_t *r, const brute_t *want) {
     CHECK_EQ(r->algorithm, HD_ALG_AUTO);
 }
 
-/* H(A,B) and h(A,B) with the engine against the brute force. */
-static void check_case(const double *a, size_t na, const double *b, size_t nb, int threads) {
-    brute_t ab = brute_directed(a, na, b, nb), ba = brute_directed(b, nb, a, na);
-    hd_points_t A = hd_points_f64(a, na), B = hd_points_f64(b, nb);
+/* H(A,B) of the views A and B through the public call, at `threads`
+ * threads: both directions are the brute force's ab and ba, witnesses
+ * included, and the distance is the larger. */
+static void check_hausdorff(const hd_points_t *A, const hd_points_t *B, const brute_t *ab, const brute_t *ba,
+                            int threads) {
     hd_options_t o;
     hd_options_init(&o);
     o.threads = threads;
     hd_symmetric_t s;
-    CHECK_RC(hd_hausdorff(&A, &B, &o, &s, NULL), HD_OK);
-    check_directed(&s.ab, &ab);
-    check_directed(&s.ba, &ba);
-    CHECK_BITS(s.distance, sqrt(ab.d2 >= ba.d2 ? ab.d2 : ba.d2));
+    CHECK_RC(hd_hausdorff(A, B, &o, &s, NULL), HD_OK);
+    check_directed(&s.ab, ab);
+    check_directed(&s.ba, ba);
+    CHECK_BITS(s.distance, sqrt(ab->d2 >= ba->d2 ? ab->d2 : ba->d2));
+}
+
+/* H(A,B) and h(A,B) with the engine against the brute force. */
+static void check_case(double *a, size_t na, double *b, size_t nb, int threads) {
+    brute_t ab = brute_directed(a, na, b, nb), ba = brute_directed(b, nb, a, na);
+    hd_points_t A = hd_points_f64(a, na), B = hd_points_f64(b, nb);
+    check_hausdorff(&A, &B, &ab, &ba, threads);
+    hd_options_t o;
+    hd_options_init(&o);
+    o.threads = threads;
     hd_result_t r;
     CHECK_RC(hd_directed(&A, &B, &o, &r, NULL), HD_OK);
     check_directed(&r, &ab);
     /* Whatever the engine's choice, both of its paths are exact. */
     static const hd__engine_force_t paths[] = {HD__ENGINE_FORCE_GRID, HD__ENGINE_FORCE_TREES};
     for (int k = 0; k < 2; k++) {
+        hd_symmetric_t s;
         CHECK_RC(hd__engine_forced(&A, &B, &o, paths[k], &s, NULL), HD_OK);
         check_directed(&s.ab, &ab);
         check_directed(&s.ba, &ba);
     }
+}
+
+/* A and B rounded to float, given to the engine as float32 views, against
+ * the brute force on the rounded values (a and b are overwritten with them). */
+static void check_float32(double *a, size_t na, double *b, size_t nb, int threads) {
+    float *fa = malloc(12 * na), *fb = malloc(12 * nb);
+    for (size_t k = 0; k < 3 * na; k++) a[k] = (double)(fa[k] = (float)a[k]);
+    for (size_t k = 0; k < 3 * nb; k++) b[k] = (double)(fb[k] = (float)b[k]);
+    brute_t ab = brute_directed(a, na, b, nb), ba = brute_directed(b, nb, a, na);
+    hd_points_t A = hd_points_f32(fa, na), B = hd_points_f32(fb, nb);
+    check_hausdorff(&A, &B, &ab, &ba, threads);
+    free(fa);
+    free(fb);
+}
+
+/* A check of one pair at a thread count (check_case, check_float32). */
+typedef void (*check_fn)(double *a, size_t na, double *b, size_t nb, int threads);
+
+/* One seeded case: the pair of `kind`, na and nb points, drawn from g
+ * (seeded with `seed`, the sizes already drawn from it), checked at
+ * `threads` threads, or at one and at three when `threads` is 0; a failure
+ * prints the seed, the kind, the sizes and the thread count. */
+static void check_seeded_pair(gen_rng_t *g, uint64_t seed, int kind, size_t na, size_t nb, int threads,
+                              check_fn check) {
+    double *a = malloc(24 * na), *b = malloc(24 * nb);
+    make_pair(g, kind, a, na, b, nb);
+    for (int t = threads ? threads : 1; t <= (threads ? threads : 3); t += 2) {
+        CONTEXT("seed=%llu kind=%s na=%zu nb=%zu threads=%d", (unsigned long long)seed, kind_name[kind], na, nb, t);
+        check(a, na, b, nb, t);
+    }
+    free(a);
+    free(b);
 }
 
 TEST(engine_matches_brute_force_on_thousands_of_seeded_cases) {
@@ -142,14 +186,7 @@ TEST(engine_matches_brute_force_on_thousands_of_seeded_cases) {
         /* Mostly small sets (one to a few buckets), some up to ~40 buckets. */
         size_t cap = seed % 10 == 0 ? 1300 : 160;
         size_t na = 1 + gen_u64(&g) % cap, nb = 1 + gen_u64(&g) % cap;
-        int threads = seed % 2 ? 1 : 3;
-        CONTEXT("seed=%llu kind=%s na=%zu nb=%zu threads=%d", (unsigned long long)seed,
-                kind_name[kind], na, nb, threads);
-        double *a = malloc(24 * na), *b = malloc(24 * nb);
-        make_pair(&g, kind, a, na, b, nb);
-        check_case(a, na, b, nb, threads);
-        free(a);
-        free(b);
+        check_seeded_pair(&g, seed, kind, na, nb, seed % 2 ? 1 : 3, check_case);
     }
 }
 
@@ -295,14 +332,7 @@ TEST(engine_matches_brute_force_on_large_sets) {
         uint64_t seed = 5000 + (uint64_t)kind;
         gen_seed(&g, seed);
         size_t na = 4000 + gen_u64(&g) % 2000, nb = 4000 + gen_u64(&g) % 2000;
-        CONTEXT("seed=%llu kind=%s na=%zu nb=%zu", (unsigned long long)seed, kind_name[kind], na,
-                nb);
-        double *a = malloc(24 * na), *b = malloc(24 * nb);
-        make_pair(&g, kind, a, na, b, nb);
-        check_case(a, na, b, nb, 1);
-        check_case(a, na, b, nb, 3);
-        free(a);
-        free(b);
+        check_seeded_pair(&g, seed, kind, na, nb, 0, check_case);
     }
 }
 
@@ -311,14 +341,8 @@ TEST(sizes_one_to_a_thousand) {
     for (int kind = 0; kind < K_COUNT; kind++) {
         uint64_t seed = 6000 + (uint64_t)kind;
         gen_seed(&g, seed);
-        size_t small = 3 + gen_u64(&g) % 5, large = 1000 * small;
-        CONTEXT("seed=%llu kind=%s small=%zu large=%zu", (unsigned long long)seed,
-                kind_name[kind], small, large);
-        double *a = malloc(24 * small), *b = malloc(24 * large);
-        make_pair(&g, kind, a, small, b, large);
-        check_case(a, small, b, large, kind % 2 ? 1 : 3);
-        free(a);
-        free(b);
+        size_t small = 3 + gen_u64(&g) % 5;
+        check_seeded_pair(&g, seed, kind, small, 1000 * small, kind % 2 ? 1 : 3, check_case);
     }
 }
 
@@ -381,38 +405,13 @@ TEST(same_answer_at_every_thread_count) {
     free(b);
 }
 
-/* A and B rounded to float, given to the engine as float32 views, against
- * the brute force on the rounded values (a and b are overwritten with them). */
-static void check_float32(double *a, size_t na, double *b, size_t nb, int threads) {
-    float *fa = malloc(12 * na), *fb = malloc(12 * nb);
-    for (size_t k = 0; k < 3 * na; k++) a[k] = (double)(fa[k] = (float)a[k]);
-    for (size_t k = 0; k < 3 * nb; k++) b[k] = (double)(fb[k] = (float)b[k]);
-    brute_t ab = brute_directed(a, na, b, nb), ba = brute_directed(b, nb, a, na);
-    hd_points_t A = hd_points_f32(fa, na), B = hd_points_f32(fb, nb);
-    hd_options_t o;
-    hd_options_init(&o);
-    o.threads = threads;
-    hd_symmetric_t s;
-    CHECK_RC(hd_hausdorff(&A, &B, &o, &s, NULL), HD_OK);
-    check_directed(&s.ab, &ab);
-    check_directed(&s.ba, &ba);
-    free(fa);
-    free(fb);
-}
-
 TEST(float32_views_are_exact_for_the_float_values) {
     gen_rng_t g;
     for (uint64_t seed = 8000; seed < 8060; seed++) {
         gen_seed(&g, seed);
         int kind = (int)(seed % K_COUNT);
         size_t na = 1 + gen_u64(&g) % 900, nb = 1 + gen_u64(&g) % 900;
-        CONTEXT("seed=%llu kind=%s na=%zu nb=%zu", (unsigned long long)seed, kind_name[kind], na,
-                nb);
-        double *a = malloc(24 * na), *b = malloc(24 * nb);
-        make_pair(&g, kind, a, na, b, nb);
-        check_float32(a, na, b, nb, seed % 2 ? 1 : 3);
-        free(a);
-        free(b);
+        check_seeded_pair(&g, seed, kind, na, nb, seed % 2 ? 1 : 3, check_float32);
     }
 }
 
