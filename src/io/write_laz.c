@@ -154,6 +154,14 @@ static int encode_table(const hd__laz_chunks_t *c, const uint64_t *bytes, hd__en
     return rc;
 }
 
+/* One chunk's outcome of encode_chunk: its new layers, or its failure. */
+typedef struct {
+    unsigned char *layers; /* the new layers, back to back */
+    size_t layers_size;
+    int rc;                /* HD_OK or the failure ... */
+    hd_error_t err;        /* ... and its message */
+} chunk_out_t;
+
 typedef struct {
     hd__writer_t *w;
     hd__las_plan_t pl;
@@ -162,13 +170,10 @@ typedef struct {
     hd__read_t r;
     hd__sink_t sink;
     size_t nl;              /* the new layers: 8 a field */
-    unsigned char **layers; /* per chunk: its new layers, back to back */
-    size_t *layers_size;
+    chunk_out_t *out;       /* per chunk */
     uint32_t *sizes;        /* nl per chunk */
     unsigned char *scratch; /* 4 * nl bytes, for write_chunk */
     uint64_t *bytes;        /* each chunk's new byte size */
-    int *rc;                /* per chunk: HD_OK or the failure ... */
-    hd_error_t *err;        /* ... and its message */
     int v4;                 /* the BYTE14 item's version is 4 (else 3) */
 } lazw_t;
 
@@ -178,7 +183,8 @@ static void encode_chunk(void *ctx, size_t k, int worker) {
     (void)worker;
     lazw_t *z = ctx;
     size_t n = (size_t)(z->c.first[k + 1] - z->c.first[k]);
-    hd_error_t *err = &z->err[k];
+    chunk_out_t *out = &z->out[k];
+    hd_error_t *err = &out->err;
     hd__read_t r = z->r;
     r.err = err;
     size_t nl = z->nl;
@@ -200,18 +206,18 @@ static void encode_chunk(void *ctx, size_t k, int worker) {
     z->bytes[k] = z->c.start[k + 1] - z->c.start[k] + nl + 4 * nl + add;
     if (rc == HD_OK && z->bytes[k] > 0xFFFFFFFFu)
         rc = hd__err(err, HD_EUNSUPPORTED, "%s: chunk %zu would exceed 4 GiB", z->w->in->name, k + 1);
-    if (rc == HD_OK && add && !(z->layers[k] = malloc((size_t)add))) rc = hd__err(err, HD_ENOMEM, "out of memory");
+    if (rc == HD_OK && add && !(out->layers = malloc((size_t)add))) rc = hd__err(err, HD_ENOMEM, "out of memory");
     for (size_t b = 0, at = 0; b < nl && rc == HD_OK; b++) {
-        if (z->sizes[nl * k + b]) memcpy(z->layers[k] + at, enc[b].buf, z->sizes[nl * k + b]);
+        if (z->sizes[nl * k + b]) memcpy(out->layers + at, enc[b].buf, z->sizes[nl * k + b]);
         at += z->sizes[nl * k + b];
     }
-    z->layers_size[k] = (size_t)add;
+    out->layers_size = (size_t)add;
     for (size_t b = 0; enc && b < nl; b++) hd__enc_free(&enc[b]);
     free(enc);
     free(changed);
     free(item);
     free(chan);
-    z->rc[k] = rc;
+    out->rc = rc;
 }
 
 /* Encode every chunk's new layers, in parallel (first pass: the sizes are
@@ -219,20 +225,17 @@ static void encode_chunk(void *ctx, size_t k, int worker) {
  * chunk in file order is the error, kept whole (its offset too). */
 static int encode_chunks(lazw_t *z) {
     size_t nc = z->c.n_chunks;
-    z->layers = hd__calloc_array(nc + 1, sizeof *z->layers);
-    z->layers_size = hd__calloc_array(nc + 1, sizeof *z->layers_size);
+    z->out = hd__calloc_array(nc + 1, sizeof *z->out);
     z->sizes = hd__calloc_array(nc + 1, z->nl * sizeof *z->sizes);
     z->bytes = hd__calloc_array(nc + 1, sizeof *z->bytes);
-    z->rc = hd__calloc_array(nc + 1, sizeof *z->rc);
     z->scratch = malloc(4 * z->nl);
-    z->err = hd__calloc_array(nc + 1, sizeof *z->err);
-    if (!z->layers || !z->layers_size || !z->sizes || !z->bytes || !z->rc || !z->err || !z->scratch)
+    if (!z->out || !z->sizes || !z->bytes || !z->scratch)
         return hd__err(z->w->err, HD_ENOMEM, "out of memory");
     hd__parallel_for(hd__thread_count(z->w->ropt->threads, nc), nc, encode_chunk, z);
     for (size_t k = 0; k < nc; k++)
-        if (z->rc[k]) {
-            if (z->w->err) *z->w->err = z->err[k];
-            return z->rc[k];
+        if (z->out[k].rc) {
+            if (z->w->err) *z->w->err = z->out[k].err;
+            return z->out[k].rc;
         }
     return HD_OK;
 }
@@ -253,7 +256,7 @@ static void write_chunk(lazw_t *z, size_t k) {
         for (int q = 0; q < 4; q++) s[4 * i + (size_t)q] = (unsigned char)(z->sizes[nl * k + i] >> (8 * q));
     hd__w_put(w, s, 4 * nl);
     hd__w_put(w, b + head, nb - head);
-    hd__w_put(w, z->layers[k], z->layers_size[k]);
+    hd__w_put(w, z->out[k].layers, z->out[k].layers_size);
 }
 
 static int write_layered(lazw_t *z) {
@@ -304,6 +307,17 @@ static int write_layered(lazw_t *z) {
     return rc;
 }
 
+/* Everything z owns (what it does not hold yet is NULL). */
+static void lazw_free(lazw_t *z) {
+    for (size_t k = 0; z->out && k < z->c.n_chunks; k++) free(z->out[k].layers);
+    hd__laz_chunks_free(&z->c);
+    free(z->out);
+    free(z->sizes);
+    free(z->bytes);
+    free(z->scratch);
+    hd__sink_free(&z->sink);
+}
+
 int hd__write_laz(hd__writer_t *w) {
     lazw_t z;
     memset(&z, 0, sizeof z);
@@ -325,8 +339,7 @@ int hd__write_laz(hd__writer_t *w) {
     if (rc == HD_OK && (!z.c.layered || w->keep != HD_KEEP_ALL)) { /* a layered subset: every point encoded again (laz14.c) */
         if (!z.c.layered) hd__copc_drop(&z.pl); /* COPC is layered: plain LAZ (write_copc.c) */
         rc = hd__write_laz_pointwise(w, &z.pl, &z.h, &z.c, &z.r);
-        hd__laz_chunks_free(&z.c);
-        hd__sink_free(&z.sink);
+        lazw_free(&z);
         return rc;
     }
     if (rc == HD_OK) /* the BYTE14 item's version: the existing one's, or POINT14's for a new one */
@@ -337,15 +350,6 @@ int hd__write_laz(hd__writer_t *w) {
     if (rc == HD_OK && z.pl.count != w->n)
         rc = hd__err(w->err, HD_EINVAL, "%s: %zu values for %llu points", w->in->name, w->n, (unsigned long long)z.pl.count);
     if (rc == HD_OK) rc = write_layered(&z);
-    hd__laz_chunks_free(&z.c);
-    for (size_t k = 0; z.layers && k < z.c.n_chunks; k++) free(z.layers[k]);
-    free(z.layers);
-    free(z.layers_size);
-    free(z.sizes);
-    free(z.bytes);
-    free(z.rc);
-    free(z.err);
-    free(z.scratch);
-    hd__sink_free(&z.sink);
+    lazw_free(&z);
     return rc;
 }

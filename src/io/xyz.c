@@ -176,6 +176,15 @@ static const char *digit_comma_among_blanks(const dialect_t *d, const char *p, c
     return blank ? comma : NULL;
 }
 
+/* Records that field `col` (1-based), [t, e), is refused: the message
+ * quotes its first 40 characters, says `what` it is and `why` it is
+ * refused; returns 0. */
+static int refuse_field(hd__chunk_t *c, long long line, int col, const char *t, const char *e, const char *what,
+                        const char *why) {
+    hd__chunk_fail(c, HD_EFORMAT, line, "'%.*s' %s (column %d)%s", (int)(e - t > 40 ? 40 : e - t), t, what, col, why);
+    return 0;
+}
+
 /* Field `col` (1-based) at *q that the fast path could not read whole: its
  * value in *v and *q past it (1), or 0 with the problem recorded. */
 static int slow_field(hd__chunk_t *c, const dialect_t *d, long long line, int col, const char **q, const char *eol,
@@ -183,27 +192,19 @@ static int slow_field(hd__chunk_t *c, const dialect_t *d, long long line, int co
     const char *t = *q, *e = t;
     while (e < eol && !is_field_sep(d, (unsigned char)*e)) e++;
     *q = e;
-    if (!hd__parse_double(t, e, v) && !(d->semicolon && parse_decimal_comma(t, e, v))) {
-        hd__chunk_fail(c, HD_EFORMAT, line, "'%.*s' is not a number (column %d)%s", (int)(e - t > 40 ? 40 : e - t), t,
-                       col, *t == '"' ? ": quoted numbers are not read (write the file without quotes around numbers)" : "");
-        return 0;
-    }
-    if (d->decimal_comma && memchr(t, '.', (size_t)(e - t))) {
-        hd__chunk_fail(c, HD_EFORMAT, line,
-                       "'%.*s' has a point (column %d) where the decimal_comma read option makes commas the "
-                       "decimal points: a thousands separator (1.234 is 1234 where 1,5 is 1.5)? write the "
-                       "numbers without one",
-                       (int)(e - t > 40 ? 40 : e - t), t, col);
-        return 0;
-    }
-    if (d->semicolon && !d->decimal_comma && memchr(t, ',', (size_t)(e - t))) {
-        hd__chunk_fail(c, HD_EFORMAT, line,
-                       "'%.*s' has a decimal comma (column %d): 1,500 is 1.5 in one locale and 1500 in "
-                       "another; to read commas as decimal points, give the decimal_comma read option "
-                       "(--decimal-comma in the tool, decimal_comma=True in Python)",
-                       (int)(e - t > 40 ? 40 : e - t), t, col);
-        return 0;
-    }
+    if (!hd__parse_double(t, e, v) && !(d->semicolon && parse_decimal_comma(t, e, v)))
+        return refuse_field(c, line, col, t, e, "is not a number",
+                            *t == '"' ? ": quoted numbers are not read (write the file without quotes around numbers)"
+                                      : "");
+    if (d->decimal_comma && memchr(t, '.', (size_t)(e - t)))
+        return refuse_field(c, line, col, t, e, "has a point",
+                            " where the decimal_comma read option makes commas the decimal points: a thousands "
+                            "separator (1.234 is 1234 where 1,5 is 1.5)? write the numbers without one");
+    if (d->semicolon && !d->decimal_comma && memchr(t, ',', (size_t)(e - t)))
+        return refuse_field(c, line, col, t, e, "has a decimal comma",
+                            ": 1,500 is 1.5 in one locale and 1500 in another; to read commas as decimal points, "
+                            "give the decimal_comma read option (--decimal-comma in the tool, decimal_comma=True "
+                            "in Python)");
     return 1;
 }
 

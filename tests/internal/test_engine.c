@@ -110,28 +110,82 @@ static void check_directed(const hd_result_t *r, const brute_t *want) {
     CHECK_EQ(r->algorithm, HD_ALG_AUTO);
 }
 
-/* H(A,B) and h(A,B) with the engine against the brute force. */
-static void check_case(const double *a, size_t na, const double *b, size_t nb, int threads) {
-    brute_t ab = brute_directed(a, na, b, nb), ba = brute_directed(b, nb, a, na);
-    hd_points_t A = hd_points_f64(a, na), B = hd_points_f64(b, nb);
+/* H(A,B) of the views A and B through the public call, at `threads`
+ * threads: both directions are the brute force's ab and ba, witnesses
+ * included, and the distance is the larger. */
+static void check_hausdorff(const hd_points_t *A, const hd_points_t *B, const brute_t *ab, const brute_t *ba,
+                            int threads) {
     hd_options_t o;
     hd_options_init(&o);
     o.threads = threads;
     hd_symmetric_t s;
-    CHECK_RC(hd_hausdorff(&A, &B, &o, &s, NULL), HD_OK);
-    check_directed(&s.ab, &ab);
-    check_directed(&s.ba, &ba);
-    CHECK_BITS(s.distance, sqrt(ab.d2 >= ba.d2 ? ab.d2 : ba.d2));
+    CHECK_RC(hd_hausdorff(A, B, &o, &s, NULL), HD_OK);
+    check_directed(&s.ab, ab);
+    check_directed(&s.ba, ba);
+    CHECK_BITS(s.distance, sqrt(ab->d2 >= ba->d2 ? ab->d2 : ba->d2));
+}
+
+/* H(A,B) and h(A,B) with the engine against the brute force. */
+static void check_case(double *a, size_t na, double *b, size_t nb, int threads) {
+    brute_t ab = brute_directed(a, na, b, nb), ba = brute_directed(b, nb, a, na);
+    hd_points_t A = hd_points_f64(a, na), B = hd_points_f64(b, nb);
+    check_hausdorff(&A, &B, &ab, &ba, threads);
+    hd_options_t o;
+    hd_options_init(&o);
+    o.threads = threads;
     hd_result_t r;
     CHECK_RC(hd_directed(&A, &B, &o, &r, NULL), HD_OK);
     check_directed(&r, &ab);
     /* Whatever the engine's choice, both of its paths are exact. */
     static const hd__engine_force_t paths[] = {HD__ENGINE_FORCE_GRID, HD__ENGINE_FORCE_TREES};
     for (int k = 0; k < 2; k++) {
+        hd_symmetric_t s;
         CHECK_RC(hd__engine_forced(&A, &B, &o, paths[k], &s, NULL), HD_OK);
         check_directed(&s.ab, &ab);
         check_directed(&s.ba, &ba);
     }
+}
+
+/* A and B rounded to float, given to the engine as float32 views, against
+ * the brute force on the rounded values (a and b are overwritten with them). */
+static void check_float32(double *a, size_t na, double *b, size_t nb, int threads) {
+    float *fa = malloc(12 * na), *fb = malloc(12 * nb);
+    for (size_t k = 0; k < 3 * na; k++) a[k] = (double)(fa[k] = (float)a[k]);
+    for (size_t k = 0; k < 3 * nb; k++) b[k] = (double)(fb[k] = (float)b[k]);
+    brute_t ab = brute_directed(a, na, b, nb), ba = brute_directed(b, nb, a, na);
+    hd_points_t A = hd_points_f32(fa, na), B = hd_points_f32(fb, nb);
+    check_hausdorff(&A, &B, &ab, &ba, threads);
+    free(fa);
+    free(fb);
+}
+
+/* Seeds g with `seed`, named with the sizes in failure messages from here
+ * on, and returns an array for na points (to fill from g) with one for nb
+ * in *b; the caller frees both. */
+static double *seeded_arrays(gen_rng_t *g, uint64_t seed, size_t na, size_t nb, double **b) {
+    gen_seed(g, seed);
+    CONTEXT("seed=%llu na=%zu nb=%zu", (unsigned long long)seed, na, nb);
+    *b = malloc(24 * nb);
+    return malloc(24 * na);
+}
+
+/* A check of one pair at a thread count (check_case, check_float32). */
+typedef void (*check_fn)(double *a, size_t na, double *b, size_t nb, int threads);
+
+/* One seeded case: the pair of `kind`, na and nb points, drawn from g
+ * (seeded with `seed`, the sizes already drawn from it), checked at
+ * `threads` threads, or at one and at three when `threads` is 0; a failure
+ * prints the seed, the kind, the sizes and the thread count. */
+static void check_seeded_pair(gen_rng_t *g, uint64_t seed, int kind, size_t na, size_t nb, int threads,
+                              check_fn check) {
+    double *a = malloc(24 * na), *b = malloc(24 * nb);
+    make_pair(g, kind, a, na, b, nb);
+    for (int t = threads ? threads : 1; t <= (threads ? threads : 3); t += 2) {
+        CONTEXT("seed=%llu kind=%s na=%zu nb=%zu threads=%d", (unsigned long long)seed, kind_name[kind], na, nb, t);
+        check(a, na, b, nb, t);
+    }
+    free(a);
+    free(b);
 }
 
 TEST(engine_matches_brute_force_on_thousands_of_seeded_cases) {
@@ -142,14 +196,7 @@ TEST(engine_matches_brute_force_on_thousands_of_seeded_cases) {
         /* Mostly small sets (one to a few buckets), some up to ~40 buckets. */
         size_t cap = seed % 10 == 0 ? 1300 : 160;
         size_t na = 1 + gen_u64(&g) % cap, nb = 1 + gen_u64(&g) % cap;
-        int threads = seed % 2 ? 1 : 3;
-        CONTEXT("seed=%llu kind=%s na=%zu nb=%zu threads=%d", (unsigned long long)seed,
-                kind_name[kind], na, nb, threads);
-        double *a = malloc(24 * na), *b = malloc(24 * nb);
-        make_pair(&g, kind, a, na, b, nb);
-        check_case(a, na, b, nb, threads);
-        free(a);
-        free(b);
+        check_seeded_pair(&g, seed, kind, na, nb, seed % 2 ? 1 : 3, check_case);
     }
 }
 
@@ -295,14 +342,7 @@ TEST(engine_matches_brute_force_on_large_sets) {
         uint64_t seed = 5000 + (uint64_t)kind;
         gen_seed(&g, seed);
         size_t na = 4000 + gen_u64(&g) % 2000, nb = 4000 + gen_u64(&g) % 2000;
-        CONTEXT("seed=%llu kind=%s na=%zu nb=%zu", (unsigned long long)seed, kind_name[kind], na,
-                nb);
-        double *a = malloc(24 * na), *b = malloc(24 * nb);
-        make_pair(&g, kind, a, na, b, nb);
-        check_case(a, na, b, nb, 1);
-        check_case(a, na, b, nb, 3);
-        free(a);
-        free(b);
+        check_seeded_pair(&g, seed, kind, na, nb, 0, check_case);
     }
 }
 
@@ -311,46 +351,15 @@ TEST(sizes_one_to_a_thousand) {
     for (int kind = 0; kind < K_COUNT; kind++) {
         uint64_t seed = 6000 + (uint64_t)kind;
         gen_seed(&g, seed);
-        size_t small = 3 + gen_u64(&g) % 5, large = 1000 * small;
-        CONTEXT("seed=%llu kind=%s small=%zu large=%zu", (unsigned long long)seed,
-                kind_name[kind], small, large);
-        double *a = malloc(24 * small), *b = malloc(24 * large);
-        make_pair(&g, kind, a, small, b, large);
-        check_case(a, small, b, large, kind % 2 ? 1 : 3);
-        free(a);
-        free(b);
-    }
-}
-
-/* Copies listed in another order cannot use the correspondence path: the
- * trees must find every partner, and the partners across a jump of the
- * Morton curve are looked up by their cells' keys (engine.c, try_cells)
- * before any search.  Every kind of copy gen_copy makes (ties at the
- * maximum, duplicates, 1e9 offsets, 1e-150 scales), shuffled, through the
- * public call and both paths forced, at one thread and three. */
-TEST(shuffled_copies_are_exact_in_every_variation) {
-    gen_rng_t g;
-    for (int how = 0; how < GEN_COPY_KINDS && !hdt_failed(); how++) {
-        uint64_t seed = 7500 + (uint64_t)how;
-        gen_seed(&g, seed);
-        size_t n = 3000 + gen_u64(&g) % 3000;
-        CONTEXT("seed=%llu copy=%s n=%zu", (unsigned long long)seed, gen_copy_name[how], n);
-        double *a = malloc(24 * n), *b = malloc(24 * n);
-        gen_copy(&g, how, a, b, n);
-        for (size_t k = n; k > 1; k--) gen_swap(b, k - 1, gen_u64(&g) % k);
-        check_case(a, n, b, n, 1);
-        check_case(a, n, b, n, 3);
-        free(a);
-        free(b);
+        size_t small = 3 + gen_u64(&g) % 5;
+        check_seeded_pair(&g, seed, kind, small, 1000 * small, kind % 2 ? 1 : 3, check_case);
     }
 }
 
 TEST(same_answer_at_every_thread_count) {
     gen_rng_t g;
-    gen_seed(&g, 7000);
-    CONTEXT("seed=7000");
     size_t n = 20000;
-    double *a = malloc(24 * n), *b = malloc(24 * n);
+    double *b, *a = seeded_arrays(&g, 7000, n, n, &b);
     make_pair(&g, K_LATTICE, a, n, b, n);
     hd_points_t A = hd_points_f64(a, n), B = hd_points_f64(b, n);
     hd_options_t o;
@@ -381,47 +390,20 @@ TEST(same_answer_at_every_thread_count) {
     free(b);
 }
 
-/* A and B rounded to float, given to the engine as float32 views, against
- * the brute force on the rounded values (a and b are overwritten with them). */
-static void check_float32(double *a, size_t na, double *b, size_t nb, int threads) {
-    float *fa = malloc(12 * na), *fb = malloc(12 * nb);
-    for (size_t k = 0; k < 3 * na; k++) a[k] = (double)(fa[k] = (float)a[k]);
-    for (size_t k = 0; k < 3 * nb; k++) b[k] = (double)(fb[k] = (float)b[k]);
-    brute_t ab = brute_directed(a, na, b, nb), ba = brute_directed(b, nb, a, na);
-    hd_points_t A = hd_points_f32(fa, na), B = hd_points_f32(fb, nb);
-    hd_options_t o;
-    hd_options_init(&o);
-    o.threads = threads;
-    hd_symmetric_t s;
-    CHECK_RC(hd_hausdorff(&A, &B, &o, &s, NULL), HD_OK);
-    check_directed(&s.ab, &ab);
-    check_directed(&s.ba, &ba);
-    free(fa);
-    free(fb);
-}
-
 TEST(float32_views_are_exact_for_the_float_values) {
     gen_rng_t g;
     for (uint64_t seed = 8000; seed < 8060; seed++) {
         gen_seed(&g, seed);
         int kind = (int)(seed % K_COUNT);
         size_t na = 1 + gen_u64(&g) % 900, nb = 1 + gen_u64(&g) % 900;
-        CONTEXT("seed=%llu kind=%s na=%zu nb=%zu", (unsigned long long)seed, kind_name[kind], na,
-                nb);
-        double *a = malloc(24 * na), *b = malloc(24 * nb);
-        make_pair(&g, kind, a, na, b, nb);
-        check_float32(a, na, b, nb, seed % 2 ? 1 : 3);
-        free(a);
-        free(b);
+        check_seeded_pair(&g, seed, kind, na, nb, seed % 2 ? 1 : 3, check_float32);
     }
 }
 
 TEST(strided_and_reversed_views_are_read_correctly) {
     gen_rng_t g;
-    gen_seed(&g, 9000);
-    CONTEXT("seed=9000");
     size_t na = 2345, nb = 3456;
-    double *a = malloc(24 * na), *b = malloc(24 * nb);
+    double *b, *a = seeded_arrays(&g, 9000, na, nb, &b);
     make_pair(&g, K_PERTURBED, a, na, b, nb);
     /* A as a column-major (Fortran) array; B reversed, inside records of
      * four doubles, through a negative stride. */
@@ -474,10 +456,8 @@ TEST(identical_sets_are_at_distance_zero_with_witness_zero) {
 
 TEST(statistics_explain_the_work) {
     gen_rng_t g;
-    gen_seed(&g, 9200);
-    CONTEXT("seed=9200");
     size_t n = 30000;
-    double *a = malloc(24 * n), *b = malloc(24 * n);
+    double *b, *a = seeded_arrays(&g, 9200, n, n, &b);
     make_pair(&g, K_DISJOINT, a, n, b, n);
     hd_points_t A = hd_points_f64(a, n), B = hd_points_f64(b, n);
     hd_result_t r;
@@ -537,6 +517,43 @@ static int plan_is(plan_t p, int path, int listed, int r0, int r1) {
            (r0 < 0 || p.resolved[0] == r0) && (r1 < 0 || p.resolved[1] == r1);
 }
 
+/* One seeded copy: B a copy of A's n points made by gen_copy's `how`
+ * from g (seeded with `seed`, n already drawn from it), listed in a random
+ * order when `shuffled`, then checked at `threads` threads, or at one and
+ * at three when `threads` is 0; a failure prints the seed, the copy, the
+ * size and the thread count.  When `settled` is given, it counts the
+ * copies whose plan the correspondence path settles. */
+static void check_seeded_copy(gen_rng_t *g, uint64_t seed, int how, size_t n, int shuffled, int threads,
+                              check_fn check, int *settled) {
+    double *a = malloc(24 * n), *b = malloc(24 * n);
+    gen_copy(g, how, a, b, n);
+    if (shuffled)
+        for (size_t k = n; k > 1; k--) gen_swap(b, k - 1, gen_u64(g) % k);
+    for (int t = threads ? threads : 1; t <= (threads ? threads : 3); t += 2) {
+        CONTEXT("seed=%llu copy=%s n=%zu threads=%d", (unsigned long long)seed, gen_copy_name[how], n, t);
+        check(a, n, b, n, t);
+    }
+    if (settled) *settled += plan_is(plan_of(a, n, b, n), PLAN_PAIRS, 1, 1, 1);
+    free(a);
+    free(b);
+}
+
+/* Copies listed in another order cannot use the correspondence path: the
+ * trees must find every partner, and the partners across a jump of the
+ * Morton curve are looked up by their cells' keys (engine.c, try_cells)
+ * before any search.  Every kind of copy gen_copy makes (ties at the
+ * maximum, duplicates, 1e9 offsets, 1e-150 scales), shuffled, through the
+ * public call and both paths forced, at one thread and three. */
+TEST(shuffled_copies_are_exact_in_every_variation) {
+    gen_rng_t g;
+    for (int how = 0; how < GEN_COPY_KINDS && !hdt_failed(); how++) {
+        uint64_t seed = 7500 + (uint64_t)how;
+        gen_seed(&g, seed);
+        size_t n = 3000 + gen_u64(&g) % 3000;
+        check_seeded_copy(&g, seed, how, n, 1, 0, check_case, NULL);
+    }
+}
+
 TEST(same_order_copies_are_exact_in_every_variation) {
     gen_rng_t g;
     int settled = 0, cases = 0;
@@ -544,16 +561,8 @@ TEST(same_order_copies_are_exact_in_every_variation) {
         gen_seed(&g, seed);
         int how = (int)(seed % GEN_COPY_KINDS);
         size_t n = 1 + gen_u64(&g) % (seed % 8 == 0 ? 6000 : 700);
-        int threads = seed % 2 ? 1 : 3;
-        CONTEXT("seed=%llu copy=%s n=%zu threads=%d", (unsigned long long)seed, gen_copy_name[how], n,
-                threads);
-        double *a = malloc(24 * n), *b = malloc(24 * n);
-        gen_copy(&g, how, a, b, n);
-        check_case(a, n, b, n, threads);
-        settled += plan_is(plan_of(a, n, b, n), PLAN_PAIRS, 1, 1, 1);
+        check_seeded_copy(&g, seed, how, n, 0, seed % 2 ? 1 : 3, check_case, &settled);
         cases++;
-        free(a);
-        free(b);
     }
     /* The path itself was under test in most cases (not only the fallback). */
     CONTEXT("settled by the correspondence path: %d of %d", settled, cases);
@@ -567,21 +576,14 @@ TEST(same_order_copies_in_float32_are_exact_for_the_float_values) {
         int how = (int)(seed % GEN_COPY_KINDS);
         if (how == GEN_COPY_SUBNORMAL_SCALE) continue; /* not representable in float */
         size_t n = 1 + gen_u64(&g) % 3000;
-        CONTEXT("seed=%llu copy=%s n=%zu", (unsigned long long)seed, gen_copy_name[how], n);
-        double *a = malloc(24 * n), *b = malloc(24 * n);
-        gen_copy(&g, how, a, b, n);
-        check_float32(a, n, b, n, seed % 2 ? 1 : 3);
-        free(a);
-        free(b);
+        check_seeded_copy(&g, seed, how, n, 0, seed % 2 ? 1 : 3, check_float32, NULL);
     }
 }
 
 TEST(a_noisy_copy_is_settled_by_the_correspondence_path) {
     gen_rng_t g;
-    gen_seed(&g, 12000);
-    CONTEXT("seed=12000");
     size_t n = 50000;
-    double *a = malloc(24 * n), *b = malloc(24 * n);
+    double *b, *a = seeded_arrays(&g, 12000, n, n, &b);
     gen_copy(&g, GEN_COPY_NOISE, a, b, n);
     CHECK(plan_is(plan_of(a, n, b, n), PLAN_PAIRS, 1, 1, 1));
     check_case(a, n, b, n, 3);
@@ -591,10 +593,8 @@ TEST(a_noisy_copy_is_settled_by_the_correspondence_path) {
 
 TEST(independent_clouds_and_shuffled_copies_do_not_take_the_correspondence_path) {
     gen_rng_t g;
-    gen_seed(&g, 12100);
-    CONTEXT("seed=12100");
     size_t n = 20000;
-    double *a = malloc(24 * n), *b = malloc(24 * n);
+    double *b, *a = seeded_arrays(&g, 12100, n, n, &b);
     make_pair(&g, K_OVERLAP, a, n, b, n);
     CHECK(plan_is(plan_of(a, n, b, n), -1, 0, -1, -1));
     /* A noisy copy listed backwards: the partners are unrelated points. */
@@ -704,13 +704,11 @@ TEST(the_early_decision_keeps_filtered_maxima_exact) {
 
 TEST(a_copy_with_more_exchanged_partners_than_the_list_falls_back_exactly) {
     gen_rng_t g;
-    gen_seed(&g, 12200);
-    CONTEXT("seed=12200");
     /* 5% of 60000 partners exchanged: some 3000 pairs far larger than the
      * answer, more than the path lists, so it must hand over to the grid or
      * the trees with what it found. */
     size_t n = 60000;
-    double *a = malloc(24 * n), *b = malloc(24 * n);
+    double *b, *a = seeded_arrays(&g, 12200, n, n, &b);
     gen_copy(&g, GEN_COPY_NOISE, a, b, n);
     for (size_t r = 0; r < n / 40; r++) {
         size_t x = gen_u64(&g) % n;
@@ -931,10 +929,8 @@ TEST(ordered_subsets_in_float32_are_exact_for_the_float_values) {
 
 TEST(subsets_out_of_order_or_with_a_stranger_are_left_to_the_other_paths) {
     gen_rng_t g;
-    gen_seed(&g, 13600);
-    CONTEXT("seed=13600");
     size_t na = 40000;
-    double *a = malloc(24 * na), *b = malloc(24 * na), m0[3] = {0, 0, 0};
+    double *b, *a = seeded_arrays(&g, 13600, na, na, &b), m0[3] = {0, 0, 0};
     gen_gauss(&g, a, na, m0, 1.0);
     size_t nb = make_subset(&g, a, na, 10, b);
     CHECK(plan_is(plan_of(a, na, b, nb), -1, -1, 0, 1));

@@ -421,19 +421,18 @@ TEST(open_mesh_is_refused_naming_an_edge) {
     gen_soup_t s;
     unit_cube(&s);
     s.nt--; /* the last triangle (1, 7, 5) gone: edges 1-7, 7-5, 5-1 are boundaries */
-    double p[] = {0.5, 0.5, 0.5};
+    double p[] = {0.5, 0.5, 0.5}, d[1];
     int8_t sg[1] = {42};
-    double d[1];
-    hd_points_t P = hd_points_f64(p, 1);
-    hd_mesh_t M = gen_soup_view(&s);
     hd_error_t err;
-    CHECK_RC(hd_mesh_signed_distances(&P, &M, NULL, d, NULL, NULL, NULL, sg, NULL, &err), HD_EINVAL);
+    CHECK_RC(signs(&s, p, 1, sg, d, &err), HD_EINVAL);
     CHECK(strstr(err.message, "not closed") != NULL);
     CHECK(strstr(err.message, "edge between vertices 1 and 7 is used by triangle 10 alone") ||
           strstr(err.message, "edge between vertices 5 and 7 is used by triangle 2 alone") ||
           strstr(err.message, "edge between vertices 1 and 5 is used by triangle 4 alone"));
     CHECK_EQ(sg[0], 42);
     /* The distances alone still work on an open mesh. */
+    hd_points_t P = hd_points_f64(p, 1);
+    hd_mesh_t M = gen_soup_view(&s);
     CHECK_RC(hd_mesh_distances(&P, &M, NULL, d, NULL, NULL, NULL, NULL, &err), HD_OK);
     gen_soup_free(&s);
 }
@@ -443,12 +442,10 @@ TEST(flipped_face_is_refused) {
     unit_cube(&s);
     uint64_t x = s.t[3 * 4 + 1]; /* triangle 4 reversed */
     s.t[3 * 4 + 1] = s.t[3 * 4 + 2], s.t[3 * 4 + 2] = x;
-    double p[] = {0.5, 0.5, 0.5};
+    double p[] = {0.5, 0.5, 0.5}, d[1];
     int8_t sg[1];
-    hd_points_t P = hd_points_f64(p, 1);
-    hd_mesh_t M = gen_soup_view(&s);
     hd_error_t err;
-    CHECK_RC(hd_mesh_signed_distances(&P, &M, NULL, NULL, NULL, NULL, NULL, sg, NULL, &err), HD_EINVAL);
+    CHECK_RC(signs(&s, p, 1, sg, d, &err), HD_EINVAL);
     CHECK(strstr(err.message, "not consistently oriented") != NULL);
     CHECK(strstr(err.message, "triangles 4 and") || strstr(err.message, "and 4 both"));
     gen_soup_free(&s);
@@ -458,16 +455,15 @@ TEST(bad_meshes_get_the_distance_errors) {
     gen_soup_t s;
     unit_cube(&s);
     s.t[5] = 99;
-    double p[] = {0.5, 0.5, 0.5};
+    double p[] = {0.5, 0.5, 0.5}, d[1];
     int8_t sg[1];
-    hd_points_t P = hd_points_f64(p, 1);
-    hd_mesh_t M = gen_soup_view(&s);
     hd_error_t err;
-    CHECK_RC(hd_mesh_signed_distances(&P, &M, NULL, NULL, NULL, NULL, NULL, sg, NULL, &err), HD_EINVAL);
+    CHECK_RC(signs(&s, p, 1, sg, d, &err), HD_EINVAL);
     CHECK(strstr(err.message, "refers to vertex 99") != NULL);
     s.t[5] = 1;
     s.v[4] = NAN;
-    CHECK_RC(hd_mesh_signed_distances(&P, &M, NULL, NULL, NULL, NULL, NULL, sg, NULL, &err), HD_ENONFINITE);
+    CHECK_RC(signs(&s, p, 1, sg, d, &err), HD_ENONFINITE);
+    hd_mesh_t M = gen_soup_view(&s);
     CHECK_RC(hd_mesh_signed_distances(NULL, &M, NULL, NULL, NULL, NULL, NULL, sg, NULL, &err), HD_EINVAL);
     gen_soup_free(&s);
 }
@@ -557,12 +553,10 @@ TEST(bundled_open_models_are_refused) {
         gen_soup_t s;
         CONTEXT("%s", files[f]);
         if (read_model(files[f], &s)) continue;
-        double p[3] = {0, 0, 0};
+        double p[3] = {0, 0, 0}, d[1];
         int8_t sg[1];
-        hd_points_t P = hd_points_f64(p, 1);
-        hd_mesh_t M = gen_soup_view(&s);
         hd_error_t err;
-        CHECK_RC(hd_mesh_signed_distances(&P, &M, NULL, NULL, NULL, NULL, NULL, sg, NULL, &err), HD_EINVAL);
+        CHECK_RC(signs(&s, p, 1, sg, d, &err), HD_EINVAL);
         CHECK(strstr(err.message, "alone (a boundary)") != NULL);
         gen_soup_free(&s);
     }
