@@ -87,27 +87,90 @@ HD__INLINE void swap_keys(bkey_t *x, long i, long j) {
     x[i] = x[j], x[j] = s;
 }
 
+/* Ranges of more than BAND_MIN keys narrow by a band (narrow): a sample
+ * of BAND_SAMPLE n^(2/3) keys, the band BAND_WIDTH sqrt(sample) sample
+ * ranks either side of the rank (about 2 standard deviations of the
+ * rank's place in the sample: the band misses it rarely, and then the
+ * step still narrows; wider bands cost more than the misses they save).
+ * Measured by `c2m_bench ... 2 1 near 1 1` (docs/benchmarks.md, "The
+ * tree's build"). */
+#define BAND_MIN 1024
+#define BAND_SAMPLE 0.5
+#define BAND_WIDTH 1.0
+/* Ranges of at most SORT_MAX + 1 keys are sorted by insertion (fewer
+ * instructions than a partition of so few; `c2m_bench ... 2 1 near 1 1`). */
+#define SORT_MAX 5
+
 /* Partial sort of x[left .. right]: x[k] becomes the key of its rank on
- * axis a, with no larger one before it and no smaller one after (Floyd and
- * Rivest's selection: a pivot from a sample about the rank first, so the
- * partition that follows reads each key about once; the sample's bounds
- * only steer the work, any values give the same postcondition).  Keys
- * equal to the pivot stop both scans and are swapped, so ties split
- * evenly. */
+ * axis a, with no larger one before it and no smaller one after.  A large
+ * range first narrows to a band of values about the rank (narrow: two
+ * partitions by values from a strided sample, the second over the keys
+ * above the first's value only); then Hoare's selection, the pivot the
+ * median of the ends and x[k], down to a few keys, sorted.  The sample
+ * and the band only steer the work: any values give the same
+ * postcondition.  Keys equal to the pivot stop both scans and are
+ * swapped, so ties split evenly. */
+static void select_rank(bkey_t *x, long left, long right, long k, int a);
+
+/* The keys of x[lo .. hi] whose c[a] is below t (strict) or at most t
+ * (!strict) moved before the others; returns the position of the first
+ * other key.  Both kinds must be present: each scan then stops at a key
+ * of the other kind, the first time at one of those, later at the key the
+ * other scan left or swapped. */
+HD__INLINE long partition_value(bkey_t *x, long lo, long hi, int a, double t, int strict) {
+#define BEFORE(c) (strict ? (c) < t : (c) <= t)
+    long i = lo, j = hi;
+    for (;;) {
+        while (BEFORE(x[i].c[a])) i++;
+        while (!BEFORE(x[j].c[a])) j--;
+        if (i >= j) return i;
+        swap_keys(x, i, j);
+        i++, j--;
+    }
+#undef BEFORE
+}
+
+/* One step of the selection of rank k in a large x[*left .. *right]: two
+ * values u <= v about the rank from a strided sample, the keys below u moved
+ * first and those above v last (two partitions, the second over the keys
+ * from u up); the range narrows to the part holding rank k, the band
+ * [u, v] unless the sample misled.  0 when it cannot narrow (no sample key
+ * below u or above v: ties) or did not. */
+static int narrow(bkey_t *x, long *left, long *right, long k, int a) {
+    long l = *left, r = *right, n = r - l + 1;
+    double cn = cbrt((double)n);
+    long s = (long)(BAND_SAMPLE * cn * cn), d = (long)(BAND_WIDTH * sqrt((double)s)) + 1, step = n / s;
+    for (long q = 1; q < s; q++) swap_keys(x, l + q, l + q * step);
+    long ks = (long)((double)(k - l) * (double)s / (double)n);
+    long ku = ks - d > 1 ? ks - d : 1, kv = ks + d < s - 2 ? ks + d : s - 2;
+    select_rank(x, l, l + s - 1, l + ku, a);
+    double u = x[l + ku].c[a];
+    select_rank(x, l + ku, l + s - 1, l + kv, a);
+    double v = x[l + kv].c[a];
+    select_rank(x, l, l + ku - 1, l, a);          /* the sample's least at l */
+    select_rank(x, l + kv + 1, l + s - 1, l + s - 1, a); /* its largest at l + s - 1 */
+    if (!(x[l].c[a] < u) || !(x[l + s - 1].c[a] > v)) return 0;
+    swap_keys(x, l + s - 1, r);
+    long p = partition_value(x, l, r, a, u, 1);
+    if (k < p) {
+        *right = p - 1;
+        return 1;
+    }
+    /* the rest holds u's key (at most v) and x[r] (above v) */
+    long q = partition_value(x, p, r, a, v, 0);
+    if (k >= q) *left = q;
+    else *left = p, *right = q - 1;
+    return *right - *left + 1 < n;
+}
+
 static void select_rank(bkey_t *x, long left, long right, long k, int a) {
-    while (right > left) {
-        if (right - left > 600) {
-            double n = (double)(right - left + 1), i = (double)(k - left + 1), z = log(n);
-            double s = 0.5 * exp(2 * z / 3), sd = 0.5 * sqrt(z * s * (n - s) / n);
-            sd = i < n / 2 ? -sd : i > n / 2 ? sd : 0;
-            long lo = (long)((double)k - i * s / n + sd), hi = (long)((double)k + (n - i) * s / n + sd);
-            select_rank(x, lo > left ? lo : left, hi < right ? hi : right, k, a);
-        }
-        else if (right - left > 2) { /* the pivot: the median of the ends and x[k] */
-            if (x[k].c[a] < x[left].c[a]) swap_keys(x, k, left);
-            if (x[right].c[a] < x[k].c[a]) swap_keys(x, right, k);
-            if (x[k].c[a] < x[left].c[a]) swap_keys(x, k, left);
-        }
+    while (right - left > BAND_MIN && narrow(x, &left, &right, k, a)) {
+    }
+    while (right - left > SORT_MAX) {
+        /* the pivot: the median of the ends and x[k] */
+        if (x[k].c[a] < x[left].c[a]) swap_keys(x, k, left);
+        if (x[right].c[a] < x[k].c[a]) swap_keys(x, right, k);
+        if (x[k].c[a] < x[left].c[a]) swap_keys(x, k, left);
         double t = x[k].c[a];
         long i = left, j = right;
         swap_keys(x, left, k);
@@ -123,21 +186,28 @@ static void select_rank(bkey_t *x, long left, long right, long k, int a) {
         if (j <= k) left = j + 1;
         if (k <= j) right = j - 1;
     }
+    for (long i = left + 1; i <= right; i++) /* a few keys: sorted by insertion */
+        for (long j = i; j > left && x[j].c[a] < x[j - 1].c[a]; j--) swap_keys(x, j, j - 1);
 }
 
 static void select_mid(bkey_t *k, size_t n, size_t mid, int a) { select_rank(k, 0, (long)n - 1, (long)mid, a); }
 
-/* The axis along which the n keys' centroids spread most: over every
- * key of a small node, over every step-th key of a large one (at least
- * AXIS_SAMPLE keys).  The sample's choice can differ from the whole
- * node's where two axes' extents are close or a few outlying centroids
- * decide an extent; any axis gives a valid tree, and the key order within
- * a node's range depends on the range alone, so the choice is the same at
- * any thread count. */
-#define AXIS_SAMPLE 64
+/* The axis along which the n keys' centroids spread most, over every
+ * step-th key: at least AXIS_SAMPLE keys of a node, AXIS_SAMPLE_LARGE of
+ * one of AXIS_LARGE keys or more (the small nodes are most of the tree,
+ * and a small sample leaves their searches as fast: docs/benchmarks.md,
+ * "The tree's build"; the large nodes' axes cost little to sample).  The
+ * sample's choice can differ from the whole node's where two axes'
+ * extents are close or a few outlying centroids decide an extent; any
+ * axis gives a valid tree, and the key order within a node's range
+ * depends on the range alone, so the choice is the same at any thread
+ * count. */
+#define AXIS_SAMPLE 8
+#define AXIS_SAMPLE_LARGE 64
+#define AXIS_LARGE 1024
 static int longest_axis(const bkey_t *k, size_t n) {
     double lo[3], hi[3];
-    size_t step = n / AXIS_SAMPLE > 1 ? n / AXIS_SAMPLE : 1;
+    size_t want = n >= AXIS_LARGE ? AXIS_SAMPLE_LARGE : AXIS_SAMPLE, step = n / want > 1 ? n / want : 1;
     for (int a = 0; a < 3; a++) lo[a] = hi[a] = k[0].c[a];
     for (size_t i = step; i < n; i += step)
         for (int a = 0; a < 3; a++) {

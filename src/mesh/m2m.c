@@ -52,7 +52,10 @@
  *    And for any triangle t of Y, d(., t) is convex, so its maximum over T
  *    is at a corner: d(y, Y) <= min over t of max_v d(v, t) (Tang et al.),
  *    taken over the corners' nearest triangles with d(v, t) <= sqrt_up(hi2)
- *    from hd__tri_bounds (or hi for v's own triangle).  Two triangles t1,
+ *    from hd__tri_bounds (or hi for v's own triangle), and, for a child
+ *    those leave above the threshold, the triangle nearest (as the bounds
+ *    tell) to its corners' centroid computed in doubles (any triangle
+ *    gives a bound; where does not matter for rigor).  Two triangles t1,
  *    t2 at once (bent pairs, whose corners are nearest to different
  *    triangles): with a_k >= d(v_k, t1), b_k >= d(v_k, t2) and y =
  *    sum w_k v_k in T, convexity gives d(y, ti) <= sum w_k a_k (resp.
@@ -86,8 +89,8 @@
  * d(v, t) <= hi_a + |v - a| (hd__m2m_carried_bound, rounded up) is an
  * upper bound with the anchor's triangle, which is all phases 1 and 2 ask
  * of a corner's hi and pos (bench/m2m_run, `through`).  A midpoint's search stops
- * the same way at a bound that keeps its children's point bound within
- * the tolerance and below the bar of exact corners.  Phase 1 evaluates
+ * the same way at a bound within the tolerance of the threshold (less the
+ * slack) and below the bar of exact corners (split()).  Phase 1 evaluates
  * every face's corners (fixed chunks, any thread) and sets the lower
  * bound L to the best corner.  Phase 2 takes the faces by decreasing
  * upper bound in batches of fixed sizes; the faces of a batch are refined
@@ -668,11 +671,46 @@ double hd__m2m_carried_bound(double hi, const double a[3], const double p[3]) {
     return up(hi + sqrt_up(up(up(d2 * (1 + 0x1p-50)) + 0x1p-1070)));
 }
 
+/* Tang's bound with the triangle nearest (as the bounds tell) to the
+ * centroid of s's computed corners (before the slack e), from s's list
+ * or else the tree, when it is none of the corners' own: U if not
+ * smaller.  Any triangle of Y
+ * gives a bound (the top); where the corners lie at vertices of Y, each
+ * nearest to one of the triangles around it, the one under the whole
+ * sub-triangle need not be any corner's.  Tried from the tree at the
+ * levels without lists only: deeper, a sub-triangle whose list could not
+ * be collected has too many triangles near it for one to settle it
+ * (bench/m2m_run, `shared`: its maximum lies on Y's medial axis). */
+static double centre_bound(const hd__m2m_job_t *J, sub_t *s, double U, const uint32_t *arena, cache_t *C,
+                           uint64_t *kernel) {
+    const hd__bvh_t *T = J->to;
+    double g[3], lo2, hi2, best = INFINITY;
+    for (int d = 0; d < 3; d++) g[d] = (s->c[0].p[d] + s->c[1].p[d] + s->c[2].p[d]) / 3;
+    size_t pos = SIZE_MAX;
+    if (s->n != NO_LIST) {
+        for (size_t i = 0; i < s->n; i++) {
+            size_t k = arena[s->off + i];
+            if (beyond(&T->boxes[k], g, best)) continue;
+            bounds_at(T, k, g, C, &lo2, &hi2);
+            (*kernel)++;
+            if (pos == SIZE_MAX || hi2 < best) best = hi2, pos = k;
+        }
+    }
+    if (pos == SIZE_MAX) {
+        double lo, hi;
+        pos = interval(T, g, s->c[0].pos, C, -1, &lo, &hi, kernel);
+    }
+    if (pos == SIZE_MAX || pos == s->c[0].pos || pos == s->c[1].pos || pos == s->c[2].pos) return U;
+    double m = 0;
+    for (int k = 0; k < 3 && m < U; k++) m = dmax(m, corner_to(&s->c[k], pos, &T->tris[pos], C, kernel));
+    return dmin(U, m);
+}
+
 /* The sub-triangle's upper bound; once the point bound alone is at most
  * `enough` (the sub-triangle will be discarded whatever its bound) the
  * dearer bounds are skipped. */
-static double upper_of(const hd__m2m_job_t *J, sub_t *s, double e, double enough, cache_t *C,
-                       uint64_t *kernel) {
+static double upper_core(const hd__m2m_job_t *J, sub_t *s, double e, double enough, cache_t *C, uint64_t *kernel,
+                         int centre, const uint32_t *arena) {
     double rmax = 0;
     for (int i = 0; i < 3; i++) rmax = dmax(rmax, s->c[i].hi);
     double U = up(rmax + reach(s));
@@ -692,14 +730,23 @@ static double upper_of(const hd__m2m_job_t *J, sub_t *s, double e, double enough
         for (int k = 0; k < 3 && m < U; k++) m = dmax(m, cand_h(J, s, &K, i, k, C, kernel));
         U = dmin(U, m);
     }
-    if (K.n > 1) U = pair_bound(J, s, U, C, kernel);
     double E = s->level ? e : 0;
+    /* three triangles (corners at vertices of Y): the centroid's first */
+    if (centre && K.n == 3 && up(U + E) > enough) U = centre_bound(J, s, U, arena, C, kernel), centre = 0;
+    if (K.n > 1 && up(U + E) > enough) U = pair_bound(J, s, U, C, kernel);
     for (int i = 0; i < K.n && up(U + E) > enough; i++) /* bent pairs */
         for (int j = i + 1; j < K.n; j++) {
             for (int k = 0; k < 3; k++) cand_h(J, s, &K, i, k, C, kernel), cand_h(J, s, &K, j, k, C, kernel);
             U = hd__m2m_bent_bound(K.h[i], K.h[j], U);
         }
+    if (centre && up(U + E) > enough) U = centre_bound(J, s, U, arena, C, kernel);
     return s->level ? up(U + e) : U;
+}
+
+/* upper_core without the centroid's triangle (a face's first bound). */
+static double upper_of(const hd__m2m_job_t *J, sub_t *s, double e, double enough, cache_t *C,
+                       uint64_t *kernel) {
+    return upper_core(J, s, e, enough, C, kernel, 0, NULL);
 }
 
 /* The bound at or below which a (sub-)triangle's point bound makes the
@@ -1227,12 +1274,16 @@ static void split(const hd__m2m_job_t *J, const hd__tri_t *t, double e, double L
         c[i] = s->c[i];
         for (int j = 0; j < 3; j++) c[i].k[j] = 2 * s->c[i].k[j];
     }
-    /* A midpoint bounded by at most `target` needs no tighter bound: each
-     * child's point bound is then at most max(the threshold + tolerance,
-     * d) (a child's reach is at most its parent's, up to rounding), where
-     * a sub-triangle is never split, and the midpoint cannot raise a lower
-     * bound (target <= exact_bar). */
-    double target = dmin(dmax(threshold(J, L, F) + J->tol, J->done_below) - reach(s) - 2 * e, exact_bar(J, L, F));
+    /* A midpoint bounded by at most `target` needs no tighter bound: it
+     * cannot raise a lower bound (target <= exact_bar), and its own bound,
+     * plus e, is at most max(the threshold + tolerance, d), where a
+     * sub-triangle is never split, so it raises none of its children's
+     * Tang bounds above that (those with other triangles take its distance
+     * to each afresh, corner_to); the triangle it names may be a
+     * poorer candidate for their Tang bounds than its nearest, which
+     * centre_bound makes up for (bench/m2m_run, `nearzero`,
+     * `subdivided`). */
+    double target = dmin(dmax(threshold(J, L, F) + J->tol, J->done_below) - 2 * e, exact_bar(J, L, F));
     for (int i = 0; i < 3; i++) {
         const corner_t *p = &s->c[i], *q = &s->c[(i + 1) % 3];
         for (int j = 0; j < 3; j++) m[i].k[j] = p->k[j] + q->k[j];
@@ -1256,7 +1307,8 @@ static void split(const hd__m2m_job_t *J, const hd__tri_t *t, double e, double L
         for (int i = 0; i < 3; i++) kids[q].c[i] = *tri[q][i];
         kids[q].level = level;
         kids[q].off = s->off, kids[q].n = s->n;
-        kids[q].U = upper_of(J, &kids[q], e, enough, P->cache, &F->kernel);
+        int centre = kids[q].n != NO_LIST || level < LIST_LEVEL;
+        kids[q].U = upper_core(J, &kids[q], e, enough, P->cache, &F->kernel, centre, P->arena);
         for (int i = 0; i < 3; i++) *tri[q][i] = kids[q].c[i];
     }
     for (int q = 0; q < 3; q++)

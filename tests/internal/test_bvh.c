@@ -299,17 +299,19 @@ TEST(a_near_point_from_a_far_seed_opens_few_nodes) {
     free(orig);
 }
 
-/* A node of 128 triangles or more chooses its axis from every
- * (n / 64)-th centroid of its range (bvh_build.c): here every fourth
- * triangle of 2048 lies along y over [0, 1], the others along x over
- * [0, 4], so the sample's longest axis (every 32nd centroid) is y and the
- * whole set's x.  The root splits along y: its first child holds the 1024
- * lowest centroids in y, and both children span x. */
-TEST(a_large_node_splits_along_the_longest_axis_of_its_sampled_centroids) {
-    size_t n = 2048;
+/* A node of 1024 triangles or more chooses its axis from every
+ * (n / 64)-th centroid of its range, a smaller one from every (n / 8)-th
+ * (bvh_build.c): here every `every`-th triangle of n lies along y over
+ * [0, 1], the others along x over [0, 4], so the sample's longest axis is
+ * y and the whole set's x.  The root splits along y: its first child holds
+ * the n / 2 lowest centroids in y, and both children span x.  With 2048
+ * triangles every fourth is along y (the sample: every 32nd); with 512
+ * every 64th (the sample: every 64th; a sample of 64, every 8th, would be
+ * mostly along x). */
+static void root_splits_along_y(size_t n, size_t every) {
     hd__tri_t *t = malloc(n * sizeof *t);
     for (size_t k = 0; k < n; k++) {
-        double x = k % 4 ? 4.0 * (double)k / (double)n : 0.5, y = k % 4 ? 0.5 : (double)k / (double)n;
+        double x = k % every ? 4.0 * (double)k / (double)n : 0.5, y = k % every ? 0.5 : (double)k / (double)n;
         double c[3][3] = {{x, y, 0}, {x + 1e-3, y, 0}, {x, y + 1e-3, 1e-3}};
         memcpy(t[k].v, c, sizeof c);
         t[k].index = k;
@@ -317,11 +319,65 @@ TEST(a_large_node_splits_along_the_longest_axis_of_its_sampled_centroids) {
     hd__bvh_t tree;
     CHECK_RC(hd__bvh_build_threads(&tree, t, n, 1), HD_OK);
     const hd__box_t *a = &tree.nodes[1].box, *b = &tree.nodes[tree.nodes[0].first_or_second].box;
-    CONTEXT("first child y [%g, %g] x [%g, %g]; second y [%g, %g]", a->lo[1], a->hi[1], a->lo[0], a->hi[0],
-            b->lo[1], b->hi[1]);
-    CHECK(a->hi[1] <= 0.5 + 1e-3 && b->hi[1] > 0.9); /* split along y: x spans the whole range in both */
+    CONTEXT("%zu triangles: first child y [%g, %g] x [%g, %g]; second y [%g, %g]", n, a->lo[1], a->hi[1], a->lo[0],
+            a->hi[0], b->lo[1], b->hi[1]);
+    CHECK(a->hi[1] <= 0.5 + 1e-3 && b->hi[1] > 0.8); /* split along y: x spans the whole range in both */
     CHECK(a->hi[0] - a->lo[0] > 3);
     hd__bvh_free(&tree);
+}
+
+TEST(a_large_node_splits_along_the_longest_axis_of_its_sampled_centroids) { root_splits_along_y(2048, 4); }
+
+TEST(a_small_node_splits_along_the_longest_axis_of_eight_sampled_centroids) { root_splits_along_y(512, 64); }
+
+/* Every inner node's first child holds the n / 2 lowest centroids along
+ * some axis: the selection's postcondition (bvh_build.c's select_rank,
+ * with its band steps on ranges of more than 1024 keys), on centroids
+ * along x in increasing, decreasing and organ-pipe order, with three
+ * values only (ties), and random; 3,000 to 100,000 triangles (the sample
+ * of the largest is itself narrowed by a band). */
+static int halves_separated(const hd__bvh_t *t, size_t me, size_t first, size_t n) {
+    const hd__bvh_node_t *node = &t->nodes[me];
+    if (node->count) return 1;
+    size_t half = n / 2;
+    int ok = 0;
+    for (int a = 0; a < 3 && !ok; a++) {
+        double hi = -INFINITY, lo = INFINITY;
+        for (size_t k = first; k < first + n; k++) {
+            const double(*v)[3] = t->tris[k].v;
+            double c = v[0][a] + v[1][a] + v[2][a];
+            if (k < first + half) hi = c > hi ? c : hi;
+            else lo = c < lo ? c : lo;
+        }
+        ok = hi <= lo;
+    }
+    return ok && halves_separated(t, me + 1, first, half) &&
+           halves_separated(t, node->first_or_second, first + half, n - half);
+}
+
+TEST(every_split_puts_the_lower_half_of_its_axis_first) {
+    size_t sizes[] = {3000, 20000, 100000 / SCALE};
+    for (int kind = 0; kind < 5; kind++)
+        for (int z = 0; z < 3; z++) {
+            size_t n = sizes[z];
+            gen_rng_t g;
+            gen_seed(&g, 13);
+            hd__tri_t *t = malloc(n * sizeof *t);
+            for (size_t k = 0; k < n; k++) {
+                double f = (double)k / (double)n;
+                double x = kind == 0 ? f : kind == 1 ? 1 - f : kind == 2 ? (f < 0.5 ? 2 * f : 2 - 2 * f)
+                         : kind == 3 ? (double)(k % 3) : gen_unit(&g);
+                double y = 0.01 * gen_unit(&g), z = 0.01 * gen_unit(&g);
+                double c[3][3] = {{x, y, z}, {x + 1e-4, y, z}, {x, y + 1e-4, z + 1e-4}};
+                memcpy(t[k].v, c, sizeof c);
+                t[k].index = k;
+            }
+            hd__bvh_t tree;
+            CHECK_RC(hd__bvh_build_threads(&tree, t, n, 1), HD_OK);
+            CONTEXT("seed 13, order %d, %zu triangles", kind, n);
+            CHECK(halves_separated(&tree, 0, 0, n));
+            hd__bvh_free(&tree);
+        }
 }
 
 /* Near points searched from a seed close by (hd__bvh_nearest's climb from
