@@ -1499,6 +1499,15 @@ static void finish_face(hd__m2m_result_t *R, const hd__m2m_job_t *J, const face_
     R->capped |= F->capped;
 }
 
+/* A face whose bound can still exceed the lower bound L by more than the
+ * tolerance (and the predicate's d).  L only grows and a face's bound
+ * changes only when it is visited, so a face not pending when phase 2
+ * starts is never pending: it is left out of the ranks, which changes no
+ * batch (a face not pending takes no place in one). */
+static int pending(const hd__m2m_job_t *J, const face_t *F, double L) {
+    return F->upper - L > J->tol && F->upper > J->done_below;
+}
+
 /* One pass over the faces rk[0, n) (by decreasing bound) in batches of
  * growing size, each face visited for at most B->budget splits. */
 static int pass(const hd__m2m_job_t *J, ctx_t *C, const rank_t *rk, size_t n, batch_t *B, size_t *size,
@@ -1510,7 +1519,7 @@ static int pass(const hd__m2m_job_t *J, ctx_t *C, const rank_t *rk, size_t n, ba
         /* faces whose bound cannot exceed L (or the predicate's d) are finished */
         for (; next < n && m < *size; next++) {
             face_t *F = &C->faces[rk[next].f];
-            if (J->per_face || (F->upper - R->lower > J->tol && F->upper > J->done_below)) {
+            if (J->per_face || pending(J, F, R->lower)) {
                 order[m++] = rk[next].f;
             } else { /* finished at its bound so far */
                 free(F->saved);
@@ -1684,12 +1693,13 @@ int hd__m2m_run(const hd__m2m_job_t *J, hd__m2m_result_t *R) {
     /* the predicate (a finite d, faces not asked for one by one) */
     int decide = isfinite(J->done_below) && !J->per_face, stopped = 0;
     int rc = decide ? decide_pass(J, &C, R, &stopped) : first_pass(J, &C, R);
-    size_t live = 0;
-    for (size_t f = 0; rc == HD_OK && f < n; f++)
-        if (!C.faces[f].done) rk[live++] = (rank_t){C.faces[f].top.U, f};
     /* no face with a corner measured (every face shared, or screened):
      * 0 is a lower bound without a witness */
     if (R->face == SIZE_MAX) R->lower = 0;
+    size_t live = 0;
+    for (size_t f = 0; rc == HD_OK && f < n; f++)
+        if (!C.faces[f].done && (J->per_face || pending(J, &C.faces[f], R->lower)))
+            rk[live++] = (rank_t){C.faces[f].top.U, f};
     sort_ranks(rk, live);
     if (rc == HD_OK && !stopped) rc = run_batches(J, &C, rk, live, R);
     for (size_t f = 0; f < n; f++) finish_face(R, J, &C.faces[f], f);
