@@ -286,18 +286,30 @@ static void offer(best_t *b, const corner_t *c, int level, double e) {
     }
 }
 
+/* R for a sub-triangle whose squared edges may have underflowed: the
+ * perimeter in the 1-norm, each step rounded up (taken only then: the
+ * squares decide when). */
+static double tiny_reach(const sub_t *s) {
+    double l1 = 0;
+    for (int i = 0; i < 3; i++) {
+        const double *p = s->c[i].p, *q = s->c[(i + 1) % 3].p;
+        double dx = p[0] - q[0], dy = p[1] - q[1], dz = p[2] - q[2];
+        l1 = up(l1 + up(up(fabs(dx) + fabs(dy)) + fabs(dz)));
+    }
+    return up(l1 * (1 + 0x1p-40));
+}
+
 /* R: the farthest a point of the hull of the corners can be from its
  * nearest corner, rounded up (see the top). */
 static double reach(const sub_t *s) {
-    double l2[3], l1 = 0;
+    double l2[3];
     for (int i = 0; i < 3; i++) {
         const double *p = s->c[i].p, *q = s->c[(i + 1) % 3].p;
         double dx = p[0] - q[0], dy = p[1] - q[1], dz = p[2] - q[2];
         l2[i] = dx * dx + dy * dy + dz * dz;
-        l1 = up(l1 + up(up(fabs(dx) + fabs(dy)) + fabs(dz)));
     }
     double a2 = dmax(l2[0], dmax(l2[1], l2[2]));
-    if (a2 < TINY2) return up(l1 * (1 + 0x1p-40));
+    if (a2 < TINY2) return tiny_reach(s);
     double rest = l2[0] + l2[1] + l2[2] - a2;
     /* a2 > rest by a margin far above the rounding of the squares: obtuse */
     double f = a2 > rest * (1 + 0x1p-40) ? 0.5 : 0.57735026918962584;
