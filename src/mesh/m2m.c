@@ -1687,7 +1687,8 @@ int hd__m2m_run(const hd__m2m_job_t *J, hd__m2m_result_t *R) {
     memset(R, 0, sizeof *R);
     R->face = R->face_b = SIZE_MAX;
     size_t n = J->n_from;
-    ctx_t C = {J, hd__malloc_array(n ? n : 1, sizeof(face_t)), NULL, NULL, 0, NULL, 0, 0, 0, SAMPLE_STRIDE, 0, NULL};
+    /* every face's state zero (calloc: no pass writing the zeros) */
+    ctx_t C = {J, calloc(n ? n : 1, sizeof(face_t)), NULL, NULL, 0, NULL, 0, 0, 0, SAMPLE_STRIDE, 0, NULL};
     rank_t *rk = hd__malloc_array(n ? n : 1, sizeof *rk);
     C.n_corners = 3 * n;
     C.caches = caches_new(J->threads, J->to->n_tris);
@@ -1697,9 +1698,8 @@ int hd__m2m_run(const hd__m2m_job_t *J, hd__m2m_result_t *R) {
         caches_free(C.caches, J->threads);
         return HD_ENOMEM;
     }
-    for (size_t f = 0; f < n; f++) {
-        memset(&C.faces[f], 0, sizeof C.faces[f]);
-        C.faces[f].done = J->drop && J->drop[f];
+    for (size_t f = 0; J->drop && f < n; f++) {
+        C.faces[f].done = J->drop[f] != 0;
         R->dropped += C.faces[f].done;
     }
     /* the predicate (a finite d, faces not asked for one by one) */
