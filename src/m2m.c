@@ -199,8 +199,9 @@ static int directed(side_t *x, side_t *y, const ask_t *q, hd_enclosure_t *out, h
     }
     if (!y->built && (rc = side_tree(y, y->points ? "points" : "mesh", err))) return rc;
     if ((rc = side_vertices(x, err))) return rc;
-    hd__m2m_job_t J = {.from = x->tris, .n_from = x->n, .to = &y->bvh, .drop = drop, .vertex = x->vert,
-                       .n_vertices = x->n_vert, .tol = q->tol,
+    /* no face dropped: no table to read (mesh/m2m.c skips its checks) */
+    hd__m2m_job_t J = {.from = x->tris, .n_from = x->n, .to = &y->bvh, .drop = dropped ? drop : NULL,
+                       .vertex = x->vert, .n_vertices = x->n_vert, .tol = q->tol,
                        .done_below = q->done_below, .stop_above = q->stop_above, .per_face = q->per_face,
                        .max_splits = q->max_splits, .face_lower = q->face_lower, .face_upper = q->face_upper};
     J.threads = hd__thread_count(q->threads, x->n);

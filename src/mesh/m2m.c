@@ -926,6 +926,11 @@ static double phase0_bar(const ctx_t *C) {
     const hd__m2m_job_t *J = C->job;
     if (J->per_face || J->face_lower) return -INFINITY;
     double bar = C->stage == 2 ? C->L0 : -INFINITY;
+    if (C->stage != 1 && C->n_corners == 3 * J->n_from) { /* every corner: in id order, no indirection */
+        for (size_t id = 0; id < C->n_corners; id++)
+            if (!C->faces[id / 3].done) bar = dmax(bar, C->found[id].lo);
+        return bar;
+    }
     for (size_t k = 0; k < C->n_corners; k += C->stage == 1 ? C->stride : 1) {
         size_t id = C->order ? (size_t)(C->order[k] & 0xffffffffu) : k;
         if (!C->faces[id / 3].done && (C->stage != 1 || is_sample(C, k))) bar = dmax(bar, C->found[id].lo);
