@@ -4,7 +4,7 @@
  * of a face of Y (d = 0 on it), and the same for Y against X, from one
  * hash table of Y's faces.
  *
- * A face's hash is a function of its corners as a multiset (the sum of
+ * A face's hash is a function of its corners as a multiset (the sums of
  * its corners' hashes), so no face is put in order before it is hashed;
  * the table keeps each slot's hash beside its face, and only faces with
  * equal hashes are compared, in full (their corners sorted in one fixed
@@ -16,21 +16,15 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Corner p's bits mixed (any function would do: equal corners have equal
- * hashes). */
-static uint64_t corner_hash(const double p[3]) {
-    uint64_t w[3], h = 0x9e3779b97f4a7c15u;
-    memcpy(w, p, sizeof w);
-    for (int i = 0; i < 3; i++) {
-        h = (h ^ w[i]) * 0xff51afd7ed558ccdu;
-        h ^= h >> 32;
-    }
-    return h;
-}
-
+/* A function of the corners' bits as a multiset: each coordinate's three
+ * words summed (the sums do not depend on the corners' order), the sums
+ * weighted by odd constants and mixed. */
 static uint64_t face_hash(const hd__tri_t *t) {
-    uint64_t h = corner_hash(t->v[0]) + corner_hash(t->v[1]) + corner_hash(t->v[2]);
-    h = (h ^ (h >> 29)) * 0xc4ceb9fe1a85ec53u;
+    uint64_t w[3][3], s[3];
+    memcpy(w, t->v, sizeof w);
+    for (int d = 0; d < 3; d++) s[d] = w[0][d] + w[1][d] + w[2][d];
+    uint64_t h = s[0] * 0x9e3779b97f4a7c15u + s[1] * 0xff51afd7ed558ccdu + s[2] * 0xc4ceb9fe1a85ec53u;
+    h = (h ^ (h >> 29)) * 0xbf58476d1ce4e5b9u;
     return h ^ (h >> 32);
 }
 
