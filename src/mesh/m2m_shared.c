@@ -4,8 +4,9 @@
  * of a face of Y (d = 0 on it), and the same for Y against X, from one
  * hash table of Y's faces.
  *
- * A face's hash is a function of its corners as a multiset (the sums of
- * its corners' hashes), so no face is put in order before it is hashed;
+ * A face's hash is a function of its corners as a multiset (its corners'
+ * words summed coordinate by coordinate), so no face is put in order before
+ * it is hashed;
  * the table keeps each slot's hash beside its face, and only faces with
  * equal hashes are compared, in full (their corners sorted in one fixed
  * order and compared bit for bit): the hash decides the cost, never the
