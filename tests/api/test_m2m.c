@@ -228,6 +228,25 @@ TEST(triangle_to_its_corners_is_the_circumradius) {
     gen_soup_free(&A);
 }
 
+/* The same scaled by 2^-500: the squared edges lie where a square may
+ * have underflowed, so the bound from the corners takes the reach of the
+ * face from its edges' 1-norms (mesh/m2m.c, reach). */
+TEST(tiny_triangle_to_its_corners_is_the_circumradius) {
+    const double s = 0x1p-500, v[] = {0, 0, 0, 4 * s, 0, 0, 0, 4 * s, 0};
+    const uint64_t t[] = {0, 1, 2};
+    gen_soup_t A = soup_of(v, 3, t, 1);
+    hd_mesh_t a = gen_soup_view(&A);
+    hd_points_t B = hd_points_f64(v, 3);
+    hd_enclosure_t ab;
+    hd_surface_options_t o = options(1e-12, 1, 1);
+    CHECK_RC(hd_surface_points_hausdorff(&a, &B, &o, &ab, NULL, NULL), HD_OK);
+    double r = sqrt(8.0) * s;
+    CONTEXT("enclosure [%.17g, %.17g], r %.17g", ab.lower, ab.upper, r);
+    CHECK(ab.lower <= r && r <= ab.upper);
+    CHECK(ab.upper - ab.lower <= ab.tolerance);
+    gen_soup_free(&A);
+}
+
 /* The two triangulations of a non-planar quad share every vertex, so a
  * vertex-only distance is 0; the surfaces are apart along the diagonals. */
 TEST(quad_split_two_ways_is_not_zero) {
