@@ -797,7 +797,13 @@ typedef struct ctx {
     size_t stride;
     double L0;
     double *target;        /* stage 2: each face's corner_target (or NULL) */
+    int some_done;         /* 0: no face is done before phase 2 (no shared
+                            * face, no screen), so phases 0 and 1 read no
+                            * face's flag */
 } ctx_t;
+
+/* Face f is done (shared, or screened) in phases 0 and 1. */
+static int done_early(const ctx_t *C, size_t f) { return C->some_done && C->faces[f].done; }
 
 #define CORNER(J, id) ((J)->from[(id) / 3].v[(id) % 3])
 
@@ -848,7 +854,7 @@ static void corner_targets(ctx_t *C) {
     if (!C->target) return;
     double *t = C->target;
     C->target = NULL;
-    for (size_t f = 0; f < J->n_from; f++) t[f] = C->faces[f].done ? 0 : corner_target(C, 3 * f);
+    for (size_t f = 0; f < J->n_from; f++) t[f] = done_early(C, f) ? 0 : corner_target(C, 3 * f);
     C->target = t;
 }
 
@@ -886,7 +892,7 @@ static void phase0(void *vctx, size_t task, int worker) {
     for (size_t k = C->stage == 1 ? (lo + step - 1) / step * step : lo; k < hi; k += step) {
         size_t id = C->order ? (size_t)(C->order[k] & 0xffffffffu) : k;
         found_t *F = &C->found[id];
-        if (C->faces[id / 3].done) continue;
+        if (done_early(C, id / 3)) continue;
         int sampled = C->stage && is_sample(C, k);
         if (C->stage == 1 && !sampled) continue;
         if (C->stage == 2 && sampled) { /* done at stage 1 */
@@ -928,12 +934,12 @@ static double phase0_bar(const ctx_t *C) {
     double bar = C->stage == 2 ? C->L0 : -INFINITY;
     if (C->stage != 1 && C->n_corners == 3 * J->n_from) { /* every corner: in id order, no indirection */
         for (size_t id = 0; id < C->n_corners; id++)
-            if (!C->faces[id / 3].done) bar = dmax(bar, C->found[id].lo);
+            if (!done_early(C, id / 3)) bar = dmax(bar, C->found[id].lo);
         return bar;
     }
     for (size_t k = 0; k < C->n_corners; k += C->stage == 1 ? C->stride : 1) {
         size_t id = C->order ? (size_t)(C->order[k] & 0xffffffffu) : k;
-        if (!C->faces[id / 3].done && (C->stage != 1 || is_sample(C, k))) bar = dmax(bar, C->found[id].lo);
+        if (!done_early(C, id / 3) && (C->stage != 1 || is_sample(C, k))) bar = dmax(bar, C->found[id].lo);
     }
     return bar;
 }
@@ -951,7 +957,7 @@ static void phase0_exact(void *vctx, size_t task, int worker) {
     for (size_t k = C->stage == 1 ? (lo + step - 1) / step * step : lo; k < hi; k += step) {
         size_t id = C->order ? (size_t)(C->order[k] & 0xffffffffu) : k;
         found_t *F = &C->found[id];
-        if (C->faces[id / 3].done || (C->stage == 1 && !is_sample(C, k)) || F->hi < C->bar) continue;
+        if (done_early(C, id / 3) || (C->stage == 1 && !is_sample(C, k)) || F->hi < C->bar) continue;
         if (C->stage == 2 && F->exact) continue; /* the sample's, at stage 1 */
         hd__tri_near_t near;
         F->pos = hd__bvh_nearest(J->to, CORNER(J, id), F->pos, 0, &near, &F->index, &st);
@@ -994,7 +1000,7 @@ static void phase1(void *vctx, size_t task, int worker) {
     size_t lo = (C->task0 + task) * CHUNK, hi = lo + CHUNK < J->n_from ? lo + CHUNK : J->n_from;
     double enough = J->face_upper ? -INFINITY : enough_for(J, C->bar);
     for (size_t f = lo; f < hi; f++)
-        if (!C->faces[f].done) face_top(J, &C->faces[f], f, &C->found[3 * f], enough, &C->caches[worker]);
+        if (!done_early(C, f)) face_top(J, &C->faces[f], f, &C->found[3 * f], enough, &C->caches[worker]);
 }
 
 /* ---- the predicate's pass: screen, then exact corners, in rounds --------- */
@@ -1601,7 +1607,7 @@ static double sample_best(const ctx_t *C) {
     double best = -INFINITY;
     for (size_t k = 0; k < C->n_corners; k += C->stride) {
         size_t id = C->order ? (size_t)(C->order[k] & 0xffffffffu) : k;
-        if (!C->faces[id / 3].done && is_sample(C, k) && C->found[id].exact) best = dmax(best, C->found[id].r);
+        if (!done_early(C, id / 3) && is_sample(C, k) && C->found[id].exact) best = dmax(best, C->found[id].r);
     }
     return best;
 }
@@ -1693,7 +1699,7 @@ int hd__m2m_run(const hd__m2m_job_t *J, hd__m2m_result_t *R) {
     R->face = R->face_b = SIZE_MAX;
     size_t n = J->n_from;
     /* every face's state zero (calloc: no pass writing the zeros) */
-    ctx_t C = {J, calloc(n ? n : 1, sizeof(face_t)), NULL, NULL, 0, NULL, 0, 0, 0, SAMPLE_STRIDE, 0, NULL};
+    ctx_t C = {J, calloc(n ? n : 1, sizeof(face_t)), NULL, NULL, 0, NULL, 0, 0, 0, SAMPLE_STRIDE, 0, NULL, 0};
     rank_t *rk = hd__malloc_array(n ? n : 1, sizeof *rk);
     C.n_corners = 3 * n;
     C.caches = caches_new(J->threads, J->to->n_tris);
@@ -1709,6 +1715,7 @@ int hd__m2m_run(const hd__m2m_job_t *J, hd__m2m_result_t *R) {
     }
     /* the predicate (a finite d, faces not asked for one by one) */
     int decide = isfinite(J->done_below) && !J->per_face, stopped = 0;
+    C.some_done = R->dropped > 0 || decide;
     int rc = decide ? decide_pass(J, &C, R, &stopped) : first_pass(J, &C, R);
     /* no face with a corner measured (every face shared, or screened):
      * 0 is a lower bound without a witness */
