@@ -1699,7 +1699,7 @@ int hd__m2m_run(const hd__m2m_job_t *J, hd__m2m_result_t *R) {
     R->face = R->face_b = SIZE_MAX;
     size_t n = J->n_from;
     /* every face's state zero (calloc: no pass writing the zeros) */
-    ctx_t C = {J, calloc(n ? n : 1, sizeof(face_t)), NULL, NULL, 0, NULL, 0, 0, 0, SAMPLE_STRIDE, 0, NULL, 0};
+    ctx_t C = {J, hd__calloc_array(n ? n : 1, sizeof(face_t)), NULL, NULL, 0, NULL, 0, 0, 0, SAMPLE_STRIDE, 0, NULL, 0};
     rank_t *rk = hd__malloc_array(n ? n : 1, sizeof *rk);
     C.n_corners = 3 * n;
     C.caches = caches_new(J->threads, J->to->n_tris);

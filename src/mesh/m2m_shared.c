@@ -72,7 +72,7 @@ int hd__m2m_shared(const hd__tri_t *x, size_t nx, const hd__tri_t *y, size_t ny,
      * at[k]: the slot of face k's key (equal keys share the first one's) */
     size_t *slot = hd__malloc_array(size, sizeof *slot), *at = hd__malloc_array(ny ? ny : 1, sizeof *at);
     uint64_t *hash = hd__malloc_array(size, sizeof *hash);
-    unsigned char *hit = calloc(size, 1);
+    unsigned char *hit = hd__calloc_array(size, 1);
     if (!slot || !at || !hash || !hit) {
         free(slot), free(at), free(hash), free(hit);
         return HD_ENOMEM;

@@ -481,90 +481,6 @@ static int round_sqrt(dd_t N, dd_t M, double *q) {
     return 0;
 }
 
-/* ---- the face first ------------------------------------------------------ */
-
-HD__INLINE double max3(const double *x) {
-    double m = fabs(x[0]) > fabs(x[1]) ? fabs(x[0]) : fabs(x[1]);
-    return fabs(x[2]) > m ? fabs(x[2]) : m;
-}
-
-/* (x x y) . z in doubles for x and y within em + u |x| and u |y|, z within
- * u |z|, of exact vectors X, Y, Z (componentwise; xm = max |x_i|), and a
- * bound *e on its distance from (X x Y) . Z.  Each of the six monomials
- * of the computed value passes through five roundings (a product and a
- * difference in the cross product, a product and two sums in the dot
- * product), so it is within gamma_5 P of (x x y) . z, P the permanent
- * sum_i |z_i| (|x_j y_k| + |x_k y_j|).  The trilinear form changes by at
- * most perm(|X - x|, |Y|, |Z|) + perm(|x|, |Y - y|, |Z|) + perm(|x|, |y|,
- * |Z - z|) <= (1 + u)^2 (3u P + Q) from the inputs' errors, Q =
- * sum_i |z_i| em (|y_k| + |y_j|).  So 8.01u P + 1.01 Q bounds the error;
- * P <= 2 xm ym z1 and Q <= 2 em ym z1 (ym = max |y_i|, z1 = sum |z_i|),
- * and (32u xm + 4 em) ym z1, computed (a few roundings), with the factor
- * SLACK is above twice that; underflow loses at most 2^-1060, as a
- * product's or a difference's rounding is multiplied by at most |z_i| < 4
- * (coordinates below 2): TINY covers it. */
-HD__INLINE double edge_term(const double *x, double xm, double em, const double *y, const double *z, double *e) {
-    double v = 0;
-    for (int i = 0; i < 3; i++) {
-        int j = (i + 1) % 3, k = (i + 2) % 3;
-        v += (x[j] * y[k] - x[k] * y[j]) * z[i];
-    }
-    *e = (32 * U * xm + 4 * em) * max3(y) * (fabs(z[0]) + fabs(z[1]) + fabs(z[2])) * SLACK + TINY;
-    return v;
-}
-
-/* The face decided first, on the scaled coordinates (sc, s as decide's).
- * With n = AB x AC, L_C = n . (AB x AP) = (n x AB) . AP,
- * L_B = n . (AP x AC) = -(n x AC) . AP and L_A = n . (BC x BP) =
- * (n x BC) . BP (they sum to |n|^2 and are |n|^2 times the weights of C,
- * B and A of p's projection p' on the plane, bounds.c), p' lies strictly
- * inside the triangle when the three are positive: then the triangle is
- * not degenerate (they sum to |n|^2 > 0), Ericson's tests evaluated
- * exactly name the face (a corner's region needs the dot products of its
- * two edges with p' non-positive, impossible inside by Cauchy-Schwarz; an
- * edge's needs its weight non-positive) and the squared distance is
- * (n . AP)^2 / |n|^2, face_sqd's N / M.  The signs are decided in plain
- * doubles: the differences are rounded once (within u of the exact ones),
- * n computed from them is within (gamma_3 + 2.01u) (|AB_j AC_k| +
- * |AB_k AC_j|) <= 5.1u 2 max|AB_i| max|AC_i| of AB x AC (three
- * roundings, two rounded factors), which em (16u of that product,
- * computed, plus TINY) covers; edge_term bounds each L.
- * Each L certainly positive: N / M from face_sqd's double-doubles,
- * rounded by step 4.  The weights are the L over their sum; the closest
- * point is face_sqd's.  1 and *out when decided; 0 leaves the call to
- * Ericson's classification (a point near or beyond an edge, a distance
- * near a midpoint). */
-HD__INLINE int face_first(const double *const sc[4], int s, hd__tri_near_t *out, int fma) {
-    const double *p = sc[0], *a = sc[1], *b = sc[2], *c = sc[3];
-    double ab[3], ac[3], ap[3], bc[3], bp[3], nr[3], L[3], e[3];
-    for (int i = 0; i < 3; i++) ab[i] = b[i] - a[i], ac[i] = c[i] - a[i], ap[i] = p[i] - a[i];
-    for (int i = 0; i < 3; i++) {
-        int j = (i + 1) % 3, k = (i + 2) % 3;
-        nr[i] = ab[j] * ac[k] - ab[k] * ac[j];
-    }
-    double nm = max3(nr), em = 16 * U * max3(ab) * max3(ac) + TINY;
-    L[2] = edge_term(nr, nm, em, ab, ap, &e[2]);
-    if (!(L[2] > e[2])) return 0;
-    L[1] = -edge_term(nr, nm, em, ac, ap, &e[1]);
-    if (!(L[1] > e[1])) return 0;
-    for (int i = 0; i < 3; i++) bc[i] = c[i] - b[i], bp[i] = p[i] - b[i];
-    L[0] = edge_term(nr, nm, em, bc, bp, &e[0]);
-    if (!(L[0] > e[0])) return 0;
-    sqd_t f;
-    double q, sum = L[0] + L[1] + L[2], scale = pow2(-s);
-    face_sqd(p, a, b, c, &f, fma);
-    if (!round_newton(f.N, f.M, &q, fma) && !round_sqrt(f.N, f.M, &q)) return 0;
-    if (!(q * scale >= 0x1p-1022)) return 0;
-    out->d = q * scale;              /* exact: a normal result */
-    out->feature = HD__TRI_FACE;
-    out->exact = 0;
-    for (int i = 0; i < 3; i++) {
-        out->point[i] = f.point[i] * scale;
-        out->bary[i] = L[i] / sum;
-    }
-    return 1;
-}
-
 /* ---- the call ------------------------------------------------------------ */
 
 /* The weights of a, b and c; an edge's from its t in double-doubles, the
@@ -621,21 +537,105 @@ int hd__tri_scale(const double *const in[4], double out[4][3], const double **us
 }
 
 /* Steps 3 and 4 on the scaled coordinates with the feature known: 1 and
- * *out (but for the unscaling) when decided. */
-HD__INLINE int decide(const double *const sc[4], const region_t *r, int s, hd__tri_near_t *out,
-                      int fma) {
+ * *out but its weights when decided (unscaled), *t an edge's parameter. */
+HD__INLINE int settle(const double *const sc[4], hd__tri_feature_t feature, int s, hd__tri_near_t *out,
+                      int fma, double *t) {
     sqd_t f = {.t = 0};
     double q;
-    feature_sqd(sc[0], sc[1], sc[2], sc[3], r->feature, &f, fma);
+    feature_sqd(sc[0], sc[1], sc[2], sc[3], feature, &f, fma);
     if (!round_newton(f.N, f.M, &q, fma) && !round_sqrt(f.N, f.M, &q)) return 0;
     if (!(q * pow2(-s) >= 0x1p-1022)) return 0;
     out->d = q * pow2(-s);           /* exact: a normal result */
-    out->feature = r->feature;
+    out->feature = feature;
     out->exact = 0;
     for (int i = 0; i < 3; i++) out->point[i] = f.point[i] * pow2(-s);
-    weigh(out, r, f.t);
+    *t = f.t;
     return 1;
 }
+
+/* settle() with the weights of Ericson's region. */
+HD__INLINE int decide(const double *const sc[4], const region_t *r, int s, hd__tri_near_t *out,
+                      int fma) {
+    double t;
+    if (!settle(sc, r->feature, s, out, fma, &t)) return 0;
+    weigh(out, r, t);
+    return 1;
+}
+
+/* ---- the face first ------------------------------------------------------ */
+
+HD__INLINE double max3(const double *x) {
+    double m = fabs(x[0]) > fabs(x[1]) ? fabs(x[0]) : fabs(x[1]);
+    return fabs(x[2]) > m ? fabs(x[2]) : m;
+}
+
+/* (x x y) . z in doubles for x and y within em + u |x| and u |y|, z within
+ * u |z|, of exact vectors X, Y, Z (componentwise; xm = max |x_i|), and a
+ * bound *e on its distance from (X x Y) . Z.  Each of the six monomials
+ * of the computed value passes through five roundings (a product and a
+ * difference in the cross product, a product and two sums in the dot
+ * product), so it is within gamma_5 P of (x x y) . z, P the permanent
+ * sum_i |z_i| (|x_j y_k| + |x_k y_j|).  The trilinear form changes by at
+ * most perm(|X - x|, |Y|, |Z|) + perm(|x|, |Y - y|, |Z|) + perm(|x|, |y|,
+ * |Z - z|) <= (1 + u)^2 (3u P + Q) from the inputs' errors, Q =
+ * sum_i |z_i| em (|y_k| + |y_j|).  So 8.01u P + 1.01 Q bounds the error;
+ * P <= 2 xm ym z1 and Q <= 2 em ym z1 (ym = max |y_i|, z1 = sum |z_i|),
+ * and (32u xm + 4 em) ym z1, computed (a few roundings), with the factor
+ * SLACK is above twice that; underflow loses at most 2^-1060, as a
+ * product's or a difference's rounding is multiplied by at most |z_i| < 4
+ * (coordinates below 2): TINY covers it. */
+HD__INLINE double edge_term(const double *x, double xm, double em, const double *y, const double *z, double *e) {
+    double v = 0;
+    for (int i = 0; i < 3; i++) {
+        int j = (i + 1) % 3, k = (i + 2) % 3;
+        v += (x[j] * y[k] - x[k] * y[j]) * z[i];
+    }
+    *e = (32 * U * xm + 4 * em) * max3(y) * (fabs(z[0]) + fabs(z[1]) + fabs(z[2])) * SLACK + TINY;
+    return v;
+}
+
+/* The face decided first, on the scaled coordinates (sc, s as decide's).
+ * With n = AB x AC, L_C = n . (AB x AP) = (n x AB) . AP,
+ * L_B = n . (AP x AC) = -(n x AC) . AP and L_A = n . (BC x BP) =
+ * (n x BC) . BP (they sum to |n|^2 and are |n|^2 times the weights of C,
+ * B and A of p's projection p' on the plane, bounds.c), p' lies strictly
+ * inside the triangle when the three are positive: then the triangle is
+ * not degenerate (they sum to |n|^2 > 0), Ericson's tests evaluated
+ * exactly name the face (a corner's region needs the dot products of its
+ * two edges with p' non-positive, impossible inside by Cauchy-Schwarz; an
+ * edge's needs its weight non-positive) and the squared distance is
+ * (n . AP)^2 / |n|^2, face_sqd's N / M.  The signs are decided in plain
+ * doubles: the differences are rounded once (within u of the exact ones),
+ * n computed from them is within (gamma_3 + 2.01u) (|AB_j AC_k| +
+ * |AB_k AC_j|) <= 5.1u 2 max|AB_i| max|AC_i| of AB x AC (three
+ * roundings, two rounded factors), which em (16u of that product,
+ * computed, plus TINY) covers; edge_term bounds each L.
+ * Each L certainly positive: settle() on the face (face_sqd's N / M,
+ * rounded by step 4); the weights are the L over their sum.  1 and *out when decided; 0 leaves the call to
+ * Ericson's classification (a point near or beyond an edge, a distance
+ * near a midpoint). */
+HD__INLINE int face_first(const double *const sc[4], int s, hd__tri_near_t *out, int fma) {
+    const double *p = sc[0], *a = sc[1], *b = sc[2], *c = sc[3];
+    double ab[3], ac[3], ap[3], bc[3], bp[3], nr[3], L[3], e[3];
+    for (int i = 0; i < 3; i++) ab[i] = b[i] - a[i], ac[i] = c[i] - a[i], ap[i] = p[i] - a[i];
+    for (int i = 0; i < 3; i++) {
+        int j = (i + 1) % 3, k = (i + 2) % 3;
+        nr[i] = ab[j] * ac[k] - ab[k] * ac[j];
+    }
+    double nm = max3(nr), em = 16 * U * max3(ab) * max3(ac) + TINY;
+    L[2] = edge_term(nr, nm, em, ab, ap, &e[2]);
+    if (!(L[2] > e[2])) return 0;
+    L[1] = -edge_term(nr, nm, em, ac, ap, &e[1]);
+    if (!(L[1] > e[1])) return 0;
+    for (int i = 0; i < 3; i++) bc[i] = c[i] - b[i], bp[i] = p[i] - b[i];
+    L[0] = edge_term(nr, nm, em, bc, bp, &e[0]);
+    if (!(L[0] > e[0])) return 0;
+    double t, sum = L[0] + L[1] + L[2];
+    if (!settle(sc, HD__TRI_FACE, s, out, fma, &t)) return 0;
+    for (int i = 0; i < 3; i++) out->bary[i] = L[i] / sum;
+    return 1;
+}
+
 
 /* The fast path on the scaled coordinates: the face first, else Ericson's
  * classification and steps 3 and 4; 0 when not decided (exact.c). */
